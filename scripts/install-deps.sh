@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs the Debian packages thzmap needs to build, test and run, if any is missing.
+# Run as root on Debian 12 (bookworm). Idempotent: does nothing when all are present.
+set -euo pipefail
+packages=(
+  build-essential cmake ninja-build pkg-config clang libomp-dev
+  libembree-dev libjansson-dev libassimp-dev librandom123-dev libpng-dev libzstd-dev
+  libplplot-dev plplot-driver-cairo libcmocka-dev
+  python3 python3-numpy python3-spectral gdal-bin python3-gdal
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+if [ "$(id -u)" -ne 0 ]; then
+  echo "install-deps: missing packages: ${missing[*]}" >&2
+  echo "install-deps: run as root, or install them with apt-get" >&2
+  exit 1
+fi
+echo "install-deps: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

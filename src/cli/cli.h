@@ -1,0 +1,35 @@
+/* The command-line interface: the only code that prints to the user or exits.
+ * Each subcommand lives in its own file cmd_<name>.c and is listed in main.c. */
+#ifndef THZ_CLI_CLI_H
+#define THZ_CLI_CLI_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "thzmap/thzmap.h"
+
+/* Exit statuses (scene-format.md): 0 success, 2 bad usage or input, 1 anything else. */
+enum { CLI_EXIT_OK = 0, CLI_EXIT_FAILURE = 1, CLI_EXIT_USAGE = 2 };
+
+int cmd_validate(int argc, char **argv);
+int cmd_simulate(int argc, char **argv);
+int cmd_render(int argc, char **argv);
+int cmd_atmosphere(int argc, char **argv);
+
+/* Prints "thzmap: <message>" to stderr and returns the exit status for err. */
+int cli_fail(const thz_error *err);
+
+/* Prints "thzmap <command>: <printf message>" and a hint to use --help; returns 2. */
+int cli_usage_error(const char *command, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* True if arg is -h or --help. */
+bool cli_is_help(const char *arg);
+
+/* Parse whole numbers and reals from option values; false (after printing a usage
+ * error naming `option`) when the text is not one, or is out of [min, max]. */
+bool cli_parse_u64(const char *command, const char *option, const char *text, uint64_t min,
+                   uint64_t max, uint64_t *out);
+bool cli_parse_double(const char *command, const char *option, const char *text, double min,
+                      double max, double *out);
+
+#endif

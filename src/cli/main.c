@@ -1,0 +1,106 @@
+/* thzmap: the program. Dispatches to the subcommands from a table (as git does). */
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli/cli.h"
+
+typedef struct command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} command;
+
+static const command commands[] = {
+    {"validate", cmd_validate, "check a scene; print its geometry and emitted power per channel"},
+    {"simulate", cmd_simulate, "fire photons and render every sensor of a scene"},
+    {"render", cmd_render, "re-render sensors of a scene from a saved photon map"},
+    {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency"},
+};
+
+static void print_usage(FILE *f)
+{
+    fprintf(f, "usage: thzmap <command> [options]\n"
+               "       thzmap --help | --version\n\n"
+               "Simulates what a passive multispectral terahertz camera sees (photon mapping).\n\n"
+               "commands:\n");
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        fprintf(f, "  %-11s %s\n", commands[i].name, commands[i].summary);
+    fprintf(f, "\n'thzmap <command> --help' describes a command's options.\n");
+}
+
+int cli_fail(const thz_error *err)
+{
+    fprintf(stderr, "thzmap: %s\n", err->message[0] ? err->message : thz_status_name(err->status));
+    return err->status == THZ_ERR_INPUT ? CLI_EXIT_USAGE : CLI_EXIT_FAILURE;
+}
+
+int cli_usage_error(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "thzmap %s: ", cmd);
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n(see 'thzmap %s --help')\n", cmd);
+    va_end(ap);
+    return CLI_EXIT_USAGE;
+}
+
+bool cli_is_help(const char *arg)
+{
+    return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
+}
+
+bool cli_parse_u64(const char *cmd, const char *option, const char *text, uint64_t min,
+                   uint64_t max, uint64_t *out)
+{
+    char *end = NULL;
+    errno = 0;
+    unsigned long long v = strtoull(text, &end, 10);
+    if (!text[0] || *end || errno || text[0] == '-' || v < min || v > max) {
+        cli_usage_error(cmd, "%s expects a whole number from %llu to %llu, got '%s'", option,
+                        (unsigned long long)min, (unsigned long long)max, text);
+        return false;
+    }
+    *out = (uint64_t)v;
+    return true;
+}
+
+bool cli_parse_double(const char *cmd, const char *option, const char *text, double min,
+                      double max, double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (!text[0] || *end || errno || !isfinite(v) || v < min || v > max) {
+        cli_usage_error(cmd, "%s expects a number from %g to %g, got '%s'", option, min, max, text);
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        print_usage(stderr);
+        return CLI_EXIT_USAGE;
+    }
+    if (cli_is_help(argv[1])) {
+        print_usage(stdout);
+        return CLI_EXIT_OK;
+    }
+    if (strcmp(argv[1], "--version") == 0) {
+        printf("thzmap %s\n", thz_version());
+        return CLI_EXIT_OK;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (strcmp(argv[1], commands[i].name) == 0)
+            return commands[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "thzmap: unknown command '%s'\n\n", argv[1]);
+    print_usage(stderr);
+    return CLI_EXIT_USAGE;
+}

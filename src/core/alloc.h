@@ -1,0 +1,43 @@
+/* Overflow-checked allocation. Every array allocation goes through these so that a
+ * size computed from user input cannot wrap around. */
+#ifndef THZ_CORE_ALLOC_H
+#define THZ_CORE_ALLOC_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+/* calloc-like: n elements of size bytes, zeroed; NULL on overflow or exhaustion. */
+static inline void *thz_calloc(size_t n, size_t size)
+{
+    if (size && n > SIZE_MAX / size)
+        return NULL;
+    return calloc(n ? n : 1, size ? size : 1);
+}
+
+/* malloc of n*size bytes; NULL on overflow or exhaustion. */
+static inline void *thz_malloc_array(size_t n, size_t size)
+{
+    if (size && n > SIZE_MAX / size)
+        return NULL;
+    size_t bytes = n * size;
+    return malloc(bytes ? bytes : 1);
+}
+
+/* realloc of n*size bytes; NULL (and p untouched) on overflow or exhaustion. */
+static inline void *thz_realloc_array(void *p, size_t n, size_t size)
+{
+    if (size && n > SIZE_MAX / size)
+        return NULL;
+    size_t bytes = n * size;
+    return realloc(p, bytes ? bytes : 1);
+}
+
+/* strdup that returns NULL for NULL. */
+char *thz_strdup(const char *s);
+
+/* Bytes of physical memory of this machine (0 if unknown). Used to refuse runs whose
+ * images or photon maps would not fit, before they start. */
+uint64_t thz_physical_memory_bytes(void);
+
+#endif

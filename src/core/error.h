@@ -1,0 +1,22 @@
+/* Status and error messages: the one way every module reports failure.
+ *
+ * A fallible function returns a thz_status and, when err is not NULL, writes a
+ * one-line message into it. Input errors name the file and line:column or JSON path.
+ */
+#ifndef THZ_CORE_ERROR_H
+#define THZ_CORE_ERROR_H
+
+#include "thzmap/thzmap.h"
+
+/* Sets err (if not NULL) to status and a printf-formatted message; returns status so
+ * that callers can write `return thz_error_set(err, THZ_ERR_INPUT, "...")`. */
+thz_status thz_error_set(thz_error *err, thz_status status, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* Prefixes err's message with a printf-formatted context ("scene.json: "). */
+void thz_error_prefix(thz_error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Clears err to THZ_OK and an empty message. */
+void thz_error_clear(thz_error *err);
+
+#endif

@@ -1,0 +1,42 @@
+/* Counter-based random numbers (Random123 Philox4x32-10).
+ *
+ * A stream is keyed by (seed, channel) and started at a counter given by the index of
+ * the unit of work (photon, pixel sample, path), so every photon's or sample's numbers
+ * are the same whichever thread computes it and in whatever order: results are
+ * bit-identical for any thread count, and batches can be fired anywhere and merged.
+ * `purpose` separates independent uses of the same index (emission vs rendering).
+ */
+#ifndef THZ_CORE_RNG_H
+#define THZ_CORE_RNG_H
+
+#include <stdint.h>
+
+typedef struct rng_stream {
+    uint32_t key[2];
+    uint32_t ctr[4];
+    uint32_t buf[4];
+    unsigned used; /* words of buf consumed */
+} rng_stream;
+
+/* Purposes: keep them distinct so that two uses never share numbers. */
+enum {
+    RNG_PURPOSE_PHOTON = 1,
+    RNG_PURPOSE_RENDER = 2,
+    RNG_PURPOSE_PATH = 3,
+    RNG_PURPOSE_GATHER = 4,
+    RNG_PURPOSE_TEST = 15
+};
+
+/* Starts the stream for unit `index` of `channel` under `seed` and `purpose`. */
+void rng_init(rng_stream *rng, uint64_t seed, uint32_t channel, uint32_t purpose, uint64_t index);
+
+/* Next 32 random bits. */
+uint32_t rng_next_u32(rng_stream *rng);
+
+/* Uniform double in [0, 1) with 53 random bits. */
+double rng_uniform(rng_stream *rng);
+
+/* Uniform double in (0, 1]: safe for log(). */
+double rng_uniform_open0(rng_stream *rng);
+
+#endif

@@ -1,0 +1,65 @@
+/* The photon map of one channel: every hit of every photon, with incident power,
+ * position, direction, frequency, object and side (physics.md "Photon phase"), and a
+ * spatial index per (object, side) answering radius and k-nearest queries.
+ *
+ * The record is 32 bytes: see photon_record below for what each field holds and why.
+ */
+#ifndef THZ_PHOTON_PHOTON_MAP_H
+#define THZ_PHOTON_PHOTON_MAP_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/vec3.h"
+
+/* One stored photon hit (32 bytes). */
+typedef struct photon_record {
+    float position_m[3];   /* hit point */
+    float power_w_per_hz;  /* incident spectral power carried (already attenuated) */
+    float freq_hz;         /* the photon's own frequency (float: 60 kHz resolution at 1 THz) */
+    uint32_t dir_oct;      /* incoming unit direction, octahedral 2 x 16 bit */
+    uint32_t object_side;  /* object index << 1 | side (0 front, 1 back) */
+    uint32_t flags;        /* bounce count in the low 16 bits; reserved */
+} photon_record;
+
+_Static_assert(sizeof(photon_record) == 32, "photon_record must stay 32 bytes");
+
+/* Direction (unit) <-> 32-bit octahedral code, error < 1e-4 rad. */
+uint32_t photon_encode_direction(vec3 dir);
+vec3 photon_decode_direction(uint32_t code);
+
+static inline uint32_t photon_object(const photon_record *p)
+{
+    return p->object_side >> 1;
+}
+static inline int photon_side(const photon_record *p)
+{
+    return (int)(p->object_side & 1u);
+}
+
+typedef struct photon_map photon_map;
+
+/* Creates a map from photons (takes ownership of the array, which must come from
+ * malloc), sorted into (object, side) groups with a spatial index each, built in
+ * parallel with `threads` threads (0: all). Deterministic: the result does not depend on
+ * the thread count. */
+thz_status photon_map_create(photon_record *photons, size_t count, size_t n_objects, int threads,
+                             photon_map **out, thz_error *err);
+void photon_map_destroy(photon_map *map);
+
+size_t photon_map_count(const photon_map *map);
+const photon_record *photon_map_records(const photon_map *map);
+
+/* The photons of (object, side) within distance sqrt(radius2_m2) of position: calls
+ * visit(ctx, photon, distance2) for each. */
+typedef void (*photon_visit_fn)(void *ctx, const photon_record *p, double distance2_m2);
+void photon_map_radius(const photon_map *map, uint32_t object, int side, vec3 position_m,
+                       double radius2_m2, photon_visit_fn visit, void *ctx);
+
+/* The squared distance to the k-th nearest photon of `object` over the sides in
+ * side_mask (bit 0 front, bit 1 back), or INFINITY if it has fewer than k. */
+double photon_map_kth_distance2(const photon_map *map, uint32_t object, unsigned side_mask,
+                                vec3 position_m, size_t k);
+
+#endif

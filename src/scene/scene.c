@@ -1,0 +1,181 @@
+/* The scene model: construction with the spec's defaults, destruction, warnings, and
+ * the per-object optics and emitted power that every stage derives from it. */
+#include "scene/scene.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "physics/planck.h"
+
+thz_scene *scene_create(void)
+{
+    thz_scene *s = thz_calloc(1, sizeof *s);
+    if (!s)
+        return NULL;
+    s->atmosphere.model = ATM_NONE;
+    s->photons.per_channel = 1000000;
+    s->photons.seed = 1;
+    s->photons.min_relative_power = 0.01;
+    s->photons.gather_min_photons = 16;
+    s->render.integrator = INTEGRATOR_PHOTON_MAP;
+    s->render.gather_rays = 32;
+    s->render.paths_per_sample = 16;
+    return s;
+}
+
+void mesh_fini(thz_mesh *mesh)
+{
+    free(mesh->positions);
+    free(mesh->indices);
+    free(mesh->normals);
+    free(mesh->areas_m2);
+    memset(mesh, 0, sizeof *mesh);
+}
+
+void scene_destroy(thz_scene *s)
+{
+    if (!s)
+        return;
+    for (size_t i = 0; i < s->n_materials; i++) {
+        thz_material *m = &s->materials[i];
+        free(m->name);
+        spectrum_fini(&m->reflectivity);
+        spectrum_fini(&m->attenuation_per_m);
+        spectrum_fini(&m->emissivity);
+    }
+    free(s->materials);
+    for (size_t i = 0; i < s->n_objects; i++) {
+        free(s->objects[i].name);
+        mesh_fini(&s->objects[i].mesh);
+    }
+    free(s->objects);
+    for (size_t i = 0; i < s->n_sensors; i++)
+        free(s->sensors[i].name);
+    free(s->sensors);
+    free(s->channels);
+    atmosphere_fini(&s->atmosphere);
+    for (size_t i = 0; i < s->n_warnings; i++)
+        free(s->warnings[i]);
+    free(s->warnings);
+    free(s->path);
+    free(s->dir);
+    free(s->name);
+    free(s);
+}
+
+void thz_scene_destroy(thz_scene *scene)
+{
+    scene_destroy(scene);
+}
+
+bool scene_add_warning(thz_scene *s, const char *fmt, ...)
+{
+    char buf[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    char **w = thz_realloc_array(s->warnings, s->n_warnings + 1, sizeof *w);
+    if (!w)
+        return false;
+    s->warnings = w;
+    w[s->n_warnings] = thz_strdup(buf);
+    if (!w[s->n_warnings])
+        return false;
+    s->n_warnings++;
+    return true;
+}
+
+optics_point scene_object_optics(const thz_scene *s, const thz_object *obj, double freq_hz)
+{
+    const thz_material *m = &s->materials[obj->material];
+    optics_point o = {
+        .reflectivity = spectrum_eval(&m->reflectivity, freq_hz),
+        .attenuation_per_m = spectrum_eval(&m->attenuation_per_m, freq_hz),
+        .thickness_m = obj->type == OBJECT_SHELL ? obj->thickness_m : 0.0,
+        .explicit_emissivity = m->emissivity.n > 0,
+    };
+    if (o.explicit_emissivity)
+        o.emissivity = spectrum_eval(&m->emissivity, freq_hz);
+    return o;
+}
+
+bool scene_object_side_is_front(const thz_object *obj, int side)
+{
+    return side == 0 || obj->type == OBJECT_SHELL || obj->two_sided;
+}
+
+static int object_emitting_sides(const thz_object *obj)
+{
+    return (obj->type == OBJECT_SHELL || obj->two_sided) ? 2 : 1;
+}
+
+double scene_emitted_power_w_per_hz(const thz_scene *s, double freq_hz)
+{
+    double total = 0.0;
+    for (size_t i = 0; i < s->n_objects; i++) {
+        const thz_object *obj = &s->objects[i];
+        if (obj->temperature_k <= 0.0 || obj->mesh.total_area_m2 <= 0.0)
+            continue;
+        optics_point o = scene_object_optics(s, obj, freq_hz);
+        double eps_mean = optics_mean_emissivity(&o);
+        total += M_PI * eps_mean * obj->mesh.total_area_m2 * object_emitting_sides(obj) *
+                 planck_radiance(freq_hz, obj->temperature_k);
+    }
+    return total;
+}
+
+static double emitted_power_at(double freq_hz, void *ctx)
+{
+    return scene_emitted_power_w_per_hz(ctx, freq_hz);
+}
+
+double scene_band_emitted_power_w_per_hz(const thz_scene *s, size_t channel)
+{
+    return channel_band_mean(&s->channels[channel], emitted_power_at, (void *)s);
+}
+
+bool mesh_finalize(thz_mesh *mesh)
+{
+    free(mesh->normals);
+    free(mesh->areas_m2);
+    mesh->normals = thz_malloc_array(mesh->n_triangles, 3 * sizeof *mesh->normals);
+    mesh->areas_m2 = thz_malloc_array(mesh->n_triangles, sizeof *mesh->areas_m2);
+    if (!mesh->normals || !mesh->areas_m2)
+        return false;
+    mesh->total_area_m2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        mesh->bbox_min_m[k] = mesh->n_vertices ? INFINITY : 0.0;
+        mesh->bbox_max_m[k] = mesh->n_vertices ? -INFINITY : 0.0;
+    }
+    for (size_t v = 0; v < mesh->n_vertices; v++) {
+        for (int k = 0; k < 3; k++) {
+            double x = mesh->positions[3 * v + (size_t)k];
+            mesh->bbox_min_m[k] = fmin(mesh->bbox_min_m[k], x);
+            mesh->bbox_max_m[k] = fmax(mesh->bbox_max_m[k], x);
+        }
+    }
+    for (size_t t = 0; t < mesh->n_triangles; t++) {
+        const float *p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = &mesh->positions[3 * (size_t)mesh->indices[3 * t + (size_t)k]];
+        double e1[3], e2[3], n[3];
+        for (int k = 0; k < 3; k++) {
+            e1[k] = (double)p[1][k] - (double)p[0][k];
+            e2[k] = (double)p[2][k] - (double)p[0][k];
+        }
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        mesh->areas_m2[t] = 0.5 * len;
+        mesh->total_area_m2 += mesh->areas_m2[t];
+        for (int k = 0; k < 3; k++)
+            mesh->normals[3 * t + (size_t)k] = len > 0.0 ? (float)(n[k] / len) : 0.0f;
+    }
+    return true;
+}

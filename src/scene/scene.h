@@ -1,0 +1,136 @@
+/* The scene model: channels, materials, atmosphere, objects (triangle meshes in world
+ * space), sensors and run settings, as loaded from a thzmap-scene/1 file
+ * (scene-format.md). Every later stage reads the scene; none changes it after loading.
+ */
+#ifndef THZ_SCENE_SCENE_H
+#define THZ_SCENE_SCENE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "atmosphere/atmosphere.h"
+#include "core/error.h"
+#include "physics/channel.h"
+#include "physics/optics.h"
+#include "physics/spectrum.h"
+
+typedef enum thz_transmission { TRANSMISSION_DIFFUSE = 0, TRANSMISSION_STRAIGHT } thz_transmission;
+
+typedef struct thz_material {
+    char *name;
+    thz_spectrum reflectivity;      /* R(nu), required */
+    thz_spectrum attenuation_per_m; /* alpha_M(nu), default constant 0 */
+    thz_spectrum emissivity;        /* explicit eps(nu); n == 0 means Kirchhoff */
+    thz_transmission transmission;  /* shells: diffuse (default) or straight */
+    double color[3];                /* rgb 0..1 for the visual truth image */
+} thz_material;
+
+typedef enum thz_object_type { OBJECT_SOLID = 0, OBJECT_SHELL } thz_object_type;
+
+/* A triangle mesh in world space. Triangle i has vertices indices[3i..3i+2], counter-
+ * clockwise seen from its front side; normal[3i..3i+2] is the unit front normal
+ * (outward for closed solids, inward for `box` with inward: true). */
+typedef struct thz_mesh {
+    size_t n_vertices;
+    float *positions; /* 3 floats per vertex, plus 4 floats of padding (Embree reads 16 B) */
+    size_t n_triangles;
+    uint32_t *indices; /* 3 per triangle */
+    float *normals;    /* 3 per triangle, unit */
+    double *areas_m2;  /* 1 per triangle */
+    double total_area_m2;
+    double bbox_min_m[3], bbox_max_m[3];
+} thz_mesh;
+
+typedef struct thz_object {
+    char *name;
+    thz_object_type type;
+    size_t material;      /* index into scene->materials */
+    double temperature_k; /* >= 0 */
+    double thickness_m;   /* shells: > 0; solids: 0 */
+    bool two_sided;       /* solids: both sides are front sides; shells: always true */
+    thz_mesh mesh;
+} thz_object;
+
+typedef struct thz_sensor {
+    char *name;
+    double position_m[3];
+    double direction[3]; /* unit viewing direction */
+    double up[3];        /* unit, not parallel to direction (as given, not orthogonalised) */
+    double fov_deg;      /* horizontal, 0 < fov < 180 */
+    uint32_t columns, rows;
+    double aperture_m2;
+    uint32_t oversampling; /* n: n x n samples per pixel */
+    double normalize_to_k; /* T_ref > 0 */
+} thz_sensor;
+
+typedef struct thz_photon_settings {
+    uint64_t per_channel; /* K > 0 */
+    uint64_t seed;
+    double min_relative_power;   /* 0 < x < 1 */
+    uint32_t gather_min_photons; /* k >= 2 */
+} thz_photon_settings;
+
+typedef enum thz_integrator {
+    INTEGRATOR_PHOTON_MAP = 0,
+    INTEGRATOR_FINAL_GATHER,
+    INTEGRATOR_PATH
+} thz_integrator;
+
+typedef struct thz_render_settings {
+    thz_integrator integrator;
+    uint32_t gather_rays;      /* final-gather, default 32 */
+    uint32_t paths_per_sample; /* path, default 16 */
+} thz_render_settings;
+
+struct thz_scene {
+    char *path; /* the scene file as given */
+    char *dir;  /* its directory: relative paths in the scene are relative to it */
+    char *name;
+
+    size_t n_channels;
+    thz_channel *channels;
+    size_t n_materials;
+    thz_material *materials;
+    thz_atmosphere atmosphere;
+    size_t n_objects;
+    thz_object *objects;
+    size_t n_sensors;
+    thz_sensor *sensors;
+    thz_photon_settings photons;
+    thz_render_settings render;
+
+    size_t n_warnings;
+    char **warnings; /* messages for validate and summary.json, one line each */
+};
+typedef struct thz_scene thz_scene;
+
+/* An empty scene with the spec's defaults; NULL on allocation failure. */
+thz_scene *scene_create(void);
+void scene_destroy(thz_scene *scene);
+
+/* Appends a warning (printf format). Returns false only on allocation failure. */
+bool scene_add_warning(thz_scene *scene, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* The optics of object `obj` at freq_hz: its material's R, alpha_M and explicit eps
+ * evaluated there, and its thickness (0 for solids). */
+optics_point scene_object_optics(const thz_scene *scene, const thz_object *obj, double freq_hz);
+
+/* Whether the side of `obj` a ray arrives on is a front side (physics.md): shells and
+ * two-sided solids always; one-sided solids when cos(normal, -ray) > 0. */
+bool scene_object_side_is_front(const thz_object *obj, int side);
+
+/* Emitted spectral power P_A(freq_hz) = sum over emitting sides of pi eps-bar A B_nu(T)
+ * in W/Hz (physics.md "Photon phase"). */
+double scene_emitted_power_w_per_hz(const thz_scene *scene, double freq_hz);
+
+/* Band mean of P_A over channel c, in W/Hz. */
+double scene_band_emitted_power_w_per_hz(const thz_scene *scene, size_t channel);
+
+/* Computes the mesh-derived data from positions and indices: allocates (replacing any
+ * earlier) normals and areas_m2, and sets total_area_m2 and the bounding box.
+ * Degenerate triangles keep area 0 and a zero normal. False on allocation failure. */
+bool mesh_finalize(thz_mesh *mesh);
+void mesh_fini(thz_mesh *mesh);
+
+#endif
