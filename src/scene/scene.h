@@ -105,6 +105,14 @@ struct thz_scene {
 };
 typedef struct thz_scene thz_scene;
 
+/* Loads a scene file (thzmap-scene/1) and checks it completely; = thz_scene_load. */
+thz_status scene_load(const char *path, thz_scene **out, thz_error *err);
+
+/* The same from JSON text: `base_dir` resolves relative file paths and `label` names
+ * the text in messages (as a file name would). For tests and for the future GUI. */
+thz_status scene_load_string(const char *json_text, const char *base_dir, const char *label,
+                             thz_scene **out, thz_error *err);
+
 /* An empty scene with the spec's defaults; NULL on allocation failure. */
 thz_scene *scene_create(void);
 void scene_destroy(thz_scene *scene);

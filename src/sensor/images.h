@@ -1,0 +1,37 @@
+/* The images one sensor produces: the per-channel cubes and the truth images
+ * (scene-format.md "Outputs"). Row 0 is the top of the picture (the `up` side),
+ * column 0 the left. Cubes are band-sequential: value(c, row, col) is at
+ * [(c * rows + row) * columns + col].
+ */
+#ifndef THZ_SENSOR_IMAGES_H
+#define THZ_SENSOR_IMAGES_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+
+typedef struct sensor_images {
+    uint32_t columns, rows;
+    size_t n_channels;
+    float *radiance;               /* L_c, W m^-2 sr^-1 Hz^-1 */
+    float *radiance_stderr;        /* standard error of L_c (NULL when not estimated) */
+    float *power;                  /* P_c, W */
+    float *brightness_temperature; /* Tb_c, K */
+    float *normalized;             /* N_c, 1 */
+    float *temperature_k;          /* 1 band: temperature of the surface seen, K (0: none) */
+    float *distance_m;             /* 1 band: distance to the surface seen, m (0: none) */
+    int32_t *object_id;            /* 1 band: index into scene objects, -1: nothing hit */
+    float *visual_rgb;             /* rows x columns x 3, shaded colours 0..1 */
+} sensor_images;
+
+/* Allocates all arrays zeroed (object_id set to -1); radiance_stderr only when
+ * with_stderr. */
+thz_status sensor_images_init(sensor_images *img, uint32_t columns, uint32_t rows,
+                              size_t n_channels, int with_stderr, thz_error *err);
+void sensor_images_fini(sensor_images *img);
+
+/* Bytes the images of a sensor take (to refuse runs that would not fit). */
+uint64_t sensor_images_bytes(uint32_t columns, uint32_t rows, size_t n_channels);
+
+#endif
