@@ -3,6 +3,16 @@
 
 #include <math.h>
 
+thz_status atmosphere_prepare(thz_atmosphere *atm, const thz_channel *channels, size_t n_channels,
+                              thz_error *err)
+{
+    (void)atm;
+    (void)channels;
+    (void)n_channels;
+    (void)err;
+    return THZ_OK;
+}
+
 double atmosphere_alpha_per_m(const thz_atmosphere *atm, double freq_hz)
 {
     switch (atm->model) {

@@ -8,6 +8,7 @@
 #include <stdbool.h>
 
 #include "core/error.h"
+#include "physics/channel.h"
 #include "physics/spectrum.h"
 
 typedef enum atm_model {
@@ -22,6 +23,12 @@ typedef struct thz_atmosphere {
     atm_model model;
     thz_spectrum attenuation_per_m; /* constant and table models */
 } thz_atmosphere;
+
+/* Prepares the model for a run over these channels (e.g. tabulates line-by-line
+ * alpha over each channel's band); the scene loader calls it once after loading.
+ * Thread-safe use of atmosphere_alpha_per_m needs it done. */
+thz_status atmosphere_prepare(thz_atmosphere *atm, const thz_channel *channels, size_t n_channels,
+                              thz_error *err);
 
 /* alpha(freq_hz) in 1/m; 0 for ATM_NONE. Thread-safe (read only). */
 double atmosphere_alpha_per_m(const thz_atmosphere *atm, double freq_hz);

@@ -1,0 +1,60 @@
+/* Writing a run's results (scene-format.md "Outputs").
+ *
+ * Atomic results: every file of a run is written into a staging directory inside
+ * OUTDIR and moved into OUTDIR only when the whole run succeeded, so a failed or
+ * interrupted run leaves no partial result files behind.
+ */
+#ifndef THZ_IO_OUTPUT_H
+#define THZ_IO_OUTPUT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "photon/photon_stats.h"
+#include "scene/scene.h"
+#include "sensor/images.h"
+
+typedef struct output_stage output_stage;
+
+/* Creates OUTDIR if missing and a fresh staging directory inside it. */
+thz_status output_stage_create(const char *outdir, output_stage **out, thz_error *err);
+
+/* The directory writers write into (the staging directory). */
+const char *output_stage_dir(const output_stage *stage);
+
+/* Moves every staged file into OUTDIR (replacing files of the same name) and removes
+ * the staging directory. */
+thz_status output_stage_commit(output_stage *stage, thz_error *err);
+
+/* Removes the staging directory and whatever it holds if not committed; frees. */
+void output_stage_destroy(output_stage *stage);
+
+/* Writes every file of sensor `sensor` into dir: the ENVI images S.radiance,
+ * S.power, S.brightness_temperature, S.normalized (and S.radiance_stderr when
+ * images->radiance_stderr is set), S.temperature, S.distance, S.object_id; S.visual.png;
+ * S.band-NN.png per channel; S.spectra.png. */
+thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t sensor,
+                               const sensor_images *images, thz_error *err);
+
+/* What summary.json reports beyond the scene. */
+typedef struct run_summary {
+    const char *command;    /* "simulate" or "render" */
+    const char *integrator; /* "photon-map", ... */
+    uint64_t seed;
+    uint64_t photons_per_channel;
+    int threads;
+    const photon_stats *channel_stats; /* n_channels entries, or NULL (render) */
+    const double *median_stderr_k;     /* n_channels entries, or NULL */
+    uint64_t *back_face_samples;       /* per sensor: samples that saw a back face, or NULL */
+    double seconds_load, seconds_accel, seconds_photons, seconds_render, seconds_output;
+    size_t n_run_warnings;
+    const char *const *run_warnings;
+} run_summary;
+
+/* Writes dir/summary.json: version, scene name, seed, per-channel photons fired and
+ * stored, emitted power P_A, run statistics and energy balance, timings, warnings. */
+thz_status summary_write(const char *dir, const thz_scene *scene, const run_summary *summary,
+                         thz_error *err);
+
+#endif
