@@ -1,0 +1,27 @@
+/* Planck's law and its inverse (physics.md "Units"). */
+#include "physics/planck.h"
+
+#include <math.h>
+
+double planck_radiance(double freq_hz, double temp_k)
+{
+    if (!(temp_k > 0.0) || !(freq_hz > 0.0))
+        return 0.0;
+    const double h = THZ_PLANCK_H, k = THZ_BOLTZMANN_K, c = THZ_SPEED_OF_LIGHT;
+    double x = h * freq_hz / (k * temp_k);
+    /* 2 h nu^3 / c^2, written to avoid overflow of nu^3 for large nu. */
+    double prefactor = 2.0 * h * freq_hz / c * (freq_hz / c) * freq_hz;
+    double denom = expm1(x);
+    if (isinf(denom))
+        return 0.0;
+    return prefactor / denom;
+}
+
+double planck_brightness_temperature(double freq_hz, double radiance)
+{
+    if (!(radiance > 0.0) || !(freq_hz > 0.0))
+        return 0.0;
+    const double h = THZ_PLANCK_H, k = THZ_BOLTZMANN_K, c = THZ_SPEED_OF_LIGHT;
+    double prefactor = 2.0 * h * freq_hz / c * (freq_hz / c) * freq_hz;
+    return h * freq_hz / (k * log1p(prefactor / radiance));
+}
