@@ -1,0 +1,193 @@
+/* Channels: widths, response, band-mean quadrature and frequency sampling. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "core/rng.h"
+#include "physics/channel.h"
+
+static const thz_channel ch_default = {"c1", 1.0e12, 0.1};
+
+static double f_const(double nu, void *ctx)
+{
+    (void)nu;
+    return *(const double *)ctx;
+}
+
+static double f_linear(double nu, void *ctx)
+{
+    (void)ctx;
+    return 3.0 + 2.0e-12 * nu;
+}
+
+static double f_response(double nu, void *ctx)
+{
+    return channel_response((const thz_channel *)ctx, nu);
+}
+
+/* A triangular line of peak 1 and half-width half_width_hz at centre_hz. */
+typedef struct triangle {
+    double centre_hz, half_width_hz;
+} triangle;
+
+static double f_triangle(double nu, void *ctx)
+{
+    const triangle *t = ctx;
+    double d = fabs(nu - t->centre_hz) / t->half_width_hz;
+    return d < 1.0 ? 1.0 - d : 0.0;
+}
+
+static void test_widths(void **state)
+{
+    (void)state;
+    /* FWHM = w nu_c: the response is 1/2 at nu_c +- FWHM/2 */
+    double fwhm = ch_default.relative_width * ch_default.center_hz;
+    assert_true(fabs(channel_response(&ch_default, ch_default.center_hz + 0.5 * fwhm) - 0.5) <
+                1e-14);
+    assert_true(fabs(channel_response(&ch_default, ch_default.center_hz - 0.5 * fwhm) - 0.5) <
+                1e-14);
+    assert_true(channel_response(&ch_default, ch_default.center_hz) == 1.0);
+    double sigma = fwhm / (2.0 * sqrt(2.0 * log(2.0)));
+    assert_true(fabs(channel_sigma_hz(&ch_default) - sigma) < 1e-14 * sigma);
+    assert_true(fabs(channel_bandwidth_hz(&ch_default) - sigma * sqrt(2.0 * M_PI)) <
+                1e-14 * sigma);
+}
+
+static void test_band_mean_constant_and_linear(void **state)
+{
+    (void)state;
+    double k = 0.123456789;
+    assert_true(fabs(channel_band_mean(&ch_default, f_const, &k) - k) < 1e-16);
+    double centre = 3.0 + 2.0e-12 * ch_default.center_hz;
+    assert_true(fabs(channel_band_mean(&ch_default, f_linear, NULL) - centre) < 1e-10 * centre);
+}
+
+static void test_band_mean_of_response(void **state)
+{
+    (void)state;
+    /* int g^2 / int g = 1/sqrt(2). The quadrature spans +-6 sigma, which drops
+     * P(|z| > 6) = 1.97e-9 of int g: allowance 2.5e-9. */
+    const thz_channel chs[] = {{"a", 1e12, 0.1}, {"b", 0.3e12, 0.02}, {"c", 2.5e12, 0.3}};
+    for (size_t i = 0; i < 3; i++) {
+        double m = channel_band_mean(&chs[i], f_response, (void *)&chs[i]);
+        assert_true(fabs(m - M_SQRT1_2) < 2.5e-9);
+    }
+}
+
+/* int over [z1, z2] of (p + q z) exp(-z^2/2) dz */
+static double gauss_linear_integral(double p, double q, double z1, double z2)
+{
+    return p * sqrt(M_PI / 2.0) * (erf(z2 / M_SQRT2) - erf(z1 / M_SQRT2)) +
+           q * (exp(-0.5 * z1 * z1) - exp(-0.5 * z2 * z2));
+}
+
+static void test_narrow_line(void **state)
+{
+    (void)state;
+    const thz_channel *ch = &ch_default;
+    double sigma = channel_sigma_hz(ch);
+    static const double offsets[] = {1.3, -0.77, 0.0, 2.1};
+    for (size_t i = 0; i < 4; i++) {
+        /* a line of full width sigma/10 (half-width sigma/20) */
+        triangle t = {ch->center_hz + offsets[i] * sigma, sigma / 20.0};
+        double z0 = offsets[i], a = 1.0 / 20.0; /* in units of sigma */
+        /* rising edge: 1 + (z - z0)/a ; falling edge: 1 - (z - z0)/a */
+        double num = gauss_linear_integral(1.0 - z0 / a, 1.0 / a, z0 - a, z0) +
+                     gauss_linear_integral(1.0 + z0 / a, -1.0 / a, z0, z0 + a);
+        double exact = num / sqrt(2.0 * M_PI);
+        double m = channel_band_mean(ch, f_triangle, &t);
+        assert_true(fabs(m - exact) < 1e-6 * exact);
+    }
+}
+
+static void test_quadrature_struct(void **state)
+{
+    (void)state;
+    channel_quadrature q;
+    thz_error err;
+    assert_int_equal(channel_quadrature_init(&q, &ch_default, CHANNEL_QUADRATURE_NODES, &err),
+                     THZ_OK);
+    assert_int_equal(q.n, CHANNEL_QUADRATURE_NODES);
+    double sum = 0.0, num = 0.0;
+    for (size_t i = 0; i < q.n; i++) {
+        sum += q.weight[i];
+        num += q.weight[i] * channel_response(&ch_default, q.freq_hz[i]);
+        /* symmetric about the centre */
+        double mirror = 2.0 * ch_default.center_hz - q.freq_hz[q.n - 1 - i];
+        assert_true(fabs(q.freq_hz[i] - mirror) < 1e-3);
+        assert_true(q.weight[i] == q.weight[q.n - 1 - i]);
+    }
+    assert_true(fabs(sum - 1.0) < 1e-14);
+    double sigma = channel_sigma_hz(&ch_default);
+    assert_true(fabs(q.freq_hz[0] - (ch_default.center_hz - 6.0 * sigma)) < 1e-3);
+    double m = channel_band_mean(&ch_default, f_response, (void *)&ch_default);
+    assert_true(fabs(num - m) < 1e-9); /* fixed rule vs adaptive refinement */
+    channel_quadrature_fini(&q);
+    assert_null(q.weight);
+
+    /* Even n is rounded up to odd; a wide channel keeps only positive nodes. */
+    thz_channel wide = {"w", 1e12, 0.5};
+    assert_int_equal(channel_quadrature_init(&q, &wide, 100, &err), THZ_OK);
+    assert_true(q.n <= 101);
+    for (size_t i = 0; i < q.n; i++)
+        assert_true(q.freq_hz[i] > 0.0);
+    channel_quadrature_fini(&q);
+}
+
+static void test_sampling(void **state)
+{
+    (void)state;
+    const thz_channel ch = {"s", 0.8e12, 0.2};
+    const double sigma = channel_sigma_hz(&ch);
+    const double scale = getenv("THZ_TEST_SCALE") ? atof(getenv("THZ_TEST_SCALE")) : 1.0;
+    const size_t n = (size_t)(1e6 * (scale > 0.0 && scale <= 1.0 ? scale : 1.0));
+    rng_stream rng;
+    rng_init(&rng, 42, 0, RNG_PURPOSE_TEST, 0);
+    double sum = 0.0, sum2 = 0.0, sum4 = 0.0;
+    size_t within_1sigma = 0;
+    for (size_t i = 0; i < n; i++) {
+        double u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
+        double nu = channel_sample_hz(&ch, u1, u2);
+        assert_true(nu > 0.0);
+        double z = (nu - ch.center_hz) / sigma;
+        sum += z;
+        sum2 += z * z;
+        sum4 += z * z * z * z;
+        within_1sigma += fabs(z) < 1.0;
+    }
+    double dn = (double)n;
+    double mean = sum / dn, var = sum2 / dn - mean * mean;
+    /* standard errors: mean 1/sqrt(n); variance sqrt(2/n); fraction sqrt(p(1-p)/n) */
+    assert_true(fabs(mean) < 5.0 / sqrt(dn));
+    assert_true(fabs(var - 1.0) < 5.0 * sqrt(2.0 / dn));
+    assert_true(fabs(sum4 / dn - 3.0) < 5.0 * sqrt(96.0 / dn));
+    double p = erf(M_SQRT1_2);
+    assert_true(fabs((double)within_1sigma / dn - p) < 5.0 * sqrt(p * (1.0 - p) / dn));
+
+    /* u1 = 0 must not produce an infinity; results stay positive for a wide channel */
+    const thz_channel wide = {"w", 1e12, 0.5};
+    for (int i = 0; i < 64; i++) {
+        double nu = channel_sample_hz(&wide, i / 64.0, (i * 37 % 64) / 64.0);
+        assert_true(isfinite(nu) && nu > 0.0);
+    }
+    assert_true(isfinite(channel_sample_hz(&ch, 0.0, 0.0)));
+    assert_true(channel_sample_hz(&wide, 1.0 - 1e-16, 0.5) > 0.0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_widths),
+        cmocka_unit_test(test_band_mean_constant_and_linear),
+        cmocka_unit_test(test_band_mean_of_response),
+        cmocka_unit_test(test_narrow_line),
+        cmocka_unit_test(test_quadrature_struct),
+        cmocka_unit_test(test_sampling),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
