@@ -1,0 +1,252 @@
+/* Surface optics: T, A, eps, their hemispherical means against E3 and independent
+ * quadrature, and the sampled mu distributions against the exact CDFs. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "core/rng.h"
+#include "physics/optics.h"
+
+static double test_scale(void)
+{
+    const char *s = getenv("THZ_TEST_SCALE");
+    double v = s ? atof(s) : 1.0;
+    return (v > 0.0 && v <= 1.0) ? v : 1.0;
+}
+
+static optics_point shell(double r, double alpha, double t)
+{
+    return (optics_point){r, alpha, t, 0.0, false};
+}
+
+/* 2 int_a^b X(mu) mu dmu by composite Simpson in long double (independent of the
+ * library's E3 form). */
+typedef double (*mu_fn)(const optics_point *o, double mu);
+
+static double hemi_integral(const optics_point *o, mu_fn x, double a, double b, int n)
+{
+    if (b <= a)
+        return 0.0;
+    long double h = ((long double)b - a) / n, s = 0.0L;
+    for (int i = 0; i <= n; i++) {
+        long double mu = a + h * i;
+        long double w = (i == 0 || i == n) ? 1.0L : (i % 2 ? 4.0L : 2.0L);
+        s += w * (mu > 0 ? x(o, (double)mu) * mu : 0.0L);
+    }
+    return (double)(2.0L * s * h / 3.0L);
+}
+
+/* The same split at the kink mu* so that each piece is smooth. */
+static double hemi_mean(const optics_point *o, mu_fn x)
+{
+    double c = 1.0 - o->reflectivity, tau = o->attenuation_per_m * o->thickness_m;
+    double k = (tau > 0.0 && c < 1.0 && c > 0.0) ? tau / -log(c) : 1.0;
+    if (k > 1.0)
+        k = 1.0;
+    return hemi_integral(o, x, 0.0, k, 20000) + hemi_integral(o, x, k, 1.0, 20000);
+}
+
+static void test_pointwise(void **state)
+{
+    (void)state;
+    optics_point o = shell(0.2, 100.0, 0.002); /* tau = 0.2 */
+    for (int i = 1; i <= 100; i++) {
+        double mu = i / 100.0;
+        double t = exp(-0.2 / mu);
+        if (t > 0.8)
+            t = 0.8;
+        assert_true(fabs(optics_transmission(&o, mu) - t) < 1e-15);
+        assert_true(fabs(optics_transmission(&o, -mu) - t) < 1e-15); /* |cos| */
+        assert_true(fabs(optics_absorption(&o, mu) - (0.8 - t)) < 1e-15);
+        assert_true(fabs(optics_emissivity(&o, mu) - (0.8 - t)) < 1e-15);
+    }
+    optics_point solid = {0.3, 50.0, 0.0, 0.0, false};
+    assert_true(optics_transmission(&solid, 0.5) == 0.0);
+    assert_true(fabs(optics_absorption(&solid, 0.5) - 0.7) < 1e-15);
+    assert_true(fabs(optics_emissivity(&solid, 0.5) - 0.7) < 1e-15);
+    optics_point clear = shell(0.1, 0.0, 0.01); /* no attenuation: T = 1 - R */
+    assert_true(fabs(optics_transmission(&clear, 0.01) - 0.9) < 1e-15);
+    assert_true(optics_absorption(&clear, 0.3) == 0.0);
+}
+
+/* E3 from mpmath at 30 digits. */
+static void test_mean_transmission_e3(void **state)
+{
+    (void)state;
+    static const double tab[][2] = {
+        {0.001, 0.499003915436452876}, {0.01, 0.490276564184665092},
+        {0.1, 0.416291457908278761},   {0.5, 0.221604364275178457},
+        {1.0, 0.109691967197760137},   {2.0, 0.0301333797978158932},
+        {5.0, 8.7780089277063827e-4},  {10.0, 3.54876255308438196e-6},
+        {30.0, 2.84307432814032745e-15},
+    };
+    for (size_t i = 0; i < sizeof tab / sizeof tab[0]; i++) {
+        /* R = 0: the cap 1 is never reached, T-bar = 2 E3(tau) */
+        optics_point o = shell(0.0, tab[i][0] / 0.004, 0.004);
+        double tbar = optics_mean_transmission(&o);
+        assert_true(fabs(tbar - 2.0 * tab[i][1]) <= 1e-12 * 2.0 * tab[i][1]);
+        assert_true(fabs(optics_mean_emissivity(&o) - (1.0 - tbar)) < 1e-15);
+    }
+}
+
+static void test_means_capped(void **state)
+{
+    (void)state;
+    static const double cases[][3] = {
+        /* R, alpha, t */
+        {0.3, 5.0, 0.01},  {0.05, 20.0, 0.01}, {0.5, 1.0, 0.2},
+        {0.9, 10.0, 0.05}, {0.2, 300.0, 0.01}, {0.6, 0.0, 0.01},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        optics_point o = shell(cases[i][0], cases[i][1], cases[i][2]);
+        double tbar = optics_mean_transmission(&o);
+        double ref = hemi_mean(&o, optics_transmission);
+        assert_true(fabs(tbar - ref) <= 1e-9 * ref + 1e-300);
+        double ebar = optics_mean_emissivity(&o);
+        assert_true(fabs(ebar - (1.0 - cases[i][0] - tbar)) < 1e-15);
+        double eref = hemi_mean(&o, optics_emissivity);
+        assert_true(fabs(ebar - eref) <= 1e-9 * (eref > 1e-6 ? eref : 1e-6));
+    }
+    optics_point solid = {0.25, 10.0, 0.0, 0.0, false};
+    assert_true(optics_mean_transmission(&solid) == 0.0);
+    assert_true(fabs(optics_mean_emissivity(&solid) - 0.75) < 1e-15);
+    optics_point expl = {0.25, 10.0, 0.01, 0.4, true};
+    assert_true(fabs(optics_mean_emissivity(&expl) - 0.4) < 1e-15);
+}
+
+static void test_kirchhoff_violation(void **state)
+{
+    (void)state;
+    optics_point o = shell(0.2, 100.0, 0.002);
+    assert_true(optics_kirchhoff_violation(&o) == 0.0);
+    optics_point solid = {0.3, 0.0, 0.0, 0.68, true};
+    assert_true(fabs(optics_kirchhoff_violation(&solid) - 0.02) < 1e-15);
+    /* explicit eps on a shell: compare with a fine scan over mu */
+    static const double epss[] = {0.0, 0.1, 0.5, 0.8};
+    for (size_t k = 0; k < 4; k++) {
+        optics_point e = {0.2, 100.0, 0.002, epss[k], true};
+        double worst = 0.0;
+        for (int i = 1; i <= 100000; i++) {
+            double mu = i / 100000.0;
+            double d = fabs(epss[k] - optics_absorption(&e, mu));
+            if (d > worst)
+                worst = d;
+        }
+        double v = optics_kirchhoff_violation(&e);
+        assert_true(v >= worst - 1e-15);
+        assert_true(v <= worst + 1e-3); /* the scan stops at mu = 1e-5 */
+    }
+}
+
+static double next_uniform(void *ctx)
+{
+    return rng_uniform(ctx);
+}
+
+typedef bool (*sample_fn)(const optics_point *, optics_uniform_fn, void *, double *);
+
+/* Histogram of n samples in `bins` bins of mu, each bin count within 5 standard
+ * errors of n p_bin where p_bin comes from the independent quadrature. */
+static void check_histogram(const optics_point *o, sample_fn sample, mu_fn x, uint64_t stream)
+{
+    enum { bins = 20 };
+    const size_t n = (size_t)(200000 * test_scale());
+    size_t count[bins] = {0};
+    rng_stream rng;
+    rng_init(&rng, 7, 0, RNG_PURPOSE_TEST, stream);
+    for (size_t i = 0; i < n; i++) {
+        double mu = -1.0;
+        assert_true(sample(o, next_uniform, &rng, &mu));
+        assert_true(mu > 0.0 && mu <= 1.0);
+        size_t b = (size_t)(mu * bins);
+        count[b < bins ? b : bins - 1]++;
+    }
+    double total = hemi_mean(o, x);
+    double chi2 = 0.0, pooled_expect = 0.0, pooled_count = 0.0;
+    for (int b = 0; b < bins; b++) {
+        double p = hemi_integral(o, x, b / (double)bins, (b + 1) / (double)bins, 2000) / total;
+        double expect = p * (double)n;
+        double sd = sqrt(expect * (1.0 - p));
+        assert_true(fabs((double)count[b] - expect) <= 5.0 * sd + 1.0);
+        if (getenv("THZ_DEBUG_HIST"))
+            fprintf(stderr, "%u bin %d: %zu vs %.1f (%.2f sd)\n", (unsigned)stream, b, count[b], expect, ((double)count[b] - expect) / sd);
+        if (expect >= 5.0) {
+            chi2 += ((double)count[b] - expect) * ((double)count[b] - expect) / expect;
+        } else { /* pool the sparse bins into one, as chi-square needs */
+            pooled_expect += expect;
+            pooled_count += (double)count[b];
+        }
+    }
+    if (pooled_expect >= 5.0)
+        chi2 += (pooled_count - pooled_expect) * (pooled_count - pooled_expect) / pooled_expect;
+    /* 19 degrees of freedom (fewer where p = 0): chi2 > 60 has probability < 3e-6 */
+    if (chi2 >= 60.0) fprintf(stderr, "chi2 %g case %u\n", chi2, (unsigned)stream);
+    assert_true(chi2 < 60.0);
+}
+
+static void test_sample_transmission(void **state)
+{
+    (void)state;
+    const optics_point cases[] = {
+        shell(0.0, 30.0, 0.01),  /* tau 0.3, uncapped, cosine-rejection branch */
+        shell(0.1, 300.0, 0.01), /* tau 3, uncapped, exponential branch */
+        shell(0.3, 5.0, 0.01),   /* tau 0.05, capped above mu* = 0.14 */
+        shell(0.5, 0.0, 0.01),   /* tau 0: cosine */
+        shell(0.0, 4000.0, 0.01) /* tau 40: deep exponential branch */
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+        check_histogram(&cases[i], optics_sample_transmission_mu, optics_transmission, i);
+}
+
+static void test_sample_emission(void **state)
+{
+    (void)state;
+    const optics_point cases[] = {
+        shell(0.2, 50.0, 0.01),   /* tau 0.5 */
+        shell(0.0, 0.01, 0.01),   /* tau 1e-4: eps ~ tau/mu, nearly uniform in mu */
+        shell(0.3, 5.0, 0.01),    /* capped: eps = 0 above mu* */
+        shell(0.1, 1000.0, 0.01), /* tau 10: nearly constant */
+        {0.4, 10.0, 0.0, 0.0, false},  /* solid: cosine */
+        {0.4, 10.0, 0.01, 0.3, true},  /* explicit: cosine */
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+        check_histogram(&cases[i], optics_sample_emission_mu, optics_emissivity, 100 + i);
+}
+
+static void test_sample_zero(void **state)
+{
+    (void)state;
+    rng_stream rng;
+    rng_init(&rng, 1, 0, RNG_PURPOSE_TEST, 0);
+    double mu = 0.5;
+    optics_point solid = {0.4, 10.0, 0.0, 0.0, false};
+    assert_false(optics_sample_transmission_mu(&solid, next_uniform, &rng, &mu));
+    optics_point mirror = {1.0, 10.0, 0.0, 0.0, false};
+    assert_false(optics_sample_emission_mu(&mirror, next_uniform, &rng, &mu));
+    optics_point mirror_shell = shell(1.0, 10.0, 0.01);
+    assert_false(optics_sample_transmission_mu(&mirror_shell, next_uniform, &rng, &mu));
+    assert_false(optics_sample_emission_mu(&mirror_shell, next_uniform, &rng, &mu));
+    optics_point clear = shell(0.1, 0.0, 0.01); /* no absorption: no emission */
+    assert_false(optics_sample_emission_mu(&clear, next_uniform, &rng, &mu));
+    assert_true(optics_mean_emissivity(&clear) == 0.0);
+    optics_point zero_eps = {0.1, 10.0, 0.01, 0.0, true};
+    assert_false(optics_sample_emission_mu(&zero_eps, next_uniform, &rng, &mu));
+    assert_true(mu == 0.5);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_pointwise),         cmocka_unit_test(test_mean_transmission_e3),
+        cmocka_unit_test(test_means_capped),      cmocka_unit_test(test_kirchhoff_violation),
+        cmocka_unit_test(test_sample_transmission), cmocka_unit_test(test_sample_emission),
+        cmocka_unit_test(test_sample_zero),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
