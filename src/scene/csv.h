@@ -1,0 +1,39 @@
+/* A small reader for the numeric CSV tables scenes refer to (material properties,
+ * atmospheric attenuation): lines starting with `#` (after optional blanks) and blank
+ * lines are comments, the first other line is a header of column names, every further
+ * line a row of numbers, one per column, separated by commas. Errors name the file
+ * and its line, the row and the column.
+ */
+#ifndef THZ_SCENE_CSV_H
+#define THZ_SCENE_CSV_H
+
+#include <stddef.h>
+
+#include "core/error.h"
+
+typedef struct csv_table {
+    char *label;        /* the file name as used in messages */
+    size_t n_columns;
+    char **names;       /* n_columns header names, blanks trimmed */
+    size_t n_rows;
+    double *values;     /* n_rows * n_columns, row-major; all finite */
+    size_t *row_lines;  /* n_rows: the 1-based line of each row in the file */
+} csv_table;
+
+/* Reads the file at path; `label` (NULL: path) names it in messages. On error the
+ * table is left empty (csv_fini is still safe). THZ_ERR_IO when the file cannot be
+ * read, THZ_ERR_INPUT for bad content. */
+thz_status csv_read(const char *path, const char *label, csv_table *table, thz_error *err);
+
+/* The same from text held in memory. */
+thz_status csv_parse(const char *text, const char *label, csv_table *table, thz_error *err);
+
+/* Index of the column named `name`, or -1. */
+long csv_column(const csv_table *table, const char *name);
+
+/* Value of column `column` in row `row` (both 0-based, in range). */
+double csv_value(const csv_table *table, size_t row, size_t column);
+
+void csv_fini(csv_table *table);
+
+#endif

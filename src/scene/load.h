@@ -1,0 +1,117 @@
+/* Shared by the JSON loader's files (load.c, load_atmosphere.c), and by nothing else:
+ * the only code that knows JSON. A "cursor" here is a JSON value together with its
+ * path in the document (`objects[2].shape.radius_m`), which every content error
+ * names, beside the scene file, with what was expected.
+ */
+#ifndef THZ_SCENE_LOAD_H
+#define THZ_SCENE_LOAD_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <jansson.h>
+#include <math.h>
+
+#include "core/error.h"
+#include "physics/spectrum.h"
+#include "scene/csv.h"
+#include "scene/scene.h"
+
+/* Long enough for any path a sane scene produces; longer ones are cut (messages only). */
+#define LOAD_PATH_MAX 512
+
+typedef struct load_ctx {
+    const char *label; /* the scene file as named in messages */
+    const char *dir;   /* relative file paths in the scene are relative to it */
+    thz_scene *scene;
+    thz_error *err;
+} load_ctx;
+
+typedef struct load_cursor {
+    json_t *value; /* borrowed; NULL when the key is absent */
+    char path[LOAD_PATH_MAX];
+} load_cursor;
+
+/* A closed, open or half-open interval of accepted numbers; infinite ends allowed. */
+typedef struct load_range {
+    double lo, hi;
+    bool lo_open, hi_open;
+} load_range;
+
+#define LOAD_ANY ((load_range){-INFINITY, INFINITY, false, false})
+#define LOAD_NONNEGATIVE ((load_range){0.0, INFINITY, false, false})
+#define LOAD_POSITIVE ((load_range){0.0, INFINITY, true, false})
+#define LOAD_UNIT ((load_range){0.0, 1.0, false, false})
+
+/* The root cursor of a document. */
+load_cursor load_root(json_t *value);
+
+/* Member `key` of object cursor c (value NULL if absent), and element i of array c. */
+load_cursor load_key(const load_cursor *c, const char *key);
+load_cursor load_index(const load_cursor *c, size_t i);
+
+/* Sets ctx->err to THZ_ERR_INPUT with "<label>: <path>: <message>" (no path part at
+ * the root) and returns THZ_ERR_INPUT. */
+thz_status load_fail(load_ctx *ctx, const load_cursor *c, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* A short description of a JSON value's type for messages ("a string", "null"). */
+const char *load_type_name(const json_t *v);
+
+/* Fails unless c is an object whose keys are all in `allowed` (NULL-terminated). */
+thz_status load_expect_object(load_ctx *ctx, const load_cursor *c, const char *const *allowed);
+
+/* Fails unless member `key` of c is present (used for required keys whose value
+ * is parsed by a caller-specific function). `what` describes the expected value. */
+thz_status load_require(load_ctx *ctx, const load_cursor *c, const char *key, const char *what);
+
+/* Member `key` of object c as a number in range r. Absent: the default if not
+ * required, an error if required. */
+thz_status load_number(load_ctx *ctx, const load_cursor *c, const char *key, load_range r,
+                       bool required, double dflt, double *out);
+
+/* Member `key` as a whole number in [min, max] (a JSON real with an integral value,
+ * such as 1e6, counts). */
+thz_status load_integer(load_ctx *ctx, const load_cursor *c, const char *key, uint64_t min,
+                        uint64_t max, bool required, uint64_t dflt, uint64_t *out);
+
+/* Member `key` as a string (borrowed from the document); *out = dflt if absent and
+ * not required. */
+thz_status load_string(load_ctx *ctx, const load_cursor *c, const char *key, bool required,
+                       const char *dflt, const char **out);
+
+/* Member `key` as a boolean. */
+thz_status load_bool(load_ctx *ctx, const load_cursor *c, const char *key, bool dflt, bool *out);
+
+/* Member `key` as an array of exactly n numbers each in r. */
+thz_status load_vector(load_ctx *ctx, const load_cursor *c, const char *key, size_t n,
+                       load_range r, bool required, double *out);
+
+/* Member `key` as one of the NULL-terminated `choices`; *out is its index. */
+thz_status load_choice(load_ctx *ctx, const load_cursor *c, const char *key,
+                       const char *const *choices, bool required, size_t dflt, size_t *out);
+
+/* A path in the scene resolved against ctx->dir (absolute paths stay); malloc'd. */
+char *load_resolve_path(const load_ctx *ctx, const char *file);
+
+/* Member `key` of c, a file name, read as a CSV table. Errors name the JSON path and
+ * the CSV file with its line and row. */
+thz_status load_csv(load_ctx *ctx, const load_cursor *c, const char *key, csv_table *table);
+
+/* Column `column` of t (against column frequency_thz, which must be present) as a
+ * spectrum, checking frequencies (> 0, strictly increasing) and values in r. Errors
+ * name the file and the row. */
+thz_status load_csv_spectrum(load_ctx *ctx, const load_cursor *c, const csv_table *t,
+                             const char *column, load_range r, thz_spectrum *out);
+
+/* Member `key` of c as a spectral property: a number, or a table
+ * [[frequency_thz, value], ...]. *present tells whether the key was there (out is
+ * left untouched when it was not). */
+thz_status load_spectrum(load_ctx *ctx, const load_cursor *c, const char *key, load_range r,
+                         thz_spectrum *out, bool *present);
+
+/* The atmosphere block (load_atmosphere.c); c->value may be NULL (model none). */
+thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *atm);
+
+#endif

@@ -1,0 +1,229 @@
+/* Mesh import through the assimp C API, vertex welding and the winding check. */
+#include "scene/mesh_import.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <assimp/cimport.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "core/alloc.h"
+#include "scene/primitives.h"
+
+/* Counts the triangles of node and its children (each mesh as often as nodes use it). */
+static thz_status mesh_import_count(const struct aiScene *sc, const struct aiNode *node,
+                                    size_t depth, size_t *n_vertices, size_t *n_triangles)
+{
+    if (depth > 1000)
+        return THZ_ERR_INPUT;
+    for (unsigned i = 0; i < node->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[node->mMeshes[i]];
+        *n_vertices += m->mNumVertices;
+        for (unsigned f = 0; f < m->mNumFaces; f++)
+            *n_triangles += m->mFaces[f].mNumIndices == 3;
+    }
+    for (unsigned c = 0; c < node->mNumChildren; c++) {
+        thz_status st = mesh_import_count(sc, node->mChildren[c], depth + 1, n_vertices,
+                                          n_triangles);
+        if (st != THZ_OK)
+            return st;
+    }
+    return THZ_OK;
+}
+
+static void mesh_import_matmul(struct aiMatrix4x4 *out, const struct aiMatrix4x4 *a,
+                               const struct aiMatrix4x4 *b)
+{
+    const float *x = &a->a1, *y = &b->a1;
+    float r[16];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            r[4 * i + j] = x[4 * i] * y[j] + x[4 * i + 1] * y[4 + j] + x[4 * i + 2] * y[8 + j] +
+                           x[4 * i + 3] * y[12 + j];
+    memcpy(&out->a1, r, sizeof r);
+}
+
+static double mesh_import_det3(const struct aiMatrix4x4 *m)
+{
+    return (double)m->a1 * ((double)m->b2 * m->c3 - (double)m->b3 * m->c2) -
+           (double)m->a2 * ((double)m->b1 * m->c3 - (double)m->b3 * m->c1) +
+           (double)m->a3 * ((double)m->b1 * m->c2 - (double)m->b2 * m->c1);
+}
+
+/* Appends node's meshes, transformed by parent * node, to out. */
+static void mesh_import_append(const struct aiScene *sc, const struct aiNode *node,
+                               const struct aiMatrix4x4 *parent, thz_mesh *out)
+{
+    struct aiMatrix4x4 world;
+    mesh_import_matmul(&world, parent, &node->mTransformation);
+    bool flip = mesh_import_det3(&world) < 0.0;
+    for (unsigned i = 0; i < node->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[node->mMeshes[i]];
+        size_t base = out->n_vertices;
+        for (unsigned v = 0; v < m->mNumVertices; v++) {
+            const struct aiVector3D *p = &m->mVertices[v];
+            const float *w = &world.a1;
+            float *q = &out->positions[3 * (base + v)];
+            for (int k = 0; k < 3; k++)
+                q[k] = w[4 * k] * p->x + w[4 * k + 1] * p->y + w[4 * k + 2] * p->z + w[4 * k + 3];
+        }
+        out->n_vertices += m->mNumVertices;
+        for (unsigned f = 0; f < m->mNumFaces; f++) {
+            const struct aiFace *face = &m->mFaces[f];
+            if (face->mNumIndices != 3)
+                continue; /* points and lines have no surface */
+            uint32_t *t = &out->indices[3 * out->n_triangles];
+            t[0] = (uint32_t)(base + face->mIndices[0]);
+            t[1] = (uint32_t)(base + face->mIndices[flip ? 2 : 1]);
+            t[2] = (uint32_t)(base + face->mIndices[flip ? 1 : 2]);
+            out->n_triangles++;
+        }
+    }
+    for (unsigned c = 0; c < node->mNumChildren; c++)
+        mesh_import_append(sc, node->mChildren[c], &world, out);
+}
+
+/* qsort context-free comparison of vertex indices by position: the positions pointer
+ * travels in the sort records. */
+typedef struct weld_record {
+    const float *p;
+    uint32_t index;
+} weld_record;
+
+static int mesh_import_weld_cmp(const void *a, const void *b)
+{
+    const weld_record *x = a, *y = b;
+    for (int k = 0; k < 3; k++) {
+        if (x->p[k] < y->p[k])
+            return -1;
+        if (x->p[k] > y->p[k])
+            return 1;
+    }
+    return x->index < y->index ? -1 : x->index > y->index;
+}
+
+/* Merges vertices with identical positions and drops the unused ones. */
+static bool mesh_import_weld(thz_mesh *mesh)
+{
+    size_t n = mesh->n_vertices;
+    weld_record *rec = thz_malloc_array(n, sizeof *rec);
+    uint32_t *remap = thz_malloc_array(n, sizeof *remap);
+    float *pos = thz_malloc_array(3 * n + 4, sizeof *pos);
+    if (!rec || !remap || !pos) {
+        free(rec);
+        free(remap);
+        free(pos);
+        return false;
+    }
+    for (size_t v = 0; v < n; v++)
+        rec[v] = (weld_record){&mesh->positions[3 * v], (uint32_t)v};
+    qsort(rec, n, sizeof *rec, mesh_import_weld_cmp);
+    size_t unique = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (i == 0 || memcmp(rec[i].p, rec[i - 1].p, 3 * sizeof(float)) != 0) {
+            memcpy(&pos[3 * unique], rec[i].p, 3 * sizeof(float));
+            unique++;
+        }
+        remap[rec[i].index] = (uint32_t)(unique - 1);
+    }
+    memset(&pos[3 * unique], 0, 4 * sizeof *pos);
+    for (size_t i = 0; i < 3 * mesh->n_triangles; i++)
+        mesh->indices[i] = remap[mesh->indices[i]];
+    free(mesh->positions);
+    mesh->positions = pos;
+    mesh->n_vertices = unique;
+    free(rec);
+    free(remap);
+    return true;
+}
+
+thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_error *err)
+{
+    const char *name = label ? label : path;
+    thz_status st = THZ_OK;
+    memset(mesh, 0, sizeof *mesh);
+    FILE *probe = fopen(path, "rb");
+    if (!probe)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open mesh file: %s", name,
+                             strerror(errno));
+    fclose(probe);
+    const struct aiScene *sc =
+        aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+    if (!sc) {
+        const char *why = aiGetErrorString();
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot read as a mesh (OBJ, PLY, STL, glTF, ...): %s",
+                             name, why && why[0] ? why : "unknown format");
+    }
+    size_t nv = 0, nt = 0;
+    if (!sc->mRootNode || mesh_import_count(sc, sc->mRootNode, 0, &nv, &nt) != THZ_OK) {
+        st = thz_error_set(err, THZ_ERR_INPUT, "%s: the mesh's node tree is malformed", name);
+        goto cleanup;
+    }
+    if (nt == 0) {
+        st = thz_error_set(err, THZ_ERR_INPUT, "%s: the mesh has no triangles", name);
+        goto cleanup;
+    }
+    if (nv > UINT32_MAX) {
+        st = thz_error_set(err, THZ_ERR_INPUT, "%s: more than %u vertices", name, UINT32_MAX);
+        goto cleanup;
+    }
+    st = primitive_mesh_alloc(mesh, nv, nt, err);
+    if (st != THZ_OK)
+        goto cleanup;
+    mesh->n_vertices = 0;
+    mesh->n_triangles = 0;
+    struct aiMatrix4x4 identity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    mesh_import_append(sc, sc->mRootNode, &identity, mesh);
+    for (size_t i = 0; i < 3 * mesh->n_vertices; i++) {
+        if (!isfinite(mesh->positions[i])) {
+            st = thz_error_set(err, THZ_ERR_INPUT, "%s: vertex %zu has a coordinate that is not a finite number",
+                               name, i / 3 + 1);
+            goto cleanup;
+        }
+    }
+    if (!mesh_import_weld(mesh)) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", name);
+        goto cleanup;
+    }
+cleanup:
+    aiReleaseImport(sc);
+    if (st != THZ_OK)
+        mesh_fini(mesh);
+    return st;
+}
+
+static int mesh_import_edge_cmp(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+size_t mesh_import_winding_conflicts(const thz_mesh *mesh)
+{
+    size_t n = 3 * mesh->n_triangles;
+    uint64_t *edges = thz_malloc_array(n, sizeof *edges);
+    if (!edges)
+        return SIZE_MAX;
+    size_t m = 0;
+    for (size_t t = 0; t < mesh->n_triangles; t++) {
+        const uint32_t *v = &mesh->indices[3 * t];
+        for (int k = 0; k < 3; k++) {
+            uint32_t a = v[k], b = v[(k + 1) % 3];
+            if (a != b)
+                edges[m++] = ((uint64_t)a << 32) | b;
+        }
+    }
+    qsort(edges, m, sizeof *edges, mesh_import_edge_cmp);
+    size_t conflicts = 0;
+    for (size_t i = 1; i < m; i++)
+        if (edges[i] == edges[i - 1] && (i < 2 || edges[i - 1] != edges[i - 2]))
+            conflicts++;
+    free(edges);
+    return conflicts;
+}
