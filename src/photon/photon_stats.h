@@ -20,6 +20,14 @@ typedef struct photon_stats {
     double atmosphere_power_w_per_hz; /* sum of power absorbed by the atmosphere */
     double mean_bounces;            /* mean number of hits per photon path */
     double seconds;                 /* wall time of the phase (not reproducible) */
+    /* Energy balance (added by the photon phase): absorbed + escaped + atmosphere +
+     * terminated power = fired power exactly; fired power estimates emitted power. */
+    double fired_power_w_per_hz;      /* sum of the photons' initial powers */
+    double terminated_power_w_per_hz; /* net power removed by the low-power roulette (removed
+                                         at termination minus added to survivors; zero in
+                                         expectation) and by the bounce cap */
+    uint64_t bounce_capped;           /* paths stopped at the bounce cap (included in
+                                         terminated; should be 0) */
 } photon_stats;
 
 #endif

@@ -1,0 +1,242 @@
+/* Ray casting with Embree 3: one triangle geometry per object (geomID = object index),
+ * sharing the scene's float positions and indices, robust traversal and high build
+ * quality.
+ *
+ * Self-intersection rule. A ray leaving a surface is protected twice:
+ *  1. the (object, triangle) it leaves from is rejected by a context filter function,
+ *     so the leaving triangle can never be hit again at t ~ 0 whatever the rounding;
+ *  2. its origin is moved off the surface along the geometric normal, towards the side
+ *     the ray leaves on, by eps = max(1e-6 * bbox diagonal, 16 * FLT_EPSILON *
+ *     largest |coordinate|, 1e-9 m). The second term keeps the offset above the float
+ *     spacing of the coordinates (Embree works in single precision), so a neighbouring
+ *     triangle sharing an edge is not hit through rounding. For scenes up to ~50 m the
+ *     offset stays well below 0.1 mm, so both surfaces of a 0.1 mm shell are resolved
+ *     (tests/unit/test_accel.c checks exactly that).
+ */
+#include "accel/accel.h"
+
+#include <embree3/rtcore.h>
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/alloc.h"
+
+struct accel {
+    const thz_scene *scene;
+    RTCDevice device;
+    RTCScene rtc;
+    double offset_m; /* eps of the self-intersection rule */
+};
+
+/* The context passed to rtcIntersect1: Embree's context first, then what to ignore. */
+typedef struct accel_context {
+    struct RTCIntersectContext base;
+    uint32_t ignore_object;
+    uint32_t ignore_triangle;
+} accel_context;
+
+/* Context filter: rejects the hit on the triangle the ray leaves from. The hit layout
+ * is Embree's RTCHitN (SOA): primID at word 5N + i, geomID at 6N + i. */
+static void accel_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    const accel_context *ctx = (const accel_context *)args->context;
+    const unsigned *words = (const unsigned *)args->hit;
+    unsigned n = args->N;
+    for (unsigned i = 0; i < n; i++) {
+        if (args->valid[i] == 0)
+            continue;
+        if (words[6 * n + i] == ctx->ignore_object && words[5 * n + i] == ctx->ignore_triangle)
+            args->valid[i] = 0;
+    }
+}
+
+static const char *accel_error_name(enum RTCError e)
+{
+    switch (e) {
+    case RTC_ERROR_NONE:
+        return "no error";
+    case RTC_ERROR_INVALID_ARGUMENT:
+        return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION:
+        return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY:
+        return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU:
+        return "unsupported CPU";
+    case RTC_ERROR_CANCELLED:
+        return "cancelled";
+    default:
+        return "unknown error";
+    }
+}
+
+static thz_status accel_check_device(RTCDevice device, const char *what, thz_error *err)
+{
+    enum RTCError e = rtcGetDeviceError(device);
+    if (e == RTC_ERROR_NONE)
+        return THZ_OK;
+    return thz_error_set(err, e == RTC_ERROR_OUT_OF_MEMORY ? THZ_ERR_NOMEM : THZ_ERR_INTERNAL,
+                         "ray casting: Embree failed while %s: %s", what, accel_error_name(e));
+}
+
+thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err)
+{
+    thz_status st = THZ_OK;
+    *out = NULL;
+    accel *a = thz_calloc(1, sizeof *a);
+    if (!a)
+        return thz_error_set(err, THZ_ERR_NOMEM, "ray casting: out of memory");
+    a->scene = scene;
+
+    if (scene->n_objects >= RTC_INVALID_GEOMETRY_ID) {
+        st = thz_error_set(err, THZ_ERR_LIMIT, "ray casting: too many objects (%zu)",
+                           scene->n_objects);
+        goto cleanup;
+    }
+
+    a->device = rtcNewDevice(NULL);
+    if (!a->device) {
+        st = thz_error_set(err, THZ_ERR_INTERNAL, "ray casting: cannot create the Embree device: %s",
+                           accel_error_name(rtcGetDeviceError(NULL)));
+        goto cleanup;
+    }
+    a->rtc = rtcNewScene(a->device);
+    if (!a->rtc) {
+        st = accel_check_device(a->device, "creating the scene", err);
+        if (st == THZ_OK)
+            st = thz_error_set(err, THZ_ERR_INTERNAL, "ray casting: cannot create the scene");
+        goto cleanup;
+    }
+    rtcSetSceneFlags(a->rtc, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    rtcSetSceneBuildQuality(a->rtc, RTC_BUILD_QUALITY_HIGH);
+
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double max_abs = 0.0;
+    for (size_t i = 0; i < scene->n_objects; i++) {
+        const thz_mesh *m = &scene->objects[i].mesh;
+        if (m->n_triangles == 0 || m->n_vertices == 0)
+            continue;
+        if (m->n_triangles > UINT32_MAX || m->n_vertices > UINT32_MAX) {
+            st = thz_error_set(err, THZ_ERR_LIMIT,
+                               "ray casting: object '%s' has too many triangles (%zu)",
+                               scene->objects[i].name ? scene->objects[i].name : "?",
+                               m->n_triangles);
+            goto cleanup;
+        }
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], m->bbox_min_m[k]);
+            hi[k] = fmax(hi[k], m->bbox_max_m[k]);
+            max_abs = fmax(max_abs, fmax(fabs(m->bbox_min_m[k]), fabs(m->bbox_max_m[k])));
+        }
+        RTCGeometry g = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        if (!g) {
+            st = accel_check_device(a->device, "creating a geometry", err);
+            goto cleanup;
+        }
+        /* Shared buffers: the scene's positions carry the 16 bytes of padding Embree
+         * reads past the last vertex. */
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m->positions, 0,
+                                   3 * sizeof(float), m->n_vertices);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m->indices, 0,
+                                   3 * sizeof(uint32_t), m->n_triangles);
+        rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(a->rtc, g, (unsigned)i);
+        rtcReleaseGeometry(g);
+        st = accel_check_device(a->device, "adding a geometry", err);
+        if (st != THZ_OK)
+            goto cleanup;
+    }
+    rtcCommitScene(a->rtc);
+    st = accel_check_device(a->device, "building the acceleration structure", err);
+    if (st != THZ_OK)
+        goto cleanup;
+
+    double diag = 0.0;
+    if (lo[0] <= hi[0]) {
+        double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+        diag = sqrt(dx * dx + dy * dy + dz * dz);
+    }
+    a->offset_m = fmax(fmax(1e-6 * diag, 16.0 * FLT_EPSILON * max_abs), 1e-9);
+
+    *out = a;
+    a = NULL;
+cleanup:
+    accel_destroy(a);
+    return st;
+}
+
+void accel_destroy(accel *a)
+{
+    if (!a)
+        return;
+    if (a->rtc)
+        rtcReleaseScene(a->rtc);
+    if (a->device)
+        rtcReleaseDevice(a->device);
+    free(a);
+}
+
+bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distance_m,
+                     uint32_t ignore_object, uint32_t ignore_triangle, accel_hit *hit)
+{
+    accel_context ctx;
+    rtcInitIntersectContext(&ctx.base);
+    ctx.ignore_object = ignore_object;
+    ctx.ignore_triangle = ignore_triangle;
+    if (ignore_object != ACCEL_NO_OBJECT)
+        ctx.base.filter = accel_filter;
+
+    struct RTCRayHit rh;
+    rh.ray.org_x = (float)origin_m.x;
+    rh.ray.org_y = (float)origin_m.y;
+    rh.ray.org_z = (float)origin_m.z;
+    rh.ray.dir_x = (float)dir.x;
+    rh.ray.dir_y = (float)dir.y;
+    rh.ray.dir_z = (float)dir.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = max_distance_m >= (double)FLT_MAX ? INFINITY : (float)max_distance_m;
+    rh.ray.time = 0.0f;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+
+    rtcIntersect1(a->rtc, &ctx.base, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        return false;
+
+    const thz_mesh *m = &a->scene->objects[rh.hit.geomID].mesh;
+    uint32_t tri = rh.hit.primID;
+    const float *nf = &m->normals[3 * (size_t)tri];
+    vec3 n = v3(nf[0], nf[1], nf[2]);
+    double c = v3_dot(dir, n);
+
+    /* The hit point from the barycentric coordinates lies on the triangle's plane to
+     * float precision, however long the ray; origin + t dir would not. */
+    const uint32_t *idx = &m->indices[3 * (size_t)tri];
+    vec3 p0 = v3_from_floats(&m->positions[3 * (size_t)idx[0]]);
+    vec3 p1 = v3_from_floats(&m->positions[3 * (size_t)idx[1]]);
+    vec3 p2 = v3_from_floats(&m->positions[3 * (size_t)idx[2]]);
+    double u = rh.hit.u, v = rh.hit.v;
+    hit->position_m = v3_add(v3_scale(p0, 1.0 - u - v), v3_add(v3_scale(p1, u), v3_scale(p2, v)));
+    hit->distance_m = rh.ray.tfar;
+    hit->object = rh.hit.geomID;
+    hit->triangle = tri;
+    hit->side = c < 0.0 ? 0 : 1;
+    double mu = fabs(c);
+    hit->cos_theta = mu > 1.0 ? 1.0 : (mu > 1e-12 ? mu : 1e-12);
+    return true;
+}
+
+vec3 accel_offset_origin(const accel *a, const accel_hit *hit, vec3 dir)
+{
+    const thz_mesh *m = &a->scene->objects[hit->object].mesh;
+    const float *nf = &m->normals[3 * (size_t)hit->triangle];
+    vec3 n = v3(nf[0], nf[1], nf[2]);
+    double s = v3_dot(dir, n) >= 0.0 ? a->offset_m : -a->offset_m;
+    return v3_madd(hit->position_m, s, n);
+}

@@ -1,0 +1,561 @@
+/* photon-map.thzpm writer and reader: see photon_map_file.h for the layout. */
+#include "io/photon_map_file.h"
+
+#include <errno.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <zstd.h>
+#include <zstd_errors.h>
+
+#include "core/alloc.h"
+#include "scene/scene_hash.h"
+
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "photon_map_file.c writes records as in memory: little-endian hosts only"
+#endif
+
+#define PMF_PREFIX_BYTES 24u
+#define PMF_HEADER_FIXED 7u   /* u64 words before the channels */
+#define PMF_CHANNEL_WORDS 20u /* centre, width, count, 10 counters, 7 reals */
+#define PMF_LEVEL 3
+#define PMF_MAX_HEADER_BYTES (16u << 20)
+
+/* ---- little-endian words ---------------------------------------------------- */
+
+static void put_u64(uint8_t *p, uint64_t v)
+{
+    for (int i = 0; i < 8; i++)
+        p[i] = (uint8_t)(v >> (8 * i));
+}
+
+static uint64_t get_u64(const uint8_t *p)
+{
+    uint64_t v = 0;
+    for (int i = 0; i < 8; i++)
+        v |= (uint64_t)p[i] << (8 * i);
+    return v;
+}
+
+static void put_f64(uint8_t *p, double x)
+{
+    uint64_t v;
+    memcpy(&v, &x, sizeof v);
+    put_u64(p, v);
+}
+
+static double get_f64(const uint8_t *p)
+{
+    uint64_t v = get_u64(p);
+    double x;
+    memcpy(&x, &v, sizeof x);
+    return x;
+}
+
+/* The stats of one channel as 17 words (order fixed by version 1). */
+static void pmf_put_stats(uint8_t *p, const photon_stats *s)
+{
+    const uint64_t u[10] = {s->fired,   s->stored,  s->hits,           s->reflected,  s->transmitted,
+                            s->absorbed, s->escaped, s->back_face_hits, s->terminated, s->bounce_capped};
+    const double d[7] = {s->emitted_power_w_per_hz,    s->absorbed_power_w_per_hz,
+                         s->escaped_power_w_per_hz,    s->atmosphere_power_w_per_hz,
+                         s->mean_bounces,              s->fired_power_w_per_hz,
+                         s->terminated_power_w_per_hz};
+    for (int i = 0; i < 10; i++)
+        put_u64(p + 8 * i, u[i]);
+    for (int i = 0; i < 7; i++)
+        put_f64(p + 80 + 8 * i, d[i]);
+}
+
+static void pmf_get_stats(const uint8_t *p, photon_stats *s)
+{
+    memset(s, 0, sizeof *s);
+    uint64_t *u[10] = {&s->fired,   &s->stored,  &s->hits,           &s->reflected,  &s->transmitted,
+                       &s->absorbed, &s->escaped, &s->back_face_hits, &s->terminated, &s->bounce_capped};
+    double *d[7] = {&s->emitted_power_w_per_hz,    &s->absorbed_power_w_per_hz,
+                    &s->escaped_power_w_per_hz,    &s->atmosphere_power_w_per_hz,
+                    &s->mean_bounces,              &s->fired_power_w_per_hz,
+                    &s->terminated_power_w_per_hz};
+    for (int i = 0; i < 10; i++)
+        *u[i] = get_u64(p + 8 * i);
+    for (int i = 0; i < 7; i++)
+        *d[i] = get_f64(p + 80 + 8 * i);
+}
+
+/* Canonical record order: by object_side, then by the record's bytes. */
+static int pmf_record_cmp(const void *a, const void *b)
+{
+    const photon_record *x = a, *y = b;
+    if (x->object_side != y->object_side)
+        return x->object_side < y->object_side ? -1 : 1;
+    return memcmp(x, y, sizeof *x);
+}
+
+/* ---- writing ------------------------------------------------------------------ */
+
+typedef struct pmf_writer {
+    const char *path;
+    FILE *f;
+    ZSTD_CCtx *cctx;
+    uint8_t *out;
+    size_t out_cap;
+} pmf_writer;
+
+static thz_status pmf_write_bytes(pmf_writer *w, const void *p, size_t n, thz_error *err)
+{
+    if (n && fwrite(p, 1, n, w->f) != n)
+        return thz_error_set(err, THZ_ERR_IO, "cannot write photon map %s: %s", w->path,
+                             strerror(errno));
+    return THZ_OK;
+}
+
+static thz_status pmf_compress(pmf_writer *w, const void *src, size_t n, ZSTD_EndDirective mode,
+                               thz_error *err)
+{
+    ZSTD_inBuffer in = {src, n, 0};
+    for (;;) {
+        ZSTD_outBuffer out = {w->out, w->out_cap, 0};
+        size_t r = ZSTD_compressStream2(w->cctx, &out, &in, mode);
+        if (ZSTD_isError(r))
+            return thz_error_set(err, THZ_ERR_INTERNAL, "cannot compress photon map %s: %s",
+                                 w->path, ZSTD_getErrorName(r));
+        thz_status st = pmf_write_bytes(w, w->out, out.pos, err);
+        if (st != THZ_OK)
+            return st;
+        if (mode == ZSTD_e_end ? r == 0 : in.pos == in.size)
+            return THZ_OK;
+    }
+}
+
+static thz_status pmf_begin_frame(pmf_writer *w, uint64_t content_bytes, thz_error *err)
+{
+    size_t r = ZSTD_CCtx_reset(w->cctx, ZSTD_reset_session_only);
+    if (!ZSTD_isError(r))
+        r = ZSTD_CCtx_setPledgedSrcSize(w->cctx, content_bytes);
+    if (ZSTD_isError(r))
+        return thz_error_set(err, THZ_ERR_INTERNAL, "cannot compress photon map %s: %s", w->path,
+                             ZSTD_getErrorName(r));
+    return THZ_OK;
+}
+
+/* Compresses one channel's records in canonical order. Records of a photon map are
+ * grouped by (object, side) in increasing order, so each group is sorted on its own and
+ * only one group is copied at a time; any other order falls back to one whole copy. */
+static thz_status pmf_write_channel(pmf_writer *w, const photon_map *map, thz_error *err)
+{
+    const photon_record *r = photon_map_records(map);
+    size_t n = photon_map_count(map);
+    bool grouped = true;
+    for (size_t i = 1; i < n && grouped; i++)
+        grouped = r[i - 1].object_side <= r[i].object_side;
+    size_t largest = grouped ? 0 : n;
+    for (size_t i = 0; i < n && grouped;) {
+        size_t j = i;
+        while (j < n && r[j].object_side == r[i].object_side)
+            j++;
+        if (j - i > largest)
+            largest = j - i;
+        i = j;
+    }
+    photon_record *tmp = thz_malloc_array(largest ? largest : 1, sizeof *tmp);
+    if (!tmp)
+        return thz_error_set(err, THZ_ERR_NOMEM, "cannot write photon map %s: out of memory",
+                             w->path);
+    thz_status st = THZ_OK;
+    for (size_t i = 0; i < n;) {
+        size_t j = n;
+        if (grouped) {
+            j = i;
+            while (j < n && r[j].object_side == r[i].object_side)
+                j++;
+        }
+        memcpy(tmp, r + i, (j - i) * sizeof *tmp);
+        qsort(tmp, j - i, sizeof *tmp, pmf_record_cmp);
+        st = pmf_compress(w, tmp, (j - i) * sizeof *tmp, ZSTD_e_continue, err);
+        if (st != THZ_OK)
+            break;
+        i = j;
+    }
+    free(tmp);
+    return st;
+}
+
+thz_status photon_map_file_write(const char *path, const thz_scene *scene,
+                                 const photon_map *const *maps, const photon_stats *stats,
+                                 thz_error *err)
+{
+    thz_status st = THZ_OK;
+    size_t nc = scene->n_channels;
+    pmf_writer w = {.path = path};
+    size_t header_bytes = 8 * (PMF_HEADER_FIXED + (size_t)PMF_CHANNEL_WORDS * nc);
+    uint8_t *header = thz_calloc(header_bytes, 1);
+    w.out_cap = ZSTD_CStreamOutSize();
+    w.out = thz_malloc_array(w.out_cap, 1);
+    w.cctx = ZSTD_createCCtx();
+    if (!header || !w.out || !w.cctx) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "cannot write photon map %s: out of memory", path);
+        goto cleanup;
+    }
+    size_t r = ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_compressionLevel, PMF_LEVEL);
+    if (!ZSTD_isError(r))
+        r = ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_checksumFlag, 1);
+    if (!ZSTD_isError(r))
+        r = ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_contentSizeFlag, 1);
+    if (ZSTD_isError(r)) {
+        st = thz_error_set(err, THZ_ERR_INTERNAL, "cannot write photon map %s: %s", path,
+                           ZSTD_getErrorName(r));
+        goto cleanup;
+    }
+
+    scene_hash h;
+    scene_hash_compute(scene, &h);
+    uint64_t total_records = 0;
+    put_u64(header + 0, h.geometry);
+    put_u64(header + 8, h.optics);
+    put_u64(header + 16, h.channels);
+    put_u64(header + 24, nc);
+    put_u64(header + 32, scene->n_objects);
+    put_u64(header + 40, scene->photons.seed);
+    put_u64(header + 48, scene->photons.per_channel);
+    for (size_t c = 0; c < nc; c++) {
+        if (!maps[c]) {
+            st = thz_error_set(err, THZ_ERR_INTERNAL, "cannot write photon map %s: channel %zu has no map",
+                               path, c);
+            goto cleanup;
+        }
+        uint8_t *p = header + 8 * (PMF_HEADER_FIXED + (size_t)PMF_CHANNEL_WORDS * c);
+        uint64_t count = photon_map_count(maps[c]);
+        put_f64(p, scene->channels[c].center_hz);
+        put_f64(p + 8, scene->channels[c].relative_width);
+        put_u64(p + 16, count);
+        photon_stats s = {0};
+        if (stats)
+            s = stats[c];
+        pmf_put_stats(p + 24, &s);
+        total_records += count;
+    }
+
+    w.f = fopen(path, "wb");
+    if (!w.f) {
+        st = thz_error_set(err, THZ_ERR_IO, "cannot create photon map %s: %s", path, strerror(errno));
+        goto cleanup;
+    }
+    uint8_t prefix[PMF_PREFIX_BYTES] = {0};
+    memcpy(prefix, PHOTON_MAP_FILE_MAGIC, 8);
+    prefix[8] = (uint8_t)PHOTON_MAP_FILE_VERSION;
+    st = pmf_write_bytes(&w, prefix, sizeof prefix, err); /* size patched at the end */
+    if (st == THZ_OK)
+        st = pmf_begin_frame(&w, header_bytes, err);
+    if (st == THZ_OK)
+        st = pmf_compress(&w, header, header_bytes, ZSTD_e_end, err);
+    if (st == THZ_OK)
+        st = pmf_begin_frame(&w, total_records * sizeof(photon_record), err);
+    for (size_t c = 0; c < nc && st == THZ_OK; c++)
+        st = pmf_write_channel(&w, maps[c], err);
+    if (st == THZ_OK)
+        st = pmf_compress(&w, NULL, 0, ZSTD_e_end, err);
+    if (st != THZ_OK)
+        goto cleanup;
+    long size = ftell(w.f);
+    if (size < 0 || fseek(w.f, 16, SEEK_SET) != 0) {
+        st = thz_error_set(err, THZ_ERR_IO, "cannot write photon map %s: %s", path, strerror(errno));
+        goto cleanup;
+    }
+    put_u64(prefix + 16, (uint64_t)size);
+    st = pmf_write_bytes(&w, prefix + 16, 8, err);
+    if (st != THZ_OK)
+        goto cleanup;
+    FILE *f = w.f;
+    w.f = NULL;
+    if (fclose(f) != 0)
+        st = thz_error_set(err, THZ_ERR_IO, "cannot write photon map %s: %s", path, strerror(errno));
+cleanup:
+    if (w.f)
+        fclose(w.f);
+    ZSTD_freeCCtx(w.cctx);
+    free(w.out);
+    free(header);
+    return st;
+}
+
+/* ---- reading ------------------------------------------------------------------ */
+
+typedef struct pmf_reader {
+    const char *path;
+    FILE *f;
+    ZSTD_DCtx *dctx;
+    uint8_t *in;
+    size_t in_cap, in_pos, in_size;
+    bool eof;
+} pmf_reader;
+
+static thz_status pmf_corrupt(const pmf_reader *r, const char *why, thz_error *err)
+{
+    return thz_error_set(err, THZ_ERR_IO, "photon map %s is corrupted (%s); run `thzmap simulate` again",
+                         r->path, why);
+}
+
+static thz_status pmf_zstd_error(const pmf_reader *r, size_t code, thz_error *err)
+{
+    if (ZSTD_getErrorCode(code) == ZSTD_error_checksum_wrong)
+        return pmf_corrupt(r, "checksum mismatch", err);
+    return pmf_corrupt(r, ZSTD_getErrorName(code), err);
+}
+
+static thz_status pmf_fill(pmf_reader *r, thz_error *err)
+{
+    if (r->in_pos < r->in_size || r->eof)
+        return THZ_OK;
+    r->in_size = fread(r->in, 1, r->in_cap, r->f);
+    r->in_pos = 0;
+    if (r->in_size == 0) {
+        if (ferror(r->f))
+            return thz_error_set(err, THZ_ERR_IO, "cannot read photon map %s: %s", r->path,
+                                 strerror(errno));
+        r->eof = true;
+    }
+    return THZ_OK;
+}
+
+/* Decompresses exactly n bytes of the current frame into dst. */
+static thz_status pmf_read(pmf_reader *r, void *dst, size_t n, thz_error *err)
+{
+    ZSTD_outBuffer out = {dst, n, 0};
+    while (out.pos < n) {
+        thz_status st = pmf_fill(r, err);
+        if (st != THZ_OK)
+            return st;
+        if (r->eof)
+            return pmf_corrupt(r, "its data ends early", err);
+        ZSTD_inBuffer in = {r->in, r->in_size, r->in_pos};
+        size_t ret = ZSTD_decompressStream(r->dctx, &out, &in);
+        r->in_pos = in.pos;
+        if (ZSTD_isError(ret))
+            return pmf_zstd_error(r, ret, err);
+        if (ret == 0 && out.pos < n)
+            return pmf_corrupt(r, "a section is shorter than its header says", err);
+    }
+    return THZ_OK;
+}
+
+/* Finishes the current frame, which must hold no more data (checks its checksum). */
+static thz_status pmf_end_frame(pmf_reader *r, thz_error *err)
+{
+    for (;;) {
+        thz_status st = pmf_fill(r, err);
+        if (st != THZ_OK)
+            return st;
+        uint8_t extra;
+        ZSTD_outBuffer out = {&extra, 1, 0};
+        ZSTD_inBuffer in = {r->in, r->in_size, r->in_pos};
+        size_t ret = ZSTD_decompressStream(r->dctx, &out, &in);
+        r->in_pos = in.pos;
+        if (ZSTD_isError(ret))
+            return pmf_zstd_error(r, ret, err);
+        if (out.pos > 0)
+            return pmf_corrupt(r, "a section is longer than its header says", err);
+        if (ret == 0)
+            return THZ_OK;
+        if (r->eof)
+            return pmf_corrupt(r, "its data ends early", err);
+    }
+}
+
+thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,
+                                photon_map **maps, photon_stats *stats,
+                                photon_map_file_info *info, thz_error *err)
+{
+    thz_status st = THZ_OK;
+    size_t nc = scene->n_channels;
+    pmf_reader r = {.path = path};
+    uint8_t *header = NULL;
+    photon_record **records = thz_calloc(nc ? nc : 1, sizeof *records);
+    for (size_t c = 0; c < nc; c++)
+        maps[c] = NULL;
+    if (!records)
+        return thz_error_set(err, THZ_ERR_NOMEM, "cannot read photon map %s: out of memory", path);
+
+    r.f = fopen(path, "rb");
+    if (!r.f) {
+        st = thz_error_set(err, errno == ENOENT ? THZ_ERR_INPUT : THZ_ERR_IO,
+                           "cannot open photon map %s: %s", path, strerror(errno));
+        goto cleanup;
+    }
+    long actual = -1;
+    if (fseek(r.f, 0, SEEK_END) == 0)
+        actual = ftell(r.f);
+    if (actual < 0 || fseek(r.f, 0, SEEK_SET) != 0) {
+        st = thz_error_set(err, THZ_ERR_IO, "cannot read photon map %s: %s", path, strerror(errno));
+        goto cleanup;
+    }
+    uint8_t prefix[PMF_PREFIX_BYTES];
+    size_t got = fread(prefix, 1, sizeof prefix, r.f);
+    if (got >= 8 && memcmp(prefix, PHOTON_MAP_FILE_MAGIC, 8) != 0) {
+        st = thz_error_set(err, THZ_ERR_INPUT, "%s is not a thzmap photon map (.thzpm) file", path);
+        goto cleanup;
+    }
+    if (got < sizeof prefix) {
+        st = thz_error_set(err, THZ_ERR_IO,
+                           "photon map %s is truncated (%ld bytes); run `thzmap simulate` again",
+                           path, actual);
+        goto cleanup;
+    }
+    uint32_t version = (uint32_t)(get_u64(prefix + 8) & 0xffffffffu);
+    if (version != PHOTON_MAP_FILE_VERSION) {
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "photon map %s has format version %u; this thzmap reads version %u",
+                           path, version, PHOTON_MAP_FILE_VERSION);
+        goto cleanup;
+    }
+    uint64_t stated = get_u64(prefix + 16);
+    if ((uint64_t)actual < stated) {
+        st = thz_error_set(err, THZ_ERR_IO,
+                           "photon map %s is truncated (%ld of %llu bytes); run `thzmap simulate` again",
+                           path, actual, (unsigned long long)stated);
+        goto cleanup;
+    }
+    if ((uint64_t)actual > stated) {
+        r.path = path;
+        st = thz_error_set(err, THZ_ERR_IO,
+                           "photon map %s is corrupted (%ld bytes where its header says %llu); run "
+                           "`thzmap simulate` again",
+                           path, actual, (unsigned long long)stated);
+        goto cleanup;
+    }
+
+    r.in_cap = ZSTD_DStreamInSize();
+    r.in = thz_malloc_array(r.in_cap, 1);
+    r.dctx = ZSTD_createDCtx();
+    if (!r.in || !r.dctx) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "cannot read photon map %s: out of memory", path);
+        goto cleanup;
+    }
+
+    /* Frame 1: the header, whose size the frame states; checksum verified before use. */
+    st = pmf_fill(&r, err);
+    if (st != THZ_OK)
+        goto cleanup;
+    unsigned long long hsize = ZSTD_getFrameContentSize(r.in + r.in_pos, r.in_size - r.in_pos);
+    if (hsize == ZSTD_CONTENTSIZE_ERROR || hsize == ZSTD_CONTENTSIZE_UNKNOWN ||
+        hsize < 8 * PMF_HEADER_FIXED || hsize > PMF_MAX_HEADER_BYTES) {
+        st = pmf_corrupt(&r, "bad header", err);
+        goto cleanup;
+    }
+    header = thz_malloc_array((size_t)hsize, 1);
+    if (!header) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "cannot read photon map %s: out of memory", path);
+        goto cleanup;
+    }
+    st = pmf_read(&r, header, (size_t)hsize, err);
+    if (st == THZ_OK)
+        st = pmf_end_frame(&r, err);
+    if (st != THZ_OK)
+        goto cleanup;
+    uint64_t file_nc = get_u64(header + 24);
+    if (file_nc > (PMF_MAX_HEADER_BYTES / 8) ||
+        hsize != 8 * (PMF_HEADER_FIXED + PMF_CHANNEL_WORDS * file_nc)) {
+        st = pmf_corrupt(&r, "inconsistent header", err);
+        goto cleanup;
+    }
+
+    /* Does it belong to this scene? */
+    scene_hash h;
+    scene_hash_compute(scene, &h);
+    if (get_u64(header + 0) != h.geometry || get_u64(header + 32) != scene->n_objects) {
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "photon map %s was made from another scene geometry (objects or meshes "
+                           "differ from %s); run `thzmap simulate` on this scene",
+                           path, scene->path ? scene->path : "this scene");
+        goto cleanup;
+    }
+    if (get_u64(header + 16) != h.channels || file_nc != nc) {
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "photon map %s was made from another channel set (%llu channels; %s has "
+                           "%zu or different ones); run `thzmap simulate` on this scene",
+                           path, (unsigned long long)file_nc,
+                           scene->path ? scene->path : "this scene", nc);
+        goto cleanup;
+    }
+    if (get_u64(header + 8) != h.optics) {
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "photon map %s was made from another scene (materials, temperatures or "
+                           "atmosphere differ from %s); run `thzmap simulate` on this scene",
+                           path, scene->path ? scene->path : "this scene");
+        goto cleanup;
+    }
+
+    /* Frame 2: the records. */
+    for (size_t c = 0; c < nc; c++) {
+        const uint8_t *p = header + 8 * (PMF_HEADER_FIXED + (size_t)PMF_CHANNEL_WORDS * c);
+        uint64_t count = get_u64(p + 16);
+        if (count > (uint64_t)(SIZE_MAX / sizeof(photon_record))) {
+            st = pmf_corrupt(&r, "impossible record count", err);
+            goto cleanup;
+        }
+        records[c] = thz_malloc_array((size_t)count, sizeof(photon_record));
+        if (!records[c]) {
+            st = thz_error_set(err, THZ_ERR_NOMEM,
+                               "cannot read photon map %s: out of memory for %llu photons", path,
+                               (unsigned long long)count);
+            goto cleanup;
+        }
+        st = pmf_read(&r, records[c], (size_t)count * sizeof(photon_record), err);
+        if (st != THZ_OK)
+            goto cleanup;
+        for (size_t i = 0; i < count; i++) {
+            if ((records[c][i].object_side >> 1) >= scene->n_objects) {
+                st = pmf_corrupt(&r, "a photon names an object the scene does not have", err);
+                goto cleanup;
+            }
+        }
+        if (stats) {
+            pmf_get_stats(p + 24, &stats[c]);
+            stats[c].seconds = 0.0;
+        }
+    }
+    st = pmf_end_frame(&r, err);
+    if (st != THZ_OK)
+        goto cleanup;
+    st = pmf_fill(&r, err);
+    if (st != THZ_OK)
+        goto cleanup;
+    if (!r.eof) {
+        st = pmf_corrupt(&r, "data after the end", err);
+        goto cleanup;
+    }
+
+    for (size_t c = 0; c < nc; c++) {
+        const uint8_t *p = header + 8 * (PMF_HEADER_FIXED + (size_t)PMF_CHANNEL_WORDS * c);
+        photon_record *rec = records[c];
+        records[c] = NULL; /* photon_map_create owns it from here, also on failure */
+        st = photon_map_create(rec, (size_t)get_u64(p + 16), scene->n_objects, threads, &maps[c],
+                               err);
+        if (st != THZ_OK) {
+            thz_error_prefix(err, "photon map %s: ", path);
+            goto cleanup;
+        }
+    }
+    if (info) {
+        info->n_channels = nc;
+        info->seed = get_u64(header + 40);
+        info->photons_per_channel = get_u64(header + 48);
+    }
+
+cleanup:
+    if (st != THZ_OK) {
+        for (size_t c = 0; c < nc; c++) {
+            photon_map_destroy(maps[c]);
+            maps[c] = NULL;
+        }
+    }
+    for (size_t c = 0; c < nc; c++)
+        free(records[c]);
+    free(records);
+    free(header);
+    ZSTD_freeDCtx(r.dctx);
+    free(r.in);
+    if (r.f)
+        fclose(r.f);
+    return st;
+}

@@ -1,0 +1,56 @@
+/* photon-map.thzpm: every channel's photon map and photon-phase statistics, so that
+ * `render` can reuse a simulation's photons (scene-format.md "Outputs").
+ *
+ * Layout (little-endian, version 1):
+ *   prefix, 24 bytes, uncompressed: magic "THZPMAP\x1a", u32 version, u32 flags (0),
+ *     u64 total file size (detects truncation before decoding anything);
+ *   zstd frame 1 (with content checksum): the header: u64 scene hashes (geometry,
+ *     optics, channels; scene_hash.h), u64 n_channels, n_objects, seed, photons per
+ *     channel, then per channel: f64 centre Hz, f64 relative width, u64 record count, and
+ *     the photon_stats (10 counters, 7 powers and means; the wall time is not stored so
+ *     that a file depends only on the scene, seed and photon count);
+ *   zstd frame 2 (with content checksum and content size): the records of channel 0,
+ *     1, ... as 32-byte photon_record images. Within a channel they are in a canonical
+ *     order (by object_side, then by their bytes) that does not depend on the photon
+ *     map's internal order, so that read + write reproduces a file byte for byte.
+ */
+#ifndef THZ_IO_PHOTON_MAP_FILE_H
+#define THZ_IO_PHOTON_MAP_FILE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "photon/photon_map.h"
+#include "photon/photon_stats.h"
+#include "scene/scene.h"
+
+#define PHOTON_MAP_FILE_VERSION 1u
+#define PHOTON_MAP_FILE_MAGIC "THZPMAP\x1a"
+
+/* What a file says beyond its maps. */
+typedef struct photon_map_file_info {
+    uint64_t seed;
+    uint64_t photons_per_channel;
+    size_t n_channels;
+} photon_map_file_info;
+
+/* Writes scene->n_channels maps (maps[c], borrowed) and their stats (n_channels entries,
+ * may be NULL: zeros are written) to path, recording scene->photons' seed and count and
+ * the scene's hashes. Errors name the file. */
+thz_status photon_map_file_write(const char *path, const thz_scene *scene,
+                                 const photon_map *const *maps, const photon_stats *stats,
+                                 thz_error *err);
+
+/* Reads a photon-map file made from `scene`: fills maps[0..n_channels-1] (the caller
+ * destroys them; all NULL on failure), stats (n_channels entries, may be NULL; seconds
+ * is 0) and info (may be NULL). `threads` is passed to photon_map_create. Refuses, with
+ * a message naming the file: a file that is not a photon map or has another version
+ * (THZ_ERR_INPUT), a truncated or corrupted one (THZ_ERR_IO; corruption is found by the
+ * zstd checksums), and one made from another scene geometry, material set or channel
+ * set (THZ_ERR_INPUT). */
+thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,
+                                photon_map **maps, photon_stats *stats,
+                                photon_map_file_info *info, thz_error *err);
+
+#endif

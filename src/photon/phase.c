@@ -1,0 +1,244 @@
+/* The photon phase of one channel: batches, OpenMP over chunks, ordered merge, stats. */
+#include "photon/phase.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "photon/emission.h"
+#include "photon/trace.h"
+
+/* Where one chunk's records landed: a range of its thread's buffer. */
+typedef struct phase_chunk {
+    int thread;
+    size_t start, count;
+    trace_counters counters;
+} phase_chunk;
+
+typedef struct phase_fire_args {
+    const thz_scene *scene;
+    const accel *acc;
+    const emission_table *table;
+    size_t channel;
+    uint64_t n_photons;
+    int threads;
+    thz_progress_fn progress;
+    void *progress_user;
+} phase_fire_args;
+
+/* Fires photons 0..n_photons-1, returning their records in photon-index order (a malloc'd
+ * array, never NULL on success) and the summed counters. */
+static thz_status phase_fire(const phase_fire_args *a, photon_record **out_records,
+                             size_t *out_count, trace_counters *total, thz_error *err)
+{
+    thz_status st = THZ_OK;
+    int nthreads = a->threads > 0 ? a->threads : omp_get_max_threads();
+    if (nthreads < 1)
+        nthreads = 1;
+    size_t ns = a->table->n_sources ? a->table->n_sources : 1;
+    trace_buffer *bufs = thz_calloc((size_t)nthreads, sizeof *bufs);
+    double *scratch = thz_malloc_array((size_t)nthreads * ns, sizeof *scratch);
+    phase_chunk *chunks = thz_calloc(PHASE_BATCH / PHASE_CHUNK, sizeof *chunks);
+    photon_record *records = thz_malloc_array(1, sizeof *records);
+    size_t count = 0, capacity = 1;
+    memset(total, 0, sizeof *total);
+    if (!bufs || !scratch || !chunks || !records) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "photon phase: out of memory");
+        goto cleanup;
+    }
+    const uint64_t seed = a->scene->photons.seed;
+    const uint32_t channel = (uint32_t)a->channel;
+
+    for (uint64_t first = 0; first < a->n_photons; first += PHASE_BATCH) {
+        uint64_t batch_n = a->n_photons - first < PHASE_BATCH ? a->n_photons - first : PHASE_BATCH;
+        long n_chunks = (long)((batch_n + PHASE_CHUNK - 1) / PHASE_CHUNK);
+        for (int t = 0; t < nthreads; t++)
+            bufs[t].count = 0;
+        int failed = 0;
+
+#pragma omp parallel num_threads(nthreads)
+        {
+            int tid = omp_get_thread_num();
+            trace_buffer *b = &bufs[tid];
+            double *scr = scratch + (size_t)tid * ns;
+#pragma omp for schedule(dynamic, 1)
+            for (long k = 0; k < n_chunks; k++) {
+                phase_chunk *ch = &chunks[k];
+                memset(&ch->counters, 0, sizeof ch->counters);
+                ch->thread = tid;
+                ch->start = b->count;
+                uint64_t lo = first + (uint64_t)k * PHASE_CHUNK;
+                uint64_t hi = lo + PHASE_CHUNK < first + batch_n ? lo + PHASE_CHUNK : first + batch_n;
+                for (uint64_t i = lo; i < hi; i++) {
+                    rng_stream rng;
+                    rng_init(&rng, seed, channel, RNG_PURPOSE_PHOTON, i);
+                    emission_photon e;
+                    if (!emission_sample(a->table, &rng, scr, &e))
+                        e.power_w_per_hz = 0.0;
+                    if (!trace_photon(a->scene, a->acc, &e, &rng, b, &ch->counters)) {
+#pragma omp atomic write
+                        failed = 1;
+                        break;
+                    }
+                }
+                ch->count = b->count - ch->start;
+            }
+        }
+        if (failed) {
+            st = thz_error_set(err, THZ_ERR_NOMEM, "photon phase: out of memory for photon records");
+            goto cleanup;
+        }
+
+        /* Merge in chunk order: the result is ordered by photon index. */
+        size_t added = 0;
+        for (long k = 0; k < n_chunks; k++)
+            added += chunks[k].count;
+        if (count + added > capacity) {
+            size_t cap = capacity;
+            while (cap < count + added)
+                cap = cap > SIZE_MAX / 2 ? count + added : 2 * cap;
+            photon_record *p = thz_realloc_array(records, cap, sizeof *p);
+            if (!p) {
+                st = thz_error_set(err, THZ_ERR_NOMEM,
+                                   "photon phase: out of memory for %zu photon records",
+                                   count + added);
+                goto cleanup;
+            }
+            records = p;
+            capacity = cap;
+        }
+        for (long k = 0; k < n_chunks; k++) {
+            const phase_chunk *ch = &chunks[k];
+            if (ch->count)
+                memcpy(records + count, bufs[ch->thread].records + ch->start,
+                       ch->count * sizeof *records);
+            count += ch->count;
+            trace_counters_add(total, &ch->counters);
+        }
+
+        if (a->progress) {
+            thz_progress p = {.stage = "photons",
+                              .channel = a->channel,
+                              .n_channels = a->scene->n_channels,
+                              .done = first + batch_n,
+                              .total = a->n_photons};
+            if (a->progress(a->progress_user, &p) != 0) {
+                st = thz_error_set(err, THZ_ERR_CANCELLED, "photon phase: cancelled");
+                goto cleanup;
+            }
+        }
+    }
+    *out_records = records;
+    *out_count = count;
+    records = NULL;
+cleanup:
+    if (bufs)
+        for (int t = 0; t < nthreads; t++)
+            trace_buffer_fini(&bufs[t]);
+    free(bufs);
+    free(scratch);
+    free(chunks);
+    free(records);
+    return st;
+}
+
+static thz_status phase_check(const thz_scene *scene, size_t channel, thz_error *err)
+{
+    if (channel >= scene->n_channels)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "photon phase: no channel %zu (scene has %zu)",
+                             channel, scene->n_channels);
+    if (scene->n_objects > (UINT32_MAX >> 1))
+        return thz_error_set(err, THZ_ERR_LIMIT, "photon phase: too many objects (%zu)",
+                             scene->n_objects);
+    return THZ_OK;
+}
+
+thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t channel,
+                            const photon_phase_options *opt, photon_map **out_map,
+                            photon_stats *stats, thz_error *err)
+{
+    double t0 = omp_get_wtime();
+    *out_map = NULL;
+    thz_status st = phase_check(scene, channel, err);
+    if (st != THZ_OK)
+        return st;
+    emission_table table;
+    st = emission_table_init(&table, scene, channel, scene->photons.per_channel, err);
+    if (st != THZ_OK)
+        return st;
+    phase_fire_args a = {.scene = scene,
+                         .acc = acc,
+                         .table = &table,
+                         .channel = channel,
+                         .n_photons = scene->photons.per_channel,
+                         .threads = opt ? opt->threads : 0,
+                         .progress = opt ? opt->progress : NULL,
+                         .progress_user = opt ? opt->progress_user : NULL};
+    photon_record *records = NULL;
+    size_t count = 0;
+    trace_counters c;
+    st = phase_fire(&a, &records, &count, &c, err);
+    emission_table_fini(&table);
+    if (st != THZ_OK)
+        return st;
+
+    /* photon_map_create takes ownership of records, also on failure. */
+    st = photon_map_create(records, count, scene->n_objects, a.threads, out_map, err);
+    if (st != THZ_OK)
+        return st;
+
+    if (stats) {
+        memset(stats, 0, sizeof *stats);
+        stats->fired = c.photons;
+        stats->stored = count;
+        stats->hits = c.hits;
+        stats->reflected = c.reflected;
+        stats->transmitted = c.transmitted;
+        stats->absorbed = c.absorbed;
+        stats->escaped = c.escaped;
+        stats->back_face_hits = c.back_face_hits;
+        stats->terminated = c.terminated + c.capped;
+        stats->bounce_capped = c.capped;
+        stats->emitted_power_w_per_hz = scene_band_emitted_power_w_per_hz(scene, channel);
+        stats->fired_power_w_per_hz = c.fired_power;
+        stats->absorbed_power_w_per_hz = c.absorbed_power;
+        stats->escaped_power_w_per_hz = c.escaped_power;
+        stats->atmosphere_power_w_per_hz = c.atmosphere_power;
+        stats->terminated_power_w_per_hz = c.terminated_power;
+        stats->mean_bounces = c.photons ? (double)c.hits / (double)c.photons : 0.0;
+        stats->seconds = omp_get_wtime() - t0;
+    }
+    return THZ_OK;
+}
+
+thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc, size_t channel,
+                                       uint64_t *bytes, thz_error *err)
+{
+    *bytes = 0;
+    thz_status st = phase_check(scene, channel, err);
+    if (st != THZ_OK)
+        return st;
+    uint64_t k = scene->photons.per_channel;
+    uint64_t pilot = k < PHASE_PILOT ? k : PHASE_PILOT;
+    if (pilot == 0)
+        return THZ_OK;
+    emission_table table;
+    st = emission_table_init(&table, scene, channel, k, err);
+    if (st != THZ_OK)
+        return st;
+    phase_fire_args a = {.scene = scene, .acc = acc, .table = &table, .channel = channel,
+                         .n_photons = pilot};
+    photon_record *records = NULL;
+    size_t count = 0;
+    trace_counters c;
+    st = phase_fire(&a, &records, &count, &c, err);
+    emission_table_fini(&table);
+    free(records);
+    if (st != THZ_OK)
+        return st;
+    double est = (double)count / (double)pilot * (double)k * (double)sizeof(photon_record) * 1.05;
+    *bytes = est >= 1.8e19 ? UINT64_MAX : (uint64_t)ceil(est);
+    return THZ_OK;
+}

@@ -1,0 +1,48 @@
+/* The photon phase of one channel (physics.md "Photon phase"): fires K photons from the
+ * scene's emitters, traces them, and builds the channel's photon map.
+ *
+ * Deterministic: photon i's random numbers come from rng_init(seed, channel,
+ * RNG_PURPOSE_PHOTON, i); photons run in batches of PHASE_BATCH, each batch in chunks of
+ * PHASE_CHUNK photons spread over OpenMP threads; each chunk's records and counters are
+ * merged after the batch in chunk order. The map's records (ordered by photon index
+ * before photon_map_create sorts them) and the statistics (summed in that fixed order)
+ * are therefore bit-identical for any thread count.
+ */
+#ifndef THZ_PHOTON_PHASE_H
+#define THZ_PHOTON_PHASE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "accel/accel.h"
+#include "core/error.h"
+#include "photon/photon_map.h"
+#include "photon/photon_stats.h"
+#include "scene/scene.h"
+
+#define PHASE_BATCH 65536u
+#define PHASE_CHUNK 256u
+
+typedef struct photon_phase_options {
+    int threads; /* 0 = all */
+    thz_progress_fn progress;
+    void *progress_user;
+} photon_phase_options;
+
+/* Fires scene->photons.per_channel photons for channel `channel` and builds its photon
+ * map (*out_map, owned by the caller). stats (may be NULL) is filled completely. Between
+ * batches, on the calling thread, calls opt->progress (stage "photons", done/total in
+ * photons) and stops with THZ_ERR_CANCELLED if it returns non-zero. opt may be NULL. */
+thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t channel,
+                            const photon_phase_options *opt, photon_map **out_map,
+                            photon_stats *stats, thz_error *err);
+
+/* Estimated bytes of channel `channel`'s photon records: a pilot of PHASE_PILOT photons
+ * (fewer if K is smaller) gives the mean number of stored hits per photon, times K,
+ * times sizeof(photon_record), times 1.05 for the pilot's statistical error. The
+ * photon map's spatial index comes on top (see photon_map.h). */
+#define PHASE_PILOT 4096u
+thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc, size_t channel,
+                                       uint64_t *bytes, thz_error *err);
+
+#endif

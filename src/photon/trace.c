@@ -1,0 +1,155 @@
+/* Propagation of one photon: see trace.h for the rules. */
+#include "photon/trace.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/alloc.h"
+
+void trace_counters_add(trace_counters *sum, const trace_counters *c)
+{
+    sum->photons += c->photons;
+    sum->hits += c->hits;
+    sum->reflected += c->reflected;
+    sum->transmitted += c->transmitted;
+    sum->absorbed += c->absorbed;
+    sum->escaped += c->escaped;
+    sum->back_face_hits += c->back_face_hits;
+    sum->terminated += c->terminated;
+    sum->capped += c->capped;
+    sum->fired_power += c->fired_power;
+    sum->absorbed_power += c->absorbed_power;
+    sum->escaped_power += c->escaped_power;
+    sum->atmosphere_power += c->atmosphere_power;
+    sum->terminated_power += c->terminated_power;
+}
+
+void trace_buffer_fini(trace_buffer *b)
+{
+    free(b->records);
+    b->records = NULL;
+    b->count = b->capacity = 0;
+}
+
+/* Amortised doubling; happens O(log n) times per thread over a whole run. */
+static bool trace_buffer_push(trace_buffer *b, const photon_record *r)
+{
+    if (b->count == b->capacity) {
+        size_t cap = b->capacity ? 2 * b->capacity : 4096;
+        photon_record *p = thz_realloc_array(b->records, cap, sizeof *p);
+        if (!p)
+            return false;
+        b->records = p;
+        b->capacity = cap;
+    }
+    b->records[b->count++] = *r;
+    return true;
+}
+
+trace_event trace_roulette(const optics_point *o, double mu, double u)
+{
+    double r = o->reflectivity;
+    if (u < r)
+        return TRACE_REFLECT;
+    if (o->thickness_m > 0.0 && u < r + optics_transmission(o, mu))
+        return TRACE_TRANSMIT;
+    return TRACE_ABSORB;
+}
+
+vec3 trace_diffuse_transmission_dir(const optics_point *o, vec3 n_out, rng_stream *rng)
+{
+    double mu;
+    if (!optics_sample_transmission_mu(o, emission_uniform, rng, &mu))
+        mu = sqrt(1.0 - rng_uniform(rng)); /* unreachable after a transmission event */
+    return emission_direction(n_out, mu, rng_uniform(rng));
+}
+
+bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photon *e,
+                  rng_stream *rng, trace_buffer *buf, trace_counters *c)
+{
+    c->photons++;
+    double power = e->power_w_per_hz;
+    if (!(power > 0.0))
+        return true;
+    c->fired_power += power;
+    const double w_min = scene->photons.min_relative_power * power;
+    const double nu = e->freq_hz;
+
+    accel_hit from = {
+        .object = e->object, .triangle = e->triangle, .position_m = e->position_m, .side = e->side};
+    vec3 dir = e->dir;
+    vec3 origin = accel_offset_origin(acc, &from, dir);
+    uint32_t ignore_obj = e->object, ignore_tri = e->triangle;
+
+    for (uint32_t bounce = 0;; bounce++) {
+        if (bounce >= TRACE_MAX_BOUNCES) {
+            c->capped++;
+            c->terminated_power += power;
+            return true;
+        }
+        accel_hit hit;
+        if (!accel_intersect(acc, origin, dir, INFINITY, ignore_obj, ignore_tri, &hit)) {
+            c->escaped++;
+            c->escaped_power += power;
+            return true;
+        }
+        double tr = atmosphere_transmittance(&scene->atmosphere, nu, hit.distance_m);
+        c->atmosphere_power += power * (1.0 - tr);
+        power *= tr;
+        if (power < w_min) {
+            /* Low-power roulette: survive with probability w / w_min at w_min. */
+            if (rng_uniform(rng) * w_min < power) {
+                c->terminated_power -= w_min - power;
+                power = w_min;
+            } else {
+                c->terminated++;
+                c->terminated_power += power;
+                return true;
+            }
+        }
+
+        photon_record rec = {
+            .position_m = {(float)hit.position_m.x, (float)hit.position_m.y,
+                           (float)hit.position_m.z},
+            .power_w_per_hz = (float)power,
+            .freq_hz = (float)nu,
+            .dir_oct = photon_encode_direction(dir),
+            .object_side = hit.object << 1 | (uint32_t)hit.side,
+            .flags = bounce < 0xffffu ? bounce : 0xffffu,
+        };
+        if (!trace_buffer_push(buf, &rec))
+            return false;
+        c->hits++;
+
+        const thz_object *obj = &scene->objects[hit.object];
+        if (!scene_object_side_is_front(obj, hit.side)) {
+            c->back_face_hits++;
+            c->absorbed++;
+            c->absorbed_power += power;
+            return true;
+        }
+        optics_point o = scene_object_optics(scene, obj, nu);
+        const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
+        vec3 n = v3(nf[0], nf[1], nf[2]);
+        vec3 n_in = hit.side == 0 ? n : v3_scale(n, -1.0); /* towards where it came from */
+
+        switch (trace_roulette(&o, hit.cos_theta, rng_uniform(rng))) {
+        case TRACE_REFLECT:
+            c->reflected++;
+            dir = emission_direction(n_in, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
+            break;
+        case TRACE_TRANSMIT:
+            c->transmitted++;
+            if (scene->materials[obj->material].transmission == TRANSMISSION_DIFFUSE)
+                dir = trace_diffuse_transmission_dir(&o, v3_scale(n_in, -1.0), rng);
+            break;
+        case TRACE_ABSORB:
+            c->absorbed++;
+            c->absorbed_power += power;
+            return true;
+        }
+        origin = accel_offset_origin(acc, &hit, dir);
+        ignore_obj = hit.object;
+        ignore_tri = hit.triangle;
+    }
+}

@@ -1,0 +1,107 @@
+/* Fingerprints of the parts of a scene that determine its photon maps. */
+#include "scene/scene_hash.h"
+
+#include <string.h>
+
+#define HASH_PRIME 0x100000001b3ull
+#define HASH_OFFSET 0xcbf29ce484222325ull
+
+static uint64_t hash_word(uint64_t h, uint64_t w)
+{
+    for (int i = 0; i < 8; i++) {
+        h ^= (w >> (8 * i)) & 0xffu;
+        h *= HASH_PRIME;
+    }
+    return h;
+}
+
+static uint64_t hash_double(uint64_t h, double x)
+{
+    uint64_t w;
+    memcpy(&w, &x, sizeof w);
+    return hash_word(h, w);
+}
+
+static uint64_t hash_u32s(uint64_t h, const uint32_t *p, size_t n)
+{
+    h = hash_word(h, n);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t w = p[i];
+        for (int k = 0; k < 4; k++) {
+            h ^= (w >> (8 * k)) & 0xffu;
+            h *= HASH_PRIME;
+        }
+    }
+    return h;
+}
+
+static uint64_t hash_floats(uint64_t h, const float *p, size_t n)
+{
+    h = hash_word(h, n);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t w;
+        memcpy(&w, &p[i], sizeof w);
+        for (int k = 0; k < 4; k++) {
+            h ^= (w >> (8 * k)) & 0xffu;
+            h *= HASH_PRIME;
+        }
+    }
+    return h;
+}
+
+static uint64_t hash_spectrum(uint64_t h, const thz_spectrum *s)
+{
+    h = hash_word(h, s->n);
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->freq_hz)
+            h = hash_double(h, s->freq_hz[i]);
+        h = hash_double(h, s->value[i]);
+    }
+    return h;
+}
+
+/* splitmix64's finaliser: spreads the last bytes over the whole word. */
+static uint64_t hash_finish(uint64_t h)
+{
+    h ^= h >> 30;
+    h *= 0xbf58476d1ce4e5b9ull;
+    h ^= h >> 27;
+    h *= 0x94d049bb133111ebull;
+    h ^= h >> 31;
+    return h;
+}
+
+void scene_hash_compute(const thz_scene *scene, scene_hash *out)
+{
+    uint64_t g = HASH_OFFSET, o = HASH_OFFSET, c = HASH_OFFSET;
+    g = hash_word(g, scene->n_objects);
+    o = hash_word(o, scene->n_objects);
+    for (size_t i = 0; i < scene->n_objects; i++) {
+        const thz_object *obj = &scene->objects[i];
+        g = hash_word(g, (uint64_t)obj->type);
+        g = hash_word(g, obj->two_sided ? 1u : 0u);
+        g = hash_double(g, obj->thickness_m);
+        g = hash_floats(g, obj->mesh.positions, 3 * obj->mesh.n_vertices);
+        g = hash_u32s(g, obj->mesh.indices, 3 * obj->mesh.n_triangles);
+        o = hash_word(o, obj->material);
+        o = hash_double(o, obj->temperature_k);
+    }
+    o = hash_word(o, scene->n_materials);
+    for (size_t i = 0; i < scene->n_materials; i++) {
+        const thz_material *m = &scene->materials[i];
+        o = hash_spectrum(o, &m->reflectivity);
+        o = hash_spectrum(o, &m->attenuation_per_m);
+        o = hash_spectrum(o, &m->emissivity);
+        o = hash_word(o, (uint64_t)m->transmission);
+    }
+    o = hash_word(o, (uint64_t)scene->atmosphere.model);
+    o = hash_spectrum(o, &scene->atmosphere.attenuation_per_m);
+    c = hash_word(c, scene->n_channels);
+    for (size_t i = 0; i < scene->n_channels; i++) {
+        c = hash_double(c, scene->channels[i].center_hz);
+        c = hash_double(c, scene->channels[i].relative_width);
+    }
+    out->geometry = hash_finish(g);
+    out->optics = hash_finish(o);
+    out->channels = hash_finish(c);
+}
