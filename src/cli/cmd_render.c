@@ -1,12 +1,8 @@
-/* thzmap render: not implemented yet. */
-#include <stdio.h>
-
+/* thzmap render SCENE.json --photon-map FILE -o OUTDIR: re-render from a saved map. */
 #include "cli/cli.h"
+#include "cli/run_command.h"
 
 int cmd_render(int argc, char **argv)
 {
-    (void)argc;
-    (void)argv;
-    fprintf(stderr, "thzmap render: not implemented yet\n");
-    return CLI_EXIT_FAILURE;
+    return cli_run_command(argc, argv, true);
 }

@@ -1,12 +1,8 @@
-/* thzmap simulate: not implemented yet. */
-#include <stdio.h>
-
+/* thzmap simulate SCENE.json -o OUTDIR: fire photons and render every sensor. */
 #include "cli/cli.h"
+#include "cli/run_command.h"
 
 int cmd_simulate(int argc, char **argv)
 {
-    (void)argc;
-    (void)argv;
-    fprintf(stderr, "thzmap simulate: not implemented yet\n");
-    return CLI_EXIT_FAILURE;
+    return cli_run_command(argc, argv, false);
 }

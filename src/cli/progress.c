@@ -1,0 +1,128 @@
+/* Progress display and interrupt handling for the long-running commands. */
+#include "cli/progress.h"
+
+#include <signal.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+/* The one piece of process-wide state in thzmap: a signal handler can reach nothing
+ * else. Written only by the handler, read by the progress callback. */
+static volatile sig_atomic_t cli_interrupted = 0;
+
+static void cli_on_signal(int sig)
+{
+    (void)sig;
+    cli_interrupted = 1;
+}
+
+void cli_signals_install(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = cli_on_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND; /* a second Ctrl-C ends the process at once */
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+bool cli_signals_interrupted(void)
+{
+    return cli_interrupted != 0;
+}
+
+static double cli_now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void cli_progress_init(cli_progress *p, const char *command, bool quiet)
+{
+    memset(p, 0, sizeof *p);
+    p->out = stderr;
+    p->command = command;
+    p->quiet = quiet;
+    p->tty = isatty(fileno(stderr)) != 0;
+}
+
+/* The unit a stage counts in. */
+static const char *cli_stage_unit(const char *stage)
+{
+    if (strcmp(stage, "photons") == 0)
+        return "photons";
+    if (strcmp(stage, "render") == 0)
+        return "rows";
+    return "steps";
+}
+
+static void cli_progress_draw_tty(cli_progress *p, const thz_progress *pr, double now)
+{
+    double elapsed = now - p->stage_start_s;
+    double frac = pr->total ? (double)pr->done / (double)pr->total : 0.0;
+    double rate = elapsed > 0.0 ? (double)pr->done / elapsed : 0.0;
+    fprintf(p->out, "\r\033[Kthzmap %s: channel %zu/%zu, %s %llu/%llu (%.0f %%)", p->command,
+            pr->channel + 1, pr->n_channels, pr->stage, (unsigned long long)pr->done,
+            (unsigned long long)pr->total, 100.0 * frac);
+    if (rate > 0.0 && pr->done < pr->total)
+        fprintf(p->out, ", %.3g %s/s, ETA %.0f s", rate, cli_stage_unit(pr->stage),
+                (double)(pr->total - pr->done) / rate);
+    fflush(p->out);
+    p->line_open = true;
+}
+
+static void cli_progress_line(cli_progress *p, const thz_progress *pr, double now)
+{
+    double elapsed = now - p->stage_start_s;
+    const char *unit = cli_stage_unit(pr->stage);
+    fprintf(p->out, "thzmap %s: channel %zu/%zu, %s: %llu %s in %.2f s", p->command,
+            pr->channel + 1, pr->n_channels, pr->stage, (unsigned long long)pr->done, unit,
+            elapsed);
+    if (elapsed > 0.0 && strcmp(pr->stage, "output") != 0)
+        fprintf(p->out, " (%.3g %s/s)", (double)pr->done / elapsed, unit);
+    fputc('\n', p->out);
+    fflush(p->out);
+}
+
+int cli_progress_report(void *user, const thz_progress *pr)
+{
+    cli_progress *p = user;
+    if (cli_interrupted)
+        return 1;
+    if (p->quiet)
+        return 0;
+    double now = cli_now_s();
+    bool new_stage = !p->stage || strcmp(p->stage, pr->stage) != 0 || p->channel != pr->channel ||
+                     pr->done < p->last_done;
+    if (new_stage) {
+        p->stage = pr->stage;
+        p->channel = pr->channel;
+        p->completed = false;
+        p->stage_start_s = now;
+        p->last_draw_s = 0.0;
+    }
+    p->last_done = pr->done;
+    bool done = pr->total > 0 && pr->done >= pr->total;
+    if (p->tty) {
+        if (done || now - p->last_draw_s >= 0.1) {
+            cli_progress_draw_tty(p, pr, now);
+            p->last_draw_s = now;
+        }
+    } else if (done && !p->completed && strcmp(pr->stage, "output") != 0) {
+        cli_progress_line(p, pr, now);
+    }
+    if (done)
+        p->completed = true;
+    return 0;
+}
+
+void cli_progress_finish(cli_progress *p)
+{
+    if (p->line_open) {
+        fputs("\r\033[K", p->out);
+        fflush(p->out);
+        p->line_open = false;
+    }
+}

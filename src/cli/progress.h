@@ -1,0 +1,45 @@
+/* Progress display on stderr for long runs, and Ctrl-C handling.
+ *
+ * When stderr is a terminal: one line, updated in place (channel i/n, stage, units done,
+ * rate, ETA in s). Otherwise: one line per channel and stage when it completes. Nothing
+ * with --quiet. The progress callback also carries cancellation: once SIGINT or SIGTERM
+ * arrived it returns non-zero, so the run stops and removes its staging directory.
+ */
+#ifndef THZ_CLI_PROGRESS_H
+#define THZ_CLI_PROGRESS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "thzmap/thzmap.h"
+
+typedef struct cli_progress {
+    FILE *out;           /* stderr */
+    const char *command; /* "simulate", "render" */
+    bool quiet;
+    bool tty;
+    bool line_open;      /* a terminal line is being updated */
+    const char *stage;   /* current (stage, channel), NULL before the first report */
+    size_t channel;
+    uint64_t last_done;
+    bool completed;      /* the completion of the current stage was shown */
+    double stage_start_s;
+    double last_draw_s;
+} cli_progress;
+
+void cli_progress_init(cli_progress *p, const char *command, bool quiet);
+
+/* The thz_progress_fn: draws, and returns non-zero once an interrupt arrived. */
+int cli_progress_report(void *user, const thz_progress *progress);
+
+/* Ends the terminal line, if one is open. */
+void cli_progress_finish(cli_progress *p);
+
+/* Installs the SIGINT/SIGTERM handler (one-shot: a second signal kills at once). */
+void cli_signals_install(void);
+
+/* True once SIGINT or SIGTERM arrived. */
+bool cli_signals_interrupted(void);
+
+#endif

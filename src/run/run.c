@@ -1,0 +1,492 @@
+/* Orchestration of simulate and render runs: memory check, photon phase, rendering,
+ * outputs through the atomic staging directory. */
+#include "run/run.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "accel/accel.h"
+#include "core/alloc.h"
+#include "io/output.h"
+#include "photon/phase.h"
+#include "photon/photon_map.h"
+#include "photon/photon_stats.h"
+#include "physics/planck.h"
+#include "sensor/images.h"
+#include "sensor/render.h"
+
+/* Everything one run owns; freed in one place (run_state_fini). */
+typedef struct run_state {
+    const thz_scene *scene;
+    const run_options *opt;
+    const char *command; /* "simulate" or "render" */
+    accel *accel;
+    output_stage *stage;
+    size_t n_selected;        /* sensors rendered */
+    size_t *selected;         /* their indices into scene->sensors */
+    sensor_images *images;    /* one per selected sensor */
+    uint64_t *back_face;      /* per selected sensor: samples that saw a back face */
+    render_stats *render_sum; /* per selected sensor: counts over all channels */
+    photon_map **maps;        /* per channel: kept for saving, or read from a file */
+    photon_stats *stats;      /* per channel (simulate) */
+    double *median_stderr_k;  /* per channel */
+    size_t n_warnings;
+    char **warnings;
+    double seconds_accel, seconds_photons, seconds_render, seconds_output;
+} run_state;
+
+static double run_now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void run_apply_overrides(thz_scene *scene, const run_overrides *ov)
+{
+    if (!ov)
+        return;
+    if (ov->photons)
+        scene->photons.per_channel = ov->photons;
+    if (ov->has_seed)
+        scene->photons.seed = ov->seed;
+    if (ov->has_integrator)
+        scene->render.integrator = ov->integrator;
+}
+
+static thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt, ...)
+{
+    char buf[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    char **w = thz_realloc_array(rs->warnings, rs->n_warnings + 1, sizeof *w);
+    if (!w)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for run warnings");
+    rs->warnings = w;
+    w[rs->n_warnings] = thz_strdup(buf);
+    if (!w[rs->n_warnings])
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for run warnings");
+    rs->n_warnings++;
+    return THZ_OK;
+}
+
+static void run_state_fini(run_state *rs)
+{
+    output_stage_destroy(rs->stage); /* removes the staging directory unless committed */
+    if (rs->images)
+        for (size_t i = 0; i < rs->n_selected; i++)
+            sensor_images_fini(&rs->images[i]);
+    free(rs->images);
+    free(rs->selected);
+    free(rs->back_face);
+    free(rs->render_sum);
+    if (rs->maps)
+        for (size_t c = 0; c < rs->scene->n_channels; c++)
+            photon_map_destroy(rs->maps[c]);
+    free(rs->maps);
+    free(rs->stats);
+    free(rs->median_stderr_k);
+    for (size_t i = 0; i < rs->n_warnings; i++)
+        free(rs->warnings[i]);
+    free(rs->warnings);
+    accel_destroy(rs->accel);
+    memset(rs, 0, sizeof *rs);
+}
+
+static bool run_report(const run_state *rs, const char *stage, size_t channel, uint64_t done,
+                       uint64_t total)
+{
+    if (!rs->opt->progress)
+        return false;
+    thz_progress p = {.stage = stage,
+                      .channel = channel,
+                      .n_channels = rs->scene->n_channels,
+                      .done = done,
+                      .total = total};
+    return rs->opt->progress(rs->opt->progress_user, &p) != 0;
+}
+
+/* Chooses the sensors (all, or the one named) and allocates the per-run arrays. */
+static thz_status run_state_init(run_state *rs, const thz_scene *scene, const run_options *opt,
+                                 const char *command, thz_error *err)
+{
+    memset(rs, 0, sizeof *rs);
+    rs->scene = scene;
+    rs->opt = opt;
+    rs->command = command;
+    if (!opt->outdir || !opt->outdir[0])
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: no output directory given", command);
+    size_t nc = scene->n_channels, ns = scene->n_sensors;
+    rs->selected = thz_calloc(ns, sizeof *rs->selected);
+    rs->maps = thz_calloc(nc, sizeof *rs->maps);
+    rs->stats = thz_calloc(nc, sizeof *rs->stats);
+    rs->median_stderr_k = thz_calloc(nc, sizeof *rs->median_stderr_k);
+    if (!rs->selected || !rs->maps || !rs->stats || !rs->median_stderr_k)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    for (size_t s = 0; s < ns; s++)
+        if (!opt->sensor_name || strcmp(opt->sensor_name, scene->sensors[s].name) == 0)
+            rs->selected[rs->n_selected++] = s;
+    if (rs->n_selected == 0)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: the scene has no sensor named '%s'",
+                             command, opt->sensor_name ? opt->sensor_name : "");
+    rs->images = thz_calloc(rs->n_selected, sizeof *rs->images);
+    rs->back_face = thz_calloc(rs->n_selected, sizeof *rs->back_face);
+    rs->render_sum = thz_calloc(rs->n_selected, sizeof *rs->render_sum);
+    if (!rs->images || !rs->back_face || !rs->render_sum)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    return THZ_OK;
+}
+
+thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err)
+{
+    if (need->available_bytes == 0)
+        return THZ_OK; /* unknown: let the allocations decide */
+    double limit = 0.9 * (double)need->available_bytes;
+    if ((double)need->total_bytes <= limit)
+        return THZ_OK;
+    double gib = 1024.0 * 1024.0 * 1024.0;
+    char key[128];
+    if (need->photon_bytes >= need->image_bytes) {
+        snprintf(key, sizeof key, "photons.per_channel (now %llu; or --photons)",
+                 (unsigned long long)scene->photons.per_channel);
+    } else {
+        size_t big = 0;
+        for (size_t s = 1; s < scene->n_sensors; s++)
+            if ((uint64_t)scene->sensors[s].columns * scene->sensors[s].rows >
+                (uint64_t)scene->sensors[big].columns * scene->sensors[big].rows)
+                big = s;
+        snprintf(key, sizeof key, "sensors[%zu].resolution", big);
+    }
+    return thz_error_set(err, THZ_ERR_LIMIT,
+                         "the run would need %.2f GiB of memory (photon maps %.2f GiB, images "
+                         "%.2f GiB) but this machine has %.2f GiB; lower %s",
+                         (double)need->total_bytes / gib, (double)need->photon_bytes / gib,
+                         (double)need->image_bytes / gib, (double)need->available_bytes / gib,
+                         key);
+}
+
+static uint64_t run_image_bytes(const run_state *rs)
+{
+    uint64_t total = 0;
+    for (size_t i = 0; i < rs->n_selected; i++) {
+        const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
+        total += sensor_images_bytes(s->columns, s->rows, rs->scene->n_channels);
+    }
+    return total;
+}
+
+/* Estimates the memory of a simulate run and refuses it if it would not fit. */
+static thz_status run_simulate_memory(run_state *rs, bool photons, thz_error *err)
+{
+    run_memory need = {.image_bytes = run_image_bytes(rs),
+                       .available_bytes = thz_physical_memory_bytes()};
+    if (photons) {
+        uint64_t sum = 0, max = 0;
+        for (size_t c = 0; c < rs->scene->n_channels; c++) {
+            uint64_t b = 0;
+            thz_status st = photon_phase_estimate_bytes(rs->scene, rs->accel, c, &b, err);
+            if (st != THZ_OK)
+                return st;
+            sum += b;
+            max = b > max ? b : max;
+        }
+        /* kept maps, plus one map while it is built (records and index) */
+        need.photon_bytes = (rs->opt->save_photon_map ? sum : max) + max;
+    }
+    need.total_bytes = need.photon_bytes + need.image_bytes;
+    return run_check_memory(rs->scene, &need, err);
+}
+
+static thz_status run_init_images(run_state *rs, thz_error *err)
+{
+    render_options ro = {.threads = rs->opt->threads};
+    for (size_t i = 0; i < rs->n_selected; i++) {
+        const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
+        thz_status st =
+            sensor_images_init(&rs->images[i], s->columns, s->rows, rs->scene->n_channels, 1, err);
+        if (st != THZ_OK)
+            return st;
+        st = render_sensor_truth(rs->scene, rs->accel, rs->selected[i], &rs->images[i], &ro, err);
+        if (st != THZ_OK)
+            return st;
+    }
+    return THZ_OK;
+}
+
+static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map,
+                                     thz_error *err)
+{
+    render_options ro = {.threads = rs->opt->threads,
+                         .progress = rs->opt->progress,
+                         .progress_user = rs->opt->progress_user};
+    double t0 = run_now_s();
+    for (size_t i = 0; i < rs->n_selected; i++) {
+        render_stats rst;
+        thz_status st = render_sensor_channel(rs->scene, rs->accel, map, c, rs->selected[i],
+                                              &rs->images[i], &ro, &rst, err);
+        if (st != THZ_OK)
+            return st;
+        render_stats *sum = &rs->render_sum[i];
+        sum->samples += rst.samples;
+        sum->escaped_samples += rst.escaped_samples;
+        sum->back_face_samples += rst.back_face_samples;
+        sum->widened_gathers += rst.widened_gathers;
+        sum->starved_gathers += rst.starved_gathers;
+        sum->truncated_paths += rst.truncated_paths;
+        rs->back_face[i] += rst.back_face_samples;
+    }
+    rs->seconds_render += run_now_s() - t0;
+    return THZ_OK;
+}
+
+/* dB/dT at (freq_hz, temp_k), in W m^-2 sr^-1 Hz^-1 K^-1. */
+static double run_planck_dbdt(double freq_hz, double temp_k)
+{
+    double x = THZ_PLANCK_H * freq_hz / (THZ_BOLTZMANN_K * temp_k);
+    double em1 = expm1(x);
+    return planck_radiance(freq_hz, temp_k) * x * (em1 + 1.0) / (em1 * temp_k);
+}
+
+static int run_compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median over all rendered pixels of the standard error of Tb_c, in K. */
+static thz_status run_median_stderr(run_state *rs, thz_error *err)
+{
+    size_t total = 0;
+    for (size_t i = 0; i < rs->n_selected; i++)
+        total += (size_t)rs->images[i].columns * rs->images[i].rows;
+    double *v = thz_malloc_array(total, sizeof *v);
+    if (!v)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the error statistics");
+    for (size_t c = 0; c < rs->scene->n_channels; c++) {
+        double nu = rs->scene->channels[c].center_hz;
+        size_t m = 0;
+        for (size_t i = 0; i < rs->n_selected; i++) {
+            const sensor_images *img = &rs->images[i];
+            size_t px = (size_t)img->columns * img->rows;
+            for (size_t p = 0; p < px; p++) {
+                double tb = img->brightness_temperature[c * px + p];
+                if (!(tb > 0.0) || !img->radiance_stderr)
+                    continue;
+                v[m++] = img->radiance_stderr[c * px + p] / run_planck_dbdt(nu, tb);
+            }
+        }
+        if (m == 0) {
+            rs->median_stderr_k[c] = 0.0;
+            continue;
+        }
+        qsort(v, m, sizeof *v, run_compare_double);
+        rs->median_stderr_k[c] = m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
+    }
+    free(v);
+    return THZ_OK;
+}
+
+static thz_status run_render_warnings(run_state *rs, thz_error *err)
+{
+    thz_status st = THZ_OK;
+    for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
+        const render_stats *r = &rs->render_sum[i];
+        const char *name = rs->scene->sensors[rs->selected[i]].name;
+        if (r->back_face_samples)
+            st = run_add_warning(rs, err,
+                                 "sensor '%s': %llu of %llu samples saw the back side of a "
+                                 "one-sided solid (radiance 0); check the mesh normals",
+                                 name, (unsigned long long)r->back_face_samples,
+                                 (unsigned long long)r->samples);
+        if (st == THZ_OK && r->starved_gathers)
+            st = run_add_warning(rs, err,
+                                 "sensor '%s': %llu samples hit objects holding fewer than "
+                                 "gather_min_photons photons (reflected radiance taken as 0); "
+                                 "raise photons.per_channel",
+                                 name, (unsigned long long)r->starved_gathers);
+        if (st == THZ_OK && r->truncated_paths)
+            st = run_add_warning(rs, err,
+                                 "sensor '%s': %llu samples crossed more than %d straight shells "
+                                 "(what lies behind was dropped)",
+                                 name, (unsigned long long)r->truncated_paths,
+                                 RENDER_MAX_CROSSINGS);
+    }
+    return st;
+}
+
+/* Photon-map files: see io/photon_map_file.h. */
+static thz_status run_save_photon_map(run_state *rs, const char *dir, thz_error *err);
+static thz_status run_load_photon_map(run_state *rs, thz_error *err);
+
+/* Writes every output file into the staging directory and commits it. */
+static thz_status run_write_outputs(run_state *rs, double t_start, thz_error *err)
+{
+    if (run_report(rs, "output", 0, 0, 1))
+        return thz_error_set(err, THZ_ERR_CANCELLED, "%s: cancelled", rs->command);
+    double t0 = run_now_s();
+    const char *dir = output_stage_dir(rs->stage);
+    thz_status st = THZ_OK;
+    for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++)
+        st = output_write_sensor(dir, rs->scene, rs->selected[i], &rs->images[i], err);
+    if (st == THZ_OK && rs->opt->save_photon_map)
+        st = run_save_photon_map(rs, dir, err);
+    if (st == THZ_OK)
+        st = run_median_stderr(rs, err);
+    if (st == THZ_OK)
+        st = run_render_warnings(rs, err);
+    if (st != THZ_OK)
+        return st;
+    bool simulate = strcmp(rs->command, "simulate") == 0;
+    rs->seconds_output = run_now_s() - t0;
+    run_summary sum = {
+        .command = rs->command,
+        .integrator = render_integrator_name(rs->scene->render.integrator),
+        .seed = rs->scene->photons.seed,
+        .photons_per_channel = rs->scene->photons.per_channel,
+        .threads = rs->opt->threads,
+        .channel_stats = simulate && render_integrator_needs_photons(rs->scene->render.integrator)
+                             ? rs->stats
+                             : NULL,
+        .median_stderr_k = rs->median_stderr_k,
+        .back_face_samples = rs->back_face,
+        .seconds_load = rs->opt->seconds_load,
+        .seconds_accel = rs->seconds_accel,
+        .seconds_photons = rs->seconds_photons,
+        .seconds_render = rs->seconds_render,
+        .seconds_output = rs->seconds_output,
+        .n_run_warnings = rs->n_warnings,
+        .run_warnings = (const char *const *)rs->warnings,
+    };
+    (void)t_start;
+    st = summary_write(dir, rs->scene, &sum, err);
+    if (st != THZ_OK)
+        return st;
+    if (run_report(rs, "output", 0, 1, 1))
+        return thz_error_set(err, THZ_ERR_CANCELLED, "%s: cancelled", rs->command);
+    return output_stage_commit(rs->stage, err);
+}
+
+static void run_fill_result(const run_state *rs, run_result *result, double t_start)
+{
+    if (!result)
+        return;
+    memset(result, 0, sizeof *result);
+    result->n_channels = rs->scene->n_channels;
+    result->n_sensors = rs->n_selected;
+    for (size_t c = 0; c < rs->scene->n_channels; c++) {
+        result->photons_fired += rs->stats[c].fired;
+        result->photons_stored += rs->stats[c].stored;
+    }
+    for (size_t i = 0; i < rs->n_selected; i++)
+        result->back_face_samples += rs->back_face[i];
+    result->n_warnings = rs->n_warnings;
+    result->seconds = run_now_s() - t_start;
+}
+
+/* The common start: integrator check, sensors, staging directory, accel. */
+static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_options *opt,
+                            const char *command, thz_error *err)
+{
+    thz_status st = run_state_init(rs, scene, opt, command, err);
+    if (st == THZ_OK)
+        st = render_integrator_check(scene->render.integrator, err);
+    if (st == THZ_OK)
+        st = output_stage_create(opt->outdir, &rs->stage, err);
+    if (st != THZ_OK)
+        return st;
+    double t0 = run_now_s();
+    st = accel_create(scene, &rs->accel, err);
+    rs->seconds_accel = run_now_s() - t0;
+    return st;
+}
+
+thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_result *result,
+                        thz_error *err)
+{
+    double t_start = run_now_s();
+    run_state rs;
+    thz_status st = run_begin(&rs, scene, opt, "simulate", err);
+    bool photons = render_integrator_needs_photons(scene->render.integrator);
+    if (st == THZ_OK)
+        st = run_simulate_memory(&rs, photons, err);
+    if (st == THZ_OK)
+        st = run_init_images(&rs, err);
+    for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
+        photon_map *map = NULL;
+        if (photons) {
+            photon_phase_options po = {.threads = opt->threads,
+                                       .progress = opt->progress,
+                                       .progress_user = opt->progress_user};
+            double t0 = run_now_s();
+            st = photon_phase_run(scene, rs.accel, c, &po, &map, &rs.stats[c], err);
+            rs.seconds_photons += run_now_s() - t0;
+            if (st != THZ_OK)
+                break;
+        }
+        st = run_render_channel(&rs, c, map, err);
+        if (opt->save_photon_map)
+            rs.maps[c] = map;
+        else
+            photon_map_destroy(map);
+    }
+    if (st == THZ_OK)
+        st = run_write_outputs(&rs, t_start, err);
+    if (st == THZ_OK)
+        run_fill_result(&rs, result, t_start);
+    run_state_fini(&rs);
+    return st;
+}
+
+thz_status run_render(const thz_scene *scene, const run_options *opt, run_result *result,
+                      thz_error *err)
+{
+    double t_start = run_now_s();
+    run_state rs;
+    if (opt->save_photon_map)
+        return thz_error_set(err, THZ_ERR_INPUT, "render: --save-photon-map is for simulate");
+    thz_status st = run_begin(&rs, scene, opt, "render", err);
+    bool photons = render_integrator_needs_photons(scene->render.integrator);
+    if (st == THZ_OK) {
+        run_memory need = {.image_bytes = run_image_bytes(&rs),
+                           .available_bytes = thz_physical_memory_bytes()};
+        need.total_bytes = need.image_bytes;
+        st = run_check_memory(scene, &need, err);
+    }
+    if (st == THZ_OK && photons)
+        st = run_load_photon_map(&rs, err);
+    if (st == THZ_OK)
+        st = run_init_images(&rs, err);
+    for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
+        st = run_render_channel(&rs, c, rs.maps[c], err);
+        photon_map_destroy(rs.maps[c]); /* each map is needed for its channel only */
+        rs.maps[c] = NULL;
+    }
+    if (st == THZ_OK)
+        st = run_write_outputs(&rs, t_start, err);
+    if (st == THZ_OK)
+        run_fill_result(&rs, result, t_start);
+    run_state_fini(&rs);
+    return st;
+}
+
+static thz_status run_save_photon_map(run_state *rs, const char *dir, thz_error *err)
+{
+    (void)rs;
+    (void)dir;
+    return thz_error_set(err, THZ_ERR_INTERNAL, "photon-map files are not available yet");
+}
+
+static thz_status run_load_photon_map(run_state *rs, thz_error *err)
+{
+    (void)rs;
+    return thz_error_set(err, THZ_ERR_INTERNAL, "photon-map files are not available yet");
+}

@@ -1,0 +1,77 @@
+/* Orchestration of a whole run, the library API behind `thzmap simulate` and
+ * `thzmap render` (scene-format.md "Command line"):
+ *
+ *   simulate: check the integrator and memory (refusing before any work) -> build the
+ *             ray-casting structure -> per channel: photon phase, render every sensor,
+ *             keep the photon map only when it is to be saved -> write every output
+ *             file into a staging directory -> move them into OUTDIR.
+ *   render:   read a saved photon map (refusing one made from another scene) -> render
+ *             the chosen sensors -> outputs as above.
+ *
+ * A failed or cancelled run (progress callback returning non-zero: THZ_ERR_CANCELLED)
+ * leaves no result files in OUTDIR. Results are bit-identical for any thread count.
+ */
+#ifndef THZ_RUN_RUN_H
+#define THZ_RUN_RUN_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "scene/scene.h"
+
+/* Command-line overrides of scene settings (applied by run_apply_overrides). */
+typedef struct run_overrides {
+    uint64_t photons;        /* photons.per_channel; 0 keeps the scene's */
+    bool has_seed;
+    uint64_t seed;           /* photons.seed */
+    bool has_integrator;
+    thz_integrator integrator; /* render.integrator */
+} run_overrides;
+
+typedef struct run_options {
+    const char *outdir;          /* required: where the result files go */
+    int threads;                 /* OpenMP threads, 0: all */
+    bool save_photon_map;        /* simulate: also write photon-map.thzpm and photon-map.ply */
+    const char *photon_map_path; /* render: the photon-map file to read (required) */
+    const char *sensor_name;     /* render: only this sensor; NULL: all */
+    thz_progress_fn progress;    /* stages "photons", "render", "output"; may be NULL */
+    void *progress_user;
+    double seconds_load;         /* time the caller spent loading the scene, for the summary */
+} run_options;
+
+/* What a finished run reports back (for the CLI's closing line). */
+typedef struct run_result {
+    size_t n_channels;
+    size_t n_sensors;             /* sensors rendered */
+    uint64_t photons_fired;       /* over all channels (0 for render) */
+    uint64_t photons_stored;
+    uint64_t back_face_samples;   /* over all sensors and channels */
+    size_t n_warnings;            /* run warnings written to summary.json */
+    double seconds;               /* wall time of the run */
+} run_result;
+
+/* Applies the overrides to the scene (before run_simulate / run_render). */
+void run_apply_overrides(thz_scene *scene, const run_overrides *ov);
+
+/* Bytes of memory a run needs, as estimated before it starts: the photon maps held at
+ * once (all channels when saving, else the largest) plus a transient copy while one is
+ * built, and every rendered sensor's images. Also names the setting to lower: the
+ * scene key of the larger part. */
+typedef struct run_memory {
+    uint64_t photon_bytes;
+    uint64_t image_bytes;
+    uint64_t total_bytes;
+    uint64_t available_bytes; /* physical memory, 0 if unknown */
+} run_memory;
+
+/* THZ_OK, or THZ_ERR_LIMIT when `need` exceeds 90 % of the machine's memory, with a
+ * message naming `photons.per_channel` or `sensors[i].resolution`. */
+thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err);
+
+thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_result *result,
+                        thz_error *err);
+thz_status run_render(const thz_scene *scene, const run_options *opt, run_result *result,
+                      thz_error *err);
+
+#endif
