@@ -1,0 +1,127 @@
+/* itu-p676 reproduces the ITU-R P.676-13 validation values (ITU-R SG3 validation
+ * spreadsheet CG-3M3J-13-ValEx via ITU-Rpy): gamma_o, gamma_w and gamma at
+ * 1-350 GHz, p = 1013.25 hPa dry air, T = 288.15 K, rho = 7.5 g/m^3. The spreadsheet
+ * evaluates the same closed formulas in double precision, so the only differences
+ * are rounding: 0.1 % is a generous bound that still catches any wrong coefficient,
+ * unit or pressure convention (each of those moves values by percents). */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "atmosphere/atm_internal.h"
+#include "atmosphere/atmosphere.h"
+
+static double db_per_km(double per_m)
+{
+    return per_m * ATM_NEPER_TO_DB * 1e3;
+}
+
+static void test_validation_values(void **state)
+{
+    (void)state;
+    atm_csv csv;
+    thz_error err = {0};
+    assert_int_equal(atm_csv_read(&csv,
+                                  THZ_SOURCE_DIR
+                                  "/data/atmosphere/itu_r_p676_13_specific_attenuation_validation.csv",
+                                  &err),
+                     THZ_OK);
+    size_t cf, cp, ct, crho, co, cw, cg;
+    assert_int_equal(atm_csv_column(&csv, "f_GHz", &cf, &err), THZ_OK);
+    assert_int_equal(atm_csv_column(&csv, "P_hPa", &cp, &err), THZ_OK);
+    assert_int_equal(atm_csv_column(&csv, "T_K", &ct, &err), THZ_OK);
+    assert_int_equal(atm_csv_column(&csv, "rho_g_per_m3", &crho, &err), THZ_OK);
+    assert_int_equal(atm_csv_column(&csv, "gamma_o_dB_per_km", &co, &err), THZ_OK);
+    assert_int_equal(atm_csv_column(&csv, "gamma_w_dB_per_km", &cw, &err), THZ_OK);
+    assert_int_equal(atm_csv_column(&csv, "gamma_dB_per_km", &cg, &err), THZ_OK);
+    assert_true(csv.n_rows >= 350);
+    double worst_o = 0, worst_w = 0, worst_g = 0;
+    for (size_t r = 0; r < csv.n_rows; r++) {
+        double t = atm_csv_at(&csv, r, ct), rho = atm_csv_at(&csv, r, crho);
+        double e = rho * t / 216.7;
+        atm_air_state air;
+        /* the table gives the dry-air pressure; our state takes the total */
+        assert_int_equal(atm_air_state_init(&air, t, atm_csv_at(&csv, r, cp) + e,
+                                            ATM_HUMIDITY_DENSITY_G_M3, rho, &err),
+                         THZ_OK);
+        thz_atmosphere atm = {0};
+        assert_int_equal(atmosphere_init_itu_p676(&atm, &air, NULL, &err), THZ_OK);
+        atm_alpha_parts p;
+        double f_hz = atm_csv_at(&csv, r, cf) * 1e9;
+        atmosphere_alpha_parts(&atm, f_hz, &p);
+        double go = db_per_km(p.o2_per_m + p.dry_continuum_per_m);
+        double gw = db_per_km(p.h2o_lines_per_m);
+        double g = db_per_km(atmosphere_alpha_per_m(&atm, f_hz));
+        double ro = fabs(go / atm_csv_at(&csv, r, co) - 1.0);
+        double rw = fabs(gw / atm_csv_at(&csv, r, cw) - 1.0);
+        double rg = fabs(g / atm_csv_at(&csv, r, cg) - 1.0);
+        worst_o = fmax(worst_o, ro);
+        worst_w = fmax(worst_w, rw);
+        worst_g = fmax(worst_g, rg);
+        if (ro > 1e-3 || rw > 1e-3 || rg > 1e-3)
+            fail_msg("%g GHz: gamma_o %g (ref %g), gamma_w %g (ref %g), gamma %g (ref %g) dB/km",
+                     f_hz * 1e-9, go, atm_csv_at(&csv, r, co), gw, atm_csv_at(&csv, r, cw), g,
+                     atm_csv_at(&csv, r, cg));
+        atmosphere_fini(&atm);
+    }
+    print_message("worst relative differences: oxygen %.2e, water vapour %.2e, total %.2e\n",
+                  worst_o, worst_w, worst_g);
+    atm_csv_fini(&csv);
+}
+
+static void test_range_refused(void **state)
+{
+    (void)state;
+    atm_air_state air;
+    thz_error err = {0};
+    assert_int_equal(atm_air_state_init(&air, 290, 1013.25, ATM_HUMIDITY_RELATIVE, 0.5, &err),
+                     THZ_OK);
+    thz_atmosphere atm = {0};
+    assert_int_equal(atmosphere_init_itu_p676(&atm, &air, NULL, &err), THZ_OK);
+    thz_channel ch = {.name = "1.5 THz", .center_hz = 1.5e12, .relative_width = 0.01};
+    assert_int_equal(atmosphere_prepare(&atm, &ch, 1, &err), THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "itu-p676"));
+    assert_non_null(strstr(err.message, "1.5 THz"));
+    atmosphere_fini(&atm);
+}
+
+static void test_humidity_conversions(void **state)
+{
+    (void)state;
+    thz_error err = {0};
+    atm_air_state a, b, c;
+    /* P.453-14: e_s(20 deg C, 1013.25 hPa) = 6.1121 exp(17.4...)...: 23.4 hPa (Buck) */
+    double es = atm_saturation_pressure_hpa(293.15, 1013.25);
+    assert_true(fabs(es - 23.46) < 0.05);
+    assert_int_equal(atm_air_state_init(&a, 293.15, 1013.25, ATM_HUMIDITY_RELATIVE, 0.5, &err),
+                     THZ_OK);
+    assert_true(fabs(a.h2o_pressure_hpa - 0.5 * es) < 1e-12);
+    assert_int_equal(atm_air_state_init(&b, 293.15, 1013.25, ATM_HUMIDITY_DENSITY_G_M3,
+                                        atm_air_h2o_density_g_m3(&a), &err),
+                     THZ_OK);
+    assert_true(fabs(b.h2o_pressure_hpa - a.h2o_pressure_hpa) < 1e-9);
+    assert_int_equal(atm_air_state_init(&c, 293.15, 1013.25, ATM_HUMIDITY_VMR, atm_air_h2o_vmr(&a),
+                                        &err),
+                     THZ_OK);
+    assert_true(fabs(c.h2o_pressure_hpa - a.h2o_pressure_hpa) < 1e-9);
+    assert_int_equal(atm_air_state_init(&a, 293.15, 1013.25, ATM_HUMIDITY_RELATIVE, 50, &err),
+                     THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "not per cent"));
+    assert_int_equal(atm_air_state_init(&a, 293.15, 10, ATM_HUMIDITY_DENSITY_G_M3, 100, &err),
+                     THZ_ERR_INPUT);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_validation_values),
+        cmocka_unit_test(test_range_refused),
+        cmocka_unit_test(test_humidity_conversions),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
