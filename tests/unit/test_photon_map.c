@@ -1,0 +1,325 @@
+/* Photon map: octahedral directions, radius and k-nearest queries against brute
+ * force, and byte-identical builds for any thread count and input order. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "core/rng.h"
+#include "photon/photon_map.h"
+
+#define AXIS_MASK (3u << 16)
+
+static double test_scale(void)
+{
+    const char *s = getenv("THZ_TEST_SCALE");
+    double v = s ? atof(s) : 1.0;
+    return (v > 0.0 && v <= 1.0) ? v : 1.0;
+}
+
+static double angle_between(vec3 a, vec3 b)
+{
+    return atan2(v3_length(v3_cross(a, b)), v3_dot(a, b));
+}
+
+static double check_direction(vec3 d)
+{
+    d = v3_normalize(d);
+    vec3 back = photon_decode_direction(photon_encode_direction(d));
+    assert_true(fabs(v3_length(back) - 1.0) < 1e-12);
+    return angle_between(d, back);
+}
+
+static void test_directions(void **state)
+{
+    (void)state;
+    double worst = 0.0;
+    /* poles, axes, the z = 0 seam, octant diagonals, signed zeros */
+    static const double special[][3] = {
+        {0, 0, 1},  {0, 0, -1}, {1, 0, 0},   {-1, 0, 0},  {0, 1, 0},  {0, -1, 0},
+        {1, 1, 0},  {-1, 1, 0}, {1, -1, 0},  {-1, -1, 0}, {1, 1, 1},  {-1, -1, -1},
+        {1, 1, -1}, {0, 1, -1}, {1, 0, -1},  {-0.0, -0.0, -1}, {-0.0, 0, 1},
+        {1e-9, 1e-9, -1}, {-1e-9, 1e-9, -1}, {0.6, 0.8, -1e-12}, {0.6, -0.8, 1e-12},
+    };
+    for (size_t i = 0; i < sizeof special / sizeof special[0]; i++) {
+        double e = check_direction(v3(special[i][0], special[i][1], special[i][2]));
+        worst = e > worst ? e : worst;
+    }
+    rng_stream rng;
+    rng_init(&rng, 3, 0, RNG_PURPOSE_TEST, 0);
+    const size_t n = (size_t)(400000 * test_scale());
+    for (size_t i = 0; i < n; i++) {
+        double z = 2.0 * rng_uniform(&rng) - 1.0, phi = 2.0 * M_PI * rng_uniform(&rng);
+        if (i % 4 == 1)
+            z = 1e-3 * (2.0 * rng_uniform(&rng) - 1.0); /* near the seam */
+        else if (i % 4 == 2)
+            z = copysign(1.0 - 1e-6 * rng_uniform(&rng), z); /* near the poles */
+        double s = sqrt(fmax(0.0, 1.0 - z * z));
+        double e = check_direction(v3(s * cos(phi), s * sin(phi), z));
+        worst = e > worst ? e : worst;
+    }
+    print_message("octahedral round trip: worst angular error %.3g rad\n", worst);
+    assert_true(worst < 1e-4);
+    /* the zero vector does not crash and decodes to a unit vector */
+    assert_true(fabs(v3_length(photon_decode_direction(photon_encode_direction(v3(0, 0, 0)))) -
+                     1.0) < 1e-12);
+}
+
+/* Random photons over n_objects objects: clustered positions, exact coordinate
+ * duplicates, fully identical records, a coplanar group and empty groups. */
+static photon_record *make_photons(size_t n, size_t n_objects, uint64_t stream)
+{
+    photon_record *p = malloc(n * sizeof *p);
+    assert_non_null(p);
+    rng_stream rng;
+    rng_init(&rng, 11, 0, RNG_PURPOSE_TEST, stream);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t obj = rng_next_u32(&rng) % (uint32_t)n_objects;
+        uint32_t side = rng_next_u32(&rng) & 1u;
+        if (obj == 2)
+            side = 0; /* object 2 has no back-side photons */
+        if (obj == 3)
+            obj = 1; /* object 3 has none at all */
+        float pos[3];
+        for (int a = 0; a < 3; a++)
+            pos[a] = (float)(rng_uniform(&rng) * (a == 2 ? 0.2 : 1.0));
+        if (obj == 1 && side == 0)
+            pos[2] = 0.5f; /* coplanar */
+        if (i % 7 == 3 && i > 0) { /* same position as the previous photon */
+            memcpy(pos, p[i - 1].position_m, sizeof pos);
+        }
+        p[i] = (photon_record){
+            .position_m = {pos[0], pos[1], pos[2]},
+            .power_w_per_hz = (float)i,
+            .freq_hz = 1e12f,
+            .dir_oct = rng_next_u32(&rng),
+            .object_side = obj << 1 | side,
+            .flags = (uint32_t)(i % 5) | (i % 3 == 0 ? AXIS_MASK : 0u),
+        };
+        if (i % 11 == 5 && i > 0 && (p[i - 1].object_side >> 1) != 3)
+            p[i] = p[i - 1]; /* fully identical record */
+    }
+    return p;
+}
+
+typedef struct visit_log {
+    const photon_record *base;
+    unsigned char *seen;
+    size_t visits;
+    int bad;
+    vec3 q;
+} visit_log;
+
+static void log_visit(void *ctx, const photon_record *p, double d2)
+{
+    visit_log *v = ctx;
+    size_t i = (size_t)(p - v->base);
+    double dx = (double)p->position_m[0] - v->q.x, dy = (double)p->position_m[1] - v->q.y,
+           dz = (double)p->position_m[2] - v->q.z;
+    if (v->seen[i] || d2 != dx * dx + dy * dy + dz * dz)
+        v->bad = 1;
+    v->seen[i] = 1;
+    v->visits++;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static void test_queries_vs_brute_force(void **state)
+{
+    (void)state;
+    const size_t n = 6000, n_objects = 5;
+    photon_record *in = make_photons(n, n_objects, 1);
+    photon_map *map = NULL;
+    thz_error err;
+    assert_int_equal(photon_map_create(in, n, n_objects, 0, &map, &err), THZ_OK);
+    assert_int_equal(photon_map_count(map), n);
+    const photon_record *r = photon_map_records(map);
+    unsigned char *seen = calloc(n, 1);
+    double *d2s = malloc(n * sizeof *d2s);
+    assert_non_null(seen);
+    assert_non_null(d2s);
+    rng_stream rng;
+    rng_init(&rng, 12, 0, RNG_PURPOSE_TEST, 0);
+    static const double radii[] = {0.0, 0.01, 0.05, 0.2, 2.0};
+    static const size_t ks[] = {1, 2, 7, 50, 256, 257, 400, 5000};
+    for (int trial = 0; trial < 60; trial++) {
+        vec3 q = v3(rng_uniform(&rng) * 1.2 - 0.1, rng_uniform(&rng) * 1.2 - 0.1,
+                    rng_uniform(&rng) * 0.6 - 0.1);
+        if (trial % 5 == 0) /* exactly on a stored photon */
+            q = v3(r[trial * 37].position_m[0], r[trial * 37].position_m[1],
+                   r[trial * 37].position_m[2]);
+        for (uint32_t obj = 0; obj < n_objects + 1; obj++) {
+            for (int side = 0; side < 2; side++) {
+                for (size_t ri = 0; ri < sizeof radii / sizeof radii[0]; ri++) {
+                    double r2 = radii[ri] * radii[ri];
+                    memset(seen, 0, n);
+                    visit_log v = {r, seen, 0, 0, q};
+                    photon_map_radius(map, obj, side, q, r2, log_visit, &v);
+                    assert_false(v.bad);
+                    size_t expect = 0;
+                    for (size_t i = 0; i < n; i++) {
+                        if (r[i].object_side != (obj << 1 | (uint32_t)side))
+                            continue;
+                        double dx = (double)r[i].position_m[0] - q.x,
+                               dy = (double)r[i].position_m[1] - q.y,
+                               dz = (double)r[i].position_m[2] - q.z;
+                        if (dx * dx + dy * dy + dz * dz <= r2) {
+                            expect++;
+                            assert_true(seen[i]);
+                        }
+                    }
+                    assert_int_equal(v.visits, expect);
+                }
+            }
+            for (unsigned mask = 0; mask < 4; mask++) {
+                size_t m = 0;
+                for (size_t i = 0; i < n; i++) {
+                    if (r[i].object_side >> 1 != obj || !(mask >> (r[i].object_side & 1) & 1))
+                        continue;
+                    double dx = (double)r[i].position_m[0] - q.x,
+                           dy = (double)r[i].position_m[1] - q.y,
+                           dz = (double)r[i].position_m[2] - q.z;
+                    d2s[m++] = dx * dx + dy * dy + dz * dz;
+                }
+                qsort(d2s, m, sizeof *d2s, cmp_double);
+                for (size_t ki = 0; ki < sizeof ks / sizeof ks[0]; ki++) {
+                    double got = photon_map_kth_distance2(map, obj, mask, q, ks[ki]);
+                    if (ks[ki] > m)
+                        assert_true(isinf(got) && got > 0);
+                    else
+                        assert_true(got == d2s[ks[ki] - 1]);
+                }
+            }
+        }
+    }
+    free(seen);
+    free(d2s);
+    photon_map_destroy(map);
+}
+
+static int cmp_record(const void *a, const void *b)
+{
+    return memcmp(a, b, sizeof(photon_record));
+}
+
+static void test_same_records_grouped(void **state)
+{
+    (void)state;
+    const size_t n = 3000, n_objects = 5;
+    photon_record *in = make_photons(n, n_objects, 2);
+    photon_record *copy = malloc(n * sizeof *copy);
+    assert_non_null(copy);
+    for (size_t i = 0; i < n; i++) {
+        copy[i] = in[i];
+        copy[i].flags &= ~AXIS_MASK;
+    }
+    photon_map *map = NULL;
+    assert_int_equal(photon_map_create(in, n, n_objects, 1, &map, NULL), THZ_OK);
+    const photon_record *r = photon_map_records(map);
+    photon_record *out = malloc(n * sizeof *out);
+    assert_non_null(out);
+    for (size_t i = 0; i < n; i++) {
+        out[i] = r[i];
+        /* grouped by object_side; bounce counts kept */
+        if (i > 0)
+            assert_true(r[i - 1].object_side <= r[i].object_side);
+        assert_true(((r[i].flags & AXIS_MASK) >> 16) < 3);
+        out[i].flags &= ~AXIS_MASK;
+    }
+    qsort(out, n, sizeof *out, cmp_record);
+    qsort(copy, n, sizeof *copy, cmp_record);
+    assert_memory_equal(out, copy, n * sizeof *out);
+    free(out);
+    free(copy);
+    photon_map_destroy(map);
+}
+
+static photon_map *build(const photon_record *src, size_t n, size_t n_objects, int threads,
+                         int reverse)
+{
+    photon_record *p = malloc(n * sizeof *p);
+    assert_non_null(p);
+    for (size_t i = 0; i < n; i++)
+        p[i] = src[reverse ? n - 1 - i : i];
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#endif
+    photon_map *map = NULL;
+    assert_int_equal(photon_map_create(p, n, n_objects, threads, &map, NULL), THZ_OK);
+    return map;
+}
+
+static void test_deterministic(void **state)
+{
+    (void)state;
+    /* big enough for the subtree tasks (8192) to run in parallel */
+    const size_t n = (size_t)(120000 * test_scale()), n_objects = 5;
+    photon_record *src = make_photons(n, n_objects, 3);
+    photon_map *a = build(src, n, n_objects, 1, 0);
+    photon_map *b = build(src, n, n_objects, 2, 0);
+    photon_map *c = build(src, n, n_objects, 2, 1);
+    assert_memory_equal(photon_map_records(a), photon_map_records(b), n * sizeof(photon_record));
+    assert_memory_equal(photon_map_records(a), photon_map_records(c), n * sizeof(photon_record));
+    photon_map_destroy(a);
+    photon_map_destroy(b);
+    photon_map_destroy(c);
+    free(src);
+}
+
+static void noop_visit(void *ctx, const photon_record *p, double d2)
+{
+    (void)p;
+    (void)d2;
+    (*(int *)ctx)++;
+}
+
+static void test_empty_and_errors(void **state)
+{
+    (void)state;
+    photon_map *map = NULL;
+    thz_error err;
+    assert_int_equal(photon_map_create(NULL, 0, 3, 0, &map, &err), THZ_OK);
+    assert_non_null(map);
+    assert_int_equal(photon_map_count(map), 0);
+    int visits = 0;
+    photon_map_radius(map, 0, 0, v3(0, 0, 0), 1e9, noop_visit, &visits);
+    photon_map_radius(map, 7, 1, v3(0, 0, 0), 1e9, noop_visit, &visits);
+    assert_int_equal(visits, 0);
+    assert_true(isinf(photon_map_kth_distance2(map, 0, 3, v3(0, 0, 0), 1)));
+    photon_map_destroy(map);
+    photon_map_destroy(NULL);
+
+    /* an object index beyond n_objects is refused (and the array freed) */
+    photon_record *p = make_photons(10, 5, 4);
+    p[4].object_side = 10 << 1;
+    map = NULL;
+    assert_int_equal(photon_map_create(p, 10, 5, 0, &map, &err), THZ_ERR_INTERNAL);
+    assert_null(map);
+    assert_true(strstr(err.message, "object 10") != NULL);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_directions),
+        cmocka_unit_test(test_queries_vs_brute_force),
+        cmocka_unit_test(test_same_records_grouped),
+        cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_empty_and_errors),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
