@@ -1,0 +1,784 @@
+/* The `lines` model: line-by-line absorption of H2O and O2 from spectral line
+ * catalogues, plus the MT_CKD water-vapour continuum and a dry-air collision-
+ * induced continuum. docs/atmosphere.md explains the choices; in short:
+ *
+ *   alpha(nu) = sum_lines n S(T) F(nu) + alpha_MT_CKD(nu) + alpha_dry(nu)
+ *
+ * - S(T) = S296 Q(296)/Q(T) exp(E''(T-296)/(296 T)) (1-exp(-h nu0/kT))/(1-exp(-h nu0/k 296))
+ *   with the TIPS 2021 partition sums Q (the HITRAN convention, as am 14.0 does);
+ * - Lorentz half width gamma = (296/T)^n_air (gamma_air (P - p_self) + gamma_self p_self),
+ *   pressure shift delta_air (P - p_self), Voigt where the Doppler width is not
+ *   negligible against the Lorentz width (low pressure);
+ * - shape: Van Vleck-Huber, F = (nu tanh(h nu/2kT)) / (nu0 tanh(h nu0/2kT)) *
+ *   (1/pi) [f(nu - nu0) + f(nu + nu0)]. With the continuum on, H2O lines use
+ *   f(d) = L(d) - L(750 GHz) for |d| < 750 GHz and 0 beyond, the shape MT_CKD is
+ *   defined against (no double counting of the far wings); O2 lines keep full wings;
+ * - O2 60 GHz band and 118.75 GHz line: first-order (Rosenkranz) line mixing with
+ *   the second-order strength and shift corrections of Makarov et al. (2011):
+ *   f = (gamma G + (nu - nu0') Y) / ((nu - nu0')^2 + gamma^2) + mirror term;
+ * - MT_CKD 4.2 self and foreign continuum from its 10 cm^-1 table (Catmull-Rom);
+ * - dry air (mostly N2-N2) collision-induced absorption: the P.676-13 eq. 8 term.
+ *
+ * Units inside: frequencies in GHz, pressures in hPa (= mbar), number densities in
+ * cm^-3, S in cm^2 GHz (HITRAN cm/molecule times 29.9792458), alpha in 1/cm until
+ * the end. Lines weaker than LINE_MIN_RELATIVE times the strongest line of their
+ * species (at the air's temperature) are dropped: at its own centre such a line adds
+ * less than 1e-7 of the continuum there (docs/atmosphere.md).
+ */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "atmosphere/atm_internal.h"
+#include "core/alloc.h"
+
+#define LINE_MIN_RELATIVE 1e-10
+#define H2O_CUTOFF_GHZ 750.0   /* 25 cm^-1: MT_CKD's line cut-off */
+#define O2_DRY_AIR_VMR 0.20946 /* O2 fraction of dry air */
+#define VOIGT_DOPPLER_RATIO 1e-3 /* Voigt when gamma_D > this times gamma_L */
+#define COUPLED_MATCH_GHZ 0.005  /* .par O2 lines this close to a coupled line are it */
+#define H_OVER_K_K_PER_GHZ 0.0479924307 /* h / k in K/GHz (CODATA 2018) */
+#define HC_OVER_K_CM_K 1.438776877      /* second radiation constant, cm K */
+#define BOLTZMANN_HPA_CM3 1.380649e-19  /* k in hPa cm^3 / K: n[cm^-3] = p[hPa] / (k T) */
+#define AMU_KG 1.66053906660e-27
+#define MT_CKD_P_REF_HPA 1013.0
+#define MT_CKD_T_REF_K 296.0
+
+/* One catalogue line as read (HITRAN reference state, am units). */
+typedef struct raw_line {
+    double nu0_ghz, s296_cm2_ghz, elower_k;
+    double gamma_air, gamma_self; /* GHz/hPa, HWHM at 296 K */
+    double n_air;
+    double delta_air; /* GHz/hPa */
+    int iso;
+    /* line mixing (coupled lines only) */
+    double y0, y1, yx, g0, g1, gx, d0, d1, dx, tref_k;
+} raw_line;
+
+typedef struct raw_catalog {
+    size_t n, cap;
+    raw_line *lines;
+} raw_catalog;
+
+/* A line at the air's state. */
+typedef struct lbl_line {
+    double nu_ghz;    /* shifted centre */
+    double amp;       /* n S(T) / (pi nu0 tanh(h nu0 / 2kT)), cm^-1 GHz^-1 ... per GHz of shape */
+    double gamma_ghz; /* Lorentz HWHM */
+    double gamma_d_ghz; /* Doppler HWHM */
+    double y, g;      /* mixing: Y (dimensionless) and G (1 for uncoupled) */
+    double pedestal;  /* cut-off shapes: L(cutoff) */
+    bool voigt;
+} lbl_line;
+
+typedef enum lbl_shape { SHAPE_VVH_CUTOFF, SHAPE_VVH, SHAPE_COUPLED } lbl_shape;
+
+typedef struct lbl_species {
+    lbl_shape shape;
+    size_t n;
+    lbl_line *lines; /* sorted by nu_ghz */
+} lbl_species;
+
+typedef struct partition_sums {
+    size_t n_t, n_iso;
+    double t0_k, dt_k;
+    double *q; /* n_t * n_iso */
+} partition_sums;
+
+struct atm_lines_data {
+    atm_air_state air;
+    double half_h_over_kt; /* h / (2 k T) in 1/GHz */
+    lbl_species h2o, o2, o2_coupled;
+    bool continuum;
+    /* MT_CKD on a uniform grid from 0 in steps of cont_step_cm1 */
+    size_t n_cont;
+    double cont_step_cm1;
+    double *c_foreign, *c_self, *self_texp;
+    double n_h2o, n_foreign, n_ref; /* cm^-3 */
+    double dry_hpa;
+};
+
+/* ---- Reading catalogues -------------------------------------------------------- */
+
+static thz_status catalog_push(raw_catalog *cat, const raw_line *line, thz_error *err)
+{
+    if (cat->n == cat->cap) {
+        size_t cap = cat->cap ? 2 * cat->cap : 4096;
+        raw_line *l = thz_realloc_array(cat->lines, cap, sizeof *l);
+        if (!l)
+            return thz_error_set(err, THZ_ERR_NOMEM, "out of memory reading a line catalogue");
+        cat->lines = l;
+        cat->cap = cap;
+    }
+    cat->lines[cat->n++] = *line;
+    return THZ_OK;
+}
+
+static bool has_suffix(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), m = strlen(suffix);
+    if (n < m)
+        return false;
+    for (size_t i = 0; i < m; i++)
+        if (tolower((unsigned char)s[n - m + i]) != suffix[i])
+            return false;
+    return true;
+}
+
+static thz_status check_line(const raw_line *l, const char *path, size_t lineno, thz_error *err)
+{
+    if (!(l->nu0_ghz > 0.0) || !(l->s296_cm2_ghz >= 0.0) || !(l->gamma_air >= 0.0) ||
+        !(l->gamma_self >= 0.0) || !isfinite(l->n_air) || !isfinite(l->delta_air) ||
+        !isfinite(l->elower_k) || l->iso < 1)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s:%zu: a line needs frequency > 0, intensity >= 0, widths >= 0, "
+                             "finite n_air, shift and lower-state energy, isotopologue >= 1",
+                             path, lineno);
+    return THZ_OK;
+}
+
+/* am 14.0 CSV catalogue (data/atmosphere/am14_*_lines*.csv); coupled adds mixing. */
+static thz_status read_csv_catalog(const char *path, bool coupled, raw_catalog *cat,
+                                   thz_error *err)
+{
+    static const char *const base[] = {"freq_GHz",       "S296_cm2_GHz",
+                                       "Elower_K",       "gamma_air_GHz_per_mbar",
+                                       "gamma_self_GHz_per_mbar", "n_air",
+                                       "delta_air_GHz_per_mbar",  "hitran_iso"};
+    static const char *const mix[] = {"y0_per_mbar",  "y1_per_mbar",  "yx",
+                                      "g0_per_mbar2", "g1_per_mbar2", "gx",
+                                      "d0_per_mbar2", "d1_per_mbar2", "dx",
+                                      "Tref_K"};
+    enum { N_BASE = 8, N_MIX = 10 };
+    size_t col[N_BASE + N_MIX];
+    atm_csv csv;
+    thz_status st = atm_csv_read(&csv, path, err);
+    if (st != THZ_OK)
+        return st;
+    for (size_t i = 0; st == THZ_OK && i < N_BASE; i++)
+        st = atm_csv_column(&csv, base[i], &col[i], err);
+    for (size_t i = 0; coupled && st == THZ_OK && i < N_MIX; i++)
+        st = atm_csv_column(&csv, mix[i], &col[N_BASE + i], err);
+    for (size_t r = 0; st == THZ_OK && r < csv.n_rows; r++) {
+        raw_line l;
+        memset(&l, 0, sizeof l);
+        l.nu0_ghz = atm_csv_at(&csv, r, col[0]);
+        l.s296_cm2_ghz = atm_csv_at(&csv, r, col[1]);
+        l.elower_k = atm_csv_at(&csv, r, col[2]);
+        l.gamma_air = atm_csv_at(&csv, r, col[3]);
+        l.gamma_self = atm_csv_at(&csv, r, col[4]);
+        l.n_air = atm_csv_at(&csv, r, col[5]);
+        l.delta_air = atm_csv_at(&csv, r, col[6]);
+        double iso = atm_csv_at(&csv, r, col[7]);
+        l.iso = iso >= 1.0 && iso <= 99.0 ? (int)iso : 0;
+        if (coupled) {
+            double *m = &l.y0;
+            for (size_t i = 0; i < N_MIX; i++)
+                m[i] = atm_csv_at(&csv, r, col[N_BASE + i]);
+            if (!(l.tref_k > 0.0))
+                st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: Tref_K must be > 0", path,
+                                   csv.line_of[r]);
+        }
+        if (st == THZ_OK)
+            st = check_line(&l, path, csv.line_of[r], err);
+        if (st == THZ_OK)
+            st = catalog_push(cat, &l, err);
+    }
+    atm_csv_fini(&csv);
+    return st;
+}
+
+/* Parses columns [start, start+len) (0-based) of a .par record as a number. */
+static bool par_field(const char *rec, size_t start, size_t len, double *out)
+{
+    char buf[32];
+    memcpy(buf, rec + start, len);
+    buf[len] = '\0';
+    char *p = buf;
+    while (*p == ' ')
+        p++;
+    if (!*p)
+        return false;
+    char *end = NULL;
+    errno = 0;
+    *out = strtod(p, &end);
+    while (*end == ' ')
+        end++;
+    return !*end && errno != ERANGE && isfinite(*out);
+}
+
+/* HITRAN 2004+ 160-character records: molecule I2, isotopologue I1 (0 = 10, A = 11,
+ * ...), nu F12.6 cm^-1, S E10.3 cm^-1/(molecule cm^-2), A E10.3, gamma_air F5.4 and
+ * gamma_self F5.3 cm^-1/atm, E'' F10.4 cm^-1, n_air F4.2, delta_air F8.6 cm^-1/atm,
+ * then quantum numbers, error and reference codes, flag, g' and g'' (unused). */
+static thz_status read_par_catalog(const char *path, int molecule, raw_catalog *cat,
+                                   size_t *n_other, thz_error *err)
+{
+    thz_status st = THZ_OK;
+    char *line = NULL;
+    size_t cap = 0, lineno = 0, n_found = 0;
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open: %s", path, strerror(errno));
+    ssize_t len;
+    while ((len = getline(&line, &cap, f)) != -1) {
+        lineno++;
+        while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r'))
+            line[--len] = '\0';
+        if (len == 0)
+            continue;
+        if (len < 67) {
+            st = thz_error_set(err, THZ_ERR_INPUT,
+                               "%s:%zu: a HITRAN .par record has 160 characters, this line has "
+                               "%zd",
+                               path, lineno, len);
+            goto cleanup;
+        }
+        double mol;
+        if (!par_field(line, 0, 2, &mol)) {
+            st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu:1: expected the molecule number", path,
+                               lineno);
+            goto cleanup;
+        }
+        if ((int)mol != molecule) {
+            (*n_other)++;
+            continue;
+        }
+        int iso;
+        char c = line[2];
+        if (c >= '1' && c <= '9')
+            iso = c - '0';
+        else if (c == '0')
+            iso = 10;
+        else if (c >= 'A' && c <= 'Z')
+            iso = 11 + (c - 'A');
+        else {
+            st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu:3: bad isotopologue code '%c'", path,
+                               lineno, c);
+            goto cleanup;
+        }
+        static const struct {
+            size_t start, len;
+            const char *name;
+        } fields[] = {{3, 12, "nu"},         {15, 10, "S"},         {35, 5, "gamma_air"},
+                      {40, 5, "gamma_self"}, {45, 10, "E''"},       {55, 4, "n_air"},
+                      {59, 8, "delta_air"}};
+        double v[7];
+        for (size_t i = 0; i < 7; i++) {
+            if (!par_field(line, fields[i].start, fields[i].len, &v[i])) {
+                st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu:%zu: expected a number for %s",
+                                   path, lineno, fields[i].start + 1, fields[i].name);
+                goto cleanup;
+            }
+        }
+        raw_line l;
+        memset(&l, 0, sizeof l);
+        l.nu0_ghz = v[0] * ATM_GHZ_PER_CM1;
+        l.s296_cm2_ghz = v[1] * ATM_GHZ_PER_CM1;
+        l.gamma_air = v[2] * ATM_GHZ_PER_CM1 / ATM_HPA_PER_ATM;
+        l.gamma_self = v[3] * ATM_GHZ_PER_CM1 / ATM_HPA_PER_ATM;
+        l.elower_k = v[4] * HC_OVER_K_CM_K;
+        l.n_air = v[5];
+        l.delta_air = v[6] * ATM_GHZ_PER_CM1 / ATM_HPA_PER_ATM;
+        l.iso = iso;
+        st = check_line(&l, path, lineno, err);
+        if (st == THZ_OK)
+            st = catalog_push(cat, &l, err);
+        if (st != THZ_OK)
+            goto cleanup;
+        n_found++;
+    }
+    if (ferror(f))
+        st = thz_error_set(err, THZ_ERR_IO, "%s: read error", path);
+    else if (n_found == 0)
+        st = thz_error_set(err, THZ_ERR_INPUT, "%s: no lines of molecule %d (%s) in this file",
+                           path, molecule, molecule == 1 ? "H2O" : "O2");
+cleanup:
+    free(line);
+    fclose(f);
+    return st;
+}
+
+static thz_status read_catalog(const char *path, int molecule, bool coupled, raw_catalog *cat,
+                               thz_error *err)
+{
+    size_t n_other = 0;
+    if (has_suffix(path, ".par"))
+        return read_par_catalog(path, molecule, cat, &n_other, err);
+    return read_csv_catalog(path, coupled, cat, err);
+}
+
+static thz_status read_partition_sums(const char *path, partition_sums *q, thz_error *err)
+{
+    atm_csv csv;
+    memset(q, 0, sizeof *q);
+    thz_status st = atm_csv_read(&csv, path, err);
+    if (st != THZ_OK)
+        return st;
+    size_t col_t;
+    st = atm_csv_column(&csv, "T_K", &col_t, err);
+    size_t cols[32];
+    size_t n_iso = 0;
+    while (st == THZ_OK && n_iso < 32) {
+        char name[16];
+        snprintf(name, sizeof name, "Q_iso%zu", n_iso + 1);
+        if (atm_csv_column(&csv, name, &cols[n_iso], NULL) != THZ_OK)
+            break;
+        n_iso++;
+    }
+    if (st == THZ_OK && (n_iso == 0 || csv.n_rows < 2))
+        st = thz_error_set(err, THZ_ERR_INPUT, "%s: needs columns T_K, Q_iso1, ... and >= 2 rows",
+                           path);
+    if (st != THZ_OK)
+        goto cleanup;
+    q->t0_k = atm_csv_at(&csv, 0, col_t);
+    q->dt_k = atm_csv_at(&csv, 1, col_t) - q->t0_k;
+    for (size_t r = 0; r < csv.n_rows; r++) {
+        double t = atm_csv_at(&csv, r, col_t);
+        if (!(q->dt_k > 0.0) || fabs(t - (q->t0_k + (double)r * q->dt_k)) > 1e-6 * q->dt_k) {
+            st = thz_error_set(err, THZ_ERR_INPUT,
+                               "%s:%zu: temperatures must be evenly spaced and increasing", path,
+                               csv.line_of[r]);
+            goto cleanup;
+        }
+    }
+    q->n_t = csv.n_rows;
+    q->n_iso = n_iso;
+    q->q = thz_malloc_array(q->n_t * n_iso, sizeof *q->q);
+    if (!q->q) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory reading %s", path);
+        goto cleanup;
+    }
+    for (size_t r = 0; r < csv.n_rows; r++) {
+        for (size_t i = 0; i < n_iso; i++) {
+            double v = atm_csv_at(&csv, r, cols[i]);
+            if (!(v > 0.0)) {
+                st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: partition sums must be > 0", path,
+                                   csv.line_of[r]);
+                goto cleanup;
+            }
+            q->q[r * n_iso + i] = v;
+        }
+    }
+cleanup:
+    if (st != THZ_OK) {
+        free(q->q);
+        q->q = NULL;
+    }
+    atm_csv_fini(&csv);
+    return st;
+}
+
+/* Q(T) of isotopologue iso (1-based), linear in T; NAN outside the table. */
+static double partition_sum(const partition_sums *q, int iso, double t_k)
+{
+    if (iso < 1 || (size_t)iso > q->n_iso)
+        return NAN;
+    double x = (t_k - q->t0_k) / q->dt_k;
+    if (x < 0.0 || x > (double)(q->n_t - 1))
+        return NAN;
+    size_t i = (size_t)x;
+    if (i >= q->n_t - 1)
+        i = q->n_t - 2;
+    double u = x - (double)i;
+    const double *col = q->q + (size_t)(iso - 1);
+    return (1.0 - u) * col[i * q->n_iso] + u * col[(i + 1) * q->n_iso];
+}
+
+/* ---- Lines at the air's state ---------------------------------------------------- */
+
+static double iso_mass_amu(int molecule, int iso)
+{
+    static const double h2o[] = {18.010565, 20.014811, 19.014780, 19.016740, 21.020985, 20.020956,
+                                 20.022915};
+    static const double o2[] = {31.989830, 33.994076, 32.994045};
+    if (molecule == 1)
+        return iso >= 1 && iso <= 7 ? h2o[iso - 1] : h2o[0];
+    return iso >= 1 && iso <= 3 ? o2[iso - 1] : o2[0];
+}
+
+static int compare_lines(const void *a, const void *b)
+{
+    double x = ((const lbl_line *)a)->nu_ghz, y = ((const lbl_line *)b)->nu_ghz;
+    return (x > y) - (x < y);
+}
+
+static double lorentz(double d, double gamma)
+{
+    return gamma / (d * d + gamma * gamma);
+}
+
+/* Converts the raw catalogue into lines at the state: strengths, widths, shifts and
+ * mixing; drops the weak ones. p_self: the species' partial pressure, n: its number
+ * density (cm^-3). Lines whose isotopologue has no partition sum are an error. */
+static thz_status species_build(lbl_species *sp, const raw_catalog *cat, const partition_sums *q,
+                                int molecule, lbl_shape shape, const atm_air_state *air,
+                                double p_self, double n_cm3, const char *what, thz_error *err)
+{
+    double t = air->temperature_k, p = air->pressure_hpa;
+    double tr = 296.0 / t;
+    double kt_ghz = t / H_OVER_K_K_PER_GHZ;
+    memset(sp, 0, sizeof *sp);
+    sp->shape = shape;
+    if (cat->n == 0)
+        return THZ_OK;
+    double *s_t = thz_malloc_array(cat->n, sizeof *s_t);
+    sp->lines = thz_calloc(cat->n, sizeof *sp->lines);
+    if (!s_t || !sp->lines) {
+        free(s_t);
+        free(sp->lines);
+        sp->lines = NULL;
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory preparing the %s lines", what);
+    }
+    double s_max = 0.0;
+    for (size_t i = 0; i < cat->n; i++) {
+        const raw_line *l = &cat->lines[i];
+        if (l->elower_k < 0.0) { /* am's flag: strength independent of T */
+            s_t[i] = l->s296_cm2_ghz;
+        } else {
+            double q296 = partition_sum(q, l->iso, 296.0), qt = partition_sum(q, l->iso, t);
+            if (!isfinite(q296) || !isfinite(qt)) {
+                free(s_t);
+                free(sp->lines);
+                sp->lines = NULL;
+                return thz_error_set(err, THZ_ERR_INPUT,
+                                     "%s lines: no partition sum for isotopologue %d at %g K "
+                                     "(the partition-sum table has %zu isotopologues); give a "
+                                     "table that has it or remove those lines",
+                                     what, l->iso, t, q->n_iso);
+            }
+            double stim_t = -expm1(-l->nu0_ghz / kt_ghz);
+            double stim_296 = -expm1(-l->nu0_ghz * H_OVER_K_K_PER_GHZ / 296.0);
+            s_t[i] = l->s296_cm2_ghz * q296 / qt * exp(l->elower_k * (t - 296.0) / (296.0 * t)) *
+                     stim_t / stim_296;
+        }
+        if (s_t[i] > s_max)
+            s_max = s_t[i];
+    }
+    size_t n = 0;
+    for (size_t i = 0; i < cat->n; i++) {
+        const raw_line *l = &cat->lines[i];
+        if (s_t[i] < LINE_MIN_RELATIVE * s_max || s_t[i] <= 0.0)
+            continue;
+        lbl_line *o = &sp->lines[n++];
+        double tanh0 = tanh(l->nu0_ghz / (2.0 * kt_ghz));
+        o->amp = n_cm3 * s_t[i] / (M_PI * l->nu0_ghz * tanh0);
+        o->gamma_ghz = pow(tr, l->n_air) * (l->gamma_air * (p - p_self) + l->gamma_self * p_self);
+        double m_kg = iso_mass_amu(molecule, l->iso) * AMU_KG;
+        o->gamma_d_ghz = l->nu0_ghz / 299792458.0 * sqrt(2.0 * M_LN2 * 1.380649e-23 * t / m_kg);
+        o->voigt = o->gamma_d_ghz > VOIGT_DOPPLER_RATIO * o->gamma_ghz;
+        o->g = 1.0;
+        if (shape == SHAPE_COUPLED) {
+            double r = l->tref_k / t;
+            o->y = p * (l->y0 + l->y1 * (r - 1.0)) * pow(r, l->yx);
+            o->g = 1.0 + p * p * (l->g0 + l->g1 * (r - 1.0)) * pow(r, l->gx);
+            o->nu_ghz = l->nu0_ghz + p * p * (l->d0 + l->d1 * (r - 1.0)) * pow(r, l->dx);
+        } else {
+            o->nu_ghz = l->nu0_ghz + l->delta_air * (p - p_self);
+        }
+        if (shape == SHAPE_VVH_CUTOFF)
+            o->pedestal = lorentz(H2O_CUTOFF_GHZ, o->gamma_ghz);
+    }
+    free(s_t);
+    sp->n = n;
+    qsort(sp->lines, n, sizeof *sp->lines, compare_lines);
+    return THZ_OK;
+}
+
+/* Drops from cat the lines of isotopologue 1 within COUPLED_MATCH_GHZ of a coupled
+ * line: a HITRAN O2 list holds the 60 GHz band and 118.75 GHz line, which the
+ * coupled table already has (with line mixing). */
+static void drop_coupled_duplicates(raw_catalog *cat, const raw_catalog *coupled)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < cat->n; i++) {
+        bool dup = false;
+        for (size_t j = 0; !dup && cat->lines[i].iso == 1 && j < coupled->n; j++)
+            dup = fabs(cat->lines[i].nu0_ghz - coupled->lines[j].nu0_ghz) < COUPLED_MATCH_GHZ;
+        if (!dup)
+            cat->lines[n++] = cat->lines[i];
+    }
+    cat->n = n;
+}
+
+/* ---- MT_CKD -------------------------------------------------------------------- */
+
+static thz_status read_continuum(atm_lines_data *d, const char *path, thz_error *err)
+{
+    atm_csv csv;
+    thz_status st = atm_csv_read(&csv, path, err);
+    if (st != THZ_OK)
+        return st;
+    size_t c_nu, c_f, c_s, c_x;
+    st = atm_csv_column(&csv, "nu_cm-1", &c_nu, err);
+    if (st == THZ_OK)
+        st = atm_csv_column(&csv, "C_foreign_ref_cm2_per_molec_per_cm-1", &c_f, err);
+    if (st == THZ_OK)
+        st = atm_csv_column(&csv, "C_self_ref_cm2_per_molec_per_cm-1", &c_s, err);
+    if (st == THZ_OK)
+        st = atm_csv_column(&csv, "self_texp", &c_x, err);
+    if (st != THZ_OK)
+        goto cleanup;
+    d->n_cont = csv.n_rows;
+    d->cont_step_cm1 = csv.n_rows > 1 ? atm_csv_at(&csv, 1, c_nu) : 0.0;
+    if (csv.n_rows < 4 || atm_csv_at(&csv, 0, c_nu) != 0.0 || !(d->cont_step_cm1 > 0.0)) {
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "%s: the continuum table must start at 0 cm^-1, be evenly spaced and "
+                           "have at least 4 rows",
+                           path);
+        goto cleanup;
+    }
+    d->c_foreign = thz_malloc_array(d->n_cont, sizeof *d->c_foreign);
+    d->c_self = thz_malloc_array(d->n_cont, sizeof *d->c_self);
+    d->self_texp = thz_malloc_array(d->n_cont, sizeof *d->self_texp);
+    if (!d->c_foreign || !d->c_self || !d->self_texp) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory reading %s", path);
+        goto cleanup;
+    }
+    for (size_t r = 0; r < csv.n_rows; r++) {
+        double nu = atm_csv_at(&csv, r, c_nu);
+        if (fabs(nu - (double)r * d->cont_step_cm1) > 1e-6 * d->cont_step_cm1) {
+            st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: wavenumbers must be evenly spaced",
+                               path, csv.line_of[r]);
+            goto cleanup;
+        }
+        d->c_foreign[r] = atm_csv_at(&csv, r, c_f);
+        d->c_self[r] = atm_csv_at(&csv, r, c_s);
+        d->self_texp[r] = atm_csv_at(&csv, r, c_x);
+    }
+cleanup:
+    atm_csv_fini(&csv);
+    return st;
+}
+
+/* Catmull-Rom spline through the table at wavenumber nu (as am interpolates it). */
+static double catmull_rom(const double *v, size_t n, double step, double nu)
+{
+    double x = nu / step;
+    if (x <= 0.0)
+        return v[0];
+    if (x >= (double)(n - 1))
+        return v[n - 1];
+    size_t i = (size_t)x;
+    double u = x - (double)i;
+    double p0 = v[i > 0 ? i - 1 : 0], p1 = v[i], p2 = v[i + 1], p3 = v[i + 2 < n ? i + 2 : n - 1];
+    return 0.5 * (2.0 * p1 + (-p0 + p2) * u + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * u * u +
+                  (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * u * u * u);
+}
+
+/* MT_CKD: alpha [1/cm] = n_w nu tanh(hc nu / 2kT) [ (n_w/n_0) (296/T)^texp C_s
+ * + (n_f/n_0) C_f ], nu in cm^-1, n_0 the number density at 1013 hPa and 296 K. */
+static double continuum_per_cm(const atm_lines_data *d, double f_ghz)
+{
+    if (!d->continuum || d->n_h2o <= 0.0)
+        return 0.0;
+    double nu = f_ghz / ATM_GHZ_PER_CM1;
+    double t = d->air.temperature_k;
+    double rad = nu * tanh(HC_OVER_K_CM_K * nu / (2.0 * t));
+    double cs = catmull_rom(d->c_self, d->n_cont, d->cont_step_cm1, nu);
+    double cf = catmull_rom(d->c_foreign, d->n_cont, d->cont_step_cm1, nu);
+    double tx = catmull_rom(d->self_texp, d->n_cont, d->cont_step_cm1, nu);
+    return d->n_h2o * rad *
+           (d->n_h2o / d->n_ref * pow(MT_CKD_T_REF_K / t, tx) * cs + d->n_foreign / d->n_ref * cf);
+}
+
+/* P.676-13 eq. 8, second term: pressure-induced absorption of dry air (mostly
+ * N2-N2), alpha in 1/cm. p: dry-air pressure in hPa. */
+static double dry_continuum_per_cm(const atm_lines_data *d, double f_ghz)
+{
+    double theta = 300.0 / d->air.temperature_k, p = d->dry_hpa;
+    double n2 = f_ghz * p * theta * theta * 1.4e-12 * p * pow(theta, 1.5) /
+                (1.0 + 1.9e-5 * pow(f_ghz, 1.5));
+    return 0.1820 * f_ghz * n2 / ATM_NEPER_TO_DB * 1e-5; /* dB/km -> 1/cm */
+}
+
+/* ---- Line sums ---------------------------------------------------------------- */
+
+/* First index with nu_ghz >= f. */
+static size_t lower_bound(const lbl_species *sp, double f)
+{
+    size_t lo = 0, hi = sp->n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (sp->lines[mid].nu_ghz < f)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* Sum over lines of amp [f(nu - nu0) + f(nu + nu0)] (the VVH factor nu tanh(h nu/2kT)
+ * is applied by the caller); 1/cm per (GHz tanh). */
+static double species_sum(const lbl_species *sp, double f)
+{
+    double sum = 0.0;
+    size_t i0 = 0, i1 = sp->n;
+    if (sp->shape == SHAPE_VVH_CUTOFF) {
+        i0 = lower_bound(sp, f - H2O_CUTOFF_GHZ);
+        i1 = lower_bound(sp, f + H2O_CUTOFF_GHZ);
+    }
+    for (size_t i = i0; i < i1; i++) {
+        const lbl_line *l = &sp->lines[i];
+        double d1 = f - l->nu_ghz, d2 = f + l->nu_ghz;
+        double g = l->gamma_ghz;
+        double term;
+        switch (sp->shape) {
+        case SHAPE_COUPLED:
+            term = (g * l->g + d1 * l->y) / (d1 * d1 + g * g) +
+                   (g * l->g - d2 * l->y) / (d2 * d2 + g * g);
+            break;
+        case SHAPE_VVH_CUTOFF:
+            term = 0.0;
+            if (fabs(d1) < H2O_CUTOFF_GHZ)
+                term += (l->voigt ? M_PI * atm_voigt(d1, g, l->gamma_d_ghz) : lorentz(d1, g)) -
+                        l->pedestal;
+            if (d2 < H2O_CUTOFF_GHZ)
+                term += lorentz(d2, g) - l->pedestal;
+            break;
+        case SHAPE_VVH:
+        default:
+            term = (l->voigt ? M_PI * atm_voigt(d1, g, l->gamma_d_ghz) : lorentz(d1, g)) +
+                   lorentz(d2, g);
+            break;
+        }
+        sum += l->amp * term;
+    }
+    return sum;
+}
+
+void atm_lines_parts(const atm_lines_data *d, double freq_hz, atm_alpha_parts *parts)
+{
+    double f = freq_hz * 1e-9;
+    double vvh = f * tanh(f * d->half_h_over_kt);
+    memset(parts, 0, sizeof *parts);
+    parts->h2o_lines_per_m = 100.0 * vvh * species_sum(&d->h2o, f);
+    parts->o2_per_m = 100.0 * vvh * (species_sum(&d->o2, f) + species_sum(&d->o2_coupled, f));
+    parts->h2o_continuum_per_m = 100.0 * continuum_per_cm(d, f);
+    parts->dry_continuum_per_m = 100.0 * dry_continuum_per_cm(d, f);
+}
+
+double atm_lines_min_width_hz(const atm_lines_data *d, double lo_hz, double hi_hz)
+{
+    const lbl_species *all[] = {&d->h2o, &d->o2, &d->o2_coupled};
+    double lo = lo_hz * 1e-9, hi = hi_hz * 1e-9, w_min = INFINITY;
+    for (size_t s = 0; s < 3; s++) {
+        for (size_t i = 0; i < all[s]->n; i++) {
+            const lbl_line *l = &all[s]->lines[i];
+            /* Voigt HWHM (Olivero & Longbothum 1977) */
+            double w = 0.5346 * l->gamma_ghz +
+                       sqrt(0.2166 * l->gamma_ghz * l->gamma_ghz + l->gamma_d_ghz * l->gamma_d_ghz);
+            if (l->nu_ghz > lo - 20.0 * w && l->nu_ghz < hi + 20.0 * w && w < w_min)
+                w_min = w;
+        }
+    }
+    return w_min * 1e9;
+}
+
+/* ---- Set-up -------------------------------------------------------------------- */
+
+static thz_status resolve(char *buf, size_t n, const char *given, const char *dir,
+                          const char *name, thz_error *err)
+{
+    if (given) {
+        if (strlen(given) >= n)
+            return thz_error_set(err, THZ_ERR_INPUT, "path too long: %s", given);
+        strcpy(buf, given);
+        return THZ_OK;
+    }
+    if (!atm_join_path(buf, n, dir, name))
+        return thz_error_set(err, THZ_ERR_INPUT, "data directory path too long: %s", dir);
+    return THZ_OK;
+}
+
+thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
+                            const atm_lines_options *opt, thz_error *err)
+{
+    enum { PATH = 4096 };
+    const char *dir = atm_data_dir(opt->data_dir);
+    char p_h2o[PATH], p_o2[PATH], p_o2c[PATH], p_qh2o[PATH], p_qo2[PATH], p_cont[PATH];
+    raw_catalog h2o = {0}, o2 = {0}, o2c = {0};
+    partition_sums q_h2o = {0}, q_o2 = {0};
+    thz_status st;
+    atm_lines_data *d = thz_calloc(1, sizeof *d);
+    if (!d)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    d->air = *air;
+    d->continuum = opt->continuum;
+    st = resolve(p_h2o, PATH, opt->h2o_lines_file, dir, "atmosphere/am14_h2o_lines.csv", err);
+    if (st == THZ_OK)
+        st = resolve(p_o2, PATH, opt->o2_lines_file, dir, "atmosphere/am14_o2_lines_uncoupled.csv",
+                     err);
+    if (st == THZ_OK)
+        st = resolve(p_o2c, PATH, opt->o2_coupled_lines_file, dir,
+                     "atmosphere/am14_o2_lines_coupled.csv", err);
+    if (st == THZ_OK)
+        st = resolve(p_qh2o, PATH, opt->h2o_partition_sums_file, dir,
+                     "atmosphere/am14_h2o_partition_sums_tips2021.csv", err);
+    if (st == THZ_OK)
+        st = resolve(p_qo2, PATH, opt->o2_partition_sums_file, dir,
+                     "atmosphere/am14_o2_partition_sums_tips2021.csv", err);
+    if (st == THZ_OK)
+        st = resolve(p_cont, PATH, opt->continuum_file, dir,
+                     "atmosphere/mt_ckd_4.2_h2o_continuum_0-520cm-1.csv", err);
+    if (st == THZ_OK)
+        st = read_catalog(p_h2o, 1, false, &h2o, err);
+    if (st == THZ_OK)
+        st = read_catalog(p_o2, 7, false, &o2, err);
+    if (st == THZ_OK)
+        st = read_csv_catalog(p_o2c, true, &o2c, err);
+    if (st == THZ_OK)
+        st = read_partition_sums(p_qh2o, &q_h2o, err);
+    if (st == THZ_OK)
+        st = read_partition_sums(p_qo2, &q_o2, err);
+    if (st == THZ_OK && d->continuum)
+        st = read_continuum(d, p_cont, err);
+    if (st != THZ_OK)
+        goto cleanup;
+    if (has_suffix(p_o2, ".par"))
+        drop_coupled_duplicates(&o2, &o2c);
+
+    double t = air->temperature_k, p = air->pressure_hpa, e = air->h2o_pressure_hpa;
+    d->dry_hpa = p - e;
+    d->half_h_over_kt = H_OVER_K_K_PER_GHZ / (2.0 * t);
+    d->n_h2o = e / (BOLTZMANN_HPA_CM3 * t);
+    d->n_foreign = (p - e) / (BOLTZMANN_HPA_CM3 * t);
+    d->n_ref = MT_CKD_P_REF_HPA / (BOLTZMANN_HPA_CM3 * MT_CKD_T_REF_K);
+    double po2_hpa = O2_DRY_AIR_VMR * (p - e);
+    double n_o2 = po2_hpa / (BOLTZMANN_HPA_CM3 * t);
+    st = species_build(&d->h2o, &h2o, &q_h2o, 1, d->continuum ? SHAPE_VVH_CUTOFF : SHAPE_VVH, air,
+                       e, d->n_h2o, "H2O", err);
+    if (st == THZ_OK)
+        st = species_build(&d->o2, &o2, &q_o2, 7, SHAPE_VVH, air, po2_hpa, n_o2, "O2", err);
+    if (st == THZ_OK)
+        st = species_build(&d->o2_coupled, &o2c, &q_o2, 7, SHAPE_COUPLED, air, po2_hpa, n_o2,
+                           "O2 coupled", err);
+cleanup:
+    free(h2o.lines);
+    free(o2.lines);
+    free(o2c.lines);
+    free(q_h2o.q);
+    free(q_o2.q);
+    if (st != THZ_OK) {
+        atm_lines_destroy(d);
+        return st;
+    }
+    *out = d;
+    return THZ_OK;
+}
+
+void atm_lines_destroy(atm_lines_data *d)
+{
+    if (!d)
+        return;
+    free(d->h2o.lines);
+    free(d->o2.lines);
+    free(d->o2_coupled.lines);
+    free(d->c_foreign);
+    free(d->c_self);
+    free(d->self_texp);
+    free(d);
+}
