@@ -1,0 +1,148 @@
+/* ENVI writer: raw little-endian BSQ data plus a text header. */
+#include "io/envi.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "thzmap/thzmap.h"
+
+/* Values converted per fwrite: bounds the stack buffer, keeps writes large. */
+enum { ENVI_CHUNK = 4096 };
+
+/* "dir/stem.ext" into buf; false if it does not fit. */
+static int envi_path(char *buf, size_t size, const char *dir, const char *stem, const char *ext)
+{
+    int n = snprintf(buf, size, "%s/%s.%s", dir, stem, ext);
+    return n >= 0 && (size_t)n < size;
+}
+
+/* Writes s with the characters that end ENVI values or lists replaced. */
+static void envi_put_text(FILE *f, const char *s)
+{
+    for (; *s; s++) {
+        char c = *s;
+        if (c == '{' || c == '}' || c == '\n' || c == '\r')
+            c = ' ';
+        else if (c == ',')
+            c = ';';
+        fputc(c, f);
+    }
+}
+
+static void envi_put_name_list(FILE *f, const char *key, const char *const *names, size_t n)
+{
+    fprintf(f, "%s = {", key);
+    for (size_t i = 0; i < n; i++) {
+        if (i)
+            fputs(", ", f);
+        envi_put_text(f, names[i] ? names[i] : "");
+    }
+    fputs("}\n", f);
+}
+
+static void envi_put_number_list(FILE *f, const char *key, const double *v, size_t n)
+{
+    fprintf(f, "%s = {", key);
+    for (size_t i = 0; i < n; i++)
+        fprintf(f, "%s%.10g", i ? ", " : "", v[i]);
+    fputs("}\n", f);
+}
+
+static thz_status envi_write_header(const char *dir, const char *stem, const envi_info *info,
+                                    int data_type, thz_error *err)
+{
+    char path[4096];
+    if (!envi_path(path, sizeof path, dir, stem, "hdr"))
+        return thz_error_set(err, THZ_ERR_IO, "%s/%s.hdr: path too long", dir, stem);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+    fputs("ENVI\ndescription = {", f);
+    envi_put_text(f, info->description ? info->description : "");
+    fputs("}\n", f);
+    fprintf(f, "samples = %u\nlines = %u\nbands = %zu\n", info->samples, info->lines, info->bands);
+    fprintf(f, "header offset = 0\nfile type = ENVI Standard\ndata type = %d\n", data_type);
+    fputs("interleave = bsq\nbyte order = 0\n", f);
+    if (info->data_units) {
+        fputs("data units = ", f);
+        envi_put_text(f, info->data_units);
+        fputc('\n', f);
+    }
+    if (info->has_ignore_value)
+        fprintf(f, "data ignore value = %.10g\n", info->ignore_value);
+    if (info->band_names)
+        envi_put_name_list(f, "band names", info->band_names, info->bands);
+    if (info->wavelength_ghz) {
+        fputs("wavelength units = GHz\n", f);
+        envi_put_number_list(f, "wavelength", info->wavelength_ghz, info->bands);
+    }
+    if (info->fwhm_ghz)
+        envi_put_number_list(f, "fwhm", info->fwhm_ghz, info->bands);
+    if (info->object_names)
+        envi_put_name_list(f, "object names", info->object_names, info->n_object_names);
+    int failed = ferror(f);
+    if (fclose(f) != 0 || failed)
+        return thz_error_set(err, THZ_ERR_IO, "%s: write failed: %s", path, strerror(errno));
+    return THZ_OK;
+}
+
+/* Writes n 32-bit words (float or int32, given as their bit patterns via memcpy) in
+ * little-endian byte order. */
+static thz_status envi_write_words(const char *dir, const char *stem, const void *data, size_t n,
+                                   thz_error *err)
+{
+    char path[4096];
+    if (!envi_path(path, sizeof path, dir, stem, "img"))
+        return thz_error_set(err, THZ_ERR_IO, "%s/%s.img: path too long", dir, stem);
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+    const unsigned char *src = data;
+    unsigned char buf[ENVI_CHUNK * 4];
+    int failed = 0;
+    for (size_t done = 0; done < n && !failed;) {
+        size_t m = n - done < ENVI_CHUNK ? n - done : ENVI_CHUNK;
+        for (size_t i = 0; i < m; i++) {
+            uint32_t w;
+            memcpy(&w, src + (done + i) * 4, 4);
+            buf[4 * i + 0] = (unsigned char)(w & 0xffu);
+            buf[4 * i + 1] = (unsigned char)((w >> 8) & 0xffu);
+            buf[4 * i + 2] = (unsigned char)((w >> 16) & 0xffu);
+            buf[4 * i + 3] = (unsigned char)((w >> 24) & 0xffu);
+        }
+        if (fwrite(buf, 4, m, f) != m)
+            failed = 1;
+        done += m;
+    }
+    failed |= ferror(f);
+    if (fclose(f) != 0 || failed)
+        return thz_error_set(err, THZ_ERR_IO, "%s: write failed: %s", path, strerror(errno));
+    return THZ_OK;
+}
+
+static thz_status envi_write(const char *dir, const char *stem, const envi_info *info,
+                             const void *data, int data_type, thz_error *err)
+{
+    size_t pixels = (size_t)info->samples * info->lines;
+    if (info->bands && pixels > SIZE_MAX / 4 / info->bands)
+        return thz_error_set(err, THZ_ERR_LIMIT, "%s/%s.img: image too large", dir, stem);
+    thz_status status = envi_write_words(dir, stem, data, pixels * info->bands, err);
+    if (status != THZ_OK)
+        return status;
+    return envi_write_header(dir, stem, info, data_type, err);
+}
+
+thz_status envi_write_float32(const char *dir, const char *stem, const envi_info *info,
+                              const float *data, thz_error *err)
+{
+    _Static_assert(sizeof(float) == 4, "ENVI data type 4 is IEEE single precision");
+    return envi_write(dir, stem, info, data, 4, err);
+}
+
+thz_status envi_write_int32(const char *dir, const char *stem, const envi_info *info,
+                            const int32_t *data, thz_error *err)
+{
+    return envi_write(dir, stem, info, data, 3, err);
+}

@@ -1,0 +1,40 @@
+/* ENVI images: a raw band-sequential file DIR/STEM.img and its text header
+ * DIR/STEM.hdr (scene-format.md "Outputs"), the format Spectral Python, GDAL and ENVI
+ * itself open. Data are little-endian on every host (`byte order = 0`), without a
+ * header offset; float32 (`data type = 4`) or int32 (`data type = 3`).
+ */
+#ifndef THZ_IO_ENVI_H
+#define THZ_IO_ENVI_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+
+/* What the header says about a cube. Strings are written with ENVI's list and brace
+ * characters ({ } ,) and line breaks replaced by spaces or semicolons, so any channel
+ * or object name yields a header the readers parse. */
+typedef struct envi_info {
+    const char *description; /* one line; required */
+    const char *data_units;  /* unit of the values, e.g. "K" or "W m-2 sr-1 Hz-1" */
+    uint32_t samples;        /* columns */
+    uint32_t lines;          /* rows; line 0 is the top of the picture */
+    size_t bands;
+    const char *const *band_names; /* `bands` entries, or NULL */
+    const double *wavelength_ghz;  /* `bands` channel centres in GHz, or NULL */
+    const double *fwhm_ghz;        /* `bands` channel FWHMs in GHz, or NULL */
+    int has_ignore_value;          /* write `data ignore value` */
+    double ignore_value;
+    const char *const *object_names; /* `object names` (object_id images), or NULL */
+    size_t n_object_names;
+} envi_info;
+
+/* Writes DIR/STEM.img (samples*lines*bands float32, BSQ) and DIR/STEM.hdr. */
+thz_status envi_write_float32(const char *dir, const char *stem, const envi_info *info,
+                              const float *data, thz_error *err);
+
+/* The same for int32 data (`data type = 3`). */
+thz_status envi_write_int32(const char *dir, const char *stem, const envi_info *info,
+                            const int32_t *data, thz_error *err);
+
+#endif

@@ -1,0 +1,344 @@
+/* PLplot figures (pngcairo): channel previews and per-object spectra.
+ *
+ * PLplot is global state; plot_lock serialises every use of it (see plot.h). Each
+ * figure is one complete plinit ... plend session, so no PLplot state survives from
+ * one figure to the next.
+ */
+#include "io/plot.h"
+
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <plplot/plplot.h>
+
+#include "core/alloc.h"
+
+/* A filled circle (U+25CF) marks each data point; cairo renders UTF-8 text. */
+#define PLOT_MARK "\xe2\x97\x8f"
+
+/* The one static of the module: PLplot cannot draw two figures at once. */
+static pthread_mutex_t plot_lock = PTHREAD_MUTEX_INITIALIZER;
+
+enum { PLOT_MAX_DEVICES = 256, PLOT_TEXT = 512, PLOT_GRID_COLOR = 15 };
+
+/* Colour stops of the perceptual "viridis" map (van der Walt and Smith, 2015), taken
+ * at 0, 1/8, ..., 1 and interpolated linearly in RGB: dark blue-violet to yellow, with
+ * lightness rising monotonically so that brighter always means warmer, also in grey. */
+static const unsigned char plot_viridis[9][3] = {
+    {68, 1, 84},    {71, 45, 123}, {59, 82, 139},  {44, 114, 142}, {33, 145, 140},
+    {40, 174, 128}, {94, 201, 98}, {173, 220, 48}, {253, 231, 37},
+};
+
+/* Distinguishable line colours (a common qualitative palette), cmap0 indices 2..11. */
+static const unsigned char plot_lines_palette[10][3] = {
+    {31, 119, 180}, {255, 127, 14},  {44, 160, 44},   {214, 39, 40},  {148, 103, 189},
+    {140, 86, 75},  {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207},
+};
+
+/* PLplot treats '#' as its escape character: double it in user text. */
+static void plot_escape(char *dst, size_t size, const char *src)
+{
+    size_t j = 0;
+    for (; *src && j + 2 < size; src++) {
+        if (*src == '#')
+            dst[j++] = '#';
+        dst[j++] = *src;
+    }
+    dst[j] = '\0';
+}
+
+/* Caller holds plot_lock. */
+static thz_status plot_check_device_locked(thz_error *err)
+{
+    const char *menu[PLOT_MAX_DEVICES];
+    const char *names[PLOT_MAX_DEVICES];
+    const char **pm = menu, **pn = names;
+    int n = PLOT_MAX_DEVICES;
+    plgDevs(&pm, &pn, &n);
+    for (int i = 0; i < n; i++)
+        if (pn[i] && strcmp(pn[i], "pngcairo") == 0)
+            return THZ_OK;
+    return thz_error_set(err, THZ_ERR_IO,
+                         "PLplot has no pngcairo device: install the package plplot-driver-cairo");
+}
+
+thz_status plot_check_device(thz_error *err)
+{
+    pthread_mutex_lock(&plot_lock);
+    thz_status status = plot_check_device_locked(err);
+    pthread_mutex_unlock(&plot_lock);
+    return status;
+}
+
+/* Starts a figure of width x height pixels into path: checks the device and that the
+ * file can be created (PLplot prompts on stdin and exits when it cannot open it),
+ * sets a white background with black text. Caller holds plot_lock. */
+static thz_status plot_begin(const char *path, int width, int height, thz_error *err)
+{
+    thz_status status = plot_check_device_locked(err);
+    if (status != THZ_OK)
+        return status;
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+    fclose(f);
+    plsdev("pngcairo");
+    plsfnam(path);
+    plspage(0.0, 0.0, width, height, 0, 0);
+    plscolbg(255, 255, 255);
+    plscol0(1, 0, 0, 0);
+    plinit();
+    pladv(0);
+    plschr(0.0, 1.0);
+    return THZ_OK;
+}
+
+/* Finishes the figure and checks the file was written. Caller holds plot_lock. */
+static thz_status plot_end(const char *path, thz_error *err)
+{
+    plend();
+    FILE *f = fopen(path, "rb");
+    long size = -1;
+    if (f) {
+        if (fseek(f, 0, SEEK_END) == 0)
+            size = ftell(f);
+        fclose(f);
+    }
+    if (size <= 0)
+        return thz_error_set(err, THZ_ERR_IO, "%s: PLplot wrote no figure", path);
+    return THZ_OK;
+}
+
+static void plot_set_viridis(void)
+{
+    enum { N = sizeof plot_viridis / sizeof plot_viridis[0] };
+    PLFLT pos[N], r[N], g[N], b[N];
+    for (int i = 0; i < N; i++) {
+        pos[i] = (PLFLT)i / (N - 1);
+        r[i] = plot_viridis[i][0] / 255.0;
+        g[i] = plot_viridis[i][1] / 255.0;
+        b[i] = plot_viridis[i][2] / 255.0;
+    }
+    plscmap1n(256);
+    plscmap1l(1, N, pos, r, g, b, NULL);
+}
+
+thz_status plot_image(const char *path, const float *values, uint32_t columns, uint32_t rows,
+                      const char *title, const char *value_label, thz_error *err)
+{
+    if (columns == 0 || rows == 0)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "%s: empty image", path);
+    /* plimage draws (nx-1) x (ny-1) cells coloured by their lower corner: pass one more
+     * column and row (copies of the last) so that every pixel is one whole cell. */
+    size_t nx = (size_t)columns + 1, ny = (size_t)rows + 1;
+    PLFLT *grid = thz_malloc_array(nx * ny, sizeof *grid);
+    PLFLT **cols = thz_malloc_array(nx, sizeof *cols);
+    thz_status status = THZ_OK;
+    if (!grid || !cols) {
+        status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+        goto cleanup;
+    }
+    double vmin = INFINITY, vmax = -INFINITY;
+    for (size_t i = 0; i < (size_t)columns * rows; i++) {
+        if (isfinite(values[i])) {
+            vmin = fmin(vmin, values[i]);
+            vmax = fmax(vmax, values[i]);
+        }
+    }
+    if (!(vmin <= vmax)) { /* nothing finite */
+        vmin = 0.0;
+        vmax = 1.0;
+    }
+    double scale = fmax(fabs(vmin), fabs(vmax));
+    if (vmax - vmin <= 1e-9 * scale) { /* a flat image still needs a scale */
+        double pad = scale > 0.0 ? 1e-3 * scale : 0.5;
+        vmin -= pad;
+        vmax += pad;
+    }
+    for (size_t i = 0; i < nx; i++) {
+        cols[i] = grid + i * ny;
+        size_t c = i < columns ? i : columns - 1;
+        for (size_t j = 0; j < ny; j++) {
+            size_t r = j < rows ? j : rows - 1;
+            float v = values[r * columns + c];
+            cols[i][j] = isfinite(v) ? v : vmin;
+        }
+    }
+    char t_title[PLOT_TEXT], t_label[PLOT_TEXT];
+    plot_escape(t_title, sizeof t_title, title);
+    snprintf(t_label, sizeof t_label, "%s", value_label);
+
+    pthread_mutex_lock(&plot_lock);
+    /* Square pixels: the plot area follows the image's aspect ratio. */
+    double aspect = (double)rows / columns;
+    int width = 720;
+    int height = (int)fmin(fmax(120.0 + 480.0 * aspect, 240.0), 1400.0);
+    status = plot_begin(path, width, height, err);
+    if (status == THZ_OK) {
+        plvpas(0.10, 0.78, 0.12, 0.90, aspect);
+        /* Row 0 at the top: the y axis runs from `rows` at the bottom to 0 on top. */
+        plwind(0.0, columns, rows, 0.0);
+        plot_set_viridis();
+        plimage((PLFLT_MATRIX)cols, (PLINT)nx, (PLINT)ny, 0.0, columns, 0.0, rows, vmin, vmax, 0.0,
+                columns, 0.0, rows);
+        plcol0(1);
+        plbox("bcnst", 0.0, 0, "bcnstv", 0.0, 0);
+        pllab("column (pixel)", "row (pixel)", t_title);
+
+        PLFLT bar_w, bar_h;
+        PLINT label_opts[] = {PL_COLORBAR_LABEL_RIGHT};
+        const char *labels[] = {t_label};
+        const char *axis_opts[] = {"bcvtm"};
+        PLFLT ticks[] = {0.0};
+        PLINT sub_ticks[] = {0};
+        PLINT n_values[] = {2};
+        PLFLT range[] = {vmin, vmax};
+        const PLFLT *value_rows[] = {range};
+        plcolorbar(&bar_w, &bar_h, PL_COLORBAR_IMAGE,
+                   PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.03, 0.0, 0.04,
+                   0.9, 0, 1, 1, 0.0, 0.0, 0, 0.0, 1, label_opts, labels, 1, axis_opts, ticks,
+                   sub_ticks, n_values, (PLFLT_MATRIX)value_rows);
+        status = plot_end(path, err);
+    }
+    pthread_mutex_unlock(&plot_lock);
+cleanup:
+    free(cols);
+    free(grid);
+    return status;
+}
+
+thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
+                      const char *const *names, const double *y, const char *title,
+                      const char *x_label, const char *y_label, thz_error *err)
+{
+    thz_status status = THZ_OK;
+    PLFLT *px = thz_malloc_array(n_x ? n_x : 1, sizeof *px);
+    PLFLT *py = thz_malloc_array(n_x ? n_x : 1, sizeof *py);
+    size_t n_legend = n_lines ? n_lines : 1;
+    char **texts = thz_calloc(n_legend, sizeof *texts);
+    PLINT *opts = thz_calloc(n_legend, sizeof *opts);
+    PLINT *colors = thz_calloc(n_legend, sizeof *colors);
+    PLINT *text_colors = thz_calloc(n_legend, sizeof *text_colors);
+    PLINT *styles = thz_calloc(n_legend, sizeof *styles);
+    PLFLT *widths = thz_calloc(n_legend, sizeof *widths);
+    PLFLT *symbol_scales = thz_calloc(n_legend, sizeof *symbol_scales);
+    PLINT *symbol_numbers = thz_calloc(n_legend, sizeof *symbol_numbers);
+    const char **symbols = thz_calloc(n_legend, sizeof *symbols);
+    if (!px || !py || !texts || !opts || !colors || !text_colors || !styles || !widths ||
+        !symbol_scales || !symbol_numbers || !symbols) {
+        status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+        goto cleanup;
+    }
+    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+    for (size_t j = 0; j < n_x; j++) {
+        if (isfinite(x[j])) {
+            xmin = fmin(xmin, x[j]);
+            xmax = fmax(xmax, x[j]);
+        }
+    }
+    for (size_t i = 0; i < n_lines * n_x; i++) {
+        if (isfinite(y[i])) {
+            ymin = fmin(ymin, y[i]);
+            ymax = fmax(ymax, y[i]);
+        }
+    }
+    if (!(xmin <= xmax)) {
+        xmin = 0.0;
+        xmax = 1.0;
+    }
+    if (!(ymin <= ymax)) {
+        ymin = 0.0;
+        ymax = 1.0;
+    }
+    double xpad = xmax > xmin ? 0.05 * (xmax - xmin) : fmax(0.05 * fabs(xmax), 0.01);
+    double ypad = ymax > ymin ? 0.08 * (ymax - ymin) : fmax(0.05 * fabs(ymax), 0.01);
+    for (size_t i = 0; i < n_lines; i++) {
+        texts[i] = malloc(PLOT_TEXT);
+        if (!texts[i]) {
+            status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+            goto cleanup;
+        }
+        plot_escape(texts[i], PLOT_TEXT, names[i] ? names[i] : "");
+        opts[i] = PL_LEGEND_LINE | PL_LEGEND_SYMBOL;
+        colors[i] = 2 + (PLINT)(i % 10);
+        text_colors[i] = 1;
+        styles[i] = 1 + (PLINT)((i / 10) % 8);
+        widths[i] = 2.0;
+        symbol_scales[i] = 0.6;
+        symbol_numbers[i] = 1;
+        symbols[i] = PLOT_MARK; /* a filled circle marks each channel */
+    }
+    char t_title[PLOT_TEXT];
+    plot_escape(t_title, sizeof t_title, title);
+
+    pthread_mutex_lock(&plot_lock);
+    status = plot_begin(path, 960, 600, err);
+    if (status == THZ_OK) {
+        for (int i = 0; i < 10; i++)
+            plscol0(2 + i, plot_lines_palette[i][0], plot_lines_palette[i][1],
+                    plot_lines_palette[i][2]);
+        plscol0(PLOT_GRID_COLOR, 210, 210, 210);
+        plvpor(0.10, 0.66, 0.12, 0.90);
+        plwind(xmin - xpad, xmax + xpad, ymin - ypad, ymax + ypad);
+        plcol0(PLOT_GRID_COLOR);
+        plbox("g", 0.0, 0, "g", 0.0, 0);
+        plcol0(1);
+        plbox("bcnst", 0.0, 0, "bcnstv", 0.0, 0);
+        pllab(x_label, y_label, t_title);
+        for (size_t i = 0; i < n_lines; i++) {
+            PLINT m = 0;
+            for (size_t j = 0; j < n_x; j++) {
+                if (isfinite(x[j]) && isfinite(y[i * n_x + j])) {
+                    px[m] = x[j];
+                    py[m] = y[i * n_x + j];
+                    m++;
+                }
+            }
+            plcol0(colors[i]);
+            pllsty(styles[i]);
+            plwidth(widths[i]);
+            if (m > 1)
+                plline(m, px, py);
+            if (m > 0) {
+                plschr(0.0, 0.6);
+                plstring(m, px, py, PLOT_MARK);
+                plschr(0.0, 1.0);
+            }
+        }
+        pllsty(1);
+        plwidth(1.0);
+        plcol0(1);
+        if (n_lines > 0) {
+            PLFLT legend_w, legend_h;
+            pllegend(&legend_w, &legend_h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+                     PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.02, 0.0,
+                     0.06, 0, 1, 1, 0, 0, (PLINT)n_lines, opts, 1.0, 0.8, 1.6, 0.0, text_colors,
+                     (PLCHAR_MATRIX)texts, NULL, NULL, NULL, NULL, colors, styles, widths, colors,
+                     symbol_scales, symbol_numbers, (PLCHAR_MATRIX)symbols);
+        } else {
+            plptex(0.5 * (xmin + xmax), 0.5 * (ymin + ymax), 1.0, 0.0, 0.5, "no object in view");
+        }
+        status = plot_end(path, err);
+    }
+    pthread_mutex_unlock(&plot_lock);
+cleanup:
+    if (texts)
+        for (size_t i = 0; i < n_lines; i++)
+            free(texts[i]);
+    free(texts);
+    free(opts);
+    free(colors);
+    free(text_colors);
+    free(styles);
+    free(widths);
+    free(symbol_scales);
+    free(symbol_numbers);
+    free(symbols);
+    free(px);
+    free(py);
+    return status;
+}

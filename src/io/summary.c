@@ -1,0 +1,176 @@
+/* summary.json: what a run did, for people and for scripts (scene-format.md
+ * "Outputs"). Units are in the key names. Timings make it the one output file that
+ * is not reproducible bit for bit.
+ *
+ * Fractions of the photon phase: `fraction_absorbed`, `fraction_escaped` and
+ * `fraction_terminated` are per photon fired (how the photon paths ended; they sum to
+ * 1), `fraction_reflected` and `fraction_transmitted` per surface hit (the Russian
+ * roulette's choices, mean R and T seen by the photons). The raw counts are given too.
+ */
+#include "io/output.h"
+
+#include <jansson.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "thzmap/thzmap.h"
+
+/* Builders that remember an allocation failure in *ok instead of checking each call. */
+static void sum_set(json_t *obj, const char *key, json_t *value, bool *ok)
+{
+    if (!value || !obj || json_object_set_new(obj, key, value) != 0)
+        *ok = false;
+}
+
+static void sum_append(json_t *arr, json_t *value, bool *ok)
+{
+    if (!value || !arr || json_array_append_new(arr, value) != 0)
+        *ok = false;
+}
+
+/* A real, or null where it is not finite (JSON has no NaN). */
+static json_t *sum_real(double v)
+{
+    return isfinite(v) ? json_real(v) : json_null();
+}
+
+static json_t *sum_u64(uint64_t v)
+{
+    if (v <= (uint64_t)INT64_MAX) /* json_int_t is long long */
+        return json_integer((json_int_t)v);
+    return json_real((double)v);
+}
+
+static json_t *sum_string(const char *s)
+{
+    return s ? json_string(s) : json_null();
+}
+
+static double sum_ratio(uint64_t part, uint64_t whole)
+{
+    return whole ? (double)part / (double)whole : 0.0;
+}
+
+static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *summary, bool *ok)
+{
+    const thz_channel *ch = &scene->channels[c];
+    json_t *o = json_object();
+    sum_set(o, "name", json_string(ch->name), ok);
+    sum_set(o, "frequency_thz", json_real(ch->center_hz / 1e12), ok);
+    sum_set(o, "relative_width", json_real(ch->relative_width), ok);
+    if (summary->channel_stats) {
+        const photon_stats *s = &summary->channel_stats[c];
+        sum_set(o, "photons_fired", sum_u64(s->fired), ok);
+        sum_set(o, "photons_stored", sum_u64(s->stored), ok);
+        sum_set(o, "emitted_power_w_per_hz", sum_real(s->emitted_power_w_per_hz), ok);
+        sum_set(o, "fraction_absorbed", json_real(sum_ratio(s->absorbed, s->fired)), ok);
+        sum_set(o, "fraction_escaped", json_real(sum_ratio(s->escaped, s->fired)), ok);
+        sum_set(o, "fraction_terminated", json_real(sum_ratio(s->terminated, s->fired)), ok);
+        sum_set(o, "fraction_reflected", json_real(sum_ratio(s->reflected, s->hits)), ok);
+        sum_set(o, "fraction_transmitted", json_real(sum_ratio(s->transmitted, s->hits)), ok);
+        sum_set(o, "back_face_hits", sum_u64(s->back_face_hits), ok);
+        sum_set(o, "mean_bounces", sum_real(s->mean_bounces), ok);
+        json_t *counts = json_object();
+        sum_set(counts, "hits", sum_u64(s->hits), ok);
+        sum_set(counts, "reflected", sum_u64(s->reflected), ok);
+        sum_set(counts, "transmitted", sum_u64(s->transmitted), ok);
+        sum_set(counts, "absorbed", sum_u64(s->absorbed), ok);
+        sum_set(counts, "escaped", sum_u64(s->escaped), ok);
+        sum_set(counts, "terminated", sum_u64(s->terminated), ok);
+        sum_set(o, "counts", counts, ok);
+        /* Emitted = absorbed + escaped + atmosphere in expectation; the relative
+         * difference is the Monte Carlo noise of the balance (or a bug). */
+        json_t *e = json_object();
+        double out =
+            s->absorbed_power_w_per_hz + s->escaped_power_w_per_hz + s->atmosphere_power_w_per_hz;
+        sum_set(e, "emitted_w_per_hz", sum_real(s->emitted_power_w_per_hz), ok);
+        sum_set(e, "absorbed_w_per_hz", sum_real(s->absorbed_power_w_per_hz), ok);
+        sum_set(e, "escaped_w_per_hz", sum_real(s->escaped_power_w_per_hz), ok);
+        sum_set(e, "atmosphere_w_per_hz", sum_real(s->atmosphere_power_w_per_hz), ok);
+        sum_set(e, "relative_difference",
+                s->emitted_power_w_per_hz > 0.0
+                    ? sum_real((s->emitted_power_w_per_hz - out) / s->emitted_power_w_per_hz)
+                    : json_null(),
+                ok);
+        sum_set(o, "energy_balance", e, ok);
+        sum_set(o, "photon_phase_s", sum_real(s->seconds), ok);
+    }
+    if (summary->median_stderr_k)
+        sum_set(o, "median_stderr_k", sum_real(summary->median_stderr_k[c]), ok);
+    return o;
+}
+
+static json_t *sum_sensor(const thz_scene *scene, size_t i, const run_summary *summary, bool *ok)
+{
+    const thz_sensor *s = &scene->sensors[i];
+    json_t *o = json_object();
+    sum_set(o, "name", json_string(s->name), ok);
+    sum_set(o, "columns", json_integer(s->columns), ok);
+    sum_set(o, "rows", json_integer(s->rows), ok);
+    sum_set(o, "fov_deg", sum_real(s->fov_deg), ok);
+    sum_set(o, "oversampling", json_integer(s->oversampling), ok);
+    sum_set(o, "aperture_m2", sum_real(s->aperture_m2), ok);
+    sum_set(o, "normalize_to_k", sum_real(s->normalize_to_k), ok);
+    if (summary->back_face_samples)
+        sum_set(o, "back_face_samples", sum_u64(summary->back_face_samples[i]), ok);
+    return o;
+}
+
+thz_status summary_write(const char *dir, const thz_scene *scene, const run_summary *summary,
+                         thz_error *err)
+{
+    char path[4096];
+    int n = snprintf(path, sizeof path, "%s/summary.json", dir);
+    if (n < 0 || (size_t)n >= sizeof path)
+        return thz_error_set(err, THZ_ERR_IO, "%s/summary.json: path too long", dir);
+    bool ok = true;
+    json_t *root = json_object();
+    sum_set(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
+    sum_set(root, "command", sum_string(summary->command), &ok);
+    json_t *sc = json_object();
+    sum_set(sc, "name", sum_string(scene->name), &ok);
+    sum_set(sc, "path", sum_string(scene->path), &ok);
+    sum_set(root, "scene", sc, &ok);
+    sum_set(root, "seed", sum_u64(summary->seed), &ok);
+    sum_set(root, "photons_per_channel", sum_u64(summary->photons_per_channel), &ok);
+    sum_set(root, "integrator", sum_string(summary->integrator), &ok);
+    sum_set(root, "threads", json_integer(summary->threads), &ok);
+    sum_set(root, "atmosphere_model", json_string(atmosphere_model_name(scene->atmosphere.model)),
+            &ok);
+
+    json_t *channels = json_array();
+    for (size_t c = 0; c < scene->n_channels; c++)
+        sum_append(channels, sum_channel(scene, c, summary, &ok), &ok);
+    sum_set(root, "channels", channels, &ok);
+
+    json_t *sensors = json_array();
+    for (size_t i = 0; i < scene->n_sensors; i++)
+        sum_append(sensors, sum_sensor(scene, i, summary, &ok), &ok);
+    sum_set(root, "sensors", sensors, &ok);
+
+    json_t *t = json_object();
+    sum_set(t, "load", sum_real(summary->seconds_load), &ok);
+    sum_set(t, "accel", sum_real(summary->seconds_accel), &ok);
+    sum_set(t, "photons", sum_real(summary->seconds_photons), &ok);
+    sum_set(t, "render", sum_real(summary->seconds_render), &ok);
+    sum_set(t, "output", sum_real(summary->seconds_output), &ok);
+    sum_set(root, "timings_s", t, &ok);
+
+    json_t *warnings = json_array();
+    for (size_t i = 0; i < scene->n_warnings; i++)
+        sum_append(warnings, sum_string(scene->warnings[i]), &ok);
+    for (size_t i = 0; i < summary->n_run_warnings; i++)
+        sum_append(warnings, sum_string(summary->run_warnings[i]), &ok);
+    sum_set(root, "warnings", warnings, &ok);
+
+    thz_status status = THZ_OK;
+    if (!ok)
+        status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+    else if (json_dump_file(root, path, JSON_INDENT(2) | JSON_REAL_PRECISION(12)) != 0)
+        status = thz_error_set(err, THZ_ERR_IO, "%s: cannot write", path);
+    json_decref(root);
+    return status;
+}

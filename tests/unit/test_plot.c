@@ -1,0 +1,213 @@
+/* PLplot figures: the pngcairo device is found, previews show the colour map's ends
+ * at the image's extremes on a white page, odd inputs (flat, NaN, one pixel, no
+ * curves, '#' in names) still give a figure, and figures drawn from two threads at
+ * once come out whole (the mutex). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <math.h>
+#include <png.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/alloc.h"
+#include "io/plot.h"
+
+static char *make_tmp_dir(void)
+{
+    const char *base = getenv("TMPDIR");
+    char templ[512];
+    snprintf(templ, sizeof templ, "%s/thz-test-plot-XXXXXX", base && *base ? base : "/tmp");
+    char *d = mkdtemp(templ);
+    assert_non_null(d);
+    return thz_strdup(d);
+}
+
+/* Decodes path as 8-bit RGB; caller frees *pixels. */
+static void read_png(const char *path, unsigned char **pixels, uint32_t *w, uint32_t *h)
+{
+    png_image image;
+    memset(&image, 0, sizeof image);
+    image.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_file(&image, path))
+        fail_msg("%s: %s", path, image.message);
+    image.format = PNG_FORMAT_RGB;
+    *pixels = malloc(PNG_IMAGE_SIZE(image));
+    assert_non_null(*pixels);
+    if (!png_image_finish_read(&image, NULL, *pixels, 0, NULL))
+        fail_msg("%s: %s", path, image.message);
+    *w = image.width;
+    *h = image.height;
+}
+
+/* Whether some pixel lies within tol of (r, g, b) in every component. */
+static int has_colour(const unsigned char *px, size_t n, int r, int g, int b, int tol)
+{
+    for (size_t i = 0; i < n; i++) {
+        const unsigned char *p = px + 3 * i;
+        if (abs(p[0] - r) <= tol && abs(p[1] - g) <= tol && abs(p[2] - b) <= tol)
+            return 1;
+    }
+    return 0;
+}
+
+static void test_device(void **state)
+{
+    (void)state;
+    thz_error err = {0};
+    thz_status st = plot_check_device(&err);
+    if (st != THZ_OK)
+        fail_msg("%s", err.message);
+}
+
+static void test_image_colours(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    char path[1024];
+    snprintf(path, sizeof path, "%s/img.png", dir);
+    enum { C = 16, R = 8 };
+    float v[C * R];
+    for (int i = 0; i < C * R; i++)
+        v[i] = 290.0f + (float)(i % C); /* 290 K on the left to 305 K on the right */
+    thz_error err = {0};
+    if (plot_image(path, v, C, R, "test: channel 1", "brightness temperature (K)", &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    unsigned char *px = NULL;
+    uint32_t w = 0, h = 0;
+    read_png(path, &px, &w, &h);
+    assert_int_equal(w, 720);
+    assert_true(h >= 240);
+    size_t n = (size_t)w * h;
+    /* White page, and both ends of the colour map present (min and max pixels). */
+    assert_memory_equal(px, "\xff\xff\xff", 3);
+    assert_true(has_colour(px, n, 68, 1, 84, 6));
+    assert_true(has_colour(px, n, 253, 231, 37, 6));
+    free(px);
+    unlink(path);
+    rmdir(dir);
+    free(dir);
+}
+
+static void test_odd_images(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    char path[1024];
+    snprintf(path, sizeof path, "%s/odd.png", dir);
+    thz_error err = {0};
+    float flat[6] = {295, 295, 295, 295, 295, 295};
+    assert_int_equal(plot_image(path, flat, 3, 2, "flat #1", "T (K)", &err), THZ_OK);
+    float nan[4] = {NAN, NAN, NAN, NAN};
+    assert_int_equal(plot_image(path, nan, 2, 2, "nan", "T (K)", &err), THZ_OK);
+    float one = 1e-14f;
+    assert_int_equal(plot_image(path, &one, 1, 1, "one", "L (W m-2 sr-1 Hz-1)", &err), THZ_OK);
+    float tall[2 * 50];
+    for (int i = 0; i < 100; i++)
+        tall[i] = (float)i;
+    assert_int_equal(plot_image(path, tall, 2, 50, "tall", "x (1)", &err), THZ_OK);
+    /* An unwritable path fails with our error instead of PLplot's prompt and exit. */
+    assert_int_equal(plot_image("/nonexistent-thz-dir/x.png", flat, 3, 2, "t", "T (K)", &err),
+                     THZ_ERR_IO);
+    assert_non_null(strstr(err.message, "/nonexistent-thz-dir/x.png"));
+    unlink(path);
+    rmdir(dir);
+    free(dir);
+}
+
+static void test_lines(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    char path[1024];
+    snprintf(path, sizeof path, "%s/lines.png", dir);
+    enum { NX = 6, NL = 13 };
+    double x[NX], y[NL * NX];
+    const char *names[NL];
+    char name_buf[NL][32];
+    for (int j = 0; j < NX; j++)
+        x[j] = 0.2 + 0.2 * j;
+    for (int i = 0; i < NL; i++) {
+        snprintf(name_buf[i], sizeof name_buf[i], "object #%d", i);
+        names[i] = name_buf[i];
+        for (int j = 0; j < NX; j++)
+            y[i * NX + j] = 0.8 + 0.01 * i + 0.02 * sin(j + i);
+    }
+    y[3] = NAN; /* a missing point is left out */
+    thz_error err = {0};
+    if (plot_lines(path, NX, x, NL, names, y, "spectra", "frequency (THz)", "N (1)", &err) !=
+        THZ_OK)
+        fail_msg("%s", err.message);
+    unsigned char *px = NULL;
+    uint32_t w = 0, h = 0;
+    read_png(path, &px, &w, &h);
+    assert_int_equal(w, 960);
+    assert_int_equal(h, 600);
+    assert_memory_equal(px, "\xff\xff\xff", 3);
+    assert_true(has_colour(px, (size_t)w * h, 31, 119, 180, 10)); /* first curve's colour */
+    free(px);
+    /* No curve at all (no object in view) is still a figure. */
+    assert_int_equal(plot_lines(path, NX, x, 0, NULL, NULL, "empty", "f (THz)", "N (1)", &err),
+                     THZ_OK);
+    unlink(path);
+    rmdir(dir);
+    free(dir);
+}
+
+typedef struct job {
+    char path[1024];
+    thz_status status;
+} job;
+
+static void *draw(void *arg)
+{
+    job *j = arg;
+    float v[64];
+    for (int i = 0; i < 64; i++)
+        v[i] = (float)i;
+    j->status = plot_image(j->path, v, 8, 8, "thread", "x (1)", NULL);
+    if (j->status == THZ_OK)
+        j->status = plot_image(j->path, v, 4, 16, "thread", "x (1)", NULL);
+    return NULL;
+}
+
+static void test_threads(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    job jobs[3];
+    pthread_t t[3];
+    for (int i = 0; i < 3; i++) {
+        snprintf(jobs[i].path, sizeof jobs[i].path, "%s/t%d.png", dir, i);
+        assert_int_equal(pthread_create(&t[i], NULL, draw, &jobs[i]), 0);
+    }
+    for (int i = 0; i < 3; i++) {
+        pthread_join(t[i], NULL);
+        assert_int_equal(jobs[i].status, THZ_OK);
+        unsigned char *px = NULL;
+        uint32_t w = 0, h = 0;
+        read_png(jobs[i].path, &px, &w, &h);
+        assert_int_equal(w, 720);
+        free(px);
+        unlink(jobs[i].path);
+    }
+    rmdir(dir);
+    free(dir);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_device),     cmocka_unit_test(test_image_colours),
+        cmocka_unit_test(test_odd_images), cmocka_unit_test(test_lines),
+        cmocka_unit_test(test_threads),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
