@@ -1,0 +1,91 @@
+/* The CSV reader: comments, blank lines, CRLF and blanks around fields; rows in
+ * order with their file lines; and errors that name the file, line, row and column. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "scene/csv.h"
+
+#define INPUTS THZ_SOURCE_DIR "/tests/inputs/csv/"
+
+static void test_good_file(void **state)
+{
+    (void)state;
+    csv_table t;
+    thz_error err = {0};
+    assert_int_equal(csv_read(INPUTS "good.csv", "good.csv", &t, &err), THZ_OK);
+    assert_int_equal(t.n_columns, 2);
+    assert_string_equal(t.names[0], "frequency_thz");
+    assert_string_equal(t.names[1], "reflectivity");
+    assert_int_equal(csv_column(&t, "reflectivity"), 1);
+    assert_int_equal(csv_column(&t, "emissivity"), -1);
+    assert_int_equal(t.n_rows, 3);
+    assert_true(csv_value(&t, 0, 0) == 0.2 && csv_value(&t, 0, 1) == 0.1);
+    assert_true(csv_value(&t, 2, 0) == 1.0 && csv_value(&t, 2, 1) == 0.35);
+    assert_int_equal(t.row_lines[0], 5);
+    assert_int_equal(t.row_lines[2], 8);
+    csv_fini(&t);
+    csv_fini(&t); /* idempotent */
+}
+
+static void expect_error(const char *file, const char *substrings[])
+{
+    char path[512];
+    snprintf(path, sizeof path, INPUTS "%s", file);
+    csv_table t;
+    thz_error err = {0};
+    assert_int_equal(csv_read(path, file, &t, &err), THZ_ERR_INPUT);
+    for (size_t i = 0; substrings[i]; i++) {
+        if (!strstr(err.message, substrings[i]))
+            fail_msg("message '%s' lacks '%s'", err.message, substrings[i]);
+    }
+    assert_int_equal(t.n_rows, 0);
+    assert_null(t.names);
+    csv_fini(&t);
+}
+
+static void test_errors(void **state)
+{
+    (void)state;
+    expect_error("bad_number.csv",
+                 (const char *[]){"bad_number.csv:3:", "row 2", "'reflectivity'", "'abc'", NULL});
+    expect_error("bad_fields.csv", (const char *[]){"bad_fields.csv:3:", "row 2", "1 fields", NULL});
+    expect_error("empty.csv", (const char *[]){"empty.csv", "no header", NULL});
+    expect_error("header_only.csv", (const char *[]){"header_only.csv", "no data rows", NULL});
+    expect_error("missing.csv", (const char *[]){"missing.csv", "cannot open", NULL});
+}
+
+static void test_parse_text(void **state)
+{
+    (void)state;
+    csv_table t;
+    thz_error err = {0};
+    assert_int_equal(csv_parse("a,b,c\n1,2,3\n4,5,6", "mem", &t, &err), THZ_OK);
+    assert_int_equal(t.n_rows, 2);
+    assert_true(csv_value(&t, 1, 2) == 6.0);
+    csv_fini(&t);
+    assert_int_equal(csv_parse("a,b\n1,nan\n", "mem", &t, &err), THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "mem:2:"));
+    assert_int_equal(csv_parse("a,b\n1,1e999\n", "mem", &t, &err), THZ_ERR_INPUT);
+    assert_int_equal(csv_parse("a,a\n1,2\n", "mem", &t, &err), THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "twice"));
+    assert_int_equal(csv_parse("a,\n1,2\n", "mem", &t, &err), THZ_ERR_INPUT);
+    assert_int_equal(csv_parse("1,2\n1,2\n", "mem", &t, &err), THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "header"));
+    assert_int_equal(csv_parse("a\n1,\n", "mem", &t, &err), THZ_ERR_INPUT);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_good_file),
+        cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_parse_text),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,122 @@
+/* Mesh import: the same tetrahedron from OBJ, PLY, STL (ASCII and binary) and glTF
+ * (with a node transform) gives 4 welded vertices, 4 triangles, the exact area and
+ * outward normals; quads are triangulated; the winding check finds a flipped face;
+ * missing, empty and garbage files are refused with the file named. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "scene/mesh_import.h"
+#include "scene/scene.h"
+
+#define MESHES THZ_SOURCE_DIR "/tests/inputs/meshes/"
+
+/* Unit right tetrahedron: three right triangles of area 1/2 and one equilateral
+ * triangle of edge sqrt 2. */
+static const double tetra_area = 1.5 + 0.8660254037844386;
+
+static void check_outward(const thz_mesh *m, const double centre[3])
+{
+    for (size_t t = 0; t < m->n_triangles; t++) {
+        double c[3] = {0, 0, 0}, dot = 0;
+        for (int v = 0; v < 3; v++)
+            for (int k = 0; k < 3; k++)
+                c[k] += m->positions[3 * m->indices[3 * t + (size_t)v] + (size_t)k] / 3.0;
+        for (int k = 0; k < 3; k++)
+            dot += m->normals[3 * t + (size_t)k] * (c[k] - centre[k]);
+        assert_true(dot > 0);
+    }
+}
+
+static void check_tetra(const char *file, double z_offset)
+{
+    thz_mesh m;
+    thz_error err = {0};
+    thz_status st = mesh_import(file, NULL, &m, &err);
+    if (st != THZ_OK)
+        fail_msg("%s: %s", file, err.message);
+    assert_true(mesh_finalize(&m));
+    assert_int_equal(m.n_triangles, 4);
+    assert_int_equal(m.n_vertices, 4);
+    assert_true(fabs(m.total_area_m2 - tetra_area) < 1e-6);
+    const double centre[3] = {0.25, 0.25, 0.25 + z_offset};
+    check_outward(&m, centre);
+    assert_int_equal(mesh_import_winding_conflicts(&m), 0);
+    assert_true(fabs(m.bbox_min_m[2] - z_offset) < 1e-6);
+    assert_true(fabs(m.bbox_max_m[2] - (1 + z_offset)) < 1e-6);
+    for (int k = 0; k < 4; k++)
+        assert_true(m.positions[3 * m.n_vertices + (size_t)k] == 0.0f);
+    mesh_fini(&m);
+}
+
+static void test_formats(void **state)
+{
+    (void)state;
+    check_tetra(MESHES "tetra.obj", 0);
+    check_tetra(MESHES "tetra.ply", 0);
+    check_tetra(MESHES "tetra_ascii.stl", 0);
+    check_tetra(MESHES "tetra_binary.stl", 0);
+    check_tetra(MESHES "tetra.gltf", 2); /* its node translates by (0, 0, 2) */
+}
+
+static void test_quads(void **state)
+{
+    (void)state;
+    thz_mesh m;
+    thz_error err = {0};
+    assert_int_equal(mesh_import(MESHES "cube_quads.obj", NULL, &m, &err), THZ_OK);
+    assert_true(mesh_finalize(&m));
+    assert_int_equal(m.n_triangles, 12);
+    assert_true(fabs(m.total_area_m2 - 6.0) < 1e-6);
+    const double centre[3] = {0.5, 0.5, 0.5};
+    check_outward(&m, centre);
+    assert_int_equal(mesh_import_winding_conflicts(&m), 0);
+    mesh_fini(&m);
+}
+
+static void test_bad_winding(void **state)
+{
+    (void)state;
+    thz_mesh m;
+    thz_error err = {0};
+    assert_int_equal(mesh_import(MESHES "tetra_bad_winding.obj", NULL, &m, &err), THZ_OK);
+    assert_int_equal(m.n_triangles, 4);
+    /* the flipped face runs all three of its edges the same way as its neighbours */
+    assert_int_equal(mesh_import_winding_conflicts(&m), 3);
+    mesh_fini(&m);
+}
+
+static void expect_refused(const char *file, const char *label, const char *what)
+{
+    thz_mesh m;
+    thz_error err = {0};
+    assert_int_equal(mesh_import(file, label, &m, &err), THZ_ERR_INPUT);
+    if (!strstr(err.message, label) || !strstr(err.message, what))
+        fail_msg("message '%s' lacks '%s' or '%s'", err.message, label, what);
+    assert_null(m.positions);
+    mesh_fini(&m);
+}
+
+static void test_refused(void **state)
+{
+    (void)state;
+    expect_refused(MESHES "does_not_exist.obj", "does_not_exist.obj", "cannot open");
+    expect_refused(MESHES "no_faces.obj", "no_faces.obj", "no triangles");
+    expect_refused(MESHES "garbage.obj", "garbage.obj", "");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_formats),
+        cmocka_unit_test(test_quads),
+        cmocka_unit_test(test_bad_winding),
+        cmocka_unit_test(test_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
