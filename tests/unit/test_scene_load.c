@@ -1,0 +1,210 @@
+/* The scene loader: the spec's example scene (geometry, materials, defaults), the
+ * channel range shorthand and default names, CSV materials with overriding keys,
+ * sensors, transforms, warnings, and a few refusals with their JSON paths (the full
+ * table of bad scenes is tests/cli/test_bad_scenes.sh). */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "scene/scene.h"
+
+#define SRC THZ_SOURCE_DIR
+
+static thz_scene *load_ok(const char *json)
+{
+    thz_scene *s = NULL;
+    thz_error err = {0};
+    thz_status st = scene_load_string(json, SRC "/tests/inputs/scenes", "test.json", &s, &err);
+    if (st != THZ_OK)
+        fail_msg("refused: %s", err.message);
+    return s;
+}
+
+static void load_bad(const char *json, const char *expect)
+{
+    thz_scene *s = (thz_scene *)1;
+    thz_error err = {0};
+    assert_int_equal(scene_load_string(json, SRC "/tests/inputs/scenes", "test.json", &s, &err),
+                     THZ_ERR_INPUT);
+    assert_null(s);
+    if (!strstr(err.message, expect))
+        fail_msg("message '%s' lacks '%s'", err.message, expect);
+    if (strncmp(err.message, "test.json", 9) != 0)
+        fail_msg("message '%s' does not start with the file name", err.message);
+}
+
+#define HEAD "{\"format\": \"thzmap-scene/1\", "
+#define CHANNELS "\"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.01}], "
+#define MATERIALS "\"materials\": {\"m\": {\"reflectivity\": 0.1}}, "
+#define OBJECT(shape) \
+    "\"objects\": [{\"name\": \"o\", \"type\": \"solid\", \"material\": \"m\", " \
+    "\"temperature_k\": 300, \"shape\": " shape "}], "
+#define SENSORS \
+    "\"sensors\": [{\"name\": \"c\", \"position_m\": [0, -5, 0], \"look_at_m\": [0, 0, 0], " \
+    "\"fov_deg\": 40, \"resolution\": [16, 8]}]"
+#define BOX "{\"type\": \"box\", \"size_m\": [1, 1, 1]}"
+
+static void test_example(void **state)
+{
+    (void)state;
+    thz_scene *s = NULL;
+    thz_error err = {0};
+    assert_int_equal(thz_scene_load(SRC "/examples/plate-in-box/scene.json", &s, &err), THZ_OK);
+    assert_string_equal(s->name, "plate-in-box");
+    assert_int_equal(s->n_channels, 1);
+    assert_string_equal(s->channels[0].name, "0.35 THz");
+    assert_true(fabs(s->channels[0].center_hz - 0.35e12) < 1);
+    assert_int_equal(s->n_materials, 4);
+    assert_string_equal(s->materials[0].name, "wall");
+    assert_string_equal(s->materials[3].name, "table");
+    assert_int_equal(s->materials[1].reflectivity.n, 2);
+    assert_true(s->materials[1].color[0] == 0.8);
+    assert_true(s->materials[0].color[1] == 0.6);
+    assert_int_equal(s->materials[2].transmission, TRANSMISSION_STRAIGHT);
+    assert_int_equal(s->materials[3].reflectivity.n, 5);
+    assert_int_equal(s->materials[3].emissivity.n, 0); /* Kirchhoff */
+    assert_int_equal(s->atmosphere.model, ATM_CONSTANT);
+    assert_int_equal(s->n_objects, 3);
+    const thz_object *room = &s->objects[0];
+    assert_true(fabs(room->mesh.total_area_m2 - 10.0) < 1e-9);
+    assert_true(room->mesh.bbox_min_m[2] == 0.0 && room->mesh.bbox_max_m[2] == 2.0);
+    assert_int_equal(s->objects[1].mesh.n_triangles, 4 * 64);
+    assert_int_equal(s->objects[2].type, OBJECT_SHELL);
+    assert_true(s->objects[2].two_sided);
+    assert_true(s->objects[2].thickness_m == 0.0005);
+    assert_int_equal(s->objects[2].mesh.n_triangles, 2 * 64);
+    assert_true(fabs(s->objects[2].mesh.bbox_min_m[2] - 0.3) < 1e-6);
+    const thz_sensor *c = &s->sensors[0];
+    assert_true(fabs(c->direction[1] - 1.0) < 1e-15 && c->direction[0] == 0.0);
+    assert_true(c->columns == 64 && c->rows == 64 && c->oversampling == 2);
+    assert_int_equal(s->photons.gather_min_photons, 16);
+    assert_int_equal(s->n_warnings, 0);
+    thz_scene_destroy(s);
+}
+
+static void test_defaults_and_range(void **state)
+{
+    (void)state;
+    thz_scene *s = load_ok(HEAD
+                           "\"channels\": {\"from_thz\": 0.2, \"to_thz\": 1.2, \"count\": 6, "
+                           "\"relative_width\": 0.02}, " MATERIALS OBJECT(BOX) SENSORS "}");
+    assert_string_equal(s->name, "test");
+    assert_int_equal(s->n_channels, 6);
+    assert_string_equal(s->channels[0].name, "0.200 THz");
+    assert_string_equal(s->channels[5].name, "1.200 THz");
+    assert_true(fabs(s->channels[2].center_hz - 0.6e12) < 1e-3);
+    assert_true(s->channels[5].center_hz == 1.2e12);
+    assert_int_equal(s->atmosphere.model, ATM_NONE);
+    const thz_sensor *c = &s->sensors[0];
+    assert_true(c->aperture_m2 == 1e-2 && c->oversampling == 1 && c->normalize_to_k == 295);
+    assert_true(c->up[2] == 1.0);
+    assert_true(s->photons.per_channel == 1000000 && s->photons.seed == 1);
+    assert_true(s->photons.min_relative_power == 0.01);
+    assert_int_equal(s->render.integrator, INTEGRATOR_PHOTON_MAP);
+    assert_int_equal(s->render.gather_rays, 32);
+    assert_int_equal(s->render.paths_per_sample, 16);
+    assert_false(s->objects[0].two_sided);
+    assert_true(s->materials[0].attenuation_per_m.n == 1);
+    thz_scene_destroy(s);
+}
+
+static void test_blocks(void **state)
+{
+    (void)state;
+    thz_scene *s = load_ok(
+        HEAD CHANNELS MATERIALS
+        "\"objects\": [{\"name\": \"ball\", \"type\": \"solid\", \"material\": \"m\", "
+        "\"temperature_k\": 0, \"two_sided\": true, "
+        "\"shape\": {\"type\": \"sphere\", \"radius_m\": 0.5, \"subdivisions\": 2}, "
+        "\"transform\": {\"scale\": 2, \"rotate_deg\": [0, 0, 45], \"translate_m\": [1, 2, 3]}}, "
+        "{\"name\": \"disk\", \"type\": \"shell\", \"thickness_m\": 0.001, \"material\": \"m\", "
+        "\"temperature_k\": 290, \"shape\": {\"type\": \"disk\", \"radius_m\": 1, \"segments\": 8}, "
+        "\"transform\": {\"scale\": [1, -1, 1]}}], "
+        "\"sensors\": [{\"name\": \"a\", \"position_m\": [0, 0, 0], \"direction\": [3, 0, 4], "
+        "\"up\": [0, 1, 0], \"fov_deg\": 10, \"resolution\": [1, 1], \"aperture_m2\": 0.5, "
+        "\"oversampling\": 16, \"normalize_to_k\": 77}], "
+        "\"photons\": {\"per_channel\": 1e3, \"seed\": 42, \"min_relative_power\": 0.5, "
+        "\"gather_min_photons\": 2}, "
+        "\"render\": {\"integrator\": \"path\", \"gather_rays\": 3, \"paths_per_sample\": 4}}");
+    const thz_object *ball = &s->objects[0];
+    assert_true(ball->two_sided);
+    assert_int_equal(ball->mesh.n_triangles, 320);
+    assert_true(fabs(ball->mesh.bbox_max_m[2] - 4.0) < 1e-5);
+    assert_true(fabs(ball->mesh.bbox_min_m[2] - 2.0) < 1e-5);
+    /* the mirrored disk keeps its normal +z (winding flipped with the mirror) */
+    const thz_object *disk = &s->objects[1];
+    for (size_t t = 0; t < disk->mesh.n_triangles; t++)
+        assert_true(disk->mesh.normals[3 * t + 2] > 0.999f);
+    assert_true(fabs(s->sensors[0].direction[0] - 0.6) < 1e-15);
+    assert_true(fabs(s->sensors[0].direction[2] - 0.8) < 1e-15);
+    assert_true(s->photons.per_channel == 1000 && s->photons.seed == 42);
+    assert_int_equal(s->photons.gather_min_photons, 2);
+    assert_int_equal(s->render.integrator, INTEGRATOR_PATH);
+    assert_int_equal(s->render.gather_rays, 3);
+    assert_int_equal(s->render.paths_per_sample, 4);
+    thz_scene_destroy(s);
+}
+
+static void test_csv_material_and_warnings(void **state)
+{
+    (void)state;
+    thz_scene *s = NULL;
+    thz_error err = {0};
+    assert_int_equal(scene_load(SRC "/tests/inputs/scenes/warnings.json", &s, &err), THZ_OK);
+    const thz_material *m = &s->materials[0];
+    assert_string_equal(m->name, "lossy");
+    assert_int_equal(m->reflectivity.n, 2);
+    assert_true(m->reflectivity.value[1] == 0.2 && m->reflectivity.freq_hz[1] == 0.5e12);
+    assert_int_equal(m->attenuation_per_m.n, 2);
+    assert_int_equal(m->emissivity.n, 1); /* the key beside `file` overrides the column */
+    assert_true(m->emissivity.value[0] == 0.3);
+    assert_true(fabs(s->objects[0].mesh.total_area_m2 - (1.5 + sqrt(3) / 2)) < 1e-6);
+    bool kirchhoff = false, table = false, winding = false;
+    for (size_t i = 0; i < s->n_warnings; i++) {
+        kirchhoff |= strstr(s->warnings[i], "\"plate\"") && strstr(s->warnings[i], "Kirchhoff");
+        table |= strstr(s->warnings[i], "\"lossy\", reflectivity") &&
+                 strstr(s->warnings[i], "0.300 THz");
+        winding |= strstr(s->warnings[i], "\"part\"") && strstr(s->warnings[i], "winding");
+    }
+    assert_true(kirchhoff);
+    assert_true(table);
+    assert_true(winding);
+    thz_scene_destroy(s);
+}
+
+static void test_refusals(void **state)
+{
+    (void)state;
+    load_bad("{\"format\": \"thzmap-scene/1\",\n  \"channels\": [}", "test.json:2:");
+    load_bad(HEAD CHANNELS MATERIALS OBJECT(BOX) SENSORS ", \"extra\": 1}", "extra: unknown key");
+    load_bad(HEAD CHANNELS MATERIALS
+             "\"objects\": [{\"name\": \"o\", \"type\": \"solid\", \"material\": \"m\", "
+             "\"temperature_k\": -1, \"shape\": " BOX "}], " SENSORS "}",
+             "objects[0].temperature_k: expected a number >= 0, got -1");
+    load_bad(HEAD CHANNELS MATERIALS OBJECT("{\"type\": \"cone\"}") SENSORS "}",
+             "objects[0].shape.type: expected one of");
+    load_bad(HEAD CHANNELS MATERIALS OBJECT("{\"type\": \"mesh\", \"file\": \"nope.obj\"}") SENSORS
+             "}",
+             "objects[0].shape.file:");
+    load_bad(HEAD "\"channels\": [], " MATERIALS OBJECT(BOX) SENSORS "}", "channels: expected at least one");
+    load_bad("{\"format\": \"thzmap-scene/2\"}", "format: expected \"thzmap-scene/1\"");
+    load_bad("[1, 2]", "expected a JSON object");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_example),
+        cmocka_unit_test(test_defaults_and_range),
+        cmocka_unit_test(test_blocks),
+        cmocka_unit_test(test_csv_material_and_warnings),
+        cmocka_unit_test(test_refusals),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
