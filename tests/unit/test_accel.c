@@ -1,0 +1,185 @@
+/* Ray casting: hits, sides, misses, thread safety, and the self-intersection rule on a
+ * 0.1 mm shell (two parallel rectangles 0.1 mm apart inside a 10 m room): a ray leaving
+ * one surface at normal or grazing angles, from anywhere including the triangles'
+ * shared edge, hits the other surface and never the one it leaves. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "../physics/photon_scenes.h"
+#include "accel/accel.h"
+#include "core/rng.h"
+#include "photon/emission.h"
+
+#define GAP_M 1e-4
+
+typedef struct fixture {
+    thz_scene *scene;
+    accel *acc;
+    size_t lower, upper, room;
+} fixture;
+
+/* Lower rectangle at z = z0 (normal +z), upper at z0 + 0.1 mm (normal -z, facing it),
+ * both 3 m x 3 m centred at (x0, y0), inside a 10 m room. */
+static int setup(void **state)
+{
+    fixture *f = calloc(1, sizeof *f);
+    f->scene = ps_scene(0.35, 0.01, 1000, 1);
+    size_t m = ps_material(f->scene, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    double x0 = 3.0, y0 = -2.0, z0 = 4.0;
+    f->lower = ps_object(f->scene, OBJECT_SOLID, m, 300, 0, true);
+    ps_face(f->scene, f->lower, v3(x0, y0, z0), v3(1.5, 0, 0), v3(0, 1.5, 0));
+    f->upper = ps_object(f->scene, OBJECT_SOLID, m, 300, 0, true);
+    ps_face(f->scene, f->upper, v3(x0, y0, z0 + GAP_M), v3(0, 1.5, 0), v3(1.5, 0, 0));
+    f->room = ps_object(f->scene, OBJECT_SOLID, m, 300, 0, false);
+    ps_box(f->scene, f->room, v3(-5, -5, 0), v3(5, 5, 10), true);
+    ps_finalize(f->scene);
+    thz_error err;
+    assert_int_equal(accel_create(f->scene, &f->acc, &err), THZ_OK);
+    *state = f;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    fixture *f = *state;
+    accel_destroy(f->acc);
+    scene_destroy(f->scene);
+    free(f);
+    return 0;
+}
+
+/* A hit record for a point on triangle `tri` of `object` (as if a ray had arrived). */
+static accel_hit at(uint32_t object, uint32_t tri, vec3 p)
+{
+    accel_hit h = {.object = object, .triangle = tri, .position_m = p, .side = 0, .cos_theta = 1};
+    return h;
+}
+
+static void test_hit_side_and_distance(void **state)
+{
+    fixture *f = *state;
+    accel_hit h;
+    /* From above, straight down: the upper rectangle's normal points down, so the ray
+     * arrives on its back (side 1). */
+    assert_true(accel_intersect(f->acc, v3(3.1, -2.1, 6.0), v3(0, 0, -1), INFINITY, ACCEL_NO_OBJECT,
+                                0, &h));
+    assert_int_equal(h.object, f->upper);
+    assert_int_equal(h.side, 1);
+    assert_float_equal(h.distance_m, 2.0 - GAP_M, 1e-5);
+    assert_float_equal(h.cos_theta, 1.0, 1e-6);
+    assert_float_equal(h.position_m.z, 4.0 + GAP_M, 1e-6);
+    /* From below, up: the lower rectangle's back side. */
+    assert_true(accel_intersect(f->acc, v3(3.1, -2.1, 1.0), v3(0, 0, 1), INFINITY, ACCEL_NO_OBJECT,
+                                0, &h));
+    assert_int_equal(h.object, f->lower);
+    assert_int_equal(h.side, 1);
+    /* Into the room's wall from inside at 60 degrees: front side, cos = 0.5. */
+    vec3 d = v3(sqrt(3.0) / 2.0, 0, 0.5);
+    assert_true(
+        accel_intersect(f->acc, v3(0, 0, 1.0), d, INFINITY, ACCEL_NO_OBJECT, 0, &h));
+    assert_int_equal(h.object, f->room);
+    assert_int_equal(h.side, 0);
+    assert_float_equal(h.cos_theta, sqrt(3.0) / 2.0, 1e-6);
+    assert_float_equal(h.position_m.x, 5.0, 1e-5);
+    /* max_distance limits the search. */
+    assert_false(accel_intersect(f->acc, v3(0, 0, 1.0), v3(1, 0, 0), 4.0, ACCEL_NO_OBJECT, 0, &h));
+}
+
+/* Leaves the lower rectangle upwards from point p (on triangle tri) in direction dir and
+ * checks that it hits the upper rectangle's front side after GAP/mu. */
+static void check_leave(const fixture *f, uint32_t tri, vec3 p, vec3 dir)
+{
+    accel_hit from = at((uint32_t)f->lower, tri, p), h;
+    vec3 o = accel_offset_origin(f->acc, &from, dir);
+    assert_true(o.z > p.z);
+    assert_true(o.z - p.z < 0.25 * GAP_M);
+    assert_true(accel_intersect(f->acc, o, dir, INFINITY, (uint32_t)f->lower, tri, &h));
+    assert_int_equal(h.object, f->upper);
+    assert_int_equal(h.side, 0);
+    assert_float_equal(h.distance_m * dir.z, GAP_M, 0.3 * GAP_M);
+
+    /* And back down from the upper one. */
+    vec3 down = v3(dir.x, dir.y, -dir.z);
+    accel_hit from2 = h;
+    vec3 o2 = accel_offset_origin(f->acc, &from2, down);
+    assert_true(accel_intersect(f->acc, o2, down, INFINITY, h.object, h.triangle, &h));
+    assert_int_equal(h.object, f->lower);
+    assert_int_equal(h.side, 0);
+}
+
+static void test_thin_shell_normal_and_grazing(void **state)
+{
+    fixture *f = *state;
+    /* mu from 1 down to cos(89.99 deg) = 1.7e-4: path 0.1 mm .. 0.57 m. */
+    const double mus[] = {1.0, 0.7, 0.2, 0.05, 0.01, 1.7453e-3, 1.7453e-4};
+    for (size_t i = 0; i < sizeof mus / sizeof mus[0]; i++) {
+        double mu = mus[i], s = sqrt(1.0 - mu * mu);
+        for (int a = 0; a < 8; a++) {
+            double phi = a * M_PI / 4.0 + 0.1;
+            vec3 dir = v3(s * cos(phi), s * sin(phi), mu);
+            /* Near the centre of triangle 0 (corner (-,-)) and triangle 1 (corner (+,+)). */
+            check_leave(f, 0, v3(3.0 + 0.2, -2.0 - 0.05, 4.0), dir);
+            check_leave(f, 1, v3(3.0 + 0.05, -2.0 + 0.2, 4.0), dir);
+        }
+    }
+}
+
+/* Points on the quad's diagonal, the edge the two triangles share: whichever triangle
+ * the ray leaves from, it must not hit the other one. */
+static void test_shared_edge(void **state)
+{
+    fixture *f = *state;
+    rng_stream rng;
+    rng_init(&rng, 7, 0, RNG_PURPOSE_TEST, 0);
+    for (int i = 0; i < 2000; i++) {
+        double t = 0.1 + 0.8 * rng_uniform(&rng);
+        vec3 p = v3(3.0 - 0.5 + t, -2.0 - 0.5 + t, 4.0);
+        double mu = fmax(1e-3, rng_uniform(&rng));
+        vec3 dir = emission_direction(v3(0, 0, 1), mu, rng_uniform(&rng));
+        check_leave(f, (uint32_t)(i & 1), p, dir);
+    }
+}
+
+/* Thread safety: the same rays from many threads give the same hits. */
+static void test_threads(void **state)
+{
+    fixture *f = *state;
+    enum { N = 20000 };
+    static accel_hit serial[N], parallel[N];
+    static bool hs[N], hp[N];
+    for (int pass = 0; pass < 2; pass++) {
+#pragma omp parallel for num_threads(pass ? 2 : 1) schedule(dynamic, 64)
+        for (int i = 0; i < N; i++) {
+            rng_stream rng;
+            rng_init(&rng, 3, 0, RNG_PURPOSE_TEST, (uint64_t)i);
+            vec3 o = v3(8 * rng_uniform(&rng) - 4, 8 * rng_uniform(&rng) - 4, 1 + 8 * rng_uniform(&rng));
+            vec3 d = v3_normalize(v3(rng_uniform(&rng) - 0.5, rng_uniform(&rng) - 0.5, rng_uniform(&rng) - 0.5));
+            if (pass == 0)
+                hs[i] = accel_intersect(f->acc, o, d, INFINITY, ACCEL_NO_OBJECT, 0, &serial[i]);
+            else
+                hp[i] = accel_intersect(f->acc, o, d, INFINITY, ACCEL_NO_OBJECT, 0, &parallel[i]);
+        }
+    }
+    for (int i = 0; i < N; i++) {
+        assert_true(hs[i]); /* a closed room: every ray hits */
+        assert_int_equal(hs[i], hp[i]);
+        assert_int_equal(serial[i].object, parallel[i].object);
+        assert_int_equal(serial[i].triangle, parallel[i].triangle);
+        assert_true(serial[i].distance_m == parallel[i].distance_m);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_hit_side_and_distance, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_thin_shell_normal_and_grazing, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_shared_edge, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_threads, setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
