@@ -1,0 +1,123 @@
+#!/usr/bin/python3
+"""Opens every ENVI header thzmap wrote with two independent readers, Spectral Python
+and GDAL, and checks what they report against the scene and against the raw bytes.
+
+usage: envi_readers.py OUTDIR SCENE.json   (run with Debian's /usr/bin/python3, which has
+python3-spectral and python3-gdal). Exits 1 with a message on the first mismatch.
+"""
+import glob
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import spectral
+from osgeo import gdal
+
+gdal.UseExceptions()
+
+CUBES = ["radiance", "power", "brightness_temperature", "normalized"]
+TRUTH = ["temperature", "distance", "object_id"]
+
+
+def fail(msg):
+    print(f"envi_readers: FAIL: {msg}", file=sys.stderr)
+    sys.exit(1)
+
+
+def check(cond, msg):
+    if not cond:
+        fail(msg)
+
+
+def channels_of(scene):
+    ch = scene["channels"]
+    if isinstance(ch, dict):  # {from_thz, to_thz, count, relative_width}
+        n = ch["count"]
+        freqs = [ch["from_thz"] + (ch["to_thz"] - ch["from_thz"]) * i / (n - 1) for i in range(n)]
+        return [(f"{f:.3f} THz", f) for f in freqs]
+    return [(c.get("name", f"{c['frequency_thz']:.3f} THz"), c["frequency_thz"]) for c in ch]
+
+
+def main():
+    outdir, scene_path = sys.argv[1], sys.argv[2]
+    scene = json.load(open(scene_path))
+    channels = channels_of(scene)
+    names = [n for n, _ in channels]
+    ghz = [f * 1000.0 for _, f in channels]
+    n_objects = len(scene["objects"])
+
+    check(not glob.glob(os.path.join(outdir, ".thzmap-staging-*")), "staging directory left")
+    summary = json.load(open(os.path.join(outdir, "summary.json")))
+    check([c["name"] for c in summary["channels"]] == names, "summary.json channel names")
+
+    for sensor in scene["sensors"]:
+        s = sensor["name"]
+        cols, rows = sensor["resolution"]
+        for png in ["visual", "spectra"] + [f"band-{i + 1:02d}" for i in range(len(channels))]:
+            path = os.path.join(outdir, f"{s}.{png}.png")
+            check(open(path, "rb").read(8) == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG")
+        quantities = CUBES + TRUTH
+        if os.path.exists(os.path.join(outdir, f"{s}.radiance_stderr.hdr")):
+            quantities.append("radiance_stderr")
+        for q in quantities:
+            hdr = os.path.join(outdir, f"{s}.{q}.hdr")
+            img = os.path.join(outdir, f"{s}.{q}.img")
+            per_channel = q not in TRUTH
+            bands = len(channels) if per_channel else 1
+            dtype = np.dtype("<i4") if q == "object_id" else np.dtype("<f4")
+            raw = np.fromfile(img, dtype=dtype)
+            check(raw.size == cols * rows * bands, f"{img}: {raw.size} values")
+            raw = raw.reshape(bands, rows, cols)  # BSQ
+
+            # Spectral Python
+            im = spectral.open_image(hdr)
+            check(im.shape == (rows, cols, bands), f"{hdr}: spectral shape {im.shape}")
+            check(np.dtype(im.dtype) == dtype, f"{hdr}: spectral dtype {im.dtype}")
+            data = im.open_memmap(interleave="bip")  # rows x columns x bands, as stored
+            check(np.array_equal(np.asarray(data), raw.transpose(1, 2, 0)),
+                  f"{hdr}: spectral data differ from the raw bytes")
+            check("data units" in im.metadata, f"{hdr}: no data units")
+            if per_channel:
+                check(im.metadata.get("band names") == names,
+                      f"{hdr}: band names {im.metadata.get('band names')} != {names}")
+                check(im.bands.band_unit == "GHz", f"{hdr}: wavelength units {im.bands.band_unit}")
+                check(np.allclose(im.bands.centers, ghz, rtol=1e-9),
+                      f"{hdr}: wavelengths {im.bands.centers} != {ghz} GHz")
+
+            # GDAL, through the Python binding and through gdalinfo
+            ds = gdal.Open(img)
+            check((ds.RasterXSize, ds.RasterYSize, ds.RasterCount) == (cols, rows, bands),
+                  f"{img}: GDAL size")
+            check(ds.GetDriver().ShortName == "ENVI", f"{img}: GDAL driver")
+            for b in range(bands):
+                band = ds.GetRasterBand(b + 1)
+                check(np.array_equal(band.ReadAsArray(), raw[b]), f"{img}: GDAL band {b + 1}")
+                if per_channel:
+                    md = band.GetMetadata()
+                    check(band.GetDescription().startswith(names[b]),
+                          f"{img}: GDAL band {b + 1} description {band.GetDescription()!r}")
+                    check(md.get("wavelength_units") == "GHz", f"{img}: GDAL wavelength units")
+                    check(abs(float(md["wavelength"]) - ghz[b]) <= 1e-9 * ghz[b],
+                          f"{img}: GDAL wavelength {md.get('wavelength')} != {ghz[b]}")
+            ds = None
+            info = json.loads(subprocess.run(["gdalinfo", "-json", img], check=True,
+                                             capture_output=True, text=True).stdout)
+            check(info["size"] == [cols, rows] and len(info["bands"]) == bands,
+                  f"{img}: gdalinfo size")
+
+            if q == "object_id":
+                check(raw.min() >= -1 and raw.max() < n_objects, f"{img}: ids out of range")
+                ids = raw[0]
+            if q == "brightness_temperature":
+                tb = raw
+        hit = ids >= 0
+        check(hit.any(), f"{s}: the sensor sees no object")
+        check(np.all(np.isfinite(tb)) and np.all(tb[:, hit] > 0), f"{s}: brightness temperature")
+    print(f"envi_readers: every header opens in Spectral Python {spectral.__version__} and "
+          f"GDAL {gdal.__version__}; band names and GHz wavelengths match the scene")
+
+
+if __name__ == "__main__":
+    main()
