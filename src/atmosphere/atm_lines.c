@@ -66,7 +66,8 @@ typedef struct raw_catalog {
 /* A line at the air's state. */
 typedef struct lbl_line {
     double nu_ghz;    /* shifted centre */
-    double amp;       /* n S(T) / (pi nu0 tanh(h nu0 / 2kT)), cm^-1 GHz^-1 ... per GHz of shape */
+    double amp;       /* n S(T) / pi in cm^-1 GHz: alpha = amp * shape [1/GHz] */
+    double inv_vvh0;  /* 1 / (nu0 tanh(h nu0 / 2kT)), the VVH normalisation */
     double gamma_ghz; /* Lorentz HWHM */
     double gamma_d_ghz; /* Doppler HWHM */
     double y, g;      /* mixing: Y (dimensionless) and G (1 for uncoupled) */
@@ -74,7 +75,7 @@ typedef struct lbl_line {
     bool voigt;
 } lbl_line;
 
-typedef enum lbl_shape { SHAPE_VVH_CUTOFF, SHAPE_VVH, SHAPE_COUPLED } lbl_shape;
+typedef enum lbl_shape { SHAPE_VVH_CUTOFF, SHAPE_VVH, SHAPE_GROSS, SHAPE_COUPLED } lbl_shape;
 
 typedef struct lbl_species {
     lbl_shape shape;
@@ -461,21 +462,24 @@ static thz_status species_build(lbl_species *sp, const raw_catalog *cat, const p
     size_t n = 0;
     for (size_t i = 0; i < cat->n; i++) {
         const raw_line *l = &cat->lines[i];
-        if (s_t[i] < LINE_MIN_RELATIVE * s_max || s_t[i] <= 0.0)
+        /* coupled lines are few and include the Debye pseudo-line, tiny in S */
+        if (shape != SHAPE_COUPLED && (s_t[i] < LINE_MIN_RELATIVE * s_max || s_t[i] <= 0.0))
             continue;
         lbl_line *o = &sp->lines[n++];
-        double tanh0 = tanh(l->nu0_ghz / (2.0 * kt_ghz));
-        o->amp = n_cm3 * s_t[i] / (M_PI * l->nu0_ghz * tanh0);
+        o->amp = n_cm3 * s_t[i] / M_PI;
+        o->inv_vvh0 = 1.0 / (l->nu0_ghz * tanh(l->nu0_ghz / (2.0 * kt_ghz)));
         o->gamma_ghz = pow(tr, l->n_air) * (l->gamma_air * (p - p_self) + l->gamma_self * p_self);
         double m_kg = iso_mass_amu(molecule, l->iso) * AMU_KG;
         o->gamma_d_ghz = l->nu0_ghz / 299792458.0 * sqrt(2.0 * M_LN2 * 1.380649e-23 * t / m_kg);
         o->voigt = o->gamma_d_ghz > VOIGT_DOPPLER_RATIO * o->gamma_ghz;
         o->g = 1.0;
         if (shape == SHAPE_COUPLED) {
+            /* Makarov et al. (2011) coefficients are per dry-air pressure */
+            double pd = p - air->h2o_pressure_hpa;
             double r = l->tref_k / t;
-            o->y = p * (l->y0 + l->y1 * (r - 1.0)) * pow(r, l->yx);
-            o->g = 1.0 + p * p * (l->g0 + l->g1 * (r - 1.0)) * pow(r, l->gx);
-            o->nu_ghz = l->nu0_ghz + p * p * (l->d0 + l->d1 * (r - 1.0)) * pow(r, l->dx);
+            o->y = pd * (l->y0 + l->y1 * (r - 1.0)) * pow(r, l->yx);
+            o->g = 1.0 + pd * pd * (l->g0 + l->g1 * (r - 1.0)) * pow(r, l->gx);
+            o->nu_ghz = l->nu0_ghz + pd * pd * (l->d0 + l->d1 * (r - 1.0)) * pow(r, l->dx);
         } else {
             o->nu_ghz = l->nu0_ghz + l->delta_air * (p - p_self);
         }
@@ -611,9 +615,8 @@ static size_t lower_bound(const lbl_species *sp, double f)
     return lo;
 }
 
-/* Sum over lines of amp [f(nu - nu0) + f(nu + nu0)] (the VVH factor nu tanh(h nu/2kT)
- * is applied by the caller); 1/cm per (GHz tanh). */
-static double species_sum(const lbl_species *sp, double f)
+/* alpha of the species in 1/cm at f GHz; vvh = f tanh(h f / 2kT). */
+static double species_sum(const lbl_species *sp, double f, double vvh)
 {
     double sum = 0.0;
     size_t i0 = 0, i1 = sp->n;
@@ -639,13 +642,24 @@ static double species_sum(const lbl_species *sp, double f)
             if (d2 < H2O_CUTOFF_GHZ)
                 term += lorentz(d2, g) - l->pedestal;
             break;
+        case SHAPE_GROSS:
+            /* Gross: (1/pi) 4 nu^2 gamma / ((nu^2 - nu0^2)^2 + 4 nu^2 gamma^2), written
+             * as the VVH factor (applied by the caller) times what remains */
+            if (l->voigt) {
+                term = (M_PI * atm_voigt(d1, g, l->gamma_d_ghz) + lorentz(d2, g)) * vvh * l->inv_vvh0;
+            } else {
+                double dd = f * f - l->nu_ghz * l->nu_ghz;
+                term = 4.0 * f * f * g / (dd * dd + 4.0 * f * f * g * g);
+            }
+            sum += l->amp * term;
+            continue;
         case SHAPE_VVH:
         default:
             term = (l->voigt ? M_PI * atm_voigt(d1, g, l->gamma_d_ghz) : lorentz(d1, g)) +
                    lorentz(d2, g);
             break;
         }
-        sum += l->amp * term;
+        sum += l->amp * term * vvh * l->inv_vvh0;
     }
     return sum;
 }
@@ -655,8 +669,8 @@ void atm_lines_parts(const atm_lines_data *d, double freq_hz, atm_alpha_parts *p
     double f = freq_hz * 1e-9;
     double vvh = f * tanh(f * d->half_h_over_kt);
     memset(parts, 0, sizeof *parts);
-    parts->h2o_lines_per_m = 100.0 * vvh * species_sum(&d->h2o, f);
-    parts->o2_per_m = 100.0 * vvh * (species_sum(&d->o2, f) + species_sum(&d->o2_coupled, f));
+    parts->h2o_lines_per_m = 100.0 * species_sum(&d->h2o, f, vvh);
+    parts->o2_per_m = 100.0 * (species_sum(&d->o2, f, vvh) + species_sum(&d->o2_coupled, f, vvh));
     parts->h2o_continuum_per_m = 100.0 * continuum_per_cm(d, f);
     parts->dry_continuum_per_m = 100.0 * dry_continuum_per_cm(d, f);
 }
@@ -752,7 +766,7 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
     st = species_build(&d->h2o, &h2o, &q_h2o, 1, d->continuum ? SHAPE_VVH_CUTOFF : SHAPE_VVH, air,
                        e, d->n_h2o, "H2O", err);
     if (st == THZ_OK)
-        st = species_build(&d->o2, &o2, &q_o2, 7, SHAPE_VVH, air, po2_hpa, n_o2, "O2", err);
+        st = species_build(&d->o2, &o2, &q_o2, 7, SHAPE_GROSS, air, po2_hpa, n_o2, "O2", err);
     if (st == THZ_OK)
         st = species_build(&d->o2_coupled, &o2c, &q_o2, 7, SHAPE_COUPLED, air, po2_hpa, n_o2,
                            "O2 coupled", err);
