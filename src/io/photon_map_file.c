@@ -20,6 +20,7 @@
 #define PMF_HEADER_FIXED 7u   /* u64 words before the channels */
 #define PMF_CHANNEL_WORDS 20u /* centre, width, count, 10 counters, 7 reals */
 #define PMF_LEVEL 3
+#define PMF_FLAGS_STORED 0xffffu /* the bounce count */
 #define PMF_MAX_HEADER_BYTES (16u << 20)
 
 /* ---- little-endian words ---------------------------------------------------- */
@@ -171,6 +172,10 @@ static thz_status pmf_write_channel(pmf_writer *w, const photon_map *map, thz_er
                 j++;
         }
         memcpy(tmp, r + i, (j - i) * sizeof *tmp);
+        /* Keep only what the phase stored: the map uses the upper flag bits for its
+         * kd-tree (photon_map.c), which a reader rebuilds. */
+        for (size_t k = 0; k < j - i; k++)
+            tmp[k].flags &= PMF_FLAGS_STORED;
         qsort(tmp, j - i, sizeof *tmp, pmf_record_cmp);
         st = pmf_compress(w, tmp, (j - i) * sizeof *tmp, ZSTD_e_continue, err);
         if (st != THZ_OK)

@@ -149,4 +149,37 @@ static inline void ps_finalize(thz_scene *s)
         ps_check(mesh_finalize(&s->objects[i].mesh));
 }
 
+/* A "box scene" with every kind of surface: a 2 x 2 x 2.5 m room (inward, R = 0.3,
+ * 295 K), a solid cube (R = 0.1, 310 K), a diffuse shell (R = 0.05, alpha 200/m, 1 mm,
+ * 300 K), a straight shell (R = 0.1, alpha 100/m, 2 mm, 290 K), a one-sided plate whose
+ * back faces are visible (R = 0.2, 320 K), a cold (0 K) two-sided plate, and an
+ * atmosphere of constant alpha = atm_per_m (none when 0). */
+static inline thz_scene *ps_box_scene(uint64_t photons, uint64_t seed, double atm_per_m)
+{
+    thz_scene *s = ps_scene(0.35, 0.02, photons, seed);
+    size_t wall = ps_material(s, 0.3, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t paint = ps_material(s, 0.1, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t cloth = ps_material(s, 0.05, 200.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t film = ps_material(s, 0.1, 100.0, -1.0, TRANSMISSION_STRAIGHT);
+    size_t metal = ps_material(s, 0.2, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t room = ps_object(s, OBJECT_SOLID, wall, 295, 0, false);
+    ps_box(s, room, v3(-1, -1, 0), v3(1, 1, 2.5), true);
+    size_t cube = ps_object(s, OBJECT_SOLID, paint, 310, 0, false);
+    ps_box(s, cube, v3(-0.3, -0.3, 0.05), v3(0.3, 0.3, 0.6), false);
+    size_t shell = ps_object(s, OBJECT_SHELL, cloth, 300, 1e-3, true);
+    ps_box(s, shell, v3(-0.4, -0.4, 0.02), v3(0.4, 0.4, 0.8), false);
+    size_t straight = ps_object(s, OBJECT_SHELL, film, 290, 2e-3, true);
+    ps_face(s, straight, v3(0, 0.8, 1.2), v3(0.5, 0, 0), v3(0, 0, 0.5));
+    size_t plate = ps_object(s, OBJECT_SOLID, metal, 320, 0, false);
+    ps_face(s, plate, v3(0.6, -0.6, 1.8), v3(0.2, 0, 0), v3(0, 0.2, 0));
+    size_t cold = ps_object(s, OBJECT_SOLID, metal, 0, 0, true);
+    ps_face(s, cold, v3(-0.6, 0.6, 2.0), v3(0.2, 0, 0), v3(0, 0.2, 0));
+    if (atm_per_m > 0.0) {
+        s->atmosphere.model = ATM_CONSTANT;
+        ps_check(spectrum_set_constant(&s->atmosphere.attenuation_per_m, atm_per_m));
+    }
+    ps_finalize(s);
+    return s;
+}
+
 #endif
