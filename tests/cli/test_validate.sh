@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# thzmap validate: the summary of the spec's example scene (channel centre and FWHM,
+# triangle counts, areas, temperatures, the emitted power P_A against an independent
+# computation), the mesh example, warnings on stderr, --help and usage errors.
+# usage: test_validate.sh THZMAP_BINARY REPO_DIR
+set -u
+thzmap=$1
+repo=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+
+fail() {
+    echo "FAIL: $*"
+    failures=$((failures + 1))
+}
+
+# expect_line FILE PATTERN: some line of FILE matches the extended regex PATTERN
+expect_line() {
+    grep -Eq -- "$2" "$1" || fail "no line matching '$2' in $(basename "$1"):" "$(cat "$1")"
+}
+
+# --- the spec's example -------------------------------------------------------------
+"$thzmap" validate "$repo/examples/plate-in-box/scene.json" >"$tmp/out" 2>"$tmp/err"
+status=$?
+[[ $status -eq 0 ]] || fail "plate-in-box: exit $status: $(cat "$tmp/err")"
+[[ -s $tmp/err ]] && fail "plate-in-box: unexpected warnings: $(cat "$tmp/err")"
+expect_line "$tmp/out" '^scene "plate-in-box"'
+expect_line "$tmp/out" '0\.35 THz +centre 0\.3500 THz +FWHM 3\.500 GHz'
+expect_line "$tmp/out" '^  \[0\] room: solid, material wall, 12 triangles, area 10 m², temperature 295\.00 K'
+expect_line "$tmp/out" '^  \[1\] target: solid, material paint, 256 triangles, area 0\.533781 m², temperature 310\.00 K'
+expect_line "$tmp/out" '^  \[2\] cover: shell 0\.5 mm, material cloth, 128 triangles, area 0\.0634347 m², temperature 300\.00 K'
+expect_line "$tmp/out" 'cam: 64 x 64 pixels, fov 40 deg, oversampling 2 x 2, aperture 0\.01 m²'
+expect_line "$tmp/out" '^atmosphere: constant'
+expect_line "$tmp/out" '^  table: reflectivity table \(5 points'
+
+# P_A = sum pi eps-bar A B(T) over emitting sides, here at the channel centre (the
+# band mean over a 1 % band differs by ~1e-5), computed independently in Python.
+pa=$(awk '/^emitted spectral power/ {getline; print $(NF-1)}' "$tmp/out")
+unit=$(awk '/^emitted spectral power/ {getline; print $NF}' "$tmp/out")
+[[ $unit == "W/Hz" ]] || fail "P_A unit is '$unit', expected W/Hz"
+python3 - "$pa" <<'PY' || fail "P_A of plate-in-box is wrong"
+import math, sys
+h, k, c = 6.62607015e-34, 1.380649e-23, 299792458.0
+nu = 0.35e12
+def B(T):
+    return 2 * h * nu**3 / c**2 / math.expm1(h * nu / (k * T))
+n = 64
+cyl_side = lambda r, hgt: n * 2 * r * math.sin(math.pi / n) * hgt
+cap = lambda r: n * r * r * math.sin(2 * math.pi / n) / 2
+R_paint = 0.05 + (0.35 - 0.2) / 1.0 * (0.12 - 0.05)
+alpha = 60 + (0.35 - 0.2) / 1.0 * (900 - 60)
+R_cloth, t = 0.02, 0.0005
+# eps-bar of the shell = 2 int (1 - R - T(mu)) mu dmu, T = min(exp(-alpha t / mu), 1 - R)
+m = 200000
+ebar = sum(2 * (1 - R_cloth - min(math.exp(-alpha * t / mu), 1 - R_cloth)) * mu / m
+           for mu in ((i + 0.5) / m for i in range(m)))
+pa = math.pi * (10 * B(295) + (1 - R_paint) * (cyl_side(0.1, 0.75) + 2 * cap(0.1)) * B(310)
+                + 2 * ebar * cyl_side(0.101, 0.1) * B(300))
+got = float(sys.argv[1])
+print("P_A expected %.6e W/Hz, got %.6e W/Hz" % (pa, got))
+sys.exit(0 if abs(got / pa - 1) < 1e-3 else 1)
+PY
+
+# --- the mesh example -----------------------------------------------------------------
+"$thzmap" validate "$repo/examples/meshes/scene.json" >"$tmp/out" 2>"$tmp/err"
+status=$?
+[[ $status -eq 0 ]] || fail "meshes example: exit $status: $(cat "$tmp/err")"
+[[ -s $tmp/err ]] && fail "meshes example: unexpected warnings: $(cat "$tmp/err")"
+expect_line "$tmp/out" 'pyramid: solid, material metal, 6 triangles, area 1\.009 m²'
+expect_line "$tmp/out" '^  0\.900 THz +[0-9.]+e-[0-9]+ W/Hz'
+
+# --- warnings ---------------------------------------------------------------------------
+"$thzmap" validate "$repo/tests/inputs/scenes/warnings.json" >"$tmp/out" 2>"$tmp/err"
+status=$?
+[[ $status -eq 0 ]] || fail "warnings scene: exit $status"
+[[ $(grep -c '^warning: ' "$tmp/err") -eq 4 ]] || fail "expected 4 warnings, got: $(cat "$tmp/err")"
+expect_line "$tmp/err" '^warning: object "part": inconsistent winding'
+expect_line "$tmp/err" '^warning: object "plate": the explicit emissivity .* Kirchhoff'
+expect_line "$tmp/err" '^warning: material "lossy", reflectivity: the table covers'
+
+# --- help and usage -----------------------------------------------------------------------
+"$thzmap" validate --help >"$tmp/out" 2>&1 || fail "validate --help failed"
+expect_line "$tmp/out" '^usage: thzmap validate SCENE\.json'
+"$thzmap" validate >/dev/null 2>"$tmp/err"
+[[ $? -eq 2 ]] || fail "validate without a scene must exit 2"
+"$thzmap" validate a.json b.json >/dev/null 2>&1
+[[ $? -eq 2 ]] || fail "validate with two scenes must exit 2"
+"$thzmap" validate --bogus "$repo/examples/plate-in-box/scene.json" >/dev/null 2>&1
+[[ $? -eq 2 ]] || fail "validate with an unknown option must exit 2"
+"$thzmap" validate "$tmp/does-not-exist.json" >/dev/null 2>"$tmp/err"
+[[ $? -eq 2 ]] || fail "validate of a missing file must exit 2"
+expect_line "$tmp/err" 'does-not-exist\.json: cannot open scene file'
+
+[[ $failures -eq 0 ]] && echo "validate: all checks passed"
+[[ $failures -eq 0 ]]
