@@ -12,6 +12,8 @@
 #include "accel/accel.h"
 #include "core/alloc.h"
 #include "io/output.h"
+#include "io/photon_map_file.h"
+#include "io/ply.h"
 #include "photon/phase.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
@@ -34,6 +36,8 @@ typedef struct run_state {
     photon_map **maps;        /* per channel: kept for saving, or read from a file */
     photon_stats *stats;      /* per channel (simulate) */
     double *median_stderr_k;  /* per channel */
+    uint64_t seed;            /* of the photons rendered (scene's, or the map file's) */
+    uint64_t photons_per_channel;
     size_t n_warnings;
     char **warnings;
     double seconds_accel, seconds_photons, seconds_render, seconds_output;
@@ -123,6 +127,8 @@ static thz_status run_state_init(run_state *rs, const thz_scene *scene, const ru
     rs->scene = scene;
     rs->opt = opt;
     rs->command = command;
+    rs->seed = scene->photons.seed;
+    rs->photons_per_channel = scene->photons.per_channel;
     if (!opt->outdir || !opt->outdir[0])
         return thz_error_set(err, THZ_ERR_INPUT, "%s: no output directory given", command);
     size_t nc = scene->n_channels, ns = scene->n_sensors;
@@ -350,8 +356,8 @@ static thz_status run_write_outputs(run_state *rs, double t_start, thz_error *er
     run_summary sum = {
         .command = rs->command,
         .integrator = render_integrator_name(rs->scene->render.integrator),
-        .seed = rs->scene->photons.seed,
-        .photons_per_channel = rs->scene->photons.per_channel,
+        .seed = rs->seed,
+        .photons_per_channel = rs->photons_per_channel,
         .threads = rs->opt->threads,
         .channel_stats = simulate && render_integrator_needs_photons(rs->scene->render.integrator)
                              ? rs->stats
@@ -480,13 +486,26 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, run_result
 
 static thz_status run_save_photon_map(run_state *rs, const char *dir, thz_error *err)
 {
-    (void)rs;
-    (void)dir;
-    return thz_error_set(err, THZ_ERR_INTERNAL, "photon-map files are not available yet");
+    char path[4096];
+    int len = snprintf(path, sizeof path, "%s/photon-map.thzpm", dir);
+    if (len < 0 || (size_t)len >= sizeof path)
+        return thz_error_set(err, THZ_ERR_IO, "output path too long: %s", dir);
+    const photon_map *const *maps = (const photon_map *const *)rs->maps;
+    thz_status st = photon_map_file_write(path, rs->scene, maps, rs->stats, err);
+    if (st != THZ_OK)
+        return st;
+    snprintf(path, sizeof path, "%s/photon-map.ply", dir);
+    return ply_write_photons(path, maps, rs->scene->n_channels, PLY_DEFAULT_MAX_POINTS, err);
 }
 
 static thz_status run_load_photon_map(run_state *rs, thz_error *err)
 {
-    (void)rs;
-    return thz_error_set(err, THZ_ERR_INTERNAL, "photon-map files are not available yet");
+    photon_map_file_info info;
+    thz_status st = photon_map_file_read(rs->opt->photon_map_path, rs->scene, rs->opt->threads,
+                                         rs->maps, NULL, &info, err);
+    if (st != THZ_OK)
+        return st;
+    rs->seed = info.seed;
+    rs->photons_per_channel = info.photons_per_channel;
+    return THZ_OK;
 }

@@ -214,7 +214,7 @@ static double render_emission(const render_context *ctx, uint32_t object, double
 typedef struct render_gather_state {
     const render_context *ctx;
     const thz_object *obj;
-    vec3 normal;         /* unit normal of the triangle hit */
+    vec3 normal_seen;    /* unit normal of the triangle hit, towards the sensor's side */
     double mu_o;         /* |cos theta| of the view ray */
     const render_path *path;
     double distance_m;   /* from the sensor */
@@ -230,6 +230,13 @@ static void render_gather_visit(void *vstate, const photon_record *p, double dis
     render_gather_state *g = vstate;
     if (g->strict ? !(distance2_m2 < g->radius2_m2) : !(distance2_m2 <= g->radius2_m2))
         return;
+    /* Only photons that arrived on the surface seen: travelling against the seen side's
+     * normal (or along it, for the transmitted ones). Rejects photons of the opposite
+     * face of a thin solid, which lie within a wide disk but light the other side. */
+    vec3 dir = photon_decode_direction(p->dir_oct);
+    double along = v3_dot(dir, g->normal_seen);
+    if (g->transmitted ? !(along > 0.0) : !(along < 0.0))
+        return;
     g->count++;
     double nu = (double)p->freq_hz;
     const thz_scene *scene = g->ctx->scene;
@@ -239,8 +246,7 @@ static void render_gather_visit(void *vstate, const photon_record *p, double dis
         f = o.reflectivity / M_PI;
     } else {
         /* f_T = T(theta_p) T(theta_o) / (pi T-bar): the reciprocal BTDF */
-        vec3 dir = photon_decode_direction(p->dir_oct);
-        double mu_p = fmax(fabs(v3_dot(dir, g->normal)), 1e-12);
+        double mu_p = fmax(fabs(along), 1e-12);
         double tbar = optics_mean_transmission(&o);
         f = tbar > 0.0
                 ? optics_transmission(&o, mu_p) * optics_transmission(&o, g->mu_o) / (M_PI * tbar)
@@ -279,10 +285,11 @@ static void render_gather(const render_context *ctx, const accel_hit *hit,
         return;
     const thz_object *obj = &ctx->scene->objects[hit->object];
     const float *nf = &obj->mesh.normals[3 * (size_t)hit->triangle];
+    vec3 normal = v3_from_floats(nf);
     render_gather_state g = {
         .ctx = ctx,
         .obj = obj,
-        .normal = v3_from_floats(nf),
+        .normal_seen = hit->side == 0 ? normal : v3_scale(normal, -1.0),
         .mu_o = hit->cos_theta,
         .path = path,
         .distance_m = distance_m,

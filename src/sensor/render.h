@@ -12,6 +12,12 @@
  * transmittance all at nu_p); the emission term is the deterministic band mean by the
  * channel's quadrature. So L_c estimates the band mean of L exp(-alpha d).
  *
+ * Gather: the photons of the object hit (the paper's rule), on the side seen (and the
+ * other side for `diffuse` shells), within the footprint disk, and, beyond the spec's
+ * wording, only those whose incoming direction agrees with that side of the triangle
+ * hit, so that the opposite face of a thin solid does not leak into a wide disk.
+ * Open edges under-estimate and concave edges over-estimate (physics.md).
+ *
  * Determinism: no random numbers; each pixel is computed by one thread into its own
  * slot, so the images are bit-identical for any thread count.
  */
