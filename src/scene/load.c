@@ -500,6 +500,12 @@ static thz_status load_object(load_ctx *ctx, const load_cursor *c, thz_object *o
         return st;
     if (!mesh_finalize(&o->mesh))
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(o->mesh.bbox_min_m[k]) || !isfinite(o->mesh.bbox_max_m[k]) ||
+            !isfinite(o->mesh.total_area_m2))
+            return load_fail(ctx, transform.value ? &transform : &shape,
+                             "the object's coordinates or area exceed the range of single-precision "
+                             "floats (expected sizes in metres well below 1e30)");
     if (o->mesh.n_triangles == 0 || !(o->mesh.total_area_m2 > 0.0))
         return load_fail(ctx, &shape, "the shape has no triangles of non-zero area");
     return THZ_OK;

@@ -1,6 +1,7 @@
 /* Tessellation of the analytic shapes into triangle meshes. */
 #include "scene/primitives.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -27,11 +28,18 @@ thz_status primitive_mesh_alloc(thz_mesh *mesh, size_t n_vertices, size_t n_tria
     return THZ_OK;
 }
 
+/* double -> float without the undefined behaviour of out-of-range conversions: values
+ * beyond float's range become infinite (and the loader refuses the object). */
+static float primitive_to_float(double x)
+{
+    return fabs(x) <= FLT_MAX ? (float)x : (float)copysign(INFINITY, x);
+}
+
 static void primitive_set_vertex(thz_mesh *m, size_t v, double x, double y, double z)
 {
-    m->positions[3 * v] = (float)x;
-    m->positions[3 * v + 1] = (float)y;
-    m->positions[3 * v + 2] = (float)z;
+    m->positions[3 * v] = primitive_to_float(x);
+    m->positions[3 * v + 1] = primitive_to_float(y);
+    m->positions[3 * v + 2] = primitive_to_float(z);
 }
 
 static void primitive_set_triangle(thz_mesh *m, size_t t, size_t a, size_t b, size_t c)

@@ -181,6 +181,8 @@ CASES = [
      "objects[1].shape.file: "),
     ("transform_zero_scale", [(["objects", 1, "transform"], {"scale": [1, 0, 1]})],
      "objects[1].transform.scale: a scale factor of 0"),
+    ("transform_huge_scale", [(["objects", 1, "transform"], {"scale": 1e300})],
+     "objects[1].transform: the object's coordinates or area exceed"),
     ("transform_unknown_key", [(["objects", 1, "transform"], {"rotate": [0, 0, 90]})],
      "objects[1].transform.rotate: unknown key"),
     ("transform_short_vector", [(["objects", 1, "transform"], {"translate_m": [0, 1]})],
