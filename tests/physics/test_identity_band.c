@@ -1,0 +1,141 @@
+/* Identity 6 (physics.md): a material whose reflectivity has a line narrower than the
+ * band gives the response-weighted band mean, not the value at the centre. Two setups
+ * with a grey plate whose R(nu) has a triangular line (half-width sigma/5, peak 0.9 on a
+ * base of 0.1, 0.3 sigma above the centre, so R(nu_c) = 0.1 while the band mean of R is
+ * ~0.16):
+ *   emission:   plate at 300 K in a black enclosure at 0 K: L = <(1 - R) B(300 K)>,
+ *               deterministic (the channel quadrature);
+ *   reflection: plate at 0 K in a black enclosure at 300 K: L = <R B(300 K)>, from the
+ *               photons' own frequencies (Monte Carlo).
+ * <.> is an independent band mean (trapezoid over +-8 sigma). */
+#include "identity.h"
+
+#define BAND_NU_C 0.5e12
+#define BAND_W 0.05
+
+typedef struct band_line {
+    double f[5], r[5]; /* the table, Hz */
+    double temp_k;
+} band_line;
+
+static double band_sigma(void)
+{
+    return BAND_W * BAND_NU_C / (2.0 * sqrt(2.0 * log(2.0)));
+}
+
+static void band_line_init(band_line *l)
+{
+    double s = band_sigma(), nu_l = BAND_NU_C + 0.3 * s, hw = s / 5.0;
+    double f[5] = {0.3e12, nu_l - hw, nu_l, nu_l + hw, 0.7e12};
+    double r[5] = {0.1, 0.1, 0.9, 0.1, 0.1};
+    memcpy(l->f, f, sizeof f);
+    memcpy(l->r, r, sizeof r);
+}
+
+static double band_r(const band_line *l, double nu)
+{
+    if (nu <= l->f[0])
+        return l->r[0];
+    for (int i = 1; i < 5; i++)
+        if (nu <= l->f[i])
+            return l->r[i - 1] + (l->r[i] - l->r[i - 1]) * (nu - l->f[i - 1]) / (l->f[i] - l->f[i - 1]);
+    return l->r[4];
+}
+
+static double band_emitted(double nu, void *ctx)
+{
+    const band_line *l = ctx;
+    return (1.0 - band_r(l, nu)) * planck_radiance(nu, l->temp_k);
+}
+
+static double band_reflected(double nu, void *ctx)
+{
+    const band_line *l = ctx;
+    return band_r(l, nu) * planck_radiance(nu, l->temp_k);
+}
+
+static void band_scene(char *json, size_t size, const band_line *l, double t_plate,
+                       double t_room)
+{
+    snprintf(json, size,
+             "{\"format\": \"thzmap-scene/1\", \"name\": \"band-line\","
+             " \"channels\": [{\"frequency_thz\": %.12g, \"relative_width\": %g}],"
+             " \"materials\": {\"black\": {\"reflectivity\": 0.0},"
+             "   \"lined\": {\"reflectivity\": [[%.12g, %g], [%.12g, %g], [%.12g, %g],"
+             "                                 [%.12g, %g], [%.12g, %g]]}},"
+             " \"objects\": ["
+             "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"black\","
+             "    \"temperature_k\": %g,"
+             "    \"shape\": {\"type\": \"box\", \"size_m\": [1.2, 0.6, 1.2], \"inward\": true}},"
+             "   {\"name\": \"plate\", \"type\": \"solid\", \"material\": \"lined\","
+             "    \"temperature_k\": %g, \"shape\": {\"type\": \"box\", \"size_m\": [1.0, 0.1, 1.0]}}],"
+             " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.28, 0],"
+             "   \"direction\": [0, 1, 0], \"fov_deg\": 100, \"resolution\": [8, 8]}],"
+             " \"photons\": {\"per_channel\": 300000, \"seed\": 11}}",
+             BAND_NU_C / 1e12, BAND_W, l->f[0] / 1e12, l->r[0], l->f[1] / 1e12, l->r[1],
+             l->f[2] / 1e12, l->r[2], l->f[3] / 1e12, l->r[3], l->f[4] / 1e12, l->r[4], t_room,
+             t_plate);
+}
+
+static void test_band_emission(void **state)
+{
+    (void)state;
+    band_line l;
+    band_line_init(&l);
+    l.temp_k = 300.0;
+    char json[4096];
+    band_scene(json, sizeof json, &l, 300.0, 0.0);
+    ident_run r;
+    ident_run_scene(&r, json, ident_photons(20000));
+    const thz_channel *ch = &r.scene->channels[0];
+    double expect = ident_band_mean(ch, band_emitted, &l);
+    double at_centre = (1.0 - band_r(&l, BAND_NU_C)) * ident_band_planck(ch, 300.0);
+    assert_true(fabs(expect / at_centre - 1.0) > 0.05); /* the line matters */
+    for (uint32_t row = 0; row < r.img.rows; row++)
+        for (uint32_t col = 0; col < r.img.columns; col++) {
+            double v = r.img.radiance[ident_at(&r, 0, col, row)];
+            if (!(fabs(v - expect) <= 2e-4 * expect))
+                print_message("pixel (%u, %u): L = %.8e, expected %.8e (centre value %.8e)\n",
+                              col, row, v, expect, at_centre);
+            /* Simpson on 401 nodes across the line's kinks: ~1e-4 */
+            assert_true(fabs(v - expect) <= 2e-4 * expect);
+        }
+    ident_run_fini(&r);
+}
+
+static void test_band_reflection(void **state)
+{
+    (void)state;
+    band_line l;
+    band_line_init(&l);
+    l.temp_k = 300.0;
+    char json[4096];
+    band_scene(json, sizeof json, &l, 0.0, 300.0);
+    ident_run r;
+    ident_run_scene(&r, json, ident_photons(300000));
+    const thz_channel *ch = &r.scene->channels[0];
+    double expect = ident_band_mean(ch, band_reflected, &l);
+    double at_centre = band_r(&l, BAND_NU_C) * ident_band_planck(ch, 300.0);
+    ident_tally t = {0};
+    for (uint32_t row = 0; row < r.img.rows; row++)
+        for (uint32_t col = 0; col < r.img.columns; col++) {
+            assert_true(ident_pixel_interior(&r, col, row));
+            ident_check_pixel(&t, &r, 0, col, row, expect, 0.0);
+        }
+    ident_tally_assert(&t, "reflection with a line", 0.2 / sqrt(ident_scale()), 0.0);
+    /* the centre value is excluded by many standard errors of the mean */
+    double se_mean = sqrt(t.sum_var) / (double)t.pixels;
+    print_message("band mean %.6e vs centre value %.6e W m^-2 sr^-1 Hz^-1 (%.1f se apart)\n",
+                  expect, at_centre, fabs(expect / at_centre - 1.0) / se_mean);
+    assert_true(fabs(expect / at_centre - 1.0) > 10.0 * se_mean);
+    ident_run_fini(&r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_band_emission),
+        cmocka_unit_test(test_band_reflection),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

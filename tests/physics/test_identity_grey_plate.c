@@ -1,0 +1,48 @@
+/* Identity 2 (physics.md): a solid plate (reflectivity R, temperature T1) inside a
+ * black enclosure at T2 shows L = (1 - R) B(T1) + R B(T2), as band means; checked per
+ * pixel against the photons' standard error, for two channels. */
+#include "identity.h"
+
+static const char *plate_json =
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"grey-plate\","
+    " \"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.1},"
+    "                {\"frequency_thz\": 1.1, \"relative_width\": 0.01}],"
+    " \"materials\": {\"black\": {\"reflectivity\": 0.0}, \"grey\": {\"reflectivity\": 0.4}},"
+    " \"objects\": ["
+    "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"black\", \"temperature_k\": 350,"
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [1.2, 0.6, 1.2], \"inward\": true}},"
+    "   {\"name\": \"plate\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 250,"
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [1.0, 0.1, 1.0]}}],"
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.28, 0], \"direction\": [0, 1, 0],"
+    "   \"fov_deg\": 100, \"resolution\": [12, 12], \"normalize_to_k\": 300}],"
+    " \"photons\": {\"per_channel\": 300000, \"seed\": 5}}";
+
+static void test_grey_plate(void **state)
+{
+    (void)state;
+    ident_run r;
+    ident_run_scene(&r, plate_json, ident_photons(300000));
+    const double refl = 0.4, t1 = 250.0, t2 = 350.0;
+    for (size_t c = 0; c < r.scene->n_channels; c++) {
+        const thz_channel *ch = &r.scene->channels[c];
+        double expect = (1.0 - refl) * ident_band_planck(ch, t1) + refl * ident_band_planck(ch, t2);
+        ident_tally t = {0};
+        for (uint32_t row = 0; row < r.img.rows; row++)
+            for (uint32_t col = 0; col < r.img.columns; col++) {
+                assert_int_equal(r.img.object_id[row * r.img.columns + col], 1);
+                assert_true(ident_pixel_interior(&r, col, row));
+                ident_check_pixel(&t, &r, c, col, row, expect, 1e-5);
+            }
+        char what[64];
+        snprintf(what, sizeof what, "grey plate, channel %zu", c);
+        /* reflected part is R B(T2) / L ~ 0.5 of L: a factor 2 moves L by 50 % */
+        ident_tally_assert(&t, what, 0.08 / sqrt(ident_scale()), 0.0);
+    }
+    ident_run_fini(&r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_grey_plate)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
