@@ -1,0 +1,218 @@
+/* Emission sampling (eq. 5-6): sampled frequencies follow the channel's Gaussian
+ * response; source fractions follow eq. 5 (pi eps-bar A B_nu(T) per emitting side) for
+ * surfaces at different temperatures, emissivities and sidedness, 0 K emits nothing;
+ * the photons' mean power is the band-mean P_A; directions leave the emitting side,
+ * cosine-distributed for constant eps and eps(theta) cos(theta) for a Kirchhoff shell.
+ * Tolerances: 5 standard errors of the sample count. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include <cmocka.h>
+
+#include "photon/emission.h"
+#include "physics/planck.h"
+#include "photon_scenes.h"
+
+static void check_fraction(uint64_t count, uint64_t n, double p, const char *what)
+{
+    double f = (double)count / (double)n;
+    double se = sqrt(fmax(p * (1 - p), 1.0 / (double)n) / (double)n);
+    printf("# %s: %.5f expected %.5f (%.1f se)\n", what, f, p, (f - p) / se);
+    assert_true(fabs(f - p) < 5.0 * se);
+}
+
+static double planck_at(double freq_hz, void *ctx)
+{
+    return planck_radiance(freq_hz, *(const double *)ctx);
+}
+
+static double band_planck(const thz_channel *ch, double temp_k)
+{
+    return channel_band_mean(ch, planck_at, &temp_k);
+}
+
+static void test_frequencies_follow_band(void **state)
+{
+    (void)state;
+    uint64_t n = ps_scaled(400000);
+    thz_scene *s = ps_scene(0.5, 0.3, n, 3); /* wide band: sigma = 64 GHz */
+    size_t black = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t plate = ps_object(s, OBJECT_SOLID, black, 300, 0, false);
+    ps_face(s, plate, v3(0, 0, 0), v3(0.5, 0, 0), v3(0, 0.5, 0));
+    ps_finalize(s);
+    emission_table t;
+    thz_error err;
+    assert_int_equal(emission_table_init(&t, s, 0, n, &err), THZ_OK);
+    const thz_channel *ch = &s->channels[0];
+    double sigma = channel_sigma_hz(ch);
+    enum { BINS = 16 };
+    uint64_t hist[BINS + 2] = {0};
+    double scratch[4], sum = 0.0, sum2 = 0.0;
+    for (uint64_t i = 0; i < n; i++) {
+        rng_stream rng;
+        rng_init(&rng, 3, 0, RNG_PURPOSE_PHOTON, i);
+        emission_photon e;
+        assert_true(emission_sample(&t, &rng, scratch, &e));
+        double z = (e.freq_hz - ch->center_hz) / sigma; /* bins of 0.5 sigma over +-4 */
+        int b = z < -4 ? 0 : (z >= 4 ? BINS + 1 : 1 + (int)floor((z + 4) * 2));
+        hist[b]++;
+        sum += e.power_w_per_hz * (double)n;
+        sum2 += (e.power_w_per_hz * (double)n) * (e.power_w_per_hz * (double)n);
+        /* The photon's power is P_A at its own frequency over K. */
+        double v = M_PI * planck_radiance(e.freq_hz, 300) * 1.0;
+        assert_true(fabs(e.power_w_per_hz * (double)n - v) <= 1e-12 * v);
+    }
+    for (int b = 0; b < BINS + 2; b++) {
+        double lo = b == 0 ? -INFINITY : -4 + (b - 1) * 0.5;
+        double hi = b == 0 ? -4 : (b == BINS + 1 ? INFINITY : lo + 0.5);
+        double p = 0.5 * (erf(hi / sqrt(2.0)) - erf(lo / sqrt(2.0)));
+        char what[48];
+        snprintf(what, sizeof what, "frequency bin %d", b);
+        check_fraction(hist[b], n, p, what);
+    }
+    /* Mean power: the band mean of P_A = pi A B_nu(T). */
+    double mean = sum / (double)n, se = sqrt((sum2 / (double)n - mean * mean) / (double)n);
+    double expect = M_PI * band_planck(ch, 300);
+    printf("# mean power %.6e expected %.6e (%.1f se)\n", mean, expect, (mean - expect) / se);
+    assert_true(fabs(mean - expect) < 5 * se);
+    assert_float_equal(scene_band_emitted_power_w_per_hz(s, 0), expect, 1e-9 * expect);
+    emission_table_fini(&t);
+    scene_destroy(s);
+}
+
+static void test_source_fractions(void **state)
+{
+    (void)state;
+    uint64_t n = ps_scaled(400000);
+    thz_scene *s = ps_scene(0.35, 0.01, n, 4);
+    size_t grey = ps_material(s, 0.3, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t black = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t explicit = ps_material(s, 0.1, 50.0, 0.4, TRANSMISSION_DIFFUSE);
+    size_t kirchhoff = ps_material(s, 0.1, 200.0, -1.0, TRANSMISSION_DIFFUSE);
+    /* a: one-sided grey solid, 1 m2, 300 K; b: two-sided black, 0.5 m2, 200 K;
+     * c: shell with explicit eps 0.4, 0.25 m2, 350 K; d: Kirchhoff shell, 0.3 m2, 280 K;
+     * e: 0 K, 2 m2. */
+    size_t a = ps_object(s, OBJECT_SOLID, grey, 300, 0, false);
+    ps_face(s, a, v3(0, 0, 0), v3(0.5, 0, 0), v3(0, 0.5, 0));
+    size_t b = ps_object(s, OBJECT_SOLID, black, 200, 0, true);
+    ps_face(s, b, v3(2, 0, 0), v3(0.5, 0, 0), v3(0, 0.25, 0));
+    size_t c = ps_object(s, OBJECT_SHELL, explicit, 350, 1e-3, true);
+    ps_face(s, c, v3(4, 0, 0), v3(0.25, 0, 0), v3(0, 0.25, 0));
+    size_t d = ps_object(s, OBJECT_SHELL, kirchhoff, 280, 1e-3, true);
+    ps_face(s, d, v3(6, 0, 0), v3(0, 0.3, 0), v3(0, 0, 0.25));
+    size_t e0 = ps_object(s, OBJECT_SOLID, black, 0, 0, true);
+    ps_face(s, e0, v3(8, 0, 0), v3(1, 0, 0), v3(0, 0.5, 0));
+    ps_finalize(s);
+    const thz_channel *ch = &s->channels[0];
+    optics_point od = scene_object_optics(s, &s->objects[d], ch->center_hz);
+    double eps_d = optics_mean_emissivity(&od);
+    assert_true(eps_d > 0.05 && eps_d < 0.9 - 0.05);
+    double w[5] = {
+        M_PI * 0.7 * 1.0 * 1 * band_planck(ch, 300),
+        M_PI * 1.0 * 0.5 * 2 * band_planck(ch, 200),
+        M_PI * 0.4 * 0.25 * 2 * band_planck(ch, 350),
+        M_PI * eps_d * 0.3 * 2 * band_planck(ch, 280),
+        0.0,
+    };
+    double total = w[0] + w[1] + w[2] + w[3];
+    assert_float_equal(scene_band_emitted_power_w_per_hz(s, 0), total, 1e-6 * total);
+
+    emission_table t;
+    thz_error err;
+    assert_int_equal(emission_table_init(&t, s, 0, n, &err), THZ_OK);
+    assert_int_equal(t.n_sources, 4);
+    uint64_t count[5] = {0}, side1[5] = {0};
+    double scratch[5];
+    for (uint64_t i = 0; i < n; i++) {
+        rng_stream rng;
+        rng_init(&rng, 4, 0, RNG_PURPOSE_PHOTON, i);
+        emission_photon e;
+        assert_true(emission_sample(&t, &rng, scratch, &e));
+        count[e.object]++;
+        side1[e.object] += (uint64_t)e.side;
+        const thz_mesh *m = &s->objects[e.object].mesh;
+        const float *nf = &m->normals[3 * (size_t)e.triangle];
+        double cn = v3_dot(e.dir, v3(nf[0], nf[1], nf[2]));
+        assert_true(e.side == 0 ? cn > 0.0 : cn < 0.0); /* leaves its emitting side */
+        for (int k = 0; k < 3; k++) {
+            double x = k == 0 ? e.position_m.x : (k == 1 ? e.position_m.y : e.position_m.z);
+            assert_true(x >= m->bbox_min_m[k] - 1e-9 && x <= m->bbox_max_m[k] + 1e-9);
+        }
+    }
+    const char *names[5] = {"one-sided grey", "two-sided black", "explicit shell",
+                            "Kirchhoff shell", "0 K"};
+    for (int k = 0; k < 5; k++)
+        check_fraction(count[k], n, w[k] / total, names[k]);
+    assert_int_equal(side1[a], 0);
+    check_fraction(side1[b], count[b], 0.5, "two-sided: back side");
+    check_fraction(side1[c], count[c], 0.5, "shell: back side");
+    emission_table_fini(&t);
+    scene_destroy(s);
+}
+
+/* 2 int_lo^hi X(mu) mu dmu by composite Simpson, X = eps(mu) or 1. */
+static double eps_mass(const optics_point *o, double lo, double hi)
+{
+    const int n = 2000;
+    double h = (hi - lo) / n, s = 0.0;
+    for (int i = 0; i <= n; i++) {
+        double mu = lo + i * h;
+        double w = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2);
+        s += w * (o ? optics_emissivity(o, mu) : 1.0) * mu;
+    }
+    return 2.0 * s * h / 3.0;
+}
+
+/* Directions: eps(theta) cos(theta) for a Kirchhoff shell (tau = 0.05, cap 0.9: T
+ * reaches the cap at mu* = 0.47, above which eps = 0), cosine for a solid. */
+static void test_direction_distribution(void **state)
+{
+    (void)state;
+    for (int kind = 0; kind < 2; kind++) {
+        uint64_t n = ps_scaled(300000);
+        thz_scene *s = ps_scene(0.35, 0.01, n, 6);
+        size_t m = kind ? ps_material(s, 0.1, 50.0, -1.0, TRANSMISSION_DIFFUSE)
+                        : ps_material(s, 0.25, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+        size_t obj = ps_object(s, kind ? OBJECT_SHELL : OBJECT_SOLID, m, 300, 1e-3, false);
+        ps_face(s, obj, v3(0, 0, 0), v3(0.5, 0, 0), v3(0, 0.5, 0));
+        ps_finalize(s);
+        optics_point o = scene_object_optics(s, &s->objects[obj], s->channels[0].center_hz);
+        emission_table t;
+        thz_error err;
+        assert_int_equal(emission_table_init(&t, s, 0, n, &err), THZ_OK);
+        enum { BINS = 20 };
+        uint64_t hist[BINS] = {0};
+        double scratch[1];
+        for (uint64_t i = 0; i < n; i++) {
+            rng_stream rng;
+            rng_init(&rng, 6, 0, RNG_PURPOSE_PHOTON, i);
+            emission_photon e;
+            assert_true(emission_sample(&t, &rng, scratch, &e));
+            double mu = fabs(e.dir.z);
+            int b = (int)(mu * BINS);
+            hist[b < BINS ? b : BINS - 1]++;
+        }
+        double total = eps_mass(kind ? &o : NULL, 0, 1);
+        for (int b = 0; b < BINS; b++) {
+            double p = eps_mass(kind ? &o : NULL, (double)b / BINS, (double)(b + 1) / BINS) / total;
+            char what[48];
+            snprintf(what, sizeof what, "%s mu bin %d", kind ? "shell" : "solid", b);
+            check_fraction(hist[b], n, p, what);
+        }
+        emission_table_fini(&t);
+        scene_destroy(s);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_frequencies_follow_band),
+        cmocka_unit_test(test_source_fractions),
+        cmocka_unit_test(test_direction_distribution),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
