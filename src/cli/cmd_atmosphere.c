@@ -1,12 +1,485 @@
-/* thzmap atmosphere: not implemented yet. */
+/* thzmap atmosphere: alpha(nu) of an atmosphere model as CSV, and optionally a
+ * PLplot figure (attenuation in dB/km on a log axis against frequency in THz, with
+ * the channels of a scene marked). */
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
+#include <plplot.h>
+
+#include "atmosphere/atmosphere.h"
 #include "cli/cli.h"
+#include "core/alloc.h"
+#include "scene/scene.h"
+
+#define CMD "atmosphere"
+#define MAX_POINTS 10000000.0
+#define DB_PER_KM_PER_INV_M 4342.944819032518 /* 10 / ln 10 * 1000 */
+
+static void print_help(void)
+{
+    printf(
+        "usage: thzmap atmosphere --from-thz F1 --to-thz F2 --step-ghz S [options]\n"
+        "\n"
+        "Prints the atmosphere's attenuation alpha against frequency as CSV on standard\n"
+        "output: frequency_thz, attenuation_per_m (1/m), attenuation_db_per_km, the parts\n"
+        "per species in dB/km, and transmittance with --distance-m.\n"
+        "\n"
+        "options:\n"
+        "  --from-thz F1, --to-thz F2   frequency range in THz, both ends included\n"
+        "  --step-ghz S                 frequency step in GHz\n"
+        "  --model M                    lines (default), itu-p676 (1-1000 GHz), none\n"
+        "  --temperature-k T            air temperature in K (default 288.15)\n"
+        "  --pressure-hpa P             total pressure (dry air + water vapour) in hPa\n"
+        "                               (default 1013.25)\n"
+        "  --relative-humidity RH       0..1 over liquid water (ITU-R P.453-14), or\n"
+        "  --water-vapour-g-m3 RHO      water-vapour density in g/m^3 (default 7.5), or\n"
+        "  --h2o-vmr X                  water-vapour volume mixing ratio (of total air)\n"
+        "  --h2o-lines FILE             lines: H2O catalogue (am CSV or HITRAN .par)\n"
+        "  --o2-lines FILE              lines: uncoupled O2 catalogue (am CSV or .par)\n"
+        "  --no-continuum               lines: no MT_CKD continuum (full H2O line wings)\n"
+        "  --distance-m D               add the transmittance exp(-alpha D) of a D m path\n"
+        "  --plot FILE.png              also draw alpha in dB/km against THz (PLplot)\n"
+        "  --compare-model M            plot: overlay model M's total (same air)\n"
+        "  --scene SCENE.json           plot: mark the scene's channels; without --model\n"
+        "                               and air options, use the scene's atmosphere\n"
+        "  -h, --help                   this help\n");
+}
+
+typedef struct options {
+    double from_thz, to_thz, step_ghz;
+    bool have_from, have_to, have_step;
+    const char *model;
+    const char *compare_model;
+    double temperature_k, pressure_hpa;
+    atm_humidity_kind humidity_kind;
+    double humidity;
+    int n_humidity;
+    bool air_given;
+    const char *h2o_lines, *o2_lines;
+    bool no_continuum;
+    double distance_m;
+    bool have_distance;
+    const char *plot;
+    const char *scene;
+} options;
+
+static int parse_options(int argc, char **argv, options *o, bool *help)
+{
+    memset(o, 0, sizeof *o);
+    o->temperature_k = 288.15;
+    o->pressure_hpa = 1013.25;
+    o->humidity_kind = ATM_HUMIDITY_DENSITY_G_M3;
+    o->humidity = 7.5;
+    *help = false;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (cli_is_help(a)) {
+            *help = true;
+            return CLI_EXIT_OK;
+        }
+        if (strcmp(a, "--no-continuum") == 0) {
+            o->no_continuum = true;
+            continue;
+        }
+        static const char *const with_value[] = {
+            "--from-thz", "--to-thz", "--step-ghz", "--model", "--compare-model",
+            "--temperature-k", "--pressure-hpa", "--relative-humidity", "--water-vapour-g-m3",
+            "--h2o-vmr", "--h2o-lines", "--o2-lines", "--distance-m", "--plot", "--scene", NULL};
+        bool known = false;
+        for (size_t k = 0; with_value[k]; k++)
+            known = known || strcmp(a, with_value[k]) == 0;
+        if (!known)
+            return cli_usage_error(CMD, strncmp(a, "--", 2) == 0 ? "unknown option '%s'"
+                                                                  : "unexpected argument '%s'",
+                                   a);
+        if (i + 1 >= argc)
+            return cli_usage_error(CMD, "%s needs a value", a);
+        const char *v = argv[++i];
+        if (strcmp(a, "--from-thz") == 0) {
+            if (!cli_parse_double(CMD, a, v, 0.0, 1000.0, &o->from_thz))
+                return CLI_EXIT_USAGE;
+            o->have_from = true;
+        } else if (strcmp(a, "--to-thz") == 0) {
+            if (!cli_parse_double(CMD, a, v, 0.0, 1000.0, &o->to_thz))
+                return CLI_EXIT_USAGE;
+            o->have_to = true;
+        } else if (strcmp(a, "--step-ghz") == 0) {
+            if (!cli_parse_double(CMD, a, v, 1e-9, 1e6, &o->step_ghz))
+                return CLI_EXIT_USAGE;
+            o->have_step = true;
+        } else if (strcmp(a, "--model") == 0) {
+            o->model = v;
+        } else if (strcmp(a, "--compare-model") == 0) {
+            o->compare_model = v;
+        } else if (strcmp(a, "--temperature-k") == 0) {
+            if (!cli_parse_double(CMD, a, v, 0.0, 1e4, &o->temperature_k))
+                return CLI_EXIT_USAGE;
+            o->air_given = true;
+        } else if (strcmp(a, "--pressure-hpa") == 0) {
+            if (!cli_parse_double(CMD, a, v, 0.0, 1e5, &o->pressure_hpa))
+                return CLI_EXIT_USAGE;
+            o->air_given = true;
+        } else if (strcmp(a, "--relative-humidity") == 0 ||
+                   strcmp(a, "--water-vapour-g-m3") == 0 || strcmp(a, "--h2o-vmr") == 0) {
+            if (!cli_parse_double(CMD, a, v, 0.0, 1e6, &o->humidity))
+                return CLI_EXIT_USAGE;
+            o->humidity_kind = a[2] == 'r'   ? ATM_HUMIDITY_RELATIVE
+                               : a[2] == 'w' ? ATM_HUMIDITY_DENSITY_G_M3
+                                             : ATM_HUMIDITY_VMR;
+            o->n_humidity++;
+            o->air_given = true;
+        } else if (strcmp(a, "--h2o-lines") == 0) {
+            o->h2o_lines = v;
+        } else if (strcmp(a, "--o2-lines") == 0) {
+            o->o2_lines = v;
+        } else if (strcmp(a, "--distance-m") == 0) {
+            if (!cli_parse_double(CMD, a, v, 0.0, 1e9, &o->distance_m))
+                return CLI_EXIT_USAGE;
+            o->have_distance = true;
+        } else if (strcmp(a, "--plot") == 0) {
+            o->plot = v;
+        } else if (strcmp(a, "--scene") == 0) {
+            o->scene = v;
+        } else {
+            return cli_usage_error(CMD, "unknown option '%s'", a);
+        }
+    }
+    if (!o->have_from || !o->have_to || !o->have_step)
+        return cli_usage_error(CMD, "--from-thz, --to-thz and --step-ghz are required");
+    if (!(o->to_thz >= o->from_thz))
+        return cli_usage_error(CMD, "--to-thz (%g THz) must not be below --from-thz (%g THz)",
+                               o->to_thz, o->from_thz);
+    if (o->n_humidity > 1)
+        return cli_usage_error(CMD, "give only one of --relative-humidity, --water-vapour-g-m3, "
+                                    "--h2o-vmr");
+    if ((o->to_thz - o->from_thz) * 1e3 / o->step_ghz + 1.0 > MAX_POINTS)
+        return cli_usage_error(CMD, "more than %.0f frequencies; raise --step-ghz", MAX_POINTS);
+    if (o->compare_model && !o->plot)
+        return cli_usage_error(CMD, "--compare-model needs --plot");
+    return CLI_EXIT_OK;
+}
+
+/* Builds the atmosphere `name` from the options (air state, catalogues). */
+static thz_status build_model(const options *o, const char *name, thz_atmosphere *atm,
+                              thz_error *err)
+{
+    atm_model model;
+    memset(atm, 0, sizeof *atm);
+    if (!atmosphere_model_from_name(name, &model) ||
+        (model != ATM_LINES && model != ATM_ITU_P676 && model != ATM_NONE))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "atmosphere: unknown model '%s' (expected lines, itu-p676 or none; "
+                             "constant and table come from a scene)",
+                             name);
+    if (model == ATM_NONE)
+        return THZ_OK;
+    atm_air_state air;
+    thz_status st = atm_air_state_init(&air, o->temperature_k, o->pressure_hpa, o->humidity_kind,
+                                       o->humidity, err);
+    if (st != THZ_OK)
+        return st;
+    if (model == ATM_ITU_P676)
+        return atmosphere_init_itu_p676(atm, &air, NULL, err);
+    atm_lines_options lo;
+    atmosphere_lines_options_default(&lo);
+    lo.h2o_lines_file = o->h2o_lines;
+    lo.o2_lines_file = o->o2_lines;
+    lo.continuum = !o->no_continuum;
+    return atmosphere_init_lines(atm, &air, &lo, err);
+}
+
+typedef struct series {
+    size_t n;
+    double *f_thz;
+    double *total_db, *h2o_lines_db, *h2o_cont_db, *o2_db, *dry_db, *compare_db;
+} series;
+
+static void series_fini(series *s)
+{
+    free(s->f_thz);
+    free(s->total_db);
+    free(s->h2o_lines_db);
+    free(s->h2o_cont_db);
+    free(s->o2_db);
+    free(s->dry_db);
+    free(s->compare_db);
+}
+
+/* log10 of a dB/km value for the plot, floored at the axis bottom. */
+static double plot_log(double v, double floor_log)
+{
+    return v > 0.0 ? fmax(log10(v), floor_log) : floor_log;
+}
+
+static bool has_pngcairo(void)
+{
+    enum { MAX_DEVICES = 128 };
+    const char **menu = calloc(MAX_DEVICES, sizeof *menu);
+    const char **devs = calloc(MAX_DEVICES, sizeof *devs);
+    int n = MAX_DEVICES;
+    bool found = false;
+    if (menu && devs) {
+        plgDevs(&menu, &devs, &n);
+        for (int i = 0; i < n; i++)
+            if (devs[i] && strcmp(devs[i], "pngcairo") == 0)
+                found = true;
+    }
+    free(menu);
+    free(devs);
+    return found;
+}
+
+static void draw_curve(const series *s, const double *y_db, double floor_log, int colour,
+                       int style, double width, double *buf)
+{
+    for (size_t i = 0; i < s->n; i++)
+        buf[i] = plot_log(y_db[i], floor_log);
+    plcol0(colour);
+    pllsty(style);
+    plwidth(width);
+    plline((PLINT)s->n, s->f_thz, buf);
+}
+
+static int draw_plot(const options *o, const series *s, const thz_atmosphere *atm,
+                     const thz_scene *scene, const char *model_name)
+{
+    if (!has_pngcairo()) {
+        fprintf(stderr, "thzmap atmosphere: PLplot has no 'pngcairo' device; install "
+                        "plplot-driver-cairo to use --plot\n");
+        return CLI_EXIT_FAILURE;
+    }
+    double *buf = thz_malloc_array(s->n, sizeof *buf);
+    if (!buf) {
+        fprintf(stderr, "thzmap atmosphere: out of memory\n");
+        return CLI_EXIT_FAILURE;
+    }
+    double top = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        top = fmax(top, plot_log(s->total_db[i], -300));
+        if (s->compare_db)
+            top = fmax(top, plot_log(s->compare_db[i], -300));
+    }
+    if (!isfinite(top) || top < -5)
+        top = 0;
+    double y_hi = ceil(top + 0.3) + 2.0, y_lo = y_hi - 9.0; /* nine decades, two for the legend */
+    double x_lo = s->f_thz[0], x_hi = s->f_thz[s->n - 1];
+    if (x_hi <= x_lo)
+        x_hi = x_lo + 1e-3;
+
+    plsdev("pngcairo");
+    plsfnam(o->plot);
+    plspage(0, 0, 1200, 750, 0, 0);
+    plscolbg(255, 255, 255);
+    plscol0(0, 255, 255, 255); /* background */
+    plscol0(1, 0, 0, 0);       /* axes, total */
+    plscol0(2, 31, 119, 180);  /* H2O lines */
+    plscol0(3, 44, 160, 44);   /* H2O continuum */
+    plscol0(4, 214, 39, 40);   /* O2 */
+    plscol0(5, 148, 103, 189); /* dry continuum */
+    plscol0(6, 255, 127, 14);  /* comparison */
+    plscol0(7, 150, 150, 150); /* channels */
+    plinit();
+    plschr(0, 1.1);
+    plcol0(1);
+    plenv(x_lo, x_hi, y_lo, y_hi, 0, 20);
+    char title[256];
+    const atm_air_state *air = &atm->air;
+    if (atm->has_air)
+        snprintf(title, sizeof title,
+                 "atmosphere '%s': %.2f K, %.1f hPa, water vapour %.2f g/m#u3#d", model_name,
+                 air->temperature_k, air->pressure_hpa, atm_air_h2o_density_g_m3(air));
+    else
+        snprintf(title, sizeof title, "atmosphere '%s'", model_name);
+    pllab("frequency (THz)", "attenuation (dB/km)", title);
+
+    if (scene) {
+        for (size_t c = 0; c < scene->n_channels; c++) {
+            const thz_channel *ch = &scene->channels[c];
+            double fc = ch->center_hz * 1e-12, half = 0.5 * ch->relative_width * fc;
+            if (fc < x_lo || fc > x_hi)
+                continue;
+            PLFLT bx[4] = {fc - half, fc + half, fc + half, fc - half};
+            PLFLT by[4] = {y_lo, y_lo, y_hi, y_hi};
+            plscol0a(8, 200, 200, 200, 0.35);
+            plcol0(8);
+            plfill(4, bx, by);
+            plcol0(7);
+            pllsty(2);
+            plwidth(1.0);
+            PLFLT lx[2] = {fc, fc}, ly[2] = {y_lo, y_hi};
+            plline(2, lx, ly);
+            plptex(fc, y_hi - 0.25, 0.0, 1.0, 1.05, ch->name);
+        }
+    }
+
+    const char *texts[6];
+    PLINT colours[6], styles[6], opts[6];
+    PLFLT widths[6];
+    int n_legend = 0;
+#define LEGEND(text_, colour_, style_, width_)                                                     \
+    do {                                                                                           \
+        texts[n_legend] = (text_);                                                                 \
+        colours[n_legend] = (colour_);                                                             \
+        styles[n_legend] = (style_);                                                               \
+        widths[n_legend] = (width_);                                                               \
+        opts[n_legend] = PL_LEGEND_LINE;                                                           \
+        n_legend++;                                                                                \
+    } while (0)
+    if (atm->model == ATM_LINES || atm->model == ATM_ITU_P676) {
+        draw_curve(s, s->h2o_lines_db, y_lo, 2, 1, 1.0, buf);
+        LEGEND(atm->model == ATM_LINES ? "H#d2#uO lines" : "H#d2#uO", 2, 1, 1.0);
+        if (atm->model == ATM_LINES) {
+            draw_curve(s, s->h2o_cont_db, y_lo, 3, 1, 1.0, buf);
+            LEGEND("H#d2#uO continuum (MT_CKD)", 3, 1, 1.0);
+        }
+        draw_curve(s, s->o2_db, y_lo, 4, 1, 1.0, buf);
+        LEGEND("O#d2#u", 4, 1, 1.0);
+        draw_curve(s, s->dry_db, y_lo, 5, 1, 1.0, buf);
+        LEGEND("dry-air continuum", 5, 1, 1.0);
+    }
+    static char total_text[96], compare_text[96];
+    snprintf(total_text, sizeof total_text, "total, %s", model_name);
+    draw_curve(s, s->total_db, y_lo, 1, 1, 2.0, buf);
+    LEGEND(total_text, 1, 1, 2.0);
+    if (s->compare_db) {
+        snprintf(compare_text, sizeof compare_text, "total, %s", o->compare_model);
+        draw_curve(s, s->compare_db, y_lo, 6, 2, 2.0, buf);
+        LEGEND(compare_text, 6, 2, 2.0);
+    }
+#undef LEGEND
+    PLFLT legend_w, legend_h;
+    PLINT box_colours[6] = {0}, box_patterns[6] = {0}, symbol_colours[6] = {0};
+    PLFLT box_scales[6] = {0}, box_widths[6] = {0}, symbol_scales[6] = {0};
+    PLINT symbol_numbers[6] = {0};
+    const char *symbols[6] = {"", "", "", "", "", ""};
+    pllsty(1);
+    plwidth(1.0);
+    pllegend(&legend_w, &legend_h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+             PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.02, 0.02, 0.1, 0, 1,
+             1, 3, 2, n_legend, opts, 1.0, 0.75, 2.0, 1.0, colours, texts, box_colours,
+             box_patterns, box_scales, box_widths, colours, styles, widths, symbol_colours,
+             symbol_scales, symbol_numbers, symbols);
+    plend();
+    free(buf);
+    return CLI_EXIT_OK;
+}
 
 int cmd_atmosphere(int argc, char **argv)
 {
-    (void)argc;
-    (void)argv;
-    fprintf(stderr, "thzmap atmosphere: not implemented yet\n");
-    return CLI_EXIT_FAILURE;
+    options o;
+    bool help;
+    int rc = parse_options(argc, argv, &o, &help);
+    if (rc != CLI_EXIT_OK || help) {
+        if (help)
+            print_help();
+        return rc;
+    }
+    thz_error err = {0};
+    thz_scene *scene = NULL;
+    thz_atmosphere own = {0}, compare = {0};
+    const thz_atmosphere *atm = &own;
+    const char *model_name = o.model ? o.model : "lines";
+    series s = {0};
+    FILE *out = stdout;
+    if (o.scene && scene_load(o.scene, &scene, &err) != THZ_OK) {
+        rc = cli_fail(&err);
+        goto cleanup;
+    }
+    if (scene && !o.model && !o.air_given) {
+        atm = &scene->atmosphere;
+        model_name = atmosphere_model_name(atm->model);
+    } else if (build_model(&o, model_name, &own, &err) != THZ_OK) {
+        rc = cli_fail(&err);
+        goto cleanup;
+    }
+    if (o.compare_model && build_model(&o, o.compare_model, &compare, &err) != THZ_OK) {
+        rc = cli_fail(&err);
+        goto cleanup;
+    }
+    double lo_hz = o.from_thz * 1e12, hi_hz = o.to_thz * 1e12;
+    if (atmosphere_check_range(atm, lo_hz, hi_hz, "--from-thz/--to-thz", &err) != THZ_OK ||
+        (o.compare_model &&
+         atmosphere_check_range(&compare, lo_hz, hi_hz, "--from-thz/--to-thz", &err) != THZ_OK)) {
+        rc = cli_fail(&err);
+        goto cleanup;
+    }
+
+    double step_thz = o.step_ghz * 1e-3;
+    size_t n = (size_t)floor((o.to_thz - o.from_thz) / step_thz * (1.0 + 1e-12)) + 1;
+    bool add_end = o.from_thz + (double)(n - 1) * step_thz < o.to_thz * (1.0 - 1e-12);
+    s.n = n + (add_end ? 1 : 0);
+    s.f_thz = thz_malloc_array(s.n, sizeof *s.f_thz);
+    s.total_db = thz_malloc_array(s.n, sizeof *s.total_db);
+    s.h2o_lines_db = thz_malloc_array(s.n, sizeof *s.h2o_lines_db);
+    s.h2o_cont_db = thz_malloc_array(s.n, sizeof *s.h2o_cont_db);
+    s.o2_db = thz_malloc_array(s.n, sizeof *s.o2_db);
+    s.dry_db = thz_malloc_array(s.n, sizeof *s.dry_db);
+    if (o.compare_model)
+        s.compare_db = thz_malloc_array(s.n, sizeof *s.compare_db);
+    if (!s.f_thz || !s.total_db || !s.h2o_lines_db || !s.h2o_cont_db || !s.o2_db || !s.dry_db ||
+        (o.compare_model && !s.compare_db)) {
+        fprintf(stderr, "thzmap atmosphere: out of memory\n");
+        rc = CLI_EXIT_FAILURE;
+        goto cleanup;
+    }
+
+    if (atm->has_air)
+        fprintf(out,
+                "# thzmap atmosphere: model %s; air %.2f K, %.2f hPa total, water vapour %.4g hPa "
+                "(%.4g g/m^3, volume mixing ratio %.4g)\n",
+                model_name, atm->air.temperature_k, atm->air.pressure_hpa,
+                atm->air.h2o_pressure_hpa, atm_air_h2o_density_g_m3(&atm->air),
+                atm_air_h2o_vmr(&atm->air));
+    else
+        fprintf(out, "# thzmap atmosphere: model %s\n", model_name);
+    fprintf(out, "frequency_thz,attenuation_per_m,attenuation_db_per_km");
+    if (atm->model == ATM_LINES)
+        fprintf(out, ",h2o_lines_db_per_km,h2o_continuum_db_per_km,o2_db_per_km,"
+                     "dry_continuum_db_per_km");
+    else if (atm->model == ATM_ITU_P676)
+        fprintf(out, ",h2o_db_per_km,o2_db_per_km,dry_continuum_db_per_km");
+    if (o.have_distance)
+        fprintf(out, ",transmittance");
+    fprintf(out, "\n");
+
+    for (size_t i = 0; i < s.n; i++) {
+        double f_thz = i < n ? o.from_thz + (double)i * step_thz : o.to_thz;
+        double f_hz = f_thz * 1e12;
+        atm_alpha_parts p;
+        atmosphere_alpha_parts(atm, f_hz, &p);
+        double alpha = p.h2o_lines_per_m + p.h2o_continuum_per_m + p.o2_per_m +
+                       p.dry_continuum_per_m + p.other_per_m;
+        s.f_thz[i] = f_thz;
+        s.total_db[i] = alpha * DB_PER_KM_PER_INV_M;
+        s.h2o_lines_db[i] = p.h2o_lines_per_m * DB_PER_KM_PER_INV_M;
+        s.h2o_cont_db[i] = p.h2o_continuum_per_m * DB_PER_KM_PER_INV_M;
+        s.o2_db[i] = p.o2_per_m * DB_PER_KM_PER_INV_M;
+        s.dry_db[i] = p.dry_continuum_per_m * DB_PER_KM_PER_INV_M;
+        if (s.compare_db)
+            s.compare_db[i] = atmosphere_alpha_direct_per_m(&compare, f_hz) * DB_PER_KM_PER_INV_M;
+        fprintf(out, "%.9g,%.6e,%.6e", f_thz, alpha, s.total_db[i]);
+        if (atm->model == ATM_LINES)
+            fprintf(out, ",%.6e,%.6e,%.6e,%.6e", s.h2o_lines_db[i], s.h2o_cont_db[i], s.o2_db[i],
+                    s.dry_db[i]);
+        else if (atm->model == ATM_ITU_P676)
+            fprintf(out, ",%.6e,%.6e,%.6e", s.h2o_lines_db[i], s.o2_db[i], s.dry_db[i]);
+        if (o.have_distance)
+            fprintf(out, ",%.6e", exp(-alpha * o.distance_m));
+        fprintf(out, "\n");
+    }
+    if (fflush(out) != 0 || ferror(out)) {
+        fprintf(stderr, "thzmap atmosphere: error writing standard output\n");
+        rc = CLI_EXIT_FAILURE;
+        goto cleanup;
+    }
+    if (o.plot)
+        rc = draw_plot(&o, &s, atm, scene, model_name);
+cleanup:
+    series_fini(&s);
+    atmosphere_fini(&own);
+    atmosphere_fini(&compare);
+    scene_destroy(scene);
+    return rc;
 }

@@ -1,0 +1,93 @@
+#!/bin/bash
+# thzmap atmosphere: CSV columns and rows, the transmittance column, agreement of
+# itu-p676 with an ITU-R validation value, the plot, scene channels, and exit
+# status 2 with a message for bad options.
+# argv: thzmap binary, repository directory.
+set -u
+THZ="$1"
+REPO="$2"
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+"$THZ" atmosphere --help > "$TMP/help" || fail "--help exit status $?"
+grep -q -- "--from-thz" "$TMP/help" || fail "--help does not describe --from-thz"
+
+# 0.1 to 0.2 THz in 10 GHz steps, both ends included: 11 rows
+"$THZ" atmosphere --from-thz 0.1 --to-thz 0.2 --step-ghz 10 --distance-m 100 > "$TMP/a.csv" \
+    || fail "lines run exit status $?"
+grep -v '^#' "$TMP/a.csv" > "$TMP/a.data"
+head -1 "$TMP/a.data" | grep -qx "frequency_thz,attenuation_per_m,attenuation_db_per_km,h2o_lines_db_per_km,h2o_continuum_db_per_km,o2_db_per_km,dry_continuum_db_per_km,transmittance" \
+    || fail "unexpected header: $(head -1 "$TMP/a.data")"
+[ "$(tail -n +2 "$TMP/a.data" | wc -l)" -eq 11 ] || fail "expected 11 rows"
+tail -n +2 "$TMP/a.data" | awk -F, '
+    NR == 1 && $1 != 0.1 { print "first frequency " $1; bad = 1 }
+    NR == 11 && $1 != 0.2 { print "last frequency " $1; bad = 1 }
+    { if ($2 <= 0 || $8 <= 0 || $8 >= 1) { print "bad row " $0; bad = 1 }
+      # dB/km = 4342.94 * (1/m); transmittance = exp(-alpha d)
+      if ((($3 / ($2 * 4342.944819)) - 1)^2 > 1e-10) { print "dB/km mismatch " $0; bad = 1 }
+      if ((($8 / exp(-$2 * 100)) - 1)^2 > 1e-10) { print "transmittance mismatch " $0; bad = 1 }
+      s = $4 + $5 + $6 + $7; if (((s / $3) - 1)^2 > 1e-8) { print "parts do not add up " $0; bad = 1 } }
+    END { exit bad }' || fail "CSV content"
+
+# itu-p676 at 100 GHz against the ITU-R validation value (1013.25 hPa dry air,
+# 288.15 K, 7.5 g/m^3): total pressure 1013.25 + 7.5 * 288.15 / 216.7 hPa
+P=$(awk 'BEGIN { printf "%.10f", 1013.25 + 7.5 * 288.15 / 216.7 }')
+REF=$(awk -F, '!/^#/ && $1 == 100 { print $7 }' "$REPO/data/atmosphere/itu_r_p676_13_specific_attenuation_validation.csv")
+GOT=$("$THZ" atmosphere --model itu-p676 --from-thz 0.1 --to-thz 0.1 --step-ghz 1 \
+      --temperature-k 288.15 --pressure-hpa "$P" --water-vapour-g-m3 7.5 | grep -v '^#' | tail -1 | cut -d, -f3)
+awk -v a="$GOT" -v b="$REF" 'BEGIN { exit !((a / b - 1)^2 < 1e-6) }' \
+    || fail "itu-p676 at 100 GHz: $GOT dB/km, ITU-R validation $REF dB/km"
+
+# the plot (skipped if PLplot's pngcairo device is missing, which the command reports)
+if "$THZ" atmosphere --from-thz 0.2 --to-thz 0.5 --step-ghz 1 --plot "$TMP/a.png" \
+       --compare-model itu-p676 > /dev/null 2> "$TMP/err"; then
+    head -c 8 "$TMP/a.png" | od -An -c | grep -q "P   N   G" || fail "--plot did not write a PNG"
+else
+    grep -q pngcairo "$TMP/err" || fail "--plot failed: $(cat "$TMP/err")"
+fi
+
+# a scene's channels on the plot; without --model the scene's atmosphere is used
+cat > "$TMP/scene.json" <<'JSON'
+{
+  "format": "thzmap-scene/1",
+  "channels": [{"name": "0.35 THz", "frequency_thz": 0.35, "relative_width": 0.05}],
+  "materials": {"wall": {"reflectivity": 0.0}},
+  "atmosphere": {"model": "constant", "attenuation_per_m": 0.05},
+  "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+               "shape": {"type": "box", "size_m": [1, 1, 1], "inward": true}}],
+  "sensors": [{"name": "cam", "position_m": [0, 0, 0], "look_at_m": [1, 0, 0],
+               "fov_deg": 40, "resolution": [4, 4]}]
+}
+JSON
+"$THZ" atmosphere --scene "$TMP/scene.json" --from-thz 0.3 --to-thz 0.4 --step-ghz 50 > "$TMP/s.csv" \
+    || fail "--scene run exit status $?"
+grep -v '^#' "$TMP/s.csv" | head -1 | grep -qx "frequency_thz,attenuation_per_m,attenuation_db_per_km" \
+    || fail "scene atmosphere header: $(cat "$TMP/s.csv")"
+grep -v '^#' "$TMP/s.csv" | tail -1 | grep -q "^0.4,5.000000e-02," || fail "scene constant alpha"
+if "$THZ" atmosphere --scene "$TMP/scene.json" --model lines --from-thz 0.3 --to-thz 0.4 \
+       --step-ghz 1 --plot "$TMP/s.png" > /dev/null 2> "$TMP/err"; then
+    [ -s "$TMP/s.png" ] || fail "--scene --plot wrote no PNG"
+else
+    grep -q pngcairo "$TMP/err" || fail "--scene --plot failed: $(cat "$TMP/err")"
+fi
+
+# bad usage: exit 2 and a message naming the problem
+expect_usage() {
+    local pattern="$1"; shift
+    "$THZ" atmosphere "$@" > /dev/null 2> "$TMP/err"
+    local rc=$?
+    [ $rc -eq 2 ] || fail "'$*' exit status $rc, expected 2"
+    grep -q -- "$pattern" "$TMP/err" || fail "'$*' message lacks '$pattern': $(cat "$TMP/err")"
+}
+expect_usage "required" --from-thz 0.1
+expect_usage "step-ghz" --from-thz 0.1 --to-thz 0.2 --step-ghz 0
+expect_usage "must not be below" --from-thz 0.3 --to-thz 0.2 --step-ghz 1
+expect_usage "unknown option '--bogus'" --bogus 1
+expect_usage "unknown model 'foo'" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --model foo
+expect_usage "not per cent" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --relative-humidity 50
+expect_usage "only one of" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --relative-humidity 0.5 --h2o-vmr 0.01
+expect_usage "range of atmosphere model 'itu-p676'" --from-thz 0.9 --to-thz 1.2 --step-ghz 1 --model itu-p676
+expect_usage "no-such.par" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --h2o-lines "$TMP/no-such.par"
+expect_usage "temperature" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --temperature-k 20
+echo "ok"
