@@ -1,12 +1,12 @@
 /* The numeric CSV reader. */
 #include "scene/csv.h"
 
-#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "core/alloc.h"
 
@@ -186,6 +186,9 @@ thz_status csv_read(const char *path, const char *label, csv_table *t, thz_error
     const char *name = label ? label : path;
     thz_status st = THZ_OK;
     char *text = NULL;
+    struct stat info;
+    if (stat(path, &info) == 0 && S_ISDIR(info.st_mode))
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: is a directory, expected a CSV file", name);
     FILE *f = fopen(path, "rb");
     if (!f)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open: %s", name, strerror(errno));

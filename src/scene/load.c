@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "core/alloc.h"
 #include "core/vec3.h"
@@ -953,6 +954,9 @@ thz_status scene_load(const char *path, thz_scene **out, thz_error *err)
 {
     *out = NULL;
     thz_error_clear(err);
+    struct stat info;
+    if (stat(path, &info) == 0 && S_ISDIR(info.st_mode))
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: is a directory, expected a scene file", path);
     FILE *f = fopen(path, "rb");
     if (!f)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open scene file: %s", path,

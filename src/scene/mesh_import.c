@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
@@ -148,6 +149,9 @@ thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_
     const char *name = label ? label : path;
     thz_status st = THZ_OK;
     memset(mesh, 0, sizeof *mesh);
+    struct stat info;
+    if (stat(path, &info) == 0 && S_ISDIR(info.st_mode))
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: is a directory, expected a mesh file", name);
     FILE *probe = fopen(path, "rb");
     if (!probe)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open mesh file: %s", name,
