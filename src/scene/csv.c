@@ -100,7 +100,7 @@ static thz_status csv_parse_row(csv_table *t, char *line, size_t line_no, double
         char *end = NULL;
         errno = 0;
         double v = strtod(text, &end);
-        if (!text[0] || *end || errno == ERANGE || !isfinite(v))
+        if (!text[0] || *end || (errno == ERANGE && fabs(v) == HUGE_VAL) || !isfinite(v))
             return thz_error_set(err, THZ_ERR_INPUT,
                                  "%s:%zu: row %zu, column '%s': expected a finite number, got '%s'",
                                  t->label, line_no, row_no, t->names[c], text);

@@ -72,6 +72,8 @@ static void test_parse_text(void **state)
     assert_int_equal(csv_parse("a,b\n1,nan\n", "mem", &t, &err), THZ_ERR_INPUT);
     assert_non_null(strstr(err.message, "mem:2:"));
     assert_int_equal(csv_parse("a,b\n1,1e999\n", "mem", &t, &err), THZ_ERR_INPUT);
+    assert_int_equal(csv_parse("a,b\n1,1e-400\n", "mem", &t, &err), THZ_OK); /* underflow: 0 */
+    csv_fini(&t);
     assert_int_equal(csv_parse("a,a\n1,2\n", "mem", &t, &err), THZ_ERR_INPUT);
     assert_non_null(strstr(err.message, "twice"));
     assert_int_equal(csv_parse("a,\n1,2\n", "mem", &t, &err), THZ_ERR_INPUT);
