@@ -79,6 +79,7 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
         .object = e->object, .triangle = e->triangle, .position_m = e->position_m, .side = e->side};
     vec3 dir = e->dir;
     vec3 origin = accel_offset_origin(acc, &from, dir);
+    vec3 surface = e->position_m; /* the un-offset point the free path starts from */
     uint32_t ignore_obj = e->object, ignore_tri = e->triangle;
 
     for (uint32_t bounce = 0;; bounce++) {
@@ -93,7 +94,9 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
             c->escaped_power += power;
             return true;
         }
-        double tr = atmosphere_transmittance(&scene->atmosphere, nu, hit.distance_m);
+        /* The free path runs from the surface point, not from the offset origin. */
+        double d = v3_length(v3_sub(hit.position_m, surface));
+        double tr = atmosphere_transmittance(&scene->atmosphere, nu, d);
         c->atmosphere_power += power * (1.0 - tr);
         power *= tr;
         if (power < w_min) {
@@ -149,6 +152,7 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
             return true;
         }
         origin = accel_offset_origin(acc, &hit, dir);
+        surface = hit.position_m;
         ignore_obj = hit.object;
         ignore_tri = hit.triangle;
     }

@@ -1,0 +1,117 @@
+/* Energy balance of the photon phase: absorbed + escaped + atmosphere + terminated power
+ * equals the power fired (exactly, up to rounding), the power fired equals the band-mean
+ * emitted power P_A within its statistical error, and the counts close (every hit is
+ * reflected, transmitted or absorbed; every path ends absorbed, escaped or terminated).
+ * Scenes: the closed box scene with every kind of surface and an atmosphere, and an open
+ * one (a plate and a shell in free space) where photons escape. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include <cmocka.h>
+
+#include "accel/accel.h"
+#include "photon/phase.h"
+#include "photon_scenes.h"
+
+typedef struct moment_ctx {
+    const thz_scene *scene;
+    int power; /* 1: P_A(nu), 2: P_A(nu)^2 */
+} moment_ctx;
+
+static double moment_at(double freq_hz, void *ctx)
+{
+    const moment_ctx *m = ctx;
+    double p = scene_emitted_power_w_per_hz(m->scene, freq_hz);
+    return m->power == 2 ? p * p : p;
+}
+
+static void check_balance(thz_scene *s, const char *name)
+{
+    accel *acc;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    photon_map *map;
+    photon_stats st;
+    photon_phase_options opt = {.threads = 2};
+    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+    uint64_t k = s->photons.per_channel;
+
+    /* Counts. */
+    assert_int_equal(st.fired, k);
+    assert_int_equal(st.stored, photon_map_count(map));
+    assert_int_equal(st.hits, st.stored);
+    assert_int_equal(st.hits, st.reflected + st.transmitted + st.absorbed);
+    assert_int_equal(st.fired, st.absorbed + st.escaped + st.terminated);
+    assert_int_equal(st.bounce_capped, 0);
+    assert_float_equal(st.mean_bounces, (double)st.hits / (double)k, 1e-12);
+
+    /* Exact balance of what was fired. */
+    double out = st.absorbed_power_w_per_hz + st.escaped_power_w_per_hz +
+                 st.atmosphere_power_w_per_hz + st.terminated_power_w_per_hz;
+    printf("# %s: fired %.6e = absorbed %.6e + escaped %.6e + atmosphere %.6e + terminated "
+           "%.3e (%.2e relative); %.2f hits per photon\n",
+           name, st.fired_power_w_per_hz, st.absorbed_power_w_per_hz, st.escaped_power_w_per_hz,
+           st.atmosphere_power_w_per_hz, st.terminated_power_w_per_hz,
+           out / st.fired_power_w_per_hz - 1, st.mean_bounces);
+    assert_float_equal(out, st.fired_power_w_per_hz, 1e-9 * st.fired_power_w_per_hz);
+
+    /* Fired vs emitted: the photons' powers P_A(nu_i)/K have the band's mean and variance;
+     * their sum's standard error follows from the band moments of P_A. */
+    moment_ctx m1 = {s, 1}, m2 = {s, 2};
+    double mean = channel_band_mean(&s->channels[0], moment_at, &m1);
+    double var = channel_band_mean(&s->channels[0], moment_at, &m2) - mean * mean;
+    double se = sqrt(fmax(var, 0.0) / (double)k) + 1e-12 * mean;
+    assert_float_equal(st.emitted_power_w_per_hz, mean, 1e-12 * mean);
+    printf("# %s: fired %.8e emitted %.8e (%.1f se)\n", name, st.fired_power_w_per_hz, mean,
+           (st.fired_power_w_per_hz - mean) / se);
+    assert_true(fabs(st.fired_power_w_per_hz - mean) < 5 * se);
+
+    /* The terminated power is zero in expectation: each low-power roulette decision
+     * (at most one per hit or termination) moves at most w_min = min_relative_power * Phi
+     * (Phi within a factor 2 of its mean in these bands), so the sum stays within
+     * 5 w_min sqrt(decisions); a plain cut-off would lose about terminated * w_min / 2. */
+    double w_min = 2.0 * s->photons.min_relative_power * mean / (double)k;
+    printf("# %s: %llu terminated, net terminated power %.3e (bound %.3e)\n", name,
+           (unsigned long long)st.terminated, st.terminated_power_w_per_hz,
+           5 * w_min * sqrt((double)(st.terminated + st.hits)));
+    assert_true(fabs(st.terminated_power_w_per_hz) <=
+                5 * w_min * sqrt((double)(st.terminated + st.hits)));
+    photon_map_destroy(map);
+    accel_destroy(acc);
+}
+
+static void test_closed_box(void **state)
+{
+    (void)state;
+    thz_scene *s = ps_box_scene(ps_scaled(200000), 21, 0.4);
+    s->channels[0].relative_width = 0.3; /* wide: the fired power varies with nu */
+    check_balance(s, "box");
+    scene_destroy(s);
+}
+
+static void test_open_scene(void **state)
+{
+    (void)state;
+    thz_scene *s = ps_scene(0.6, 0.05, ps_scaled(200000), 22);
+    size_t grey = ps_material(s, 0.4, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t cloth = ps_material(s, 0.1, 150.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t plate = ps_object(s, OBJECT_SOLID, grey, 305, 0, false);
+    ps_face(s, plate, v3(0, 0, 0), v3(0.5, 0, 0), v3(0, 0.5, 0));
+    size_t shell = ps_object(s, OBJECT_SHELL, cloth, 280, 2e-3, true);
+    ps_box(s, shell, v3(-0.3, -0.3, 0.1), v3(0.3, 0.3, 0.5), false);
+    ps_finalize(s);
+    check_balance(s, "open");
+    scene_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_closed_box),
+        cmocka_unit_test(test_open_scene),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
