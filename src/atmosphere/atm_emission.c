@@ -52,7 +52,10 @@ double atmosphere_path_radiance(const thz_atmosphere *atm, double freq_hz, doubl
 {
     if (!atm->emitting)
         return 0.0;
-    double tau = atmosphere_alpha_per_m(atm, freq_hz) * distance_m;
+    double alpha = atmosphere_alpha_per_m(atm, freq_hz);
+    if (alpha <= 0.0)
+        return 0.0; /* also avoids 0 * infinity */
+    double tau = alpha * distance_m;
     return planck_radiance(freq_hz, atm->air.temperature_k) * -expm1(-tau);
 }
 
@@ -96,9 +99,8 @@ double atmosphere_escape_radiance(const thz_atmosphere *atm, double freq_hz, dou
 {
     if (!atm->emitting)
         return 0.0;
-    double t = atmosphere_transmittance(atm, freq_hz, distance_m);
-    if (isinf(distance_m) && atmosphere_alpha_per_m(atm, freq_hz) <= 0.0)
-        t = 1.0;
+    double alpha = atmosphere_alpha_per_m(atm, freq_hz);
+    double t = alpha <= 0.0 ? 1.0 : exp(-alpha * distance_m);
     return planck_radiance(freq_hz, atm->background_temperature_k) * t +
            planck_radiance(freq_hz, atm->air.temperature_k) * (1.0 - t);
 }
