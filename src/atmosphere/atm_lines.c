@@ -21,9 +21,9 @@
  *
  * Units inside: frequencies in GHz, pressures in hPa (= mbar), number densities in
  * cm^-3, S in cm^2 GHz (HITRAN cm/molecule times 29.9792458), alpha in 1/cm until
- * the end. Lines weaker than LINE_MIN_RELATIVE times the strongest line of their
- * species (at the air's temperature) are dropped: at its own centre such a line adds
- * less than 1e-7 of the continuum there (docs/atmosphere.md).
+ * the end. Uncoupled O2 lines weaker than LINE_MIN_RELATIVE times the strongest
+ * O2 line (at the air's temperature) are dropped (3069 of 9597 lines are kept);
+ * this changes alpha by < 1e-7 relative at 1 GHz - 3 THz even in dry air.
  */
 #include <ctype.h>
 #include <errno.h>
@@ -462,8 +462,11 @@ static thz_status species_build(lbl_species *sp, const raw_catalog *cat, const p
     size_t n = 0;
     for (size_t i = 0; i < cat->n; i++) {
         const raw_line *l = &cat->lines[i];
-        /* coupled lines are few and include the Debye pseudo-line, tiny in S */
-        if (shape != SHAPE_COUPLED && (s_t[i] < LINE_MIN_RELATIVE * s_max || s_t[i] <= 0.0))
+        /* Only uncoupled O2 lines are thinned: every H2O line is kept (weak
+         * low-frequency HDO lines carry ~1 % of alpha below 10 GHz, and the 750 GHz
+         * cut-off bounds the cost anyway); coupled lines are few and include the
+         * Debye pseudo-line, tiny in S. */
+        if (shape == SHAPE_GROSS && (s_t[i] < LINE_MIN_RELATIVE * s_max || s_t[i] <= 0.0))
             continue;
         lbl_line *o = &sp->lines[n++];
         o->amp = n_cm3 * s_t[i] / M_PI;
