@@ -293,6 +293,7 @@ typedef struct pmf_reader {
     uint8_t *in;
     size_t in_cap, in_pos, in_size;
     bool eof;
+    bool frame_done; /* the current frame was completed (checksum verified) */
 } pmf_reader;
 
 static thz_status pmf_corrupt(const pmf_reader *r, const char *why, thz_error *err)
@@ -340,6 +341,7 @@ static thz_status pmf_read(pmf_reader *r, void *dst, size_t n, thz_error *err)
             return pmf_zstd_error(r, ret, err);
         if (ret == 0 && out.pos < n)
             return pmf_corrupt(r, "a section is shorter than its header says", err);
+        r->frame_done = ret == 0;
     }
     return THZ_OK;
 }
@@ -347,6 +349,11 @@ static thz_status pmf_read(pmf_reader *r, void *dst, size_t n, thz_error *err)
 /* Finishes the current frame, which must hold no more data (checks its checksum). */
 static thz_status pmf_end_frame(pmf_reader *r, thz_error *err)
 {
+    /* Once a frame is done, zstd would start decoding the next one. */
+    if (r->frame_done) {
+        r->frame_done = false;
+        return THZ_OK;
+    }
     for (;;) {
         thz_status st = pmf_fill(r, err);
         if (st != THZ_OK)
@@ -474,12 +481,19 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
                            path, scene->path ? scene->path : "this scene");
         goto cleanup;
     }
-    if (get_u64(header + 16) != h.channels || file_nc != nc) {
+    if (file_nc != nc) {
         st = thz_error_set(err, THZ_ERR_INPUT,
                            "photon map %s was made from another channel set (%llu channels; %s has "
-                           "%zu or different ones); run `thzmap simulate` on this scene",
+                           "%zu); run `thzmap simulate` on this scene",
                            path, (unsigned long long)file_nc,
                            scene->path ? scene->path : "this scene", nc);
+        goto cleanup;
+    }
+    if (get_u64(header + 16) != h.channels) {
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "photon map %s was made from another channel set (frequencies or widths "
+                           "differ from %s); run `thzmap simulate` on this scene",
+                           path, scene->path ? scene->path : "this scene");
         goto cleanup;
     }
     if (get_u64(header + 8) != h.optics) {

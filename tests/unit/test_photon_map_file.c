@@ -1,0 +1,234 @@
+/* photon-map.thzpm: write + read gives the same maps and stats, and read + write
+ * reproduces the file byte for byte; corrupted (one byte flipped), truncated, foreign
+ * and mismatched (another geometry, channel set or temperatures) files are refused with
+ * messages that name the file and say what is wrong. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "../physics/photon_scenes.h"
+#include "accel/accel.h"
+#include "io/photon_map_file.h"
+#include "photon/phase.h"
+
+typedef struct fixture {
+    char dir[64];
+    char path[128];
+    thz_scene *scene;
+    photon_map *maps[2];
+    photon_stats stats[2];
+} fixture;
+
+static thz_scene *two_channel_scene(void)
+{
+    thz_scene *s = ps_box_scene(ps_scaled(20000), 5, 0.2);
+    ps_add_channel(s, 0.65, 0.05);
+    return s;
+}
+
+static int setup(void **state)
+{
+    fixture *f = calloc(1, sizeof *f);
+    strcpy(f->dir, "/tmp/thz-pmf-XXXXXX");
+    if (!mkdtemp(f->dir))
+        return -1;
+    snprintf(f->path, sizeof f->path, "%s/photon-map.thzpm", f->dir);
+    f->scene = two_channel_scene();
+    accel *acc;
+    thz_error err;
+    if (accel_create(f->scene, &acc, &err) != THZ_OK)
+        return -1;
+    for (size_t c = 0; c < 2; c++)
+        if (photon_phase_run(f->scene, acc, c, NULL, &f->maps[c], &f->stats[c], &err) != THZ_OK)
+            return -1;
+    accel_destroy(acc);
+    if (photon_map_file_write(f->path, f->scene, (const photon_map *const *)f->maps, f->stats,
+                              &err) != THZ_OK)
+        return -1;
+    *state = f;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    fixture *f = *state;
+    for (size_t c = 0; c < 2; c++)
+        photon_map_destroy(f->maps[c]);
+    scene_destroy(f->scene);
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", f->dir);
+    if (system(cmd) != 0)
+        return -1;
+    free(f);
+    return 0;
+}
+
+static unsigned char *slurp(const char *path, size_t *n)
+{
+    FILE *fp = fopen(path, "rb");
+    assert_non_null(fp);
+    fseek(fp, 0, SEEK_END);
+    long size = ftell(fp);
+    fseek(fp, 0, SEEK_SET);
+    unsigned char *buf = malloc((size_t)size + 1);
+    assert_int_equal(fread(buf, 1, (size_t)size, fp), (size_t)size);
+    fclose(fp);
+    *n = (size_t)size;
+    return buf;
+}
+
+static void spit(const char *path, const unsigned char *buf, size_t n)
+{
+    FILE *fp = fopen(path, "wb");
+    assert_non_null(fp);
+    assert_int_equal(fwrite(buf, 1, n, fp), n);
+    fclose(fp);
+}
+
+static void test_round_trip(void **state)
+{
+    fixture *f = *state;
+    photon_map *maps[2] = {NULL, NULL};
+    photon_stats stats[2];
+    photon_map_file_info info;
+    thz_error err;
+    assert_int_equal(photon_map_file_read(f->path, f->scene, 2, maps, stats, &info, &err), THZ_OK);
+    assert_int_equal(info.n_channels, 2);
+    assert_int_equal(info.seed, 5);
+    assert_int_equal(info.photons_per_channel, f->scene->photons.per_channel);
+    for (size_t c = 0; c < 2; c++) {
+        assert_int_equal(photon_map_count(maps[c]), photon_map_count(f->maps[c]));
+        /* The map's layout is a function of its records alone, so equal records give
+         * equal arrays. */
+        assert_memory_equal(photon_map_records(maps[c]), photon_map_records(f->maps[c]),
+                            photon_map_count(maps[c]) * sizeof(photon_record));
+        photon_stats a = f->stats[c];
+        a.seconds = 0.0;
+        assert_memory_equal(&a, &stats[c], sizeof a);
+    }
+    assert_true(photon_map_count(maps[0]) != photon_map_count(maps[1]));
+
+    char again[160];
+    snprintf(again, sizeof again, "%s/again.thzpm", f->dir);
+    assert_int_equal(photon_map_file_write(again, f->scene, (const photon_map *const *)maps, stats,
+                                           &err),
+                     THZ_OK);
+    size_t n1, n2;
+    unsigned char *b1 = slurp(f->path, &n1), *b2 = slurp(again, &n2);
+    assert_int_equal(n1, n2);
+    assert_memory_equal(b1, b2, n1);
+    /* Compressed: well under 32 bytes per photon. */
+    size_t records = photon_map_count(maps[0]) + photon_map_count(maps[1]);
+    printf("# %zu photons in %zu bytes (%.1f bytes per photon)\n", records, n1,
+           (double)n1 / (double)records);
+    free(b1);
+    free(b2);
+    for (size_t c = 0; c < 2; c++)
+        photon_map_destroy(maps[c]);
+}
+
+/* Reads `path` expecting failure with `status` and a message holding `what` and path. */
+static void expect_refusal(const char *path, const thz_scene *scene, thz_status status,
+                           const char *what)
+{
+    photon_map *maps[2] = {(photon_map *)1, (photon_map *)1};
+    thz_error err;
+    thz_status st = photon_map_file_read(path, scene, 1, maps, NULL, NULL, &err);
+    printf("# %s\n", st == THZ_OK ? "(accepted)" : err.message);
+    assert_int_equal(st, status);
+    assert_non_null(strstr(err.message, what));
+    assert_non_null(strstr(err.message, path));
+    for (size_t c = 0; c < scene->n_channels; c++)
+        assert_null(maps[c]);
+}
+
+static void test_corrupted(void **state)
+{
+    fixture *f = *state;
+    size_t n;
+    unsigned char *buf = slurp(f->path, &n);
+    char bad[160];
+    snprintf(bad, sizeof bad, "%s/bad.thzpm", f->dir);
+    /* One flipped bit anywhere in the compressed sections: the header frame, the start,
+     * middle and end of the records frame (the last bytes are its checksum). */
+    const size_t where[] = {30, 60, n / 3, n / 2, n - 40, n - 2};
+    for (size_t i = 0; i < sizeof where / sizeof where[0]; i++) {
+        buf[where[i]] ^= 0x10;
+        spit(bad, buf, n);
+        expect_refusal(bad, f->scene, THZ_ERR_IO, "corrupted");
+        buf[where[i]] ^= 0x10;
+    }
+    /* A damaged magic number: not a photon map at all. */
+    buf[2] ^= 0x01;
+    spit(bad, buf, n);
+    expect_refusal(bad, f->scene, THZ_ERR_INPUT, "not a thzmap photon map");
+    free(buf);
+}
+
+static void test_truncated(void **state)
+{
+    fixture *f = *state;
+    size_t n;
+    unsigned char *buf = slurp(f->path, &n);
+    char bad[160];
+    snprintf(bad, sizeof bad, "%s/short.thzpm", f->dir);
+    const size_t lengths[] = {n - 1, n / 2, 100, 20, 0};
+    for (size_t i = 0; i < sizeof lengths / sizeof lengths[0]; i++) {
+        spit(bad, buf, lengths[i]);
+        expect_refusal(bad, f->scene, THZ_ERR_IO, "truncated");
+    }
+    free(buf);
+    char missing[160];
+    snprintf(missing, sizeof missing, "%s/missing.thzpm", f->dir);
+    expect_refusal(missing, f->scene, THZ_ERR_INPUT, "cannot open");
+}
+
+static void test_mismatched_scene(void **state)
+{
+    fixture *f = *state;
+    /* Another geometry: the cube moved by 1 mm. */
+    thz_scene *s = two_channel_scene();
+    s->objects[1].mesh.positions[0] += 0.001f;
+    expect_refusal(f->path, s, THZ_ERR_INPUT, "another scene geometry");
+    scene_destroy(s);
+    /* Another channel set: one channel less, or one moved. */
+    s = two_channel_scene();
+    s->n_channels = 1;
+    expect_refusal(f->path, s, THZ_ERR_INPUT, "another channel set");
+    s->n_channels = 2;
+    s->channels[1].center_hz *= 1.01;
+    expect_refusal(f->path, s, THZ_ERR_INPUT, "another channel set");
+    scene_destroy(s);
+    /* Another temperature. */
+    s = two_channel_scene();
+    s->objects[2].temperature_k += 1.0;
+    expect_refusal(f->path, s, THZ_ERR_INPUT, "temperatures");
+    scene_destroy(s);
+    /* Seed and photon count are not part of the match: a map fired with --photons N
+     * renders any time. */
+    s = two_channel_scene();
+    s->photons.seed = 99;
+    s->photons.per_channel = 5;
+    photon_map *maps[2];
+    thz_error err;
+    assert_int_equal(photon_map_file_read(f->path, s, 1, maps, NULL, NULL, &err), THZ_OK);
+    photon_map_destroy(maps[0]);
+    photon_map_destroy(maps[1]);
+    scene_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_round_trip, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_corrupted, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_truncated, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_mismatched_scene, setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
