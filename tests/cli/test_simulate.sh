@@ -1,0 +1,145 @@
+#!/usr/bin/env bash
+# simulate and render, end to end (scene-format.md "Command line"):
+#  - outputs are byte-identical for --threads 1 and 2 (every file but summary.json);
+#  - render from a saved photon map reproduces simulate's images byte for byte, and
+#    --sensor renders one sensor only;
+#  - SIGINT during a run exits 130 and leaves no result files in OUTDIR;
+#  - render refuses a photon map made from another scene;
+#  - usage errors exit 2.
+# argv: path to the thzmap binary, repository directory.
+set -u
+THZMAP=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+
+scene() { # $1: file, $2: width of the plate in m
+cat > "$1" <<JSON
+{
+  "format": "thzmap-scene/1",
+  "name": "cli-test",
+  "channels": [{"frequency_thz": 0.35, "relative_width": 0.05},
+               {"frequency_thz": 0.9, "relative_width": 0.02}],
+  "materials": {
+    "wall": {"reflectivity": 0.2},
+    "paint": {"reflectivity": [[0.2, 0.05], [1.2, 0.3]], "color": [0.8, 0.2, 0.2]},
+    "cloth": {"reflectivity": 0.05, "attenuation_per_m": 200, "transmission": "straight"},
+    "foam": {"reflectivity": 0.1, "attenuation_per_m": 100}
+  },
+  "atmosphere": {"model": "constant", "attenuation_per_m": 0.05},
+  "objects": [
+    {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}},
+    {"name": "plate", "type": "solid", "material": "paint", "temperature_k": 310,
+     "shape": {"type": "box", "size_m": [$2, 0.05, 0.5]},
+     "transform": {"translate_m": [0, 0.5, 0]}},
+    {"name": "veil", "type": "shell", "thickness_m": 0.001, "material": "cloth",
+     "temperature_k": 300, "shape": {"type": "rectangle", "size_m": [0.4, 0.4]},
+     "transform": {"rotate_deg": [90, 0, 0], "translate_m": [0.2, 0.1, 0]}},
+    {"name": "can", "type": "shell", "thickness_m": 0.002, "material": "foam",
+     "temperature_k": 305,
+     "shape": {"type": "cylinder", "radius_m": 0.15, "height_m": 0.4, "caps": true},
+     "transform": {"translate_m": [-0.4, 0.3, -0.5]}}
+  ],
+  "sensors": [
+    {"name": "cam", "position_m": [0, -0.9, 0], "look_at_m": [0, 0.5, 0],
+     "fov_deg": 70, "resolution": [20, 16], "oversampling": 2, "normalize_to_k": 295},
+    {"name": "side", "position_m": [0.8, -0.8, 0.3], "look_at_m": [0, 0.4, -0.2],
+     "fov_deg": 50, "resolution": [12, 12]}
+  ],
+  "photons": {"per_channel": 60000, "seed": 4}
+}
+JSON
+}
+scene "$work/scene.json" 0.6
+scene "$work/other.json" 0.7
+
+# --- determinism over thread counts -------------------------------------------------
+"$THZMAP" simulate "$work/scene.json" -o "$work/t1" --threads 1 --save-photon-map --quiet \
+    || fail "simulate --threads 1 exited $?"
+"$THZMAP" simulate "$work/scene.json" -o "$work/t2" --threads 2 --save-photon-map --quiet \
+    || fail "simulate --threads 2 exited $?"
+for f in cam.radiance.img cam.power.hdr side.normalized.img cam.visual.png photon-map.thzpm \
+         photon-map.ply summary.json; do
+    [ -s "$work/t1/$f" ] || fail "simulate did not write $f"
+done
+n1=$(ls "$work/t1" | wc -l)
+[ "$n1" -ge 30 ] || fail "only $n1 files in the output"
+if ! diff -r -q --exclude=summary.json "$work/t1" "$work/t2"; then
+    fail "outputs differ between --threads 1 and --threads 2"
+fi
+ls -A "$work/t1" | grep -q '^\.' && fail "a hidden (staging) entry was left in OUTDIR"
+
+# --- render from the saved map ---------------------------------------------------------
+"$THZMAP" render "$work/scene.json" --photon-map "$work/t1/photon-map.thzpm" -o "$work/r" \
+    --threads 2 --quiet || fail "render exited $?"
+for f in "$work"/t1/cam.* "$work"/t1/side.*; do
+    b=$(basename "$f")
+    cmp -s "$f" "$work/r/$b" || fail "render's $b differs from simulate's"
+done
+[ -e "$work/r/photon-map.thzpm" ] && fail "render wrote a photon map"
+grep -q '"command": *"render"' "$work/r/summary.json" || fail "render's summary.json lacks command"
+
+"$THZMAP" render "$work/scene.json" --photon-map "$work/t1/photon-map.thzpm" -o "$work/rs" \
+    --sensor side --quiet || fail "render --sensor exited $?"
+[ -e "$work/rs/side.radiance.img" ] || fail "render --sensor side wrote no side images"
+ls "$work/rs" | grep -q '^cam\.' && fail "render --sensor side wrote cam images"
+cmp -s "$work/t1/side.radiance.img" "$work/rs/side.radiance.img" \
+    || fail "render --sensor side differs from simulate"
+"$THZMAP" render "$work/scene.json" --photon-map "$work/t1/photon-map.thzpm" -o "$work/rx" \
+    --sensor nosuch --quiet 2>/dev/null
+[ $? -eq 2 ] || fail "render --sensor nosuch should exit 2"
+
+# --- a map from another scene is refused -----------------------------------------------
+"$THZMAP" render "$work/other.json" --photon-map "$work/t1/photon-map.thzpm" -o "$work/o" \
+    --quiet 2> "$work/other.err"
+rc=$?
+[ $rc -eq 2 ] || fail "render with another scene's map exited $rc, expected 2"
+[ -s "$work/other.err" ] || fail "render with another scene's map said nothing"
+[ -z "$(ls -A "$work/o" 2>/dev/null)" ] || fail "refused render left files in OUTDIR"
+
+# --- interruption ----------------------------------------------------------------------
+"$THZMAP" simulate "$work/scene.json" -o "$work/int" --photons 20000000 --threads 2 \
+    2> "$work/int.err" &
+pid=$!
+sleep 1.5
+if kill -0 "$pid" 2>/dev/null; then
+    kill -INT "$pid"
+    wait "$pid"
+    rc=$?
+    [ $rc -eq 130 ] || fail "interrupted simulate exited $rc, expected 130"
+    [ -z "$(ls -A "$work/int" 2>/dev/null)" ] || fail "interrupted run left files: $(ls -A "$work/int")"
+    grep -q interrupted "$work/int.err" || fail "interrupted run did not say so"
+else
+    wait "$pid"
+    fail "the run meant to be interrupted finished within 1.5 s"
+fi
+
+# --- a run that cannot fit in memory is refused before it starts --------------------------
+"$THZMAP" simulate "$work/scene.json" -o "$work/big" --photons 1000000000000 --quiet \
+    2> "$work/big.err"
+rc=$?
+[ $rc -eq 1 ] || fail "an oversized run exited $rc, expected 1"
+grep -q "photons.per_channel" "$work/big.err" || fail "oversized run message: $(cat "$work/big.err")"
+[ -z "$(ls -A "$work/big" 2>/dev/null)" ] || fail "refused run left files in OUTDIR"
+
+# --- usage --------------------------------------------------------------------------------
+"$THZMAP" simulate "$work/scene.json" 2>/dev/null
+[ $? -eq 2 ] || fail "simulate without -o should exit 2"
+"$THZMAP" simulate "$work/scene.json" -o "$work/u" --integrator nonsense 2>/dev/null
+[ $? -eq 2 ] || fail "unknown integrator should exit 2"
+"$THZMAP" simulate "$work/scene.json" -o "$work/u" --integrator path --quiet 2> "$work/u.err"
+[ $? -eq 2 ] || fail "an unimplemented integrator should exit 2"
+grep -q "not implemented yet" "$work/u.err" || fail "unimplemented integrator message: $(cat "$work/u.err")"
+"$THZMAP" simulate "$work/scene.json" -o "$work/u" --photons 0 2>/dev/null
+[ $? -eq 2 ] || fail "--photons 0 should exit 2"
+"$THZMAP" render "$work/scene.json" -o "$work/u" 2>/dev/null
+[ $? -eq 2 ] || fail "render without --photon-map should exit 2"
+"$THZMAP" simulate --help | grep -q -- "--save-photon-map" || fail "simulate --help"
+
+if [ $fails -ne 0 ]; then
+    echo "$fails check(s) failed"
+    exit 1
+fi
+echo "all simulate/render checks passed"
