@@ -9,6 +9,7 @@
 #include <errno.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,6 +50,12 @@ static void plot_escape(char *dst, size_t size, const char *src)
         dst[j++] = *src;
     }
     dst[j] = '\0';
+}
+
+static int plot_compare_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
 }
 
 /* Caller holds plot_lock. */
@@ -137,21 +144,29 @@ thz_status plot_image(const char *path, const float *values, uint32_t columns, u
     size_t nx = (size_t)columns + 1, ny = (size_t)rows + 1;
     PLFLT *grid = thz_malloc_array(nx * ny, sizeof *grid);
     PLFLT **cols = thz_malloc_array(nx, sizeof *cols);
+    float *sorted = thz_malloc_array((size_t)columns * rows, sizeof *sorted);
     thz_status status = THZ_OK;
-    if (!grid || !cols) {
+    if (!grid || !cols || !sorted) {
         status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
         goto cleanup;
     }
-    double vmin = INFINITY, vmax = -INFINITY;
-    for (size_t i = 0; i < (size_t)columns * rows; i++) {
-        if (isfinite(values[i])) {
-            vmin = fmin(vmin, values[i]);
-            vmax = fmax(vmax, values[i]);
-        }
-    }
-    if (!(vmin <= vmax)) { /* nothing finite */
-        vmin = 0.0;
-        vmax = 1.0;
+    /* The colour bar spans the 1st to 99th percentile of the finite values, so that a
+     * few noisy pixels do not flatten the picture; values beyond are drawn in the end
+     * colours, and the bar then shows a triangular cap at that end. */
+    double vmin = 0.0, vmax = 1.0;
+    bool clipped_low = false, clipped_high = false;
+    size_t n_finite = 0;
+    for (size_t i = 0; i < (size_t)columns * rows; i++)
+        if (isfinite(values[i]))
+            sorted[n_finite++] = values[i];
+    if (n_finite > 0) {
+        qsort(sorted, n_finite, sizeof *sorted, plot_compare_float);
+        size_t lo = (size_t)floor(0.01 * (double)(n_finite - 1));
+        size_t hi = (size_t)ceil(0.99 * (double)(n_finite - 1));
+        vmin = sorted[lo];
+        vmax = sorted[hi];
+        clipped_low = sorted[0] < vmin;
+        clipped_high = sorted[n_finite - 1] > vmax;
     }
     double scale = fmax(fabs(vmin), fabs(vmax));
     if (vmax - vmin <= 1e-9 * scale) { /* a flat image still needs a scale */
@@ -165,7 +180,7 @@ thz_status plot_image(const char *path, const float *values, uint32_t columns, u
         for (size_t j = 0; j < ny; j++) {
             size_t r = j < rows ? j : rows - 1;
             float v = values[r * columns + c];
-            cols[i][j] = isfinite(v) ? v : vmin;
+            cols[i][j] = isfinite(v) ? fmin(fmax(v, vmin), vmax) : vmin;
         }
     }
     char t_title[PLOT_TEXT], t_label[PLOT_TEXT];
@@ -198,14 +213,17 @@ thz_status plot_image(const char *path, const float *values, uint32_t columns, u
         PLINT n_values[] = {2};
         PLFLT range[] = {vmin, vmax};
         const PLFLT *value_rows[] = {range};
-        plcolorbar(&bar_w, &bar_h, PL_COLORBAR_IMAGE,
+        PLINT bar_opt = PL_COLORBAR_IMAGE | (clipped_low ? PL_COLORBAR_CAP_LOW : 0) |
+                        (clipped_high ? PL_COLORBAR_CAP_HIGH : 0);
+        plcolorbar(&bar_w, &bar_h, bar_opt,
                    PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.03, 0.0, 0.04,
-                   0.9, 0, 1, 1, 0.0, 0.0, 0, 0.0, 1, label_opts, labels, 1, axis_opts, ticks,
+                   0.9, 0, 1, 1, 0.0, 1.0, 0, 0.0, 1, label_opts, labels, 1, axis_opts, ticks,
                    sub_ticks, n_values, (PLFLT_MATRIX)value_rows);
         status = plot_end(path, err);
     }
     pthread_mutex_unlock(&plot_lock);
 cleanup:
+    free(sorted);
     free(cols);
     free(grid);
     return status;
