@@ -94,8 +94,35 @@ void scene_hash_compute(const thz_scene *scene, scene_hash *out)
         o = hash_spectrum(o, &m->emissivity);
         o = hash_word(o, (uint64_t)m->transmission);
     }
-    o = hash_word(o, (uint64_t)scene->atmosphere.model);
-    o = hash_spectrum(o, &scene->atmosphere.attenuation_per_m);
+    const thz_atmosphere *atm = &scene->atmosphere;
+    o = hash_word(o, (uint64_t)atm->model);
+    o = hash_spectrum(o, &atm->attenuation_per_m);
+    o = hash_word(o, atm->has_air ? 1u : 0u);
+    if (atm->has_air) {
+        o = hash_double(o, atm->air.temperature_k);
+        o = hash_double(o, atm->air.pressure_hpa);
+        o = hash_double(o, atm->air.h2o_pressure_hpa);
+    }
+    /* The line-by-line models' alpha over the bands, as prepared: covers the catalogues
+     * and switches without knowing them. */
+    o = hash_word(o, atm->n_tables);
+    for (size_t i = 0; i < atm->n_tables; i++) {
+        const atm_band_table *t = &atm->tables[i];
+        o = hash_double(o, t->lo_hz);
+        o = hash_double(o, t->step_hz);
+        o = hash_word(o, t->n);
+        for (size_t k = 0; k < t->n; k++)
+            o = hash_double(o, t->alpha_per_m[k]);
+    }
+    o = hash_word(o, atm->emitting ? 1u : 0u);
+    if (atm->emitting)
+        o = hash_double(o, atm->background_temperature_k);
+    o = hash_word(o, atm->has_extent ? 1u : 0u);
+    if (atm->has_extent)
+        for (int k = 0; k < 3; k++) {
+            o = hash_double(o, atm->extent_min_m[k]);
+            o = hash_double(o, atm->extent_max_m[k]);
+        }
     c = hash_word(c, scene->n_channels);
     for (size_t i = 0; i < scene->n_channels; i++) {
         c = hash_double(c, scene->channels[i].center_hz);

@@ -5,7 +5,8 @@
  *  - geometry: every object's type, sidedness, thickness and mesh (vertex positions
  *    and triangle indices, bit for bit);
  *  - optics: every object's material index and temperature, every material's spectra
- *    (R, alpha_M, eps) and transmission mode, the atmosphere model and its spectrum;
+ *    (R, alpha_M, eps) and transmission mode, the atmosphere (model, spectrum, air
+ *    state, the prepared alpha tables of the line-by-line models, emission, extent);
  *  - channels: the channels' centres and widths.
  * Names, colours, sensors, render settings and the photon count, seed and
  * min_relative_power are left out: they change neither what a photon map means nor
