@@ -31,7 +31,7 @@ typedef struct run_state {
     size_t n_selected;        /* sensors rendered */
     size_t *selected;         /* their indices into scene->sensors */
     sensor_images *images;    /* one per selected sensor */
-    uint64_t *back_face;      /* per selected sensor: samples that saw a back face */
+    uint64_t *back_face;      /* per scene sensor: samples that saw a back face */
     render_stats *render_sum; /* per selected sensor: counts over all channels */
     photon_map **maps;        /* per channel: kept for saving, or read from a file */
     photon_stats *stats;      /* per channel (simulate) */
@@ -145,7 +145,7 @@ static thz_status run_state_init(run_state *rs, const thz_scene *scene, const ru
         return thz_error_set(err, THZ_ERR_INPUT, "%s: the scene has no sensor named '%s'",
                              command, opt->sensor_name ? opt->sensor_name : "");
     rs->images = thz_calloc(rs->n_selected, sizeof *rs->images);
-    rs->back_face = thz_calloc(rs->n_selected, sizeof *rs->back_face);
+    rs->back_face = thz_calloc(ns, sizeof *rs->back_face); /* summary.json: per scene sensor */
     rs->render_sum = thz_calloc(rs->n_selected, sizeof *rs->render_sum);
     if (!rs->images || !rs->back_face || !rs->render_sum)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
@@ -248,7 +248,7 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
         sum->widened_gathers += rst.widened_gathers;
         sum->starved_gathers += rst.starved_gathers;
         sum->truncated_paths += rst.truncated_paths;
-        rs->back_face[i] += rst.back_face_samples;
+        rs->back_face[rs->selected[i]] += rst.back_face_samples;
     }
     rs->seconds_render += run_now_s() - t0;
     return THZ_OK;
@@ -393,7 +393,7 @@ static void run_fill_result(const run_state *rs, run_result *result, double t_st
         result->photons_stored += rs->stats[c].stored;
     }
     for (size_t i = 0; i < rs->n_selected; i++)
-        result->back_face_samples += rs->back_face[i];
+        result->back_face_samples += rs->back_face[rs->selected[i]];
     result->n_warnings = rs->n_warnings;
     result->seconds = run_now_s() - t_start;
 }

@@ -202,6 +202,10 @@ typedef struct ident_tally {
     double sum_var;    /* sum of (stderr / L_exp)^2 */
     double max_rel_se; /* largest stderr / L_exp */
     double worst_z;
+    /* when > 0: a pixel's standard error is at least this fraction of the expected value
+     * (the pooled error of the image), for heavy-tailed photon terms where a pixel's own
+     * error estimate fails when the rare large terms happen to be missing */
+    double pooled_rel_se;
 } ident_tally;
 
 /* Compares pixel (col,row) of channel c with expected radiance `expect`; `floor_rel` is
@@ -211,6 +215,8 @@ static inline void ident_check_pixel(ident_tally *t, const ident_run *r, size_t 
 {
     size_t i = ident_at(r, c, col, row);
     double l = r->img.radiance[i], se = r->img.radiance_stderr[i];
+    if (se < t->pooled_rel_se * fabs(expect))
+        se = t->pooled_rel_se * fabs(expect);
     double diff = l - expect;
     double tol = IDENT_Z * se + floor_rel * fabs(expect);
     double z = se > 0.0 ? diff / se : (diff == 0.0 ? 0.0 : INFINITY);
