@@ -63,6 +63,12 @@ static void cli_progress_draw_tty(cli_progress *p, const thz_progress *pr, doubl
     double elapsed = now - p->stage_start_s;
     double frac = pr->total ? (double)pr->done / (double)pr->total : 0.0;
     double rate = elapsed > 0.0 ? (double)pr->done / elapsed : 0.0;
+    if (strcmp(pr->stage, "output") == 0) {
+        fprintf(p->out, "\r\033[Kthzmap %s: writing the results", p->command);
+        fflush(p->out);
+        p->line_open = true;
+        return;
+    }
     fprintf(p->out, "\r\033[Kthzmap %s: channel %zu/%zu, %s %llu/%llu (%.0f %%)", p->command,
             pr->channel + 1, pr->n_channels, pr->stage, (unsigned long long)pr->done,
             (unsigned long long)pr->total, 100.0 * frac);

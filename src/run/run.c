@@ -3,6 +3,7 @@
 #include "run/run.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -358,7 +359,7 @@ static thz_status run_write_outputs(run_state *rs, double t_start, thz_error *er
         .integrator = render_integrator_name(rs->scene->render.integrator),
         .seed = rs->seed,
         .photons_per_channel = rs->photons_per_channel,
-        .threads = rs->opt->threads,
+        .threads = rs->opt->threads > 0 ? rs->opt->threads : omp_get_max_threads(),
         .channel_stats = simulate && render_integrator_needs_photons(rs->scene->render.integrator)
                              ? rs->stats
                              : NULL,
