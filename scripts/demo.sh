@@ -18,7 +18,7 @@ echo "simulating $scene (6 channels x 10 million photons; a few minutes on 2 cor
 
 echo
 echo "written to $outdir:"
-ls -l "$outdir"
+ls -lh "$outdir"
 echo
 echo "start with $outdir/cam.spectra.png (the paper's Fig. 6), $outdir/cam.band-01.png ..."
 echo "$outdir/cam.band-06.png and $outdir/cam.visual.png; docs/user-guide.md says how to"
