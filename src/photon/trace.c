@@ -94,8 +94,14 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
             c->escaped_power += power;
             return true;
         }
-        /* The free path runs from the surface point, not from the offset origin. */
-        double d = v3_length(v3_sub(hit.position_m, surface));
+        /* The free path runs from the surface point along dir, not from the offset
+         * origin: its length to the plane of the triangle hit. (From the offset origin
+         * it would be short by about eps/cos, a bias of alpha eps / cos.) */
+        const float *hn = &scene->objects[hit.object].mesh.normals[3 * (size_t)hit.triangle];
+        vec3 to_hit = v3_sub(hit.position_m, surface);
+        double d = hit.cos_theta > 1e-6
+                       ? fabs(v3_dot(to_hit, v3(hn[0], hn[1], hn[2]))) / hit.cos_theta
+                       : v3_length(to_hit);
         double tr = atmosphere_transmittance(&scene->atmosphere, nu, d);
         c->atmosphere_power += power * (1.0 - tr);
         power *= tr;
