@@ -1,6 +1,6 @@
-/* Atomic results: files written into the stage appear in OUTDIR only on commit, and a
- * destroyed stage leaves nothing behind (scene-format.md "A failed run leaves no
- * partial output files"). */
+/* Run-level outputs. Atomic results: files written into the stage appear in OUTDIR only
+ * on commit, and a destroyed stage leaves nothing behind (scene-format.md "A failed run
+ * leaves no partial output files"). And summary.json's keys and values. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -9,6 +9,8 @@
 #include <cmocka.h>
 
 #include <dirent.h>
+#include <jansson.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +19,7 @@
 
 #include "core/alloc.h"
 #include "io/output.h"
+#include "scene/scene.h"
 
 static char *make_tmp_dir(void)
 {
@@ -165,13 +168,135 @@ static void test_bad_outdir(void **state)
     free(tmp);
 }
 
+/* summary.json: the run's numbers under their documented keys, fractions with their
+ * documented denominators, non-finite values as null, scene and run warnings merged. */
+static void test_summary_json(void **state)
+{
+    (void)state;
+    char *tmp = make_tmp_dir();
+    thz_scene *scene = scene_create();
+    assert_non_null(scene);
+    scene->name = thz_strdup("s");
+    scene->path = thz_strdup("/x/s.json");
+    scene->n_channels = 2;
+    scene->channels = thz_calloc(2, sizeof *scene->channels);
+    snprintf(scene->channels[0].name, sizeof scene->channels[0].name, "a");
+    scene->channels[0].center_hz = 0.35e12;
+    scene->channels[0].relative_width = 0.01;
+    snprintf(scene->channels[1].name, sizeof scene->channels[1].name, "b");
+    scene->channels[1].center_hz = 1.2e12;
+    scene->channels[1].relative_width = 0.02;
+    scene->n_sensors = 1;
+    scene->sensors = thz_calloc(1, sizeof *scene->sensors);
+    scene->sensors[0].name = thz_strdup("cam");
+    scene->sensors[0].columns = 7;
+    scene->sensors[0].rows = 5;
+    assert_true(scene_add_warning(scene, "scene warning"));
+
+    photon_stats st[2] = {{0}};
+    st[0].fired = 1000;
+    st[0].stored = 1500;
+    st[0].hits = 1500;
+    st[0].reflected = 300;
+    st[0].transmitted = 200;
+    st[0].absorbed = 900;
+    st[0].escaped = 60;
+    st[0].terminated = 40;
+    st[0].emitted_power_w_per_hz = 2e-12;
+    st[0].absorbed_power_w_per_hz = 1.5e-12;
+    st[0].escaped_power_w_per_hz = 0.4e-12;
+    st[0].atmosphere_power_w_per_hz = 0.08e-12;
+    st[0].mean_bounces = 1.5;
+    st[1].fired = 10;
+    st[1].emitted_power_w_per_hz = NAN;
+    double stderr_k[2] = {0.5, 0.25};
+    uint64_t back[1] = {3};
+    const char *run_warnings[] = {"run warning"};
+    run_summary rs = {.command = "simulate",
+                      .integrator = "photon-map",
+                      .seed = 42,
+                      .photons_per_channel = 1000,
+                      .threads = 2,
+                      .channel_stats = st,
+                      .median_stderr_k = stderr_k,
+                      .back_face_samples = back,
+                      .seconds_photons = 1.25,
+                      .n_run_warnings = 1,
+                      .run_warnings = run_warnings};
+    thz_error err = {0};
+    assert_int_equal(summary_write(tmp, scene, &rs, &err), THZ_OK);
+
+    char path[1024];
+    snprintf(path, sizeof path, "%s/summary.json", tmp);
+    json_error_t jerr;
+    json_t *root = json_load_file(path, 0, &jerr);
+    if (!root)
+        fail_msg("summary.json does not parse: %s", jerr.text);
+    assert_string_equal(json_string_value(json_object_get(root, "thzmap_version")),
+                        THZ_VERSION_STRING);
+    assert_string_equal(json_string_value(json_object_get(root, "command")), "simulate");
+    assert_int_equal(json_integer_value(json_object_get(root, "seed")), 42);
+    assert_int_equal(json_integer_value(json_object_get(root, "threads")), 2);
+    json_t *sc = json_object_get(root, "scene");
+    assert_string_equal(json_string_value(json_object_get(sc, "path")), "/x/s.json");
+
+    json_t *chs = json_object_get(root, "channels");
+    assert_int_equal(json_array_size(chs), 2);
+    json_t *c0 = json_array_get(chs, 0);
+    assert_string_equal(json_string_value(json_object_get(c0, "name")), "a");
+    assert_true(fabs(json_number_value(json_object_get(c0, "frequency_thz")) - 0.35) < 1e-12);
+    assert_int_equal(json_integer_value(json_object_get(c0, "photons_fired")), 1000);
+    assert_int_equal(json_integer_value(json_object_get(c0, "photons_stored")), 1500);
+    /* per photon fired: 0.9 + 0.06 + 0.04 = 1; per hit: 0.2 and 0.1333 */
+    assert_true(fabs(json_number_value(json_object_get(c0, "fraction_absorbed")) - 0.9) < 1e-12);
+    assert_true(fabs(json_number_value(json_object_get(c0, "fraction_escaped")) - 0.06) < 1e-12);
+    assert_true(fabs(json_number_value(json_object_get(c0, "fraction_reflected")) - 0.2) < 1e-12);
+    assert_true(fabs(json_number_value(json_object_get(c0, "fraction_transmitted")) - 0.2 / 1.5) <
+                1e-12);
+    json_t *eb = json_object_get(c0, "energy_balance");
+    assert_true(fabs(json_number_value(json_object_get(eb, "relative_difference")) - 0.01) < 1e-9);
+    assert_true(fabs(json_number_value(json_object_get(c0, "median_stderr_k")) - 0.5) < 1e-12);
+    json_t *c1 = json_array_get(chs, 1);
+    assert_true(json_is_null(json_object_get(c1, "emitted_power_w_per_hz")));
+    assert_true(json_is_null(
+        json_object_get(json_object_get(c1, "energy_balance"), "relative_difference")));
+
+    json_t *s0 = json_array_get(json_object_get(root, "sensors"), 0);
+    assert_string_equal(json_string_value(json_object_get(s0, "name")), "cam");
+    assert_int_equal(json_integer_value(json_object_get(s0, "columns")), 7);
+    assert_int_equal(json_integer_value(json_object_get(s0, "rows")), 5);
+    assert_int_equal(json_integer_value(json_object_get(s0, "back_face_samples")), 3);
+    json_t *t = json_object_get(root, "timings_s");
+    assert_true(fabs(json_number_value(json_object_get(t, "photons")) - 1.25) < 1e-12);
+    json_t *w = json_object_get(root, "warnings");
+    assert_int_equal(json_array_size(w), 2);
+    assert_string_equal(json_string_value(json_array_get(w, 0)), "scene warning");
+    assert_string_equal(json_string_value(json_array_get(w, 1)), "run warning");
+    json_decref(root);
+
+    /* render: no photon statistics, no stderr, no back-face counts */
+    run_summary render = {.command = "render", .integrator = "photon-map"};
+    assert_int_equal(summary_write(tmp, scene, &render, &err), THZ_OK);
+    root = json_load_file(path, 0, &jerr);
+    assert_non_null(root);
+    c0 = json_array_get(json_object_get(root, "channels"), 0);
+    assert_null(json_object_get(c0, "photons_fired"));
+    assert_null(json_object_get(c0, "median_stderr_k"));
+    assert_string_equal(json_string_value(json_object_get(c0, "name")), "a");
+    json_decref(root);
+
+    rm(tmp, "summary.json");
+    assert_int_equal(rmdir(tmp), 0);
+    free(tmp);
+    scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_commit_moves_files),
-        cmocka_unit_test(test_destroy_leaves_nothing),
-        cmocka_unit_test(test_two_stages),
-        cmocka_unit_test(test_bad_outdir),
+        cmocka_unit_test(test_commit_moves_files), cmocka_unit_test(test_destroy_leaves_nothing),
+        cmocka_unit_test(test_two_stages),         cmocka_unit_test(test_bad_outdir),
+        cmocka_unit_test(test_summary_json),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
