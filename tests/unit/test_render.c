@@ -1,0 +1,229 @@
+/* Renderer behaviour beyond the physics identities: back faces, truth images,
+ * oversampling, thread-count independence, cancellation, unimplemented integrators. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "accel/accel.h"
+#include "photon/phase.h"
+#include "physics/planck.h"
+#include "scene/scene.h"
+#include "sensor/camera.h"
+#include "sensor/images.h"
+#include "sensor/render.h"
+
+/* A black corridor at 300 K seen along y through alpha = 0.2 /m, a grey box (R = 0.5)
+ * in it, and a second camera outside the corridor looking at its outside (back faces of
+ * the inward box). */
+static const char *render_json =
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"render-unit\","
+    " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.02}],"
+    " \"materials\": {\"black\": {\"reflectivity\": 0.0, \"color\": [0.2, 0.4, 0.8]},"
+    "                 \"grey\": {\"reflectivity\": 0.5}},"
+    " \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.2},"
+    " \"objects\": ["
+    "   {\"name\": \"corridor\", \"type\": \"solid\", \"material\": \"black\","
+    "    \"temperature_k\": 300,"
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [1, 6, 1], \"inward\": true}},"
+    "   {\"name\": \"box\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 320,"
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [0.2, 0.2, 0.2]},"
+    "    \"transform\": {\"translate_m\": [0.3, 0, 0.3]}}],"
+    " \"sensors\": ["
+    "   {\"name\": \"inside\", \"position_m\": [0, -2.9, 0], \"direction\": [0, 1, 0],"
+    "    \"fov_deg\": 6, \"resolution\": [5, 4], \"oversampling\": 3},"
+    "   {\"name\": \"outside\", \"position_m\": [0, -5, 0], \"direction\": [0, 1, 0],"
+    "    \"fov_deg\": 5, \"resolution\": [4, 4]}],"
+    " \"photons\": {\"per_channel\": 20000, \"seed\": 2}}";
+
+typedef struct fixture {
+    thz_scene *scene;
+    accel *acc;
+    photon_map *map;
+} fixture;
+
+static int setup(void **state)
+{
+    static fixture f;
+    memset(&f, 0, sizeof f);
+    thz_error err;
+    if (scene_load_string(render_json, ".", "render-unit", &f.scene, &err) != THZ_OK) {
+        print_message("%s\n", err.message);
+        return -1;
+    }
+    if (accel_create(f.scene, &f.acc, &err) != THZ_OK)
+        return -1;
+    photon_phase_options po = {.threads = 2};
+    if (photon_phase_run(f.scene, f.acc, 0, &po, &f.map, NULL, &err) != THZ_OK)
+        return -1;
+    *state = &f;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    fixture *f = *state;
+    photon_map_destroy(f->map);
+    accel_destroy(f->acc);
+    scene_destroy(f->scene);
+    return 0;
+}
+
+static void render(fixture *f, size_t sensor, int threads, sensor_images *img, render_stats *st)
+{
+    const thz_sensor *s = &f->scene->sensors[sensor];
+    assert_int_equal(sensor_images_init(img, s->columns, s->rows, 1, 1, NULL), THZ_OK);
+    render_options ro = {.threads = threads};
+    thz_error err;
+    assert_int_equal(render_sensor_truth(f->scene, f->acc, sensor, img, &ro, &err), THZ_OK);
+    assert_int_equal(
+        render_sensor_channel(f->scene, f->acc, f->map, 0, sensor, img, &ro, st, &err), THZ_OK);
+}
+
+/* The channel's band mean of B(T), by the library quadrature (tested elsewhere). */
+static double band_planck(const thz_channel *ch, double t)
+{
+    channel_quadrature q;
+    assert_int_equal(channel_quadrature_init(&q, ch, CHANNEL_QUADRATURE_NODES, NULL), THZ_OK);
+    double b = 0.0;
+    for (size_t k = 0; k < q.n; k++)
+        b += q.weight[k] * planck_radiance(q.freq_hz[k], t);
+    channel_quadrature_fini(&q);
+    return b;
+}
+
+static void test_oversampled_attenuation_and_truth(void **state)
+{
+    fixture *f = *state;
+    sensor_images img;
+    render_stats st;
+    render(f, 0, 2, &img, &st);
+    camera cam;
+    assert_int_equal(camera_init(&cam, &f->scene->sensors[0], NULL), THZ_OK);
+    double b = band_planck(&f->scene->channels[0], 300.0);
+    assert_int_equal(st.samples, 5 * 4 * 9);
+    assert_int_equal(st.back_face_samples, 0);
+    for (uint32_t row = 0; row < 4; row++)
+        for (uint32_t col = 0; col < 5; col++) {
+            /* the pixel value is the mean of its 9 samples, each B exp(-alpha d_s) */
+            double expect = 0.0;
+            for (uint32_t j = 0; j < 3; j++)
+                for (uint32_t i = 0; i < 3; i++) {
+                    vec3 d = camera_sample_dir(&cam, col, row, i, j);
+                    expect += b * exp(-0.2 * (3.0 + 2.9) / d.y) / 9.0;
+                }
+            size_t p = row * 5 + col;
+            assert_true(fabs(img.radiance[p] - expect) <= 1e-5 * expect);
+            vec3 c = camera_pixel_center_dir(&cam, col, row);
+            assert_true(fabs(img.distance_m[p] - 5.9 / c.y) <= 1e-5);
+            assert_int_equal(img.object_id[p], 0);
+            assert_true(img.temperature_k[p] == 300.0f);
+            double shade = 0.25 + 0.75 * c.y; /* |cos theta| against the far wall */
+            assert_true(fabs(img.visual_rgb[3 * p + 2] - 0.8 * shade) < 1e-6);
+            assert_true(fabs(img.visual_rgb[3 * p + 0] - 0.2 * shade) < 1e-6);
+        }
+    sensor_images_fini(&img);
+}
+
+static void test_back_faces_are_black_and_counted(void **state)
+{
+    fixture *f = *state;
+    sensor_images img;
+    render_stats st;
+    render(f, 1, 1, &img, &st);
+    assert_int_equal(st.samples, 16);
+    assert_int_equal(st.back_face_samples, 16);
+    for (size_t p = 0; p < 16; p++) {
+        assert_true(img.radiance[p] == 0.0f);
+        assert_true(img.brightness_temperature[p] == 0.0f);
+        assert_int_equal(img.object_id[p], 0); /* the truth still names what is there */
+    }
+    sensor_images_fini(&img);
+}
+
+static void test_thread_count_does_not_matter(void **state)
+{
+    fixture *f = *state;
+    /* a sensor that sees the grey box: photon terms, widened gathers */
+    thz_sensor *s = &f->scene->sensors[0];
+    thz_sensor saved = *s;
+    s->fov_deg = 30.0;
+    s->columns = 33;
+    s->rows = 17;
+    s->oversampling = 2;
+    sensor_images a, b;
+    render_stats sa, sb;
+    render(f, 0, 1, &a, &sa);
+    render(f, 0, 2, &b, &sb);
+    *s = saved;
+    size_t n = 33 * 17;
+    assert_memory_equal(a.radiance, b.radiance, n * sizeof(float));
+    assert_memory_equal(a.radiance_stderr, b.radiance_stderr, n * sizeof(float));
+    assert_memory_equal(a.visual_rgb, b.visual_rgb, 3 * n * sizeof(float));
+    assert_int_equal(sa.widened_gathers, sb.widened_gathers);
+    bool sees_box = false;
+    for (size_t p = 0; p < n; p++)
+        sees_box |= a.object_id[p] == 1;
+    assert_true(sees_box);
+    sensor_images_fini(&a);
+    sensor_images_fini(&b);
+}
+
+static int cancel_at_second_call(void *user, const thz_progress *p)
+{
+    int *calls = user;
+    assert_string_equal(p->stage, "render");
+    return ++*calls >= 2;
+}
+
+static void test_cancel(void **state)
+{
+    fixture *f = *state;
+    const thz_sensor *s = &f->scene->sensors[0];
+    sensor_images img;
+    assert_int_equal(sensor_images_init(&img, s->columns, s->rows, 1, 0, NULL), THZ_OK);
+    int calls = 0;
+    render_options ro = {.threads = 1, .progress = cancel_at_second_call, .progress_user = &calls};
+    thz_error err;
+    assert_int_equal(render_sensor_channel(f->scene, f->acc, f->map, 0, 0, &img, &ro, NULL, &err),
+                     THZ_ERR_CANCELLED);
+    assert_int_equal(calls, 2);
+    sensor_images_fini(&img);
+}
+
+static void test_unimplemented_integrator(void **state)
+{
+    fixture *f = *state;
+    thz_error err;
+    assert_int_equal(render_integrator_check(INTEGRATOR_PHOTON_MAP, &err), THZ_OK);
+    assert_int_equal(render_integrator_check(INTEGRATOR_PATH, &err), THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "integrator 'path' is not implemented yet"));
+    f->scene->render.integrator = INTEGRATOR_FINAL_GATHER;
+    sensor_images img;
+    assert_int_equal(sensor_images_init(&img, 5, 4, 1, 0, NULL), THZ_OK);
+    assert_int_equal(render_sensor_channel(f->scene, f->acc, f->map, 0, 0, &img, NULL, NULL, &err),
+                     THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "'final-gather' is not implemented yet"));
+    f->scene->render.integrator = INTEGRATOR_PHOTON_MAP;
+    thz_integrator it;
+    assert_true(render_integrator_parse("path", &it) && it == INTEGRATOR_PATH);
+    assert_false(render_integrator_parse("photonmap", &it));
+    assert_string_equal(render_integrator_name(INTEGRATOR_FINAL_GATHER), "final-gather");
+    sensor_images_fini(&img);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_oversampled_attenuation_and_truth),
+        cmocka_unit_test(test_back_faces_are_black_and_counted),
+        cmocka_unit_test(test_thread_count_does_not_matter),
+        cmocka_unit_test(test_cancel),
+        cmocka_unit_test(test_unimplemented_integrator),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
