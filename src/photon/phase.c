@@ -130,6 +130,11 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
             }
         }
     }
+    if (capacity > count && count > 0) { /* give back the growth slack */
+        photon_record *p = thz_realloc_array(records, count, sizeof *p);
+        if (p)
+            records = p;
+    }
     *out_records = records;
     *out_count = count;
     records = NULL;
