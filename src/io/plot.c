@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <plplot/plplot.h>
 
@@ -61,6 +62,18 @@ static int plot_compare_float(const void *a, const void *b)
 /* Caller holds plot_lock. */
 static thz_status plot_check_device_locked(thz_error *err)
 {
+    /* PLplot exits the process when its driver directory holds no driver at all, so a
+     * directory set by the user is checked for the cairo driver before PLplot looks. */
+    const char *drv_dir = getenv("PLPLOT_DRV_DIR");
+    if (drv_dir && *drv_dir) {
+        char info[4096];
+        int n = snprintf(info, sizeof info, "%s/cairo.driver_info", drv_dir);
+        if (n < 0 || (size_t)n >= sizeof info || access(info, R_OK) != 0)
+            return thz_error_set(err, THZ_ERR_IO,
+                                 "PLplot has no pngcairo device in PLPLOT_DRV_DIR=%s: install "
+                                 "the package plplot-driver-cairo or unset PLPLOT_DRV_DIR",
+                                 drv_dir);
+    }
     const char *menu[PLOT_MAX_DEVICES];
     const char *names[PLOT_MAX_DEVICES];
     const char **pm = menu, **pn = names;

@@ -67,6 +67,23 @@ static void test_device(void **state)
         fail_msg("%s", err.message);
 }
 
+/* A PLPLOT_DRV_DIR without the cairo driver is our error, not PLplot's exit. */
+static void test_device_dir_without_cairo(void **state)
+{
+    (void)state;
+    const char *old = getenv("PLPLOT_DRV_DIR");
+    char *saved = old ? thz_strdup(old) : NULL;
+    setenv("PLPLOT_DRV_DIR", "/nonexistent-thz-plplot-drivers", 1);
+    thz_error err = {0};
+    assert_int_equal(plot_check_device(&err), THZ_ERR_IO);
+    assert_non_null(strstr(err.message, "plplot-driver-cairo"));
+    if (saved)
+        setenv("PLPLOT_DRV_DIR", saved, 1);
+    else
+        unsetenv("PLPLOT_DRV_DIR");
+    free(saved);
+}
+
 static void test_image_colours(void **state)
 {
     (void)state;
@@ -205,9 +222,9 @@ static void test_threads(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_device),     cmocka_unit_test(test_image_colours),
-        cmocka_unit_test(test_odd_images), cmocka_unit_test(test_lines),
-        cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_device),        cmocka_unit_test(test_device_dir_without_cairo),
+        cmocka_unit_test(test_image_colours), cmocka_unit_test(test_odd_images),
+        cmocka_unit_test(test_lines),         cmocka_unit_test(test_threads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
