@@ -48,9 +48,10 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
                             const atm_lines_options *opt, thz_error *err);
 void atm_lines_destroy(atm_lines_data *lines);
 void atm_lines_parts(const atm_lines_data *lines, double freq_hz, atm_alpha_parts *parts);
-/* Smallest line half width (Lorentz and Doppler combined) among lines centred in
- * [lo_hz, hi_hz], in Hz; INFINITY if none. Sets the tabulation step. */
-double atm_lines_min_width_hz(const atm_lines_data *lines, double lo_hz, double hi_hz);
+/* Grid step in Hz for tabulating alpha over [lo_hz, hi_hz] to ~6e-6 relative with
+ * cubic interpolation, from the widths of the lines near the band and their share
+ * of alpha; INFINITY if no line shapes the band. */
+double atm_lines_grid_step_hz(const atm_lines_data *lines, double lo_hz, double hi_hz);
 
 /* The Voigt profile (area 1, in 1/Hz units of its arguments) at offset x from the
  * centre, for Lorentz HWHM gamma_l and Doppler HWHM gamma_d; Humlicek (1982) W4. */

