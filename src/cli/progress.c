@@ -46,6 +46,7 @@ void cli_progress_init(cli_progress *p, const char *command, bool quiet)
     p->command = command;
     p->quiet = quiet;
     p->tty = isatty(fileno(stderr)) != 0;
+    p->last_report_s = cli_now_s();
 }
 
 /* The unit a stage counts in. */
@@ -100,13 +101,15 @@ int cli_progress_report(void *user, const thz_progress *pr)
     if (p->quiet)
         return 0;
     double now = cli_now_s();
+    double previous = p->last_report_s;
+    p->last_report_s = now;
     bool new_stage = !p->stage || strcmp(p->stage, pr->stage) != 0 || p->channel != pr->channel ||
                      pr->done < p->last_done;
     if (new_stage) {
         p->stage = pr->stage;
         p->channel = pr->channel;
         p->completed = false;
-        p->stage_start_s = now;
+        p->stage_start_s = previous;
         p->last_draw_s = 0.0;
     }
     p->last_done = pr->done;

@@ -24,7 +24,9 @@ typedef struct cli_progress {
     size_t channel;
     uint64_t last_done;
     bool completed;      /* the completion of the current stage was shown */
-    double stage_start_s;
+    double stage_start_s; /* taken as the time of the report before the stage's first one:
+                             stages may report only when a batch is done */
+    double last_report_s;
     double last_draw_s;
 } cli_progress;
 

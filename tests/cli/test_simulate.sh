@@ -71,6 +71,17 @@ if ! diff -r -q --exclude=summary.json "$work/t1" "$work/t2"; then
 fi
 ls -A "$work/t1" | grep -q '^\.' && fail "a hidden (staging) entry was left in OUTDIR"
 
+# --- progress: one line per channel and stage on a non-terminal, nothing with --quiet ---
+"$THZMAP" simulate "$work/scene.json" -o "$work/p" --photons 20000 > "$work/p.out" 2> "$work/p.err" \
+    || fail "simulate with progress exited $?"
+grep -q "channel 2/2, photons: 20000 photons in .* s (.* photons/s)" "$work/p.err" \
+    || fail "no photon progress line: $(cat "$work/p.err")"
+grep -q "channel 1/2, render: " "$work/p.err" || fail "no render progress line"
+grep -q "results in $work/p" "$work/p.out" || fail "no closing line: $(cat "$work/p.out")"
+"$THZMAP" simulate "$work/scene.json" -o "$work/q" --photons 20000 --quiet > "$work/q.out" 2> "$work/q.err"
+[ -s "$work/q.err" ] && fail "--quiet printed to stderr: $(cat "$work/q.err")"
+[ -s "$work/q.out" ] && fail "--quiet printed to stdout: $(cat "$work/q.out")"
+
 # --- render from the saved map ---------------------------------------------------------
 "$THZMAP" render "$work/scene.json" --photon-map "$work/t1/photon-map.thzpm" -o "$work/r" \
     --threads 2 --quiet || fail "render exited $?"
