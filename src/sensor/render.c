@@ -240,12 +240,12 @@ static void render_gather_visit(void *vstate, const photon_record *p, double dis
     g->count++;
     double nu = (double)p->freq_hz;
     const thz_scene *scene = g->ctx->scene;
-    optics_point o = scene_object_optics(scene, g->obj, nu);
     double f;
     if (!g->transmitted) {
-        f = o.reflectivity / M_PI;
+        f = spectrum_eval(&scene->materials[g->obj->material].reflectivity, nu) / M_PI;
     } else {
         /* f_T = T(theta_p) T(theta_o) / (pi T-bar): the reciprocal BTDF */
+        optics_point o = scene_object_optics(scene, g->obj, nu);
         double mu_p = fmax(fabs(along), 1e-12);
         double tbar = optics_mean_transmission(&o);
         f = tbar > 0.0
