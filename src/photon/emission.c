@@ -36,8 +36,61 @@ void emission_table_fini(emission_table *t)
         return;
     for (size_t i = 0; i < t->n_sources; i++)
         free(t->sources[i].triangle_cdf);
+    for (size_t g = 0; g < t->n_groups; g++)
+        free(t->groups[g].cdf);
     free(t->sources);
+    free(t->groups);
+    free(t->order);
     memset(t, 0, sizeof *t);
+}
+
+/* Groups the sources: constant-optics sources by temperature (in order of first
+ * appearance), every other source alone. */
+static bool emission_group_sources(emission_table *t)
+{
+    size_t n = t->n_sources;
+    t->groups = thz_calloc(n ? n : 1, sizeof *t->groups);
+    t->order = thz_malloc_array(n ? n : 1, sizeof *t->order);
+    bool *taken = thz_calloc(n ? n : 1, sizeof *taken);
+    if (!t->groups || !t->order || !taken) {
+        free(taken);
+        return false;
+    }
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (taken[i])
+            continue;
+        const emission_source *s = &t->sources[i];
+        double temp = t->scene->objects[s->object].temperature_k;
+        emission_group *g = &t->groups[t->n_groups++];
+        g->temperature_k = temp;
+        g->first = k;
+        for (size_t j = i; j < n; j++) {
+            const emission_source *u = &t->sources[j];
+            bool same = j == i || (s->constant_optics && u->constant_optics && !taken[j] &&
+                                   t->scene->objects[u->object].temperature_k == temp);
+            if (!same)
+                continue;
+            taken[j] = true;
+            t->order[k++] = j;
+            g->weight += u->weight;
+        }
+        g->count = k - g->first;
+        if (g->count > 1) {
+            g->cdf = thz_malloc_array(g->count, sizeof *g->cdf);
+            if (!g->cdf) {
+                free(taken);
+                return false;
+            }
+            double acc = 0.0;
+            for (size_t m = 0; m < g->count; m++) {
+                acc += t->sources[t->order[g->first + m]].weight;
+                g->cdf[m] = acc;
+            }
+        }
+    }
+    free(taken);
+    return true;
 }
 
 thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t channel,
@@ -47,7 +100,7 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t
     t->scene = scene;
     t->channel = channel;
     t->n_photons = n_photons ? n_photons : 1;
-    t->sources = thz_calloc(scene->n_objects, sizeof *t->sources);
+    t->sources = thz_calloc(scene->n_objects ? scene->n_objects : 1, sizeof *t->sources);
     if (!t->sources)
         return thz_error_set(err, THZ_ERR_NOMEM, "photon emission: out of memory");
     for (size_t i = 0; i < scene->n_objects; i++) {
@@ -63,6 +116,7 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t
             emission_table_fini(t);
             return thz_error_set(err, THZ_ERR_NOMEM, "photon emission: out of memory");
         }
+        t->n_sources++;
         double sum = 0.0;
         for (size_t k = 0; k < obj->mesh.n_triangles; k++) {
             sum += obj->mesh.areas_m2[k];
@@ -75,26 +129,39 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t
                              spectrum_is_constant(&m->emissivity);
         if (s->constant_optics) {
             optics_point o = scene_object_optics(scene, obj, scene->channels[channel].center_hz);
-            s->eps_mean = optics_mean_emissivity(&o);
+            s->weight = M_PI * optics_mean_emissivity(&o) * s->area_m2 * s->sides;
+            if (!(s->weight > 0.0)) { /* eps-bar = 0: emits nothing */
+                free(s->triangle_cdf);
+                memset(s, 0, sizeof *s);
+                t->n_sources--;
+            }
         }
-        t->n_sources++;
+    }
+    if (!emission_group_sources(t)) {
+        emission_table_fini(t);
+        return thz_error_set(err, THZ_ERR_NOMEM, "photon emission: out of memory");
     }
     return THZ_OK;
 }
 
-double emission_source_weights(const emission_table *t, double freq_hz, double *weights)
+/* pi eps-bar(nu) A sides of a source whose optics vary with frequency. */
+static double emission_variable_weight(const emission_table *t, const emission_source *s,
+                                       double freq_hz)
+{
+    const thz_object *obj = &t->scene->objects[s->object];
+    optics_point o = scene_object_optics(t->scene, obj, freq_hz);
+    return M_PI * optics_mean_emissivity(&o) * s->area_m2 * s->sides;
+}
+
+double emission_group_weights(const emission_table *t, double freq_hz, double *weights)
 {
     double total = 0.0;
-    for (size_t i = 0; i < t->n_sources; i++) {
-        const emission_source *s = &t->sources[i];
-        const thz_object *obj = &t->scene->objects[s->object];
-        double eps = s->eps_mean;
-        if (!s->constant_optics) {
-            optics_point o = scene_object_optics(t->scene, obj, freq_hz);
-            eps = optics_mean_emissivity(&o);
-        }
-        double w = M_PI * eps * s->area_m2 * s->sides * planck_radiance(freq_hz, obj->temperature_k);
-        weights[i] = w;
+    for (size_t g = 0; g < t->n_groups; g++) {
+        const emission_group *gr = &t->groups[g];
+        const emission_source *s = &t->sources[t->order[gr->first]];
+        double w = s->constant_optics ? gr->weight : emission_variable_weight(t, s, freq_hz);
+        w *= planck_radiance(freq_hz, gr->temperature_k);
+        weights[g] = w;
         total += w;
     }
     return total;
@@ -120,26 +187,36 @@ bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
     const thz_channel *ch = &t->scene->channels[t->channel];
     double u1 = rng_uniform(rng), u2 = rng_uniform(rng);
     out->freq_hz = channel_sample_hz(ch, u1, u2);
-    double total = emission_source_weights(t, out->freq_hz, scratch);
+    double total = emission_group_weights(t, out->freq_hz, scratch);
     out->power_w_per_hz = total / (double)t->n_photons;
     if (!(total > 0.0)) {
         out->power_w_per_hz = 0.0;
         return false;
     }
 
-    /* Source object by its weight at this frequency (linear scan: objects are few). */
+    /* Group by its power at this frequency (linear scan: groups are few), then the
+     * source within it by its weight. */
     double x = rng_uniform(rng) * total;
-    size_t src = t->n_sources - 1;
+    size_t g = t->n_groups - 1;
     double acc = 0.0;
-    for (size_t i = 0; i < t->n_sources; i++) {
+    for (size_t i = 0; i < t->n_groups; i++) {
         acc += scratch[i];
         if (x < acc && scratch[i] > 0.0) {
-            src = i;
+            g = i;
             break;
         }
     }
-    while (scratch[src] <= 0.0 && src > 0) /* rounding at the top end */
-        src--;
+    while (scratch[g] <= 0.0 && g > 0) /* rounding at the top end */
+        g--;
+    const emission_group *gr = &t->groups[g];
+    size_t within = 0;
+    double uw = rng_uniform(rng);
+    if (gr->count > 1) {
+        within = emission_search(gr->cdf, gr->count, uw * gr->cdf[gr->count - 1]);
+        while (t->sources[t->order[gr->first + within]].weight <= 0.0 && within > 0)
+            within--;
+    }
+    size_t src = t->order[gr->first + within];
     const emission_source *s = &t->sources[src];
     const thz_object *obj = &t->scene->objects[s->object];
     const thz_mesh *m = &obj->mesh;

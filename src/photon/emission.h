@@ -32,9 +32,21 @@ typedef struct emission_source {
     int sides;               /* 1 or 2 emitting sides */
     double area_m2;          /* total area of one side */
     bool constant_optics;    /* R, alpha_M and eps do not depend on frequency */
-    double eps_mean;         /* eps-bar when constant_optics */
+    double weight;           /* constant optics: pi eps-bar A sides (times B_nu(T) = power) */
     double *triangle_cdf;    /* n_triangles cumulative areas, last = total */
 } emission_source;
+
+/* Sources sharing a temperature and constant optics form one group, so that a photon
+ * costs one Planck evaluation per group, not per object: the group is drawn by its
+ * power at the photon's frequency, the source within it by its frequency-independent
+ * weight (CDF over the group's sources). A source whose optics vary with frequency is
+ * a group of its own, its eps-bar evaluated at each photon's frequency. */
+typedef struct emission_group {
+    double temperature_k;
+    size_t first, count; /* range of emission_table.order */
+    double weight;       /* sum of the sources' weights (constant optics) */
+    double *cdf;         /* count cumulative weights (count > 1) */
+} emission_group;
 
 /* Sampling tables of one channel. Read-only after init: shared by all threads. */
 typedef struct emission_table {
@@ -43,6 +55,9 @@ typedef struct emission_table {
     uint64_t n_photons; /* K: each photon carries P_A(nu) / K */
     size_t n_sources;
     emission_source *sources;
+    size_t n_groups;
+    emission_group *groups;
+    size_t *order; /* source indices, grouped */
 } emission_table;
 
 /* A photon as emitted. */
@@ -60,13 +75,13 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t
                                uint64_t n_photons, thz_error *err);
 void emission_table_fini(emission_table *t);
 
-/* P_A(freq_hz) over the table's sources, writing each source's weight
- * pi eps-bar A sides B_nu(T) into weights[0..n_sources-1] (caller's scratch). */
-double emission_source_weights(const emission_table *t, double freq_hz, double *weights);
+/* P_A(freq_hz) over the table's sources, writing each group's power
+ * pi eps-bar A sides B_nu(T) into weights[0..n_groups-1] (caller's scratch). */
+double emission_group_weights(const emission_table *t, double freq_hz, double *weights);
 
-/* Draws one photon from rng. `scratch` holds n_sources doubles (per thread; nothing is
- * allocated here). Returns false when P_A(nu) = 0 at the drawn frequency: the photon then
- * has power 0 and nothing else is set. */
+/* Draws one photon from rng. `scratch` holds n_sources doubles (>= n_groups; per thread,
+ * nothing is allocated here). Returns false when P_A(nu) = 0 at the drawn frequency: the
+ * photon then has power 0 and nothing else is set. */
 bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
                      emission_photon *out);
 

@@ -34,6 +34,18 @@ static double band_planck(const thz_channel *ch, double temp_k)
     return channel_band_mean(ch, planck_at, &temp_k);
 }
 
+static double table_emission_at(double freq_hz, void *ctx)
+{
+    double r = 0.8 * (freq_hz - 0.3e12) / 0.1e12;
+    r = r < 0 ? 0 : (r > 0.8 ? 0.8 : r);
+    return (1.0 - r) * planck_radiance(freq_hz, *(const double *)ctx);
+}
+
+static double band_table_emission(const thz_channel *ch, double temp_k)
+{
+    return channel_band_mean(ch, table_emission_at, &temp_k);
+}
+
 static void test_frequencies_follow_band(void **state)
 {
     (void)state;
@@ -87,7 +99,7 @@ static void test_source_fractions(void **state)
 {
     (void)state;
     uint64_t n = ps_scaled(400000);
-    thz_scene *s = ps_scene(0.35, 0.01, n, 4);
+    thz_scene *s = ps_scene(0.35, 0.1, n, 4); /* wide: g's R varies by 0.28 across it */
     size_t grey = ps_material(s, 0.3, 0.0, -1.0, TRANSMISSION_DIFFUSE);
     size_t black = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
     size_t explicit = ps_material(s, 0.1, 50.0, 0.4, TRANSMISSION_DIFFUSE);
@@ -105,27 +117,44 @@ static void test_source_fractions(void **state)
     ps_face(s, d, v3(6, 0, 0), v3(0, 0.3, 0), v3(0, 0, 0.25));
     size_t e0 = ps_object(s, OBJECT_SOLID, black, 0, 0, true);
     ps_face(s, e0, v3(8, 0, 0), v3(1, 0, 0), v3(0, 0.5, 0));
+    /* f: another 300 K constant-optics source (shares a's group), R = 0.5, 0.5 m2;
+     * g: a 300 K source whose R varies across the band (a group of its own), 0.2 m2. */
+    size_t half = ps_material(s, 0.5, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t f6 = ps_object(s, OBJECT_SOLID, half, 300, 0, false);
+    ps_face(s, f6, v3(10, 0, 0), v3(0.5, 0, 0), v3(0, 0.25, 0));
+    size_t table = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    const double fr[2] = {0.3e12, 0.4e12}, rv[2] = {0.0, 0.8};
+    ps_check(spectrum_set_table(&s->materials[table].reflectivity, 2, fr, rv));
+    size_t g7 = ps_object(s, OBJECT_SOLID, table, 300, 0, false);
+    ps_face(s, g7, v3(12, 0, 0), v3(0.1, 0, 0), v3(0, 0.5, 0));
     ps_finalize(s);
     const thz_channel *ch = &s->channels[0];
     optics_point od = scene_object_optics(s, &s->objects[d], ch->center_hz);
     double eps_d = optics_mean_emissivity(&od);
     assert_true(eps_d > 0.05 && eps_d < 0.9 - 0.05);
-    double w[5] = {
+    /* g's emissivity 1 - R(nu) is linear across the band: 1 - 8 (nu - 0.3 THz) / THz
+     * at 0.35 THz is 0.6; the band mean of (1 - R) B is computed by quadrature. */
+    double w[7] = {
         M_PI * 0.7 * 1.0 * 1 * band_planck(ch, 300),
         M_PI * 1.0 * 0.5 * 2 * band_planck(ch, 200),
         M_PI * 0.4 * 0.25 * 2 * band_planck(ch, 350),
         M_PI * eps_d * 0.3 * 2 * band_planck(ch, 280),
         0.0,
+        M_PI * 0.5 * 0.5 * 1 * band_planck(ch, 300),
+        M_PI * 1.0 * 0.2 * 1 * band_table_emission(ch, 300),
     };
-    double total = w[0] + w[1] + w[2] + w[3];
+    double total = w[0] + w[1] + w[2] + w[3] + w[5] + w[6];
     assert_float_equal(scene_band_emitted_power_w_per_hz(s, 0), total, 1e-6 * total);
 
     emission_table t;
     thz_error err;
     assert_int_equal(emission_table_init(&t, s, 0, n, &err), THZ_OK);
-    assert_int_equal(t.n_sources, 4);
-    uint64_t count[5] = {0}, side1[5] = {0};
-    double scratch[5];
+    assert_int_equal(t.n_sources, 6);
+    assert_int_equal(t.n_groups, 5);
+    uint64_t count[7] = {0}, side1[7] = {0};
+    double scratch[7], power[7] = {0}, fired = 0.0;
+    double *phi = malloc(n * sizeof *phi);
+    uint32_t *src = malloc(n * sizeof *src);
     for (uint64_t i = 0; i < n; i++) {
         rng_stream rng;
         rng_init(&rng, 4, 0, RNG_PURPOSE_PHOTON, i);
@@ -133,6 +162,10 @@ static void test_source_fractions(void **state)
         assert_true(emission_sample(&t, &rng, scratch, &e));
         count[e.object]++;
         side1[e.object] += (uint64_t)e.side;
+        power[e.object] += e.power_w_per_hz;
+        fired += e.power_w_per_hz;
+        phi[i] = e.power_w_per_hz;
+        src[i] = e.object;
         const thz_mesh *m = &s->objects[e.object].mesh;
         const float *nf = &m->normals[3 * (size_t)e.triangle];
         double cn = v3_dot(e.dir, v3(nf[0], nf[1], nf[2]));
@@ -142,10 +175,23 @@ static void test_source_fractions(void **state)
             assert_true(x >= m->bbox_min_m[k] - 1e-9 && x <= m->bbox_max_m[k] + 1e-9);
         }
     }
-    const char *names[5] = {"one-sided grey", "two-sided black", "explicit shell",
-                            "Kirchhoff shell", "0 K"};
-    for (int k = 0; k < 5; k++)
-        check_fraction(count[k], n, w[k] / total, names[k]);
+    const char *names[7] = {"one-sided grey", "two-sided black", "explicit shell",
+                            "Kirchhoff shell", "0 K", "same group as grey", "R(nu) table"};
+    /* Eq. 5 in the band mean: each source's share of the power fired is its share of
+     * P-bar_A. Standard error of the ratio estimator: sqrt(sum Phi^2 (I - f)^2) / sum Phi. */
+    for (uint32_t k = 0; k < 7; k++) {
+        double f = power[k] / fired, v = 0.0;
+        for (uint64_t i = 0; i < n; i++) {
+            double dev = (src[i] == k ? 1.0 : 0.0) - f;
+            v += phi[i] * phi[i] * dev * dev;
+        }
+        double se = fmax(sqrt(v) / fired, 1.0 / (double)n), p = w[k] / total;
+        printf("# %s: power share %.5f expected %.5f (%.1f se)\n", names[k], f, p, (f - p) / se);
+        assert_true(fabs(f - p) < 5.0 * se);
+    }
+    assert_int_equal(count[e0], 0);
+    free(phi);
+    free(src);
     assert_int_equal(side1[a], 0);
     check_fraction(side1[b], count[b], 0.5, "two-sided: back side");
     check_fraction(side1[c], count[c], 0.5, "shell: back side");
