@@ -39,8 +39,8 @@
 #define H2O_CUTOFF_GHZ 750.0   /* 25 cm^-1: MT_CKD's line cut-off */
 #define O2_DRY_AIR_VMR 0.20946 /* O2 fraction of dry air */
 #define VOIGT_DOPPLER_RATIO 1e-3 /* Voigt when gamma_D > this times gamma_L */
-#define VOIGT_WINDOW 300.0       /* ... within this many gamma_D of the centre; beyond,
-                                    Voigt = Lorentz to ~1e-5 relative */
+#define VOIGT_WINDOW 3000.0      /* ... within this many gamma_D of the centre; beyond,
+                                    Voigt = Lorentz to ~3e-7 relative */
 #define COUPLED_MATCH_GHZ 0.005  /* .par O2 lines this close to a coupled line are it */
 #define H_OVER_K_K_PER_GHZ 0.0479924307 /* h / k in K/GHz (CODATA 2018) */
 #define HC_OVER_K_CM_K 1.438776877      /* second radiation constant, cm K */

@@ -173,6 +173,36 @@ static void test_par_equals_csv(void **state)
     atmosphere_fini(&b);
 }
 
+/* An O2 HITRAN list holds the 60 GHz band and the 118.75 GHz line too; read as a
+ * .par, those (here 1 MHz off the coupled table's frequencies) are dropped, since
+ * the coupled table already has them with line mixing: alpha equals that of the
+ * uncoupled CSV lines alone. Without the drop the band would count twice (+100 %). */
+static void test_par_o2_coupled_not_doubled(void **state)
+{
+    (void)state;
+    atm_air_state air = reference_air(7.5);
+    atm_lines_options o;
+    atmosphere_lines_options_default(&o);
+    thz_atmosphere a, b;
+    o.o2_lines_file = THZ_SOURCE_DIR "/tests/inputs/atm_o2_subset.csv";
+    init_lines(&a, &air, &o);
+    o.o2_lines_file = THZ_SOURCE_DIR "/tests/inputs/atm_o2_with_coupled.par";
+    init_lines(&b, &air, &o);
+    double worst = 0;
+    for (double f = 2.0; f < 200.0; f += 0.37) {
+        atm_alpha_parts pa, pb;
+        atmosphere_alpha_parts(&a, f * 1e9, &pa);
+        atmosphere_alpha_parts(&b, f * 1e9, &pb);
+        double r = fabs(pb.o2_per_m / pa.o2_per_m - 1);
+        worst = fmax(worst, r);
+        if (r > 1e-4)
+            fail_msg("%g GHz: O2 from .par %g 1/m, from CSV %g 1/m", f, pb.o2_per_m, pa.o2_per_m);
+    }
+    print_message("O2 .par (with coupled lines) vs CSV: worst relative difference %.2e\n", worst);
+    atmosphere_fini(&a);
+    atmosphere_fini(&b);
+}
+
 static void test_bad_par_refused(void **state)
 {
     (void)state;
@@ -218,6 +248,56 @@ static void test_tabulation_error(void **state)
     atmosphere_fini(&lbl);
 }
 
+/* At 10 hPa the lines are Doppler-and-pressure (Voigt) lines of a few MHz; the
+ * tabulation must still reach < 1e-4 (it needs a smooth Voigt to do so). */
+static void test_tabulation_low_pressure(void **state)
+{
+    (void)state;
+    thz_error err = {0};
+    atm_air_state air;
+    assert_int_equal(atm_air_state_init(&air, 230.0, 10.0, ATM_HUMIDITY_VMR, 1e-4, &err), THZ_OK);
+    thz_atmosphere lbl;
+    init_lines(&lbl, &air, NULL);
+    thz_channel ch = {.name = "557", .center_hz = 556.936e9, .relative_width = 0.002};
+    if (atmosphere_prepare(&lbl, &ch, 1, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    double sigma = channel_sigma_hz(&ch), worst = 0;
+    for (int i = 0; i < 4000; i++) {
+        double u = fmod(0.5 + i * 0.6180339887498949, 1.0);
+        double f = ch.center_hz + (2 * u - 1) * 6 * sigma;
+        double t = atmosphere_alpha_per_m(&lbl, f), d = atmosphere_alpha_direct_per_m(&lbl, f);
+        worst = fmax(worst, fabs(t / d - 1));
+    }
+    print_message("tabulation at 10 hPa: %zu points, worst relative error %.2e\n",
+                  lbl.tables[0].n, worst);
+    assert_true(worst < 1e-4);
+    atmosphere_fini(&lbl);
+}
+
+/* The Voigt profile against a direct quadrature of its defining convolution,
+ * V(x) = int G(t) L(x - t) dt, to 1e-7 (the quadrature's own error is ~1e-9). */
+static void test_voigt_quadrature(void **state)
+{
+    (void)state;
+    static const double xs[] = {0.0, 0.3, 1.0, 2.5, 6.0, 20.0};
+    static const double gls[] = {0.05, 0.3, 1.0, 4.0};
+    double gd = 1.0, alpha_d = gd / sqrt(M_LN2), worst = 0;
+    for (size_t i = 0; i < sizeof xs / sizeof xs[0]; i++) {
+        for (size_t j = 0; j < sizeof gls / sizeof gls[0]; j++) {
+            double gl = gls[j], h = fmin(1e-3, gl / 40.0), sum = 0;
+            for (double t = -12 * alpha_d; t <= 12 * alpha_d; t += h) {
+                double g = exp(-(t / alpha_d) * (t / alpha_d)) / (alpha_d * sqrt(M_PI));
+                double d = xs[i] - t;
+                sum += g * gl / (M_PI * (d * d + gl * gl)) * h;
+            }
+            double v = atm_voigt(xs[i], gl, gd);
+            worst = fmax(worst, fabs(v / sum - 1));
+        }
+    }
+    print_message("Voigt vs quadrature: worst relative difference %.2e\n", worst);
+    assert_true(worst < 1e-7);
+}
+
 /* Voigt: unit area; Lorentz limit when Doppler is negligible; Gaussian peak
  * sqrt(ln 2 / pi) / gamma_D when pressure is negligible. Humlicek W4 is good to
  * ~1e-4, so 1e-3. */
@@ -240,8 +320,10 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_agrees_with_itu),  cmocka_unit_test(test_line_positions),
         cmocka_unit_test(test_humidity_scaling), cmocka_unit_test(test_par_equals_csv),
+        cmocka_unit_test(test_par_o2_coupled_not_doubled),
         cmocka_unit_test(test_bad_par_refused),  cmocka_unit_test(test_tabulation_error),
-        cmocka_unit_test(test_voigt),
+        cmocka_unit_test(test_tabulation_low_pressure),
+        cmocka_unit_test(test_voigt_quadrature), cmocka_unit_test(test_voigt),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
