@@ -1,7 +1,8 @@
 /* Russian roulette at a hit (eq. 8-10): the fractions reflected, transmitted and
  * absorbed equal R, T(theta) and A(theta); the diffuse BTDF's exit directions follow
  * T(theta_o) cos(theta_o) (histogram); and in a traced scene a photon crossing a
- * straight shell keeps its direction and power. Tolerances: 5 binomial standard errors
+ * straight shell keeps its direction and power; reflection is Lambertian on the side of
+ * incidence; the back of a one-sided solid absorbs. Tolerances: 5 binomial standard errors
  * of the sample count. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -160,12 +161,89 @@ static void test_transmission_in_scene(void **state)
     }
 }
 
+/* Reflection is Lambertian on the side of incidence: a photon arriving on either side of
+ * a two-sided mirror-white (R = 1) plate leaves into that side's hemisphere with
+ * mu ~ 2 mu (histogram of the direction recorded at the next hit, on a black plane).
+ * On the back of a one-sided solid it is absorbed however high R is, and recorded. */
+static void test_reflection_and_back_faces(void **state)
+{
+    (void)state;
+    for (int from_below = 0; from_below < 2; from_below++) {
+        thz_scene *s = ps_scene(0.35, 0.01, 1000, 6);
+        size_t white = ps_material(s, 1.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+        size_t black = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+        size_t plate = ps_object(s, OBJECT_SOLID, white, 0, 0, true);
+        ps_face(s, plate, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0)); /* normal +z */
+        double zc = from_below ? -1.0 : 1.0;
+        size_t cover = ps_object(s, OBJECT_SOLID, black, 0, 0, true);
+        ps_face(s, cover, v3(0, 0, zc), v3(1000, 0, 0), v3(0, 1000, 0));
+        size_t one_sided = ps_object(s, OBJECT_SOLID, white, 0, 0, false);
+        ps_face(s, one_sided, v3(50, 0, 0), v3(1, 0, 0), v3(0, 1, 0)); /* normal +z */
+        ps_finalize(s);
+        accel *acc;
+        thz_error err;
+        assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+        enum { BINS = 10 };
+        uint64_t n = ps_scaled(100000), hist[BINS] = {0};
+        trace_buffer buf = {0};
+        trace_counters c = {0};
+        vec3 in = v3_normalize(v3(0.3, 0.1, from_below ? 1.0 : -1.0));
+        for (uint64_t i = 0; i < n; i++) {
+            emission_photon e = {.freq_hz = 0.35e12, .power_w_per_hz = 1.0,
+                                 .position_m = v3(-0.15, -0.05, 0.5 * zc), .dir = in,
+                                 .object = (uint32_t)cover, .triangle = 0};
+            rng_stream rng;
+            rng_init(&rng, 6, 0, RNG_PURPOSE_TEST, i);
+            buf.count = 0;
+            assert_true(trace_photon(s, acc, &e, &rng, &buf, &c));
+            assert_int_equal(buf.count, 2);
+            assert_int_equal(photon_object(&buf.records[0]), plate);
+            assert_int_equal(photon_side(&buf.records[0]), from_below);
+            assert_int_equal(photon_object(&buf.records[1]), cover);
+            vec3 d = photon_decode_direction(buf.records[1].dir_oct);
+            assert_true(from_below ? d.z < 0 : d.z > 0); /* back into the side it came from */
+            int b = (int)(fabs(d.z) * BINS);
+            hist[b < BINS ? b : BINS - 1]++;
+        }
+        assert_int_equal(c.reflected, n);
+        assert_int_equal(c.back_face_hits, 0);
+        for (int b = 0; b < BINS; b++) {
+            double lo = (double)b / BINS, hi = (double)(b + 1) / BINS;
+            char what[48];
+            snprintf(what, sizeof what, "reflected mu bin %d", b);
+            check_fraction(hist[b], n, hi * hi - lo * lo, what);
+        }
+
+        /* From below onto the one-sided plate: its back side. */
+        if (from_below) {
+            memset(&c, 0, sizeof c);
+            emission_photon e = {.freq_hz = 0.35e12, .power_w_per_hz = 1.0,
+                                 .position_m = v3(50, 0, -0.5), .dir = v3(0, 0, 1),
+                                 .object = (uint32_t)cover, .triangle = 0};
+            rng_stream rng;
+            rng_init(&rng, 6, 1, RNG_PURPOSE_TEST, 0);
+            buf.count = 0;
+            assert_true(trace_photon(s, acc, &e, &rng, &buf, &c));
+            assert_int_equal(buf.count, 1);
+            assert_int_equal(photon_object(&buf.records[0]), one_sided);
+            assert_int_equal(photon_side(&buf.records[0]), 1);
+            assert_int_equal(c.back_face_hits, 1);
+            assert_int_equal(c.absorbed, 1);
+            assert_float_equal(c.absorbed_power, 1.0, 0.0);
+        }
+        trace_buffer_fini(&buf);
+        accel_destroy(acc);
+        scene_destroy(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_fractions),
         cmocka_unit_test(test_diffuse_exit_distribution),
         cmocka_unit_test(test_transmission_in_scene),
+        cmocka_unit_test(test_reflection_and_back_faces),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
