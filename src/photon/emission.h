@@ -3,9 +3,10 @@
  * Scheme (unbiased for the band mean, as physics.md allows): a photon's frequency nu is
  * drawn from the channel response g_c alone; at that nu its source object is chosen
  * with probability proportional to pi eps-bar(nu) A B_nu(T) times the number of
- * emitting sides (objects are few, so the weights are recomputed per photon, exactly,
- * at the photon's own frequency: no tabulation in frequency, narrow material lines are
- * integrated); then one of its emitting sides uniformly, a triangle by an area CDF
+ * emitting sides (recomputed per photon, exactly, at the photon's own frequency: no
+ * tabulation in frequency, so narrow material lines are integrated; one Planck
+ * evaluation per group of sources, see emission_group); then one of its emitting sides
+ * uniformly, a triangle by an area CDF
  * (binary search), a point uniformly on the triangle, and a direction with
  * mu ~ eps(mu) mu about the emitting side's normal and uniform azimuth. The photon
  * carries Phi(nu) = P_A(nu) / K, so the mean of Phi over photons is the band mean
