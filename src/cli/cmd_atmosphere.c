@@ -310,7 +310,10 @@ static int draw_plot(const options *o, const series *s, const thz_atmosphere *at
             plwidth(1.0);
             PLFLT lx[2] = {fc, fc}, ly[2] = {y_lo, y_hi};
             plline(2, lx, ly);
-            plptex(fc, y_hi - 0.25, 0.0, 1.0, 1.05, ch->name);
+            plcol0(1);
+            plschr(0, 0.8);
+            plptex(fc - 0.004 * (x_hi - x_lo), y_lo + 0.15, 0.0, 1.0, 0.0, ch->name);
+            plschr(0, 1.1);
         }
     }
 
