@@ -72,6 +72,50 @@ static void test_agrees_with_itu(void **state)
     atmosphere_fini(&lbl);
 }
 
+/* The same at 250 K and 310 K (relative humidity 0.5, 1013.25 hPa), which checks the
+ * temperature scaling of intensities, widths and the continuum against P.676's
+ * independent fit: line centres 6 % as above; windows 25 %, since the dry cold air
+ * (0.5 hPa of vapour at 250 K) makes the windows continuum-dominated, where the two
+ * continua's temperature laws differ most. Measured: 5.6 % and 20.1 %. */
+static void test_agrees_with_itu_other_temperatures(void **state)
+{
+    (void)state;
+    static const double centres_ghz[] = {22.235, 60.0, 118.75, 183.31, 556.94, 752.03};
+    static const double windows_ghz[] = {94.0, 220.0, 345.0, 410.0, 500.0, 670.0, 850.0};
+    static const double temps_k[] = {250.0, 310.0};
+    double worst_c = 0, worst_w = 0;
+    for (size_t k = 0; k < 2; k++) {
+        thz_error err = {0};
+        atm_air_state air;
+        assert_int_equal(atm_air_state_init(&air, temps_k[k], 1013.25, ATM_HUMIDITY_RELATIVE, 0.5,
+                                            &err),
+                         THZ_OK);
+        thz_atmosphere itu = {0}, lbl;
+        assert_int_equal(atmosphere_init_itu_p676(&itu, &air, NULL, &err), THZ_OK);
+        init_lines(&lbl, &air, NULL);
+        for (size_t i = 0; i < sizeof centres_ghz / sizeof centres_ghz[0]; i++) {
+            double f = centres_ghz[i] * 1e9;
+            double r = atmosphere_alpha_direct_per_m(&lbl, f) / atmosphere_alpha_direct_per_m(&itu, f);
+            worst_c = fmax(worst_c, fabs(r - 1));
+            if (fabs(r - 1) > 0.06)
+                fail_msg("%g K, line centre %g GHz: lines/itu-p676 = %.4f", temps_k[k],
+                         centres_ghz[i], r);
+        }
+        for (size_t i = 0; i < sizeof windows_ghz / sizeof windows_ghz[0]; i++) {
+            double f = windows_ghz[i] * 1e9;
+            double r = atmosphere_alpha_direct_per_m(&lbl, f) / atmosphere_alpha_direct_per_m(&itu, f);
+            worst_w = fmax(worst_w, fabs(r - 1));
+            if (fabs(r - 1) > 0.25)
+                fail_msg("%g K, window %g GHz: lines/itu-p676 = %.4f", temps_k[k], windows_ghz[i], r);
+        }
+        atmosphere_fini(&itu);
+        atmosphere_fini(&lbl);
+    }
+    print_message("lines vs itu-p676 at 250 and 310 K: worst %.1f %% at line centres, %.1f %% in "
+                  "windows\n",
+                  100 * worst_c, 100 * worst_w);
+}
+
 /* The 557 and 752 GHz H2O lines peak within 0.1 GHz of their catalogue centres
  * at 100 hPa (pressure shift there: 0.02 GHz), and at 1 atm within 0.1 GHz of the
  * air-shifted centre nu0 + delta_air p (+0.20 and +0.25 GHz: HITRAN's shifts are
@@ -318,7 +362,9 @@ static void test_voigt(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_agrees_with_itu),  cmocka_unit_test(test_line_positions),
+        cmocka_unit_test(test_agrees_with_itu),
+        cmocka_unit_test(test_agrees_with_itu_other_temperatures),
+        cmocka_unit_test(test_line_positions),
         cmocka_unit_test(test_humidity_scaling), cmocka_unit_test(test_par_equals_csv),
         cmocka_unit_test(test_par_o2_coupled_not_doubled),
         cmocka_unit_test(test_bad_par_refused),  cmocka_unit_test(test_tabulation_error),
