@@ -18,8 +18,8 @@ thz_status atm_air_state_init(atm_air_state *air, double temperature_k, double p
                               atm_humidity_kind kind, double value, thz_error *err)
 {
     if (!(temperature_k >= 100.0 && temperature_k <= 400.0))
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "air temperature must be 100 to 400 K, got %g K", temperature_k);
+        return thz_error_set(err, THZ_ERR_INPUT, "air temperature must be 100 to 400 K, got %g K",
+                             temperature_k);
     if (!(pressure_hpa > 0.0 && pressure_hpa <= 2000.0))
         return thz_error_set(err, THZ_ERR_INPUT,
                              "air pressure must be above 0 and at most 2000 hPa, got %g hPa",

@@ -19,8 +19,8 @@ typedef struct atm_csv {
     char *path;
     size_t n_cols, n_rows;
     char **names;
-    double *values;    /* n_rows * n_cols, row-major */
-    size_t *line_of;   /* file line number of each row, for messages */
+    double *values;  /* n_rows * n_cols, row-major */
+    size_t *line_of; /* file line number of each row, for messages */
 } atm_csv;
 
 thz_status atm_csv_read(atm_csv *csv, const char *path, thz_error *err);

@@ -24,8 +24,8 @@ struct atm_itu_data {
     itu_line *o2, *h2o;
 };
 
-static thz_status read_lines(const char *dir, const char *name, const char *prefix,
-                             itu_line **out, size_t *n_out, thz_error *err)
+static thz_status read_lines(const char *dir, const char *name, const char *prefix, itu_line **out,
+                             size_t *n_out, thz_error *err)
 {
     char path[4096];
     atm_csv csv;
@@ -54,8 +54,8 @@ static thz_status read_lines(const char *dir, const char *name, const char *pref
         for (int i = 0; i < ITU_COEFFS; i++)
             lines[r].c[i] = atm_csv_at(&csv, r, cols[i + 1]);
         if (!(lines[r].f0_ghz > 0.0)) {
-            st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: line frequency must be > 0 GHz",
-                               path, csv.line_of[r]);
+            st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: line frequency must be > 0 GHz", path,
+                               csv.line_of[r]);
             goto cleanup;
         }
     }
@@ -126,7 +126,8 @@ void atm_itu_parts(const atm_itu_data *itu, const atm_air_state *air, double fre
      * pressure-induced N2 absorption above 100 GHz. */
     double d = 5.6e-4 * (p + e) * pow(theta, 0.8);
     double debye = f * p * theta * theta * 6.14e-5 / (d * (1.0 + (f / d) * (f / d)));
-    double n2 = f * p * theta * theta * 1.4e-12 * p * pow(theta, 1.5) / (1.0 + 1.9e-5 * pow(f, 1.5));
+    double n2 =
+        f * p * theta * theta * 1.4e-12 * p * pow(theta, 1.5) / (1.0 + 1.9e-5 * pow(f, 1.5));
 
     double n_wv = 0.0;
     for (size_t i = 0; i < itu->n_h2o; i++) {

@@ -36,12 +36,13 @@
 #include "core/alloc.h"
 
 #define LINE_MIN_RELATIVE 1e-10
-#define H2O_CUTOFF_GHZ 750.0   /* 25 cm^-1: MT_CKD's line cut-off */
-#define O2_DRY_AIR_VMR 0.20946 /* O2 fraction of dry air */
+#define H2O_CUTOFF_GHZ 750.0     /* 25 cm^-1: MT_CKD's line cut-off */
+#define O2_DRY_AIR_VMR 0.20946   /* O2 fraction of dry air */
 #define VOIGT_DOPPLER_RATIO 1e-3 /* Voigt when gamma_D > this times gamma_L */
-#define VOIGT_WINDOW 3000.0      /* ... within this many gamma_D of the centre; beyond,
-                                    Voigt = Lorentz to ~3e-7 relative */
-#define COUPLED_MATCH_GHZ 0.005  /* .par O2 lines this close to a coupled line are it */
+#define VOIGT_WINDOW                                                                               \
+    3000.0                              /* ... within this many gamma_D of the centre; beyond,     \
+                                           Voigt = Lorentz to ~3e-7 relative */
+#define COUPLED_MATCH_GHZ 0.005         /* .par O2 lines this close to a coupled line are it */
 #define H_OVER_K_K_PER_GHZ 0.0479924307 /* h / k in K/GHz (CODATA 2018) */
 #define HC_OVER_K_CM_K 1.438776877      /* second radiation constant, cm K */
 #define BOLTZMANN_HPA_CM3 1.380649e-19  /* k in hPa cm^3 / K: n[cm^-3] = p[hPa] / (k T) */
@@ -67,13 +68,13 @@ typedef struct raw_catalog {
 
 /* A line at the air's state. */
 typedef struct lbl_line {
-    double nu_ghz;    /* shifted centre */
-    double amp;       /* n S(T) / pi in cm^-1 GHz: alpha = amp * shape [1/GHz] */
-    double inv_vvh0;  /* 1 / (nu0 tanh(h nu0 / 2kT)), the VVH normalisation */
-    double gamma_ghz; /* Lorentz HWHM */
+    double nu_ghz;      /* shifted centre */
+    double amp;         /* n S(T) / pi in cm^-1 GHz: alpha = amp * shape [1/GHz] */
+    double inv_vvh0;    /* 1 / (nu0 tanh(h nu0 / 2kT)), the VVH normalisation */
+    double gamma_ghz;   /* Lorentz HWHM */
     double gamma_d_ghz; /* Doppler HWHM */
-    double y, g;      /* mixing: Y (dimensionless) and G (1 for uncoupled) */
-    double pedestal;  /* cut-off shapes: L(cutoff) */
+    double y, g;        /* mixing: Y (dimensionless) and G (1 for uncoupled) */
+    double pedestal;    /* cut-off shapes: L(cutoff) */
     bool voigt;
 } lbl_line;
 
@@ -144,17 +145,19 @@ static thz_status check_line(const raw_line *l, const char *path, size_t lineno,
 }
 
 /* am 14.0 CSV catalogue (data/atmosphere/am14_*_lines*.csv); coupled adds mixing. */
-static thz_status read_csv_catalog(const char *path, bool coupled, raw_catalog *cat,
-                                   thz_error *err)
+static thz_status read_csv_catalog(const char *path, bool coupled, raw_catalog *cat, thz_error *err)
 {
-    static const char *const base[] = {"freq_GHz",       "S296_cm2_GHz",
-                                       "Elower_K",       "gamma_air_GHz_per_mbar",
-                                       "gamma_self_GHz_per_mbar", "n_air",
-                                       "delta_air_GHz_per_mbar",  "hitran_iso"};
-    static const char *const mix[] = {"y0_per_mbar",  "y1_per_mbar",  "yx",
-                                      "g0_per_mbar2", "g1_per_mbar2", "gx",
-                                      "d0_per_mbar2", "d1_per_mbar2", "dx",
-                                      "Tref_K"};
+    static const char *const base[] = {"freq_GHz",
+                                       "S296_cm2_GHz",
+                                       "Elower_K",
+                                       "gamma_air_GHz_per_mbar",
+                                       "gamma_self_GHz_per_mbar",
+                                       "n_air",
+                                       "delta_air_GHz_per_mbar",
+                                       "hitran_iso"};
+    static const char *const mix[] = {"y0_per_mbar",  "y1_per_mbar", "yx",           "g0_per_mbar2",
+                                      "g1_per_mbar2", "gx",          "d0_per_mbar2", "d1_per_mbar2",
+                                      "dx",           "Tref_K"};
     enum { N_BASE = 8, N_MIX = 10 };
     size_t col[N_BASE + N_MIX];
     atm_csv csv;
@@ -266,14 +269,14 @@ static thz_status read_par_catalog(const char *path, int molecule, raw_catalog *
         static const struct {
             size_t start, len;
             const char *name;
-        } fields[] = {{3, 12, "nu"},         {15, 10, "S"},         {35, 5, "gamma_air"},
-                      {40, 5, "gamma_self"}, {45, 10, "E''"},       {55, 4, "n_air"},
+        } fields[] = {{3, 12, "nu"},         {15, 10, "S"},   {35, 5, "gamma_air"},
+                      {40, 5, "gamma_self"}, {45, 10, "E''"}, {55, 4, "n_air"},
                       {59, 8, "delta_air"}};
         double v[7];
         for (size_t i = 0; i < 7; i++) {
             if (!par_field(line, fields[i].start, fields[i].len, &v[i])) {
-                st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu:%zu: expected a number for %s",
-                                   path, lineno, fields[i].start + 1, fields[i].name);
+                st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu:%zu: expected a number for %s", path,
+                                   lineno, fields[i].start + 1, fields[i].name);
                 goto cleanup;
             }
         }
@@ -395,8 +398,8 @@ static double partition_sum(const partition_sums *q, int iso, double t_k)
 
 static double iso_mass_amu(int molecule, int iso)
 {
-    static const double h2o[] = {18.010565, 20.014811, 19.014780, 19.016740, 21.020985, 20.020956,
-                                 20.022915};
+    static const double h2o[] = {18.010565, 20.014811, 19.014780, 19.016740,
+                                 21.020985, 20.020956, 20.022915};
     static const double o2[] = {31.989830, 33.994076, 32.994045};
     if (molecule == 1)
         return iso >= 1 && iso <= 7 ? h2o[iso - 1] : h2o[0];
@@ -650,13 +653,11 @@ static double species_sum(const lbl_species *sp, double f, double vvh)
         case SHAPE_VVH_CUTOFF:
             term = 0.0;
             if (fabs(d1) < H2O_CUTOFF_GHZ)
-                term += core(l, d1) -
-                        l->pedestal;
+                term += core(l, d1) - l->pedestal;
             if (d2 < H2O_CUTOFF_GHZ)
                 term += lorentz(d2, g) - l->pedestal;
             break;
-        case SHAPE_GROSS:
-        {
+        case SHAPE_GROSS: {
             /* Gross: (1/pi) 4 nu^2 gamma / ((nu^2 - nu0^2)^2 + 4 nu^2 gamma^2); where
              * Doppler matters, times Voigt / Lorentz of the resonant core */
             double dd = f * f - l->nu_ghz * l->nu_ghz;
@@ -719,8 +720,8 @@ double atm_lines_grid_step_hz(const atm_lines_data *d, double lo_hz, double hi_h
 
 /* ---- Set-up -------------------------------------------------------------------- */
 
-static thz_status resolve(char *buf, size_t n, const char *given, const char *dir,
-                          const char *name, thz_error *err)
+static thz_status resolve(char *buf, size_t n, const char *given, const char *dir, const char *name,
+                          thz_error *err)
 {
     if (given) {
         if (strlen(given) >= n)

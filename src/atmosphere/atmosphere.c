@@ -86,8 +86,8 @@ thz_status atmosphere_check_range(const thz_atmosphere *atm, double lo_hz, doubl
         return thz_error_set(err, THZ_ERR_INPUT,
                              "%s: %.6g to %.6g THz leaves the range of atmosphere model '%s' "
                              "(%.6g to %.6g THz)",
-                             what, lo_hz * 1e-12, hi_hz * 1e-12,
-                             atmosphere_model_name(atm->model), lo * 1e-12, hi * 1e-12);
+                             what, lo_hz * 1e-12, hi_hz * 1e-12, atmosphere_model_name(atm->model),
+                             lo * 1e-12, hi * 1e-12);
     return THZ_OK;
 }
 
@@ -139,7 +139,8 @@ static double table_eval(const atm_band_table *t, double freq_hz)
 
 static bool table_covers(const atm_band_table *t, double freq_hz)
 {
-    return freq_hz >= t->lo_hz + t->step_hz && freq_hz <= t->lo_hz + (double)(t->n - 2) * t->step_hz;
+    return freq_hz >= t->lo_hz + t->step_hz &&
+           freq_hz <= t->lo_hz + (double)(t->n - 2) * t->step_hz;
 }
 
 double atmosphere_alpha_per_m(const thz_atmosphere *atm, double freq_hz)

@@ -25,6 +25,7 @@
 #include "physics/channel.h"
 #include "physics/spectrum.h"
 
+/* clang-format off */
 typedef enum atm_model {
     ATM_NONE = 0,
     ATM_CONSTANT,
@@ -32,13 +33,14 @@ typedef enum atm_model {
     ATM_ITU_P676,
     ATM_LINES
 } atm_model;
+/* clang-format on */
 
 /* How the humidity of the air was given (scene keys of the same names). */
 typedef enum atm_humidity_kind {
-    ATM_HUMIDITY_NONE = 0,        /* dry air */
-    ATM_HUMIDITY_RELATIVE,        /* relative_humidity, 0..1 over liquid water */
-    ATM_HUMIDITY_DENSITY_G_M3,    /* water_vapour_g_m3 */
-    ATM_HUMIDITY_VMR              /* h2o_vmr, relative to total air */
+    ATM_HUMIDITY_NONE = 0,     /* dry air */
+    ATM_HUMIDITY_RELATIVE,     /* relative_humidity, 0..1 over liquid water */
+    ATM_HUMIDITY_DENSITY_G_M3, /* water_vapour_g_m3 */
+    ATM_HUMIDITY_VMR           /* h2o_vmr, relative to total air */
 } atm_humidity_kind;
 
 /* The state of the air. pressure_hpa is the total barometric pressure (dry air plus
@@ -60,8 +62,8 @@ typedef struct atm_lines_options {
     const char *h2o_partition_sums_file;
     const char *o2_partition_sums_file;
     const char *continuum_file;
-    bool continuum; /* MT_CKD on (default): H2O lines then use the 750 GHz cut-off
-                       shape MT_CKD is defined against; off: full far wings */
+    bool continuum;       /* MT_CKD on (default): H2O lines then use the 750 GHz cut-off
+                             shape MT_CKD is defined against; off: full far wings */
     const char *data_dir; /* NULL: $THZMAP_DATA_DIR, else the build's data dir */
 } atm_lines_options;
 
@@ -184,8 +186,8 @@ thz_status atmosphere_set_emitting(thz_atmosphere *atm, double temperature_k,
                                    double background_temperature_k, thz_error *err);
 
 /* Bounds the atmosphere to the box [min_m, max_m] (each min < max). */
-thz_status atmosphere_set_extent(thz_atmosphere *atm, const double min_m[3],
-                                 const double max_m[3], thz_error *err);
+thz_status atmosphere_set_extent(thz_atmosphere *atm, const double min_m[3], const double max_m[3],
+                                 thz_error *err);
 
 /* Radiance the air adds along a free path of length distance_m towards the viewer:
  * B_nu(T_air) (1 - exp(-alpha d)). 0 when not emitting. A sample ray that hits a

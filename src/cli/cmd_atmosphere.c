@@ -19,32 +19,31 @@
 
 static void print_help(void)
 {
-    printf(
-        "usage: thzmap atmosphere --from-thz F1 --to-thz F2 --step-ghz S [options]\n"
-        "\n"
-        "Prints the atmosphere's attenuation alpha against frequency as CSV on standard\n"
-        "output: frequency_thz, attenuation_per_m (1/m), attenuation_db_per_km, the parts\n"
-        "per species in dB/km, and transmittance with --distance-m.\n"
-        "\n"
-        "options:\n"
-        "  --from-thz F1, --to-thz F2   frequency range in THz, both ends included\n"
-        "  --step-ghz S                 frequency step in GHz\n"
-        "  --model M                    lines (default), itu-p676 (1-1000 GHz), none\n"
-        "  --temperature-k T            air temperature in K (default 288.15)\n"
-        "  --pressure-hpa P             total pressure (dry air + water vapour) in hPa\n"
-        "                               (default 1013.25)\n"
-        "  --relative-humidity RH       0..1 over liquid water (ITU-R P.453-14), or\n"
-        "  --water-vapour-g-m3 RHO      water-vapour density in g/m^3 (default 7.5), or\n"
-        "  --h2o-vmr X                  water-vapour volume mixing ratio (of total air)\n"
-        "  --h2o-lines FILE             lines: H2O catalogue (am CSV or HITRAN .par)\n"
-        "  --o2-lines FILE              lines: uncoupled O2 catalogue (am CSV or .par)\n"
-        "  --no-continuum               lines: no MT_CKD continuum (full H2O line wings)\n"
-        "  --distance-m D               add the transmittance exp(-alpha D) of a D m path\n"
-        "  --plot FILE.png              also draw alpha in dB/km against THz (PLplot)\n"
-        "  --compare-model M            plot: overlay model M's total (same air)\n"
-        "  --scene SCENE.json           plot: mark the scene's channels; without --model\n"
-        "                               and air options, use the scene's atmosphere\n"
-        "  -h, --help                   this help\n");
+    printf("usage: thzmap atmosphere --from-thz F1 --to-thz F2 --step-ghz S [options]\n"
+           "\n"
+           "Prints the atmosphere's attenuation alpha against frequency as CSV on standard\n"
+           "output: frequency_thz, attenuation_per_m (1/m), attenuation_db_per_km, the parts\n"
+           "per species in dB/km, and transmittance with --distance-m.\n"
+           "\n"
+           "options:\n"
+           "  --from-thz F1, --to-thz F2   frequency range in THz, both ends included\n"
+           "  --step-ghz S                 frequency step in GHz\n"
+           "  --model M                    lines (default), itu-p676 (1-1000 GHz), none\n"
+           "  --temperature-k T            air temperature in K (default 288.15)\n"
+           "  --pressure-hpa P             total pressure (dry air + water vapour) in hPa\n"
+           "                               (default 1013.25)\n"
+           "  --relative-humidity RH       0..1 over liquid water (ITU-R P.453-14), or\n"
+           "  --water-vapour-g-m3 RHO      water-vapour density in g/m^3 (default 7.5), or\n"
+           "  --h2o-vmr X                  water-vapour volume mixing ratio (of total air)\n"
+           "  --h2o-lines FILE             lines: H2O catalogue (am CSV or HITRAN .par)\n"
+           "  --o2-lines FILE              lines: uncoupled O2 catalogue (am CSV or .par)\n"
+           "  --no-continuum               lines: no MT_CKD continuum (full H2O line wings)\n"
+           "  --distance-m D               add the transmittance exp(-alpha D) of a D m path\n"
+           "  --plot FILE.png              also draw alpha in dB/km against THz (PLplot)\n"
+           "  --compare-model M            plot: overlay model M's total (same air)\n"
+           "  --scene SCENE.json           plot: mark the scene's channels; without --model\n"
+           "                               and air options, use the scene's atmosphere\n"
+           "  -h, --help                   this help\n");
 }
 
 typedef struct options {
@@ -84,16 +83,17 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
             continue;
         }
         static const char *const with_value[] = {
-            "--from-thz", "--to-thz", "--step-ghz", "--model", "--compare-model",
-            "--temperature-k", "--pressure-hpa", "--relative-humidity", "--water-vapour-g-m3",
-            "--h2o-vmr", "--h2o-lines", "--o2-lines", "--distance-m", "--plot", "--scene", NULL};
+            "--from-thz",          "--to-thz",        "--step-ghz",     "--model",
+            "--compare-model",     "--temperature-k", "--pressure-hpa", "--relative-humidity",
+            "--water-vapour-g-m3", "--h2o-vmr",       "--h2o-lines",    "--o2-lines",
+            "--distance-m",        "--plot",          "--scene",        NULL};
         bool known = false;
         for (size_t k = 0; with_value[k]; k++)
             known = known || strcmp(a, with_value[k]) == 0;
         if (!known)
-            return cli_usage_error(CMD, strncmp(a, "--", 2) == 0 ? "unknown option '%s'"
-                                                                  : "unexpected argument '%s'",
-                                   a);
+            return cli_usage_error(
+                CMD, strncmp(a, "--", 2) == 0 ? "unknown option '%s'" : "unexpected argument '%s'",
+                a);
         if (i + 1 >= argc)
             return cli_usage_error(CMD, "%s needs a value", a);
         const char *v = argv[++i];
@@ -121,8 +121,8 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
             if (!cli_parse_double(CMD, a, v, 0.0, 1e5, &o->pressure_hpa))
                 return CLI_EXIT_USAGE;
             o->air_given = true;
-        } else if (strcmp(a, "--relative-humidity") == 0 ||
-                   strcmp(a, "--water-vapour-g-m3") == 0 || strcmp(a, "--h2o-vmr") == 0) {
+        } else if (strcmp(a, "--relative-humidity") == 0 || strcmp(a, "--water-vapour-g-m3") == 0 ||
+                   strcmp(a, "--h2o-vmr") == 0) {
             if (!cli_parse_double(CMD, a, v, 0.0, 1e6, &o->humidity))
                 return CLI_EXIT_USAGE;
             o->humidity_kind = a[2] == 'r'   ? ATM_HUMIDITY_RELATIVE
@@ -231,8 +231,8 @@ static bool has_pngcairo(void)
     return found;
 }
 
-static void draw_curve(const series *s, const double *y_db, double floor_log, int colour,
-                       int style, double width, double *buf)
+static void draw_curve(const series *s, const double *y_db, double floor_log, int colour, int style,
+                       double width, double *buf)
 {
     for (size_t i = 0; i < s->n; i++)
         buf[i] = plot_log(y_db[i], floor_log);
@@ -360,10 +360,10 @@ static int draw_plot(const options *o, const series *s, const thz_atmosphere *at
     pllsty(1);
     plwidth(1.0);
     pllegend(&legend_w, &legend_h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-             PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.02, 0.02, 0.1, 0, 1,
-             1, 3, 2, n_legend, opts, 1.0, 0.75, 2.0, 1.0, colours, texts, box_colours,
-             box_patterns, box_scales, box_widths, colours, styles, widths, symbol_colours,
-             symbol_scales, symbol_numbers, symbols);
+             PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.02, 0.02, 0.1, 0, 1, 1, 3,
+             2, n_legend, opts, 1.0, 0.75, 2.0, 1.0, colours, texts, box_colours, box_patterns,
+             box_scales, box_widths, colours, styles, widths, symbol_colours, symbol_scales,
+             symbol_numbers, symbols);
     plend();
     free(buf);
     return CLI_EXIT_OK;

@@ -30,15 +30,14 @@ static thz_status load_air(load_ctx *ctx, const load_cursor *c, atm_air_state *a
                                                 "h2o_vmr"};
     static const atm_humidity_kind kinds[] = {ATM_HUMIDITY_RELATIVE, ATM_HUMIDITY_DENSITY_G_M3,
                                               ATM_HUMIDITY_VMR};
-    static const load_range ranges[] = {{0.0, 1.0, false, false},
-                                        {0.0, INFINITY, false, false},
-                                        {0.0, 1.0, false, true}};
+    static const load_range ranges[] = {
+        {0.0, 1.0, false, false}, {0.0, INFINITY, false, false}, {0.0, 1.0, false, true}};
     double t = 0.0, p = 0.0, h = 0.0;
     thz_status st = load_number(ctx, c, "temperature_k", (load_range){100.0, 400.0, false, false},
                                 true, 0.0, &t);
     if (st == THZ_OK)
-        st = load_number(ctx, c, "pressure_hpa", (load_range){0.0, 2000.0, true, false}, true,
-                         0.0, &p);
+        st = load_number(ctx, c, "pressure_hpa", (load_range){0.0, 2000.0, true, false}, true, 0.0,
+                         &p);
     if (st != THZ_OK)
         return st;
     int found = -1;
@@ -47,8 +46,9 @@ static thz_status load_air(load_ctx *ctx, const load_cursor *c, atm_air_state *a
         if (!k.value)
             continue;
         if (found >= 0)
-            return load_fail(ctx, &k, "give only one of relative_humidity, water_vapour_g_m3, "
-                                      "h2o_vmr (%s is given too)",
+            return load_fail(ctx, &k,
+                             "give only one of relative_humidity, water_vapour_g_m3, "
+                             "h2o_vmr (%s is given too)",
                              humidity_keys[found]);
         found = i;
         st = load_number(ctx, c, humidity_keys[i], ranges[i], true, 0.0, &h);
@@ -118,13 +118,14 @@ static thz_status load_emitting(load_ctx *ctx, const load_cursor *c, thz_atmosph
     if (!emitting) {
         const load_cursor *stray = bg.value ? &bg : lo.value ? &lo : hi.value ? &hi : NULL;
         if (stray)
-            return load_fail(ctx, stray, "only an emitting atmosphere (\"emitting\": true) has this");
+            return load_fail(ctx, stray,
+                             "only an emitting atmosphere (\"emitting\": true) has this");
         return THZ_OK;
     }
     double t_air = atm->air.temperature_k, t_bg = 0.0;
     if (!atm->has_air) {
-        st = load_number(ctx, c, "temperature_k", (load_range){0.0, 1000.0, true, false}, true,
-                         0.0, &t_air);
+        st = load_number(ctx, c, "temperature_k", (load_range){0.0, 1000.0, true, false}, true, 0.0,
+                         &t_air);
         if (st != THZ_OK)
             return st;
     }
@@ -155,8 +156,7 @@ thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *
     static const char *const keys_none[] = {"model", NULL};
     static const char *const keys_constant[] = {"model", "attenuation_per_m", "temperature_k",
                                                 EMITTING_KEYS, NULL};
-    static const char *const keys_table[] = {"model", "file", "temperature_k", EMITTING_KEYS,
-                                             NULL};
+    static const char *const keys_table[] = {"model", "file", "temperature_k", EMITTING_KEYS, NULL};
     static const char *const keys_itu[] = {"model", AIR_KEYS, EMITTING_KEYS, NULL};
     static const char *const keys_lines[] = {"model",
                                              AIR_KEYS,
@@ -210,9 +210,10 @@ thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *
         for (size_t i = 0; i < table.n_columns; i++) {
             if (strcmp(table.names[i], "frequency_thz") != 0 &&
                 strcmp(table.names[i], "attenuation_per_m") != 0) {
-                st = load_fail(ctx, &file,
-                               "%s: unknown column '%s' (expected frequency_thz, attenuation_per_m)",
-                               table.label, table.names[i]);
+                st =
+                    load_fail(ctx, &file,
+                              "%s: unknown column '%s' (expected frequency_thz, attenuation_per_m)",
+                              table.label, table.names[i]);
                 break;
             }
         }
@@ -247,8 +248,9 @@ thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *
         bool emitting = false;
         if (!atm->has_air && t.value && load_bool(ctx, c, "emitting", false, &emitting) == THZ_OK &&
             !emitting)
-            st = load_fail(ctx, &t, "only the air of itu-p676 and lines, or an emitting "
-                                    "atmosphere (\"emitting\": true), has a temperature");
+            st = load_fail(ctx, &t,
+                           "only the air of itu-p676 and lines, or an emitting "
+                           "atmosphere (\"emitting\": true), has a temperature");
     }
     if (st == THZ_OK)
         st = load_emitting(ctx, c, atm);

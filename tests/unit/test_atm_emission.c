@@ -34,7 +34,8 @@ static void test_path_and_volume(void **state)
     assert_true(fabs(atmosphere_volume_emission_w_per_m3_hz(&atm, f) / (4 * M_PI * 0.2 * b) - 1) <
                 1e-12);
     /* radiative equilibrium: a black wall at T_air seen through the air looks the same */
-    double wall = b * atmosphere_transmittance(&atm, f, 7.0) + atmosphere_path_radiance(&atm, f, 7.0);
+    double wall =
+        b * atmosphere_transmittance(&atm, f, 7.0) + atmosphere_path_radiance(&atm, f, 7.0);
     assert_true(fabs(wall / b - 1) < 1e-12);
     /* escape without extent: infinitely thick air */
     assert_true(fabs(atmosphere_escape_radiance(&atm, f, INFINITY) / b - 1) < 1e-12);
@@ -105,8 +106,9 @@ static void test_scene_keys(void **state)
     s = NULL;
 
     /* catalogue paths are relative to the scene */
-    const char *par = "{\"model\": \"lines\", \"temperature_k\": 290, \"pressure_hpa\": 1000,"
-                      " \"h2o_vmr\": 0.01, \"h2o_lines_file\": \"tests/inputs/atm_h2o_o2_subset.par\"}";
+    const char *par =
+        "{\"model\": \"lines\", \"temperature_k\": 290, \"pressure_hpa\": 1000,"
+        " \"h2o_vmr\": 0.01, \"h2o_lines_file\": \"tests/inputs/atm_h2o_o2_subset.par\"}";
     if (scene_load_string(scene_with(par, buf, sizeof buf), THZ_SOURCE_DIR, "t.json", &s, &err) !=
         THZ_OK)
         fail_msg("%s", err.message);
@@ -133,8 +135,8 @@ static void test_scene_keys(void **state)
          "atmosphere.continuum: unknown key"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        thz_status st =
-            scene_load_string(scene_with(bad[i].atm, buf, sizeof buf), THZ_SOURCE_DIR, "t.json", &s, &err);
+        thz_status st = scene_load_string(scene_with(bad[i].atm, buf, sizeof buf), THZ_SOURCE_DIR,
+                                          "t.json", &s, &err);
         if (st != THZ_ERR_INPUT || !strstr(err.message, bad[i].expect))
             fail_msg("%s: status %d, message '%s', expected '%s'", bad[i].atm, st, err.message,
                      bad[i].expect);

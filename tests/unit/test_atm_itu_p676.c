@@ -26,11 +26,12 @@ static void test_validation_values(void **state)
     (void)state;
     atm_csv csv;
     thz_error err = {0};
-    assert_int_equal(atm_csv_read(&csv,
-                                  THZ_SOURCE_DIR
-                                  "/data/atmosphere/itu_r_p676_13_specific_attenuation_validation.csv",
-                                  &err),
-                     THZ_OK);
+    assert_int_equal(
+        atm_csv_read(&csv,
+                     THZ_SOURCE_DIR
+                     "/data/atmosphere/itu_r_p676_13_specific_attenuation_validation.csv",
+                     &err),
+        THZ_OK);
     size_t cf, cp, ct, crho, co, cw, cg;
     assert_int_equal(atm_csv_column(&csv, "f_GHz", &cf, &err), THZ_OK);
     assert_int_equal(atm_csv_column(&csv, "P_hPa", &cp, &err), THZ_OK);
@@ -105,9 +106,9 @@ static void test_humidity_conversions(void **state)
                                         atm_air_h2o_density_g_m3(&a), &err),
                      THZ_OK);
     assert_true(fabs(b.h2o_pressure_hpa - a.h2o_pressure_hpa) < 1e-9);
-    assert_int_equal(atm_air_state_init(&c, 293.15, 1013.25, ATM_HUMIDITY_VMR, atm_air_h2o_vmr(&a),
-                                        &err),
-                     THZ_OK);
+    assert_int_equal(
+        atm_air_state_init(&c, 293.15, 1013.25, ATM_HUMIDITY_VMR, atm_air_h2o_vmr(&a), &err),
+        THZ_OK);
     assert_true(fabs(c.h2o_pressure_hpa - a.h2o_pressure_hpa) < 1e-9);
     assert_int_equal(atm_air_state_init(&a, 293.15, 1013.25, ATM_HUMIDITY_RELATIVE, 50, &err),
                      THZ_ERR_INPUT);

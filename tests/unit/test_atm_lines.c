@@ -18,9 +18,9 @@ static atm_air_state reference_air(double rho_g_m3)
     atm_air_state air;
     thz_error err = {0};
     double t = 288.15, e = rho_g_m3 * t / 216.7;
-    assert_int_equal(atm_air_state_init(&air, t, 1013.25 + e, ATM_HUMIDITY_DENSITY_G_M3, rho_g_m3,
-                                        &err),
-                     THZ_OK);
+    assert_int_equal(
+        atm_air_state_init(&air, t, 1013.25 + e, ATM_HUMIDITY_DENSITY_G_M3, rho_g_m3, &err),
+        THZ_OK);
     return air;
 }
 
@@ -42,7 +42,7 @@ static void init_lines(thz_atmosphere *atm, const atm_air_state *air, const atm_
 static void test_agrees_with_itu(void **state)
 {
     (void)state;
-    static const double centres_ghz[] = {22.235, 60.0, 118.75, 183.31, 325.15,
+    static const double centres_ghz[] = {22.235, 60.0,  118.75, 183.31, 325.15,
                                          380.2,  448.0, 556.94, 752.03, 987.93};
     static const double windows_ghz[] = {10.0,  35.0,  94.0,  140.0, 220.0,
                                          345.0, 410.0, 500.0, 670.0, 850.0};
@@ -87,15 +87,16 @@ static void test_agrees_with_itu_other_temperatures(void **state)
     for (size_t k = 0; k < 2; k++) {
         thz_error err = {0};
         atm_air_state air;
-        assert_int_equal(atm_air_state_init(&air, temps_k[k], 1013.25, ATM_HUMIDITY_RELATIVE, 0.5,
-                                            &err),
-                         THZ_OK);
+        assert_int_equal(
+            atm_air_state_init(&air, temps_k[k], 1013.25, ATM_HUMIDITY_RELATIVE, 0.5, &err),
+            THZ_OK);
         thz_atmosphere itu = {0}, lbl;
         assert_int_equal(atmosphere_init_itu_p676(&itu, &air, NULL, &err), THZ_OK);
         init_lines(&lbl, &air, NULL);
         for (size_t i = 0; i < sizeof centres_ghz / sizeof centres_ghz[0]; i++) {
             double f = centres_ghz[i] * 1e9;
-            double r = atmosphere_alpha_direct_per_m(&lbl, f) / atmosphere_alpha_direct_per_m(&itu, f);
+            double r =
+                atmosphere_alpha_direct_per_m(&lbl, f) / atmosphere_alpha_direct_per_m(&itu, f);
             worst_c = fmax(worst_c, fabs(r - 1));
             if (fabs(r - 1) > 0.06)
                 fail_msg("%g K, line centre %g GHz: lines/itu-p676 = %.4f", temps_k[k],
@@ -103,10 +104,12 @@ static void test_agrees_with_itu_other_temperatures(void **state)
         }
         for (size_t i = 0; i < sizeof windows_ghz / sizeof windows_ghz[0]; i++) {
             double f = windows_ghz[i] * 1e9;
-            double r = atmosphere_alpha_direct_per_m(&lbl, f) / atmosphere_alpha_direct_per_m(&itu, f);
+            double r =
+                atmosphere_alpha_direct_per_m(&lbl, f) / atmosphere_alpha_direct_per_m(&itu, f);
             worst_w = fmax(worst_w, fabs(r - 1));
             if (fabs(r - 1) > 0.25)
-                fail_msg("%g K, window %g GHz: lines/itu-p676 = %.4f", temps_k[k], windows_ghz[i], r);
+                fail_msg("%g K, window %g GHz: lines/itu-p676 = %.4f", temps_k[k], windows_ghz[i],
+                         r);
         }
         atmosphere_fini(&itu);
         atmosphere_fini(&lbl);
@@ -152,7 +155,8 @@ static void test_line_positions(void **state)
         double p_low = peak_ghz(&a_low, lines_ghz[k]);
         if (fabs(p_low - lines_ghz[k]) > 0.1)
             fail_msg("line %g GHz peaks at %g GHz at 100 hPa", lines_ghz[k], p_low);
-        double shifted = lines_ghz[k] + delta_ghz_per_hpa[k] * (air.pressure_hpa - air.h2o_pressure_hpa);
+        double shifted =
+            lines_ghz[k] + delta_ghz_per_hpa[k] * (air.pressure_hpa - air.h2o_pressure_hpa);
         double p_ref = peak_ghz(&a_ref, shifted);
         if (fabs(p_ref - shifted) > 0.1)
             fail_msg("line %g GHz peaks at %g GHz at 1 atm, shifted centre %g GHz", lines_ghz[k],
@@ -179,7 +183,8 @@ static void test_humidity_scaling(void **state)
         double f = windows_ghz[i] * 1e9;
         double r = atmosphere_alpha_direct_per_m(&l2, f) / atmosphere_alpha_direct_per_m(&l1, f);
         if (!(r > 2.05 && r < 4.0))
-            fail_msg("window %g GHz: doubling humidity multiplies alpha by %.3f", windows_ghz[i], r);
+            fail_msg("window %g GHz: doubling humidity multiplies alpha by %.3f", windows_ghz[i],
+                     r);
     }
     atmosphere_fini(&l1);
     atmosphere_fini(&l2);
@@ -312,8 +317,8 @@ static void test_tabulation_low_pressure(void **state)
         double t = atmosphere_alpha_per_m(&lbl, f), d = atmosphere_alpha_direct_per_m(&lbl, f);
         worst = fmax(worst, fabs(t / d - 1));
     }
-    print_message("tabulation at 10 hPa: %zu points, worst relative error %.2e\n",
-                  lbl.tables[0].n, worst);
+    print_message("tabulation at 10 hPa: %zu points, worst relative error %.2e\n", lbl.tables[0].n,
+                  worst);
     assert_true(worst < 1e-4);
     atmosphere_fini(&lbl);
 }
@@ -365,11 +370,14 @@ int main(void)
         cmocka_unit_test(test_agrees_with_itu),
         cmocka_unit_test(test_agrees_with_itu_other_temperatures),
         cmocka_unit_test(test_line_positions),
-        cmocka_unit_test(test_humidity_scaling), cmocka_unit_test(test_par_equals_csv),
+        cmocka_unit_test(test_humidity_scaling),
+        cmocka_unit_test(test_par_equals_csv),
         cmocka_unit_test(test_par_o2_coupled_not_doubled),
-        cmocka_unit_test(test_bad_par_refused),  cmocka_unit_test(test_tabulation_error),
+        cmocka_unit_test(test_bad_par_refused),
+        cmocka_unit_test(test_tabulation_error),
         cmocka_unit_test(test_tabulation_low_pressure),
-        cmocka_unit_test(test_voigt_quadrature), cmocka_unit_test(test_voigt),
+        cmocka_unit_test(test_voigt_quadrature),
+        cmocka_unit_test(test_voigt),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
