@@ -512,28 +512,42 @@ static thz_status load_object(load_ctx *ctx, const load_cursor *c, thz_object *o
     return THZ_OK;
 }
 
+/* The required, non-empty list `key` of the root (objects, sensors): its cursor and
+ * length, or a failure naming what was expected. */
+static thz_status load_list(load_ctx *ctx, const load_cursor *root, const char *key,
+                            const char *what, load_cursor *list, size_t *n)
+{
+    *list = load_key(root, key);
+    if (!list->value)
+        return load_fail(ctx, list, "missing key (expected a list of %ss)", what);
+    if (!json_is_array(list->value))
+        return load_fail(ctx, list, "expected a list of %ss, got %s", what,
+                         load_type_name(list->value));
+    *n = json_array_size(list->value);
+    if (*n == 0)
+        return load_fail(ctx, list, "expected at least one %s, got an empty list", what);
+    return THZ_OK;
+}
+
+/* Items are counted as they load (n_objects = i + 1) so that a failure frees them, and
+ * so that load_object sees the objects before it (duplicate names). */
 static thz_status load_objects(load_ctx *ctx, const load_cursor *root)
 {
     thz_scene *s = ctx->scene;
-    load_cursor c = load_key(root, "objects");
-    if (!c.value)
-        return load_fail(ctx, &c, "missing key (expected a list of objects)");
-    if (!json_is_array(c.value))
-        return load_fail(ctx, &c, "expected a list of objects, got %s", load_type_name(c.value));
-    size_t n = json_array_size(c.value);
-    if (n == 0)
-        return load_fail(ctx, &c, "expected at least one object, got an empty list");
+    load_cursor c;
+    size_t n;
+    thz_status st = load_list(ctx, root, "objects", "object", &c, &n);
+    if (st != THZ_OK)
+        return st;
     s->objects = thz_calloc(n, sizeof *s->objects);
     if (!s->objects)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n && st == THZ_OK; i++) {
         load_cursor e = load_index(&c, i);
         s->n_objects = i + 1;
-        thz_status st = load_object(ctx, &e, &s->objects[i], i);
-        if (st != THZ_OK)
-            return st;
+        st = load_object(ctx, &e, &s->objects[i], i);
     }
-    return THZ_OK;
+    return st;
 }
 
 /* ---- sensors -------------------------------------------------------------------- */
@@ -662,25 +676,20 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *c, thz_sensor *s
 static thz_status load_sensors(load_ctx *ctx, const load_cursor *root)
 {
     thz_scene *s = ctx->scene;
-    load_cursor c = load_key(root, "sensors");
-    if (!c.value)
-        return load_fail(ctx, &c, "missing key (expected a list of sensors)");
-    if (!json_is_array(c.value))
-        return load_fail(ctx, &c, "expected a list of sensors, got %s", load_type_name(c.value));
-    size_t n = json_array_size(c.value);
-    if (n == 0)
-        return load_fail(ctx, &c, "expected at least one sensor, got an empty list");
+    load_cursor c;
+    size_t n;
+    thz_status st = load_list(ctx, root, "sensors", "sensor", &c, &n);
+    if (st != THZ_OK)
+        return st;
     s->sensors = thz_calloc(n, sizeof *s->sensors);
     if (!s->sensors)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n && st == THZ_OK; i++) {
         load_cursor e = load_index(&c, i);
         s->n_sensors = i + 1;
-        thz_status st = load_sensor(ctx, &e, &s->sensors[i], i);
-        if (st != THZ_OK)
-            return st;
+        st = load_sensor(ctx, &e, &s->sensors[i], i);
     }
-    return THZ_OK;
+    return st;
 }
 
 /* ---- photons and render --------------------------------------------------------- */
