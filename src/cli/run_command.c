@@ -1,7 +1,9 @@
 /* simulate and render: options, scene, run, report. */
 #include "cli/run_command.h"
 
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -23,7 +25,15 @@ static void cli_run_usage(FILE *f, bool render)
                 "  --photons N           photons per channel (overrides photons.per_channel)\n"
                 "  --seed S              random seed (overrides photons.seed)\n"
                 "  --threads T           threads to use (default: all cores)\n"
-                "  --integrator NAME     photon-map | final-gather | path\n"
+                "  --integrator NAME     photon-map | final-gather | path (overrides\n"
+                "                        render.integrator; path fires no photons)\n"
+                "  --target-noise-k X    final-gather, path: add passes of gather rays or\n"
+                "                        paths to each channel until the median per-pixel\n"
+                "                        standard error of the brightness temperature is at\n"
+                "                        most X K (each pass is deterministic)\n"
+                "  --max-seconds S       with --target-noise-k: stop adding passes once a\n"
+                "                        channel has rendered for S s; the stopping point, and\n"
+                "                        so the images, then depend on the machine's speed\n"
                 "  --save-photon-map     also write photon-map.thzpm (for render) and\n"
                 "                        photon-map.ply\n"
                 "  --quiet               no progress output\n");
@@ -33,11 +43,17 @@ static void cli_run_usage(FILE *f, bool render)
                 "Renders the scene's sensors again from a photon map saved by\n"
                 "'thzmap simulate --save-photon-map', without firing photons.\n\n"
                 "options:\n"
-                "  --photon-map FILE     the photon map (photon-map.thzpm)\n"
+                "  --photon-map FILE     the photon map (photon-map.thzpm); not needed with\n"
+                "                        --integrator path\n"
                 "  -o, --output OUTDIR   where the results go (required)\n"
                 "  --sensor NAME         render only this sensor (default: all)\n"
                 "  --threads T           threads to use (default: all cores)\n"
                 "  --integrator NAME     photon-map | final-gather | path\n"
+                "  --target-noise-k X    final-gather, path: add passes until the median\n"
+                "                        per-pixel standard error of the brightness\n"
+                "                        temperature is at most X K (each pass deterministic)\n"
+                "  --max-seconds S       with --target-noise-k: stop adding passes once a\n"
+                "                        channel has rendered for S s (time-dependent result)\n"
                 "  --quiet               no progress output\n");
 }
 
@@ -67,6 +83,8 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
         }
         bool takes_value = strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0 ||
                            strcmp(arg, "--threads") == 0 || strcmp(arg, "--integrator") == 0 ||
+                           strcmp(arg, "--target-noise-k") == 0 ||
+                           strcmp(arg, "--max-seconds") == 0 ||
                            (!render && (strcmp(arg, "--photons") == 0 ||
                                         strcmp(arg, "--seed") == 0)) ||
                            (render && (strcmp(arg, "--photon-map") == 0 ||
@@ -89,6 +107,17 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
                                            "path, got '%s'",
                                            val);
                 a->ov.has_integrator = true;
+            } else if (strcmp(arg, "--target-noise-k") == 0 ||
+                       strcmp(arg, "--max-seconds") == 0) {
+                char *end = NULL;
+                double x = strtod(val, &end);
+                if (end == val || *end || !isfinite(x) || !(x > 0.0))
+                    return cli_usage_error(cmd, "%s expects a positive number (%s), got '%s'",
+                                           arg, arg[2] == 't' ? "K" : "s", val);
+                if (arg[2] == 't')
+                    a->opt.target_noise_k = x;
+                else
+                    a->opt.max_seconds = x;
             } else if (strcmp(arg, "--photons") == 0) {
                 if (!cli_parse_u64(cmd, arg, val, 1, UINT64_C(1000000000000), &u))
                     return CLI_EXIT_USAGE;
@@ -119,8 +148,8 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
         return cli_usage_error(cmd, "no scene file given");
     if (!a->opt.outdir)
         return cli_usage_error(cmd, "no output directory given (-o OUTDIR)");
-    if (render && !a->opt.photon_map_path)
-        return cli_usage_error(cmd, "no photon map given (--photon-map FILE)");
+    if (a->opt.max_seconds > 0.0 && !(a->opt.target_noise_k > 0.0))
+        return cli_usage_error(cmd, "--max-seconds limits --target-noise-k; give both");
     return -1;
 }
 
@@ -142,6 +171,12 @@ int cli_run_command(int argc, char **argv, bool render)
     if (st != THZ_OK)
         return cli_fail(&err);
     run_apply_overrides(scene, &a.ov);
+    if (render && !a.opt.photon_map_path &&
+        render_integrator_needs_photons(scene->render.integrator)) {
+        scene_destroy(scene);
+        return cli_usage_error(cmd, "no photon map given (--photon-map FILE); only the path "
+                                    "integrator renders without one");
+    }
     if (!a.quiet)
         for (size_t i = 0; i < scene->n_warnings; i++)
             fprintf(stderr, "thzmap %s: warning: %s\n", cmd, scene->warnings[i]);

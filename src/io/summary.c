@@ -100,6 +100,10 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
     }
     if (summary->median_stderr_k)
         sum_set(o, "median_stderr_k", sum_real(summary->median_stderr_k[c]), ok);
+    if (summary->passes)
+        sum_set(o, "render_passes", json_integer(summary->passes[c]), ok);
+    if (summary->seconds_render_channel)
+        sum_set(o, "render_s", sum_real(summary->seconds_render_channel[c]), ok);
     return o;
 }
 
@@ -137,6 +141,8 @@ thz_status summary_write(const char *dir, const thz_scene *scene, const run_summ
     sum_set(root, "seed", sum_u64(summary->seed), &ok);
     sum_set(root, "photons_per_channel", sum_u64(summary->photons_per_channel), &ok);
     sum_set(root, "integrator", sum_string(summary->integrator), &ok);
+    sum_set(root, "target_noise_k",
+            summary->target_noise_k > 0.0 ? sum_real(summary->target_noise_k) : json_null(), &ok);
     sum_set(root, "threads", json_integer(summary->threads), &ok);
     sum_set(root, "atmosphere_model", json_string(atmosphere_model_name(scene->atmosphere.model)),
             &ok);

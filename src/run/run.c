@@ -22,6 +22,9 @@
 #include "sensor/images.h"
 #include "sensor/render.h"
 
+/* A noise target stops here at the latest (with a run warning). */
+#define RUN_MAX_PASSES 100000u
+
 /* Everything one run owns; freed in one place (run_state_fini). */
 typedef struct run_state {
     const thz_scene *scene;
@@ -37,6 +40,8 @@ typedef struct run_state {
     photon_map **maps;        /* per channel: kept for saving, or read from a file */
     photon_stats *stats;      /* per channel (simulate) */
     double *median_stderr_k;  /* per channel */
+    uint32_t *passes;         /* per channel: render passes */
+    double *seconds_channel;  /* per channel: render time, s */
     uint64_t seed;            /* of the photons rendered (scene's, or the map file's) */
     uint64_t photons_per_channel;
     size_t n_warnings;
@@ -49,6 +54,21 @@ static double run_now_s(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+thz_status run_check_options(const thz_scene *scene, const run_options *opt, thz_error *err)
+{
+    if (opt->target_noise_k < 0.0 || !isfinite(opt->target_noise_k))
+        return thz_error_set(err, THZ_ERR_INPUT, "the noise target must be > 0 K");
+    if (opt->max_seconds < 0.0 || !isfinite(opt->max_seconds))
+        return thz_error_set(err, THZ_ERR_INPUT, "the time limit must be > 0 s");
+    if (opt->target_noise_k > 0.0 && !render_integrator_has_passes(scene->render.integrator))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "a noise target needs the final-gather or path integrator: "
+                             "'%s' is deterministic given its photon map, so only more photons "
+                             "(--photons) lower its noise",
+                             render_integrator_name(scene->render.integrator));
+    return THZ_OK;
 }
 
 void run_apply_overrides(thz_scene *scene, const run_overrides *ov)
@@ -100,6 +120,8 @@ static void run_state_fini(run_state *rs)
     free(rs->maps);
     free(rs->stats);
     free(rs->median_stderr_k);
+    free(rs->passes);
+    free(rs->seconds_channel);
     for (size_t i = 0; i < rs->n_warnings; i++)
         free(rs->warnings[i]);
     free(rs->warnings);
@@ -129,7 +151,9 @@ static thz_status run_state_init(run_state *rs, const thz_scene *scene, const ru
     rs->opt = opt;
     rs->command = command;
     rs->seed = scene->photons.seed;
-    rs->photons_per_channel = scene->photons.per_channel;
+    rs->photons_per_channel = render_integrator_needs_photons(scene->render.integrator)
+                                  ? scene->photons.per_channel
+                                  : 0; /* path fires none */
     if (!opt->outdir || !opt->outdir[0])
         return thz_error_set(err, THZ_ERR_INPUT, "%s: no output directory given", command);
     size_t nc = scene->n_channels, ns = scene->n_sensors;
@@ -137,7 +161,10 @@ static thz_status run_state_init(run_state *rs, const thz_scene *scene, const ru
     rs->maps = thz_calloc(nc, sizeof *rs->maps);
     rs->stats = thz_calloc(nc, sizeof *rs->stats);
     rs->median_stderr_k = thz_calloc(nc, sizeof *rs->median_stderr_k);
-    if (!rs->selected || !rs->maps || !rs->stats || !rs->median_stderr_k)
+    rs->passes = thz_calloc(nc, sizeof *rs->passes);
+    rs->seconds_channel = thz_calloc(nc, sizeof *rs->seconds_channel);
+    if (!rs->selected || !rs->maps || !rs->stats || !rs->median_stderr_k || !rs->passes ||
+        !rs->seconds_channel)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     for (size_t s = 0; s < ns; s++)
         if (!opt->sensor_name || strcmp(opt->sensor_name, scene->sensors[s].name) == 0)
@@ -229,6 +256,47 @@ static thz_status run_init_images(run_state *rs, thz_error *err)
     return THZ_OK;
 }
 
+static int run_compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median over the rendered pixels of channel c (all selected sensors) of the standard
+ * error of Tb_c in K (physics.md: dTb/dL at the pixel's L_c); pixels with Tb_c = 0
+ * (nothing or a back face seen) are left out; 0 when none is left. `v` holds room for
+ * every rendered pixel. */
+static double run_channel_median_stderr_k(const run_state *rs, size_t c, double *v)
+{
+    double nu = rs->scene->channels[c].center_hz;
+    size_t m = 0;
+    for (size_t i = 0; i < rs->n_selected; i++) {
+        const sensor_images *img = &rs->images[i];
+        size_t px = (size_t)img->columns * img->rows;
+        if (!img->radiance_stderr)
+            continue;
+        for (size_t p = 0; p < px; p++) {
+            double tb = img->brightness_temperature[c * px + p];
+            if (tb > 0.0)
+                v[m++] = render_stderr_k(nu, tb, img->radiance_stderr[c * px + p]);
+        }
+    }
+    if (m == 0)
+        return 0.0;
+    qsort(v, m, sizeof *v, run_compare_double);
+    return m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
+}
+
+static size_t run_rendered_pixels(const run_state *rs)
+{
+    size_t total = 0;
+    for (size_t i = 0; i < rs->n_selected; i++)
+        total += (size_t)rs->images[i].columns * rs->images[i].rows;
+    return total;
+}
+
+/* Renders channel c of every selected sensor: one pass, or, with a noise target, passes
+ * until the channel's median standard error reaches it or the time limit passes. */
 static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map,
                                      thz_error *err)
 {
@@ -236,68 +304,69 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
                          .progress = rs->opt->progress,
                          .progress_user = rs->opt->progress_user};
     double t0 = run_now_s();
-    for (size_t i = 0; i < rs->n_selected; i++) {
-        render_stats rst;
-        thz_status st = render_sensor_channel(rs->scene, rs->accel, map, c, rs->selected[i],
-                                              &rs->images[i], &ro, &rst, err);
-        if (st != THZ_OK)
-            return st;
-        render_stats *sum = &rs->render_sum[i];
-        sum->samples += rst.samples;
-        sum->escaped_samples += rst.escaped_samples;
-        sum->back_face_samples += rst.back_face_samples;
-        sum->widened_gathers += rst.widened_gathers;
-        sum->starved_gathers += rst.starved_gathers;
-        sum->truncated_paths += rst.truncated_paths;
-        rs->back_face[rs->selected[i]] += rst.back_face_samples;
+    double target = rs->opt->target_noise_k;
+    render_accum *acc = thz_calloc(rs->n_selected, sizeof *acc);
+    double *v = target > 0.0 ? thz_malloc_array(run_rendered_pixels(rs), sizeof *v) : NULL;
+    thz_status st = THZ_OK;
+    if (!acc || (target > 0.0 && !v))
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the pixel statistics");
+    for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
+        const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
+        st = render_accum_init(&acc[i], (size_t)s->columns * s->rows, err);
     }
-    rs->seconds_render += run_now_s() - t0;
-    return THZ_OK;
+    for (uint32_t pass = 0; st == THZ_OK; pass++) {
+        for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
+            render_stats rst;
+            st = render_sensor_channel_pass(rs->scene, rs->accel, map, c, rs->selected[i], pass,
+                                            &acc[i], &ro, &rst, err);
+            if (st != THZ_OK)
+                break;
+            render_stats *sum = &rs->render_sum[i];
+            sum->samples += rst.samples;
+            sum->escaped_samples += rst.escaped_samples;
+            sum->back_face_samples += rst.back_face_samples;
+            sum->widened_gathers += rst.widened_gathers;
+            sum->starved_gathers += rst.starved_gathers;
+            sum->truncated_paths += rst.truncated_paths;
+            sum->paths += rst.paths;
+            rs->back_face[rs->selected[i]] += rst.back_face_samples;
+            st = render_accum_write(rs->scene, c, rs->selected[i], &acc[i], &rs->images[i], err);
+        }
+        if (st != THZ_OK)
+            break;
+        rs->passes[c] = pass + 1;
+        if (!(target > 0.0))
+            break;
+        if (run_channel_median_stderr_k(rs, c, v) <= target)
+            break;
+        if (rs->opt->max_seconds > 0.0 && run_now_s() - t0 >= rs->opt->max_seconds)
+            break;
+        if (pass + 1 >= RUN_MAX_PASSES) {
+            st = run_add_warning(rs, err,
+                                 "channel %zu: stopped after %u passes above the noise target "
+                                 "of %g K",
+                                 c, (unsigned)RUN_MAX_PASSES, target);
+            break;
+        }
+    }
+    if (acc)
+        for (size_t i = 0; i < rs->n_selected; i++)
+            render_accum_fini(&acc[i]);
+    free(acc);
+    free(v);
+    rs->seconds_channel[c] = run_now_s() - t0;
+    rs->seconds_render += rs->seconds_channel[c];
+    return st;
 }
 
-/* dB/dT at (freq_hz, temp_k), in W m^-2 sr^-1 Hz^-1 K^-1. */
-static double run_planck_dbdt(double freq_hz, double temp_k)
-{
-    double x = THZ_PLANCK_H * freq_hz / (THZ_BOLTZMANN_K * temp_k);
-    double em1 = expm1(x);
-    return planck_radiance(freq_hz, temp_k) * x * (em1 + 1.0) / (em1 * temp_k);
-}
-
-static int run_compare_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* Median over all rendered pixels of the standard error of Tb_c, in K. */
+/* Median over all rendered pixels of the standard error of Tb_c, in K, per channel. */
 static thz_status run_median_stderr(run_state *rs, thz_error *err)
 {
-    size_t total = 0;
-    for (size_t i = 0; i < rs->n_selected; i++)
-        total += (size_t)rs->images[i].columns * rs->images[i].rows;
-    double *v = thz_malloc_array(total, sizeof *v);
+    double *v = thz_malloc_array(run_rendered_pixels(rs), sizeof *v);
     if (!v)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the error statistics");
-    for (size_t c = 0; c < rs->scene->n_channels; c++) {
-        double nu = rs->scene->channels[c].center_hz;
-        size_t m = 0;
-        for (size_t i = 0; i < rs->n_selected; i++) {
-            const sensor_images *img = &rs->images[i];
-            size_t px = (size_t)img->columns * img->rows;
-            for (size_t p = 0; p < px; p++) {
-                double tb = img->brightness_temperature[c * px + p];
-                if (!(tb > 0.0) || !img->radiance_stderr)
-                    continue;
-                v[m++] = img->radiance_stderr[c * px + p] / run_planck_dbdt(nu, tb);
-            }
-        }
-        if (m == 0) {
-            rs->median_stderr_k[c] = 0.0;
-            continue;
-        }
-        qsort(v, m, sizeof *v, run_compare_double);
-        rs->median_stderr_k[c] = m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
-    }
+    for (size_t c = 0; c < rs->scene->n_channels; c++)
+        rs->median_stderr_k[c] = run_channel_median_stderr_k(rs, c, v);
     free(v);
     return THZ_OK;
 }
@@ -364,6 +433,9 @@ static thz_status run_write_outputs(run_state *rs, double t_start, thz_error *er
                              ? rs->stats
                              : NULL,
         .median_stderr_k = rs->median_stderr_k,
+        .passes = rs->passes,
+        .seconds_render_channel = rs->seconds_channel,
+        .target_noise_k = rs->opt->target_noise_k,
         .back_face_samples = rs->back_face,
         .seconds_load = rs->opt->seconds_load,
         .seconds_accel = rs->seconds_accel,
@@ -406,6 +478,8 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
     thz_status st = run_state_init(rs, scene, opt, command, err);
     if (st == THZ_OK)
         st = render_integrator_check(scene->render.integrator, err);
+    if (st == THZ_OK)
+        st = run_check_options(scene, opt, err);
     if (st == THZ_OK)
         st = output_stage_create(opt->outdir, &rs->stage, err);
     if (st != THZ_OK)

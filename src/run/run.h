@@ -8,6 +8,10 @@
  *   render:   read a saved photon map (refusing one made from another scene) -> render
  *             the chosen sensors -> outputs as above.
  *
+ * With the `path` integrator simulate fires no photons. With target_noise_k, each
+ * channel gets passes 0, 1, 2, ... (each deterministic) until its median standard
+ * error in K is at most the target, or max_seconds have passed.
+ *
  * A failed or cancelled run (progress callback returning non-zero: THZ_ERR_CANCELLED)
  * leaves no result files in OUTDIR. Results are bit-identical for any thread count.
  */
@@ -38,6 +42,11 @@ typedef struct run_options {
     thz_progress_fn progress;    /* stages "photons", "render", "output"; may be NULL */
     void *progress_user;
     double seconds_load;         /* time the caller spent loading the scene, for the summary */
+    double target_noise_k;       /* > 0: add passes to each channel until the median per-pixel
+                                    standard error of Tb_c, over the rendered sensors, is at
+                                    most this (K); final-gather and path only */
+    double max_seconds;          /* > 0: stop adding passes once a channel has rendered this
+                                    long (s); makes the stopping point time-dependent */
 } run_options;
 
 /* What a finished run reports back (for the CLI's closing line). */
@@ -50,6 +59,10 @@ typedef struct run_result {
     size_t n_warnings;            /* run warnings written to summary.json */
     double seconds;               /* wall time of the run */
 } run_result;
+
+/* THZ_ERR_INPUT unless the options suit the scene's integrator (a noise target needs
+ * final-gather or path; targets and limits must be positive). */
+thz_status run_check_options(const thz_scene *scene, const run_options *opt, thz_error *err);
 
 /* Applies the overrides to the scene (before run_simulate / run_render). */
 void run_apply_overrides(thz_scene *scene, const run_overrides *ov);

@@ -1,5 +1,20 @@
-/* Rendering a sensor's channel images from a photon map (physics.md "Rendering phase"),
- * and its truth images. */
+/* Rendering a sensor's channel images (physics.md "Rendering phase" and "Integrators"),
+ * and its truth images.
+ *
+ * The `path` estimator. With B0(nu) = B_nu(T0) for a reference temperature T0, the
+ * radiance leaving a front side obeys (physics.md "Surfaces", Kirchhoff or explicit eps)
+ *   L - B0 = [eps B(T) - A B0] + R (L_R - B0) + T (L_T - B0),   A = 1 - R - T(theta),
+ * and across a free path of transmittance tau, L_in - B0 = tau (L_far - B0) + (tau - 1) B0;
+ * nothing hit, or the back of a one-sided solid, is L - B0 = -B0. A path samples nu from
+ * g_c, adds the bracket at every hit (times the product beta of the transmittances so
+ * far), continues by Russian roulette with probabilities R (cosine reflection) and
+ * T(theta) (straight: unchanged; diffuse: exit mu ~ T(mu) mu), which makes the BRDF and
+ * BTDF weights exactly 1, and returns  Bbar0 + sum, with Bbar0 the band mean of B0 by the
+ * channel quadrature. E[B0(nu)] = Bbar0, so the estimate is unbiased for the band mean of
+ * L for any T0 (B0 is an additive control variate, in space and in frequency). In an
+ * isothermal enclosure at T0 every bracket is exactly 0, so every path returns Bbar0:
+ * N_c = 1 to rounding. T0 is the temperature of the object with the largest emitting
+ * area x hemispherical emissivity at the channel centre (the walls of a room). */
 #include "sensor/render.h"
 
 #include <math.h>
@@ -9,6 +24,8 @@
 #include <time.h>
 
 #include "core/alloc.h"
+#include "core/rng.h"
+#include "photon/emission.h"
 #include "physics/channel.h"
 #include "physics/optics.h"
 #include "physics/planck.h"
@@ -21,6 +38,9 @@ typedef struct render_context {
     const thz_scene *scene;
     const accel *accel;
     const photon_map *map;
+    const thz_channel *channel;
+    uint32_t channel_index;
+    uint64_t seed;
     size_t k;                /* gather_min_photons */
     channel_quadrature quad; /* nodes and normalised weights of g_c */
     double *planck;          /* [object * quad.n + node]: B_nu(T_object), W m^-2 sr^-1 Hz^-1 */
@@ -28,7 +48,10 @@ typedef struct render_context {
     double *alpha_per_m;     /* [node]: atmospheric attenuation, 1/m */
     double *emission_mean;   /* [object]: band mean of eps B when eps does not depend on the
                                 angle (solids, explicit eps); NAN for the others */
+    bool *scatters;          /* [object]: R > 0 somewhere, or a diffuse shell */
     bool atmosphere;         /* some node has alpha > 0 */
+    double t0_k;             /* path: reference temperature T0, K */
+    double b0_mean;          /* path: band mean of B(T0) */
 } render_context;
 
 /* The `straight` shells a sample ray has passed through: the path weight at frequency nu
@@ -39,33 +62,48 @@ typedef struct render_path {
     double mu[RENDER_MAX_CROSSINGS];
 } render_path;
 
-/* The result of one sample ray. */
+/* Counters and the photon-map variance of one sample. */
 typedef struct render_sample {
-    double radiance; /* band mean of L exp(-alpha d), W m^-2 sr^-1 Hz^-1 */
-    double variance; /* its estimated variance (photon terms, Poisson) */
+    double variance; /* photon-map: estimated variance of its radiance (Poisson) */
     unsigned escaped, back_face, widened, starved, truncated;
+    uint64_t paths;
 } render_sample;
 
-/* An integrator: the radiance seen by one sample ray. `sample_sr` is the sample's solid
- * angle Omega_S / n^2; `sample_index` identifies the sample for random streams. */
-typedef void (*render_radiance_fn)(const render_context *ctx, vec3 origin_m, vec3 dir,
-                                   double sample_sr, uint64_t sample_index, render_sample *out);
+/* Where a sample's estimates go: est[j] += weight x (estimate j), j < n_est. */
+typedef struct render_target {
+    double *est;
+    uint32_t n_est;
+    double weight;        /* 1 / n^2 */
+    uint64_t rng_index;   /* first index of this sample's random streams (x n_est) */
+} render_target;
 
-static void render_photon_map_radiance(const render_context *ctx, vec3 origin_m, vec3 dir,
-                                       double sample_sr, uint64_t sample_index,
+/* An integrator: the estimates of one sample ray. `sample_sr` is the sample's solid
+ * angle Omega_S / n^2. */
+typedef void (*render_sample_fn)(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                 double sample_sr, const render_target *t, render_sample *out);
+
+static void render_photon_map_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                     double sample_sr, const render_target *t,
+                                     render_sample *out);
+static void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                       double sample_sr, const render_target *t,
                                        render_sample *out);
+static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
+                               double sample_sr, const render_target *t, render_sample *out);
 
 typedef struct render_integrator {
     thz_integrator id;
     const char *name;
-    render_radiance_fn radiance; /* NULL: not implemented yet */
+    render_sample_fn sample; /* NULL: not implemented yet */
     bool needs_photons;
+    uint32_t purpose;        /* RNG purpose; 0: no random numbers (one pass) */
 } render_integrator;
 
 static const render_integrator render_integrators[] = {
-    {INTEGRATOR_PHOTON_MAP, "photon-map", render_photon_map_radiance, true},
-    {INTEGRATOR_FINAL_GATHER, "final-gather", NULL, true},
-    {INTEGRATOR_PATH, "path", NULL, false},
+    {INTEGRATOR_PHOTON_MAP, "photon-map", render_photon_map_sample, true, 0},
+    {INTEGRATOR_FINAL_GATHER, "final-gather", render_final_gather_sample, true,
+     RNG_PURPOSE_GATHER},
+    {INTEGRATOR_PATH, "path", render_path_sample, false, RNG_PURPOSE_PATH},
 };
 #define RENDER_N_INTEGRATORS (sizeof render_integrators / sizeof render_integrators[0])
 
@@ -98,7 +136,7 @@ thz_status render_integrator_check(thz_integrator integrator, thz_error *err)
     const render_integrator *it = render_find_integrator(integrator);
     if (!it)
         return thz_error_set(err, THZ_ERR_INPUT, "unknown integrator %d", (int)integrator);
-    if (!it->radiance)
+    if (!it->sample)
         return thz_error_set(err, THZ_ERR_INPUT, "integrator '%s' is not implemented yet",
                              it->name);
     return THZ_OK;
@@ -108,6 +146,24 @@ bool render_integrator_needs_photons(thz_integrator integrator)
 {
     const render_integrator *it = render_find_integrator(integrator);
     return it ? it->needs_photons : true;
+}
+
+bool render_integrator_has_passes(thz_integrator integrator)
+{
+    const render_integrator *it = render_find_integrator(integrator);
+    return it && it->purpose != 0;
+}
+
+uint32_t render_estimates_per_pass(const thz_scene *scene)
+{
+    switch (scene->render.integrator) {
+    case INTEGRATOR_PATH:
+        return scene->render.paths_per_sample > 0 ? scene->render.paths_per_sample : 1;
+    case INTEGRATOR_FINAL_GATHER:
+        return scene->render.gather_rays > 0 ? scene->render.gather_rays : 1;
+    default:
+        return 1;
+    }
 }
 
 static double render_now_s(void)
@@ -124,7 +180,26 @@ static void render_context_fini(render_context *ctx)
     free(ctx->optics);
     free(ctx->alpha_per_m);
     free(ctx->emission_mean);
+    free(ctx->scatters);
     memset(ctx, 0, sizeof *ctx);
+}
+
+/* T0 of the path estimator: the temperature of the object with the largest
+ * area x sides x hemispherical emissivity at the channel centre. */
+static double render_reference_temperature(const thz_scene *scene, const thz_channel *ch)
+{
+    double best = -1.0, t0 = 0.0;
+    for (size_t o = 0; o < scene->n_objects; o++) {
+        const thz_object *obj = &scene->objects[o];
+        optics_point op = scene_object_optics(scene, obj, ch->center_hz);
+        double sides = obj->type == OBJECT_SHELL || obj->two_sided ? 2.0 : 1.0;
+        double w = obj->mesh.total_area_m2 * sides * optics_mean_emissivity(&op);
+        if (w > best) {
+            best = w;
+            t0 = obj->temperature_k;
+        }
+    }
+    return t0;
 }
 
 static thz_status render_context_init(render_context *ctx, const thz_scene *scene, const accel *a,
@@ -134,6 +209,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->scene = scene;
     ctx->accel = a;
     ctx->map = map;
+    ctx->channel = &scene->channels[channel];
+    ctx->channel_index = (uint32_t)channel;
+    ctx->seed = scene->photons.seed;
     ctx->k = scene->photons.gather_min_photons;
     thz_status st = channel_quadrature_init(&ctx->quad, &scene->channels[channel],
                                             CHANNEL_QUADRATURE_NODES, err);
@@ -147,7 +225,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->optics = thz_malloc_array(cells, sizeof *ctx->optics);
     ctx->alpha_per_m = thz_malloc_array(n, sizeof *ctx->alpha_per_m);
     ctx->emission_mean = thz_malloc_array(n_obj, sizeof *ctx->emission_mean);
-    if (!ctx->planck || !ctx->optics || !ctx->alpha_per_m || !ctx->emission_mean) {
+    ctx->scatters = thz_malloc_array(n_obj, sizeof *ctx->scatters);
+    if (!ctx->planck || !ctx->optics || !ctx->alpha_per_m || !ctx->emission_mean ||
+        !ctx->scatters) {
         render_context_fini(ctx);
         return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
     }
@@ -158,8 +238,8 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     }
     for (size_t o = 0; o < n_obj; o++) {
         const thz_object *obj = &scene->objects[o];
-        bool angle_free = obj->type == OBJECT_SOLID ||
-                          scene->materials[obj->material].emissivity.n > 0;
+        const thz_material *mat = &scene->materials[obj->material];
+        bool angle_free = obj->type == OBJECT_SOLID || mat->emissivity.n > 0;
         double mean = 0.0;
         for (size_t k = 0; k < n; k++) {
             double nu = ctx->quad.freq_hz[k];
@@ -169,7 +249,14 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
             mean += ctx->quad.weight[k] * optics_emissivity(op, 1.0) * ctx->planck[o * n + k];
         }
         ctx->emission_mean[o] = angle_free ? mean : NAN;
+        double r_min, r_max;
+        spectrum_range(&mat->reflectivity, &r_min, &r_max);
+        ctx->scatters[o] = r_max > 0.0 || (obj->type == OBJECT_SHELL &&
+                                           mat->transmission == TRANSMISSION_DIFFUSE);
     }
+    ctx->t0_k = render_reference_temperature(scene, ctx->channel);
+    for (size_t k = 0; k < n; k++)
+        ctx->b0_mean += ctx->quad.weight[k] * planck_radiance(ctx->quad.freq_hz[k], ctx->t0_k);
     return THZ_OK;
 }
 
@@ -210,6 +297,35 @@ static double render_emission(const render_context *ctx, uint32_t object, double
     return sum;
 }
 
+/* The scattering at a final-gather vertex x, as a weight on whatever arrives along the
+ * gather ray at frequency nu: f_x(nu) cos / pdf / P(branch), with the direction and the
+ * branch drawn at the gather ray's frequency nu_j. */
+typedef struct render_scatter {
+    const thz_material *material;
+    const thz_object *object;
+    bool transmitted;   /* diffuse transmission (else Lambertian reflection) */
+    double mu_o;        /* |cos| of the direction towards the sensor at x */
+    double mu_i;        /* |cos| of the gather ray at x */
+    double pdf_ratio;   /* transmitted: Tbar(nu_j) / T(nu_j, mu_i) */
+    double inv_branch;  /* 1 / P(branch) */
+} render_scatter;
+
+static double render_scatter_weight(const render_context *ctx, const render_scatter *s,
+                                    double nu)
+{
+    if (!s)
+        return 1.0;
+    if (!s->transmitted)
+        return spectrum_eval(&s->material->reflectivity, nu) * s->inv_branch;
+    /* f_T cos_i / pdf = T(nu,mu_i) T(nu,mu_o) / Tbar(nu) x Tbar(nu_j) / T(nu_j,mu_i) */
+    optics_point o = scene_object_optics(ctx->scene, s->object, nu);
+    double tbar = optics_mean_transmission(&o);
+    if (!(tbar > 0.0))
+        return 0.0;
+    return optics_transmission(&o, s->mu_i) * optics_transmission(&o, s->mu_o) / tbar *
+           s->pdf_ratio * s->inv_branch;
+}
+
 /* Accumulator of one gather over one side of the hit object. */
 typedef struct render_gather_state {
     const render_context *ctx;
@@ -217,6 +333,7 @@ typedef struct render_gather_state {
     vec3 normal_seen;    /* unit normal of the triangle hit, towards the sensor's side */
     double mu_o;         /* |cos theta| of the view ray */
     const render_path *path;
+    const render_scatter *scatter; /* final-gather: the first vertex's weight, or NULL */
     double distance_m;   /* from the sensor */
     double radius2_m2;
     bool strict;         /* only photons strictly inside (widened disk) */
@@ -255,7 +372,8 @@ static void render_gather_visit(void *vstate, const photon_record *p, double dis
     if (f == 0.0)
         return;
     double c = f * (double)p->power_w_per_hz * render_path_weight(g->ctx, g->path, nu) *
-               atmosphere_transmittance(&scene->atmosphere, nu, g->distance_m);
+               atmosphere_transmittance(&scene->atmosphere, nu, g->distance_m) *
+               render_scatter_weight(g->ctx, g->scatter, nu);
     g->sum += c;
     g->sum2 += c * c;
 }
@@ -266,6 +384,8 @@ static void render_gather_pass(render_gather_state *g, uint32_t object, int seen
     g->count = 0;
     g->sum = g->sum2 = 0.0;
     g->transmitted = false;
+    if (!(g->radius2_m2 > 0.0))
+        return;
     photon_map_radius(g->ctx->map, object, seen_side, position, g->radius2_m2,
                       render_gather_visit, g);
     if (with_other_side) {
@@ -276,10 +396,13 @@ static void render_gather_pass(render_gather_state *g, uint32_t object, int seen
 }
 
 /* L_R (+ L_T for diffuse shells) at the hit by density estimation over the sample's
- * footprint, widened to the k-th nearest photon when it holds fewer than k. */
+ * footprint (sample_sr > 0), widened to the k-th nearest photon when it holds fewer than
+ * k; sample_sr = 0 asks for the k-th nearest radius directly. Adds the estimate to
+ * *radiance and its Poisson variance to out->variance. */
 static void render_gather(const render_context *ctx, const accel_hit *hit,
-                          const render_path *path, double distance_m, double sample_sr,
-                          bool diffuse_shell, render_sample *out)
+                          const render_path *path, const render_scatter *scatter,
+                          double distance_m, double sample_sr, bool diffuse_shell,
+                          double *radiance, render_sample *out)
 {
     if (!ctx->map)
         return;
@@ -292,6 +415,7 @@ static void render_gather(const render_context *ctx, const accel_hit *hit,
         .normal_seen = hit->side == 0 ? normal : v3_scale(normal, -1.0),
         .mu_o = hit->cos_theta,
         .path = path,
+        .scatter = scatter,
         .distance_m = distance_m,
         .radius2_m2 = sample_sr * distance_m * distance_m / (M_PI * hit->cos_theta),
     };
@@ -306,21 +430,144 @@ static void render_gather(const render_context *ctx, const accel_hit *hit,
             out->starved = 1;
             return;
         }
-        out->widened = 1;
+        if (sample_sr > 0.0)
+            out->widened = 1;
         g.radius2_m2 = rk2;
         g.strict = true; /* the k-th photon lies on the boundary: k - 1 inside */
         render_gather_pass(&g, hit->object, hit->side, diffuse_shell, hit->position_m);
     }
     double area = M_PI * g.radius2_m2;
-    out->radiance += g.sum / area;
+    *radiance += g.sum / area;
     out->variance += g.sum2 / (area * area);
 }
 
-static void render_photon_map_radiance(const render_context *ctx, vec3 origin_m, vec3 dir,
-                                       double sample_sr, uint64_t sample_index,
+/* The photon-map radiance along a ray (physics.md "Rendering phase"): emission and the
+ * photon terms at the first hit, continued through straight shells. `path` and
+ * `distance_m` carry what lies between the sensor and `origin_m` (final-gather's
+ * secondary rays start with the first vertex's); `scatter` (may be NULL) weights every
+ * term by the first vertex's scattering at the term's frequency; emission_hz > 0
+ * evaluates the emission at that frequency (a sampled one) instead of the band mean. */
+static double render_photon_map_trace(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                      uint32_t ignore_object, uint32_t ignore_triangle,
+                                      render_path path, double distance_m,
+                                      const render_scatter *scatter, double emission_hz,
+                                      double sample_sr, render_sample *out)
+{
+    double radiance = 0.0;
+    size_t crossings = 0;
+    for (;;) {
+        accel_hit hit;
+        if (!accel_intersect(ctx->accel, origin_m, dir, INFINITY, ignore_object, ignore_triangle,
+                             &hit)) {
+            if (crossings == 0)
+                out->escaped = 1;
+            return radiance;
+        }
+        distance_m += hit.distance_m;
+        const thz_object *obj = &ctx->scene->objects[hit.object];
+        if (!scene_object_side_is_front(obj, hit.side)) {
+            out->back_face = 1;
+            return radiance;
+        }
+        if (emission_hz > 0.0) {
+            if (obj->temperature_k > 0.0) {
+                optics_point o = scene_object_optics(ctx->scene, obj, emission_hz);
+                radiance += optics_emissivity(&o, hit.cos_theta) *
+                            planck_radiance(emission_hz, obj->temperature_k) *
+                            render_path_weight(ctx, &path, emission_hz) *
+                            atmosphere_transmittance(&ctx->scene->atmosphere, emission_hz,
+                                                     distance_m) *
+                            render_scatter_weight(ctx, scatter, emission_hz);
+            }
+        } else {
+            radiance += render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m);
+        }
+        bool shell = obj->type == OBJECT_SHELL;
+        bool straight =
+            shell && ctx->scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
+        render_gather(ctx, &hit, &path, scatter, distance_m, sample_sr, shell && !straight,
+                      &radiance, out);
+        if (!straight)
+            return radiance;
+        if (path.n == RENDER_MAX_CROSSINGS) {
+            out->truncated = 1;
+            return radiance;
+        }
+        path.object[path.n] = hit.object;
+        path.mu[path.n] = hit.cos_theta;
+        path.n++;
+        crossings++;
+        origin_m = accel_offset_origin(ctx->accel, &hit, dir);
+        ignore_object = hit.object;
+        ignore_triangle = hit.triangle;
+    }
+}
+
+static void render_photon_map_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                     double sample_sr, const render_target *t,
+                                     render_sample *out)
+{
+    render_path path = {.n = 0};
+    double l = render_photon_map_trace(ctx, origin_m, dir, ACCEL_NO_OBJECT, 0, path, 0.0, NULL,
+                                       0.0, sample_sr, out);
+    for (uint32_t j = 0; j < t->n_est; j++)
+        t->est[j] += t->weight * l;
+}
+
+static void render_add_all(const render_target *t, double v)
+{
+    for (uint32_t j = 0; j < t->n_est; j++)
+        t->est[j] += t->weight * v;
+}
+
+/* One gather ray from first vertex `hit` (object obj, seen through `path`, at distance
+ * distance_m from the sensor): its estimate of the scattered radiance towards the sensor. */
+static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
+                                const thz_object *obj, bool diffuse_shell,
+                                const render_path *path, double distance_m, rng_stream *rng,
+                                render_sample *out)
+{
+    const thz_material *mat = &ctx->scene->materials[obj->material];
+    double nu_j = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
+    optics_point o = scene_object_optics(ctx->scene, obj, nu_j);
+    double r = o.reflectivity;
+    double tr = diffuse_shell ? optics_transmission(&o, hit->cos_theta) : 0.0;
+    if (!(r + tr > 0.0))
+        return 0.0;
+    const float *nf = &obj->mesh.normals[3 * (size_t)hit->triangle];
+    vec3 n = v3_from_floats(nf);
+    vec3 n_seen = hit->side == 0 ? n : v3_scale(n, -1.0);
+    render_scatter s = {.material = mat, .object = obj, .mu_o = hit->cos_theta};
+    vec3 dir;
+    if (rng_uniform(rng) * (r + tr) < r) {
+        s.inv_branch = (r + tr) / r;
+        double mu = sqrt(1.0 - rng_uniform(rng));
+        dir = emission_direction(n_seen, mu, rng_uniform(rng));
+        s.mu_i = mu;
+    } else {
+        s.transmitted = true;
+        s.inv_branch = (r + tr) / tr;
+        double mu;
+        if (!optics_sample_transmission_mu(&o, emission_uniform, rng, &mu))
+            return 0.0;
+        dir = emission_direction(v3_scale(n_seen, -1.0), mu, rng_uniform(rng));
+        s.mu_i = mu;
+        s.pdf_ratio = optics_mean_transmission(&o) / optics_transmission(&o, mu);
+    }
+    vec3 origin = accel_offset_origin(ctx->accel, hit, dir);
+    render_sample sec = {.variance = 0.0};
+    double l = render_photon_map_trace(ctx, origin, dir, hit->object, hit->triangle, *path,
+                                       distance_m, &s, nu_j, 0.0, &sec);
+    out->starved |= sec.starved;
+    out->truncated |= sec.truncated;
+    return l;
+}
+
+static void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                       double sample_sr, const render_target *t,
                                        render_sample *out)
 {
-    (void)sample_index; /* deterministic: no random numbers */
+    (void)sample_sr;
     render_path path = {.n = 0};
     double distance_m = 0.0;
     uint32_t ignore_object = ACCEL_NO_OBJECT, ignore_triangle = 0;
@@ -338,11 +585,22 @@ static void render_photon_map_radiance(const render_context *ctx, vec3 origin_m,
             out->back_face = 1;
             return;
         }
-        out->radiance += render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m);
+        render_add_all(t, render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m));
         bool shell = obj->type == OBJECT_SHELL;
         bool straight =
             shell && ctx->scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
-        render_gather(ctx, &hit, &path, distance_m, sample_sr, shell && !straight, out);
+        if (ctx->scatters[hit.object]) {
+            /* streams: the sample's, one per gather ray; crossings of straight shells
+             * shift them so that each vertex has its own */
+            for (uint32_t j = 0; j < t->n_est; j++) {
+                rng_stream rng;
+                rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_GATHER,
+                         (t->rng_index + j) * (RENDER_MAX_CROSSINGS + 1) + path.n);
+                t->est[j] += t->weight * render_gather_ray(ctx, &hit, obj, shell && !straight,
+                                                           &path, distance_m, &rng, out);
+            }
+            out->paths += t->n_est;
+        }
         if (!straight)
             return;
         if (path.n == RENDER_MAX_CROSSINGS) {
@@ -355,6 +613,97 @@ static void render_photon_map_radiance(const render_context *ctx, vec3 origin_m,
         origin_m = accel_offset_origin(ctx->accel, &hit, dir);
         ignore_object = hit.object;
         ignore_triangle = hit.triangle;
+    }
+}
+
+/* One path from the first hit `first` (ray along dir0 from the sensor); returns its
+ * estimate of the band-mean radiance (see the top of this file). */
+static double render_path_trace(const render_context *ctx, const accel_hit *first, vec3 dir0,
+                                rng_stream *rng, render_sample *out)
+{
+    const thz_scene *scene = ctx->scene;
+    double nu = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
+    double b0 = planck_radiance(nu, ctx->t0_k);
+    double sum = 0.0, beta = 1.0;
+    accel_hit hit = *first;
+    vec3 dir = dir0;
+    double d = hit.distance_m; /* free path to this hit */
+    for (uint32_t bounce = 0;; bounce++) {
+        if (bounce > 0) {
+            vec3 surface = hit.position_m;
+            vec3 origin = accel_offset_origin(ctx->accel, &hit, dir);
+            uint32_t from_object = hit.object, from_triangle = hit.triangle;
+            if (!accel_intersect(ctx->accel, origin, dir, INFINITY, from_object, from_triangle,
+                                 &hit)) {
+                sum -= beta * b0;
+                break;
+            }
+            /* from the surface point, not the offset origin (as the photon phase) */
+            const float *hn = &scene->objects[hit.object].mesh.normals[3 * (size_t)hit.triangle];
+            vec3 to_hit = v3_sub(hit.position_m, surface);
+            d = hit.cos_theta > 1e-6 ? fabs(v3_dot(to_hit, v3_from_floats(hn))) / hit.cos_theta
+                                     : v3_length(to_hit);
+        }
+        if (bounce >= RENDER_MAX_BOUNCES) {
+            out->truncated = 1;
+            break;
+        }
+        if (ctx->atmosphere) {
+            double tau = atmosphere_transmittance(&scene->atmosphere, nu, d);
+            sum += beta * (tau - 1.0) * b0;
+            beta *= tau;
+        }
+        const thz_object *obj = &scene->objects[hit.object];
+        if (!scene_object_side_is_front(obj, hit.side)) {
+            sum -= beta * b0;
+            break;
+        }
+        optics_point o = scene_object_optics(scene, obj, nu);
+        double mu = hit.cos_theta;
+        double r = o.reflectivity;
+        double tr = optics_transmission(&o, mu);
+        double a = 1.0 - r - tr;
+        double eps = o.explicit_emissivity ? o.emissivity : a;
+        double bt = obj->temperature_k == ctx->t0_k ? b0 : planck_radiance(nu, obj->temperature_k);
+        sum += beta * (eps * bt - a * b0);
+        double u = rng_uniform(rng);
+        const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
+        vec3 n = v3_from_floats(nf);
+        vec3 n_seen = hit.side == 0 ? n : v3_scale(n, -1.0);
+        if (u < r) {
+            dir = emission_direction(n_seen, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
+        } else if (u < r + tr) {
+            if (scene->materials[obj->material].transmission == TRANSMISSION_DIFFUSE) {
+                double m;
+                if (!optics_sample_transmission_mu(&o, emission_uniform, rng, &m))
+                    break; /* unreachable: T > 0 here */
+                dir = emission_direction(v3_scale(n_seen, -1.0), m, rng_uniform(rng));
+            }
+        } else {
+            break;
+        }
+    }
+    out->paths++;
+    return ctx->b0_mean + sum;
+}
+
+static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
+                               double sample_sr, const render_target *t, render_sample *out)
+{
+    (void)sample_sr;
+    accel_hit first;
+    if (!accel_intersect(ctx->accel, origin_m, dir, INFINITY, ACCEL_NO_OBJECT, 0, &first)) {
+        out->escaped = 1;
+        return; /* radiance 0 for every path */
+    }
+    if (!scene_object_side_is_front(&ctx->scene->objects[first.object], first.side)) {
+        out->back_face = 1;
+        return;
+    }
+    for (uint32_t j = 0; j < t->n_est; j++) {
+        rng_stream rng;
+        rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_PATH, t->rng_index + j);
+        t->est[j] += t->weight * render_path_trace(ctx, &first, dir, &rng, out);
     }
 }
 
@@ -378,11 +727,232 @@ static bool render_report(const render_options *opt, const thz_scene *scene, siz
     return opt->progress(opt->progress_user, &p) != 0;
 }
 
+thz_status render_accum_init(render_accum *acc, size_t pixels, thz_error *err)
+{
+    memset(acc, 0, sizeof *acc);
+    acc->pixels = pixels;
+    acc->mean = thz_calloc(pixels ? pixels : 1, sizeof *acc->mean);
+    acc->m2 = thz_calloc(pixels ? pixels : 1, sizeof *acc->m2);
+    if (!acc->mean || !acc->m2) {
+        render_accum_fini(acc);
+        return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for %zu pixel statistics",
+                             pixels);
+    }
+    return THZ_OK;
+}
+
+void render_accum_fini(render_accum *acc)
+{
+    free(acc->mean);
+    free(acc->m2);
+    memset(acc, 0, sizeof *acc);
+}
+
+double render_accum_stderr(const render_accum *acc, size_t p)
+{
+    if (acc->poisson)
+        return sqrt(acc->m2[p]);
+    if (acc->n < 2)
+        return 0.0;
+    double n = (double)acc->n;
+    return sqrt(acc->m2[p] / ((n - 1.0) * n));
+}
+
+/* The random-stream index of estimate 0 of sample `sample` (of `samples` per pass) of
+ * sensor `sensor` in pass `pass`, with J estimates per sample: the fold of the four
+ * indices (unique below 2^64 estimates in all). */
+static uint64_t render_rng_index(const thz_scene *scene, size_t sensor, uint32_t pass,
+                                 uint64_t samples, uint64_t sample, uint32_t j_count)
+{
+    uint64_t unit = (uint64_t)pass * scene->n_sensors + sensor;
+    return (unit * samples + sample) * j_count;
+}
+
+thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a,
+                                      const photon_map *map, size_t channel, size_t sensor,
+                                      uint32_t pass, render_accum *acc, const render_options *opt,
+                                      render_stats *stats, thz_error *err)
+{
+    double t0 = render_now_s();
+    if (stats)
+        memset(stats, 0, sizeof *stats);
+    if (channel >= scene->n_channels || sensor >= scene->n_sensors)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "render: channel %zu or sensor %zu out of range",
+                             channel, sensor);
+    const thz_sensor *sn = &scene->sensors[sensor];
+    if (acc->pixels != (size_t)sn->columns * sn->rows)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "render: statistics do not match sensor '%s'",
+                             sn->name);
+    thz_status st = render_integrator_check(scene->render.integrator, err);
+    if (st != THZ_OK)
+        return st;
+    const render_integrator *integ = render_find_integrator(scene->render.integrator);
+    if (integ->needs_photons && !map)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "render: integrator '%s' needs a photon map",
+                             integ->name);
+    if (integ->purpose == 0 && pass > 0)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "render: integrator '%s' is deterministic given its photon map; "
+                             "more passes cannot lower its noise (more photons do)",
+                             integ->name);
+    if (pass != acc->passes)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "render: pass %u out of order (expected %u)",
+                             pass, acc->passes);
+    camera cam;
+    st = camera_init(&cam, sn, err);
+    if (st != THZ_OK)
+        return st;
+    uint32_t n_est = integ->purpose ? render_estimates_per_pass(scene) : 1;
+    int threads = render_threads(opt);
+    render_context ctx;
+    st = render_context_init(&ctx, scene, a, map, channel, err);
+    if (st != THZ_OK)
+        return st;
+    /* per thread: the current pixel's n_est estimates */
+    double *scratch = thz_malloc_array((size_t)threads * n_est, sizeof *scratch);
+    if (!scratch) {
+        render_context_fini(&ctx);
+        return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for %u estimates x %d "
+                             "threads", n_est, threads);
+    }
+
+    uint32_t n = cam.oversampling, cols = cam.columns, rows = cam.rows;
+    double n2 = (double)n * (double)n;
+    uint64_t samples_per_pass = (uint64_t)cols * rows * n * n;
+    /* Rows per block: about 16k sample estimates between progress calls. */
+    uint64_t work_per_row = (uint64_t)cols * n * n * (integ->purpose ? n_est : 1);
+    uint32_t block = (uint32_t)(16384 / (work_per_row ? work_per_row : 1));
+    if (block < 1)
+        block = 1;
+    uint64_t n_samples = 0, n_escaped = 0, n_back = 0, n_widened = 0, n_starved = 0,
+             n_truncated = 0, n_paths = 0;
+    double n_b = (double)n_est, n_a = (double)acc->n, n_ab = n_a + n_b;
+
+    if (render_report(opt, scene, channel, 0, rows)) {
+        st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
+        goto cleanup;
+    }
+    for (uint32_t r0 = 0; r0 < rows; r0 += block) {
+        uint32_t r1 = r0 + block < rows ? r0 + block : rows;
+        int64_t first = (int64_t)r0 * cols, last = (int64_t)r1 * cols;
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads) \
+    reduction(+ : n_samples, n_escaped, n_back, n_widened, n_starved, n_truncated, n_paths)
+        for (int64_t px = first; px < last; px++) {
+            double *est = &scratch[(size_t)omp_get_thread_num() * n_est];
+            for (uint32_t j = 0; j < n_est; j++)
+                est[j] = 0.0;
+            uint32_t row = (uint32_t)(px / cols), col = (uint32_t)(px % cols);
+            double omega_sr = camera_pixel_solid_angle(&cam, col, row);
+            double sample_sr = omega_sr / n2;
+            double var_sum = 0.0;
+            for (uint32_t j = 0; j < n; j++)
+                for (uint32_t i = 0; i < n; i++) {
+                    render_sample s = {.variance = 0.0};
+                    vec3 dir = camera_sample_dir(&cam, col, row, i, j);
+                    uint64_t sample = (uint64_t)px * n * n + (uint64_t)j * n + i;
+                    render_target t = {
+                        .est = est,
+                        .n_est = n_est,
+                        .weight = 1.0 / n2,
+                        .rng_index =
+                            render_rng_index(scene, sensor, pass, samples_per_pass, sample, n_est),
+                    };
+                    integ->sample(&ctx, cam.position_m, dir, sample_sr, &t, &s);
+                    var_sum += s.variance;
+                    n_samples++;
+                    n_escaped += s.escaped;
+                    n_back += s.back_face;
+                    n_widened += s.widened;
+                    n_starved += s.starved;
+                    n_truncated += s.truncated;
+                    n_paths += s.paths;
+                }
+            size_t p = (size_t)px;
+            if (!integ->purpose) {
+                acc->mean[p] = est[0];
+                acc->m2[p] = var_sum / (n2 * n2);
+                continue;
+            }
+            /* this pass's mean and squared deviations (two-pass), merged with the earlier
+             * passes' (Chan et al.) */
+            double mean_b = 0.0, m2_b = 0.0;
+            for (uint32_t k = 0; k < n_est; k++)
+                mean_b += est[k];
+            mean_b /= n_b;
+            for (uint32_t k = 0; k < n_est; k++)
+                m2_b += (est[k] - mean_b) * (est[k] - mean_b);
+            double delta = mean_b - acc->mean[p];
+            acc->mean[p] += delta * n_b / n_ab;
+            acc->m2[p] += m2_b + delta * delta * n_a * n_b / n_ab;
+        }
+        if (render_report(opt, scene, channel, r1, rows)) {
+            st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
+            goto cleanup;
+        }
+    }
+    acc->n += n_est;
+    acc->passes++;
+    acc->poisson = integ->purpose == 0;
+
+cleanup:
+    if (stats) {
+        stats->samples = n_samples;
+        stats->escaped_samples = n_escaped;
+        stats->back_face_samples = n_back;
+        stats->widened_gathers = n_widened;
+        stats->starved_gathers = n_starved;
+        stats->truncated_paths = n_truncated;
+        stats->paths = n_paths;
+        stats->seconds = render_now_s() - t0;
+    }
+    free(scratch);
+    render_context_fini(&ctx);
+    return st;
+}
+
+thz_status render_accum_write(const thz_scene *scene, size_t channel, size_t sensor,
+                              const render_accum *acc, sensor_images *images, thz_error *err)
+{
+    const thz_sensor *sn = &scene->sensors[sensor];
+    if (images->columns != sn->columns || images->rows != sn->rows ||
+        images->n_channels != scene->n_channels || acc->pixels != (size_t)sn->columns * sn->rows)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "render: images do not match sensor '%s'",
+                             sn->name);
+    camera cam;
+    thz_status st = camera_init(&cam, sn, err);
+    if (st != THZ_OK)
+        return st;
+    const thz_channel *ch = &scene->channels[channel];
+    channel_quadrature q;
+    st = channel_quadrature_init(&q, ch, CHANNEL_QUADRATURE_NODES, err);
+    if (st != THZ_OK)
+        return st;
+    double b_ref = 0.0; /* band mean of B_nu(T_ref) */
+    for (size_t k = 0; k < q.n; k++)
+        b_ref += q.weight[k] * planck_radiance(q.freq_hz[k], sn->normalize_to_k);
+    channel_quadrature_fini(&q);
+    double bandwidth_hz = channel_bandwidth_hz(ch);
+    size_t plane = channel * acc->pixels;
+    for (size_t p = 0; p < acc->pixels; p++) {
+        uint32_t row = (uint32_t)(p / sn->columns), col = (uint32_t)(p % sn->columns);
+        double omega_sr = camera_pixel_solid_angle(&cam, col, row);
+        double l = acc->mean[p]; /* L_c, W m^-2 sr^-1 Hz^-1 */
+        size_t at = plane + p;
+        images->radiance[at] = (float)l;
+        if (images->radiance_stderr)
+            images->radiance_stderr[at] = (float)render_accum_stderr(acc, p);
+        images->power[at] = (float)(l * omega_sr * sn->aperture_m2 * bandwidth_hz);
+        images->brightness_temperature[at] =
+            l > 0.0 ? (float)planck_brightness_temperature(ch->center_hz, l) : 0.0f;
+        images->normalized[at] = b_ref > 0.0 ? (float)(l / b_ref) : 0.0f;
+    }
+    return THZ_OK;
+}
+
 thz_status render_sensor_channel(const thz_scene *scene, const accel *a, const photon_map *map,
                                  size_t channel, size_t sensor, sensor_images *images,
                                  const render_options *opt, render_stats *stats, thz_error *err)
 {
-    double t0 = render_now_s();
     if (stats)
         memset(stats, 0, sizeof *stats);
     if (channel >= scene->n_channels || sensor >= scene->n_sensors)
@@ -393,97 +963,25 @@ thz_status render_sensor_channel(const thz_scene *scene, const accel *a, const p
         images->n_channels != scene->n_channels)
         return thz_error_set(err, THZ_ERR_INTERNAL, "render: images do not match sensor '%s'",
                              sn->name);
-    thz_status st = render_integrator_check(scene->render.integrator, err);
+    render_accum acc;
+    thz_status st = render_accum_init(&acc, (size_t)sn->columns * sn->rows, err);
     if (st != THZ_OK)
         return st;
-    const render_integrator *integ = render_find_integrator(scene->render.integrator);
-    if (integ->needs_photons && !map)
-        return thz_error_set(err, THZ_ERR_INTERNAL, "render: integrator '%s' needs a photon map",
-                             integ->name);
-    camera cam;
-    st = camera_init(&cam, sn, err);
-    if (st != THZ_OK)
-        return st;
-    render_context ctx;
-    st = render_context_init(&ctx, scene, a, map, channel, err);
-    if (st != THZ_OK)
-        return st;
-
-    const thz_channel *ch = &scene->channels[channel];
-    double bandwidth_hz = channel_bandwidth_hz(ch);
-    double b_ref = 0.0; /* band mean of B_nu(T_ref) */
-    for (size_t k = 0; k < ctx.quad.n; k++)
-        b_ref += ctx.quad.weight[k] * planck_radiance(ctx.quad.freq_hz[k], sn->normalize_to_k);
-
-    uint32_t n = cam.oversampling, cols = cam.columns, rows = cam.rows;
-    double n2 = (double)n * (double)n;
-    size_t plane = (size_t)channel * rows * cols;
-    /* Rows per block: about 16k samples between progress calls (cancellation latency). */
-    uint64_t samples_per_row = (uint64_t)cols * n * n;
-    uint32_t block = (uint32_t)(16384 / (samples_per_row ? samples_per_row : 1));
-    if (block < 1)
-        block = 1;
-    int threads = render_threads(opt);
-    uint64_t n_samples = 0, n_escaped = 0, n_back = 0, n_widened = 0, n_starved = 0,
-             n_truncated = 0;
-
-    if (render_report(opt, scene, channel, 0, rows)) {
-        st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
-        goto cleanup;
-    }
-    for (uint32_t r0 = 0; r0 < rows; r0 += block) {
-        uint32_t r1 = r0 + block < rows ? r0 + block : rows;
-        int64_t first = (int64_t)r0 * cols, last = (int64_t)r1 * cols;
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads) \
-    reduction(+ : n_samples, n_escaped, n_back, n_widened, n_starved, n_truncated)
-        for (int64_t px = first; px < last; px++) {
-            uint32_t row = (uint32_t)(px / cols), col = (uint32_t)(px % cols);
-            double omega_sr = camera_pixel_solid_angle(&cam, col, row);
-            double sample_sr = omega_sr / n2;
-            double l_sum = 0.0, var_sum = 0.0;
-            for (uint32_t j = 0; j < n; j++)
-                for (uint32_t i = 0; i < n; i++) {
-                    render_sample s = {.radiance = 0.0};
-                    vec3 dir = camera_sample_dir(&cam, col, row, i, j);
-                    uint64_t index = (uint64_t)px * n * n + (uint64_t)j * n + i;
-                    integ->radiance(&ctx, cam.position_m, dir, sample_sr, index, &s);
-                    l_sum += s.radiance;
-                    var_sum += s.variance;
-                    n_samples++;
-                    n_escaped += s.escaped;
-                    n_back += s.back_face;
-                    n_widened += s.widened;
-                    n_starved += s.starved;
-                    n_truncated += s.truncated;
-                }
-            double l = l_sum / n2; /* L_c, W m^-2 sr^-1 Hz^-1 */
-            size_t at = plane + (size_t)px;
-            images->radiance[at] = (float)l;
-            if (images->radiance_stderr)
-                images->radiance_stderr[at] = (float)(sqrt(var_sum) / n2);
-            images->power[at] = (float)(l * omega_sr * sn->aperture_m2 * bandwidth_hz);
-            images->brightness_temperature[at] =
-                l > 0.0 ? (float)planck_brightness_temperature(ch->center_hz, l) : 0.0f;
-            images->normalized[at] = b_ref > 0.0 ? (float)(l / b_ref) : 0.0f;
-        }
-        if (render_report(opt, scene, channel, r1, rows)) {
-            st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
-            goto cleanup;
-        }
-    }
-
-cleanup:
-    if (stats) {
-        stats->samples = n_samples;
-        stats->escaped_samples = n_escaped;
-        stats->back_face_samples = n_back;
-        stats->widened_gathers = n_widened;
-        stats->starved_gathers = n_starved;
-        stats->truncated_paths = n_truncated;
-        stats->seconds = render_now_s() - t0;
-    }
-    render_context_fini(&ctx);
+    st = render_sensor_channel_pass(scene, a, map, channel, sensor, 0, &acc, opt, stats, err);
+    if (st == THZ_OK)
+        st = render_accum_write(scene, channel, sensor, &acc, images, err);
+    render_accum_fini(&acc);
     return st;
+}
+
+double render_stderr_k(double freq_hz, double tb_k, double stderr_l)
+{
+    if (!(tb_k > 0.0))
+        return 0.0;
+    double x = THZ_PLANCK_H * freq_hz / (THZ_BOLTZMANN_K * tb_k);
+    double em1 = expm1(x);
+    double dbdt = planck_radiance(freq_hz, tb_k) * x * (em1 + 1.0) / (em1 * tb_k);
+    return stderr_l / dbdt;
 }
 
 thz_status render_sensor_truth(const thz_scene *scene, const accel *a, size_t sensor,

@@ -1,25 +1,42 @@
-/* The rendering phase (physics.md "Rendering phase", eq. 11-13): for every pixel
- * sample of a sensor, the radiance reaching the pinhole in one channel, and from its
- * pixel mean the channel images L_c, P_c, Tb_c and N_c; plus the truth images.
+/* The rendering phase (physics.md "Rendering phase", eq. 11-13, and "Integrators"): for
+ * every pixel sample of a sensor, the radiance reaching the pinhole in one channel, and
+ * from its pixel mean the channel images L_c, P_c, Tb_c and N_c; plus the truth images.
  *
- * Integrators: the per-sample radiance is computed by the integrator the scene's
- * `render.integrator` names (an internal table of per-sample radiance functions, so
- * `final-gather` and `path` slot in beside `photon-map`). Only `photon-map` is
- * implemented; the others fail with THZ_ERR_INPUT.
+ * Integrators (an internal table of per-sample functions; docs/integrators.md):
+ *   photon-map:   the paper's density estimate over the sample's footprint; deterministic
+ *                 given the photon map; one pass.
+ *   final-gather: at the first non-straight hit, `gather_rays` secondary rays (cosine for
+ *                 reflection, by the BTDF T(theta) cos(theta) for diffuse shells) each
+ *                 adding L_e + L_R + L_T from the photon map at its own hit, with the
+ *                 k-nearest-photon radius (k = gather_min_photons) there.
+ *   path:         backward Monte Carlo without a photon map, `paths_per_sample` paths per
+ *                 sample, frequency drawn from g_c per path; written as the transport of
+ *                 L - B_nu(T0) (T0: a reference temperature of the scene) so that every
+ *                 path of an isothermal enclosure at T0 returns exactly the band mean of
+ *                 B(T0); unbiased for any scene (see render.c).
  *
- * Band means: every photon term is evaluated at the photon's own frequency (its
- * reflectance or BTDF, the straight-shell path weight and the atmospheric
- * transmittance all at nu_p); the emission term is the deterministic band mean by the
- * channel's quadrature. So L_c estimates the band mean of L exp(-alpha d).
+ * Passes and the noise estimate: a pass gives every pixel J independent, identically
+ * distributed estimates (J = paths_per_sample or gather_rays; estimate j is the mean over
+ * the pixel's n x n samples of their j-th path or gather ray). A render_accum merges the
+ * passes per pixel (mean and sum of squared deviations); the standard error of the pixel
+ * mean is sqrt(sample variance / N). Pass p draws its random numbers from
+ * rng_init(seed, channel, RNG_PURPOSE_PATH or _GATHER, index) with index the fold of
+ * (pass, sensor, sample, j), so any pass is bit-identical for any thread count.
+ * photon-map has one pass and keeps the Poisson estimate: sum of squared photon terms over
+ * A_g^2 (the photon map's own noise, which the renderer cannot resample).
  *
- * Gather: the photons of the object hit (the paper's rule), on the side seen (and the
- * other side for `diffuse` shells), within the footprint disk, and, beyond the spec's
- * wording, only those whose incoming direction agrees with that side of the triangle
- * hit, so that the opposite face of a thin solid does not leak into a wide disk.
+ * Band means: photon terms are evaluated at the photon's own frequency; the emission of
+ * photon-map (and of final-gather's first hit) is the deterministic band mean by the
+ * channel's quadrature; path and final-gather's secondary emission sample nu from g_c.
+ *
+ * Gather (photon-map): the photons of the object hit (the paper's rule), on the side seen
+ * (and the other side for `diffuse` shells), within the footprint disk, and, beyond the
+ * spec's wording, only those whose incoming direction agrees with that side of the
+ * triangle hit, so that the opposite face of a thin solid does not leak into a wide disk.
  * Open edges under-estimate and concave edges over-estimate (physics.md).
  *
- * Determinism: no random numbers; each pixel is computed by one thread into its own
- * slot, so the images are bit-identical for any thread count.
+ * Determinism: each pixel is computed by one thread into its own slot, and its random
+ * numbers depend only on the indices above: bit-identical for any thread count.
  */
 #ifndef THZ_SENSOR_RENDER_H
 #define THZ_SENSOR_RENDER_H
@@ -36,6 +53,10 @@
  * lies behind is dropped (counted in render_stats.truncated_paths). */
 #define RENDER_MAX_CROSSINGS 32
 
+/* A `path` is cut after this many hits (counted in truncated_paths; the radiance beyond
+ * is taken as B(T0), the control variate's value). */
+#define RENDER_MAX_BOUNCES 10000
+
 typedef struct render_options {
     int threads;              /* OpenMP threads, 0: all */
     thz_progress_fn progress; /* stage "render": done/total = rows of this sensor; may be NULL */
@@ -44,12 +65,14 @@ typedef struct render_options {
 
 /* Counts of one render_sensor_channel call; add them up across calls. */
 typedef struct render_stats {
-    uint64_t samples;           /* sample rays cast */
+    uint64_t samples;           /* sample rays cast (per pass) */
     uint64_t escaped_samples;   /* rays that hit nothing (radiance 0) */
     uint64_t back_face_samples; /* rays that saw the back of a one-sided solid (radiance 0) */
     uint64_t widened_gathers;   /* footprints with < k photons, widened to the k-th nearest */
     uint64_t starved_gathers;   /* objects with < k photons where the gather looked: term 0 */
-    uint64_t truncated_paths;   /* rays cut after RENDER_MAX_CROSSINGS straight shells */
+    uint64_t truncated_paths;   /* rays cut after RENDER_MAX_CROSSINGS straight shells, or
+                                   paths after RENDER_MAX_BOUNCES hits */
+    uint64_t paths;             /* path: paths traced; final-gather: gather rays cast */
     double seconds;             /* wall time (not reproducible) */
 } render_stats;
 
@@ -59,23 +82,62 @@ const char *render_integrator_name(thz_integrator integrator);
 /* Parses an integrator name; false if unknown. */
 bool render_integrator_parse(const char *name, thz_integrator *out);
 
-/* THZ_OK if `integrator` is implemented; otherwise THZ_ERR_INPUT
- * "integrator 'X' is not implemented yet". Call before a run starts. */
+/* THZ_OK if `integrator` is implemented; otherwise THZ_ERR_INPUT. Call before a run. */
 thz_status render_integrator_check(thz_integrator integrator, thz_error *err);
 
 /* Whether the integrator needs a photon map (all but `path`). */
 bool render_integrator_needs_photons(thz_integrator integrator);
 
-/* Renders channel `channel` of sensor `sensor` into `images` (initialised with
- * sensor_images_init for that sensor's resolution and the scene's channel count): the
- * channel's planes of radiance, power, brightness_temperature, normalized and, when
- * images->radiance_stderr is set, the standard error of L_c estimated from the
- * gathered photons (Poisson: sum of squared photon terms over A_g^2). `map` is the
- * photon map of that channel. `stats` (may be NULL) is overwritten.
+/* Whether more passes lower the noise (final-gather, path; not photon-map). */
+bool render_integrator_has_passes(thz_integrator integrator);
+
+/* Independent estimates a pass gives each pixel: paths_per_sample, gather_rays, or 1. */
+uint32_t render_estimates_per_pass(const thz_scene *scene);
+
+/* Per-pixel statistics of one sensor's channel over the passes rendered so far. */
+typedef struct render_accum {
+    size_t pixels;
+    uint64_t n;      /* estimates per pixel so far (the same for every pixel) */
+    uint32_t passes;
+    bool poisson;    /* photon-map: var holds the Poisson variance of the mean */
+    double *mean;    /* per pixel: mean of the estimates, W m^-2 sr^-1 Hz^-1 */
+    double *m2;      /* per pixel: sum of squared deviations from the mean (or, poisson,
+                        the variance of the mean) */
+} render_accum;
+
+thz_status render_accum_init(render_accum *acc, size_t pixels, thz_error *err);
+void render_accum_fini(render_accum *acc);
+
+/* Standard error of pixel p's mean, W m^-2 sr^-1 Hz^-1 (0 with fewer than 2 estimates). */
+double render_accum_stderr(const render_accum *acc, size_t p);
+
+/* Renders pass `pass` of channel `channel` of sensor `sensor` and merges it into `acc`
+ * (initialised for that sensor's pixel count; pass 0 first, then 1, 2, ... in order).
+ * `map` is the channel's photon map (NULL for path). photon-map refuses pass > 0
+ * (THZ_ERR_INPUT). `stats` (may be NULL) is overwritten with this pass's counts.
  * THZ_ERR_CANCELLED if the progress callback asks to stop. */
+thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a,
+                                      const photon_map *map, size_t channel, size_t sensor,
+                                      uint32_t pass, render_accum *acc, const render_options *opt,
+                                      render_stats *stats, thz_error *err);
+
+/* Writes the channel's planes of `images` from `acc`: radiance, power,
+ * brightness_temperature, normalized and, when images->radiance_stderr is set, the
+ * standard error of L_c. */
+thz_status render_accum_write(const thz_scene *scene, size_t channel, size_t sensor,
+                              const render_accum *acc, sensor_images *images, thz_error *err);
+
+/* One pass into `images` (initialised with sensor_images_init for that sensor's
+ * resolution and the scene's channel count): render_sensor_channel_pass with pass 0 and
+ * render_accum_write. */
 thz_status render_sensor_channel(const thz_scene *scene, const accel *a, const photon_map *map,
                                  size_t channel, size_t sensor, sensor_images *images,
                                  const render_options *opt, render_stats *stats, thz_error *err);
+
+/* dTb/dL inverse: the standard error in K of a brightness temperature tb_k (> 0) at
+ * freq_hz whose radiance has standard error stderr_l (W m^-2 sr^-1 Hz^-1), to first
+ * order: stderr_l / (dB_nu/dT at tb_k). */
+double render_stderr_k(double freq_hz, double tb_k, double stderr_l);
 
 /* Fills the truth images of `sensor` (temperature_k, distance_m, object_id, visual_rgb)
  * from the first hit of the ray through each pixel's centre: 0, 0, -1 and black where

@@ -140,14 +140,58 @@ grep -q "photons.per_channel" "$work/big.err" || fail "oversized run message: $(
 [ $? -eq 2 ] || fail "simulate without -o should exit 2"
 "$THZMAP" simulate "$work/scene.json" -o "$work/u" --integrator nonsense 2>/dev/null
 [ $? -eq 2 ] || fail "unknown integrator should exit 2"
-"$THZMAP" simulate "$work/scene.json" -o "$work/u" --integrator path --quiet 2> "$work/u.err"
-[ $? -eq 2 ] || fail "an unimplemented integrator should exit 2"
-grep -q "not implemented yet" "$work/u.err" || fail "unimplemented integrator message: $(cat "$work/u.err")"
+"$THZMAP" simulate "$work/scene.json" -o "$work/u" --target-noise-k 0.1 --quiet 2> "$work/u.err"
+[ $? -eq 2 ] || fail "a noise target with photon-map should exit 2"
+grep -q "final-gather or path" "$work/u.err" || fail "photon-map noise target message: $(cat "$work/u.err")"
+"$THZMAP" simulate "$work/scene.json" -o "$work/u" --integrator path --target-noise-k -1 2>/dev/null
+[ $? -eq 2 ] || fail "a negative noise target should exit 2"
+"$THZMAP" simulate "$work/scene.json" -o "$work/u" --integrator path --max-seconds 3 2>/dev/null
+[ $? -eq 2 ] || fail "--max-seconds without --target-noise-k should exit 2"
 "$THZMAP" simulate "$work/scene.json" -o "$work/u" --photons 0 2>/dev/null
 [ $? -eq 2 ] || fail "--photons 0 should exit 2"
 "$THZMAP" render "$work/scene.json" -o "$work/u" 2>/dev/null
 [ $? -eq 2 ] || fail "render without --photon-map should exit 2"
 "$THZMAP" simulate --help | grep -q -- "--save-photon-map" || fail "simulate --help"
+for opt in --integrator --target-noise-k --max-seconds; do
+    "$THZMAP" simulate --help | grep -q -- "$opt" || fail "simulate --help lacks $opt"
+    "$THZMAP" render --help | grep -q -- "$opt" || fail "render --help lacks $opt"
+done
+
+# --- integrators --------------------------------------------------------------------------
+# path fires no photons; both sampled integrators are thread-count independent, with and
+# without a noise target; render with path needs no photon map.
+for integ in path final-gather; do
+    for t in 1 2; do
+        "$THZMAP" simulate "$work/scene.json" -o "$work/$integ$t" --integrator $integ \
+            --photons 20000 --threads $t --quiet || fail "simulate --integrator $integ exited $?"
+        "$THZMAP" simulate "$work/scene.json" -o "$work/${integ}n$t" --integrator $integ \
+            --photons 20000 --threads $t --target-noise-k 2 --quiet \
+            || fail "simulate --integrator $integ --target-noise-k exited $?"
+    done
+    diff -r -q --exclude=summary.json "$work/${integ}1" "$work/${integ}2" \
+        || fail "$integ outputs differ between --threads 1 and 2"
+    diff -r -q --exclude=summary.json "$work/${integ}n1" "$work/${integ}n2" \
+        || fail "$integ outputs with a noise target differ between --threads 1 and 2"
+    [ -s "$work/${integ}1/cam.radiance_stderr.img" ] || fail "$integ wrote no radiance_stderr"
+    grep -q "\"integrator\": *\"$integ\"" "$work/${integ}1/summary.json" \
+        || fail "$integ: summary.json does not name the integrator"
+    grep -q '"median_stderr_k"' "$work/${integ}n1/summary.json" || fail "no median_stderr_k"
+    python3 - "$work/${integ}n1/summary.json" <<'PY' || fail "$integ: noise target not reached"
+import json, sys
+s = json.load(open(sys.argv[1]))
+for c in s["channels"]:
+    assert c["median_stderr_k"] <= 2.0, c
+    assert c["render_passes"] >= 1, c
+PY
+done
+grep -q '"photons_per_channel": *0' "$work/path1/summary.json" \
+    || fail "path's summary.json should say 0 photons: $(grep photons "$work/path1/summary.json")"
+grep -q '"photons_fired"' "$work/path1/summary.json" && fail "path fired photons"
+"$THZMAP" render "$work/scene.json" -o "$work/rpath" --integrator path --threads 2 --quiet \
+    || fail "render --integrator path without a photon map exited $?"
+for f in cam.radiance.img side.radiance_stderr.img; do
+    cmp -s "$work/path1/$f" "$work/rpath/$f" || fail "render --integrator path: $f differs"
+done
 
 if [ $fails -ne 0 ]; then
     echo "$fails check(s) failed"

@@ -1,5 +1,6 @@
 /* Renderer behaviour beyond the physics identities: back faces, truth images,
- * oversampling, thread-count independence, cancellation, unimplemented integrators. */
+ * oversampling, thread-count independence, cancellation, the integrator table and
+ * deterministic passes. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -195,25 +196,81 @@ static void test_cancel(void **state)
     sensor_images_fini(&img);
 }
 
-static void test_unimplemented_integrator(void **state)
+static void test_integrator_table(void **state)
 {
     fixture *f = *state;
     thz_error err;
     assert_int_equal(render_integrator_check(INTEGRATOR_PHOTON_MAP, &err), THZ_OK);
-    assert_int_equal(render_integrator_check(INTEGRATOR_PATH, &err), THZ_ERR_INPUT);
-    assert_non_null(strstr(err.message, "integrator 'path' is not implemented yet"));
-    f->scene->render.integrator = INTEGRATOR_FINAL_GATHER;
-    sensor_images img;
-    assert_int_equal(sensor_images_init(&img, 5, 4, 1, 0, NULL), THZ_OK);
-    assert_int_equal(render_sensor_channel(f->scene, f->acc, f->map, 0, 0, &img, NULL, NULL, &err),
-                     THZ_ERR_INPUT);
-    assert_non_null(strstr(err.message, "'final-gather' is not implemented yet"));
-    f->scene->render.integrator = INTEGRATOR_PHOTON_MAP;
+    assert_int_equal(render_integrator_check(INTEGRATOR_FINAL_GATHER, &err), THZ_OK);
+    assert_int_equal(render_integrator_check(INTEGRATOR_PATH, &err), THZ_OK);
+    assert_false(render_integrator_needs_photons(INTEGRATOR_PATH));
+    assert_true(render_integrator_needs_photons(INTEGRATOR_FINAL_GATHER));
+    assert_false(render_integrator_has_passes(INTEGRATOR_PHOTON_MAP));
+    assert_true(render_integrator_has_passes(INTEGRATOR_PATH));
+    /* photon-map is deterministic given its map: a second pass is refused */
+    const thz_sensor *s = &f->scene->sensors[0];
+    render_accum acc;
+    assert_int_equal(render_accum_init(&acc, (size_t)s->columns * s->rows, &err), THZ_OK);
+    assert_int_equal(
+        render_sensor_channel_pass(f->scene, f->acc, f->map, 0, 0, 0, &acc, NULL, NULL, &err),
+        THZ_OK);
+    assert_int_equal(
+        render_sensor_channel_pass(f->scene, f->acc, f->map, 0, 0, 1, &acc, NULL, NULL, &err),
+        THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "more photons"));
+    render_accum_fini(&acc);
     thz_integrator it;
     assert_true(render_integrator_parse("path", &it) && it == INTEGRATOR_PATH);
     assert_false(render_integrator_parse("photonmap", &it));
     assert_string_equal(render_integrator_name(INTEGRATOR_FINAL_GATHER), "final-gather");
-    sensor_images_fini(&img);
+}
+
+/* Passes of the sampled integrators: deterministic for any thread count, merged in
+ * order, and pass 1 differs from pass 0 (its own random numbers). */
+static void test_passes_are_deterministic(void **state)
+{
+    fixture *f = *state;
+    const thz_integrator kinds[] = {INTEGRATOR_PATH, INTEGRATOR_FINAL_GATHER};
+    thz_sensor *s = &f->scene->sensors[0];
+    thz_sensor saved = *s;
+    s->fov_deg = 30.0;
+    size_t px = (size_t)s->columns * s->rows;
+    for (size_t k = 0; k < 2; k++) {
+        f->scene->render.integrator = kinds[k];
+        f->scene->render.paths_per_sample = 3;
+        f->scene->render.gather_rays = 3;
+        render_accum a, b;
+        thz_error err;
+        assert_int_equal(render_accum_init(&a, px, &err), THZ_OK);
+        assert_int_equal(render_accum_init(&b, px, &err), THZ_OK);
+        render_options one = {.threads = 1}, two = {.threads = 2};
+        render_stats st;
+        for (uint32_t pass = 0; pass < 2; pass++) {
+            assert_int_equal(render_sensor_channel_pass(f->scene, f->acc, f->map, 0, 0, pass, &a,
+                                                        &one, &st, &err),
+                             THZ_OK);
+            assert_int_equal(render_sensor_channel_pass(f->scene, f->acc, f->map, 0, 0, pass, &b,
+                                                        &two, NULL, &err),
+                             THZ_OK);
+            if (pass == 0)
+                assert_true(st.paths > 0);
+        }
+        assert_int_equal(a.n, 6);
+        assert_memory_equal(a.mean, b.mean, px * sizeof(double));
+        assert_memory_equal(a.m2, b.m2, px * sizeof(double));
+        /* out-of-order passes are an internal error */
+        assert_int_equal(render_sensor_channel_pass(f->scene, f->acc, f->map, 0, 0, 5, &a, &one,
+                                                    NULL, &err),
+                         THZ_ERR_INTERNAL);
+        bool spread = false;
+        for (size_t p = 0; p < px; p++)
+            spread |= render_accum_stderr(&a, p) > 0.0;
+        assert_true(spread); /* the grey box's reflections vary between paths */
+        render_accum_fini(&a);
+        render_accum_fini(&b);
+    }
+    f->scene->render.integrator = INTEGRATOR_PHOTON_MAP;
+    *s = saved;
 }
 
 int main(void)
@@ -223,7 +280,8 @@ int main(void)
         cmocka_unit_test(test_back_faces_are_black_and_counted),
         cmocka_unit_test(test_thread_count_does_not_matter),
         cmocka_unit_test(test_cancel),
-        cmocka_unit_test(test_unimplemented_integrator),
+        cmocka_unit_test(test_integrator_table),
+        cmocka_unit_test(test_passes_are_deterministic),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
