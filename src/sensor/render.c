@@ -11,7 +11,11 @@
  * T(theta) (straight: unchanged; diffuse: exit mu ~ T(mu) mu), which makes the BRDF and
  * BTDF weights exactly 1, and returns  Bbar0 + sum, with Bbar0 the band mean of B0 by the
  * channel quadrature. E[B0(nu)] = Bbar0, so the estimate is unbiased for the band mean of
- * L for any T0 (B0 is an additive control variate, in space and in frequency). In an
+ * L for any T0 (B0 is an additive control variate, in space and in frequency). The terms
+ * of the first free path and the first hit are known functions of nu once the sample's
+ * first hit is known: they enter by their band mean (the channel quadrature, as the
+ * photon-map emission), not at the path's nu, so a black surface seen through an
+ * attenuating atmosphere comes out deterministic. In an
  * isothermal enclosure at T0 every bracket is exactly 0, so every path returns Bbar0:
  * N_c = 1 to rounding. T0 is the temperature of the object with the largest emitting
  * area x hemispherical emissivity at the channel centre (the walls of a room). */
@@ -52,6 +56,9 @@ typedef struct render_context {
     bool atmosphere;         /* some node has alpha > 0 */
     double t0_k;             /* path: reference temperature T0, K */
     double b0_mean;          /* path: band mean of B(T0) */
+    double *b0;              /* path: [node] B_nu(T0) */
+    double *source_mean;     /* path: [object] band mean of eps B - A B0 for solids; NAN
+                                for shells (angle-dependent) */
 } render_context;
 
 /* The `straight` shells a sample ray has passed through: the path weight at frequency nu
@@ -181,6 +188,8 @@ static void render_context_fini(render_context *ctx)
     free(ctx->alpha_per_m);
     free(ctx->emission_mean);
     free(ctx->scatters);
+    free(ctx->b0);
+    free(ctx->source_mean);
     memset(ctx, 0, sizeof *ctx);
 }
 
@@ -226,8 +235,10 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->alpha_per_m = thz_malloc_array(n, sizeof *ctx->alpha_per_m);
     ctx->emission_mean = thz_malloc_array(n_obj, sizeof *ctx->emission_mean);
     ctx->scatters = thz_malloc_array(n_obj, sizeof *ctx->scatters);
+    ctx->b0 = thz_malloc_array(n, sizeof *ctx->b0);
+    ctx->source_mean = thz_malloc_array(n_obj, sizeof *ctx->source_mean);
     if (!ctx->planck || !ctx->optics || !ctx->alpha_per_m || !ctx->emission_mean ||
-        !ctx->scatters) {
+        !ctx->scatters || !ctx->b0 || !ctx->source_mean) {
         render_context_fini(ctx);
         return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
     }
@@ -255,8 +266,19 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
                                            mat->transmission == TRANSMISSION_DIFFUSE);
     }
     ctx->t0_k = render_reference_temperature(scene, ctx->channel);
-    for (size_t k = 0; k < n; k++)
-        ctx->b0_mean += ctx->quad.weight[k] * planck_radiance(ctx->quad.freq_hz[k], ctx->t0_k);
+    for (size_t k = 0; k < n; k++) {
+        ctx->b0[k] = planck_radiance(ctx->quad.freq_hz[k], ctx->t0_k);
+        ctx->b0_mean += ctx->quad.weight[k] * ctx->b0[k];
+    }
+    for (size_t o = 0; o < n_obj; o++) {
+        double sum = 0.0;
+        for (size_t k = 0; k < n; k++) {
+            const optics_point *op = &ctx->optics[o * n + k];
+            sum += ctx->quad.weight[k] * (optics_emissivity(op, 1.0) * ctx->planck[o * n + k] -
+                                          optics_absorption(op, 1.0) * ctx->b0[k]);
+        }
+        ctx->source_mean[o] = scene->objects[o].type == OBJECT_SOLID ? sum : NAN;
+    }
     return THZ_OK;
 }
 
@@ -503,6 +525,24 @@ static double render_photon_map_trace(const render_context *ctx, vec3 origin_m, 
     }
 }
 
+/* The origin of a scattered ray leaving `hit` along dir: the hit point moved by 1e-5 of
+ * its distance towards the triangle's centroid, then off the surface by the accel's
+ * rule. A hit on the edge between two faces (the corners of a room, which camera rays
+ * along the image diagonals meet exactly) lies on the neighbouring face's plane, and a
+ * ray from there towards that face would slip out of a closed enclosure; the nudge keeps
+ * it inside. It moves the point by far less than any gather disk. */
+static vec3 render_leave(const render_context *ctx, const accel_hit *hit, vec3 dir)
+{
+    const thz_mesh *m = &ctx->scene->objects[hit->object].mesh;
+    const uint32_t *ix = &m->indices[3 * (size_t)hit->triangle];
+    vec3 c = v3(0.0, 0.0, 0.0);
+    for (int k = 0; k < 3; k++)
+        c = v3_add(c, v3_from_floats(&m->positions[3 * (size_t)ix[k]]));
+    accel_hit moved = *hit;
+    moved.position_m = v3_madd(hit->position_m, 1e-5, v3_sub(v3_scale(c, 1.0 / 3.0), hit->position_m));
+    return accel_offset_origin(ctx->accel, &moved, dir);
+}
+
 static void render_photon_map_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
                                      double sample_sr, const render_target *t,
                                      render_sample *out)
@@ -554,7 +594,7 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
         s.mu_i = mu;
         s.pdf_ratio = optics_mean_transmission(&o) / optics_transmission(&o, mu);
     }
-    vec3 origin = accel_offset_origin(ctx->accel, hit, dir);
+    vec3 origin = render_leave(ctx, hit, dir);
     render_sample sec = {.variance = 0.0};
     double l = render_photon_map_trace(ctx, origin, dir, hit->object, hit->triangle, *path,
                                        distance_m, &s, nu_j, 0.0, &sec);
@@ -631,7 +671,7 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
     for (uint32_t bounce = 0;; bounce++) {
         if (bounce > 0) {
             vec3 surface = hit.position_m;
-            vec3 origin = accel_offset_origin(ctx->accel, &hit, dir);
+            vec3 origin = render_leave(ctx, &hit, dir);
             uint32_t from_object = hit.object, from_triangle = hit.triangle;
             if (!accel_intersect(ctx->accel, origin, dir, INFINITY, from_object, from_triangle,
                                  &hit)) {
@@ -650,7 +690,8 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
         }
         if (ctx->atmosphere) {
             double tau = atmosphere_transmittance(&scene->atmosphere, nu, d);
-            sum += beta * (tau - 1.0) * b0;
+            if (bounce > 0) /* the first segment's term is in render_path_first */
+                sum += beta * (tau - 1.0) * b0;
             beta *= tau;
         }
         const thz_object *obj = &scene->objects[hit.object];
@@ -664,8 +705,11 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
         double tr = optics_transmission(&o, mu);
         double a = 1.0 - r - tr;
         double eps = o.explicit_emissivity ? o.emissivity : a;
-        double bt = obj->temperature_k == ctx->t0_k ? b0 : planck_radiance(nu, obj->temperature_k);
-        sum += beta * (eps * bt - a * b0);
+        if (bounce > 0) {
+            double bt =
+                obj->temperature_k == ctx->t0_k ? b0 : planck_radiance(nu, obj->temperature_k);
+            sum += beta * (eps * bt - a * b0);
+        }
         double u = rng_uniform(rng);
         const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
         vec3 n = v3_from_floats(nf);
@@ -684,7 +728,29 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
         }
     }
     out->paths++;
-    return ctx->b0_mean + sum;
+    return sum;
+}
+
+/* The band mean of the first segment's and first hit's terms, (tau - 1) B0 +
+ * tau (eps B(T) - A B0), by the channel quadrature: deterministic per sample, so that the
+ * band noise of what the sensor sees directly (the emission of the surface hit, its
+ * attenuation) does not enter the paths. */
+static double render_path_first(const render_context *ctx, const accel_hit *hit)
+{
+    if (!ctx->atmosphere && !isnan(ctx->source_mean[hit->object]))
+        return ctx->source_mean[hit->object];
+    size_t n = ctx->quad.n;
+    const optics_point *op = &ctx->optics[(size_t)hit->object * n];
+    const double *planck = &ctx->planck[(size_t)hit->object * n];
+    double sum = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        double tau = ctx->atmosphere ? exp(-ctx->alpha_per_m[k] * hit->distance_m) : 1.0;
+        double a = optics_absorption(&op[k], hit->cos_theta);
+        double eps = optics_emissivity(&op[k], hit->cos_theta);
+        sum += ctx->quad.weight[k] *
+               ((tau - 1.0) * ctx->b0[k] + tau * (eps * planck[k] - a * ctx->b0[k]));
+    }
+    return sum;
 }
 
 static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
@@ -700,10 +766,11 @@ static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 di
         out->back_face = 1;
         return;
     }
+    double fixed = ctx->b0_mean + render_path_first(ctx, &first);
     for (uint32_t j = 0; j < t->n_est; j++) {
         rng_stream rng;
         rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_PATH, t->rng_index + j);
-        t->est[j] += t->weight * render_path_trace(ctx, &first, dir, &rng, out);
+        t->est[j] += t->weight * (fixed + render_path_trace(ctx, &first, dir, &rng, out));
     }
 }
 
@@ -875,10 +942,10 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a,
             }
             /* this pass's mean and squared deviations (two-pass), merged with the earlier
              * passes' (Chan et al.) */
-            double mean_b = 0.0, m2_b = 0.0;
-            for (uint32_t k = 0; k < n_est; k++)
-                mean_b += est[k];
-            mean_b /= n_b;
+            double shift = 0.0, m2_b = 0.0; /* about est[0]: equal estimates give 0 */
+            for (uint32_t k = 1; k < n_est; k++)
+                shift += est[k] - est[0];
+            double mean_b = est[0] + shift / n_b;
             for (uint32_t k = 0; k < n_est; k++)
                 m2_b += (est[k] - mean_b) * (est[k] - mean_b);
             double delta = mean_b - acc->mean[p];

@@ -1,12 +1,16 @@
 /* Shared helpers of the physics identity tests (physics.md "Identities"): load a scene
- * from JSON text, run the photon phase and the renderer for one channel, and check
- * pixels against a closed form with tolerances from the photons gathered.
+ * from JSON text, run the photon phase (unless the integrator is `path`) and the
+ * renderer with a chosen integrator, and check pixels against a closed form with
+ * tolerances from the renderer's own standard errors. Every identity test loops over
+ * ident_integrators: the identities hold for each integrator (physics.md "Integrators").
  *
- * Tolerances: the renderer estimates each pixel's standard error from the photons it
- * gathered (Poisson: sqrt(sum of squared photon terms) / A_g). A pixel passes when it
- * lies within IDENT_Z standard errors; the tests also bound that standard error so that
- * no tolerance is wide enough to hide a factor of 2 or pi. THZ_TEST_SCALE (e.g. 0.25)
- * scales the photon counts; the standard errors, and so the tolerances, follow.
+ * Tolerances: the renderer estimates each pixel's standard error: photon-map from the
+ * photons it gathered (Poisson: sqrt(sum of squared photon terms) / A_g), final-gather
+ * and path from the spread of the pixel's independent estimates (gather rays, paths).
+ * A pixel passes when it lies within IDENT_Z standard errors; the tests also bound that
+ * standard error so that no tolerance is wide enough to hide a factor of 2 or pi.
+ * THZ_TEST_SCALE (e.g. 0.25) scales the photon, path and gather-ray counts; the standard
+ * errors, and so the tolerances, follow.
  */
 #ifndef THZ_TESTS_PHYSICS_IDENTITY_H
 #define THZ_TESTS_PHYSICS_IDENTITY_H
@@ -50,6 +54,20 @@ static inline uint64_t ident_photons(double base)
     return n < 1000.0 ? 1000u : (uint64_t)n;
 }
 
+/* The integrators every identity is checked with. */
+static const thz_integrator ident_integrators[] = {INTEGRATOR_PHOTON_MAP, INTEGRATOR_FINAL_GATHER,
+                                                  INTEGRATOR_PATH};
+#define IDENT_N_INTEGRATORS (sizeof ident_integrators / sizeof ident_integrators[0])
+
+/* Paths per sample (path) and gather rays (final-gather) for a test: base x
+ * THZ_TEST_SCALE, at least 16 (so that a pixel's standard error is itself known to
+ * about 1/sqrt(2 x 16) = 18 %). */
+static inline uint32_t ident_estimates(double base)
+{
+    double n = base * ident_scale();
+    return n < 16.0 ? 16u : (uint32_t)n;
+}
+
 typedef struct ident_run {
     thz_scene *scene;
     accel *acc;
@@ -60,8 +78,10 @@ typedef struct ident_run {
 } ident_run;
 
 /* Loads the scene (photons.per_channel replaced by `photons` when non-zero), renders
- * every channel of sensor 0 with 2 threads, and fills the truth images. */
-static inline void ident_run_scene(ident_run *r, const char *json, uint64_t photons)
+ * every channel of sensor 0 with 2 threads and `integrator` (paths_per_sample and
+ * gather_rays set to `estimates` when non-zero), and fills the truth images. */
+static inline void ident_run_scene_with(ident_run *r, const char *json, uint64_t photons,
+                                        thz_integrator integrator, uint32_t estimates)
 {
     memset(r, 0, sizeof *r);
     thz_error err;
@@ -72,6 +92,11 @@ static inline void ident_run_scene(ident_run *r, const char *json, uint64_t phot
     assert_int_equal(st, THZ_OK);
     if (photons)
         r->scene->photons.per_channel = photons;
+    r->scene->render.integrator = integrator;
+    if (estimates) {
+        r->scene->render.paths_per_sample = estimates;
+        r->scene->render.gather_rays = estimates;
+    }
     assert_true(r->scene->n_channels <= 8);
     assert_int_equal(accel_create(r->scene, &r->acc, &err), THZ_OK);
     const thz_sensor *sn = &r->scene->sensors[0];
@@ -83,16 +108,24 @@ static inline void ident_run_scene(ident_run *r, const char *json, uint64_t phot
     for (size_t c = 0; c < r->scene->n_channels; c++) {
         photon_phase_options po = {.threads = 2};
         photon_map *map = NULL;
-        st = photon_phase_run(r->scene, r->acc, c, &po, &map, &r->stats[c], &err);
-        if (st != THZ_OK)
-            print_message("photon phase: %s\n", err.message);
-        assert_int_equal(st, THZ_OK);
+        if (render_integrator_needs_photons(integrator)) {
+            st = photon_phase_run(r->scene, r->acc, c, &po, &map, &r->stats[c], &err);
+            if (st != THZ_OK)
+                print_message("photon phase: %s\n", err.message);
+            assert_int_equal(st, THZ_OK);
+        }
         st = render_sensor_channel(r->scene, r->acc, map, c, 0, &r->img, &ro, &r->rstats[c], &err);
         if (st != THZ_OK)
             print_message("render: %s\n", err.message);
         assert_int_equal(st, THZ_OK);
         photon_map_destroy(map);
     }
+}
+
+/* The same with the paper's photon-map integrator. */
+static inline void ident_run_scene(ident_run *r, const char *json, uint64_t photons)
+{
+    ident_run_scene_with(r, json, photons, INTEGRATOR_PHOTON_MAP, 0);
 }
 
 static inline void ident_run_fini(ident_run *r)
