@@ -9,7 +9,8 @@
  * g_c, adds the bracket at every hit (times the product beta of the transmittances so
  * far), continues by Russian roulette with probabilities R (cosine reflection) and
  * T(theta) (straight: unchanged; diffuse: exit mu ~ T(mu) mu), which makes the BRDF and
- * BTDF weights exactly 1, and returns  Bbar0 + sum, with Bbar0 the band mean of B0 by the
+ * BTDF weights exactly 1 (at the first hit it splits instead: render_path_trace), and
+ * returns  Bbar0 + sum, with Bbar0 the band mean of B0 by the
  * channel quadrature. E[B0(nu)] = Bbar0, so the estimate is unbiased for the band mean of
  * L for any T0 (B0 is an additive control variate, in space and in frequency). The terms
  * of the first free path and the first hit are known functions of nu once the sample's
@@ -656,42 +657,56 @@ static void render_final_gather_sample(const render_context *ctx, vec3 origin_m,
     }
 }
 
-/* One path from the first hit `first` (ray along dir0 from the sensor); returns its
- * estimate of the band-mean radiance (see the top of this file). */
-static double render_path_trace(const render_context *ctx, const accel_hit *first, vec3 dir0,
-                                rng_stream *rng, render_sample *out)
+/* A scattered direction at `hit` (unit normal n_seen towards the side the ray came from):
+ * cosine-distributed on that side (reflection), or leaving the other side with
+ * mu ~ T(mu) mu (diffuse transmission). False if T is 0 there (cannot happen after a
+ * transmission event). */
+static bool render_scatter_dir(const optics_point *o, vec3 n_seen, bool transmitted,
+                               rng_stream *rng, vec3 *dir)
+{
+    if (!transmitted) {
+        *dir = emission_direction(n_seen, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
+        return true;
+    }
+    double m;
+    if (!optics_sample_transmission_mu(o, emission_uniform, rng, &m))
+        return false;
+    *dir = emission_direction(v3_scale(n_seen, -1.0), m, rng_uniform(rng));
+    return true;
+}
+
+/* Continues a path leaving `from` along dir with throughput beta at frequency nu (B0 =
+ * b0 there): the sum of the terms of every later free path and hit (see the top of this
+ * file), with Russian roulette on R and T(theta) at each hit. */
+static double render_path_continue(const render_context *ctx, const accel_hit *from, vec3 dir,
+                                   double nu, double b0, double beta, rng_stream *rng,
+                                   render_sample *out)
 {
     const thz_scene *scene = ctx->scene;
-    double nu = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
-    double b0 = planck_radiance(nu, ctx->t0_k);
-    double sum = 0.0, beta = 1.0;
-    accel_hit hit = *first;
-    vec3 dir = dir0;
-    double d = hit.distance_m; /* free path to this hit */
-    for (uint32_t bounce = 0;; bounce++) {
-        if (bounce > 0) {
-            vec3 surface = hit.position_m;
-            vec3 origin = render_leave(ctx, &hit, dir);
-            uint32_t from_object = hit.object, from_triangle = hit.triangle;
-            if (!accel_intersect(ctx->accel, origin, dir, INFINITY, from_object, from_triangle,
-                                 &hit)) {
-                sum -= beta * b0;
-                break;
-            }
-            /* from the surface point, not the offset origin (as the photon phase) */
-            const float *hn = &scene->objects[hit.object].mesh.normals[3 * (size_t)hit.triangle];
-            vec3 to_hit = v3_sub(hit.position_m, surface);
-            d = hit.cos_theta > 1e-6 ? fabs(v3_dot(to_hit, v3_from_floats(hn))) / hit.cos_theta
-                                     : v3_length(to_hit);
+    double sum = 0.0;
+    accel_hit hit = *from;
+    for (uint32_t bounce = 1;; bounce++) {
+        vec3 surface = hit.position_m;
+        vec3 origin = render_leave(ctx, &hit, dir);
+        uint32_t from_object = hit.object, from_triangle = hit.triangle;
+        if (!accel_intersect(ctx->accel, origin, dir, INFINITY, from_object, from_triangle,
+                             &hit)) {
+            sum -= beta * b0;
+            break;
         }
         if (bounce >= RENDER_MAX_BOUNCES) {
             out->truncated = 1;
             break;
         }
         if (ctx->atmosphere) {
+            /* from the surface point, not the offset origin (as the photon phase) */
+            const float *hn = &scene->objects[hit.object].mesh.normals[3 * (size_t)hit.triangle];
+            vec3 to_hit = v3_sub(hit.position_m, surface);
+            double d = hit.cos_theta > 1e-6
+                           ? fabs(v3_dot(to_hit, v3_from_floats(hn))) / hit.cos_theta
+                           : v3_length(to_hit);
             double tau = atmosphere_transmittance(&scene->atmosphere, nu, d);
-            if (bounce > 0) /* the first segment's term is in render_path_first */
-                sum += beta * (tau - 1.0) * b0;
+            sum += beta * (tau - 1.0) * b0;
             beta *= tau;
         }
         const thz_object *obj = &scene->objects[hit.object];
@@ -700,32 +715,60 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
             break;
         }
         optics_point o = scene_object_optics(scene, obj, nu);
-        double mu = hit.cos_theta;
         double r = o.reflectivity;
-        double tr = optics_transmission(&o, mu);
+        double tr = optics_transmission(&o, hit.cos_theta);
         double a = 1.0 - r - tr;
         double eps = o.explicit_emissivity ? o.emissivity : a;
-        if (bounce > 0) {
-            double bt =
-                obj->temperature_k == ctx->t0_k ? b0 : planck_radiance(nu, obj->temperature_k);
-            sum += beta * (eps * bt - a * b0);
-        }
+        double bt = obj->temperature_k == ctx->t0_k ? b0 : planck_radiance(nu, obj->temperature_k);
+        sum += beta * (eps * bt - a * b0);
         double u = rng_uniform(rng);
+        if (!(u < r + tr))
+            break; /* absorbed */
+        bool transmitted = !(u < r);
+        if (transmitted &&
+            scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT)
+            continue; /* straight on, dir unchanged */
         const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
         vec3 n = v3_from_floats(nf);
         vec3 n_seen = hit.side == 0 ? n : v3_scale(n, -1.0);
-        if (u < r) {
-            dir = emission_direction(n_seen, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
-        } else if (u < r + tr) {
-            if (scene->materials[obj->material].transmission == TRANSMISSION_DIFFUSE) {
-                double m;
-                if (!optics_sample_transmission_mu(&o, emission_uniform, rng, &m))
-                    break; /* unreachable: T > 0 here */
-                dir = emission_direction(v3_scale(n_seen, -1.0), m, rng_uniform(rng));
-            }
-        } else {
+        if (!render_scatter_dir(&o, n_seen, transmitted, rng, &dir))
             break;
-        }
+    }
+    return sum;
+}
+
+/* One path from the sample's first hit `first` (ray along dir0 from the sensor): the
+ * random part of its estimate, beyond the deterministic first terms. At the first hit
+ * the path splits instead of playing roulette: a reflected branch weighted R and, for
+ * shells, a transmitted branch weighted T(theta), each continued by roulette. (Every path
+ * of a sample shares the first hit; roulette there would add the variance of choosing
+ * between what the reflection and the transmission see, the main noise of a wall that
+ * reflects a warmer object.) */
+static double render_path_trace(const render_context *ctx, const accel_hit *first, vec3 dir0,
+                                rng_stream *rng, render_sample *out)
+{
+    const thz_scene *scene = ctx->scene;
+    double nu = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
+    double b0 = planck_radiance(nu, ctx->t0_k);
+    double beta = ctx->atmosphere
+                      ? atmosphere_transmittance(&scene->atmosphere, nu, first->distance_m)
+                      : 1.0;
+    const thz_object *obj = &scene->objects[first->object];
+    optics_point o = scene_object_optics(scene, obj, nu);
+    double r = o.reflectivity;
+    double tr = optics_transmission(&o, first->cos_theta);
+    const float *nf = &obj->mesh.normals[3 * (size_t)first->triangle];
+    vec3 n = v3_from_floats(nf);
+    vec3 n_seen = first->side == 0 ? n : v3_scale(n, -1.0);
+    double sum = 0.0;
+    vec3 dir;
+    if (r > 0.0 && render_scatter_dir(&o, n_seen, false, rng, &dir))
+        sum += r * render_path_continue(ctx, first, dir, nu, b0, beta, rng, out);
+    if (tr > 0.0) {
+        bool straight = scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
+        dir = dir0;
+        if (straight || render_scatter_dir(&o, n_seen, true, rng, &dir))
+            sum += tr * render_path_continue(ctx, first, dir, nu, b0, beta, rng, out);
     }
     out->paths++;
     return sum;
