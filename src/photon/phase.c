@@ -173,6 +173,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     st = emission_table_init(&table, scene, channel, scene->photons.per_channel, err);
     if (st != THZ_OK)
         return st;
+    double t1 = omp_get_wtime();
     phase_fire_args a = {.scene = scene,
                          .acc = acc,
                          .table = &table,
@@ -188,11 +189,13 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     emission_table_fini(&table);
     if (st != THZ_OK)
         return st;
+    double t2 = omp_get_wtime();
 
     /* photon_map_create takes ownership of records, also on failure. */
     st = photon_map_create(records, count, scene->n_objects, a.threads, out_map, err);
     if (st != THZ_OK)
         return st;
+    double t3 = omp_get_wtime();
 
     if (stats) {
         memset(stats, 0, sizeof *stats);
@@ -213,6 +216,10 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
         stats->atmosphere_power_w_per_hz = c.atmosphere_power;
         stats->terminated_power_w_per_hz = c.terminated_power;
         stats->mean_bounces = c.photons ? (double)c.hits / (double)c.photons : 0.0;
+        stats->rays = c.rays;
+        stats->seconds_emission_table = t1 - t0;
+        stats->seconds_tracing = t2 - t1;
+        stats->seconds_index = t3 - t2;
         stats->seconds = omp_get_wtime() - t0;
     }
     return THZ_OK;

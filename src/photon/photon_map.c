@@ -329,6 +329,13 @@ size_t photon_map_count(const photon_map *map)
     return map ? map->count : 0;
 }
 
+size_t photon_map_bytes(const photon_map *map)
+{
+    if (!map)
+        return 0;
+    return sizeof *map + map->count * sizeof *map->records + (map->n_groups + 1) * sizeof *map->start;
+}
+
 const photon_record *photon_map_records(const photon_map *map)
 {
     return map ? map->records : NULL;

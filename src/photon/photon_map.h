@@ -49,6 +49,10 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
 void photon_map_destroy(photon_map *map);
 
 size_t photon_map_count(const photon_map *map);
+
+/* Bytes the map holds: its records and its spatial index (the benchmark's bytes per
+ * stored photon). */
+size_t photon_map_bytes(const photon_map *map);
 const photon_record *photon_map_records(const photon_map *map);
 
 /* The photons of (object, side) within distance sqrt(radius2_m2) of position: calls

@@ -28,6 +28,13 @@ typedef struct photon_stats {
                                          expectation) and by the bounce cap */
     uint64_t bounce_capped;           /* paths stopped at the bounce cap (included in
                                          terminated; should be 0) */
+    /* Where the phase's time went (added for the benchmark, issue 6; wall times, not
+     * reproducible): seconds = seconds_emission_table + seconds_tracing + seconds_index
+     * + a little bookkeeping. */
+    uint64_t rays;                 /* rays cast: one per hit, escape or low-power stop */
+    double seconds_emission_table; /* emission_table_init */
+    double seconds_tracing;        /* firing, tracing and merging the records of every batch */
+    double seconds_index;          /* photon_map_create: grouping and the spatial index */
 } photon_stats;
 
 #endif

@@ -9,6 +9,7 @@
 void trace_counters_add(trace_counters *sum, const trace_counters *c)
 {
     sum->photons += c->photons;
+    sum->rays += c->rays;
     sum->hits += c->hits;
     sum->reflected += c->reflected;
     sum->transmitted += c->transmitted;
@@ -89,6 +90,7 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
             return true;
         }
         accel_hit hit;
+        c->rays++;
         if (!accel_intersect(acc, origin, dir, INFINITY, ignore_obj, ignore_tri, &hit)) {
             c->escaped++;
             c->escaped_power += power;

@@ -31,6 +31,7 @@
 /* Counters of the paths traced; summed over chunks in a fixed order. */
 typedef struct trace_counters {
     uint64_t photons;   /* photons started (including those of zero power) */
+    uint64_t rays;      /* rays cast (hits, escapes and low-power stops) */
     uint64_t hits;
     uint64_t reflected;
     uint64_t transmitted;

@@ -108,7 +108,9 @@ static void test_round_trip(void **state)
         assert_memory_equal(photon_map_records(maps[c]), photon_map_records(f->maps[c]),
                             photon_map_count(maps[c]) * sizeof(photon_record));
         photon_stats a = f->stats[c];
-        a.seconds = 0.0;
+        /* Timings and the ray count (benchmark only) are not in the file. */
+        a.seconds = a.seconds_emission_table = a.seconds_tracing = a.seconds_index = 0.0;
+        a.rays = 0;
         assert_memory_equal(&a, &stats[c], sizeof a);
     }
     assert_true(photon_map_count(maps[0]) != photon_map_count(maps[1]));
