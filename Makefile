@@ -38,3 +38,7 @@ format:
 
 clean:
 	rm -rf $(BUILD) $(ASAN_BUILD)
+
+# The benchmark (issue 6): the paper's case in full, scaling, rendering; see README.
+bench: build
+	$(BUILD)/thzbench --json $(BUILD)/thzbench.json

@@ -1,0 +1,277 @@
+/* The benchmark's measurements: see bench_measure.h. */
+#include "bench_measure.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "accel/accel.h"
+#include "bench_probe.h"
+#include "core/alloc.h"
+#include "io/output.h"
+#include "photon/phase.h"
+#include "photon/photon_map.h"
+#include "run/run.h"
+#include "scene/scene.h"
+#include "sensor/images.h"
+#include "sensor/render.h"
+#include "thzmap/thzmap.h"
+
+static double bench_now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static thz_status bench_load(const char *path, uint64_t photons, thz_scene **scene,
+                             thz_error *err)
+{
+    thz_status st = thz_scene_load(path, scene, err);
+    if (st == THZ_OK && photons)
+        (*scene)->photons.per_channel = photons;
+    return st;
+}
+
+static void bench_images_fini(sensor_images *img, size_t n)
+{
+    if (!img)
+        return;
+    for (size_t i = 0; i < n; i++)
+        sensor_images_fini(&img[i]);
+    free(img);
+}
+
+/* Allocates every sensor's images (as run_simulate does: with the standard error). */
+static thz_status bench_images_init(const thz_scene *s, sensor_images **out, thz_error *err)
+{
+    sensor_images *img = thz_calloc(s->n_sensors, sizeof *img);
+    if (!img)
+        return thz_error_set(err, THZ_ERR_NOMEM, "bench: out of memory");
+    for (size_t i = 0; i < s->n_sensors; i++) {
+        thz_status st = sensor_images_init(&img[i], s->sensors[i].columns, s->sensors[i].rows,
+                                           s->n_channels, 1, err);
+        if (st != THZ_OK) {
+            bench_images_fini(img, s->n_sensors);
+            return st;
+        }
+    }
+    *out = img;
+    return THZ_OK;
+}
+
+thz_status bench_measure_paper(const char *scene_path, uint64_t photons, int threads,
+                               const char *outdir, bench_paper *out, thz_error *err)
+{
+    memset(out, 0, sizeof *out);
+    thz_scene *s = NULL;
+    accel *acc = NULL;
+    sensor_images *img = NULL;
+    output_stage *stage = NULL;
+    double t_start = bench_now_s();
+    thz_status st = bench_load(scene_path, photons, &s, err);
+    if (st != THZ_OK)
+        return st;
+    double t = bench_now_s();
+    out->s_load = t - t_start;
+    out->photons_per_channel = s->photons.per_channel;
+    out->channels = s->n_channels;
+    if (s->n_sensors) {
+        out->columns = s->sensors[0].columns;
+        out->rows = s->sensors[0].rows;
+        out->oversampling = s->sensors[0].oversampling;
+    }
+
+    st = accel_create(s, &acc, err);
+    out->s_accel = bench_now_s() - t;
+    if (st != THZ_OK)
+        goto cleanup;
+
+    render_options ro = {.threads = threads};
+    t = bench_now_s();
+    st = bench_images_init(s, &img, err);
+    for (size_t i = 0; st == THZ_OK && i < s->n_sensors; i++)
+        st = render_sensor_truth(s, acc, i, &img[i], &ro, err);
+    out->s_render += bench_now_s() - t;
+
+    photon_phase_options po = {.threads = threads};
+    for (size_t c = 0; st == THZ_OK && c < s->n_channels; c++) {
+        photon_map *map = NULL;
+        photon_stats ps;
+        t = bench_now_s();
+        st = photon_phase_run(s, acc, c, &po, &map, &ps, err);
+        out->s_photons += bench_now_s() - t;
+        if (st != THZ_OK)
+            break;
+        out->s_emission_table += ps.seconds_emission_table;
+        out->s_tracing += ps.seconds_tracing;
+        out->s_index += ps.seconds_index;
+        out->fired += ps.fired;
+        out->stored += ps.stored;
+        out->rays += ps.rays;
+        if (photon_map_bytes(map) > out->largest_map_bytes) {
+            out->largest_map_bytes = photon_map_bytes(map);
+            out->largest_map_stored = photon_map_count(map);
+        }
+        t = bench_now_s();
+        for (size_t i = 0; st == THZ_OK && i < s->n_sensors; i++)
+            st = render_sensor_channel(s, acc, map, c, i, &img[i], &ro, NULL, err);
+        out->s_render += bench_now_s() - t;
+        photon_map_destroy(map);
+    }
+
+    t = bench_now_s();
+    if (st == THZ_OK)
+        st = output_stage_create(outdir, &stage, err);
+    for (size_t i = 0; st == THZ_OK && i < s->n_sensors; i++)
+        st = output_write_sensor(output_stage_dir(stage), s, i, &img[i], err);
+    if (st == THZ_OK)
+        st = output_stage_commit(stage, err);
+    out->s_output = bench_now_s() - t;
+    out->s_total = bench_now_s() - t_start;
+cleanup:
+    output_stage_destroy(stage);
+    if (s)
+        bench_images_fini(img, s->n_sensors);
+    accel_destroy(acc);
+    thz_scene_destroy(s);
+    return st;
+}
+
+thz_status bench_measure_e2e(const char *scene_path, uint64_t photons, int threads,
+                             const char *outdir, bench_e2e *out, thz_error *err)
+{
+    memset(out, 0, sizeof *out);
+    thz_scene *s = NULL;
+    double t0 = bench_now_s();
+    thz_status st = bench_load(scene_path, photons, &s, err);
+    if (st != THZ_OK)
+        return st;
+    double t1 = bench_now_s();
+    run_options opt = {.outdir = outdir, .threads = threads, .seconds_load = t1 - t0};
+    run_result res;
+    st = run_simulate(s, &opt, &res, err);
+    double t2 = bench_now_s();
+    out->s_load = t1 - t0;
+    out->s_run = t2 - t1;
+    out->s_total = t2 - t0;
+    out->stored = st == THZ_OK ? res.photons_stored : 0;
+    thz_scene_destroy(s);
+    return st;
+}
+
+thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int threads,
+                               bench_probe_out *out, thz_error *err)
+{
+    memset(out, 0, sizeof *out);
+    thz_scene *s = NULL;
+    thz_status st = bench_load(scene_path, 0, &s, err);
+    if (st != THZ_OK)
+        return st;
+    bench_probe_result r;
+    st = bench_probe_run(s, rays, threads, &r, err);
+    out->rays = r.rays;
+    out->hits = r.hits;
+    out->seconds = r.seconds;
+    thz_scene_destroy(s);
+    return st;
+}
+
+thz_status bench_measure_series(const char *scene_path, size_t channel, const uint64_t *photons,
+                                int n, int threads, int render, int probe, bench_series *out,
+                                thz_error *err)
+{
+    memset(out, 0, sizeof *out);
+    thz_scene *s = NULL;
+    accel *acc = NULL;
+    sensor_images *img = NULL;
+    thz_status st = bench_load(scene_path, 0, &s, err);
+    if (st != THZ_OK)
+        return st;
+    if (channel >= s->n_channels)
+        channel = s->n_channels - 1;
+    uint64_t triangles = 0;
+    for (size_t i = 0; i < s->n_objects; i++)
+        triangles += s->objects[i].mesh.n_triangles;
+    st = accel_create(s, &acc, err);
+    if (st == THZ_OK && render)
+        st = bench_images_init(s, &img, err);
+    photon_phase_options po = {.threads = threads};
+    render_options ro = {.threads = threads};
+    for (int k = 0; st == THZ_OK && k < n && k < BENCH_MAX_POINTS; k++) {
+        bench_point *p = &out->p[k];
+        s->photons.per_channel = photons[k];
+        photon_map *map = NULL;
+        photon_stats ps;
+        double t = bench_now_s();
+        st = photon_phase_run(s, acc, channel, &po, &map, &ps, err);
+        p->s_photons = bench_now_s() - t;
+        if (st != THZ_OK)
+            break;
+        p->photons = ps.fired;
+        p->stored = ps.stored;
+        p->rays = ps.rays;
+        p->triangles = triangles;
+        p->s_emission_table = ps.seconds_emission_table;
+        p->s_tracing = ps.seconds_tracing;
+        p->s_index = ps.seconds_index;
+        if (render) {
+            t = bench_now_s();
+            for (size_t i = 0; st == THZ_OK && i < s->n_sensors; i++) {
+                render_stats rs;
+                st = render_sensor_channel(s, acc, map, channel, i, &img[i], &ro, &rs, err);
+                p->samples += rs.samples;
+                p->pixels += (uint64_t)s->sensors[i].columns * s->sensors[i].rows;
+            }
+            p->s_render = bench_now_s() - t;
+        }
+        photon_map_destroy(map);
+        if (st == THZ_OK && probe) {
+            bench_probe_result r;
+            st = bench_probe_run(s, ps.rays, threads, &r, err);
+            p->s_probe = r.seconds;
+        }
+        out->n = k + 1;
+    }
+    if (s)
+        bench_images_fini(img, s->n_sensors);
+    accel_destroy(acc);
+    thz_scene_destroy(s);
+    return st;
+}
+
+thz_status bench_write_mesh_scene(const char *path, unsigned subdivisions, uint64_t photons,
+                                  thz_error *err)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_IO, "bench: cannot write %s", path);
+    /* The teraeye room with four spheres in it: well-shaped triangles at every size. */
+    fprintf(f,
+            "{\n  \"format\": \"thzmap-scene/1\",\n  \"name\": \"mesh-s%u\",\n"
+            "  \"channels\": [{\"frequency_thz\": 0.6, \"relative_width\": 0.01}],\n"
+            "  \"materials\": {\"wall\": {\"reflectivity\": 0.1},\n"
+            "                \"target\": {\"reflectivity\": 0.5}},\n"
+            "  \"objects\": [\n"
+            "    {\"name\": \"box\", \"type\": \"solid\", \"material\": \"wall\", "
+            "\"temperature_k\": 293,\n"
+            "     \"shape\": {\"type\": \"box\", \"size_m\": [1, 2, 1], \"inward\": true},\n"
+            "     \"transform\": {\"translate_m\": [0, 0, 0.5]}}",
+            subdivisions);
+    const double xy[4][2] = {{-0.25, 0.3}, {0.25, 0.3}, {-0.25, -0.3}, {0.25, -0.3}};
+    for (int i = 0; i < 4; i++)
+        fprintf(f,
+                ",\n    {\"name\": \"sphere-%d\", \"type\": \"solid\", \"material\": \"target\", "
+                "\"temperature_k\": %d,\n     \"shape\": {\"type\": \"sphere\", \"radius_m\": 0.2, "
+                "\"subdivisions\": %u},\n     \"transform\": {\"translate_m\": [%g, %g, 0.5]}}",
+                i, 300 + 5 * i, subdivisions, xy[i][0], xy[i][1]);
+    fprintf(f,
+            "\n  ],\n  \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.95, 0.5], "
+            "\"look_at_m\": [0, 0, 0.5], \"fov_deg\": 60, \"resolution\": [32, 32]}],\n"
+            "  \"photons\": {\"per_channel\": %llu, \"seed\": 1}\n}\n",
+            (unsigned long long)photons);
+    if (fclose(f) != 0)
+        return thz_error_set(err, THZ_ERR_IO, "bench: cannot write %s", path);
+    return THZ_OK;
+}

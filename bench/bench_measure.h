@@ -1,0 +1,69 @@
+/* The measurements of the benchmark harness (issue 6). Each runs inside its own child
+ * process (bench/thzbench.c forks one per measurement), so that the peak memory the OS
+ * reports for it (getrusage) belongs to that measurement alone, and writes its results
+ * into a fixed-size struct that the child sends back through a pipe.
+ *
+ * Everything here calls the library's own stages (scene loading, src/accel, the photon
+ * phase, the renderer, the output writers, run_simulate); nothing re-implements them.
+ */
+#ifndef THZ_BENCH_MEASURE_H
+#define THZ_BENCH_MEASURE_H
+
+#include <stdint.h>
+
+#include "core/error.h"
+
+/* 1. The paper's case, stage by stage (the stages of run_simulate, timed one by one). */
+typedef struct bench_paper {
+    uint64_t photons_per_channel, channels, columns, rows, oversampling;
+    uint64_t fired, stored, rays;
+    uint64_t largest_map_bytes, largest_map_stored;
+    double s_load, s_accel, s_emission_table, s_tracing, s_index, s_photons, s_render,
+        s_output, s_total;
+} bench_paper;
+
+/* The same case through run_simulate (what `thzmap simulate` runs), end to end. */
+typedef struct bench_e2e {
+    double s_load, s_run, s_total;
+    uint64_t stored;
+} bench_e2e;
+
+/* 2. The raw Embree probe for n rays in the scene. */
+typedef struct bench_probe_out {
+    uint64_t rays, hits;
+    double seconds;
+} bench_probe_out;
+
+/* 3 and 4. Photon phase of one channel at several photon counts, each followed by a
+ * render of every sensor for that channel. */
+#define BENCH_MAX_POINTS 8
+typedef struct bench_point {
+    uint64_t photons, stored, rays, triangles, samples, pixels;
+    double s_emission_table, s_tracing, s_index, s_photons, s_render, s_probe;
+} bench_point;
+
+typedef struct bench_series {
+    int n;
+    bench_point p[BENCH_MAX_POINTS];
+} bench_series;
+
+thz_status bench_measure_paper(const char *scene_path, uint64_t photons, int threads,
+                               const char *outdir, bench_paper *out, thz_error *err);
+thz_status bench_measure_e2e(const char *scene_path, uint64_t photons, int threads,
+                             const char *outdir, bench_e2e *out, thz_error *err);
+thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int threads,
+                               bench_probe_out *out, thz_error *err);
+
+/* Photon phase (and, with render, a render of every sensor) of channel `channel` for each
+ * of photons[0..n): one point each; with probe, also the raw Embree probe for the same
+ * number of rays. */
+thz_status bench_measure_series(const char *scene_path, size_t channel, const uint64_t *photons,
+                                int n, int threads, int render, int probe, bench_series *out,
+                                thz_error *err);
+
+/* Writes the tessellated-mesh scene of the triangle scaling into path: an enclosure and
+ * four icospheres of `subdivisions` (20 * 4^s triangles each), one channel. */
+thz_status bench_write_mesh_scene(const char *path, unsigned subdivisions, uint64_t photons,
+                                  thz_error *err);
+
+#endif
