@@ -47,6 +47,7 @@ typedef struct render_context {
     uint32_t channel_index;
     uint64_t seed;
     size_t k;                /* gather_min_photons */
+    size_t k_secondary;      /* final-gather: photons of a secondary hit's k-nearest disk */
     channel_quadrature quad; /* nodes and normalised weights of g_c */
     double *planck;          /* [object * quad.n + node]: B_nu(T_object), W m^-2 sr^-1 Hz^-1 */
     optics_point *optics;    /* [object * quad.n + node] */
@@ -54,6 +55,7 @@ typedef struct render_context {
     double *emission_mean;   /* [object]: band mean of eps B when eps does not depend on the
                                 angle (solids, explicit eps); NAN for the others */
     bool *scatters;          /* [object]: R > 0 somewhere, or a diffuse shell */
+    double *tbar;            /* [object * quad.n + node]: T-bar of diffuse shells, else 0 */
     bool atmosphere;         /* some node has alpha > 0 */
     double t0_k;             /* path: reference temperature T0, K */
     double b0_mean;          /* path: band mean of B(T0) */
@@ -189,6 +191,7 @@ static void render_context_fini(render_context *ctx)
     free(ctx->alpha_per_m);
     free(ctx->emission_mean);
     free(ctx->scatters);
+    free(ctx->tbar);
     free(ctx->b0);
     free(ctx->source_mean);
     memset(ctx, 0, sizeof *ctx);
@@ -223,6 +226,7 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->channel_index = (uint32_t)channel;
     ctx->seed = scene->photons.seed;
     ctx->k = scene->photons.gather_min_photons;
+    ctx->k_secondary = ctx->k > RENDER_SECONDARY_K ? ctx->k : RENDER_SECONDARY_K;
     thz_status st = channel_quadrature_init(&ctx->quad, &scene->channels[channel],
                                             CHANNEL_QUADRATURE_NODES, err);
     if (st != THZ_OK)
@@ -238,8 +242,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->scatters = thz_malloc_array(n_obj, sizeof *ctx->scatters);
     ctx->b0 = thz_malloc_array(n, sizeof *ctx->b0);
     ctx->source_mean = thz_malloc_array(n_obj, sizeof *ctx->source_mean);
+    ctx->tbar = thz_calloc(cells ? cells : 1, sizeof *ctx->tbar);
     if (!ctx->planck || !ctx->optics || !ctx->alpha_per_m || !ctx->emission_mean ||
-        !ctx->scatters || !ctx->b0 || !ctx->source_mean) {
+        !ctx->scatters || !ctx->b0 || !ctx->source_mean || !ctx->tbar) {
         render_context_fini(ctx);
         return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
     }
@@ -263,8 +268,10 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         ctx->emission_mean[o] = angle_free ? mean : NAN;
         double r_min, r_max;
         spectrum_range(&mat->reflectivity, &r_min, &r_max);
-        ctx->scatters[o] = r_max > 0.0 || (obj->type == OBJECT_SHELL &&
-                                           mat->transmission == TRANSMISSION_DIFFUSE);
+        bool diffuse = obj->type == OBJECT_SHELL && mat->transmission == TRANSMISSION_DIFFUSE;
+        ctx->scatters[o] = r_max > 0.0 || diffuse;
+        for (size_t k = 0; diffuse && k < n; k++)
+            ctx->tbar[o * n + k] = optics_mean_transmission(&ctx->optics[o * n + k]);
     }
     ctx->t0_k = render_reference_temperature(scene, ctx->channel);
     for (size_t k = 0; k < n; k++) {
@@ -326,6 +333,7 @@ static double render_emission(const render_context *ctx, uint32_t object, double
 typedef struct render_scatter {
     const thz_material *material;
     const thz_object *object;
+    uint32_t object_index;
     bool transmitted;   /* diffuse transmission (else Lambertian reflection) */
     double mu_o;        /* |cos| of the direction towards the sensor at x */
     double mu_i;        /* |cos| of the gather ray at x */
@@ -347,6 +355,41 @@ static double render_scatter_weight(const render_context *ctx, const render_scat
         return 0.0;
     return optics_transmission(&o, s->mu_i) * optics_transmission(&o, s->mu_o) / tbar *
            s->pdf_ratio * s->inv_branch;
+}
+
+/* Final-gather's secondary emission: the band mean, by the channel quadrature, of
+ * eps(theta) B_nu(T) at the secondary hit times the straight-shell path weight,
+ * exp(-alpha d) and the first vertex's scattering weight, all at each node: the gather
+ * ray then carries no band noise of B. */
+static double render_emission_scattered(const render_context *ctx, uint32_t object, double mu,
+                                        const render_path *path, double distance_m,
+                                        const render_scatter *s)
+{
+    if (!(ctx->scene->objects[object].temperature_k > 0.0))
+        return 0.0;
+    size_t n = ctx->quad.n;
+    const optics_point *op = &ctx->optics[(size_t)object * n];
+    const double *planck = &ctx->planck[(size_t)object * n];
+    const optics_point *ox = &ctx->optics[(size_t)s->object_index * n];
+    const double *tbar_x = &ctx->tbar[(size_t)s->object_index * n];
+    double sum = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        double f;
+        if (!s->transmitted)
+            f = ox[k].reflectivity;
+        else
+            f = tbar_x[k] > 0.0 ? optics_transmission(&ox[k], s->mu_i) *
+                                      optics_transmission(&ox[k], s->mu_o) / tbar_x[k] *
+                                      s->pdf_ratio
+                                : 0.0;
+        double v = ctx->quad.weight[k] * f * optics_emissivity(&op[k], mu) * planck[k];
+        for (size_t i = 0; i < path->n && v != 0.0; i++)
+            v *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
+        if (ctx->atmosphere)
+            v *= exp(-ctx->alpha_per_m[k] * distance_m);
+        sum += v;
+    }
+    return sum * s->inv_branch;
 }
 
 /* Accumulator of one gather over one side of the hit object. */
@@ -443,12 +486,12 @@ static void render_gather(const render_context *ctx, const accel_hit *hit,
         .radius2_m2 = sample_sr * distance_m * distance_m / (M_PI * hit->cos_theta),
     };
     render_gather_pass(&g, hit->object, hit->side, diffuse_shell, hit->position_m);
-    if (g.count < ctx->k) {
+    size_t k = sample_sr > 0.0 ? ctx->k : ctx->k_secondary;
+    if (g.count < k) {
         unsigned mask = 1u << hit->side;
         if (diffuse_shell)
             mask |= 1u << (1 - hit->side);
-        double rk2 = photon_map_kth_distance2(ctx->map, hit->object, mask, hit->position_m,
-                                              ctx->k);
+        double rk2 = photon_map_kth_distance2(ctx->map, hit->object, mask, hit->position_m, k);
         if (!isfinite(rk2) || !(rk2 > 0.0)) {
             out->starved = 1;
             return;
@@ -468,13 +511,12 @@ static void render_gather(const render_context *ctx, const accel_hit *hit,
  * photon terms at the first hit, continued through straight shells. `path` and
  * `distance_m` carry what lies between the sensor and `origin_m` (final-gather's
  * secondary rays start with the first vertex's); `scatter` (may be NULL) weights every
- * term by the first vertex's scattering at the term's frequency; emission_hz > 0
- * evaluates the emission at that frequency (a sampled one) instead of the band mean. */
+ * term by the first vertex's scattering at the term's frequency. */
 static double render_photon_map_trace(const render_context *ctx, vec3 origin_m, vec3 dir,
                                       uint32_t ignore_object, uint32_t ignore_triangle,
                                       render_path path, double distance_m,
-                                      const render_scatter *scatter, double emission_hz,
-                                      double sample_sr, render_sample *out)
+                                      const render_scatter *scatter, double sample_sr,
+                                      render_sample *out)
 {
     double radiance = 0.0;
     size_t crossings = 0;
@@ -492,19 +534,11 @@ static double render_photon_map_trace(const render_context *ctx, vec3 origin_m, 
             out->back_face = 1;
             return radiance;
         }
-        if (emission_hz > 0.0) {
-            if (obj->temperature_k > 0.0) {
-                optics_point o = scene_object_optics(ctx->scene, obj, emission_hz);
-                radiance += optics_emissivity(&o, hit.cos_theta) *
-                            planck_radiance(emission_hz, obj->temperature_k) *
-                            render_path_weight(ctx, &path, emission_hz) *
-                            atmosphere_transmittance(&ctx->scene->atmosphere, emission_hz,
-                                                     distance_m) *
-                            render_scatter_weight(ctx, scatter, emission_hz);
-            }
-        } else {
+        if (scatter)
+            radiance += render_emission_scattered(ctx, hit.object, hit.cos_theta, &path,
+                                                  distance_m, scatter);
+        else
             radiance += render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m);
-        }
         bool shell = obj->type == OBJECT_SHELL;
         bool straight =
             shell && ctx->scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
@@ -550,7 +584,7 @@ static void render_photon_map_sample(const render_context *ctx, vec3 origin_m, v
 {
     render_path path = {.n = 0};
     double l = render_photon_map_trace(ctx, origin_m, dir, ACCEL_NO_OBJECT, 0, path, 0.0, NULL,
-                                       0.0, sample_sr, out);
+                                       sample_sr, out);
     for (uint32_t j = 0; j < t->n_est; j++)
         t->est[j] += t->weight * l;
 }
@@ -578,7 +612,8 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
     const float *nf = &obj->mesh.normals[3 * (size_t)hit->triangle];
     vec3 n = v3_from_floats(nf);
     vec3 n_seen = hit->side == 0 ? n : v3_scale(n, -1.0);
-    render_scatter s = {.material = mat, .object = obj, .mu_o = hit->cos_theta};
+    render_scatter s = {
+        .material = mat, .object = obj, .object_index = hit->object, .mu_o = hit->cos_theta};
     vec3 dir;
     if (rng_uniform(rng) * (r + tr) < r) {
         s.inv_branch = (r + tr) / r;
@@ -598,7 +633,7 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
     vec3 origin = render_leave(ctx, hit, dir);
     render_sample sec = {.variance = 0.0};
     double l = render_photon_map_trace(ctx, origin, dir, hit->object, hit->triangle, *path,
-                                       distance_m, &s, nu_j, 0.0, &sec);
+                                       distance_m, &s, 0.0, &sec);
     out->starved |= sec.starved;
     out->truncated |= sec.truncated;
     return l;

@@ -53,6 +53,13 @@
  * lies behind is dropped (counted in render_stats.truncated_paths). */
 #define RENDER_MAX_CROSSINGS 32
 
+/* final-gather's density estimate at a secondary hit uses the disk of the k-th nearest
+ * photon with k = max(gather_min_photons, RENDER_SECONDARY_K): a gather ray's noise is
+ * R/sqrt(k - 1) of the radiance there, so a larger k trades blur for fewer rays. */
+#ifndef RENDER_SECONDARY_K
+#define RENDER_SECONDARY_K 64
+#endif
+
 /* A `path` is cut after this many hits (counted in truncated_paths; the radiance beyond
  * is taken as B(T0), the control variate's value). */
 #define RENDER_MAX_BOUNCES 10000

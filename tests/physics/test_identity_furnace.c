@@ -66,7 +66,8 @@ static void furnace_case(thz_integrator integrator)
                     assert_true(r.img.radiance_stderr[i] <= 1e-12 * r.img.radiance[i]);
                     t.pixels++;
                 } else if (ident_pixel_interior(&r, col, row)) {
-                    ident_check_pixel(&t, &r, c, col, row, b, 1e-5);
+                    ident_check_pixel(&t, &r, c, col, row, b,
+                                      integrator == INTEGRATOR_FINAL_GATHER ? 3e-3 : 1e-5);
                 } else if (fabs(n - 1.0) > 0.35) {
                     /* an edge loses at most half the disk: 0.5 R <= 0.3 of N */
                     print_message("edge pixel (%u, %u): N = %.4f\n", col, row, n);
@@ -77,8 +78,12 @@ static void furnace_case(thz_integrator integrator)
         char what[64];
         snprintf(what, sizeof what, "furnace, %s, channel %zu",
                  render_integrator_name(integrator), c);
+        /* final-gather: the secondary hits' k-nearest disks (k = 64) that reach past an
+         * edge under-estimate everywhere in the picture, not only at the primary edges:
+         * measured -0.13 % here; 0.3 % allowed */
+        double bias = integrator == INTEGRATOR_FINAL_GATHER ? 3e-3 : 0.0;
         if (!exact)
-            ident_tally_assert(&t, what, 0.12 / sqrt(ident_scale()), 0.0);
+            ident_tally_assert(&t, what, 0.12 / sqrt(ident_scale()), bias);
         interior = t.pixels;
 
         /* P_c = L_c Omega_S A_S B_c, Tb_c inverts B at the centre, for a sample pixel */
