@@ -1,6 +1,7 @@
 /* Emission sampling of the photon phase: see emission.h for the scheme. */
 #include "photon/emission.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,11 +42,24 @@ void emission_table_fini(emission_table *t)
     free(t->sources);
     free(t->groups);
     free(t->order);
+    free(t->cum_q);
     memset(t, 0, sizeof *t);
 }
 
-/* Groups the sources: constant-optics sources by temperature (in order of first
- * appearance), every other source alone. */
+/* Whether sources i and j have powers in a frequency-independent ratio. */
+static bool emission_same_group(const emission_table *t, const emission_source *a,
+                                const emission_source *b)
+{
+    const thz_object *oa = &t->scene->objects[a->object], *ob = &t->scene->objects[b->object];
+    if (oa->temperature_k != ob->temperature_k || a->constant_optics != b->constant_optics)
+        return false;
+    if (a->constant_optics)
+        return true;
+    return oa->material == ob->material && oa->type == ob->type &&
+           oa->thickness_m == ob->thickness_m && a->sides == b->sides;
+}
+
+/* Groups the sources (in order of first appearance). */
 static bool emission_group_sources(emission_table *t)
 {
     size_t n = t->n_sources;
@@ -61,19 +75,17 @@ static bool emission_group_sources(emission_table *t)
         if (taken[i])
             continue;
         const emission_source *s = &t->sources[i];
-        double temp = t->scene->objects[s->object].temperature_k;
         emission_group *g = &t->groups[t->n_groups++];
-        g->temperature_k = temp;
+        g->temperature_k = t->scene->objects[s->object].temperature_k;
+        g->constant_optics = s->constant_optics;
         g->first = k;
         for (size_t j = i; j < n; j++) {
             const emission_source *u = &t->sources[j];
-            bool same = j == i || (s->constant_optics && u->constant_optics && !taken[j] &&
-                                   t->scene->objects[u->object].temperature_k == temp);
-            if (!same)
+            if (taken[j] || (j != i && !emission_same_group(t, s, u)))
                 continue;
             taken[j] = true;
             t->order[k++] = j;
-            g->weight += u->weight;
+            g->weight += u->constant_optics ? u->weight : M_PI * u->share;
         }
         g->count = k - g->first;
         if (g->count > 1) {
@@ -84,12 +96,54 @@ static bool emission_group_sources(emission_table *t)
             }
             double acc = 0.0;
             for (size_t m = 0; m < g->count; m++) {
-                acc += t->sources[t->order[g->first + m]].weight;
+                acc += t->sources[t->order[g->first + m]].share;
                 g->cdf[m] = acc;
             }
         }
     }
     free(taken);
+    return true;
+}
+
+/* Tabulates q_g on EMISSION_TABLE_NODES nodes over the band as cumulative sums over the
+ * groups. q_g(node) = max(w_g(node), floor) with floor = 1e-6 of the largest total:
+ * q_g > 0 everywhere, so every group with power at some frequency can be drawn there. */
+static bool emission_tabulate(emission_table *t)
+{
+    const thz_channel *ch = &t->scene->channels[t->channel];
+    size_t ng = t->n_groups ? t->n_groups : 1;
+    t->cum_q = thz_malloc_array((size_t)EMISSION_TABLE_NODES * ng, sizeof *t->cum_q);
+    if (!t->cum_q)
+        return false;
+    double sigma = channel_sigma_hz(ch);
+    double lo = ch->center_hz - EMISSION_TABLE_SIGMAS * sigma;
+    if (lo < 0.0)
+        lo = 0.0;
+    double hi = ch->center_hz + EMISSION_TABLE_SIGMAS * sigma;
+    t->nu0_hz = lo;
+    t->step_hz = (hi - lo) / (EMISSION_TABLE_NODES - 1);
+    double largest = 0.0;
+    for (size_t i = 0; i < EMISSION_TABLE_NODES; i++) {
+        double *row = &t->cum_q[i * ng];
+        double nu = lo + (double)i * t->step_hz;
+        double total = 0.0;
+        for (size_t g = 0; g < t->n_groups; g++) {
+            row[g] = nu > 0.0 ? emission_group_power(t, g, nu) : 0.0;
+            total += row[g];
+        }
+        largest = total > largest ? total : largest;
+    }
+    double floor_w = 1e-6 * largest;
+    if (!(floor_w > 0.0))
+        floor_w = DBL_MIN;
+    for (size_t i = 0; i < EMISSION_TABLE_NODES; i++) {
+        double *row = &t->cum_q[i * ng];
+        double acc = 0.0;
+        for (size_t g = 0; g < t->n_groups; g++) {
+            acc += row[g] > floor_w ? row[g] : floor_w;
+            row[g] = acc;
+        }
+    }
     return true;
 }
 
@@ -127,9 +181,11 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t
         s->constant_optics = spectrum_is_constant(&m->reflectivity) &&
                              spectrum_is_constant(&m->attenuation_per_m) &&
                              spectrum_is_constant(&m->emissivity);
+        s->share = s->area_m2 * s->sides;
         if (s->constant_optics) {
-            optics_point o = scene_object_optics(scene, obj, scene->channels[channel].center_hz);
-            s->weight = M_PI * optics_mean_emissivity(&o) * s->area_m2 * s->sides;
+            s->optics = scene_object_optics(scene, obj, scene->channels[channel].center_hz);
+            s->weight = M_PI * optics_mean_emissivity(&s->optics) * s->area_m2 * s->sides;
+            s->share = s->weight;
             if (!(s->weight > 0.0)) { /* eps-bar = 0: emits nothing */
                 free(s->triangle_cdf);
                 memset(s, 0, sizeof *s);
@@ -137,32 +193,31 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t
             }
         }
     }
-    if (!emission_group_sources(t)) {
+    if (!emission_group_sources(t) || !emission_tabulate(t)) {
         emission_table_fini(t);
         return thz_error_set(err, THZ_ERR_NOMEM, "photon emission: out of memory");
     }
     return THZ_OK;
 }
 
-/* pi eps-bar(nu) A sides of a source whose optics vary with frequency. */
-static double emission_variable_weight(const emission_table *t, const emission_source *s,
-                                       double freq_hz)
+double emission_group_power(const emission_table *t, size_t g, double freq_hz)
 {
-    const thz_object *obj = &t->scene->objects[s->object];
-    optics_point o = scene_object_optics(t->scene, obj, freq_hz);
-    return M_PI * optics_mean_emissivity(&o) * s->area_m2 * s->sides;
+    const emission_group *gr = &t->groups[g];
+    double w = gr->weight;
+    if (!gr->constant_optics) {
+        const emission_source *s = &t->sources[t->order[gr->first]];
+        optics_point o = scene_object_optics(t->scene, &t->scene->objects[s->object], freq_hz);
+        w *= optics_mean_emissivity(&o);
+    }
+    return w * planck_radiance(freq_hz, gr->temperature_k);
 }
 
 double emission_group_weights(const emission_table *t, double freq_hz, double *weights)
 {
     double total = 0.0;
     for (size_t g = 0; g < t->n_groups; g++) {
-        const emission_group *gr = &t->groups[g];
-        const emission_source *s = &t->sources[t->order[gr->first]];
-        double w = s->constant_optics ? gr->weight : emission_variable_weight(t, s, freq_hz);
-        w *= planck_radiance(freq_hz, gr->temperature_k);
-        weights[g] = w;
-        total += w;
+        weights[g] = emission_group_power(t, g, freq_hz);
+        total += weights[g];
     }
     return total;
 }
@@ -181,45 +236,71 @@ static size_t emission_search(const double *cdf, size_t n, double x)
     return lo;
 }
 
+/* The tabulated cumulative weight C_g(nu) at interpolation position (row, frac). */
+static double emission_cum(const emission_table *t, size_t row, double frac, size_t g)
+{
+    const double *a = &t->cum_q[row * t->n_groups + g];
+    return a[0] + frac * (a[t->n_groups] - a[0]);
+}
+
 bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
                      emission_photon *out)
 {
+    (void)scratch;
     const thz_channel *ch = &t->scene->channels[t->channel];
     double u1 = rng_uniform(rng), u2 = rng_uniform(rng);
-    out->freq_hz = channel_sample_hz(ch, u1, u2);
-    double total = emission_group_weights(t, out->freq_hz, scratch);
-    out->power_w_per_hz = total / (double)t->n_photons;
-    if (!(total > 0.0)) {
-        out->power_w_per_hz = 0.0;
+    double nu = channel_sample_hz(ch, u1, u2);
+    out->freq_hz = nu;
+    out->power_w_per_hz = 0.0;
+    if (t->n_groups == 0)
         return false;
-    }
 
-    /* Group by its power at this frequency (linear scan: groups are few), then the
-     * source within it by its weight. */
+    /* Group g by q_g(nu): C_g(nu) interpolates two monotone rows, so it is monotone in g
+     * and a binary search finds the first C_g > x; then q_g = C_g - C_{g-1} > 0. */
+    double pos = (nu - t->nu0_hz) / t->step_hz;
+    if (!(pos > 0.0))
+        pos = 0.0;
+    if (pos > EMISSION_TABLE_NODES - 1)
+        pos = EMISSION_TABLE_NODES - 1;
+    size_t row = (size_t)pos;
+    if (row > EMISSION_TABLE_NODES - 2)
+        row = EMISSION_TABLE_NODES - 2;
+    double frac = pos - (double)row;
+    size_t ng = t->n_groups;
+    double total = emission_cum(t, row, frac, ng - 1);
     double x = rng_uniform(rng) * total;
-    size_t g = t->n_groups - 1;
-    double acc = 0.0;
-    for (size_t i = 0; i < t->n_groups; i++) {
-        acc += scratch[i];
-        if (x < acc && scratch[i] > 0.0) {
-            g = i;
-            break;
-        }
+    size_t lo = 0, hi = ng - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (emission_cum(t, row, frac, mid) > x)
+            hi = mid;
+        else
+            lo = mid + 1;
     }
-    while (scratch[g] <= 0.0 && g > 0) /* rounding at the top end */
-        g--;
+    size_t g = lo;
+    double q = emission_cum(t, row, frac, g) - (g ? emission_cum(t, row, frac, g - 1) : 0.0);
+
     const emission_group *gr = &t->groups[g];
     size_t within = 0;
     double uw = rng_uniform(rng);
     if (gr->count > 1) {
         within = emission_search(gr->cdf, gr->count, uw * gr->cdf[gr->count - 1]);
-        while (t->sources[t->order[gr->first + within]].weight <= 0.0 && within > 0)
+        while (t->sources[t->order[gr->first + within]].share <= 0.0 && within > 0)
             within--;
     }
     size_t src = t->order[gr->first + within];
     const emission_source *s = &t->sources[src];
     const thz_object *obj = &t->scene->objects[s->object];
     const thz_mesh *m = &obj->mesh;
+
+    /* The exact power of the group drawn, at this frequency. */
+    optics_point o = s->constant_optics ? s->optics : scene_object_optics(t->scene, obj, nu);
+    double w = gr->weight * planck_radiance(nu, gr->temperature_k);
+    if (!gr->constant_optics)
+        w *= optics_mean_emissivity(&o);
+    if (!(w > 0.0) || !(q > 0.0))
+        return false;
+    out->power_w_per_hz = w * (total / q) / (double)t->n_photons;
 
     int side = 0;
     double us = rng_uniform(rng);
@@ -243,7 +324,6 @@ bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
     vec3 n = v3(nf[0], nf[1], nf[2]);
     if (side == 1)
         n = v3_scale(n, -1.0);
-    optics_point o = scene_object_optics(t->scene, obj, out->freq_hz);
     double mu;
     if (!optics_sample_emission_mu(&o, emission_uniform, rng, &mu))
         mu = sqrt(1.0 - rng_uniform(rng)); /* unreachable: the source has eps-bar > 0 */
