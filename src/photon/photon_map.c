@@ -85,22 +85,32 @@ uint32_t photon_encode_direction(vec3 dir)
         x = (1.0 - fabs(y)) * photon_sign(ox);
         y = (1.0 - fabs(ox)) * photon_sign(y);
     }
-    /* Of the four codes around (x, y), keep the one that decodes closest to dir
-     * (the rounded one is not always best near the fold). */
-    vec3 unit = v3_normalize(dir);
-    uint32_t qx0 = photon_quantize(x), qy0 = photon_quantize(y);
-    uint32_t best = qx0 << 16 | qy0;
-    double best_dot = -2.0;
-    for (int dx = -1; dx <= 1; dx++) {
-        for (int dy = -1; dy <= 1; dy++) {
-            int64_t qx = (int64_t)qx0 + dx, qy = (int64_t)qy0 + dy;
+    /* Of the four codes around (x, y) (floor and ceiling in each axis), keep the one
+     * that decodes closest to dir (the rounded one is not always best near the fold).
+     * Compared by dot(d, dir)^2 / |d|^2 over candidates of positive dot, so no square
+     * root or division is needed per candidate. */
+    double fx = (x * 0.5 + 0.5) * 65535.0, fy = (y * 0.5 + 0.5) * 65535.0;
+    int64_t qx0 = (int64_t)floor(fx), qy0 = (int64_t)floor(fy);
+    uint32_t best = photon_quantize(x) << 16 | photon_quantize(y);
+    double best_num = -1.0, best_den = 1.0;
+    for (int64_t qx = qx0; qx <= qx0 + 1; qx++) {
+        for (int64_t qy = qy0; qy <= qy0 + 1; qy++) {
             if (qx < 0 || qy < 0 || qx > 65535 || qy > 65535)
                 continue;
-            vec3 d = photon_decode_xy(photon_dequantize((uint32_t)qx),
-                                      photon_dequantize((uint32_t)qy));
-            double dot = v3_dot(d, unit);
-            if (dot > best_dot) {
-                best_dot = dot;
+            double cx = photon_dequantize((uint32_t)qx), cy = photon_dequantize((uint32_t)qy);
+            double cz = 1.0 - fabs(cx) - fabs(cy);
+            if (cz < 0.0) {
+                double ox = cx;
+                cx = (1.0 - fabs(cy)) * photon_sign(ox);
+                cy = (1.0 - fabs(ox)) * photon_sign(cy);
+            }
+            double dot = cx * dir.x + cy * dir.y + cz * dir.z;
+            if (!(dot > 0.0))
+                continue;
+            double num = dot * dot, den = cx * cx + cy * cy + cz * cz;
+            if (num * best_den > best_num * den) {
+                best_num = num;
+                best_den = den;
                 best = (uint32_t)qx << 16 | (uint32_t)qy;
             }
         }
@@ -138,6 +148,16 @@ static int photon_compare(const photon_record *a, const photon_record *b, unsign
     return memcmp(a, b, sizeof *a);
 }
 
+/* a before (key, record) t in the total order; the key compare settles almost all. */
+static bool photon_before(const photon_record *a, uint32_t key_t, const photon_record *t,
+                          unsigned axis)
+{
+    uint32_t ka = photon_sortable(a->position_m[axis]);
+    if (ka != key_t)
+        return ka < key_t;
+    return memcmp(a, t, sizeof *a) < 0;
+}
+
 static void photon_swap(photon_record *a, photon_record *b)
 {
     photon_record t = *a;
@@ -145,80 +165,109 @@ static void photon_swap(photon_record *a, photon_record *b)
     *b = t;
 }
 
-/* Rearranges r[0..n) so that r[k] is the element of rank k, smaller ones before it and
- * larger ones after (quickselect, median-of-three pivot, Hoare partition). */
-static void photon_select(photon_record *r, size_t n, size_t k, unsigned axis)
+/* Rearranges r[left..right] so that r[k] is the element of rank k - left, smaller ones
+ * before it and larger ones after: Floyd and Rivest's SELECT (1975). Large ranges first
+ * select within a sample-sized window around k, recursively, which leaves a pivot at k
+ * whose rank is close to k, so one partition pass brings the range down to a window of
+ * o(n): about 1.5 n comparisons for a median instead of quickselect's 3.4 n. */
+static void photon_select_range(photon_record *r, int64_t left, int64_t right, int64_t k,
+                                unsigned axis)
 {
-    size_t lo = 0, hi = n; /* [lo, hi) contains rank k */
-    while (hi - lo > 2) {
-        size_t mid = lo + (hi - lo) / 2;
-        /* order r[lo], r[mid], r[hi-1]; the median moves to lo as the pivot */
-        if (photon_compare(&r[mid], &r[lo], axis) < 0)
-            photon_swap(&r[mid], &r[lo]);
-        if (photon_compare(&r[hi - 1], &r[lo], axis) < 0)
-            photon_swap(&r[hi - 1], &r[lo]);
-        if (photon_compare(&r[hi - 1], &r[mid], axis) < 0)
-            photon_swap(&r[hi - 1], &r[mid]);
-        photon_swap(&r[lo], &r[mid]); /* pivot (median) at lo; r[hi-1] >= pivot */
-        const photon_record pivot = r[lo];
-        size_t i = lo, j = hi;
-        for (;;) {
-            do
-                i++;
-            while (photon_compare(&r[i], &pivot, axis) < 0);
-            do
-                j--;
-            while (photon_compare(&pivot, &r[j], axis) < 0);
-            if (i >= j)
-                break;
-            photon_swap(&r[i], &r[j]);
+    while (right > left) {
+        if (right - left > 600) {
+            double n = (double)(right - left + 1);
+            double i = (double)(k - left + 1);
+            double z = log(n);
+            double sz = 0.5 * exp(2.0 * z / 3.0);
+            double sd = 0.5 * sqrt(z * sz * (n - sz) / n) * (i - n / 2.0 < 0.0 ? -1.0 : 1.0);
+            int64_t nl = (int64_t)((double)k - i * sz / n + sd);
+            int64_t nr = (int64_t)((double)k + (n - i) * sz / n + sd);
+            photon_select_range(r, nl > left ? nl : left, nr < right ? nr : right, k, axis);
         }
-        photon_swap(&r[lo], &r[j]); /* pivot to its final rank j */
-        if (j == k)
-            return;
-        if (k < j)
-            hi = j;
-        else
-            lo = j + 1;
+        const photon_record t = r[k];
+        const uint32_t tk = photon_sortable(t.position_m[axis]);
+        int64_t i = left, j = right;
+        photon_swap(&r[left], &r[k]);
+        if (photon_compare(&r[right], &t, axis) > 0)
+            photon_swap(&r[right], &r[left]);
+        while (i < j) {
+            photon_swap(&r[i], &r[j]);
+            i++;
+            j--;
+            while (photon_before(&r[i], tk, &t, axis))
+                i++;
+            while (photon_compare(&r[j], &t, axis) > 0)
+                j--;
+        }
+        if (photon_compare(&r[left], &t, axis) == 0) {
+            photon_swap(&r[left], &r[j]);
+        } else {
+            j++;
+            photon_swap(&r[j], &r[right]);
+        }
+        if (j <= k)
+            left = j + 1;
+        if (k <= j)
+            right = j - 1;
     }
-    if (hi - lo == 2 && photon_compare(&r[lo + 1], &r[lo], axis) < 0)
-        photon_swap(&r[lo], &r[lo + 1]);
 }
 
-static unsigned photon_widest_axis(const photon_record *r, size_t n)
+static void photon_select(photon_record *r, size_t n, size_t k, unsigned axis)
 {
+    if (n > 1)
+        photon_select_range(r, 0, (int64_t)n - 1, (int64_t)k, axis);
+}
+
+/* The box a subtree's points lie in: the group's bounding box cut by the split planes of
+ * the subtree's ancestors. Its widest side is the subtree's split axis, which saves a
+ * pass over the points per level (the points' own bounding box would need one). */
+typedef struct photon_cell {
     float lo[3], hi[3];
+} photon_cell;
+
+static photon_cell photon_bounds(const photon_record *r, size_t n)
+{
+    photon_cell c;
     for (int a = 0; a < 3; a++)
-        lo[a] = hi[a] = r[0].position_m[a];
+        c.lo[a] = c.hi[a] = r[0].position_m[a];
     for (size_t i = 1; i < n; i++) {
         for (int a = 0; a < 3; a++) {
             float v = r[i].position_m[a];
-            if (v < lo[a])
-                lo[a] = v;
-            if (v > hi[a])
-                hi[a] = v;
+            if (v < c.lo[a])
+                c.lo[a] = v;
+            if (v > c.hi[a])
+                c.hi[a] = v;
         }
     }
-    double ex = (double)hi[0] - lo[0], ey = (double)hi[1] - lo[1], ez = (double)hi[2] - lo[2];
+    return c;
+}
+
+static unsigned photon_widest_axis(const photon_cell *c)
+{
+    double ex = (double)c->hi[0] - c->lo[0], ey = (double)c->hi[1] - c->lo[1],
+           ez = (double)c->hi[2] - c->lo[2];
     if (ex >= ey && ex >= ez)
         return 0;
     return ey >= ez ? 1 : 2;
 }
 
-static void photon_build(photon_record *r, size_t n)
+static void photon_build(photon_record *r, size_t n, photon_cell cell)
 {
     while (n > 0) {
         size_t mid = n / 2;
-        unsigned axis = n > 1 ? photon_widest_axis(r, n) : 0;
+        unsigned axis = n > 1 ? photon_widest_axis(&cell) : 0;
         if (n > 1)
             photon_select(r, n, mid, axis);
         r[mid].flags = (r[mid].flags & ~PHOTON_MAP_AXIS_MASK) | axis << PHOTON_MAP_AXIS_SHIFT;
+        photon_cell left_cell = cell;
+        left_cell.hi[axis] = r[mid].position_m[axis];
+        cell.lo[axis] = r[mid].position_m[axis];
         if (mid >= PHOTON_MAP_TASK_MIN) {
             photon_record *left = r;
-#pragma omp task firstprivate(left, mid)
-            photon_build(left, mid);
+#pragma omp task firstprivate(left, mid, left_cell)
+            photon_build(left, mid, left_cell);
         } else {
-            photon_build(r, mid);
+            photon_build(r, mid, left_cell);
         }
         /* the right subtree in this task (loop instead of recursion) */
         r += mid + 1;
@@ -303,7 +352,7 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
             continue;
         photon_record *r = map->records + lo;
 #pragma omp task firstprivate(r, n)
-        photon_build(r, n);
+        photon_build(r, n, photon_bounds(r, n));
     }
 
     *out = map;
