@@ -1,0 +1,217 @@
+/* The three integrators against each other (physics.md "Integrators"), and the honesty
+ * of their per-pixel standard errors, on a scene with reflective solids, a diffuse and a
+ * straight shell and temperature contrasts:
+ *
+ *   cross-validation: `path` with many paths is the reference; photon-map and
+ *     final-gather agree with it, pixel by pixel away from object borders, within
+ *     IDENT_Z combined standard errors plus a bias allowance (the density estimates'
+ *     edge and disk bias, measured and printed), and their mean deviation over the
+ *     picture stays within that allowance;
+ *   honesty: over M runs with different seeds, the observed spread of each pixel
+ *     matches its reported standard error: pooled over the pixels, the ratio of the
+ *     observed variance to the mean reported variance is within 20 % of 1. With M runs
+ *     and P pixels its relative precision is about sqrt(2 / ((M - 1) P)) (a few %), so
+ *     the 20 % test can fail. final-gather's error is conditional on the photon map (it
+ *     cannot see the map's own noise), so it is checked with one map and different
+ *     gather seeds; photon-map's Poisson estimate is checked over photon seeds. */
+#include "identity.h"
+
+#define XVAL_JSON \
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"cross-validation\"," \
+    " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.05}]," \
+    " \"materials\": {" \
+    "   \"wall\": {\"reflectivity\": 0.2}," \
+    "   \"metal\": {\"reflectivity\": 0.7}," \
+    "   \"grey\": {\"reflectivity\": 0.4}," \
+    "   \"foam\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 150, \"transmission\": \"diffuse\"}," \
+    "   \"film\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 100, \"transmission\": \"straight\"}}," \
+    " \"objects\": [" \
+    "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"wall\", \"temperature_k\": 295," \
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2], \"inward\": true}}," \
+    "   {\"name\": \"heater\", \"type\": \"solid\", \"material\": \"metal\", \"temperature_k\": 340," \
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [0.5, 0.3, 0.5]}," \
+    "    \"transform\": {\"rotate_deg\": [0, 0, 30], \"translate_m\": [0.45, 0.5, 0.3]}}," \
+    "   {\"name\": \"cold\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 250," \
+    "    \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.2, \"height_m\": 0.9, \"caps\": true}," \
+    "    \"transform\": {\"translate_m\": [-0.4, 0.5, -1.0]}}," \
+    "   {\"name\": \"sleeve\", \"type\": \"shell\", \"thickness_m\": 0.003, \"material\": \"foam\"," \
+    "    \"temperature_k\": 305," \
+    "    \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.25, \"height_m\": 0.5, \"caps\": false}," \
+    "    \"transform\": {\"translate_m\": [-0.4, 0.5, -0.6]}}," \
+    "   {\"name\": \"veil\", \"type\": \"shell\", \"thickness_m\": 0.002, \"material\": \"film\"," \
+    "    \"temperature_k\": 300, \"shape\": {\"type\": \"rectangle\", \"size_m\": [0.6, 0.6]}," \
+    "    \"transform\": {\"rotate_deg\": [90, 0, 0], \"translate_m\": [0.35, 0.0, 0.3]}}]," \
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.9, 0], \"direction\": [0, 1, 0]," \
+    "   \"up\": [0, 0, 1], \"fov_deg\": 80, \"resolution\": [%u, %u], \"oversampling\": 1," \
+    "   \"aperture_m2\": 0.01, \"normalize_to_k\": 295}]," \
+    " \"photons\": {\"per_channel\": 300000, \"seed\": %llu}}"
+
+static void xval_scene(char *json, size_t size, uint32_t res, uint64_t seed)
+{
+    snprintf(json, size, XVAL_JSON, res, res, (unsigned long long)seed);
+}
+
+static void test_cross_validation(void **state)
+{
+    (void)state;
+    char json[8192];
+    xval_scene(json, sizeof json, 20, 21);
+    ident_run ref;
+    ident_run_scene_with(&ref, json, 0, INTEGRATOR_PATH, ident_estimates(1024));
+    size_t px = (size_t)ref.img.columns * ref.img.rows;
+    const thz_integrator others[] = {INTEGRATOR_PHOTON_MAP, INTEGRATOR_FINAL_GATHER};
+    /* bias allowances, relative to L: the density estimates' edge and disk bias in this
+     * scene (photon-map: footprint disks, widened where photons are sparse; final-gather:
+     * the 64-photon disks of its secondary hits) */
+    const double allowance[] = {0.01, 0.005};
+    for (size_t k = 0; k < 2; k++) {
+        ident_run r;
+        ident_run_scene_with(&r, json, ident_photons(300000), others[k], ident_estimates(64));
+        size_t n = 0, failed = 0;
+        double sum_rel = 0.0, worst_z = 0.0, sum_se_ref = 0.0;
+        for (uint32_t row = 0; row < r.img.rows; row++)
+            for (uint32_t col = 0; col < r.img.columns; col++) {
+                size_t i = ident_at(&r, 0, col, row);
+                if (!ident_pixel_interior(&r, col, row))
+                    continue;
+                double l = r.img.radiance[i], l_ref = ref.img.radiance[i];
+                double se = hypot(r.img.radiance_stderr[i], ref.img.radiance_stderr[i]);
+                double tol = IDENT_Z * se + allowance[k] * l_ref;
+                double z = (l - l_ref) / se;
+                n++;
+                sum_rel += (l - l_ref) / l_ref;
+                sum_se_ref += ref.img.radiance_stderr[i] / l_ref;
+                if (fabs(z) > fabs(worst_z))
+                    worst_z = z;
+                if (!(fabs(l - l_ref) <= tol)) {
+                    if (failed < 8)
+                        print_message("%s pixel (%u, %u): L = %.5e, path %.5e (%+.3f %%, z = %.1f)\n",
+                                      render_integrator_name(others[k]), col, row, l, l_ref,
+                                      100.0 * (l - l_ref) / l_ref, z);
+                    failed++;
+                }
+            }
+        double mean_rel = sum_rel / (double)n;
+        print_message("%s vs path: %zu interior of %zu pixels, mean deviation %+.3f %%, worst z "
+                      "%.2f, path's mean stderr %.4f %%\n",
+                      render_integrator_name(others[k]), n, px, 100.0 * mean_rel, worst_z,
+                      100.0 * sum_se_ref / (double)n);
+        assert_true(n > px / 3);
+        assert_int_equal(failed, 0);
+        assert_true(fabs(mean_rel) <= allowance[k]);
+        ident_run_fini(&r);
+    }
+    /* the reference is tight: its standard errors are far below the allowances */
+    double worst = 0.0;
+    for (size_t i = 0; i < px; i++)
+        if (ref.img.radiance[i] > 0.0)
+            worst = fmax(worst, ref.img.radiance_stderr[i] / ref.img.radiance[i]);
+    print_message("path reference: largest pixel stderr %.4f %%\n", 100.0 * worst);
+    assert_true(worst < 0.004 / sqrt(ident_scale()));
+    /* the scene has contrast: the picture spans more than 30 K of brightness temperature */
+    double tmin = 1e9, tmax = 0.0;
+    for (size_t i = 0; i < px; i++) {
+        tmin = fmin(tmin, ref.img.brightness_temperature[i]);
+        tmax = fmax(tmax, ref.img.brightness_temperature[i]);
+    }
+    assert_true(tmax - tmin > 30.0);
+    ident_run_fini(&ref);
+}
+
+/* Renders channel 0 of sensor 0 M times and pools observed against reported variance. */
+#define HONEST_RUNS 16
+#define HONEST_RES 12
+
+static double honesty_ratio(thz_integrator integrator, bool fixed_map)
+{
+    char json[8192];
+    xval_scene(json, sizeof json, HONEST_RES, 1);
+    size_t px = (size_t)HONEST_RES * HONEST_RES;
+    double sum[HONEST_RES * HONEST_RES] = {0}, sum2[HONEST_RES * HONEST_RES] = {0};
+    double rep[HONEST_RES * HONEST_RES] = {0};
+    thz_error err;
+    thz_scene *scene = NULL;
+    assert_int_equal(scene_load_string(json, ".", "honesty", &scene, &err), THZ_OK);
+    scene->render.integrator = integrator;
+    scene->render.paths_per_sample = ident_estimates(16);
+    scene->render.gather_rays = ident_estimates(16);
+    scene->photons.per_channel = ident_photons(100000);
+    accel *acc = NULL;
+    assert_int_equal(accel_create(scene, &acc, &err), THZ_OK);
+    photon_map *map = NULL;
+    photon_phase_options po = {.threads = 2};
+    render_options ro = {.threads = 2};
+    for (int m = 0; m < HONEST_RUNS; m++) {
+        scene->photons.seed = 1000 + (uint64_t)m;
+        if (render_integrator_needs_photons(integrator) && (!fixed_map || !map)) {
+            photon_map_destroy(map);
+            map = NULL;
+            assert_int_equal(photon_phase_run(scene, acc, 0, &po, &map, NULL, &err), THZ_OK);
+        }
+        sensor_images img;
+        assert_int_equal(sensor_images_init(&img, HONEST_RES, HONEST_RES, 1, 1, &err), THZ_OK);
+        assert_int_equal(render_sensor_channel(scene, acc, map, 0, 0, &img, &ro, NULL, &err),
+                         THZ_OK);
+        for (size_t p = 0; p < px; p++) {
+            sum[p] += img.radiance[p];
+            sum2[p] += (double)img.radiance[p] * img.radiance[p];
+            rep[p] += (double)img.radiance_stderr[p] * img.radiance_stderr[p];
+        }
+        sensor_images_fini(&img);
+    }
+    double obs = 0.0, reported = 0.0;
+    size_t used = 0;
+    for (size_t p = 0; p < px; p++) {
+        double mean = sum[p] / HONEST_RUNS;
+        double var = (sum2[p] - HONEST_RUNS * mean * mean) / (HONEST_RUNS - 1);
+        if (!(rep[p] > 0.0))
+            continue;
+        /* relative to the pixel's value, so that bright pixels do not dominate */
+        obs += var / (mean * mean);
+        reported += rep[p] / HONEST_RUNS / (mean * mean);
+        used++;
+    }
+    photon_map_destroy(map);
+    accel_destroy(acc);
+    scene_destroy(scene);
+    double ratio = sqrt(obs / reported);
+    print_message("%s%s: observed / reported standard error = %.3f over %zu pixels x %d runs "
+                  "(precision ~%.1f %%)\n",
+                  render_integrator_name(integrator), fixed_map ? " (one photon map)" : "", ratio,
+                  used, HONEST_RUNS,
+                  100.0 * sqrt(1.0 / (2.0 * (HONEST_RUNS - 1) * (double)used)));
+    assert_true(used > px / 2);
+    return ratio;
+}
+
+static void test_stderr_is_honest_path(void **state)
+{
+    (void)state;
+    double r = honesty_ratio(INTEGRATOR_PATH, false);
+    assert_true(fabs(r - 1.0) <= 0.2);
+}
+
+static void test_stderr_is_honest_final_gather(void **state)
+{
+    (void)state;
+    double r = honesty_ratio(INTEGRATOR_FINAL_GATHER, true);
+    assert_true(fabs(r - 1.0) <= 0.2);
+}
+
+static void test_stderr_is_honest_photon_map(void **state)
+{
+    (void)state;
+    double r = honesty_ratio(INTEGRATOR_PHOTON_MAP, false);
+    assert_true(fabs(r - 1.0) <= 0.2);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cross_validation),
+        cmocka_unit_test(test_stderr_is_honest_path),
+        cmocka_unit_test(test_stderr_is_honest_final_gather),
+        cmocka_unit_test(test_stderr_is_honest_photon_map),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
