@@ -988,9 +988,10 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a,
     uint32_t n = cam.oversampling, cols = cam.columns, rows = cam.rows;
     double n2 = (double)n * (double)n;
     uint64_t samples_per_pass = (uint64_t)cols * rows * n * n;
-    /* Rows per block: about 16k sample estimates between progress calls. */
+    /* Rows per block: about 64k sample estimates between progress calls (fewer parallel
+     * regions: less waiting at their ends). */
     uint64_t work_per_row = (uint64_t)cols * n * n * (integ->purpose ? n_est : 1);
-    uint32_t block = (uint32_t)(16384 / (work_per_row ? work_per_row : 1));
+    uint32_t block = (uint32_t)(65536 / (work_per_row ? work_per_row : 1));
     if (block < 1)
         block = 1;
     uint64_t n_samples = 0, n_escaped = 0, n_back = 0, n_widened = 0, n_starved = 0,
