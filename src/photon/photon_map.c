@@ -1,18 +1,24 @@
-/* Photon map: records grouped by (object, side), each group an implicit balanced
- * kd-tree in a flat array (Jensen's balanced kd-tree, Radiance's pmapkdt).
+/* Photon map: records grouped by (object, side), each group sorted along a Morton
+ * (z-order) curve, with an implicit octree over the sorted array as its spatial index.
  *
  * Layout. The records are reordered in place, with no per-photon side array, so the
- * map costs exactly 32 bytes per photon plus one offset per (object, side). Group g =
- * object << 1 | side occupies [start[g], start[g+1]). Within a group a subtree over
- * [lo, hi) has its node at mid = lo + (hi - lo) / 2: the median along the node's split
- * axis, with [lo, mid) before and [mid + 1, hi) after it in that axis' order. The split
- * axis (0, 1, 2 = x, y, z; the axis of largest extent of the subtree's points) is kept
- * in bits 16..17 of the node's `flags`; the low 16 bits keep the bounce count.
+ * map costs 32 bytes per photon plus, per (object, side), one offset and the cube its
+ * octree spans. Group g = object << 1 | side occupies [start[g], start[g+1]). Within a
+ * group, positions are quantised to PHOTON_MAP_LEVELS bits per axis in the group's
+ * bounding cube, and the records are sorted by the interleaved bits (x, y, z at each
+ * level, coarsest first), then by their bytes. So the records of every octree cell form
+ * one contiguous range, and a cell's eight children split it into eight sub-ranges,
+ * found by binary search on the next level's digit: the octree needs no stored nodes.
+ * Queries descend the cells that reach the query sphere and scan ranges of at most
+ * PHOTON_MAP_LEAF records.
  *
- * Determinism. Records are ordered by a total order (the split coordinate's bits
- * mapped to a sortable integer, then the record's bytes), so every position of the
- * final array is a function of the group's multiset of records alone: neither the
- * input order nor the thread count changes a byte of the result.
+ * Why not the balanced kd-tree it replaces: its build (a median selection per node and
+ * level, O(n log n) passes over 32-byte records) took a third of the photon phase; the
+ * sort is an in-place MSD radix sort with 64-way digits, a few passes over the array.
+ *
+ * Determinism. The order (Morton code, then the record's bytes) is total, so every
+ * position of the final array is a function of the group's multiset of records alone:
+ * neither the input order nor the thread count changes a byte of the result.
  */
 #include "photon/photon_map.h"
 
@@ -27,19 +33,8 @@
 #include <omp.h>
 #endif
 
-#define PHOTON_MAP_AXIS_SHIFT 16u
-#define PHOTON_MAP_AXIS_MASK (3u << PHOTON_MAP_AXIS_SHIFT)
-/* Subtrees larger than this are built as separate OpenMP tasks. */
-#define PHOTON_MAP_TASK_MIN 8192
 /* k up to this uses a heap on the stack; larger k allocates one per query. */
 #define PHOTON_MAP_STACK_K 256
-
-struct photon_map {
-    photon_record *records;
-    size_t count;
-    size_t n_groups; /* 2 n_objects */
-    size_t *start;   /* n_groups + 1 offsets */
-};
 
 /* ---- Octahedral direction encoding ------------------------------------------------ */
 
@@ -125,37 +120,175 @@ vec3 photon_decode_direction(uint32_t code)
 
 /* ---- Build -------------------------------------------------------------------------- */
 
-static unsigned photon_axis(const photon_record *p)
+/* Bits per axis of the quantised positions: cells down to 2^-21 of the group's extent. */
+#define PHOTON_MAP_LEVELS 21
+/* Ranges up to this many records are scanned instead of split. */
+#define PHOTON_MAP_LEAF 48
+/* Ranges up to this many records (2 MB) are sorted 64 buckets at a time. */
+#define PHOTON_MAP_CACHED 65536
+/* Ranges up to this many records are sorted by insertion. */
+#define PHOTON_MAP_SORT_SMALL 16
+
+/* The cube a group's octree spans: origin (its bounding box's minimum) and side. */
+typedef struct photon_cube {
+    double origin[3];
+    double side;  /* of the root cell, m; cells at level L have side / 2^L */
+    double scale; /* 2^LEVELS / side: position offset -> quantised coordinate */
+} photon_cube;
+
+struct photon_map {
+    photon_record *records;
+    size_t count;
+    size_t n_groups;    /* 2 n_objects */
+    size_t *start;      /* n_groups + 1 offsets */
+    photon_cube *cubes; /* n_groups */
+};
+
+static uint32_t photon_quantize_axis(const photon_cube *c, const photon_record *p, int a)
 {
-    return (p->flags & PHOTON_MAP_AXIS_MASK) >> PHOTON_MAP_AXIS_SHIFT;
+    double q = ((double)p->position_m[a] - c->origin[a]) * c->scale;
+    if (!(q > 0.0))
+        return 0;
+    if (q >= (double)(1u << PHOTON_MAP_LEVELS))
+        return (1u << PHOTON_MAP_LEVELS) - 1;
+    return (uint32_t)q;
 }
 
-/* Float bits mapped so that unsigned order is the numeric order (total, -0 < +0). */
-static uint32_t photon_sortable(float f)
+/* `levels` levels' digits of a Morton code from `level` on (3 bits each, the first
+ * level's highest; levels past the last count as digit 0). */
+static unsigned photon_code_digits(uint64_t code, int level, int levels)
 {
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+    int last = level + levels - 1; /* deepest level wanted */
+    int shift = 3 * (PHOTON_MAP_LEVELS - last);
+    uint64_t mask = ((uint64_t)1 << (3 * levels)) - 1;
+    if (shift >= 0)
+        return (unsigned)(code >> shift & mask);
+    return (unsigned)(code << -shift & mask);
 }
 
-/* Total order along axis: coordinate, then the record's bytes. */
-static int photon_compare(const photon_record *a, const photon_record *b, unsigned axis)
+/* The low 21 bits of v spread to every third bit (bit i to bit 3i). */
+static uint64_t photon_spread3(uint32_t v)
 {
-    uint32_t ka = photon_sortable(a->position_m[axis]);
-    uint32_t kb = photon_sortable(b->position_m[axis]);
-    if (ka != kb)
-        return ka < kb ? -1 : 1;
-    return memcmp(a, b, sizeof *a);
+    uint64_t x = v & 0x1fffffu;
+    x = (x | x << 32) & 0x1f00000000ffffu;
+    x = (x | x << 16) & 0x1f0000ff0000ffu;
+    x = (x | x << 8) & 0x100f00f00f00f00fu;
+    x = (x | x << 4) & 0x10c30c30c30c30c3u;
+    x = (x | x << 2) & 0x1249249249249249u;
+    return x;
 }
 
-/* a before (key, record) t in the total order; the key compare settles almost all. */
-static bool photon_before(const photon_record *a, uint32_t key_t, const photon_record *t,
-                          unsigned axis)
+/* The full Morton code (3 LEVELS bits; x the highest bit of each level). */
+static uint64_t photon_morton(const photon_cube *c, const photon_record *p)
 {
-    uint32_t ka = photon_sortable(a->position_m[axis]);
-    if (ka != key_t)
-        return ka < key_t;
-    return memcmp(a, t, sizeof *a) < 0;
+    return photon_spread3(photon_quantize_axis(c, p, 0)) << 2 |
+           photon_spread3(photon_quantize_axis(c, p, 1)) << 1 |
+           photon_spread3(photon_quantize_axis(c, p, 2));
+}
+
+/* Swaps records i and j and their codes. */
+static void photon_swap2(photon_record *r, uint64_t *code, size_t i, size_t j)
+{
+    photon_record t = r[i];
+    r[i] = r[j];
+    r[j] = t;
+    uint64_t k = code[i];
+    code[i] = code[j];
+    code[j] = k;
+}
+
+static int photon_compare_bytes(const void *a, const void *b)
+{
+    return memcmp(a, b, sizeof(photon_record));
+}
+
+/* Insertion sort of a small range by (Morton code, bytes). */
+static void photon_sort_small(photon_record *r, uint64_t *code, size_t n)
+{
+    for (size_t i = 1; i < n; i++) {
+        photon_record x = r[i];
+        uint64_t k = code[i];
+        size_t j = i;
+        while (j > 0 && (code[j - 1] > k ||
+                         (code[j - 1] == k && memcmp(&r[j - 1], &x, sizeof x) > 0))) {
+            r[j] = r[j - 1];
+            code[j] = code[j - 1];
+            j--;
+        }
+        r[j] = x;
+        code[j] = k;
+    }
+}
+
+/* Sorts r[0..n) (with their Morton codes alongside), whose codes share the digits of
+ * levels 1..level-1, by code and then bytes: American flag sort. Ranges larger than the
+ * caches go three levels (512 buckets) at a time, since every pass over them costs a
+ * cache miss per record; cached ones two levels (64 buckets) at a time. */
+static void photon_sort(photon_record *r, uint64_t *code, size_t n, int level)
+{
+    if (n <= PHOTON_MAP_SORT_SMALL) {
+        photon_sort_small(r, code, n);
+        return;
+    }
+    if (level > PHOTON_MAP_LEVELS) { /* one position: by bytes (the codes are equal) */
+        qsort(r, n, sizeof *r, photon_compare_bytes);
+        return;
+    }
+    const int levels = n <= PHOTON_MAP_CACHED ? 2 : 3;
+    const int nb = 1 << (3 * levels);
+    size_t count[512] = {0}, start[513], next[512];
+    for (size_t i = 0; i < n; i++)
+        count[photon_code_digits(code[i], level, levels)]++;
+    start[0] = 0;
+    for (int b = 0; b < nb; b++)
+        start[b + 1] = start[b] + count[b];
+    for (int b = 0; b < nb; b++)
+        next[b] = start[b];
+    for (int b = 0; b < nb; b++) {
+        while (next[b] < start[b + 1]) {
+            unsigned d = photon_code_digits(code[next[b]], level, levels);
+            if (d == (unsigned)b)
+                next[b]++;
+            else
+                photon_swap2(r, code, next[b], next[d]++);
+        }
+    }
+    for (int b = 0; b < nb; b++) {
+        photon_record *sub = r + start[b];
+        uint64_t *sub_code = code + start[b];
+        size_t m = count[b];
+        if (m == 0)
+            continue;
+        int sub_level = level + levels;
+        if (m >= 8192) {
+#pragma omp task firstprivate(sub, sub_code, m, sub_level)
+            photon_sort(sub, sub_code, m, sub_level);
+        } else {
+            photon_sort(sub, sub_code, m, sub_level);
+        }
+    }
+}
+
+/* A group's bounding box. */
+typedef struct photon_bounds {
+    double lo[3], hi[3];
+} photon_bounds;
+
+/* The group's cube: its records' bounding box, widened to a cube (cells stay cubes). */
+static photon_cube photon_group_cube(const photon_bounds *b)
+{
+    photon_cube c;
+    double side = 0.0;
+    for (int a = 0; a < 3; a++) {
+        c.origin[a] = b->lo[a] <= b->hi[a] ? b->lo[a] : 0.0; /* empty group: any */
+        side = b->hi[a] - b->lo[a] > side ? b->hi[a] - b->lo[a] : side;
+    }
+    if (!(side > 0.0))
+        side = 1.0;
+    /* slightly larger, so the top corner quantises inside */
+    c.side = side * (1.0 + 1e-9);
+    c.scale = (double)(1u << PHOTON_MAP_LEVELS) / c.side;
+    return c;
 }
 
 static void photon_swap(photon_record *a, photon_record *b)
@@ -165,125 +298,11 @@ static void photon_swap(photon_record *a, photon_record *b)
     *b = t;
 }
 
-/* Rearranges r[left..right] so that r[k] is the element of rank k - left, smaller ones
- * before it and larger ones after: Floyd and Rivest's SELECT (1975). Large ranges first
- * select within a sample-sized window around k, recursively, which leaves a pivot at k
- * whose rank is close to k, so one partition pass brings the range down to a window of
- * o(n): about 1.5 n comparisons for a median instead of quickselect's 3.4 n. */
-static void photon_select_range(photon_record *r, int64_t left, int64_t right, int64_t k,
-                                unsigned axis)
+/* Groups records by object_side in place (American flag sort: the counts come from
+ * photon_map_create's checking pass, then cycles); the order within a group is
+ * irrelevant since the sort fixes it. */
+static void photon_group(photon_record *r, size_t n_groups, size_t *start, size_t *next)
 {
-    while (right > left) {
-        if (right - left > 600) {
-            double n = (double)(right - left + 1);
-            double i = (double)(k - left + 1);
-            double z = log(n);
-            double sz = 0.5 * exp(2.0 * z / 3.0);
-            double sd = 0.5 * sqrt(z * sz * (n - sz) / n) * (i - n / 2.0 < 0.0 ? -1.0 : 1.0);
-            int64_t nl = (int64_t)((double)k - i * sz / n + sd);
-            int64_t nr = (int64_t)((double)k + (n - i) * sz / n + sd);
-            photon_select_range(r, nl > left ? nl : left, nr < right ? nr : right, k, axis);
-        }
-        const photon_record t = r[k];
-        const uint32_t tk = photon_sortable(t.position_m[axis]);
-        int64_t i = left, j = right;
-        photon_swap(&r[left], &r[k]);
-        if (photon_compare(&r[right], &t, axis) > 0)
-            photon_swap(&r[right], &r[left]);
-        while (i < j) {
-            photon_swap(&r[i], &r[j]);
-            i++;
-            j--;
-            while (photon_before(&r[i], tk, &t, axis))
-                i++;
-            while (photon_compare(&r[j], &t, axis) > 0)
-                j--;
-        }
-        if (photon_compare(&r[left], &t, axis) == 0) {
-            photon_swap(&r[left], &r[j]);
-        } else {
-            j++;
-            photon_swap(&r[j], &r[right]);
-        }
-        if (j <= k)
-            left = j + 1;
-        if (k <= j)
-            right = j - 1;
-    }
-}
-
-static void photon_select(photon_record *r, size_t n, size_t k, unsigned axis)
-{
-    if (n > 1)
-        photon_select_range(r, 0, (int64_t)n - 1, (int64_t)k, axis);
-}
-
-/* The box a subtree's points lie in: the group's bounding box cut by the split planes of
- * the subtree's ancestors. Its widest side is the subtree's split axis, which saves a
- * pass over the points per level (the points' own bounding box would need one). */
-typedef struct photon_cell {
-    float lo[3], hi[3];
-} photon_cell;
-
-static photon_cell photon_bounds(const photon_record *r, size_t n)
-{
-    photon_cell c;
-    for (int a = 0; a < 3; a++)
-        c.lo[a] = c.hi[a] = r[0].position_m[a];
-    for (size_t i = 1; i < n; i++) {
-        for (int a = 0; a < 3; a++) {
-            float v = r[i].position_m[a];
-            if (v < c.lo[a])
-                c.lo[a] = v;
-            if (v > c.hi[a])
-                c.hi[a] = v;
-        }
-    }
-    return c;
-}
-
-static unsigned photon_widest_axis(const photon_cell *c)
-{
-    double ex = (double)c->hi[0] - c->lo[0], ey = (double)c->hi[1] - c->lo[1],
-           ez = (double)c->hi[2] - c->lo[2];
-    if (ex >= ey && ex >= ez)
-        return 0;
-    return ey >= ez ? 1 : 2;
-}
-
-static void photon_build(photon_record *r, size_t n, photon_cell cell)
-{
-    while (n > 0) {
-        size_t mid = n / 2;
-        unsigned axis = n > 1 ? photon_widest_axis(&cell) : 0;
-        if (n > 1)
-            photon_select(r, n, mid, axis);
-        r[mid].flags = (r[mid].flags & ~PHOTON_MAP_AXIS_MASK) | axis << PHOTON_MAP_AXIS_SHIFT;
-        photon_cell left_cell = cell;
-        left_cell.hi[axis] = r[mid].position_m[axis];
-        cell.lo[axis] = r[mid].position_m[axis];
-        if (mid >= PHOTON_MAP_TASK_MIN) {
-            photon_record *left = r;
-#pragma omp task firstprivate(left, mid, left_cell)
-            photon_build(left, mid, left_cell);
-        } else {
-            photon_build(r, mid, left_cell);
-        }
-        /* the right subtree in this task (loop instead of recursion) */
-        r += mid + 1;
-        n -= mid + 1;
-    }
-}
-
-/* Groups records by object_side in place (American flag sort: counts, then cycles);
- * the order within a group is irrelevant since the kd-tree build fixes it. */
-static void photon_group(photon_record *r, size_t count, size_t n_groups, size_t *start,
-                         size_t *next)
-{
-    for (size_t g = 0; g <= n_groups; g++)
-        start[g] = 0;
-    for (size_t i = 0; i < count; i++)
-        start[r[i].object_side + 1]++;
     for (size_t g = 0; g < n_groups; g++)
         start[g + 1] += start[g];
     for (size_t g = 0; g < n_groups; g++)
@@ -305,6 +324,8 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
     thz_status st = THZ_OK;
     photon_map *map = NULL;
     size_t *next = NULL;
+    uint64_t *codes = NULL;
+    photon_bounds *bounds = NULL;
     *out = NULL;
     if (count > 0 && !photons) {
         st = thz_error_set(err, THZ_ERR_INTERNAL, "photon map: %zu photons but no array", count);
@@ -315,25 +336,53 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
         goto cleanup;
     }
     const size_t n_groups = 2 * n_objects;
-    for (size_t i = 0; i < count; i++) {
-        if (photons[i].object_side >= n_groups) {
-            st = thz_error_set(err, THZ_ERR_INTERNAL,
-                               "photon map: photon %zu names object %u of %zu", i,
-                               (unsigned)photon_object(&photons[i]), n_objects);
-            goto cleanup;
-        }
-        photons[i].flags &= ~PHOTON_MAP_AXIS_MASK;
-    }
     map = calloc(1, sizeof *map);
-    if (map)
+    if (map) {
         map->start = thz_calloc(n_groups + 1, sizeof *map->start);
+        map->cubes = thz_calloc(n_groups ? n_groups : 1, sizeof *map->cubes);
+    }
     next = thz_calloc(n_groups + 1, sizeof *next);
-    if (!map || !map->start || !next) {
+    bounds = thz_malloc_array(n_groups ? n_groups : 1, sizeof *bounds);
+    if (!map || !map->start || !map->cubes || !next || !bounds) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu objects",
                            n_objects);
         goto cleanup;
     }
-    photon_group(photons, count, n_groups, map->start, next);
+    /* One pass: check, count per group, and the groups' bounding boxes. */
+    for (size_t g = 0; g < n_groups; g++)
+        for (int a = 0; a < 3; a++) {
+            bounds[g].lo[a] = INFINITY;
+            bounds[g].hi[a] = -INFINITY;
+        }
+    for (size_t i = 0; i < count; i++) {
+        photon_record *p = &photons[i];
+        if (p->object_side >= n_groups) {
+            st = thz_error_set(err, THZ_ERR_INTERNAL,
+                               "photon map: photon %zu names object %u of %zu", i,
+                               (unsigned)photon_object(p), n_objects);
+            goto cleanup;
+        }
+        /* bits 16..17 held a kd-tree's split axis in maps before the octree; kept zero */
+        p->flags &= ~(3u << 16);
+        map->start[p->object_side + 1]++;
+        photon_bounds *bb = &bounds[p->object_side];
+        for (int a = 0; a < 3; a++) {
+            double v = p->position_m[a];
+            bb->lo[a] = v < bb->lo[a] ? v : bb->lo[a];
+            bb->hi[a] = v > bb->hi[a] ? v : bb->hi[a];
+        }
+    }
+    for (size_t g = 0; g < n_groups; g++)
+        map->cubes[g] = photon_group_cube(&bounds[g]);
+    photon_group(photons, n_groups, map->start, next);
+    /* The records' Morton codes, sorted alongside them (8 bytes per record, freed when
+     * the map is built: the peak is 1.25 times the map). */
+    codes = thz_malloc_array(count ? count : 1, sizeof *codes);
+    if (!codes) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu photons",
+                           count);
+        goto cleanup;
+    }
     map->records = photons;
     map->count = count;
     map->n_groups = n_groups;
@@ -351,14 +400,22 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
         if (n == 0)
             continue;
         photon_record *r = map->records + lo;
-#pragma omp task firstprivate(r, n)
-        photon_build(r, n, photon_bounds(r, n));
+        uint64_t *code = codes + lo;
+        const photon_cube *cube = &map->cubes[g];
+#pragma omp task firstprivate(r, code, n, cube)
+        {
+            for (size_t i = 0; i < n; i++)
+                code[i] = photon_morton(cube, &r[i]);
+            photon_sort(r, code, n, 1);
+        }
     }
 
     *out = map;
     map = NULL;
 cleanup:
     free(next);
+    free(codes);
+    free(bounds);
     free(photons);
     photon_map_destroy(map);
     return st;
@@ -370,6 +427,7 @@ void photon_map_destroy(photon_map *map)
         return;
     free(map->records);
     free(map->start);
+    free(map->cubes);
     free(map);
 }
 
@@ -382,7 +440,8 @@ size_t photon_map_bytes(const photon_map *map)
 {
     if (!map)
         return 0;
-    return sizeof *map + map->count * sizeof *map->records + (map->n_groups + 1) * sizeof *map->start;
+    return sizeof *map + map->count * sizeof *map->records +
+           (map->n_groups + 1) * sizeof *map->start + map->n_groups * sizeof *map->cubes;
 }
 
 const photon_record *photon_map_records(const photon_map *map)
@@ -400,36 +459,123 @@ static double photon_distance2(const photon_record *p, const double q[3])
     return dx * dx + dy * dy + dz * dz;
 }
 
+/* A cell of a group's octree: its level, integer coordinates and record range. */
+typedef struct photon_cell {
+    int level;
+    uint32_t c[3];
+    size_t lo, hi;
+} photon_cell;
+
+/* Squared distance from q to the cell's box, the box widened by a millionth of its
+ * side: quantisation rounds in double, so a point on a cell's face may sit in the
+ * neighbouring cell; the widening keeps pruning conservative. */
+static double photon_cell_distance2(const photon_cube *cube, const photon_cell *cell,
+                                    const double q[3])
+{
+    double size = ldexp(cube->side, -cell->level);
+    double pad = 1e-6 * size;
+    double d2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        double lo = cube->origin[a] + (double)cell->c[a] * size - pad;
+        double hi = lo + size + 2.0 * pad;
+        double d = q[a] < lo ? lo - q[a] : (q[a] > hi ? q[a] - hi : 0.0);
+        d2 += d * d;
+    }
+    return d2;
+}
+
+/* First index in [lo, hi) whose quantised coordinate on axis a has bit `bit` set: the
+ * range is sorted by that bit (a cell's records by x bit, then, within each half, by y
+ * bit, then by z bit of the next level). */
+static size_t photon_bit_boundary(const photon_cube *cube, const photon_record *r, size_t lo,
+                                  size_t hi, int a, int bit)
+{
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (photon_quantize_axis(cube, &r[mid], a) >> bit & 1u)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return lo;
+}
+
+/* Splits a cell's range into its 8 children's: b[d]..b[d+1] is child d. */
+static void photon_cell_split(const photon_cube *cube, const photon_record *r,
+                              const photon_cell *cell, size_t b[9])
+{
+    int bit = PHOTON_MAP_LEVELS - (cell->level + 1);
+    b[0] = cell->lo;
+    b[8] = cell->hi;
+    b[4] = photon_bit_boundary(cube, r, b[0], b[8], 0, bit);
+    b[2] = photon_bit_boundary(cube, r, b[0], b[4], 1, bit);
+    b[6] = photon_bit_boundary(cube, r, b[4], b[8], 1, bit);
+    for (int k = 1; k < 8; k += 2)
+        b[k] = photon_bit_boundary(cube, r, b[k - 1], b[k + 1], 2, bit);
+}
+
+static photon_cell photon_child(const photon_cell *cell, unsigned d, const size_t b[9])
+{
+    photon_cell ch = {.level = cell->level + 1,
+                      .c = {cell->c[0] << 1 | (d >> 2 & 1u), cell->c[1] << 1 | (d >> 1 & 1u),
+                            cell->c[2] << 1 | (d & 1u)},
+                      .lo = b[d],
+                      .hi = b[d + 1]};
+    return ch;
+}
+
 typedef struct photon_radius_query {
+    const photon_cube *cube;
+    const photon_record *r; /* the map's records */
     double q[3];
-    double radius2;
+    double radius2, radius;
     photon_visit_fn visit;
     void *ctx;
 } photon_radius_query;
 
-static void photon_radius_rec(const photon_radius_query *qr, const photon_record *r, size_t n)
+static void photon_radius_rec(const photon_radius_query *qr, const photon_cell *cell);
+
+/* Splits [lo, hi) of `cell` by the next level's bit on axes `axis`..2, descending only
+ * into the halves the query sphere reaches on each axis (so a small sphere costs one
+ * binary search per axis, not seven per cell); `bits` collects the child's digit. */
+static void photon_radius_axes(const photon_radius_query *qr, const photon_cell *cell, size_t lo,
+                               size_t hi, int axis, unsigned bits)
 {
-    while (n > 0) {
-        size_t mid = n / 2;
-        const photon_record *node = &r[mid];
-        double d2 = photon_distance2(node, qr->q);
-        if (d2 <= qr->radius2)
-            qr->visit(qr->ctx, node, d2);
-        unsigned axis = photon_axis(node);
-        double d = qr->q[axis] - (double)node->position_m[axis];
-        /* Near side first (recursively), far side only if the plane is within reach;
-         * points on the plane may be on either side. */
-        if (d < 0.0) {
-            if (d * d <= qr->radius2)
-                photon_radius_rec(qr, r + mid + 1, n - mid - 1);
-            n = mid;
-        } else {
-            if (d * d <= qr->radius2)
-                photon_radius_rec(qr, r, mid);
-            r += mid + 1;
-            n -= mid + 1;
-        }
+    if (lo == hi)
+        return;
+    if (axis == 3) {
+        photon_cell ch = {.level = cell->level + 1,
+                          .c = {cell->c[0] << 1 | (bits >> 2 & 1u), cell->c[1] << 1 | (bits >> 1 & 1u),
+                                cell->c[2] << 1 | (bits & 1u)},
+                          .lo = lo,
+                          .hi = hi};
+        if (photon_cell_distance2(qr->cube, &ch, qr->q) <= qr->radius2)
+            photon_radius_rec(qr, &ch);
+        return;
     }
+    double size = ldexp(qr->cube->side, -cell->level), pad = 1e-6 * size;
+    double mid_m = qr->cube->origin[axis] + ((double)cell->c[axis] + 0.5) * size;
+    bool low = qr->q[axis] - qr->radius <= mid_m + pad;
+    bool high = qr->q[axis] + qr->radius >= mid_m - pad;
+    size_t m = photon_bit_boundary(qr->cube, qr->r, lo, hi, axis,
+                                   PHOTON_MAP_LEVELS - (cell->level + 1));
+    if (low)
+        photon_radius_axes(qr, cell, lo, m, axis + 1, bits << 1);
+    if (high)
+        photon_radius_axes(qr, cell, m, hi, axis + 1, bits << 1 | 1u);
+}
+
+static void photon_radius_rec(const photon_radius_query *qr, const photon_cell *cell)
+{
+    if (cell->hi - cell->lo <= PHOTON_MAP_LEAF || cell->level == PHOTON_MAP_LEVELS) {
+        for (size_t i = cell->lo; i < cell->hi; i++) {
+            double d2 = photon_distance2(&qr->r[i], qr->q);
+            if (d2 <= qr->radius2)
+                qr->visit(qr->ctx, &qr->r[i], d2);
+        }
+        return;
+    }
+    photon_radius_axes(qr, cell, cell->lo, cell->hi, 0, 0);
 }
 
 static bool photon_group_range(const photon_map *map, uint32_t object, int side, size_t *lo,
@@ -443,19 +589,35 @@ static bool photon_group_range(const photon_map *map, uint32_t object, int side,
     return *n > 0;
 }
 
+static photon_cell photon_root(size_t lo, size_t n)
+{
+    photon_cell root = {.level = 0, .c = {0, 0, 0}, .lo = lo, .hi = lo + n};
+    return root;
+}
+
 void photon_map_radius(const photon_map *map, uint32_t object, int side, vec3 position_m,
                        double radius2_m2, photon_visit_fn visit, void *ctx)
 {
     size_t lo, n;
     if (!(radius2_m2 >= 0.0) || !photon_group_range(map, object, side, &lo, &n))
         return;
-    photon_radius_query qr = {{position_m.x, position_m.y, position_m.z}, radius2_m2, visit,
+    size_t g = (size_t)object * 2 + (size_t)side;
+    photon_radius_query qr = {&map->cubes[g],
+                              map->records,
+                              {position_m.x, position_m.y, position_m.z},
+                              radius2_m2,
+                              sqrt(radius2_m2),
+                              visit,
                               ctx};
-    photon_radius_rec(&qr, map->records + lo, n);
+    photon_cell root = photon_root(lo, n);
+    if (photon_cell_distance2(qr.cube, &root, qr.q) <= radius2_m2)
+        photon_radius_rec(&qr, &root);
 }
 
 /* A bounded max-heap of the k smallest squared distances seen. */
 typedef struct photon_knn {
+    const photon_cube *cube;
+    const photon_record *r;
     double q[3];
     double *heap;
     size_t size, k;
@@ -492,42 +654,44 @@ static void photon_knn_push(photon_knn *h, double d2)
     }
     h->heap[i] = d2;
 }
-
-/* Current pruning bound: the k-th distance once k are known, else infinity. */
 static double photon_knn_bound(const photon_knn *h)
 {
     return h->size < h->k ? INFINITY : h->heap[0];
 }
 
-static void photon_knn_rec(photon_knn *h, const photon_record *r, size_t n)
+/* Visits the children nearest first, each only while it may hold a closer photon. */
+static void photon_knn_rec(photon_knn *h, const photon_cell *cell)
 {
-    while (n > 0) {
-        size_t mid = n / 2;
-        const photon_record *node = &r[mid];
-        unsigned axis = photon_axis(node);
-        double d = h->q[axis] - (double)node->position_m[axis];
-        double d2 = photon_distance2(node, h->q);
-        if (d2 < photon_knn_bound(h))
-            photon_knn_push(h, d2);
-        const photon_record *near_r, *far_r;
-        size_t near_n, far_n;
-        if (d < 0.0) {
-            near_r = r;
-            near_n = mid;
-            far_r = r + mid + 1;
-            far_n = n - mid - 1;
-        } else {
-            near_r = r + mid + 1;
-            near_n = n - mid - 1;
-            far_r = r;
-            far_n = mid;
+    if (cell->hi - cell->lo <= PHOTON_MAP_LEAF || cell->level == PHOTON_MAP_LEVELS) {
+        for (size_t i = cell->lo; i < cell->hi; i++) {
+            double d2 = photon_distance2(&h->r[i], h->q);
+            if (d2 < photon_knn_bound(h))
+                photon_knn_push(h, d2);
         }
-        photon_knn_rec(h, near_r, near_n);
-        if (!(d * d < photon_knn_bound(h)))
-            return;
-        r = far_r;
-        n = far_n;
+        return;
     }
+    size_t b[9];
+    photon_cell_split(h->cube, h->r, cell, b);
+    photon_cell ch[8];
+    double dist[8];
+    int n = 0;
+    for (unsigned d = 0; d < 8; d++) {
+        if (b[d] == b[d + 1])
+            continue;
+        photon_cell c = photon_child(cell, d, b);
+        double d2 = photon_cell_distance2(h->cube, &c, h->q);
+        int j = n++;
+        while (j > 0 && dist[j - 1] > d2) { /* insertion by distance (stable) */
+            ch[j] = ch[j - 1];
+            dist[j] = dist[j - 1];
+            j--;
+        }
+        ch[j] = c;
+        dist[j] = d2;
+    }
+    for (int i = 0; i < n; i++)
+        if (dist[i] < photon_knn_bound(h))
+            photon_knn_rec(h, &ch[i]);
 }
 
 double photon_map_kth_distance2(const photon_map *map, uint32_t object, unsigned side_mask,
@@ -545,16 +709,21 @@ double photon_map_kth_distance2(const photon_map *map, uint32_t object, unsigned
     if (total < k)
         return INFINITY;
     double stack_heap[PHOTON_MAP_STACK_K];
-    photon_knn h = {{position_m.x, position_m.y, position_m.z}, stack_heap, 0, k};
+    photon_knn h = {NULL, map->records, {position_m.x, position_m.y, position_m.z}, stack_heap,
+                    0, k};
     if (k > PHOTON_MAP_STACK_K) {
         /* Documented exception to "queries allocate nothing": k above 256. */
         h.heap = thz_malloc_array(k, sizeof *h.heap);
         if (!h.heap)
             return NAN;
     }
-    for (int s = 0; s < 2; s++)
-        if (has[s])
-            photon_knn_rec(&h, map->records + lo[s], n[s]);
+    for (int s = 0; s < 2; s++) {
+        if (!has[s])
+            continue;
+        h.cube = &map->cubes[(size_t)object * 2 + (size_t)s];
+        photon_cell root = photon_root(lo[s], n[s]);
+        photon_knn_rec(&h, &root);
+    }
     double result = h.heap[0];
     if (h.heap != stack_heap)
         free(h.heap);
