@@ -301,6 +301,8 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
                                      thz_error *err)
 {
     render_options ro = {.threads = rs->opt->threads,
+                         .use_seed = true,
+                         .seed = rs->seed, /* the photon map's, for render */
                          .progress = rs->opt->progress,
                          .progress_user = rs->opt->progress_user};
     double t0 = run_now_s();

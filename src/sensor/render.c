@@ -977,6 +977,8 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a,
     st = render_context_init(&ctx, scene, a, map, channel, err);
     if (st != THZ_OK)
         return st;
+    if (opt && opt->use_seed)
+        ctx.seed = opt->seed;
     /* per thread: the current pixel's n_est estimates */
     double *scratch = thz_malloc_array((size_t)threads * n_est, sizeof *scratch);
     if (!scratch) {

@@ -66,6 +66,9 @@
 
 typedef struct render_options {
     int threads;              /* OpenMP threads, 0: all */
+    bool use_seed;            /* seed the random streams with `seed`, not photons.seed (render
+                                 from a saved map uses the map's seed) */
+    uint64_t seed;
     thz_progress_fn progress; /* stage "render": done/total = rows of this sensor; may be NULL */
     void *progress_user;
 } render_options;

@@ -184,6 +184,14 @@ for c in s["channels"]:
     assert c["render_passes"] >= 1, c
 PY
 done
+# final-gather from a saved map (seeded elsewhere than the scene) re-renders byte for byte
+"$THZMAP" simulate "$work/scene.json" -o "$work/fgs" --integrator final-gather --photons 20000 \
+    --seed 9 --save-photon-map --quiet || fail "simulate final-gather --save-photon-map exited $?"
+"$THZMAP" render "$work/scene.json" --photon-map "$work/fgs/photon-map.thzpm" -o "$work/fgr" \
+    --integrator final-gather --quiet || fail "render --integrator final-gather exited $?"
+for f in cam.radiance.img cam.radiance_stderr.img side.brightness_temperature.img; do
+    cmp -s "$work/fgs/$f" "$work/fgr/$f" || fail "render --integrator final-gather: $f differs"
+done
 grep -q '"photons_per_channel": *0' "$work/path1/summary.json" \
     || fail "path's summary.json should say 0 photons: $(grep photons "$work/path1/summary.json")"
 grep -q '"photons_fired"' "$work/path1/summary.json" && fail "path fired photons"
