@@ -80,37 +80,7 @@ uint32_t photon_encode_direction(vec3 dir)
         x = (1.0 - fabs(y)) * photon_sign(ox);
         y = (1.0 - fabs(ox)) * photon_sign(y);
     }
-    /* Of the four codes around (x, y) (floor and ceiling in each axis), keep the one
-     * that decodes closest to dir (the rounded one is not always best near the fold).
-     * Compared by dot(d, dir)^2 / |d|^2 over candidates of positive dot, so no square
-     * root or division is needed per candidate. */
-    double fx = (x * 0.5 + 0.5) * 65535.0, fy = (y * 0.5 + 0.5) * 65535.0;
-    int64_t qx0 = (int64_t)floor(fx), qy0 = (int64_t)floor(fy);
-    uint32_t best = photon_quantize(x) << 16 | photon_quantize(y);
-    double best_num = -1.0, best_den = 1.0;
-    for (int64_t qx = qx0; qx <= qx0 + 1; qx++) {
-        for (int64_t qy = qy0; qy <= qy0 + 1; qy++) {
-            if (qx < 0 || qy < 0 || qx > 65535 || qy > 65535)
-                continue;
-            double cx = photon_dequantize((uint32_t)qx), cy = photon_dequantize((uint32_t)qy);
-            double cz = 1.0 - fabs(cx) - fabs(cy);
-            if (cz < 0.0) {
-                double ox = cx;
-                cx = (1.0 - fabs(cy)) * photon_sign(ox);
-                cy = (1.0 - fabs(ox)) * photon_sign(cy);
-            }
-            double dot = cx * dir.x + cy * dir.y + cz * dir.z;
-            if (!(dot > 0.0))
-                continue;
-            double num = dot * dot, den = cx * cx + cy * cy + cz * cz;
-            if (num * best_den > best_num * den) {
-                best_num = num;
-                best_den = den;
-                best = (uint32_t)qx << 16 | (uint32_t)qy;
-            }
-        }
-    }
-    return best;
+    return photon_quantize(x) << 16 | photon_quantize(y);
 }
 
 vec3 photon_decode_direction(uint32_t code)
