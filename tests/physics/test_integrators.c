@@ -13,7 +13,8 @@
  *     and P pixels its relative precision is about sqrt(2 / ((M - 1) P)) (a few %), so
  *     the 20 % test can fail. final-gather's error is conditional on the photon map (it
  *     cannot see the map's own noise), so it is checked with one map and different
- *     gather seeds; photon-map's Poisson estimate is checked over photon seeds. */
+ *     gather seeds (over photon seeds its spread is larger: the map's own noise, bounded
+ *     by FG_MAP_FACTOR); photon-map's Poisson estimate is checked over photon seeds. */
 #include "identity.h"
 
 #define XVAL_JSON \
@@ -46,6 +47,13 @@
     "   \"aperture_m2\": 0.01, \"normalize_to_k\": 295}]," \
     " \"photons\": {\"per_channel\": 300000, \"seed\": %llu}}"
 
+/* final-gather's standard error is conditional on its photon map: the map's own noise,
+ * shared by the gather rays that land near the same photons, comes on top. Over photon
+ * seeds the spread is 1.44 x the reported error here (test_final_gather_map_noise
+ * checks it stays below this factor); the cross-validation scales final-gather's error
+ * by it. */
+#define FG_MAP_FACTOR 2.0
+
 static void xval_scene(char *json, size_t size, uint32_t res, uint64_t seed)
 {
     snprintf(json, size, XVAL_JSON, res, res, (unsigned long long)seed);
@@ -75,7 +83,8 @@ static void test_cross_validation(void **state)
                 if (!ident_pixel_interior(&r, col, row))
                     continue;
                 double l = r.img.radiance[i], l_ref = ref.img.radiance[i];
-                double se = hypot(r.img.radiance_stderr[i], ref.img.radiance_stderr[i]);
+                double f = others[k] == INTEGRATOR_FINAL_GATHER ? FG_MAP_FACTOR : 1.0;
+                double se = hypot(f * r.img.radiance_stderr[i], ref.img.radiance_stderr[i]);
                 double tol = IDENT_Z * se + allowance[k] * l_ref;
                 double z = (l - l_ref) / se;
                 n++;
@@ -198,6 +207,13 @@ static void test_stderr_is_honest_final_gather(void **state)
     assert_true(fabs(r - 1.0) <= 0.2);
 }
 
+static void test_final_gather_map_noise(void **state)
+{
+    (void)state;
+    double r = honesty_ratio(INTEGRATOR_FINAL_GATHER, false);
+    assert_true(r >= 0.8 && r <= FG_MAP_FACTOR);
+}
+
 static void test_stderr_is_honest_photon_map(void **state)
 {
     (void)state;
@@ -212,6 +228,7 @@ int main(void)
         cmocka_unit_test(test_stderr_is_honest_path),
         cmocka_unit_test(test_stderr_is_honest_final_gather),
         cmocka_unit_test(test_stderr_is_honest_photon_map),
+        cmocka_unit_test(test_final_gather_map_noise),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
