@@ -14,6 +14,7 @@
 typedef struct phase_chunk {
     int thread;
     size_t start, count;
+    size_t offset; /* where the records go in the phase's array */
     trace_counters counters;
 } phase_chunk;
 
@@ -85,37 +86,48 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                 }
                 ch->count = b->count - ch->start;
             }
+            /* Merge in chunk order (the result is ordered by photon index): one thread
+             * sizes the array and sums the counters in that fixed order, then all copy. */
+#pragma omp single
+            {
+                size_t added = 0;
+                for (long k = 0; k < n_chunks; k++) {
+                    chunks[k].offset = count + added;
+                    added += chunks[k].count;
+                    trace_counters_add(total, &chunks[k].counters);
+                }
+                if (!failed && count + added > capacity) {
+                    size_t cap = capacity;
+                    while (cap < count + added)
+                        cap = cap > SIZE_MAX / 2 ? count + added : 2 * cap;
+                    photon_record *p = thz_realloc_array(records, cap, sizeof *p);
+                    if (p) {
+                        records = p;
+                        capacity = cap;
+                    } else {
+                        failed = 2;
+                    }
+                }
+                if (!failed)
+                    count += added;
+            }
+            if (!failed) {
+#pragma omp for schedule(static)
+                for (long k = 0; k < n_chunks; k++) {
+                    const phase_chunk *ch = &chunks[k];
+                    if (ch->count)
+                        memcpy(records + ch->offset, bufs[ch->thread].records + ch->start,
+                               ch->count * sizeof *records);
+                }
+            }
         }
         if (failed) {
-            st = thz_error_set(err, THZ_ERR_NOMEM, "photon phase: out of memory for photon records");
+            st = failed == 2 ? thz_error_set(err, THZ_ERR_NOMEM,
+                                             "photon phase: out of memory for %zu photon records",
+                                             count)
+                             : thz_error_set(err, THZ_ERR_NOMEM,
+                                             "photon phase: out of memory for photon records");
             goto cleanup;
-        }
-
-        /* Merge in chunk order: the result is ordered by photon index. */
-        size_t added = 0;
-        for (long k = 0; k < n_chunks; k++)
-            added += chunks[k].count;
-        if (count + added > capacity) {
-            size_t cap = capacity;
-            while (cap < count + added)
-                cap = cap > SIZE_MAX / 2 ? count + added : 2 * cap;
-            photon_record *p = thz_realloc_array(records, cap, sizeof *p);
-            if (!p) {
-                st = thz_error_set(err, THZ_ERR_NOMEM,
-                                   "photon phase: out of memory for %zu photon records",
-                                   count + added);
-                goto cleanup;
-            }
-            records = p;
-            capacity = cap;
-        }
-        for (long k = 0; k < n_chunks; k++) {
-            const phase_chunk *ch = &chunks[k];
-            if (ch->count)
-                memcpy(records + count, bufs[ch->thread].records + ch->start,
-                       ch->count * sizeof *records);
-            count += ch->count;
-            trace_counters_add(total, &ch->counters);
         }
 
         if (a->progress) {
