@@ -360,22 +360,25 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
 
 #ifdef _OPENMP
     int nt = threads > 0 ? threads : omp_get_max_threads();
-#pragma omp parallel num_threads(nt)
-#pragma omp single
 #else
     (void)threads;
 #endif
-    for (size_t g = 0; g < n_groups; g++) {
-        size_t lo = map->start[g], n = map->start[g + 1] - lo;
-        if (n == 0)
-            continue;
-        photon_record *r = map->records + lo;
-        uint64_t *code = codes + lo;
-        const photon_cube *cube = &map->cubes[g];
-#pragma omp task firstprivate(r, code, n, cube)
-        {
-            for (size_t i = 0; i < n; i++)
-                code[i] = photon_morton(cube, &r[i]);
+    photon_record *rec = map->records;
+    const photon_cube *cubes = map->cubes;
+    const size_t *start = map->start;
+#pragma omp parallel num_threads(nt)
+    {
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < count; i++)
+            codes[i] = photon_morton(&cubes[rec[i].object_side], &rec[i]);
+#pragma omp single
+        for (size_t g = 0; g < n_groups; g++) {
+            size_t lo = start[g], n = start[g + 1] - lo;
+            if (n == 0)
+                continue;
+            photon_record *r = rec + lo;
+            uint64_t *code = codes + lo;
+#pragma omp task firstprivate(r, code, n)
             photon_sort(r, code, n, 1);
         }
     }
