@@ -214,6 +214,8 @@ static uint64_t run_image_bytes(const run_state *rs)
     for (size_t i = 0; i < rs->n_selected; i++) {
         const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
         total += sensor_images_bytes(s->columns, s->rows, rs->scene->n_channels);
+        /* the pixel statistics of the channel being rendered: mean and m2 */
+        total += (uint64_t)s->columns * s->rows * 2u * sizeof(double);
     }
     return total;
 }
