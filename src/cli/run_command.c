@@ -205,6 +205,10 @@ int cli_run_command(int argc, char **argv, bool render)
             if (result.photons_fired)
                 printf(", %llu photons fired, %llu stored", (unsigned long long)result.photons_fired,
                        (unsigned long long)result.photons_stored);
+            if (result.worst_median_stderr_k > 0.0)
+                printf(", median pixel standard error <= %.3g K", result.worst_median_stderr_k);
+            if (result.max_passes > 1)
+                printf(" after up to %u passes", result.max_passes);
             printf(", %.2f s; results in %s\n", result.seconds, a.opt.outdir);
             if (result.n_warnings)
                 fprintf(stderr, "thzmap %s: %zu run warning%s, see %s/summary.json\n", cmd,

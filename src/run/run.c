@@ -472,6 +472,11 @@ static void run_fill_result(const run_state *rs, run_result *result, double t_st
     for (size_t i = 0; i < rs->n_selected; i++)
         result->back_face_samples += rs->back_face[rs->selected[i]];
     result->n_warnings = rs->n_warnings;
+    for (size_t c = 0; c < rs->scene->n_channels; c++) {
+        result->worst_median_stderr_k = fmax(result->worst_median_stderr_k, rs->median_stderr_k[c]);
+        if (rs->passes[c] > result->max_passes)
+            result->max_passes = rs->passes[c];
+    }
     result->seconds = run_now_s() - t_start;
 }
 

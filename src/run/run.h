@@ -57,6 +57,9 @@ typedef struct run_result {
     uint64_t photons_stored;
     uint64_t back_face_samples;   /* over all sensors and channels */
     size_t n_warnings;            /* run warnings written to summary.json */
+    double worst_median_stderr_k; /* largest over channels of the median per-pixel standard
+                                     error of Tb_c, K (0 if not estimated) */
+    uint32_t max_passes;          /* most render passes of any channel */
     double seconds;               /* wall time of the run */
 } run_result;
 
