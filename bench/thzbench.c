@@ -74,10 +74,16 @@ static bool bench_read_all(int fd, void *buf, size_t n)
     return true;
 }
 
-/* Runs fn(arg, out) in a child; out (size bytes) comes back through a pipe. *peak_bytes
- * is the child's peak resident memory. */
+/* What the OS reports for a child: its peak resident memory and CPU time (user +
+ * system, all threads: against wall time it shows how many cores the child got). */
+typedef struct bench_usage {
+    uint64_t peak_bytes;
+    double cpu_s;
+} bench_usage;
+
+/* Runs fn(arg, out) in a child; out (size bytes) comes back through a pipe. */
 static thz_status bench_fork(bench_job_fn fn, const void *arg, void *out, size_t size,
-                             uint64_t *peak_bytes, thz_error *err)
+                             bench_usage *usage, thz_error *err)
 {
     int fds[2];
     if (pipe(fds) != 0)
@@ -108,8 +114,11 @@ static thz_status bench_fork(bench_job_fn fn, const void *arg, void *out, size_t
     memset(&ru, 0, sizeof ru);
     while (wait4(pid, &wstatus, 0, &ru) < 0 && errno == EINTR) {
     }
-    if (peak_bytes)
-        *peak_bytes = (uint64_t)ru.ru_maxrss * 1024u; /* Linux: kilobytes */
+    if (usage) {
+        usage->peak_bytes = (uint64_t)ru.ru_maxrss * 1024u; /* Linux: kilobytes */
+        usage->cpu_s = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+                       (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+    }
     if (!ok || !WIFEXITED(wstatus) || WEXITSTATUS(wstatus) != 0)
         return thz_error_set(err, THZ_ERR_INTERNAL, "bench: a measurement process failed");
     if (h.status != THZ_OK) {
@@ -195,7 +204,7 @@ static void bench_target(bench_targets *t, const char *name, double value, const
     t->total++;
 }
 
-static void bench_usage(FILE *f)
+static void bench_print_usage(FILE *f)
 {
     fprintf(f, "usage: thzbench [--small] [--json PATH] [--threads N] [--scene PATH] [--no-e2e]\n"
                "  --small      counts shrunk to seconds (CI); speed targets are not meaningful\n"
@@ -224,14 +233,14 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
             threads = atoi(argv[++i]);
             if (threads < 1) {
-                bench_usage(stderr);
+                bench_print_usage(stderr);
                 return 2;
             }
         } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            bench_usage(stdout);
+            bench_print_usage(stdout);
             return 0;
         } else {
-            bench_usage(stderr);
+            bench_print_usage(stderr);
             return 2;
         }
     }
@@ -278,10 +287,11 @@ int main(int argc, char **argv)
 
     /* 1. The paper's case. */
     bench_paper paper;
-    uint64_t paper_peak = 0;
+    bench_usage paper_use = {0, 0.0};
     bench_job jp = {.scene = scene, .outdir = outdir, .photons = paper_photons, .threads = threads};
     double load_paper = bench_load1();
-    st = bench_fork(bench_job_paper, &jp, &paper, sizeof paper, &paper_peak, &err);
+    st = bench_fork(bench_job_paper, &jp, &paper, sizeof paper, &paper_use, &err);
+    const uint64_t paper_peak = paper_use.peak_bytes;
     if (st != THZ_OK)
         goto fail;
     double bpp = bench_ratio((double)paper.largest_map_bytes, (double)paper.largest_map_stored);
@@ -302,6 +312,8 @@ int main(int argc, char **argv)
     printf("  photon phase %.3f s: %.3g photons/s, %llu stored (%.3f per photon), %llu rays\n",
            paper.s_photons, pps, (unsigned long long)paper.stored,
            bench_ratio((double)paper.stored, (double)paper.fired), (unsigned long long)paper.rays);
+    printf("  %.1f CPU s over %.1f s wall: %.2f cores on average\n", paper_use.cpu_s,
+           paper.s_total, bench_ratio(paper_use.cpu_s, paper.s_total));
     printf("  largest photon map %.1f MB, %.2f bytes per stored photon; peak memory %.1f MB "
            "(%.2f x the map)\n",
            (double)paper.largest_map_bytes / 1e6, bpp, (double)paper_peak / 1e6,
@@ -326,22 +338,25 @@ int main(int argc, char **argv)
     json_object_set_new(jpaper, "peak_memory_bytes", json_integer((json_int_t)paper_peak));
     json_object_set_new(jpaper, "peak_memory_over_map", bench_real(bench_ratio((double)paper_peak, (double)paper.largest_map_bytes)));
     json_object_set_new(jpaper, "load_average", bench_real(load_paper));
+    json_object_set_new(jpaper, "cpu_seconds", bench_real(paper_use.cpu_s));
 
     bench_e2e e2e_r;
     memset(&e2e_r, 0, sizeof e2e_r);
-    uint64_t e2e_peak = 0;
+    bench_usage e2e_use = {0, 0.0};
     if (e2e) {
         double l = bench_load1();
-        st = bench_fork(bench_job_e2e, &jp, &e2e_r, sizeof e2e_r, &e2e_peak, &err);
+        st = bench_fork(bench_job_e2e, &jp, &e2e_r, sizeof e2e_r, &e2e_use, &err);
+        const uint64_t e2e_peak = e2e_use.peak_bytes;
         if (st != THZ_OK)
             goto fail;
         printf("  end to end through run_simulate (thzmap simulate): %.3f s (load %.3f s), peak "
-               "memory %.1f MB (load average %.2f)\n",
-               e2e_r.s_total, e2e_r.s_load, (double)e2e_peak / 1e6, l);
+               "memory %.1f MB, %.1f CPU s (load average %.2f)\n",
+               e2e_r.s_total, e2e_r.s_load, (double)e2e_peak / 1e6, e2e_use.cpu_s, l);
         json_t *je = json_object();
         json_object_set_new(je, "seconds", bench_real(e2e_r.s_total));
         json_object_set_new(je, "seconds_load", bench_real(e2e_r.s_load));
         json_object_set_new(je, "peak_memory_bytes", json_integer((json_int_t)e2e_peak));
+        json_object_set_new(je, "cpu_seconds", bench_real(e2e_use.cpu_s));
         json_object_set_new(je, "photons_stored", json_integer((json_int_t)e2e_r.stored));
         json_object_set_new(je, "load_average", bench_real(l));
         json_object_set_new(jpaper, "run_simulate", je);
@@ -449,17 +464,18 @@ int main(int argc, char **argv)
     bench_job jn = j1;
     jn.threads = threads;
     double load_th = bench_load1();
-    st = bench_fork(bench_job_series, &j1, &th1, sizeof th1, NULL, &err);
+    bench_usage use1 = {0, 0.0}, usen = {0, 0.0};
+    st = bench_fork(bench_job_series, &j1, &th1, sizeof th1, &use1, &err);
     if (st == THZ_OK)
-        st = bench_fork(bench_job_series, &jn, &thn, sizeof thn, NULL, &err);
+        st = bench_fork(bench_job_series, &jn, &thn, sizeof thn, &usen, &err);
     if (st != THZ_OK)
         goto fail;
     double speedup = bench_ratio(th1.p[0].s_photons, thn.p[0].s_photons);
     double speedup_raw = bench_ratio(th1.p[0].s_probe, thn.p[0].s_probe);
     printf("\n   Threads (%llu photons, channel %zu; load average %.2f): photon phase %.3f s on 1, "
-           "%.3f s on %d: speed-up %.2f (raw Embree: %.2f)\n",
+           "%.3f s on %d: speed-up %.2f (raw Embree: %.2f); CPU s of the runs %.2f and %.2f\n",
            (unsigned long long)thread_photons, series_channel + 1, load_th, th1.p[0].s_photons,
-           thn.p[0].s_photons, threads, speedup, speedup_raw);
+           thn.p[0].s_photons, threads, speedup, speedup_raw, use1.cpu_s, usen.cpu_s);
     json_t *jth = json_object();
     json_object_set_new(jth, "photons", json_integer((json_int_t)thread_photons));
     json_object_set_new(jth, "threads", json_integer(threads));
@@ -467,6 +483,8 @@ int main(int argc, char **argv)
     json_object_set_new(jth, "seconds_all", bench_real(thn.p[0].s_photons));
     json_object_set_new(jth, "speedup", bench_real(speedup));
     json_object_set_new(jth, "raw_speedup", bench_real(speedup_raw));
+    json_object_set_new(jth, "cpu_seconds_1", bench_real(use1.cpu_s));
+    json_object_set_new(jth, "cpu_seconds_all", bench_real(usen.cpu_s));
     json_object_set_new(jth, "load_average", bench_real(load_th));
     json_object_set_new(root, "scaling_threads", jth);
 
