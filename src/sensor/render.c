@@ -7,19 +7,21 @@
  * and across a free path of transmittance tau, L_in - B0 = tau (L_far - B0) + (tau - 1) B0;
  * nothing hit, or the back of a one-sided solid, is L - B0 = -B0. A path samples nu from
  * g_c, adds the bracket at every hit (times the product beta of the transmittances so
- * far), continues by Russian roulette with probabilities R (cosine reflection) and
+ * far) and continues by Russian roulette with probabilities R (cosine reflection) and
  * T(theta) (straight: unchanged; diffuse: exit mu ~ T(mu) mu), which makes the BRDF and
- * BTDF weights exactly 1 (at the first hit it splits instead: render_path_trace), and
- * returns  Bbar0 + sum, with Bbar0 the band mean of B0 by the
- * channel quadrature. E[B0(nu)] = Bbar0, so the estimate is unbiased for the band mean of
- * L for any T0 (B0 is an additive control variate, in space and in frequency). The terms
- * of the first free path and the first hit are known functions of nu once the sample's
- * first hit is known: they enter by their band mean (the channel quadrature, as the
- * photon-map emission), not at the path's nu, so a black surface seen through an
- * attenuating atmosphere comes out deterministic. In an
- * isothermal enclosure at T0 every bracket is exactly 0, so every path returns Bbar0:
- * N_c = 1 to rounding. T0 is the temperature of the object with the largest emitting
- * area x hemispherical emissivity at the channel centre (the walls of a room). */
+ * BTDF weights exactly 1. The estimate is Bbar0 + the sum, Bbar0 the band mean of B0 by
+ * the channel quadrature; E[B0(nu)] = Bbar0, so it is unbiased for the band mean of L
+ * for any T0 (B0 is an additive control variate, in space and in frequency).
+ *
+ * Two refinements at the sample's first hit, which all its paths share: the terms of
+ * the first free path and the first hit are known functions of nu there, so they enter
+ * by their band mean (the channel quadrature, as photon-map's emission), not at the
+ * path's nu; and the path splits there (a reflected branch weighted R, a transmitted one
+ * weighted T(theta)) instead of playing roulette.
+ *
+ * In an isothermal enclosure at T0 every bracket is exactly 0, so every path returns
+ * Bbar0: N_c = 1 to rounding. T0 is the temperature of the object with the largest
+ * area x sides x hemispherical emissivity at the channel centre (the walls of a room). */
 #include "sensor/render.h"
 
 #include <math.h>
