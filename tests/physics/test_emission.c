@@ -253,12 +253,85 @@ static void test_direction_distribution(void **state)
     }
 }
 
+
+/* The group is drawn from a tabulation q_g on a grid over the band and the photon
+ * carries w_g Q / (q_g K), w_g exact: a reflectivity line lying wholly between two grid
+ * nodes, which the tabulation cannot see, must still get exactly its share of the
+ * power (eq. 5 in the band mean). Object a: a solid whose R(nu) is 0 but 1 on a
+ * plateau filling most of the gap between two nodes near the centre (no emission
+ * there); b: a black solid at the same temperature (a group of its own, constant
+ * optics). Without the exact w_g, a's share would be 0.5 instead of 0.494 (~6 se). */
+static void test_line_between_nodes(void **state)
+{
+    (void)state;
+    uint64_t n = ps_scaled(400000);
+    thz_scene *s = ps_scene(0.35, 0.1, n, 7);
+    size_t lined = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t black = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t a = ps_object(s, OBJECT_SOLID, lined, 300, 0, false);
+    ps_face(s, a, v3(0, 0, 0), v3(0.5, 0, 0), v3(0, 0.5, 0));
+    size_t b = ps_object(s, OBJECT_SOLID, black, 300, 0, false);
+    ps_face(s, b, v3(2, 0, 0), v3(0.5, 0, 0), v3(0, 0.5, 0));
+    const thz_channel *ch = &s->channels[0];
+    double sigma = channel_sigma_hz(ch);
+    double step = 2.0 * EMISSION_TABLE_SIGMAS * sigma / (EMISSION_TABLE_NODES - 1);
+    double c = ch->center_hz; /* a node: the grid is symmetric about the centre */
+    const double fr[4] = {c + 0.05 * step, c + 0.06 * step, c + 0.94 * step, c + 0.95 * step};
+    const double rv[4] = {0.0, 1.0, 1.0, 0.0};
+    ps_check(spectrum_set_table(&s->materials[lined].reflectivity, 4, fr, rv));
+    ps_finalize(s);
+
+    /* Expected share of a: band means by a fine Simpson rule over +-8.5 sigma. */
+    const int m = 400000;
+    double lo = c - 8.5 * sigma, h = 17.0 * sigma / m, wa = 0.0, wb = 0.0;
+    for (int i = 0; i <= m; i++) {
+        double nu = lo + i * h, g = exp(-0.5 * ((nu - c) / sigma) * ((nu - c) / sigma));
+        double k = (i == 0 || i == m) ? 1 : (i % 2 ? 4 : 2);
+        double bb = k * g * planck_radiance(nu, 300);
+        wa += bb * (1.0 - spectrum_eval(&s->materials[lined].reflectivity, nu));
+        wb += bb;
+    }
+    double p = wa / (wa + wb);
+    assert_true(1.0 - wa / wb > 0.01); /* the line takes more than 1 % of a's power */
+
+    emission_table t;
+    thz_error err;
+    assert_int_equal(emission_table_init(&t, s, 0, n, &err), THZ_OK);
+    assert_int_equal(t.n_groups, 2);
+    double pa = 0.0, fired = 0.0, sum2 = 0.0;
+    uint64_t zero = 0;
+    double scratch[2];
+    for (uint64_t i = 0; i < n; i++) {
+        rng_stream rng;
+        rng_init(&rng, 7, 0, RNG_PURPOSE_PHOTON, i);
+        emission_photon e;
+        if (!emission_sample(&t, &rng, scratch, &e)) {
+            zero++;
+            continue;
+        }
+        fired += e.power_w_per_hz;
+        sum2 += e.power_w_per_hz * e.power_w_per_hz;
+        if (e.object == a)
+            pa += e.power_w_per_hz;
+    }
+    double f = pa / fired;
+    double se = sqrt(p * (1.0 - p) / (double)n) * 1.2; /* spread of powers: a few % */
+    printf("# line between nodes: a's power share %.5f expected %.5f (%.1f se), %llu photons of "
+           "power 0\n",
+           f, p, (f - p) / se, (unsigned long long)zero);
+    assert_true(fabs(f - p) < 5.0 * se);
+    assert_true(zero > 0); /* photons drawn from a inside the line carry nothing */
+    emission_table_fini(&t);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_frequencies_follow_band),
         cmocka_unit_test(test_source_fractions),
         cmocka_unit_test(test_direction_distribution),
+        cmocka_unit_test(test_line_between_nodes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
