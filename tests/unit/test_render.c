@@ -273,6 +273,18 @@ static void test_passes_are_deterministic(void **state)
     *s = saved;
 }
 
+/* render_stderr_k: a radiance error converted to K with dTb/dL at the pixel's Tb. */
+static void test_stderr_in_kelvin(void **state)
+{
+    (void)state;
+    const double nu = 0.6e12, tb = 300.0;
+    double l = planck_radiance(nu, tb), dl = 1e-4 * l;
+    double dt = planck_brightness_temperature(nu, l + dl) - planck_brightness_temperature(nu, l - dl);
+    double expect = dt / 2.0; /* K per dl */
+    assert_true(fabs(render_stderr_k(nu, tb, dl) - expect) <= 1e-5 * expect);
+    assert_true(render_stderr_k(nu, 0.0, dl) == 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -282,6 +294,7 @@ int main(void)
         cmocka_unit_test(test_cancel),
         cmocka_unit_test(test_integrator_table),
         cmocka_unit_test(test_passes_are_deterministic),
+        cmocka_unit_test(test_stderr_in_kelvin),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
