@@ -64,6 +64,9 @@ typedef struct render_context {
     double *b0;              /* path: [node] B_nu(T0) */
     double *source_mean;     /* path: [object] band mean of eps B - A B0 for solids; NAN
                                 for shells (angle-dependent) */
+    bool emitting;           /* emitting atmosphere (docs/atmosphere.md) */
+    double *air_planck;      /* emitting: [node] B_nu(T_air) */
+    double *bg_planck;       /* emitting: [node] B_nu(T_background) */
 } render_context;
 
 /* The `straight` shells a sample ray has passed through: the path weight at frequency nu
@@ -196,6 +199,8 @@ static void render_context_fini(render_context *ctx)
     free(ctx->tbar);
     free(ctx->b0);
     free(ctx->source_mean);
+    free(ctx->air_planck);
+    free(ctx->bg_planck);
     memset(ctx, 0, sizeof *ctx);
 }
 
@@ -289,7 +294,37 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         }
         ctx->source_mean[o] = scene->objects[o].type == OBJECT_SOLID ? sum : NAN;
     }
+    const thz_atmosphere *atm = &scene->atmosphere;
+    if (atm->emitting) {
+        ctx->emitting = true;
+        ctx->air_planck = thz_malloc_array(n ? n : 1, sizeof *ctx->air_planck);
+        ctx->bg_planck = thz_malloc_array(n ? n : 1, sizeof *ctx->bg_planck);
+        if (!ctx->air_planck || !ctx->bg_planck) {
+            render_context_fini(ctx);
+            return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
+        }
+        /* The same call as b0: air at T0 gives B_air == B0 bit for bit, so the path
+         * estimator's air terms (B_air - B0)(1 - tau) vanish exactly in the furnace. */
+        for (size_t k = 0; k < n; k++) {
+            double nu = ctx->quad.freq_hz[k];
+            ctx->air_planck[k] = planck_radiance(nu, atm->air.temperature_k);
+            ctx->bg_planck[k] = planck_radiance(nu, atm->background_temperature_k);
+        }
+    }
     return THZ_OK;
+}
+
+/* exp(-alpha d), 1 where alpha = 0 (also for d infinite). */
+static double render_tau(double alpha_per_m, double distance_m)
+{
+    return alpha_per_m > 0.0 ? exp(-alpha_per_m * distance_m) : 1.0;
+}
+
+/* Distance from origin_m along dir to where the ray leaves the atmosphere's extent. */
+static double render_exit_m(const render_context *ctx, vec3 origin_m, vec3 dir)
+{
+    const double o[3] = {origin_m.x, origin_m.y, origin_m.z}, d[3] = {dir.x, dir.y, dir.z};
+    return atmosphere_extent_exit_m(&ctx->scene->atmosphere, o, d);
 }
 
 /* Product of T(theta) of the crossed straight shells at frequency freq_hz. */
@@ -381,6 +416,19 @@ static double render_scatter_weight(const render_context *ctx, const render_scat
            s->pdf_ratio * s->inv_branch;
 }
 
+/* The first vertex's scattering weight at quadrature node k, without 1 / P(branch). */
+static double render_scatter_node(const render_context *ctx, const render_scatter *s, size_t k)
+{
+    size_t n = ctx->quad.n;
+    const optics_point *ox = &ctx->optics[(size_t)s->object_index * n + k];
+    if (!s->transmitted)
+        return ox->reflectivity;
+    double tbar = ctx->tbar[(size_t)s->object_index * n + k];
+    return tbar > 0.0 ? optics_transmission(ox, s->mu_i) * optics_transmission(ox, s->mu_o) /
+                            tbar * s->pdf_ratio
+                      : 0.0;
+}
+
 /* Final-gather's secondary emission: the band mean, by the channel quadrature, of
  * eps(theta) B_nu(T) at the secondary hit times the straight-shell path weight,
  * exp(-alpha d) and the first vertex's scattering weight, all at each node: the gather
@@ -394,18 +442,9 @@ static double render_emission_scattered(const render_context *ctx, uint32_t obje
     size_t n = ctx->quad.n;
     const optics_point *op = &ctx->optics[(size_t)object * n];
     const double *planck = &ctx->planck[(size_t)object * n];
-    const optics_point *ox = &ctx->optics[(size_t)s->object_index * n];
-    const double *tbar_x = &ctx->tbar[(size_t)s->object_index * n];
     double sum = 0.0;
     for (size_t k = 0; k < n; k++) {
-        double f;
-        if (!s->transmitted)
-            f = ox[k].reflectivity;
-        else
-            f = tbar_x[k] > 0.0 ? optics_transmission(&ox[k], s->mu_i) *
-                                      optics_transmission(&ox[k], s->mu_o) / tbar_x[k] *
-                                      s->pdf_ratio
-                                : 0.0;
+        double f = render_scatter_node(ctx, s, k);
         double v = ctx->quad.weight[k] * f * optics_emissivity(&op[k], mu) * planck[k];
         for (size_t i = 0; i < path->n && v != 0.0; i++)
             v *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
@@ -414,6 +453,39 @@ static double render_emission_scattered(const render_context *ctx, uint32_t obje
         sum += v;
     }
     return sum * s->inv_branch;
+}
+
+/* The emitting air along one free segment of a sample or gather ray, from distance d0_m
+ * to d1_m from the sensor: the band mean, by the channel quadrature, of
+ * B_nu(T_air) (exp(-alpha d0) - exp(-alpha d1)), i.e. the segment's path radiance
+ * B(1 - exp(-alpha (d1 - d0))) weighted by the transmittance before it, times the
+ * straight-shell path weight and the first vertex's scattering weight (s may be NULL).
+ * `escaped`: the ray hits nothing and d1_m is where it leaves the extent (may be
+ * infinite); the background B_nu(T_bg) exp(-alpha d1) is added. 0 when the air does
+ * not emit. */
+static double render_air(const render_context *ctx, const render_path *path,
+                         const render_scatter *s, double d0_m, double d1_m, bool escaped)
+{
+    if (!ctx->emitting)
+        return 0.0;
+    size_t n = ctx->quad.n;
+    double sum = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        double a = ctx->alpha_per_m[k];
+        double t1 = render_tau(a, d1_m);
+        double v = ctx->air_planck[k] * (render_tau(a, d0_m) - t1);
+        if (escaped)
+            v += ctx->bg_planck[k] * t1;
+        if (v == 0.0)
+            continue;
+        v *= ctx->quad.weight[k];
+        if (s)
+            v *= render_scatter_node(ctx, s, k);
+        for (size_t i = 0; i < path->n && v != 0.0; i++)
+            v *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
+        sum += v;
+    }
+    return s ? sum * s->inv_branch : sum;
 }
 
 /* Accumulator of one gather over one side of the hit object. */
@@ -552,9 +624,14 @@ static double render_photon_map_trace(const render_context *ctx, vec3 origin_m, 
                              &hit)) {
             if (crossings == 0)
                 out->escaped = 1;
+            if (ctx->emitting)
+                radiance += render_air(ctx, &path, scatter, distance_m,
+                                       distance_m + render_exit_m(ctx, origin_m, dir), true);
             return radiance;
         }
+        double d0_m = distance_m;
         distance_m += hit.distance_m;
+        radiance += render_air(ctx, &path, scatter, d0_m, distance_m, false);
         const thz_object *obj = &ctx->scene->objects[hit.object];
         if (!scene_object_side_is_front(obj, hit.side)) {
             out->back_face = 1;
@@ -679,9 +756,16 @@ static void render_final_gather_sample(const render_context *ctx, vec3 origin_m,
                              &hit)) {
             if (path.n == 0)
                 out->escaped = 1;
+            if (ctx->emitting)
+                render_add_all(t, render_air(ctx, &path, NULL, distance_m,
+                                             distance_m + render_exit_m(ctx, origin_m, dir),
+                                             true));
             return;
         }
+        double d0_m = distance_m;
         distance_m += hit.distance_m;
+        if (ctx->emitting)
+            render_add_all(t, render_air(ctx, &path, NULL, d0_m, distance_m, false));
         const thz_object *obj = &ctx->scene->objects[hit.object];
         if (!scene_object_side_is_front(obj, hit.side)) {
             out->back_face = 1;
@@ -737,11 +821,13 @@ static bool render_scatter_dir(const optics_point *o, vec3 n_seen, bool transmit
 }
 
 /* Continues a path leaving `from` along dir with throughput beta at frequency nu (B0 =
- * b0 there): the sum of the terms of every later free path and hit (see the top of this
- * file), with Russian roulette on R and T(theta) at each hit. */
+ * b0 there; b_air = B_nu(T_air) of an emitting atmosphere, else unused): the sum of the
+ * terms of every later free path and hit (see the top of this file), with Russian
+ * roulette on R and T(theta) at each hit. An emitting atmosphere turns a free path's term
+ * (tau - 1) B0 into (1 - tau)(B_air - B0) and the escape term -B0 into L_escape - B0. */
 static double render_path_continue(const render_context *ctx, const accel_hit *from, vec3 dir,
-                                   double nu, double b0, double beta, rng_stream *rng,
-                                   render_sample *out)
+                                   double nu, double b0, double b_air, double beta,
+                                   rng_stream *rng, render_sample *out)
 {
     const thz_scene *scene = ctx->scene;
     double sum = 0.0;
@@ -752,7 +838,14 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
         uint32_t from_object = hit.object, from_triangle = hit.triangle;
         if (!accel_intersect(ctx->accel, origin, dir, INFINITY, from_object, from_triangle,
                              &hit)) {
-            sum -= beta * b0;
+            if (ctx->emitting) {
+                double a = atmosphere_alpha_per_m(&scene->atmosphere, nu);
+                double tau = render_tau(a, render_exit_m(ctx, origin, dir));
+                double b_bg = planck_radiance(nu, scene->atmosphere.background_temperature_k);
+                sum += beta * (b_bg * tau + b_air * (1.0 - tau) - b0);
+            } else {
+                sum -= beta * b0;
+            }
             break;
         }
         if (bounce >= RENDER_MAX_BOUNCES) {
@@ -767,7 +860,10 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
                            ? fabs(v3_dot(to_hit, v3_from_floats(hn))) / hit.cos_theta
                            : v3_length(to_hit);
             double tau = atmosphere_transmittance(&scene->atmosphere, nu, d);
-            sum += beta * (tau - 1.0) * b0;
+            if (ctx->emitting)
+                sum += beta * (1.0 - tau) * (b_air - b0);
+            else
+                sum += beta * (tau - 1.0) * b0;
             beta *= tau;
         }
         const thz_object *obj = &scene->objects[hit.object];
@@ -811,6 +907,8 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
     const thz_scene *scene = ctx->scene;
     double nu = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
     double b0 = planck_radiance(nu, ctx->t0_k);
+    double t_air = scene->atmosphere.air.temperature_k;
+    double b_air = !ctx->emitting ? 0.0 : t_air == ctx->t0_k ? b0 : planck_radiance(nu, t_air);
     double beta = ctx->atmosphere
                       ? atmosphere_transmittance(&scene->atmosphere, nu, first->distance_m)
                       : 1.0;
@@ -824,12 +922,12 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
     double sum = 0.0;
     vec3 dir;
     if (r > 0.0 && render_scatter_dir(&o, n_seen, false, rng, &dir))
-        sum += r * render_path_continue(ctx, first, dir, nu, b0, beta, rng, out);
+        sum += r * render_path_continue(ctx, first, dir, nu, b0, b_air, beta, rng, out);
     if (tr > 0.0) {
         bool straight = scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
         dir = dir0;
         if (straight || render_scatter_dir(&o, n_seen, true, rng, &dir))
-            sum += tr * render_path_continue(ctx, first, dir, nu, b0, beta, rng, out);
+            sum += tr * render_path_continue(ctx, first, dir, nu, b0, b_air, beta, rng, out);
     }
     out->paths++;
     return sum;
@@ -851,8 +949,9 @@ static double render_path_first(const render_context *ctx, const accel_hit *hit)
         double tau = ctx->atmosphere ? exp(-ctx->alpha_per_m[k] * hit->distance_m) : 1.0;
         double a = optics_absorption(&op[k], hit->cos_theta);
         double eps = optics_emissivity(&op[k], hit->cos_theta);
-        sum += ctx->quad.weight[k] *
-               ((tau - 1.0) * ctx->b0[k] + tau * (eps * planck[k] - a * ctx->b0[k]));
+        double free_path = ctx->emitting ? (1.0 - tau) * (ctx->air_planck[k] - ctx->b0[k])
+                                         : (tau - 1.0) * ctx->b0[k];
+        sum += ctx->quad.weight[k] * (free_path + tau * (eps * planck[k] - a * ctx->b0[k]));
     }
     return sum;
 }
@@ -862,12 +961,19 @@ static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 di
 {
     (void)sample_sr;
     accel_hit first;
+    render_path none = {.n = 0};
     if (!accel_intersect(ctx->accel, origin_m, dir, INFINITY, ACCEL_NO_OBJECT, 0, &first)) {
         out->escaped = 1;
-        return; /* radiance 0 for every path */
+        /* radiance 0 for every path, or what the air and the background give */
+        if (ctx->emitting)
+            render_add_all(t, render_air(ctx, &none, NULL, 0.0, render_exit_m(ctx, origin_m, dir),
+                                         true));
+        return;
     }
     if (!scene_object_side_is_front(&ctx->scene->objects[first.object], first.side)) {
         out->back_face = 1;
+        if (ctx->emitting)
+            render_add_all(t, render_air(ctx, &none, NULL, 0.0, first.distance_m, false));
         return;
     }
     double fixed = ctx->b0_mean + render_path_first(ctx, &first);
