@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "photon/air_emission.h"
 #include "photon/emission.h"
 #include "photon/trace.h"
 
@@ -22,6 +23,7 @@ typedef struct phase_fire_args {
     const thz_scene *scene;
     const accel *acc;
     const emission_table *table;
+    const air_emission *air; /* the emitting air, or NULL */
     size_t channel;
     uint64_t n_photons;
     int threads;
@@ -76,7 +78,7 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                     rng_stream rng;
                     rng_init(&rng, seed, channel, RNG_PURPOSE_PHOTON, i);
                     emission_photon e;
-                    if (!emission_sample(a->table, &rng, scr, &e))
+                    if (!air_emission_sample(a->air, a->table, &rng, scr, &e))
                         e.power_w_per_hz = 0.0;
                     if (!trace_photon(a->scene, a->acc, &e, &rng, b, &ch->counters)) {
 #pragma omp atomic write
@@ -185,10 +187,18 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     st = emission_table_init(&table, scene, channel, scene->photons.per_channel, err);
     if (st != THZ_OK)
         return st;
+    double surface_power = scene_band_emitted_power_w_per_hz(scene, channel);
+    air_emission air;
+    st = air_emission_init(&air, scene, channel, scene->photons.per_channel, surface_power, err);
+    if (st != THZ_OK) {
+        emission_table_fini(&table);
+        return st;
+    }
     double t1 = omp_get_wtime();
     phase_fire_args a = {.scene = scene,
                          .acc = acc,
                          .table = &table,
+                         .air = &air,
                          .channel = channel,
                          .n_photons = scene->photons.per_channel,
                          .threads = opt ? opt->threads : 0,
@@ -199,6 +209,8 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     trace_counters c;
     st = phase_fire(&a, &records, &count, &c, err);
     emission_table_fini(&table);
+    double air_power = air.band_power_w_per_hz;
+    air_emission_fini(&air);
     if (st != THZ_OK)
         return st;
     double t2 = omp_get_wtime();
@@ -221,7 +233,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
         stats->back_face_hits = c.back_face_hits;
         stats->terminated = c.terminated + c.capped;
         stats->bounce_capped = c.capped;
-        stats->emitted_power_w_per_hz = scene_band_emitted_power_w_per_hz(scene, channel);
+        stats->emitted_power_w_per_hz = surface_power + air_power; /* surfaces and air */
         stats->fired_power_w_per_hz = c.fired_power;
         stats->absorbed_power_w_per_hz = c.absorbed_power;
         stats->escaped_power_w_per_hz = c.escaped_power;
@@ -252,13 +264,21 @@ thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc,
     st = emission_table_init(&table, scene, channel, k, err);
     if (st != THZ_OK)
         return st;
-    phase_fire_args a = {.scene = scene, .acc = acc, .table = &table, .channel = channel,
-                         .n_photons = pilot};
+    air_emission air;
+    st = air_emission_init(&air, scene, channel, k, scene_band_emitted_power_w_per_hz(scene, channel),
+                           err);
+    if (st != THZ_OK) {
+        emission_table_fini(&table);
+        return st;
+    }
+    phase_fire_args a = {.scene = scene, .acc = acc, .table = &table, .air = &air,
+                         .channel = channel, .n_photons = pilot};
     photon_record *records = NULL;
     size_t count = 0;
     trace_counters c;
     st = phase_fire(&a, &records, &count, &c, err);
     emission_table_fini(&table);
+    air_emission_fini(&air);
     free(records);
     if (st != THZ_OK)
         return st;
