@@ -24,6 +24,7 @@ enum {
     RNG_PURPOSE_RENDER = 2,
     RNG_PURPOSE_PATH = 3,
     RNG_PURPOSE_GATHER = 4,
+    RNG_PURPOSE_AIR_VOLUME = 5, /* photon/air_emission.c: the air's share of the extent */
     RNG_PURPOSE_TEST = 15
 };
 

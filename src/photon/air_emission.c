@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "accel/accel.h"
 #include "core/alloc.h"
 #include "physics/planck.h"
 
@@ -50,8 +49,40 @@ static void air_emission_box(const thz_scene *scene, double min_m[3], double max
     }
 }
 
-thz_status air_emission_init(air_emission *a, const thz_scene *scene, size_t channel,
-                             uint64_t n_photons, double surface_power_w_per_hz, thz_error *err)
+/* A uniform point in the box and an isotropic direction from rng. */
+static void air_emission_point(const air_emission *a, rng_stream *rng, vec3 *p, vec3 *dir)
+{
+    double x[3];
+    for (int k = 0; k < 3; k++)
+        x[k] = a->min_m[k] + rng_uniform(rng) * (a->max_m[k] - a->min_m[k]);
+    *p = v3(x[0], x[1], x[2]);
+    double z = 1.0 - 2.0 * rng_uniform(rng);
+    double s = sqrt(fmax(0.0, 1.0 - z * z)), phi = 2.0 * M_PI * rng_uniform(rng);
+    *dir = v3(s * cos(phi), s * sin(phi), z);
+}
+
+/* Share of air photons that trace_photon keeps: points whose first hit along an isotropic
+ * direction is not the back face of a one-sided solid. */
+static double air_emission_share(const air_emission *a, const accel *acc)
+{
+    const thz_scene *scene = a->scene;
+    uint64_t inside = 0;
+    for (uint64_t i = 0; i < AIR_EMISSION_VOLUME_RAYS; i++) {
+        rng_stream rng;
+        rng_init(&rng, scene->photons.seed, (uint32_t)a->channel, RNG_PURPOSE_AIR_VOLUME, i);
+        vec3 p, dir;
+        air_emission_point(a, &rng, &p, &dir);
+        accel_hit hit;
+        if (accel_intersect(acc, p, dir, INFINITY, ACCEL_NO_OBJECT, 0, &hit) &&
+            !scene_object_side_is_front(&scene->objects[hit.object], hit.side))
+            inside++;
+    }
+    return 1.0 - (double)inside / AIR_EMISSION_VOLUME_RAYS;
+}
+
+thz_status air_emission_init(air_emission *a, const thz_scene *scene, const accel *acc,
+                             size_t channel, uint64_t n_photons, double surface_power_w_per_hz,
+                             thz_error *err)
 {
     memset(a, 0, sizeof *a);
     a->scene = scene;
@@ -95,14 +126,16 @@ thz_status air_emission_init(air_emission *a, const thz_scene *scene, size_t cha
         a->scene = scene;
         return THZ_OK;
     }
-    double acc = 0.0;
+    double sum = 0.0;
     for (size_t i = 0; i < AIR_EMISSION_BINS; i++) {
         a->q[i] = fmax(a->q[i], 1e-6 * peak);
-        acc += a->q[i] * a->bin_hz;
-        a->cdf[i] = acc;
+        sum += a->q[i] * a->bin_hz;
+        a->cdf[i] = sum;
     }
-    a->band_power_w_per_hz = trapezoid / (sigma * sqrt(2.0 * M_PI));
-    a->p_air = a->band_power_w_per_hz / (a->band_power_w_per_hz + fmax(surface_power_w_per_hz, 0.0));
+    a->air_share = air_emission_share(a, acc);
+    a->band_power_w_per_hz = a->air_share * trapezoid / (sigma * sqrt(2.0 * M_PI));
+    a->p_air = a->band_power_w_per_hz /
+               (a->band_power_w_per_hz + fmax(surface_power_w_per_hz, 0.0));
     a->active = true;
     return THZ_OK;
 }
@@ -134,13 +167,7 @@ bool air_emission_sample(const air_emission *a, const emission_table *t, rng_str
     out->freq_hz = nu;
     out->power_w_per_hz = f * a->cdf[AIR_EMISSION_BINS - 1] /
                           (a->q[lo] * sigma * sqrt(2.0 * M_PI) * a->p_air * (double)a->n_photons);
-    double p[3];
-    for (int k = 0; k < 3; k++)
-        p[k] = a->min_m[k] + rng_uniform(rng) * (a->max_m[k] - a->min_m[k]);
-    out->position_m = v3(p[0], p[1], p[2]);
-    double z = 1.0 - 2.0 * rng_uniform(rng);
-    double s = sqrt(fmax(0.0, 1.0 - z * z)), phi = 2.0 * M_PI * rng_uniform(rng);
-    out->dir = v3(s * cos(phi), s * sin(phi), z);
+    air_emission_point(a, rng, &out->position_m, &out->dir);
     out->object = ACCEL_NO_OBJECT;
     out->triangle = 0;
     out->side = 0;

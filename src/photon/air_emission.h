@@ -11,6 +11,12 @@
  *     Phi = g_c(nu) P_air(nu) Q / (q(nu) B_c p_air K),   Q = integral of q,
  * with P_air exact at its own frequency; its point is uniform in the box, its direction
  * isotropic, its object ACCEL_NO_OBJECT (trace_photon starts it from the point itself).
+ * A point inside a solid is not air: an air photon whose first hit is the back face of a
+ * one-sided solid (solids are closed) is dropped by trace_photon, so the photons fire
+ * 4 pi alpha B over the air's true volume in expectation. The reported band power is
+ * Pbar_air times the air's share of the box, estimated from AIR_EMISSION_VOLUME_RAYS
+ * points and isotropic directions tested by the same rule (it only enters the
+ * statistics and p_air, never the photons' powers).
  * Without an emitting atmosphere nothing is drawn for the class, so photon streams are
  * those of a scene without air emission.
  */
@@ -21,6 +27,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "accel/accel.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "photon/emission.h"
@@ -28,6 +35,7 @@
 
 #define AIR_EMISSION_BINS 4096
 #define AIR_EMISSION_SIGMAS 6.0
+#define AIR_EMISSION_VOLUME_RAYS 16384
 
 typedef struct air_emission {
     bool active;                /* the air emits in this channel */
@@ -36,7 +44,8 @@ typedef struct air_emission {
     uint64_t n_photons;         /* K */
     double min_m[3], max_m[3];  /* the emitting box */
     double volume_m3;
-    double band_power_w_per_hz; /* Pbar_air: band mean of P_air */
+    double air_share;           /* estimated share of the box that is air (not in solids) */
+    double band_power_w_per_hz; /* Pbar_air: band mean of P_air, times air_share */
     double p_air;               /* probability of an air photon */
     double lo_hz, bin_hz;       /* bin i covers [lo + i bin, lo + (i + 1) bin) */
     double *q;                  /* AIR_EMISSION_BINS histogram densities q_i (> 0) */
@@ -46,8 +55,9 @@ typedef struct air_emission {
 /* Prepares channel `channel`'s air source for K = n_photons photons, beside surfaces of
  * band-mean power surface_power_w_per_hz. Inactive (and allocating nothing) when the
  * atmosphere does not emit or has no power in the band. */
-thz_status air_emission_init(air_emission *a, const thz_scene *scene, size_t channel,
-                             uint64_t n_photons, double surface_power_w_per_hz, thz_error *err);
+thz_status air_emission_init(air_emission *a, const thz_scene *scene, const accel *acc,
+                             size_t channel, uint64_t n_photons, double surface_power_w_per_hz,
+                             thz_error *err);
 void air_emission_fini(air_emission *a);
 
 /* Draws one photon of either class (see above); the same contract as emission_sample,

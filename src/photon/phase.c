@@ -189,7 +189,8 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
         return st;
     double surface_power = scene_band_emitted_power_w_per_hz(scene, channel);
     air_emission air;
-    st = air_emission_init(&air, scene, channel, scene->photons.per_channel, surface_power, err);
+    st = air_emission_init(&air, scene, acc, channel, scene->photons.per_channel, surface_power,
+                           err);
     if (st != THZ_OK) {
         emission_table_fini(&table);
         return st;
@@ -265,8 +266,8 @@ thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc,
     if (st != THZ_OK)
         return st;
     air_emission air;
-    st = air_emission_init(&air, scene, channel, k, scene_band_emitted_power_w_per_hz(scene, channel),
-                           err);
+    st = air_emission_init(&air, scene, acc, channel, k,
+                           scene_band_emitted_power_w_per_hz(scene, channel), err);
     if (st != THZ_OK) {
         emission_table_fini(&table);
         return st;

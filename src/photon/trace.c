@@ -98,6 +98,16 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
             c->escaped_power += power;
             return true;
         }
+        if (bounce == 0 && e->object == ACCEL_NO_OBJECT &&
+            !scene_object_side_is_front(&scene->objects[hit.object], hit.side)) {
+            /* An air photon born inside a solid (it meets a back face first): there is
+             * no air there, so it was never emitted (counted absorbed, with no power).
+             * Photons carry the power of the whole extent, so the rest fire the air's
+             * true power in expectation (air_emission.h). */
+            c->fired_power -= power;
+            c->absorbed++;
+            return true;
+        }
         /* The free path runs from the surface point along dir, not from the offset
          * origin: its length to the plane of the triangle hit. (From the offset origin
          * it would be short by about eps/cos, a bias of alpha eps / cos.) */
