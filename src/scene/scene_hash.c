@@ -115,8 +115,11 @@ void scene_hash_compute(const thz_scene *scene, scene_hash *out)
             o = hash_double(o, t->alpha_per_m[k]);
     }
     o = hash_word(o, atm->emitting ? 1u : 0u);
-    if (atm->emitting)
+    if (atm->emitting) {
         o = hash_double(o, atm->background_temperature_k);
+        /* constant/table models have no air state: their emitting air's temperature */
+        o = hash_double(o, atm->air.temperature_k);
+    }
     o = hash_word(o, atm->has_extent ? 1u : 0u);
     if (atm->has_extent)
         for (int k = 0; k < 3; k++) {

@@ -13,6 +13,7 @@
 #include "atmosphere/atmosphere.h"
 #include "physics/planck.h"
 #include "scene/scene.h"
+#include "scene/scene_hash.h"
 
 static void constant_atm(thz_atmosphere *atm, double alpha)
 {
@@ -145,12 +146,41 @@ static void test_scene_keys(void **state)
     }
 }
 
+/* The scene hash (which a saved photon map is checked against) sees the emitting flag
+ * and the emitting air's temperature, also for models without an air state. */
+static void test_scene_hash(void **state)
+{
+    (void)state;
+    static const char *const atms[] = {
+        "{\"model\": \"constant\", \"attenuation_per_m\": 0.1}",
+        "{\"model\": \"constant\", \"attenuation_per_m\": 0.1, \"emitting\": true,"
+        " \"temperature_k\": 290, \"background_temperature_k\": 3}",
+        "{\"model\": \"constant\", \"attenuation_per_m\": 0.1, \"emitting\": true,"
+        " \"temperature_k\": 291, \"background_temperature_k\": 3}",
+    };
+    scene_hash h[3];
+    char buf[4096];
+    for (size_t i = 0; i < 3; i++) {
+        thz_scene *s = NULL;
+        thz_error err = {0};
+        if (scene_load_string(scene_with(atms[i], buf, sizeof buf), THZ_SOURCE_DIR, "t.json", &s,
+                              &err) != THZ_OK)
+            fail_msg("%s", err.message);
+        scene_hash_compute(s, &h[i]);
+        scene_destroy(s);
+    }
+    assert_true(h[0].optics != h[1].optics);
+    assert_true(h[1].optics != h[2].optics);
+    assert_true(h[0].geometry == h[2].geometry);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_path_and_volume),
         cmocka_unit_test(test_extent),
         cmocka_unit_test(test_scene_keys),
+        cmocka_unit_test(test_scene_hash),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
