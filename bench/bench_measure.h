@@ -51,15 +51,17 @@ thz_status bench_measure_paper(const char *scene_path, uint64_t photons, int thr
                                const char *outdir, bench_paper *out, thz_error *err);
 thz_status bench_measure_e2e(const char *scene_path, uint64_t photons, int threads,
                              const char *outdir, bench_e2e *out, thz_error *err);
-thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int threads,
+/* Timed phases repeat `repeats` times (>= 1) and keep the fastest: on a shared machine
+ * the minimum is the time least disturbed by other processes. */
+thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int threads, int repeats,
                                bench_probe_out *out, thz_error *err);
 
 /* Photon phase (and, with render, a render of every sensor) of channel `channel` for each
  * of photons[0..n): one point each; with probe, also the raw Embree probe for the same
  * number of rays. */
 thz_status bench_measure_series(const char *scene_path, size_t channel, const uint64_t *photons,
-                                int n, int threads, int render, int probe, bench_series *out,
-                                thz_error *err);
+                                int n, int threads, int render, int probe, int repeats,
+                                bench_series *out, thz_error *err);
 
 /* Writes the tessellated-mesh scene of the triangle scaling into path: an enclosure and
  * four icospheres of `subdivisions` (20 * 4^s triangles each), one channel. */
