@@ -298,7 +298,7 @@ static void test_line_between_nodes(void **state)
     thz_error err;
     assert_int_equal(emission_table_init(&t, s, 0, n, &err), THZ_OK);
     assert_int_equal(t.n_groups, 2);
-    double pa = 0.0, fired = 0.0, sum2 = 0.0;
+    double pa = 0.0, fired = 0.0;
     uint64_t zero = 0;
     double scratch[2];
     for (uint64_t i = 0; i < n; i++) {
@@ -310,7 +310,6 @@ static void test_line_between_nodes(void **state)
             continue;
         }
         fired += e.power_w_per_hz;
-        sum2 += e.power_w_per_hz * e.power_w_per_hz;
         if (e.object == a)
             pa += e.power_w_per_hz;
     }
