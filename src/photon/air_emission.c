@@ -17,7 +17,7 @@ void air_emission_fini(air_emission *a)
     memset(a, 0, sizeof *a);
 }
 
-/* g_c(nu) P_air(nu), W/Hz (unnormalised response). */
+/* g_c(nu) P_air(nu), W/Hz (unnormalised response), over the whole box. */
 static double air_emission_density(const air_emission *a, double sigma_hz, double freq_hz)
 {
     if (!(freq_hz > 0.0))
@@ -28,16 +28,37 @@ static double air_emission_density(const air_emission *a, double sigma_hz, doubl
            atmosphere_volume_emission_w_per_m3_hz(&a->scene->atmosphere, freq_hz);
 }
 
-/* The emitting box: the atmosphere's extent, else the bounding box of every mesh. */
-static void air_emission_box(const thz_scene *scene, double min_m[3], double max_m[3])
+/* L_b(nu): the radiance entering the box from outside (the escape radiance at its
+ * faces). */
+static double air_emission_boundary_radiance(const thz_atmosphere *atm, double freq_hz)
+{
+    if (!atm->has_extent && atmosphere_alpha_per_m(atm, freq_hz) > 0.0)
+        return planck_radiance(freq_hz, atm->air.temperature_k);
+    return planck_radiance(freq_hz, atm->background_temperature_k);
+}
+
+static double air_emission_boundary_at(double freq_hz, void *atm)
+{
+    return air_emission_boundary_radiance(atm, freq_hz);
+}
+
+/* The box: the atmosphere's extent, else the bounding box of every mesh widened by 1 % of
+ * its diagonal on each side (a flat scene still gets a volume, and the faces keep clear
+ * of the surfaces). False if there is none. */
+static bool air_emission_box(const thz_scene *scene, double min_m[3], double max_m[3])
 {
     const thz_atmosphere *atm = &scene->atmosphere;
-    for (int k = 0; k < 3; k++) {
-        min_m[k] = atm->has_extent ? atm->extent_min_m[k] : INFINITY;
-        max_m[k] = atm->has_extent ? atm->extent_max_m[k] : -INFINITY;
+    if (atm->has_extent) {
+        for (int k = 0; k < 3; k++) {
+            min_m[k] = atm->extent_min_m[k];
+            max_m[k] = atm->extent_max_m[k];
+        }
+        return true;
     }
-    if (atm->has_extent)
-        return;
+    for (int k = 0; k < 3; k++) {
+        min_m[k] = INFINITY;
+        max_m[k] = -INFINITY;
+    }
     for (size_t i = 0; i < scene->n_objects; i++) {
         const thz_mesh *m = &scene->objects[i].mesh;
         if (m->n_triangles == 0)
@@ -47,10 +68,20 @@ static void air_emission_box(const thz_scene *scene, double min_m[3], double max
             max_m[k] = fmax(max_m[k], m->bbox_max_m[k]);
         }
     }
+    double d2 = 0.0;
+    for (int k = 0; k < 3; k++)
+        d2 += (max_m[k] - min_m[k]) * (max_m[k] - min_m[k]);
+    if (!(d2 > 0.0) || !isfinite(d2))
+        return false;
+    for (int k = 0; k < 3; k++) {
+        min_m[k] -= 0.01 * sqrt(d2);
+        max_m[k] += 0.01 * sqrt(d2);
+    }
+    return true;
 }
 
-/* A uniform point in the box and an isotropic direction from rng. */
-static void air_emission_point(const air_emission *a, rng_stream *rng, vec3 *p, vec3 *dir)
+/* A uniform point in the box and an isotropic direction. */
+static void air_emission_volume_point(const air_emission *a, rng_stream *rng, vec3 *p, vec3 *dir)
 {
     double x[3];
     for (int k = 0; k < 3; k++)
@@ -61,43 +92,67 @@ static void air_emission_point(const air_emission *a, rng_stream *rng, vec3 *p, 
     *dir = v3(s * cos(phi), s * sin(phi), z);
 }
 
-/* Share of air photons that trace_photon keeps: points whose first hit along an isotropic
- * direction is not the back face of a one-sided solid. */
-static double air_emission_share(const air_emission *a, const accel *acc)
+/* A point uniform over the box's faces (by area) and a cosine-distributed direction
+ * into the box. */
+static void air_emission_face_point(const air_emission *a, rng_stream *rng, vec3 *p, vec3 *dir)
 {
-    const thz_scene *scene = a->scene;
-    uint64_t inside = 0;
-    for (uint64_t i = 0; i < AIR_EMISSION_VOLUME_RAYS; i++) {
-        rng_stream rng;
-        rng_init(&rng, scene->photons.seed, (uint32_t)a->channel, RNG_PURPOSE_AIR_VOLUME, i);
-        vec3 p, dir;
-        air_emission_point(a, &rng, &p, &dir);
-        accel_hit hit;
-        if (accel_intersect(acc, p, dir, INFINITY, ACCEL_NO_OBJECT, 0, &hit) &&
-            !scene_object_side_is_front(&scene->objects[hit.object], hit.side))
-            inside++;
-    }
-    return 1.0 - (double)inside / AIR_EMISSION_VOLUME_RAYS;
+    double x = rng_uniform(rng) * a->face_cdf[5];
+    int f = 0;
+    while (f < 5 && !(a->face_cdf[f] > x))
+        f++;
+    int axis = f / 2;
+    bool at_max = f % 2 == 1;
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = a->min_m[k] + rng_uniform(rng) * (a->max_m[k] - a->min_m[k]);
+    c[axis] = at_max ? a->max_m[axis] : a->min_m[axis];
+    *p = v3(c[0], c[1], c[2]);
+    double nv[3] = {0.0, 0.0, 0.0};
+    nv[axis] = at_max ? -1.0 : 1.0;
+    double u = rng_uniform(rng);
+    *dir = emission_direction(v3(nv[0], nv[1], nv[2]), sqrt(1.0 - u), rng_uniform(rng));
 }
 
-thz_status air_emission_init(air_emission *a, const thz_scene *scene, const accel *acc,
-                             size_t channel, uint64_t n_photons, double surface_power_w_per_hz,
-                             thz_error *err)
+/* Whether a boundary photon at p going along dir comes from outside: a ray from just
+ * inside back out of the box meets nothing. */
+static bool air_emission_open(const air_emission *a, vec3 p, vec3 dir)
 {
-    memset(a, 0, sizeof *a);
-    a->scene = scene;
-    a->channel = channel;
-    a->n_photons = n_photons ? n_photons : 1;
-    if (!scene->atmosphere.emitting)
-        return THZ_OK;
-    air_emission_box(scene, a->min_m, a->max_m);
-    a->volume_m3 = 1.0;
-    for (int k = 0; k < 3; k++)
-        a->volume_m3 *= a->max_m[k] - a->min_m[k];
-    if (!(a->volume_m3 > 0.0) || !isfinite(a->volume_m3))
-        return THZ_OK;
+    accel_hit hit;
+    return !accel_intersect(a->acc, v3_madd(p, a->eps_m, dir), v3_scale(dir, -1.0), INFINITY,
+                            ACCEL_NO_OBJECT, 0, &hit);
+}
 
-    const thz_channel *ch = &scene->channels[channel];
+/* Whether trace_photon keeps a photon starting at p along dir: its first hit is not the
+ * back face of a one-sided solid. */
+static bool air_emission_kept(const air_emission *a, vec3 p, vec3 dir)
+{
+    accel_hit hit;
+    return !accel_intersect(a->acc, p, dir, INFINITY, ACCEL_NO_OBJECT, 0, &hit) ||
+           scene_object_side_is_front(&a->scene->objects[hit.object], hit.side);
+}
+
+/* Shares of air and boundary photons kept, by the rules of sampling and tracing. */
+static void air_emission_shares(air_emission *a)
+{
+    uint64_t air = 0, open = 0;
+    for (uint64_t i = 0; i < AIR_EMISSION_SHARE_RAYS; i++) {
+        rng_stream rng;
+        rng_init(&rng, a->scene->photons.seed, (uint32_t)a->channel, RNG_PURPOSE_AIR_VOLUME, i);
+        vec3 p, dir;
+        air_emission_volume_point(a, &rng, &p, &dir);
+        air += air_emission_kept(a, p, dir);
+        air_emission_face_point(a, &rng, &p, &dir);
+        open += air_emission_open(a, p, dir) && air_emission_kept(a, p, dir);
+    }
+    a->air_share = (double)air / AIR_EMISSION_SHARE_RAYS;
+    a->open_share = (double)open / AIR_EMISSION_SHARE_RAYS;
+}
+
+/* The air's frequency histogram and band power over the whole box (0 if none). */
+static thz_status air_emission_tabulate(air_emission *a, double *power, thz_error *err)
+{
+    *power = 0.0;
+    const thz_channel *ch = &a->scene->channels[a->channel];
     double sigma = channel_sigma_hz(ch);
     double lo = ch->center_hz - AIR_EMISSION_SIGMAS * sigma;
     double hi = ch->center_hz + AIR_EMISSION_SIGMAS * sigma;
@@ -107,10 +162,8 @@ thz_status air_emission_init(air_emission *a, const thz_scene *scene, const acce
     a->bin_hz = (hi - lo) / AIR_EMISSION_BINS;
     a->q = thz_malloc_array(AIR_EMISSION_BINS, sizeof *a->q);
     a->cdf = thz_malloc_array(AIR_EMISSION_BINS, sizeof *a->cdf);
-    if (!a->q || !a->cdf) {
-        air_emission_fini(a);
+    if (!a->q || !a->cdf)
         return thz_error_set(err, THZ_ERR_NOMEM, "air emission: out of memory");
-    }
     /* q_i = the larger node value of the bin (the bins resolve alpha's table far finer
      * than a line), floored at 1e-6 of the peak so that q > 0 wherever g P may be. */
     double prev = air_emission_density(a, sigma, lo), peak = 0.0, trapezoid = 0.0;
@@ -122,8 +175,9 @@ thz_status air_emission_init(air_emission *a, const thz_scene *scene, const acce
         prev = next;
     }
     if (!(peak > 0.0)) {
-        air_emission_fini(a);
-        a->scene = scene;
+        free(a->q);
+        free(a->cdf);
+        a->q = a->cdf = NULL;
         return THZ_OK;
     }
     double sum = 0.0;
@@ -132,25 +186,69 @@ thz_status air_emission_init(air_emission *a, const thz_scene *scene, const acce
         sum += a->q[i] * a->bin_hz;
         a->cdf[i] = sum;
     }
-    a->air_share = air_emission_share(a, acc);
-    a->band_power_w_per_hz = a->air_share * trapezoid / (sigma * sqrt(2.0 * M_PI));
-    a->p_air = a->band_power_w_per_hz /
-               (a->band_power_w_per_hz + fmax(surface_power_w_per_hz, 0.0));
+    *power = trapezoid / (sigma * sqrt(2.0 * M_PI));
+    return THZ_OK;
+}
+
+thz_status air_emission_init(air_emission *a, const thz_scene *scene, const accel *acc,
+                             size_t channel, uint64_t n_photons, double surface_power_w_per_hz,
+                             thz_error *err)
+{
+    memset(a, 0, sizeof *a);
+    a->scene = scene;
+    a->acc = acc;
+    a->channel = channel;
+    a->n_photons = n_photons ? n_photons : 1;
+    const thz_atmosphere *atm = &scene->atmosphere;
+    if (!atm->emitting || !air_emission_box(scene, a->min_m, a->max_m))
+        return THZ_OK;
+    double ext[3], d2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        ext[k] = a->max_m[k] - a->min_m[k];
+        d2 += ext[k] * ext[k];
+    }
+    a->eps_m = 1e-6 * sqrt(d2);
+    a->volume_m3 = ext[0] * ext[1] * ext[2];
+    double sum = 0.0;
+    for (int f = 0; f < 6; f++) {
+        int axis = f / 2;
+        sum += ext[(axis + 1) % 3] * ext[(axis + 2) % 3];
+        a->face_cdf[f] = sum;
+    }
+    a->area_m2 = sum;
+
+    double air_box = 0.0, boundary_box = 0.0;
+    if (a->volume_m3 > 0.0) {
+        thz_status st = air_emission_tabulate(a, &air_box, err);
+        if (st != THZ_OK) {
+            air_emission_fini(a);
+            return st;
+        }
+    }
+    if (a->area_m2 > 0.0)
+        boundary_box = M_PI * a->area_m2 *
+                       channel_band_mean(&scene->channels[channel], air_emission_boundary_at,
+                                         (void *)atm);
+    if (!(air_box > 0.0) && !(boundary_box > 0.0)) {
+        air_emission_fini(a);
+        a->scene = scene;
+        return THZ_OK;
+    }
+    air_emission_shares(a);
+    a->air_power_w_per_hz = a->air_share * air_box;
+    a->boundary_power_w_per_hz = a->open_share * boundary_box;
+    a->band_power_w_per_hz = a->air_power_w_per_hz + a->boundary_power_w_per_hz;
+    double total = a->band_power_w_per_hz + fmax(surface_power_w_per_hz, 0.0);
+    a->p_air = a->air_power_w_per_hz / total;
+    a->p_boundary = a->boundary_power_w_per_hz / total;
+    a->p_surfaces = fmax(surface_power_w_per_hz, 0.0) / total;
     a->active = true;
     return THZ_OK;
 }
 
-bool air_emission_sample(const air_emission *a, const emission_table *t, rng_stream *rng,
-                         double *scratch, emission_photon *out)
+/* An air photon: frequency from the histogram, point and direction uniform. */
+static bool air_emission_air_photon(const air_emission *a, rng_stream *rng, emission_photon *out)
 {
-    if (!a || !a->active)
-        return emission_sample(t, rng, scratch, out);
-    if (!(rng_uniform(rng) < a->p_air)) {
-        bool ok = emission_sample(t, rng, scratch, out);
-        out->power_w_per_hz /= 1.0 - a->p_air;
-        return ok;
-    }
-    /* Bin by the histogram's CDF, then uniform within the bin. */
     double x = rng_uniform(rng) * a->cdf[AIR_EMISSION_BINS - 1];
     size_t lo = 0, hi = AIR_EMISSION_BINS - 1;
     while (lo < hi) {
@@ -161,15 +259,48 @@ bool air_emission_sample(const air_emission *a, const emission_table *t, rng_str
             lo = mid + 1;
     }
     double nu = a->lo_hz + ((double)lo + rng_uniform(rng)) * a->bin_hz;
-    const thz_channel *ch = &a->scene->channels[a->channel];
-    double sigma = channel_sigma_hz(ch);
+    double sigma = channel_sigma_hz(&a->scene->channels[a->channel]);
     double f = air_emission_density(a, sigma, nu);
     out->freq_hz = nu;
     out->power_w_per_hz = f * a->cdf[AIR_EMISSION_BINS - 1] /
                           (a->q[lo] * sigma * sqrt(2.0 * M_PI) * a->p_air * (double)a->n_photons);
-    air_emission_point(a, rng, &out->position_m, &out->dir);
-    out->object = ACCEL_NO_OBJECT;
-    out->triangle = 0;
-    out->side = 0;
+    air_emission_volume_point(a, rng, &out->position_m, &out->dir);
     return out->power_w_per_hz > 0.0;
+}
+
+/* A boundary photon: frequency from g_c, a point on the faces, cosine inwards; dropped
+ * (power 0) where the point is hidden from outside. */
+static bool air_emission_boundary_photon(const air_emission *a, rng_stream *rng,
+                                         emission_photon *out)
+{
+    const thz_channel *ch = &a->scene->channels[a->channel];
+    double u1 = rng_uniform(rng), u2 = rng_uniform(rng);
+    double nu = channel_sample_hz(ch, u1, u2);
+    out->freq_hz = nu;
+    air_emission_face_point(a, rng, &out->position_m, &out->dir);
+    out->power_w_per_hz = 0.0;
+    if (!air_emission_open(a, out->position_m, out->dir))
+        return false;
+    out->power_w_per_hz = M_PI * a->area_m2 *
+                          air_emission_boundary_radiance(&a->scene->atmosphere, nu) /
+                          (a->p_boundary * (double)a->n_photons);
+    return out->power_w_per_hz > 0.0;
+}
+
+bool air_emission_sample(const air_emission *a, const emission_table *t, rng_stream *rng,
+                         double *scratch, emission_photon *out)
+{
+    if (!a || !a->active)
+        return emission_sample(t, rng, scratch, out);
+    double u = rng_uniform(rng);
+    if (u < a->p_air || u < a->p_air + a->p_boundary) {
+        out->object = ACCEL_NO_OBJECT;
+        out->triangle = 0;
+        out->side = 0;
+        return u < a->p_air ? air_emission_air_photon(a, rng, out)
+                            : air_emission_boundary_photon(a, rng, out);
+    }
+    bool ok = emission_sample(t, rng, scratch, out);
+    out->power_w_per_hz = a->p_surfaces > 0.0 ? out->power_w_per_hz / a->p_surfaces : 0.0;
+    return ok;
 }

@@ -1,24 +1,35 @@
 /* The emitting atmosphere as a photon source (docs/atmosphere.md "Emitting atmosphere";
- * beyond the paper). The air inside the atmosphere's extent (the scene's bounding box
- * without one) emits P_air(nu) = 4 pi alpha(nu) B_nu(T_air) V, isotropically.
+ * beyond the paper): the air in a box, and the radiance that enters the box from
+ * outside it.
  *
- * Scheme (unbiased for the band mean, as physics.md "Photon phase" allows): the air is a
- * source class beside the surfaces. Each photon first picks the air with probability
- * p_air = Pbar_air / (Pbar_air + Pbar_A) (band means), else the surfaces by
- * emission_sample, and divides its power by the probability of its class. An air photon's
- * frequency is drawn from a histogram q of g_c(nu) P_air(nu) over nu_c +- 6 sigma
- * (AIR_EMISSION_BINS bins: the air's power follows alpha's lines), and it carries
- *     Phi = g_c(nu) P_air(nu) Q / (q(nu) B_c p_air K),   Q = integral of q,
- * with P_air exact at its own frequency; its point is uniform in the box, its direction
- * isotropic, its object ACCEL_NO_OBJECT (trace_photon starts it from the point itself).
- * A point inside a solid is not air: an air photon whose first hit is the back face of a
- * one-sided solid (solids are closed) is dropped by trace_photon, so the photons fire
- * 4 pi alpha B over the air's true volume in expectation. The reported band power is
- * Pbar_air times the air's share of the box, estimated from AIR_EMISSION_VOLUME_RAYS
- * points and isotropic directions tested by the same rule (it only enters the
- * statistics and p_air, never the photons' powers).
- * Without an emitting atmosphere nothing is drawn for the class, so photon streams are
- * those of a scene without air emission.
+ * The box is the atmosphere's extent, or without one the bounding box of every mesh
+ * widened by 1 % of its diagonal on each side. Two source classes join the surfaces:
+ *
+ * - the air: 4 pi alpha(nu) B_nu(T_air) per unit volume, isotropic, uniform in the box;
+ * - the boundary: each face of the box emits inwards, Lambertian, with the radiance a
+ *   ray leaving the box sees (the renderer's escape radiance there): B_nu(T_bg) with an
+ *   extent; without one the air beyond, B_nu(T_air) where alpha > 0 (else B_nu(T_bg)).
+ *
+ * Scheme (unbiased for the band mean, as physics.md "Photon phase" allows): each photon
+ * picks a class with probability proportional to its band-mean power, then divides its
+ * power by that probability. An air photon's frequency is drawn from a histogram q of
+ * g_c(nu) P_air(nu) over nu_c +- 6 sigma (AIR_EMISSION_BINS bins: the air's power
+ * follows alpha's lines) and it carries Phi = g_c P_air Q / (q B_c p_air K), P_air exact
+ * at its frequency, Q the integral of q; a boundary photon's frequency is drawn from g_c
+ * and it carries pi A L_b(nu) / (p_b K). Their object is ACCEL_NO_OBJECT (trace_photon
+ * starts them from their point).
+ *
+ * Where there is no air or no opening, nothing is emitted: an air photon whose first hit
+ * is the back face of a one-sided solid (it was born inside a solid) is dropped by
+ * trace_photon, and so is a boundary photon whose point is hidden from outside (a ray
+ * back out of the box from just inside it meets a surface) or that first meets a back
+ * face. Photons carry the power of the whole box and faces, so the rest fire the true
+ * power in expectation. The reported band powers are multiplied by the shares kept,
+ * estimated from AIR_EMISSION_SHARE_RAYS points by the same rules (they enter only the
+ * statistics and the class probabilities, never the photons' expected power).
+ *
+ * Without an emitting atmosphere no class uniform is drawn: photon streams are those of
+ * a scene without it.
  */
 #ifndef THZ_PHOTON_AIR_EMISSION_H
 #define THZ_PHOTON_AIR_EMISSION_H
@@ -35,32 +46,42 @@
 
 #define AIR_EMISSION_BINS 4096
 #define AIR_EMISSION_SIGMAS 6.0
-#define AIR_EMISSION_VOLUME_RAYS 16384
+#define AIR_EMISSION_SHARE_RAYS 16384
 
 typedef struct air_emission {
-    bool active;                /* the air emits in this channel */
+    bool active; /* the air or the boundary emits in this channel */
     const thz_scene *scene;
+    const accel *acc;
     size_t channel;
-    uint64_t n_photons;         /* K */
-    double min_m[3], max_m[3];  /* the emitting box */
+    uint64_t n_photons;        /* K */
+    double min_m[3], max_m[3]; /* the box */
+    double eps_m;              /* step inside the box for the boundary's visibility test */
+    /* the air */
     double volume_m3;
-    double air_share;           /* estimated share of the box that is air (not in solids) */
-    double band_power_w_per_hz; /* Pbar_air: band mean of P_air, times air_share */
-    double p_air;               /* probability of an air photon */
+    double air_share;           /* estimated share of air photons kept (not in solids) */
+    double air_power_w_per_hz;  /* band mean of P_air over the box, times air_share */
     double lo_hz, bin_hz;       /* bin i covers [lo + i bin, lo + (i + 1) bin) */
-    double *q;                  /* AIR_EMISSION_BINS histogram densities q_i (> 0) */
+    double *q;                  /* AIR_EMISSION_BINS histogram densities (> 0), or NULL */
     double *cdf;                /* cumulative q_i bin_hz; last = Q */
+    /* the boundary */
+    double area_m2;                  /* of the box's six faces */
+    double face_cdf[6];              /* cumulative face areas */
+    double open_share;               /* estimated share of boundary photons kept */
+    double boundary_power_w_per_hz;  /* pi A band mean of L_b, times open_share */
+    /* class probabilities: air, boundary, surfaces */
+    double p_air, p_boundary, p_surfaces;
+    double band_power_w_per_hz; /* air + boundary: to add to the surfaces' Pbar_A */
 } air_emission;
 
-/* Prepares channel `channel`'s air source for K = n_photons photons, beside surfaces of
- * band-mean power surface_power_w_per_hz. Inactive (and allocating nothing) when the
- * atmosphere does not emit or has no power in the band. */
+/* Prepares channel `channel`'s air and boundary sources for K = n_photons photons,
+ * beside surfaces of band-mean power surface_power_w_per_hz. Inactive when the
+ * atmosphere does not emit or nothing has power in the band. */
 thz_status air_emission_init(air_emission *a, const thz_scene *scene, const accel *acc,
                              size_t channel, uint64_t n_photons, double surface_power_w_per_hz,
                              thz_error *err);
 void air_emission_fini(air_emission *a);
 
-/* Draws one photon of either class (see above); the same contract as emission_sample,
+/* Draws one photon of any class (see above); the same contract as emission_sample,
  * which it calls for surface photons. Allocates nothing. */
 bool air_emission_sample(const air_emission *a, const emission_table *t, rng_stream *rng,
                          double *scratch, emission_photon *out);

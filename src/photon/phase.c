@@ -234,7 +234,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
         stats->back_face_hits = c.back_face_hits;
         stats->terminated = c.terminated + c.capped;
         stats->bounce_capped = c.capped;
-        stats->emitted_power_w_per_hz = surface_power + air_power; /* surfaces and air */
+        stats->emitted_power_w_per_hz = surface_power + air_power; /* + air, boundary */
         stats->fired_power_w_per_hz = c.fired_power;
         stats->absorbed_power_w_per_hz = c.absorbed_power;
         stats->escaped_power_w_per_hz = c.escaped_power;

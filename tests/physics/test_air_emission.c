@@ -177,6 +177,89 @@ static void test_air_furnace(void **state)
         air_furnace_case(ident_integrators[k]);
 }
 
+/* Open sky: a grey sphere and a two-sided plate at 300 K in humid air at 300 K, inside
+ * an extent beyond which the background is at 300 K too (or, without an extent, the air
+ * goes on for ever and the background at 3 K is never seen where alpha > 0). Everything
+ * the sphere reflects comes from the air and from outside the box: N_c = 1 needs the
+ * photon phase's boundary source (air_emission.h). Pixels that see the sky are
+ * deterministic. */
+#define SKY_JSON(ATM_KEYS)                                                                       \
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"open sky\"," \
+    " \"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.05}," \
+    "                {\"frequency_thz\": 0.557, \"relative_width\": 0.02}]," \
+    " \"materials\": {\"grey\": {\"reflectivity\": 0.5}, \"sheet\": {\"reflectivity\": 0.3}}," \
+    " \"atmosphere\": {\"model\": \"itu-p676\", \"temperature_k\": 300, \"pressure_hpa\": 1013.25," \
+    "   \"relative_humidity\": 0.5, \"emitting\": true, " ATM_KEYS "}," \
+    " \"objects\": [" \
+    "   {\"name\": \"ball\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 300," \
+    "    \"shape\": {\"type\": \"sphere\", \"radius_m\": 0.6}," \
+    "    \"transform\": {\"translate_m\": [0.3, 0.6, 0]}}," \
+    "   {\"name\": \"sheet\", \"type\": \"solid\", \"two_sided\": true, \"material\": \"sheet\"," \
+    "    \"temperature_k\": 300, \"shape\": {\"type\": \"rectangle\", \"size_m\": [0.8, 0.8]}," \
+    "    \"transform\": {\"rotate_deg\": [60, 0, 30], \"translate_m\": [-0.7, 0.2, 0.3]}}]," \
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -1.4, 0], \"direction\": [0, 1, 0]," \
+    "   \"up\": [0, 0, 1], \"fov_deg\": 70, \"resolution\": [16, 16], \"oversampling\": 1," \
+    "   \"aperture_m2\": 0.01, \"normalize_to_k\": 300}]," \
+    " \"photons\": {\"per_channel\": 1000000, \"seed\": 9}}"
+
+static void sky_case(thz_integrator integrator, bool extent)
+{
+    const char *json =
+        extent ? SKY_JSON("\"background_temperature_k\": 300, \"extent_min_m\": [-1.5, -1.5, -1.5],"
+                          " \"extent_max_m\": [1.5, 1.5, 1.5]")
+               : SKY_JSON("\"background_temperature_k\": 3");
+    ident_run r;
+    ident_run_scene_with(&r, json, ident_photons(1000000), integrator, ident_estimates(32));
+    bool exact = integrator == INTEGRATOR_PATH;
+    for (size_t c = 0; c < r.scene->n_channels; c++) {
+        const thz_channel *ch = &r.scene->channels[c];
+        double b = ident_band_planck(ch, 300.0);
+        assert_true(r.rstats[c].escaped_samples > 20);
+        ident_tally t = {0};
+        double pooled = 0.0;
+        for (size_t i = 0; i < (size_t)r.img.rows * r.img.columns; i++)
+            pooled += pow(r.img.radiance_stderr[ident_at(&r, c, 0, 0) + i], 2);
+        t.pooled_rel_se = sqrt(pooled / (double)((size_t)r.img.rows * r.img.columns)) / b;
+        size_t sky = 0;
+        for (uint32_t row = 0; row < r.img.rows; row++)
+            for (uint32_t col = 0; col < r.img.columns; col++) {
+                size_t i = ident_at(&r, c, col, row);
+                double n = r.img.normalized[i];
+                ident_chain chain;
+                ident_trace_chain(&r, camera_pixel_center_dir(&r.cam, col, row), &chain);
+                if (exact || chain.n == 0) { /* path everywhere, the others' sky */
+                    if (!(fabs(n - 1.0) <= 1e-9))
+                        print_message("%s pixel (%u, %u): N - 1 = %.3e\n",
+                                      render_integrator_name(integrator), col, row, n - 1.0);
+                    assert_true(fabs(n - 1.0) <= 1e-9);
+                    sky += chain.n == 0;
+                } else if (ident_pixel_interior(&r, col, row)) {
+                    ident_check_pixel(&t, &r, c, col, row, b,
+                                      integrator == INTEGRATOR_FINAL_GATHER ? 3e-3 : 1e-5);
+                }
+            }
+        assert_true(sky > 20);
+        char what[80];
+        snprintf(what, sizeof what, "open sky%s, %s, channel %zu", extent ? "" : " (no extent)",
+                 render_integrator_name(integrator), c);
+        if (!exact)
+            ident_tally_assert(&t, what, 0.12 / sqrt(ident_scale()),
+                               integrator == INTEGRATOR_FINAL_GATHER ? 3e-3 : 0.0);
+        else
+            print_message("%s: every pixel N = 1 to 1e-9\n", what);
+    }
+    ident_run_fini(&r);
+}
+
+static void test_air_open_sky(void **state)
+{
+    (void)state;
+    for (size_t k = 0; k < IDENT_N_INTEGRATORS; k++) {
+        sky_case(ident_integrators[k], true);
+        sky_case(ident_integrators[k], false);
+    }
+}
+
 /* A black corridor at 0 K filled with air at 290 K of constant alpha: every pixel sees
  * the far wall through the column, L = B(290)(1 - e^{-alpha d}); deterministic for every
  * integrator (nothing reflects; path's T0 is the walls' 0 K). */
@@ -311,6 +394,7 @@ int main(void)
         cmocka_unit_test(test_air_column),
         cmocka_unit_test(test_humid_beer_lambert),
         cmocka_unit_test(test_air_furnace),
+        cmocka_unit_test(test_air_open_sky),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
