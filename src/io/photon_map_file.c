@@ -172,8 +172,8 @@ static thz_status pmf_write_channel(pmf_writer *w, const photon_map *map, thz_er
                 j++;
         }
         memcpy(tmp, r + i, (j - i) * sizeof *tmp);
-        /* Keep only what the phase stored: the map uses the upper flag bits for its
-         * kd-tree (photon_map.c), which a reader rebuilds. */
+        /* Keep only what the phase stored: the upper flag bits are the map's (maps before
+         * the octree kept a kd-tree split axis there), and a reader rebuilds its index. */
         for (size_t k = 0; k < j - i; k++)
             tmp[k].flags &= PMF_FLAGS_STORED;
         qsort(tmp, j - i, sizeof *tmp, pmf_record_cmp);

@@ -11,7 +11,7 @@
  *     that a file depends only on the scene, seed and photon count);
  *   zstd frame 2 (with content checksum and content size): the records of channel 0,
  *     1, ... as 32-byte photon_record images, `flags` holding only the bounce count
- *     (the map's kd-tree bits are rebuilt on reading). Within a channel they are in a canonical
+ *     (the map's index is rebuilt on reading). Within a channel they are in a canonical
  *     order (by object_side, then by their bytes) that does not depend on the photon
  *     map's internal order, so that read + write reproduces a file byte for byte.
  */
