@@ -13,14 +13,20 @@ repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 scene=$repo/examples/teraeye/scene.json
 
 "$thzmap" validate "$scene" >/dev/null
-echo "simulating $scene (6 channels x 10 million photons; a few minutes on 2 cores)"
+echo "simulating $scene with the paper's method (photon-map: 6 channels x 10 million"
+echo "photons; about half a minute on 2 cores)"
 # No --save-photon-map: at 10 M photons per channel the map file is about 1.5 GB.
 "$thzmap" simulate "$scene" -o "$outdir"
 
 echo
-echo "written to $outdir:"
-ls -lh "$outdir"
+echo "rendering it again with the converged backward integrator (path; about a second)"
+"$thzmap" render "$scene" --integrator path -o "$outdir/path"
+
 echo
-echo "start with $outdir/cam.spectra.png (the paper's Fig. 6), $outdir/cam.band-01.png ..."
-echo "$outdir/cam.band-06.png and $outdir/cam.visual.png; docs/user-guide.md says how to"
-echo "read the ENVI cubes (cam.*.hdr) in Python."
+echo "written to $outdir (photon-map) and $outdir/path (path):"
+ls -lh "$outdir" "$outdir/path"
+echo
+echo "start with $outdir/path/cam.spectra.png (the paper's Fig. 6), then compare"
+echo "$outdir/cam.band-06.png (photon-map, the paper's estimate) with"
+echo "$outdir/path/cam.band-06.png (converged); docs/user-guide.md says how to read the"
+echo "ENVI cubes (cam.*.hdr) in Python."
