@@ -36,6 +36,8 @@ static void cli_run_usage(FILE *f, bool render)
                 "                        so the images, then depend on the machine's speed\n"
                 "  --save-photon-map     also write photon-map.thzpm (for render) and\n"
                 "                        photon-map.ply\n"
+                "  --ply-max-points N    at most N photons (evenly strided) in\n"
+                "                        photon-map.ply (default 2000000)\n"
                 "  --quiet               no progress output\n");
     else
         fprintf(f,
@@ -86,7 +88,8 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
                            strcmp(arg, "--target-noise-k") == 0 ||
                            strcmp(arg, "--max-seconds") == 0 ||
                            (!render && (strcmp(arg, "--photons") == 0 ||
-                                        strcmp(arg, "--seed") == 0)) ||
+                                        strcmp(arg, "--seed") == 0 ||
+                                        strcmp(arg, "--ply-max-points") == 0)) ||
                            (render && (strcmp(arg, "--photon-map") == 0 ||
                                        strcmp(arg, "--sensor") == 0));
         if (takes_value) {
@@ -127,6 +130,10 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
                     return CLI_EXIT_USAGE;
                 a->ov.has_seed = true;
                 a->ov.seed = u;
+            } else if (strcmp(arg, "--ply-max-points") == 0) {
+                if (!cli_parse_u64(cmd, arg, val, 1, UINT64_C(1000000000000), &u))
+                    return CLI_EXIT_USAGE;
+                a->opt.ply_max_points = u;
             } else if (strcmp(arg, "--photon-map") == 0) {
                 a->opt.photon_map_path = val;
             } else {

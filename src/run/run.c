@@ -579,7 +579,8 @@ static thz_status run_save_photon_map(run_state *rs, const char *dir, thz_error 
     if (st != THZ_OK)
         return st;
     snprintf(path, sizeof path, "%s/photon-map.ply", dir);
-    return ply_write_photons(path, maps, rs->scene->n_channels, PLY_DEFAULT_MAX_POINTS, err);
+    uint64_t cap = rs->opt->ply_max_points ? rs->opt->ply_max_points : PLY_DEFAULT_MAX_POINTS;
+    return ply_write_photons(path, maps, rs->scene->n_channels, cap, err);
 }
 
 static thz_status run_load_photon_map(run_state *rs, thz_error *err)

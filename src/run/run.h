@@ -37,6 +37,7 @@ typedef struct run_options {
     const char *outdir;          /* required: where the result files go */
     int threads;                 /* OpenMP threads, 0: all */
     bool save_photon_map;        /* simulate: also write photon-map.thzpm and photon-map.ply */
+    uint64_t ply_max_points;     /* photons in photon-map.ply at most; 0: PLY_DEFAULT_MAX_POINTS */
     const char *photon_map_path; /* render: the photon-map file to read (required) */
     const char *sensor_name;     /* render: only this sensor; NULL: all */
     thz_progress_fn progress;    /* stages "photons", "render", "output"; may be NULL */
