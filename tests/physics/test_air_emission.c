@@ -260,6 +260,69 @@ static void test_air_open_sky(void **state)
     }
 }
 
+/* Not isothermal, closed form: a grey ball (R = 0.5, 310 K) in air of constant alpha
+ * (0.3 /m, 290 K) without an extent, so that every ray leaving the ball sees
+ * B(T_air) (the 50 K background is never seen): a ball pixel at distance d shows
+ * e^{-alpha d} [(1 - R) B(310) + R B(290)] + (1 - e^{-alpha d}) B(290). It checks what
+ * the isothermal scenes cannot: the air terms of path's continuation (B_air != B0, T0 =
+ * 310 K), final-gather's escaping gather rays, and the boundary photons without an
+ * extent. */
+static const char *ball_json =
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"warm ball\","
+    " \"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.05}],"
+    " \"materials\": {\"grey\": {\"reflectivity\": 0.5}},"
+    " \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.3, \"emitting\": true,"
+    "   \"temperature_k\": 290, \"background_temperature_k\": 50},"
+    " \"objects\": ["
+    "   {\"name\": \"ball\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 310,"
+    "    \"shape\": {\"type\": \"sphere\", \"radius_m\": 0.6},"
+    "    \"transform\": {\"translate_m\": [0, 0.6, 0]}}],"
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -1.4, 0], \"direction\": [0, 1, 0],"
+    "   \"up\": [0, 0, 1], \"fov_deg\": 30, \"resolution\": [16, 16], \"oversampling\": 1,"
+    "   \"aperture_m2\": 0.01, \"normalize_to_k\": 300}],"
+    " \"photons\": {\"per_channel\": 1000000, \"seed\": 4}}";
+
+static void ball_case(thz_integrator integrator)
+{
+    ident_run r;
+    ident_run_scene_with(&r, ball_json, ident_photons(1000000), integrator, ident_estimates(32));
+    const thz_channel *ch = &r.scene->channels[0];
+    double b_ball = ident_band_planck(ch, 310.0), b_air = ident_band_planck(ch, 290.0);
+    ident_tally t = {0};
+    double pooled = 0.0;
+    for (size_t i = 0; i < (size_t)r.img.rows * r.img.columns; i++)
+        pooled += pow(r.img.radiance_stderr[i], 2);
+    t.pooled_rel_se = sqrt(pooled / (double)((size_t)r.img.rows * r.img.columns)) / b_air;
+    size_t sky = 0;
+    for (uint32_t row = 0; row < r.img.rows; row++)
+        for (uint32_t col = 0; col < r.img.columns; col++) {
+            size_t i = ident_at(&r, 0, col, row);
+            double d = r.img.distance_m[row * r.img.columns + col];
+            if (!(d > 0.0 && isfinite(d))) { /* the sky: the air for ever */
+                assert_true(fabs(r.img.radiance[i] - b_air) <= 1e-5 * b_air);
+                sky++;
+                continue;
+            }
+            double tau = exp(-0.3 * d);
+            double expect = tau * (0.5 * b_ball + 0.5 * b_air) + (1.0 - tau) * b_air;
+            if (integrator == INTEGRATOR_PATH || ident_pixel_interior(&r, col, row))
+                ident_check_pixel(&t, &r, 0, col, row, expect, 1e-5);
+        }
+    assert_true(sky > 10);
+    char what[80];
+    snprintf(what, sizeof what, "warm ball, %s", render_integrator_name(integrator));
+    /* final-gather is exact here (every gather ray escapes into B(T_air)): 1e-5 floor */
+    ident_tally_assert(&t, what, 0.12 / sqrt(ident_scale()), 1e-5);
+    ident_run_fini(&r);
+}
+
+static void test_air_warm_ball(void **state)
+{
+    (void)state;
+    for (size_t k = 0; k < IDENT_N_INTEGRATORS; k++)
+        ball_case(ident_integrators[k]);
+}
+
 /* A black corridor at 0 K filled with air at 290 K of constant alpha: every pixel sees
  * the far wall through the column, L = B(290)(1 - e^{-alpha d}); deterministic for every
  * integrator (nothing reflects; path's T0 is the walls' 0 K). */
@@ -395,6 +458,7 @@ int main(void)
         cmocka_unit_test(test_humid_beer_lambert),
         cmocka_unit_test(test_air_furnace),
         cmocka_unit_test(test_air_open_sky),
+        cmocka_unit_test(test_air_warm_ball),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
