@@ -323,6 +323,65 @@ static void test_air_warm_ball(void **state)
         ball_case(ident_integrators[k]);
 }
 
+/* Not isothermal, no closed form: a grey two-sided plate (R = 0.6, 320 K) in a black
+ * room at 250 K filled with air at 300 K (alpha 0.5 /m). What the plate reflects crosses
+ * the warm air: path's free paths between surfaces add (1 - tau)(B_air - B0) with
+ * T0 = 250 K, final-gather's gather rays the band mean of the air before the wall. The two
+ * must agree pixel by pixel within their standard errors. */
+static const char *plate_json =
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"plate in warm air\","
+    " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.05}],"
+    " \"materials\": {\"black\": {\"reflectivity\": 0.0}, \"grey\": {\"reflectivity\": 0.6}},"
+    " \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.5, \"emitting\": true,"
+    "   \"temperature_k\": 300, \"background_temperature_k\": 0},"
+    " \"objects\": ["
+    "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"black\", \"temperature_k\": 250,"
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [3, 3, 3], \"inward\": true}},"
+    "   {\"name\": \"plate\", \"type\": \"solid\", \"two_sided\": true, \"material\": \"grey\","
+    "    \"temperature_k\": 320, \"shape\": {\"type\": \"rectangle\", \"size_m\": [1, 1]},"
+    "    \"transform\": {\"rotate_deg\": [70, 0, 20], \"translate_m\": [0, 0.5, 0]}}],"
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -1.2, 0], \"direction\": [0, 1, 0],"
+    "   \"up\": [0, 0, 1], \"fov_deg\": 30, \"resolution\": [12, 12], \"oversampling\": 1,"
+    "   \"aperture_m2\": 0.01, \"normalize_to_k\": 300}],"
+    " \"photons\": {\"per_channel\": 1000, \"seed\": 4}}";
+
+static void test_air_warm_room(void **state)
+{
+    (void)state;
+    ident_run fg, pt;
+    ident_run_scene_with(&fg, plate_json, 0, INTEGRATOR_FINAL_GATHER, ident_estimates(64));
+    ident_run_scene_with(&pt, plate_json, 0, INTEGRATOR_PATH, ident_estimates(64));
+    size_t n = 0, failed = 0;
+    double sum = 0.0, var = 0.0;
+    for (uint32_t row = 0; row < fg.img.rows; row++)
+        for (uint32_t col = 0; col < fg.img.columns; col++) {
+            ident_chain c;
+            ident_trace_chain(&fg, camera_pixel_center_dir(&fg.cam, col, row), &c);
+            if (c.n != 1 || c.object[0] != 1)
+                continue; /* the plate only */
+            size_t i = ident_at(&fg, 0, col, row);
+            double a = fg.img.radiance[i], b = pt.img.radiance[i];
+            double se = hypot(fg.img.radiance_stderr[i], pt.img.radiance_stderr[i]);
+            n++;
+            sum += (a - b) / b;
+            var += (se / b) * (se / b);
+            if (!(fabs(a - b) <= IDENT_Z * se + 1e-5 * b)) {
+                print_message("pixel (%u, %u): final-gather %.6e, path %.6e (se %.2e)\n", col,
+                              row, a, b, se);
+                failed++;
+            }
+        }
+    double mean = sum / (double)n, se_mean = sqrt(var) / (double)n;
+    print_message("warm room: %zu plate pixels, final-gather - path %+.4f %% (se %.4f %%)\n", n,
+                  100.0 * mean, 100.0 * se_mean);
+    assert_true(n > 30);
+    assert_int_equal(failed, 0);
+    assert_true(fabs(mean) <= IDENT_Z * se_mean + 1e-5);
+    assert_true(se_mean < 2e-3); /* the comparison is tight */
+    ident_run_fini(&fg);
+    ident_run_fini(&pt);
+}
+
 /* A black corridor at 0 K filled with air at 290 K of constant alpha: every pixel sees
  * the far wall through the column, L = B(290)(1 - e^{-alpha d}); deterministic for every
  * integrator (nothing reflects; path's T0 is the walls' 0 K). */
@@ -459,6 +518,7 @@ int main(void)
         cmocka_unit_test(test_air_furnace),
         cmocka_unit_test(test_air_open_sky),
         cmocka_unit_test(test_air_warm_ball),
+        cmocka_unit_test(test_air_warm_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
