@@ -40,6 +40,8 @@ typedef struct bench_probe_out {
 typedef struct bench_point {
     uint64_t photons, stored, rays, triangles, samples, pixels;
     double s_emission_table, s_tracing, s_index, s_photons, s_render, s_probe;
+    double cpu_photons; /* CPU seconds of the process (all threads) in that photon phase:
+                           time slices taken by other processes do not count */
 } bench_point;
 
 typedef struct bench_series {

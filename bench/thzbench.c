@@ -402,16 +402,17 @@ int main(int argc, char **argv)
         goto fail;
     printf("\n3. Scaling in photons (channel %zu of the paper's case; load average %.2f)\n",
            series_channel + 1, load_sp);
-    printf("  %12s %12s %10s %10s %10s %10s\n", "photons", "stored", "phase s", "ns/photon",
-           "trace ns", "index ns");
+    printf("  %12s %12s %10s %10s %10s %10s %12s\n", "photons", "stored", "phase s", "ns/photon",
+           "trace ns", "index ns", "CPU ns/ph.");
     json_t *jsp = json_array();
     for (int k = 0; k < sp.n; k++) {
         const bench_point *p = &sp.p[k];
         double ns = 1e9 * bench_ratio(p->s_photons, (double)p->photons);
-        printf("  %12llu %12llu %10.3f %10.1f %10.1f %10.1f\n", (unsigned long long)p->photons,
-               (unsigned long long)p->stored, p->s_photons, ns,
+        printf("  %12llu %12llu %10.3f %10.1f %10.1f %10.1f %12.1f\n",
+               (unsigned long long)p->photons, (unsigned long long)p->stored, p->s_photons, ns,
                1e9 * bench_ratio(p->s_tracing, (double)p->photons),
-               1e9 * bench_ratio(p->s_index, (double)p->photons));
+               1e9 * bench_ratio(p->s_index, (double)p->photons),
+               1e9 * bench_ratio(p->cpu_photons, (double)p->photons));
         json_t *o = json_object();
         json_object_set_new(o, "photons", json_integer((json_int_t)p->photons));
         json_object_set_new(o, "stored", json_integer((json_int_t)p->stored));
@@ -419,6 +420,8 @@ int main(int argc, char **argv)
         json_object_set_new(o, "seconds_tracing", bench_real(p->s_tracing));
         json_object_set_new(o, "seconds_index", bench_real(p->s_index));
         json_object_set_new(o, "ns_per_photon", bench_real(ns));
+        json_object_set_new(o, "cpu_ns_per_photon",
+                            bench_real(1e9 * bench_ratio(p->cpu_photons, (double)p->photons)));
         json_array_append_new(jsp, o);
     }
     json_object_set_new(root, "scaling_photons", jsp);
@@ -430,8 +433,8 @@ int main(int argc, char **argv)
     json_t *jtri = json_array();
     printf("\n   Scaling in triangles (enclosure + 4 icospheres, %llu photons; load average %.2f)\n",
            (unsigned long long)mesh_photons, load_tri);
-    printf("  %12s %10s %10s %12s %12s\n", "triangles", "phase s", "ns/photon", "raw ns/ray",
-           "phase/raw");
+    printf("  %12s %10s %10s %12s %12s %12s\n", "triangles", "phase s", "ns/photon", "raw ns/ray",
+           "phase/raw", "CPU ns/ph.");
     for (unsigned sd = subdiv_lo; sd <= subdiv_hi; sd++) {
         char path[4300];
         snprintf(path, sizeof path, "%s-s%u.json", meshdir, sd);
@@ -448,15 +451,18 @@ int main(int argc, char **argv)
         const bench_point *p = &one.p[0];
         tri.p[tri.n++] = *p;
         double ns = 1e9 * bench_ratio(p->s_photons, (double)p->photons);
-        printf("  %12llu %10.3f %10.1f %12.1f %12.2f\n", (unsigned long long)p->triangles,
+        printf("  %12llu %10.3f %10.1f %12.1f %12.2f %12.1f\n", (unsigned long long)p->triangles,
                p->s_photons, ns, 1e9 * bench_ratio(p->s_probe, (double)p->rays),
-               bench_ratio(p->s_photons, p->s_probe));
+               bench_ratio(p->s_photons, p->s_probe),
+               1e9 * bench_ratio(p->cpu_photons, (double)p->photons));
         json_t *o = json_object();
         json_object_set_new(o, "triangles", json_integer((json_int_t)p->triangles));
         json_object_set_new(o, "photons", json_integer((json_int_t)p->photons));
         json_object_set_new(o, "seconds", bench_real(p->s_photons));
         json_object_set_new(o, "ns_per_photon", bench_real(ns));
         json_object_set_new(o, "raw_seconds", bench_real(p->s_probe));
+        json_object_set_new(o, "cpu_ns_per_photon",
+                            bench_real(1e9 * bench_ratio(p->cpu_photons, (double)p->photons)));
         json_object_set_new(o, "raw_ns_per_ray", bench_real(1e9 * bench_ratio(p->s_probe, (double)p->rays)));
         json_array_append_new(jtri, o);
     }
@@ -525,21 +531,26 @@ int main(int argc, char **argv)
     bench_target(&t, "bytes per stored photon", bpp, "<=", 32, bpp <= 32.005, "B");
     double peak_ratio = bench_ratio((double)paper_peak, (double)paper.largest_map_bytes);
     bench_target(&t, "peak memory / photon map", peak_ratio, "<=", 1.5, peak_ratio <= 1.5, "");
+    /* Flatness and triangle growth from the CPU time per photon: the wall time of a point
+     * also counts the time slices other processes took, which on a shared machine varies
+     * from point to point; CPU time does not (both are in the table and the JSON). */
     double lo = 0, hi = 0, first = 0;
     for (int k = 0; k < sp.n; k++) {
-        double ns = bench_ratio(sp.p[k].s_photons, (double)sp.p[k].photons);
+        double ns = bench_ratio(sp.p[k].cpu_photons, (double)sp.p[k].photons);
         if (k == 0)
             first = lo = hi = ns;
         lo = ns < lo ? ns : lo;
         hi = ns > hi ? ns : hi;
     }
     double dev = first > 0 ? (hi - first > first - lo ? hi / first - 1 : 1 - lo / first) : 0;
-    bench_target(&t, "time per photon, 1 M..30 M: largest deviation", 100 * dev, "<=", 20,
+    bench_target(&t, "CPU time per photon, 1 M..30 M: largest deviation", 100 * dev, "<=", 20,
                  dev <= 0.2, "%");
-    double tri_ratio = tri.n ? bench_ratio(bench_ratio(tri.p[tri.n - 1].s_photons, (double)tri.p[tri.n - 1].photons),
-                                           bench_ratio(tri.p[0].s_photons, (double)tri.p[0].photons))
-                             : 0;
-    bench_target(&t, "time per photon, 1 k..1 M triangles", tri_ratio, "<=", 3, tri_ratio <= 3, "x");
+    double tri_ratio =
+        tri.n ? bench_ratio(bench_ratio(tri.p[tri.n - 1].cpu_photons, (double)tri.p[tri.n - 1].photons),
+                            bench_ratio(tri.p[0].cpu_photons, (double)tri.p[0].photons))
+              : 0;
+    bench_target(&t, "CPU time per photon, 1 k..1 M triangles", tri_ratio, "<=", 3, tri_ratio <= 3,
+                 "x");
     bench_target(&t, "speed-up on all threads", speedup, ">=", 1.8, speedup >= 1.8, "x");
     double render_share = bench_ratio(paper.s_render, paper.s_total);
     bench_target(&t, "rendering share of the paper's case", 100 * render_share, "<=", 20,
