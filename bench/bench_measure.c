@@ -32,8 +32,7 @@ static double bench_cpu_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static thz_status bench_load(const char *path, uint64_t photons, thz_scene **scene,
-                             thz_error *err)
+static thz_status bench_load(const char *path, uint64_t photons, thz_scene **scene, thz_error *err)
 {
     thz_status st = thz_scene_load(path, scene, err);
     if (st == THZ_OK && photons)

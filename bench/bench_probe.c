@@ -91,11 +91,11 @@ static thz_status bench_probe_pool(const thz_scene *scene, bench_ray *pool, size
         v3_basis(nrm, &tb, &bb);
         double mu = sqrt(1.0 - rng_uniform(&rng)), phi = 2.0 * M_PI * rng_uniform(&rng);
         double s = sqrt(fmax(0.0, 1.0 - mu * mu));
-        vec3 d = v3_normalize(
-            v3_madd(v3_madd(v3_scale(nrm, mu), s * cos(phi), tb), s * sin(phi), bb));
+        vec3 d =
+            v3_normalize(v3_madd(v3_madd(v3_scale(nrm, mu), s * cos(phi), tb), s * sin(phi), bb));
         p = v3_madd(p, offset_m, nrm);
-        pool[r] = (bench_ray){{(float)p.x, (float)p.y, (float)p.z},
-                              {(float)d.x, (float)d.y, (float)d.z}};
+        pool[r] =
+            (bench_ray){{(float)p.x, (float)p.y, (float)p.z}, {(float)d.x, (float)d.y, (float)d.z}};
     }
     free(cdf);
     free(obj_of);
@@ -148,8 +148,8 @@ thz_status bench_probe_run(const thz_scene *scene, uint64_t n_rays, int threads,
     out->seconds_build = omp_get_wtime() - t0;
 
     double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
-    double offset = fmax(fmax(1e-6 * sqrt(dx * dx + dy * dy + dz * dz),
-                              16.0 * FLT_EPSILON * max_abs), 1e-9);
+    double offset =
+        fmax(fmax(1e-6 * sqrt(dx * dx + dy * dy + dz * dz), 16.0 * FLT_EPSILON * max_abs), 1e-9);
     size_t n_pool = n_rays < BENCH_PROBE_POOL ? (size_t)n_rays : BENCH_PROBE_POOL;
     if (n_pool == 0)
         n_pool = 1;

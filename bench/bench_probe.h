@@ -22,10 +22,10 @@
 #include "scene/scene.h"
 
 typedef struct bench_probe_result {
-    uint64_t rays;       /* rays cast */
-    uint64_t hits;       /* of which hit something */
-    uint64_t pool;       /* distinct rays generated */
-    double seconds;      /* wall time of the casting loop */
+    uint64_t rays;        /* rays cast */
+    uint64_t hits;        /* of which hit something */
+    uint64_t pool;        /* distinct rays generated */
+    double seconds;       /* wall time of the casting loop */
     double seconds_build; /* Embree scene build */
 } bench_probe_result;
 

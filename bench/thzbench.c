@@ -163,8 +163,8 @@ static thz_status bench_job_probe(const void *arg, void *out, thz_error *err)
 static thz_status bench_job_series(const void *arg, void *out, thz_error *err)
 {
     const bench_job *j = arg;
-    return bench_measure_series(j->scene, j->channel, j->series, j->n_series, j->threads,
-                                j->render, j->probe, j->repeats, out, err);
+    return bench_measure_series(j->scene, j->channel, j->series, j->n_series, j->threads, j->render,
+                                j->probe, j->repeats, out, err);
 }
 
 /* ---- Reporting ------------------------------------------------------------------------ */
@@ -193,7 +193,8 @@ typedef struct bench_targets {
 static void bench_target(bench_targets *t, const char *name, double value, const char *op,
                          double limit, bool met, const char *unit)
 {
-    printf("  %-48s %10.3f %s %-6g %-3s %s\n", name, value, op, limit, unit, met ? "met" : "NOT met");
+    printf("  %-48s %10.3f %s %-6g %-3s %s\n", name, value, op, limit, unit,
+           met ? "met" : "NOT met");
     json_t *o = json_object();
     json_object_set_new(o, "target", json_string(name));
     json_object_set_new(o, "value", bench_real(value));
@@ -306,10 +307,10 @@ int main(int argc, char **argv)
            (unsigned long long)paper.columns, (unsigned long long)paper.rows,
            (unsigned long long)paper.oversampling, load_paper);
     printf("  %-22s %9s %7s\n", "phase", "seconds", "share");
-    const char *names[] = {"load", "ray-casting build", "emission table", "tracing",
-                           "index build", "rendering", "output", "total"};
-    double secs[] = {paper.s_load, paper.s_accel, paper.s_emission_table, paper.s_tracing,
-                     paper.s_index, paper.s_render, paper.s_output, paper.s_total};
+    const char *names[] = {"load",        "ray-casting build", "emission table", "tracing",
+                           "index build", "rendering",         "output",         "total"};
+    double secs[] = {paper.s_load,  paper.s_accel,  paper.s_emission_table, paper.s_tracing,
+                     paper.s_index, paper.s_render, paper.s_output,         paper.s_total};
     for (int i = 0; i < 8; i++)
         printf("  %-22s %9.3f %6.1f %%\n", names[i], secs[i],
                100.0 * bench_ratio(secs[i], paper.s_total));
@@ -317,19 +318,22 @@ int main(int argc, char **argv)
     printf("  photon phase %.3f s: %.3g photons/s, %llu stored (%.3f per photon), %llu rays\n",
            paper.s_photons, pps, (unsigned long long)paper.stored,
            bench_ratio((double)paper.stored, (double)paper.fired), (unsigned long long)paper.rays);
-    printf("  %.1f CPU s over %.1f s wall: %.2f cores on average\n", paper_use.cpu_s,
-           paper.s_total, bench_ratio(paper_use.cpu_s, paper.s_total));
+    printf("  %.1f CPU s over %.1f s wall: %.2f cores on average\n", paper_use.cpu_s, paper.s_total,
+           bench_ratio(paper_use.cpu_s, paper.s_total));
     printf("  largest photon map %.1f MB, %.2f bytes per stored photon; peak memory %.1f MB "
            "(%.2f x the map)\n",
            (double)paper.largest_map_bytes / 1e6, bpp, (double)paper_peak / 1e6,
            bench_ratio((double)paper_peak, (double)paper.largest_map_bytes));
     json_t *jpaper = json_object();
-    json_object_set_new(jpaper, "photons_per_channel", json_integer((json_int_t)paper.photons_per_channel));
+    json_object_set_new(jpaper, "photons_per_channel",
+                        json_integer((json_int_t)paper.photons_per_channel));
     json_object_set_new(jpaper, "channels", json_integer((json_int_t)paper.channels));
-    json_object_set_new(jpaper, "resolution", json_pack("[I, I]", (json_int_t)paper.columns, (json_int_t)paper.rows));
+    json_object_set_new(jpaper, "resolution",
+                        json_pack("[I, I]", (json_int_t)paper.columns, (json_int_t)paper.rows));
     json_object_set_new(jpaper, "oversampling", json_integer((json_int_t)paper.oversampling));
     json_t *jsec = json_object();
-    const char *keys[] = {"load", "accel", "emission_table", "tracing", "index", "render", "output", "total"};
+    const char *keys[] = {"load",  "accel",  "emission_table", "tracing",
+                          "index", "render", "output",         "total"};
     for (int i = 0; i < 8; i++)
         json_object_set_new(jsec, keys[i], bench_real(secs[i]));
     json_object_set_new(jsec, "photon_phase", bench_real(paper.s_photons));
@@ -338,10 +342,13 @@ int main(int argc, char **argv)
     json_object_set_new(jpaper, "photons_stored", json_integer((json_int_t)paper.stored));
     json_object_set_new(jpaper, "rays", json_integer((json_int_t)paper.rays));
     json_object_set_new(jpaper, "photons_per_s", bench_real(pps));
-    json_object_set_new(jpaper, "largest_map_bytes", json_integer((json_int_t)paper.largest_map_bytes));
+    json_object_set_new(jpaper, "largest_map_bytes",
+                        json_integer((json_int_t)paper.largest_map_bytes));
     json_object_set_new(jpaper, "bytes_per_stored_photon", bench_real(bpp));
     json_object_set_new(jpaper, "peak_memory_bytes", json_integer((json_int_t)paper_peak));
-    json_object_set_new(jpaper, "peak_memory_over_map", bench_real(bench_ratio((double)paper_peak, (double)paper.largest_map_bytes)));
+    json_object_set_new(
+        jpaper, "peak_memory_over_map",
+        bench_real(bench_ratio((double)paper_peak, (double)paper.largest_map_bytes)));
     json_object_set_new(jpaper, "load_average", bench_real(load_paper));
     json_object_set_new(jpaper, "cpu_seconds", bench_real(paper_use.cpu_s));
 
@@ -384,9 +391,11 @@ int main(int argc, char **argv)
     printf("  photon phase / raw trace = %.2f (tracing alone: %.2f)\n", ratio_phase, ratio_trace);
     json_t *jt = json_object();
     json_object_set_new(jt, "rays", json_integer((json_int_t)probe.rays));
-    json_object_set_new(jt, "hit_fraction", bench_real(bench_ratio((double)probe.hits, (double)probe.rays)));
+    json_object_set_new(jt, "hit_fraction",
+                        bench_real(bench_ratio((double)probe.hits, (double)probe.rays)));
     json_object_set_new(jt, "seconds", bench_real(probe.seconds));
-    json_object_set_new(jt, "rays_per_s", bench_real(bench_ratio((double)probe.rays, probe.seconds)));
+    json_object_set_new(jt, "rays_per_s",
+                        bench_real(bench_ratio((double)probe.rays, probe.seconds)));
     json_object_set_new(jt, "photon_phase_over_raw", bench_real(ratio_phase));
     json_object_set_new(jt, "tracing_over_raw", bench_real(ratio_trace));
     json_object_set_new(jt, "load_average", bench_real(load_probe));
@@ -394,8 +403,13 @@ int main(int argc, char **argv)
 
     /* 3a + 4. Photons per channel, and rendering as photons per pixel grow. */
     bench_series sp;
-    bench_job js = {.scene = scene, .threads = threads, .channel = series_channel,
-                    .series = series, .n_series = n_series, .render = 1, .repeats = repeats};
+    bench_job js = {.scene = scene,
+                    .threads = threads,
+                    .channel = series_channel,
+                    .series = series,
+                    .n_series = n_series,
+                    .render = 1,
+                    .repeats = repeats};
     double load_sp = bench_load1();
     st = bench_fork(bench_job_series, &js, &sp, sizeof sp, NULL, &err);
     if (st != THZ_OK)
@@ -431,8 +445,9 @@ int main(int argc, char **argv)
     memset(&tri, 0, sizeof tri);
     double load_tri = bench_load1();
     json_t *jtri = json_array();
-    printf("\n   Scaling in triangles (enclosure + 4 icospheres, %llu photons; load average %.2f)\n",
-           (unsigned long long)mesh_photons, load_tri);
+    printf(
+        "\n   Scaling in triangles (enclosure + 4 icospheres, %llu photons; load average %.2f)\n",
+        (unsigned long long)mesh_photons, load_tri);
     printf("  %12s %10s %10s %12s %12s %12s\n", "triangles", "phase s", "ns/photon", "raw ns/ray",
            "phase/raw", "CPU ns/ph.");
     for (unsigned sd = subdiv_lo; sd <= subdiv_hi; sd++) {
@@ -442,8 +457,13 @@ int main(int argc, char **argv)
         if (st != THZ_OK)
             goto fail;
         bench_series one;
-        bench_job jm = {.scene = path, .threads = threads, .channel = 0, .series = &mesh_photons,
-                        .n_series = 1, .probe = 1, .repeats = repeats};
+        bench_job jm = {.scene = path,
+                        .threads = threads,
+                        .channel = 0,
+                        .series = &mesh_photons,
+                        .n_series = 1,
+                        .probe = 1,
+                        .repeats = repeats};
         st = bench_fork(bench_job_series, &jm, &one, sizeof one, NULL, &err);
         remove(path);
         if (st != THZ_OK)
@@ -463,15 +483,21 @@ int main(int argc, char **argv)
         json_object_set_new(o, "raw_seconds", bench_real(p->s_probe));
         json_object_set_new(o, "cpu_ns_per_photon",
                             bench_real(1e9 * bench_ratio(p->cpu_photons, (double)p->photons)));
-        json_object_set_new(o, "raw_ns_per_ray", bench_real(1e9 * bench_ratio(p->s_probe, (double)p->rays)));
+        json_object_set_new(o, "raw_ns_per_ray",
+                            bench_real(1e9 * bench_ratio(p->s_probe, (double)p->rays)));
         json_array_append_new(jtri, o);
     }
     json_object_set_new(root, "scaling_triangles", jtri);
 
     /* 3c. Threads: the photon phase and the raw probe, 1 thread against all. */
     bench_series th1, thn;
-    bench_job j1 = {.scene = scene, .threads = 1, .channel = series_channel,
-                    .series = &thread_photons, .n_series = 1, .probe = 1, .repeats = repeats};
+    bench_job j1 = {.scene = scene,
+                    .threads = 1,
+                    .channel = series_channel,
+                    .series = &thread_photons,
+                    .n_series = 1,
+                    .probe = 1,
+                    .repeats = repeats};
     bench_job jn = j1;
     jn.threads = threads;
     double load_th = bench_load1();
@@ -546,8 +572,9 @@ int main(int argc, char **argv)
     bench_target(&t, "CPU time per photon, 1 M..30 M: largest deviation", 100 * dev, "<=", 20,
                  dev <= 0.2, "%");
     double tri_ratio =
-        tri.n ? bench_ratio(bench_ratio(tri.p[tri.n - 1].cpu_photons, (double)tri.p[tri.n - 1].photons),
-                            bench_ratio(tri.p[0].cpu_photons, (double)tri.p[0].photons))
+        tri.n ? bench_ratio(
+                    bench_ratio(tri.p[tri.n - 1].cpu_photons, (double)tri.p[tri.n - 1].photons),
+                    bench_ratio(tri.p[0].cpu_photons, (double)tri.p[0].photons))
               : 0;
     bench_target(&t, "CPU time per photon, 1 k..1 M triangles", tri_ratio, "<=", 3, tri_ratio <= 3,
                  "x");

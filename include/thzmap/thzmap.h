@@ -44,10 +44,10 @@ typedef struct thz_error {
 /* Progress of a long run. `stage` is a static string ("photons", "render", ...). */
 typedef struct thz_progress {
     const char *stage;
-    size_t channel;     /* index of the channel being processed */
+    size_t channel; /* index of the channel being processed */
     size_t n_channels;
-    uint64_t done;      /* units of work done in this stage and channel */
-    uint64_t total;     /* units of work in this stage and channel */
+    uint64_t done;  /* units of work done in this stage and channel */
+    uint64_t total; /* units of work in this stage and channel */
 } thz_progress;
 
 /* Called from the thread that started the run, never from worker threads. Return

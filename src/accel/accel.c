@@ -97,8 +97,9 @@ thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err)
 
     a->device = rtcNewDevice(NULL);
     if (!a->device) {
-        st = thz_error_set(err, THZ_ERR_INTERNAL, "ray casting: cannot create the Embree device: %s",
-                           accel_error_name(rtcGetDeviceError(NULL)));
+        st =
+            thz_error_set(err, THZ_ERR_INTERNAL, "ray casting: cannot create the Embree device: %s",
+                          accel_error_name(rtcGetDeviceError(NULL)));
         goto cleanup;
     }
     a->rtc = rtcNewScene(a->device);
@@ -118,10 +119,9 @@ thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err)
         if (m->n_triangles == 0 || m->n_vertices == 0)
             continue;
         if (m->n_triangles > UINT32_MAX || m->n_vertices > UINT32_MAX) {
-            st = thz_error_set(err, THZ_ERR_LIMIT,
-                               "ray casting: object '%s' has too many triangles (%zu)",
-                               scene->objects[i].name ? scene->objects[i].name : "?",
-                               m->n_triangles);
+            st = thz_error_set(
+                err, THZ_ERR_LIMIT, "ray casting: object '%s' has too many triangles (%zu)",
+                scene->objects[i].name ? scene->objects[i].name : "?", m->n_triangles);
             goto cleanup;
         }
         for (int k = 0; k < 3; k++) {

@@ -19,12 +19,12 @@
 typedef struct accel accel;
 
 typedef struct accel_hit {
-    double distance_m;  /* along the unit ray direction */
-    uint32_t object;    /* index into scene->objects */
-    uint32_t triangle;  /* index into that object's mesh */
-    int side;           /* 0: arrived on the front (normal) side, 1: on the back */
-    double cos_theta;   /* |cos| between the ray and the triangle normal, in (0, 1] */
-    vec3 position_m;    /* hit point */
+    double distance_m; /* along the unit ray direction */
+    uint32_t object;   /* index into scene->objects */
+    uint32_t triangle; /* index into that object's mesh */
+    int side;          /* 0: arrived on the front (normal) side, 1: on the back */
+    double cos_theta;  /* |cos| between the ray and the triangle normal, in (0, 1] */
+    vec3 position_m;   /* hit point */
 } accel_hit;
 
 /* Builds the acceleration structure for the scene (borrowed; must outlive it). */

@@ -20,7 +20,8 @@ int cmd_atmosphere(int argc, char **argv);
 int cli_fail(const thz_error *err);
 
 /* Prints "thzmap <command>: <printf message>" and a hint to use --help; returns 2. */
-int cli_usage_error(const char *command, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+int cli_usage_error(const char *command, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
 
 /* True if arg is -h or --help. */
 bool cli_is_help(const char *arg);

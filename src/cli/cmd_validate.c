@@ -11,16 +11,15 @@
 
 static void validate_usage(FILE *f)
 {
-    fprintf(f,
-            "usage: thzmap validate SCENE.json\n\n"
-            "Loads the scene, checks it completely (exit 0 when valid, 2 when not, naming\n"
-            "the file and the line:column or JSON path of the problem) and prints its\n"
-            "channels, materials, objects (triangles, area, temperature), sensors and the\n"
-            "total emitted spectral power P_A per channel. Warnings (emissivity breaking\n"
-            "Kirchhoff's law, channel bands leaving a material table, inconsistent mesh\n"
-            "winding) go to standard error, prefixed \"warning: \".\n\n"
-            "options:\n"
-            "  -h, --help   show this help\n");
+    fprintf(f, "usage: thzmap validate SCENE.json\n\n"
+               "Loads the scene, checks it completely (exit 0 when valid, 2 when not, naming\n"
+               "the file and the line:column or JSON path of the problem) and prints its\n"
+               "channels, materials, objects (triangles, area, temperature), sensors and the\n"
+               "total emitted spectral power P_A per channel. Warnings (emissivity breaking\n"
+               "Kirchhoff's law, channel bands leaving a material table, inconsistent mesh\n"
+               "winding) go to standard error, prefixed \"warning: \".\n\n"
+               "options:\n"
+               "  -h, --help   show this help\n");
 }
 
 /* "0.05", or "table of 3 points, 0.2 to 1.2 THz, 0.05 to 0.12". */
@@ -90,10 +89,9 @@ static void validate_print(const thz_scene *s)
         const thz_sensor *sn = &s->sensors[i];
         printf("  [%zu] %s: %u x %u pixels, fov %g deg, oversampling %u x %u, aperture %g m², "
                "at [%g, %g, %g] m looking along [%.4f, %.4f, %.4f], T_ref %g K\n",
-               i, sn->name, sn->columns, sn->rows, sn->fov_deg, sn->oversampling,
-               sn->oversampling, sn->aperture_m2, sn->position_m[0], sn->position_m[1],
-               sn->position_m[2], sn->direction[0], sn->direction[1], sn->direction[2],
-               sn->normalize_to_k);
+               i, sn->name, sn->columns, sn->rows, sn->fov_deg, sn->oversampling, sn->oversampling,
+               sn->aperture_m2, sn->position_m[0], sn->position_m[1], sn->position_m[2],
+               sn->direction[0], sn->direction[1], sn->direction[2], sn->normalize_to_k);
     }
     static const char *const integrators[] = {"photon-map", "final-gather", "path"};
     printf("\nphotons: %llu per channel, seed %llu, min_relative_power %g, gather_min_photons %u\n",
@@ -103,8 +101,7 @@ static void validate_print(const thz_scene *s)
            integrators[s->render.integrator], s->render.gather_rays, s->render.paths_per_sample);
     printf("\nemitted spectral power P_A (band mean):\n");
     for (size_t c = 0; c < s->n_channels; c++)
-        printf("  %-16s %.6e W/Hz\n", s->channels[c].name,
-               scene_band_emitted_power_w_per_hz(s, c));
+        printf("  %-16s %.6e W/Hz\n", s->channels[c].name, scene_band_emitted_power_w_per_hz(s, c));
 }
 
 int cmd_validate(int argc, char **argv)

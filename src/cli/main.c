@@ -69,8 +69,8 @@ bool cli_parse_u64(const char *cmd, const char *option, const char *text, uint64
     return true;
 }
 
-bool cli_parse_double(const char *cmd, const char *option, const char *text, double min,
-                      double max, double *out)
+bool cli_parse_double(const char *cmd, const char *option, const char *text, double min, double max,
+                      double *out)
 {
     char *end = NULL;
     errno = 0;

@@ -19,11 +19,11 @@ typedef struct cli_progress {
     const char *command; /* "simulate", "render" */
     bool quiet;
     bool tty;
-    bool line_open;      /* a terminal line is being updated */
-    const char *stage;   /* current (stage, channel), NULL before the first report */
+    bool line_open;    /* a terminal line is being updated */
+    const char *stage; /* current (stage, channel), NULL before the first report */
     size_t channel;
     uint64_t last_done;
-    bool completed;      /* the completion of the current stage was shown */
+    bool completed;       /* the completion of the current stage was shown */
     double stage_start_s; /* taken as the time of the report before the stage's first one:
                              stages may report only when a batch is done */
     double last_report_s;

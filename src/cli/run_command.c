@@ -16,47 +16,45 @@
 static void cli_run_usage(FILE *f, bool render)
 {
     if (!render)
-        fprintf(f,
-                "usage: thzmap simulate SCENE.json -o OUTDIR [options]\n\n"
-                "Fires photons and renders every sensor of the scene; writes the images,\n"
-                "previews and summary.json into OUTDIR (created if missing).\n\n"
-                "options:\n"
-                "  -o, --output OUTDIR   where the results go (required)\n"
-                "  --photons N           photons per channel (overrides photons.per_channel)\n"
-                "  --seed S              random seed (overrides photons.seed)\n"
-                "  --threads T           threads to use (default: all cores)\n"
-                "  --integrator NAME     photon-map | final-gather | path (overrides\n"
-                "                        render.integrator; path fires no photons)\n"
-                "  --target-noise-k X    final-gather, path: add passes of gather rays or\n"
-                "                        paths to each channel until the median per-pixel\n"
-                "                        standard error of the brightness temperature is at\n"
-                "                        most X K (each pass is deterministic)\n"
-                "  --max-seconds S       with --target-noise-k: stop adding passes once a\n"
-                "                        channel has rendered for S s; the stopping point, and\n"
-                "                        so the images, then depend on the machine's speed\n"
-                "  --save-photon-map     also write photon-map.thzpm (for render) and\n"
-                "                        photon-map.ply\n"
-                "  --ply-max-points N    at most N photons (evenly strided) in\n"
-                "                        photon-map.ply (default 2000000)\n"
-                "  --quiet               no progress output\n");
+        fprintf(f, "usage: thzmap simulate SCENE.json -o OUTDIR [options]\n\n"
+                   "Fires photons and renders every sensor of the scene; writes the images,\n"
+                   "previews and summary.json into OUTDIR (created if missing).\n\n"
+                   "options:\n"
+                   "  -o, --output OUTDIR   where the results go (required)\n"
+                   "  --photons N           photons per channel (overrides photons.per_channel)\n"
+                   "  --seed S              random seed (overrides photons.seed)\n"
+                   "  --threads T           threads to use (default: all cores)\n"
+                   "  --integrator NAME     photon-map | final-gather | path (overrides\n"
+                   "                        render.integrator; path fires no photons)\n"
+                   "  --target-noise-k X    final-gather, path: add passes of gather rays or\n"
+                   "                        paths to each channel until the median per-pixel\n"
+                   "                        standard error of the brightness temperature is at\n"
+                   "                        most X K (each pass is deterministic)\n"
+                   "  --max-seconds S       with --target-noise-k: stop adding passes once a\n"
+                   "                        channel has rendered for S s; the stopping point, and\n"
+                   "                        so the images, then depend on the machine's speed\n"
+                   "  --save-photon-map     also write photon-map.thzpm (for render) and\n"
+                   "                        photon-map.ply\n"
+                   "  --ply-max-points N    at most N photons (evenly strided) in\n"
+                   "                        photon-map.ply (default 2000000)\n"
+                   "  --quiet               no progress output\n");
     else
-        fprintf(f,
-                "usage: thzmap render SCENE.json --photon-map FILE -o OUTDIR [options]\n\n"
-                "Renders the scene's sensors again from a photon map saved by\n"
-                "'thzmap simulate --save-photon-map', without firing photons.\n\n"
-                "options:\n"
-                "  --photon-map FILE     the photon map (photon-map.thzpm); not needed with\n"
-                "                        --integrator path\n"
-                "  -o, --output OUTDIR   where the results go (required)\n"
-                "  --sensor NAME         render only this sensor (default: all)\n"
-                "  --threads T           threads to use (default: all cores)\n"
-                "  --integrator NAME     photon-map | final-gather | path\n"
-                "  --target-noise-k X    final-gather, path: add passes until the median\n"
-                "                        per-pixel standard error of the brightness\n"
-                "                        temperature is at most X K (each pass deterministic)\n"
-                "  --max-seconds S       with --target-noise-k: stop adding passes once a\n"
-                "                        channel has rendered for S s (time-dependent result)\n"
-                "  --quiet               no progress output\n");
+        fprintf(f, "usage: thzmap render SCENE.json --photon-map FILE -o OUTDIR [options]\n\n"
+                   "Renders the scene's sensors again from a photon map saved by\n"
+                   "'thzmap simulate --save-photon-map', without firing photons.\n\n"
+                   "options:\n"
+                   "  --photon-map FILE     the photon map (photon-map.thzpm); not needed with\n"
+                   "                        --integrator path\n"
+                   "  -o, --output OUTDIR   where the results go (required)\n"
+                   "  --sensor NAME         render only this sensor (default: all)\n"
+                   "  --threads T           threads to use (default: all cores)\n"
+                   "  --integrator NAME     photon-map | final-gather | path\n"
+                   "  --target-noise-k X    final-gather, path: add passes until the median\n"
+                   "                        per-pixel standard error of the brightness\n"
+                   "                        temperature is at most X K (each pass deterministic)\n"
+                   "  --max-seconds S       with --target-noise-k: stop adding passes once a\n"
+                   "                        channel has rendered for S s (time-dependent result)\n"
+                   "  --quiet               no progress output\n");
 }
 
 static double cli_now_s(void)
@@ -83,15 +81,13 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
             cli_run_usage(stdout, render);
             return CLI_EXIT_OK;
         }
-        bool takes_value = strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0 ||
-                           strcmp(arg, "--threads") == 0 || strcmp(arg, "--integrator") == 0 ||
-                           strcmp(arg, "--target-noise-k") == 0 ||
-                           strcmp(arg, "--max-seconds") == 0 ||
-                           (!render && (strcmp(arg, "--photons") == 0 ||
-                                        strcmp(arg, "--seed") == 0 ||
-                                        strcmp(arg, "--ply-max-points") == 0)) ||
-                           (render && (strcmp(arg, "--photon-map") == 0 ||
-                                       strcmp(arg, "--sensor") == 0));
+        bool takes_value =
+            strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0 ||
+            strcmp(arg, "--threads") == 0 || strcmp(arg, "--integrator") == 0 ||
+            strcmp(arg, "--target-noise-k") == 0 || strcmp(arg, "--max-seconds") == 0 ||
+            (!render && (strcmp(arg, "--photons") == 0 || strcmp(arg, "--seed") == 0 ||
+                         strcmp(arg, "--ply-max-points") == 0)) ||
+            (render && (strcmp(arg, "--photon-map") == 0 || strcmp(arg, "--sensor") == 0));
         if (takes_value) {
             if (i + 1 >= argc)
                 return cli_usage_error(cmd, "%s needs a value", arg);
@@ -110,13 +106,12 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
                                            "path, got '%s'",
                                            val);
                 a->ov.has_integrator = true;
-            } else if (strcmp(arg, "--target-noise-k") == 0 ||
-                       strcmp(arg, "--max-seconds") == 0) {
+            } else if (strcmp(arg, "--target-noise-k") == 0 || strcmp(arg, "--max-seconds") == 0) {
                 char *end = NULL;
                 double x = strtod(val, &end);
                 if (end == val || *end || !isfinite(x) || !(x > 0.0))
-                    return cli_usage_error(cmd, "%s expects a positive number (%s), got '%s'",
-                                           arg, arg[2] == 't' ? "K" : "s", val);
+                    return cli_usage_error(cmd, "%s expects a positive number (%s), got '%s'", arg,
+                                           arg[2] == 't' ? "K" : "s", val);
                 if (arg[2] == 't')
                     a->opt.target_noise_k = x;
                 else
@@ -210,7 +205,8 @@ int cli_run_command(int argc, char **argv, bool render)
                    result.n_sensors == 1 ? "" : "s", result.n_channels,
                    result.n_channels == 1 ? "" : "s");
             if (result.photons_fired)
-                printf(", %llu photons fired, %llu stored", (unsigned long long)result.photons_fired,
+                printf(", %llu photons fired, %llu stored",
+                       (unsigned long long)result.photons_fired,
                        (unsigned long long)result.photons_stored);
             if (result.worst_median_stderr_k > 0.0)
                 printf(", median pixel standard error <= %.3g K", result.worst_median_stderr_k);

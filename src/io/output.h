@@ -47,12 +47,12 @@ typedef struct run_summary {
     uint64_t seed;
     uint64_t photons_per_channel;
     int threads;
-    const photon_stats *channel_stats; /* n_channels entries, or NULL (render) */
-    const double *median_stderr_k;     /* n_channels entries, or NULL */
-    const uint32_t *passes;            /* n_channels entries: render passes, or NULL */
+    const photon_stats *channel_stats;    /* n_channels entries, or NULL (render) */
+    const double *median_stderr_k;        /* n_channels entries, or NULL */
+    const uint32_t *passes;               /* n_channels entries: render passes, or NULL */
     const double *seconds_render_channel; /* n_channels entries: render time (s), or NULL */
-    double target_noise_k;             /* the run's noise target (K), 0: none */
-    uint64_t *back_face_samples;       /* per sensor: samples that saw a back face, or NULL */
+    double target_noise_k;                /* the run's noise target (K), 0: none */
+    uint64_t *back_face_samples;          /* per sensor: samples that saw a back face, or NULL */
     double seconds_load, seconds_accel, seconds_photons, seconds_render, seconds_output;
     size_t n_run_warnings;
     const char *const *run_warnings;

@@ -57,11 +57,15 @@ static double get_f64(const uint8_t *p)
 /* The stats of one channel as 17 words (order fixed by version 1). */
 static void pmf_put_stats(uint8_t *p, const photon_stats *s)
 {
-    const uint64_t u[10] = {s->fired,   s->stored,  s->hits,           s->reflected,  s->transmitted,
-                            s->absorbed, s->escaped, s->back_face_hits, s->terminated, s->bounce_capped};
-    const double d[7] = {s->emitted_power_w_per_hz,    s->absorbed_power_w_per_hz,
-                         s->escaped_power_w_per_hz,    s->atmosphere_power_w_per_hz,
-                         s->mean_bounces,              s->fired_power_w_per_hz,
+    const uint64_t u[10] = {s->fired,       s->stored,       s->hits,    s->reflected,
+                            s->transmitted, s->absorbed,     s->escaped, s->back_face_hits,
+                            s->terminated,  s->bounce_capped};
+    const double d[7] = {s->emitted_power_w_per_hz,
+                         s->absorbed_power_w_per_hz,
+                         s->escaped_power_w_per_hz,
+                         s->atmosphere_power_w_per_hz,
+                         s->mean_bounces,
+                         s->fired_power_w_per_hz,
                          s->terminated_power_w_per_hz};
     for (int i = 0; i < 10; i++)
         put_u64(p + 8 * i, u[i]);
@@ -72,11 +76,15 @@ static void pmf_put_stats(uint8_t *p, const photon_stats *s)
 static void pmf_get_stats(const uint8_t *p, photon_stats *s)
 {
     memset(s, 0, sizeof *s);
-    uint64_t *u[10] = {&s->fired,   &s->stored,  &s->hits,           &s->reflected,  &s->transmitted,
-                       &s->absorbed, &s->escaped, &s->back_face_hits, &s->terminated, &s->bounce_capped};
-    double *d[7] = {&s->emitted_power_w_per_hz,    &s->absorbed_power_w_per_hz,
-                    &s->escaped_power_w_per_hz,    &s->atmosphere_power_w_per_hz,
-                    &s->mean_bounces,              &s->fired_power_w_per_hz,
+    uint64_t *u[10] = {&s->fired,       &s->stored,       &s->hits,    &s->reflected,
+                       &s->transmitted, &s->absorbed,     &s->escaped, &s->back_face_hits,
+                       &s->terminated,  &s->bounce_capped};
+    double *d[7] = {&s->emitted_power_w_per_hz,
+                    &s->absorbed_power_w_per_hz,
+                    &s->escaped_power_w_per_hz,
+                    &s->atmosphere_power_w_per_hz,
+                    &s->mean_bounces,
+                    &s->fired_power_w_per_hz,
                     &s->terminated_power_w_per_hz};
     for (int i = 0; i < 10; i++)
         *u[i] = get_u64(p + 8 * i);
@@ -225,8 +233,8 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
     put_u64(header + 48, scene->photons.per_channel);
     for (size_t c = 0; c < nc; c++) {
         if (!maps[c]) {
-            st = thz_error_set(err, THZ_ERR_INTERNAL, "cannot write photon map %s: channel %zu has no map",
-                               path, c);
+            st = thz_error_set(err, THZ_ERR_INTERNAL,
+                               "cannot write photon map %s: channel %zu has no map", path, c);
             goto cleanup;
         }
         uint8_t *p = header + 8 * (PMF_HEADER_FIXED + (size_t)PMF_CHANNEL_WORDS * c);
@@ -243,7 +251,8 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
 
     w.f = fopen(path, "wb");
     if (!w.f) {
-        st = thz_error_set(err, THZ_ERR_IO, "cannot create photon map %s: %s", path, strerror(errno));
+        st = thz_error_set(err, THZ_ERR_IO, "cannot create photon map %s: %s", path,
+                           strerror(errno));
         goto cleanup;
     }
     uint8_t prefix[PMF_PREFIX_BYTES] = {0};
@@ -264,7 +273,8 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
         goto cleanup;
     long size = ftell(w.f);
     if (size < 0 || fseek(w.f, 16, SEEK_SET) != 0) {
-        st = thz_error_set(err, THZ_ERR_IO, "cannot write photon map %s: %s", path, strerror(errno));
+        st =
+            thz_error_set(err, THZ_ERR_IO, "cannot write photon map %s: %s", path, strerror(errno));
         goto cleanup;
     }
     put_u64(prefix + 16, (uint64_t)size);
@@ -274,7 +284,8 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
     FILE *f = w.f;
     w.f = NULL;
     if (fclose(f) != 0)
-        st = thz_error_set(err, THZ_ERR_IO, "cannot write photon map %s: %s", path, strerror(errno));
+        st =
+            thz_error_set(err, THZ_ERR_IO, "cannot write photon map %s: %s", path, strerror(errno));
 cleanup:
     if (w.f)
         fclose(w.f);
@@ -298,8 +309,9 @@ typedef struct pmf_reader {
 
 static thz_status pmf_corrupt(const pmf_reader *r, const char *why, thz_error *err)
 {
-    return thz_error_set(err, THZ_ERR_IO, "photon map %s is corrupted (%s); run `thzmap simulate` again",
-                         r->path, why);
+    return thz_error_set(err, THZ_ERR_IO,
+                         "photon map %s is corrupted (%s); run `thzmap simulate` again", r->path,
+                         why);
 }
 
 static thz_status pmf_zstd_error(const pmf_reader *r, size_t code, thz_error *err)
@@ -375,8 +387,8 @@ static thz_status pmf_end_frame(pmf_reader *r, thz_error *err)
 }
 
 thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,
-                                photon_map **maps, photon_stats *stats,
-                                photon_map_file_info *info, thz_error *err)
+                                photon_map **maps, photon_stats *stats, photon_map_file_info *info,
+                                thz_error *err)
 {
     thz_status st = THZ_OK;
     size_t nc = scene->n_channels;
@@ -422,9 +434,10 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
     }
     uint64_t stated = get_u64(prefix + 16);
     if ((uint64_t)actual < stated) {
-        st = thz_error_set(err, THZ_ERR_IO,
-                           "photon map %s is truncated (%ld of %llu bytes); run `thzmap simulate` again",
-                           path, actual, (unsigned long long)stated);
+        st = thz_error_set(
+            err, THZ_ERR_IO,
+            "photon map %s is truncated (%ld of %llu bytes); run `thzmap simulate` again", path,
+            actual, (unsigned long long)stated);
         goto cleanup;
     }
     if ((uint64_t)actual > stated) {

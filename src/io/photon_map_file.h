@@ -51,7 +51,7 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
  * zstd checksums), and one made from another scene geometry, material set or channel
  * set (THZ_ERR_INPUT). */
 thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,
-                                photon_map **maps, photon_stats *stats,
-                                photon_map_file_info *info, thz_error *err);
+                                photon_map **maps, photon_stats *stats, photon_map_file_info *info,
+                                thz_error *err);
 
 #endif

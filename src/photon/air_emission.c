@@ -226,9 +226,9 @@ thz_status air_emission_init(air_emission *a, const thz_scene *scene, const acce
         }
     }
     if (a->area_m2 > 0.0)
-        boundary_box = M_PI * a->area_m2 *
-                       channel_band_mean(&scene->channels[channel], air_emission_boundary_at,
-                                         (void *)atm);
+        boundary_box =
+            M_PI * a->area_m2 *
+            channel_band_mean(&scene->channels[channel], air_emission_boundary_at, (void *)atm);
     if (!(air_box > 0.0) && !(boundary_box > 0.0)) {
         air_emission_fini(a);
         a->scene = scene;

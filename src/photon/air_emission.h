@@ -58,16 +58,16 @@ typedef struct air_emission {
     double eps_m;              /* step inside the box for the boundary's visibility test */
     /* the air */
     double volume_m3;
-    double air_share;           /* estimated share of air photons kept (not in solids) */
-    double air_power_w_per_hz;  /* band mean of P_air over the box, times air_share */
-    double lo_hz, bin_hz;       /* bin i covers [lo + i bin, lo + (i + 1) bin) */
-    double *q;                  /* AIR_EMISSION_BINS histogram densities (> 0), or NULL */
-    double *cdf;                /* cumulative q_i bin_hz; last = Q */
+    double air_share;          /* estimated share of air photons kept (not in solids) */
+    double air_power_w_per_hz; /* band mean of P_air over the box, times air_share */
+    double lo_hz, bin_hz;      /* bin i covers [lo + i bin, lo + (i + 1) bin) */
+    double *q;                 /* AIR_EMISSION_BINS histogram densities (> 0), or NULL */
+    double *cdf;               /* cumulative q_i bin_hz; last = Q */
     /* the boundary */
-    double area_m2;                  /* of the box's six faces */
-    double face_cdf[6];              /* cumulative face areas */
-    double open_share;               /* estimated share of boundary photons kept */
-    double boundary_power_w_per_hz;  /* pi A band mean of L_b, times open_share */
+    double area_m2;                 /* of the box's six faces */
+    double face_cdf[6];             /* cumulative face areas */
+    double open_share;              /* estimated share of boundary photons kept */
+    double boundary_power_w_per_hz; /* pi A band mean of L_b, times open_share */
     /* class probabilities: air, boundary, surfaces */
     double p_air, p_boundary, p_surfaces;
     double band_power_w_per_hz; /* air + boundary: to add to the surfaces' Pbar_A */

@@ -35,15 +35,15 @@
 
 /* One emitting object. */
 typedef struct emission_source {
-    uint32_t object;         /* index into scene->objects */
-    int sides;               /* 1 or 2 emitting sides */
-    double area_m2;          /* total area of one side */
-    bool constant_optics;    /* R, alpha_M and eps do not depend on frequency */
-    double weight;           /* constant optics: pi eps-bar A sides (times B_nu(T) = power) */
-    double share;            /* weight within its group: `weight` (constant optics) or
-                                A sides (variable optics, eps-bar shared by the group) */
-    optics_point optics;     /* constant optics: the optics at every frequency */
-    double *triangle_cdf;    /* n_triangles cumulative areas, last = total */
+    uint32_t object;      /* index into scene->objects */
+    int sides;            /* 1 or 2 emitting sides */
+    double area_m2;       /* total area of one side */
+    bool constant_optics; /* R, alpha_M and eps do not depend on frequency */
+    double weight;        /* constant optics: pi eps-bar A sides (times B_nu(T) = power) */
+    double share;         /* weight within its group: `weight` (constant optics) or
+                             A sides (variable optics, eps-bar shared by the group) */
+    optics_point optics;  /* constant optics: the optics at every frequency */
+    double *triangle_cdf; /* n_triangles cumulative areas, last = total */
 } emission_source;
 
 /* Sources whose power differs only by a frequency-independent factor form one group, so
@@ -55,8 +55,8 @@ typedef struct emission_group {
     double temperature_k;
     size_t first, count; /* range of emission_table.order */
     bool constant_optics;
-    double weight;       /* constant: sum of weights; variable: pi sum of A sides */
-    double *cdf;         /* count cumulative shares (count > 1) */
+    double weight; /* constant: sum of weights; variable: pi sum of A sides */
+    double *cdf;   /* count cumulative shares (count > 1) */
 } emission_group;
 
 /* Nodes of the tabulated group weights q_g over the band: centre +- 9 sigma (Box-Muller
@@ -73,7 +73,7 @@ typedef struct emission_table {
     emission_source *sources;
     size_t n_groups;
     emission_group *groups;
-    size_t *order; /* source indices, grouped */
+    size_t *order;          /* source indices, grouped */
     double nu0_hz, step_hz; /* node i at nu0 + i step */
     double *cum_q;          /* [node * n_groups + g]: sum of q_g' over g' <= g */
 } emission_table;
@@ -86,7 +86,7 @@ typedef struct emission_photon {
     vec3 dir;              /* unit, into the emitting side's hemisphere */
     uint32_t object;
     uint32_t triangle;
-    int side;              /* 0 front, 1 back */
+    int side; /* 0 front, 1 back */
 } emission_photon;
 
 thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t channel,

@@ -73,7 +73,8 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                 ch->thread = tid;
                 ch->start = b->count;
                 uint64_t lo = first + (uint64_t)k * PHASE_CHUNK;
-                uint64_t hi = lo + PHASE_CHUNK < first + batch_n ? lo + PHASE_CHUNK : first + batch_n;
+                uint64_t hi =
+                    lo + PHASE_CHUNK < first + batch_n ? lo + PHASE_CHUNK : first + batch_n;
                 for (uint64_t i = lo; i < hi; i++) {
                     rng_stream rng;
                     rng_init(&rng, seed, channel, RNG_PURPOSE_PHOTON, i);
@@ -124,11 +125,11 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
             }
         }
         if (failed) {
-            st = failed == 2 ? thz_error_set(err, THZ_ERR_NOMEM,
-                                             "photon phase: out of memory for %zu photon records",
-                                             count)
-                             : thz_error_set(err, THZ_ERR_NOMEM,
-                                             "photon phase: out of memory for photon records");
+            st = failed == 2
+                     ? thz_error_set(err, THZ_ERR_NOMEM,
+                                     "photon phase: out of memory for %zu photon records", count)
+                     : thz_error_set(err, THZ_ERR_NOMEM,
+                                     "photon phase: out of memory for photon records");
             goto cleanup;
         }
 
@@ -272,8 +273,12 @@ thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc,
         emission_table_fini(&table);
         return st;
     }
-    phase_fire_args a = {.scene = scene, .acc = acc, .table = &table, .air = &air,
-                         .channel = channel, .n_photons = pilot};
+    phase_fire_args a = {.scene = scene,
+                         .acc = acc,
+                         .table = &table,
+                         .air = &air,
+                         .channel = channel,
+                         .n_photons = pilot};
     photon_record *records = NULL;
     size_t count = 0;
     trace_counters c;

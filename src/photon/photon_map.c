@@ -179,8 +179,8 @@ static void photon_sort_small(photon_record *r, uint64_t *code, size_t n)
         photon_record x = r[i];
         uint64_t k = code[i];
         size_t j = i;
-        while (j > 0 && (code[j - 1] > k ||
-                         (code[j - 1] == k && memcmp(&r[j - 1], &x, sizeof x) > 0))) {
+        while (j > 0 &&
+               (code[j - 1] > k || (code[j - 1] == k && memcmp(&r[j - 1], &x, sizeof x) > 0))) {
             r[j] = r[j - 1];
             code[j] = code[j - 1];
             j--;
@@ -349,8 +349,7 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
      * the map is built: the peak is 1.25 times the map). */
     codes = thz_malloc_array(count ? count : 1, sizeof *codes);
     if (!codes) {
-        st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu photons",
-                           count);
+        st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu photons", count);
         goto cleanup;
     }
     map->records = photons;
@@ -518,8 +517,8 @@ static void photon_radius_axes(const photon_radius_query *qr, const photon_cell 
         return;
     if (axis == 3) {
         photon_cell ch = {.level = cell->level + 1,
-                          .c = {cell->c[0] << 1 | (bits >> 2 & 1u), cell->c[1] << 1 | (bits >> 1 & 1u),
-                                cell->c[2] << 1 | (bits & 1u)},
+                          .c = {cell->c[0] << 1 | (bits >> 2 & 1u),
+                                cell->c[1] << 1 | (bits >> 1 & 1u), cell->c[2] << 1 | (bits & 1u)},
                           .lo = lo,
                           .hi = hi};
         if (photon_cell_distance2(qr->cube, &ch, qr->q) <= qr->radius2)
@@ -530,8 +529,8 @@ static void photon_radius_axes(const photon_radius_query *qr, const photon_cell 
     double mid_m = qr->cube->origin[axis] + ((double)cell->c[axis] + 0.5) * size;
     bool low = qr->q[axis] - qr->radius <= mid_m + pad;
     bool high = qr->q[axis] + qr->radius >= mid_m - pad;
-    size_t m = photon_bit_boundary(qr->cube, qr->r, lo, hi, axis,
-                                   PHOTON_MAP_LEVELS - (cell->level + 1));
+    size_t m =
+        photon_bit_boundary(qr->cube, qr->r, lo, hi, axis, PHOTON_MAP_LEVELS - (cell->level + 1));
     if (low)
         photon_radius_axes(qr, cell, lo, m, axis + 1, bits << 1);
     if (high)
@@ -682,8 +681,8 @@ double photon_map_kth_distance2(const photon_map *map, uint32_t object, unsigned
     if (total < k)
         return INFINITY;
     double stack_heap[PHOTON_MAP_STACK_K];
-    photon_knn h = {NULL, map->records, {position_m.x, position_m.y, position_m.z}, stack_heap,
-                    0, k};
+    photon_knn h = {NULL, map->records, {position_m.x, position_m.y, position_m.z}, stack_heap, 0,
+                    k};
     if (k > PHOTON_MAP_STACK_K) {
         /* Documented exception to "queries allocate nothing": k above 256. */
         h.heap = thz_malloc_array(k, sizeof *h.heap);

@@ -15,12 +15,12 @@
 
 /* One stored photon hit (32 bytes). */
 typedef struct photon_record {
-    float position_m[3];   /* hit point */
-    float power_w_per_hz;  /* incident spectral power carried (already attenuated) */
-    float freq_hz;         /* the photon's own frequency (float: 60 kHz resolution at 1 THz) */
-    uint32_t dir_oct;      /* incoming unit direction, octahedral 2 x 16 bit */
-    uint32_t object_side;  /* object index << 1 | side (0 front, 1 back) */
-    uint32_t flags;        /* bounce count in the low 16 bits; reserved */
+    float position_m[3];  /* hit point */
+    float power_w_per_hz; /* incident spectral power carried (already attenuated) */
+    float freq_hz;        /* the photon's own frequency (float: 60 kHz resolution at 1 THz) */
+    uint32_t dir_oct;     /* incoming unit direction, octahedral 2 x 16 bit */
+    uint32_t object_side; /* object index << 1 | side (0 front, 1 back) */
+    uint32_t flags;       /* bounce count in the low 16 bits; reserved */
 } photon_record;
 
 _Static_assert(sizeof(photon_record) == 32, "photon_record must stay 32 bytes");

@@ -5,21 +5,21 @@
 #include <stdint.h>
 
 typedef struct photon_stats {
-    uint64_t fired;          /* K */
-    uint64_t stored;         /* records in the photon map */
-    uint64_t hits;           /* surface hits (each stored) */
-    uint64_t reflected;      /* roulette: reflection */
-    uint64_t transmitted;    /* roulette: transmission through a shell */
-    uint64_t absorbed;       /* roulette: absorption (front or back side) */
-    uint64_t escaped;        /* left the scene without a hit */
-    uint64_t back_face_hits; /* hits on the back side of one-sided solids (absorbed) */
-    uint64_t terminated;     /* ended by the low-power roulette */
-    double emitted_power_w_per_hz;  /* band mean P_A: the power fired */
-    double absorbed_power_w_per_hz; /* sum of power absorbed by surfaces */
-    double escaped_power_w_per_hz;  /* sum of power that left the scene */
+    uint64_t fired;                   /* K */
+    uint64_t stored;                  /* records in the photon map */
+    uint64_t hits;                    /* surface hits (each stored) */
+    uint64_t reflected;               /* roulette: reflection */
+    uint64_t transmitted;             /* roulette: transmission through a shell */
+    uint64_t absorbed;                /* roulette: absorption (front or back side) */
+    uint64_t escaped;                 /* left the scene without a hit */
+    uint64_t back_face_hits;          /* hits on the back side of one-sided solids (absorbed) */
+    uint64_t terminated;              /* ended by the low-power roulette */
+    double emitted_power_w_per_hz;    /* band mean P_A: the power fired */
+    double absorbed_power_w_per_hz;   /* sum of power absorbed by surfaces */
+    double escaped_power_w_per_hz;    /* sum of power that left the scene */
     double atmosphere_power_w_per_hz; /* sum of power absorbed by the atmosphere */
-    double mean_bounces;            /* mean number of hits per photon path */
-    double seconds;                 /* wall time of the phase (not reproducible) */
+    double mean_bounces;              /* mean number of hits per photon path */
+    double seconds;                   /* wall time of the phase (not reproducible) */
     /* Energy balance (added by the photon phase): absorbed + escaped + atmosphere +
      * terminated power = fired power exactly; fired power estimates emitted power. */
     double fired_power_w_per_hz;      /* sum of the photons' initial powers */

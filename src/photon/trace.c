@@ -80,8 +80,8 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
         .object = e->object, .triangle = e->triangle, .position_m = e->position_m, .side = e->side};
     vec3 dir = e->dir;
     /* An air photon (air_emission.h) starts from its point in the volume itself. */
-    vec3 origin = e->object == ACCEL_NO_OBJECT ? e->position_m
-                                               : accel_offset_origin(acc, &from, dir);
+    vec3 origin =
+        e->object == ACCEL_NO_OBJECT ? e->position_m : accel_offset_origin(acc, &from, dir);
     vec3 surface = e->position_m; /* the un-offset point the free path starts from */
     uint32_t ignore_obj = e->object, ignore_tri = e->triangle;
 

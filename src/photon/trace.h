@@ -30,8 +30,8 @@
 
 /* Counters of the paths traced; summed over chunks in a fixed order. */
 typedef struct trace_counters {
-    uint64_t photons;   /* photons started (including those of zero power) */
-    uint64_t rays;      /* rays cast (hits, escapes and low-power stops) */
+    uint64_t photons; /* photons started (including those of zero power) */
+    uint64_t rays;    /* rays cast (hits, escapes and low-power stops) */
     uint64_t hits;
     uint64_t reflected;
     uint64_t transmitted;
@@ -40,7 +40,7 @@ typedef struct trace_counters {
     uint64_t back_face_hits;
     uint64_t terminated;
     uint64_t capped;    /* paths stopped at TRACE_MAX_BOUNCES */
-    double fired_power;      /* sum of initial powers, W/Hz */
+    double fired_power; /* sum of initial powers, W/Hz */
     double absorbed_power;
     double escaped_power;
     double atmosphere_power;

@@ -79,8 +79,8 @@ thz_status channel_quadrature_init(channel_quadrature *q, const thz_channel *ch,
     if (!f || !w) {
         free(f);
         free(w);
-        return thz_error_set(err, THZ_ERR_NOMEM,
-                             "channel quadrature: cannot allocate %zu nodes", n);
+        return thz_error_set(err, THZ_ERR_NOMEM, "channel quadrature: cannot allocate %zu nodes",
+                             n);
     }
     double sigma = channel_sigma_hz(ch);
     double sum = 0.0;
@@ -146,8 +146,7 @@ static void channel_adapt_eval(const channel_adapt *a, double x, double *gf, dou
 /* Panel [x0, x2] with values at its ends and midpoint; s_num its Simpson estimate of
  * int g f. */
 static void channel_adapt_panel(channel_adapt *a, double x0, double x2, const double fv[3],
-                                const double gv[3], double s_num, double tol,
-                                int depth)
+                                const double gv[3], double s_num, double tol, int depth)
 {
     double x1 = 0.5 * (x0 + x2);
     double xl = 0.5 * (x0 + x1), xr = 0.5 * (x1 + x2);

@@ -182,8 +182,7 @@ bool optics_sample_transmission_mu(const optics_point *o, optics_uniform_fn next
     }
 }
 
-bool optics_sample_emission_mu(const optics_point *o, optics_uniform_fn next, void *ctx,
-                               double *mu)
+bool optics_sample_emission_mu(const optics_point *o, optics_uniform_fn next, void *ctx, double *mu)
 {
     double c = optics_cap(o);
     double tau = optics_tau(o);

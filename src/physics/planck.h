@@ -2,8 +2,8 @@
 #ifndef THZ_PHYSICS_PLANCK_H
 #define THZ_PHYSICS_PLANCK_H
 
-#define THZ_PLANCK_H 6.62607015e-34  /* J s   */
-#define THZ_BOLTZMANN_K 1.380649e-23 /* J/K   */
+#define THZ_PLANCK_H 6.62607015e-34    /* J s   */
+#define THZ_BOLTZMANN_K 1.380649e-23   /* J/K   */
 #define THZ_SPEED_OF_LIGHT 299792458.0 /* m/s */
 
 /* Spectral radiance of a black body, B_nu(T) in W m^-2 sr^-1 Hz^-1. T = 0 gives 0.

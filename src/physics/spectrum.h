@@ -8,9 +8,9 @@
 #include <stddef.h>
 
 typedef struct thz_spectrum {
-    size_t n;         /* 0: not given; 1: constant value[0]; >1: table */
-    double *freq_hz;  /* n entries for a table, NULL for a constant */
-    double *value;    /* n entries */
+    size_t n;        /* 0: not given; 1: constant value[0]; >1: table */
+    double *freq_hz; /* n entries for a table, NULL for a constant */
+    double *value;   /* n entries */
 } thz_spectrum;
 
 /* Value at freq_hz. An absent spectrum (n == 0) evaluates to 0. */

@@ -170,8 +170,8 @@ static thz_status run_state_init(run_state *rs, const thz_scene *scene, const ru
         if (!opt->sensor_name || strcmp(opt->sensor_name, scene->sensors[s].name) == 0)
             rs->selected[rs->n_selected++] = s;
     if (rs->n_selected == 0)
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: the scene has no sensor named '%s'",
-                             command, opt->sensor_name ? opt->sensor_name : "");
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: the scene has no sensor named '%s'", command,
+                             opt->sensor_name ? opt->sensor_name : "");
     rs->images = thz_calloc(rs->n_selected, sizeof *rs->images);
     rs->back_face = thz_calloc(ns, sizeof *rs->back_face); /* summary.json: per scene sensor */
     rs->render_sum = thz_calloc(rs->n_selected, sizeof *rs->render_sum);
@@ -204,8 +204,7 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
                          "the run would need %.2f GiB of memory (photon maps %.2f GiB, images "
                          "%.2f GiB) but this machine has %.2f GiB; lower %s",
                          (double)need->total_bytes / gib, (double)need->photon_bytes / gib,
-                         (double)need->image_bytes / gib, (double)need->available_bytes / gib,
-                         key);
+                         (double)need->image_bytes / gib, (double)need->available_bytes / gib, key);
 }
 
 static uint64_t run_image_bytes(const run_state *rs)
@@ -299,8 +298,7 @@ static size_t run_rendered_pixels(const run_state *rs)
 
 /* Renders channel c of every selected sensor: one pass, or, with a noise target, passes
  * until the channel's median standard error reaches it or the time limit passes. */
-static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map,
-                                     thz_error *err)
+static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, thz_error *err)
 {
     render_options ro = {.threads = rs->opt->threads,
                          .use_seed = true,
@@ -394,11 +392,11 @@ static thz_status run_render_warnings(run_state *rs, thz_error *err)
                                  "raise photons.per_channel",
                                  name, (unsigned long long)r->starved_gathers);
         if (st == THZ_OK && r->truncated_paths)
-            st = run_add_warning(rs, err,
-                                 "sensor '%s': %llu samples crossed more than %d straight shells "
-                                 "(what lies behind was dropped)",
-                                 name, (unsigned long long)r->truncated_paths,
-                                 RENDER_MAX_CROSSINGS);
+            st =
+                run_add_warning(rs, err,
+                                "sensor '%s': %llu samples crossed more than %d straight shells "
+                                "(what lies behind was dropped)",
+                                name, (unsigned long long)r->truncated_paths, RENDER_MAX_CROSSINGS);
     }
     return st;
 }

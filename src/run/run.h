@@ -26,9 +26,9 @@
 
 /* Command-line overrides of scene settings (applied by run_apply_overrides). */
 typedef struct run_overrides {
-    uint64_t photons;        /* photons.per_channel; 0 keeps the scene's */
+    uint64_t photons; /* photons.per_channel; 0 keeps the scene's */
     bool has_seed;
-    uint64_t seed;           /* photons.seed */
+    uint64_t seed; /* photons.seed */
     bool has_integrator;
     thz_integrator integrator; /* render.integrator */
 } run_overrides;
@@ -42,19 +42,19 @@ typedef struct run_options {
     const char *sensor_name;     /* render: only this sensor; NULL: all */
     thz_progress_fn progress;    /* stages "photons", "render", "output"; may be NULL */
     void *progress_user;
-    double seconds_load;         /* time the caller spent loading the scene, for the summary */
-    double target_noise_k;       /* > 0: add passes to each channel until the median per-pixel
-                                    standard error of Tb_c, over the rendered sensors, is at
-                                    most this (K); final-gather and path only */
-    double max_seconds;          /* > 0: stop adding passes once a channel has rendered this
-                                    long (s); makes the stopping point time-dependent */
+    double seconds_load;   /* time the caller spent loading the scene, for the summary */
+    double target_noise_k; /* > 0: add passes to each channel until the median per-pixel
+                              standard error of Tb_c, over the rendered sensors, is at
+                              most this (K); final-gather and path only */
+    double max_seconds;    /* > 0: stop adding passes once a channel has rendered this
+                              long (s); makes the stopping point time-dependent */
 } run_options;
 
 /* What a finished run reports back (for the CLI's closing line). */
 typedef struct run_result {
     size_t n_channels;
-    size_t n_sensors;             /* sensors rendered */
-    uint64_t photons_fired;       /* over all channels (0 for render) */
+    size_t n_sensors;       /* sensors rendered */
+    uint64_t photons_fired; /* over all channels (0 for render) */
     uint64_t photons_stored;
     uint64_t back_face_samples;   /* over all sensors and channels */
     size_t n_warnings;            /* run warnings written to summary.json */

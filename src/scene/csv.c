@@ -168,8 +168,8 @@ thz_status csv_parse(const char *text, const char *label, csv_table *t, thz_erro
         t->n_rows++;
     }
     if (!t->names)
-        st = thz_error_set(err, THZ_ERR_INPUT, "%s: no header line (the file is empty or all comments)",
-                           t->label);
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "%s: no header line (the file is empty or all comments)", t->label);
     else if (t->n_rows == 0)
         st = thz_error_set(err, THZ_ERR_INPUT, "%s: no data rows after the header", t->label);
 cleanup:
@@ -201,8 +201,8 @@ thz_status csv_read(const char *path, const char *label, csv_table *t, thz_error
     for (;;) {
         if (len + 1 == cap) {
             if (cap >= CSV_MAX_BYTES) {
-                st = thz_error_set(err, THZ_ERR_INPUT, "%s: larger than %zu MiB, not a table",
-                                   name, CSV_MAX_BYTES >> 20);
+                st = thz_error_set(err, THZ_ERR_INPUT, "%s: larger than %zu MiB, not a table", name,
+                                   CSV_MAX_BYTES >> 20);
                 goto cleanup;
             }
             char *bigger = realloc(text, 2 * cap);

@@ -12,12 +12,12 @@
 #include "core/error.h"
 
 typedef struct csv_table {
-    char *label;        /* the file name as used in messages */
+    char *label; /* the file name as used in messages */
     size_t n_columns;
-    char **names;       /* n_columns header names, blanks trimmed */
+    char **names; /* n_columns header names, blanks trimmed */
     size_t n_rows;
-    double *values;     /* n_rows * n_columns, row-major; all finite */
-    size_t *row_lines;  /* n_rows: the 1-based line of each row in the file */
+    double *values;    /* n_rows * n_columns, row-major; all finite */
+    size_t *row_lines; /* n_rows: the 1-based line of each row in the file */
 } csv_table;
 
 /* Reads the file at path; `label` (NULL: path) names it in messages. On error the

@@ -42,8 +42,7 @@ static thz_status load_channel_name(load_ctx *ctx, const load_cursor *c, thz_cha
     if (!given[0])
         return load_fail(ctx, &k, "expected a non-empty channel name");
     if (strlen(given) >= sizeof ch->name)
-        return load_fail(ctx, &k, "channel names are at most %zu characters",
-                         sizeof ch->name - 1);
+        return load_fail(ctx, &k, "channel names are at most %zu characters", sizeof ch->name - 1);
     snprintf(ch->name, sizeof ch->name, "%s", given);
     return THZ_OK;
 }
@@ -209,8 +208,8 @@ static thz_status load_check_energy(load_ctx *ctx, const load_cursor *c, const t
 
 static thz_status load_material(load_ctx *ctx, const load_cursor *c, thz_material *m)
 {
-    static const char *const keys[] = {"reflectivity", "attenuation_per_m", "emissivity",
-                                       "transmission", "color", "file", NULL};
+    static const char *const keys[] = {
+        "reflectivity", "attenuation_per_m", "emissivity", "transmission", "color", "file", NULL};
     static const char *const transmissions[] = {"diffuse", "straight", NULL};
     thz_status st = load_expect_object(ctx, c, keys);
     if (st != THZ_OK)
@@ -268,7 +267,8 @@ static thz_status load_materials(load_ctx *ctx, const load_cursor *root)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
     const char *name;
     json_t *value;
-    json_object_foreach(c.value, name, value) {
+    json_object_foreach(c.value, name, value)
+    {
         thz_material *m = &s->materials[s->n_materials++];
         load_cursor e = load_key(&c, name);
         m->name = thz_strdup(name);
@@ -286,16 +286,16 @@ static thz_status load_materials(load_ctx *ctx, const load_cursor *root)
 static thz_status load_segments(load_ctx *ctx, const load_cursor *c, unsigned *out)
 {
     uint64_t v;
-    thz_status st = load_integer(ctx, c, "segments", PRIMITIVE_MIN_SEGMENTS,
-                                 PRIMITIVE_MAX_SEGMENTS, false, 64, &v);
+    thz_status st = load_integer(ctx, c, "segments", PRIMITIVE_MIN_SEGMENTS, PRIMITIVE_MAX_SEGMENTS,
+                                 false, 64, &v);
     *out = (unsigned)v;
     return st;
 }
 
 static thz_status load_shape(load_ctx *ctx, const load_cursor *c, thz_mesh *mesh)
 {
-    static const char *const types[] = {"box", "cylinder", "sphere", "rectangle", "disk", "mesh",
-                                        NULL};
+    static const char *const types[] = {"box",  "cylinder", "sphere", "rectangle",
+                                        "disk", "mesh",     NULL};
     static const char *const keys[][6] = {
         {"type", "size_m", "inward", NULL},
         {"type", "radius_m", "height_m", "caps", "segments", NULL},
@@ -349,8 +349,8 @@ static thz_status load_shape(load_ctx *ctx, const load_cursor *c, thz_mesh *mesh
         uint64_t sub;
         st = load_number(ctx, c, "radius_m", LOAD_POSITIVE, true, 0, &r);
         if (st == THZ_OK)
-            st = load_integer(ctx, c, "subdivisions", 0, PRIMITIVE_MAX_SUBDIVISIONS, false, 4,
-                              &sub);
+            st =
+                load_integer(ctx, c, "subdivisions", 0, PRIMITIVE_MAX_SUBDIVISIONS, false, 4, &sub);
         if (st == THZ_OK)
             st = primitive_sphere(mesh, r, (unsigned)sub, err);
         break;
@@ -425,7 +425,8 @@ static thz_status load_transform(load_ctx *ctx, const load_cursor *c, thz_mesh *
         return st;
     for (int i = 0; i < 3; i++)
         if (scale[i] == 0.0)
-            return load_fail(ctx, &k, "a scale factor of 0 flattens the object (expected non-zero factors)");
+            return load_fail(ctx, &k,
+                             "a scale factor of 0 flattens the object (expected non-zero factors)");
     st = load_vector(ctx, c, "rotate_deg", 3, LOAD_ANY, false, rot);
     if (st == THZ_OK)
         st = load_vector(ctx, c, "translate_m", 3, LOAD_ANY, false, tr);
@@ -438,8 +439,9 @@ static thz_status load_transform(load_ctx *ctx, const load_cursor *c, thz_mesh *
 
 static thz_status load_object(load_ctx *ctx, const load_cursor *c, thz_object *o, size_t index)
 {
-    static const char *const keys[] = {"name", "type", "material", "temperature_k", "thickness_m",
-                                       "two_sided", "shape", "transform", NULL};
+    static const char *const keys[] = {"name",          "type",        "material",
+                                       "temperature_k", "thickness_m", "two_sided",
+                                       "shape",         "transform",   NULL};
     static const char *const types[] = {"solid", "shell", NULL};
     thz_scene *s = ctx->scene;
     const char *name, *material;
@@ -454,8 +456,10 @@ static thz_status load_object(load_ctx *ctx, const load_cursor *c, thz_object *o
         return load_fail(ctx, &name_c, "expected a non-empty object name");
     for (size_t j = 0; j < index; j++)
         if (strcmp(s->objects[j].name, name) == 0)
-            return load_fail(ctx, &name_c, "object name \"%s\" is already used by objects[%zu] "
-                             "(expected unique names)", name, j);
+            return load_fail(ctx, &name_c,
+                             "object name \"%s\" is already used by objects[%zu] "
+                             "(expected unique names)",
+                             name, j);
     o->name = thz_strdup(name);
     if (!o->name)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
@@ -480,7 +484,8 @@ static thz_status load_object(load_ctx *ctx, const load_cursor *c, thz_object *o
     load_cursor thick = load_key(c, "thickness_m");
     if (o->type == OBJECT_SHELL) {
         if (!thick.value)
-            return load_fail(ctx, &thick, "missing key (a shell needs its thickness, a number > 0)");
+            return load_fail(ctx, &thick,
+                             "missing key (a shell needs its thickness, a number > 0)");
         st = load_number(ctx, c, "thickness_m", LOAD_POSITIVE, true, 0, &o->thickness_m);
     } else if (thick.value) {
         return load_fail(ctx, &thick, "only shells have a thickness (this object is a solid)");
@@ -504,9 +509,10 @@ static thz_status load_object(load_ctx *ctx, const load_cursor *c, thz_object *o
     for (int k = 0; k < 3; k++)
         if (!isfinite(o->mesh.bbox_min_m[k]) || !isfinite(o->mesh.bbox_max_m[k]) ||
             !isfinite(o->mesh.total_area_m2))
-            return load_fail(ctx, transform.value ? &transform : &shape,
-                             "the object's coordinates or area exceed the range of single-precision "
-                             "floats (expected sizes in metres well below 1e30)");
+            return load_fail(
+                ctx, transform.value ? &transform : &shape,
+                "the object's coordinates or area exceed the range of single-precision "
+                "floats (expected sizes in metres well below 1e30)");
     if (o->mesh.n_triangles == 0 || !(o->mesh.total_area_m2 > 0.0))
         return load_fail(ctx, &shape, "the shape has no triangles of non-zero area");
     return THZ_OK;
@@ -568,11 +574,11 @@ static thz_status load_resolution(load_ctx *ctx, const load_cursor *c, uint32_t 
         if (!json_is_number(e.value) || x != floor(x) || x < 1 || x > LOAD_MAX_RESOLUTION)
             return load_fail(ctx, &k, "expected %s, got %s%s", what,
                              json_is_number(e.value) ? "" : load_type_name(e.value),
-                             json_is_number(e.value) ? (x < 1 ? "a value below 1"
-                                                              : x > LOAD_MAX_RESOLUTION
-                                                                    ? "a value above 65536"
-                                                                    : "a fraction")
-                                                     : "");
+                             json_is_number(e.value)
+                                 ? (x < 1                     ? "a value below 1"
+                                    : x > LOAD_MAX_RESOLUTION ? "a value above 65536"
+                                                              : "a fraction")
+                                 : "");
         v[i] = (uint32_t)x;
     }
     *columns = v[0];
@@ -582,9 +588,9 @@ static thz_status load_resolution(load_ctx *ctx, const load_cursor *c, uint32_t 
 
 static thz_status load_sensor(load_ctx *ctx, const load_cursor *c, thz_sensor *sn, size_t index)
 {
-    static const char *const keys[] = {"name", "position_m", "look_at_m", "direction", "up",
-                                       "fov_deg", "resolution", "aperture_m2", "oversampling",
-                                       "normalize_to_k", NULL};
+    static const char *const keys[] = {
+        "name",       "position_m",  "look_at_m",    "direction",      "up", "fov_deg",
+        "resolution", "aperture_m2", "oversampling", "normalize_to_k", NULL};
     thz_scene *s = ctx->scene;
     const char *name;
     thz_status st = load_expect_object(ctx, c, keys);
@@ -597,8 +603,10 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *c, thz_sensor *s
         return load_fail(ctx, &name_c, "expected a non-empty sensor name");
     for (size_t j = 0; j < index; j++)
         if (strcmp(s->sensors[j].name, name) == 0)
-            return load_fail(ctx, &name_c, "sensor name \"%s\" is already used by sensors[%zu] "
-                             "(expected unique names)", name, j);
+            return load_fail(ctx, &name_c,
+                             "sensor name \"%s\" is already used by sensors[%zu] "
+                             "(expected unique names)",
+                             name, j);
     sn->name = thz_strdup(name);
     if (!sn->name)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
@@ -610,8 +618,9 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *c, thz_sensor *s
     if (look.value && dir.value)
         return load_fail(ctx, &dir, "give either look_at_m or direction, not both");
     if (!look.value && !dir.value)
-        return load_fail(ctx, c, "missing key 'look_at_m' or 'direction' (expected a point to "
-                                 "look at or a viewing direction, 3 numbers)");
+        return load_fail(ctx, c,
+                         "missing key 'look_at_m' or 'direction' (expected a point to "
+                         "look at or a viewing direction, 3 numbers)");
     if (look.value) {
         double p[3];
         st = load_vector(ctx, c, "look_at_m", 3, LOAD_ANY, true, p);
@@ -640,8 +649,9 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *c, thz_sensor *s
         return load_fail(ctx, &up_c, "expected a non-zero up vector");
     uv = v3_scale(uv, 1.0 / ul);
     if (v3_length(v3_cross(dv, uv)) < 1e-6)
-        return load_fail(ctx, &up_c, "the up vector is parallel to the viewing direction "
-                                     "(expected a vector not parallel to it, default [0, 0, 1])");
+        return load_fail(ctx, &up_c,
+                         "the up vector is parallel to the viewing direction "
+                         "(expected a vector not parallel to it, default [0, 0, 1])");
     sn->direction[0] = dv.x, sn->direction[1] = dv.y, sn->direction[2] = dv.z;
     sn->up[0] = uv.x, sn->up[1] = uv.y, sn->up[2] = uv.z;
     const load_range fov = {0.0, 180.0, true, true};
@@ -654,8 +664,8 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *c, thz_sensor *s
     if (st == THZ_OK)
         st = load_integer(ctx, c, "oversampling", 1, LOAD_MAX_OVERSAMPLING, false, 1, &over);
     if (st == THZ_OK)
-        st = load_number(ctx, c, "normalize_to_k", LOAD_POSITIVE, false, 295.0,
-                         &sn->normalize_to_k);
+        st =
+            load_number(ctx, c, "normalize_to_k", LOAD_POSITIVE, false, 295.0, &sn->normalize_to_k);
     if (st != THZ_OK)
         return st;
     sn->oversampling = (uint32_t)over;
@@ -714,8 +724,8 @@ static thz_status load_photons(load_ctx *ctx, const load_cursor *root)
         st = load_number(ctx, &c, "min_relative_power", fraction, false, p->min_relative_power,
                          &p->min_relative_power);
     if (st == THZ_OK)
-        st = load_integer(ctx, &c, "gather_min_photons", 2, 1000000, false,
-                          p->gather_min_photons, &k);
+        st = load_integer(ctx, &c, "gather_min_photons", 2, 1000000, false, p->gather_min_photons,
+                          &k);
     if (st == THZ_OK)
         p->gather_min_photons = (uint32_t)k;
     return st;
@@ -817,8 +827,7 @@ static thz_status load_warnings(load_ctx *ctx)
     bool ok = true;
     for (size_t m = 0; m < s->n_materials; m++) {
         const thz_material *mat = &s->materials[m];
-        const thz_spectrum *sp[3] = {&mat->reflectivity, &mat->attenuation_per_m,
-                                     &mat->emissivity};
+        const thz_spectrum *sp[3] = {&mat->reflectivity, &mat->attenuation_per_m, &mat->emissivity};
         for (int k = 0; k < 3 && ok; k++) {
             char what[256];
             snprintf(what, sizeof what, "material \"%s\", %s", mat->name, load_property_names[k]);
@@ -858,13 +867,14 @@ static thz_status load_warnings(load_ctx *ctx)
 
 static thz_status load_document(load_ctx *ctx, json_t *doc)
 {
-    static const char *const keys[] = {"format", "name", "channels", "materials", "atmosphere",
-                                       "objects", "sensors", "photons", "render", NULL};
+    static const char *const keys[] = {"format",  "name",    "channels", "materials", "atmosphere",
+                                       "objects", "sensors", "photons",  "render",    NULL};
     thz_scene *s = ctx->scene;
     load_cursor root = load_root(doc);
     const char *format, *name = NULL;
     if (!json_is_object(doc))
-        return load_fail(ctx, NULL, "expected a JSON object {\"format\": \"%s\", ...}", LOAD_FORMAT);
+        return load_fail(ctx, NULL, "expected a JSON object {\"format\": \"%s\", ...}",
+                         LOAD_FORMAT);
     if (!json_object_get(doc, "format"))
         return load_require(ctx, &root, "format", "\"" LOAD_FORMAT "\"");
     thz_status st = load_string(ctx, &root, "format", true, NULL, &format);
@@ -941,8 +951,7 @@ static thz_status load_begin(const char *path_or_label, const char *dir, thz_sce
 static thz_status load_finish(thz_scene **scene, json_t *doc, thz_status st, thz_error *err)
 {
     if (st == THZ_OK) {
-        load_ctx ctx = {.label = (*scene)->path, .dir = (*scene)->dir, .scene = *scene,
-                        .err = err};
+        load_ctx ctx = {.label = (*scene)->path, .dir = (*scene)->dir, .scene = *scene, .err = err};
         st = load_document(&ctx, doc);
     }
     json_decref(doc);

@@ -85,8 +85,8 @@ thz_status load_string(load_ctx *ctx, const load_cursor *c, const char *key, boo
 thz_status load_bool(load_ctx *ctx, const load_cursor *c, const char *key, bool dflt, bool *out);
 
 /* Member `key` as an array of exactly n numbers each in r. */
-thz_status load_vector(load_ctx *ctx, const load_cursor *c, const char *key, size_t n,
-                       load_range r, bool required, double *out);
+thz_status load_vector(load_ctx *ctx, const load_cursor *c, const char *key, size_t n, load_range r,
+                       bool required, double *out);
 
 /* Member `key` as one of the NULL-terminated `choices`; *out is its index. */
 thz_status load_choice(load_ctx *ctx, const load_cursor *c, const char *key,

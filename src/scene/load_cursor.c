@@ -85,7 +85,8 @@ thz_status load_expect_object(load_ctx *ctx, const load_cursor *c, const char *c
         return load_fail(ctx, c, "expected an object {...}, got %s", load_type_name(c->value));
     const char *key;
     json_t *value;
-    json_object_foreach(c->value, key, value) {
+    json_object_foreach(c->value, key, value)
+    {
         bool known = false;
         for (const char *const *a = allowed; *a && !known; a++)
             known = strcmp(*a, key) == 0;
@@ -230,8 +231,8 @@ thz_status load_bool(load_ctx *ctx, const load_cursor *c, const char *key, bool 
     return THZ_OK;
 }
 
-thz_status load_vector(load_ctx *ctx, const load_cursor *c, const char *key, size_t n,
-                       load_range r, bool required, double *out)
+thz_status load_vector(load_ctx *ctx, const load_cursor *c, const char *key, size_t n, load_range r,
+                       bool required, double *out)
 {
     load_cursor k = load_key(c, key);
     if (!k.value) {
@@ -332,14 +333,16 @@ thz_status load_csv_spectrum(load_ctx *ctx, const load_cursor *c, const csv_tabl
     for (size_t i = 0; i < t->n_rows; i++) {
         double thz = csv_value(t, i, (size_t)fc);
         if (!(thz > 0.0)) {
-            st = load_fail(ctx, c, "%s:%zu: row %zu, column 'frequency_thz': expected a number > 0, got %g",
+            st = load_fail(ctx, c,
+                           "%s:%zu: row %zu, column 'frequency_thz': expected a number > 0, got %g",
                            t->label, t->row_lines[i], i + 1, thz);
             goto cleanup;
         }
         if (i > 0 && !(thz * 1e12 > f[i - 1])) {
-            st = load_fail(ctx, c,
-                           "%s:%zu: row %zu: frequencies must increase strictly, got %g THz after %g THz",
-                           t->label, t->row_lines[i], i + 1, thz, f[i - 1] * 1e-12);
+            st = load_fail(
+                ctx, c,
+                "%s:%zu: row %zu: frequencies must increase strictly, got %g THz after %g THz",
+                t->label, t->row_lines[i], i + 1, thz, f[i - 1] * 1e-12);
             goto cleanup;
         }
         f[i] = thz * 1e12;
@@ -381,9 +384,9 @@ thz_status load_spectrum(load_ctx *ctx, const load_cursor *c, const char *key, l
     }
     size_t n = json_array_size(k.value);
     if (!json_is_array(k.value) || n == 0)
-        return load_fail(ctx, &k,
-                         "expected %s or a non-empty table [[frequency_thz, value], ...], got %s",
-                         expected, json_is_array(k.value) ? "an empty list" : load_type_name(k.value));
+        return load_fail(
+            ctx, &k, "expected %s or a non-empty table [[frequency_thz, value], ...], got %s",
+            expected, json_is_array(k.value) ? "an empty list" : load_type_name(k.value));
     double *f = thz_malloc_array(n, sizeof *f);
     double *v = thz_malloc_array(n, sizeof *v);
     thz_status st = THZ_OK;

@@ -30,8 +30,8 @@ static thz_status mesh_import_count(const struct aiScene *sc, const struct aiNod
             *n_triangles += m->mFaces[f].mNumIndices == 3;
     }
     for (unsigned c = 0; c < node->mNumChildren; c++) {
-        thz_status st = mesh_import_count(sc, node->mChildren[c], depth + 1, n_vertices,
-                                          n_triangles);
+        thz_status st =
+            mesh_import_count(sc, node->mChildren[c], depth + 1, n_vertices, n_triangles);
         if (st != THZ_OK)
             return st;
     }
@@ -161,8 +161,9 @@ thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_
         aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
     if (!sc) {
         const char *why = aiGetErrorString();
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot read as a mesh (OBJ, PLY, STL, glTF, ...): %s",
-                             name, why && why[0] ? why : "unknown format");
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: cannot read as a mesh (OBJ, PLY, STL, glTF, ...): %s", name,
+                             why && why[0] ? why : "unknown format");
     }
     size_t nv = 0, nt = 0;
     if (!sc->mRootNode || mesh_import_count(sc, sc->mRootNode, 0, &nv, &nt) != THZ_OK) {
@@ -186,8 +187,9 @@ thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_
     mesh_import_append(sc, sc->mRootNode, &identity, mesh);
     for (size_t i = 0; i < 3 * mesh->n_vertices; i++) {
         if (!isfinite(mesh->positions[i])) {
-            st = thz_error_set(err, THZ_ERR_INPUT, "%s: vertex %zu has a coordinate that is not a finite number",
-                               name, i / 3 + 1);
+            st = thz_error_set(err, THZ_ERR_INPUT,
+                               "%s: vertex %zu has a coordinate that is not a finite number", name,
+                               i / 3 + 1);
             goto cleanup;
         }
     }

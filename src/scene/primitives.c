@@ -180,8 +180,7 @@ static uint32_t sphere_midpoint(double *pos, size_t *nv, sphere_edge_slot *slots
     return m;
 }
 
-thz_status primitive_sphere(thz_mesh *mesh, double radius_m, unsigned subdivisions,
-                            thz_error *err)
+thz_status primitive_sphere(thz_mesh *mesh, double radius_m, unsigned subdivisions, thz_error *err)
 {
     thz_status st = THZ_OK;
     double *pos = NULL;
@@ -197,8 +196,8 @@ thz_status primitive_sphere(thz_mesh *mesh, double radius_m, unsigned subdivisio
     next = thz_malloc_array(max_t, 3 * sizeof *next);
     slots = thz_malloc_array(max_v, SPHERE_SLOTS * sizeof *slots);
     if (!pos || !tri || !next || !slots) {
-        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for a sphere of %zu triangles",
-                           max_t);
+        st =
+            thz_error_set(err, THZ_ERR_NOMEM, "out of memory for a sphere of %zu triangles", max_t);
         goto cleanup;
     }
     const double g = (1.0 + sqrt(5.0)) / 2.0;
@@ -206,9 +205,9 @@ thz_status primitive_sphere(thz_mesh *mesh, double radius_m, unsigned subdivisio
                                  {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
                                  {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
     static const uint32_t ico_t[20][3] = {
-        {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+        {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
         {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-        {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+        {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
     size_t nv = 12, nt = 20;
     for (size_t v = 0; v < 12; v++) {
         double len = sqrt(1.0 + g * g);

@@ -35,8 +35,7 @@ thz_status primitive_cylinder(thz_mesh *mesh, double radius_m, double height_m, 
 
 /* Icosphere centred on the origin: an icosahedron with each triangle split into four
  * `subdivisions` times, vertices projected onto the sphere (20 * 4^s triangles). */
-thz_status primitive_sphere(thz_mesh *mesh, double radius_m, unsigned subdivisions,
-                            thz_error *err);
+thz_status primitive_sphere(thz_mesh *mesh, double radius_m, unsigned subdivisions, thz_error *err);
 
 /* Rectangle size_m[0] x size_m[1] in the xy plane, centred, normal +z. */
 thz_status primitive_rectangle(thz_mesh *mesh, const double size_m[2], thz_error *err);

@@ -118,7 +118,8 @@ thz_scene *scene_create(void);
 void scene_destroy(thz_scene *scene);
 
 /* Appends a warning (printf format). Returns false only on allocation failure. */
-bool scene_add_warning(thz_scene *scene, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+bool scene_add_warning(thz_scene *scene, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
 
 /* The optics of object `obj` at freq_hz: its material's R, alpha_M and explicit eps
  * evaluated there, and its thickness (0 for solids). */

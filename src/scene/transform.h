@@ -12,7 +12,7 @@
 #include "scene/scene.h"
 
 typedef struct scene_transform {
-    double m[3][3];       /* linear part, row-major: p'_i = sum_j m[i][j] p_j + t_i */
+    double m[3][3]; /* linear part, row-major: p'_i = sum_j m[i][j] p_j + t_i */
     double translate_m[3];
 } scene_transform;
 

@@ -10,8 +10,8 @@ thz_status camera_init(camera *cam, const thz_sensor *sensor, thz_error *err)
     vec3 r = v3_cross(f, up);
     double rl = v3_length(r);
     if (v3_length(f) == 0.0 || rl < 1e-9)
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "sensor '%s': direction is zero or parallel to up", sensor->name);
+        return thz_error_set(err, THZ_ERR_INPUT, "sensor '%s': direction is zero or parallel to up",
+                             sensor->name);
     if (!(sensor->fov_deg > 0.0 && sensor->fov_deg < 180.0))
         return thz_error_set(err, THZ_ERR_INPUT,
                              "sensor '%s': fov_deg must lie in (0, 180) deg, got %g deg",

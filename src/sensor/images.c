@@ -38,8 +38,8 @@ thz_status sensor_images_init(sensor_images *img, uint32_t columns, uint32_t row
         (with_stderr && !img->radiance_stderr) || !img->temperature_k || !img->distance_m ||
         !img->object_id || !img->visual_rgb) {
         sensor_images_fini(img);
-        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for a %u x %u x %zu image",
-                             columns, rows, n_channels);
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for a %u x %u x %zu image", columns,
+                             rows, n_channels);
     }
     for (size_t i = 0; i < pixels; i++)
         img->object_id[i] = -1;

@@ -88,8 +88,8 @@ typedef struct render_sample {
 typedef struct render_target {
     double *est;
     uint32_t n_est;
-    double weight;        /* 1 / n^2 */
-    uint64_t rng_index;   /* first index of this sample's random streams (x n_est) */
+    double weight;      /* 1 / n^2 */
+    uint64_t rng_index; /* first index of this sample's random streams (x n_est) */
 } render_target;
 
 /* An integrator: the estimates of one sample ray. `sample_sr` is the sample's solid
@@ -98,26 +98,24 @@ typedef void (*render_sample_fn)(const render_context *ctx, vec3 origin_m, vec3 
                                  double sample_sr, const render_target *t, render_sample *out);
 
 static void render_photon_map_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
-                                     double sample_sr, const render_target *t,
-                                     render_sample *out);
+                                     double sample_sr, const render_target *t, render_sample *out);
 static void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
                                        double sample_sr, const render_target *t,
                                        render_sample *out);
-static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
-                               double sample_sr, const render_target *t, render_sample *out);
+static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir, double sample_sr,
+                               const render_target *t, render_sample *out);
 
 typedef struct render_integrator {
     thz_integrator id;
     const char *name;
     render_sample_fn sample; /* NULL: not implemented yet */
     bool needs_photons;
-    uint32_t purpose;        /* RNG purpose; 0: no random numbers (one pass) */
+    uint32_t purpose; /* RNG purpose; 0: no random numbers (one pass) */
 } render_integrator;
 
 static const render_integrator render_integrators[] = {
     {INTEGRATOR_PHOTON_MAP, "photon-map", render_photon_map_sample, true, 0},
-    {INTEGRATOR_FINAL_GATHER, "final-gather", render_final_gather_sample, true,
-     RNG_PURPOSE_GATHER},
+    {INTEGRATOR_FINAL_GATHER, "final-gather", render_final_gather_sample, true, RNG_PURPOSE_GATHER},
     {INTEGRATOR_PATH, "path", render_path_sample, false, RNG_PURPOSE_PATH},
 };
 #define RENDER_N_INTEGRATORS (sizeof render_integrators / sizeof render_integrators[0])
@@ -328,8 +326,7 @@ static double render_exit_m(const render_context *ctx, vec3 origin_m, vec3 dir)
 }
 
 /* Product of T(theta) of the crossed straight shells at frequency freq_hz. */
-static double render_path_weight(const render_context *ctx, const render_path *path,
-                                 double freq_hz)
+static double render_path_weight(const render_context *ctx, const render_path *path, double freq_hz)
 {
     double w = 1.0;
     for (size_t i = 0; i < path->n; i++) {
@@ -393,15 +390,14 @@ typedef struct render_scatter {
     const thz_material *material;
     const thz_object *object;
     uint32_t object_index;
-    bool transmitted;   /* diffuse transmission (else Lambertian reflection) */
-    double mu_o;        /* |cos| of the direction towards the sensor at x */
-    double mu_i;        /* |cos| of the gather ray at x */
-    double pdf_ratio;   /* transmitted: Tbar(nu_j) / T(nu_j, mu_i) */
-    double inv_branch;  /* 1 / P(branch) */
+    bool transmitted;  /* diffuse transmission (else Lambertian reflection) */
+    double mu_o;       /* |cos| of the direction towards the sensor at x */
+    double mu_i;       /* |cos| of the gather ray at x */
+    double pdf_ratio;  /* transmitted: Tbar(nu_j) / T(nu_j, mu_i) */
+    double inv_branch; /* 1 / P(branch) */
 } render_scatter;
 
-static double render_scatter_weight(const render_context *ctx, const render_scatter *s,
-                                    double nu)
+static double render_scatter_weight(const render_context *ctx, const render_scatter *s, double nu)
 {
     if (!s)
         return 1.0;
@@ -424,8 +420,8 @@ static double render_scatter_node(const render_context *ctx, const render_scatte
     if (!s->transmitted)
         return ox->reflectivity;
     double tbar = ctx->tbar[(size_t)s->object_index * n + k];
-    return tbar > 0.0 ? optics_transmission(ox, s->mu_i) * optics_transmission(ox, s->mu_o) /
-                            tbar * s->pdf_ratio
+    return tbar > 0.0 ? optics_transmission(ox, s->mu_i) * optics_transmission(ox, s->mu_o) / tbar *
+                            s->pdf_ratio
                       : 0.0;
 }
 
@@ -493,16 +489,16 @@ typedef struct render_gather_state {
     const render_context *ctx;
     const thz_object *obj;
     uint32_t object_index;
-    vec3 normal_seen;    /* unit normal of the triangle hit, towards the sensor's side */
-    double mu_o;         /* |cos theta| of the view ray */
+    vec3 normal_seen; /* unit normal of the triangle hit, towards the sensor's side */
+    double mu_o;      /* |cos theta| of the view ray */
     const render_path *path;
     const render_scatter *scatter; /* final-gather: the first vertex's weight, or NULL */
-    double distance_m;   /* from the sensor */
+    double distance_m;             /* from the sensor */
     double radius2_m2;
-    bool strict;         /* only photons strictly inside (widened disk) */
-    bool transmitted;    /* photons of the other side of a diffuse shell: BTDF, not BRDF */
+    bool strict;      /* only photons strictly inside (widened disk) */
+    bool transmitted; /* photons of the other side of a diffuse shell: BTDF, not BRDF */
     size_t count;
-    double sum, sum2;    /* sum of photon terms f Phi w exp(-alpha d), and of their squares */
+    double sum, sum2; /* sum of photon terms f Phi w exp(-alpha d), and of their squares */
 } render_gather_state;
 
 static void render_gather_visit(void *vstate, const photon_record *p, double distance2_m2)
@@ -549,8 +545,8 @@ static void render_gather_pass(render_gather_state *g, uint32_t object, int seen
     g->transmitted = false;
     if (!(g->radius2_m2 > 0.0))
         return;
-    photon_map_radius(g->ctx->map, object, seen_side, position, g->radius2_m2,
-                      render_gather_visit, g);
+    photon_map_radius(g->ctx->map, object, seen_side, position, g->radius2_m2, render_gather_visit,
+                      g);
     if (with_other_side) {
         g->transmitted = true;
         photon_map_radius(g->ctx->map, object, 1 - seen_side, position, g->radius2_m2,
@@ -562,10 +558,9 @@ static void render_gather_pass(render_gather_state *g, uint32_t object, int seen
  * footprint (sample_sr > 0), widened to the k-th nearest photon when it holds fewer than
  * k; sample_sr = 0 asks for the k-th nearest radius directly. Adds the estimate to
  * *radiance and its Poisson variance to out->variance. */
-static void render_gather(const render_context *ctx, const accel_hit *hit,
-                          const render_path *path, const render_scatter *scatter,
-                          double distance_m, double sample_sr, bool diffuse_shell,
-                          double *radiance, render_sample *out)
+static void render_gather(const render_context *ctx, const accel_hit *hit, const render_path *path,
+                          const render_scatter *scatter, double distance_m, double sample_sr,
+                          bool diffuse_shell, double *radiance, render_sample *out)
 {
     if (!ctx->map)
         return;
@@ -638,8 +633,8 @@ static double render_photon_map_trace(const render_context *ctx, vec3 origin_m, 
             return radiance;
         }
         if (scatter)
-            radiance += render_emission_scattered(ctx, hit.object, hit.cos_theta, &path,
-                                                  distance_m, scatter);
+            radiance += render_emission_scattered(ctx, hit.object, hit.cos_theta, &path, distance_m,
+                                                  scatter);
         else
             radiance += render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m);
         bool shell = obj->type == OBJECT_SHELL;
@@ -677,13 +672,13 @@ static vec3 render_leave(const render_context *ctx, const accel_hit *hit, vec3 d
     for (int k = 0; k < 3; k++)
         c = v3_add(c, v3_from_floats(&m->positions[3 * (size_t)ix[k]]));
     accel_hit moved = *hit;
-    moved.position_m = v3_madd(hit->position_m, 1e-5, v3_sub(v3_scale(c, 1.0 / 3.0), hit->position_m));
+    moved.position_m =
+        v3_madd(hit->position_m, 1e-5, v3_sub(v3_scale(c, 1.0 / 3.0), hit->position_m));
     return accel_offset_origin(ctx->accel, &moved, dir);
 }
 
 static void render_photon_map_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
-                                     double sample_sr, const render_target *t,
-                                     render_sample *out)
+                                     double sample_sr, const render_target *t, render_sample *out)
 {
     render_path path = {.n = 0};
     double l = render_photon_map_trace(ctx, origin_m, dir, ACCEL_NO_OBJECT, 0, path, 0.0, NULL,
@@ -701,9 +696,8 @@ static void render_add_all(const render_target *t, double v)
 /* One gather ray from first vertex `hit` (object obj, seen through `path`, at distance
  * distance_m from the sensor): its estimate of the scattered radiance towards the sensor. */
 static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
-                                const thz_object *obj, bool diffuse_shell,
-                                const render_path *path, double distance_m, rng_stream *rng,
-                                render_sample *out)
+                                const thz_object *obj, bool diffuse_shell, const render_path *path,
+                                double distance_m, rng_stream *rng, render_sample *out)
 {
     const thz_material *mat = &ctx->scene->materials[obj->material];
     double nu_j = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
@@ -743,8 +737,7 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
 }
 
 static void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
-                                       double sample_sr, const render_target *t,
-                                       render_sample *out)
+                                       double sample_sr, const render_target *t, render_sample *out)
 {
     (void)sample_sr;
     render_path path = {.n = 0};
@@ -758,8 +751,7 @@ static void render_final_gather_sample(const render_context *ctx, vec3 origin_m,
                 out->escaped = 1;
             if (ctx->emitting)
                 render_add_all(t, render_air(ctx, &path, NULL, distance_m,
-                                             distance_m + render_exit_m(ctx, origin_m, dir),
-                                             true));
+                                             distance_m + render_exit_m(ctx, origin_m, dir), true));
             return;
         }
         double d0_m = distance_m;
@@ -826,8 +818,8 @@ static bool render_scatter_dir(const optics_point *o, vec3 n_seen, bool transmit
  * roulette on R and T(theta) at each hit. An emitting atmosphere turns a free path's term
  * (tau - 1) B0 into (1 - tau)(B_air - B0) and the escape term -B0 into L_escape - B0. */
 static double render_path_continue(const render_context *ctx, const accel_hit *from, vec3 dir,
-                                   double nu, double b0, double b_air, double beta,
-                                   rng_stream *rng, render_sample *out)
+                                   double nu, double b0, double b_air, double beta, rng_stream *rng,
+                                   render_sample *out)
 {
     const thz_scene *scene = ctx->scene;
     double sum = 0.0;
@@ -836,8 +828,7 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
         vec3 surface = hit.position_m;
         vec3 origin = render_leave(ctx, &hit, dir);
         uint32_t from_object = hit.object, from_triangle = hit.triangle;
-        if (!accel_intersect(ctx->accel, origin, dir, INFINITY, from_object, from_triangle,
-                             &hit)) {
+        if (!accel_intersect(ctx->accel, origin, dir, INFINITY, from_object, from_triangle, &hit)) {
             if (ctx->emitting) {
                 double a = atmosphere_alpha_per_m(&scene->atmosphere, nu);
                 double tau = render_tau(a, render_exit_m(ctx, origin, dir));
@@ -882,8 +873,7 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
         if (!(u < r + tr))
             break; /* absorbed */
         bool transmitted = !(u < r);
-        if (transmitted &&
-            scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT)
+        if (transmitted && scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT)
             continue; /* straight on, dir unchanged */
         const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
         vec3 n = v3_from_floats(nf);
@@ -909,9 +899,8 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
     double b0 = planck_radiance(nu, ctx->t0_k);
     double t_air = scene->atmosphere.air.temperature_k;
     double b_air = !ctx->emitting ? 0.0 : t_air == ctx->t0_k ? b0 : planck_radiance(nu, t_air);
-    double beta = ctx->atmosphere
-                      ? atmosphere_transmittance(&scene->atmosphere, nu, first->distance_m)
-                      : 1.0;
+    double beta =
+        ctx->atmosphere ? atmosphere_transmittance(&scene->atmosphere, nu, first->distance_m) : 1.0;
     const thz_object *obj = &scene->objects[first->object];
     optics_point o = scene_object_optics(scene, obj, nu);
     double r = o.reflectivity;
@@ -956,8 +945,8 @@ static double render_path_first(const render_context *ctx, const accel_hit *hit)
     return sum;
 }
 
-static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
-                               double sample_sr, const render_target *t, render_sample *out)
+static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir, double sample_sr,
+                               const render_target *t, render_sample *out)
 {
     (void)sample_sr;
     accel_hit first;
@@ -966,8 +955,8 @@ static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 di
         out->escaped = 1;
         /* radiance 0 for every path, or what the air and the background give */
         if (ctx->emitting)
-            render_add_all(t, render_air(ctx, &none, NULL, 0.0, render_exit_m(ctx, origin_m, dir),
-                                         true));
+            render_add_all(
+                t, render_air(ctx, &none, NULL, 0.0, render_exit_m(ctx, origin_m, dir), true));
         return;
     }
     if (!scene_object_side_is_front(&ctx->scene->objects[first.object], first.side)) {
@@ -1045,17 +1034,17 @@ static uint64_t render_rng_index(const thz_scene *scene, size_t sensor, uint32_t
     return (unit * samples + sample) * j_count;
 }
 
-thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a,
-                                      const photon_map *map, size_t channel, size_t sensor,
-                                      uint32_t pass, render_accum *acc, const render_options *opt,
+thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, const photon_map *map,
+                                      size_t channel, size_t sensor, uint32_t pass,
+                                      render_accum *acc, const render_options *opt,
                                       render_stats *stats, thz_error *err)
 {
     double t0 = render_now_s();
     if (stats)
         memset(stats, 0, sizeof *stats);
     if (channel >= scene->n_channels || sensor >= scene->n_sensors)
-        return thz_error_set(err, THZ_ERR_INTERNAL, "render: channel %zu or sensor %zu out of range",
-                             channel, sensor);
+        return thz_error_set(err, THZ_ERR_INTERNAL,
+                             "render: channel %zu or sensor %zu out of range", channel, sensor);
     const thz_sensor *sn = &scene->sensors[sensor];
     if (acc->pixels != (size_t)sn->columns * sn->rows)
         return thz_error_set(err, THZ_ERR_INTERNAL, "render: statistics do not match sensor '%s'",
@@ -1091,8 +1080,10 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a,
     double *scratch = thz_malloc_array((size_t)threads * n_est, sizeof *scratch);
     if (!scratch) {
         render_context_fini(&ctx);
-        return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for %u estimates x %d "
-                             "threads", n_est, threads);
+        return thz_error_set(err, THZ_ERR_NOMEM,
+                             "render: out of memory for %u estimates x %d "
+                             "threads",
+                             n_est, threads);
     }
 
     uint32_t n = cam.oversampling, cols = cam.columns, rows = cam.rows;
@@ -1236,8 +1227,8 @@ thz_status render_sensor_channel(const thz_scene *scene, const accel *a, const p
     if (stats)
         memset(stats, 0, sizeof *stats);
     if (channel >= scene->n_channels || sensor >= scene->n_sensors)
-        return thz_error_set(err, THZ_ERR_INTERNAL, "render: channel %zu or sensor %zu out of range",
-                             channel, sensor);
+        return thz_error_set(err, THZ_ERR_INTERNAL,
+                             "render: channel %zu or sensor %zu out of range", channel, sensor);
     const thz_sensor *sn = &scene->sensors[sensor];
     if (images->columns != sn->columns || images->rows != sn->rows ||
         images->n_channels != scene->n_channels)

@@ -65,9 +65,9 @@
 #define RENDER_MAX_BOUNCES 10000
 
 typedef struct render_options {
-    int threads;              /* OpenMP threads, 0: all */
-    bool use_seed;            /* seed the random streams with `seed`, not photons.seed (render
-                                 from a saved map uses the map's seed) */
+    int threads;   /* OpenMP threads, 0: all */
+    bool use_seed; /* seed the random streams with `seed`, not photons.seed (render
+                      from a saved map uses the map's seed) */
     uint64_t seed;
     thz_progress_fn progress; /* stage "render": done/total = rows of this sensor; may be NULL */
     void *progress_user;
@@ -107,12 +107,12 @@ uint32_t render_estimates_per_pass(const thz_scene *scene);
 /* Per-pixel statistics of one sensor's channel over the passes rendered so far. */
 typedef struct render_accum {
     size_t pixels;
-    uint64_t n;      /* estimates per pixel so far (the same for every pixel) */
+    uint64_t n; /* estimates per pixel so far (the same for every pixel) */
     uint32_t passes;
-    bool poisson;    /* photon-map: var holds the Poisson variance of the mean */
-    double *mean;    /* per pixel: mean of the estimates, W m^-2 sr^-1 Hz^-1 */
-    double *m2;      /* per pixel: sum of squared deviations from the mean (or, poisson,
-                        the variance of the mean) */
+    bool poisson; /* photon-map: var holds the Poisson variance of the mean */
+    double *mean; /* per pixel: mean of the estimates, W m^-2 sr^-1 Hz^-1 */
+    double *m2;   /* per pixel: sum of squared deviations from the mean (or, poisson,
+                     the variance of the mean) */
 } render_accum;
 
 thz_status render_accum_init(render_accum *acc, size_t pixels, thz_error *err);
@@ -126,9 +126,9 @@ double render_accum_stderr(const render_accum *acc, size_t p);
  * `map` is the channel's photon map (NULL for path). photon-map refuses pass > 0
  * (THZ_ERR_INPUT). `stats` (may be NULL) is overwritten with this pass's counts.
  * THZ_ERR_CANCELLED if the progress callback asks to stop. */
-thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a,
-                                      const photon_map *map, size_t channel, size_t sensor,
-                                      uint32_t pass, render_accum *acc, const render_options *opt,
+thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, const photon_map *map,
+                                      size_t channel, size_t sensor, uint32_t pass,
+                                      render_accum *acc, const render_options *opt,
                                       render_stats *stats, thz_error *err);
 
 /* Writes the channel's planes of `images` from `acc`: radiance, power,

@@ -56,7 +56,7 @@ static inline uint64_t ident_photons(double base)
 
 /* The integrators every identity is checked with. */
 static const thz_integrator ident_integrators[] = {INTEGRATOR_PHOTON_MAP, INTEGRATOR_FINAL_GATHER,
-                                                  INTEGRATOR_PATH};
+                                                   INTEGRATOR_PATH};
 #define IDENT_N_INTEGRATORS (sizeof ident_integrators / sizeof ident_integrators[0])
 
 /* Paths per sample (path) and gather rays (final-gather) for a test: base x

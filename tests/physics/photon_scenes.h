@@ -135,12 +135,12 @@ static inline void ps_box(thz_scene *s, size_t object, vec3 lo, vec3 hi, bool in
     vec3 h = v3_scale(v3_sub(hi, lo), 0.5);
     double sg = inward ? -1.0 : 1.0;
     vec3 ex = v3(h.x, 0, 0), ey = v3(0, h.y, 0), ez = v3(0, 0, h.z);
-    ps_face(s, object, v3_add(c, ex), ey, v3_scale(ez, sg));  /* +x */
-    ps_face(s, object, v3_sub(c, ex), ez, v3_scale(ey, sg));  /* -x */
-    ps_face(s, object, v3_add(c, ey), ez, v3_scale(ex, sg));  /* +y */
-    ps_face(s, object, v3_sub(c, ey), ex, v3_scale(ez, sg));  /* -y */
-    ps_face(s, object, v3_add(c, ez), ex, v3_scale(ey, sg));  /* +z */
-    ps_face(s, object, v3_sub(c, ez), ey, v3_scale(ex, sg));  /* -z */
+    ps_face(s, object, v3_add(c, ex), ey, v3_scale(ez, sg)); /* +x */
+    ps_face(s, object, v3_sub(c, ex), ez, v3_scale(ey, sg)); /* -x */
+    ps_face(s, object, v3_add(c, ey), ez, v3_scale(ex, sg)); /* +y */
+    ps_face(s, object, v3_sub(c, ey), ex, v3_scale(ez, sg)); /* -y */
+    ps_face(s, object, v3_add(c, ez), ex, v3_scale(ey, sg)); /* +z */
+    ps_face(s, object, v3_sub(c, ez), ey, v3_scale(ex, sg)); /* -z */
 }
 
 static inline void ps_finalize(thz_scene *s)

@@ -20,7 +20,8 @@ static const char *air_furnace_json =
     " \"materials\": {"
     "   \"wall\": {\"reflectivity\": 0.3},"
     "   \"shiny\": {\"reflectivity\": 0.6},"
-    "   \"foam\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 300, \"transmission\": \"diffuse\"}},"
+    "   \"foam\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 300, \"transmission\": "
+    "\"diffuse\"}},"
     " \"atmosphere\": {\"model\": \"itu-p676\", \"temperature_k\": 300, \"pressure_hpa\": 1013.25,"
     "   \"relative_humidity\": 0.5, \"emitting\": true, \"background_temperature_k\": 0,"
     "   \"extent_min_m\": [-1, -1, -1], \"extent_max_m\": [1, 1, 1]},"
@@ -32,7 +33,8 @@ static const char *air_furnace_json =
     "    \"transform\": {\"translate_m\": [0.45, 0.2, -0.3]}},"
     "   {\"name\": \"can\", \"type\": \"shell\", \"thickness_m\": 0.002, \"material\": \"foam\","
     "    \"temperature_k\": 300,"
-    "    \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.25, \"height_m\": 0.7, \"caps\": false},"
+    "    \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.25, \"height_m\": 0.7, \"caps\": "
+    "false},"
     "    \"transform\": {\"translate_m\": [-0.2, 0.6, -0.8]}}],"
     " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.9, 0], \"direction\": [0, 1, 0],"
     "   \"up\": [0, 0, 1], \"fov_deg\": 90, \"resolution\": [20, 20], \"oversampling\": 1,"
@@ -183,23 +185,24 @@ static void test_air_furnace(void **state)
  * the sphere reflects comes from the air and from outside the box: N_c = 1 needs the
  * photon phase's boundary source (air_emission.h). Pixels that see the sky are
  * deterministic. */
-#define SKY_JSON(ATM_KEYS)                                                                       \
-    "{\"format\": \"thzmap-scene/1\", \"name\": \"open sky\"," \
-    " \"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.05}," \
-    "                {\"frequency_thz\": 0.557, \"relative_width\": 0.02}]," \
-    " \"materials\": {\"grey\": {\"reflectivity\": 0.5}, \"sheet\": {\"reflectivity\": 0.3}}," \
-    " \"atmosphere\": {\"model\": \"itu-p676\", \"temperature_k\": 300, \"pressure_hpa\": 1013.25," \
-    "   \"relative_humidity\": 0.5, \"emitting\": true, " ATM_KEYS "}," \
-    " \"objects\": [" \
+#define SKY_JSON(ATM_KEYS)                                                                         \
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"open sky\","                                     \
+    " \"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.05},"                         \
+    "                {\"frequency_thz\": 0.557, \"relative_width\": 0.02}],"                       \
+    " \"materials\": {\"grey\": {\"reflectivity\": 0.5}, \"sheet\": {\"reflectivity\": 0.3}},"     \
+    " \"atmosphere\": {\"model\": \"itu-p676\", \"temperature_k\": 300, \"pressure_hpa\": "        \
+    "1013.25,"                                                                                     \
+    "   \"relative_humidity\": 0.5, \"emitting\": true, " ATM_KEYS "},"                            \
+    " \"objects\": ["                                                                              \
     "   {\"name\": \"ball\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 300," \
-    "    \"shape\": {\"type\": \"sphere\", \"radius_m\": 0.6}," \
-    "    \"transform\": {\"translate_m\": [0.3, 0.6, 0]}}," \
-    "   {\"name\": \"sheet\", \"type\": \"solid\", \"two_sided\": true, \"material\": \"sheet\"," \
-    "    \"temperature_k\": 300, \"shape\": {\"type\": \"rectangle\", \"size_m\": [0.8, 0.8]}," \
-    "    \"transform\": {\"rotate_deg\": [60, 0, 30], \"translate_m\": [-0.7, 0.2, 0.3]}}]," \
-    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -1.4, 0], \"direction\": [0, 1, 0]," \
-    "   \"up\": [0, 0, 1], \"fov_deg\": 70, \"resolution\": [16, 16], \"oversampling\": 1," \
-    "   \"aperture_m2\": 0.01, \"normalize_to_k\": 300}]," \
+    "    \"shape\": {\"type\": \"sphere\", \"radius_m\": 0.6},"                                    \
+    "    \"transform\": {\"translate_m\": [0.3, 0.6, 0]}},"                                        \
+    "   {\"name\": \"sheet\", \"type\": \"solid\", \"two_sided\": true, \"material\": \"sheet\","  \
+    "    \"temperature_k\": 300, \"shape\": {\"type\": \"rectangle\", \"size_m\": [0.8, 0.8]},"    \
+    "    \"transform\": {\"rotate_deg\": [60, 0, 30], \"translate_m\": [-0.7, 0.2, 0.3]}}],"       \
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -1.4, 0], \"direction\": [0, 1, 0],"   \
+    "   \"up\": [0, 0, 1], \"fov_deg\": 70, \"resolution\": [16, 16], \"oversampling\": 1,"        \
+    "   \"aperture_m2\": 0.01, \"normalize_to_k\": 300}],"                                         \
     " \"photons\": {\"per_channel\": 1000000, \"seed\": 9}}"
 
 static void sky_case(thz_integrator integrator, bool extent)
@@ -366,8 +369,8 @@ static void test_air_warm_room(void **state)
             sum += (a - b) / b;
             var += (se / b) * (se / b);
             if (!(fabs(a - b) <= IDENT_Z * se + 1e-5 * b)) {
-                print_message("pixel (%u, %u): final-gather %.6e, path %.6e (se %.2e)\n", col,
-                              row, a, b, se);
+                print_message("pixel (%u, %u): final-gather %.6e, path %.6e (se %.2e)\n", col, row,
+                              a, b, se);
                 failed++;
             }
         }
@@ -513,12 +516,9 @@ static void test_humid_beer_lambert(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_air_column),
-        cmocka_unit_test(test_humid_beer_lambert),
-        cmocka_unit_test(test_air_furnace),
-        cmocka_unit_test(test_air_open_sky),
-        cmocka_unit_test(test_air_warm_ball),
-        cmocka_unit_test(test_air_warm_room),
+        cmocka_unit_test(test_air_column),    cmocka_unit_test(test_humid_beer_lambert),
+        cmocka_unit_test(test_air_furnace),   cmocka_unit_test(test_air_open_sky),
+        cmocka_unit_test(test_air_warm_ball), cmocka_unit_test(test_air_warm_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -175,8 +175,9 @@ static void test_source_fractions(void **state)
             assert_true(x >= m->bbox_min_m[k] - 1e-9 && x <= m->bbox_max_m[k] + 1e-9);
         }
     }
-    const char *names[7] = {"one-sided grey", "two-sided black", "explicit shell",
-                            "Kirchhoff shell", "0 K", "same group as grey", "R(nu) table"};
+    const char *names[7] = {
+        "one-sided grey",     "two-sided black", "explicit shell", "Kirchhoff shell", "0 K",
+        "same group as grey", "R(nu) table"};
     /* Eq. 5 in the band mean: each source's share of the power fired is its share of
      * P-bar_A. Standard error of the ratio estimator: sqrt(sum Phi^2 (I - f)^2) / sum Phi. */
     for (uint32_t k = 0; k < 7; k++) {
@@ -252,7 +253,6 @@ static void test_direction_distribution(void **state)
         scene_destroy(s);
     }
 }
-
 
 /* The group is drawn from a tabulation q_g on a grid over the band and the photon
  * carries w_g Q / (q_g K), w_g exact: a reflectivity line lying wholly between two grid

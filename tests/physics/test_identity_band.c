@@ -39,7 +39,8 @@ static double band_r(const band_line *l, double nu)
         return l->r[0];
     for (int i = 1; i < 5; i++)
         if (nu <= l->f[i])
-            return l->r[i - 1] + (l->r[i] - l->r[i - 1]) * (nu - l->f[i - 1]) / (l->f[i] - l->f[i - 1]);
+            return l->r[i - 1] +
+                   (l->r[i] - l->r[i - 1]) * (nu - l->f[i - 1]) / (l->f[i] - l->f[i - 1]);
     return l->r[4];
 }
 
@@ -55,27 +56,26 @@ static double band_reflected(double nu, void *ctx)
     return band_r(l, nu) * planck_radiance(nu, l->temp_k);
 }
 
-static void band_scene(char *json, size_t size, const band_line *l, double t_plate,
-                       double t_room)
+static void band_scene(char *json, size_t size, const band_line *l, double t_plate, double t_room)
 {
-    snprintf(json, size,
-             "{\"format\": \"thzmap-scene/1\", \"name\": \"band-line\","
-             " \"channels\": [{\"frequency_thz\": %.12g, \"relative_width\": %g}],"
-             " \"materials\": {\"black\": {\"reflectivity\": 0.0},"
-             "   \"lined\": {\"reflectivity\": [[%.12g, %g], [%.12g, %g], [%.12g, %g],"
-             "                                 [%.12g, %g], [%.12g, %g]]}},"
-             " \"objects\": ["
-             "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"black\","
-             "    \"temperature_k\": %g,"
-             "    \"shape\": {\"type\": \"box\", \"size_m\": [1.2, 0.6, 1.2], \"inward\": true}},"
-             "   {\"name\": \"plate\", \"type\": \"solid\", \"material\": \"lined\","
-             "    \"temperature_k\": %g, \"shape\": {\"type\": \"box\", \"size_m\": [1.0, 0.1, 1.0]}}],"
-             " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.28, 0],"
-             "   \"direction\": [0, 1, 0], \"fov_deg\": 100, \"resolution\": [8, 8]}],"
-             " \"photons\": {\"per_channel\": 300000, \"seed\": 11}}",
-             BAND_NU_C / 1e12, BAND_W, l->f[0] / 1e12, l->r[0], l->f[1] / 1e12, l->r[1],
-             l->f[2] / 1e12, l->r[2], l->f[3] / 1e12, l->r[3], l->f[4] / 1e12, l->r[4], t_room,
-             t_plate);
+    snprintf(
+        json, size,
+        "{\"format\": \"thzmap-scene/1\", \"name\": \"band-line\","
+        " \"channels\": [{\"frequency_thz\": %.12g, \"relative_width\": %g}],"
+        " \"materials\": {\"black\": {\"reflectivity\": 0.0},"
+        "   \"lined\": {\"reflectivity\": [[%.12g, %g], [%.12g, %g], [%.12g, %g],"
+        "                                 [%.12g, %g], [%.12g, %g]]}},"
+        " \"objects\": ["
+        "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"black\","
+        "    \"temperature_k\": %g,"
+        "    \"shape\": {\"type\": \"box\", \"size_m\": [1.2, 0.6, 1.2], \"inward\": true}},"
+        "   {\"name\": \"plate\", \"type\": \"solid\", \"material\": \"lined\","
+        "    \"temperature_k\": %g, \"shape\": {\"type\": \"box\", \"size_m\": [1.0, 0.1, 1.0]}}],"
+        " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.28, 0],"
+        "   \"direction\": [0, 1, 0], \"fov_deg\": 100, \"resolution\": [8, 8]}],"
+        " \"photons\": {\"per_channel\": 300000, \"seed\": 11}}",
+        BAND_NU_C / 1e12, BAND_W, l->f[0] / 1e12, l->r[0], l->f[1] / 1e12, l->r[1], l->f[2] / 1e12,
+        l->r[2], l->f[3] / 1e12, l->r[3], l->f[4] / 1e12, l->r[4], t_room, t_plate);
 }
 
 static void band_emission_case(thz_integrator integrator)

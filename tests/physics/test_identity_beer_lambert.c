@@ -43,7 +43,8 @@ static void beer_lambert_case(thz_integrator integrator)
                 assert_true(fabs(l - expect) <= tol);
                 /* no photon term; path: the band noise only (well below 1 %) */
                 if (!(sampled ? se < 0.01 * expect : se == 0.0))
-                    print_message("%s: stderr %.3e of %.3e\n", render_integrator_name(integrator), se, expect);
+                    print_message("%s: stderr %.3e of %.3e\n", render_integrator_name(integrator),
+                                  se, expect);
                 assert_true(sampled ? se < 0.01 * expect : se == 0.0);
                 /* the attenuation is real: without it L would be e^{alpha d} ~ 4.4x larger */
                 assert_true(r.img.normalized[i] < 0.3);

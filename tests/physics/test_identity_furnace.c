@@ -15,8 +15,10 @@ static const char *furnace_json =
     "   \"wall\": {\"reflectivity\": 0.3},"
     "   \"shiny\": {\"reflectivity\": 0.6},"
     "   \"sheet\": {\"reflectivity\": 0.5},"
-    "   \"foam\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 300, \"transmission\": \"diffuse\"},"
-    "   \"film\": {\"reflectivity\": 0.2, \"attenuation_per_m\": 150, \"transmission\": \"straight\"}},"
+    "   \"foam\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 300, \"transmission\": "
+    "\"diffuse\"},"
+    "   \"film\": {\"reflectivity\": 0.2, \"attenuation_per_m\": 150, \"transmission\": "
+    "\"straight\"}},"
     " \"objects\": ["
     "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"wall\", \"temperature_k\": 300,"
     "    \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2], \"inward\": true}},"
@@ -28,7 +30,8 @@ static const char *furnace_json =
     "    \"transform\": {\"rotate_deg\": [60, 0, 30], \"translate_m\": [-0.4, 0.4, 0.3]}},"
     "   {\"name\": \"can\", \"type\": \"shell\", \"thickness_m\": 0.002, \"material\": \"foam\","
     "    \"temperature_k\": 300,"
-    "    \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.25, \"height_m\": 0.7, \"caps\": false},"
+    "    \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.25, \"height_m\": 0.7, \"caps\": "
+    "false},"
     "    \"transform\": {\"translate_m\": [-0.2, 0.6, -0.8]}},"
     "   {\"name\": \"veil\", \"type\": \"shell\", \"thickness_m\": 0.002, \"material\": \"film\","
     "    \"temperature_k\": 300, \"shape\": {\"type\": \"rectangle\", \"size_m\": [0.6, 0.6]},"
@@ -79,8 +82,8 @@ static void furnace_case(thz_integrator integrator)
             }
         assert_int_equal(loose_fail, 0);
         char what[64];
-        snprintf(what, sizeof what, "furnace, %s, channel %zu",
-                 render_integrator_name(integrator), c);
+        snprintf(what, sizeof what, "furnace, %s, channel %zu", render_integrator_name(integrator),
+                 c);
         /* final-gather: the secondary hits' k-nearest disks (k = 64) that reach past an
          * edge under-estimate everywhere in the picture, not only at the primary edges:
          * measured -0.13 % here; 0.3 % allowed */
@@ -110,7 +113,6 @@ static void test_furnace(void **state)
     for (size_t k = 0; k < IDENT_N_INTEGRATORS; k++)
         furnace_case(ident_integrators[k]);
 }
-
 
 int main(void)
 {

@@ -18,35 +18,41 @@
  *     by FG_MAP_FACTOR); photon-map's Poisson estimate is checked over photon seeds. */
 #include "identity.h"
 
-#define XVAL_JSON \
-    "{\"format\": \"thzmap-scene/1\", \"name\": \"cross-validation\"," \
-    " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.05}]," \
-    " \"materials\": {" \
-    "   \"wall\": {\"reflectivity\": 0.2}," \
-    "   \"metal\": {\"reflectivity\": 0.7}," \
-    "   \"grey\": {\"reflectivity\": 0.4}," \
-    "   \"foam\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 150, \"transmission\": \"diffuse\"}," \
-    "   \"film\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 100, \"transmission\": \"straight\"}}," \
-    " \"objects\": [" \
+#define XVAL_JSON                                                                                  \
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"cross-validation\","                             \
+    " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.05}],"                         \
+    " \"materials\": {"                                                                            \
+    "   \"wall\": {\"reflectivity\": 0.2},"                                                        \
+    "   \"metal\": {\"reflectivity\": 0.7},"                                                       \
+    "   \"grey\": {\"reflectivity\": 0.4},"                                                        \
+    "   \"foam\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 150, \"transmission\": "          \
+    "\"diffuse\"},"                                                                                \
+    "   \"film\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 100, \"transmission\": "          \
+    "\"straight\"}},"                                                                              \
+    " \"objects\": ["                                                                              \
     "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"wall\", \"temperature_k\": 295," \
-    "    \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2], \"inward\": true}}," \
-    "   {\"name\": \"heater\", \"type\": \"solid\", \"material\": \"metal\", \"temperature_k\": 340," \
-    "    \"shape\": {\"type\": \"box\", \"size_m\": [0.5, 0.3, 0.5]}," \
-    "    \"transform\": {\"rotate_deg\": [0, 0, 30], \"translate_m\": [0.45, 0.5, 0.3]}}," \
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2], \"inward\": true}},"                \
+    "   {\"name\": \"heater\", \"type\": \"solid\", \"material\": \"metal\", \"temperature_k\": "  \
+    "340,"                                                                                         \
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [0.5, 0.3, 0.5]},"                             \
+    "    \"transform\": {\"rotate_deg\": [0, 0, 30], \"translate_m\": [0.45, 0.5, 0.3]}},"         \
     "   {\"name\": \"cold\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 250," \
-    "    \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.2, \"height_m\": 0.9, \"caps\": true}," \
-    "    \"transform\": {\"translate_m\": [-0.4, 0.5, -1.0]}}," \
-    "   {\"name\": \"sleeve\", \"type\": \"shell\", \"thickness_m\": 0.003, \"material\": \"foam\"," \
-    "    \"temperature_k\": 305," \
-    "    \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.25, \"height_m\": 0.5, \"caps\": false}," \
-    "    \"transform\": {\"translate_m\": [-0.4, 0.5, -0.6]}}," \
+    "    \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.2, \"height_m\": 0.9, \"caps\": "     \
+    "true},"                                                                                       \
+    "    \"transform\": {\"translate_m\": [-0.4, 0.5, -1.0]}},"                                    \
+    "   {\"name\": \"sleeve\", \"type\": \"shell\", \"thickness_m\": 0.003, \"material\": "        \
+    "\"foam\","                                                                                    \
+    "    \"temperature_k\": 305,"                                                                  \
+    "    \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.25, \"height_m\": 0.5, \"caps\": "    \
+    "false},"                                                                                      \
+    "    \"transform\": {\"translate_m\": [-0.4, 0.5, -0.6]}},"                                    \
     "   {\"name\": \"veil\", \"type\": \"shell\", \"thickness_m\": 0.002, \"material\": \"film\"," \
-    "    \"temperature_k\": 300, \"shape\": {\"type\": \"rectangle\", \"size_m\": [0.6, 0.6]}," \
-    "    \"transform\": {\"rotate_deg\": [90, 0, 0], \"translate_m\": [0.35, 0.0, 0.3]}}]," \
-    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.9, 0], \"direction\": [0, 1, 0]," \
-    "   \"up\": [0, 0, 1], \"fov_deg\": 80, \"resolution\": [%u, %u], \"oversampling\": 1," \
-    "   \"aperture_m2\": 0.01, \"normalize_to_k\": 295}]," \
-    " \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": %g}," \
+    "    \"temperature_k\": 300, \"shape\": {\"type\": \"rectangle\", \"size_m\": [0.6, 0.6]},"    \
+    "    \"transform\": {\"rotate_deg\": [90, 0, 0], \"translate_m\": [0.35, 0.0, 0.3]}}],"        \
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.9, 0], \"direction\": [0, 1, 0],"   \
+    "   \"up\": [0, 0, 1], \"fov_deg\": 80, \"resolution\": [%u, %u], \"oversampling\": 1,"        \
+    "   \"aperture_m2\": 0.01, \"normalize_to_k\": 295}],"                                         \
+    " \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": %g},"                       \
     " \"photons\": {\"per_channel\": 300000, \"seed\": %llu}}"
 
 /* final-gather's standard error is conditional on its photon map: the map's own noise,
@@ -96,9 +102,10 @@ static void cross_validation(double alpha_per_m)
                     worst_z = z;
                 if (!(fabs(l - l_ref) <= tol)) {
                     if (failed < 8)
-                        print_message("%s pixel (%u, %u): L = %.5e, path %.5e (%+.3f %%, z = %.1f)\n",
-                                      render_integrator_name(others[k]), col, row, l, l_ref,
-                                      100.0 * (l - l_ref) / l_ref, z);
+                        print_message(
+                            "%s pixel (%u, %u): L = %.5e, path %.5e (%+.3f %%, z = %.1f)\n",
+                            render_integrator_name(others[k]), col, row, l, l_ref,
+                            100.0 * (l - l_ref) / l_ref, z);
                     failed++;
                 }
             }
@@ -199,8 +206,7 @@ static double honesty_ratio(thz_integrator integrator, bool fixed_map)
     print_message("%s%s: observed / reported standard error = %.3f over %zu pixels x %d runs "
                   "(precision ~%.1f %%)\n",
                   render_integrator_name(integrator), fixed_map ? " (one photon map)" : "", ratio,
-                  used, HONEST_RUNS,
-                  100.0 * sqrt(1.0 / (2.0 * (HONEST_RUNS - 1) * (double)used)));
+                  used, HONEST_RUNS, 100.0 * sqrt(1.0 / (2.0 * (HONEST_RUNS - 1) * (double)used)));
     assert_true(used > px / 2);
     return ratio;
 }

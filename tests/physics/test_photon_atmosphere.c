@@ -45,8 +45,12 @@ static void straight_down(double alpha, double d, uint64_t n, double *mean_power
     double sum = 0.0;
     *stored = 0;
     for (uint64_t i = 0; i < n; i++) {
-        emission_photon e = {.freq_hz = 0.35e12, .power_w_per_hz = 1.0, .position_m = v3(0, 0, d),
-                             .dir = v3(0, 0, -1), .object = (uint32_t)src, .triangle = 0};
+        emission_photon e = {.freq_hz = 0.35e12,
+                             .power_w_per_hz = 1.0,
+                             .position_m = v3(0, 0, d),
+                             .dir = v3(0, 0, -1),
+                             .object = (uint32_t)src,
+                             .triangle = 0};
         rng_stream rng;
         rng_init(&rng, 8, 0, RNG_PURPOSE_PHOTON, i);
         buf.count = 0;

@@ -112,8 +112,8 @@ static void test_transmission_in_scene(void **state)
     (void)state;
     for (int mode = 0; mode < 2; mode++) {
         thz_scene *s = ps_scene(0.35, 0.01, 1000, 5);
-        size_t cloth = ps_material(s, 0.0, 300.0, -1.0,
-                                   mode ? TRANSMISSION_STRAIGHT : TRANSMISSION_DIFFUSE);
+        size_t cloth =
+            ps_material(s, 0.0, 300.0, -1.0, mode ? TRANSMISSION_STRAIGHT : TRANSMISSION_DIFFUSE);
         size_t black = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
         size_t shell = ps_object(s, OBJECT_SHELL, cloth, 0, 1e-3, true);
         ps_face(s, shell, v3(0, 0, 1), v3(50, 0, 0), v3(0, 50, 0));
@@ -131,9 +131,12 @@ static void test_transmission_in_scene(void **state)
         for (uint64_t i = 0; i < n; i++) {
             /* Starts in free space at z = 2; the "source" triangle (for the offset and
              * the filter of the first ray) is a floor triangle, 2 m away. */
-            emission_photon e = {.freq_hz = 0.35e12, .power_w_per_hz = 1.0,
-                                 .position_m = v3(0, 0, 2), .dir = dir,
-                                 .object = (uint32_t)floor, .triangle = 0};
+            emission_photon e = {.freq_hz = 0.35e12,
+                                 .power_w_per_hz = 1.0,
+                                 .position_m = v3(0, 0, 2),
+                                 .dir = dir,
+                                 .object = (uint32_t)floor,
+                                 .triangle = 0};
             rng_stream rng;
             rng_init(&rng, 5, 0, RNG_PURPOSE_TEST, i);
             buf.count = 0;
@@ -189,9 +192,12 @@ static void test_reflection_and_back_faces(void **state)
         trace_counters c = {0};
         vec3 in = v3_normalize(v3(0.3, 0.1, from_below ? 1.0 : -1.0));
         for (uint64_t i = 0; i < n; i++) {
-            emission_photon e = {.freq_hz = 0.35e12, .power_w_per_hz = 1.0,
-                                 .position_m = v3(-0.15, -0.05, 0.5 * zc), .dir = in,
-                                 .object = (uint32_t)cover, .triangle = 0};
+            emission_photon e = {.freq_hz = 0.35e12,
+                                 .power_w_per_hz = 1.0,
+                                 .position_m = v3(-0.15, -0.05, 0.5 * zc),
+                                 .dir = in,
+                                 .object = (uint32_t)cover,
+                                 .triangle = 0};
             rng_stream rng;
             rng_init(&rng, 6, 0, RNG_PURPOSE_TEST, i);
             buf.count = 0;
@@ -217,9 +223,12 @@ static void test_reflection_and_back_faces(void **state)
         /* From below onto the one-sided plate: its back side. */
         if (from_below) {
             memset(&c, 0, sizeof c);
-            emission_photon e = {.freq_hz = 0.35e12, .power_w_per_hz = 1.0,
-                                 .position_m = v3(50, 0, -0.5), .dir = v3(0, 0, 1),
-                                 .object = (uint32_t)cover, .triangle = 0};
+            emission_photon e = {.freq_hz = 0.35e12,
+                                 .power_w_per_hz = 1.0,
+                                 .position_m = v3(50, 0, -0.5),
+                                 .dir = v3(0, 0, 1),
+                                 .object = (uint32_t)cover,
+                                 .triangle = 0};
             rng_stream rng;
             rng_init(&rng, 6, 1, RNG_PURPOSE_TEST, 0);
             buf.count = 0;

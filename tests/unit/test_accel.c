@@ -73,14 +73,13 @@ static void test_hit_side_and_distance(void **state)
     assert_float_equal(h.cos_theta, 1.0, 1e-6);
     assert_float_equal(h.position_m.z, 4.0 + GAP_M, 1e-6);
     /* From below, up: the lower rectangle's back side. */
-    assert_true(accel_intersect(f->acc, v3(3.1, -2.1, 1.0), v3(0, 0, 1), INFINITY, ACCEL_NO_OBJECT,
-                                0, &h));
+    assert_true(
+        accel_intersect(f->acc, v3(3.1, -2.1, 1.0), v3(0, 0, 1), INFINITY, ACCEL_NO_OBJECT, 0, &h));
     assert_int_equal(h.object, f->lower);
     assert_int_equal(h.side, 1);
     /* Into the room's wall from inside at 60 degrees: front side, cos = 0.5. */
     vec3 d = v3(sqrt(3.0) / 2.0, 0, 0.5);
-    assert_true(
-        accel_intersect(f->acc, v3(0, 0, 1.0), d, INFINITY, ACCEL_NO_OBJECT, 0, &h));
+    assert_true(accel_intersect(f->acc, v3(0, 0, 1.0), d, INFINITY, ACCEL_NO_OBJECT, 0, &h));
     assert_int_equal(h.object, f->room);
     assert_int_equal(h.side, 0);
     assert_float_equal(h.cos_theta, sqrt(3.0) / 2.0, 1e-6);
@@ -156,8 +155,10 @@ static void test_threads(void **state)
         for (int i = 0; i < N; i++) {
             rng_stream rng;
             rng_init(&rng, 3, 0, RNG_PURPOSE_TEST, (uint64_t)i);
-            vec3 o = v3(8 * rng_uniform(&rng) - 4, 8 * rng_uniform(&rng) - 4, 1 + 8 * rng_uniform(&rng));
-            vec3 d = v3_normalize(v3(rng_uniform(&rng) - 0.5, rng_uniform(&rng) - 0.5, rng_uniform(&rng) - 0.5));
+            vec3 o =
+                v3(8 * rng_uniform(&rng) - 4, 8 * rng_uniform(&rng) - 4, 1 + 8 * rng_uniform(&rng));
+            vec3 d = v3_normalize(
+                v3(rng_uniform(&rng) - 0.5, rng_uniform(&rng) - 0.5, rng_uniform(&rng) - 0.5));
             if (pass == 0)
                 hs[i] = accel_intersect(f->acc, o, d, INFINITY, ACCEL_NO_OBJECT, 0, &serial[i]);
             else

@@ -54,8 +54,7 @@ static void test_widths(void **state)
     assert_true(channel_response(&ch_default, ch_default.center_hz) == 1.0);
     double sigma = fwhm / (2.0 * sqrt(2.0 * log(2.0)));
     assert_true(fabs(channel_sigma_hz(&ch_default) - sigma) < 1e-14 * sigma);
-    assert_true(fabs(channel_bandwidth_hz(&ch_default) - sigma * sqrt(2.0 * M_PI)) <
-                1e-14 * sigma);
+    assert_true(fabs(channel_bandwidth_hz(&ch_default) - sigma * sqrt(2.0 * M_PI)) < 1e-14 * sigma);
 }
 
 static void test_band_mean_constant_and_linear(void **state)

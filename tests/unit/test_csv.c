@@ -54,7 +54,8 @@ static void test_errors(void **state)
     (void)state;
     expect_error("bad_number.csv",
                  (const char *[]){"bad_number.csv:3:", "row 2", "'reflectivity'", "'abc'", NULL});
-    expect_error("bad_fields.csv", (const char *[]){"bad_fields.csv:3:", "row 2", "1 fields", NULL});
+    expect_error("bad_fields.csv",
+                 (const char *[]){"bad_fields.csv:3:", "row 2", "1 fields", NULL});
     expect_error("empty.csv", (const char *[]){"empty.csv", "no header", NULL});
     expect_error("header_only.csv", (const char *[]){"header_only.csv", "no data rows", NULL});
     expect_error("missing.csv", (const char *[]){"missing.csv", "cannot open", NULL});

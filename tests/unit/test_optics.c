@@ -80,10 +80,10 @@ static void test_mean_transmission_e3(void **state)
 {
     (void)state;
     static const double tab[][2] = {
-        {0.001, 0.499003915436452876}, {0.01, 0.490276564184665092},
-        {0.1, 0.416291457908278761},   {0.5, 0.221604364275178457},
-        {1.0, 0.109691967197760137},   {2.0, 0.0301333797978158932},
-        {5.0, 8.7780089277063827e-4},  {10.0, 3.54876255308438196e-6},
+        {0.001, 0.499003915436452876},   {0.01, 0.490276564184665092},
+        {0.1, 0.416291457908278761},     {0.5, 0.221604364275178457},
+        {1.0, 0.109691967197760137},     {2.0, 0.0301333797978158932},
+        {5.0, 8.7780089277063827e-4},    {10.0, 3.54876255308438196e-6},
         {30.0, 2.84307432814032745e-15},
     };
     for (size_t i = 0; i < sizeof tab / sizeof tab[0]; i++) {
@@ -175,7 +175,8 @@ static void check_histogram(const optics_point *o, sample_fn sample, mu_fn x, ui
         double sd = sqrt(expect * (1.0 - p));
         assert_true(fabs((double)count[b] - expect) <= 5.0 * sd + 1.0);
         if (getenv("THZ_DEBUG_HIST"))
-            fprintf(stderr, "%u bin %d: %zu vs %.1f (%.2f sd)\n", (unsigned)stream, b, count[b], expect, ((double)count[b] - expect) / sd);
+            fprintf(stderr, "%u bin %d: %zu vs %.1f (%.2f sd)\n", (unsigned)stream, b, count[b],
+                    expect, ((double)count[b] - expect) / sd);
         if (expect >= 5.0) {
             chi2 += ((double)count[b] - expect) * ((double)count[b] - expect) / expect;
         } else { /* pool the sparse bins into one, as chi-square needs */
@@ -186,7 +187,8 @@ static void check_histogram(const optics_point *o, sample_fn sample, mu_fn x, ui
     if (pooled_expect >= 5.0)
         chi2 += (pooled_count - pooled_expect) * (pooled_count - pooled_expect) / pooled_expect;
     /* 19 degrees of freedom (fewer where p = 0): chi2 > 60 has probability < 3e-6 */
-    if (chi2 >= 60.0) fprintf(stderr, "chi2 %g case %u\n", chi2, (unsigned)stream);
+    if (chi2 >= 60.0)
+        fprintf(stderr, "chi2 %g case %u\n", chi2, (unsigned)stream);
     assert_true(chi2 < 60.0);
 }
 
@@ -208,12 +210,12 @@ static void test_sample_emission(void **state)
 {
     (void)state;
     const optics_point cases[] = {
-        shell(0.2, 50.0, 0.01),   /* tau 0.5 */
-        shell(0.0, 0.01, 0.01),   /* tau 1e-4: eps ~ tau/mu, nearly uniform in mu */
-        shell(0.3, 5.0, 0.01),    /* capped: eps = 0 above mu* */
-        shell(0.1, 1000.0, 0.01), /* tau 10: nearly constant */
-        {0.4, 10.0, 0.0, 0.0, false},  /* solid: cosine */
-        {0.4, 10.0, 0.01, 0.3, true},  /* explicit: cosine */
+        shell(0.2, 50.0, 0.01),       /* tau 0.5 */
+        shell(0.0, 0.01, 0.01),       /* tau 1e-4: eps ~ tau/mu, nearly uniform in mu */
+        shell(0.3, 5.0, 0.01),        /* capped: eps = 0 above mu* */
+        shell(0.1, 1000.0, 0.01),     /* tau 10: nearly constant */
+        {0.4, 10.0, 0.0, 0.0, false}, /* solid: cosine */
+        {0.4, 10.0, 0.01, 0.3, true}, /* explicit: cosine */
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
         check_histogram(&cases[i], optics_sample_emission_mu, optics_emissivity, 100 + i);
@@ -243,8 +245,8 @@ static void test_sample_zero(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_pointwise),         cmocka_unit_test(test_mean_transmission_e3),
-        cmocka_unit_test(test_means_capped),      cmocka_unit_test(test_kirchhoff_violation),
+        cmocka_unit_test(test_pointwise),           cmocka_unit_test(test_mean_transmission_e3),
+        cmocka_unit_test(test_means_capped),        cmocka_unit_test(test_kirchhoff_violation),
         cmocka_unit_test(test_sample_transmission), cmocka_unit_test(test_sample_emission),
         cmocka_unit_test(test_sample_zero),
     };

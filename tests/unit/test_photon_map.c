@@ -46,10 +46,11 @@ static void test_directions(void **state)
     double worst = 0.0;
     /* poles, axes, the z = 0 seam, octant diagonals, signed zeros */
     static const double special[][3] = {
-        {0, 0, 1},  {0, 0, -1}, {1, 0, 0},   {-1, 0, 0},  {0, 1, 0},  {0, -1, 0},
-        {1, 1, 0},  {-1, 1, 0}, {1, -1, 0},  {-1, -1, 0}, {1, 1, 1},  {-1, -1, -1},
-        {1, 1, -1}, {0, 1, -1}, {1, 0, -1},  {-0.0, -0.0, -1}, {-0.0, 0, 1},
-        {1e-9, 1e-9, -1}, {-1e-9, 1e-9, -1}, {0.6, 0.8, -1e-12}, {0.6, -0.8, 1e-12},
+        {0, 0, 1},          {0, 0, -1},   {1, 0, 0},        {-1, 0, 0},        {0, 1, 0},
+        {0, -1, 0},         {1, 1, 0},    {-1, 1, 0},       {1, -1, 0},        {-1, -1, 0},
+        {1, 1, 1},          {-1, -1, -1}, {1, 1, -1},       {0, 1, -1},        {1, 0, -1},
+        {-0.0, -0.0, -1},   {-0.0, 0, 1}, {1e-9, 1e-9, -1}, {-1e-9, 1e-9, -1}, {0.6, 0.8, -1e-12},
+        {0.6, -0.8, 1e-12},
     };
     for (size_t i = 0; i < sizeof special / sizeof special[0]; i++) {
         double e = check_direction(v3(special[i][0], special[i][1], special[i][2]));
@@ -94,7 +95,7 @@ static photon_record *make_photons(size_t n, size_t n_objects, uint64_t stream)
         for (int a = 0; a < 3; a++)
             pos[a] = (float)(rng_uniform(&rng) * (a == 2 ? 0.2 : 1.0));
         if (obj == 1 && side == 0)
-            pos[2] = 0.5f; /* coplanar */
+            pos[2] = 0.5f;         /* coplanar */
         if (i % 7 == 3 && i > 0) { /* same position as the previous photon */
             memcpy(pos, p[i - 1].position_m, sizeof pos);
         }
@@ -315,10 +316,8 @@ static void test_empty_and_errors(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_directions),
-        cmocka_unit_test(test_queries_vs_brute_force),
-        cmocka_unit_test(test_same_records_grouped),
-        cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_directions),           cmocka_unit_test(test_queries_vs_brute_force),
+        cmocka_unit_test(test_same_records_grouped), cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_empty_and_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -117,9 +117,9 @@ static void test_round_trip(void **state)
 
     char again[160];
     snprintf(again, sizeof again, "%s/again.thzpm", f->dir);
-    assert_int_equal(photon_map_file_write(again, f->scene, (const photon_map *const *)maps, stats,
-                                           &err),
-                     THZ_OK);
+    assert_int_equal(
+        photon_map_file_write(again, f->scene, (const photon_map *const *)maps, stats, &err),
+        THZ_OK);
     size_t n1, n2;
     unsigned char *b1 = slurp(f->path, &n1), *b2 = slurp(again, &n2);
     assert_int_equal(n1, n2);

@@ -122,9 +122,9 @@ static void test_round_trip(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_matches_long_double), cmocka_unit_test(test_exact_values),
+        cmocka_unit_test(test_matches_long_double),  cmocka_unit_test(test_exact_values),
         cmocka_unit_test(test_rayleigh_jeans_limit), cmocka_unit_test(test_wien_limit),
-        cmocka_unit_test(test_zero_and_negative),   cmocka_unit_test(test_round_trip),
+        cmocka_unit_test(test_zero_and_negative),    cmocka_unit_test(test_round_trip),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -52,8 +52,7 @@ static size_t parse_header(const unsigned char *buf, size_t n, uint64_t *vertice
     return len;
 }
 
-static void check_file(const char *path, const photon_map *const *maps, size_t n_maps,
-                       uint64_t cap)
+static void check_file(const char *path, const photon_map *const *maps, size_t n_maps, uint64_t cap)
 {
     thz_error err;
     assert_int_equal(ply_write_photons(path, maps, n_maps, cap, &err), THZ_OK);
@@ -108,9 +107,9 @@ static void test_ply(void **state)
     photon_map *empty[1] = {NULL};
     check_file(path, (const photon_map *const *)empty, 1, 10); /* no photons: header only */
     thz_error err;
-    assert_int_equal(ply_write_photons("/nonexistent-dir/x.ply", (const photon_map *const *)maps, 3,
-                                       0, &err),
-                     THZ_ERR_IO);
+    assert_int_equal(
+        ply_write_photons("/nonexistent-dir/x.ply", (const photon_map *const *)maps, 3, 0, &err),
+        THZ_ERR_IO);
     assert_non_null(strstr(err.message, "/nonexistent-dir/x.ply"));
     photon_map_destroy(maps[0]);
     photon_map_destroy(maps[2]);

@@ -202,8 +202,8 @@ static void test_disk(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_box),      cmocka_unit_test(test_box_inward),
-        cmocka_unit_test(test_cylinder), cmocka_unit_test(test_sphere),
+        cmocka_unit_test(test_box),       cmocka_unit_test(test_box_inward),
+        cmocka_unit_test(test_cylinder),  cmocka_unit_test(test_sphere),
         cmocka_unit_test(test_rectangle), cmocka_unit_test(test_disk),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -81,8 +81,8 @@ static void render(fixture *f, size_t sensor, int threads, sensor_images *img, r
     render_options ro = {.threads = threads};
     thz_error err;
     assert_int_equal(render_sensor_truth(f->scene, f->acc, sensor, img, &ro, &err), THZ_OK);
-    assert_int_equal(
-        render_sensor_channel(f->scene, f->acc, f->map, 0, sensor, img, &ro, st, &err), THZ_OK);
+    assert_int_equal(render_sensor_channel(f->scene, f->acc, f->map, 0, sensor, img, &ro, st, &err),
+                     THZ_OK);
 }
 
 /* The channel's band mean of B(T), by the library quadrature (tested elsewhere). */
@@ -259,9 +259,9 @@ static void test_passes_are_deterministic(void **state)
         assert_memory_equal(a.mean, b.mean, px * sizeof(double));
         assert_memory_equal(a.m2, b.m2, px * sizeof(double));
         /* out-of-order passes are an internal error */
-        assert_int_equal(render_sensor_channel_pass(f->scene, f->acc, f->map, 0, 0, 5, &a, &one,
-                                                    NULL, &err),
-                         THZ_ERR_INTERNAL);
+        assert_int_equal(
+            render_sensor_channel_pass(f->scene, f->acc, f->map, 0, 0, 5, &a, &one, NULL, &err),
+            THZ_ERR_INTERNAL);
         bool spread = false;
         for (size_t p = 0; p < px; p++)
             spread |= render_accum_stderr(&a, p) > 0.0;
@@ -279,7 +279,8 @@ static void test_stderr_in_kelvin(void **state)
     (void)state;
     const double nu = 0.6e12, tb = 300.0;
     double l = planck_radiance(nu, tb), dl = 1e-4 * l;
-    double dt = planck_brightness_temperature(nu, l + dl) - planck_brightness_temperature(nu, l - dl);
+    double dt =
+        planck_brightness_temperature(nu, l + dl) - planck_brightness_temperature(nu, l - dl);
     double expect = dt / 2.0; /* K per dl */
     assert_true(fabs(render_stderr_k(nu, tb, dl) - expect) <= 1e-5 * expect);
     assert_true(render_stderr_k(nu, 0.0, dl) == 0.0);

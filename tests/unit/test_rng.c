@@ -56,8 +56,8 @@ static void test_stream_layout(void **state)
     rng_stream s;
     rng_init(&s, seed, 5, RNG_PURPOSE_RENDER, index);
     for (uint32_t block = 0; block < 5; block++) {
-        philox4x32_ctr_t c = {{block, (5u << 4) | RNG_PURPOSE_RENDER, (uint32_t)index,
-                               (uint32_t)(index >> 32)}};
+        philox4x32_ctr_t c = {
+            {block, (5u << 4) | RNG_PURPOSE_RENDER, (uint32_t)index, (uint32_t)(index >> 32)}};
         philox4x32_key_t k = {{(uint32_t)seed, (uint32_t)(seed >> 32)}};
         philox4x32_ctr_t r = philox4x32(c, k);
         for (int w = 0; w < 4; w++)
@@ -76,9 +76,12 @@ static void test_keying(void **state)
     for (int i = 0; i < 100; i++)
         assert_true(rng_uniform(&a) == rng_uniform(&b));
     static const uint64_t variants[][4] = {
-        {10, 1, RNG_PURPOSE_PHOTON, 77}, {9, 2, RNG_PURPOSE_PHOTON, 77},
-        {9, 1, RNG_PURPOSE_RENDER, 77},  {9, 1, RNG_PURPOSE_PHOTON, 78},
-        {9ull | 1ull << 40, 1, RNG_PURPOSE_PHOTON, 77}, {9, 1, RNG_PURPOSE_PHOTON, 77ull | 1ull << 40},
+        {10, 1, RNG_PURPOSE_PHOTON, 77},
+        {9, 2, RNG_PURPOSE_PHOTON, 77},
+        {9, 1, RNG_PURPOSE_RENDER, 77},
+        {9, 1, RNG_PURPOSE_PHOTON, 78},
+        {9ull | 1ull << 40, 1, RNG_PURPOSE_PHOTON, 77},
+        {9, 1, RNG_PURPOSE_PHOTON, 77ull | 1ull << 40},
     };
     for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
         rng_init(&a, 9, 1, RNG_PURPOSE_PHOTON, 77);

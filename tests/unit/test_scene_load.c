@@ -42,11 +42,11 @@ static void load_bad(const char *json, const char *expect)
 #define HEAD "{\"format\": \"thzmap-scene/1\", "
 #define CHANNELS "\"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.01}], "
 #define MATERIALS "\"materials\": {\"m\": {\"reflectivity\": 0.1}}, "
-#define OBJECT(shape) \
-    "\"objects\": [{\"name\": \"o\", \"type\": \"solid\", \"material\": \"m\", " \
+#define OBJECT(shape)                                                                              \
+    "\"objects\": [{\"name\": \"o\", \"type\": \"solid\", \"material\": \"m\", "                   \
     "\"temperature_k\": 300, \"shape\": " shape "}], "
-#define SENSORS \
-    "\"sensors\": [{\"name\": \"c\", \"position_m\": [0, -5, 0], \"look_at_m\": [0, 0, 0], " \
+#define SENSORS                                                                                    \
+    "\"sensors\": [{\"name\": \"c\", \"position_m\": [0, -5, 0], \"look_at_m\": [0, 0, 0], "       \
     "\"fov_deg\": 40, \"resolution\": [16, 8]}]"
 #define BOX "{\"type\": \"box\", \"size_m\": [1, 1, 1]}"
 
@@ -91,9 +91,8 @@ static void test_example(void **state)
 static void test_defaults_and_range(void **state)
 {
     (void)state;
-    thz_scene *s = load_ok(HEAD
-                           "\"channels\": {\"from_thz\": 0.2, \"to_thz\": 1.2, \"count\": 6, "
-                           "\"relative_width\": 0.02}, " MATERIALS OBJECT(BOX) SENSORS "}");
+    thz_scene *s = load_ok(HEAD "\"channels\": {\"from_thz\": 0.2, \"to_thz\": 1.2, \"count\": 6, "
+                                "\"relative_width\": 0.02}, " MATERIALS OBJECT(BOX) SENSORS "}");
     assert_string_equal(s->name, "test");
     assert_int_equal(s->n_channels, 6);
     assert_string_equal(s->channels[0].name, "0.200 THz");
@@ -124,7 +123,8 @@ static void test_blocks(void **state)
         "\"shape\": {\"type\": \"sphere\", \"radius_m\": 0.5, \"subdivisions\": 2}, "
         "\"transform\": {\"scale\": 2, \"rotate_deg\": [0, 0, 45], \"translate_m\": [1, 2, 3]}}, "
         "{\"name\": \"disk\", \"type\": \"shell\", \"thickness_m\": 0.001, \"material\": \"m\", "
-        "\"temperature_k\": 290, \"shape\": {\"type\": \"disk\", \"radius_m\": 1, \"segments\": 8}, "
+        "\"temperature_k\": 290, \"shape\": {\"type\": \"disk\", \"radius_m\": 1, \"segments\": "
+        "8}, "
         "\"transform\": {\"scale\": [1, -1, 1]}}], "
         "\"sensors\": [{\"name\": \"a\", \"position_m\": [0, 0, 0], \"direction\": [3, 0, 4], "
         "\"up\": [0, 1, 0], \"fov_deg\": 10, \"resolution\": [1, 1], \"aperture_m2\": 0.5, "
@@ -192,7 +192,8 @@ static void test_refusals(void **state)
     load_bad(HEAD CHANNELS MATERIALS OBJECT("{\"type\": \"mesh\", \"file\": \"nope.obj\"}") SENSORS
              "}",
              "objects[0].shape.file:");
-    load_bad(HEAD "\"channels\": [], " MATERIALS OBJECT(BOX) SENSORS "}", "channels: expected at least one");
+    load_bad(HEAD "\"channels\": [], " MATERIALS OBJECT(BOX) SENSORS "}",
+             "channels: expected at least one");
     load_bad("{\"format\": \"thzmap-scene/2\"}", "format: expected \"thzmap-scene/1\"");
     load_bad("[1, 2]", "expected a JSON object");
 }
@@ -200,10 +201,8 @@ static void test_refusals(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_example),
-        cmocka_unit_test(test_defaults_and_range),
-        cmocka_unit_test(test_blocks),
-        cmocka_unit_test(test_csv_material_and_warnings),
+        cmocka_unit_test(test_example),  cmocka_unit_test(test_defaults_and_range),
+        cmocka_unit_test(test_blocks),   cmocka_unit_test(test_csv_material_and_warnings),
         cmocka_unit_test(test_refusals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
