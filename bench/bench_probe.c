@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/cdf.h"
 #include "core/rng.h"
 #include "core/vec3.h"
 
@@ -20,19 +21,6 @@ typedef struct bench_ray {
     float dir[3];
 } bench_ray;
 
-/* First index whose cumulative value exceeds x. */
-static size_t bench_search(const double *cdf, size_t n, double x)
-{
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (cdf[mid] > x)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
 
 /* Fills pool[0..n) with photon-like rays. cdf: per emitting triangle (all objects in
  * order, both sides counted for two-sided ones), tri_obj/tri_idx name the triangle. */
@@ -72,7 +60,7 @@ static thz_status bench_probe_pool(const thz_scene *scene, bench_ray *pool, size
     rng_stream rng;
     for (size_t r = 0; r < n; r++) {
         rng_init(&rng, 12345, 0, RNG_PURPOSE_TEST, r);
-        size_t j = bench_search(cdf, total, rng_uniform(&rng) * acc);
+        size_t j = cdf_search(cdf, total, rng_uniform(&rng) * acc);
         const thz_object *o = &scene->objects[obj_of[j]];
         const thz_mesh *m = &o->mesh;
         size_t t = tri_of[j];

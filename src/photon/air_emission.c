@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/cdf.h"
 #include "physics/planck.h"
 
 void air_emission_fini(air_emission *a)
@@ -250,14 +251,7 @@ thz_status air_emission_init(air_emission *a, const thz_scene *scene, const acce
 static bool air_emission_air_photon(const air_emission *a, rng_stream *rng, emission_photon *out)
 {
     double x = rng_uniform(rng) * a->cdf[AIR_EMISSION_BINS - 1];
-    size_t lo = 0, hi = AIR_EMISSION_BINS - 1;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (a->cdf[mid] > x)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
+    size_t lo = cdf_search(a->cdf, AIR_EMISSION_BINS, x);
     double nu = a->lo_hz + ((double)lo + rng_uniform(rng)) * a->bin_hz;
     double sigma = channel_sigma_hz(&a->scene->channels[a->channel]);
     double f = air_emission_density(a, sigma, nu);

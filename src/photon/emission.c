@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/cdf.h"
 #include "physics/planck.h"
 
 double emission_uniform(void *rng)
@@ -222,19 +223,6 @@ double emission_group_weights(const emission_table *t, double freq_hz, double *w
     return total;
 }
 
-/* First index whose cumulative value exceeds x (x in [0, cdf[n-1])). */
-static size_t emission_search(const double *cdf, size_t n, double x)
-{
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (cdf[mid] > x)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
 
 /* The tabulated cumulative weight C_g(nu) at interpolation position (row, frac). */
 static double emission_cum(const emission_table *t, size_t row, double frac, size_t g)
@@ -284,7 +272,7 @@ bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
     size_t within = 0;
     double uw = rng_uniform(rng);
     if (gr->count > 1) {
-        within = emission_search(gr->cdf, gr->count, uw * gr->cdf[gr->count - 1]);
+        within = cdf_search(gr->cdf, gr->count, uw * gr->cdf[gr->count - 1]);
         while (t->sources[t->order[gr->first + within]].share <= 0.0 && within > 0)
             within--;
     }
@@ -307,7 +295,7 @@ bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
     if (s->sides == 2)
         side = us < 0.5 ? 0 : 1;
 
-    size_t tri = emission_search(s->triangle_cdf, m->n_triangles, rng_uniform(rng) * s->area_m2);
+    size_t tri = cdf_search(s->triangle_cdf, m->n_triangles, rng_uniform(rng) * s->area_m2);
     while (m->areas_m2[tri] <= 0.0 && tri > 0)
         tri--;
 
