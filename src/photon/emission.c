@@ -223,7 +223,6 @@ double emission_group_weights(const emission_table *t, double freq_hz, double *w
     return total;
 }
 
-
 /* The tabulated cumulative weight C_g(nu) at interpolation position (row, frac). */
 static double emission_cum(const emission_table *t, size_t row, double frac, size_t g)
 {
