@@ -287,4 +287,39 @@ static inline void ident_tally_assert(const ident_tally *t, const char *what, do
     assert_true(fabs(mean) <= IDENT_Z * se_mean + floor_rel);
 }
 
+/* The furnace check of channel c, whose every pixel should show b (the band mean of
+ * B(T) of the enclosure): N = L / b as written; with `path` every pixel exact (N = 1 to
+ * 1e-9 and zero error, edges included); otherwise interior pixels within their error
+ * (floor 0.3 % for final-gather's secondary-disk edge bias) and edge pixels within 0.35
+ * plus their noise (an edge loses at most half the disk, 0.5 R <= 0.3 of N; concave
+ * edges gain as much; few photons at THZ_TEST_SCALE = 0.25). Fills t for
+ * ident_tally_assert (t->pooled_rel_se may be set beforehand). */
+static inline void ident_check_furnace_channel(ident_tally *t, const ident_run *r, size_t c,
+                                               thz_integrator integrator, double b)
+{
+    bool exact = integrator == INTEGRATOR_PATH;
+    size_t loose_fail = 0;
+    for (uint32_t row = 0; row < r->img.rows; row++)
+        for (uint32_t col = 0; col < r->img.columns; col++) {
+            size_t i = ident_at(r, c, col, row);
+            double n = r->img.normalized[i];
+            assert_true(fabs(n - r->img.radiance[i] / b) <= 1e-5 * n);
+            if (exact) {
+                if (!(fabs(n - 1.0) <= 1e-9))
+                    print_message("path: pixel (%u, %u): N - 1 = %.3e\n", col, row, n - 1.0);
+                assert_true(fabs(n - 1.0) <= 1e-9);
+                assert_true(r->img.radiance_stderr[i] <= 1e-12 * r->img.radiance[i]);
+                t->pixels++;
+            } else if (ident_pixel_interior(r, col, row)) {
+                ident_check_pixel(t, r, c, col, row, b,
+                                  integrator == INTEGRATOR_FINAL_GATHER ? 3e-3 : 1e-5);
+            } else if (fabs(n - 1.0) >
+                       0.35 + IDENT_Z * r->img.radiance_stderr[i] / r->img.radiance[i]) {
+                print_message("edge pixel (%u, %u): N = %.4f\n", col, row, n);
+                loose_fail++;
+            }
+        }
+    assert_int_equal(loose_fail, 0);
+}
+
 #endif

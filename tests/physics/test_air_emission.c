@@ -139,27 +139,7 @@ static void air_furnace_case(thz_integrator integrator)
         for (size_t i = 0; i < (size_t)r.img.rows * r.img.columns; i++)
             pooled += pow(r.img.radiance_stderr[ident_at(&r, c, 0, 0) + i], 2);
         t.pooled_rel_se = sqrt(pooled / (double)((size_t)r.img.rows * r.img.columns)) / b;
-        size_t loose_fail = 0;
-        for (uint32_t row = 0; row < r.img.rows; row++)
-            for (uint32_t col = 0; col < r.img.columns; col++) {
-                size_t i = ident_at(&r, c, col, row);
-                double n = r.img.normalized[i];
-                if (exact) {
-                    if (!(fabs(n - 1.0) <= 1e-9))
-                        print_message("path: pixel (%u, %u): N - 1 = %.3e\n", col, row, n - 1.0);
-                    assert_true(fabs(n - 1.0) <= 1e-9);
-                    assert_true(r.img.radiance_stderr[i] <= 1e-12 * r.img.radiance[i]);
-                    t.pixels++;
-                } else if (ident_pixel_interior(&r, col, row)) {
-                    ident_check_pixel(&t, &r, c, col, row, b,
-                                      integrator == INTEGRATOR_FINAL_GATHER ? 3e-3 : 1e-5);
-                } else if (fabs(n - 1.0) >
-                           0.35 + IDENT_Z * r.img.radiance_stderr[i] / r.img.radiance[i]) {
-                    print_message("edge pixel (%u, %u): N = %.4f\n", col, row, n);
-                    loose_fail++;
-                }
-            }
-        assert_int_equal(loose_fail, 0);
+        ident_check_furnace_channel(&t, &r, c, integrator, b);
         char what[80];
         snprintf(what, sizeof what, "air furnace, %s, channel %zu",
                  render_integrator_name(integrator), c);

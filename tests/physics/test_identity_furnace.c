@@ -55,32 +55,7 @@ static void furnace_case(thz_integrator integrator)
         assert_int_equal(r.rstats[c].back_face_samples, 0);
         assert_int_equal(r.rstats[c].starved_gathers, 0);
         ident_tally t = {0};
-        size_t loose_fail = 0;
-        for (uint32_t row = 0; row < r.img.rows; row++)
-            for (uint32_t col = 0; col < r.img.columns; col++) {
-                size_t i = ident_at(&r, c, col, row);
-                double n = r.img.normalized[i];
-                /* N = L / band mean of B(T_ref), with an independent band mean */
-                assert_true(fabs(n - r.img.radiance[i] / b) <= 1e-5 * n);
-                if (exact) {
-                    if (!(fabs(n - 1.0) <= 1e-9))
-                        print_message("path: pixel (%u, %u): N - 1 = %.3e\n", col, row, n - 1.0);
-                    assert_true(fabs(n - 1.0) <= 1e-9);
-                    assert_true(r.img.radiance_stderr[i] <= 1e-12 * r.img.radiance[i]);
-                    t.pixels++;
-                } else if (ident_pixel_interior(&r, col, row)) {
-                    ident_check_pixel(&t, &r, c, col, row, b,
-                                      integrator == INTEGRATOR_FINAL_GATHER ? 3e-3 : 1e-5);
-                } else if (fabs(n - 1.0) >
-                           0.35 + IDENT_Z * r.img.radiance_stderr[i] / r.img.radiance[i]) {
-                    /* an edge loses at most half the disk: 0.5 R <= 0.3 of N; concave
-                     * edges gain as much; plus the pixel's noise (few photons at
-                     * THZ_TEST_SCALE = 0.25) */
-                    print_message("edge pixel (%u, %u): N = %.4f\n", col, row, n);
-                    loose_fail++;
-                }
-            }
-        assert_int_equal(loose_fail, 0);
+        ident_check_furnace_channel(&t, &r, c, integrator, b);
         char what[64];
         snprintf(what, sizeof what, "furnace, %s, channel %zu", render_integrator_name(integrator),
                  c);
