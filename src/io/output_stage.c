@@ -24,6 +24,7 @@ struct output_stage {
     char *outdir;
     char *dir; /* the staging directory */
     bool committed;
+    bool created_outdir; /* OUTDIR did not exist before: a failed run removes it again */
 };
 
 /* How many staging names are tried before giving up (each failed try is a directory
@@ -80,12 +81,15 @@ static char *stage_join(const char *dir, const char *name)
 thz_status output_stage_create(const char *outdir, output_stage **out, thz_error *err)
 {
     *out = NULL;
+    struct stat before;
+    bool existed = stat(outdir, &before) == 0;
     thz_status status = stage_make_dirs(outdir, err);
     if (status != THZ_OK)
         return status;
     output_stage *stage = calloc(1, sizeof *stage);
     if (!stage)
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", outdir);
+    stage->created_outdir = !existed;
     stage->outdir = thz_strdup(outdir);
     if (!stage->outdir) {
         status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", outdir);
@@ -187,6 +191,9 @@ void output_stage_destroy(output_stage *stage)
         return;
     if (!stage->committed && stage->dir)
         stage_remove(stage->dir);
+    /* rmdir removes only an empty directory: OUTDIR goes only if nothing else is there */
+    if (!stage->committed && stage->created_outdir && stage->outdir)
+        rmdir(stage->outdir);
     free(stage->dir);
     free(stage->outdir);
     free(stage);

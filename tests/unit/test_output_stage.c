@@ -135,6 +135,24 @@ static void test_destroy_leaves_nothing(void **state)
     free(tmp);
 }
 
+/* A failed run removes the OUTDIR it created (and only that: not its parents, and not
+ * an OUTDIR that existed, which test_destroy_leaves_nothing keeps). */
+static void test_destroy_removes_created_outdir(void **state)
+{
+    (void)state;
+    char *tmp = make_tmp_dir();
+    char outdir[4096];
+    snprintf(outdir, sizeof outdir, "%s/new", tmp);
+    output_stage *stage = NULL;
+    assert_int_equal(output_stage_create(outdir, &stage, NULL), THZ_OK);
+    write_file(output_stage_dir(stage), "half.img", "partial");
+    assert_int_equal(count_entries(tmp), 1);
+    output_stage_destroy(stage);
+    assert_int_equal(count_entries(tmp), 0); /* OUTDIR gone, tmp kept */
+    assert_int_equal(rmdir(tmp), 0);
+    free(tmp);
+}
+
 /* Two stages in one OUTDIR (one process) get different directories. */
 static void test_two_stages(void **state)
 {
@@ -294,8 +312,11 @@ static void test_summary_json(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_commit_moves_files), cmocka_unit_test(test_destroy_leaves_nothing),
-        cmocka_unit_test(test_two_stages),         cmocka_unit_test(test_bad_outdir),
+        cmocka_unit_test(test_commit_moves_files),
+        cmocka_unit_test(test_destroy_leaves_nothing),
+        cmocka_unit_test(test_destroy_removes_created_outdir),
+        cmocka_unit_test(test_two_stages),
+        cmocka_unit_test(test_bad_outdir),
         cmocka_unit_test(test_summary_json),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
