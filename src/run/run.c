@@ -423,7 +423,6 @@ static thz_status run_write_outputs(run_state *rs, double t_start, thz_error *er
         st = run_render_warnings(rs, err);
     if (st != THZ_OK)
         return st;
-    bool simulate = strcmp(rs->command, "simulate") == 0;
     rs->seconds_output = run_now_s() - t0;
     run_summary sum = {
         .command = rs->command,
@@ -431,9 +430,9 @@ static thz_status run_write_outputs(run_state *rs, double t_start, thz_error *er
         .seed = rs->seed,
         .photons_per_channel = rs->photons_per_channel,
         .threads = rs->opt->threads > 0 ? rs->opt->threads : omp_get_max_threads(),
-        .channel_stats = simulate && render_integrator_needs_photons(rs->scene->render.integrator)
-                             ? rs->stats
-                             : NULL,
+        /* render: the statistics of the photon phase that made the map it read */
+        .channel_stats =
+            render_integrator_needs_photons(rs->scene->render.integrator) ? rs->stats : NULL,
         .median_stderr_k = rs->median_stderr_k,
         .passes = rs->passes,
         .seconds_render_channel = rs->seconds_channel,
@@ -463,7 +462,8 @@ static void run_fill_result(const run_state *rs, run_result *result, double t_st
     memset(result, 0, sizeof *result);
     result->n_channels = rs->scene->n_channels;
     result->n_sensors = rs->n_selected;
-    for (size_t c = 0; c < rs->scene->n_channels; c++) {
+    /* render fires no photons: the stats it read describe the saved map */
+    for (size_t c = 0; c < rs->scene->n_channels && strcmp(rs->command, "simulate") == 0; c++) {
         result->photons_fired += rs->stats[c].fired;
         result->photons_stored += rs->stats[c].stored;
     }
@@ -585,7 +585,7 @@ static thz_status run_load_photon_map(run_state *rs, thz_error *err)
 {
     photon_map_file_info info;
     thz_status st = photon_map_file_read(rs->opt->photon_map_path, rs->scene, rs->opt->threads,
-                                         rs->maps, NULL, &info, err);
+                                         rs->maps, rs->stats, &info, err);
     if (st != THZ_OK)
         return st;
     rs->seed = info.seed;

@@ -91,6 +91,13 @@ for f in "$work"/t1/cam.* "$work"/t1/side.*; do
 done
 [ -e "$work/r/photon-map.thzpm" ] && fail "render wrote a photon map"
 grep -q '"command": *"render"' "$work/r/summary.json" || fail "render's summary.json lacks command"
+# render's summary reports the photon phase that made the map it read
+python3 - "$work/t1/summary.json" "$work/r/summary.json" <<'PY' || fail "render's summary lacks the map's photon statistics"
+import json, sys
+s, r = (json.load(open(p))["channels"] for p in sys.argv[1:3])
+keys = ("photons_fired", "photons_stored", "emitted_power_w_per_hz")
+assert all(a.get(k) == b.get(k) and a.get(k) for a, b in zip(s, r) for k in keys), (s, r)
+PY
 
 "$THZMAP" render "$work/scene.json" --photon-map "$work/t1/photon-map.thzpm" -o "$work/rs" \
     --sensor side --quiet || fail "render --sensor exited $?"
