@@ -21,7 +21,6 @@ typedef struct bench_ray {
     float dir[3];
 } bench_ray;
 
-
 /* Fills pool[0..n) with photon-like rays. cdf: per emitting triangle (all objects in
  * order, both sides counted for two-sided ones), tri_obj/tri_idx name the triangle. */
 static thz_status bench_probe_pool(const thz_scene *scene, bench_ray *pool, size_t n,
