@@ -81,15 +81,18 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
         sum_set(counts, "escaped", sum_u64(s->escaped), ok);
         sum_set(counts, "terminated", sum_u64(s->terminated), ok);
         sum_set(o, "counts", counts, ok);
-        /* Emitted = absorbed + escaped + atmosphere in expectation; the relative
-         * difference is the Monte Carlo noise of the balance (or a bug). */
+        /* Exact bookkeeping: fired = absorbed + escaped + atmosphere + terminated (the
+         * low-power roulette's net removal). relative_difference compares that total
+         * with the band-mean P_A: Monte Carlo noise of the fired power only (or a bug). */
         json_t *e = json_object();
-        double out =
-            s->absorbed_power_w_per_hz + s->escaped_power_w_per_hz + s->atmosphere_power_w_per_hz;
+        double out = s->absorbed_power_w_per_hz + s->escaped_power_w_per_hz +
+                     s->atmosphere_power_w_per_hz + s->terminated_power_w_per_hz;
         sum_set(e, "emitted_w_per_hz", sum_real(s->emitted_power_w_per_hz), ok);
+        sum_set(e, "fired_w_per_hz", sum_real(s->fired_power_w_per_hz), ok);
         sum_set(e, "absorbed_w_per_hz", sum_real(s->absorbed_power_w_per_hz), ok);
         sum_set(e, "escaped_w_per_hz", sum_real(s->escaped_power_w_per_hz), ok);
         sum_set(e, "atmosphere_w_per_hz", sum_real(s->atmosphere_power_w_per_hz), ok);
+        sum_set(e, "terminated_w_per_hz", sum_real(s->terminated_power_w_per_hz), ok);
         sum_set(e, "relative_difference",
                 s->emitted_power_w_per_hz > 0.0
                     ? sum_real((s->emitted_power_w_per_hz - out) / s->emitted_power_w_per_hz)

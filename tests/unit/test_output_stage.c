@@ -224,6 +224,8 @@ static void test_summary_json(void **state)
     st[0].absorbed_power_w_per_hz = 1.5e-12;
     st[0].escaped_power_w_per_hz = 0.4e-12;
     st[0].atmosphere_power_w_per_hz = 0.08e-12;
+    st[0].terminated_power_w_per_hz = 0.01e-12;
+    st[0].fired_power_w_per_hz = 1.99e-12;
     st[0].mean_bounces = 1.5;
     st[1].fired = 10;
     st[1].emitted_power_w_per_hz = NAN;
@@ -272,7 +274,11 @@ static void test_summary_json(void **state)
     assert_true(fabs(json_number_value(json_object_get(c0, "fraction_transmitted")) - 0.2 / 1.5) <
                 1e-12);
     json_t *eb = json_object_get(c0, "energy_balance");
-    assert_true(fabs(json_number_value(json_object_get(eb, "relative_difference")) - 0.01) < 1e-9);
+    /* (2 - 1.5 - 0.4 - 0.08 - 0.01) / 2: the terminated power counts in the balance */
+    assert_true(fabs(json_number_value(json_object_get(eb, "relative_difference")) - 0.005) < 1e-9);
+    assert_true(fabs(json_number_value(json_object_get(eb, "fired_w_per_hz")) - 1.99e-12) < 1e-24);
+    assert_true(fabs(json_number_value(json_object_get(eb, "terminated_w_per_hz")) - 0.01e-12) <
+                1e-24);
     assert_true(fabs(json_number_value(json_object_get(c0, "median_stderr_k")) - 0.5) < 1e-12);
     json_t *c1 = json_array_get(chs, 1);
     assert_true(json_is_null(json_object_get(c1, "emitted_power_w_per_hz")));
