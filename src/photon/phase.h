@@ -25,6 +25,11 @@
 
 typedef struct photon_phase_options {
     int threads; /* 0 = all */
+    /* T0 of a deviation map (photon_map.h "Reference temperature"): 0 fires the paper's
+     * map of L; T0 > 0 fires the map of L - B_nu(T0), whose sources are
+     * eps B(T) - A B(T0) at surfaces, 4 pi alpha (B(T_air) - B(T0)) in the air (T_air = 0
+     * for a non-emitting atmosphere) and L_b - B(T0) at the boundary. */
+    double reference_temperature_k;
     thz_progress_fn progress;
     void *progress_user;
 } photon_phase_options;

@@ -112,6 +112,7 @@ struct photon_map {
     size_t n_groups;    /* 2 n_objects */
     size_t *start;      /* n_groups + 1 offsets */
     photon_cube *cubes; /* n_groups */
+    double t0_k;        /* reference temperature: 0 for the paper's map */
 };
 
 static uint32_t photon_quantize_axis(const photon_cube *c, const photon_record *p, int a)
@@ -406,6 +407,16 @@ void photon_map_destroy(photon_map *map)
 size_t photon_map_count(const photon_map *map)
 {
     return map ? map->count : 0;
+}
+
+double photon_map_reference_temperature_k(const photon_map *map)
+{
+    return map ? map->t0_k : 0.0;
+}
+
+void photon_map_set_reference_temperature_k(photon_map *map, double t0_k)
+{
+    map->t0_k = t0_k;
 }
 
 size_t photon_map_bytes(const photon_map *map)

@@ -50,6 +50,14 @@ void photon_map_destroy(photon_map *map);
 
 size_t photon_map_count(const photon_map *map);
 
+/* Reference temperature T0 (K) of the map. 0 (the default of photon_map_create): the
+ * paper's map, photons carry the power of L. T0 > 0: a deviation map, photons carry the
+ * signed power of L - B_nu(T0), fired from the sources of that difference (phase.h);
+ * the renderer adds B_nu(T0) back. In a near-isothermal scene at T0 the sources, and so
+ * the map's noise, are small. */
+double photon_map_reference_temperature_k(const photon_map *map);
+void photon_map_set_reference_temperature_k(photon_map *map, double t0_k);
+
 /* Bytes the map holds: its records and its spatial index (the benchmark's bytes per
  * stored photon). */
 size_t photon_map_bytes(const photon_map *map);

@@ -202,10 +202,9 @@ static void render_context_fini(render_context *ctx)
     memset(ctx, 0, sizeof *ctx);
 }
 
-/* T0 of the path estimator: the temperature of the object with the largest
- * area x sides x hemispherical emissivity at the channel centre. */
-static double render_reference_temperature(const thz_scene *scene, const thz_channel *ch)
+double render_reference_temperature_k(const thz_scene *scene, size_t channel)
 {
+    const thz_channel *ch = &scene->channels[channel];
     double best = -1.0, t0 = 0.0;
     for (size_t o = 0; o < scene->n_objects; o++) {
         const thz_object *obj = &scene->objects[o];
@@ -278,7 +277,7 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         for (size_t k = 0; diffuse && k < n; k++)
             ctx->tbar[o * n + k] = optics_mean_transmission(&ctx->optics[o * n + k]);
     }
-    ctx->t0_k = render_reference_temperature(scene, ctx->channel);
+    ctx->t0_k = render_reference_temperature_k(scene, channel);
     for (size_t k = 0; k < n; k++) {
         ctx->b0[k] = planck_radiance(ctx->quad.freq_hz[k], ctx->t0_k);
         ctx->b0_mean += ctx->quad.weight[k] * ctx->b0[k];

@@ -95,6 +95,12 @@ bool render_integrator_parse(const char *name, thz_integrator *out);
 /* THZ_OK if `integrator` is implemented; otherwise THZ_ERR_INPUT. Call before a run. */
 thz_status render_integrator_check(thz_integrator integrator, thz_error *err);
 
+/* T0 of the control variate B_nu(T0) (path always; photon-map and final-gather when
+ * the photon map was fired as the deviation from it, photon_map.h): the temperature of
+ * the object with the largest area x sides x hemispherical emissivity at the channel
+ * centre (the walls of a room). */
+double render_reference_temperature_k(const thz_scene *scene, size_t channel);
+
 /* Whether the integrator needs a photon map (all but `path`). */
 bool render_integrator_needs_photons(thz_integrator integrator);
 
