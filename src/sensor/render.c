@@ -59,14 +59,18 @@ typedef struct render_context {
     bool *scatters;          /* [object]: R > 0 somewhere, or a diffuse shell */
     double *tbar;            /* [object * quad.n + node]: T-bar of diffuse shells, else 0 */
     bool atmosphere;         /* some node has alpha > 0 */
-    double t0_k;             /* path: reference temperature T0, K */
-    double b0_mean;          /* path: band mean of B(T0) */
-    double *b0;              /* path: [node] B_nu(T0) */
-    double *source_mean;     /* path: [object] band mean of eps B - A B0 for solids; NAN
-                                for shells (angle-dependent) */
+    double t0_k;             /* reference temperature T0, K: path's, or the photon map's */
+    double b0_mean;          /* band mean of B(T0) */
+    double *b0;              /* [node] B_nu(T0) */
+    double *source_mean;     /* [object] band mean of eps B - A B0 for solids; NAN for
+                                shells (angle-dependent) */
+    bool deviation;          /* photon-map, final-gather: the map holds L - B(T0), T0 > 0,
+                                so every source term is eps B - A B0 (escapes, back faces,
+                                the air: minus B0) and the sample adds B0 back */
     bool emitting;           /* emitting atmosphere (docs/atmosphere.md) */
-    double *air_planck;      /* emitting: [node] B_nu(T_air) */
-    double *bg_planck;       /* emitting: [node] B_nu(T_background) */
+    bool air_terms;          /* render_air contributes: emitting, or deviation */
+    double *air_planck;      /* air_terms: [node] B_nu(T_air), 0 for non-emitting air */
+    double *bg_planck;       /* air_terms: [node] escape radiance B_nu(T_background), or 0 */
 } render_context;
 
 /* The `straight` shells a sample ray has passed through: the path weight at frequency nu
@@ -219,8 +223,10 @@ double render_reference_temperature_k(const thz_scene *scene, size_t channel)
     return t0;
 }
 
+/* map_t0: take T0 from the photon map (photon-map, final-gather), else choose it (path). */
 static thz_status render_context_init(render_context *ctx, const thz_scene *scene, const accel *a,
-                                      const photon_map *map, size_t channel, thz_error *err)
+                                      const photon_map *map, size_t channel, bool map_t0,
+                                      thz_error *err)
 {
     memset(ctx, 0, sizeof *ctx);
     ctx->scene = scene;
@@ -277,7 +283,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         for (size_t k = 0; diffuse && k < n; k++)
             ctx->tbar[o * n + k] = optics_mean_transmission(&ctx->optics[o * n + k]);
     }
-    ctx->t0_k = render_reference_temperature_k(scene, channel);
+    ctx->t0_k = map_t0 ? photon_map_reference_temperature_k(map)
+                       : render_reference_temperature_k(scene, channel);
+    ctx->deviation = map_t0 && ctx->t0_k > 0.0;
     for (size_t k = 0; k < n; k++) {
         ctx->b0[k] = planck_radiance(ctx->quad.freq_hz[k], ctx->t0_k);
         ctx->b0_mean += ctx->quad.weight[k] * ctx->b0[k];
@@ -292,8 +300,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         ctx->source_mean[o] = scene->objects[o].type == OBJECT_SOLID ? sum : NAN;
     }
     const thz_atmosphere *atm = &scene->atmosphere;
-    if (atm->emitting) {
-        ctx->emitting = true;
+    ctx->emitting = atm->emitting;
+    ctx->air_terms = atm->emitting || ctx->deviation;
+    if (ctx->air_terms) {
         ctx->air_planck = thz_malloc_array(n ? n : 1, sizeof *ctx->air_planck);
         ctx->bg_planck = thz_malloc_array(n ? n : 1, sizeof *ctx->bg_planck);
         if (!ctx->air_planck || !ctx->bg_planck) {
@@ -304,8 +313,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
          * estimator's air terms (B_air - B0)(1 - tau) vanish exactly in the furnace. */
         for (size_t k = 0; k < n; k++) {
             double nu = ctx->quad.freq_hz[k];
-            ctx->air_planck[k] = planck_radiance(nu, atm->air.temperature_k);
-            ctx->bg_planck[k] = planck_radiance(nu, atm->background_temperature_k);
+            ctx->air_planck[k] = atm->emitting ? planck_radiance(nu, atm->air.temperature_k) : 0.0;
+            ctx->bg_planck[k] =
+                atm->emitting ? planck_radiance(nu, atm->background_temperature_k) : 0.0;
         }
     }
     return THZ_OK;
@@ -358,21 +368,24 @@ static double render_tbar(const render_context *ctx, const thz_object *obj, uint
     return optics_mean_transmission(&o);
 }
 
-/* Band mean of eps(theta) B_nu(T) times the path weight and exp(-alpha d) (no cos
- * factor: physics.md "Surfaces"). */
+/* Band mean of eps(theta) B_nu(T) (deviation: eps B - A(theta) B0) times the path
+ * weight and exp(-alpha d) (no cos factor: physics.md "Surfaces"). */
 static double render_emission(const render_context *ctx, uint32_t object, double mu,
                               const render_path *path, double distance_m)
 {
-    if (!(ctx->scene->objects[object].temperature_k > 0.0))
+    if (!(ctx->scene->objects[object].temperature_k > 0.0) && !ctx->deviation)
         return 0.0;
-    if (path->n == 0 && !ctx->atmosphere && !isnan(ctx->emission_mean[object]))
-        return ctx->emission_mean[object];
+    const double *mean = ctx->deviation ? ctx->source_mean : ctx->emission_mean;
+    if (path->n == 0 && !ctx->atmosphere && !isnan(mean[object]))
+        return mean[object];
     size_t n = ctx->quad.n;
     const optics_point *op = &ctx->optics[(size_t)object * n];
     const double *planck = &ctx->planck[(size_t)object * n];
     double sum = 0.0;
     for (size_t k = 0; k < n; k++) {
         double v = ctx->quad.weight[k] * optics_emissivity(&op[k], mu) * planck[k];
+        if (ctx->deviation)
+            v -= ctx->quad.weight[k] * optics_absorption(&op[k], mu) * ctx->b0[k];
         for (size_t i = 0; i < path->n && v != 0.0; i++)
             v *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
         if (ctx->atmosphere)
@@ -432,7 +445,7 @@ static double render_emission_scattered(const render_context *ctx, uint32_t obje
                                         const render_path *path, double distance_m,
                                         const render_scatter *s)
 {
-    if (!(ctx->scene->objects[object].temperature_k > 0.0))
+    if (!(ctx->scene->objects[object].temperature_k > 0.0) && !ctx->deviation)
         return 0.0;
     size_t n = ctx->quad.n;
     const optics_point *op = &ctx->optics[(size_t)object * n];
@@ -441,6 +454,8 @@ static double render_emission_scattered(const render_context *ctx, uint32_t obje
     for (size_t k = 0; k < n; k++) {
         double f = render_scatter_node(ctx, s, k);
         double v = ctx->quad.weight[k] * f * optics_emissivity(&op[k], mu) * planck[k];
+        if (ctx->deviation)
+            v -= ctx->quad.weight[k] * f * optics_absorption(&op[k], mu) * ctx->b0[k];
         for (size_t i = 0; i < path->n && v != 0.0; i++)
             v *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
         if (ctx->atmosphere)
@@ -450,6 +465,24 @@ static double render_emission_scattered(const render_context *ctx, uint32_t obje
     return sum * s->inv_branch;
 }
 
+/* Deviation: the band mean of B0 times the scattering weight (s may be NULL), the path
+ * weight and exp(-alpha d): what a back face (radiance 0, deviation -B0) takes away. */
+static double render_b0_term(const render_context *ctx, const render_path *path,
+                             const render_scatter *s, double distance_m)
+{
+    size_t n = ctx->quad.n;
+    double sum = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        double v = ctx->quad.weight[k] * ctx->b0[k] * render_tau(ctx->alpha_per_m[k], distance_m);
+        if (s)
+            v *= render_scatter_node(ctx, s, k);
+        for (size_t i = 0; i < path->n && v != 0.0; i++)
+            v *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
+        sum += v;
+    }
+    return s ? sum * s->inv_branch : sum;
+}
+
 /* The emitting air along one free segment of a sample or gather ray, from distance d0_m
  * to d1_m from the sensor: the band mean, by the channel quadrature, of
  * B_nu(T_air) (exp(-alpha d0) - exp(-alpha d1)), i.e. the segment's path radiance
@@ -457,20 +490,23 @@ static double render_emission_scattered(const render_context *ctx, uint32_t obje
  * straight-shell path weight and the first vertex's scattering weight (s may be NULL).
  * `escaped`: the ray hits nothing and d1_m is where it leaves the extent (may be
  * infinite); the background B_nu(T_bg) exp(-alpha d1) is added. 0 when the air does
- * not emit. */
+ * not emit. Deviation (photon map of L - B0): B_air - B0 and B_bg - B0 instead (B_air,
+ * B_bg = 0 for air that does not emit): the free path's (tau - 1) B0 and an escape's
+ * -B0. */
 static double render_air(const render_context *ctx, const render_path *path,
                          const render_scatter *s, double d0_m, double d1_m, bool escaped)
 {
-    if (!ctx->emitting)
-        return 0.0;
+    if (!ctx->air_terms || (!escaped && !ctx->atmosphere))
+        return 0.0; /* without attenuation a free path adds nothing */
     size_t n = ctx->quad.n;
     double sum = 0.0;
     for (size_t k = 0; k < n; k++) {
         double a = ctx->alpha_per_m[k];
         double t1 = render_tau(a, d1_m);
-        double v = ctx->air_planck[k] * (render_tau(a, d0_m) - t1);
+        double b0 = ctx->deviation ? ctx->b0[k] : 0.0;
+        double v = (ctx->air_planck[k] - b0) * (render_tau(a, d0_m) - t1);
         if (escaped)
-            v += ctx->bg_planck[k] * t1;
+            v += (ctx->bg_planck[k] - b0) * t1;
         if (v == 0.0)
             continue;
         v *= ctx->quad.weight[k];
@@ -618,7 +654,7 @@ static double render_photon_map_trace(const render_context *ctx, vec3 origin_m, 
                              &hit)) {
             if (crossings == 0)
                 out->escaped = 1;
-            if (ctx->emitting)
+            if (ctx->air_terms)
                 radiance += render_air(ctx, &path, scatter, distance_m,
                                        distance_m + render_exit_m(ctx, origin_m, dir), true);
             return radiance;
@@ -629,6 +665,8 @@ static double render_photon_map_trace(const render_context *ctx, vec3 origin_m, 
         const thz_object *obj = &ctx->scene->objects[hit.object];
         if (!scene_object_side_is_front(obj, hit.side)) {
             out->back_face = 1;
+            if (ctx->deviation)
+                radiance -= render_b0_term(ctx, &path, scatter, distance_m);
             return radiance;
         }
         if (scatter)
@@ -682,6 +720,8 @@ static void render_photon_map_sample(const render_context *ctx, vec3 origin_m, v
     render_path path = {.n = 0};
     double l = render_photon_map_trace(ctx, origin_m, dir, ACCEL_NO_OBJECT, 0, path, 0.0, NULL,
                                        sample_sr, out);
+    if (ctx->deviation)
+        l += ctx->b0_mean;
     for (uint32_t j = 0; j < t->n_est; j++)
         t->est[j] += t->weight * l;
 }
@@ -742,24 +782,28 @@ static void render_final_gather_sample(const render_context *ctx, vec3 origin_m,
     render_path path = {.n = 0};
     double distance_m = 0.0;
     uint32_t ignore_object = ACCEL_NO_OBJECT, ignore_triangle = 0;
+    if (ctx->deviation)
+        render_add_all(t, ctx->b0_mean);
     for (;;) {
         accel_hit hit;
         if (!accel_intersect(ctx->accel, origin_m, dir, INFINITY, ignore_object, ignore_triangle,
                              &hit)) {
             if (path.n == 0)
                 out->escaped = 1;
-            if (ctx->emitting)
+            if (ctx->air_terms)
                 render_add_all(t, render_air(ctx, &path, NULL, distance_m,
                                              distance_m + render_exit_m(ctx, origin_m, dir), true));
             return;
         }
         double d0_m = distance_m;
         distance_m += hit.distance_m;
-        if (ctx->emitting)
+        if (ctx->air_terms)
             render_add_all(t, render_air(ctx, &path, NULL, d0_m, distance_m, false));
         const thz_object *obj = &ctx->scene->objects[hit.object];
         if (!scene_object_side_is_front(obj, hit.side)) {
             out->back_face = 1;
+            if (ctx->deviation)
+                render_add_all(t, -render_b0_term(ctx, &path, NULL, distance_m));
             return;
         }
         render_add_all(t, render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m));
@@ -1070,7 +1114,7 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
     uint32_t n_est = integ->purpose ? render_estimates_per_pass(scene) : 1;
     int threads = render_threads(opt);
     render_context ctx;
-    st = render_context_init(&ctx, scene, a, map, channel, err);
+    st = render_context_init(&ctx, scene, a, map, channel, integ->needs_photons, err);
     if (st != THZ_OK)
         return st;
     if (opt && opt->use_seed)
