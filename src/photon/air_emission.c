@@ -18,29 +18,62 @@ void air_emission_fini(air_emission *a)
     memset(a, 0, sizeof *a);
 }
 
-/* g_c(nu) P_air(nu), W/Hz (unnormalised response), over the whole box. */
-static double air_emission_density(const air_emission *a, double sigma_hz, double freq_hz)
+/* g_c(nu) P_air(nu), W/Hz (unnormalised response), over the whole box: the deviation
+ * source 4 pi alpha (B(T_air) - B0) (T_air = 0 when the air does not emit) and, in
+ * *physical (may be NULL), the air's own emission 4 pi alpha B(T_air). Equal when
+ * T0 = 0. */
+static double air_emission_density(const air_emission *a, double sigma_hz, double freq_hz,
+                                   double *physical)
 {
+    if (physical)
+        *physical = 0.0;
     if (!(freq_hz > 0.0))
         return 0.0;
     const thz_channel *ch = &a->scene->channels[a->channel];
+    const thz_atmosphere *atm = &a->scene->atmosphere;
     double x = (freq_hz - ch->center_hz) / sigma_hz;
-    return exp(-0.5 * x * x) * a->volume_m3 *
-           atmosphere_volume_emission_w_per_m3_hz(&a->scene->atmosphere, freq_hz);
+    double g = exp(-0.5 * x * x) * a->volume_m3;
+    double own = g * atmosphere_volume_emission_w_per_m3_hz(atm, freq_hz);
+    if (physical)
+        *physical = own;
+    if (!(a->t0_k > 0.0))
+        return own;
+    double air = atm->emitting ? planck_radiance(freq_hz, atm->air.temperature_k) : 0.0;
+    return g * 4.0 * M_PI * atmosphere_alpha_per_m(atm, freq_hz) *
+           (air - planck_radiance(freq_hz, a->t0_k));
 }
 
 /* L_b(nu): the radiance entering the box from outside (the escape radiance at its
- * faces). */
+ * faces); 0 when the atmosphere does not emit. */
 static double air_emission_boundary_radiance(const thz_atmosphere *atm, double freq_hz)
 {
+    if (!atm->emitting)
+        return 0.0;
     if (!atm->has_extent && atmosphere_alpha_per_m(atm, freq_hz) > 0.0)
         return planck_radiance(freq_hz, atm->air.temperature_k);
     return planck_radiance(freq_hz, atm->background_temperature_k);
 }
 
+/* L_b(nu) - B0: the boundary's deviation source. */
+static double air_emission_boundary_deviation(const air_emission *a, double freq_hz)
+{
+    double l = air_emission_boundary_radiance(&a->scene->atmosphere, freq_hz);
+    return a->t0_k > 0.0 ? l - planck_radiance(freq_hz, a->t0_k) : l;
+}
+
 static double air_emission_boundary_at(double freq_hz, void *atm)
 {
     return air_emission_boundary_radiance(atm, freq_hz);
+}
+
+static double air_emission_boundary_magnitude_at(double freq_hz, void *a)
+{
+    return fabs(air_emission_boundary_deviation(a, freq_hz));
+}
+
+static double air_emission_boundary_deviation_at(double freq_hz, void *a)
+{
+    return air_emission_boundary_deviation(a, freq_hz);
 }
 
 /* The box: the atmosphere's extent, else the bounding box of every mesh widened by 1 % of
@@ -132,10 +165,20 @@ static bool air_emission_kept(const air_emission *a, vec3 p, vec3 dir)
            scene_object_side_is_front(&a->scene->objects[hit.object], hit.side);
 }
 
-/* Shares of air and boundary photons kept, by the rules of sampling and tracing. */
+/* Whether a photon starting at p along dir meets the front side of a surface first: it
+ * stores a record (a deviation map's boundary photons count only if so, see below). */
+static bool air_emission_reaches(const air_emission *a, vec3 p, vec3 dir)
+{
+    accel_hit hit;
+    return accel_intersect(a->acc, p, dir, INFINITY, ACCEL_NO_OBJECT, 0, &hit) &&
+           scene_object_side_is_front(&a->scene->objects[hit.object], hit.side);
+}
+
+/* Shares of air and boundary photons kept, by the rules of sampling and tracing; with
+ * T0 > 0 also the share of boundary photons that reach a surface. */
 static void air_emission_shares(air_emission *a)
 {
-    uint64_t air = 0, open = 0;
+    uint64_t air = 0, open = 0, reach = 0;
     for (uint64_t i = 0; i < AIR_EMISSION_SHARE_RAYS; i++) {
         rng_stream rng;
         rng_init(&rng, a->scene->photons.seed, (uint32_t)a->channel, RNG_PURPOSE_AIR_VOLUME, i);
@@ -143,16 +186,22 @@ static void air_emission_shares(air_emission *a)
         air_emission_volume_point(a, &rng, &p, &dir);
         air += air_emission_kept(a, p, dir);
         air_emission_face_point(a, &rng, &p, &dir);
-        open += air_emission_open(a, p, dir) && air_emission_kept(a, p, dir);
+        bool is_open = air_emission_open(a, p, dir) && air_emission_kept(a, p, dir);
+        open += is_open;
+        if (a->t0_k > 0.0)
+            reach += is_open && air_emission_reaches(a, p, dir);
     }
     a->air_share = (double)air / AIR_EMISSION_SHARE_RAYS;
     a->open_share = (double)open / AIR_EMISSION_SHARE_RAYS;
+    a->reach_share = a->t0_k > 0.0 ? (double)reach / AIR_EMISSION_SHARE_RAYS : a->open_share;
 }
 
-/* The air's frequency histogram and band power over the whole box (0 if none). */
-static thz_status air_emission_tabulate(air_emission *a, double *power, thz_error *err)
+/* The air's frequency histogram (of |g_c P_air|) and band powers over the whole box: the
+ * deviation source's (signed) and the air's own emission (0 if none). */
+static thz_status air_emission_tabulate(air_emission *a, double *power, double *physical_power,
+                                        thz_error *err)
 {
-    *power = 0.0;
+    *power = *physical_power = 0.0;
     const thz_channel *ch = &a->scene->channels[a->channel];
     double sigma = channel_sigma_hz(ch);
     double lo = ch->center_hz - AIR_EMISSION_SIGMAS * sigma;
@@ -165,16 +214,22 @@ static thz_status air_emission_tabulate(air_emission *a, double *power, thz_erro
     a->cdf = thz_malloc_array(AIR_EMISSION_BINS, sizeof *a->cdf);
     if (!a->q || !a->cdf)
         return thz_error_set(err, THZ_ERR_NOMEM, "air emission: out of memory");
-    /* q_i = the larger node value of the bin (the bins resolve alpha's table far finer
-     * than a line), floored at 1e-6 of the peak so that q > 0 wherever g P may be. */
-    double prev = air_emission_density(a, sigma, lo), peak = 0.0, trapezoid = 0.0;
+    /* q_i = the larger |node value| of the bin (the bins resolve alpha's table far finer
+     * than a line), floored at 1e-6 of the peak so that q > 0 wherever g P may be
+     * nonzero. (B(T_air) - B0 has one sign over the band: so has the density.) */
+    double own_prev, own_next;
+    double prev = air_emission_density(a, sigma, lo, &own_prev), peak = 0.0, trapezoid = 0.0;
+    double own_trapezoid = 0.0;
     for (size_t i = 0; i < AIR_EMISSION_BINS; i++) {
-        double next = air_emission_density(a, sigma, lo + (double)(i + 1) * a->bin_hz);
-        a->q[i] = fmax(prev, next);
+        double next = air_emission_density(a, sigma, lo + (double)(i + 1) * a->bin_hz, &own_next);
+        a->q[i] = fmax(fabs(prev), fabs(next));
         trapezoid += 0.5 * (prev + next) * a->bin_hz;
+        own_trapezoid += 0.5 * (own_prev + own_next) * a->bin_hz;
         peak = fmax(peak, a->q[i]);
         prev = next;
+        own_prev = own_next;
     }
+    *physical_power = own_trapezoid / (sigma * sqrt(2.0 * M_PI));
     if (!(peak > 0.0)) {
         free(a->q);
         free(a->cdf);
@@ -193,15 +248,18 @@ static thz_status air_emission_tabulate(air_emission *a, double *power, thz_erro
 
 thz_status air_emission_init(air_emission *a, const thz_scene *scene, const accel *acc,
                              size_t channel, uint64_t n_photons, double surface_power_w_per_hz,
-                             thz_error *err)
+                             double t0_k, thz_error *err)
 {
     memset(a, 0, sizeof *a);
     a->scene = scene;
     a->acc = acc;
     a->channel = channel;
     a->n_photons = n_photons ? n_photons : 1;
+    a->t0_k = t0_k > 0.0 ? t0_k : 0.0;
     const thz_atmosphere *atm = &scene->atmosphere;
-    if (!atm->emitting || !air_emission_box(scene, a->min_m, a->max_m))
+    /* With T0 > 0 the boundary emits L_b - B0 != 0 and absorbing air 4 pi alpha
+     * (B(T_air) - B0) != 0 even when the atmosphere does not emit. */
+    if ((!atm->emitting && !(a->t0_k > 0.0)) || !air_emission_box(scene, a->min_m, a->max_m))
         return THZ_OK;
     double ext[3], d2 = 0.0;
     for (int k = 0; k < 3; k++) {
@@ -218,31 +276,66 @@ thz_status air_emission_init(air_emission *a, const thz_scene *scene, const acce
     }
     a->area_m2 = sum;
 
-    double air_box = 0.0, boundary_box = 0.0;
+    /* Band powers over the whole box and faces: the air's and the boundary's own
+     * (physical) ones, their deviation sources' (signed) ones and the magnitudes that
+     * set the class probabilities. All equal when T0 = 0. */
+    double air_box = 0.0, air_own = 0.0, boundary_box = 0.0, boundary_own = 0.0;
+    double boundary_magnitude = 0.0;
+    const thz_channel *ch = &scene->channels[channel];
     if (a->volume_m3 > 0.0) {
-        thz_status st = air_emission_tabulate(a, &air_box, err);
+        thz_status st = air_emission_tabulate(a, &air_box, &air_own, err);
         if (st != THZ_OK) {
             air_emission_fini(a);
             return st;
         }
     }
-    if (a->area_m2 > 0.0)
-        boundary_box =
-            M_PI * a->area_m2 *
-            channel_band_mean(&scene->channels[channel], air_emission_boundary_at, (void *)atm);
-    if (!(air_box > 0.0) && !(boundary_box > 0.0)) {
+    if (a->area_m2 > 0.0) {
+        boundary_own =
+            atm->emitting
+                ? M_PI * a->area_m2 * channel_band_mean(ch, air_emission_boundary_at, (void *)atm)
+                : 0.0;
+        if (a->t0_k > 0.0) {
+            boundary_box =
+                M_PI * a->area_m2 * channel_band_mean(ch, air_emission_boundary_deviation_at, a);
+            boundary_magnitude =
+                M_PI * a->area_m2 * channel_band_mean(ch, air_emission_boundary_magnitude_at, a);
+        } else {
+            boundary_box = boundary_magnitude = boundary_own;
+        }
+    }
+    bool air_fires = a->q != NULL && air_box != 0.0;
+    bool boundary_fires = boundary_magnitude > 0.0;
+    if (!air_fires && !boundary_fires && !(air_own > 0.0) && !(boundary_own > 0.0)) {
         air_emission_fini(a);
         a->scene = scene;
+        a->t0_k = t0_k > 0.0 ? t0_k : 0.0;
         return THZ_OK;
     }
     air_emission_shares(a);
-    a->air_power_w_per_hz = a->air_share * air_box;
-    a->boundary_power_w_per_hz = a->open_share * boundary_box;
+    /* A deviation map's boundary fires only where its photons reach a surface: in a
+     * closed room without extent the box's faces see the room from outside, and the
+     * photons that slip through the gap between them store nothing (they would take
+     * most of the photons when the surfaces' sources are small, as near T0). */
+    if (a->t0_k > 0.0)
+        boundary_fires = boundary_fires && a->reach_share > 0.0;
+    a->air_power_w_per_hz = a->air_share * air_own;
+    a->boundary_power_w_per_hz = a->open_share * boundary_own;
     a->band_power_w_per_hz = a->air_power_w_per_hz + a->boundary_power_w_per_hz;
-    double total = a->band_power_w_per_hz + fmax(surface_power_w_per_hz, 0.0);
-    a->p_air = a->air_power_w_per_hz / total;
-    a->p_boundary = a->boundary_power_w_per_hz / total;
-    a->p_surfaces = fmax(surface_power_w_per_hz, 0.0) / total;
+    a->air_deviation_w_per_hz = a->air_share * air_box;
+    a->boundary_deviation_w_per_hz = a->open_share * boundary_box;
+    if (a->t0_k > 0.0 && !air_fires && !boundary_fires)
+        return THZ_OK; /* nothing to fire (a furnace at T0): statistics only */
+    double air_mass = air_fires ? a->air_share * fabs(air_box) : 0.0;
+    double boundary_mass = a->reach_share * boundary_magnitude;
+    if (!boundary_fires)
+        boundary_mass = 0.0;
+    double surface_mass = fmax(surface_power_w_per_hz, 0.0);
+    double total = air_mass + boundary_mass + surface_mass;
+    if (!(total > 0.0))
+        return THZ_OK; /* every air and boundary photon would be dropped */
+    a->p_air = air_mass / total;
+    a->p_boundary = boundary_mass / total;
+    a->p_surfaces = surface_mass / total;
     a->active = true;
     return THZ_OK;
 }
@@ -254,12 +347,12 @@ static bool air_emission_air_photon(const air_emission *a, rng_stream *rng, emis
     size_t lo = cdf_search(a->cdf, AIR_EMISSION_BINS, x);
     double nu = a->lo_hz + ((double)lo + rng_uniform(rng)) * a->bin_hz;
     double sigma = channel_sigma_hz(&a->scene->channels[a->channel]);
-    double f = air_emission_density(a, sigma, nu);
+    double f = air_emission_density(a, sigma, nu, NULL);
     out->freq_hz = nu;
     out->power_w_per_hz = f * a->cdf[AIR_EMISSION_BINS - 1] /
                           (a->q[lo] * sigma * sqrt(2.0 * M_PI) * a->p_air * (double)a->n_photons);
     air_emission_volume_point(a, rng, &out->position_m, &out->dir);
-    return out->power_w_per_hz > 0.0;
+    return out->power_w_per_hz != 0.0;
 }
 
 /* A boundary photon: frequency from g_c, a point on the faces, cosine inwards; dropped
@@ -275,10 +368,9 @@ static bool air_emission_boundary_photon(const air_emission *a, rng_stream *rng,
     out->power_w_per_hz = 0.0;
     if (!air_emission_open(a, out->position_m, out->dir))
         return false;
-    out->power_w_per_hz = M_PI * a->area_m2 *
-                          air_emission_boundary_radiance(&a->scene->atmosphere, nu) /
+    out->power_w_per_hz = M_PI * a->area_m2 * air_emission_boundary_deviation(a, nu) /
                           (a->p_boundary * (double)a->n_photons);
-    return out->power_w_per_hz > 0.0;
+    return out->power_w_per_hz != 0.0;
 }
 
 bool air_emission_sample(const air_emission *a, const emission_table *t, rng_stream *rng,

@@ -6,18 +6,30 @@
  * widened by 1 % of its diagonal on each side. Two source classes join the surfaces:
  *
  * - the air: 4 pi alpha(nu) B_nu(T_air) per unit volume, isotropic, uniform in the box;
- * - the boundary: each face of the box emits inwards, Lambertian, with the radiance a
+ * - the boundary: each face of the box emits inwards, Lambertian, with the radiance L_b a
  *   ray leaving the box sees (the renderer's escape radiance there): B_nu(T_bg) with an
  *   extent; without one the air beyond, B_nu(T_air) where alpha > 0 (else B_nu(T_bg)).
+ *   L_b = 0 when the atmosphere does not emit (or there is none).
+ *
+ * Deviation maps (reference temperature T0 > 0, emission.h): the sources become
+ * 4 pi alpha (B(T_air) - B0) per volume, with T_air = 0 for a non-emitting atmosphere
+ * (absorbing air is air at 0 K), and L_b - B0 at the boundary (-B0 where a scene without
+ * an emitting atmosphere is open). Both classes may then fire without an emitting
+ * atmosphere, with signed powers; the class probabilities follow the magnitudes (the
+ * air's source has one sign over the band; the boundary's band mean of |L_b - B0|),
+ * the boundary's times the share of its photons that reach a surface (reach_share): a
+ * boundary whose photons never meet a surface (a closed room inside the widened box,
+ * whose faces see only the room's outside and the gap around it) fires nothing, as it
+ * would store nothing. That changes the power fired, never the map.
  *
  * Scheme (unbiased for the band mean, as physics.md "Photon phase" allows): each photon
  * picks a class with probability proportional to its band-mean power, then divides its
  * power by that probability. An air photon's frequency is drawn from a histogram q of
- * g_c(nu) P_air(nu) over nu_c +- 6 sigma (AIR_EMISSION_BINS bins: the air's power
+ * |g_c(nu) P_air(nu)| over nu_c +- 6 sigma (AIR_EMISSION_BINS bins: the air's power
  * follows alpha's lines) and it carries Phi = g_c P_air Q / (q B_c p_air K), P_air exact
  * at its frequency, Q the integral of q; a boundary photon's frequency is drawn from g_c
- * and it carries pi A L_b(nu) / (p_b K). Their object is ACCEL_NO_OBJECT (trace_photon
- * starts them from their point).
+ * and it carries pi A L_b(nu) / (p_b K) (pi A (L_b - B0) / (p_b K) when T0 > 0). Their object is
+ * ACCEL_NO_OBJECT (trace_photon starts them from their point).
  *
  * Where there is no air or no opening, nothing is emitted: an air photon whose first hit
  * is the back face of a one-sided solid (it was born inside a solid) is dropped by
@@ -28,8 +40,9 @@
  * estimated from AIR_EMISSION_SHARE_RAYS points by the same rules (they enter only the
  * statistics and the class probabilities, never the photons' expected power).
  *
- * Without an emitting atmosphere no class uniform is drawn: photon streams are those of
- * a scene without it.
+ * Without an emitting atmosphere and with T0 = 0 no class uniform is drawn: photon
+ * streams are those of a scene without it. With T0 = 0 everything is as above,
+ * bit for bit.
  */
 #ifndef THZ_PHOTON_AIR_EMISSION_H
 #define THZ_PHOTON_AIR_EMISSION_H
@@ -49,7 +62,7 @@
 #define AIR_EMISSION_SHARE_RAYS 16384
 
 typedef struct air_emission {
-    bool active; /* the air or the boundary emits in this channel */
+    bool active; /* the air or the boundary fires photons in this channel */
     const thz_scene *scene;
     const accel *acc;
     size_t channel;
@@ -67,18 +80,27 @@ typedef struct air_emission {
     double area_m2;                 /* of the box's six faces */
     double face_cdf[6];             /* cumulative face areas */
     double open_share;              /* estimated share of boundary photons kept */
+    double reach_share;             /* T0 > 0: ... and that reach a surface (else open_share) */
     double boundary_power_w_per_hz; /* pi A band mean of L_b, times open_share */
     /* class probabilities: air, boundary, surfaces */
     double p_air, p_boundary, p_surfaces;
-    double band_power_w_per_hz; /* air + boundary: to add to the surfaces' Pbar_A */
+    double band_power_w_per_hz; /* air + boundary: to add to the surfaces' Pbar_A (the
+                                   physical emission, also when T0 > 0) */
+    /* deviation map (T0 > 0; equal to the powers above when T0 = 0) */
+    double t0_k;                        /* reference temperature T0 */
+    double air_deviation_w_per_hz;      /* band mean of the air's source, signed, x share */
+    double boundary_deviation_w_per_hz; /* pi A band mean of L_b - B0, x open_share */
 } air_emission;
 
-/* Prepares channel `channel`'s air and boundary sources for K = n_photons photons,
- * beside surfaces of band-mean power surface_power_w_per_hz. Inactive when the
- * atmosphere does not emit or nothing has power in the band. */
+/* Prepares channel `channel`'s air and boundary sources for K = n_photons photons of
+ * the map of L - B_nu(t0_k) (t0_k = 0: of L), beside surfaces of band-mean power
+ * surface_power_w_per_hz (with T0 > 0: the band mean of the magnitude of their signed
+ * power, emission_band_magnitude_w_per_hz). Inactive (no class is drawn) when neither
+ * the air nor the boundary has a source in the band: with T0 = 0, when the atmosphere
+ * does not emit. */
 thz_status air_emission_init(air_emission *a, const thz_scene *scene, const accel *acc,
                              size_t channel, uint64_t n_photons, double surface_power_w_per_hz,
-                             thz_error *err);
+                             double t0_k, thz_error *err);
 void air_emission_fini(air_emission *a);
 
 /* Draws one photon of any class (see above); the same contract as emission_sample,

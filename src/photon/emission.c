@@ -47,15 +47,18 @@ void emission_table_fini(emission_table *t)
     memset(t, 0, sizeof *t);
 }
 
-/* Whether sources i and j have powers in a frequency-independent ratio. */
+/* Whether sources a and b have powers in a frequency-independent ratio. */
 static bool emission_same_group(const emission_table *t, const emission_source *a,
                                 const emission_source *b)
 {
     const thz_object *oa = &t->scene->objects[a->object], *ob = &t->scene->objects[b->object];
     if (oa->temperature_k != ob->temperature_k || a->constant_optics != b->constant_optics)
         return false;
+    if (t->t0_k > 0.0 && a->kind != b->kind)
+        return false; /* with T0 = 0 every kind's power is B(T) times a constant */
     if (a->constant_optics)
-        return true;
+        return a->kind != EMISSION_EPS_ABSORB || (a->optics.emissivity == b->optics.emissivity &&
+                                                  a->optics.reflectivity == b->optics.reflectivity);
     return oa->material == ob->material && oa->type == ob->type &&
            oa->thickness_m == ob->thickness_m && a->sides == b->sides;
 }
@@ -78,6 +81,7 @@ static bool emission_group_sources(emission_table *t)
         const emission_source *s = &t->sources[i];
         emission_group *g = &t->groups[t->n_groups++];
         g->temperature_k = t->scene->objects[s->object].temperature_k;
+        g->kind = s->kind;
         g->constant_optics = s->constant_optics;
         g->first = k;
         for (size_t j = i; j < n; j++) {
@@ -87,6 +91,7 @@ static bool emission_group_sources(emission_table *t)
             taken[j] = true;
             t->order[k++] = j;
             g->weight += u->constant_optics ? u->weight : M_PI * u->share;
+            g->weight0 += u->constant_optics ? u->weight0 : 0.0;
         }
         g->count = k - g->first;
         if (g->count > 1) {
@@ -107,8 +112,9 @@ static bool emission_group_sources(emission_table *t)
 }
 
 /* Tabulates q_g on EMISSION_TABLE_NODES nodes over the band as cumulative sums over the
- * groups. q_g(node) = max(w_g(node), floor) with floor = 1e-6 of the largest total:
- * q_g > 0 everywhere, so every group with power at some frequency can be drawn there. */
+ * groups. q_g(node) = max(|w_g(node)|, floor) with floor = 1e-6 of the largest sum of
+ * |w_g|: q_g > 0 everywhere, so every group with power at some frequency (of either
+ * sign) can be drawn there. */
 static bool emission_tabulate(emission_table *t)
 {
     const thz_channel *ch = &t->scene->channels[t->channel];
@@ -129,7 +135,7 @@ static bool emission_tabulate(emission_table *t)
         double nu = lo + (double)i * t->step_hz;
         double total = 0.0;
         for (size_t g = 0; g < t->n_groups; g++) {
-            row[g] = nu > 0.0 ? emission_group_power(t, g, nu) : 0.0;
+            row[g] = nu > 0.0 ? fabs(emission_group_power(t, g, nu)) : 0.0;
             total += row[g];
         }
         largest = total > largest ? total : largest;
@@ -148,69 +154,151 @@ static bool emission_tabulate(emission_table *t)
     return true;
 }
 
+/* A-bar and sampling by A(mu) mu: the optics with Kirchhoff's eps = A. */
+static optics_point emission_kirchhoff_optics(optics_point o)
+{
+    o.explicit_emissivity = false;
+    return o;
+}
+
+/* Adds object i's source of `kind`; false only when out of memory. A source without
+ * power (constant optics, zero weights) is not added. */
+static bool emission_add_source(emission_table *t, size_t i, emission_kind kind)
+{
+    const thz_scene *scene = t->scene;
+    const thz_object *obj = &scene->objects[i];
+    emission_source *s = &t->sources[t->n_sources];
+    memset(s, 0, sizeof *s);
+    s->object = (uint32_t)i;
+    s->kind = kind;
+    s->sides = (obj->type == OBJECT_SHELL || obj->two_sided) ? 2 : 1;
+    const thz_material *m = &scene->materials[obj->material];
+    s->constant_optics = spectrum_is_constant(&m->reflectivity) &&
+                         spectrum_is_constant(&m->attenuation_per_m) &&
+                         spectrum_is_constant(&m->emissivity);
+    double area = 0.0;
+    for (size_t k = 0; k < obj->mesh.n_triangles; k++)
+        area += obj->mesh.areas_m2[k];
+    s->area_m2 = area;
+    s->share = s->area_m2 * s->sides;
+    if (s->constant_optics) {
+        s->optics = scene_object_optics(scene, obj, scene->channels[t->channel].center_hz);
+        double eps = optics_mean_emissivity(&s->optics);
+        optics_point kirchhoff = emission_kirchhoff_optics(s->optics);
+        double abs = optics_mean_emissivity(&kirchhoff);
+        double coef = M_PI * s->area_m2 * s->sides;
+        s->weight = kind == EMISSION_ABSORB ? 0.0 : M_PI * eps * s->area_m2 * s->sides;
+        if (t->t0_k > 0.0)
+            s->weight0 = kind == EMISSION_KIRCHHOFF ? s->weight
+                         : kind == EMISSION_EPS     ? 0.0
+                                                    : coef * abs;
+        s->share = s->weight + s->weight0;
+        if (!(s->share > 0.0)) /* eps-bar = 0 (and A-bar = 0): emits nothing */
+            return true;
+    }
+    s->triangle_cdf = thz_malloc_array(obj->mesh.n_triangles, sizeof *s->triangle_cdf);
+    if (!s->triangle_cdf)
+        return false;
+    double sum = 0.0;
+    for (size_t k = 0; k < obj->mesh.n_triangles; k++) {
+        sum += obj->mesh.areas_m2[k];
+        s->triangle_cdf[k] = sum;
+    }
+    t->n_sources++;
+    return true;
+}
+
 thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t channel,
-                               uint64_t n_photons, thz_error *err)
+                               uint64_t n_photons, double t0_k, thz_error *err)
 {
     memset(t, 0, sizeof *t);
+    if (!(t0_k >= 0.0) || !isfinite(t0_k))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "photon emission: reference temperature must be >= 0 K, got %g K",
+                             t0_k);
     t->scene = scene;
     t->channel = channel;
     t->n_photons = n_photons ? n_photons : 1;
-    t->sources = thz_calloc(scene->n_objects ? scene->n_objects : 1, sizeof *t->sources);
+    t->t0_k = t0_k;
+    /* At most two sources per object (explicit-emissivity shells with T0 > 0). */
+    size_t cap = 2 * scene->n_objects;
+    t->sources = thz_calloc(cap ? cap : 1, sizeof *t->sources);
     if (!t->sources)
         return thz_error_set(err, THZ_ERR_NOMEM, "photon emission: out of memory");
-    for (size_t i = 0; i < scene->n_objects; i++) {
+    bool ok = true;
+    for (size_t i = 0; i < scene->n_objects && ok; i++) {
         const thz_object *obj = &scene->objects[i];
-        if (!(obj->temperature_k > 0.0) || !(obj->mesh.total_area_m2 > 0.0) ||
-            obj->mesh.n_triangles == 0)
+        if (!(obj->mesh.total_area_m2 > 0.0) || obj->mesh.n_triangles == 0)
             continue;
-        emission_source *s = &t->sources[t->n_sources];
-        s->object = (uint32_t)i;
-        s->sides = (obj->type == OBJECT_SHELL || obj->two_sided) ? 2 : 1;
-        s->triangle_cdf = thz_malloc_array(obj->mesh.n_triangles, sizeof *s->triangle_cdf);
-        if (!s->triangle_cdf) {
-            emission_table_fini(t);
-            return thz_error_set(err, THZ_ERR_NOMEM, "photon emission: out of memory");
-        }
-        t->n_sources++;
-        double sum = 0.0;
-        for (size_t k = 0; k < obj->mesh.n_triangles; k++) {
-            sum += obj->mesh.areas_m2[k];
-            s->triangle_cdf[k] = sum;
-        }
-        s->area_m2 = sum;
-        const thz_material *m = &scene->materials[obj->material];
-        s->constant_optics = spectrum_is_constant(&m->reflectivity) &&
-                             spectrum_is_constant(&m->attenuation_per_m) &&
-                             spectrum_is_constant(&m->emissivity);
-        s->share = s->area_m2 * s->sides;
-        if (s->constant_optics) {
-            s->optics = scene_object_optics(scene, obj, scene->channels[channel].center_hz);
-            s->weight = M_PI * optics_mean_emissivity(&s->optics) * s->area_m2 * s->sides;
-            s->share = s->weight;
-            if (!(s->weight > 0.0)) { /* eps-bar = 0: emits nothing */
-                free(s->triangle_cdf);
-                memset(s, 0, sizeof *s);
-                t->n_sources--;
-            }
+        bool hot = obj->temperature_k > 0.0;
+        bool explicit_eps = scene->materials[obj->material].emissivity.n > 0;
+        if (!(t0_k > 0.0)) { /* the paper's sources: eps B(T) */
+            if (hot)
+                ok = emission_add_source(t, i, explicit_eps ? EMISSION_EPS : EMISSION_KIRCHHOFF);
+        } else if (!explicit_eps) { /* A (B(T) - B0): nothing at T0 */
+            if (obj->temperature_k != t0_k)
+                ok = emission_add_source(t, i, EMISSION_KIRCHHOFF);
+        } else if (obj->type == OBJECT_SHELL) { /* eps B(T) and -A(mu) B0: two laws */
+            if (hot)
+                ok = emission_add_source(t, i, EMISSION_EPS);
+            if (ok)
+                ok = emission_add_source(t, i, EMISSION_ABSORB);
+        } else {
+            ok = emission_add_source(t, i, EMISSION_EPS_ABSORB);
         }
     }
-    if (!emission_group_sources(t) || !emission_tabulate(t)) {
+    if (!ok || !emission_group_sources(t) || !emission_tabulate(t)) {
         emission_table_fini(t);
         return thz_error_set(err, THZ_ERR_NOMEM, "photon emission: out of memory");
     }
     return THZ_OK;
 }
 
+/* The signed power of group gr at freq_hz, given the optics `o` of its sources (used
+ * for variable optics only). */
+static double emission_power_with(const emission_table *t, const emission_group *gr,
+                                  const optics_point *o, double freq_hz)
+{
+    double b0 = t->t0_k > 0.0 ? planck_radiance(freq_hz, t->t0_k) : 0.0;
+    double w;
+    switch (gr->kind) {
+    case EMISSION_KIRCHHOFF:
+    case EMISSION_EPS:
+    default:
+        /* EMISSION_EPS has no B0 term (and with T0 = 0 b0 = 0, B - 0 = B exactly). */
+        w = gr->weight * (planck_radiance(freq_hz, gr->temperature_k) -
+                          (gr->kind == EMISSION_KIRCHHOFF ? b0 : 0.0));
+        if (!gr->constant_optics)
+            w *= optics_mean_emissivity(o);
+        return w;
+    case EMISSION_EPS_ABSORB:
+        if (gr->constant_optics)
+            return gr->weight * planck_radiance(freq_hz, gr->temperature_k) - gr->weight0 * b0;
+        {
+            optics_point k = emission_kirchhoff_optics(*o);
+            return gr->weight *
+                   (optics_mean_emissivity(o) * planck_radiance(freq_hz, gr->temperature_k) -
+                    optics_mean_emissivity(&k) * b0);
+        }
+    case EMISSION_ABSORB:
+        if (gr->constant_optics)
+            return -gr->weight0 * b0;
+        {
+            optics_point k = emission_kirchhoff_optics(*o);
+            return -gr->weight * optics_mean_emissivity(&k) * b0;
+        }
+    }
+}
+
 double emission_group_power(const emission_table *t, size_t g, double freq_hz)
 {
     const emission_group *gr = &t->groups[g];
-    double w = gr->weight;
+    optics_point o = {0};
     if (!gr->constant_optics) {
         const emission_source *s = &t->sources[t->order[gr->first]];
-        optics_point o = scene_object_optics(t->scene, &t->scene->objects[s->object], freq_hz);
-        w *= optics_mean_emissivity(&o);
+        o = scene_object_optics(t->scene, &t->scene->objects[s->object], freq_hz);
     }
-    return w * planck_radiance(freq_hz, gr->temperature_k);
+    return emission_power_with(t, gr, &o, freq_hz);
 }
 
 double emission_group_weights(const emission_table *t, double freq_hz, double *weights)
@@ -221,6 +309,22 @@ double emission_group_weights(const emission_table *t, double freq_hz, double *w
         total += weights[g];
     }
     return total;
+}
+
+static double emission_magnitude_at(double freq_hz, void *ctx)
+{
+    const emission_table *t = ctx;
+    double total = 0.0;
+    for (size_t g = 0; g < t->n_groups; g++)
+        total += fabs(emission_group_power(t, g, freq_hz));
+    return total;
+}
+
+double emission_band_magnitude_w_per_hz(const emission_table *t)
+{
+    if (t->n_groups == 0)
+        return 0.0;
+    return channel_band_mean(&t->scene->channels[t->channel], emission_magnitude_at, (void *)t);
 }
 
 /* The tabulated cumulative weight C_g(nu) at interpolation position (row, frac). */
@@ -280,12 +384,10 @@ bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
     const thz_object *obj = &t->scene->objects[s->object];
     const thz_mesh *m = &obj->mesh;
 
-    /* The exact power of the group drawn, at this frequency. */
+    /* The exact signed power of the group drawn, at this frequency. */
     optics_point o = s->constant_optics ? s->optics : scene_object_optics(t->scene, obj, nu);
-    double w = gr->weight * planck_radiance(nu, gr->temperature_k);
-    if (!gr->constant_optics)
-        w *= optics_mean_emissivity(&o);
-    if (!(w > 0.0) || !(q > 0.0))
+    double w = emission_power_with(t, gr, &o, nu);
+    if (w == 0.0 || isnan(w) || !(q > 0.0))
         return false;
     out->power_w_per_hz = w * (total / q) / (double)t->n_photons;
 
@@ -311,9 +413,12 @@ bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
     vec3 n = v3(nf[0], nf[1], nf[2]);
     if (side == 1)
         n = v3_scale(n, -1.0);
+    /* mu ~ eps(mu) mu, or A(mu) mu for the -A B0 part of an explicit-emissivity shell
+     * (EMISSION_EPS_ABSORB is a solid's: eps and A both cosine). */
+    optics_point law = s->kind == EMISSION_ABSORB ? emission_kirchhoff_optics(o) : o;
     double mu;
-    if (!optics_sample_emission_mu(&o, emission_uniform, rng, &mu))
-        mu = sqrt(1.0 - rng_uniform(rng)); /* unreachable: the source has eps-bar > 0 */
+    if (!optics_sample_emission_mu(&law, emission_uniform, rng, &mu))
+        mu = sqrt(1.0 - rng_uniform(rng)); /* eps = 0 (a -A B0 source) or unreachable */
     out->dir = emission_direction(n, mu, rng_uniform(rng));
     out->object = s->object;
     out->triangle = (uint32_t)tri;

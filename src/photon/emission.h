@@ -1,25 +1,43 @@
 /* Emission sampling of the photon phase (physics.md "Photon phase", eq. 5-6).
  *
+ * Sources. With reference temperature T0 = 0 (the paper's map of L) each object emits
+ * eps(mu) B_nu(T) per unit projected area, mu ~ eps(mu) mu. With T0 > 0 the table fires
+ * the map of the deviation L - B0, B0 = B_nu(T0) (photon_map.h "Reference temperature"):
+ * since R + T(mu) + A(mu) = 1 at every surface, L - B0 obeys the same transport with
+ * the signed sources eps(mu) B(T) - A(mu) B0. By kind of source (emission_kind):
+ * - Kirchhoff materials (eps = A): A(mu) (B(T) - B0), the emission above with B(T)
+ *   replaced by B(T) - B0 and the same angular law; identically 0 (no source) at T = T0;
+ *   an object at 0 K emits -A B0;
+ * - explicit-emissivity solids: eps and A = 1 - R do not depend on angle, so one cosine
+ *   source of power pi A_area sides (eps B(T) - (1 - R) B0), whose sign may change with
+ *   frequency;
+ * - explicit-emissivity shells: eps B(T) (cosine) and -A(mu) B0 (mu ~ A(mu) mu) have
+ *   different angular laws: two sources, each in its own group.
+ * With T0 = 0 only the B(T) parts exist and the tables, photons and random streams are
+ * exactly those of the paper's scheme.
+ *
  * Scheme (unbiased for the band mean, as physics.md allows): a photon's frequency nu is
  * drawn from the channel response g_c alone. At that nu the sources are grouped (see
- * emission_group) and each group g has the exact power w_g(nu) = pi eps-bar_g(nu) A_g
- * B_nu(T_g) (times its sides). Evaluating every w_g at every photon's frequency costs
- * an optics evaluation per group (an exponential integral for shells) and was most of
- * the photon phase's time, so the group is drawn instead from a tabulation q_g(nu) of
- * the same weights (linear interpolation on a fine grid over the band, floored so that
- * q_g > 0 wherever w_g may be), and the photon carries
+ * emission_group) and each group g has the exact signed power w_g(nu) (for a Kirchhoff
+ * group pi eps-bar_g(nu) A_g (B_nu(T_g) - B0), times its sides). Evaluating every w_g at
+ * every photon's frequency costs an optics evaluation per group (an exponential
+ * integral for shells) and was most of the photon phase's time, so the group is drawn
+ * instead from a tabulation q_g(nu) of the magnitudes |w_g| (linear interpolation on a
+ * fine grid over the band, floored so that q_g > 0 wherever w_g may be nonzero), and the
+ * photon carries the signed power
  *     Phi = w_g(nu) Q(nu) / (q_g(nu) K),   Q = sum_g q_g,
  * with w_g evaluated exactly, at the photon's own frequency, for the drawn group only.
- * Then E[Phi | nu] = sum_g w_g(nu) / K = P_A(nu) / K exactly: the tabulation changes
- * only how evenly the power is spread over photons (w / q differs from 1 by the
- * interpolation error, ~1e-7 for smooth optics), never the mean; narrow material lines
- * are still integrated, since w_g is exact. Within the group a source is drawn by its
- * frequency-independent share, one of its emitting sides uniformly, a triangle by an
- * area CDF (binary search), a point uniformly on the triangle, and a direction with
- * mu ~ eps(mu) mu about the emitting side's normal and uniform azimuth.
+ * Then E[Phi | nu] = sum_g w_g(nu) / K = P_A(nu) / K exactly (P_A the deviation sources'
+ * power when T0 > 0): the tabulation changes only how evenly the power is spread over
+ * photons (|w| / q differs from 1 by the interpolation error, ~1e-7 for smooth optics),
+ * never the mean; narrow material lines are still integrated, since w_g is exact. Within
+ * the group a source is drawn by its frequency-independent share, one of its emitting
+ * sides uniformly, a triangle by an area CDF (binary search), a point uniformly on the
+ * triangle, and a direction by the source's angular law about the emitting side's
+ * normal and uniform azimuth.
  *
  * Emitting sides: both sides of shells and two-sided solids, the front side of one-sided
- * solids; objects at 0 K (or without area) emit nothing.
+ * solids. Objects without area emit nothing; with T0 = 0 neither do objects at 0 K.
  */
 #ifndef THZ_PHOTON_EMISSION_H
 #define THZ_PHOTON_EMISSION_H
@@ -33,30 +51,49 @@
 #include "core/vec3.h"
 #include "scene/scene.h"
 
-/* One emitting object. */
+/* Kind of a source: how its power and direction depend on B(T), B0 and the optics.
+ * Powers per frequency, with W = pi A_area sides: */
+typedef enum emission_kind {
+    EMISSION_KIRCHHOFF = 0, /* W eps-bar (B(T) - B0), mu ~ A(mu) mu (eps = A) */
+    EMISSION_EPS,           /* W eps B(T), cosine: explicit eps (shells; solids when T0 = 0) */
+    EMISSION_EPS_ABSORB,    /* W (eps B(T) - (1 - R) B0), cosine: explicit-eps solids, T0 > 0 */
+    EMISSION_ABSORB         /* -W A-bar B0, mu ~ A(mu) mu: explicit-eps shells, T0 > 0 */
+} emission_kind;
+
+/* One emitting object (an explicit-emissivity shell with T0 > 0 is two sources). */
 typedef struct emission_source {
-    uint32_t object;      /* index into scene->objects */
+    uint32_t object; /* index into scene->objects */
+    emission_kind kind;
     int sides;            /* 1 or 2 emitting sides */
     double area_m2;       /* total area of one side */
     bool constant_optics; /* R, alpha_M and eps do not depend on frequency */
-    double weight;        /* constant optics: pi eps-bar A sides (times B_nu(T) = power) */
-    double share;         /* weight within its group: `weight` (constant optics) or
-                             A sides (variable optics, eps-bar shared by the group) */
+    double weight;        /* constant optics: the coefficient of B_nu(T) in the power
+                             (pi eps-bar A sides), 0 for EMISSION_ABSORB */
+    double weight0;       /* constant optics: the coefficient of -B0 (pi A-bar A sides;
+                             0 with T0 = 0 and for EMISSION_EPS) */
+    double share;         /* weight within its group: weight + weight0 (constant optics,
+                             a fixed multiple of |power| within a group) or A sides
+                             (variable optics, the optics shared by the group) */
     optics_point optics;  /* constant optics: the optics at every frequency */
     double *triangle_cdf; /* n_triangles cumulative areas, last = total */
 } emission_source;
 
 /* Sources whose power differs only by a frequency-independent factor form one group, so
- * that a photon needs the exact power of one group only: sources with constant optics
- * and the same temperature, or sources with frequency-dependent optics that share the
- * material, type, thickness, sidedness and temperature (so eps-bar(nu) is the same).
- * The source within the group is drawn by its share (CDF over the group's sources). */
+ * that a photon needs the exact power of one group only: the same temperature and kind,
+ * and either constant optics (for EMISSION_EPS_ABSORB also the same eps and R, which fix
+ * the ratio of the two terms; with T0 = 0 constant-optics sources of any kind share a
+ * group per temperature, as their powers are all B(T) times a constant), or
+ * frequency-dependent optics with the same material, type, thickness and sidedness (so
+ * eps-bar(nu) and A-bar(nu) are the same). The source within the group is drawn by its
+ * share (CDF over the group's sources). */
 typedef struct emission_group {
     double temperature_k;
+    emission_kind kind;  /* of its sources (with T0 = 0 and constant optics: of the first) */
     size_t first, count; /* range of emission_table.order */
     bool constant_optics;
-    double weight; /* constant: sum of weights; variable: pi sum of A sides */
-    double *cdf;   /* count cumulative shares (count > 1) */
+    double weight;  /* constant: sum of weights; variable: pi sum of A sides */
+    double weight0; /* constant: sum of weight0s; variable: unused */
+    double *cdf;    /* count cumulative shares (count > 1) */
 } emission_group;
 
 /* Nodes of the tabulated group weights q_g over the band: centre +- 9 sigma (Box-Muller
@@ -69,6 +106,7 @@ typedef struct emission_table {
     const thz_scene *scene;
     size_t channel;
     uint64_t n_photons; /* K: each photon carries P_A(nu) / K on average */
+    double t0_k;        /* reference temperature T0 (0: the paper's map of L) */
     size_t n_sources;
     emission_source *sources;
     size_t n_groups;
@@ -81,7 +119,7 @@ typedef struct emission_table {
 /* A photon as emitted. */
 typedef struct emission_photon {
     double freq_hz;
-    double power_w_per_hz; /* Phi(nu) = P_A(nu) / K; 0 when nothing emits at nu */
+    double power_w_per_hz; /* signed: E[Phi | nu] = P_A(nu) / K; 0 when nothing emits */
     vec3 position_m;       /* on the triangle */
     vec3 dir;              /* unit, into the emitting side's hemisphere */
     uint32_t object;
@@ -89,21 +127,27 @@ typedef struct emission_photon {
     int side; /* 0 front, 1 back */
 } emission_photon;
 
+/* Prepares channel `channel`'s sources for K = n_photons photons of the map of
+ * L - B_nu(t0_k) (t0_k = 0: the paper's map of L; t0_k must be >= 0). */
 thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t channel,
-                               uint64_t n_photons, thz_error *err);
+                               uint64_t n_photons, double t0_k, thz_error *err);
 void emission_table_fini(emission_table *t);
 
-/* P_A(freq_hz) over the table's sources, writing each group's exact power
- * pi eps-bar A sides B_nu(T) into weights[0..n_groups-1] (caller's scratch). */
+/* P_A(freq_hz) over the table's sources (signed when T0 > 0), writing each group's exact
+ * power w_g into weights[0..n_groups-1] (caller's scratch). */
 double emission_group_weights(const emission_table *t, double freq_hz, double *weights);
 
-/* Exact power w_g(freq_hz) of group g (W/Hz). */
+/* Exact signed power w_g(freq_hz) of group g (W/Hz). */
 double emission_group_power(const emission_table *t, size_t g, double freq_hz);
+
+/* Band mean (channel response) of sum_g |w_g(nu)|, W/Hz: the surfaces' share of the
+ * photons beside the air and boundary sources when T0 > 0 (air_emission.h). */
+double emission_band_magnitude_w_per_hz(const emission_table *t);
 
 /* Draws one photon from rng. `scratch` is unused (kept for callers that size it as
  * n_sources doubles); nothing is allocated here. Returns false when the drawn group has
  * no power at the drawn frequency: the photon then has power 0 and nothing else is
- * set. */
+ * set. The power is signed (negative where the source's eps B(T) < A B0). */
 bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
                      emission_photon *out);
 

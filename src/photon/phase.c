@@ -184,14 +184,21 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     thz_status st = phase_check(scene, channel, err);
     if (st != THZ_OK)
         return st;
+    double t0_k = opt ? opt->reference_temperature_k : 0.0;
+    if (!(t0_k >= 0.0) || !isfinite(t0_k))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "photon phase: reference temperature must be >= 0 K, got %g K", t0_k);
     emission_table table;
-    st = emission_table_init(&table, scene, channel, scene->photons.per_channel, err);
+    st = emission_table_init(&table, scene, channel, scene->photons.per_channel, t0_k, err);
     if (st != THZ_OK)
         return st;
+    /* The physical band power P_A (statistics); the photons' share of the surfaces is
+     * that power with T0 = 0, else the band mean of the signed sources' magnitude. */
     double surface_power = scene_band_emitted_power_w_per_hz(scene, channel);
+    double surface_mass = t0_k > 0.0 ? emission_band_magnitude_w_per_hz(&table) : surface_power;
     air_emission air;
-    st = air_emission_init(&air, scene, acc, channel, scene->photons.per_channel, surface_power,
-                           err);
+    st = air_emission_init(&air, scene, acc, channel, scene->photons.per_channel, surface_mass,
+                           t0_k, err);
     if (st != THZ_OK) {
         emission_table_fini(&table);
         return st;
@@ -221,6 +228,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     st = photon_map_create(records, count, scene->n_objects, a.threads, out_map, err);
     if (st != THZ_OK)
         return st;
+    photon_map_set_reference_temperature_k(*out_map, t0_k);
     double t3 = omp_get_wtime();
 
     if (stats) {
@@ -236,6 +244,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
         stats->terminated = c.terminated + c.capped;
         stats->bounce_capped = c.capped;
         stats->emitted_power_w_per_hz = surface_power + air_power; /* + air, boundary */
+        stats->reference_temperature_k = t0_k;
         stats->fired_power_w_per_hz = c.fired_power;
         stats->absorbed_power_w_per_hz = c.absorbed_power;
         stats->escaped_power_w_per_hz = c.escaped_power;
@@ -263,12 +272,12 @@ thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc,
     if (pilot == 0)
         return THZ_OK;
     emission_table table;
-    st = emission_table_init(&table, scene, channel, k, err);
+    st = emission_table_init(&table, scene, channel, k, 0.0, err);
     if (st != THZ_OK)
         return st;
     air_emission air;
     st = air_emission_init(&air, scene, acc, channel, k,
-                           scene_band_emitted_power_w_per_hz(scene, channel), err);
+                           scene_band_emitted_power_w_per_hz(scene, channel), 0.0, err);
     if (st != THZ_OK) {
         emission_table_fini(&table);
         return st;

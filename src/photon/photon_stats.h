@@ -14,7 +14,8 @@ typedef struct photon_stats {
     uint64_t escaped;                 /* left the scene without a hit */
     uint64_t back_face_hits;          /* hits on the back side of one-sided solids (absorbed) */
     uint64_t terminated;              /* ended by the low-power roulette */
-    double emitted_power_w_per_hz;    /* band mean P_A: the power fired */
+    double emitted_power_w_per_hz;    /* band mean P_A of the scene's physical sources (the
+                                         power fired when T0 = 0) */
     double absorbed_power_w_per_hz;   /* sum of power absorbed by surfaces */
     double escaped_power_w_per_hz;    /* sum of power that left the scene */
     double atmosphere_power_w_per_hz; /* sum of power absorbed by the atmosphere */
@@ -35,6 +36,12 @@ typedef struct photon_stats {
     double seconds_emission_table; /* emission_table_init */
     double seconds_tracing;        /* firing, tracing and merging the records of every batch */
     double seconds_index;          /* photon_map_create: grouping and the spatial index */
+    /* Reference temperature T0 of the map (K; 0: the paper's map of L). With T0 > 0 the
+     * photons carry the signed power of L - B_nu(T0) (photon_map.h): fired, absorbed,
+     * escaped, atmosphere and terminated powers are the deviation map's signed sums (the
+     * balance still closes exactly; fired estimates the band power of the deviation
+     * sources, not emitted_power_w_per_hz), and the counts count photons of either sign. */
+    double reference_temperature_k;
 } photon_stats;
 
 #endif

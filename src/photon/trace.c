@@ -69,11 +69,13 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
                   rng_stream *rng, trace_buffer *buf, trace_counters *c)
 {
     c->photons++;
+    /* The power is signed in a deviation map (emission.h): the path is traced with its
+     * magnitude and every record and sum keeps the sign. */
     double power = e->power_w_per_hz;
-    if (!(power > 0.0))
+    if (power == 0.0 || isnan(power))
         return true;
     c->fired_power += power;
-    const double w_min = scene->photons.min_relative_power * power;
+    const double w_min = scene->photons.min_relative_power * fabs(power);
     const double nu = e->freq_hz;
 
     accel_hit from = {
@@ -119,11 +121,12 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
         double tr = atmosphere_transmittance(&scene->atmosphere, nu, d);
         c->atmosphere_power += power * (1.0 - tr);
         power *= tr;
-        if (power < w_min) {
-            /* Low-power roulette: survive with probability w / w_min at w_min. */
-            if (rng_uniform(rng) * w_min < power) {
-                c->terminated_power -= w_min - power;
-                power = w_min;
+        if (fabs(power) < w_min) {
+            /* Low-power roulette: survive with probability |w| / w_min at +-w_min. */
+            if (rng_uniform(rng) * w_min < fabs(power)) {
+                double survivor = copysign(w_min, power);
+                c->terminated_power -= survivor - power;
+                power = survivor;
             } else {
                 c->terminated++;
                 c->terminated_power += power;

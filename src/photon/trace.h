@@ -2,8 +2,8 @@
  *
  * From its emission the photon flies to the next hit; its power is multiplied by the
  * atmosphere's transmittance exp(-alpha(nu) d); when it has fallen below
- * min_relative_power of the initial power it survives with probability w / w_min at
- * w_min (else it ends, "terminated"); the hit is recorded (incident power, position,
+ * w_min = min_relative_power of the initial power it survives with probability w / w_min
+ * at w_min (else it ends, "terminated"); the hit is recorded (incident power, position,
  * frequency, incoming direction, object << 1 | side, bounce count); then one uniform
  * picks reflection (p = R), transmission (p = T(theta), shells only) or absorption.
  * The back side of a one-sided solid absorbs (counted in back_face_hits; the record is
@@ -12,6 +12,12 @@
  * `straight` transmission goes on unchanged. Neither changes the power: the sampling
  * probabilities equal the BRDF/BTDF weights. A path is capped at TRACE_MAX_BOUNCES hits
  * (counted; it should never trigger).
+ *
+ * Photons of a deviation map (emission.h) may carry negative power: the path is the
+ * same, traced with |power| (the roulette compares |w| with min_relative_power times the
+ * initial |power| and a survivor keeps its sign); records and the power sums keep the
+ * sign, so fired = absorbed + escaped + atmosphere + terminated still holds. Photons of
+ * power 0 (or NaN) are counted and not traced.
  */
 #ifndef THZ_PHOTON_TRACE_H
 #define THZ_PHOTON_TRACE_H
