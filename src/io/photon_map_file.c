@@ -2,6 +2,7 @@
 #include "io/photon_map_file.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,8 +18,9 @@
 #endif
 
 #define PMF_PREFIX_BYTES 24u
-#define PMF_HEADER_FIXED 7u   /* u64 words before the channels */
-#define PMF_CHANNEL_WORDS 20u /* centre, width, count, 10 counters, 7 reals */
+#define PMF_HEADER_FIXED 7u      /* u64 words before the channels */
+#define PMF_CHANNEL_WORDS 21u    /* centre, width, count, 10 counters, 7 reals, T0 */
+#define PMF_CHANNEL_WORDS_V1 20u /* version 1 had no T0 (its maps have T0 = 0) */
 #define PMF_LEVEL 3
 #define PMF_FLAGS_STORED 0xffffu /* the bounce count */
 #define PMF_MAX_HEADER_BYTES (16u << 20)
@@ -246,6 +248,7 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
         if (stats)
             s = stats[c];
         pmf_put_stats(p + 24, &s);
+        put_f64(p + 160, photon_map_reference_temperature_k(maps[c]));
         total_records += count;
     }
 
@@ -426,12 +429,14 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
         goto cleanup;
     }
     uint32_t version = (uint32_t)(get_u64(prefix + 8) & 0xffffffffu);
-    if (version != PHOTON_MAP_FILE_VERSION) {
-        st = thz_error_set(err, THZ_ERR_INPUT,
-                           "photon map %s has format version %u; this thzmap reads version %u",
-                           path, version, PHOTON_MAP_FILE_VERSION);
+    if (version != PHOTON_MAP_FILE_VERSION && version != 1u) {
+        st =
+            thz_error_set(err, THZ_ERR_INPUT,
+                          "photon map %s has format version %u; this thzmap reads versions 1 to %u",
+                          path, version, PHOTON_MAP_FILE_VERSION);
         goto cleanup;
     }
+    const size_t channel_words = version == 1u ? PMF_CHANNEL_WORDS_V1 : PMF_CHANNEL_WORDS;
     uint64_t stated = get_u64(prefix + 16);
     if ((uint64_t)actual < stated) {
         st = thz_error_set(
@@ -479,7 +484,7 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
         goto cleanup;
     uint64_t file_nc = get_u64(header + 24);
     if (file_nc > (PMF_MAX_HEADER_BYTES / 8) ||
-        hsize != 8 * (PMF_HEADER_FIXED + PMF_CHANNEL_WORDS * file_nc)) {
+        hsize != 8 * (PMF_HEADER_FIXED + channel_words * file_nc)) {
         st = pmf_corrupt(&r, "inconsistent header", err);
         goto cleanup;
     }
@@ -519,7 +524,7 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
 
     /* Frame 2: the records. */
     for (size_t c = 0; c < nc; c++) {
-        const uint8_t *p = header + 8 * (PMF_HEADER_FIXED + (size_t)PMF_CHANNEL_WORDS * c);
+        const uint8_t *p = header + 8 * (PMF_HEADER_FIXED + channel_words * c);
         uint64_t count = get_u64(p + 16);
         if (count > (uint64_t)(SIZE_MAX / sizeof(photon_record))) {
             st = pmf_corrupt(&r, "impossible record count", err);
@@ -541,9 +546,15 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
                 goto cleanup;
             }
         }
+        double t0_k = version == 1u ? 0.0 : get_f64(p + 160);
+        if (!(t0_k >= 0.0) || !isfinite(t0_k)) {
+            st = pmf_corrupt(&r, "impossible reference temperature", err);
+            goto cleanup;
+        }
         if (stats) {
             pmf_get_stats(p + 24, &stats[c]);
             stats[c].seconds = 0.0;
+            stats[c].reference_temperature_k = t0_k;
         }
     }
     st = pmf_end_frame(&r, err);
@@ -558,7 +569,7 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
     }
 
     for (size_t c = 0; c < nc; c++) {
-        const uint8_t *p = header + 8 * (PMF_HEADER_FIXED + (size_t)PMF_CHANNEL_WORDS * c);
+        const uint8_t *p = header + 8 * (PMF_HEADER_FIXED + channel_words * c);
         photon_record *rec = records[c];
         records[c] = NULL; /* photon_map_create owns it from here, also on failure */
         st = photon_map_create(rec, (size_t)get_u64(p + 16), scene->n_objects, threads, &maps[c],
@@ -567,6 +578,7 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
             thz_error_prefix(err, "photon map %s: ", path);
             goto cleanup;
         }
+        photon_map_set_reference_temperature_k(maps[c], version == 1u ? 0.0 : get_f64(p + 160));
     }
     if (info) {
         info->n_channels = nc;

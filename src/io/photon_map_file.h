@@ -1,19 +1,23 @@
 /* photon-map.thzpm: every channel's photon map and photon-phase statistics, so that
  * `render` can reuse a simulation's photons (scene-format.md "Outputs").
  *
- * Layout (little-endian, version 1):
+ * Layout (little-endian, version 2):
  *   prefix, 24 bytes, uncompressed: magic "THZPMAP\x1a", u32 version, u32 flags (0),
  *     u64 total file size (detects truncation before decoding anything);
  *   zstd frame 1 (with content checksum): the header: u64 scene hashes (geometry,
  *     optics, channels; scene_hash.h), u64 n_channels, n_objects, seed, photons per
  *     channel, then per channel: f64 centre Hz, f64 relative width, u64 record count, and
  *     the photon_stats (10 counters, 7 powers and means; the wall time is not stored so
- *     that a file depends only on the scene, seed and photon count);
+ *     that a file depends only on the scene, seed and photon count), then f64 the map's
+ *     reference temperature T0 in K (photon_map.h; 0 for the paper's map of L);
  *   zstd frame 2 (with content checksum and content size): the records of channel 0,
  *     1, ... as 32-byte photon_record images, `flags` holding only the bounce count
  *     (the map's index is rebuilt on reading). Within a channel they are in a canonical
  *     order (by object_side, then by their bytes) that does not depend on the photon
  *     map's internal order, so that read + write reproduces a file byte for byte.
+ *
+ * Version 1 is version 2 without T0 (20 words per channel): it is still read, its maps
+ * with T0 = 0.
  */
 #ifndef THZ_IO_PHOTON_MAP_FILE_H
 #define THZ_IO_PHOTON_MAP_FILE_H
@@ -26,7 +30,7 @@
 #include "photon/photon_stats.h"
 #include "scene/scene.h"
 
-#define PHOTON_MAP_FILE_VERSION 1u
+#define PHOTON_MAP_FILE_VERSION 2u
 #define PHOTON_MAP_FILE_MAGIC "THZPMAP\x1a"
 
 /* What a file says beyond its maps. */
@@ -44,10 +48,11 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
                                  thz_error *err);
 
 /* Reads a photon-map file made from `scene`: fills maps[0..n_channels-1] (the caller
- * destroys them; all NULL on failure), stats (n_channels entries, may be NULL; seconds
- * is 0) and info (may be NULL). `threads` is passed to photon_map_create. Refuses, with
- * a message naming the file: a file that is not a photon map or has another version
- * (THZ_ERR_INPUT), a truncated or corrupted one (THZ_ERR_IO; corruption is found by the
+ * destroys them; all NULL on failure; each with its reference temperature set), stats
+ * (n_channels entries, may be NULL; seconds is 0; reference_temperature_k the map's)
+ * and info (may be NULL). `threads` is passed to photon_map_create. Refuses, with a
+ * message naming the file: a file that is not a photon map or has a version other than
+ * 1 or 2 (THZ_ERR_INPUT), a truncated or corrupted one (THZ_ERR_IO; corruption is found by the
  * zstd checksums), and one made from another scene geometry, material set or channel
  * set (THZ_ERR_INPUT). */
 thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,

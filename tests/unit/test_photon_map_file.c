@@ -1,6 +1,7 @@
-/* photon-map.thzpm: write + read gives the same maps and stats, and read + write
- * reproduces the file byte for byte; corrupted (one byte flipped), truncated, foreign
- * and mismatched (another geometry, channel set or temperatures) files are refused with
+/* photon-map.thzpm: write + read gives the same maps, stats and reference temperatures
+ * (channel 1 is a deviation map, T0 = 290 K), and read + write reproduces the file byte
+ * for byte; a version-1 file (no T0) reads with T0 = 0; corrupted (one byte flipped), truncated,
+ * foreign and mismatched (another geometry, channel set or temperatures) files are refused with
  * messages that name the file and say what is wrong. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -10,6 +11,7 @@
 #include <unistd.h>
 
 #include <cmocka.h>
+#include <zstd.h>
 
 #include "../physics/photon_scenes.h"
 #include "accel/accel.h"
@@ -43,9 +45,11 @@ static int setup(void **state)
     thz_error err;
     if (accel_create(f->scene, &acc, &err) != THZ_OK)
         return -1;
-    for (size_t c = 0; c < 2; c++)
-        if (photon_phase_run(f->scene, acc, c, NULL, &f->maps[c], &f->stats[c], &err) != THZ_OK)
+    for (size_t c = 0; c < 2; c++) {
+        photon_phase_options po = {.reference_temperature_k = c == 1 ? 290.0 : 0.0};
+        if (photon_phase_run(f->scene, acc, c, &po, &f->maps[c], &f->stats[c], &err) != THZ_OK)
             return -1;
+    }
     accel_destroy(acc);
     if (photon_map_file_write(f->path, f->scene, (const photon_map *const *)f->maps, f->stats,
                               &err) != THZ_OK)
@@ -112,7 +116,11 @@ static void test_round_trip(void **state)
         a.seconds = a.seconds_emission_table = a.seconds_tracing = a.seconds_index = 0.0;
         a.rays = 0;
         assert_memory_equal(&a, &stats[c], sizeof a);
+        assert_true(photon_map_reference_temperature_k(maps[c]) ==
+                    photon_map_reference_temperature_k(f->maps[c]));
+        assert_true(stats[c].reference_temperature_k == (c == 1 ? 290.0 : 0.0));
     }
+    assert_true(photon_map_reference_temperature_k(maps[1]) == 290.0);
     assert_true(photon_map_count(maps[0]) != photon_map_count(maps[1]));
 
     char again[160];
@@ -132,6 +140,66 @@ static void test_round_trip(void **state)
     free(b2);
     for (size_t c = 0; c < 2; c++)
         photon_map_destroy(maps[c]);
+}
+
+static void expect_refusal(const char *path, const thz_scene *scene, thz_status status,
+                           const char *what);
+
+/* A version-1 file (20 words per channel, no T0) made from a version-2 one: its header
+ * frame without each channel's last word, the records frame as is. */
+static void test_version_1(void **state)
+{
+    fixture *f = *state;
+    size_t n;
+    unsigned char *buf = slurp(f->path, &n);
+    size_t h1 = ZSTD_findFrameCompressedSize(buf + 24, n - 24);
+    assert_false(ZSTD_isError(h1));
+    unsigned long long hsize = ZSTD_getFrameContentSize(buf + 24, h1);
+    unsigned char *header = malloc(hsize);
+    assert_int_equal(ZSTD_decompress(header, hsize, buf + 24, h1), hsize);
+    const size_t fixed = 7, words = 21, nc = 2;
+    assert_int_equal(hsize, 8 * (fixed + words * nc));
+    unsigned char *old = malloc(hsize);
+    memcpy(old, header, 8 * fixed);
+    for (size_t c = 0; c < nc; c++)
+        memcpy(old + 8 * (fixed + 20 * c), header + 8 * (fixed + words * c), 8 * 20);
+    size_t old_size = 8 * (fixed + 20 * nc);
+    ZSTD_CCtx *cctx = ZSTD_createCCtx();
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
+    size_t cap = ZSTD_compressBound(old_size);
+    unsigned char *out = malloc(24 + cap + (n - 24 - h1));
+    size_t h0 = ZSTD_compress2(cctx, out + 24, cap, old, old_size);
+    assert_false(ZSTD_isError(h0));
+    ZSTD_freeCCtx(cctx);
+    memcpy(out, buf, 24);
+    memcpy(out + 24 + h0, buf + 24 + h1, n - 24 - h1);
+    size_t total = 24 + h0 + (n - 24 - h1);
+    out[8] = 1; /* version */
+    for (int i = 0; i < 8; i++)
+        out[16 + i] = (unsigned char)((uint64_t)total >> (8 * i));
+    char v1[160];
+    snprintf(v1, sizeof v1, "%s/v1.thzpm", f->dir);
+    spit(v1, out, total);
+
+    photon_map *maps[2] = {NULL, NULL};
+    photon_stats stats[2];
+    thz_error err;
+    assert_int_equal(photon_map_file_read(v1, f->scene, 1, maps, stats, NULL, &err), THZ_OK);
+    for (size_t c = 0; c < 2; c++) {
+        assert_int_equal(photon_map_count(maps[c]), photon_map_count(f->maps[c]));
+        assert_true(photon_map_reference_temperature_k(maps[c]) == 0.0);
+        assert_true(stats[c].reference_temperature_k == 0.0);
+        assert_true(stats[c].fired_power_w_per_hz == f->stats[c].fired_power_w_per_hz);
+        photon_map_destroy(maps[c]);
+    }
+    /* Another version number is refused. */
+    out[8] = 9;
+    spit(v1, out, total);
+    expect_refusal(v1, f->scene, THZ_ERR_INPUT, "format version 9");
+    free(buf);
+    free(header);
+    free(old);
+    free(out);
 }
 
 /* Reads `path` expecting failure with `status` and a message holding `what` and path. */
@@ -228,6 +296,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_round_trip, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_version_1, setup, teardown),
         cmocka_unit_test_setup_teardown(test_corrupted, setup, teardown),
         cmocka_unit_test_setup_teardown(test_truncated, setup, teardown),
         cmocka_unit_test_setup_teardown(test_mismatched_scene, setup, teardown),
