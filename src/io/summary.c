@@ -66,6 +66,7 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
         sum_set(o, "photons_fired", sum_u64(s->fired), ok);
         sum_set(o, "photons_stored", sum_u64(s->stored), ok);
         sum_set(o, "emitted_power_w_per_hz", sum_real(s->emitted_power_w_per_hz), ok);
+        sum_set(o, "photon_reference_temperature_k", sum_real(s->reference_temperature_k), ok);
         sum_set(o, "fraction_absorbed", json_real(sum_ratio(s->absorbed, s->fired)), ok);
         sum_set(o, "fraction_escaped", json_real(sum_ratio(s->escaped, s->fired)), ok);
         sum_set(o, "fraction_terminated", json_real(sum_ratio(s->terminated, s->fired)), ok);
@@ -83,7 +84,9 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
         sum_set(o, "counts", counts, ok);
         /* Exact bookkeeping: fired = absorbed + escaped + atmosphere + terminated (the
          * low-power roulette's net removal). relative_difference compares that total
-         * with the band-mean P_A: Monte Carlo noise of the fired power only (or a bug). */
+         * with the band-mean P_A: Monte Carlo noise of the fired power only (or a bug).
+         * A deviation map (T0 > 0) fires the signed sources of L - B(T0), not P_A: its
+         * sums balance as well, but relative_difference is null. */
         json_t *e = json_object();
         double out = s->absorbed_power_w_per_hz + s->escaped_power_w_per_hz +
                      s->atmosphere_power_w_per_hz + s->terminated_power_w_per_hz;
@@ -94,7 +97,7 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
         sum_set(e, "atmosphere_w_per_hz", sum_real(s->atmosphere_power_w_per_hz), ok);
         sum_set(e, "terminated_w_per_hz", sum_real(s->terminated_power_w_per_hz), ok);
         sum_set(e, "relative_difference",
-                s->emitted_power_w_per_hz > 0.0
+                s->emitted_power_w_per_hz > 0.0 && !(s->reference_temperature_k > 0.0)
                     ? sum_real((s->emitted_power_w_per_hz - out) / s->emitted_power_w_per_hz)
                     : json_null(),
                 ok);
