@@ -511,7 +511,13 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_resu
     for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
         photon_map *map = NULL;
         if (photons) {
+            /* final-gather fires the deviation map of L - B(T0) (photon_map.h), T0 the
+             * renderer's control-variate temperature; photon-map keeps the paper's map. */
             photon_phase_options po = {.threads = opt->threads,
+                                       .reference_temperature_k =
+                                           scene->render.integrator == INTEGRATOR_FINAL_GATHER
+                                               ? render_reference_temperature_k(scene, c)
+                                               : 0.0,
                                        .progress = opt->progress,
                                        .progress_user = opt->progress_user};
             double t0 = run_now_s();
