@@ -1,0 +1,512 @@
+/* Deviation photon maps (phase.h, photon_map.h "Reference temperature"): with T0 > 0
+ * the photon phase fires the map of L - B_nu(T0), whose sources are signed.
+ *
+ * - T0 = 0 reproduces the paper's map bit for bit: checksums of records and statistics
+ *   of three scenes (closed with a non-emitting atmosphere, open with an emitting one
+ *   with and without extent) stored from the code before deviation maps existed.
+ * - Furnace: a closed isothermal enclosure at T = T0 (solids, shells of both modes,
+ *   an absorbing atmosphere at T0) fires no power.
+ * - Fired power = the analytic band power of the deviation sources, for T0 between and
+ *   outside the object temperatures, with an explicit-emissivity shell (two sources of
+ *   different angular law) and a non-emitting absorbing atmosphere (air at 0 K: the air
+ *   fires -4 pi alpha B(T0) per volume). Tolerances: 5 standard errors of the mean
+ *   photon power, estimated from the photons themselves; a sign or factor-2 error is
+ *   far beyond them.
+ * - Determinism across 1 and 2 threads with T0 > 0; the energy balance closes exactly.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include <cmocka.h>
+
+#include "accel/accel.h"
+#include "physics/channel.h"
+#include "physics/planck.h"
+#include "photon/phase.h"
+#include "photon_scenes.h"
+
+/* The box scene plus explicit-emissivity objects (a solid with eps 0.5 < 1 - R and a
+ * shell with eps 0.3) and a solid whose reflectivity varies over the band. Without the
+ * room (room = false) the scene is open. */
+static thz_scene *mixed_scene(uint64_t photons, uint64_t seed, bool room, double atm_per_m)
+{
+    thz_scene *s = ps_box_scene(photons, seed, atm_per_m);
+    if (!room) { /* object 0 is the room: shrink it to a 2 mm speck at the origin */
+        thz_mesh *m = &s->objects[0].mesh;
+        for (size_t i = 0; i < 3 * m->n_vertices; i++)
+            m->positions[i] *= 1e-3f;
+    }
+    size_t grey = ps_material(s, 0.2, 0.0, 0.5, TRANSMISSION_DIFFUSE);
+    size_t veil = ps_material(s, 0.1, 50.0, 0.3, TRANSMISSION_DIFFUSE);
+    size_t tile = ps_material(s, 0.1, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    double f[3] = {0.30e12, 0.35e12, 0.40e12}, r[3] = {0.1, 0.4, 0.2};
+    ps_check(spectrum_set_table(&s->materials[tile].reflectivity, 3, f, r));
+    size_t a = ps_object(s, OBJECT_SOLID, grey, 305, 0, true);
+    ps_face(s, a, v3(-0.6, -0.6, 1.5), v3(0.2, 0, 0), v3(0, 0.2, 0));
+    size_t b = ps_object(s, OBJECT_SHELL, veil, 285, 1e-3, true);
+    ps_face(s, b, v3(0.6, 0.6, 1.0), v3(0.2, 0, 0), v3(0, 0, 0.2));
+    size_t c = ps_object(s, OBJECT_SOLID, tile, 315, 0, false);
+    ps_face(s, c, v3(-0.6, 0.0, 1.0), v3(0, 0.2, 0), v3(0, 0, 0.2));
+    ps_finalize(s);
+    return s;
+}
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *c = p;
+    for (size_t i = 0; i < n; i++) {
+        h ^= c[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+/* Checksum of the records and of every reproducible statistic. */
+static uint64_t map_checksum(const photon_map *map, const photon_stats *st)
+{
+    uint64_t h = fnv(1469598103934665603ull, photon_map_records(map),
+                     photon_map_count(map) * sizeof(photon_record));
+    uint64_t u[] = {st->fired,       st->stored,        st->hits,    st->reflected,
+                    st->transmitted, st->absorbed,      st->escaped, st->back_face_hits,
+                    st->terminated,  st->bounce_capped, st->rays};
+    double d[] = {st->emitted_power_w_per_hz,
+                  st->absorbed_power_w_per_hz,
+                  st->escaped_power_w_per_hz,
+                  st->atmosphere_power_w_per_hz,
+                  st->mean_bounces,
+                  st->fired_power_w_per_hz,
+                  st->terminated_power_w_per_hz};
+    h = fnv(h, u, sizeof u);
+    return fnv(h, d, sizeof d);
+}
+
+static void fire(const thz_scene *s, double t0_k, int threads, photon_map **map, photon_stats *st)
+{
+    accel *acc;
+    thz_error err;
+    if (accel_create(s, &acc, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    photon_phase_options opt = {.threads = threads, .reference_temperature_k = t0_k};
+    thz_status status = photon_phase_run(s, acc, 0, &opt, map, st, &err);
+    accel_destroy(acc);
+    if (status != THZ_OK)
+        fail_msg("%s", err.message);
+}
+
+/* The three scenes of the checksums. */
+static thz_scene *checksum_scene(int which)
+{
+    thz_error err;
+    if (which == 0)
+        return mixed_scene(20000, 42, true, 0.3);
+    thz_scene *s = mixed_scene(20000, 43 + (uint64_t)which, false, 0.1);
+    ps_check(atmosphere_set_emitting(&s->atmosphere, 290, 50, &err) == THZ_OK);
+    if (which == 1) {
+        double lo[3] = {-1.5, -1.5, -0.5}, hi[3] = {1.5, 1.5, 3.0};
+        ps_check(atmosphere_set_extent(&s->atmosphere, lo, hi, &err) == THZ_OK);
+    }
+    return s;
+}
+
+/* Stored from the code before deviation maps (commit 04bc2fc), Release and Debug +
+ * sanitizer builds alike (x86-64, glibc). */
+static const uint64_t t0_zero_checksums[3] = {0xf563a42e712e2834ull, 0x12d94feab98eac81ull,
+                                              0x8c4e906e43371393ull};
+
+static void test_t0_zero_checksums(void **state)
+{
+    (void)state;
+    for (int w = 0; w < 3; w++) {
+        thz_scene *s = checksum_scene(w);
+        photon_map *map;
+        photon_stats st;
+        fire(s, 0.0, 2, &map, &st);
+        uint64_t h = map_checksum(map, &st);
+        printf("# scene %d: %zu records, checksum 0x%016llx (expected 0x%016llx)\n", w,
+               photon_map_count(map), (unsigned long long)h,
+               (unsigned long long)t0_zero_checksums[w]);
+        assert_true(h == t0_zero_checksums[w]);
+        assert_true(photon_map_reference_temperature_k(map) == 0.0);
+        assert_true(st.reference_temperature_k == 0.0);
+        photon_map_destroy(map);
+        scene_destroy(s);
+    }
+}
+
+static double planck_at(double freq_hz, void *t_k)
+{
+    return planck_radiance(freq_hz, *(const double *)t_k);
+}
+
+/* Band mean of B_nu(T) over channel 0. */
+static double band_b(const thz_scene *s, double t_k)
+{
+    return channel_band_mean(&s->channels[0], planck_at, &t_k);
+}
+
+/* Moments of the photons' initial powers, from the first-hit records (bounce 0) of a
+ * scene without atmosphere where every photon hits something: n photons in all (those
+ * of power 0 count as 0). */
+typedef struct power_moments {
+    double sum, sum2, sum_abs;
+    size_t n_neg, n_pos;
+} power_moments;
+
+static power_moments first_hits(const photon_map *map)
+{
+    power_moments m = {0};
+    const photon_record *r = photon_map_records(map);
+    for (size_t i = 0; i < photon_map_count(map); i++) {
+        if ((r[i].flags & 0xffffu) != 0)
+            continue;
+        double p = r[i].power_w_per_hz;
+        m.sum += p;
+        m.sum2 += p * p;
+        m.sum_abs += fabs(p);
+        m.n_neg += p < 0.0;
+        m.n_pos += p > 0.0;
+    }
+    return m;
+}
+
+/* 5 standard errors of a sum of n photon powers with these moments. */
+static double five_sigma(const power_moments *m, uint64_t n)
+{
+    double mean = m->sum / (double)n;
+    double var = m->sum2 / (double)n - mean * mean;
+    return 5.0 * sqrt(fmax(var, 0.0) * (double)n);
+}
+
+static void assert_balance(const photon_stats *st, double scale)
+{
+    double out = st->absorbed_power_w_per_hz + st->escaped_power_w_per_hz +
+                 st->atmosphere_power_w_per_hz + st->terminated_power_w_per_hz;
+    assert_true(fabs(out - st->fired_power_w_per_hz) <= 1e-9 * scale);
+    assert_int_equal(st->fired, st->absorbed + st->escaped + st->terminated);
+    assert_int_equal(st->hits, st->reflected + st->transmitted + st->absorbed);
+}
+
+/* A closed room (inward, one-sided, R = 0.3) at T with a solid cube, a diffuse and a
+ * straight Kirchhoff shell, a two-sided plate with frequency-dependent R, all at T. */
+static thz_scene *furnace_scene(uint64_t photons, double t_k)
+{
+    thz_scene *s = ps_scene(0.35, 0.05, photons, 3);
+    size_t wall = ps_material(s, 0.3, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t paint = ps_material(s, 0.1, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t cloth = ps_material(s, 0.05, 200.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t film = ps_material(s, 0.1, 100.0, -1.0, TRANSMISSION_STRAIGHT);
+    size_t tile = ps_material(s, 0.1, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    double f[3] = {0.30e12, 0.35e12, 0.40e12}, r[3] = {0.1, 0.4, 0.2};
+    ps_check(spectrum_set_table(&s->materials[tile].reflectivity, 3, f, r));
+    size_t room = ps_object(s, OBJECT_SOLID, wall, t_k, 0, false);
+    ps_box(s, room, v3(-1, -1, 0), v3(1, 1, 2.5), true);
+    size_t cube = ps_object(s, OBJECT_SOLID, paint, t_k, 0, false);
+    ps_box(s, cube, v3(-0.3, -0.3, 0.05), v3(0.3, 0.3, 0.6), false);
+    size_t shell = ps_object(s, OBJECT_SHELL, cloth, t_k, 1e-3, true);
+    ps_box(s, shell, v3(-0.4, -0.4, 0.02), v3(0.4, 0.4, 0.8), false);
+    size_t straight = ps_object(s, OBJECT_SHELL, film, t_k, 2e-3, true);
+    ps_face(s, straight, v3(0, 0.8, 1.2), v3(0.5, 0, 0), v3(0, 0, 0.5));
+    size_t plate = ps_object(s, OBJECT_SOLID, tile, t_k, 0, true);
+    ps_face(s, plate, v3(0.6, -0.6, 1.8), v3(0.2, 0, 0), v3(0, 0.2, 0));
+    ps_finalize(s);
+    return s;
+}
+
+/* Isothermal furnace at T = T0: no source anywhere, so no photon carries power; with an
+ * absorbing atmosphere emitting at T too, and (closed scene) without atmosphere, where
+ * the boundary's -B0 is hidden. The physical P_A is still reported. */
+static void test_furnace(void **state)
+{
+    (void)state;
+    thz_error err;
+    for (int atm = 0; atm < 2; atm++) {
+        thz_scene *s = furnace_scene(20000, 300.0);
+        if (atm) {
+            s->atmosphere.model = ATM_CONSTANT;
+            ps_check(spectrum_set_constant(&s->atmosphere.attenuation_per_m, 0.2));
+            ps_check(atmosphere_set_emitting(&s->atmosphere, 300.0, 300.0, &err) == THZ_OK);
+        }
+        photon_map *map;
+        photon_stats st;
+        fire(s, 300.0, 2, &map, &st);
+        printf("# furnace%s: %zu records, fired %.3e W/Hz (P_A %.3e W/Hz)\n",
+               atm ? " with air" : "", photon_map_count(map), st.fired_power_w_per_hz,
+               st.emitted_power_w_per_hz);
+        assert_int_equal(st.fired, s->photons.per_channel);
+        assert_int_equal(photon_map_count(map), 0);
+        assert_true(st.fired_power_w_per_hz == 0.0);
+        assert_true(st.absorbed_power_w_per_hz == 0.0 && st.escaped_power_w_per_hz == 0.0);
+        assert_true(st.emitted_power_w_per_hz > 0.0);
+        assert_true(st.reference_temperature_k == 300.0);
+        assert_true(photon_map_reference_temperature_k(map) == 300.0);
+        photon_map_destroy(map);
+        scene_destroy(s);
+    }
+}
+
+/* A closed room of grey Kirchhoff solids: the room (inward, one-sided, R = 0.3, 295 K),
+ * a two-sided plate (R = 0.2, 320 K), a one-sided plate (R = 0.1, 280 K) and a cold
+ * two-sided plate (R = 0.5, 0 K). */
+static thz_scene *grey_room(uint64_t photons)
+{
+    thz_scene *s = ps_scene(0.35, 0.1, photons, 11);
+    size_t wall = ps_material(s, 0.3, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t a = ps_material(s, 0.2, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t b = ps_material(s, 0.1, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t c = ps_material(s, 0.5, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t room = ps_object(s, OBJECT_SOLID, wall, 295, 0, false);
+    ps_box(s, room, v3(-1, -1, 0), v3(1, 1, 2.5), true);
+    size_t p1 = ps_object(s, OBJECT_SOLID, a, 320, 0, true);
+    ps_face(s, p1, v3(0, 0, 1.0), v3(0.4, 0, 0), v3(0, 0.3, 0)); /* 0.48 m2 */
+    size_t p2 = ps_object(s, OBJECT_SOLID, b, 280, 0, false);
+    ps_face(s, p2, v3(0.5, 0.5, 2.0), v3(0.3, 0, 0), v3(0, 0.3, 0)); /* 0.36 m2 */
+    size_t p3 = ps_object(s, OBJECT_SOLID, c, 0, 0, true);
+    ps_face(s, p3, v3(-0.5, -0.5, 1.5), v3(0.2, 0, 0), v3(0, 0, 0.2)); /* 0.16 m2 */
+    ps_finalize(s);
+    return s;
+}
+
+/* Fired power = sum over objects of pi area sides (1 - R) (Bbar(T) - Bbar(T0)) for T0
+ * below, between and above the temperatures (signs mixed or not), within 5 standard
+ * errors; the balance closes; photons of both signs where expected. */
+static void test_fired_power(void **state)
+{
+    (void)state;
+    const double t0s[] = {250.0, 295.0, 300.0, 350.0};
+    uint64_t k = ps_scaled(200000);
+    for (size_t i = 0; i < sizeof t0s / sizeof t0s[0]; i++) {
+        double t0 = t0s[i];
+        thz_scene *s = grey_room(k);
+        double expected = 0.0;
+        const double r[4] = {0.3, 0.2, 0.1, 0.5}, sides[4] = {1, 2, 1, 2};
+        for (size_t o = 0; o < 4; o++)
+            expected += M_PI * s->objects[o].mesh.total_area_m2 * sides[o] * (1.0 - r[o]) *
+                        (band_b(s, s->objects[o].temperature_k) - band_b(s, t0));
+        photon_map *map;
+        photon_stats st;
+        fire(s, t0, 2, &map, &st);
+        power_moments m = first_hits(map);
+        double tol = five_sigma(&m, k);
+        printf("# T0 = %.0f K: fired %.6e W/Hz, expected %.6e (tolerance %.2e); %zu negative "
+               "and %zu positive photons; P_A %.6e\n",
+               t0, st.fired_power_w_per_hz, expected, tol, m.n_neg, m.n_pos,
+               st.emitted_power_w_per_hz);
+        assert_int_equal(m.n_neg + m.n_pos, k); /* a closed room: every photon hits */
+        assert_true(fabs(m.sum - st.fired_power_w_per_hz) <= 1e-6 * m.sum_abs); /* floats */
+        assert_true(fabs(st.fired_power_w_per_hz - expected) <= tol);
+        assert_true(tol < 0.05 * fabs(expected)); /* a factor 2 or a sign would fail */
+        assert_balance(&st, m.sum_abs);
+        assert_true(m.n_neg > 0); /* the 0 K plate (and the rest when T0 = 350 K) */
+        if (t0 < 280.0)
+            assert_true(m.n_pos > m.n_neg);
+        if (t0 > 320.0)
+            assert_int_equal(m.n_pos, 0);
+        if (t0 > 280.0 && t0 < 320.0)
+            assert_true(m.n_pos > 0);
+        photon_map_destroy(map);
+        scene_destroy(s);
+    }
+}
+
+/* 2 int_0^1 A(mu) mu dmu and 2 int_0^1 A(mu) mu^2 dmu of a shell (Simpson), A = 1 - R -
+ * min(exp(-tau / mu), 1 - R). */
+static void shell_absorption(double r, double tau, double *abar, double *mu_moment)
+{
+    const int n = 20000;
+    double h = 1.0 / n, s1 = 0.0, s2 = 0.0;
+    for (int i = 1; i <= n; i++) {
+        double mu = i * h;
+        double w = i == n ? 1 : (i % 2 ? 4 : 2);
+        double a = 1.0 - r - fmin(exp(-tau / mu), 1.0 - r);
+        s1 += w * a * mu;
+        s2 += w * a * mu * mu;
+    }
+    *abar = 2.0 * s1 * h / 3.0;
+    *mu_moment = 2.0 * s2 * h / 3.0;
+}
+
+/* An explicit-emissivity shell (eps 0.3, R 0.1, alpha_M t = 0.05) in a closed room at
+ * T0 (Kirchhoff: no source): two sources, eps B(T) with cosine directions and -A(mu) B0
+ * with mu ~ A(mu) mu. Their powers and angular laws, from the first-hit records. */
+static void test_explicit_shell(void **state)
+{
+    (void)state;
+    const double t0 = 300.0, r = 0.1, eps = 0.3, alpha = 50.0, t_m = 1e-3;
+    const double temps[] = {300.0, 330.0};
+    uint64_t k = ps_scaled(200000);
+    double abar, mu2;
+    shell_absorption(r, alpha * t_m, &abar, &mu2);
+    for (size_t i = 0; i < 2; i++) {
+        thz_scene *s = ps_scene(0.35, 0.1, k, 17);
+        size_t wall = ps_material(s, 0.3, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+        size_t veil = ps_material(s, r, alpha, eps, TRANSMISSION_DIFFUSE);
+        size_t room = ps_object(s, OBJECT_SOLID, wall, t0, 0, false);
+        ps_box(s, room, v3(-1, -1, 0), v3(1, 1, 2.5), true);
+        size_t shell = ps_object(s, OBJECT_SHELL, veil, temps[i], t_m, true);
+        ps_face(s, shell, v3(0, 0, 1.2), v3(0.4, 0, 0), v3(0, 0.4, 0)); /* normal +z */
+        ps_finalize(s);
+        double area = s->objects[shell].mesh.total_area_m2;
+        double p_eps = M_PI * area * 2.0 * eps * band_b(s, temps[i]);
+        double p_abs = -M_PI * area * 2.0 * abar * band_b(s, t0);
+        photon_map *map;
+        photon_stats st;
+        fire(s, t0, 1, &map, &st);
+        /* Each sign separately: sums and mean mu = |dir_z| of the first hits. */
+        double sum[2] = {0, 0}, sum2[2] = {0, 0}, mu[2] = {0, 0}, mu_sq[2] = {0, 0};
+        size_t n[2] = {0, 0};
+        const photon_record *rec = photon_map_records(map);
+        for (size_t j = 0; j < photon_map_count(map); j++) {
+            if ((rec[j].flags & 0xffffu) != 0)
+                continue;
+            int neg = rec[j].power_w_per_hz < 0.0f;
+            double p = rec[j].power_w_per_hz;
+            double z = fabs(photon_decode_direction(rec[j].dir_oct).z);
+            sum[neg] += p;
+            sum2[neg] += p * p;
+            mu[neg] += z;
+            mu_sq[neg] += z * z;
+            n[neg]++;
+        }
+        assert_int_equal(n[0] + n[1], k);
+        const double expect_sum[2] = {p_eps, p_abs};
+        const double expect_mu[2] = {2.0 / 3.0, mu2 / abar}; /* cosine; A(mu) mu */
+        for (int g = 0; g < 2; g++) {
+            double mean = sum[g] / (double)k;
+            double tol = 5.0 * sqrt(fmax(sum2[g] / (double)k - mean * mean, 0.0) * (double)k);
+            double m = mu[g] / (double)n[g];
+            double tol_mu = 5.0 * sqrt((mu_sq[g] / (double)n[g] - m * m) / (double)n[g]);
+            printf("# T = %.0f K, %s part: %zu photons, power %.6e W/Hz expected %.6e (tol "
+                   "%.1e); mean mu %.4f expected %.4f (tol %.4f)\n",
+                   temps[i], g ? "-A B0" : "eps B(T)", n[g], sum[g], expect_sum[g], tol, m,
+                   expect_mu[g], tol_mu);
+            assert_true(fabs(sum[g] - expect_sum[g]) <= tol);
+            assert_true(tol < 0.1 * fabs(expect_sum[g])); /* the -A B0 part: 5 % of photons */
+            assert_true(fabs(m - expect_mu[g]) <= tol_mu);
+        }
+        /* The two laws differ by far more than the tolerance: the split is tested. */
+        assert_true(fabs(expect_mu[0] - expect_mu[1]) > 0.05);
+        assert_true(fabs(st.fired_power_w_per_hz - (p_eps + p_abs)) <=
+                    5.0 * sqrt(sum2[0] + sum2[1]));
+        assert_balance(&st, fabs(sum[0]) + fabs(sum[1]));
+        photon_map_destroy(map);
+        scene_destroy(s);
+    }
+}
+
+/* Air in a closed room at T0 (Kirchhoff walls: no surface source), in an extent 1 cm
+ * inside the walls (so that its boundary is hidden and every air photon is kept): a
+ * non-emitting absorbing atmosphere is air at 0 K and fires 4 pi alpha (0 - Bbar(T0)) V;
+ * an emitting one at 280 K fires 4 pi alpha (Bbar(280) - Bbar(T0)) V. The photons'
+ * powers differ only by the frequency histogram's interpolation (below 1e-3). */
+static void test_absorbing_air(void **state)
+{
+    (void)state;
+    const double t0 = 300.0, alpha = 0.2;
+    uint64_t k = ps_scaled(200000);
+    thz_error err;
+    for (int emitting = 0; emitting < 2; emitting++) {
+        thz_scene *s = ps_scene(0.35, 0.1, k, 23);
+        size_t wall = ps_material(s, 0.3, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+        size_t room = ps_object(s, OBJECT_SOLID, wall, t0, 0, false);
+        ps_box(s, room, v3(-1, -1, 0), v3(1, 1, 2.5), true);
+        ps_finalize(s);
+        s->atmosphere.model = ATM_CONSTANT;
+        ps_check(spectrum_set_constant(&s->atmosphere.attenuation_per_m, alpha));
+        if (emitting)
+            ps_check(atmosphere_set_emitting(&s->atmosphere, 280.0, 0.0, &err) == THZ_OK);
+        double lo[3] = {-0.99, -0.99, 0.01}, hi[3] = {0.99, 0.99, 2.49};
+        ps_check(atmosphere_set_extent(&s->atmosphere, lo, hi, &err) == THZ_OK);
+        double v = 1.98 * 1.98 * 2.48;
+        double expected =
+            4.0 * M_PI * alpha * v * ((emitting ? band_b(s, 280.0) : 0.0) - band_b(s, t0));
+        photon_map *map;
+        photon_stats st;
+        fire(s, t0, 2, &map, &st);
+        double tol = 1e-3 * fabs(expected);
+        printf("# %s air: fired %.6e W/Hz, expected %.6e (tolerance %.2e); P_A %.3e\n",
+               emitting ? "emitting" : "absorbing", st.fired_power_w_per_hz, expected, tol,
+               st.emitted_power_w_per_hz);
+        assert_true(fabs(st.fired_power_w_per_hz - expected) <= tol);
+        assert_true(tol < 0.05 * fabs(expected));
+        assert_true(st.atmosphere_power_w_per_hz < 0.0); /* negative photons, absorbed */
+        assert_balance(&st, fabs(expected));
+        /* Physical P_A: nothing for the non-emitting air, the air's own for the other. */
+        if (!emitting)
+            assert_true(st.emitted_power_w_per_hz > 0.0); /* the walls */
+        photon_map_destroy(map);
+        scene_destroy(s);
+    }
+}
+
+/* An open scene without atmosphere: the boundary (the widened bounding box, all open)
+ * fires -B0 inwards, pi A_box Bbar(T0) in all; the plate at T0 fires nothing. */
+static void test_open_boundary(void **state)
+{
+    (void)state;
+    const double t0 = 290.0;
+    uint64_t k = ps_scaled(100000);
+    thz_scene *s = ps_scene(0.35, 0.1, k, 29);
+    size_t grey = ps_material(s, 0.2, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t plate = ps_object(s, OBJECT_SOLID, grey, t0, 0, true);
+    ps_face(s, plate, v3(0, 0, 0), v3(0.2, 0, 0), v3(0, 0.2, 0));
+    ps_finalize(s);
+    double d = sqrt(0.4 * 0.4 + 0.4 * 0.4), w = 0.02 * d;
+    double ax = 0.4 + w, az = w;
+    double area = 2.0 * (ax * ax + 2.0 * ax * az);
+    double expected = -M_PI * area * band_b(s, t0);
+    photon_map *map;
+    photon_stats st;
+    fire(s, t0, 2, &map, &st);
+    double phi = expected / (double)k; /* every photon carries about this */
+    printf("# open boundary: fired %.6e W/Hz, expected %.6e; %zu records\n",
+           st.fired_power_w_per_hz, expected, photon_map_count(map));
+    assert_true(fabs(st.fired_power_w_per_hz - expected) <= 1e-3 * fabs(expected));
+    assert_true(photon_map_count(map) > 0);
+    const photon_record *rec = photon_map_records(map);
+    for (size_t j = 0; j < photon_map_count(map); j++)
+        assert_true(rec[j].power_w_per_hz < 0.0f && rec[j].power_w_per_hz > 2.0 * phi);
+    assert_balance(&st, fabs(expected));
+    assert_true(st.escaped_power_w_per_hz < 0.0);
+    photon_map_destroy(map);
+    scene_destroy(s);
+}
+
+/* T0 > 0: the map and statistics are byte-identical for 1 and 2 threads (every source
+ * class: surfaces of every kind, an emitting atmosphere and an open boundary). */
+static void test_threads_identical(void **state)
+{
+    (void)state;
+    thz_scene *s = checksum_scene(2);
+    s->photons.per_channel = PHASE_BATCH + 5000;
+    photon_map *m1, *m2;
+    photon_stats s1, s2;
+    fire(s, 300.0, 1, &m1, &s1);
+    fire(s, 300.0, 2, &m2, &s2);
+    assert_int_equal(photon_map_count(m1), photon_map_count(m2));
+    assert_memory_equal(photon_map_records(m1), photon_map_records(m2),
+                        photon_map_count(m1) * sizeof(photon_record));
+    assert_true(map_checksum(m1, &s1) == map_checksum(m2, &s2));
+    size_t neg = 0;
+    const photon_record *r = photon_map_records(m1);
+    for (size_t i = 0; i < photon_map_count(m1); i++)
+        neg += r[i].power_w_per_hz < 0.0f;
+    printf("# %zu records, %zu negative\n", photon_map_count(m1), neg);
+    assert_true(neg > 0 && neg < photon_map_count(m1));
+    photon_map_destroy(m1);
+    photon_map_destroy(m2);
+    scene_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_t0_zero_checksums), cmocka_unit_test(test_furnace),
+        cmocka_unit_test(test_fired_power),       cmocka_unit_test(test_explicit_shell),
+        cmocka_unit_test(test_absorbing_air),     cmocka_unit_test(test_open_boundary),
+        cmocka_unit_test(test_threads_identical),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
