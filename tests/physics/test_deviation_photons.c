@@ -383,7 +383,8 @@ static void test_explicit_shell(void **state)
                    temps[i], g ? "-A B0" : "eps B(T)", n[g], sum[g], expect_sum[g], tol, m,
                    expect_mu[g], tol_mu);
             assert_true(fabs(sum[g] - expect_sum[g]) <= tol);
-            assert_true(tol < 0.1 * fabs(expect_sum[g])); /* the -A B0 part: 5 % of photons */
+            /* a sign or factor 2 still fails (the -A B0 part has 5 % of the photons) */
+            assert_true(tol < 0.25 * fabs(expect_sum[g]));
             assert_true(fabs(m - expect_mu[g]) <= tol_mu);
         }
         /* The two laws differ by far more than the tolerance: the split is tested. */
