@@ -22,7 +22,8 @@
 #define PMF_CHANNEL_WORDS 21u    /* centre, width, count, 10 counters, 7 reals, T0 */
 #define PMF_CHANNEL_WORDS_V1 20u /* version 1 had no T0 (its maps have T0 = 0) */
 #define PMF_LEVEL 3
-#define PMF_FLAGS_STORED 0xffffu /* the bounce count */
+#define PMF_FLAGS_STORED                                                                           \
+    (0xffffu | (PHOTON_MAP_BATCHES - 1u) << PHOTON_BATCH_SHIFT) /* bounces, batch */
 #define PMF_MAX_HEADER_BYTES (16u << 20)
 
 /* ---- little-endian words ---------------------------------------------------- */
@@ -579,6 +580,8 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
             goto cleanup;
         }
         photon_map_set_reference_temperature_k(maps[c], version == 1u ? 0.0 : get_f64(p + 160));
+        /* version 1 stored no batches (its flags' upper bits are 0) */
+        photon_map_set_batches(maps[c], version == 1u ? 1u : PHOTON_MAP_BATCHES);
     }
     if (info) {
         info->n_channels = nc;

@@ -378,6 +378,7 @@ bool air_emission_sample(const air_emission *a, const emission_table *t, rng_str
 {
     if (!a || !a->active)
         return emission_sample(t, rng, scratch, out);
+    out->batch = 0;
     double u = rng_uniform(rng);
     if (u < a->p_air || u < a->p_air + a->p_boundary) {
         out->object = ACCEL_NO_OBJECT;

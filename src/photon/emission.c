@@ -338,6 +338,7 @@ bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
                      emission_photon *out)
 {
     (void)scratch;
+    out->batch = 0;
     const thz_channel *ch = &t->scene->channels[t->channel];
     double u1 = rng_uniform(rng), u2 = rng_uniform(rng);
     double nu = channel_sample_hz(ch, u1, u2);

@@ -124,7 +124,8 @@ typedef struct emission_photon {
     vec3 dir;              /* unit, into the emitting side's hemisphere */
     uint32_t object;
     uint32_t triangle;
-    int side; /* 0 front, 1 back */
+    int side;       /* 0 front, 1 back */
+    uint32_t batch; /* photon_map.h: set by the phase (photon index mod batches) */
 } emission_photon;
 
 /* Prepares channel `channel`'s sources for K = n_photons photons of the map of

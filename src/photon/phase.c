@@ -81,6 +81,7 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                     emission_photon e;
                     if (!air_emission_sample(a->air, a->table, &rng, scr, &e))
                         e.power_w_per_hz = 0.0;
+                    e.batch = (uint32_t)(i % PHOTON_MAP_BATCHES);
                     if (!trace_photon(a->scene, a->acc, &e, &rng, b, &ch->counters)) {
 #pragma omp atomic write
                         failed = 1;
@@ -229,6 +230,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     if (st != THZ_OK)
         return st;
     photon_map_set_reference_temperature_k(*out_map, t0_k);
+    photon_map_set_batches(*out_map, PHOTON_MAP_BATCHES);
     double t3 = omp_get_wtime();
 
     if (stats) {

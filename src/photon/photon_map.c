@@ -113,6 +113,7 @@ struct photon_map {
     size_t *start;      /* n_groups + 1 offsets */
     photon_cube *cubes; /* n_groups */
     double t0_k;        /* reference temperature: 0 for the paper's map */
+    unsigned batches;   /* PHOTON_MAP_BATCHES, or 1: records without their batch */
 };
 
 static uint32_t photon_quantize_axis(const photon_cube *c, const photon_record *p, int a)
@@ -419,6 +420,16 @@ void photon_map_set_reference_temperature_k(photon_map *map, double t0_k)
     map->t0_k = t0_k;
 }
 
+unsigned photon_map_batches(const photon_map *map)
+{
+    return map && map->batches ? map->batches : 1u;
+}
+
+void photon_map_set_batches(photon_map *map, unsigned batches)
+{
+    map->batches = batches;
+}
+
 size_t photon_map_bytes(const photon_map *map)
 {
     if (!map)
@@ -570,6 +581,15 @@ static bool photon_group_range(const photon_map *map, uint32_t object, int side,
     *lo = map->start[g];
     *n = map->start[g + 1] - *lo;
     return *n > 0;
+}
+
+size_t photon_map_object_count(const photon_map *map, uint32_t object, unsigned side_mask)
+{
+    size_t total = 0, lo, n;
+    for (int s = 0; s < 2; s++)
+        if ((side_mask >> s & 1u) && photon_group_range(map, object, s, &lo, &n))
+            total += n;
+    return total;
 }
 
 static photon_cell photon_root(size_t lo, size_t n)

@@ -20,8 +20,21 @@ typedef struct photon_record {
     float freq_hz;        /* the photon's own frequency (float: 60 kHz resolution at 1 THz) */
     uint32_t dir_oct;     /* incoming unit direction, octahedral 2 x 16 bit */
     uint32_t object_side; /* object index << 1 | side (0 front, 1 back) */
-    uint32_t flags;       /* bounce count in the low 16 bits; reserved */
+    uint32_t flags;       /* bounce count in the low 16 bits; the batch in bits 24-26 */
 } photon_record;
+
+/* Photon batches: photon i of the phase (all records of its path) belongs to batch
+ * i mod PHOTON_MAP_BATCHES. The batches are independent, identically distributed maps of
+ * K / PHOTON_MAP_BATCHES photons each, so the spread between what each batch contributes
+ * to a pixel measures the photon map's own noise there (final-gather's standard error,
+ * docs/integrators.md). */
+#define PHOTON_MAP_BATCHES 8u
+#define PHOTON_BATCH_SHIFT 24
+
+static inline unsigned photon_batch(const photon_record *p)
+{
+    return (p->flags >> PHOTON_BATCH_SHIFT) & (PHOTON_MAP_BATCHES - 1u);
+}
 
 _Static_assert(sizeof(photon_record) == 32, "photon_record must stay 32 bytes");
 
@@ -56,6 +69,11 @@ size_t photon_map_count(const photon_map *map);
  * the renderer adds B_nu(T0) back. In a near-isothermal scene at T0 the sources, and so
  * the map's noise, are small. */
 double photon_map_reference_temperature_k(const photon_map *map);
+
+/* PHOTON_MAP_BATCHES when the records carry their batch (maps of this version's photon
+ * phase), 1 for maps without (photon_map_create's default; .thzpm version 1). */
+unsigned photon_map_batches(const photon_map *map);
+void photon_map_set_batches(photon_map *map, unsigned batches);
 void photon_map_set_reference_temperature_k(photon_map *map, double t0_k);
 
 /* Bytes the map holds: its records and its spatial index (the benchmark's bytes per
@@ -68,6 +86,10 @@ const photon_record *photon_map_records(const photon_map *map);
 typedef void (*photon_visit_fn)(void *ctx, const photon_record *p, double distance2_m2);
 void photon_map_radius(const photon_map *map, uint32_t object, int side, vec3 position_m,
                        double radius2_m2, photon_visit_fn visit, void *ctx);
+
+/* The number of photons of `object` over the sides in side_mask (bit 0 front, bit 1
+ * back). */
+size_t photon_map_object_count(const photon_map *map, uint32_t object, unsigned side_mask);
 
 /* The squared distance to the k-th nearest photon of `object` over the sides in
  * side_mask (bit 0 front, bit 1 back), or INFINITY if it has fewer than k. */

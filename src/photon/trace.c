@@ -141,7 +141,7 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
             .freq_hz = (float)nu,
             .dir_oct = photon_encode_direction(dir),
             .object_side = hit.object << 1 | (uint32_t)hit.side,
-            .flags = bounce < 0xffffu ? bounce : 0xffffu,
+            .flags = (bounce < 0xffffu ? bounce : 0xffffu) | e->batch << PHOTON_BATCH_SHIFT,
         };
         if (!trace_buffer_push(buf, &rec))
             return false;
