@@ -83,7 +83,8 @@ typedef struct render_path {
 
 /* Counters and the photon-map variance of one sample. */
 typedef struct render_sample {
-    double variance; /* photon-map: estimated variance of its radiance (Poisson) */
+    double variance;                  /* photon-map: estimated variance of its radiance (Poisson) */
+    double batch[PHOTON_MAP_BATCHES]; /* the photon terms of each batch (in the radiance) */
     unsigned escaped, back_face, widened, starved, truncated;
     uint64_t paths;
 } render_sample;
@@ -92,6 +93,8 @@ typedef struct render_sample {
 typedef struct render_target {
     double *est;
     uint32_t n_est;
+    double *batch;      /* final-gather with batches: += weight x each batch's photon terms */
+    double *poisson;    /* and += weight^2 x their Poisson variance; else NULL */
     double weight;      /* 1 / n^2 */
     uint64_t rng_index; /* first index of this sample's random streams (x n_est) */
 } render_target;
@@ -534,6 +537,7 @@ typedef struct render_gather_state {
     bool transmitted; /* photons of the other side of a diffuse shell: BTDF, not BRDF */
     size_t count;
     double sum, sum2; /* sum of photon terms f Phi w exp(-alpha d), and of their squares */
+    double batch[PHOTON_MAP_BATCHES]; /* sum per photon batch */
 } render_gather_state;
 
 static void render_gather_visit(void *vstate, const photon_record *p, double distance2_m2)
@@ -570,6 +574,7 @@ static void render_gather_visit(void *vstate, const photon_record *p, double dis
                render_scatter_weight(g->ctx, g->scatter, nu);
     g->sum += c;
     g->sum2 += c * c;
+    g->batch[photon_batch(p)] += c;
 }
 
 static void render_gather_pass(render_gather_state *g, uint32_t object, int seen_side,
@@ -577,6 +582,7 @@ static void render_gather_pass(render_gather_state *g, uint32_t object, int seen
 {
     g->count = 0;
     g->sum = g->sum2 = 0.0;
+    memset(g->batch, 0, sizeof g->batch);
     g->transmitted = false;
     if (!(g->radius2_m2 > 0.0))
         return;
@@ -621,7 +627,10 @@ static void render_gather(const render_context *ctx, const accel_hit *hit, const
             mask |= 1u << (1 - hit->side);
         double rk2 = photon_map_kth_distance2(ctx->map, hit->object, mask, hit->position_m, k);
         if (!isfinite(rk2) || !(rk2 > 0.0)) {
-            out->starved = 1;
+            /* A deviation map holds no photons where no deviation arrives (an object at
+             * T0 lit only by objects at T0): its estimate 0 is right, not starved. */
+            if (!ctx->deviation || photon_map_object_count(ctx->map, hit->object, mask) > 0)
+                out->starved = 1;
             return;
         }
         if (sample_sr > 0.0)
@@ -633,6 +642,8 @@ static void render_gather(const render_context *ctx, const accel_hit *hit, const
     double area = M_PI * g.radius2_m2;
     *radiance += g.sum / area;
     out->variance += g.sum2 / (area * area);
+    for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
+        out->batch[b] += g.batch[b] / area;
 }
 
 /* The photon-map radiance along a ray (physics.md "Rendering phase"): emission and the
@@ -736,7 +747,8 @@ static void render_add_all(const render_target *t, double v)
  * distance_m from the sensor): its estimate of the scattered radiance towards the sensor. */
 static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
                                 const thz_object *obj, bool diffuse_shell, const render_path *path,
-                                double distance_m, rng_stream *rng, render_sample *out)
+                                double distance_m, rng_stream *rng, render_sample *out,
+                                render_sample *sec)
 {
     const thz_material *mat = &ctx->scene->materials[obj->material];
     double nu_j = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
@@ -767,11 +779,10 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
         s.pdf_ratio = optics_mean_transmission(&o) / optics_transmission(&o, mu);
     }
     vec3 origin = render_leave(ctx, hit, dir);
-    render_sample sec = {.variance = 0.0};
     double l = render_photon_map_trace(ctx, origin, dir, hit->object, hit->triangle, *path,
-                                       distance_m, &s, 0.0, &sec);
-    out->starved |= sec.starved;
-    out->truncated |= sec.truncated;
+                                       distance_m, &s, 0.0, sec);
+    out->starved |= sec->starved;
+    out->truncated |= sec->truncated;
     return l;
 }
 
@@ -817,8 +828,14 @@ static void render_final_gather_sample(const render_context *ctx, vec3 origin_m,
                 rng_stream rng;
                 rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_GATHER,
                          (t->rng_index + j) * (RENDER_MAX_CROSSINGS + 1) + path.n);
+                render_sample sec = {.variance = 0.0};
                 t->est[j] += t->weight * render_gather_ray(ctx, &hit, obj, shell && !straight,
-                                                           &path, distance_m, &rng, out);
+                                                           &path, distance_m, &rng, out, &sec);
+                if (t->batch) {
+                    for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
+                        t->batch[b] += t->weight * sec.batch[b];
+                    *t->poisson += t->weight * t->weight * sec.variance;
+                }
             }
             out->paths += t->n_est;
         }
@@ -1054,6 +1071,8 @@ void render_accum_fini(render_accum *acc)
 {
     free(acc->mean);
     free(acc->m2);
+    free(acc->batch);
+    free(acc->disk_var);
     memset(acc, 0, sizeof *acc);
 }
 
@@ -1064,7 +1083,22 @@ double render_accum_stderr(const render_accum *acc, size_t p)
     if (acc->n < 2)
         return 0.0;
     double n = (double)acc->n;
-    return sqrt(acc->m2[p] / ((n - 1.0) * n));
+    double var = acc->m2[p] / ((n - 1.0) * n);
+    if (acc->batch) {
+        const double *s = &acc->batch[p * PHOTON_MAP_BATCHES];
+        double nb = (double)PHOTON_MAP_BATCHES, mean = 0.0, ss = 0.0;
+        for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
+            mean += s[b];
+        mean /= nb;
+        for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
+            ss += (s[b] - mean) * (s[b] - mean);
+        /* Z_b = B s_b / N estimates the photon part alone; var of their mean */
+        double map_var = ss * nb * nb / (n * n) / (nb - 1.0) / nb;
+        double diag = acc->disk_var[p] / (n * n);
+        if (map_var > diag)
+            var += map_var - diag;
+    }
+    return sqrt(var);
 }
 
 /* The random-stream index of estimate 0 of sample `sample` (of `samples` per pass) of
@@ -1119,8 +1153,24 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
         return st;
     if (opt && opt->use_seed)
         ctx.seed = opt->seed;
-    /* per thread: the current pixel's n_est estimates */
-    double *scratch = thz_malloc_array((size_t)threads * n_est, sizeof *scratch);
+    /* final-gather with a batched map: the map's own noise per pixel (render_accum) */
+    bool batched = scene->render.integrator == INTEGRATOR_FINAL_GATHER &&
+                   photon_map_batches(map) == PHOTON_MAP_BATCHES;
+    if (batched && pass == 0 && !acc->batch) {
+        acc->batch = thz_calloc(acc->pixels * PHOTON_MAP_BATCHES, sizeof *acc->batch);
+        acc->disk_var = thz_calloc(acc->pixels ? acc->pixels : 1, sizeof *acc->disk_var);
+        if (!acc->batch || !acc->disk_var) {
+            render_context_fini(&ctx);
+            return thz_error_set(err, THZ_ERR_NOMEM,
+                                 "render: out of memory for %zu pixels' photon batches",
+                                 acc->pixels);
+        }
+    }
+    batched = batched && acc->batch;
+    /* per thread: the current pixel's n_est estimates, then its batch sums and Poisson
+     * variance */
+    size_t per_thread = n_est + PHOTON_MAP_BATCHES + 1;
+    double *scratch = thz_malloc_array((size_t)threads * per_thread, sizeof *scratch);
     if (!scratch) {
         render_context_fini(&ctx);
         return thz_error_set(err, THZ_ERR_NOMEM,
@@ -1152,9 +1202,11 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads) \
     reduction(+ : n_samples, n_escaped, n_back, n_widened, n_starved, n_truncated, n_paths)
         for (int64_t px = first; px < last; px++) {
-            double *est = &scratch[(size_t)omp_get_thread_num() * n_est];
-            for (uint32_t j = 0; j < n_est; j++)
+            double *est = &scratch[(size_t)omp_get_thread_num() * per_thread];
+            for (size_t j = 0; j < per_thread; j++)
                 est[j] = 0.0;
+            double *pixel_batch = batched ? est + n_est : NULL;
+            double *pixel_poisson = batched ? est + n_est + PHOTON_MAP_BATCHES : NULL;
             uint32_t row = (uint32_t)(px / cols), col = (uint32_t)(px % cols);
             double omega_sr = camera_pixel_solid_angle(&cam, col, row);
             double sample_sr = omega_sr / n2;
@@ -1167,6 +1219,8 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
                     render_target t = {
                         .est = est,
                         .n_est = n_est,
+                        .batch = pixel_batch,
+                        .poisson = pixel_poisson,
                         .weight = 1.0 / n2,
                         .rng_index =
                             render_rng_index(scene, sensor, pass, samples_per_pass, sample, n_est),
@@ -1198,6 +1252,11 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
             double delta = mean_b - acc->mean[p];
             acc->mean[p] += delta * n_b / n_ab;
             acc->m2[p] += m2_b + delta * delta * n_a * n_b / n_ab;
+            if (batched) {
+                for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
+                    acc->batch[p * PHOTON_MAP_BATCHES + b] += pixel_batch[b];
+                acc->disk_var[p] += *pixel_poisson;
+            }
         }
         if (render_report(opt, scene, channel, r1, rows)) {
             st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");

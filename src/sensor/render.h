@@ -119,12 +119,22 @@ typedef struct render_accum {
     double *mean; /* per pixel: mean of the estimates, W m^-2 sr^-1 Hz^-1 */
     double *m2;   /* per pixel: sum of squared deviations from the mean (or, poisson,
                      the variance of the mean) */
+    /* final-gather with a batched photon map (photon_map.h), else NULL: the map's own
+     * noise, which the spread of the estimates given the map cannot show */
+    double *batch;    /* [pixel * PHOTON_MAP_BATCHES + b]: sum over all estimates of the
+                         photon terms of batch b */
+    double *disk_var; /* per pixel: sum over all estimates of their photon terms' Poisson
+                        variance (sum of squared terms over disk areas squared) */
 } render_accum;
 
 thz_status render_accum_init(render_accum *acc, size_t pixels, thz_error *err);
 void render_accum_fini(render_accum *acc);
 
-/* Standard error of pixel p's mean, W m^-2 sr^-1 Hz^-1 (0 with fewer than 2 estimates). */
+/* Standard error of pixel p's mean, W m^-2 sr^-1 Hz^-1 (0 with fewer than 2 estimates).
+ * With a batched photon map (final-gather) the variance is s^2 / N from the estimates'
+ * spread given the map, plus the map's own variance given the gather rays: the spread of
+ * the pixel's photon part between the independent batches, s_B^2 / B, less what s^2 / N
+ * already holds of it (each gather disk's own Poisson variance, sum / N^2), at least 0. */
 double render_accum_stderr(const render_accum *acc, size_t p);
 
 /* Renders pass `pass` of channel `channel` of sensor `sensor` and merges it into `acc`
