@@ -595,6 +595,120 @@ static void render_gather_pass(render_gather_state *g, uint32_t object, int seen
     }
 }
 
+/* The k-nearest search by radius queries: the photons of one object within a radius,
+ * with their squared distances, collected in a bounded buffer; the radius is bisected
+ * (in r^2, geometrically) until the buffer holds at least k and at most its capacity.
+ * The k-th smallest distance in the buffer is then the k-th nearest photon's, and the
+ * photons strictly inside it are those of the buffer below it: one or two cheap radius
+ * queries instead of a k-nearest traversal and a radius query (about half of
+ * final-gather's time). The result is that of photon_map_kth_distance2 exactly, whatever
+ * the first guess. */
+#define RENDER_KNN_CAP 2048
+#define RENDER_KNN_TRIES 48
+
+typedef struct render_knn_entry {
+    double d2;
+    const photon_record *p;
+    int other_side; /* the side not seen (diffuse shells: transmitted photons) */
+} render_knn_entry;
+
+typedef struct render_knn_buffer {
+    render_knn_entry e[RENDER_KNN_CAP];
+    size_t n;     /* entries stored (<= RENDER_KNN_CAP) */
+    size_t total; /* photons within the radius, stored or not */
+    double radius2_m2;
+    int other_side;
+} render_knn_buffer;
+
+static void render_knn_visit(void *vb, const photon_record *p, double distance2_m2)
+{
+    render_knn_buffer *b = vb;
+    if (!(distance2_m2 <= b->radius2_m2))
+        return;
+    if (b->n < RENDER_KNN_CAP)
+        b->e[b->n++] = (render_knn_entry){distance2_m2, p, b->other_side};
+    b->total++;
+}
+
+/* The k-th smallest of n values (k >= 1, n >= k); reorders v. */
+static double render_kth_smallest(double *v, size_t n, size_t k)
+{
+    size_t lo = 0, hi = n - 1, want = k - 1;
+    while (lo < hi) {
+        double pivot = v[lo + (hi - lo) / 2];
+        size_t i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] < pivot)
+                i++;
+            while (v[j] > pivot)
+                j--;
+            if (i <= j) {
+                double t = v[i];
+                v[i] = v[j];
+                v[j] = t;
+                i++;
+                if (j == 0)
+                    break;
+                j--;
+            }
+        }
+        if (want <= j)
+            hi = j;
+        else if (want >= i)
+            lo = i;
+        else
+            return v[want];
+    }
+    return v[want];
+}
+
+/* Fills b with the photons of `object` (sides in `mask`, seen side first) within the k-th
+ * nearest photon's distance or somewhat beyond, and returns that squared distance; NAN
+ * when the search does not settle (the caller falls back to the k-nearest traversal),
+ * INFINITY when the object holds fewer than k photons. */
+static double render_knn_collect(const render_context *ctx, uint32_t object, int seen_side,
+                                 unsigned mask, vec3 position, size_t k, render_knn_buffer *b,
+                                 double *scratch)
+{
+    size_t available = photon_map_object_count(ctx->map, object, mask);
+    if (available < k)
+        return INFINITY;
+    const thz_object *obj = &ctx->scene->objects[object];
+    double sides = (mask & 3u) == 3u ? 2.0 : 1.0;
+    double area = obj->mesh.total_area_m2 * sides;
+    /* first guess: k photons at the object's mean density (right at once for about two
+     * thirds of final-gather's secondary hits on the paper's scene, 1.4 queries on
+     * average) */
+    double r2 = area > 0.0 ? (double)k * area / ((double)available * M_PI) : 1.0;
+    double lo = 0.0, hi = INFINITY; /* too few photons within lo, too many within hi */
+    for (int tries = 0; tries < RENDER_KNN_TRIES; tries++) {
+        b->n = b->total = 0;
+        b->radius2_m2 = r2;
+        for (int pass = 0; pass < 2; pass++) {
+            int side = pass == 0 ? seen_side : 1 - seen_side;
+            if (!(mask >> side & 1u))
+                continue;
+            b->other_side = side != seen_side;
+            photon_map_radius(ctx->map, object, side, position, r2, render_knn_visit, b);
+        }
+        if (b->total < k) {
+            lo = r2;
+            r2 = isfinite(hi) ? sqrt(lo * hi)
+                              : r2 * (b->total ? 2.0 * (double)k / (double)b->total : 16.0);
+        } else if (b->total > RENDER_KNN_CAP) {
+            hi = r2;
+            r2 = lo > 0.0 ? sqrt(lo * hi) : r2 * 0.5 * (double)RENDER_KNN_CAP / (double)b->total;
+        } else {
+            for (size_t i = 0; i < b->n; i++)
+                scratch[i] = b->e[i].d2;
+            return render_kth_smallest(scratch, b->n, k);
+        }
+        if (!(r2 > 0.0) || !isfinite(r2))
+            break;
+    }
+    return NAN;
+}
+
 /* L_R (+ L_T for diffuse shells) at the hit by density estimation over the sample's
  * footprint (sample_sr > 0), widened to the k-th nearest photon when it holds fewer than
  * k; sample_sr = 0 asks for the k-th nearest radius directly. Adds the estimate to
@@ -619,13 +733,19 @@ static void render_gather(const render_context *ctx, const accel_hit *hit, const
         .distance_m = distance_m,
         .radius2_m2 = sample_sr * distance_m * distance_m / (M_PI * hit->cos_theta),
     };
-    render_gather_pass(&g, hit->object, hit->side, diffuse_shell, hit->position_m);
     size_t k = sample_sr > 0.0 ? ctx->k : ctx->k_secondary;
+    render_gather_pass(&g, hit->object, hit->side, diffuse_shell, hit->position_m);
     if (g.count < k) {
         unsigned mask = 1u << hit->side;
         if (diffuse_shell)
             mask |= 1u << (1 - hit->side);
-        double rk2 = photon_map_kth_distance2(ctx->map, hit->object, mask, hit->position_m, k);
+        render_knn_buffer b;
+        double scratch[RENDER_KNN_CAP];
+        double rk2 =
+            render_knn_collect(ctx, hit->object, hit->side, mask, hit->position_m, k, &b, scratch);
+        bool collected = !isnan(rk2);
+        if (!collected)
+            rk2 = photon_map_kth_distance2(ctx->map, hit->object, mask, hit->position_m, k);
         if (!isfinite(rk2) || !(rk2 > 0.0)) {
             /* A deviation map holds no photons where no deviation arrives (an object at
              * T0 lit only by objects at T0): its estimate 0 is right, not starved. */
@@ -637,7 +757,19 @@ static void render_gather(const render_context *ctx, const accel_hit *hit, const
             out->widened = 1;
         g.radius2_m2 = rk2;
         g.strict = true; /* the k-th photon lies on the boundary: k - 1 inside */
-        render_gather_pass(&g, hit->object, hit->side, diffuse_shell, hit->position_m);
+        if (collected) {
+            /* the buffer holds every photon within rk2, seen side first, in the order a
+             * radius query visits them */
+            g.count = 0;
+            g.sum = g.sum2 = 0.0;
+            memset(g.batch, 0, sizeof g.batch);
+            for (size_t i = 0; i < b.n; i++) {
+                g.transmitted = b.e[i].other_side;
+                render_gather_visit(&g, b.e[i].p, b.e[i].d2);
+            }
+        } else {
+            render_gather_pass(&g, hit->object, hit->side, diffuse_shell, hit->position_m);
+        }
     }
     double area = M_PI * g.radius2_m2;
     *radiance += g.sum / area;
