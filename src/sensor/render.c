@@ -38,6 +38,10 @@
 #include "physics/planck.h"
 #include "sensor/camera.h"
 
+/* Scenes with at most this many objects get final-gather's table of band means per pair
+ * of objects (render_context.pair_mean). */
+#define RENDER_PAIR_OBJECTS 256
+
 /* What every sample of one channel needs, precomputed once: the channel quadrature for
  * the emission term's band mean, and the optics and Planck radiance of every object at
  * every node. Read-only while rendering. */
@@ -67,6 +71,10 @@ typedef struct render_context {
     bool deviation;          /* photon-map, final-gather: the map holds L - B(T0), T0 > 0,
                                 so every source term is eps B - A B0 (escapes, back faces,
                                 the air: minus B0) and the sample adds B0 back */
+    double *pair_mean;       /* final-gather, [x * n_objects + y]: the band mean of
+                                R_x (eps_y B_y - A_y B0) for solid y (else NAN), what a
+                                reflected gather ray from x adds at y without shells or
+                                air between; NULL beyond RENDER_PAIR_OBJECTS objects */
     bool emitting;           /* emitting atmosphere (docs/atmosphere.md) */
     bool air_terms;          /* render_air contributes: emitting, or deviation */
     double *air_planck;      /* air_terms: [node] B_nu(T_air), 0 for non-emitting air */
@@ -204,6 +212,7 @@ static void render_context_fini(render_context *ctx)
     free(ctx->tbar);
     free(ctx->b0);
     free(ctx->source_mean);
+    free(ctx->pair_mean);
     free(ctx->air_planck);
     free(ctx->bg_planck);
     memset(ctx, 0, sizeof *ctx);
@@ -302,6 +311,27 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         }
         ctx->source_mean[o] = scene->objects[o].type == OBJECT_SOLID ? sum : NAN;
     }
+    if (n_obj <= RENDER_PAIR_OBJECTS && map && scene->render.integrator == INTEGRATOR_FINAL_GATHER)
+        ctx->pair_mean = thz_malloc_array(n_obj > 0 ? n_obj * n_obj : 1, sizeof *ctx->pair_mean);
+    for (size_t x = 0; ctx->pair_mean && x < n_obj; x++)
+        for (size_t y = 0; y < n_obj; y++) {
+            double *v = &ctx->pair_mean[x * n_obj + y];
+            *v = NAN;
+            if (scene->objects[y].type != OBJECT_SOLID || !ctx->scatters[x])
+                continue;
+            /* the same terms in the same order as render_emission_scattered's loop */
+            double sum = 0.0;
+            for (size_t k = 0; k < n; k++) {
+                double f = ctx->optics[x * n + k].reflectivity;
+                const optics_point *oy = &ctx->optics[y * n + k];
+                double t =
+                    ctx->quad.weight[k] * f * optics_emissivity(oy, 1.0) * ctx->planck[y * n + k];
+                if (ctx->deviation)
+                    t -= ctx->quad.weight[k] * f * optics_absorption(oy, 1.0) * ctx->b0[k];
+                sum += t;
+            }
+            *v = sum;
+        }
     const thz_atmosphere *atm = &scene->atmosphere;
     ctx->emitting = atm->emitting;
     ctx->air_terms = atm->emitting || ctx->deviation;
@@ -450,6 +480,11 @@ static double render_emission_scattered(const render_context *ctx, uint32_t obje
 {
     if (!(ctx->scene->objects[object].temperature_k > 0.0) && !ctx->deviation)
         return 0.0;
+    if (ctx->pair_mean && !s->transmitted && path->n == 0 && !ctx->atmosphere) {
+        double v = ctx->pair_mean[(size_t)s->object_index * ctx->scene->n_objects + object];
+        if (!isnan(v))
+            return v * s->inv_branch;
+    }
     size_t n = ctx->quad.n;
     const optics_point *op = &ctx->optics[(size_t)object * n];
     const double *planck = &ctx->planck[(size_t)object * n];
@@ -604,6 +639,7 @@ static void render_gather_pass(render_gather_state *g, uint32_t object, int seen
  * final-gather's time). The result is that of photon_map_kth_distance2 exactly, whatever
  * the first guess. */
 #define RENDER_KNN_CAP 2048
+
 #define RENDER_KNN_TRIES 48
 
 typedef struct render_knn_entry {
