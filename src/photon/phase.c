@@ -263,7 +263,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
 }
 
 thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc, size_t channel,
-                                       uint64_t *bytes, thz_error *err)
+                                       double t0_k, uint64_t *bytes, thz_error *err)
 {
     *bytes = 0;
     thz_status st = phase_check(scene, channel, err);
@@ -274,12 +274,12 @@ thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc,
     if (pilot == 0)
         return THZ_OK;
     emission_table table;
-    st = emission_table_init(&table, scene, channel, k, 0.0, err);
+    st = emission_table_init(&table, scene, channel, k, t0_k, err);
     if (st != THZ_OK)
         return st;
     air_emission air;
     st = air_emission_init(&air, scene, acc, channel, k,
-                           scene_band_emitted_power_w_per_hz(scene, channel), 0.0, err);
+                           scene_band_emitted_power_w_per_hz(scene, channel), t0_k, err);
     if (st != THZ_OK) {
         emission_table_fini(&table);
         return st;

@@ -219,6 +219,16 @@ static uint64_t run_image_bytes(const run_state *rs)
     return total;
 }
 
+/* T0 of channel c's photon map in simulate: final-gather fires the deviation map of
+ * L - B(T0) (photon_map.h), T0 the renderer's control-variate temperature; photon-map
+ * keeps the paper's map. */
+static double run_photon_t0_k(const thz_scene *scene, size_t c)
+{
+    return scene->render.integrator == INTEGRATOR_FINAL_GATHER
+               ? render_reference_temperature_k(scene, c)
+               : 0.0;
+}
+
 /* Estimates the memory of a simulate run and refuses it if it would not fit. */
 static thz_status run_simulate_memory(run_state *rs, bool photons, thz_error *err)
 {
@@ -228,7 +238,8 @@ static thz_status run_simulate_memory(run_state *rs, bool photons, thz_error *er
         uint64_t sum = 0, max = 0;
         for (size_t c = 0; c < rs->scene->n_channels; c++) {
             uint64_t b = 0;
-            thz_status st = photon_phase_estimate_bytes(rs->scene, rs->accel, c, &b, err);
+            thz_status st = photon_phase_estimate_bytes(rs->scene, rs->accel, c,
+                                                        run_photon_t0_k(rs->scene, c), &b, err);
             if (st != THZ_OK)
                 return st;
             sum += b;
@@ -511,13 +522,8 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_resu
     for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
         photon_map *map = NULL;
         if (photons) {
-            /* final-gather fires the deviation map of L - B(T0) (photon_map.h), T0 the
-             * renderer's control-variate temperature; photon-map keeps the paper's map. */
             photon_phase_options po = {.threads = opt->threads,
-                                       .reference_temperature_k =
-                                           scene->render.integrator == INTEGRATOR_FINAL_GATHER
-                                               ? render_reference_temperature_k(scene, c)
-                                               : 0.0,
+                                       .reference_temperature_k = run_photon_t0_k(scene, c),
                                        .progress = opt->progress,
                                        .progress_user = opt->progress_user};
             double t0 = run_now_s();

@@ -510,13 +510,42 @@ static void test_threads_identical(void **state)
     scene_destroy(s);
 }
 
+/* The memory estimate's pilot fires the same kind of map: a deviation map stores a
+ * different number of hits per photon than the paper's (its sources are other objects). */
+static void test_estimate_bytes(void **state)
+{
+    (void)state;
+    thz_scene *s = mixed_scene(200000, 5, true, 0.0);
+    accel *acc;
+    thz_error err;
+    if (accel_create(s, &acc, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    for (int t = 0; t < 2; t++) {
+        double t0_k = t == 0 ? 0.0 : 295.0;
+        uint64_t bytes = 0;
+        assert_int_equal(photon_phase_estimate_bytes(s, acc, 0, t0_k, &bytes, &err), THZ_OK);
+        photon_phase_options opt = {.threads = 2, .reference_temperature_k = t0_k};
+        photon_map *map = NULL;
+        photon_stats st;
+        assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+        double actual = (double)st.stored * sizeof(photon_record);
+        printf("# T0 = %.0f K: estimated %.0f bytes, stored %.0f (%.3f hits per photon)\n", t0_k,
+               (double)bytes, actual, (double)st.stored / (double)st.fired);
+        /* the pilot's 4096 photons: a few % of statistical error, times 1.05 */
+        assert_true(bytes > 0.95 * actual && bytes < 1.2 * actual);
+        photon_map_destroy(map);
+    }
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_t0_zero_checksums), cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_fired_power),       cmocka_unit_test(test_explicit_shell),
         cmocka_unit_test(test_absorbing_air),     cmocka_unit_test(test_open_boundary),
-        cmocka_unit_test(test_threads_identical),
+        cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_estimate_bytes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
