@@ -26,13 +26,14 @@ typedef struct phase_fire_args {
     const air_emission *air; /* the emitting air, or NULL */
     size_t channel;
     uint64_t n_photons;
+    uint64_t first_photon; /* index of the first photon (its random stream and batch) */
     int threads;
     thz_progress_fn progress;
     void *progress_user;
 } phase_fire_args;
 
-/* Fires photons 0..n_photons-1, returning their records in photon-index order (a malloc'd
- * array, never NULL on success) and the summed counters. */
+/* Fires photons first_photon + 0..n_photons-1, returning their records in photon-index order (a
+ * malloc'd array, never NULL on success) and the summed counters. */
 static thz_status phase_fire(const phase_fire_args *a, photon_record **out_records,
                              size_t *out_count, trace_counters *total, thz_error *err)
 {
@@ -77,11 +78,12 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                     lo + PHASE_CHUNK < first + batch_n ? lo + PHASE_CHUNK : first + batch_n;
                 for (uint64_t i = lo; i < hi; i++) {
                     rng_stream rng;
-                    rng_init(&rng, seed, channel, RNG_PURPOSE_PHOTON, i);
+                    uint64_t index = a->first_photon + i;
+                    rng_init(&rng, seed, channel, RNG_PURPOSE_PHOTON, index);
                     emission_photon e;
                     if (!air_emission_sample(a->air, a->table, &rng, scr, &e))
                         e.power_w_per_hz = 0.0;
-                    e.batch = (uint32_t)(i % PHOTON_MAP_BATCHES);
+                    e.batch = (uint32_t)(index % PHOTON_MAP_BATCHES);
                     if (!trace_photon(a->scene, a->acc, &e, &rng, b, &ch->counters)) {
 #pragma omp atomic write
                         failed = 1;
@@ -211,6 +213,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
                          .air = &air,
                          .channel = channel,
                          .n_photons = scene->photons.per_channel,
+                         .first_photon = opt ? opt->first_photon : 0,
                          .threads = opt ? opt->threads : 0,
                          .progress = opt ? opt->progress : NULL,
                          .progress_user = opt ? opt->progress_user : NULL};

@@ -2,11 +2,11 @@
  * scene's emitters, traces them, and builds the channel's photon map.
  *
  * Deterministic: photon i's random numbers come from rng_init(seed, channel,
- * RNG_PURPOSE_PHOTON, i); photons run in batches of PHASE_BATCH, each batch in chunks of
- * PHASE_CHUNK photons spread over OpenMP threads; each chunk's records and counters are
- * merged after the batch in chunk order. The map's records (ordered by photon index
- * before photon_map_create sorts them) and the statistics (summed in that fixed order)
- * are therefore bit-identical for any thread count.
+ * RNG_PURPOSE_PHOTON, i) (i counted from photon_phase_options.first_photon); photons run in batches
+ * of PHASE_BATCH, each batch in chunks of PHASE_CHUNK photons spread over OpenMP threads; each
+ * chunk's records and counters are merged after the batch in chunk order. The map's records
+ * (ordered by photon index before photon_map_create sorts them) and the statistics (summed in that
+ * fixed order) are therefore bit-identical for any thread count.
  */
 #ifndef THZ_PHOTON_PHASE_H
 #define THZ_PHOTON_PHASE_H
@@ -30,6 +30,10 @@ typedef struct photon_phase_options {
      * eps B(T) - A B(T0) at surfaces, 4 pi alpha (B(T_air) - B(T0)) in the air (T_air = 0
      * for a non-emitting atmosphere) and L_b - B(T0) at the boundary. */
     double reference_temperature_k;
+    /* Index of the first photon: photons first_photon .. first_photon + K - 1 are fired
+     * (their random streams and batches), so that maps fired with disjoint ranges are
+     * independent and merge into one of more photons (photon_map_merge). 0 by default. */
+    uint64_t first_photon;
     thz_progress_fn progress;
     void *progress_user;
 } photon_phase_options;

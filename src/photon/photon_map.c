@@ -405,6 +405,43 @@ void photon_map_destroy(photon_map *map)
     free(map);
 }
 
+thz_status photon_map_merge(const photon_map *const *maps, size_t n, size_t n_objects, int threads,
+                            photon_map **out, thz_error *err)
+{
+    *out = NULL;
+    size_t total = 0;
+    unsigned batches = PHOTON_MAP_BATCHES;
+    for (size_t i = 0; i < n; i++) {
+        if (photon_map_reference_temperature_k(maps[i]) !=
+            photon_map_reference_temperature_k(maps[0]))
+            return thz_error_set(err, THZ_ERR_INTERNAL,
+                                 "photon map merge: maps of different reference temperatures");
+        if (photon_map_batches(maps[i]) != PHOTON_MAP_BATCHES)
+            batches = 1;
+        total += photon_map_count(maps[i]);
+    }
+    photon_record *all = thz_malloc_array(total ? total : 1, sizeof *all);
+    if (!all)
+        return thz_error_set(err, THZ_ERR_NOMEM, "photon map merge: out of memory for %zu photons",
+                             total);
+    size_t at = 0;
+    double scale = 1.0 / (double)(n ? n : 1);
+    for (size_t i = 0; i < n; i++) {
+        size_t count = photon_map_count(maps[i]);
+        memcpy(all + at, photon_map_records(maps[i]), count * sizeof *all);
+        for (size_t j = at; j < at + count; j++)
+            all[j].power_w_per_hz = (float)((double)all[j].power_w_per_hz * scale);
+        at += count;
+    }
+    thz_status st = photon_map_create(all, total, n_objects, threads, out, err);
+    if (st != THZ_OK)
+        return st;
+    photon_map_set_reference_temperature_k(*out,
+                                           n ? photon_map_reference_temperature_k(maps[0]) : 0.0);
+    photon_map_set_batches(*out, batches);
+    return THZ_OK;
+}
+
 size_t photon_map_count(const photon_map *map)
 {
     return map ? map->count : 0;

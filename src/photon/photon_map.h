@@ -61,6 +61,13 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
                              photon_map **out, thz_error *err);
 void photon_map_destroy(photon_map *map);
 
+/* One map of the photons of n maps of one channel fired with the same K and disjoint
+ * photon ranges (photon_phase_options.first_photon): their records in order, each power
+ * divided by n (each map's photons carry P/K; together they are n K photons). The maps
+ * must share T0; the result has it, and batches when all have them. Deterministic. */
+thz_status photon_map_merge(const photon_map *const *maps, size_t n, size_t n_objects, int threads,
+                            photon_map **out, thz_error *err);
+
 size_t photon_map_count(const photon_map *map);
 
 /* Reference temperature T0 (K) of the map. 0 (the default of photon_map_create): the

@@ -58,16 +58,11 @@ static double run_now_s(void)
 
 thz_status run_check_options(const thz_scene *scene, const run_options *opt, thz_error *err)
 {
+    (void)scene; /* every integrator takes a noise target in simulate (photon-map: photons) */
     if (opt->target_noise_k < 0.0 || !isfinite(opt->target_noise_k))
         return thz_error_set(err, THZ_ERR_INPUT, "the noise target must be > 0 K");
     if (opt->max_seconds < 0.0 || !isfinite(opt->max_seconds))
         return thz_error_set(err, THZ_ERR_INPUT, "the time limit must be > 0 s");
-    if (opt->target_noise_k > 0.0 && !render_integrator_has_passes(scene->render.integrator))
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "a noise target needs the final-gather or path integrator: "
-                             "'%s' is deterministic given its photon map, so only more photons "
-                             "(--photons) lower its noise",
-                             render_integrator_name(scene->render.integrator));
     return THZ_OK;
 }
 
@@ -307,8 +302,9 @@ static size_t run_rendered_pixels(const run_state *rs)
     return total;
 }
 
-/* Renders channel c of every selected sensor: one pass, or, with a noise target, passes
- * until the channel's median standard error reaches it or the time limit passes. */
+/* Renders channel c of every selected sensor: one pass, or, with a noise target and an
+ * integrator with passes, passes until the channel's median standard error reaches it
+ * or the time limit passes. */
 static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, thz_error *err)
 {
     render_options ro = {.threads = rs->opt->threads,
@@ -317,7 +313,8 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
                          .progress = rs->opt->progress,
                          .progress_user = rs->opt->progress_user};
     double t0 = run_now_s();
-    double target = rs->opt->target_noise_k;
+    double target =
+        render_integrator_has_passes(rs->scene->render.integrator) ? rs->opt->target_noise_k : 0.0;
     render_accum *acc = thz_calloc(rs->n_selected, sizeof *acc);
     double *v = target > 0.0 ? thz_malloc_array(run_rendered_pixels(rs), sizeof *v) : NULL;
     thz_status st = THZ_OK;
@@ -367,8 +364,9 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
             render_accum_fini(&acc[i]);
     free(acc);
     free(v);
-    rs->seconds_channel[c] = run_now_s() - t0;
-    rs->seconds_render += rs->seconds_channel[c];
+    double seconds = run_now_s() - t0;
+    rs->seconds_channel[c] += seconds; /* photon-map's photon passes render again */
+    rs->seconds_render += seconds;
     return st;
 }
 
@@ -508,6 +506,135 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
     return st;
 }
 
+/* Adds the statistics of photon pass `p` (p + 1 passes so far) to the merged map's:
+ * counts and times add up; powers are the merged photons' (each pass's divided by the
+ * number of passes: the mean of the passes'). */
+static void run_stats_merge(photon_stats *sum, const photon_stats *p, uint32_t passes)
+{
+    if (passes == 1) {
+        *sum = *p;
+        return;
+    }
+    double w = 1.0 / passes, keep = 1.0 - w;
+    sum->fired += p->fired;
+    sum->hits += p->hits;
+    sum->reflected += p->reflected;
+    sum->transmitted += p->transmitted;
+    sum->absorbed += p->absorbed;
+    sum->escaped += p->escaped;
+    sum->back_face_hits += p->back_face_hits;
+    sum->terminated += p->terminated;
+    sum->bounce_capped += p->bounce_capped;
+    sum->rays += p->rays;
+    sum->absorbed_power_w_per_hz =
+        keep * sum->absorbed_power_w_per_hz + w * p->absorbed_power_w_per_hz;
+    sum->escaped_power_w_per_hz =
+        keep * sum->escaped_power_w_per_hz + w * p->escaped_power_w_per_hz;
+    sum->atmosphere_power_w_per_hz =
+        keep * sum->atmosphere_power_w_per_hz + w * p->atmosphere_power_w_per_hz;
+    sum->fired_power_w_per_hz = keep * sum->fired_power_w_per_hz + w * p->fired_power_w_per_hz;
+    sum->terminated_power_w_per_hz =
+        keep * sum->terminated_power_w_per_hz + w * p->terminated_power_w_per_hz;
+    sum->mean_bounces = sum->fired ? (double)sum->hits / (double)sum->fired : 0.0;
+    sum->seconds += p->seconds;
+    sum->seconds_emission_table += p->seconds_emission_table;
+    sum->seconds_tracing += p->seconds_tracing;
+    sum->seconds_index += p->seconds_index;
+}
+
+/* photon-map with a noise target (it cannot add render passes: it is deterministic given
+ * its map): photon passes instead. Pass p fires photons p K .. (p + 1) K - 1 of the
+ * channel, and the channel is rendered from the merge of all passes' photons
+ * (photon_map_merge: (p + 1) K photons), until the median standard error reaches the
+ * target, the time limit passes, or the next merge would not fit in half the memory.
+ * *out_map is the merged map; the passes are bit-identical for any thread count. */
+static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_error *err)
+{
+    const thz_scene *scene = rs->scene;
+    const run_options *opt = rs->opt;
+    double target = opt->target_noise_k, t_start = run_now_s();
+    double *v = thz_malloc_array(run_rendered_pixels(rs) ? run_rendered_pixels(rs) : 1, sizeof *v);
+    size_t cap = 16, n = 0;
+    photon_map **maps = thz_calloc(cap, sizeof *maps);
+    photon_map *merged = NULL;
+    thz_status st = THZ_OK;
+    if (!v || !maps)
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the photon passes");
+    uint64_t k = scene->photons.per_channel;
+    double limit = 0.5 * (double)thz_physical_memory_bytes();
+    while (st == THZ_OK) {
+        if (n == cap) {
+            photon_map **m = thz_realloc_array(maps, 2 * cap, sizeof *m);
+            if (!m) {
+                st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the photon passes");
+                break;
+            }
+            maps = m;
+            cap *= 2;
+        }
+        photon_phase_options po = {.threads = opt->threads,
+                                   .reference_temperature_k = run_photon_t0_k(scene, c),
+                                   .first_photon = (uint64_t)n * k,
+                                   .progress = opt->progress,
+                                   .progress_user = opt->progress_user};
+        photon_stats ps;
+        double t0 = run_now_s();
+        st = photon_phase_run(scene, rs->accel, c, &po, &maps[n], &ps, err);
+        if (st != THZ_OK)
+            break;
+        n++;
+        photon_map_destroy(merged);
+        merged = NULL;
+        if (n > 1)
+            st = photon_map_merge((const photon_map *const *)maps, n, scene->n_objects,
+                                  opt->threads, &merged, err);
+        rs->seconds_photons += run_now_s() - t0;
+        run_stats_merge(&rs->stats[c], &ps, (uint32_t)n);
+        if (st != THZ_OK)
+            break;
+        const photon_map *map = n > 1 ? merged : maps[0];
+        rs->stats[c].stored = photon_map_count(map);
+        st = run_render_channel(rs, c, map, err);
+        rs->passes[c] = (uint32_t)n;
+        if (st != THZ_OK || run_channel_median_stderr_k(rs, c, v) <= target)
+            break;
+        if (opt->max_seconds > 0.0 && run_now_s() - t_start >= opt->max_seconds)
+            break;
+        /* the passes' maps and the next merge: twice the records, and their indexes */
+        double next = 2.2 * (double)photon_map_bytes(map) * (double)(n + 1) / (double)n;
+        if (next > limit) {
+            st = run_add_warning(rs, err,
+                                 "channel %zu: stopped after %zu photon passes (%llu photons) "
+                                 "above the noise target of %g K: the next would need %.1f GB "
+                                 "of memory",
+                                 c, n, (unsigned long long)(n * k), target, next / 1e9);
+            break;
+        }
+        if (n >= RUN_MAX_PASSES) {
+            st = run_add_warning(rs, err,
+                                 "channel %zu: stopped after %u passes above the noise target "
+                                 "of %g K",
+                                 c, (unsigned)RUN_MAX_PASSES, target);
+            break;
+        }
+    }
+    if (st == THZ_OK && n > 0) {
+        if (n > 1) {
+            *out_map = merged;
+            merged = NULL;
+        } else {
+            *out_map = maps[0];
+            maps[0] = NULL;
+        }
+    }
+    photon_map_destroy(merged);
+    for (size_t i = 0; maps && i < n; i++)
+        photon_map_destroy(maps[i]);
+    free(maps);
+    free(v);
+    return st;
+}
+
 thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_result *result,
                         thz_error *err)
 {
@@ -519,8 +646,18 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_resu
         st = run_simulate_memory(&rs, photons, err);
     if (st == THZ_OK)
         st = run_init_images(&rs, err);
+    bool photon_passes = photons && opt->target_noise_k > 0.0 &&
+                         !render_integrator_has_passes(scene->render.integrator);
     for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
         photon_map *map = NULL;
+        if (photon_passes) {
+            st = run_photon_passes(&rs, c, &map, err);
+            if (opt->save_photon_map)
+                rs.maps[c] = map;
+            else
+                photon_map_destroy(map);
+            continue;
+        }
         if (photons) {
             photon_phase_options po = {.threads = opt->threads,
                                        .reference_temperature_k = run_photon_t0_k(scene, c),
@@ -553,6 +690,12 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, run_result
     run_state rs;
     if (opt->save_photon_map)
         return thz_error_set(err, THZ_ERR_INPUT, "render: --save-photon-map is for simulate");
+    if (opt->target_noise_k > 0.0 && !render_integrator_has_passes(scene->render.integrator))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "render: '%s' is deterministic given its photon map, and render "
+                             "fires no photons: a noise target needs simulate (which fires "
+                             "photons until it is met) or final-gather or path",
+                             render_integrator_name(scene->render.integrator));
     thz_status st = run_begin(&rs, scene, opt, "render", err);
     bool photons = render_integrator_needs_photons(scene->render.integrator);
     if (st == THZ_OK) {

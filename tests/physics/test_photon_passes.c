@@ -1,0 +1,124 @@
+/* Photon passes (photon_phase_options.first_photon, photon_map_merge): maps fired with
+ * disjoint photon ranges merge into exactly the map of all their photons fired at once.
+ * Pass p of K photons fires photons p K .. (p + 1) K - 1 with power P/K; merged, each
+ * power is halved (a power of two: exact), so the merge of passes [0, K) and [K, 2K)
+ * holds the same records, bit for bit, as one phase of 2 K photons; and the batches
+ * follow the global photon index. Checked on the box scene (every kind of surface, an
+ * attenuating atmosphere) with the paper's map and a deviation map. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <cmocka.h>
+
+#include "accel/accel.h"
+#include "photon/phase.h"
+#include "photon_scenes.h"
+
+static int record_cmp(const void *a, const void *b)
+{
+    return memcmp(a, b, sizeof(photon_record));
+}
+
+/* The map's records, sorted bytewise (the merge's order of equal spatial keys may
+ * differ from a single phase's). */
+static photon_record *sorted_records(const photon_map *map)
+{
+    size_t n = photon_map_count(map);
+    photon_record *r = malloc((n ? n : 1) * sizeof *r);
+    assert_non_null(r);
+    memcpy(r, photon_map_records(map), n * sizeof *r);
+    qsort(r, n, sizeof *r, record_cmp);
+    return r;
+}
+
+static photon_map *fire(thz_scene *s, const accel *acc, uint64_t k, uint64_t first, double t0_k)
+{
+    thz_error err;
+    s->photons.per_channel = k;
+    photon_phase_options po = {
+        .threads = 2, .reference_temperature_k = t0_k, .first_photon = first};
+    photon_map *map = NULL;
+    if (photon_phase_run(s, acc, 0, &po, &map, NULL, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    return map;
+}
+
+static void merge_case(double t0_k)
+{
+    uint64_t k = 3 * PHASE_BATCH / 2 + 77; /* passes that end mid-batch */
+    thz_scene *s = ps_box_scene(k, 11, 0.1);
+    accel *acc;
+    thz_error err;
+    if (accel_create(s, &acc, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    photon_map *passes[2] = {fire(s, acc, k, 0, t0_k), fire(s, acc, k, k, t0_k)};
+    photon_map *whole = fire(s, acc, 2 * k, 0, t0_k);
+    photon_map *merged = NULL;
+    assert_int_equal(
+        photon_map_merge((const photon_map *const *)passes, 2, s->n_objects, 2, &merged, &err),
+        THZ_OK);
+    size_t n = photon_map_count(whole);
+    printf("# T0 = %.0f K: %zu + %zu records merged, %zu fired at once\n", t0_k,
+           photon_map_count(passes[0]), photon_map_count(passes[1]), n);
+    assert_true(n > k);
+    assert_int_equal(photon_map_count(merged), n);
+    assert_true(photon_map_reference_temperature_k(merged) == t0_k);
+    assert_int_equal(photon_map_batches(merged), PHOTON_MAP_BATCHES);
+    photon_record *a = sorted_records(merged), *b = sorted_records(whole);
+    assert_memory_equal(a, b, n * sizeof *a);
+    /* every batch is there, in about equal numbers */
+    size_t per[PHOTON_MAP_BATCHES] = {0};
+    for (size_t i = 0; i < n; i++)
+        per[photon_batch(&a[i])]++;
+    for (unsigned i = 0; i < PHOTON_MAP_BATCHES; i++)
+        assert_true(fabs((double)per[i] - (double)n / PHOTON_MAP_BATCHES) <
+                    6.0 * sqrt((double)n / PHOTON_MAP_BATCHES) +
+                        0.02 * (double)n / PHOTON_MAP_BATCHES);
+    free(a);
+    free(b);
+    photon_map_destroy(merged);
+    photon_map_destroy(whole);
+    photon_map_destroy(passes[0]);
+    photon_map_destroy(passes[1]);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
+static void test_merge_equals_one_phase(void **state)
+{
+    (void)state;
+    merge_case(0.0);
+    merge_case(295.0);
+}
+
+/* Maps of different reference temperatures do not merge. */
+static void test_merge_refuses_mixed_t0(void **state)
+{
+    (void)state;
+    thz_scene *s = ps_box_scene(2000, 3, 0.0);
+    accel *acc;
+    thz_error err;
+    if (accel_create(s, &acc, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    photon_map *maps[2] = {fire(s, acc, 2000, 0, 0.0), fire(s, acc, 2000, 2000, 295.0)};
+    photon_map *merged = NULL;
+    assert_int_not_equal(
+        photon_map_merge((const photon_map *const *)maps, 2, s->n_objects, 1, &merged, &err),
+        THZ_OK);
+    assert_null(merged);
+    photon_map_destroy(maps[0]);
+    photon_map_destroy(maps[1]);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_merge_equals_one_phase),
+        cmocka_unit_test(test_merge_refuses_mixed_t0),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
