@@ -10,8 +10,9 @@ total, on THREADS threads, and prints a table; writes the numbers as JSON.
   final-gather  the same with --photons PHOTONS; the time includes the photon phase;
                 stops at --max-seconds per channel (then "not reached" and the median
                 reached is shown)
-  photon-map    cannot add passes: one run with PHOTONS photons, and the photon count
-                (and time) the target would need if the standard error falls as
+  photon-map    its photon passes (simulate --target-noise-k) would need ~1e10 photons
+                on this scene: one run with PHOTONS photons, and the photon count (and
+                time) the target would need if the standard error falls as
                 1/sqrt(photons) (extrapolated, marked ~)
 
 Times come from summary.json (photon_phase_s, render_s per channel); they depend on the
