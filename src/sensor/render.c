@@ -503,21 +503,30 @@ static double render_emission_scattered(const render_context *ctx, uint32_t obje
     return sum * s->inv_branch;
 }
 
-/* Deviation: the band mean of B0 times the scattering weight (s may be NULL), the path
- * weight and exp(-alpha d): what a back face (radiance 0, deviation -B0) takes away. */
+/* The weight of quadrature node k in a band mean seen through `path` and the first
+ * vertex's scattering s (may be NULL; without 1 / P(branch)): the node's quadrature
+ * weight times s's scattering weight and the straight shells' T(theta) at that node. */
+static double render_node_weight(const render_context *ctx, const render_path *path,
+                                 const render_scatter *s, size_t k)
+{
+    size_t n = ctx->quad.n;
+    double w = ctx->quad.weight[k];
+    if (s)
+        w *= render_scatter_node(ctx, s, k);
+    for (size_t i = 0; i < path->n && w != 0.0; i++)
+        w *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
+    return w;
+}
+
+/* Deviation: the band mean of B0 exp(-alpha d), seen through path and s: what a back
+ * face (radiance 0, deviation -B0) takes away. */
 static double render_b0_term(const render_context *ctx, const render_path *path,
                              const render_scatter *s, double distance_m)
 {
-    size_t n = ctx->quad.n;
     double sum = 0.0;
-    for (size_t k = 0; k < n; k++) {
-        double v = ctx->quad.weight[k] * ctx->b0[k] * render_tau(ctx->alpha_per_m[k], distance_m);
-        if (s)
-            v *= render_scatter_node(ctx, s, k);
-        for (size_t i = 0; i < path->n && v != 0.0; i++)
-            v *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
-        sum += v;
-    }
+    for (size_t k = 0; k < ctx->quad.n; k++)
+        sum += ctx->b0[k] * render_tau(ctx->alpha_per_m[k], distance_m) *
+               render_node_weight(ctx, path, s, k);
     return s ? sum * s->inv_branch : sum;
 }
 
@@ -536,23 +545,16 @@ static double render_air(const render_context *ctx, const render_path *path,
 {
     if (!ctx->air_terms || (!escaped && !ctx->atmosphere))
         return 0.0; /* without attenuation a free path adds nothing */
-    size_t n = ctx->quad.n;
     double sum = 0.0;
-    for (size_t k = 0; k < n; k++) {
+    for (size_t k = 0; k < ctx->quad.n; k++) {
         double a = ctx->alpha_per_m[k];
         double t1 = render_tau(a, d1_m);
         double b0 = ctx->deviation ? ctx->b0[k] : 0.0;
         double v = (ctx->air_planck[k] - b0) * (render_tau(a, d0_m) - t1);
         if (escaped)
             v += (ctx->bg_planck[k] - b0) * t1;
-        if (v == 0.0)
-            continue;
-        v *= ctx->quad.weight[k];
-        if (s)
-            v *= render_scatter_node(ctx, s, k);
-        for (size_t i = 0; i < path->n && v != 0.0; i++)
-            v *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
-        sum += v;
+        if (v != 0.0)
+            sum += v * render_node_weight(ctx, path, s, k);
     }
     return s ? sum * s->inv_branch : sum;
 }
