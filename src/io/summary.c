@@ -16,19 +16,30 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/path.h"
 #include "thzmap/thzmap.h"
 
-/* Builders that remember an allocation failure in *ok instead of checking each call. */
+/* Builders that remember an allocation failure in *ok instead of checking each call.
+ * They take ownership of value, as jansson's _new functions do (which release it even
+ * when they fail): when obj or arr could not be made, value is released here. */
 static void sum_set(json_t *obj, const char *key, json_t *value, bool *ok)
 {
-    if (!value || !obj || json_object_set_new(obj, key, value) != 0)
+    if (!obj) {
+        json_decref(value);
         *ok = false;
+    } else if (!value || json_object_set_new(obj, key, value) != 0) {
+        *ok = false;
+    }
 }
 
 static void sum_append(json_t *arr, json_t *value, bool *ok)
 {
-    if (!value || !arr || json_array_append_new(arr, value) != 0)
+    if (!arr) {
+        json_decref(value);
         *ok = false;
+    } else if (!value || json_array_append_new(arr, value) != 0) {
+        *ok = false;
+    }
 }
 
 /* A real, or null where it is not finite (JSON has no NaN). */
@@ -132,10 +143,10 @@ static json_t *sum_sensor(const thz_scene *scene, size_t i, const run_summary *s
 thz_status summary_write(const char *dir, const thz_scene *scene, const run_summary *summary,
                          thz_error *err)
 {
-    char path[4096];
-    int n = snprintf(path, sizeof path, "%s/summary.json", dir);
-    if (n < 0 || (size_t)n >= sizeof path)
-        return thz_error_set(err, THZ_ERR_IO, "%s/summary.json: path too long", dir);
+    char path[THZ_PATH_MAX];
+    thz_status status = thz_path_join(path, sizeof path, dir, "summary.json", err);
+    if (status != THZ_OK)
+        return status;
     bool ok = true;
     json_t *root = json_object();
     sum_set(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
@@ -178,7 +189,6 @@ thz_status summary_write(const char *dir, const thz_scene *scene, const run_summ
         sum_append(warnings, sum_string(summary->run_warnings[i]), &ok);
     sum_set(root, "warnings", warnings, &ok);
 
-    thz_status status = THZ_OK;
     if (!ok)
         status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
     else if (json_dump_file(root, path, JSON_INDENT(2) | JSON_REAL_PRECISION(12)) != 0)
