@@ -24,7 +24,9 @@ thz_status output_stage_create(const char *outdir, output_stage **out, thz_error
 const char *output_stage_dir(const output_stage *stage);
 
 /* Moves every staged file into OUTDIR (replacing files of the same name) and removes
- * the staging directory. */
+ * the staging directory. All or nothing: if any file cannot be moved (e.g. OUTDIR holds
+ * a directory of its name), the files it replaced are put back and the new ones taken
+ * out again, so OUTDIR holds exactly the previous results, and the error says so. */
 thz_status output_stage_commit(output_stage *stage, thz_error *err);
 
 /* Removes the staging directory and whatever it holds if not committed; frees. */

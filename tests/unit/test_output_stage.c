@@ -118,6 +118,72 @@ static void test_commit_moves_files(void **state)
     free(tmp);
 }
 
+/* A commit that fails half-way (the last file, in name order, meets a non-empty
+ * directory of its name in OUTDIR, after three files were moved in, two of them
+ * replacing old ones) is undone: OUTDIR holds exactly the old files again. */
+static void test_failed_commit_rolls_back(void **state)
+{
+    (void)state;
+    char *outdir = make_tmp_dir();
+    write_file(outdir, "a.hdr", "old a");
+    write_file(outdir, "b.img", "old b");
+    write_file(outdir, "keep.txt", "not ours");
+    char sub[512];
+    snprintf(sub, sizeof sub, "%s/z.png", outdir);
+    assert_int_equal(mkdir(sub, 0777), 0);
+    write_file(sub, "inner", "user data");
+
+    output_stage *stage = NULL;
+    thz_error err = {0};
+    assert_int_equal(output_stage_create(outdir, &stage, &err), THZ_OK);
+    const char *sdir = output_stage_dir(stage);
+    write_file(sdir, "a.hdr", "new a");
+    write_file(sdir, "b.img", "new b");
+    write_file(sdir, "c.json", "new c"); /* no old file of this name */
+    write_file(sdir, "z.png", "new z");  /* last: OUTDIR/z.png is a directory */
+
+    assert_int_equal(output_stage_commit(stage, &err), THZ_ERR_IO);
+    assert_non_null(strstr(err.message, "z.png"));
+    assert_non_null(strstr(err.message, "previous results stay"));
+    output_stage_destroy(stage);
+
+    assert_int_equal(count_entries(outdir), 4); /* a.hdr b.img keep.txt z.png/, no stage */
+    assert_file_text(outdir, "a.hdr", "old a");
+    assert_file_text(outdir, "b.img", "old b");
+    assert_file_text(outdir, "keep.txt", "not ours");
+    assert_int_equal(count_entries(sub), 1);
+    assert_file_text(sub, "inner", "user data");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/c.json", outdir);
+    assert_int_not_equal(access(path, F_OK), 0);
+
+    rm(sub, "inner");
+    assert_int_equal(rmdir(sub), 0);
+    rm(outdir, "a.hdr");
+    rm(outdir, "b.img");
+    rm(outdir, "keep.txt");
+    assert_int_equal(rmdir(outdir), 0);
+    free(outdir);
+}
+
+/* The commit leaves no hidden directory behind when it replaced files. */
+static void test_commit_leaves_no_aside(void **state)
+{
+    (void)state;
+    char *outdir = make_tmp_dir();
+    write_file(outdir, "x.img", "old");
+    output_stage *stage = NULL;
+    assert_int_equal(output_stage_create(outdir, &stage, NULL), THZ_OK);
+    write_file(output_stage_dir(stage), "x.img", "new");
+    assert_int_equal(output_stage_commit(stage, NULL), THZ_OK);
+    output_stage_destroy(stage);
+    assert_int_equal(count_entries(outdir), 1);
+    assert_file_text(outdir, "x.img", "new");
+    rm(outdir, "x.img");
+    assert_int_equal(rmdir(outdir), 0);
+    free(outdir);
+}
+
 static void test_destroy_leaves_nothing(void **state)
 {
     (void)state;
@@ -319,6 +385,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_commit_moves_files),
+        cmocka_unit_test(test_failed_commit_rolls_back),
+        cmocka_unit_test(test_commit_leaves_no_aside),
         cmocka_unit_test(test_destroy_leaves_nothing),
         cmocka_unit_test(test_destroy_removes_created_outdir),
         cmocka_unit_test(test_two_stages),
