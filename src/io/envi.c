@@ -6,16 +6,22 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/path.h"
 #include "thzmap/thzmap.h"
 
 /* Values converted per fwrite: bounds the stack buffer, keeps writes large. */
 enum { ENVI_CHUNK = 4096 };
 
-/* "dir/stem.ext" into buf; false if it does not fit. */
-static int envi_path(char *buf, size_t size, const char *dir, const char *stem, const char *ext)
+/* "dir/stem.ext" into buf (THZ_PATH_MAX bytes). */
+static thz_status envi_path(char *buf, const char *dir, const char *stem, const char *ext,
+                            thz_error *err)
 {
-    int n = snprintf(buf, size, "%s/%s.%s", dir, stem, ext);
-    return n >= 0 && (size_t)n < size;
+    char name[THZ_PATH_MAX];
+    int n = snprintf(name, sizeof name, "%s.%s", stem, ext);
+    if (n < 0 || (size_t)n >= sizeof name)
+        return thz_error_set(err, THZ_ERR_IO, "file name longer than the limit of %zu bytes: %s.%s",
+                             sizeof name - 1, stem, ext);
+    return thz_path_join(buf, THZ_PATH_MAX, dir, name, err);
 }
 
 /* Writes s with the characters that end ENVI values or lists replaced. */
@@ -51,11 +57,12 @@ static void envi_put_number_list(FILE *f, const char *key, const double *v, size
 }
 
 static thz_status envi_write_header(const char *dir, const char *stem, const envi_info *info,
-                                    int data_type, thz_error *err)
+                                    thz_error *err)
 {
-    char path[4096];
-    if (!envi_path(path, sizeof path, dir, stem, "hdr"))
-        return thz_error_set(err, THZ_ERR_IO, "%s/%s.hdr: path too long", dir, stem);
+    char path[THZ_PATH_MAX];
+    thz_status status = envi_path(path, dir, stem, "hdr", err);
+    if (status != THZ_OK)
+        return status;
     FILE *f = fopen(path, "w");
     if (!f)
         return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
@@ -63,7 +70,7 @@ static thz_status envi_write_header(const char *dir, const char *stem, const env
     envi_put_text(f, info->description ? info->description : "");
     fputs("}\n", f);
     fprintf(f, "samples = %u\nlines = %u\nbands = %zu\n", info->samples, info->lines, info->bands);
-    fprintf(f, "header offset = 0\nfile type = ENVI Standard\ndata type = %d\n", data_type);
+    fputs("header offset = 0\nfile type = ENVI Standard\ndata type = 4\n", f);
     fputs("interleave = bsq\nbyte order = 0\n", f);
     if (info->data_units) {
         fputs("data units = ", f);
@@ -88,25 +95,24 @@ static thz_status envi_write_header(const char *dir, const char *stem, const env
     return THZ_OK;
 }
 
-/* Writes n 32-bit words (float or int32, given as their bit patterns via memcpy) in
- * little-endian byte order. */
-static thz_status envi_write_words(const char *dir, const char *stem, const void *data, size_t n,
+/* Writes n floats, as their bit patterns, in little-endian byte order. */
+static thz_status envi_write_words(const char *dir, const char *stem, const float *data, size_t n,
                                    thz_error *err)
 {
-    char path[4096];
-    if (!envi_path(path, sizeof path, dir, stem, "img"))
-        return thz_error_set(err, THZ_ERR_IO, "%s/%s.img: path too long", dir, stem);
+    char path[THZ_PATH_MAX];
+    thz_status status = envi_path(path, dir, stem, "img", err);
+    if (status != THZ_OK)
+        return status;
     FILE *f = fopen(path, "wb");
     if (!f)
         return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
-    const unsigned char *src = data;
     unsigned char buf[ENVI_CHUNK * 4];
     int failed = 0;
     for (size_t done = 0; done < n && !failed;) {
         size_t m = n - done < ENVI_CHUNK ? n - done : ENVI_CHUNK;
         for (size_t i = 0; i < m; i++) {
             uint32_t w;
-            memcpy(&w, src + (done + i) * 4, 4);
+            memcpy(&w, &data[done + i], 4);
             buf[4 * i + 0] = (unsigned char)(w & 0xffu);
             buf[4 * i + 1] = (unsigned char)((w >> 8) & 0xffu);
             buf[4 * i + 2] = (unsigned char)((w >> 16) & 0xffu);
@@ -122,27 +128,15 @@ static thz_status envi_write_words(const char *dir, const char *stem, const void
     return THZ_OK;
 }
 
-static thz_status envi_write(const char *dir, const char *stem, const envi_info *info,
-                             const void *data, int data_type, thz_error *err)
+thz_status envi_write_float32(const char *dir, const char *stem, const envi_info *info,
+                              const float *data, thz_error *err)
 {
+    _Static_assert(sizeof(float) == 4, "ENVI data type 4 is IEEE single precision");
     size_t pixels = (size_t)info->samples * info->lines;
     if (info->bands && pixels > SIZE_MAX / 4 / info->bands)
         return thz_error_set(err, THZ_ERR_LIMIT, "%s/%s.img: image too large", dir, stem);
     thz_status status = envi_write_words(dir, stem, data, pixels * info->bands, err);
     if (status != THZ_OK)
         return status;
-    return envi_write_header(dir, stem, info, data_type, err);
-}
-
-thz_status envi_write_float32(const char *dir, const char *stem, const envi_info *info,
-                              const float *data, thz_error *err)
-{
-    _Static_assert(sizeof(float) == 4, "ENVI data type 4 is IEEE single precision");
-    return envi_write(dir, stem, info, data, 4, err);
-}
-
-thz_status envi_write_int32(const char *dir, const char *stem, const envi_info *info,
-                            const int32_t *data, thz_error *err)
-{
-    return envi_write(dir, stem, info, data, 3, err);
+    return envi_write_header(dir, stem, info, err);
 }

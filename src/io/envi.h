@@ -1,7 +1,8 @@
 /* ENVI images: a raw band-sequential file DIR/STEM.img and its text header
  * DIR/STEM.hdr (scene-format.md "Outputs"), the format Spectral Python, GDAL and ENVI
  * itself open. Data are little-endian on every host (`byte order = 0`), without a
- * header offset; float32 (`data type = 4`) or int32 (`data type = 3`).
+ * header offset; float32 (`data type = 4`) only, as the format promises for every
+ * image: integer data such as object indices are written as exact float values.
  */
 #ifndef THZ_IO_ENVI_H
 #define THZ_IO_ENVI_H
@@ -29,12 +30,9 @@ typedef struct envi_info {
     size_t n_object_names;
 } envi_info;
 
-/* Writes DIR/STEM.img (samples*lines*bands float32, BSQ) and DIR/STEM.hdr. */
+/* Writes DIR/STEM.img (samples*lines*bands float32, BSQ) and DIR/STEM.hdr. A path
+ * longer than THZ_PATH_MAX is THZ_ERR_IO (core/path.h). */
 thz_status envi_write_float32(const char *dir, const char *stem, const envi_info *info,
                               const float *data, thz_error *err);
-
-/* The same for int32 data (`data type = 3`). */
-thz_status envi_write_int32(const char *dir, const char *stem, const envi_info *info,
-                            const int32_t *data, thz_error *err);
 
 #endif

@@ -10,23 +10,35 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/path.h"
 #include "io/envi.h"
 #include "io/plot.h"
 #include "io/png_image.h"
 
-enum { OUT_NAME = 1024 };
+/* Descriptions and titles: text only, a long sensor or scene name may cut them. */
+enum { OUT_TEXT = 1024 };
 
-/* The file stem "S.<quantity>", with '/' in the sensor name replaced so that every
+/* float32 holds every integer up to 2^24 exactly: the most objects S.object_id can
+ * index (scene-format.md: every ENVI image is float32). */
+#define OUT_MAX_OBJECTS (1u << 24)
+
+/* The file name "S.<quantity><ext>", with '/' in the sensor name replaced so that every
  * file lands in dir. */
-static void out_stem(char *buf, size_t size, const char *sensor, const char *quantity)
+static thz_status out_file_name(char *buf, size_t size, const char *sensor, const char *quantity,
+                                const char *ext, thz_error *err)
 {
-    snprintf(buf, size, "%s.%s", sensor, quantity);
+    int n = snprintf(buf, size, "%s.%s%s", sensor, quantity, ext);
+    if (n < 0 || (size_t)n >= size)
+        return thz_error_set(err, THZ_ERR_IO,
+                             "sensor %s: file name longer than the limit of %zu bytes: %s%s",
+                             sensor, size - 1, quantity, ext);
     for (char *p = buf; *p; p++)
         if (*p == '/')
             *p = '_';
+    return THZ_OK;
 }
 
-/* Everything the cubes of one sensor share. */
+/* Everything the images of one sensor share. */
 typedef struct out_context {
     const char *dir;
     const thz_scene *scene;
@@ -35,33 +47,36 @@ typedef struct out_context {
     const char **channel_names; /* n_channels */
     double *center_ghz;
     double *fwhm_ghz;
+    const char **object_names; /* n_objects */
 } out_context;
 
-static thz_status out_cube(const out_context *ctx, const char *quantity, const float *data,
-                           const char *what, const char *units, thz_error *err)
+/* "dir/S.<quantity>.png" into path (THZ_PATH_MAX bytes). */
+static thz_status out_png_path(char *path, const out_context *ctx, const char *quantity,
+                               thz_error *err)
 {
-    char stem[OUT_NAME], description[OUT_NAME];
-    out_stem(stem, sizeof stem, ctx->sensor->name, quantity);
-    snprintf(description, sizeof description, "thzmap %s: %s [%s]; sensor %s; scene %s",
-             THZ_VERSION_STRING, what, units, ctx->sensor->name, ctx->scene->name);
-    envi_info info = {
-        .description = description,
-        .data_units = units,
-        .samples = ctx->images->columns,
-        .lines = ctx->images->rows,
-        .bands = ctx->images->n_channels,
-        .band_names = ctx->channel_names,
-        .wavelength_ghz = ctx->center_ghz,
-        .fwhm_ghz = ctx->fwhm_ghz,
-    };
-    return envi_write_float32(ctx->dir, stem, &info, data, err);
+    char name[THZ_PATH_MAX];
+    thz_status status = out_file_name(name, sizeof name, ctx->sensor->name, quantity, ".png", err);
+    if (status != THZ_OK)
+        return status;
+    return thz_path_join(path, THZ_PATH_MAX, ctx->dir, name, err);
 }
 
-static thz_status out_truth(const out_context *ctx, const char *quantity, const float *data,
-                            const char *what, const char *units, thz_error *err)
+/* What an image's bands are, and so what its header says about them. */
+typedef enum out_kind {
+    OUT_CHANNELS, /* one band per channel: band names, wavelength and fwhm in GHz */
+    OUT_TRUTH,    /* one band, named after the quantity */
+    OUT_INDEX     /* a truth image of object indices: also `data ignore value = -1` and
+                     `object names` */
+} out_kind;
+
+/* The ENVI image S.<quantity>; `what` and `units` go into its description. */
+static thz_status out_image(const out_context *ctx, out_kind kind, const char *quantity,
+                            const float *data, const char *what, const char *units, thz_error *err)
 {
-    char stem[OUT_NAME], description[OUT_NAME];
-    out_stem(stem, sizeof stem, ctx->sensor->name, quantity);
+    char stem[THZ_PATH_MAX], description[OUT_TEXT];
+    thz_status status = out_file_name(stem, sizeof stem, ctx->sensor->name, quantity, "", err);
+    if (status != THZ_OK)
+        return status;
     snprintf(description, sizeof description, "thzmap %s: %s [%s]; sensor %s; scene %s",
              THZ_VERSION_STRING, what, units, ctx->sensor->name, ctx->scene->name);
     const char *band_names[] = {quantity};
@@ -73,38 +88,36 @@ static thz_status out_truth(const out_context *ctx, const char *quantity, const 
         .bands = 1,
         .band_names = band_names,
     };
+    if (kind == OUT_CHANNELS) {
+        info.bands = ctx->images->n_channels;
+        info.band_names = ctx->channel_names;
+        info.wavelength_ghz = ctx->center_ghz;
+        info.fwhm_ghz = ctx->fwhm_ghz;
+    } else if (kind == OUT_INDEX) {
+        info.has_ignore_value = 1;
+        info.ignore_value = -1.0;
+        info.object_names = ctx->object_names;
+        info.n_object_names = ctx->scene->n_objects;
+    }
     return envi_write_float32(ctx->dir, stem, &info, data, err);
 }
 
+/* S.object_id: the indices as float32 like every ENVI image (exact, the scene having at
+ * most OUT_MAX_OBJECTS objects), -1.0 where nothing is hit. */
 static thz_status out_object_id(const out_context *ctx, thz_error *err)
 {
-    char stem[OUT_NAME], description[OUT_NAME];
-    out_stem(stem, sizeof stem, ctx->sensor->name, "object_id");
-    snprintf(description, sizeof description,
-             "thzmap %s: index of the object seen into the scene's objects (see object "
-             "names); -1 where nothing is hit; sensor %s; scene %s",
-             THZ_VERSION_STRING, ctx->sensor->name, ctx->scene->name);
-    const char *band_names[] = {"object_id"};
-    const thz_scene *scene = ctx->scene;
-    const char **names = thz_calloc(scene->n_objects, sizeof *names);
-    if (!names)
+    size_t pixels = (size_t)ctx->images->columns * ctx->images->rows;
+    float *ids = thz_malloc_array(pixels, sizeof *ids);
+    if (!ids)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-    for (size_t i = 0; i < scene->n_objects; i++)
-        names[i] = scene->objects[i].name;
-    envi_info info = {
-        .description = description,
-        .data_units = "index",
-        .samples = ctx->images->columns,
-        .lines = ctx->images->rows,
-        .bands = 1,
-        .band_names = band_names,
-        .has_ignore_value = 1,
-        .ignore_value = -1.0,
-        .object_names = names,
-        .n_object_names = scene->n_objects,
-    };
-    thz_status status = envi_write_int32(ctx->dir, stem, &info, ctx->images->object_id, err);
-    free(names);
+    for (size_t p = 0; p < pixels; p++)
+        ids[p] = (float)ctx->images->object_id[p];
+    thz_status status =
+        out_image(ctx, OUT_INDEX, "object_id", ids,
+                  "index of the object seen into the scene's objects (see object names); -1 where "
+                  "nothing is hit",
+                  "index", err);
+    free(ids);
     return status;
 }
 
@@ -112,10 +125,11 @@ static thz_status out_object_id(const out_context *ctx, thz_error *err)
  * kelvin without knowing T_ref. */
 static thz_status out_band_preview(const out_context *ctx, size_t c, thz_error *err)
 {
-    char quantity[64], stem[OUT_NAME], path[OUT_NAME * 2], title[OUT_NAME];
+    char quantity[64], path[THZ_PATH_MAX], title[OUT_TEXT];
     snprintf(quantity, sizeof quantity, "band-%02zu", c + 1);
-    out_stem(stem, sizeof stem, ctx->sensor->name, quantity);
-    snprintf(path, sizeof path, "%s/%s.png", ctx->dir, stem);
+    thz_status status = out_png_path(path, ctx, quantity, err);
+    if (status != THZ_OK)
+        return status;
     const thz_channel *ch = &ctx->scene->channels[c];
     snprintf(title, sizeof title, "%s: channel %zu, %s (%.4g GHz)", ctx->sensor->name, c + 1,
              ch->name, ch->center_hz / 1e9);
@@ -161,9 +175,10 @@ static thz_status out_spectra(const out_context *ctx, thz_error *err)
     }
     for (size_t c = 0; c < n_ch; c++)
         x[c] = scene->channels[c].center_hz / 1e12;
-    char stem[OUT_NAME], path[OUT_NAME * 2], title[OUT_NAME], y_label[OUT_NAME];
-    out_stem(stem, sizeof stem, ctx->sensor->name, "spectra");
-    snprintf(path, sizeof path, "%s/%s.png", ctx->dir, stem);
+    char path[THZ_PATH_MAX], title[OUT_TEXT], y_label[OUT_TEXT];
+    status = out_png_path(path, ctx, "spectra", err);
+    if (status != THZ_OK)
+        goto cleanup;
     snprintf(title, sizeof title, "%s: mean normalised radiance of each object in view",
              ctx->sensor->name);
     snprintf(y_label, sizeof y_label, "L / B(T#dref#u = %.6g K) (1)", ctx->sensor->normalize_to_k);
@@ -184,6 +199,10 @@ thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t s
         return thz_error_set(err, THZ_ERR_INTERNAL,
                              "output_write_sensor: sensor %zu or channel count out of range",
                              sensor);
+    if (scene->n_objects > OUT_MAX_OBJECTS)
+        return thz_error_set(err, THZ_ERR_LIMIT,
+                             "%zu objects: %s.object_id holds at most %u (float32 indices)",
+                             scene->n_objects, scene->sensors[sensor].name, OUT_MAX_OBJECTS);
     thz_status status = plot_check_device(err);
     if (status != THZ_OK)
         return status;
@@ -193,7 +212,8 @@ thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t s
     ctx.channel_names = thz_calloc(n_ch, sizeof *ctx.channel_names);
     ctx.center_ghz = thz_calloc(n_ch, sizeof *ctx.center_ghz);
     ctx.fwhm_ghz = thz_calloc(n_ch, sizeof *ctx.fwhm_ghz);
-    if (!ctx.channel_names || !ctx.center_ghz || !ctx.fwhm_ghz) {
+    ctx.object_names = thz_calloc(scene->n_objects, sizeof *ctx.object_names);
+    if (!ctx.channel_names || !ctx.center_ghz || !ctx.fwhm_ghz || !ctx.object_names) {
         status = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
         goto cleanup;
     }
@@ -203,37 +223,40 @@ thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t s
         ctx.center_ghz[c] = ch->center_hz / 1e9;
         ctx.fwhm_ghz[c] = ch->relative_width * ch->center_hz / 1e9;
     }
+    for (size_t i = 0; i < scene->n_objects; i++)
+        ctx.object_names[i] = scene->objects[i].name;
 
-    status = out_cube(&ctx, "radiance", images->radiance, "band-mean spectral radiance L_c",
-                      "W m-2 sr-1 Hz-1", err);
+    status = out_image(&ctx, OUT_CHANNELS, "radiance", images->radiance,
+                       "band-mean spectral radiance L_c", "W m-2 sr-1 Hz-1", err);
     if (status == THZ_OK && images->radiance_stderr)
-        status = out_cube(&ctx, "radiance_stderr", images->radiance_stderr, "standard error of L_c",
-                          "W m-2 sr-1 Hz-1", err);
+        status = out_image(&ctx, OUT_CHANNELS, "radiance_stderr", images->radiance_stderr,
+                           "standard error of L_c", "W m-2 sr-1 Hz-1", err);
     if (status == THZ_OK)
-        status = out_cube(&ctx, "power", images->power, "power on the pixel P_c", "W", err);
+        status = out_image(&ctx, OUT_CHANNELS, "power", images->power, "power on the pixel P_c",
+                           "W", err);
     if (status == THZ_OK)
-        status = out_cube(&ctx, "brightness_temperature", images->brightness_temperature,
-                          "brightness temperature Tb_c", "K", err);
+        status = out_image(&ctx, OUT_CHANNELS, "brightness_temperature",
+                           images->brightness_temperature, "brightness temperature Tb_c", "K", err);
     if (status == THZ_OK) {
         char what[256];
         snprintf(what, sizeof what, "normalised radiance N_c = L_c / B(T_ref = %.6g K)",
                  ctx.sensor->normalize_to_k);
-        status = out_cube(&ctx, "normalized", images->normalized, what, "1", err);
+        status = out_image(&ctx, OUT_CHANNELS, "normalized", images->normalized, what, "1", err);
     }
     if (status == THZ_OK)
-        status = out_truth(&ctx, "temperature", images->temperature_k,
+        status = out_image(&ctx, OUT_TRUTH, "temperature", images->temperature_k,
                            "temperature of the surface seen (0: nothing hit)", "K", err);
     if (status == THZ_OK)
-        status = out_truth(&ctx, "distance", images->distance_m,
+        status = out_image(&ctx, OUT_TRUTH, "distance", images->distance_m,
                            "distance to the surface seen (0: nothing hit)", "m", err);
     if (status == THZ_OK)
         status = out_object_id(&ctx, err);
     if (status == THZ_OK) {
-        char stem[OUT_NAME], path[OUT_NAME * 2];
-        out_stem(stem, sizeof stem, ctx.sensor->name, "visual");
-        snprintf(path, sizeof path, "%s/%s.png", dir, stem);
-        status =
-            png_image_write_srgb8(path, images->visual_rgb, images->columns, images->rows, err);
+        char path[THZ_PATH_MAX];
+        status = out_png_path(path, &ctx, "visual", err);
+        if (status == THZ_OK)
+            status =
+                png_image_write_srgb8(path, images->visual_rgb, images->columns, images->rows, err);
     }
     for (size_t c = 0; c < n_ch && status == THZ_OK; c++)
         status = out_band_preview(&ctx, c, err);
@@ -243,5 +266,6 @@ cleanup:
     free(ctx.channel_names);
     free(ctx.center_ghz);
     free(ctx.fwhm_ghz);
+    free(ctx.object_names);
     return status;
 }

@@ -66,7 +66,7 @@ def main():
             img = os.path.join(outdir, f"{s}.{q}.img")
             per_channel = q not in TRUTH
             bands = len(channels) if per_channel else 1
-            dtype = np.dtype("<i4") if q == "object_id" else np.dtype("<f4")
+            dtype = np.dtype("<f4")  # every image, object_id too (scene-format.md "Outputs")
             raw = np.fromfile(img, dtype=dtype)
             check(raw.size == cols * rows * bands, f"{img}: {raw.size} values")
             raw = raw.reshape(bands, rows, cols)  # BSQ
@@ -109,7 +109,17 @@ def main():
 
             if q == "object_id":
                 check(raw.min() >= -1 and raw.max() < n_objects, f"{img}: ids out of range")
-                ids = raw[0]
+                check(np.array_equal(raw, np.round(raw)), f"{img}: ids are not whole numbers")
+                objects = [o["name"] for o in scene["objects"]]
+                check(im.metadata.get("object names") == objects,
+                      f"{hdr}: object names {im.metadata.get('object names')} != {objects}")
+                check(float(im.metadata.get("data ignore value", "nan")) == -1.0,
+                      f"{hdr}: spectral data ignore value")
+                ds = gdal.Open(img)  # kept while its band is used: GDAL frees bands with it
+                nodata = ds.GetRasterBand(1).GetNoDataValue()
+                ds = None
+                check(nodata == -1.0, f"{img}: GDAL no-data value {nodata}")
+                ids = raw[0].astype(np.int32)
             if q == "brightness_temperature":
                 tb = raw
         hit = ids >= 0

@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "core/alloc.h"
+#include "core/path.h"
 #include "io/envi.h"
 #include "io/output.h"
 #include "scene/scene.h"
@@ -243,23 +244,24 @@ static void test_sensor_files(void **state)
         free(hdr);
     }
 
-    /* object_id: int32, -1 where nothing is hit, the object names for the indices. */
-    char path[1024];
-    snprintf(path, sizeof path, "%s/cam.object_id.img", dir);
-    size_t size = 0;
-    char *ids = slurp(path, &size);
-    assert_non_null(ids);
-    assert_int_equal(size, plane * 4);
+    /* object_id: float32 like every ENVI image, the index as an exact float, -1 where
+     * nothing is hit, the object names for the indices. */
+    float ids[COLS * ROWS];
     for (size_t p = 0; p < plane; p++)
-        assert_int_equal((int32_t)le32((const unsigned char *)ids + 4 * p), img.object_id[p]);
-    free(ids);
+        ids[p] = (float)img.object_id[p];
+    assert_img_floats(dir, "cam.object_id", ids, plane);
     char *hdr = read_header(dir, "cam.object_id");
-    assert_header(hdr, "data type", "3");
+    assert_header(hdr, "data type", "4");
+    assert_header(hdr, "bands", "1");
+    assert_header(hdr, "band names", "{object_id}");
+    assert_header(hdr, "data units", "index");
     assert_header(hdr, "data ignore value", "-1");
     assert_header(hdr, "object names", "{room, target, hidden#1}");
     free(hdr);
 
     /* The PNGs: visual, one preview per channel (numbered from 01), the spectra. */
+    char path[1024];
+    size_t size = 0;
     const char *pngs[] = {"cam.visual.png", "cam.band-01.png", "cam.band-02.png",
                           "cam.spectra.png"};
     for (size_t k = 0; k < 4; k++) {
@@ -310,12 +312,41 @@ static void test_unwritable(void **state)
     assert_non_null(strstr(err.message, "/nonexistent-thz-dir/a.img"));
 }
 
+/* An OUTDIR so long that the file names do not fit: an error naming the limit (the old
+ * snprintf into a fixed buffer cut the name silently). */
+static void test_path_too_long(void **state)
+{
+    (void)state;
+    thz_scene *scene = make_scene();
+    sensor_images img;
+    fill_images(&img, 0);
+    /* 4080 bytes: "/cam.radiance.img" (17) does not fit in 4095, "/summary.json" (13) does */
+    char *outdir = malloc(THZ_PATH_MAX);
+    assert_non_null(outdir);
+    memset(outdir, 'd', 4080);
+    outdir[0] = '/';
+    outdir[4080] = '\0';
+    thz_error err = {0};
+    assert_int_equal(output_write_sensor(outdir, scene, 0, &img, &err), THZ_ERR_IO);
+    assert_non_null(strstr(err.message, "path of 4097 bytes, longer than the limit of 4095"));
+    memset(outdir, 'd', 4090);
+    outdir[0] = '/';
+    outdir[4090] = '\0';
+    run_summary rs = {.command = "simulate"};
+    assert_int_equal(summary_write(outdir, scene, &rs, &err), THZ_ERR_IO);
+    assert_non_null(strstr(err.message, "path of 4103 bytes, longer than the limit of 4095"));
+    free(outdir);
+    sensor_images_fini(&img);
+    scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sensor_files),
         cmocka_unit_test(test_no_stderr),
         cmocka_unit_test(test_unwritable),
+        cmocka_unit_test(test_path_too_long),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
