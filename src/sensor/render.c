@@ -102,7 +102,7 @@ typedef struct render_target {
     double *est;
     uint32_t n_est;
     double *batch;      /* final-gather with batches: += weight x each batch's photon terms */
-    double *poisson;    /* and += weight^2 x their Poisson variance; else NULL */
+    double *disk_var;   /* and += weight^2 x their disks' Poisson variance; else NULL */
     double weight;      /* 1 / n^2 */
     uint64_t rng_index; /* first index of this sample's random streams (x n_est) */
 } render_target;
@@ -111,6 +111,12 @@ typedef struct render_target {
  * angle Omega_S / n^2. */
 typedef void (*render_sample_fn)(const render_context *ctx, vec3 origin_m, vec3 dir,
                                  double sample_sr, const render_target *t, render_sample *out);
+
+static void render_add_all(const render_target *t, double v)
+{
+    for (uint32_t j = 0; j < t->n_est; j++)
+        t->est[j] += t->weight * v;
+}
 
 static void render_photon_map_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
                                      double sample_sr, const render_target *t, render_sample *out);
@@ -123,7 +129,7 @@ static void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 di
 typedef struct render_integrator {
     thz_integrator id;
     const char *name;
-    render_sample_fn sample; /* NULL: not implemented yet */
+    render_sample_fn sample;
     bool needs_photons;
     uint32_t purpose; /* RNG purpose; 0: no random numbers (one pass) */
 } render_integrator;
@@ -164,9 +170,6 @@ thz_status render_integrator_check(thz_integrator integrator, thz_error *err)
     const render_integrator *it = render_find_integrator(integrator);
     if (!it)
         return thz_error_set(err, THZ_ERR_INPUT, "unknown integrator %d", (int)integrator);
-    if (!it->sample)
-        return thz_error_set(err, THZ_ERR_INPUT, "integrator '%s' is not implemented yet",
-                             it->name);
     return THZ_OK;
 }
 
@@ -235,10 +238,13 @@ double render_reference_temperature_k(const thz_scene *scene, size_t channel)
     return t0;
 }
 
-/* map_t0: take T0 from the photon map (photon-map, final-gather), else choose it (path). */
+static void render_pair_table(render_context *ctx);
+
+/* T0: the photon map's when map_t0 (photon-map, final-gather), else path_t0_k when it is
+ * not NAN, else render_reference_temperature_k (path). */
 static thz_status render_context_init(render_context *ctx, const thz_scene *scene, const accel *a,
                                       const photon_map *map, size_t channel, bool map_t0,
-                                      thz_error *err)
+                                      double path_t0_k, thz_error *err)
 {
     memset(ctx, 0, sizeof *ctx);
     ctx->scene = scene;
@@ -295,8 +301,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         for (size_t k = 0; diffuse && k < n; k++)
             ctx->tbar[o * n + k] = optics_mean_transmission(&ctx->optics[o * n + k]);
     }
-    ctx->t0_k = map_t0 ? photon_map_reference_temperature_k(map)
-                       : render_reference_temperature_k(scene, channel);
+    ctx->t0_k = map_t0                ? photon_map_reference_temperature_k(map)
+                 : !isnan(path_t0_k) ? path_t0_k
+                                     : render_reference_temperature_k(scene, channel);
     ctx->deviation = map_t0 && ctx->t0_k > 0.0;
     for (size_t k = 0; k < n; k++) {
         ctx->b0[k] = planck_radiance(ctx->quad.freq_hz[k], ctx->t0_k);
@@ -311,27 +318,6 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         }
         ctx->source_mean[o] = scene->objects[o].type == OBJECT_SOLID ? sum : NAN;
     }
-    if (n_obj <= RENDER_PAIR_OBJECTS && map && scene->render.integrator == INTEGRATOR_FINAL_GATHER)
-        ctx->pair_mean = thz_malloc_array(n_obj > 0 ? n_obj * n_obj : 1, sizeof *ctx->pair_mean);
-    for (size_t x = 0; ctx->pair_mean && x < n_obj; x++)
-        for (size_t y = 0; y < n_obj; y++) {
-            double *v = &ctx->pair_mean[x * n_obj + y];
-            *v = NAN;
-            if (scene->objects[y].type != OBJECT_SOLID || !ctx->scatters[x])
-                continue;
-            /* the same terms in the same order as render_emission_scattered's loop */
-            double sum = 0.0;
-            for (size_t k = 0; k < n; k++) {
-                double f = ctx->optics[x * n + k].reflectivity;
-                const optics_point *oy = &ctx->optics[y * n + k];
-                double t =
-                    ctx->quad.weight[k] * f * optics_emissivity(oy, 1.0) * ctx->planck[y * n + k];
-                if (ctx->deviation)
-                    t -= ctx->quad.weight[k] * f * optics_absorption(oy, 1.0) * ctx->b0[k];
-                sum += t;
-            }
-            *v = sum;
-        }
     const thz_atmosphere *atm = &scene->atmosphere;
     ctx->emitting = atm->emitting;
     ctx->air_terms = atm->emitting || ctx->deviation;
@@ -351,6 +337,8 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
                 atm->emitting ? planck_radiance(nu, atm->background_temperature_k) : 0.0;
         }
     }
+    if (map && scene->render.integrator == INTEGRATOR_FINAL_GATHER)
+        render_pair_table(ctx);
     return THZ_OK;
 }
 
@@ -401,33 +389,6 @@ static double render_tbar(const render_context *ctx, const thz_object *obj, uint
     return optics_mean_transmission(&o);
 }
 
-/* Band mean of eps(theta) B_nu(T) (deviation: eps B - A(theta) B0) times the path
- * weight and exp(-alpha d) (no cos factor: physics.md "Surfaces"). */
-static double render_emission(const render_context *ctx, uint32_t object, double mu,
-                              const render_path *path, double distance_m)
-{
-    if (!(ctx->scene->objects[object].temperature_k > 0.0) && !ctx->deviation)
-        return 0.0;
-    const double *mean = ctx->deviation ? ctx->source_mean : ctx->emission_mean;
-    if (path->n == 0 && !ctx->atmosphere && !isnan(mean[object]))
-        return mean[object];
-    size_t n = ctx->quad.n;
-    const optics_point *op = &ctx->optics[(size_t)object * n];
-    const double *planck = &ctx->planck[(size_t)object * n];
-    double sum = 0.0;
-    for (size_t k = 0; k < n; k++) {
-        double v = ctx->quad.weight[k] * optics_emissivity(&op[k], mu) * planck[k];
-        if (ctx->deviation)
-            v -= ctx->quad.weight[k] * optics_absorption(&op[k], mu) * ctx->b0[k];
-        for (size_t i = 0; i < path->n && v != 0.0; i++)
-            v *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
-        if (ctx->atmosphere)
-            v *= exp(-ctx->alpha_per_m[k] * distance_m);
-        sum += v;
-    }
-    return sum;
-}
-
 /* The scattering at a final-gather vertex x, as a weight on whatever arrives along the
  * gather ray at frequency nu: f_x(nu) cos / pdf / P(branch), with the direction and the
  * branch drawn at the gather ray's frequency nu_j. */
@@ -470,39 +431,6 @@ static double render_scatter_node(const render_context *ctx, const render_scatte
                       : 0.0;
 }
 
-/* Final-gather's secondary emission: the band mean, by the channel quadrature, of
- * eps(theta) B_nu(T) at the secondary hit times the straight-shell path weight,
- * exp(-alpha d) and the first vertex's scattering weight, all at each node: the gather
- * ray then carries no band noise of B. */
-static double render_emission_scattered(const render_context *ctx, uint32_t object, double mu,
-                                        const render_path *path, double distance_m,
-                                        const render_scatter *s)
-{
-    if (!(ctx->scene->objects[object].temperature_k > 0.0) && !ctx->deviation)
-        return 0.0;
-    if (ctx->pair_mean && !s->transmitted && path->n == 0 && !ctx->atmosphere) {
-        double v = ctx->pair_mean[(size_t)s->object_index * ctx->scene->n_objects + object];
-        if (!isnan(v))
-            return v * s->inv_branch;
-    }
-    size_t n = ctx->quad.n;
-    const optics_point *op = &ctx->optics[(size_t)object * n];
-    const double *planck = &ctx->planck[(size_t)object * n];
-    double sum = 0.0;
-    for (size_t k = 0; k < n; k++) {
-        double f = render_scatter_node(ctx, s, k);
-        double v = ctx->quad.weight[k] * f * optics_emissivity(&op[k], mu) * planck[k];
-        if (ctx->deviation)
-            v -= ctx->quad.weight[k] * f * optics_absorption(&op[k], mu) * ctx->b0[k];
-        for (size_t i = 0; i < path->n && v != 0.0; i++)
-            v *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
-        if (ctx->atmosphere)
-            v *= exp(-ctx->alpha_per_m[k] * distance_m);
-        sum += v;
-    }
-    return sum * s->inv_branch;
-}
-
 /* The weight of quadrature node k in a band mean seen through `path` and the first
  * vertex's scattering s (may be NULL; without 1 / P(branch)): the node's quadrature
  * weight times s's scattering weight and the straight shells' T(theta) at that node. */
@@ -516,6 +444,67 @@ static double render_node_weight(const render_context *ctx, const render_path *p
     for (size_t i = 0; i < path->n && w != 0.0; i++)
         w *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
     return w;
+}
+
+/* Band mean of eps(theta) B_nu(T) at a hit (deviation: eps B - A(theta) B0; no cos
+ * factor: physics.md "Surfaces") times exp(-alpha d), the straight-shell path weight and
+ * the first vertex's scattering s (may be NULL; final-gather's secondary hits), all at
+ * each quadrature node: what the sensor sees carries no band noise of B. Without shells
+ * or air between, the band means come from the tables (emission_mean or source_mean for
+ * the sample's own hit, pair_mean for a reflected gather ray). */
+static double render_emission(const render_context *ctx, uint32_t object, double mu,
+                              const render_path *path, double distance_m, const render_scatter *s)
+{
+    if (!(ctx->scene->objects[object].temperature_k > 0.0) && !ctx->deviation)
+        return 0.0;
+    if (path->n == 0 && !ctx->atmosphere) {
+        if (!s) {
+            double v = (ctx->deviation ? ctx->source_mean : ctx->emission_mean)[object];
+            if (!isnan(v))
+                return v;
+        } else if (ctx->pair_mean && !s->transmitted) {
+            double v = ctx->pair_mean[(size_t)s->object_index * ctx->scene->n_objects + object];
+            if (!isnan(v))
+                return v * s->inv_branch;
+        }
+    }
+    size_t n = ctx->quad.n;
+    const optics_point *op = &ctx->optics[(size_t)object * n];
+    const double *planck = &ctx->planck[(size_t)object * n];
+    double sum = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        double v = optics_emissivity(&op[k], mu) * planck[k];
+        if (ctx->deviation)
+            v -= optics_absorption(&op[k], mu) * ctx->b0[k];
+        if (ctx->atmosphere)
+            v *= exp(-ctx->alpha_per_m[k] * distance_m);
+        if (v != 0.0)
+            sum += v * render_node_weight(ctx, path, s, k);
+    }
+    return s ? sum * s->inv_branch : sum;
+}
+
+/* final-gather's table of band means per pair of objects (render_context.pair_mean):
+ * render_emission of solid y seen by a reflected gather ray from x, with nothing
+ * between; left NULL beyond RENDER_PAIR_OBJECTS objects or without memory (then every
+ * ray sums the nodes). */
+static void render_pair_table(render_context *ctx)
+{
+    size_t n_obj = ctx->scene->n_objects;
+    if (n_obj == 0 || n_obj > RENDER_PAIR_OBJECTS)
+        return;
+    double *table = thz_malloc_array(n_obj * n_obj, sizeof *table);
+    if (!table)
+        return;
+    render_path none = {.n = 0};
+    for (size_t x = 0; x < n_obj; x++) {
+        render_scatter s = {.object_index = (uint32_t)x, .inv_branch = 1.0};
+        for (size_t y = 0; y < n_obj; y++)
+            table[x * n_obj + y] = ctx->scatters[x] && ctx->scene->objects[y].type == OBJECT_SOLID
+                                       ? render_emission(ctx, (uint32_t)y, 1.0, &none, 0.0, &s)
+                                       : NAN;
+    }
+    ctx->pair_mean = table;
 }
 
 /* Deviation: the band mean of B0 exp(-alpha d), seen through path and s: what a back
@@ -850,11 +839,7 @@ static double render_photon_map_trace(const render_context *ctx, vec3 origin_m, 
                 radiance -= render_b0_term(ctx, &path, scatter, distance_m);
             return radiance;
         }
-        if (scatter)
-            radiance += render_emission_scattered(ctx, hit.object, hit.cos_theta, &path, distance_m,
-                                                  scatter);
-        else
-            radiance += render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m);
+        radiance += render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m, scatter);
         bool shell = obj->type == OBJECT_SHELL;
         bool straight =
             shell && ctx->scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
@@ -903,14 +888,7 @@ static void render_photon_map_sample(const render_context *ctx, vec3 origin_m, v
                                        sample_sr, out);
     if (ctx->deviation)
         l += ctx->b0_mean;
-    for (uint32_t j = 0; j < t->n_est; j++)
-        t->est[j] += t->weight * l;
-}
-
-static void render_add_all(const render_target *t, double v)
-{
-    for (uint32_t j = 0; j < t->n_est; j++)
-        t->est[j] += t->weight * v;
+    render_add_all(t, l);
 }
 
 /* One gather ray from first vertex `hit` (object obj, seen through `path`, at distance
@@ -987,7 +965,7 @@ static void render_final_gather_sample(const render_context *ctx, vec3 origin_m,
                 render_add_all(t, -render_b0_term(ctx, &path, NULL, distance_m));
             return;
         }
-        render_add_all(t, render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m));
+        render_add_all(t, render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m, NULL));
         bool shell = obj->type == OBJECT_SHELL;
         bool straight =
             shell && ctx->scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
@@ -1004,7 +982,7 @@ static void render_final_gather_sample(const render_context *ctx, vec3 origin_m,
                 if (t->batch) {
                     for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
                         t->batch[b] += t->weight * sec.batch[b];
-                    *t->poisson += t->weight * t->weight * sec.variance;
+                    *t->disk_var += t->weight * t->weight * sec.variance;
                 }
             }
             out->paths += t->n_est;
@@ -1318,7 +1296,10 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
     uint32_t n_est = integ->purpose ? render_estimates_per_pass(scene) : 1;
     int threads = render_threads(opt);
     render_context ctx;
-    st = render_context_init(&ctx, scene, a, map, channel, integ->needs_photons, err);
+    double path_t0_k = opt && opt->path_t0_set ? opt->path_t0_k : NAN;
+    if (!(path_t0_k >= 0.0) && !isnan(path_t0_k))
+        return thz_error_set(err, THZ_ERR_INTERNAL, "render: path T0 %g K is negative", path_t0_k);
+    st = render_context_init(&ctx, scene, a, map, channel, integ->needs_photons, path_t0_k, err);
     if (st != THZ_OK)
         return st;
     if (opt && opt->use_seed)
@@ -1354,7 +1335,7 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
     uint64_t samples_per_pass = (uint64_t)cols * rows * n * n;
     /* Rows per block: about 64k sample estimates between progress calls (fewer parallel
      * regions: less waiting at their ends). */
-    uint64_t work_per_row = (uint64_t)cols * n * n * (integ->purpose ? n_est : 1);
+    uint64_t work_per_row = (uint64_t)cols * n * n * n_est;
     uint32_t block = (uint32_t)(65536 / (work_per_row ? work_per_row : 1));
     if (block < 1)
         block = 1;
@@ -1376,7 +1357,7 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
             for (size_t j = 0; j < per_thread; j++)
                 est[j] = 0.0;
             double *pixel_batch = batched ? est + n_est : NULL;
-            double *pixel_poisson = batched ? est + n_est + PHOTON_MAP_BATCHES : NULL;
+            double *pixel_disk_var = batched ? est + n_est + PHOTON_MAP_BATCHES : NULL;
             uint32_t row = (uint32_t)(px / cols), col = (uint32_t)(px % cols);
             double omega_sr = camera_pixel_solid_angle(&cam, col, row);
             double sample_sr = omega_sr / n2;
@@ -1390,7 +1371,7 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
                         .est = est,
                         .n_est = n_est,
                         .batch = pixel_batch,
-                        .poisson = pixel_poisson,
+                        .disk_var = pixel_disk_var,
                         .weight = 1.0 / n2,
                         .rng_index =
                             render_rng_index(scene, sensor, pass, samples_per_pass, sample, n_est),
@@ -1425,7 +1406,7 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
             if (batched) {
                 for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
                     acc->batch[p * PHOTON_MAP_BATCHES + b] += pixel_batch[b];
-                acc->disk_var[p] += *pixel_poisson;
+                acc->disk_var[p] += *pixel_disk_var;
             }
         }
         if (render_report(opt, scene, channel, r1, rows)) {

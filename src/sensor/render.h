@@ -8,7 +8,9 @@
  *   final-gather: at the first non-straight hit, `gather_rays` secondary rays (cosine for
  *                 reflection, by the BTDF T(theta) cos(theta) for diffuse shells) each
  *                 adding L_e + L_R + L_T from the photon map at its own hit, with the
- *                 k-nearest-photon radius (k = gather_min_photons) there.
+ *                 k-nearest-photon radius there (k = max(gather_min_photons,
+ *                 RENDER_SECONDARY_K)); from a deviation map (photon_map.h) the terms are
+ *                 those of L - B(T0) and the sample adds B(T0).
  *   path:         backward Monte Carlo without a photon map, `paths_per_sample` paths per
  *                 sample, frequency drawn from g_c per path; written as the transport of
  *                 L - B_nu(T0) (T0: a reference temperature of the scene) so that every
@@ -71,6 +73,11 @@ typedef struct render_options {
     uint64_t seed;
     thz_progress_fn progress; /* stage "render": done/total = rows of this sensor; may be NULL */
     void *progress_user;
+    /* path: use T0 = path_t0_k (K, >= 0) instead of render_reference_temperature_k. Any T0
+     * gives the same expected image (only the noise changes); the identity tests use it
+     * so that reflected and transmitted terms do not vanish against B(T0). */
+    bool path_t0_set;
+    double path_t0_k;
 } render_options;
 
 /* Counts of one render_sensor_channel call; add them up across calls. */
