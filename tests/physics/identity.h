@@ -77,6 +77,43 @@ typedef struct ident_run {
     camera cam;
 } ident_run;
 
+/* The reference temperatures every identity runs with: NAN, as simulate and path choose
+ * it (the enclosure's, where reflected and transmitted terms vanish against B(T0), so
+ * their weights go unchecked), and 0 K (no control variate: those weights count in full;
+ * final-gather then reads the paper's map of L). photon-map's own map has T0 = 0
+ * already, so it runs once. */
+#define IDENT_N_T0 2
+static const double ident_t0s[IDENT_N_T0] = {NAN, 0.0};
+
+static inline bool ident_t0_applies(thz_integrator integrator, size_t variant)
+{
+    return variant == 0 || integrator != INTEGRATOR_PHOTON_MAP;
+}
+
+/* The image's pooled relative standard error of channel c against expected values
+ * expect(col, row) (ident_tally.pooled_rel_se): a pixel's own error, from 16 estimates at
+ * THZ_TEST_SCALE = 0.25, is Student-t distributed, and among 144 pixels one then lies
+ * beyond 5 of its own errors now and then (measured z = 6.1 with path at T0 = 0 K). */
+static inline double ident_pooled_rel_se(const ident_run *r, size_t c, const double *expect)
+{
+    double sum = 0.0;
+    size_t n = (size_t)r->img.rows * r->img.columns;
+    for (size_t i = 0; i < n; i++) {
+        double rel = r->img.radiance_stderr[c * n + i] / expect[i];
+        sum += rel * rel;
+    }
+    return n ? sqrt(sum / (double)n) : 0.0;
+}
+
+/* "integrator" or "integrator, T0 = 0 K", for messages. */
+static inline void ident_label(char *out, size_t size, thz_integrator integrator, double t0_k)
+{
+    if (isnan(t0_k))
+        snprintf(out, size, "%s", render_integrator_name(integrator));
+    else
+        snprintf(out, size, "%s, T0 = %g K", render_integrator_name(integrator), t0_k);
+}
+
 /* The photon phase's options as `simulate` sets them: final-gather fires the deviation
  * map at the renderer's T0, photon-map the paper's map. */
 static inline photon_phase_options ident_photon_options(const thz_scene *scene, size_t channel,
@@ -100,7 +137,10 @@ static inline void ident_run_scene_with(ident_run *r, const char *json, uint64_t
     ident_run_scene_t0(r, json, photons, integrator, estimates, NAN);
 }
 
-/* The same with the photon map fired at reference temperature t0_k (NAN: as simulate). */
+/* The same with reference temperature t0_k (NAN: as simulate chooses it): the photon
+ * map's (photon-map, final-gather) or path's T0. With T0 away from the enclosure's
+ * temperature the reflected and transmitted terms no longer vanish against B(T0), so an
+ * identity then checks their weights too. */
 static inline void ident_run_scene_t0(ident_run *r, const char *json, uint64_t photons,
                                       thz_integrator integrator, uint32_t estimates, double t0_k)
 {
@@ -124,7 +164,7 @@ static inline void ident_run_scene_t0(ident_run *r, const char *json, uint64_t p
     assert_int_equal(camera_init(&r->cam, sn, &err), THZ_OK);
     assert_int_equal(
         sensor_images_init(&r->img, sn->columns, sn->rows, r->scene->n_channels, 1, &err), THZ_OK);
-    render_options ro = {.threads = 2};
+    render_options ro = {.threads = 2, .path_t0_set = !isnan(t0_k), .path_t0_k = t0_k};
     assert_int_equal(render_sensor_truth(r->scene, r->acc, 0, &r->img, &ro, &err), THZ_OK);
     for (size_t c = 0; c < r->scene->n_channels; c++) {
         photon_phase_options po = ident_photon_options(r->scene, c, integrator);

@@ -115,7 +115,7 @@ static void test_band_emission(void **state)
         band_emission_case(ident_integrators[k]);
 }
 
-static void band_reflection_case(thz_integrator integrator)
+static void band_reflection_case(thz_integrator integrator, double t0_k)
 {
     band_line l;
     band_line_init(&l);
@@ -125,7 +125,7 @@ static void band_reflection_case(thz_integrator integrator)
     ident_run r;
     /* R B is heavy-tailed in frequency: 128 gather rays or paths keep a pixel's standard
      * error below the bound */
-    ident_run_scene_with(&r, json, ident_photons(300000), integrator, ident_estimates(128));
+    ident_run_scene_t0(&r, json, ident_photons(300000), integrator, ident_estimates(128), t0_k);
     const thz_channel *ch = &r.scene->channels[0];
     double expect = ident_band_mean(ch, band_reflected, &l);
     double at_centre = band_r(&l, BAND_NU_C) * ident_band_planck(ch, 300.0);
@@ -143,8 +143,9 @@ static void band_reflection_case(thz_integrator integrator)
              * is its band mean, deterministic here) */
             ident_check_pixel(&t, &r, 0, col, row, expect, 2e-4);
         }
-    char what[64];
-    snprintf(what, sizeof what, "reflection with a line, %s", render_integrator_name(integrator));
+    char label[64], what[128];
+    ident_label(label, sizeof label, integrator, t0_k);
+    snprintf(what, sizeof what, "reflection with a line, %s", label);
     ident_tally_assert(&t, what, 0.2 / sqrt(ident_scale()), 2e-4);
     /* the centre value is excluded by many standard errors of the mean */
     double se_mean = t.pooled_rel_se / sqrt((double)t.pixels);
@@ -158,7 +159,9 @@ static void test_band_reflection(void **state)
 {
     (void)state;
     for (size_t k = 0; k < IDENT_N_INTEGRATORS; k++)
-        band_reflection_case(ident_integrators[k]);
+        for (size_t v = 0; v < IDENT_N_T0; v++)
+            if (ident_t0_applies(ident_integrators[k], v))
+                band_reflection_case(ident_integrators[k], ident_t0s[v]);
 }
 
 int main(void)

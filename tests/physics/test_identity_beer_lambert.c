@@ -21,10 +21,10 @@ static const char *corridor_json =
     "   \"fov_deg\": 4, \"resolution\": [8, 6], \"normalize_to_k\": 310}],"
     " \"photons\": {\"per_channel\": 2000, \"seed\": 1}}";
 
-static void beer_lambert_case(thz_integrator integrator)
+static void beer_lambert_case(thz_integrator integrator, double t0_k)
 {
     ident_run r;
-    ident_run_scene_with(&r, corridor_json, 0, integrator, ident_estimates(32));
+    ident_run_scene_t0(&r, corridor_json, 0, integrator, ident_estimates(32), t0_k);
     bool sampled = integrator == INTEGRATOR_PATH;
     const double alpha = 0.15, temp_k = 310.0, wall_y = 5.0, cam_y = -4.9;
     for (size_t c = 0; c < r.scene->n_channels; c++) {
@@ -58,7 +58,9 @@ static void test_beer_lambert(void **state)
 {
     (void)state;
     for (size_t k = 0; k < IDENT_N_INTEGRATORS; k++)
-        beer_lambert_case(ident_integrators[k]);
+        for (size_t v = 0; v < IDENT_N_T0; v++)
+            if (ident_t0_applies(ident_integrators[k], v))
+                beer_lambert_case(ident_integrators[k], ident_t0s[v]);
 }
 
 int main(void)

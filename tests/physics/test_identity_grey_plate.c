@@ -17,24 +17,29 @@ static const char *plate_json =
     "   \"fov_deg\": 100, \"resolution\": [12, 12], \"normalize_to_k\": 300}],"
     " \"photons\": {\"per_channel\": 300000, \"seed\": 5}}";
 
-static void grey_plate_case(thz_integrator integrator)
+static void grey_plate_case(thz_integrator integrator, double t0_k)
 {
     ident_run r;
-    ident_run_scene_with(&r, plate_json, ident_photons(300000), integrator, ident_estimates(32));
+    ident_run_scene_t0(&r, plate_json, ident_photons(300000), integrator, ident_estimates(32),
+                       t0_k);
     const double refl = 0.4, t1 = 250.0, t2 = 350.0;
     for (size_t c = 0; c < r.scene->n_channels; c++) {
         const thz_channel *ch = &r.scene->channels[c];
         double expect = (1.0 - refl) * ident_band_planck(ch, t1) + refl * ident_band_planck(ch, t2);
-        ident_tally t = {0};
+        double expects[144];
+        assert_true((size_t)r.img.rows * r.img.columns <= 144);
+        for (size_t i = 0; i < (size_t)r.img.rows * r.img.columns; i++)
+            expects[i] = expect;
+        ident_tally t = {.pooled_rel_se = ident_pooled_rel_se(&r, c, expects)};
         for (uint32_t row = 0; row < r.img.rows; row++)
             for (uint32_t col = 0; col < r.img.columns; col++) {
                 assert_int_equal(r.img.object_id[row * r.img.columns + col], 1);
                 assert_true(ident_pixel_interior(&r, col, row));
                 ident_check_pixel(&t, &r, c, col, row, expect, 1e-5);
             }
-        char what[64];
-        snprintf(what, sizeof what, "grey plate, %s, channel %zu",
-                 render_integrator_name(integrator), c);
+        char label[64], what[128];
+        ident_label(label, sizeof label, integrator, t0_k);
+        snprintf(what, sizeof what, "grey plate, %s, channel %zu", label, c);
         /* reflected part is R B(T2) / L ~ 0.5 of L: a factor 2 moves L by 50 % */
         ident_tally_assert(&t, what, 0.08 / sqrt(ident_scale()), 1e-5);
     }
@@ -45,7 +50,9 @@ static void test_grey_plate(void **state)
 {
     (void)state;
     for (size_t k = 0; k < IDENT_N_INTEGRATORS; k++)
-        grey_plate_case(ident_integrators[k]);
+        for (size_t v = 0; v < IDENT_N_T0; v++)
+            if (ident_t0_applies(ident_integrators[k], v))
+                grey_plate_case(ident_integrators[k], ident_t0s[v]);
 }
 
 int main(void)

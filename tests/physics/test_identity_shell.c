@@ -13,7 +13,7 @@
 #define SHELL_TS 400.0
 #define SHELL_TB 250.0
 
-static void shell_case_with(const char *mode, uint64_t seed, thz_integrator integrator)
+static void shell_case_with(const char *mode, uint64_t seed, thz_integrator integrator, double t0_k)
 {
     char json[2048];
     snprintf(json, sizeof json,
@@ -36,26 +36,31 @@ static void shell_case_with(const char *mode, uint64_t seed, thz_integrator inte
              mode, SHELL_R, SHELL_ALPHA, mode, SHELL_TB, SHELL_T_M, SHELL_TS,
              (unsigned long long)seed);
     ident_run r;
-    ident_run_scene_with(&r, json, ident_photons(300000), integrator, ident_estimates(32));
+    ident_run_scene_t0(&r, json, ident_photons(300000), integrator, ident_estimates(32), t0_k);
     const thz_channel *ch = &r.scene->channels[0];
     double bs = ident_band_planck(ch, SHELL_TS), bb = ident_band_planck(ch, SHELL_TB);
-    ident_tally t = {0};
-    double t_min = 1.0, t_max = 0.0;
+    double t_min = 1.0, t_max = 0.0, expects[144];
+    assert_true((size_t)r.img.rows * r.img.columns <= 144);
+    for (uint32_t row = 0; row < r.img.rows; row++)
+        for (uint32_t col = 0; col < r.img.columns; col++) {
+            double mu = fabs(camera_pixel_center_dir(&r.cam, col, row).y); /* normal is -y */
+            double tr = fmin(exp(-SHELL_ALPHA * SHELL_T_M / mu), 1.0 - SHELL_R);
+            t_min = fmin(t_min, tr);
+            t_max = fmax(t_max, tr);
+            expects[row * r.img.columns + col] = (1.0 - SHELL_R - tr) * bs + (SHELL_R + tr) * bb;
+        }
+    ident_tally t = {.pooled_rel_se = ident_pooled_rel_se(&r, 0, expects)};
     for (uint32_t row = 0; row < r.img.rows; row++)
         for (uint32_t col = 0; col < r.img.columns; col++) {
             assert_int_equal(r.img.object_id[row * r.img.columns + col], 1);
             /* no edge of the cover within a disk (the black background needs none) */
             assert_true(strcmp(mode, "straight") == 0 || ident_pixel_interior(&r, col, row));
-            double mu = fabs(camera_pixel_center_dir(&r.cam, col, row).y); /* normal is -y */
-            double tr = fmin(exp(-SHELL_ALPHA * SHELL_T_M / mu), 1.0 - SHELL_R);
-            t_min = fmin(t_min, tr);
-            t_max = fmax(t_max, tr);
-            double expect = (1.0 - SHELL_R - tr) * bs + (SHELL_R + tr) * bb;
-            ident_check_pixel(&t, &r, 0, col, row, expect, 1e-5);
+            ident_check_pixel(&t, &r, 0, col, row, expects[row * r.img.columns + col], 1e-5);
         }
     assert_true(t_max - t_min > 0.1); /* the view spans a real range of T(theta) */
-    char what[64];
-    snprintf(what, sizeof what, "%s shell, %s", mode, render_integrator_name(integrator));
+    char label[64], what[128];
+    ident_label(label, sizeof label, integrator, t0_k);
+    snprintf(what, sizeof what, "%s shell, %s", mode, label);
     ident_tally_assert(&t, what, 0.08 / sqrt(ident_scale()), 1e-5);
     ident_run_fini(&r);
 }
@@ -63,7 +68,9 @@ static void shell_case_with(const char *mode, uint64_t seed, thz_integrator inte
 static void shell_case(const char *mode, uint64_t seed)
 {
     for (size_t k = 0; k < IDENT_N_INTEGRATORS; k++)
-        shell_case_with(mode, seed, ident_integrators[k]);
+        for (size_t v = 0; v < IDENT_N_T0; v++)
+            if (ident_t0_applies(ident_integrators[k], v))
+                shell_case_with(mode, seed, ident_integrators[k], ident_t0s[v]);
 }
 
 static void test_shell_straight(void **state)
