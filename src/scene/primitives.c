@@ -28,9 +28,7 @@ thz_status primitive_mesh_alloc(thz_mesh *mesh, size_t n_vertices, size_t n_tria
     return THZ_OK;
 }
 
-/* double -> float without the undefined behaviour of out-of-range conversions: values
- * beyond float's range become infinite (and the loader refuses the object). */
-static float primitive_to_float(double x)
+float primitive_to_float(double x)
 {
     return fabs(x) <= FLT_MAX ? (float)x : (float)copysign(INFINITY, x);
 }
@@ -216,7 +214,7 @@ thz_status primitive_sphere(thz_mesh *mesh, double radius_m, unsigned subdivisio
     }
     memcpy(tri, ico_t, sizeof ico_t);
     for (unsigned level = 0; level < subdivisions; level++) {
-        for (size_t i = 0; i < max_v * SPHERE_SLOTS; i++)
+        for (size_t i = 0; i < nv * SPHERE_SLOTS; i++) /* midpoints key on older vertices */
             slots[i].other = UINT32_MAX;
         size_t nt2 = 0;
         for (size_t t = 0; t < nt; t++) {

@@ -25,6 +25,11 @@
 thz_status primitive_mesh_alloc(thz_mesh *mesh, size_t n_vertices, size_t n_triangles,
                                 thz_error *err);
 
+/* double -> float without the undefined behaviour of out-of-range conversions: values
+ * beyond float's range become infinite (and the loader refuses the object). Shared with
+ * the transforms. */
+float primitive_to_float(double x);
+
 /* Box of size_m centred on the origin; 8 vertices, 12 triangles. */
 thz_status primitive_box(thz_mesh *mesh, const double size_m[3], bool inward, thz_error *err);
 

@@ -2,9 +2,10 @@
  * application to meshes (with the winding flip for mirroring maps). */
 #include "scene/transform.h"
 
-#include <float.h>
 #include <math.h>
 #include <string.h>
+
+#include "scene/primitives.h"
 
 scene_transform transform_identity(void)
 {
@@ -87,8 +88,8 @@ void transform_apply_mesh(const scene_transform *t, thz_mesh *mesh)
         float *p = &mesh->positions[3 * v];
         double d[3] = {p[0], p[1], p[2]};
         transform_apply_point(t, d, d);
-        for (int k = 0; k < 3; k++) /* out of float range: infinite, refused by the loader */
-            p[k] = fabs(d[k]) <= FLT_MAX ? (float)d[k] : (float)copysign(INFINITY, d[k]);
+        for (int k = 0; k < 3; k++)
+            p[k] = primitive_to_float(d[k]);
     }
     if (transform_determinant(t) < 0.0) {
         for (size_t i = 0; i < mesh->n_triangles; i++) {
