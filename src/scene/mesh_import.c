@@ -97,24 +97,34 @@ typedef struct weld_record {
     uint32_t index;
 } weld_record;
 
+/* Orders positions; 0 exactly when the weld merges them (so the sort and the merge
+ * agree on what is equal). */
+static int mesh_import_position_cmp(const float *x, const float *y)
+{
+    for (int k = 0; k < 3; k++) {
+        if (x[k] < y[k])
+            return -1;
+        if (x[k] > y[k])
+            return 1;
+    }
+    return 0;
+}
+
 static int mesh_import_weld_cmp(const void *a, const void *b)
 {
     const weld_record *x = a, *y = b;
-    for (int k = 0; k < 3; k++) {
-        if (x->p[k] < y->p[k])
-            return -1;
-        if (x->p[k] > y->p[k])
-            return 1;
-    }
-    return x->index < y->index ? -1 : x->index > y->index;
+    int c = mesh_import_position_cmp(x->p, y->p);
+    return c ? c : (x->index > y->index) - (x->index < y->index);
 }
 
-/* Merges vertices with identical positions and drops the unused ones. */
+/* Keeps the vertices that triangles use (those of points and lines have no surface and
+ * would widen the bounding box), merging those at the same position, and renumbers
+ * them in position order. */
 static bool mesh_import_weld(thz_mesh *mesh)
 {
     size_t n = mesh->n_vertices;
     weld_record *rec = thz_malloc_array(n, sizeof *rec);
-    uint32_t *remap = thz_malloc_array(n, sizeof *remap);
+    uint32_t *remap = thz_calloc(n, sizeof *remap);
     float *pos = thz_malloc_array(3 * n + 4, sizeof *pos);
     if (!rec || !remap || !pos) {
         free(rec);
@@ -122,12 +132,22 @@ static bool mesh_import_weld(thz_mesh *mesh)
         free(pos);
         return false;
     }
-    for (size_t v = 0; v < n; v++)
-        rec[v] = (weld_record){&mesh->positions[3 * v], (uint32_t)v};
-    qsort(rec, n, sizeof *rec, mesh_import_weld_cmp);
+    for (size_t i = 0; i < 3 * mesh->n_triangles; i++)
+        remap[mesh->indices[i]] = 1;
+    size_t used = 0;
+    for (size_t v = 0; v < n; v++) {
+        if (!remap[v])
+            continue;
+        float *p = &mesh->positions[3 * v];
+        for (int k = 0; k < 3; k++)
+            if (p[k] == 0.0f)
+                p[k] = 0.0f; /* -0 becomes +0: one position, one bit pattern */
+        rec[used++] = (weld_record){p, (uint32_t)v};
+    }
+    qsort(rec, used, sizeof *rec, mesh_import_weld_cmp);
     size_t unique = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (i == 0 || memcmp(rec[i].p, rec[i - 1].p, 3 * sizeof(float)) != 0) {
+    for (size_t i = 0; i < used; i++) {
+        if (i == 0 || mesh_import_position_cmp(rec[i].p, rec[i - 1].p) != 0) {
             memcpy(&pos[3 * unique], rec[i].p, 3 * sizeof(float));
             unique++;
         }

@@ -3,7 +3,8 @@
  * in; nothing that reorders the winding or invents normals is applied, because the
  * normals follow the winding order (a mesh's front side is where its triangles turn
  * counter-clockwise). Vertices at exactly the same position are merged, so that
- * formats storing each triangle's corners separately (STL) come out connected.
+ * formats storing each triangle's corners separately (STL) come out connected, and
+ * vertices no triangle uses (those of points and lines) are dropped.
  */
 #ifndef THZ_SCENE_MESH_IMPORT_H
 #define THZ_SCENE_MESH_IMPORT_H

@@ -1,6 +1,7 @@
 /* Mesh import: the same tetrahedron from OBJ, PLY, STL (ASCII and binary) and glTF
  * (with a node transform) gives 4 welded vertices, 4 triangles, the exact area and
- * outward normals; quads are triangulated; the winding check finds a flipped face;
+ * outward normals; quads are triangulated; vertices of points and lines are dropped
+ * and -0.0 welds with 0; the winding check finds a flipped face;
  * missing, empty and garbage files are refused with the file named. */
 #include <math.h>
 #include <setjmp.h>
@@ -91,6 +92,20 @@ static void test_bad_winding(void **state)
     mesh_fini(&m);
 }
 
+static void test_points_lines_negative_zero(void **state)
+{
+    (void)state;
+    /* the extra vertices lie outside the unit cube; check_tetra checks 4 vertices, the
+     * bounding box and outward normals */
+    check_tetra(MESHES "tetra_points_lines.obj", 0);
+    thz_mesh m;
+    thz_error err = {0};
+    assert_int_equal(mesh_import(MESHES "tetra_points_lines.obj", NULL, &m, &err), THZ_OK);
+    for (size_t i = 0; i < 3 * m.n_vertices; i++)
+        assert_false(signbit(m.positions[i]));
+    mesh_fini(&m);
+}
+
 static void expect_refused(const char *file, const char *label, const char *what)
 {
     thz_mesh m;
@@ -113,9 +128,8 @@ static void test_refused(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_formats),
-        cmocka_unit_test(test_quads),
-        cmocka_unit_test(test_bad_winding),
+        cmocka_unit_test(test_formats),     cmocka_unit_test(test_quads),
+        cmocka_unit_test(test_bad_winding), cmocka_unit_test(test_points_lines_negative_zero),
         cmocka_unit_test(test_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
