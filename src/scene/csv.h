@@ -21,8 +21,8 @@ typedef struct csv_table {
 } csv_table;
 
 /* Reads the file at path; `label` (NULL: path) names it in messages. On error the
- * table is left empty (csv_fini is still safe). THZ_ERR_IO when the file cannot be
- * read, THZ_ERR_INPUT for bad content. */
+ * table is left empty (csv_fini is still safe). THZ_ERR_INPUT when the file cannot
+ * be read or its content is bad (both are the user's input), THZ_ERR_NOMEM. */
 thz_status csv_read(const char *path, const char *label, csv_table *table, thz_error *err);
 
 /* The same from text held in memory. */

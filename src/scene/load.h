@@ -99,9 +99,14 @@ char *load_resolve_path(const load_ctx *ctx, const char *file);
  * the CSV file with its line and row. */
 thz_status load_csv(load_ctx *ctx, const load_cursor *c, const char *key, csv_table *table);
 
-/* Column `column` of t (against column frequency_thz, which must be present) as a
- * spectrum, checking frequencies (> 0, strictly increasing) and values in r. Errors
- * name the file and the row. */
+/* Fails unless t has a column frequency_thz, a column `required` (unless NULL), and no
+ * column but these and the NULL-terminated `known` ones. Errors name the CSV file. */
+thz_status load_csv_columns(load_ctx *ctx, const load_cursor *c, const csv_table *t,
+                            const char *const *known, const char *required);
+
+/* Column `column` of t (against column frequency_thz; load_csv_columns has checked
+ * both are present) as a spectrum, checking frequencies (> 0, strictly increasing) and
+ * values in r. Errors name the file and the row. */
 thz_status load_csv_spectrum(load_ctx *ctx, const load_cursor *c, const csv_table *t,
                              const char *column, load_range r, thz_spectrum *out);
 

@@ -3,7 +3,6 @@
  * data, src/atmosphere/), and the emitting-atmosphere keys. docs/atmosphere.md
  * lists the keys. */
 #include <stdlib.h>
-#include <string.h>
 
 #include "scene/load.h"
 
@@ -106,16 +105,21 @@ static thz_status load_lines(load_ctx *ctx, const load_cursor *c, thz_atmosphere
     return st;
 }
 
-/* emitting, background_temperature_k and the extent (after the model is set). */
+/* emitting, background_temperature_k and the extent (after the model is set); the
+ * temperature_k of a model without air belongs to an emitting atmosphere. */
 static thz_status load_emitting(load_ctx *ctx, const load_cursor *c, thz_atmosphere *atm)
 {
     bool emitting = false;
     thz_status st = load_bool(ctx, c, "emitting", false, &emitting);
     if (st != THZ_OK)
         return st;
-    load_cursor bg = load_key(c, "background_temperature_k");
+    load_cursor t = load_key(c, "temperature_k"), bg = load_key(c, "background_temperature_k");
     load_cursor lo = load_key(c, "extent_min_m"), hi = load_key(c, "extent_max_m");
     if (!emitting) {
+        if (!atm->has_air && t.value)
+            return load_fail(ctx, &t,
+                             "only the air of itu-p676 and lines, or an emitting "
+                             "atmosphere (\"emitting\": true), has a temperature");
         const load_cursor *stray = bg.value ? &bg : lo.value ? &lo : hi.value ? &hi : NULL;
         if (stray)
             return load_fail(ctx, stray,
@@ -206,17 +210,9 @@ thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *
             st = load_csv(ctx, c, "file", &table);
         if (st != THZ_OK)
             break;
+        static const char *const columns[] = {"attenuation_per_m", NULL};
         load_cursor file = load_key(c, "file");
-        for (size_t i = 0; i < table.n_columns; i++) {
-            if (strcmp(table.names[i], "frequency_thz") != 0 &&
-                strcmp(table.names[i], "attenuation_per_m") != 0) {
-                st =
-                    load_fail(ctx, &file,
-                              "%s: unknown column '%s' (expected frequency_thz, attenuation_per_m)",
-                              table.label, table.names[i]);
-                break;
-            }
-        }
+        st = load_csv_columns(ctx, &file, &table, columns, "attenuation_per_m");
         if (st == THZ_OK)
             st = load_csv_spectrum(ctx, &file, &table, "attenuation_per_m", LOAD_NONNEGATIVE,
                                    &atm->attenuation_per_m);
@@ -242,15 +238,6 @@ thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *
         if (st == THZ_OK)
             st = load_lines(ctx, c, atm);
         break;
-    }
-    if (st == THZ_OK) {
-        load_cursor t = load_key(c, "temperature_k");
-        bool emitting = false;
-        if (!atm->has_air && t.value && load_bool(ctx, c, "emitting", false, &emitting) == THZ_OK &&
-            !emitting)
-            st = load_fail(ctx, &t,
-                           "only the air of itu-p676 and lines, or an emitting "
-                           "atmosphere (\"emitting\": true), has a temperature");
     }
     if (st == THZ_OK)
         st = load_emitting(ctx, c, atm);

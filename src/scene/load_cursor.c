@@ -1,5 +1,6 @@
 /* The JSON cursor of the loader: typed access to members with the document path in
  * every message, the unknown-key check, and spectral properties from JSON or CSV. */
+#include <assert.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -305,10 +306,36 @@ thz_status load_csv(load_ctx *ctx, const load_cursor *c, const char *key, csv_ta
     thz_error inner = {0};
     st = csv_read(path, path, table, &inner);
     free(path);
-    if (st == THZ_ERR_INPUT || st == THZ_ERR_IO)
+    if (st == THZ_ERR_INPUT)
         return load_fail(ctx, &k, "%s", inner.message);
     if (st != THZ_OK)
         return thz_error_set(ctx->err, st, "%s", inner.message);
+    return THZ_OK;
+}
+
+thz_status load_csv_columns(load_ctx *ctx, const load_cursor *c, const csv_table *t,
+                            const char *const *known, const char *required)
+{
+    const char *needed[] = {"frequency_thz", required};
+    for (size_t i = 0; i < 2; i++)
+        if (needed[i] && csv_column(t, needed[i]) < 0)
+            return load_fail(ctx, c, "%s: the header names no column '%s'", t->label, needed[i]);
+    for (size_t i = 0; i < t->n_columns; i++) {
+        bool ok = strcmp(t->names[i], "frequency_thz") == 0;
+        for (size_t k = 0; known[k] && !ok; k++)
+            ok = strcmp(t->names[i], known[k]) == 0;
+        if (ok)
+            continue;
+        char list[256] = "";
+        size_t used = 0;
+        for (size_t k = 0; known[k]; k++) {
+            int n = snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", known[k]);
+            if (n > 0 && (size_t)n < sizeof list - used)
+                used += (size_t)n;
+        }
+        return load_fail(ctx, c, "%s: unknown column '%s' (expected frequency_thz and %s%s)",
+                         t->label, t->names[i], known[0] && known[1] ? "any of " : "", list);
+    }
     return THZ_OK;
 }
 
@@ -317,10 +344,7 @@ thz_status load_csv_spectrum(load_ctx *ctx, const load_cursor *c, const csv_tabl
 {
     long fc = csv_column(t, "frequency_thz");
     long vc = csv_column(t, column);
-    if (fc < 0)
-        return load_fail(ctx, c, "%s: the header names no column 'frequency_thz'", t->label);
-    if (vc < 0)
-        return load_fail(ctx, c, "%s: the header names no column '%s'", t->label, column);
+    assert(fc >= 0 && vc >= 0); /* load_csv_columns has checked the header */
     char expected[128];
     load_format_range(expected, sizeof expected, r);
     double *f = thz_malloc_array(t->n_rows, sizeof *f);
@@ -353,9 +377,7 @@ thz_status load_csv_spectrum(load_ctx *ctx, const load_cursor *c, const csv_tabl
             goto cleanup;
         }
     }
-    spectrum_fini(out);
-    if (!(t->n_rows == 1 ? spectrum_set_constant(out, v[0])
-                         : spectrum_set_table(out, t->n_rows, f, v)))
+    if (!spectrum_set_table(out, t->n_rows, f, v))
         st = thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
 cleanup:
     free(f);
@@ -377,7 +399,6 @@ thz_status load_spectrum(load_ctx *ctx, const load_cursor *c, const char *key, l
         thz_status st = load_number_value(ctx, &k, r, &v);
         if (st != THZ_OK)
             return st;
-        spectrum_fini(out);
         if (!spectrum_set_constant(out, v))
             return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
         return THZ_OK;
@@ -416,8 +437,7 @@ thz_status load_spectrum(load_ctx *ctx, const load_cursor *c, const char *key, l
         if (st != THZ_OK)
             goto cleanup;
     }
-    spectrum_fini(out);
-    if (!(n == 1 ? spectrum_set_constant(out, v[0]) : spectrum_set_table(out, n, f, v)))
+    if (!spectrum_set_table(out, n, f, v))
         st = thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
 cleanup:
     free(f);
