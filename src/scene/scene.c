@@ -104,14 +104,14 @@ optics_point scene_object_optics(const thz_scene *s, const thz_object *obj, doub
     return o;
 }
 
-bool scene_object_side_is_front(const thz_object *obj, int side)
+bool scene_object_two_sided(const thz_object *obj)
 {
-    return side == 0 || obj->type == OBJECT_SHELL || obj->two_sided;
+    return obj->type == OBJECT_SHELL || obj->two_sided;
 }
 
-static int object_emitting_sides(const thz_object *obj)
+bool scene_object_side_is_front(const thz_object *obj, int side)
 {
-    return (obj->type == OBJECT_SHELL || obj->two_sided) ? 2 : 1;
+    return side == 0 || scene_object_two_sided(obj);
 }
 
 double scene_emitted_power_w_per_hz(const thz_scene *s, double freq_hz)
@@ -123,7 +123,7 @@ double scene_emitted_power_w_per_hz(const thz_scene *s, double freq_hz)
             continue;
         optics_point o = scene_object_optics(s, obj, freq_hz);
         double eps_mean = optics_mean_emissivity(&o);
-        total += M_PI * eps_mean * obj->mesh.total_area_m2 * object_emitting_sides(obj) *
+        total += M_PI * eps_mean * obj->mesh.total_area_m2 * (scene_object_two_sided(obj) ? 2 : 1) *
                  planck_radiance(freq_hz, obj->temperature_k);
     }
     return total;

@@ -48,7 +48,7 @@ typedef struct thz_object {
     size_t material;      /* index into scene->materials */
     double temperature_k; /* >= 0 */
     double thickness_m;   /* shells: > 0; solids: 0 */
-    bool two_sided;       /* solids: both sides are front sides; shells: always true */
+    bool two_sided;       /* the `two_sided` key; scene_object_two_sided is the rule */
     thz_mesh mesh;
 } thz_object;
 
@@ -124,6 +124,10 @@ bool scene_add_warning(thz_scene *scene, const char *fmt, ...)
 /* The optics of object `obj` at freq_hz: its material's R, alpha_M and explicit eps
  * evaluated there, and its thickness (0 for solids). */
 optics_point scene_object_optics(const thz_scene *scene, const thz_object *obj, double freq_hz);
+
+/* Whether both sides of `obj` are front sides (and emit): shells, and solids with
+ * `two_sided`. */
+bool scene_object_two_sided(const thz_object *obj);
 
 /* Whether the side of `obj` a ray arrives on is a front side (physics.md): shells and
  * two-sided solids always; one-sided solids when cos(normal, -ray) > 0. */

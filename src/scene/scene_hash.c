@@ -22,25 +22,16 @@ static uint64_t hash_double(uint64_t h, double x)
     return hash_word(h, w);
 }
 
-static uint64_t hash_u32s(uint64_t h, const uint32_t *p, size_t n)
+/* n 32-bit words (indices or float bit patterns) after their count, each least
+ * significant byte first whatever the host's byte order, so the hashes stored in
+ * photon-map files stay comparable. */
+static uint64_t hash_words32(uint64_t h, const void *p, size_t n)
 {
-    h = hash_word(h, n);
-    for (size_t i = 0; i < n; i++) {
-        uint32_t w = p[i];
-        for (int k = 0; k < 4; k++) {
-            h ^= (w >> (8 * k)) & 0xffu;
-            h *= HASH_PRIME;
-        }
-    }
-    return h;
-}
-
-static uint64_t hash_floats(uint64_t h, const float *p, size_t n)
-{
+    const unsigned char *bytes = p;
     h = hash_word(h, n);
     for (size_t i = 0; i < n; i++) {
         uint32_t w;
-        memcpy(&w, &p[i], sizeof w);
+        memcpy(&w, bytes + 4 * i, sizeof w);
         for (int k = 0; k < 4; k++) {
             h ^= (w >> (8 * k)) & 0xffu;
             h *= HASH_PRIME;
@@ -79,10 +70,10 @@ void scene_hash_compute(const thz_scene *scene, scene_hash *out)
     for (size_t i = 0; i < scene->n_objects; i++) {
         const thz_object *obj = &scene->objects[i];
         g = hash_word(g, (uint64_t)obj->type);
-        g = hash_word(g, obj->two_sided ? 1u : 0u);
+        g = hash_word(g, scene_object_two_sided(obj) ? 1u : 0u);
         g = hash_double(g, obj->thickness_m);
-        g = hash_floats(g, obj->mesh.positions, 3 * obj->mesh.n_vertices);
-        g = hash_u32s(g, obj->mesh.indices, 3 * obj->mesh.n_triangles);
+        g = hash_words32(g, obj->mesh.positions, 3 * obj->mesh.n_vertices);
+        g = hash_words32(g, obj->mesh.indices, 3 * obj->mesh.n_triangles);
         o = hash_word(o, obj->material);
         o = hash_double(o, obj->temperature_k);
     }
