@@ -29,22 +29,122 @@
 /* Rounding slack for eps + R <= 1. */
 #define LOAD_SUM_SLACK 1e-9
 
+/* ---- names ---------------------------------------------------------------------- */
+
+/* Member "name" of list[i]: a non-empty string unlike the "name" of every earlier entry
+ * of the list (entries without one do not count). *out is borrowed from the document,
+ * NULL when the key is absent and not required. */
+static thz_status load_unique_name(load_ctx *ctx, const load_cursor *list, size_t i,
+                                   const char *what, bool required, const char **out)
+{
+    load_cursor e = load_index(list, i);
+    thz_status st = load_string(ctx, &e, "name", required, NULL, out);
+    if (st != THZ_OK || !*out)
+        return st;
+    load_cursor k = load_key(&e, "name");
+    if (!(*out)[0])
+        return load_fail(ctx, &k, "expected a non-empty %s name", what);
+    for (size_t j = 0; j < i; j++) {
+        json_t *other = json_object_get(json_array_get(list->value, j), "name");
+        if (json_is_string(other) && strcmp(json_string_value(other), *out) == 0)
+            return load_fail(ctx, &k,
+                             "%s name \"%s\" is already used by %s[%zu] (expected unique names)",
+                             what, *out, list->path, j);
+    }
+    return THZ_OK;
+}
+
 /* ---- channels ------------------------------------------------------------------- */
 
-static thz_status load_channel_name(load_ctx *ctx, const load_cursor *c, thz_channel *ch,
-                                    const char *given)
+/* Default names show the frequency with 3 decimals, more where that is what tells two
+ * channels apart (0.350 and 0.3501 THz become "0.3500 THz" and "0.3501 THz"), up to
+ * 1 Hz; channels at the same frequency get their index too. */
+#define LOAD_NAME_MIN_DECIMALS 3
+#define LOAD_NAME_MAX_DECIMALS 12
+
+typedef struct load_name_entry {
+    char name[sizeof(((thz_channel *)NULL)->name)];
+    size_t channel;
+} load_name_entry;
+
+static int load_name_cmp(const void *a, const void *b)
 {
-    if (!given) {
-        snprintf(ch->name, sizeof ch->name, "%.3f THz", ch->center_hz * 1e-12);
-        return THZ_OK;
+    const load_name_entry *x = a, *y = b;
+    int c = strcmp(x->name, y->name);
+    return c ? c : (x->channel > y->channel) - (x->channel < y->channel);
+}
+
+/* Fills e with every channel's name, or for unnamed channels their frequency with
+ * `decimals` decimals, sorted by name. */
+static void load_name_entries(const thz_scene *s, load_name_entry *e, int decimals)
+{
+    for (size_t i = 0; i < s->n_channels; i++) {
+        const thz_channel *ch = &s->channels[i];
+        e[i].channel = i;
+        if (ch->name[0])
+            memcpy(e[i].name, ch->name, sizeof e[i].name);
+        else
+            snprintf(e[i].name, sizeof e[i].name, "%.*f THz", decimals, ch->center_hz * 1e-12);
     }
-    load_cursor k = load_key(c, "name");
-    if (!given[0])
-        return load_fail(ctx, &k, "expected a non-empty channel name");
-    if (strlen(given) >= sizeof ch->name)
-        return load_fail(ctx, &k, "channel names are at most %zu characters", sizeof ch->name - 1);
-    snprintf(ch->name, sizeof ch->name, "%s", given);
-    return THZ_OK;
+    qsort(e, s->n_channels, sizeof *e, load_name_cmp);
+}
+
+/* Names the channels that have no name (c: the channels key; `list`: the list form,
+ * whose entries' paths then name a channel). */
+static thz_status load_channel_default_names(load_ctx *ctx, const load_cursor *c, bool list)
+{
+    thz_scene *s = ctx->scene;
+    size_t n = s->n_channels;
+    load_name_entry *e = thz_malloc_array(n, sizeof *e);
+    bool *unnamed = thz_malloc_array(n, sizeof *unnamed);
+    thz_status st = THZ_OK;
+    if (!e || !unnamed) {
+        st = thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+        goto cleanup;
+    }
+    size_t left = 0;
+    for (size_t i = 0; i < n; i++) {
+        unnamed[i] = !s->channels[i].name[0];
+        left += unnamed[i];
+    }
+    /* Names of different widths never coincide, so a name unique among those of its
+     * width (and the given ones) is unique. */
+    for (int d = LOAD_NAME_MIN_DECIMALS; d <= LOAD_NAME_MAX_DECIMALS && left > 0; d++) {
+        load_name_entries(s, e, d);
+        for (size_t i = 0; i < n; i++) {
+            thz_channel *ch = &s->channels[e[i].channel];
+            bool alone = (i == 0 || strcmp(e[i].name, e[i - 1].name) != 0) &&
+                         (i + 1 == n || strcmp(e[i].name, e[i + 1].name) != 0);
+            if (alone && !ch->name[0]) {
+                memcpy(ch->name, e[i].name, sizeof ch->name);
+                left--;
+            }
+        }
+    }
+    for (size_t i = 0; i < n && left > 0; i++) {
+        thz_channel *ch = &s->channels[i];
+        if (!ch->name[0])
+            snprintf(ch->name, sizeof ch->name, "%.*f THz #%zu", LOAD_NAME_MIN_DECIMALS,
+                     ch->center_hz * 1e-12, i);
+    }
+    /* Only a given name that looks like a default one can still coincide with it. */
+    load_name_entries(s, e, 0);
+    for (size_t i = 1; i < n; i++) {
+        if (strcmp(e[i].name, e[i - 1].name) != 0)
+            continue;
+        size_t mine = unnamed[e[i].channel] ? e[i].channel : e[i - 1].channel;
+        size_t other = mine == e[i].channel ? e[i - 1].channel : e[i].channel;
+        load_cursor k = list ? load_index(c, mine) : *c;
+        st = load_fail(ctx, &k,
+                       "the default name \"%s\" of channels[%zu] is already used by "
+                       "channels[%zu] (expected a \"name\" for it)",
+                       s->channels[mine].name, mine, other);
+        goto cleanup;
+    }
+cleanup:
+    free(e);
+    free(unnamed);
+    return st;
 }
 
 static const load_range load_relative_width = {0.0, 0.5, true, false};
@@ -82,9 +182,8 @@ static thz_status load_channel_range(load_ctx *ctx, const load_cursor *c)
             thz = to; /* exactly the given end */
         ch->center_hz = thz * 1e12;
         ch->relative_width = width;
-        load_channel_name(ctx, c, ch, NULL);
     }
-    return THZ_OK;
+    return load_channel_default_names(ctx, c, false);
 }
 
 static thz_status load_channels(load_ctx *ctx, const load_cursor *root)
@@ -121,28 +220,35 @@ static thz_status load_channels(load_ctx *ctx, const load_cursor *root)
             st = load_number(ctx, &e, "relative_width", load_relative_width, true, 0,
                              &ch->relative_width);
         if (st == THZ_OK)
-            st = load_string(ctx, &e, "name", false, NULL, &name);
+            st = load_unique_name(ctx, &c, i, "channel", false, &name);
         if (st != THZ_OK)
             return st;
         ch->center_hz = thz * 1e12;
-        st = load_channel_name(ctx, &e, ch, name);
-        if (st != THZ_OK)
-            return st;
-        for (size_t j = 0; j < i; j++) {
-            if (strcmp(s->channels[j].name, ch->name) == 0) {
-                load_cursor k = load_key(&e, "name");
-                return load_fail(ctx, &k, "channel name \"%s\" is already used by channels[%zu]",
-                                 ch->name, j);
-            }
+        if (name && strlen(name) >= sizeof ch->name) {
+            load_cursor k = load_key(&e, "name");
+            return load_fail(ctx, &k, "channel names are at most %zu characters",
+                             sizeof ch->name - 1);
         }
+        if (name)
+            memcpy(ch->name, name, strlen(name) + 1);
     }
-    return THZ_OK;
+    return load_channel_default_names(ctx, &c, true);
 }
 
 /* ---- materials ------------------------------------------------------------------ */
 
+/* The spectral properties of a material: their keys (and CSV columns), accepted
+ * values, and load_material_property's order. */
 static const char *const load_material_columns[] = {"reflectivity", "attenuation_per_m",
                                                     "emissivity", NULL};
+static const load_range load_material_ranges[] = {
+    {0.0, 1.0, false, false}, {0.0, INFINITY, false, false}, {0.0, 1.0, false, false}};
+#define LOAD_N_PROPERTIES 3
+
+static thz_spectrum *load_material_property(thz_material *m, size_t k)
+{
+    return k == 0 ? &m->reflectivity : k == 1 ? &m->attenuation_per_m : &m->emissivity;
+}
 
 /* Fills the spectra of m from the CSV file named by c's `file`. */
 static thz_status load_material_file(load_ctx *ctx, const load_cursor *c, thz_material *m)
@@ -152,32 +258,11 @@ static thz_status load_material_file(load_ctx *ctx, const load_cursor *c, thz_ma
     if (st != THZ_OK)
         return st;
     load_cursor file = load_key(c, "file");
-    thz_spectrum *spectra[] = {&m->reflectivity, &m->attenuation_per_m, &m->emissivity};
-    const load_range ranges[] = {LOAD_UNIT, LOAD_NONNEGATIVE, LOAD_UNIT};
-    if (csv_column(&t, "frequency_thz") < 0) {
-        st = load_fail(ctx, &file, "%s: the header names no column 'frequency_thz'", t.label);
-        goto cleanup;
-    }
-    for (size_t i = 0; i < t.n_columns; i++) {
-        bool known = strcmp(t.names[i], "frequency_thz") == 0;
-        for (size_t k = 0; load_material_columns[k] && !known; k++)
-            known = strcmp(t.names[i], load_material_columns[k]) == 0;
-        if (!known) {
-            st = load_fail(ctx, &file,
-                           "%s: unknown column '%s' (expected frequency_thz and any of "
-                           "reflectivity, attenuation_per_m, emissivity)",
-                           t.label, t.names[i]);
-            goto cleanup;
-        }
-    }
-    for (size_t k = 0; load_material_columns[k]; k++) {
-        if (csv_column(&t, load_material_columns[k]) < 0)
-            continue;
-        st = load_csv_spectrum(ctx, &file, &t, load_material_columns[k], ranges[k], spectra[k]);
-        if (st != THZ_OK)
-            goto cleanup;
-    }
-cleanup:
+    st = load_csv_columns(ctx, &file, &t, load_material_columns, NULL);
+    for (size_t k = 0; k < LOAD_N_PROPERTIES && st == THZ_OK; k++)
+        if (csv_column(&t, load_material_columns[k]) >= 0)
+            st = load_csv_spectrum(ctx, &file, &t, load_material_columns[k],
+                                   load_material_ranges[k], load_material_property(m, k));
     csv_fini(&t);
     return st;
 }
@@ -220,12 +305,9 @@ static thz_status load_material(load_ctx *ctx, const load_cursor *c, thz_materia
             return st;
     }
     bool present;
-    st = load_spectrum(ctx, c, "reflectivity", LOAD_UNIT, &m->reflectivity, &present);
-    if (st == THZ_OK)
-        st = load_spectrum(ctx, c, "attenuation_per_m", LOAD_NONNEGATIVE, &m->attenuation_per_m,
-                           &present);
-    if (st == THZ_OK)
-        st = load_spectrum(ctx, c, "emissivity", LOAD_UNIT, &m->emissivity, &present);
+    for (size_t k = 0; k < LOAD_N_PROPERTIES && st == THZ_OK; k++)
+        st = load_spectrum(ctx, c, load_material_columns[k], load_material_ranges[k],
+                           load_material_property(m, k), &present);
     if (st != THZ_OK)
         return st;
     if (m->reflectivity.n == 0) {
@@ -397,8 +479,6 @@ static thz_status load_shape(load_ctx *ctx, const load_cursor *c, thz_mesh *mesh
         break;
     }
     }
-    if (st != THZ_OK && err && err->status == THZ_ERR_LIMIT)
-        st = load_fail(ctx, c, "%s", err->message);
     return st;
 }
 
@@ -437,29 +517,22 @@ static thz_status load_transform(load_ctx *ctx, const load_cursor *c, thz_mesh *
     return THZ_OK;
 }
 
-static thz_status load_object(load_ctx *ctx, const load_cursor *c, thz_object *o, size_t index)
+static thz_status load_object(load_ctx *ctx, const load_cursor *list, size_t index, thz_object *o)
 {
     static const char *const keys[] = {"name",          "type",        "material",
                                        "temperature_k", "thickness_m", "two_sided",
                                        "shape",         "transform",   NULL};
     static const char *const types[] = {"solid", "shell", NULL};
     thz_scene *s = ctx->scene;
+    load_cursor e = load_index(list, index);
+    const load_cursor *c = &e;
     const char *name, *material;
     size_t type;
     thz_status st = load_expect_object(ctx, c, keys);
     if (st == THZ_OK)
-        st = load_string(ctx, c, "name", true, NULL, &name);
+        st = load_unique_name(ctx, list, index, "object", true, &name);
     if (st != THZ_OK)
         return st;
-    load_cursor name_c = load_key(c, "name");
-    if (!name[0])
-        return load_fail(ctx, &name_c, "expected a non-empty object name");
-    for (size_t j = 0; j < index; j++)
-        if (strcmp(s->objects[j].name, name) == 0)
-            return load_fail(ctx, &name_c,
-                             "object name \"%s\" is already used by objects[%zu] "
-                             "(expected unique names)",
-                             name, j);
     o->name = thz_strdup(name);
     if (!o->name)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
@@ -494,8 +567,6 @@ static thz_status load_object(load_ctx *ctx, const load_cursor *c, thz_object *o
         st = load_bool(ctx, c, "two_sided", false, &o->two_sided);
     if (st != THZ_OK)
         return st;
-    if (o->type == OBJECT_SHELL)
-        o->two_sided = true;
     load_cursor shape = load_key(c, "shape");
     st = load_shape(ctx, &shape, &o->mesh);
     if (st != THZ_OK)
@@ -535,8 +606,7 @@ static thz_status load_list(load_ctx *ctx, const load_cursor *root, const char *
     return THZ_OK;
 }
 
-/* Items are counted as they load (n_objects = i + 1) so that a failure frees them, and
- * so that load_object sees the objects before it (duplicate names). */
+/* Items are counted as they load (n_objects = i + 1) so that a failure frees them. */
 static thz_status load_objects(load_ctx *ctx, const load_cursor *root)
 {
     thz_scene *s = ctx->scene;
@@ -549,9 +619,8 @@ static thz_status load_objects(load_ctx *ctx, const load_cursor *root)
     if (!s->objects)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
     for (size_t i = 0; i < n && st == THZ_OK; i++) {
-        load_cursor e = load_index(&c, i);
         s->n_objects = i + 1;
-        st = load_object(ctx, &e, &s->objects[i], i);
+        st = load_object(ctx, &c, i, &s->objects[i]);
     }
     return st;
 }
@@ -586,27 +655,20 @@ static thz_status load_resolution(load_ctx *ctx, const load_cursor *c, uint32_t 
     return THZ_OK;
 }
 
-static thz_status load_sensor(load_ctx *ctx, const load_cursor *c, thz_sensor *sn, size_t index)
+static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t index, thz_sensor *sn)
 {
     static const char *const keys[] = {
         "name",       "position_m",  "look_at_m",    "direction",      "up", "fov_deg",
         "resolution", "aperture_m2", "oversampling", "normalize_to_k", NULL};
     thz_scene *s = ctx->scene;
+    load_cursor e = load_index(list, index);
+    const load_cursor *c = &e;
     const char *name;
     thz_status st = load_expect_object(ctx, c, keys);
     if (st == THZ_OK)
-        st = load_string(ctx, c, "name", true, NULL, &name);
+        st = load_unique_name(ctx, list, index, "sensor", true, &name);
     if (st != THZ_OK)
         return st;
-    load_cursor name_c = load_key(c, "name");
-    if (!name[0])
-        return load_fail(ctx, &name_c, "expected a non-empty sensor name");
-    for (size_t j = 0; j < index; j++)
-        if (strcmp(s->sensors[j].name, name) == 0)
-            return load_fail(ctx, &name_c,
-                             "sensor name \"%s\" is already used by sensors[%zu] "
-                             "(expected unique names)",
-                             name, j);
     sn->name = thz_strdup(name);
     if (!sn->name)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
@@ -695,9 +757,8 @@ static thz_status load_sensors(load_ctx *ctx, const load_cursor *root)
     if (!s->sensors)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
     for (size_t i = 0; i < n && st == THZ_OK; i++) {
-        load_cursor e = load_index(&c, i);
         s->n_sensors = i + 1;
-        st = load_sensor(ctx, &e, &s->sensors[i], i);
+        st = load_sensor(ctx, &c, i, &s->sensors[i]);
     }
     return st;
 }
@@ -761,15 +822,11 @@ static thz_status load_render(load_ctx *ctx, const load_cursor *root)
 
 /* ---- warnings ------------------------------------------------------------------- */
 
-static const char *const load_property_names[] = {"reflectivity", "attenuation_per_m",
-                                                  "emissivity"};
-
 /* Largest Kirchhoff violation of obj over the channel centres and the table points of
  * its material; *at_hz gets where. */
-static double load_kirchhoff_worst(const thz_scene *s, const thz_object *obj, double *at_hz)
+static double load_kirchhoff_worst(thz_scene *s, const thz_object *obj, double *at_hz)
 {
-    const thz_material *m = &s->materials[obj->material];
-    const thz_spectrum *sp[3] = {&m->reflectivity, &m->attenuation_per_m, &m->emissivity};
+    thz_material *m = &s->materials[obj->material];
     double worst = 0.0;
     *at_hz = s->channels[0].center_hz;
     for (size_t c = 0; c < s->n_channels; c++) {
@@ -780,13 +837,14 @@ static double load_kirchhoff_worst(const thz_scene *s, const thz_object *obj, do
             *at_hz = s->channels[c].center_hz;
         }
     }
-    for (int k = 0; k < 3; k++) {
-        for (size_t i = 0; sp[k]->freq_hz && i < sp[k]->n; i++) {
-            optics_point o = scene_object_optics(s, obj, sp[k]->freq_hz[i]);
+    for (size_t k = 0; k < LOAD_N_PROPERTIES; k++) {
+        const thz_spectrum *sp = load_material_property(m, k);
+        for (size_t i = 0; sp->freq_hz && i < sp->n; i++) {
+            optics_point o = scene_object_optics(s, obj, sp->freq_hz[i]);
             double v = optics_kirchhoff_violation(&o);
             if (v > worst) {
                 worst = v;
-                *at_hz = sp[k]->freq_hz[i];
+                *at_hz = sp->freq_hz[i];
             }
         }
     }
@@ -821,17 +879,25 @@ static bool load_warn_table(thz_scene *s, const thz_spectrum *sp, const char *wh
         count > 1 ? " and others" : "");
 }
 
-static thz_status load_warnings(load_ctx *ctx)
+/* Whether object i of the document (validated) is a mesh file: built-in shapes are
+ * wound consistently by construction (primitives.h), so only files need the check. */
+static bool load_is_mesh_file(const load_cursor *root, size_t i)
+{
+    json_t *object = json_array_get(json_object_get(root->value, "objects"), i);
+    const char *type = json_string_value(json_object_get(json_object_get(object, "shape"), "type"));
+    return type && strcmp(type, "mesh") == 0;
+}
+
+static thz_status load_warnings(load_ctx *ctx, const load_cursor *root)
 {
     thz_scene *s = ctx->scene;
     bool ok = true;
     for (size_t m = 0; m < s->n_materials; m++) {
-        const thz_material *mat = &s->materials[m];
-        const thz_spectrum *sp[3] = {&mat->reflectivity, &mat->attenuation_per_m, &mat->emissivity};
-        for (int k = 0; k < 3 && ok; k++) {
+        thz_material *mat = &s->materials[m];
+        for (size_t k = 0; k < LOAD_N_PROPERTIES && ok; k++) {
             char what[256];
-            snprintf(what, sizeof what, "material \"%s\", %s", mat->name, load_property_names[k]);
-            ok = load_warn_table(s, sp[k], what);
+            snprintf(what, sizeof what, "material \"%s\", %s", mat->name, load_material_columns[k]);
+            ok = load_warn_table(s, load_material_property(mat, k), what);
         }
     }
     if (ok && s->atmosphere.model == ATM_TABLE)
@@ -849,6 +915,8 @@ static thz_status load_warnings(load_ctx *ctx)
                     "conserve energy in equilibrium",
                     obj->name, s->materials[obj->material].name, worst, at_hz * 1e-12);
         }
+        if (!load_is_mesh_file(root, i))
+            continue;
         size_t conflicts = mesh_import_winding_conflicts(&obj->mesh);
         if (conflicts == SIZE_MAX)
             return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
@@ -916,7 +984,7 @@ static thz_status load_document(load_ctx *ctx, json_t *doc)
         thz_error_prefix(ctx->err, "%s: atmosphere: ", ctx->label);
         return st;
     }
-    return load_warnings(ctx);
+    return load_warnings(ctx, &root);
 }
 
 /* The scene's default name: the file name without directory and extension. */

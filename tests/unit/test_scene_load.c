@@ -1,7 +1,8 @@
 /* The scene loader: the spec's example scene (geometry, materials, defaults), the
- * channel range shorthand and default names, CSV materials with overriding keys,
- * sensors, transforms, warnings, and a few refusals with their JSON paths (the full
- * table of bad scenes is tests/cli/test_bad_scenes.sh). */
+ * channel range shorthand and default names (unique; given names checked among
+ * themselves), CSV materials with overriding keys, sensors, transforms, warnings, and a
+ * few refusals with their JSON paths (the full table of bad scenes is
+ * tests/cli/test_bad_scenes.sh). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -76,7 +77,7 @@ static void test_example(void **state)
     assert_true(room->mesh.bbox_min_m[2] == 0.0 && room->mesh.bbox_max_m[2] == 2.0);
     assert_int_equal(s->objects[1].mesh.n_triangles, 4 * 64);
     assert_int_equal(s->objects[2].type, OBJECT_SHELL);
-    assert_true(s->objects[2].two_sided);
+    assert_true(scene_object_two_sided(&s->objects[2]));
     assert_true(s->objects[2].thickness_m == 0.0005);
     assert_int_equal(s->objects[2].mesh.n_triangles, 2 * 64);
     assert_true(fabs(s->objects[2].mesh.bbox_min_m[2] - 0.3) < 1e-6);
@@ -178,6 +179,50 @@ static void test_csv_material_and_warnings(void **state)
     thz_scene_destroy(s);
 }
 
+static void test_default_channel_names(void **state)
+{
+    (void)state;
+    /* 0.35 and 0.3501 THz would both be "0.350 THz": they get a decimal more, the
+     * others keep three; a given name that looks like a default one stays */
+    thz_scene *s =
+        load_ok(HEAD "\"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.01}, "
+                     "{\"frequency_thz\": 0.3501, \"relative_width\": 0.01}, "
+                     "{\"frequency_thz\": 0.6, \"relative_width\": 0.01}, "
+                     "{\"name\": \"0.700 THz\", \"frequency_thz\": 0.9, "
+                     "\"relative_width\": 0.01}, "
+                     "{\"frequency_thz\": 0.7, \"relative_width\": 0.01}, "
+                     "{\"frequency_thz\": 1.1, \"relative_width\": 0.01}, "
+                     "{\"frequency_thz\": 1.1, \"relative_width\": 0.02}], " MATERIALS OBJECT(BOX)
+                         SENSORS "}");
+    static const char *const names[] = {"0.3500 THz", "0.3501 THz",   "0.600 THz",   "0.700 THz",
+                                        "0.7000 THz", "1.100 THz #5", "1.100 THz #6"};
+    assert_int_equal(s->n_channels, 7);
+    for (size_t i = 0; i < 7; i++)
+        assert_string_equal(s->channels[i].name, names[i]);
+    thz_scene_destroy(s);
+    /* the range form: names stay unique where the step is below the 3rd decimal */
+    s = load_ok(HEAD "\"channels\": {\"from_thz\": 0.2, \"to_thz\": 0.2005, \"count\": 6, "
+                     "\"relative_width\": 0.02}, " MATERIALS OBJECT(BOX) SENSORS "}");
+    assert_string_equal(s->channels[1].name, "0.2001 THz");
+    for (size_t i = 0; i < s->n_channels; i++)
+        for (size_t j = 0; j < i; j++)
+            assert_true(strcmp(s->channels[i].name, s->channels[j].name) != 0);
+    thz_scene_destroy(s);
+    /* only names the user gave are checked against each other, under their own key */
+    load_bad(HEAD "\"channels\": [{\"name\": \"a\", \"frequency_thz\": 0.3, \"relative_width\": "
+                  "0.01}, {\"frequency_thz\": 0.3, \"relative_width\": 0.01}, {\"name\": \"a\", "
+                  "\"frequency_thz\": 0.4, \"relative_width\": 0.01}], " MATERIALS OBJECT(BOX)
+                      SENSORS "}",
+             "channels[2].name: channel name \"a\" is already used by channels[0]");
+    /* a given name that takes the last resort of a default one */
+    load_bad(HEAD "\"channels\": [{\"name\": \"0.300 THz #2\", \"frequency_thz\": 0.4, "
+                  "\"relative_width\": 0.01}, {\"frequency_thz\": 0.3, \"relative_width\": 0.01}, "
+                  "{\"frequency_thz\": 0.3, \"relative_width\": 0.01}], " MATERIALS OBJECT(BOX)
+                      SENSORS "}",
+             "channels[2]: the default name \"0.300 THz #2\" of channels[2] is already used by "
+             "channels[0]");
+}
+
 static void test_refusals(void **state)
 {
     (void)state;
@@ -196,13 +241,24 @@ static void test_refusals(void **state)
              "channels: expected at least one");
     load_bad("{\"format\": \"thzmap-scene/2\"}", "format: expected \"thzmap-scene/1\"");
     load_bad("[1, 2]", "expected a JSON object");
+    load_bad(HEAD CHANNELS MATERIALS OBJECT(BOX) SENSORS
+             ", \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.1, "
+             "\"temperature_k\": 290}}",
+             "atmosphere.temperature_k: only the air of itu-p676 and lines, or an emitting");
+    load_bad(HEAD CHANNELS MATERIALS OBJECT(BOX) SENSORS
+             ", \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.1, "
+             "\"temperature_k\": 290, \"emitting\": 1}}",
+             "atmosphere.emitting: expected true or false");
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_example),  cmocka_unit_test(test_defaults_and_range),
-        cmocka_unit_test(test_blocks),   cmocka_unit_test(test_csv_material_and_warnings),
+        cmocka_unit_test(test_example),
+        cmocka_unit_test(test_defaults_and_range),
+        cmocka_unit_test(test_blocks),
+        cmocka_unit_test(test_csv_material_and_warnings),
+        cmocka_unit_test(test_default_channel_names),
         cmocka_unit_test(test_refusals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
