@@ -165,7 +165,10 @@ double atmosphere_transmittance(const thz_atmosphere *atm, double freq_hz, doubl
 {
     if (atm->model == ATM_NONE)
         return 1.0;
-    return exp(-atmosphere_alpha_per_m(atm, freq_hz) * distance_m);
+    double alpha = atmosphere_alpha_per_m(atm, freq_hz);
+    if (alpha == 0.0)
+        return 1.0; /* also for an infinite distance, where alpha d would be 0 * inf = NaN */
+    return exp(-alpha * distance_m);
 }
 
 /* First grid step (Hz) over [lo, hi]. lines: from the line widths and strengths.

@@ -168,7 +168,8 @@ double atmosphere_alpha_per_m(const thz_atmosphere *atm, double freq_hz);
 double atmosphere_alpha_direct_per_m(const thz_atmosphere *atm, double freq_hz);
 void atmosphere_alpha_parts(const thz_atmosphere *atm, double freq_hz, atm_alpha_parts *parts);
 
-/* exp(-alpha(freq_hz) * distance_m): the transmittance of a free path. */
+/* exp(-alpha(freq_hz) * distance_m): the transmittance of a free path; 1 where
+ * alpha = 0, also for distance_m = INFINITY (a ray that leaves an open scene). */
 double atmosphere_transmittance(const thz_atmosphere *atm, double freq_hz, double distance_m);
 
 /* The model's name as in the scene file ("none", "constant", ...), and back

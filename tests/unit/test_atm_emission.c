@@ -43,6 +43,34 @@ static void test_path_and_volume(void **state)
     atmosphere_fini(&atm);
 }
 
+/* Transmittance exp(-alpha d), and 1 where alpha = 0 even over an infinite path (no
+ * 0 * inf = NaN): a constant atmosphere of alpha 0 and a table that is 0 in part. */
+static void test_transmittance(void **state)
+{
+    (void)state;
+    thz_atmosphere atm;
+    constant_atm(&atm, 0.2);
+    assert_true(fabs(atmosphere_transmittance(&atm, 0.5e12, 3.0) / exp(-0.6) - 1) < 1e-15);
+    assert_true(atmosphere_transmittance(&atm, 0.5e12, INFINITY) == 0.0);
+    atmosphere_fini(&atm);
+
+    constant_atm(&atm, 0.0);
+    assert_true(atmosphere_transmittance(&atm, 0.5e12, 3.0) == 1.0);
+    assert_true(atmosphere_transmittance(&atm, 0.5e12, INFINITY) == 1.0);
+    atmosphere_fini(&atm);
+
+    memset(&atm, 0, sizeof atm);
+    atm.model = ATM_TABLE;
+    const double f[] = {0.1e12, 0.2e12, 1.0e12}, a[] = {0.0, 0.0, 0.5};
+    assert_true(spectrum_set_table(&atm.attenuation_per_m, 3, f, a));
+    assert_true(atmosphere_transmittance(&atm, 0.15e12, INFINITY) == 1.0);
+    assert_true(atmosphere_transmittance(&atm, 0.6e12, INFINITY) == 0.0);
+    atmosphere_fini(&atm);
+
+    memset(&atm, 0, sizeof atm); /* ATM_NONE */
+    assert_true(atmosphere_transmittance(&atm, 0.5e12, INFINITY) == 1.0);
+}
+
 static void test_extent(void **state)
 {
     (void)state;
@@ -177,9 +205,8 @@ static void test_scene_hash(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_path_and_volume),
-        cmocka_unit_test(test_extent),
-        cmocka_unit_test(test_scene_keys),
+        cmocka_unit_test(test_path_and_volume), cmocka_unit_test(test_transmittance),
+        cmocka_unit_test(test_extent),          cmocka_unit_test(test_scene_keys),
         cmocka_unit_test(test_scene_hash),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
