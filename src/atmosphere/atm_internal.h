@@ -11,7 +11,6 @@
 /* 1 hPa = 1 mbar; 1 cm^-1 = 29.9792458 GHz; 1 atm = 1013.25 hPa. */
 #define ATM_GHZ_PER_CM1 29.9792458
 #define ATM_HPA_PER_ATM 1013.25
-#define ATM_NEPER_TO_DB 4.342944819032518 /* 10 / ln 10 */
 
 /* A numeric CSV table as in data/atmosphere/: '#' comment lines, one header line,
  * then rows of numbers separated by commas (empty field: NaN). */

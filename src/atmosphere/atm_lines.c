@@ -705,8 +705,7 @@ double atm_lines_grid_step_hz(const atm_lines_data *d, double lo_hz, double hi_h
              * scales that, so h = w (1e-5 / share)^(1/4) keeps it near 6e-6 of alpha. */
             atm_alpha_parts p;
             atm_lines_parts(d, l->nu_ghz * 1e9, &p);
-            double total_per_cm = 1e-2 * (p.h2o_lines_per_m + p.h2o_continuum_per_m + p.o2_per_m +
-                                          p.dry_continuum_per_m);
+            double total_per_cm = 1e-2 * atmosphere_alpha_parts_sum(&p);
             double share = fabs(l->amp * core(l, 0.0)) / total_per_cm;
             if (!(share > 0.0))
                 continue;

@@ -110,12 +110,17 @@ void atmosphere_alpha_parts(const thz_atmosphere *atm, double freq_hz, atm_alpha
     }
 }
 
+double atmosphere_alpha_parts_sum(const atm_alpha_parts *p)
+{
+    return p->h2o_lines_per_m + p->h2o_continuum_per_m + p->o2_per_m + p->dry_continuum_per_m +
+           p->other_per_m;
+}
+
 double atmosphere_alpha_direct_per_m(const thz_atmosphere *atm, double freq_hz)
 {
     atm_alpha_parts p;
     atmosphere_alpha_parts(atm, freq_hz, &p);
-    return p.h2o_lines_per_m + p.h2o_continuum_per_m + p.o2_per_m + p.dry_continuum_per_m +
-           p.other_per_m;
+    return atmosphere_alpha_parts_sum(&p);
 }
 
 /* 4-point Lagrange interpolation on the uniform grid; valid for

@@ -76,6 +76,12 @@ typedef struct atm_alpha_parts {
     double other_per_m;         /* none/constant/table: the whole alpha */
 } atm_alpha_parts;
 
+/* alpha in 1/m: the sum of the parts. */
+double atmosphere_alpha_parts_sum(const atm_alpha_parts *parts);
+
+/* 10 / ln 10: dB per neper (alpha in 1/m times this times 1000 is dB/km). */
+#define ATM_NEPER_TO_DB 4.342944819032518
+
 typedef struct atm_itu_data atm_itu_data;     /* atm_itu_p676.c */
 typedef struct atm_lines_data atm_lines_data; /* atm_lines.c */
 
