@@ -53,7 +53,8 @@ void atm_lines_parts(const atm_lines_data *lines, double freq_hz, atm_alpha_part
 double atm_lines_grid_step_hz(const atm_lines_data *lines, double lo_hz, double hi_hz);
 
 /* The Voigt profile (area 1, in 1/Hz units of its arguments) at offset x from the
- * centre, for Lorentz HWHM gamma_l and Doppler HWHM gamma_d; Humlicek (1982) W4. */
+ * centre, for Lorentz HWHM gamma_l and Doppler HWHM gamma_d; Weideman's (1994)
+ * 32-term rational series for the Faddeeva function (atm_voigt.c). */
 double atm_voigt(double x, double gamma_l, double gamma_d);
 
 #endif

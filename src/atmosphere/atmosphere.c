@@ -177,9 +177,12 @@ double atmosphere_transmittance(const thz_atmosphere *atm, double freq_hz, doubl
 }
 
 /* First grid step (Hz) over [lo, hi]. lines: from the line widths and strengths.
- * itu-p676: a quarter of the narrowest possible width: the smallest Table 1/2 width
- * coefficient is 6.69e-4 GHz/hPa times the pressure, floored at the O2 Zeeman
- * width 1.5 MHz (eq. 6b). The midpoint check refines either. */
+ * itu-p676: a quarter of a lower bound on the line widths, 6.0e-4 GHz/hPa * P *
+ * theta^0.8 (P the total pressure, theta = 300/T), floored at the O2 Zeeman width
+ * 1.5 MHz (ITU-R P.676-13 Annex 1 eq. 6b). P.676-13 eq. 6a gives O2 widths
+ * a3 * 1e-4 * (p theta^(0.8 - a4) + 1.1 e theta) GHz; the smallest a3 of Table 1 is
+ * 6.69 (with a4 = 0), so 6.0 leaves about 10 % margin; the H2O widths of Table 2
+ * (b3 >= 15.55) are wider. The midpoint check refines either. */
 static double model_first_step_hz(const thz_atmosphere *atm, double lo_hz, double hi_hz)
 {
     if (atm->model == ATM_LINES)

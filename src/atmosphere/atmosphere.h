@@ -103,7 +103,9 @@ typedef struct thz_atmosphere {
     atm_itu_data *itu;     /* owned, itu-p676 */
     atm_lines_data *lines; /* owned, lines */
 
-    /* Filled by atmosphere_prepare for itu-p676 and lines, sorted by lo_hz. */
+    /* Filled by atmosphere_prepare for itu-p676 and lines: one per channel, in the
+     * order of the channels it was given (bands may overlap; the first that covers a
+     * frequency is used). */
     size_t n_tables;
     atm_band_table *tables;
 
