@@ -21,7 +21,7 @@ thz_status atmosphere_set_emitting(thz_atmosphere *atm, double temperature_k,
                              "emitting atmosphere: background temperature must be 0 to 10000 K, "
                              "got %g K",
                              background_temperature_k);
-    if (atm->has_air && fabs(atm->air.temperature_k - temperature_k) > 0.0)
+    if (atm->has_air && atm->air.temperature_k != temperature_k)
         return thz_error_set(err, THZ_ERR_INPUT,
                              "emitting atmosphere: temperature %g K differs from the air's %g K",
                              temperature_k, atm->air.temperature_k);

@@ -220,8 +220,7 @@ static bool par_field(const char *rec, size_t start, size_t len, double *out)
  * ...), nu F12.6 cm^-1, S E10.3 cm^-1/(molecule cm^-2), A E10.3, gamma_air F5.4 and
  * gamma_self F5.3 cm^-1/atm, E'' F10.4 cm^-1, n_air F4.2, delta_air F8.6 cm^-1/atm,
  * then quantum numbers, error and reference codes, flag, g' and g'' (unused). */
-static thz_status read_par_catalog(const char *path, int molecule, raw_catalog *cat,
-                                   size_t *n_other, thz_error *err)
+static thz_status read_par_catalog(const char *path, int molecule, raw_catalog *cat, thz_error *err)
 {
     thz_status st = THZ_OK;
     char *line = NULL;
@@ -249,10 +248,8 @@ static thz_status read_par_catalog(const char *path, int molecule, raw_catalog *
                                lineno);
             goto cleanup;
         }
-        if ((int)mol != molecule) {
-            (*n_other)++;
-            continue;
-        }
+        if ((int)mol != molecule)
+            continue; /* other molecules are skipped */
         int iso;
         char c = line[2];
         if (c >= '1' && c <= '9')
@@ -311,9 +308,8 @@ cleanup:
 static thz_status read_catalog(const char *path, int molecule, bool coupled, raw_catalog *cat,
                                thz_error *err)
 {
-    size_t n_other = 0;
     if (has_suffix(path, ".par"))
-        return read_par_catalog(path, molecule, cat, &n_other, err);
+        return read_par_catalog(path, molecule, cat, err);
     return read_csv_catalog(path, coupled, cat, err);
 }
 
