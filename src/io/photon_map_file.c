@@ -25,6 +25,7 @@
 #define PMF_FLAGS_STORED                                                                           \
     (0xffffu | (PHOTON_MAP_BATCHES - 1u) << PHOTON_BATCH_SHIFT) /* bounces, batch */
 #define PMF_MAX_HEADER_BYTES (16u << 20)
+#define PMF_FRAME_HEADER_MAX 18u /* bytes: zstd's largest frame header */
 
 /* ---- little-endian words ---------------------------------------------------- */
 
@@ -390,6 +391,59 @@ static thz_status pmf_end_frame(pmf_reader *r, thz_error *err)
     }
 }
 
+/* Makes at least n bytes (n <= in_cap) of input available at r->in + r->in_pos, or all
+ * that is left of the file. */
+static thz_status pmf_peek(pmf_reader *r, size_t n, thz_error *err)
+{
+    size_t have = r->in_size - r->in_pos;
+    if (have >= n || r->eof)
+        return THZ_OK;
+    memmove(r->in, r->in + r->in_pos, have);
+    r->in_pos = 0;
+    r->in_size = have + fread(r->in + have, 1, r->in_cap - have, r->f);
+    if (ferror(r->f))
+        return thz_error_set(err, THZ_ERR_IO, "cannot read photon map %s: %s", r->path,
+                             strerror(errno));
+    return THZ_OK;
+}
+
+/* Before the records are allocated: the header's counts (nc channels) must be the
+ * bytes the records frame states it holds (when it states them), and no more than the
+ * rest of the file (file_bytes in all) can decompress to: a zstd block holds at most
+ * ZSTD_BLOCKSIZE_MAX bytes and takes at least 4 (a 3-byte header and one RLE byte). */
+static thz_status pmf_check_counts(pmf_reader *r, const uint8_t *header, size_t channel_words,
+                                   size_t nc, uint64_t file_bytes, thz_error *err)
+{
+    uint64_t total = 0;
+    for (size_t c = 0; c < nc; c++) {
+        uint64_t count = get_u64(header + 8 * (PMF_HEADER_FIXED + channel_words * c) + 16);
+        if (count > (UINT64_MAX - total) / sizeof(photon_record))
+            return pmf_corrupt(r, "impossible record count", err);
+        total += count * sizeof(photon_record);
+    }
+    thz_status st = pmf_peek(r, PMF_FRAME_HEADER_MAX, err);
+    if (st != THZ_OK)
+        return st;
+    long pos = ftell(r->f);
+    uint64_t consumed = pos >= 0 ? (uint64_t)pos - (r->in_size - r->in_pos) : 0;
+    uint64_t rest = file_bytes > consumed ? file_bytes - consumed : 0;
+    unsigned long long stated = ZSTD_getFrameContentSize(r->in + r->in_pos, r->in_size - r->in_pos);
+    if (stated == ZSTD_CONTENTSIZE_ERROR)
+        return pmf_corrupt(r, "bad records section", err);
+    if (stated != ZSTD_CONTENTSIZE_UNKNOWN && stated != total)
+        return thz_error_set(err, THZ_ERR_IO,
+                             "photon map %s is corrupted (its header counts %llu bytes of photons, "
+                             "its records section holds %llu); run `thzmap simulate` again",
+                             r->path, (unsigned long long)total, stated);
+    if (total > SIZE_MAX || total / ZSTD_BLOCKSIZE_MAX > rest / 4 + 1)
+        return thz_error_set(err, THZ_ERR_IO,
+                             "photon map %s is corrupted (its header counts %llu bytes of photons, "
+                             "more than its %llu remaining bytes can hold); run `thzmap simulate` "
+                             "again",
+                             r->path, (unsigned long long)total, (unsigned long long)rest);
+    return THZ_OK;
+}
+
 thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,
                                 photon_map **maps, photon_stats *stats, photon_map_file_info *info,
                                 thz_error *err)
@@ -399,10 +453,14 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
     pmf_reader r = {.path = path};
     uint8_t *header = NULL;
     photon_record **records = thz_calloc(nc ? nc : 1, sizeof *records);
+    double *t0_k = thz_calloc(nc ? nc : 1, sizeof *t0_k); /* each map's reference temperature */
     for (size_t c = 0; c < nc; c++)
         maps[c] = NULL;
-    if (!records)
+    if (!records || !t0_k) {
+        free(records);
+        free(t0_k);
         return thz_error_set(err, THZ_ERR_NOMEM, "cannot read photon map %s: out of memory", path);
+    }
 
     r.f = fopen(path, "rb");
     if (!r.f) {
@@ -447,7 +505,6 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
         goto cleanup;
     }
     if ((uint64_t)actual > stated) {
-        r.path = path;
         st = thz_error_set(err, THZ_ERR_IO,
                            "photon map %s is corrupted (%ld bytes where its header says %llu); run "
                            "`thzmap simulate` again",
@@ -523,14 +580,14 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
         goto cleanup;
     }
 
-    /* Frame 2: the records. */
+    /* Frame 2: the records. Before allocating them, the counts must fit what the rest of
+     * the file can hold. */
+    st = pmf_check_counts(&r, header, channel_words, nc, (uint64_t)actual, err);
+    if (st != THZ_OK)
+        goto cleanup;
     for (size_t c = 0; c < nc; c++) {
         const uint8_t *p = header + 8 * (PMF_HEADER_FIXED + channel_words * c);
         uint64_t count = get_u64(p + 16);
-        if (count > (uint64_t)(SIZE_MAX / sizeof(photon_record))) {
-            st = pmf_corrupt(&r, "impossible record count", err);
-            goto cleanup;
-        }
         records[c] = thz_malloc_array((size_t)count, sizeof(photon_record));
         if (!records[c]) {
             st = thz_error_set(err, THZ_ERR_NOMEM,
@@ -547,15 +604,15 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
                 goto cleanup;
             }
         }
-        double t0_k = version == 1u ? 0.0 : get_f64(p + 160);
-        if (!(t0_k >= 0.0) || !isfinite(t0_k)) {
+        t0_k[c] = version == 1u ? 0.0 : get_f64(p + 160);
+        if (!(t0_k[c] >= 0.0) || !isfinite(t0_k[c])) {
             st = pmf_corrupt(&r, "impossible reference temperature", err);
             goto cleanup;
         }
         if (stats) {
             pmf_get_stats(p + 24, &stats[c]);
             stats[c].seconds = 0.0;
-            stats[c].reference_temperature_k = t0_k;
+            stats[c].reference_temperature_k = t0_k[c];
         }
     }
     st = pmf_end_frame(&r, err);
@@ -579,7 +636,7 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
             thz_error_prefix(err, "photon map %s: ", path);
             goto cleanup;
         }
-        photon_map_set_reference_temperature_k(maps[c], version == 1u ? 0.0 : get_f64(p + 160));
+        photon_map_set_reference_temperature_k(maps[c], t0_k[c]);
         /* version 1 stored no batches (its flags' upper bits are 0) */
         photon_map_set_batches(maps[c], version == 1u ? 1u : PHOTON_MAP_BATCHES);
     }
@@ -599,6 +656,7 @@ cleanup:
     for (size_t c = 0; c < nc; c++)
         free(records[c]);
     free(records);
+    free(t0_k);
     free(header);
     ZSTD_freeDCtx(r.dctx);
     free(r.in);

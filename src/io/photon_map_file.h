@@ -11,10 +11,10 @@
  *     that a file depends only on the scene, seed and photon count), then f64 the map's
  *     reference temperature T0 in K (photon_map.h; 0 for the paper's map of L);
  *   zstd frame 2 (with content checksum and content size): the records of channel 0,
- *     1, ... as 32-byte photon_record images, `flags` holding only the bounce count
- *     (the map's index is rebuilt on reading). Within a channel they are in a canonical
- *     order (by object_side, then by their bytes) that does not depend on the photon
- *     map's internal order, so that read + write reproduces a file byte for byte.
+ *     1, ... as 32-byte photon_record images, `flags` holding only the bounce count and
+ *     the batch (bits 24-26; the map's index is rebuilt on reading). Within a channel they are in a
+ * canonical order (by object_side, then by their bytes) that does not depend on the photon map's
+ * internal order, so that read + write reproduces a file byte for byte.
  *
  * Version 1 is version 2 without T0 (20 words per channel): it is still read, its maps
  * with T0 = 0.

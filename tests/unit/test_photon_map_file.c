@@ -1,7 +1,8 @@
 /* photon-map.thzpm: write + read gives the same maps, stats and reference temperatures
  * (channel 1 is a deviation map, T0 = 290 K), and read + write reproduces the file byte
  * for byte; a version-1 file (no T0) reads with T0 = 0; corrupted (one byte flipped), truncated,
- * foreign and mismatched (another geometry, channel set or temperatures) files are refused with
+ * forged (a record count the file cannot hold, refused before allocating), foreign and
+ * mismatched (another geometry, channel set or temperatures) files are refused with
  * messages that name the file and say what is wrong. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -240,6 +241,60 @@ static void test_corrupted(void **state)
     free(buf);
 }
 
+/* The file at f->path with its header frame replaced by `header` (hsize bytes), as
+ * `out_path`. */
+static void spit_with_header(const fixture *f, const char *out_path, const unsigned char *header,
+                             size_t hsize)
+{
+    size_t n;
+    unsigned char *buf = slurp(f->path, &n);
+    size_t h1 = ZSTD_findFrameCompressedSize(buf + 24, n - 24);
+    assert_false(ZSTD_isError(h1));
+    ZSTD_CCtx *cctx = ZSTD_createCCtx();
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
+    size_t cap = ZSTD_compressBound(hsize);
+    unsigned char *out = malloc(24 + cap + (n - 24 - h1));
+    size_t h0 = ZSTD_compress2(cctx, out + 24, cap, header, hsize);
+    assert_false(ZSTD_isError(h0));
+    ZSTD_freeCCtx(cctx);
+    memcpy(out, buf, 24);
+    memcpy(out + 24 + h0, buf + 24 + h1, n - 24 - h1);
+    size_t total = 24 + h0 + (n - 24 - h1);
+    for (int i = 0; i < 8; i++)
+        out[16 + i] = (unsigned char)((uint64_t)total >> (8 * i));
+    spit(out_path, out, total);
+    free(buf);
+    free(out);
+}
+
+/* A header (with a valid checksum) whose record count is a lie is refused before the
+ * records are allocated: a huge count (2^40 records, 32 TB) and one too many. */
+static void test_forged_count(void **state)
+{
+    fixture *f = *state;
+    size_t n;
+    unsigned char *buf = slurp(f->path, &n);
+    size_t h1 = ZSTD_findFrameCompressedSize(buf + 24, n - 24);
+    unsigned long long hsize = ZSTD_getFrameContentSize(buf + 24, h1);
+    unsigned char *header = malloc(hsize);
+    assert_int_equal(ZSTD_decompress(header, hsize, buf + 24, h1), hsize);
+    char bad[160];
+    snprintf(bad, sizeof bad, "%s/forged.thzpm", f->dir);
+    unsigned char *count = header + 8 * 7 + 16; /* channel 0's record count */
+    uint64_t real = 0;
+    for (int i = 0; i < 8; i++)
+        real |= (uint64_t)count[i] << (8 * i);
+    const uint64_t lies[] = {(uint64_t)1 << 40, real + 1};
+    for (size_t k = 0; k < 2; k++) {
+        for (int i = 0; i < 8; i++)
+            count[i] = (unsigned char)(lies[k] >> (8 * i));
+        spit_with_header(f, bad, header, hsize);
+        expect_refusal(bad, f->scene, THZ_ERR_IO, "bytes of photons");
+    }
+    free(buf);
+    free(header);
+}
+
 static void test_truncated(void **state)
 {
     fixture *f = *state;
@@ -299,6 +354,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_version_1, setup, teardown),
         cmocka_unit_test_setup_teardown(test_corrupted, setup, teardown),
         cmocka_unit_test_setup_teardown(test_truncated, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_forged_count, setup, teardown),
         cmocka_unit_test_setup_teardown(test_mismatched_scene, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
