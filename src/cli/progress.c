@@ -3,8 +3,9 @@
 
 #include <signal.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
+
+#include "core/clock.h"
 
 /* The one piece of process-wide state in thzmap: a signal handler can reach nothing
  * else. Written only by the handler, read by the progress callback. */
@@ -27,18 +28,6 @@ void cli_signals_install(void)
     sigaction(SIGTERM, &sa, NULL);
 }
 
-bool cli_signals_interrupted(void)
-{
-    return cli_interrupted != 0;
-}
-
-static double cli_now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 void cli_progress_init(cli_progress *p, const char *command, bool quiet)
 {
     memset(p, 0, sizeof *p);
@@ -46,7 +35,7 @@ void cli_progress_init(cli_progress *p, const char *command, bool quiet)
     p->command = command;
     p->quiet = quiet;
     p->tty = isatty(fileno(stderr)) != 0;
-    p->last_report_s = cli_now_s();
+    p->last_report_s = thz_now_s();
 }
 
 /* The unit a stage counts in. */
@@ -100,7 +89,7 @@ int cli_progress_report(void *user, const thz_progress *pr)
         return 1;
     if (p->quiet)
         return 0;
-    double now = cli_now_s();
+    double now = thz_now_s();
     double previous = p->last_report_s;
     p->last_report_s = now;
     bool new_stage = !p->stage || strcmp(p->stage, pr->stage) != 0 || p->channel != pr->channel ||

@@ -41,7 +41,4 @@ void cli_progress_finish(cli_progress *p);
 /* Installs the SIGINT/SIGTERM handler (one-shot: a second signal kills at once). */
 void cli_signals_install(void);
 
-/* True once SIGINT or SIGTERM arrived. */
-bool cli_signals_interrupted(void);
-
 #endif

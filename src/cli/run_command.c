@@ -1,14 +1,15 @@
 /* simulate and render: options, scene, run, report. */
 #include "cli/run_command.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "cli/cli.h"
 #include "cli/progress.h"
+#include "core/clock.h"
 #include "run/run.h"
 #include "scene/scene.h"
 #include "sensor/render.h"
@@ -59,13 +60,6 @@ static void cli_run_usage(FILE *f, bool render)
                    "  --quiet               no progress output\n");
 }
 
-static double cli_now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 typedef struct cli_run_args {
     const char *scene_path;
     bool quiet;
@@ -109,15 +103,14 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
                                            val);
                 a->ov.has_integrator = true;
             } else if (strcmp(arg, "--target-noise-k") == 0 || strcmp(arg, "--max-seconds") == 0) {
+                bool target = strcmp(arg, "--target-noise-k") == 0;
                 char *end = NULL;
+                errno = 0;
                 double x = strtod(val, &end);
-                if (end == val || *end || !isfinite(x) || !(x > 0.0))
+                if (end == val || *end || errno || !isfinite(x) || !(x > 0.0))
                     return cli_usage_error(cmd, "%s expects a positive number (%s), got '%s'", arg,
-                                           arg[2] == 't' ? "K" : "s", val);
-                if (arg[2] == 't')
-                    a->opt.target_noise_k = x;
-                else
-                    a->opt.max_seconds = x;
+                                           target ? "K" : "s", val);
+                *(target ? &a->opt.target_noise_k : &a->opt.max_seconds) = x;
             } else if (strcmp(arg, "--photons") == 0) {
                 if (!cli_parse_u64(cmd, arg, val, 1, UINT64_C(1000000000000), &u))
                     return CLI_EXIT_USAGE;
@@ -169,7 +162,7 @@ int cli_run_command(int argc, char **argv, bool render)
     cli_signals_install();
     thz_error err;
     thz_error_clear(&err);
-    double t0 = cli_now_s();
+    double t0 = thz_now_s();
     thz_scene *scene = NULL;
     thz_status st = thz_scene_load(a.scene_path, &scene, &err);
     if (st != THZ_OK)
@@ -189,7 +182,7 @@ int cli_run_command(int argc, char **argv, bool render)
     cli_progress_init(&progress, cmd, a.quiet);
     a.opt.progress = cli_progress_report;
     a.opt.progress_user = &progress;
-    a.opt.seconds_load = cli_now_s() - t0;
+    a.opt.seconds_load = thz_now_s() - t0;
     run_result result;
     st = render ? run_render(scene, &a.opt, &result, &err)
                 : run_simulate(scene, &a.opt, &result, &err);

@@ -28,9 +28,9 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "core/alloc.h"
+#include "core/clock.h"
 #include "core/rng.h"
 #include "photon/emission.h"
 #include "physics/channel.h"
@@ -197,13 +197,6 @@ uint32_t render_estimates_per_pass(const thz_scene *scene)
     }
 }
 
-static double render_now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static void render_context_fini(render_context *ctx)
 {
     channel_quadrature_fini(&ctx->quad);
@@ -301,9 +294,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         for (size_t k = 0; diffuse && k < n; k++)
             ctx->tbar[o * n + k] = optics_mean_transmission(&ctx->optics[o * n + k]);
     }
-    ctx->t0_k = map_t0                ? photon_map_reference_temperature_k(map)
-                 : !isnan(path_t0_k) ? path_t0_k
-                                     : render_reference_temperature_k(scene, channel);
+    ctx->t0_k = map_t0              ? photon_map_reference_temperature_k(map)
+                : !isnan(path_t0_k) ? path_t0_k
+                                    : render_reference_temperature_k(scene, channel);
     ctx->deviation = map_t0 && ctx->t0_k > 0.0;
     for (size_t k = 0; k < n; k++) {
         ctx->b0[k] = planck_radiance(ctx->quad.freq_hz[k], ctx->t0_k);
@@ -1264,7 +1257,7 @@ thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, co
                                       render_accum *acc, const render_options *opt,
                                       render_stats *stats, thz_error *err)
 {
-    double t0 = render_now_s();
+    double t0 = thz_now_s();
     if (stats)
         memset(stats, 0, sizeof *stats);
     if (channel >= scene->n_channels || sensor >= scene->n_sensors)
@@ -1427,7 +1420,7 @@ cleanup:
         stats->starved_gathers = n_starved;
         stats->truncated_paths = n_truncated;
         stats->paths = n_paths;
-        stats->seconds = render_now_s() - t0;
+        stats->seconds = thz_now_s() - t0;
     }
     free(scratch);
     render_context_fini(&ctx);
