@@ -8,6 +8,7 @@
 #include "cli/cli.h"
 #include "physics/channel.h"
 #include "scene/scene.h"
+#include "sensor/render.h"
 
 static void validate_usage(FILE *f)
 {
@@ -93,12 +94,12 @@ static void validate_print(const thz_scene *s)
                sn->aperture_m2, sn->position_m[0], sn->position_m[1], sn->position_m[2],
                sn->direction[0], sn->direction[1], sn->direction[2], sn->normalize_to_k);
     }
-    static const char *const integrators[] = {"photon-map", "final-gather", "path"};
     printf("\nphotons: %llu per channel, seed %llu, min_relative_power %g, gather_min_photons %u\n",
            (unsigned long long)s->photons.per_channel, (unsigned long long)s->photons.seed,
            s->photons.min_relative_power, s->photons.gather_min_photons);
     printf("render: integrator %s, gather_rays %u, paths_per_sample %u\n",
-           integrators[s->render.integrator], s->render.gather_rays, s->render.paths_per_sample);
+           render_integrator_name(s->render.integrator), s->render.gather_rays,
+           s->render.paths_per_sample);
     printf("\nemitted spectral power P_A (band mean):\n");
     for (size_t c = 0; c < s->n_channels; c++)
         printf("  %-16s %.6e W/Hz\n", s->channels[c].name, scene_band_emitted_power_w_per_hz(s, c));

@@ -8,10 +8,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "accel/accel.h"
 #include "core/alloc.h"
+#include "core/clock.h"
+#include "core/path.h"
 #include "io/output.h"
 #include "io/photon_map_file.h"
 #include "io/ply.h"
@@ -37,6 +38,9 @@ typedef struct run_state {
     sensor_images *images;    /* one per selected sensor */
     uint64_t *back_face;      /* per scene sensor: samples that saw a back face */
     render_stats *render_sum; /* per selected sensor: counts over all channels */
+    render_stats *last;       /* [channel * n_selected + i]: the channel's last render pass
+                                 (every pass casts the same sample rays, so the counts are
+                                 a channel's, not the number of passes') */
     photon_map **maps;        /* per channel: kept for saving, or read from a file */
     photon_stats *stats;      /* per channel (simulate) */
     double *median_stderr_k;  /* per channel */
@@ -49,20 +53,14 @@ typedef struct run_state {
     double seconds_accel, seconds_photons, seconds_render, seconds_output;
 } run_state;
 
-static double run_now_s(void)
+thz_status run_check_options(const run_options *opt, thz_error *err)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-thz_status run_check_options(const thz_scene *scene, const run_options *opt, thz_error *err)
-{
-    (void)scene; /* every integrator takes a noise target in simulate (photon-map: photons) */
     if (opt->target_noise_k < 0.0 || !isfinite(opt->target_noise_k))
-        return thz_error_set(err, THZ_ERR_INPUT, "the noise target must be > 0 K");
+        return thz_error_set(err, THZ_ERR_INPUT, "the noise target must be > 0 K, got %g K",
+                             opt->target_noise_k);
     if (opt->max_seconds < 0.0 || !isfinite(opt->max_seconds))
-        return thz_error_set(err, THZ_ERR_INPUT, "the time limit must be > 0 s");
+        return thz_error_set(err, THZ_ERR_INPUT, "the time limit must be > 0 s, got %g s",
+                             opt->max_seconds);
     return THZ_OK;
 }
 
@@ -109,6 +107,7 @@ static void run_state_fini(run_state *rs)
     free(rs->selected);
     free(rs->back_face);
     free(rs->render_sum);
+    free(rs->last);
     if (rs->maps)
         for (size_t c = 0; c < rs->scene->n_channels; c++)
             photon_map_destroy(rs->maps[c]);
@@ -170,7 +169,8 @@ static thz_status run_state_init(run_state *rs, const thz_scene *scene, const ru
     rs->images = thz_calloc(rs->n_selected, sizeof *rs->images);
     rs->back_face = thz_calloc(ns, sizeof *rs->back_face); /* summary.json: per scene sensor */
     rs->render_sum = thz_calloc(rs->n_selected, sizeof *rs->render_sum);
-    if (!rs->images || !rs->back_face || !rs->render_sum)
+    rs->last = thz_calloc(nc * rs->n_selected, sizeof *rs->last);
+    if (!rs->images || !rs->back_face || !rs->render_sum || !rs->last)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     return THZ_OK;
 }
@@ -205,11 +205,15 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
 static uint64_t run_image_bytes(const run_state *rs)
 {
     uint64_t total = 0;
+    /* the pixel statistics of the channel being rendered: mean and m2, and final-gather's
+     * photon batches and disk variance (render_accum) */
+    uint64_t per_pixel =
+        2u +
+        (rs->scene->render.integrator == INTEGRATOR_FINAL_GATHER ? PHOTON_MAP_BATCHES + 1u : 0u);
     for (size_t i = 0; i < rs->n_selected; i++) {
         const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
         total += sensor_images_bytes(s->columns, s->rows, rs->scene->n_channels);
-        /* the pixel statistics of the channel being rendered: mean and m2 */
-        total += (uint64_t)s->columns * s->rows * 2u * sizeof(double);
+        total += (uint64_t)s->columns * s->rows * per_pixel * sizeof(double);
     }
     return total;
 }
@@ -312,7 +316,7 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
                          .seed = rs->seed, /* the photon map's, for render */
                          .progress = rs->opt->progress,
                          .progress_user = rs->opt->progress_user};
-    double t0 = run_now_s();
+    double t0 = thz_now_s();
     double target =
         render_integrator_has_passes(rs->scene->render.integrator) ? rs->opt->target_noise_k : 0.0;
     render_accum *acc = thz_calloc(rs->n_selected, sizeof *acc);
@@ -331,15 +335,7 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
                                             &acc[i], &ro, &rst, err);
             if (st != THZ_OK)
                 break;
-            render_stats *sum = &rs->render_sum[i];
-            sum->samples += rst.samples;
-            sum->escaped_samples += rst.escaped_samples;
-            sum->back_face_samples += rst.back_face_samples;
-            sum->widened_gathers += rst.widened_gathers;
-            sum->starved_gathers += rst.starved_gathers;
-            sum->truncated_paths += rst.truncated_paths;
-            sum->paths += rst.paths;
-            rs->back_face[rs->selected[i]] += rst.back_face_samples;
+            rs->last[c * rs->n_selected + i] = rst;
             st = render_accum_write(rs->scene, c, rs->selected[i], &acc[i], &rs->images[i], err);
         }
         if (st != THZ_OK)
@@ -349,7 +345,7 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
             break;
         if (run_channel_median_stderr_k(rs, c, v) <= target)
             break;
-        if (rs->opt->max_seconds > 0.0 && run_now_s() - t0 >= rs->opt->max_seconds)
+        if (rs->opt->max_seconds > 0.0 && thz_now_s() - t0 >= rs->opt->max_seconds)
             break;
         if (pass + 1 >= RUN_MAX_PASSES) {
             st = run_add_warning(rs, err,
@@ -364,7 +360,7 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
             render_accum_fini(&acc[i]);
     free(acc);
     free(v);
-    double seconds = run_now_s() - t0;
+    double seconds = thz_now_s() - t0;
     rs->seconds_channel[c] += seconds; /* photon-map's photon passes render again */
     rs->seconds_render += seconds;
     return st;
@@ -382,8 +378,22 @@ static thz_status run_median_stderr(run_state *rs, thz_error *err)
     return THZ_OK;
 }
 
+/* Per sensor, the counts of every channel's last render pass (render_sum, and back_face
+ * per scene sensor for summary.json), then the warnings they call for. */
 static thz_status run_render_warnings(run_state *rs, thz_error *err)
 {
+    for (size_t i = 0; i < rs->n_selected; i++) {
+        render_stats *sum = &rs->render_sum[i];
+        memset(sum, 0, sizeof *sum);
+        for (size_t c = 0; c < rs->scene->n_channels; c++) {
+            const render_stats *l = &rs->last[c * rs->n_selected + i];
+            sum->samples += l->samples;
+            sum->back_face_samples += l->back_face_samples;
+            sum->starved_gathers += l->starved_gathers;
+            sum->truncated_paths += l->truncated_paths;
+        }
+        rs->back_face[rs->selected[i]] = sum->back_face_samples;
+    }
     thz_status st = THZ_OK;
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
         const render_stats *r = &rs->render_sum[i];
@@ -396,16 +406,18 @@ static thz_status run_render_warnings(run_state *rs, thz_error *err)
                                  (unsigned long long)r->samples);
         if (st == THZ_OK && r->starved_gathers)
             st = run_add_warning(rs, err,
-                                 "sensor '%s': %llu samples hit objects holding fewer than "
-                                 "gather_min_photons photons (reflected radiance taken as 0); "
-                                 "raise photons.per_channel",
-                                 name, (unsigned long long)r->starved_gathers);
+                                 "sensor '%s': %llu samples hit objects holding fewer photons "
+                                 "than a density estimate needs (gather_min_photons; "
+                                 "final-gather's secondary hits at least %d) and took their "
+                                 "reflected radiance as 0; raise photons.per_channel",
+                                 name, (unsigned long long)r->starved_gathers, RENDER_SECONDARY_K);
         if (st == THZ_OK && r->truncated_paths)
-            st =
-                run_add_warning(rs, err,
-                                "sensor '%s': %llu samples crossed more than %d straight shells "
-                                "(what lies behind was dropped)",
-                                name, (unsigned long long)r->truncated_paths, RENDER_MAX_CROSSINGS);
+            st = run_add_warning(rs, err,
+                                 "sensor '%s': %llu samples were cut short: after %d straight "
+                                 "shells (what lies behind was dropped) or, with path, after %d "
+                                 "hits (the rest taken as B(T0))",
+                                 name, (unsigned long long)r->truncated_paths, RENDER_MAX_CROSSINGS,
+                                 RENDER_MAX_BOUNCES);
     }
     return st;
 }
@@ -415,11 +427,11 @@ static thz_status run_save_photon_map(run_state *rs, const char *dir, thz_error 
 static thz_status run_load_photon_map(run_state *rs, thz_error *err);
 
 /* Writes every output file into the staging directory and commits it. */
-static thz_status run_write_outputs(run_state *rs, double t_start, thz_error *err)
+static thz_status run_write_outputs(run_state *rs, thz_error *err)
 {
     if (run_report(rs, "output", 0, 0, 1))
         return thz_error_set(err, THZ_ERR_CANCELLED, "%s: cancelled", rs->command);
-    double t0 = run_now_s();
+    double t0 = thz_now_s();
     const char *dir = output_stage_dir(rs->stage);
     thz_status st = THZ_OK;
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++)
@@ -432,7 +444,7 @@ static thz_status run_write_outputs(run_state *rs, double t_start, thz_error *er
         st = run_render_warnings(rs, err);
     if (st != THZ_OK)
         return st;
-    rs->seconds_output = run_now_s() - t0;
+    rs->seconds_output = thz_now_s() - t0;
     run_summary sum = {
         .command = rs->command,
         .integrator = render_integrator_name(rs->scene->render.integrator),
@@ -455,7 +467,6 @@ static thz_status run_write_outputs(run_state *rs, double t_start, thz_error *er
         .n_run_warnings = rs->n_warnings,
         .run_warnings = (const char *const *)rs->warnings,
     };
-    (void)t_start;
     st = summary_write(dir, rs->scene, &sum, err);
     if (st != THZ_OK)
         return st;
@@ -484,7 +495,7 @@ static void run_fill_result(const run_state *rs, run_result *result, double t_st
         if (rs->passes[c] > result->max_passes)
             result->max_passes = rs->passes[c];
     }
-    result->seconds = run_now_s() - t_start;
+    result->seconds = thz_now_s() - t_start;
 }
 
 /* The common start: integrator check, sensors, staging directory, accel. */
@@ -495,14 +506,14 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
     if (st == THZ_OK)
         st = render_integrator_check(scene->render.integrator, err);
     if (st == THZ_OK)
-        st = run_check_options(scene, opt, err);
+        st = run_check_options(opt, err);
     if (st == THZ_OK)
         st = output_stage_create(opt->outdir, &rs->stage, err);
     if (st != THZ_OK)
         return st;
-    double t0 = run_now_s();
+    double t0 = thz_now_s();
     st = accel_create(scene, &rs->accel, err);
-    rs->seconds_accel = run_now_s() - t0;
+    rs->seconds_accel = thz_now_s() - t0;
     return st;
 }
 
@@ -552,7 +563,7 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
 {
     const thz_scene *scene = rs->scene;
     const run_options *opt = rs->opt;
-    double target = opt->target_noise_k, t_start = run_now_s();
+    double target = opt->target_noise_k, t_start = thz_now_s();
     double *v = thz_malloc_array(run_rendered_pixels(rs) ? run_rendered_pixels(rs) : 1, sizeof *v);
     size_t cap = 16, n = 0;
     photon_map **maps = thz_calloc(cap, sizeof *maps);
@@ -578,7 +589,7 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
                                    .progress = opt->progress,
                                    .progress_user = opt->progress_user};
         photon_stats ps;
-        double t0 = run_now_s();
+        double t0 = thz_now_s();
         st = photon_phase_run(scene, rs->accel, c, &po, &maps[n], &ps, err);
         if (st != THZ_OK)
             break;
@@ -588,7 +599,7 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
         if (n > 1)
             st = photon_map_merge((const photon_map *const *)maps, n, scene->n_objects,
                                   opt->threads, &merged, err);
-        rs->seconds_photons += run_now_s() - t0;
+        rs->seconds_photons += thz_now_s() - t0;
         run_stats_merge(&rs->stats[c], &ps, (uint32_t)n);
         if (st != THZ_OK)
             break;
@@ -598,16 +609,16 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
         rs->passes[c] = (uint32_t)n;
         if (st != THZ_OK || run_channel_median_stderr_k(rs, c, v) <= target)
             break;
-        if (opt->max_seconds > 0.0 && run_now_s() - t_start >= opt->max_seconds)
+        if (opt->max_seconds > 0.0 && thz_now_s() - t_start >= opt->max_seconds)
             break;
         /* the passes' maps and the next merge: twice the records, and their indexes */
         double next = 2.2 * (double)photon_map_bytes(map) * (double)(n + 1) / (double)n;
-        if (next > limit) {
+        if (limit > 0.0 && next > limit) { /* 0: the machine's memory is unknown */
             st = run_add_warning(rs, err,
                                  "channel %zu: stopped after %zu photon passes (%llu photons) "
-                                 "above the noise target of %g K: the next would need %.1f GB "
+                                 "above the noise target of %g K: the next would need %.2f GiB "
                                  "of memory",
-                                 c, n, (unsigned long long)(n * k), target, next / 1e9);
+                                 c, n, (unsigned long long)(n * k), target, next / 1073741824.0);
             break;
         }
         if (n >= RUN_MAX_PASSES) {
@@ -638,7 +649,7 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
 thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_result *result,
                         thz_error *err)
 {
-    double t_start = run_now_s();
+    double t_start = thz_now_s();
     run_state rs;
     thz_status st = run_begin(&rs, scene, opt, "simulate", err);
     bool photons = render_integrator_needs_photons(scene->render.integrator);
@@ -663,9 +674,9 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_resu
                                        .reference_temperature_k = run_photon_t0_k(scene, c),
                                        .progress = opt->progress,
                                        .progress_user = opt->progress_user};
-            double t0 = run_now_s();
+            double t0 = thz_now_s();
             st = photon_phase_run(scene, rs.accel, c, &po, &map, &rs.stats[c], err);
-            rs.seconds_photons += run_now_s() - t0;
+            rs.seconds_photons += thz_now_s() - t0;
             if (st != THZ_OK)
                 break;
         }
@@ -676,7 +687,7 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_resu
             photon_map_destroy(map);
     }
     if (st == THZ_OK)
-        st = run_write_outputs(&rs, t_start, err);
+        st = run_write_outputs(&rs, err);
     if (st == THZ_OK)
         run_fill_result(&rs, result, t_start);
     run_state_fini(&rs);
@@ -686,7 +697,7 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_resu
 thz_status run_render(const thz_scene *scene, const run_options *opt, run_result *result,
                       thz_error *err)
 {
-    double t_start = run_now_s();
+    double t_start = thz_now_s();
     run_state rs;
     if (opt->save_photon_map)
         return thz_error_set(err, THZ_ERR_INPUT, "render: --save-photon-map is for simulate");
@@ -714,7 +725,7 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, run_result
         rs.maps[c] = NULL;
     }
     if (st == THZ_OK)
-        st = run_write_outputs(&rs, t_start, err);
+        st = run_write_outputs(&rs, err);
     if (st == THZ_OK)
         run_fill_result(&rs, result, t_start);
     run_state_fini(&rs);
@@ -723,15 +734,15 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, run_result
 
 static thz_status run_save_photon_map(run_state *rs, const char *dir, thz_error *err)
 {
-    char path[4096];
-    int len = snprintf(path, sizeof path, "%s/photon-map.thzpm", dir);
-    if (len < 0 || (size_t)len >= sizeof path)
-        return thz_error_set(err, THZ_ERR_IO, "output path too long: %s", dir);
+    char path[THZ_PATH_MAX];
+    thz_status st = thz_path_join(path, sizeof path, dir, "photon-map.thzpm", err);
     const photon_map *const *maps = (const photon_map *const *)rs->maps;
-    thz_status st = photon_map_file_write(path, rs->scene, maps, rs->stats, err);
+    if (st == THZ_OK)
+        st = photon_map_file_write(path, rs->scene, maps, rs->stats, err);
+    if (st == THZ_OK)
+        st = thz_path_join(path, sizeof path, dir, "photon-map.ply", err);
     if (st != THZ_OK)
         return st;
-    snprintf(path, sizeof path, "%s/photon-map.ply", dir);
     uint64_t cap = rs->opt->ply_max_points ? rs->opt->ply_max_points : PLY_DEFAULT_MAX_POINTS;
     return ply_write_photons(path, maps, rs->scene->n_channels, cap, err);
 }

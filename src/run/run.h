@@ -64,9 +64,10 @@ typedef struct run_result {
     double seconds;               /* wall time of the run */
 } run_result;
 
-/* THZ_ERR_INPUT unless the options suit the scene's integrator (a noise target needs
- * final-gather or path; targets and limits must be positive). */
-thz_status run_check_options(const thz_scene *scene, const run_options *opt, thz_error *err);
+/* THZ_ERR_INPUT unless the noise target and the time limit are positive (or 0: none).
+ * Every integrator takes a target in simulate (photon-map by photon passes); render
+ * refuses one for photon-map, which would need photons. */
+thz_status run_check_options(const run_options *opt, thz_error *err);
 
 /* Applies the overrides to the scene (before run_simulate / run_render). */
 void run_apply_overrides(thz_scene *scene, const run_overrides *ov);
