@@ -78,6 +78,15 @@ static void furnace_case(thz_integrator integrator, double t0_k)
         assert_true(fabs(r.img.power[i] - p) <= 1e-5 * p);
         double tb = r.img.brightness_temperature[i];
         assert_true(fabs(planck_radiance(ch->center_hz, tb) - l) <= 1e-5 * l);
+        /* physics.md identity 1: Tb_c = T up to the band-width term of inverting at nu_c
+         * (~0.04 K at 1 %, growing as the width squared): checked where L is exact */
+        double tb_band = planck_brightness_temperature(ch->center_hz, b);
+        double w = ch->relative_width / 0.01;
+        print_message("furnace, channel %zu: Tb of the band mean %.4f K (width term %+.4f K)\n", c,
+                      tb_band, tb_band - temp_k);
+        assert_true(fabs(tb_band - temp_k) <= 0.06 * w * w && tb_band > temp_k);
+        if (exact)
+            assert_true(fabs(tb - tb_band) <= 1e-4);
     }
     assert_true(interior > 200); /* most of the picture is checked tightly */
     ident_run_fini(&r);
