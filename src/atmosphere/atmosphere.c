@@ -191,24 +191,49 @@ static double model_first_step_hz(const thz_atmosphere *atm, double lo_hz, doubl
     return fmax(w_ghz, 1.5e-3) * 1e9 / 4.0;
 }
 
-static void fill_table(const thz_atmosphere *atm, atm_band_table *t)
+/* Frequency at grid index x of t; x = i + 0.5 is the midpoint after point i. Every
+ * grid and midpoint frequency comes from this one expression, so that a value is
+ * reused (fill_table) only at a bit-identical frequency. */
+static double table_freq_hz(const atm_band_table *t, double x)
+{
+    return t->lo_hz + x * t->step_hz;
+}
+
+/* Fills t->alpha_per_m. After a halving (prev: the previous table, prev_mid: direct
+ * alpha at its midpoints, or NULL on the first pass) the grid starts half a step
+ * lower, lo - h/2 = (lo - h) + h/2, so the previous grid point i is the new point
+ * 2i - 1 (odd) and the previous midpoint i + 1/2 the new point 2i (even): those are
+ * copied where the frequency is the same to the bit, the rest (the ends, and any
+ * point where rounding moved the frequency) evaluated directly. */
+static void fill_table(const thz_atmosphere *atm, atm_band_table *t, const atm_band_table *prev,
+                       const double *prev_mid)
 {
     long n = (long)t->n;
 #pragma omp parallel for schedule(dynamic, 64)
-    for (long i = 0; i < n; i++)
-        t->alpha_per_m[i] = atmosphere_alpha_direct_per_m(atm, t->lo_hz + (double)i * t->step_hz);
+    for (long j = 0; j < n; j++) {
+        double f = table_freq_hz(t, (double)j);
+        size_t i = (size_t)(j + 1) / 2;
+        if (prev_mid && j % 2 == 1 && i < prev->n && table_freq_hz(prev, (double)i) == f)
+            t->alpha_per_m[j] = prev->alpha_per_m[i];
+        else if (prev_mid && j % 2 == 0 && i >= 1 && i + 2 < prev->n &&
+                 table_freq_hz(prev, (double)i + 0.5) == f)
+            t->alpha_per_m[j] = prev_mid[i];
+        else
+            t->alpha_per_m[j] = atmosphere_alpha_direct_per_m(atm, f);
+    }
 }
 
 /* Largest relative difference between interpolation and direct evaluation at the
- * midpoints of the grid intervals inside [lo, hi]. */
-static double table_midpoint_error(const thz_atmosphere *atm, const atm_band_table *t)
+ * midpoints i + 1/2, 1 <= i < n - 2, of the grid; the direct values go to mid[i]. */
+static double table_midpoint_error(const thz_atmosphere *atm, const atm_band_table *t, double *mid)
 {
     long n = (long)t->n;
     double worst = 0.0;
 #pragma omp parallel for schedule(dynamic, 64) reduction(max : worst)
     for (long i = 1; i < n - 2; i++) {
-        double f = t->lo_hz + ((double)i + 0.5) * t->step_hz;
+        double f = table_freq_hz(t, (double)i + 0.5);
         double direct = atmosphere_alpha_direct_per_m(atm, f);
+        mid[i] = direct;
         double rel = fabs(table_eval(t, f) - direct) / fmax(fabs(direct), 1e-300);
         if (rel > worst)
             worst = rel;
@@ -216,37 +241,59 @@ static double table_midpoint_error(const thz_atmosphere *atm, const atm_band_tab
     return worst;
 }
 
+/* On failure t may hold the last grid tried; the caller frees t->alpha_per_m. */
 static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, double lo_hz,
                               double hi_hz, atm_band_table *t, thz_error *err)
 {
     double step = fmin(model_first_step_hz(atm, lo_hz, hi_hz), (hi_hz - lo_hz) / 32.0);
+    atm_band_table prev = {0};
+    double *prev_mid = NULL, *mid = NULL;
+    thz_status st = THZ_OK;
     memset(t, 0, sizeof *t);
     for (int refine = 0;; refine++) {
         double n_real = ceil((hi_hz - lo_hz) / step) + 3.0;
-        if (n_real > (double)TABLE_MAX_POINTS)
-            return thz_error_set(err, THZ_ERR_LIMIT,
-                                 "channel '%s': tabulating the atmosphere over its band needs "
-                                 "more than %zu points (step %.3g MHz); narrow the channel's "
-                                 "relative_width or raise the pressure",
-                                 ch->name, TABLE_MAX_POINTS, step * 1e-6);
-        free(t->alpha_per_m);
+        if (n_real > (double)TABLE_MAX_POINTS) {
+            st = thz_error_set(err, THZ_ERR_LIMIT,
+                               "channel '%s': tabulating the atmosphere over its band needs "
+                               "more than %zu points (step %.3g MHz); narrow the channel's "
+                               "relative_width or raise the pressure",
+                               ch->name, TABLE_MAX_POINTS, step * 1e-6);
+            break;
+        }
         t->n = (size_t)n_real;
         t->step_hz = step;
         t->lo_hz = lo_hz - step;
         t->alpha_per_m = thz_malloc_array(t->n, sizeof *t->alpha_per_m);
-        if (!t->alpha_per_m)
-            return thz_error_set(err, THZ_ERR_NOMEM, "out of memory tabulating the atmosphere");
-        fill_table(atm, t);
-        double e = table_midpoint_error(atm, t);
+        mid = thz_malloc_array(t->n, sizeof *mid);
+        if (!t->alpha_per_m || !mid) {
+            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory tabulating the atmosphere");
+            break;
+        }
+        fill_table(atm, t, &prev, prev_mid);
+        free(prev.alpha_per_m);
+        free(prev_mid);
+        prev.alpha_per_m = NULL;
+        prev_mid = NULL;
+        double e = table_midpoint_error(atm, t, mid);
         if (e <= TABLE_TOLERANCE)
-            return THZ_OK;
-        if (refine == TABLE_MAX_REFINEMENTS)
-            return thz_error_set(err, THZ_ERR_INTERNAL,
-                                 "channel '%s': atmosphere tabulation did not reach %g relative "
-                                 "error (%.3g at step %.3g MHz)",
-                                 ch->name, TABLE_TOLERANCE, e, step * 1e-6);
+            break;
+        if (refine == TABLE_MAX_REFINEMENTS) {
+            st = thz_error_set(err, THZ_ERR_INTERNAL,
+                               "channel '%s': atmosphere tabulation did not reach %g relative "
+                               "error (%.3g at step %.3g MHz)",
+                               ch->name, TABLE_TOLERANCE, e, step * 1e-6);
+            break;
+        }
+        prev = *t;
+        prev_mid = mid;
+        mid = NULL;
+        t->alpha_per_m = NULL;
         step *= 0.5;
     }
+    free(mid);
+    free(prev_mid);
+    free(prev.alpha_per_m);
+    return st;
 }
 
 static void free_tables(thz_atmosphere *atm)
