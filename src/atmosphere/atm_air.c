@@ -17,13 +17,13 @@ double atm_saturation_pressure_hpa(double temperature_k, double pressure_hpa)
 thz_status atm_air_state_init(atm_air_state *air, double temperature_k, double pressure_hpa,
                               atm_humidity_kind kind, double value, thz_error *err)
 {
-    if (!(temperature_k >= 100.0 && temperature_k <= 400.0))
-        return thz_error_set(err, THZ_ERR_INPUT, "air temperature must be 100 to 400 K, got %g K",
-                             temperature_k);
-    if (!(pressure_hpa > 0.0 && pressure_hpa <= 2000.0))
+    if (!(temperature_k >= ATM_AIR_MIN_TEMPERATURE_K && temperature_k <= ATM_AIR_MAX_TEMPERATURE_K))
+        return thz_error_set(err, THZ_ERR_INPUT, "air temperature must be %g to %g K, got %g K",
+                             ATM_AIR_MIN_TEMPERATURE_K, ATM_AIR_MAX_TEMPERATURE_K, temperature_k);
+    if (!(pressure_hpa > 0.0 && pressure_hpa <= ATM_AIR_MAX_PRESSURE_HPA))
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "air pressure must be above 0 and at most 2000 hPa, got %g hPa",
-                             pressure_hpa);
+                             "air pressure must be above 0 and at most %g hPa, got %g hPa",
+                             ATM_AIR_MAX_PRESSURE_HPA, pressure_hpa);
     double e = 0.0;
     switch (kind) {
     case ATM_HUMIDITY_NONE:

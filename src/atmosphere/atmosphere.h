@@ -125,10 +125,16 @@ typedef struct thz_atmosphere {
  * factor EF), stated for -40..+50 deg C and used outside that range as is. */
 double atm_saturation_pressure_hpa(double temperature_k, double pressure_hpa);
 
+/* The air states the models accept: temperature in [MIN, MAX] K, total pressure in
+ * (0, MAX] hPa. */
+#define ATM_AIR_MIN_TEMPERATURE_K 100.0
+#define ATM_AIR_MAX_TEMPERATURE_K 400.0
+#define ATM_AIR_MAX_PRESSURE_HPA 2000.0
+
 /* Fills *air from temperature, total pressure and a humidity of the given kind
  * (value ignored for ATM_HUMIDITY_NONE). Refuses, with THZ_ERR_INPUT and a message
- * naming the quantity, T outside 100..400 K, pressure outside (0, 2000] hPa, negative
- * humidity, relative humidity above 1 and a vapour pressure above the total. */
+ * naming the quantity, T and pressure outside the bounds above, negative humidity,
+ * relative humidity above 1 and a vapour pressure above the total. */
 thz_status atm_air_state_init(atm_air_state *air, double temperature_k, double pressure_hpa,
                               atm_humidity_kind kind, double value, thz_error *err);
 
