@@ -1,21 +1,26 @@
 /* thzmap atmosphere: alpha(nu) of an atmosphere model as CSV, and optionally a
  * PLplot figure (attenuation in dB/km on a log axis against frequency in THz, with
  * the channels of a scene marked). */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include <plplot.h>
-
 #include "atmosphere/atmosphere.h"
 #include "cli/cli.h"
 #include "core/alloc.h"
+#include "io/plot.h"
 #include "scene/scene.h"
 
 #define CMD "atmosphere"
 #define MAX_POINTS 10000000.0
-#define DB_PER_KM_PER_INV_M 4342.944819032518 /* 10 / ln 10 * 1000 */
+
+/* alpha in 1/m as dB/km. */
+static double db_per_km(double alpha_per_m)
+{
+    return alpha_per_m * (ATM_NEPER_TO_DB * 1e3);
+}
 
 static void print_help(void)
 {
@@ -29,18 +34,21 @@ static void print_help(void)
            "  --from-thz F1, --to-thz F2   frequency range in THz, both ends included\n"
            "  --step-ghz S                 frequency step in GHz\n"
            "  --model M                    lines (default), itu-p676 (1-1000 GHz), none\n"
-           "  --temperature-k T            air temperature in K (default 288.15)\n"
-           "  --pressure-hpa P             total pressure (dry air + water vapour) in hPa\n"
-           "                               (default 1013.25)\n"
+           "  --temperature-k T            air temperature in K, 100-400 (default 288.15)\n"
+           "  --pressure-hpa P             total pressure (dry air + water vapour) in hPa,\n"
+           "                               above 0, at most 2000 (default 1013.25)\n"
            "  --relative-humidity RH       0..1 over liquid water (ITU-R P.453-14), or\n"
            "  --water-vapour-g-m3 RHO      water-vapour density in g/m^3 (default 7.5), or\n"
            "  --h2o-vmr X                  water-vapour volume mixing ratio (of total air)\n"
            "  --h2o-lines FILE             lines: H2O catalogue (am CSV or HITRAN .par)\n"
            "  --o2-lines FILE              lines: uncoupled O2 catalogue (am CSV or .par)\n"
            "  --no-continuum               lines: no MT_CKD continuum (full H2O line wings)\n"
+           "                               (these three apply to --model or --compare-model\n"
+           "                               lines; refused when neither is)\n"
            "  --distance-m D               add the transmittance exp(-alpha D) of a D m path\n"
            "  --plot FILE.png              also draw alpha in dB/km against THz (PLplot)\n"
-           "  --compare-model M            plot: overlay model M's total (same air)\n"
+           "  --compare-model M            plot: overlay model M's total (same air, also\n"
+           "                               the scene's)\n"
            "  --scene SCENE.json           plot: mark the scene's channels; without --model\n"
            "                               and air options, use the scene's atmosphere\n"
            "  -h, --help                   this help\n");
@@ -114,11 +122,12 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
         } else if (strcmp(a, "--compare-model") == 0) {
             o->compare_model = v;
         } else if (strcmp(a, "--temperature-k") == 0) {
-            if (!cli_parse_double(CMD, a, v, 0.0, 1e4, &o->temperature_k))
+            if (!cli_parse_double(CMD, a, v, ATM_AIR_MIN_TEMPERATURE_K, ATM_AIR_MAX_TEMPERATURE_K,
+                                  &o->temperature_k))
                 return CLI_EXIT_USAGE;
             o->air_given = true;
         } else if (strcmp(a, "--pressure-hpa") == 0) {
-            if (!cli_parse_double(CMD, a, v, 0.0, 1e5, &o->pressure_hpa))
+            if (!cli_parse_double(CMD, a, v, 0.0, ATM_AIR_MAX_PRESSURE_HPA, &o->pressure_hpa))
                 return CLI_EXIT_USAGE;
             o->air_given = true;
         } else if (strcmp(a, "--relative-humidity") == 0 || strcmp(a, "--water-vapour-g-m3") == 0 ||
@@ -161,9 +170,25 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
     return CLI_EXIT_OK;
 }
 
-/* Builds the atmosphere `name` from the options (air state, catalogues). */
-static thz_status build_model(const options *o, const char *name, thz_atmosphere *atm,
-                              thz_error *err)
+static const char *humidity_option(atm_humidity_kind kind)
+{
+    switch (kind) {
+    case ATM_HUMIDITY_RELATIVE:
+        return "--relative-humidity";
+    case ATM_HUMIDITY_VMR:
+        return "--h2o-vmr";
+    case ATM_HUMIDITY_NONE:
+    case ATM_HUMIDITY_DENSITY_G_M3:
+        break;
+    }
+    return "--water-vapour-g-m3";
+}
+
+/* Builds the atmosphere `name` from the options (catalogues) in the air `air`, or
+ * with air == NULL in the air of the options (their values are then named in an
+ * error about the air). */
+static thz_status build_model(const options *o, const char *name, const atm_air_state *air,
+                              thz_atmosphere *atm, thz_error *err)
 {
     atm_model model;
     memset(atm, 0, sizeof *atm);
@@ -175,19 +200,26 @@ static thz_status build_model(const options *o, const char *name, thz_atmosphere
                              name);
     if (model == ATM_NONE)
         return THZ_OK;
-    atm_air_state air;
-    thz_status st = atm_air_state_init(&air, o->temperature_k, o->pressure_hpa, o->humidity_kind,
-                                       o->humidity, err);
-    if (st != THZ_OK)
-        return st;
+    atm_air_state own_air;
+    if (!air) {
+        thz_status st = atm_air_state_init(&own_air, o->temperature_k, o->pressure_hpa,
+                                           o->humidity_kind, o->humidity, err);
+        if (st != THZ_OK) {
+            thz_error_prefix(err,
+                             "--temperature-k %g, --pressure-hpa %g, %s %g: ", o->temperature_k,
+                             o->pressure_hpa, humidity_option(o->humidity_kind), o->humidity);
+            return st;
+        }
+        air = &own_air;
+    }
     if (model == ATM_ITU_P676)
-        return atmosphere_init_itu_p676(atm, &air, NULL, err);
+        return atmosphere_init_itu_p676(atm, air, NULL, err);
     atm_lines_options lo;
     atmosphere_lines_options_default(&lo);
     lo.h2o_lines_file = o->h2o_lines;
     lo.o2_lines_file = o->o2_lines;
     lo.continuum = !o->no_continuum;
-    return atmosphere_init_lines(atm, &air, &lo, err);
+    return atmosphere_init_lines(atm, air, &lo, err);
 }
 
 typedef struct series {
@@ -207,166 +239,63 @@ static void series_fini(series *s)
     free(s->compare_db);
 }
 
-/* log10 of a dB/km value for the plot, floored at the axis bottom. */
-static double plot_log(double v, double floor_log)
+/* The figure: the parts and the total of atm (and the comparison's total) in dB/km
+ * on a log axis against THz, the scene's channels (centre and FWHM) shaded. */
+static thz_status draw_plot(const options *o, const series *s, const thz_atmosphere *atm,
+                            const thz_atmosphere *compare, const thz_scene *scene,
+                            const char *model_name, thz_error *err)
 {
-    return v > 0.0 ? fmax(log10(v), floor_log) : floor_log;
-}
-
-static bool has_pngcairo(void)
-{
-    enum { MAX_DEVICES = 128 };
-    const char **menu = calloc(MAX_DEVICES, sizeof *menu);
-    const char **devs = calloc(MAX_DEVICES, sizeof *devs);
-    int n = MAX_DEVICES;
-    bool found = false;
-    if (menu && devs) {
-        plgDevs(&menu, &devs, &n);
-        for (int i = 0; i < n; i++)
-            if (devs[i] && strcmp(devs[i], "pngcairo") == 0)
-                found = true;
-    }
-    free(menu);
-    free(devs);
-    return found;
-}
-
-static void draw_curve(const series *s, const double *y_db, double floor_log, int colour, int style,
-                       double width, double *buf)
-{
-    for (size_t i = 0; i < s->n; i++)
-        buf[i] = plot_log(y_db[i], floor_log);
-    plcol0(colour);
-    pllsty(style);
-    plwidth(width);
-    plline((PLINT)s->n, s->f_thz, buf);
-}
-
-static int draw_plot(const options *o, const series *s, const thz_atmosphere *atm,
-                     const thz_scene *scene, const char *model_name)
-{
-    if (!has_pngcairo()) {
-        fprintf(stderr, "thzmap atmosphere: PLplot has no 'pngcairo' device; install "
-                        "plplot-driver-cairo to use --plot\n");
-        return CLI_EXIT_FAILURE;
-    }
-    double *buf = thz_malloc_array(s->n, sizeof *buf);
-    if (!buf) {
-        fprintf(stderr, "thzmap atmosphere: out of memory\n");
-        return CLI_EXIT_FAILURE;
-    }
-    double top = -INFINITY;
-    for (size_t i = 0; i < s->n; i++) {
-        top = fmax(top, plot_log(s->total_db[i], -300));
-        if (s->compare_db)
-            top = fmax(top, plot_log(s->compare_db[i], -300));
-    }
-    if (!isfinite(top) || top < -5)
-        top = 0;
-    double y_hi = ceil(top + 0.3) + 2.0, y_lo = y_hi - 9.0; /* nine decades, two for the legend */
-    double x_lo = s->f_thz[0], x_hi = s->f_thz[s->n - 1];
-    if (x_hi <= x_lo)
-        x_hi = x_lo + 1e-3;
-
-    plsdev("pngcairo");
-    plsfnam(o->plot);
-    plspage(0, 0, 1200, 750, 0, 0);
-    plscolbg(255, 255, 255);
-    plscol0(0, 255, 255, 255); /* background */
-    plscol0(1, 0, 0, 0);       /* axes, total */
-    plscol0(2, 31, 119, 180);  /* H2O lines */
-    plscol0(3, 44, 160, 44);   /* H2O continuum */
-    plscol0(4, 214, 39, 40);   /* O2 */
-    plscol0(5, 148, 103, 189); /* dry continuum */
-    plscol0(6, 255, 127, 14);  /* comparison */
-    plscol0(7, 150, 150, 150); /* channels */
-    plinit();
-    plschr(0, 1.1);
-    plcol0(1);
-    plenv(x_lo, x_hi, y_lo, y_hi, 0, 20);
-    char title[256];
-    const atm_air_state *air = &atm->air;
-    if (atm->has_air)
-        snprintf(title, sizeof title,
-                 "atmosphere '%s': %.2f K, %.1f hPa, water vapour %.2f g/m#u3#d", model_name,
-                 air->temperature_k, air->pressure_hpa, atm_air_h2o_density_g_m3(air));
-    else
-        snprintf(title, sizeof title, "atmosphere '%s'", model_name);
-    pllab("frequency (THz)", "attenuation (dB/km)", title);
-
-    if (scene) {
-        for (size_t c = 0; c < scene->n_channels; c++) {
-            const thz_channel *ch = &scene->channels[c];
-            double fc = ch->center_hz * 1e-12, half = 0.5 * ch->relative_width * fc;
-            if (fc < x_lo || fc > x_hi)
-                continue;
-            PLFLT bx[4] = {fc - half, fc + half, fc + half, fc - half};
-            PLFLT by[4] = {y_lo, y_lo, y_hi, y_hi};
-            plscol0a(8, 200, 200, 200, 0.35);
-            plcol0(8);
-            plfill(4, bx, by);
-            plcol0(7);
-            pllsty(2);
-            plwidth(1.0);
-            PLFLT lx[2] = {fc, fc}, ly[2] = {y_lo, y_hi};
-            plline(2, lx, ly);
-            plcol0(1);
-            plschr(0, 0.8);
-            plptex(fc - 0.004 * (x_hi - x_lo), y_lo + 0.15, 0.0, 1.0, 0.0, ch->name);
-            plschr(0, 1.1);
-        }
-    }
-
-    const char *texts[6];
-    PLINT colours[6], styles[6], opts[6];
-    PLFLT widths[6];
-    int n_legend = 0;
-#define LEGEND(text_, colour_, style_, width_)                                                     \
-    do {                                                                                           \
-        texts[n_legend] = (text_);                                                                 \
-        colours[n_legend] = (colour_);                                                             \
-        styles[n_legend] = (style_);                                                               \
-        widths[n_legend] = (width_);                                                               \
-        opts[n_legend] = PL_LEGEND_LINE;                                                           \
-        n_legend++;                                                                                \
-    } while (0)
+    plot_curve curves[6];
+    size_t n = 0;
     if (atm->model == ATM_LINES || atm->model == ATM_ITU_P676) {
-        draw_curve(s, s->h2o_lines_db, y_lo, 2, 1, 1.0, buf);
-        LEGEND(atm->model == ATM_LINES ? "H#d2#uO lines" : "H#d2#uO", 2, 1, 1.0);
-        if (atm->model == ATM_LINES) {
-            draw_curve(s, s->h2o_cont_db, y_lo, 3, 1, 1.0, buf);
-            LEGEND("H#d2#uO continuum (MT_CKD)", 3, 1, 1.0);
-        }
-        draw_curve(s, s->o2_db, y_lo, 4, 1, 1.0, buf);
-        LEGEND("O#d2#u", 4, 1, 1.0);
-        draw_curve(s, s->dry_db, y_lo, 5, 1, 1.0, buf);
-        LEGEND("dry-air continuum", 5, 1, 1.0);
+        curves[n++] = (plot_curve){atm->model == ATM_LINES ? "H#d2#uO lines" : "H#d2#uO",
+                                   s->h2o_lines_db,
+                                   {31, 119, 180},
+                                   1.0,
+                                   false};
+        if (atm->model == ATM_LINES)
+            curves[n++] = (plot_curve){
+                "H#d2#uO continuum (MT_CKD)", s->h2o_cont_db, {44, 160, 44}, 1.0, false};
+        curves[n++] = (plot_curve){"O#d2#u", s->o2_db, {214, 39, 40}, 1.0, false};
+        curves[n++] = (plot_curve){"dry-air continuum", s->dry_db, {148, 103, 189}, 1.0, false};
     }
-    static char total_text[96], compare_text[96];
+    char total_text[96], compare_text[96];
     snprintf(total_text, sizeof total_text, "total, %s", model_name);
-    draw_curve(s, s->total_db, y_lo, 1, 1, 2.0, buf);
-    LEGEND(total_text, 1, 1, 2.0);
+    curves[n++] = (plot_curve){total_text, s->total_db, {0, 0, 0}, 2.0, false};
     if (s->compare_db) {
         snprintf(compare_text, sizeof compare_text, "total, %s", o->compare_model);
-        draw_curve(s, s->compare_db, y_lo, 6, 2, 2.0, buf);
-        LEGEND(compare_text, 6, 2, 2.0);
+        curves[n++] = (plot_curve){compare_text, s->compare_db, {255, 127, 14}, 2.0, true};
     }
-#undef LEGEND
-    PLFLT legend_w, legend_h;
-    PLINT box_colours[6] = {0}, box_patterns[6] = {0}, symbol_colours[6] = {0};
-    PLFLT box_scales[6] = {0}, box_widths[6] = {0}, symbol_scales[6] = {0};
-    PLINT symbol_numbers[6] = {0};
-    const char *symbols[6] = {"", "", "", "", "", ""};
-    pllsty(1);
-    plwidth(1.0);
-    pllegend(&legend_w, &legend_h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-             PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.02, 0.02, 0.1, 0, 1, 1, 3,
-             2, n_legend, opts, 1.0, 0.75, 2.0, 1.0, colours, texts, box_colours, box_patterns,
-             box_scales, box_widths, colours, styles, widths, symbol_colours, symbol_scales,
-             symbol_numbers, symbols);
-    plend();
-    free(buf);
-    return CLI_EXIT_OK;
+
+    size_t n_bands = scene ? scene->n_channels : 0;
+    plot_band *bands = thz_calloc(n_bands ? n_bands : 1, sizeof *bands);
+    if (!bands)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    for (size_t c = 0; c < n_bands; c++) {
+        const thz_channel *ch = &scene->channels[c];
+        double fc = ch->center_hz * 1e-12, half = 0.5 * ch->relative_width * fc;
+        bands[c] = (plot_band){ch->name, fc - half, fc, fc + half};
+    }
+
+    /* The air in the title: the model's, or else the comparison's. */
+    char title[256];
+    const thz_atmosphere *with_air = atm->has_air ? atm : compare->has_air ? compare : NULL;
+    const atm_air_state *air = with_air ? &with_air->air : NULL;
+    if (with_air == atm)
+        snprintf(title, sizeof title,
+                 "atmosphere '%s': %.2f K, %.1f hPa, water vapour %.2f g/m\u00b3", model_name,
+                 air->temperature_k, air->pressure_hpa, atm_air_h2o_density_g_m3(air));
+    else if (with_air)
+        snprintf(title, sizeof title,
+                 "atmosphere '%s'; %s air: %.2f K, %.1f hPa, %.2f g/m\u00b3 vapour", model_name,
+                 o->compare_model, air->temperature_k, air->pressure_hpa,
+                 atm_air_h2o_density_g_m3(air));
+    else
+        snprintf(title, sizeof title, "atmosphere '%s'", model_name);
+    thz_status st = plot_attenuation(o->plot, s->n, s->f_thz, n, curves, n_bands, bands, title,
+                                     "frequency (THz)", "attenuation (dB/km)", err);
+    free(bands);
+    return st;
 }
 
 int cmd_atmosphere(int argc, char **argv)
@@ -390,14 +319,27 @@ int cmd_atmosphere(int argc, char **argv)
         rc = cli_fail(&err);
         goto cleanup;
     }
-    if (scene && !o.model && !o.air_given) {
+    bool from_scene = scene && !o.model && !o.air_given;
+    bool lines_options = o.h2o_lines || o.o2_lines || o.no_continuum;
+    if (lines_options && (from_scene || strcmp(model_name, "lines") != 0) &&
+        !(o.compare_model && strcmp(o.compare_model, "lines") == 0)) {
+        rc = cli_usage_error(CMD,
+                             "--h2o-lines, --o2-lines and --no-continuum apply to a lines model "
+                             "built from the options (--model lines or --compare-model lines)%s",
+                             from_scene ? "; the scene's atmosphere is used as its file sets it"
+                                        : "");
+        goto cleanup;
+    }
+    if (from_scene) {
         atm = &scene->atmosphere;
         model_name = atmosphere_model_name(atm->model);
-    } else if (build_model(&o, model_name, &own, &err) != THZ_OK) {
+    } else if (build_model(&o, model_name, NULL, &own, &err) != THZ_OK) {
         rc = cli_fail(&err);
         goto cleanup;
     }
-    if (o.compare_model && build_model(&o, o.compare_model, &compare, &err) != THZ_OK) {
+    /* The comparison is computed in the same air: the scene's when that is used. */
+    if (o.compare_model && build_model(&o, o.compare_model, atm->has_air ? &atm->air : NULL,
+                                       &compare, &err) != THZ_OK) {
         rc = cli_fail(&err);
         goto cleanup;
     }
@@ -407,6 +349,23 @@ int cmd_atmosphere(int argc, char **argv)
          atmosphere_check_range(&compare, lo_hz, hi_hz, "--from-thz/--to-thz", &err) != THZ_OK)) {
         rc = cli_fail(&err);
         goto cleanup;
+    }
+
+    /* The figure's device and file are checked before the work: a missing device or
+     * an unwritable path fails at once, with nothing printed. */
+    if (o.plot) {
+        if (plot_check_device(&err) != THZ_OK) {
+            rc = cli_fail(&err);
+            goto cleanup;
+        }
+        FILE *f = fopen(o.plot, "wb");
+        if (!f) {
+            thz_error_set(&err, THZ_ERR_INPUT, "--plot %s: cannot create: %s", o.plot,
+                          strerror(errno));
+            rc = cli_fail(&err);
+            goto cleanup;
+        }
+        fclose(f);
     }
 
     double step_thz = o.step_ghz * 1e-3;
@@ -452,16 +411,15 @@ int cmd_atmosphere(int argc, char **argv)
         double f_hz = f_thz * 1e12;
         atm_alpha_parts p;
         atmosphere_alpha_parts(atm, f_hz, &p);
-        double alpha = p.h2o_lines_per_m + p.h2o_continuum_per_m + p.o2_per_m +
-                       p.dry_continuum_per_m + p.other_per_m;
+        double alpha = atmosphere_alpha_parts_sum(&p);
         s.f_thz[i] = f_thz;
-        s.total_db[i] = alpha * DB_PER_KM_PER_INV_M;
-        s.h2o_lines_db[i] = p.h2o_lines_per_m * DB_PER_KM_PER_INV_M;
-        s.h2o_cont_db[i] = p.h2o_continuum_per_m * DB_PER_KM_PER_INV_M;
-        s.o2_db[i] = p.o2_per_m * DB_PER_KM_PER_INV_M;
-        s.dry_db[i] = p.dry_continuum_per_m * DB_PER_KM_PER_INV_M;
+        s.total_db[i] = db_per_km(alpha);
+        s.h2o_lines_db[i] = db_per_km(p.h2o_lines_per_m);
+        s.h2o_cont_db[i] = db_per_km(p.h2o_continuum_per_m);
+        s.o2_db[i] = db_per_km(p.o2_per_m);
+        s.dry_db[i] = db_per_km(p.dry_continuum_per_m);
         if (s.compare_db)
-            s.compare_db[i] = atmosphere_alpha_direct_per_m(&compare, f_hz) * DB_PER_KM_PER_INV_M;
+            s.compare_db[i] = db_per_km(atmosphere_alpha_direct_per_m(&compare, f_hz));
         fprintf(out, "%.9g,%.6e,%.6e", f_thz, alpha, s.total_db[i]);
         if (atm->model == ATM_LINES)
             fprintf(out, ",%.6e,%.6e,%.6e,%.6e", s.h2o_lines_db[i], s.h2o_cont_db[i], s.o2_db[i],
@@ -477,8 +435,8 @@ int cmd_atmosphere(int argc, char **argv)
         rc = CLI_EXIT_FAILURE;
         goto cleanup;
     }
-    if (o.plot)
-        rc = draw_plot(&o, &s, atm, scene, model_name);
+    if (o.plot && draw_plot(&o, &s, atm, &compare, scene, model_name, &err) != THZ_OK)
+        rc = cli_fail(&err);
 cleanup:
     series_fini(&s);
     atmosphere_fini(&own);

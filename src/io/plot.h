@@ -1,6 +1,7 @@
 /* Figures drawn with PLplot's pngcairo device: the per-channel preview S.band-NN.png
- * (an image with a perceptual colour map and a labelled colour bar) and S.spectra.png
- * (one line per object against frequency, as the paper's Fig. 6).
+ * (an image with a perceptual colour map and a labelled colour bar), S.spectra.png
+ * (one line per object against frequency, as the paper's Fig. 6), and the
+ * attenuation spectrum of `thzmap atmosphere --plot` (log axis, shaded channels).
  *
  * Thread safety: PLplot keeps global state and can draw one figure at a time, so
  * every function here holds one process-wide mutex (the module's only static) while
@@ -10,6 +11,7 @@
 #ifndef THZ_IO_PLOT_H
 #define THZ_IO_PLOT_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -35,5 +37,34 @@ thz_status plot_image(const char *path, const float *values, uint32_t columns, u
 thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
                       const char *const *names, const double *y, const char *title,
                       const char *x_label, const char *y_label, thz_error *err);
+
+/* A curve of plot_attenuation: n_x values y over the figure's abscissae, drawn in
+ * colour rgb with line width `width` (1 = thin), dashed or solid. `name` is PLplot
+ * text, like the axis labels (e.g. "H#d2#uO" for a subscript 2). */
+typedef struct plot_curve {
+    const char *name;
+    const double *y;
+    unsigned char rgb[3];
+    double width;
+    bool dashed;
+} plot_curve;
+
+/* A frequency band of plot_attenuation, in x units: shaded from lo to hi, a dashed
+ * line at centre, and `name` (shown as given) written upwards beside it. */
+typedef struct plot_band {
+    const char *name;
+    double lo, centre, hi;
+} plot_band;
+
+enum { PLOT_MAX_CURVES = 12 };
+
+/* Curves (at most PLOT_MAX_CURVES) of attenuation against x on a logarithmic y axis of nine decades
+ * whose top clears the largest value by two decades for the legend (top left, naming every curve);
+ * values <= 0 or below the axis are drawn at its bottom. Bands whose centre lies outside the x
+ * range are left out. 1200 x 750 pixels. */
+thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_t n_curves,
+                            const plot_curve *curves, size_t n_bands, const plot_band *bands,
+                            const char *title, const char *x_label, const char *y_label,
+                            thz_error *err);
 
 #endif

@@ -51,7 +51,8 @@ fi
 cat > "$TMP/scene.json" <<'JSON'
 {
   "format": "thzmap-scene/1",
-  "channels": [{"name": "0.35 THz", "frequency_thz": 0.35, "relative_width": 0.05}],
+  "channels": [{"name": "0.35 THz", "frequency_thz": 0.35, "relative_width": 0.05},
+               {"name": "#2 (0.38)", "frequency_thz": 0.38, "relative_width": 0.02}],
   "materials": {"wall": {"reflectivity": 0.0}},
   "atmosphere": {"model": "constant", "attenuation_per_m": 0.05},
   "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
@@ -72,6 +73,17 @@ else
     grep -q pngcairo "$TMP/err" || fail "--scene --plot failed: $(cat "$TMP/err")"
 fi
 
+# a scene's humid air compared with itu-p676 (the comparison takes the scene's air)
+sed 's/"model": "constant", "attenuation_per_m": 0.05/"model": "lines", "temperature_k": 250, "pressure_hpa": 900, "relative_humidity": 0.5/' \
+    "$TMP/scene.json" > "$TMP/humid.json"
+if "$THZ" atmosphere --scene "$TMP/humid.json" --from-thz 0.3 --to-thz 0.4 --step-ghz 1 \
+       --plot "$TMP/h.png" --compare-model itu-p676 > "$TMP/h.csv" 2> "$TMP/err"; then
+    [ -s "$TMP/h.png" ] || fail "--scene --compare-model wrote no PNG"
+    grep -q "^# .*250.00 K, 900.00 hPa" "$TMP/h.csv" || fail "scene air not used: $(head -1 "$TMP/h.csv")"
+else
+    grep -q pngcairo "$TMP/err" || fail "--scene --compare-model failed: $(cat "$TMP/err")"
+fi
+
 # bad usage: exit 2 and a message naming the problem
 expect_usage() {
     local pattern="$1"; shift
@@ -90,4 +102,22 @@ expect_usage "only one of" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --relative-h
 expect_usage "range of atmosphere model 'itu-p676'" --from-thz 0.9 --to-thz 1.2 --step-ghz 1 --model itu-p676
 expect_usage "no-such.par" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --h2o-lines "$TMP/no-such.par"
 expect_usage "temperature" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --temperature-k 20
+expect_usage "--temperature-k expects a number from 100 to 400" --from-thz 0.1 --to-thz 0.2 \
+    --step-ghz 1 --temperature-k 500
+expect_usage "--pressure-hpa 0, .*air pressure must be above 0" --from-thz 0.1 --to-thz 0.2 \
+    --step-ghz 1 --pressure-hpa 0
+expect_usage "--pressure-hpa expects a number from 0 to 2000" --from-thz 0.1 --to-thz 0.2 \
+    --step-ghz 1 --pressure-hpa 5000
+expect_usage "apply to a lines model" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --model itu-p676 \
+    --no-continuum
+expect_usage "the scene's atmosphere is used" --scene "$TMP/humid.json" --from-thz 0.3 \
+    --to-thz 0.4 --step-ghz 1 --h2o-lines "$TMP/no-such.par"
+# an unwritable --plot path: PLplot would prompt on stdin and exit; thzmap refuses it
+# first (exit 2, naming the path) and never reads stdin
+timeout 60 "$THZ" atmosphere --from-thz 0.1 --to-thz 0.2 --step-ghz 1 \
+    --plot "$TMP/no-such-dir/a.png" < /dev/null > "$TMP/out" 2> "$TMP/err"
+rc=$?
+[ $rc -eq 2 ] || fail "unwritable --plot: exit status $rc, expected 2 ($(cat "$TMP/err"))"
+grep -q "no-such-dir/a.png: cannot create" "$TMP/err" || fail "unwritable --plot message: $(cat "$TMP/err")"
+[ ! -s "$TMP/out" ] || fail "unwritable --plot: CSV printed before the failure"
 echo "ok"

@@ -219,12 +219,55 @@ static void test_threads(void **state)
     free(dir);
 }
 
+/* The attenuation figure: its size, the curves' and the shaded band's colours, a
+ * '#' in a band name, zero values (drawn at the axis bottom), and an unwritable path
+ * as our error (PLplot would prompt on stdin and exit). */
+static void test_attenuation(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    char path[1024];
+    snprintf(path, sizeof path, "%s/att.png", dir);
+    enum { NX = 200 };
+    double x[NX], total[NX], part[NX];
+    for (int j = 0; j < NX; j++) {
+        x[j] = 0.1 + 0.9 * j / (NX - 1);
+        total[j] = 10.0 + 1e4 / (1.0 + pow((x[j] - 0.557) / 0.005, 2.0));
+        part[j] = j % 7 == 0 ? 0.0 : 0.5 * total[j];
+    }
+    plot_curve curves[] = {{"H#d2#uO lines", part, {214, 39, 40}, 1.0, false},
+                           {"total", total, {44, 160, 44}, 2.0, true}};
+    plot_band bands[] = {{"#1 (0.35 THz)", 0.34, 0.35, 0.36}, {"out", 1.5, 1.6, 1.7}};
+    thz_error err = {0};
+    if (plot_attenuation(path, NX, x, 2, curves, 2, bands, "air #1", "frequency (THz)",
+                         "attenuation (dB/km)", &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    unsigned char *px = NULL;
+    uint32_t w = 0, h = 0;
+    read_png(path, &px, &w, &h);
+    assert_int_equal(w, 1200);
+    assert_int_equal(h, 750);
+    assert_true(has_colour(px, (size_t)w * h, 214, 39, 40, 10));
+    assert_true(has_colour(px, (size_t)w * h, 44, 160, 44, 10));
+    assert_true(has_colour(px, (size_t)w * h, 234, 234, 234, 6)); /* band shading on white */
+    free(px);
+    unlink(path);
+
+    snprintf(path, sizeof path, "%s/no-such-dir/att.png", dir);
+    assert_int_equal(plot_attenuation(path, NX, x, 2, curves, 0, NULL, "t", "f", "a", &err),
+                     THZ_ERR_IO);
+    assert_non_null(strstr(err.message, "cannot create"));
+    rmdir(dir);
+    free(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_device),        cmocka_unit_test(test_device_dir_without_cairo),
         cmocka_unit_test(test_image_colours), cmocka_unit_test(test_odd_images),
         cmocka_unit_test(test_lines),         cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_attenuation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
