@@ -148,9 +148,12 @@ static void air_emission_face_point(const air_emission *a, rng_stream *rng, vec3
 }
 
 /* Whether a boundary photon at p going along dir comes from outside: a ray from just
- * inside back out of the box meets nothing. */
+ * inside back out of the box meets nothing (always, without casting it, when every mesh
+ * keeps clear of the faces). */
 static bool air_emission_open(const air_emission *a, vec3 p, vec3 dir)
 {
+    if (a->faces_clear)
+        return true;
     accel_hit hit;
     return !accel_intersect(a->acc, v3_madd(p, a->eps_m, dir), v3_scale(dir, -1.0), INFINITY,
                             ACCEL_NO_OBJECT, 0, &hit);
@@ -172,6 +175,25 @@ static bool air_emission_reaches(const air_emission *a, vec3 p, vec3 dir)
     accel_hit hit;
     return accel_intersect(a->acc, p, dir, INFINITY, ACCEL_NO_OBJECT, 0, &hit) &&
            scene_object_side_is_front(&a->scene->objects[hit.object], hit.side);
+}
+
+/* Whether every mesh's bounding box lies inside the box by more than 1e-3 of its
+ * diagonal (1000 times the step eps_m the visibility ray starts inside): that ray runs
+ * from eps_m inside a face outwards, so it can meet no surface. Always so without an
+ * extent (the box is widened by 1 % of the meshes' diagonal). */
+static bool air_emission_faces_clear(const air_emission *a)
+{
+    double margin = 1e3 * a->eps_m;
+    for (size_t i = 0; i < a->scene->n_objects; i++) {
+        const thz_mesh *m = &a->scene->objects[i].mesh;
+        if (m->n_triangles == 0)
+            continue;
+        for (int k = 0; k < 3; k++)
+            if (!(m->bbox_min_m[k] - a->min_m[k] > margin &&
+                  a->max_m[k] - m->bbox_max_m[k] > margin))
+                return false;
+    }
+    return true;
 }
 
 /* Shares of air and boundary photons kept, by the rules of sampling and tracing; with
@@ -267,6 +289,7 @@ thz_status air_emission_init(air_emission *a, const thz_scene *scene, const acce
         d2 += ext[k] * ext[k];
     }
     a->eps_m = 1e-6 * sqrt(d2);
+    a->faces_clear = air_emission_faces_clear(a);
     a->volume_m3 = ext[0] * ext[1] * ext[2];
     double sum = 0.0;
     for (int f = 0; f < 6; f++) {
@@ -374,20 +397,20 @@ static bool air_emission_boundary_photon(const air_emission *a, rng_stream *rng,
 }
 
 bool air_emission_sample(const air_emission *a, const emission_table *t, rng_stream *rng,
-                         double *scratch, emission_photon *out)
+                         emission_photon *out)
 {
     if (!a || !a->active)
-        return emission_sample(t, rng, scratch, out);
+        return emission_sample(t, rng, out);
     out->batch = 0;
     double u = rng_uniform(rng);
-    if (u < a->p_air || u < a->p_air + a->p_boundary) {
+    if (u < a->p_air + a->p_boundary) {
         out->object = ACCEL_NO_OBJECT;
         out->triangle = 0;
         out->side = 0;
         return u < a->p_air ? air_emission_air_photon(a, rng, out)
                             : air_emission_boundary_photon(a, rng, out);
     }
-    bool ok = emission_sample(t, rng, scratch, out);
+    bool ok = emission_sample(t, rng, out);
     out->power_w_per_hz = a->p_surfaces > 0.0 ? out->power_w_per_hz / a->p_surfaces : 0.0;
     return ok;
 }

@@ -69,6 +69,8 @@ typedef struct air_emission {
     uint64_t n_photons;        /* K */
     double min_m[3], max_m[3]; /* the box */
     double eps_m;              /* step inside the box for the boundary's visibility test */
+    bool faces_clear;          /* every mesh keeps clear of the faces: the test always
+                                  passes and casts no ray */
     /* the air */
     double volume_m3;
     double air_share;          /* estimated share of air photons kept (not in solids) */
@@ -106,6 +108,6 @@ void air_emission_fini(air_emission *a);
 /* Draws one photon of any class (see above); the same contract as emission_sample,
  * which it calls for surface photons. Allocates nothing. */
 bool air_emission_sample(const air_emission *a, const emission_table *t, rng_stream *rng,
-                         double *scratch, emission_photon *out);
+                         emission_photon *out);
 
 #endif

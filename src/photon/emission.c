@@ -37,7 +37,8 @@ void emission_table_fini(emission_table *t)
     if (!t)
         return;
     for (size_t i = 0; i < t->n_sources; i++)
-        free(t->sources[i].triangle_cdf);
+        if (t->sources[i].owns_cdf)
+            free(t->sources[i].triangle_cdf);
     for (size_t g = 0; g < t->n_groups; g++)
         free(t->groups[g].cdf);
     free(t->sources);
@@ -52,6 +53,8 @@ static bool emission_same_group(const emission_table *t, const emission_source *
                                 const emission_source *b)
 {
     const thz_object *oa = &t->scene->objects[a->object], *ob = &t->scene->objects[b->object];
+    if (a->kind == EMISSION_BACK || b->kind == EMISSION_BACK)
+        return a->kind == b->kind; /* -pi A r B0 whatever the object */
     if (oa->temperature_k != ob->temperature_k || a->constant_optics != b->constant_optics)
         return false;
     if (t->t0_k > 0.0 && a->kind != b->kind)
@@ -161,9 +164,59 @@ static optics_point emission_kirchhoff_optics(optics_point o)
     return o;
 }
 
+/* A point uniform on mesh m (triangle by the area CDF, then uniform on it); *tri is
+ * its triangle. */
+static vec3 emission_point(const thz_mesh *m, const double *triangle_cdf, double area_m2,
+                           rng_stream *rng, size_t *tri)
+{
+    size_t k = cdf_search(triangle_cdf, m->n_triangles, rng_uniform(rng) * area_m2);
+    while (m->areas_m2[k] <= 0.0 && k > 0)
+        k--;
+    *tri = k;
+    /* p = (1 - sqrt(a)) p0 + sqrt(a)(1 - b) p1 + sqrt(a) b p2. */
+    const uint32_t *idx = &m->indices[3 * k];
+    vec3 p0 = v3_from_floats(&m->positions[3 * (size_t)idx[0]]);
+    vec3 p1 = v3_from_floats(&m->positions[3 * (size_t)idx[1]]);
+    vec3 p2 = v3_from_floats(&m->positions[3 * (size_t)idx[2]]);
+    double ra = sqrt(rng_uniform(rng)), rb = rng_uniform(rng);
+    return v3_add(v3_scale(p0, 1.0 - ra),
+                  v3_add(v3_scale(p1, ra * (1.0 - rb)), v3_scale(p2, ra * rb)));
+}
+
+/* The reach share of object i's back side (emission.h): the share of EMISSION_REACH_RAYS
+ * cosine rays from uniform back-side points, traced as trace_photon starts a photon,
+ * whose first hit is a front face. The streams depend on the seed only (channel 0), so
+ * every channel gets the same share. */
+static double emission_back_reach(const emission_table *t, const accel *acc, size_t i,
+                                  const double *triangle_cdf)
+{
+    const thz_scene *scene = t->scene;
+    const thz_mesh *m = &scene->objects[i].mesh;
+    uint64_t reach = 0;
+    for (uint64_t k = 0; k < EMISSION_REACH_RAYS; k++) {
+        rng_stream rng;
+        rng_init(&rng, scene->photons.seed, 0, RNG_PURPOSE_BACK_FACE,
+                 (uint64_t)i * EMISSION_REACH_RAYS + k);
+        size_t tri;
+        vec3 p = emission_point(m, triangle_cdf, m->total_area_m2, &rng, &tri);
+        const float *nf = &m->normals[3 * tri];
+        vec3 n = v3_scale(v3(nf[0], nf[1], nf[2]), -1.0);
+        double u = rng_uniform(&rng);
+        vec3 dir = emission_direction(n, sqrt(1.0 - u), rng_uniform(&rng));
+        accel_hit from = {
+            .object = (uint32_t)i, .triangle = (uint32_t)tri, .position_m = p, .side = 1};
+        accel_hit hit;
+        reach += accel_intersect(acc, accel_offset_origin(acc, &from, dir), dir, INFINITY,
+                                 (uint32_t)i, (uint32_t)tri, &hit) &&
+                 scene_object_side_is_front(&scene->objects[hit.object], hit.side);
+    }
+    return (double)reach / EMISSION_REACH_RAYS;
+}
+
 /* Adds object i's source of `kind`; false only when out of memory. A source without
- * power (constant optics, zero weights) is not added. */
-static bool emission_add_source(emission_table *t, size_t i, emission_kind kind)
+ * power (constant optics, zero weights; a back side that reaches no front face) is not
+ * added. An object's sources share one triangle CDF. */
+static bool emission_add_source(emission_table *t, const accel *acc, size_t i, emission_kind kind)
 {
     const thz_scene *scene = t->scene;
     const thz_object *obj = &scene->objects[i];
@@ -173,15 +226,33 @@ static bool emission_add_source(emission_table *t, size_t i, emission_kind kind)
     s->kind = kind;
     s->sides = (obj->type == OBJECT_SHELL || obj->two_sided) ? 2 : 1;
     const thz_material *m = &scene->materials[obj->material];
-    s->constant_optics = spectrum_is_constant(&m->reflectivity) &&
-                         spectrum_is_constant(&m->attenuation_per_m) &&
-                         spectrum_is_constant(&m->emissivity);
-    double area = 0.0;
-    for (size_t k = 0; k < obj->mesh.n_triangles; k++)
-        area += obj->mesh.areas_m2[k];
-    s->area_m2 = area;
+    s->constant_optics = kind == EMISSION_BACK || (spectrum_is_constant(&m->reflectivity) &&
+                                                   spectrum_is_constant(&m->attenuation_per_m) &&
+                                                   spectrum_is_constant(&m->emissivity));
+    s->area_m2 = obj->mesh.total_area_m2; /* the sum of areas_m2, in order */
     s->share = s->area_m2 * s->sides;
-    if (s->constant_optics) {
+    s->reach_share = 1.0;
+    /* The object's previous source (an explicit-emissivity shell's eps B(T), a solid's
+     * front side) has the same triangle CDF. */
+    const emission_source *prev = t->n_sources ? &t->sources[t->n_sources - 1] : NULL;
+    s->triangle_cdf = prev && prev->object == s->object ? prev->triangle_cdf : NULL;
+    s->owns_cdf = false;
+    if (!s->triangle_cdf) {
+        s->triangle_cdf = thz_malloc_array(obj->mesh.n_triangles, sizeof *s->triangle_cdf);
+        if (!s->triangle_cdf)
+            return false;
+        s->owns_cdf = true;
+        double sum = 0.0;
+        for (size_t k = 0; k < obj->mesh.n_triangles; k++) {
+            sum += obj->mesh.areas_m2[k];
+            s->triangle_cdf[k] = sum;
+        }
+    }
+    if (kind == EMISSION_BACK) {
+        s->reach_share = emission_back_reach(t, acc, i, s->triangle_cdf);
+        s->weight0 = M_PI * s->area_m2 * s->reach_share;
+        s->share = s->weight0;
+    } else if (s->constant_optics) {
         s->optics = scene_object_optics(scene, obj, scene->channels[t->channel].center_hz);
         double eps = optics_mean_emissivity(&s->optics);
         optics_point kirchhoff = emission_kirchhoff_optics(s->optics);
@@ -193,34 +264,34 @@ static bool emission_add_source(emission_table *t, size_t i, emission_kind kind)
                          : kind == EMISSION_EPS     ? 0.0
                                                     : coef * abs;
         s->share = s->weight + s->weight0;
-        if (!(s->share > 0.0)) /* eps-bar = 0 (and A-bar = 0): emits nothing */
-            return true;
     }
-    s->triangle_cdf = thz_malloc_array(obj->mesh.n_triangles, sizeof *s->triangle_cdf);
-    if (!s->triangle_cdf)
-        return false;
-    double sum = 0.0;
-    for (size_t k = 0; k < obj->mesh.n_triangles; k++) {
-        sum += obj->mesh.areas_m2[k];
-        s->triangle_cdf[k] = sum;
+    if (!(s->share > 0.0)) { /* eps-bar = 0 (and A-bar = 0), or a closed back: nothing */
+        if (s->owns_cdf)
+            free(s->triangle_cdf);
+        memset(s, 0, sizeof *s);
+        return true;
     }
     t->n_sources++;
     return true;
 }
 
-thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t channel,
-                               uint64_t n_photons, double t0_k, thz_error *err)
+thz_status emission_table_init(emission_table *t, const thz_scene *scene, const accel *acc,
+                               size_t channel, uint64_t n_photons, double t0_k, thz_error *err)
 {
     memset(t, 0, sizeof *t);
     if (!(t0_k >= 0.0) || !isfinite(t0_k))
         return thz_error_set(err, THZ_ERR_INPUT,
                              "photon emission: reference temperature must be >= 0 K, got %g K",
                              t0_k);
+    if (t0_k > 0.0 && !acc)
+        return thz_error_set(err, THZ_ERR_INTERNAL,
+                             "photon emission: a deviation map needs the scene's ray caster");
     t->scene = scene;
     t->channel = channel;
     t->n_photons = n_photons ? n_photons : 1;
     t->t0_k = t0_k;
-    /* At most two sources per object (explicit-emissivity shells with T0 > 0). */
+    /* At most two sources per object (with T0 > 0: explicit-emissivity shells, one-sided
+     * solids with their back side). */
     size_t cap = 2 * scene->n_objects;
     t->sources = thz_calloc(cap ? cap : 1, sizeof *t->sources);
     if (!t->sources)
@@ -234,18 +305,21 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t
         bool explicit_eps = scene->materials[obj->material].emissivity.n > 0;
         if (!(t0_k > 0.0)) { /* the paper's sources: eps B(T) */
             if (hot)
-                ok = emission_add_source(t, i, explicit_eps ? EMISSION_EPS : EMISSION_KIRCHHOFF);
+                ok = emission_add_source(t, acc, i,
+                                         explicit_eps ? EMISSION_EPS : EMISSION_KIRCHHOFF);
         } else if (!explicit_eps) { /* A (B(T) - B0): nothing at T0 */
             if (obj->temperature_k != t0_k)
-                ok = emission_add_source(t, i, EMISSION_KIRCHHOFF);
+                ok = emission_add_source(t, acc, i, EMISSION_KIRCHHOFF);
         } else if (obj->type == OBJECT_SHELL) { /* eps B(T) and -A(mu) B0: two laws */
             if (hot)
-                ok = emission_add_source(t, i, EMISSION_EPS);
+                ok = emission_add_source(t, acc, i, EMISSION_EPS);
             if (ok)
-                ok = emission_add_source(t, i, EMISSION_ABSORB);
+                ok = emission_add_source(t, acc, i, EMISSION_ABSORB);
         } else {
-            ok = emission_add_source(t, i, EMISSION_EPS_ABSORB);
+            ok = emission_add_source(t, acc, i, EMISSION_EPS_ABSORB);
         }
+        if (ok && t0_k > 0.0 && !scene_object_side_is_front(obj, 1))
+            ok = emission_add_source(t, acc, i, EMISSION_BACK);
     }
     if (!ok || !emission_group_sources(t) || !emission_tabulate(t)) {
         emission_table_fini(t);
@@ -280,6 +354,8 @@ static double emission_power_with(const emission_table *t, const emission_group 
                    (optics_mean_emissivity(o) * planck_radiance(freq_hz, gr->temperature_k) -
                     optics_mean_emissivity(&k) * b0);
         }
+    case EMISSION_BACK:
+        return -gr->weight0 * b0;
     case EMISSION_ABSORB:
         if (gr->constant_optics)
             return -gr->weight0 * b0;
@@ -299,16 +375,6 @@ double emission_group_power(const emission_table *t, size_t g, double freq_hz)
         o = scene_object_optics(t->scene, &t->scene->objects[s->object], freq_hz);
     }
     return emission_power_with(t, gr, &o, freq_hz);
-}
-
-double emission_group_weights(const emission_table *t, double freq_hz, double *weights)
-{
-    double total = 0.0;
-    for (size_t g = 0; g < t->n_groups; g++) {
-        weights[g] = emission_group_power(t, g, freq_hz);
-        total += weights[g];
-    }
-    return total;
 }
 
 static double emission_magnitude_at(double freq_hz, void *ctx)
@@ -334,10 +400,8 @@ static double emission_cum(const emission_table *t, size_t row, double frac, siz
     return a[0] + frac * (a[t->n_groups] - a[0]);
 }
 
-bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
-                     emission_photon *out)
+bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *out)
 {
-    (void)scratch;
     out->batch = 0;
     const thz_channel *ch = &t->scene->channels[t->channel];
     double u1 = rng_uniform(rng), u2 = rng_uniform(rng);
@@ -391,24 +455,19 @@ bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
     if (w == 0.0 || isnan(w) || !(q > 0.0))
         return false;
     out->power_w_per_hz = w * (total / q) / (double)t->n_photons;
+    bool back = s->kind == EMISSION_BACK;
+    if (back) /* drawn r times as often as its power says (emission.h) */
+        out->power_w_per_hz /= s->reach_share;
 
     int side = 0;
     double us = rng_uniform(rng);
     if (s->sides == 2)
         side = us < 0.5 ? 0 : 1;
+    if (back)
+        side = 1;
 
-    size_t tri = cdf_search(s->triangle_cdf, m->n_triangles, rng_uniform(rng) * s->area_m2);
-    while (m->areas_m2[tri] <= 0.0 && tri > 0)
-        tri--;
-
-    /* Uniform point: p = (1 - sqrt(a)) p0 + sqrt(a)(1 - b) p1 + sqrt(a) b p2. */
-    const uint32_t *idx = &m->indices[3 * tri];
-    vec3 p0 = v3_from_floats(&m->positions[3 * (size_t)idx[0]]);
-    vec3 p1 = v3_from_floats(&m->positions[3 * (size_t)idx[1]]);
-    vec3 p2 = v3_from_floats(&m->positions[3 * (size_t)idx[2]]);
-    double ra = sqrt(rng_uniform(rng)), rb = rng_uniform(rng);
-    out->position_m = v3_add(v3_scale(p0, 1.0 - ra),
-                             v3_add(v3_scale(p1, ra * (1.0 - rb)), v3_scale(p2, ra * rb)));
+    size_t tri;
+    out->position_m = emission_point(m, s->triangle_cdf, s->area_m2, rng, &tri);
 
     const float *nf = &m->normals[3 * tri];
     vec3 n = v3(nf[0], nf[1], nf[2]);
@@ -418,7 +477,9 @@ bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
      * (EMISSION_EPS_ABSORB is a solid's: eps and A both cosine). */
     optics_point law = s->kind == EMISSION_ABSORB ? emission_kirchhoff_optics(o) : o;
     double mu;
-    if (!optics_sample_emission_mu(&law, emission_uniform, rng, &mu))
+    if (back)
+        mu = sqrt(1.0 - rng_uniform(rng)); /* radiance -B0: cosine */
+    else if (!optics_sample_emission_mu(&law, emission_uniform, rng, &mu))
         mu = sqrt(1.0 - rng_uniform(rng)); /* eps = 0 (a -A B0 source) or unreachable */
     out->dir = emission_direction(n, mu, rng_uniform(rng));
     out->object = s->object;

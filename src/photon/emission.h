@@ -12,7 +12,17 @@
  *   source of power pi A_area sides (eps B(T) - (1 - R) B0), whose sign may change with
  *   frequency;
  * - explicit-emissivity shells: eps B(T) (cosine) and -A(mu) B0 (mu ~ A(mu) mu) have
- *   different angular laws: two sources, each in its own group.
+ *   different angular laws: two sources, each in its own group;
+ * - back faces of one-sided solids: they leave radiance 0 (the renderer adds -B0 where a
+ *   ray meets one), i.e. the deviation -B0: a Lambertian source of power -pi A B0 on the
+ *   back side (EMISSION_BACK, all in one group). Most back faces face into a closed
+ *   solid or out of a closed room, where their photons would store nothing, so each is
+ *   drawn in proportion to its reach share r, the share of EMISSION_REACH_RAYS cosine
+ *   rays from random back-side points (fixed streams, RNG_PURPOSE_BACK_FACE) whose
+ *   first hit is a front face, and its photons carry 1 / r more power: the power fired
+ *   is exactly -pi A B0 in expectation. A back face with r = 0 gets no source: an
+ *   opening that fewer than about 1 in EMISSION_REACH_RAYS rays find counts as closed
+ *   (as for the boundary, air_emission.h).
  * With T0 = 0 only the B(T) parts exist and the tables, photons and random streams are
  * exactly those of the paper's scheme.
  *
@@ -37,7 +47,8 @@
  * normal and uniform azimuth.
  *
  * Emitting sides: both sides of shells and two-sided solids, the front side of one-sided
- * solids. Objects without area emit nothing; with T0 = 0 neither do objects at 0 K.
+ * solids (and with T0 > 0 their back side's -B0). Objects without area emit nothing;
+ * with T0 = 0 neither do objects at 0 K.
  */
 #ifndef THZ_PHOTON_EMISSION_H
 #define THZ_PHOTON_EMISSION_H
@@ -48,8 +59,12 @@
 
 #include "core/error.h"
 #include "core/rng.h"
+#include "accel/accel.h"
 #include "core/vec3.h"
 #include "scene/scene.h"
+
+/* Rays per one-sided solid for the reach share of its back side's source (T0 > 0). */
+#define EMISSION_REACH_RAYS 16384
 
 /* Kind of a source: how its power and direction depend on B(T), B0 and the optics.
  * Powers per frequency, with W = pi A_area sides: */
@@ -57,25 +72,30 @@ typedef enum emission_kind {
     EMISSION_KIRCHHOFF = 0, /* W eps-bar (B(T) - B0), mu ~ A(mu) mu (eps = A) */
     EMISSION_EPS,           /* W eps B(T), cosine: explicit eps (shells; solids when T0 = 0) */
     EMISSION_EPS_ABSORB,    /* W (eps B(T) - (1 - R) B0), cosine: explicit-eps solids, T0 > 0 */
-    EMISSION_ABSORB         /* -W A-bar B0, mu ~ A(mu) mu: explicit-eps shells, T0 > 0 */
+    EMISSION_ABSORB,        /* -W A-bar B0, mu ~ A(mu) mu: explicit-eps shells, T0 > 0 */
+    EMISSION_BACK           /* -pi A B0, cosine, from side 1: one-sided solids, T0 > 0 */
 } emission_kind;
 
-/* One emitting object (an explicit-emissivity shell with T0 > 0 is two sources). */
+/* One emitting object (an explicit-emissivity shell with T0 > 0 is two sources, and so
+ * is a one-sided solid with T0 > 0 whose back side reaches a front face). */
 typedef struct emission_source {
     uint32_t object; /* index into scene->objects */
     emission_kind kind;
-    int sides;            /* 1 or 2 emitting sides */
+    int sides;            /* 1 or 2 emitting sides (EMISSION_BACK: 1, side 1) */
     double area_m2;       /* total area of one side */
     bool constant_optics; /* R, alpha_M and eps do not depend on frequency */
     double weight;        /* constant optics: the coefficient of B_nu(T) in the power
-                             (pi eps-bar A sides), 0 for EMISSION_ABSORB */
+                             (pi eps-bar A sides), 0 for EMISSION_ABSORB and _BACK */
     double weight0;       /* constant optics: the coefficient of -B0 (pi A-bar A sides;
-                             0 with T0 = 0 and for EMISSION_EPS) */
+                             0 with T0 = 0 and for EMISSION_EPS; pi A r for _BACK) */
     double share;         /* weight within its group: weight + weight0 (constant optics,
                              a fixed multiple of |power| within a group) or A sides
                              (variable optics, the optics shared by the group) */
+    double reach_share;   /* EMISSION_BACK: r in (0, 1], the photons carry 1 / r; else 1 */
     optics_point optics;  /* constant optics: the optics at every frequency */
-    double *triangle_cdf; /* n_triangles cumulative areas, last = total */
+    double *triangle_cdf; /* n_triangles cumulative areas, last = total; shared by an
+                             object's sources, owned by the first (owns_cdf) */
+    bool owns_cdf;
 } emission_source;
 
 /* Sources whose power differs only by a frequency-independent factor form one group, so
@@ -129,14 +149,12 @@ typedef struct emission_photon {
 } emission_photon;
 
 /* Prepares channel `channel`'s sources for K = n_photons photons of the map of
- * L - B_nu(t0_k) (t0_k = 0: the paper's map of L; t0_k must be >= 0). */
-thz_status emission_table_init(emission_table *t, const thz_scene *scene, size_t channel,
-                               uint64_t n_photons, double t0_k, thz_error *err);
+ * L - B_nu(t0_k) (t0_k = 0: the paper's map of L; t0_k must be >= 0). acc (borrowed,
+ * the scene's) estimates the back faces' reach shares; it may be NULL only with
+ * t0_k = 0. */
+thz_status emission_table_init(emission_table *t, const thz_scene *scene, const accel *acc,
+                               size_t channel, uint64_t n_photons, double t0_k, thz_error *err);
 void emission_table_fini(emission_table *t);
-
-/* P_A(freq_hz) over the table's sources (signed when T0 > 0), writing each group's exact
- * power w_g into weights[0..n_groups-1] (caller's scratch). */
-double emission_group_weights(const emission_table *t, double freq_hz, double *weights);
 
 /* Exact signed power w_g(freq_hz) of group g (W/Hz). */
 double emission_group_power(const emission_table *t, size_t g, double freq_hz);
@@ -145,12 +163,10 @@ double emission_group_power(const emission_table *t, size_t g, double freq_hz);
  * photons beside the air and boundary sources when T0 > 0 (air_emission.h). */
 double emission_band_magnitude_w_per_hz(const emission_table *t);
 
-/* Draws one photon from rng. `scratch` is unused (kept for callers that size it as
- * n_sources doubles); nothing is allocated here. Returns false when the drawn group has
+/* Draws one photon from rng; allocates nothing. Returns false when the drawn group has
  * no power at the drawn frequency: the photon then has power 0 and nothing else is
  * set. The power is signed (negative where the source's eps B(T) < A B0). */
-bool emission_sample(const emission_table *t, rng_stream *rng, double *scratch,
-                     emission_photon *out);
+bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *out);
 
 /* A unit direction about unit normal n with cos(theta) = mu and azimuth 2 pi u. */
 vec3 emission_direction(vec3 n, double mu, double u);

@@ -41,14 +41,12 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
     int nthreads = a->threads > 0 ? a->threads : omp_get_max_threads();
     if (nthreads < 1)
         nthreads = 1;
-    size_t ns = a->table->n_sources ? a->table->n_sources : 1;
     trace_buffer *bufs = thz_calloc((size_t)nthreads, sizeof *bufs);
-    double *scratch = thz_malloc_array((size_t)nthreads * ns, sizeof *scratch);
     phase_chunk *chunks = thz_calloc(PHASE_BATCH / PHASE_CHUNK, sizeof *chunks);
     photon_record *records = thz_malloc_array(1, sizeof *records);
     size_t count = 0, capacity = 1;
     memset(total, 0, sizeof *total);
-    if (!bufs || !scratch || !chunks || !records) {
+    if (!bufs || !chunks || !records) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "photon phase: out of memory");
         goto cleanup;
     }
@@ -66,7 +64,6 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
         {
             int tid = omp_get_thread_num();
             trace_buffer *b = &bufs[tid];
-            double *scr = scratch + (size_t)tid * ns;
 #pragma omp for schedule(dynamic, 1)
             for (long k = 0; k < n_chunks; k++) {
                 phase_chunk *ch = &chunks[k];
@@ -81,7 +78,7 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                     uint64_t index = a->first_photon + i;
                     rng_init(&rng, seed, channel, RNG_PURPOSE_PHOTON, index);
                     emission_photon e;
-                    if (!air_emission_sample(a->air, a->table, &rng, scr, &e))
+                    if (!air_emission_sample(a->air, a->table, &rng, &e))
                         e.power_w_per_hz = 0.0;
                     e.batch = (uint32_t)(index % PHOTON_MAP_BATCHES);
                     if (!trace_photon(a->scene, a->acc, &e, &rng, b, &ch->counters)) {
@@ -161,7 +158,6 @@ cleanup:
         for (int t = 0; t < nthreads; t++)
             trace_buffer_fini(&bufs[t]);
     free(bufs);
-    free(scratch);
     free(chunks);
     free(records);
     return st;
@@ -175,6 +171,30 @@ static thz_status phase_check(const thz_scene *scene, size_t channel, thz_error 
     if (scene->n_objects > (UINT32_MAX >> 1))
         return thz_error_set(err, THZ_ERR_LIMIT, "photon phase: too many objects (%zu)",
                              scene->n_objects);
+    return THZ_OK;
+}
+
+/* The sources of channel `channel` for K = n_photons photons of the map of
+ * L - B(t0_k), as both the run and its pilot fire them: the surfaces' table and the air
+ * and boundary beside them, whose class probabilities weigh the surfaces by their
+ * physical band power P_A with T0 = 0, else by the band mean of their signed sources'
+ * magnitude. *surface_power_w_per_hz is P_A (statistics). Both are finalised on failure. */
+static thz_status phase_sources_init(const thz_scene *scene, const accel *acc, size_t channel,
+                                     uint64_t n_photons, double t0_k, emission_table *table,
+                                     air_emission *air, double *surface_power_w_per_hz,
+                                     thz_error *err)
+{
+    thz_status st = emission_table_init(table, scene, acc, channel, n_photons, t0_k, err);
+    if (st != THZ_OK)
+        return st;
+    double surface_power = scene_band_emitted_power_w_per_hz(scene, channel);
+    double surface_mass = t0_k > 0.0 ? emission_band_magnitude_w_per_hz(table) : surface_power;
+    st = air_emission_init(air, scene, acc, channel, n_photons, surface_mass, t0_k, err);
+    if (st != THZ_OK) {
+        emission_table_fini(table);
+        return st;
+    }
+    *surface_power_w_per_hz = surface_power;
     return THZ_OK;
 }
 
@@ -192,20 +212,12 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
         return thz_error_set(err, THZ_ERR_INPUT,
                              "photon phase: reference temperature must be >= 0 K, got %g K", t0_k);
     emission_table table;
-    st = emission_table_init(&table, scene, channel, scene->photons.per_channel, t0_k, err);
+    air_emission air;
+    double surface_power;
+    st = phase_sources_init(scene, acc, channel, scene->photons.per_channel, t0_k, &table, &air,
+                            &surface_power, err);
     if (st != THZ_OK)
         return st;
-    /* The physical band power P_A (statistics); the photons' share of the surfaces is
-     * that power with T0 = 0, else the band mean of the signed sources' magnitude. */
-    double surface_power = scene_band_emitted_power_w_per_hz(scene, channel);
-    double surface_mass = t0_k > 0.0 ? emission_band_magnitude_w_per_hz(&table) : surface_power;
-    air_emission air;
-    st = air_emission_init(&air, scene, acc, channel, scene->photons.per_channel, surface_mass,
-                           t0_k, err);
-    if (st != THZ_OK) {
-        emission_table_fini(&table);
-        return st;
-    }
     double t1 = omp_get_wtime();
     phase_fire_args a = {.scene = scene,
                          .acc = acc,
@@ -277,16 +289,11 @@ thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc,
     if (pilot == 0)
         return THZ_OK;
     emission_table table;
-    st = emission_table_init(&table, scene, channel, k, t0_k, err);
+    air_emission air;
+    double surface_power;
+    st = phase_sources_init(scene, acc, channel, k, t0_k, &table, &air, &surface_power, err);
     if (st != THZ_OK)
         return st;
-    air_emission air;
-    st = air_emission_init(&air, scene, acc, channel, k,
-                           scene_band_emitted_power_w_per_hz(scene, channel), t0_k, err);
-    if (st != THZ_OK) {
-        emission_table_fini(&table);
-        return st;
-    }
     phase_fire_args a = {.scene = scene,
                          .acc = acc,
                          .table = &table,
