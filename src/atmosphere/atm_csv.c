@@ -23,12 +23,6 @@ const char *atm_data_dir(const char *dir)
     return THZ_DATA_DIR;
 }
 
-bool atm_join_path(char *buf, size_t n, const char *dir, const char *name)
-{
-    int len = snprintf(buf, n, "%s/%s", dir, name);
-    return len >= 0 && (size_t)len < n;
-}
-
 /* Splits line in place at commas; returns the number of fields (at most max). */
 static size_t split_fields(char *line, char **fields, size_t max)
 {

@@ -33,8 +33,6 @@ static inline double atm_csv_at(const atm_csv *csv, size_t row, size_t col)
 
 /* The data directory: dir if not NULL, else $THZMAP_DATA_DIR, else the build's. */
 const char *atm_data_dir(const char *dir);
-/* dir/name into buf (size n); false if it does not fit. */
-bool atm_join_path(char *buf, size_t n, const char *dir, const char *name);
 
 /* itu-p676 (atm_itu_p676.c). */
 thz_status atm_itu_create(atm_itu_data **out, const char *data_dir, thz_error *err);

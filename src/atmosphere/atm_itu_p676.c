@@ -11,6 +11,7 @@
 
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
+#include "core/path.h"
 
 enum { ITU_COEFFS = 6 };
 
@@ -30,9 +31,10 @@ static thz_status read_lines(const char *dir, const char *name, const char *pref
     char path[4096];
     atm_csv csv;
     itu_line *lines = NULL;
-    if (!atm_join_path(path, sizeof path, dir, name))
-        return thz_error_set(err, THZ_ERR_INPUT, "data directory path too long: %s", dir);
-    thz_status st = atm_csv_read(&csv, path, err);
+    thz_status st = thz_path_join(path, sizeof path, dir, name, err);
+    if (st != THZ_OK)
+        return st;
+    st = atm_csv_read(&csv, path, err);
     if (st != THZ_OK)
         return st;
     size_t cols[ITU_COEFFS + 1];

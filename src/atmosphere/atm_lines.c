@@ -34,6 +34,7 @@
 
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
+#include "core/path.h"
 
 #define LINE_MIN_RELATIVE 1e-10
 #define H2O_CUTOFF_GHZ 750.0     /* 25 cm^-1: MT_CKD's line cut-off */
@@ -724,9 +725,7 @@ static thz_status resolve(char *buf, size_t n, const char *given, const char *di
         strcpy(buf, given);
         return THZ_OK;
     }
-    if (!atm_join_path(buf, n, dir, name))
-        return thz_error_set(err, THZ_ERR_INPUT, "data directory path too long: %s", dir);
-    return THZ_OK;
+    return thz_path_join(buf, n, dir, name, err);
 }
 
 thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
