@@ -7,6 +7,7 @@
 #include "atmosphere/atmosphere.h"
 #include "cli/cli.h"
 #include "physics/channel.h"
+#include "run/run.h"
 #include "scene/scene.h"
 #include "sensor/render.h"
 
@@ -126,6 +127,10 @@ int cmd_validate(int argc, char **argv)
     thz_error err = {0};
     if (thz_scene_load(path, &scene, &err) != THZ_OK)
         return cli_fail(&err);
+    if (run_check_scene_memory(scene, &err) != THZ_OK) {
+        thz_scene_destroy(scene);
+        return cli_fail(&err);
+    }
     validate_print(scene);
     fflush(stdout);
     for (size_t i = 0; i < scene->n_warnings; i++)

@@ -35,7 +35,9 @@ static void print_usage(FILE *f)
 int cli_fail(const thz_error *err)
 {
     fprintf(stderr, "thzmap: %s\n", err->message[0] ? err->message : thz_status_name(err->status));
-    return err->status == THZ_ERR_INPUT ? CLI_EXIT_USAGE : CLI_EXIT_FAILURE;
+    /* THZ_ERR_LIMIT: the scene or the options ask for more than fits (memory, sizes) */
+    return err->status == THZ_ERR_INPUT || err->status == THZ_ERR_LIMIT ? CLI_EXIT_USAGE
+                                                                        : CLI_EXIT_FAILURE;
 }
 
 int cli_usage_error(const char *cmd, const char *fmt, ...)

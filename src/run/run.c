@@ -202,6 +202,19 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
                          (double)need->image_bytes / gib, (double)need->available_bytes / gib, key);
 }
 
+thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err)
+{
+    run_memory need = {.available_bytes = thz_physical_memory_bytes()};
+    for (size_t s = 0; s < scene->n_sensors; s++)
+        need.image_bytes += sensor_images_bytes(scene->sensors[s].columns, scene->sensors[s].rows,
+                                                scene->n_channels);
+    need.total_bytes = need.image_bytes;
+    thz_status st = run_check_memory(scene, &need, err);
+    if (st != THZ_OK)
+        thz_error_prefix(err, "%s: ", scene->path);
+    return st;
+}
+
 static uint64_t run_image_bytes(const run_state *rs)
 {
     uint64_t total = 0;

@@ -87,6 +87,10 @@ typedef struct run_memory {
  * message naming `photons.per_channel` or `sensors[i].resolution`. */
 thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err);
 
+/* The same for the images of every sensor alone (what `validate` can tell without
+ * building anything); the message starts with the scene file. */
+thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err);
+
 thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_result *result,
                         thz_error *err);
 thz_status run_render(const thz_scene *scene, const run_options *opt, run_result *result,

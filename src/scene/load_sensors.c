@@ -8,7 +8,6 @@
 #include "core/alloc.h"
 #include "scene/load.h"
 #include "core/vec3.h"
-#include "sensor/images.h"
 
 #define LOAD_MAX_RESOLUTION 65536u
 #define LOAD_MAX_OVERSAMPLING 16u
@@ -46,7 +45,6 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
     static const char *const keys[] = {
         "name",       "position_m",  "look_at_m",    "direction",      "up", "fov_deg",
         "resolution", "aperture_m2", "oversampling", "normalize_to_k", NULL};
-    thz_scene *s = ctx->scene;
     load_cursor e = load_index(list, index);
     const load_cursor *c = &e;
     const char *name;
@@ -117,17 +115,6 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
     if (st != THZ_OK)
         return st;
     sn->oversampling = (uint32_t)over;
-    uint64_t need = sensor_images_bytes(sn->columns, sn->rows, s->n_channels);
-    uint64_t have = thz_physical_memory_bytes();
-    if (have > 0 && need > have) {
-        load_cursor k = load_key(c, "resolution");
-        return load_fail(ctx, &k,
-                         "the images of %u x %u pixels in %zu channels need %.1f GiB, more than "
-                         "this machine's memory (%.1f GiB); lower 'resolution' (or the number "
-                         "of channels)",
-                         sn->columns, sn->rows, s->n_channels, (double)need / 1073741824.0,
-                         (double)have / 1073741824.0);
-    }
     return THZ_OK;
 }
 

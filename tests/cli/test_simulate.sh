@@ -138,7 +138,7 @@ fi
 "$THZMAP" simulate "$work/scene.json" -o "$work/big" --photons 1000000000000 --quiet \
     2> "$work/big.err"
 rc=$?
-[ $rc -eq 1 ] || fail "an oversized run exited $rc, expected 1"
+[ $rc -eq 2 ] || fail "an oversized run exited $rc, expected 2 (THZ_ERR_LIMIT: the user's settings)"
 grep -q "photons.per_channel" "$work/big.err" || fail "oversized run message: $(cat "$work/big.err")"
 [ -z "$(ls -A "$work/big" 2>/dev/null)" ] || fail "refused run left files in OUTDIR"
 
