@@ -411,12 +411,18 @@ static thz_status run_render_warnings(run_state *rs, thz_error *err)
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
         const render_stats *r = &rs->render_sum[i];
         const char *name = rs->scene->sensors[rs->selected[i]].name;
+        /* a sensor inside a solid or outside the enclosure has its own scene warning:
+         * then the normals are not to blame */
+        bool misplaced = rs->scene->sensors[rs->selected[i]].misplaced;
         if (r->back_face_samples)
             st = run_add_warning(rs, err,
                                  "sensor '%s': %llu of %llu samples saw the back side of a "
-                                 "one-sided solid (radiance 0); check the mesh normals",
+                                 "one-sided solid (radiance 0); %s",
                                  name, (unsigned long long)r->back_face_samples,
-                                 (unsigned long long)r->samples);
+                                 (unsigned long long)r->samples,
+                                 misplaced ? "the sensor is inside a solid or outside the "
+                                             "enclosure (see the scene warning)"
+                                           : "check the mesh normals");
         if (st == THZ_OK && r->starved_gathers)
             st = run_add_warning(rs, err,
                                  "sensor '%s': %llu samples hit objects holding fewer photons "

@@ -15,6 +15,7 @@
 #include "core/alloc.h"
 #include "scene/load.h"
 #include "scene/mesh_import.h"
+#include "scene/scene_checks.h"
 
 #define LOAD_FORMAT "thzmap-scene/1"
 /* Explicit emissivity may differ from Kirchhoff's value by this much before validate
@@ -217,12 +218,25 @@ static thz_status load_document(load_ctx *ctx, json_t *doc)
         st = load_render(ctx, &root);
     if (st != THZ_OK)
         return st;
+    bool ok = true;
+    size_t enclosure = scene_checks_enclosure(s, &ok);
+    if (!ok)
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    st = load_atmosphere_defaults(ctx, enclosure == SIZE_MAX ? 0.0
+                                                             : s->objects[enclosure].temperature_k);
+    if (st != THZ_OK)
+        return st;
     st = atmosphere_prepare(&s->atmosphere, s->channels, s->n_channels, ctx->err);
     if (st != THZ_OK) {
         thz_error_prefix(ctx->err, "%s: atmosphere: ", ctx->label);
         return st;
     }
-    return load_warnings(ctx, &root);
+    st = load_warnings(ctx, &root);
+    scene_check_inputs in = {.non_emitting_air = ctx->non_emitting_air,
+                             .background_given = ctx->background_given};
+    if (st == THZ_OK && !scene_checks_run(s, &in))
+        st = thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    return st;
 }
 
 /* The scene's default name: the file name without directory and extension. */

@@ -29,7 +29,15 @@ typedef struct load_ctx {
     const char *dir;   /* relative file paths in the scene are relative to it */
     thz_scene *scene;
     thz_error *err;
+    /* what the atmosphere block gave (for the defaults and warnings that need objects) */
+    bool non_emitting_air;      /* "emitting": false */
+    bool air_temperature_given; /* the air's (itu-p676, lines) or temperature_k */
+    bool background_given;      /* background_temperature_k */
 } load_ctx;
+
+/* The temperature of emitting air whose model has none (constant, table) when the
+ * scene has no enclosure around its sensors to take it from (scene_checks.h). */
+#define LOAD_DEFAULT_AIR_TEMPERATURE_K 293.15
 
 typedef struct load_cursor {
     json_t *value; /* borrowed; NULL when the key is absent */
@@ -142,6 +150,10 @@ thz_status load_channels(load_ctx *ctx, const load_cursor *root);
 thz_status load_materials(load_ctx *ctx, const load_cursor *root);
 /* The atmosphere block (load_atmosphere.c); c->value may be NULL (model none). */
 thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *atm);
+/* After the objects: emitting air with no temperature given takes the enclosure's
+ * (when > 0; else it keeps LOAD_DEFAULT_AIR_TEMPERATURE_K), and so does its background
+ * when none is given. */
+thz_status load_atmosphere_defaults(load_ctx *ctx, double enclosure_temperature_k);
 thz_status load_objects(load_ctx *ctx, const load_cursor *root);
 thz_status load_sensors(load_ctx *ctx, const load_cursor *root);
 /* The optional photons and render blocks (absent: the scene's defaults stay). */

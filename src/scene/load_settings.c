@@ -17,8 +17,9 @@ thz_status load_photons(load_ctx *ctx, const load_cursor *root)
     if (!c.value)
         return THZ_OK;
     uint64_t k = 0;
-    const load_range fraction = {0.0, 1.0, true, true};
+    const load_range fraction = {0.0, 1.0, false, true}; /* 0: no cut-off */
     thz_status st = load_expect_object(ctx, &c, keys);
+    p->per_channel_given = json_object_get(c.value, "per_channel") != NULL;
     if (st == THZ_OK)
         st = load_integer(ctx, &c, "per_channel", 1, (uint64_t)1 << 53, false, p->per_channel,
                           &p->per_channel);
@@ -37,7 +38,8 @@ thz_status load_photons(load_ctx *ctx, const load_cursor *root)
 
 thz_status load_render(load_ctx *ctx, const load_cursor *root)
 {
-    static const char *const keys[] = {"integrator", "gather_rays", "paths_per_sample", NULL};
+    static const char *const keys[] = {"integrator",     "gather_rays", "paths_per_sample",
+                                       "target_noise_k", "max_seconds", NULL};
     static const char *const integrators[] = {"photon-map", "final-gather", "path", NULL};
     thz_render_settings *r = &ctx->scene->render;
     load_cursor c = load_key(root, "render");
@@ -47,14 +49,19 @@ thz_status load_render(load_ctx *ctx, const load_cursor *root)
     uint64_t rays = 0, paths = 0;
     thz_status st = load_expect_object(ctx, &c, keys);
     if (st == THZ_OK)
-        st = load_choice(ctx, &c, "integrator", integrators, false, 0, &integrator);
+        st = load_choice(ctx, &c, "integrator", integrators, false, 2, &integrator);
     if (st == THZ_OK)
         st = load_integer(ctx, &c, "gather_rays", 1, 1000000, false, r->gather_rays, &rays);
     if (st == THZ_OK)
         st = load_integer(ctx, &c, "paths_per_sample", 1, 1000000, false, r->paths_per_sample,
                           &paths);
+    if (st == THZ_OK)
+        st = load_number(ctx, &c, "target_noise_k", LOAD_POSITIVE, false, 0.0, &r->target_noise_k);
+    if (st == THZ_OK)
+        st = load_number(ctx, &c, "max_seconds", LOAD_POSITIVE, false, 0.0, &r->max_seconds);
     if (st != THZ_OK)
         return st;
+    r->paths_per_sample_given = json_object_get(c.value, "paths_per_sample") != NULL;
     r->integrator = integrator == 2   ? INTEGRATOR_PATH
                     : integrator == 1 ? INTEGRATOR_FINAL_GATHER
                                       : INTEGRATOR_PHOTON_MAP;
