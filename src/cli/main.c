@@ -62,7 +62,15 @@ bool cli_parse_u64(const char *cmd, const char *option, const char *text, uint64
     char *end = NULL;
     errno = 0;
     unsigned long long v = strtoull(text, &end, 10);
-    if (!text[0] || *end || errno || text[0] == '-' || v < min || v > max) {
+    bool ok = text[0] && !*end && !errno && text[0] != '-';
+    if (!ok && text[0] && text[0] != '-' && strpbrk(text, ".eE")) {
+        /* 1e6 or 2.5e3: a real that is a whole number, exact in a double (as in JSON) */
+        errno = 0;
+        double x = strtod(text, &end);
+        ok = !*end && !errno && isfinite(x) && x >= 0.0 && x == floor(x) && x <= 9007199254740992.0;
+        v = ok ? (unsigned long long)x : 0;
+    }
+    if (!ok || v < min || v > max) {
         cli_usage_error(cmd, "%s expects a whole number from %llu to %llu, got '%s'", option,
                         (unsigned long long)min, (unsigned long long)max, text);
         return false;

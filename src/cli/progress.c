@@ -124,3 +124,11 @@ void cli_progress_finish(cli_progress *p)
         p->line_open = false;
     }
 }
+
+void cli_progress_warning(void *user, const char *message)
+{
+    cli_progress *p = user;
+    cli_progress_finish(p); /* a warning gets its own line, even with --quiet */
+    fprintf(p->out, "thzmap %s: warning: %s\n", p->command, message);
+    fflush(p->out);
+}

@@ -1,9 +1,10 @@
 /* Progress display on stderr for long runs, and Ctrl-C handling.
  *
  * When stderr is a terminal: one line, updated in place (channel i/n, stage, units done,
- * rate, ETA in s). Otherwise: one line per channel and stage when it completes. Nothing
- * with --quiet. The progress callback also carries cancellation: once SIGINT or SIGTERM
- * arrived it returns non-zero, so the run stops and removes its staging directory.
+ * rate, ETA in s). Otherwise: one line per channel and stage when it completes. No
+ * progress with --quiet; warnings always. The progress callback also carries cancellation: once
+ * SIGINT or SIGTERM arrived it returns non-zero, so the run stops and removes its staging
+ * directory.
  */
 #ifndef THZ_CLI_PROGRESS_H
 #define THZ_CLI_PROGRESS_H
@@ -34,6 +35,10 @@ void cli_progress_init(cli_progress *p, const char *command, bool quiet);
 
 /* The thz_progress_fn: draws, and returns non-zero once an interrupt arrived. */
 int cli_progress_report(void *user, const thz_progress *progress);
+
+/* The run's warning callback: prints "thzmap CMD: warning: MESSAGE" on its own line of
+ * stderr (with --quiet too). */
+void cli_progress_warning(void *user, const char *message);
 
 /* Ends the terminal line, if one is open. */
 void cli_progress_finish(cli_progress *p);

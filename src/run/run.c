@@ -19,6 +19,7 @@
 #include "photon/phase.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
+#include "run/run_noise.h"
 #include "physics/planck.h"
 #include "sensor/images.h"
 #include "sensor/render.h"
@@ -33,20 +34,24 @@ typedef struct run_state {
     const char *command; /* "simulate" or "render" */
     accel *accel;
     output_stage *stage;
-    size_t n_selected;        /* sensors rendered */
-    size_t *selected;         /* their indices into scene->sensors */
-    sensor_images *images;    /* one per selected sensor */
-    uint64_t *back_face;      /* per scene sensor: samples that saw a back face */
-    render_stats *render_sum; /* per selected sensor: counts over all channels */
-    render_stats *last;       /* [channel * n_selected + i]: the channel's last render pass
-                                 (every pass casts the same sample rays, so the counts are
-                                 a channel's, not the number of passes') */
-    photon_map **maps;        /* per channel: kept for saving, or read from a file */
-    photon_stats *stats;      /* per channel (simulate) */
-    double *median_stderr_k;  /* per channel */
-    uint32_t *passes;         /* per channel: render passes */
-    double *seconds_channel;  /* per channel: render time, s */
-    uint64_t seed;            /* of the photons rendered (scene's, or the map file's) */
+    size_t n_selected;         /* sensors rendered */
+    size_t *selected;          /* their indices into scene->sensors */
+    sensor_images *images;     /* one per selected sensor */
+    uint64_t *back_face;       /* per scene sensor: samples that saw a back face */
+    render_stats *render_sum;  /* per selected sensor: counts over all channels */
+    render_stats *last;        /* [channel * n_selected + i]: the channel's last render pass
+                                  (every pass casts the same sample rays, so the counts are
+                                  a channel's, not the number of passes') */
+    photon_map **maps;         /* per channel: kept for saving, or read from a file */
+    photon_stats *stats;       /* per channel (simulate) */
+    run_noise *noise;          /* per channel */
+    run_noise *object_noise;   /* [channel * n_objects + object] */
+    double target_noise_k;     /* the run's target (run_target_noise_k), 0: none */
+    const char *target_source; /* "command line", "scene", "default" or NULL */
+    double max_seconds;        /* the command line's, else the scene's; 0: none */
+    uint32_t *passes;          /* per channel: render passes */
+    double *seconds_channel;   /* per channel: render time, s */
+    uint64_t seed;             /* of the photons rendered (scene's, or the map file's) */
     uint64_t photons_per_channel;
     size_t n_warnings;
     char **warnings;
@@ -68,12 +73,37 @@ void run_apply_overrides(thz_scene *scene, const run_overrides *ov)
 {
     if (!ov)
         return;
-    if (ov->photons)
+    if (ov->photons) {
         scene->photons.per_channel = ov->photons;
+        scene->photons.per_channel_given = true;
+    }
     if (ov->has_seed)
         scene->photons.seed = ov->seed;
     if (ov->has_integrator)
         scene->render.integrator = ov->integrator;
+}
+
+double run_target_noise_k(const thz_scene *scene, const run_options *opt, bool render,
+                          const char **source)
+{
+    thz_integrator in = scene->render.integrator;
+    /* render's photon-map is deterministic given its map: no passes, no target */
+    bool can = !render || render_integrator_has_passes(in);
+    const char *from = NULL;
+    double t = 0.0;
+    if (opt->target_noise_k > 0.0) {
+        t = opt->target_noise_k, from = "command line";
+    } else if (can && scene->render.target_noise_k > 0.0) {
+        t = scene->render.target_noise_k, from = "scene";
+    } else if (can) {
+        bool given = in == INTEGRATOR_PATH ? scene->render.paths_per_sample_given
+                                           : scene->photons.per_channel_given;
+        if (!given)
+            t = RUN_DEFAULT_TARGET_NOISE_K, from = "default";
+    }
+    if (source)
+        *source = from;
+    return t;
 }
 
 static thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt, ...)
@@ -94,6 +124,8 @@ static thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt
     if (!w[rs->n_warnings])
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for run warnings");
     rs->n_warnings++;
+    if (rs->opt->warning)
+        rs->opt->warning(rs->opt->warning_user, buf);
     return THZ_OK;
 }
 
@@ -113,7 +145,8 @@ static void run_state_fini(run_state *rs)
             photon_map_destroy(rs->maps[c]);
     free(rs->maps);
     free(rs->stats);
-    free(rs->median_stderr_k);
+    free(rs->noise);
+    free(rs->object_noise);
     free(rs->passes);
     free(rs->seconds_channel);
     for (size_t i = 0; i < rs->n_warnings; i++)
@@ -150,15 +183,20 @@ static thz_status run_state_init(run_state *rs, const thz_scene *scene, const ru
                                   : 0; /* path fires none */
     if (!opt->outdir || !opt->outdir[0])
         return thz_error_set(err, THZ_ERR_INPUT, "%s: no output directory given", command);
+    rs->target_noise_k =
+        run_target_noise_k(scene, opt, strcmp(command, "render") == 0, &rs->target_source);
+    rs->max_seconds = opt->max_seconds > 0.0 ? opt->max_seconds : scene->render.max_seconds;
     size_t nc = scene->n_channels, ns = scene->n_sensors;
     rs->selected = thz_calloc(ns, sizeof *rs->selected);
     rs->maps = thz_calloc(nc, sizeof *rs->maps);
     rs->stats = thz_calloc(nc, sizeof *rs->stats);
-    rs->median_stderr_k = thz_calloc(nc, sizeof *rs->median_stderr_k);
+    rs->noise = thz_calloc(nc, sizeof *rs->noise);
+    rs->object_noise =
+        thz_calloc(nc * (scene->n_objects ? scene->n_objects : 1), sizeof *rs->object_noise);
     rs->passes = thz_calloc(nc, sizeof *rs->passes);
     rs->seconds_channel = thz_calloc(nc, sizeof *rs->seconds_channel);
-    if (!rs->selected || !rs->maps || !rs->stats || !rs->median_stderr_k || !rs->passes ||
-        !rs->seconds_channel)
+    if (!rs->selected || !rs->maps || !rs->stats || !rs->noise || !rs->object_noise ||
+        !rs->passes || !rs->seconds_channel)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     for (size_t s = 0; s < ns; s++)
         if (!opt->sensor_name || strcmp(opt->sensor_name, scene->sensors[s].name) == 0)
@@ -280,43 +318,17 @@ static thz_status run_init_images(run_state *rs, thz_error *err)
     return THZ_OK;
 }
 
-static int run_compare_double(const void *a, const void *b)
+/* The 95th percentile over the rendered pixels of channel c (all selected sensors) of
+ * the standard error of Tb_c in K (run_noise.h): what a noise target aims at. A
+ * negative value (never below a target) on allocation failure: the caller stops. */
+static double run_channel_p95_stderr_k(const run_state *rs, size_t c)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* Median over the rendered pixels of channel c (all selected sensors) of the standard
- * error of Tb_c in K (physics.md: dTb/dL at the pixel's L_c); pixels with Tb_c = 0
- * (nothing or a back face seen) are left out; 0 when none is left. `v` holds room for
- * every rendered pixel. */
-static double run_channel_median_stderr_k(const run_state *rs, size_t c, double *v)
-{
-    double nu = rs->scene->channels[c].center_hz;
-    size_t m = 0;
-    for (size_t i = 0; i < rs->n_selected; i++) {
-        const sensor_images *img = &rs->images[i];
-        size_t px = (size_t)img->columns * img->rows;
-        if (!img->radiance_stderr)
-            continue;
-        for (size_t p = 0; p < px; p++) {
-            double tb = img->brightness_temperature[c * px + p];
-            if (tb > 0.0)
-                v[m++] = render_stderr_k(nu, tb, img->radiance_stderr[c * px + p]);
-        }
-    }
-    if (m == 0)
-        return 0.0;
-    qsort(v, m, sizeof *v, run_compare_double);
-    return m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
-}
-
-static size_t run_rendered_pixels(const run_state *rs)
-{
-    size_t total = 0;
-    for (size_t i = 0; i < rs->n_selected; i++)
-        total += (size_t)rs->images[i].columns * rs->images[i].rows;
-    return total;
+    run_noise all;
+    thz_error ignored;
+    if (run_noise_channel(rs->images, rs->n_selected, c, rs->scene->channels[c].center_hz, 0, &all,
+                          NULL, &ignored) != THZ_OK)
+        return -1.0;
+    return all.p95_k;
 }
 
 /* Renders channel c of every selected sensor: one pass, or, with a noise target and an
@@ -331,11 +343,10 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
                          .progress_user = rs->opt->progress_user};
     double t0 = thz_now_s();
     double target =
-        render_integrator_has_passes(rs->scene->render.integrator) ? rs->opt->target_noise_k : 0.0;
+        render_integrator_has_passes(rs->scene->render.integrator) ? rs->target_noise_k : 0.0;
     render_accum *acc = thz_calloc(rs->n_selected, sizeof *acc);
-    double *v = target > 0.0 ? thz_malloc_array(run_rendered_pixels(rs), sizeof *v) : NULL;
     thz_status st = THZ_OK;
-    if (!acc || (target > 0.0 && !v))
+    if (!acc)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the pixel statistics");
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
         const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
@@ -356,9 +367,9 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
         rs->passes[c] = pass + 1;
         if (!(target > 0.0))
             break;
-        if (run_channel_median_stderr_k(rs, c, v) <= target)
+        if (run_channel_p95_stderr_k(rs, c) <= target)
             break;
-        if (rs->opt->max_seconds > 0.0 && thz_now_s() - t0 >= rs->opt->max_seconds)
+        if (rs->max_seconds > 0.0 && thz_now_s() - t0 >= rs->max_seconds)
             break;
         if (pass + 1 >= RUN_MAX_PASSES) {
             st = run_add_warning(rs, err,
@@ -372,23 +383,22 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
         for (size_t i = 0; i < rs->n_selected; i++)
             render_accum_fini(&acc[i]);
     free(acc);
-    free(v);
     double seconds = thz_now_s() - t0;
     rs->seconds_channel[c] += seconds; /* photon-map's photon passes render again */
     rs->seconds_render += seconds;
     return st;
 }
 
-/* Median over all rendered pixels of the standard error of Tb_c, in K, per channel. */
-static thz_status run_median_stderr(run_state *rs, thz_error *err)
+/* The noise figures of every channel, overall and per object. */
+static thz_status run_noise_figures(run_state *rs, thz_error *err)
 {
-    double *v = thz_malloc_array(run_rendered_pixels(rs), sizeof *v);
-    if (!v)
-        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the error statistics");
-    for (size_t c = 0; c < rs->scene->n_channels; c++)
-        rs->median_stderr_k[c] = run_channel_median_stderr_k(rs, c, v);
-    free(v);
-    return THZ_OK;
+    const thz_scene *sc = rs->scene;
+    thz_status st = THZ_OK;
+    for (size_t c = 0; c < sc->n_channels && st == THZ_OK; c++)
+        st = run_noise_channel(rs->images, rs->n_selected, c, sc->channels[c].center_hz,
+                               sc->n_objects, &rs->noise[c], &rs->object_noise[c * sc->n_objects],
+                               err);
+    return st;
 }
 
 /* Per sensor, the counts of every channel's last render pass (render_sum, and back_face
@@ -458,7 +468,7 @@ static thz_status run_write_outputs(run_state *rs, thz_error *err)
     if (st == THZ_OK && rs->opt->save_photon_map)
         st = run_save_photon_map(rs, dir, err);
     if (st == THZ_OK)
-        st = run_median_stderr(rs, err);
+        st = run_noise_figures(rs, err);
     if (st == THZ_OK)
         st = run_render_warnings(rs, err);
     if (st != THZ_OK)
@@ -473,10 +483,12 @@ static thz_status run_write_outputs(run_state *rs, thz_error *err)
         /* render: the statistics of the photon phase that made the map it read */
         .channel_stats =
             render_integrator_needs_photons(rs->scene->render.integrator) ? rs->stats : NULL,
-        .median_stderr_k = rs->median_stderr_k,
+        .noise = rs->noise,
+        .object_noise = rs->object_noise,
+        .target_source = rs->target_source,
         .passes = rs->passes,
         .seconds_render_channel = rs->seconds_channel,
-        .target_noise_k = rs->opt->target_noise_k,
+        .target_noise_k = rs->target_noise_k,
         .back_face_samples = rs->back_face,
         .seconds_load = rs->opt->seconds_load,
         .seconds_accel = rs->seconds_accel,
@@ -509,8 +521,20 @@ static void run_fill_result(const run_state *rs, run_result *result, double t_st
     for (size_t i = 0; i < rs->n_selected; i++)
         result->back_face_samples += rs->back_face[rs->selected[i]];
     result->n_warnings = rs->n_warnings;
+    size_t no = rs->scene->n_objects;
+    result->worst_object = SIZE_MAX;
     for (size_t c = 0; c < rs->scene->n_channels; c++) {
-        result->worst_median_stderr_k = fmax(result->worst_median_stderr_k, rs->median_stderr_k[c]);
+        result->worst_median_stderr_k = fmax(result->worst_median_stderr_k, rs->noise[c].median_k);
+        result->worst_p95_stderr_k = fmax(result->worst_p95_stderr_k, rs->noise[c].p95_k);
+        for (size_t o = 0; o < no; o++) {
+            const run_noise *n = &rs->object_noise[c * no + o];
+            if (n->pixels > 0 && (result->worst_object == SIZE_MAX ||
+                                  n->p95_k > result->worst_object_p95_stderr_k)) {
+                result->worst_object = o;
+                result->worst_object_channel = c;
+                result->worst_object_p95_stderr_k = n->p95_k;
+            }
+        }
         if (rs->passes[c] > result->max_passes)
             result->max_passes = rs->passes[c];
     }
@@ -582,13 +606,12 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
 {
     const thz_scene *scene = rs->scene;
     const run_options *opt = rs->opt;
-    double target = opt->target_noise_k, t_start = thz_now_s();
-    double *v = thz_malloc_array(run_rendered_pixels(rs) ? run_rendered_pixels(rs) : 1, sizeof *v);
+    double target = rs->target_noise_k, t_start = thz_now_s();
     size_t cap = 16, n = 0;
     photon_map **maps = thz_calloc(cap, sizeof *maps);
     photon_map *merged = NULL;
     thz_status st = THZ_OK;
-    if (!v || !maps)
+    if (!maps)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the photon passes");
     uint64_t k = scene->photons.per_channel;
     double limit = 0.5 * (double)thz_physical_memory_bytes();
@@ -626,9 +649,9 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
         rs->stats[c].stored = photon_map_count(map);
         st = run_render_channel(rs, c, map, err);
         rs->passes[c] = (uint32_t)n;
-        if (st != THZ_OK || run_channel_median_stderr_k(rs, c, v) <= target)
+        if (st != THZ_OK || run_channel_p95_stderr_k(rs, c) <= target)
             break;
-        if (opt->max_seconds > 0.0 && thz_now_s() - t_start >= opt->max_seconds)
+        if (rs->max_seconds > 0.0 && thz_now_s() - t_start >= rs->max_seconds)
             break;
         /* the passes' maps and the next merge: twice the records, and their indexes */
         double next = 2.2 * (double)photon_map_bytes(map) * (double)(n + 1) / (double)n;
@@ -661,7 +684,6 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
     for (size_t i = 0; maps && i < n; i++)
         photon_map_destroy(maps[i]);
     free(maps);
-    free(v);
     return st;
 }
 
@@ -676,7 +698,7 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_resu
         st = run_simulate_memory(&rs, photons, err);
     if (st == THZ_OK)
         st = run_init_images(&rs, err);
-    bool photon_passes = photons && opt->target_noise_k > 0.0 &&
+    bool photon_passes = photons && rs.target_noise_k > 0.0 &&
                          !render_integrator_has_passes(scene->render.integrator);
     for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
         photon_map *map = NULL;

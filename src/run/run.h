@@ -8,9 +8,10 @@
  *   render:   read a saved photon map (refusing one made from another scene) -> render
  *             the chosen sensors -> outputs as above.
  *
- * With the `path` integrator simulate fires no photons. With target_noise_k, each
- * channel gets passes 0, 1, 2, ... (each deterministic) until its median standard
- * error in K is at most the target, or max_seconds have passed.
+ * With the `path` integrator simulate fires no photons. With a noise target
+ * (run_target_noise_k), each channel gets passes 0, 1, 2, ... (each deterministic)
+ * until the 95th percentile over its pixels of the standard error of Tb_c is at most
+ * the target (K), or max_seconds have passed.
  *
  * A failed or cancelled run (progress callback returning non-zero: THZ_ERR_CANCELLED)
  * leaves no result files in OUTDIR. Results are bit-identical for any thread count.
@@ -42,12 +43,17 @@ typedef struct run_options {
     const char *sensor_name;     /* render: only this sensor; NULL: all */
     thz_progress_fn progress;    /* stages "photons", "render", "output"; may be NULL */
     void *progress_user;
+    /* called with each run warning as it arises (also written to summary.json), from the
+       calling thread; may be NULL */
+    void (*warning)(void *user, const char *message);
+    void *warning_user;
     double seconds_load;   /* time the caller spent loading the scene, for the summary */
-    double target_noise_k; /* > 0: add passes to each channel until the median per-pixel
-                              standard error of Tb_c, over the rendered sensors, is at
-                              most this (K); final-gather and path only */
+    double target_noise_k; /* > 0: add passes to each channel until the 95th percentile of
+                              the per-pixel standard error of Tb_c, over the rendered
+                              sensors, is at most this (K); overrides the scene's */
     double max_seconds;    /* > 0: stop adding passes once a channel has rendered this
-                              long (s); makes the stopping point time-dependent */
+                              long (s); makes the stopping point time-dependent;
+                              overrides the scene's render.max_seconds */
 } run_options;
 
 /* What a finished run reports back (for the CLI's closing line). */
@@ -60,14 +66,30 @@ typedef struct run_result {
     size_t n_warnings;            /* run warnings written to summary.json */
     double worst_median_stderr_k; /* largest over channels of the median per-pixel standard
                                      error of Tb_c, K (0 if not estimated) */
-    uint32_t max_passes;          /* most render passes of any channel */
-    double seconds;               /* wall time of the run */
+    double worst_p95_stderr_k;    /* the same for the 95th percentile, K */
+    size_t worst_object;          /* object whose pixels' p95 is largest (over channels), or
+                                     SIZE_MAX when no object was seen */
+    size_t worst_object_channel;
+    double worst_object_p95_stderr_k; /* K */
+    uint32_t max_passes;              /* most render passes of any channel */
+    double seconds;                   /* wall time of the run */
 } run_result;
 
 /* THZ_ERR_INPUT unless the noise target and the time limit are positive (or 0: none).
  * Every integrator takes a target in simulate (photon-map by photon passes); render
  * refuses one for photon-map, which would need photons. */
 thz_status run_check_options(const run_options *opt, thz_error *err);
+
+/* The noise target where the user gives no count (photons.per_channel or --photons for
+ * photon-map and final-gather, render.paths_per_sample for path) and no target, K. */
+#define RUN_DEFAULT_TARGET_NOISE_K 0.1
+
+/* The run's noise target in K (0: none, one pass): the command line's, else the
+ * scene's render.target_noise_k, else the default when no count is given. render
+ * with photon-map has none but the command line's (which it refuses). *source (may be
+ * NULL) gets "command line", "scene", "default" or NULL. */
+double run_target_noise_k(const thz_scene *scene, const run_options *opt, bool render,
+                          const char **source);
 
 /* Applies the overrides to the scene (before run_simulate / run_render). */
 void run_apply_overrides(thz_scene *scene, const run_overrides *ov);
