@@ -13,6 +13,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "run/run.h"
 #include "thzmap/thzmap.h"
 
 typedef struct cli_progress {
@@ -29,6 +30,9 @@ typedef struct cli_progress {
                              stages may report only when a batch is done */
     double last_report_s;
     double last_draw_s;
+    double run_start_s; /* when the plan was told (0: no plan) */
+    double estimate_s;  /* the plan's estimate of the whole run, s */
+    bool photons_seen;  /* the run fires photons (half of each channel's share) */
 } cli_progress;
 
 void cli_progress_init(cli_progress *p, const char *command, bool quiet);
@@ -39,6 +43,10 @@ int cli_progress_report(void *user, const thz_progress *progress);
 /* The run's warning callback: prints "thzmap CMD: warning: MESSAGE" on its own line of
  * stderr (with --quiet too). */
 void cli_progress_warning(void *user, const char *message);
+
+/* The run's plan callback: prints the estimate of time and memory before the run
+ * (not with --quiet) and keeps it for the whole-run ETA. */
+void cli_progress_plan(void *user, const run_plan *plan);
 
 /* Ends the terminal line, if one is open. */
 void cli_progress_finish(cli_progress *p);

@@ -190,6 +190,7 @@ int cli_run_command(int argc, char **argv, bool render)
     a.opt.progress_user = &progress;
     a.opt.warning = cli_progress_warning;
     a.opt.warning_user = &progress;
+    a.opt.plan = cli_progress_plan;
     a.opt.seconds_load = thz_now_s() - t0;
     run_result result;
     st = render ? run_render(scene, &a.opt, &result, &err)

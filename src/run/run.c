@@ -19,6 +19,7 @@
 #include "photon/phase.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
+#include "run/run_estimate.h"
 #include "run/run_noise.h"
 #include "physics/planck.h"
 #include "sensor/images.h"
@@ -49,6 +50,7 @@ typedef struct run_state {
     double target_noise_k;     /* the run's target (run_target_noise_k), 0: none */
     const char *target_source; /* "command line", "scene", "default" or NULL */
     double max_seconds;        /* the command line's, else the scene's; 0: none */
+    uint64_t memory_bytes;     /* estimated before the run (run_memory total) */
     uint32_t *passes;          /* per channel: render passes */
     double *seconds_channel;   /* per channel: render time, s */
     uint64_t seed;             /* of the photons rendered (scene's, or the map file's) */
@@ -299,6 +301,7 @@ static thz_status run_simulate_memory(run_state *rs, bool photons, thz_error *er
         need.photon_bytes = (rs->opt->save_photon_map ? sum : max) + max;
     }
     need.total_bytes = need.photon_bytes + need.image_bytes;
+    rs->memory_bytes = need.total_bytes;
     return run_check_memory(rs->scene, &need, err);
 }
 
@@ -687,6 +690,26 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
     return st;
 }
 
+/* Estimates the run's time (a pilot) and tells opt->plan. */
+static thz_status run_tell_plan(run_state *rs, thz_error *err)
+{
+    run_estimate_input in = {.scene = rs->scene,
+                             .accel = rs->accel,
+                             .selected = rs->selected,
+                             .n_selected = rs->n_selected,
+                             .target_noise_k = rs->target_noise_k,
+                             .threads = rs->opt->threads};
+    run_plan plan = {.memory_bytes = rs->memory_bytes,
+                     .available_bytes = thz_physical_memory_bytes(),
+                     .target_noise_k = rs->target_noise_k,
+                     .target_source = rs->target_source};
+    thz_status st =
+        run_estimate_time(&in, &plan.seconds_photons, &plan.seconds_render, &plan.passes, err);
+    if (st == THZ_OK)
+        rs->opt->plan(rs->opt->warning_user, &plan);
+    return st;
+}
+
 thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_result *result,
                         thz_error *err)
 {
@@ -696,6 +719,8 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_resu
     bool photons = render_integrator_needs_photons(scene->render.integrator);
     if (st == THZ_OK)
         st = run_simulate_memory(&rs, photons, err);
+    if (st == THZ_OK && opt->plan)
+        st = run_tell_plan(&rs, err);
     if (st == THZ_OK)
         st = run_init_images(&rs, err);
     bool photon_passes = photons && rs.target_noise_k > 0.0 &&

@@ -34,6 +34,16 @@ typedef struct run_overrides {
     thz_integrator integrator; /* render.integrator */
 } run_overrides;
 
+/* What a simulate run is about to do, told before it starts (run_estimate.h). */
+typedef struct run_plan {
+    double seconds_photons, seconds_render; /* estimated, s */
+    uint32_t passes;                        /* estimated passes per channel */
+    uint64_t memory_bytes;                  /* estimated peak, bytes */
+    uint64_t available_bytes;               /* physical memory, 0 if unknown */
+    double target_noise_k;                  /* 0: none */
+    const char *target_source;              /* run_target_noise_k's *source */
+} run_plan;
+
 typedef struct run_options {
     const char *outdir;          /* required: where the result files go */
     int threads;                 /* OpenMP threads, 0: all */
@@ -47,6 +57,9 @@ typedef struct run_options {
        calling thread; may be NULL */
     void (*warning)(void *user, const char *message);
     void *warning_user;
+    /* simulate: called once before the work starts with the estimate (its pilot costs
+       a moment, so only when set); user: warning_user */
+    void (*plan)(void *user, const run_plan *plan);
     double seconds_load;   /* time the caller spent loading the scene, for the summary */
     double target_noise_k; /* > 0: add passes to each channel until the 95th percentile of
                               the per-pixel standard error of Tb_c, over the rendered
