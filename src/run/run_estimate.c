@@ -64,9 +64,13 @@ thz_status run_estimate_time(const run_estimate_input *in, double *seconds_photo
     /* pass 0 warms up (threads, caches); pass 1 is timed */
     if (st == THZ_OK)
         st = render_sensor_channel_pass(&pilot, in->accel, map, 0, 0, 0, &acc, &ro, &rst, err);
+    if (st == THZ_OK) { /* photon-map has one pass only: time pass 0 again, afresh */
+        render_accum_fini(&acc);
+        st = render_accum_init(&acc, (size_t)cam.columns * cam.rows, err);
+    }
     double t0 = thz_now_s();
     if (st == THZ_OK)
-        st = render_sensor_channel_pass(&pilot, in->accel, map, 0, 0, 1, &acc, &ro, &rst, err);
+        st = render_sensor_channel_pass(&pilot, in->accel, map, 0, 0, 0, &acc, &ro, &rst, err);
     double per_sample = (thz_now_s() - t0) / estimate_samples(&pilot, &cam);
     if (st == THZ_OK)
         st = render_accum_write(&pilot, 0, 0, &acc, &img, err);
@@ -88,8 +92,7 @@ thz_status run_estimate_time(const run_estimate_input *in, double *seconds_photo
     if (in->target_noise_k > 0.0 && noise.p95_k > in->target_noise_k) {
         /* the pilot has estimate_samples(cam) / side^2 samples per pixel; the standard
          * error falls as 1/sqrt(samples) (photon-map: of photons, the same law) */
-        double pilot_per_pixel =
-            2.0 * estimate_samples(&pilot, &cam) / (double)(cam.columns * cam.rows);
+        double pilot_per_pixel = estimate_samples(&pilot, &cam) / (double)(cam.columns * cam.rows);
         double need = pilot_per_pixel * pow(noise.p95_k / in->target_noise_k, 2.0);
         double p = ceil(photons && scene->render.integrator == INTEGRATOR_PHOTON_MAP
                             ? need / pilot_per_pixel * RUN_PILOT_PHOTONS /

@@ -1,6 +1,6 @@
 /* The up-front estimate of a simulate run's time: a pilot on a small copy of the first
- * rendered sensor (RUN_PILOT_SIDE^2 pixels, one sample each, two passes of which the
- * second is timed) and, for the integrators
+ * rendered sensor (RUN_PILOT_SIDE^2 pixels, one sample each, pass 0 twice, the second
+ * timed) and, for the integrators
  * that need photons, a pilot photon phase of RUN_PILOT_PHOTONS, both on channel 0.
  * Time per path sample (or gather sample) and per photon, times the run's counts,
  * gives the time; with a noise target the pilot's 95th percentile of the standard
