@@ -204,7 +204,7 @@ int cli_run_command(int argc, char **argv, bool render)
         rc = cli_fail(&err);
     } else {
         rc = CLI_EXIT_OK;
-        { /* the result, not progress: printed with --quiet too */
+        if (!a.quiet) {
             printf("thzmap %s: %zu sensor%s x %zu channel%s", cmd, result.n_sensors,
                    result.n_sensors == 1 ? "" : "s", result.n_channels,
                    result.n_channels == 1 ? "" : "s");

@@ -551,6 +551,12 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
     thz_status st = run_state_init(rs, scene, opt, command, err);
     if (st == THZ_OK)
         st = render_integrator_check(scene->render.integrator, err);
+    if (st == THZ_OK && opt->save_photon_map &&
+        !render_integrator_needs_photons(scene->render.integrator))
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "%s: --save-photon-map: the %s integrator fires no photons (give "
+                           "--integrator final-gather or photon-map, or render.integrator)",
+                           command, render_integrator_name(scene->render.integrator));
     if (st == THZ_OK)
         st = run_check_options(opt, err);
     if (st == THZ_OK)

@@ -48,7 +48,8 @@ cat > "$1" <<JSON
     {"name": "side", "position_m": [0.8, -0.8, 0.3], "look_at_m": [0, 0.4, -0.2],
      "fov_deg": 50, "resolution": [12, 12]}
   ],
-  "photons": {"per_channel": 60000, "seed": 4}
+  "photons": {"per_channel": 60000, "seed": 4},
+  "render": {"integrator": "photon-map"}
 }
 JSON
 }
