@@ -188,14 +188,17 @@ typedef struct thz_write_options {
 
 /* Writes every file of the run into `outdir` (created if missing): per sensor as
  * thz_image_write, summary.json, and the photon map if asked (opt may be NULL). Files
- * appear only when all were written; a failure or cancellation leaves OUTDIR as it was.
+ * appear only when all were written (thz_output); a failure or cancellation leaves
+ * outdir as it was.
  * Records the time writing took in the summary.json it writes (the run is modified). */
 THZ_API thz_status thz_run_write(thz_context *ctx, thz_run *run, const char *outdir,
                                  const thz_write_options *opt, thz_error *err);
 
-/* An atomic result directory: files go into a staging directory inside `outdir` and
- * move into it on thz_output_commit; destroying an uncommitted output removes them
- * (and outdir, if it created it). Open it before a long run to fail early. */
+/* An atomic result directory (docs/reliability.md): files go into a staging directory
+ * beside `outdir`, which holds outdir's lock (a second output into it fails with
+ * THZ_ERR_IO), and become outdir's results on thz_output_commit, all or nothing;
+ * destroying an uncommitted output removes them. Open it before a long run to fail
+ * early on a bad or busy outdir. */
 THZ_API thz_status thz_output_open(const char *outdir, thz_output **out, thz_error *err);
 THZ_API thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run,
                                       const thz_write_options *opt, thz_error *err);
