@@ -14,8 +14,8 @@
  * error in K is at most the target, or max_seconds have passed.
  *
  * A failed or cancelled run (progress callback returning non-zero: THZ_ERR_CANCELLED)
- * returns nothing; a failed or cancelled write leaves no result files in OUTDIR. Results are
- * bit-identical for any thread count.
+ * returns nothing; a failed or cancelled write leaves no result files in OUTDIR.
+ * Results are bit-identical for any thread count.
  */
 #ifndef THZ_RUN_RUN_H
 #define THZ_RUN_RUN_H
