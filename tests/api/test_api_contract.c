@@ -110,8 +110,10 @@ int main(int argc, char **argv)
                        "saving half-fired photons");
     expect_input_error(thz_render_sensor(ctx, a, merged, 7, NULL, &image, &err), &err, "sensor 7",
                        "sensor out of range");
-    expect_input_error(thz_photons_fire_channel(ctx, a, &settings, 2, &one, &err), &err,
+    thz_photons *none = (thz_photons *)&err;
+    expect_input_error(thz_photons_fire_channel(ctx, a, &settings, 2, &none, &err), &err,
                        "channel 2", "channel out of range");
+    CHECK(none == NULL, "photons came back");
 
     /* a photon map of another scene is refused on loading */
     char dir[4096], path[4200];
