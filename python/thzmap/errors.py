@@ -49,10 +49,9 @@ class ArgumentError(Error, ValueError):
     """An argument of a thzmap function is wrong (checked before the library is called)."""
 
 
-# The top-level keys of a thzmap-scene/1 document: a JSON path starts with one of them.
-_TOP_KEYS = ("format", "name", "channels", "materials", "atmosphere", "objects", "sensors",
-             "photons", "render")
-_PATH = re.compile(r"^((?:%s)(?:[.\[][^:]*?)?): (.*)$" % "|".join(_TOP_KEYS), re.S)
+# A JSON path as the loader writes it: a key, then ".key" or "[index]" steps (keys of
+# materials may hold spaces), up to the ": " that starts the reason.
+_PATH = re.compile(r"^([A-Za-z_][\w-]*(?:\.[^:]*?|\[\d+\])*): (.*)$", re.S)
 _POSITION = re.compile(r"^(\d+)(?::(\d+))?: (.*)$", re.S)
 
 

@@ -311,7 +311,7 @@ class Result:
 
     @property
     def summary(self):
-        """The dict of summary.json (timings_s.output is set once the run is saved)."""
+        """The dict of summary.json (as written by save, but for timings_s.output)."""
         if self._summary is None:
             self._summary = json.loads(_lib.text(_lib.lib.thz_run_summary_json(self._owner.ptr)))
         return self._summary
