@@ -122,3 +122,27 @@ def test_run_warnings_arrive_as_warnings(tiny_dir):
     with pytest.warns(thzmap.RunWarning):
         result = thzmap.simulate(scene, photons=200)
     assert result.summary["warnings"]
+
+
+def _bad_scenes():
+    import os
+    from conftest import REPO
+    with open(os.path.join(REPO, "tests", "inputs", "bad_scenes.tsv")) as f:
+        rows = [line.rstrip("\n").split("\t") for line in f if not line.startswith("#")]
+    return [(os.path.join(REPO, "tests", "inputs", "bad", name), want)
+            for name, _, want in rows]
+
+
+@pytest.mark.parametrize("path, want", _bad_scenes(),
+                         ids=[p.rsplit("/", 1)[1] for p, _ in _bad_scenes()])
+def test_every_bad_scene_of_the_cli_tests(path, want):
+    """The CLI's corpus of bad scenes: each raises SceneError with the CLI's message,
+    naming its file and a JSON path or a line (but for a document that is no object)."""
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.load_scene(path)
+    assert want in str(e.value)
+    assert e.value.file == path
+    assert (e.value.path is not None or e.value.line is not None
+            or path.endswith("not_an_object.json"))
+    if e.value.path is not None:
+        assert str(e.value) == f"{path}: {e.value.path}: {e.value.reason}"
