@@ -35,7 +35,7 @@ class _Bar:
                 self.close()
                 self._key = key
                 self._bar = self._tqdm(total=p.total, desc=label, unit=_UNITS.get(p.stage, ""),
-                                       unit_scale=True, leave=False)
+                                       unit_scale=p.stage == "photons", leave=False)
             self._bar.update(p.done - self._bar.n)
         else:
             now = time.monotonic()
