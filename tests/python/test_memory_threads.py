@@ -1,6 +1,7 @@
 """Memory: simulate in a loop does not grow the process; threads: two runs in two
 Python threads give the arrays of sequential runs, and the GIL is free while a run
 goes on."""
+import ctypes
 import gc
 import os
 import threading
@@ -14,7 +15,14 @@ from conftest import CUBES, MAPS, assert_bitwise_equal, tiny_scene_dict
 PAGE = os.sysconf("SC_PAGE_SIZE")
 
 
+_LIBC = ctypes.CDLL("libc.so.6")
+
+
 def rss_bytes():
+    """Resident memory, after glibc has given free heap pages back to the system (so
+    that memory freed by earlier tests and reused here is not counted as growth)."""
+    gc.collect()
+    _LIBC.malloc_trim(0)
     with open("/proc/self/statm") as f:
         return int(f.read().split()[1]) * PAGE
 
