@@ -236,6 +236,22 @@ for _name, (_restype, _argtypes) in _PROTOTYPES.items():
     _fn.argtypes = _argtypes
 
 
+class Handle:
+    """A library handle and its destructor, called when the Handle is collected (also
+    at interpreter exit: the destructor is held here, not looked up then). `keep` holds
+    the Python objects whose handles this one borrows, so they outlive it."""
+
+    def __init__(self, ptr, destroy, *keep):
+        self.ptr = ptr
+        self._destroy = destroy
+        self._keep = keep
+
+    def __del__(self):
+        ptr, self.ptr = self.ptr, None
+        if ptr and self._destroy is not None:
+            self._destroy(ptr)
+
+
 def text(value):
     """A C string (bytes or None) as str."""
     return None if value is None else value.decode("utf-8", "replace")

@@ -31,20 +31,6 @@ PhotonStats = collections.namedtuple("PhotonStats",
                                      [f for f, _ in _lib.ThzPhotonStats._fields_])
 
 
-class _Owned:
-    """A library handle and its destructor; `keep` holds what the handle borrows."""
-
-    def __init__(self, ptr, destroy, *keep):
-        self.ptr = ptr
-        self._destroy = destroy
-        self._keep = keep
-
-    def __del__(self):
-        ptr, self.ptr = self.ptr, None
-        if ptr and self._destroy is not None:
-            self._destroy(ptr)
-
-
 class _PlaneBuffer:
     """Exposes one float plane to numpy (read-only) while holding its owner."""
 
@@ -118,7 +104,7 @@ class PhotonMap:
     (keep_photons=True, as Result.photon_map)."""
 
     def __init__(self, owner, ptr, scene):
-        self._owner = owner  # keeps ptr valid: its own _Owned, or the run it belongs to
+        self._owner = owner  # keeps ptr valid: its own Handle, or the run it belongs to
         self._ptr = ptr
         self.scene = scene
 
@@ -171,7 +157,7 @@ def _photons_call(call, fn, scene):
         if out.value:
             _lib.lib.thz_photons_destroy(out.value)
         raise
-    return PhotonMap(_Owned(out.value, _lib.lib.thz_photons_destroy, scene), out.value, scene)
+    return PhotonMap(_lib.Handle(out.value, _lib.lib.thz_photons_destroy, scene), out.value, scene)
 
 
 def fire_photons(scene, integrator=None, photons=None, seed=None, first_photon=0,
@@ -212,6 +198,13 @@ def merge_photon_maps(parts, threads=None):
 
 
 # ---- images -----------------------------------------------------------------------------
+_PLANES = {"radiance": _lib.PLANE_RADIANCE, "radiance_stderr": _lib.PLANE_RADIANCE_STDERR,
+           "power": _lib.PLANE_POWER,
+           "brightness_temperature": _lib.PLANE_BRIGHTNESS_TEMPERATURE,
+           "normalized": _lib.PLANE_NORMALIZED, "temperature": _lib.PLANE_TEMPERATURE,
+           "distance": _lib.PLANE_DISTANCE, "object_id": _lib.PLANE_OBJECT_ID,
+           "visual": _lib.PLANE_VISUAL_RGB}
+
 class Image:
     """One sensor's rendered image. Cubes are numpy float32 arrays shaped (rows, columns,
     channels): radiance (W m^-2 sr^-1 Hz^-1), radiance_stderr (None when not estimated),
@@ -230,9 +223,16 @@ class Image:
         self.n_channels = _lib.lib.thz_image_channel_count(ptr)
 
     def plane(self, plane):
-        """The plane (a _lib.PLANE_* code) as the library lays it out: channel cubes
-        band-sequential (bands, rows, columns), visual (rows, columns, 3), maps (rows,
-        columns); None when absent."""
+        """A plane by its file quantity ("radiance", "object_id", "visual", ...) as the
+        library lays it out: channel cubes band-sequential (bands, rows, columns) like the
+        ENVI files, visual (rows, columns, 3), maps (rows, columns); None when absent."""
+        if isinstance(plane, str):
+            if plane not in _PLANES:
+                raise ArgumentError(f"plane: expected one of {', '.join(_PLANES)}, "
+                                    f"got {plane!r}")
+            plane = _PLANES[plane]
+        elif plane not in _PLANES.values():
+            raise ArgumentError(f"plane: expected a plane name, got {plane!r}")
         n = ctypes.c_size_t()
         p = _lib.lib.thz_image_plane(self._ptr, plane, ctypes.byref(n))
         if not p:
@@ -356,7 +356,7 @@ def _run_call(call, fn, scene, photons=None):
         if out.value:
             _lib.lib.thz_run_destroy(out.value)
         raise
-    return Result(_Owned(out.value, _lib.lib.thz_run_destroy, scene, photons), scene, photons)
+    return Result(_lib.Handle(out.value, _lib.lib.thz_run_destroy, scene, photons), scene, photons)
 
 
 def simulate(scene, integrator=None, photons=None, seed=None, threads=None,
@@ -392,6 +392,9 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
     if photon_map is None and _lib.lib.thz_integrator_needs_photons(effective.encode()):
         raise ArgumentError(f"photon_map: the {effective} integrator renders from a photon "
                             "map; give one (or integrator='path')")
+    if seed is not None and photon_map is not None:
+        raise ArgumentError("seed: a render from a photon map uses the map's seed "
+                            f"({photon_map.seed})")
     index = -1 if sensor is None else scene.sensor_index(sensor)
     s = _settings(scene, integrator, None, seed, target_noise_k, max_seconds)
     ptr = photon_map._ptr if photon_map is not None else None

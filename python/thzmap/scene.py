@@ -46,6 +46,7 @@ class Scene:
     scene_from_dict or scene_from_json; results and photon maps keep it alive."""
 
     def __init__(self, handle, label, seconds_load):
+        self._owned = _lib.Handle(handle, _lib.lib.thz_scene_destroy)
         self._handle = handle
         self.label = label
         self.seconds_load = seconds_load
@@ -70,11 +71,6 @@ class Scene:
             fn(self._handle, i, ctypes.byref(s))
             out.append(record(**_convert(s)))
         return out
-
-    def __del__(self):
-        handle, self._handle = getattr(self, "_handle", None), None
-        if handle:
-            _lib.lib.thz_scene_destroy(handle)
 
     @property
     def name(self):

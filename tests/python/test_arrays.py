@@ -50,7 +50,7 @@ def test_arrays_are_views_of_the_library_buffers(tiny_dir):
     assert not cube.flags.writeable
     assert not cube.flags.owndata and cube.base is not None
     # (rows, columns, channels) is a transposed view of the band-sequential plane.
-    bsq = im.plane(thzmap._lib.PLANE_RADIANCE)
+    bsq = im.plane("radiance")
     assert cube.__array_interface__["data"][0] == bsq.__array_interface__["data"][0]
     assert cube.strides == (20 * 4, 4, 12 * 20 * 4)
     # An array outlives the Result and the Scene it came from.
