@@ -17,7 +17,6 @@ import matplotlib
 
 matplotlib.use("Agg")  # files only, no display
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
 import thzmap  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))

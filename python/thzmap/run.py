@@ -8,7 +8,6 @@ taken from it are gone. A run borrows its scene, so it keeps the Scene alive too
 """
 import collections
 import ctypes
-import functools
 import json
 import math
 import numbers
