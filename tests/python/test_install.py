@@ -40,3 +40,39 @@ def test_installed_package_uses_the_installed_library(tmp_path):
     library, shape = p.stdout.splitlines()
     assert library.startswith(str(prefix) + os.sep), library
     assert shape == "(64, 64, 1)"
+
+
+def _import_in_fresh_python(pythonpath, cwd, library=None):
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("THZMAP_LIBRARY", "PYTHONPATH", "LD_LIBRARY_PATH")}
+    env["PYTHONPATH"] = str(pythonpath)
+    if library is not None:
+        env["THZMAP_LIBRARY"] = library
+    return subprocess.run([sys.executable, "-c", "import thzmap; print(thzmap.library_path)"],
+                          cwd=cwd, env=env, capture_output=True, text=True)
+
+
+def test_from_a_repository_the_package_finds_its_build_tree(tmp_path):
+    """PYTHONPATH=python is all a built repository needs: the package loads
+    build/libthzmap.so of the repository it sits in (a copy of the layout here, with
+    this build's library, so that the test holds whatever the build directory)."""
+    built = os.environ.get("THZMAP_LIBRARY")
+    if not built:
+        pytest.fail("THZMAP_LIBRARY is not set (CTest sets it to the built library)")
+    import shutil
+    from conftest import REPO
+    shutil.copytree(os.path.join(REPO, "python", "thzmap"), tmp_path / "python" / "thzmap",
+                    ignore=shutil.ignore_patterns("__pycache__", "_installed.py"))
+    (tmp_path / "build").mkdir()
+    os.symlink(built, tmp_path / "build" / "libthzmap.so")
+    p = _import_in_fresh_python(tmp_path / "python", cwd="/")
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() == str(tmp_path / "build" / "libthzmap.so")
+
+
+def test_an_explicit_library_that_is_missing_is_an_import_error(tmp_path):
+    from conftest import REPO
+    p = _import_in_fresh_python(os.path.join(REPO, "python"), cwd=tmp_path,
+                                library=str(tmp_path / "nope.so"))
+    assert p.returncode != 0
+    assert "ImportError" in p.stderr and "THZMAP_LIBRARY" in p.stderr
