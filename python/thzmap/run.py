@@ -25,6 +25,9 @@ from .scene import Scene, _path_arg, load_scene
 # figure at a time in the whole process.
 _WRITE_LOCK = threading.Lock()
 
+# The CLI's bound of --photons; the library itself does not bound photons_per_channel.
+MAX_PHOTONS = 10**12
+
 Totals = collections.namedtuple("Totals", [f for f, _ in _lib.ThzRunTotals._fields_])
 PhotonStats = collections.namedtuple("PhotonStats",
                                      [f for f, _ in _lib.ThzPhotonStats._fields_])
@@ -78,7 +81,7 @@ def _settings(scene, integrator=None, photons=None, seed=None, target_noise_k=No
               max_seconds=None, keep_photons=False, first_photon=0):
     s = _lib.ThzRunSettings()
     if photons is not None:
-        s.photons_per_channel = _whole("photons", photons, 1)
+        s.photons_per_channel = _whole("photons", photons, 1, MAX_PHOTONS)
     if seed is not None:
         s.has_seed, s.seed = 1, _whole("seed", seed, 0)
     integrator = _integrator_arg(integrator)
@@ -335,7 +338,7 @@ class Result:
             raise ArgumentError("photon_map: the run did not keep its photons "
                                 "(simulate(..., keep_photons=True))")
         if ply_max_points is not None:
-            opt.ply_max_points = _whole("ply_max_points", ply_max_points, 1)
+            opt.ply_max_points = _whole("ply_max_points", ply_max_points, 1, MAX_PHOTONS)
         with _WRITE_LOCK, Call(None, progress) as call:
             status = _lib.lib.thz_run_write(call.ctx, self._owner.ptr, os.fsencode(outdir),
                                             ctypes.byref(opt), call.err)

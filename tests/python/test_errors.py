@@ -72,7 +72,7 @@ def test_missing_file(tmp_path):
 
 
 @pytest.mark.parametrize("kwargs", [
-    {"photons": 0}, {"photons": -5}, {"photons": 2.5}, {"photons": 1 << 64},
+    {"photons": 0}, {"photons": -5}, {"photons": 2.5}, {"photons": 1 << 64}, {"photons": 10**12 + 1},
     {"seed": -1}, {"seed": "1"}, {"threads": 0}, {"threads": True},
     {"integrator": "magic"}, {"integrator": "path\0"}, {"target_noise_k": math.nan},
     {"target_noise_k": -1}, {"max_seconds": 3}, {"progress": 42},
