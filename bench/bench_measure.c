@@ -156,14 +156,26 @@ thz_status bench_measure_e2e(const char *scene_path, uint64_t photons, int threa
     if (st != THZ_OK)
         return st;
     double t1 = bench_now_s();
-    run_options opt = {.outdir = outdir, .threads = threads, .seconds_load = t1 - t0};
-    run_result res;
-    st = run_simulate(s, &opt, &res, err);
+    /* through the public API, as `thzmap simulate` runs */
+    thz_context *ctx = thz_context_create();
+    thz_run_settings settings = {.seconds_load = t1 - t0};
+    thz_run *run = NULL;
+    if (!ctx)
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    thz_context_set_threads(ctx, threads);
+    if (st == THZ_OK)
+        st = thz_simulate(ctx, s, &settings, &run, err);
+    if (st == THZ_OK)
+        st = thz_run_write(ctx, run, outdir, NULL, err);
     double t2 = bench_now_s();
+    thz_run_totals res;
+    thz_run_get_totals(run, &res);
     out->s_load = t1 - t0;
     out->s_run = t2 - t1;
     out->s_total = t2 - t0;
     out->stored = st == THZ_OK ? res.photons_stored : 0;
+    thz_run_destroy(run);
+    thz_context_destroy(ctx);
     thz_scene_destroy(s);
     return st;
 }

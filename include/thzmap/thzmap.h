@@ -1,8 +1,22 @@
-/* thzmap public API.
+/* thzmap: the public C API of the passive multispectral THz scene simulator.
  *
- * A reentrant library: no globals, every state hangs off a handle. Fallible functions
- * return a thz_status and fill a caller-supplied thz_error (which may be NULL). Long
- * runs report progress through a callback that can also cancel them.
+ * Everything the `thzmap` program does, in memory: a context (threads, progress and
+ * cancellation, warnings), scenes (from a file or a JSON string) with read access,
+ * the photon phase as a handle, rendering into image handles whose planes are float
+ * arrays, whole runs, and writing results to a directory. docs/api.md is the tour.
+ *
+ * Conventions, as in Embree's rtcore_device.h:
+ *   - opaque handles; the function that creates one says so, its _destroy frees it,
+ *     and _destroy(NULL) does nothing;
+ *   - fallible functions return a thz_status and fill a caller-supplied thz_error
+ *     (may be NULL); on failure every out-handle is set to NULL;
+ *   - parameters are borrowed; strings and arrays returned by accessors belong to the
+ *     handle they came from and live as long as it;
+ *   - no globals: handles are independent. A handle may be used from any thread, but
+ *     by one thread at a time, except that a scene is read-only after loading and
+ *     may be shared by concurrent runs;
+ *   - no varargs, plain structs and float/double arrays (for ctypes and cffi).
+ * Units are in the names (scene-format.md): _hz, _thz, _k, _m, _w_per_hz, _s.
  */
 #ifndef THZMAP_THZMAP_H
 #define THZMAP_THZMAP_H
@@ -22,8 +36,10 @@
 extern "C" {
 #endif
 
-/* Status codes. THZ_ERR_INPUT means the user's input (scene, mesh, CSV, options) is
- * wrong; the CLI exits 2 for it and 1 for every other error. */
+/* ---- status and errors ------------------------------------------------------------ */
+
+/* THZ_ERR_INPUT means the user's input (scene, mesh, CSV, options) is wrong; the CLI
+ * exits 2 for it and 1 for every other error. */
 typedef enum thz_status {
     THZ_OK = 0,
     THZ_ERR_INPUT = 2,
@@ -41,7 +57,15 @@ typedef struct thz_error {
     char message[1024];
 } thz_error;
 
-/* Progress of a long run. `stage` is a static string ("photons", "render", ...). */
+/* "0.1.0"; static. */
+THZ_API const char *thz_version(void);
+/* "bad input", "cancelled", ...; static, never NULL. */
+THZ_API const char *thz_status_name(thz_status status);
+
+/* ---- context ---------------------------------------------------------------------- */
+
+/* Progress of a long run. `stage` is a static string: "photons" (done/total in photons
+ * of the channel), "render" (rows of a sensor), "output" (0/1, then 1/1). */
 typedef struct thz_progress {
     const char *stage;
     size_t channel; /* index of the channel being processed */
@@ -50,21 +74,39 @@ typedef struct thz_progress {
     uint64_t total; /* units of work in this stage and channel */
 } thz_progress;
 
-/* Called from the thread that started the run, never from worker threads. Return
+/* Called on the thread that started the run, never from worker threads. Return
  * non-zero to cancel: the run then stops soon and returns THZ_ERR_CANCELLED. */
 typedef int (*thz_progress_fn)(void *user, const thz_progress *progress);
 
-typedef struct thz_scene thz_scene;
+/* A run warning (one line, no newline), on the thread that started the run; the text
+ * is valid during the call only. Run warnings also go into summary.json. */
+typedef void (*thz_warning_fn)(void *user, const char *message);
 
-THZ_API const char *thz_version(void);
-THZ_API const char *thz_status_name(thz_status status);
+/* What a run is done with: threads, callbacks. Cheap; one per thread of the caller. */
+typedef struct thz_context thz_context;
 
-/* Loads and validates a scene file (format thzmap-scene/1). On success *out owns the
- * scene; destroy it with thz_scene_destroy. */
-THZ_API thz_status thz_scene_load(const char *path, thz_scene **out, thz_error *err);
-THZ_API void thz_scene_destroy(thz_scene *scene);
+/* Creates a context (all cores, no callbacks). NULL only when out of memory. */
+THZ_API thz_context *thz_context_create(void);
+THZ_API void thz_context_destroy(thz_context *ctx);
+/* OpenMP threads of the runs started with ctx; 0 (the default) means all cores. Runs
+ * give bit-identical results for any thread count. */
+THZ_API void thz_context_set_threads(thz_context *ctx, int threads);
+THZ_API int thz_context_threads(const thz_context *ctx);
+/* The progress callback (NULL: none); `user` is passed back to it. */
+THZ_API void thz_context_set_progress(thz_context *ctx, thz_progress_fn fn, void *user);
+/* The warning callback (NULL: none; the library never prints). */
+THZ_API void thz_context_set_warning(thz_context *ctx, thz_warning_fn fn, void *user);
+/* The status and message of the last failed call that took ctx (THZ_OK and "" if
+ * none); the message is valid until the next call with ctx. */
+THZ_API thz_status thz_context_last_status(const thz_context *ctx);
+THZ_API const char *thz_context_last_message(const thz_context *ctx);
 
 #ifdef __cplusplus
 }
 #endif
+
+#include "thzmap/scene.h"
+#include "thzmap/run.h"
+#include "thzmap/atmosphere.h"
+
 #endif

@@ -23,6 +23,9 @@ int cli_fail(const thz_error *err);
 int cli_usage_error(const char *command, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 
+/* Monotonic wall-clock time in s (for progress rates and the closing line). */
+double cli_now_s(void);
+
 /* True if arg is -h or --help. */
 bool cli_is_help(const char *arg);
 

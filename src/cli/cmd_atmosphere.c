@@ -7,11 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "atmosphere/atmosphere.h"
-#include "cli/cli.h"
-#include "core/alloc.h"
-#include "io/plot.h"
-#include "scene/scene.h"
+#include "cli.h"
+#include "thzmap/thzmap.h"
 
 #define CMD "atmosphere"
 #define MAX_POINTS 10000000.0
@@ -19,7 +16,7 @@
 /* alpha in 1/m as dB/km. */
 static double db_per_km(double alpha_per_m)
 {
-    return alpha_per_m * (ATM_NEPER_TO_DB * 1e3);
+    return alpha_per_m * (THZ_NEPER_TO_DB * 1e3);
 }
 
 static void print_help(void)
@@ -60,7 +57,7 @@ typedef struct options {
     const char *model;
     const char *compare_model;
     double temperature_k, pressure_hpa;
-    atm_humidity_kind humidity_kind;
+    thz_humidity_kind humidity_kind;
     double humidity;
     int n_humidity;
     bool air_given;
@@ -77,7 +74,7 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
     memset(o, 0, sizeof *o);
     o->temperature_k = 288.15;
     o->pressure_hpa = 1013.25;
-    o->humidity_kind = ATM_HUMIDITY_DENSITY_G_M3;
+    o->humidity_kind = THZ_HUMIDITY_DENSITY_G_M3;
     o->humidity = 7.5;
     *help = false;
     for (int i = 1; i < argc; i++) {
@@ -122,21 +119,21 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
         } else if (strcmp(a, "--compare-model") == 0) {
             o->compare_model = v;
         } else if (strcmp(a, "--temperature-k") == 0) {
-            if (!cli_parse_double(CMD, a, v, ATM_AIR_MIN_TEMPERATURE_K, ATM_AIR_MAX_TEMPERATURE_K,
+            if (!cli_parse_double(CMD, a, v, THZ_AIR_MIN_TEMPERATURE_K, THZ_AIR_MAX_TEMPERATURE_K,
                                   &o->temperature_k))
                 return CLI_EXIT_USAGE;
             o->air_given = true;
         } else if (strcmp(a, "--pressure-hpa") == 0) {
-            if (!cli_parse_double(CMD, a, v, 0.0, ATM_AIR_MAX_PRESSURE_HPA, &o->pressure_hpa))
+            if (!cli_parse_double(CMD, a, v, 0.0, THZ_AIR_MAX_PRESSURE_HPA, &o->pressure_hpa))
                 return CLI_EXIT_USAGE;
             o->air_given = true;
         } else if (strcmp(a, "--relative-humidity") == 0 || strcmp(a, "--water-vapour-g-m3") == 0 ||
                    strcmp(a, "--h2o-vmr") == 0) {
             if (!cli_parse_double(CMD, a, v, 0.0, 1e6, &o->humidity))
                 return CLI_EXIT_USAGE;
-            o->humidity_kind = a[2] == 'r'   ? ATM_HUMIDITY_RELATIVE
-                               : a[2] == 'w' ? ATM_HUMIDITY_DENSITY_G_M3
-                                             : ATM_HUMIDITY_VMR;
+            o->humidity_kind = a[2] == 'r'   ? THZ_HUMIDITY_RELATIVE
+                               : a[2] == 'w' ? THZ_HUMIDITY_DENSITY_G_M3
+                                             : THZ_HUMIDITY_VMR;
             o->n_humidity++;
             o->air_given = true;
         } else if (strcmp(a, "--h2o-lines") == 0) {
@@ -170,56 +167,53 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
     return CLI_EXIT_OK;
 }
 
-static const char *humidity_option(atm_humidity_kind kind)
+static const char *humidity_option(thz_humidity_kind kind)
 {
     switch (kind) {
-    case ATM_HUMIDITY_RELATIVE:
+    case THZ_HUMIDITY_RELATIVE:
         return "--relative-humidity";
-    case ATM_HUMIDITY_VMR:
+    case THZ_HUMIDITY_VMR:
         return "--h2o-vmr";
-    case ATM_HUMIDITY_NONE:
-    case ATM_HUMIDITY_DENSITY_G_M3:
+    case THZ_HUMIDITY_DRY:
+    case THZ_HUMIDITY_DENSITY_G_M3:
         break;
     }
     return "--water-vapour-g-m3";
 }
 
-/* Builds the atmosphere `name` from the options (catalogues) in the air `air`, or
- * with air == NULL in the air of the options (their values are then named in an
+/* Builds the atmosphere `name` from the options (catalogues) in the air of `air_from`
+ * when it has one, or else in the air of the options (their values are then named in an
  * error about the air). */
-static thz_status build_model(const options *o, const char *name, const atm_air_state *air,
-                              thz_atmosphere *atm, thz_error *err)
+static thz_status build_model(const options *o, const char *name, const thz_atm *air_from,
+                              thz_atm **out, thz_error *err)
 {
-    atm_model model;
-    memset(atm, 0, sizeof *atm);
-    if (!atmosphere_model_from_name(name, &model) ||
-        (model != ATM_LINES && model != ATM_ITU_P676 && model != ATM_NONE))
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "atmosphere: unknown model '%s' (expected lines, itu-p676 or none; "
-                             "constant and table come from a scene)",
-                             name);
-    if (model == ATM_NONE)
-        return THZ_OK;
-    atm_air_state own_air;
-    if (!air) {
-        thz_status st = atm_air_state_init(&own_air, o->temperature_k, o->pressure_hpa,
-                                           o->humidity_kind, o->humidity, err);
-        if (st != THZ_OK) {
-            thz_error_prefix(err,
-                             "--temperature-k %g, --pressure-hpa %g, %s %g: ", o->temperature_k,
-                             o->pressure_hpa, humidity_option(o->humidity_kind), o->humidity);
-            return st;
-        }
-        air = &own_air;
+    thz_atm_options ao;
+    thz_atm_options_init(&ao);
+    ao.model = name;
+    ao.temperature_k = o->temperature_k;
+    ao.pressure_hpa = o->pressure_hpa;
+    ao.humidity_kind = o->humidity_kind;
+    ao.humidity = o->humidity;
+    ao.h2o_lines_file = o->h2o_lines;
+    ao.o2_lines_file = o->o2_lines;
+    ao.no_continuum = o->no_continuum;
+    thz_atm_info from = {0};
+    if (air_from)
+        thz_atm_get_info(air_from, &from);
+    bool needs_air = strcmp(name, "lines") == 0 || strcmp(name, "itu-p676") == 0;
+    if (needs_air && !from.has_air && thz_atm_check_air(&ao, err) != THZ_OK) {
+        char message[sizeof err->message];
+        int n = snprintf(message, sizeof message,
+                         "--temperature-k %g, --pressure-hpa %g, %s %g: ", o->temperature_k,
+                         o->pressure_hpa, humidity_option(o->humidity_kind), o->humidity);
+        size_t used = n > 0 && (size_t)n < sizeof message ? (size_t)n : 0;
+        size_t rest = strnlen(err->message, sizeof message - 1 - used);
+        memcpy(message + used, err->message, rest); /* as thz_error_prefix cuts */
+        message[used + rest] = '\0';
+        memcpy(err->message, message, sizeof message);
+        return err->status;
     }
-    if (model == ATM_ITU_P676)
-        return atmosphere_init_itu_p676(atm, air, NULL, err);
-    atm_lines_options lo;
-    atmosphere_lines_options_default(&lo);
-    lo.h2o_lines_file = o->h2o_lines;
-    lo.o2_lines_file = o->o2_lines;
-    lo.continuum = !o->no_continuum;
-    return atmosphere_init_lines(atm, air, &lo, err);
+    return thz_atm_create(&ao, air_from, out, err);
 }
 
 typedef struct series {
@@ -239,63 +233,9 @@ static void series_fini(series *s)
     free(s->compare_db);
 }
 
-/* The figure: the parts and the total of atm (and the comparison's total) in dB/km
- * on a log axis against THz, the scene's channels (centre and FWHM) shaded. */
-static thz_status draw_plot(const options *o, const series *s, const thz_atmosphere *atm,
-                            const thz_atmosphere *compare, const thz_scene *scene,
-                            const char *model_name, thz_error *err)
+static double *series_array(size_t n)
 {
-    plot_curve curves[6];
-    size_t n = 0;
-    if (atm->model == ATM_LINES || atm->model == ATM_ITU_P676) {
-        curves[n++] = (plot_curve){atm->model == ATM_LINES ? "H#d2#uO lines" : "H#d2#uO",
-                                   s->h2o_lines_db,
-                                   {31, 119, 180},
-                                   1.0,
-                                   false};
-        if (atm->model == ATM_LINES)
-            curves[n++] = (plot_curve){
-                "H#d2#uO continuum (MT_CKD)", s->h2o_cont_db, {44, 160, 44}, 1.0, false};
-        curves[n++] = (plot_curve){"O#d2#u", s->o2_db, {214, 39, 40}, 1.0, false};
-        curves[n++] = (plot_curve){"dry-air continuum", s->dry_db, {148, 103, 189}, 1.0, false};
-    }
-    char total_text[96], compare_text[96];
-    snprintf(total_text, sizeof total_text, "total, %s", model_name);
-    curves[n++] = (plot_curve){total_text, s->total_db, {0, 0, 0}, 2.0, false};
-    if (s->compare_db) {
-        snprintf(compare_text, sizeof compare_text, "total, %s", o->compare_model);
-        curves[n++] = (plot_curve){compare_text, s->compare_db, {255, 127, 14}, 2.0, true};
-    }
-
-    size_t n_bands = scene ? scene->n_channels : 0;
-    plot_band *bands = thz_calloc(n_bands ? n_bands : 1, sizeof *bands);
-    if (!bands)
-        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-    for (size_t c = 0; c < n_bands; c++) {
-        const thz_channel *ch = &scene->channels[c];
-        double fc = ch->center_hz * 1e-12, half = 0.5 * ch->relative_width * fc;
-        bands[c] = (plot_band){ch->name, fc - half, fc, fc + half};
-    }
-
-    /* The air in the title: the model's, or else the comparison's. */
-    char title[256];
-    const thz_atmosphere *with_air = atm->has_air ? atm : compare->has_air ? compare : NULL;
-    const atm_air_state *air = with_air ? &with_air->air : NULL;
-    if (with_air == atm)
-        snprintf(title, sizeof title,
-                 "atmosphere '%s': %.2f K, %.1f hPa, water vapour %.2f g/m\u00b3", model_name,
-                 air->temperature_k, air->pressure_hpa, atm_air_h2o_density_g_m3(air));
-    else if (with_air)
-        snprintf(title, sizeof title,
-                 "atmosphere '%s'; %s air: %.2f K, %.1f hPa, %.2f g/m\u00b3 vapour", model_name,
-                 o->compare_model, air->temperature_k, air->pressure_hpa,
-                 atm_air_h2o_density_g_m3(air));
-    else
-        snprintf(title, sizeof title, "atmosphere '%s'", model_name);
-    thz_status st = plot_attenuation(o->plot, s->n, s->f_thz, n, curves, n_bands, bands, title,
-                                     "frequency (THz)", "attenuation (dB/km)", err);
-    free(bands);
-    return st;
+    return n <= SIZE_MAX / sizeof(double) ? malloc(n * sizeof(double)) : NULL;
 }
 
 int cmd_atmosphere(int argc, char **argv)
@@ -310,12 +250,11 @@ int cmd_atmosphere(int argc, char **argv)
     }
     thz_error err = {0};
     thz_scene *scene = NULL;
-    thz_atmosphere own = {0}, compare = {0};
-    const thz_atmosphere *atm = &own;
+    thz_atm *atm = NULL, *compare = NULL;
     const char *model_name = o.model ? o.model : "lines";
     series s = {0};
     FILE *out = stdout;
-    if (o.scene && scene_load(o.scene, &scene, &err) != THZ_OK) {
+    if (o.scene && thz_scene_load(o.scene, &scene, &err) != THZ_OK) {
         rc = cli_fail(&err);
         goto cleanup;
     }
@@ -330,23 +269,24 @@ int cmd_atmosphere(int argc, char **argv)
                                         : "");
         goto cleanup;
     }
-    if (from_scene) {
-        atm = &scene->atmosphere;
-        model_name = atmosphere_model_name(atm->model);
-    } else if (build_model(&o, model_name, NULL, &own, &err) != THZ_OK) {
+    if (from_scene ? thz_atm_from_scene(scene, &atm, &err) != THZ_OK
+                   : build_model(&o, model_name, NULL, &atm, &err) != THZ_OK) {
         rc = cli_fail(&err);
         goto cleanup;
     }
+    thz_atm_info info;
+    thz_atm_get_info(atm, &info);
+    if (from_scene)
+        model_name = info.model;
     /* The comparison is computed in the same air: the scene's when that is used. */
-    if (o.compare_model && build_model(&o, o.compare_model, atm->has_air ? &atm->air : NULL,
-                                       &compare, &err) != THZ_OK) {
+    if (o.compare_model && build_model(&o, o.compare_model, atm, &compare, &err) != THZ_OK) {
         rc = cli_fail(&err);
         goto cleanup;
     }
     double lo_hz = o.from_thz * 1e12, hi_hz = o.to_thz * 1e12;
-    if (atmosphere_check_range(atm, lo_hz, hi_hz, "--from-thz/--to-thz", &err) != THZ_OK ||
+    if (thz_atm_check_range(atm, lo_hz, hi_hz, "--from-thz/--to-thz", &err) != THZ_OK ||
         (o.compare_model &&
-         atmosphere_check_range(&compare, lo_hz, hi_hz, "--from-thz/--to-thz", &err) != THZ_OK)) {
+         thz_atm_check_range(compare, lo_hz, hi_hz, "--from-thz/--to-thz", &err) != THZ_OK)) {
         rc = cli_fail(&err);
         goto cleanup;
     }
@@ -354,14 +294,15 @@ int cmd_atmosphere(int argc, char **argv)
     /* The figure's device and file are checked before the work: a missing device or
      * an unwritable path fails at once, with nothing printed. */
     if (o.plot) {
-        if (plot_check_device(&err) != THZ_OK) {
+        if (thz_plot_check(&err) != THZ_OK) {
             rc = cli_fail(&err);
             goto cleanup;
         }
         FILE *f = fopen(o.plot, "wb");
         if (!f) {
-            thz_error_set(&err, THZ_ERR_INPUT, "--plot %s: cannot create: %s", o.plot,
-                          strerror(errno));
+            err.status = THZ_ERR_INPUT;
+            snprintf(err.message, sizeof err.message, "--plot %s: cannot create: %s", o.plot,
+                     strerror(errno));
             rc = cli_fail(&err);
             goto cleanup;
         }
@@ -372,14 +313,14 @@ int cmd_atmosphere(int argc, char **argv)
     size_t n = (size_t)floor((o.to_thz - o.from_thz) / step_thz * (1.0 + 1e-12)) + 1;
     bool add_end = o.from_thz + (double)(n - 1) * step_thz < o.to_thz * (1.0 - 1e-12);
     s.n = n + (add_end ? 1 : 0);
-    s.f_thz = thz_malloc_array(s.n, sizeof *s.f_thz);
-    s.total_db = thz_malloc_array(s.n, sizeof *s.total_db);
-    s.h2o_lines_db = thz_malloc_array(s.n, sizeof *s.h2o_lines_db);
-    s.h2o_cont_db = thz_malloc_array(s.n, sizeof *s.h2o_cont_db);
-    s.o2_db = thz_malloc_array(s.n, sizeof *s.o2_db);
-    s.dry_db = thz_malloc_array(s.n, sizeof *s.dry_db);
+    s.f_thz = series_array(s.n);
+    s.total_db = series_array(s.n);
+    s.h2o_lines_db = series_array(s.n);
+    s.h2o_cont_db = series_array(s.n);
+    s.o2_db = series_array(s.n);
+    s.dry_db = series_array(s.n);
     if (o.compare_model)
-        s.compare_db = thz_malloc_array(s.n, sizeof *s.compare_db);
+        s.compare_db = series_array(s.n);
     if (!s.f_thz || !s.total_db || !s.h2o_lines_db || !s.h2o_cont_db || !s.o2_db || !s.dry_db ||
         (o.compare_model && !s.compare_db)) {
         fprintf(stderr, "thzmap atmosphere: out of memory\n");
@@ -387,20 +328,20 @@ int cmd_atmosphere(int argc, char **argv)
         goto cleanup;
     }
 
-    if (atm->has_air)
+    if (info.has_air)
         fprintf(out,
                 "# thzmap atmosphere: model %s; air %.2f K, %.2f hPa total, water vapour %.4g hPa "
                 "(%.4g g/m^3, volume mixing ratio %.4g)\n",
-                model_name, atm->air.temperature_k, atm->air.pressure_hpa,
-                atm->air.h2o_pressure_hpa, atm_air_h2o_density_g_m3(&atm->air),
-                atm_air_h2o_vmr(&atm->air));
+                model_name, info.temperature_k, info.pressure_hpa, info.h2o_pressure_hpa,
+                info.h2o_density_g_m3, info.h2o_vmr);
     else
         fprintf(out, "# thzmap atmosphere: model %s\n", model_name);
     fprintf(out, "frequency_thz,attenuation_per_m,attenuation_db_per_km");
-    if (atm->model == ATM_LINES)
+    bool lines = strcmp(info.model, "lines") == 0, itu = strcmp(info.model, "itu-p676") == 0;
+    if (lines)
         fprintf(out, ",h2o_lines_db_per_km,h2o_continuum_db_per_km,o2_db_per_km,"
                      "dry_continuum_db_per_km");
-    else if (atm->model == ATM_ITU_P676)
+    else if (itu)
         fprintf(out, ",h2o_db_per_km,o2_db_per_km,dry_continuum_db_per_km");
     if (o.have_distance)
         fprintf(out, ",transmittance");
@@ -409,9 +350,9 @@ int cmd_atmosphere(int argc, char **argv)
     for (size_t i = 0; i < s.n; i++) {
         double f_thz = i < n ? o.from_thz + (double)i * step_thz : o.to_thz;
         double f_hz = f_thz * 1e12;
-        atm_alpha_parts p;
-        atmosphere_alpha_parts(atm, f_hz, &p);
-        double alpha = atmosphere_alpha_parts_sum(&p);
+        thz_atm_attenuation p;
+        thz_atm_attenuation_parts(atm, f_hz, &p);
+        double alpha = p.total_per_m;
         s.f_thz[i] = f_thz;
         s.total_db[i] = db_per_km(alpha);
         s.h2o_lines_db[i] = db_per_km(p.h2o_lines_per_m);
@@ -419,12 +360,12 @@ int cmd_atmosphere(int argc, char **argv)
         s.o2_db[i] = db_per_km(p.o2_per_m);
         s.dry_db[i] = db_per_km(p.dry_continuum_per_m);
         if (s.compare_db)
-            s.compare_db[i] = db_per_km(atmosphere_alpha_direct_per_m(&compare, f_hz));
+            s.compare_db[i] = db_per_km(thz_atm_attenuation_per_m(compare, f_hz));
         fprintf(out, "%.9g,%.6e,%.6e", f_thz, alpha, s.total_db[i]);
-        if (atm->model == ATM_LINES)
+        if (lines)
             fprintf(out, ",%.6e,%.6e,%.6e,%.6e", s.h2o_lines_db[i], s.h2o_cont_db[i], s.o2_db[i],
                     s.dry_db[i]);
-        else if (atm->model == ATM_ITU_P676)
+        else if (itu)
             fprintf(out, ",%.6e,%.6e,%.6e", s.h2o_lines_db[i], s.o2_db[i], s.dry_db[i]);
         if (o.have_distance)
             fprintf(out, ",%.6e", exp(-alpha * o.distance_m));
@@ -435,12 +376,28 @@ int cmd_atmosphere(int argc, char **argv)
         rc = CLI_EXIT_FAILURE;
         goto cleanup;
     }
-    if (o.plot && draw_plot(&o, &s, atm, &compare, scene, model_name, &err) != THZ_OK)
-        rc = cli_fail(&err);
+    if (o.plot) {
+        thz_atm_plot plot = {.path = o.plot,
+                             .atm = atm,
+                             .model_name = model_name,
+                             .compare = compare,
+                             .compare_name = o.compare_model,
+                             .scene = scene,
+                             .n = s.n,
+                             .f_thz = s.f_thz,
+                             .total_db = s.total_db,
+                             .h2o_lines_db = s.h2o_lines_db,
+                             .h2o_continuum_db = s.h2o_cont_db,
+                             .o2_db = s.o2_db,
+                             .dry_db = s.dry_db,
+                             .compare_db = s.compare_db};
+        if (thz_atm_draw_plot(&plot, &err) != THZ_OK)
+            rc = cli_fail(&err);
+    }
 cleanup:
     series_fini(&s);
-    atmosphere_fini(&own);
-    atmosphere_fini(&compare);
-    scene_destroy(scene);
+    thz_atm_destroy(atm);
+    thz_atm_destroy(compare);
+    thz_scene_destroy(scene);
     return rc;
 }

@@ -1,6 +1,6 @@
 /* thzmap render SCENE.json --photon-map FILE -o OUTDIR: re-render from a saved map. */
-#include "cli/cli.h"
-#include "cli/run_command.h"
+#include "cli.h"
+#include "run_command.h"
 
 int cmd_render(int argc, char **argv)
 {

@@ -1,6 +1,6 @@
 /* thzmap simulate SCENE.json -o OUTDIR: fire photons and render every sensor. */
-#include "cli/cli.h"
-#include "cli/run_command.h"
+#include "cli.h"
+#include "run_command.h"
 
 int cmd_simulate(int argc, char **argv)
 {

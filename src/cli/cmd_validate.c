@@ -4,12 +4,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "atmosphere/atmosphere.h"
-#include "cli/cli.h"
-#include "physics/channel.h"
-#include "run/run.h"
-#include "scene/scene.h"
-#include "sensor/render.h"
+#include "cli.h"
+#include "thzmap/thzmap.h"
 
 static void validate_usage(FILE *f)
 {
@@ -24,86 +20,87 @@ static void validate_usage(FILE *f)
                "  -h, --help   show this help\n");
 }
 
-/* "0.05", or "table of 3 points, 0.2 to 1.2 THz, 0.05 to 0.12". */
-static void validate_describe_spectrum(char *out, size_t n, const thz_spectrum *sp)
+/* "0.05", or "table (3 points, 0.2 to 1.2 THz; 0.05 to 0.12)". */
+static void validate_describe_spectrum(char *out, size_t n, const thz_spectrum_info *sp)
 {
-    if (sp->n == 0) {
+    if (sp->kind == THZ_SPECTRUM_ABSENT)
         snprintf(out, n, "-");
-        return;
-    }
-    if (!sp->freq_hz) {
-        snprintf(out, n, "%g", sp->value[0]);
-        return;
-    }
-    double lo, hi;
-    spectrum_range(sp, &lo, &hi);
-    snprintf(out, n, "table (%zu points, %g to %g THz; %g to %g)", sp->n, sp->freq_hz[0] * 1e-12,
-             sp->freq_hz[sp->n - 1] * 1e-12, lo, hi);
+    else if (sp->kind == THZ_SPECTRUM_CONSTANT)
+        snprintf(out, n, "%g", sp->value);
+    else
+        snprintf(out, n, "table (%zu points, %g to %g THz; %g to %g)", sp->n_points, sp->from_thz,
+                 sp->to_thz, sp->min_value, sp->max_value);
 }
 
 static void validate_print(const thz_scene *s)
 {
-    printf("scene \"%s\" (%s): valid\n", s->name, s->path);
-    printf("\nchannels: %zu\n", s->n_channels);
-    for (size_t c = 0; c < s->n_channels; c++) {
-        const thz_channel *ch = &s->channels[c];
-        printf("  [%zu] %-16s centre %.4f THz  FWHM %.3f GHz  bandwidth B_c %.3f GHz\n", c,
-               ch->name, ch->center_hz * 1e-12, ch->relative_width * ch->center_hz * 1e-9,
-               channel_bandwidth_hz(ch) * 1e-9);
+    thz_scene_info si;
+    thz_scene_get_info(s, &si);
+    printf("scene \"%s\" (%s): valid\n", si.name, si.path);
+    printf("\nchannels: %zu\n", si.n_channels);
+    for (size_t c = 0; c < si.n_channels; c++) {
+        thz_channel_info ch;
+        thz_scene_channel(s, c, &ch);
+        printf("  [%zu] %-16s centre %.4f THz  FWHM %.3f GHz  bandwidth B_c %.3f GHz\n", c, ch.name,
+               ch.frequency_hz * 1e-12, ch.relative_width * ch.frequency_hz * 1e-9,
+               ch.bandwidth_hz * 1e-9);
     }
-    printf("\nmaterials: %zu\n", s->n_materials);
-    for (size_t m = 0; m < s->n_materials; m++) {
-        const thz_material *mat = &s->materials[m];
+    printf("\nmaterials: %zu\n", si.n_materials);
+    for (size_t m = 0; m < si.n_materials; m++) {
+        thz_material_info mat;
+        thz_scene_material(s, m, &mat);
         char r[160], a[160], e[160];
-        validate_describe_spectrum(r, sizeof r, &mat->reflectivity);
-        validate_describe_spectrum(a, sizeof a, &mat->attenuation_per_m);
-        if (mat->emissivity.n == 0)
+        validate_describe_spectrum(r, sizeof r, &mat.reflectivity);
+        validate_describe_spectrum(a, sizeof a, &mat.attenuation_per_m);
+        if (mat.emissivity.kind == THZ_SPECTRUM_ABSENT)
             snprintf(e, sizeof e, "Kirchhoff");
         else
-            validate_describe_spectrum(e, sizeof e, &mat->emissivity);
+            validate_describe_spectrum(e, sizeof e, &mat.emissivity);
         printf("  %s: reflectivity %s; attenuation %s 1/m; emissivity %s; transmission %s\n",
-               mat->name, r, a, e,
-               mat->transmission == TRANSMISSION_STRAIGHT ? "straight" : "diffuse");
+               mat.name, r, a, e, mat.transmission);
     }
-    printf("\natmosphere: %s\n", atmosphere_model_name(s->atmosphere.model));
-    printf("\nobjects: %zu\n", s->n_objects);
+    printf("\natmosphere: %s\n", si.atmosphere_model);
+    printf("\nobjects: %zu\n", si.n_objects);
     double total_area = 0.0;
     size_t total_triangles = 0;
-    for (size_t i = 0; i < s->n_objects; i++) {
-        const thz_object *o = &s->objects[i];
-        total_area += o->mesh.total_area_m2;
-        total_triangles += o->mesh.n_triangles;
+    for (size_t i = 0; i < si.n_objects; i++) {
+        thz_object_info o;
+        thz_scene_object(s, i, &o);
+        total_area += o.area_m2;
+        total_triangles += o.triangles;
         char kind[64];
-        if (o->type == OBJECT_SHELL)
-            snprintf(kind, sizeof kind, "shell %g mm", o->thickness_m * 1e3);
+        if (strcmp(o.type, "shell") == 0)
+            snprintf(kind, sizeof kind, "shell %g mm", o.thickness_m * 1e3);
         else
-            snprintf(kind, sizeof kind, "%s", o->two_sided ? "solid two-sided" : "solid");
+            snprintf(kind, sizeof kind, "%s", o.two_sided ? "solid two-sided" : "solid");
         printf("  [%zu] %s: %s, material %s, %zu triangles, area %.6g m², temperature %.2f K, "
                "bounds [%.4g, %.4g, %.4g] to [%.4g, %.4g, %.4g] m\n",
-               i, o->name, kind, s->materials[o->material].name, o->mesh.n_triangles,
-               o->mesh.total_area_m2, o->temperature_k, o->mesh.bbox_min_m[0],
-               o->mesh.bbox_min_m[1], o->mesh.bbox_min_m[2], o->mesh.bbox_max_m[0],
-               o->mesh.bbox_max_m[1], o->mesh.bbox_max_m[2]);
+               i, o.name, kind, o.material_name, o.triangles, o.area_m2, o.temperature_k,
+               o.bbox_min_m[0], o.bbox_min_m[1], o.bbox_min_m[2], o.bbox_max_m[0], o.bbox_max_m[1],
+               o.bbox_max_m[2]);
     }
     printf("  total: %zu triangles, area %.6g m²\n", total_triangles, total_area);
-    printf("\nsensors: %zu\n", s->n_sensors);
-    for (size_t i = 0; i < s->n_sensors; i++) {
-        const thz_sensor *sn = &s->sensors[i];
+    printf("\nsensors: %zu\n", si.n_sensors);
+    for (size_t i = 0; i < si.n_sensors; i++) {
+        thz_sensor_info sn;
+        thz_scene_sensor(s, i, &sn);
         printf("  [%zu] %s: %u x %u pixels, fov %g deg, oversampling %u x %u, aperture %g m², "
                "at [%g, %g, %g] m looking along [%.4f, %.4f, %.4f], T_ref %g K\n",
-               i, sn->name, sn->columns, sn->rows, sn->fov_deg, sn->oversampling, sn->oversampling,
-               sn->aperture_m2, sn->position_m[0], sn->position_m[1], sn->position_m[2],
-               sn->direction[0], sn->direction[1], sn->direction[2], sn->normalize_to_k);
+               i, sn.name, sn.columns, sn.rows, sn.fov_deg, sn.oversampling, sn.oversampling,
+               sn.aperture_m2, sn.position_m[0], sn.position_m[1], sn.position_m[2],
+               sn.direction[0], sn.direction[1], sn.direction[2], sn.normalize_to_k);
     }
     printf("\nphotons: %llu per channel, seed %llu, min_relative_power %g, gather_min_photons %u\n",
-           (unsigned long long)s->photons.per_channel, (unsigned long long)s->photons.seed,
-           s->photons.min_relative_power, s->photons.gather_min_photons);
-    printf("render: integrator %s, gather_rays %u, paths_per_sample %u\n",
-           render_integrator_name(s->render.integrator), s->render.gather_rays,
-           s->render.paths_per_sample);
+           (unsigned long long)si.photons_per_channel, (unsigned long long)si.seed,
+           si.min_relative_power, si.gather_min_photons);
+    printf("render: integrator %s, gather_rays %u, paths_per_sample %u\n", si.integrator,
+           si.gather_rays, si.paths_per_sample);
     printf("\nemitted spectral power P_A (band mean):\n");
-    for (size_t c = 0; c < s->n_channels; c++)
-        printf("  %-16s %.6e W/Hz\n", s->channels[c].name, scene_band_emitted_power_w_per_hz(s, c));
+    for (size_t c = 0; c < si.n_channels; c++) {
+        thz_channel_info ch;
+        thz_scene_channel(s, c, &ch);
+        printf("  %-16s %.6e W/Hz\n", ch.name, ch.emitted_power_w_per_hz);
+    }
 }
 
 int cmd_validate(int argc, char **argv)
@@ -127,14 +124,10 @@ int cmd_validate(int argc, char **argv)
     thz_error err = {0};
     if (thz_scene_load(path, &scene, &err) != THZ_OK)
         return cli_fail(&err);
-    if (run_check_scene_memory(scene, &err) != THZ_OK) {
-        thz_scene_destroy(scene);
-        return cli_fail(&err);
-    }
     validate_print(scene);
     fflush(stdout);
-    for (size_t i = 0; i < scene->n_warnings; i++)
-        fprintf(stderr, "warning: %s\n", scene->warnings[i]);
+    for (size_t i = 0; i < thz_scene_warning_count(scene); i++)
+        fprintf(stderr, "warning: %s\n", thz_scene_warning(scene, i));
     thz_scene_destroy(scene);
     return CLI_EXIT_OK;
 }

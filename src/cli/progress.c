@@ -1,12 +1,12 @@
 /* Progress display and interrupt handling for the long-running commands. */
-#include "cli/progress.h"
+#include "progress.h"
 
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "core/clock.h"
+#include "cli.h"
 
 /* The one piece of process-wide state in thzmap: a signal handler can reach nothing
  * else. Written only by the handler, read by the progress callback. */
@@ -36,7 +36,7 @@ void cli_progress_init(cli_progress *p, const char *command, bool quiet)
     p->command = command;
     p->quiet = quiet;
     p->tty = isatty(fileno(stderr)) != 0;
-    p->last_report_s = thz_now_s();
+    p->last_report_s = cli_now_s();
 }
 
 /* The unit a stage counts in. */
@@ -99,7 +99,7 @@ int cli_progress_report(void *user, const thz_progress *pr)
         return 1;
     if (p->quiet)
         return 0;
-    double now = thz_now_s();
+    double now = cli_now_s();
     double previous = p->last_report_s;
     p->last_report_s = now;
     bool new_stage = !p->stage || strcmp(p->stage, pr->stage) != 0 || p->channel != pr->channel ||
@@ -145,12 +145,12 @@ void cli_progress_warning(void *user, const char *message)
     fflush(p->out);
 }
 
-void cli_progress_plan(void *user, const run_plan *plan)
+void cli_progress_plan(void *user, const thz_run_plan *plan)
 {
     cli_progress *p = user;
     double total = plan->seconds_photons + plan->seconds_render;
     p->estimate_s = total;
-    p->run_start_s = thz_now_s();
+    p->run_start_s = cli_now_s();
     if (p->quiet)
         return;
     char target[160] = "";

@@ -13,7 +13,6 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "run/run.h"
 #include "thzmap/thzmap.h"
 
 typedef struct cli_progress {
@@ -46,7 +45,7 @@ void cli_progress_warning(void *user, const char *message);
 
 /* The run's plan callback: prints the estimate of time and memory before the run
  * (not with --quiet) and keeps it for the whole-run ETA. */
-void cli_progress_plan(void *user, const run_plan *plan);
+void cli_progress_plan(void *user, const thz_run_plan *plan);
 
 /* Ends the terminal line, if one is open. */
 void cli_progress_finish(cli_progress *p);

@@ -1,5 +1,5 @@
 /* simulate and render: options, scene, run, report. */
-#include "cli/run_command.h"
+#include "run_command.h"
 
 #include <errno.h>
 #include <math.h>
@@ -7,12 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cli/cli.h"
-#include "cli/progress.h"
-#include "core/clock.h"
-#include "run/run.h"
-#include "scene/scene.h"
-#include "sensor/render.h"
+#include "cli.h"
+#include "progress.h"
+#include "thzmap/thzmap.h"
 
 static void cli_run_usage(FILE *f, bool render)
 {
@@ -69,9 +66,13 @@ static void cli_run_usage(FILE *f, bool render)
 
 typedef struct cli_run_args {
     const char *scene_path;
+    const char *outdir;
+    const char *photon_map_path; /* render */
+    const char *sensor_name;     /* render: only this sensor */
+    int threads;
     bool quiet;
-    run_overrides ov;
-    run_options opt;
+    thz_run_settings settings;
+    thz_write_options write;
 } cli_run_args;
 
 /* Parses argv into args; returns -1 to go on, or the exit status. */
@@ -99,18 +100,18 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
                 return cli_usage_error(cmd, "%s needs a value, got the option '%s'", arg, val);
             uint64_t u = 0;
             if (strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0) {
-                a->opt.outdir = val;
+                a->outdir = val;
             } else if (strcmp(arg, "--threads") == 0) {
                 if (!cli_parse_u64(cmd, arg, val, 1, 4096, &u))
                     return CLI_EXIT_USAGE;
-                a->opt.threads = (int)u;
+                a->threads = (int)u;
             } else if (strcmp(arg, "--integrator") == 0) {
-                if (!render_integrator_parse(val, &a->ov.integrator))
+                if (!thz_integrator_known(val))
                     return cli_usage_error(cmd,
                                            "--integrator expects photon-map, final-gather or "
                                            "path, got '%s'",
                                            val);
-                a->ov.has_integrator = true;
+                a->settings.integrator = val;
             } else if (strcmp(arg, "--target-noise-k") == 0 || strcmp(arg, "--max-seconds") == 0) {
                 bool target = strcmp(arg, "--target-noise-k") == 0;
                 char *end = NULL;
@@ -119,29 +120,30 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
                 if (end == val || *end || errno || !isfinite(x) || !(x > 0.0))
                     return cli_usage_error(cmd, "%s expects a positive number (%s), got '%s'", arg,
                                            target ? "K" : "s", val);
-                *(target ? &a->opt.target_noise_k : &a->opt.max_seconds) = x;
+                *(target ? &a->settings.target_noise_k : &a->settings.max_seconds) = x;
             } else if (strcmp(arg, "--photons") == 0) {
                 if (!cli_parse_u64(cmd, arg, val, 1, UINT64_C(1000000000000), &u))
                     return CLI_EXIT_USAGE;
-                a->ov.photons = u;
+                a->settings.photons_per_channel = u;
             } else if (strcmp(arg, "--seed") == 0) {
                 if (!cli_parse_u64(cmd, arg, val, 0, UINT64_MAX, &u))
                     return CLI_EXIT_USAGE;
-                a->ov.has_seed = true;
-                a->ov.seed = u;
+                a->settings.has_seed = 1;
+                a->settings.seed = u;
             } else if (strcmp(arg, "--ply-max-points") == 0) {
                 if (!cli_parse_u64(cmd, arg, val, 1, UINT64_C(1000000000000), &u))
                     return CLI_EXIT_USAGE;
-                a->opt.ply_max_points = u;
+                a->write.ply_max_points = u;
             } else if (strcmp(arg, "--photon-map") == 0) {
-                a->opt.photon_map_path = val;
+                a->photon_map_path = val;
             } else {
-                a->opt.sensor_name = val;
+                a->sensor_name = val;
             }
         } else if (strcmp(arg, "--quiet") == 0 || strcmp(arg, "-q") == 0) {
             a->quiet = true;
         } else if (!render && strcmp(arg, "--save-photon-map") == 0) {
-            a->opt.save_photon_map = true;
+            a->settings.keep_photons = 1;
+            a->write.photon_map = 1;
         } else if (arg[0] == '-' && arg[1]) {
             return cli_usage_error(cmd, "unknown option '%s'", arg);
         } else if (!a->scene_path) {
@@ -152,9 +154,40 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
     }
     if (!a->scene_path)
         return cli_usage_error(cmd, "no scene file given");
-    if (!a->opt.outdir)
+    if (!a->outdir)
         return cli_usage_error(cmd, "no output directory given (-o OUTDIR)");
     return -1;
+}
+
+/* The run: photons read (render) or fired, images rendered, results written through an
+ * output directory opened first, so that a bad OUTDIR fails before any work. */
+static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_run_args *a,
+                          bool render, thz_run **run, thz_error *err)
+{
+    thz_output *output = NULL;
+    thz_photons *photons = NULL;
+    thz_status st = thz_output_open(a->outdir, &output, err);
+    long sensor = -1;
+    if (st == THZ_OK && render && a->sensor_name) {
+        sensor = thz_scene_sensor_index(scene, a->sensor_name);
+        if (sensor < 0) {
+            snprintf(err->message, sizeof err->message,
+                     "render: the scene has no sensor named '%s'", a->sensor_name);
+            err->status = st = THZ_ERR_INPUT;
+        }
+    }
+    if (st == THZ_OK && render && a->photon_map_path)
+        st = thz_photons_load(ctx, scene, a->photon_map_path, &photons, err);
+    if (st == THZ_OK)
+        st = render ? thz_render_run(ctx, scene, photons, sensor, &a->settings, run, err)
+                    : thz_simulate(ctx, scene, &a->settings, run, err);
+    thz_photons_destroy(photons);
+    if (st == THZ_OK)
+        st = thz_output_add_run(ctx, output, *run, &a->write, err);
+    if (st == THZ_OK)
+        st = thz_output_commit(output, err);
+    thz_output_destroy(output);
+    return st;
 }
 
 int cli_run_command(int argc, char **argv, bool render)
@@ -167,43 +200,52 @@ int cli_run_command(int argc, char **argv, bool render)
         return rc;
 
     cli_signals_install();
-    thz_error err;
-    thz_error_clear(&err);
-    double t0 = thz_now_s();
+    thz_error err = {0};
+    double t0 = cli_now_s();
     thz_scene *scene = NULL;
     thz_status st = thz_scene_load(a.scene_path, &scene, &err);
     if (st != THZ_OK)
         return cli_fail(&err);
-    run_apply_overrides(scene, &a.ov);
-    if (render && !a.opt.photon_map_path &&
-        render_integrator_needs_photons(scene->render.integrator)) {
-        scene_destroy(scene);
+    thz_scene_info info;
+    thz_scene_get_info(scene, &info);
+    const char *integrator = a.settings.integrator ? a.settings.integrator : info.integrator;
+    if (render && !a.photon_map_path && thz_integrator_needs_photons(integrator)) {
+        thz_scene_destroy(scene);
         return cli_usage_error(cmd, "no photon map given (--photon-map FILE); only the path "
                                     "integrator renders without one");
     }
-    for (size_t i = 0; i < scene->n_warnings; i++) /* --quiet hides progress, not these */
-        fprintf(stderr, "thzmap %s: warning: %s\n", cmd, scene->warnings[i]);
+    for (size_t i = 0; i < thz_scene_warning_count(scene); i++) /* --quiet hides progress only */
+        fprintf(stderr, "thzmap %s: warning: %s\n", cmd, thz_scene_warning(scene, i));
 
+    thz_context *ctx = thz_context_create();
+    if (!ctx) {
+        thz_scene_destroy(scene);
+        fprintf(stderr, "thzmap %s: out of memory\n", cmd);
+        return CLI_EXIT_FAILURE;
+    }
     cli_progress progress;
     cli_progress_init(&progress, cmd, a.quiet);
-    a.opt.progress = cli_progress_report;
-    a.opt.progress_user = &progress;
-    a.opt.warning = cli_progress_warning;
-    a.opt.warning_user = &progress;
-    a.opt.plan = cli_progress_plan;
-    a.opt.seconds_load = thz_now_s() - t0;
-    run_result result;
-    st = render ? run_render(scene, &a.opt, &result, &err)
-                : run_simulate(scene, &a.opt, &result, &err);
+    thz_context_set_threads(ctx, a.threads);
+    thz_context_set_progress(ctx, cli_progress_report, &progress);
+    thz_context_set_warning(ctx, cli_progress_warning, &progress);
+    a.settings.plan = cli_progress_plan;
+    a.settings.plan_user = &progress;
+    a.settings.seconds_load = cli_now_s() - t0;
+    double t_run = cli_now_s();
+    thz_run *run = NULL;
+    st = cli_run(ctx, scene, &a, render, &run, &err);
     cli_progress_finish(&progress);
 
     if (st == THZ_ERR_CANCELLED) {
-        fprintf(stderr, "thzmap %s: interrupted; no results written to %s\n", cmd, a.opt.outdir);
+        fprintf(stderr, "thzmap %s: interrupted; no results written to %s\n", cmd, a.outdir);
         rc = CLI_EXIT_INTERRUPTED;
     } else if (st != THZ_OK) {
         rc = cli_fail(&err);
     } else {
         rc = CLI_EXIT_OK;
+        thz_run_totals result;
+        thz_run_get_totals(run, &result);
+        result.seconds = cli_now_s() - t_run; /* the run and its writing */
         if (!a.quiet) {
             printf("thzmap %s: %zu sensor%s x %zu channel%s", cmd, result.n_sensors,
                    result.n_sensors == 1 ? "" : "s", result.n_channels,
@@ -217,15 +259,19 @@ int cli_run_command(int argc, char **argv, bool render)
                        result.worst_median_stderr_k, result.worst_p95_stderr_k);
             if (result.max_passes > 1)
                 printf(" after up to %u passes", result.max_passes);
-            printf(", %.2f s; results in %s\n", result.seconds, a.opt.outdir);
-            if (result.worst_object != SIZE_MAX && result.worst_p95_stderr_k > 0.0)
+            printf(", %.2f s; results in %s\n", result.seconds, a.outdir);
+            thz_object_info obj;
+            thz_channel_info ch;
+            if (result.worst_object >= 0 && result.worst_p95_stderr_k > 0.0 &&
+                thz_scene_object(scene, (size_t)result.worst_object, &obj) == THZ_OK &&
+                thz_scene_channel(scene, result.worst_object_channel, &ch) == THZ_OK)
                 printf("thzmap %s: noisiest object: '%s', 95th percentile standard error "
                        "%.3g K at %s\n",
-                       cmd, scene->objects[result.worst_object].name,
-                       result.worst_object_p95_stderr_k,
-                       scene->channels[result.worst_object_channel].name);
+                       cmd, obj.name, result.worst_object_p95_stderr_k, ch.name);
         }
     }
-    scene_destroy(scene);
+    thz_run_destroy(run);
+    thz_context_destroy(ctx);
+    thz_scene_destroy(scene);
     return rc;
 }

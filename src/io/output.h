@@ -75,4 +75,7 @@ typedef struct run_summary {
 thz_status summary_write(const char *dir, const thz_scene *scene, const run_summary *summary,
                          thz_error *err);
 
+/* The same document as text (malloc'd; NULL with err set when out of memory). */
+char *summary_text(const thz_scene *scene, const run_summary *summary, thz_error *err);
+
 #endif

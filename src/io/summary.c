@@ -156,13 +156,9 @@ static json_t *sum_sensor(const thz_scene *scene, size_t i, const run_summary *s
     return o;
 }
 
-thz_status summary_write(const char *dir, const thz_scene *scene, const run_summary *summary,
-                         thz_error *err)
+/* The document, or NULL when out of memory. */
+static json_t *summary_build(const thz_scene *scene, const run_summary *summary)
 {
-    char path[THZ_PATH_MAX];
-    thz_status status = thz_path_join(path, sizeof path, dir, "summary.json", err);
-    if (status != THZ_OK)
-        return status;
     bool ok = true;
     json_t *root = json_object();
     sum_set(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
@@ -207,9 +203,36 @@ thz_status summary_write(const char *dir, const thz_scene *scene, const run_summ
         sum_append(warnings, sum_string(summary->run_warnings[i]), &ok);
     sum_set(root, "warnings", warnings, &ok);
 
-    if (!ok)
+    if (!ok) {
+        json_decref(root);
+        return NULL;
+    }
+    return root;
+}
+
+#define SUMMARY_FLAGS (JSON_INDENT(2) | JSON_REAL_PRECISION(12))
+
+char *summary_text(const thz_scene *scene, const run_summary *summary, thz_error *err)
+{
+    json_t *root = summary_build(scene, summary);
+    char *text = root ? json_dumps(root, SUMMARY_FLAGS) : NULL;
+    json_decref(root);
+    if (!text)
+        thz_error_set(err, THZ_ERR_NOMEM, "summary.json: out of memory");
+    return text;
+}
+
+thz_status summary_write(const char *dir, const thz_scene *scene, const run_summary *summary,
+                         thz_error *err)
+{
+    char path[THZ_PATH_MAX];
+    thz_status status = thz_path_join(path, sizeof path, dir, "summary.json", err);
+    if (status != THZ_OK)
+        return status;
+    json_t *root = summary_build(scene, summary);
+    if (!root)
         status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
-    else if (json_dump_file(root, path, JSON_INDENT(2) | JSON_REAL_PRECISION(12)) != 0)
+    else if (json_dump_file(root, path, SUMMARY_FLAGS) != 0)
         status = thz_error_set(err, THZ_ERR_IO, "%s: cannot write", path);
     json_decref(root);
     return status;

@@ -13,9 +13,6 @@
 #include "core/alloc.h"
 #include "core/clock.h"
 #include "core/path.h"
-#include "io/output.h"
-#include "io/photon_map_file.h"
-#include "io/ply.h"
 #include "photon/phase.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
@@ -27,38 +24,6 @@
 
 /* A noise target stops here at the latest (with a run warning). */
 #define RUN_MAX_PASSES 100000u
-
-/* Everything one run owns; freed in one place (run_state_fini). */
-typedef struct run_state {
-    const thz_scene *scene;
-    const run_options *opt;
-    const char *command; /* "simulate" or "render" */
-    accel *accel;
-    output_stage *stage;
-    size_t n_selected;         /* sensors rendered */
-    size_t *selected;          /* their indices into scene->sensors */
-    sensor_images *images;     /* one per selected sensor */
-    uint64_t *back_face;       /* per scene sensor: samples that saw a back face */
-    render_stats *render_sum;  /* per selected sensor: counts over all channels */
-    render_stats *last;        /* [channel * n_selected + i]: the channel's last render pass
-                                  (every pass casts the same sample rays, so the counts are
-                                  a channel's, not the number of passes') */
-    photon_map **maps;         /* per channel: kept for saving, or read from a file */
-    photon_stats *stats;       /* per channel (simulate) */
-    run_noise *noise;          /* per channel */
-    run_noise *object_noise;   /* [channel * n_objects + object] */
-    double target_noise_k;     /* the run's target (run_target_noise_k), 0: none */
-    const char *target_source; /* "command line", "scene", "default" or NULL */
-    double max_seconds;        /* the command line's, else the scene's; 0: none */
-    uint64_t memory_bytes;     /* estimated before the run (run_memory total) */
-    uint32_t *passes;          /* per channel: render passes */
-    double *seconds_channel;   /* per channel: render time, s */
-    uint64_t seed;             /* of the photons rendered (scene's, or the map file's) */
-    uint64_t photons_per_channel;
-    size_t n_warnings;
-    char **warnings;
-    double seconds_accel, seconds_photons, seconds_render, seconds_output;
-} run_state;
 
 thz_status run_check_options(const run_options *opt, thz_error *err)
 {
@@ -131,9 +96,8 @@ static thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt
     return THZ_OK;
 }
 
-static void run_state_fini(run_state *rs)
+void run_state_fini(run_state *rs)
 {
-    output_stage_destroy(rs->stage); /* removes the staging directory unless committed */
     if (rs->images)
         for (size_t i = 0; i < rs->n_selected; i++)
             sensor_images_fini(&rs->images[i]);
@@ -158,33 +122,19 @@ static void run_state_fini(run_state *rs)
     memset(rs, 0, sizeof *rs);
 }
 
-static bool run_report(const run_state *rs, const char *stage, size_t channel, uint64_t done,
-                       uint64_t total)
-{
-    if (!rs->opt->progress)
-        return false;
-    thz_progress p = {.stage = stage,
-                      .channel = channel,
-                      .n_channels = rs->scene->n_channels,
-                      .done = done,
-                      .total = total};
-    return rs->opt->progress(rs->opt->progress_user, &p) != 0;
-}
-
 /* Chooses the sensors (all, or the one named) and allocates the per-run arrays. */
 static thz_status run_state_init(run_state *rs, const thz_scene *scene, const run_options *opt,
                                  const char *command, thz_error *err)
 {
     memset(rs, 0, sizeof *rs);
     rs->scene = scene;
-    rs->opt = opt;
+    rs->options = *opt;
+    rs->opt = &rs->options;
     rs->command = command;
     rs->seed = scene->photons.seed;
     rs->photons_per_channel = render_integrator_needs_photons(scene->render.integrator)
                                   ? scene->photons.per_channel
                                   : 0; /* path fires none */
-    if (!opt->outdir || !opt->outdir[0])
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: no output directory given", command);
     rs->target_noise_k =
         run_target_noise_k(scene, opt, strcmp(command, "render") == 0, &rs->target_source);
     rs->max_seconds = opt->max_seconds > 0.0 ? opt->max_seconds : scene->render.max_seconds;
@@ -274,7 +224,7 @@ static uint64_t run_image_bytes(const run_state *rs)
 /* T0 of channel c's photon map in simulate: final-gather fires the deviation map of
  * L - B(T0) (photon_map.h), T0 the renderer's control-variate temperature; photon-map
  * keeps the paper's map. */
-static double run_photon_t0_k(const thz_scene *scene, size_t c)
+double run_photon_t0_k(const thz_scene *scene, size_t c)
 {
     return scene->render.integrator == INTEGRATOR_FINAL_GATHER
                ? render_reference_temperature_k(scene, c)
@@ -298,7 +248,7 @@ static thz_status run_simulate_memory(run_state *rs, bool photons, thz_error *er
             max = b > max ? b : max;
         }
         /* kept maps, plus one map while it is built (records and index) */
-        need.photon_bytes = (rs->opt->save_photon_map ? sum : max) + max;
+        need.photon_bytes = (rs->opt->keep_photon_maps ? sum : max) + max;
     }
     need.total_bytes = need.photon_bytes + need.image_bytes;
     rs->memory_bytes = need.total_bytes;
@@ -454,65 +404,18 @@ static thz_status run_render_warnings(run_state *rs, thz_error *err)
     return st;
 }
 
-/* Photon-map files: see io/photon_map_file.h. */
-static thz_status run_save_photon_map(run_state *rs, const char *dir, thz_error *err);
-static thz_status run_load_photon_map(run_state *rs, thz_error *err);
-
-/* Writes every output file into the staging directory and commits it. */
-static thz_status run_write_outputs(run_state *rs, thz_error *err)
+/* The end of a successful run: the noise figures and warnings of what was rendered, the
+ * totals; the ray-casting structure is no longer needed. */
+static thz_status run_finish(run_state *rs, double t_start, thz_error *err)
 {
-    if (run_report(rs, "output", 0, 0, 1))
-        return thz_error_set(err, THZ_ERR_CANCELLED, "%s: cancelled", rs->command);
-    double t0 = thz_now_s();
-    const char *dir = output_stage_dir(rs->stage);
-    thz_status st = THZ_OK;
-    for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++)
-        st = output_write_sensor(dir, rs->scene, rs->selected[i], &rs->images[i], err);
-    if (st == THZ_OK && rs->opt->save_photon_map)
-        st = run_save_photon_map(rs, dir, err);
-    if (st == THZ_OK)
-        st = run_noise_figures(rs, err);
+    accel_destroy(rs->accel);
+    rs->accel = NULL;
+    thz_status st = run_noise_figures(rs, err);
     if (st == THZ_OK)
         st = run_render_warnings(rs, err);
     if (st != THZ_OK)
         return st;
-    rs->seconds_output = thz_now_s() - t0;
-    run_summary sum = {
-        .command = rs->command,
-        .integrator = render_integrator_name(rs->scene->render.integrator),
-        .seed = rs->seed,
-        .photons_per_channel = rs->photons_per_channel,
-        .threads = rs->opt->threads > 0 ? rs->opt->threads : omp_get_max_threads(),
-        /* render: the statistics of the photon phase that made the map it read */
-        .channel_stats =
-            render_integrator_needs_photons(rs->scene->render.integrator) ? rs->stats : NULL,
-        .noise = rs->noise,
-        .object_noise = rs->object_noise,
-        .target_source = rs->target_source,
-        .passes = rs->passes,
-        .seconds_render_channel = rs->seconds_channel,
-        .target_noise_k = rs->target_noise_k,
-        .back_face_samples = rs->back_face,
-        .seconds_load = rs->opt->seconds_load,
-        .seconds_accel = rs->seconds_accel,
-        .seconds_photons = rs->seconds_photons,
-        .seconds_render = rs->seconds_render,
-        .seconds_output = rs->seconds_output,
-        .n_run_warnings = rs->n_warnings,
-        .run_warnings = (const char *const *)rs->warnings,
-    };
-    st = summary_write(dir, rs->scene, &sum, err);
-    if (st != THZ_OK)
-        return st;
-    if (run_report(rs, "output", 0, 1, 1))
-        return thz_error_set(err, THZ_ERR_CANCELLED, "%s: cancelled", rs->command);
-    return output_stage_commit(rs->stage, err);
-}
-
-static void run_fill_result(const run_state *rs, run_result *result, double t_start)
-{
-    if (!result)
-        return;
+    run_result *result = &rs->result;
     memset(result, 0, sizeof *result);
     result->n_channels = rs->scene->n_channels;
     result->n_sensors = rs->n_selected;
@@ -542,16 +445,17 @@ static void run_fill_result(const run_state *rs, run_result *result, double t_st
             result->max_passes = rs->passes[c];
     }
     result->seconds = thz_now_s() - t_start;
+    return THZ_OK;
 }
 
-/* The common start: integrator check, sensors, staging directory, accel. */
+/* The common start: integrator check, sensors, accel. */
 static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_options *opt,
                             const char *command, thz_error *err)
 {
     thz_status st = run_state_init(rs, scene, opt, command, err);
     if (st == THZ_OK)
         st = render_integrator_check(scene->render.integrator, err);
-    if (st == THZ_OK && opt->save_photon_map &&
+    if (st == THZ_OK && opt->keep_photon_maps && strcmp(command, "simulate") == 0 &&
         !render_integrator_needs_photons(scene->render.integrator))
         st = thz_error_set(err, THZ_ERR_INPUT,
                            "%s: --save-photon-map: the %s integrator fires no photons (give "
@@ -559,8 +463,6 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
                            command, render_integrator_name(scene->render.integrator));
     if (st == THZ_OK)
         st = run_check_options(opt, err);
-    if (st == THZ_OK)
-        st = output_stage_create(opt->outdir, &rs->stage, err);
     if (st != THZ_OK)
         return st;
     double t0 = thz_now_s();
@@ -572,7 +474,7 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
 /* Adds the statistics of photon pass `p` (p + 1 passes so far) to the merged map's:
  * counts and times add up; powers are the merged photons' (each pass's divided by the
  * number of passes: the mean of the passes'). */
-static void run_stats_merge(photon_stats *sum, const photon_stats *p, uint32_t passes)
+void run_stats_merge(photon_stats *sum, const photon_stats *p, uint32_t passes)
 {
     if (passes == 1) {
         *sum = *p;
@@ -712,31 +614,30 @@ static thz_status run_tell_plan(run_state *rs, thz_error *err)
     thz_status st =
         run_estimate_time(&in, &plan.seconds_photons, &plan.seconds_render, &plan.passes, err);
     if (st == THZ_OK)
-        rs->opt->plan(rs->opt->warning_user, &plan);
+        rs->opt->plan(rs->opt->plan_user, &plan);
     return st;
 }
 
-thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_result *result,
+thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_state *rs,
                         thz_error *err)
 {
     double t_start = thz_now_s();
-    run_state rs;
-    thz_status st = run_begin(&rs, scene, opt, "simulate", err);
+    thz_status st = run_begin(rs, scene, opt, "simulate", err);
     bool photons = render_integrator_needs_photons(scene->render.integrator);
     if (st == THZ_OK)
-        st = run_simulate_memory(&rs, photons, err);
+        st = run_simulate_memory(rs, photons, err);
     if (st == THZ_OK && opt->plan)
-        st = run_tell_plan(&rs, err);
+        st = run_tell_plan(rs, err);
     if (st == THZ_OK)
-        st = run_init_images(&rs, err);
-    bool photon_passes = photons && rs.target_noise_k > 0.0 &&
+        st = run_init_images(rs, err);
+    bool photon_passes = photons && rs->target_noise_k > 0.0 &&
                          !render_integrator_has_passes(scene->render.integrator);
     for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
         photon_map *map = NULL;
         if (photon_passes) {
-            st = run_photon_passes(&rs, c, &map, err);
-            if (opt->save_photon_map)
-                rs.maps[c] = map;
+            st = run_photon_passes(rs, c, &map, err);
+            if (opt->keep_photon_maps)
+                rs->maps[c] = map;
             else
                 photon_map_destroy(map);
             continue;
@@ -747,31 +648,30 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_resu
                                        .progress = opt->progress,
                                        .progress_user = opt->progress_user};
             double t0 = thz_now_s();
-            st = photon_phase_run(scene, rs.accel, c, &po, &map, &rs.stats[c], err);
-            rs.seconds_photons += thz_now_s() - t0;
+            st = photon_phase_run(scene, rs->accel, c, &po, &map, &rs->stats[c], err);
+            rs->seconds_photons += thz_now_s() - t0;
             if (st != THZ_OK)
                 break;
         }
-        st = run_render_channel(&rs, c, map, err);
-        if (opt->save_photon_map)
-            rs.maps[c] = map;
+        st = run_render_channel(rs, c, map, err);
+        if (opt->keep_photon_maps)
+            rs->maps[c] = map;
         else
             photon_map_destroy(map);
     }
     if (st == THZ_OK)
-        st = run_write_outputs(&rs, err);
-    if (st == THZ_OK)
-        run_fill_result(&rs, result, t_start);
-    run_state_fini(&rs);
+        st = run_finish(rs, t_start, err);
+    if (st != THZ_OK)
+        run_state_fini(rs);
     return st;
 }
 
-thz_status run_render(const thz_scene *scene, const run_options *opt, run_result *result,
-                      thz_error *err)
+thz_status run_render(const thz_scene *scene, const run_options *opt, const run_photons *in,
+                      run_state *rs, thz_error *err)
 {
     double t_start = thz_now_s();
-    run_state rs;
-    if (opt->save_photon_map)
+    memset(rs, 0, sizeof *rs);
+    if (opt->keep_photon_maps)
         return thz_error_set(err, THZ_ERR_INPUT, "render: --save-photon-map is for simulate");
     if (opt->target_noise_k > 0.0 && !render_integrator_has_passes(scene->render.integrator))
         return thz_error_set(err, THZ_ERR_INPUT,
@@ -779,54 +679,33 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, run_result
                              "fires no photons: a noise target needs simulate (which fires "
                              "photons until it is met) or final-gather or path",
                              render_integrator_name(scene->render.integrator));
-    thz_status st = run_begin(&rs, scene, opt, "render", err);
     bool photons = render_integrator_needs_photons(scene->render.integrator);
+    for (size_t c = 0; photons && c < scene->n_channels; c++)
+        if (!in || !in->maps[c])
+            return thz_error_set(err, THZ_ERR_INPUT,
+                                 "render: no photon map for channel %zu; only the path "
+                                 "integrator renders without one",
+                                 c);
+    thz_status st = run_begin(rs, scene, opt, "render", err);
     if (st == THZ_OK) {
-        run_memory need = {.image_bytes = run_image_bytes(&rs),
+        run_memory need = {.image_bytes = run_image_bytes(rs),
                            .available_bytes = thz_physical_memory_bytes()};
         need.total_bytes = need.image_bytes;
         st = run_check_memory(scene, &need, err);
     }
-    if (st == THZ_OK && photons)
-        st = run_load_photon_map(&rs, err);
-    if (st == THZ_OK)
-        st = run_init_images(&rs, err);
-    for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
-        st = run_render_channel(&rs, c, rs.maps[c], err);
-        photon_map_destroy(rs.maps[c]); /* each map is needed for its channel only */
-        rs.maps[c] = NULL;
+    if (st == THZ_OK && in) {
+        if (in->stats)
+            memcpy(rs->stats, in->stats, scene->n_channels * sizeof *rs->stats);
+        rs->seed = in->seed;
+        rs->photons_per_channel = in->photons_per_channel;
     }
     if (st == THZ_OK)
-        st = run_write_outputs(&rs, err);
+        st = run_init_images(rs, err);
+    for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++)
+        st = run_render_channel(rs, c, photons ? in->maps[c] : NULL, err);
     if (st == THZ_OK)
-        run_fill_result(&rs, result, t_start);
-    run_state_fini(&rs);
+        st = run_finish(rs, t_start, err);
+    if (st != THZ_OK)
+        run_state_fini(rs);
     return st;
-}
-
-static thz_status run_save_photon_map(run_state *rs, const char *dir, thz_error *err)
-{
-    char path[THZ_PATH_MAX];
-    thz_status st = thz_path_join(path, sizeof path, dir, "photon-map.thzpm", err);
-    const photon_map *const *maps = (const photon_map *const *)rs->maps;
-    if (st == THZ_OK)
-        st = photon_map_file_write(path, rs->scene, maps, rs->stats, err);
-    if (st == THZ_OK)
-        st = thz_path_join(path, sizeof path, dir, "photon-map.ply", err);
-    if (st != THZ_OK)
-        return st;
-    uint64_t cap = rs->opt->ply_max_points ? rs->opt->ply_max_points : PLY_DEFAULT_MAX_POINTS;
-    return ply_write_photons(path, maps, rs->scene->n_channels, cap, err);
-}
-
-static thz_status run_load_photon_map(run_state *rs, thz_error *err)
-{
-    photon_map_file_info info;
-    thz_status st = photon_map_file_read(rs->opt->photon_map_path, rs->scene, rs->opt->threads,
-                                         rs->maps, rs->stats, &info, err);
-    if (st != THZ_OK)
-        return st;
-    rs->seed = info.seed;
-    rs->photons_per_channel = info.photons_per_channel;
-    return THZ_OK;
 }

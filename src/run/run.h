@@ -3,10 +3,11 @@
  *
  *   simulate: check the integrator and memory (refusing before any work) -> build the
  *             ray-casting structure -> per channel: photon phase, render every sensor,
- *             keep the photon map only when it is to be saved -> write every output
- *             file into a staging directory -> move them into OUTDIR.
- *   render:   read a saved photon map (refusing one made from another scene) -> render
- *             the chosen sensors -> outputs as above.
+ *             keep the photon map only when it is to be saved.
+ *   render:   from photon maps read before (io/photon_map_file.h) -> render the chosen
+ *             sensors.
+ *   write:    every output file of a finished run into a staging directory, which the
+ *             caller commits into OUTDIR (io/output.h; run_output.c).
  *
  * With the `path` integrator simulate fires no photons. With a noise target
  * (run_target_noise_k), each channel gets passes 0, 1, 2, ... (each deterministic)
@@ -14,7 +15,8 @@
  * the target (K), or max_seconds have passed.
  *
  * A failed or cancelled run (progress callback returning non-zero: THZ_ERR_CANCELLED)
- * leaves no result files in OUTDIR. Results are bit-identical for any thread count.
+ * returns nothing; a failed or cancelled write leaves no result files in OUTDIR.
+ * Results are bit-identical for any thread count.
  */
 #ifndef THZ_RUN_RUN_H
 #define THZ_RUN_RUN_H
@@ -22,10 +24,16 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "accel/accel.h"
 #include "core/error.h"
+#include "photon/photon_map.h"
+#include "photon/photon_stats.h"
+#include "run/run_noise.h"
 #include "scene/scene.h"
+#include "sensor/images.h"
+#include "sensor/render.h"
 
-/* Command-line overrides of scene settings (applied by run_apply_overrides). */
+/* Overrides of scene settings (applied by run_apply_overrides to a copy of the scene). */
 typedef struct run_overrides {
     uint64_t photons; /* photons.per_channel; 0 keeps the scene's */
     bool has_seed;
@@ -45,21 +53,13 @@ typedef struct run_plan {
 } run_plan;
 
 typedef struct run_options {
-    const char *outdir;          /* required: where the result files go */
-    int threads;                 /* OpenMP threads, 0: all */
-    bool save_photon_map;        /* simulate: also write photon-map.thzpm and photon-map.ply */
-    uint64_t ply_max_points;     /* photons in photon-map.ply at most; 0: PLY_DEFAULT_MAX_POINTS */
-    const char *photon_map_path; /* render: the photon-map file to read (required) */
-    const char *sensor_name;     /* render: only this sensor; NULL: all */
-    thz_progress_fn progress;    /* stages "photons", "render", "output"; may be NULL */
+    int threads;              /* OpenMP threads, 0: all */
+    bool keep_photon_maps;    /* simulate: keep every channel's map in the run (to save it) */
+    const char *sensor_name;  /* only this sensor; NULL: all */
+    thz_progress_fn progress; /* stages "photons", "render", "output"; may be NULL */
     void *progress_user;
-    /* called with each run warning as it arises (also written to summary.json), from the
-       calling thread; may be NULL */
-    void (*warning)(void *user, const char *message);
+    thz_warning_fn warning; /* each run warning as it is added; may be NULL */
     void *warning_user;
-    /* simulate: called once before the work starts with the estimate (its pilot costs
-       a moment, so only when set); user: warning_user */
-    void (*plan)(void *user, const run_plan *plan);
     double seconds_load;   /* time the caller spent loading the scene, for the summary */
     double target_noise_k; /* > 0: add passes to each channel until the 95th percentile of
                               the per-pixel standard error of Tb_c, over the rendered
@@ -67,7 +67,20 @@ typedef struct run_options {
     double max_seconds;    /* > 0: stop adding passes once a channel has rendered this
                               long (s); makes the stopping point time-dependent;
                               overrides the scene's render.max_seconds */
+    /* simulate: called once before the work starts with the estimate (its pilot costs
+       a moment, so only when set); may be NULL */
+    void (*plan)(void *user, const run_plan *plan);
+    void *plan_user;
 } run_options;
+
+/* The photon maps a render run reads (borrowed): one per channel, their photon-phase
+ * statistics, and the seed and photon count they were fired with. */
+typedef struct run_photons {
+    photon_map *const *maps;
+    const photon_stats *stats;
+    uint64_t seed;
+    uint64_t photons_per_channel;
+} run_photons;
 
 /* What a finished run reports back (for the CLI's closing line). */
 typedef struct run_result {
@@ -87,6 +100,41 @@ typedef struct run_result {
     uint32_t max_passes;              /* most render passes of any channel */
     double seconds;                   /* wall time of the run */
 } run_result;
+
+/* Everything one run owns, from its start to its written outputs; freed in one place
+ * (run_state_fini). run_simulate and run_render fill it; run_write writes it. It must
+ * not move while a run fills it (opt points into it). */
+typedef struct run_state {
+    const thz_scene *scene;    /* borrowed: the scene with the run's overrides */
+    run_options options;       /* a copy of the caller's */
+    const run_options *opt;    /* = &options */
+    const char *command;       /* "simulate" or "render" */
+    accel *accel;              /* during the run only */
+    size_t n_selected;         /* sensors rendered */
+    size_t *selected;          /* their indices into scene->sensors */
+    sensor_images *images;     /* one per selected sensor */
+    uint64_t *back_face;       /* per scene sensor: samples that saw a back face */
+    render_stats *render_sum;  /* per selected sensor: counts over all channels */
+    render_stats *last;        /* [channel * n_selected + i]: the channel's last render pass
+                                  (every pass casts the same sample rays, so the counts are
+                                  a channel's, not the number of passes') */
+    photon_map **maps;         /* per channel: kept for saving (simulate) */
+    photon_stats *stats;       /* per channel (simulate), or the read maps' (render) */
+    run_noise *noise;          /* per channel */
+    run_noise *object_noise;   /* [channel * n_objects + object] */
+    double target_noise_k;     /* the run's target (run_target_noise_k), 0: none */
+    const char *target_source; /* "command line", "scene", "default" or NULL */
+    double max_seconds;        /* the command line's, else the scene's; 0: none */
+    uint64_t memory_bytes;     /* estimated before the run (run_memory total) */
+    uint32_t *passes;          /* per channel: render passes */
+    double *seconds_channel;   /* per channel: render time, s */
+    uint64_t seed;             /* of the photons rendered (scene's, or the map file's) */
+    uint64_t photons_per_channel;
+    size_t n_warnings;
+    char **warnings;
+    double seconds_accel, seconds_photons, seconds_render, seconds_output;
+    run_result result; /* the totals, filled when the run succeeded */
+} run_state;
 
 /* THZ_ERR_INPUT unless the noise target and the time limit are positive (or 0: none).
  * Every integrator takes a target in simulate (photon-map by photon passes); render
@@ -126,9 +174,37 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
  * building anything); the message starts with the scene file. */
 thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err);
 
-thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_result *result,
+/* Fire and render (simulate) or render from `in` (render; NULL only for path) into rs,
+ * nothing written. On failure rs is finalised. */
+thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_state *rs,
                         thz_error *err);
-thz_status run_render(const thz_scene *scene, const run_options *opt, run_result *result,
-                      thz_error *err);
+thz_status run_render(const thz_scene *scene, const run_options *opt, const run_photons *in,
+                      run_state *rs, thz_error *err);
+
+/* What run_write adds to the files of every sensor and summary.json. */
+typedef struct run_write_options {
+    bool photon_map;          /* photon-map.thzpm and photon-map.ply (needs kept maps) */
+    uint64_t ply_max_points;  /* photons in photon-map.ply at most; 0: PLY_DEFAULT_MAX_POINTS */
+    thz_progress_fn progress; /* stage "output"; may be NULL */
+    void *progress_user;
+} run_write_options;
+
+/* Writes every output file of a finished run into `dir` (a staging directory: see
+ * io/output.h); THZ_ERR_CANCELLED when the progress callback asks. Records the time
+ * it took in rs->seconds_output. */
+thz_status run_write(run_state *rs, const char *dir, const run_write_options *wo, thz_error *err);
+
+/* summary.json's text for a finished run (malloc'd; NULL and err set on failure). */
+char *run_summary_text(const run_state *rs, thz_error *err);
+
+void run_state_fini(run_state *rs);
+
+/* T0 of channel c's photon map as simulate fires it (photon_map.h): final-gather's
+ * deviation map takes the renderer's reference temperature, photon-map 0. */
+double run_photon_t0_k(const thz_scene *scene, size_t c);
+
+/* Adds the statistics of photon pass `p` (`passes` passes so far, this one included)
+ * to those of the merged map: counts and times add up, powers are averaged. */
+void run_stats_merge(photon_stats *sum, const photon_stats *p, uint32_t passes);
 
 #endif

@@ -330,8 +330,3 @@ thz_status scene_load_string(const char *json_text, const char *base_dir, const 
     thz_status st = load_begin(label, base_dir ? base_dir : ".", out, err);
     return load_finish(out, doc, st, err);
 }
-
-thz_status thz_scene_load(const char *path, thz_scene **out, thz_error *err)
-{
-    return scene_load(path, out, err);
-}

@@ -1,0 +1,237 @@
+/* thzmap public API: runs (include thzmap/thzmap.h, which includes this).
+ *
+ * A run has two phases (physics.md): the photon phase fires photons per channel into
+ * photon maps (a thz_photons), the rendering phase turns them into the images of a
+ * sensor (a thz_image). thz_simulate does both for every sensor into a thz_run, as
+ * `thzmap simulate` does; thz_render_run renders from existing photons, as `thzmap
+ * render` does. Writing to disk is separate (thz_run_write, thz_image_write, and
+ * thz_output for staging several writes into one atomic result).
+ *
+ * The same scene, settings and seed give bit-identical images, photon maps and files
+ * for any thread count, in memory or written. Long calls report progress and can be
+ * cancelled through the context (THZ_ERR_CANCELLED: nothing is returned or written).
+ */
+#ifndef THZMAP_RUN_H
+#define THZMAP_RUN_H
+
+#include "thzmap/thzmap.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct thz_photons thz_photons;
+typedef struct thz_image thz_image;
+typedef struct thz_run thz_run;
+typedef struct thz_output thz_output;
+
+/* ---- settings ----------------------------------------------------------------------- */
+
+/* What thz_simulate is about to do, told before the work starts: the estimate of a
+ * short pilot (time per sample and per photon times the counts; with a target, the
+ * passes from the pilot's noise). An estimate, not a promise. */
+typedef struct thz_run_plan {
+    double seconds_photons, seconds_render; /* estimated, s */
+    uint32_t passes;                        /* estimated passes per channel */
+    uint64_t memory_bytes;                  /* estimated peak, bytes */
+    uint64_t available_bytes;               /* physical memory, 0 if unknown */
+    double target_noise_k;                  /* the run's noise target, K; 0: none */
+    const char *target_source;              /* "command line" (settings), "scene",
+                                               "default" or NULL */
+} thz_run_plan;
+typedef void (*thz_plan_fn)(void *user, const thz_run_plan *plan);
+
+/* Per-run overrides of the scene's settings: zero / NULL keeps the scene's value.
+ * Initialise with thz_run_settings_init (or = {0}); a NULL settings pointer means all
+ * defaults. */
+typedef struct thz_run_settings {
+    uint64_t photons_per_channel; /* photons.per_channel; 0: the scene's */
+    int has_seed;                 /* non-zero: use `seed` instead of photons.seed */
+    uint64_t seed;
+    const char *integrator; /* "photon-map", "final-gather", "path"; NULL: the scene's */
+    double target_noise_k;  /* > 0: add passes to each channel until the 95th percentile
+                               over pixels of the per-pixel standard error of Tb_c is at
+                               most this (K); overrides render.target_noise_k (default
+                               0.1 K where the scene gives no count) */
+    double max_seconds;     /* > 0: stop adding passes after this (s) */
+    int keep_photons;       /* thz_simulate: keep the photon maps in the run (needed to
+                               write photon-map.thzpm) */
+    uint64_t first_photon;  /* thz_photons_fire*: fire photons first_photon .. + K - 1, so that
+                               maps fired with disjoint ranges merge (thz_photons_merge) */
+    double seconds_load;    /* reported in summary.json (timings_s.load); 0: unknown */
+    thz_plan_fn plan;       /* thz_simulate: called once with the estimate before the work
+                               (its pilot costs a moment: only when set); may be NULL */
+    void *plan_user;
+} thz_run_settings;
+
+THZ_API void thz_run_settings_init(thz_run_settings *settings);
+
+/* ---- the photon phase ----------------------------------------------------------------- */
+
+/* Statistics of one channel's photon phase (summary.json "channels"). */
+typedef struct thz_photon_stats {
+    uint64_t fired, stored, hits, reflected, transmitted, absorbed, escaped;
+    uint64_t back_face_hits, terminated, bounce_capped, rays;
+    double emitted_power_w_per_hz;  /* band mean P_A of the scene's sources */
+    double fired_power_w_per_hz;    /* sum of the photons' initial powers */
+    double absorbed_power_w_per_hz; /* the energy balance: absorbed + escaped + */
+    double escaped_power_w_per_hz;  /* atmosphere + terminated = fired */
+    double atmosphere_power_w_per_hz;
+    double terminated_power_w_per_hz;
+    double mean_bounces;
+    double reference_temperature_k; /* T0 of a deviation map (final-gather), 0: map of L */
+    double seconds;                 /* wall time of the phase (0 when read from a file) */
+} thz_photon_stats;
+
+/* Fires the photons of every channel (integrator, photon count, seed and first_photon
+ * from settings over the scene). *out owns the maps; `scene` must outlive it. */
+THZ_API thz_status thz_photons_fire(thz_context *ctx, const thz_scene *scene,
+                                    const thz_run_settings *settings, thz_photons **out,
+                                    thz_error *err);
+/* The same for channel `channel` only. The other channels hold no map: such photons
+ * merge and give statistics, but rendering and saving refuse them (THZ_ERR_INPUT). */
+THZ_API thz_status thz_photons_fire_channel(thz_context *ctx, const thz_scene *scene,
+                                            const thz_run_settings *settings, size_t channel,
+                                            thz_photons **out, thz_error *err);
+/* Reads a photon-map file (.thzpm) made from `scene`; refuses one made from another
+ * scene geometry, material or channel set (THZ_ERR_INPUT) or a damaged one. `scene`
+ * must outlive *out. */
+THZ_API thz_status thz_photons_load(thz_context *ctx, const thz_scene *scene, const char *path,
+                                    thz_photons **out, thz_error *err);
+/* Writes every channel's map to `path` (.thzpm, what `render` reads); THZ_ERR_INPUT
+ * when a channel has no map. Writes the file directly (not staged). */
+THZ_API thz_status thz_photons_save(const thz_photons *photons, const char *path, thz_error *err);
+/* Merges n photon sets of one scene, seed and integrator, fired with disjoint photon
+ * ranges, into one of all their photons (*out; the parts stay the caller's). */
+THZ_API thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, size_t n,
+                                     thz_photons **out, thz_error *err);
+THZ_API void thz_photons_destroy(thz_photons *photons);
+
+THZ_API size_t thz_photons_channel_count(const thz_photons *photons);
+/* Whether channel c holds a map (1) or not (0). */
+THZ_API int thz_photons_has_channel(const thz_photons *photons, size_t c);
+/* The seed and photons per channel they were fired with. */
+THZ_API uint64_t thz_photons_seed(const thz_photons *photons);
+THZ_API uint64_t thz_photons_per_channel(const thz_photons *photons);
+/* Fills *out with channel c's statistics; THZ_ERR_INPUT when c is out of range. */
+THZ_API thz_status thz_photons_stats(const thz_photons *photons, size_t c, thz_photon_stats *out);
+
+/* ---- images ------------------------------------------------------------------------- */
+
+/* The planes of a sensor's image (scene-format.md "Outputs"). Row 0 is the top of the
+ * picture, column 0 the left. Channel cubes (RADIANCE .. NORMALIZED) have one band per
+ * channel, band-sequential: value(c, row, col) at [(c * rows + row) * columns + col]. */
+typedef enum thz_plane {
+    THZ_PLANE_RADIANCE = 0,           /* L_c, W m^-2 sr^-1 Hz^-1 */
+    THZ_PLANE_RADIANCE_STDERR,        /* standard error of L_c (absent: not estimated) */
+    THZ_PLANE_POWER,                  /* P_c on the pixel, W */
+    THZ_PLANE_BRIGHTNESS_TEMPERATURE, /* Tb_c, K */
+    THZ_PLANE_NORMALIZED,             /* N_c = L_c / B(T_ref), 1 */
+    THZ_PLANE_TEMPERATURE,            /* 1 band: temperature of the surface seen, K (0: none) */
+    THZ_PLANE_DISTANCE,               /* 1 band: distance to the surface seen, m (0: none) */
+    THZ_PLANE_OBJECT_ID,              /* 1 band: object index as float, -1: nothing hit */
+    THZ_PLANE_VISUAL_RGB,             /* 3 bands, pixel-interleaved: [(row * columns + col)
+                                       * 3 + k], shaded colour 0..1 */
+    THZ_PLANE_COUNT
+} thz_plane;
+
+/* Renders sensor `sensor` of the scene: from `photons` (their seed, every channel), or
+ * with photons NULL for the path integrator (seed from settings or the scene). With a
+ * noise target, passes stop on this sensor's median error. *out owns the image. */
+THZ_API thz_status thz_render_sensor(thz_context *ctx, const thz_scene *scene,
+                                     const thz_photons *photons, size_t sensor,
+                                     const thz_run_settings *settings, thz_image **out,
+                                     thz_error *err);
+THZ_API void thz_image_destroy(thz_image *image);
+
+THZ_API uint32_t thz_image_columns(const thz_image *image);
+THZ_API uint32_t thz_image_rows(const thz_image *image);
+THZ_API size_t thz_image_channel_count(const thz_image *image);
+/* The sensor's index in its scene and its name. */
+THZ_API size_t thz_image_sensor(const thz_image *image);
+THZ_API const char *thz_image_sensor_name(const thz_image *image);
+/* The plane's values (owned by the image) and its band count (1, 3 or the channels)
+ * in *n_bands (may be NULL); NULL (and 0 bands) when the plane is absent. */
+THZ_API const float *thz_image_plane(const thz_image *image, thz_plane plane, size_t *n_bands);
+/* The plane's file quantity ("radiance", "object_id", "visual", ...); static. */
+THZ_API const char *thz_plane_name(thz_plane plane);
+
+/* Writes the image's files (S.radiance, ... ENVI; S.visual.png, S.band-NN.png,
+ * S.spectra.png) into `dir` (created if missing), atomically like a run. */
+THZ_API thz_status thz_image_write(thz_context *ctx, const thz_image *image, const char *dir,
+                                   thz_error *err);
+
+/* ---- whole runs ----------------------------------------------------------------------- */
+
+/* `thzmap simulate` in memory: per channel the photon phase (none for path), then every
+ * sensor rendered. *out owns the images, the photons if settings->keep_photons, and the
+ * summary. */
+THZ_API thz_status thz_simulate(thz_context *ctx, const thz_scene *scene,
+                                const thz_run_settings *settings, thz_run **out, thz_error *err);
+/* `thzmap render` in memory: every sensor (or only sensor `sensor`, if it is not -1)
+ * rendered from `photons` (NULL only for path). The run's seed and photon count are the
+ * photons'. `photons` must have been made for `scene`. */
+THZ_API thz_status thz_render_run(thz_context *ctx, const thz_scene *scene,
+                                  const thz_photons *photons, long sensor,
+                                  const thz_run_settings *settings, thz_run **out, thz_error *err);
+THZ_API void thz_run_destroy(thz_run *run);
+
+/* The rendered sensors: count, and image i (borrowed from the run; NULL if out of range). */
+THZ_API size_t thz_run_image_count(const thz_run *run);
+THZ_API const thz_image *thz_run_image(const thz_run *run, size_t i);
+/* The run's photons (borrowed), or NULL when not kept. */
+THZ_API const thz_photons *thz_run_photons(const thz_run *run);
+/* summary.json as text (the file thz_run_write writes, but for timings_s.output). */
+THZ_API const char *thz_run_summary_json(const thz_run *run);
+
+/* What the closing line of the CLI reports. */
+typedef struct thz_run_totals {
+    size_t n_channels;
+    size_t n_sensors;       /* rendered */
+    uint64_t photons_fired; /* over all channels (0 for a render run) */
+    uint64_t photons_stored;
+    uint64_t back_face_samples;
+    size_t n_warnings;            /* run warnings (in the summary) */
+    double worst_median_stderr_k; /* largest median per-pixel standard error of Tb_c, K */
+    uint32_t max_passes;          /* most render passes of any channel */
+    double seconds;               /* wall time of the run */
+    double worst_p95_stderr_k;    /* largest 95th percentile of the per-pixel standard
+                                     error of Tb_c over channels, K */
+    long worst_object;            /* the object whose pixels' 95th percentile is largest
+                                     (over channels), -1 when none was seen */
+    size_t worst_object_channel;
+    double worst_object_p95_stderr_k; /* K */
+} thz_run_totals;
+THZ_API void thz_run_get_totals(const thz_run *run, thz_run_totals *out);
+
+/* ---- writing ---------------------------------------------------------------------------- */
+
+typedef struct thz_write_options {
+    int photon_map;          /* also photon-map.thzpm and photon-map.ply (kept photons) */
+    uint64_t ply_max_points; /* photons in photon-map.ply at most; 0: 2000000 */
+} thz_write_options;
+
+/* Writes every file of the run into `outdir` (created if missing): per sensor as
+ * thz_image_write, summary.json, and the photon map if asked (opt may be NULL). Files
+ * appear only when all were written (thz_output); a failure or cancellation leaves
+ * outdir as it was.
+ * Records the time writing took in the summary.json it writes (the run is modified). */
+THZ_API thz_status thz_run_write(thz_context *ctx, thz_run *run, const char *outdir,
+                                 const thz_write_options *opt, thz_error *err);
+
+/* An atomic result directory (docs/reliability.md): files go into a staging directory
+ * beside `outdir`, which holds outdir's lock (a second output into it fails with
+ * THZ_ERR_IO), and become outdir's results on thz_output_commit, all or nothing;
+ * destroying an uncommitted output removes them. Open it before a long run to fail
+ * early on a bad or busy outdir. */
+THZ_API thz_status thz_output_open(const char *outdir, thz_output **out, thz_error *err);
+THZ_API thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run,
+                                      const thz_write_options *opt, thz_error *err);
+THZ_API thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_error *err);
+THZ_API thz_status thz_output_commit(thz_output *output, thz_error *err);
+THZ_API void thz_output_destroy(thz_output *output);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,134 @@
+/* thzmap public API: scenes (include thzmap/thzmap.h, which includes this).
+ *
+ * A thz_scene is a loaded and completely checked thzmap-scene/1 document: channels,
+ * materials, atmosphere, objects (triangle meshes), sensors and run settings. It is
+ * read-only once loaded, so concurrent runs may share it. Indices are 0-based in the
+ * order of the scene file; info structs are filled by value, their strings belong to
+ * the scene.
+ */
+#ifndef THZMAP_SCENE_H
+#define THZMAP_SCENE_H
+
+#include "thzmap/thzmap.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct thz_scene thz_scene;
+
+/* Loads and checks a scene file. On success *out owns the scene (thz_scene_destroy);
+ * errors name the file and line:column or JSON path (THZ_ERR_INPUT). */
+THZ_API thz_status thz_scene_load(const char *path, thz_scene **out, thz_error *err);
+/* The same from JSON text. `base_dir` resolves the relative file paths in it (NULL:
+ * the current directory); `label` names the text in messages as a file name would
+ * (NULL: "<string>"). */
+THZ_API thz_status thz_scene_load_string(const char *json_text, const char *base_dir,
+                                         const char *label, thz_scene **out, thz_error *err);
+THZ_API void thz_scene_destroy(thz_scene *scene);
+
+/* The scene as a whole and its run settings (the `photons` and `render` blocks). */
+typedef struct thz_scene_info {
+    const char *name;
+    const char *path;             /* the file as given, or the label of a string */
+    const char *atmosphere_model; /* "none", "constant", "table", "itu-p676", "lines" */
+    size_t n_channels, n_materials, n_objects, n_sensors, n_warnings;
+    uint64_t photons_per_channel;
+    uint64_t seed;
+    double min_relative_power;
+    uint32_t gather_min_photons;
+    const char *integrator; /* "photon-map", "final-gather", "path" */
+    uint32_t gather_rays;
+    uint32_t paths_per_sample;
+} thz_scene_info;
+
+typedef struct thz_channel_info {
+    const char *name;
+    double frequency_hz;           /* centre */
+    double frequency_thz;          /* centre, as in the scene file */
+    double relative_width;         /* FWHM / centre */
+    double bandwidth_hz;           /* B_c: the response's integral (physics.md) */
+    double emitted_power_w_per_hz; /* band mean of the scene's emitted power P_A */
+} thz_channel_info;
+
+/* A spectral property of a material: absent, a constant, or a table. */
+typedef enum thz_spectrum_kind {
+    THZ_SPECTRUM_ABSENT = 0,
+    THZ_SPECTRUM_CONSTANT,
+    THZ_SPECTRUM_TABLE
+} thz_spectrum_kind;
+
+typedef struct thz_spectrum_info {
+    thz_spectrum_kind kind;
+    size_t n_points;             /* table: its points; constant: 1 */
+    double value;                /* constant: the value */
+    double from_thz, to_thz;     /* table: first and last frequency */
+    double min_value, max_value; /* table: range of its values */
+} thz_spectrum_info;
+
+typedef struct thz_material_info {
+    const char *name;
+    thz_spectrum_info reflectivity;
+    thz_spectrum_info attenuation_per_m;
+    thz_spectrum_info emissivity; /* ABSENT: Kirchhoff's law */
+    const char *transmission;     /* "diffuse" or "straight" */
+    double color[3];              /* rgb 0..1 of the visual truth image */
+} thz_material_info;
+
+typedef struct thz_object_info {
+    const char *name;
+    const char *type;   /* "solid" or "shell" */
+    int two_sided;      /* the `two_sided` key (solids) */
+    double thickness_m; /* shells; 0 for solids */
+    size_t material;    /* index of its material */
+    const char *material_name;
+    double temperature_k;
+    size_t triangles;
+    double area_m2;
+    double bbox_min_m[3], bbox_max_m[3];
+} thz_object_info;
+
+typedef struct thz_sensor_info {
+    const char *name;
+    uint32_t columns, rows;
+    size_t channels; /* bands of its cubes: the scene's channels */
+    double fov_deg;  /* horizontal */
+    uint32_t oversampling;
+    double aperture_m2;
+    double position_m[3];
+    double direction[3]; /* unit viewing direction */
+    double up[3];
+    double normalize_to_k;
+} thz_sensor_info;
+
+/* Fill *out; THZ_ERR_INPUT (and *out zeroed) when an index is out of range. */
+THZ_API thz_status thz_scene_get_info(const thz_scene *scene, thz_scene_info *out);
+THZ_API thz_status thz_scene_channel(const thz_scene *scene, size_t i, thz_channel_info *out);
+THZ_API thz_status thz_scene_material(const thz_scene *scene, size_t i, thz_material_info *out);
+THZ_API thz_status thz_scene_object(const thz_scene *scene, size_t i, thz_object_info *out);
+THZ_API thz_status thz_scene_sensor(const thz_scene *scene, size_t i, thz_sensor_info *out);
+
+THZ_API size_t thz_scene_channel_count(const thz_scene *scene);
+THZ_API size_t thz_scene_object_count(const thz_scene *scene);
+THZ_API size_t thz_scene_sensor_count(const thz_scene *scene);
+
+/* The index of the sensor (object) called `name`, or -1 when there is none. */
+THZ_API long thz_scene_sensor_index(const thz_scene *scene, const char *name);
+THZ_API long thz_scene_object_index(const thz_scene *scene, const char *name);
+
+/* The scene's validation warnings (emissivity breaking Kirchhoff's law, bands leaving
+ * a table, mesh winding): count, and warning i (NULL when out of range). */
+THZ_API size_t thz_scene_warning_count(const thz_scene *scene);
+THZ_API const char *thz_scene_warning(const thz_scene *scene, size_t i);
+
+/* Integrators by name ("photon-map", "final-gather", "path"): 1 when `name` is one,
+ * else 0; whether it needs a photon map (photon-map, final-gather); whether more
+ * render passes lower its noise (final-gather, path). 0 for unknown names. */
+THZ_API int thz_integrator_known(const char *name);
+THZ_API int thz_integrator_needs_photons(const char *name);
+THZ_API int thz_integrator_has_passes(const char *name);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,30 @@
+"""thzmap: simulate a passive multispectral terahertz camera from Python.
+
+    import thzmap
+    scene = thzmap.load_scene("examples/teraeye/scene.json")
+    result = thzmap.simulate(scene, photons=100_000, seed=1, progress=True)
+    image = result.image("camera")
+    image.brightness_temperature      # numpy float32 (rows, columns, channels), K
+    result.summary["channels"]        # summary.json as a dict
+    result.save("out/teraeye")        # the files `thzmap simulate` writes
+
+A binding of libthzmap's C API (include/thzmap/) through ctypes; docs/python.md tells
+the whole story (installation, threads, cancellation, memory ownership).
+"""
+from . import _lib
+from ._call import RunWarning
+from .errors import (ArgumentError, CancelledError, Error, OutOfMemoryError,
+                     SceneError)
+from .progress import Progress
+from .run import (Image, PhotonMap, Result, fire_photons, load_photon_map,
+                  merge_photon_maps, render, simulate)
+from .scene import Scene, load_scene, scene_from_dict, scene_from_json
+
+__version__ = _lib.text(_lib.lib.thz_version())
+library_path = _lib.path
+"""The libthzmap file this package uses."""
+
+__all__ = ["ArgumentError", "CancelledError", "Error", "Image", "OutOfMemoryError",
+           "PhotonMap", "Progress", "Result", "RunWarning", "Scene", "SceneError",
+           "fire_photons", "library_path", "load_photon_map", "load_scene",
+           "merge_photon_maps", "render", "scene_from_dict", "scene_from_json", "simulate"]

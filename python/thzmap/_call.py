@@ -1,0 +1,117 @@
+"""One call into a long-running library function: its thz_context (threads, progress,
+warnings), Ctrl-C, and turning the outcome into a value or an exception.
+
+Cancellation. The library calls the progress callback on the thread that started the
+run, between batches of work; a non-zero return cancels the run, which then returns
+THZ_ERR_CANCELLED having freed everything and written nothing. A callback can also
+raise: the exception is kept, the run cancelled, and the exception re-raised once the
+C call has returned (an exception must never cross the C frames).
+
+Ctrl-C. Python's default SIGINT handler raises KeyboardInterrupt at whatever bytecode
+runs next; inside a ctypes callback that may be before any `try` (the function's entry),
+and ctypes would then print and drop it. So while a run started from the main thread is
+in C, SIGINT only sets a flag (if the default handler is in place); the progress
+callback sees it and cancels, and KeyboardInterrupt is raised after the C call returns.
+Runs on other threads are not interrupted by Ctrl-C (Python delivers it to the main
+thread only).
+"""
+import ctypes
+import signal
+import threading
+import warnings
+
+from . import _lib
+from .errors import ArgumentError, from_status
+from .progress import Progress, make_reporter
+
+
+class RunWarning(UserWarning):
+    """A warning of a run (also recorded in its summary)."""
+
+
+class Call:
+    """Use as `with Call(threads, progress) as call: status = call.run(fn, ...)`."""
+
+    def __init__(self, threads=None, progress=None):
+        if threads is not None:
+            if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+                raise ArgumentError(f"threads: expected a whole number >= 1, got {threads!r}")
+            threads = min(threads, 1 << 20)
+        self._report = make_reporter(progress)
+        self._exc = None
+        self._interrupted = False
+        self._cancelled = False
+        self._warnings = []
+        self._old_handler = None
+        self.error = _lib.ThzError()
+        self.ctx = _lib.lib.thz_context_create()
+        if not self.ctx:
+            raise MemoryError("thzmap: out of memory for a context")
+        _lib.lib.thz_context_set_threads(self.ctx, threads or 0)
+        # Keep the ctypes callbacks alive as long as the context may call them.
+        self._progress_cb = _lib.PROGRESS_FN(self._on_progress)
+        self._warning_cb = _lib.WARNING_FN(self._on_warning)
+        _lib.lib.thz_context_set_progress(self.ctx, self._progress_cb, None)
+        _lib.lib.thz_context_set_warning(self.ctx, self._warning_cb, None)
+
+    # -- callbacks (run on the calling thread, with the GIL, inside the C call) ------------
+    def _on_progress(self, user, p):
+        try:
+            if self._report is not None and not self._interrupted:
+                c = p.contents
+                info = Progress(_lib.text(c.stage), c.channel, c.n_channels, c.done, c.total)
+                if self._report(info):
+                    self._cancelled = True
+        except BaseException as e:  # noqa: B902 - every exception must stop at this frame
+            if self._exc is None:
+                self._exc = e
+        return 1 if (self._exc is not None or self._cancelled or self._interrupted) else 0
+
+    def _on_warning(self, user, message):
+        try:
+            self._warnings.append(_lib.text(message))
+        except BaseException as e:  # noqa: B902
+            if self._exc is None:
+                self._exc = e
+
+    def _on_sigint(self, signum, frame):
+        self._interrupted = True
+
+    # -- the call ----------------------------------------------------------------------------
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            try:
+                if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+                    self._old_handler = signal.signal(signal.SIGINT, self._on_sigint)
+            except ValueError:  # not the main interpreter
+                self._old_handler = None
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if self._old_handler is not None:
+            signal.signal(signal.SIGINT, self._old_handler)
+            self._old_handler = None
+        if self._report is not None and hasattr(self._report, "close"):
+            self._report.close()
+        _lib.lib.thz_context_set_progress(self.ctx, _lib.PROGRESS_FN(), None)
+        _lib.lib.thz_context_set_warning(self.ctx, _lib.WARNING_FN(), None)
+        _lib.lib.thz_context_destroy(self.ctx)
+        self.ctx = None
+        for w in self._warnings:
+            warnings.warn(w, RunWarning, stacklevel=3)
+        return False
+
+    def check(self, status, scene_label=None):
+        """Raises what the call's outcome calls for: the callback's exception,
+        KeyboardInterrupt after Ctrl-C, CancelledError, or the library's error."""
+        if self._exc is not None:
+            exc, self._exc = self._exc, None
+            raise exc
+        if self._interrupted:
+            raise KeyboardInterrupt
+        if status != _lib.OK:
+            raise from_status(status, _lib.text(self.error.message), scene_label)
+
+    @property
+    def err(self):
+        return ctypes.byref(self.error)

@@ -1,0 +1,95 @@
+"""The exceptions of thzmap, and how a C error becomes one.
+
+The library reports an error as a status and a one-line message that names the file
+and either line:column (JSON syntax, CSV files) or the JSON path (content). A bad
+scene becomes SceneError with those parts as attributes; every other failure Error.
+"""
+import re
+
+from . import _lib
+
+
+class Error(Exception):
+    """A failure reported by libthzmap. `status` is the library's status name
+    ("bad input", "I/O error", ...), `message` its one-line message."""
+
+    def __init__(self, message, status=None):
+        super().__init__(message)
+        self.message = message
+        self.status = status
+
+
+class SceneError(Error):
+    """A scene the library refuses. `file` is the scene file (or the label of a scene
+    made from a dict), `path` the JSON path such as "objects[2].temperature_k" (None for
+    a syntax error), `line` and `column` the position of a syntax error (else None),
+    `reason` the message without file and path."""
+
+    def __init__(self, message, file=None, path=None, line=None, column=None, reason=None):
+        super().__init__(message, "bad input")
+        self.file = file
+        self.path = path
+        self.line = line
+        self.column = column
+        self.reason = reason if reason is not None else message
+
+
+class CancelledError(Error):
+    """The run was cancelled by the progress callback; nothing was returned or written."""
+
+    def __init__(self, message="cancelled"):
+        super().__init__(message, "cancelled")
+
+
+class OutOfMemoryError(Error, MemoryError):
+    """The library ran out of memory (the run was refused or stopped; nothing leaked)."""
+
+
+class ArgumentError(Error, ValueError):
+    """An argument of a thzmap function is wrong (checked before the library is called)."""
+
+
+# A JSON path as the loader writes it: a key, then ".key" or "[index]" steps (keys of
+# materials may hold spaces), up to the ": " that starts the reason.
+_PATH = re.compile(r"^([A-Za-z_][\w-]*(?:\.[^:]*?|\[\d+\])*): (.*)$", re.S)
+_POSITION = re.compile(r"^(\d+)(?::(\d+))?: (.*)$", re.S)
+
+
+def scene_error(message, label):
+    """SceneError from the library's message about a scene labelled `label`."""
+    file = None
+    rest = message
+    if label is not None and message.startswith(label + ":"):
+        file, rest = label, message[len(label) + 1:]
+    else:  # a file other than the label, e.g. "dir/x.csv:3: ..."
+        m = re.match(r"^([^:\s][^:]*):(?=\s|\d)", message)
+        if m:
+            file, rest = m.group(1), message[m.end():]
+    line = column = path = None
+    m = _POSITION.match(rest)
+    if m:
+        line = int(m.group(1))
+        column = int(m.group(2)) if m.group(2) else None
+        reason = m.group(3)
+    else:
+        rest = rest[1:] if rest.startswith(" ") else rest
+        m = _PATH.match(rest)
+        if m:
+            path, reason = m.group(1), m.group(2)
+        else:
+            reason = rest
+    return SceneError(message, file=file, path=path, line=line, column=column, reason=reason)
+
+
+def from_status(status, message, scene_label=None):
+    """The exception for a failed call: SceneError for bad input about a scene (when
+    `scene_label` names it), CancelledError, else Error."""
+    if status == _lib.ERR_CANCELLED:
+        return CancelledError(message or "cancelled")
+    if status == _lib.ERR_NOMEM:
+        return OutOfMemoryError(message, "out of memory")
+    if status == _lib.ERR_INPUT and scene_label is not None:
+        err = scene_error(message, scene_label)
+        if err.path is not None or err.line is not None:
+            return err
+    return Error(message, _lib.text(_lib.lib.thz_status_name(status)))

@@ -1,0 +1,72 @@
+"""Progress reports of a run: the record a callback receives, and the bar shown for
+progress=True (tqdm when it is installed, else a line on stderr every second)."""
+import collections
+import sys
+import time
+
+from .errors import ArgumentError
+
+Progress = collections.namedtuple("Progress", "stage channel n_channels done total")
+Progress.__doc__ = """One progress report. `stage` is "photons" (done/total photons of the
+channel), "render" (rows of a sensor) or "output" (0/1, then 1/1); `channel` is the
+0-based index of the channel among `n_channels`."""
+
+_UNITS = {"photons": "photons", "render": "rows", "output": "steps"}
+
+
+class _Bar:
+    """A progress display: one tqdm bar per stage and channel."""
+
+    def __init__(self):
+        try:
+            import tqdm
+            self._tqdm = tqdm.tqdm
+        except ImportError:
+            self._tqdm = None
+        self._key = None
+        self._bar = None
+        self._last_line = 0.0
+
+    def __call__(self, p):
+        key = (p.stage, p.channel)
+        label = f"channel {p.channel + 1}/{p.n_channels} {p.stage}"
+        if self._tqdm is not None:
+            if key != self._key:
+                self.close()
+                self._key = key
+                self._bar = self._tqdm(total=p.total, desc=label, unit=_UNITS.get(p.stage, ""),
+                                       unit_scale=p.stage == "photons", leave=False)
+            self._bar.update(p.done - self._bar.n)
+        else:
+            now = time.monotonic()
+            if now - self._last_line >= 1.0 or p.done == p.total:
+                self._last_line = now
+                print(f"thzmap: {label}: {p.done}/{p.total} {_UNITS.get(p.stage, '')}",
+                      file=sys.stderr, flush=True)
+        return False
+
+    def close(self):
+        if self._bar is not None:
+            self._bar.close()
+        self._bar = None
+        self._key = None
+
+
+class _Callback:
+    def __init__(self, fn):
+        self._fn = fn
+
+    def __call__(self, p):
+        return bool(self._fn(p))
+
+
+def make_reporter(progress):
+    """None/False: no reports; True: a bar; a callable: called with a Progress, a true
+    return value cancels the run."""
+    if progress is None or progress is False:
+        return None
+    if progress is True:
+        return _Bar()
+    if callable(progress):
+        return _Callback(progress)
+    raise ArgumentError(f"progress: expected None, True or a callable, got {progress!r}")

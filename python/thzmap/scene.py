@@ -1,0 +1,196 @@
+"""Scenes: loading one from a file, a dict or JSON text, and reading what it holds."""
+import collections
+import ctypes
+import json
+import math
+import numbers
+import os
+import time
+
+from . import _lib
+from .errors import ArgumentError, SceneError, scene_error
+
+
+def _record(name, struct):
+    """A namedtuple type with the fields of a ctypes structure."""
+    return collections.namedtuple(name, [f for f, _ in struct._fields_])
+
+
+Channel = _record("Channel", _lib.ThzChannelInfo)
+Spectrum = _record("Spectrum", _lib.ThzSpectrumInfo)
+Material = _record("Material", _lib.ThzMaterialInfo)
+Object = _record("Object", _lib.ThzObjectInfo)
+Sensor = _record("Sensor", _lib.ThzSensorInfo)
+SceneInfo = _record("SceneInfo", _lib.ThzSceneInfo)
+_SPECTRUM_KINDS = {0: "absent", 1: "constant", 2: "table"}
+
+
+def _value(v):
+    if isinstance(v, bytes):
+        return v.decode("utf-8", "replace")
+    if isinstance(v, ctypes.Array):
+        return tuple(v)
+    if isinstance(v, _lib.ThzSpectrumInfo):
+        fields = _convert(v)
+        fields["kind"] = _SPECTRUM_KINDS.get(fields["kind"], fields["kind"])
+        return Spectrum(**fields)
+    return v
+
+
+def _convert(struct):
+    return {f: _value(getattr(struct, f)) for f, _ in struct._fields_}
+
+
+class Scene:
+    """A loaded and checked thzmap-scene/1 document (read-only). Made by load_scene,
+    scene_from_dict or scene_from_json; results and photon maps keep it alive."""
+
+    def __init__(self, handle, label, seconds_load):
+        self._owned = _lib.Handle(handle, _lib.lib.thz_scene_destroy)
+        self._handle = handle
+        self.label = label
+        self.seconds_load = seconds_load
+        info = _lib.ThzSceneInfo()
+        _lib.lib.thz_scene_get_info(handle, ctypes.byref(info))
+        self.info = SceneInfo(**_convert(info))
+        self.channels = self._list(_lib.lib.thz_scene_channel, _lib.ThzChannelInfo, Channel,
+                                   self.info.n_channels)
+        self.materials = self._list(_lib.lib.thz_scene_material, _lib.ThzMaterialInfo,
+                                    Material, self.info.n_materials)
+        self.objects = self._list(_lib.lib.thz_scene_object, _lib.ThzObjectInfo, Object,
+                                  self.info.n_objects)
+        self.sensors = self._list(_lib.lib.thz_scene_sensor, _lib.ThzSensorInfo, Sensor,
+                                  self.info.n_sensors)
+        n = _lib.lib.thz_scene_warning_count(handle)
+        self.warnings = [_lib.text(_lib.lib.thz_scene_warning(handle, i)) for i in range(n)]
+
+    def _list(self, fn, struct, record, n):
+        out = []
+        for i in range(n):
+            s = struct()
+            fn(self._handle, i, ctypes.byref(s))
+            out.append(record(**_convert(s)))
+        return out
+
+    @property
+    def name(self):
+        return self.info.name
+
+    @property
+    def sensor_names(self):
+        return [s.name for s in self.sensors]
+
+    @property
+    def object_names(self):
+        return [o.name for o in self.objects]
+
+    def sensor_index(self, sensor):
+        """The index of a sensor given by name or index; ArgumentError if there is none."""
+        if isinstance(sensor, numbers.Integral) and not isinstance(sensor, bool):
+            if 0 <= sensor < len(self.sensors):
+                return int(sensor)
+        elif isinstance(sensor, str):
+            for i, s in enumerate(self.sensors):
+                if s.name == sensor:
+                    return i
+        raise ArgumentError(f"sensor: the scene has no sensor {sensor!r} "
+                            f"(it has {', '.join(self.sensor_names)})")
+
+    def __repr__(self):
+        return (f"<thzmap.Scene {self.name!r}: {len(self.channels)} channels, "
+                f"{len(self.objects)} objects, sensors {self.sensor_names}>")
+
+
+def _load(loader, label):
+    handle = ctypes.c_void_p()
+    err = _lib.ThzError()
+    start = time.perf_counter()
+    status = loader(ctypes.byref(handle), ctypes.byref(err))
+    seconds = time.perf_counter() - start
+    if status != _lib.OK:
+        message = _lib.text(err.message)
+        if status == _lib.ERR_INPUT:
+            raise scene_error(message, label)
+        from .errors import from_status
+        raise from_status(status, message)
+    return Scene(handle.value, label, seconds)
+
+
+def _path_arg(name, value):
+    if not isinstance(value, (str, bytes, os.PathLike)):
+        raise ArgumentError(f"{name}: expected a path, got {value!r}")
+    value = os.fsdecode(value)
+    if "\0" in value:
+        raise ArgumentError(f"{name}: a path cannot contain a NUL character")
+    return value
+
+
+def load_scene(path):
+    """Loads and checks the scene file at `path`. Raises SceneError (with .file, .path,
+    .line, .column) for a bad scene."""
+    path = _path_arg("path", path)
+    return _load(lambda out, err: _lib.lib.thz_scene_load(os.fsencode(path), out, err), path)
+
+
+def _check_json_values(value, path, label):
+    """Raises SceneError at the first value JSON cannot hold (NaN, infinity, other
+    types), naming its JSON path as the library would."""
+    def fail(reason):
+        where = f"{label}: {path}: " if path else f"{label}: "
+        return SceneError(where + reason, file=label, path=path or None, reason=reason)
+
+    if isinstance(value, dict):
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise fail(f"keys must be strings, got {k!r}")
+            _check_json_values(v, f"{path}.{k}" if path else k, label)
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            _check_json_values(v, f"{path}[{i}]", label)
+    elif hasattr(value, "tolist") and not isinstance(value, (str, bytes)):  # numpy
+        _check_json_values(value.tolist(), path, label)
+    elif isinstance(value, bool) or value is None or isinstance(value, str):
+        pass
+    elif isinstance(value, numbers.Real):
+        if not math.isfinite(value):
+            raise fail(f"expected a finite number, got {value}")
+    else:
+        raise fail(f"cannot be written as JSON ({type(value).__name__})")
+
+
+def _json_default(value):
+    if hasattr(value, "tolist"):  # numpy arrays and scalars
+        return value.tolist()
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real):
+        return float(value)
+    raise TypeError(type(value).__name__)
+
+
+def scene_from_json(text, base_dir=None, label="<string>"):
+    """A scene from JSON text; relative file paths in it are taken against `base_dir`
+    (default: the current directory); `label` names it in messages (SceneError.file)."""
+    if not isinstance(text, str):
+        raise ArgumentError(f"text: expected a str, got {type(text).__name__}")
+    if not isinstance(label, str) or "\0" in label:
+        raise ArgumentError(f"label: expected a str without NUL, got {label!r}")
+    if "\0" in text:
+        raise ArgumentError("text: JSON text cannot contain a NUL character")
+    base = None if base_dir is None else os.fsencode(_path_arg("base_dir", base_dir))
+    data = text.encode("utf-8")
+    return _load(lambda out, err: _lib.lib.thz_scene_load_string(
+        data, base, label.encode("utf-8"), out, err), label)
+
+
+def scene_from_dict(d, base_dir=None, label="<dict>"):
+    """A scene from a dict with the keys of a scene file; relative file paths in it are
+    taken against `base_dir` (default: the current directory). Numbers may be numpy
+    scalars or arrays. Raises SceneError naming the JSON path of a bad value."""
+    if not isinstance(d, dict):
+        raise ArgumentError(f"d: expected a dict, got {type(d).__name__}")
+    if not isinstance(label, str):
+        raise ArgumentError(f"label: expected a str, got {label!r}")
+    _check_json_values(d, "", label)
+    text = json.dumps(d, default=_json_default, allow_nan=False)
+    return scene_from_json(text, base_dir=base_dir, label=label)

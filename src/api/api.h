@@ -1,0 +1,79 @@
+/* The public API's handles (include/thzmap/) over the internal stages: what each
+ * handle holds, and the helpers the src/api/ files share. Nothing here is public. */
+#ifndef THZ_API_API_H
+#define THZ_API_API_H
+
+#include <stdbool.h>
+
+#include "core/error.h"
+#include "photon/photon_map.h"
+#include "photon/photon_stats.h"
+#include "run/run.h"
+#include "scene/scene.h"
+#include "sensor/images.h"
+#include "thzmap/thzmap.h"
+
+struct thz_context {
+    int threads;
+    thz_progress_fn progress;
+    void *progress_user;
+    thz_warning_fn warning;
+    void *warning_user;
+    thz_error last; /* the last failure of a call that took this context */
+};
+
+/* Photon maps of every channel of a scene (a channel may have none). */
+struct thz_photons {
+    const thz_scene *scene; /* borrowed: the scene the caller fired or loaded them for */
+    thz_scene effective;    /* shallow copy of *scene with the overrides they were fired with */
+    size_t n_channels;
+    photon_map **maps;   /* per channel, NULL: none */
+    photon_stats *stats; /* per channel */
+    uint64_t seed;
+    uint64_t photons_per_channel;
+    bool owned; /* maps and stats belong to this handle (not to a thz_run) */
+};
+
+struct thz_image {
+    const thz_scene *scene; /* the (effective) scene it was rendered in; borrowed */
+    size_t sensor;
+    const sensor_images *img; /* borrowed from a run */
+    float *object_id;         /* object_id as float, -1: nothing hit */
+    struct thz_run *run;      /* a standalone image owns its run (the planes live there) */
+};
+
+struct thz_run {
+    const thz_scene *scene; /* borrowed: the caller's */
+    thz_scene effective;    /* shallow copy with the run's overrides; rs.scene points here */
+    run_state rs;
+    thz_image *images;   /* per rendered sensor, borrowing rs.images */
+    thz_photons photons; /* the kept maps (borrowed from rs), if any */
+    bool has_photons;
+    char *summary;
+};
+
+/* Applies the settings' overrides to a shallow copy of `scene` (the copy shares every
+ * array with it and must not be destroyed). THZ_ERR_INPUT for an unknown integrator. */
+thz_status api_effective_scene(const thz_scene *scene, const thz_run_settings *settings,
+                               thz_scene *out, thz_error *err);
+
+/* run_options from a context and settings. */
+void api_run_options(const thz_context *ctx, const thz_run_settings *settings, run_options *opt);
+
+/* Records a failure in ctx (may be NULL) and returns st. */
+thz_status api_done(thz_context *ctx, thz_status st, const thz_error *err);
+
+/* The caller's error, or `local` when the caller passed NULL (so ctx still gets the
+ * message). */
+static inline thz_error *api_err(thz_error *err, thz_error *local)
+{
+    thz_error_clear(local);
+    return err ? err : local;
+}
+
+/* Builds the image handles of a finished run (borrowing its planes). */
+thz_status api_image_init_borrowed(thz_image *image, const thz_scene *scene, size_t sensor,
+                                   const sensor_images *img, thz_error *err);
+void api_image_fini(thz_image *image);
+
+#endif

@@ -1,0 +1,110 @@
+/* Writing results: an atomic output directory (io/output.h's staging) that runs and
+ * images are added to, and the one-call writers built on it. */
+#include <stdlib.h>
+
+#include "api/api.h"
+#include "core/alloc.h"
+#include "io/output.h"
+
+struct thz_output {
+    output_stage *stage;
+};
+
+thz_status thz_output_open(const char *outdir, thz_output **out, thz_error *err)
+{
+    *out = NULL;
+    if (!outdir || !outdir[0])
+        return thz_error_set(err, THZ_ERR_INPUT, "no output directory given");
+    thz_output *o = thz_calloc(1, sizeof *o);
+    if (!o)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    thz_status st = output_stage_create(outdir, &o->stage, err);
+    if (st != THZ_OK) {
+        free(o);
+        return st;
+    }
+    *out = o;
+    return THZ_OK;
+}
+
+void thz_output_destroy(thz_output *output)
+{
+    if (!output)
+        return;
+    output_stage_destroy(output->stage); /* removes what was not committed */
+    free(output);
+}
+
+thz_status thz_output_commit(thz_output *output, thz_error *err)
+{
+    if (!output)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_output_commit: no output");
+    return output_stage_commit(output->stage, err);
+}
+
+thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run,
+                              const thz_write_options *opt, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    if (!output || !run)
+        return api_done(ctx,
+                        thz_error_set(err, THZ_ERR_INPUT, "thz_output_add_run: no %s",
+                                      output ? "run" : "output"),
+                        err);
+    run_write_options wo = {0};
+    if (opt) {
+        wo.photon_map = opt->photon_map != 0;
+        wo.ply_max_points = opt->ply_max_points;
+    }
+    if (ctx) {
+        wo.progress = ctx->progress;
+        wo.progress_user = ctx->progress_user;
+    }
+    if (wo.photon_map && !run->has_photons)
+        return api_done(ctx,
+                        thz_error_set(err, THZ_ERR_INPUT,
+                                      "the run kept no photon maps to write (keep_photons, and "
+                                      "an integrator that fires photons)"),
+                        err);
+    return api_done(ctx, run_write(&run->rs, output_stage_dir(output->stage), &wo, err), err);
+}
+
+thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_error *err)
+{
+    if (!output || !image)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_output_add_image: no %s",
+                             output ? "image" : "output");
+    return output_write_sensor(output_stage_dir(output->stage), image->scene, image->sensor,
+                               image->img, err);
+}
+
+thz_status thz_run_write(thz_context *ctx, thz_run *run, const char *outdir,
+                         const thz_write_options *opt, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    thz_output *o = NULL;
+    thz_status st = thz_output_open(outdir, &o, err);
+    if (st == THZ_OK)
+        st = thz_output_add_run(ctx, o, run, opt, err);
+    if (st == THZ_OK)
+        st = thz_output_commit(o, err);
+    thz_output_destroy(o);
+    return api_done(ctx, st, err);
+}
+
+thz_status thz_image_write(thz_context *ctx, const thz_image *image, const char *dir,
+                           thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    thz_output *o = NULL;
+    thz_status st = thz_output_open(dir, &o, err);
+    if (st == THZ_OK)
+        st = thz_output_add_image(o, image, err);
+    if (st == THZ_OK)
+        st = thz_output_commit(o, err);
+    thz_output_destroy(o);
+    return api_done(ctx, st, err);
+}

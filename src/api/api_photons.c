@@ -1,0 +1,269 @@
+/* The photon phase as a handle: fire, load, save, merge, statistics. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "accel/accel.h"
+#include "api/api.h"
+#include "core/alloc.h"
+#include "io/photon_map_file.h"
+#include "photon/phase.h"
+
+static thz_status api_photons_create(const thz_scene *scene, thz_photons **out, thz_error *err)
+{
+    thz_photons *ph = thz_calloc(1, sizeof *ph);
+    size_t nc = scene->n_channels;
+    if (ph) {
+        ph->maps = thz_calloc(nc ? nc : 1, sizeof *ph->maps);
+        ph->stats = thz_calloc(nc ? nc : 1, sizeof *ph->stats);
+    }
+    if (!ph || !ph->maps || !ph->stats) {
+        if (ph) {
+            free(ph->maps);
+            free(ph->stats);
+        }
+        free(ph);
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the photon maps");
+    }
+    ph->scene = scene;
+    ph->effective = *scene;
+    ph->n_channels = nc;
+    ph->owned = true;
+    *out = ph;
+    return THZ_OK;
+}
+
+void thz_photons_destroy(thz_photons *ph)
+{
+    if (!ph || !ph->owned)
+        return;
+    for (size_t c = 0; c < ph->n_channels; c++)
+        photon_map_destroy(ph->maps[c]);
+    free(ph->maps);
+    free(ph->stats);
+    free(ph);
+}
+
+/* Fires channel `only` (or every channel when only == SIZE_MAX). */
+static thz_status api_fire(thz_context *ctx, const thz_scene *scene,
+                           const thz_run_settings *settings, size_t only, thz_photons **out,
+                           thz_error *err)
+{
+    *out = NULL;
+    if (!scene)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_photons_fire: no scene");
+    if (only != SIZE_MAX && only >= scene->n_channels)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_photons_fire_channel: channel %zu of %zu",
+                             only, scene->n_channels);
+    thz_photons *ph = NULL;
+    accel *acc = NULL;
+    thz_status st = api_photons_create(scene, &ph, err);
+    if (st == THZ_OK)
+        st = api_effective_scene(scene, settings, &ph->effective, err);
+    const thz_scene *eff = ph ? &ph->effective : NULL;
+    if (st == THZ_OK)
+        st = render_integrator_check(eff->render.integrator, err);
+    if (st == THZ_OK && !render_integrator_needs_photons(eff->render.integrator))
+        st = thz_error_set(err, THZ_ERR_INPUT, "the %s integrator uses no photons",
+                           render_integrator_name(eff->render.integrator));
+    if (st == THZ_OK)
+        st = accel_create(eff, &acc, err);
+    for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
+        if (only != SIZE_MAX && c != only)
+            continue;
+        photon_phase_options po = {.threads = ctx ? ctx->threads : 0,
+                                   .reference_temperature_k = run_photon_t0_k(eff, c),
+                                   .first_photon = settings ? settings->first_photon : 0,
+                                   .progress = ctx ? ctx->progress : NULL,
+                                   .progress_user = ctx ? ctx->progress_user : NULL};
+        st = photon_phase_run(eff, acc, c, &po, &ph->maps[c], &ph->stats[c], err);
+    }
+    accel_destroy(acc);
+    if (st != THZ_OK) {
+        thz_photons_destroy(ph);
+        return st;
+    }
+    ph->seed = eff->photons.seed;
+    ph->photons_per_channel = eff->photons.per_channel;
+    *out = ph;
+    return THZ_OK;
+}
+
+thz_status thz_photons_fire(thz_context *ctx, const thz_scene *scene,
+                            const thz_run_settings *settings, thz_photons **out, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    return api_done(ctx, api_fire(ctx, scene, settings, SIZE_MAX, out, err), err);
+}
+
+thz_status thz_photons_fire_channel(thz_context *ctx, const thz_scene *scene,
+                                    const thz_run_settings *settings, size_t channel,
+                                    thz_photons **out, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    if (channel == SIZE_MAX)
+        channel = SIZE_MAX - 1; /* out of range, not "all" */
+    return api_done(ctx, api_fire(ctx, scene, settings, channel, out, err), err);
+}
+
+thz_status thz_photons_load(thz_context *ctx, const thz_scene *scene, const char *path,
+                            thz_photons **out, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    *out = NULL;
+    if (!scene || !path)
+        return api_done(
+            ctx,
+            thz_error_set(err, THZ_ERR_INPUT, "thz_photons_load: no %s", scene ? "path" : "scene"),
+            err);
+    thz_photons *ph = NULL;
+    thz_status st = api_photons_create(scene, &ph, err);
+    photon_map_file_info info;
+    if (st == THZ_OK)
+        st = photon_map_file_read(path, scene, ctx ? ctx->threads : 0, ph->maps, ph->stats, &info,
+                                  err);
+    if (st != THZ_OK) {
+        thz_photons_destroy(ph);
+        return api_done(ctx, st, err);
+    }
+    ph->seed = info.seed;
+    ph->photons_per_channel = info.photons_per_channel;
+    ph->effective.photons.seed = info.seed;
+    ph->effective.photons.per_channel = info.photons_per_channel;
+    *out = ph;
+    return THZ_OK;
+}
+
+thz_status thz_photons_save(const thz_photons *ph, const char *path, thz_error *err)
+{
+    if (!ph || !path)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_photons_save: no %s",
+                             ph ? "path" : "photons");
+    for (size_t c = 0; c < ph->n_channels; c++)
+        if (!ph->maps[c])
+            return thz_error_set(err, THZ_ERR_INPUT,
+                                 "%s: channel %zu has no photon map (fired one channel only?)",
+                                 path, c);
+    return photon_map_file_write(path, &ph->effective, (const photon_map *const *)ph->maps,
+                                 ph->stats, err);
+}
+
+/* Whether the parts can merge: one scene, seed, photon count and T0 per channel. */
+static thz_status api_merge_check(const thz_photons *const *parts, size_t n, thz_error *err)
+{
+    if (!parts || n == 0)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_photons_merge: no photons to merge");
+    for (size_t i = 0; i < n; i++) {
+        const thz_photons *p = parts[i], *a = parts[0];
+        if (!p)
+            return thz_error_set(err, THZ_ERR_INPUT, "thz_photons_merge: part %zu is NULL", i);
+        if (p->scene != a->scene || p->seed != a->seed ||
+            p->photons_per_channel != a->photons_per_channel)
+            return thz_error_set(err, THZ_ERR_INPUT,
+                                 "thz_photons_merge: part %zu has another scene, seed or photon "
+                                 "count than part 0",
+                                 i);
+        for (size_t c = 0; c < p->n_channels; c++)
+            if (p->maps[c] && a->maps[c] &&
+                photon_map_reference_temperature_k(p->maps[c]) !=
+                    photon_map_reference_temperature_k(a->maps[c]))
+                return thz_error_set(err, THZ_ERR_INPUT,
+                                     "thz_photons_merge: part %zu was fired for another "
+                                     "integrator (reference temperature of channel %zu)",
+                                     i, c);
+    }
+    return THZ_OK;
+}
+
+thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, size_t n,
+                             thz_photons **out, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    *out = NULL;
+    thz_photons *ph = NULL;
+    thz_status st = api_merge_check(parts, n, err);
+    if (st == THZ_OK)
+        st = api_photons_create(parts[0]->scene, &ph, err);
+    const photon_map **maps = st == THZ_OK ? thz_calloc(n, sizeof *maps) : NULL;
+    if (st == THZ_OK && !maps)
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for merging photon maps");
+    for (size_t c = 0; st == THZ_OK && c < ph->n_channels; c++) {
+        size_t m = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (!parts[i]->maps[c])
+                continue;
+            maps[m++] = parts[i]->maps[c];
+            run_stats_merge(&ph->stats[c], &parts[i]->stats[c], (uint32_t)m);
+        }
+        if (m > 0)
+            st = photon_map_merge(maps, m, ph->effective.n_objects, ctx ? ctx->threads : 0,
+                                  &ph->maps[c], err);
+        if (st == THZ_OK && ph->maps[c])
+            ph->stats[c].stored = photon_map_count(ph->maps[c]);
+    }
+    free(maps);
+    if (st != THZ_OK) {
+        thz_photons_destroy(ph);
+        return api_done(ctx, st, err);
+    }
+    ph->effective = parts[0]->effective;
+    ph->seed = parts[0]->seed;
+    ph->photons_per_channel = parts[0]->photons_per_channel * n;
+    ph->effective.photons.per_channel = ph->photons_per_channel;
+    *out = ph;
+    return THZ_OK;
+}
+
+size_t thz_photons_channel_count(const thz_photons *ph)
+{
+    return ph ? ph->n_channels : 0;
+}
+
+int thz_photons_has_channel(const thz_photons *ph, size_t c)
+{
+    return ph && c < ph->n_channels && ph->maps[c] != NULL;
+}
+
+uint64_t thz_photons_seed(const thz_photons *ph)
+{
+    return ph ? ph->seed : 0;
+}
+
+uint64_t thz_photons_per_channel(const thz_photons *ph)
+{
+    return ph ? ph->photons_per_channel : 0;
+}
+
+thz_status thz_photons_stats(const thz_photons *ph, size_t c, thz_photon_stats *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!ph || c >= ph->n_channels)
+        return THZ_ERR_INPUT;
+    const photon_stats *s = &ph->stats[c];
+    *out = (thz_photon_stats){
+        .fired = s->fired,
+        .stored = s->stored,
+        .hits = s->hits,
+        .reflected = s->reflected,
+        .transmitted = s->transmitted,
+        .absorbed = s->absorbed,
+        .escaped = s->escaped,
+        .back_face_hits = s->back_face_hits,
+        .terminated = s->terminated,
+        .bounce_capped = s->bounce_capped,
+        .rays = s->rays,
+        .emitted_power_w_per_hz = s->emitted_power_w_per_hz,
+        .fired_power_w_per_hz = s->fired_power_w_per_hz,
+        .absorbed_power_w_per_hz = s->absorbed_power_w_per_hz,
+        .escaped_power_w_per_hz = s->escaped_power_w_per_hz,
+        .atmosphere_power_w_per_hz = s->atmosphere_power_w_per_hz,
+        .terminated_power_w_per_hz = s->terminated_power_w_per_hz,
+        .mean_bounces = s->mean_bounces,
+        .reference_temperature_k = s->reference_temperature_k,
+        .seconds = s->seconds,
+    };
+    return THZ_OK;
+}

@@ -1,0 +1,302 @@
+/* Whole runs in memory (simulate, render from photons), their images, and writing them
+ * through an atomic output directory. */
+#include <limits.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "api/api.h"
+#include "core/alloc.h"
+
+/* ---- images ------------------------------------------------------------------------- */
+
+thz_status api_image_init_borrowed(thz_image *image, const thz_scene *scene, size_t sensor,
+                                   const sensor_images *img, thz_error *err)
+{
+    memset(image, 0, sizeof *image);
+    image->scene = scene;
+    image->sensor = sensor;
+    image->img = img;
+    size_t pixels = (size_t)img->columns * img->rows;
+    image->object_id = thz_malloc_array(pixels ? pixels : 1, sizeof *image->object_id);
+    if (!image->object_id)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the object_id plane");
+    for (size_t p = 0; p < pixels; p++)
+        image->object_id[p] = (float)img->object_id[p]; /* exact: at most 2^24 objects */
+    return THZ_OK;
+}
+
+void api_image_fini(thz_image *image)
+{
+    free(image->object_id);
+    image->object_id = NULL;
+}
+
+void thz_image_destroy(thz_image *image)
+{
+    if (!image || !image->run) /* a run's image belongs to the run */
+        return;
+    thz_run_destroy(image->run);
+    free(image);
+}
+
+uint32_t thz_image_columns(const thz_image *image)
+{
+    return image ? image->img->columns : 0;
+}
+
+uint32_t thz_image_rows(const thz_image *image)
+{
+    return image ? image->img->rows : 0;
+}
+
+size_t thz_image_channel_count(const thz_image *image)
+{
+    return image ? image->img->n_channels : 0;
+}
+
+size_t thz_image_sensor(const thz_image *image)
+{
+    return image ? image->sensor : 0;
+}
+
+const char *thz_image_sensor_name(const thz_image *image)
+{
+    return image ? image->scene->sensors[image->sensor].name : NULL;
+}
+
+const float *thz_image_plane(const thz_image *image, thz_plane plane, size_t *n_bands)
+{
+    const float *data = NULL;
+    size_t bands = 1;
+    if (image) {
+        const sensor_images *img = image->img;
+        switch (plane) {
+        case THZ_PLANE_RADIANCE:
+            data = img->radiance;
+            bands = img->n_channels;
+            break;
+        case THZ_PLANE_RADIANCE_STDERR:
+            data = img->radiance_stderr;
+            bands = img->n_channels;
+            break;
+        case THZ_PLANE_POWER:
+            data = img->power;
+            bands = img->n_channels;
+            break;
+        case THZ_PLANE_BRIGHTNESS_TEMPERATURE:
+            data = img->brightness_temperature;
+            bands = img->n_channels;
+            break;
+        case THZ_PLANE_NORMALIZED:
+            data = img->normalized;
+            bands = img->n_channels;
+            break;
+        case THZ_PLANE_TEMPERATURE:
+            data = img->temperature_k;
+            break;
+        case THZ_PLANE_DISTANCE:
+            data = img->distance_m;
+            break;
+        case THZ_PLANE_OBJECT_ID:
+            data = image->object_id;
+            break;
+        case THZ_PLANE_VISUAL_RGB:
+            data = img->visual_rgb;
+            bands = 3;
+            break;
+        case THZ_PLANE_COUNT:
+            break;
+        }
+    }
+    if (n_bands)
+        *n_bands = data ? bands : 0;
+    return data;
+}
+
+const char *thz_plane_name(thz_plane plane)
+{
+    static const char *const names[THZ_PLANE_COUNT] = {
+        "radiance",   "radiance_stderr", "power",    "brightness_temperature",
+        "normalized", "temperature",     "distance", "object_id",
+        "visual"};
+    return (unsigned)plane < THZ_PLANE_COUNT ? names[plane] : NULL;
+}
+
+/* ---- runs ----------------------------------------------------------------------------- */
+
+void thz_run_destroy(thz_run *run)
+{
+    if (!run)
+        return;
+    for (size_t i = 0; run->images && i < run->rs.n_selected; i++)
+        api_image_fini(&run->images[i]);
+    free(run->images);
+    free(run->summary);
+    run_state_fini(&run->rs);
+    free(run);
+}
+
+/* The handles of a finished run: its images, its kept photons, its summary. */
+static thz_status api_run_wrap(thz_run *run, thz_error *err)
+{
+    run_state *rs = &run->rs;
+    run->images = thz_calloc(rs->n_selected ? rs->n_selected : 1, sizeof *run->images);
+    if (!run->images)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < rs->n_selected; i++) {
+        thz_status st = api_image_init_borrowed(&run->images[i], &run->effective, rs->selected[i],
+                                                &rs->images[i], err);
+        if (st != THZ_OK)
+            return st;
+    }
+    bool all = rs->maps != NULL;
+    for (size_t c = 0; all && c < run->effective.n_channels; c++)
+        all = rs->maps[c] != NULL;
+    if (all) {
+        run->photons = (thz_photons){.scene = run->scene,
+                                     .effective = run->effective,
+                                     .n_channels = run->effective.n_channels,
+                                     .maps = rs->maps,
+                                     .stats = rs->stats,
+                                     .seed = rs->seed,
+                                     .photons_per_channel = rs->photons_per_channel,
+                                     .owned = false};
+        run->has_photons = true;
+    }
+    run->summary = run_summary_text(rs, err);
+    return run->summary ? THZ_OK : THZ_ERR_NOMEM;
+}
+
+/* simulate (photons NULL and !render) or render. */
+static thz_status api_run(thz_context *ctx, const thz_scene *scene, const thz_photons *photons,
+                          bool render, const char *sensor_name, const thz_run_settings *settings,
+                          thz_run **out, thz_error *err)
+{
+    *out = NULL;
+    if (!scene)
+        return thz_error_set(err, THZ_ERR_INPUT, "no scene");
+    if (photons && photons->scene != scene)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "the photons were fired or loaded for another scene handle");
+    thz_run *run = thz_calloc(1, sizeof *run);
+    if (!run)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    run->scene = scene;
+    thz_status st = api_effective_scene(scene, settings, &run->effective, err);
+    run_options opt;
+    api_run_options(ctx, settings, &opt);
+    opt.sensor_name = sensor_name;
+    if (st == THZ_OK && render) {
+        opt.keep_photon_maps = false; /* the photons are the caller's */
+        run_photons in = {0};
+        if (photons)
+            in = (run_photons){.maps = photons->maps,
+                               .stats = photons->stats,
+                               .seed = photons->seed,
+                               .photons_per_channel = photons->photons_per_channel};
+        st = run_render(&run->effective, &opt, photons ? &in : NULL, &run->rs, err);
+    } else if (st == THZ_OK) {
+        st = run_simulate(&run->effective, &opt, &run->rs, err);
+    }
+    if (st == THZ_OK)
+        st = api_run_wrap(run, err);
+    if (st != THZ_OK) {
+        thz_run_destroy(run);
+        return st;
+    }
+    *out = run;
+    return THZ_OK;
+}
+
+thz_status thz_simulate(thz_context *ctx, const thz_scene *scene, const thz_run_settings *settings,
+                        thz_run **out, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    return api_done(ctx, api_run(ctx, scene, NULL, false, NULL, settings, out, err), err);
+}
+
+thz_status thz_render_run(thz_context *ctx, const thz_scene *scene, const thz_photons *photons,
+                          long sensor, const thz_run_settings *settings, thz_run **out,
+                          thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    const char *name = NULL;
+    if (sensor >= 0) {
+        if (!scene || (size_t)sensor >= scene->n_sensors) {
+            *out = NULL;
+            return api_done(
+                ctx,
+                thz_error_set(err, THZ_ERR_INPUT, "render: the scene has no sensor %ld", sensor),
+                err);
+        }
+        name = scene->sensors[sensor].name;
+    }
+    return api_done(ctx, api_run(ctx, scene, photons, true, name, settings, out, err), err);
+}
+
+thz_status thz_render_sensor(thz_context *ctx, const thz_scene *scene, const thz_photons *photons,
+                             size_t sensor, const thz_run_settings *settings, thz_image **out,
+                             thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    *out = NULL;
+    thz_image *image = thz_calloc(1, sizeof *image);
+    if (!image)
+        return api_done(ctx, thz_error_set(err, THZ_ERR_NOMEM, "out of memory"), err);
+    thz_run *run = NULL;
+    long index = sensor > (size_t)LONG_MAX ? LONG_MAX : (long)sensor;
+    thz_status st = thz_render_run(ctx, scene, photons, index, settings, &run, err);
+    if (st != THZ_OK) {
+        free(image);
+        return st;
+    }
+    *image = run->images[0];
+    image->run = run;
+    *out = image;
+    return THZ_OK;
+}
+
+size_t thz_run_image_count(const thz_run *run)
+{
+    return run ? run->rs.n_selected : 0;
+}
+
+const thz_image *thz_run_image(const thz_run *run, size_t i)
+{
+    return run && i < run->rs.n_selected ? &run->images[i] : NULL;
+}
+
+const thz_photons *thz_run_photons(const thz_run *run)
+{
+    return run && run->has_photons ? &run->photons : NULL;
+}
+
+const char *thz_run_summary_json(const thz_run *run)
+{
+    return run ? run->summary : NULL;
+}
+
+void thz_run_get_totals(const thz_run *run, thz_run_totals *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!run)
+        return;
+    const run_result *r = &run->rs.result;
+    *out =
+        (thz_run_totals){.n_channels = r->n_channels,
+                         .n_sensors = r->n_sensors,
+                         .photons_fired = r->photons_fired,
+                         .photons_stored = r->photons_stored,
+                         .back_face_samples = r->back_face_samples,
+                         .n_warnings = r->n_warnings,
+                         .worst_median_stderr_k = r->worst_median_stderr_k,
+                         .worst_p95_stderr_k = r->worst_p95_stderr_k,
+                         .worst_object = r->worst_object == SIZE_MAX ? -1 : (long)r->worst_object,
+                         .worst_object_channel = r->worst_object_channel,
+                         .worst_object_p95_stderr_k = r->worst_object_p95_stderr_k,
+                         .max_passes = r->max_passes,
+                         .seconds = r->seconds};
+}

@@ -1,0 +1,216 @@
+/* Scenes through the public API: loading (the loader, then the check that the sensors'
+ * images fit in memory, which the loader cannot make: it knows no images), read access
+ * by value. (Destroying is scene/scene.c's thz_scene_destroy.) */
+#include <string.h>
+
+#include "api/api.h"
+#include "physics/channel.h"
+#include "sensor/render.h"
+
+/* A loaded scene whose images would not fit in memory is refused (THZ_ERR_LIMIT, naming
+ * sensors[i].resolution). */
+static thz_status api_scene_checked(thz_status st, thz_scene **out, thz_error *err)
+{
+    if (st == THZ_OK && (st = run_check_scene_memory(*out, err)) != THZ_OK) {
+        scene_destroy(*out);
+        *out = NULL;
+    }
+    return st;
+}
+
+thz_status thz_scene_load_string(const char *json_text, const char *base_dir, const char *label,
+                                 thz_scene **out, thz_error *err)
+{
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_scene_load_string: no place for the scene");
+    if (!json_text) {
+        *out = NULL;
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_scene_load_string: no JSON text");
+    }
+    return api_scene_checked(
+        scene_load_string(json_text, base_dir, label ? label : "<string>", out, err), out, err);
+}
+
+thz_status thz_scene_load(const char *path, thz_scene **out, thz_error *err)
+{
+    return api_scene_checked(scene_load(path, out, err), out, err);
+}
+
+thz_status thz_scene_get_info(const thz_scene *s, thz_scene_info *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!s)
+        return THZ_ERR_INPUT;
+    *out = (thz_scene_info){
+        .name = s->name,
+        .path = s->path,
+        .atmosphere_model = atmosphere_model_name(s->atmosphere.model),
+        .n_channels = s->n_channels,
+        .n_materials = s->n_materials,
+        .n_objects = s->n_objects,
+        .n_sensors = s->n_sensors,
+        .n_warnings = s->n_warnings,
+        .photons_per_channel = s->photons.per_channel,
+        .seed = s->photons.seed,
+        .min_relative_power = s->photons.min_relative_power,
+        .gather_min_photons = s->photons.gather_min_photons,
+        .integrator = render_integrator_name(s->render.integrator),
+        .gather_rays = s->render.gather_rays,
+        .paths_per_sample = s->render.paths_per_sample,
+    };
+    return THZ_OK;
+}
+
+thz_status thz_scene_channel(const thz_scene *s, size_t i, thz_channel_info *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!s || i >= s->n_channels)
+        return THZ_ERR_INPUT;
+    const thz_channel *ch = &s->channels[i];
+    *out = (thz_channel_info){
+        .name = ch->name,
+        .frequency_hz = ch->center_hz,
+        .frequency_thz = ch->center_hz * 1e-12,
+        .relative_width = ch->relative_width,
+        .bandwidth_hz = channel_bandwidth_hz(ch),
+        .emitted_power_w_per_hz = scene_band_emitted_power_w_per_hz(s, i),
+    };
+    return THZ_OK;
+}
+
+static thz_spectrum_info api_spectrum(const thz_spectrum *sp)
+{
+    thz_spectrum_info info = {0};
+    if (sp->n == 0)
+        return info;
+    if (!sp->freq_hz) {
+        info.kind = THZ_SPECTRUM_CONSTANT;
+        info.n_points = 1;
+        info.value = sp->value[0];
+        return info;
+    }
+    info.kind = THZ_SPECTRUM_TABLE;
+    info.n_points = sp->n;
+    info.from_thz = sp->freq_hz[0] * 1e-12;
+    info.to_thz = sp->freq_hz[sp->n - 1] * 1e-12;
+    spectrum_range(sp, &info.min_value, &info.max_value);
+    return info;
+}
+
+thz_status thz_scene_material(const thz_scene *s, size_t i, thz_material_info *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!s || i >= s->n_materials)
+        return THZ_ERR_INPUT;
+    const thz_material *m = &s->materials[i];
+    out->name = m->name;
+    out->reflectivity = api_spectrum(&m->reflectivity);
+    out->attenuation_per_m = api_spectrum(&m->attenuation_per_m);
+    out->emissivity = api_spectrum(&m->emissivity);
+    out->transmission = m->transmission == TRANSMISSION_STRAIGHT ? "straight" : "diffuse";
+    memcpy(out->color, m->color, sizeof out->color);
+    return THZ_OK;
+}
+
+thz_status thz_scene_object(const thz_scene *s, size_t i, thz_object_info *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!s || i >= s->n_objects)
+        return THZ_ERR_INPUT;
+    const thz_object *o = &s->objects[i];
+    *out = (thz_object_info){
+        .name = o->name,
+        .type = o->type == OBJECT_SHELL ? "shell" : "solid",
+        .two_sided = o->two_sided,
+        .thickness_m = o->thickness_m,
+        .material = o->material,
+        .material_name = s->materials[o->material].name,
+        .temperature_k = o->temperature_k,
+        .triangles = o->mesh.n_triangles,
+        .area_m2 = o->mesh.total_area_m2,
+    };
+    memcpy(out->bbox_min_m, o->mesh.bbox_min_m, sizeof out->bbox_min_m);
+    memcpy(out->bbox_max_m, o->mesh.bbox_max_m, sizeof out->bbox_max_m);
+    return THZ_OK;
+}
+
+thz_status thz_scene_sensor(const thz_scene *s, size_t i, thz_sensor_info *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!s || i >= s->n_sensors)
+        return THZ_ERR_INPUT;
+    const thz_sensor *sn = &s->sensors[i];
+    *out = (thz_sensor_info){
+        .name = sn->name,
+        .columns = sn->columns,
+        .rows = sn->rows,
+        .channels = s->n_channels,
+        .fov_deg = sn->fov_deg,
+        .oversampling = sn->oversampling,
+        .aperture_m2 = sn->aperture_m2,
+        .normalize_to_k = sn->normalize_to_k,
+    };
+    memcpy(out->position_m, sn->position_m, sizeof out->position_m);
+    memcpy(out->direction, sn->direction, sizeof out->direction);
+    memcpy(out->up, sn->up, sizeof out->up);
+    return THZ_OK;
+}
+
+size_t thz_scene_channel_count(const thz_scene *s)
+{
+    return s ? s->n_channels : 0;
+}
+
+size_t thz_scene_object_count(const thz_scene *s)
+{
+    return s ? s->n_objects : 0;
+}
+
+size_t thz_scene_sensor_count(const thz_scene *s)
+{
+    return s ? s->n_sensors : 0;
+}
+
+long thz_scene_sensor_index(const thz_scene *s, const char *name)
+{
+    for (size_t i = 0; s && name && i < s->n_sensors; i++)
+        if (strcmp(s->sensors[i].name, name) == 0)
+            return (long)i;
+    return -1;
+}
+
+long thz_scene_object_index(const thz_scene *s, const char *name)
+{
+    for (size_t i = 0; s && name && i < s->n_objects; i++)
+        if (strcmp(s->objects[i].name, name) == 0)
+            return (long)i;
+    return -1;
+}
+
+size_t thz_scene_warning_count(const thz_scene *s)
+{
+    return s ? s->n_warnings : 0;
+}
+
+const char *thz_scene_warning(const thz_scene *s, size_t i)
+{
+    return s && i < s->n_warnings ? s->warnings[i] : NULL;
+}
+
+int thz_integrator_known(const char *name)
+{
+    thz_integrator it;
+    return name && render_integrator_parse(name, &it);
+}
+
+int thz_integrator_needs_photons(const char *name)
+{
+    thz_integrator it;
+    return name && render_integrator_parse(name, &it) && render_integrator_needs_photons(it);
+}
+
+int thz_integrator_has_passes(const char *name)
+{
+    thz_integrator it;
+    return name && render_integrator_parse(name, &it) && render_integrator_has_passes(it);
+}

@@ -1,0 +1,94 @@
+/* Cancelling from the progress callback: a run stopped in its photon phase, in its
+ * rendering, or while it is written returns THZ_ERR_CANCELLED, hands nothing back, and
+ * leaves no output directory contents (the output directory it created is removed).
+ * argv: the thzmap binary (unused), the repository. */
+#include <dirent.h>
+#include <sys/stat.h>
+
+#include "api_test.h"
+
+typedef struct cancel_at {
+    const char *stage; /* cancel at the first report of this stage */
+    int reports;       /* reports seen before cancelling */
+    int cancelled;
+} cancel_at;
+
+static int cancel_progress(void *user, const thz_progress *p)
+{
+    cancel_at *c = user;
+    c->reports++;
+    if (strcmp(p->stage, c->stage) == 0) {
+        c->cancelled = 1;
+        return 1;
+    }
+    return 0;
+}
+
+/* 1 when path does not exist or is an empty directory. */
+static int empty_or_missing(const char *path)
+{
+    DIR *d = opendir(path);
+    if (!d)
+        return 1;
+    int entries = 0;
+    for (struct dirent *e; (e = readdir(d));)
+        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0)
+            entries++;
+    closedir(d);
+    return entries == 0;
+}
+
+int main(int argc, char **argv)
+{
+    (void)argc;
+    char dir[4096], out[4200];
+    test_temp_dir(dir, sizeof dir);
+    thz_error err = {0};
+    thz_scene *scene = NULL;
+    REQUIRE_OK(thz_scene_load_string(test_scene_json, dir, "cancel.json", &scene, &err), &err);
+    thz_context *ctx = thz_context_create();
+
+    /* in the photon phase and in rendering, with the output opened first (as the CLI) */
+    const char *stages[] = {"photons", "render"};
+    for (size_t k = 0; k < 2; k++) {
+        cancel_at c = {.stage = stages[k]};
+        thz_context_set_progress(ctx, cancel_progress, &c);
+        snprintf(out, sizeof out, "%s/out-%s", dir, stages[k]);
+        thz_output *output = NULL;
+        REQUIRE_OK(thz_output_open(out, &output, &err), &err);
+        thz_run *run = (thz_run *)&c; /* must be reset to NULL */
+        thz_status st = thz_simulate(ctx, scene, NULL, &run, &err);
+        CHECK(st == THZ_ERR_CANCELLED, "%s: %s (%s)", stages[k], thz_status_name(st), err.message);
+        CHECK(c.cancelled, "%s: the callback never saw the stage", stages[k]);
+        CHECK(run == NULL, "%s: a run came back", stages[k]);
+        CHECK(thz_context_last_status(ctx) == THZ_ERR_CANCELLED, "last status %s",
+              thz_status_name(thz_context_last_status(ctx)));
+        thz_output_destroy(output);
+        CHECK(empty_or_missing(out), "%s holds files after cancelling", out);
+    }
+
+    /* while writing: OUTDIR, created by the write, is gone again */
+    thz_context_set_progress(ctx, NULL, NULL);
+    thz_run_settings settings = {.integrator = "path"}; /* quick: no photons */
+    thz_run *run = NULL;
+    REQUIRE_OK(thz_simulate(ctx, scene, &settings, &run, &err), &err);
+    cancel_at c = {.stage = "output"};
+    thz_context_set_progress(ctx, cancel_progress, &c);
+    snprintf(out, sizeof out, "%s/out-write", dir);
+    thz_status st = thz_run_write(ctx, run, out, NULL, &err);
+    CHECK(st == THZ_ERR_CANCELLED, "write: %s (%s)", thz_status_name(st), err.message);
+    struct stat info;
+    CHECK(stat(out, &info) != 0, "%s exists after a cancelled write", out);
+    /* and without cancelling, it is written */
+    thz_context_set_progress(ctx, NULL, NULL);
+    REQUIRE_OK(thz_run_write(ctx, run, out, NULL, &err), &err);
+    CHECK(!empty_or_missing(out), "%s empty after a write", out);
+    thz_run_destroy(run);
+
+    thz_context_destroy(ctx);
+    thz_scene_destroy(scene);
+    if (test_failures == 0)
+        test_remove_dir(dir);
+    printf("%s: %d failures\n", argv[0], test_failures);
+    return test_failures ? 1 : 0;
+}

@@ -1,0 +1,146 @@
+/* The API's contracts: _destroy(NULL) does nothing; bad input gives THZ_ERR_INPUT with
+ * a message naming the text's label and the JSON path or line:column; out-of-range
+ * indices, foreign photons, unknown integrators and half-fired photons are refused;
+ * photons fired in disjoint ranges merge. argv: the thzmap binary (unused), the repo. */
+#include "api_test.h"
+
+static void expect_input_error(thz_status st, const thz_error *err, const char *needle,
+                               const char *what)
+{
+    CHECK(st == THZ_ERR_INPUT, "%s: %s (%s)", what, thz_status_name(st), err->message);
+    CHECK(strstr(err->message, needle) != NULL, "%s: '%s' not in '%s'", what, needle, err->message);
+}
+
+/* The test scene with `from` replaced by `to` (malloc'd). */
+static char *scene_with(const char *from, const char *to)
+{
+    const char *at = strstr(test_scene_json, from);
+    if (!at)
+        exit(1);
+    size_t n = strlen(test_scene_json) - strlen(from) + strlen(to) + 1;
+    char *s = malloc(n);
+    if (!s)
+        exit(1);
+    snprintf(s, n, "%.*s%s%s", (int)(at - test_scene_json), test_scene_json, to, at + strlen(from));
+    return s;
+}
+
+int main(int argc, char **argv)
+{
+    (void)argc;
+    thz_context_destroy(NULL);
+    thz_scene_destroy(NULL);
+    thz_photons_destroy(NULL);
+    thz_image_destroy(NULL);
+    thz_run_destroy(NULL);
+    thz_output_destroy(NULL);
+    thz_atm_destroy(NULL);
+    CHECK(thz_image_plane(NULL, THZ_PLANE_RADIANCE, NULL) == NULL, "plane of NULL");
+    CHECK(thz_run_image(NULL, 0) == NULL, "image of NULL");
+    CHECK(strcmp(thz_version(), THZ_VERSION_STRING) == 0, "version %s", thz_version());
+    CHECK(thz_plane_name(THZ_PLANE_COUNT) == NULL, "plane name out of range");
+
+    thz_error err = {0};
+    thz_scene *scene = (thz_scene *)&err; /* must be reset to NULL */
+    char *bad = scene_with("\"frequency_thz\": 0.9", "\"frequency_thz\": -0.9");
+    expect_input_error(thz_scene_load_string(bad, NULL, "bad.json", &scene, &err), &err,
+                       "channels[1].frequency_thz", "negative frequency");
+    CHECK(strstr(err.message, "bad.json") != NULL, "label missing: %s", err.message);
+    CHECK(scene == NULL, "a scene came back");
+    free(bad);
+    expect_input_error(thz_scene_load_string("{\"format\": ", NULL, "cut.json", &scene, &err), &err,
+                       "cut.json:1:", "syntax");
+    expect_input_error(thz_scene_load_string(NULL, NULL, NULL, &scene, &err), &err, "no JSON",
+                       "NULL text");
+
+    thz_scene *a = NULL, *b = NULL;
+    REQUIRE_OK(thz_scene_load_string(test_scene_json, NULL, "a.json", &a, &err), &err);
+    REQUIRE_OK(thz_scene_load_string(test_scene_json, NULL, "b.json", &b, &err), &err);
+    thz_object_info oi;
+    CHECK(thz_scene_object(a, 99, &oi) == THZ_ERR_INPUT && oi.name == NULL, "object 99");
+    CHECK(thz_scene_object(a, 2, &oi) == THZ_OK && strcmp(oi.type, "shell") == 0 &&
+              strcmp(oi.material_name, "cloth") == 0,
+          "object 2 is %s of %s", oi.type, oi.material_name);
+    CHECK(thz_scene_sensor_index(a, "nobody") == -1, "unknown sensor");
+    CHECK(thz_scene_warning(a, thz_scene_warning_count(a)) == NULL, "warning out of range");
+    CHECK(thz_integrator_known("path") && !thz_integrator_known("magic"), "integrator names");
+    CHECK(thz_integrator_needs_photons("final-gather") && !thz_integrator_needs_photons("path"),
+          "needs photons");
+
+    thz_context *ctx = thz_context_create();
+    thz_run_settings settings = {.integrator = "magic"};
+    thz_photons *ph = (thz_photons *)&err;
+    expect_input_error(thz_photons_fire(ctx, a, &settings, &ph, &err), &err, "magic",
+                       "unknown integrator");
+    CHECK(ph == NULL, "photons came back");
+    CHECK(thz_context_last_status(ctx) == THZ_ERR_INPUT &&
+              strstr(thz_context_last_message(ctx), "magic"),
+          "context's last error: %s", thz_context_last_message(ctx));
+    thz_run_settings_init(&settings);
+    settings.photons_per_channel = 4000;
+
+    /* two disjoint halves merge into photons of both */
+    thz_photons *half[2] = {NULL, NULL}, *merged = NULL;
+    REQUIRE_OK(thz_photons_fire(ctx, a, &settings, &half[0], &err), &err);
+    settings.first_photon = 4000;
+    REQUIRE_OK(thz_photons_fire(ctx, a, &settings, &half[1], &err), &err);
+    REQUIRE_OK(thz_photons_merge(ctx, (const thz_photons *const *)half, 2, &merged, &err), &err);
+    thz_photon_stats s0, s1, sm;
+    thz_photons_stats(half[0], 0, &s0);
+    thz_photons_stats(half[1], 0, &s1);
+    thz_photons_stats(merged, 0, &sm);
+    CHECK(sm.fired == 8000 && sm.stored == s0.stored + s1.stored,
+          "merged: %llu fired, %llu stored of %llu + %llu", (unsigned long long)sm.fired,
+          (unsigned long long)sm.stored, (unsigned long long)s0.stored,
+          (unsigned long long)s1.stored);
+    CHECK(thz_photons_per_channel(merged) == 8000, "merged per channel %llu",
+          (unsigned long long)thz_photons_per_channel(merged));
+
+    /* photons of another scene handle, or of one channel only, do not render */
+    thz_image *image = (thz_image *)&err;
+    expect_input_error(thz_render_sensor(ctx, b, merged, 0, NULL, &image, &err), &err,
+                       "another scene", "foreign photons");
+    CHECK(image == NULL, "an image came back");
+    thz_photons *one = NULL;
+    REQUIRE_OK(thz_photons_fire_channel(ctx, a, &settings, 1, &one, &err), &err);
+    CHECK(!thz_photons_has_channel(one, 0) && thz_photons_has_channel(one, 1), "one channel");
+    expect_input_error(thz_render_sensor(ctx, a, one, 0, NULL, &image, &err), &err, "channel 0",
+                       "half-fired photons");
+    expect_input_error(thz_photons_save(one, "/nonexistent/x.thzpm", &err), &err, "channel 0",
+                       "saving half-fired photons");
+    expect_input_error(thz_render_sensor(ctx, a, merged, 7, NULL, &image, &err), &err, "sensor 7",
+                       "sensor out of range");
+    thz_photons *none = (thz_photons *)&err;
+    expect_input_error(thz_photons_fire_channel(ctx, a, &settings, 2, &none, &err), &err,
+                       "channel 2", "channel out of range");
+    CHECK(none == NULL, "photons came back");
+
+    /* a photon map of another scene is refused on loading */
+    char dir[4096], path[4200];
+    test_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/a.thzpm", dir);
+    REQUIRE_OK(thz_photons_save(merged, path, &err), &err);
+    char *other_text = scene_with("\"size_m\": [0.6, 0.05, 0.5]", "\"size_m\": [0.7, 0.05, 0.5]");
+    thz_scene *other = NULL;
+    REQUIRE_OK(thz_scene_load_string(other_text, NULL, "other.json", &other, &err), &err);
+    thz_photons *foreign = (thz_photons *)&err;
+    expect_input_error(thz_photons_load(ctx, other, path, &foreign, &err), &err, "a.thzpm",
+                       "map of another scene");
+    CHECK(foreign == NULL, "photons came back");
+    thz_output *output = NULL;
+    expect_input_error(thz_output_open("", &output, &err), &err, "no output directory",
+                       "empty OUTDIR");
+
+    thz_photons_destroy(one);
+    thz_photons_destroy(merged);
+    thz_photons_destroy(half[0]);
+    thz_photons_destroy(half[1]);
+    thz_scene_destroy(other);
+    free(other_text);
+    thz_scene_destroy(a);
+    thz_scene_destroy(b);
+    thz_context_destroy(ctx);
+    test_remove_dir(dir);
+    printf("%s: %d failures\n", argv[0], test_failures);
+    return test_failures ? 1 : 0;
+}

@@ -1,0 +1,138 @@
+/* The API against the CLI: a scene from a JSON string, photons fired, saved and read
+ * back, two sensors rendered in memory; every plane must equal, bit for bit, the ENVI
+ * image `thzmap simulate` writes for the same scene and seed (and the saved map the
+ * CLI's photon-map.thzpm), whatever the thread counts (1 here, 2 for the CLI).
+ * argv: the thzmap binary, the repository. */
+#include "api_test.h"
+
+/* Compares every ENVI plane of `image` with the files of dir/<sensor>.<quantity>.img. */
+static void compare_with_files(const thz_image *image, const char *dir)
+{
+    size_t pixels = (size_t)thz_image_columns(image) * thz_image_rows(image);
+    for (int p = 0; p < THZ_PLANE_COUNT; p++) {
+        if (p == THZ_PLANE_VISUAL_RGB)
+            continue; /* a PNG, 8 bits: not the float plane */
+        size_t bands = 0;
+        const float *plane = thz_image_plane(image, (thz_plane)p, &bands);
+        char path[4200];
+        snprintf(path, sizeof path, "%s/%s.%s.img", dir, thz_image_sensor_name(image),
+                 thz_plane_name((thz_plane)p));
+        size_t size = 0;
+        unsigned char *file = test_read_file(path, &size);
+        if (!plane) {
+            CHECK(!file, "%s exists but the image has no %s plane", path,
+                  thz_plane_name((thz_plane)p));
+            free(file);
+            continue;
+        }
+        CHECK(file != NULL, "%s missing", path);
+        if (file) {
+            CHECK(size == bands * pixels * sizeof(float), "%s: %zu bytes, plane %zu", path, size,
+                  bands * pixels * sizeof(float));
+            CHECK(size == bands * pixels * sizeof(float) && memcmp(file, plane, size) == 0,
+                  "%s differs from the in-memory plane", path);
+        }
+        free(file);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: %s THZMAP_BINARY [REPO]\n", argv[0]);
+        return 2;
+    }
+    char dir[4096], path[4200], cmd[9000];
+    test_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/scene.json", dir);
+    test_write_file(path, test_scene_json);
+    snprintf(cmd, sizeof cmd,
+             "'%s' simulate '%s' -o '%s/cli' --threads 2 --save-photon-map --quiet", argv[1], path,
+             dir);
+    CHECK(system(cmd) == 0, "%s failed", cmd);
+
+    thz_error err = {0};
+    thz_scene *scene = NULL;
+    REQUIRE_OK(thz_scene_load_string(test_scene_json, dir, "api-test.json", &scene, &err), &err);
+    CHECK(thz_scene_sensor_count(scene) == 2, "%zu sensors", thz_scene_sensor_count(scene));
+    CHECK(thz_scene_channel_count(scene) == 2, "%zu channels", thz_scene_channel_count(scene));
+    CHECK(thz_scene_sensor_index(scene, "side") == 1, "index of 'side'");
+    thz_sensor_info sn;
+    REQUIRE_OK(thz_scene_sensor(scene, 0, &sn), &err);
+    CHECK(sn.columns == 20 && sn.rows == 16 && sn.channels == 2, "cam is %ux%u", sn.columns,
+          sn.rows);
+
+    thz_context *ctx = thz_context_create();
+    thz_context_set_threads(ctx, 1);
+    thz_photons *fired = NULL, *photons = NULL;
+    REQUIRE_OK(thz_photons_fire(ctx, scene, NULL, &fired, &err), &err);
+    thz_photon_stats ps;
+    REQUIRE_OK(thz_photons_stats(fired, 1, &ps), &err);
+    CHECK(ps.fired == 20000 && ps.stored > 0, "channel 1: %llu fired, %llu stored",
+          (unsigned long long)ps.fired, (unsigned long long)ps.stored);
+    CHECK(ps.emitted_power_w_per_hz > 0.0, "emitted power %g W/Hz", ps.emitted_power_w_per_hz);
+    snprintf(path, sizeof path, "%s/api.thzpm", dir);
+    REQUIRE_OK(thz_photons_save(fired, path, &err), &err);
+    thz_photons_destroy(fired);
+    REQUIRE_OK(thz_photons_load(ctx, scene, path, &photons, &err), &err);
+    CHECK(thz_photons_seed(photons) == 4 && thz_photons_per_channel(photons) == 20000,
+          "seed %llu, %llu photons", (unsigned long long)thz_photons_seed(photons),
+          (unsigned long long)thz_photons_per_channel(photons));
+
+    /* the saved map is the CLI's, byte for byte */
+    size_t n_api = 0, n_cli = 0;
+    unsigned char *api_map = test_read_file(path, &n_api);
+    snprintf(path, sizeof path, "%s/cli/photon-map.thzpm", dir);
+    unsigned char *cli_map = test_read_file(path, &n_cli);
+    CHECK(api_map && cli_map && n_api == n_cli && memcmp(api_map, cli_map, n_api) == 0,
+          "the saved photon map differs from %s (%zu and %zu bytes)", path, n_api, n_cli);
+    free(api_map);
+    free(cli_map);
+
+    snprintf(path, sizeof path, "%s/cli", dir);
+    for (size_t s = 0; s < 2; s++) {
+        thz_image *image = NULL;
+        REQUIRE_OK(thz_render_sensor(ctx, scene, photons, s, NULL, &image, &err), &err);
+        CHECK(thz_image_sensor(image) == s, "sensor %zu", thz_image_sensor(image));
+        size_t bands = 0;
+        CHECK(thz_image_plane(image, THZ_PLANE_RADIANCE, &bands) && bands == 2, "radiance bands");
+        CHECK(thz_image_plane(image, THZ_PLANE_VISUAL_RGB, &bands) && bands == 3, "visual bands");
+        compare_with_files(image, path);
+        thz_image_destroy(image);
+    }
+
+    /* a whole run in memory gives the same images, a summary, and kept photons */
+    thz_run_settings settings;
+    thz_run_settings_init(&settings);
+    settings.keep_photons = 1;
+    thz_run *run = NULL;
+    REQUIRE_OK(thz_simulate(ctx, scene, &settings, &run, &err), &err);
+    CHECK(thz_run_image_count(run) == 2, "%zu images", thz_run_image_count(run));
+    for (size_t i = 0; i < thz_run_image_count(run); i++)
+        compare_with_files(thz_run_image(run, i), path);
+    const char *summary = thz_run_summary_json(run);
+    CHECK(summary && strstr(summary, "\"photons_fired\": 20000"), "summary: %.200s",
+          summary ? summary : "(null)");
+    CHECK(thz_run_photons(run) != NULL, "photons kept");
+    thz_run_totals totals;
+    thz_run_get_totals(run, &totals);
+    CHECK(totals.photons_fired == 40000 && totals.n_sensors == 2, "%llu photons, %zu sensors",
+          (unsigned long long)totals.photons_fired, totals.n_sensors);
+    /* written, it is the CLI's output again */
+    snprintf(path, sizeof path, "%s/written", dir);
+    thz_write_options wo = {.photon_map = 1};
+    REQUIRE_OK(thz_run_write(ctx, run, path, &wo, &err), &err);
+    for (size_t i = 0; i < thz_run_image_count(run); i++)
+        compare_with_files(thz_run_image(run, i), path);
+    thz_run_destroy(run);
+
+    thz_photons_destroy(photons);
+    thz_context_destroy(ctx);
+    thz_scene_destroy(scene);
+    if (test_failures == 0)
+        test_remove_dir(dir);
+    else
+        fprintf(stderr, "kept %s\n", dir);
+    printf("%s: %d failures\n", argv[0], test_failures);
+    return test_failures ? 1 : 0;
+}

@@ -1,0 +1,133 @@
+"""The arrays of the Python API equal, bit for bit, the ENVI files `thzmap simulate`
+and `thzmap render` write for the same scene and seed; result.save writes the same
+files; photon maps save, load and re-render."""
+import filecmp
+import json
+import os
+
+import numpy as np
+import pytest
+import thzmap
+from conftest import (CUBES, MAPS, assert_bitwise_equal, read_envi, run_cli,
+                      tiny_scene_dict)
+
+SEED = 7
+
+
+def compare_with_files(result, outdir):
+    for sensor in result.sensors:
+        im = result.image(sensor)
+        for q in CUBES + MAPS:
+            if q == "radiance_stderr" and not os.path.exists(
+                    os.path.join(outdir, f"{sensor}.{q}.img")):
+                assert im.radiance_stderr is None
+                continue
+            assert_bitwise_equal(getattr(im, q), read_envi(outdir, sensor, q, im.rows,
+                                                            im.columns), f"{sensor}.{q}")
+
+
+@pytest.mark.parametrize("integrator", [None, "path"])
+def test_simulate_equals_cli_files(tiny_dir, thzmap_binary, integrator):
+    out = tiny_dir / "cli"
+    args = ["simulate", tiny_dir / "scene.json", "-o", out, "--seed", SEED, "--threads", 2,
+            "--quiet"]
+    if integrator:
+        args += ["--integrator", integrator]
+    run_cli(thzmap_binary, *args)
+    # From a dict with a base directory, and with a different thread count.
+    scene = thzmap.scene_from_dict(tiny_scene_dict(), base_dir=tiny_dir)
+    result = thzmap.simulate(scene, integrator=integrator, seed=SEED, threads=1)
+    im = result.image("cam")
+    assert im.radiance.shape == (12, 20, 2)
+    assert im.object_id.shape == (12, 20)
+    compare_with_files(result, out)
+
+
+def test_arrays_are_views_of_the_library_buffers(tiny_dir):
+    result = thzmap.simulate(thzmap.load_scene(tiny_dir / "scene.json"), seed=SEED)
+    im = result.image("cam")
+    cube = im.radiance
+    assert not cube.flags.writeable
+    assert not cube.flags.owndata and cube.base is not None
+    # (rows, columns, channels) is a transposed view of the band-sequential plane.
+    bsq = im.plane("radiance")
+    assert cube.__array_interface__["data"][0] == bsq.__array_interface__["data"][0]
+    assert cube.strides == (20 * 4, 4, 12 * 20 * 4)
+    # An array outlives the Result and the Scene it came from.
+    copy = np.array(cube)
+    del result, im, bsq, cube
+    import gc
+    gc.collect()
+    again = thzmap.simulate(thzmap.load_scene(tiny_dir / "scene.json"), seed=SEED)
+    assert np.array_equal(again.image("cam").radiance, copy)
+
+
+def test_save_writes_the_cli_files(tiny_dir, thzmap_binary):
+    cli = tiny_dir / "cli"
+    run_cli(thzmap_binary, "simulate", tiny_dir / "scene.json", "-o", cli, "--seed", SEED,
+            "--quiet", "--save-photon-map")
+    result = thzmap.simulate(thzmap.load_scene(tiny_dir / "scene.json"), seed=SEED,
+                             keep_photons=True)
+    py = tiny_dir / "py"
+    result.save(py)
+    assert sorted(os.listdir(py)) == sorted(os.listdir(cli))
+    for name in os.listdir(cli):
+        if name != "summary.json":  # it holds timings
+            assert filecmp.cmp(cli / name, py / name, shallow=False), name
+    with open(cli / "summary.json") as f:
+        cli_summary = json.load(f)
+    for key in ("seed", "photons_per_channel", "integrator", "channels"):
+        if key == "channels":
+            strip = [{k: v for k, v in c.items() if not k.endswith("_s")}
+                     for c in cli_summary[key]]
+            mine = [{k: v for k, v in c.items() if not k.endswith("_s")}
+                    for c in result.summary[key]]
+            assert strip == mine
+        else:
+            assert result.summary[key] == cli_summary[key]
+
+
+def test_photon_map_save_load_render(tiny_dir, thzmap_binary):
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    result = thzmap.simulate(scene, seed=SEED, keep_photons=True)
+    pm = result.photon_map
+    assert pm.n_channels == 2 and pm.seed == SEED and pm.photons_per_channel == 3000
+    assert pm.stats[0].fired == 3000
+    path = tiny_dir / "map.thzpm"
+    pm.save(path)
+    # Re-rendering the kept map gives the simulate's images again.
+    again = thzmap.render(scene, pm)
+    for q in CUBES[:1] + CUBES[2:] + MAPS:
+        assert_bitwise_equal(getattr(again.image("cam"), q), getattr(result.image("cam"), q), q)
+    # From the file, with the final-gather integrator... compared with `thzmap render`.
+    loaded = thzmap.load_photon_map(scene, path)
+    # Timings and ray counts are not stored in the file.
+    assert [s._replace(seconds=0, rays=0) for s in loaded.stats] == \
+        [s._replace(seconds=0, rays=0) for s in pm.stats]
+    rendered = thzmap.render(scene, loaded, sensor="cam")
+    out = tiny_dir / "render"
+    run_cli(thzmap_binary, "render", tiny_dir / "scene.json", "--photon-map", path, "-o", out,
+            "--quiet")
+    compare_with_files(rendered, out)
+    by_path = thzmap.render(scene, str(path))
+    assert_bitwise_equal(by_path.image(0).power, rendered.image(0).power, "power")
+
+
+def test_fire_and_merge(tiny_dir):
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    a = thzmap.fire_photons(scene, photons=1500, seed=SEED)
+    b = thzmap.fire_photons(scene, photons=1500, seed=SEED, first_photon=1500)
+    merged = thzmap.merge_photon_maps([a, b])
+    assert [s.fired for s in merged.stats] == [3000, 3000]
+    assert thzmap.render(scene, merged).image("cam").radiance.shape == (12, 20, 2)
+
+
+def test_scene_accessors(tiny_dir):
+    scene = thzmap.scene_from_dict(tiny_scene_dict(), base_dir=tiny_dir, label="tiny")
+    assert scene.name == "plate-in-box"
+    assert [c.frequency_thz for c in scene.channels] == pytest.approx([0.35, 0.8])
+    assert scene.object_names == ["room", "target", "cover"]
+    assert scene.sensors[0].columns == 20 and scene.sensors[0].rows == 12
+    table = [m for m in scene.materials if m.name == "table"][0]
+    assert table.reflectivity.kind == "table"
+    assert scene.info.path == "tiny"

@@ -1,0 +1,148 @@
+"""Errors: a bad scene raises SceneError naming the file and the JSON path (or line and
+column); wrong arguments raise ArgumentError before the library is called; nothing here
+may crash the interpreter."""
+import math
+
+import numpy as np
+import pytest
+import thzmap
+from conftest import tiny_scene_dict
+
+
+def test_bad_dict_names_the_json_path(tiny_dir):
+    d = tiny_scene_dict()
+    d["channels"][1]["frequency_thz"] = -0.3
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.scene_from_dict(d, base_dir=tiny_dir)
+    assert e.value.file == "<dict>"
+    assert e.value.path == "channels[1].frequency_thz"
+    assert "expected a number > 0, got -0.3" in e.value.reason
+    assert isinstance(e.value, thzmap.Error)
+
+
+@pytest.mark.parametrize("edit, path", [
+    (lambda d: d["objects"][2].__setitem__("temperature_k", "hot"), "objects[2].temperature_k"),
+    (lambda d: d["materials"]["wall"].__setitem__("reflectivity", 1.5),
+     "materials.wall.reflectivity"),
+    (lambda d: d.__setitem__("photon", {}), "photon"),
+    (lambda d: d["sensors"][0].__setitem__("fov_deg", math.nan), "sensors[0].fov_deg"),
+    (lambda d: d["sensors"][0].__setitem__("fov_deg", np.float32(np.inf)),
+     "sensors[0].fov_deg"),
+    (lambda d: d["objects"][0]["shape"].__setitem__("size_m", object()),
+     "objects[0].shape.size_m"),
+])
+def test_bad_values_name_their_path(tiny_dir, edit, path):
+    d = tiny_scene_dict()
+    edit(d)
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.scene_from_dict(d, base_dir=tiny_dir, label="mine")
+    assert e.value.path == path
+    assert e.value.file == "mine"
+    assert str(e.value).startswith("mine: " + path + ": ")
+
+
+def test_relative_paths_need_the_base_dir(tmp_path):
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.scene_from_dict(tiny_scene_dict(), base_dir=tmp_path)  # no materials/ there
+    assert e.value.path == "materials.table.file"
+
+
+def test_numpy_values_are_accepted(tiny_dir):
+    d = tiny_scene_dict()
+    d["sensors"][0]["position_m"] = np.array([0, -0.45, 0.4])
+    d["sensors"][0]["resolution"] = [np.int64(20), np.int64(12)]
+    scene = thzmap.scene_from_dict(d, base_dir=tiny_dir)
+    assert scene.sensors[0].position_m == (0, -0.45, 0.4)
+
+
+def test_syntax_error_in_a_file_names_line_and_column(tmp_path):
+    p = tmp_path / "broken.json"
+    p.write_text('{\n  "format": "thzmap-scene/1"\n  "name": "x"\n}\n')
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.load_scene(p)
+    assert e.value.file == str(p)
+    assert (e.value.line, e.value.path) == (3, None)
+    assert e.value.column is not None
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(thzmap.Error) as e:
+        thzmap.load_scene(tmp_path / "nothing.json")
+    assert "nothing.json" in str(e.value)
+
+
+@pytest.mark.parametrize("kwargs", [
+    {"photons": 0}, {"photons": -5}, {"photons": 2.5}, {"photons": 1 << 64}, {"photons": 10**12 + 1},
+    {"seed": -1}, {"seed": "1"}, {"threads": 0}, {"threads": True},
+    {"integrator": "magic"}, {"integrator": "path\0"}, {"target_noise_k": math.nan},
+    {"target_noise_k": -1}, {"max_seconds": 3}, {"progress": 42},
+])
+def test_bad_arguments_raise_before_the_library(tiny_dir, kwargs):
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    with pytest.raises(thzmap.ArgumentError):
+        thzmap.simulate(scene, **kwargs)
+
+
+def test_bad_render_arguments(tiny_dir):
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    other = thzmap.load_scene(tiny_dir / "scene.json")
+    pm = thzmap.fire_photons(scene, photons=500)
+    with pytest.raises(thzmap.ArgumentError, match="another Scene"):
+        thzmap.render(other, pm)
+    with pytest.raises(thzmap.ArgumentError, match="no sensor"):
+        thzmap.render(scene, pm, sensor="nope")
+    with pytest.raises(thzmap.ArgumentError, match="photon map"):
+        thzmap.render(scene, None)
+    with pytest.raises(thzmap.ArgumentError):
+        thzmap.render(scene, 3.0)
+    with pytest.raises(thzmap.ArgumentError):
+        thzmap.scene_from_dict("not a dict")
+    result = thzmap.render(scene, pm)
+    with pytest.raises(thzmap.ArgumentError):
+        result.image("nope")
+    with pytest.raises(thzmap.ArgumentError, match="keep"):
+        result.save(tiny_dir / "o", photon_map=True)
+
+
+def test_a_photon_map_of_another_scene_is_refused(tiny_dir):
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    path = tiny_dir / "map.thzpm"
+    thzmap.fire_photons(scene, photons=500).save(path)
+    d = tiny_scene_dict()
+    d["objects"][1]["temperature_k"] = 311
+    changed = thzmap.scene_from_dict(d, base_dir=tiny_dir)
+    with pytest.raises(thzmap.Error):
+        thzmap.load_photon_map(changed, path)
+    with pytest.raises(thzmap.Error):
+        thzmap.load_photon_map(scene, tiny_dir / "scene.json")  # not a photon map
+
+
+def test_run_warnings_arrive_as_warnings(tiny_dir):
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    with pytest.warns(thzmap.RunWarning):
+        result = thzmap.simulate(scene, photons=200)
+    assert result.summary["warnings"]
+
+
+def _bad_scenes():
+    import os
+    from conftest import REPO
+    with open(os.path.join(REPO, "tests", "inputs", "bad_scenes.tsv")) as f:
+        rows = [line.rstrip("\n").split("\t") for line in f if not line.startswith("#")]
+    return [(os.path.join(REPO, "tests", "inputs", "bad", name), want)
+            for name, _, want in rows]
+
+
+@pytest.mark.parametrize("path, want", _bad_scenes(),
+                         ids=[p.rsplit("/", 1)[1] for p, _ in _bad_scenes()])
+def test_every_bad_scene_of_the_cli_tests(path, want):
+    """The CLI's corpus of bad scenes: each raises SceneError with the CLI's message,
+    naming its file and a JSON path or a line (but for a document that is no object)."""
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.load_scene(path)
+    assert want in str(e.value)
+    assert e.value.file == path
+    assert (e.value.path is not None or e.value.line is not None
+            or path.endswith("not_an_object.json"))
+    if e.value.path is not None:
+        assert str(e.value) == f"{path}: {e.value.path}: {e.value.reason}"
