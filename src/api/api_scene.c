@@ -7,13 +7,16 @@
 #include "physics/channel.h"
 #include "sensor/render.h"
 
-/* A loaded scene whose images would not fit in memory is refused (THZ_ERR_LIMIT, naming
+/* A loaded scene whose images would not fit in memory is refused (THZ_ERR_INPUT, naming
  * sensors[i].resolution). */
 static thz_status api_scene_checked(thz_status st, thz_scene **out, thz_error *err)
 {
-    if (st == THZ_OK && (st = run_check_scene_memory(*out, err)) != THZ_OK) {
+    if (st == THZ_OK && run_check_scene_memory(*out, err) != THZ_OK) {
         scene_destroy(*out);
         *out = NULL;
+        st = THZ_ERR_INPUT; /* the scene asks too much: bad input, as before */
+        if (err)
+            err->status = st;
     }
     return st;
 }

@@ -209,6 +209,13 @@ int cli_run_command(int argc, char **argv, bool render)
     thz_scene_info info;
     thz_scene_get_info(scene, &info);
     const char *integrator = a.settings.integrator ? a.settings.integrator : info.integrator;
+    if (a.write.photon_map && !thz_integrator_needs_photons(integrator)) {
+        thz_scene_destroy(scene);
+        return cli_usage_error(cmd,
+                               "--save-photon-map: the %s integrator fires no photons (give "
+                               "--integrator final-gather or photon-map, or render.integrator)",
+                               integrator);
+    }
     if (render && !a.photon_map_path && thz_integrator_needs_photons(integrator)) {
         thz_scene_destroy(scene);
         return cli_usage_error(cmd, "no photon map given (--photon-map FILE); only the path "

@@ -194,15 +194,20 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
 
 thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err)
 {
-    run_memory need = {.available_bytes = thz_physical_memory_bytes()};
-    for (size_t s = 0; s < scene->n_sensors; s++)
-        need.image_bytes += sensor_images_bytes(scene->sensors[s].columns, scene->sensors[s].rows,
-                                                scene->n_channels);
-    need.total_bytes = need.image_bytes;
-    thz_status st = run_check_memory(scene, &need, err);
-    if (st != THZ_OK)
-        thz_error_prefix(err, "%s: ", scene->path);
-    return st;
+    uint64_t have = thz_physical_memory_bytes();
+    for (size_t s = 0; s < scene->n_sensors && have > 0; s++) {
+        const thz_sensor *sn = &scene->sensors[s];
+        uint64_t need = sensor_images_bytes(sn->columns, sn->rows, scene->n_channels);
+        if ((double)need > 0.9 * (double)have) /* as run_check_memory */
+            return thz_error_set(err, THZ_ERR_LIMIT,
+                                 "%s: sensors[%zu].resolution: the images of %u x %u pixels in "
+                                 "%zu channels need %.1f GiB, more than this machine's memory "
+                                 "(%.1f GiB) allows; lower 'resolution' (or the number of "
+                                 "channels)",
+                                 scene->path, s, sn->columns, sn->rows, scene->n_channels,
+                                 (double)need / 1073741824.0, (double)have / 1073741824.0);
+    }
+    return THZ_OK;
 }
 
 static uint64_t run_image_bytes(const run_state *rs)
@@ -455,12 +460,6 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
     thz_status st = run_state_init(rs, scene, opt, command, err);
     if (st == THZ_OK)
         st = render_integrator_check(scene->render.integrator, err);
-    if (st == THZ_OK && opt->keep_photon_maps && strcmp(command, "simulate") == 0 &&
-        !render_integrator_needs_photons(scene->render.integrator))
-        st = thz_error_set(err, THZ_ERR_INPUT,
-                           "%s: --save-photon-map: the %s integrator fires no photons (give "
-                           "--integrator final-gather or photon-map, or render.integrator)",
-                           command, render_integrator_name(scene->render.integrator));
     if (st == THZ_OK)
         st = run_check_options(opt, err);
     if (st != THZ_OK)

@@ -170,8 +170,8 @@ typedef struct run_memory {
  * message naming `photons.per_channel` or `sensors[i].resolution`. */
 thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err);
 
-/* The same for the images of every sensor alone (what `validate` can tell without
- * building anything); the message starts with the scene file. */
+/* The same for each sensor's images alone (what loading can tell without building
+ * anything): THZ_ERR_LIMIT naming the scene file and sensors[i].resolution. */
 thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err);
 
 /* Fire and render (simulate) or render from `in` (render; NULL only for path) into rs,

@@ -202,7 +202,7 @@ CASES = [
     ("sensor_resolution_beyond_memory",
      [(["channels"], {"from_thz": 0.2, "to_thz": 1.2, "count": 400, "relative_width": 0.01}),
       (["sensors", 0, "resolution"], [65536, 65536])],
-     "lower sensors[0].resolution"),
+     "sensors[0].resolution: the images of 65536 x 65536 pixels in 400 channels need"),
     ("sensor_look_at_self", [(["sensors", 0, "look_at_m"], [0, -0.45, 0.4])],
      "sensors[0].look_at_m: the point to look at is the sensor's position"),
     ("sensor_both_directions", [(["sensors", 0, "direction"], [0, 1, 0])],
