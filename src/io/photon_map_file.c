@@ -495,6 +495,15 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
                           path, version, PHOTON_MAP_FILE_VERSION);
         goto cleanup;
     }
+    /* No flag is defined yet: a set bit means a format this thzmap would misread. */
+    uint32_t flags = (uint32_t)(get_u64(prefix + 8) >> 32);
+    if (flags != 0u) {
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "photon map %s has unknown flags 0x%08x in its prefix (this thzmap "
+                           "knows none); it was written by another program or is corrupted",
+                           path, (unsigned)flags);
+        goto cleanup;
+    }
     const size_t channel_words = version == 1u ? PMF_CHANNEL_WORDS_V1 : PMF_CHANNEL_WORDS;
     uint64_t stated = get_u64(prefix + 16);
     if ((uint64_t)actual < stated) {
