@@ -26,8 +26,8 @@ typedef struct sensor_images {
     float *normalized;             /* N_c, 1 */
     float *temperature_k; /* 1 band: temperature of the surface seen, K (SENSOR_NOTHING_HIT) */
     float *distance_m;    /* 1 band: distance to the surface seen, m (SENSOR_NOTHING_HIT) */
-    int32_t *object_id;            /* 1 band: index into scene objects, -1: nothing hit */
-    float *visual_rgb;             /* rows x columns x 3, shaded colours 0..1 */
+    int32_t *object_id;   /* 1 band: index into scene objects, -1: nothing hit */
+    float *visual_rgb;    /* rows x columns x 3, shaded colours 0..1 */
 } sensor_images;
 
 /* Allocates all arrays, the cubes zeroed and the truth images at "nothing hit" (-1);

@@ -1,8 +1,9 @@
-/* Mesh import: the same tetrahedron from OBJ, PLY, STL (ASCII and binary) and glTF
- * (with a node transform) gives 4 welded vertices, 4 triangles, the exact area and
+/* Mesh import: the same tetrahedron from OBJ, PLY (ASCII, binary little- and big-endian)
+ * and STL (ASCII and binary) gives 4 welded vertices, 4 triangles, the exact area and
  * outward normals; quads are triangulated; vertices of points and lines are dropped
- * and -0.0 welds with 0; the winding check finds a flipped face;
- * missing, empty and garbage files are refused with the file named. */
+ * and -0.0 welds with 0; the winding check finds a flipped face; missing, empty and
+ * garbage files and formats the mesh check does not cover (glTF) are refused with the
+ * file named. The malformed-file corpus is tests/cli/test_bad_meshes.sh. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -62,7 +63,8 @@ static void test_formats(void **state)
     check_tetra(MESHES "tetra.ply", 0);
     check_tetra(MESHES "tetra_ascii.stl", 0);
     check_tetra(MESHES "tetra_binary.stl", 0);
-    check_tetra(MESHES "tetra.gltf", 2); /* its node translates by (0, 0, 2) */
+    check_tetra(MESHES "tetra_binary_le.ply", 0);
+    check_tetra(MESHES "tetra_binary_be.ply", 0);
 }
 
 static void test_quads(void **state)
@@ -122,7 +124,10 @@ static void test_refused(void **state)
     (void)state;
     expect_refused(MESHES "does_not_exist.obj", "does_not_exist.obj", "cannot open");
     expect_refused(MESHES "no_faces.obj", "no_faces.obj", "no triangles");
-    expect_refused(MESHES "garbage.obj", "garbage.obj", "");
+    expect_refused(MESHES "garbage.obj", "garbage.obj", "binary data");
+    expect_refused(MESHES "tetra.gltf", "tetra.gltf",
+                   "unsupported mesh format '.gltf': thzmap reads Wavefront OBJ (.obj), PLY "
+                   "(.ply) or STL (.stl)");
 }
 
 int main(void)
