@@ -82,6 +82,36 @@ static void test_quads(void **state)
     mesh_fini(&m);
 }
 
+/* The example pyramid and the quad cube give what the importer gave before the mesh
+ * check was added (vertices, triangles, bounding box and area recorded then). */
+static void test_examples_unchanged(void **state)
+{
+    (void)state;
+    const struct {
+        const char *file;
+        size_t vertices, triangles;
+        double bbox[6], area_m2;
+    } want[] = {
+        {THZ_SOURCE_DIR "/examples/meshes/pyramid.obj", 5, 6, {-1, -1, 0, 1, 1, 1.5}, 11.2111026},
+        {MESHES "cube_quads.obj", 8, 12, {0, 0, 0, 1, 1, 1}, 6.0},
+    };
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) {
+        thz_mesh m;
+        thz_error err = {0};
+        if (mesh_import(want[i].file, NULL, &m, &err) != THZ_OK)
+            fail_msg("%s", err.message);
+        assert_true(mesh_finalize(&m));
+        assert_int_equal(m.n_vertices, want[i].vertices);
+        assert_int_equal(m.n_triangles, want[i].triangles);
+        for (int k = 0; k < 3; k++) {
+            assert_true(m.bbox_min_m[k] == want[i].bbox[k]);
+            assert_true(m.bbox_max_m[k] == want[i].bbox[3 + k]);
+        }
+        assert_true(fabs(m.total_area_m2 - want[i].area_m2) < 1e-6);
+        mesh_fini(&m);
+    }
+}
+
 static void test_bad_winding(void **state)
 {
     (void)state;
@@ -133,8 +163,11 @@ static void test_refused(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_formats),     cmocka_unit_test(test_quads),
-        cmocka_unit_test(test_bad_winding), cmocka_unit_test(test_points_lines_negative_zero),
+        cmocka_unit_test(test_formats),
+        cmocka_unit_test(test_quads),
+        cmocka_unit_test(test_examples_unchanged),
+        cmocka_unit_test(test_bad_winding),
+        cmocka_unit_test(test_points_lines_negative_zero),
         cmocka_unit_test(test_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
