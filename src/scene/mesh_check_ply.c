@@ -269,6 +269,8 @@ static thz_status ply_list_count(mc_ctx *c, const ply_element *e, const ply_prop
                                  long long n, mc_where w)
 {
     uint64_t bound = p->is_index ? MESH_MAX_POLYGON_VERTICES : MESH_MAX_LIST_VALUES;
+    if (p->is_index && n == 0) /* assimp's triangulation aborts the process on it */
+        return mc_fail(c, w, "a face of no vertices in element '%s'", e->name);
     if (n < 0 || (uint64_t)n > bound)
         return mc_fail(c, w, "a '%s' list of %lld values in element '%s', expected 0 to %llu%s",
                        p->name, n, e->name, (unsigned long long)bound,

@@ -6,7 +6,8 @@
 # for inputs made here (a directory, a FIFO, /dev/zero, a sparse file over the 1 GiB
 # limit, the 60 000-index OBJ polygon that took assimp 24 s), `thzmap validate` of a
 # scene using the file must exit 2 within 1 s (wall time, measured per file) with one
-# line on stderr naming the file and containing the expected text. The good meshes
+# line on stderr naming the file and containing the expected text (a file over 1 s is
+# run once more, since the machine may be shared; over 1 s twice fails). The good meshes
 # must still validate. Lists every failure, and the slowest file.
 #   usage: test_bad_meshes.sh THZMAP REPO
 set -u
@@ -42,13 +43,17 @@ check() {
     local name=$1 path=$2 status=$3 expect=$4
     rows=$((rows + 1))
     scene_for "$path"
-    local t0 t1 got ms problem=""
-    t0=$(date +%s%N)
-    # a hang must not hang the test: stop at 10 s (and count it a failure)
-    timeout -s KILL 10 "$thzmap" validate "$tmp/scene.json" >"$tmp/out" 2>"$tmp/err"
-    got=$?
-    t1=$(date +%s%N)
-    ms=$(((t1 - t0) / 1000000))
+    local t0 t1 got ms problem="" try
+    # Over the limit once may be the shared machine's load: a second run decides.
+    for try in 1 2; do
+        t0=$(date +%s%N)
+        # a hang must not hang the test: stop at 10 s (and count it a failure)
+        timeout -s KILL 10 "$thzmap" validate "$tmp/scene.json" >"$tmp/out" 2>"$tmp/err"
+        got=$?
+        t1=$(date +%s%N)
+        ms=$(((t1 - t0) / 1000000))
+        ((ms <= limit_ms)) && break
+    done
     if ((ms > slowest_ms)); then
         slowest_ms=$ms
         slowest=$name

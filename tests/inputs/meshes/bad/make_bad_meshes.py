@@ -143,6 +143,9 @@ CASES = [
      ply_header("binary_little_endian", n_faces=1, face="property list int int vertex_indices\n")
      + b"".join(struct.pack("<3f", *v) for v in V) + struct.pack("<i", -5) + b"\0" * 12,
      "a 'vertex_indices' list of -5 values"),
+    ("ply_binary_empty_faces.ply",  # found by fuzzing: assimp aborts the process on it
+     ply_header("binary_little_endian") + b"".join(struct.pack("<3f", *v) for v in V)
+     + b"\0" * 4, "byte 217: a face of no vertices in element 'face'"),
     ("ply_ascii_bad_number.ply", PLY_ASCII.replace("1 0 0\n", "1 zero 0\n").encode(),
      ":11: expected a finite number for 'y' of element 'vertex'"),
     ("ply_ascii_extra_values.ply", PLY_ASCII.replace("0 1 0\n", "0 1 0 5\n").encode(),
