@@ -7,10 +7,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <zstd.h>
 #include <zstd_errors.h>
 
 #include "core/alloc.h"
+#include "core/file.h"
 #include "scene/scene_hash.h"
 
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -462,6 +464,14 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
         return thz_error_set(err, THZ_ERR_NOMEM, "cannot read photon map %s: out of memory", path);
     }
 
+    /* a FIFO or a device would block the open or never end: regular files only (the
+     * size is checked against the prefix below) */
+    struct stat file;
+    if (stat(path, &file) == 0 && !S_ISREG(file.st_mode)) {
+        st = file_check_regular(path, NULL, UINT64_MAX, NULL, err);
+        thz_error_prefix(err, "photon map ");
+        goto cleanup;
+    }
     r.f = fopen(path, "rb");
     if (!r.f) {
         st = thz_error_set(err, errno == ENOENT ? THZ_ERR_INPUT : THZ_ERR_IO,

@@ -246,6 +246,9 @@ static void test_corrupted(void **state)
     assert_int_equal(photon_map_file_read(bad, f->scene, 1, ok, NULL, NULL, NULL), THZ_OK);
     photon_map_destroy(ok[0]);
     photon_map_destroy(ok[1]);
+    /* A device or a directory: refused before opening (a FIFO would block the open). */
+    expect_refusal("/dev/zero", f->scene, THZ_ERR_INPUT, "is a character device");
+    expect_refusal(f->dir, f->scene, THZ_ERR_INPUT, "is a directory");
     /* A damaged magic number: not a photon map at all. */
     buf[2] ^= 0x01;
     spit(bad, buf, n);
