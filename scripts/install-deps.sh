@@ -7,7 +7,7 @@ packages=(
   libembree-dev libjansson-dev libassimp-dev librandom123-dev libpng-dev libzstd-dev
   libplplot-dev plplot-driver-cairo libcmocka-dev
   python3 python3-numpy python3-spectral gdal-bin python3-gdal
-  strace
+  strace zstd
 )
 missing=()
 for p in "${packages[@]}"; do
