@@ -1,5 +1,5 @@
 /* Reading the numeric CSV tables of data/atmosphere/ (line catalogues, partition
- * sums, continuum and ITU tables), and locating the data directory. */
+ * sums, continuum and ITU tables). */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -8,20 +8,6 @@
 
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
-
-#ifndef THZ_DATA_DIR
-#define THZ_DATA_DIR "data"
-#endif
-
-const char *atm_data_dir(const char *dir)
-{
-    if (dir && dir[0])
-        return dir;
-    const char *env = getenv("THZMAP_DATA_DIR");
-    if (env && env[0])
-        return env;
-    return THZ_DATA_DIR;
-}
 
 /* Splits line in place at commas; returns the number of fields (at most max). */
 static size_t split_fields(char *line, char **fields, size_t max)

@@ -31,9 +31,6 @@ static inline double atm_csv_at(const atm_csv *csv, size_t row, size_t col)
     return csv->values[row * csv->n_cols + col];
 }
 
-/* The data directory: dir if not NULL, else $THZMAP_DATA_DIR, else the build's. */
-const char *atm_data_dir(const char *dir);
-
 /* itu-p676 (atm_itu_p676.c). */
 thz_status atm_itu_create(atm_itu_data **out, const char *data_dir, thz_error *err);
 void atm_itu_destroy(atm_itu_data *itu);
