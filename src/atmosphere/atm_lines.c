@@ -35,9 +35,13 @@
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
 #include "core/data_dir.h"
+#include "core/file.h"
 #include "core/path.h"
 
 #define LINE_MIN_RELATIVE 1e-10
+/* Largest line catalogue or table read: HITRAN's whole H2O list (all bands) as .par is
+ * about 50 MB; a .par of every molecule is streamed, a CSV is held in memory. */
+#define ATM_LINES_MAX_FILE_BYTES ((uint64_t)512 << 20)
 #define H2O_CUTOFF_GHZ 750.0     /* 25 cm^-1: MT_CKD's line cut-off */
 #define O2_DRY_AIR_VMR 0.20946   /* O2 fraction of dry air */
 #define VOIGT_DOPPLER_RATIO 1e-3 /* Voigt when gamma_D > this times gamma_L */
@@ -761,6 +765,12 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
     if (st == THZ_OK)
         st = resolve(p_cont, PATH, opt->continuum_file, dir,
                      "atmosphere/mt_ckd_4.2_h2o_continuum_0-520cm-1.csv", err);
+    /* Regular files of bounded size only: the readers grow their buffers line by line, and
+     * /dev/zero or a FIFO would grow them, or block, without end. */
+    const char *const inputs[] = {p_h2o, p_o2, p_o2c, p_qh2o, p_qo2, p_cont};
+    for (size_t i = 0; st == THZ_OK && i < sizeof inputs / sizeof inputs[0]; i++)
+        if (i < 5 || d->continuum)
+            st = file_check_regular(inputs[i], NULL, ATM_LINES_MAX_FILE_BYTES, NULL, err);
     if (st == THZ_OK)
         st = read_catalog(p_h2o, 1, false, &h2o, err);
     if (st == THZ_OK)

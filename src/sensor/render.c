@@ -1523,8 +1523,8 @@ thz_status render_sensor_truth(const thz_scene *scene, const accel *a, size_t se
         accel_hit hit;
         float *rgb = &images->visual_rgb[3 * (size_t)px];
         if (!accel_intersect(a, cam.position_m, dir, INFINITY, ACCEL_NO_OBJECT, 0, &hit)) {
-            images->temperature_k[px] = 0.0f;
-            images->distance_m[px] = 0.0f;
+            images->temperature_k[px] = SENSOR_NOTHING_HIT;
+            images->distance_m[px] = SENSOR_NOTHING_HIT;
             images->object_id[px] = -1;
             rgb[0] = rgb[1] = rgb[2] = 0.0f;
             continue;
