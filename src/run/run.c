@@ -22,6 +22,7 @@
 #include "physics/planck.h"
 #include "sensor/images.h"
 #include "sensor/render.h"
+#include "sensor/truth.h"
 
 /* A noise target stops here at the latest (with a run warning). */
 #define RUN_MAX_PASSES 100000u
@@ -219,12 +220,12 @@ static uint64_t run_image_bytes(const run_state *rs)
 }
 
 /* T0 of channel c's photon map in simulate: final-gather fires the deviation map of
- * L - B(T0) (photon_map.h), T0 the renderer's control-variate temperature; photon-map
- * keeps the paper's map. */
+ * L - B(T0) (photon_map.h), T0 the scene's reference temperature (also path's control
+ * variate); photon-map keeps the paper's map. */
 static double run_photon_t0_k(const thz_scene *scene, size_t c)
 {
     return scene->render.integrator == INTEGRATOR_FINAL_GATHER
-               ? render_reference_temperature_k(scene, c)
+               ? scene_reference_temperature_k(scene, c)
                : 0.0;
 }
 
@@ -328,11 +329,14 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
         const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
         st = render_accum_init(&acc[i], (size_t)s->columns * s->rows, err);
     }
+    /* the channel's tables, built once for all its passes and sensors */
+    render_context *ctx = NULL;
+    if (st == THZ_OK)
+        st = render_context_create(rs->scene, rs->accel, map, c, &ro, &ctx, err);
     for (uint32_t pass = 0; st == THZ_OK; pass++) {
         for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
             render_stats rst;
-            st = render_sensor_channel_pass(rs->scene, rs->accel, map, c, rs->selected[i], pass,
-                                            &acc[i], &ro, &rst, err);
+            st = render_context_pass(ctx, rs->selected[i], pass, &acc[i], &ro, &rst, err);
             if (st != THZ_OK)
                 break;
             rs->last[c * rs->n_selected + i] = rst;
@@ -355,6 +359,7 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
             break;
         }
     }
+    render_context_destroy(ctx);
     if (acc)
         for (size_t i = 0; i < rs->n_selected; i++)
             render_accum_fini(&acc[i]);
