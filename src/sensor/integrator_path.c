@@ -49,13 +49,14 @@ static bool render_scatter_dir(const optics_point *o, vec3 n_seen, bool transmit
 }
 
 /* Continues a path leaving `from` along dir with throughput beta at frequency nu (B0 =
- * b0 there; b_air = B_nu(T_air) of an emitting atmosphere, else unused): the sum of the
+ * b0 there; b_air = B_nu(T_air) of an emitting atmosphere, else unused; alpha_per_m the
+ * air's attenuation at nu, looked up once per path): the sum of the
  * terms of every later free path and hit (see the top of this file), with Russian
  * roulette on R and T(theta) at each hit. An emitting atmosphere turns a free path's term
  * (tau - 1) B0 into (1 - tau)(B_air - B0) and the escape term -B0 into L_escape - B0. */
 static double render_path_continue(const render_context *ctx, const accel_hit *from, vec3 dir,
-                                   double nu, double b0, double b_air, double beta, rng_stream *rng,
-                                   render_sample *out)
+                                   double nu, double b0, double b_air, double alpha_per_m,
+                                   double beta, rng_stream *rng, render_sample *out)
 {
     const thz_scene *scene = ctx->scene;
     double sum = 0.0;
@@ -66,8 +67,7 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
         uint32_t from_object = hit.object, from_triangle = hit.triangle;
         if (!accel_intersect(ctx->accel, origin, dir, INFINITY, from_object, from_triangle, &hit)) {
             if (ctx->emitting) {
-                double a = atmosphere_alpha_per_m(&scene->atmosphere, nu);
-                double tau = render_tau(a, render_exit_m(ctx, origin, dir));
+                double tau = render_tau(alpha_per_m, render_exit_m(ctx, origin, dir));
                 double b_bg = planck_radiance(nu, scene->atmosphere.background_temperature_k);
                 sum += beta * (b_bg * tau + b_air * (1.0 - tau) - b0);
             } else {
@@ -86,7 +86,7 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
             double d = hit.cos_theta > 1e-6
                            ? fabs(v3_dot(to_hit, v3_from_floats(hn))) / hit.cos_theta
                            : v3_length(to_hit);
-            double tau = atmosphere_transmittance(&scene->atmosphere, nu, d);
+            double tau = render_tau(alpha_per_m, d); /* atmosphere_transmittance */
             if (ctx->emitting)
                 sum += beta * (1.0 - tau) * (b_air - b0);
             else
@@ -135,8 +135,10 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
     double b0 = planck_radiance(nu, ctx->t0_k);
     double t_air = scene->atmosphere.air.temperature_k;
     double b_air = !ctx->emitting ? 0.0 : t_air == ctx->t0_k ? b0 : planck_radiance(nu, t_air);
-    double beta =
-        ctx->atmosphere ? atmosphere_transmittance(&scene->atmosphere, nu, first->distance_m) : 1.0;
+    /* alpha(nu) is fixed along the path: render_tau(alpha, d) is
+     * atmosphere_transmittance(nu, d) bit for bit (alpha >= 0) */
+    double alpha = atmosphere_alpha_per_m(&scene->atmosphere, nu);
+    double beta = ctx->atmosphere ? render_tau(alpha, first->distance_m) : 1.0;
     const thz_object *obj = &scene->objects[first->object];
     optics_point o = scene_object_optics(scene, obj, nu);
     double r = o.reflectivity;
@@ -147,12 +149,12 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
     double sum = 0.0;
     vec3 dir;
     if (r > 0.0 && render_scatter_dir(&o, n_seen, false, rng, &dir))
-        sum += r * render_path_continue(ctx, first, dir, nu, b0, b_air, beta, rng, out);
+        sum += r * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta, rng, out);
     if (tr > 0.0) {
         bool straight = scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
         dir = dir0;
         if (straight || render_scatter_dir(&o, n_seen, true, rng, &dir))
-            sum += tr * render_path_continue(ctx, first, dir, nu, b0, b_air, beta, rng, out);
+            sum += tr * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta, rng, out);
     }
     out->paths++;
     return sum;
