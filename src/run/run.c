@@ -522,42 +522,6 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
     return st;
 }
 
-/* Adds the statistics of photon pass `p` (p + 1 passes so far) to the merged map's:
- * counts and times add up; powers are the merged photons' (each pass's divided by the
- * number of passes: the mean of the passes'). */
-static void run_stats_merge(photon_stats *sum, const photon_stats *p, uint32_t passes)
-{
-    if (passes == 1) {
-        *sum = *p;
-        return;
-    }
-    double w = 1.0 / passes, keep = 1.0 - w;
-    sum->fired += p->fired;
-    sum->hits += p->hits;
-    sum->reflected += p->reflected;
-    sum->transmitted += p->transmitted;
-    sum->absorbed += p->absorbed;
-    sum->escaped += p->escaped;
-    sum->back_face_hits += p->back_face_hits;
-    sum->terminated += p->terminated;
-    sum->bounce_capped += p->bounce_capped;
-    sum->rays += p->rays;
-    sum->absorbed_power_w_per_hz =
-        keep * sum->absorbed_power_w_per_hz + w * p->absorbed_power_w_per_hz;
-    sum->escaped_power_w_per_hz =
-        keep * sum->escaped_power_w_per_hz + w * p->escaped_power_w_per_hz;
-    sum->atmosphere_power_w_per_hz =
-        keep * sum->atmosphere_power_w_per_hz + w * p->atmosphere_power_w_per_hz;
-    sum->fired_power_w_per_hz = keep * sum->fired_power_w_per_hz + w * p->fired_power_w_per_hz;
-    sum->terminated_power_w_per_hz =
-        keep * sum->terminated_power_w_per_hz + w * p->terminated_power_w_per_hz;
-    sum->mean_bounces = sum->fired ? (double)sum->hits / (double)sum->fired : 0.0;
-    sum->seconds += p->seconds;
-    sum->seconds_emission_table += p->seconds_emission_table;
-    sum->seconds_tracing += p->seconds_tracing;
-    sum->seconds_index += p->seconds_index;
-}
-
 /* photon-map with a noise target (it cannot add render passes: it is deterministic given
  * its map): photon passes instead. Pass p fires photons p K .. (p + 1) K - 1 of the
  * channel, and the channel is rendered from the merge of all passes' photons
@@ -605,7 +569,7 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
             st = photon_map_merge((const photon_map *const *)maps, n, scene->n_objects,
                                   opt->threads, &merged, err);
         rs->seconds_photons += thz_now_s() - t0;
-        run_stats_merge(&rs->stats[c], &ps, (uint32_t)n);
+        photon_stats_merge(&rs->stats[c], &ps, (uint32_t)n);
         if (st != THZ_OK)
             break;
         const photon_map *map = n > 1 ? merged : maps[0];
