@@ -3,10 +3,11 @@
 # Run as root on Debian 12 (bookworm). Idempotent: does nothing when all are present.
 set -euo pipefail
 packages=(
-  build-essential cmake ninja-build pkg-config clang libomp-dev
+  build-essential cmake ninja-build pkg-config clang libomp-dev groff-base
   libembree-dev libjansson-dev libassimp-dev librandom123-dev libpng-dev libzstd-dev
   libplplot-dev plplot-driver-cairo libcmocka-dev
   python3 python3-numpy python3-spectral gdal-bin python3-gdal
+  strace
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,5 +1,5 @@
-/* Internals of the atmosphere module shared between its files: the CSV table
- * reader, the data directory, and the two line-by-line models' entry points.
+/* Internals of the atmosphere module shared between its files: the two line-by-line
+ * models' entry points (their CSV tables are read by core/csv.h).
  * Nothing outside src/atmosphere/ includes this. */
 #ifndef THZ_ATMOSPHERE_ATM_INTERNAL_H
 #define THZ_ATMOSPHERE_ATM_INTERNAL_H
@@ -12,9 +12,6 @@
 /* 1 hPa = 1 mbar; 1 cm^-1 = 29.9792458 GHz; 1 atm = 1013.25 hPa. */
 #define ATM_GHZ_PER_CM1 29.9792458
 #define ATM_HPA_PER_ATM 1013.25
-
-/* The data directory: dir if not NULL, else $THZMAP_DATA_DIR, else the build's. */
-const char *atm_data_dir(const char *dir);
 
 /* itu-p676 (atm_itu_p676.c). */
 thz_status atm_itu_create(atm_itu_data **out, const char *data_dir, thz_error *err);

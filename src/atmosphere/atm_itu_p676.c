@@ -11,6 +11,7 @@
 
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
+#include "core/data_dir.h"
 #include "core/path.h"
 
 enum { ITU_COEFFS = 6 };
@@ -72,12 +73,15 @@ cleanup:
 
 thz_status atm_itu_create(atm_itu_data **out, const char *data_dir, thz_error *err)
 {
-    const char *dir = atm_data_dir(data_dir);
+    char dir[THZ_PATH_MAX];
+    thz_status st = thz_data_dir_find(data_dir, dir, sizeof dir, err);
+    if (st != THZ_OK)
+        return st;
     atm_itu_data *itu = thz_calloc(1, sizeof *itu);
     if (!itu)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-    thz_status st = read_lines(dir, "atmosphere/itu_r_p676_13_oxygen_lines.csv", "a", &itu->o2,
-                               &itu->n_o2, err);
+    st = read_lines(dir, "atmosphere/itu_r_p676_13_oxygen_lines.csv", "a", &itu->o2, &itu->n_o2,
+                    err);
     if (st == THZ_OK)
         st = read_lines(dir, "atmosphere/itu_r_p676_13_water_vapour_lines.csv", "b", &itu->h2o,
                         &itu->n_h2o, err);

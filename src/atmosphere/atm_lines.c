@@ -34,6 +34,7 @@
 
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
+#include "core/data_dir.h"
 #include "core/path.h"
 
 #define LINE_MIN_RELATIVE 1e-10
@@ -732,11 +733,13 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
                             const atm_lines_options *opt, thz_error *err)
 {
     enum { PATH = 4096 };
-    const char *dir = atm_data_dir(opt->data_dir);
+    char dir[PATH];
     char p_h2o[PATH], p_o2[PATH], p_o2c[PATH], p_qh2o[PATH], p_qo2[PATH], p_cont[PATH];
     raw_catalog h2o = {0}, o2 = {0}, o2c = {0};
     partition_sums q_h2o = {0}, q_o2 = {0};
-    thz_status st;
+    thz_status st = thz_data_dir_find(opt->data_dir, dir, sizeof dir, err);
+    if (st != THZ_OK)
+        return st;
     atm_lines_data *d = thz_calloc(1, sizeof *d);
     if (!d)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");

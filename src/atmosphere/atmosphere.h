@@ -64,7 +64,7 @@ typedef struct atm_lines_options {
     const char *continuum_file;
     bool continuum;       /* MT_CKD on (default): H2O lines then use the 750 GHz cut-off
                              shape MT_CKD is defined against; off: full far wings */
-    const char *data_dir; /* NULL: $THZMAP_DATA_DIR, else the build's data dir */
+    const char *data_dir; /* NULL: the rule of core/data_dir.h */
 } atm_lines_options;
 
 /* Contributions to alpha at one frequency, in 1/m (what `thzmap atmosphere` lists). */

@@ -1,8 +1,11 @@
 /* Writing a run's results (scene-format.md "Outputs").
  *
- * Atomic results: every file of a run is written into a staging directory inside
- * OUTDIR and moved into OUTDIR only when the whole run succeeded, so a failed or
- * interrupted run leaves no partial result files behind.
+ * Atomic results: every file of a run is written into a staging directory beside OUTDIR
+ * and the finished run replaces OUTDIR's previous one in a single directory exchange, so
+ * that a failed, interrupted or killed run leaves OUTDIR holding the previous results or
+ * the new ones, each whole (docs/reliability.md; output_commit.c has the steps). Files
+ * of OUTDIR that the run does not write are kept. A lock keeps a second run out of an
+ * OUTDIR in use, and a run cleans up what a killed run left beside its OUTDIR.
  */
 #ifndef THZ_IO_OUTPUT_H
 #define THZ_IO_OUTPUT_H
@@ -17,19 +20,23 @@
 
 typedef struct output_stage output_stage;
 
-/* Creates OUTDIR if missing and a fresh staging directory inside it. */
+/* Takes OUTDIR's lock (THZ_ERR_IO naming the process that holds it), cleans up what
+ * killed runs left, and creates a fresh staging directory: beside OUTDIR, or inside it
+ * when OUTDIR is a mount point or the working directory. Creates missing parents (and
+ * removes them again if the run fails). OUTDIR itself appears only on commit. */
 thz_status output_stage_create(const char *outdir, output_stage **out, thz_error *err);
 
 /* The directory writers write into (the staging directory). */
 const char *output_stage_dir(const output_stage *stage);
 
-/* Moves every staged file into OUTDIR (replacing files of the same name) and removes
- * the staging directory. All or nothing: if any file cannot be moved (e.g. OUTDIR holds
- * a directory of its name), the files it replaced are put back and the new ones taken
- * out again, so OUTDIR holds exactly the previous results, and the error says so. */
+/* Makes the staged files OUTDIR's results (replacing files of the same name, keeping
+ * the others) and removes the staging directory. All or nothing: on failure (e.g.
+ * OUTDIR holds a directory where the run writes a file) OUTDIR keeps exactly the
+ * previous results, and the error says so. */
 thz_status output_stage_commit(output_stage *stage, thz_error *err);
 
-/* Removes the staging directory and whatever it holds if not committed; frees. */
+/* Removes the staging directory and whatever it holds if not committed, releases the
+ * lock; frees. NULL: nothing. */
 void output_stage_destroy(output_stage *stage);
 
 /* Writes every file of sensor `sensor` into dir: the ENVI images S.radiance,

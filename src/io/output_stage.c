@@ -1,122 +1,332 @@
-/* Atomic results: a staging directory inside OUTDIR that writers fill and that is
- * moved into OUTDIR file by file (rename(2) is atomic per file) only when the whole run
- * has succeeded. A run that fails or is interrupted destroys the stage, so OUTDIR never
- * holds a half-written result file.
+/* Atomic results (output.h): the staging directory, the lock that keeps a second run out
+ * of the same OUTDIR, and the clean-up of what a killed run left behind.
  *
- * The staging directory is OUTDIR/.thzmap-staging-<pid>-<n>/, n the first number for
- * which mkdir succeeds, so that concurrent runs into one OUTDIR do not collide.
- *
- * The commit is all or nothing as far as POSIX allows (a crash in the middle of it can
- * still leave a mix; a failure cannot): it first moves the files it will replace aside
- * into STAGE/.thzmap-replaced/, then renames the new files in. If any rename fails it
- * renames the moved-aside files back and removes the new ones it placed, so OUTDIR holds
- * exactly the previous results again; on success it removes the moved-aside files.
+ * Names beside OUTDIR (PARENT is the directory holding it, H a hash of its name, so that
+ * every name fits NAME_MAX however long OUTDIR's name is):
+ *   PARENT/.thzmap-H-lock            held with flock(2) for the stage's lifetime
+ *   PARENT/.thzmap-H-stage-PID-N     the new run (STAGE_SWAP), or the old run after the swap
+ *   PARENT/.thzmap-H-old-PID-N       the old run, only while a swap falls back to two renames
+ * A run that holds the lock owns every such name: anything found there is left by a run
+ * that died, and is cleaned up before the new stage is made (output_stage_create).
  */
+#define _GNU_SOURCE /* O_CLOEXEC, flock */
 #include "io/output.h"
+#include "io/output_stage_internal.h"
 
 #include <dirent.h>
 #include <errno.h>
-#include <stdbool.h>
+#include <fcntl.h>
+#include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
-#include <sys/types.h>
 #include <unistd.h>
 
 #include "core/alloc.h"
 #include "core/path.h"
 
-struct output_stage {
-    char *outdir;
-    char *dir; /* the staging directory */
-    bool committed;
-    bool created_outdir; /* OUTDIR did not exist before: a failed run removes it again */
-};
-
-/* How many staging names are tried before giving up (each failed try is a directory
- * of the same name left by another run of the same pid, e.g. in a container). */
+/* How many staging names are tried before giving up. */
 enum { STAGE_MAX_TRIES = 10000 };
 
-/* mkdir -p: creates path and its missing parents (mode 0777 before umask). */
-static thz_status stage_make_dirs(const char *path, thz_error *err)
+/* strndup through malloc (alloc.h has no counterpart). */
+static char *stage_strndup(const char *s, size_t n)
+{
+    char *d = malloc(n + 1);
+    if (d) {
+        memcpy(d, s, n);
+        d[n] = '\0';
+    }
+    return d;
+}
+
+static thz_status stage_nomem(const char *outdir, thz_error *err)
+{
+    return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while preparing the output",
+                         outdir);
+}
+
+/* mkdir -p: creates path and its missing parents; *created (may be NULL) gets the
+ * topmost directory created (malloc'd), or NULL when all existed. */
+static thz_status stage_make_dirs(const char *path, char **created, thz_error *err)
 {
     thz_status status = THZ_OK;
-    if (path[0] == '\0')
-        return thz_error_set(err, THZ_ERR_IO, "the output directory name is empty");
     char *copy = thz_strdup(path);
     if (!copy)
-        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
-    size_t len = strlen(copy);
-    while (len > 1 && copy[len - 1] == '/')
-        copy[--len] = '\0';
+        return stage_nomem(path, err);
     for (char *p = copy + 1;; p++) {
         bool end = (*p == '\0');
         if (*p != '/' && !end)
             continue;
-        char saved = *p;
         *p = '\0';
-        if (mkdir(copy, 0777) != 0 && errno != EEXIST) {
+        if (mkdir(copy, 0777) == 0) {
+            if (created && !*created && !(*created = thz_strdup(copy))) {
+                status = stage_nomem(path, err);
+                goto cleanup;
+            }
+        } else if (errno != EEXIST) {
             status = thz_error_set(err, THZ_ERR_IO, "%s: cannot create directory: %s", copy,
                                    strerror(errno));
             goto cleanup;
         }
-        *p = saved;
         if (end)
             break;
+        *p = '/';
     }
     struct stat st;
-    if (stat(copy, &st) != 0 || !S_ISDIR(st.st_mode)) {
+    if (stat(copy, &st) != 0 || !S_ISDIR(st.st_mode))
         status = thz_error_set(err, THZ_ERR_IO, "%s: not a directory", path);
-        goto cleanup;
-    }
 cleanup:
     free(copy);
     return status;
 }
 
-/* Where the commit keeps the files it replaces until it has succeeded: inside the stage,
- * so hidden and private to this run. No staged file has this name (every writer's file
- * name has an extension after the sensor name or is summary.json or photon-map.*). */
-static const char stage_aside_name[] = ".thzmap-replaced";
+/* 64-bit FNV-1a of a name: the H of the sibling names. */
+static uint64_t stage_name_hash(const char *name)
+{
+    uint64_t h = 0xcbf29ce484222325u;
+    for (const unsigned char *p = (const unsigned char *)name; *p; p++)
+        h = (h ^ *p) * 0x100000001b3u;
+    return h;
+}
+
+/* Splits the target path into parent and base name (both malloc'd). */
+static thz_status stage_split(output_stage *stage, char **base, thz_error *err)
+{
+    char *slash = strrchr(stage->target, '/');
+    if (!slash)
+        stage->parent = thz_strdup(".");
+    else if (slash == stage->target)
+        stage->parent = thz_strdup("/");
+    else
+        stage->parent = stage_strndup(stage->target, (size_t)(slash - stage->target));
+    *base = thz_strdup(slash ? slash + 1 : stage->target);
+    if (!stage->parent || !*base)
+        return stage_nomem(stage->outdir, err);
+    if (!**base)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot write results into the root directory",
+                             stage->outdir);
+    return THZ_OK;
+}
+
+/* target = OUTDIR without trailing '/'; the real path where its last part is "." or
+ * "..", whose parent is not the directory holding it. */
+static thz_status stage_target(output_stage *stage, thz_error *err)
+{
+    size_t len = strlen(stage->outdir);
+    while (len > 1 && stage->outdir[len - 1] == '/')
+        len--;
+    const char *last = stage->outdir + len;
+    while (last > stage->outdir && last[-1] != '/')
+        last--;
+    size_t last_len = (size_t)(stage->outdir + len - last);
+    bool dots = (last_len == 1 && last[0] == '.') || (last_len == 2 && !strncmp(last, "..", 2));
+    if (!dots) {
+        stage->target = stage_strndup(stage->outdir, len);
+        return stage->target ? THZ_OK : stage_nomem(stage->outdir, err);
+    }
+    stage->target = realpath(stage->outdir, NULL);
+    if (!stage->target)
+        return thz_error_set(err, THZ_ERR_IO, "%s: %s", stage->outdir, strerror(errno));
+    return THZ_OK;
+}
+
+/* Takes PARENT/.thzmap-H-lock, refusing when another run holds it. The lock file is
+ * removed by whoever holds it last, so the flock'd file must still be the one at the
+ * path (same inode) once the lock is had; otherwise it was removed meanwhile: retry. */
+static thz_status stage_lock(output_stage *stage, const char *lock_path, thz_error *err)
+{
+    for (int attempt = 0; attempt < 100; attempt++) {
+        int fd = open(lock_path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+        if (fd < 0)
+            return thz_error_set(err, THZ_ERR_IO, "%s: cannot create the lock file: %s", lock_path,
+                                 strerror(errno));
+        if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+            int e = errno;
+            char pid[32] = {0};
+            ssize_t n = read(fd, pid, sizeof pid - 1);
+            close(fd);
+            if (e != EWOULDBLOCK)
+                return thz_error_set(err, THZ_ERR_IO, "%s: cannot lock: %s", lock_path,
+                                     strerror(e));
+            pid[n > 0 ? n : 0] = '\0';
+            pid[strcspn(pid, "\n")] = '\0';
+            return thz_error_set(err, THZ_ERR_IO,
+                                 "%s: another thzmap run (process %s) is writing its results "
+                                 "there; wait for it to end or choose another output directory",
+                                 stage->outdir, pid[0] ? pid : "unknown");
+        }
+        struct stat a, b;
+        if (fstat(fd, &a) == 0 && stat(lock_path, &b) == 0 && a.st_ino == b.st_ino &&
+            a.st_dev == b.st_dev) {
+            char pid[32];
+            int n = snprintf(pid, sizeof pid, "%ld\n", (long)getpid());
+            if (ftruncate(fd, 0) != 0 || write(fd, pid, (size_t)n) != n) {
+                /* the pid is only for the message of a refused run */
+            }
+            stage->lock_fd = fd;
+            stage->lock_path = thz_strdup(lock_path);
+            return stage->lock_path ? THZ_OK : stage_nomem(stage->outdir, err);
+        }
+        close(fd);
+    }
+    return thz_error_set(err, THZ_ERR_IO, "%s: cannot take the lock file", lock_path);
+}
+
+static bool stage_has_prefix(const char *name, const char *prefix)
+{
+    return strncmp(name, prefix, strlen(prefix)) == 0;
+}
+
+/* Restores and removes what runs killed before us left (we hold the lock, so no live
+ * run owns any of it):
+ *   - an old run parked by the two-rename fallback, OUTDIR missing: put back;
+ *   - a stage, or an old run after its swap: the directories and links of the old
+ *     OUTDIR that had not been moved back yet go back into OUTDIR; the rest (regular
+ *     files: results, or links of files OUTDIR holds too) is removed;
+ *   - a stage of the file-by-file mode inside OUTDIR (also thzmap 0.1's stages): the
+ *     moved-aside old results go back where OUTDIR lacks them, the rest is removed. */
+static void stage_clean_leftovers(const output_stage *stage, const char *base_prefix)
+{
+    char old_prefix[300], stage_prefix[300];
+    snprintf(old_prefix, sizeof old_prefix, "%s-old-", base_prefix);
+    snprintf(stage_prefix, sizeof stage_prefix, "%s-stage-", base_prefix);
+    struct stat st;
+    bool have_outdir = lstat(stage->target, &st) == 0;
+    for (int pass = 0; pass < 2; pass++) {
+        const char *scan = pass == 0 ? stage->parent : stage->target;
+        DIR *d = opendir(scan);
+        if (!d)
+            continue;
+        struct dirent *e;
+        while ((e = readdir(d)) != NULL) {
+            char path[THZ_PATH_MAX], aside[THZ_PATH_MAX];
+            if (thz_path_join(path, sizeof path, scan, e->d_name, NULL) != THZ_OK)
+                continue;
+            if (pass == 0 && stage_has_prefix(e->d_name, old_prefix) && !have_outdir) {
+                have_outdir = rename(path, stage->target) == 0;
+                continue;
+            }
+            bool ours = pass == 0 ? stage_has_prefix(e->d_name, old_prefix) ||
+                                        stage_has_prefix(e->d_name, stage_prefix)
+                                  : stage_has_prefix(e->d_name, ".thzmap-staging-");
+            if (!ours)
+                continue;
+            if (pass == 1 &&
+                thz_path_join(aside, sizeof aside, path, ".thzmap-replaced", NULL) == THZ_OK) {
+                stage_move_others(aside, stage->target); /* links and directories */
+                DIR *a = opendir(aside);
+                struct dirent *f;
+                while (a && (f = readdir(a)) != NULL) {
+                    char from[THZ_PATH_MAX], to[THZ_PATH_MAX];
+                    if (f->d_name[0] == '.' ||
+                        thz_path_join(from, sizeof from, aside, f->d_name, NULL) != THZ_OK ||
+                        thz_path_join(to, sizeof to, stage->target, f->d_name, NULL) != THZ_OK)
+                        continue;
+                    if (lstat(to, &st) != 0)
+                        rename(from, to);
+                }
+                if (a)
+                    closedir(a);
+                stage_remove_files(aside);
+            }
+            if (have_outdir)
+                stage_move_others(path, stage->target);
+            stage_remove_files(path);
+        }
+        closedir(d);
+        if (!have_outdir)
+            break;
+    }
+}
+
+/* STAGE_FILES when OUTDIR exists and is a mount point or the working directory. */
+static stage_mode stage_choose_mode(const output_stage *stage)
+{
+    struct stat out, parent, cwd;
+    if (stat(stage->target, &out) != 0 || !S_ISDIR(out.st_mode))
+        return STAGE_SWAP;
+    if (stat(stage->parent, &parent) == 0 && parent.st_dev != out.st_dev)
+        return STAGE_FILES;
+    if (stat(".", &cwd) == 0 && cwd.st_dev == out.st_dev && cwd.st_ino == out.st_ino)
+        return STAGE_FILES;
+    return STAGE_SWAP;
+}
 
 thz_status output_stage_create(const char *outdir, output_stage **out, thz_error *err)
 {
     *out = NULL;
-    struct stat before;
-    bool existed = stat(outdir, &before) == 0;
-    thz_status status = stage_make_dirs(outdir, err);
-    if (status != THZ_OK)
-        return status;
+    if (!outdir || !outdir[0])
+        return thz_error_set(err, THZ_ERR_IO, "the output directory name is empty");
     output_stage *stage = calloc(1, sizeof *stage);
     if (!stage)
-        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", outdir);
-    stage->created_outdir = !existed;
-    stage->outdir = thz_strdup(outdir);
-    if (!stage->outdir) {
-        status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", outdir);
+        return stage_nomem(outdir, err);
+    stage->lock_fd = -1;
+    char *base = NULL;
+    thz_status status = THZ_OK;
+    if (!(stage->outdir = thz_strdup(outdir))) {
+        status = stage_nomem(outdir, err);
         goto cleanup;
     }
-    for (int n = 0; n < STAGE_MAX_TRIES; n++) {
-        char name[64], dir[THZ_PATH_MAX];
-        snprintf(name, sizeof name, ".thzmap-staging-%ld-%d", (long)getpid(), n);
-        /* Fails early, before the run, if OUTDIR leaves no room for file names. */
-        status = thz_path_join(dir, sizeof dir, outdir, name, err);
+    status = stage_target(stage, err);
+    if (status == THZ_OK)
+        status = stage_split(stage, &base, err);
+    if (status == THZ_OK)
+        status = stage_make_dirs(stage->parent, &stage->created_root, err);
+    if (status != THZ_OK)
+        goto cleanup;
+    struct stat st;
+    if (lstat(stage->target, &st) == 0 && !S_ISDIR(st.st_mode)) {
+        status = thz_error_set(err, THZ_ERR_IO, "%s: exists and is not a directory", outdir);
+        goto cleanup;
+    }
+    char name[64], path[THZ_PATH_MAX];
+    snprintf(name, sizeof name, ".thzmap-%016" PRIx64, stage_name_hash(base));
+    status = thz_path_join(path, sizeof path, stage->parent, name, err);
+    if (status != THZ_OK)
+        goto cleanup;
+    if (!(stage->prefix = thz_strdup(path))) {
+        status = stage_nomem(outdir, err);
+        goto cleanup;
+    }
+    stage->mode = stage_choose_mode(stage);
+    char lock_path[THZ_PATH_MAX + 8];
+    if (stage->mode == STAGE_FILES)
+        status = thz_path_join(lock_path, THZ_PATH_MAX, stage->target, ".thzmap-lock", err);
+    else
+        snprintf(lock_path, sizeof lock_path, "%s-lock", stage->prefix);
+    if (status == THZ_OK)
+        status = stage_lock(stage, lock_path, err);
+    if (status != THZ_OK)
+        goto cleanup;
+    stage_clean_leftovers(stage, name);
+
+    for (int n = 0; n < STAGE_MAX_TRIES && !stage->dir; n++) {
+        char dir[THZ_PATH_MAX + 64];
+        if (stage->mode == STAGE_FILES) {
+            snprintf(name, sizeof name, ".thzmap-staging-%ld-%d", (long)getpid(), n);
+            status = thz_path_join(dir, THZ_PATH_MAX, stage->target, name, err);
+        } else {
+            snprintf(dir, sizeof dir, "%s-stage-%ld-%d", stage->prefix, (long)getpid(), n);
+        }
+        /* Fails early, before the run, if the path leaves no room for file names. */
+        char probe[THZ_PATH_MAX];
+        if (status == THZ_OK)
+            status = thz_path_join(probe, sizeof probe, dir, "summary.json", err);
+        if (status == THZ_OK)
+            status = thz_path_join(probe, sizeof probe, stage->target, "summary.json", err);
         if (status != THZ_OK)
             goto cleanup;
         if (mkdir(dir, 0777) == 0) {
-            stage->dir = thz_strdup(dir);
-            if (!stage->dir) {
+            if (!(stage->dir = thz_strdup(dir))) {
                 rmdir(dir);
-                status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", outdir);
+                status = stage_nomem(outdir, err);
                 goto cleanup;
             }
-            break;
-        }
-        int e = errno;
-        if (e != EEXIST) {
+        } else if (errno != EEXIST) {
             status = thz_error_set(err, THZ_ERR_IO, "%s: cannot create the staging directory: %s",
-                                   outdir, strerror(e));
+                                   outdir, strerror(errno));
             goto cleanup;
         }
     }
@@ -124,11 +334,12 @@ thz_status output_stage_create(const char *outdir, output_stage **out, thz_error
         status = thz_error_set(err, THZ_ERR_IO, "%s: no free staging directory name", outdir);
         goto cleanup;
     }
+    free(base);
     *out = stage;
     return THZ_OK;
 cleanup:
-    free(stage->outdir);
-    free(stage);
+    free(base);
+    output_stage_destroy(stage);
     return status;
 }
 
@@ -137,193 +348,29 @@ const char *output_stage_dir(const output_stage *stage)
     return stage->dir;
 }
 
-static int stage_name_cmp(const void *a, const void *b)
-{
-    return strcmp(*(char *const *)a, *(char *const *)b);
-}
-
-static void stage_free_names(char **names, size_t n)
-{
-    for (size_t i = 0; i < n; i++)
-        free(names[i]);
-    free(names);
-}
-
-/* The names of the regular files in dir (what writers create), sorted so that the
- * commit's order, and so which file a failure stops at, does not depend on readdir. */
-static thz_status stage_list(const char *dir, char ***names_out, size_t *n_out, thz_error *err)
-{
-    *names_out = NULL;
-    *n_out = 0;
-    DIR *d = opendir(dir);
-    if (!d)
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot read the staging directory: %s", dir,
-                             strerror(errno));
-    thz_status status = THZ_OK;
-    char **names = NULL;
-    size_t n = 0, cap = 0;
-    struct dirent *e;
-    while (status == THZ_OK && (e = readdir(d)) != NULL) {
-        char path[THZ_PATH_MAX];
-        struct stat st;
-        status = thz_path_join(path, sizeof path, dir, e->d_name, err);
-        if (status != THZ_OK || lstat(path, &st) != 0 || !S_ISREG(st.st_mode))
-            continue;
-        if (n == cap) {
-            size_t new_cap = cap ? 2 * cap : 16;
-            char **grown = thz_realloc_array(names, new_cap, sizeof *names);
-            if (!grown) {
-                status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", dir);
-                break;
-            }
-            names = grown;
-            cap = new_cap;
-        }
-        names[n] = thz_strdup(e->d_name);
-        if (!names[n]) {
-            status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", dir);
-            break;
-        }
-        n++;
-    }
-    closedir(d);
-    if (status != THZ_OK) {
-        stage_free_names(names, n);
-        return status;
-    }
-    if (n)
-        qsort(names, n, sizeof *names, stage_name_cmp);
-    *names_out = names;
-    *n_out = n;
-    return THZ_OK;
-}
-
-/* The three places of a staged file: in the stage, in OUTDIR, moved aside. */
-static thz_status stage_paths(const output_stage *stage, const char *aside, const char *name,
-                              char *staged, char *target, char *moved, thz_error *err)
-{
-    thz_status status = thz_path_join(staged, THZ_PATH_MAX, stage->dir, name, err);
-    if (status == THZ_OK)
-        status = thz_path_join(target, THZ_PATH_MAX, stage->outdir, name, err);
-    if (status == THZ_OK)
-        status = thz_path_join(moved, THZ_PATH_MAX, aside, name, err);
-    return status;
-}
-
-/* Undoes a failed commit: removes the first n_placed new files from OUTDIR and renames
- * the moved-aside files (had_old) back. Returns false if some old file could not be put
- * back (it then stays in aside, which nothing removes). */
-static bool stage_roll_back(const output_stage *stage, const char *aside, char **names,
-                            const bool *had_old, size_t n, size_t n_placed)
-{
-    bool ok = true;
-    for (size_t i = 0; i < n; i++) {
-        char staged[THZ_PATH_MAX], target[THZ_PATH_MAX], moved[THZ_PATH_MAX];
-        if (stage_paths(stage, aside, names[i], staged, target, moved, NULL) != THZ_OK)
-            continue;   /* cannot happen: the same joins succeeded before */
-        if (had_old[i]) /* atomically replaces the new file, if placed */
-            ok &= rename(moved, target) == 0;
-        else if (i < n_placed)
-            unlink(target);
-    }
-    return ok;
-}
-
 thz_status output_stage_commit(output_stage *stage, thz_error *err)
 {
-    char **names = NULL;
-    size_t n = 0, n_placed = 0;
-    bool *had_old = NULL, made_aside = false;
-    char aside[THZ_PATH_MAX], staged[THZ_PATH_MAX], target[THZ_PATH_MAX], moved[THZ_PATH_MAX];
-    thz_status status = stage_list(stage->dir, &names, &n, err);
-    if (status != THZ_OK)
-        return status;
-    had_old = thz_calloc(n, sizeof *had_old);
-    if (!had_old) {
-        status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", stage->outdir);
-        goto cleanup;
-    }
-    status = thz_path_join(aside, sizeof aside, stage->dir, stage_aside_name, err);
-    if (status != THZ_OK)
-        goto cleanup;
-    if (mkdir(aside, 0777) != 0) {
-        status = thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", aside, strerror(errno));
-        goto cleanup;
-    }
-    made_aside = true;
-
-    /* 1. The files of the previous results that the new ones replace, aside. A directory
-     * of a staged file's name is not moved: renaming the file onto it fails below. */
-    for (size_t i = 0; i < n && status == THZ_OK; i++) {
-        struct stat st;
-        status = stage_paths(stage, aside, names[i], staged, target, moved, err);
-        if (status != THZ_OK)
-            break;
-        if (lstat(target, &st) != 0) {
-            if (errno != ENOENT)
-                status = thz_error_set(err, THZ_ERR_IO, "%s: %s", target, strerror(errno));
-        } else if (!S_ISDIR(st.st_mode)) {
-            if (rename(target, moved) != 0)
-                status = thz_error_set(err, THZ_ERR_IO, "%s: cannot move aside: %s", target,
-                                       strerror(errno));
-            else
-                had_old[i] = true;
-        }
-    }
-    /* 2. The new files in. */
-    for (; n_placed < n && status == THZ_OK; n_placed++) {
-        status = stage_paths(stage, aside, names[n_placed], staged, target, moved, err);
-        if (status == THZ_OK && rename(staged, target) != 0)
-            status = thz_error_set(err, THZ_ERR_IO, "%s: cannot move into place: %s", target,
-                                   strerror(errno));
-        if (status != THZ_OK)
-            break;
-    }
-    if (status != THZ_OK) {
-        if (stage_roll_back(stage, aside, names, had_old, n, n_placed))
-            thz_error_prefix(err, "nothing committed, the previous results stay: ");
-        else
-            thz_error_prefix(
-                err, "commit failed and so did its rollback (previous files are in %s): ", aside);
-        goto cleanup;
-    }
-
-    /* Committed: the previous results go, then the (now empty) stage. */
-    stage->committed = true;
-    for (size_t i = 0; i < n; i++)
-        if (had_old[i] &&
-            stage_paths(stage, aside, names[i], staged, target, moved, NULL) == THZ_OK)
-            unlink(moved);
-    if (rmdir(aside) != 0 || rmdir(stage->dir) != 0)
-        status = thz_error_set(err, THZ_ERR_IO,
-                               "%s: results committed, but the staging directory %s cannot be "
-                               "removed: %s",
-                               stage->outdir, stage->dir, strerror(errno));
-    made_aside = false;
-cleanup:
-    if (made_aside && status != THZ_OK)
-        rmdir(aside); /* only when empty: a failed rollback leaves the old files there */
-    stage_free_names(names, n);
-    free(had_old);
+    thz_status status =
+        stage->mode == STAGE_SWAP ? stage_commit_swap(stage, err) : stage_commit_files(stage, err);
+    if (status == THZ_OK)
+        stage->committed = true;
     return status;
 }
 
-/* Removes dir's regular files (writers create nothing else) and dir itself. */
-static void stage_remove(const char *dir)
+/* Removes the directories from created_root down to the parent if they are empty. */
+static void stage_remove_created(const output_stage *stage)
 {
-    DIR *d = opendir(dir);
-    if (d) {
-        struct dirent *e;
-        while ((e = readdir(d)) != NULL) {
-            if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
-                continue;
-            char path[THZ_PATH_MAX];
-            if (thz_path_join(path, sizeof path, dir, e->d_name, NULL) == THZ_OK)
-                unlink(path);
-        }
-        closedir(d);
+    if (!stage->created_root || !stage->parent)
+        return;
+    char *p = thz_strdup(stage->parent);
+    size_t root_len = strlen(stage->created_root);
+    while (p && strlen(p) >= root_len && rmdir(p) == 0) {
+        char *slash = strrchr(p, '/');
+        if (!slash || slash == p)
+            break;
+        *slash = '\0';
     }
-    rmdir(dir);
+    free(p);
 }
 
 void output_stage_destroy(output_stage *stage)
@@ -331,11 +378,19 @@ void output_stage_destroy(output_stage *stage)
     if (!stage)
         return;
     if (!stage->committed && stage->dir)
-        stage_remove(stage->dir);
-    /* rmdir removes only an empty directory: OUTDIR goes only if nothing else is there */
-    if (!stage->committed && stage->created_outdir && stage->outdir)
-        rmdir(stage->outdir);
-    free(stage->dir);
+        stage_remove_files(stage->dir);
+    if (stage->lock_fd >= 0) {
+        unlink(stage->lock_path); /* while still holding it: see stage_lock */
+        close(stage->lock_fd);
+    }
+    if (!stage->committed)
+        stage_remove_created(stage);
     free(stage->outdir);
+    free(stage->target);
+    free(stage->parent);
+    free(stage->prefix);
+    free(stage->dir);
+    free(stage->lock_path);
+    free(stage->created_root);
     free(stage);
 }

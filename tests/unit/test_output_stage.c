@@ -48,7 +48,7 @@ static int count_entries(const char *dir)
 
 static void write_file(const char *dir, const char *name, const char *text)
 {
-    char path[1024];
+    char path[4096];
     snprintf(path, sizeof path, "%s/%s", dir, name);
     FILE *f = fopen(path, "w");
     assert_non_null(f);
@@ -58,7 +58,7 @@ static void write_file(const char *dir, const char *name, const char *text)
 
 static void assert_file_text(const char *dir, const char *name, const char *text)
 {
-    char path[1024], buf[256] = {0};
+    char path[4096], buf[256] = {0};
     snprintf(path, sizeof path, "%s/%s", dir, name);
     FILE *f = fopen(path, "r");
     if (!f)
@@ -71,7 +71,7 @@ static void assert_file_text(const char *dir, const char *name, const char *text
 
 static void rm(const char *dir, const char *name)
 {
-    char path[1024];
+    char path[4096];
     snprintf(path, sizeof path, "%s/%s", dir, name);
     unlink(path);
 }
@@ -86,24 +86,28 @@ static void test_commit_moves_files(void **state)
     thz_error err = {0};
     assert_int_equal(output_stage_create(outdir, &stage, &err), THZ_OK);
     const char *sdir = output_stage_dir(stage);
-    assert_non_null(strstr(sdir, "/.thzmap-staging-"));
-    assert_int_equal(strncmp(sdir, outdir, strlen(outdir)), 0);
+    char parent[1024];
+    snprintf(parent, sizeof parent, "%s/a/b/.thzmap-", tmp); /* beside OUTDIR */
+    assert_int_equal(strncmp(sdir, parent, strlen(parent)), 0);
+    assert_int_equal(mkdir(outdir, 0777), 0); /* an earlier run's OUTDIR */
 
     write_file(outdir, "old.txt", "previous run");
     write_file(outdir, "x.hdr", "old");
     write_file(sdir, "x.hdr", "new");
     write_file(sdir, "x.img", "data");
-    /* Before commit OUTDIR shows no new file: only the old ones and the stage. */
-    assert_int_equal(count_entries(outdir), 3);
+    /* Before commit OUTDIR shows no new file: only the old ones. */
+    assert_int_equal(count_entries(outdir), 2);
     assert_file_text(outdir, "x.hdr", "old");
 
     assert_int_equal(output_stage_commit(stage, &err), THZ_OK);
     assert_file_text(outdir, "x.hdr", "new"); /* replaced */
     assert_file_text(outdir, "x.img", "data");
     assert_file_text(outdir, "old.txt", "previous run");
-    assert_int_equal(count_entries(outdir), 3); /* the stage is gone */
-    output_stage_destroy(stage);                /* after commit: removes nothing */
     assert_int_equal(count_entries(outdir), 3);
+    output_stage_destroy(stage); /* after commit: removes nothing but the lock */
+    assert_int_equal(count_entries(outdir), 3);
+    snprintf(parent, sizeof parent, "%s/a/b", tmp);
+    assert_int_equal(count_entries(parent), 1); /* OUTDIR alone: no stage, no lock */
 
     rm(outdir, "x.hdr");
     rm(outdir, "x.img");
@@ -188,48 +192,158 @@ static void test_destroy_leaves_nothing(void **state)
 {
     (void)state;
     char *tmp = make_tmp_dir();
+    char outdir[1024];
+    snprintf(outdir, sizeof outdir, "%s/out", tmp);
+    assert_int_equal(mkdir(outdir, 0777), 0);
+    write_file(outdir, "x.img", "previous");
     output_stage *stage = NULL;
     thz_error err = {0};
-    assert_int_equal(output_stage_create(tmp, &stage, &err), THZ_OK);
+    assert_int_equal(output_stage_create(outdir, &stage, &err), THZ_OK);
     write_file(output_stage_dir(stage), "half.img", "partial");
     write_file(output_stage_dir(stage), "summary.json", "{}");
-    assert_int_equal(count_entries(tmp), 1);
+    assert_int_equal(count_entries(tmp), 3); /* OUTDIR, the stage, the lock */
     output_stage_destroy(stage);
-    assert_int_equal(count_entries(tmp), 0);
+    assert_int_equal(count_entries(tmp), 1);
+    assert_int_equal(count_entries(outdir), 1);
+    assert_file_text(outdir, "x.img", "previous");
     output_stage_destroy(NULL);
+    rm(outdir, "x.img");
+    assert_int_equal(rmdir(outdir), 0);
     assert_int_equal(rmdir(tmp), 0);
     free(tmp);
 }
 
-/* A failed run removes the OUTDIR it created (and only that: not its parents, and not
- * an OUTDIR that existed, which test_destroy_leaves_nothing keeps). */
+/* A failed run into a new OUTDIR leaves nothing: OUTDIR appears only on commit, and
+ * the parents it created go again (not those that existed). */
 static void test_destroy_removes_created_outdir(void **state)
 {
     (void)state;
     char *tmp = make_tmp_dir();
     char outdir[4096];
-    snprintf(outdir, sizeof outdir, "%s/new", tmp);
+    snprintf(outdir, sizeof outdir, "%s/new/deeper/out", tmp);
     output_stage *stage = NULL;
     assert_int_equal(output_stage_create(outdir, &stage, NULL), THZ_OK);
     write_file(output_stage_dir(stage), "half.img", "partial");
     assert_int_equal(count_entries(tmp), 1);
     output_stage_destroy(stage);
-    assert_int_equal(count_entries(tmp), 0); /* OUTDIR gone, tmp kept */
+    assert_int_equal(count_entries(tmp), 0); /* new/ gone, tmp kept */
     assert_int_equal(rmdir(tmp), 0);
     free(tmp);
 }
 
-/* Two stages in one OUTDIR (one process) get different directories. */
+/* A second run into an OUTDIR in use is refused, saying why; once the first is done the
+ * OUTDIR is free again. */
 static void test_two_stages(void **state)
 {
     (void)state;
     char *tmp = make_tmp_dir();
-    output_stage *a = NULL, *b = NULL;
-    assert_int_equal(output_stage_create(tmp, &a, NULL), THZ_OK);
-    assert_int_equal(output_stage_create(tmp, &b, NULL), THZ_OK);
-    assert_string_not_equal(output_stage_dir(a), output_stage_dir(b));
+    char outdir[1024];
+    snprintf(outdir, sizeof outdir, "%s/out", tmp);
+    output_stage *a = NULL, *b = (output_stage *)&b;
+    thz_error err = {0};
+    assert_int_equal(output_stage_create(outdir, &a, NULL), THZ_OK);
+    assert_int_equal(output_stage_create(outdir, &b, &err), THZ_ERR_IO);
+    assert_null(b);
+    assert_non_null(strstr(err.message, "another thzmap run"));
     output_stage_destroy(a);
+    assert_int_equal(output_stage_create(outdir, &b, NULL), THZ_OK);
     output_stage_destroy(b);
+    assert_int_equal(count_entries(tmp), 0);
+    assert_int_equal(rmdir(tmp), 0);
+    free(tmp);
+}
+
+/* What a killed run left beside OUTDIR is cleaned up by the next run: a stage never
+ * committed (removed), and the old run of a swap whose user directory had not been
+ * moved back yet (moved back, the rest removed); OUTDIR's own files are untouched. */
+static void test_leftovers_cleaned(void **state)
+{
+    (void)state;
+    char *tmp = make_tmp_dir();
+    char outdir[1024], p[1200];
+    snprintf(outdir, sizeof outdir, "%s/out", tmp);
+    output_stage *a = NULL;
+    assert_int_equal(output_stage_create(outdir, &a, NULL), THZ_OK);
+    char first[1024];
+    snprintf(first, sizeof first, "%s", output_stage_dir(a));
+    output_stage_destroy(a);
+    /* fake a killed run: its stage, holding a result file and a user's directory */
+    assert_int_equal(mkdir(outdir, 0777), 0);
+    write_file(outdir, "x.img", "current");
+    assert_int_equal(mkdir(first, 0777), 0);
+    write_file(first, "x.img", "stale");
+    snprintf(p, sizeof p, "%s/subrun", first);
+    assert_int_equal(mkdir(p, 0777), 0);
+    write_file(p, "inner", "user data");
+    assert_int_equal(count_entries(tmp), 2);
+
+    assert_int_equal(output_stage_create(outdir, &a, NULL), THZ_OK);
+    /* the leftover is gone (the new stage may reuse its name, empty) */
+    assert_true(access(first, F_OK) != 0 || count_entries(first) == 0);
+    output_stage_destroy(a);
+    assert_int_equal(count_entries(tmp), 1);
+    assert_file_text(outdir, "x.img", "current");
+    snprintf(p, sizeof p, "%s/subrun", outdir);
+    assert_file_text(p, "inner", "user data");
+    rm(p, "inner");
+    rmdir(p);
+    rm(outdir, "x.img");
+    rmdir(outdir);
+    assert_int_equal(rmdir(tmp), 0);
+    free(tmp);
+}
+
+/* OUTDIR = the working directory is not swapped (a shell there would be left in a
+ * deleted directory): the stage is inside it and the files move one by one. */
+static void test_commit_into_working_directory(void **state)
+{
+    (void)state;
+    char *tmp = make_tmp_dir();
+    char cwd[4096];
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    assert_int_equal(chdir(tmp), 0);
+    write_file(".", "x.img", "old");
+    output_stage *stage = NULL;
+    assert_int_equal(output_stage_create(".", &stage, NULL), THZ_OK);
+    assert_non_null(strstr(output_stage_dir(stage), "/.thzmap-staging-"));
+    write_file(output_stage_dir(stage), "x.img", "new");
+    assert_int_equal(output_stage_commit(stage, NULL), THZ_OK);
+    output_stage_destroy(stage);
+    assert_file_text(".", "x.img", "new");
+    assert_int_equal(count_entries("."), 1);
+    rm(".", "x.img");
+    assert_int_equal(chdir(cwd), 0);
+    assert_int_equal(rmdir(tmp), 0);
+    free(tmp);
+}
+
+/* OUTDIR's subdirectories (another run's OUTDIR) and foreign files survive a commit. */
+static void test_commit_keeps_subdirectories(void **state)
+{
+    (void)state;
+    char *tmp = make_tmp_dir();
+    char outdir[1024], sub[1200];
+    snprintf(outdir, sizeof outdir, "%s/out", tmp);
+    snprintf(sub, sizeof sub, "%s/path", outdir);
+    assert_int_equal(mkdir(outdir, 0777), 0);
+    assert_int_equal(mkdir(sub, 0777), 0);
+    write_file(sub, "cam.img", "nested run");
+    write_file(outdir, "notes.txt", "mine");
+    output_stage *stage = NULL;
+    assert_int_equal(output_stage_create(outdir, &stage, NULL), THZ_OK);
+    write_file(output_stage_dir(stage), "cam.img", "new");
+    assert_int_equal(output_stage_commit(stage, NULL), THZ_OK);
+    output_stage_destroy(stage);
+    assert_int_equal(count_entries(tmp), 1);
+    assert_int_equal(count_entries(outdir), 3);
+    assert_file_text(outdir, "cam.img", "new");
+    assert_file_text(outdir, "notes.txt", "mine");
+    assert_file_text(sub, "cam.img", "nested run");
+    rm(sub, "cam.img");
+    rmdir(sub);
+    rm(outdir, "cam.img");
+    rm(outdir, "notes.txt");
+    rmdir(outdir);
     assert_int_equal(rmdir(tmp), 0);
     free(tmp);
 }
@@ -390,6 +504,9 @@ int main(void)
         cmocka_unit_test(test_destroy_leaves_nothing),
         cmocka_unit_test(test_destroy_removes_created_outdir),
         cmocka_unit_test(test_two_stages),
+        cmocka_unit_test(test_leftovers_cleaned),
+        cmocka_unit_test(test_commit_keeps_subdirectories),
+        cmocka_unit_test(test_commit_into_working_directory),
         cmocka_unit_test(test_bad_outdir),
         cmocka_unit_test(test_summary_json),
     };

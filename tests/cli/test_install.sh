@@ -1,0 +1,210 @@
+#!/usr/bin/env bash
+# cmake --install: installs the already built tree (the one holding THZMAP_BINARY) into
+# a fresh temporary prefix P and checks what a user gets there: the shared library
+# with its soname links, the public headers, thzmap.pc, the CLI, the man page (every
+# command and option of the CLI's --help in it) and the run-time data. Builds every
+# examples/api/*.c against P with pkg-config alone and runs it on the installed
+# library. Proves that the installed library and CLI read their data from
+# P/share/thzmap (a catalogue missing there makes them fail naming that path while
+# the build's data/ is complete), also after P is moved, and that THZMAP_DATA_DIR
+# overrides. Writes nothing into the build tree but what `cmake --install` writes.
+# usage: test_install.sh THZMAP_BINARY REPO_DIR
+set -u
+thzmap=$1
+repo=$2
+build=$(cd "$(dirname "$thzmap")" && pwd)
+tmp=$(mktemp -d)
+tmp=$(realpath "$tmp")
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+
+fail() {
+    echo "FAIL: $*"
+    failures=$((failures + 1))
+}
+
+# brief FILE: the start of FILE, for a failure message.
+brief() {
+    head -c 400 "$1"
+}
+
+finish() {
+    if [[ $failures -ne 0 ]]; then
+        echo "$failures failure(s)"
+        exit 1
+    fi
+    echo "ok"
+    exit 0
+}
+
+[[ -f $build/cmake_install.cmake ]] || {
+    fail "$build (the directory of $thzmap) is not a CMake build tree"
+    finish
+}
+unset THZMAP_DATA_DIR
+version=$("$thzmap" --version | awk '{print $2}')
+[[ $version =~ ^[0-9]+\.[0-9]+\.[0-9]+$ ]] || fail "thzmap --version gave '$version'"
+major=${version%%.*}
+
+# --- install ----------------------------------------------------------------------------
+P=$tmp/prefix
+if ! cmake --install "$build" --prefix "$P" >"$tmp/install.log" 2>&1; then
+    fail "cmake --install failed: $(cat "$tmp/install.log")"
+    finish
+fi
+
+# --- the file list ------------------------------------------------------------------------
+lib=$P/lib
+[[ -f $lib/libthzmap.so.$version && ! -L $lib/libthzmap.so.$version ]] ||
+    fail "no regular file lib/libthzmap.so.$version"
+[[ $(readlink "$lib/libthzmap.so.$major") == "libthzmap.so.$version" ]] ||
+    fail "lib/libthzmap.so.$major is not a link to libthzmap.so.$version"
+[[ $(readlink "$lib/libthzmap.so") == "libthzmap.so.$major" ]] ||
+    fail "lib/libthzmap.so is not a link to libthzmap.so.$major"
+soname=$(readelf -d "$lib/libthzmap.so.$version" 2>/dev/null | sed -n 's/.*Library soname: \[\(.*\)\]/\1/p')
+[[ $soname == "libthzmap.so.$major" ]] || fail "soname is '$soname', expected libthzmap.so.$major"
+[[ -x $P/bin/thzmap ]] || fail "no executable bin/thzmap"
+for h in "$repo"/include/thzmap/*.h; do
+    cmp -s "$h" "$P/include/thzmap/$(basename "$h")" || fail "header $(basename "$h") not installed as is"
+done
+[[ -f $lib/pkgconfig/thzmap.pc ]] || fail "no lib/pkgconfig/thzmap.pc"
+(cd "$repo/data" && find . -type f) | sort >"$tmp/data.list"
+[[ -s $tmp/data.list ]] || fail "the repository has no data/ files"
+while read -r f; do
+    cmp -s "$repo/data/$f" "$P/share/thzmap/$f" || fail "data file $f not installed as is under share/thzmap"
+done <"$tmp/data.list"
+grep -q 'AER' "$P/share/thzmap/atmosphere/README.md" 2>/dev/null ||
+    fail "the data's README with its licence notices is not installed"
+
+# --- the CLI runs from the prefix, without the environment's help -----------------------
+[[ $("$P/bin/thzmap" --version 2>&1) == "thzmap $version" ]] || fail "installed thzmap --version: $("$P/bin/thzmap" --version 2>&1)"
+
+# --- the man page: renders without warnings, names every command and option ---------------
+man1=$P/share/man/man1/thzmap.1
+if [[ ! -f $man1 ]]; then
+    fail "no share/man/man1/thzmap.1"
+elif ! command -v groff >/dev/null; then
+    fail "groff is not installed (package groff-base, in scripts/install-deps.sh): cannot check the man page"
+else
+    LC_ALL=C groff -man -Tutf8 -ww -z "$man1" 2>"$tmp/groff.err" || fail "groff failed on thzmap.1"
+    [[ -s $tmp/groff.err ]] && fail "groff warnings on thzmap.1: $(cat "$tmp/groff.err")"
+    LC_ALL=C groff -man -Tutf8 -P-cbou "$man1" 2>/dev/null >"$tmp/man.txt"
+    for section in NAME SYNOPSIS DESCRIPTION COMMANDS FILES ENVIRONMENT 'EXIT STATUS'; do
+        grep -q "^$section" "$tmp/man.txt" || fail "thzmap.1 has no $section section"
+    done
+    grep -q 'THZMAP_DATA_DIR' "$tmp/man.txt" || fail "thzmap.1 does not describe THZMAP_DATA_DIR"
+    commands=$("$thzmap" --help | awk '/^commands:/ {f = 1; next} f && /^  [a-z]/ {print $1}')
+    [[ -n $commands ]] || fail "no commands in thzmap --help"
+    awk '/^COMMANDS/ {f = 1; next} /^[A-Z]/ {f = 0} f' "$tmp/man.txt" >"$tmp/man.commands"
+    for c in $commands; do
+        grep -Eq "^ +$c( |\$)" "$tmp/man.commands" || fail "thzmap.1 COMMANDS does not describe '$c'"
+        options=$("$thzmap" "$c" --help | grep -oE -- '(^| )--?[a-z0-9][a-z0-9-]*' | tr -d ' ' | sort -u)
+        [[ -n $options ]] || fail "no options in 'thzmap $c --help'"
+        for o in $options; do
+            [[ $o == -h || $o == --help ]] && continue
+            grep -Eq -- "(^|[^a-z0-9-])$o([^a-z0-9-]|\$)" "$tmp/man.txt" ||
+                fail "thzmap.1 does not mention option $o of '$c'"
+        done
+    done
+fi
+
+# --- pkg-config -------------------------------------------------------------------------------
+export PKG_CONFIG_PATH=$lib/pkgconfig
+[[ $(pkg-config --modversion thzmap 2>&1) == "$version" ]] || fail "pkg-config --modversion thzmap: $(pkg-config --modversion thzmap 2>&1)"
+[[ $(pkg-config --variable=prefix thzmap) == "$P" ]] || fail "thzmap.pc has prefix $(pkg-config --variable=prefix thzmap), expected $P"
+flags=$(pkg-config --cflags --libs thzmap) || fail "pkg-config --cflags --libs thzmap failed"
+[[ $flags == *"-I$P/include"* && $flags == *"-L$lib"* && $flags == *"-lthzmap"* ]] ||
+    fail "pkg-config --cflags --libs thzmap gave: $flags"
+[[ $flags == *"$repo"* || $flags == *"$build"* ]] && fail "pkg-config flags point into the source or build tree: $flags"
+pkg-config --static --libs thzmap | grep -q -- -lembree3 || fail "pkg-config --static --libs lacks -lembree3"
+
+# --- every examples/api/*.c, built against P alone --------------------------------------------
+cc=${CC:-cc}
+extra=()
+if grep -q '^THZ_SANITIZE:BOOL=ON' "$build/CMakeCache.txt"; then
+    # An instrumented library needs the sanitizer runtime in the program too.
+    cc=$(sed -n 's/^CMAKE_C_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")
+    extra=(-fsanitize=address,undefined)
+fi
+scene=$repo/examples/plate-in-box/scene.json
+examples=("$repo"/examples/api/*.c)
+[[ -f ${examples[0]} ]] || fail "no examples/api/*.c"
+for src in "${examples[@]}"; do
+    name=$(basename "$src" .c)
+    # shellcheck disable=SC2046 # the flags are words
+    if ! "$cc" -std=c17 -Wall -Wextra -Wpedantic -Werror "${extra[@]}" "$src" -o "$tmp/$name" \
+        $(pkg-config --cflags --libs thzmap) >"$tmp/$name.cc" 2>&1; then
+        fail "examples/api/$name.c does not build against the installed tree: $(cat "$tmp/$name.cc")"
+        continue
+    fi
+    resolved=$(LD_LIBRARY_PATH=$lib ldd "$tmp/$name" | awk '/libthzmap/ {print $3}')
+    [[ $resolved == "$lib/libthzmap.so.$major" ]] || fail "$name loads libthzmap from '$resolved', not $lib"
+    mkdir -p "$tmp/run-$name"
+    if ! (cd "$tmp/run-$name" && LD_LIBRARY_PATH=$lib "$tmp/$name" "$scene") >"$tmp/$name.out" 2>&1; then
+        fail "examples/api/$name on plate-in-box: $(cat "$tmp/$name.out")"
+    fi
+done
+
+# --- the installed data directory is the one used ----------------------------------------------
+# A scene with the line-by-line atmosphere reads the catalogues while it loads.
+mkdir -p "$tmp/lines"
+cp -r "$repo/examples/plate-in-box/." "$tmp/lines/"
+sed 's/"model": "constant", "attenuation_per_m": 0.05/"model": "lines", "temperature_k": 293, "pressure_hpa": 1000, "relative_humidity": 0.5/' \
+    "$scene" >"$tmp/lines/scene.json"
+grep -q '"model": "lines"' "$tmp/lines/scene.json" || fail "could not make the lines scene"
+load=$tmp/load_scene
+catalogue=atmosphere/am14_h2o_lines.csv
+
+# expect_load WHAT STATUS PATTERN [ENV...]: load_scene on the lines scene exits STATUS and
+# its output matches PATTERN (fixed string, empty: anything).
+expect_load() {
+    local what=$1 want=$2 pattern=$3
+    shift 3
+    env "$@" LD_LIBRARY_PATH="$lib" "$load" "$tmp/lines/scene.json" >"$tmp/load.out" 2>&1
+    local status=$?
+    [[ $status -eq $want ]] || fail "$what: load_scene exit $status, expected $want: $(brief "$tmp/load.out")"
+    [[ -z $pattern ]] || grep -qF -- "$pattern" "$tmp/load.out" ||
+        fail "$what: expected '$pattern' in: $(brief "$tmp/load.out")"
+}
+
+# expect_cli WHAT STATUS PATTERN: the installed CLI validates the lines scene likewise.
+expect_cli() {
+    "$P/bin/thzmap" validate "$tmp/lines/scene.json" >"$tmp/cli.out" 2>&1
+    local status=$?
+    [[ $status -eq $2 ]] || fail "$1: installed thzmap validate exit $status, expected $2: $(brief "$tmp/cli.out")"
+    [[ -z $3 ]] || grep -qF -- "$3" "$tmp/cli.out" || fail "$1: expected '$3' in: $(brief "$tmp/cli.out")"
+}
+
+if [[ -x $load ]]; then
+    expect_load "installed, complete" 0 ""
+    expect_cli "installed, complete" 0 ""
+    # The build's data/ stays complete: only the installed copy loses a catalogue.
+    mv "$P/share/thzmap/$catalogue" "$tmp/catalogue.csv"
+    "$thzmap" validate "$tmp/lines/scene.json" >/dev/null 2>&1 ||
+        fail "the build tree's thzmap no longer loads the lines scene (its data/ must be untouched)"
+    expect_load "installed, catalogue missing" 2 "$P/share/thzmap/$catalogue"
+    expect_cli "installed, catalogue missing" 2 "$P/share/thzmap/$catalogue"
+    # Moved as a whole, the tree still finds its own data (nothing of P compiled in).
+    mv "$P" "$tmp/moved"
+    P=$tmp/moved lib=$tmp/moved/lib
+    expect_load "moved prefix, catalogue missing" 2 "$P/share/thzmap/$catalogue"
+    expect_cli "moved prefix, catalogue missing" 2 "$P/share/thzmap/$catalogue"
+    mv "$tmp/catalogue.csv" "$P/share/thzmap/$catalogue"
+    expect_load "moved prefix, complete" 0 ""
+    # THZMAP_DATA_DIR overrides the installed directory, also to fail.
+    mkdir -p "$tmp/alt"
+    cp -r "$repo/data/." "$tmp/alt/"
+    rm "$tmp/alt/$catalogue"
+    expect_load "THZMAP_DATA_DIR without the catalogue" 2 "$tmp/alt/$catalogue" THZMAP_DATA_DIR="$tmp/alt"
+    cp "$repo/data/$catalogue" "$tmp/alt/$catalogue"
+    mv "$P/share/thzmap/$catalogue" "$tmp/catalogue.csv"
+    expect_load "THZMAP_DATA_DIR complete, installed incomplete" 0 "" THZMAP_DATA_DIR="$tmp/alt"
+    mv "$tmp/catalogue.csv" "$P/share/thzmap/$catalogue"
+    # Without an installed data directory the build's data/ is the fallback.
+    mv "$P/share/thzmap" "$tmp/share-aside"
+    expect_load "no installed data directory" 0 ""
+else
+    fail "examples/api/load_scene.c did not build: cannot check the data directory"
+fi
+
+finish
