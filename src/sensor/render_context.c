@@ -50,7 +50,7 @@ static void render_pair_table(render_context *ctx)
 }
 
 /* T0: the photon map's when map_t0 (photon-map, final-gather), else path_t0_k when it is
- * not NAN, else render_reference_temperature_k (path). */
+ * not NAN, else scene_reference_temperature_k (path). */
 static thz_status render_context_init(render_context *ctx, const thz_scene *scene, const accel *a,
                                       const photon_map *map, size_t channel, bool map_t0,
                                       double path_t0_k, thz_error *err)
