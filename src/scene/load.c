@@ -795,7 +795,6 @@ static thz_status load_photons(load_ctx *ctx, const load_cursor *root)
 static thz_status load_render(load_ctx *ctx, const load_cursor *root)
 {
     static const char *const keys[] = {"integrator", "gather_rays", "paths_per_sample", NULL};
-    static const char *const integrators[] = {"photon-map", "final-gather", "path", NULL};
     thz_render_settings *r = &ctx->scene->render;
     load_cursor c = load_key(root, "render");
     if (!c.value)
@@ -804,7 +803,7 @@ static thz_status load_render(load_ctx *ctx, const load_cursor *root)
     uint64_t rays = 0, paths = 0;
     thz_status st = load_expect_object(ctx, &c, keys);
     if (st == THZ_OK)
-        st = load_choice(ctx, &c, "integrator", integrators, false, 0, &integrator);
+        st = load_choice(ctx, &c, "integrator", scene_integrator_names, false, 0, &integrator);
     if (st == THZ_OK)
         st = load_integer(ctx, &c, "gather_rays", 1, 1000000, false, r->gather_rays, &rays);
     if (st == THZ_OK)
@@ -812,9 +811,7 @@ static thz_status load_render(load_ctx *ctx, const load_cursor *root)
                           &paths);
     if (st != THZ_OK)
         return st;
-    r->integrator = integrator == 2   ? INTEGRATOR_PATH
-                    : integrator == 1 ? INTEGRATOR_FINAL_GATHER
-                                      : INTEGRATOR_PHOTON_MAP;
+    r->integrator = (thz_integrator)integrator; /* scene_integrator_names' index */
     r->gather_rays = (uint32_t)rays;
     r->paths_per_sample = (uint32_t)paths;
     return THZ_OK;

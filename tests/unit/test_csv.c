@@ -9,7 +9,7 @@
 
 #include <cmocka.h>
 
-#include "scene/csv.h"
+#include "core/csv.h"
 
 #define INPUTS THZ_SOURCE_DIR "/tests/inputs/csv/"
 

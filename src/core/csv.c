@@ -1,5 +1,5 @@
 /* The numeric CSV reader. */
-#include "scene/csv.h"
+#include "core/csv.h"
 
 #include <errno.h>
 #include <math.h>
@@ -240,6 +240,16 @@ long csv_column(const csv_table *t, const char *name)
         if (strcmp(t->names[c], name) == 0)
             return (long)c;
     return -1;
+}
+
+thz_status csv_column_index(const csv_table *t, const char *name, size_t *column, thz_error *err)
+{
+    long c = csv_column(t, name);
+    if (c < 0)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: no column '%s' in the header", t->label,
+                             name);
+    *column = (size_t)c;
+    return THZ_OK;
 }
 
 double csv_value(const csv_table *t, size_t row, size_t column)
