@@ -1,5 +1,6 @@
 /* The numeric CSV reader. */
 #include "core/csv.h"
+#include "core/file.h"
 
 #include <errno.h>
 #include <math.h>
@@ -186,9 +187,10 @@ thz_status csv_read(const char *path, const char *label, csv_table *t, thz_error
     const char *name = label ? label : path;
     thz_status st = THZ_OK;
     char *text = NULL;
-    struct stat info;
-    if (stat(path, &info) == 0 && S_ISDIR(info.st_mode))
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: is a directory, expected a CSV file", name);
+    /* A directory, FIFO or device is refused before it is opened (a FIFO would block). */
+    st = file_check_regular(path, name, CSV_MAX_BYTES, NULL, err);
+    if (st != THZ_OK)
+        return st;
     FILE *f = fopen(path, "rb");
     if (!f)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open: %s", name, strerror(errno));
