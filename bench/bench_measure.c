@@ -16,6 +16,7 @@
 #include "scene/scene.h"
 #include "sensor/images.h"
 #include "sensor/render.h"
+#include "sensor/truth.h"
 #include "thzmap/thzmap.h"
 
 static double bench_now_s(void)

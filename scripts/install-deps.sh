@@ -8,7 +8,7 @@ packages=(
   libplplot-dev plplot-driver-cairo libcmocka-dev
   python3 python3-numpy python3-spectral gdal-bin python3-gdal
   python3-pytest python3-matplotlib python3-sklearn python3-tqdm
-  strace
+  strace zstd
 )
 missing=()
 for p in "${packages[@]}"; do

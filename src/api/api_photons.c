@@ -196,7 +196,7 @@ thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, 
             if (!parts[i]->maps[c])
                 continue;
             maps[m++] = parts[i]->maps[c];
-            run_stats_merge(&ph->stats[c], &parts[i]->stats[c], (uint32_t)m);
+            photon_stats_merge(&ph->stats[c], &parts[i]->stats[c], (uint32_t)m);
         }
         if (m > 0)
             st = photon_map_merge(maps, m, ph->effective.n_objects, ctx ? ctx->threads : 0,

@@ -30,20 +30,20 @@ static thz_status read_lines(const char *dir, const char *name, const char *pref
                              size_t *n_out, thz_error *err)
 {
     char path[4096];
-    atm_csv csv;
+    csv_table csv;
     itu_line *lines = NULL;
     thz_status st = thz_path_join(path, sizeof path, dir, name, err);
     if (st != THZ_OK)
         return st;
-    st = atm_csv_read(&csv, path, err);
+    st = csv_read(path, NULL, &csv, err);
     if (st != THZ_OK)
         return st;
     size_t cols[ITU_COEFFS + 1];
-    st = atm_csv_column(&csv, "f0_GHz", &cols[0], err);
+    st = csv_column_index(&csv, "f0_GHz", &cols[0], err);
     for (int i = 0; st == THZ_OK && i < ITU_COEFFS; i++) {
         char name_i[8];
         snprintf(name_i, sizeof name_i, "%s%d", prefix, i + 1);
-        st = atm_csv_column(&csv, name_i, &cols[i + 1], err);
+        st = csv_column_index(&csv, name_i, &cols[i + 1], err);
     }
     if (st != THZ_OK)
         goto cleanup;
@@ -53,12 +53,12 @@ static thz_status read_lines(const char *dir, const char *name, const char *pref
         goto cleanup;
     }
     for (size_t r = 0; r < csv.n_rows; r++) {
-        lines[r].f0_ghz = atm_csv_at(&csv, r, cols[0]);
+        lines[r].f0_ghz = csv_value(&csv, r, cols[0]);
         for (int i = 0; i < ITU_COEFFS; i++)
-            lines[r].c[i] = atm_csv_at(&csv, r, cols[i + 1]);
+            lines[r].c[i] = csv_value(&csv, r, cols[i + 1]);
         if (!(lines[r].f0_ghz > 0.0)) {
             st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: line frequency must be > 0 GHz", path,
-                               csv.line_of[r]);
+                               csv.row_lines[r]);
             goto cleanup;
         }
     }
@@ -67,7 +67,7 @@ static thz_status read_lines(const char *dir, const char *name, const char *pref
     lines = NULL;
 cleanup:
     free(lines);
-    atm_csv_fini(&csv);
+    csv_fini(&csv);
     return st;
 }
 

@@ -35,9 +35,13 @@
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
 #include "core/data_dir.h"
+#include "core/file.h"
 #include "core/path.h"
 
 #define LINE_MIN_RELATIVE 1e-10
+/* Largest line catalogue or table read: HITRAN's whole H2O list (all bands) as .par is
+ * about 50 MB; a .par of every molecule is streamed, a CSV is held in memory. */
+#define ATM_LINES_MAX_FILE_BYTES ((uint64_t)512 << 20)
 #define H2O_CUTOFF_GHZ 750.0     /* 25 cm^-1: MT_CKD's line cut-off */
 #define O2_DRY_AIR_VMR 0.20946   /* O2 fraction of dry air */
 #define VOIGT_DOPPLER_RATIO 1e-3 /* Voigt when gamma_D > this times gamma_L */
@@ -162,40 +166,40 @@ static thz_status read_csv_catalog(const char *path, bool coupled, raw_catalog *
                                       "dx",           "Tref_K"};
     enum { N_BASE = 8, N_MIX = 10 };
     size_t col[N_BASE + N_MIX];
-    atm_csv csv;
-    thz_status st = atm_csv_read(&csv, path, err);
+    csv_table csv;
+    thz_status st = csv_read(path, NULL, &csv, err);
     if (st != THZ_OK)
         return st;
     for (size_t i = 0; st == THZ_OK && i < N_BASE; i++)
-        st = atm_csv_column(&csv, base[i], &col[i], err);
+        st = csv_column_index(&csv, base[i], &col[i], err);
     for (size_t i = 0; coupled && st == THZ_OK && i < N_MIX; i++)
-        st = atm_csv_column(&csv, mix[i], &col[N_BASE + i], err);
+        st = csv_column_index(&csv, mix[i], &col[N_BASE + i], err);
     for (size_t r = 0; st == THZ_OK && r < csv.n_rows; r++) {
         raw_line l;
         memset(&l, 0, sizeof l);
-        l.nu0_ghz = atm_csv_at(&csv, r, col[0]);
-        l.s296_cm2_ghz = atm_csv_at(&csv, r, col[1]);
-        l.elower_k = atm_csv_at(&csv, r, col[2]);
-        l.gamma_air = atm_csv_at(&csv, r, col[3]);
-        l.gamma_self = atm_csv_at(&csv, r, col[4]);
-        l.n_air = atm_csv_at(&csv, r, col[5]);
-        l.delta_air = atm_csv_at(&csv, r, col[6]);
-        double iso = atm_csv_at(&csv, r, col[7]);
+        l.nu0_ghz = csv_value(&csv, r, col[0]);
+        l.s296_cm2_ghz = csv_value(&csv, r, col[1]);
+        l.elower_k = csv_value(&csv, r, col[2]);
+        l.gamma_air = csv_value(&csv, r, col[3]);
+        l.gamma_self = csv_value(&csv, r, col[4]);
+        l.n_air = csv_value(&csv, r, col[5]);
+        l.delta_air = csv_value(&csv, r, col[6]);
+        double iso = csv_value(&csv, r, col[7]);
         l.iso = iso >= 1.0 && iso <= 99.0 ? (int)iso : 0;
         if (coupled) {
             double *m = &l.y0;
             for (size_t i = 0; i < N_MIX; i++)
-                m[i] = atm_csv_at(&csv, r, col[N_BASE + i]);
+                m[i] = csv_value(&csv, r, col[N_BASE + i]);
             if (!(l.tref_k > 0.0))
                 st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: Tref_K must be > 0", path,
-                                   csv.line_of[r]);
+                                   csv.row_lines[r]);
         }
         if (st == THZ_OK)
-            st = check_line(&l, path, csv.line_of[r], err);
+            st = check_line(&l, path, csv.row_lines[r], err);
         if (st == THZ_OK)
             st = catalog_push(cat, &l, err);
     }
-    atm_csv_fini(&csv);
+    csv_fini(&csv);
     return st;
 }
 
@@ -317,19 +321,19 @@ static thz_status read_catalog(const char *path, int molecule, bool coupled, raw
 
 static thz_status read_partition_sums(const char *path, partition_sums *q, thz_error *err)
 {
-    atm_csv csv;
+    csv_table csv;
     memset(q, 0, sizeof *q);
-    thz_status st = atm_csv_read(&csv, path, err);
+    thz_status st = csv_read(path, NULL, &csv, err);
     if (st != THZ_OK)
         return st;
     size_t col_t;
-    st = atm_csv_column(&csv, "T_K", &col_t, err);
+    st = csv_column_index(&csv, "T_K", &col_t, err);
     size_t cols[32];
     size_t n_iso = 0;
     while (st == THZ_OK && n_iso < 32) {
         char name[16];
         snprintf(name, sizeof name, "Q_iso%zu", n_iso + 1);
-        if (atm_csv_column(&csv, name, &cols[n_iso], NULL) != THZ_OK)
+        if (csv_column_index(&csv, name, &cols[n_iso], NULL) != THZ_OK)
             break;
         n_iso++;
     }
@@ -338,14 +342,14 @@ static thz_status read_partition_sums(const char *path, partition_sums *q, thz_e
                            path);
     if (st != THZ_OK)
         goto cleanup;
-    q->t0_k = atm_csv_at(&csv, 0, col_t);
-    q->dt_k = atm_csv_at(&csv, 1, col_t) - q->t0_k;
+    q->t0_k = csv_value(&csv, 0, col_t);
+    q->dt_k = csv_value(&csv, 1, col_t) - q->t0_k;
     for (size_t r = 0; r < csv.n_rows; r++) {
-        double t = atm_csv_at(&csv, r, col_t);
+        double t = csv_value(&csv, r, col_t);
         if (!(q->dt_k > 0.0) || fabs(t - (q->t0_k + (double)r * q->dt_k)) > 1e-6 * q->dt_k) {
             st = thz_error_set(err, THZ_ERR_INPUT,
                                "%s:%zu: temperatures must be evenly spaced and increasing", path,
-                               csv.line_of[r]);
+                               csv.row_lines[r]);
             goto cleanup;
         }
     }
@@ -358,10 +362,10 @@ static thz_status read_partition_sums(const char *path, partition_sums *q, thz_e
     }
     for (size_t r = 0; r < csv.n_rows; r++) {
         for (size_t i = 0; i < n_iso; i++) {
-            double v = atm_csv_at(&csv, r, cols[i]);
+            double v = csv_value(&csv, r, cols[i]);
             if (!(v > 0.0)) {
                 st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: partition sums must be > 0", path,
-                                   csv.line_of[r]);
+                                   csv.row_lines[r]);
                 goto cleanup;
             }
             q->q[r * n_iso + i] = v;
@@ -372,7 +376,7 @@ cleanup:
         free(q->q);
         q->q = NULL;
     }
-    atm_csv_fini(&csv);
+    csv_fini(&csv);
     return st;
 }
 
@@ -526,23 +530,23 @@ static void drop_coupled_duplicates(raw_catalog *cat, const raw_catalog *coupled
 
 static thz_status read_continuum(atm_lines_data *d, const char *path, thz_error *err)
 {
-    atm_csv csv;
-    thz_status st = atm_csv_read(&csv, path, err);
+    csv_table csv;
+    thz_status st = csv_read(path, NULL, &csv, err);
     if (st != THZ_OK)
         return st;
     size_t c_nu, c_f, c_s, c_x;
-    st = atm_csv_column(&csv, "nu_cm-1", &c_nu, err);
+    st = csv_column_index(&csv, "nu_cm-1", &c_nu, err);
     if (st == THZ_OK)
-        st = atm_csv_column(&csv, "C_foreign_ref_cm2_per_molec_per_cm-1", &c_f, err);
+        st = csv_column_index(&csv, "C_foreign_ref_cm2_per_molec_per_cm-1", &c_f, err);
     if (st == THZ_OK)
-        st = atm_csv_column(&csv, "C_self_ref_cm2_per_molec_per_cm-1", &c_s, err);
+        st = csv_column_index(&csv, "C_self_ref_cm2_per_molec_per_cm-1", &c_s, err);
     if (st == THZ_OK)
-        st = atm_csv_column(&csv, "self_texp", &c_x, err);
+        st = csv_column_index(&csv, "self_texp", &c_x, err);
     if (st != THZ_OK)
         goto cleanup;
     d->n_cont = csv.n_rows;
-    d->cont_step_cm1 = csv.n_rows > 1 ? atm_csv_at(&csv, 1, c_nu) : 0.0;
-    if (csv.n_rows < 4 || atm_csv_at(&csv, 0, c_nu) != 0.0 || !(d->cont_step_cm1 > 0.0)) {
+    d->cont_step_cm1 = csv.n_rows > 1 ? csv_value(&csv, 1, c_nu) : 0.0;
+    if (csv.n_rows < 4 || csv_value(&csv, 0, c_nu) != 0.0 || !(d->cont_step_cm1 > 0.0)) {
         st = thz_error_set(err, THZ_ERR_INPUT,
                            "%s: the continuum table must start at 0 cm^-1, be evenly spaced and "
                            "have at least 4 rows",
@@ -557,18 +561,18 @@ static thz_status read_continuum(atm_lines_data *d, const char *path, thz_error 
         goto cleanup;
     }
     for (size_t r = 0; r < csv.n_rows; r++) {
-        double nu = atm_csv_at(&csv, r, c_nu);
+        double nu = csv_value(&csv, r, c_nu);
         if (fabs(nu - (double)r * d->cont_step_cm1) > 1e-6 * d->cont_step_cm1) {
             st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: wavenumbers must be evenly spaced",
-                               path, csv.line_of[r]);
+                               path, csv.row_lines[r]);
             goto cleanup;
         }
-        d->c_foreign[r] = atm_csv_at(&csv, r, c_f);
-        d->c_self[r] = atm_csv_at(&csv, r, c_s);
-        d->self_texp[r] = atm_csv_at(&csv, r, c_x);
+        d->c_foreign[r] = csv_value(&csv, r, c_f);
+        d->c_self[r] = csv_value(&csv, r, c_s);
+        d->self_texp[r] = csv_value(&csv, r, c_x);
     }
 cleanup:
-    atm_csv_fini(&csv);
+    csv_fini(&csv);
     return st;
 }
 
@@ -761,6 +765,12 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
     if (st == THZ_OK)
         st = resolve(p_cont, PATH, opt->continuum_file, dir,
                      "atmosphere/mt_ckd_4.2_h2o_continuum_0-520cm-1.csv", err);
+    /* Regular files of bounded size only: the readers grow their buffers line by line, and
+     * /dev/zero or a FIFO would grow them, or block, without end. */
+    const char *const inputs[] = {p_h2o, p_o2, p_o2c, p_qh2o, p_qo2, p_cont};
+    for (size_t i = 0; st == THZ_OK && i < sizeof inputs / sizeof inputs[0]; i++)
+        if (i < 5 || d->continuum)
+            st = file_check_regular(inputs[i], NULL, ATM_LINES_MAX_FILE_BYTES, NULL, err);
     if (st == THZ_OK)
         st = read_catalog(p_h2o, 1, false, &h2o, err);
     if (st == THZ_OK)

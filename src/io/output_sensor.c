@@ -64,9 +64,9 @@ static thz_status out_png_path(char *path, const out_context *ctx, const char *q
 /* What an image's bands are, and so what its header says about them. */
 typedef enum out_kind {
     OUT_CHANNELS, /* one band per channel: band names, wavelength and fwhm in GHz */
-    OUT_TRUTH,    /* one band, named after the quantity */
-    OUT_INDEX     /* a truth image of object indices: also `data ignore value = -1` and
-                     `object names` */
+    OUT_TRUTH,    /* one band, named after the quantity; `data ignore value` is
+                     SENSOR_NOTHING_HIT */
+    OUT_INDEX     /* a truth image of object indices: also `object names` */
 } out_kind;
 
 /* The ENVI image S.<quantity>; `what` and `units` go into its description. */
@@ -93,9 +93,11 @@ static thz_status out_image(const out_context *ctx, out_kind kind, const char *q
         info.band_names = ctx->channel_names;
         info.wavelength_ghz = ctx->center_ghz;
         info.fwhm_ghz = ctx->fwhm_ghz;
-    } else if (kind == OUT_INDEX) {
+    } else {
         info.has_ignore_value = 1;
-        info.ignore_value = -1.0;
+        info.ignore_value = SENSOR_NOTHING_HIT;
+    }
+    if (kind == OUT_INDEX) {
         info.object_names = ctx->object_names;
         info.n_object_names = ctx->scene->n_objects;
     }
@@ -103,7 +105,7 @@ static thz_status out_image(const out_context *ctx, out_kind kind, const char *q
 }
 
 /* S.object_id: the indices as float32 like every ENVI image (exact, the scene having at
- * most OUT_MAX_OBJECTS objects), -1.0 where nothing is hit. */
+ * most OUT_MAX_OBJECTS objects), -1.0 (SENSOR_NOTHING_HIT) where nothing is hit. */
 static thz_status out_object_id(const out_context *ctx, thz_error *err)
 {
     size_t pixels = (size_t)ctx->images->columns * ctx->images->rows;
@@ -116,7 +118,7 @@ static thz_status out_object_id(const out_context *ctx, thz_error *err)
         out_image(ctx, OUT_INDEX, "object_id", ids,
                   "index of the object seen into the scene's objects (see object names); -1 where "
                   "nothing is hit",
-                  "index", err);
+                  "1", err);
     free(ids);
     return status;
 }
@@ -245,10 +247,10 @@ thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t s
     }
     if (status == THZ_OK)
         status = out_image(&ctx, OUT_TRUTH, "temperature", images->temperature_k,
-                           "temperature of the surface seen (0: nothing hit)", "K", err);
+                           "temperature of the surface seen (-1: nothing hit)", "K", err);
     if (status == THZ_OK)
         status = out_image(&ctx, OUT_TRUTH, "distance", images->distance_m,
-                           "distance to the surface seen (0: nothing hit)", "m", err);
+                           "distance to the surface seen (-1: nothing hit)", "m", err);
     if (status == THZ_OK)
         status = out_object_id(&ctx, err);
     if (status == THZ_OK) {

@@ -7,10 +7,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <zstd.h>
 #include <zstd_errors.h>
 
 #include "core/alloc.h"
+#include "core/file.h"
 #include "scene/scene_hash.h"
 
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -462,6 +464,14 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
         return thz_error_set(err, THZ_ERR_NOMEM, "cannot read photon map %s: out of memory", path);
     }
 
+    /* a FIFO or a device would block the open or never end: regular files only (the
+     * size is checked against the prefix below) */
+    struct stat file;
+    if (stat(path, &file) == 0 && !S_ISREG(file.st_mode)) {
+        st = file_check_regular(path, NULL, UINT64_MAX, NULL, err);
+        thz_error_prefix(err, "photon map ");
+        goto cleanup;
+    }
     r.f = fopen(path, "rb");
     if (!r.f) {
         st = thz_error_set(err, errno == ENOENT ? THZ_ERR_INPUT : THZ_ERR_IO,
@@ -493,6 +503,15 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
             thz_error_set(err, THZ_ERR_INPUT,
                           "photon map %s has format version %u; this thzmap reads versions 1 to %u",
                           path, version, PHOTON_MAP_FILE_VERSION);
+        goto cleanup;
+    }
+    /* No flag is defined yet: a set bit means a format this thzmap would misread. */
+    uint32_t flags = (uint32_t)(get_u64(prefix + 8) >> 32);
+    if (flags != 0u) {
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "photon map %s has unknown flags 0x%08x in its prefix (this thzmap "
+                           "knows none); it was written by another program or is corrupted",
+                           path, (unsigned)flags);
         goto cleanup;
     }
     const size_t channel_words = version == 1u ? PMF_CHANNEL_WORDS_V1 : PMF_CHANNEL_WORDS;

@@ -2,7 +2,8 @@
  * `render` can reuse a simulation's photons (scene-format.md "Outputs").
  *
  * Layout (little-endian, version 2):
- *   prefix, 24 bytes, uncompressed: magic "THZPMAP\x1a", u32 version, u32 flags (0),
+ *   prefix, 24 bytes, uncompressed: magic "THZPMAP\x1a", u32 version, u32 flags (0;
+ *     none is defined, a reader refuses any set bit),
  *     u64 total file size (detects truncation before decoding anything);
  *   zstd frame 1 (with content checksum): the header: u64 scene hashes (geometry,
  *     optics, channels; scene_hash.h), u64 n_channels, n_objects, seed, photons per

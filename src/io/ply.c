@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#define PLY_VERTEX_BYTES 15u /* 3 floats + 3 uchars, packed */
+#define PLY_VERTEX_BYTES 39u /* 3 floats, 3 uchars, uint, float, int, 3 floats: packed */
 
 static uint8_t ply_channel(double d)
 {
@@ -14,12 +14,17 @@ static uint8_t ply_channel(double d)
     return (uint8_t)(v < 0.0 ? 0.0 : (v > 255.0 ? 255.0 : v));
 }
 
+static void ply_put_u32(uint8_t *p, uint32_t v)
+{
+    for (int i = 0; i < 4; i++)
+        p[i] = (uint8_t)(v >> (8 * i));
+}
+
 static void ply_put_f32(uint8_t *p, float x)
 {
     uint32_t v;
     memcpy(&v, &x, sizeof v);
-    for (int i = 0; i < 4; i++)
-        p[i] = (uint8_t)(v >> (8 * i));
+    ply_put_u32(p, v);
 }
 
 thz_status ply_write_photons(const char *path, const photon_map *const *maps, size_t n_maps,
@@ -38,16 +43,22 @@ thz_status ply_write_photons(const char *path, const photon_map *const *maps, si
     if (!f)
         return thz_error_set(err, THZ_ERR_IO, "cannot create %s: %s", path, strerror(errno));
     thz_status st = THZ_OK;
-    if (fprintf(f,
-                "ply\nformat binary_little_endian 1.0\n"
-                "comment thzmap photon map: stored photons, colour = 0.5 (1 - incoming direction)\n"
-                "comment %llu of %llu photons\n"
-                "element vertex %llu\n"
-                "property float x\nproperty float y\nproperty float z\n"
-                "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-                "end_header\n",
-                (unsigned long long)n_out, (unsigned long long)total,
-                (unsigned long long)n_out) < 0)
+    if (fprintf(
+            f,
+            "ply\nformat binary_little_endian 1.0\n"
+            "comment thzmap photon map: one vertex per stored photon\n"
+            "comment x y z: hit point (m); dx dy dz: unit direction of travel as it arrived\n"
+            "comment red green blue: 255 * 0.5 * (1 - d), the direction it came from\n"
+            "comment channel, object: indices into the scene's channels and objects\n"
+            "comment power_w_per_hz: spectral power carried (W/Hz, negative in deviation maps)\n"
+            "comment %llu of %llu photons\n"
+            "element vertex %llu\n"
+            "property float x\nproperty float y\nproperty float z\n"
+            "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+            "property uint channel\nproperty float power_w_per_hz\nproperty int object\n"
+            "property float dx\nproperty float dy\nproperty float dz\n"
+            "end_header\n",
+            (unsigned long long)n_out, (unsigned long long)total, (unsigned long long)n_out) < 0)
         goto write_error;
 
     enum { PLY_BUF_POINTS = 4096 };
@@ -71,6 +82,12 @@ thz_status ply_write_photons(const char *path, const photon_map *const *maps, si
         q[12] = ply_channel(d.x);
         q[13] = ply_channel(d.y);
         q[14] = ply_channel(d.z);
+        ply_put_u32(q + 15, (uint32_t)m);
+        ply_put_f32(q + 19, p->power_w_per_hz);
+        ply_put_u32(q + 23, photon_object(p)); /* < 2^31: a non-negative int */
+        ply_put_f32(q + 27, (float)d.x);
+        ply_put_f32(q + 31, (float)d.y);
+        ply_put_f32(q + 35, (float)d.z);
         if (++used == PLY_BUF_POINTS) {
             if (fwrite(buf, PLY_VERTEX_BYTES, used, f) != used)
                 goto write_error;

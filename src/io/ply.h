@@ -1,9 +1,18 @@
 /* photon-map.ply: the stored photons as a coloured point cloud (the paper's Fig. 3),
  * binary little-endian PLY that MeshLab, CloudCompare and Blender open.
  *
- * One vertex per photon: float x, y, z (m) and uchar red, green, blue, the colour of the
- * incoming direction d: rgb = round(255 * 0.5 * (1 - d)) (a photon travelling along -z,
- * i.e. arriving from above, is blue-ish white: (128, 128, 255)).
+ * One vertex per photon, 39 bytes, these properties in this order:
+ *   float x, y, z           the hit point, m
+ *   uchar red, green, blue  the colour of the incoming direction d (the photon's unit
+ *                           direction of travel as it arrived): rgb = round(255 * 0.5 *
+ *                           (1 - d)), i.e. the direction it came from mapped to [0, 255]
+ *                           (a photon arriving from above, travelling along -z, is
+ *                           blue-ish white: (128, 128, 255))
+ *   uint channel            index into the scene's channels (the map it belongs to)
+ *   float power_w_per_hz    the spectral power it carries, W/Hz (negative where a
+ *                           deviation map's photon carries a deficit below B(T0))
+ *   int object              index into the scene's objects of the surface hit
+ *   float dx, dy, dz        d itself (unit vector)
  */
 #ifndef THZ_IO_PLY_H
 #define THZ_IO_PLY_H

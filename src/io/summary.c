@@ -65,6 +65,52 @@ static double sum_ratio(uint64_t part, uint64_t whole)
     return whole ? (double)part / (double)whole : 0.0;
 }
 
+/* A channel's photon statistics into its object o: the one place photon_stats becomes
+ * JSON. */
+static void sum_photon_stats(json_t *o, const photon_stats *s, bool *ok)
+{
+    sum_set(o, "photons_fired", sum_u64(s->fired), ok);
+    sum_set(o, "photons_stored", sum_u64(s->stored), ok);
+    sum_set(o, "emitted_power_w_per_hz", sum_real(s->emitted_power_w_per_hz), ok);
+    sum_set(o, "photon_reference_temperature_k", sum_real(s->reference_temperature_k), ok);
+    sum_set(o, "fraction_absorbed", json_real(sum_ratio(s->absorbed, s->fired)), ok);
+    sum_set(o, "fraction_escaped", json_real(sum_ratio(s->escaped, s->fired)), ok);
+    sum_set(o, "fraction_terminated", json_real(sum_ratio(s->terminated, s->fired)), ok);
+    sum_set(o, "fraction_reflected", json_real(sum_ratio(s->reflected, s->hits)), ok);
+    sum_set(o, "fraction_transmitted", json_real(sum_ratio(s->transmitted, s->hits)), ok);
+    sum_set(o, "back_face_hits", sum_u64(s->back_face_hits), ok);
+    sum_set(o, "mean_bounces", sum_real(s->mean_bounces), ok);
+    json_t *counts = json_object();
+    sum_set(counts, "hits", sum_u64(s->hits), ok);
+    sum_set(counts, "reflected", sum_u64(s->reflected), ok);
+    sum_set(counts, "transmitted", sum_u64(s->transmitted), ok);
+    sum_set(counts, "absorbed", sum_u64(s->absorbed), ok);
+    sum_set(counts, "escaped", sum_u64(s->escaped), ok);
+    sum_set(counts, "terminated", sum_u64(s->terminated), ok);
+    sum_set(o, "counts", counts, ok);
+    /* Exact bookkeeping: fired = absorbed + escaped + atmosphere + terminated (the
+     * low-power roulette's net removal). relative_difference compares that total
+     * with the band-mean P_A: Monte Carlo noise of the fired power only (or a bug).
+     * A deviation map (T0 > 0) fires the signed sources of L - B(T0), not P_A: its
+     * sums balance as well, but relative_difference is null. */
+    json_t *e = json_object();
+    double out = s->absorbed_power_w_per_hz + s->escaped_power_w_per_hz +
+                 s->atmosphere_power_w_per_hz + s->terminated_power_w_per_hz;
+    sum_set(e, "emitted_w_per_hz", sum_real(s->emitted_power_w_per_hz), ok);
+    sum_set(e, "fired_w_per_hz", sum_real(s->fired_power_w_per_hz), ok);
+    sum_set(e, "absorbed_w_per_hz", sum_real(s->absorbed_power_w_per_hz), ok);
+    sum_set(e, "escaped_w_per_hz", sum_real(s->escaped_power_w_per_hz), ok);
+    sum_set(e, "atmosphere_w_per_hz", sum_real(s->atmosphere_power_w_per_hz), ok);
+    sum_set(e, "terminated_w_per_hz", sum_real(s->terminated_power_w_per_hz), ok);
+    sum_set(e, "relative_difference",
+            s->emitted_power_w_per_hz > 0.0 && !(s->reference_temperature_k > 0.0)
+                ? sum_real((s->emitted_power_w_per_hz - out) / s->emitted_power_w_per_hz)
+                : json_null(),
+            ok);
+    sum_set(o, "energy_balance", e, ok);
+    sum_set(o, "photon_phase_s", sum_real(s->seconds), ok);
+}
+
 static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *summary, bool *ok)
 {
     const thz_channel *ch = &scene->channels[c];
@@ -72,49 +118,8 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
     sum_set(o, "name", json_string(ch->name), ok);
     sum_set(o, "frequency_thz", json_real(ch->center_hz / 1e12), ok);
     sum_set(o, "relative_width", json_real(ch->relative_width), ok);
-    if (summary->channel_stats) {
-        const photon_stats *s = &summary->channel_stats[c];
-        sum_set(o, "photons_fired", sum_u64(s->fired), ok);
-        sum_set(o, "photons_stored", sum_u64(s->stored), ok);
-        sum_set(o, "emitted_power_w_per_hz", sum_real(s->emitted_power_w_per_hz), ok);
-        sum_set(o, "photon_reference_temperature_k", sum_real(s->reference_temperature_k), ok);
-        sum_set(o, "fraction_absorbed", json_real(sum_ratio(s->absorbed, s->fired)), ok);
-        sum_set(o, "fraction_escaped", json_real(sum_ratio(s->escaped, s->fired)), ok);
-        sum_set(o, "fraction_terminated", json_real(sum_ratio(s->terminated, s->fired)), ok);
-        sum_set(o, "fraction_reflected", json_real(sum_ratio(s->reflected, s->hits)), ok);
-        sum_set(o, "fraction_transmitted", json_real(sum_ratio(s->transmitted, s->hits)), ok);
-        sum_set(o, "back_face_hits", sum_u64(s->back_face_hits), ok);
-        sum_set(o, "mean_bounces", sum_real(s->mean_bounces), ok);
-        json_t *counts = json_object();
-        sum_set(counts, "hits", sum_u64(s->hits), ok);
-        sum_set(counts, "reflected", sum_u64(s->reflected), ok);
-        sum_set(counts, "transmitted", sum_u64(s->transmitted), ok);
-        sum_set(counts, "absorbed", sum_u64(s->absorbed), ok);
-        sum_set(counts, "escaped", sum_u64(s->escaped), ok);
-        sum_set(counts, "terminated", sum_u64(s->terminated), ok);
-        sum_set(o, "counts", counts, ok);
-        /* Exact bookkeeping: fired = absorbed + escaped + atmosphere + terminated (the
-         * low-power roulette's net removal). relative_difference compares that total
-         * with the band-mean P_A: Monte Carlo noise of the fired power only (or a bug).
-         * A deviation map (T0 > 0) fires the signed sources of L - B(T0), not P_A: its
-         * sums balance as well, but relative_difference is null. */
-        json_t *e = json_object();
-        double out = s->absorbed_power_w_per_hz + s->escaped_power_w_per_hz +
-                     s->atmosphere_power_w_per_hz + s->terminated_power_w_per_hz;
-        sum_set(e, "emitted_w_per_hz", sum_real(s->emitted_power_w_per_hz), ok);
-        sum_set(e, "fired_w_per_hz", sum_real(s->fired_power_w_per_hz), ok);
-        sum_set(e, "absorbed_w_per_hz", sum_real(s->absorbed_power_w_per_hz), ok);
-        sum_set(e, "escaped_w_per_hz", sum_real(s->escaped_power_w_per_hz), ok);
-        sum_set(e, "atmosphere_w_per_hz", sum_real(s->atmosphere_power_w_per_hz), ok);
-        sum_set(e, "terminated_w_per_hz", sum_real(s->terminated_power_w_per_hz), ok);
-        sum_set(e, "relative_difference",
-                s->emitted_power_w_per_hz > 0.0 && !(s->reference_temperature_k > 0.0)
-                    ? sum_real((s->emitted_power_w_per_hz - out) / s->emitted_power_w_per_hz)
-                    : json_null(),
-                ok);
-        sum_set(o, "energy_balance", e, ok);
-        sum_set(o, "photon_phase_s", sum_real(s->seconds), ok);
-    }
+    if (summary->channel_stats)
+        sum_photon_stats(o, &summary->channel_stats[c], ok);
     if (summary->noise) {
         sum_set(o, "median_stderr_k", sum_real(summary->noise[c].median_k), ok);
         sum_set(o, "p95_stderr_k", sum_real(summary->noise[c].p95_k), ok);

@@ -7,6 +7,7 @@
 
 #include "core/alloc.h"
 #include "core/cdf.h"
+#include "core/sampling.h"
 #include "physics/planck.h"
 
 void air_emission_fini(air_emission *a)
@@ -144,7 +145,7 @@ static void air_emission_face_point(const air_emission *a, rng_stream *rng, vec3
     double nv[3] = {0.0, 0.0, 0.0};
     nv[axis] = at_max ? -1.0 : 1.0;
     double u = rng_uniform(rng);
-    *dir = emission_direction(v3(nv[0], nv[1], nv[2]), sqrt(1.0 - u), rng_uniform(rng));
+    *dir = sampling_direction(v3(nv[0], nv[1], nv[2]), sqrt(1.0 - u), rng_uniform(rng));
 }
 
 /* Whether a boundary photon at p going along dir comes from outside: a ray from just

@@ -8,24 +8,8 @@
 
 #include "core/alloc.h"
 #include "core/cdf.h"
+#include "core/sampling.h"
 #include "physics/planck.h"
-
-double emission_uniform(void *rng)
-{
-    return rng_uniform(rng);
-}
-
-vec3 emission_direction(vec3 n, double mu, double u)
-{
-    vec3 t, b;
-    v3_basis(n, &t, &b);
-    double s = sqrt(fmax(0.0, 1.0 - mu * mu));
-    double phi = 2.0 * M_PI * u;
-    vec3 d = v3_scale(n, mu);
-    d = v3_madd(d, s * cos(phi), t);
-    d = v3_madd(d, s * sin(phi), b);
-    return v3_normalize(d);
-}
 
 static bool spectrum_is_constant(const thz_spectrum *s)
 {
@@ -202,7 +186,7 @@ static double emission_back_reach(const emission_table *t, const accel *acc, siz
         const float *nf = &m->normals[3 * tri];
         vec3 n = v3_scale(v3(nf[0], nf[1], nf[2]), -1.0);
         double u = rng_uniform(&rng);
-        vec3 dir = emission_direction(n, sqrt(1.0 - u), rng_uniform(&rng));
+        vec3 dir = sampling_direction(n, sqrt(1.0 - u), rng_uniform(&rng));
         accel_hit from = {
             .object = (uint32_t)i, .triangle = (uint32_t)tri, .position_m = p, .side = 1};
         accel_hit hit;
@@ -479,9 +463,9 @@ bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *
     double mu;
     if (back)
         mu = sqrt(1.0 - rng_uniform(rng)); /* radiance -B0: cosine */
-    else if (!optics_sample_emission_mu(&law, emission_uniform, rng, &mu))
+    else if (!optics_sample_emission_mu(&law, sampling_uniform, rng, &mu))
         mu = sqrt(1.0 - rng_uniform(rng)); /* eps = 0 (a -A B0 source) or unreachable */
-    out->dir = emission_direction(n, mu, rng_uniform(rng));
+    out->dir = sampling_direction(n, mu, rng_uniform(rng));
     out->object = s->object;
     out->triangle = (uint32_t)tri;
     out->side = side;

@@ -168,10 +168,4 @@ double emission_band_magnitude_w_per_hz(const emission_table *t);
  * set. The power is signed (negative where the source's eps B(T) < A B0). */
 bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *out);
 
-/* A unit direction about unit normal n with cos(theta) = mu and azimuth 2 pi u. */
-vec3 emission_direction(vec3 n, double mu, double u);
-
-/* Adapter: rng_uniform as an optics_uniform_fn (ctx is the rng_stream). */
-double emission_uniform(void *rng);
-
 #endif

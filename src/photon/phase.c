@@ -249,26 +249,10 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     double t3 = omp_get_wtime();
 
     if (stats) {
-        memset(stats, 0, sizeof *stats);
-        stats->fired = c.photons;
-        stats->stored = count;
-        stats->hits = c.hits;
-        stats->reflected = c.reflected;
-        stats->transmitted = c.transmitted;
-        stats->absorbed = c.absorbed;
-        stats->escaped = c.escaped;
-        stats->back_face_hits = c.back_face_hits;
-        stats->terminated = c.terminated + c.capped;
-        stats->bounce_capped = c.capped;
+        photon_stats_init(stats);
+        photon_stats_add(stats, &c, count);
         stats->emitted_power_w_per_hz = surface_power + air_power; /* + air, boundary */
         stats->reference_temperature_k = t0_k;
-        stats->fired_power_w_per_hz = c.fired_power;
-        stats->absorbed_power_w_per_hz = c.absorbed_power;
-        stats->escaped_power_w_per_hz = c.escaped_power;
-        stats->atmosphere_power_w_per_hz = c.atmosphere_power;
-        stats->terminated_power_w_per_hz = c.terminated_power;
-        stats->mean_bounces = c.photons ? (double)c.hits / (double)c.photons : 0.0;
-        stats->rays = c.rays;
         stats->seconds_emission_table = t1 - t0;
         stats->seconds_tracing = t2 - t1;
         stats->seconds_index = t3 - t2;

@@ -1,4 +1,7 @@
-/* Run statistics of the photon phase for one channel (summary.json "channels"). */
+/* Run statistics of the photon phase for one channel (summary.json "channels"): filled
+ * from the tracer's counters by the phase, merged over photon passes by the run, written
+ * to summary.json (io/summary.c) and photon-map files (io/photon_map_file.c). This file
+ * and photon_stats.c are their one owner. */
 #ifndef THZ_PHOTON_PHOTON_STATS_H
 #define THZ_PHOTON_PHOTON_STATS_H
 
@@ -43,5 +46,20 @@ typedef struct photon_stats {
      * sources, not emitted_power_w_per_hz), and the counts count photons of either sign. */
     double reference_temperature_k;
 } photon_stats;
+
+struct trace_counters; /* photon/trace.h */
+
+/* Empty statistics (every count and sum 0). */
+void photon_stats_init(photon_stats *s);
+
+/* Adds the outcome of traced paths (trace.h's counters, summed in a fixed order) and the
+ * records they stored: counts and power sums add up, mean_bounces follows. Times,
+ * emitted power and T0 are the caller's to set. */
+void photon_stats_add(photon_stats *s, const struct trace_counters *c, uint64_t stored);
+
+/* Merges the statistics of photon pass p into sum, which holds passes - 1 earlier ones
+ * (passes >= 1; the first is copied): counts and times add up, powers are the merged
+ * photons' (each pass's divided by the number of passes: the mean of the passes'). */
+void photon_stats_merge(photon_stats *sum, const photon_stats *p, uint32_t passes);
 
 #endif

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "core/alloc.h"
+#include "core/sampling.h"
 
 void trace_counters_add(trace_counters *sum, const trace_counters *c)
 {
@@ -60,9 +61,9 @@ trace_event trace_roulette(const optics_point *o, double mu, double u)
 vec3 trace_diffuse_transmission_dir(const optics_point *o, vec3 n_out, rng_stream *rng)
 {
     double mu;
-    if (!optics_sample_transmission_mu(o, emission_uniform, rng, &mu))
+    if (!optics_sample_transmission_mu(o, sampling_uniform, rng, &mu))
         mu = sqrt(1.0 - rng_uniform(rng)); /* unreachable after a transmission event */
-    return emission_direction(n_out, mu, rng_uniform(rng));
+    return sampling_direction(n_out, mu, rng_uniform(rng));
 }
 
 bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photon *e,
@@ -162,7 +163,7 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
         switch (trace_roulette(&o, hit.cos_theta, rng_uniform(rng))) {
         case TRACE_REFLECT:
             c->reflected++;
-            dir = emission_direction(n_in, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
+            dir = sampling_direction(n_in, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
             break;
         case TRACE_TRANSMIT:
             c->transmitted++;

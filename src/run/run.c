@@ -21,6 +21,7 @@
 #include "physics/planck.h"
 #include "sensor/images.h"
 #include "sensor/render.h"
+#include "sensor/truth.h"
 
 /* A noise target stops here at the latest (with a run warning). */
 #define RUN_MAX_PASSES 100000u
@@ -227,12 +228,12 @@ static uint64_t run_image_bytes(const run_state *rs)
 }
 
 /* T0 of channel c's photon map in simulate: final-gather fires the deviation map of
- * L - B(T0) (photon_map.h), T0 the renderer's control-variate temperature; photon-map
- * keeps the paper's map. */
+ * L - B(T0) (photon_map.h), T0 the scene's reference temperature (also path's control
+ * variate); photon-map keeps the paper's map. */
 double run_photon_t0_k(const thz_scene *scene, size_t c)
 {
     return scene->render.integrator == INTEGRATOR_FINAL_GATHER
-               ? render_reference_temperature_k(scene, c)
+               ? scene_reference_temperature_k(scene, c)
                : 0.0;
 }
 
@@ -310,11 +311,14 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
         const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
         st = render_accum_init(&acc[i], (size_t)s->columns * s->rows, err);
     }
+    /* the channel's tables, built once for all its passes and sensors */
+    render_context *ctx = NULL;
+    if (st == THZ_OK)
+        st = render_context_create(rs->scene, rs->accel, map, c, &ro, &ctx, err);
     for (uint32_t pass = 0; st == THZ_OK; pass++) {
         for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
             render_stats rst;
-            st = render_sensor_channel_pass(rs->scene, rs->accel, map, c, rs->selected[i], pass,
-                                            &acc[i], &ro, &rst, err);
+            st = render_context_pass(ctx, rs->selected[i], pass, &acc[i], &ro, &rst, err);
             if (st != THZ_OK)
                 break;
             rs->last[c * rs->n_selected + i] = rst;
@@ -337,6 +341,7 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
             break;
         }
     }
+    render_context_destroy(ctx);
     if (acc)
         for (size_t i = 0; i < rs->n_selected; i++)
             render_accum_fini(&acc[i]);
@@ -470,42 +475,6 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
     return st;
 }
 
-/* Adds the statistics of photon pass `p` (p + 1 passes so far) to the merged map's:
- * counts and times add up; powers are the merged photons' (each pass's divided by the
- * number of passes: the mean of the passes'). */
-void run_stats_merge(photon_stats *sum, const photon_stats *p, uint32_t passes)
-{
-    if (passes == 1) {
-        *sum = *p;
-        return;
-    }
-    double w = 1.0 / passes, keep = 1.0 - w;
-    sum->fired += p->fired;
-    sum->hits += p->hits;
-    sum->reflected += p->reflected;
-    sum->transmitted += p->transmitted;
-    sum->absorbed += p->absorbed;
-    sum->escaped += p->escaped;
-    sum->back_face_hits += p->back_face_hits;
-    sum->terminated += p->terminated;
-    sum->bounce_capped += p->bounce_capped;
-    sum->rays += p->rays;
-    sum->absorbed_power_w_per_hz =
-        keep * sum->absorbed_power_w_per_hz + w * p->absorbed_power_w_per_hz;
-    sum->escaped_power_w_per_hz =
-        keep * sum->escaped_power_w_per_hz + w * p->escaped_power_w_per_hz;
-    sum->atmosphere_power_w_per_hz =
-        keep * sum->atmosphere_power_w_per_hz + w * p->atmosphere_power_w_per_hz;
-    sum->fired_power_w_per_hz = keep * sum->fired_power_w_per_hz + w * p->fired_power_w_per_hz;
-    sum->terminated_power_w_per_hz =
-        keep * sum->terminated_power_w_per_hz + w * p->terminated_power_w_per_hz;
-    sum->mean_bounces = sum->fired ? (double)sum->hits / (double)sum->fired : 0.0;
-    sum->seconds += p->seconds;
-    sum->seconds_emission_table += p->seconds_emission_table;
-    sum->seconds_tracing += p->seconds_tracing;
-    sum->seconds_index += p->seconds_index;
-}
-
 /* photon-map with a noise target (it cannot add render passes: it is deterministic given
  * its map): photon passes instead. Pass p fires photons p K .. (p + 1) K - 1 of the
  * channel, and the channel is rendered from the merge of all passes' photons
@@ -552,7 +521,7 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
             st = photon_map_merge((const photon_map *const *)maps, n, scene->n_objects,
                                   opt->threads, &merged, err);
         rs->seconds_photons += thz_now_s() - t0;
-        run_stats_merge(&rs->stats[c], &ps, (uint32_t)n);
+        photon_stats_merge(&rs->stats[c], &ps, (uint32_t)n);
         if (st != THZ_OK)
             break;
         const photon_map *map = n > 1 ? merged : maps[0];

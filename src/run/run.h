@@ -203,8 +203,5 @@ void run_state_fini(run_state *rs);
  * deviation map takes the renderer's reference temperature, photon-map 0. */
 double run_photon_t0_k(const thz_scene *scene, size_t c);
 
-/* Adds the statistics of photon pass `p` (`passes` passes so far, this one included)
- * to those of the merged map: counts and times add up, powers are averaged. */
-void run_stats_merge(photon_stats *sum, const photon_stats *p, uint32_t passes);
 
 #endif

@@ -10,6 +10,8 @@
 #include "run/run_noise.h"
 #include "sensor/images.h"
 #include "sensor/render.h"
+#include "sensor/render_accum.h"
+#include "sensor/truth.h"
 
 /* Samples one pass of sensor s renders: pixels x oversampling^2 (x paths for path). */
 static double estimate_samples(const thz_scene *scene, const thz_sensor *s)
@@ -40,7 +42,7 @@ thz_status run_estimate_time(const run_estimate_input *in, double *seconds_photo
         photon_phase_options po = {.threads = in->threads,
                                    .reference_temperature_k =
                                        scene->render.integrator == INTEGRATOR_FINAL_GATHER
-                                           ? render_reference_temperature_k(scene, 0)
+                                           ? scene_reference_temperature_k(scene, 0)
                                            : 0.0};
         photon_stats ps;
         double t0 = thz_now_s();

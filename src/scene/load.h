@@ -18,7 +18,7 @@
 
 #include "core/error.h"
 #include "physics/spectrum.h"
-#include "scene/csv.h"
+#include "core/csv.h"
 #include "scene/scene.h"
 
 /* Long enough for any path a sane scene produces; longer ones are cut (messages only). */

@@ -40,7 +40,6 @@ thz_status load_render(load_ctx *ctx, const load_cursor *root)
 {
     static const char *const keys[] = {"integrator",     "gather_rays", "paths_per_sample",
                                        "target_noise_k", "max_seconds", NULL};
-    static const char *const integrators[] = {"photon-map", "final-gather", "path", NULL};
     thz_render_settings *r = &ctx->scene->render;
     load_cursor c = load_key(root, "render");
     if (!c.value)
@@ -49,7 +48,8 @@ thz_status load_render(load_ctx *ctx, const load_cursor *root)
     uint64_t rays = 0, paths = 0;
     thz_status st = load_expect_object(ctx, &c, keys);
     if (st == THZ_OK)
-        st = load_choice(ctx, &c, "integrator", integrators, false, 2, &integrator);
+        st = load_choice(ctx, &c, "integrator", scene_integrator_names, false, INTEGRATOR_PATH,
+                         &integrator);
     if (st == THZ_OK)
         st = load_integer(ctx, &c, "gather_rays", 1, 1000000, false, r->gather_rays, &rays);
     if (st == THZ_OK)
@@ -62,9 +62,7 @@ thz_status load_render(load_ctx *ctx, const load_cursor *root)
     if (st != THZ_OK)
         return st;
     r->paths_per_sample_given = json_object_get(c.value, "paths_per_sample") != NULL;
-    r->integrator = integrator == 2   ? INTEGRATOR_PATH
-                    : integrator == 1 ? INTEGRATOR_FINAL_GATHER
-                                      : INTEGRATOR_PHOTON_MAP;
+    r->integrator = (thz_integrator)integrator; /* scene_integrator_names' index */
     r->gather_rays = (uint32_t)rays;
     r->paths_per_sample = (uint32_t)paths;
     return THZ_OK;

@@ -1,4 +1,7 @@
-/* Mesh import through the assimp C API, vertex welding and the winding check. */
+/* Mesh import through the assimp C API, vertex welding and the winding check. The file
+ * is read into memory and checked (mesh_check.h) before assimp sees it; assimp then reads
+ * those bytes through our own file callbacks, which serve that one file and no other (an
+ * OBJ's `mtllib` could otherwise name a FIFO or a device). */
 #include "scene/mesh_import.h"
 
 #include <errno.h>
@@ -8,13 +11,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
+#include <assimp/cfileio.h>
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include "core/alloc.h"
+#include "core/file.h"
+#include "scene/mesh_check.h"
 #include "scene/primitives.h"
 
 /* Counts the triangles of node and its children (each mesh as often as nodes use it). */
@@ -24,10 +29,22 @@ static thz_status mesh_import_count(const struct aiScene *sc, const struct aiNod
     if (depth > 1000)
         return THZ_ERR_INPUT;
     for (unsigned i = 0; i < node->mNumMeshes; i++) {
+        if (node->mMeshes[i] >= sc->mNumMeshes)
+            return THZ_ERR_INPUT;
         const struct aiMesh *m = sc->mMeshes[node->mMeshes[i]];
+        if (m->mNumVertices && !m->mVertices)
+            return THZ_ERR_INPUT;
         *n_vertices += m->mNumVertices;
-        for (unsigned f = 0; f < m->mNumFaces; f++)
-            *n_triangles += m->mFaces[f].mNumIndices == 3;
+        for (unsigned f = 0; f < m->mNumFaces; f++) {
+            const struct aiFace *face = &m->mFaces[f];
+            if (face->mNumIndices != 3)
+                continue;
+            /* what the checks let through must still index this mesh's vertices */
+            for (int k = 0; k < 3; k++)
+                if (face->mIndices[k] >= m->mNumVertices)
+                    return THZ_ERR_INPUT;
+            *n_triangles += 1;
+        }
     }
     for (unsigned c = 0; c < node->mNumChildren; c++) {
         thz_status st =
@@ -164,30 +181,150 @@ static bool mesh_import_weld(thz_mesh *mesh)
     return true;
 }
 
+/* ---- assimp's file callbacks: the checked bytes, and no other file ------------- */
+
+typedef struct mesh_source {
+    const char *name; /* what assimp is asked to open: "mesh.<ext>" */
+    const char *data;
+    size_t size;
+} mesh_source;
+
+typedef struct mesh_stream {
+    const mesh_source *src;
+    size_t pos;
+} mesh_stream;
+
+static size_t mesh_io_read(struct aiFile *f, char *buf, size_t size, size_t count)
+{
+    mesh_stream *s = (mesh_stream *)f->UserData;
+    if (size == 0)
+        return 0;
+    size_t n = (s->src->size - s->pos) / size;
+    n = n < count ? n : count;
+    memcpy(buf, s->src->data + s->pos, n * size);
+    s->pos += n * size;
+    return n;
+}
+
+static size_t mesh_io_write(struct aiFile *f, const char *buf, size_t size, size_t count)
+{
+    (void)f, (void)buf, (void)size, (void)count;
+    return 0;
+}
+
+static size_t mesh_io_tell(struct aiFile *f)
+{
+    return ((mesh_stream *)f->UserData)->pos;
+}
+
+static size_t mesh_io_size(struct aiFile *f)
+{
+    return ((mesh_stream *)f->UserData)->src->size;
+}
+
+static enum aiReturn mesh_io_seek(struct aiFile *f, size_t offset, enum aiOrigin origin)
+{
+    mesh_stream *s = (mesh_stream *)f->UserData;
+    size_t base = origin == aiOrigin_SET ? 0 : origin == aiOrigin_CUR ? s->pos : s->src->size;
+    if (offset > s->src->size - base)
+        return aiReturn_FAILURE;
+    s->pos = base + offset;
+    return aiReturn_SUCCESS;
+}
+
+static void mesh_io_flush(struct aiFile *f)
+{
+    (void)f;
+}
+
+static struct aiFile *mesh_io_open(struct aiFileIO *io, const char *name, const char *mode)
+{
+    const mesh_source *src = (const mesh_source *)io->UserData;
+    if (strcmp(name, src->name) != 0 || strchr(mode, 'w') || strchr(mode, 'a'))
+        return NULL; /* material libraries and the like: not read */
+    struct aiFile *f = thz_calloc(1, sizeof *f);
+    mesh_stream *s = thz_calloc(1, sizeof *s);
+    if (!f || !s) {
+        free(f);
+        free(s);
+        return NULL;
+    }
+    s->src = src;
+    *f = (struct aiFile){mesh_io_read, mesh_io_write, mesh_io_tell, mesh_io_size,
+                         mesh_io_seek, mesh_io_flush, (aiUserData)s};
+    return f;
+}
+
+static void mesh_io_close(struct aiFileIO *io, struct aiFile *f)
+{
+    (void)io;
+    if (f)
+        free(f->UserData);
+    free(f);
+}
+
+/* The whole file (size bytes, as file_check_regular found) into *data. */
+static thz_status mesh_import_read(const char *path, const char *name, size_t size, char **data,
+                                   thz_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open mesh file: %s", name,
+                             strerror(errno));
+    *data = malloc(size ? size : 1);
+    if (!*data) {
+        fclose(f);
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while reading %zu bytes", name,
+                             size);
+    }
+    size_t got = fread(*data, 1, size, f);
+    int more = fgetc(f) != EOF, failed = ferror(f);
+    fclose(f);
+    if (failed || got != size || more) {
+        free(*data);
+        *data = NULL;
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: %s while reading the mesh file", name,
+                             failed ? "read error" : "the file changed size");
+    }
+    return THZ_OK;
+}
+
 thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_error *err)
 {
     const char *name = label ? label : path;
-    thz_status st = THZ_OK;
     memset(mesh, 0, sizeof *mesh);
-    struct stat info;
-    if (stat(path, &info) == 0 && S_ISDIR(info.st_mode))
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: is a directory, expected a mesh file", name);
-    FILE *probe = fopen(path, "rb");
-    if (!probe)
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open mesh file: %s", name,
-                             strerror(errno));
-    fclose(probe);
+    mesh_format format;
+    uint64_t size;
+    char *data = NULL;
+    thz_status st = mesh_check_format(path, name, &format, err);
+    if (st == THZ_OK)
+        st = file_check_regular(path, name, MESH_MAX_FILE_BYTES, &size, err);
+    if (st == THZ_OK)
+        st = mesh_import_read(path, name, (size_t)size, &data, err);
+    if (st == THZ_OK)
+        st = mesh_check(data, (size_t)size, format, name, NULL, err);
+    if (st != THZ_OK) {
+        free(data);
+        return st;
+    }
+    char fake_name[16];
+    snprintf(fake_name, sizeof fake_name, "mesh.%s", mesh_format_extension(format));
+    mesh_source src = {fake_name, data, (size_t)size};
+    struct aiFileIO io = {mesh_io_open, mesh_io_close, (aiUserData)&src};
     const struct aiScene *sc =
-        aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+        aiImportFileEx(fake_name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices, &io);
+    free(data);
     if (!sc) {
         const char *why = aiGetErrorString();
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "%s: cannot read as a mesh (OBJ, PLY, STL, glTF, ...): %s", name,
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot read as a mesh: %s", name,
                              why && why[0] ? why : "unknown format");
     }
     size_t nv = 0, nt = 0;
     if (!sc->mRootNode || mesh_import_count(sc, sc->mRootNode, 0, &nv, &nt) != THZ_OK) {
-        st = thz_error_set(err, THZ_ERR_INPUT, "%s: the mesh's node tree is malformed", name);
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "%s: the importer's result is malformed (its node tree, or a face "
+                           "index beyond its vertices)",
+                           name);
         goto cleanup;
     }
     if (nt == 0) {

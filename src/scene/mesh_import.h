@@ -1,7 +1,8 @@
-/* Mesh files through assimp: Wavefront OBJ, PLY, STL (ASCII and binary), glTF and
- * whatever else assimp reads. Polygons are triangulated and the node transforms baked
- * in; nothing that reorders the winding or invents normals is applied, because the
- * normals follow the winding order (a mesh's front side is where its triangles turn
+/* Mesh files through assimp: Wavefront OBJ (.obj), PLY (.ply, ASCII and binary) and STL
+ * (.stl, ASCII and binary), the formats mesh_check.h checks before assimp sees a file
+ * (others are refused: an unchecked file could hang the import). Polygons are triangulated and the
+ * node transforms baked in; nothing that reorders the winding or invents normals is applied,
+ * because the normals follow the winding order (a mesh's front side is where its triangles turn
  * counter-clockwise). Vertices at exactly the same position are merged, so that
  * formats storing each triangle's corners separately (STL) come out connected, and
  * vertices no triangle uses (those of points and lines) are dropped.
@@ -16,7 +17,8 @@
 
 /* Reads the file at path into mesh (positions and indices; mesh_finalize computes the
  * rest). `label` (NULL: path) names the file in messages. THZ_ERR_INPUT when the file
- * is missing, unreadable, not a mesh, or holds no triangles. */
+ * is missing, not a regular file, of another format, fails the checks of mesh_check.h,
+ * or holds no triangles; THZ_ERR_NOMEM when memory runs out. */
 thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_error *err);
 
 /* Number of directed edges used by more than one triangle (in the same direction):

@@ -11,6 +11,13 @@
 #include "core/alloc.h"
 #include "physics/planck.h"
 
+const char *const scene_integrator_names[] = {
+    [INTEGRATOR_PHOTON_MAP] = "photon-map",
+    [INTEGRATOR_FINAL_GATHER] = "final-gather",
+    [INTEGRATOR_PATH] = "path",
+    [INTEGRATOR_PATH + 1] = NULL,
+};
+
 thz_scene *scene_create(void)
 {
     thz_scene *s = thz_calloc(1, sizeof *s);
@@ -178,4 +185,21 @@ bool mesh_finalize(thz_mesh *mesh)
             mesh->normals[3 * t + (size_t)k] = len > 0.0 ? (float)(n[k] / len) : 0.0f;
     }
     return true;
+}
+
+double scene_reference_temperature_k(const thz_scene *scene, size_t channel)
+{
+    const thz_channel *ch = &scene->channels[channel];
+    double best = -1.0, t0 = 0.0;
+    for (size_t o = 0; o < scene->n_objects; o++) {
+        const thz_object *obj = &scene->objects[o];
+        optics_point op = scene_object_optics(scene, obj, ch->center_hz);
+        double sides = obj->type == OBJECT_SHELL || obj->two_sided ? 2.0 : 1.0;
+        double w = obj->mesh.total_area_m2 * sides * optics_mean_emissivity(&op);
+        if (w > best) {
+            best = w;
+            t0 = obj->temperature_k;
+        }
+    }
+    return t0;
 }

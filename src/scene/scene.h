@@ -82,6 +82,10 @@ typedef enum thz_integrator {
     INTEGRATOR_PATH
 } thz_integrator;
 
+/* The integrators' names as in the scene file ("photon-map", "final-gather", "path"),
+ * indexed by thz_integrator and ended by NULL: the one list of them. */
+extern const char *const scene_integrator_names[];
+
 typedef struct thz_render_settings {
     thz_integrator integrator;
     uint32_t gather_rays;      /* final-gather, default 32 */
@@ -148,6 +152,12 @@ double scene_emitted_power_w_per_hz(const thz_scene *scene, double freq_hz);
 
 /* Band mean of P_A over channel c, in W/Hz. */
 double scene_band_emitted_power_w_per_hz(const thz_scene *scene, size_t channel);
+
+/* The reference temperature T0 of channel c, K: the temperature of the object with the
+ * largest area x sides x hemispherical emissivity at the channel centre (the walls of a
+ * room); 0 without objects. The control variate B_nu(T0) of the `path` integrator, and
+ * the T0 of final-gather's deviation photon map (photon_map.h). */
+double scene_reference_temperature_k(const thz_scene *scene, size_t channel);
 
 /* Computes the mesh-derived data from positions and indices: allocates (replacing any
  * earlier) normals and areas_m2, and sets total_area_m2 and the bounding box.

@@ -30,8 +30,8 @@ thz_status sensor_images_init(sensor_images *img, uint32_t columns, uint32_t row
     img->brightness_temperature = thz_calloc(cube, sizeof(float));
     img->normalized = thz_calloc(cube, sizeof(float));
     img->radiance_stderr = with_stderr ? thz_calloc(cube, sizeof(float)) : NULL;
-    img->temperature_k = thz_calloc(pixels, sizeof(float));
-    img->distance_m = thz_calloc(pixels, sizeof(float));
+    img->temperature_k = thz_malloc_array(pixels, sizeof(float));
+    img->distance_m = thz_malloc_array(pixels, sizeof(float));
     img->object_id = thz_malloc_array(pixels, sizeof(int32_t));
     img->visual_rgb = thz_calloc(pixels, 3 * sizeof(float));
     if (!img->radiance || !img->power || !img->brightness_temperature || !img->normalized ||
@@ -41,8 +41,11 @@ thz_status sensor_images_init(sensor_images *img, uint32_t columns, uint32_t row
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for a %u x %u x %zu image", columns,
                              rows, n_channels);
     }
-    for (size_t i = 0; i < pixels; i++)
-        img->object_id[i] = -1;
+    for (size_t i = 0; i < pixels; i++) {
+        img->temperature_k[i] = SENSOR_NOTHING_HIT;
+        img->distance_m[i] = SENSOR_NOTHING_HIT;
+        img->object_id[i] = (int32_t)SENSOR_NOTHING_HIT;
+    }
     return THZ_OK;
 }
 

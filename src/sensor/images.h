@@ -11,6 +11,11 @@
 
 #include "core/error.h"
 
+/* The truth images' value where nothing is hit: no temperature (0 K is a valid object
+ * temperature) or distance can be negative, and object_id's -1 is the same number, so
+ * one `data ignore value` covers all three. */
+#define SENSOR_NOTHING_HIT (-1.0f)
+
 typedef struct sensor_images {
     uint32_t columns, rows;
     size_t n_channels;
@@ -19,14 +24,14 @@ typedef struct sensor_images {
     float *power;                  /* P_c, W */
     float *brightness_temperature; /* Tb_c, K */
     float *normalized;             /* N_c, 1 */
-    float *temperature_k;          /* 1 band: temperature of the surface seen, K (0: none) */
-    float *distance_m;             /* 1 band: distance to the surface seen, m (0: none) */
-    int32_t *object_id;            /* 1 band: index into scene objects, -1: nothing hit */
-    float *visual_rgb;             /* rows x columns x 3, shaded colours 0..1 */
+    float *temperature_k; /* 1 band: temperature of the surface seen, K (SENSOR_NOTHING_HIT) */
+    float *distance_m;    /* 1 band: distance to the surface seen, m (SENSOR_NOTHING_HIT) */
+    int32_t *object_id;   /* 1 band: index into scene objects, -1: nothing hit */
+    float *visual_rgb;    /* rows x columns x 3, shaded colours 0..1 */
 } sensor_images;
 
-/* Allocates all arrays zeroed (object_id set to -1); radiance_stderr only when
- * with_stderr. */
+/* Allocates all arrays, the cubes zeroed and the truth images at "nothing hit" (-1);
+ * radiance_stderr only when with_stderr. */
 thz_status sensor_images_init(sensor_images *img, uint32_t columns, uint32_t rows,
                               size_t n_channels, int with_stderr, thz_error *err);
 void sensor_images_fini(sensor_images *img);

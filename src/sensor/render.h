@@ -2,7 +2,7 @@
  * every pixel sample of a sensor, the radiance reaching the pinhole in one channel, and
  * from its pixel mean the channel images L_c, P_c, Tb_c and N_c; plus the truth images.
  *
- * Integrators (an internal table of per-sample functions; docs/integrators.md):
+ * Integrators (the table in integrators.c, one file each; docs/integrators.md):
  *   photon-map:   the paper's density estimate over the sample's footprint; deterministic
  *                 given the photon map; one pass.
  *   final-gather: at the first non-straight hit, `gather_rays` secondary rays (cosine for
@@ -15,7 +15,7 @@
  *                 sample, frequency drawn from g_c per path; written as the transport of
  *                 L - B_nu(T0) (T0: a reference temperature of the scene) so that every
  *                 path of an isothermal enclosure at T0 returns exactly the band mean of
- *                 B(T0); unbiased for any scene (see render.c).
+ *                 B(T0); unbiased for any scene (see integrator_path.c).
  *
  * Passes and the noise estimate: a pass gives every pixel J independent, identically
  * distributed estimates (J = paths_per_sample or gather_rays; estimate j is the mean over
@@ -50,6 +50,7 @@
 #include "photon/photon_map.h"
 #include "scene/scene.h"
 #include "sensor/images.h"
+#include "sensor/render_accum.h"
 
 /* A sample ray continues through at most this many `straight` shells; beyond, what
  * lies behind is dropped (counted in render_stats.truncated_paths). */
@@ -73,7 +74,7 @@ typedef struct render_options {
     uint64_t seed;
     thz_progress_fn progress; /* stage "render": done/total = rows of this sensor; may be NULL */
     void *progress_user;
-    /* path: use T0 = path_t0_k (K, >= 0) instead of render_reference_temperature_k. Any T0
+    /* path: use T0 = path_t0_k (K, >= 0) instead of scene_reference_temperature_k. Any T0
      * gives the same expected image (only the noise changes); the identity tests use it
      * so that reflected and transmitted terms do not vanish against B(T0). */
     bool path_t0_set;
@@ -102,12 +103,6 @@ bool render_integrator_parse(const char *name, thz_integrator *out);
 /* THZ_OK if `integrator` is implemented; otherwise THZ_ERR_INPUT. Call before a run. */
 thz_status render_integrator_check(thz_integrator integrator, thz_error *err);
 
-/* T0 of the control variate B_nu(T0) (path always; photon-map and final-gather when
- * the photon map was fired as the deviation from it, photon_map.h): the temperature of
- * the object with the largest area x sides x hemispherical emissivity at the channel
- * centre (the walls of a room). */
-double render_reference_temperature_k(const thz_scene *scene, size_t channel);
-
 /* Whether the integrator needs a photon map (all but `path`). */
 bool render_integrator_needs_photons(thz_integrator integrator);
 
@@ -117,48 +112,36 @@ bool render_integrator_has_passes(thz_integrator integrator);
 /* Independent estimates a pass gives each pixel: paths_per_sample, gather_rays, or 1. */
 uint32_t render_estimates_per_pass(const thz_scene *scene);
 
-/* Per-pixel statistics of one sensor's channel over the passes rendered so far. */
-typedef struct render_accum {
-    size_t pixels;
-    uint64_t n; /* estimates per pixel so far (the same for every pixel) */
-    uint32_t passes;
-    bool poisson; /* photon-map: var holds the Poisson variance of the mean */
-    double *mean; /* per pixel: mean of the estimates, W m^-2 sr^-1 Hz^-1 */
-    double *m2;   /* per pixel: sum of squared deviations from the mean (or, poisson,
-                     the variance of the mean) */
-    /* final-gather with a batched photon map (photon_map.h), else NULL: the map's own
-     * noise, which the spread of the estimates given the map cannot show */
-    double *batch;    /* [pixel * PHOTON_MAP_BATCHES + b]: sum over all estimates of the
-                         photon terms of batch b */
-    double *disk_var; /* per pixel: sum over all estimates of their photon terms' Poisson
-                        variance (sum of squared terms over disk areas squared) */
-} render_accum;
+/* The per-channel state of the renderer (render_context.h): tables that depend only on
+ * the scene, the channel, the photon map and opt's seed and path T0, built once per
+ * channel and shared by its passes and sensors (read-only: any thread). */
+typedef struct render_context render_context;
 
-thz_status render_accum_init(render_accum *acc, size_t pixels, thz_error *err);
-void render_accum_fini(render_accum *acc);
+/* Builds channel `channel`'s state for the scene's integrator; `map` (borrowed, must
+ * outlive it) is the channel's photon map, NULL for path. The scene and accel are
+ * borrowed too. Only opt's use_seed, seed and path T0 are read. */
+thz_status render_context_create(const thz_scene *scene, const accel *a, const photon_map *map,
+                                 size_t channel, const render_options *opt, render_context **out,
+                                 thz_error *err);
 
-/* Standard error of pixel p's mean, W m^-2 sr^-1 Hz^-1 (0 with fewer than 2 estimates).
- * With a batched photon map (final-gather) the variance is s^2 / N from the estimates'
- * spread given the map, plus the map's own variance given the gather rays: the spread of
- * the pixel's photon part between the independent batches, s_B^2 / B, less what s^2 / N
- * already holds of it (each gather disk's own Poisson variance, sum / N^2), at least 0. */
-double render_accum_stderr(const render_accum *acc, size_t p);
+/* NULL does nothing. */
+void render_context_destroy(render_context *ctx);
 
-/* Renders pass `pass` of channel `channel` of sensor `sensor` and merges it into `acc`
- * (initialised for that sensor's pixel count; pass 0 first, then 1, 2, ... in order).
- * `map` is the channel's photon map (NULL for path). photon-map refuses pass > 0
- * (THZ_ERR_INPUT). `stats` (may be NULL) is overwritten with this pass's counts.
+/* Renders pass `pass` of the context's channel for sensor `sensor` and merges it into
+ * `acc` (initialised for that sensor's pixel count; pass 0 first, then 1, 2, ... in
+ * order). photon-map refuses pass > 0 (THZ_ERR_INPUT). `stats` (may be NULL) is
+ * overwritten with this pass's counts. Only opt's threads and progress are read.
  * THZ_ERR_CANCELLED if the progress callback asks to stop. */
+thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_t pass,
+                               render_accum *acc, const render_options *opt, render_stats *stats,
+                               thz_error *err);
+
+/* render_context_pass with a context built for this call alone (render_context_create
+ * with map, channel and opt). */
 thz_status render_sensor_channel_pass(const thz_scene *scene, const accel *a, const photon_map *map,
                                       size_t channel, size_t sensor, uint32_t pass,
                                       render_accum *acc, const render_options *opt,
                                       render_stats *stats, thz_error *err);
-
-/* Writes the channel's planes of `images` from `acc`: radiance, power,
- * brightness_temperature, normalized and, when images->radiance_stderr is set, the
- * standard error of L_c. */
-thz_status render_accum_write(const thz_scene *scene, size_t channel, size_t sensor,
-                              const render_accum *acc, sensor_images *images, thz_error *err);
 
 /* One pass into `images` (initialised with sensor_images_init for that sensor's
  * resolution and the scene's channel count): render_sensor_channel_pass with pass 0 and
@@ -166,16 +149,5 @@ thz_status render_accum_write(const thz_scene *scene, size_t channel, size_t sen
 thz_status render_sensor_channel(const thz_scene *scene, const accel *a, const photon_map *map,
                                  size_t channel, size_t sensor, sensor_images *images,
                                  const render_options *opt, render_stats *stats, thz_error *err);
-
-/* dTb/dL inverse: the standard error in K of a brightness temperature tb_k (> 0) at
- * freq_hz whose radiance has standard error stderr_l (W m^-2 sr^-1 Hz^-1), to first
- * order: stderr_l / (dB_nu/dT at tb_k). */
-double render_stderr_k(double freq_hz, double tb_k, double stderr_l);
-
-/* Fills the truth images of `sensor` (temperature_k, distance_m, object_id, visual_rgb)
- * from the first hit of the ray through each pixel's centre: 0, 0, -1 and black where
- * it hits nothing; visual = material colour x (0.25 + 0.75 |cos theta|). */
-thz_status render_sensor_truth(const thz_scene *scene, const accel *a, size_t sensor,
-                               sensor_images *images, const render_options *opt, thz_error *err);
 
 #endif

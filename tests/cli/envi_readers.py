@@ -19,6 +19,11 @@ gdal.UseExceptions()
 
 CUBES = ["radiance", "power", "brightness_temperature", "normalized"]
 TRUTH = ["temperature", "distance", "object_id"]
+# scene-format.md "Outputs": the unit of each quantity, in the ASCII `data units` key
+UNITS = {"radiance": "W m-2 sr-1 Hz-1", "radiance_stderr": "W m-2 sr-1 Hz-1", "power": "W",
+         "brightness_temperature": "K", "normalized": "1", "temperature": "K", "distance": "m",
+         "object_id": "1"}
+NOTHING_HIT = -1.0  # every truth map's value, and `data ignore value`, where nothing is hit
 
 
 def fail(msg):
@@ -59,6 +64,7 @@ def main():
             path = os.path.join(outdir, f"{s}.{png}.png")
             check(open(path, "rb").read(8) == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG")
         quantities = CUBES + TRUTH
+        truth = {}
         if os.path.exists(os.path.join(outdir, f"{s}.radiance_stderr.hdr")):
             quantities.append("radiance_stderr")
         for q in quantities:
@@ -78,7 +84,8 @@ def main():
             data = im.open_memmap(interleave="bip")  # rows x columns x bands, as stored
             check(np.array_equal(np.asarray(data), raw.transpose(1, 2, 0)),
                   f"{hdr}: spectral data differ from the raw bytes")
-            check("data units" in im.metadata, f"{hdr}: no data units")
+            check(im.metadata.get("data units") == UNITS[q],
+                  f"{hdr}: data units {im.metadata.get('data units')!r} != {UNITS[q]!r}")
             if per_channel:
                 check(im.metadata.get("band names") == names,
                       f"{hdr}: band names {im.metadata.get('band names')} != {names}")
@@ -102,10 +109,22 @@ def main():
                     check(abs(float(md["wavelength"]) - ghz[b]) <= 1e-9 * ghz[b],
                           f"{img}: GDAL wavelength {md.get('wavelength')} != {ghz[b]}")
             ds = None
-            info = json.loads(subprocess.run(["gdalinfo", "-json", img], check=True,
-                                             capture_output=True, text=True).stdout)
+            # GDAL keeps every header key in its ENVI metadata domain; `data units` is the
+            # ENVI key for the unit of the values (GDAL 3.6 maps no key to a band's unit type)
+            info = json.loads(subprocess.run(["gdalinfo", "-json", "-mdd", "ENVI", img],
+                                             check=True, capture_output=True, text=True).stdout)
             check(info["size"] == [cols, rows] and len(info["bands"]) == bands,
                   f"{img}: gdalinfo size")
+            units = info.get("metadata", {}).get("ENVI", {}).get("data_units")
+            check(units == UNITS[q], f"{img}: gdalinfo data_units {units!r} != {UNITS[q]!r}")
+            nodata = [b.get("noDataValue") for b in info["bands"]]
+            if per_channel:
+                check(nodata == [None] * bands, f"{img}: gdalinfo no-data {nodata} on a cube")
+            else:
+                check(nodata == [NOTHING_HIT], f"{img}: gdalinfo no-data {nodata}")
+                check(float(im.metadata.get("data ignore value", "nan")) == NOTHING_HIT,
+                      f"{hdr}: spectral data ignore value")
+                truth[q] = raw[0]
 
             if q == "object_id":
                 check(raw.min() >= -1 and raw.max() < n_objects, f"{img}: ids out of range")
@@ -113,20 +132,24 @@ def main():
                 objects = [o["name"] for o in scene["objects"]]
                 check(im.metadata.get("object names") == objects,
                       f"{hdr}: object names {im.metadata.get('object names')} != {objects}")
-                check(float(im.metadata.get("data ignore value", "nan")) == -1.0,
-                      f"{hdr}: spectral data ignore value")
                 ds = gdal.Open(img)  # kept while its band is used: GDAL frees bands with it
                 nodata = ds.GetRasterBand(1).GetNoDataValue()
                 ds = None
-                check(nodata == -1.0, f"{img}: GDAL no-data value {nodata}")
+                check(nodata == NOTHING_HIT, f"{img}: GDAL no-data value {nodata}")
                 ids = raw[0].astype(np.int32)
             if q == "brightness_temperature":
                 tb = raw
         hit = ids >= 0
-        check(hit.any(), f"{s}: the sensor sees no object")
+        check(hit.any() == (s != "sky"), f"{s}: the sensor sees {hit.sum()} object pixels")
+        for q in ["temperature", "distance"]:
+            check(np.all(truth[q][hit] > 0), f"{s}.{q}: not positive where an object is seen")
+            check(np.all(truth[q][~hit] == NOTHING_HIT), f"{s}.{q}: not -1 where nothing is hit")
+        if s == "sky":
+            continue
         check(np.all(np.isfinite(tb)) and np.all(tb[:, hit] > 0), f"{s}: brightness temperature")
     print(f"envi_readers: every header opens in Spectral Python {spectral.__version__} and "
-          f"GDAL {gdal.__version__}; band names and GHz wavelengths match the scene")
+          f"GDAL {gdal.__version__}; band names, GHz wavelengths, data units and the truth "
+          f"maps' ignore value match the scene")
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # simulate --save-photon-map --ply-max-points N writes a PLY with exactly N points when
-# more photons were stored, and refuses a cap of 0.
+# more photons were stored, and refuses a cap of 0; uncapped, photon-map.ply read back
+# by a generic PLY reader holds the photon map's photons (tests/cli/photon_ply.py).
 set -u
 thzmap=$1
 repo=$2
@@ -10,11 +11,34 @@ fail() { echo "FAIL: $*"; exit 1; }
 
 "$thzmap" simulate "$repo/examples/plate-in-box/scene.json" -o "$tmp/out" --integrator photon-map --photons 2000 \
     --save-photon-map --ply-max-points 100 --quiet || fail "simulate exited $?"
-header=$(head -c 400 "$tmp/out/photon-map.ply" | tr -d '\0' | sed -n '1,/end_header/p')
+header=$(head -c 2000 "$tmp/out/photon-map.ply" | tr -d '\0' | sed -n '1,/end_header/p')
 grep -q '^format binary_little_endian 1.0' <<<"$header" || fail "not a binary LE PLY: $header"
 grep -q '^element vertex 100$' <<<"$header" || fail "expected 100 points: $header"
 stored=$(/usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['channels'][0]['photons_stored'])" "$tmp/out/summary.json")
 [ "$stored" -gt 100 ] || fail "only $stored photons stored: the cap was not exercised"
+
+# Uncapped: every photon, compared with photon-map.thzpm; two channels, and final-gather's
+# deviation maps (from B(T0)): the sphere, colder than T0 (the room's), sends photons of
+# negative power
+cat >"$tmp/two.json" <<'JSON'
+{"format": "thzmap-scene/1", "name": "two",
+ "channels": [{"frequency_thz": 0.35, "relative_width": 0.01},
+              {"frequency_thz": 0.7, "relative_width": 0.01}],
+ "materials": {"wall": {"reflectivity": 0.1}, "paint": {"reflectivity": 0.3}},
+ "objects": [
+   {"name": "room", "type": "solid", "material": "wall", "temperature_k": 330,
+    "shape": {"type": "box", "size_m": [1, 1, 1], "inward": true}},
+   {"name": "target", "type": "solid", "material": "paint", "temperature_k": 280,
+    "shape": {"type": "sphere", "radius_m": 0.2}}],
+ "sensors": [{"name": "cam", "position_m": [0, -0.45, 0], "look_at_m": [0, 0, 0],
+              "fov_deg": 40, "resolution": [8, 8]}],
+ "render": {"integrator": "final-gather"},
+ "photons": {"per_channel": 2000, "seed": 5}}
+JSON
+"$thzmap" simulate "$tmp/two.json" -o "$tmp/all" --save-photon-map --quiet ||
+    fail "simulate exited $?"
+/usr/bin/python3 "$repo/tests/cli/photon_ply.py" "$tmp/all" 2 2 --negative ||
+    fail "photon-map.ply"
 
 "$thzmap" simulate "$repo/examples/plate-in-box/scene.json" -o "$tmp/out2" \
     --save-photon-map --ply-max-points 0 --quiet 2>"$tmp/err"

@@ -35,6 +35,7 @@
 #include "sensor/camera.h"
 #include "sensor/images.h"
 #include "sensor/render.h"
+#include "sensor/truth.h"
 
 /* Standard errors a pixel may lie from the closed form (per pixel, ~600 pixels a test:
  * P(|z| > 5) = 5.7e-7 each). */
@@ -121,7 +122,7 @@ static inline photon_phase_options ident_photon_options(const thz_scene *scene, 
 {
     photon_phase_options po = {.threads = 2};
     if (integrator == INTEGRATOR_FINAL_GATHER)
-        po.reference_temperature_k = render_reference_temperature_k(scene, channel);
+        po.reference_temperature_k = scene_reference_temperature_k(scene, channel);
     return po;
 }
 

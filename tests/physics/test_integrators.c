@@ -178,7 +178,7 @@ static double honesty_ratio(thz_integrator integrator, honesty_case hc)
     if (hc.planck_map)
         po.reference_temperature_k = 0.0;
     if (hc.deviation_map)
-        po.reference_temperature_k = render_reference_temperature_k(scene, 0);
+        po.reference_temperature_k = scene_reference_temperature_k(scene, 0);
     render_options ro = {.threads = 2};
     for (int m = 0; m < HONEST_RUNS; m++) {
         scene->photons.seed = 1000 + (uint64_t)m;

@@ -12,7 +12,7 @@
 #include "../physics/photon_scenes.h"
 #include "accel/accel.h"
 #include "core/rng.h"
-#include "photon/emission.h"
+#include "core/sampling.h"
 
 #define GAP_M 1e-4
 
@@ -138,7 +138,7 @@ static void test_shared_edge(void **state)
         double t = 0.1 + 0.8 * rng_uniform(&rng);
         vec3 p = v3(3.0 - 0.5 + t, -2.0 - 0.5 + t, 4.0);
         double mu = fmax(1e-3, rng_uniform(&rng));
-        vec3 dir = emission_direction(v3(0, 0, 1), mu, rng_uniform(&rng));
+        vec3 dir = sampling_direction(v3(0, 0, 1), mu, rng_uniform(&rng));
         check_leave(f, (uint32_t)(i & 1), p, dir);
     }
 }

@@ -24,55 +24,53 @@ static double db_per_km(double per_m)
 static void test_validation_values(void **state)
 {
     (void)state;
-    atm_csv csv;
+    csv_table csv;
     thz_error err = {0};
-    assert_int_equal(
-        atm_csv_read(&csv,
-                     THZ_SOURCE_DIR
-                     "/data/atmosphere/itu_r_p676_13_specific_attenuation_validation.csv",
-                     &err),
-        THZ_OK);
+    assert_int_equal(csv_read(THZ_SOURCE_DIR
+                              "/data/atmosphere/itu_r_p676_13_specific_attenuation_validation.csv",
+                              NULL, &csv, &err),
+                     THZ_OK);
     size_t cf, cp, ct, crho, co, cw, cg;
-    assert_int_equal(atm_csv_column(&csv, "f_GHz", &cf, &err), THZ_OK);
-    assert_int_equal(atm_csv_column(&csv, "P_hPa", &cp, &err), THZ_OK);
-    assert_int_equal(atm_csv_column(&csv, "T_K", &ct, &err), THZ_OK);
-    assert_int_equal(atm_csv_column(&csv, "rho_g_per_m3", &crho, &err), THZ_OK);
-    assert_int_equal(atm_csv_column(&csv, "gamma_o_dB_per_km", &co, &err), THZ_OK);
-    assert_int_equal(atm_csv_column(&csv, "gamma_w_dB_per_km", &cw, &err), THZ_OK);
-    assert_int_equal(atm_csv_column(&csv, "gamma_dB_per_km", &cg, &err), THZ_OK);
+    assert_int_equal(csv_column_index(&csv, "f_GHz", &cf, &err), THZ_OK);
+    assert_int_equal(csv_column_index(&csv, "P_hPa", &cp, &err), THZ_OK);
+    assert_int_equal(csv_column_index(&csv, "T_K", &ct, &err), THZ_OK);
+    assert_int_equal(csv_column_index(&csv, "rho_g_per_m3", &crho, &err), THZ_OK);
+    assert_int_equal(csv_column_index(&csv, "gamma_o_dB_per_km", &co, &err), THZ_OK);
+    assert_int_equal(csv_column_index(&csv, "gamma_w_dB_per_km", &cw, &err), THZ_OK);
+    assert_int_equal(csv_column_index(&csv, "gamma_dB_per_km", &cg, &err), THZ_OK);
     assert_true(csv.n_rows >= 350);
     double worst_o = 0, worst_w = 0, worst_g = 0;
     for (size_t r = 0; r < csv.n_rows; r++) {
-        double t = atm_csv_at(&csv, r, ct), rho = atm_csv_at(&csv, r, crho);
+        double t = csv_value(&csv, r, ct), rho = csv_value(&csv, r, crho);
         double e = rho * t / 216.7;
         atm_air_state air;
         /* the table gives the dry-air pressure; our state takes the total */
-        assert_int_equal(atm_air_state_init(&air, t, atm_csv_at(&csv, r, cp) + e,
+        assert_int_equal(atm_air_state_init(&air, t, csv_value(&csv, r, cp) + e,
                                             ATM_HUMIDITY_DENSITY_G_M3, rho, &err),
                          THZ_OK);
         thz_atmosphere atm = {0};
         assert_int_equal(atmosphere_init_itu_p676(&atm, &air, NULL, &err), THZ_OK);
         atm_alpha_parts p;
-        double f_hz = atm_csv_at(&csv, r, cf) * 1e9;
+        double f_hz = csv_value(&csv, r, cf) * 1e9;
         atmosphere_alpha_parts(&atm, f_hz, &p);
         double go = db_per_km(p.o2_per_m + p.dry_continuum_per_m);
         double gw = db_per_km(p.h2o_lines_per_m);
         double g = db_per_km(atmosphere_alpha_per_m(&atm, f_hz));
-        double ro = fabs(go / atm_csv_at(&csv, r, co) - 1.0);
-        double rw = fabs(gw / atm_csv_at(&csv, r, cw) - 1.0);
-        double rg = fabs(g / atm_csv_at(&csv, r, cg) - 1.0);
+        double ro = fabs(go / csv_value(&csv, r, co) - 1.0);
+        double rw = fabs(gw / csv_value(&csv, r, cw) - 1.0);
+        double rg = fabs(g / csv_value(&csv, r, cg) - 1.0);
         worst_o = fmax(worst_o, ro);
         worst_w = fmax(worst_w, rw);
         worst_g = fmax(worst_g, rg);
         if (ro > 1e-3 || rw > 1e-3 || rg > 1e-3)
             fail_msg("%g GHz: gamma_o %g (ref %g), gamma_w %g (ref %g), gamma %g (ref %g) dB/km",
-                     f_hz * 1e-9, go, atm_csv_at(&csv, r, co), gw, atm_csv_at(&csv, r, cw), g,
-                     atm_csv_at(&csv, r, cg));
+                     f_hz * 1e-9, go, csv_value(&csv, r, co), gw, csv_value(&csv, r, cw), g,
+                     csv_value(&csv, r, cg));
         atmosphere_fini(&atm);
     }
     print_message("worst relative differences: oxygen %.2e, water vapour %.2e, total %.2e\n",
                   worst_o, worst_w, worst_g);
-    atm_csv_fini(&csv);
+    csv_fini(&csv);
 }
 
 static void test_range_refused(void **state)

@@ -264,6 +264,16 @@ static void test_bad_par_refused(void **state)
     thz_error err = {0};
     assert_int_equal(atmosphere_init_lines(&a, &air, &o, &err), THZ_ERR_INPUT);
     assert_non_null(strstr(err.message, "no-such-file.par"));
+    /* a device or a directory, which the line readers would read (or block on) without
+     * end, is refused before it is opened */
+    const char *not_files[] = {"/dev/zero", THZ_SOURCE_DIR "/tests/inputs"};
+    const char *what[] = {"is a character device", "is a directory"};
+    for (int i = 0; i < 2; i++) {
+        o.h2o_lines_file = not_files[i];
+        assert_int_equal(atmosphere_init_lines(&a, &air, &o, &err), THZ_ERR_INPUT);
+        if (!strstr(err.message, not_files[i]) || !strstr(err.message, what[i]))
+            fail_msg("'%s' lacks '%s'", err.message, what[i]);
+    }
 }
 
 /* Tabulated alpha over channel bands matches direct evaluation to < 1e-4 relative

@@ -9,7 +9,11 @@
 
 #include <cmocka.h>
 
-#include "scene/csv.h"
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "core/csv.h"
 
 #define INPUTS THZ_SOURCE_DIR "/tests/inputs/csv/"
 
@@ -61,6 +65,25 @@ static void test_errors(void **state)
     expect_error("missing.csv", (const char *[]){"missing.csv", "cannot open", NULL});
 }
 
+/* A FIFO given as a material or atmosphere table is refused before it is opened (the
+ * open would block for ever). */
+static void test_fifo_refused(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/thz-test-csv-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[64];
+    snprintf(path, sizeof path, "%s/table.csv", dir);
+    assert_int_equal(mkfifo(path, 0600), 0);
+    csv_table t;
+    thz_error err = {0};
+    assert_int_equal(csv_read(path, "materials.cloth.file", &t, &err), THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "materials.cloth.file"));
+    assert_non_null(strstr(err.message, "FIFO"));
+    unlink(path);
+    rmdir(dir);
+}
+
 static void test_parse_text(void **state)
 {
     (void)state;
@@ -89,6 +112,7 @@ int main(void)
         cmocka_unit_test(test_good_file),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_parse_text),
+        cmocka_unit_test(test_fifo_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

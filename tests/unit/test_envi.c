@@ -238,8 +238,12 @@ static void test_sensor_files(void **state)
             assert_header(hdr, "wavelength units", "GHz");
             assert_header(hdr, "wavelength", "{200, 1200}");
             assert_header(hdr, "fwhm", "{2, 24}");
+            assert_null(header_value(hdr, "data ignore value", v, sizeof v));
         } else {
             assert_null(header_value(hdr, "wavelength", v, sizeof v));
+            /* truth maps: -1 where nothing is hit, distinct from any temperature or
+             * distance */
+            assert_header(hdr, "data ignore value", "-1");
         }
         free(hdr);
     }
@@ -254,7 +258,7 @@ static void test_sensor_files(void **state)
     assert_header(hdr, "data type", "4");
     assert_header(hdr, "bands", "1");
     assert_header(hdr, "band names", "{object_id}");
-    assert_header(hdr, "data units", "index");
+    assert_header(hdr, "data units", "1");
     assert_header(hdr, "data ignore value", "-1");
     assert_header(hdr, "object names", "{room, target, hidden#1}");
     free(hdr);

@@ -1,8 +1,9 @@
-/* Mesh import: the same tetrahedron from OBJ, PLY, STL (ASCII and binary) and glTF
- * (with a node transform) gives 4 welded vertices, 4 triangles, the exact area and
+/* Mesh import: the same tetrahedron from OBJ, PLY (ASCII, binary little- and big-endian)
+ * and STL (ASCII and binary) gives 4 welded vertices, 4 triangles, the exact area and
  * outward normals; quads are triangulated; vertices of points and lines are dropped
- * and -0.0 welds with 0; the winding check finds a flipped face;
- * missing, empty and garbage files are refused with the file named. */
+ * and -0.0 welds with 0; the winding check finds a flipped face; missing, empty and
+ * garbage files and formats the mesh check does not cover (glTF) are refused with the
+ * file named. The malformed-file corpus is tests/cli/test_bad_meshes.sh. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -62,7 +63,8 @@ static void test_formats(void **state)
     check_tetra(MESHES "tetra.ply", 0);
     check_tetra(MESHES "tetra_ascii.stl", 0);
     check_tetra(MESHES "tetra_binary.stl", 0);
-    check_tetra(MESHES "tetra.gltf", 2); /* its node translates by (0, 0, 2) */
+    check_tetra(MESHES "tetra_binary_le.ply", 0);
+    check_tetra(MESHES "tetra_binary_be.ply", 0);
 }
 
 static void test_quads(void **state)
@@ -78,6 +80,36 @@ static void test_quads(void **state)
     check_outward(&m, centre);
     assert_int_equal(mesh_import_winding_conflicts(&m), 0);
     mesh_fini(&m);
+}
+
+/* The example pyramid and the quad cube give what the importer gave before the mesh
+ * check was added (vertices, triangles, bounding box and area recorded then). */
+static void test_examples_unchanged(void **state)
+{
+    (void)state;
+    const struct {
+        const char *file;
+        size_t vertices, triangles;
+        double bbox[6], area_m2;
+    } want[] = {
+        {THZ_SOURCE_DIR "/examples/meshes/pyramid.obj", 5, 6, {-1, -1, 0, 1, 1, 1.5}, 11.2111026},
+        {MESHES "cube_quads.obj", 8, 12, {0, 0, 0, 1, 1, 1}, 6.0},
+    };
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) {
+        thz_mesh m;
+        thz_error err = {0};
+        if (mesh_import(want[i].file, NULL, &m, &err) != THZ_OK)
+            fail_msg("%s", err.message);
+        assert_true(mesh_finalize(&m));
+        assert_int_equal(m.n_vertices, want[i].vertices);
+        assert_int_equal(m.n_triangles, want[i].triangles);
+        for (int k = 0; k < 3; k++) {
+            assert_true(m.bbox_min_m[k] == want[i].bbox[k]);
+            assert_true(m.bbox_max_m[k] == want[i].bbox[3 + k]);
+        }
+        assert_true(fabs(m.total_area_m2 - want[i].area_m2) < 1e-6);
+        mesh_fini(&m);
+    }
 }
 
 static void test_bad_winding(void **state)
@@ -122,14 +154,20 @@ static void test_refused(void **state)
     (void)state;
     expect_refused(MESHES "does_not_exist.obj", "does_not_exist.obj", "cannot open");
     expect_refused(MESHES "no_faces.obj", "no_faces.obj", "no triangles");
-    expect_refused(MESHES "garbage.obj", "garbage.obj", "");
+    expect_refused(MESHES "garbage.obj", "garbage.obj", "binary data");
+    expect_refused(MESHES "tetra.gltf", "tetra.gltf",
+                   "unsupported mesh format '.gltf': thzmap reads Wavefront OBJ (.obj), PLY "
+                   "(.ply) or STL (.stl)");
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_formats),     cmocka_unit_test(test_quads),
-        cmocka_unit_test(test_bad_winding), cmocka_unit_test(test_points_lines_negative_zero),
+        cmocka_unit_test(test_formats),
+        cmocka_unit_test(test_quads),
+        cmocka_unit_test(test_examples_unchanged),
+        cmocka_unit_test(test_bad_winding),
+        cmocka_unit_test(test_points_lines_negative_zero),
         cmocka_unit_test(test_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -234,6 +234,21 @@ static void test_corrupted(void **state)
         expect_refusal(bad, f->scene, THZ_ERR_IO, "corrupted");
         buf[where[i]] ^= 0x10;
     }
+    /* Unknown flags in the prefix (bytes 12-15; none is defined): refused, each bit. */
+    for (int bit = 0; bit < 32; bit += 7) {
+        buf[12 + bit / 8] ^= (unsigned char)(1u << (bit % 8));
+        spit(bad, buf, n);
+        expect_refusal(bad, f->scene, THZ_ERR_INPUT, "unknown flags");
+        buf[12 + bit / 8] ^= (unsigned char)(1u << (bit % 8));
+    }
+    spit(bad, buf, n); /* and the restored bytes read */
+    photon_map *ok[2] = {NULL, NULL};
+    assert_int_equal(photon_map_file_read(bad, f->scene, 1, ok, NULL, NULL, NULL), THZ_OK);
+    photon_map_destroy(ok[0]);
+    photon_map_destroy(ok[1]);
+    /* A device or a directory: refused before opening (a FIFO would block the open). */
+    expect_refusal("/dev/zero", f->scene, THZ_ERR_INPUT, "is a character device");
+    expect_refusal(f->dir, f->scene, THZ_ERR_INPUT, "is a directory");
     /* A damaged magic number: not a photon map at all. */
     buf[2] ^= 0x01;
     spit(bad, buf, n);

@@ -1,6 +1,7 @@
-/* photon-map.ply: a valid binary little-endian PLY header, one 15-byte vertex per photon
- * (or per strided photon under a cap), positions as stored and colours
- * round(255 * 0.5 * (1 - d)) of the incoming direction. */
+/* photon-map.ply: a valid binary little-endian PLY header, one 39-byte vertex per photon
+ * (or per strided photon under a cap) read back against the photon maps: positions,
+ * channel (the map's index), signed power, object and incoming direction as stored, and
+ * colours round(255 * 0.5 * (1 - d)) of that direction. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -22,11 +23,11 @@ static photon_map *make_map(size_t n, uint32_t salt)
         r[i].position_m[0] = (float)(0.001 * t);
         r[i].position_m[1] = (float)(-0.002 * t);
         r[i].position_m[2] = (float)(1.0 + 0.0001 * t);
-        r[i].power_w_per_hz = 1.0f;
+        r[i].power_w_per_hz = (float)((i % 2 ? -1.0 : 1.0) * 1e-20 * (1.0 + t)); /* signed */
         r[i].freq_hz = 3.5e11f;
         vec3 d = v3_normalize(v3(cos(t), sin(t), -0.5 - 0.4 * sin(3 * t)));
         r[i].dir_oct = photon_encode_direction(d);
-        r[i].object_side = (uint32_t)(i % 3) << 1;
+        r[i].object_side = (uint32_t)(i % 3) << 1 | (uint32_t)(i % 2);
     }
     photon_map *map;
     thz_error err;
@@ -47,6 +48,9 @@ static size_t parse_header(const unsigned char *buf, size_t n, uint64_t *vertice
     *vertices = strtoull(ev + 15, NULL, 10);
     assert_non_null(strstr(h, "property float x\nproperty float y\nproperty float z\n"
                               "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                              "property uint channel\nproperty float power_w_per_hz\n"
+                              "property int object\n"
+                              "property float dx\nproperty float dy\nproperty float dz\n"
                               "end_header\n"));
     free(h);
     return len;
@@ -68,7 +72,7 @@ static void check_file(const char *path, const photon_map *const *maps, size_t n
         total += maps[m] ? photon_map_count(maps[m]) : 0;
     uint64_t expect = cap && total > cap ? cap : total;
     assert_int_equal(v, expect);
-    assert_int_equal(n, off + 15 * v);
+    assert_int_equal(n, off + 39 * v);
     for (uint64_t i = 0; i < v; i++) {
         uint64_t k = expect == total ? i : i * total / expect; /* the documented stride */
         size_t m = 0;
@@ -78,7 +82,7 @@ static void check_file(const char *path, const photon_map *const *maps, size_t n
             m++;
         }
         const photon_record *p = &photon_map_records(maps[m])[k];
-        const unsigned char *q = buf + off + 15 * i;
+        const unsigned char *q = buf + off + 39 * i;
         float xyz[3];
         memcpy(xyz, q, 12);
         for (int c = 0; c < 3; c++)
@@ -89,6 +93,18 @@ static void check_file(const char *path, const photon_map *const *maps, size_t n
             double want = 255.0 * 0.5 * (1.0 - dd[c]);
             assert_true(fabs((double)q[12 + c] - want) <= 0.5 + 1e-9);
         }
+        uint32_t channel;
+        int32_t object;
+        float power, dir[3];
+        memcpy(&channel, q + 15, 4); /* little-endian host, as the file */
+        memcpy(&power, q + 19, 4);
+        memcpy(&object, q + 23, 4);
+        memcpy(dir, q + 27, 12);
+        assert_int_equal(channel, m);
+        assert_true(power == p->power_w_per_hz);
+        assert_int_equal(object, (int32_t)photon_object(p));
+        for (int c = 0; c < 3; c++)
+            assert_true(dir[c] == (float)dd[c]);
     }
 }
 

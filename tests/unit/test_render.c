@@ -17,6 +17,7 @@
 #include "sensor/camera.h"
 #include "sensor/images.h"
 #include "sensor/render.h"
+#include "sensor/truth.h"
 
 #include "../physics/identity.h"
 

@@ -1,5 +1,6 @@
 /* The numeric CSV reader. */
-#include "scene/csv.h"
+#include "core/csv.h"
+#include "core/file.h"
 
 #include <errno.h>
 #include <math.h>
@@ -186,9 +187,10 @@ thz_status csv_read(const char *path, const char *label, csv_table *t, thz_error
     const char *name = label ? label : path;
     thz_status st = THZ_OK;
     char *text = NULL;
-    struct stat info;
-    if (stat(path, &info) == 0 && S_ISDIR(info.st_mode))
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: is a directory, expected a CSV file", name);
+    /* A directory, FIFO or device is refused before it is opened (a FIFO would block). */
+    st = file_check_regular(path, name, CSV_MAX_BYTES, NULL, err);
+    if (st != THZ_OK)
+        return st;
     FILE *f = fopen(path, "rb");
     if (!f)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open: %s", name, strerror(errno));
@@ -240,6 +242,16 @@ long csv_column(const csv_table *t, const char *name)
         if (strcmp(t->names[c], name) == 0)
             return (long)c;
     return -1;
+}
+
+thz_status csv_column_index(const csv_table *t, const char *name, size_t *column, thz_error *err)
+{
+    long c = csv_column(t, name);
+    if (c < 0)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: no column '%s' in the header", t->label,
+                             name);
+    *column = (size_t)c;
+    return THZ_OK;
 }
 
 double csv_value(const csv_table *t, size_t row, size_t column)

@@ -1,11 +1,11 @@
-/* A small reader for the numeric CSV tables scenes refer to (material properties,
- * atmospheric attenuation): lines starting with `#` (after optional blanks) and blank
- * lines are comments, the first other line is a header of column names, every further
- * line a row of numbers, one per column, separated by commas. Errors name the file
- * and its line, the row and the column.
+/* The one reader of numeric CSV tables: those scenes refer to (material properties,
+ * atmospheric attenuation) and the line catalogues and tables of data/atmosphere/. Lines starting
+ * with `#` (after optional blanks) and blank lines are comments, the first other line is a header
+ * of column names, every further line a row of numbers, one per column, separated by commas. Errors
+ * name the file and its line, the row and the column.
  */
-#ifndef THZ_SCENE_CSV_H
-#define THZ_SCENE_CSV_H
+#ifndef THZ_CORE_CSV_H
+#define THZ_CORE_CSV_H
 
 #include <stddef.h>
 
@@ -30,6 +30,11 @@ thz_status csv_parse(const char *text, const char *label, csv_table *table, thz_
 
 /* Index of the column named `name`, or -1. */
 long csv_column(const csv_table *table, const char *name);
+
+/* The same as a status: THZ_ERR_INPUT naming the table when there is no such column
+ * (err may be NULL). */
+thz_status csv_column_index(const csv_table *table, const char *name, size_t *column,
+                            thz_error *err);
 
 /* Value of column `column` in row `row` (both 0-based, in range). */
 double csv_value(const csv_table *table, size_t row, size_t column);

@@ -1,0 +1,77 @@
+/* The integrators' interface (physics.md "Integrators", docs/integrators.md): each
+ * integrator is one file (integrator_*.c) with one function, the estimates of the
+ * radiance along one sample ray, and one row of the table in integrators.c. The pixel
+ * loop, sample placement, statistics and truth maps are render.c's, render_accum.c's and
+ * truth.c's; the band terms render_terms.c's.
+ */
+#ifndef THZ_SENSOR_INTEGRATOR_H
+#define THZ_SENSOR_INTEGRATOR_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "accel/accel.h"
+#include "photon/photon_map.h"
+#include "sensor/render_terms.h"
+
+/* Counters and the photon-map variance of one sample. */
+typedef struct render_sample {
+    double variance;                  /* photon-map: estimated variance of its radiance (Poisson) */
+    double batch[PHOTON_MAP_BATCHES]; /* the photon terms of each batch (in the radiance) */
+    unsigned escaped, back_face, widened, starved, truncated;
+    uint64_t paths;
+} render_sample;
+
+/* Where a sample's estimates go: est[j] += weight x (estimate j), j < n_est. */
+typedef struct render_target {
+    double *est;
+    uint32_t n_est;
+    double *batch;      /* final-gather with batches: += weight x each batch's photon terms */
+    double *disk_var;   /* and += weight^2 x their disks' Poisson variance; else NULL */
+    double weight;      /* 1 / n^2 */
+    uint64_t rng_index; /* first index of this sample's random streams (x n_est) */
+} render_target;
+
+/* An integrator: the estimates of one sample ray. `sample_sr` is the sample's solid
+ * angle Omega_S / n^2. */
+typedef void (*render_sample_fn)(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                 double sample_sr, const render_target *t, render_sample *out);
+
+static inline void render_add_all(const render_target *t, double v)
+{
+    for (uint32_t j = 0; j < t->n_est; j++)
+        t->est[j] += t->weight * v;
+}
+
+typedef struct render_integrator {
+    thz_integrator id; /* its name: scene_integrator_names[id] */
+    render_sample_fn sample;
+    bool needs_photons;
+    uint32_t purpose; /* RNG purpose; 0: no random numbers (one pass) */
+} render_integrator;
+
+/* The table's row of integrator `id`, or NULL. */
+const render_integrator *render_integrator_find(thz_integrator id);
+
+void render_photon_map_sample(const render_context *ctx, vec3 origin_m, vec3 dir, double sample_sr,
+                              const render_target *t, render_sample *out);
+void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                double sample_sr, const render_target *t, render_sample *out);
+void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir, double sample_sr,
+                        const render_target *t, render_sample *out);
+
+/* The photon-map radiance along a ray (integrator_photon_map.c), also final-gather's
+ * gather rays: `path` and `distance_m` carry what lies between the sensor and origin_m,
+ * `scatter` (may be NULL) the first vertex's weight. */
+double render_photon_map_trace(const render_context *ctx, vec3 origin_m, vec3 dir,
+                               uint32_t ignore_object, uint32_t ignore_triangle, render_path path,
+                               double distance_m, const render_scatter *scatter, double sample_sr,
+                               render_sample *out);
+
+/* The density estimate at a hit (gather.c): adds L_R (+ L_T for diffuse shells) to
+ * *radiance and its Poisson variance and batch terms to *out. */
+void render_gather(const render_context *ctx, const accel_hit *hit, const render_path *path,
+                   const render_scatter *scatter, double distance_m, double sample_sr,
+                   bool diffuse_shell, double *radiance, render_sample *out);
+
+#endif

@@ -1,0 +1,126 @@
+/* The `final-gather` integrator (physics.md "Integrators"): at the first non-straight hit,
+ * `gather_rays` secondary rays (cosine for reflection, by the BTDF T(theta) cos(theta)
+ * for diffuse shells), each adding what render_photon_map_trace finds at its own hit with
+ * the k-nearest-photon radius there (k = max(gather_min_photons, RENDER_SECONDARY_K));
+ * the first hit's emission enters by its band mean. From a deviation map the terms are
+ * those of L - B(T0) and the sample adds B(T0). One estimate per gather ray: more passes
+ * lower the noise.
+ */
+#include <math.h>
+
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "physics/channel.h"
+#include "physics/optics.h"
+#include "sensor/integrator.h"
+
+/* One gather ray from first vertex `hit` (object obj, seen through `path`, at distance
+ * distance_m from the sensor): its estimate of the scattered radiance towards the sensor. */
+static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
+                                const thz_object *obj, bool diffuse_shell, const render_path *path,
+                                double distance_m, rng_stream *rng, render_sample *out,
+                                render_sample *sec)
+{
+    const thz_material *mat = &ctx->scene->materials[obj->material];
+    double nu_j = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
+    optics_point o = scene_object_optics(ctx->scene, obj, nu_j);
+    double r = o.reflectivity;
+    double tr = diffuse_shell ? optics_transmission(&o, hit->cos_theta) : 0.0;
+    if (!(r + tr > 0.0))
+        return 0.0;
+    const float *nf = &obj->mesh.normals[3 * (size_t)hit->triangle];
+    vec3 n = v3_from_floats(nf);
+    vec3 n_seen = hit->side == 0 ? n : v3_scale(n, -1.0);
+    render_scatter s = {
+        .material = mat, .object = obj, .object_index = hit->object, .mu_o = hit->cos_theta};
+    vec3 dir;
+    if (rng_uniform(rng) * (r + tr) < r) {
+        s.inv_branch = (r + tr) / r;
+        double mu = sqrt(1.0 - rng_uniform(rng));
+        dir = sampling_direction(n_seen, mu, rng_uniform(rng));
+        s.mu_i = mu;
+    } else {
+        s.transmitted = true;
+        s.inv_branch = (r + tr) / tr;
+        double mu;
+        if (!optics_sample_transmission_mu(&o, sampling_uniform, rng, &mu))
+            return 0.0;
+        dir = sampling_direction(v3_scale(n_seen, -1.0), mu, rng_uniform(rng));
+        s.mu_i = mu;
+        s.pdf_ratio = optics_mean_transmission(&o) / optics_transmission(&o, mu);
+    }
+    vec3 origin = render_leave(ctx, hit, dir);
+    double l = render_photon_map_trace(ctx, origin, dir, hit->object, hit->triangle, *path,
+                                       distance_m, &s, 0.0, sec);
+    out->starved |= sec->starved;
+    out->truncated |= sec->truncated;
+    return l;
+}
+
+void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                double sample_sr, const render_target *t, render_sample *out)
+{
+    (void)sample_sr;
+    render_path path = {.n = 0};
+    double distance_m = 0.0;
+    uint32_t ignore_object = ACCEL_NO_OBJECT, ignore_triangle = 0;
+    if (ctx->deviation)
+        render_add_all(t, ctx->b0_mean);
+    for (;;) {
+        accel_hit hit;
+        if (!accel_intersect(ctx->accel, origin_m, dir, INFINITY, ignore_object, ignore_triangle,
+                             &hit)) {
+            if (path.n == 0)
+                out->escaped = 1;
+            if (ctx->air_terms)
+                render_add_all(t, render_air(ctx, &path, NULL, distance_m,
+                                             distance_m + render_exit_m(ctx, origin_m, dir), true));
+            return;
+        }
+        double d0_m = distance_m;
+        distance_m += hit.distance_m;
+        if (ctx->air_terms)
+            render_add_all(t, render_air(ctx, &path, NULL, d0_m, distance_m, false));
+        const thz_object *obj = &ctx->scene->objects[hit.object];
+        if (!scene_object_side_is_front(obj, hit.side)) {
+            out->back_face = 1;
+            if (ctx->deviation)
+                render_add_all(t, -render_b0_term(ctx, &path, NULL, distance_m));
+            return;
+        }
+        render_add_all(t, render_emission(ctx, hit.object, hit.cos_theta, &path, distance_m, NULL));
+        bool shell = obj->type == OBJECT_SHELL;
+        bool straight =
+            shell && ctx->scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
+        if (ctx->scatters[hit.object]) {
+            /* streams: the sample's, one per gather ray; crossings of straight shells
+             * shift them so that each vertex has its own */
+            for (uint32_t j = 0; j < t->n_est; j++) {
+                rng_stream rng;
+                rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_GATHER,
+                         (t->rng_index + j) * (RENDER_MAX_CROSSINGS + 1) + path.n);
+                render_sample sec = {.variance = 0.0};
+                t->est[j] += t->weight * render_gather_ray(ctx, &hit, obj, shell && !straight,
+                                                           &path, distance_m, &rng, out, &sec);
+                if (t->batch) {
+                    for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
+                        t->batch[b] += t->weight * sec.batch[b];
+                    *t->disk_var += t->weight * t->weight * sec.variance;
+                }
+            }
+            out->paths += t->n_est;
+        }
+        if (!straight)
+            return;
+        if (path.n == RENDER_MAX_CROSSINGS) {
+            out->truncated = 1;
+            return;
+        }
+        path.object[path.n] = hit.object;
+        path.mu[path.n] = hit.cos_theta;
+        path.n++;
+        origin_m = accel_offset_origin(ctx->accel, &hit, dir);
+        ignore_object = hit.object;
+        ignore_triangle = hit.triangle;
+    }
+}

@@ -1,0 +1,212 @@
+/* The `path` integrator (physics.md "Integrators"): backward Monte Carlo without a
+ * photon map.
+ * With B0(nu) = B_nu(T0) for a reference temperature T0, the
+ * radiance leaving a front side obeys (physics.md "Surfaces", Kirchhoff or explicit eps)
+ *   L - B0 = [eps B(T) - A B0] + R (L_R - B0) + T (L_T - B0),   A = 1 - R - T(theta),
+ * and across a free path of transmittance tau, L_in - B0 = tau (L_far - B0) + (tau - 1) B0;
+ * nothing hit, or the back of a one-sided solid, is L - B0 = -B0. A path samples nu from
+ * g_c, adds the bracket at every hit (times the product beta of the transmittances so
+ * far) and continues by Russian roulette with probabilities R (cosine reflection) and
+ * T(theta) (straight: unchanged; diffuse: exit mu ~ T(mu) mu), which makes the BRDF and
+ * BTDF weights exactly 1. The estimate is Bbar0 + the sum, Bbar0 the band mean of B0 by
+ * the channel quadrature; E[B0(nu)] = Bbar0, so it is unbiased for the band mean of L
+ * for any T0 (B0 is an additive control variate, in space and in frequency).
+ *
+ * Two refinements at the sample's first hit, which all its paths share: the terms of
+ * the first free path and the first hit are known functions of nu there, so they enter
+ * by their band mean (the channel quadrature, as photon-map's emission), not at the
+ * path's nu; and the path splits there (a reflected branch weighted R, a transmitted one
+ * weighted T(theta)) instead of playing roulette.
+ *
+ * In an isothermal enclosure at T0 every bracket is exactly 0, so every path returns
+ * Bbar0: N_c = 1 to rounding. T0 is the temperature of the object with the largest
+ * area x sides x hemispherical emissivity at the channel centre (the walls of a room). */
+#include <math.h>
+
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "physics/channel.h"
+#include "physics/optics.h"
+#include "physics/planck.h"
+#include "sensor/integrator.h"
+
+/* A scattered direction at `hit` (unit normal n_seen towards the side the ray came from):
+ * cosine-distributed on that side (reflection), or leaving the other side with
+ * mu ~ T(mu) mu (diffuse transmission). False if T is 0 there (cannot happen after a
+ * transmission event). */
+static bool render_scatter_dir(const optics_point *o, vec3 n_seen, bool transmitted,
+                               rng_stream *rng, vec3 *dir)
+{
+    if (!transmitted) {
+        *dir = sampling_direction(n_seen, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
+        return true;
+    }
+    double m;
+    if (!optics_sample_transmission_mu(o, sampling_uniform, rng, &m))
+        return false;
+    *dir = sampling_direction(v3_scale(n_seen, -1.0), m, rng_uniform(rng));
+    return true;
+}
+
+/* Continues a path leaving `from` along dir with throughput beta at frequency nu (B0 =
+ * b0 there; b_air = B_nu(T_air) of an emitting atmosphere, else unused; alpha_per_m the
+ * air's attenuation at nu, looked up once per path): the sum of the
+ * terms of every later free path and hit (see the top of this file), with Russian
+ * roulette on R and T(theta) at each hit. An emitting atmosphere turns a free path's term
+ * (tau - 1) B0 into (1 - tau)(B_air - B0) and the escape term -B0 into L_escape - B0. */
+static double render_path_continue(const render_context *ctx, const accel_hit *from, vec3 dir,
+                                   double nu, double b0, double b_air, double alpha_per_m,
+                                   double beta, rng_stream *rng, render_sample *out)
+{
+    const thz_scene *scene = ctx->scene;
+    double sum = 0.0;
+    accel_hit hit = *from;
+    for (uint32_t bounce = 1;; bounce++) {
+        vec3 surface = hit.position_m;
+        vec3 origin = render_leave(ctx, &hit, dir);
+        uint32_t from_object = hit.object, from_triangle = hit.triangle;
+        if (!accel_intersect(ctx->accel, origin, dir, INFINITY, from_object, from_triangle, &hit)) {
+            if (ctx->emitting) {
+                double tau = render_tau(alpha_per_m, render_exit_m(ctx, origin, dir));
+                double b_bg = planck_radiance(nu, scene->atmosphere.background_temperature_k);
+                sum += beta * (b_bg * tau + b_air * (1.0 - tau) - b0);
+            } else {
+                sum -= beta * b0;
+            }
+            break;
+        }
+        if (bounce >= RENDER_MAX_BOUNCES) {
+            out->truncated = 1;
+            break;
+        }
+        if (ctx->atmosphere) {
+            /* from the surface point, not the offset origin (as the photon phase) */
+            const float *hn = &scene->objects[hit.object].mesh.normals[3 * (size_t)hit.triangle];
+            vec3 to_hit = v3_sub(hit.position_m, surface);
+            double d = hit.cos_theta > 1e-6
+                           ? fabs(v3_dot(to_hit, v3_from_floats(hn))) / hit.cos_theta
+                           : v3_length(to_hit);
+            double tau = render_tau(alpha_per_m, d); /* atmosphere_transmittance */
+            if (ctx->emitting)
+                sum += beta * (1.0 - tau) * (b_air - b0);
+            else
+                sum += beta * (tau - 1.0) * b0;
+            beta *= tau;
+        }
+        const thz_object *obj = &scene->objects[hit.object];
+        if (!scene_object_side_is_front(obj, hit.side)) {
+            sum -= beta * b0;
+            break;
+        }
+        optics_point o = scene_object_optics(scene, obj, nu);
+        double r = o.reflectivity;
+        double tr = optics_transmission(&o, hit.cos_theta);
+        double a = 1.0 - r - tr;
+        double eps = o.explicit_emissivity ? o.emissivity : a;
+        double bt = obj->temperature_k == ctx->t0_k ? b0 : planck_radiance(nu, obj->temperature_k);
+        sum += beta * (eps * bt - a * b0);
+        double u = rng_uniform(rng);
+        if (!(u < r + tr))
+            break; /* absorbed */
+        bool transmitted = !(u < r);
+        if (transmitted && scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT)
+            continue; /* straight on, dir unchanged */
+        const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
+        vec3 n = v3_from_floats(nf);
+        vec3 n_seen = hit.side == 0 ? n : v3_scale(n, -1.0);
+        if (!render_scatter_dir(&o, n_seen, transmitted, rng, &dir))
+            break;
+    }
+    return sum;
+}
+
+/* One path from the sample's first hit `first` (ray along dir0 from the sensor): the
+ * random part of its estimate, beyond the deterministic first terms. At the first hit
+ * the path splits instead of playing roulette: a reflected branch weighted R and, for
+ * shells, a transmitted branch weighted T(theta), each continued by roulette. (Every path
+ * of a sample shares the first hit; roulette there would add the variance of choosing
+ * between what the reflection and the transmission see, the main noise of a wall that
+ * reflects a warmer object.) */
+static double render_path_trace(const render_context *ctx, const accel_hit *first, vec3 dir0,
+                                rng_stream *rng, render_sample *out)
+{
+    const thz_scene *scene = ctx->scene;
+    double nu = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
+    double b0 = planck_radiance(nu, ctx->t0_k);
+    double t_air = scene->atmosphere.air.temperature_k;
+    double b_air = !ctx->emitting ? 0.0 : t_air == ctx->t0_k ? b0 : planck_radiance(nu, t_air);
+    /* alpha(nu) is fixed along the path: render_tau(alpha, d) is
+     * atmosphere_transmittance(nu, d) bit for bit (alpha >= 0) */
+    double alpha = atmosphere_alpha_per_m(&scene->atmosphere, nu);
+    double beta = ctx->atmosphere ? render_tau(alpha, first->distance_m) : 1.0;
+    const thz_object *obj = &scene->objects[first->object];
+    optics_point o = scene_object_optics(scene, obj, nu);
+    double r = o.reflectivity;
+    double tr = optics_transmission(&o, first->cos_theta);
+    const float *nf = &obj->mesh.normals[3 * (size_t)first->triangle];
+    vec3 n = v3_from_floats(nf);
+    vec3 n_seen = first->side == 0 ? n : v3_scale(n, -1.0);
+    double sum = 0.0;
+    vec3 dir;
+    if (r > 0.0 && render_scatter_dir(&o, n_seen, false, rng, &dir))
+        sum += r * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta, rng, out);
+    if (tr > 0.0) {
+        bool straight = scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
+        dir = dir0;
+        if (straight || render_scatter_dir(&o, n_seen, true, rng, &dir))
+            sum += tr * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta, rng, out);
+    }
+    out->paths++;
+    return sum;
+}
+
+/* The band mean of the first segment's and first hit's terms, (tau - 1) B0 +
+ * tau (eps B(T) - A B0), by the channel quadrature: deterministic per sample, so that the
+ * band noise of what the sensor sees directly (the emission of the surface hit, its
+ * attenuation) does not enter the paths. */
+static double render_path_first(const render_context *ctx, const accel_hit *hit)
+{
+    if (!ctx->atmosphere && !isnan(ctx->source_mean[hit->object]))
+        return ctx->source_mean[hit->object];
+    size_t n = ctx->quad.n;
+    const optics_point *op = &ctx->optics[(size_t)hit->object * n];
+    const double *planck = &ctx->planck[(size_t)hit->object * n];
+    double sum = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        double tau = ctx->atmosphere ? exp(-ctx->alpha_per_m[k] * hit->distance_m) : 1.0;
+        double a = optics_absorption(&op[k], hit->cos_theta);
+        double eps = optics_emissivity(&op[k], hit->cos_theta);
+        double free_path = ctx->emitting ? (1.0 - tau) * (ctx->air_planck[k] - ctx->b0[k])
+                                         : (tau - 1.0) * ctx->b0[k];
+        sum += ctx->quad.weight[k] * (free_path + tau * (eps * planck[k] - a * ctx->b0[k]));
+    }
+    return sum;
+}
+
+void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir, double sample_sr,
+                        const render_target *t, render_sample *out)
+{
+    (void)sample_sr;
+    accel_hit first;
+    render_path none = {.n = 0};
+    if (!accel_intersect(ctx->accel, origin_m, dir, INFINITY, ACCEL_NO_OBJECT, 0, &first)) {
+        out->escaped = 1;
+        /* radiance 0 for every path, or what the air and the background give */
+        if (ctx->emitting)
+            render_add_all(
+                t, render_air(ctx, &none, NULL, 0.0, render_exit_m(ctx, origin_m, dir), true));
+        return;
+    }
+    if (!scene_object_side_is_front(&ctx->scene->objects[first.object], first.side)) {
+        out->back_face = 1;
+        if (ctx->emitting)
+            render_add_all(t, render_air(ctx, &none, NULL, 0.0, first.distance_m, false));
+        return;
+    }
+    double fixed = ctx->b0_mean + render_path_first(ctx, &first);
+    for (uint32_t j = 0; j < t->n_est; j++) {
+        rng_stream rng;
+        rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_PATH, t->rng_index + j);
+        t->est[j] += t->weight * (fixed + render_path_trace(ctx, &first, dir, &rng, out));
+    }
+}

@@ -1,0 +1,68 @@
+/* The table of integrators (integrator.h) and what the run asks of them. */
+#include <string.h>
+
+#include "core/rng.h"
+#include "sensor/integrator.h"
+
+/* The one table of integrators (their names: scene_integrator_names). */
+static const render_integrator render_integrators[] = {
+    {INTEGRATOR_PHOTON_MAP, render_photon_map_sample, true, 0},
+    {INTEGRATOR_FINAL_GATHER, render_final_gather_sample, true, RNG_PURPOSE_GATHER},
+    {INTEGRATOR_PATH, render_path_sample, false, RNG_PURPOSE_PATH},
+};
+#define RENDER_N_INTEGRATORS (sizeof render_integrators / sizeof render_integrators[0])
+
+const render_integrator *render_integrator_find(thz_integrator id)
+{
+    for (size_t i = 0; i < RENDER_N_INTEGRATORS; i++)
+        if (render_integrators[i].id == id)
+            return &render_integrators[i];
+    return NULL;
+}
+
+const char *render_integrator_name(thz_integrator integrator)
+{
+    return render_integrator_find(integrator) ? scene_integrator_names[integrator] : "unknown";
+}
+
+bool render_integrator_parse(const char *name, thz_integrator *out)
+{
+    for (size_t i = 0; i < RENDER_N_INTEGRATORS; i++)
+        if (strcmp(scene_integrator_names[render_integrators[i].id], name) == 0) {
+            *out = render_integrators[i].id;
+            return true;
+        }
+    return false;
+}
+
+thz_status render_integrator_check(thz_integrator integrator, thz_error *err)
+{
+    const render_integrator *it = render_integrator_find(integrator);
+    if (!it)
+        return thz_error_set(err, THZ_ERR_INPUT, "unknown integrator %d", (int)integrator);
+    return THZ_OK;
+}
+
+bool render_integrator_needs_photons(thz_integrator integrator)
+{
+    const render_integrator *it = render_integrator_find(integrator);
+    return it ? it->needs_photons : true;
+}
+
+bool render_integrator_has_passes(thz_integrator integrator)
+{
+    const render_integrator *it = render_integrator_find(integrator);
+    return it && it->purpose != 0;
+}
+
+uint32_t render_estimates_per_pass(const thz_scene *scene)
+{
+    switch (scene->render.integrator) {
+    case INTEGRATOR_PATH:
+        return scene->render.paths_per_sample > 0 ? scene->render.paths_per_sample : 1;
+    case INTEGRATOR_FINAL_GATHER:
+        return scene->render.gather_rays > 0 ? scene->render.gather_rays : 1;
+    default:
+        return 1;
+    }
+}

@@ -1,0 +1,192 @@
+/* The per-channel state of the renderer: see render_context.h. */
+#include "sensor/render_context.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "physics/planck.h"
+#include "sensor/integrator.h"
+
+static void render_context_fini(render_context *ctx)
+{
+    channel_quadrature_fini(&ctx->quad);
+    free(ctx->planck);
+    free(ctx->optics);
+    free(ctx->alpha_per_m);
+    free(ctx->emission_mean);
+    free(ctx->scatters);
+    free(ctx->tbar);
+    free(ctx->b0);
+    free(ctx->source_mean);
+    free(ctx->pair_mean);
+    free(ctx->air_planck);
+    free(ctx->bg_planck);
+    memset(ctx, 0, sizeof *ctx);
+}
+
+/* final-gather's table of band means per pair of objects (render_context.pair_mean):
+ * render_emission of solid y seen by a reflected gather ray from x, with nothing
+ * between; left NULL beyond RENDER_PAIR_OBJECTS objects or without memory (then every
+ * ray sums the nodes). */
+static void render_pair_table(render_context *ctx)
+{
+    size_t n_obj = ctx->scene->n_objects;
+    if (n_obj == 0 || n_obj > RENDER_PAIR_OBJECTS)
+        return;
+    double *table = thz_malloc_array(n_obj * n_obj, sizeof *table);
+    if (!table)
+        return;
+    render_path none = {.n = 0};
+    for (size_t x = 0; x < n_obj; x++) {
+        render_scatter s = {.object_index = (uint32_t)x, .inv_branch = 1.0};
+        for (size_t y = 0; y < n_obj; y++)
+            table[x * n_obj + y] = ctx->scatters[x] && ctx->scene->objects[y].type == OBJECT_SOLID
+                                       ? render_emission(ctx, (uint32_t)y, 1.0, &none, 0.0, &s)
+                                       : NAN;
+    }
+    ctx->pair_mean = table;
+}
+
+/* T0: the photon map's when map_t0 (photon-map, final-gather), else path_t0_k when it is
+ * not NAN, else scene_reference_temperature_k (path). */
+static thz_status render_context_init(render_context *ctx, const thz_scene *scene, const accel *a,
+                                      const photon_map *map, size_t channel, bool map_t0,
+                                      double path_t0_k, thz_error *err)
+{
+    memset(ctx, 0, sizeof *ctx);
+    ctx->scene = scene;
+    ctx->accel = a;
+    ctx->map = map;
+    ctx->channel = &scene->channels[channel];
+    ctx->channel_index = (uint32_t)channel;
+    ctx->seed = scene->photons.seed;
+    ctx->k = scene->photons.gather_min_photons;
+    ctx->k_secondary = ctx->k > RENDER_SECONDARY_K ? ctx->k : RENDER_SECONDARY_K;
+    thz_status st = channel_quadrature_init(&ctx->quad, &scene->channels[channel],
+                                            CHANNEL_QUADRATURE_NODES, err);
+    if (st != THZ_OK)
+        return st;
+    size_t n = ctx->quad.n, n_obj = scene->n_objects;
+    size_t cells = n_obj * n;
+    if (n_obj && cells / n_obj != n)
+        return thz_error_set(err, THZ_ERR_LIMIT, "render: too many objects (%zu)", n_obj);
+    ctx->planck = thz_malloc_array(cells, sizeof *ctx->planck);
+    ctx->optics = thz_malloc_array(cells, sizeof *ctx->optics);
+    ctx->alpha_per_m = thz_malloc_array(n, sizeof *ctx->alpha_per_m);
+    ctx->emission_mean = thz_malloc_array(n_obj, sizeof *ctx->emission_mean);
+    ctx->scatters = thz_malloc_array(n_obj, sizeof *ctx->scatters);
+    ctx->b0 = thz_malloc_array(n, sizeof *ctx->b0);
+    ctx->source_mean = thz_malloc_array(n_obj, sizeof *ctx->source_mean);
+    ctx->tbar = thz_calloc(cells ? cells : 1, sizeof *ctx->tbar);
+    if (!ctx->planck || !ctx->optics || !ctx->alpha_per_m || !ctx->emission_mean ||
+        !ctx->scatters || !ctx->b0 || !ctx->source_mean || !ctx->tbar) {
+        render_context_fini(ctx);
+        return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
+    }
+    for (size_t k = 0; k < n; k++) {
+        ctx->alpha_per_m[k] = atmosphere_alpha_per_m(&scene->atmosphere, ctx->quad.freq_hz[k]);
+        if (ctx->alpha_per_m[k] != 0.0)
+            ctx->atmosphere = true;
+    }
+    for (size_t o = 0; o < n_obj; o++) {
+        const thz_object *obj = &scene->objects[o];
+        const thz_material *mat = &scene->materials[obj->material];
+        bool angle_free = obj->type == OBJECT_SOLID || mat->emissivity.n > 0;
+        double mean = 0.0;
+        for (size_t k = 0; k < n; k++) {
+            double nu = ctx->quad.freq_hz[k];
+            optics_point *op = &ctx->optics[o * n + k];
+            *op = scene_object_optics(scene, obj, nu);
+            ctx->planck[o * n + k] = planck_radiance(nu, obj->temperature_k);
+            mean += ctx->quad.weight[k] * optics_emissivity(op, 1.0) * ctx->planck[o * n + k];
+        }
+        ctx->emission_mean[o] = angle_free ? mean : NAN;
+        double r_min, r_max;
+        spectrum_range(&mat->reflectivity, &r_min, &r_max);
+        bool diffuse = obj->type == OBJECT_SHELL && mat->transmission == TRANSMISSION_DIFFUSE;
+        ctx->scatters[o] = r_max > 0.0 || diffuse;
+        for (size_t k = 0; diffuse && k < n; k++)
+            ctx->tbar[o * n + k] = optics_mean_transmission(&ctx->optics[o * n + k]);
+    }
+    ctx->t0_k = map_t0              ? photon_map_reference_temperature_k(map)
+                : !isnan(path_t0_k) ? path_t0_k
+                                    : scene_reference_temperature_k(scene, channel);
+    ctx->deviation = map_t0 && ctx->t0_k > 0.0;
+    for (size_t k = 0; k < n; k++) {
+        ctx->b0[k] = planck_radiance(ctx->quad.freq_hz[k], ctx->t0_k);
+        ctx->b0_mean += ctx->quad.weight[k] * ctx->b0[k];
+    }
+    for (size_t o = 0; o < n_obj; o++) {
+        double sum = 0.0;
+        for (size_t k = 0; k < n; k++) {
+            const optics_point *op = &ctx->optics[o * n + k];
+            sum += ctx->quad.weight[k] * (optics_emissivity(op, 1.0) * ctx->planck[o * n + k] -
+                                          optics_absorption(op, 1.0) * ctx->b0[k]);
+        }
+        ctx->source_mean[o] = scene->objects[o].type == OBJECT_SOLID ? sum : NAN;
+    }
+    const thz_atmosphere *atm = &scene->atmosphere;
+    ctx->emitting = atm->emitting;
+    ctx->air_terms = atm->emitting || ctx->deviation;
+    if (ctx->air_terms) {
+        ctx->air_planck = thz_malloc_array(n ? n : 1, sizeof *ctx->air_planck);
+        ctx->bg_planck = thz_malloc_array(n ? n : 1, sizeof *ctx->bg_planck);
+        if (!ctx->air_planck || !ctx->bg_planck) {
+            render_context_fini(ctx);
+            return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
+        }
+        /* The same call as b0: air at T0 gives B_air == B0 bit for bit, so the path
+         * estimator's air terms (B_air - B0)(1 - tau) vanish exactly in the furnace. */
+        for (size_t k = 0; k < n; k++) {
+            double nu = ctx->quad.freq_hz[k];
+            ctx->air_planck[k] = atm->emitting ? planck_radiance(nu, atm->air.temperature_k) : 0.0;
+            ctx->bg_planck[k] =
+                atm->emitting ? planck_radiance(nu, atm->background_temperature_k) : 0.0;
+        }
+    }
+    if (map && scene->render.integrator == INTEGRATOR_FINAL_GATHER)
+        render_pair_table(ctx);
+    return THZ_OK;
+}
+
+thz_status render_context_create(const thz_scene *scene, const accel *a, const photon_map *map,
+                                 size_t channel, const render_options *opt, render_context **out,
+                                 thz_error *err)
+{
+    *out = NULL;
+    if (channel >= scene->n_channels)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "render: channel %zu out of range", channel);
+    thz_status st = render_integrator_check(scene->render.integrator, err);
+    if (st != THZ_OK)
+        return st;
+    const render_integrator *integ = render_integrator_find(scene->render.integrator);
+    if (integ->needs_photons && !map)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "render: integrator '%s' needs a photon map",
+                             render_integrator_name(integ->id));
+    double path_t0_k = opt && opt->path_t0_set ? opt->path_t0_k : NAN;
+    if (!(path_t0_k >= 0.0) && !isnan(path_t0_k))
+        return thz_error_set(err, THZ_ERR_INTERNAL, "render: path T0 %g K is negative", path_t0_k);
+    render_context *ctx = thz_calloc(1, sizeof *ctx);
+    if (!ctx)
+        return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory");
+    st = render_context_init(ctx, scene, a, map, channel, integ->needs_photons, path_t0_k, err);
+    if (st != THZ_OK) {
+        render_context_destroy(ctx); /* fini is safe on what init left */
+        return st;
+    }
+    if (opt && opt->use_seed)
+        ctx->seed = opt->seed;
+    ctx->integrator = integ;
+    *out = ctx;
+    return THZ_OK;
+}
+
+void render_context_destroy(render_context *ctx)
+{
+    if (!ctx)
+        return;
+    render_context_fini(ctx);
+    free(ctx);
+}

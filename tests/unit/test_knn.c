@@ -1,0 +1,109 @@
+/* photon/knn: the k-nearest search by radius queries gives photon_map_kth_distance2's
+ * distance exactly, whatever its first guess, and its buffer holds exactly the photons
+ * within that distance, seen side first. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "core/rng.h"
+#include "photon/knn.h"
+#include "photon/photon_map.h"
+
+/* n photons over n_objects objects, both sides, clustered in a 1 x 1 x 0.2 m slab, with
+ * some exact duplicates of position (ties at the k-th distance). */
+static photon_record *make_photons(size_t n, uint32_t n_objects)
+{
+    photon_record *p = malloc(n * sizeof *p);
+    assert_non_null(p);
+    rng_stream rng;
+    rng_init(&rng, 5, 0, RNG_PURPOSE_TEST, 0);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t obj = rng_next_u32(&rng) % n_objects, side = rng_next_u32(&rng) & 1u;
+        float pos[3];
+        for (int a = 0; a < 3; a++)
+            pos[a] = (float)(rng_uniform(&rng) * (a == 2 ? 0.2 : 1.0));
+        if (i % 9 == 4)
+            for (int a = 0; a < 3; a++)
+                pos[a] = p[i - 1].position_m[a];
+        p[i] = (photon_record){.position_m = {pos[0], pos[1], pos[2]},
+                               .power_w_per_hz = 1.0f,
+                               .freq_hz = 1e12f,
+                               .object_side = obj << 1 | side};
+    }
+    return p;
+}
+
+static double dist2(const photon_record *r, vec3 q)
+{
+    double dx = (double)r->position_m[0] - q.x, dy = (double)r->position_m[1] - q.y,
+           dz = (double)r->position_m[2] - q.z;
+    return dx * dx + dy * dy + dz * dz;
+}
+
+static void test_knn_matches_kth_distance(void **state)
+{
+    (void)state;
+    const size_t n = 20000;
+    const uint32_t n_objects = 3;
+    photon_map *map = NULL;
+    assert_int_equal(photon_map_create(make_photons(n, n_objects), n, n_objects, 0, &map, NULL),
+                     THZ_OK);
+    const photon_record *r = photon_map_records(map);
+    static knn_buffer b; /* ~48 KiB: not on the test's stack */
+    static double scratch[KNN_CAP];
+    static const size_t ks[] = {1, 2, 7, 64, 300, 1900, 5000, 20000};
+    static const double areas[] = {1e-6, 1.0, 1e4}; /* bad first guesses too */
+    rng_stream rng;
+    rng_init(&rng, 6, 0, RNG_PURPOSE_TEST, 0);
+    size_t settled = 0;
+    for (int trial = 0; trial < 20; trial++) {
+        vec3 q = v3(rng_uniform(&rng), rng_uniform(&rng), rng_uniform(&rng) * 0.2);
+        uint32_t obj = (uint32_t)trial % n_objects;
+        for (unsigned mask = 1; mask < 4; mask++) {
+            int seen = mask == 2u ? 1 : 0;
+            for (size_t ki = 0; ki < sizeof ks / sizeof ks[0]; ki++) {
+                for (size_t ai = 0; ai < sizeof areas / sizeof areas[0]; ai++) {
+                    size_t k = ks[ki];
+                    double want = photon_map_kth_distance2(map, obj, mask, q, k);
+                    double got = knn_collect(map, obj, areas[ai], seen, mask, q, k, &b, scratch);
+                    if (isnan(got))
+                        continue; /* did not settle: the caller falls back */
+                    assert_true(got == want);
+                    if (isinf(got))
+                        continue;
+                    settled++;
+                    /* the buffer: every photon of those sides within got, once */
+                    size_t inside = 0, expect = 0;
+                    int other_seen = 0;
+                    for (size_t i = 0; i < b.n; i++) {
+                        assert_true(b.e[i].d2 == dist2(b.e[i].p, q));
+                        inside += b.e[i].d2 <= got;
+                        if (b.e[i].other_side)
+                            other_seen = 1;
+                        else
+                            assert_false(other_seen); /* seen side first */
+                    }
+                    for (size_t i = 0; i < n; i++)
+                        if (r[i].object_side >> 1 == obj &&
+                            (mask >> (r[i].object_side & 1u) & 1u) && dist2(&r[i], q) <= got)
+                            expect++;
+                    assert_int_equal(inside, expect);
+                    assert_true(expect >= k);
+                }
+            }
+        }
+    }
+    assert_true(settled > 300); /* the search settles for every k <= KNN_CAP */
+    photon_map_destroy(map);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_knn_matches_kth_distance)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
