@@ -27,6 +27,20 @@ typedef struct thz_output thz_output;
 
 /* ---- settings ----------------------------------------------------------------------- */
 
+/* What thz_simulate is about to do, told before the work starts: the estimate of a
+ * short pilot (time per sample and per photon times the counts; with a target, the
+ * passes from the pilot's noise). An estimate, not a promise. */
+typedef struct thz_run_plan {
+    double seconds_photons, seconds_render; /* estimated, s */
+    uint32_t passes;                        /* estimated passes per channel */
+    uint64_t memory_bytes;                  /* estimated peak, bytes */
+    uint64_t available_bytes;               /* physical memory, 0 if unknown */
+    double target_noise_k;                  /* the run's noise target, K; 0: none */
+    const char *target_source;              /* "command line" (settings), "scene",
+                                               "default" or NULL */
+} thz_run_plan;
+typedef void (*thz_plan_fn)(void *user, const thz_run_plan *plan);
+
 /* Per-run overrides of the scene's settings: zero / NULL keeps the scene's value.
  * Initialise with thz_run_settings_init (or = {0}); a NULL settings pointer means all
  * defaults. */
@@ -35,14 +49,19 @@ typedef struct thz_run_settings {
     int has_seed;                 /* non-zero: use `seed` instead of photons.seed */
     uint64_t seed;
     const char *integrator; /* "photon-map", "final-gather", "path"; NULL: the scene's */
-    double target_noise_k;  /* > 0: add passes to each channel until the median per-pixel
-                               standard error of Tb_c is at most this (K) */
-    double max_seconds;     /* > 0, with a target: stop adding passes after this (s) */
+    double target_noise_k;  /* > 0: add passes to each channel until the 95th percentile
+                               over pixels of the per-pixel standard error of Tb_c is at
+                               most this (K); overrides render.target_noise_k (default
+                               0.1 K where the scene gives no count) */
+    double max_seconds;     /* > 0: stop adding passes after this (s) */
     int keep_photons;       /* thz_simulate: keep the photon maps in the run (needed to
                                write photon-map.thzpm) */
     uint64_t first_photon;  /* thz_photons_fire*: fire photons first_photon .. + K - 1, so that
                                maps fired with disjoint ranges merge (thz_photons_merge) */
     double seconds_load;    /* reported in summary.json (timings_s.load); 0: unknown */
+    thz_plan_fn plan;       /* thz_simulate: called once with the estimate before the work
+                               (its pilot costs a moment: only when set); may be NULL */
+    void *plan_user;
 } thz_run_settings;
 
 THZ_API void thz_run_settings_init(thz_run_settings *settings);
@@ -176,6 +195,12 @@ typedef struct thz_run_totals {
     double worst_median_stderr_k; /* largest median per-pixel standard error of Tb_c, K */
     uint32_t max_passes;          /* most render passes of any channel */
     double seconds;               /* wall time of the run */
+    double worst_p95_stderr_k;    /* largest 95th percentile of the per-pixel standard
+                                     error of Tb_c over channels, K */
+    long worst_object;            /* the object whose pixels' 95th percentile is largest
+                                     (over channels), -1 when none was seen */
+    size_t worst_object_channel;
+    double worst_object_p95_stderr_k; /* K */
 } thz_run_totals;
 THZ_API void thz_run_get_totals(const thz_run *run, thz_run_totals *out);
 

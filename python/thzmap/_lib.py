@@ -95,7 +95,8 @@ class ThzRunSettings(Structure):
     _fields_ = [("photons_per_channel", c_uint64), ("has_seed", c_int), ("seed", c_uint64),
                 ("integrator", c_char_p), ("target_noise_k", c_double),
                 ("max_seconds", c_double), ("keep_photons", c_int),
-                ("first_photon", c_uint64), ("seconds_load", c_double)]
+                ("first_photon", c_uint64), ("seconds_load", c_double),
+                ("plan", c_void_p), ("plan_user", c_void_p)]
 
 
 class ThzPhotonStats(Structure):
@@ -114,7 +115,9 @@ class ThzRunTotals(Structure):
                 ("photons_fired", c_uint64), ("photons_stored", c_uint64),
                 ("back_face_samples", c_uint64), ("n_warnings", c_size_t),
                 ("worst_median_stderr_k", c_double), ("max_passes", c_uint32),
-                ("seconds", c_double)]
+                ("seconds", c_double), ("worst_p95_stderr_k", c_double),
+                ("worst_object", c_long), ("worst_object_channel", c_size_t),
+                ("worst_object_p95_stderr_k", c_double)]
 
 
 class ThzWriteOptions(Structure):

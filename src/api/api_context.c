@@ -2,6 +2,8 @@
  * shares (settings into run options, overrides into a scene copy). */
 #include <stdlib.h>
 
+#include <stdint.h>
+
 #include "api/api.h"
 #include "core/alloc.h"
 #include "sensor/render.h"
@@ -89,6 +91,20 @@ thz_status api_effective_scene(const thz_scene *scene, const thz_run_settings *s
     return THZ_OK;
 }
 
+/* run_plan to the caller's thz_plan_fn (plan_user: the settings, alive during the run). */
+static void api_plan(void *user, const run_plan *plan)
+{
+    const thz_run_settings *settings = user;
+    thz_run_plan p = {.seconds_photons = plan->seconds_photons,
+                      .seconds_render = plan->seconds_render,
+                      .passes = plan->passes,
+                      .memory_bytes = plan->memory_bytes,
+                      .available_bytes = plan->available_bytes,
+                      .target_noise_k = plan->target_noise_k,
+                      .target_source = plan->target_source};
+    settings->plan(settings->plan_user, &p);
+}
+
 void api_run_options(const thz_context *ctx, const thz_run_settings *settings, run_options *opt)
 {
     *opt = (run_options){0};
@@ -104,5 +120,9 @@ void api_run_options(const thz_context *ctx, const thz_run_settings *settings, r
         opt->target_noise_k = settings->target_noise_k;
         opt->max_seconds = settings->max_seconds;
         opt->seconds_load = settings->seconds_load;
+        if (settings->plan) {
+            opt->plan = api_plan;
+            opt->plan_user = (void *)(uintptr_t)settings; /* read only */
+        }
     }
 }

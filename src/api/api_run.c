@@ -285,13 +285,18 @@ void thz_run_get_totals(const thz_run *run, thz_run_totals *out)
     if (!run)
         return;
     const run_result *r = &run->rs.result;
-    *out = (thz_run_totals){.n_channels = r->n_channels,
-                            .n_sensors = r->n_sensors,
-                            .photons_fired = r->photons_fired,
-                            .photons_stored = r->photons_stored,
-                            .back_face_samples = r->back_face_samples,
-                            .n_warnings = r->n_warnings,
-                            .worst_median_stderr_k = r->worst_median_stderr_k,
-                            .max_passes = r->max_passes,
-                            .seconds = r->seconds};
+    *out =
+        (thz_run_totals){.n_channels = r->n_channels,
+                         .n_sensors = r->n_sensors,
+                         .photons_fired = r->photons_fired,
+                         .photons_stored = r->photons_stored,
+                         .back_face_samples = r->back_face_samples,
+                         .n_warnings = r->n_warnings,
+                         .worst_median_stderr_k = r->worst_median_stderr_k,
+                         .worst_p95_stderr_k = r->worst_p95_stderr_k,
+                         .worst_object = r->worst_object == SIZE_MAX ? -1 : (long)r->worst_object,
+                         .worst_object_channel = r->worst_object_channel,
+                         .worst_object_p95_stderr_k = r->worst_object_p95_stderr_k,
+                         .max_passes = r->max_passes,
+                         .seconds = r->seconds};
 }

@@ -1,11 +1,25 @@
-/* Scenes through the public API: loading from a string, read access by value. (Loading
- * a file and destroying are scene/load.c's thz_scene_load and scene/scene.c's
- * thz_scene_destroy.) */
+/* Scenes through the public API: loading (the loader, then the check that the sensors'
+ * images fit in memory, which the loader cannot make: it knows no images), read access
+ * by value. (Destroying is scene/scene.c's thz_scene_destroy.) */
 #include <string.h>
 
 #include "api/api.h"
 #include "physics/channel.h"
 #include "sensor/render.h"
+
+/* A loaded scene whose images would not fit in memory is refused (THZ_ERR_INPUT, naming
+ * sensors[i].resolution). */
+static thz_status api_scene_checked(thz_status st, thz_scene **out, thz_error *err)
+{
+    if (st == THZ_OK && run_check_scene_memory(*out, err) != THZ_OK) {
+        scene_destroy(*out);
+        *out = NULL;
+        st = THZ_ERR_INPUT; /* the scene asks too much: bad input, as before */
+        if (err)
+            err->status = st;
+    }
+    return st;
+}
 
 thz_status thz_scene_load_string(const char *json_text, const char *base_dir, const char *label,
                                  thz_scene **out, thz_error *err)
@@ -16,7 +30,13 @@ thz_status thz_scene_load_string(const char *json_text, const char *base_dir, co
         *out = NULL;
         return thz_error_set(err, THZ_ERR_INPUT, "thz_scene_load_string: no JSON text");
     }
-    return scene_load_string(json_text, base_dir, label ? label : "<string>", out, err);
+    return api_scene_checked(
+        scene_load_string(json_text, base_dir, label ? label : "<string>", out, err), out, err);
+}
+
+thz_status thz_scene_load(const char *path, thz_scene **out, thz_error *err)
+{
+    return api_scene_checked(scene_load(path, out, err), out, err);
 }
 
 thz_status thz_scene_get_info(const thz_scene *s, thz_scene_info *out)

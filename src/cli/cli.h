@@ -30,7 +30,9 @@ double cli_now_s(void);
 bool cli_is_help(const char *arg);
 
 /* Parse whole numbers and reals from option values; false (after printing a usage
- * error naming `option`) when the text is not one, or is out of [min, max]. */
+ * error naming `option`) when the text is not one, or is out of [min, max]. Whole
+ * numbers may be written with a fraction or an exponent when their value is whole
+ * (1e6, 2.5e3). */
 bool cli_parse_u64(const char *command, const char *option, const char *text, uint64_t min,
                    uint64_t max, uint64_t *out);
 bool cli_parse_double(const char *command, const char *option, const char *text, double min,

@@ -203,9 +203,9 @@ static thz_status build_model(const options *o, const char *name, const thz_atm 
     bool needs_air = strcmp(name, "lines") == 0 || strcmp(name, "itu-p676") == 0;
     if (needs_air && !from.has_air && thz_atm_check_air(&ao, err) != THZ_OK) {
         char message[sizeof err->message];
-        int n = snprintf(message, sizeof message, "--temperature-k %g, --pressure-hpa %g, %s %g: ",
-                         o->temperature_k, o->pressure_hpa, humidity_option(o->humidity_kind),
-                         o->humidity);
+        int n = snprintf(message, sizeof message,
+                         "--temperature-k %g, --pressure-hpa %g, %s %g: ", o->temperature_k,
+                         o->pressure_hpa, humidity_option(o->humidity_kind), o->humidity);
         size_t used = n > 0 && (size_t)n < sizeof message ? (size_t)n : 0;
         size_t rest = strnlen(err->message, sizeof message - 1 - used);
         memcpy(message + used, err->message, rest); /* as thz_error_prefix cuts */

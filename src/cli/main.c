@@ -36,7 +36,9 @@ static void print_usage(FILE *f)
 int cli_fail(const thz_error *err)
 {
     fprintf(stderr, "thzmap: %s\n", err->message[0] ? err->message : thz_status_name(err->status));
-    return err->status == THZ_ERR_INPUT ? CLI_EXIT_USAGE : CLI_EXIT_FAILURE;
+    /* THZ_ERR_LIMIT: the scene or the options ask for more than fits (memory, sizes) */
+    return err->status == THZ_ERR_INPUT || err->status == THZ_ERR_LIMIT ? CLI_EXIT_USAGE
+                                                                        : CLI_EXIT_FAILURE;
 }
 
 int cli_usage_error(const char *cmd, const char *fmt, ...)
@@ -68,7 +70,15 @@ bool cli_parse_u64(const char *cmd, const char *option, const char *text, uint64
     char *end = NULL;
     errno = 0;
     unsigned long long v = strtoull(text, &end, 10);
-    if (!text[0] || *end || errno || text[0] == '-' || v < min || v > max) {
+    bool ok = text[0] && !*end && !errno && text[0] != '-';
+    if (!ok && text[0] && text[0] != '-' && strpbrk(text, ".eE")) {
+        /* 1e6 or 2.5e3: a real that is a whole number, exact in a double (as in JSON) */
+        errno = 0;
+        double x = strtod(text, &end);
+        ok = !*end && !errno && isfinite(x) && x >= 0.0 && x == floor(x) && x <= 9007199254740992.0;
+        v = ok ? (unsigned long long)x : 0;
+    }
+    if (!ok || v < min || v > max) {
         cli_usage_error(cmd, "%s expects a whole number from %llu to %llu, got '%s'", option,
                         (unsigned long long)min, (unsigned long long)max, text);
         return false;

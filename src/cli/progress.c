@@ -2,6 +2,7 @@
 #include "progress.h"
 
 #include <signal.h>
+#include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -62,9 +63,18 @@ static void cli_progress_draw_tty(cli_progress *p, const thz_progress *pr, doubl
     fprintf(p->out, "\r\033[Kthzmap %s: channel %zu/%zu, %s %llu/%llu (%.0f %%)", p->command,
             pr->channel + 1, pr->n_channels, pr->stage, (unsigned long long)pr->done,
             (unsigned long long)pr->total, 100.0 * frac);
-    if (rate > 0.0 && pr->done < pr->total)
-        fprintf(p->out, ", %.3g %s/s, ETA %.0f s", rate, cli_stage_unit(pr->stage),
-                (double)(pr->total - pr->done) / rate);
+    if (rate > 0.0)
+        fprintf(p->out, ", %.3g %s/s", rate, cli_stage_unit(pr->stage));
+    /* the whole run: the share of the channels done so far (photons the first half of a
+     * channel when it fires any), else the estimate less the time spent */
+    double run_elapsed = now - p->run_start_s;
+    double share = (double)pr->channel + (strcmp(pr->stage, "photons") == 0 ? 0.5 * frac
+                                          : p->photons_seen                 ? 0.5 + 0.5 * frac
+                                                                            : frac);
+    share /= (double)(pr->n_channels ? pr->n_channels : 1);
+    double eta = share > 0.02 ? run_elapsed * (1.0 - share) / share : p->estimate_s - run_elapsed;
+    if (eta > 0.0 && p->run_start_s > 0.0)
+        fprintf(p->out, ", run ETA %.0f s", eta);
     fflush(p->out);
     p->line_open = true;
 }
@@ -102,6 +112,8 @@ int cli_progress_report(void *user, const thz_progress *pr)
         p->last_draw_s = 0.0;
     }
     p->last_done = pr->done;
+    if (strcmp(pr->stage, "photons") == 0)
+        p->photons_seen = true;
     bool done = pr->total > 0 && pr->done >= pr->total;
     if (p->tty) {
         if (done || now - p->last_draw_s >= 0.1) {
@@ -123,4 +135,35 @@ void cli_progress_finish(cli_progress *p)
         fflush(p->out);
         p->line_open = false;
     }
+}
+
+void cli_progress_warning(void *user, const char *message)
+{
+    cli_progress *p = user;
+    cli_progress_finish(p); /* a warning gets its own line, even with --quiet */
+    fprintf(p->out, "thzmap %s: warning: %s\n", p->command, message);
+    fflush(p->out);
+}
+
+void cli_progress_plan(void *user, const thz_run_plan *plan)
+{
+    cli_progress *p = user;
+    double total = plan->seconds_photons + plan->seconds_render;
+    p->estimate_s = total;
+    p->run_start_s = cli_now_s();
+    if (p->quiet)
+        return;
+    char target[160] = "";
+    if (plan->target_noise_k > 0.0)
+        snprintf(target, sizeof target,
+                 ", about %u pass%s per channel to reach the noise target of %g K (%s)",
+                 plan->passes, plan->passes == 1 ? "" : "es", plan->target_noise_k,
+                 plan->target_source ? plan->target_source : "given");
+    fprintf(p->out,
+            "thzmap %s: estimate: %.3g s (photons %.3g s, rendering %.3g s)%s; memory %.3g GiB "
+            "of %.3g GiB\n",
+            p->command, total, plan->seconds_photons, plan->seconds_render, target,
+            (double)plan->memory_bytes / 1073741824.0,
+            (double)plan->available_bytes / 1073741824.0);
+    fflush(p->out);
 }

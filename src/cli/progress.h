@@ -1,9 +1,10 @@
 /* Progress display on stderr for long runs, and Ctrl-C handling.
  *
  * When stderr is a terminal: one line, updated in place (channel i/n, stage, units done,
- * rate, ETA in s). Otherwise: one line per channel and stage when it completes. Nothing
- * with --quiet. The progress callback also carries cancellation: once SIGINT or SIGTERM
- * arrived it returns non-zero, so the run stops and removes its staging directory.
+ * rate, ETA in s). Otherwise: one line per channel and stage when it completes. No
+ * progress with --quiet; warnings always. The progress callback also carries cancellation: once
+ * SIGINT or SIGTERM arrived it returns non-zero, so the run stops and removes its staging
+ * directory.
  */
 #ifndef THZ_CLI_PROGRESS_H
 #define THZ_CLI_PROGRESS_H
@@ -28,12 +29,23 @@ typedef struct cli_progress {
                              stages may report only when a batch is done */
     double last_report_s;
     double last_draw_s;
+    double run_start_s; /* when the plan was told (0: no plan) */
+    double estimate_s;  /* the plan's estimate of the whole run, s */
+    bool photons_seen;  /* the run fires photons (half of each channel's share) */
 } cli_progress;
 
 void cli_progress_init(cli_progress *p, const char *command, bool quiet);
 
 /* The thz_progress_fn: draws, and returns non-zero once an interrupt arrived. */
 int cli_progress_report(void *user, const thz_progress *progress);
+
+/* The run's warning callback: prints "thzmap CMD: warning: MESSAGE" on its own line of
+ * stderr (with --quiet too). */
+void cli_progress_warning(void *user, const char *message);
+
+/* The run's plan callback: prints the estimate of time and memory before the run
+ * (not with --quiet) and keeps it for the whole-run ETA. */
+void cli_progress_plan(void *user, const thz_run_plan *plan);
 
 /* Ends the terminal line, if one is open. */
 void cli_progress_finish(cli_progress *p);

@@ -19,25 +19,31 @@ static void cli_run_usage(FILE *f, bool render)
                    "previews and summary.json into OUTDIR (created if missing).\n\n"
                    "options:\n"
                    "  -o, --output OUTDIR   where the results go (required)\n"
-                   "  --photons N           photons per channel (overrides photons.per_channel)\n"
+                   "  --photons N           photons per channel (overrides photons.per_channel;\n"
+                   "                        1e6 is accepted)\n"
                    "  --seed S              random seed (overrides photons.seed)\n"
                    "  --threads T           threads to use (default: all cores)\n"
-                   "  --integrator NAME     photon-map | final-gather | path (overrides\n"
-                   "                        render.integrator; path fires no photons)\n"
-                   "  --target-noise-k X    add passes to each channel until the median\n"
-                   "                        per-pixel standard error of the brightness\n"
-                   "                        temperature is at most X K: of gather rays\n"
-                   "                        (final-gather), paths (path), or N more photons\n"
-                   "                        (photon-map: rendered from all photons so far);\n"
-                   "                        each pass is deterministic\n"
-                   "  --max-seconds S       with --target-noise-k: stop adding passes once a\n"
-                   "                        channel has run for S s; the stopping point, and\n"
-                   "                        so the images, then depend on the machine's speed\n"
+                   "  --integrator NAME     path (default) | final-gather | photon-map\n"
+                   "                        (overrides render.integrator; path fires no\n"
+                   "                        photons; photon-map is the paper's method)\n"
+                   "  --target-noise-k X    add passes to each channel until the 95th\n"
+                   "                        percentile over pixels of the per-pixel standard\n"
+                   "                        error of the brightness temperature is at most\n"
+                   "                        X K: of gather rays (final-gather), paths (path),\n"
+                   "                        or N more photons (photon-map: rendered from all\n"
+                   "                        photons so far); each pass is deterministic.\n"
+                   "                        Overrides render.target_noise_k. Default 0.1 K\n"
+                   "                        when the scene gives no count (photons.per_channel\n"
+                   "                        or --photons; render.paths_per_sample for path)\n"
+                   "  --max-seconds S       stop adding passes once a channel has run for S s\n"
+                   "                        (overrides render.max_seconds); the stopping\n"
+                   "                        point, and so the images, then depend on the\n"
+                   "                        machine's speed\n"
                    "  --save-photon-map     also write photon-map.thzpm (for render) and\n"
                    "                        photon-map.ply\n"
                    "  --ply-max-points N    at most N photons (evenly strided) in\n"
                    "                        photon-map.ply (default 2000000)\n"
-                   "  --quiet               no progress output\n");
+                   "  --quiet               no progress output (warnings are still printed)\n");
     else
         fprintf(f, "usage: thzmap render SCENE.json --photon-map FILE -o OUTDIR [options]\n\n"
                    "Renders the scene's sensors again from a photon map saved by\n"
@@ -48,13 +54,14 @@ static void cli_run_usage(FILE *f, bool render)
                    "  -o, --output OUTDIR   where the results go (required)\n"
                    "  --sensor NAME         render only this sensor (default: all)\n"
                    "  --threads T           threads to use (default: all cores)\n"
-                   "  --integrator NAME     photon-map | final-gather | path\n"
-                   "  --target-noise-k X    final-gather, path: add passes until the median\n"
-                   "                        per-pixel standard error of the brightness\n"
-                   "                        temperature is at most X K (each pass deterministic)\n"
-                   "  --max-seconds S       with --target-noise-k: stop adding passes once a\n"
-                   "                        channel has rendered for S s (time-dependent result)\n"
-                   "  --quiet               no progress output\n");
+                   "  --integrator NAME     path (default) | final-gather | photon-map\n"
+                   "  --target-noise-k X    final-gather, path: add passes until the 95th\n"
+                   "                        percentile over pixels of the per-pixel standard\n"
+                   "                        error of the brightness temperature is at most X K\n"
+                   "                        (each pass deterministic; default as in simulate)\n"
+                   "  --max-seconds S       stop adding passes once a channel has rendered for\n"
+                   "                        S s (time-dependent result)\n"
+                   "  --quiet               no progress output (warnings are still printed)\n");
 }
 
 typedef struct cli_run_args {
@@ -89,6 +96,8 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
             if (i + 1 >= argc)
                 return cli_usage_error(cmd, "%s needs a value", arg);
             const char *val = argv[++i];
+            if (strncmp(val, "--", 2) == 0) /* -o --quiet: a forgotten value, not a name */
+                return cli_usage_error(cmd, "%s needs a value, got the option '%s'", arg, val);
             uint64_t u = 0;
             if (strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0) {
                 a->outdir = val;
@@ -147,8 +156,6 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
         return cli_usage_error(cmd, "no scene file given");
     if (!a->outdir)
         return cli_usage_error(cmd, "no output directory given (-o OUTDIR)");
-    if (a->settings.max_seconds > 0.0 && !(a->settings.target_noise_k > 0.0))
-        return cli_usage_error(cmd, "--max-seconds limits --target-noise-k; give both");
     return -1;
 }
 
@@ -202,14 +209,20 @@ int cli_run_command(int argc, char **argv, bool render)
     thz_scene_info info;
     thz_scene_get_info(scene, &info);
     const char *integrator = a.settings.integrator ? a.settings.integrator : info.integrator;
+    if (a.write.photon_map && !thz_integrator_needs_photons(integrator)) {
+        thz_scene_destroy(scene);
+        return cli_usage_error(cmd,
+                               "--save-photon-map: the %s integrator fires no photons (give "
+                               "--integrator final-gather or photon-map, or render.integrator)",
+                               integrator);
+    }
     if (render && !a.photon_map_path && thz_integrator_needs_photons(integrator)) {
         thz_scene_destroy(scene);
         return cli_usage_error(cmd, "no photon map given (--photon-map FILE); only the path "
                                     "integrator renders without one");
     }
-    if (!a.quiet)
-        for (size_t i = 0; i < thz_scene_warning_count(scene); i++)
-            fprintf(stderr, "thzmap %s: warning: %s\n", cmd, thz_scene_warning(scene, i));
+    for (size_t i = 0; i < thz_scene_warning_count(scene); i++) /* --quiet hides progress only */
+        fprintf(stderr, "thzmap %s: warning: %s\n", cmd, thz_scene_warning(scene, i));
 
     thz_context *ctx = thz_context_create();
     if (!ctx) {
@@ -221,6 +234,9 @@ int cli_run_command(int argc, char **argv, bool render)
     cli_progress_init(&progress, cmd, a.quiet);
     thz_context_set_threads(ctx, a.threads);
     thz_context_set_progress(ctx, cli_progress_report, &progress);
+    thz_context_set_warning(ctx, cli_progress_warning, &progress);
+    a.settings.plan = cli_progress_plan;
+    a.settings.plan_user = &progress;
     a.settings.seconds_load = cli_now_s() - t0;
     double t_run = cli_now_s();
     thz_run *run = NULL;
@@ -245,14 +261,20 @@ int cli_run_command(int argc, char **argv, bool render)
                 printf(", %llu photons fired, %llu stored",
                        (unsigned long long)result.photons_fired,
                        (unsigned long long)result.photons_stored);
-            if (result.worst_median_stderr_k > 0.0)
-                printf(", median pixel standard error <= %.3g K", result.worst_median_stderr_k);
+            if (result.worst_p95_stderr_k > 0.0)
+                printf(", pixel standard error: median <= %.3g K, 95th percentile <= %.3g K",
+                       result.worst_median_stderr_k, result.worst_p95_stderr_k);
             if (result.max_passes > 1)
                 printf(" after up to %u passes", result.max_passes);
             printf(", %.2f s; results in %s\n", result.seconds, a.outdir);
-            if (result.n_warnings)
-                fprintf(stderr, "thzmap %s: %zu run warning%s, see %s/summary.json\n", cmd,
-                        result.n_warnings, result.n_warnings == 1 ? "" : "s", a.outdir);
+            thz_object_info obj;
+            thz_channel_info ch;
+            if (result.worst_object >= 0 && result.worst_p95_stderr_k > 0.0 &&
+                thz_scene_object(scene, (size_t)result.worst_object, &obj) == THZ_OK &&
+                thz_scene_channel(scene, result.worst_object_channel, &ch) == THZ_OK)
+                printf("thzmap %s: noisiest object: '%s', 95th percentile standard error "
+                       "%.3g K at %s\n",
+                       cmd, obj.name, result.worst_object_p95_stderr_k, ch.name);
         }
     }
     thz_run_destroy(run);

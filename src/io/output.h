@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "photon/photon_stats.h"
+#include "run/run_noise.h"
 #include "scene/scene.h"
 #include "sensor/images.h"
 
@@ -57,7 +58,9 @@ typedef struct run_summary {
     uint64_t photons_per_channel;
     int threads;
     const photon_stats *channel_stats;    /* n_channels entries, or NULL (render) */
-    const double *median_stderr_k;        /* n_channels entries, or NULL */
+    const run_noise *noise;               /* n_channels entries, or NULL */
+    const run_noise *object_noise;        /* [channel * n_objects + object], or NULL */
+    const char *target_source;            /* "command line", "scene", "default", NULL */
     const uint32_t *passes;               /* n_channels entries: render passes, or NULL */
     const double *seconds_render_channel; /* n_channels entries: render time (s), or NULL */
     double target_noise_k;                /* the run's noise target (K), 0: none */

@@ -120,8 +120,24 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
     sum_set(o, "relative_width", json_real(ch->relative_width), ok);
     if (summary->channel_stats)
         sum_photon_stats(o, &summary->channel_stats[c], ok);
-    if (summary->median_stderr_k)
-        sum_set(o, "median_stderr_k", sum_real(summary->median_stderr_k[c]), ok);
+    if (summary->noise) {
+        sum_set(o, "median_stderr_k", sum_real(summary->noise[c].median_k), ok);
+        sum_set(o, "p95_stderr_k", sum_real(summary->noise[c].p95_k), ok);
+    }
+    if (summary->object_noise) {
+        /* per object: the pixels whose truth object_id is it (null figures: none) */
+        json_t *objects = json_array();
+        for (size_t i = 0; i < scene->n_objects; i++) {
+            const run_noise *n = &summary->object_noise[c * scene->n_objects + i];
+            json_t *e = json_object();
+            sum_set(e, "name", json_string(scene->objects[i].name), ok);
+            sum_set(e, "pixels", sum_u64(n->pixels), ok);
+            sum_set(e, "median_stderr_k", n->pixels ? sum_real(n->median_k) : json_null(), ok);
+            sum_set(e, "p95_stderr_k", n->pixels ? sum_real(n->p95_k) : json_null(), ok);
+            sum_append(objects, e, ok);
+        }
+        sum_set(o, "objects", objects, ok);
+    }
     if (summary->passes)
         sum_set(o, "render_passes", json_integer(summary->passes[c]), ok);
     if (summary->seconds_render_channel)
@@ -159,8 +175,10 @@ static json_t *summary_build(const thz_scene *scene, const run_summary *summary)
     sum_set(root, "seed", sum_u64(summary->seed), &ok);
     sum_set(root, "photons_per_channel", sum_u64(summary->photons_per_channel), &ok);
     sum_set(root, "integrator", sum_string(summary->integrator), &ok);
+    /* the 95th percentile over pixels of the standard error of Tb_c aimed at */
     sum_set(root, "target_noise_k",
             summary->target_noise_k > 0.0 ? sum_real(summary->target_noise_k) : json_null(), &ok);
+    sum_set(root, "target_noise_source", sum_string(summary->target_source), &ok);
     sum_set(root, "threads", json_integer(summary->threads), &ok);
     sum_set(root, "atmosphere_model", json_string(atmosphere_model_name(scene->atmosphere.model)),
             &ok);

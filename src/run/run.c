@@ -16,6 +16,8 @@
 #include "photon/phase.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
+#include "run/run_estimate.h"
+#include "run/run_noise.h"
 #include "physics/planck.h"
 #include "sensor/images.h"
 #include "sensor/render.h"
@@ -39,12 +41,37 @@ void run_apply_overrides(thz_scene *scene, const run_overrides *ov)
 {
     if (!ov)
         return;
-    if (ov->photons)
+    if (ov->photons) {
         scene->photons.per_channel = ov->photons;
+        scene->photons.per_channel_given = true;
+    }
     if (ov->has_seed)
         scene->photons.seed = ov->seed;
     if (ov->has_integrator)
         scene->render.integrator = ov->integrator;
+}
+
+double run_target_noise_k(const thz_scene *scene, const run_options *opt, bool render,
+                          const char **source)
+{
+    thz_integrator in = scene->render.integrator;
+    /* render's photon-map is deterministic given its map: no passes, no target */
+    bool can = !render || render_integrator_has_passes(in);
+    const char *from = NULL;
+    double t = 0.0;
+    if (opt->target_noise_k > 0.0) {
+        t = opt->target_noise_k, from = "command line";
+    } else if (can && scene->render.target_noise_k > 0.0) {
+        t = scene->render.target_noise_k, from = "scene";
+    } else if (can) {
+        bool given = in == INTEGRATOR_PATH ? scene->render.paths_per_sample_given
+                                           : scene->photons.per_channel_given;
+        if (!given)
+            t = RUN_DEFAULT_TARGET_NOISE_K, from = "default";
+    }
+    if (source)
+        *source = from;
+    return t;
 }
 
 static thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt, ...)
@@ -85,7 +112,8 @@ void run_state_fini(run_state *rs)
             photon_map_destroy(rs->maps[c]);
     free(rs->maps);
     free(rs->stats);
-    free(rs->median_stderr_k);
+    free(rs->noise);
+    free(rs->object_noise);
     free(rs->passes);
     free(rs->seconds_channel);
     for (size_t i = 0; i < rs->n_warnings; i++)
@@ -108,15 +136,20 @@ static thz_status run_state_init(run_state *rs, const thz_scene *scene, const ru
     rs->photons_per_channel = render_integrator_needs_photons(scene->render.integrator)
                                   ? scene->photons.per_channel
                                   : 0; /* path fires none */
+    rs->target_noise_k =
+        run_target_noise_k(scene, opt, strcmp(command, "render") == 0, &rs->target_source);
+    rs->max_seconds = opt->max_seconds > 0.0 ? opt->max_seconds : scene->render.max_seconds;
     size_t nc = scene->n_channels, ns = scene->n_sensors;
     rs->selected = thz_calloc(ns, sizeof *rs->selected);
     rs->maps = thz_calloc(nc, sizeof *rs->maps);
     rs->stats = thz_calloc(nc, sizeof *rs->stats);
-    rs->median_stderr_k = thz_calloc(nc, sizeof *rs->median_stderr_k);
+    rs->noise = thz_calloc(nc, sizeof *rs->noise);
+    rs->object_noise =
+        thz_calloc(nc * (scene->n_objects ? scene->n_objects : 1), sizeof *rs->object_noise);
     rs->passes = thz_calloc(nc, sizeof *rs->passes);
     rs->seconds_channel = thz_calloc(nc, sizeof *rs->seconds_channel);
-    if (!rs->selected || !rs->maps || !rs->stats || !rs->median_stderr_k || !rs->passes ||
-        !rs->seconds_channel)
+    if (!rs->selected || !rs->maps || !rs->stats || !rs->noise || !rs->object_noise ||
+        !rs->passes || !rs->seconds_channel)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     for (size_t s = 0; s < ns; s++)
         if (!opt->sensor_name || strcmp(opt->sensor_name, scene->sensors[s].name) == 0)
@@ -158,6 +191,24 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
                          "%.2f GiB) but this machine has %.2f GiB; lower %s",
                          (double)need->total_bytes / gib, (double)need->photon_bytes / gib,
                          (double)need->image_bytes / gib, (double)need->available_bytes / gib, key);
+}
+
+thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err)
+{
+    uint64_t have = thz_physical_memory_bytes();
+    for (size_t s = 0; s < scene->n_sensors && have > 0; s++) {
+        const thz_sensor *sn = &scene->sensors[s];
+        uint64_t need = sensor_images_bytes(sn->columns, sn->rows, scene->n_channels);
+        if ((double)need > 0.9 * (double)have) /* as run_check_memory */
+            return thz_error_set(err, THZ_ERR_LIMIT,
+                                 "%s: sensors[%zu].resolution: the images of %u x %u pixels in "
+                                 "%zu channels need %.1f GiB, more than this machine's memory "
+                                 "(%.1f GiB) allows; lower 'resolution' (or the number of "
+                                 "channels)",
+                                 scene->path, s, sn->columns, sn->rows, scene->n_channels,
+                                 (double)need / 1073741824.0, (double)have / 1073741824.0);
+    }
+    return THZ_OK;
 }
 
 static uint64_t run_image_bytes(const run_state *rs)
@@ -206,6 +257,7 @@ static thz_status run_simulate_memory(run_state *rs, bool photons, thz_error *er
         need.photon_bytes = (rs->opt->keep_photon_maps ? sum : max) + max;
     }
     need.total_bytes = need.photon_bytes + need.image_bytes;
+    rs->memory_bytes = need.total_bytes;
     return run_check_memory(rs->scene, &need, err);
 }
 
@@ -225,43 +277,17 @@ static thz_status run_init_images(run_state *rs, thz_error *err)
     return THZ_OK;
 }
 
-static int run_compare_double(const void *a, const void *b)
+/* The 95th percentile over the rendered pixels of channel c (all selected sensors) of
+ * the standard error of Tb_c in K (run_noise.h): what a noise target aims at. A
+ * negative value (never below a target) on allocation failure: the caller stops. */
+static double run_channel_p95_stderr_k(const run_state *rs, size_t c)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* Median over the rendered pixels of channel c (all selected sensors) of the standard
- * error of Tb_c in K (physics.md: dTb/dL at the pixel's L_c); pixels with Tb_c = 0
- * (nothing or a back face seen) are left out; 0 when none is left. `v` holds room for
- * every rendered pixel. */
-static double run_channel_median_stderr_k(const run_state *rs, size_t c, double *v)
-{
-    double nu = rs->scene->channels[c].center_hz;
-    size_t m = 0;
-    for (size_t i = 0; i < rs->n_selected; i++) {
-        const sensor_images *img = &rs->images[i];
-        size_t px = (size_t)img->columns * img->rows;
-        if (!img->radiance_stderr)
-            continue;
-        for (size_t p = 0; p < px; p++) {
-            double tb = img->brightness_temperature[c * px + p];
-            if (tb > 0.0)
-                v[m++] = render_stderr_k(nu, tb, img->radiance_stderr[c * px + p]);
-        }
-    }
-    if (m == 0)
-        return 0.0;
-    qsort(v, m, sizeof *v, run_compare_double);
-    return m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
-}
-
-static size_t run_rendered_pixels(const run_state *rs)
-{
-    size_t total = 0;
-    for (size_t i = 0; i < rs->n_selected; i++)
-        total += (size_t)rs->images[i].columns * rs->images[i].rows;
-    return total;
+    run_noise all;
+    thz_error ignored;
+    if (run_noise_channel(rs->images, rs->n_selected, c, rs->scene->channels[c].center_hz, 0, &all,
+                          NULL, &ignored) != THZ_OK)
+        return -1.0;
+    return all.p95_k;
 }
 
 /* Renders channel c of every selected sensor: one pass, or, with a noise target and an
@@ -276,11 +302,10 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
                          .progress_user = rs->opt->progress_user};
     double t0 = thz_now_s();
     double target =
-        render_integrator_has_passes(rs->scene->render.integrator) ? rs->opt->target_noise_k : 0.0;
+        render_integrator_has_passes(rs->scene->render.integrator) ? rs->target_noise_k : 0.0;
     render_accum *acc = thz_calloc(rs->n_selected, sizeof *acc);
-    double *v = target > 0.0 ? thz_malloc_array(run_rendered_pixels(rs), sizeof *v) : NULL;
     thz_status st = THZ_OK;
-    if (!acc || (target > 0.0 && !v))
+    if (!acc)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the pixel statistics");
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
         const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
@@ -304,9 +329,9 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
         rs->passes[c] = pass + 1;
         if (!(target > 0.0))
             break;
-        if (run_channel_median_stderr_k(rs, c, v) <= target)
+        if (run_channel_p95_stderr_k(rs, c) <= target)
             break;
-        if (rs->opt->max_seconds > 0.0 && thz_now_s() - t0 >= rs->opt->max_seconds)
+        if (rs->max_seconds > 0.0 && thz_now_s() - t0 >= rs->max_seconds)
             break;
         if (pass + 1 >= RUN_MAX_PASSES) {
             st = run_add_warning(rs, err,
@@ -321,23 +346,22 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
         for (size_t i = 0; i < rs->n_selected; i++)
             render_accum_fini(&acc[i]);
     free(acc);
-    free(v);
     double seconds = thz_now_s() - t0;
     rs->seconds_channel[c] += seconds; /* photon-map's photon passes render again */
     rs->seconds_render += seconds;
     return st;
 }
 
-/* Median over all rendered pixels of the standard error of Tb_c, in K, per channel. */
-static thz_status run_median_stderr(run_state *rs, thz_error *err)
+/* The noise figures of every channel, overall and per object. */
+static thz_status run_noise_figures(run_state *rs, thz_error *err)
 {
-    double *v = thz_malloc_array(run_rendered_pixels(rs), sizeof *v);
-    if (!v)
-        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the error statistics");
-    for (size_t c = 0; c < rs->scene->n_channels; c++)
-        rs->median_stderr_k[c] = run_channel_median_stderr_k(rs, c, v);
-    free(v);
-    return THZ_OK;
+    const thz_scene *sc = rs->scene;
+    thz_status st = THZ_OK;
+    for (size_t c = 0; c < sc->n_channels && st == THZ_OK; c++)
+        st = run_noise_channel(rs->images, rs->n_selected, c, sc->channels[c].center_hz,
+                               sc->n_objects, &rs->noise[c], &rs->object_noise[c * sc->n_objects],
+                               err);
+    return st;
 }
 
 /* Per sensor, the counts of every channel's last render pass (render_sum, and back_face
@@ -360,12 +384,18 @@ static thz_status run_render_warnings(run_state *rs, thz_error *err)
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
         const render_stats *r = &rs->render_sum[i];
         const char *name = rs->scene->sensors[rs->selected[i]].name;
+        /* a sensor inside a solid or outside the enclosure has its own scene warning:
+         * then the normals are not to blame */
+        bool misplaced = rs->scene->sensors[rs->selected[i]].misplaced;
         if (r->back_face_samples)
             st = run_add_warning(rs, err,
                                  "sensor '%s': %llu of %llu samples saw the back side of a "
-                                 "one-sided solid (radiance 0); check the mesh normals",
+                                 "one-sided solid (radiance 0); %s",
                                  name, (unsigned long long)r->back_face_samples,
-                                 (unsigned long long)r->samples);
+                                 (unsigned long long)r->samples,
+                                 misplaced ? "the sensor is inside a solid or outside the "
+                                             "enclosure (see the scene warning)"
+                                           : "check the mesh normals");
         if (st == THZ_OK && r->starved_gathers)
             st = run_add_warning(rs, err,
                                  "sensor '%s': %llu samples hit objects holding fewer photons "
@@ -390,7 +420,7 @@ static thz_status run_finish(run_state *rs, double t_start, thz_error *err)
 {
     accel_destroy(rs->accel);
     rs->accel = NULL;
-    thz_status st = run_median_stderr(rs, err);
+    thz_status st = run_noise_figures(rs, err);
     if (st == THZ_OK)
         st = run_render_warnings(rs, err);
     if (st != THZ_OK)
@@ -407,8 +437,20 @@ static thz_status run_finish(run_state *rs, double t_start, thz_error *err)
     for (size_t i = 0; i < rs->n_selected; i++)
         result->back_face_samples += rs->back_face[rs->selected[i]];
     result->n_warnings = rs->n_warnings;
+    size_t no = rs->scene->n_objects;
+    result->worst_object = SIZE_MAX;
     for (size_t c = 0; c < rs->scene->n_channels; c++) {
-        result->worst_median_stderr_k = fmax(result->worst_median_stderr_k, rs->median_stderr_k[c]);
+        result->worst_median_stderr_k = fmax(result->worst_median_stderr_k, rs->noise[c].median_k);
+        result->worst_p95_stderr_k = fmax(result->worst_p95_stderr_k, rs->noise[c].p95_k);
+        for (size_t o = 0; o < no; o++) {
+            const run_noise *n = &rs->object_noise[c * no + o];
+            if (n->pixels > 0 && (result->worst_object == SIZE_MAX ||
+                                  n->p95_k > result->worst_object_p95_stderr_k)) {
+                result->worst_object = o;
+                result->worst_object_channel = c;
+                result->worst_object_p95_stderr_k = n->p95_k;
+            }
+        }
         if (rs->passes[c] > result->max_passes)
             result->max_passes = rs->passes[c];
     }
@@ -443,13 +485,12 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
 {
     const thz_scene *scene = rs->scene;
     const run_options *opt = rs->opt;
-    double target = opt->target_noise_k, t_start = thz_now_s();
-    double *v = thz_malloc_array(run_rendered_pixels(rs) ? run_rendered_pixels(rs) : 1, sizeof *v);
+    double target = rs->target_noise_k, t_start = thz_now_s();
     size_t cap = 16, n = 0;
     photon_map **maps = thz_calloc(cap, sizeof *maps);
     photon_map *merged = NULL;
     thz_status st = THZ_OK;
-    if (!v || !maps)
+    if (!maps)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the photon passes");
     uint64_t k = scene->photons.per_channel;
     double limit = 0.5 * (double)thz_physical_memory_bytes();
@@ -487,9 +528,9 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
         rs->stats[c].stored = photon_map_count(map);
         st = run_render_channel(rs, c, map, err);
         rs->passes[c] = (uint32_t)n;
-        if (st != THZ_OK || run_channel_median_stderr_k(rs, c, v) <= target)
+        if (st != THZ_OK || run_channel_p95_stderr_k(rs, c) <= target)
             break;
-        if (opt->max_seconds > 0.0 && thz_now_s() - t_start >= opt->max_seconds)
+        if (rs->max_seconds > 0.0 && thz_now_s() - t_start >= rs->max_seconds)
             break;
         /* the passes' maps and the next merge: twice the records, and their indexes */
         double next = 2.2 * (double)photon_map_bytes(map) * (double)(n + 1) / (double)n;
@@ -522,7 +563,26 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
     for (size_t i = 0; maps && i < n; i++)
         photon_map_destroy(maps[i]);
     free(maps);
-    free(v);
+    return st;
+}
+
+/* Estimates the run's time (a pilot) and tells opt->plan. */
+static thz_status run_tell_plan(run_state *rs, thz_error *err)
+{
+    run_estimate_input in = {.scene = rs->scene,
+                             .accel = rs->accel,
+                             .selected = rs->selected,
+                             .n_selected = rs->n_selected,
+                             .target_noise_k = rs->target_noise_k,
+                             .threads = rs->opt->threads};
+    run_plan plan = {.memory_bytes = rs->memory_bytes,
+                     .available_bytes = thz_physical_memory_bytes(),
+                     .target_noise_k = rs->target_noise_k,
+                     .target_source = rs->target_source};
+    thz_status st =
+        run_estimate_time(&in, &plan.seconds_photons, &plan.seconds_render, &plan.passes, err);
+    if (st == THZ_OK)
+        rs->opt->plan(rs->opt->plan_user, &plan);
     return st;
 }
 
@@ -534,9 +594,11 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
     bool photons = render_integrator_needs_photons(scene->render.integrator);
     if (st == THZ_OK)
         st = run_simulate_memory(rs, photons, err);
+    if (st == THZ_OK && opt->plan)
+        st = run_tell_plan(rs, err);
     if (st == THZ_OK)
         st = run_init_images(rs, err);
-    bool photon_passes = photons && opt->target_noise_k > 0.0 &&
+    bool photon_passes = photons && rs->target_noise_k > 0.0 &&
                          !render_integrator_has_passes(scene->render.integrator);
     for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
         photon_map *map = NULL;

@@ -9,9 +9,10 @@
  *   write:    every output file of a finished run into a staging directory, which the
  *             caller commits into OUTDIR (io/output.h; run_output.c).
  *
- * With the `path` integrator simulate fires no photons. With target_noise_k, each
- * channel gets passes 0, 1, 2, ... (each deterministic) until its median standard
- * error in K is at most the target, or max_seconds have passed.
+ * With the `path` integrator simulate fires no photons. With a noise target
+ * (run_target_noise_k), each channel gets passes 0, 1, 2, ... (each deterministic)
+ * until the 95th percentile over its pixels of the standard error of Tb_c is at most
+ * the target (K), or max_seconds have passed.
  *
  * A failed or cancelled run (progress callback returning non-zero: THZ_ERR_CANCELLED)
  * returns nothing; a failed or cancelled write leaves no result files in OUTDIR.
@@ -27,6 +28,7 @@
 #include "core/error.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
+#include "run/run_noise.h"
 #include "scene/scene.h"
 #include "sensor/images.h"
 #include "sensor/render.h"
@@ -40,6 +42,16 @@ typedef struct run_overrides {
     thz_integrator integrator; /* render.integrator */
 } run_overrides;
 
+/* What a simulate run is about to do, told before it starts (run_estimate.h). */
+typedef struct run_plan {
+    double seconds_photons, seconds_render; /* estimated, s */
+    uint32_t passes;                        /* estimated passes per channel */
+    uint64_t memory_bytes;                  /* estimated peak, bytes */
+    uint64_t available_bytes;               /* physical memory, 0 if unknown */
+    double target_noise_k;                  /* 0: none */
+    const char *target_source;              /* run_target_noise_k's *source */
+} run_plan;
+
 typedef struct run_options {
     int threads;              /* OpenMP threads, 0: all */
     bool keep_photon_maps;    /* simulate: keep every channel's map in the run (to save it) */
@@ -49,11 +61,16 @@ typedef struct run_options {
     thz_warning_fn warning; /* each run warning as it is added; may be NULL */
     void *warning_user;
     double seconds_load;   /* time the caller spent loading the scene, for the summary */
-    double target_noise_k; /* > 0: add passes to each channel until the median per-pixel
-                              standard error of Tb_c, over the rendered sensors, is at
-                              most this (K); final-gather and path only */
+    double target_noise_k; /* > 0: add passes to each channel until the 95th percentile of
+                              the per-pixel standard error of Tb_c, over the rendered
+                              sensors, is at most this (K); overrides the scene's */
     double max_seconds;    /* > 0: stop adding passes once a channel has rendered this
-                              long (s); makes the stopping point time-dependent */
+                              long (s); makes the stopping point time-dependent;
+                              overrides the scene's render.max_seconds */
+    /* simulate: called once before the work starts with the estimate (its pilot costs
+       a moment, so only when set); may be NULL */
+    void (*plan)(void *user, const run_plan *plan);
+    void *plan_user;
 } run_options;
 
 /* The photon maps a render run reads (borrowed): one per channel, their photon-phase
@@ -75,33 +92,43 @@ typedef struct run_result {
     size_t n_warnings;            /* run warnings written to summary.json */
     double worst_median_stderr_k; /* largest over channels of the median per-pixel standard
                                      error of Tb_c, K (0 if not estimated) */
-    uint32_t max_passes;          /* most render passes of any channel */
-    double seconds;               /* wall time of the run */
+    double worst_p95_stderr_k;    /* the same for the 95th percentile, K */
+    size_t worst_object;          /* object whose pixels' p95 is largest (over channels), or
+                                     SIZE_MAX when no object was seen */
+    size_t worst_object_channel;
+    double worst_object_p95_stderr_k; /* K */
+    uint32_t max_passes;              /* most render passes of any channel */
+    double seconds;                   /* wall time of the run */
 } run_result;
 
 /* Everything one run owns, from its start to its written outputs; freed in one place
  * (run_state_fini). run_simulate and run_render fill it; run_write writes it. It must
  * not move while a run fills it (opt points into it). */
 typedef struct run_state {
-    const thz_scene *scene;   /* borrowed: the scene with the run's overrides */
-    run_options options;      /* a copy of the caller's */
-    const run_options *opt;   /* = &options */
-    const char *command;      /* "simulate" or "render" */
-    accel *accel;             /* during the run only */
-    size_t n_selected;        /* sensors rendered */
-    size_t *selected;         /* their indices into scene->sensors */
-    sensor_images *images;    /* one per selected sensor */
-    uint64_t *back_face;      /* per scene sensor: samples that saw a back face */
-    render_stats *render_sum; /* per selected sensor: counts over all channels */
-    render_stats *last;       /* [channel * n_selected + i]: the channel's last render pass
-                                 (every pass casts the same sample rays, so the counts are
-                                 a channel's, not the number of passes') */
-    photon_map **maps;        /* per channel: kept for saving (simulate) */
-    photon_stats *stats;      /* per channel (simulate), or the read maps' (render) */
-    double *median_stderr_k;  /* per channel */
-    uint32_t *passes;         /* per channel: render passes */
-    double *seconds_channel;  /* per channel: render time, s */
-    uint64_t seed;            /* of the photons rendered (scene's, or the map file's) */
+    const thz_scene *scene;    /* borrowed: the scene with the run's overrides */
+    run_options options;       /* a copy of the caller's */
+    const run_options *opt;    /* = &options */
+    const char *command;       /* "simulate" or "render" */
+    accel *accel;              /* during the run only */
+    size_t n_selected;         /* sensors rendered */
+    size_t *selected;          /* their indices into scene->sensors */
+    sensor_images *images;     /* one per selected sensor */
+    uint64_t *back_face;       /* per scene sensor: samples that saw a back face */
+    render_stats *render_sum;  /* per selected sensor: counts over all channels */
+    render_stats *last;        /* [channel * n_selected + i]: the channel's last render pass
+                                  (every pass casts the same sample rays, so the counts are
+                                  a channel's, not the number of passes') */
+    photon_map **maps;         /* per channel: kept for saving (simulate) */
+    photon_stats *stats;       /* per channel (simulate), or the read maps' (render) */
+    run_noise *noise;          /* per channel */
+    run_noise *object_noise;   /* [channel * n_objects + object] */
+    double target_noise_k;     /* the run's target (run_target_noise_k), 0: none */
+    const char *target_source; /* "command line", "scene", "default" or NULL */
+    double max_seconds;        /* the command line's, else the scene's; 0: none */
+    uint64_t memory_bytes;     /* estimated before the run (run_memory total) */
+    uint32_t *passes;          /* per channel: render passes */
+    double *seconds_channel;   /* per channel: render time, s */
+    uint64_t seed;             /* of the photons rendered (scene's, or the map file's) */
     uint64_t photons_per_channel;
     size_t n_warnings;
     char **warnings;
@@ -113,6 +140,17 @@ typedef struct run_state {
  * Every integrator takes a target in simulate (photon-map by photon passes); render
  * refuses one for photon-map, which would need photons. */
 thz_status run_check_options(const run_options *opt, thz_error *err);
+
+/* The noise target where the user gives no count (photons.per_channel or --photons for
+ * photon-map and final-gather, render.paths_per_sample for path) and no target, K. */
+#define RUN_DEFAULT_TARGET_NOISE_K 0.1
+
+/* The run's noise target in K (0: none, one pass): the command line's, else the
+ * scene's render.target_noise_k, else the default when no count is given. render
+ * with photon-map has none but the command line's (which it refuses). *source (may be
+ * NULL) gets "command line", "scene", "default" or NULL. */
+double run_target_noise_k(const thz_scene *scene, const run_options *opt, bool render,
+                          const char **source);
 
 /* Applies the overrides to the scene (before run_simulate / run_render). */
 void run_apply_overrides(thz_scene *scene, const run_overrides *ov);
@@ -131,6 +169,10 @@ typedef struct run_memory {
 /* THZ_OK, or THZ_ERR_LIMIT when `need` exceeds 90 % of the machine's memory, with a
  * message naming `photons.per_channel` or `sensors[i].resolution`. */
 thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err);
+
+/* The same for each sensor's images alone (what loading can tell without building
+ * anything): THZ_ERR_LIMIT naming the scene file and sensors[i].resolution. */
+thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err);
 
 /* Fire and render (simulate) or render from `in` (render; NULL only for path) into rs,
  * nothing written. On failure rs is finalised. */

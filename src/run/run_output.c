@@ -24,10 +24,12 @@ static run_summary run_summary_of(const run_state *rs)
         /* render: the statistics of the photon phase that made the map it read */
         .channel_stats =
             render_integrator_needs_photons(rs->scene->render.integrator) ? rs->stats : NULL,
-        .median_stderr_k = rs->median_stderr_k,
+        .noise = rs->noise,
+        .object_noise = rs->object_noise,
+        .target_source = rs->target_source,
         .passes = rs->passes,
         .seconds_render_channel = rs->seconds_channel,
-        .target_noise_k = rs->opt->target_noise_k,
+        .target_noise_k = rs->target_noise_k,
         .back_face_samples = rs->back_face,
         .seconds_load = rs->opt->seconds_load,
         .seconds_accel = rs->seconds_accel,

@@ -1,4 +1,7 @@
-/* Shared by the JSON loader's files (load.c, load_atmosphere.c), and by nothing else:
+/* Shared by the JSON loader's files (load.c: the document and its warnings; one file
+ * per block: load_channels.c, load_materials.c, load_atmosphere.c, load_objects.c,
+ * load_sensors.c, load_settings.c (photons and render); load_cursor.c: typed access),
+ * and by nothing else:
  * the only code that knows JSON. A "cursor" here is a JSON value together with its
  * path in the document (`objects[2].shape.radius_m`), which every content error
  * names, beside the scene file, with what was expected.
@@ -26,7 +29,15 @@ typedef struct load_ctx {
     const char *dir;   /* relative file paths in the scene are relative to it */
     thz_scene *scene;
     thz_error *err;
+    /* what the atmosphere block gave (for the defaults and warnings that need objects) */
+    bool non_emitting_air;      /* "emitting": false */
+    bool air_temperature_given; /* the air's (itu-p676, lines) or temperature_k */
+    bool background_given;      /* background_temperature_k */
 } load_ctx;
+
+/* The temperature of emitting air whose model has none (constant, table) when the
+ * scene has no enclosure around its sensors to take it from (scene_checks.h). */
+#define LOAD_DEFAULT_AIR_TEMPERATURE_K 293.15
 
 typedef struct load_cursor {
     json_t *value; /* borrowed; NULL when the key is absent */
@@ -116,7 +127,37 @@ thz_status load_csv_spectrum(load_ctx *ctx, const load_cursor *c, const csv_tabl
 thz_status load_spectrum(load_ctx *ctx, const load_cursor *c, const char *key, load_range r,
                          thz_spectrum *out, bool *present);
 
+/* Member "name" of list[i]: a non-empty string unlike the "name" of every earlier entry
+ * of the list (entries without one do not count). *out is borrowed from the document,
+ * NULL when the key is absent and not required. `what` names the entry in messages. */
+thz_status load_unique_name(load_ctx *ctx, const load_cursor *list, size_t i, const char *what,
+                            bool required, const char **out);
+
+/* The required, non-empty list `key` of the root (objects, sensors): its cursor and
+ * length, or a failure naming what was expected. */
+thz_status load_list(load_ctx *ctx, const load_cursor *root, const char *key, const char *what,
+                     load_cursor *list, size_t *n);
+
+/* The spectral properties of a material: their keys (and CSV columns), NULL-terminated,
+ * in the order of load_material_property (0 reflectivity, 1 attenuation, 2 emissivity). */
+#define LOAD_N_PROPERTIES 3
+extern const char *const load_material_columns[];
+thz_spectrum *load_material_property(thz_material *m, size_t k);
+
+/* The blocks of the document, in dependency order; each fills its part of ctx->scene
+ * (root is the document's cursor). Channels before sensors, materials before objects. */
+thz_status load_channels(load_ctx *ctx, const load_cursor *root);
+thz_status load_materials(load_ctx *ctx, const load_cursor *root);
 /* The atmosphere block (load_atmosphere.c); c->value may be NULL (model none). */
 thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *atm);
+/* After the objects: emitting air with no temperature given takes the enclosure's
+ * (when > 0; else it keeps LOAD_DEFAULT_AIR_TEMPERATURE_K), and so does its background
+ * when none is given. */
+thz_status load_atmosphere_defaults(load_ctx *ctx, double enclosure_temperature_k);
+thz_status load_objects(load_ctx *ctx, const load_cursor *root);
+thz_status load_sensors(load_ctx *ctx, const load_cursor *root);
+/* The optional photons and render blocks (absent: the scene's defaults stay). */
+thz_status load_photons(load_ctx *ctx, const load_cursor *root);
+thz_status load_render(load_ctx *ctx, const load_cursor *root);
 
 #endif

@@ -1,7 +1,7 @@
 /* The scene's `atmosphere` block: models none, constant and table (alpha given),
  * itu-p676 and lines (alpha computed from the state of the air and spectral line
  * data, src/atmosphere/), and the emitting-atmosphere keys. docs/atmosphere.md
- * lists the keys. */
+ * lists the keys. Every model but none emits unless "emitting": false (Kirchhoff). */
 #include <stdlib.h>
 
 #include "scene/load.h"
@@ -105,35 +105,40 @@ static thz_status load_lines(load_ctx *ctx, const load_cursor *c, thz_atmosphere
     return st;
 }
 
-/* emitting, background_temperature_k and the extent (after the model is set); the
- * temperature_k of a model without air belongs to an emitting atmosphere. */
+/* emitting (default true: air that absorbs emits), background_temperature_k and the
+ * extent (after the model is set). Without air (constant, table) the temperature_k,
+ * when absent, and the background, when absent, get their defaults in
+ * load_atmosphere_defaults once the objects are known. */
 static thz_status load_emitting(load_ctx *ctx, const load_cursor *c, thz_atmosphere *atm)
 {
-    bool emitting = false;
-    thz_status st = load_bool(ctx, c, "emitting", false, &emitting);
+    bool emitting = true;
+    thz_status st = load_bool(ctx, c, "emitting", true, &emitting);
     if (st != THZ_OK)
         return st;
     load_cursor t = load_key(c, "temperature_k"), bg = load_key(c, "background_temperature_k");
     load_cursor lo = load_key(c, "extent_min_m"), hi = load_key(c, "extent_max_m");
     if (!emitting) {
+        ctx->non_emitting_air = true;
         if (!atm->has_air && t.value)
             return load_fail(ctx, &t,
                              "only the air of itu-p676 and lines, or an emitting "
-                             "atmosphere (\"emitting\": true), has a temperature");
+                             "atmosphere (the default), has a temperature");
         const load_cursor *stray = bg.value ? &bg : lo.value ? &lo : hi.value ? &hi : NULL;
         if (stray)
-            return load_fail(ctx, stray,
-                             "only an emitting atmosphere (\"emitting\": true) has this");
+            return load_fail(ctx, stray, "only an emitting atmosphere (the default) has this");
         return THZ_OK;
     }
-    double t_air = atm->air.temperature_k, t_bg = 0.0;
+    double t_air = atm->has_air ? atm->air.temperature_k : LOAD_DEFAULT_AIR_TEMPERATURE_K;
+    ctx->air_temperature_given = atm->has_air || t.value;
     if (!atm->has_air) {
-        st = load_number(ctx, c, "temperature_k", (load_range){0.0, 1000.0, true, false}, true, 0.0,
-                         &t_air);
+        st = load_number(ctx, c, "temperature_k", (load_range){0.0, 1000.0, true, false}, false,
+                         t_air, &t_air);
         if (st != THZ_OK)
             return st;
     }
-    st = load_number(ctx, c, "background_temperature_k", LOAD_NONNEGATIVE, true, 0.0, &t_bg);
+    double t_bg = t_air;
+    ctx->background_given = bg.value != NULL;
+    st = load_number(ctx, c, "background_temperature_k", LOAD_NONNEGATIVE, false, t_air, &t_bg);
     if (st != THZ_OK)
         return st;
     thz_error inner = {0};
@@ -151,6 +156,19 @@ static thz_status load_emitting(load_ctx *ctx, const load_cursor *c, thz_atmosph
     st = atmosphere_set_extent(atm, min_m, max_m, &inner);
     if (st != THZ_OK)
         return fail_from(ctx, &hi, st, &inner);
+    return THZ_OK;
+}
+
+thz_status load_atmosphere_defaults(load_ctx *ctx, double enclosure_temperature_k)
+{
+    thz_atmosphere *atm = &ctx->scene->atmosphere;
+    if (!atm->emitting || ctx->air_temperature_given || !(enclosure_temperature_k > 0.0))
+        return THZ_OK;
+    double t_bg = ctx->background_given ? atm->background_temperature_k : enclosure_temperature_k;
+    thz_error inner = {0};
+    thz_status st = atmosphere_set_emitting(atm, enclosure_temperature_k, t_bg, &inner);
+    if (st != THZ_OK)
+        return thz_error_set(ctx->err, st, "%s: atmosphere: %s", ctx->label, inner.message);
     return THZ_OK;
 }
 

@@ -28,7 +28,7 @@ thz_scene *scene_create(void)
     s->photons.seed = 1;
     s->photons.min_relative_power = 0.01;
     s->photons.gather_min_photons = 16;
-    s->render.integrator = INTEGRATOR_PHOTON_MAP;
+    s->render.integrator = INTEGRATOR_PATH; /* converged fastest: docs/integrators.md */
     s->render.gather_rays = 32;
     s->render.paths_per_sample = 16;
     return s;

@@ -62,12 +62,17 @@ typedef struct thz_sensor {
     double aperture_m2;
     uint32_t oversampling; /* n: n x n samples per pixel */
     double normalize_to_k; /* T_ref > 0 */
+    bool misplaced;        /* scene_checks found it inside a closed solid or outside the
+                              enclosure (and warned): back faces it sees are not the
+                              normals' fault */
 } thz_sensor;
 
 typedef struct thz_photon_settings {
-    uint64_t per_channel; /* K > 0 */
+    uint64_t per_channel;   /* K > 0 */
+    bool per_channel_given; /* by the scene or the command line (else the default noise
+                               target applies, run.h) */
     uint64_t seed;
-    double min_relative_power;   /* 0 < x < 1 */
+    double min_relative_power;   /* 0 <= x < 1; 0: no power cut-off */
     uint32_t gather_min_photons; /* k >= 2 */
 } thz_photon_settings;
 
@@ -85,6 +90,10 @@ typedef struct thz_render_settings {
     thz_integrator integrator;
     uint32_t gather_rays;      /* final-gather, default 32 */
     uint32_t paths_per_sample; /* path, default 16 */
+    bool paths_per_sample_given;
+    double target_noise_k; /* render.target_noise_k: p95 of the per-pixel standard error
+                              of Tb_c to reach (K); 0: none given */
+    double max_seconds;    /* render.max_seconds: time limit of the passes (s); 0: none */
 } thz_render_settings;
 
 struct thz_scene {

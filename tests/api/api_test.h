@@ -34,7 +34,8 @@ static int test_failures = 0;
         }                                                                                          \
     } while (0)
 
-/* The scene (20000 photons per channel; settings may change that). */
+/* The scene (20000 photons per channel, photon-map: the integrator that fires photons and
+ * has no passes; settings may change both). */
 static const char test_scene_json[] =
     "{\n"
     "  \"format\": \"thzmap-scene/1\",\n"
@@ -68,7 +69,8 @@ static const char test_scene_json[] =
     "    {\"name\": \"side\", \"position_m\": [0.8, -0.8, 0.3], \"look_at_m\": [0, 0.4, -0.2],\n"
     "     \"fov_deg\": 50, \"resolution\": [12, 12]}\n"
     "  ],\n"
-    "  \"photons\": {\"per_channel\": 20000, \"seed\": 4}\n"
+    "  \"photons\": {\"per_channel\": 20000, \"seed\": 4},\n"
+    "  \"render\": {\"integrator\": \"photon-map\"}\n"
     "}\n";
 
 /* A fresh directory under $TMPDIR (or /tmp); exits on failure. */

@@ -21,6 +21,9 @@ fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 
 cp -r "$REPO/examples/plate-in-box" "$work/scene"
 S=$work/scene/scene.json
+# the paper's non-emitting air, as this test is about (the example's air emits)
+sed -i 's/"attenuation_per_m": 0.05}/"attenuation_per_m": 0.05, "emitting": false}/' "$S"
+grep -q '"emitting": false' "$S" || fail "could not make the example's air non-emitting"
 run() { # $1: what, rest: thzmap arguments
     local what=$1
     shift
@@ -32,7 +35,9 @@ run() { # $1: what, rest: thzmap arguments
 run fg simulate "$S" -o "$work/fg" --integrator final-gather --photons 200000 \
     --threads 2 --save-photon-map
 run pmap simulate "$S" -o "$work/pmap" --integrator photon-map --photons 20000 --threads 2
-run path simulate "$S" -o "$work/path" --integrator path --target-noise-k 0.01 --threads 2
+# 0.03 K at the 95th percentile: the one pass that the median target of 0.01 K gave
+# before targets meant the 95th percentile (the walls are exact, so the median is 0)
+run path simulate "$S" -o "$work/path" --integrator path --target-noise-k 0.03 --threads 2
 run rerender render "$S" -o "$work/rerender" --integrator photon-map \
     --photon-map "$work/fg/photon-map.thzpm" --threads 2
 

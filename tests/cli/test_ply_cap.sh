@@ -9,7 +9,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
-"$thzmap" simulate "$repo/examples/plate-in-box/scene.json" -o "$tmp/out" --photons 2000 \
+"$thzmap" simulate "$repo/examples/plate-in-box/scene.json" -o "$tmp/out" --integrator photon-map --photons 2000 \
     --save-photon-map --ply-max-points 100 --quiet || fail "simulate exited $?"
 header=$(head -c 2000 "$tmp/out/photon-map.ply" | tr -d '\0' | sed -n '1,/end_header/p')
 grep -q '^format binary_little_endian 1.0' <<<"$header" || fail "not a binary LE PLY: $header"

@@ -445,7 +445,7 @@ static const char *humid_json =
     " \"channels\": [{\"frequency_thz\": 0.325, \"relative_width\": 0.03}],"
     " \"materials\": {\"black\": {\"reflectivity\": 0.0}},"
     " \"atmosphere\": {\"model\": \"itu-p676\", \"temperature_k\": 300, \"pressure_hpa\": 1013.25,"
-    "   \"relative_humidity\": 0.5},"
+    "   \"relative_humidity\": 0.5, \"emitting\": false},"
     " \"objects\": ["
     "   {\"name\": \"corridor\", \"type\": \"solid\", \"material\": \"black\","
     "    \"temperature_k\": 310,"

@@ -52,7 +52,7 @@
     " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.9, 0], \"direction\": [0, 1, 0],"   \
     "   \"up\": [0, 0, 1], \"fov_deg\": 80, \"resolution\": [%u, %u], \"oversampling\": 1,"        \
     "   \"aperture_m2\": 0.01, \"normalize_to_k\": 295}],"                                         \
-    " \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": %g},"                       \
+    " \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": %g, \"emitting\": false},"  \
     " \"photons\": {\"per_channel\": 300000, \"seed\": %llu}}"
 
 static void xval_scene(char *json, size_t size, uint32_t res, double alpha_per_m, uint64_t seed)

@@ -19,7 +19,7 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 PLATE = os.path.join(REPO, "examples", "plate-in-box")
 
 # The plate-in-box example made small: two channels, 20 x 12 pixels (not square, so a
-# swapped axis shows), few photons. It keeps its CSV material ("materials/sample.csv"),
+# swapped axis shows), few photons, photon-map. It keeps its CSV material ("materials/sample.csv"),
 # a relative path that tests base_dir.
 with open(os.path.join(PLATE, "scene.json")) as f:
     _TINY = json.load(f)
@@ -27,6 +27,8 @@ _TINY["channels"] = [{"name": "0.35 THz", "frequency_thz": 0.35, "relative_width
                      {"name": "0.8 THz", "frequency_thz": 0.8, "relative_width": 0.01}]
 _TINY["sensors"][0].update({"resolution": [20, 12], "oversampling": 1})
 _TINY["photons"]["per_channel"] = 3000
+# the integrator these tests fire photons for (the default, path, fires none)
+_TINY["render"] = {"integrator": "photon-map"}
 
 # The quantities of a sensor's ENVI files, and their shape in the Python API.
 CUBES = ["radiance", "radiance_stderr", "power", "brightness_temperature", "normalized"]

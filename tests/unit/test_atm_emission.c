@@ -154,9 +154,12 @@ static void test_scene_keys(void **state)
          "missing.par"},
         {"{\"model\": \"itu-p676\", \"temperature_k\": 90, \"pressure_hpa\": 1000, \"h2o_vmr\": 0}",
          "atmosphere.temperature_k"},
-        {"{\"model\": \"constant\", \"attenuation_per_m\": 0.1, \"background_temperature_k\": 3}",
+        /* changed with emitting air by default: the background needs emitting air,
+         * and its temperature, optional now, must still be in range */
+        {"{\"model\": \"constant\", \"attenuation_per_m\": 0.1, \"emitting\": false,"
+         " \"background_temperature_k\": 3}",
          "atmosphere.background_temperature_k"},
-        {"{\"model\": \"constant\", \"attenuation_per_m\": 0.1, \"emitting\": true,"
+        {"{\"model\": \"constant\", \"attenuation_per_m\": 0.1, \"temperature_k\": 0,"
          " \"background_temperature_k\": 3}",
          "atmosphere.temperature_k"},
         {"{\"model\": \"itu-p676\", \"temperature_k\": 290, \"pressure_hpa\": 1000, \"h2o_vmr\": 0,"

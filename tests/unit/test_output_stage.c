@@ -389,6 +389,9 @@ static void test_summary_json(void **state)
     scene->sensors[0].name = thz_strdup("cam");
     scene->sensors[0].columns = 7;
     scene->sensors[0].rows = 5;
+    scene->n_objects = 1;
+    scene->objects = thz_calloc(1, sizeof *scene->objects);
+    scene->objects[0].name = thz_strdup("wall");
     assert_true(scene_add_warning(scene, "scene warning"));
 
     photon_stats st[2] = {{0}};
@@ -409,7 +412,10 @@ static void test_summary_json(void **state)
     st[0].mean_bounces = 1.5;
     st[1].fired = 10;
     st[1].emitted_power_w_per_hz = NAN;
-    double stderr_k[2] = {0.5, 0.25};
+    run_noise noise[2] = {{.median_k = 0.5, .p95_k = 0.9, .pixels = 35},
+                          {.median_k = 0.25, .p95_k = 0.4, .pixels = 35}};
+    run_noise object_noise[2] = {{.median_k = 0.6, .p95_k = 1.1, .pixels = 20},
+                                 {.median_k = 0.0, .p95_k = 0.0, .pixels = 0}};
     uint64_t back[1] = {3};
     const char *run_warnings[] = {"run warning"};
     run_summary rs = {.command = "simulate",
@@ -418,7 +424,10 @@ static void test_summary_json(void **state)
                       .photons_per_channel = 1000,
                       .threads = 2,
                       .channel_stats = st,
-                      .median_stderr_k = stderr_k,
+                      .noise = noise,
+                      .object_noise = object_noise,
+                      .target_noise_k = 0.1,
+                      .target_source = "default",
                       .back_face_samples = back,
                       .seconds_photons = 1.25,
                       .n_run_warnings = 1,
@@ -460,7 +469,17 @@ static void test_summary_json(void **state)
     assert_true(fabs(json_number_value(json_object_get(eb, "terminated_w_per_hz")) - 0.01e-12) <
                 1e-24);
     assert_true(fabs(json_number_value(json_object_get(c0, "median_stderr_k")) - 0.5) < 1e-12);
+    assert_true(fabs(json_number_value(json_object_get(c0, "p95_stderr_k")) - 0.9) < 1e-12);
+    json_t *o0 = json_array_get(json_object_get(c0, "objects"), 0);
+    assert_string_equal(json_string_value(json_object_get(o0, "name")), "wall");
+    assert_int_equal(json_integer_value(json_object_get(o0, "pixels")), 20);
+    assert_true(fabs(json_number_value(json_object_get(o0, "median_stderr_k")) - 0.6) < 1e-12);
+    assert_true(fabs(json_number_value(json_object_get(o0, "p95_stderr_k")) - 1.1) < 1e-12);
+    assert_string_equal(json_string_value(json_object_get(root, "target_noise_source")), "default");
     json_t *c1 = json_array_get(chs, 1);
+    json_t *o1 = json_array_get(json_object_get(c1, "objects"), 0);
+    assert_int_equal(json_integer_value(json_object_get(o1, "pixels")), 0);
+    assert_true(json_is_null(json_object_get(o1, "p95_stderr_k"))); /* no pixels: no figure */
     assert_true(json_is_null(json_object_get(c1, "emitted_power_w_per_hz")));
     assert_true(json_is_null(
         json_object_get(json_object_get(c1, "energy_balance"), "relative_difference")));

@@ -21,7 +21,8 @@
 
 #include "../physics/identity.h"
 
-/* A black corridor at 300 K seen along y through alpha = 0.2 /m, a grey box (R = 0.5)
+/* A black corridor at 300 K seen along y through alpha = 0.2 /m of the paper's
+ * non-emitting air (the closed forms below are Beer-Lambert's), a grey box (R = 0.5)
  * in it, and a second camera outside the corridor looking at its outside (back faces of
  * the inward box). */
 static const char *render_json =
@@ -29,7 +30,7 @@ static const char *render_json =
     " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.02}],"
     " \"materials\": {\"black\": {\"reflectivity\": 0.0, \"color\": [0.2, 0.4, 0.8]},"
     "                 \"grey\": {\"reflectivity\": 0.5}},"
-    " \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.2},"
+    " \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.2, \"emitting\": false},"
     " \"objects\": ["
     "   {\"name\": \"corridor\", \"type\": \"solid\", \"material\": \"black\","
     "    \"temperature_k\": 300,"
@@ -42,7 +43,8 @@ static const char *render_json =
     "    \"fov_deg\": 6, \"resolution\": [5, 4], \"oversampling\": 3},"
     "   {\"name\": \"outside\", \"position_m\": [0, -5, 0], \"direction\": [0, 1, 0],"
     "    \"fov_deg\": 5, \"resolution\": [4, 4]}],"
-    " \"photons\": {\"per_channel\": 20000, \"seed\": 2}}";
+    " \"photons\": {\"per_channel\": 20000, \"seed\": 2},"
+    " \"render\": {\"integrator\": \"photon-map\"}}";
 
 typedef struct fixture {
     thz_scene *scene;

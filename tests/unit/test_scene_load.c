@@ -106,7 +106,10 @@ static void test_defaults_and_range(void **state)
     assert_true(c->up[2] == 1.0);
     assert_true(s->photons.per_channel == 1000000 && s->photons.seed == 1);
     assert_true(s->photons.min_relative_power == 0.01);
-    assert_int_equal(s->render.integrator, INTEGRATOR_PHOTON_MAP);
+    assert_int_equal(s->render.integrator, INTEGRATOR_PATH); /* changed: docs/integrators.md */
+    assert_false(s->photons.per_channel_given);
+    assert_false(s->render.paths_per_sample_given);
+    assert_true(s->render.target_noise_k == 0.0 && s->render.max_seconds == 0.0);
     assert_int_equal(s->render.gather_rays, 32);
     assert_int_equal(s->render.paths_per_sample, 16);
     assert_false(s->objects[0].two_sided);
@@ -243,7 +246,7 @@ static void test_refusals(void **state)
     load_bad("[1, 2]", "expected a JSON object");
     load_bad(HEAD CHANNELS MATERIALS OBJECT(BOX) SENSORS
              ", \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.1, "
-             "\"temperature_k\": 290}}",
+             "\"temperature_k\": 290, \"emitting\": false}}",
              "atmosphere.temperature_k: only the air of itu-p676 and lines, or an emitting");
     load_bad(HEAD CHANNELS MATERIALS OBJECT(BOX) SENSORS
              ", \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.1, "

@@ -232,7 +232,7 @@ CASES = [
     ("photons_gather_min_one", [(["photons"], {"gather_min_photons": 1})],
      "photons.gather_min_photons: expected a whole number from 2"),
     ("photons_min_power_one", [(["photons"], {"min_relative_power": 1})],
-     "photons.min_relative_power: expected a number in (0, 1), got 1"),
+     "photons.min_relative_power: expected a number in [0, 1), got 1"),
     ("photons_negative_seed", [(["photons"], {"seed": -1})],
      "photons.seed: expected a whole number from 0"),
     ("photons_unknown_key", [(["photons"], {"count": 10})], "photons.count: unknown key"),

@@ -1,0 +1,109 @@
+/* The up-front time estimate of a run (run_estimate.h). */
+#include "run/run_estimate.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "core/clock.h"
+#include "photon/phase.h"
+#include "photon/photon_map.h"
+#include "run/run_noise.h"
+#include "sensor/images.h"
+#include "sensor/render.h"
+#include "sensor/render_accum.h"
+#include "sensor/truth.h"
+
+/* Samples one pass of sensor s renders: pixels x oversampling^2 (x paths for path). */
+static double estimate_samples(const thz_scene *scene, const thz_sensor *s)
+{
+    double n = (double)s->columns * s->rows * s->oversampling * s->oversampling;
+    return scene->render.integrator == INTEGRATOR_PATH ? n * scene->render.paths_per_sample : n;
+}
+
+thz_status run_estimate_time(const run_estimate_input *in, double *seconds_photons,
+                             double *seconds_render, uint32_t *passes, thz_error *err)
+{
+    const thz_scene *scene = in->scene;
+    *seconds_photons = *seconds_render = 0.0;
+    *passes = 1;
+    /* the pilot scene: the same objects, K photons and one small sensor */
+    thz_scene pilot = *scene;
+    thz_sensor cam = scene->sensors[in->selected[0]];
+    cam.columns = cam.rows = RUN_PILOT_SIDE;
+    cam.oversampling = 1;
+    pilot.sensors = &cam;
+    pilot.n_sensors = 1;
+    pilot.n_warnings = 0;
+    bool photons = render_integrator_needs_photons(scene->render.integrator);
+    photon_map *map = NULL;
+    thz_status st = THZ_OK;
+    if (photons) {
+        pilot.photons.per_channel = RUN_PILOT_PHOTONS;
+        photon_phase_options po = {.threads = in->threads,
+                                   .reference_temperature_k =
+                                       scene->render.integrator == INTEGRATOR_FINAL_GATHER
+                                           ? scene_reference_temperature_k(scene, 0)
+                                           : 0.0};
+        photon_stats ps;
+        double t0 = thz_now_s();
+        st = photon_phase_run(&pilot, in->accel, 0, &po, &map, &ps, err);
+        double per_photon = (thz_now_s() - t0) / RUN_PILOT_PHOTONS;
+        *seconds_photons =
+            per_photon * (double)scene->photons.per_channel * (double)scene->n_channels;
+        if (st != THZ_OK)
+            return st;
+    }
+    sensor_images img;
+    render_accum acc;
+    memset(&acc, 0, sizeof acc);
+    st = sensor_images_init(&img, cam.columns, cam.rows, scene->n_channels, 1, err);
+    if (st == THZ_OK)
+        st = render_accum_init(&acc, (size_t)cam.columns * cam.rows, err);
+    render_options ro = {.threads = in->threads};
+    render_stats rst;
+    if (st == THZ_OK)
+        st = render_sensor_truth(&pilot, in->accel, 0, &img, &ro, err);
+    /* pass 0 warms up (threads, caches); pass 1 is timed */
+    if (st == THZ_OK)
+        st = render_sensor_channel_pass(&pilot, in->accel, map, 0, 0, 0, &acc, &ro, &rst, err);
+    if (st == THZ_OK) { /* photon-map has one pass only: time pass 0 again, afresh */
+        render_accum_fini(&acc);
+        st = render_accum_init(&acc, (size_t)cam.columns * cam.rows, err);
+    }
+    double t0 = thz_now_s();
+    if (st == THZ_OK)
+        st = render_sensor_channel_pass(&pilot, in->accel, map, 0, 0, 0, &acc, &ro, &rst, err);
+    double per_sample = (thz_now_s() - t0) / estimate_samples(&pilot, &cam);
+    if (st == THZ_OK)
+        st = render_accum_write(&pilot, 0, 0, &acc, &img, err);
+    run_noise noise = {0};
+    if (st == THZ_OK)
+        st = run_noise_channel(&img, 1, 0, scene->channels[0].center_hz, 0, &noise, NULL, err);
+    render_accum_fini(&acc);
+    sensor_images_fini(&img);
+    photon_map_destroy(map);
+    if (st != THZ_OK)
+        return st;
+    double samples = 0.0, per_pixel = 0.0, pixels = 0.0;
+    for (size_t i = 0; i < in->n_selected; i++) {
+        const thz_sensor *s = &scene->sensors[in->selected[i]];
+        samples += estimate_samples(scene, s);
+        pixels += (double)s->columns * s->rows;
+    }
+    per_pixel = samples / pixels; /* samples per pixel in one pass */
+    if (in->target_noise_k > 0.0 && noise.p95_k > in->target_noise_k) {
+        /* the pilot has estimate_samples(cam) / side^2 samples per pixel; the standard
+         * error falls as 1/sqrt(samples) (photon-map: of photons, the same law) */
+        double pilot_per_pixel = estimate_samples(&pilot, &cam) / (double)(cam.columns * cam.rows);
+        double need = pilot_per_pixel * pow(noise.p95_k / in->target_noise_k, 2.0);
+        double p = ceil(photons && scene->render.integrator == INTEGRATOR_PHOTON_MAP
+                            ? need / pilot_per_pixel * RUN_PILOT_PHOTONS /
+                                  (double)scene->photons.per_channel
+                            : need / per_pixel);
+        *passes = (uint32_t)fmin(fmax(p, 1.0), 100000.0);
+    }
+    *seconds_render = per_sample * samples * (double)scene->n_channels * *passes;
+    if (photons && scene->render.integrator == INTEGRATOR_PHOTON_MAP)
+        *seconds_photons *= *passes;
+    return THZ_OK;
+}

@@ -1,0 +1,36 @@
+/* The up-front estimate of a simulate run's time: a pilot on a small copy of the first
+ * rendered sensor (RUN_PILOT_SIDE^2 pixels, one sample each, pass 0 twice, the second
+ * timed) and, for the integrators
+ * that need photons, a pilot photon phase of RUN_PILOT_PHOTONS, both on channel 0.
+ * Time per path sample (or gather sample) and per photon, times the run's counts,
+ * gives the time; with a noise target the pilot's 95th percentile of the standard
+ * error, scaled as 1/sqrt(samples), gives the passes. An estimate, not a promise: it
+ * assumes every channel costs what channel 0 does.
+ */
+#ifndef THZ_RUN_RUN_ESTIMATE_H
+#define THZ_RUN_RUN_ESTIMATE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "accel/accel.h"
+#include "core/error.h"
+#include "scene/scene.h"
+
+#define RUN_PILOT_SIDE 32u
+#define RUN_PILOT_PHOTONS 20000u
+
+typedef struct run_estimate_input {
+    const thz_scene *scene;
+    const accel *accel;
+    const size_t *selected; /* sensors rendered */
+    size_t n_selected;
+    double target_noise_k; /* 0: one pass */
+    int threads;
+} run_estimate_input;
+
+/* *seconds_photons and *seconds_render of the whole run, s; *passes per channel. */
+thz_status run_estimate_time(const run_estimate_input *in, double *seconds_photons,
+                             double *seconds_render, uint32_t *passes, thz_error *err);
+
+#endif

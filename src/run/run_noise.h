@@ -1,0 +1,28 @@
+/* The noise figures of a run: over the rendered pixels of a channel (every selected
+ * sensor), the median and the 95th percentile of the per-pixel standard error of Tb_c
+ * (K), for the whole picture and per object (the pixels whose truth object_id is that
+ * object). The 95th percentile is what a noise target aims at: a median can hide the
+ * noisy objects (a metal part, a covered target) behind the walls around them.
+ */
+#ifndef THZ_RUN_RUN_NOISE_H
+#define THZ_RUN_RUN_NOISE_H
+
+#include <stddef.h>
+
+#include "core/error.h"
+#include "sensor/images.h"
+
+/* One set of pixels' figures; both 0 when there are no pixels. */
+typedef struct run_noise {
+    double median_k;
+    double p95_k;  /* nearest rank: the smallest value >= 95 % of the pixels' */
+    size_t pixels; /* pixels counted (Tb_c > 0: nothing or a back face seen are left out) */
+} run_noise;
+
+/* Figures of channel c (centre freq_hz) over n_images images: *all for every pixel, and
+ * objects[o] (n_objects entries, NULL to skip) per object. Images without standard
+ * errors are skipped. */
+thz_status run_noise_channel(const sensor_images *images, size_t n_images, size_t c, double freq_hz,
+                             size_t n_objects, run_noise *all, run_noise *objects, thz_error *err);
+
+#endif

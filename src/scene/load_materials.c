@@ -1,0 +1,137 @@
+/* The scene's `materials` block: spectral properties from numbers, tables or a CSV
+ * file, and the energy check eps + R <= 1. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "scene/load.h"
+
+/* Rounding slack for eps + R <= 1. */
+#define LOAD_SUM_SLACK 1e-9
+
+/* The spectral properties of a material: their keys (and CSV columns), accepted
+ * values, and load_material_property's order. */
+const char *const load_material_columns[] = {"reflectivity", "attenuation_per_m", "emissivity",
+                                             NULL};
+static const load_range load_material_ranges[] = {
+    {0.0, 1.0, false, false}, {0.0, INFINITY, false, false}, {0.0, 1.0, false, false}};
+
+thz_spectrum *load_material_property(thz_material *m, size_t k)
+{
+    return k == 0 ? &m->reflectivity : k == 1 ? &m->attenuation_per_m : &m->emissivity;
+}
+
+/* Fills the spectra of m from the CSV file named by c's `file`. */
+static thz_status load_material_file(load_ctx *ctx, const load_cursor *c, thz_material *m)
+{
+    csv_table t = {0};
+    thz_status st = load_csv(ctx, c, "file", &t);
+    if (st != THZ_OK)
+        return st;
+    load_cursor file = load_key(c, "file");
+    st = load_csv_columns(ctx, &file, &t, load_material_columns, NULL);
+    for (size_t k = 0; k < LOAD_N_PROPERTIES && st == THZ_OK; k++)
+        if (csv_column(&t, load_material_columns[k]) >= 0)
+            st = load_csv_spectrum(ctx, &file, &t, load_material_columns[k],
+                                   load_material_ranges[k], load_material_property(m, k));
+    csv_fini(&t);
+    return st;
+}
+
+/* Refuses eps + R > 1 at any table point of either (and at one point when both are
+ * constants); between table points both are linear, so the ends of each piece suffice. */
+static thz_status load_check_energy(load_ctx *ctx, const load_cursor *c, const thz_material *m)
+{
+    if (m->emissivity.n == 0)
+        return THZ_OK;
+    const thz_spectrum *sp[2] = {&m->reflectivity, &m->emissivity};
+    for (int which = 0; which < 2; which++) {
+        size_t n = sp[which]->freq_hz ? sp[which]->n : 1;
+        for (size_t i = 0; i < n; i++) {
+            double f = sp[which]->freq_hz ? sp[which]->freq_hz[i] : 1e12;
+            double r = spectrum_eval(&m->reflectivity, f), e = spectrum_eval(&m->emissivity, f);
+            if (e + r > 1.0 + LOAD_SUM_SLACK) {
+                load_cursor k = load_key(c, "emissivity");
+                return load_fail(ctx, &k,
+                                 "emissivity + reflectivity must not exceed 1, got %g + %g = %g "
+                                 "at %.4g THz",
+                                 e, r, e + r, f * 1e-12);
+            }
+        }
+    }
+    return THZ_OK;
+}
+
+static thz_status load_material(load_ctx *ctx, const load_cursor *c, thz_material *m)
+{
+    static const char *const keys[] = {
+        "reflectivity", "attenuation_per_m", "emissivity", "transmission", "color", "file", NULL};
+    static const char *const transmissions[] = {"diffuse", "straight", NULL};
+    thz_status st = load_expect_object(ctx, c, keys);
+    if (st != THZ_OK)
+        return st;
+    if (json_object_get(c->value, "file")) {
+        st = load_material_file(ctx, c, m);
+        if (st != THZ_OK)
+            return st;
+    }
+    bool present;
+    for (size_t k = 0; k < LOAD_N_PROPERTIES && st == THZ_OK; k++)
+        st = load_spectrum(ctx, c, load_material_columns[k], load_material_ranges[k],
+                           load_material_property(m, k), &present);
+    if (st != THZ_OK)
+        return st;
+    if (m->reflectivity.n == 0) {
+        load_cursor k = load_key(c, "reflectivity");
+        return load_fail(ctx, &k,
+                         "missing key (expected R, a number in [0, 1] or a table "
+                         "[[frequency_thz, R], ...], or a \"file\" with a reflectivity column)");
+    }
+    if (m->attenuation_per_m.n == 0 && !spectrum_set_constant(&m->attenuation_per_m, 0.0))
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    size_t transmission = 0;
+    st = load_choice(ctx, c, "transmission", transmissions, false, 0, &transmission);
+    if (st != THZ_OK)
+        return st;
+    m->transmission = transmission == 1 ? TRANSMISSION_STRAIGHT : TRANSMISSION_DIFFUSE;
+    for (int k = 0; k < 3; k++)
+        m->color[k] = 0.6;
+    st = load_vector(ctx, c, "color", 3, LOAD_UNIT, false, m->color);
+    if (st != THZ_OK)
+        return st;
+    return load_check_energy(ctx, c, m);
+}
+
+thz_status load_materials(load_ctx *ctx, const load_cursor *root)
+{
+    thz_scene *s = ctx->scene;
+    load_cursor c = load_key(root, "materials");
+    const char *what = "an object mapping material names to materials, such as "
+                       "{\"wall\": {\"reflectivity\": 0.1}}";
+    if (!c.value)
+        return load_fail(ctx, &c, "missing key (expected %s)", what);
+    if (!json_is_object(c.value))
+        return load_fail(ctx, &c, "expected %s, got %s", what, load_type_name(c.value));
+    size_t n = json_object_size(c.value);
+    if (n == 0)
+        return load_fail(ctx, &c, "expected at least one material, got an empty object");
+    s->materials = thz_calloc(n, sizeof *s->materials);
+    if (!s->materials)
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    const char *name;
+    json_t *value;
+    json_object_foreach(c.value, name, value)
+    {
+        thz_material *m = &s->materials[s->n_materials++];
+        load_cursor e = load_key(&c, name);
+        m->name = thz_strdup(name);
+        if (!m->name)
+            return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+        thz_status st = load_material(ctx, &e, m);
+        if (st != THZ_OK)
+            return st;
+    }
+    return THZ_OK;
+}

@@ -1,0 +1,255 @@
+/* The scene's `objects` block: each object's material, temperature and kind, its shape
+ * (a built-in primitive or a mesh file) and its transform into world space. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "scene/load.h"
+#include "scene/mesh_import.h"
+#include "scene/primitives.h"
+#include "scene/transform.h"
+
+static thz_status load_segments(load_ctx *ctx, const load_cursor *c, unsigned *out)
+{
+    uint64_t v;
+    thz_status st = load_integer(ctx, c, "segments", PRIMITIVE_MIN_SEGMENTS, PRIMITIVE_MAX_SEGMENTS,
+                                 false, 64, &v);
+    *out = (unsigned)v;
+    return st;
+}
+
+static thz_status load_shape(load_ctx *ctx, const load_cursor *c, thz_mesh *mesh)
+{
+    static const char *const types[] = {"box",  "cylinder", "sphere", "rectangle",
+                                        "disk", "mesh",     NULL};
+    static const char *const keys[][6] = {
+        {"type", "size_m", "inward", NULL},
+        {"type", "radius_m", "height_m", "caps", "segments", NULL},
+        {"type", "radius_m", "subdivisions", NULL},
+        {"type", "size_m", NULL},
+        {"type", "radius_m", "segments", NULL},
+        {"type", "file", NULL},
+    };
+    if (!c->value)
+        return load_fail(ctx, c,
+                         "missing key (expected a shape such as {\"type\": \"box\", \"size_m\": "
+                         "[1, 1, 1]})");
+    if (!json_is_object(c->value))
+        return load_fail(ctx, c, "expected a shape object {\"type\": ...}, got %s",
+                         load_type_name(c->value));
+    size_t type;
+    thz_status st = load_choice(ctx, c, "type", types, true, 0, &type);
+    if (st == THZ_OK)
+        st = load_expect_object(ctx, c, keys[type]);
+    if (st != THZ_OK)
+        return st;
+    thz_error *err = ctx->err;
+    switch (type) {
+    case 0: {
+        double size[3];
+        bool inward;
+        st = load_vector(ctx, c, "size_m", 3, LOAD_POSITIVE, true, size);
+        if (st == THZ_OK)
+            st = load_bool(ctx, c, "inward", false, &inward);
+        if (st == THZ_OK)
+            st = primitive_box(mesh, size, inward, err);
+        break;
+    }
+    case 1: {
+        double r, h;
+        bool caps;
+        unsigned segments;
+        st = load_number(ctx, c, "radius_m", LOAD_POSITIVE, true, 0, &r);
+        if (st == THZ_OK)
+            st = load_number(ctx, c, "height_m", LOAD_POSITIVE, true, 0, &h);
+        if (st == THZ_OK)
+            st = load_bool(ctx, c, "caps", true, &caps);
+        if (st == THZ_OK)
+            st = load_segments(ctx, c, &segments);
+        if (st == THZ_OK)
+            st = primitive_cylinder(mesh, r, h, caps, segments, err);
+        break;
+    }
+    case 2: {
+        double r;
+        uint64_t sub;
+        st = load_number(ctx, c, "radius_m", LOAD_POSITIVE, true, 0, &r);
+        if (st == THZ_OK)
+            st =
+                load_integer(ctx, c, "subdivisions", 0, PRIMITIVE_MAX_SUBDIVISIONS, false, 4, &sub);
+        if (st == THZ_OK)
+            st = primitive_sphere(mesh, r, (unsigned)sub, err);
+        break;
+    }
+    case 3: {
+        double size[2];
+        st = load_vector(ctx, c, "size_m", 2, LOAD_POSITIVE, true, size);
+        if (st == THZ_OK)
+            st = primitive_rectangle(mesh, size, err);
+        break;
+    }
+    case 4: {
+        double r;
+        unsigned segments;
+        st = load_number(ctx, c, "radius_m", LOAD_POSITIVE, true, 0, &r);
+        if (st == THZ_OK)
+            st = load_segments(ctx, c, &segments);
+        if (st == THZ_OK)
+            st = primitive_disk(mesh, r, segments, err);
+        break;
+    }
+    case 5: {
+        const char *file;
+        st = load_string(ctx, c, "file", true, NULL, &file);
+        if (st != THZ_OK)
+            break;
+        load_cursor k = load_key(c, "file");
+        if (!file[0]) {
+            st = load_fail(ctx, &k, "expected a mesh file name, got an empty string");
+            break;
+        }
+        char *path = load_resolve_path(ctx, file);
+        if (!path) {
+            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+            break;
+        }
+        thz_error inner = {0};
+        st = mesh_import(path, path, mesh, &inner);
+        free(path);
+        if (st == THZ_ERR_INPUT)
+            st = load_fail(ctx, &k, "%s", inner.message);
+        else if (st != THZ_OK)
+            st = thz_error_set(err, st, "%s", inner.message);
+        break;
+    }
+    }
+    return st;
+}
+
+static thz_status load_transform(load_ctx *ctx, const load_cursor *c, thz_mesh *mesh)
+{
+    static const char *const keys[] = {"scale", "rotate_deg", "translate_m", NULL};
+    if (!c->value)
+        return THZ_OK;
+    thz_status st = load_expect_object(ctx, c, keys);
+    if (st != THZ_OK)
+        return st;
+    double scale[3] = {1, 1, 1}, rot[3] = {0, 0, 0}, tr[3] = {0, 0, 0};
+    load_cursor k = load_key(c, "scale");
+    if (json_is_number(k.value)) {
+        st = load_number(ctx, c, "scale", LOAD_ANY, true, 1, &scale[0]);
+        scale[1] = scale[2] = scale[0];
+    } else if (k.value && !json_is_array(k.value)) {
+        return load_fail(ctx, &k, "expected a number or a list of 3 numbers, got %s",
+                         load_type_name(k.value));
+    } else {
+        st = load_vector(ctx, c, "scale", 3, LOAD_ANY, false, scale);
+    }
+    if (st != THZ_OK)
+        return st;
+    for (int i = 0; i < 3; i++)
+        if (scale[i] == 0.0)
+            return load_fail(ctx, &k,
+                             "a scale factor of 0 flattens the object (expected non-zero factors)");
+    st = load_vector(ctx, c, "rotate_deg", 3, LOAD_ANY, false, rot);
+    if (st == THZ_OK)
+        st = load_vector(ctx, c, "translate_m", 3, LOAD_ANY, false, tr);
+    if (st != THZ_OK)
+        return st;
+    scene_transform t = transform_make(scale, rot, tr);
+    transform_apply_mesh(&t, mesh);
+    return THZ_OK;
+}
+
+static thz_status load_object(load_ctx *ctx, const load_cursor *list, size_t index, thz_object *o)
+{
+    static const char *const keys[] = {"name",          "type",        "material",
+                                       "temperature_k", "thickness_m", "two_sided",
+                                       "shape",         "transform",   NULL};
+    static const char *const types[] = {"solid", "shell", NULL};
+    thz_scene *s = ctx->scene;
+    load_cursor e = load_index(list, index);
+    const load_cursor *c = &e;
+    const char *name, *material;
+    size_t type;
+    thz_status st = load_expect_object(ctx, c, keys);
+    if (st == THZ_OK)
+        st = load_unique_name(ctx, list, index, "object", true, &name);
+    if (st != THZ_OK)
+        return st;
+    o->name = thz_strdup(name);
+    if (!o->name)
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    st = load_choice(ctx, c, "type", types, true, 0, &type);
+    if (st == THZ_OK)
+        st = load_string(ctx, c, "material", true, NULL, &material);
+    if (st != THZ_OK)
+        return st;
+    o->type = type == 1 ? OBJECT_SHELL : OBJECT_SOLID;
+    o->material = s->n_materials;
+    for (size_t m = 0; m < s->n_materials; m++)
+        if (strcmp(s->materials[m].name, material) == 0)
+            o->material = m;
+    if (o->material == s->n_materials) {
+        load_cursor k = load_key(c, "material");
+        return load_fail(ctx, &k, "unknown material \"%s\" (expected a key of \"materials\")",
+                         material);
+    }
+    st = load_number(ctx, c, "temperature_k", LOAD_NONNEGATIVE, true, 0, &o->temperature_k);
+    if (st != THZ_OK)
+        return st;
+    load_cursor thick = load_key(c, "thickness_m");
+    if (o->type == OBJECT_SHELL) {
+        if (!thick.value)
+            return load_fail(ctx, &thick,
+                             "missing key (a shell needs its thickness, a number > 0)");
+        st = load_number(ctx, c, "thickness_m", LOAD_POSITIVE, true, 0, &o->thickness_m);
+    } else if (thick.value) {
+        return load_fail(ctx, &thick, "only shells have a thickness (this object is a solid)");
+    }
+    if (st == THZ_OK)
+        st = load_bool(ctx, c, "two_sided", false, &o->two_sided);
+    if (st != THZ_OK)
+        return st;
+    load_cursor shape = load_key(c, "shape");
+    st = load_shape(ctx, &shape, &o->mesh);
+    if (st != THZ_OK)
+        return st;
+    load_cursor transform = load_key(c, "transform");
+    st = load_transform(ctx, &transform, &o->mesh);
+    if (st != THZ_OK)
+        return st;
+    if (!mesh_finalize(&o->mesh))
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(o->mesh.bbox_min_m[k]) || !isfinite(o->mesh.bbox_max_m[k]) ||
+            !isfinite(o->mesh.total_area_m2))
+            return load_fail(
+                ctx, transform.value ? &transform : &shape,
+                "the object's coordinates or area exceed the range of single-precision "
+                "floats (expected sizes in metres well below 1e30)");
+    if (o->mesh.n_triangles == 0 || !(o->mesh.total_area_m2 > 0.0))
+        return load_fail(ctx, &shape, "the shape has no triangles of non-zero area");
+    return THZ_OK;
+}
+
+/* Items are counted as they load (n_objects = i + 1) so that a failure frees them. */
+thz_status load_objects(load_ctx *ctx, const load_cursor *root)
+{
+    thz_scene *s = ctx->scene;
+    load_cursor c;
+    size_t n;
+    thz_status st = load_list(ctx, root, "objects", "object", &c, &n);
+    if (st != THZ_OK)
+        return st;
+    s->objects = thz_calloc(n, sizeof *s->objects);
+    if (!s->objects)
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < n && st == THZ_OK; i++) {
+        s->n_objects = i + 1;
+        st = load_object(ctx, &c, i, &s->objects[i]);
+    }
+    return st;
+}

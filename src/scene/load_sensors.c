@@ -1,0 +1,137 @@
+/* The scene's `sensors` block: pinhole cameras (position, viewing direction, up, angle
+ * of view, resolution, aperture, oversampling, normalisation temperature). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "scene/load.h"
+#include "core/vec3.h"
+
+#define LOAD_MAX_RESOLUTION 65536u
+#define LOAD_MAX_OVERSAMPLING 16u
+
+static thz_status load_resolution(load_ctx *ctx, const load_cursor *c, uint32_t *columns,
+                                  uint32_t *rows)
+{
+    load_cursor k = load_key(c, "resolution");
+    const char *what = "[columns, rows], whole numbers from 1 to 65536";
+    if (!k.value)
+        return load_fail(ctx, &k, "missing key (expected %s)", what);
+    if (!json_is_array(k.value) || json_array_size(k.value) != 2)
+        return load_fail(ctx, &k, "expected %s, got %s", what, load_type_name(k.value));
+    uint32_t v[2];
+    for (size_t i = 0; i < 2; i++) {
+        load_cursor e = load_index(&k, i);
+        double x = json_is_number(e.value) ? json_number_value(e.value) : NAN;
+        if (!json_is_number(e.value) || x != floor(x) || x < 1 || x > LOAD_MAX_RESOLUTION)
+            return load_fail(ctx, &k, "expected %s, got %s%s", what,
+                             json_is_number(e.value) ? "" : load_type_name(e.value),
+                             json_is_number(e.value)
+                                 ? (x < 1                     ? "a value below 1"
+                                    : x > LOAD_MAX_RESOLUTION ? "a value above 65536"
+                                                              : "a fraction")
+                                 : "");
+        v[i] = (uint32_t)x;
+    }
+    *columns = v[0];
+    *rows = v[1];
+    return THZ_OK;
+}
+
+static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t index, thz_sensor *sn)
+{
+    static const char *const keys[] = {
+        "name",       "position_m",  "look_at_m",    "direction",      "up", "fov_deg",
+        "resolution", "aperture_m2", "oversampling", "normalize_to_k", NULL};
+    load_cursor e = load_index(list, index);
+    const load_cursor *c = &e;
+    const char *name;
+    thz_status st = load_expect_object(ctx, c, keys);
+    if (st == THZ_OK)
+        st = load_unique_name(ctx, list, index, "sensor", true, &name);
+    if (st != THZ_OK)
+        return st;
+    sn->name = thz_strdup(name);
+    if (!sn->name)
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    st = load_vector(ctx, c, "position_m", 3, LOAD_ANY, true, sn->position_m);
+    if (st != THZ_OK)
+        return st;
+    load_cursor look = load_key(c, "look_at_m"), dir = load_key(c, "direction");
+    double d[3];
+    if (look.value && dir.value)
+        return load_fail(ctx, &dir, "give either look_at_m or direction, not both");
+    if (!look.value && !dir.value)
+        return load_fail(ctx, c,
+                         "missing key 'look_at_m' or 'direction' (expected a point to "
+                         "look at or a viewing direction, 3 numbers)");
+    if (look.value) {
+        double p[3];
+        st = load_vector(ctx, c, "look_at_m", 3, LOAD_ANY, true, p);
+        for (int i = 0; i < 3; i++)
+            d[i] = p[i] - sn->position_m[i];
+    } else {
+        st = load_vector(ctx, c, "direction", 3, LOAD_ANY, true, d);
+    }
+    if (st != THZ_OK)
+        return st;
+    vec3 dv = v3_from_array(d);
+    if (!(v3_length(dv) > 0.0) || !isfinite(v3_length(dv)))
+        return load_fail(ctx, look.value ? &look : &dir,
+                         look.value ? "the point to look at is the sensor's position (expected "
+                                      "a different point)"
+                                    : "expected a non-zero direction");
+    dv = v3_normalize(dv);
+    double up[3] = {0, 0, 1};
+    st = load_vector(ctx, c, "up", 3, LOAD_ANY, false, up);
+    if (st != THZ_OK)
+        return st;
+    vec3 uv = v3_from_array(up);
+    load_cursor up_c = load_key(c, "up");
+    double ul = v3_length(uv);
+    if (!(ul > 0.0) || !isfinite(ul))
+        return load_fail(ctx, &up_c, "expected a non-zero up vector");
+    uv = v3_scale(uv, 1.0 / ul);
+    if (v3_length(v3_cross(dv, uv)) < 1e-6)
+        return load_fail(ctx, &up_c,
+                         "the up vector is parallel to the viewing direction "
+                         "(expected a vector not parallel to it, default [0, 0, 1])");
+    sn->direction[0] = dv.x, sn->direction[1] = dv.y, sn->direction[2] = dv.z;
+    sn->up[0] = uv.x, sn->up[1] = uv.y, sn->up[2] = uv.z;
+    const load_range fov = {0.0, 180.0, true, true};
+    uint64_t over;
+    st = load_number(ctx, c, "fov_deg", fov, true, 0, &sn->fov_deg);
+    if (st == THZ_OK)
+        st = load_resolution(ctx, c, &sn->columns, &sn->rows);
+    if (st == THZ_OK)
+        st = load_number(ctx, c, "aperture_m2", LOAD_POSITIVE, false, 1e-2, &sn->aperture_m2);
+    if (st == THZ_OK)
+        st = load_integer(ctx, c, "oversampling", 1, LOAD_MAX_OVERSAMPLING, false, 1, &over);
+    if (st == THZ_OK)
+        st =
+            load_number(ctx, c, "normalize_to_k", LOAD_POSITIVE, false, 295.0, &sn->normalize_to_k);
+    if (st != THZ_OK)
+        return st;
+    sn->oversampling = (uint32_t)over;
+    return THZ_OK;
+}
+
+thz_status load_sensors(load_ctx *ctx, const load_cursor *root)
+{
+    thz_scene *s = ctx->scene;
+    load_cursor c;
+    size_t n;
+    thz_status st = load_list(ctx, root, "sensors", "sensor", &c, &n);
+    if (st != THZ_OK)
+        return st;
+    s->sensors = thz_calloc(n, sizeof *s->sensors);
+    if (!s->sensors)
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < n && st == THZ_OK; i++) {
+        s->n_sensors = i + 1;
+        st = load_sensor(ctx, &c, i, &s->sensors[i]);
+    }
+    return st;
+}

@@ -1,0 +1,40 @@
+/* Plausibility checks of a loaded scene: the mistakes that load without an error and
+ * give wrong answers that look right (temperatures in degrees Celsius, a mesh in
+ * millimetres in a room in metres, GHz given as THz, a sensor outside the enclosure or
+ * inside a solid, non-emitting absorbing air, a background no ray can see). Each adds
+ * a scene warning (validate prints them; simulate prints and records them).
+ *
+ * Geometry is judged from the meshes alone: an object is closed when every edge (by
+ * vertex position) is shared by exactly two triangles; a closed object with inward
+ * normals (negative signed volume) is an enclosure; a point is inside a closed mesh
+ * when a ray from it crosses the mesh an odd number of times.
+ */
+#ifndef THZ_SCENE_SCENE_CHECKS_H
+#define THZ_SCENE_SCENE_CHECKS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "scene/scene.h"
+
+/* Frequencies thzmap's models are meant for; channels outside get a warning. */
+#define SCENE_CHECK_MIN_THZ 0.05
+#define SCENE_CHECK_MAX_THZ 10.0
+/* An object whose bounding box diagonal exceeds this times the enclosure's (or, without
+ * one, the median object's) is taken for a unit mistake. */
+#define SCENE_CHECK_SCALE_RATIO 100.0
+
+/* What the loader knew of the atmosphere block, beyond the scene. */
+typedef struct scene_check_inputs {
+    bool non_emitting_air; /* "emitting": false given */
+    bool background_given; /* background_temperature_k given */
+} scene_check_inputs;
+
+/* The innermost enclosure containing every sensor, or SIZE_MAX when there is none (then
+ * rays can leave the scene). Sets *ok = false on allocation failure. */
+size_t scene_checks_enclosure(const thz_scene *scene, bool *ok);
+
+/* Adds the warnings (and marks misplaced sensors). False only on allocation failure. */
+bool scene_checks_run(thz_scene *scene, const scene_check_inputs *in);
+
+#endif

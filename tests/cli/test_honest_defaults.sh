@@ -1,0 +1,120 @@
+#!/usr/bin/env bash
+# A newcomer's run (issue 13): scene warnings for the usual unit and placement mistakes
+# (each triggered by a scene made for it, none on the shipped examples), warnings printed
+# in full on stderr also with --quiet, the estimate before the run, the noise figures
+# (median and 95th percentile per channel and per object, the noisiest object named on
+# the last line with its unit) and the command-line items (--photons 1e6, an option
+# given as a value, a run too large for the machine exits 2).
+# argv: path to the thzmap binary, repository directory.
+set -u
+THZMAP=$1
+REPO=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+
+# variants of one small scene: NAME and a Python statement changing the dict `s`
+make_scene() {
+python3 - "$work/$1.json" "$2" <<'PY'
+import json, sys
+s = {"format": "thzmap-scene/1",
+     "channels": [{"frequency_thz": 0.35, "relative_width": 0.02}],
+     "materials": {"wall": {"reflectivity": 0.1}, "metal": {"reflectivity": 0.9}},
+     "atmosphere": {"model": "constant", "attenuation_per_m": 0.05},
+     "objects": [
+       {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+        "shape": {"type": "box", "size_m": [2, 2, 2], "inward": True}},
+       {"name": "target", "type": "solid", "material": "metal", "temperature_k": 310,
+        "shape": {"type": "box", "size_m": [0.4, 0.4, 0.4]},
+        "transform": {"translate_m": [0, 0.5, 0]}}],
+     "sensors": [{"name": "cam", "position_m": [0, -0.9, 0], "direction": [0, 1, 0],
+                  "fov_deg": 60, "resolution": [12, 10]}]}
+exec(sys.argv[2])
+json.dump(s, open(sys.argv[1], "w"))
+PY
+}
+
+make_scene plain "pass"
+make_scene celsius "s['objects'][0]['temperature_k'] = 22; s['objects'][1]['temperature_k'] = 37"
+make_scene millimetres "s['objects'][1]['transform']['scale'] = 1000"
+make_scene ghz "s['channels'][0]['frequency_thz'] = 350"
+make_scene outside "s['sensors'][0]['position_m'] = [0, -3, 0]"
+make_scene inside "s['sensors'][0]['position_m'] = [0, 0.5, 0]"
+make_scene nonemitting "s['atmosphere']['emitting'] = False"
+make_scene background "s['atmosphere']['background_temperature_k'] = 3"
+
+check_warning() { # $1: scene, $2: text the warning must contain
+    "$THZMAP" validate "$work/$1.json" > /dev/null 2> "$work/$1.err" ||
+        fail "$1: validate failed: $(cat "$work/$1.err")"
+    grep -q "^warning: .*$2" "$work/$1.err" || fail "$1: no warning with '$2': $(cat "$work/$1.err")"
+}
+check_warning celsius "look like degrees Celsius"
+check_warning millimetres "scales differ by orders of magnitude"
+check_warning ghz "outside 0.05 to 10 THz"
+check_warning outside 'sensor "cam" .* is outside the enclosure "room"'
+check_warning inside 'sensor "cam" .* is inside object "target"'
+check_warning nonemitting "breaks equilibrium"
+check_warning background "no ray leaves the scene"
+"$THZMAP" validate "$work/plain.json" > /dev/null 2> "$work/plain.err"
+[ -s "$work/plain.err" ] && fail "the plain scene warns: $(cat "$work/plain.err")"
+for ex in "$REPO"/examples/*/scene.json; do
+    "$THZMAP" validate "$ex" > /dev/null 2> "$work/ex.err" || fail "$ex does not validate"
+    [ -s "$work/ex.err" ] && fail "$ex warns: $(cat "$work/ex.err")"
+done
+
+# --- warnings on stderr in full, also with --quiet; the misplaced sensor's back faces
+# are not blamed on the normals ------------------------------------------------------------
+"$THZMAP" simulate "$work/outside.json" -o "$work/out-outside" --quiet \
+    > "$work/o.out" 2> "$work/o.err" || fail "simulate outside: $(cat "$work/o.err")"
+grep -q "warning: sensor \"cam\" .* is outside the enclosure" "$work/o.err" ||
+    fail "--quiet hid the scene warning: $(cat "$work/o.err")"
+grep -q "warning: sensor 'cam': .* back side" "$work/o.err" ||
+    fail "the run warning is not printed in full: $(cat "$work/o.err")"
+grep -q "mesh normals" "$work/o.err" && fail "a misplaced sensor's warning blames the normals"
+grep -q "see .*summary.json" "$work/o.err" && fail "warnings point to summary.json instead"
+grep -q "channel 1/1" "$work/o.err" && fail "--quiet printed progress"
+
+# --- estimate, noise figures, last line ---------------------------------------------------
+"$THZMAP" simulate "$work/plain.json" -o "$work/out-plain" > "$work/p.out" 2> "$work/p.err" ||
+    fail "simulate plain: $(cat "$work/p.err")"
+grep -q "estimate: .* s .*memory .* GiB" "$work/p.err" || fail "no estimate: $(cat "$work/p.err")"
+tail -1 "$work/p.out" | grep -q "noisiest object: '.*', 95th percentile standard error [0-9.e-]* K" ||
+    fail "last line: $(tail -1 "$work/p.out")"
+python3 - "$work/out-plain/summary.json" <<'PY' || fail "summary.json noise figures"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["integrator"] == "path", d["integrator"]
+assert d["target_noise_k"] == 0.1 and d["target_noise_source"] == "default", d["target_noise_k"]
+for c in d["channels"]:
+    assert c["p95_stderr_k"] >= c["median_stderr_k"] >= 0, c
+    assert c["p95_stderr_k"] <= 0.1, c  # the default target was reached
+    objs = {o["name"]: o for o in c["objects"]}
+    assert set(objs) == {"room", "target"}, objs
+    assert objs["target"]["pixels"] > 0 and objs["room"]["pixels"] > 0
+    assert objs["target"]["pixels"] + objs["room"]["pixels"] <= 12 * 10
+    for o in objs.values():
+        assert o["p95_stderr_k"] >= o["median_stderr_k"] >= 0, o
+PY
+
+# --- command line -------------------------------------------------------------------------
+"$THZMAP" simulate "$work/plain.json" -o "$work/out-e" --integrator photon-map --photons 2e4 \
+    --quiet > /dev/null 2> "$work/e.err" || fail "--photons 2e4 refused: $(cat "$work/e.err")"
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['photons_per_channel'] == 20000 and d['target_noise_k'] is None" \
+    "$work/out-e/summary.json" || fail "--photons 2e4: not 20000 photons in one pass"
+"$THZMAP" simulate "$work/plain.json" -o "$work/out-f" --photons 2.5e4.5 2> /dev/null
+[ $? -eq 2 ] || fail "--photons 2.5e4.5 should exit 2"
+"$THZMAP" simulate "$work/plain.json" -o "$work/out-f" --photons 1.5 2> /dev/null
+[ $? -eq 2 ] || fail "--photons 1.5 (not whole) should exit 2"
+(cd "$work" && "$THZMAP" simulate plain.json -o --quiet 2> q.err)
+[ $? -eq 2 ] || fail "-o --quiet should exit 2"
+[ -e "$work/--quiet" ] && fail "-o --quiet created a directory named --quiet"
+grep -q "needs a value" "$work/q.err" || fail "-o --quiet message: $(cat "$work/q.err")"
+make_scene huge "s['sensors'][0]['resolution'] = [65536, 65536]; s['channels'] = {'from_thz': 0.2, 'to_thz': 1.2, 'count': 400, 'relative_width': 0.01}"
+"$THZMAP" simulate "$work/huge.json" -o "$work/out-h" --quiet 2> "$work/h.err"
+[ $? -eq 2 ] || fail "a run too large for the machine should exit 2"
+grep -q "sensors\[0\].resolution" "$work/h.err" || fail "too large: $(cat "$work/h.err")"
+"$THZMAP" simulate --help | grep -q "95th" || fail "--help does not say the target is the 95th percentile"
+
+[ $fails -eq 0 ] && echo "honest defaults: all checks passed"
+exit $((fails > 0))
