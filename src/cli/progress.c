@@ -14,8 +14,12 @@ static volatile sig_atomic_t cli_interrupted = 0;
 
 static void cli_on_signal(int sig)
 {
-    (void)sig;
-    cli_interrupted = 1;
+    cli_interrupted = sig;
+}
+
+int cli_interrupt_signal(void)
+{
+    return (int)cli_interrupted;
 }
 
 void cli_signals_install(void)

@@ -53,4 +53,8 @@ void cli_progress_finish(cli_progress *p);
 /* Installs the SIGINT/SIGTERM handler (one-shot: a second signal kills at once). */
 void cli_signals_install(void);
 
+/* The signal that interrupted the run (SIGINT, SIGTERM), 0 if none: the exit status is
+ * 128 + it, the shell's convention (130 for Ctrl-C, 143 for SIGTERM). */
+int cli_interrupt_signal(void);
+
 #endif

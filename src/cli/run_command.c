@@ -245,7 +245,7 @@ int cli_run_command(int argc, char **argv, bool render)
 
     if (st == THZ_ERR_CANCELLED) {
         fprintf(stderr, "thzmap %s: interrupted; no results written to %s\n", cmd, a.outdir);
-        rc = CLI_EXIT_INTERRUPTED;
+        rc = cli_interrupt_signal() ? 128 + cli_interrupt_signal() : CLI_EXIT_INTERRUPTED;
     } else if (st != THZ_OK) {
         rc = cli_fail(&err);
     } else {

@@ -3,7 +3,7 @@
 #  - outputs are byte-identical for --threads 1 and 2 (every file but summary.json);
 #  - render from a saved photon map reproduces simulate's images byte for byte, and
 #    --sensor renders one sensor only;
-#  - SIGINT during a run exits 130 and leaves no result files in OUTDIR;
+#  - SIGINT during a run exits 130, SIGTERM 143, and neither leaves result files in OUTDIR;
 #  - render refuses a photon map made from another scene;
 #  - usage errors exit 2.
 # argv: path to the thzmap binary, repository directory.
@@ -133,6 +133,25 @@ if kill -0 "$pid" 2>/dev/null; then
 else
     wait "$pid"
     fail "the run meant to be interrupted finished within 1.5 s"
+fi
+
+# SIGTERM is handled like SIGINT (clean up, say so) and exits 128 + 15 = 143.
+"$THZMAP" simulate "$work/scene.json" -o "$work/term" --photons 20000000 --threads 2 \
+    2> "$work/term.err" &
+pid=$!
+sleep 1.5
+if kill -0 "$pid" 2>/dev/null; then
+    t0=$(date +%s%N)
+    kill -TERM "$pid"
+    wait "$pid"
+    rc=$?
+    echo "SIGTERM to exit: $(( ($(date +%s%N) - t0) / 1000000 )) ms"
+    [ $rc -eq 143 ] || fail "simulate ended by SIGTERM exited $rc, expected 143"
+    [ ! -e "$work/term" ] || fail "a run ended by SIGTERM left OUTDIR behind: $(ls -A "$work/term")"
+    grep -q interrupted "$work/term.err" || fail "a run ended by SIGTERM did not say so"
+else
+    wait "$pid"
+    fail "the run meant to be ended by SIGTERM finished within 1.5 s"
 fi
 
 # --- a run that cannot fit in memory is refused before it starts --------------------------
