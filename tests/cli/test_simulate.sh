@@ -213,11 +213,12 @@ for c in s["channels"]:
 PY
 done
 # photon-map with a noise target fires photon passes of --photons each and renders from
-# all of them: several passes (one gives ~7 K here), the target met, thread-count
+# all of them: several passes (the 95th percentile the target aims at is ~20 K after 9-26
+# passes here; 5 K took ~450 passes, 5 minutes), the target met, thread-count
 # independent, and render from the saved merged map reproduces the images byte for byte
 for t in 1 2; do
     "$THZMAP" simulate "$work/scene.json" -o "$work/pmn$t" --photons 5000 --threads $t \
-        --target-noise-k 5 --save-photon-map --quiet \
+        --target-noise-k 20 --save-photon-map --quiet \
         || fail "simulate photon-map --target-noise-k exited $?"
 done
 diff -r -q --exclude=summary.json "$work/pmn1" "$work/pmn2" \
@@ -226,7 +227,7 @@ python3 - "$work/pmn1/summary.json" <<'PY' || fail "photon-map: noise target not
 import json, sys
 s = json.load(open(sys.argv[1]))
 for c in s["channels"]:
-    assert c["median_stderr_k"] <= 5.0, c
+    assert c["median_stderr_k"] <= c["p95_stderr_k"] <= 20.0, c
     assert c["render_passes"] > 1, c
     assert c["photons_fired"] == 5000 * c["render_passes"], c
 PY
