@@ -150,16 +150,23 @@ class PhotonMap:
                 f"{self.photons_per_channel} photons per channel, seed {self.seed}>")
 
 
-def _photons_call(call, fn, scene):
+def _owned_call(call, fn, scene, destroy, *keep):
+    """Calls fn(&out) and returns out as a Handle that destroys it, keeping `keep`
+    alive; on failure destroys whatever fn left in out and raises."""
     out = ctypes.c_void_p()
     status = fn(ctypes.byref(out))
     try:
         call.check(status, scene.label)
     except BaseException:
         if out.value:
-            _lib.lib.thz_photons_destroy(out.value)
+            destroy(out.value)
         raise
-    return PhotonMap(_lib.Handle(out.value, _lib.lib.thz_photons_destroy, scene), out.value, scene)
+    return _lib.Handle(out.value, destroy, scene, *keep)
+
+
+def _photons_call(call, fn, scene):
+    handle = _owned_call(call, fn, scene, _lib.lib.thz_photons_destroy)
+    return PhotonMap(handle, handle.ptr, scene)
 
 
 def fire_photons(scene, integrator=None, photons=None, seed=None, first_photon=0,
@@ -350,15 +357,8 @@ class Result:
 
 
 def _run_call(call, fn, scene, photons=None):
-    out = ctypes.c_void_p()
-    status = fn(ctypes.byref(out))
-    try:
-        call.check(status, scene.label)
-    except BaseException:
-        if out.value:
-            _lib.lib.thz_run_destroy(out.value)
-        raise
-    return Result(_lib.Handle(out.value, _lib.lib.thz_run_destroy, scene, photons), scene, photons)
+    handle = _owned_call(call, fn, scene, _lib.lib.thz_run_destroy, photons)
+    return Result(handle, scene, photons)
 
 
 def simulate(scene, integrator=None, photons=None, seed=None, threads=None,

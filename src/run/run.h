@@ -203,5 +203,4 @@ void run_state_fini(run_state *rs);
  * deviation map takes the renderer's reference temperature, photon-map 0. */
 double run_photon_t0_k(const thz_scene *scene, size_t c);
 
-
 #endif
