@@ -42,6 +42,11 @@ double channel_bandwidth_hz(const thz_channel *ch)
     return channel_sigma_hz(ch) * CHANNEL_SQRT_2PI;
 }
 
+double channel_noise_bandwidth_hz(const thz_channel *ch)
+{
+    return 2.0 * sqrt(M_PI) * channel_sigma_hz(ch);
+}
+
 double channel_response(const thz_channel *ch, double freq_hz)
 {
     double s = channel_sigma_hz(ch);

@@ -22,6 +22,10 @@ double channel_sigma_hz(const thz_channel *ch);
 /* Equivalent bandwidth B_c = int g_c dnu = sigma_c sqrt(2 pi), in Hz. */
 double channel_bandwidth_hz(const thz_channel *ch);
 
+/* Noise bandwidth B_n = (int g_c dnu)^2 / int g_c^2 dnu in Hz (scene-format.md "Sensors:
+ * optics and noise"): 2 sqrt(pi) sigma_c = 1.5054 FWHM for the Gaussian. */
+double channel_noise_bandwidth_hz(const thz_channel *ch);
+
 /* g_c(freq_hz), 1 at the centre. */
 double channel_response(const thz_channel *ch, double freq_hz);
 

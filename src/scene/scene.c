@@ -53,6 +53,7 @@ void scene_destroy(thz_scene *s)
         spectrum_fini(&m->reflectivity);
         spectrum_fini(&m->attenuation_per_m);
         spectrum_fini(&m->emissivity);
+        material_index_destroy(m->index);
     }
     free(s->materials);
     for (size_t i = 0; i < s->n_objects; i++) {

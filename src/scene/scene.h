@@ -12,10 +12,18 @@
 #include "atmosphere/atmosphere.h"
 #include "core/error.h"
 #include "physics/channel.h"
+#include "physics/material_index.h"
 #include "physics/optics.h"
 #include "physics/spectrum.h"
 
 typedef enum thz_transmission { TRANSMISSION_DIFFUSE = 0, TRANSMISSION_STRAIGHT } thz_transmission;
+
+/* The `reflection` key: Lambertian (default), mirror, or Ward's anisotropic lobe. */
+typedef enum thz_reflection {
+    REFLECTION_DIFFUSE = 0,
+    REFLECTION_SPECULAR,
+    REFLECTION_WARD
+} thz_reflection;
 
 typedef struct thz_material {
     char *name;
@@ -23,7 +31,11 @@ typedef struct thz_material {
     thz_spectrum attenuation_per_m; /* alpha_M(nu), default constant 0 */
     thz_spectrum emissivity;        /* explicit eps(nu); n == 0 means Kirchhoff */
     thz_transmission transmission;  /* shells: diffuse (default) or straight */
-    double color[3];                /* rgb 0..1 for the visual truth image */
+    material_index *index;          /* n + ik (refractive_index, permittivity_model or library);
+                                       NULL: the R, alpha_M, eps tables alone */
+    thz_reflection reflection;
+    double ward_alpha[2]; /* Ward's alpha_x, alpha_y (REFLECTION_WARD) */
+    double color[3];      /* rgb 0..1 for the visual truth image */
 } thz_material;
 
 typedef enum thz_object_type { OBJECT_SOLID = 0, OBJECT_SHELL } thz_object_type;
