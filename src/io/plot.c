@@ -1,15 +1,17 @@
 /* PLplot figures (pngcairo): channel previews, per-object spectra and attenuation
  * spectra.
  *
- * PLplot is global state; plot_lock serialises every use of it (see plot.h). Each
- * figure is one complete plinit ... plend session, so no PLplot state survives from
- * one figure to the next.
+ * PLplot, and the cairo, fontconfig and GLib it draws with, end the process (exit() or
+ * abort()) or deadlock when an allocation fails, and PLplot also exits on some errors.
+ * So PLplot never runs in the caller's process, which may hold a run's staging files:
+ * every figure, and the device check, is drawn in a child process (core/child.h) that
+ * writes the PNG and reports its status. Each child runs one plinit ... plend session
+ * on its own copy of PLplot's global state, so figures need no lock.
  */
 #include "io/plot.h"
 
 #include <errno.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,14 +21,19 @@
 #include <plplot/plplot.h>
 
 #include "core/alloc.h"
+#include "core/child.h"
 
 /* A filled circle (U+25CF) marks each data point; cairo renders UTF-8 text. */
 #define PLOT_MARK "\xe2\x97\x8f"
 
-/* The one static of the module: PLplot cannot draw two figures at once. */
-static pthread_mutex_t plot_lock = PTHREAD_MUTEX_INITIALIZER;
-
 enum { PLOT_MAX_DEVICES = 256, PLOT_TEXT = 512, PLOT_GRID_COLOR = 15 };
+
+/* How long a figure may take before its child is killed (a deadlocked GLib): far
+ * beyond a normal figure (well under 1 s), plus time for the cells of a large image. */
+static double plot_timeout_s(size_t cells)
+{
+    return 60.0 + 2e-6 * (double)cells;
+}
 
 /* Colour stops of the perceptual "viridis" map (van der Walt and Smith, 2015), taken
  * at 0, 1/8, ..., 1 and interpolated linearly in RGB: dark blue-violet to yellow, with
@@ -60,9 +67,10 @@ static int plot_compare_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Caller holds plot_lock. */
-static thz_status plot_check_device_locked(thz_error *err)
+/* In the child. */
+static thz_status plot_check_device_child(void *arg, thz_error *err)
 {
+    (void)arg;
     /* PLplot exits the process when its driver directory holds no driver at all, so a
      * directory set by the user is checked for the cairo driver before PLplot looks. */
     const char *drv_dir = getenv("PLPLOT_DRV_DIR");
@@ -89,18 +97,16 @@ static thz_status plot_check_device_locked(thz_error *err)
 
 thz_status plot_check_device(thz_error *err)
 {
-    pthread_mutex_lock(&plot_lock);
-    thz_status status = plot_check_device_locked(err);
-    pthread_mutex_unlock(&plot_lock);
-    return status;
+    return child_run("checking PLplot's devices", plot_check_device_child, NULL, plot_timeout_s(0),
+                     err);
 }
 
 /* Starts a figure of width x height pixels into path: checks the device and that the
  * file can be created (PLplot prompts on stdin and exits when it cannot open it),
- * sets a white background with black text. Caller holds plot_lock. */
+ * sets a white background with black text. In the child. */
 static thz_status plot_begin(const char *path, int width, int height, thz_error *err)
 {
-    thz_status status = plot_check_device_locked(err);
+    thz_status status = plot_check_device_child(NULL, err);
     if (status != THZ_OK)
         return status;
     FILE *f = fopen(path, "wb");
@@ -118,7 +124,7 @@ static thz_status plot_begin(const char *path, int width, int height, thz_error 
     return THZ_OK;
 }
 
-/* Finishes the figure and checks the file was written. Caller holds plot_lock. */
+/* Finishes the figure and checks the file was written. In the child. */
 static thz_status plot_end(const char *path, thz_error *err)
 {
     plend();
@@ -148,8 +154,10 @@ static void plot_set_viridis(void)
     plscmap1l(1, N, pos, r, g, b, NULL);
 }
 
-thz_status plot_image(const char *path, const float *values, uint32_t columns, uint32_t rows,
-                      const char *title, const char *value_label, thz_error *err)
+/* plot_image's figure, in the child. */
+static thz_status plot_image_draw(const char *path, const float *values, uint32_t columns,
+                                  uint32_t rows, const char *title, const char *value_label,
+                                  thz_error *err)
 {
     if (columns == 0 || rows == 0)
         return thz_error_set(err, THZ_ERR_INTERNAL, "%s: empty image", path);
@@ -201,7 +209,6 @@ thz_status plot_image(const char *path, const float *values, uint32_t columns, u
     plot_escape(t_title, sizeof t_title, title);
     snprintf(t_label, sizeof t_label, "%s", value_label);
 
-    pthread_mutex_lock(&plot_lock);
     /* Square pixels: the plot area follows the image's aspect ratio. */
     double aspect = (double)rows / columns;
     int width = 720;
@@ -235,7 +242,6 @@ thz_status plot_image(const char *path, const float *values, uint32_t columns, u
                    sub_ticks, n_values, (PLFLT_MATRIX)value_rows);
         status = plot_end(path, err);
     }
-    pthread_mutex_unlock(&plot_lock);
 cleanup:
     free(sorted);
     free(cols);
@@ -243,9 +249,10 @@ cleanup:
     return status;
 }
 
-thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
-                      const char *const *names, const double *y, const char *title,
-                      const char *x_label, const char *y_label, thz_error *err)
+/* plot_lines's figure, in the child. */
+static thz_status plot_lines_draw(const char *path, size_t n_x, const double *x, size_t n_lines,
+                                  const char *const *names, const double *y, const char *title,
+                                  const char *x_label, const char *y_label, thz_error *err)
 {
     thz_status status = THZ_OK;
     PLFLT *px = thz_malloc_array(n_x ? n_x : 1, sizeof *px);
@@ -307,7 +314,6 @@ thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_li
     char t_title[PLOT_TEXT];
     plot_escape(t_title, sizeof t_title, title);
 
-    pthread_mutex_lock(&plot_lock);
     status = plot_begin(path, 960, 600, err);
     if (status == THZ_OK) {
         for (int i = 0; i < 10; i++)
@@ -356,7 +362,6 @@ thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_li
         }
         status = plot_end(path, err);
     }
-    pthread_mutex_unlock(&plot_lock);
 cleanup:
     if (texts)
         for (size_t i = 0; i < n_lines; i++)
@@ -381,10 +386,11 @@ static double plot_log(double v, double floor_log)
     return v > 0.0 ? fmax(log10(v), floor_log) : floor_log;
 }
 
-thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_t n_curves,
-                            const plot_curve *curves, size_t n_bands, const plot_band *bands,
-                            const char *title, const char *x_label, const char *y_label,
-                            thz_error *err)
+/* plot_attenuation's figure, in the child. */
+static thz_status plot_attenuation_draw(const char *path, size_t n_x, const double *x,
+                                        size_t n_curves, const plot_curve *curves, size_t n_bands,
+                                        const plot_band *bands, const char *title,
+                                        const char *x_label, const char *y_label, thz_error *err)
 {
     if (n_x == 0 || n_curves == 0)
         return thz_error_set(err, THZ_ERR_INTERNAL, "%s: nothing to plot", path);
@@ -431,7 +437,6 @@ thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_
     char t_title[PLOT_TEXT], t_band[PLOT_TEXT];
     plot_escape(t_title, sizeof t_title, title);
 
-    pthread_mutex_lock(&plot_lock);
     status = plot_begin(path, 1200, 750, err);
     if (status == THZ_OK) {
         plscol0a(BAND_FILL, 200, 200, 200, 0.35);
@@ -482,7 +487,6 @@ thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_
                  (PLCHAR_MATRIX)symbols);
         status = plot_end(path, err);
     }
-    pthread_mutex_unlock(&plot_lock);
 cleanup:
     free(py);
     free(texts);
@@ -494,4 +498,93 @@ cleanup:
     free(widths);
     free(zeros_f);
     return status;
+}
+
+/* ---- the figures, each drawn in a child process ------------------------------------ */
+
+/* Every argument of a figure, passed to its child (which sees the caller's memory). */
+typedef struct plot_args {
+    const char *path, *title, *x_label, *y_label;
+    const float *values;
+    uint32_t columns, rows;
+    size_t n_x, n_lines, n_bands;
+    const double *x, *y;
+    const char *const *names;
+    const plot_curve *curves;
+    const plot_band *bands;
+} plot_args;
+
+static thz_status plot_image_child(void *arg, thz_error *err)
+{
+    const plot_args *a = arg;
+    return plot_image_draw(a->path, a->values, a->columns, a->rows, a->title, a->y_label, err);
+}
+
+static thz_status plot_lines_child(void *arg, thz_error *err)
+{
+    const plot_args *a = arg;
+    return plot_lines_draw(a->path, a->n_x, a->x, a->n_lines, a->names, a->y, a->title, a->x_label,
+                           a->y_label, err);
+}
+
+static thz_status plot_attenuation_child(void *arg, thz_error *err)
+{
+    const plot_args *a = arg;
+    return plot_attenuation_draw(a->path, a->n_x, a->x, a->n_lines, a->curves, a->n_bands, a->bands,
+                                 a->title, a->x_label, a->y_label, err);
+}
+
+/* Runs a figure's child; "plotting PATH" names it in the messages. */
+static thz_status plot_in_child(const char *path, child_fn fn, plot_args *a, size_t cells,
+                                thz_error *err)
+{
+    char what[PLOT_TEXT];
+    snprintf(what, sizeof what, "plotting %s", path);
+    return child_run(what, fn, a, plot_timeout_s(cells), err);
+}
+
+thz_status plot_image(const char *path, const float *values, uint32_t columns, uint32_t rows,
+                      const char *title, const char *value_label, thz_error *err)
+{
+    plot_args a = {.path = path,
+                   .values = values,
+                   .columns = columns,
+                   .rows = rows,
+                   .title = title,
+                   .y_label = value_label};
+    return plot_in_child(path, plot_image_child, &a, (size_t)columns * rows, err);
+}
+
+thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
+                      const char *const *names, const double *y, const char *title,
+                      const char *x_label, const char *y_label, thz_error *err)
+{
+    plot_args a = {.path = path,
+                   .n_x = n_x,
+                   .x = x,
+                   .n_lines = n_lines,
+                   .names = names,
+                   .y = y,
+                   .title = title,
+                   .x_label = x_label,
+                   .y_label = y_label};
+    return plot_in_child(path, plot_lines_child, &a, n_x * n_lines, err);
+}
+
+thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_t n_curves,
+                            const plot_curve *curves, size_t n_bands, const plot_band *bands,
+                            const char *title, const char *x_label, const char *y_label,
+                            thz_error *err)
+{
+    plot_args a = {.path = path,
+                   .n_x = n_x,
+                   .x = x,
+                   .n_lines = n_curves,
+                   .curves = curves,
+                   .n_bands = n_bands,
+                   .bands = bands,
+                   .title = title,
+                   .x_label = x_label,
+                   .y_label = y_label};
+    return plot_in_child(path, plot_attenuation_child, &a, n_x * n_curves, err);
 }

@@ -3,10 +3,12 @@
  * (one line per object against frequency, as the paper's Fig. 6), and the
  * attenuation spectrum of `thzmap atmosphere --plot` (log axis, shaded channels).
  *
- * Thread safety: PLplot keeps global state and can draw one figure at a time, so
- * every function here holds one process-wide mutex (the module's only static) while
- * it talks to PLplot. Figures drawn from several threads are therefore serialised;
- * code outside this file must not call PLplot itself.
+ * Every figure (and the device check) is drawn in a child process (core/child.h):
+ * PLplot, cairo, fontconfig and GLib end the process or deadlock when memory runs out,
+ * so they never run in the caller's process. PLplot's global state therefore lives in
+ * the child only, and figures may be drawn from several threads at once; code outside
+ * this file must not call PLplot itself. A child that fails, dies or takes too long
+ * (then killed) gives an error "... while plotting PATH ..." (THZ_ERR_IO).
  */
 #ifndef THZ_IO_PLOT_H
 #define THZ_IO_PLOT_H

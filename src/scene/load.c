@@ -282,8 +282,13 @@ static thz_status load_finish(thz_scene **scene, json_t *doc, thz_status st, thz
     return st;
 }
 
-static thz_status load_syntax_error(const char *label, const json_error_t *je, thz_error *err)
+/* The error of a failed parse: out of memory, or the syntax error jansson found. */
+static thz_status load_syntax_error(const char *label, const json_error_t *je, bool out_of_memory,
+                                    thz_error *err)
 {
+    if (out_of_memory)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while parsing the scene",
+                             label);
     if (je->line > 0)
         return thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s", label, je->line,
                              je->column, je->text);
@@ -298,14 +303,17 @@ thz_status scene_load(const char *path, thz_scene **out, thz_error *err)
     if (stat(path, &info) == 0 && S_ISDIR(info.st_mode))
         return thz_error_set(err, THZ_ERR_INPUT, "%s: is a directory, expected a scene file", path);
     FILE *f = fopen(path, "rb");
+    if (!f && errno == ENOMEM)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while opening the scene", path);
     if (!f)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open scene file: %s", path,
                              strerror(errno));
-    fclose(f);
     json_error_t je;
-    json_t *doc = json_load_file(path, JSON_REJECT_DUPLICATES, &je);
+    bool oom = false;
+    json_t *doc = load_json_parse(f, NULL, &je, &oom);
+    fclose(f);
     if (!doc)
-        return load_syntax_error(path, &je, err);
+        return load_syntax_error(path, &je, oom, err);
     char *copy = thz_strdup(path);
     if (!copy) {
         json_decref(doc);
@@ -324,9 +332,10 @@ thz_status scene_load_string(const char *json_text, const char *base_dir, const 
     if (!label)
         label = "<scene>";
     json_error_t je;
-    json_t *doc = json_loads(json_text, JSON_REJECT_DUPLICATES, &je);
+    bool oom = false;
+    json_t *doc = load_json_parse(NULL, json_text, &je, &oom);
     if (!doc)
-        return load_syntax_error(label, &je, err);
+        return load_syntax_error(label, &je, oom, err);
     thz_status st = load_begin(label, base_dir ? base_dir : ".", out, err);
     return load_finish(out, doc, st, err);
 }

@@ -15,11 +15,18 @@
 
 #include <jansson.h>
 #include <math.h>
+#include <stdio.h>
 
 #include "core/error.h"
 #include "physics/spectrum.h"
 #include "core/csv.h"
 #include "scene/scene.h"
+
+/* Parses the JSON text of file f (or, when f is NULL, the string text), rejecting
+ * duplicate keys. NULL on failure: *out_of_memory then says whether memory ran out
+ * (never reported as a syntax error), otherwise je holds the syntax error
+ * (load_json.c). */
+json_t *load_json_parse(FILE *f, const char *text, json_error_t *je, bool *out_of_memory);
 
 /* Long enough for any path a sane scene produces; longer ones are cut (messages only). */
 #define LOAD_PATH_MAX 512

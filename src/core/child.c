@@ -1,0 +1,112 @@
+/* Work in a child process (child.h). */
+#define _GNU_SOURCE /* pipe2 */
+#include "core/child.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <stdbool.h>
+#include <signal.h>
+#include <string.h>
+#include <time.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "core/clock.h"
+
+/* The child: runs fn, writes its error (status and message; at most 1 KiB, so one
+ * write below PIPE_BUF that the pipe takes whole) and ends without exit handlers. */
+static _Noreturn void child_main(int fd, child_fn fn, void *arg)
+{
+    /* The caller's handlers only set a flag the child never reads: a SIGTERM or
+     * SIGINT sent to the child must end it. */
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    thz_error e;
+    memset(&e, 0, sizeof e);
+    e.status = fn(arg, &e);
+    ssize_t n = write(fd, &e, sizeof e);
+    _exit(n == (ssize_t)sizeof e ? 0 : 1);
+}
+
+/* Reads the child's report into *report (*got bytes so far) until its end of the pipe
+ * closes, which happens when it exits; false when the deadline passes first. */
+static bool child_collect(int fd, double deadline_s, thz_error *report, size_t *got)
+{
+    for (;;) {
+        double left_s = deadline_s - thz_now_s();
+        if (left_s <= 0.0)
+            return false;
+        struct pollfd p = {.fd = fd, .events = POLLIN};
+        int r = poll(&p, 1, left_s > 1.0 ? 1000 : (int)(left_s * 1e3) + 1);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r < 0)
+            return true; /* cannot wait here: waitpid blocks instead */
+        if (r == 0)
+            continue;
+        char buf[2048];
+        ssize_t n = read(fd, buf, sizeof buf);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            return true;
+        size_t room = sizeof *report - *got, take = (size_t)n < room ? (size_t)n : room;
+        memcpy((char *)report + *got, buf, take);
+        *got += take;
+    }
+}
+
+thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err)
+{
+    int fds[2];
+    if (pipe2(fds, O_CLOEXEC) != 0)
+        return thz_error_set(err, errno == ENOMEM ? THZ_ERR_NOMEM : THZ_ERR_IO,
+                             "%s while %s: cannot create a pipe: %s",
+                             errno == ENOMEM ? "out of memory" : "failed", what, strerror(errno));
+    pid_t pid = fork();
+    if (pid < 0) {
+        int e = errno;
+        close(fds[0]);
+        close(fds[1]);
+        if (e == ENOMEM || e == EAGAIN)
+            return thz_error_set(err, THZ_ERR_NOMEM,
+                                 "out of memory while %s: cannot start a process: %s", what,
+                                 strerror(e));
+        return thz_error_set(err, THZ_ERR_IO, "failed while %s: cannot start a process: %s", what,
+                             strerror(e));
+    }
+    if (pid == 0) {
+        close(fds[0]);
+        child_main(fds[1], fn, arg);
+    }
+    close(fds[1]);
+    thz_error report;
+    memset(&report, 0, sizeof report);
+    size_t got = 0;
+    bool timed_out = !child_collect(fds[0], thz_now_s() + timeout_s, &report, &got);
+    close(fds[0]);
+    if (timed_out)
+        kill(pid, SIGKILL);
+    int ws = 0;
+    while (waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
+    }
+
+    if (timed_out)
+        return thz_error_set(err, THZ_ERR_IO, "failed while %s: no result after %.0f s (stopped)",
+                             what, timeout_s);
+    if (WIFSIGNALED(ws))
+        return thz_error_set(err, THZ_ERR_IO,
+                             "failed while %s: the process doing it ended by signal %d (%s)", what,
+                             WTERMSIG(ws), strsignal(WTERMSIG(ws)));
+    if (got != sizeof report || !WIFEXITED(ws) || WEXITSTATUS(ws) != 0)
+        return thz_error_set(err, THZ_ERR_IO,
+                             "failed while %s: the process doing it stopped with exit status %d "
+                             "before it finished (a library it uses ends the process when it "
+                             "runs out of memory)",
+                             what, WIFEXITED(ws) ? WEXITSTATUS(ws) : -1);
+    report.message[sizeof report.message - 1] = '\0';
+    if (report.status == THZ_OK)
+        return THZ_OK;
+    return thz_error_set(err, report.status, "%s", report.message);
+}

@@ -1,0 +1,27 @@
+/* Running a piece of work in a child process, so that a library that ends the process
+ * (exit() or abort() when an allocation fails, as PLplot, fontconfig and GLib do) or
+ * deadlocks cannot take down or freeze the process that holds a run's staging files.
+ *
+ * The child is a fork() of the caller: it sees the caller's memory as it was (copy on
+ * write), runs the function, sends back its status and message through a pipe and ends
+ * with _exit(), so no exit handler of the caller runs in it. The caller waits, up to a
+ * time limit after which the child is killed.
+ */
+#ifndef THZ_CORE_CHILD_H
+#define THZ_CORE_CHILD_H
+
+#include "core/error.h"
+
+/* The work: returns a status and fills err like any fallible function. */
+typedef thz_status (*child_fn)(void *arg, thz_error *err);
+
+/* Runs fn(arg) in a child process and returns its status and message. `what` says
+ * what the child does ("plotting out/cam.band-01.png") for the messages of a child
+ * that cannot start (THZ_ERR_NOMEM "out of memory while <what>: ..." when fork fails
+ * for lack of memory), dies from a signal, exits without reporting (a library called
+ * exit()), or runs longer than timeout_s (it is then killed): THZ_ERR_IO, the message
+ * saying which. Call from one thread at a time per fn's shared state; the child runs
+ * only the calling thread, so fn must not wait for other threads of the caller. */
+thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err);
+
+#endif

@@ -1,0 +1,167 @@
+#!/usr/bin/env bash
+# Out of memory at any allocation (issue 20; docs/reliability.md): validate, simulate and
+# render a small scene (a mesh, a material table, two channels, a saved photon map) with
+# the Nth allocation failing, through the LD_PRELOAD shim tests/support/failalloc.c.
+# A counting run gives each command's total: its own allocations and those of the
+# child processes that draw the figures (they continue the count). N takes every value
+# up to 300, then log-spaced values up to the process's total, then log-spaced values
+# through the children's range (THZ_TEST_SCALE thins the sample). Every run must:
+#  - exit 0 with complete results (a library absorbed the failure), or 1 with a message
+#    on stderr; "out of memory" when the failure hit thzmap's own process; never 2 (the
+#    scene is valid), never a signal (crash), never a sanitizer report, never a hang;
+#  - leave nothing beside OUTDIR (no staging directory, no lock file), and OUTDIR as it
+#    was: absent stays absent, a previous run stays byte for byte.
+# argv: path to the thzmap binary, repository directory.
+set -u
+THZMAP=$1
+REPO=$2
+SHIM=$(dirname "$THZMAP")/libthz_failalloc.so
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+[ -f "$SHIM" ] || { echo "FAIL: $SHIM is missing (built with the thzmap target's CMake)"; exit 1; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+SCALE=${THZ_TEST_SCALE:-1}
+
+mkdir -p "$work/scene/materials"
+cp "$REPO/examples/meshes/pyramid.obj" "$work/scene/"
+cp "$REPO/examples/plate-in-box/materials/sample.csv" "$work/scene/materials/"
+cat > "$work/scene/scene.json" <<'JSON'
+{
+  "format": "thzmap-scene/1",
+  "name": "alloc-fail",
+  "channels": [{"frequency_thz": 0.35, "relative_width": 0.05},
+               {"frequency_thz": 0.6, "relative_width": 0.05}],
+  "materials": {"wall": {"reflectivity": 0.2}, "table": {"file": "materials/sample.csv"}},
+  "atmosphere": {"model": "constant", "attenuation_per_m": 0.05},
+  "objects": [
+    {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}},
+    {"name": "pyramid", "type": "solid", "material": "table", "temperature_k": 310,
+     "shape": {"type": "mesh", "file": "pyramid.obj"}, "transform": {"scale": 0.3}}
+  ],
+  "sensors": [{"name": "cam", "position_m": [0, -0.9, 0], "look_at_m": [0, 0, 0],
+               "fov_deg": 60, "resolution": [6, 5]}],
+  "photons": {"per_channel": 200, "seed": 3, "gather_min_photons": 4},
+  "render": {"integrator": "photon-map"}
+}
+JSON
+scene=$work/scene/scene.json
+"$THZMAP" simulate "$scene" -o "$work/pm" --threads 1 --quiet --save-photon-map ||
+  { echo "FAIL: the scene does not simulate without failures"; exit 1; }
+# A previous run's results, the OUTDIR content that must survive a failed run.
+"$THZMAP" render "$scene" --photon-map "$work/pm/photon-map.thzpm" -o "$work/previous" \
+  --threads 1 --quiet || { echo "FAIL: the scene does not render without failures"; exit 1; }
+(cd "$work/previous" && find . -type f | sort | xargs sha256sum) > "$work/previous.sums"
+
+# The commands; OUT is replaced by the run's OUTDIR.
+cmd_validate=(validate "$scene")
+cmd_simulate=(simulate "$scene" -o OUT --threads 1 --quiet --save-photon-map)
+cmd_render=(render "$scene" --photon-map "$work/pm/photon-map.thzpm" -o OUT --threads 1 --quiet)
+
+# Behind the sanitizer's allocator (the sanitizer build) the shim must come first.
+export ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}verify_asan_link_order=0
+export THZMAP SHIM work
+
+# One run: run_one NAME N ARGS...; prints one result line "N verdict detail".
+run_one() {
+  local name=$1 n=$2
+  shift 2
+  local dir=$work/runs/$name-$n
+  mkdir -p "$dir"
+  local has_out=$((n % 2)) # odd N: OUTDIR holds a previous run; even N: it is absent
+  [ "$has_out" = 1 ] && [ "$name" != validate ] && cp -a "$work/previous" "$dir/out"
+  local args=()
+  for a in "$@"; do args+=("${a/#OUT/$dir/out}"); done
+  local t0=$(date +%s%N)
+  THZ_FAIL_ALLOC_AT=$n THZ_FAIL_ALLOC_REPORT=$dir/report LD_PRELOAD=$SHIM \
+    timeout -s KILL 90 "$THZMAP" "${args[@]}" >/dev/null 2>"$dir/err"
+  local rc=$?
+  local ms=$(( ($(date +%s%N) - t0) / 1000000 ))
+  local parent_failed
+  parent_failed=$(awk -v pid_line=1 'END { print $3 }' "$dir/report" 2>/dev/null)
+  local verdict=ok detail="exit $rc, $ms ms"
+  local msg
+  msg=$(grep -v '^failalloc' "$dir/err" | head -c 300 | tr '\n' ' ')
+  if [ "$rc" -ge 124 ]; then
+    verdict=bad detail="exit $rc (signal or timeout after $ms ms): $msg"
+  elif grep -qE 'AddressSanitizer|LeakSanitizer|runtime error' "$dir/err"; then
+    verdict=bad detail="sanitizer report: $msg"
+  elif [ "$rc" = 2 ]; then
+    verdict=bad detail="exit 2 (bad input) for a valid scene: $msg"
+  elif [ "$rc" = 1 ] && [ -z "$msg" ]; then
+    verdict=bad detail="exit 1 without a message"
+  elif [ "$rc" = 1 ] && [ "$parent_failed" = 1 ] && ! grep -q 'out of memory' "$dir/err"; then
+    verdict=bad detail="the failure hit thzmap's process but the message does not say out of memory: $msg"
+  elif [ "$rc" != 0 ] && [ "$rc" != 1 ]; then
+    verdict=bad detail="exit $rc: $msg"
+  fi
+  # Nothing beside OUTDIR, OUTDIR as it was (or complete after a success).
+  local left
+  left=$(ls -A "$dir" | grep -vxE 'out|err|report' | tr '\n' ' ')
+  [ -n "$left" ] && verdict=bad detail="$detail; left beside OUTDIR: $left"
+  if [ "$name" != validate ]; then
+    if [ "$rc" = 0 ]; then
+      [ -f "$dir/out/summary.json" ] || { verdict=bad; detail="$detail; exit 0 without summary.json"; }
+    elif [ "$has_out" = 1 ]; then
+      (cd "$dir/out" && find . -type f | sort | xargs sha256sum) | cmp -s - "$work/previous.sums" ||
+        { verdict=bad; detail="$detail; the previous run in OUTDIR changed"; }
+    elif [ -e "$dir/out" ]; then
+      verdict=bad detail="$detail; a failed run created OUTDIR"
+    fi
+  fi
+  [ "$rc" = 0 ] && [ "$verdict" = ok ] && verdict=absorbed
+  echo "$n $verdict $detail"
+  [ "$verdict" = bad ] || rm -rf "$dir"
+}
+export -f run_one
+
+# N values: all up to 300, 150 log-spaced up to the process's own count, 50 through the
+# children's (each scaled by THZ_TEST_SCALE).
+sample() {
+  python3 - "$1" "$2" "$SCALE" <<'PY'
+import math, sys
+own, most, scale = int(sys.argv[1]), int(sys.argv[2]), float(sys.argv[3])
+def logspace(lo, hi, k):
+    if hi <= lo or k <= 0: return set()
+    return {int(round(math.exp(math.log(lo) + (math.log(hi) - math.log(lo)) * i / k)))
+            for i in range(1, k + 1)}
+dense = int(300 * scale) if scale < 1 else 300
+ns = set(range(1, min(dense, own) + 1)) | logspace(dense, own, int(150 * scale)) \
+    | logspace(own, most, int(50 * scale))
+print("\n".join(str(n) for n in sorted(ns)))
+PY
+}
+
+t_start=$(date +%s)
+total_runs=0
+for name in validate simulate render; do
+  declare -n cmd="cmd_$name"
+  args=()
+  for a in "${cmd[@]}"; do args+=("${a/#OUT/$work/count-$name}"); done
+  rm -f "$work/count.report"
+  THZ_FAIL_ALLOC_REPORT=$work/count.report LD_PRELOAD=$SHIM "$THZMAP" "${args[@]}" \
+    >/dev/null 2>"$work/count.err" || fail "$name: the counting run failed: $(cat "$work/count.err")"
+  # the last line is the parent's (it exits last); the largest count is a child's
+  own=$(tail -n 1 "$work/count.report" | awk '{ print $2 }')
+  most=$(awk 'BEGIN { m = 0 } $2 > m { m = $2 } END { print m }' "$work/count.report")
+  sample "$own" "$most" > "$work/ns-$name"
+  runs=$(wc -l < "$work/ns-$name")
+  total_runs=$((total_runs + runs))
+  t0=$(date +%s)
+  xargs -P 2 -I{} bash -c 'run_one "$@"' _ "$name" {} "${cmd[@]}" < "$work/ns-$name" \
+    > "$work/results-$name"
+  bad=$(grep -c ' bad ' "$work/results-$name")
+  absorbed=$(grep -c ' absorbed ' "$work/results-$name")
+  oom=$(grep -c ' ok exit 1' "$work/results-$name")
+  echo "$name: $own allocations in thzmap's process, up to $most with the figure processes;" \
+    "$runs runs in $(($(date +%s) - t0)) s: $oom exit 1, $absorbed exit 0 (absorbed), $bad bad"
+  if [ "$bad" != 0 ]; then
+    fail "$name: $bad runs misbehaved; the first ones:"
+    grep ' bad ' "$work/results-$name" | sort -n | head -n 20
+  fi
+  unset -n cmd
+done
+echo "alloc fail: $total_runs runs in $(($(date +%s) - t_start)) s"
+[ "$fails" = 0 ] && echo "alloc fail: all checks passed"
+exit $((fails > 0))

@@ -1,0 +1,257 @@
+/* failalloc: an LD_PRELOAD shim that makes the Nth allocation fail, for
+ * tests/cli/test_alloc_fail.sh (issue 20).
+ *
+ * Every call of malloc, calloc, realloc, reallocarray, posix_memalign, aligned_alloc,
+ * memalign, valloc and pvalloc made after the shim's constructor ran (so the dynamic
+ * loader's and the C library's own start-up are not counted) is numbered 1, 2, ...
+ * across all threads. Environment:
+ *   THZ_FAIL_ALLOC_AT=N       call N returns NULL (ENOMEM); 0 or unset: none fails
+ *   THZ_FAIL_ALLOC_REPORT=F   at exit, append "PID COUNT FAILED" to file F: the calls
+ *                             counted in this process and whether call N failed in it
+ *   THZ_FAIL_ALLOC_BACKTRACE=1  print the stack of the failing call to stderr
+ * (or run under gdb with a breakpoint on failalloc_hit).
+ * A forked child inherits the count and goes on numbering from there; it reports too
+ * (also when it leaves through _exit). The real allocator is found with
+ * dlsym(RTLD_NEXT), so the shim also works in front of AddressSanitizer's allocator
+ * (run with ASAN_OPTIONS=verify_asan_link_order=0).
+ */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <execinfo.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <malloc.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#define EXPORT __attribute__((visibility("default")))
+
+static void *(*real_malloc)(size_t);
+static void *(*real_calloc)(size_t, size_t);
+static void *(*real_realloc)(void *, size_t);
+static void (*real_free)(void *);
+static int (*real_posix_memalign)(void **, size_t, size_t);
+static void *(*real_aligned_alloc)(size_t, size_t);
+static void *(*real_memalign)(size_t, size_t);
+
+static atomic_uint_least64_t counted;
+static atomic_int armed;   /* counting starts when the constructor has run */
+static atomic_int failed;  /* call N failed in this process */
+static uint64_t fail_at;   /* 0: never */
+
+/* dlsym may allocate before the real functions are known: serve it from here. */
+static _Alignas(16) char boot_arena[16384];
+static atomic_size_t boot_used;
+
+static void *boot_alloc(size_t n)
+{
+    n = (n + 15) & ~(size_t)15;
+    size_t at = atomic_fetch_add(&boot_used, n);
+    return at + n <= sizeof boot_arena ? boot_arena + at : NULL;
+}
+
+static int in_boot_arena(const void *p)
+{
+    return (const char *)p >= boot_arena && (const char *)p < boot_arena + sizeof boot_arena;
+}
+
+static void resolve(void)
+{
+    static atomic_int resolving;
+    if (real_malloc || atomic_exchange(&resolving, 1))
+        return;
+    *(void **)&real_calloc = dlsym(RTLD_NEXT, "calloc");
+    *(void **)&real_realloc = dlsym(RTLD_NEXT, "realloc");
+    *(void **)&real_free = dlsym(RTLD_NEXT, "free");
+    *(void **)&real_posix_memalign = dlsym(RTLD_NEXT, "posix_memalign");
+    *(void **)&real_aligned_alloc = dlsym(RTLD_NEXT, "aligned_alloc");
+    *(void **)&real_memalign = dlsym(RTLD_NEXT, "memalign");
+    *(void **)&real_malloc = dlsym(RTLD_NEXT, "malloc");
+}
+
+/* Called when call N fails: a place for a debugger's breakpoint. */
+__attribute__((noinline)) void failalloc_hit(uint64_t n);
+EXPORT __attribute__((noinline)) void failalloc_hit(uint64_t n)
+{
+    __asm__ volatile("" : : "r"(n) : "memory");
+    if (getenv("THZ_FAIL_ALLOC_BACKTRACE")) {
+        void *frames[48];
+        int depth = backtrace(frames, 48);
+        dprintf(2, "failalloc: call %llu fails in process %ld:\n", (unsigned long long)n,
+                (long)getpid());
+        backtrace_symbols_fd(frames, depth, 2);
+    }
+}
+
+/* True when this call is the one to fail. */
+static int should_fail(void)
+{
+    if (!atomic_load_explicit(&armed, memory_order_relaxed))
+        return 0;
+    uint64_t n = atomic_fetch_add_explicit(&counted, 1, memory_order_relaxed) + 1;
+    if (fail_at && n == fail_at) {
+        atomic_store(&failed, 1);
+        failalloc_hit(n);
+        return 1;
+    }
+    return 0;
+}
+
+static void report(void)
+{
+    const char *path = getenv("THZ_FAIL_ALLOC_REPORT");
+    if (!path || !*path)
+        return;
+    char line[96];
+    int n = snprintf(line, sizeof line, "%ld %llu %d\n", (long)getpid(),
+                     (unsigned long long)atomic_load(&counted), atomic_load(&failed));
+    int fd = open(path, O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+        if (n > 0 && write(fd, line, (size_t)n) < 0) {
+            /* nothing to do: the report is best effort */
+        }
+        close(fd);
+    }
+}
+
+__attribute__((constructor)) static void failalloc_init(void)
+{
+    resolve();
+    if (getenv("THZ_FAIL_ALLOC_BACKTRACE")) { /* backtrace() loads libgcc_s once: not later */
+        void *frame;
+        backtrace(&frame, 1);
+    }
+    const char *at = getenv("THZ_FAIL_ALLOC_AT");
+    fail_at = at ? strtoull(at, NULL, 10) : 0;
+    atomic_store(&armed, 1);
+}
+
+__attribute__((destructor)) static void failalloc_fini(void)
+{
+    atomic_store(&armed, 0); /* exit handlers after this one may still allocate */
+    report();
+}
+
+EXPORT void _exit(int status)
+{
+    atomic_store(&armed, 0);
+    report();
+    syscall(SYS_exit_group, status);
+    __builtin_unreachable();
+}
+
+EXPORT void _Exit(int status)
+{
+    _exit(status);
+}
+
+EXPORT void *malloc(size_t n)
+{
+    if (!real_malloc) {
+        resolve();
+        if (!real_malloc)
+            return boot_alloc(n);
+    }
+    if (should_fail()) {
+        errno = ENOMEM;
+        return NULL;
+    }
+    return real_malloc(n);
+}
+
+EXPORT void *calloc(size_t n, size_t size)
+{
+    if (!real_calloc) {
+        resolve();
+        if (!real_calloc)
+            return boot_alloc(n * size); /* the arena is zeroed */
+    }
+    if (should_fail()) {
+        errno = ENOMEM;
+        return NULL;
+    }
+    return real_calloc(n, size);
+}
+
+EXPORT void *realloc(void *p, size_t n)
+{
+    if (in_boot_arena(p)) { /* grow a boot allocation into a real one */
+        size_t avail = (size_t)(boot_arena + sizeof boot_arena - (char *)p);
+        void *q = malloc(n);
+        if (q)
+            memcpy(q, p, n < avail ? n : avail);
+        return q;
+    }
+    if (!real_realloc)
+        resolve();
+    if (should_fail()) {
+        errno = ENOMEM;
+        return NULL;
+    }
+    return real_realloc(p, n);
+}
+
+EXPORT void *reallocarray(void *p, size_t n, size_t size)
+{
+    if (size && n > SIZE_MAX / size) {
+        errno = ENOMEM;
+        return NULL;
+    }
+    return realloc(p, n * size);
+}
+
+EXPORT void free(void *p)
+{
+    if (!p || in_boot_arena(p))
+        return;
+    if (!real_free)
+        resolve();
+    real_free(p);
+}
+
+EXPORT int posix_memalign(void **out, size_t align, size_t n)
+{
+    if (!real_posix_memalign)
+        resolve();
+    if (should_fail())
+        return ENOMEM;
+    return real_posix_memalign(out, align, n);
+}
+
+EXPORT void *aligned_alloc(size_t align, size_t n)
+{
+    if (!real_aligned_alloc)
+        resolve();
+    if (should_fail()) {
+        errno = ENOMEM;
+        return NULL;
+    }
+    return real_aligned_alloc(align, n);
+}
+
+EXPORT void *memalign(size_t align, size_t n)
+{
+    if (!real_memalign)
+        resolve();
+    if (should_fail()) {
+        errno = ENOMEM;
+        return NULL;
+    }
+    return real_memalign(align, n);
+}
+
+EXPORT void *valloc(size_t n)
+{
+    return memalign((size_t)sysconf(_SC_PAGESIZE), n);
+}
+
+EXPORT void *pvalloc(size_t n)
+{
+    size_t page = (size_t)sysconf(_SC_PAGESIZE);
+    return memalign(page, (n + page - 1) / page * page);
+}
