@@ -5,71 +5,107 @@
  * of a block (a crash found by tests/cli/test_alloc_fail.sh), and where it does notice,
  * the failure comes back as a syntax error. So while a parse runs on a thread, jansson
  * allocates through load_json_malloc, which on failure jumps straight out of the parse
- * (longjmp: jansson holds no lock or resource but memory there) and frees every block
- * jansson allocated in that parse, which it tracks in a list. The caller then reports
- * out of memory, never "invalid JSON".
+ * (longjmp: jansson holds no lock or resource but memory there) after freeing every
+ * block jansson allocated in that parse and still holds; a hash set of the parse's
+ * live blocks keeps them. The caller then reports out of memory, never "invalid JSON".
  *
- * The hook is installed once, and only over jansson's default malloc/free, so that a
+ * The hooks are installed once, and only over jansson's default malloc/free, so that a
  * program that gave jansson its own allocator keeps it (it then gets the syntax error
- * for an allocation failure). Blocks carry a small header for the list; outside a
- * parse it is unused.
+ * for an allocation failure). Outside a parse they are malloc and free, so that what
+ * json_dumps returns can still be given to free().
  */
 #include <pthread.h>
 #include <setjmp.h>
-#include <stdalign.h>
 #include <stdbool.h>
+#include <stdint.h>
 #include <stdlib.h>
 
 #include "scene/load.h"
 
-/* Links in the list of a parse's blocks (both NULL: in no list). */
-typedef struct json_link {
-    struct json_link *prev, *next;
-} json_link;
-
-/* The header before each block jansson gets. */
-typedef struct json_block {
-    json_link link; /* first: a json_link * of a block is the block */
-    alignas(max_align_t) unsigned char data[];
-} json_block;
-
-/* The parse running on this thread (NULL: none). */
+/* A parse: where to jump on failure, and the set of blocks jansson allocated in it and
+ * has not freed (open addressing, linear probing, capacity a power of two, at most half
+ * full). One per thread, not on the stack: it is read after the longjmp. */
 typedef struct json_parse {
     jmp_buf out;
-    json_link head; /* sentinel of the list of live blocks allocated in the parse */
+    void **slots;
+    size_t cap, n;
 } json_parse;
 
+static _Thread_local json_parse json_state;
+/* &json_state while a parse runs on this thread, else NULL */
 static _Thread_local json_parse *json_current;
+
+static size_t json_slot(const json_parse *p, const void *ptr)
+{
+    uint64_t h = (uint64_t)(uintptr_t)ptr * 0x9e3779b97f4a7c15u;
+    return (size_t)(h >> 20) & (p->cap - 1);
+}
+
+static bool json_set_insert(json_parse *p, void *ptr)
+{
+    if (2 * (p->n + 1) > p->cap) {
+        size_t cap = p->cap ? 2 * p->cap : 1024;
+        void **old = p->slots, **slots = calloc(cap, sizeof *slots);
+        if (!slots)
+            return false;
+        size_t old_cap = p->cap;
+        p->slots = slots;
+        p->cap = cap;
+        p->n = 0;
+        for (size_t i = 0; i < old_cap; i++)
+            if (old[i])
+                json_set_insert(p, old[i]);
+        free(old);
+    }
+    size_t i = json_slot(p, ptr);
+    while (p->slots[i])
+        i = (i + 1) & (p->cap - 1);
+    p->slots[i] = ptr;
+    p->n++;
+    return true;
+}
+
+static void json_set_remove(json_parse *p, const void *ptr)
+{
+    if (!p->cap)
+        return;
+    size_t i = json_slot(p, ptr);
+    while (p->slots[i] && p->slots[i] != ptr)
+        i = (i + 1) & (p->cap - 1);
+    if (!p->slots[i])
+        return;
+    p->slots[i] = NULL;
+    p->n--;
+    /* backward shift: re-place the run after the hole so no lookup stops at it */
+    for (size_t j = (i + 1) & (p->cap - 1); p->slots[j]; j = (j + 1) & (p->cap - 1)) {
+        void *moved = p->slots[j];
+        p->slots[j] = NULL;
+        p->n--;
+        json_set_insert(p, moved); /* cannot grow: the set just shrank */
+    }
+}
 
 static void *load_json_malloc(size_t size)
 {
     json_parse *p = json_current;
-    json_block *b = size <= SIZE_MAX - sizeof *b ? malloc(sizeof *b + size) : NULL;
-    if (!b) {
-        if (p)
-            longjmp(p->out, 1);
-        return NULL;
+    void *block = malloc(size);
+    if (!p)
+        return block;
+    if (!block)
+        longjmp(p->out, 1);
+    if (!json_set_insert(p, block)) {
+        free(block);
+        longjmp(p->out, 1);
     }
-    b->link.prev = b->link.next = NULL;
-    if (p) {
-        b->link.next = p->head.next;
-        b->link.prev = &p->head;
-        p->head.next->prev = &b->link;
-        p->head.next = &b->link;
-    }
-    return b->data;
+    return block;
 }
 
 static void load_json_free(void *ptr)
 {
-    if (!ptr)
-        return;
-    json_block *b = (json_block *)((unsigned char *)ptr - offsetof(json_block, data));
-    if (b->link.next) { /* in the list of the parse running on this thread */
-        b->link.prev->next = b->link.next;
-        b->link.next->prev = b->link.prev;
-    }
-    free(b);
+    json_parse *p = json_current;
+    if (p && ptr)
+        json_set_remove(p, ptr);
+    free(ptr);
 }
 
 static bool json_hooked;
@@ -90,30 +126,22 @@ json_t *load_json_parse(FILE *f, const char *text, json_error_t *je, bool *out_o
     static pthread_once_t once = PTHREAD_ONCE_INIT;
     pthread_once(&once, load_json_install);
     *out_of_memory = false;
-    json_parse parse;
-    parse.head.prev = parse.head.next = &parse.head;
-    /* volatile: read after longjmp */
-    json_t *volatile doc = NULL;
-    if (setjmp(parse.out) == 0) {
+    json_parse *parse = &json_state;
+    parse->slots = NULL;
+    parse->cap = parse->n = 0;
+    json_t *volatile doc = NULL; /* volatile: read after longjmp */
+    if (setjmp(parse->out) == 0) {
         if (json_hooked)
-            json_current = &parse;
+            json_current = parse;
         doc = f ? json_loadf(f, JSON_REJECT_DUPLICATES, je)
                 : json_loads(text, JSON_REJECT_DUPLICATES, je);
     } else {
         *out_of_memory = true;
-        while (parse.head.next != &parse.head) {
-            json_link *b = parse.head.next;
-            parse.head.next = b->next;
-            free(b);
-        }
-        parse.head.prev = &parse.head;
+        for (size_t i = 0; i < parse->cap; i++)
+            free(parse->slots[i]);
     }
     json_current = NULL;
-    /* the document's blocks outlive the parse: take them out of its list */
-    for (json_link *b = parse.head.next, *next; b != &parse.head; b = next) {
-        next = b->next;
-        b->prev = b->next = NULL;
-    }
+    free(parse->slots); /* a document's blocks outlive the parse, freed by json_decref */
     if (!doc && json_error_code(je) == json_error_out_of_memory)
         *out_of_memory = true;
     return doc;
