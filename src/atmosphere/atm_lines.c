@@ -232,6 +232,8 @@ static thz_status read_par_catalog(const char *path, int molecule, raw_catalog *
     char *line = NULL;
     size_t cap = 0, lineno = 0, n_found = 0;
     FILE *f = fopen(path, "r");
+    if (!f && errno == ENOMEM)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while opening it", path);
     if (!f)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open: %s", path, strerror(errno));
     ssize_t len;

@@ -35,7 +35,10 @@ static void print_usage(FILE *f)
 
 int cli_fail(const thz_error *err)
 {
-    fprintf(stderr, "thzmap: %s\n", err->message[0] ? err->message : thz_status_name(err->status));
+    const char *message = err->message[0] ? err->message : thz_status_name(err->status);
+    /* a C library call that failed with ENOMEM says "Cannot allocate memory" */
+    bool say_oom = err->status == THZ_ERR_NOMEM && !strstr(message, "out of memory");
+    fprintf(stderr, "thzmap: %s%s\n", say_oom ? "out of memory: " : "", message);
     /* THZ_ERR_LIMIT: the scene or the options ask for more than fits (memory, sizes) */
     return err->status == THZ_ERR_INPUT || err->status == THZ_ERR_LIMIT ? CLI_EXIT_USAGE
                                                                         : CLI_EXIT_FAILURE;

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "progress.h"
@@ -159,6 +160,26 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
     return -1;
 }
 
+/* The output directory of the run in progress and the process that opened it. libgomp
+ * calls exit() when it cannot allocate or start a thread; the exit handler then removes
+ * the staging directory and the lock, which would otherwise stay beside OUTDIR until
+ * the next run. Process state, like the signal flag (progress.c): an exit handler can
+ * reach nothing else. (PLplot, the other library that exits, runs in child processes,
+ * which _exit() past this handler or find another process id.) */
+static thz_output *cli_open_output;
+static pid_t cli_output_pid;
+
+static void cli_exit_cleanup(void)
+{
+    thz_output *output = cli_open_output;
+    if (!output || getpid() != cli_output_pid)
+        return;
+    cli_open_output = NULL;
+    thz_output_destroy(output);
+    fprintf(stderr, "thzmap: a library ended the process early (out of memory, or no thread "
+                    "could be started); no results written, OUTDIR left as it was\n");
+}
+
 /* The run: photons read (render) or fired, images rendered, results written through an
  * output directory opened first, so that a bad OUTDIR fails before any work. */
 static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_run_args *a,
@@ -167,6 +188,11 @@ static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_ru
     thz_output *output = NULL;
     thz_photons *photons = NULL;
     thz_status st = thz_output_open(a->outdir, &output, err);
+    static bool handler_installed = false;
+    if (!handler_installed)
+        handler_installed = atexit(cli_exit_cleanup) == 0;
+    cli_output_pid = getpid();
+    cli_open_output = output;
     long sensor = -1;
     if (st == THZ_OK && render && a->sensor_name) {
         sensor = thz_scene_sensor_index(scene, a->sensor_name);
@@ -186,6 +212,7 @@ static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_ru
         st = thz_output_add_run(ctx, output, *run, &a->write, err);
     if (st == THZ_OK)
         st = thz_output_commit(output, err);
+    cli_open_output = NULL;
     thz_output_destroy(output);
     return st;
 }

@@ -192,6 +192,8 @@ thz_status csv_read(const char *path, const char *label, csv_table *t, thz_error
     if (st != THZ_OK)
         return st;
     FILE *f = fopen(path, "rb");
+    if (!f && errno == ENOMEM)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while opening it", name);
     if (!f)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open: %s", name, strerror(errno));
     size_t cap = 4096, len = 0;

@@ -1,6 +1,7 @@
 /* Status and error messages. */
 #include "core/error.h"
 
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -37,6 +38,11 @@ void thz_error_prefix(thz_error *err, const char *fmt, ...)
     memcpy(joined + n, err->message, rest);
     joined[n + rest] = '\0';
     memcpy(err->message, joined, sizeof joined);
+}
+
+thz_status thz_errno_status(int errnum, thz_status otherwise)
+{
+    return errnum == ENOMEM ? THZ_ERR_NOMEM : otherwise;
 }
 
 void thz_error_clear(thz_error *err)

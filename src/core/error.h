@@ -16,6 +16,11 @@ thz_status thz_error_set(thz_error *err, thz_status status, const char *fmt, ...
 /* Prefixes err's message with a printf-formatted context ("scene.json: "). */
 void thz_error_prefix(thz_error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
+/* The status of a C library or system call that failed with errno `errnum`:
+ * THZ_ERR_NOMEM for ENOMEM (it could not allocate: no fault of the input or the disk),
+ * `otherwise` for anything else. */
+thz_status thz_errno_status(int errnum, thz_status otherwise);
+
 /* Clears err to THZ_OK and an empty message. */
 void thz_error_clear(thz_error *err);
 

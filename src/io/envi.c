@@ -65,7 +65,8 @@ static thz_status envi_write_header(const char *dir, const char *stem, const env
         return status;
     FILE *f = fopen(path, "w");
     if (!f)
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+        return thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO), "%s: cannot create: %s",
+                             path, strerror(errno));
     fputs("ENVI\ndescription = {", f);
     envi_put_text(f, info->description ? info->description : "");
     fputs("}\n", f);
@@ -105,7 +106,8 @@ static thz_status envi_write_words(const char *dir, const char *stem, const floa
         return status;
     FILE *f = fopen(path, "wb");
     if (!f)
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+        return thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO), "%s: cannot create: %s",
+                             path, strerror(errno));
     unsigned char buf[ENVI_CHUNK * 4];
     int failed = 0;
     for (size_t done = 0; done < n && !failed;) {

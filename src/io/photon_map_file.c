@@ -258,8 +258,8 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
 
     w.f = fopen(path, "wb");
     if (!w.f) {
-        st = thz_error_set(err, THZ_ERR_IO, "cannot create photon map %s: %s", path,
-                           strerror(errno));
+        st = thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO),
+                           "cannot create photon map %s: %s", path, strerror(errno));
         goto cleanup;
     }
     uint8_t prefix[PMF_PREFIX_BYTES] = {0};
@@ -474,8 +474,11 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
     }
     r.f = fopen(path, "rb");
     if (!r.f) {
-        st = thz_error_set(err, errno == ENOENT ? THZ_ERR_INPUT : THZ_ERR_IO,
-                           "cannot open photon map %s: %s", path, strerror(errno));
+        st = errno == ENOMEM
+                 ? thz_error_set(err, THZ_ERR_NOMEM, "out of memory while opening photon map %s",
+                                 path)
+                 : thz_error_set(err, errno == ENOENT ? THZ_ERR_INPUT : THZ_ERR_IO,
+                                 "cannot open photon map %s: %s", path, strerror(errno));
         goto cleanup;
     }
     long actual = -1;

@@ -41,7 +41,8 @@ thz_status ply_write_photons(const char *path, const photon_map *const *maps, si
 
     FILE *f = fopen(path, "wb");
     if (!f)
-        return thz_error_set(err, THZ_ERR_IO, "cannot create %s: %s", path, strerror(errno));
+        return thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO), "cannot create %s: %s", path,
+                             strerror(errno));
     thz_status st = THZ_OK;
     if (fprintf(
             f,

@@ -1,6 +1,7 @@
 /* PNG writer for the visual truth image, by libpng's simplified API (no setjmp). */
 #include "io/png_image.h"
 
+#include <errno.h>
 #include <png.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,8 +36,11 @@ thz_status png_image_write_srgb8(const char *path, const float *rgb, uint32_t co
     image.height = rows;
     image.format = PNG_FORMAT_RGB; /* 8-bit, sRGB-encoded (not linear) */
     thz_status status = THZ_OK;
+    errno = 0; /* libpng reports an allocation failure, or fopen's ENOMEM, as a message */
     if (!png_image_write_to_file(&image, path, 0, bytes, (png_int_32)(3 * (size_t)columns), NULL))
-        status = thz_error_set(err, THZ_ERR_IO, "%s: cannot write PNG: %s", path, image.message);
+        status = thz_error_set(
+            err, errno == ENOMEM || strstr(image.message, "memory") ? THZ_ERR_NOMEM : THZ_ERR_IO,
+            "%s: cannot write PNG: %s", path, image.message);
     png_image_free(&image);
     free(bytes);
     return status;

@@ -9,6 +9,7 @@
  */
 #include "io/output.h"
 
+#include <errno.h>
 #include <jansson.h>
 #include <math.h>
 #include <stdbool.h>
@@ -237,8 +238,12 @@ thz_status summary_write(const char *dir, const thz_scene *scene, const run_summ
     json_t *root = summary_build(scene, summary);
     if (!root)
         status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
-    else if (json_dump_file(root, path, SUMMARY_FLAGS) != 0)
-        status = thz_error_set(err, THZ_ERR_IO, "%s: cannot write", path);
+    else {
+        errno = 0; /* ENOMEM after a failure: out of memory, not a write error */
+        if (json_dump_file(root, path, SUMMARY_FLAGS) != 0)
+            status = thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO), "%s: cannot write%s",
+                                   path, errno == ENOMEM ? ": out of memory" : "");
+    }
     json_decref(root);
     return status;
 }

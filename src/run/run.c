@@ -263,11 +263,13 @@ static thz_status run_simulate_memory(run_state *rs, bool photons, thz_error *er
 
 static thz_status run_init_images(run_state *rs, thz_error *err)
 {
-    render_options ro = {.threads = rs->opt->threads};
+    render_options ro = {.threads = rs->opt->threads,
+                         .progress = rs->opt->progress,
+                         .progress_user = rs->opt->progress_user};
     for (size_t i = 0; i < rs->n_selected; i++) {
         const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
         thz_status st =
-            sensor_images_init(&rs->images[i], s->columns, s->rows, rs->scene->n_channels, 1, err);
+            sensor_images_alloc(&rs->images[i], s->columns, s->rows, rs->scene->n_channels, 1, err);
         if (st != THZ_OK)
             return st;
         st = render_sensor_truth(rs->scene, rs->accel, rs->selected[i], &rs->images[i], &ro, err);
@@ -566,8 +568,8 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
     return st;
 }
 
-/* Estimates the run's time (a pilot) and tells opt->plan. */
-static thz_status run_tell_plan(run_state *rs, thz_error *err)
+/* Estimates the run's time (a pilot) and tells opt->plan; render fires no photons. */
+static thz_status run_tell_plan(run_state *rs, bool fires_photons, thz_error *err)
 {
     run_estimate_input in = {.scene = rs->scene,
                              .accel = rs->accel,
@@ -581,6 +583,8 @@ static thz_status run_tell_plan(run_state *rs, thz_error *err)
                      .target_source = rs->target_source};
     thz_status st =
         run_estimate_time(&in, &plan.seconds_photons, &plan.seconds_render, &plan.passes, err);
+    if (!fires_photons)
+        plan.seconds_photons = 0.0;
     if (st == THZ_OK)
         rs->opt->plan(rs->opt->plan_user, &plan);
     return st;
@@ -595,7 +599,7 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
     if (st == THZ_OK)
         st = run_simulate_memory(rs, photons, err);
     if (st == THZ_OK && opt->plan)
-        st = run_tell_plan(rs, err);
+        st = run_tell_plan(rs, true, err);
     if (st == THZ_OK)
         st = run_init_images(rs, err);
     bool photon_passes = photons && rs->target_noise_k > 0.0 &&
@@ -659,6 +663,7 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, const run_
         run_memory need = {.image_bytes = run_image_bytes(rs),
                            .available_bytes = thz_physical_memory_bytes()};
         need.total_bytes = need.image_bytes;
+        rs->memory_bytes = need.total_bytes;
         st = run_check_memory(scene, &need, err);
     }
     if (st == THZ_OK && in) {
@@ -667,6 +672,8 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, const run_
         rs->seed = in->seed;
         rs->photons_per_channel = in->photons_per_channel;
     }
+    if (st == THZ_OK && opt->plan) /* a large render must not start without one */
+        st = run_tell_plan(rs, false, err);
     if (st == THZ_OK)
         st = run_init_images(rs, err);
     for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++)

@@ -268,6 +268,8 @@ static thz_status mesh_import_read(const char *path, const char *name, size_t si
                                    thz_error *err)
 {
     FILE *f = fopen(path, "rb");
+    if (!f && errno == ENOMEM)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while opening it", name);
     if (!f)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open mesh file: %s", name,
                              strerror(errno));
@@ -311,9 +313,16 @@ thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_
     snprintf(fake_name, sizeof fake_name, "mesh.%s", mesh_format_extension(format));
     mesh_source src = {fake_name, data, (size_t)size};
     struct aiFileIO io = {mesh_io_open, mesh_io_close, (aiUserData)&src};
+    /* assimp reports an allocation failure (a std::bad_alloc it catches) as a reading
+     * error; the C library's ENOMEM in errno tells it apart from a bad file */
+    errno = 0;
     const struct aiScene *sc =
         aiImportFileEx(fake_name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices, &io);
+    int import_errno = errno;
     free(data);
+    if (!sc && import_errno == ENOMEM)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while importing the mesh",
+                             name);
     if (!sc) {
         const char *why = aiGetErrorString();
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot read as a mesh: %s", name,

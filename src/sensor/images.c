@@ -13,8 +13,8 @@ uint64_t sensor_images_bytes(uint32_t columns, uint32_t rows, size_t n_channels)
     return pixels * 4u * (5u * (uint64_t)n_channels + 3u + 3u);
 }
 
-thz_status sensor_images_init(sensor_images *img, uint32_t columns, uint32_t rows,
-                              size_t n_channels, int with_stderr, thz_error *err)
+thz_status sensor_images_alloc(sensor_images *img, uint32_t columns, uint32_t rows,
+                               size_t n_channels, int with_stderr, thz_error *err)
 {
     memset(img, 0, sizeof *img);
     img->columns = columns;
@@ -41,6 +41,16 @@ thz_status sensor_images_init(sensor_images *img, uint32_t columns, uint32_t row
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for a %u x %u x %zu image", columns,
                              rows, n_channels);
     }
+    return THZ_OK;
+}
+
+thz_status sensor_images_init(sensor_images *img, uint32_t columns, uint32_t rows,
+                              size_t n_channels, int with_stderr, thz_error *err)
+{
+    thz_status st = sensor_images_alloc(img, columns, rows, n_channels, with_stderr, err);
+    if (st != THZ_OK)
+        return st;
+    size_t pixels = (size_t)columns * rows;
     for (size_t i = 0; i < pixels; i++) {
         img->temperature_k[i] = SENSOR_NOTHING_HIT;
         img->distance_m[i] = SENSOR_NOTHING_HIT;

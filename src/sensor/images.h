@@ -34,6 +34,11 @@ typedef struct sensor_images {
  * radiance_stderr only when with_stderr. */
 thz_status sensor_images_init(sensor_images *img, uint32_t columns, uint32_t rows,
                               size_t n_channels, int with_stderr, thz_error *err);
+/* sensor_images_init without writing the truth images, for a caller that fills every
+ * pixel of them (render_sensor_truth): a large image's memory is then first touched in
+ * that cancellable loop, not here (first touch costs seconds per GB on some machines). */
+thz_status sensor_images_alloc(sensor_images *img, uint32_t columns, uint32_t rows,
+                               size_t n_channels, int with_stderr, thz_error *err);
 void sensor_images_fini(sensor_images *img);
 
 /* Bytes the images of a sensor take (to refuse runs that would not fit). */

@@ -4,6 +4,7 @@
 #include "sensor/render.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,6 +32,23 @@ static bool render_report(const render_options *opt, const thz_scene *scene, siz
                       .done = done,
                       .total = total};
     return opt->progress(opt->progress_user, &p) != 0;
+}
+
+bool render_poll_stop(render_poll *poll)
+{
+    if (atomic_load_explicit(&poll->stop, memory_order_relaxed))
+        return true;
+    if (omp_get_thread_num() != 0 || !poll->opt || !poll->opt->progress ||
+        (poll->calls++ & 15) != 0) /* the clock costs as much as a cheap pixel */
+        return false;
+    double now = thz_now_s();
+    if (now < poll->next_s)
+        return false;
+    poll->next_s = now + RENDER_POLL_S;
+    if (!render_report(poll->opt, poll->scene, poll->channel, poll->done, poll->total))
+        return false;
+    atomic_store_explicit(&poll->stop, 1, memory_order_relaxed);
+    return true;
 }
 
 /* The random-stream index of estimate 0 of sample `sample` (of `samples` per pass) of
@@ -108,12 +126,20 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
         st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
         goto cleanup;
     }
+    render_poll poll = {.opt = opt,
+                        .scene = scene,
+                        .channel = channel,
+                        .total = rows,
+                        .next_s = thz_now_s() + RENDER_POLL_S};
     for (uint32_t r0 = 0; r0 < rows; r0 += block) {
         uint32_t r1 = r0 + block < rows ? r0 + block : rows;
         int64_t first = (int64_t)r0 * cols, last = (int64_t)r1 * cols;
+        poll.done = r0;
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads) \
     reduction(+ : n_samples, n_escaped, n_back, n_widened, n_starved, n_truncated, n_paths)
         for (int64_t px = first; px < last; px++) {
+            if (render_poll_stop(&poll))
+                continue;
             double *est = &scratch[(size_t)omp_get_thread_num() * per_thread];
             for (size_t j = 0; j < per_thread; j++)
                 est[j] = 0.0;
@@ -153,7 +179,7 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
             else
                 render_accum_add_pixel(acc, p, est, n_est, pixel_batch, pixel_disk_var);
         }
-        if (render_report(opt, scene, channel, r1, rows)) {
+        if (atomic_load(&poll.stop) || render_report(opt, scene, channel, r1, rows)) {
             st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
             goto cleanup;
         }

@@ -81,6 +81,25 @@ typedef struct render_options {
     double path_t0_k;
 } render_options;
 
+/* Cancelling inside a parallel pixel loop, so that a run stops within a second however
+ * long a row or a block of rows takes: each thread calls render_poll_stop for each
+ * pixel; on thread 0 (the caller's, where the callback may run) it calls the progress
+ * callback, at most every RENDER_POLL_S, reporting `done` of `total` rows; once that
+ * asks to stop, it returns true on every thread, which then skip their pixels. */
+#define RENDER_POLL_S 0.1
+
+typedef struct render_poll {
+    const render_options *opt;
+    const thz_scene *scene;
+    size_t channel;
+    uint64_t done, total;
+    double next_s;  /* thread 0 only */
+    uint64_t calls; /* thread 0 only */
+    _Atomic int stop;
+} render_poll;
+
+bool render_poll_stop(render_poll *poll);
+
 /* Counts of one render_sensor_channel call; add them up across calls. */
 typedef struct render_stats {
     uint64_t samples;           /* sample rays cast (per pass) */

@@ -3,6 +3,9 @@
 
 #include <math.h>
 #include <omp.h>
+#include <stdatomic.h>
+
+#include "core/clock.h"
 
 #include "sensor/camera.h"
 
@@ -21,8 +24,13 @@ thz_status render_sensor_truth(const thz_scene *scene, const accel *a, size_t se
         return st;
     int64_t n_px = (int64_t)cam.columns * cam.rows;
     int threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
+    /* about 16 M pixels take seconds: poll for cancelling */
+    render_poll poll = {
+        .opt = opt, .scene = scene, .total = sn->rows, .next_s = thz_now_s() + RENDER_POLL_S};
 #pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
     for (int64_t px = 0; px < n_px; px++) {
+        if (render_poll_stop(&poll))
+            continue;
         uint32_t row = (uint32_t)(px / cam.columns), col = (uint32_t)(px % cam.columns);
         vec3 dir = camera_pixel_center_dir(&cam, col, row);
         accel_hit hit;
@@ -43,5 +51,7 @@ thz_status render_sensor_truth(const thz_scene *scene, const accel *a, size_t se
         for (int c = 0; c < 3; c++)
             rgb[c] = (float)(color[c] * shade);
     }
+    if (atomic_load(&poll.stop))
+        return thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
     return THZ_OK;
 }

@@ -4,11 +4,13 @@
 # the Nth allocation failing, through the LD_PRELOAD shim tests/support/failalloc.c.
 # A counting run gives each command's total: its own allocations and those of the
 # child processes that draw the figures (they continue the count). N takes every value
-# up to 300, then log-spaced values up to the process's total, then log-spaced values
-# through the children's range (THZ_TEST_SCALE thins the sample). Every run must:
+# up to 120, then 100 log-spaced values up to the process's total, then 25 log-spaced
+# values through the children's range (THZ_TEST_SCALE thins the sample;
+# THZ_ALLOC_FAIL_FULL=1 takes every N up to the total). Every run must:
 #  - exit 0 with complete results (a library absorbed the failure), or 1 with a message
-#    on stderr; "out of memory" when the failure hit thzmap's own process; never 2 (the
-#    scene is valid), never a signal (crash), never a sanitizer report, never a hang;
+#    on stderr; "out of memory" when the failure hit thzmap's own process (also when
+#    libgomp ended it with exit(): the CLI's exit handler says so and cleans up); never
+#    2 (the scene is valid), never a signal (crash), never a sanitizer report, no hang;
 #  - leave nothing beside OUTDIR (no staging directory, no lock file), and OUTDIR as it
 #    was: absent stays absent, a previous run stays byte for byte.
 # argv: path to the thzmap binary, repository directory.
@@ -74,8 +76,8 @@ run_one() {
   local args=()
   for a in "$@"; do args+=("${a/#OUT/$dir/out}"); done
   local t0=$(date +%s%N)
-  THZ_FAIL_ALLOC_AT=$n THZ_FAIL_ALLOC_REPORT=$dir/report LD_PRELOAD=$SHIM \
-    timeout -s KILL 90 "$THZMAP" "${args[@]}" >/dev/null 2>"$dir/err"
+  timeout -s KILL 90 env THZ_FAIL_ALLOC_AT="$n" THZ_FAIL_ALLOC_REPORT="$dir/report" \
+    LD_PRELOAD="$SHIM" "$THZMAP" "${args[@]}" >/dev/null 2>"$dir/err"
   local rc=$?
   local ms=$(( ($(date +%s%N) - t0) / 1000000 ))
   local parent_failed
@@ -91,7 +93,7 @@ run_one() {
     verdict=bad detail="exit 2 (bad input) for a valid scene: $msg"
   elif [ "$rc" = 1 ] && [ -z "$msg" ]; then
     verdict=bad detail="exit 1 without a message"
-  elif [ "$rc" = 1 ] && [ "$parent_failed" = 1 ] && ! grep -q 'out of memory' "$dir/err"; then
+  elif [ "$rc" = 1 ] && [ "$parent_failed" = 1 ] && ! grep -qi 'out of memory' "$dir/err"; then
     verdict=bad detail="the failure hit thzmap's process but the message does not say out of memory: $msg"
   elif [ "$rc" != 0 ] && [ "$rc" != 1 ]; then
     verdict=bad detail="exit $rc: $msg"
@@ -111,24 +113,29 @@ run_one() {
     fi
   fi
   [ "$rc" = 0 ] && [ "$verdict" = ok ] && verdict=absorbed
+  [ "$verdict" = ok ] && grep -q 'a library ended the process' "$dir/err" && verdict=exited
   echo "$n $verdict $detail"
   [ "$verdict" = bad ] || rm -rf "$dir"
 }
 export -f run_one
 
-# N values: all up to 300, 150 log-spaced up to the process's own count, 50 through the
-# children's (each scaled by THZ_TEST_SCALE).
+# N values: every one up to DENSE, LOG log-spaced ones up to the process's own count,
+# CHILD log-spaced ones through the figure processes' range (each times THZ_TEST_SCALE).
+# THZ_ALLOC_FAIL_FULL=1: every N up to the process's own count, 200 in the children's.
+DENSE=120 LOG=100 CHILD=25
+[ "${THZ_ALLOC_FAIL_FULL:-0}" = 1 ] && DENSE=1000000 LOG=0 CHILD=200 SCALE=1
 sample() {
-  python3 - "$1" "$2" "$SCALE" <<'PY'
+  python3 - "$1" "$2" "$SCALE" "$DENSE" "$LOG" "$CHILD" <<'PY'
 import math, sys
-own, most, scale = int(sys.argv[1]), int(sys.argv[2]), float(sys.argv[3])
+own, most = int(sys.argv[1]), int(sys.argv[2])
+scale, dense, n_log, n_child = float(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5]), int(sys.argv[6])
 def logspace(lo, hi, k):
     if hi <= lo or k <= 0: return set()
     return {int(round(math.exp(math.log(lo) + (math.log(hi) - math.log(lo)) * i / k)))
             for i in range(1, k + 1)}
-dense = int(300 * scale) if scale < 1 else 300
-ns = set(range(1, min(dense, own) + 1)) | logspace(dense, own, int(150 * scale)) \
-    | logspace(own, most, int(50 * scale))
+dense = max(1, int(dense * min(scale, 1.0)))
+ns = set(range(1, min(dense, own) + 1)) | logspace(dense, own, int(n_log * scale)) \
+    | logspace(own, most, int(n_child * scale))
 print("\n".join(str(n) for n in sorted(ns)))
 PY
 }
@@ -154,8 +161,10 @@ for name in validate simulate render; do
   bad=$(grep -c ' bad ' "$work/results-$name")
   absorbed=$(grep -c ' absorbed ' "$work/results-$name")
   oom=$(grep -c ' ok exit 1' "$work/results-$name")
+  exited=$(grep -c ' exited ' "$work/results-$name")
   echo "$name: $own allocations in thzmap's process, up to $most with the figure processes;" \
-    "$runs runs in $(($(date +%s) - t0)) s: $oom exit 1, $absorbed exit 0 (absorbed), $bad bad"
+    "$runs runs in $(($(date +%s) - t0)) s: $oom exit 1 (out of memory reported)," \
+    "$exited exit 1 (a library's exit(), cleaned up), $absorbed exit 0 (absorbed), $bad bad"
   if [ "$bad" != 0 ]; then
     fail "$name: $bad runs misbehaved; the first ones:"
     grep ' bad ' "$work/results-$name" | sort -n | head -n 20
