@@ -2,6 +2,7 @@
  * is read into memory and checked (mesh_check.h) before assimp sees it; assimp then reads
  * those bytes through our own file callbacks, which serve that one file and no other (an
  * OBJ's `mtllib` could otherwise name a FIFO or a device). */
+#define _GNU_SOURCE /* memfd_create */
 #include "scene/mesh_import.h"
 
 #include <errno.h>
@@ -11,6 +12,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
@@ -18,6 +22,7 @@
 #include <assimp/scene.h>
 
 #include "core/alloc.h"
+#include "core/child.h"
 #include "core/file.h"
 #include "scene/mesh_check.h"
 #include "scene/primitives.h"
@@ -291,36 +296,31 @@ static thz_status mesh_import_read(const char *path, const char *name, size_t si
     return THZ_OK;
 }
 
-thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_error *err)
-{
-    const char *name = label ? label : path;
-    memset(mesh, 0, sizeof *mesh);
+/* What the import child needs, and the file (a memfd) it writes the mesh into. */
+typedef struct mesh_job {
+    const char *name;
+    const char *data;
+    size_t size;
     mesh_format format;
-    uint64_t size;
-    char *data = NULL;
-    thz_status st = mesh_check_format(path, name, &format, err);
-    if (st == THZ_OK)
-        st = file_check_regular(path, name, MESH_MAX_FILE_BYTES, &size, err);
-    if (st == THZ_OK)
-        st = mesh_import_read(path, name, (size_t)size, &data, err);
-    if (st == THZ_OK)
-        st = mesh_check(data, (size_t)size, format, name, NULL, err);
-    if (st != THZ_OK) {
-        free(data);
-        return st;
-    }
+    int fd;
+} mesh_job;
+
+/* Imports job's bytes with assimp into mesh (triangulated, welded). In the child. */
+static thz_status mesh_import_assimp(const mesh_job *job, thz_mesh *mesh, thz_error *err)
+{
+    const char *name = job->name;
+    thz_status st = THZ_OK;
+    memset(mesh, 0, sizeof *mesh);
     char fake_name[16];
-    snprintf(fake_name, sizeof fake_name, "mesh.%s", mesh_format_extension(format));
-    mesh_source src = {fake_name, data, (size_t)size};
+    snprintf(fake_name, sizeof fake_name, "mesh.%s", mesh_format_extension(job->format));
+    mesh_source src = {fake_name, job->data, job->size};
     struct aiFileIO io = {mesh_io_open, mesh_io_close, (aiUserData)&src};
     /* assimp reports an allocation failure (a std::bad_alloc it catches) as a reading
      * error; the C library's ENOMEM in errno tells it apart from a bad file */
     errno = 0;
     const struct aiScene *sc =
         aiImportFileEx(fake_name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices, &io);
-    int import_errno = errno;
-    free(data);
-    if (!sc && import_errno == ENOMEM)
+    if (!sc && errno == ENOMEM)
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while importing the mesh",
                              name);
     if (!sc) {
@@ -367,6 +367,121 @@ cleanup:
     aiReleaseImport(sc);
     if (st != THZ_OK)
         mesh_fini(mesh);
+    return st;
+}
+
+/* Writes all n bytes of p to fd. */
+static bool mesh_write_all(int fd, const void *p, size_t n)
+{
+    const char *c = p;
+    while (n > 0) {
+        ssize_t w = write(fd, c, n);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            return false;
+        c += w;
+        n -= (size_t)w;
+    }
+    return true;
+}
+
+/* The child: imports, then writes the vertex and triangle counts (uint64 each), the
+ * positions (3 floats per vertex) and the indices (3 per triangle) into job->fd. */
+static thz_status mesh_import_child(void *arg, thz_error *err)
+{
+    const mesh_job *job = arg;
+    thz_mesh mesh;
+    thz_status st = mesh_import_assimp(job, &mesh, err);
+    if (st != THZ_OK)
+        return st;
+    uint64_t counts[2] = {mesh.n_vertices, mesh.n_triangles};
+    if (!mesh_write_all(job->fd, counts, sizeof counts) ||
+        !mesh_write_all(job->fd, mesh.positions, 3 * mesh.n_vertices * sizeof *mesh.positions) ||
+        !mesh_write_all(job->fd, mesh.indices, 3 * mesh.n_triangles * sizeof *mesh.indices))
+        st = thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO),
+                           "%s: cannot pass the imported mesh on: %s", job->name, strerror(errno));
+    mesh_fini(&mesh);
+    return st;
+}
+
+/* Reads n bytes at offset off of fd into p. */
+static bool mesh_read_all(int fd, void *p, size_t n, off_t off)
+{
+    char *c = p;
+    while (n > 0) {
+        ssize_t r = pread(fd, c, n, off);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0)
+            return false;
+        c += r;
+        n -= (size_t)r;
+        off += r;
+    }
+    return true;
+}
+
+/* The parent: the mesh the child wrote into fd. */
+static thz_status mesh_import_receive(int fd, const char *name, thz_mesh *mesh, thz_error *err)
+{
+    uint64_t counts[2];
+    struct stat info;
+    if (fstat(fd, &info) != 0 || !mesh_read_all(fd, counts, sizeof counts, 0))
+        return thz_error_set(err, THZ_ERR_IO, "%s: the imported mesh did not come back", name);
+    uint64_t nv = counts[0], nt = counts[1];
+    uint64_t bytes = (uint64_t)info.st_size - sizeof counts;
+    if (nv > UINT32_MAX || nt > bytes / 12 || nv > bytes / 12 || 12 * (nv + nt) != bytes)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "%s: the imported mesh came back garbled",
+                             name);
+    thz_status st = primitive_mesh_alloc(mesh, (size_t)nv, (size_t)nt, err);
+    if (st != THZ_OK)
+        return st;
+    if (!mesh_read_all(fd, mesh->positions, 12 * (size_t)nv, sizeof counts) ||
+        !mesh_read_all(fd, mesh->indices, 12 * (size_t)nt, (off_t)(sizeof counts + 12 * nv))) {
+        mesh_fini(mesh);
+        return thz_error_set(err, THZ_ERR_IO, "%s: the imported mesh did not come back", name);
+    }
+    mesh->n_vertices = (size_t)nv;
+    mesh->n_triangles = (size_t)nt;
+    return THZ_OK;
+}
+
+thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_error *err)
+{
+    const char *name = label ? label : path;
+    memset(mesh, 0, sizeof *mesh);
+    mesh_format format;
+    uint64_t size;
+    char *data = NULL;
+    thz_status st = mesh_check_format(path, name, &format, err);
+    if (st == THZ_OK)
+        st = file_check_regular(path, name, MESH_MAX_FILE_BYTES, &size, err);
+    if (st == THZ_OK)
+        st = mesh_import_read(path, name, (size_t)size, &data, err);
+    if (st == THZ_OK)
+        st = mesh_check(data, (size_t)size, format, name, NULL, err);
+    if (st != THZ_OK) {
+        free(data);
+        return st;
+    }
+    /* assimp frees twice or aborts when an allocation fails (a std::bad_alloc in its
+     * post-processing): it runs in a child process (core/child.h), which writes the
+     * mesh into a memory file that this process then reads */
+    int fd = memfd_create("thzmap-mesh", MFD_CLOEXEC);
+    if (fd < 0) {
+        free(data);
+        return thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO),
+                             "%s: cannot import the mesh: memfd_create: %s", name, strerror(errno));
+    }
+    mesh_job job = {.name = name, .data = data, .size = (size_t)size, .format = format, .fd = fd};
+    char what[256];
+    snprintf(what, sizeof what, "importing the mesh %s", name);
+    st = child_run(what, mesh_import_child, &job, 60.0 + 1e-6 * (double)size, err);
+    free(data);
+    if (st == THZ_OK)
+        st = mesh_import_receive(fd, name, mesh, err);
+    close(fd);
     return st;
 }
 
