@@ -185,6 +185,12 @@ static void test_csv_material_and_warnings(void **state)
 static void test_default_channel_names(void **state)
 {
     (void)state;
+    /* format 1.1 only adds keys: a 1/1.1 file loads either way */
+    thz_scene *s11 = load_ok("{\"format\": \"thzmap-scene/1.1\", "
+                             "\"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": "
+                             "0.01}], " MATERIALS OBJECT(BOX) SENSORS "}");
+    assert_int_equal(s11->n_channels, 1);
+    thz_scene_destroy(s11);
     /* 0.35 and 0.3501 THz would both be "0.350 THz": they get a decimal more, the
      * others keep three; a given name that looks like a default one stays */
     thz_scene *s =
@@ -243,6 +249,8 @@ static void test_refusals(void **state)
     load_bad(HEAD "\"channels\": [], " MATERIALS OBJECT(BOX) SENSORS "}",
              "channels: expected at least one");
     load_bad("{\"format\": \"thzmap-scene/2\"}", "format: expected \"thzmap-scene/1\"");
+    load_bad("{\"format\": \"thzmap-scene/1.2\"}",
+             "format: expected \"thzmap-scene/1\" or \"thzmap-scene/1.1\"");
     load_bad("[1, 2]", "expected a JSON object");
     load_bad(HEAD CHANNELS MATERIALS OBJECT(BOX) SENSORS
              ", \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.1, "
