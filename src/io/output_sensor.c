@@ -152,7 +152,7 @@ static thz_status out_measured_preview(const out_context *ctx, size_t c, thz_err
         return status;
     const thz_channel *ch = &ctx->scene->channels[c];
     sensor_model_describe(ctx->sensor, c, ctx->images->noise_seed, model, sizeof model);
-    snprintf(title, sizeof title, "%s measured, %.4g GHz: %s", ctx->sensor->name,
+    snprintf(title, sizeof title, "%s, %.4g GHz: %s", ctx->sensor->name,
              ch->center_hz / 1e9, model);
     size_t pixels = (size_t)ctx->images->columns * ctx->images->rows;
     return plot_image(path, ctx->images->measured_brightness_temperature + c * pixels,
