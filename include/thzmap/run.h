@@ -134,7 +134,7 @@ typedef enum thz_plane {
                                        * 3 + k], shaded colour 0..1 */
     /* The sensor as built (scene-format.md "Sensors: optics and noise"), channel cubes;
      * absent (NULL) unless the sensor has a PSF or noise: */
-    THZ_PLANE_MEASURED_RADIANCE,              /* L_c through the PSF, plus noise */
+    THZ_PLANE_MEASURED_RADIANCE,               /* L_c through the PSF, plus noise */
     THZ_PLANE_MEASURED_BRIGHTNESS_TEMPERATURE, /* Tb_c of the measured L_c, K */
     THZ_PLANE_COUNT
 } thz_plane;

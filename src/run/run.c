@@ -426,8 +426,8 @@ static thz_status run_finish(run_state *rs, double t_start, thz_error *err)
     thz_status st = THZ_OK;
     /* the sensor as built, from the finished noise-free cubes (measure.h) */
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++)
-        st = sensor_measure(rs->scene, rs->selected[i], rs->seed, &rs->images[i],
-                            rs->opt->threads, err);
+        st = sensor_measure(rs->scene, rs->selected[i], rs->seed, &rs->images[i], rs->opt->threads,
+                            err);
     if (st == THZ_OK)
         st = run_noise_figures(rs, err);
     if (st == THZ_OK)

@@ -27,7 +27,7 @@ static thz_status load_netd(load_ctx *ctx, const load_cursor *noise, size_t n_ch
     if (!json_is_array(k.value))
         return load_fail(ctx, &k, "expected %s, got %s", what, load_type_name(k.value));
     if (json_array_size(k.value) != n_channels)
-        return load_fail(ctx, &k, "expected %zu values (one per channel), got %zu", n_channels,
+        return load_fail(ctx, &k, "expected one value per channel (%zu), got %zu", n_channels,
                          json_array_size(k.value));
     for (size_t c = 0; c < n_channels; c++) {
         load_cursor e = load_index(&k, c);
@@ -80,6 +80,8 @@ static thz_status load_noise(load_ctx *ctx, const load_cursor *c, size_t n_chann
         st = load_number(ctx, &k, "integration_time_s", LOAD_POSITIVE, true, 0.0,
                          &noise->integration_time_s);
     if (st == THZ_OK)
+        st = load_require(ctx, &k, "radiometer", "\"total-power\" or \"dicke\"");
+    if (st == THZ_OK)
         st = load_choice(ctx, &k, "radiometer", load_radiometers, true, 0, &type);
     if (st != THZ_OK)
         return st;
@@ -88,8 +90,7 @@ static thz_status load_noise(load_ctx *ctx, const load_cursor *c, size_t n_chann
     return THZ_OK;
 }
 
-thz_status load_sensor_model(load_ctx *ctx, const load_cursor *c, size_t n_channels,
-                             thz_sensor *sn)
+thz_status load_sensor_model(load_ctx *ctx, const load_cursor *c, size_t n_channels, thz_sensor *sn)
 {
     static const char *const psfs[] = {"none", "airy", "gaussian", NULL}; /* thz_psf_kind */
     thz_status st = load_number(ctx, c, "aperture_diameter_m", LOAD_POSITIVE, false, 0.0,
@@ -115,8 +116,9 @@ thz_status load_sensor_model(load_ctx *ctx, const load_cursor *c, size_t n_chann
         if (st != THZ_OK)
             return st;
     } else if (fwhm.value) {
-        return load_fail(ctx, &fwhm, "psf_fwhm_deg is for \"psf\": \"gaussian\" only (the PSF "
-                                     "here is \"%s\")",
+        return load_fail(ctx, &fwhm,
+                         "psf_fwhm_deg is for \"psf\": \"gaussian\" only (the PSF "
+                         "here is \"%s\")",
                          psfs[psf]);
     }
     st = load_noise(ctx, c, n_channels, &sn->noise);

@@ -44,9 +44,10 @@ static thz_status load_resolution(load_ctx *ctx, const load_cursor *c, uint32_t 
 static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t index, thz_sensor *sn)
 {
     static const char *const keys[] = {
-        "name",       "position_m",  "look_at_m",    "direction",      "up", "fov_deg",
-        "resolution", "aperture_m2", "oversampling", "normalize_to_k", "aperture_diameter_m",
-        "psf", "psf_fwhm_deg", "noise", "noise_seed", NULL};
+        "name",         "position_m",     "look_at_m",           "direction",
+        "up",           "fov_deg",        "resolution",          "aperture_m2",
+        "oversampling", "normalize_to_k", "aperture_diameter_m", "psf",
+        "psf_fwhm_deg", "noise",          "noise_seed",          NULL};
     load_cursor e = load_index(list, index);
     const load_cursor *c = &e;
     const char *name;

@@ -92,17 +92,17 @@ typedef struct thz_sensor {
     double fov_deg;      /* horizontal, 0 < fov < 180 */
     uint32_t columns, rows;
     double aperture_m2;
-    uint32_t oversampling; /* n: n x n samples per pixel */
-    double normalize_to_k; /* T_ref > 0 */
+    uint32_t oversampling;      /* n: n x n samples per pixel */
+    double normalize_to_k;      /* T_ref > 0 */
     double aperture_diameter_m; /* D of the circular aperture, m; 0: none given */
     thz_psf_kind psf;
     double psf_fwhm_deg; /* PSF_GAUSSIAN: FWHM of the Gaussian PSF, degrees */
     thz_sensor_noise noise;
     bool noise_seed_given; /* else the noise takes the run's seed */
     uint64_t noise_seed;
-    bool misplaced;        /* scene_checks found it inside a closed solid or outside the
-                              enclosure (and warned): back faces it sees are not the
-                              normals' fault */
+    bool misplaced; /* scene_checks found it inside a closed solid or outside the
+                       enclosure (and warned): back faces it sees are not the
+                       normals' fault */
 } thz_sensor;
 
 typedef struct thz_photon_settings {

@@ -77,7 +77,8 @@ static thz_status psf_profile_init(psf_profile *p, const thz_sensor *sn, const t
     for (size_t i = 0; i < p->n; i++) {
         double sum = 0.0;
         for (size_t k = 0; k < q.n; k++)
-            sum += q.weight[k] * psf_airy((double)i * p->h_rad, q.freq_hz[k], sn->aperture_diameter_m);
+            sum +=
+                q.weight[k] * psf_airy((double)i * p->h_rad, q.freq_hz[k], sn->aperture_diameter_m);
         p->value[i] = sum;
     }
     channel_quadrature_fini(&q);
@@ -107,8 +108,8 @@ thz_status psf_kernel_init(psf_kernel *k, const thz_sensor *sn, const thz_channe
     /* no wider than the image: beyond, the mirror border repeats the image anyway */
     double max_half = (double)(sn->columns > sn->rows ? sn->columns : sn->rows);
     k->half = (uint32_t)fmin(ceil(radius_rad / k->pitch_rad), max_half);
-    k->subsamples = (uint32_t)fmin(fmax(ceil(8.0 * k->pitch_rad / fwhm_rad), 1.0),
-                                   (double)PSF_MAX_SUBSAMPLES);
+    k->subsamples =
+        (uint32_t)fmin(fmax(ceil(8.0 * k->pitch_rad / fwhm_rad), 1.0), (double)PSF_MAX_SUBSAMPLES);
     /* the table reaches the far corner of the outermost kernel pixel */
     double reach = fmin(radius_rad, ((double)k->half + 1.0) * k->pitch_rad * M_SQRT2);
     psf_profile prof;
@@ -141,8 +142,7 @@ thz_status psf_kernel_init(psf_kernel *k, const thz_sensor *sn, const thz_channe
     free(prof.value);
     if (!(total > 0.0)) {
         psf_kernel_fini(k);
-        return thz_error_set(err, THZ_ERR_INTERNAL, "psf: empty kernel for sensor '%s'",
-                             sn->name);
+        return thz_error_set(err, THZ_ERR_INTERNAL, "psf: empty kernel for sensor '%s'", sn->name);
     }
     for (size_t i = 0; i < side * side; i++)
         k->weight[i] /= total;

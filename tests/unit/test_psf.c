@@ -143,8 +143,8 @@ static void test_airy_profile_and_fwhm(void **state)
             fail_msg("channel %d: FWHM %.4g mrad, band-averaged Airy %.4g mrad", c, fwhm * 1e3,
                      fwhm_want * 1e3);
         if (fabs(fwhm_want / fwhm_mono - 1.0) > 0.01)
-            fail_msg("channel %d: band-averaged FWHM %.4g mrad far from 1.029 lambda/D = %.4g",
-                     c, fwhm_want * 1e3, fwhm_mono * 1e3);
+            fail_msg("channel %d: band-averaged FWHM %.4g mrad far from 1.029 lambda/D = %.4g", c,
+                     fwhm_want * 1e3, fwhm_mono * 1e3);
         if (fabs(sum(out) - 1.0) > 0.005)
             fail_msg("channel %d: summed power %.6f, sharp 1", c, sum(out));
         /* at a corner: the mirror border keeps the power */
