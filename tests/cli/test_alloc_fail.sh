@@ -162,7 +162,7 @@ for name in validate simulate render; do
   absorbed=$(grep -c ' absorbed ' "$work/results-$name")
   oom=$(grep -c ' ok exit 1' "$work/results-$name")
   exited=$(grep -c ' exited ' "$work/results-$name")
-  echo "$name: $own allocations in thzmap's process, up to $most with the figure processes;" \
+  echo "$name: $own allocations in thzmap's process, up to $most with its child processes (figures, mesh import);" \
     "$runs runs in $(($(date +%s) - t0)) s: $oom exit 1 (out of memory reported)," \
     "$exited exit 1 (a library's exit(), cleaned up), $absorbed exit 0 (absorbed), $bad bad"
   if [ "$bad" != 0 ]; then
