@@ -38,11 +38,11 @@ THZ_API size_t thz_sequence_sweep_count(const thz_sequence *seq);
 THZ_API size_t thz_sequence_frames_per_sweep(const thz_sequence *seq);
 
 typedef struct thz_frame_info {
-    size_t sweep;      /* index of the sweep value (0 without a sweep) */
-    size_t index;      /* frame index within its sweep value */
-    double time_s;     /* index / fps */
-    const char *dir;   /* "frame-00003" or "sweep-01/frame-00003" (owned by seq) */
-    uint64_t hash;     /* hash of the frame's inputs: its scene text and the files it names */
+    size_t sweep;    /* index of the sweep value (0 without a sweep) */
+    size_t index;    /* frame index within its sweep value */
+    double time_s;   /* index / fps */
+    const char *dir; /* "frame-00003" or "sweep-01/frame-00003" (owned by seq) */
+    uint64_t hash;   /* hash of the frame's inputs: its scene text and the files it names */
 } thz_frame_info;
 
 /* Fills *out for frame i (0 .. count - 1); THZ_ERR_INPUT when out of range. */
@@ -59,7 +59,7 @@ THZ_API thz_status thz_sequence_frame_scene(const thz_sequence *seq, size_t i, t
 
 /* Progress of a batch, before each frame and once at the end (frame == n_frames). */
 typedef struct thz_batch_progress {
-    size_t frame;      /* index of the frame about to be run (n_frames: done) */
+    size_t frame; /* index of the frame about to be run (n_frames: done) */
     size_t n_frames;
     size_t computed;   /* frames computed so far by this call */
     size_t reused;     /* frames found finished in OUTDIR and skipped */
@@ -72,7 +72,7 @@ typedef int (*thz_batch_progress_fn)(void *user, const thz_batch_progress *progr
 typedef struct thz_batch_options {
     thz_batch_progress_fn progress; /* may be NULL */
     void *progress_user;
-    int no_movies;                  /* non-zero: frames and batch.json only */
+    int no_movies; /* non-zero: frames and batch.json only */
 } thz_batch_options;
 
 /* What a batch did. */
@@ -93,13 +93,13 @@ THZ_API thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, cons
 
 /* Linear interpolation of n values between keyframes: times t[0] < ... < t[k-1] (s),
  * values v[j * n + m]; at time `time_s` (held beyond the ends) into out[n]. */
-THZ_API void thz_interp_linear(const double *t, const double *v, size_t k, size_t n,
-                               double time_s, double *out);
+THZ_API void thz_interp_linear(const double *t, const double *v, size_t k, size_t n, double time_s,
+                               double *out);
 /* The same for rotations given as rotate_deg triples (rotations about x, then y, then z):
  * spherical linear interpolation of their quaternions (the shorter arc), back to a
  * triple in the same convention. */
-THZ_API void thz_interp_rotation(const double *t, const double *rotate_deg, size_t k,
-                                 double time_s, double out_deg[3]);
+THZ_API void thz_interp_rotation(const double *t, const double *rotate_deg, size_t k, double time_s,
+                                 double out_deg[3]);
 
 #ifdef __cplusplus
 }

@@ -118,8 +118,9 @@ thz_status thz_output_add_file(thz_output *output, const char *name, const void 
 {
     if (!output || !name || !name[0] || strchr(name, '/') || !strcmp(name, ".") ||
         !strcmp(name, "..") || (size && !data))
-        return thz_error_set(err, THZ_ERR_INPUT, "thz_output_add_file: expected an output, a "
-                                                 "plain file name and data");
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "thz_output_add_file: expected an output, a "
+                             "plain file name and data");
     char path[THZ_PATH_MAX];
     thz_status st = thz_path_join(path, sizeof path, output_stage_dir(output->stage), name, err);
     if (st != THZ_OK)

@@ -39,9 +39,9 @@ struct movie_writer {
 };
 
 /* viridis at 9 even stops (its lightness rises monotonically) */
-static const unsigned char movie_viridis[9][3] = {
-    {68, 1, 84},    {71, 44, 122},  {59, 81, 139},  {44, 113, 142}, {33, 144, 141},
-    {39, 173, 129}, {92, 200, 99},  {170, 220, 50}, {253, 231, 37}};
+static const unsigned char movie_viridis[9][3] = {{68, 1, 84},    {71, 44, 122},  {59, 81, 139},
+                                                  {44, 113, 142}, {33, 144, 141}, {39, 173, 129},
+                                                  {92, 200, 99},  {170, 220, 50}, {253, 231, 37}};
 
 static void movie_colour(double x, uint8_t rgb[3])
 {
@@ -61,10 +61,10 @@ static unsigned movie_glyph(char c)
 {
     static const char chars[] = "0123456789.-=tsK";
     static const unsigned rows[][5] = {
-        {7, 5, 5, 5, 7}, {2, 6, 2, 2, 7}, {7, 1, 7, 4, 7}, {7, 1, 7, 1, 7}, {5, 5, 7, 1, 1},
-        {7, 4, 7, 1, 7}, {7, 4, 7, 5, 7}, {7, 1, 1, 1, 1}, {7, 5, 7, 5, 7}, {7, 5, 7, 1, 7},
-        {0, 0, 0, 0, 2}, {0, 0, 7, 0, 0}, {0, 7, 0, 7, 0}, {2, 7, 2, 2, 1}, {3, 4, 2, 1, 6},
-        {5, 6, 4, 6, 5}};
+        {7, 5, 5, 5, 7}, {2, 6, 2, 2, 7}, {7, 1, 7, 4, 7}, {7, 1, 7, 1, 7},
+        {5, 5, 7, 1, 1}, {7, 4, 7, 1, 7}, {7, 4, 7, 5, 7}, {7, 1, 1, 1, 1},
+        {7, 5, 7, 5, 7}, {7, 5, 7, 1, 7}, {0, 0, 0, 0, 2}, {0, 0, 7, 0, 0},
+        {0, 7, 0, 7, 0}, {2, 7, 2, 2, 1}, {3, 4, 2, 1, 6}, {5, 6, 4, 6, 5}};
     const char *p = strchr(chars, c);
     if (!p || !c)
         return 0;
@@ -254,8 +254,7 @@ thz_status movie_add_frame(movie_writer *m, const float *tb, double time_s, thz_
         return movie_av_error(err, m->spec.path, "frame buffer", rc);
     const uint8_t *src[1] = {m->rgb};
     const int stride[1] = {(int)m->layout.width * 3};
-    sws_scale(m->sws, src, stride, 0, (int)m->layout.height, m->frame->data,
-              m->frame->linesize);
+    sws_scale(m->sws, src, stride, 0, (int)m->layout.height, m->frame->data, m->frame->linesize);
     m->frame->pts = m->pts++;
     return movie_encode(m, m->frame, err);
 }

@@ -16,17 +16,17 @@
 #include "thzmap/thzmap.h"
 
 struct thz_sequence {
-    char *path;        /* the sequence file as given */
-    char *scene_path;  /* its scene, resolved against the sequence's directory */
-    char *scene_dir;   /* the scene's directory: relative paths in frame scenes */
-    double fps;        /* frames per second */
-    size_t frames;     /* per sweep value */
-    size_t n_sweeps;   /* sweep values (1 without a sweep) */
-    int has_sweep;     /* frame directories under sweep-NN/ */
-    size_t n_frames;   /* frames * n_sweeps */
-    char **frame_json; /* per frame: the scene text (compact, sorted keys) */
-    char **frame_dir;  /* per frame: "frame-NNNNN" or "sweep-NN/frame-NNNNN" */
-    uint64_t *hash;    /* per frame: hash of its inputs */
+    char *path;         /* the sequence file as given */
+    char *scene_path;   /* its scene, resolved against the sequence's directory */
+    char *scene_dir;    /* the scene's directory: relative paths in frame scenes */
+    double fps;         /* frames per second */
+    size_t frames;      /* per sweep value */
+    size_t n_sweeps;    /* sweep values (1 without a sweep) */
+    int has_sweep;      /* frame directories under sweep-NN/ */
+    size_t n_frames;    /* frames * n_sweeps */
+    char **frame_json;  /* per frame: the scene text (compact, sorted keys) */
+    char **frame_dir;   /* per frame: "frame-NNNNN" or "sweep-NN/frame-NNNNN" */
+    uint64_t *hash;     /* per frame: hash of its inputs */
     char **sweep_label; /* per sweep value: "atmosphere.relative_humidity = 0.5, ..." */
 };
 

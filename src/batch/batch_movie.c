@@ -144,8 +144,7 @@ thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_
                                "(movies need the same ones in every sweep value)",
                                seq->path, s);
     }
-    float *band = st == THZ_OK ? thz_malloc_array(max_pixels ? max_pixels : 1, sizeof *band)
-                               : NULL;
+    float *band = st == THZ_OK ? thz_malloc_array(max_pixels ? max_pixels : 1, sizeof *band) : NULL;
     if (st == THZ_OK && !band)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     size_t n_sensors = st == THZ_OK ? sw[0].n : 0, n_channels = st == THZ_OK ? sw[0].n_channels : 0;

@@ -128,9 +128,9 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
         json_object_set_new(e, "input_hash", json_string(hex));
         json_object_set_new(e, "status", json_string(batch_state_name(b->state[f])));
         if (b->state[f] == FRAME_COMPUTED || b->state[f] == FRAME_REUSED)
-            json_object_set_new(e, "computed",
-                                json_string(b->state[f] == FRAME_COMPUTED ? "this run"
-                                                                          : "an earlier run"));
+            json_object_set_new(
+                e, "computed",
+                json_string(b->state[f] == FRAME_COMPUTED ? "this run" : "an earlier run"));
         json_object_set_new(e, "seconds",
                             b->state[f] == FRAME_COMPUTED ? json_real(b->seconds[f]) : json_null());
         json_array_append_new(frames, e);

@@ -55,14 +55,20 @@ static thz_status seq_fail(const seq_build *b, const char *where, const char *fm
 static const char *seq_type(const json_t *v)
 {
     switch (json_typeof(v)) {
-    case JSON_OBJECT: return "an object";
-    case JSON_ARRAY: return "an array";
-    case JSON_STRING: return "a string";
+    case JSON_OBJECT:
+        return "an object";
+    case JSON_ARRAY:
+        return "an array";
+    case JSON_STRING:
+        return "a string";
     case JSON_INTEGER:
-    case JSON_REAL: return "a number";
+    case JSON_REAL:
+        return "a number";
     case JSON_TRUE:
-    case JSON_FALSE: return "a boolean";
-    default: return "null";
+    case JSON_FALSE:
+        return "a boolean";
+    default:
+        return "null";
     }
 }
 
@@ -129,7 +135,8 @@ static thz_status seq_check_path(const seq_build *b, const char *where, const ch
         return seq_fail(b, where, "%s", what);
     }
     if (leaf && depth < (!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors") ? 3u : 2u))
-        return seq_fail(b, where, "%s", "expected a path to a value, e.g. objects.NAME.temperature_k");
+        return seq_fail(b, where, "%s",
+                        "expected a path to a value, e.g. objects.NAME.temperature_k");
     return THZ_OK;
 }
 
@@ -157,8 +164,7 @@ static thz_status seq_add_value(seq_build *b, const char *where, const char *con
     for (size_t i = 0; ok && json_is_array(v) && i < n; i++)
         ok = json_is_number(json_array_get(v, i));
     if (!ok)
-        return seq_fail(b, where, "expected a number or an array of numbers, got %s",
-                        seq_type(v));
+        return seq_fail(b, where, "expected a number or an array of numbers, got %s", seq_type(v));
     int rotation = !strcmp(seg[depth - 1], "rotate_deg");
     if (rotation && (!json_is_array(v) || n != 3))
         return seq_fail(b, where, "%s", "expected [rx, ry, rz] in degrees");
@@ -308,7 +314,8 @@ static thz_status seq_check_sweep(seq_build *b, size_t *n_sweeps)
         size_t depth = seq_split(buf, seg);
         for (size_t i = 0; i < depth; i++)
             if (!seg[i][0])
-                return seq_fail(b, where, "%s", "expected a dotted key like atmosphere.relative_humidity");
+                return seq_fail(b, where, "%s",
+                                "expected a dotted key like atmosphere.relative_humidity");
         thz_status st = seq_check_path(b, where, seg, depth, 1);
         if (st != THZ_OK)
             return st;
@@ -331,8 +338,7 @@ static int seq_apply_sweep(const seq_build *b, size_t s, json_t *doc, char *labe
     size_t stride = 1;
     const char *key;
     json_t *vals;
-    json_object_foreach(b->sweep, key, vals)
-        stride *= json_array_size(vals);
+    json_object_foreach(b->sweep, key, vals) stride *= json_array_size(vals);
     json_object_foreach(b->sweep, key, vals)
     {
         stride /= json_array_size(vals);
@@ -566,8 +572,7 @@ thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *er
                                              seq->scene_path, je.line, je.column, je.text)
                              : thz_error_set(err, THZ_ERR_INPUT, "%s: scene: %s", path, je.text);
         else if (!json_is_object(b.scene))
-            st = thz_error_set(err, THZ_ERR_INPUT, "%s: expected a scene object",
-                               seq->scene_path);
+            st = thz_error_set(err, THZ_ERR_INPUT, "%s: expected a scene object", seq->scene_path);
     }
     if (st == THZ_OK && keyframes)
         st = seq_keyframes(&b, keyframes);

@@ -42,8 +42,7 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
         char eta[64] = "";
         if (p->computed > 0) {
             double per_frame = p->seconds / (double)p->computed;
-            snprintf(eta, sizeof eta, ", ETA %.0f s",
-                     per_frame * (double)(p->n_frames - finished));
+            snprintf(eta, sizeof eta, ", ETA %.0f s", per_frame * (double)(p->n_frames - finished));
         }
         fprintf(stderr, "thzmap batch: frame %zu/%zu (%zu done, %zu reused), %.1f s%s\n",
                 p->frame + 1, p->n_frames, finished, p->reused, p->seconds, eta);
