@@ -5,6 +5,7 @@
  * and checked by loading it, and the hash of each frame's inputs.
  */
 #include <jansson.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -371,7 +372,7 @@ static int seq_apply_tracks(const seq_build *b, double time_s, json_t *doc)
             thz_interp_linear(tr->t, tr->v, tr->k, tr->n, time_s, x);
         json_t *v = tr->is_array ? json_array() : NULL;
         for (size_t m = 0; m < tr->n; m++) {
-            json_t *num = tr->all_integers && x[m] == (double)(json_int_t)x[m]
+            json_t *num = tr->all_integers && fabs(x[m]) < 9.0e15 && x[m] == floor(x[m])
                               ? json_integer((json_int_t)x[m])
                               : json_real(x[m]);
             if (tr->is_array)

@@ -26,8 +26,6 @@ static void batch_usage(FILE *f)
 
 typedef struct batch_cli {
     bool quiet;
-    bool tty;
-    size_t last_frame;
 } batch_cli;
 
 static int batch_on_progress(void *user, const thz_batch_progress *p)
