@@ -78,7 +78,8 @@ thz_status movie_add_frame(movie_writer *m, const float *tb, double time_s, thz_
 thz_status movie_finish(movie_writer *m, thz_error *err);
 /* Frees; removes the temporary file if not finished. NULL: nothing. */
 void movie_destroy(movie_writer *m);
-/* The encoder's name: "libx264", or "mpeg4" where libavcodec lacks libx264; static. */
-const char *movie_codec_name(void);
+/* The encoder's name: "libx264", or "mpeg4" where libavcodec lacks libx264 (valid while
+ * m lives). */
+const char *movie_codec(const movie_writer *m);
 
 #endif

@@ -84,6 +84,8 @@ static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, s
     }
     if (st == THZ_OK)
         st = movie_finish(m, err);
+    char codec[32];
+    snprintf(codec, sizeof codec, "%s", movie_codec(m));
     movie_destroy(m);
     if (st != THZ_OK)
         return st;
@@ -99,7 +101,7 @@ static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, s
     json_object_set_new(e, "quantity", json_string("brightness_temperature"));
     json_object_set_new(e, "frames", json_integer((json_int_t)seq->frames));
     json_object_set_new(e, "fps", json_real(seq->fps));
-    json_object_set_new(e, "codec", json_string(movie_codec_name()));
+    json_object_set_new(e, "codec", json_string(codec));
     json_object_set_new(scale, "min_k", json_real(lo));
     json_object_set_new(scale, "max_k", json_real(hi));
     json_object_set_new(scale, "colour_map", json_string("viridis"));
