@@ -1,8 +1,9 @@
 /* Sequences and batches (include/thzmap/batch.h): what a loaded sequence holds, and
  * what the files of src/batch/ share. batch_sequence.c loads and checks a sequence and
- * builds every frame's scene text; batch_interp.c interpolates; batch_run.c runs the
- * frames and writes batch.json; batch_movie.c (the only file that includes FFmpeg)
- * encodes the movies. Nothing here is public.
+ * builds every frame's scene text; batch_frames.c gives the frames out; batch_interp.c
+ * interpolates; batch_run.c runs the frames and writes batch.json; batch_movie.c makes
+ * the movies from the frames' cubes, through batch_encode.c (the only file that
+ * includes FFmpeg). Nothing here is public.
  */
 #ifndef THZ_BATCH_BATCH_INTERNAL_H
 #define THZ_BATCH_BATCH_INTERNAL_H
