@@ -76,11 +76,11 @@ static const char *const movie_sonames[4] = {
     "libavformat.so." AV_STRINGIFY(LIBAVFORMAT_VERSION_MAJOR),
     "libswscale.so." AV_STRINGIFY(LIBSWSCALE_VERSION_MAJOR)};
 
+/* Forgets the libraries without closing them: FFmpeg's dependencies keep state from
+ * their initialisers (allocations that would leak, and codecs registered once), so
+ * they stay loaded for the process, as if linked; opening them again is cheap. */
 static void movie_av_close(movie_av *av)
 {
-    for (int i = 3; i >= 0; i--)
-        if (av->lib[i])
-            dlclose(av->lib[i]);
     memset(av, 0, sizeof *av);
 }
 
