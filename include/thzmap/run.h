@@ -232,6 +232,10 @@ THZ_API thz_status thz_output_open(const char *outdir, thz_output **out, thz_err
 THZ_API thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run,
                                       const thz_write_options *opt, thz_error *err);
 THZ_API thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_error *err);
+/* Adds a file of the caller's (`name`: a plain file name, no '/') holding `size` bytes
+ * of `data`, committed with the rest (e.g. a batch frame's frame.json). */
+THZ_API thz_status thz_output_add_file(thz_output *output, const char *name, const void *data,
+                                       size_t size, thz_error *err);
 THZ_API thz_status thz_output_commit(thz_output *output, thz_error *err);
 THZ_API void thz_output_destroy(thz_output *output);
 

@@ -1,9 +1,13 @@
 /* Writing results: an atomic output directory (io/output.h's staging) that runs and
  * images are added to, and the one-call writers built on it. */
+#include <errno.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "api/api.h"
 #include "core/alloc.h"
+#include "core/path.h"
 #include "io/output.h"
 
 struct thz_output {
@@ -107,4 +111,24 @@ thz_status thz_image_write(thz_context *ctx, const thz_image *image, const char 
         st = thz_output_commit(o, err);
     thz_output_destroy(o);
     return api_done(ctx, st, err);
+}
+
+thz_status thz_output_add_file(thz_output *output, const char *name, const void *data, size_t size,
+                               thz_error *err)
+{
+    if (!output || !name || !name[0] || strchr(name, '/') || !strcmp(name, ".") ||
+        !strcmp(name, "..") || (size && !data))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "thz_output_add_file: expected an output, a "
+                             "plain file name and data");
+    char path[THZ_PATH_MAX];
+    thz_status st = thz_path_join(path, sizeof path, output_stage_dir(output->stage), name, err);
+    if (st != THZ_OK)
+        return st;
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+    int ok = fwrite(data, 1, size, f) == size;
+    ok &= fclose(f) == 0;
+    return ok ? THZ_OK : thz_error_set(err, THZ_ERR_IO, "%s: cannot write", path);
 }

@@ -20,6 +20,7 @@ static const command commands[] = {
     {"simulate", cmd_simulate, "fire photons and render every sensor of a scene"},
     {"render", cmd_render, "re-render sensors of a scene from a saved photon map"},
     {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency"},
+    {"batch", cmd_batch, "run a sequence of frames (keyframes, sweeps) and make movies"},
 };
 
 static void print_usage(FILE *f)

@@ -1,0 +1,81 @@
+/* A loaded sequence's frames through the public API (include/thzmap/batch.h): counts,
+ * each frame's place, time, directory and input hash, its scene as JSON text or loaded,
+ * and freeing. batch_sequence.c builds what these read.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "batch/batch_internal.h"
+#include "core/error.h"
+
+void thz_sequence_destroy(thz_sequence *seq)
+{
+    if (!seq)
+        return;
+    for (size_t f = 0; f < seq->n_frames; f++) {
+        if (seq->frame_json)
+            free(seq->frame_json[f]);
+        if (seq->frame_dir)
+            free(seq->frame_dir[f]);
+    }
+    for (size_t s = 0; seq->sweep_label && s < seq->n_sweeps; s++)
+        free(seq->sweep_label[s]);
+    free(seq->frame_json);
+    free(seq->frame_dir);
+    free(seq->hash);
+    free(seq->sweep_label);
+    free(seq->path);
+    free(seq->scene_path);
+    free(seq->scene_dir);
+    free(seq);
+}
+
+size_t thz_sequence_frame_count(const thz_sequence *seq)
+{
+    return seq ? seq->n_frames : 0;
+}
+
+size_t thz_sequence_sweep_count(const thz_sequence *seq)
+{
+    return seq ? seq->n_sweeps : 0;
+}
+
+size_t thz_sequence_frames_per_sweep(const thz_sequence *seq)
+{
+    return seq ? seq->frames : 0;
+}
+
+thz_status thz_sequence_frame(const thz_sequence *seq, size_t i, thz_frame_info *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!seq || i >= seq->n_frames)
+        return THZ_ERR_INPUT;
+    *out = (thz_frame_info){.sweep = i / seq->frames,
+                            .index = i % seq->frames,
+                            .time_s = (double)(i % seq->frames) / seq->fps,
+                            .dir = seq->frame_dir[i],
+                            .hash = seq->hash[i]};
+    return THZ_OK;
+}
+
+size_t thz_sequence_frame_json(const thz_sequence *seq, size_t i, char *buf, size_t size)
+{
+    if (!seq || i >= seq->n_frames || !seq->frame_json[i])
+        return 0;
+    size_t len = strlen(seq->frame_json[i]);
+    if (buf && size > 0) {
+        size_t n = len < size - 1 ? len : size - 1;
+        memcpy(buf, seq->frame_json[i], n);
+        buf[n] = '\0';
+    }
+    return len;
+}
+
+thz_status thz_sequence_frame_scene(const thz_sequence *seq, size_t i, thz_scene **out,
+                                    thz_error *err)
+{
+    *out = NULL;
+    if (!seq || i >= seq->n_frames || !seq->frame_json[i])
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_sequence_frame_scene: no frame %zu", i);
+    return thz_scene_load_string(seq->frame_json[i], seq->scene_dir, seq->scene_path, out, err);
+}

@@ -1,0 +1,86 @@
+/* Sequences and batches (include/thzmap/batch.h): what a loaded sequence holds, and
+ * what the files of src/batch/ share. batch_sequence.c loads and checks a sequence and
+ * builds every frame's scene text; batch_frames.c gives the frames out; batch_interp.c
+ * interpolates; batch_run.c runs the frames and writes batch.json; batch_movie.c makes
+ * the movies from the frames' cubes, through batch_encode.c (the only file that
+ * includes FFmpeg). Nothing here is public.
+ */
+#ifndef THZ_BATCH_BATCH_INTERNAL_H
+#define THZ_BATCH_BATCH_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <jansson.h>
+
+#include "thzmap/batch.h"
+#include "thzmap/thzmap.h"
+
+struct thz_sequence {
+    char *path;         /* the sequence file as given */
+    char *scene_path;   /* its scene, resolved against the sequence's directory */
+    char *scene_dir;    /* the scene's directory: relative paths in frame scenes */
+    double fps;         /* frames per second */
+    size_t frames;      /* per sweep value */
+    size_t n_sweeps;    /* sweep values (1 without a sweep) */
+    int has_sweep;      /* frame directories under sweep-NN/ */
+    size_t n_frames;    /* frames * n_sweeps */
+    char **frame_json;  /* per frame: the scene text (compact, sorted keys) */
+    char **frame_dir;   /* per frame: "frame-NNNNN" or "sweep-NN/frame-NNNNN" */
+    uint64_t *hash;     /* per frame: hash of its inputs */
+    char **sweep_label; /* per sweep value: "atmosphere.relative_humidity = 0.5, ..." */
+};
+
+/* The keyframe segment j (0 .. k-2) holding time_s and the weight u in [0, 1] of its
+ * end (held beyond the ends: u = 0 before the first, 1 after the last). */
+void batch_segment(const double *t, size_t k, double time_s, size_t *j, double *u);
+
+/* 64-bit FNV-1a of n bytes, continuing from h (start with BATCH_HASH_INIT). */
+#define BATCH_HASH_INIT UINT64_C(14695981039346656037)
+uint64_t batch_hash_bytes(uint64_t h, const void *data, size_t n);
+
+/* Reads band `channel` of an ENVI float32 cube of `columns * rows * channels` values
+ * into out (columns * rows); THZ_ERR_IO naming the file when it is missing or short. */
+thz_status batch_read_band(const char *path, uint32_t columns, uint32_t rows, size_t channels,
+                           size_t channel, float *out, thz_error *err);
+
+/* Encodes the movies of every sweep value, sensor and channel from the frames' cubes in
+ * outdir ([sweep-NN/]S.band-NN.mp4, each written to a temporary name and renamed), on
+ * one colour scale per sensor and channel over all frames; appends their descriptions
+ * to `movies` (a JSON array, batch.json's "movies"). Deterministic: the same frames give
+ * the same bytes. */
+thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_t *movies,
+                              thz_error *err);
+
+/* ---- batch_encode.c: one movie, frame by frame (the only code that includes FFmpeg) -- */
+
+/* The picture of a movie frame: the Tb image scaled by `pixel` (whole pixels), its top
+ * left corner at (image_x, image_y), a strip above it with the frame time, a colour
+ * bar with the scale's ends at its right; width x height in all (both even). */
+typedef struct movie_layout {
+    uint32_t pixel, image_x, image_y, width, height;
+} movie_layout;
+
+typedef struct movie_spec {
+    const char *path; /* the .mp4 */
+    uint32_t columns, rows;
+    double fps;
+    double tb_min_k, tb_max_k; /* the colour scale, K */
+} movie_spec;
+
+typedef struct movie_writer movie_writer;
+
+void movie_layout_of(uint32_t columns, uint32_t rows, movie_layout *out);
+/* Opens the encoder on a temporary file beside spec->path. */
+thz_status movie_open(const movie_spec *spec, movie_writer **out, thz_error *err);
+/* Encodes the next frame: tb (columns * rows, K, row 0 at the top) at time_s. */
+thz_status movie_add_frame(movie_writer *m, const float *tb, double time_s, thz_error *err);
+/* Finishes the file and renames it to spec->path. */
+thz_status movie_finish(movie_writer *m, thz_error *err);
+/* Frees; removes the temporary file if not finished. NULL: nothing. */
+void movie_destroy(movie_writer *m);
+/* The encoder's name: "libx264", or "mpeg4" where libavcodec lacks libx264 (valid while
+ * m lives). */
+const char *movie_codec(const movie_writer *m);
+
+#endif

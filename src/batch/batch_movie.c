@@ -1,0 +1,181 @@
+/* The movies of a batch: per sweep value, sensor and channel, [sweep-NN/]S.band-NN.mp4
+ * of the brightness temperature, read back from the frames' S.brightness_temperature
+ * cubes (so that a resumed batch, whose earlier frames are only on disk, makes the same
+ * movies as an uninterrupted one). One colour scale per sensor and channel: the least
+ * and greatest finite Tb over every frame of every sweep value.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "batch/batch_internal.h"
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/path.h"
+
+thz_status batch_read_band(const char *path, uint32_t columns, uint32_t rows, size_t channels,
+                           size_t channel, float *out, thz_error *err)
+{
+    size_t n = (size_t)columns * rows;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot open (a frame's cube)", path);
+    int ok = channel < channels && fseek(f, (long)(channel * n * sizeof(float)), SEEK_SET) == 0 &&
+             fread(out, sizeof(float), n, f) == n;
+    fclose(f);
+    if (!ok)
+        return thz_error_set(err, THZ_ERR_IO, "%s: shorter than %u x %u x %zu floats", path,
+                             columns, rows, channels);
+    /* ENVI byte order 0 (little-endian): swap on a big-endian host */
+    const uint16_t probe = 1;
+    if (*(const unsigned char *)&probe == 0)
+        for (size_t i = 0; i < n; i++) {
+            unsigned char *b = (unsigned char *)&out[i], t;
+            t = b[0], b[0] = b[3], b[3] = t;
+            t = b[1], b[1] = b[2], b[2] = t;
+        }
+    return THZ_OK;
+}
+
+/* The sensors of sweep value s (from its first frame's scene). */
+typedef struct sweep_sensors {
+    size_t n;
+    thz_sensor_info *info; /* names borrowed from scene */
+    thz_scene *scene;
+    size_t n_channels;
+} sweep_sensors;
+
+static thz_status batch_cube_path(const thz_sequence *seq, const char *outdir, size_t f,
+                                  const char *sensor, char *path, size_t size, thz_error *err)
+{
+    if (snprintf(path, size, "%s/%s/%s.brightness_temperature.img", outdir, seq->frame_dir[f],
+                 sensor) >= (int)size)
+        return thz_error_set(err, THZ_ERR_IO, "%s: path too long", outdir);
+    return THZ_OK;
+}
+
+static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, size_t s,
+                                  const thz_sensor_info *si, size_t c, double lo, double hi,
+                                  float *band, json_t *movies, thz_error *err)
+{
+    char path[THZ_PATH_MAX], name[512], cube[THZ_PATH_MAX];
+    snprintf(name, sizeof name, "%s.band-%02zu.mp4", si->name, c + 1);
+    char sub[32] = "";
+    if (seq->has_sweep)
+        snprintf(sub, sizeof sub, "sweep-%02zu/", s);
+    if (snprintf(path, sizeof path, "%s/%s%s", outdir, sub, name) >= (int)sizeof path)
+        return thz_error_set(err, THZ_ERR_IO, "%s: path too long", outdir);
+    movie_spec spec = {.path = path,
+                       .columns = si->columns,
+                       .rows = si->rows,
+                       .fps = seq->fps,
+                       .tb_min_k = lo,
+                       .tb_max_k = hi};
+    movie_writer *m = NULL;
+    thz_status st = movie_open(&spec, &m, err);
+    for (size_t i = 0; st == THZ_OK && i < seq->frames; i++) {
+        size_t f = s * seq->frames + i;
+        st = batch_cube_path(seq, outdir, f, si->name, cube, sizeof cube, err);
+        if (st == THZ_OK)
+            st = batch_read_band(cube, si->columns, si->rows, si->channels, c, band, err);
+        if (st == THZ_OK)
+            st = movie_add_frame(m, band, (double)i / seq->fps, err);
+    }
+    if (st == THZ_OK)
+        st = movie_finish(m, err);
+    char codec[32];
+    snprintf(codec, sizeof codec, "%s", movie_codec(m));
+    movie_destroy(m);
+    if (st != THZ_OK)
+        return st;
+    movie_layout l;
+    movie_layout_of(si->columns, si->rows, &l);
+    json_t *e = json_object(), *scale = json_object(), *layout = json_object();
+    char file[600];
+    snprintf(file, sizeof file, "%s%s", sub, name);
+    json_object_set_new(e, "file", json_string(file));
+    json_object_set_new(e, "sensor", json_string(si->name));
+    json_object_set_new(e, "band", json_integer((json_int_t)(c + 1)));
+    json_object_set_new(e, "sweep", json_integer((json_int_t)s));
+    json_object_set_new(e, "quantity", json_string("brightness_temperature"));
+    json_object_set_new(e, "frames", json_integer((json_int_t)seq->frames));
+    json_object_set_new(e, "fps", json_real(seq->fps));
+    json_object_set_new(e, "codec", json_string(codec));
+    json_object_set_new(scale, "min_k", json_real(lo));
+    json_object_set_new(scale, "max_k", json_real(hi));
+    json_object_set_new(scale, "colour_map", json_string("viridis"));
+    json_object_set_new(e, "colour_scale", scale);
+    json_object_set_new(layout, "image_x_px", json_integer(l.image_x));
+    json_object_set_new(layout, "image_y_px", json_integer(l.image_y));
+    json_object_set_new(layout, "pixel_px", json_integer(l.pixel));
+    json_object_set_new(layout, "width_px", json_integer(l.width));
+    json_object_set_new(layout, "height_px", json_integer(l.height));
+    json_object_set_new(e, "layout", layout);
+    json_array_append_new(movies, e);
+    return THZ_OK;
+}
+
+thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_t *movies,
+                              thz_error *err)
+{
+    sweep_sensors *sw = thz_calloc(seq->n_sweeps, sizeof *sw);
+    if (!sw)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    thz_status st = THZ_OK;
+    size_t max_pixels = 0;
+    for (size_t s = 0; st == THZ_OK && s < seq->n_sweeps; s++) {
+        st = thz_sequence_frame_scene(seq, s * seq->frames, &sw[s].scene, err);
+        if (st != THZ_OK)
+            break;
+        sw[s].n = thz_scene_sensor_count(sw[s].scene);
+        sw[s].n_channels = thz_scene_channel_count(sw[s].scene);
+        sw[s].info = thz_calloc(sw[s].n, sizeof *sw[s].info);
+        if (!sw[s].info) {
+            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+            break;
+        }
+        for (size_t k = 0; k < sw[s].n; k++) {
+            thz_scene_sensor(sw[s].scene, k, &sw[s].info[k]);
+            size_t px = (size_t)sw[s].info[k].columns * sw[s].info[k].rows;
+            max_pixels = px > max_pixels ? px : max_pixels;
+        }
+        if (sw[s].n != sw[0].n || sw[s].n_channels != sw[0].n_channels)
+            st = thz_error_set(err, THZ_ERR_INPUT,
+                               "%s: sweep value %zu changes the scene's sensors or channels "
+                               "(movies need the same ones in every sweep value)",
+                               seq->path, s);
+    }
+    float *band = st == THZ_OK ? thz_malloc_array(max_pixels ? max_pixels : 1, sizeof *band) : NULL;
+    if (st == THZ_OK && !band)
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    size_t n_sensors = st == THZ_OK ? sw[0].n : 0, n_channels = st == THZ_OK ? sw[0].n_channels : 0;
+    for (size_t k = 0; st == THZ_OK && k < n_sensors; k++)
+        for (size_t c = 0; st == THZ_OK && c < n_channels; c++) {
+            /* the colour scale over every frame of every sweep value */
+            double lo = INFINITY, hi = -INFINITY;
+            for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++) {
+                const thz_sensor_info *si = &sw[f / seq->frames].info[k];
+                char cube[THZ_PATH_MAX];
+                st = batch_cube_path(seq, outdir, f, si->name, cube, sizeof cube, err);
+                if (st == THZ_OK)
+                    st = batch_read_band(cube, si->columns, si->rows, si->channels, c, band, err);
+                for (size_t p = 0; st == THZ_OK && p < (size_t)si->columns * si->rows; p++)
+                    if (isfinite(band[p])) {
+                        lo = fmin(lo, band[p]);
+                        hi = fmax(hi, band[p]);
+                    }
+            }
+            if (!(lo <= hi))
+                lo = hi = 0.0;
+            for (size_t s = 0; st == THZ_OK && s < seq->n_sweeps; s++)
+                st = batch_one_movie(seq, outdir, s, &sw[s].info[k], c, lo, hi, band, movies, err);
+        }
+    free(band);
+    for (size_t s = 0; s < seq->n_sweeps; s++) {
+        free(sw[s].info);
+        thz_scene_destroy(sw[s].scene);
+    }
+    free(sw);
+    return st;
+}

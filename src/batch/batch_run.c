@@ -1,0 +1,349 @@
+/* Running a sequence (thz_batch_run): every frame as `thzmap simulate` would, each into
+ * its own atomic output directory (thz_output) holding frame.json with the hash of the
+ * frame's inputs; OUTDIR/batch.json rewritten (temporary file, then rename) after each
+ * frame; the movies at the end, rebuilt from the frames' files. A frame directory whose
+ * frame.json carries the frame's hash is finished and is not run again, which is all
+ * that resuming a killed batch needs: a frame appears whole or not at all.
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <jansson.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "batch/batch_internal.h"
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/path.h"
+
+typedef enum frame_state { FRAME_PENDING, FRAME_REUSED, FRAME_COMPUTED, FRAME_FAILED } frame_state;
+
+typedef struct batch_state {
+    const thz_sequence *seq;
+    const char *outdir;
+    frame_state *state;
+    double *seconds; /* per frame computed by this call, s */
+    json_t *movies;  /* the movies' descriptions (batch.json "movies") */
+    double t0, seconds_frames, seconds_movies;
+    size_t computed, reused;
+} batch_state;
+
+static double batch_now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* mkdir -p */
+static thz_status batch_mkdirs(const char *dir, thz_error *err)
+{
+    char path[THZ_PATH_MAX];
+    if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path)
+        return thz_error_set(err, THZ_ERR_IO, "%s: path too long", dir);
+    for (char *p = path + 1;; p++) {
+        char c = *p;
+        if (c != '/' && c != '\0')
+            continue;
+        *p = '\0';
+        if (mkdir(path, 0777) != 0 && errno != EEXIST)
+            return thz_error_set(err, THZ_ERR_IO, "%s: cannot create the directory: %s", path,
+                                 strerror(errno));
+        *p = c;
+        if (!c)
+            break;
+    }
+    struct stat st;
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+        return thz_error_set(err, THZ_ERR_IO, "%s: not a directory", dir);
+    return THZ_OK;
+}
+
+static void batch_hex(uint64_t h, char hex[17])
+{
+    snprintf(hex, 17, "%016llx", (unsigned long long)h);
+}
+
+/* Whether frame f's directory holds a finished frame with the same inputs. */
+static int batch_frame_done(const batch_state *b, size_t f)
+{
+    char path[THZ_PATH_MAX], hex[17];
+    if (snprintf(path, sizeof path, "%s/%s/frame.json", b->outdir, b->seq->frame_dir[f]) >=
+        (int)sizeof path)
+        return 0;
+    json_t *doc = json_load_file(path, 0, NULL);
+    batch_hex(b->seq->hash[f], hex);
+    const char *h = json_string_value(json_object_get(doc, "input_hash"));
+    int done = h && !strcmp(h, hex);
+    json_decref(doc);
+    return done;
+}
+
+/* Writes text to outdir/name through a temporary file and a rename. */
+static thz_status batch_write_atomic(const char *outdir, const char *name, const char *text,
+                                     thz_error *err)
+{
+    char path[THZ_PATH_MAX], tmp[THZ_PATH_MAX];
+    if (snprintf(path, sizeof path, "%s/%s", outdir, name) >= (int)sizeof path ||
+        snprintf(tmp, sizeof tmp, "%s/.%s.part", outdir, name) >= (int)sizeof tmp)
+        return thz_error_set(err, THZ_ERR_IO, "%s: path too long", outdir);
+    FILE *f = fopen(tmp, "wb");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", tmp, strerror(errno));
+    size_t n = strlen(text);
+    int ok = fwrite(text, 1, n, f) == n && fputc('\n', f) != EOF;
+    ok &= fflush(f) == 0 && fsync(fileno(f)) == 0;
+    ok &= fclose(f) == 0;
+    if (!ok || rename(tmp, path) != 0) {
+        unlink(tmp);
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot write", path);
+    }
+    return THZ_OK;
+}
+
+static const char *batch_state_name(frame_state s)
+{
+    return s == FRAME_PENDING ? "pending" : s == FRAME_FAILED ? "failed" : "done";
+}
+
+static thz_status batch_write_json(const batch_state *b, thz_error *err)
+{
+    const thz_sequence *seq = b->seq;
+    json_t *root = json_object(), *frames = json_array(), *sweeps = json_array();
+    size_t done = 0;
+    for (size_t f = 0; f < seq->n_frames; f++) {
+        char hex[17];
+        batch_hex(seq->hash[f], hex);
+        json_t *e = json_object();
+        json_object_set_new(e, "frame", json_integer((json_int_t)f));
+        json_object_set_new(e, "sweep", json_integer((json_int_t)(f / seq->frames)));
+        json_object_set_new(e, "index", json_integer((json_int_t)(f % seq->frames)));
+        json_object_set_new(e, "time_s", json_real((double)(f % seq->frames) / seq->fps));
+        json_object_set_new(e, "dir", json_string(seq->frame_dir[f]));
+        json_object_set_new(e, "input_hash", json_string(hex));
+        json_object_set_new(e, "status", json_string(batch_state_name(b->state[f])));
+        if (b->state[f] == FRAME_COMPUTED || b->state[f] == FRAME_REUSED)
+            json_object_set_new(
+                e, "computed",
+                json_string(b->state[f] == FRAME_COMPUTED ? "this run" : "an earlier run"));
+        json_object_set_new(e, "seconds",
+                            b->state[f] == FRAME_COMPUTED ? json_real(b->seconds[f]) : json_null());
+        json_array_append_new(frames, e);
+        done += b->state[f] == FRAME_COMPUTED || b->state[f] == FRAME_REUSED;
+    }
+    for (size_t s = 0; s < seq->n_sweeps && seq->has_sweep; s++) {
+        char dir[32];
+        snprintf(dir, sizeof dir, "sweep-%02zu", s);
+        json_t *e = json_object();
+        json_object_set_new(e, "dir", json_string(dir));
+        json_object_set_new(e, "values", json_string(seq->sweep_label[s]));
+        json_array_append_new(sweeps, e);
+    }
+    json_t *t = json_object();
+    json_object_set_new(t, "frames", json_real(b->seconds_frames));
+    json_object_set_new(t, "movies", json_real(b->seconds_movies));
+    json_object_set_new(t, "total", json_real(batch_now_s() - b->t0));
+    json_object_set_new(root, "format", json_string("thzmap-batch/1"));
+    json_object_set_new(root, "thzmap_version", json_string(THZ_VERSION_STRING));
+    json_object_set_new(root, "sequence", json_string(seq->path));
+    json_object_set_new(root, "scene", json_string(seq->scene_path));
+    json_object_set_new(root, "fps", json_real(seq->fps));
+    json_object_set_new(root, "frames_per_sweep", json_integer((json_int_t)seq->frames));
+    json_object_set_new(root, "n_frames", json_integer((json_int_t)seq->n_frames));
+    json_object_set_new(root, "frames_done", json_integer((json_int_t)done));
+    json_object_set_new(root, "frames_computed", json_integer((json_int_t)b->computed));
+    json_object_set_new(root, "frames_reused", json_integer((json_int_t)b->reused));
+    json_object_set_new(root, "complete", json_boolean(done == seq->n_frames && b->movies));
+    json_object_set_new(root, "sweeps", sweeps);
+    json_object_set_new(root, "frames", frames);
+    if (b->movies)
+        json_object_set(root, "movies", b->movies);
+    else
+        json_object_set_new(root, "movies", json_array());
+    json_object_set_new(root, "timings_s", t);
+    char *text = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
+    json_decref(root);
+    if (!text)
+        return thz_error_set(err, THZ_ERR_NOMEM, "batch.json: out of memory");
+    thz_status st = batch_write_atomic(b->outdir, "batch.json", text, err);
+    free(text);
+    return st;
+}
+
+/* frame.json: which frame this directory is and the hash of its inputs (and the scene
+ * it was run with, to rerun it by hand). No timings: it is the same in every run. */
+static char *batch_frame_json(const thz_sequence *seq, size_t f)
+{
+    char hex[17];
+    batch_hex(seq->hash[f], hex);
+    json_t *root = json_object();
+    json_object_set_new(root, "format", json_string("thzmap-frame/1"));
+    json_object_set_new(root, "frame", json_integer((json_int_t)f));
+    json_object_set_new(root, "sweep", json_integer((json_int_t)(f / seq->frames)));
+    json_object_set_new(root, "index", json_integer((json_int_t)(f % seq->frames)));
+    json_object_set_new(root, "time_s", json_real((double)(f % seq->frames) / seq->fps));
+    json_object_set_new(root, "sweep_values", json_string(seq->sweep_label[f / seq->frames]));
+    json_object_set_new(root, "input_hash", json_string(hex));
+    json_object_set_new(root, "scene_dir", json_string(seq->scene_dir));
+    json_object_set_new(root, "scene", json_loads(seq->frame_json[f], 0, NULL));
+    char *text = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
+    json_decref(root);
+    return text;
+}
+
+/* Runs frame f into its directory (atomically, with frame.json). */
+static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, thz_error *err)
+{
+    const thz_sequence *seq = b->seq;
+    char dir[THZ_PATH_MAX];
+    if (snprintf(dir, sizeof dir, "%s/%s", b->outdir, seq->frame_dir[f]) >= (int)sizeof dir)
+        return thz_error_set(err, THZ_ERR_IO, "%s: path too long", b->outdir);
+    double t0 = batch_now_s();
+    thz_scene *scene = NULL;
+    thz_output *output = NULL;
+    thz_run *run = NULL;
+    char *frame_json = batch_frame_json(seq, f);
+    thz_status st = frame_json ? thz_sequence_frame_scene(seq, f, &scene, err)
+                               : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    if (st == THZ_OK)
+        st = thz_output_open(dir, &output, err);
+    thz_run_settings settings;
+    thz_run_settings_init(&settings);
+    if (st == THZ_OK)
+        st = thz_simulate(ctx, scene, &settings, &run, err);
+    if (st == THZ_OK)
+        st = thz_output_add_run(ctx, output, run, NULL, err);
+    if (st == THZ_OK)
+        st = thz_output_add_file(output, "frame.json", frame_json, strlen(frame_json), err);
+    if (st == THZ_OK)
+        st = thz_output_commit(output, err);
+    thz_output_destroy(output);
+    thz_run_destroy(run);
+    thz_scene_destroy(scene);
+    free(frame_json);
+    b->seconds[f] = batch_now_s() - t0;
+    if (st != THZ_OK && st != THZ_ERR_CANCELLED && err)
+        thz_error_prefix(err, "%s: ", seq->frame_dir[f]);
+    return st;
+}
+
+static int batch_report(const thz_batch_options *opt, const batch_state *b, size_t frame,
+                        const char *stage)
+{
+    if (!opt || !opt->progress)
+        return 0;
+    thz_batch_progress p = {.frame = frame,
+                            .n_frames = b->seq->n_frames,
+                            .computed = b->computed,
+                            .reused = b->reused,
+                            .seconds = batch_now_s() - b->t0,
+                            .stage = stage};
+    return opt->progress(opt->progress_user, &p);
+}
+
+/* Takes OUTDIR's batch lock (held until fd is closed). */
+static thz_status batch_lock(const char *outdir, int *fd, thz_error *err)
+{
+    char path[THZ_PATH_MAX];
+    thz_status st = thz_path_join(path, sizeof path, outdir, ".thzmap-batch-lock", err);
+    if (st != THZ_OK)
+        return st;
+    *fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (*fd < 0)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    if (flock(*fd, LOCK_EX | LOCK_NB) != 0) {
+        close(*fd);
+        *fd = -1;
+        return thz_error_set(err, THZ_ERR_IO,
+                             "%s: another thzmap batch is running into this directory", outdir);
+    }
+    return THZ_OK;
+}
+
+thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *outdir,
+                         const thz_batch_options *opt, thz_batch_result *result, thz_error *err)
+{
+    thz_error local;
+    if (!err) {
+        thz_error_clear(&local);
+        err = &local;
+    }
+    if (result)
+        memset(result, 0, sizeof *result);
+    if (!seq || !outdir || !outdir[0])
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_batch_run: no %s",
+                             seq ? "output directory" : "sequence");
+    batch_state b = {.seq = seq, .outdir = outdir, .t0 = batch_now_s()};
+    b.state = thz_calloc(seq->n_frames, sizeof *b.state);
+    b.seconds = thz_calloc(seq->n_frames, sizeof *b.seconds);
+    int lock_fd = -1;
+    thz_status st = b.state && b.seconds ? batch_mkdirs(outdir, err)
+                                         : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    if (st == THZ_OK)
+        st = batch_lock(outdir, &lock_fd, err);
+    for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++)
+        if (batch_frame_done(&b, f)) {
+            b.state[f] = FRAME_REUSED;
+            b.reused++;
+        }
+    if (st == THZ_OK)
+        st = batch_write_json(&b, err);
+    for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++) {
+        if (b.state[f] == FRAME_REUSED)
+            continue;
+        if (batch_report(opt, &b, f, "frame")) {
+            st = thz_error_set(err, THZ_ERR_CANCELLED, "cancelled");
+            break;
+        }
+        double t0 = batch_now_s();
+        st = batch_run_frame(ctx, &b, f, err);
+        b.seconds_frames += batch_now_s() - t0;
+        if (st == THZ_OK) {
+            b.state[f] = FRAME_COMPUTED;
+            b.computed++;
+        } else if (st != THZ_ERR_CANCELLED) {
+            b.state[f] = FRAME_FAILED;
+        }
+        thz_error werr;
+        if (batch_write_json(&b, &werr) != THZ_OK && st == THZ_OK) {
+            *err = werr;
+            st = werr.status;
+        }
+    }
+    if (st == THZ_OK && !(opt && opt->no_movies)) {
+        if (batch_report(opt, &b, seq->n_frames, "movie"))
+            st = thz_error_set(err, THZ_ERR_CANCELLED, "cancelled");
+        double t0 = batch_now_s();
+        b.movies = st == THZ_OK ? json_array() : NULL;
+        if (st == THZ_OK)
+            st = b.movies ? batch_movies_write(seq, outdir, b.movies, err)
+                          : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        b.seconds_movies = batch_now_s() - t0;
+        if (st != THZ_OK) {
+            json_decref(b.movies);
+            b.movies = NULL;
+        }
+    }
+    if (st == THZ_OK)
+        st = batch_write_json(&b, err);
+    if (st == THZ_OK)
+        batch_report(opt, &b, seq->n_frames, "done");
+    if (result) {
+        result->n_frames = seq ? seq->n_frames : 0;
+        result->computed = b.computed;
+        result->reused = b.reused;
+        result->movies = b.movies ? json_array_size(b.movies) : 0;
+        result->seconds = batch_now_s() - b.t0;
+    }
+    json_decref(b.movies);
+    free(b.state);
+    free(b.seconds);
+    if (lock_fd >= 0)
+        close(lock_fd);
+    return st;
+}

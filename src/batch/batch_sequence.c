@@ -1,0 +1,608 @@
+/* Loading a sequence file ("thzmap-sequence/1"): its keys checked with JSON paths, its
+ * keyframes gathered into tracks (one per value a keyframe names, e.g.
+ * objects.person.transform.translate_m), every frame's scene built as JSON text from
+ * the scene file (tracks interpolated at the frame's time, then the sweep value set)
+ * and checked by loading it, and the hash of each frame's inputs.
+ */
+#include <jansson.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "batch/batch_internal.h"
+#include "core/alloc.h"
+#include "core/error.h"
+
+enum { SEQ_MAX_FRAMES = 100000, SEQ_MAX_SWEEPS = 10000, SEQ_MAX_DEPTH = 8 };
+
+/* A value that keyframes name: its path (segments; objects and sensors by name), and
+ * per keyframe that names it the time and n numbers. */
+typedef struct seq_track {
+    const char *seg[SEQ_MAX_DEPTH];
+    size_t depth;
+    size_t n;         /* numbers per value: 1 for a number, else the array's length */
+    int is_array;     /* the value is an array (even of one number) */
+    int all_integers; /* every keyframe value is whole: write whole results as integers */
+    int rotation;     /* rotate_deg: slerp */
+    size_t k;         /* keyframes naming it */
+    double *t, *v;    /* k times; k * n values */
+} seq_track;
+
+typedef struct seq_build {
+    const char *label; /* the sequence file, in messages */
+    json_t *scene;     /* the scene document */
+    seq_track *tracks;
+    size_t n_tracks;
+    json_t *sweep;       /* the sweep object, or NULL */
+    json_t *file_hashes; /* path -> hash of the files frames name (hex string) */
+    thz_error *err;
+} seq_build;
+
+static thz_status seq_fail(const seq_build *b, const char *where, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static thz_status seq_fail(const seq_build *b, const char *where, const char *fmt, ...)
+{
+    char what[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    return thz_error_set(b->err, THZ_ERR_INPUT, "%s: %s: %s", b->label, where, what);
+}
+
+static const char *seq_type(const json_t *v)
+{
+    switch (json_typeof(v)) {
+    case JSON_OBJECT:
+        return "an object";
+    case JSON_ARRAY:
+        return "an array";
+    case JSON_STRING:
+        return "a string";
+    case JSON_INTEGER:
+    case JSON_REAL:
+        return "a number";
+    case JSON_TRUE:
+    case JSON_FALSE:
+        return "a boolean";
+    default:
+        return "null";
+    }
+}
+
+/* The element of scene[list] ("objects", "sensors") whose "name" is name, or NULL. */
+static json_t *seq_named(json_t *scene, const char *list, const char *name)
+{
+    json_t *arr = json_object_get(scene, list), *e;
+    size_t i;
+    json_array_foreach(arr, i, e)
+    {
+        const char *n = json_string_value(json_object_get(e, "name"));
+        if (n && strcmp(n, name) == 0)
+            return e;
+    }
+    return NULL;
+}
+
+/* Sets the value at path seg[0..depth-1] of doc (objects and sensors by name; missing
+ * objects on the way are created); takes a reference to value. */
+static int seq_set(json_t *doc, const char *const *seg, size_t depth, json_t *value)
+{
+    json_t *node = doc;
+    size_t i = 0;
+    if (depth >= 2 && (!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors"))) {
+        node = seq_named(doc, seg[0], seg[1]);
+        i = 2;
+    }
+    for (; node && i + 1 < depth; i++) {
+        json_t *next = json_object_get(node, seg[i]);
+        if (!json_is_object(next)) {
+            next = json_object();
+            if (json_object_set_new(node, seg[i], next) != 0)
+                return -1;
+        }
+        node = next;
+    }
+    if (!json_is_object(node))
+        return -1;
+    return json_object_set(node, seg[depth - 1], value);
+}
+
+static const char *const seq_blocks[] = {"objects", "sensors", "atmosphere", "materials"};
+
+/* Checks that the path names something keyframes or sweeps may set: a block of the
+ * scene, and an object or sensor the scene has. */
+static thz_status seq_check_path(const seq_build *b, const char *where, const char *const *seg,
+                                 size_t depth, int leaf)
+{
+    int known = 0;
+    for (size_t i = 0; i < sizeof seq_blocks / sizeof seq_blocks[0]; i++)
+        known |= !strcmp(seg[0], seq_blocks[i]);
+    if (!known && depth >= 2 && (!strcmp(seg[0], "photons") || !strcmp(seg[0], "render")))
+        known = 1;
+    if (!known)
+        return seq_fail(b, where,
+                        "\"%s\" cannot be set (expected objects, sensors, atmosphere, materials, "
+                        "photons or render)",
+                        seg[0]);
+    if ((!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors")) && depth >= 2 &&
+        !seq_named(b->scene, seg[0], seg[1])) {
+        char what[300];
+        snprintf(what, sizeof what, "the scene has no %s named \"%s\"",
+                 !strcmp(seg[0], "objects") ? "object" : "sensor", seg[1]);
+        return seq_fail(b, where, "%s", what);
+    }
+    if (leaf && depth < (!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors") ? 3u : 2u))
+        return seq_fail(b, where, "%s",
+                        "expected a path to a value, e.g. objects.NAME.temperature_k");
+    return THZ_OK;
+}
+
+static seq_track *seq_track_find(seq_build *b, const char *const *seg, size_t depth)
+{
+    for (size_t i = 0; i < b->n_tracks; i++) {
+        seq_track *tr = &b->tracks[i];
+        if (tr->depth != depth)
+            continue;
+        size_t j = 0;
+        while (j < depth && !strcmp(tr->seg[j], seg[j]))
+            j++;
+        if (j == depth)
+            return tr;
+    }
+    return NULL;
+}
+
+/* Adds keyframe value v (at time t) to the track of path seg; where names it. */
+static thz_status seq_add_value(seq_build *b, const char *where, const char *const *seg,
+                                size_t depth, double t, const json_t *v)
+{
+    size_t n = json_is_array(v) ? json_array_size(v) : 1;
+    int ok = json_is_number(v) || (json_is_array(v) && n > 0);
+    for (size_t i = 0; ok && json_is_array(v) && i < n; i++)
+        ok = json_is_number(json_array_get(v, i));
+    if (!ok)
+        return seq_fail(b, where, "expected a number or an array of numbers, got %s", seq_type(v));
+    int rotation = !strcmp(seg[depth - 1], "rotate_deg");
+    if (rotation && (!json_is_array(v) || n != 3))
+        return seq_fail(b, where, "%s", "expected [rx, ry, rz] in degrees");
+    seq_track *tr = seq_track_find(b, seg, depth);
+    if (!tr) {
+        seq_track *grown = thz_realloc_array(b->tracks, b->n_tracks + 1, sizeof *grown);
+        if (!grown)
+            return thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
+        b->tracks = grown;
+        tr = &b->tracks[b->n_tracks++];
+        memset(tr, 0, sizeof *tr);
+        memcpy(tr->seg, seg, depth * sizeof *seg);
+        tr->depth = depth;
+        tr->n = n;
+        tr->is_array = json_is_array(v);
+        tr->all_integers = 1;
+        tr->rotation = rotation;
+    } else if (tr->n != n || tr->is_array != json_is_array(v)) {
+        return seq_fail(b, where, "%s",
+                        "expected the same kind of value (number, or array of as many numbers) "
+                        "as in the earlier keyframes");
+    }
+    double *t2 = thz_realloc_array(tr->t, tr->k + 1, sizeof *t2);
+    if (t2)
+        tr->t = t2;
+    double *v2 = t2 ? thz_realloc_array(tr->v, (tr->k + 1) * n, sizeof *v2) : NULL;
+    if (!v2)
+        return thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
+    tr->v = v2;
+    tr->t[tr->k] = t;
+    for (size_t i = 0; i < n; i++) {
+        const json_t *x = json_is_array(v) ? json_array_get(v, i) : v;
+        tr->v[tr->k * n + i] = json_number_value(x);
+        tr->all_integers &= json_is_integer(x);
+    }
+    tr->k++;
+    return THZ_OK;
+}
+
+/* Walks a keyframe's value at path seg (where: its JSON path), adding its leaves. */
+static thz_status seq_walk(seq_build *b, char *where, size_t where_size, const char **seg,
+                           size_t depth, double t, json_t *v)
+{
+    if (!json_is_object(v)) {
+        thz_status st = seq_check_path(b, where, seg, depth, 1);
+        return st != THZ_OK ? st : seq_add_value(b, where, seg, depth, t, v);
+    }
+    if (depth == SEQ_MAX_DEPTH)
+        return seq_fail(b, where, "%s", "nested too deeply");
+    if (depth == 2 && (!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors"))) {
+        thz_status st = seq_check_path(b, where, seg, depth, 0);
+        if (st != THZ_OK)
+            return st;
+    }
+    const char *key;
+    json_t *child;
+    size_t len = strlen(where);
+    json_object_foreach(v, key, child)
+    {
+        snprintf(where + len, where_size - len, ".%s", key);
+        seg[depth] = key;
+        thz_status st = seq_walk(b, where, where_size, seg, depth + 1, t, child);
+        if (st != THZ_OK)
+            return st;
+    }
+    where[len] = '\0';
+    return THZ_OK;
+}
+
+static thz_status seq_keyframes(seq_build *b, json_t *keyframes)
+{
+    if (!json_is_array(keyframes))
+        return seq_fail(b, "keyframes", "expected an array of keyframes, got %s",
+                        seq_type(keyframes));
+    size_t i;
+    json_t *kf;
+    double last_t = -1.0;
+    json_array_foreach(keyframes, i, kf)
+    {
+        char where[1024];
+        snprintf(where, sizeof where, "keyframes[%zu]", i);
+        if (!json_is_object(kf))
+            return seq_fail(b, where, "expected an object, got %s", seq_type(kf));
+        json_t *tv = json_object_get(kf, "time_s");
+        if (!json_is_number(tv) || json_number_value(tv) < 0.0) {
+            strcat(where, ".time_s");
+            return seq_fail(b, where, "%s", "expected a time >= 0 s");
+        }
+        double t = json_number_value(tv);
+        if (t <= last_t) {
+            strcat(where, ".time_s");
+            return seq_fail(b, where, "%s",
+                            "expected keyframe times in increasing order (each later than the "
+                            "one before)");
+        }
+        last_t = t;
+        const char *key;
+        json_t *val;
+        json_object_foreach(kf, key, val)
+        {
+            if (!strcmp(key, "time_s"))
+                continue;
+            char w[1024];
+            if (snprintf(w, sizeof w, "%s.%s", where, key) >= (int)sizeof w)
+                return seq_fail(b, where, "%s", "key too long");
+            const char *seg[SEQ_MAX_DEPTH] = {key};
+            if (!json_is_object(val))
+                return seq_fail(b, w, "expected an object, got %s", seq_type(val));
+            thz_status st = seq_walk(b, w, sizeof w, seg, 1, t, val);
+            if (st != THZ_OK)
+                return st;
+        }
+    }
+    return THZ_OK;
+}
+
+/* Splits a sweep key "a.b.c" into seg (pointing into buf). */
+static size_t seq_split(char *buf, const char **seg)
+{
+    size_t depth = 0;
+    for (char *p = buf; depth < SEQ_MAX_DEPTH;) {
+        seg[depth++] = p;
+        p = strchr(p, '.');
+        if (!p)
+            break;
+        *p++ = '\0';
+    }
+    return depth;
+}
+
+static thz_status seq_check_sweep(seq_build *b, size_t *n_sweeps)
+{
+    *n_sweeps = 1;
+    if (!b->sweep)
+        return THZ_OK;
+    if (!json_is_object(b->sweep) || json_object_size(b->sweep) == 0)
+        return seq_fail(b, "sweep", "expected an object {\"dotted.key\": [values]}, got %s",
+                        json_is_object(b->sweep) ? "an empty one" : seq_type(b->sweep));
+    const char *key;
+    json_t *vals;
+    json_object_foreach(b->sweep, key, vals)
+    {
+        char where[600], buf[512];
+        snprintf(where, sizeof where, "sweep.%s", key);
+        snprintf(buf, sizeof buf, "%s", key);
+        const char *seg[SEQ_MAX_DEPTH];
+        size_t depth = seq_split(buf, seg);
+        for (size_t i = 0; i < depth; i++)
+            if (!seg[i][0])
+                return seq_fail(b, where, "%s",
+                                "expected a dotted key like atmosphere.relative_humidity");
+        thz_status st = seq_check_path(b, where, seg, depth, 1);
+        if (st != THZ_OK)
+            return st;
+        if (!json_is_array(vals) || json_array_size(vals) == 0)
+            return seq_fail(b, where, "expected a non-empty array of values, got %s",
+                            json_is_array(vals) ? "an empty one" : seq_type(vals));
+        *n_sweeps *= json_array_size(vals);
+        if (*n_sweeps > SEQ_MAX_SWEEPS)
+            return seq_fail(b, "sweep", "%s", "more than 10000 combinations of values");
+    }
+    return THZ_OK;
+}
+
+/* Sets sweep combination s (the first key varies slowest) into doc; its label. */
+static int seq_apply_sweep(const seq_build *b, size_t s, json_t *doc, char *label, size_t size)
+{
+    label[0] = '\0';
+    if (!b->sweep)
+        return 0;
+    size_t stride = 1;
+    const char *key;
+    json_t *vals;
+    json_object_foreach(b->sweep, key, vals) stride *= json_array_size(vals);
+    json_object_foreach(b->sweep, key, vals)
+    {
+        stride /= json_array_size(vals);
+        json_t *v = json_array_get(vals, (s / stride) % json_array_size(vals));
+        char buf[512];
+        snprintf(buf, sizeof buf, "%s", key);
+        const char *seg[SEQ_MAX_DEPTH];
+        size_t depth = seq_split(buf, seg);
+        if (seq_set(doc, seg, depth, v) != 0)
+            return -1;
+        char *text = json_dumps(v, JSON_ENCODE_ANY | JSON_COMPACT);
+        size_t len = strlen(label);
+        snprintf(label + len, size - len, "%s%s = %s", len ? ", " : "", key, text ? text : "?");
+        free(text);
+    }
+    return 0;
+}
+
+static int seq_apply_tracks(const seq_build *b, double time_s, json_t *doc)
+{
+    for (size_t i = 0; i < b->n_tracks; i++) {
+        const seq_track *tr = &b->tracks[i];
+        double out[64];
+        double *x = tr->n <= 64 ? out : thz_malloc_array(tr->n, sizeof *x);
+        if (!x)
+            return -1;
+        if (tr->rotation)
+            thz_interp_rotation(tr->t, tr->v, tr->k, time_s, x);
+        else
+            thz_interp_linear(tr->t, tr->v, tr->k, tr->n, time_s, x);
+        json_t *v = tr->is_array ? json_array() : NULL;
+        for (size_t m = 0; m < tr->n; m++) {
+            json_t *num = tr->all_integers && fabs(x[m]) < 9.0e15 && x[m] == floor(x[m])
+                              ? json_integer((json_int_t)x[m])
+                              : json_real(x[m]);
+            if (tr->is_array)
+                json_array_append_new(v, num);
+            else
+                v = num;
+        }
+        if (x != out)
+            free(x);
+        int rc = seq_set(doc, tr->seg, tr->depth, v);
+        json_decref(v);
+        if (rc != 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* The hash of a file the frames name ("file", "*_file" keys), cached per path; 0 when
+ * it cannot be read (the scene loader then reports it). */
+static uint64_t seq_file_hash(seq_build *b, const char *scene_dir, const char *name)
+{
+    char path[4096];
+    if (name[0] == '/')
+        snprintf(path, sizeof path, "%s", name);
+    else
+        snprintf(path, sizeof path, "%s/%s", scene_dir, name);
+    json_t *cached = json_object_get(b->file_hashes, path);
+    if (cached)
+        return (uint64_t)strtoull(json_string_value(cached), NULL, 16);
+    uint64_t h = BATCH_HASH_INIT;
+    FILE *f = fopen(path, "rb");
+    if (f) {
+        unsigned char buf[65536];
+        size_t n;
+        while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+            h = batch_hash_bytes(h, buf, n);
+        fclose(f);
+    } else {
+        h = 0;
+    }
+    char hex[17];
+    snprintf(hex, sizeof hex, "%016llx", (unsigned long long)h);
+    json_object_set_new(b->file_hashes, path, json_string(hex));
+    return h;
+}
+
+static uint64_t seq_hash_files(seq_build *b, const char *scene_dir, const json_t *v, uint64_t h)
+{
+    if (json_is_object(v)) {
+        const char *key;
+        json_t *child;
+        json_object_foreach((json_t *)v, key, child)
+        {
+            size_t len = strlen(key);
+            int is_file = !strcmp(key, "file") || (len > 5 && !strcmp(key + len - 5, "_file"));
+            if (is_file && json_is_string(child)) {
+                uint64_t fh = seq_file_hash(b, scene_dir, json_string_value(child));
+                h = batch_hash_bytes(h, &fh, sizeof fh);
+            } else {
+                h = seq_hash_files(b, scene_dir, child, h);
+            }
+        }
+    } else if (json_is_array(v)) {
+        for (size_t i = 0; i < json_array_size(v); i++)
+            h = seq_hash_files(b, scene_dir, json_array_get(v, i), h);
+    }
+    return h;
+}
+
+uint64_t batch_hash_bytes(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= UINT64_C(1099511628211);
+    }
+    return h;
+}
+
+/* Builds frame f's scene text, dir, hash and sweep label; checks that it loads. */
+static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
+{
+    size_t s = f / seq->frames, i = f % seq->frames;
+    double time_s = (double)i / seq->fps;
+    json_t *doc = json_deep_copy(b->scene);
+    char label[1024];
+    if (!doc || seq_apply_tracks(b, time_s, doc) != 0 ||
+        seq_apply_sweep(b, s, doc, label, sizeof label) != 0) {
+        json_decref(doc);
+        return thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
+    }
+    if (i == 0 && !seq->sweep_label[s])
+        seq->sweep_label[s] = thz_strdup(label);
+    seq->frame_json[f] = json_dumps(doc, JSON_COMPACT);
+    uint64_t h = batch_hash_bytes(BATCH_HASH_INIT, "thzmap " THZ_VERSION_STRING,
+                                  sizeof("thzmap " THZ_VERSION_STRING) - 1);
+    if (seq->frame_json[f])
+        h = batch_hash_bytes(h, seq->frame_json[f], strlen(seq->frame_json[f]));
+    h = batch_hash_bytes(h, seq->scene_dir, strlen(seq->scene_dir));
+    seq->hash[f] = seq_hash_files(b, seq->scene_dir, doc, h);
+    json_decref(doc);
+    char dir[64];
+    if (seq->has_sweep)
+        snprintf(dir, sizeof dir, "sweep-%02zu/frame-%05zu", s, i);
+    else
+        snprintf(dir, sizeof dir, "frame-%05zu", i);
+    seq->frame_dir[f] = thz_strdup(dir);
+    if (!seq->frame_json[f] || !seq->frame_dir[f] || !seq->sweep_label[s])
+        return thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
+    thz_scene *scene = NULL;
+    thz_status st = thz_sequence_frame_scene(seq, f, &scene, b->err);
+    thz_scene_destroy(scene);
+    if (st != THZ_OK && b->err)
+        thz_error_prefix(b->err, "%s: frame %zu (%s%st = %g s): ", b->label, i, label,
+                         label[0] ? ", " : "", time_s);
+    return st;
+}
+
+static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_sequence *seq,
+                          json_t **keyframes)
+{
+    static const char *const keys[] = {"format", "scene", "fps", "frames", "keyframes", "sweep"};
+    if (!json_is_object(root))
+        return seq_fail(b, "(top level)", "expected an object, got %s", seq_type(root));
+    const char *key;
+    json_t *v;
+    json_object_foreach(root, key, v)
+    {
+        size_t i = 0;
+        while (i < 6 && strcmp(key, keys[i]))
+            i++;
+        if (i == 6)
+            return seq_fail(b, key, "%s",
+                            "unknown key (expected format, scene, fps, frames, keyframes, sweep)");
+    }
+    const char *format = json_string_value(json_object_get(root, "format"));
+    if (!format || strcmp(format, "thzmap-sequence/1"))
+        return seq_fail(b, "format", "%s", "expected \"thzmap-sequence/1\"");
+    const char *scene = json_string_value(json_object_get(root, "scene"));
+    if (!scene || !scene[0])
+        return seq_fail(b, "scene", "%s", "expected the scene file's name (a string)");
+    char path[4096];
+    if (snprintf(path, sizeof path, "%s%s%s", scene[0] == '/' ? "" : seq_dir,
+                 scene[0] == '/' ? "" : "/", scene) >= (int)sizeof path)
+        return seq_fail(b, "scene", "%s", "path too long");
+    seq->scene_path = thz_strdup(path);
+    char *slash = strrchr(path, '/');
+    if (slash)
+        *slash = '\0';
+    seq->scene_dir = thz_strdup(slash ? (path[0] ? path : "/") : ".");
+    *keyframes = json_object_get(root, "keyframes");
+    json_t *fps = json_object_get(root, "fps"), *frames = json_object_get(root, "frames");
+    if (fps && (!json_is_number(fps) || !(json_number_value(fps) > 0.0)))
+        return seq_fail(b, "fps", "%s", "expected frames per second > 0");
+    if (!fps && *keyframes)
+        return seq_fail(b, "fps", "%s", "required with keyframes (frames per second > 0)");
+    seq->fps = fps ? json_number_value(fps) : 1.0;
+    if (frames && (!json_is_integer(frames) || json_integer_value(frames) < 1 ||
+                   json_integer_value(frames) > SEQ_MAX_FRAMES))
+        return seq_fail(b, "frames", "%s", "expected a whole number of frames from 1 to 100000");
+    seq->frames = frames ? (size_t)json_integer_value(frames) : 1;
+    b->sweep = json_object_get(root, "sweep");
+    return seq->scene_path && seq->scene_dir
+               ? THZ_OK
+               : thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
+}
+
+thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *err)
+{
+    *out = NULL;
+    if (!path)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_sequence_load: no path");
+    thz_sequence *seq = thz_calloc(1, sizeof *seq);
+    seq_build b = {.label = path, .err = err, .file_hashes = json_object()};
+    json_error_t je;
+    json_t *root = json_load_file(path, JSON_REJECT_DUPLICATES, &je);
+    thz_status st = THZ_OK;
+    if (!seq || !b.file_hashes)
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    else if (!root)
+        st = je.line > 0 ? thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s", path,
+                                         je.line, je.column, je.text)
+                         : thz_error_set(err, THZ_ERR_INPUT, "%s: %s", path, je.text);
+    json_t *keyframes = NULL;
+    if (st == THZ_OK) {
+        seq->path = thz_strdup(path);
+        char dir[4096];
+        snprintf(dir, sizeof dir, "%s", path);
+        char *slash = strrchr(dir, '/');
+        if (slash)
+            *slash = '\0';
+        st = seq_top(&b, root, slash ? (dir[0] ? dir : "/") : ".", seq, &keyframes);
+    }
+    if (st == THZ_OK) {
+        b.scene = json_load_file(seq->scene_path, JSON_REJECT_DUPLICATES, &je);
+        if (!b.scene)
+            st = je.line > 0 ? thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s",
+                                             seq->scene_path, je.line, je.column, je.text)
+                             : thz_error_set(err, THZ_ERR_INPUT, "%s: scene: %s", path, je.text);
+        else if (!json_is_object(b.scene))
+            st = thz_error_set(err, THZ_ERR_INPUT, "%s: expected a scene object", seq->scene_path);
+    }
+    if (st == THZ_OK && keyframes)
+        st = seq_keyframes(&b, keyframes);
+    if (st == THZ_OK)
+        st = seq_check_sweep(&b, &seq->n_sweeps);
+    if (st == THZ_OK) {
+        seq->has_sweep = b.sweep != NULL;
+        seq->n_frames = seq->frames * seq->n_sweeps;
+        seq->frame_json = thz_calloc(seq->n_frames, sizeof *seq->frame_json);
+        seq->frame_dir = thz_calloc(seq->n_frames, sizeof *seq->frame_dir);
+        seq->hash = thz_calloc(seq->n_frames, sizeof *seq->hash);
+        seq->sweep_label = thz_calloc(seq->n_sweeps, sizeof *seq->sweep_label);
+        if (!seq->frame_json || !seq->frame_dir || !seq->hash || !seq->sweep_label)
+            st = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+    }
+    for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++)
+        st = seq_frame(&b, seq, f);
+    for (size_t i = 0; i < b.n_tracks; i++) {
+        free(b.tracks[i].t);
+        free(b.tracks[i].v);
+    }
+    free(b.tracks);
+    json_decref(b.file_hashes);
+    json_decref(b.scene);
+    json_decref(root); /* the tracks' segments pointed into it: freed after them */
+    if (st != THZ_OK) {
+        thz_sequence_destroy(seq);
+        return st;
+    }
+    *out = seq;
+    return THZ_OK;
+}

@@ -1,0 +1,227 @@
+#!/usr/bin/env bash
+# thzmap batch (issue 17; scene-format.md "Sequences, sweeps and movies"):
+#  - a 5-frame sequence (a box walking from x = -0.5 to 0.5 m while warming from 300 to
+#    308 K, fps 4): frame.json of frames 1 and 3 hold the hand values (x = -0.25 and
+#    0.25 m, 302 and 306 K), and their files equal, bit for bit, `thzmap simulate` of
+#    hand-written scenes with those values (summary.json aside: timings);
+#  - the movies: H.264, 5 frames, 1.25 s, the size batch.json states; decoded, the
+#    pixels' lightness ranks like the frame's brightness temperatures;
+#  - resuming: a batch interrupted by SIGTERM (exit 143) after a frame, then killed
+#    with SIGKILL after more, and run again, redoes no finished frame (frame.json's
+#    inode and time unchanged; batch.json's counts) and ends with every file identical
+#    to an uninterrupted run's (summary.json and batch.json aside: timings);
+#  - a changed keyframe redoes exactly the frames it changes;
+#  - a sweep without keyframes: sweep-NN/frame-00000 per value;
+#  - bad sequence files: exit 2, the JSON path in the message, nothing written.
+# argv: path to the thzmap binary, repository directory.
+set -u
+THZMAP=$1
+REPO=$2
+PY=/usr/bin/python3 # Debian's, with numpy
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+command -v ffprobe >/dev/null || { echo "FAIL: ffprobe is missing (scripts/install-deps.sh installs ffmpeg)"; exit 1; }
+command -v ffmpeg >/dev/null || { echo "FAIL: ffmpeg is missing (scripts/install-deps.sh installs it)"; exit 1; }
+
+cp "$REPO/tests/inputs/batch/scene.json" "$REPO/tests/inputs/batch/sequence.json" "$work/"
+seq="$work/sequence.json"
+
+# --- an uninterrupted batch ---------------------------------------------------------
+"$THZMAP" batch "$seq" -o "$work/A" --threads 2 --quiet > "$work/A.out" 2> "$work/A.err" ||
+    { fail "batch A: exit $?"; cat "$work/A.err"; }
+[ -s "$work/A.err" ] && fail "batch --quiet printed on stderr: $(head -c 300 "$work/A.err")"
+for i in 0 1 2 3 4; do
+    [ -f "$work/A/frame-0000$i/cam.brightness_temperature.img" ] || fail "frame $i missing"
+done
+[ -e "$work/A/frame-00005" ] && fail "a sixth frame"
+"$PY" - "$work/A/batch.json" <<'PY' || fail "batch.json of A"
+import json, sys
+b = json.load(open(sys.argv[1]))
+assert b["format"] == "thzmap-batch/1" and b["n_frames"] == 5, b
+assert b["frames_computed"] == 5 and b["frames_reused"] == 0 and b["complete"], b
+assert [f["time_s"] for f in b["frames"]] == [0, 0.25, 0.5, 0.75, 1.0], b["frames"]
+assert all(f["status"] == "done" and f["seconds"] > 0 for f in b["frames"])
+m = {x["file"]: x for x in b["movies"]}
+assert set(m) == {"cam.band-01.mp4", "cam.band-02.mp4"}, m
+s = m["cam.band-01.mp4"]["colour_scale"]
+assert 280 < s["min_k"] < s["max_k"] < 320, s
+PY
+
+# --- frames against simulate of hand-written scenes ---------------------------------
+for case in "1 -0.25 302" "3 0.25 306"; do
+    set -- $case
+    "$PY" - "$work/scene.json" "$work/hand-$1.json" "$2" "$3" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+person = [o for o in s["objects"] if o["name"] == "person"][0]
+person["transform"]["translate_m"] = [float(sys.argv[3]), 0, 0.8]
+person["temperature_k"] = int(sys.argv[4])
+json.dump(s, open(sys.argv[2], "w"), indent=1)
+PY
+    "$PY" - "$work/A/frame-0000$1/frame.json" "$2" "$3" <<'PY' || fail "frame $1: frame.json's scene is not the hand values"
+import json, sys
+f = json.load(open(sys.argv[1]))
+p = [o for o in f["scene"]["objects"] if o["name"] == "person"][0]
+assert p["transform"]["translate_m"] == [float(sys.argv[2]), 0, 0.8], p
+assert p["temperature_k"] == float(sys.argv[3]), p
+PY
+    "$THZMAP" simulate "$work/hand-$1.json" -o "$work/S$1" --threads 1 --quiet >/dev/null ||
+        fail "simulate of hand-$1.json"
+    n=0
+    for f in "$work/S$1"/*; do
+        b=$(basename "$f")
+        [ "$b" = summary.json ] && continue
+        n=$((n + 1))
+        cmp -s "$f" "$work/A/frame-0000$1/$b" || fail "frame $1: $b differs from simulate's"
+    done
+    [ "$n" -ge 10 ] || fail "frame $1: only $n files compared"
+done
+
+# --- the movies ---------------------------------------------------------------------
+probe=$(ffprobe -v error -count_frames -show_entries stream=codec_name,nb_read_frames,width,height,duration \
+        -of default=nw=1 "$work/A/cam.band-01.mp4")
+echo "$probe" | grep -qx 'codec_name=h264' || fail "movie codec: $probe"
+echo "$probe" | grep -qx 'nb_read_frames=5' || fail "movie frames: $probe"
+echo "$probe" | grep -qx 'duration=1.250000' || fail "movie duration (5 frames at 4 fps): $probe"
+ffmpeg -v error -i "$work/A/cam.band-01.mp4" -f rawvideo -pix_fmt gray "$work/movie.gray" ||
+    fail "decoding the movie"
+"$PY" - "$work/A" "$work/movie.gray" <<'PY' || fail "movie pixels against the Tb images"
+import json, sys
+import numpy as np
+out, raw = sys.argv[1], sys.argv[2]
+b = json.load(open(out + "/batch.json"))
+m = [x for x in b["movies"] if x["file"] == "cam.band-01.mp4"][0]
+L = m["layout"]
+w, h, k = L["width_px"], L["height_px"], L["pixel_px"]
+video = np.fromfile(raw, np.uint8).reshape(-1, h, w)
+assert video.shape[0] == 5, video.shape
+cols, rows = 16, 12
+for i in range(5):
+    tb = np.fromfile(f"{out}/frame-{i:05d}/cam.brightness_temperature.img", "<f4")[: cols * rows]
+    tb = tb.reshape(rows, cols)
+    ys = L["image_y_px"] + np.arange(rows) * k + k // 2
+    xs = L["image_x_px"] + np.arange(cols) * k + k // 2
+    luma = video[i][np.ix_(ys, xs)].astype(float)
+    # ranks agree: for every pair of pixels more than 5 % of the scale apart in Tb,
+    # the warmer is the lighter
+    span = m["colour_scale"]["max_k"] - m["colour_scale"]["min_k"]
+    t, y = tb.ravel(), luma.ravel()
+    dt = t[:, None] - t[None, :]
+    dy = y[:, None] - y[None, :]
+    far = dt > 0.05 * span
+    assert far.sum() > 100, far.sum()
+    bad = (far & (dy <= 0)).sum()
+    assert bad == 0, (i, bad, far.sum())
+PY
+
+# --- interrupted, killed, resumed ---------------------------------------------------
+# frames_done DIR: frames whose frame.json is there
+frames_done() { ls "$1"/frame-*/frame.json 2>/dev/null | wc -l; }
+# wait_frames DIR N PID: until N frames are done (or the batch ended)
+wait_frames() {
+    for _ in $(seq 1 600); do
+        [ "$(frames_done "$1")" -ge "$2" ] && return 0
+        kill -0 "$3" 2>/dev/null || return 1
+        sleep 0.02
+    done
+    return 1
+}
+"$THZMAP" batch "$seq" -o "$work/B" --quiet > /dev/null 2>&1 &
+pid=$!
+wait_frames "$work/B" 1 $pid || fail "batch B ended before its first frame"
+kill -TERM $pid
+wait $pid
+rc=$?
+[ $rc -eq 143 ] || [ $rc -eq 0 ] || fail "SIGTERM: exit $rc, expected 143"
+n1=$(frames_done "$work/B")
+"$THZMAP" batch "$seq" -o "$work/B" --quiet > /dev/null 2>&1 &
+pid=$!
+wait_frames "$work/B" $((n1 + 2)) $pid
+kill -KILL $pid 2>/dev/null
+wait $pid 2>/dev/null
+n2=$(frames_done "$work/B")
+echo "interrupted after $n1 frame(s) (SIGTERM), killed after $n2 (SIGKILL)"
+[ "$n2" -lt 5 ] || echo "note: the SIGKILL came after the last frame"
+stat -c '%n %i %Y.%y' "$work"/B/frame-*/frame.json | sort > "$work/B.before"
+"$THZMAP" batch "$seq" -o "$work/B" --quiet > /dev/null 2>&1 || fail "batch B, resumed: exit $?"
+stat -c '%n %i %Y.%y' "$work"/B/frame-*/frame.json | sort | head -n "$n2" > "$work/B.after"
+cmp -s "$work/B.before" "$work/B.after" || fail "a finished frame was redone: $(diff "$work/B.before" "$work/B.after")"
+"$PY" - "$work/B/batch.json" "$n2" <<'PY' || fail "batch.json of the resumed run"
+import json, sys
+b = json.load(open(sys.argv[1]))
+n = int(sys.argv[2])
+assert b["frames_reused"] == n and b["frames_computed"] == 5 - n and b["complete"], (b["frames_reused"], n)
+PY
+(cd "$work/A" && find . -type f ! -name summary.json ! -name batch.json ! -name '.*' | sort) > "$work/A.files"
+(cd "$work/B" && find . -type f ! -name summary.json ! -name batch.json ! -name '.*' | sort) > "$work/B.files"
+cmp -s "$work/A.files" "$work/B.files" || fail "resumed run's files: $(diff "$work/A.files" "$work/B.files" | head)"
+while read -r f; do
+    cmp -s "$work/A/$f" "$work/B/$f" || fail "resumed run: $f differs from the uninterrupted run's"
+done < "$work/A.files"
+leftovers=$(cd "$work/B" && find . -name '.*' ! -name .thzmap-batch-lock ! -name . | head)
+[ -z "$leftovers" ] || fail "leftovers in OUTDIR after the resumed run: $leftovers"
+
+# --- a changed keyframe redoes the frames it changes --------------------------------
+sed 's/"temperature_k": 308/"temperature_k": 312/' "$seq" > "$work/changed.json"
+"$THZMAP" batch "$work/changed.json" -o "$work/A" --quiet > /dev/null 2>&1 || fail "changed batch: exit $?"
+"$PY" - "$work/A/batch.json" <<'PY' || fail "a changed sequence must redo frames 1-4 and keep frame 0"
+import json, sys
+b = json.load(open(sys.argv[1]))
+assert b["frames_reused"] == 1 and b["frames_computed"] == 4, b
+assert [f["computed"] for f in b["frames"]][0] == "an earlier run"
+PY
+
+# --- a sweep without keyframes ------------------------------------------------------
+cat > "$work/sweep.json" <<'JSON'
+{"format": "thzmap-sequence/1", "scene": "scene.json",
+ "sweep": {"objects.person.temperature_k": [300, 310]}}
+JSON
+"$THZMAP" batch "$work/sweep.json" -o "$work/W" --quiet > /dev/null 2>&1 || fail "sweep batch: exit $?"
+for s in 00 01; do
+    [ -f "$work/W/sweep-$s/frame-00000/cam.brightness_temperature.img" ] || fail "sweep-$s/frame-00000 missing"
+    [ -f "$work/W/sweep-$s/cam.band-01.mp4" ] || fail "sweep-$s/cam.band-01.mp4 missing"
+done
+grep -q '"temperature_k": 310' "$work/W/sweep-01/frame-00000/frame.json" || fail "sweep-01 is not at 310 K"
+
+# --- bad sequence files -------------------------------------------------------------
+bad() { # bad NAME EXPECTED-TEXT JSON
+    printf '%s\n' "$3" > "$work/bad-$1.json"
+    "$THZMAP" batch "$work/bad-$1.json" -o "$work/bad-out" > "$work/bad.out" 2> "$work/bad.err"
+    rc=$?
+    [ $rc -eq 2 ] || fail "bad $1: exit $rc, expected 2"
+    grep -qF -- "$2" "$work/bad.err" || fail "bad $1: expected '$2' in: $(cat "$work/bad.err")"
+    [ -e "$work/bad-out" ] && { fail "bad $1: wrote $work/bad-out"; rm -rf "$work/bad-out"; }
+}
+K0='{"time_s": 0, "objects": {"person": {"temperature_k": 300}}}'
+bad format 'bad-format.json: format: expected "thzmap-sequence/1"' \
+    '{"format": "thzmap-scene/1", "scene": "scene.json"}'
+bad unknown 'bad-unknown.json: fsp: unknown key' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fsp": 4}'
+bad order 'keyframes[1].time_s: expected keyframe times in increasing order' \
+    "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"fps\": 4, \"keyframes\": [{\"time_s\": 1}, $K0]}"
+bad nobody 'keyframes[0].objects.nobody: the scene has no object named "nobody"' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "keyframes": [{"time_s": 0, "objects": {"nobody": {"temperature_k": 3}}}]}'
+bad string 'keyframes[0].objects.person.temperature_k: expected a number or an array of numbers, got a string' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": "hot"}}}]}'
+bad shape 'keyframes[1].sensors.cam.position_m: expected the same kind of value' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [0, -1, 1]}}}, {"time_s": 1, "sensors": {"cam": {"position_m": [0, 1]}}}]}'
+bad frames 'frames: expected a whole number of frames' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 0}'
+bad fps 'fps: required with keyframes' \
+    "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"keyframes\": [$K0]}"
+bad sweep 'sweep.objects.person.temperature_k: expected a non-empty array' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "sweep": {"objects.person.temperature_k": []}}'
+bad syntax 'bad-syntax.json:1:' '{"format": "thzmap-sequence/1",, }'
+bad frame_scene 'frame 2 (t = 0.5 s): ' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 3, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 0.5, "objects": {"person": {"temperature_k": -10}}}]}'
+grep -qF 'objects[1].temperature_k' "$work/bad.err" || fail "bad frame_scene: the scene's JSON path: $(cat "$work/bad.err")"
+"$THZMAP" batch "$seq" > /dev/null 2>&1
+[ $? -eq 2 ] || fail "batch without -o: expected exit 2"
+
+if [ "$fails" -ne 0 ]; then
+    echo "$fails failure(s)"
+    exit 1
+fi
+echo "test_batch: all passed"
