@@ -15,8 +15,9 @@ static size_t n_temp_names;
 static void remove_temp_dir(void)
 {
     for (size_t i = 0; i < n_temp_names; i++) {
-        snprintf(temp_path, sizeof temp_path, "%s/%s", temp_dir, temp_names[i]);
-        unlink(temp_path);
+        if (snprintf(temp_path, sizeof temp_path, "%s/%s", temp_dir, temp_names[i]) <
+            (int)sizeof temp_path)
+            unlink(temp_path);
     }
     rmdir(temp_dir);
 }
@@ -24,8 +25,9 @@ static void remove_temp_dir(void)
 static void make_temp_dir(void)
 {
     const char *tmp = getenv("TMPDIR");
-    snprintf(temp_dir, sizeof temp_dir, "%s/thz-fuzz-XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    if (!mkdtemp(temp_dir)) {
+    if (snprintf(temp_dir, sizeof temp_dir, "%s/thz-fuzz-XXXXXX", tmp && *tmp ? tmp : "/tmp") >=
+            (int)sizeof temp_dir ||
+        !mkdtemp(temp_dir)) {
         perror("fuzz: mkdtemp");
         abort();
     }
@@ -45,7 +47,8 @@ const char *fuzz_temp_file(const char *name, const uint8_t *data, size_t size)
             abort();
         strcpy(temp_names[n_temp_names++], name);
     }
-    snprintf(temp_path, sizeof temp_path, "%s/%s", temp_dir, name);
+    if (snprintf(temp_path, sizeof temp_path, "%s/%s", temp_dir, name) >= (int)sizeof temp_path)
+        abort();
     FILE *f = fopen(temp_path, "wb");
     if (!f || (size && fwrite(data, 1, size, f) != size) || fclose(f) != 0) {
         perror("fuzz: cannot write the input file");

@@ -8,6 +8,10 @@
 # coverage (cov:, ft:) and corpus size. Exits 1 if any harness found anything: a crash,
 # a sanitizer report, a leak, a timeout or memory beyond the limit; the input is kept in
 # BUILD_DIR/fuzz-findings/<name>/ (replay it with fuzz_replay_<name> FILE).
+# libFuzzer's timeout is wall-clock time, which a busy machine stretches: it runs in fork
+# mode (-fork=1) so that a timeout does not end the run, and each timeout input is then
+# replayed by fuzz_replay_<name>, which counts it only if it takes more than 1 s of both
+# wall-clock and CPU time. A crash, leak or out-of-memory ends the run at once.
 set -uo pipefail
 build=${1:?usage: run.sh BUILD_DIR SECONDS [HARNESS...]}
 seconds=${2:?usage: run.sh BUILD_DIR SECONDS [HARNESS...]}
@@ -24,7 +28,7 @@ for h in "${harnesses[@]}"; do
   work=$build/fuzz-work/$h
   findings=$build/fuzz-findings/$h
   log=$build/fuzz-work/$h.log
-  rm -rf "$work"
+  rm -rf "$work" "$findings"
   mkdir -p "$work" "$findings"
   cp "$here/corpus/$h"/* "$work"/
   dict=()
@@ -32,22 +36,31 @@ for h in "${harnesses[@]}"; do
   ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 \
   LSAN_OPTIONS=suppressions=$here/../lsan.supp:print_suppressions=0 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    "$bin" -max_total_time="$seconds" -timeout=1 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
-      -max_len="${max_len[$h]}" -print_final_stats=1 -artifact_prefix="$findings/" \
-      "${dict[@]}" "$work" >"$log" 2>&1
+    "$bin" -fork=1 -ignore_timeouts=1 -max_total_time="$seconds" -timeout=1 \
+      -rss_limit_mb=2048 -malloc_limit_mb=2048 -max_len="${max_len[$h]}" \
+      -artifact_prefix="$findings/" "${dict[@]}" "$work" >"$log" 2>&1
   rc=$?
-  # the last status line: "#N DONE cov: C ft: F corp: K/B lim: ... exec/s: E rss: R"
-  status=$(grep -E '^#[0-9]+[[:space:]]+(DONE|pulse|NEW|REDUCE|INITED)' "$log" | tail -1)
-  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
+  # confirm the timeouts (see the top)
+  for t in "$findings"/timeout-*; do
+    [ -e "$t" ] || continue
+    if timeout 120 "$build/tests/fuzz/fuzz_replay_$h" --max-seconds 1 "$t" >>"$log" 2>&1; then
+      echo "run.sh: $t: not slow when replayed (the machine was busy)" >>"$log"
+      mkdir -p "$findings/unconfirmed"
+      mv "$t" "$findings/unconfirmed/"
+    fi
+  done
+  # fork mode's status line: "#N: cov: C ft: F corp: K exec/s E oom/timeout/crash: ..."
+  status=$(grep -E '^#[0-9]+: cov:' "$log" | tail -1)
+  execs=$(sed -n 's/^#\([0-9]*\):.*/\1/p' <<<"$status")
   cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$status")
   ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$status")
-  corp=$(sed -n 's/.* corp: \([0-9]*\/[0-9a-zA-Z]*\).*/\1/p' <<<"$status")
-  rate=$(sed -n 's/.* exec\/s: \([0-9]*\).*/\1/p' <<<"$status")
-  printf 'fuzz %-10s %4ss: %9s execs (%s exec/s), cov: %s ft: %s corpus: %s' "$h" "$seconds" \
-    "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}"
-  if [ $rc -ne 0 ] || [ -n "$(ls -A "$findings")" ]; then
+  corp=$(ls "$work" | wc -l)
+  rate=$(sed -n 's/.* exec\/s \([0-9]*\).*/\1/p' <<<"$status")
+  printf 'fuzz %-10s %4ss: %9s execs (%s exec/s), cov: %s ft: %s corpus: %s files' "$h" \
+    "$seconds" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "$corp"
+  if [ $rc -ne 0 ] || [ -n "$(find "$findings" -maxdepth 1 -type f)" ] || [ -z "$status" ]; then
     printf '  FAILED (exit %s)\n' "$rc"
-    grep -E '^(==[0-9]+==ERROR|SUMMARY|ALARM|.*runtime error|==[0-9]+== ERROR|MS: |artifact_prefix|Test unit written)' \
+    grep -E '^(==[0-9]+==ERROR|SUMMARY|ALARM|.*slow input|.*runtime error|==[0-9]+== ERROR|MS: |artifact_prefix|Test unit written)' \
       "$log" | head -20 | sed 's/^/  | /'
     echo "  | full log: $log; inputs: $findings/"
     failed+=("$h")
