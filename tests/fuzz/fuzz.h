@@ -25,6 +25,10 @@ const char *fuzz_temp_file(const char *name, const uint8_t *data, size_t size);
 /* The repository's tests/fuzz/ directory (compiled in), for the harnesses' fixtures. */
 #define FUZZ_DIR THZ_SOURCE_DIR "/tests/fuzz"
 
+/* Prints a reader's message on stderr when the environment sets FUZZ_VERBOSE (for
+ * triage with fuzz_replay_<name>; fuzzing itself stays quiet). */
+void fuzz_report(const char *message);
+
 /* Points the library's data directory at tests/fuzz/data/ (tiny line catalogues and
  * tables, so that an input naming the `lines` atmosphere costs milliseconds). */
 void fuzz_use_fixture_data(void);

@@ -40,7 +40,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     thz_status st = csv_read(path, "input.csv", &file_table, &err);
     if (st == THZ_OK)
         check_table(&file_table);
-    else if (!err.message[0])
+    else if (fuzz_report(err.message), !err.message[0])
         abort(); /* a refusal says why */
     if (!memchr(data, '\0', size)) {
         char *text = malloc(size + 1);

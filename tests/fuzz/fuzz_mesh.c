@@ -40,8 +40,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (!mesh_finalize(&mesh))
             abort();
         (void)mesh_import_winding_conflicts(&mesh);
-    } else if (!err.message[0]) {
-        abort();
+    } else {
+        fuzz_report(err.message);
+        if (!err.message[0])
+            abort();
     }
     mesh_fini(&mesh);
     return 0;

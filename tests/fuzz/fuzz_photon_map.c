@@ -143,6 +143,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     thz_error err = {0};
     thz_status st = photon_map_file_read(path, scene, 1, maps, stats, &info, &err);
     if (st != THZ_OK) {
+        fuzz_report(err.message);
         if (!err.message[0])
             abort();
         for (size_t c = 0; c < scene->n_channels; c++)

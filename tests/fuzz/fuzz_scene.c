@@ -32,8 +32,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             abort();
         scene_hash h;
         scene_hash_compute(scene, &h);
-    } else if (!err.message[0] || scene) {
-        abort();
+    } else {
+        fuzz_report(err.message);
+        if (!err.message[0] || scene)
+            abort();
     }
     scene_destroy(scene);
     free(text);

@@ -61,3 +61,9 @@ void fuzz_use_fixture_data(void)
 {
     setenv("THZMAP_DATA_DIR", FUZZ_DIR "/data", 1);
 }
+
+void fuzz_report(const char *message)
+{
+    if (getenv("FUZZ_VERBOSE"))
+        fprintf(stderr, "fuzz: %s\n", message);
+}
