@@ -58,6 +58,8 @@ for h in "${harnesses[@]}"; do
   rate=$(sed -n 's/.* exec\/s \([0-9]*\).*/\1/p' <<<"$status")
   printf 'fuzz %-10s %4ss: %9s execs (%s exec/s), cov: %s ft: %s corpus: %s files' "$h" \
     "$seconds" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "$corp"
+  # 70: libFuzzer's exit status when there were timeouts; they were just confirmed or not
+  [ $rc -eq 70 ] && [ -d "$findings/unconfirmed" ] && rc=0
   if [ $rc -ne 0 ] || [ -n "$(find "$findings" -maxdepth 1 -type f)" ] || [ -z "$status" ]; then
     printf '  FAILED (exit %s)\n' "$rc"
     grep -E '^(==[0-9]+==ERROR|SUMMARY|ALARM|.*slow input|.*runtime error|==[0-9]+== ERROR|MS: |artifact_prefix|Test unit written)' \
