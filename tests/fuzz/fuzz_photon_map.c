@@ -3,13 +3,16 @@
  * - an input that starts with the magic "THZPMAP" is the .thzpm file itself (the prefix,
  *   the zstd frames, their checksums);
  * - any other input is the content of a file of this scene: its first byte chooses
- *   version 1 (odd) or 2, then come the header words (the scene's hashes and counts are
- *   filled in, the record counts split the rest among the channels) and the records.
+ *   version 1 (bit 0 set) or 2, whether the header's record counts are kept as they are
+ *   (bit 1; else they split the records given among the channels) and whether the records
+ *   frame omits its content size (bit 2); then come the header words (the scene's hashes
+ *   and counts are filled in) and the records.
  *   The harness compresses them into frames with valid checksums, so that what lies
  *   behind them (the header's and the records' checks, the map's index built from
  *   arbitrary records) is reached.
  * A map that is read is then queried as the renderer queries it.
  */
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <zstd.h>
@@ -45,11 +48,13 @@ static uint64_t get_u64(const uint8_t *p)
     return v;
 }
 
-/* Appends one zstd frame (checksum and content size) of src[0..n) at out + *pos. */
-static void put_frame(uint8_t *out, size_t cap, size_t *pos, const void *src, size_t n)
+/* Appends one zstd frame (with checksum; with its content size if `sized`) of
+ * src[0..n) at out + *pos. */
+static void put_frame(uint8_t *out, size_t cap, size_t *pos, const void *src, size_t n, bool sized)
 {
     ZSTD_CCtx *cctx = ZSTD_createCCtx();
-    if (!cctx || ZSTD_isError(ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1)))
+    if (!cctx || ZSTD_isError(ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1)) ||
+        ZSTD_isError(ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, sized ? 1 : 0)))
         abort();
     size_t r = ZSTD_compress2(cctx, out + *pos, cap - *pos, src, n);
     if (ZSTD_isError(r))
@@ -61,7 +66,8 @@ static void put_frame(uint8_t *out, size_t cap, size_t *pos, const void *src, si
 /* Builds a .thzpm file of this scene from content (see the top); returns its size. */
 static size_t build_file(const uint8_t *data, size_t size, uint8_t **file)
 {
-    unsigned version = size > 0 && (data[0] & 1) ? 1u : 2u;
+    unsigned options = size > 0 ? data[0] : 0u;
+    unsigned version = (options & 1u) ? 1u : 2u;
     size_t words = version == 1u ? 20u : 21u, nc = scene->n_channels;
     size_t header_bytes = 8 * (HEADER_FIXED + words * nc);
     const uint8_t *rest = size > 0 ? data + 1 : data;
@@ -79,7 +85,7 @@ static size_t build_file(const uint8_t *data, size_t size, uint8_t **file)
     put_u64(header + 24, nc);
     put_u64(header + 32, scene->n_objects);
     size_t left = n_records;
-    for (size_t c = 0; c < nc; c++) {
+    for (size_t c = 0; c < nc && !(options & 2u); c++) {
         uint8_t *count = header + 8 * (HEADER_FIXED + words * c) + 16;
         uint64_t n = c + 1 == nc ? left : get_u64(count) % (left + 1);
         put_u64(count, n);
@@ -92,8 +98,8 @@ static size_t build_file(const uint8_t *data, size_t size, uint8_t **file)
     memcpy(out, PHOTON_MAP_FILE_MAGIC, 8);
     out[8] = (uint8_t)version;
     size_t pos = 24;
-    put_frame(out, cap, &pos, header, header_bytes);
-    put_frame(out, cap, &pos, records, records_bytes);
+    put_frame(out, cap, &pos, header, header_bytes, true);
+    put_frame(out, cap, &pos, records, records_bytes, !(options & 4u));
     put_u64(out + 16, pos);
     free(header);
     *file = out;
