@@ -1,13 +1,18 @@
 # The two set-up commands of the README, and a few conveniences.
 #   make demo   installs what is missing, builds, and runs the paper's test scene
-#   make check  installs what is missing, builds, and runs all tests (also under ASan+UBSan)
+#   make check  installs what is missing, builds, and runs all tests (also under ASan+UBSan),
+#               then fuzzes each reader for 30 s (fuzz-ci)
+#   make fuzz   fuzzes each reader for FUZZ_SECONDS (default 60) s (tests/fuzz/README.md)
 JOBS ?= $(shell nproc)
 BUILD ?= build
 ASAN_BUILD ?= build-asan
 DEMO_OUT ?= out/teraeye
 PREFIX ?= /usr/local
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_CI_SECONDS ?= 30
 
-.PHONY: all deps build install demo check test test-asan bench format clean
+.PHONY: all deps build install demo check test test-asan fuzz-build fuzz fuzz-ci bench format clean
 
 all: build
 
@@ -38,13 +43,25 @@ test-asan: deps
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  THZ_TEST_SCALE=0.25 ctest --output-on-failure -j $(JOBS) --label-exclude slow
 
-check: test test-asan
+# The libFuzzer harnesses (tests/fuzz/): a clang build of their own with ASan+UBSan.
+fuzz-build: deps
+	cmake -S . -B $(FUZZ_BUILD) -G Ninja -DCMAKE_C_COMPILER=clang \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTHZ_FUZZ=ON >/dev/null
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_harnesses
+
+fuzz: fuzz-build
+	bash tests/fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
+
+fuzz-ci: fuzz-build
+	bash tests/fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_CI_SECONDS)
+
+check: test test-asan fuzz-ci
 
 format:
 	clang-format -i $$(git ls-files '*.c' '*.h')
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD)
 
 # The benchmark (issue 6): the paper's case in full, scaling, rendering; see README.
 bench: build
