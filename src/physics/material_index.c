@@ -151,6 +151,23 @@ bool material_index_range(const material_index *idx, double *lo_hz, double *hi_h
     return true;
 }
 
+size_t material_index_n_ranges(const material_index *idx)
+{
+    if (idx->is_model)
+        return idx->model.kind == PERMITTIVITY_P2040 ? idx->model.n_rows : 0;
+    return idx->freq_hz ? 1 : 0;
+}
+
+void material_index_range_at(const material_index *idx, size_t r, double *lo_hz, double *hi_hz)
+{
+    if (idx->is_model) {
+        *lo_hz = idx->model.rows[r].lo_hz;
+        *hi_hz = idx->model.rows[r].hi_hz;
+    } else {
+        material_index_range(idx, lo_hz, hi_hz);
+    }
+}
+
 const permittivity_model *material_index_model_of(const material_index *idx)
 {
     return idx->is_model ? &idx->model : NULL;

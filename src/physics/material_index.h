@@ -47,6 +47,11 @@ const char *material_index_form(const material_index *idx);
  * itu-p2040 model's rows; false (0, infinity) for constants and the other models. */
 bool material_index_range(const material_index *idx, double *lo_hz, double *hi_hz);
 
+/* The ranges the data are given for, one by one: the table's, or each itu-p2040 row's
+ * (in file order; they may overlap or leave gaps). 0 for constants and other models. */
+size_t material_index_n_ranges(const material_index *idx);
+void material_index_range_at(const material_index *idx, size_t r, double *lo_hz, double *hi_hz);
+
 /* The model behind idx, or NULL for constants and tables. */
 const permittivity_model *material_index_model_of(const material_index *idx);
 
