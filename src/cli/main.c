@@ -21,6 +21,7 @@ static const command commands[] = {
     {"render", cmd_render, "re-render sensors of a scene from a saved photon map"},
     {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency"},
     {"batch", cmd_batch, "run a sequence of frames (keyframes, sweeps) and make movies"},
+    {"materials", cmd_materials, "list the material library, or describe one material"},
 };
 
 static void print_usage(FILE *f)
