@@ -20,6 +20,8 @@ static const command commands[] = {
     {"simulate", cmd_simulate, "fire photons and render every sensor of a scene"},
     {"render", cmd_render, "re-render sensors of a scene from a saved photon map"},
     {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency"},
+    {"bands", cmd_bands, "choose the channel frequencies that best separate a scene's targets"},
+    {"classify", cmd_classify, "recognise materials in a run's cubes against its truth"},
 };
 
 static void print_usage(FILE *f)
