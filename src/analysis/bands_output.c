@@ -101,7 +101,8 @@ char *bands_json(const bands_report *rep, thz_error *err)
     put(cand, "frequency_thz", array_of(s->candidates_thz, n, &ok), &ok);
     json_t *noise = json_object();
     put(root, "noise", noise, &ok);
-    put(noise, "netd_k", json_real(s->netd_k), &ok);
+    put(noise, "source", json_string(rep->netd_source), &ok);
+    put(noise, "netd_k", array_of(s->netd_k, n, &ok), &ok);
     json_t *nu = json_object();
     put(root, "nuisances", nu, &ok);
     put(nu, "target_temperature_range_k", json_real(s->target_range_k), &ok);

@@ -16,6 +16,7 @@ typedef struct bands_report {
     const bands_values *values;
     const bands_search_result *search;
     const double *air_db_per_km; /* per candidate, or NULL (no attenuating air) */
+    const char *netd_source;     /* where the NETD came from, e.g. "--netd-k" */
 } bands_report;
 
 /* bands.json's text (malloc'd), NULL with err set when out of memory. */

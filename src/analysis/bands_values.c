@@ -289,7 +289,7 @@ static void pixel_covariance(const render_out *r, const int32_t *cls, const band
                 cov[a * n + b] *= x[a] * x[b];
         for (size_t c = 0; c < n; c++) {
             v->pixel_sd[k * n + c] = sqrt(cov[c * n + c]);
-            cov[c * n + c] += s->netd_k * s->netd_k;
+            cov[c * n + c] += s->netd_k[c] * s->netd_k[c];
         }
     }
 }

@@ -23,7 +23,7 @@ typedef struct bands_setup {
     size_t sensor;
     const long *targets; /* object indices; n_targets 0: every object seen is a class */
     size_t n_targets;
-    double netd_k;
+    const double *netd_k; /* per candidate: the sensor's NETD, K (thzmap/analysis.h) */
     double target_range_k, ambient_range_k, humidity_range;
     uint32_t paths_per_sample;
     uint64_t seed;

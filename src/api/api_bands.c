@@ -19,6 +19,7 @@ struct thz_bands {
     char *scene_path, *scene_name, *sensor;
     double from_thz, to_thz, step_ghz;
     double *candidates_thz;
+    double *netd_k; /* per candidate */
     long *targets;
     bands_setup setup;
     bands_values values;
@@ -49,6 +50,7 @@ void thz_bands_destroy(thz_bands *b)
     free(b->scene_name);
     free(b->sensor);
     free(b->candidates_thz);
+    free(b->netd_k);
     free(b->targets);
     bands_values_fini(&b->values);
     bands_search_result_fini(&b->search);
@@ -169,7 +171,8 @@ static bands_report make_report(const thz_bands *b)
                           .step_ghz = b->step_ghz,
                           .values = &b->values,
                           .search = &b->search,
-                          .air_db_per_km = b->air_db_per_km};
+                          .air_db_per_km = b->air_db_per_km,
+                          .netd_source = "--netd-k"};
 }
 
 thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_bands_options *o,
@@ -189,20 +192,26 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
         return api_done(ctx, thz_error_set(err, THZ_ERR_NOMEM, "out of memory"), err);
     b->scene_path = thz_strdup(scene_path);
     b->candidates_thz = thz_calloc(n, sizeof *b->candidates_thz);
-    if (!b->scene_path || !b->candidates_thz) {
+    b->netd_k = thz_calloc(n, sizeof *b->netd_k);
+    if (!b->scene_path || !b->candidates_thz || !b->netd_k) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
         goto done;
     }
     b->from_thz = o->from_thz;
     b->to_thz = o->to_thz;
     b->step_ghz = o->step_ghz;
-    for (size_t c = 0; c < n; c++) /* from + c step, rounded to the kHz the grid means */
+    for (size_t c = 0; c < n; c++) { /* from + c step, rounded to the kHz the grid means */
         b->candidates_thz[c] = round((o->from_thz + (double)c * o->step_ghz * 1e-3) * 1e9) / 1e9;
+        /* The noise enters per candidate; today from the options. When scenes carry the
+         * sensor's noise (scene-format 1.1 `noise`), its netd_k or radiometer NETD for
+         * each candidate's bandwidth belongs here. */
+        b->netd_k[c] = o->netd_k;
+    }
     b->setup = (bands_setup){.scene_path = b->scene_path,
                              .candidates_thz = b->candidates_thz,
                              .n_candidates = n,
                              .n_targets = o->n_targets,
-                             .netd_k = o->netd_k,
+                             .netd_k = b->netd_k,
                              .target_range_k = o->target_temperature_range_k,
                              .ambient_range_k = o->ambient_temperature_range_k,
                              .humidity_range = o->humidity_range,

@@ -44,7 +44,7 @@ assert d["per_k"][1]["selected_thz"] == sel and d["per_k"][1]["score"] == d["sco
 assert d["search"] == "exhaustive"
 assert len(d["candidates"]["frequency_thz"]) == 17
 assert [c["name"] for c in d["classes"]] == ["room", "A", "B", "C"]
-assert d["noise"]["netd_k"] == 0.5
+assert d["noise"]["netd_k"] == [0.5] * 17 and d["noise"]["source"] == "--netd-k"
 PYEOF
 
 # the same with two threads: the same file but for its timing
