@@ -6,7 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <unistd.h>
+
 #include "cli.h"
+#include "progress.h"
 #include "thzmap/thzmap.h"
 
 #define CMD "bands"
@@ -171,12 +174,25 @@ int cmd_bands(int argc, char **argv)
         return CLI_EXIT_FAILURE;
     }
     thz_context_set_threads(ctx, (int)threads);
+    /* Progress on a terminal only (a render line per candidate channel and nuisance
+     * would flood a log); the callback also carries Ctrl-C into the run. */
+    cli_progress progress;
+    cli_progress_init(&progress, CMD, quiet || !isatty(STDERR_FILENO));
+    thz_context_set_progress(ctx, cli_progress_report, &progress);
+    thz_context_set_warning(ctx, cli_progress_warning, &progress);
+    cli_signals_install();
     thz_error err = {0};
     thz_bands *b = NULL;
     double t0 = cli_now_s();
     int rc = CLI_EXIT_OK;
-    if (thz_bands_select(ctx, scene, &opt, &b, &err) != THZ_OK ||
-        thz_bands_write(b, outdir, &err) != THZ_OK) {
+    thz_status st = thz_bands_select(ctx, scene, &opt, &b, &err);
+    if (st == THZ_OK)
+        st = thz_bands_write(b, outdir, &err);
+    cli_progress_finish(&progress);
+    if (st == THZ_ERR_CANCELLED && cli_interrupt_signal()) {
+        fprintf(stderr, "thzmap bands: interrupted; nothing written\n");
+        rc = 128 + cli_interrupt_signal();
+    } else if (st != THZ_OK) {
         rc = cli_fail(&err);
     } else if (!quiet) {
         thz_bands_info info;
