@@ -108,7 +108,10 @@ typedef struct thz_bands_options {
     const char *sensor;         /* NULL: the scene's first */
     const char *const *targets; /* object names; n_targets 0: every object the sensor sees */
     size_t n_targets;
-    double netd_k;                      /* the sensor's noise per channel, K (>= 0; default 0.5) */
+    int has_netd;  /* non-zero: netd_k for every candidate; 0: the sensor's noise (its netd_k
+                      interpolated in frequency to the candidates, or its radiometer NETD
+                      for each candidate's bandwidth), or netd_k when it has none */
+    double netd_k; /* K, >= 0; default 0.5 */
     double target_temperature_range_k;  /* each target's temperature varies within +- this
                                            (uniformly, independently), K; default 2 */
     double ambient_temperature_range_k; /* the other objects' and the air's temperature

@@ -75,6 +75,12 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
     json_object_set_new(render, "integrator", json_string("path"));
     json_object_set_new(render, "paths_per_sample", json_integer(s->paths_per_sample));
     json_object_set_new(doc, "render", render);
+    /* the sensor's noise with one netd_k per channel cannot follow the candidates: its
+     * NETD is interpolated to them instead (api_bands.c), and the renders need none */
+    json_t *sensor = json_array_get(json_object_get(doc, "sensors"), s->sensor);
+    json_t *noise = json_object_get(sensor, "noise");
+    if (noise && json_is_array(json_object_get(noise, "netd_k")))
+        json_object_del(sensor, "noise");
     *changed = 0;
     json_t *objects = json_object_get(doc, "objects");
     json_t *atm = json_object_get(doc, "atmosphere");
@@ -337,6 +343,15 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     if (st != THZ_OK)
         goto done;
     v->renders = 1;
+    for (size_t c = 0; c < n && s->netd_from_sensor; c++) {
+        thz_sensor_channel_info sc;
+        st = thz_scene_sensor_channel(scene, s->sensor, c, &sc);
+        if (st != THZ_OK) {
+            thz_error_set(err, st, "sensor %zu, channel %zu: no noise figures", s->sensor, c);
+            goto done;
+        }
+        s->netd_k[c] = sc.netd_k; /* at the channel's reference temperature */
+    }
     cls = thz_calloc(nominal.pixels, sizeof *cls);
     if (!cls)
         goto nomem;

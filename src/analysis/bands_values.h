@@ -23,7 +23,9 @@ typedef struct bands_setup {
     size_t sensor;
     const long *targets; /* object indices; n_targets 0: every object seen is a class */
     size_t n_targets;
-    const double *netd_k; /* per candidate: the sensor's NETD, K (thzmap/analysis.h) */
+    double *netd_k;        /* per candidate: the sensor's NETD, K (thzmap/analysis.h) */
+    bool netd_from_sensor; /* a radiometer: netd_k becomes the sensor's NETD of each
+                              candidate in the scene with the candidates as channels */
     double target_range_k, ambient_range_k, humidity_range;
     uint32_t paths_per_sample;
     uint64_t seed;

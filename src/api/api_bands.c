@@ -20,6 +20,7 @@ struct thz_bands {
     double from_thz, to_thz, step_ghz;
     double *candidates_thz;
     double *netd_k; /* per candidate */
+    const char *netd_source;
     long *targets;
     bands_setup setup;
     bands_values values;
@@ -34,7 +35,7 @@ void thz_bands_options_init(thz_bands_options *opt)
     opt->from_thz = 0.1;
     opt->to_thz = 1.5;
     opt->step_ghz = 10.0;
-    opt->netd_k = 0.5;
+    opt->netd_k = 0.5; /* used when has_netd, or when the sensor has no noise */
     opt->target_temperature_range_k = 2.0;
     opt->ambient_temperature_range_k = 2.0;
     opt->humidity_range = 0.2;
@@ -92,6 +93,61 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
     return THZ_OK;
 }
 
+/* The NETD per candidate: --netd-k; or the sensor's given netd_k, interpolated linearly
+ * in frequency between its channels (held beyond the ends); or, for a radiometer,
+ * bands_values reads each candidate's NETD from the scene with the candidates as its
+ * channels (it depends on their bandwidth); or netd_k when the sensor has no noise. */
+static thz_status resolve_netd(thz_bands *b, const thz_bands_options *o, const thz_scene *scene,
+                               size_t sensor, thz_error *err)
+{
+    b->netd_source = "--netd-k";
+    if (o->has_netd)
+        return THZ_OK;
+    size_t nch = thz_scene_channel_count(scene), n = b->setup.n_candidates;
+    thz_sensor_channel_info sc;
+    thz_status st = thz_scene_sensor_channel(scene, sensor, 0, &sc);
+    if (st != THZ_OK)
+        return thz_error_set(err, st, "sensor %zu: no noise figures", sensor);
+    if (strcmp(sc.noise, "none") == 0) {
+        b->netd_source = "default (the sensor has no noise)";
+        return THZ_OK;
+    }
+    if (strcmp(sc.noise, "netd") != 0) {
+        b->netd_source = strcmp(sc.noise, "dicke") == 0 ? "the sensor's radiometer (dicke)"
+                                                        : "the sensor's radiometer (total-power)";
+        b->setup.netd_from_sensor = true;
+        return THZ_OK;
+    }
+    b->netd_source = "the sensor's netd_k, interpolated to the candidates";
+    for (size_t c = 0; c < n; c++) {
+        double f = b->candidates_thz[c], lo = -1.0, hi = -1.0, lo_f = 0.0, hi_f = 0.0;
+        for (size_t i = 0; i < nch; i++) {
+            thz_channel_info ci;
+            st = thz_scene_channel(scene, i, &ci);
+            if (st == THZ_OK)
+                st = thz_scene_sensor_channel(scene, sensor, i, &sc);
+            if (st != THZ_OK)
+                return thz_error_set(err, st, "sensor %zu, channel %zu: no noise figures", sensor,
+                                     i);
+            if (ci.frequency_thz <= f && (lo < 0.0 || ci.frequency_thz > lo_f)) {
+                lo_f = ci.frequency_thz;
+                lo = sc.netd_k;
+            }
+            if (ci.frequency_thz >= f && (hi < 0.0 || ci.frequency_thz < hi_f)) {
+                hi_f = ci.frequency_thz;
+                hi = sc.netd_k;
+            }
+        }
+        if (lo < 0.0)
+            b->netd_k[c] = hi;
+        else if (hi < 0.0 || hi_f == lo_f)
+            b->netd_k[c] = lo;
+        else
+            b->netd_k[c] = lo + (hi - lo) * (f - lo_f) / (hi_f - lo_f);
+    }
+    return THZ_OK;
+}
+
 /* Scene facts: the sensor, the targets, the default width and seed, the air. */
 static thz_status resolve_scene(thz_bands *b, const thz_bands_options *o, thz_error *err)
 {
@@ -132,6 +188,9 @@ static thz_status resolve_scene(thz_bands *b, const thz_bands_options *o, thz_er
                 goto done;
             }
     }
+    st = resolve_netd(b, o, scene, (size_t)sensor, err);
+    if (st != THZ_OK)
+        goto done;
     thz_channel_info ci;
     thz_scene_channel(scene, 0, &ci);
     b->setup.relative_width = o->relative_width > 0.0 ? o->relative_width : ci.relative_width;
@@ -172,7 +231,7 @@ static bands_report make_report(const thz_bands *b)
                           .values = &b->values,
                           .search = &b->search,
                           .air_db_per_km = b->air_db_per_km,
-                          .netd_source = "--netd-k"};
+                          .netd_source = b->netd_source};
 }
 
 thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_bands_options *o,
@@ -202,10 +261,7 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
     b->step_ghz = o->step_ghz;
     for (size_t c = 0; c < n; c++) { /* from + c step, rounded to the kHz the grid means */
         b->candidates_thz[c] = round((o->from_thz + (double)c * o->step_ghz * 1e-3) * 1e9) / 1e9;
-        /* The noise enters per candidate; today from the options. When scenes carry the
-         * sensor's noise (scene-format 1.1 `noise`), its netd_k or radiometer NETD for
-         * each candidate's bandwidth belongs here. */
-        b->netd_k[c] = o->netd_k;
+        b->netd_k[c] = o->netd_k; /* resolve_netd or bands_values may replace it */
     }
     b->setup = (bands_setup){.scene_path = b->scene_path,
                              .candidates_thz = b->candidates_thz,

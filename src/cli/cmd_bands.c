@@ -38,7 +38,8 @@ static void print_help(void)
            "                              scene's first channel's)\n"
            "  --targets OBJ,...           the objects to recognise (default: every object seen)\n"
            "  --sensor NAME               the sensor (default: the scene's first)\n"
-           "  --netd-k X                  the sensor's noise per channel, K (default 0.5)\n"
+           "  --netd-k X                  the sensor's noise per channel, K (default: the\n"
+           "                              sensor's noise block, else 0.5)\n"
            "  --temperature-range-k X     each target's temperature within +-X K (default 2)\n"
            "  --ambient-range-k X         the other objects' and the air's temperature\n"
            "                              within +-X K (default 2)\n"
@@ -138,6 +139,7 @@ int cmd_bands(int argc, char **argv)
             opt.sensor = v;
         } else if (strcmp(a, "--netd-k") == 0) {
             ok = cli_parse_double(CMD, a, v, 0.0, 1e6, &opt.netd_k);
+            opt.has_netd = 1;
         } else if (strcmp(a, "--temperature-range-k") == 0) {
             ok = cli_parse_double(CMD, a, v, 0.0, 1000.0, &opt.target_temperature_range_k);
         } else if (strcmp(a, "--ambient-range-k") == 0) {

@@ -44,7 +44,7 @@ assert d["per_k"][1]["selected_thz"] == sel and d["per_k"][1]["score"] == d["sco
 assert d["search"] == "exhaustive"
 assert len(d["candidates"]["frequency_thz"]) == 17
 assert [c["name"] for c in d["classes"]] == ["room", "A", "B", "C"]
-assert d["noise"]["netd_k"] == [0.5] * 17 and d["noise"]["source"] == "--netd-k"
+assert d["noise"]["netd_k"] == [0.5] * 17 and "no noise" in d["noise"]["source"]
 PYEOF
 
 # the same with two threads: the same file but for its timing
@@ -91,6 +91,39 @@ tb_dry = next(c for c in d["classes"] if c["name"] == "B")["mean_tb_k"]
 tb_humid = next(c for c in h["classes"] if c["name"] == "B")["mean_tb_k"]
 assert tb_dry[i_line] > max(tb_dry[i] for i in plateau) - 0.3, tb_dry
 assert tb_humid[i_line] < tb_humid[freqs.index(humid_f)] - 2.0, tb_humid
+PYEOF
+
+# the sensor's noise: a given netd_k per channel, interpolated to the candidates; a
+# radiometer, whose NETD falls as 1/sqrt(bandwidth), i.e. 1/sqrt(frequency) at a fixed
+# relative width; --netd-k overrides both
+$PY - "$IN/features.json" "$TMP" <<'PYEOF' || fail "noisy scenes"
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["channels"] = [{"frequency_thz": 0.2, "relative_width": 0.01},
+                 {"frequency_thz": 1.0, "relative_width": 0.01}]
+d["sensors"][0]["noise"] = {"netd_k": [0.2, 1.0]}
+json.dump(d, open(sys.argv[2] + "/netd.json", "w"))
+d["sensors"][0]["noise"] = {"receiver_temperature_k": 2000, "integration_time_s": 0.001,
+                            "radiometer": "total-power"}
+json.dump(d, open(sys.argv[2] + "/radiometer.json", "w"))
+PYEOF
+for s in netd radiometer; do
+    "$THZ" bands "$TMP/$s.json" -o "$TMP/n-$s" --count 1 --from-thz 0.2 --to-thz 1.0 \
+        --step-ghz 200 --paths 2 -q || fail "$s scene exit status $?"
+done
+"$THZ" bands "$TMP/netd.json" -o "$TMP/n-given" --count 1 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 200 --paths 2 -q --netd-k 0.7 || fail "--netd-k on a noisy scene: exit status $?"
+$PY - "$TMP" <<'PYEOF' || fail "the sensor's NETD"
+import json, math, sys
+n = {k: json.load(open(f"{sys.argv[1]}/n-{k}/bands.json"))["noise"]
+     for k in ("netd", "radiometer", "given")}
+assert "interpolated" in n["netd"]["source"], n["netd"]
+assert all(abs(a - b) < 1e-12 for a, b in zip(n["netd"]["netd_k"], [0.2, 0.4, 0.6, 0.8, 1.0])), n["netd"]
+r = n["radiometer"]["netd_k"]
+assert "radiometer" in n["radiometer"]["source"] and all(x > 0 for x in r), n["radiometer"]
+# T_rec dominates: NETD ~ (T + T_rec) / sqrt(B_n tau), B_n proportional to the frequency
+assert abs(r[0] / r[4] / math.sqrt(5.0) - 1.0) < 0.02, r
+assert n["given"]["netd_k"] == [0.7] * 5 and n["given"]["source"] == "--netd-k", n["given"]
 PYEOF
 
 # bad input: exit status 2 and a message naming the problem

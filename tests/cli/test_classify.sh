@@ -81,6 +81,19 @@ import json; d = json.load(open('$TMP/m/classification.json'))
 assert d['source'] == 'cam.measured_brightness_temperature', d['source']
 assert d['accuracy'] < 0.9, d['accuracy']" || fail "the measured cube was not used"
 
+# a run whose sensor has noise writes the measured cube; classify takes it
+$PY -c "
+import json; d = json.load(open('$IN/distinct.json'))
+d['sensors'][0]['noise'] = {'netd_k': 3.0}
+json.dump(d, open('$TMP/noisy.json', 'w'))"
+"$THZ" simulate "$TMP/noisy.json" -o "$TMP/run3" -q --seed 3 || fail "noisy simulate exit status $?"
+[ -s "$TMP/run3/cam.measured_brightness_temperature.img" ] || fail "no measured cube written"
+"$THZ" classify "$TMP/run3" --sensor cam -o "$TMP/m3" --method lda -q || fail "noisy: exit status $?"
+$PY -c "
+import json; d = json.load(open('$TMP/m3/classification.json'))
+assert d['source'] == 'cam.measured_brightness_temperature', d['source']
+assert d['accuracy'] < 1.0, d['accuracy']" || fail "the sensor's measured cube was not used"
+
 # bad input
 expect2() {
     local what=$1; shift
