@@ -110,5 +110,6 @@ THZ_API const char *thz_context_last_message(const thz_context *ctx);
 #include "thzmap/atmosphere.h"
 #include "thzmap/batch.h"
 #include "thzmap/materials.h"
+#include "thzmap/analysis.h"
 
 #endif

@@ -17,6 +17,8 @@ int cmd_render(int argc, char **argv);
 int cmd_atmosphere(int argc, char **argv);
 int cmd_batch(int argc, char **argv);
 int cmd_materials(int argc, char **argv);
+int cmd_classify(int argc, char **argv);
+int cmd_bands(int argc, char **argv);
 
 /* Prints "thzmap: <message>" to stderr and returns the exit status for err. */
 int cli_fail(const thz_error *err);

@@ -22,6 +22,8 @@ static const command commands[] = {
     {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency"},
     {"batch", cmd_batch, "run a sequence of frames (keyframes, sweeps) and make movies"},
     {"materials", cmd_materials, "list the material library, or describe one material"},
+    {"bands", cmd_bands, "choose the channel frequencies that best separate a scene's targets"},
+    {"classify", cmd_classify, "recognise materials in a run's cubes against its truth"},
 };
 
 static void print_usage(FILE *f)

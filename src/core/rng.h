@@ -27,6 +27,7 @@ enum {
     RNG_PURPOSE_AIR_VOLUME = 5,   /* photon/air_emission.c: the air's share of the extent */
     RNG_PURPOSE_BACK_FACE = 6,    /* photon/emission.c: back faces' reach shares */
     RNG_PURPOSE_SENSOR_NOISE = 7, /* sensor/noise.c: radiometer noise, per pixel */
+    RNG_PURPOSE_ANALYSIS = 9,     /* analysis/: training splits, noise added to cubes */
     RNG_PURPOSE_TEST = 15
 };
 

@@ -35,4 +35,26 @@ typedef struct envi_info {
 thz_status envi_write_float32(const char *dir, const char *stem, const envi_info *info,
                               const float *data, thz_error *err);
 
+/* An image read back (envi_read.c): what thzmap writes, and any ENVI Standard file of
+ * float32 values in band-sequential order with byte order 0 or 1 and a header offset. */
+typedef struct envi_cube {
+    uint32_t samples, lines;
+    size_t bands;
+    float *data;            /* bands x lines x samples, BSQ, host order */
+    double *wavelength;     /* `bands` values of `wavelength`, or NULL */
+    char *wavelength_units; /* or NULL */
+    char **object_names;    /* `object names`, or NULL */
+    size_t n_object_names;
+} envi_cube;
+
+/* Largest header and data file envi_read_float32 reads (bytes). */
+#define ENVI_MAX_HEADER_BYTES (1u << 20)
+#define ENVI_MAX_DATA_BYTES (16ull << 30)
+
+/* Reads DIR/STEM.hdr and DIR/STEM.img. THZ_ERR_INPUT (naming the file and, for the
+ * header, the line) when a file is missing, not a regular file, above the limits, or
+ * not a float32 BSQ image of the size its header says. */
+thz_status envi_read_float32(const char *dir, const char *stem, envi_cube *out, thz_error *err);
+void envi_cube_fini(envi_cube *cube);
+
 #endif

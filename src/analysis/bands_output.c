@@ -1,0 +1,216 @@
+/* The files of a band selection (bands_output.h). */
+#include "analysis/bands_output.h"
+
+#include <jansson.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/path.h"
+#include "io/plot.h"
+
+static void put(json_t *obj, const char *key, json_t *v, bool *ok)
+{
+    if (!obj || !v || json_object_set_new(obj, key, v) != 0)
+        *ok = false;
+}
+
+static void push(json_t *arr, json_t *v, bool *ok)
+{
+    if (!arr || !v || json_array_append_new(arr, v) != 0)
+        *ok = false;
+}
+
+static json_t *num(double v)
+{
+    return isfinite(v) ? json_real(v) : json_null();
+}
+
+static json_t *array_of(const double *v, size_t n, bool *ok)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; i < n; i++)
+        push(a, num(v[i]), ok);
+    return a;
+}
+
+/* The chosen centres of the best set of size k, THz, ascending. */
+static json_t *set_thz(const bands_report *rep, size_t k, bool *ok)
+{
+    json_t *a = json_array();
+    const size_t *set = rep->search->sets + (k - 1) * rep->search->count;
+    for (size_t i = 0; i < k; i++)
+        push(a, json_real(rep->setup->candidates_thz[set[i]]), ok);
+    return a;
+}
+
+static json_t *pair_names(const bands_report *rep, const bands_score *s, bool *ok)
+{
+    json_t *a = json_array();
+    push(a, json_string(rep->values->class_names[s->worst_pair[0]]), ok);
+    push(a, json_string(rep->values->class_names[s->worst_pair[1]]), ok);
+    return a;
+}
+
+char *bands_json(const bands_report *rep, thz_error *err)
+{
+    const bands_setup *s = rep->setup;
+    const bands_values *v = rep->values;
+    const bands_search_result *r = rep->search;
+    size_t K = r->count, n = s->n_candidates;
+    const bands_score *final = &r->scores[K - 1];
+    bool ok = true;
+    json_t *root = json_object();
+    put(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
+    put(root, "scene", json_string(rep->scene_path), &ok);
+    put(root, "scene_name", json_string(rep->scene_name), &ok);
+    put(root, "sensor", json_string(rep->sensor), &ok);
+    put(root, "count", json_integer((json_int_t)K), &ok);
+    put(root, "selected_thz", set_thz(rep, K, &ok), &ok);
+    put(root, "score", json_real(final->worst_jm), &ok);
+    put(root, "criterion",
+        json_string("worst-pair Jeffries-Matusita distance JM = 2 (1 - exp(-B)) of Gaussian "
+                    "classes, 0..2 (B: Bhattacharyya distance)"),
+        &ok);
+    put(root, "bhattacharyya", num(final->worst_b), &ok);
+    put(root, "mean_jm", num(final->mean_jm), &ok);
+    put(root, "worst_pair", pair_names(rep, final, &ok), &ok);
+    put(root, "search", json_string(r->search), &ok);
+    put(root, "sets_scored", json_integer((json_int_t)r->evaluations), &ok);
+    json_t *per_k = json_array();
+    put(root, "per_k", per_k, &ok);
+    for (size_t k = 1; k <= K && ok; k++) {
+        json_t *e = json_object();
+        push(per_k, e, &ok);
+        put(e, "k", json_integer((json_int_t)k), &ok);
+        put(e, "selected_thz", set_thz(rep, k, &ok), &ok);
+        put(e, "score", json_real(r->scores[k - 1].worst_jm), &ok);
+        put(e, "bhattacharyya", num(r->scores[k - 1].worst_b), &ok);
+        put(e, "mean_jm", num(r->scores[k - 1].mean_jm), &ok);
+        put(e, "worst_pair", pair_names(rep, &r->scores[k - 1], &ok), &ok);
+    }
+    json_t *cand = json_object();
+    put(root, "candidates", cand, &ok);
+    put(cand, "from_thz", json_real(rep->from_thz), &ok);
+    put(cand, "to_thz", json_real(rep->to_thz), &ok);
+    put(cand, "step_ghz", json_real(rep->step_ghz), &ok);
+    put(cand, "relative_width", json_real(s->relative_width), &ok);
+    put(cand, "frequency_thz", array_of(s->candidates_thz, n, &ok), &ok);
+    json_t *noise = json_object();
+    put(root, "noise", noise, &ok);
+    put(noise, "source", json_string(rep->netd_source), &ok);
+    put(noise, "netd_k", array_of(s->netd_k, n, &ok), &ok);
+    json_t *nu = json_object();
+    put(root, "nuisances", nu, &ok);
+    put(nu, "target_temperature_range_k", json_real(s->target_range_k), &ok);
+    put(nu, "ambient_temperature_range_k", json_real(s->ambient_range_k), &ok);
+    put(nu, "air_temperature_varied", json_boolean(v->air_temperature_varied), &ok);
+    put(nu, "humidity_range", json_real(s->humidity_range), &ok);
+    put(nu, "humidity_varied", json_boolean(v->humidity_varied), &ok);
+    json_t *classes = json_array();
+    put(root, "classes", classes, &ok);
+    for (size_t k = 0; k < v->n_classes && ok; k++) {
+        json_t *c = json_object();
+        push(classes, c, &ok);
+        put(c, "name", json_string(v->class_names[k]), &ok);
+        put(c, "pixels", json_integer((json_int_t)v->class_pixels[k]), &ok);
+        put(c, "mean_tb_k", array_of(v->mean + k * n, n, &ok), &ok);
+        put(c, "pixel_sd_k", array_of(v->pixel_sd + k * n, n, &ok), &ok);
+        put(c, "nuisance_sd_k", array_of(v->nuisance_sd + k * n, n, &ok), &ok);
+    }
+    put(root, "air_attenuation_db_per_km",
+        rep->air_db_per_km ? array_of(rep->air_db_per_km, n, &ok) : json_null(), &ok);
+    put(root, "renders", json_integer((json_int_t)v->renders), &ok);
+    put(root, "paths_per_sample", json_integer(s->paths_per_sample), &ok);
+    put(root, "seed", json_integer((json_int_t)(s->seed & INT64_MAX)), &ok);
+    put(root, "seconds", json_real(v->seconds), &ok);
+    char *text =
+        ok ? json_dumps(root, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10))
+           : NULL;
+    json_decref(root);
+    if (!text)
+        thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    return text;
+}
+
+static thz_status join(char *path, const char *dir, const char *name, thz_error *err)
+{
+    return thz_path_join(path, THZ_PATH_MAX, dir, name, err);
+}
+
+thz_status bands_write_files(const char *dir, const bands_report *rep, const char *json_text,
+                             thz_error *err)
+{
+    const bands_setup *s = rep->setup;
+    const bands_values *v = rep->values;
+    const bands_search_result *r = rep->search;
+    size_t K = r->count, n = s->n_candidates;
+    char path[THZ_PATH_MAX], title[1024];
+    thz_status st = plot_check_device(err);
+    if (st == THZ_OK)
+        st = join(path, dir, "bands.json", err);
+    if (st != THZ_OK)
+        return st;
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create", path);
+    int failed = fputs(json_text, f) < 0 || fputc('\n', f) == EOF;
+    if (fclose(f) != 0 || failed)
+        return thz_error_set(err, THZ_ERR_IO, "%s: write failed", path);
+
+    double *x = thz_calloc(K > n ? K : n, sizeof *x), *y = thz_calloc(K, sizeof *y);
+    plot_band *bands = thz_calloc(K, sizeof *bands);
+    char(*names)[32] = thz_calloc(K, sizeof *names);
+    if (!x || !y || !bands || !names) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t k = 0; k < K; k++) {
+        x[k] = (double)(k + 1);
+        y[k] = r->scores[k].worst_jm;
+    }
+    const char *score_name[] = {"worst pair"};
+    snprintf(title, sizeof title, "%s: best set of K channels (%s)", rep->scene_name, r->search);
+    st = join(path, dir, "bands-score.png", err);
+    if (st == THZ_OK)
+        st = plot_lines(path, K, x, 1, score_name, y, title, "channels K",
+                        "Jeffries-Matusita distance (0..2)", err);
+    int used = snprintf(title, sizeof title, "%s: mean T#db#u per class; chosen:", rep->scene_name);
+    const size_t *set = r->sets + (K - 1) * K;
+    for (size_t i = 0; i < K && used > 0 && (size_t)used < sizeof title; i++)
+        used +=
+            snprintf(title + used, sizeof title - (size_t)used, " %.4g", s->candidates_thz[set[i]]);
+    if (used > 0 && (size_t)used < sizeof title)
+        snprintf(title + used, sizeof title - (size_t)used, " THz");
+    if (st == THZ_OK)
+        st = join(path, dir, "bands-spectra.png", err);
+    if (st == THZ_OK)
+        st = plot_lines(path, n, s->candidates_thz, v->n_classes,
+                        (const char *const *)v->class_names, v->mean, title, "frequency (THz)",
+                        "brightness temperature (K)", err);
+    if (st == THZ_OK && rep->air_db_per_km) {
+        for (size_t i = 0; i < K; i++) {
+            double f0 = s->candidates_thz[set[i]], half = 0.5 * s->relative_width * f0;
+            snprintf(names[i], sizeof names[i], "%.4g THz", f0);
+            bands[i] =
+                (plot_band){.name = names[i], .lo = f0 - half, .centre = f0, .hi = f0 + half};
+        }
+        plot_curve curve = {
+            .name = "air", .y = rep->air_db_per_km, .rgb = {31, 119, 180}, .width = 2.0};
+        snprintf(title, sizeof title, "%s: the air's attenuation and the chosen channels",
+                 rep->scene_name);
+        st = join(path, dir, "bands-air.png", err);
+        if (st == THZ_OK)
+            st = plot_attenuation(path, n, s->candidates_thz, 1, &curve, K, bands, title,
+                                  "frequency (THz)", "attenuation (dB/km)", err);
+    }
+done:
+    free(x);
+    free(y);
+    free(bands);
+    free(names);
+    return st;
+}

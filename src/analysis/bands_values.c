@@ -1,0 +1,438 @@
+/* Band values from the scene itself (bands_values.h). */
+#include "analysis/bands_values.h"
+
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/path.h"
+
+/* Physical constants (SI, exact since 2019). */
+#define BV_H 6.62607015e-34
+#define BV_K 1.380649e-23
+#define BV_C 299792458.0
+
+void bands_values_fini(bands_values *v)
+{
+    if (v->class_names)
+        for (size_t k = 0; k < v->n_classes; k++)
+            free(v->class_names[k]);
+    free(v->class_names);
+    free(v->class_pixels);
+    free(v->mean);
+    free(v->cov);
+    free(v->pixel_sd);
+    free(v->nuisance_sd);
+    memset(v, 0, sizeof *v);
+}
+
+/* dB_nu/dT at nu (Hz) and T (K), W m^-2 sr^-1 Hz^-1 K^-1: turns a radiance's standard
+ * error into kelvin (at the channel centre: the bands are narrow). */
+static double planck_dbdt(double nu, double t)
+{
+    double x = BV_H * nu / (BV_K * t);
+    double ex = exp(x);
+    double b = 2.0 * BV_H * nu * nu * nu / (BV_C * BV_C) / (ex - 1.0);
+    return b * x * ex / (ex - 1.0) / t;
+}
+
+/* The scene's JSON with the nuisance `what` changed: 0 nominal, 1 the targets'
+ * temperatures + range, 2 the other objects' and the air's temperature + range, 3 the
+ * humidity x (1 - range). Channels and render settings replaced in every variant. */
+enum { VAR_NOMINAL = 0, VAR_TARGETS, VAR_AMBIENT, VAR_HUMIDITY, VAR_COUNT };
+
+static const char *const humidity_keys[] = {"relative_humidity", "water_vapour_g_m3", "h2o_vmr"};
+
+static int add_number(json_t *obj, const char *key, double delta, double factor)
+{
+    json_t *v = json_object_get(obj, key);
+    if (!v || !json_is_number(v))
+        return 0;
+    json_object_set_new(obj, key, json_real(json_number_value(v) * factor + delta));
+    return 1;
+}
+
+static char *variant_text(const json_t *root, const bands_setup *s, const bool *is_class, int what,
+                          int *changed)
+{
+    json_t *doc = json_deep_copy(root);
+    if (!doc)
+        return NULL;
+    json_t *channels = json_array();
+    for (size_t c = 0; c < s->n_candidates; c++) {
+        json_t *ch = json_object();
+        json_object_set_new(ch, "frequency_thz", json_real(s->candidates_thz[c]));
+        json_object_set_new(ch, "relative_width", json_real(s->relative_width));
+        json_array_append_new(channels, ch);
+    }
+    json_object_set_new(doc, "channels", channels);
+    json_t *render = json_object();
+    json_object_set_new(render, "integrator", json_string("path"));
+    json_object_set_new(render, "paths_per_sample", json_integer(s->paths_per_sample));
+    json_object_set_new(doc, "render", render);
+    /* the sensor's noise with one netd_k per channel cannot follow the candidates: its
+     * NETD is interpolated to them instead (api_bands.c), and the renders need none */
+    json_t *sensor = json_array_get(json_object_get(doc, "sensors"), s->sensor);
+    json_t *noise = json_object_get(sensor, "noise");
+    if (noise && json_is_array(json_object_get(noise, "netd_k")))
+        json_object_del(sensor, "noise");
+    *changed = 0;
+    json_t *objects = json_object_get(doc, "objects");
+    json_t *atm = json_object_get(doc, "atmosphere");
+    if (what == VAR_TARGETS || what == VAR_AMBIENT) {
+        double dt = what == VAR_TARGETS ? s->target_range_k : s->ambient_range_k;
+        for (size_t i = 0; i < json_array_size(objects); i++)
+            if (is_class[i] == (what == VAR_TARGETS))
+                *changed += add_number(json_array_get(objects, i), "temperature_k", dt, 1.0);
+        if (what == VAR_AMBIENT && atm)
+            *changed += 2 * add_number(atm, "temperature_k", dt, 1.0);
+    } else if (what == VAR_HUMIDITY && atm) {
+        /* downwards, which every humidity key accepts */
+        for (size_t i = 0; i < 3; i++)
+            *changed += add_number(atm, humidity_keys[i], 0.0, 1.0 - s->humidity_range);
+    }
+    char *text = json_dumps(doc, JSON_COMPACT | JSON_REAL_PRECISION(17));
+    json_decref(doc);
+    return text;
+}
+
+/* One render of a variant: its Tb cube and radiance standard error (copied), and the
+ * object_id truth (nominal only). */
+typedef struct render_out {
+    float *tb, *stderr_l;
+    int32_t *ids;
+    size_t pixels;
+} render_out;
+
+static thz_status render_variant(thz_context *ctx, const char *text, const bands_setup *s,
+                                 const char *base_dir, render_out *out, thz_error *err)
+{
+    thz_scene *scene = NULL;
+    thz_image *img = NULL;
+    thz_status st = thz_scene_load_string(text, base_dir, s->scene_path, &scene, err);
+    if (st != THZ_OK)
+        return st;
+    thz_run_settings rs;
+    thz_run_settings_init(&rs);
+    rs.integrator = "path";
+    rs.has_seed = 1;
+    rs.seed = s->seed;
+    st = thz_render_sensor(ctx, scene, NULL, s->sensor, &rs, &img, err);
+    if (st != THZ_OK)
+        goto done;
+    size_t pixels = (size_t)thz_image_columns(img) * thz_image_rows(img), nb = 0, ne = 0;
+    const float *tb = thz_image_plane(img, THZ_PLANE_BRIGHTNESS_TEMPERATURE, &nb);
+    const float *se = thz_image_plane(img, THZ_PLANE_RADIANCE_STDERR, &ne);
+    const float *ids = thz_image_plane(img, THZ_PLANE_OBJECT_ID, NULL);
+    out->pixels = pixels;
+    out->tb = thz_malloc_array(pixels * s->n_candidates, sizeof *out->tb);
+    out->stderr_l = thz_calloc(pixels * s->n_candidates, sizeof *out->stderr_l);
+    out->ids = thz_malloc_array(pixels, sizeof *out->ids);
+    if (!out->tb || !out->stderr_l || !out->ids || !tb || nb != s->n_candidates || !ids) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    memcpy(out->tb, tb, pixels * nb * sizeof *tb);
+    if (se && ne == nb)
+        memcpy(out->stderr_l, se, pixels * nb * sizeof *se);
+    for (size_t p = 0; p < pixels; p++)
+        out->ids[p] = (int32_t)ids[p];
+done:
+    thz_image_destroy(img);
+    thz_scene_destroy(scene);
+    return st;
+}
+
+static void render_out_fini(render_out *r)
+{
+    free(r->tb);
+    free(r->stderr_l);
+    free(r->ids);
+    memset(r, 0, sizeof *r);
+}
+
+/* Class of each pixel from the truth: targets (in order) and "background", or every
+ * object seen. */
+static thz_status assign_classes(const bands_setup *s, const thz_scene *scene, const int32_t *ids,
+                                 size_t pixels, int32_t *cls, bool *is_class, bands_values *v,
+                                 thz_error *err)
+{
+    size_t n_obj = thz_scene_object_count(scene);
+    int32_t *class_of = thz_calloc(n_obj, sizeof *class_of);
+    uint64_t *seen = thz_calloc(n_obj, sizeof *seen);
+    thz_status st = THZ_OK;
+    if (!class_of || !seen) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t p = 0; p < pixels; p++)
+        if (ids[p] >= 0 && (size_t)ids[p] < n_obj)
+            seen[ids[p]]++;
+    size_t nc = 0;
+    if (s->n_targets) {
+        for (size_t o = 0; o < n_obj; o++)
+            class_of[o] = -1;
+        for (size_t t = 0; t < s->n_targets; t++) {
+            if (!seen[s->targets[t]]) {
+                thz_object_info oi;
+                thz_scene_object(scene, (size_t)s->targets[t], &oi);
+                st = thz_error_set(err, THZ_ERR_INPUT,
+                                   "--targets: the sensor sees no pixel of '%s'", oi.name);
+                goto done;
+            }
+            class_of[s->targets[t]] = (int32_t)nc++;
+            is_class[s->targets[t]] = true;
+        }
+        bool background = false;
+        for (size_t o = 0; o < n_obj; o++)
+            background = background || (seen[o] && class_of[o] < 0);
+        for (size_t o = 0; o < n_obj; o++)
+            if (class_of[o] < 0)
+                class_of[o] = background ? (int32_t)nc : -1;
+        nc += background;
+    } else {
+        for (size_t o = 0; o < n_obj; o++) {
+            class_of[o] = seen[o] ? (int32_t)nc++ : -1;
+            is_class[o] = seen[o] > 0;
+        }
+    }
+    v->n_classes = nc;
+    v->class_names = thz_calloc(nc, sizeof *v->class_names);
+    v->class_pixels = thz_calloc(nc, sizeof *v->class_pixels);
+    if (!v->class_names || !v->class_pixels) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t o = 0; o < n_obj; o++) {
+        int32_t k = class_of[o];
+        if (k < 0 || v->class_names[k])
+            continue;
+        thz_object_info oi;
+        thz_scene_object(scene, o, &oi);
+        v->class_names[k] = thz_strdup(is_class[o] ? oi.name : "background");
+        if (!v->class_names[k]) {
+            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+    }
+    for (size_t p = 0; p < pixels; p++) {
+        cls[p] = ids[p] >= 0 && (size_t)ids[p] < n_obj ? class_of[ids[p]] : -1;
+        if (cls[p] >= 0)
+            v->class_pixels[cls[p]]++;
+    }
+done:
+    free(class_of);
+    free(seen);
+    return st;
+}
+
+/* Class means of a render's Tb into mean[class * n + c]. */
+static void class_means(const render_out *r, const int32_t *cls, const bands_values *v,
+                        double *mean)
+{
+    size_t n = v->n_candidates;
+    memset(mean, 0, v->n_classes * n * sizeof *mean);
+    for (size_t c = 0; c < n; c++)
+        for (size_t p = 0; p < r->pixels; p++)
+            if (cls[p] >= 0)
+                mean[(size_t)cls[p] * n + c] += r->tb[c * r->pixels + p];
+    for (size_t k = 0; k < v->n_classes; k++)
+        for (size_t c = 0; c < n; c++)
+            mean[k * n + c] /= (double)v->class_pixels[k];
+}
+
+/* The pixel covariance of each class about its mean, less the Monte Carlo variance of
+ * its pixels on the diagonal (floored at 0), plus NETD^2 on the diagonal. */
+static void pixel_covariance(const render_out *r, const int32_t *cls, const bands_setup *s,
+                             bands_values *v, double *x)
+{
+    size_t n = v->n_candidates, pixels = r->pixels;
+    for (size_t p = 0; p < pixels; p++) {
+        if (cls[p] < 0)
+            continue;
+        size_t k = (size_t)cls[p];
+        for (size_t c = 0; c < n; c++)
+            x[c] = r->tb[c * pixels + p] - v->mean[k * n + c];
+        double *cov = v->cov + k * n * n;
+        for (size_t a = 0; a < n; a++)
+            for (size_t b = 0; b <= a; b++)
+                cov[a * n + b] += x[a] * x[b];
+    }
+    for (size_t k = 0; k < v->n_classes; k++) {
+        double *cov = v->cov + k * n * n;
+        double d = v->class_pixels[k] > 1 ? (double)(v->class_pixels[k] - 1) : 1.0;
+        for (size_t a = 0; a < n; a++)
+            for (size_t b = 0; b <= a; b++) {
+                cov[a * n + b] /= d;
+                cov[b * n + a] = cov[a * n + b];
+            }
+    }
+    /* Removing the Monte Carlo variance mc_c from the diagonal alone could leave a
+     * matrix that is not positive semi-definite; scaling row and column c by
+     * sqrt(1 - mc_c / var_c) instead (D C D, D >= 0 diagonal) keeps it so and keeps the
+     * correlations. */
+    for (size_t k = 0; k < v->n_classes; k++) {
+        double *cov = v->cov + k * n * n;
+        for (size_t c = 0; c < n; c++) {
+            double nu = s->candidates_thz[c] * 1e12, mc = 0.0;
+            for (size_t p = 0; p < pixels; p++)
+                if (cls[p] == (int32_t)k) {
+                    double t = r->tb[c * pixels + p];
+                    double sd = t > 0.0 ? r->stderr_l[c * pixels + p] / planck_dbdt(nu, t) : 0.0;
+                    mc += sd * sd;
+                }
+            mc /= (double)v->class_pixels[k];
+            double var = cov[c * n + c];
+            x[c] = var > mc ? sqrt(1.0 - mc / var) : 0.0;
+        }
+        for (size_t a = 0; a < n; a++)
+            for (size_t b = 0; b < n; b++)
+                cov[a * n + b] *= x[a] * x[b];
+        for (size_t c = 0; c < n; c++) {
+            v->pixel_sd[k * n + c] = sqrt(cov[c * n + c]);
+            cov[c * n + c] += s->netd_k[c] * s->netd_k[c];
+        }
+    }
+}
+
+thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_values *v,
+                                thz_error *err)
+{
+    memset(v, 0, sizeof *v);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    size_t n = s->n_candidates;
+    v->n_candidates = n;
+    json_error_t jerr;
+    json_t *root = json_load_file(s->scene_path, JSON_REJECT_DUPLICATES, &jerr);
+    if (!root)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: %s", s->scene_path, jerr.line,
+                             jerr.column, jerr.text);
+    char base_dir[THZ_PATH_MAX];
+    snprintf(base_dir, sizeof base_dir, "%s", s->scene_path);
+    char *slash = strrchr(base_dir, '/');
+    if (slash)
+        *slash = '\0';
+    else
+        snprintf(base_dir, sizeof base_dir, ".");
+    thz_status st = THZ_OK;
+    thz_scene *scene = NULL;
+    render_out nominal = {0}, other = {0};
+    int32_t *cls = NULL;
+    bool *is_class = NULL;
+    double *x = NULL, *dmean = NULL;
+    char *text = NULL;
+    int changed = 0;
+    size_t n_obj = json_array_size(json_object_get(root, "objects"));
+    is_class = thz_calloc(n_obj, sizeof *is_class);
+    if (!is_class)
+        goto nomem;
+    text = variant_text(root, s, is_class, VAR_NOMINAL, &changed);
+    if (!text)
+        goto nomem;
+    st = thz_scene_load_string(text, base_dir, s->scene_path, &scene, err);
+    if (st == THZ_OK)
+        st = render_variant(ctx, text, s, base_dir, &nominal, err);
+    free(text);
+    text = NULL;
+    if (st != THZ_OK)
+        goto done;
+    v->renders = 1;
+    for (size_t c = 0; c < n && s->netd_from_sensor; c++) {
+        thz_sensor_channel_info sc;
+        st = thz_scene_sensor_channel(scene, s->sensor, c, &sc);
+        if (st != THZ_OK) {
+            thz_error_set(err, st, "sensor %zu, channel %zu: no noise figures", s->sensor, c);
+            goto done;
+        }
+        s->netd_k[c] = sc.netd_k; /* at the channel's reference temperature */
+    }
+    cls = thz_calloc(nominal.pixels, sizeof *cls);
+    if (!cls)
+        goto nomem;
+    st = assign_classes(s, scene, nominal.ids, nominal.pixels, cls, is_class, v, err);
+    if (st != THZ_OK)
+        goto done;
+    if (v->n_classes < 2) {
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "%s: the sensor sees %zu class(es); band selection needs two or more",
+                           s->scene_path, v->n_classes);
+        goto done;
+    }
+    size_t nc = v->n_classes;
+    v->mean = thz_calloc(nc * n, sizeof *v->mean);
+    v->cov = thz_calloc(nc * n * n, sizeof *v->cov);
+    v->pixel_sd = thz_calloc(nc * n, sizeof *v->pixel_sd);
+    v->nuisance_sd = thz_calloc(nc * n, sizeof *v->nuisance_sd);
+    x = thz_calloc(n, sizeof *x);
+    dmean = thz_calloc(nc * n, sizeof *dmean);
+    if (!v->mean || !v->cov || !v->pixel_sd || !v->nuisance_sd || !x || !dmean)
+        goto nomem;
+    class_means(&nominal, cls, v, v->mean);
+    pixel_covariance(&nominal, cls, s, v, x);
+
+    /* Nuisances: a uniform variation within +-range has variance range^2 / 3; the
+     * render at +range (humidity: x (1 - range)) gives the change d of each class's
+     * mean, which adds d d^T / 3 to its covariance (the same seed in every render keeps
+     * the Monte Carlo noise out of d). */
+    double ranges[VAR_COUNT] = {0, s->target_range_k, s->ambient_range_k, s->humidity_range};
+    for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
+        if (!(ranges[what] > 0.0))
+            continue;
+        text = variant_text(root, s, is_class, what, &changed);
+        if (!text)
+            goto nomem;
+        if (!changed) {
+            free(text);
+            text = NULL;
+            continue;
+        }
+        if (what == VAR_HUMIDITY)
+            v->humidity_varied = true;
+        if (what == VAR_AMBIENT && changed >= 2)
+            v->air_temperature_varied = true;
+        st = render_variant(ctx, text, s, base_dir, &other, err);
+        free(text);
+        text = NULL;
+        if (st != THZ_OK)
+            goto done;
+        v->renders++;
+        class_means(&other, cls, v, dmean);
+        render_out_fini(&other);
+        for (size_t k = 0; k < nc; k++) {
+            double *d = dmean + k * n, *cov = v->cov + k * n * n;
+            for (size_t c = 0; c < n; c++)
+                d[c] = (d[c] - v->mean[k * n + c]) / sqrt(3.0);
+            for (size_t a = 0; a < n; a++) {
+                for (size_t b = 0; b < n; b++)
+                    cov[a * n + b] += d[a] * d[b];
+                v->nuisance_sd[k * n + a] += d[a] * d[a];
+            }
+        }
+    }
+    for (size_t i = 0; i < nc * n; i++)
+        v->nuisance_sd[i] = sqrt(v->nuisance_sd[i]);
+    goto done;
+nomem:
+    st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+done:
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    v->seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    free(text);
+    free(x);
+    free(dmean);
+    free(cls);
+    free(is_class);
+    render_out_fini(&nominal);
+    render_out_fini(&other);
+    thz_scene_destroy(scene);
+    json_decref(root);
+    if (st != THZ_OK)
+        bands_values_fini(v);
+    return st;
+}

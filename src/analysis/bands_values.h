@@ -1,0 +1,52 @@
+/* Band values from the scene itself (docs/analysis.md "thzmap bands"): the scene is
+ * rendered with the candidate channels as its channels (path integrator, converged
+ * radiance through covers and air), once as it is and once per nuisance changed
+ * (targets' temperatures, the surroundings' and the air's temperature, the air's
+ * humidity); each class's pixels come from the object_id truth. The result is each
+ * class's mean brightness temperature per candidate and its covariance over the
+ * candidates: pixel spread (Monte Carlo noise removed) + nuisances + the sensor's NETD.
+ */
+#ifndef THZ_ANALYSIS_BANDS_VALUES_H
+#define THZ_ANALYSIS_BANDS_VALUES_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "thzmap/thzmap.h"
+
+typedef struct bands_setup {
+    const char *scene_path;
+    const double *candidates_thz; /* n_candidates centres */
+    size_t n_candidates;
+    double relative_width;
+    size_t sensor;
+    const long *targets; /* object indices; n_targets 0: every object seen is a class */
+    size_t n_targets;
+    double *netd_k;        /* per candidate: the sensor's NETD, K (thzmap/analysis.h) */
+    bool netd_from_sensor; /* a radiometer: netd_k becomes the sensor's NETD of each
+                              candidate in the scene with the candidates as channels */
+    double target_range_k, ambient_range_k, humidity_range;
+    uint32_t paths_per_sample;
+    uint64_t seed;
+} bands_setup;
+
+typedef struct bands_values {
+    size_t n_candidates, n_classes;
+    char **class_names;     /* per class: the object's name, or "background" */
+    uint64_t *class_pixels; /* per class */
+    double *mean;           /* [class * n + c]: mean Tb of the class's pixels, K (nominal) */
+    double *cov;            /* [class * n^2 + c * n + c']: K^2 */
+    double *pixel_sd;       /* [class * n + c]: pixel spread (MC removed), K */
+    double *nuisance_sd;    /* [class * n + c]: all nuisances together, K */
+    bool humidity_varied, air_temperature_varied;
+    size_t renders;
+    double seconds;
+} bands_values;
+
+/* Renders and reduces as above. Progress and cancellation through ctx. */
+thz_status bands_values_compute(thz_context *ctx, const bands_setup *setup, bands_values *out,
+                                thz_error *err);
+void bands_values_fini(bands_values *v);
+
+#endif

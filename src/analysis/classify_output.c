@@ -1,0 +1,190 @@
+/* The files of a classification (classify_output.h): classification.json, the class
+ * map as ENVI and as a PNG in a qualitative palette. */
+#include "analysis/classify_output.h"
+
+#include <jansson.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/path.h"
+#include "io/envi.h"
+#include "io/png_image.h"
+
+/* A qualitative palette (sRGB 0..255): class k is drawn in colour k mod 10, pixels
+ * where nothing is hit in black. */
+static const unsigned char class_palette[10][3] = {
+    {31, 119, 180}, {255, 127, 14},  {44, 160, 44},   {214, 39, 40},  {148, 103, 189},
+    {140, 86, 75},  {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207},
+};
+
+static void put(json_t *obj, const char *key, json_t *v, bool *ok)
+{
+    if (!v || json_object_set_new(obj, key, v) != 0)
+        *ok = false;
+}
+
+static void push(json_t *arr, json_t *v, bool *ok)
+{
+    if (!v || json_array_append_new(arr, v) != 0)
+        *ok = false;
+}
+
+static json_t *real_or_null(double v)
+{
+    return isfinite(v) ? json_real(v) : json_null();
+}
+
+char *classify_json(const classify_report *rep, thz_error *err)
+{
+    const classify_result *r = rep->result;
+    size_t nc = r->n_classes;
+    bool ok = true;
+    json_t *root = json_object();
+    if (!root)
+        goto nomem;
+    put(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
+    put(root, "run_dir", rep->run_dir ? json_string(rep->run_dir) : json_null(), &ok);
+    put(root, "sensor", rep->sensor ? json_string(rep->sensor) : json_null(), &ok);
+    put(root, "source", json_string(rep->source), &ok);
+    put(root, "method", json_string(classify_method_name(rep->method)), &ok);
+    put(root, "seed", json_integer((json_int_t)(rep->seed & INT64_MAX)), &ok);
+    put(root, "train_fraction", json_real(rep->train_fraction), &ok);
+    put(root, "added_netd_k", rep->netd_k > 0.0 ? json_real(rep->netd_k) : json_null(), &ok);
+    put(root, "columns", json_integer(rep->columns), &ok);
+    put(root, "rows", json_integer(rep->rows), &ok);
+    uint64_t total = 0;
+    for (size_t i = 0; i < nc * nc; i++)
+        total += r->confusion[i];
+    put(root, "pixels", json_integer((json_int_t)total), &ok);
+    put(root, "training_pixels", json_integer((json_int_t)r->n_train), &ok);
+    put(root, "held_out_pixels", json_integer((json_int_t)r->n_held_out), &ok);
+    put(root, "accuracy", real_or_null(r->accuracy), &ok);
+    put(root, "held_out_accuracy", real_or_null(r->held_out_accuracy), &ok);
+    json_t *classes = json_array(), *confusion = json_array();
+    put(root, "classes", classes, &ok);
+    put(root, "confusion", confusion, &ok);
+    for (size_t k = 0; k < nc && ok; k++) {
+        json_t *c = json_object(), *row = json_array(), *roc = json_object();
+        json_t *fpr = json_array(), *tpr = json_array(), *color = json_array();
+        push(classes, c, &ok);
+        push(confusion, row, &ok);
+        if (!ok || !roc || !fpr || !tpr || !color) {
+            json_decref(roc);
+            json_decref(fpr);
+            json_decref(tpr);
+            json_decref(color);
+            ok = false;
+            break;
+        }
+        uint64_t n = 0;
+        for (size_t j = 0; j < nc; j++) {
+            push(row, json_integer((json_int_t)r->confusion[k * nc + j]), &ok);
+            n += r->confusion[k * nc + j];
+        }
+        put(c, "object", json_integer(r->class_object[k]), &ok);
+        put(c, "name", json_string(rep->class_names[k]), &ok);
+        put(c, "pixels", json_integer((json_int_t)n), &ok);
+        put(c, "accuracy", real_or_null(r->class_accuracy[k]), &ok);
+        put(c, "auc", real_or_null(r->auc[k]), &ok);
+        for (int i = 0; i < 3; i++)
+            push(color, json_integer(class_palette[k % 10][i]), &ok);
+        put(c, "color", color, &ok);
+        put(c, "roc", roc, &ok);
+        put(roc, "false_positive_rate", fpr, &ok);
+        put(roc, "true_positive_rate", tpr, &ok);
+        for (size_t i = 0; i < CLASSIFY_ROC_POINTS; i++) {
+            push(fpr, real_or_null(r->roc_fpr[k * CLASSIFY_ROC_POINTS + i]), &ok);
+            push(tpr, real_or_null(r->roc_tpr[k * CLASSIFY_ROC_POINTS + i]), &ok);
+        }
+    }
+    if (!ok)
+        goto nomem;
+    char *text = json_dumps(root, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10));
+    json_decref(root);
+    if (!text)
+        goto nomem_text;
+    return text;
+nomem:
+    json_decref(root);
+nomem_text:
+    thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    return NULL;
+}
+
+static thz_status write_text(const char *dir, const char *name, const char *text, thz_error *err)
+{
+    char path[THZ_PATH_MAX];
+    thz_status st = thz_path_join(path, sizeof path, dir, name, err);
+    if (st != THZ_OK)
+        return st;
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create", path);
+    int failed = fputs(text, f) < 0 || fputc('\n', f) == EOF;
+    if (fclose(f) != 0 || failed)
+        return thz_error_set(err, THZ_ERR_IO, "%s: write failed", path);
+    return THZ_OK;
+}
+
+thz_status classify_write_files(const char *dir, const classify_report *rep, const char *json_text,
+                                thz_error *err)
+{
+    const classify_result *r = rep->result;
+    size_t pixels = (size_t)rep->columns * rep->rows;
+    thz_status st = write_text(dir, "classification.json", json_text, err);
+    if (st != THZ_OK)
+        return st;
+    float *map = thz_malloc_array(pixels, sizeof *map);
+    float *rgb = thz_malloc_array(pixels * 3, sizeof *rgb);
+    if (!map || !rgb) {
+        free(map);
+        free(rgb);
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    }
+    for (size_t p = 0; p < pixels; p++) {
+        map[p] = (float)r->assigned[p];
+        size_t k = 0;
+        while (k < r->n_classes && r->class_object[k] != r->assigned[p])
+            k++;
+        for (int i = 0; i < 3; i++)
+            rgb[3 * p + (size_t)i] =
+                k < r->n_classes ? (float)class_palette[k % 10][i] / 255.0f : 0.0f;
+    }
+    const char *stem_sensor = rep->sensor ? rep->sensor : "cube";
+    char stem[THZ_PATH_MAX], description[1024], png[THZ_PATH_MAX], name[THZ_PATH_MAX];
+    snprintf(stem, sizeof stem, "%s.class", stem_sensor);
+    for (char *p = stem; *p; p++)
+        if (*p == '/')
+            *p = '_';
+    snprintf(description, sizeof description,
+             "thzmap %s: class map of %s by %s: object index of the assigned class (-1: nothing "
+             "hit) [1]",
+             THZ_VERSION_STRING, rep->source, classify_method_name(rep->method));
+    const char *band_names[] = {"class"};
+    envi_info info = {.description = description,
+                      .data_units = "1",
+                      .samples = rep->columns,
+                      .lines = rep->rows,
+                      .bands = 1,
+                      .band_names = band_names,
+                      .has_ignore_value = 1,
+                      .ignore_value = -1.0,
+                      .object_names = (const char *const *)rep->object_names,
+                      .n_object_names = rep->n_object_names};
+    st = envi_write_float32(dir, stem, &info, map, err);
+    if (st == THZ_OK) {
+        int n = snprintf(name, sizeof name, "%.4000s.png", stem);
+        st = n > 0 && (size_t)n < sizeof name
+                 ? thz_path_join(png, sizeof png, dir, name, err)
+                 : thz_error_set(err, THZ_ERR_IO, "%s.png: file name too long", stem);
+    }
+    if (st == THZ_OK)
+        st = png_image_write_srgb8(png, rgb, rep->columns, rep->rows, err);
+    free(map);
+    free(rgb);
+    return st;
+}

@@ -1,0 +1,348 @@
+/* The public API of band selection (thzmap/analysis.h): options, the search over a
+ * scene's candidate channels, and its files (analysis/bands_*.c). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "analysis/bands_output.h"
+#include "analysis/bands_search.h"
+#include "analysis/bands_values.h"
+#include "api/api.h"
+#include "core/alloc.h"
+#include "io/output.h"
+
+/* Most candidates: a scene has at most this many channels (scene-format.md). */
+enum { BANDS_MAX_CANDIDATES = 4096 };
+
+struct thz_bands {
+    char *scene_path, *scene_name, *sensor;
+    double from_thz, to_thz, step_ghz;
+    double *candidates_thz;
+    double *netd_k; /* per candidate */
+    const char *netd_source;
+    long *targets;
+    bands_setup setup;
+    bands_values values;
+    bands_search_result search;
+    double *air_db_per_km; /* or NULL */
+    char *json;
+};
+
+void thz_bands_options_init(thz_bands_options *opt)
+{
+    memset(opt, 0, sizeof *opt);
+    opt->from_thz = 0.1;
+    opt->to_thz = 1.5;
+    opt->step_ghz = 10.0;
+    opt->netd_k = 0.5; /* used when has_netd, or when the sensor has no noise */
+    opt->target_temperature_range_k = 2.0;
+    opt->ambient_temperature_range_k = 2.0;
+    opt->humidity_range = 0.2;
+    opt->paths_per_sample = 16;
+    opt->exhaustive_limit = 200000;
+}
+
+void thz_bands_destroy(thz_bands *b)
+{
+    if (!b)
+        return;
+    free(b->scene_path);
+    free(b->scene_name);
+    free(b->sensor);
+    free(b->candidates_thz);
+    free(b->netd_k);
+    free(b->targets);
+    bands_values_fini(&b->values);
+    bands_search_result_fini(&b->search);
+    free(b->air_db_per_km);
+    free(b->json);
+    free(b);
+}
+
+static thz_status check_options(const thz_bands_options *o, size_t *n_candidates, thz_error *err)
+{
+    if (o->count < 1 || o->count > BANDS_MAX_COUNT)
+        return thz_error_set(err, THZ_ERR_INPUT, "--count %zu: expected 1 to %d", o->count,
+                             BANDS_MAX_COUNT);
+    if (!(o->from_thz > 0.0) || !(o->to_thz >= o->from_thz) || !(o->step_ghz > 0.0) ||
+        !isfinite(o->to_thz))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "candidates %g to %g THz by %g GHz: expected 0 < from <= to and a "
+                             "step > 0",
+                             o->from_thz, o->to_thz, o->step_ghz);
+    double n = floor((o->to_thz - o->from_thz) * 1e3 / o->step_ghz + 1e-9) + 1.0;
+    if (n > BANDS_MAX_CANDIDATES)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%.0f candidates from %g to %g THz by %g GHz: at most %d (raise "
+                             "--step-ghz)",
+                             n, o->from_thz, o->to_thz, o->step_ghz, BANDS_MAX_CANDIDATES);
+    if ((size_t)n < o->count)
+        return thz_error_set(err, THZ_ERR_INPUT, "--count %zu: only %.0f candidates", o->count, n);
+    if (!(o->relative_width >= 0.0 && o->relative_width <= 0.5))
+        return thz_error_set(err, THZ_ERR_INPUT, "relative width %g: expected 0 < w <= 0.5",
+                             o->relative_width);
+    if (!(o->netd_k >= 0.0) || !(o->target_temperature_range_k >= 0.0) ||
+        !(o->ambient_temperature_range_k >= 0.0) ||
+        !(o->humidity_range >= 0.0 && o->humidity_range < 1.0))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "NETD and ranges must be >= 0 (and the humidity range below 1)");
+    if (o->paths_per_sample < 1)
+        return thz_error_set(err, THZ_ERR_INPUT, "paths per sample: expected at least 1");
+    *n_candidates = (size_t)n;
+    return THZ_OK;
+}
+
+/* The NETD per candidate: --netd-k; or the sensor's given netd_k, interpolated linearly
+ * in frequency between its channels (held beyond the ends); or, for a radiometer,
+ * bands_values reads each candidate's NETD from the scene with the candidates as its
+ * channels (it depends on their bandwidth); or netd_k when the sensor has no noise. */
+static thz_status resolve_netd(thz_bands *b, const thz_bands_options *o, const thz_scene *scene,
+                               size_t sensor, thz_error *err)
+{
+    b->netd_source = "--netd-k";
+    if (o->has_netd)
+        return THZ_OK;
+    size_t nch = thz_scene_channel_count(scene), n = b->setup.n_candidates;
+    thz_sensor_channel_info sc;
+    thz_status st = thz_scene_sensor_channel(scene, sensor, 0, &sc);
+    if (st != THZ_OK)
+        return thz_error_set(err, st, "sensor %zu: no noise figures", sensor);
+    if (strcmp(sc.noise, "none") == 0) {
+        b->netd_source = "default (the sensor has no noise)";
+        return THZ_OK;
+    }
+    if (strcmp(sc.noise, "netd") != 0) {
+        b->netd_source = strcmp(sc.noise, "dicke") == 0 ? "the sensor's radiometer (dicke)"
+                                                        : "the sensor's radiometer (total-power)";
+        b->setup.netd_from_sensor = true;
+        return THZ_OK;
+    }
+    b->netd_source = "the sensor's netd_k, interpolated to the candidates";
+    for (size_t c = 0; c < n; c++) {
+        double f = b->candidates_thz[c], lo = -1.0, hi = -1.0, lo_f = 0.0, hi_f = 0.0;
+        for (size_t i = 0; i < nch; i++) {
+            thz_channel_info ci;
+            st = thz_scene_channel(scene, i, &ci);
+            if (st == THZ_OK)
+                st = thz_scene_sensor_channel(scene, sensor, i, &sc);
+            if (st != THZ_OK)
+                return thz_error_set(err, st, "sensor %zu, channel %zu: no noise figures", sensor,
+                                     i);
+            if (ci.frequency_thz <= f && (lo < 0.0 || ci.frequency_thz > lo_f)) {
+                lo_f = ci.frequency_thz;
+                lo = sc.netd_k;
+            }
+            if (ci.frequency_thz >= f && (hi < 0.0 || ci.frequency_thz < hi_f)) {
+                hi_f = ci.frequency_thz;
+                hi = sc.netd_k;
+            }
+        }
+        if (lo < 0.0)
+            b->netd_k[c] = hi;
+        else if (hi < 0.0 || hi_f == lo_f)
+            b->netd_k[c] = lo;
+        else
+            b->netd_k[c] = lo + (hi - lo) * (f - lo_f) / (hi_f - lo_f);
+    }
+    return THZ_OK;
+}
+
+/* Scene facts: the sensor, the targets, the default width and seed, the air. */
+static thz_status resolve_scene(thz_bands *b, const thz_bands_options *o, thz_error *err)
+{
+    thz_scene *scene = NULL;
+    thz_atm *atm = NULL;
+    thz_status st = thz_scene_load(b->scene_path, &scene, err);
+    if (st != THZ_OK)
+        return st;
+    thz_scene_info info;
+    thz_scene_get_info(scene, &info);
+    long sensor = o->sensor ? thz_scene_sensor_index(scene, o->sensor) : 0;
+    if (sensor < 0) {
+        st =
+            thz_error_set(err, THZ_ERR_INPUT, "%s: no sensor named '%s'", b->scene_path, o->sensor);
+        goto done;
+    }
+    thz_sensor_info si;
+    thz_scene_sensor(scene, (size_t)sensor, &si);
+    b->setup.sensor = (size_t)sensor;
+    b->scene_name = thz_strdup(info.name);
+    b->sensor = thz_strdup(si.name);
+    b->targets = thz_calloc(o->n_targets, sizeof *b->targets);
+    if (!b->scene_name || !b->sensor || !b->targets) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t t = 0; t < o->n_targets; t++) {
+        b->targets[t] = thz_scene_object_index(scene, o->targets[t]);
+        if (b->targets[t] < 0) {
+            st = thz_error_set(err, THZ_ERR_INPUT, "--targets: %s has no object named '%s'",
+                               b->scene_path, o->targets[t]);
+            goto done;
+        }
+        for (size_t u = 0; u < t; u++)
+            if (b->targets[u] == b->targets[t]) {
+                st =
+                    thz_error_set(err, THZ_ERR_INPUT, "--targets: '%s' named twice", o->targets[t]);
+                goto done;
+            }
+    }
+    st = resolve_netd(b, o, scene, (size_t)sensor, err);
+    if (st != THZ_OK)
+        goto done;
+    thz_channel_info ci;
+    thz_scene_channel(scene, 0, &ci);
+    b->setup.relative_width = o->relative_width > 0.0 ? o->relative_width : ci.relative_width;
+    b->setup.seed = o->has_seed ? o->seed : info.seed;
+    if (strcmp(info.atmosphere_model, "none") != 0) {
+        st = thz_atm_from_scene(scene, &atm, err);
+        if (st != THZ_OK)
+            goto done;
+        st = thz_atm_check_range(atm, b->candidates_thz[0] * 1e12,
+                                 b->candidates_thz[b->setup.n_candidates - 1] * 1e12,
+                                 "the candidate frequencies", err);
+        if (st != THZ_OK)
+            goto done;
+        b->air_db_per_km = thz_calloc(b->setup.n_candidates, sizeof *b->air_db_per_km);
+        if (!b->air_db_per_km) {
+            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+        for (size_t c = 0; c < b->setup.n_candidates; c++)
+            b->air_db_per_km[c] =
+                thz_atm_attenuation_per_m(atm, b->candidates_thz[c] * 1e12) * THZ_NEPER_TO_DB * 1e3;
+    }
+done:
+    thz_atm_destroy(atm);
+    thz_scene_destroy(scene);
+    return st;
+}
+
+static bands_report make_report(const thz_bands *b)
+{
+    return (bands_report){.scene_path = b->scene_path,
+                          .scene_name = b->scene_name,
+                          .sensor = b->sensor,
+                          .setup = &b->setup,
+                          .from_thz = b->from_thz,
+                          .to_thz = b->to_thz,
+                          .step_ghz = b->step_ghz,
+                          .values = &b->values,
+                          .search = &b->search,
+                          .air_db_per_km = b->air_db_per_km,
+                          .netd_source = b->netd_source};
+}
+
+thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_bands_options *o,
+                            thz_bands **out, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    *out = NULL;
+    size_t n = 0;
+    if (!scene_path || !o)
+        return api_done(ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_bands_select: no scene"), err);
+    thz_status st = check_options(o, &n, err);
+    if (st != THZ_OK)
+        return api_done(ctx, st, err);
+    thz_bands *b = thz_calloc(1, sizeof *b);
+    if (!b)
+        return api_done(ctx, thz_error_set(err, THZ_ERR_NOMEM, "out of memory"), err);
+    b->scene_path = thz_strdup(scene_path);
+    b->candidates_thz = thz_calloc(n, sizeof *b->candidates_thz);
+    b->netd_k = thz_calloc(n, sizeof *b->netd_k);
+    if (!b->scene_path || !b->candidates_thz || !b->netd_k) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    b->from_thz = o->from_thz;
+    b->to_thz = o->to_thz;
+    b->step_ghz = o->step_ghz;
+    for (size_t c = 0; c < n; c++) { /* from + c step, rounded to the kHz the grid means */
+        b->candidates_thz[c] = round((o->from_thz + (double)c * o->step_ghz * 1e-3) * 1e9) / 1e9;
+        b->netd_k[c] = o->netd_k; /* resolve_netd or bands_values may replace it */
+    }
+    b->setup = (bands_setup){.scene_path = b->scene_path,
+                             .candidates_thz = b->candidates_thz,
+                             .n_candidates = n,
+                             .n_targets = o->n_targets,
+                             .netd_k = b->netd_k,
+                             .target_range_k = o->target_temperature_range_k,
+                             .ambient_range_k = o->ambient_temperature_range_k,
+                             .humidity_range = o->humidity_range,
+                             .paths_per_sample = o->paths_per_sample};
+    st = resolve_scene(b, o, err);
+    if (st != THZ_OK)
+        goto done;
+    b->setup.targets = b->targets;
+    st = bands_values_compute(ctx, &b->setup, &b->values, err);
+    if (st != THZ_OK)
+        goto done;
+    bands_classes cl = {.n_candidates = n,
+                        .n_classes = b->values.n_classes,
+                        .mean = b->values.mean,
+                        .cov = b->values.cov};
+    st = bands_search(&cl, o->count, o->exhaustive_limit ? o->exhaustive_limit : 200000, &b->search,
+                      err);
+    if (st != THZ_OK)
+        goto done;
+    bands_report rep = make_report(b);
+    b->json = bands_json(&rep, err);
+    if (!b->json)
+        st = err->status;
+done:
+    if (st != THZ_OK) {
+        thz_bands_destroy(b);
+        return api_done(ctx, st, err);
+    }
+    *out = b;
+    return THZ_OK;
+}
+
+void thz_bands_get_info(const thz_bands *b, thz_bands_info *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!b)
+        return;
+    out->n_candidates = b->setup.n_candidates;
+    out->count = b->search.count;
+    out->n_classes = b->values.n_classes;
+    out->search = b->search.search;
+    out->score = b->search.scores[b->search.count - 1].worst_jm;
+}
+
+double thz_bands_selected_thz(const thz_bands *b, size_t i)
+{
+    if (!b || i >= b->search.count)
+        return NAN;
+    size_t K = b->search.count;
+    return b->candidates_thz[b->search.sets[(K - 1) * K + i]];
+}
+
+double thz_bands_score(const thz_bands *b, size_t k)
+{
+    return b && k >= 1 && k <= b->search.count ? b->search.scores[k - 1].worst_jm : NAN;
+}
+
+const char *thz_bands_json(const thz_bands *b)
+{
+    return b ? b->json : NULL;
+}
+
+thz_status thz_bands_write(const thz_bands *b, const char *outdir, thz_error *err)
+{
+    if (!b || !outdir || !outdir[0])
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_bands_write: no %s",
+                             b ? "output directory" : "band selection");
+    output_stage *stage = NULL;
+    thz_status st = output_stage_create(outdir, &stage, err);
+    if (st != THZ_OK)
+        return st;
+    bands_report rep = make_report(b);
+    st = bands_write_files(output_stage_dir(stage), &rep, b->json, err);
+    if (st == THZ_OK)
+        st = output_stage_commit(stage, err);
+    output_stage_destroy(stage);
+    return st;
+}

@@ -1,0 +1,399 @@
+/* The public API of cubes read from disk and of classification (thzmap/analysis.h):
+ * handles over io/envi_read.c and analysis/classify.c. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "analysis/classify.h"
+#include "analysis/classify_output.h"
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/file.h"
+#include "core/path.h"
+#include "io/envi.h"
+#include "io/output.h"
+#include "thzmap/thzmap.h"
+
+struct thz_cube {
+    envi_cube c;
+    char *stem;
+    bool wavelength_ghz;
+};
+
+struct thz_classification {
+    classify_result r;
+    classify_method method;
+    char *sensor, *source, *run_dir;
+    uint32_t columns, rows;
+    char **class_names; /* n_classes */
+    char **object_names;
+    size_t n_object_names;
+    uint64_t seed;
+    double train_fraction, netd_k;
+    char *json;
+};
+
+thz_status thz_cube_read(const char *dir, const char *stem, thz_cube **out, thz_error *err)
+{
+    *out = NULL;
+    if (!dir || !stem)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_cube_read: no directory or stem");
+    thz_cube *cube = thz_calloc(1, sizeof *cube);
+    if (!cube)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    thz_status st = envi_read_float32(dir, stem, &cube->c, err);
+    if (st == THZ_OK && !(cube->stem = thz_strdup(stem)))
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    if (st != THZ_OK) {
+        thz_cube_destroy(cube);
+        return st;
+    }
+    cube->wavelength_ghz = cube->c.wavelength && cube->c.wavelength_units &&
+                           strcmp(cube->c.wavelength_units, "GHz") == 0;
+    *out = cube;
+    return THZ_OK;
+}
+
+void thz_cube_destroy(thz_cube *cube)
+{
+    if (!cube)
+        return;
+    envi_cube_fini(&cube->c);
+    free(cube->stem);
+    free(cube);
+}
+
+uint32_t thz_cube_columns(const thz_cube *cube)
+{
+    return cube ? cube->c.samples : 0;
+}
+
+uint32_t thz_cube_rows(const thz_cube *cube)
+{
+    return cube ? cube->c.lines : 0;
+}
+
+size_t thz_cube_bands(const thz_cube *cube)
+{
+    return cube ? cube->c.bands : 0;
+}
+
+const float *thz_cube_data(const thz_cube *cube)
+{
+    return cube ? cube->c.data : NULL;
+}
+
+const double *thz_cube_wavelength_ghz(const thz_cube *cube)
+{
+    return cube && cube->wavelength_ghz ? cube->c.wavelength : NULL;
+}
+
+size_t thz_cube_object_name_count(const thz_cube *cube)
+{
+    return cube ? cube->c.n_object_names : 0;
+}
+
+const char *thz_cube_object_name(const thz_cube *cube, size_t i)
+{
+    return cube && i < cube->c.n_object_names ? cube->c.object_names[i] : NULL;
+}
+
+/* ---- classification ------------------------------------------------------------------ */
+
+void thz_classify_options_init(thz_classify_options *opt)
+{
+    memset(opt, 0, sizeof *opt);
+    opt->method = "sam";
+    opt->train_fraction = 0.5;
+    opt->seed = 1;
+}
+
+const char *thz_classify_method(size_t i)
+{
+    return i < CLASSIFY_METHOD_COUNT ? classify_method_name((classify_method)i) : NULL;
+}
+
+void thz_classification_destroy(thz_classification *c)
+{
+    if (!c)
+        return;
+    if (c->class_names)
+        for (size_t k = 0; k < c->r.n_classes; k++)
+            free(c->class_names[k]);
+    free(c->class_names);
+    for (size_t i = 0; i < c->n_object_names; i++)
+        free(c->object_names[i]);
+    free(c->object_names);
+    classify_result_fini(&c->r);
+    free(c->sensor);
+    free(c->source);
+    free(c->run_dir);
+    free(c->json);
+    free(c);
+}
+
+static thz_status classify_check_options(const thz_classify_options *opt, classify_method *m,
+                                         thz_error *err)
+{
+    int method = classify_method_from_name(opt->method ? opt->method : "sam");
+    if (method < 0)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "unknown method '%s' (expected sam, mahalanobis, lda, "
+                             "matched-filter or ace)",
+                             opt->method);
+    if (!(opt->train_fraction > 0.0 && opt->train_fraction < 1.0))
+        return thz_error_set(err, THZ_ERR_INPUT, "training fraction %g: expected 0 < f < 1",
+                             opt->train_fraction);
+    if (!(opt->netd_k >= 0.0) || !isfinite(opt->netd_k))
+        return thz_error_set(err, THZ_ERR_INPUT, "NETD %g K: expected a number >= 0", opt->netd_k);
+    *m = (classify_method)method;
+    return THZ_OK;
+}
+
+/* Classifies, names the classes, and makes the JSON text. */
+static thz_status classify_build(const thz_cube *cube, const thz_cube *truth,
+                                 const thz_classify_options *opt, const char *run_dir,
+                                 const char *sensor, thz_classification **out, thz_error *err)
+{
+    *out = NULL;
+    thz_classify_options defaults;
+    thz_classify_options_init(&defaults);
+    if (!opt)
+        opt = &defaults;
+    if (!cube || !truth)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_classify_cube: no cube or truth");
+    classify_method method = CLASSIFY_SAM;
+    thz_status st = classify_check_options(opt, &method, err);
+    if (st != THZ_OK)
+        return st;
+    const envi_cube *cc = &cube->c, *tc = &truth->c;
+    if (tc->bands != 1 || tc->samples != cc->samples || tc->lines != cc->lines)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: the truth is %u x %u with %zu bands; expected one band of "
+                             "%u x %u like %s",
+                             truth->stem, tc->samples, tc->lines, tc->bands, cc->samples, cc->lines,
+                             cube->stem);
+    size_t pixels = (size_t)cc->samples * cc->lines;
+    thz_classification *c = thz_calloc(1, sizeof *c);
+    int32_t *ids = thz_calloc(pixels, sizeof *ids);
+    float *values = thz_malloc_array(pixels * cc->bands, sizeof *values);
+    double *sigma = thz_calloc(cc->bands, sizeof *sigma);
+    if (!c || !ids || !values || !sigma) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t p = 0; p < pixels; p++) {
+        float v = tc->data[p];
+        if (!(v == floorf(v) && v >= -1.0f && v < 16777216.0f)) {
+            st = thz_error_set(err, THZ_ERR_INPUT,
+                               "%s: pixel %zu holds %g, not an object index or -1", truth->stem, p,
+                               (double)v);
+            goto done;
+        }
+        ids[p] = (int32_t)v;
+    }
+    memcpy(values, cc->data, pixels * cc->bands * sizeof *values);
+    for (size_t b = 0; b < cc->bands; b++)
+        sigma[b] = opt->netd_k;
+    if (opt->netd_k > 0.0)
+        classify_add_noise(values, cc->bands, pixels, sigma, opt->seed);
+    st = classify_run(values, cc->bands, pixels, ids, method, opt->train_fraction, opt->seed, &c->r,
+                      err);
+    if (st != THZ_OK) {
+        thz_error_prefix(err, "%s: ", cube->stem);
+        goto done;
+    }
+    c->method = method;
+    c->columns = cc->samples;
+    c->rows = cc->lines;
+    c->seed = opt->seed;
+    c->train_fraction = opt->train_fraction;
+    c->netd_k = opt->netd_k;
+    c->source = thz_strdup(cube->stem);
+    c->sensor = thz_strdup(sensor);
+    c->run_dir = thz_strdup(run_dir);
+    c->class_names = thz_calloc(c->r.n_classes, sizeof *c->class_names);
+    c->object_names = thz_calloc(tc->n_object_names, sizeof *c->object_names);
+    if (!c->source || !c->class_names || !c->object_names || (sensor && !c->sensor) ||
+        (run_dir && !c->run_dir)) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < tc->n_object_names; i++, c->n_object_names++)
+        if (!(c->object_names[i] = thz_strdup(tc->object_names[i]))) {
+            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+    for (size_t k = 0; k < c->r.n_classes; k++) {
+        size_t o = (size_t)c->r.class_object[k];
+        char name[64];
+        snprintf(name, sizeof name, "object %zu", o);
+        c->class_names[k] = thz_strdup(o < tc->n_object_names ? tc->object_names[o] : name);
+        if (!c->class_names[k]) {
+            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+    }
+    classify_report rep = {.result = &c->r,
+                           .run_dir = c->run_dir,
+                           .sensor = c->sensor,
+                           .source = c->source,
+                           .method = method,
+                           .seed = c->seed,
+                           .train_fraction = c->train_fraction,
+                           .netd_k = c->netd_k,
+                           .columns = c->columns,
+                           .rows = c->rows,
+                           .class_names = (const char *const *)c->class_names,
+                           .object_names = c->object_names,
+                           .n_object_names = c->n_object_names};
+    c->json = classify_json(&rep, err);
+    if (!c->json)
+        st = err ? err->status : THZ_ERR_NOMEM;
+done:
+    free(ids);
+    free(values);
+    free(sigma);
+    if (st != THZ_OK) {
+        thz_classification_destroy(c);
+        return st;
+    }
+    *out = c;
+    return THZ_OK;
+}
+
+thz_status thz_classify_cube(const thz_cube *cube, const thz_cube *truth,
+                             const thz_classify_options *opt, thz_classification **out,
+                             thz_error *err)
+{
+    return classify_build(cube, truth, opt, NULL, NULL, out, err);
+}
+
+/* "S.<quantity>" as the run names its files (io/output_sensor.c: '/' in a sensor name
+ * becomes '_'). */
+static thz_status run_stem(char *buf, size_t size, const char *sensor, const char *quantity,
+                           thz_error *err)
+{
+    int n = snprintf(buf, size, "%s.%s", sensor, quantity);
+    if (n < 0 || (size_t)n >= size)
+        return thz_error_set(err, THZ_ERR_INPUT, "sensor name too long: %.64s...", sensor);
+    for (char *p = buf; *p; p++)
+        if (*p == '/')
+            *p = '_';
+    return THZ_OK;
+}
+
+thz_status thz_classify_run(const char *run_dir, const char *sensor,
+                            const thz_classify_options *opt, thz_classification **out,
+                            thz_error *err)
+{
+    *out = NULL;
+    if (!run_dir || !sensor || !sensor[0])
+        return thz_error_set(err, THZ_ERR_INPUT, "no run directory or sensor given");
+    char stem[THZ_PATH_MAX], truth_stem[THZ_PATH_MAX], name[THZ_PATH_MAX], path[THZ_PATH_MAX];
+    thz_status st = run_stem(stem, sizeof stem, sensor, "measured_brightness_temperature.hdr", err);
+    if (st == THZ_OK)
+        st = thz_path_join(path, sizeof path, run_dir, stem, err);
+    if (st == THZ_OK)
+        st = run_stem(truth_stem, sizeof truth_stem, sensor, "object_id", err);
+    if (st == THZ_OK)
+        st = run_stem(name, sizeof name, sensor, "brightness_temperature", err);
+    if (st != THZ_OK)
+        return st;
+    if (file_check_regular(path, NULL, ENVI_MAX_HEADER_BYTES, NULL, NULL) == THZ_OK)
+        stem[strlen(stem) - 4] = '\0'; /* the measured cube: without ".hdr" */
+    else
+        memcpy(stem, name, sizeof stem);
+    thz_cube *cube = NULL, *truth = NULL;
+    st = thz_cube_read(run_dir, stem, &cube, err);
+    if (st == THZ_OK)
+        st = thz_cube_read(run_dir, truth_stem, &truth, err);
+    if (st == THZ_OK)
+        st = classify_build(cube, truth, opt, run_dir, sensor, out, err);
+    thz_cube_destroy(cube);
+    thz_cube_destroy(truth);
+    return st;
+}
+
+void thz_classification_get_info(const thz_classification *c, thz_classification_info *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!c)
+        return;
+    out->method = classify_method_name(c->method);
+    out->sensor = c->sensor;
+    out->source = c->source;
+    out->n_classes = c->r.n_classes;
+    out->columns = c->columns;
+    out->rows = c->rows;
+    out->training_pixels = c->r.n_train;
+    out->held_out_pixels = c->r.n_held_out;
+    out->pixels = c->r.n_train + c->r.n_held_out;
+    out->accuracy = c->r.accuracy;
+    out->held_out_accuracy = c->r.held_out_accuracy;
+}
+
+long thz_classification_class_object(const thz_classification *c, size_t k)
+{
+    return c && k < c->r.n_classes ? (long)c->r.class_object[k] : -1;
+}
+
+const char *thz_classification_class_name(const thz_classification *c, size_t k)
+{
+    return c && k < c->r.n_classes ? c->class_names[k] : NULL;
+}
+
+double thz_classification_class_accuracy(const thz_classification *c, size_t k)
+{
+    return c && k < c->r.n_classes ? c->r.class_accuracy[k] : NAN;
+}
+
+double thz_classification_auc(const thz_classification *c, size_t k)
+{
+    return c && k < c->r.n_classes ? c->r.auc[k] : NAN;
+}
+
+const uint64_t *thz_classification_confusion(const thz_classification *c)
+{
+    return c ? c->r.confusion : NULL;
+}
+
+const int32_t *thz_classification_map(const thz_classification *c)
+{
+    return c ? c->r.assigned : NULL;
+}
+
+const char *thz_classification_json(const thz_classification *c)
+{
+    return c ? c->json : NULL;
+}
+
+thz_status thz_classification_write(const thz_classification *c, const char *outdir, thz_error *err)
+{
+    if (!c || !outdir || !outdir[0])
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_classification_write: no %s",
+                             c ? "output directory" : "classification");
+    output_stage *stage = NULL;
+    thz_status st = output_stage_create(outdir, &stage, err);
+    if (st != THZ_OK)
+        return st;
+    classify_report rep = {.result = &c->r,
+                           .run_dir = c->run_dir,
+                           .sensor = c->sensor,
+                           .source = c->source,
+                           .method = c->method,
+                           .seed = c->seed,
+                           .train_fraction = c->train_fraction,
+                           .netd_k = c->netd_k,
+                           .columns = c->columns,
+                           .rows = c->rows,
+                           .class_names = (const char *const *)c->class_names,
+                           .object_names = c->object_names,
+                           .n_object_names = c->n_object_names};
+    st = classify_write_files(output_stage_dir(stage), &rep, c->json, err);
+    if (st == THZ_OK)
+        st = output_stage_commit(stage, err);
+    output_stage_destroy(stage);
+    return st;
+}

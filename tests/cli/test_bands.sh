@@ -1,0 +1,147 @@
+#!/bin/bash
+# thzmap bands: on plates whose emissivity peaks at known frequencies it chooses a
+# channel within one grid step of each feature (K = the number of features); with a
+# feature across a water-vapour line and humid air it moves off the line, where dry
+# air lets it sit on it; bands.json as the reference says (selected_thz ascending,
+# score, the best set of every k <= K), the figures, determinism for a seed and any
+# thread count, and exit status 2 for bad input.
+# argv: thzmap binary, repository directory.
+set -u
+THZ="$1"
+REPO="$2"
+IN="$REPO/tests/inputs/analysis"
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+PY=/usr/bin/python3
+
+"$THZ" bands --help > "$TMP/help" || fail "--help exit status $?"
+for o in --count --from-thz --to-thz --step-ghz --targets --netd-k --humidity-range; do
+    grep -q -- "$o" "$TMP/help" || fail "--help does not describe $o"
+done
+
+# features at 0.40 and 0.80 THz, candidates every 50 GHz from 0.2 to 1.0 THz
+"$THZ" bands "$IN/features.json" -o "$TMP/f" --count 2 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 50 --paths 4 -q --threads 1 || fail "features run exit status $?"
+for f in bands.json bands-score.png bands-spectra.png; do
+    [ -s "$TMP/f/$f" ] || fail "no $f"
+done
+[ -e "$TMP/f/bands-air.png" ] && fail "bands-air.png written without attenuating air"
+$PY - "$TMP/f/bands.json" <<'PYEOF' || fail "features: $(cat "$TMP/f/bands.json" | head -c 600)"
+import json, sys
+d = json.load(open(sys.argv[1]))
+sel = d["selected_thz"]
+assert sel == sorted(sel), "not ascending"
+assert len(sel) == 2 and d["count"] == 2
+step = 0.05
+for feature in (0.40, 0.80):
+    assert any(abs(f - feature) <= step + 1e-9 for f in sel), f"no channel near {feature}: {sel}"
+assert 0.0 <= d["score"] <= 2.0
+assert len(d["per_k"]) == 2
+scores = [e["score"] for e in d["per_k"]]
+assert all(b >= a - 1e-3 for a, b in zip(scores, scores[1:])), scores
+assert d["per_k"][1]["selected_thz"] == sel and d["per_k"][1]["score"] == d["score"]
+assert d["search"] == "exhaustive"
+assert len(d["candidates"]["frequency_thz"]) == 17
+assert [c["name"] for c in d["classes"]] == ["room", "A", "B", "C"]
+assert d["noise"]["netd_k"] == [0.5] * 17 and "no noise" in d["noise"]["source"]
+PYEOF
+
+# the same with two threads: the same file but for its timing
+"$THZ" bands "$IN/features.json" -o "$TMP/f2" --count 2 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 50 --paths 4 -q --threads 2 || fail "second run exit status $?"
+$PY - "$TMP/f/bands.json" "$TMP/f2/bands.json" <<'PYEOF' || fail "not reproducible over threads"
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:3])
+a.pop("seconds"); b.pop("seconds")
+assert a == b
+PYEOF
+
+# --targets: the plates and the rest as one background class
+"$THZ" bands "$IN/features.json" -o "$TMP/t" --count 2 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 50 --paths 4 -q --targets A,B || fail "--targets run exit status $?"
+$PY -c "import json,sys; d=json.load(open('$TMP/t/bands.json')); \
+names=[c['name'] for c in d['classes']]; assert names==['A','B','background'], names" \
+    || fail "--targets classes"
+
+# a feature across the 556.9 GHz water line: dry air lets the choice sit on the line,
+# humid air moves it off (within the feature, 0.52-0.60 THz)
+for air in dry humid; do
+    "$THZ" bands "$IN/water-line-$air.json" -o "$TMP/w-$air" --count 2 --from-thz 0.5 \
+        --to-thz 0.72 --step-ghz 20 --paths 4 -q || fail "water line ($air) exit status $?"
+done
+[ -s "$TMP/w-humid/bands-air.png" ] || fail "no bands-air.png with humid air"
+$PY - "$TMP/w-dry/bands.json" "$TMP/w-humid/bands.json" <<'PYEOF' || fail "water line"
+import json, sys
+dry, humid = (json.load(open(p))["selected_thz"] for p in sys.argv[1:3])
+line = 0.55693
+for sel, name in ((dry, "dry"), (humid, "humid")):
+    assert any(abs(f - 0.68) <= 0.02 + 1e-9 for f in sel), f"{name}: no channel near 0.68: {sel}"
+    feature = [f for f in sel if 0.50 <= f <= 0.62]
+    assert len(feature) == 1, f"{name}: no channel in the 0.52-0.60 THz feature: {sel}"
+humid_f = [f for f in humid if 0.50 <= f <= 0.62][0]
+assert abs(humid_f - line) > 0.01, f"humid air: {humid_f} THz still on the line"
+# on the line's candidate the dry spectrum of B is as high as anywhere on its feature
+# (so the move is the air's doing), the humid one far lower
+d = json.load(open(sys.argv[1])); h = json.load(open(sys.argv[2]))
+freqs = d["candidates"]["frequency_thz"]
+i_line = min(range(len(freqs)), key=lambda i: abs(freqs[i] - line))
+plateau = [i for i, f in enumerate(freqs) if 0.52 <= f <= 0.60]
+tb_dry = next(c for c in d["classes"] if c["name"] == "B")["mean_tb_k"]
+tb_humid = next(c for c in h["classes"] if c["name"] == "B")["mean_tb_k"]
+assert tb_dry[i_line] > max(tb_dry[i] for i in plateau) - 0.3, tb_dry
+assert tb_humid[i_line] < tb_humid[freqs.index(humid_f)] - 2.0, tb_humid
+PYEOF
+
+# the sensor's noise: a given netd_k per channel, interpolated to the candidates; a
+# radiometer, whose NETD falls as 1/sqrt(bandwidth), i.e. 1/sqrt(frequency) at a fixed
+# relative width; --netd-k overrides both
+$PY - "$IN/features.json" "$TMP" <<'PYEOF' || fail "noisy scenes"
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["channels"] = [{"frequency_thz": 0.2, "relative_width": 0.01},
+                 {"frequency_thz": 1.0, "relative_width": 0.01}]
+d["sensors"][0]["noise"] = {"netd_k": [0.2, 1.0]}
+json.dump(d, open(sys.argv[2] + "/netd.json", "w"))
+d["sensors"][0]["noise"] = {"receiver_temperature_k": 2000, "integration_time_s": 0.001,
+                            "radiometer": "total-power"}
+json.dump(d, open(sys.argv[2] + "/radiometer.json", "w"))
+PYEOF
+for s in netd radiometer; do
+    "$THZ" bands "$TMP/$s.json" -o "$TMP/n-$s" --count 1 --from-thz 0.2 --to-thz 1.0 \
+        --step-ghz 200 --paths 2 -q || fail "$s scene exit status $?"
+done
+"$THZ" bands "$TMP/netd.json" -o "$TMP/n-given" --count 1 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 200 --paths 2 -q --netd-k 0.7 || fail "--netd-k on a noisy scene: exit status $?"
+$PY - "$TMP" <<'PYEOF' || fail "the sensor's NETD"
+import json, math, sys
+n = {k: json.load(open(f"{sys.argv[1]}/n-{k}/bands.json"))["noise"]
+     for k in ("netd", "radiometer", "given")}
+assert "interpolated" in n["netd"]["source"], n["netd"]
+assert all(abs(a - b) < 1e-12 for a, b in zip(n["netd"]["netd_k"], [0.2, 0.4, 0.6, 0.8, 1.0])), n["netd"]
+r = n["radiometer"]["netd_k"]
+assert "radiometer" in n["radiometer"]["source"] and all(x > 0 for x in r), n["radiometer"]
+# T_rec dominates: NETD ~ (T + T_rec) / sqrt(B_n tau), B_n proportional to the frequency
+assert abs(r[0] / r[4] / math.sqrt(5.0) - 1.0) < 0.02, r
+assert n["given"]["netd_k"] == [0.7] * 5 and n["given"]["source"] == "--netd-k", n["given"]
+PYEOF
+
+# bad input: exit status 2 and a message naming the problem
+expect2() {
+    local what=$1; shift
+    "$THZ" bands "$@" > /dev/null 2> "$TMP/err"
+    local rc=$?
+    [ $rc -eq 2 ] || fail "$what: exit status $rc, expected 2"
+    [ -s "$TMP/err" ] || fail "$what: no message"
+}
+expect2 "no --count" "$IN/features.json" -o "$TMP/x"
+expect2 "--count 0" "$IN/features.json" -o "$TMP/x" --count 0
+expect2 "no -o" "$IN/features.json" --count 1
+expect2 "to below from" "$IN/features.json" -o "$TMP/x" --count 1 --from-thz 1 --to-thz 0.5
+expect2 "unknown target" "$IN/features.json" -o "$TMP/x" --count 1 --targets A,nope
+grep -q "nope" "$TMP/err" || fail "unknown target not named: $(cat "$TMP/err")"
+expect2 "missing scene" "$TMP/none.json" -o "$TMP/x" --count 1
+expect2 "count above candidates" "$IN/features.json" -o "$TMP/x" --count 3 --from-thz 0.5 \
+    --to-thz 0.52 --step-ghz 20
+[ -e "$TMP/x" ] && fail "a failed run left $TMP/x"
+echo ok

@@ -1,0 +1,163 @@
+/* Classification (analysis/classify.c): on a synthetic cube of three distinct spectra
+ * every method is exact without noise; with noise raised the accuracy falls
+ * monotonically; the confusion matrix sums to the pixels that see an object; the
+ * training split depends on the seed alone; the AUC of a known ranking. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "analysis/classify.h"
+
+enum { BANDS = 4, COLS = 30, ROWS = 20, PIXELS = COLS * ROWS };
+
+/* Objects 0, 2 and 5 (indices need not be contiguous) in vertical stripes; the first
+ * column sees nothing (-1). Spectra in K, 1-2 K apart in one or two bands. */
+static const double spectra[3][BANDS] = {
+    {300.0, 300.0, 300.0, 300.0}, {300.0, 302.0, 300.0, 300.0}, {300.0, 300.0, 301.5, 301.5}};
+static const int32_t objects[3] = {0, 2, 5};
+
+static void make_cube(float *cube, int32_t *truth)
+{
+    for (size_t p = 0; p < PIXELS; p++) {
+        size_t col = p % COLS;
+        int cls = col == 0 ? -1 : (int)((col - 1) * 3 / (COLS - 1));
+        truth[p] = cls < 0 ? -1 : objects[cls];
+        for (size_t b = 0; b < BANDS; b++)
+            cube[b * PIXELS + p] = cls < 0 ? 0.0f : (float)spectra[cls][b];
+    }
+}
+
+static uint64_t confusion_sum(const classify_result *r)
+{
+    uint64_t s = 0;
+    for (size_t i = 0; i < r->n_classes * r->n_classes; i++)
+        s += r->confusion[i];
+    return s;
+}
+
+static void test_noise_free_exact(void **state)
+{
+    (void)state;
+    static float cube[BANDS * PIXELS];
+    static int32_t truth[PIXELS];
+    make_cube(cube, truth);
+    /* tiny noise so that covariances are estimated from something */
+    double sigma[BANDS] = {1e-3, 1e-3, 1e-3, 1e-3};
+    classify_add_noise(cube, BANDS, PIXELS, sigma, 7);
+    for (int m = 0; m < CLASSIFY_METHOD_COUNT; m++) {
+        classify_result r;
+        thz_error err = {0};
+        assert_int_equal(
+            classify_run(cube, BANDS, PIXELS, truth, (classify_method)m, 0.5, 1, &r, &err), THZ_OK);
+        assert_int_equal(r.n_classes, 3);
+        assert_int_equal(r.class_object[1], 2);
+        assert_int_equal(r.class_object[2], 5);
+        assert_int_equal(confusion_sum(&r), PIXELS - ROWS); /* all but column 0 */
+        assert_int_equal(r.n_train + r.n_held_out, PIXELS - ROWS);
+        assert_true(r.accuracy == 1.0);
+        for (size_t k = 0; k < 3; k++)
+            assert_true(r.auc[k] == 1.0);
+        for (size_t p = 0; p < PIXELS; p++)
+            assert_int_equal(r.assigned[p], truth[p]);
+        classify_result_fini(&r);
+    }
+}
+
+static void test_accuracy_falls_with_noise(void **state)
+{
+    (void)state;
+    static float clean[BANDS * PIXELS], cube[BANDS * PIXELS];
+    static int32_t truth[PIXELS];
+    make_cube(clean, truth);
+    const double levels[] = {0.01, 0.3, 1.0, 3.0, 10.0}; /* K */
+    for (int m = 0; m < CLASSIFY_METHOD_COUNT; m++) {
+        double last = 2.0;
+        for (size_t i = 0; i < sizeof levels / sizeof levels[0]; i++) {
+            memcpy(cube, clean, sizeof cube);
+            double sigma[BANDS];
+            for (size_t b = 0; b < BANDS; b++)
+                sigma[b] = levels[i];
+            classify_add_noise(cube, BANDS, PIXELS, sigma, 3);
+            classify_result r;
+            thz_error err = {0};
+            assert_int_equal(
+                classify_run(cube, BANDS, PIXELS, truth, (classify_method)m, 0.5, 1, &r, &err),
+                THZ_OK);
+            assert_int_equal(confusion_sum(&r), PIXELS - ROWS);
+            if (!(r.held_out_accuracy <= last))
+                fail_msg("%s: held-out accuracy %g at %g K above %g at the level before",
+                         classify_method_name((classify_method)m), r.held_out_accuracy,
+                         levels[i], last);
+            last = r.held_out_accuracy;
+            if (i == 0)
+                assert_true(r.held_out_accuracy == 1.0);
+            classify_result_fini(&r);
+        }
+        /* 10 K of noise on 1-2 K differences: close to chance (1/3) */
+        assert_true(last < 0.6);
+    }
+}
+
+static void test_split_depends_on_seed(void **state)
+{
+    (void)state;
+    static float cube[BANDS * PIXELS];
+    static int32_t truth[PIXELS];
+    make_cube(cube, truth);
+    classify_result a, b, c;
+    thz_error err = {0};
+    assert_int_equal(classify_run(cube, BANDS, PIXELS, truth, CLASSIFY_SAM, 0.5, 11, &a, &err),
+                     THZ_OK);
+    assert_int_equal(classify_run(cube, BANDS, PIXELS, truth, CLASSIFY_SAM, 0.5, 11, &b, &err),
+                     THZ_OK);
+    assert_int_equal(classify_run(cube, BANDS, PIXELS, truth, CLASSIFY_SAM, 0.5, 12, &c, &err),
+                     THZ_OK);
+    assert_memory_equal(a.train, b.train, PIXELS);
+    assert_true(memcmp(a.train, c.train, PIXELS) != 0);
+    /* half of each class (19 x 10 = 190 pixels of each... in stripes of 9 or 10 columns) */
+    assert_true(a.n_train >= (PIXELS - ROWS) / 2 - 2 && a.n_train <= (PIXELS - ROWS) / 2 + 2);
+    classify_result_fini(&a);
+    classify_result_fini(&b);
+    classify_result_fini(&c);
+}
+
+static void test_bad_input(void **state)
+{
+    (void)state;
+    static float cube[BANDS * PIXELS];
+    static int32_t truth[PIXELS];
+    make_cube(cube, truth);
+    classify_result r;
+    thz_error err = {0};
+    int32_t none[PIXELS];
+    for (size_t p = 0; p < PIXELS; p++)
+        none[p] = -1;
+    assert_int_equal(classify_run(cube, BANDS, PIXELS, none, CLASSIFY_SAM, 0.5, 1, &r, &err),
+                     THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "no object"));
+    cube[5] = NAN;
+    assert_int_equal(classify_run(cube, BANDS, PIXELS, truth, CLASSIFY_SAM, 0.5, 1, &r, &err),
+                     THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "not finite"));
+    assert_int_equal(classify_method_from_name("ace"), CLASSIFY_ACE);
+    assert_int_equal(classify_method_from_name("svm"), -1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_noise_free_exact),
+        cmocka_unit_test(test_accuracy_falls_with_noise),
+        cmocka_unit_test(test_split_depends_on_seed),
+        cmocka_unit_test(test_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
