@@ -73,6 +73,10 @@ typedef struct thz_material_info {
     thz_spectrum_info emissivity; /* ABSENT: Kirchhoff's law */
     const char *transmission;     /* "diffuse" or "straight" */
     double color[3];              /* rgb 0..1 of the visual truth image */
+    /* The complex index (refractive_index, permittivity_model or library): NULL when
+     * none, else "constant", "table", "debye", "double-debye", "lorentz", "drude" or
+     * "itu-p2040". Absent reflectivity and attenuation then come from it. */
+    const char *index_model;
 } thz_material_info;
 
 typedef struct thz_object_info {

@@ -108,5 +108,6 @@ THZ_API const char *thz_context_last_message(const thz_context *ctx);
 #include "thzmap/scene.h"
 #include "thzmap/run.h"
 #include "thzmap/atmosphere.h"
+#include "thzmap/materials.h"
 
 #endif

@@ -74,7 +74,8 @@ class ThzSpectrumInfo(Structure):
 class ThzMaterialInfo(Structure):
     _fields_ = [("name", c_char_p), ("reflectivity", ThzSpectrumInfo),
                 ("attenuation_per_m", ThzSpectrumInfo), ("emissivity", ThzSpectrumInfo),
-                ("transmission", c_char_p), ("color", c_double * 3)]
+                ("transmission", c_char_p), ("color", c_double * 3),
+                ("index_model", c_char_p)]
 
 
 class ThzObjectInfo(Structure):

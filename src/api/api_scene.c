@@ -112,6 +112,7 @@ thz_status thz_scene_material(const thz_scene *s, size_t i, thz_material_info *o
     out->emissivity = api_spectrum(&m->emissivity);
     out->transmission = m->transmission == TRANSMISSION_STRAIGHT ? "straight" : "diffuse";
     memcpy(out->color, m->color, sizeof out->color);
+    out->index_model = m->index ? material_index_form(m->index) : NULL;
     return THZ_OK;
 }
 

@@ -15,6 +15,7 @@ int cmd_validate(int argc, char **argv);
 int cmd_simulate(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_atmosphere(int argc, char **argv);
+int cmd_materials(int argc, char **argv);
 
 /* Prints "thzmap: <message>" to stderr and returns the exit status for err. */
 int cli_fail(const thz_error *err);

@@ -56,8 +56,17 @@ static void validate_print(const thz_scene *s)
             snprintf(e, sizeof e, "Kirchhoff");
         else
             validate_describe_spectrum(e, sizeof e, &mat.emissivity);
-        printf("  %s: reflectivity %s; attenuation %s 1/m; emissivity %s; transmission %s\n",
-               mat.name, r, a, e, mat.transmission);
+        if (mat.index_model && mat.reflectivity.kind == THZ_SPECTRUM_ABSENT)
+            snprintf(r, sizeof r, "Fresnel of the index");
+        if (mat.index_model && mat.attenuation_per_m.kind == THZ_SPECTRUM_ABSENT)
+            snprintf(a, sizeof a, "4 pi k nu / c of the index");
+        else
+            strncat(a, " 1/m", sizeof a - strlen(a) - 1);
+        printf("  %s: reflectivity %s; attenuation %s; emissivity %s; transmission %s", mat.name, r,
+               a, e, mat.transmission);
+        if (mat.index_model)
+            printf("; complex index %s", mat.index_model);
+        printf("\n");
     }
     printf("\natmosphere: %s\n", si.atmosphere_model);
     printf("\nobjects: %zu\n", si.n_objects);

@@ -20,6 +20,7 @@ static const command commands[] = {
     {"simulate", cmd_simulate, "fire photons and render every sensor of a scene"},
     {"render", cmd_render, "re-render sensors of a scene from a saved photon map"},
     {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency"},
+    {"materials", cmd_materials, "list the material library, or describe one material"},
 };
 
 static void print_usage(FILE *f)

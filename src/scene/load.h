@@ -77,6 +77,9 @@ thz_status load_expect_object(load_ctx *ctx, const load_cursor *c, const char *c
  * is parsed by a caller-specific function). `what` describes the expected value. */
 thz_status load_require(load_ctx *ctx, const load_cursor *c, const char *key, const char *what);
 
+/* The value of cursor c itself as a number in range r. */
+thz_status load_number_value(load_ctx *ctx, const load_cursor *c, load_range r, double *out);
+
 /* Member `key` of object c as a number in range r. Absent: the default if not
  * required, an error if required. */
 thz_status load_number(load_ctx *ctx, const load_cursor *c, const char *key, load_range r,
@@ -143,6 +146,16 @@ thz_status load_list(load_ctx *ctx, const load_cursor *root, const char *key, co
 #define LOAD_N_PROPERTIES 3
 extern const char *const load_material_columns[];
 thz_spectrum *load_material_property(thz_material *m, size_t k);
+
+/* A material's complex index (load_index.c): `refractive_index` or
+ * `permittivity_model` of c (replacing m->index when given; *given says whether one
+ * was), the n and k columns of a material CSV t, the `library` entry named by c, and the
+ * check that every channel's band lies in an itu-p2040 model's stated range. */
+thz_status load_material_index(load_ctx *ctx, const load_cursor *c, thz_material *m, bool *given);
+thz_status load_index_csv(load_ctx *ctx, const load_cursor *file, const csv_table *t,
+                          thz_material *m);
+thz_status load_material_library(load_ctx *ctx, const load_cursor *c, thz_material *m);
+thz_status load_index_check_channels(load_ctx *ctx, const load_cursor *c, const thz_material *m);
 
 /* The blocks of the document, in dependency order; each fills its part of ctx->scene
  * (root is the document's cursor). Channels before sensors, materials before objects. */

@@ -139,8 +139,7 @@ static bool load_in_range(double v, load_range r)
     return true;
 }
 
-/* Checks that cursor value v is a number in r. */
-static thz_status load_number_value(load_ctx *ctx, const load_cursor *c, load_range r, double *out)
+thz_status load_number_value(load_ctx *ctx, const load_cursor *c, load_range r, double *out)
 {
     char expected[128];
     load_format_range(expected, sizeof expected, r);

@@ -30,12 +30,16 @@ static thz_status load_material_file(load_ctx *ctx, const load_cursor *c, thz_ma
     thz_status st = load_csv(ctx, c, "file", &t);
     if (st != THZ_OK)
         return st;
+    static const char *const columns[] = {
+        "reflectivity", "attenuation_per_m", "emissivity", "n", "k", NULL};
     load_cursor file = load_key(c, "file");
-    st = load_csv_columns(ctx, &file, &t, load_material_columns, NULL);
+    st = load_csv_columns(ctx, &file, &t, columns, NULL);
     for (size_t k = 0; k < LOAD_N_PROPERTIES && st == THZ_OK; k++)
         if (csv_column(&t, load_material_columns[k]) >= 0)
             st = load_csv_spectrum(ctx, &file, &t, load_material_columns[k],
                                    load_material_ranges[k], load_material_property(m, k));
+    if (st == THZ_OK)
+        st = load_index_csv(ctx, &file, &t, m);
     csv_fini(&t);
     return st;
 }
@@ -67,11 +71,19 @@ static thz_status load_check_energy(load_ctx *ctx, const load_cursor *c, const t
 static thz_status load_material(load_ctx *ctx, const load_cursor *c, thz_material *m)
 {
     static const char *const keys[] = {
-        "reflectivity", "attenuation_per_m", "emissivity", "transmission", "color", "file", NULL};
+        "reflectivity", "attenuation_per_m", "emissivity",         "transmission", "color",
+        "file",         "refractive_index",  "permittivity_model", "library",      NULL};
     static const char *const transmissions[] = {"diffuse", "straight", NULL};
     thz_status st = load_expect_object(ctx, c, keys);
     if (st != THZ_OK)
         return st;
+    for (int k = 0; k < 3; k++)
+        m->color[k] = 0.6;
+    if (json_object_get(c->value, "library")) {
+        st = load_material_library(ctx, c, m);
+        if (st != THZ_OK)
+            return st;
+    }
     if (json_object_get(c->value, "file")) {
         st = load_material_file(ctx, c, m);
         if (st != THZ_OK)
@@ -81,23 +93,28 @@ static thz_status load_material(load_ctx *ctx, const load_cursor *c, thz_materia
     for (size_t k = 0; k < LOAD_N_PROPERTIES && st == THZ_OK; k++)
         st = load_spectrum(ctx, c, load_material_columns[k], load_material_ranges[k],
                            load_material_property(m, k), &present);
+    if (st == THZ_OK)
+        st = load_material_index(ctx, c, m, &present);
+    if (st == THZ_OK)
+        st = load_index_check_channels(ctx, c, m);
     if (st != THZ_OK)
         return st;
-    if (m->reflectivity.n == 0) {
+    /* With an index, R and alpha_M not given (n == 0) come from it (physics.md). */
+    if (m->reflectivity.n == 0 && !m->index) {
         load_cursor k = load_key(c, "reflectivity");
         return load_fail(ctx, &k,
                          "missing key (expected R, a number in [0, 1] or a table "
-                         "[[frequency_thz, R], ...], or a \"file\" with a reflectivity column)");
+                         "[[frequency_thz, R], ...], a \"file\" with a reflectivity column, or "
+                         "a complex index: refractive_index, permittivity_model or library)");
     }
-    if (m->attenuation_per_m.n == 0 && !spectrum_set_constant(&m->attenuation_per_m, 0.0))
+    if (m->attenuation_per_m.n == 0 && !m->index &&
+        !spectrum_set_constant(&m->attenuation_per_m, 0.0))
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
     size_t transmission = 0;
     st = load_choice(ctx, c, "transmission", transmissions, false, 0, &transmission);
     if (st != THZ_OK)
         return st;
     m->transmission = transmission == 1 ? TRANSMISSION_STRAIGHT : TRANSMISSION_DIFFUSE;
-    for (int k = 0; k < 3; k++)
-        m->color[k] = 0.6;
     st = load_vector(ctx, c, "color", 3, LOAD_UNIT, false, m->color);
     if (st != THZ_OK)
         return st;

@@ -1,0 +1,303 @@
+/* A material's complex index from the scene: `refractive_index` (a constant [n, k] or a
+ * table [[frequency_thz, n, k], ...]), the n and k columns of a material CSV, and
+ * `permittivity_model` (permittivity.h), including the ITU-R P.2040 materials of
+ * data/materials/itu-r-p2040.json and the check of their stated frequency ranges. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/data_dir.h"
+#include "core/path.h"
+#include "scene/load.h"
+
+#define LOAD_INDEX_N ((load_range){0.0, INFINITY, true, false})
+
+/* The ITU-R P.2040 table shipped in the data directory. */
+#define P2040_FILE "materials/itu-r-p2040.json"
+
+/* Replaces m->index by idx (NULL: out of memory). */
+static thz_status set_index(load_ctx *ctx, thz_material *m, material_index *idx)
+{
+    if (!idx)
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    material_index_destroy(m->index);
+    m->index = idx;
+    return THZ_OK;
+}
+
+/* A table [[frequency_thz, n, k], ...] at cursor k (a non-empty array of arrays). */
+static thz_status index_table(load_ctx *ctx, const load_cursor *k, thz_material *m)
+{
+    size_t count = json_array_size(k->value);
+    double *f = thz_malloc_array(count, sizeof *f), *n = thz_malloc_array(count, sizeof *n);
+    double *kk = thz_malloc_array(count, sizeof *kk);
+    thz_status st = THZ_OK;
+    if (!f || !n || !kk) {
+        st = thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+        goto cleanup;
+    }
+    for (size_t i = 0; i < count && st == THZ_OK; i++) {
+        load_cursor row = load_index(k, i);
+        if (!json_is_array(row.value) || json_array_size(row.value) != 3) {
+            st = load_fail(ctx, &row, "expected a row [frequency_thz, n, k], got %s",
+                           load_type_name(row.value));
+            break;
+        }
+        load_cursor fc = load_index(&row, 0), nc = load_index(&row, 1), kc = load_index(&row, 2);
+        double thz;
+        st = load_number_value(ctx, &fc, LOAD_POSITIVE, &thz);
+        if (st == THZ_OK && i > 0 && !(thz * 1e12 > f[i - 1]))
+            st = load_fail(ctx, &fc, "frequencies must increase strictly, got %g THz after %g THz",
+                           thz, f[i - 1] * 1e-12);
+        f[i] = thz * 1e12;
+        if (st == THZ_OK)
+            st = load_number_value(ctx, &nc, LOAD_INDEX_N, &n[i]);
+        if (st == THZ_OK)
+            st = load_number_value(ctx, &kc, LOAD_NONNEGATIVE, &kk[i]);
+    }
+    if (st == THZ_OK)
+        st = set_index(ctx, m, material_index_table(count, f, n, kk));
+cleanup:
+    free(f);
+    free(n);
+    free(kk);
+    return st;
+}
+
+static thz_status refractive_index(load_ctx *ctx, const load_cursor *k, thz_material *m)
+{
+    const char *what = "[n, k] (n > 0, k >= 0) or a table [[frequency_thz, n, k], ...]";
+    size_t count = json_array_size(k->value);
+    if (!json_is_array(k->value) || count == 0)
+        return load_fail(ctx, k, "expected %s, got %s", what,
+                         json_is_array(k->value) ? "an empty list" : load_type_name(k->value));
+    if (json_is_array(json_array_get(k->value, 0)))
+        return index_table(ctx, k, m);
+    if (count != 2)
+        return load_fail(ctx, k, "expected %s, got a list of %zu numbers", what, count);
+    load_cursor nc = load_index(k, 0), kc = load_index(k, 1);
+    double n, kk;
+    thz_status st = load_number_value(ctx, &nc, LOAD_INDEX_N, &n);
+    if (st == THZ_OK)
+        st = load_number_value(ctx, &kc, LOAD_NONNEGATIVE, &kk);
+    if (st == THZ_OK)
+        st = set_index(ctx, m, material_index_constant(n, kk));
+    return st;
+}
+
+/* The rows of ITU-R P.2040 material `name` from the data directory into pm. */
+static thz_status p2040_rows(load_ctx *ctx, const load_cursor *mc, const char *name,
+                             permittivity_model *pm)
+{
+    char dir[THZ_PATH_MAX], path[THZ_PATH_MAX];
+    thz_status st = thz_data_dir_find(NULL, dir, sizeof dir, ctx->err);
+    if (st != THZ_OK)
+        return st;
+    if (snprintf(path, sizeof path, "%s/%s", dir, P2040_FILE) >= (int)sizeof path)
+        return thz_error_set(ctx->err, THZ_ERR_IO, "%s/%s: path too long", dir, P2040_FILE);
+    json_error_t je;
+    json_t *doc = json_load_file(path, JSON_REJECT_DUPLICATES, &je);
+    if (!doc)
+        return thz_error_set(ctx->err, THZ_ERR_IO, "%s:%d:%d: %s", path, je.line, je.column,
+                             je.text);
+    json_t *all = json_object_get(doc, "materials"), *rows = json_object_get(all, name);
+    if (!json_is_array(rows) || json_array_size(rows) == 0) {
+        char names[1024] = "";
+        const char *key;
+        json_t *v;
+        json_object_foreach(all, key, v)
+        {
+            size_t used = strlen(names);
+            snprintf(names + used, sizeof names - used, "%s%s", used ? ", " : "", key);
+        }
+        json_decref(doc);
+        return load_fail(ctx, mc, "unknown ITU-R P.2040 material \"%s\" (expected one of: %s)",
+                         name, names);
+    }
+    snprintf(pm->material, sizeof pm->material, "%s", name);
+    size_t i;
+    json_t *row;
+    st = THZ_OK;
+    json_array_foreach(rows, i, row)
+    {
+        if (i >= PERMITTIVITY_MAX_RANGES) {
+            st = thz_error_set(ctx->err, THZ_ERR_INPUT, "%s: %s: more than %d rows", path, name,
+                               PERMITTIVITY_MAX_RANGES);
+            break;
+        }
+        permittivity_p2040_row *r = &pm->rows[pm->n_rows++];
+        r->lo_hz = json_number_value(json_object_get(row, "from_ghz")) * 1e9;
+        r->hi_hz = json_number_value(json_object_get(row, "to_ghz")) * 1e9;
+        r->a = json_number_value(json_object_get(row, "a"));
+        r->b = json_number_value(json_object_get(row, "b"));
+        r->c = json_number_value(json_object_get(row, "c"));
+        r->d = json_number_value(json_object_get(row, "d"));
+        if (!(r->lo_hz > 0.0 && r->hi_hz > r->lo_hz && r->a > 0.0 && r->c >= 0.0))
+            st = thz_error_set(ctx->err, THZ_ERR_INPUT, "%s: %s: row %zu is not a valid fit", path,
+                               name, i + 1);
+    }
+    json_decref(doc);
+    return st;
+}
+
+static thz_status lorentz_oscillators(load_ctx *ctx, const load_cursor *c, permittivity_model *pm)
+{
+    static const char *const keys[] = {"frequency_thz", "strength", "width_thz", NULL};
+    thz_status st = load_require(ctx, c, "oscillators",
+                                 "a list of {\"frequency_thz\", \"strength\", \"width_thz\"}");
+    load_cursor list = load_key(c, "oscillators");
+    size_t count = json_array_size(list.value);
+    if (st == THZ_OK && (!json_is_array(list.value) || count == 0))
+        st = load_fail(ctx, &list, "expected a non-empty list of oscillators, got %s",
+                       json_is_array(list.value) ? "an empty list" : load_type_name(list.value));
+    if (st == THZ_OK && count > PERMITTIVITY_MAX_OSCILLATORS)
+        st = load_fail(ctx, &list, "expected at most %d oscillators, got %zu",
+                       PERMITTIVITY_MAX_OSCILLATORS, count);
+    for (size_t i = 0; i < count && st == THZ_OK; i++) {
+        load_cursor o = load_index(&list, i);
+        permittivity_oscillator *osc = &pm->oscillators[pm->n_oscillators++];
+        double thz = 0, width = 0;
+        st = load_expect_object(ctx, &o, keys);
+        if (st == THZ_OK)
+            st = load_number(ctx, &o, "frequency_thz", LOAD_POSITIVE, true, 0, &thz);
+        if (st == THZ_OK)
+            st = load_number(ctx, &o, "strength", LOAD_POSITIVE, true, 0, &osc->strength);
+        if (st == THZ_OK)
+            st = load_number(ctx, &o, "width_thz", LOAD_POSITIVE, true, 0, &width);
+        osc->freq_hz = thz * 1e12;
+        osc->width_hz = width * 1e12;
+    }
+    return st;
+}
+
+static thz_status permittivity(load_ctx *ctx, const load_cursor *c, thz_material *m)
+{
+    static const char *const keys[][7] = {
+        {"model", "eps_inf", "eps_s", "tau_ps", NULL},
+        {"model", "eps_inf", "eps_2", "eps_s", "tau1_ps", "tau2_ps", NULL},
+        {"model", "eps_inf", "oscillators", NULL},
+        {"model", "plasma_frequency_thz", "collision_frequency_thz", NULL},
+        {"model", "material", NULL}};
+    const load_range eps = {1.0, INFINITY, false, false};
+    if (!json_is_object(c->value))
+        return load_fail(ctx, c, "expected an object {\"model\": ...}, got %s",
+                         load_type_name(c->value));
+    size_t kind = 0;
+    thz_status st = load_choice(ctx, c, "model", permittivity_kind_names, true, 0, &kind);
+    if (st == THZ_OK)
+        st = load_expect_object(ctx, c, keys[kind]);
+    if (st != THZ_OK)
+        return st;
+    permittivity_model pm = {.kind = (permittivity_kind)kind, .eps_inf = 1.0};
+    double tau1 = 0, tau2 = 0, fp = 0, fc = 0;
+    const char *name = NULL;
+    switch (pm.kind) {
+    case PERMITTIVITY_DEBYE:
+        if ((st = load_number(ctx, c, "eps_inf", eps, true, 0, &pm.eps_inf)) == THZ_OK &&
+            (st = load_number(ctx, c, "eps_s", eps, true, 0, &pm.eps_s)) == THZ_OK)
+            st = load_number(ctx, c, "tau_ps", LOAD_POSITIVE, true, 0, &tau1);
+        break;
+    case PERMITTIVITY_DOUBLE_DEBYE:
+        if ((st = load_number(ctx, c, "eps_inf", eps, true, 0, &pm.eps_inf)) == THZ_OK &&
+            (st = load_number(ctx, c, "eps_2", eps, true, 0, &pm.eps_2)) == THZ_OK &&
+            (st = load_number(ctx, c, "eps_s", eps, true, 0, &pm.eps_s)) == THZ_OK &&
+            (st = load_number(ctx, c, "tau1_ps", LOAD_POSITIVE, true, 0, &tau1)) == THZ_OK)
+            st = load_number(ctx, c, "tau2_ps", LOAD_POSITIVE, true, 0, &tau2);
+        break;
+    case PERMITTIVITY_LORENTZ:
+        if ((st = load_number(ctx, c, "eps_inf", eps, true, 0, &pm.eps_inf)) == THZ_OK)
+            st = lorentz_oscillators(ctx, c, &pm);
+        break;
+    case PERMITTIVITY_DRUDE:
+        if ((st = load_number(ctx, c, "plasma_frequency_thz", LOAD_POSITIVE, true, 0, &fp)) ==
+            THZ_OK)
+            st = load_number(ctx, c, "collision_frequency_thz", LOAD_POSITIVE, true, 0, &fc);
+        break;
+    case PERMITTIVITY_P2040:
+        if ((st = load_string(ctx, c, "material", true, NULL, &name)) == THZ_OK) {
+            load_cursor mc = load_key(c, "material");
+            st = p2040_rows(ctx, &mc, name, &pm);
+        }
+        break;
+    }
+    if (st != THZ_OK)
+        return st;
+    pm.tau1_s = tau1 * 1e-12;
+    pm.tau2_s = tau2 * 1e-12;
+    pm.plasma_hz = fp * 1e12;
+    pm.collision_hz = fc * 1e12;
+    /* Relaxation strengths must be >= 0 for a passive medium (eps'' >= 0). */
+    if (pm.kind == PERMITTIVITY_DEBYE && pm.eps_s < pm.eps_inf) {
+        load_cursor k = load_key(c, "eps_s");
+        return load_fail(ctx, &k, "expected eps_s >= eps_inf = %g, got %g", pm.eps_inf, pm.eps_s);
+    }
+    if (pm.kind == PERMITTIVITY_DOUBLE_DEBYE && !(pm.eps_s >= pm.eps_2 && pm.eps_2 >= pm.eps_inf)) {
+        load_cursor k = load_key(c, "eps_2");
+        return load_fail(ctx, &k, "expected eps_s >= eps_2 >= eps_inf, got %g, %g, %g", pm.eps_s,
+                         pm.eps_2, pm.eps_inf);
+    }
+    return set_index(ctx, m, material_index_model(&pm));
+}
+
+thz_status load_material_index(load_ctx *ctx, const load_cursor *c, thz_material *m, bool *given)
+{
+    load_cursor ri = load_key(c, "refractive_index"), pm = load_key(c, "permittivity_model");
+    *given = ri.value || pm.value;
+    if (ri.value && pm.value)
+        return load_fail(ctx, &pm, "give either refractive_index or permittivity_model, not both");
+    if (ri.value)
+        return refractive_index(ctx, &ri, m);
+    if (pm.value)
+        return permittivity(ctx, &pm, m);
+    return THZ_OK;
+}
+
+thz_status load_index_csv(load_ctx *ctx, const load_cursor *file, const csv_table *t,
+                          thz_material *m)
+{
+    bool has_n = csv_column(t, "n") >= 0, has_k = csv_column(t, "k") >= 0;
+    if (!has_n && !has_k)
+        return THZ_OK;
+    if (has_n != has_k)
+        return load_fail(ctx, file, "%s: the columns n and k go together, but only %s is there",
+                         t->label, has_n ? "n" : "k");
+    thz_spectrum n = {0}, k = {0};
+    thz_status st = load_csv_spectrum(ctx, file, t, "n", LOAD_INDEX_N, &n);
+    if (st == THZ_OK)
+        st = load_csv_spectrum(ctx, file, t, "k", LOAD_NONNEGATIVE, &k);
+    if (st == THZ_OK)
+        st = set_index(ctx, m, material_index_table(n.n, n.freq_hz, n.value, k.value));
+    spectrum_fini(&n);
+    spectrum_fini(&k);
+    return st;
+}
+
+thz_status load_index_check_channels(load_ctx *ctx, const load_cursor *c, const thz_material *m)
+{
+    const permittivity_model *pm = m->index ? material_index_model_of(m->index) : NULL;
+    if (!pm || pm->kind != PERMITTIVITY_P2040)
+        return THZ_OK;
+    const thz_scene *s = ctx->scene;
+    for (size_t i = 0; i < s->n_channels; i++) {
+        const thz_channel *ch = &s->channels[i];
+        double fwhm = ch->relative_width * ch->center_hz;
+        double lo = ch->center_hz - 2 * fwhm, hi = ch->center_hz + 2 * fwhm;
+        if (permittivity_covers(pm, lo, hi))
+            continue;
+        char ranges[512] = "";
+        for (size_t r = 0; r < pm->n_rows; r++) {
+            size_t used = strlen(ranges);
+            snprintf(ranges + used, sizeof ranges - used, "%s%g to %g GHz", r ? ", " : "",
+                     pm->rows[r].lo_hz * 1e-9, pm->rows[r].hi_hz * 1e-9);
+        }
+        load_cursor k = load_key(c, "permittivity_model");
+        if (!k.value)
+            k = load_key(c, "library");
+        return load_fail(ctx, &k,
+                         "ITU-R P.2040 gives \"%s\" only for %s, but channel \"%s\" (band %.4g "
+                         "to %.4g GHz, centre +- 2 FWHM) reaches outside that",
+                         pm->material, ranges, ch->name, lo * 1e-9, hi * 1e-9);
+    }
+    return THZ_OK;
+}

@@ -1,0 +1,111 @@
+#!/usr/bin/env bash
+# thzmap materials: the list names every entry of data/materials/library.json with its
+# source; one entry's description (water's n, k at 1 THz against the Liebe 1991 model
+# computed here independently; P.2040 rows; units); usage errors; and scenes using the
+# library: P.2040 outside its range refused with exit 2, the JSON path and the range.
+# usage: test_materials.sh THZMAP_BINARY REPO_DIR
+set -u
+thzmap=$1
+repo=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+
+fail() {
+    echo "FAIL: $*"
+    failures=$((failures + 1))
+}
+
+# --- the list: every entry, each followed by its source -----------------------------
+"$thzmap" materials >"$tmp/list" 2>"$tmp/err" || fail "materials: exit $?: $(cat "$tmp/err")"
+python3 - "$repo/data/materials/library.json" "$tmp/list" <<'PY' || fail "the list does not match library.json"
+import json, sys
+lib = json.load(open(sys.argv[1]))["materials"]
+lines = open(sys.argv[2]).read().splitlines()
+ok = True
+for name, e in lib.items():
+    rows = [i for i, l in enumerate(lines) if l.split(" ")[0] == name]
+    if len(rows) != 1:
+        print(f"entry {name}: {len(rows)} lines"); ok = False; continue
+    src = lines[rows[0] + 1].strip()
+    if src != "source: " + e["source"]:
+        print(f"entry {name}: source line '{src}'"); ok = False
+if not lines[0].startswith(f"{len(lib)} materials"):
+    print("first line:", lines[0]); ok = False
+sys.exit(0 if ok else 1)
+PY
+
+# --- one entry: water (Liebe 1991 double Debye at 25 C), computed independently -------
+"$thzmap" materials water --at-thz 0.5,1 >"$tmp/water" 2>"$tmp/err" || fail "materials water: exit $?"
+python3 - "$tmp/water" <<'PY' || fail "water's n, k differ from Liebe's model: $(cat "$tmp/water")"
+import cmath, sys
+T = 298.15; th = 1 - 300 / T
+e0 = 77.66 - 103.3 * th; e1 = 0.0671 * e0; e2 = 3.52 + 7.52 * th
+f1 = 20.2 + 146.4 * th + 316 * th ** 2; f2 = 39.8 * f1
+rows = {}
+for l in open(sys.argv[1]):
+    p = l.split()
+    if len(p) >= 7 and p[0] in ("0.5", "1"):
+        rows[float(p[0])] = [float(x) for x in p[1:7]]
+ok = len(rows) == 2
+for f, r in rows.items():
+    eps = e2 + (e1 - e2) / (1 - 1j * f * 1e3 / f2) + (e0 - e1) / (1 - 1j * f * 1e3 / f1)
+    nk = cmath.sqrt(eps)
+    alpha = 4 * cmath.pi * nk.imag * f * 1e12 / 299792458.0
+    R = abs((nk - 1) / (nk + 1)) ** 2
+    # the printed values have 5 significant digits; the library rounds Liebe's numbers to 5
+    for got, want in ((r[0], nk.real), (r[1], nk.imag), (r[4], alpha), (r[5], R)):
+        if abs(got - want) > 2e-4 * abs(want):
+            print(f, got, want); ok = False
+sys.exit(0 if ok else 1)
+PY
+grep -q '^source: H. J. Liebe' "$tmp/water" || fail "water: no source line"
+grep -q 'alpha (1/m)' "$tmp/water" || fail "water: the attenuation column has no unit"
+grep -q '^stated validity: 0.001 to 1 THz' "$tmp/water" || fail "water: no stated range"
+
+"$thzmap" materials concrete >"$tmp/concrete" || fail "materials concrete: exit $?"
+grep -q '^data: 0.001 to 0.1 THz, 0.11 to 0.33 THz' "$tmp/concrete" ||
+    fail "concrete: P.2040 rows not listed: $(cat "$tmp/concrete")"
+grep -Eq '^ +1 .* \*$' "$tmp/concrete" || fail "concrete: 1 THz not marked outside the range"
+
+# --- usage errors ------------------------------------------------------------------
+expect_exit() { # expect_exit STATUS PATTERN ARGS...
+    local want=$1 pattern=$2
+    shift 2
+    "$thzmap" materials "$@" >"$tmp/out" 2>"$tmp/err"
+    local got=$?
+    [[ $got -eq $want ]] || fail "materials $*: exit $got, want $want"
+    grep -q -- "$pattern" "$tmp/err" || fail "materials $*: stderr lacks '$pattern': $(cat "$tmp/err")"
+    [[ -s $tmp/out ]] && fail "materials $*: printed to stdout on error"
+}
+expect_exit 2 'no material "unobtainium"' unobtainium
+expect_exit 2 "unknown option '--bogus'" --bogus
+expect_exit 2 -- '--at-thz: expected' water --at-thz 1,-2
+expect_exit 2 'one material name at most' water ice
+"$thzmap" materials --help | grep -q '^usage: thzmap materials' || fail "materials --help"
+
+# --- scenes with library materials ------------------------------------------------------
+scene() { # scene FILE FREQUENCY_THZ MATERIAL_JSON
+    cat >"$1" <<JSON
+{"format": "thzmap-scene/1", "channels": [{"frequency_thz": $2, "relative_width": 0.01}],
+ "materials": {"m": $3},
+ "objects": [{"name": "o", "type": "solid", "material": "m", "temperature_k": 300,
+              "shape": {"type": "box", "size_m": [1, 1, 1]}}],
+ "sensors": [{"name": "c", "position_m": [0, -5, 0], "look_at_m": [0, 0, 0],
+              "fov_deg": 40, "resolution": [16, 8]}]}
+JSON
+}
+scene "$tmp/ok.json" 0.3 '{"library": "skin"}'
+"$thzmap" validate "$tmp/ok.json" >/dev/null 2>"$tmp/err" || fail "skin scene: exit $?: $(cat "$tmp/err")"
+scene "$tmp/far.json" 0.5 '{"library": "wood"}'
+"$thzmap" validate "$tmp/far.json" >/dev/null 2>"$tmp/err"
+status=$?
+[[ $status -eq 2 ]] || fail "wood at 0.5 THz: exit $status, want 2"
+grep -q 'far.json: materials.m.library: ITU-R P.2040 gives "wood" only for 0.001 to 100 GHz, 110 to 330 GHz, 100 to 400 GHz, but channel "0.500 THz" (band 490 to 510 GHz' "$tmp/err" ||
+    fail "wood at 0.5 THz: message: $(cat "$tmp/err")"
+
+if [[ $failures -ne 0 ]]; then
+    echo "$failures failure(s)"
+    exit 1
+fi
+echo "materials: all checks passed"
