@@ -62,8 +62,10 @@ void scene_destroy(thz_scene *s)
         mesh_fini(&s->objects[i].mesh);
     }
     free(s->objects);
-    for (size_t i = 0; i < s->n_sensors; i++)
+    for (size_t i = 0; i < s->n_sensors; i++) {
         free(s->sensors[i].name);
+        free(s->sensors[i].noise.netd_k);
+    }
     free(s->sensors);
     free(s->channels);
     atmosphere_fini(&s->atmosphere);
