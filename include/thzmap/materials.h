@@ -18,9 +18,9 @@ extern "C" {
 typedef struct thz_library thz_library;
 
 /* Reads and checks the library. THZ_ERR_IO when its file is missing, THZ_ERR_INPUT
- * naming the JSON path of a bad entry. *out is owned (thz_library_close). */
-THZ_API thz_status thz_library_open(thz_library **out, thz_error *err);
-THZ_API void thz_library_close(thz_library *lib);
+ * naming the JSON path of a bad entry. *out is owned (thz_library_destroy). */
+THZ_API thz_status thz_library_load(thz_library **out, thz_error *err);
+THZ_API void thz_library_destroy(thz_library *lib);
 
 /* The number of entries, and the index of the entry called name (THZ_ERR_INPUT naming
  * the known names when there is none). */

@@ -16,7 +16,7 @@ struct thz_library {
     material_library *lib;
 };
 
-thz_status thz_library_open(thz_library **out, thz_error *err)
+thz_status thz_library_load(thz_library **out, thz_error *err)
 {
     *out = NULL;
     thz_library *l = thz_calloc(1, sizeof *l);
@@ -31,7 +31,7 @@ thz_status thz_library_open(thz_library **out, thz_error *err)
     return THZ_OK;
 }
 
-void thz_library_close(thz_library *lib)
+void thz_library_destroy(thz_library *lib)
 {
     if (!lib)
         return;

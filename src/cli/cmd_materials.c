@@ -142,9 +142,9 @@ int cmd_materials(int argc, char **argv)
     }
     thz_library *lib = NULL;
     thz_error err = {0};
-    if (thz_library_open(&lib, &err) != THZ_OK)
+    if (thz_library_load(&lib, &err) != THZ_OK)
         return cli_fail(&err);
     int rc = name ? describe(lib, name, thz, n_thz) : list_all(lib);
-    thz_library_close(lib);
+    thz_library_destroy(lib);
     return rc;
 }

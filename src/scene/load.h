@@ -149,13 +149,18 @@ thz_spectrum *load_material_property(thz_material *m, size_t k);
 
 /* A material's complex index (load_index.c): `refractive_index` or
  * `permittivity_model` of c (replacing m->index when given; *given says whether one
- * was), the n and k columns of a material CSV t, the `library` entry named by c, and the
- * check that every channel's band lies in an itu-p2040 model's stated range. */
+ * was), the n and k columns of a material CSV t, and the `library` entry named by c
+ * (material_library.c; range_hz gets the range its source states, {0, 0} if none).
+ * load_index_check_channels refuses channel bands that leave an itu-p2040 model's
+ * ranges and warns where they leave an index table or, when lib_range_hz is not NULL,
+ * the library entry's stated range. */
 thz_status load_material_index(load_ctx *ctx, const load_cursor *c, thz_material *m, bool *given);
 thz_status load_index_csv(load_ctx *ctx, const load_cursor *file, const csv_table *t,
                           thz_material *m);
-thz_status load_material_library(load_ctx *ctx, const load_cursor *c, thz_material *m);
-thz_status load_index_check_channels(load_ctx *ctx, const load_cursor *c, const thz_material *m);
+thz_status load_material_library(load_ctx *ctx, const load_cursor *c, thz_material *m,
+                                 double range_hz[2]);
+thz_status load_index_check_channels(load_ctx *ctx, const load_cursor *c, const thz_material *m,
+                                     const double *lib_range_hz);
 
 /* The blocks of the document, in dependency order; each fills its part of ctx->scene
  * (root is the document's cursor). Channels before sensors, materials before objects. */

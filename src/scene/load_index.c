@@ -273,11 +273,63 @@ thz_status load_index_csv(load_ctx *ctx, const load_cursor *file, const csv_tabl
     return st;
 }
 
-thz_status load_index_check_channels(load_ctx *ctx, const load_cursor *c, const thz_material *m)
+/* The first channel whose band (centre +- 2 FWHM) leaves [lo_hz, hi_hz], and how many do;
+ * n_channels when none. */
+static size_t band_outside(const thz_scene *s, double lo_hz, double hi_hz, size_t *count)
 {
-    const permittivity_model *pm = m->index ? material_index_model_of(m->index) : NULL;
-    if (!pm || pm->kind != PERMITTIVITY_P2040)
+    size_t first = s->n_channels;
+    *count = 0;
+    for (size_t i = 0; i < s->n_channels; i++) {
+        const thz_channel *ch = &s->channels[i];
+        double fwhm = ch->relative_width * ch->center_hz;
+        if (ch->center_hz - 2 * fwhm < lo_hz || ch->center_hz + 2 * fwhm > hi_hz) {
+            if (first == s->n_channels)
+                first = i;
+            (*count)++;
+        }
+    }
+    return first;
+}
+
+/* Warns that channel bands leave [lo_hz, hi_hz], `what` saying whose range it is. */
+static thz_status warn_outside(load_ctx *ctx, const load_cursor *c, const char *what, double lo_hz,
+                               double hi_hz, const char *consequence)
+{
+    size_t count;
+    size_t first = band_outside(ctx->scene, lo_hz, hi_hz, &count);
+    if (count == 0)
         return THZ_OK;
+    const thz_channel *ch = &ctx->scene->channels[first];
+    double fwhm = ch->relative_width * ch->center_hz;
+    if (!scene_add_warning(ctx->scene,
+                           "%s: %s covers %.4g to %.4g THz but channel \"%s\" (band %.4g to "
+                           "%.4g THz, centre +- 2 FWHM)%s reaches beyond it; %s",
+                           c->path, what, lo_hz * 1e-12, hi_hz * 1e-12, ch->name,
+                           (ch->center_hz - 2 * fwhm) * 1e-12, (ch->center_hz + 2 * fwhm) * 1e-12,
+                           count > 1 ? " and others" : "", consequence))
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    return THZ_OK;
+}
+
+thz_status load_index_check_channels(load_ctx *ctx, const load_cursor *c, const thz_material *m,
+                                     const double *lib_range_hz)
+{
+    if (!m->index)
+        return THZ_OK;
+    thz_status st = THZ_OK;
+    double t_lo, t_hi;
+    if (lib_range_hz && lib_range_hz[1] > 0.0) {
+        load_cursor k = load_key(c, "library");
+        st = warn_outside(ctx, &k, "the source of this library entry", lib_range_hz[0],
+                          lib_range_hz[1], "its model or data are used there all the same");
+    }
+    if (st == THZ_OK && strcmp(material_index_form(m->index), "table") == 0 &&
+        material_index_range(m->index, &t_lo, &t_hi))
+        st = warn_outside(ctx, c, "the table of n and k", t_lo, t_hi,
+                          "the end values are used there");
+    const permittivity_model *pm = material_index_model_of(m->index);
+    if (st != THZ_OK || !pm || pm->kind != PERMITTIVITY_P2040)
+        return st;
     const thz_scene *s = ctx->scene;
     for (size_t i = 0; i < s->n_channels; i++) {
         const thz_channel *ch = &s->channels[i];

@@ -118,10 +118,13 @@ static thz_status load_material(load_ctx *ctx, const load_cursor *c, thz_materia
         return st;
     for (int k = 0; k < 3; k++)
         m->color[k] = 0.6;
+    double lib_range_hz[2] = {0, 0};
+    const material_index *lib_index = NULL;
     if (json_object_get(c->value, "library")) {
-        st = load_material_library(ctx, c, m);
+        st = load_material_library(ctx, c, m, lib_range_hz);
         if (st != THZ_OK)
             return st;
+        lib_index = m->index;
     }
     if (json_object_get(c->value, "file")) {
         st = load_material_file(ctx, c, m);
@@ -135,7 +138,8 @@ static thz_status load_material(load_ctx *ctx, const load_cursor *c, thz_materia
     if (st == THZ_OK)
         st = load_material_index(ctx, c, m, &present);
     if (st == THZ_OK)
-        st = load_index_check_channels(ctx, c, m);
+        st = load_index_check_channels(ctx, c, m,
+                                       m->index && m->index == lib_index ? lib_range_hz : NULL);
     if (st != THZ_OK)
         return st;
     /* With an index, R and alpha_M not given (n == 0) come from it (physics.md). */

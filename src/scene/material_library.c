@@ -149,8 +149,10 @@ void material_library_destroy(material_library *lib)
     free(lib);
 }
 
-thz_status load_material_library(load_ctx *ctx, const load_cursor *c, thz_material *m)
+thz_status load_material_library(load_ctx *ctx, const load_cursor *c, thz_material *m,
+                                 double range_hz[2])
 {
+    range_hz[0] = range_hz[1] = 0.0;
     const char *name = NULL;
     thz_status st = load_string(ctx, c, "library", true, NULL, &name);
     if (st != THZ_OK)
@@ -178,6 +180,10 @@ thz_status load_material_library(load_ctx *ctx, const load_cursor *c, thz_materi
             st = thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
         if (e->has_color)
             memcpy(m->color, e->color, sizeof m->color);
+        if (e->has_range) {
+            range_hz[0] = e->lo_hz;
+            range_hz[1] = e->hi_hz;
+        }
     }
     material_library_destroy(lib);
     return st;

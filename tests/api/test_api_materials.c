@@ -14,7 +14,7 @@ int main(int argc, char **argv)
     (void)argv;
     thz_error err = {0};
     thz_library *lib = NULL;
-    REQUIRE_OK(thz_library_open(&lib, &err), &err);
+    REQUIRE_OK(thz_library_load(&lib, &err), &err);
     size_t n = thz_library_count(lib);
     CHECK(n >= 25, "%zu entries", n);
     for (size_t i = 0; i < n; i++) {
@@ -57,6 +57,6 @@ int main(int argc, char **argv)
     size_t none = 0;
     CHECK(thz_library_find(lib, "unobtainium", &none, &err) == THZ_ERR_INPUT, "unknown name");
     CHECK(strstr(err.message, "unobtainium") && strstr(err.message, "water"), "%s", err.message);
-    thz_library_close(lib);
+    thz_library_destroy(lib);
     return test_failures ? 1 : 0;
 }

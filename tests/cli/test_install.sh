@@ -78,6 +78,8 @@ grep -q 'AER' "$P/share/thzmap/atmosphere/README.md" 2>/dev/null ||
 
 # --- the CLI runs from the prefix, without the environment's help -----------------------
 [[ $("$P/bin/thzmap" --version 2>&1) == "thzmap $version" ]] || fail "installed thzmap --version: $("$P/bin/thzmap" --version 2>&1)"
+"$P/bin/thzmap" materials water >"$tmp/materials.out" 2>&1 && grep -q '^source: ' "$tmp/materials.out" ||
+    fail "installed thzmap materials water: $(cat "$tmp/materials.out")"
 
 # --- the man page: renders without warnings, names every command and option ---------------
 man1=$P/share/man/man1/thzmap.1

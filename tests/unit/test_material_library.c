@@ -136,6 +136,33 @@ static void test_scene_keys(void **state)
     scene_destroy(s);
 }
 
+/* The one warning of a scene that has exactly one, containing `expect`. */
+static void expect_warning(const thz_scene *s, const char *expect)
+{
+    if (s->n_warnings != 1 || !strstr(s->warnings[0], expect))
+        fail_msg("%zu warning(s), the first '%s'; expected one with '%s'", s->n_warnings,
+                 s->n_warnings ? s->warnings[0] : "", expect);
+}
+
+static void test_warnings(void **state)
+{
+    (void)state;
+    thz_scene *s = load_ok("0.5", "{\"library\": \"water\"}");
+    assert_int_equal(s->n_warnings, 0);
+    scene_destroy(s);
+    s = load_ok("2.0", "{\"library\": \"water\"}");
+    expect_warning(s, "materials.m.library: the source of this library entry covers 0.001 to 1 "
+                      "THz but channel \"2.000 THz\" (band 1.96 to 2.04 THz");
+    scene_destroy(s);
+    /* an index given beside the entry replaces it: no warning about the entry's range */
+    s = load_ok("2.0", "{\"library\": \"water\", \"refractive_index\": [2, 0.3]}");
+    assert_int_equal(s->n_warnings, 0);
+    scene_destroy(s);
+    s = load_ok("2.0", "{\"refractive_index\": [[0.5, 1.5, 0.01], [1.5, 1.7, 0.05]]}");
+    expect_warning(s, "materials.m: the table of n and k covers 0.5 to 1.5 THz but channel");
+    scene_destroy(s);
+}
+
 static void test_refusals(void **state)
 {
     (void)state;
@@ -193,6 +220,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_entry),
         cmocka_unit_test(test_scene_keys),
+        cmocka_unit_test(test_warnings),
         cmocka_unit_test(test_refusals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
