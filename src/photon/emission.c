@@ -210,9 +210,10 @@ static bool emission_add_source(emission_table *t, const accel *acc, size_t i, e
     s->kind = kind;
     s->sides = (obj->type == OBJECT_SHELL || obj->two_sided) ? 2 : 1;
     const thz_material *m = &scene->materials[obj->material];
-    s->constant_optics = kind == EMISSION_BACK || (spectrum_is_constant(&m->reflectivity) &&
-                                                   spectrum_is_constant(&m->attenuation_per_m) &&
-                                                   spectrum_is_constant(&m->emissivity));
+    s->constant_optics =
+        kind == EMISSION_BACK ||
+        (!m->index && spectrum_is_constant(&m->reflectivity) &&
+         spectrum_is_constant(&m->attenuation_per_m) && spectrum_is_constant(&m->emissivity));
     s->area_m2 = obj->mesh.total_area_m2; /* the sum of areas_m2, in order */
     s->share = s->area_m2 * s->sides;
     s->reach_share = 1.0;
@@ -238,6 +239,7 @@ static bool emission_add_source(emission_table *t, const accel *acc, size_t i, e
         s->share = s->weight0;
     } else if (s->constant_optics) {
         s->optics = scene_object_optics(scene, obj, scene->channels[t->channel].center_hz);
+        optics_prepare(&s->optics);
         double eps = optics_mean_emissivity(&s->optics);
         optics_point kirchhoff = emission_kirchhoff_optics(s->optics);
         double abs = optics_mean_emissivity(&kirchhoff);
@@ -294,7 +296,8 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, const 
         } else if (!explicit_eps) { /* A (B(T) - B0): nothing at T0 */
             if (obj->temperature_k != t0_k)
                 ok = emission_add_source(t, acc, i, EMISSION_KIRCHHOFF);
-        } else if (obj->type == OBJECT_SHELL) { /* eps B(T) and -A(mu) B0: two laws */
+        } else if (obj->type == OBJECT_SHELL || scene->materials[obj->material].index) {
+            /* eps B(T) and -A(mu) B0: two laws (A of a solid depends on angle with an index) */
             if (hot)
                 ok = emission_add_source(t, acc, i, EMISSION_EPS);
             if (ok)

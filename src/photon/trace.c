@@ -50,7 +50,7 @@ static bool trace_buffer_push(trace_buffer *b, const photon_record *r)
 
 trace_event trace_roulette(const optics_point *o, double mu, double u)
 {
-    double r = o->reflectivity;
+    double r = optics_reflectance(o, mu);
     if (u < r)
         return TRACE_REFLECT;
     if (o->thickness_m > 0.0 && u < r + optics_transmission(o, mu))
@@ -64,6 +64,27 @@ vec3 trace_diffuse_transmission_dir(const optics_point *o, vec3 n_out, rng_strea
     if (!optics_sample_transmission_mu(o, sampling_uniform, rng, &mu))
         mu = sqrt(1.0 - rng_uniform(rng)); /* unreachable after a transmission event */
     return sampling_direction(n_out, mu, rng_uniform(rng));
+}
+
+/* Reflection by the material's lobe (brdf.h) from hit, arriving along *dir: the new
+ * direction, and the power times the sample's weight (1 for diffuse and mirror; for
+ * Ward of mean 1: the difference is booked as terminated power, so that the power sums
+ * still balance). False if the sample is lost. */
+static bool trace_reflect_lobe(const thz_scene *scene, const thz_object *obj, const accel_hit *hit,
+                               const optics_point *o, rng_stream *rng, vec3 *dir, double *power,
+                               trace_counters *c)
+{
+    brdf_frame f = scene_triangle_frame(obj, hit->triangle, hit->side);
+    brdf_lobe lobe;
+    scene_object_lobe(scene, obj, o, &lobe);
+    double w;
+    if (!brdf_sample(&lobe, &f, v3_scale(*dir, -1.0), sampling_uniform, rng, dir, &w))
+        return false;
+    if (w != 1.0) {
+        c->terminated_power -= *power * (w - 1.0);
+        *power *= w;
+    }
+    return true;
 }
 
 bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photon *e,
@@ -163,7 +184,13 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
         switch (trace_roulette(&o, hit.cos_theta, rng_uniform(rng))) {
         case TRACE_REFLECT:
             c->reflected++;
-            dir = sampling_direction(n_in, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
+            if (o.lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(&o)) {
+                dir = sampling_direction(n_in, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
+            } else if (!trace_reflect_lobe(scene, obj, &hit, &o, rng, &dir, &power, c)) {
+                c->absorbed++; /* a glossy sample below the surface: lost */
+                c->absorbed_power += power;
+                return true;
+            }
             break;
         case TRACE_TRANSMIT:
             c->transmitted++;

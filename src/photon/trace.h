@@ -8,10 +8,11 @@
  * picks reflection (p = R), transmission (p = T(theta), shells only) or absorption.
  * The back side of a one-sided solid absorbs (counted in back_face_hits; the record is
  * still stored, the renderer ignores it). Reflection is Lambertian on the side of
- * incidence; `diffuse` transmission leaves from the other side with mu ~ T(mu) mu,
- * `straight` transmission goes on unchanged. Neither changes the power: the sampling
- * probabilities equal the BRDF/BTDF weights. A path is capped at TRACE_MAX_BOUNCES hits
- * (counted; it should never trigger).
+ * incidence (reciprocal and exact with an angle-dependent R: mu ~ R(mu) mu, brdf.h), a
+ * mirror, or Ward's lobe (whose sample weight multiplies the power); `diffuse` transmission leaves
+ * from the other side with mu ~ T(mu) mu, `straight` transmission goes on unchanged. Neither
+ * changes the power: the sampling probabilities equal the BRDF/BTDF weights. A path is capped at
+ * TRACE_MAX_BOUNCES hits (counted; it should never trigger).
  *
  * Photons of a deviation map (emission.h) may carry negative power: the path is the
  * same, traced with |power| (the roulette compares |w| with min_relative_power times the
@@ -65,7 +66,7 @@ void trace_buffer_fini(trace_buffer *b);
 
 typedef enum trace_event { TRACE_REFLECT = 0, TRACE_TRANSMIT, TRACE_ABSORB } trace_event;
 
-/* Russian roulette (eq. 8-10) with one uniform u in [0, 1): reflect if u < R, transmit
+/* Russian roulette (eq. 8-10) with one uniform u in [0, 1): reflect if u < R(mu), transmit
  * if u < R + T(mu) (T = 0 for solids), else absorb. */
 trace_event trace_roulette(const optics_point *o, double mu, double u);
 

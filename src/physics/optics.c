@@ -11,6 +11,11 @@
 #include <float.h>
 #include <math.h>
 
+#include "physics/fresnel.h"
+#include "physics/gauss_legendre.h"
+
+#define OPTICS_C_M_PER_S 299792458.0
+
 #define OPTICS_EULER_GAMMA 0.57721566490153286061
 #define OPTICS_EXPINT_MAXIT 200
 
@@ -86,10 +91,121 @@ static double optics_kink(double tau, double c)
     return mstar < 1.0 ? mstar : 1.0;
 }
 
+/* ---- Optics from a complex index (has_index) ---- */
+
+bool optics_reflectance_varies(const optics_point *o)
+{
+    return o->has_index && !o->reflectivity_given;
+}
+
+/* The slab's internal attenuation, 1/m: alpha_M when given, else 4 pi k nu / c. */
+static double optics_index_alpha(const optics_point *o)
+{
+    if (o->attenuation_given)
+        return o->attenuation_per_m > 0.0 ? o->attenuation_per_m : 0.0;
+    double a = 4.0 * M_PI * o->k * o->freq_hz / OPTICS_C_M_PER_S;
+    return a > 0.0 ? a : 0.0;
+}
+
+/* R(mu) and T(mu) with an index. */
+static void optics_index_rt(const optics_point *o, double mu, double *r, double *t)
+{
+    mu = fabs(mu);
+    if (mu > 1.0)
+        mu = 1.0;
+    if (!optics_is_shell(o)) {
+        *r = o->reflectivity_given ? o->reflectivity : fresnel_reflectance(o->n, o->k, mu);
+        *t = 0.0;
+        return;
+    }
+    double rs, ts;
+    fresnel_slab(o->n, o->k, mu, optics_index_alpha(o), o->thickness_m, &rs, &ts);
+    if (o->reflectivity_given) {
+        double c = optics_cap(o);
+        *r = o->reflectivity;
+        *t = ts < c ? ts : c;
+        return;
+    }
+    *r = rs;
+    *t = ts;
+}
+
+/* 2 int_0^1 X(mu) mu dmu by Gauss-Legendre, X = R (which = 0) or T (which = 1). */
+static double optics_index_mean(const optics_point *o, int which)
+{
+    double sum = 0.0;
+    for (int i = 0; i < GAUSS_LEGENDRE_NODES; i++) {
+        double mu = gauss_legendre_x[i], r, t;
+        optics_index_rt(o, mu, &r, &t);
+        sum += gauss_legendre_w[i] * (which == 0 ? r : t) * mu;
+    }
+    return 2.0 * sum;
+}
+
+void optics_prepare(optics_point *o)
+{
+    if (!o->has_index)
+        return;
+    o->means_ready = false;
+    o->mean_r = optics_index_mean(o, 0);
+    o->mean_t = optics_is_shell(o) ? optics_index_mean(o, 1) : 0.0;
+    o->means_ready = true;
+}
+
+double optics_reflectance(const optics_point *o, double mu)
+{
+    if (!o->has_index)
+        return o->reflectivity;
+    double r, t;
+    optics_index_rt(o, mu, &r, &t);
+    return r;
+}
+
+double optics_mean_reflectance(const optics_point *o)
+{
+    if (!o->has_index)
+        return o->reflectivity;
+    return o->means_ready ? o->mean_r : optics_index_mean(o, 0);
+}
+
+typedef double (*optics_law_fn)(const optics_point *o, double mu);
+
+/* Samples mu with density proportional to law(mu) mu, law in [0, 1], by rejection from
+ * the cosine law (acceptance = the law's hemispherical mean). */
+static bool optics_reject(const optics_point *o, optics_law_fn law, optics_uniform_fn next,
+                          void *ctx, double *mu)
+{
+    for (long i = 0; i < OPTICS_MAX_TRIES; i++) {
+        double cand = sqrt(1.0 - next(ctx));
+        if (cand > 0.0 && next(ctx) < law(o, cand)) {
+            *mu = cand;
+            return true;
+        }
+    }
+    return false;
+}
+
+bool optics_sample_reflection_mu(const optics_point *o, optics_uniform_fn next, void *ctx,
+                                 double *mu)
+{
+    if (!optics_reflectance_varies(o)) {
+        if (!(optics_reflectance(o, 1.0) > 0.0))
+            return false;
+        *mu = sqrt(1.0 - next(ctx));
+        return true;
+    }
+    return optics_reject(o, optics_reflectance, next, ctx, mu);
+}
+
 double optics_transmission(const optics_point *o, double mu)
 {
     if (!optics_is_shell(o))
         return 0.0;
+    if (o->has_index) {
+        double r, t;
+        optics_index_rt(o, mu, &r, &t);
+        return t;
+    }
     double c = optics_cap(o);
     double tau = optics_tau(o);
     mu = fabs(mu);
@@ -103,6 +219,12 @@ double optics_transmission(const optics_point *o, double mu)
 
 double optics_absorption(const optics_point *o, double mu)
 {
+    if (o->has_index) {
+        double r, t;
+        optics_index_rt(o, mu, &r, &t);
+        double a = 1.0 - r - t;
+        return a > 0.0 ? a : 0.0;
+    }
     double a = optics_cap(o) - optics_transmission(o, mu);
     return a > 0.0 ? a : 0.0;
 }
@@ -118,6 +240,8 @@ double optics_mean_transmission(const optics_point *o)
 {
     if (!optics_is_shell(o))
         return 0.0;
+    if (o->has_index)
+        return o->means_ready ? o->mean_t : optics_index_mean(o, 1);
     double c = optics_cap(o);
     double tau = optics_tau(o);
     if (c == 0.0)
@@ -132,6 +256,10 @@ double optics_mean_emissivity(const optics_point *o)
 {
     if (o->explicit_emissivity)
         return o->emissivity > 0.0 ? o->emissivity : 0.0;
+    if (o->has_index) {
+        double e = 1.0 - optics_mean_reflectance(o) - optics_mean_transmission(o);
+        return e > 0.0 ? e : 0.0;
+    }
     double e = optics_cap(o) - optics_mean_transmission(o);
     return e > 0.0 ? e : 0.0;
 }
@@ -141,6 +269,8 @@ bool optics_sample_transmission_mu(const optics_point *o, optics_uniform_fn next
 {
     if (!optics_is_shell(o))
         return false;
+    if (o->has_index)
+        return optics_reject(o, optics_transmission, next, ctx, mu);
     double c = optics_cap(o);
     double tau = optics_tau(o);
     if (c == 0.0)
@@ -184,6 +314,8 @@ bool optics_sample_transmission_mu(const optics_point *o, optics_uniform_fn next
 
 bool optics_sample_emission_mu(const optics_point *o, optics_uniform_fn next, void *ctx, double *mu)
 {
+    if (o->has_index && !o->explicit_emissivity)
+        return optics_reject(o, optics_absorption, next, ctx, mu);
     double c = optics_cap(o);
     double tau = optics_tau(o);
     if (o->explicit_emissivity || !optics_is_shell(o) || tau == 0.0) {
@@ -227,6 +359,15 @@ double optics_kirchhoff_violation(const optics_point *o)
 {
     if (!o->explicit_emissivity)
         return 0.0;
+    if (o->has_index) { /* A(mu) at the quadrature nodes and both ends */
+        double eps = optics_emissivity(o, 1.0), worst = 0.0;
+        for (int i = -1; i <= GAUSS_LEGENDRE_NODES; i++) {
+            double mu = i < 0 ? 1e-9 : i == GAUSS_LEGENDRE_NODES ? 1.0 : gauss_legendre_x[i];
+            double d = fabs(eps - optics_absorption(o, mu));
+            worst = d > worst ? d : worst;
+        }
+        return worst;
+    }
     /* A(mu) is monotone in mu (constant for solids, decreasing for shells), so the
      * largest |eps - A| is at an end of (0, 1]: A(0+) = c for a shell with tau > 0
      * (T -> 0), and A(1). */

@@ -68,11 +68,50 @@ static thz_status load_check_energy(load_ctx *ctx, const load_cursor *c, const t
     return THZ_OK;
 }
 
+/* The `reflection` key: "diffuse" (default), "specular", or {"model": "ward", "alpha_x",
+ * "alpha_y"} (0 < alpha <= 1), whose albedo table is built here (brdf.h). */
+static thz_status load_material_reflection(load_ctx *ctx, const load_cursor *c, thz_material *m)
+{
+    static const char *const names[] = {"diffuse", "specular", NULL};
+    static const char *const ward_keys[] = {"model", "alpha_x", "alpha_y", NULL};
+    static const char *const models[] = {"ward", NULL};
+    load_cursor r = load_key(c, "reflection");
+    m->reflection = REFLECTION_DIFFUSE;
+    if (!r.value || json_is_string(r.value)) {
+        size_t which = 0;
+        thz_status st = load_choice(ctx, c, "reflection", names, false, 0, &which);
+        m->reflection = which == 1 ? REFLECTION_SPECULAR : REFLECTION_DIFFUSE;
+        return st;
+    }
+    if (!json_is_object(r.value))
+        return load_fail(ctx, &r,
+                         "expected \"diffuse\", \"specular\" or {\"model\": \"ward\", "
+                         "\"alpha_x\": ax, \"alpha_y\": ay}, got %s",
+                         load_type_name(r.value));
+    thz_status st = load_expect_object(ctx, &r, ward_keys);
+    size_t model = 0;
+    const load_range slope = {0.0, 1.0, true, false};
+    if (st == THZ_OK)
+        st = load_choice(ctx, &r, "model", models, true, 0, &model);
+    if (st == THZ_OK)
+        st = load_number(ctx, &r, "alpha_x", slope, true, 0.0, &m->ward_alpha[0]);
+    if (st == THZ_OK)
+        st = load_number(ctx, &r, "alpha_y", slope, true, 0.0, &m->ward_alpha[1]);
+    if (st != THZ_OK)
+        return st;
+    m->reflection = REFLECTION_WARD;
+    m->ward_table = brdf_ward_table_create(m->ward_alpha[0], m->ward_alpha[1]);
+    if (!m->ward_table)
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    return THZ_OK;
+}
+
 static thz_status load_material(load_ctx *ctx, const load_cursor *c, thz_material *m)
 {
     static const char *const keys[] = {
         "reflectivity", "attenuation_per_m", "emissivity",         "transmission", "color",
-        "file",         "refractive_index",  "permittivity_model", "library",      NULL};
+        "file",         "refractive_index",  "permittivity_model", "library",      "reflection",
+        NULL};
     static const char *const transmissions[] = {"diffuse", "straight", NULL};
     thz_status st = load_expect_object(ctx, c, keys);
     if (st != THZ_OK)
@@ -119,6 +158,9 @@ static thz_status load_material(load_ctx *ctx, const load_cursor *c, thz_materia
     if (st != THZ_OK)
         return st;
     m->transmission = transmission == 1 ? TRANSMISSION_STRAIGHT : TRANSMISSION_DIFFUSE;
+    st = load_material_reflection(ctx, c, m);
+    if (st != THZ_OK)
+        return st;
     st = load_vector(ctx, c, "color", 3, LOAD_UNIT, false, m->color);
     if (st != THZ_OK)
         return st;

@@ -54,6 +54,7 @@ void scene_destroy(thz_scene *s)
         spectrum_fini(&m->attenuation_per_m);
         spectrum_fini(&m->emissivity);
         material_index_destroy(m->index);
+        brdf_ward_table_destroy(m->ward_table);
     }
     free(s->materials);
     for (size_t i = 0; i < s->n_objects; i++) {
@@ -108,10 +109,53 @@ optics_point scene_object_optics(const thz_scene *s, const thz_object *obj, doub
         .attenuation_per_m = spectrum_eval(&m->attenuation_per_m, freq_hz),
         .thickness_m = obj->type == OBJECT_SHELL ? obj->thickness_m : 0.0,
         .explicit_emissivity = m->emissivity.n > 0,
+        .freq_hz = freq_hz,
+        .lobe = m->reflection == REFLECTION_SPECULAR ? OPTICS_LOBE_SPECULAR
+                : m->reflection == REFLECTION_WARD   ? OPTICS_LOBE_WARD
+                                                     : OPTICS_LOBE_DIFFUSE,
+        .ward_alpha = {m->ward_alpha[0], m->ward_alpha[1]},
     };
     if (o.explicit_emissivity)
         o.emissivity = spectrum_eval(&m->emissivity, freq_hz);
+    if (m->index && material_index_at(m->index, freq_hz, &o.n, &o.k)) {
+        /* a property given beside the index overrides it (scene-format.md): the loader
+         * leaves a spectrum empty (n == 0) when its key is absent */
+        o.has_index = true;
+        o.reflectivity_given = m->reflectivity.n > 0;
+        o.attenuation_given = m->attenuation_per_m.n > 0;
+        if (!o.reflectivity_given)
+            o.reflectivity = 0.0;
+        if (!o.attenuation_given)
+            o.attenuation_per_m = 0.0;
+    }
     return o;
+}
+
+brdf_frame scene_triangle_frame(const thz_object *obj, uint32_t tri, int side)
+{
+    const thz_mesh *m = &obj->mesh;
+    vec3 n = v3_from_floats(&m->normals[3 * (size_t)tri]);
+    if (side == 1)
+        n = v3_scale(n, -1.0);
+    const uint32_t *ix = &m->indices[3 * (size_t)tri];
+    vec3 e = v3_sub(v3_from_floats(&m->positions[3 * (size_t)ix[1]]),
+                    v3_from_floats(&m->positions[3 * (size_t)ix[0]]));
+    e = v3_sub(e, v3_scale(n, v3_dot(e, n)));
+    brdf_frame f = {.n = n};
+    double len = v3_length(e);
+    if (len > 0.0) {
+        f.t = v3_scale(e, 1.0 / len);
+        f.b = v3_cross(n, f.t);
+    } else {
+        v3_basis(n, &f.t, &f.b);
+    }
+    return f;
+}
+
+void scene_object_lobe(const thz_scene *scene, const thz_object *obj, const optics_point *o,
+                       brdf_lobe *lobe)
+{
+    brdf_lobe_init(lobe, o, scene->materials[obj->material].ward_table);
 }
 
 bool scene_object_two_sided(const thz_object *obj)

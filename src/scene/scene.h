@@ -11,6 +11,7 @@
 
 #include "atmosphere/atmosphere.h"
 #include "core/error.h"
+#include "physics/brdf.h"
 #include "physics/channel.h"
 #include "physics/material_index.h"
 #include "physics/optics.h"
@@ -34,8 +35,9 @@ typedef struct thz_material {
     material_index *index;          /* n + ik (refractive_index, permittivity_model or library);
                                        NULL: the R, alpha_M, eps tables alone */
     thz_reflection reflection;
-    double ward_alpha[2]; /* Ward's alpha_x, alpha_y (REFLECTION_WARD) */
-    double color[3];      /* rgb 0..1 for the visual truth image */
+    double ward_alpha[2];        /* Ward's alpha_x, alpha_y (REFLECTION_WARD) */
+    brdf_ward_table *ward_table; /* Ward's albedo table (REFLECTION_WARD), owned */
+    double color[3];             /* rgb 0..1 for the visual truth image */
 } thz_material;
 
 typedef enum thz_object_type { OBJECT_SOLID = 0, OBJECT_SHELL } thz_object_type;
@@ -175,6 +177,14 @@ bool scene_add_warning(thz_scene *scene, const char *fmt, ...)
 /* The optics of object `obj` at freq_hz: its material's R, alpha_M and explicit eps
  * evaluated there, and its thickness (0 for solids). */
 optics_point scene_object_optics(const thz_scene *scene, const thz_object *obj, double freq_hz);
+
+/* The BRDF frame of triangle `tri` of `obj` seen from `side` (brdf.h): the normal on that
+ * side, the tangent along the triangle's first edge v0 -> v1 (Ward's x axis), b = n x t. */
+brdf_frame scene_triangle_frame(const thz_object *obj, uint32_t tri, int side);
+
+/* The lobe of `obj`'s material at optics point o (borrowed; must outlive the lobe). */
+void scene_object_lobe(const thz_scene *scene, const thz_object *obj, const optics_point *o,
+                       brdf_lobe *lobe);
 
 /* Whether both sides of `obj` are front sides (and emit): shells, and solids with
  * `two_sided`. */

@@ -84,6 +84,11 @@ void scene_hash_compute(const thz_scene *scene, scene_hash *out)
         o = hash_spectrum(o, &m->attenuation_per_m);
         o = hash_spectrum(o, &m->emissivity);
         o = hash_word(o, (uint64_t)m->transmission);
+        if (m->reflection != REFLECTION_DIFFUSE) { /* only then: older hashes stay valid */
+            o = hash_word(o, (uint64_t)m->reflection);
+            o = hash_double(o, m->ward_alpha[0]);
+            o = hash_double(o, m->ward_alpha[1]);
+        }
     }
     const thz_atmosphere *atm = &scene->atmosphere;
     o = hash_word(o, (uint64_t)atm->model);

@@ -21,6 +21,10 @@ typedef struct render_gather_state {
     double distance_m;             /* from the sensor */
     double radius2_m2;
     bool strict;      /* only photons strictly inside (widened disk) */
+    bool plain;       /* constant-R Lambertian reflection: f = R(nu)/pi */
+    bool skip_seen;   /* a mirror: its reflection is traced, not estimated */
+    brdf_frame frame; /* the frame on the seen side and the direction towards the sensor */
+    vec3 w_view;
     bool transmitted; /* photons of the other side of a diffuse shell: BTDF, not BRDF */
     size_t count;
     double sum, sum2; /* sum of photon terms f Phi w exp(-alpha d), and of their squares */
@@ -40,11 +44,18 @@ static void render_gather_visit(void *vstate, const photon_record *p, double dis
     if (g->transmitted ? !(along > 0.0) : !(along < 0.0))
         return;
     g->count++;
+    if (!g->transmitted && g->skip_seen)
+        return;
     double nu = (double)p->freq_hz;
     const thz_scene *scene = g->ctx->scene;
     double f;
-    if (!g->transmitted) {
+    if (!g->transmitted && g->plain) {
         f = spectrum_eval(&scene->materials[g->obj->material].reflectivity, nu) / M_PI;
+    } else if (!g->transmitted) {
+        optics_point o;
+        brdf_lobe l;
+        render_lobe_at(g->ctx, g->obj, g->object_index, nu, &o, &l);
+        f = brdf_eval(&l, &g->frame, v3_scale(dir, -1.0), g->w_view);
     } else {
         /* f_T = T(theta_p) T(theta_o) / (pi T-bar): the reciprocal BTDF */
         optics_point o = scene_object_optics(scene, g->obj, nu);
@@ -86,13 +97,16 @@ static void render_gather_pass(render_gather_state *g, uint32_t object, int seen
  * footprint (sample_sr > 0), widened to the k-th nearest photon when it holds fewer than
  * k; sample_sr = 0 asks for the k-th nearest radius directly. Adds the estimate to
  * *radiance and its Poisson variance to out->variance. */
-void render_gather(const render_context *ctx, const accel_hit *hit, const render_path *path,
-                   const render_scatter *scatter, double distance_m, double sample_sr,
-                   bool diffuse_shell, double *radiance, render_sample *out)
+void render_gather(const render_context *ctx, const accel_hit *hit, vec3 ray_dir,
+                   const render_path *path, const render_scatter *scatter, double distance_m,
+                   double sample_sr, bool diffuse_shell, double *radiance, render_sample *out)
 {
     if (!ctx->map)
         return;
     const thz_object *obj = &ctx->scene->objects[hit->object];
+    const thz_material *mat = &ctx->scene->materials[obj->material];
+    if (mat->reflection == REFLECTION_SPECULAR && !diffuse_shell)
+        return; /* a mirror's reflection is traced by the integrator */
     const float *nf = &obj->mesh.normals[3 * (size_t)hit->triangle];
     vec3 normal = v3_from_floats(nf);
     render_gather_state g = {
@@ -105,6 +119,10 @@ void render_gather(const render_context *ctx, const accel_hit *hit, const render
         .scatter = scatter,
         .distance_m = distance_m,
         .radius2_m2 = sample_sr * distance_m * distance_m / (M_PI * hit->cos_theta),
+        .plain = !mat->index && mat->reflection == REFLECTION_DIFFUSE,
+        .skip_seen = mat->reflection == REFLECTION_SPECULAR,
+        .frame = scene_triangle_frame(obj, hit->triangle, hit->side),
+        .w_view = v3_scale(ray_dir, -1.0),
     };
     size_t k = sample_sr > 0.0 ? ctx->k : ctx->k_secondary;
     render_gather_pass(&g, hit->object, hit->side, diffuse_shell, hit->position_m);

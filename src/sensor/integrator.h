@@ -68,10 +68,20 @@ double render_photon_map_trace(const render_context *ctx, vec3 origin_m, vec3 di
                                double distance_m, const render_scatter *scatter, double sample_sr,
                                render_sample *out);
 
+/* A `straight` shell that is also a mirror splits a ray in two; beyond this many
+ * entries of the path the mirror branch is dropped (counted in truncated_paths). */
+#define RENDER_MIRROR_BRANCHES 8
+
+/* At a hit of a mirror (`specular` reflection): appends the bounce (R(theta)) to path,
+ * turns *dir into the mirrored direction and *origin_m into its start, and returns true;
+ * false for other surfaces (and when the path is full: counted as truncated). */
+bool render_mirror(const render_context *ctx, const accel_hit *hit, render_path *path, vec3 *dir,
+                   vec3 *origin_m, render_sample *out);
+
 /* The density estimate at a hit (gather.c): adds L_R (+ L_T for diffuse shells) to
  * *radiance and its Poisson variance and batch terms to *out. */
-void render_gather(const render_context *ctx, const accel_hit *hit, const render_path *path,
-                   const render_scatter *scatter, double distance_m, double sample_sr,
-                   bool diffuse_shell, double *radiance, render_sample *out);
+void render_gather(const render_context *ctx, const accel_hit *hit, vec3 ray_dir,
+                   const render_path *path, const render_scatter *scatter, double distance_m,
+                   double sample_sr, bool diffuse_shell, double *radiance, render_sample *out);
 
 #endif

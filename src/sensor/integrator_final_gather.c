@@ -16,15 +16,18 @@
 
 /* One gather ray from first vertex `hit` (object obj, seen through `path`, at distance
  * distance_m from the sensor): its estimate of the scattered radiance towards the sensor. */
-static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
+static double render_gather_ray(const render_context *ctx, const accel_hit *hit, vec3 ray_dir,
                                 const thz_object *obj, bool diffuse_shell, const render_path *path,
                                 double distance_m, rng_stream *rng, render_sample *out,
                                 render_sample *sec)
 {
     const thz_material *mat = &ctx->scene->materials[obj->material];
     double nu_j = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
-    optics_point o = scene_object_optics(ctx->scene, obj, nu_j);
-    double r = o.reflectivity;
+    optics_point o;
+    brdf_lobe lobe;
+    render_lobe_at(ctx, obj, hit->object, nu_j, &o, &lobe);
+    /* a mirror's reflection is traced by the sample (render_mirror), not gathered */
+    double r = o.lobe == OPTICS_LOBE_SPECULAR ? 0.0 : optics_reflectance(&o, hit->cos_theta);
     double tr = diffuse_shell ? optics_transmission(&o, hit->cos_theta) : 0.0;
     if (!(r + tr > 0.0))
         return 0.0;
@@ -36,9 +39,24 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
     vec3 dir;
     if (rng_uniform(rng) * (r + tr) < r) {
         s.inv_branch = (r + tr) / r;
-        double mu = sqrt(1.0 - rng_uniform(rng));
-        dir = sampling_direction(n_seen, mu, rng_uniform(rng));
-        s.mu_i = mu;
+        if (o.lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(&o)) {
+            double mu = sqrt(1.0 - rng_uniform(rng));
+            dir = sampling_direction(n_seen, mu, rng_uniform(rng));
+            s.mu_i = mu;
+        } else {
+            /* the lobe's own sampling at nu_j, weighted f(nu) cos / pdf(nu_j) */
+            s.lobe = true;
+            s.frame = scene_triangle_frame(obj, hit->triangle, hit->side);
+            s.w_view = v3_scale(ray_dir, -1.0);
+            double w;
+            if (!brdf_sample(&lobe, &s.frame, s.w_view, sampling_uniform, rng, &dir, &w))
+                return 0.0;
+            s.w_gather = dir;
+            s.mu_i = v3_dot(dir, s.frame.n);
+            s.pdf = brdf_pdf(&lobe, &s.frame, s.w_view, dir);
+            if (!(s.pdf > 0.0) || !(s.mu_i > 0.0))
+                return 0.0;
+        }
     } else {
         s.transmitted = true;
         s.inv_branch = (r + tr) / tr;
@@ -57,15 +75,14 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
     return l;
 }
 
-void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
-                                double sample_sr, const render_target *t, render_sample *out)
+/* The sample's terms along a ray from origin_m (past `path`, at distance_m): emission
+ * and air on the way, through straight shells and mirrors, and the gather rays at the
+ * first hit that scatters otherwise. Recursive where a straight shell is also a mirror. */
+static void render_final_gather_trace(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                      uint32_t ignore_object, uint32_t ignore_triangle,
+                                      render_path path, double distance_m, const render_target *t,
+                                      render_sample *out)
 {
-    (void)sample_sr;
-    render_path path = {.n = 0};
-    double distance_m = 0.0;
-    uint32_t ignore_object = ACCEL_NO_OBJECT, ignore_triangle = 0;
-    if (ctx->deviation)
-        render_add_all(t, ctx->b0_mean);
     for (;;) {
         accel_hit hit;
         if (!accel_intersect(ctx->accel, origin_m, dir, INFINITY, ignore_object, ignore_triangle,
@@ -92,7 +109,8 @@ void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 d
         bool shell = obj->type == OBJECT_SHELL;
         bool straight =
             shell && ctx->scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
-        if (ctx->scatters[hit.object]) {
+        bool mirror = ctx->scene->materials[obj->material].reflection == REFLECTION_SPECULAR;
+        if (ctx->scatters[hit.object] && (!mirror || (shell && !straight))) {
             /* streams: the sample's, one per gather ray; crossings of straight shells
              * shift them so that each vertex has its own */
             for (uint32_t j = 0; j < t->n_est; j++) {
@@ -100,7 +118,7 @@ void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 d
                 rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_GATHER,
                          (t->rng_index + j) * (RENDER_MAX_CROSSINGS + 1) + path.n);
                 render_sample sec = {.variance = 0.0};
-                t->est[j] += t->weight * render_gather_ray(ctx, &hit, obj, shell && !straight,
+                t->est[j] += t->weight * render_gather_ray(ctx, &hit, dir, obj, shell && !straight,
                                                            &path, distance_m, &rng, out, &sec);
                 if (t->batch) {
                     for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
@@ -110,6 +128,21 @@ void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 d
             }
             out->paths += t->n_est;
         }
+        vec3 in_dir = dir;
+        if (render_mirror(ctx, &hit, &path, &dir, &origin_m, out)) {
+            ignore_object = hit.object;
+            ignore_triangle = hit.triangle;
+            if (!straight)
+                continue;
+            render_path branch = path;
+            path.n--;
+            if (path.n < RENDER_MIRROR_BRANCHES)
+                render_final_gather_trace(ctx, origin_m, dir, hit.object, hit.triangle, branch,
+                                          distance_m, t, out);
+            else
+                out->truncated = 1;
+            dir = in_dir;
+        }
         if (!straight)
             return;
         if (path.n == RENDER_MAX_CROSSINGS) {
@@ -118,9 +151,20 @@ void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 d
         }
         path.object[path.n] = hit.object;
         path.mu[path.n] = hit.cos_theta;
+        path.reflected[path.n] = false;
         path.n++;
         origin_m = accel_offset_origin(ctx->accel, &hit, dir);
         ignore_object = hit.object;
         ignore_triangle = hit.triangle;
     }
+}
+
+void render_final_gather_sample(const render_context *ctx, vec3 origin_m, vec3 dir,
+                                double sample_sr, const render_target *t, render_sample *out)
+{
+    (void)sample_sr;
+    render_path path = {.n = 0};
+    if (ctx->deviation)
+        render_add_all(t, ctx->b0_mean);
+    render_final_gather_trace(ctx, origin_m, dir, ACCEL_NO_OBJECT, 0, path, 0.0, t, out);
 }

@@ -6,7 +6,8 @@
  * and across a free path of transmittance tau, L_in - B0 = tau (L_far - B0) + (tau - 1) B0;
  * nothing hit, or the back of a one-sided solid, is L - B0 = -B0. A path samples nu from
  * g_c, adds the bracket at every hit (times the product beta of the transmittances so
- * far) and continues by Russian roulette with probabilities R (cosine reflection) and
+ * far) and continues by Russian roulette with probabilities R(theta) (reflection by the
+ * material's lobe, brdf.h, whose sample weight multiplies beta; 1 but for Ward) and
  * T(theta) (straight: unchanged; diffuse: exit mu ~ T(mu) mu), which makes the BRDF and
  * BTDF weights exactly 1. The estimate is Bbar0 + the sum, Bbar0 the band mean of B0 by
  * the channel quadrature; E[B0(nu)] = Bbar0, so it is unbiased for the band mean of L
@@ -30,15 +31,28 @@
 #include "physics/planck.h"
 #include "sensor/integrator.h"
 
-/* A scattered direction at `hit` (unit normal n_seen towards the side the ray came from):
- * cosine-distributed on that side (reflection), or leaving the other side with
- * mu ~ T(mu) mu (diffuse transmission). False if T is 0 there (cannot happen after a
- * transmission event). */
-static bool render_scatter_dir(const optics_point *o, vec3 n_seen, bool transmitted,
-                               rng_stream *rng, vec3 *dir)
+/* A scattered direction at `hit` (arriving along *dir; unit normal n_seen towards the
+ * side the ray came from): by the material's lobe on that side (reflection: cosine for
+ * a constant-R diffuse surface, else brdf_sample, whose weight multiplies *beta), or
+ * leaving the other side with mu ~ T(mu) mu (diffuse transmission). False if nothing
+ * can be sampled (T = 0 cannot happen after a transmission event; a glossy sample may
+ * fall below the surface). */
+static bool render_scatter_dir(const thz_scene *scene, const thz_object *obj, const accel_hit *hit,
+                               const optics_point *o, vec3 n_seen, bool transmitted,
+                               rng_stream *rng, vec3 *dir, double *beta)
 {
     if (!transmitted) {
-        *dir = sampling_direction(n_seen, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
+        if (o->lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(o)) {
+            *dir = sampling_direction(n_seen, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
+            return true;
+        }
+        brdf_frame f = scene_triangle_frame(obj, hit->triangle, hit->side);
+        brdf_lobe lobe;
+        scene_object_lobe(scene, obj, o, &lobe);
+        double w;
+        if (!brdf_sample(&lobe, &f, v3_scale(*dir, -1.0), sampling_uniform, rng, dir, &w))
+            return false;
+        *beta *= w;
         return true;
     }
     double m;
@@ -99,7 +113,7 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
             break;
         }
         optics_point o = scene_object_optics(scene, obj, nu);
-        double r = o.reflectivity;
+        double r = optics_reflectance(&o, hit.cos_theta);
         double tr = optics_transmission(&o, hit.cos_theta);
         double a = 1.0 - r - tr;
         double eps = o.explicit_emissivity ? o.emissivity : a;
@@ -114,7 +128,7 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
         const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
         vec3 n = v3_from_floats(nf);
         vec3 n_seen = hit.side == 0 ? n : v3_scale(n, -1.0);
-        if (!render_scatter_dir(&o, n_seen, transmitted, rng, &dir))
+        if (!render_scatter_dir(scene, obj, &hit, &o, n_seen, transmitted, rng, &dir, &beta))
             break;
     }
     return sum;
@@ -141,19 +155,20 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
     double beta = ctx->atmosphere ? render_tau(alpha, first->distance_m) : 1.0;
     const thz_object *obj = &scene->objects[first->object];
     optics_point o = scene_object_optics(scene, obj, nu);
-    double r = o.reflectivity;
+    double r = optics_reflectance(&o, first->cos_theta);
     double tr = optics_transmission(&o, first->cos_theta);
     const float *nf = &obj->mesh.normals[3 * (size_t)first->triangle];
     vec3 n = v3_from_floats(nf);
     vec3 n_seen = first->side == 0 ? n : v3_scale(n, -1.0);
     double sum = 0.0;
-    vec3 dir;
-    if (r > 0.0 && render_scatter_dir(&o, n_seen, false, rng, &dir))
-        sum += r * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta, rng, out);
+    vec3 dir = dir0;
+    double beta_r = beta;
+    if (r > 0.0 && render_scatter_dir(scene, obj, first, &o, n_seen, false, rng, &dir, &beta_r))
+        sum += r * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta_r, rng, out);
     if (tr > 0.0) {
         bool straight = scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
         dir = dir0;
-        if (straight || render_scatter_dir(&o, n_seen, true, rng, &dir))
+        if (straight || render_scatter_dir(scene, obj, first, &o, n_seen, true, rng, &dir, &beta))
             sum += tr * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta, rng, out);
     }
     out->paths++;

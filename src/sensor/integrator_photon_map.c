@@ -8,6 +8,26 @@
 
 #include "sensor/integrator.h"
 
+bool render_mirror(const render_context *ctx, const accel_hit *hit, render_path *path, vec3 *dir,
+                   vec3 *origin_m, render_sample *out)
+{
+    const thz_object *obj = &ctx->scene->objects[hit->object];
+    if (ctx->scene->materials[obj->material].reflection != REFLECTION_SPECULAR)
+        return false;
+    if (path->n == RENDER_MAX_CROSSINGS) {
+        out->truncated = 1;
+        return false;
+    }
+    vec3 n = v3_from_floats(&obj->mesh.normals[3 * (size_t)hit->triangle]);
+    *dir = v3_normalize(v3_sub(*dir, v3_scale(n, 2.0 * v3_dot(*dir, n))));
+    path->object[path->n] = hit->object;
+    path->mu[path->n] = hit->cos_theta;
+    path->reflected[path->n] = true;
+    path->n++;
+    *origin_m = accel_offset_origin(ctx->accel, hit, *dir);
+    return true;
+}
+
 /* The photon-map radiance along a ray (physics.md "Rendering phase"): emission and the
  * photon terms at the first hit, continued through straight shells. `path` and
  * `distance_m` carry what lies between the sensor and `origin_m` (final-gather's
@@ -45,8 +65,27 @@ double render_photon_map_trace(const render_context *ctx, vec3 origin_m, vec3 di
         bool shell = obj->type == OBJECT_SHELL;
         bool straight =
             shell && ctx->scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
-        render_gather(ctx, &hit, &path, scatter, distance_m, sample_sr, shell && !straight,
+        render_gather(ctx, &hit, dir, &path, scatter, distance_m, sample_sr, shell && !straight,
                       &radiance, out);
+        vec3 in_dir = dir;
+        if (render_mirror(ctx, &hit, &path, &dir, &origin_m, out)) {
+            if (!straight) {
+                ignore_object = hit.object;
+                ignore_triangle = hit.triangle;
+                crossings++;
+                continue;
+            }
+            /* a mirror that also lets light straight through: the mirror branch here,
+             * then on straight (path holds the bounce only in the branch) */
+            render_path branch = path;
+            path.n--;
+            if (path.n < RENDER_MIRROR_BRANCHES)
+                radiance += render_photon_map_trace(ctx, origin_m, dir, hit.object, hit.triangle,
+                                                    branch, distance_m, scatter, sample_sr, out);
+            else
+                out->truncated = 1;
+            dir = in_dir;
+        }
         if (!straight)
             return radiance;
         if (path.n == RENDER_MAX_CROSSINGS) {
@@ -55,6 +94,7 @@ double render_photon_map_trace(const render_context *ctx, vec3 origin_m, vec3 di
         }
         path.object[path.n] = hit.object;
         path.mu[path.n] = hit.cos_theta;
+        path.reflected[path.n] = false;
         path.n++;
         crossings++;
         origin_m = accel_offset_origin(ctx->accel, &hit, dir);

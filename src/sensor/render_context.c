@@ -18,6 +18,10 @@ static void render_context_fini(render_context *ctx)
     free(ctx->emission_mean);
     free(ctx->scatters);
     free(ctx->tbar);
+    free(ctx->rbar);
+    free(ctx->lobes);
+    free(ctx->ward_scale);
+    free(ctx->ward_comp);
     free(ctx->b0);
     free(ctx->source_mean);
     free(ctx->pair_mean);
@@ -41,10 +45,17 @@ static void render_pair_table(render_context *ctx)
     render_path none = {.n = 0};
     for (size_t x = 0; x < n_obj; x++) {
         render_scatter s = {.object_index = (uint32_t)x, .inv_branch = 1.0};
-        for (size_t y = 0; y < n_obj; y++)
-            table[x * n_obj + y] = ctx->scatters[x] && ctx->scene->objects[y].type == OBJECT_SOLID
+        /* only a constant-R Lambertian x weights y's terms by R(nu) alone, and only a solid
+         * y without an index emits the same at every angle */
+        const thz_material *mx = &ctx->scene->materials[ctx->scene->objects[x].material];
+        bool plain_x = !mx->index && mx->reflection == REFLECTION_DIFFUSE;
+        for (size_t y = 0; y < n_obj; y++) {
+            const thz_object *oy = &ctx->scene->objects[y];
+            table[x * n_obj + y] = ctx->scatters[x] && plain_x && oy->type == OBJECT_SOLID &&
+                                           !ctx->scene->materials[oy->material].index
                                        ? render_emission(ctx, (uint32_t)y, 1.0, &none, 0.0, &s)
                                        : NAN;
+        }
     }
     ctx->pair_mean = table;
 }
@@ -80,8 +91,13 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->b0 = thz_malloc_array(n, sizeof *ctx->b0);
     ctx->source_mean = thz_malloc_array(n_obj, sizeof *ctx->source_mean);
     ctx->tbar = thz_calloc(cells ? cells : 1, sizeof *ctx->tbar);
+    ctx->rbar = thz_calloc(cells ? cells : 1, sizeof *ctx->rbar);
+    ctx->lobes = thz_calloc(cells ? cells : 1, sizeof *ctx->lobes);
+    ctx->ward_scale = thz_calloc(cells ? cells : 1, sizeof *ctx->ward_scale);
+    ctx->ward_comp = thz_calloc(cells ? cells : 1, sizeof *ctx->ward_comp);
     if (!ctx->planck || !ctx->optics || !ctx->alpha_per_m || !ctx->emission_mean ||
-        !ctx->scatters || !ctx->b0 || !ctx->source_mean || !ctx->tbar) {
+        !ctx->scatters || !ctx->b0 || !ctx->source_mean || !ctx->tbar || !ctx->rbar ||
+        !ctx->lobes || !ctx->ward_scale || !ctx->ward_comp) {
         render_context_fini(ctx);
         return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
     }
@@ -93,12 +109,17 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     for (size_t o = 0; o < n_obj; o++) {
         const thz_object *obj = &scene->objects[o];
         const thz_material *mat = &scene->materials[obj->material];
-        bool angle_free = obj->type == OBJECT_SOLID || mat->emissivity.n > 0;
+        bool angle_free = (obj->type == OBJECT_SOLID && !mat->index) || mat->emissivity.n > 0;
         double mean = 0.0;
         for (size_t k = 0; k < n; k++) {
             double nu = ctx->quad.freq_hz[k];
             optics_point *op = &ctx->optics[o * n + k];
             *op = scene_object_optics(scene, obj, nu);
+            optics_prepare(op);
+            ctx->rbar[o * n + k] = optics_mean_reflectance(op);
+            scene_object_lobe(scene, obj, op, &ctx->lobes[o * n + k]);
+            ctx->ward_scale[o * n + k] = ctx->lobes[o * n + k].scale;
+            ctx->ward_comp[o * n + k] = ctx->lobes[o * n + k].comp_norm;
             ctx->planck[o * n + k] = planck_radiance(nu, obj->temperature_k);
             mean += ctx->quad.weight[k] * optics_emissivity(op, 1.0) * ctx->planck[o * n + k];
         }
@@ -106,8 +127,8 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         double r_min, r_max;
         spectrum_range(&mat->reflectivity, &r_min, &r_max);
         bool diffuse = obj->type == OBJECT_SHELL && mat->transmission == TRANSMISSION_DIFFUSE;
-        ctx->scatters[o] = r_max > 0.0 || diffuse;
-        for (size_t k = 0; diffuse && k < n; k++)
+        ctx->scatters[o] = r_max > 0.0 || diffuse || mat->index;
+        for (size_t k = 0; (diffuse || mat->index) && k < n; k++)
             ctx->tbar[o * n + k] = optics_mean_transmission(&ctx->optics[o * n + k]);
     }
     ctx->t0_k = map_t0              ? photon_map_reference_temperature_k(map)
@@ -125,7 +146,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
             sum += ctx->quad.weight[k] * (optics_emissivity(op, 1.0) * ctx->planck[o * n + k] -
                                           optics_absorption(op, 1.0) * ctx->b0[k]);
         }
-        ctx->source_mean[o] = scene->objects[o].type == OBJECT_SOLID ? sum : NAN;
+        const thz_object *obj = &scene->objects[o];
+        ctx->source_mean[o] =
+            obj->type == OBJECT_SOLID && !scene->materials[obj->material].index ? sum : NAN;
     }
     const thz_atmosphere *atm = &scene->atmosphere;
     ctx->emitting = atm->emitting;

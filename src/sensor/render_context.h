@@ -35,15 +35,21 @@ struct render_context {
     optics_point *optics;    /* [object * quad.n + node] */
     double *alpha_per_m;     /* [node]: atmospheric attenuation, 1/m */
     double *emission_mean;   /* [object]: band mean of eps B when eps does not depend on the
-                                angle (solids, explicit eps); NAN for the others */
+                                angle (solids without an index, explicit eps); NAN for the
+                                others */
     bool *scatters;          /* [object]: R > 0 somewhere, or a diffuse shell */
     double *tbar;            /* [object * quad.n + node]: T-bar of diffuse shells, else 0 */
+    double *rbar;            /* [object * quad.n + node]: R-bar */
+    brdf_lobe *lobes;        /* [object * quad.n + node]: the lobe at the node (its optics
+                                point is optics[] there, means cached) */
+    double *ward_scale;      /* [object * quad.n + node]: lobes[].scale and .comp_norm, */
+    double *ward_comp;       /* as tables for render_lobe_at's interpolation */
     bool atmosphere;         /* some node has alpha > 0 */
     double t0_k;             /* reference temperature T0, K: path's, or the photon map's */
     double b0_mean;          /* band mean of B(T0) */
     double *b0;              /* [node] B_nu(T0) */
-    double *source_mean;     /* [object] band mean of eps B - A B0 for solids; NAN for
-                                shells (angle-dependent) */
+    double *source_mean;     /* [object] band mean of eps B - A B0 for solids without an
+                                index; NAN for the others (angle-dependent) */
     bool deviation;          /* photon-map, final-gather: the map holds L - B(T0), T0 > 0,
                                 so every source term is eps B - A B0 (escapes, back faces,
                                 the air: minus B0) and the sample adds B0 back */

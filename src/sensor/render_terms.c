@@ -20,17 +20,18 @@ double render_path_weight(const render_context *ctx, const render_path *path, do
     for (size_t i = 0; i < path->n; i++) {
         const thz_object *obj = &ctx->scene->objects[path->object[i]];
         optics_point o = scene_object_optics(ctx->scene, obj, freq_hz);
-        w *= optics_transmission(&o, path->mu[i]);
+        w *= path->reflected[i] ? optics_reflectance(&o, path->mu[i])
+                                : optics_transmission(&o, path->mu[i]);
     }
     return w;
 }
 
-/* T-bar of diffuse shell `object` at freq_hz: linear interpolation of the table at the
- * (evenly spaced) quadrature nodes inside the band, the exact value outside. T-bar is
- * smooth in frequency, so the interpolation is exact to ~1e-8 over a node spacing of
- * 0.03 sigma; it spares an exponential integral per photon term. */
-double render_tbar(const render_context *ctx, const thz_object *obj, uint32_t object,
-                   double freq_hz)
+/* Linear interpolation of table[object * n + node] at freq_hz between the (evenly
+ * spaced) quadrature nodes inside the band; NAN outside. The tabled quantities are smooth
+ * in frequency, so the interpolation is exact to ~1e-8 over a node spacing of 0.03 sigma;
+ * it spares a quadrature per photon term. */
+static double render_interp(const render_context *ctx, const double *table, uint32_t object,
+                            double freq_hz)
 {
     size_t n = ctx->quad.n;
     if (n >= 2) {
@@ -39,18 +40,60 @@ double render_tbar(const render_context *ctx, const thz_object *obj, uint32_t ob
         if (x >= 0.0 && x < (double)(n - 1)) {
             size_t i = (size_t)x;
             double t = x - (double)i;
-            const double *tb = &ctx->tbar[(size_t)object * n];
+            const double *tb = &table[(size_t)object * n];
             return tb[i] + t * (tb[i + 1] - tb[i]);
         }
     }
+    return NAN;
+}
+
+/* T-bar of diffuse shell `object` at freq_hz: the table's interpolation inside the band,
+ * the exact value outside. */
+double render_tbar(const render_context *ctx, const thz_object *obj, uint32_t object,
+                   double freq_hz)
+{
+    double v = render_interp(ctx, ctx->tbar, object, freq_hz);
+    if (!isnan(v))
+        return v;
     optics_point o = scene_object_optics(ctx->scene, obj, freq_hz);
     return optics_mean_transmission(&o);
+}
+
+void render_lobe_at(const render_context *ctx, const thz_object *obj, uint32_t object,
+                    double freq_hz, optics_point *o, brdf_lobe *l)
+{
+    *o = scene_object_optics(ctx->scene, obj, freq_hz);
+    double rbar = render_interp(ctx, ctx->rbar, object, freq_hz);
+    if (o->has_index) {
+        if (isnan(rbar)) {
+            optics_prepare(o);
+        } else {
+            o->mean_r = rbar;
+            o->mean_t = render_interp(ctx, ctx->tbar, object, freq_hz);
+            o->means_ready = true;
+        }
+    }
+    double scale = render_interp(ctx, ctx->ward_scale, object, freq_hz);
+    if (o->lobe != OPTICS_LOBE_WARD || isnan(scale)) {
+        scene_object_lobe(ctx->scene, obj, o, l);
+        return;
+    }
+    l->o = o;
+    l->ward = ctx->scene->materials[obj->material].ward_table;
+    l->scale = scale;
+    l->comp_norm = render_interp(ctx, ctx->ward_comp, object, freq_hz);
 }
 
 double render_scatter_weight(const render_context *ctx, const render_scatter *s, double nu)
 {
     if (!s)
         return 1.0;
+    if (s->lobe) {
+        optics_point o;
+        brdf_lobe l;
+        render_lobe_at(ctx, s->object, s->object_index, nu, &o, &l);
+        return brdf_eval(&l, &s->frame, s->w_gather, s->w_view) * s->mu_i / s->pdf * s->inv_branch;
+    }
     if (!s->transmitted)
         return spectrum_eval(&s->material->reflectivity, nu) * s->inv_branch;
     /* f_T cos_i / pdf = T(nu,mu_i) T(nu,mu_o) / Tbar(nu) x Tbar(nu_j) / T(nu_j,mu_i) */
@@ -67,6 +110,10 @@ static double render_scatter_node(const render_context *ctx, const render_scatte
 {
     size_t n = ctx->quad.n;
     const optics_point *ox = &ctx->optics[(size_t)s->object_index * n + k];
+    if (s->lobe)
+        return brdf_eval(&ctx->lobes[(size_t)s->object_index * n + k], &s->frame, s->w_gather,
+                         s->w_view) *
+               s->mu_i / s->pdf;
     if (!s->transmitted)
         return ox->reflectivity;
     double tbar = ctx->tbar[(size_t)s->object_index * n + k];
@@ -85,8 +132,11 @@ static double render_node_weight(const render_context *ctx, const render_path *p
     double w = ctx->quad.weight[k];
     if (s)
         w *= render_scatter_node(ctx, s, k);
-    for (size_t i = 0; i < path->n && w != 0.0; i++)
-        w *= optics_transmission(&ctx->optics[(size_t)path->object[i] * n + k], path->mu[i]);
+    for (size_t i = 0; i < path->n && w != 0.0; i++) {
+        const optics_point *o = &ctx->optics[(size_t)path->object[i] * n + k];
+        w *= path->reflected[i] ? optics_reflectance(o, path->mu[i])
+                                : optics_transmission(o, path->mu[i]);
+    }
     return w;
 }
 
@@ -106,7 +156,7 @@ double render_emission(const render_context *ctx, uint32_t object, double mu,
             double v = (ctx->deviation ? ctx->source_mean : ctx->emission_mean)[object];
             if (!isnan(v))
                 return v;
-        } else if (ctx->pair_mean && !s->transmitted) {
+        } else if (ctx->pair_mean && !s->transmitted && !s->lobe) {
             double v = ctx->pair_mean[(size_t)s->object_index * ctx->scene->n_objects + object];
             if (!isnan(v))
                 return v * s->inv_branch;

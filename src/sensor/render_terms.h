@@ -14,12 +14,14 @@
 #include "accel/accel.h"
 #include "sensor/render_context.h"
 
-/* The `straight` shells a sample ray has passed through: the path weight at frequency nu
- * is the product of their T(theta) at nu. */
+/* The `straight` shells a sample ray has passed through and the mirrors (`specular`
+ * reflection) it has bounced off: the path weight at frequency nu is the product of
+ * their T(theta) and R(theta) at nu. */
 typedef struct render_path {
     size_t n;
     uint32_t object[RENDER_MAX_CROSSINGS];
     double mu[RENDER_MAX_CROSSINGS];
+    bool reflected[RENDER_MAX_CROSSINGS]; /* a mirror bounce (R), else a crossing (T) */
 } render_path;
 
 /* The scattering at a final-gather vertex x, as a weight on whatever arrives along the
@@ -29,12 +31,24 @@ typedef struct render_scatter {
     const thz_material *material;
     const thz_object *object;
     uint32_t object_index;
-    bool transmitted;  /* diffuse transmission (else Lambertian reflection) */
+    bool transmitted;  /* diffuse transmission (else reflection) */
+    bool lobe;         /* reflection by an angle-dependent or glossy lobe: the weight is
+                          f(nu; w_gather, w_view) mu_i / pdf (else a constant-R
+                          Lambertian one: R(nu)) */
     double mu_o;       /* |cos| of the direction towards the sensor at x */
     double mu_i;       /* |cos| of the gather ray at x */
     double pdf_ratio;  /* transmitted: Tbar(nu_j) / T(nu_j, mu_i) */
     double inv_branch; /* 1 / P(branch) */
+    brdf_frame frame;  /* lobe: the frame at x, and the directions away from x */
+    vec3 w_gather, w_view;
+    double pdf; /* lobe: the density of w_gather per solid angle at nu_j */
 } render_scatter;
+
+/* The optics of `object` (obj) at freq_hz with its means cached from the band's tables
+ * (interpolated as render_tbar), and its lobe (brdf.h; Ward's scale and complement
+ * interpolated likewise). o must outlive l. */
+void render_lobe_at(const render_context *ctx, const thz_object *obj, uint32_t object,
+                    double freq_hz, optics_point *o, brdf_lobe *l);
 
 /* exp(-alpha d), 1 where alpha = 0 (also for d infinite). */
 static inline double render_tau(double alpha_per_m, double distance_m)

@@ -22,7 +22,11 @@ static double test_scale(void)
 
 static optics_point shell(double r, double alpha, double t)
 {
-    return (optics_point){r, alpha, t, 0.0, false};
+    return (optics_point){.reflectivity = r,
+                          .attenuation_per_m = alpha,
+                          .thickness_m = t,
+                          .emissivity = 0.0,
+                          .explicit_emissivity = false};
 }
 
 /* 2 int_a^b X(mu) mu dmu by composite Simpson in long double (independent of the
@@ -66,7 +70,11 @@ static void test_pointwise(void **state)
         assert_true(fabs(optics_absorption(&o, mu) - (0.8 - t)) < 1e-15);
         assert_true(fabs(optics_emissivity(&o, mu) - (0.8 - t)) < 1e-15);
     }
-    optics_point solid = {0.3, 50.0, 0.0, 0.0, false};
+    optics_point solid = {.reflectivity = 0.3,
+                          .attenuation_per_m = 50.0,
+                          .thickness_m = 0.0,
+                          .emissivity = 0.0,
+                          .explicit_emissivity = false};
     assert_true(optics_transmission(&solid, 0.5) == 0.0);
     assert_true(fabs(optics_absorption(&solid, 0.5) - 0.7) < 1e-15);
     assert_true(fabs(optics_emissivity(&solid, 0.5) - 0.7) < 1e-15);
@@ -113,10 +121,18 @@ static void test_means_capped(void **state)
         double eref = hemi_mean(&o, optics_emissivity);
         assert_true(fabs(ebar - eref) <= 1e-9 * (eref > 1e-6 ? eref : 1e-6));
     }
-    optics_point solid = {0.25, 10.0, 0.0, 0.0, false};
+    optics_point solid = {.reflectivity = 0.25,
+                          .attenuation_per_m = 10.0,
+                          .thickness_m = 0.0,
+                          .emissivity = 0.0,
+                          .explicit_emissivity = false};
     assert_true(optics_mean_transmission(&solid) == 0.0);
     assert_true(fabs(optics_mean_emissivity(&solid) - 0.75) < 1e-15);
-    optics_point expl = {0.25, 10.0, 0.01, 0.4, true};
+    optics_point expl = {.reflectivity = 0.25,
+                         .attenuation_per_m = 10.0,
+                         .thickness_m = 0.01,
+                         .emissivity = 0.4,
+                         .explicit_emissivity = true};
     assert_true(fabs(optics_mean_emissivity(&expl) - 0.4) < 1e-15);
 }
 
@@ -125,12 +141,20 @@ static void test_kirchhoff_violation(void **state)
     (void)state;
     optics_point o = shell(0.2, 100.0, 0.002);
     assert_true(optics_kirchhoff_violation(&o) == 0.0);
-    optics_point solid = {0.3, 0.0, 0.0, 0.68, true};
+    optics_point solid = {.reflectivity = 0.3,
+                          .attenuation_per_m = 0.0,
+                          .thickness_m = 0.0,
+                          .emissivity = 0.68,
+                          .explicit_emissivity = true};
     assert_true(fabs(optics_kirchhoff_violation(&solid) - 0.02) < 1e-15);
     /* explicit eps on a shell: compare with a fine scan over mu */
     static const double epss[] = {0.0, 0.1, 0.5, 0.8};
     for (size_t k = 0; k < 4; k++) {
-        optics_point e = {0.2, 100.0, 0.002, epss[k], true};
+        optics_point e = {.reflectivity = 0.2,
+                          .attenuation_per_m = 100.0,
+                          .thickness_m = 0.002,
+                          .emissivity = epss[k],
+                          .explicit_emissivity = true};
         double worst = 0.0;
         for (int i = 1; i <= 100000; i++) {
             double mu = i / 100000.0;
@@ -210,12 +234,16 @@ static void test_sample_emission(void **state)
 {
     (void)state;
     const optics_point cases[] = {
-        shell(0.2, 50.0, 0.01),       /* tau 0.5 */
-        shell(0.0, 0.01, 0.01),       /* tau 1e-4: eps ~ tau/mu, nearly uniform in mu */
-        shell(0.3, 5.0, 0.01),        /* capped: eps = 0 above mu* */
-        shell(0.1, 1000.0, 0.01),     /* tau 10: nearly constant */
-        {0.4, 10.0, 0.0, 0.0, false}, /* solid: cosine */
-        {0.4, 10.0, 0.01, 0.3, true}, /* explicit: cosine */
+        shell(0.2, 50.0, 0.01),   /* tau 0.5 */
+        shell(0.0, 0.01, 0.01),   /* tau 1e-4: eps ~ tau/mu, nearly uniform in mu */
+        shell(0.3, 5.0, 0.01),    /* capped: eps = 0 above mu* */
+        shell(0.1, 1000.0, 0.01), /* tau 10: nearly constant */
+        {.reflectivity = 0.4, .attenuation_per_m = 10.0}, /* solid: cosine */
+        {.reflectivity = 0.4,
+         .attenuation_per_m = 10.0,
+         .thickness_m = 0.01,
+         .emissivity = 0.3,
+         .explicit_emissivity = true}, /* explicit: cosine */
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
         check_histogram(&cases[i], optics_sample_emission_mu, optics_emissivity, 100 + i);
@@ -227,9 +255,17 @@ static void test_sample_zero(void **state)
     rng_stream rng;
     rng_init(&rng, 1, 0, RNG_PURPOSE_TEST, 0);
     double mu = 0.5;
-    optics_point solid = {0.4, 10.0, 0.0, 0.0, false};
+    optics_point solid = {.reflectivity = 0.4,
+                          .attenuation_per_m = 10.0,
+                          .thickness_m = 0.0,
+                          .emissivity = 0.0,
+                          .explicit_emissivity = false};
     assert_false(optics_sample_transmission_mu(&solid, next_uniform, &rng, &mu));
-    optics_point mirror = {1.0, 10.0, 0.0, 0.0, false};
+    optics_point mirror = {.reflectivity = 1.0,
+                           .attenuation_per_m = 10.0,
+                           .thickness_m = 0.0,
+                           .emissivity = 0.0,
+                           .explicit_emissivity = false};
     assert_false(optics_sample_emission_mu(&mirror, next_uniform, &rng, &mu));
     optics_point mirror_shell = shell(1.0, 10.0, 0.01);
     assert_false(optics_sample_transmission_mu(&mirror_shell, next_uniform, &rng, &mu));
@@ -237,7 +273,11 @@ static void test_sample_zero(void **state)
     optics_point clear = shell(0.1, 0.0, 0.01); /* no absorption: no emission */
     assert_false(optics_sample_emission_mu(&clear, next_uniform, &rng, &mu));
     assert_true(optics_mean_emissivity(&clear) == 0.0);
-    optics_point zero_eps = {0.1, 10.0, 0.01, 0.0, true};
+    optics_point zero_eps = {.reflectivity = 0.1,
+                             .attenuation_per_m = 10.0,
+                             .thickness_m = 0.01,
+                             .emissivity = 0.0,
+                             .explicit_emissivity = true};
     assert_false(optics_sample_emission_mu(&zero_eps, next_uniform, &rng, &mu));
     assert_true(mu == 0.5);
 }

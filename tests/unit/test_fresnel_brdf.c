@@ -1,0 +1,180 @@
+/* Fresnel interface and slab (fresnel.h), angle-dependent optics from an index
+ * (optics.h) and the reflection lobes (brdf.h): closed forms, energy balance, Ward's
+ * reciprocity and the lobes' directional albedo by independent quadrature. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "physics/brdf.h"
+#include "physics/fresnel.h"
+#include "physics/optics.h"
+
+static void test_normal_incidence(void **state)
+{
+    (void)state;
+    const double n[] = {1.5, 3.4, 2.0, 0.3}, k[] = {0.0, 0.0, 0.5, 8.0};
+    for (int i = 0; i < 4; i++) {
+        double expect =
+            ((n[i] - 1) * (n[i] - 1) + k[i] * k[i]) / ((n[i] + 1) * (n[i] + 1) + k[i] * k[i]);
+        assert_true(fabs(fresnel_reflectance(n[i], k[i], 1.0) - expect) <= 1e-14);
+    }
+    /* real index at 45 degrees: r_s, r_p from Snell's law */
+    double ci = sqrt(0.5), st = sqrt(0.5) / 1.5, ct = sqrt(1 - st * st);
+    double rs = (ci - 1.5 * ct) / (ci + 1.5 * ct), rp = (1.5 * ci - ct) / (1.5 * ci + ct);
+    assert_true(fabs(fresnel_reflectance(1.5, 0.0, ci) - 0.5 * (rs * rs + rp * rp)) <= 1e-14);
+    /* grazing: everything reflected */
+    assert_true(fabs(fresnel_reflectance(2.0, 0.3, 1e-9) - 1.0) <= 1e-7);
+}
+
+static void test_slab(void **state)
+{
+    (void)state;
+    double r = fresnel_reflectance(1.7, 0.0, 1.0), refl, trans;
+    fresnel_slab(1.7, 0.0, 1.0, 0.0, 0.01, &refl, &trans);
+    assert_true(fabs(refl - 2 * r / (1 + r)) <= 1e-14);
+    assert_true(fabs(refl + trans - 1.0) <= 1e-14);
+    /* absorbing: R + T + A = 1 with A >= 0 at every angle, and A grows with k */
+    optics_point o = {
+        .has_index = true, .n = 1.9, .k = 0.02, .freq_hz = 0.5e12, .thickness_m = 0.003};
+    for (int i = 1; i <= 100; i++) {
+        double mu = i / 100.0;
+        double rr = optics_reflectance(&o, mu), tt = optics_transmission(&o, mu);
+        double aa = optics_absorption(&o, mu);
+        assert_true(aa >= 0.0 && rr > 0.0 && tt > 0.0);
+        assert_true(fabs(rr + tt + aa - 1.0) <= 1e-14);
+        assert_true(fabs(optics_emissivity(&o, mu) - aa) <= 1e-15);
+    }
+    /* normal incidence: alpha = 4 pi k nu / c along t, tau = exp(-alpha t) */
+    double alpha = 4 * M_PI * 0.02 * 0.5e12 / 299792458.0, tau = exp(-alpha * 0.003);
+    double r0 = fresnel_reflectance(1.9, 0.02, 1.0);
+    double t_expect = (1 - r0) * (1 - r0) * tau / (1 - r0 * r0 * tau * tau);
+    assert_true(fabs(optics_transmission(&o, 1.0) - t_expect) <= 1e-12);
+}
+
+/* Hemispherical means: Gauss-Legendre against composite Simpson with 20000 intervals. */
+static void test_means(void **state)
+{
+    (void)state;
+    optics_point cases[] = {
+        {.has_index = true, .n = 2.1, .k = 0.35, .freq_hz = 1e12},
+        {.has_index = true, .n = 0.4, .k = 9.0, .freq_hz = 1e12},
+        {.has_index = true, .n = 1.5, .k = 0.01, .freq_hz = 1e12, .thickness_m = 0.002},
+    };
+    for (size_t c = 0; c < 3; c++) {
+        const int m = 20000;
+        double sr = 0.0, st = 0.0;
+        for (int i = 0; i <= m; i++) {
+            double mu = (double)i / m, w = (i == 0 || i == m) ? 1 : (i % 2 ? 4 : 2);
+            double x = mu > 0 ? mu : 1e-300;
+            sr += w * optics_reflectance(&cases[c], x) * mu;
+            st += w * optics_transmission(&cases[c], x) * mu;
+        }
+        sr *= 2.0 / (3.0 * m);
+        st *= 2.0 / (3.0 * m);
+        assert_true(fabs(optics_mean_reflectance(&cases[c]) - sr) <= 1e-10);
+        assert_true(fabs(optics_mean_transmission(&cases[c]) - st) <= 1e-10);
+        assert_true(fabs(optics_mean_emissivity(&cases[c]) - (1 - sr - st)) <= 1e-10);
+    }
+}
+
+/* Sampling mu ~ R(mu) mu: histogram against the law, 200000 samples in 10 bins. */
+static void test_sample_reflection(void **state)
+{
+    (void)state;
+    optics_point o = {.has_index = true, .n = 2.1, .k = 0.35, .freq_hz = 1e12};
+    rng_stream rng;
+    rng_init(&rng, 11, 0, 0, 0);
+    const int n = 200000, bins = 10;
+    int hist[10] = {0};
+    for (int i = 0; i < n; i++) {
+        double mu;
+        assert_true(optics_sample_reflection_mu(&o, sampling_uniform, &rng, &mu));
+        hist[(int)fmin(mu * bins, bins - 1)]++;
+    }
+    double total = optics_mean_reflectance(&o) / 2.0;
+    for (int b = 0; b < bins; b++) {
+        double p = 0.0;
+        for (int j = 0; j < 1000; j++) {
+            double mu = (b + (j + 0.5) / 1000.0) / bins;
+            p += optics_reflectance(&o, mu) * mu / (1000.0 * bins);
+        }
+        double expect = n * p / total, sd = sqrt(expect);
+        assert_true(fabs(hist[b] - expect) <= 5 * sd);
+    }
+}
+
+static vec3 dir_at(double mu, double phi)
+{
+    double s = sqrt(fmax(0.0, 1 - mu * mu));
+    return v3(s * cos(phi), s * sin(phi), mu);
+}
+
+/* int f(wi, wo) cos(theta_o) dwo by a midpoint rule in (cos theta, phi). */
+static double albedo(const brdf_lobe *l, const brdf_frame *f, vec3 wi)
+{
+    const int nm = 600, np = 600;
+    double sum = 0.0;
+    for (int i = 0; i < nm; i++) {
+        double mu = (i + 0.5) / nm;
+        for (int j = 0; j < np; j++) {
+            vec3 wo = dir_at(mu, 2 * M_PI * (j + 0.5) / np);
+            sum += brdf_eval(l, f, wi, wo) * mu;
+        }
+    }
+    return sum * (1.0 / nm) * (2 * M_PI / np);
+}
+
+static void test_ward(void **state)
+{
+    (void)state;
+    brdf_ward_table *table = brdf_ward_table_create(0.2, 0.45);
+    assert_non_null(table);
+    brdf_frame f = {.n = v3(0, 0, 1), .t = v3(1, 0, 0), .b = v3(0, 1, 0)};
+    optics_point cases[] = {
+        {.has_index = true, .n = 3.0, .k = 0.5, .freq_hz = 1e12, .lobe = OPTICS_LOBE_WARD},
+        {.reflectivity = 0.7, .lobe = OPTICS_LOBE_WARD},
+        {.has_index = true, .n = 1.6, .k = 0.05, .freq_hz = 1e12, .lobe = OPTICS_LOBE_DIFFUSE},
+    };
+    rng_stream rng;
+    rng_init(&rng, 5, 0, 0, 0);
+    for (size_t c = 0; c < 3; c++) {
+        brdf_lobe l;
+        brdf_lobe_init(&l, &cases[c], table);
+        /* reciprocity at random pairs */
+        for (int i = 0; i < 1000; i++) {
+            vec3 a = dir_at(rng_uniform(&rng), 2 * M_PI * rng_uniform(&rng));
+            vec3 b = dir_at(rng_uniform(&rng), 2 * M_PI * rng_uniform(&rng));
+            double fab = brdf_eval(&l, &f, a, b), fba = brdf_eval(&l, &f, b, a);
+            assert_true(fabs(fab - fba) <= 1e-12 * fmax(fab, 1.0));
+        }
+        /* directional-hemispherical reflectance = R(theta) within 0.5 % */
+        const double thetas[] = {0.0, 30.0, 60.0, 80.0};
+        for (int t = 0; t < 4; t++) {
+            double mu = cos(thetas[t] * M_PI / 180.0);
+            vec3 wi = dir_at(mu, 0.7);
+            double a = albedo(&l, &f, wi), r = optics_reflectance(&cases[c], mu);
+            print_message("lobe %zu at %g deg: albedo %.5f, R %.5f (%+.3f %%)\n", c, thetas[t], a,
+                          r, 100 * (a / r - 1));
+            assert_true(fabs(a / r - 1.0) <= 0.005);
+        }
+    }
+    brdf_ward_table_destroy(table);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_normal_incidence),
+        cmocka_unit_test(test_slab),
+        cmocka_unit_test(test_means),
+        cmocka_unit_test(test_sample_reflection),
+        cmocka_unit_test(test_ward),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
