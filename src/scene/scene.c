@@ -64,6 +64,8 @@ void scene_destroy(thz_scene *s)
     for (size_t i = 0; i < s->n_sensors; i++)
         free(s->sensors[i].name);
     free(s->sensors);
+    for (size_t i = 0; s->channels && i < s->n_channels; i++)
+        channel_fini(&s->channels[i]);
     free(s->channels);
     atmosphere_fini(&s->atmosphere);
     for (size_t i = 0; i < s->n_warnings; i++)
