@@ -5,8 +5,9 @@ JOBS ?= $(shell nproc)
 BUILD ?= build
 ASAN_BUILD ?= build-asan
 DEMO_OUT ?= out/teraeye
+PREFIX ?= /usr/local
 
-.PHONY: all deps build demo check test test-asan bench format clean
+.PHONY: all deps build install demo check test test-asan bench format clean
 
 all: build
 
@@ -16,6 +17,12 @@ deps:
 build: deps
 	cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 	cmake --build $(BUILD) -j $(JOBS)
+
+# The CLI, library, headers, pkg-config file, man page, data and Python package under
+# PREFIX; the set-up commands run it (as root) before the demo or the tests.
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX) >/dev/null
+	@echo "installed thzmap under $(PREFIX)"
 
 demo: build
 	bash scripts/demo.sh $(BUILD)/thzmap $(DEMO_OUT)

@@ -11,4 +11,11 @@ case "${1:-}" in
   *) echo "usage: bash scripts/setup.sh demo|check" >&2; exit 2 ;;
 esac
 bash scripts/install-deps.sh
+# Build and install under /usr/local (CLI, libthzmap, headers, thzmap.pc, man page, data,
+# and the Python package where Debian's python3 finds it), then check that a python3
+# started elsewhere, with no PYTHONPATH, imports the installed package.
+make install PREFIX=/usr/local
+ldconfig 2>/dev/null || true
+(cd / && env -u PYTHONPATH -u THZMAP_LIBRARY /usr/bin/python3 -c \
+  'import thzmap; print("setup: python3 imports thzmap from", thzmap.__file__, "using", thzmap.library_path)')
 exec make "$1"

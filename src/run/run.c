@@ -237,6 +237,13 @@ double run_photon_t0_k(const thz_scene *scene, size_t c)
                : 0.0;
 }
 
+/* a + b, or UINT64_MAX when the sum does not fit (estimates of absurd runs saturate, so
+ * that they are refused instead of wrapping to a small number). */
+static uint64_t run_add_bytes(uint64_t a, uint64_t b)
+{
+    return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
+
 /* Estimates the memory of a simulate run and refuses it if it would not fit. */
 static thz_status run_simulate_memory(run_state *rs, bool photons, thz_error *err)
 {
@@ -250,13 +257,13 @@ static thz_status run_simulate_memory(run_state *rs, bool photons, thz_error *er
                                                         run_photon_t0_k(rs->scene, c), &b, err);
             if (st != THZ_OK)
                 return st;
-            sum += b;
+            sum = run_add_bytes(sum, b);
             max = b > max ? b : max;
         }
         /* kept maps, plus one map while it is built (records and index) */
-        need.photon_bytes = (rs->opt->keep_photon_maps ? sum : max) + max;
+        need.photon_bytes = run_add_bytes(rs->opt->keep_photon_maps ? sum : max, max);
     }
-    need.total_bytes = need.photon_bytes + need.image_bytes;
+    need.total_bytes = run_add_bytes(need.photon_bytes, need.image_bytes);
     rs->memory_bytes = need.total_bytes;
     return run_check_memory(rs->scene, &need, err);
 }

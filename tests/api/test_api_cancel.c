@@ -85,6 +85,20 @@ int main(int argc, char **argv)
     CHECK(!empty_or_missing(out), "%s empty after a write", out);
     thz_run_destroy(run);
 
+    /* photon counts whose memory estimate overflows 64 bits are refused at once (they
+     * once wrapped to a small estimate and started firing 2^60 photons) */
+    thz_context_set_progress(ctx, NULL, NULL);
+    const uint64_t huge[] = {(uint64_t)1 << 60, UINT64_MAX};
+    for (size_t k = 0; k < sizeof huge / sizeof huge[0]; k++) {
+        thz_run_settings big = {.photons_per_channel = huge[k]};
+        run = NULL;
+        st = thz_simulate(ctx, scene, &big, &run, &err);
+        CHECK(st == THZ_ERR_LIMIT, "%llu photons: %s (%s)", (unsigned long long)huge[k],
+              thz_status_name(st), err.message);
+        CHECK(run == NULL, "%llu photons: a run came back", (unsigned long long)huge[k]);
+        thz_run_destroy(run);
+    }
+
     thz_context_destroy(ctx);
     thz_scene_destroy(scene);
     if (test_failures == 0)
