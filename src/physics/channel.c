@@ -1,7 +1,7 @@
 /* Channel responses (Gaussian or a measured table), sampling and band-mean quadrature
- * (physics.md "Channels"). Every function handles both: the Gaussian's code paths are
- * those the outputs were first checksummed with; a table's are exact for its
- * piecewise-linear g (channel_table.c would be one file more for ~150 lines). */
+ * (physics.md "Channels"). Every function handles both: the Gaussian's arithmetic is
+ * unchanged from before tables existed (outputs stay bit-identical); a table's is exact
+ * for its piecewise-linear g. */
 #include "physics/channel.h"
 
 #include <math.h>
