@@ -61,7 +61,7 @@ thz_status channel_set_response(thz_channel *ch, size_t n, const double *freq_hz
     area[0] = 0.0;
     for (size_t i = 0; i < n; i++) {
         f[i] = freq_hz[i];
-        w[i] = weight[i] / peak;
+        w[i] = weight[i];
         if (i == 0)
             continue;
         double h = f[i] - f[i - 1];
@@ -163,17 +163,21 @@ double channel_fwhm_hz(const thz_channel *ch)
         return ch->relative_width * ch->center_hz;
     const double *f = ch->response_hz, *w = ch->response_weight;
     size_t n = ch->n_response, first = 0, last = n - 1;
-    while (w[first] < 0.5)
-        first++; /* the peak is 1: both loops stop */
-    while (w[last] < 0.5)
+    double half = 0.0;
+    for (size_t i = 0; i < n; i++)
+        half = w[i] > half ? w[i] : half;
+    half *= 0.5;
+    while (w[first] < half)
+        first++; /* the peak is >= half: both loops stop */
+    while (w[last] < half)
         last--;
-    /* g rises through 1/2 on the piece before `first` (or jumps there at the table's
-     * start), falls through it after `last` */
+    /* g rises through half its peak on the piece before `first` (or jumps there at the
+     * table's start), falls through it after `last` */
     double lo = first == 0 ? f[0]
-                           : f[first - 1] + (f[first] - f[first - 1]) * (0.5 - w[first - 1]) /
+                           : f[first - 1] + (f[first] - f[first - 1]) * (half - w[first - 1]) /
                                                 (w[first] - w[first - 1]);
     double hi = last == n - 1 ? f[n - 1]
-                              : f[last] + (f[last + 1] - f[last]) * (w[last] - 0.5) /
+                              : f[last] + (f[last + 1] - f[last]) * (w[last] - half) /
                                               (w[last] - w[last + 1]);
     return hi - lo;
 }
@@ -425,8 +429,8 @@ static void channel_adapt_panel(channel_adapt *a, double x0, double x2, const do
 /* A table's base panels (as channel_quadrature_table's for CHANNEL_QUADRATURE_NODES),
  * each refined adaptively. Two passes: the first sums |g f| for the tolerance's scale
  * (no allocation; f is evaluated twice on the base nodes). */
-static double channel_band_mean_table(const thz_channel *ch,
-                                      double (*f)(double freq_hz, void *ctx), void *ctx)
+static double channel_band_mean_table(const thz_channel *ch, double (*f)(double freq_hz, void *ctx),
+                                      void *ctx)
 {
     channel_adapt a = {ch, 0.0, f, ctx, 0.0, 0.0};
     const size_t panels = (CHANNEL_QUADRATURE_NODES - 1) / 2;

@@ -3,7 +3,8 @@
  * A channel's response g_c is either the Gaussian
  * g_c(nu) = exp(-(nu - nu_c)^2 / (2 sigma_c^2)), sigma_c = w_c nu_c / (2 sqrt(2 ln 2)),
  * or a measured table (scene-format.md "Channels: measured spectral response"): linear
- * interpolation between its points, 0 outside them, scaled to a peak of 1.
+ * interpolation between its points, 0 outside them, the weights as given (so that B_c
+ * keeps a filter's transmission; band means and B_n do not depend on their scale).
  * A channel value is the response-weighted mean X_c = int g X dnu / int g dnu.
  */
 #ifndef THZ_PHYSICS_CHANNEL_H
@@ -18,8 +19,8 @@ typedef struct thz_channel {
     double center_hz;      /* nu_c; of a table: as given, else the response-weighted mean */
     double relative_width; /* w_c = FWHM / nu_c, 0 < w <= 0.5; 0 for a table */
     /* The measured response (n_response == 0: the Gaussian): n_response >= 2 strictly
-     * increasing frequencies, weights >= 0 with a peak of 1, and the cumulative integral
-     * of g from the first point to each point (Hz). Owned; channel_fini frees them. */
+     * increasing frequencies, weights >= 0 not all 0, and the cumulative integral of g
+     * from the first point to each point (Hz). Owned; channel_fini frees them. */
     size_t n_response;
     double *response_hz;
     double *response_weight;
@@ -30,9 +31,9 @@ typedef struct thz_channel {
 #define CHANNEL_FWHM_PER_SIGMA 2.3548200450309493
 
 /* Makes ch a table channel: copies the n points (freq_hz > 0 strictly increasing,
- * weight >= 0 not all 0: the loader has checked), scales the weights to a peak of 1 and,
- * when centre_hz is not > 0, sets nu_c to the response-weighted mean frequency
- * int nu g dnu / int g dnu. THZ_ERR_NOMEM or THZ_ERR_INPUT (a bad table). */
+ * weight >= 0 not all 0: the loader has checked) and, when centre_hz is not > 0, sets
+ * nu_c to the response-weighted mean frequency int nu g dnu / int g dnu. THZ_ERR_NOMEM
+ * or THZ_ERR_INPUT (a bad table). */
 thz_status channel_set_response(thz_channel *ch, size_t n, const double *freq_hz,
                                 const double *weight, double centre_hz, thz_error *err);
 
@@ -45,8 +46,8 @@ static inline int channel_has_response(const thz_channel *ch)
     return ch->n_response > 0;
 }
 
-/* sigma_c in Hz. For a table, the sigma of the Gaussian of the same peak and area,
- * B_c / sqrt(2 pi): a scale, never a span (spans come from channel_support_hz). */
+/* sigma_c in Hz. For a table, B_c / sqrt(2 pi) (the sigma of the peak-1 Gaussian of the
+ * same area): a scale, never a span (spans come from channel_support_hz). */
 double channel_sigma_hz(const thz_channel *ch);
 
 /* The frequencies outside which g_c is 0 or negligible: the Gaussian's nu_c +- sigmas
@@ -55,7 +56,7 @@ double channel_sigma_hz(const thz_channel *ch);
 void channel_support_hz(const thz_channel *ch, double sigmas, double *lo_hz, double *hi_hz);
 
 /* Full width at half maximum in Hz: w_c nu_c for the Gaussian; for a table, between the
- * outermost frequencies where g_c crosses 1/2 (ENVI's `fwhm`, the plots' bands). */
+ * outermost frequencies where g_c crosses half its peak (ENVI's `fwhm`). */
 double channel_fwhm_hz(const thz_channel *ch);
 
 /* Equivalent bandwidth B_c = int g_c dnu in Hz: sigma_c sqrt(2 pi) for the Gaussian,
@@ -67,7 +68,7 @@ double channel_bandwidth_hz(const thz_channel *ch);
  * (g^2 of a linear piece integrates to h (a^2 + ab + b^2) / 3). */
 double channel_noise_bandwidth_hz(const thz_channel *ch);
 
-/* g_c(freq_hz): 1 at the Gaussian's centre and at a table's peak, 0 outside a table. */
+/* g_c(freq_hz): 1 at the Gaussian's centre; a table's interpolated weight, 0 outside it. */
 double channel_response(const thz_channel *ch, double freq_hz);
 
 /* A frequency drawn from g_c (Gaussian) given two uniforms in [0,1); the non-positive

@@ -46,11 +46,11 @@ printf '# triangle\nfrequency_thz,weight\n0.58,0\n0.60,2\n0.62,0\n' >"$tmp/tri.c
 scene 0.36 '{"model": "none"}' >"$tmp/scene.json"
 
 "$thzmap" validate "$tmp/scene.json" >"$tmp/out" 2>"$tmp/err" || fail "validate: $(cat "$tmp/err")"
-# top-hat: B_c = B_n = FWHM = 20 GHz, centre its middle; triangle of base 40 GHz:
-# B_c = 20, B_n = 30 GHz, centre its centroid 0.6 THz; 1 % Gaussian at 0.35 THz:
+# top-hat: B_c = B_n = FWHM = 20 GHz, centre its middle; triangle of base 40 GHz and
+# peak 2: B_c = 40, B_n = 30, FWHM 20 GHz, centre its centroid 0.6 THz; 1 % Gaussian at 0.35 THz:
 # FWHM 3.5, B_c = 1.0645 FWHM = 3.726, B_n = 1.5054 FWHM = 5.269 GHz
 expect_line "$tmp/out" 'hat +centre 0\.3500 THz +FWHM 20\.000 GHz +bandwidth B_c 20\.000 GHz +noise bandwidth B_n 20\.000 GHz +measured response \(2 points\)'
-expect_line "$tmp/out" 'tri +centre 0\.6000 THz +FWHM 20\.000 GHz +bandwidth B_c 20\.000 GHz +noise bandwidth B_n 30\.000 GHz +measured response \(3 points\)'
+expect_line "$tmp/out" 'tri +centre 0\.6000 THz +FWHM 20\.000 GHz +bandwidth B_c 40\.000 GHz +noise bandwidth B_n 30\.000 GHz +measured response \(3 points\)'
 expect_line "$tmp/out" 'gauss +centre 0\.3500 THz +FWHM 3\.500 GHz +bandwidth B_c 3\.726 GHz +noise bandwidth B_n 5\.269 GHz +Gaussian'
 
 # an atmosphere model tabulated over the measured bands
@@ -64,7 +64,7 @@ import json, sys
 ch = json.load(open(sys.argv[1]))["channels"]
 assert [c["response"] for c in ch] == ["table", "table", "gaussian"], ch
 assert ch[0]["relative_width"] is None and ch[2]["relative_width"] == 0.01
-assert abs(ch[1]["bandwidth_ghz"] - 20) < 1e-9 and abs(ch[1]["noise_bandwidth_ghz"] - 30) < 1e-9
+assert abs(ch[1]["bandwidth_ghz"] - 40) < 1e-9 and abs(ch[1]["noise_bandwidth_ghz"] - 30) < 1e-9
 PY
 expect_line "$tmp/sim/cam.radiance.hdr" '^fwhm = \{20, 20, 3\.5\}'
 

@@ -1,5 +1,5 @@
 /* The loader's measured channel responses: inline tables and CSV files (centre given or
- * the response-weighted mean, weights scaled to a peak of 1), and the refusals with their
+ * the response-weighted mean, weights as given), and the refusals with their
  * JSON paths or file:line (negative weight, all zero, not ascending, too few points, a
  * missing file, a wrong column, two responses, none). */
 #include <math.h>
@@ -58,13 +58,13 @@ static void test_tables(void **state)
     assert_int_equal(s->n_channels, 4);
     const thz_channel *hat = &s->channels[0], *tri = &s->channels[1], *skew = &s->channels[2];
     assert_int_equal(hat->n_response, 2);
-    assert_true(hat->response_weight[0] == 1.0 && hat->response_weight[1] == 1.0);
+    assert_true(hat->response_weight[0] == 4.0 && hat->response_weight[1] == 4.0);
     assert_true(fabs(hat->center_hz - 0.35e12) < 1.0);
-    assert_true(fabs(channel_bandwidth_hz(hat) - 0.02e12) < 1.0);
+    assert_true(fabs(channel_bandwidth_hz(hat) - 0.08e12) < 1.0); /* weights as given */
     assert_int_equal(tri->n_response, 3);
     assert_true(tri->center_hz == 0.605e12); /* as given */
-    assert_true(tri->response_weight[1] == 1.0);
-    assert_true(fabs(channel_bandwidth_hz(tri) - 0.02e12) < 1.0);
+    assert_true(tri->response_weight[1] == 2.0);
+    assert_true(fabs(channel_bandwidth_hz(tri) - 0.04e12) < 1.0);
     assert_true(fabs(skew->center_hz - 2.0e12 / 3.0) < 1.0); /* (0.5 + 0.6 + 0.9) / 3 THz */
     assert_string_equal(skew->name, "0.667 THz");            /* named by its centre */
     assert_int_equal(s->channels[3].n_response, 0);

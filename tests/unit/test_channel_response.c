@@ -20,7 +20,7 @@ static int close_rel(double a, double b, double rel)
     return fabs(a - b) <= rel * fabs(b);
 }
 
-/* A table channel from points in THz (weights as given: the channel scales them). */
+/* A table channel from points in THz. */
 static thz_channel table_channel(const double *thz, const double *w, size_t n, double centre_thz)
 {
     thz_channel ch = {.name = "t"};
@@ -78,19 +78,20 @@ static void test_gaussian_noise_bandwidth(void **state)
 static void test_top_hat(void **state)
 {
     (void)state;
-    const double thz[] = {0.34, 0.36}, w[] = {3.0, 3.0}; /* weights scale to a peak of 1 */
+    const double thz[] = {0.34, 0.36}, w[] = {3.0, 3.0}; /* a top-hat of height 3 */
     thz_channel ch = table_channel(thz, w, 2, 0.0);
     const double width = 0.02e12;
     assert_true(channel_has_response(&ch));
     assert_true(ch.relative_width == 0.0);
-    assert_true(close_rel(channel_bandwidth_hz(&ch), width, 1e-12));
+    /* B_c = int g keeps the weights' scale, B_n and the FWHM do not depend on it */
+    assert_true(close_rel(channel_bandwidth_hz(&ch), 3.0 * width, 1e-12));
     assert_true(close_rel(channel_noise_bandwidth_hz(&ch), width, 1e-12));
     assert_true(close_rel(channel_fwhm_hz(&ch), width, 1e-12));
     assert_true(close_rel(ch.center_hz, 0.35e12, 1e-14)); /* the response-weighted mean */
-    assert_true(close_rel(channel_sigma_hz(&ch) * sqrt(2.0 * M_PI), width, 1e-14));
-    assert_true(channel_response(&ch, 0.345e12) == 1.0);
-    assert_true(channel_response(&ch, 0.34e12) == 1.0);
-    assert_true(channel_response(&ch, 0.36e12) == 1.0);
+    assert_true(close_rel(channel_sigma_hz(&ch) * sqrt(2.0 * M_PI), 3.0 * width, 1e-14));
+    assert_true(channel_response(&ch, 0.345e12) == 3.0);
+    assert_true(channel_response(&ch, 0.34e12) == 3.0);
+    assert_true(channel_response(&ch, 0.36e12) == 3.0);
     assert_true(channel_response(&ch, 0.3399e12) == 0.0); /* 0 outside the table */
     assert_true(channel_response(&ch, 0.3601e12) == 0.0);
     double lo, hi;
@@ -121,12 +122,12 @@ static void test_triangles_and_trapezoid(void **state)
     assert_true(lo == a && hi == c);
     channel_fini(&ch);
 
-    /* A trapezoid 0 -> 1 over r, 1 over p, 1 -> 0 over r: int g = p + r,
-     * int g^2 = p + 2 r / 3; a given centre stays as given. */
+    /* A trapezoid 0 -> h over r, h over p, h -> 0 over r (h = 5): int g = h (p + r),
+     * int g^2 = h^2 (p + 2 r / 3); a given centre stays as given. */
     const double tz[] = {1.0, 1.01, 1.05, 1.06}, tw[] = {0, 5, 5, 0};
     ch = table_channel(tz, tw, 4, 1.02);
     double r = 0.01e12, p = 0.04e12;
-    assert_true(close_rel(channel_bandwidth_hz(&ch), p + r, 1e-12));
+    assert_true(close_rel(channel_bandwidth_hz(&ch), 5.0 * (p + r), 1e-12));
     assert_true(
         close_rel(channel_noise_bandwidth_hz(&ch), (p + r) * (p + r) / (p + 2.0 * r / 3.0), 1e-12));
     assert_true(ch.center_hz == 1.02e12);
