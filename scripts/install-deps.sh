@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config clang libomp-dev groff-base
   libembree-dev libjansson-dev libassimp-dev librandom123-dev libpng-dev libzstd-dev
-  libplplot-dev plplot-driver-cairo libcmocka-dev
+  libplplot-dev plplot-driver-cairo libcmocka-dev libfftw3-dev
   python3 python3-numpy python3-spectral gdal-bin python3-gdal
   python3-pytest python3-matplotlib python3-sklearn python3-tqdm
   strace zstd

@@ -119,7 +119,7 @@ THZ_API thz_status thz_photons_stats(const thz_photons *photons, size_t c, thz_p
 /* ---- images ------------------------------------------------------------------------- */
 
 /* The planes of a sensor's image (scene-format.md "Outputs"). Row 0 is the top of the
- * picture, column 0 the left. Channel cubes (RADIANCE .. NORMALIZED) have one band per
+ * picture, column 0 the left. Channel cubes (RADIANCE .. NORMALIZED, MEASURED_*) have one band per
  * channel, band-sequential: value(c, row, col) at [(c * rows + row) * columns + col]. */
 typedef enum thz_plane {
     THZ_PLANE_RADIANCE = 0,           /* L_c, W m^-2 sr^-1 Hz^-1 */
@@ -132,6 +132,10 @@ typedef enum thz_plane {
     THZ_PLANE_OBJECT_ID,              /* 1 band: object index as float, -1: nothing hit */
     THZ_PLANE_VISUAL_RGB,             /* 3 bands, pixel-interleaved: [(row * columns + col)
                                        * 3 + k], shaded colour 0..1 */
+    /* The sensor as built (scene-format.md "Sensors: optics and noise"), channel cubes;
+     * absent (NULL) unless the sensor has a PSF or noise: */
+    THZ_PLANE_MEASURED_RADIANCE,               /* L_c through the PSF, plus noise */
+    THZ_PLANE_MEASURED_BRIGHTNESS_TEMPERATURE, /* Tb_c of the measured L_c, K */
     THZ_PLANE_COUNT
 } thz_plane;
 

@@ -105,12 +105,30 @@ typedef struct thz_sensor_info {
     double normalize_to_k;
 } thz_sensor_info;
 
+/* A sensor's optics and noise in one channel (scene-format.md "Sensors: optics and
+ * noise"). */
+typedef struct thz_sensor_channel_info {
+    const char *psf;            /* "airy", "gaussian" or "none" */
+    double aperture_diameter_m; /* D, m; 0 when not given */
+    double spot_rad;            /* airy: 1.22 lambda_c / D, the first dark ring's angular radius;
+                                   gaussian: its FWHM; none: 0 (rad) */
+    const char *noise;          /* "netd", "total-power", "dicke" or "none" */
+    double netd_k;              /* the given NETD, or the radiometer's at netd_at_k; 0: none */
+    double netd_at_k;           /* the Tb netd_k holds for: the channel's reference temperature
+                                   (radiometer; NETD varies with each pixel's Tb), K */
+    double noise_bandwidth_hz;  /* B_n of the channel, Hz */
+    int noise_seed_given;       /* else the noise takes the run's seed */
+    uint64_t noise_seed;
+} thz_sensor_channel_info;
+
 /* Fill *out; THZ_ERR_INPUT (and *out zeroed) when an index is out of range. */
 THZ_API thz_status thz_scene_get_info(const thz_scene *scene, thz_scene_info *out);
 THZ_API thz_status thz_scene_channel(const thz_scene *scene, size_t i, thz_channel_info *out);
 THZ_API thz_status thz_scene_material(const thz_scene *scene, size_t i, thz_material_info *out);
 THZ_API thz_status thz_scene_object(const thz_scene *scene, size_t i, thz_object_info *out);
 THZ_API thz_status thz_scene_sensor(const thz_scene *scene, size_t i, thz_sensor_info *out);
+THZ_API thz_status thz_scene_sensor_channel(const thz_scene *scene, size_t sensor, size_t channel,
+                                            thz_sensor_channel_info *out);
 
 THZ_API size_t thz_scene_channel_count(const thz_scene *scene);
 THZ_API size_t thz_scene_object_count(const thz_scene *scene);

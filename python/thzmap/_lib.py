@@ -37,6 +37,8 @@ PLANE_TEMPERATURE = 5
 PLANE_DISTANCE = 6
 PLANE_OBJECT_ID = 7
 PLANE_VISUAL_RGB = 8
+PLANE_MEASURED_RADIANCE = 9
+PLANE_MEASURED_BRIGHTNESS_TEMPERATURE = 10
 
 
 # ---- structures ------------------------------------------------------------------------

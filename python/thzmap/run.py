@@ -212,14 +212,18 @@ _PLANES = {"radiance": _lib.PLANE_RADIANCE, "radiance_stderr": _lib.PLANE_RADIAN
            "brightness_temperature": _lib.PLANE_BRIGHTNESS_TEMPERATURE,
            "normalized": _lib.PLANE_NORMALIZED, "temperature": _lib.PLANE_TEMPERATURE,
            "distance": _lib.PLANE_DISTANCE, "object_id": _lib.PLANE_OBJECT_ID,
-           "visual": _lib.PLANE_VISUAL_RGB}
+           "visual": _lib.PLANE_VISUAL_RGB, "measured_radiance": _lib.PLANE_MEASURED_RADIANCE,
+           "measured_brightness_temperature": _lib.PLANE_MEASURED_BRIGHTNESS_TEMPERATURE}
+_MAPS = (_lib.PLANE_TEMPERATURE, _lib.PLANE_DISTANCE, _lib.PLANE_OBJECT_ID)
 
 class Image:
     """One sensor's rendered image. Cubes are numpy float32 arrays shaped (rows, columns,
     channels): radiance (W m^-2 sr^-1 Hz^-1), radiance_stderr (None when not estimated),
     power (W), brightness_temperature (K), normalized (1). Maps shaped (rows, columns):
     temperature (K, 0 where nothing is hit), distance (m, 0: none), object_id (index of
-    the object seen as float, -1: none); visual (rows, columns, 3) rgb 0..1. Row 0 is the
+    the object seen as float, -1: none); visual (rows, columns, 3) rgb 0..1;
+    measured_radiance and measured_brightness_temperature (the sensor's PSF and noise
+    applied; None when the sensor has neither) shaped like the cubes. Row 0 is the
     top of the picture. The arrays are read-only views of the library's buffers."""
 
     def __init__(self, run_owner, ptr, scene):
@@ -248,7 +252,7 @@ class Image:
             return None
         if plane == _lib.PLANE_VISUAL_RGB:
             shape = (self.rows, self.columns, n.value)
-        elif n.value == 1 and plane >= _lib.PLANE_TEMPERATURE:
+        elif plane in _MAPS:
             shape = (self.rows, self.columns)
         else:
             shape = (n.value, self.rows, self.columns)
@@ -269,6 +273,9 @@ class Image:
     distance = property(lambda self: self.plane(_lib.PLANE_DISTANCE))
     object_id = property(lambda self: self.plane(_lib.PLANE_OBJECT_ID))
     visual = property(lambda self: self.plane(_lib.PLANE_VISUAL_RGB))
+    measured_radiance = property(lambda self: self._cube(_lib.PLANE_MEASURED_RADIANCE))
+    measured_brightness_temperature = property(
+        lambda self: self._cube(_lib.PLANE_MEASURED_BRIGHTNESS_TEMPERATURE))
 
     @property
     def frequencies_thz(self):

@@ -104,6 +104,14 @@ const float *thz_image_plane(const thz_image *image, thz_plane plane, size_t *n_
             data = img->visual_rgb;
             bands = 3;
             break;
+        case THZ_PLANE_MEASURED_RADIANCE:
+            data = img->measured_radiance;
+            bands = img->n_channels;
+            break;
+        case THZ_PLANE_MEASURED_BRIGHTNESS_TEMPERATURE:
+            data = img->measured_brightness_temperature;
+            bands = img->n_channels;
+            break;
         case THZ_PLANE_COUNT:
             break;
         }
@@ -115,10 +123,17 @@ const float *thz_image_plane(const thz_image *image, thz_plane plane, size_t *n_
 
 const char *thz_plane_name(thz_plane plane)
 {
-    static const char *const names[THZ_PLANE_COUNT] = {
-        "radiance",   "radiance_stderr", "power",    "brightness_temperature",
-        "normalized", "temperature",     "distance", "object_id",
-        "visual"};
+    static const char *const names[THZ_PLANE_COUNT] = {"radiance",
+                                                       "radiance_stderr",
+                                                       "power",
+                                                       "brightness_temperature",
+                                                       "normalized",
+                                                       "temperature",
+                                                       "distance",
+                                                       "object_id",
+                                                       "visual",
+                                                       "measured_radiance",
+                                                       "measured_brightness_temperature"};
     return (unsigned)plane < THZ_PLANE_COUNT ? names[plane] : NULL;
 }
 

@@ -1,10 +1,14 @@
 /* Scenes through the public API: loading (the loader, then the check that the sensors'
  * images fit in memory, which the loader cannot make: it knows no images), read access
  * by value. (Destroying is scene/scene.c's thz_scene_destroy.) */
+#include <math.h>
 #include <string.h>
 
 #include "api/api.h"
 #include "physics/channel.h"
+#include "physics/planck.h"
+#include "sensor/measure.h"
+#include "sensor/noise.h"
 #include "sensor/render.h"
 
 /* A loaded scene whose images would not fit in memory is refused (THZ_ERR_INPUT, naming
@@ -159,6 +163,32 @@ thz_status thz_scene_sensor(const thz_scene *s, size_t i, thz_sensor_info *out)
     memcpy(out->position_m, sn->position_m, sizeof out->position_m);
     memcpy(out->direction, sn->direction, sizeof out->direction);
     memcpy(out->up, sn->up, sizeof out->up);
+    return THZ_OK;
+}
+
+thz_status thz_scene_sensor_channel(const thz_scene *s, size_t sensor, size_t channel,
+                                    thz_sensor_channel_info *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!s || sensor >= s->n_sensors || channel >= s->n_channels)
+        return THZ_ERR_INPUT;
+    const thz_sensor *sn = &s->sensors[sensor];
+    const thz_channel *ch = &s->channels[channel];
+    double t0 = scene_reference_temperature_k(s, channel);
+    *out = (thz_sensor_channel_info){
+        .psf = sensor_psf_name(sn->psf),
+        .aperture_diameter_m = sn->aperture_diameter_m,
+        .noise = sensor_noise_name(&sn->noise),
+        .netd_k = noise_netd_k(&sn->noise, ch, channel, t0),
+        .netd_at_k = sn->noise.kind == NOISE_RADIOMETER ? t0 : 0.0,
+        .noise_bandwidth_hz = channel_noise_bandwidth_hz(ch),
+        .noise_seed_given = sn->noise_seed_given,
+        .noise_seed = sn->noise_seed,
+    };
+    if (sn->psf == PSF_AIRY)
+        out->spot_rad = 1.22 * THZ_SPEED_OF_LIGHT / ch->center_hz / sn->aperture_diameter_m;
+    else if (sn->psf == PSF_GAUSSIAN)
+        out->spot_rad = sn->psf_fwhm_deg * M_PI / 180.0;
     return THZ_OK;
 }
 

@@ -1,6 +1,8 @@
 /* thzmap validate SCENE.json: loads and checks a scene, prints what it holds (its
  * channels, materials, objects with their geometry, sensors, and the emitted spectral
  * power per channel) and its warnings. Exit 0 when the scene is valid, 2 when not. */
+#include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -13,7 +15,9 @@ static void validate_usage(FILE *f)
                "Loads the scene, checks it completely (exit 0 when valid, 2 when not, naming\n"
                "the file and the line:column or JSON path of the problem) and prints its\n"
                "channels, materials, objects (triangles, area, temperature), sensors and the\n"
-               "total emitted spectral power P_A per channel. Warnings (emissivity breaking\n"
+               "total emitted spectral power P_A per channel; for sensors with optics or\n"
+               "noise, each channel's NETD (K) and diffraction spot (mrad, and its size at\n"
+               "the nearest and farthest object centre). Warnings (emissivity breaking\n"
                "Kirchhoff's law, channel bands leaving a material table, inconsistent mesh\n"
                "winding) go to standard error, prefixed \"warning: \".\n\n"
                "options:\n"
@@ -30,6 +34,90 @@ static void validate_describe_spectrum(char *out, size_t n, const thz_spectrum_i
     else
         snprintf(out, n, "table (%zu points, %g to %g THz; %g to %g)", sp->n_points, sp->from_thz,
                  sp->to_thz, sp->min_value, sp->max_value);
+}
+
+/* The nearest and farthest distance (m) from point p to the centres of the objects'
+ * bounding boxes, leaving out boxes that hold p (the enclosure around a sensor); false
+ * when no object is left. */
+static bool validate_object_distances(const thz_scene *s, const double p[3], double *near_m,
+                                      double *far_m)
+{
+    bool any = false;
+    for (size_t i = 0; i < thz_scene_object_count(s); i++) {
+        thz_object_info o;
+        thz_scene_object(s, i, &o);
+        bool inside = true;
+        double d2 = 0.0;
+        for (int k = 0; k < 3; k++) {
+            inside = inside && p[k] >= o.bbox_min_m[k] && p[k] <= o.bbox_max_m[k];
+            double d = 0.5 * (o.bbox_min_m[k] + o.bbox_max_m[k]) - p[k];
+            d2 += d * d;
+        }
+        if (inside)
+            continue;
+        double d = sqrt(d2);
+        *near_m = any && *near_m < d ? *near_m : d;
+        *far_m = any && *far_m > d ? *far_m : d;
+        any = true;
+    }
+    return any;
+}
+
+/* "12.3 mm" or "4.56 cm" or "1.2 m": a length in the unit that reads best. */
+static void validate_length(char *out, size_t n, double m)
+{
+    if (m < 0.01)
+        snprintf(out, n, "%.3g mm", m * 1e3);
+    else if (m < 1.0)
+        snprintf(out, n, "%.3g cm", m * 1e2);
+    else
+        snprintf(out, n, "%.3g m", m);
+}
+
+/* Sensor i's optics and noise per channel: NETD and the diffraction spot. */
+static void validate_print_sensor_model(const thz_scene *s, size_t i, const double position_m[3])
+{
+    thz_sensor_channel_info m;
+    thz_scene_sensor_channel(s, i, 0, &m);
+    if (strcmp(m.psf, "none") == 0 && strcmp(m.noise, "none") == 0)
+        return;
+    double near_m = 0.0, far_m = 0.0;
+    bool dist = validate_object_distances(s, position_m, &near_m, &far_m);
+    printf("      psf %s", m.psf);
+    if (m.aperture_diameter_m > 0.0)
+        printf(", aperture diameter D %g m", m.aperture_diameter_m);
+    printf("; noise %s", m.noise);
+    if (strcmp(m.noise, "none") != 0) {
+        if (m.noise_seed_given)
+            printf(", noise seed %llu", (unsigned long long)m.noise_seed);
+        else
+            printf(", noise seed the run's");
+    }
+    printf("\n");
+    for (size_t c = 0; c < thz_scene_channel_count(s); c++) {
+        thz_channel_info ch;
+        thz_scene_channel(s, c, &ch);
+        thz_scene_sensor_channel(s, i, c, &m);
+        printf("      %-16s", ch.name);
+        if (m.netd_k > 0.0) {
+            printf(" NETD %.4g K", m.netd_k);
+            if (m.netd_at_k > 0.0)
+                printf(" at Tb %.5g K (B_n %.4g GHz)", m.netd_at_k, m.noise_bandwidth_hz * 1e-9);
+        }
+        if (m.spot_rad > 0.0) {
+            printf("%s %s %.4g mrad", m.netd_k > 0.0 ? ";" : "",
+                   strcmp(m.psf, "airy") == 0 ? "spot 1.22 lambda/D" : "PSF FWHM",
+                   m.spot_rad * 1e3);
+            if (dist) {
+                char a[32], b[32];
+                validate_length(a, sizeof a, m.spot_rad * near_m);
+                validate_length(b, sizeof b, m.spot_rad * far_m);
+                printf(" = %s at %.4g m, %s at %.4g m (nearest and farthest object centre)", a,
+                       near_m, b, far_m);
+            }
+        }
+        printf("\n");
+    }
 }
 
 static void validate_print(const thz_scene *s)
@@ -96,6 +184,7 @@ static void validate_print(const thz_scene *s)
                i, sn.name, sn.columns, sn.rows, sn.fov_deg, sn.oversampling, sn.oversampling,
                sn.aperture_m2, sn.position_m[0], sn.position_m[1], sn.position_m[2],
                sn.direction[0], sn.direction[1], sn.direction[2], sn.normalize_to_k);
+        validate_print_sensor_model(s, i, sn.position_m);
     }
     printf("\nphotons: %llu per channel, seed %llu, min_relative_power %g, gather_min_photons %u\n",
            (unsigned long long)si.photons_per_channel, (unsigned long long)si.seed,

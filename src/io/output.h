@@ -44,7 +44,9 @@ void output_stage_destroy(output_stage *stage);
  * S.power, S.brightness_temperature, S.normalized (and S.radiance_stderr when
  * images->radiance_stderr is set), S.temperature, S.distance, S.object_id; S.visual.png;
  * S.band-NN.png per channel (its brightness temperature in K, NN from 01);
- * S.spectra.png (mean normalised radiance per object in view against frequency).
+ * S.spectra.png (mean normalised radiance per object in view against frequency); when
+ * the images hold measured planes (sensor/measure.h), S.measured_radiance,
+ * S.measured_brightness_temperature and S.measured-band-NN.png, titled with the model.
  * Checks PLplot's pngcairo device before writing anything (THZ_ERR_IO if missing).
  * Draws with PLplot, which is serialised process-wide (io/plot.h). */
 thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t sensor,

@@ -14,6 +14,7 @@
 #include "io/envi.h"
 #include "io/plot.h"
 #include "io/png_image.h"
+#include "sensor/measure.h"
 
 /* Descriptions and titles: text only, a long sensor or scene name may cut them. */
 enum { OUT_TEXT = 1024 };
@@ -140,6 +141,45 @@ static thz_status out_band_preview(const out_context *ctx, size_t c, thz_error *
                       ctx->images->rows, title, "brightness temperature T#db#u (K)", err);
 }
 
+/* S.measured-band-NN.png: the measured brightness temperature of channel c, its title
+ * naming the sensor model that made it. */
+static thz_status out_measured_preview(const out_context *ctx, size_t c, thz_error *err)
+{
+    char quantity[64], path[THZ_PATH_MAX], title[OUT_TEXT], model[512];
+    snprintf(quantity, sizeof quantity, "measured-band-%02zu", c + 1);
+    thz_status status = out_png_path(path, ctx, quantity, err);
+    if (status != THZ_OK)
+        return status;
+    const thz_channel *ch = &ctx->scene->channels[c];
+    sensor_model_describe(ctx->sensor, c, ctx->images->noise_seed, model, sizeof model);
+    snprintf(title, sizeof title, "%s, %.4g GHz: %s", ctx->sensor->name, ch->center_hz / 1e9,
+             model);
+    size_t pixels = (size_t)ctx->images->columns * ctx->images->rows;
+    return plot_image(path, ctx->images->measured_brightness_temperature + c * pixels,
+                      ctx->images->columns, ctx->images->rows, title,
+                      "measured brightness temperature T#db#u (K)", err);
+}
+
+/* The measured cubes and their previews, when the sensor has a model. */
+static thz_status out_measured(const out_context *ctx, thz_error *err)
+{
+    const sensor_images *img = ctx->images;
+    if (!img->measured_radiance)
+        return THZ_OK;
+    char model[512], what[OUT_TEXT];
+    sensor_model_describe(ctx->sensor, 0, img->noise_seed, model, sizeof model);
+    snprintf(what, sizeof what, "measured band-mean spectral radiance L_c (%s)", model);
+    thz_status status = out_image(ctx, OUT_CHANNELS, "measured_radiance", img->measured_radiance,
+                                  what, "W m-2 sr-1 Hz-1", err);
+    snprintf(what, sizeof what, "measured brightness temperature Tb_c (%s)", model);
+    if (status == THZ_OK)
+        status = out_image(ctx, OUT_CHANNELS, "measured_brightness_temperature",
+                           img->measured_brightness_temperature, what, "K", err);
+    for (size_t c = 0; c < img->n_channels && status == THZ_OK; c++)
+        status = out_measured_preview(ctx, c, err);
+    return status;
+}
+
 /* S.spectra.png: for each object in view, the mean normalised radiance N_c of its
  * pixels against the channel centres (the paper's Fig. 6). */
 static thz_status out_spectra(const out_context *ctx, thz_error *err)
@@ -264,6 +304,8 @@ thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t s
         status = out_band_preview(&ctx, c, err);
     if (status == THZ_OK)
         status = out_spectra(&ctx, err);
+    if (status == THZ_OK)
+        status = out_measured(&ctx, err);
 cleanup:
     free(ctx.channel_names);
     free(ctx.center_ghz);

@@ -18,6 +18,8 @@
 
 #include "core/path.h"
 #include "physics/channel.h"
+#include "sensor/measure.h"
+#include "sensor/noise.h"
 #include "thzmap/thzmap.h"
 
 /* Builders that remember an allocation failure in *ok instead of checking each call.
@@ -150,6 +152,46 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
     return o;
 }
 
+/* sensors[].model: the optics and noise that made S.measured_*, or null without them. */
+static json_t *sum_sensor_model(const thz_scene *scene, const thz_sensor *s,
+                                const run_summary *summary, bool *ok)
+{
+    if (!sensor_has_model(s))
+        return json_null();
+    json_t *o = json_object();
+    sum_set(o, "psf", json_string(sensor_psf_name(s->psf)), ok);
+    sum_set(o, "aperture_diameter_m",
+            s->aperture_diameter_m > 0.0 ? sum_real(s->aperture_diameter_m) : json_null(), ok);
+    if (s->psf == PSF_GAUSSIAN)
+        sum_set(o, "psf_fwhm_deg", sum_real(s->psf_fwhm_deg), ok);
+    const thz_sensor_noise *n = &s->noise;
+    json_t *noise = json_null();
+    if (n->kind != NOISE_NONE) {
+        noise = json_object();
+        sum_set(noise, "model", json_string(sensor_noise_name(n)), ok);
+        if (n->kind == NOISE_RADIOMETER) {
+            sum_set(noise, "receiver_temperature_k", sum_real(n->receiver_temperature_k), ok);
+            sum_set(noise, "integration_time_s", sum_real(n->integration_time_s), ok);
+        }
+        /* per channel: the given NETD, or the radiometer's at the channel's reference
+         * temperature (it varies per pixel with Tb) */
+        json_t *netd = json_array(), *tref = json_array();
+        for (size_t c = 0; c < scene->n_channels; c++) {
+            double t0 = scene_reference_temperature_k(scene, c);
+            sum_append(netd, sum_real(noise_netd_k(n, &scene->channels[c], c, t0)), ok);
+            sum_append(tref, sum_real(t0), ok);
+        }
+        sum_set(noise, "netd_k", netd, ok);
+        if (n->kind == NOISE_RADIOMETER)
+            sum_set(noise, "netd_at_temperature_k", tref, ok);
+        else
+            json_decref(tref);
+    }
+    sum_set(o, "noise", noise, ok);
+    sum_set(o, "noise_seed", sum_u64(sensor_noise_seed(s, summary->seed)), ok);
+    return o;
+}
+
 static json_t *sum_sensor(const thz_scene *scene, size_t i, const run_summary *summary, bool *ok)
 {
     const thz_sensor *s = &scene->sensors[i];
@@ -161,6 +203,7 @@ static json_t *sum_sensor(const thz_scene *scene, size_t i, const run_summary *s
     sum_set(o, "oversampling", json_integer(s->oversampling), ok);
     sum_set(o, "aperture_m2", sum_real(s->aperture_m2), ok);
     sum_set(o, "normalize_to_k", sum_real(s->normalize_to_k), ok);
+    sum_set(o, "model", sum_sensor_model(scene, s, summary, ok), ok);
     if (summary->back_face_samples)
         sum_set(o, "back_face_samples", sum_u64(summary->back_face_samples[i]), ok);
     return o;

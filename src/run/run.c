@@ -20,6 +20,7 @@
 #include "run/run_noise.h"
 #include "physics/planck.h"
 #include "sensor/images.h"
+#include "sensor/measure.h"
 #include "sensor/render.h"
 #include "sensor/truth.h"
 
@@ -222,6 +223,8 @@ static uint64_t run_image_bytes(const run_state *rs)
     for (size_t i = 0; i < rs->n_selected; i++) {
         const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
         total += sensor_images_bytes(s->columns, s->rows, rs->scene->n_channels);
+        if (sensor_has_model(s)) /* measured radiance and Tb */
+            total += 2u * sizeof(float) * s->columns * s->rows * rs->scene->n_channels;
         total += (uint64_t)s->columns * s->rows * per_pixel * sizeof(double);
     }
     return total;
@@ -427,7 +430,13 @@ static thz_status run_finish(run_state *rs, double t_start, thz_error *err)
 {
     accel_destroy(rs->accel);
     rs->accel = NULL;
-    thz_status st = run_noise_figures(rs, err);
+    thz_status st = THZ_OK;
+    /* the sensor as built, from the finished noise-free cubes (measure.h) */
+    for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++)
+        st = sensor_measure(rs->scene, rs->selected[i], rs->seed, &rs->images[i], rs->opt->threads,
+                            err);
+    if (st == THZ_OK)
+        st = run_noise_figures(rs, err);
     if (st == THZ_OK)
         st = run_render_warnings(rs, err);
     if (st != THZ_OK)

@@ -18,6 +18,8 @@
 #include "scene/scene_checks.h"
 
 #define LOAD_FORMAT "thzmap-scene/1"
+/* Format 1.1 adds optional keys only (scene-format.md): a file may say so. */
+#define LOAD_FORMAT_1_1 "thzmap-scene/1.1"
 /* Explicit emissivity may differ from Kirchhoff's value by this much before validate
  * warns (physics.md "Surfaces"). */
 #define LOAD_KIRCHHOFF_TOLERANCE 0.01
@@ -193,9 +195,10 @@ static thz_status load_document(load_ctx *ctx, json_t *doc)
     if (!json_object_get(doc, "format"))
         return load_require(ctx, &root, "format", "\"" LOAD_FORMAT "\"");
     thz_status st = load_string(ctx, &root, "format", true, NULL, &format);
-    if (st == THZ_OK && strcmp(format, LOAD_FORMAT) != 0) {
+    if (st == THZ_OK && strcmp(format, LOAD_FORMAT) != 0 && strcmp(format, LOAD_FORMAT_1_1) != 0) {
         load_cursor k = load_key(&root, "format");
-        return load_fail(ctx, &k, "expected \"%s\", got \"%s\"", LOAD_FORMAT, format);
+        return load_fail(ctx, &k, "expected \"%s\" or \"%s\", got \"%s\"", LOAD_FORMAT,
+                         LOAD_FORMAT_1_1, format);
     }
     if (st == THZ_OK)
         st = load_expect_object(ctx, &root, keys);

@@ -156,6 +156,9 @@ thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *
 thz_status load_atmosphere_defaults(load_ctx *ctx, double enclosure_temperature_k);
 thz_status load_objects(load_ctx *ctx, const load_cursor *root);
 thz_status load_sensors(load_ctx *ctx, const load_cursor *root);
+/* Sensor c's optics and noise keys into sn (load_sensor_model.c); after aperture_m2. */
+thz_status load_sensor_model(load_ctx *ctx, const load_cursor *c, size_t n_channels,
+                             thz_sensor *sn);
 /* The optional photons and render blocks (absent: the scene's defaults stay). */
 thz_status load_photons(load_ctx *ctx, const load_cursor *root);
 thz_status load_render(load_ctx *ctx, const load_cursor *root);

@@ -1,5 +1,6 @@
 /* The scene's `sensors` block: pinhole cameras (position, viewing direction, up, angle
- * of view, resolution, aperture, oversampling, normalisation temperature). */
+ * of view, resolution, aperture, oversampling, normalisation temperature); their optics
+ * and noise are in load_sensor_model.c. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -43,8 +44,10 @@ static thz_status load_resolution(load_ctx *ctx, const load_cursor *c, uint32_t 
 static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t index, thz_sensor *sn)
 {
     static const char *const keys[] = {
-        "name",       "position_m",  "look_at_m",    "direction",      "up", "fov_deg",
-        "resolution", "aperture_m2", "oversampling", "normalize_to_k", NULL};
+        "name",         "position_m",     "look_at_m",           "direction",
+        "up",           "fov_deg",        "resolution",          "aperture_m2",
+        "oversampling", "normalize_to_k", "aperture_diameter_m", "psf",
+        "psf_fwhm_deg", "noise",          "noise_seed",          NULL};
     load_cursor e = load_index(list, index);
     const load_cursor *c = &e;
     const char *name;
@@ -115,7 +118,7 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
     if (st != THZ_OK)
         return st;
     sn->oversampling = (uint32_t)over;
-    return THZ_OK;
+    return load_sensor_model(ctx, c, ctx->scene->n_channels, sn);
 }
 
 thz_status load_sensors(load_ctx *ctx, const load_cursor *root)

@@ -61,8 +61,10 @@ void scene_destroy(thz_scene *s)
         mesh_fini(&s->objects[i].mesh);
     }
     free(s->objects);
-    for (size_t i = 0; i < s->n_sensors; i++)
+    for (size_t i = 0; i < s->n_sensors; i++) {
         free(s->sensors[i].name);
+        free(s->sensors[i].noise.netd_k);
+    }
     free(s->sensors);
     for (size_t i = 0; s->channels && i < s->n_channels; i++)
         channel_fini(&s->channels[i]);

@@ -64,6 +64,26 @@ typedef struct thz_object {
     thz_mesh mesh;
 } thz_object;
 
+/* The sensor's optics and noise (scene-format.md "Sensors: optics and noise";
+ * sensor/psf.h, sensor/noise.h). */
+typedef enum thz_psf_kind { PSF_NONE = 0, PSF_AIRY, PSF_GAUSSIAN } thz_psf_kind;
+
+typedef enum thz_noise_kind {
+    NOISE_NONE = 0,
+    NOISE_NETD,       /* netd_k given per channel */
+    NOISE_RADIOMETER, /* the radiometer equation */
+} thz_noise_kind;
+
+typedef enum thz_radiometer { RADIOMETER_TOTAL_POWER = 0, RADIOMETER_DICKE } thz_radiometer;
+
+typedef struct thz_sensor_noise {
+    thz_noise_kind kind;
+    double *netd_k;                /* NOISE_NETD: one per channel, K (owned) */
+    double receiver_temperature_k; /* NOISE_RADIOMETER: T_rec >= 0, K */
+    double integration_time_s;     /* NOISE_RADIOMETER: tau > 0, s */
+    thz_radiometer radiometer;
+} thz_sensor_noise;
+
 typedef struct thz_sensor {
     char *name;
     double position_m[3];
@@ -72,11 +92,17 @@ typedef struct thz_sensor {
     double fov_deg;      /* horizontal, 0 < fov < 180 */
     uint32_t columns, rows;
     double aperture_m2;
-    uint32_t oversampling; /* n: n x n samples per pixel */
-    double normalize_to_k; /* T_ref > 0 */
-    bool misplaced;        /* scene_checks found it inside a closed solid or outside the
-                              enclosure (and warned): back faces it sees are not the
-                              normals' fault */
+    uint32_t oversampling;      /* n: n x n samples per pixel */
+    double normalize_to_k;      /* T_ref > 0 */
+    double aperture_diameter_m; /* D of the circular aperture, m; 0: none given */
+    thz_psf_kind psf;
+    double psf_fwhm_deg; /* PSF_GAUSSIAN: FWHM of the Gaussian PSF, degrees */
+    thz_sensor_noise noise;
+    bool noise_seed_given; /* else the noise takes the run's seed */
+    uint64_t noise_seed;
+    bool misplaced; /* scene_checks found it inside a closed solid or outside the
+                       enclosure (and warned): back faces it sees are not the
+                       normals' fault */
 } thz_sensor;
 
 typedef struct thz_photon_settings {

@@ -60,5 +60,7 @@ void sensor_images_fini(sensor_images *img)
     free(img->distance_m);
     free(img->object_id);
     free(img->visual_rgb);
+    free(img->measured_radiance);
+    free(img->measured_brightness_temperature);
     memset(img, 0, sizeof *img);
 }

@@ -28,6 +28,11 @@ typedef struct sensor_images {
     float *distance_m;    /* 1 band: distance to the surface seen, m (SENSOR_NOTHING_HIT) */
     int32_t *object_id;   /* 1 band: index into scene objects, -1: nothing hit */
     float *visual_rgb;    /* rows x columns x 3, shaded colours 0..1 */
+    /* The sensor as built (sensor/measure.h): the noise-free radiance through the PSF,
+     * plus noise; NULL when the sensor has neither (psf none, no noise). */
+    float *measured_radiance;               /* W m^-2 sr^-1 Hz^-1 */
+    float *measured_brightness_temperature; /* K */
+    uint64_t noise_seed;                    /* the seed the noise was drawn with */
 } sensor_images;
 
 /* Allocates all arrays, the cubes zeroed and the truth images at "nothing hit" (-1);

@@ -35,7 +35,9 @@ static int test_failures = 0;
     } while (0)
 
 /* The scene (20000 photons per channel, photon-map: the integrator that fires photons and
- * has no passes; settings may change both). */
+ * has no passes; settings may change both). Both sensors have optics and noise (an Airy
+ * PSF by FFT, a Gaussian one applied directly), so the measured planes are compared
+ * too. */
 static const char test_scene_json[] =
     "{\n"
     "  \"format\": \"thzmap-scene/1\",\n"
@@ -65,9 +67,13 @@ static const char test_scene_json[] =
     "  \"sensors\": [\n"
     "    {\"name\": \"cam\", \"position_m\": [0, -0.9, 0], \"look_at_m\": [0, 0.5, 0],\n"
     "     \"fov_deg\": 70, \"resolution\": [20, 16], \"oversampling\": 2, \"normalize_to_k\": "
-    "295},\n"
+    "295,\n"
+    "     \"aperture_m2\": 0.01, \"aperture_diameter_m\": 0.01,\n"
+    "     \"noise\": {\"receiver_temperature_k\": 600, \"integration_time_s\": 0.001, "
+    "\"radiometer\": \"dicke\"}},\n"
     "    {\"name\": \"side\", \"position_m\": [0.8, -0.8, 0.3], \"look_at_m\": [0, 0.4, -0.2],\n"
-    "     \"fov_deg\": 50, \"resolution\": [12, 12]}\n"
+    "     \"fov_deg\": 50, \"resolution\": [12, 12], \"psf\": \"gaussian\", \"psf_fwhm_deg\": 8,\n"
+    "     \"noise\": {\"netd_k\": [0.3, 0.5]}, \"noise_seed\": 3}\n"
     "  ],\n"
     "  \"photons\": {\"per_channel\": 20000, \"seed\": 4},\n"
     "  \"render\": {\"integrator\": \"photon-map\"}\n"

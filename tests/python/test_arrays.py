@@ -131,3 +131,26 @@ def test_scene_accessors(tiny_dir):
     table = [m for m in scene.materials if m.name == "table"][0]
     assert table.reflectivity.kind == "table"
     assert scene.info.path == "tiny"
+
+
+def test_measured_planes(tiny_dir, thzmap_binary):
+    """measured_radiance and measured_brightness_temperature: None without a sensor
+    model, else (rows, columns, channels) equal to the CLI's ENVI files."""
+    plain = thzmap.simulate(thzmap.load_scene(tiny_dir / "scene.json"), seed=SEED,
+                            integrator="path")
+    assert plain.image("cam").measured_radiance is None
+    assert plain.image("cam").measured_brightness_temperature is None
+    d = tiny_scene_dict()
+    d["sensors"][0].update({"aperture_diameter_m": 0.02, "noise": {"netd_k": 0.5}})
+    with open(tiny_dir / "model.json", "w") as f:
+        json.dump(d, f)
+    out = tiny_dir / "cli-model"
+    run_cli(thzmap_binary, "simulate", tiny_dir / "model.json", "-o", out, "--seed", SEED,
+            "--integrator", "path", "--threads", 2, "--quiet")
+    im = thzmap.simulate(thzmap.load_scene(tiny_dir / "model.json"), seed=SEED,
+                         integrator="path", threads=1).image("cam")
+    for q in ("measured_radiance", "measured_brightness_temperature"):
+        a = getattr(im, q)
+        assert a.shape == (im.rows, im.columns, im.n_channels)
+        assert_bitwise_equal(a, read_envi(out, "cam", q, im.rows, im.columns), q)
+    assert not np.array_equal(im.measured_brightness_temperature, im.brightness_temperature)

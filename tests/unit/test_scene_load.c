@@ -185,6 +185,12 @@ static void test_csv_material_and_warnings(void **state)
 static void test_default_channel_names(void **state)
 {
     (void)state;
+    /* format 1.1 only adds keys: a 1/1.1 file loads either way */
+    thz_scene *s11 = load_ok("{\"format\": \"thzmap-scene/1.1\", "
+                             "\"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": "
+                             "0.01}], " MATERIALS OBJECT(BOX) SENSORS "}");
+    assert_int_equal(s11->n_channels, 1);
+    thz_scene_destroy(s11);
     /* 0.35 and 0.3501 THz would both be "0.350 THz": they get a decimal more, the
      * others keep three; a given name that looks like a default one stays */
     thz_scene *s =
@@ -226,6 +232,50 @@ static void test_default_channel_names(void **state)
              "channels[0]");
 }
 
+/* Sensor optics and noise: defaults, A_S from D, NETD for every channel. */
+static void test_sensor_model(void **state)
+{
+    (void)state;
+#define CAM                                                                                        \
+    "\"position_m\": [0, -5, 0], \"look_at_m\": [0, 0, 0], "                                       \
+    "\"fov_deg\": 40, \"resolution\": [16, 8]"
+#define TWO_CHANNELS                                                                               \
+    "\"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.01}, "                         \
+    "{\"frequency_thz\": 0.7, \"relative_width\": 0.01}], "
+    thz_scene *s = load_ok(HEAD TWO_CHANNELS MATERIALS OBJECT(BOX) "\"sensors\": ["
+                                                                   "{\"name\": \"c\", " CAM "}, "
+                                                                   "{\"name\": \"d\", " CAM ", "
+                                                                   "\"aperture_diameter_m\": 0.5, "
+                                                                   "\"noise\": {\"netd_k\": 0.3}}, "
+                                                                   "{\"name\": \"e\", " CAM ", "
+                                                                   "\"aperture_diameter_m\": 0.5, "
+                                                                   "\"aperture_m2\": 0.02, "
+                                                                   "\"psf\": \"none\", "
+                                                                   "\"noise\": {\"receiver_"
+                                                                   "temperature_k\": 400, "
+                                                                   "\"integration_time_s\": 0.1, "
+                                                                   "\"radiometer\": \"dicke\"}, "
+                                                                   "\"noise_seed\": 9}]}");
+    const thz_sensor *c = &s->sensors[0], *d = &s->sensors[1], *e = &s->sensors[2];
+    assert_int_equal(c->psf, PSF_NONE);
+    assert_int_equal(c->noise.kind, NOISE_NONE);
+    assert_true(c->aperture_m2 == 1e-2);
+    assert_false(c->noise_seed_given);
+    assert_int_equal(d->psf, PSF_AIRY);
+    assert_true(fabs(d->aperture_m2 - M_PI * 0.25 / 4.0) < 1e-15);
+    assert_int_equal(d->noise.kind, NOISE_NETD);
+    assert_true(d->noise.netd_k[0] == 0.3 && d->noise.netd_k[1] == 0.3);
+    assert_int_equal(e->psf, PSF_NONE);
+    assert_true(e->aperture_m2 == 0.02);
+    assert_int_equal(e->noise.kind, NOISE_RADIOMETER);
+    assert_int_equal(e->noise.radiometer, RADIOMETER_DICKE);
+    assert_true(e->noise.receiver_temperature_k == 400 && e->noise.integration_time_s == 0.1);
+    assert_true(e->noise_seed_given && e->noise_seed == 9);
+    thz_scene_destroy(s);
+#undef CAM
+#undef TWO_CHANNELS
+}
+
 static void test_refusals(void **state)
 {
     (void)state;
@@ -243,6 +293,8 @@ static void test_refusals(void **state)
     load_bad(HEAD "\"channels\": [], " MATERIALS OBJECT(BOX) SENSORS "}",
              "channels: expected at least one");
     load_bad("{\"format\": \"thzmap-scene/2\"}", "format: expected \"thzmap-scene/1\"");
+    load_bad("{\"format\": \"thzmap-scene/1.2\"}",
+             "format: expected \"thzmap-scene/1\" or \"thzmap-scene/1.1\"");
     load_bad("[1, 2]", "expected a JSON object");
     load_bad(HEAD CHANNELS MATERIALS OBJECT(BOX) SENSORS
              ", \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.1, "
@@ -262,6 +314,7 @@ int main(void)
         cmocka_unit_test(test_blocks),
         cmocka_unit_test(test_csv_material_and_warnings),
         cmocka_unit_test(test_default_channel_names),
+        cmocka_unit_test(test_sensor_model),
         cmocka_unit_test(test_refusals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,0 +1,132 @@
+#!/usr/bin/env bash
+# The sensor as built (scene-format.md "Sensors: optics and noise"), end to end:
+#  - noise: a black furnace at 300 K (path: every pixel exactly B(300 K)) seen by three
+#    sensors (total-power, Dicke, given NETD per channel), two channels, 128 x 128: the
+#    measured Tb's standard deviation is K (T + T_rec) / sqrt(B_n tau) (or the given
+#    NETD) within 3 sigma of its sampling error, the mean is unbiased within
+#    3 NETD / sqrt(N), neighbouring pixels and the two channels are uncorrelated
+#    (|r| < 3 / sqrt(N)) (sensor_check.py);
+#  - the noise-free cubes are byte for byte those of the same scene without the model;
+#  - the measured cubes are bit-identical for --threads 1 and 2, and `render` from a
+#    saved photon map gives simulate's measured cubes;
+#  - PSF: a black disk at 1000 K far below the diffraction limit (0.6 mrad across,
+#    lambda/D 17 mrad) in two channels: the radial profile of the measured radiance
+#    matches the band-averaged Airy pattern, FWHM within 3 % of it, summed power within
+#    0.5 % of the sharp image's;
+#  - summary.json names the model, validate prints NETD and spot size with units, and a
+#    bad noise block is refused with its JSON path (exit 2).
+# argv: path to the thzmap binary, repository directory.
+set -u
+THZMAP=$1
+REPO=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+run() { # $1: what, rest: thzmap arguments
+    local what=$1
+    shift
+    if ! "$THZMAP" "$@" --quiet > "$work/$what.log" 2>&1; then
+        fail "$what: thzmap $* failed"
+        cat "$work/$what.log"
+    fi
+}
+check() { # python checks
+    if ! /usr/bin/python3 "$REPO/tests/cli/sensor_check.py" "$@"; then
+        fail "sensor_check.py $*"
+    fi
+}
+
+# ---- noise: the furnace ----------------------------------------------------------------
+furnace() { # $1: file, $2: "model" or "" (the same scene without the sensor model)
+    local tp='' dk='' nd=''
+    if [ "$2" = model ]; then
+        tp=', "noise": {"receiver_temperature_k": 500, "integration_time_s": 0.01, "radiometer": "total-power"}'
+        dk=', "noise": {"receiver_temperature_k": 800, "integration_time_s": 0.004, "radiometer": "dicke"}'
+        nd=', "noise": {"netd_k": [0.5, 0.2]}, "noise_seed": 7'
+    fi
+    local cam='"position_m": [0, 0, 0], "direction": [0, 1, 0], "fov_deg": 30, "resolution": [128, 128]'
+    cat > "$1" <<EOF
+{"format": "thzmap-scene/1", "name": "furnace",
+ "channels": [{"frequency_thz": 0.35, "relative_width": 0.01},
+              {"frequency_thz": 0.65, "relative_width": 0.01}],
+ "materials": {"black": {"reflectivity": 0}},
+ "objects": [{"name": "box", "type": "solid", "material": "black", "temperature_k": 300,
+              "shape": {"type": "box", "size_m": [4, 4, 4], "inward": true}}],
+ "sensors": [{"name": "tp", $cam$tp}, {"name": "dicke", $cam$dk}, {"name": "netd", $cam$nd}],
+ "render": {"integrator": "path", "paths_per_sample": 1}}
+EOF
+}
+furnace "$work/furnace.json" model
+furnace "$work/plain.json" ""
+run noise1 simulate "$work/furnace.json" -o "$work/n1" --threads 1
+run noise2 simulate "$work/furnace.json" -o "$work/n2" --threads 2
+run plain simulate "$work/plain.json" -o "$work/plain" --threads 2
+check noise "$work/n2" 300
+for s in tp dicke netd; do
+    for q in measured_radiance measured_brightness_temperature; do
+        cmp -s "$work/n1/$s.$q.img" "$work/n2/$s.$q.img" ||
+            fail "$s.$q differs between --threads 1 and 2"
+    done
+    for q in radiance brightness_temperature power normalized; do
+        cmp -s "$work/n2/$s.$q.img" "$work/plain/$s.$q.img" ||
+            fail "$s.$q (noise-free) changed by the sensor model"
+    done
+    [ -e "$work/plain/$s.measured_radiance.img" ] && fail "measured cube without a model"
+    [ -e "$work/n2/$s.measured-band-01.png" ] || fail "$s.measured-band-01.png missing"
+done
+/usr/bin/python3 - "$work/n2/summary.json" <<'EOF' || fail "summary.json: sensors[].model"
+import json, sys
+s = {x["name"]: x["model"] for x in json.load(open(sys.argv[1]))["sensors"]}
+assert s["tp"]["noise"]["model"] == "total-power" and s["tp"]["psf"] == "none", s["tp"]
+assert s["dicke"]["noise"]["model"] == "dicke", s["dicke"]
+assert s["netd"]["noise"]["netd_k"] == [0.5, 0.2] and s["netd"]["noise_seed"] == 7, s["netd"]
+assert s["tp"]["noise_seed"] == 1, s["tp"]
+EOF
+# render from a saved photon map: the same measured cubes as simulate
+run pm simulate "$work/furnace.json" -o "$work/pm" --integrator photon-map --photons 20000 \
+    --save-photon-map --threads 2
+run pmr render "$work/furnace.json" --photon-map "$work/pm/photon-map.thzpm" -o "$work/pmr" \
+    --integrator photon-map --threads 1
+for q in measured_radiance measured_brightness_temperature; do
+    cmp -s "$work/pm/netd.$q.img" "$work/pmr/netd.$q.img" ||
+        fail "netd.$q: render from the saved map differs from simulate"
+done
+
+# ---- PSF: a hot disk far below the diffraction limit -----------------------------------
+pitch=0.0015 # rad per pixel at the centre, 129 columns
+fov=$(/usr/bin/python3 -c "import math; print(2 * math.degrees(math.atan(math.tan($pitch / 2) * 129)))")
+cat > "$work/disk.json" <<EOF
+{"format": "thzmap-scene/1", "name": "disk",
+ "channels": [{"frequency_thz": 0.35, "relative_width": 0.01},
+              {"frequency_thz": 0.5, "relative_width": 0.05}],
+ "materials": {"black": {"reflectivity": 0}},
+ "objects": [{"name": "disk", "type": "solid", "material": "black", "temperature_k": 1000,
+              "shape": {"type": "disk", "radius_m": 0.0003}}],
+ "sensors": [{"name": "cam", "position_m": [0, 0, 1], "direction": [0, 0, -1], "up": [0, 1, 0],
+              "fov_deg": $fov, "resolution": [129, 129], "oversampling": 4,
+              "aperture_diameter_m": 0.05}],
+ "render": {"integrator": "path", "paths_per_sample": 1}}
+EOF
+run disk1 simulate "$work/disk.json" -o "$work/d1" --threads 1
+run disk2 simulate "$work/disk.json" -o "$work/d2" --threads 2
+check psf "$work/d2" 0.05 "$pitch"
+cmp -s "$work/d1/cam.measured_radiance.img" "$work/d2/cam.measured_radiance.img" ||
+    fail "PSF: measured radiance differs between --threads 1 and 2"
+
+# ---- validate and bad input ------------------------------------------------------------
+"$THZMAP" validate "$work/disk.json" > "$work/v.log" 2>&1 || fail "validate disk.json"
+grep -q "spot 1.22 lambda/D 20.9 mrad = 2.09 cm at 1 m" "$work/v.log" ||
+    { fail "validate: no spot size of 20.9 mrad (2.09 cm at 1 m)"; cat "$work/v.log"; }
+"$THZMAP" validate "$work/furnace.json" > "$work/vf.log" 2>&1 || fail "validate furnace.json"
+grep -q "NETD 0.1102 K at Tb 300 K" "$work/vf.log" ||
+    { fail "validate: total-power NETD of 0.1102 K at 300 K missing"; cat "$work/vf.log"; }
+sed 's/"netd_k": \[0.5, 0.2\]/"netd_k": [0.5]/' "$work/furnace.json" > "$work/bad.json"
+"$THZMAP" validate "$work/bad.json" > "$work/bad.log" 2>&1
+rc=$?
+[ $rc -eq 2 ] || fail "a netd_k list of the wrong length: exit $rc, expected 2"
+grep -q 'sensors\[2\].noise.netd_k' "$work/bad.log" ||
+    { fail "the error does not name sensors[2].noise.netd_k"; cat "$work/bad.log"; }
+
+[ $fails -eq 0 ] && echo "PASS"
+exit $((fails > 0))
