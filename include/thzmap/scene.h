@@ -46,9 +46,13 @@ typedef struct thz_channel_info {
     const char *name;
     double frequency_hz;           /* centre */
     double frequency_thz;          /* centre, as in the scene file */
-    double relative_width;         /* FWHM / centre */
+    double relative_width;         /* FWHM / centre of the Gaussian; 0 for a measured response */
     double bandwidth_hz;           /* B_c: the response's integral (physics.md) */
     double emitted_power_w_per_hz; /* band mean of the scene's emitted power P_A */
+    /* (added with measured responses; after the older fields, for callers built earlier) */
+    double noise_bandwidth_hz; /* B_n = (int g)^2 / int g^2 */
+    double fwhm_hz;            /* full width at half maximum of the response */
+    size_t response_points;    /* points of the measured response table; 0: Gaussian */
 } thz_channel_info;
 
 /* A spectral property of a material: absent, a constant, or a table. */

@@ -64,7 +64,8 @@ class ThzSceneInfo(Structure):
 class ThzChannelInfo(Structure):
     _fields_ = [("name", c_char_p), ("frequency_hz", c_double), ("frequency_thz", c_double),
                 ("relative_width", c_double), ("bandwidth_hz", c_double),
-                ("emitted_power_w_per_hz", c_double)]
+                ("emitted_power_w_per_hz", c_double), ("noise_bandwidth_hz", c_double),
+                ("fwhm_hz", c_double), ("response_points", c_size_t)]
 
 
 class ThzSpectrumInfo(Structure):

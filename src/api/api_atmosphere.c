@@ -194,8 +194,17 @@ thz_status thz_atm_draw_plot(const thz_atm_plot *d, thz_error *err)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     for (size_t c = 0; c < n_bands; c++) {
         const thz_channel *ch = &scene->channels[c];
-        double fc = ch->center_hz * 1e-12, half = 0.5 * ch->relative_width * fc;
-        bands[c] = (plot_band){ch->name, fc - half, fc, fc + half};
+        double fc = ch->center_hz * 1e-12, lo, hi;
+        if (channel_has_response(ch)) {
+            channel_support_hz(ch, 0.0, &lo, &hi); /* where the measured response is > 0 */
+            lo *= 1e-12;
+            hi *= 1e-12;
+        } else {
+            double half = 0.5 * channel_fwhm_hz(ch) * 1e-12;
+            lo = fc - half;
+            hi = fc + half;
+        }
+        bands[c] = (plot_band){ch->name, lo, fc, hi};
     }
 
     /* The air in the title: the model's, or else the comparison's. */

@@ -81,6 +81,9 @@ thz_status thz_scene_channel(const thz_scene *s, size_t i, thz_channel_info *out
         .relative_width = ch->relative_width,
         .bandwidth_hz = channel_bandwidth_hz(ch),
         .emitted_power_w_per_hz = scene_band_emitted_power_w_per_hz(s, i),
+        .noise_bandwidth_hz = channel_noise_bandwidth_hz(ch),
+        .fwhm_hz = channel_fwhm_hz(ch),
+        .response_points = ch->n_response,
     };
     return THZ_OK;
 }

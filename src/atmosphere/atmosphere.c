@@ -256,7 +256,7 @@ static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, 
             st = thz_error_set(err, THZ_ERR_LIMIT,
                                "channel '%s': tabulating the atmosphere over its band needs "
                                "more than %zu points (step %.3g MHz); narrow the channel's "
-                               "relative_width or raise the pressure",
+                               "band or raise the pressure",
                                ch->name, TABLE_MAX_POINTS, step * 1e-6);
             break;
         }
@@ -318,8 +318,8 @@ thz_status atmosphere_prepare(thz_atmosphere *atm, const thz_channel *channels, 
     size_t done = 0;
     for (size_t c = 0; c < n_channels; c++) {
         const thz_channel *ch = &channels[c];
-        double sigma = channel_sigma_hz(ch);
-        double lo = ch->center_hz - BAND_SIGMAS * sigma, hi = ch->center_hz + BAND_SIGMAS * sigma;
+        double lo, hi;
+        channel_support_hz(ch, BAND_SIGMAS, &lo, &hi);
         /* A wide band's low tail may reach below the model's range (even below 0):
          * it is tabulated from the range's start and evaluated directly below it
          * (alpha -> 0 there); the centre and the upper edge must be in range. */
@@ -328,7 +328,8 @@ thz_status atmosphere_prepare(thz_atmosphere *atm, const thz_channel *channels, 
         if (lo < model_lo && ch->center_hz >= model_lo)
             lo = model_lo;
         char what[128];
-        snprintf(what, sizeof what, "channel '%s' band (centre +- 6 sigma)", ch->name);
+        snprintf(what, sizeof what, "channel '%s' band (%s)", ch->name,
+                 channel_has_response(ch) ? "where its response is > 0" : "centre +- 6 sigma");
         st = atmosphere_check_range(atm, lo, hi, what, err);
         if (st != THZ_OK)
             goto cleanup;

@@ -129,9 +129,16 @@ static void validate_print(const thz_scene *s)
     for (size_t c = 0; c < si.n_channels; c++) {
         thz_channel_info ch;
         thz_scene_channel(s, c, &ch);
-        printf("  [%zu] %-16s centre %.4f THz  FWHM %.3f GHz  bandwidth B_c %.3f GHz\n", c, ch.name,
-               ch.frequency_hz * 1e-12, ch.relative_width * ch.frequency_hz * 1e-9,
-               ch.bandwidth_hz * 1e-9);
+        char response[64];
+        if (ch.response_points)
+            snprintf(response, sizeof response, "measured response (%zu points)",
+                     ch.response_points);
+        else
+            snprintf(response, sizeof response, "Gaussian");
+        printf("  [%zu] %-16s centre %.4f THz  FWHM %.3f GHz  bandwidth B_c %.3f GHz  noise "
+               "bandwidth B_n %.3f GHz  %s\n",
+               c, ch.name, ch.frequency_hz * 1e-12, ch.fwhm_hz * 1e-9, ch.bandwidth_hz * 1e-9,
+               ch.noise_bandwidth_hz * 1e-9, response);
     }
     printf("\nmaterials: %zu\n", si.n_materials);
     for (size_t m = 0; m < si.n_materials; m++) {

@@ -263,7 +263,7 @@ thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t s
         const thz_channel *ch = &scene->channels[c];
         ctx.channel_names[c] = ch->name;
         ctx.center_ghz[c] = ch->center_hz / 1e9;
-        ctx.fwhm_ghz[c] = ch->relative_width * ch->center_hz / 1e9;
+        ctx.fwhm_ghz[c] = channel_fwhm_hz(ch) / 1e9;
     }
     for (size_t i = 0; i < scene->n_objects; i++)
         ctx.object_names[i] = scene->objects[i].name;

@@ -246,6 +246,7 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
         uint8_t *p = header + 8 * (PMF_HEADER_FIXED + (size_t)PMF_CHANNEL_WORDS * c);
         uint64_t count = photon_map_count(maps[c]);
         put_f64(p, scene->channels[c].center_hz);
+        /* 0 for a measured response: its table is in the header's channel hash */
         put_f64(p + 8, scene->channels[c].relative_width);
         put_u64(p + 16, count);
         photon_stats s = {0};
@@ -589,8 +590,8 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
     }
     if (get_u64(header + 16) != h.channels) {
         st = thz_error_set(err, THZ_ERR_INPUT,
-                           "photon map %s was made from another channel set (frequencies or widths "
-                           "differ from %s); run `thzmap simulate` on this scene",
+                           "photon map %s was made from another channel set (frequencies, widths or "
+                           "responses differ from %s); run `thzmap simulate` on this scene",
                            path, scene->path ? scene->path : "this scene");
         goto cleanup;
     }

@@ -7,7 +7,8 @@
  *     u64 total file size (detects truncation before decoding anything);
  *   zstd frame 1 (with content checksum): the header: u64 scene hashes (geometry,
  *     optics, channels; scene_hash.h), u64 n_channels, n_objects, seed, photons per
- *     channel, then per channel: f64 centre Hz, f64 relative width, u64 record count, and
+ *     channel, then per channel: f64 centre Hz, f64 relative width (0 for a measured
+ *     response, whose table only the channels hash records), u64 record count, and
  *     the photon_stats (10 counters, 7 powers and means; the wall time is not stored so
  *     that a file depends only on the scene, seed and photon count), then f64 the map's
  *     reference temperature T0 in K (photon_map.h; 0 for the paper's map of L);

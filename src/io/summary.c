@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "core/path.h"
+#include "physics/channel.h"
 #include "sensor/measure.h"
 #include "sensor/noise.h"
 #include "thzmap/thzmap.h"
@@ -120,7 +121,11 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
     json_t *o = json_object();
     sum_set(o, "name", json_string(ch->name), ok);
     sum_set(o, "frequency_thz", json_real(ch->center_hz / 1e12), ok);
-    sum_set(o, "relative_width", json_real(ch->relative_width), ok);
+    bool table = channel_has_response(ch);
+    sum_set(o, "relative_width", table ? json_null() : json_real(ch->relative_width), ok);
+    sum_set(o, "response", json_string(table ? "table" : "gaussian"), ok);
+    sum_set(o, "bandwidth_ghz", sum_real(channel_bandwidth_hz(ch) * 1e-9), ok);
+    sum_set(o, "noise_bandwidth_ghz", sum_real(channel_noise_bandwidth_hz(ch) * 1e-9), ok);
     if (summary->channel_stats)
         sum_photon_stats(o, &summary->channel_stats[c], ok);
     if (summary->noise) {

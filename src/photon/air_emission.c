@@ -23,8 +23,7 @@ void air_emission_fini(air_emission *a)
  * source 4 pi alpha (B(T_air) - B0) (T_air = 0 when the air does not emit) and, in
  * *physical (may be NULL), the air's own emission 4 pi alpha B(T_air). Equal when
  * T0 = 0. */
-static double air_emission_density(const air_emission *a, double sigma_hz, double freq_hz,
-                                   double *physical)
+static double air_emission_density(const air_emission *a, double freq_hz, double *physical)
 {
     if (physical)
         *physical = 0.0;
@@ -32,8 +31,7 @@ static double air_emission_density(const air_emission *a, double sigma_hz, doubl
         return 0.0;
     const thz_channel *ch = &a->scene->channels[a->channel];
     const thz_atmosphere *atm = &a->scene->atmosphere;
-    double x = (freq_hz - ch->center_hz) / sigma_hz;
-    double g = exp(-0.5 * x * x) * a->volume_m3;
+    double g = channel_response(ch, freq_hz) * a->volume_m3;
     double own = g * atmosphere_volume_emission_w_per_m3_hz(atm, freq_hz);
     if (physical)
         *physical = own;
@@ -226,9 +224,8 @@ static thz_status air_emission_tabulate(air_emission *a, double *power, double *
 {
     *power = *physical_power = 0.0;
     const thz_channel *ch = &a->scene->channels[a->channel];
-    double sigma = channel_sigma_hz(ch);
-    double lo = ch->center_hz - AIR_EMISSION_SIGMAS * sigma;
-    double hi = ch->center_hz + AIR_EMISSION_SIGMAS * sigma;
+    double lo, hi;
+    channel_support_hz(ch, AIR_EMISSION_SIGMAS, &lo, &hi);
     if (lo < 0.0)
         lo = 0.0;
     a->lo_hz = lo;
@@ -241,10 +238,10 @@ static thz_status air_emission_tabulate(air_emission *a, double *power, double *
      * than a line), floored at 1e-6 of the peak so that q > 0 wherever g P may be
      * nonzero. (B(T_air) - B0 has one sign over the band: so has the density.) */
     double own_prev, own_next;
-    double prev = air_emission_density(a, sigma, lo, &own_prev), peak = 0.0, trapezoid = 0.0;
+    double prev = air_emission_density(a, lo, &own_prev), peak = 0.0, trapezoid = 0.0;
     double own_trapezoid = 0.0;
     for (size_t i = 0; i < AIR_EMISSION_BINS; i++) {
-        double next = air_emission_density(a, sigma, lo + (double)(i + 1) * a->bin_hz, &own_next);
+        double next = air_emission_density(a, lo + (double)(i + 1) * a->bin_hz, &own_next);
         a->q[i] = fmax(fabs(prev), fabs(next));
         trapezoid += 0.5 * (prev + next) * a->bin_hz;
         own_trapezoid += 0.5 * (own_prev + own_next) * a->bin_hz;
@@ -252,7 +249,7 @@ static thz_status air_emission_tabulate(air_emission *a, double *power, double *
         prev = next;
         own_prev = own_next;
     }
-    *physical_power = own_trapezoid / (sigma * sqrt(2.0 * M_PI));
+    *physical_power = own_trapezoid / channel_bandwidth_hz(ch);
     if (!(peak > 0.0)) {
         free(a->q);
         free(a->cdf);
@@ -265,7 +262,7 @@ static thz_status air_emission_tabulate(air_emission *a, double *power, double *
         sum += a->q[i] * a->bin_hz;
         a->cdf[i] = sum;
     }
-    *power = trapezoid / (sigma * sqrt(2.0 * M_PI));
+    *power = trapezoid / channel_bandwidth_hz(ch);
     return THZ_OK;
 }
 
@@ -370,8 +367,9 @@ static bool air_emission_air_photon(const air_emission *a, rng_stream *rng, emis
     double x = rng_uniform(rng) * a->cdf[AIR_EMISSION_BINS - 1];
     size_t lo = cdf_search(a->cdf, AIR_EMISSION_BINS, x);
     double nu = a->lo_hz + ((double)lo + rng_uniform(rng)) * a->bin_hz;
+    /* sigma sqrt(2 pi) = B_c (channel_sigma_hz; kept as two factors, the outputs' rounding) */
     double sigma = channel_sigma_hz(&a->scene->channels[a->channel]);
-    double f = air_emission_density(a, sigma, nu, NULL);
+    double f = air_emission_density(a, nu, NULL);
     out->freq_hz = nu;
     out->power_w_per_hz = f * a->cdf[AIR_EMISSION_BINS - 1] /
                           (a->q[lo] * sigma * sqrt(2.0 * M_PI) * a->p_air * (double)a->n_photons);

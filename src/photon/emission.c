@@ -109,11 +109,10 @@ static bool emission_tabulate(emission_table *t)
     t->cum_q = thz_malloc_array((size_t)EMISSION_TABLE_NODES * ng, sizeof *t->cum_q);
     if (!t->cum_q)
         return false;
-    double sigma = channel_sigma_hz(ch);
-    double lo = ch->center_hz - EMISSION_TABLE_SIGMAS * sigma;
+    double lo, hi;
+    channel_support_hz(ch, EMISSION_TABLE_SIGMAS, &lo, &hi);
     if (lo < 0.0)
         lo = 0.0;
-    double hi = ch->center_hz + EMISSION_TABLE_SIGMAS * sigma;
     t->nu0_hz = lo;
     t->step_hz = (hi - lo) / (EMISSION_TABLE_NODES - 1);
     double largest = 0.0;

@@ -1,5 +1,7 @@
-/* Gaussian channel responses, sampling and band-mean quadrature (physics.md
- * "Channels"). */
+/* Channel responses (Gaussian or a measured table), sampling and band-mean quadrature
+ * (physics.md "Channels"). Every function handles both: the Gaussian's arithmetic is
+ * unchanged from before tables existed (outputs stay bit-identical); a table's is exact
+ * for its piecewise-linear g. */
 #include "physics/channel.h"
 
 #include <math.h>
@@ -7,8 +9,124 @@
 
 #include "core/alloc.h"
 
-/* 2 sqrt(2 ln 2): FWHM of a Gaussian in units of sigma. */
-#define CHANNEL_FWHM_PER_SIGMA 2.3548200450309493
+/* ---- measured response tables ---------------------------------------------------- */
+
+/* The piece i of the table, [f_i, f_i+1]: its width and end weights. */
+static void channel_piece(const thz_channel *ch, size_t i, double *h, double *a, double *b)
+{
+    *h = ch->response_hz[i + 1] - ch->response_hz[i];
+    *a = ch->response_weight[i];
+    *b = ch->response_weight[i + 1];
+}
+
+/* Index of the piece holding freq_hz (inside the table): the last i < n - 1 with
+ * f_i <= freq_hz. */
+static size_t channel_piece_at(const thz_channel *ch, double freq_hz)
+{
+    size_t lo = 0, hi = ch->n_response - 1; /* f_lo <= freq < f_hi, or freq == f_hi */
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (ch->response_hz[mid] <= freq_hz)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+thz_status channel_set_response(thz_channel *ch, size_t n, const double *freq_hz,
+                                const double *weight, double centre_hz, thz_error *err)
+{
+    double peak = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        if (!(weight[i] >= 0.0) || !isfinite(weight[i]) || !(freq_hz[i] > 0.0) ||
+            (i > 0 && !(freq_hz[i] > freq_hz[i - 1])))
+            return thz_error_set(err, THZ_ERR_INPUT,
+                                 "channel '%s': bad response table at point %zu", ch->name, i + 1);
+        peak = weight[i] > peak ? weight[i] : peak;
+    }
+    if (n < 2 || !(peak > 0.0))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "channel '%s': a response needs 2 points and a weight > 0", ch->name);
+    double *f = thz_malloc_array(n, sizeof *f);
+    double *w = thz_malloc_array(n, sizeof *w);
+    double *area = thz_malloc_array(n, sizeof *area);
+    if (!f || !w || !area) {
+        free(f);
+        free(w);
+        free(area);
+        return thz_error_set(err, THZ_ERR_NOMEM, "channel '%s': out of memory", ch->name);
+    }
+    double moment = 0.0; /* int nu g dnu, Simpson: exact for the quadratic nu g */
+    area[0] = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        f[i] = freq_hz[i];
+        w[i] = weight[i];
+        if (i == 0)
+            continue;
+        double h = f[i] - f[i - 1];
+        area[i] = area[i - 1] + 0.5 * h * (w[i - 1] + w[i]);
+        moment += h / 6.0 * (w[i - 1] * (2.0 * f[i - 1] + f[i]) + w[i] * (f[i - 1] + 2.0 * f[i]));
+    }
+    channel_fini(ch);
+    ch->n_response = n;
+    ch->response_hz = f;
+    ch->response_weight = w;
+    ch->response_area_hz = area;
+    ch->relative_width = 0.0;
+    ch->center_hz = centre_hz > 0.0 ? centre_hz : moment / area[n - 1];
+    return THZ_OK;
+}
+
+void channel_fini(thz_channel *ch)
+{
+    if (!ch)
+        return;
+    free(ch->response_hz);
+    free(ch->response_weight);
+    free(ch->response_area_hz);
+    ch->n_response = 0;
+    ch->response_hz = ch->response_weight = ch->response_area_hz = NULL;
+}
+
+void channel_support_hz(const thz_channel *ch, double sigmas, double *lo_hz, double *hi_hz)
+{
+    if (!channel_has_response(ch)) {
+        double sigma = channel_sigma_hz(ch);
+        *lo_hz = ch->center_hz - sigmas * sigma;
+        *hi_hz = ch->center_hz + sigmas * sigma;
+        return;
+    }
+    size_t n = ch->n_response, first = 0, last = n - 1;
+    while (first < n - 1 && !(ch->response_weight[first] > 0.0))
+        first++;
+    while (last > 0 && !(ch->response_weight[last] > 0.0))
+        last--;
+    *lo_hz = ch->response_hz[first > 0 ? first - 1 : 0];
+    *hi_hz = ch->response_hz[last < n - 1 ? last + 1 : n - 1];
+}
+
+/* The width of a table's support (Hz). */
+static double channel_support_width_hz(const thz_channel *ch)
+{
+    double lo, hi;
+    channel_support_hz(ch, 0.0, &lo, &hi);
+    return hi - lo;
+}
+
+/* Composite Simpson panels given to table piece i when about `panels` are spread over
+ * the pieces where g > 0 (support width `width_hz`) in proportion to their widths; 0 for
+ * a piece where g = 0. */
+static size_t channel_piece_panels(const thz_channel *ch, size_t i, size_t panels, double width_hz)
+{
+    double h, a, b;
+    channel_piece(ch, i, &h, &a, &b);
+    if (!(a + b > 0.0))
+        return 0;
+    double p = ceil((double)panels * h / width_hz);
+    return p < 1.0 ? 1 : (size_t)p;
+}
+
 #define CHANNEL_SQRT_2PI 2.5066282746310002
 #define CHANNEL_TWO_PI 6.283185307179586
 #define CHANNEL_HALF_SPAN_SIGMAS 6.0
@@ -34,28 +152,105 @@ static double channel_simpson_weight(size_t i, size_t n)
 
 double channel_sigma_hz(const thz_channel *ch)
 {
+    if (channel_has_response(ch))
+        return channel_bandwidth_hz(ch) / CHANNEL_SQRT_2PI;
     return ch->relative_width * ch->center_hz / CHANNEL_FWHM_PER_SIGMA;
+}
+
+double channel_fwhm_hz(const thz_channel *ch)
+{
+    if (!channel_has_response(ch))
+        return ch->relative_width * ch->center_hz;
+    const double *f = ch->response_hz, *w = ch->response_weight;
+    size_t n = ch->n_response, first = 0, last = n - 1;
+    double half = 0.0;
+    for (size_t i = 0; i < n; i++)
+        half = w[i] > half ? w[i] : half;
+    half *= 0.5;
+    while (w[first] < half)
+        first++; /* the peak is >= half: both loops stop */
+    while (w[last] < half)
+        last--;
+    /* g rises through half its peak on the piece before `first` (or jumps there at the
+     * table's start), falls through it after `last` */
+    double lo = first == 0 ? f[0]
+                           : f[first - 1] + (f[first] - f[first - 1]) * (half - w[first - 1]) /
+                                                (w[first] - w[first - 1]);
+    double hi = last == n - 1 ? f[n - 1]
+                              : f[last] + (f[last + 1] - f[last]) * (w[last] - half) /
+                                              (w[last] - w[last + 1]);
+    return hi - lo;
 }
 
 double channel_bandwidth_hz(const thz_channel *ch)
 {
+    if (channel_has_response(ch))
+        return ch->response_area_hz[ch->n_response - 1];
     return channel_sigma_hz(ch) * CHANNEL_SQRT_2PI;
 }
 
 double channel_noise_bandwidth_hz(const thz_channel *ch)
 {
+    if (channel_has_response(ch)) {
+        double g2 = 0.0; /* int g^2 dnu, exact on each linear piece */
+        for (size_t i = 0; i + 1 < ch->n_response; i++) {
+            double h, a, b;
+            channel_piece(ch, i, &h, &a, &b);
+            g2 += h * (a * a + a * b + b * b) / 3.0;
+        }
+        double bc = channel_bandwidth_hz(ch);
+        return bc * bc / g2;
+    }
     return 2.0 * sqrt(M_PI) * channel_sigma_hz(ch);
 }
 
 double channel_response(const thz_channel *ch, double freq_hz)
 {
+    if (channel_has_response(ch)) {
+        const double *f = ch->response_hz;
+        if (!(freq_hz >= f[0]) || freq_hz > f[ch->n_response - 1])
+            return 0.0;
+        size_t i = channel_piece_at(ch, freq_hz);
+        double h, a, b;
+        channel_piece(ch, i, &h, &a, &b);
+        return a + (b - a) * ((freq_hz - f[i]) / h);
+    }
     double s = channel_sigma_hz(ch);
     double d = (freq_hz - ch->center_hz) / s;
     return exp(-0.5 * d * d);
 }
 
+/* A table's frequency: the piece whose cumulative area first exceeds u1 B_c, then the
+ * root t in [0, 1] of a t + (b - a) t^2 / 2 = u2 (a + b) / 2 (the piece's linear
+ * density inverted), in the form that stays accurate when b - a is small. */
+static double channel_sample_table_hz(const thz_channel *ch, double u1, double u2)
+{
+    const double *area = ch->response_area_hz;
+    size_t n = ch->n_response;
+    double target = u1 * area[n - 1];
+    size_t lo = 0, hi = n - 1; /* the piece is the first i with area[i + 1] > target */
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (area[mid] > target)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    while (lo > 0 && !(area[lo + 1] > area[lo]))
+        lo--; /* u1 rounded onto the end of a zero piece: the last piece with area */
+    double h, a, b;
+    channel_piece(ch, lo, &h, &a, &b);
+    double c = u2 * 0.5 * (a + b);
+    double root = a * a + 2.0 * (b - a) * c;
+    double t = c > 0.0 ? 2.0 * c / (a + sqrt(root > 0.0 ? root : 0.0)) : 0.0;
+    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    return ch->response_hz[lo] + t * h;
+}
+
 double channel_sample_hz(const thz_channel *ch, double u1, double u2)
 {
+    if (channel_has_response(ch))
+        return channel_sample_table_hz(ch, u1, u2);
     /* Box-Muller; 1 - u1 lies in (0, 1] so the log is finite. */
     double r = sqrt(-2.0 * log(1.0 - u1));
     double z = r * cos(CHANNEL_TWO_PI * u2);
@@ -69,12 +264,65 @@ double channel_sample_hz(const thz_channel *ch, double u1, double u2)
     return nu;
 }
 
+/* A table's nodes: composite Simpson on each piece where g > 0 (panels as
+ * channel_piece_panels for about n nodes), nodes shared by adjacent pieces merged. */
+static thz_status channel_quadrature_table(channel_quadrature *q, const thz_channel *ch, size_t n,
+                                           thz_error *err)
+{
+    size_t panels = n / 2, count = 0;
+    double width = channel_support_width_hz(ch);
+    for (size_t i = 0; i + 1 < ch->n_response; i++) {
+        size_t p = channel_piece_panels(ch, i, panels, width);
+        count += p ? 2 * p + 1 : 0;
+    }
+    double *f = thz_malloc_array(count, sizeof *f);
+    double *w = thz_malloc_array(count, sizeof *w);
+    if (!f || !w) {
+        free(f);
+        free(w);
+        return thz_error_set(err, THZ_ERR_NOMEM, "channel quadrature: cannot allocate %zu nodes",
+                             count);
+    }
+    size_t m = 0;
+    double sum = 0.0;
+    for (size_t i = 0; i + 1 < ch->n_response; i++) {
+        size_t p = channel_piece_panels(ch, i, panels, width);
+        if (!p)
+            continue;
+        double h, a, b;
+        channel_piece(ch, i, &h, &a, &b);
+        size_t k_n = 2 * p + 1;
+        double d = h / (double)(k_n - 1);
+        for (size_t k = 0; k < k_n; k++) {
+            double t = (double)k / (double)(k_n - 1);
+            double nu = k + 1 == k_n ? ch->response_hz[i + 1] : ch->response_hz[i] + t * h;
+            double wk = d / 3.0 * channel_simpson_weight(k, k_n) * (a + (b - a) * t);
+            if (k == 0 && m > 0 && f[m - 1] == nu) {
+                w[m - 1] += wk; /* the end node of the previous piece */
+            } else {
+                f[m] = nu;
+                w[m] = wk;
+                m++;
+            }
+            sum += wk;
+        }
+    }
+    for (size_t i = 0; i < m; i++)
+        w[i] /= sum;
+    q->n = m;
+    q->freq_hz = f;
+    q->weight = w;
+    return THZ_OK;
+}
+
 thz_status channel_quadrature_init(channel_quadrature *q, const thz_channel *ch, size_t n,
                                    thz_error *err)
 {
     q->n = 0;
     q->freq_hz = NULL;
     q->weight = NULL;
+    if (channel_has_response(ch))
+        return channel_quadrature_table(q, ch, n < 3 ? 3 : n, err);
     if (n < 3)
         n = 3;
     if (n % 2 == 0)
@@ -129,15 +377,21 @@ void channel_quadrature_fini(channel_quadrature *q)
 
 typedef struct channel_adapt {
     const thz_channel *ch;
-    double sigma_hz;
+    double sigma_hz; /* the Gaussian's; 0 for a table, whose x is the frequency in Hz */
     double (*f)(double freq_hz, void *ctx);
     void *ctx;
     double num, den; /* accumulated int g f dx and int g dx (x in sigma units) */
 } channel_adapt;
 
-/* g(x) f(nu(x)) and g(x) at x sigma from the centre; 0 for nu <= 0. */
+/* g(x) f(nu(x)) and g(x) at x sigma from the centre (a table: at x Hz); 0 for nu <= 0
+ * and where a table's g is 0. */
 static void channel_adapt_eval(const channel_adapt *a, double x, double *gf, double *g)
 {
+    if (a->sigma_hz == 0.0) {
+        *g = channel_response(a->ch, x);
+        *gf = *g > 0.0 ? *g * a->f(x, a->ctx) : 0.0;
+        return;
+    }
     double nu = a->ch->center_hz + a->sigma_hz * x;
     if (!(nu > 0.0)) {
         *gf = 0.0;
@@ -172,8 +426,45 @@ static void channel_adapt_panel(channel_adapt *a, double x0, double x2, const do
     channel_adapt_panel(a, x1, x2, rf, rg, rn, 0.5 * tol, depth + 1);
 }
 
+/* A table's base panels (as channel_quadrature_table's for CHANNEL_QUADRATURE_NODES),
+ * each refined adaptively. Two passes: the first sums |g f| for the tolerance's scale
+ * (no allocation; f is evaluated twice on the base nodes). */
+static double channel_band_mean_table(const thz_channel *ch, double (*f)(double freq_hz, void *ctx),
+                                      void *ctx)
+{
+    channel_adapt a = {ch, 0.0, f, ctx, 0.0, 0.0};
+    const size_t panels = (CHANNEL_QUADRATURE_NODES - 1) / 2;
+    double scale = 0.0, tol = 0.0, width = channel_support_width_hz(ch);
+    size_t total = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t i = 0; i + 1 < ch->n_response; i++) {
+            size_t p = channel_piece_panels(ch, i, panels, width);
+            double lo = ch->response_hz[i], hi = ch->response_hz[i + 1];
+            for (size_t j = 0; j < p; j++) {
+                double x0 = lo + (hi - lo) * (double)j / (double)p;
+                double x2 = j + 1 == p ? hi : lo + (hi - lo) * (double)(j + 1) / (double)p;
+                double fv[3], gv[3];
+                channel_adapt_eval(&a, x0, &fv[0], &gv[0]);
+                channel_adapt_eval(&a, 0.5 * (x0 + x2), &fv[1], &gv[1]);
+                channel_adapt_eval(&a, x2, &fv[2], &gv[2]);
+                double s_num = (x2 - x0) / 6.0 * (fv[0] + 4.0 * fv[1] + fv[2]);
+                if (pass == 0) {
+                    scale += (x2 - x0) / 6.0 * (fabs(fv[0]) + 4.0 * fabs(fv[1]) + fabs(fv[2]));
+                    total++;
+                } else {
+                    channel_adapt_panel(&a, x0, x2, fv, gv, s_num, tol, 0);
+                }
+            }
+        }
+        tol = CHANNEL_ADAPT_REL_TOL * scale / (double)(total ? total : 1);
+    }
+    return a.den > 0.0 ? a.num / a.den : 0.0;
+}
+
 double channel_band_mean(const thz_channel *ch, double (*f)(double freq_hz, void *ctx), void *ctx)
 {
+    if (channel_has_response(ch))
+        return channel_band_mean_table(ch, f, ctx);
     /* The base grid of CHANNEL_QUADRATURE_NODES nodes (as channel_quadrature_init),
      * kept on the stack: no allocation. */
     enum { n = CHANNEL_QUADRATURE_NODES };

@@ -92,16 +92,23 @@ static double load_kirchhoff_worst(thz_scene *s, const thz_object *obj, double *
     return worst;
 }
 
-/* Warns about channel bands (centre +- 2 FWHM) that leave table `sp`. */
+/* The band of a channel the table warnings check: the Gaussian's centre +- 2 FWHM, a
+ * measured response's span where it is > 0. */
+static void load_channel_band(const thz_channel *ch, double *lo_hz, double *hi_hz)
+{
+    channel_support_hz(ch, 2.0 * CHANNEL_FWHM_PER_SIGMA, lo_hz, hi_hz);
+}
+
+/* Warns about channel bands (load_channel_band) that leave table `sp`. */
 static bool load_warn_table(thz_scene *s, const thz_spectrum *sp, const char *what)
 {
     if (!sp->freq_hz || sp->n < 2)
         return true;
     size_t first = s->n_channels, count = 0;
     for (size_t c = 0; c < s->n_channels; c++) {
-        const thz_channel *ch = &s->channels[c];
-        double fwhm = ch->relative_width * ch->center_hz;
-        if (spectrum_table_exceeded(sp, ch->center_hz - 2 * fwhm, ch->center_hz + 2 * fwhm)) {
+        double lo, hi;
+        load_channel_band(&s->channels[c], &lo, &hi);
+        if (spectrum_table_exceeded(sp, lo, hi)) {
             if (first == s->n_channels)
                 first = c;
             count++;
@@ -110,13 +117,14 @@ static bool load_warn_table(thz_scene *s, const thz_spectrum *sp, const char *wh
     if (count == 0)
         return true;
     const thz_channel *ch = &s->channels[first];
-    double fwhm = ch->relative_width * ch->center_hz;
+    double lo, hi;
+    load_channel_band(ch, &lo, &hi);
     return scene_add_warning(
         s,
         "%s: the table covers %.4g to %.4g THz but channel \"%s\" (band %.4g to %.4g THz, "
-        "centre +- 2 FWHM)%s reaches beyond it; the end values are used there",
-        what, sp->freq_hz[0] * 1e-12, sp->freq_hz[sp->n - 1] * 1e-12, ch->name,
-        (ch->center_hz - 2 * fwhm) * 1e-12, (ch->center_hz + 2 * fwhm) * 1e-12,
+        "%s)%s reaches beyond it; the end values are used there",
+        what, sp->freq_hz[0] * 1e-12, sp->freq_hz[sp->n - 1] * 1e-12, ch->name, lo * 1e-12,
+        hi * 1e-12, channel_has_response(ch) ? "where its response is > 0" : "centre +- 2 FWHM",
         count > 1 ? " and others" : "");
 }
 

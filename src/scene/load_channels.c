@@ -1,5 +1,7 @@
-/* The scene's `channels` block: a list of channels or an evenly spaced range, and the
- * default names of unnamed channels (unique, so that ENVI band names are). */
+/* The scene's `channels` block: a list of channels (each a Gaussian of relative_width
+ * or a measured response, inline or from a CSV file) or an evenly spaced range of
+ * Gaussians, and the default names of unnamed channels (unique, so that ENVI band names
+ * are). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -140,12 +142,103 @@ static thz_status load_channel_range(load_ctx *ctx, const load_cursor *c)
     return load_channel_default_names(ctx, c, false);
 }
 
+/* The measured response of list entry e (`response` or `response_file`, which the
+ * caller has found) as a table of at least 2 points with a weight > 0. */
+static thz_status load_channel_table(load_ctx *ctx, const load_cursor *e, thz_spectrum *out)
+{
+    load_cursor k = load_key(e, "response");
+    thz_status st = THZ_OK;
+    const char *where = NULL; /* the CSV file, for messages */
+    csv_table t = {0};
+    if (k.value) {
+        bool present;
+        if (!json_is_array(k.value))
+            return load_fail(ctx, &k, "expected a table [[frequency_thz, weight], ...], got %s",
+                             load_type_name(k.value));
+        if (json_array_size(k.value) < 2)
+            return load_fail(ctx, &k, "expected at least 2 points [frequency_thz, weight], got %zu",
+                             json_array_size(k.value));
+        st = load_spectrum(ctx, e, "response", LOAD_NONNEGATIVE, out, &present);
+    } else {
+        k = load_key(e, "response_file");
+        st = load_csv(ctx, e, "response_file", &t);
+        if (st == THZ_OK) {
+            static const char *const columns[] = {"weight", NULL};
+            where = t.label;
+            st = load_csv_columns(ctx, &k, &t, columns, "weight");
+        }
+        if (st == THZ_OK && t.n_rows < 2)
+            st = load_fail(ctx, &k, "%s: expected at least 2 rows (frequency_thz, weight), got %zu",
+                           t.label, t.n_rows);
+        if (st == THZ_OK)
+            st = load_csv_spectrum(ctx, &k, &t, "weight", LOAD_NONNEGATIVE, out);
+    }
+    double peak = 0.0;
+    for (size_t i = 0; st == THZ_OK && i < out->n; i++)
+        peak = out->value[i] > peak ? out->value[i] : peak;
+    if (st == THZ_OK && !(peak > 0.0))
+        st = load_fail(ctx, &k, "%s%severy weight is 0 (expected at least one > 0)",
+                       where ? where : "", where ? ": " : "");
+    csv_fini(&t);
+    return st;
+}
+
+/* The spectral response of list entry e: relative_width (the Gaussian), or a measured
+ * `response` or `response_file`, exactly one of them. frequency_thz (*thz) is required
+ * with the Gaussian; with a table it is optional (0: the response-weighted mean) and
+ * must lie where the response is > 0. */
+static thz_status load_channel_response(load_ctx *ctx, const load_cursor *e, thz_channel *ch)
+{
+    static const char *const forms[] = {"relative_width", "response", "response_file"};
+    size_t given = 0, which = 0;
+    for (size_t i = 0; i < 3; i++)
+        if (json_object_get(e->value, forms[i])) {
+            given++;
+            which = given == 1 ? i : which;
+        }
+    if (given != 1)
+        return load_fail(ctx, e, "%s (expected exactly one of relative_width, response, "
+                                 "response_file)",
+                         given ? "conflicting responses" : "missing spectral response");
+    double thz = 0.0;
+    thz_status st = load_number(ctx, e, "frequency_thz", LOAD_POSITIVE, which == 0, 0.0, &thz);
+    if (st != THZ_OK)
+        return st;
+    if (which == 0) {
+        ch->center_hz = thz * 1e12;
+        return load_number(ctx, e, "relative_width", load_relative_width, true, 0,
+                           &ch->relative_width);
+    }
+    thz_spectrum table = {0};
+    st = load_channel_table(ctx, e, &table);
+    if (st == THZ_OK) {
+        thz_error inner = {0};
+        st = channel_set_response(ch, table.n, table.freq_hz, table.value, thz * 1e12, &inner);
+        if (st != THZ_OK)
+            st = load_fail(ctx, e, "%s", inner.message);
+    }
+    spectrum_fini(&table);
+    double lo, hi;
+    if (st == THZ_OK && thz > 0.0) {
+        channel_support_hz(ch, 0.0, &lo, &hi);
+        if (!(ch->center_hz >= lo && ch->center_hz <= hi)) {
+            load_cursor k = load_key(e, "frequency_thz");
+            st = load_fail(ctx, &k,
+                           "expected a frequency where the response is > 0 (%g to %g THz), got %g",
+                           lo * 1e-12, hi * 1e-12, thz);
+        }
+    }
+    return st;
+}
+
 thz_status load_channels(load_ctx *ctx, const load_cursor *root)
 {
-    static const char *const keys[] = {"name", "frequency_thz", "relative_width", NULL};
+    static const char *const keys[] = {"name",     "frequency_thz", "relative_width",
+                                       "response", "response_file", NULL};
     thz_scene *s = ctx->scene;
     load_cursor c = load_key(root, "channels");
-    const char *what = "a list of channels [{\"frequency_thz\": ..., \"relative_width\": ...}] or "
+    const char *what = "a list of channels [{\"frequency_thz\": ..., \"relative_width\": ...} or "
+                       "{\"response\": [[frequency_thz, weight], ...]}] or "
                        "a range {\"from_thz\", \"to_thz\", \"count\", \"relative_width\"}";
     if (!c.value)
         return load_fail(ctx, &c, "missing key (expected %s)", what);
@@ -165,19 +258,14 @@ thz_status load_channels(load_ctx *ctx, const load_cursor *root)
     for (size_t i = 0; i < n; i++) {
         load_cursor e = load_index(&c, i);
         thz_channel *ch = &s->channels[i];
-        double thz;
         const char *name = NULL;
         thz_status st = load_expect_object(ctx, &e, keys);
         if (st == THZ_OK)
-            st = load_number(ctx, &e, "frequency_thz", LOAD_POSITIVE, true, 0, &thz);
-        if (st == THZ_OK)
-            st = load_number(ctx, &e, "relative_width", load_relative_width, true, 0,
-                             &ch->relative_width);
+            st = load_channel_response(ctx, &e, ch);
         if (st == THZ_OK)
             st = load_unique_name(ctx, &c, i, "channel", false, &name);
         if (st != THZ_OK)
             return st;
-        ch->center_hz = thz * 1e12;
         if (name && strlen(name) >= sizeof ch->name) {
             load_cursor k = load_key(&e, "name");
             return load_fail(ctx, &k, "channel names are at most %zu characters",

@@ -67,6 +67,8 @@ void scene_destroy(thz_scene *s)
         free(s->sensors[i].noise.netd_k);
     }
     free(s->sensors);
+    for (size_t i = 0; s->channels && i < s->n_channels; i++)
+        channel_fini(&s->channels[i]);
     free(s->channels);
     atmosphere_fini(&s->atmosphere);
     for (size_t i = 0; i < s->n_warnings; i++)

@@ -126,6 +126,11 @@ void scene_hash_compute(const thz_scene *scene, scene_hash *out)
     for (size_t i = 0; i < scene->n_channels; i++) {
         c = hash_double(c, scene->channels[i].center_hz);
         c = hash_double(c, scene->channels[i].relative_width);
+        const thz_channel *ch = &scene->channels[i];
+        for (size_t k = 0; k < ch->n_response; k++) { /* nothing for a Gaussian: as before */
+            c = hash_double(c, ch->response_hz[k]);
+            c = hash_double(c, ch->response_weight[k]);
+        }
     }
     out->geometry = hash_finish(g);
     out->optics = hash_finish(o);

@@ -7,7 +7,8 @@
  *  - optics: every object's material index and temperature, every material's spectra
  *    (R, alpha_M, eps) and transmission mode, the atmosphere (model, spectrum, air
  *    state, the prepared alpha tables of the line-by-line models, emission, extent);
- *  - channels: the channels' centres and widths.
+ *  - channels: the channels' centres and widths, and measured responses' tables (nothing
+ *    for a Gaussian, so that its hash is what it was before tables existed).
  * Names, colours, sensors, render settings and the photon count, seed and
  * min_relative_power are left out: they change neither what a photon map means nor
  * whether it fits the scene (a map fired with `--photons N` is valid for any render).

@@ -11,7 +11,7 @@
 #include "core/rng.h"
 #include "physics/channel.h"
 
-static const thz_channel ch_default = {"c1", 1.0e12, 0.1};
+static const thz_channel ch_default = {.name = "c1", .center_hz = 1.0e12, .relative_width = 0.1};
 
 static double f_const(double nu, void *ctx)
 {
@@ -71,7 +71,7 @@ static void test_band_mean_of_response(void **state)
     (void)state;
     /* int g^2 / int g = 1/sqrt(2). The quadrature spans +-6 sigma, which drops
      * P(|z| > 6) = 1.97e-9 of int g: allowance 2.5e-9. */
-    const thz_channel chs[] = {{"a", 1e12, 0.1}, {"b", 0.3e12, 0.02}, {"c", 2.5e12, 0.3}};
+    const thz_channel chs[] = {{.name = "a", .center_hz = 1e12, .relative_width = 0.1}, {.name = "b", .center_hz = 0.3e12, .relative_width = 0.02}, {.name = "c", .center_hz = 2.5e12, .relative_width = 0.3}};
     for (size_t i = 0; i < 3; i++) {
         double m = channel_band_mean(&chs[i], f_response, (void *)&chs[i]);
         assert_true(fabs(m - M_SQRT1_2) < 2.5e-9);
@@ -130,7 +130,7 @@ static void test_quadrature_struct(void **state)
     assert_null(q.weight);
 
     /* Even n is rounded up to odd; a wide channel keeps only positive nodes. */
-    thz_channel wide = {"w", 1e12, 0.5};
+    thz_channel wide = {.name = "w", .center_hz = 1e12, .relative_width = 0.5};
     assert_int_equal(channel_quadrature_init(&q, &wide, 100, &err), THZ_OK);
     assert_true(q.n <= 101);
     for (size_t i = 0; i < q.n; i++)
@@ -141,7 +141,7 @@ static void test_quadrature_struct(void **state)
 static void test_sampling(void **state)
 {
     (void)state;
-    const thz_channel ch = {"s", 0.8e12, 0.2};
+    const thz_channel ch = {.name = "s", .center_hz = 0.8e12, .relative_width = 0.2};
     const double sigma = channel_sigma_hz(&ch);
     const double scale = getenv("THZ_TEST_SCALE") ? atof(getenv("THZ_TEST_SCALE")) : 1.0;
     const size_t n = (size_t)(1e6 * (scale > 0.0 && scale <= 1.0 ? scale : 1.0));
@@ -169,7 +169,7 @@ static void test_sampling(void **state)
     assert_true(fabs((double)within_1sigma / dn - p) < 5.0 * sqrt(p * (1.0 - p) / dn));
 
     /* u1 = 0 must not produce an infinity; results stay positive for a wide channel */
-    const thz_channel wide = {"w", 1e12, 0.5};
+    const thz_channel wide = {.name = "w", .center_hz = 1e12, .relative_width = 0.5};
     for (int i = 0; i < 64; i++) {
         double nu = channel_sample_hz(&wide, i / 64.0, (i * 37 % 64) / 64.0);
         assert_true(isfinite(nu) && nu > 0.0);

@@ -109,7 +109,8 @@ static void test_airy_profile_and_fwhm(void **state)
 {
     (void)state;
     const double d_m = 0.05, pitch = 1.5e-3;
-    const thz_channel chans[2] = {{"a", 0.35e12, 0.01}, {"b", 0.5e12, 0.05}};
+    const thz_channel chans[2] = {{.name = "a", .center_hz = 0.35e12, .relative_width = 0.01},
+                                  {.name = "b", .center_hz = 0.5e12, .relative_width = 0.05}};
     for (int c = 0; c < 2; c++) {
         const thz_channel *ch = &chans[c];
         thz_sensor s = test_sensor(pitch, d_m);
@@ -170,7 +171,7 @@ static void test_airy_profile_and_fwhm(void **state)
 static void test_airy_narrow(void **state)
 {
     (void)state;
-    const thz_channel ch = {"a", 0.35e12, 0.01};
+    const thz_channel ch = {.name = "a", .center_hz = 0.35e12, .relative_width = 0.01};
     const double d_m = 0.05, pitch = 8.5e-3;
     thz_sensor s = test_sensor(pitch, d_m);
     psf_kernel k;
@@ -207,7 +208,7 @@ static void test_airy_narrow(void **state)
 static void test_gaussian_direct(void **state)
 {
     (void)state;
-    const thz_channel ch = {"a", 0.35e12, 0.01};
+    const thz_channel ch = {.name = "a", .center_hz = 0.35e12, .relative_width = 0.01};
     const double pitch = 1e-3;
     thz_sensor s = test_sensor(pitch, 0.0);
     s.psf = PSF_GAUSSIAN;
