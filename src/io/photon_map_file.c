@@ -589,10 +589,11 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
         goto cleanup;
     }
     if (get_u64(header + 16) != h.channels) {
-        st = thz_error_set(err, THZ_ERR_INPUT,
-                           "photon map %s was made from another channel set (frequencies, widths or "
-                           "responses differ from %s); run `thzmap simulate` on this scene",
-                           path, scene->path ? scene->path : "this scene");
+        st =
+            thz_error_set(err, THZ_ERR_INPUT,
+                          "photon map %s was made from another channel set (frequencies, widths or "
+                          "responses differ from %s); run `thzmap simulate` on this scene",
+                          path, scene->path ? scene->path : "this scene");
         goto cleanup;
     }
     if (get_u64(header + 8) != h.optics) {

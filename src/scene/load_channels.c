@@ -197,8 +197,9 @@ static thz_status load_channel_response(load_ctx *ctx, const load_cursor *e, thz
             which = given == 1 ? i : which;
         }
     if (given != 1)
-        return load_fail(ctx, e, "%s (expected exactly one of relative_width, response, "
-                                 "response_file)",
+        return load_fail(ctx, e,
+                         "%s (expected exactly one of relative_width, response, "
+                         "response_file)",
                          given ? "conflicting responses" : "missing spectral response");
     double thz = 0.0;
     thz_status st = load_number(ctx, e, "frequency_thz", LOAD_POSITIVE, which == 0, 0.0, &thz);

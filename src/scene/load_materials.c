@@ -109,9 +109,8 @@ static thz_status load_material_reflection(load_ctx *ctx, const load_cursor *c, 
 static thz_status load_material(load_ctx *ctx, const load_cursor *c, thz_material *m)
 {
     static const char *const keys[] = {
-        "reflectivity", "attenuation_per_m", "emissivity",         "transmission", "color",
-        "file",         "refractive_index",  "permittivity_model", "library",      "reflection",
-        NULL};
+        "reflectivity",     "attenuation_per_m",  "emissivity", "transmission", "color", "file",
+        "refractive_index", "permittivity_model", "library",    "reflection",   NULL};
     static const char *const transmissions[] = {"diffuse", "straight", NULL};
     thz_status st = load_expect_object(ctx, c, keys);
     if (st != THZ_OK)

@@ -40,9 +40,9 @@ static void *(*real_aligned_alloc)(size_t, size_t);
 static void *(*real_memalign)(size_t, size_t);
 
 static atomic_uint_least64_t counted;
-static atomic_int armed;   /* counting starts when the constructor has run */
-static atomic_int failed;  /* call N failed in this process */
-static uint64_t fail_at;   /* 0: never */
+static atomic_int armed;  /* counting starts when the constructor has run */
+static atomic_int failed; /* call N failed in this process */
+static uint64_t fail_at;  /* 0: never */
 
 /* dlsym may allocate before the real functions are known: serve it from here. */
 static _Alignas(16) char boot_arena[16384];

@@ -71,7 +71,9 @@ static void test_band_mean_of_response(void **state)
     (void)state;
     /* int g^2 / int g = 1/sqrt(2). The quadrature spans +-6 sigma, which drops
      * P(|z| > 6) = 1.97e-9 of int g: allowance 2.5e-9. */
-    const thz_channel chs[] = {{.name = "a", .center_hz = 1e12, .relative_width = 0.1}, {.name = "b", .center_hz = 0.3e12, .relative_width = 0.02}, {.name = "c", .center_hz = 2.5e12, .relative_width = 0.3}};
+    const thz_channel chs[] = {{.name = "a", .center_hz = 1e12, .relative_width = 0.1},
+                               {.name = "b", .center_hz = 0.3e12, .relative_width = 0.02},
+                               {.name = "c", .center_hz = 2.5e12, .relative_width = 0.3}};
     for (size_t i = 0; i < 3; i++) {
         double m = channel_band_mean(&chs[i], f_response, (void *)&chs[i]);
         assert_true(fabs(m - M_SQRT1_2) < 2.5e-9);

@@ -94,8 +94,8 @@ static void test_accuracy_falls_with_noise(void **state)
             assert_int_equal(confusion_sum(&r), PIXELS - ROWS);
             if (!(r.held_out_accuracy <= last))
                 fail_msg("%s: held-out accuracy %g at %g K above %g at the level before",
-                         classify_method_name((classify_method)m), r.held_out_accuracy,
-                         levels[i], last);
+                         classify_method_name((classify_method)m), r.held_out_accuracy, levels[i],
+                         last);
             last = r.held_out_accuracy;
             if (i == 0)
                 assert_true(r.held_out_accuracy == 1.0);
