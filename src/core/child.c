@@ -9,6 +9,7 @@
 #include <signal.h>
 #include <string.h>
 #include <time.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -64,6 +65,7 @@ thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s,
         return thz_error_set(err, errno == ENOMEM ? THZ_ERR_NOMEM : THZ_ERR_IO,
                              "%s while %s: cannot create a pipe: %s",
                              errno == ENOMEM ? "out of memory" : "failed", what, strerror(errno));
+    pid_t parent = getpid();
     pid_t pid = fork();
     if (pid < 0) {
         int e = errno;
@@ -77,6 +79,10 @@ thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s,
                              strerror(e));
     }
     if (pid == 0) {
+        /* The child shares the parent's lock files (flock follows the descriptor): it
+         * must not outlive a parent killed with SIGKILL, or a rerun finds OUTDIR locked. */
+        if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != parent)
+            _exit(127);
         close(fds[0]);
         child_main(fds[1], fn, arg);
     }
