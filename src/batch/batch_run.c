@@ -11,7 +11,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/file.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -286,7 +285,7 @@ static int batch_report(const thz_batch_options *opt, const batch_state *b, size
     return opt->progress(opt->progress_user, &p);
 }
 
-/* Takes OUTDIR's batch lock (held until fd is closed). */
+/* Takes OUTDIR's batch lock (held until fd is closed or the process ends). */
 static thz_status batch_lock(const char *outdir, int *fd, thz_error *err)
 {
     char path[THZ_PATH_MAX];
@@ -296,7 +295,10 @@ static thz_status batch_lock(const char *outdir, int *fd, thz_error *err)
     *fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
     if (*fd < 0)
         return thz_error_set(err, THZ_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    if (flock(*fd, LOCK_EX | LOCK_NB) != 0) {
+    /* A process-associated (POSIX) lock, not flock: children forked for plotting
+     * (core/child.c) would inherit a flock and hold it after a SIGKILL of the batch. */
+    struct flock lk = {.l_type = F_WRLCK, .l_whence = SEEK_SET};
+    if (fcntl(*fd, F_SETLK, &lk) != 0) {
         close(*fd);
         *fd = -1;
         return thz_error_set(err, THZ_ERR_IO,
