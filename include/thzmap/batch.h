@@ -13,6 +13,8 @@
  * the hash of the frame's inputs), writes OUTDIR/batch.json and the movies
  * [sweep-NN/]S.band-NN.mp4. Run again on the same OUTDIR it skips every frame whose
  * frame.json carries the same input hash, so a killed batch resumes where it stopped.
+ * A frame whose scene differs from the previous frame's only in its sensors is rendered
+ * (as thz_render_run) from the photons of the first frame of that run, fired once.
  */
 #ifndef THZMAP_BATCH_H
 #define THZMAP_BATCH_H

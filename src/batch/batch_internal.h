@@ -52,6 +52,34 @@ thz_status batch_read_band(const char *path, uint32_t columns, uint32_t rows, si
 thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_t *movies,
                               thz_error *err);
 
+/* ---- batch_reuse.c: photons shared by frames that differ only in their sensors ---- */
+
+/* base[f] for every frame: the first frame of the run of consecutive frames whose scene
+ * texts equal f's but for "sensors" (f itself when the previous frame differs more). */
+thz_status batch_photon_bases(const thz_sequence *seq, size_t *base, thz_error *err);
+
+/* The photons of one base frame, kept while the frames after it reuse them: either the
+ * base frame's own run (fired by thz_simulate with keep_photons) or, when a resumed
+ * batch starts after the base, fired again from the base's scene. */
+typedef struct batch_photon_cache {
+    size_t base;        /* the frame they belong to; SIZE_MAX: none */
+    thz_scene *scene;   /* the base's scene (the photons point to it) */
+    thz_run *run;       /* the base frame's run, holding its photons; or NULL */
+    thz_photons *fired; /* fired again by batch_render_reused; or NULL */
+} batch_photon_cache;
+
+void batch_photon_cache_clear(batch_photon_cache *c);
+/* Takes the base frame's scene and run (with kept photons) into the cache; *scene and
+ * *run become NULL. */
+void batch_photon_cache_keep(batch_photon_cache *c, size_t base, thz_scene **scene, thz_run **run);
+/* Renders `scene` (a frame whose base is `base`) from the base's photons (*reused = 1),
+ * firing them into the cache first when it holds another base's (*fired = 1 then). When
+ * the air's temperature differs from the base's (it defaults to that of the enclosure
+ * around the sensors), simulates the frame instead (*reused = 0, *fired = 1). */
+thz_status batch_render_reused(thz_context *ctx, const thz_sequence *seq, batch_photon_cache *c,
+                               size_t base, const thz_scene *scene, thz_run **run, int *reused,
+                               int *fired, thz_error *err);
+
 /* ---- batch_encode.c: one movie, frame by frame (the only code that includes FFmpeg) -- */
 
 /* The picture of a movie frame: the Tb image scaled by `pixel` (whole pixels), its top

@@ -11,7 +11,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/file.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -27,10 +26,14 @@ typedef struct batch_state {
     const thz_sequence *seq;
     const char *outdir;
     frame_state *state;
-    double *seconds; /* per frame computed by this call, s */
-    json_t *movies;  /* the movies' descriptions (batch.json "movies") */
+    double *seconds;     /* per frame computed by this call, s */
+    size_t *base;        /* per frame: the frame whose photons it renders from (batch_reuse.c) */
+    int *reused_photons; /* per frame computed by this call: rendered from base's */
+    batch_photon_cache cache; /* the photons of the current base frame */
+    json_t *movies;           /* the movies' descriptions (batch.json "movies") */
     double t0, seconds_frames, seconds_movies;
     size_t computed, reused;
+    size_t fired, rerendered; /* photon phases run, frames rendered from kept photons */
 } batch_state;
 
 static double batch_now_s(void)
@@ -131,6 +134,10 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
             json_object_set_new(
                 e, "computed",
                 json_string(b->state[f] == FRAME_COMPUTED ? "this run" : "an earlier run"));
+        if (b->state[f] == FRAME_COMPUTED)
+            json_object_set_new(e, "photons",
+                                json_string(b->reused_photons[f] ? "reused" : "fired"));
+        json_object_set_new(e, "photon_base_frame", json_integer((json_int_t)b->base[f]));
         json_object_set_new(e, "seconds",
                             b->state[f] == FRAME_COMPUTED ? json_real(b->seconds[f]) : json_null());
         json_array_append_new(frames, e);
@@ -158,6 +165,8 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
     json_object_set_new(root, "frames_done", json_integer((json_int_t)done));
     json_object_set_new(root, "frames_computed", json_integer((json_int_t)b->computed));
     json_object_set_new(root, "frames_reused", json_integer((json_int_t)b->reused));
+    json_object_set_new(root, "photon_phases_fired", json_integer((json_int_t)b->fired));
+    json_object_set_new(root, "frames_rerendered", json_integer((json_int_t)b->rerendered));
     json_object_set_new(root, "complete", json_boolean(done == seq->n_frames && b->movies));
     json_object_set_new(root, "sweeps", sweeps);
     json_object_set_new(root, "frames", frames);
@@ -177,7 +186,7 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
 
 /* frame.json: which frame this directory is and the hash of its inputs (and the scene
  * it was run with, to rerun it by hand). No timings: it is the same in every run. */
-static char *batch_frame_json(const thz_sequence *seq, size_t f)
+static char *batch_frame_json(const thz_sequence *seq, size_t f, long reused_from)
 {
     char hex[17];
     batch_hex(seq->hash[f], hex);
@@ -189,6 +198,8 @@ static char *batch_frame_json(const thz_sequence *seq, size_t f)
     json_object_set_new(root, "time_s", json_real((double)(f % seq->frames) / seq->fps));
     json_object_set_new(root, "sweep_values", json_string(seq->sweep_label[f / seq->frames]));
     json_object_set_new(root, "input_hash", json_string(hex));
+    json_object_set_new(root, "photons_reused_from_frame",
+                        reused_from >= 0 ? json_integer(reused_from) : json_null());
     json_object_set_new(root, "scene_dir", json_string(seq->scene_dir));
     json_object_set_new(root, "scene", json_loads(seq->frame_json[f], 0, NULL));
     char *text = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
@@ -196,7 +207,17 @@ static char *batch_frame_json(const thz_sequence *seq, size_t f)
     return text;
 }
 
-/* Runs frame f into its directory (atomically, with frame.json). */
+/* Whether frame f's scene uses photons, so that the frames after it can reuse them. */
+static int batch_uses_photons(const thz_scene *scene)
+{
+    thz_scene_info info;
+    return thz_scene_get_info(scene, &info) == THZ_OK &&
+           thz_integrator_needs_photons(info.integrator);
+}
+
+/* Runs frame f into its directory (atomically, with frame.json): as `thzmap simulate`
+ * for a base frame (keeping its photons when the next frame reuses them), else as
+ * `thzmap render` from its base frame's photons. */
 static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, thz_error *err)
 {
     const thz_sequence *seq = b->seq;
@@ -207,21 +228,39 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
     thz_scene *scene = NULL;
     thz_output *output = NULL;
     thz_run *run = NULL;
-    char *frame_json = batch_frame_json(seq, f);
-    thz_status st = frame_json ? thz_sequence_frame_scene(seq, f, &scene, err)
-                               : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    char *frame_json = NULL;
+    thz_status st = thz_sequence_frame_scene(seq, f, &scene, err);
+    int photons = st == THZ_OK && batch_uses_photons(scene);
+    int reuse = photons && b->base[f] != f;
+    int keep = photons && f + 1 < seq->n_frames && b->base[f + 1] == f;
     if (st == THZ_OK)
         st = thz_output_open(dir, &output, err);
     thz_run_settings settings;
     thz_run_settings_init(&settings);
-    if (st == THZ_OK)
+    settings.keep_photons = keep;
+    int fired = !reuse;
+    if (st == THZ_OK && reuse)
+        st = batch_render_reused(ctx, seq, &b->cache, b->base[f], scene, &run, &reuse, &fired, err);
+    else if (st == THZ_OK)
         st = thz_simulate(ctx, scene, &settings, &run, err);
+    if (st == THZ_OK) {
+        frame_json = batch_frame_json(seq, f, reuse ? (long)b->base[f] : -1);
+        if (!frame_json)
+            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    }
     if (st == THZ_OK)
         st = thz_output_add_run(ctx, output, run, NULL, err);
     if (st == THZ_OK)
         st = thz_output_add_file(output, "frame.json", frame_json, strlen(frame_json), err);
     if (st == THZ_OK)
         st = thz_output_commit(output, err);
+    if (st == THZ_OK && keep)
+        batch_photon_cache_keep(&b->cache, f, &scene, &run);
+    if (st == THZ_OK) {
+        b->reused_photons[f] = reuse;
+        b->fired += (size_t)fired;
+        b->rerendered += (size_t)reuse;
+    }
     thz_output_destroy(output);
     thz_run_destroy(run);
     thz_scene_destroy(scene);
@@ -246,7 +285,7 @@ static int batch_report(const thz_batch_options *opt, const batch_state *b, size
     return opt->progress(opt->progress_user, &p);
 }
 
-/* Takes OUTDIR's batch lock (held until fd is closed). */
+/* Takes OUTDIR's batch lock (held until fd is closed or the process ends). */
 static thz_status batch_lock(const char *outdir, int *fd, thz_error *err)
 {
     char path[THZ_PATH_MAX];
@@ -256,7 +295,10 @@ static thz_status batch_lock(const char *outdir, int *fd, thz_error *err)
     *fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
     if (*fd < 0)
         return thz_error_set(err, THZ_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    if (flock(*fd, LOCK_EX | LOCK_NB) != 0) {
+    /* A process-associated (POSIX) lock, not flock: children forked for plotting
+     * (core/child.c) would inherit a flock and hold it after a SIGKILL of the batch. */
+    struct flock lk = {.l_type = F_WRLCK, .l_whence = SEEK_SET};
+    if (fcntl(*fd, F_SETLK, &lk) != 0) {
         close(*fd);
         *fd = -1;
         return thz_error_set(err, THZ_ERR_IO,
@@ -278,12 +320,18 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
     if (!seq || !outdir || !outdir[0])
         return thz_error_set(err, THZ_ERR_INPUT, "thz_batch_run: no %s",
                              seq ? "output directory" : "sequence");
-    batch_state b = {.seq = seq, .outdir = outdir, .t0 = batch_now_s()};
+    batch_state b = {
+        .seq = seq, .outdir = outdir, .t0 = batch_now_s(), .cache = {.base = SIZE_MAX}};
     b.state = thz_calloc(seq->n_frames, sizeof *b.state);
     b.seconds = thz_calloc(seq->n_frames, sizeof *b.seconds);
+    b.base = thz_calloc(seq->n_frames, sizeof *b.base);
+    b.reused_photons = thz_calloc(seq->n_frames, sizeof *b.reused_photons);
     int lock_fd = -1;
-    thz_status st = b.state && b.seconds ? batch_mkdirs(outdir, err)
-                                         : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    thz_status st = b.state && b.seconds && b.base && b.reused_photons
+                        ? batch_photon_bases(seq, b.base, err)
+                        : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    if (st == THZ_OK)
+        st = batch_mkdirs(outdir, err);
     if (st == THZ_OK)
         st = batch_lock(outdir, &lock_fd, err);
     for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++)
@@ -309,6 +357,8 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
         } else if (st != THZ_ERR_CANCELLED) {
             b.state[f] = FRAME_FAILED;
         }
+        if (st != THZ_OK)
+            batch_photon_cache_clear(&b.cache);
         thz_error werr;
         if (batch_write_json(&b, &werr) != THZ_OK && st == THZ_OK) {
             *err = werr;
@@ -341,8 +391,11 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
         result->seconds = batch_now_s() - b.t0;
     }
     json_decref(b.movies);
+    batch_photon_cache_clear(&b.cache);
     free(b.state);
     free(b.seconds);
+    free(b.base);
+    free(b.reused_photons);
     if (lock_fd >= 0)
         close(lock_fd);
     return st;

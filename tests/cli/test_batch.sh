@@ -11,6 +11,11 @@
 #    inode and time unchanged; batch.json's counts) and ends with every file identical
 #    to an uninterrupted run's (summary.json and batch.json aside: timings);
 #  - a changed keyframe redoes exactly the frames it changes;
+#  - a sensor-only sequence (the camera moving, photon-map integrator, 3 frames) fires
+#    photons once (batch.json, frame.json) and its frames equal, bit for bit, `thzmap
+#    render` of each frame's scene from the map `simulate --save-photon-map` fires for
+#    frame 0 (summary.json aside); resumed after losing frames 1-2 or after a SIGKILL,
+#    it ends with the same files;
 #  - a sweep without keyframes: sweep-NN/frame-00000 per value;
 #  - bad sequence files: exit 2, the JSON path in the message, nothing written.
 # argv: path to the thzmap binary, repository directory.
@@ -136,10 +141,11 @@ wait $pid
 rc=$?
 [ $rc -eq 143 ] || [ $rc -eq 0 ] || fail "SIGTERM: exit $rc, expected 143"
 n1=$(frames_done "$work/B")
-"$THZMAP" batch "$seq" -o "$work/B" --quiet > /dev/null 2>&1 &
+# its own process group killed whole (see the sensor-only resume below)
+setsid "$THZMAP" batch "$seq" -o "$work/B" --quiet > /dev/null 2>&1 &
 pid=$!
 wait_frames "$work/B" $((n1 + 2)) $pid
-kill -KILL $pid 2>/dev/null
+kill -KILL -- -$pid 2>/dev/null
 wait $pid 2>/dev/null
 n2=$(frames_done "$work/B")
 echo "interrupted after $n1 frame(s) (SIGTERM), killed after $n2 (SIGKILL)"
@@ -184,6 +190,77 @@ for s in 00 01; do
     [ -f "$work/W/sweep-$s/cam.band-01.mp4" ] || fail "sweep-$s/cam.band-01.mp4 missing"
 done
 grep -q '"temperature_k": 310' "$work/W/sweep-01/frame-00000/frame.json" || fail "sweep-01 is not at 310 K"
+
+# --- a sensor-only sequence: photons fired once, frames rendered from them ----------
+"$PY" - "$work/scene.json" "$work/pm-scene.json" "$work/pm-seq.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["render"] = {"integrator": "photon-map"}
+s["photons"] = {"seed": 7, "per_channel": 20000}
+json.dump(s, open(sys.argv[2], "w"), indent=1)
+q = {"format": "thzmap-sequence/1", "scene": "pm-scene.json", "fps": 2, "frames": 3,
+     "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [-0.3, -1.4, 0.9]}}},
+                   {"time_s": 1, "sensors": {"cam": {"position_m": [0.3, -1.4, 0.9]}}}]}
+json.dump(q, open(sys.argv[3], "w"))
+PY
+"$THZMAP" batch "$work/pm-seq.json" -o "$work/P" --threads 2 --quiet > /dev/null 2>&1 ||
+    fail "sensor-only batch: exit $?"
+"$PY" - "$work/P" <<'PY' || fail "sensor-only batch: photons must be fired once (batch.json, frame.json)"
+import json, sys
+b = json.load(open(sys.argv[1] + "/batch.json"))
+assert b["photon_phases_fired"] == 1 and b["frames_rerendered"] == 2, b
+assert [f["photons"] for f in b["frames"]] == ["fired", "reused", "reused"], b["frames"]
+assert [f["photon_base_frame"] for f in b["frames"]] == [0, 0, 0], b["frames"]
+for i, want in enumerate([None, 0, 0]):
+    f = json.load(open(f"{sys.argv[1]}/frame-{i:05d}/frame.json"))
+    assert f["photons_reused_from_frame"] == want, (i, f["photons_reused_from_frame"])
+    json.dump(f["scene"], open(f"{sys.argv[1]}/../pm-frame-{i}.json", "w"))
+PY
+# the map fired for frame 0, and every frame rendered from it by `thzmap render`
+"$THZMAP" simulate "$work/pm-frame-0.json" -o "$work/PM" --save-photon-map --threads 1 --quiet \
+    > /dev/null || fail "simulate --save-photon-map of frame 0"
+for i in 0 1 2; do
+    "$THZMAP" render "$work/pm-frame-$i.json" --photon-map "$work/PM/photon-map.thzpm" \
+        -o "$work/PR$i" --threads 1 --quiet > /dev/null || fail "render of frame $i"
+    n=0
+    for f in "$work/PR$i"/*; do
+        b=$(basename "$f")
+        [ "$b" = summary.json ] && continue
+        n=$((n + 1))
+        cmp -s "$f" "$work/P/frame-0000$i/$b" || fail "sensor-only frame $i: $b differs from render's"
+    done
+    [ "$n" -ge 10 ] || fail "sensor-only frame $i: only $n files compared"
+done
+cmp -s "$work/P/frame-00001/cam.radiance.img" "$work/P/frame-00002/cam.radiance.img" &&
+    fail "sensor-only frames 1 and 2 are the same picture: the camera did not move"
+# resumed inside the run of sensor-only frames: frame 0's photons are fired again, the
+# same; once after removing frames 1-2, once after a SIGKILL once frame 0 is done
+for how in removed killed; do
+    rm -rf "$work/Q"
+    if [ $how = removed ]; then
+        cp -r "$work/P" "$work/Q"
+        rm -rf "$work/Q/frame-00001" "$work/Q/frame-00002"
+    else
+        # in its own process group, killed whole: a plotting child (core/child.c) of a
+        # batch killed alone would keep frame 1's output lock for a moment
+        setsid "$THZMAP" batch "$work/pm-seq.json" -o "$work/Q" --threads 1 --quiet > /dev/null 2>&1 &
+        pid=$!
+        wait_frames "$work/Q" 1 $pid
+        kill -KILL -- -$pid 2>/dev/null
+        wait $pid 2>/dev/null
+    fi
+    "$THZMAP" batch "$work/pm-seq.json" -o "$work/Q" --threads 1 --quiet > /dev/null 2>&1 ||
+        fail "sensor-only batch resumed ($how): exit $?"
+    (cd "$work/P" && find . -type f ! -name summary.json ! -name batch.json ! -name '.*' | sort) > "$work/P.files"
+    while read -r f; do
+        cmp -s "$work/P/$f" "$work/Q/$f" || fail "sensor-only batch resumed ($how): $f differs"
+    done < "$work/P.files"
+done
+"$PY" - "$work/Q/batch.json" <<'PY' || fail "resumed sensor-only batch.json"
+import json, sys
+b = json.load(open(sys.argv[1]))
+assert b["complete"] and b["photon_phases_fired"] <= 1, b
+PY
 
 # --- bad sequence files -------------------------------------------------------------
 bad() { # bad NAME EXPECTED-TEXT JSON

@@ -1,0 +1,113 @@
+/* Photons shared between frames (the paper's point of a photon map): frames whose scene
+ * differs from the previous frame's only in "sensors" render from the photons of the
+ * first frame of that run of frames (its base) instead of firing again. The photon
+ * phase reads no sensor, so those photons are what each frame would fire itself; the
+ * base is fixed by the sequence alone, so a resumed batch that starts inside such a run
+ * fires the base's scene again with the same seed and gets the same maps.
+ */
+#include <jansson.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "api/api.h"
+#include "batch/batch_internal.h"
+#include "core/alloc.h"
+#include "core/error.h"
+#include "thzmap/atmosphere.h"
+
+/* Frame f's scene text without its "sensors" (NULL when out of memory). */
+static char *reuse_scene_without_sensors(const thz_sequence *seq, size_t f)
+{
+    json_t *root = json_loads(seq->frame_json[f], 0, NULL);
+    json_object_del(root, "sensors");
+    char *text =
+        root ? json_dumps(root, JSON_COMPACT | JSON_SORT_KEYS | JSON_REAL_PRECISION(17)) : NULL;
+    json_decref(root);
+    return text;
+}
+
+thz_status batch_photon_bases(const thz_sequence *seq, size_t *base, thz_error *err)
+{
+    char *prev = NULL;
+    for (size_t f = 0; f < seq->n_frames; f++) {
+        char *text = reuse_scene_without_sensors(seq, f);
+        if (!text) {
+            free(prev);
+            return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", seq->frame_dir[f]);
+        }
+        base[f] = prev && !strcmp(prev, text) ? base[f - 1] : f;
+        free(prev);
+        prev = text;
+    }
+    free(prev);
+    return THZ_OK;
+}
+
+void batch_photon_cache_clear(batch_photon_cache *c)
+{
+    thz_photons_destroy(c->fired);
+    thz_run_destroy(c->run);
+    thz_scene_destroy(c->scene);
+    *c = (batch_photon_cache){.base = SIZE_MAX};
+}
+
+void batch_photon_cache_keep(batch_photon_cache *c, size_t base, thz_scene **scene, thz_run **run)
+{
+    batch_photon_cache_clear(c);
+    c->base = base;
+    c->scene = *scene;
+    c->run = *run;
+    *scene = NULL;
+    *run = NULL;
+}
+
+/* The air's temperature of a scene, which defaults to the temperature of the enclosure
+ * around the sensors (scene-format.md "atmosphere"), so moving a sensor can change it;
+ * -1 when unknown. */
+static double reuse_air_temperature_k(const thz_scene *scene)
+{
+    thz_atm *atm = NULL;
+    thz_atm_info info = {0};
+    if (thz_atm_from_scene(scene, &atm, NULL) != THZ_OK)
+        return -1.0;
+    thz_atm_get_info(atm, &info);
+    thz_atm_destroy(atm);
+    return info.has_air ? info.temperature_k : 0.0;
+}
+
+thz_status batch_render_reused(thz_context *ctx, const thz_sequence *seq, batch_photon_cache *c,
+                               size_t base, const thz_scene *scene, thz_run **run, int *reused,
+                               int *fired, thz_error *err)
+{
+    *fired = 0;
+    *reused = 0;
+    if (c->base != base) {
+        batch_photon_cache_clear(c);
+        thz_status st = thz_sequence_frame_scene(seq, base, &c->scene, err);
+        if (st == THZ_OK)
+            st = thz_photons_fire(ctx, c->scene, NULL, &c->fired, err);
+        if (st != THZ_OK) {
+            batch_photon_cache_clear(c);
+            return st;
+        }
+        c->base = base;
+        *fired = 1;
+    }
+    thz_run_settings settings;
+    thz_run_settings_init(&settings);
+    double air_k = reuse_air_temperature_k(scene);
+    if (air_k < 0.0 || air_k != reuse_air_temperature_k(c->scene)) {
+        *fired = 1; /* the sensors moved into another enclosure: fire this frame's own */
+        return thz_simulate(ctx, scene, &settings, run, err);
+    }
+    *reused = 1;
+    const thz_photons *kept = c->fired ? c->fired : thz_run_photons(c->run);
+    if (!kept)
+        return thz_error_set(err, THZ_ERR_INPUT, "frame %zu kept no photons", base);
+    /* The same maps seen from this frame's scene handle, which differs from the base's
+     * only in its sensors (the photon phase reads none). */
+    thz_photons view = *kept;
+    view.scene = scene;
+    view.owned = false;
+    return thz_render_run(ctx, scene, &view, -1, &settings, run, err);
+}
