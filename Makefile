@@ -41,7 +41,7 @@ test-asan: deps
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-	  THZ_TEST_SCALE=0.25 ctest --output-on-failure -j $(JOBS) --label-exclude slow
+	  THZ_TEST_SCALE=0.25 ctest --output-on-failure -j $(JOBS) --label-exclude 'slow|no-sanitizer'
 
 # The libFuzzer harnesses (tests/fuzz/): a clang build of their own with ASan+UBSan.
 fuzz-build: deps
