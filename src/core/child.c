@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
+#include <pthread.h>
 #include <stdbool.h>
 #include <signal.h>
 #include <string.h>
@@ -58,7 +59,25 @@ static bool child_collect(int fd, double deadline_s, thz_error *report, size_t *
     }
 }
 
+/* One child at a time per process: a fork while another thread is inside fork, malloc
+ * or a child's set-up can leave the new child holding a lock no thread will release
+ * (seen under AddressSanitizer: three threads plotting at once, a child hung until its
+ * time limit). The figures were serialised before they moved into children, too. */
+static pthread_mutex_t child_lock = PTHREAD_MUTEX_INITIALIZER;
+
+static thz_status child_run_locked(const char *what, child_fn fn, void *arg, double timeout_s,
+                                   thz_error *err);
+
 thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err)
+{
+    pthread_mutex_lock(&child_lock);
+    thz_status st = child_run_locked(what, fn, arg, timeout_s, err);
+    pthread_mutex_unlock(&child_lock);
+    return st;
+}
+
+static thz_status child_run_locked(const char *what, child_fn fn, void *arg, double timeout_s,
+                                   thz_error *err)
 {
     int fds[2];
     if (pipe2(fds, O_CLOEXEC) != 0)
