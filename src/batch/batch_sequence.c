@@ -14,6 +14,12 @@
 #include "batch/batch_internal.h"
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/file.h"
+
+/* A sequence or scene file larger than this is refused before it is read: they are
+ * kilobytes (the scene loader allows more for inline tables, but a batch holds every
+ * frame's scene text). */
+#define SEQ_MAX_FILE_BYTES (64u * 1024u * 1024u)
 
 enum { SEQ_MAX_FRAMES = 100000, SEQ_MAX_SWEEPS = 10000, SEQ_MAX_DEPTH = 8 };
 
@@ -548,11 +554,12 @@ thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *er
     thz_sequence *seq = thz_calloc(1, sizeof *seq);
     seq_build b = {.label = path, .err = err, .file_hashes = json_object()};
     json_error_t je;
-    json_t *root = json_load_file(path, JSON_REJECT_DUPLICATES, &je);
-    thz_status st = THZ_OK;
-    if (!seq || !b.file_hashes)
+    /* a FIFO or device would block the open or never end (core/file.h) */
+    thz_status st = file_check_regular(path, NULL, SEQ_MAX_FILE_BYTES, NULL, err);
+    json_t *root = NULL;
+    if (st == THZ_OK && (!seq || !b.file_hashes))
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-    else if (!root)
+    else if (st == THZ_OK && !(root = json_load_file(path, JSON_REJECT_DUPLICATES, &je)))
         st = je.line > 0 ? thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s", path,
                                          je.line, je.column, je.text)
                          : thz_error_set(err, THZ_ERR_INPUT, "%s: %s", path, je.text);
@@ -566,6 +573,8 @@ thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *er
             *slash = '\0';
         st = seq_top(&b, root, slash ? (dir[0] ? dir : "/") : ".", seq, &keyframes);
     }
+    if (st == THZ_OK)
+        st = file_check_regular(seq->scene_path, NULL, SEQ_MAX_FILE_BYTES, NULL, err);
     if (st == THZ_OK) {
         b.scene = json_load_file(seq->scene_path, JSON_REJECT_DUPLICATES, &je);
         if (!b.scene)

@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 
 #include "core/alloc.h"
+#include "core/file.h"
 #include "scene/load.h"
 #include "scene/mesh_import.h"
 #include "scene/scene_checks.h"
@@ -20,6 +21,9 @@
 #define LOAD_FORMAT "thzmap-scene/1"
 /* Format 1.1 adds optional keys only (scene-format.md): a file may say so. */
 #define LOAD_FORMAT_1_1 "thzmap-scene/1.1"
+/* A scene file larger than this is refused before it is read (as the CSV reader caps its
+ * tables): scenes are kilobytes; inline tables may make them megabytes. */
+#define LOAD_MAX_SCENE_BYTES (256u * 1024u * 1024u)
 /* Explicit emissivity may differ from Kirchhoff's value by this much before validate
  * warns (physics.md "Surfaces"). */
 #define LOAD_KIRCHHOFF_TOLERANCE 0.01
@@ -310,9 +314,10 @@ thz_status scene_load(const char *path, thz_scene **out, thz_error *err)
 {
     *out = NULL;
     thz_error_clear(err);
-    struct stat info;
-    if (stat(path, &info) == 0 && S_ISDIR(info.st_mode))
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: is a directory, expected a scene file", path);
+    /* a FIFO or device would block the open or never end (core/file.h) */
+    thz_status st = file_check_regular(path, NULL, LOAD_MAX_SCENE_BYTES, NULL, err);
+    if (st != THZ_OK)
+        return st;
     FILE *f = fopen(path, "rb");
     if (!f && errno == ENOMEM)
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while opening the scene", path);
@@ -330,7 +335,7 @@ thz_status scene_load(const char *path, thz_scene **out, thz_error *err)
         json_decref(doc);
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     }
-    thz_status st = load_begin(path, dirname(copy), out, err);
+    st = load_begin(path, dirname(copy), out, err);
     free(copy);
     return load_finish(out, doc, st, err);
 }

@@ -265,7 +265,7 @@ PY
 # --- bad sequence files -------------------------------------------------------------
 bad() { # bad NAME EXPECTED-TEXT JSON
     printf '%s\n' "$3" > "$work/bad-$1.json"
-    "$THZMAP" batch "$work/bad-$1.json" -o "$work/bad-out" > "$work/bad.out" 2> "$work/bad.err"
+    timeout 60 "$THZMAP" batch "$work/bad-$1.json" -o "$work/bad-out" > "$work/bad.out" 2> "$work/bad.err"
     rc=$?
     [ $rc -eq 2 ] || fail "bad $1: exit $rc, expected 2"
     grep -qF -- "$2" "$work/bad.err" || fail "bad $1: expected '$2' in: $(cat "$work/bad.err")"
@@ -290,6 +290,8 @@ bad fps 'fps: required with keyframes' \
     "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"keyframes\": [$K0]}"
 bad sweep 'sweep.objects.person.temperature_k: expected a non-empty array' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "sweep": {"objects.person.temperature_k": []}}'
+mkfifo "$work/pipe.json" # a FIFO as the scene would block the open: refused at once
+bad fifo_scene 'pipe.json: is a FIFO' '{"format": "thzmap-sequence/1", "scene": "pipe.json"}'
 bad syntax 'bad-syntax.json:1:' '{"format": "thzmap-sequence/1",, }'
 bad frame_scene 'frame 2 (t = 0.5 s): ' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 3, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 0.5, "objects": {"person": {"temperature_k": -10}}}]}'

@@ -90,7 +90,12 @@ expect_line "$tmp/out" '^usage: thzmap validate SCENE\.json'
 [[ $? -eq 2 ]] || fail "validate with an unknown option must exit 2"
 "$thzmap" validate "$tmp/does-not-exist.json" >/dev/null 2>"$tmp/err"
 [[ $? -eq 2 ]] || fail "validate of a missing file must exit 2"
-expect_line "$tmp/err" 'does-not-exist\.json: cannot open scene file'
+expect_line "$tmp/err" 'does-not-exist\.json: cannot open'
+# a FIFO as the scene would block the open: refused at once (timeout: a hang fails)
+mkfifo "$tmp/pipe.json"
+timeout 10 "$thzmap" validate "$tmp/pipe.json" 2>"$tmp/err"
+[[ $? -eq 2 ]] || fail "validate of a FIFO must exit 2 at once"
+expect_line "$tmp/err" 'pipe\.json: is a FIFO'
 
 [[ $failures -eq 0 ]] && echo "validate: all checks passed"
 [[ $failures -eq 0 ]]
