@@ -1,4 +1,5 @@
-# The two set-up commands of the README, and a few conveniences.
+# What the README's two set-up commands (scripts/setup.sh demo|check, which also install
+# thzmap under /usr/local first) run, and a few conveniences.
 #   make demo   installs what is missing, builds, and runs the paper's test scene
 #   make check  installs what is missing, builds, and runs all tests (also under ASan+UBSan),
 #               then fuzzes each reader for 30 s (fuzz-ci)

@@ -16,8 +16,8 @@
 
 #include "core/clock.h"
 
-/* The child: runs fn, writes its error (status and message; at most 1 KiB, so one
- * write below PIPE_BUF that the pipe takes whole) and ends without exit handlers. */
+/* The child: runs fn, writes its error (status and message, about 1 KiB: one write
+ * below PIPE_BUF that the pipe takes whole) and ends without exit handlers. */
 static _Noreturn void child_main(int fd, child_fn fn, void *arg)
 {
     /* The caller's handlers only set a flag the child never reads: a SIGTERM or
@@ -102,6 +102,9 @@ static thz_status child_run_locked(const char *what, child_fn fn, void *arg, dou
          * must not outlive a parent killed with SIGKILL, or a rerun finds OUTDIR locked. */
         if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != parent)
             _exit(127);
+        /* child_lock was held across the fork by the thread this one replicates: release
+         * it, or an fn that starts a child of its own waits for it until its time limit. */
+        pthread_mutex_unlock(&child_lock);
         close(fds[0]);
         child_main(fds[1], fn, arg);
     }

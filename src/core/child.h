@@ -20,8 +20,9 @@ typedef thz_status (*child_fn)(void *arg, thz_error *err);
  * that cannot start (THZ_ERR_NOMEM "out of memory while <what>: ..." when fork fails
  * for lack of memory), dies from a signal, exits without reporting (a library called
  * exit()), or runs longer than timeout_s (it is then killed): THZ_ERR_IO, the message
- * saying which. Call from one thread at a time per fn's shared state; the child runs
- * only the calling thread, so fn must not wait for other threads of the caller. */
+ * saying which. Calls from several threads run one child at a time (a process-wide
+ * lock, released in the child, so fn may call child_run too); the child runs only the
+ * calling thread, so fn must not wait for other threads of the caller. */
 thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err);
 
 #endif
