@@ -147,6 +147,9 @@ static thz_status classify_check_options(const thz_classify_options *opt, classi
                              opt->train_fraction);
     if (!(opt->netd_k >= 0.0) || !isfinite(opt->netd_k))
         return thz_error_set(err, THZ_ERR_INPUT, "NETD %g K: expected a number >= 0", opt->netd_k);
+    if (opt->seed > (uint64_t)INT64_MAX) /* classification.json records it exactly */
+        return thz_error_set(err, THZ_ERR_INPUT, "seed %llu: expected 0 to %lld",
+                             (unsigned long long)opt->seed, (long long)INT64_MAX);
     *m = (classify_method)method;
     return THZ_OK;
 }

@@ -109,6 +109,8 @@ expect2 "no sensor" "$TMP/run" -o "$TMP/x"
 expect2 "unknown sensor" "$TMP/run" --sensor nope -o "$TMP/x"
 grep -q "nope.brightness_temperature" "$TMP/err" || fail "missing cube not named: $(cat "$TMP/err")"
 expect2 "unknown method" "$TMP/run" --sensor cam -o "$TMP/x" --method svm
+expect2 "seed beyond 2^63 - 1 (classification.json could not record it)" "$TMP/run" \
+    --sensor cam -o "$TMP/x" --seed 9223372036854775808
 expect2 "no run" "$TMP/none" --sensor cam -o "$TMP/x"
 printf 'ENVI\nsamples = 24\nlines = 16\nbands = 5\ndata type = 4\n' > "$TMP/run2/cam.measured_brightness_temperature.hdr"
 head -c 100 "$TMP/run/cam.brightness_temperature.img" > "$TMP/run2/cam.measured_brightness_temperature.img"
