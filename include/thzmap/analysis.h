@@ -38,7 +38,8 @@ THZ_API const char *thz_cube_object_name(const thz_cube *cube, size_t i);
 typedef struct thz_classify_options {
     const char *method;    /* "sam" (default), "mahalanobis", "lda", "matched-filter", "ace" */
     double train_fraction; /* of each class's pixels that train, 0 < f < 1; default 0.5 */
-    uint64_t seed;         /* chooses the training pixels and the added noise; default 1 */
+    uint64_t seed;         /* chooses the training pixels and the added noise, 0 to INT64_MAX;
+                              default 1 */
     double netd_k;         /* > 0: first add Gaussian noise of this standard deviation (K)
                               to every value (a sensor's NETD on a noise-free run); 0: none */
 } thz_classify_options;
@@ -120,9 +121,9 @@ typedef struct thz_bands_options {
                                            value (0.2: +- 20 %); default 0.2 */
     uint32_t paths_per_sample;          /* path integrator paths per sample; default 16 */
     int has_seed;                       /* non-zero: `seed` instead of the scene's */
-    uint64_t seed;
-    uint64_t exhaustive_limit; /* search every subset when there are at most this many of
-                                  sizes 1..K (default 200000), else SFFS */
+    uint64_t seed;                      /* 0 to INT64_MAX, like photons.seed */
+    uint64_t exhaustive_limit;          /* search every subset when there are at most this many of
+                                           sizes 1..K (default 200000), else SFFS */
 } thz_bands_options;
 
 THZ_API void thz_bands_options_init(thz_bands_options *opt);

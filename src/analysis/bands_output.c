@@ -125,7 +125,7 @@ char *bands_json(const bands_report *rep, thz_error *err)
         rep->air_db_per_km ? array_of(rep->air_db_per_km, n, &ok) : json_null(), &ok);
     put(root, "renders", json_integer((json_int_t)v->renders), &ok);
     put(root, "paths_per_sample", json_integer(s->paths_per_sample), &ok);
-    put(root, "seed", json_integer((json_int_t)(s->seed & INT64_MAX)), &ok);
+    put(root, "seed", json_integer((json_int_t)s->seed), &ok);
     put(root, "seconds", json_real(v->seconds), &ok);
     char *text =
         ok ? json_dumps(root, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10))

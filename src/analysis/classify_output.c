@@ -51,7 +51,7 @@ char *classify_json(const classify_report *rep, thz_error *err)
     put(root, "sensor", rep->sensor ? json_string(rep->sensor) : json_null(), &ok);
     put(root, "source", json_string(rep->source), &ok);
     put(root, "method", json_string(classify_method_name(rep->method)), &ok);
-    put(root, "seed", json_integer((json_int_t)(rep->seed & INT64_MAX)), &ok);
+    put(root, "seed", json_integer((json_int_t)rep->seed), &ok);
     put(root, "train_fraction", json_real(rep->train_fraction), &ok);
     put(root, "added_netd_k", rep->netd_k > 0.0 ? json_real(rep->netd_k) : json_null(), &ok);
     put(root, "columns", json_integer(rep->columns), &ok);

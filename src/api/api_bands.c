@@ -89,6 +89,9 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
                              "NETD and ranges must be >= 0 (and the humidity range below 1)");
     if (o->paths_per_sample < 1)
         return thz_error_set(err, THZ_ERR_INPUT, "paths per sample: expected at least 1");
+    if (o->has_seed && o->seed > (uint64_t)INT64_MAX) /* bands.json records it exactly */
+        return thz_error_set(err, THZ_ERR_INPUT, "seed %llu: expected 0 to %lld, as photons.seed",
+                             (unsigned long long)o->seed, (long long)INT64_MAX);
     *n_candidates = (size_t)n;
     return THZ_OK;
 }

@@ -147,8 +147,29 @@ static thz_status classify_check_options(const thz_classify_options *opt, classi
                              opt->train_fraction);
     if (!(opt->netd_k >= 0.0) || !isfinite(opt->netd_k))
         return thz_error_set(err, THZ_ERR_INPUT, "NETD %g K: expected a number >= 0", opt->netd_k);
+    if (opt->seed > (uint64_t)INT64_MAX) /* classification.json records it exactly */
+        return thz_error_set(err, THZ_ERR_INPUT, "seed %llu: expected 0 to %lld",
+                             (unsigned long long)opt->seed, (long long)INT64_MAX);
     *m = (classify_method)method;
     return THZ_OK;
+}
+
+/* What classification.json and the class images say, from c. */
+static classify_report report_of(const thz_classification *c)
+{
+    return (classify_report){.result = &c->r,
+                             .run_dir = c->run_dir,
+                             .sensor = c->sensor,
+                             .source = c->source,
+                             .method = c->method,
+                             .seed = c->seed,
+                             .train_fraction = c->train_fraction,
+                             .netd_k = c->netd_k,
+                             .columns = c->columns,
+                             .rows = c->rows,
+                             .class_names = (const char *const *)c->class_names,
+                             .object_names = c->object_names,
+                             .n_object_names = c->n_object_names};
 }
 
 /* Classifies, names the classes, and makes the JSON text. */
@@ -235,19 +256,7 @@ static thz_status classify_build(const thz_cube *cube, const thz_cube *truth,
             goto done;
         }
     }
-    classify_report rep = {.result = &c->r,
-                           .run_dir = c->run_dir,
-                           .sensor = c->sensor,
-                           .source = c->source,
-                           .method = method,
-                           .seed = c->seed,
-                           .train_fraction = c->train_fraction,
-                           .netd_k = c->netd_k,
-                           .columns = c->columns,
-                           .rows = c->rows,
-                           .class_names = (const char *const *)c->class_names,
-                           .object_names = c->object_names,
-                           .n_object_names = c->n_object_names};
+    classify_report rep = report_of(c);
     c->json = classify_json(&rep, err);
     if (!c->json)
         st = err ? err->status : THZ_ERR_NOMEM;
@@ -378,19 +387,7 @@ thz_status thz_classification_write(const thz_classification *c, const char *out
     thz_status st = output_stage_create(outdir, &stage, err);
     if (st != THZ_OK)
         return st;
-    classify_report rep = {.result = &c->r,
-                           .run_dir = c->run_dir,
-                           .sensor = c->sensor,
-                           .source = c->source,
-                           .method = c->method,
-                           .seed = c->seed,
-                           .train_fraction = c->train_fraction,
-                           .netd_k = c->netd_k,
-                           .columns = c->columns,
-                           .rows = c->rows,
-                           .class_names = (const char *const *)c->class_names,
-                           .object_names = c->object_names,
-                           .n_object_names = c->n_object_names};
+    classify_report rep = report_of(c);
     st = classify_write_files(output_stage_dir(stage), &rep, c->json, err);
     if (st == THZ_OK)
         st = output_stage_commit(stage, err);

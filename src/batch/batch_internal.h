@@ -25,7 +25,7 @@ struct thz_sequence {
     size_t n_sweeps;    /* sweep values (1 without a sweep) */
     int has_sweep;      /* frame directories under sweep-NN/ */
     size_t n_frames;    /* frames * n_sweeps */
-    char **frame_json;  /* per frame: the scene text (compact, sorted keys) */
+    char **frame_json;  /* per frame: the scene text (compact, keys in document order) */
     char **frame_dir;   /* per frame: "frame-NNNNN" or "sweep-NN/frame-NNNNN" */
     uint64_t *hash;     /* per frame: hash of its inputs */
     char **sweep_label; /* per sweep value: "atmosphere.relative_humidity = 0.5, ..." */

@@ -150,7 +150,7 @@ int cmd_bands(int argc, char **argv)
             ok = cli_parse_u64(CMD, a, v, 1, 1000000, &paths);
             opt.paths_per_sample = (uint32_t)paths;
         } else if (strcmp(a, "--seed") == 0) {
-            ok = cli_parse_u64(CMD, a, v, 0, UINT64_MAX, &seed);
+            ok = cli_parse_u64(CMD, a, v, 0, INT64_MAX, &seed);
             opt.has_seed = 1;
             opt.seed = seed;
         } else if (strcmp(a, "--threads") == 0) {

@@ -86,7 +86,7 @@ int cmd_classify(int argc, char **argv)
             if (!cli_parse_double(CMD, a, v, 1e-9, 1.0 - 1e-9, &opt.train_fraction))
                 return CLI_EXIT_USAGE;
         } else if (strcmp(a, "--seed") == 0) {
-            if (!cli_parse_u64(CMD, a, v, 0, UINT64_MAX, &opt.seed))
+            if (!cli_parse_u64(CMD, a, v, 0, INT64_MAX, &opt.seed))
                 return CLI_EXIT_USAGE;
         } else if (strcmp(a, "--netd-k") == 0) {
             if (!cli_parse_double(CMD, a, v, 0.0, 1e6, &opt.netd_k))

@@ -27,6 +27,18 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fails=0
 fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+# Every file of the run in $1 (summary.json aside: timings) equals, byte for byte, the
+# file of the same name in $2; at least 10 of them ($3 names the comparison).
+same_files() {
+    local n=0 f b
+    for f in "$1"/*; do
+        b=$(basename "$f")
+        [ "$b" = summary.json ] && continue
+        n=$((n + 1))
+        cmp -s "$f" "$2/$b" || fail "$3: $b differs"
+    done
+    [ "$n" -ge 10 ] || fail "$3: only $n files compared"
+}
 command -v ffprobe >/dev/null || { echo "FAIL: ffprobe is missing (scripts/install-deps.sh installs ffmpeg)"; exit 1; }
 command -v ffmpeg >/dev/null || { echo "FAIL: ffmpeg is missing (scripts/install-deps.sh installs it)"; exit 1; }
 
@@ -74,14 +86,7 @@ assert p["temperature_k"] == float(sys.argv[3]), p
 PY
     "$THZMAP" simulate "$work/hand-$1.json" -o "$work/S$1" --threads 1 --quiet >/dev/null ||
         fail "simulate of hand-$1.json"
-    n=0
-    for f in "$work/S$1"/*; do
-        b=$(basename "$f")
-        [ "$b" = summary.json ] && continue
-        n=$((n + 1))
-        cmp -s "$f" "$work/A/frame-0000$1/$b" || fail "frame $1: $b differs from simulate's"
-    done
-    [ "$n" -ge 10 ] || fail "frame $1: only $n files compared"
+    same_files "$work/S$1" "$work/A/frame-0000$1" "frame $1 against simulate's"
 done
 
 # --- the movies ---------------------------------------------------------------------
@@ -222,14 +227,7 @@ PY
 for i in 0 1 2; do
     "$THZMAP" render "$work/pm-frame-$i.json" --photon-map "$work/PM/photon-map.thzpm" \
         -o "$work/PR$i" --threads 1 --quiet > /dev/null || fail "render of frame $i"
-    n=0
-    for f in "$work/PR$i"/*; do
-        b=$(basename "$f")
-        [ "$b" = summary.json ] && continue
-        n=$((n + 1))
-        cmp -s "$f" "$work/P/frame-0000$i/$b" || fail "sensor-only frame $i: $b differs from render's"
-    done
-    [ "$n" -ge 10 ] || fail "sensor-only frame $i: only $n files compared"
+    same_files "$work/PR$i" "$work/P/frame-0000$i" "sensor-only frame $i against render's"
 done
 cmp -s "$work/P/frame-00001/cam.radiance.img" "$work/P/frame-00002/cam.radiance.img" &&
     fail "sensor-only frames 1 and 2 are the same picture: the camera did not move"

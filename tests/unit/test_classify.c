@@ -1,7 +1,8 @@
 /* Classification (analysis/classify.c): on a synthetic cube of three distinct spectra
  * every method is exact without noise; with noise raised the accuracy falls
  * monotonically; the confusion matrix sums to the pixels that see an object; the
- * training split depends on the seed alone; the AUC of a known ranking. */
+ * training split depends on the seed alone. (The AUC is checked only where it is 1;
+ * analysis/classify.c's roc_curve is static.) */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
