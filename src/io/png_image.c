@@ -39,7 +39,10 @@ thz_status png_image_write_srgb8(const char *path, const float *rgb, uint32_t co
     errno = 0; /* libpng reports an allocation failure, or fopen's ENOMEM, as a message */
     if (!png_image_write_to_file(&image, path, 0, bytes, (png_int_32)(3 * (size_t)columns), NULL))
         status = thz_error_set(
-            err, errno == ENOMEM || strstr(image.message, "memory") ? THZ_ERR_NOMEM : THZ_ERR_IO,
+            err,
+            errno == ENOMEM || (strstr(image.message, "memory") || strstr(image.message, "Memory"))
+                ? THZ_ERR_NOMEM
+                : THZ_ERR_IO,
             "%s: cannot write PNG: %s", path, image.message);
     png_image_free(&image);
     free(bytes);

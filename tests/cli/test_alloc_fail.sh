@@ -81,7 +81,7 @@ run_one() {
   local rc=$?
   local ms=$(( ($(date +%s%N) - t0) / 1000000 ))
   local parent_failed
-  parent_failed=$(awk -v pid_line=1 'END { print $3 }' "$dir/report" 2>/dev/null)
+  parent_failed=$(awk 'END { print $3 }' "$dir/report" 2>/dev/null)
   local verdict=ok detail="exit $rc, $ms ms"
   local msg
   msg=$(grep -v '^failalloc' "$dir/err" | head -c 300 | tr '\n' ' ')

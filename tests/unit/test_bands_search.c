@@ -68,8 +68,11 @@ static void check_search(uint64_t limit, const char *expect_search)
     const size_t *two = r.sets + 1 * 3;
     assert_int_equal(two[0], 5);
     assert_int_equal(two[1], 17);
+    /* adding a band never lowers a Bhattacharyya (so JM) distance: the exhaustive search's
+     * best scores cannot fall with k beyond round-off; SFFS may miss by a little */
+    double slack = strcmp(expect_search, "exhaustive") == 0 ? 1e-12 : 1e-3;
     for (size_t k = 1; k < 3; k++)
-        assert_true(r.scores[k].worst_jm >= r.scores[k - 1].worst_jm - 1e-3);
+        assert_true(r.scores[k].worst_jm >= r.scores[k - 1].worst_jm - slack);
     assert_true(r.scores[1].worst_jm > 1.0);
     const size_t *three = r.sets + 2 * 3;
     assert_true(three[0] < three[1] && three[1] < three[2]);
