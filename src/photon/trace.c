@@ -75,8 +75,8 @@ static bool trace_reflect_lobe(const thz_scene *scene, const thz_object *obj, co
                                trace_counters *c)
 {
     brdf_frame f = scene_triangle_frame(obj, hit->triangle, hit->side);
-    brdf_lobe lobe;
-    scene_object_lobe(scene, obj, o, &lobe);
+    brdf_lobe lobe; /* sampling only: per reflection, R-bar would cost 48 Fresnel terms */
+    brdf_lobe_init_sampling(&lobe, o, scene->materials[obj->material].ward_table);
     double w;
     if (!brdf_sample(&lobe, &f, v3_scale(*dir, -1.0), sampling_uniform, rng, dir, &w))
         return false;

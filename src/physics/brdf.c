@@ -138,7 +138,7 @@ void brdf_ward_table_destroy(brdf_ward_table *t)
     free(t);
 }
 
-void brdf_lobe_init(brdf_lobe *l, const optics_point *o, const brdf_ward_table *ward)
+void brdf_lobe_init_sampling(brdf_lobe *l, const optics_point *o, const brdf_ward_table *ward)
 {
     l->o = o;
     l->ward = o->lobe == OPTICS_LOBE_WARD ? ward : NULL;
@@ -156,7 +156,15 @@ void brdf_lobe_init(brdf_lobe *l, const optics_point *o, const brdf_ward_table *
         s = ratio < s ? ratio : s;
     }
     l->scale = isfinite(s) && s > 0.0 ? s : 0.0;
-    double c = optics_mean_reflectance(o) - l->scale * t->a_mean;
+    l->comp_norm = NAN;
+}
+
+void brdf_lobe_init(brdf_lobe *l, const optics_point *o, const brdf_ward_table *ward)
+{
+    brdf_lobe_init_sampling(l, o, ward);
+    if (!l->ward)
+        return;
+    double c = optics_mean_reflectance(o) - l->scale * l->ward->a_mean;
     l->comp_norm = c > 1e-12 ? M_PI * c : 0.0;
 }
 

@@ -45,11 +45,17 @@ typedef struct brdf_lobe {
     const optics_point *o;
     const brdf_ward_table *ward; /* OPTICS_LOBE_WARD only */
     double scale;                /* s */
-    double comp_norm;            /* pi c; 0: no complement */
+    double comp_norm;            /* pi c; 0: no complement (NAN: brdf_lobe_init_sampling) */
 } brdf_lobe;
 
 /* `o` and `ward` are borrowed (ward may be NULL unless o->lobe is OPTICS_LOBE_WARD). */
 void brdf_lobe_init(brdf_lobe *l, const optics_point *o, const brdf_ward_table *ward);
+
+/* As brdf_lobe_init but for brdf_sample alone, which never reads comp_norm (left NAN):
+ * it spares R-bar, the 48 evaluations of R(mu) that an unprepared Fresnel point costs,
+ * on the per-reflection paths (photon tracing, the path integrator). brdf_eval and
+ * brdf_pdf need brdf_lobe_init. */
+void brdf_lobe_init_sampling(brdf_lobe *l, const optics_point *o, const brdf_ward_table *ward);
 
 /* f(wi, wo) in 1/sr without delta parts (0 for a mirror, or either direction below the
  * surface). */

@@ -273,16 +273,29 @@ thz_status load_index_csv(load_ctx *ctx, const load_cursor *file, const csv_tabl
     return st;
 }
 
-/* The first channel whose band (centre +- 2 FWHM) leaves [lo_hz, hi_hz], and how many do;
+/* The band a channel needs the index over, as load.c's table warnings take it: centre
+ * +- 2 FWHM for the Gaussian; for a measured response (relative_width 0), where it is > 0. */
+static void index_band_hz(const thz_channel *ch, double *lo_hz, double *hi_hz)
+{
+    channel_support_hz(ch, 2.0 * CHANNEL_FWHM_PER_SIGMA, lo_hz, hi_hz);
+}
+
+/* How index_band_hz chose the band, for messages. */
+static const char *index_band_how(const thz_channel *ch)
+{
+    return channel_has_response(ch) ? "where its response is > 0" : "centre +- 2 FWHM";
+}
+
+/* The first channel whose band (index_band_hz) leaves [lo_hz, hi_hz], and how many do;
  * n_channels when none. */
 static size_t band_outside(const thz_scene *s, double lo_hz, double hi_hz, size_t *count)
 {
     size_t first = s->n_channels;
     *count = 0;
     for (size_t i = 0; i < s->n_channels; i++) {
-        const thz_channel *ch = &s->channels[i];
-        double fwhm = ch->relative_width * ch->center_hz;
-        if (ch->center_hz - 2 * fwhm < lo_hz || ch->center_hz + 2 * fwhm > hi_hz) {
+        double lo, hi;
+        index_band_hz(&s->channels[i], &lo, &hi);
+        if (lo < lo_hz || hi > hi_hz) {
             if (first == s->n_channels)
                 first = i;
             (*count)++;
@@ -300,13 +313,14 @@ static thz_status warn_outside(load_ctx *ctx, const load_cursor *c, const char *
     if (count == 0)
         return THZ_OK;
     const thz_channel *ch = &ctx->scene->channels[first];
-    double fwhm = ch->relative_width * ch->center_hz;
+    double lo, hi;
+    index_band_hz(ch, &lo, &hi);
     if (!scene_add_warning(ctx->scene,
                            "%s: %s covers %.4g to %.4g THz but channel \"%s\" (band %.4g to "
-                           "%.4g THz, centre +- 2 FWHM)%s reaches beyond it; %s",
-                           c->path, what, lo_hz * 1e-12, hi_hz * 1e-12, ch->name,
-                           (ch->center_hz - 2 * fwhm) * 1e-12, (ch->center_hz + 2 * fwhm) * 1e-12,
-                           count > 1 ? " and others" : "", consequence))
+                           "%.4g THz, %s)%s reaches beyond it; %s",
+                           c->path, what, lo_hz * 1e-12, hi_hz * 1e-12, ch->name, lo * 1e-12,
+                           hi * 1e-12, index_band_how(ch), count > 1 ? " and others" : "",
+                           consequence))
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
     return THZ_OK;
 }
@@ -333,8 +347,8 @@ thz_status load_index_check_channels(load_ctx *ctx, const load_cursor *c, const 
     const thz_scene *s = ctx->scene;
     for (size_t i = 0; i < s->n_channels; i++) {
         const thz_channel *ch = &s->channels[i];
-        double fwhm = ch->relative_width * ch->center_hz;
-        double lo = ch->center_hz - 2 * fwhm, hi = ch->center_hz + 2 * fwhm;
+        double lo, hi;
+        index_band_hz(ch, &lo, &hi);
         if (permittivity_covers(pm, lo, hi))
             continue;
         char ranges[512] = "";
@@ -348,8 +362,8 @@ thz_status load_index_check_channels(load_ctx *ctx, const load_cursor *c, const 
             k = load_key(c, "library");
         return load_fail(ctx, &k,
                          "ITU-R P.2040 gives \"%s\" only for %s, but channel \"%s\" (band %.4g "
-                         "to %.4g GHz, centre +- 2 FWHM) reaches outside that",
-                         pm->material, ranges, ch->name, lo * 1e-9, hi * 1e-9);
+                         "to %.4g GHz, %s) reaches outside that",
+                         pm->material, ranges, ch->name, lo * 1e-9, hi * 1e-9, index_band_how(ch));
     }
     return THZ_OK;
 }

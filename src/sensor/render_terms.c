@@ -26,25 +26,44 @@ double render_path_weight(const render_context *ctx, const render_path *path, do
     return w;
 }
 
-/* Linear interpolation of table[object * n + node] at freq_hz between the (evenly
- * spaced) quadrature nodes inside the band; NAN outside. The tabled quantities are smooth
- * in frequency, so the interpolation is exact to ~1e-8 over a node spacing of 0.03 sigma;
- * it spares a quadrature per photon term. */
+/* Linear interpolation of table[object * n + node] at freq_hz between the quadrature
+ * nodes inside the band; NAN outside. The tabled quantities are smooth in frequency, so
+ * the interpolation is exact to ~1e-8 over a node spacing of 0.03 sigma; it spares a
+ * quadrature per photon term. The Gaussian's nodes are evenly spaced (the node is found
+ * by division); a measured response's are not (each piece has its own Simpson spacing,
+ * pieces where g = 0 have none), so there the node is found by bisection. */
 static double render_interp(const render_context *ctx, const double *table, uint32_t object,
                             double freq_hz)
 {
     size_t n = ctx->quad.n;
-    if (n >= 2) {
-        double f0 = ctx->quad.freq_hz[0], step = ctx->quad.freq_hz[1] - f0;
-        double x = (freq_hz - f0) / step;
-        if (x >= 0.0 && x < (double)(n - 1)) {
-            size_t i = (size_t)x;
-            double t = x - (double)i;
-            const double *tb = &table[(size_t)object * n];
-            return tb[i] + t * (tb[i + 1] - tb[i]);
+    if (n < 2)
+        return NAN;
+    const double *f = ctx->quad.freq_hz;
+    size_t i;
+    double t;
+    if (!channel_has_response(ctx->channel)) {
+        double step = f[1] - f[0];
+        double x = (freq_hz - f[0]) / step;
+        if (!(x >= 0.0 && x < (double)(n - 1)))
+            return NAN;
+        i = (size_t)x;
+        t = x - (double)i;
+    } else {
+        if (!(freq_hz >= f[0] && freq_hz < f[n - 1]))
+            return NAN;
+        size_t lo = 0, hi = n - 1; /* f[lo] <= freq_hz < f[hi] */
+        while (hi - lo > 1) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (f[mid] <= freq_hz)
+                lo = mid;
+            else
+                hi = mid;
         }
+        i = lo;
+        t = (freq_hz - f[i]) / (f[i + 1] - f[i]);
     }
-    return NAN;
+    const double *tb = &table[(size_t)object * n];
+    return tb[i] + t * (tb[i + 1] - tb[i]);
 }
 
 /* T-bar of diffuse shell `object` at freq_hz: the table's interpolation inside the band,

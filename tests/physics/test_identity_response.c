@@ -5,6 +5,8 @@
  * renderer's standard error for every integrator; the Gaussian's value must lie far
  * outside the top-hat image's tolerance, so that the test can tell the two apart. */
 #include "identity.h"
+#include "sensor/render_context.h"
+#include "sensor/render_terms.h"
 
 /* R(nu): 0 except a line of 1 from 0.357 to 0.3595 THz (ramps of 0.4 GHz), inside the
  * top-hat [0.34, 0.36] THz, where a Gaussian of FWHM 20 GHz centred on 0.35 THz has
@@ -112,8 +114,63 @@ static void test_top_hat_over_a_line(void **state)
         response_case(ident_integrators[k]);
 }
 
+/* The renderer's band tables (T-bar, R-bar, Ward's scale: render_context) are read at a
+ * photon's frequency by interpolation between the quadrature nodes. A measured
+ * response's nodes are not evenly spaced (each piece has its own Simpson spacing), so at
+ * every node the interpolation must give that node's own entry, not a neighbour's. A
+ * diffuse shell whose index changes across the band makes T-bar differ from node to
+ * node. */
+static void test_band_tables_at_nodes(void **state)
+{
+    (void)state;
+    const char *json =
+        "{\"format\": \"thzmap-scene/1\", \"name\": \"uneven-nodes\","
+        " \"channels\": [{\"response\": [[0.3, 0.2], [0.3137, 1], [0.3571, 1], [0.371, 0.1]]}],"
+        " \"materials\": {\"black\": {\"reflectivity\": 0.0},"
+        "   \"foam\": {\"refractive_index\": [[0.25, 1.4, 0.01], [0.45, 2.6, 0.3]],"
+        "     \"transmission\": \"diffuse\"}},"
+        " \"objects\": ["
+        "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"black\","
+        "    \"temperature_k\": 300, \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2],"
+        "    \"inward\": true}},"
+        "   {\"name\": \"veil\", \"type\": \"shell\", \"thickness_m\": 0.002,"
+        "    \"material\": \"foam\", \"temperature_k\": 300,"
+        "    \"shape\": {\"type\": \"rectangle\", \"size_m\": [0.5, 0.5]}}],"
+        " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.9, 0],"
+        "   \"direction\": [0, 1, 0], \"fov_deg\": 40, \"resolution\": [4, 4]}],"
+        " \"render\": {\"integrator\": \"path\"}}";
+    thz_scene *scene = NULL;
+    thz_error err = {0};
+    if (scene_load_string(json, ".", "uneven-nodes.json", &scene, &err) != THZ_OK)
+        fail_msg("refused: %s", err.message);
+    render_context *ctx = NULL;
+    if (render_context_create(scene, NULL, NULL, 0, NULL, &ctx, &err) != THZ_OK)
+        fail_msg("render context: %s", err.message);
+    size_t n = ctx->quad.n;
+    const double *f = ctx->quad.freq_hz;
+    double spacing_min = INFINITY, spacing_max = 0.0;
+    for (size_t k = 0; k + 1 < n; k++) {
+        spacing_min = fmin(spacing_min, f[k + 1] - f[k]);
+        spacing_max = fmax(spacing_max, f[k + 1] - f[k]);
+    }
+    print_message("%zu nodes, spacing %.4f..%.4f GHz; T-bar %.5f..%.5f\n", n, 1e-9 * spacing_min,
+                  1e-9 * spacing_max, ctx->tbar[n], ctx->tbar[2 * n - 1]);
+    assert_true(spacing_max > 1.01 * spacing_min); /* uneven: the case under test */
+    assert_true(fabs(ctx->tbar[2 * n - 1] / ctx->tbar[n] - 1.0) > 0.01);
+    const thz_object *veil = &scene->objects[1];
+    for (size_t k = 0; k + 1 < n; k++) {
+        double v = render_tbar(ctx, veil, 1, f[k]), expect = ctx->tbar[n + k];
+        if (!(fabs(v - expect) <= 1e-12 * expect))
+            fail_msg("node %zu (%.6f THz): interpolated T-bar %.9f, the node's %.9f", k,
+                     1e-12 * f[k], v, expect);
+    }
+    render_context_destroy(ctx);
+    scene_destroy(scene);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_top_hat_over_a_line)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_band_tables_at_nodes),
+                                       cmocka_unit_test(test_top_hat_over_a_line)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -144,8 +144,22 @@ static void test_ward(void **state)
     rng_stream rng;
     rng_init(&rng, 5, 0, 0, 0);
     for (size_t c = 0; c < 3; c++) {
-        brdf_lobe l;
+        brdf_lobe l, ls;
         brdf_lobe_init(&l, &cases[c], table);
+        /* the sampling-only lobe draws the same directions with the same weights */
+        brdf_lobe_init_sampling(&ls, &cases[c], table);
+        assert_true(ls.scale == l.scale && ls.ward == l.ward);
+        rng_stream ra, rb;
+        rng_init(&ra, 17, 0, 0, 0);
+        rng_init(&rb, 17, 0, 0, 0);
+        for (int i = 0; i < 1000; i++) {
+            vec3 wi = dir_at(rng_uniform(&rng), 2 * M_PI * rng_uniform(&rng)), oa, ob;
+            double wa = 0.0, wb = 0.0;
+            bool ka = brdf_sample(&l, &f, wi, sampling_uniform, &ra, &oa, &wa);
+            bool kb = brdf_sample(&ls, &f, wi, sampling_uniform, &rb, &ob, &wb);
+            assert_true(ka == kb && wa == wb);
+            assert_true(!ka || (oa.x == ob.x && oa.y == ob.y && oa.z == ob.z));
+        }
         /* reciprocity at random pairs */
         for (int i = 0; i < 1000; i++) {
             vec3 a = dir_at(rng_uniform(&rng), 2 * M_PI * rng_uniform(&rng));

@@ -210,6 +210,19 @@ static void test_refusals(void **state)
              "100 GHz, 110 to 330 GHz, 100 to 400 GHz, but channel \"1.000 THz\"");
     load_bad("0.105", "{\"library\": \"concrete\"}",
              "materials.m.library: ITU-R P.2040 gives \"concrete\" only for 1 to 100 GHz");
+    /* a measured response has no relative width: its band is where it is > 0 */
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{\"format\": \"thzmap-scene/1\", \"channels\": [{\"frequency_thz\": 0.1, "
+             "\"response\": [[0.05, 1], [0.9, 1]]}], \"materials\": {\"m\": "
+             "{\"library\": \"concrete\"}}, %s",
+             strstr(HEAD, "\"objects\""));
+    thz_scene *s = NULL;
+    thz_error err = {0};
+    assert_int_equal(scene_load_string(json, SRC, "test.json", &s, &err), THZ_ERR_INPUT);
+    assert_null(s);
+    if (!strstr(err.message, "(band 50 to 900 GHz, where its response is > 0)"))
+        fail_msg("message '%s' lacks the table's band", err.message);
     load_bad("1.0", "{\"library\": \"unobtainium\"}",
              "materials.m.library: unknown library material \"unobtainium\"");
     load_bad("1.0", "{\"file\": \"materials/n_only.csv\"}", "the columns n and k go together");
