@@ -174,6 +174,11 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
  * anything): THZ_ERR_LIMIT naming the scene file and sensors[i].resolution. */
 thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err);
 
+/* Estimates the memory of the run in rs (its selected sensors' images and, when
+ * `photons`, the photon maps it fires), stores it in rs->memory_bytes and refuses the run
+ * as run_check_memory does. */
+thz_status run_check_run_memory(run_state *rs, bool photons, thz_error *err);
+
 /* Fire and render (simulate) or render from `in` (render; NULL only for path) into rs,
  * nothing written. On failure rs is finalised. */
 thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_state *rs,

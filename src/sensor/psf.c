@@ -166,24 +166,45 @@ static size_t psf_mirror(long long i, size_t n)
     return (size_t)(m < (long long)n ? m : p - 1 - m);
 }
 
-static void psf_direct(const psf_kernel *k, const float *in, float *out, uint32_t columns,
-                       uint32_t rows, int threads)
+/* The mirrored index of each position -h .. n - 1 + h of a line of n pixels, at [i + h]:
+ * the taps then read it instead of dividing twice each. NULL when out of memory. */
+static size_t *psf_mirror_table(size_t n, size_t h)
+{
+    size_t *t = thz_malloc_array(n + 2 * h, sizeof *t);
+    for (size_t i = 0; t && i < n + 2 * h; i++)
+        t[i] = psf_mirror((long long)i - (long long)h, n);
+    return t;
+}
+
+static thz_status psf_direct(const psf_kernel *k, const float *in, float *out, uint32_t columns,
+                             uint32_t rows, int threads, thz_error *err)
 {
     long long h = k->half, side = 2 * h + 1;
+    size_t *mx = psf_mirror_table(columns, (size_t)h), *my = psf_mirror_table(rows, (size_t)h);
+    if (!mx || !my) {
+        free(mx);
+        free(my);
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the PSF's border");
+    }
     int nt = threads > 0 ? threads : omp_get_max_threads();
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (long long r = 0; r < (long long)rows; r++) {
         for (long long c = 0; c < (long long)columns; c++) {
             double sum = 0.0;
+            /* tap (kx, ky) reads pixel (c - (kx - h), r - (ky - h)), at [. + h] */
             for (long long ky = 0; ky < side; ky++) {
-                size_t sy = psf_mirror(r - (ky - h), rows);
+                const float *line = in + my[r + 2 * h - ky] * columns;
                 const double *w = k->weight + ky * side;
+                const size_t *xs = mx + c + 2 * h;
                 for (long long kx = 0; kx < side; kx++)
-                    sum += w[kx] * in[sy * columns + psf_mirror(c - (kx - h), columns)];
+                    sum += w[kx] * line[xs[-kx]];
             }
             out[(size_t)r * columns + (size_t)c] = (float)sum;
         }
     }
+    free(mx);
+    free(my);
+    return THZ_OK;
 }
 
 /* Circular convolution of the mirror-extended image (columns + 2h) x (rows + 2h) with
@@ -255,9 +276,7 @@ thz_status psf_apply(const psf_kernel *k, const float *in, float *out, uint32_t 
                      uint32_t rows, int threads, thz_error *err)
 {
     size_t side = 2 * (size_t)k->half + 1;
-    if (side * side <= PSF_DIRECT_MAX_TAPS) {
-        psf_direct(k, in, out, columns, rows, threads);
-        return THZ_OK;
-    }
+    if (side * side <= PSF_DIRECT_MAX_TAPS)
+        return psf_direct(k, in, out, columns, rows, threads, err);
     return psf_fft(k, in, out, columns, rows, err);
 }

@@ -5,7 +5,8 @@
 #    measured Tb's standard deviation is K (T + T_rec) / sqrt(B_n tau) (or the given
 #    NETD) within 3 sigma of its sampling error, the mean is unbiased within
 #    3 NETD / sqrt(N), neighbouring pixels and the two channels are uncorrelated
-#    (|r| < 3 / sqrt(N)) (sensor_check.py);
+#    (|r| < 3 / sqrt(N)) (sensor_check.py); with a 1000 K ball in view, the NETD follows
+#    each pixel's Tb (not the channel's reference temperature);
 #  - the noise-free cubes are byte for byte those of the same scene without the model;
 #  - the measured cubes are bit-identical for --threads 1 and 2, and `render` from a
 #    saved photon map gives simulate's measured cubes;
@@ -92,6 +93,45 @@ for q in measured_radiance measured_brightness_temperature; do
     cmp -s "$work/pm/netd.$q.img" "$work/pmr/netd.$q.img" ||
         fail "netd.$q: render from the saved map differs from simulate"
 done
+
+# ---- noise where Tb varies: a 1000 K ball in the 300 K furnace --------------------------
+# The radiometer's NETD follows each pixel's Tb, not the channel's reference temperature
+# (the box's 300 K): (measured - true Tb) / NETD(true Tb) has mean 0 and spread 1 on the
+# ball's pixels and on the box's (NETD at 1000 K is 1.6 x that at 300 K).
+cat > "$work/hot.json" <<EOF
+{"format": "thzmap-scene/1", "name": "hot",
+ "channels": [{"frequency_thz": 0.35, "relative_width": 0.01}],
+ "materials": {"black": {"reflectivity": 0}},
+ "objects": [{"name": "box", "type": "solid", "material": "black", "temperature_k": 300,
+              "shape": {"type": "box", "size_m": [4, 4, 4], "inward": true}},
+             {"name": "ball", "type": "solid", "material": "black", "temperature_k": 1000,
+              "shape": {"type": "sphere", "radius_m": 0.3},
+              "transform": {"translate_m": [0, 1.5, 0]}}],
+ "sensors": [{"name": "tp", "position_m": [0, 0, 0], "direction": [0, 1, 0], "fov_deg": 30,
+              "resolution": [128, 128], "noise": {"receiver_temperature_k": 500,
+              "integration_time_s": 0.01, "radiometer": "total-power"}}],
+ "render": {"integrator": "path", "paths_per_sample": 1}}
+EOF
+run hot simulate "$work/hot.json" -o "$work/hot" --threads 2
+/usr/bin/python3 - "$REPO/tests/cli" "$work/hot" <<'EOF' || fail "noise where Tb varies"
+import math, sys
+sys.path.insert(0, sys.argv[1])
+from sensor_check import cube
+truth = cube(sys.argv[2], "tp", "brightness_temperature")[0]
+meas = cube(sys.argv[2], "tp", "measured_brightness_temperature")[0]
+b_n = 2.0 * math.sqrt(math.pi) * 0.01 * 0.35e12 / (2.0 * math.sqrt(2.0 * math.log(2.0)))
+z = (meas - truth) / ((truth + 500.0) / math.sqrt(b_n * 0.01))
+ok = True
+for name, sel in (("ball", truth > 650.0), ("box", truth < 650.0)):
+    n = int(sel.sum())
+    std, mean = float(z[sel].std(ddof=1)), float(z[sel].mean())
+    tol = 3.0 / math.sqrt(2.0 * n)
+    good = n > 3000 and abs(std - 1.0) < tol and abs(mean) < 3.0 / math.sqrt(n)
+    print(("ok:   " if good else "FAIL: ") + f"{name}: {n} pixels, (measured - true Tb) / "
+          f"NETD(Tb): std {std:.4f} (1 +- {tol:.4f}), mean {mean:+.4f}")
+    ok = ok and good
+sys.exit(0 if ok else 1)
+EOF
 
 # ---- PSF: a hot disk far below the diffraction limit -----------------------------------
 pitch=0.0015 # rad per pixel at the centre, 129 columns

@@ -1,0 +1,103 @@
+/* The memory a run needs, estimated before it starts, and the refusal of a run that
+ * would not fit (run.h: run_memory). */
+#include <stdio.h>
+
+#include "core/alloc.h"
+#include "photon/phase.h"
+#include "photon/photon_map.h"
+#include "run/run.h"
+#include "sensor/images.h"
+#include "sensor/measure.h"
+
+thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err)
+{
+    if (need->available_bytes == 0)
+        return THZ_OK; /* unknown: let the allocations decide */
+    double limit = 0.9 * (double)need->available_bytes;
+    if ((double)need->total_bytes <= limit)
+        return THZ_OK;
+    double gib = 1024.0 * 1024.0 * 1024.0;
+    char key[128];
+    if (need->photon_bytes >= need->image_bytes) {
+        snprintf(key, sizeof key, "photons.per_channel (now %llu; or --photons)",
+                 (unsigned long long)scene->photons.per_channel);
+    } else {
+        size_t big = 0;
+        for (size_t s = 1; s < scene->n_sensors; s++)
+            if ((uint64_t)scene->sensors[s].columns * scene->sensors[s].rows >
+                (uint64_t)scene->sensors[big].columns * scene->sensors[big].rows)
+                big = s;
+        snprintf(key, sizeof key, "sensors[%zu].resolution", big);
+    }
+    return thz_error_set(err, THZ_ERR_LIMIT,
+                         "the run would need %.2f GiB of memory (photon maps %.2f GiB, images "
+                         "%.2f GiB) but this machine has %.2f GiB; lower %s",
+                         (double)need->total_bytes / gib, (double)need->photon_bytes / gib,
+                         (double)need->image_bytes / gib, (double)need->available_bytes / gib, key);
+}
+
+thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err)
+{
+    uint64_t have = thz_physical_memory_bytes();
+    for (size_t s = 0; s < scene->n_sensors && have > 0; s++) {
+        const thz_sensor *sn = &scene->sensors[s];
+        uint64_t need = sensor_images_bytes(sn->columns, sn->rows, scene->n_channels);
+        if ((double)need > 0.9 * (double)have) /* as run_check_memory */
+            return thz_error_set(err, THZ_ERR_LIMIT,
+                                 "%s: sensors[%zu].resolution: the images of %u x %u pixels in "
+                                 "%zu channels need %.1f GiB, more than this machine's memory "
+                                 "(%.1f GiB) allows; lower 'resolution' (or the number of "
+                                 "channels)",
+                                 scene->path, s, sn->columns, sn->rows, scene->n_channels,
+                                 (double)need / 1073741824.0, (double)have / 1073741824.0);
+    }
+    return THZ_OK;
+}
+
+static uint64_t run_image_bytes(const run_state *rs)
+{
+    uint64_t total = 0;
+    /* the pixel statistics of the channel being rendered: mean and m2, and final-gather's
+     * photon batches and disk variance (render_accum) */
+    uint64_t per_pixel =
+        2u +
+        (rs->scene->render.integrator == INTEGRATOR_FINAL_GATHER ? PHOTON_MAP_BATCHES + 1u : 0u);
+    for (size_t i = 0; i < rs->n_selected; i++) {
+        const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
+        total += sensor_images_bytes(s->columns, s->rows, rs->scene->n_channels);
+        if (sensor_has_model(s)) /* measured radiance and Tb */
+            total += 2u * sizeof(float) * s->columns * s->rows * rs->scene->n_channels;
+        total += (uint64_t)s->columns * s->rows * per_pixel * sizeof(double);
+    }
+    return total;
+}
+
+/* a + b, or UINT64_MAX when the sum does not fit (estimates of absurd runs saturate, so
+ * that they are refused instead of wrapping to a small number). */
+static uint64_t run_add_bytes(uint64_t a, uint64_t b)
+{
+    return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
+
+thz_status run_check_run_memory(run_state *rs, bool photons, thz_error *err)
+{
+    run_memory need = {.image_bytes = run_image_bytes(rs),
+                       .available_bytes = thz_physical_memory_bytes()};
+    if (photons) {
+        uint64_t sum = 0, max = 0;
+        for (size_t c = 0; c < rs->scene->n_channels; c++) {
+            uint64_t b = 0;
+            thz_status st = photon_phase_estimate_bytes(rs->scene, rs->accel, c,
+                                                        run_photon_t0_k(rs->scene, c), &b, err);
+            if (st != THZ_OK)
+                return st;
+            sum = run_add_bytes(sum, b);
+            max = b > max ? b : max;
+        }
+        /* kept maps, plus one map while it is built (records and index) */
+        need.photon_bytes = run_add_bytes(rs->opt->keep_photon_maps ? sum : max, max);
+    }
+    need.total_bytes = run_add_bytes(need.photon_bytes, need.image_bytes);
+    rs->memory_bytes = need.total_bytes;
+    return run_check_memory(rs->scene, &need, err);
+}
