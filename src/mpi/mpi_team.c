@@ -43,16 +43,19 @@ static thz_status team_error(thz_error *err, int rc, const char *what)
     return thz_error_set(err, THZ_ERR_IO, "MPI: %s: %s", what, text);
 }
 
-/* Waits for req, polling: a waiting rank leaves the cores to the working ones. */
+/* Waits for req, polling with a pause that doubles from 50 us to 5 ms: a waiting rank
+ * (a member while rank 0 renders, for seconds) leaves the cores to the working ones. */
 static int team_wait(MPI_Request *req)
 {
+    long pause_ns = 50000;
     for (;;) {
         int done = 0;
         int rc = MPI_Test(req, &done, MPI_STATUS_IGNORE);
         if (rc != MPI_SUCCESS || done)
             return rc;
-        struct timespec pause = {.tv_sec = 0, .tv_nsec = 200000};
+        struct timespec pause = {.tv_sec = 0, .tv_nsec = pause_ns};
         nanosleep(&pause, NULL);
+        pause_ns = pause_ns < 5000000 ? 2 * pause_ns : 5000000;
     }
 }
 

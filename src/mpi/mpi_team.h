@@ -10,7 +10,7 @@
  * the team calls MPI) and finalises it after destroying the team; the library never
  * aborts: a failed rank returns its error, and the program ends the job (MPI_Abort).
  *
- * Waiting ranks poll (MPI_Test, then sleep 0.2 ms) rather than spin, so that ranks
+ * Waiting ranks poll (MPI_Test, then sleep up to 5 ms) rather than spin, so that ranks
  * oversubscribing a machine leave its cores to the ranks that work.
  */
 #ifndef THZ_MPI_MPI_TEAM_H
