@@ -72,7 +72,7 @@ uint64_t thz_context_mpi_bytes(const thz_context *ctx)
     return ctx->team ? mpi_team_bytes(ctx->team) : ctx->mpi_bytes;
 }
 
-const photon_phase_team *api_mpi_phase_team(const thz_context *ctx)
+const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx)
 {
     return ctx && ctx->team ? mpi_team_phase(ctx->team) : NULL;
 }
@@ -107,7 +107,7 @@ uint64_t thz_context_mpi_bytes(const thz_context *ctx)
     return 0;
 }
 
-const photon_phase_team *api_mpi_phase_team(const thz_context *ctx)
+const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx)
 {
     (void)ctx;
     return NULL;

@@ -2,7 +2,7 @@
 # MPI runs (docs/mpi.md): `mpirun -np N thzmap simulate` gives, byte for byte, the files of
 # one process with the same seed (summary.json aside: wall times, threads, mpi_ranks),
 # for 2 and 3 ranks of 1 thread and 2 ranks of 2 threads, photon-map and final-gather
-# (with the saved photon map); only rank 0 writes; a failed or killed rank fails the
+# (with the saved photon map), and photon passes (several shared phases in one run); only rank 0 writes; a failed or killed rank fails the
 # run with a message and a non-zero exit, never a hang, and leaves no OUTDIR.
 # Usage: bash test_mpi.sh THZMAP_BINARY REPO_DIR
 set -u
@@ -87,9 +87,19 @@ mpi 3 "$THZMAP" simulate "$scene" -o "$work/fg3" --integrator final-gather --sav
 [ -f "$work/fg3/photon-map.thzpm" ] || fail "3 ranks: no photon-map.thzpm"
 same_run "$work/fg3" "$work/fg1" "3 ranks x 1 thread, final-gather and its photon map"
 
+# photon passes (photon-map with a noise target): one shared phase per pass, 70 000
+# photons each (p95 5.5 K after one pass, so a 5 K target takes two or more)
+"$THZMAP" simulate "$scene" -o "$work/pp1" --integrator photon-map --photons 70000 \
+    --target-noise-k 5 --threads 1 --quiet || fail "one process, photon passes: exit $?"
+mpi 2 "$THZMAP" simulate "$scene" -o "$work/pp2" --integrator photon-map --photons 70000 \
+    --target-noise-k 5 --threads 1 --quiet || fail "2 ranks, photon passes: exit $?"
+same_run "$work/pp2" "$work/pp1" "2 ranks, photon passes"
+$PY -c 'import json,sys; sys.exit(json.load(open(sys.argv[1]))["channels"][0]["render_passes"] < 2)' \
+    "$work/pp2/summary.json" || fail "photon passes: fewer than 2 passes (the test tests one phase)"
+
 step "only rank 0"
 # --- only rank 0 writes: nothing else beside the outputs -----------------------------
-extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3')
+extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3|pp1|pp2')
 [ -z "$extra" ] || fail "files beside the outputs: $extra"
 
 
