@@ -124,6 +124,16 @@ typedef struct thz_bands_options {
     uint64_t seed;                      /* 0 to INT64_MAX, like photons.seed */
     uint64_t exhaustive_limit;          /* search every subset when there are at most this many of
                                            sizes 1..K (default 200000), else SFFS */
+    /* Channel widths searched too: every centre is a candidate with each of these n_widths
+     * relative widths (FWHM / centre, 0 < w <= 0.5, distinct); a chosen set holds each
+     * centre at most once. n_widths 0: relative_width alone. */
+    const double *relative_widths;
+    size_t n_widths;
+    double thickness_range; /* every shell's thickness within +- this fraction of its own
+                               (0.2: +- 20 %), 0 <= f < 1; default 0 (not varied) */
+    double angle_range_deg; /* the viewing angle within +- this: the sensor turned about its
+                               up axis around its look_at_m point (about its own position
+                               when it gives a direction), 0 <= a <= 90 degrees; default 0 */
 } thz_bands_options;
 
 THZ_API void thz_bands_options_init(thz_bands_options *opt);
@@ -147,6 +157,9 @@ typedef struct thz_bands_info {
 THZ_API void thz_bands_get_info(const thz_bands *b, thz_bands_info *out);
 /* The chosen centre i (ascending), THz; NaN past the end. */
 THZ_API double thz_bands_selected_thz(const thz_bands *b, size_t i);
+/* The relative width (FWHM / centre) of chosen channel i, aligned with
+ * thz_bands_selected_thz; NaN past the end. */
+THZ_API double thz_bands_selected_relative_width(const thz_bands *b, size_t i);
 /* The best set's worst-pair Jeffries-Matusita distance with k = 1..count channels. */
 THZ_API double thz_bands_score(const thz_bands *b, size_t k);
 /* bands.json as text (owned by b). */
