@@ -140,19 +140,20 @@ THZ_API void thz_bands_options_init(thz_bands_options *opt);
 
 typedef struct thz_bands thz_bands;
 
-/* Chooses opt->count channel centres among the candidates for the scene file at
- * `scene_path`: renders the scene (path integrator) with the candidates as its channels,
- * nominal and with each nuisance changed, takes each class's pixels from the object_id
- * truth, and searches the set that maximises the worst pair's Bhattacharyya distance
- * (docs/analysis.md). Progress and cancellation through ctx. */
+/* Chooses opt->count channel centres (with their widths when opt->n_widths > 0) among
+ * the candidates for the scene file at `scene_path`: renders the scene (path
+ * integrator) with the candidates as its channels, nominal and with each nuisance
+ * changed, takes each class's pixels from the object_id truth, and searches the set
+ * that maximises the worst pair's Bhattacharyya distance (docs/analysis.md). Progress
+ * and cancellation through ctx. */
 THZ_API thz_status thz_bands_select(thz_context *ctx, const char *scene_path,
                                     const thz_bands_options *opt, thz_bands **out, thz_error *err);
 THZ_API void thz_bands_destroy(thz_bands *b);
 
 typedef struct thz_bands_info {
-    size_t n_candidates, count, n_classes;
-    const char *search; /* "exhaustive" or "sffs" */
-    double score;       /* worst-pair Jeffries-Matusita distance of the chosen set, 0..2 */
+    size_t n_candidates, count, n_classes; /* candidates: centres x widths */
+    const char *search;                    /* "exhaustive" or "sffs" */
+    double score; /* worst-pair Jeffries-Matusita distance of the chosen set, 0..2 */
 } thz_bands_info;
 THZ_API void thz_bands_get_info(const thz_bands *b, thz_bands_info *out);
 /* The chosen centre i (ascending), THz; NaN past the end. */

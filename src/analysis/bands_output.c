@@ -130,6 +130,8 @@ char *bands_json(const bands_report *rep, thz_error *err)
     put(nu, "thickness_varied", json_boolean(v->thickness_varied), &ok);
     put(nu, "angle_range_deg", json_real(s->angle_range_deg), &ok);
     put(nu, "angle_varied", json_boolean(v->angle_varied), &ok);
+    put(nu, "render_paths_per_sample", json_integer(v->coarse_paths), &ok);
+    put(nu, "render_oversampling", json_integer(1), &ok);
     json_t *classes = json_array();
     put(root, "classes", classes, &ok);
     for (size_t k = 0; k < v->n_classes && ok; k++) {

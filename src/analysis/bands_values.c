@@ -129,8 +129,17 @@ static int turn_sensor(json_t *sensor, double deg)
     return 1;
 }
 
+/* The nuisances' renders are coarse: one sample per pixel and a quarter of the paths
+ * (at least one), against a coarse nominal render with the same seed. A class mean's
+ * change is smooth over its pixels and the common seed keeps the Monte Carlo noise out
+ * of the difference, so it needs far fewer samples than the pixel statistics do. */
+static uint32_t coarse_paths(uint32_t paths)
+{
+    return paths >= 4 ? paths / 4 : 1;
+}
+
 static char *variant_text(const json_t *root, const bands_setup *s, const bool *is_class, int what,
-                          int *changed)
+                          bool coarse, int *changed)
 {
     json_t *doc = json_deep_copy(root);
     if (!doc)
@@ -145,7 +154,9 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
     json_object_set_new(doc, "channels", channels);
     json_t *render = json_object();
     json_object_set_new(render, "integrator", json_string("path"));
-    json_object_set_new(render, "paths_per_sample", json_integer(s->paths_per_sample));
+    json_object_set_new(
+        render, "paths_per_sample",
+        json_integer(coarse ? coarse_paths(s->paths_per_sample) : s->paths_per_sample));
     json_object_set_new(doc, "render", render);
     /* the sensor's noise with one netd_k per channel cannot follow the candidates: its
      * NETD is interpolated to them instead (api_bands.c), and the renders need none */
@@ -153,6 +164,8 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
     json_t *noise = json_object_get(sensor, "noise");
     if (noise && json_is_array(json_object_get(noise, "netd_k")))
         json_object_del(sensor, "noise");
+    if (coarse && sensor)
+        json_object_set_new(sensor, "oversampling", json_integer(1));
     *changed = 0;
     json_t *objects = json_object_get(doc, "objects");
     json_t *atm = json_object_get(doc, "atmosphere");
@@ -388,6 +401,26 @@ static void pixel_covariance(const render_out *r, const int32_t *cls, const band
     }
 }
 
+/* Renders variant `text` and puts its class means in mean (classes from its own truth:
+ * a turned sensor sees them elsewhere; `fallback` for a class it no longer sees). cls
+ * and count are scratch of the nominal's pixels and the classes. */
+static thz_status variant_means(thz_context *ctx, const char *text, const bands_setup *s,
+                                const char *base_dir, const int32_t *class_of, size_t n_obj,
+                                size_t pixels, int32_t *cls, uint64_t *count, const bands_values *v,
+                                const double *fallback, double *mean, thz_error *err)
+{
+    render_out r = {0};
+    thz_status st = render_variant(ctx, text, s, base_dir, &r, err);
+    if (st == THZ_OK && r.pixels != pixels) /* a variant never changes the resolution */
+        st = thz_error_set(err, THZ_ERR_INTERNAL, "band values: a variant's image differs");
+    if (st == THZ_OK) {
+        pixel_classes(&r, class_of, n_obj, v->n_classes, cls, count);
+        class_means(&r, cls, count, v, fallback, mean);
+    }
+    render_out_fini(&r);
+    return st;
+}
+
 /* The NETD of each class and candidate: the radiometer's at the class's mean Tb (its
  * noise grows with the Tb it measures, scene-format.md "noise"), else the candidate's. */
 static void class_netd(const thz_scene *scene, const bands_setup *s, bands_values *v)
@@ -409,6 +442,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     clock_gettime(CLOCK_MONOTONIC, &t0);
     size_t n = s->n_candidates;
     v->n_candidates = n;
+    v->coarse_paths = coarse_paths(s->paths_per_sample);
     json_error_t jerr;
     json_t *root = json_load_file(s->scene_path, JSON_REJECT_DUPLICATES, &jerr);
     if (!root)
@@ -423,11 +457,11 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
         snprintf(base_dir, sizeof base_dir, ".");
     thz_status st = THZ_OK;
     thz_scene *scene = NULL;
-    render_out nominal = {0}, other = {0};
+    render_out nominal = {0};
     int32_t *cls = NULL, *class_of = NULL;
     uint64_t *count = NULL;
     bool *is_class = NULL;
-    double *x = NULL, *dmean = NULL;
+    double *x = NULL, *dmean = NULL, *coarse_mean = NULL;
     char *text = NULL;
     int changed = 0;
     size_t n_obj = json_array_size(json_object_get(root, "objects"));
@@ -435,7 +469,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     class_of = thz_calloc(n_obj ? n_obj : 1, sizeof *class_of);
     if (!is_class || !class_of)
         goto nomem;
-    text = variant_text(root, s, is_class, VAR_NOMINAL, &changed);
+    text = variant_text(root, s, is_class, VAR_NOMINAL, false, &changed);
     if (!text)
         goto nomem;
     st = thz_scene_load_string(text, base_dir, s->scene_path, &scene, err);
@@ -487,8 +521,9 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     /* Nuisances: a uniform variation within +-range has variance range^2 / 3; the
      * render at +range (humidity: x (1 - range)) gives the change d of each class's
      * mean, which adds d d^T / 3 to its covariance (the same seed in every render keeps
-     * the Monte Carlo noise out of d). Each render's own truth gives its classes' pixels:
-     * a turned sensor sees them elsewhere in the image. */
+     * the Monte Carlo noise out of d). These renders and the nominal one d is taken
+     * against are coarse (coarse_paths). Each render's own truth gives its classes'
+     * pixels: a turned sensor sees them elsewhere in the image. */
     double ranges[VAR_COUNT] = {0,
                                 s->target_range_k,
                                 s->ambient_range_k,
@@ -498,7 +533,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
         if (!(ranges[what] > 0.0))
             continue;
-        text = variant_text(root, s, is_class, what, &changed);
+        text = variant_text(root, s, is_class, what, true, &changed);
         if (!text)
             goto nomem;
         if (!changed) {
@@ -506,28 +541,36 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
             text = NULL;
             continue;
         }
+        if (!coarse_mean) { /* the coarse nominal render the changes are taken against */
+            char *nominal_text = variant_text(root, s, is_class, VAR_NOMINAL, true, &changed);
+            coarse_mean = thz_calloc(nc * n, sizeof *coarse_mean);
+            if (!nominal_text || !coarse_mean) {
+                free(nominal_text);
+                goto nomem;
+            }
+            st = variant_means(ctx, nominal_text, s, base_dir, class_of, n_obj, nominal.pixels, cls,
+                               count, v, v->mean, coarse_mean, err);
+            free(nominal_text);
+            if (st != THZ_OK)
+                goto done;
+            v->renders++;
+        }
         v->humidity_varied = v->humidity_varied || what == VAR_HUMIDITY;
         v->air_temperature_varied =
             v->air_temperature_varied || (what == VAR_AMBIENT && changed >= 2);
         v->thickness_varied = v->thickness_varied || what == VAR_THICKNESS;
         v->angle_varied = v->angle_varied || what == VAR_ANGLE;
-        st = render_variant(ctx, text, s, base_dir, &other, err);
+        st = variant_means(ctx, text, s, base_dir, class_of, n_obj, nominal.pixels, cls, count, v,
+                           coarse_mean, dmean, err);
         free(text);
         text = NULL;
         if (st != THZ_OK)
             goto done;
         v->renders++;
-        if (other.pixels != nominal.pixels) { /* a variant never changes the resolution */
-            st = thz_error_set(err, THZ_ERR_INTERNAL, "band values: a variant's image differs");
-            goto done;
-        }
-        pixel_classes(&other, class_of, n_obj, nc, cls, count); /* cls is free by now */
-        class_means(&other, cls, count, v, v->mean, dmean);
-        render_out_fini(&other);
         for (size_t k = 0; k < nc; k++) {
             double *d = dmean + k * n, *cov = v->cov + k * n * n;
             for (size_t c = 0; c < n; c++)
-                d[c] = (d[c] - v->mean[k * n + c]) / sqrt(3.0);
+                d[c] = (d[c] - coarse_mean[k * n + c]) / sqrt(3.0);
             for (size_t a = 0; a < n; a++) {
                 for (size_t b = 0; b < n; b++)
                     cov[a * n + b] += d[a] * d[b];
@@ -546,12 +589,12 @@ done:
     free(text);
     free(x);
     free(dmean);
+    free(coarse_mean);
     free(count);
     free(cls);
     free(class_of);
     free(is_class);
     render_out_fini(&nominal);
-    render_out_fini(&other);
     thz_scene_destroy(scene);
     json_decref(root);
     if (st != THZ_OK)

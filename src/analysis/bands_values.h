@@ -44,6 +44,7 @@ typedef struct bands_values {
     double *netd_k;         /* [class * n + c]: the sensor's NETD at the class's mean Tb, K */
     bool humidity_varied, air_temperature_varied, thickness_varied, angle_varied;
     size_t renders;
+    uint32_t coarse_paths; /* paths per sample of the nuisances' renders (1 sample per pixel) */
     double seconds;
 } bands_values;
 

@@ -125,6 +125,16 @@ assert "radiometer" in n["radiometer"]["source"] and all(x > 0 for x in r), n["r
 # T_rec dominates: NETD ~ (T + T_rec) / sqrt(B_n tau), B_n proportional to the frequency
 assert abs(r[0] / r[4] / math.sqrt(5.0) - 1.0) < 0.02, r
 assert n["given"]["netd_k"] == [0.7] * 5 and n["given"]["source"] == "--netd-k", n["given"]
+# the radiometer's NETD in each class's covariance is at the class's own Tb:
+# NETD ~ Tb + T_rec (T_rec = 2000 K), so the plates at 310 K read more noise than the room
+cl = json.load(open(f"{sys.argv[1]}/n-radiometer/bands.json"))["classes"]
+room, plate = cl[0], cl[1]
+for c in range(5):
+    ratio = plate["netd_k"][c] / room["netd_k"][c]
+    expect = (plate["mean_tb_k"][c] + 2000) / (room["mean_tb_k"][c] + 2000)
+    assert abs(ratio / expect - 1) < 1e-9 and abs(ratio - 1) > 1e-3, (c, ratio, expect)
+given = json.load(open(f"{sys.argv[1]}/n-given/bands.json"))["classes"]
+assert all(k["netd_k"] == [0.7] * 5 for k in given), given
 PYEOF
 
 # widths searched: every centre with a narrow (1 %) and a broad (30 %) width at one
@@ -182,10 +192,13 @@ r = {k: json.load(open(f"{sys.argv[1]}/{k}/bands.json")) for k in ("c0", "ct", "
 sd = {k: {c["name"]: c["nuisance_sd_k"] for c in d["classes"]} for k, d in r.items()}
 assert r["c0"]["renders"] == 1 and all(x == 0 for v in sd["c0"].values() for x in v), sd["c0"]
 n = r["ct"]["nuisances"]
-assert r["ct"]["renders"] == 2 and n["thickness_varied"] and n["thickness_range"] == 0.5, n
+# the nominal render, and a coarse nominal and the variant (1 sample per pixel, a
+# quarter of the paths)
+assert r["ct"]["renders"] == 3 and n["thickness_varied"] and n["thickness_range"] == 0.5, n
 assert all(c > 0.3 and c > 10 * b for c, b in zip(sd["ct"]["cover"], sd["ct"]["B"])), sd["ct"]
 n = r["ca"]["nuisances"]
-assert r["ca"]["renders"] == 2 and n["angle_varied"] and not n["thickness_varied"], n
+assert n["render_paths_per_sample"] == 1 and n["render_oversampling"] == 1, n
+assert r["ca"]["renders"] == 3 and n["angle_varied"] and not n["thickness_varied"], n
 assert max(max(v) for v in sd["ca"].values()) > 0.05, sd["ca"]
 PYEOF
 
