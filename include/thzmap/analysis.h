@@ -123,7 +123,7 @@ typedef struct thz_bands_options {
     int has_seed;                       /* non-zero: `seed` instead of the scene's */
     uint64_t seed;                      /* 0 to INT64_MAX, like photons.seed */
     uint64_t exhaustive_limit;          /* search every subset when there are at most this many of
-                                           sizes 1..K (default 200000), else SFFS */
+                                           sizes 1..K (default 2000000), else SFFS */
     /* Channel widths searched too: every centre is a candidate with each of these n_widths
      * relative widths (FWHM / centre, 0 < w <= 0.5, distinct); a chosen set holds each
      * centre at most once. n_widths 0: relative_width alone. */

@@ -44,7 +44,7 @@ void thz_bands_options_init(thz_bands_options *opt)
     opt->ambient_temperature_range_k = 2.0;
     opt->humidity_range = 0.2;
     opt->paths_per_sample = 16;
-    opt->exhaustive_limit = 200000;
+    opt->exhaustive_limit = 2000000;
 }
 
 void thz_bands_destroy(thz_bands *b)
@@ -340,7 +340,7 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
                         .mean = b->values.mean,
                         .cov = b->values.cov,
                         .group = b->group};
-    st = bands_search(&cl, o->count, o->exhaustive_limit ? o->exhaustive_limit : 200000, &b->search,
+    st = bands_search(&cl, o->count, o->exhaustive_limit ? o->exhaustive_limit : 2000000, &b->search,
                       err);
     if (st != THZ_OK)
         goto done;
