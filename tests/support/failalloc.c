@@ -28,6 +28,7 @@
 #include <fcntl.h>
 #include <link.h>
 #include <malloc.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -134,10 +135,13 @@ EXPORT __attribute__((noinline)) void failalloc_hit(uint64_t n)
     }
 }
 
+/* Set while the calling thread is inside pthread_getattr_np for the sanitizer (below). */
+static _Thread_local int exempt;
+
 /* True when this call is the one to fail. */
 static int should_fail(void)
 {
-    if (!atomic_load_explicit(&armed, memory_order_relaxed))
+    if (!atomic_load_explicit(&armed, memory_order_relaxed) || exempt)
         return 0;
     uint64_t n = atomic_fetch_add_explicit(&counted, 1, memory_order_relaxed) + 1;
     if (fail_at && n == fail_at) {
@@ -194,6 +198,23 @@ EXPORT void _exit(int status)
 EXPORT void _Exit(int status)
 {
     _exit(status);
+}
+
+/* AddressSanitizer's runtime calls pthread_getattr_np as each thread starts, and stops
+ * the process (a failed CHECK) when that cannot allocate: not a failure thzmap could
+ * handle, nor one the release build has. In the sanitizer build (where LSan's hook
+ * exists), what it allocates is neither counted nor made to fail, whoever calls it. */
+EXPORT int pthread_getattr_np(pthread_t thread, pthread_attr_t *attr)
+{
+    static int (*real_getattr)(pthread_t, pthread_attr_t *);
+    if (!real_getattr)
+        *(void **)&real_getattr = dlsym(RTLD_NEXT, "pthread_getattr_np");
+    if (!lsan_ignore_object)
+        return real_getattr(thread, attr);
+    exempt++;
+    int r = real_getattr(thread, attr);
+    exempt--;
+    return r;
 }
 
 EXPORT void *malloc(size_t n)
