@@ -165,9 +165,15 @@ static thz_status stage_lock(output_stage *stage, const char *lock_path, thz_err
             if (ftruncate(fd, 0) != 0 || write(fd, pid, (size_t)n) != n) {
                 /* the pid is only for the message of a refused run */
             }
+            /* Out of memory: the lock is ours, so remove it (as output_stage_destroy
+             * would, which needs lock_path) and let go. */
+            if (!(stage->lock_path = thz_strdup(lock_path))) {
+                unlink(lock_path);
+                close(fd);
+                return stage_nomem(stage->outdir, err);
+            }
             stage->lock_fd = fd;
-            stage->lock_path = thz_strdup(lock_path);
-            return stage->lock_path ? THZ_OK : stage_nomem(stage->outdir, err);
+            return THZ_OK;
         }
         close(fd);
     }
