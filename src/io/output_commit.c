@@ -101,19 +101,29 @@ static thz_status stage_list(const char *dir, bool regular_only, char ***names_o
     return THZ_OK;
 }
 
+/* Allocates nothing (no opendir, whose buffer is malloc'd): a run that fails for lack of
+ * memory must still remove its stage. Rescans while a pass removed something, as
+ * removing entries while reading the directory may make it skip some. */
 void stage_remove_files(const char *dir)
 {
-    DIR *d = opendir(dir);
-    if (d) {
-        struct dirent *e;
-        while ((e = readdir(d)) != NULL) {
-            char path[THZ_PATH_MAX];
-            struct stat st;
-            if (thz_path_join(path, sizeof path, dir, e->d_name, NULL) == THZ_OK &&
-                lstat(path, &st) == 0 && !S_ISDIR(st.st_mode))
-                unlink(path);
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+        _Alignas(struct dirent64) char buf[4096];
+        bool removed = true;
+        for (int pass = 0; removed && pass < 8 && lseek(fd, 0, SEEK_SET) == 0; pass++) {
+            removed = false;
+            ssize_t n;
+            while ((n = getdents64(fd, buf, sizeof buf)) > 0) {
+                for (ssize_t at = 0; at < n;) {
+                    const struct dirent64 *e = (const struct dirent64 *)(buf + at);
+                    at += e->d_reclen;
+                    /* unlinkat without AT_REMOVEDIR leaves directories (and . and ..) */
+                    if (unlinkat(fd, e->d_name, 0) == 0)
+                        removed = true;
+                }
+            }
         }
-        closedir(d);
+        close(fd);
     }
     rmdir(dir);
 }

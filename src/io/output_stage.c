@@ -165,9 +165,15 @@ static thz_status stage_lock(output_stage *stage, const char *lock_path, thz_err
             if (ftruncate(fd, 0) != 0 || write(fd, pid, (size_t)n) != n) {
                 /* the pid is only for the message of a refused run */
             }
+            /* Out of memory: the lock is ours, so remove it (as output_stage_destroy
+             * would, which needs lock_path) and let go. */
+            if (!(stage->lock_path = thz_strdup(lock_path))) {
+                unlink(lock_path);
+                close(fd);
+                return stage_nomem(stage->outdir, err);
+            }
             stage->lock_fd = fd;
-            stage->lock_path = thz_strdup(lock_path);
-            return stage->lock_path ? THZ_OK : stage_nomem(stage->outdir, err);
+            return THZ_OK;
         }
         close(fd);
     }
@@ -357,20 +363,22 @@ thz_status output_stage_commit(output_stage *stage, thz_error *err)
     return status;
 }
 
-/* Removes the directories from created_root down to the parent if they are empty. */
+/* Removes the directories from created_root down to the parent if they are empty.
+ * Allocates nothing: it also runs when the run failed for lack of memory. */
 static void stage_remove_created(const output_stage *stage)
 {
     if (!stage->created_root || !stage->parent)
         return;
-    char *p = thz_strdup(stage->parent);
+    char p[THZ_PATH_MAX];
+    if (snprintf(p, sizeof p, "%s", stage->parent) >= (int)sizeof p)
+        return;
     size_t root_len = strlen(stage->created_root);
-    while (p && strlen(p) >= root_len && rmdir(p) == 0) {
+    while (strlen(p) >= root_len && rmdir(p) == 0) {
         char *slash = strrchr(p, '/');
         if (!slash || slash == p)
             break;
         *slash = '\0';
     }
-    free(p);
 }
 
 void output_stage_destroy(output_stage *stage)

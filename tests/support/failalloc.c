@@ -13,19 +13,28 @@
  * A forked child inherits the count and goes on numbering from there; it reports too
  * (also when it leaves through _exit). The real allocator is found with
  * dlsym(RTLD_NEXT), so the shim also works in front of AddressSanitizer's allocator
- * (run with ASAN_OPTIONS=verify_asan_link_order=0).
+ * (run with ASAN_OPTIONS=verify_asan_link_order=0). There, LeakSanitizer counts what the
+ * dynamic loader allocates as reachable (the loader keeps those pointers in memory LSan
+ * does not scan, such as the main program's link map), recognising it by the caller of
+ * malloc; in front of it, that caller is the shim. So the shim marks the loader's
+ * allocations itself (__lsan_ignore_object): without this, every process that dlopens a
+ * library reports its global-scope array (320 bytes, add_to_global_resize) as a leak.
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
+#include <elf.h>
 #include <execinfo.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <link.h>
 #include <malloc.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/auxv.h>
 #include <sys/syscall.h>
 #include <unistd.h>
 
@@ -60,11 +69,49 @@ static int in_boot_arena(const void *p)
     return (const char *)p >= boot_arena && (const char *)p < boot_arena + sizeof boot_arena;
 }
 
+/* The dynamic loader's address range, and LeakSanitizer's hook (NULL without it). */
+static uintptr_t loader_lo, loader_hi;
+static void (*lsan_ignore_object)(const void *);
+
+/* Finds the loader's mapped range from its ELF program headers (AT_BASE is where it is
+ * loaded); reads memory only: this runs while the loader may hold its locks. */
+static void find_loader(void)
+{
+    uintptr_t base = (uintptr_t)getauxval(AT_BASE);
+    if (!base)
+        return;
+    const ElfW(Ehdr) *eh = (const ElfW(Ehdr) *)base;
+    const ElfW(Phdr) *ph = (const ElfW(Phdr) *)(base + eh->e_phoff);
+    uintptr_t lo = UINTPTR_MAX, hi = 0;
+    for (int i = 0; i < eh->e_phnum; i++) {
+        if (ph[i].p_type != PT_LOAD)
+            continue;
+        if (base + ph[i].p_vaddr < lo)
+            lo = base + ph[i].p_vaddr;
+        if (base + ph[i].p_vaddr + ph[i].p_memsz > hi)
+            hi = base + ph[i].p_vaddr + ph[i].p_memsz;
+    }
+    if (hi > lo) {
+        loader_lo = lo;
+        loader_hi = hi;
+    }
+}
+
+/* p was allocated for the code at caller: if that is the loader, LSan must not report it. */
+static void *note_caller(void *p, const void *caller)
+{
+    if (p && lsan_ignore_object && (uintptr_t)caller >= loader_lo && (uintptr_t)caller < loader_hi)
+        lsan_ignore_object(p);
+    return p;
+}
+
 static void resolve(void)
 {
     static atomic_int resolving;
     if (real_malloc || atomic_exchange(&resolving, 1))
         return;
+    find_loader();
+    *(void **)&lsan_ignore_object = dlsym(RTLD_DEFAULT, "__lsan_ignore_object");
     *(void **)&real_calloc = dlsym(RTLD_NEXT, "calloc");
     *(void **)&real_realloc = dlsym(RTLD_NEXT, "realloc");
     *(void **)&real_free = dlsym(RTLD_NEXT, "free");
@@ -88,10 +135,13 @@ EXPORT __attribute__((noinline)) void failalloc_hit(uint64_t n)
     }
 }
 
+/* Set while the calling thread is inside pthread_getattr_np for the sanitizer (below). */
+static _Thread_local int exempt;
+
 /* True when this call is the one to fail. */
 static int should_fail(void)
 {
-    if (!atomic_load_explicit(&armed, memory_order_relaxed))
+    if (!atomic_load_explicit(&armed, memory_order_relaxed) || exempt)
         return 0;
     uint64_t n = atomic_fetch_add_explicit(&counted, 1, memory_order_relaxed) + 1;
     if (fail_at && n == fail_at) {
@@ -150,6 +200,23 @@ EXPORT void _Exit(int status)
     _exit(status);
 }
 
+/* AddressSanitizer's runtime calls pthread_getattr_np as each thread starts, and stops
+ * the process (a failed CHECK) when that cannot allocate: not a failure thzmap could
+ * handle, nor one the release build has. In the sanitizer build (where LSan's hook
+ * exists), what it allocates is neither counted nor made to fail, whoever calls it. */
+EXPORT int pthread_getattr_np(pthread_t thread, pthread_attr_t *attr)
+{
+    static int (*real_getattr)(pthread_t, pthread_attr_t *);
+    if (!real_getattr)
+        *(void **)&real_getattr = dlsym(RTLD_NEXT, "pthread_getattr_np");
+    if (!lsan_ignore_object)
+        return real_getattr(thread, attr);
+    exempt++;
+    int r = real_getattr(thread, attr);
+    exempt--;
+    return r;
+}
+
 EXPORT void *malloc(size_t n)
 {
     if (!real_malloc) {
@@ -161,7 +228,7 @@ EXPORT void *malloc(size_t n)
         errno = ENOMEM;
         return NULL;
     }
-    return real_malloc(n);
+    return note_caller(real_malloc(n), __builtin_return_address(0));
 }
 
 EXPORT void *calloc(size_t n, size_t size)
@@ -175,7 +242,7 @@ EXPORT void *calloc(size_t n, size_t size)
         errno = ENOMEM;
         return NULL;
     }
-    return real_calloc(n, size);
+    return note_caller(real_calloc(n, size), __builtin_return_address(0));
 }
 
 EXPORT void *realloc(void *p, size_t n)
@@ -193,7 +260,7 @@ EXPORT void *realloc(void *p, size_t n)
         errno = ENOMEM;
         return NULL;
     }
-    return real_realloc(p, n);
+    return note_caller(real_realloc(p, n), __builtin_return_address(0));
 }
 
 EXPORT void *reallocarray(void *p, size_t n, size_t size)
