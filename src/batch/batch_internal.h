@@ -3,7 +3,8 @@
  * builds every frame's scene text; batch_frames.c gives the frames out; batch_interp.c
  * interpolates; batch_run.c runs the frames and writes batch.json; batch_movie.c makes
  * the movies from the frames' cubes, through batch_encode.c (the only file that
- * includes FFmpeg). Nothing here is public.
+ * includes FFmpeg); batch_scenes.c loads the scene files a sequence names. Nothing here
+ * is public.
  */
 #ifndef THZ_BATCH_BATCH_INTERNAL_H
 #define THZ_BATCH_BATCH_INTERNAL_H
@@ -18,8 +19,10 @@
 
 struct thz_sequence {
     char *path;         /* the sequence file as given */
-    char *scene_path;   /* its scene, resolved against the sequence's directory */
-    char *scene_dir;    /* the scene's directory: relative paths in frame scenes */
+    size_t n_scenes;    /* scene files: 1 ("scene"), or the length of "scenes" */
+    int scene_list;     /* "scenes": frame i of each sweep value is scene i */
+    char **scene_paths; /* per scene file, resolved against the sequence's directory */
+    char **scene_dirs;  /* per scene file, its directory: relative paths in its frames */
     double fps;         /* frames per second */
     size_t frames;      /* per sweep value */
     size_t n_sweeps;    /* sweep values (1 without a sweep) */
@@ -30,6 +33,18 @@ struct thz_sequence {
     uint64_t *hash;     /* per frame: hash of its inputs */
     char **sweep_label; /* per sweep value: "atmosphere.relative_humidity = 0.5, ..." */
 };
+
+/* The scene file of frame f (its index into scene_paths and scene_dirs). */
+size_t batch_frame_scene(const thz_sequence *seq, size_t f);
+
+/* Reads the sequence's "scene" or "scenes" (root: the sequence document; errors name
+ * label, the sequence file, and the JSON path) into seq's scene_paths, scene_dirs,
+ * n_scenes and scene_list, and their documents into *docs (n_scenes; free with
+ * batch_scenes_free, also after a failure). Refuses both keys, neither, an empty list,
+ * and keyframes or frames with a list. */
+thz_status batch_scenes_load(const char *label, const json_t *root, const char *seq_dir,
+                             thz_sequence *seq, json_t ***docs, thz_error *err);
+void batch_scenes_free(json_t **docs, size_t n);
 
 /* The keyframe segment j (0 .. k-2) holding time_s and the weight u in [0, 1] of its
  * end (held beyond the ends: u = 0 before the first, 1 after the last). */
@@ -48,9 +63,11 @@ thz_status batch_read_band(const char *path, uint32_t columns, uint32_t rows, si
  * outdir ([sweep-NN/]S.band-NN.mp4, each written to a temporary name and renamed), on
  * one colour scale per sensor and channel over all frames; appends their descriptions
  * to `movies` (a JSON array, batch.json's "movies"). Deterministic: the same frames give
- * the same bytes. */
+ * the same bytes. When the frames do not all have the same sensors (names and sizes)
+ * and channels (frequencies and widths), writes none and says why in skipped (else
+ * skipped[0] = '\0'). */
 thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_t *movies,
-                              thz_error *err);
+                              char *skipped, size_t skipped_size, thz_error *err);
 
 /* ---- batch_reuse.c: photons shared by frames that differ only in their sensors ---- */
 
