@@ -83,6 +83,11 @@ typedef struct thz_batch_options {
     thz_batch_progress_fn progress; /* may be NULL */
     void *progress_user;
     int no_movies; /* non-zero: frames and batch.json only */
+    /* May be NULL. Else the batch keeps there the output directory of the frame it is
+     * running (NULL between frames), so that a handler run at exit (a library such as
+     * libgomp may call exit() when it cannot allocate) can thz_output_destroy it and
+     * leave no staging directory or lock behind; the thzmap program does. */
+    thz_output **open_output;
 } thz_batch_options;
 
 /* What a batch did. */

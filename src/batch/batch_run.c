@@ -259,6 +259,9 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
     int keep = photons && f + 1 < seq->n_frames && b->base[f + 1] == f;
     if (st == THZ_OK)
         st = thz_output_open(dir, &output, err);
+    thz_output **guard = b->opt ? b->opt->open_output : NULL;
+    if (guard)
+        *guard = output;
     thz_run_settings settings;
     thz_run_settings_init(&settings);
     settings.keep_photons = keep;
@@ -285,6 +288,8 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
         b->fired += (size_t)fired;
         b->rerendered += (size_t)reuse;
     }
+    if (guard)
+        *guard = NULL;
     thz_output_destroy(output);
     thz_run_destroy(run);
     thz_scene_destroy(scene);

@@ -167,7 +167,8 @@ int cmd_batch(int argc, char **argv)
                 thz_sequence_frame_count(seq), thz_sequence_frame_count(seq) == 1 ? "" : "s",
                 thz_sequence_sweep_count(seq), thz_sequence_sweep_count(seq) == 1 ? "" : "s",
                 thz_sequence_frames_per_sweep(seq), outdir);
-    thz_batch_options opt = {.progress = batch_on_progress, .progress_user = &b};
+    thz_batch_options opt = {
+        .progress = batch_on_progress, .progress_user = &b, .open_output = cli_exit_guard()};
     thz_batch_result res;
     thz_status st = thz_batch_run(ctx, seq, outdir, &opt, &res, &err);
     if (b.line_open)

@@ -20,6 +20,7 @@
 #  - a plain list of scenes ("scenes"): one frame each, as simulate's, resumed by input
 #    hash, with movies; scenes with other sensors: no movies, a warning; the batch's
 #    progress within a frame (the CLI's lines on a non-terminal);
+#  - libgomp calling exit() inside a frame leaves no staging directory or lock;
 #  - bad sequence files: exit 2, the JSON path in the message, nothing written.
 # argv: path to the thzmap binary, repository directory.
 set -u
@@ -311,6 +312,17 @@ import json, sys
 b = json.load(open(sys.argv[1]))
 assert b["movies"] == [] and "8 x 6" in b["movies_skipped"] and b["frames_computed"] == 2, b
 PY
+
+# --- libgomp's exit() inside a frame -------------------------------------------------
+# No thread can start with a stack larger than the address space: libgomp calls exit()
+# while frame 0 is open. The exit handler removes its staging directory and lock and
+# says so (any non-zero status: a sanitizer build may add its leak report).
+OMP_STACKSIZE=1000000G "$THZMAP" batch "$work/list.json" -o "$work/X" --threads 2 --quiet \
+    > /dev/null 2> "$work/X.err"
+[ $? -ne 0 ] || fail "libgomp exit: exit status 0"
+grep -q 'a library ended the process early' "$work/X.err" || fail "libgomp exit: $(cat "$work/X.err")"
+left=$(ls -A "$work/X" | grep -v -x -e batch.json -e .thzmap-batch-lock)
+[ -z "$left" ] || fail "libgomp exit left in OUTDIR: $left"
 
 # --- bad sequence files -------------------------------------------------------------
 bad() { # bad NAME EXPECTED-TEXT JSON
