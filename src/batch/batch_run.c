@@ -5,6 +5,7 @@
  * frame.json carries the frame's hash is finished and is not run again, which is all
  * that resuming a killed batch needs: a frame appears whole or not at all.
  */
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <jansson.h>
@@ -94,6 +95,49 @@ static int batch_frame_done(const batch_state *b, size_t f)
     int done = h && !strcmp(h, hex);
     json_decref(doc);
     return done;
+}
+
+/* Whether dir holds what a killed output commit leaves beside the directory it commits
+ * (.thzmap-H-lock, .thzmap-H-stage-..., .thzmap-H-old-...; io/output_stage.c). */
+static int batch_has_leftovers(const char *dir)
+{
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    int found = 0;
+    while (d && !found && (e = readdir(d)) != NULL)
+        found = !strncmp(e->d_name, ".thzmap-", 8) && strcmp(e->d_name, ".thzmap-batch-lock");
+    if (d)
+        closedir(d);
+    return found;
+}
+
+/* A batch killed inside a frame's commit after the exchange (while the replaced frame's
+ * files were being deleted) leaves them and the lock beside a frame that is finished,
+ * which no later run opens again: opening each finished frame's output and closing it
+ * without a commit cleans them up (thz_output_open removes what a dead run left). Only
+ * in the directories (OUTDIR, sweep-NN/) that hold such names; best effort: a frame
+ * another process holds is left for later. */
+static void batch_clean_finished(const batch_state *b)
+{
+    const thz_sequence *seq = b->seq;
+    for (size_t s = 0; s < seq->n_sweeps; s++) {
+        char parent[THZ_PATH_MAX], dir[THZ_PATH_MAX];
+        if (seq->has_sweep)
+            snprintf(parent, sizeof parent, "%s/sweep-%02zu", b->outdir, s);
+        else
+            snprintf(parent, sizeof parent, "%s", b->outdir);
+        if (!batch_has_leftovers(parent))
+            continue;
+        for (size_t f = s * seq->frames; f < (s + 1) * seq->frames; f++) {
+            if (b->state[f] != FRAME_REUSED ||
+                snprintf(dir, sizeof dir, "%s/%s", b->outdir, seq->frame_dir[f]) >= (int)sizeof dir)
+                continue;
+            thz_output *output = NULL;
+            thz_error ignored;
+            if (thz_output_open(dir, &output, &ignored) == THZ_OK)
+                thz_output_destroy(output);
+        }
+    }
 }
 
 /* Writes text to outdir/name through a temporary file and a rename. */
@@ -395,6 +439,8 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
             b.state[f] = FRAME_REUSED;
             b.reused++;
         }
+    if (st == THZ_OK && b.reused > 0)
+        batch_clean_finished(&b);
     if (st == THZ_OK)
         st = batch_write_json(&b, err);
     if (ctx) { /* the frames' runs report through batch_on_run_progress */
