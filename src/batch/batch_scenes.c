@@ -73,7 +73,10 @@ thz_status batch_scenes_load(const char *label, const json_t *root, const char *
     if (list && (!json_is_array(list) || json_array_size(list) == 0))
         return thz_error_set(err, THZ_ERR_INPUT,
                              "%s: scenes: expected a non-empty list of scene files, got %s", label,
-                             json_is_array(list) ? "an empty one" : "no list");
+                             json_is_array(list)    ? "an empty one"
+                             : json_is_string(list) ? "a string"
+                             : json_is_object(list) ? "an object"
+                                                    : "a number or a literal");
     if (list && json_array_size(list) > SCENES_MAX)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: scenes: more than 100000 scene files", label);
     if (list && json_object_get(root, "keyframes"))
