@@ -1,10 +1,10 @@
 /* Sequences and batches (include/thzmap/batch.h): what a loaded sequence holds, and
  * what the files of src/batch/ share. batch_sequence.c loads and checks a sequence and
- * builds every frame's scene text; batch_frames.c gives the frames out; batch_interp.c
- * interpolates; batch_run.c runs the frames and writes batch.json; batch_movie.c makes
- * the movies from the frames' cubes, through batch_encode.c (the only file that
- * includes FFmpeg); batch_scenes.c loads the scene files a sequence names. Nothing here
- * is public.
+ * builds every frame's scene text, from the scene files batch_scenes.c loads;
+ * batch_frames.c gives the frames out; batch_interp.c interpolates; batch_hash.c hashes
+ * a frame's inputs; batch_run.c runs the frames and writes batch.json; batch_movie.c
+ * makes the movies from the frames' cubes, through batch_encode.c (the only file that
+ * includes FFmpeg). Nothing here is public.
  */
 #ifndef THZ_BATCH_BATCH_INTERNAL_H
 #define THZ_BATCH_BATCH_INTERNAL_H
@@ -53,6 +53,11 @@ void batch_segment(const double *t, size_t k, double time_s, size_t *j, double *
 /* 64-bit FNV-1a of n bytes, continuing from h (start with BATCH_HASH_INIT). */
 #define BATCH_HASH_INIT UINT64_C(14695981039346656037)
 uint64_t batch_hash_bytes(uint64_t h, const void *data, size_t n);
+/* Continues h over the content of every file that doc (a frame's scene) names in its
+ * "file" and "*_file" keys, relative to scene_dir; cache maps a path to its hash (hex),
+ * so each file is read once. An unreadable file hashes as 0 (the scene loader reports
+ * it). */
+uint64_t batch_hash_files(json_t *cache, const char *scene_dir, const json_t *doc, uint64_t h);
 
 /* Reads band `channel` of an ENVI float32 cube of `columns * rows * channels` values
  * into out (columns * rows); THZ_ERR_IO naming the file when it is missing or short. */

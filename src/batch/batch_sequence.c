@@ -417,68 +417,6 @@ static int seq_apply_tracks(const seq_build *b, double time_s, json_t *doc)
     return 0;
 }
 
-/* The hash of a file the frames name ("file", "*_file" keys), cached per path; 0 when
- * it cannot be read (the scene loader then reports it). */
-static uint64_t seq_file_hash(seq_build *b, const char *scene_dir, const char *name)
-{
-    char path[4096];
-    if (name[0] == '/')
-        snprintf(path, sizeof path, "%s", name);
-    else
-        snprintf(path, sizeof path, "%s/%s", scene_dir, name);
-    json_t *cached = json_object_get(b->file_hashes, path);
-    if (cached)
-        return (uint64_t)strtoull(json_string_value(cached), NULL, 16);
-    uint64_t h = BATCH_HASH_INIT;
-    FILE *f = fopen(path, "rb");
-    if (f) {
-        unsigned char buf[65536];
-        size_t n;
-        while ((n = fread(buf, 1, sizeof buf, f)) > 0)
-            h = batch_hash_bytes(h, buf, n);
-        fclose(f);
-    } else {
-        h = 0;
-    }
-    char hex[17];
-    snprintf(hex, sizeof hex, "%016llx", (unsigned long long)h);
-    json_object_set_new(b->file_hashes, path, json_string(hex));
-    return h;
-}
-
-static uint64_t seq_hash_files(seq_build *b, const char *scene_dir, const json_t *v, uint64_t h)
-{
-    if (json_is_object(v)) {
-        const char *key;
-        json_t *child;
-        json_object_foreach((json_t *)v, key, child)
-        {
-            size_t len = strlen(key);
-            int is_file = !strcmp(key, "file") || (len > 5 && !strcmp(key + len - 5, "_file"));
-            if (is_file && json_is_string(child)) {
-                uint64_t fh = seq_file_hash(b, scene_dir, json_string_value(child));
-                h = batch_hash_bytes(h, &fh, sizeof fh);
-            } else {
-                h = seq_hash_files(b, scene_dir, child, h);
-            }
-        }
-    } else if (json_is_array(v)) {
-        for (size_t i = 0; i < json_array_size(v); i++)
-            h = seq_hash_files(b, scene_dir, json_array_get(v, i), h);
-    }
-    return h;
-}
-
-uint64_t batch_hash_bytes(uint64_t h, const void *data, size_t n)
-{
-    const unsigned char *p = data;
-    for (size_t i = 0; i < n; i++) {
-        h ^= p[i];
-        h *= UINT64_C(1099511628211);
-    }
-    return h;
-}
-
 /* Builds frame f's scene text, dir, hash and sweep label; checks that it loads. */
 static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
 {
@@ -500,7 +438,7 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
     if (seq->frame_json[f])
         h = batch_hash_bytes(h, seq->frame_json[f], strlen(seq->frame_json[f]));
     h = batch_hash_bytes(h, seq->scene_dirs[k], strlen(seq->scene_dirs[k]));
-    seq->hash[f] = seq_hash_files(b, seq->scene_dirs[k], doc, h);
+    seq->hash[f] = batch_hash_files(b->file_hashes, seq->scene_dirs[k], doc, h);
     json_decref(doc);
     char dir[64];
     if (seq->has_sweep)
