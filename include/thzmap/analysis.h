@@ -123,30 +123,44 @@ typedef struct thz_bands_options {
     int has_seed;                       /* non-zero: `seed` instead of the scene's */
     uint64_t seed;                      /* 0 to INT64_MAX, like photons.seed */
     uint64_t exhaustive_limit;          /* search every subset when there are at most this many of
-                                           sizes 1..K (default 200000), else SFFS */
+                                           sizes 1..K (default 2000000), else SFFS */
+    /* Channel widths searched too: every centre is a candidate with each of these n_widths
+     * relative widths (FWHM / centre, 0 < w <= 0.5, distinct); a chosen set holds each
+     * centre at most once. n_widths 0: relative_width alone. */
+    const double *relative_widths;
+    size_t n_widths;
+    double thickness_range; /* every shell's thickness within +- this fraction of its own
+                               (0.2: +- 20 %), 0 <= f < 1; default 0 (not varied) */
+    double angle_range_deg; /* the viewing angle within +- this: the sensor turned about its
+                               up axis around its look_at_m point (about its own position
+                               when it gives a direction), 0 <= a <= 90 degrees; default 0 */
 } thz_bands_options;
 
 THZ_API void thz_bands_options_init(thz_bands_options *opt);
 
 typedef struct thz_bands thz_bands;
 
-/* Chooses opt->count channel centres among the candidates for the scene file at
- * `scene_path`: renders the scene (path integrator) with the candidates as its channels,
- * nominal and with each nuisance changed, takes each class's pixels from the object_id
- * truth, and searches the set that maximises the worst pair's Bhattacharyya distance
- * (docs/analysis.md). Progress and cancellation through ctx. */
+/* Chooses opt->count channel centres (with their widths when opt->n_widths > 0) among
+ * the candidates for the scene file at `scene_path`: renders the scene (path
+ * integrator) with the candidates as its channels, nominal and with each nuisance
+ * changed, takes each class's pixels from the object_id truth, and searches the set
+ * that maximises the worst pair's Bhattacharyya distance (docs/analysis.md). Progress
+ * and cancellation through ctx. */
 THZ_API thz_status thz_bands_select(thz_context *ctx, const char *scene_path,
                                     const thz_bands_options *opt, thz_bands **out, thz_error *err);
 THZ_API void thz_bands_destroy(thz_bands *b);
 
 typedef struct thz_bands_info {
-    size_t n_candidates, count, n_classes;
-    const char *search; /* "exhaustive" or "sffs" */
-    double score;       /* worst-pair Jeffries-Matusita distance of the chosen set, 0..2 */
+    size_t n_candidates, count, n_classes; /* candidates: centres x widths */
+    const char *search;                    /* "exhaustive" or "sffs" */
+    double score; /* worst-pair Jeffries-Matusita distance of the chosen set, 0..2 */
 } thz_bands_info;
 THZ_API void thz_bands_get_info(const thz_bands *b, thz_bands_info *out);
 /* The chosen centre i (ascending), THz; NaN past the end. */
 THZ_API double thz_bands_selected_thz(const thz_bands *b, size_t i);
+/* The relative width (FWHM / centre) of chosen channel i, aligned with
+ * thz_bands_selected_thz; NaN past the end. */
+THZ_API double thz_bands_selected_relative_width(const thz_bands *b, size_t i);
 /* The best set's worst-pair Jeffries-Matusita distance with k = 1..count channels. */
 THZ_API double thz_bands_score(const thz_bands *b, size_t k);
 /* bands.json as text (owned by b). */

@@ -81,6 +81,10 @@ typedef struct thz_material_info {
      * none, else "constant", "table", "debye", "double-debye", "lorentz", "drude" or
      * "itu-p2040". Absent reflectivity and attenuation then come from it. */
     const char *index_model;
+    /* (added with reflection lobes; after the older fields, for callers built earlier) */
+    const char *reflection; /* the `reflection` key: "diffuse", "specular" or "ward" */
+    double ward_alpha_x;    /* Ward's slopes (0 < alpha <= 1) along each triangle's first edge */
+    double ward_alpha_y;    /* (x) and across it (y); both 0 unless reflection is "ward" */
 } thz_material_info;
 
 typedef struct thz_object_info {

@@ -111,5 +111,6 @@ THZ_API const char *thz_context_last_message(const thz_context *ctx);
 #include "thzmap/batch.h"
 #include "thzmap/materials.h"
 #include "thzmap/analysis.h"
+#include "thzmap/mpi.h"
 
 #endif

@@ -13,6 +13,8 @@ the whole story (installation, threads, cancellation, memory ownership).
 """
 from . import _lib
 from ._call import RunWarning
+from .band_selection import BandSelection, bands
+from .classification import Classification, classify
 from .errors import (ArgumentError, CancelledError, Error, OutOfMemoryError,
                      SceneError)
 from .progress import Progress
@@ -24,7 +26,8 @@ __version__ = _lib.text(_lib.lib.thz_version())
 library_path = _lib.path
 """The libthzmap file this package uses."""
 
-__all__ = ["ArgumentError", "CancelledError", "Error", "Image", "OutOfMemoryError",
+__all__ = ["ArgumentError", "BandSelection", "CancelledError", "Classification", "Error",
+           "Image", "OutOfMemoryError",
            "PhotonMap", "Progress", "Result", "RunWarning", "Scene", "SceneError",
-           "fire_photons", "library_path", "load_photon_map", "load_scene",
+           "bands", "classify", "fire_photons", "library_path", "load_photon_map", "load_scene",
            "merge_photon_maps", "render", "scene_from_dict", "scene_from_json", "simulate"]

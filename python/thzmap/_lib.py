@@ -78,7 +78,8 @@ class ThzMaterialInfo(Structure):
     _fields_ = [("name", c_char_p), ("reflectivity", ThzSpectrumInfo),
                 ("attenuation_per_m", ThzSpectrumInfo), ("emissivity", ThzSpectrumInfo),
                 ("transmission", c_char_p), ("color", c_double * 3),
-                ("index_model", c_char_p)]
+                ("index_model", c_char_p), ("reflection", c_char_p),
+                ("ward_alpha_x", c_double), ("ward_alpha_y", c_double)]
 
 
 class ThzObjectInfo(Structure):

@@ -47,6 +47,16 @@ static json_t *set_thz(const bands_report *rep, size_t k, bool *ok)
     return a;
 }
 
+/* Their relative widths, aligned with set_thz. */
+static json_t *set_widths(const bands_report *rep, size_t k, bool *ok)
+{
+    json_t *a = json_array();
+    const size_t *set = rep->search->sets + (k - 1) * rep->search->count;
+    for (size_t i = 0; i < k; i++)
+        push(a, json_real(rep->setup->widths[set[i]]), ok);
+    return a;
+}
+
 static json_t *pair_names(const bands_report *rep, const bands_score *s, bool *ok)
 {
     json_t *a = json_array();
@@ -70,6 +80,7 @@ char *bands_json(const bands_report *rep, thz_error *err)
     put(root, "sensor", json_string(rep->sensor), &ok);
     put(root, "count", json_integer((json_int_t)K), &ok);
     put(root, "selected_thz", set_thz(rep, K, &ok), &ok);
+    put(root, "selected_relative_width", set_widths(rep, K, &ok), &ok);
     put(root, "score", json_real(final->worst_jm), &ok);
     put(root, "criterion",
         json_string("worst-pair Jeffries-Matusita distance JM = 2 (1 - exp(-B)) of Gaussian "
@@ -87,6 +98,7 @@ char *bands_json(const bands_report *rep, thz_error *err)
         push(per_k, e, &ok);
         put(e, "k", json_integer((json_int_t)k), &ok);
         put(e, "selected_thz", set_thz(rep, k, &ok), &ok);
+        put(e, "selected_relative_width", set_widths(rep, k, &ok), &ok);
         put(e, "score", json_real(r->scores[k - 1].worst_jm), &ok);
         put(e, "bhattacharyya", num(r->scores[k - 1].worst_b), &ok);
         put(e, "mean_jm", num(r->scores[k - 1].mean_jm), &ok);
@@ -97,8 +109,12 @@ char *bands_json(const bands_report *rep, thz_error *err)
     put(cand, "from_thz", json_real(rep->from_thz), &ok);
     put(cand, "to_thz", json_real(rep->to_thz), &ok);
     put(cand, "step_ghz", json_real(rep->step_ghz), &ok);
-    put(cand, "relative_width", json_real(s->relative_width), &ok);
+    /* one width: a number, as before widths could be searched; several: null */
+    put(cand, "relative_width", rep->n_widths == 1 ? json_real(rep->width_list[0]) : json_null(),
+        &ok);
+    put(cand, "relative_widths", array_of(rep->width_list, rep->n_widths, &ok), &ok);
     put(cand, "frequency_thz", array_of(s->candidates_thz, n, &ok), &ok);
+    put(cand, "candidate_relative_width", array_of(s->widths, n, &ok), &ok);
     json_t *noise = json_object();
     put(root, "noise", noise, &ok);
     put(noise, "source", json_string(rep->netd_source), &ok);
@@ -110,6 +126,12 @@ char *bands_json(const bands_report *rep, thz_error *err)
     put(nu, "air_temperature_varied", json_boolean(v->air_temperature_varied), &ok);
     put(nu, "humidity_range", json_real(s->humidity_range), &ok);
     put(nu, "humidity_varied", json_boolean(v->humidity_varied), &ok);
+    put(nu, "thickness_range", json_real(s->thickness_range), &ok);
+    put(nu, "thickness_varied", json_boolean(v->thickness_varied), &ok);
+    put(nu, "angle_range_deg", json_real(s->angle_range_deg), &ok);
+    put(nu, "angle_varied", json_boolean(v->angle_varied), &ok);
+    put(nu, "render_paths_per_sample", json_integer(v->coarse_paths), &ok);
+    put(nu, "render_oversampling", json_integer(1), &ok);
     json_t *classes = json_array();
     put(root, "classes", classes, &ok);
     for (size_t k = 0; k < v->n_classes && ok; k++) {
@@ -120,6 +142,7 @@ char *bands_json(const bands_report *rep, thz_error *err)
         put(c, "mean_tb_k", array_of(v->mean + k * n, n, &ok), &ok);
         put(c, "pixel_sd_k", array_of(v->pixel_sd + k * n, n, &ok), &ok);
         put(c, "nuisance_sd_k", array_of(v->nuisance_sd + k * n, n, &ok), &ok);
+        put(c, "netd_k", array_of(v->netd_k + k * n, n, &ok), &ok);
     }
     put(root, "air_attenuation_db_per_km",
         rep->air_db_per_km ? array_of(rep->air_db_per_km, n, &ok) : json_null(), &ok);
@@ -147,7 +170,7 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
     const bands_setup *s = rep->setup;
     const bands_values *v = rep->values;
     const bands_search_result *r = rep->search;
-    size_t K = r->count, n = s->n_candidates;
+    size_t K = r->count, n = s->n_candidates, nw = rep->n_widths, nx = n / nw;
     char path[THZ_PATH_MAX], title[1024];
     thz_status st = plot_check_device(err);
     if (st == THZ_OK)
@@ -161,12 +184,21 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
     if (fclose(f) != 0 || failed)
         return thz_error_set(err, THZ_ERR_IO, "%s: write failed", path);
 
+    /* the spectra and the air over the centres, at the narrowest width searched */
     double *x = thz_calloc(K > n ? K : n, sizeof *x), *y = thz_calloc(K, sizeof *y);
+    double *fx = thz_calloc(nx, sizeof *fx), *my = thz_calloc(v->n_classes * nx, sizeof *my);
+    double *air = thz_calloc(nx, sizeof *air);
     plot_band *bands = thz_calloc(K, sizeof *bands);
     char(*names)[32] = thz_calloc(K, sizeof *names);
-    if (!x || !y || !bands || !names) {
+    if (!x || !y || !fx || !my || !air || !bands || !names) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
         goto done;
+    }
+    for (size_t i = 0; i < nx; i++) {
+        fx[i] = s->candidates_thz[i * nw];
+        air[i] = rep->air_db_per_km ? rep->air_db_per_km[i * nw] : 0.0;
+        for (size_t k = 0; k < v->n_classes; k++)
+            my[k * nx + i] = v->mean[k * n + i * nw];
     }
     for (size_t k = 0; k < K; k++) {
         x[k] = (double)(k + 1);
@@ -181,35 +213,39 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
     int used = snprintf(title, sizeof title, "%s: mean T#db#u per class; chosen:", rep->scene_name);
     const size_t *set = r->sets + (K - 1) * K;
     for (size_t i = 0; i < K && used > 0 && (size_t)used < sizeof title; i++)
-        used +=
-            snprintf(title + used, sizeof title - (size_t)used, " %.4g", s->candidates_thz[set[i]]);
+        used += nw > 1 ? snprintf(title + used, sizeof title - (size_t)used, " %.4g (%.3g)",
+                                  s->candidates_thz[set[i]], s->widths[set[i]])
+                       : snprintf(title + used, sizeof title - (size_t)used, " %.4g",
+                                  s->candidates_thz[set[i]]);
     if (used > 0 && (size_t)used < sizeof title)
         snprintf(title + used, sizeof title - (size_t)used, " THz");
     if (st == THZ_OK)
         st = join(path, dir, "bands-spectra.png", err);
     if (st == THZ_OK)
-        st = plot_lines(path, n, s->candidates_thz, v->n_classes,
-                        (const char *const *)v->class_names, v->mean, title, "frequency (THz)",
+        st = plot_lines(path, nx, fx, v->n_classes, (const char *const *)v->class_names, my, title,
+                        nw > 1 ? "frequency (THz), at the narrowest width" : "frequency (THz)",
                         "brightness temperature (K)", err);
     if (st == THZ_OK && rep->air_db_per_km) {
         for (size_t i = 0; i < K; i++) {
-            double f0 = s->candidates_thz[set[i]], half = 0.5 * s->relative_width * f0;
+            double f0 = s->candidates_thz[set[i]], half = 0.5 * s->widths[set[i]] * f0;
             snprintf(names[i], sizeof names[i], "%.4g THz", f0);
             bands[i] =
                 (plot_band){.name = names[i], .lo = f0 - half, .centre = f0, .hi = f0 + half};
         }
-        plot_curve curve = {
-            .name = "air", .y = rep->air_db_per_km, .rgb = {31, 119, 180}, .width = 2.0};
+        plot_curve curve = {.name = "air", .y = air, .rgb = {31, 119, 180}, .width = 2.0};
         snprintf(title, sizeof title, "%s: the air's attenuation and the chosen channels",
                  rep->scene_name);
         st = join(path, dir, "bands-air.png", err);
         if (st == THZ_OK)
-            st = plot_attenuation(path, n, s->candidates_thz, 1, &curve, K, bands, title,
-                                  "frequency (THz)", "attenuation (dB/km)", err);
+            st = plot_attenuation(path, nx, fx, 1, &curve, K, bands, title, "frequency (THz)",
+                                  "attenuation (dB/km)", err);
     }
 done:
     free(x);
     free(y);
+    free(fx);
+    free(my);
+    free(air);
     free(bands);
     free(names);
     return st;

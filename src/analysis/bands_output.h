@@ -17,6 +17,9 @@ typedef struct bands_report {
     const bands_search_result *search;
     const double *air_db_per_km; /* per candidate, or NULL (no attenuating air) */
     const char *netd_source;     /* where the NETD came from, e.g. "--netd-k" */
+    const double *width_list;    /* the n_widths relative widths searched, ascending; the
+                                    candidates are centre-major (c = centre * n_widths + w) */
+    size_t n_widths;
 } bands_report;
 
 /* bands.json's text (malloc'd), NULL with err set when out of memory. */

@@ -126,7 +126,22 @@ static thz_status consider(search *s, const size_t *set, size_t m, bands_score *
     return THZ_OK;
 }
 
-/* Every set of size m in lexicographic order. */
+static size_t group_of(const bands_classes *cl, size_t c)
+{
+    return cl->group ? cl->group[c] : c;
+}
+
+/* Whether set (m entries, ascending) holds a group twice: groups are non-decreasing
+ * with the candidate, so such entries are neighbours. */
+static bool repeats_group(const bands_classes *cl, const size_t *set, size_t m)
+{
+    for (size_t i = 1; i < m; i++)
+        if (group_of(cl, set[i]) == group_of(cl, set[i - 1]))
+            return true;
+    return false;
+}
+
+/* Every set of size m in lexicographic order (but those holding a group twice). */
 static thz_status exhaustive(search *s, size_t m, thz_error *err)
 {
     size_t n = s->cl->n_candidates;
@@ -136,7 +151,8 @@ static thz_status exhaustive(search *s, size_t m, thz_error *err)
     for (;;) {
         bands_score sc;
         bool improved;
-        thz_status st = consider(s, idx, m, &sc, &improved, err);
+        thz_status st =
+            repeats_group(s->cl, idx, m) ? THZ_OK : consider(s, idx, m, &sc, &improved, err);
         if (st != THZ_OK)
             return st;
         size_t i = m;
@@ -150,10 +166,11 @@ static thz_status exhaustive(search *s, size_t m, thz_error *err)
     }
 }
 
-static bool in_set(const size_t *set, size_t m, size_t c)
+/* Whether set (m entries) holds c's group already. */
+static bool in_set(const bands_classes *cl, const size_t *set, size_t m, size_t c)
 {
     for (size_t i = 0; i < m; i++)
-        if (set[i] == c)
+        if (group_of(cl, set[i]) == group_of(cl, c))
             return true;
     return false;
 }
@@ -173,7 +190,7 @@ static thz_status sffs(search *s, thz_error *err)
         size_t best_c = n;
         bands_score best = {0};
         for (size_t c = 0; c < n; c++) {
-            if (in_set(cur, m, c))
+            if (in_set(s->cl, cur, m, c))
                 continue;
             cur[m] = c;
             thz_status st = consider(s, cur, m + 1, &sc, &improved, err);
@@ -239,10 +256,13 @@ thz_status bands_search(const bands_classes *cl, size_t count, uint64_t exhausti
     if (cl->n_classes < 2)
         return thz_error_set(err, THZ_ERR_INPUT,
                              "band selection needs at least two classes, got %zu", cl->n_classes);
-    if (count < 1 || count > cl->n_candidates || count > BANDS_MAX_COUNT)
+    size_t groups = cl->n_candidates ? 1 : 0;
+    for (size_t c = 1; c < cl->n_candidates; c++)
+        groups += group_of(cl, c) != group_of(cl, c - 1);
+    if (count < 1 || count > groups || count > BANDS_MAX_COUNT)
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "--count %zu: expected 1 to %zu (the candidates, at most %d)", count,
-                             cl->n_candidates, BANDS_MAX_COUNT);
+                             "--count %zu: expected 1 to %zu (the candidate centres, at most %d)",
+                             count, groups, BANDS_MAX_COUNT);
     search s = {.cl = cl, .count = count, .r = out};
     out->count = count;
     out->sets = thz_calloc(count * count, sizeof *out->sets);

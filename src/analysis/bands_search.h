@@ -17,8 +17,11 @@ enum { BANDS_MAX_COUNT = 32 };
 
 typedef struct bands_classes {
     size_t n_candidates, n_classes;
-    const double *mean; /* [class * n_candidates + c], e.g. K of Tb */
-    const double *cov;  /* [class * n^2 + c * n + c'], positive definite on every subset */
+    const double *mean;  /* [class * n_candidates + c], e.g. K of Tb */
+    const double *cov;   /* [class * n^2 + c * n + c'], positive definite on every subset */
+    const size_t *group; /* per candidate its centre, non-decreasing with the candidate; a set
+                            holds each group at most once (a centre with one width); NULL:
+                            each candidate its own group */
 } bands_classes;
 
 /* A set's separability. */
@@ -47,7 +50,7 @@ thz_status bands_score_set(const bands_classes *cl, const size_t *set, size_t m,
  * sets, JM = 2), the larger worst-pair B. */
 int bands_score_better(const bands_score *a, const bands_score *b);
 
-/* The best set of every size 1..count. At least two classes; count <= n_candidates and
+/* The best set of every size 1..count. At least two classes; count <= the groups and
  * <= BANDS_MAX_COUNT. Exhaustive when the sets of sizes 1..count number at most
  * exhaustive_limit, else SFFS. */
 thz_status bands_search(const bands_classes *cl, size_t count, uint64_t exhaustive_limit,

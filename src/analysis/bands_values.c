@@ -11,6 +11,8 @@
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/path.h"
+#include "scene/scene.h"
+#include "sensor/noise.h"
 
 /* Physical constants (SI, exact since 2019). */
 #define BV_H 6.62607015e-34
@@ -28,6 +30,7 @@ void bands_values_fini(bands_values *v)
     free(v->cov);
     free(v->pixel_sd);
     free(v->nuisance_sd);
+    free(v->netd_k);
     memset(v, 0, sizeof *v);
 }
 
@@ -43,8 +46,17 @@ static double planck_dbdt(double nu, double t)
 
 /* The scene's JSON with the nuisance `what` changed: 0 nominal, 1 the targets'
  * temperatures + range, 2 the other objects' and the air's temperature + range, 3 the
- * humidity x (1 - range). Channels and render settings replaced in every variant. */
-enum { VAR_NOMINAL = 0, VAR_TARGETS, VAR_AMBIENT, VAR_HUMIDITY, VAR_COUNT };
+ * humidity x (1 - range), 4 every shell's thickness x (1 + range), 5 the sensor turned
+ * by the angle range. Channels and render settings replaced in every variant. */
+enum {
+    VAR_NOMINAL = 0,
+    VAR_TARGETS,
+    VAR_AMBIENT,
+    VAR_HUMIDITY,
+    VAR_THICKNESS,
+    VAR_ANGLE,
+    VAR_COUNT
+};
 
 static const char *const humidity_keys[] = {"relative_humidity", "water_vapour_g_m3", "h2o_vmr"};
 
@@ -57,8 +69,77 @@ static int add_number(json_t *obj, const char *key, double delta, double factor)
     return 1;
 }
 
+static bool get_vec3(const json_t *obj, const char *key, double v[3])
+{
+    const json_t *a = json_object_get(obj, key);
+    if (!json_is_array(a) || json_array_size(a) != 3)
+        return false;
+    for (size_t i = 0; i < 3; i++) {
+        const json_t *x = json_array_get(a, i);
+        if (!json_is_number(x))
+            return false;
+        v[i] = json_number_value(x);
+    }
+    return true;
+}
+
+static void set_vec3(json_t *obj, const char *key, const double v[3])
+{
+    json_t *a = json_array();
+    for (size_t i = 0; i < 3; i++)
+        json_array_append_new(a, json_real(v[i]));
+    json_object_set_new(obj, key, a);
+}
+
+/* v turned by `deg` about the axis `k` (any length but 0), Rodrigues' formula. */
+static void rotate(double v[3], const double k_in[3], double deg)
+{
+    double len = sqrt(k_in[0] * k_in[0] + k_in[1] * k_in[1] + k_in[2] * k_in[2]);
+    double k[3] = {k_in[0] / len, k_in[1] / len, k_in[2] / len};
+    double th = deg * M_PI / 180.0, c = cos(th), sn = sin(th);
+    double kv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
+    double x[3] = {k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]};
+    for (size_t i = 0; i < 3; i++)
+        v[i] = v[i] * c + x[i] * sn + k[i] * kv * (1.0 - c);
+}
+
+/* The viewing-angle nuisance: the sensor turned by `deg` about its up axis, around its
+ * look_at_m point (it keeps looking at it, from another side), or about its own position
+ * when it gives a direction instead. Returns 1 when it changed the sensor. */
+static int turn_sensor(json_t *sensor, double deg)
+{
+    double pos[3], at[3], dir[3], up[3] = {0.0, 0.0, 1.0};
+    if (!get_vec3(sensor, "position_m", pos))
+        return 0;
+    get_vec3(sensor, "up", up);
+    if (!(up[0] * up[0] + up[1] * up[1] + up[2] * up[2] > 0.0))
+        return 0;
+    if (get_vec3(sensor, "look_at_m", at)) {
+        double r[3] = {pos[0] - at[0], pos[1] - at[1], pos[2] - at[2]};
+        rotate(r, up, deg);
+        for (size_t i = 0; i < 3; i++)
+            pos[i] = at[i] + r[i];
+        set_vec3(sensor, "position_m", pos);
+        return 1;
+    }
+    if (!get_vec3(sensor, "direction", dir))
+        return 0;
+    rotate(dir, up, deg);
+    set_vec3(sensor, "direction", dir);
+    return 1;
+}
+
+/* The nuisances' renders are coarse: one sample per pixel and a quarter of the paths
+ * (at least one), against a coarse nominal render with the same seed. A class mean's
+ * change is smooth over its pixels and the common seed keeps the Monte Carlo noise out
+ * of the difference, so it needs far fewer samples than the pixel statistics do. */
+static uint32_t coarse_paths(uint32_t paths)
+{
+    return paths >= 4 ? paths / 4 : 1;
+}
+
 static char *variant_text(const json_t *root, const bands_setup *s, const bool *is_class, int what,
-                          int *changed)
+                          bool coarse, int *changed)
 {
     json_t *doc = json_deep_copy(root);
     if (!doc)
@@ -67,13 +148,15 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
     for (size_t c = 0; c < s->n_candidates; c++) {
         json_t *ch = json_object();
         json_object_set_new(ch, "frequency_thz", json_real(s->candidates_thz[c]));
-        json_object_set_new(ch, "relative_width", json_real(s->relative_width));
+        json_object_set_new(ch, "relative_width", json_real(s->widths[c]));
         json_array_append_new(channels, ch);
     }
     json_object_set_new(doc, "channels", channels);
     json_t *render = json_object();
     json_object_set_new(render, "integrator", json_string("path"));
-    json_object_set_new(render, "paths_per_sample", json_integer(s->paths_per_sample));
+    json_object_set_new(
+        render, "paths_per_sample",
+        json_integer(coarse ? coarse_paths(s->paths_per_sample) : s->paths_per_sample));
     json_object_set_new(doc, "render", render);
     /* the sensor's noise with one netd_k per channel cannot follow the candidates: its
      * NETD is interpolated to them instead (api_bands.c), and the renders need none */
@@ -81,6 +164,8 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
     json_t *noise = json_object_get(sensor, "noise");
     if (noise && json_is_array(json_object_get(noise, "netd_k")))
         json_object_del(sensor, "noise");
+    if (coarse && sensor)
+        json_object_set_new(sensor, "oversampling", json_integer(1));
     *changed = 0;
     json_t *objects = json_object_get(doc, "objects");
     json_t *atm = json_object_get(doc, "atmosphere");
@@ -95,6 +180,15 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
         /* downwards, which every humidity key accepts */
         for (size_t i = 0; i < 3; i++)
             *changed += add_number(atm, humidity_keys[i], 0.0, 1.0 - s->humidity_range);
+    } else if (what == VAR_THICKNESS) {
+        for (size_t i = 0; i < json_array_size(objects); i++) {
+            json_t *o = json_array_get(objects, i);
+            const char *type = json_string_value(json_object_get(o, "type"));
+            if (type && strcmp(type, "shell") == 0)
+                *changed += add_number(o, "thickness_m", 0.0, 1.0 + s->thickness_range);
+        }
+    } else if (what == VAR_ANGLE && sensor) {
+        *changed += turn_sensor(sensor, s->angle_range_deg);
     }
     char *text = json_dumps(doc, JSON_COMPACT | JSON_REAL_PRECISION(17));
     json_decref(doc);
@@ -156,17 +250,16 @@ static void render_out_fini(render_out *r)
     memset(r, 0, sizeof *r);
 }
 
-/* Class of each pixel from the truth: targets (in order) and "background", or every
- * object seen. */
+/* The class of each object (class_of, n_obj entries, -1: none) from the nominal
+ * render's truth: targets (in order) and "background", or every object seen. */
 static thz_status assign_classes(const bands_setup *s, const thz_scene *scene, const int32_t *ids,
-                                 size_t pixels, int32_t *cls, bool *is_class, bands_values *v,
+                                 size_t pixels, int32_t *class_of, bool *is_class, bands_values *v,
                                  thz_error *err)
 {
     size_t n_obj = thz_scene_object_count(scene);
-    int32_t *class_of = thz_calloc(n_obj, sizeof *class_of);
     uint64_t *seen = thz_calloc(n_obj, sizeof *seen);
     thz_status st = THZ_OK;
-    if (!class_of || !seen) {
+    if (!seen) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
         goto done;
     }
@@ -220,20 +313,28 @@ static thz_status assign_classes(const bands_setup *s, const thz_scene *scene, c
             goto done;
         }
     }
-    for (size_t p = 0; p < pixels; p++) {
-        cls[p] = ids[p] >= 0 && (size_t)ids[p] < n_obj ? class_of[ids[p]] : -1;
-        if (cls[p] >= 0)
-            v->class_pixels[cls[p]]++;
-    }
 done:
-    free(class_of);
     free(seen);
     return st;
 }
 
-/* Class means of a render's Tb into mean[class * n + c]. */
-static void class_means(const render_out *r, const int32_t *cls, const bands_values *v,
-                        double *mean)
+/* The class of each pixel of render r (cls, r->pixels entries, -1: none) and each
+ * class's pixel count. */
+static void pixel_classes(const render_out *r, const int32_t *class_of, size_t n_obj,
+                          size_t n_classes, int32_t *cls, uint64_t *count)
+{
+    memset(count, 0, n_classes * sizeof *count);
+    for (size_t p = 0; p < r->pixels; p++) {
+        cls[p] = r->ids[p] >= 0 && (size_t)r->ids[p] < n_obj ? class_of[r->ids[p]] : -1;
+        if (cls[p] >= 0)
+            count[cls[p]]++;
+    }
+}
+
+/* Class means of a render's Tb into mean[class * n + c]; a class without pixels (a
+ * turned sensor may lose one) takes `fallback`'s mean, i.e. no change. */
+static void class_means(const render_out *r, const int32_t *cls, const uint64_t *count,
+                        const bands_values *v, const double *fallback, double *mean)
 {
     size_t n = v->n_candidates;
     memset(mean, 0, v->n_classes * n * sizeof *mean);
@@ -243,11 +344,11 @@ static void class_means(const render_out *r, const int32_t *cls, const bands_val
                 mean[(size_t)cls[p] * n + c] += r->tb[c * r->pixels + p];
     for (size_t k = 0; k < v->n_classes; k++)
         for (size_t c = 0; c < n; c++)
-            mean[k * n + c] /= (double)v->class_pixels[k];
+            mean[k * n + c] = count[k] ? mean[k * n + c] / (double)count[k] : fallback[k * n + c];
 }
 
 /* The pixel covariance of each class about its mean, less the Monte Carlo variance of
- * its pixels on the diagonal (floored at 0), plus NETD^2 on the diagonal. */
+ * its pixels on the diagonal (floored at 0), plus its NETD^2 on the diagonal. */
 static void pixel_covariance(const render_out *r, const int32_t *cls, const bands_setup *s,
                              bands_values *v, double *x)
 {
@@ -295,9 +396,42 @@ static void pixel_covariance(const render_out *r, const int32_t *cls, const band
                 cov[a * n + b] *= x[a] * x[b];
         for (size_t c = 0; c < n; c++) {
             v->pixel_sd[k * n + c] = sqrt(cov[c * n + c]);
-            cov[c * n + c] += s->netd_k[c] * s->netd_k[c];
+            cov[c * n + c] += v->netd_k[k * n + c] * v->netd_k[k * n + c];
         }
     }
+}
+
+/* Renders variant `text` and puts its class means in mean (classes from its own truth:
+ * a turned sensor sees them elsewhere; `fallback` for a class it no longer sees). cls
+ * and count are scratch of the nominal's pixels and the classes. */
+static thz_status variant_means(thz_context *ctx, const char *text, const bands_setup *s,
+                                const char *base_dir, const int32_t *class_of, size_t n_obj,
+                                size_t pixels, int32_t *cls, uint64_t *count, const bands_values *v,
+                                const double *fallback, double *mean, thz_error *err)
+{
+    render_out r = {0};
+    thz_status st = render_variant(ctx, text, s, base_dir, &r, err);
+    if (st == THZ_OK && r.pixels != pixels) /* a variant never changes the resolution */
+        st = thz_error_set(err, THZ_ERR_INTERNAL, "band values: a variant's image differs");
+    if (st == THZ_OK) {
+        pixel_classes(&r, class_of, n_obj, v->n_classes, cls, count);
+        class_means(&r, cls, count, v, fallback, mean);
+    }
+    render_out_fini(&r);
+    return st;
+}
+
+/* The NETD of each class and candidate: the radiometer's at the class's mean Tb (its
+ * noise grows with the Tb it measures, scene-format.md "noise"), else the candidate's. */
+static void class_netd(const thz_scene *scene, const bands_setup *s, bands_values *v)
+{
+    size_t n = v->n_candidates;
+    for (size_t k = 0; k < v->n_classes; k++)
+        for (size_t c = 0; c < n; c++)
+            v->netd_k[k * n + c] = s->netd_from_sensor
+                                       ? noise_netd_k(&scene->sensors[s->sensor].noise,
+                                                      &scene->channels[c], c, v->mean[k * n + c])
+                                       : s->netd_k[c];
 }
 
 thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_values *v,
@@ -308,6 +442,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     clock_gettime(CLOCK_MONOTONIC, &t0);
     size_t n = s->n_candidates;
     v->n_candidates = n;
+    v->coarse_paths = coarse_paths(s->paths_per_sample);
     json_error_t jerr;
     json_t *root = json_load_file(s->scene_path, JSON_REJECT_DUPLICATES, &jerr);
     if (!root)
@@ -322,17 +457,19 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
         snprintf(base_dir, sizeof base_dir, ".");
     thz_status st = THZ_OK;
     thz_scene *scene = NULL;
-    render_out nominal = {0}, other = {0};
-    int32_t *cls = NULL;
+    render_out nominal = {0};
+    int32_t *cls = NULL, *class_of = NULL;
+    uint64_t *count = NULL;
     bool *is_class = NULL;
-    double *x = NULL, *dmean = NULL;
+    double *x = NULL, *dmean = NULL, *coarse_mean = NULL;
     char *text = NULL;
     int changed = 0;
     size_t n_obj = json_array_size(json_object_get(root, "objects"));
-    is_class = thz_calloc(n_obj, sizeof *is_class);
-    if (!is_class)
+    is_class = thz_calloc(n_obj ? n_obj : 1, sizeof *is_class);
+    class_of = thz_calloc(n_obj ? n_obj : 1, sizeof *class_of);
+    if (!is_class || !class_of)
         goto nomem;
-    text = variant_text(root, s, is_class, VAR_NOMINAL, &changed);
+    text = variant_text(root, s, is_class, VAR_NOMINAL, false, &changed);
     if (!text)
         goto nomem;
     st = thz_scene_load_string(text, base_dir, s->scene_path, &scene, err);
@@ -350,12 +487,12 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
             thz_error_set(err, st, "sensor %zu, channel %zu: no noise figures", s->sensor, c);
             goto done;
         }
-        s->netd_k[c] = sc.netd_k; /* at the channel's reference temperature */
+        s->netd_k[c] = sc.netd_k; /* at the channel's reference temperature (reported) */
     }
     cls = thz_calloc(nominal.pixels, sizeof *cls);
     if (!cls)
         goto nomem;
-    st = assign_classes(s, scene, nominal.ids, nominal.pixels, cls, is_class, v, err);
+    st = assign_classes(s, scene, nominal.ids, nominal.pixels, class_of, is_class, v, err);
     if (st != THZ_OK)
         goto done;
     if (v->n_classes < 2) {
@@ -365,26 +502,38 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
         goto done;
     }
     size_t nc = v->n_classes;
+    pixel_classes(&nominal, class_of, n_obj, nc, cls, v->class_pixels);
     v->mean = thz_calloc(nc * n, sizeof *v->mean);
     v->cov = thz_calloc(nc * n * n, sizeof *v->cov);
     v->pixel_sd = thz_calloc(nc * n, sizeof *v->pixel_sd);
     v->nuisance_sd = thz_calloc(nc * n, sizeof *v->nuisance_sd);
+    v->netd_k = thz_calloc(nc * n, sizeof *v->netd_k);
     x = thz_calloc(n, sizeof *x);
     dmean = thz_calloc(nc * n, sizeof *dmean);
-    if (!v->mean || !v->cov || !v->pixel_sd || !v->nuisance_sd || !x || !dmean)
+    count = thz_calloc(nc, sizeof *count);
+    if (!v->mean || !v->cov || !v->pixel_sd || !v->nuisance_sd || !v->netd_k || !x || !dmean ||
+        !count)
         goto nomem;
-    class_means(&nominal, cls, v, v->mean);
+    class_means(&nominal, cls, v->class_pixels, v, v->mean, v->mean);
+    class_netd(scene, s, v);
     pixel_covariance(&nominal, cls, s, v, x);
 
     /* Nuisances: a uniform variation within +-range has variance range^2 / 3; the
      * render at +range (humidity: x (1 - range)) gives the change d of each class's
      * mean, which adds d d^T / 3 to its covariance (the same seed in every render keeps
-     * the Monte Carlo noise out of d). */
-    double ranges[VAR_COUNT] = {0, s->target_range_k, s->ambient_range_k, s->humidity_range};
+     * the Monte Carlo noise out of d). These renders and the nominal one d is taken
+     * against are coarse (coarse_paths). Each render's own truth gives its classes'
+     * pixels: a turned sensor sees them elsewhere in the image. */
+    double ranges[VAR_COUNT] = {0,
+                                s->target_range_k,
+                                s->ambient_range_k,
+                                s->humidity_range,
+                                s->thickness_range,
+                                s->angle_range_deg};
     for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
         if (!(ranges[what] > 0.0))
             continue;
-        text = variant_text(root, s, is_class, what, &changed);
+        text = variant_text(root, s, is_class, what, true, &changed);
         if (!text)
             goto nomem;
         if (!changed) {
@@ -392,22 +541,36 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
             text = NULL;
             continue;
         }
-        if (what == VAR_HUMIDITY)
-            v->humidity_varied = true;
-        if (what == VAR_AMBIENT && changed >= 2)
-            v->air_temperature_varied = true;
-        st = render_variant(ctx, text, s, base_dir, &other, err);
+        if (!coarse_mean) { /* the coarse nominal render the changes are taken against */
+            char *nominal_text = variant_text(root, s, is_class, VAR_NOMINAL, true, &changed);
+            coarse_mean = thz_calloc(nc * n, sizeof *coarse_mean);
+            if (!nominal_text || !coarse_mean) {
+                free(nominal_text);
+                goto nomem;
+            }
+            st = variant_means(ctx, nominal_text, s, base_dir, class_of, n_obj, nominal.pixels, cls,
+                               count, v, v->mean, coarse_mean, err);
+            free(nominal_text);
+            if (st != THZ_OK)
+                goto done;
+            v->renders++;
+        }
+        v->humidity_varied = v->humidity_varied || what == VAR_HUMIDITY;
+        v->air_temperature_varied =
+            v->air_temperature_varied || (what == VAR_AMBIENT && changed >= 2);
+        v->thickness_varied = v->thickness_varied || what == VAR_THICKNESS;
+        v->angle_varied = v->angle_varied || what == VAR_ANGLE;
+        st = variant_means(ctx, text, s, base_dir, class_of, n_obj, nominal.pixels, cls, count, v,
+                           coarse_mean, dmean, err);
         free(text);
         text = NULL;
         if (st != THZ_OK)
             goto done;
         v->renders++;
-        class_means(&other, cls, v, dmean);
-        render_out_fini(&other);
         for (size_t k = 0; k < nc; k++) {
             double *d = dmean + k * n, *cov = v->cov + k * n * n;
             for (size_t c = 0; c < n; c++)
-                d[c] = (d[c] - v->mean[k * n + c]) / sqrt(3.0);
+                d[c] = (d[c] - coarse_mean[k * n + c]) / sqrt(3.0);
             for (size_t a = 0; a < n; a++) {
                 for (size_t b = 0; b < n; b++)
                     cov[a * n + b] += d[a] * d[b];
@@ -426,10 +589,12 @@ done:
     free(text);
     free(x);
     free(dmean);
+    free(coarse_mean);
+    free(count);
     free(cls);
+    free(class_of);
     free(is_class);
     render_out_fini(&nominal);
-    render_out_fini(&other);
     thz_scene_destroy(scene);
     json_decref(root);
     if (st != THZ_OK)

@@ -2,7 +2,8 @@
  * rendered with the candidate channels as its channels (path integrator, converged
  * radiance through covers and air), once as it is and once per nuisance changed
  * (targets' temperatures, the surroundings' and the air's temperature, the air's
- * humidity); each class's pixels come from the object_id truth. The result is each
+ * humidity, the shells' thickness, the viewing angle); each class's pixels come from
+ * each render's object_id truth. The result is each
  * class's mean brightness temperature per candidate and its covariance over the
  * candidates: pixel spread (Monte Carlo noise removed) + nuisances + the sensor's NETD.
  */
@@ -17,9 +18,9 @@
 
 typedef struct bands_setup {
     const char *scene_path;
-    const double *candidates_thz; /* n_candidates centres */
+    const double *candidates_thz; /* n_candidates centres (repeated once per width) */
+    const double *widths;         /* n_candidates relative widths (FWHM / centre) */
     size_t n_candidates;
-    double relative_width;
     size_t sensor;
     const long *targets; /* object indices; n_targets 0: every object seen is a class */
     size_t n_targets;
@@ -27,6 +28,7 @@ typedef struct bands_setup {
     bool netd_from_sensor; /* a radiometer: netd_k becomes the sensor's NETD of each
                               candidate in the scene with the candidates as channels */
     double target_range_k, ambient_range_k, humidity_range;
+    double thickness_range, angle_range_deg;
     uint32_t paths_per_sample;
     uint64_t seed;
 } bands_setup;
@@ -39,8 +41,10 @@ typedef struct bands_values {
     double *cov;            /* [class * n^2 + c * n + c']: K^2 */
     double *pixel_sd;       /* [class * n + c]: pixel spread (MC removed), K */
     double *nuisance_sd;    /* [class * n + c]: all nuisances together, K */
-    bool humidity_varied, air_temperature_varied;
+    double *netd_k;         /* [class * n + c]: the sensor's NETD at the class's mean Tb, K */
+    bool humidity_varied, air_temperature_varied, thickness_varied, angle_varied;
     size_t renders;
+    uint32_t coarse_paths; /* paths per sample of the nuisances' renders (1 sample per pixel) */
     double seconds;
 } bands_values;
 

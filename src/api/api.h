@@ -20,6 +20,8 @@ struct thz_context {
     thz_warning_fn warning;
     void *warning_user;
     thz_error last; /* the last failure of a call that took this context */
+    struct mpi_team *team; /* rank 0 of an MPI run (api_mpi.c), else NULL */
+    uint64_t mpi_bytes;    /* the other ranks: bytes their finished team moved */
 };
 
 /* Photon maps of every channel of a scene (a channel may have none). */
@@ -56,6 +58,11 @@ struct thz_run {
  * array with it and must not be destroyed). THZ_ERR_INPUT for an unknown integrator. */
 thz_status api_effective_scene(const thz_scene *scene, const thz_run_settings *settings,
                                thz_scene *out, thz_error *err);
+
+/* The context's team of MPI ranks for shared photon phases, NULL when alone or built
+ * without MPI; api_mpi_release ends it (thz_context_destroy). */
+const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx);
+void api_mpi_release(thz_context *ctx);
 
 /* run_options from a context and settings. */
 void api_run_options(const thz_context *ctx, const thz_run_settings *settings, run_options *opt);

@@ -18,7 +18,11 @@ enum { BANDS_MAX_CANDIDATES = 4096 };
 struct thz_bands {
     char *scene_path, *scene_name, *sensor;
     double from_thz, to_thz, step_ghz;
-    double *candidates_thz;
+    double *candidates_thz; /* per candidate: its centre (c = centre * n_widths + width) */
+    double *widths;         /* per candidate: its relative width */
+    size_t *group;          /* per candidate: its centre's index */
+    double *width_list;     /* the n_widths widths searched, ascending */
+    size_t n_widths, n_centres;
     double *netd_k; /* per candidate */
     const char *netd_source;
     long *targets;
@@ -40,7 +44,7 @@ void thz_bands_options_init(thz_bands_options *opt)
     opt->ambient_temperature_range_k = 2.0;
     opt->humidity_range = 0.2;
     opt->paths_per_sample = 16;
-    opt->exhaustive_limit = 200000;
+    opt->exhaustive_limit = 2000000;
 }
 
 void thz_bands_destroy(thz_bands *b)
@@ -51,6 +55,9 @@ void thz_bands_destroy(thz_bands *b)
     free(b->scene_name);
     free(b->sensor);
     free(b->candidates_thz);
+    free(b->widths);
+    free(b->group);
+    free(b->width_list);
     free(b->netd_k);
     free(b->targets);
     bands_values_fini(&b->values);
@@ -78,10 +85,33 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
                              "--step-ghz)",
                              n, o->from_thz, o->to_thz, o->step_ghz, BANDS_MAX_CANDIDATES);
     if ((size_t)n < o->count)
-        return thz_error_set(err, THZ_ERR_INPUT, "--count %zu: only %.0f candidates", o->count, n);
+        return thz_error_set(err, THZ_ERR_INPUT, "--count %zu: only %.0f candidate centres",
+                             o->count, n);
     if (!(o->relative_width >= 0.0 && o->relative_width <= 0.5))
         return thz_error_set(err, THZ_ERR_INPUT, "relative width %g: expected 0 < w <= 0.5",
                              o->relative_width);
+    if (o->n_widths && !o->relative_widths)
+        return thz_error_set(err, THZ_ERR_INPUT, "widths: %zu given but no list", o->n_widths);
+    for (size_t i = 0; i < o->n_widths; i++) {
+        if (!(o->relative_widths[i] > 0.0 && o->relative_widths[i] <= 0.5))
+            return thz_error_set(err, THZ_ERR_INPUT, "--widths: %g: expected 0 < w <= 0.5",
+                                 o->relative_widths[i]);
+        for (size_t j = 0; j < i; j++)
+            if (o->relative_widths[j] == o->relative_widths[i])
+                return thz_error_set(err, THZ_ERR_INPUT, "--widths: %g given twice",
+                                     o->relative_widths[i]);
+    }
+    if (n * (double)(o->n_widths ? o->n_widths : 1) > BANDS_MAX_CANDIDATES)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%.0f centres x %zu widths: at most %d candidates (raise "
+                             "--step-ghz or give fewer widths)",
+                             n, o->n_widths, BANDS_MAX_CANDIDATES);
+    if (!(o->thickness_range >= 0.0 && o->thickness_range < 1.0) ||
+        !(o->angle_range_deg >= 0.0 && o->angle_range_deg <= 90.0))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "thickness range %g (expected 0 <= f < 1), angle range %g degrees "
+                             "(expected 0 to 90)",
+                             o->thickness_range, o->angle_range_deg);
     if (!(o->netd_k >= 0.0) || !(o->target_temperature_range_k >= 0.0) ||
         !(o->ambient_temperature_range_k >= 0.0) ||
         !(o->humidity_range >= 0.0 && o->humidity_range < 1.0))
@@ -196,7 +226,10 @@ static thz_status resolve_scene(thz_bands *b, const thz_bands_options *o, thz_er
         goto done;
     thz_channel_info ci;
     thz_scene_channel(scene, 0, &ci);
-    b->setup.relative_width = o->relative_width > 0.0 ? o->relative_width : ci.relative_width;
+    if (!o->n_widths)
+        b->width_list[0] = o->relative_width > 0.0 ? o->relative_width : ci.relative_width;
+    for (size_t c = 0; c < b->setup.n_candidates; c++)
+        b->widths[c] = b->width_list[c % b->n_widths];
     b->setup.seed = o->has_seed ? o->seed : info.seed;
     if (strcmp(info.atmosphere_model, "none") != 0) {
         st = thz_atm_from_scene(scene, &atm, err);
@@ -234,6 +267,8 @@ static bands_report make_report(const thz_bands *b)
                           .values = &b->values,
                           .search = &b->search,
                           .air_db_per_km = b->air_db_per_km,
+                          .width_list = b->width_list,
+                          .n_widths = b->n_widths,
                           .netd_source = b->netd_source};
 }
 
@@ -252,28 +287,46 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
     thz_bands *b = thz_calloc(1, sizeof *b);
     if (!b)
         return api_done(ctx, thz_error_set(err, THZ_ERR_NOMEM, "out of memory"), err);
+    b->n_centres = n;
+    b->n_widths = o->n_widths ? o->n_widths : 1;
+    n *= b->n_widths;
     b->scene_path = thz_strdup(scene_path);
     b->candidates_thz = thz_calloc(n, sizeof *b->candidates_thz);
+    b->widths = thz_calloc(n, sizeof *b->widths);
+    b->group = thz_calloc(n, sizeof *b->group);
+    b->width_list = thz_calloc(b->n_widths, sizeof *b->width_list);
     b->netd_k = thz_calloc(n, sizeof *b->netd_k);
-    if (!b->scene_path || !b->candidates_thz || !b->netd_k) {
+    if (!b->scene_path || !b->candidates_thz || !b->widths || !b->group || !b->width_list ||
+        !b->netd_k) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
         goto done;
     }
     b->from_thz = o->from_thz;
     b->to_thz = o->to_thz;
     b->step_ghz = o->step_ghz;
-    for (size_t c = 0; c < n; c++) { /* from + c step, rounded to the kHz the grid means */
-        b->candidates_thz[c] = round((o->from_thz + (double)c * o->step_ghz * 1e-3) * 1e9) / 1e9;
+    for (size_t i = 0; i < o->n_widths; i++) { /* ascending (insertion sort: a few) */
+        size_t j = i;
+        for (; j > 0 && b->width_list[j - 1] > o->relative_widths[i]; j--)
+            b->width_list[j] = b->width_list[j - 1];
+        b->width_list[j] = o->relative_widths[i];
+    }
+    for (size_t c = 0; c < n; c++) { /* from + i step, rounded to the kHz the grid means */
+        size_t i = c / b->n_widths;
+        b->candidates_thz[c] = round((o->from_thz + (double)i * o->step_ghz * 1e-3) * 1e9) / 1e9;
+        b->group[c] = i;
         b->netd_k[c] = o->netd_k; /* resolve_netd or bands_values may replace it */
     }
     b->setup = (bands_setup){.scene_path = b->scene_path,
                              .candidates_thz = b->candidates_thz,
+                             .widths = b->widths,
                              .n_candidates = n,
                              .n_targets = o->n_targets,
                              .netd_k = b->netd_k,
                              .target_range_k = o->target_temperature_range_k,
                              .ambient_range_k = o->ambient_temperature_range_k,
                              .humidity_range = o->humidity_range,
+                             .thickness_range = o->thickness_range,
+                             .angle_range_deg = o->angle_range_deg,
                              .paths_per_sample = o->paths_per_sample};
     st = resolve_scene(b, o, err);
     if (st != THZ_OK)
@@ -285,8 +338,9 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
     bands_classes cl = {.n_candidates = n,
                         .n_classes = b->values.n_classes,
                         .mean = b->values.mean,
-                        .cov = b->values.cov};
-    st = bands_search(&cl, o->count, o->exhaustive_limit ? o->exhaustive_limit : 200000, &b->search,
+                        .cov = b->values.cov,
+                        .group = b->group};
+    st = bands_search(&cl, o->count, o->exhaustive_limit ? o->exhaustive_limit : 2000000, &b->search,
                       err);
     if (st != THZ_OK)
         goto done;
@@ -321,6 +375,14 @@ double thz_bands_selected_thz(const thz_bands *b, size_t i)
         return NAN;
     size_t K = b->search.count;
     return b->candidates_thz[b->search.sets[(K - 1) * K + i]];
+}
+
+double thz_bands_selected_relative_width(const thz_bands *b, size_t i)
+{
+    if (!b || i >= b->search.count)
+        return NAN;
+    size_t K = b->search.count;
+    return b->widths[b->search.sets[(K - 1) * K + i]];
 }
 
 double thz_bands_score(const thz_bands *b, size_t k)

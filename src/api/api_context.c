@@ -15,6 +15,8 @@ thz_context *thz_context_create(void)
 
 void thz_context_destroy(thz_context *ctx)
 {
+    if (ctx)
+        api_mpi_release(ctx);
     free(ctx);
 }
 
@@ -114,6 +116,7 @@ void api_run_options(const thz_context *ctx, const thz_run_settings *settings, r
         opt->progress_user = ctx->progress_user;
         opt->warning = ctx->warning;
         opt->warning_user = ctx->warning_user;
+        opt->team = api_mpi_phase_team(ctx);
     }
     if (settings) {
         opt->keep_photon_maps = settings->keep_photons != 0;

@@ -120,6 +120,13 @@ thz_status thz_scene_material(const thz_scene *s, size_t i, thz_material_info *o
     out->transmission = m->transmission == TRANSMISSION_STRAIGHT ? "straight" : "diffuse";
     memcpy(out->color, m->color, sizeof out->color);
     out->index_model = m->index ? material_index_form(m->index) : NULL;
+    out->reflection = m->reflection == REFLECTION_SPECULAR ? "specular"
+                      : m->reflection == REFLECTION_WARD   ? "ward"
+                                                           : "diffuse";
+    if (m->reflection == REFLECTION_WARD) {
+        out->ward_alpha_x = m->ward_alpha[0];
+        out->ward_alpha_y = m->ward_alpha[1];
+    }
     return THZ_OK;
 }
 

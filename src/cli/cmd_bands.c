@@ -13,7 +13,7 @@
 #include "thzmap/thzmap.h"
 
 #define CMD "bands"
-enum { MAX_TARGETS = 256 };
+enum { MAX_TARGETS = 256, MAX_WIDTHS = 16 };
 
 static void print_help(void)
 {
@@ -36,6 +36,9 @@ static void print_help(void)
            "  --step-ghz S                candidate spacing, GHz (default 10)\n"
            "  --relative-width W          FWHM / centre of every candidate (default: the\n"
            "                              scene's first channel's)\n"
+           "  --widths W1,W2,...          search the widths too: every centre with each of\n"
+           "                              these relative widths (FWHM / centre, up to 16);\n"
+           "                              a chosen set holds each centre once\n"
            "  --targets OBJ,...           the objects to recognise (default: every object seen)\n"
            "  --sensor NAME               the sensor (default: the scene's first)\n"
            "  --netd-k X                  the sensor's noise per channel, K (default: the\n"
@@ -45,6 +48,11 @@ static void print_help(void)
            "                              within +-X K (default 2)\n"
            "  --humidity-range F          the air's humidity within +-F of its value\n"
            "                              (a fraction; default 0.2)\n"
+           "  --thickness-range F         every shell's (cover's) thickness within +-F of\n"
+           "                              its own (a fraction; default 0: not varied)\n"
+           "  --angle-range-deg X         the viewing angle within +-X degrees: the sensor\n"
+           "                              turned about its up axis around the point it looks\n"
+           "                              at (default 0: not varied)\n"
            "  --paths N                   path-integrator paths per sample (default 16)\n"
            "  --seed S                    the renders' seed (default: the scene's)\n"
            "  --threads T                 threads (default: all cores); results do not depend\n"
@@ -65,10 +73,23 @@ static bool split_targets(char *list, const char **names, size_t *n)
     return *n > 0;
 }
 
+/* Parses "w1,w2,..." (relative widths) in place. */
+static bool split_widths(char *list, double *w, size_t *n)
+{
+    *n = 0;
+    for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
+        if (*n == MAX_WIDTHS || !cli_parse_double(CMD, "--widths", tok, 1e-9, 0.5, &w[*n]))
+            return false;
+        (*n)++;
+    }
+    return *n > 0;
+}
+
 int cmd_bands(int argc, char **argv)
 {
     const char *scene = NULL, *outdir = NULL;
     const char *targets[MAX_TARGETS];
+    double widths[MAX_WIDTHS];
     bool quiet = false, have_count = false;
     uint64_t count = 0, paths = 0, threads = 0, seed = 0;
     thz_bands_options opt;
@@ -96,6 +117,9 @@ int cmd_bands(int argc, char **argv)
                                                  "--to-thz",
                                                  "--step-ghz",
                                                  "--relative-width",
+                                                 "--widths",
+                                                 "--thickness-range",
+                                                 "--angle-range-deg",
                                                  "--targets",
                                                  "--sensor",
                                                  "--netd-k",
@@ -128,6 +152,17 @@ int cmd_bands(int argc, char **argv)
             ok = cli_parse_double(CMD, a, v, 1e-6, 1e6, &opt.step_ghz);
         } else if (strcmp(a, "--relative-width") == 0) {
             ok = cli_parse_double(CMD, a, v, 1e-9, 0.5, &opt.relative_width);
+        } else if (strcmp(a, "--widths") == 0) {
+            if (!split_widths(v, widths, &opt.n_widths))
+                return cli_usage_error(CMD,
+                                       "--widths expects 1 to %d relative widths in (0, 0.5], "
+                                       "comma separated",
+                                       MAX_WIDTHS);
+            opt.relative_widths = widths;
+        } else if (strcmp(a, "--thickness-range") == 0) {
+            ok = cli_parse_double(CMD, a, v, 0.0, 0.99, &opt.thickness_range);
+        } else if (strcmp(a, "--angle-range-deg") == 0) {
+            ok = cli_parse_double(CMD, a, v, 0.0, 90.0, &opt.angle_range_deg);
         } else if (strcmp(a, "--targets") == 0) {
             if (!split_targets(v, targets, &opt.n_targets))
                 return cli_usage_error(CMD,
@@ -206,7 +241,8 @@ int cmd_bands(int argc, char **argv)
                     thz_bands_score(b, k));
         fprintf(stderr, "chosen:");
         for (size_t i = 0; i < info.count; i++)
-            fprintf(stderr, " %.4g THz", thz_bands_selected_thz(b, i));
+            fprintf(stderr, " %.4g THz (relative width %.3g)", thz_bands_selected_thz(b, i),
+                    thz_bands_selected_relative_width(b, i));
         fprintf(stderr, "; results in %s\n", outdir);
     }
     thz_bands_destroy(b);

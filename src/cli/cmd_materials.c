@@ -81,6 +81,9 @@ static int describe(const thz_library *lib, const char *name, const double *thz,
     printf("source: %s\n", info.source);
     if (info.note[0])
         printf("note:   %s\n", info.note);
+    /* An entry is an index only: the lobe belongs to the scene material using it. */
+    printf("reflection: not part of the entry; the scene material's \"reflection\" "
+           "(diffuse, specular or ward) applies, diffuse by default\n");
     if (info.has_valid_range)
         printf("stated validity: %.4g to %.4g THz\n", info.valid_from_thz, info.valid_to_thz);
     else

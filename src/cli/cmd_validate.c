@@ -161,6 +161,11 @@ static void validate_print(const thz_scene *s)
                a, e, mat.transmission);
         if (mat.index_model)
             printf("; complex index %s", mat.index_model);
+        if (strcmp(mat.reflection, "ward") == 0)
+            printf("; reflection ward (alpha_x %g, alpha_y %g)", mat.ward_alpha_x,
+                   mat.ward_alpha_y);
+        else
+            printf("; reflection %s", mat.reflection);
         printf("\n");
     }
     printf("\natmosphere: %s\n", si.atmosphere_model);

@@ -8,22 +8,26 @@
 #include <time.h>
 
 #include "cli.h"
+#include "cli_mpi.h"
 
 typedef struct command {
     const char *name;
     int (*run)(int argc, char **argv);
     const char *summary;
+    bool shares_ranks; /* runs as one job over several MPI ranks (docs/mpi.md) */
 } command;
 
 static const command commands[] = {
-    {"validate", cmd_validate, "check a scene; print its geometry and emitted power per channel"},
-    {"simulate", cmd_simulate, "fire photons and render every sensor of a scene"},
-    {"render", cmd_render, "re-render sensors of a scene from a saved photon map"},
-    {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency"},
-    {"batch", cmd_batch, "run a sequence of frames (keyframes, sweeps) and make movies"},
-    {"materials", cmd_materials, "list the material library, or describe one material"},
-    {"bands", cmd_bands, "choose the channel frequencies that best separate a scene's targets"},
-    {"classify", cmd_classify, "recognise materials in a run's cubes against its truth"},
+    {"validate", cmd_validate, "check a scene; print its geometry and emitted power per channel",
+     false},
+    {"simulate", cmd_simulate, "fire photons and render every sensor of a scene", true},
+    {"render", cmd_render, "re-render sensors of a scene from a saved photon map", false},
+    {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency", false},
+    {"batch", cmd_batch, "run a sequence of frames (keyframes, sweeps) and make movies", false},
+    {"materials", cmd_materials, "list the material library, or describe one material", false},
+    {"bands", cmd_bands, "choose the channel frequencies that best separate a scene's targets",
+     false},
+    {"classify", cmd_classify, "recognise materials in a run's cubes against its truth", false},
 };
 
 static void print_usage(FILE *f)
@@ -108,6 +112,20 @@ bool cli_parse_double(const char *cmd, const char *option, const char *text, dou
     return true;
 }
 
+/* The command's exit status; under mpirun, after MPI started and before it ends. */
+static int main_run(const command *c, int argc, char **argv)
+{
+    if (cli_mpi_size() > 1 && !c->shares_ranks) {
+        if (cli_mpi_rank() == 0)
+            fprintf(stderr,
+                    "thzmap %s: does not run over several MPI ranks (only simulate does); run "
+                    "it without mpirun\n",
+                    c->name);
+        return CLI_EXIT_USAGE;
+    }
+    return c->run(argc, argv);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -122,9 +140,14 @@ int main(int argc, char **argv)
         printf("thzmap %s\n", thz_version());
         return CLI_EXIT_OK;
     }
-    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-        if (strcmp(argv[1], commands[i].name) == 0)
-            return commands[i].run(argc - 1, argv + 1);
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {
+        if (strcmp(argv[1], commands[i].name) != 0)
+            continue;
+        int rc = cli_mpi_init(&argc, &argv);
+        if (rc >= 0)
+            return rc;
+        return cli_mpi_finalize(main_run(&commands[i], argc - 1, argv + 1));
+    }
     fprintf(stderr, "thzmap: unknown command '%s'\n\n", argv[1]);
     print_usage(stderr);
     return CLI_EXIT_USAGE;

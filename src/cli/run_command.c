@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "cli_mpi.h"
 #include "progress.h"
 #include "thzmap/thzmap.h"
 
@@ -222,40 +223,93 @@ static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_ru
     return st;
 }
 
+/* The scene of the run and the checks of the options against it; -1 to go on, or the
+ * exit status after printing why not. */
+static int cli_run_load(const char *cmd, cli_run_args *a, bool render, thz_scene **scene)
+{
+    thz_error err = {0};
+    thz_status st = thz_scene_load(a->scene_path, scene, &err);
+    if (st != THZ_OK)
+        return cli_fail(&err);
+    thz_scene_info info;
+    thz_scene_get_info(*scene, &info);
+    const char *integrator = a->settings.integrator ? a->settings.integrator : info.integrator;
+    if (a->write.photon_map && !thz_integrator_needs_photons(integrator))
+        return cli_usage_error(cmd,
+                               "--save-photon-map: the %s integrator fires no photons (give "
+                               "--integrator final-gather or photon-map, or render.integrator)",
+                               integrator);
+    if (render && !a->photon_map_path && thz_integrator_needs_photons(integrator))
+        return cli_usage_error(cmd, "no photon map given (--photon-map FILE); only the path "
+                                    "integrator renders without one");
+    for (size_t i = 0; i < thz_scene_warning_count(*scene); i++) /* --quiet hides progress only */
+        fprintf(stderr, "thzmap %s: warning: %s\n", cmd, thz_scene_warning(*scene, i));
+    if (cli_mpi_size() > 1 && !thz_integrator_needs_photons(integrator))
+        fprintf(stderr,
+                "thzmap %s: warning: the %s integrator fires no photons: rank 0 renders alone "
+                "and the other %d MPI ranks wait (pixels are not shared yet)\n",
+                cmd, integrator, cli_mpi_size() - 1);
+    return -1;
+}
+
+/* A rank other than 0 of an MPI run: fires its shares of rank 0's photon phases. A
+ * failure ends the job, since rank 0 waits for the share. */
+static int cli_run_member(const char *cmd, const cli_run_args *a, const thz_scene *scene)
+{
+    thz_error err = {0};
+    thz_context *ctx = thz_context_create();
+    if (!ctx) {
+        fprintf(stderr, "thzmap %s (MPI rank %d): out of memory\n", cmd, cli_mpi_rank());
+        cli_mpi_abort(CLI_EXIT_FAILURE);
+    }
+    thz_context_set_threads(ctx, a->threads);
+    thz_status st = thz_mpi_serve(ctx, scene, &a->settings, &err);
+    if (st != THZ_OK) {
+        char message[sizeof err.message + 64];
+        snprintf(message, sizeof message, "%s (MPI rank %d): %s", cmd, cli_mpi_rank(), err.message);
+        memcpy(err.message, message, sizeof err.message - 1);
+        err.message[sizeof err.message - 1] = '\0';
+        cli_mpi_abort(cli_fail(&err));
+    }
+    thz_context_destroy(ctx);
+    return CLI_EXIT_OK;
+}
+
 int cli_run_command(int argc, char **argv, bool render)
 {
     const char *cmd = argv[0];
     cli_run_args a;
     memset(&a, 0, sizeof a);
+    double t0 = cli_now_s();
+    thz_scene *scene = NULL;
+    /* Under mpirun every rank parses and loads alike; rank 0 alone says what is wrong. */
+    cli_mpi_quiet_begin();
     int rc = cli_run_parse(argc, argv, render, &a);
-    if (rc >= 0)
+    if (rc < 0)
+        rc = cli_run_load(cmd, &a, render, &scene);
+    cli_mpi_quiet_end();
+    int lead_rc = rc, failed = cli_mpi_agree(rc < 0, rc, &lead_rc);
+    if (failed >= 0) {
+        thz_scene_destroy(scene);
+        if (lead_rc >= 0)
+            return lead_rc;
+        if (cli_mpi_rank() == 0)
+            fprintf(stderr,
+                    "thzmap %s: MPI rank %d could not load the scene or options rank 0 did (is "
+                    "%s the same file on every node?)\n",
+                    cmd, failed, a.scene_path);
+        return CLI_EXIT_FAILURE;
+    }
+    bool shared = cli_mpi_size() > 1;
+    if (shared && cli_mpi_rank() > 0) {
+        rc = cli_run_member(cmd, &a, scene);
+        thz_scene_destroy(scene);
         return rc;
+    }
 
     cli_signals_install();
     thz_error err = {0};
-    double t0 = cli_now_s();
-    thz_scene *scene = NULL;
-    thz_status st = thz_scene_load(a.scene_path, &scene, &err);
-    if (st != THZ_OK)
-        return cli_fail(&err);
-    thz_scene_info info;
-    thz_scene_get_info(scene, &info);
-    const char *integrator = a.settings.integrator ? a.settings.integrator : info.integrator;
-    if (a.write.photon_map && !thz_integrator_needs_photons(integrator)) {
-        thz_scene_destroy(scene);
-        return cli_usage_error(cmd,
-                               "--save-photon-map: the %s integrator fires no photons (give "
-                               "--integrator final-gather or photon-map, or render.integrator)",
-                               integrator);
-    }
-    if (render && !a.photon_map_path && thz_integrator_needs_photons(integrator)) {
-        thz_scene_destroy(scene);
-        return cli_usage_error(cmd, "no photon map given (--photon-map FILE); only the path "
-                                    "integrator renders without one");
-    }
-    for (size_t i = 0; i < thz_scene_warning_count(scene); i++) /* --quiet hides progress only */
-        fprintf(stderr, "thzmap %s: warning: %s\n", cmd, thz_scene_warning(scene, i));
-
+    thz_status st = THZ_OK;
     thz_context *ctx = thz_context_create();
     if (!ctx) {
         thz_scene_destroy(scene);
@@ -265,6 +319,8 @@ int cli_run_command(int argc, char **argv, bool render)
     cli_progress progress;
     cli_progress_init(&progress, cmd, a.quiet);
     thz_context_set_threads(ctx, a.threads);
+    if (shared && thz_context_set_mpi(ctx, &err) != THZ_OK)
+        cli_mpi_abort(cli_fail(&err));
     thz_context_set_progress(ctx, cli_progress_report, &progress);
     thz_context_set_warning(ctx, cli_progress_warning, &progress);
     a.settings.plan = cli_progress_plan;
@@ -298,6 +354,9 @@ int cli_run_command(int argc, char **argv, bool render)
                        result.worst_median_stderr_k, result.worst_p95_stderr_k);
             if (result.max_passes > 1)
                 printf(" after up to %u passes", result.max_passes);
+            if (shared)
+                printf(", %d MPI ranks (%.3g MB gathered)", cli_mpi_size(),
+                       1e-6 * (double)thz_context_mpi_bytes(ctx));
             printf(", %.2f s; results in %s\n", result.seconds, a.outdir);
             thz_object_info obj;
             thz_channel_info ch;
@@ -309,8 +368,10 @@ int cli_run_command(int argc, char **argv, bool render)
                        cmd, obj.name, result.worst_object_p95_stderr_k, ch.name);
         }
     }
+    if (shared && rc != CLI_EXIT_OK) /* the other ranks may be waiting for rank 0 */
+        cli_mpi_abort(rc);
     thz_run_destroy(run);
-    thz_context_destroy(ctx);
+    thz_context_destroy(ctx); /* ends the other ranks' thz_mpi_serve */
     thz_scene_destroy(scene);
     return rc;
 }

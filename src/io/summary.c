@@ -229,6 +229,7 @@ static json_t *summary_build(const thz_scene *scene, const run_summary *summary)
             summary->target_noise_k > 0.0 ? sum_real(summary->target_noise_k) : json_null(), &ok);
     sum_set(root, "target_noise_source", sum_string(summary->target_source), &ok);
     sum_set(root, "threads", json_integer(summary->threads), &ok);
+    sum_set(root, "mpi_ranks", json_integer(summary->mpi_ranks > 1 ? summary->mpi_ranks : 1), &ok);
     sum_set(root, "atmosphere_model", json_string(atmosphere_model_name(scene->atmosphere.model)),
             &ok);
 

@@ -25,17 +25,20 @@ typedef struct phase_fire_args {
     const emission_table *table;
     const air_emission *air; /* the emitting air, or NULL */
     size_t channel;
-    uint64_t n_photons;
+    uint64_t n_photons;    /* K: the phase's photons (their power is P / K) */
+    uint64_t lo, hi;       /* fire photons [lo, hi) of K (lo a multiple of PHASE_BATCH) */
     uint64_t first_photon; /* index of the first photon (its random stream and batch) */
     int threads;
     thz_progress_fn progress;
     void *progress_user;
 } phase_fire_args;
 
-/* Fires photons first_photon + 0..n_photons-1, returning their records in photon-index order (a
- * malloc'd array, never NULL on success) and the summed counters. */
+/* Fires photons first_photon + lo..hi-1, returning their records in photon-index order (a
+ * malloc'd array, never NULL on success) and the summed counters; chunk_out (may be NULL)
+ * gets each chunk's counters in order (room for ceil((hi - lo) / PHASE_CHUNK)). */
 static thz_status phase_fire(const phase_fire_args *a, photon_record **out_records,
-                             size_t *out_count, trace_counters *total, thz_error *err)
+                             size_t *out_count, trace_counters *total, trace_counters *chunk_out,
+                             thz_error *err)
 {
     thz_status st = THZ_OK;
     int nthreads = a->threads > 0 ? a->threads : omp_get_max_threads();
@@ -53,8 +56,8 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
     const uint64_t seed = a->scene->photons.seed;
     const uint32_t channel = (uint32_t)a->channel;
 
-    for (uint64_t first = 0; first < a->n_photons; first += PHASE_BATCH) {
-        uint64_t batch_n = a->n_photons - first < PHASE_BATCH ? a->n_photons - first : PHASE_BATCH;
+    for (uint64_t first = a->lo; first < a->hi; first += PHASE_BATCH) {
+        uint64_t batch_n = a->hi - first < PHASE_BATCH ? a->hi - first : PHASE_BATCH;
         long n_chunks = (long)((batch_n + PHASE_CHUNK - 1) / PHASE_CHUNK);
         for (int t = 0; t < nthreads; t++)
             bufs[t].count = 0;
@@ -98,6 +101,8 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                     chunks[k].offset = count + added;
                     added += chunks[k].count;
                     trace_counters_add(total, &chunks[k].counters);
+                    if (chunk_out)
+                        *chunk_out++ = chunks[k].counters;
                 }
                 if (!failed && count + added > capacity) {
                     size_t cap = capacity;
@@ -133,11 +138,12 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
             goto cleanup;
         }
 
-        if (a->progress) {
+        if (a->progress) { /* a share's progress, scaled to K */
+            double share = (double)(first + batch_n - a->lo) / (double)(a->hi - a->lo);
             thz_progress p = {.stage = "photons",
                               .channel = a->channel,
                               .n_channels = a->scene->n_channels,
-                              .done = first + batch_n,
+                              .done = (uint64_t)(share * (double)a->n_photons),
                               .total = a->n_photons};
             if (a->progress(a->progress_user, &p) != 0) {
                 st = thz_error_set(err, THZ_ERR_CANCELLED, "photon phase: cancelled");
@@ -198,6 +204,88 @@ static thz_status phase_sources_init(const thz_scene *scene, const accel *acc, s
     return THZ_OK;
 }
 
+void photon_phase_share_fini(photon_phase_share *s)
+{
+    free(s->records);
+    free(s->chunks);
+    memset(s, 0, sizeof *s);
+}
+
+void photon_phase_share_range(uint64_t k, size_t member, size_t members, uint64_t *lo, uint64_t *hi)
+{
+    uint64_t batches = (k + PHASE_BATCH - 1) / PHASE_BATCH, n = members ? members : 1;
+    uint64_t m = member < n ? member : n, each = batches / n, extra = batches % n;
+    uint64_t b_lo = m * each + (m < extra ? m : extra);
+    uint64_t b_hi = m < n ? b_lo + each + (m < extra ? 1 : 0) : batches;
+    *lo = b_lo * PHASE_BATCH < k ? b_lo * PHASE_BATCH : k;
+    *hi = b_hi * PHASE_BATCH < k ? b_hi * PHASE_BATCH : k;
+}
+
+/* Fires photons [lo, hi) of rq from its sources: the share's records and chunk counters,
+ * their sum in *total. */
+static thz_status phase_fire_range(const thz_scene *scene, const accel *acc,
+                                   const photon_phase_request *rq, const emission_table *table,
+                                   const air_emission *air, int threads, uint64_t lo, uint64_t hi,
+                                   thz_progress_fn progress, void *progress_user,
+                                   photon_phase_share *out, trace_counters *total, thz_error *err)
+{
+    memset(out, 0, sizeof *out);
+    size_t n_chunks = (size_t)((hi - lo + PHASE_CHUNK - 1) / PHASE_CHUNK);
+    out->chunks = thz_malloc_array(n_chunks ? n_chunks : 1, sizeof *out->chunks);
+    if (!out->chunks)
+        return thz_error_set(err, THZ_ERR_NOMEM, "photon phase: out of memory");
+    out->n_chunks = n_chunks;
+    phase_fire_args a = {.scene = scene,
+                         .acc = acc,
+                         .table = table,
+                         .air = air,
+                         .channel = (size_t)rq->channel,
+                         .n_photons = rq->photons,
+                         .lo = lo,
+                         .hi = hi,
+                         .first_photon = rq->first_photon,
+                         .threads = threads,
+                         .progress = progress,
+                         .progress_user = progress_user};
+    thz_status st = phase_fire(&a, &out->records, &out->count, total, out->chunks, err);
+    if (st != THZ_OK)
+        photon_phase_share_fini(out);
+    return st;
+}
+
+thz_status photon_phase_fire_share(const thz_scene *scene, const accel *acc,
+                                   const photon_phase_request *rq, int threads, size_t member,
+                                   size_t members, photon_phase_share *out, thz_error *err)
+{
+    memset(out, 0, sizeof *out);
+    thz_status st = phase_check(scene, (size_t)rq->channel, err);
+    if (st != THZ_OK)
+        return st;
+    if (rq->seed != scene->photons.seed || rq->photons != scene->photons.per_channel)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "photon phase: process %zu has seed %llu and %llu photons per "
+                             "channel, the lead %llu and %llu (every process must load the same "
+                             "scene with the same options)",
+                             member, (unsigned long long)scene->photons.seed,
+                             (unsigned long long)scene->photons.per_channel,
+                             (unsigned long long)rq->seed, (unsigned long long)rq->photons);
+    emission_table table;
+    air_emission air;
+    double surface_power;
+    st = phase_sources_init(scene, acc, (size_t)rq->channel, rq->photons,
+                            rq->reference_temperature_k, &table, &air, &surface_power, err);
+    if (st != THZ_OK)
+        return st;
+    uint64_t lo, hi;
+    photon_phase_share_range(rq->photons, member, members, &lo, &hi);
+    trace_counters total;
+    st = phase_fire_range(scene, acc, rq, &table, &air, threads, lo, hi, NULL, NULL, out, &total,
+                          err);
+    emission_table_fini(&table);
+    air_emission_fini(&air);
+    return st;
+}
+
 thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t channel,
                             const photon_phase_options *opt, photon_map **out_map,
                             photon_stats *stats, thz_error *err)
@@ -211,37 +299,54 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     if (!(t0_k >= 0.0) || !isfinite(t0_k))
         return thz_error_set(err, THZ_ERR_INPUT,
                              "photon phase: reference temperature must be >= 0 K, got %g K", t0_k);
+    const photon_phase_team *team = opt ? opt->team : NULL;
+    photon_phase_request rq = {.channel = channel,
+                               .photons = scene->photons.per_channel,
+                               .first_photon = opt ? opt->first_photon : 0,
+                               .seed = scene->photons.seed,
+                               .reference_temperature_k = t0_k};
+    uint64_t lo = 0, hi = rq.photons;
+    if (team) { /* the others start on their shares while the lead builds its table */
+        photon_phase_share_range(rq.photons, 0, team->members, &lo, &hi);
+        st = team->start(team->impl, &rq, err);
+        if (st != THZ_OK)
+            return st;
+    }
     emission_table table;
     air_emission air;
     double surface_power;
-    st = phase_sources_init(scene, acc, channel, scene->photons.per_channel, t0_k, &table, &air,
-                            &surface_power, err);
+    st = phase_sources_init(scene, acc, channel, rq.photons, t0_k, &table, &air, &surface_power,
+                            err);
     if (st != THZ_OK)
         return st;
     double t1 = omp_get_wtime();
-    phase_fire_args a = {.scene = scene,
-                         .acc = acc,
-                         .table = &table,
-                         .air = &air,
-                         .channel = channel,
-                         .n_photons = scene->photons.per_channel,
-                         .first_photon = opt ? opt->first_photon : 0,
-                         .threads = opt ? opt->threads : 0,
-                         .progress = opt ? opt->progress : NULL,
-                         .progress_user = opt ? opt->progress_user : NULL};
-    photon_record *records = NULL;
-    size_t count = 0;
+    int threads = opt ? opt->threads : 0;
+    photon_phase_share share;
     trace_counters c;
-    st = phase_fire(&a, &records, &count, &c, err);
+    st =
+        phase_fire_range(scene, acc, &rq, &table, &air, threads, lo, hi, opt ? opt->progress : NULL,
+                         opt ? opt->progress_user : NULL, &share, &c, err);
     emission_table_fini(&table);
     double air_power = air.band_power_w_per_hz;
     air_emission_fini(&air);
-    if (st != THZ_OK)
+    if (st == THZ_OK && team) { /* the counters again, summed in one process's order */
+        st = team->gather(team->impl, &share, err);
+        memset(&c, 0, sizeof c);
+        for (size_t k = 0; st == THZ_OK && k < share.n_chunks; k++)
+            trace_counters_add(&c, &share.chunks[k]);
+    }
+    size_t count = share.count;
+    photon_record *records = share.records;
+    share.records = NULL;
+    photon_phase_share_fini(&share);
+    if (st != THZ_OK) {
+        free(records);
         return st;
+    }
     double t2 = omp_get_wtime();
 
     /* photon_map_create takes ownership of records, also on failure. */
-    st = photon_map_create(records, count, scene->n_objects, a.threads, out_map, err);
+    st = photon_map_create(records, count, scene->n_objects, threads, out_map, err);
     if (st != THZ_OK)
         return st;
     photon_map_set_reference_temperature_k(*out_map, t0_k);
@@ -283,11 +388,12 @@ thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc,
                          .table = &table,
                          .air = &air,
                          .channel = channel,
-                         .n_photons = pilot};
+                         .n_photons = pilot,
+                         .hi = pilot};
     photon_record *records = NULL;
     size_t count = 0;
     trace_counters c;
-    st = phase_fire(&a, &records, &count, &c, err);
+    st = phase_fire(&a, &records, &count, &c, NULL, err);
     emission_table_fini(&table);
     air_emission_fini(&air);
     free(records);

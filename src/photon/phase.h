@@ -6,7 +6,8 @@
  * of PHASE_BATCH, each batch in chunks of PHASE_CHUNK photons spread over OpenMP threads; each
  * chunk's records and counters are merged after the batch in chunk order. The map's records
  * (ordered by photon index before photon_map_create sorts them) and the statistics (summed in that
- * fixed order) are therefore bit-identical for any thread count.
+ * fixed order) are therefore bit-identical for any thread count, and, with a team of
+ * processes (below), for any number of processes.
  */
 #ifndef THZ_PHOTON_PHASE_H
 #define THZ_PHOTON_PHASE_H
@@ -18,6 +19,7 @@
 #include "core/error.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
+#include "photon/trace.h"
 #include "scene/scene.h"
 
 #define PHASE_BATCH 65536u
@@ -34,6 +36,8 @@ typedef struct photon_phase_options {
      * (their random streams and batches), so that maps fired with disjoint ranges are
      * independent and merge into one of more photons (photon_map_merge). 0 by default. */
     uint64_t first_photon;
+    /* The processes sharing the phase (NULL: this one alone); see photon_phase_team. */
+    const struct photon_phase_team *team;
     thz_progress_fn progress;
     void *progress_user;
 } photon_phase_options;
@@ -45,6 +49,53 @@ typedef struct photon_phase_options {
 thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t channel,
                             const photon_phase_options *opt, photon_map **out_map,
                             photon_stats *stats, thz_error *err);
+
+/* ---- a phase shared by processes (MPI: src/mpi/) ----------------------------------------
+ * Member m of n fires the contiguous batches photon_phase_share_range gives it, each photon
+ * with the power of the whole phase's K (not of its share), and the lead (member 0) gathers
+ * the shares in member order. The records in that order are the photon-index order, and the
+ * counters of every chunk, summed in that order, are the sums one process makes: the lead's
+ * map and statistics are bit-identical to one process's. */
+
+/* What the lead asks every member to fire: photons first_photon + [0, K) of a channel. */
+typedef struct photon_phase_request {
+    uint64_t channel;
+    uint64_t photons; /* K of the whole phase */
+    uint64_t first_photon;
+    uint64_t seed; /* the scene's, checked by the members (same scene on every process) */
+    double reference_temperature_k;
+} photon_phase_request;
+
+/* One member's share: its records in photon-index order and the counters of each of its
+ * chunks (PHASE_CHUNK photons; the last of the phase may be shorter), in order. */
+typedef struct photon_phase_share {
+    photon_record *records;
+    size_t count;
+    trace_counters *chunks;
+    size_t n_chunks;
+} photon_phase_share;
+
+void photon_phase_share_fini(photon_phase_share *s);
+
+/* Photons [*lo, *hi) of K (counted from the request's first photon) that member m of n
+ * fires: whole batches, the first B mod n members one batch more (B = batches of K). */
+void photon_phase_share_range(uint64_t k, size_t member, size_t members, uint64_t *lo,
+                              uint64_t *hi);
+
+/* Fires member `member` of `members`'s share of rq (threads as photon_phase_options). */
+thz_status photon_phase_fire_share(const thz_scene *scene, const accel *acc,
+                                   const photon_phase_request *rq, int threads, size_t member,
+                                   size_t members, photon_phase_share *out, thz_error *err);
+
+/* How the lead reaches the other members; implemented over MPI by src/mpi/. */
+typedef struct photon_phase_team {
+    size_t members; /* processes, the lead included */
+    /* Before the lead fires its share: every other member starts on rq. */
+    thz_status (*start)(void *impl, const photon_phase_request *rq, thz_error *err);
+    /* After: the other members' shares, in member order, appended to *share. */
+    thz_status (*gather)(void *impl, photon_phase_share *share, thz_error *err);
+    void *impl;
+} photon_phase_team;
 
 /* Estimated bytes of channel `channel`'s photon records for a map of reference
  * temperature t0_k (a deviation map stores a different number of hits per photon: 1.78

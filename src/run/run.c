@@ -431,6 +431,7 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
         photon_phase_options po = {.threads = opt->threads,
                                    .reference_temperature_k = run_photon_t0_k(scene, c),
                                    .first_photon = (uint64_t)n * k,
+                                   .team = opt->team,
                                    .progress = opt->progress,
                                    .progress_user = opt->progress_user};
         photon_stats ps;
@@ -539,6 +540,7 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
         if (photons) {
             photon_phase_options po = {.threads = opt->threads,
                                        .reference_temperature_k = run_photon_t0_k(scene, c),
+                                       .team = opt->team,
                                        .progress = opt->progress,
                                        .progress_user = opt->progress_user};
             double t0 = thz_now_s();

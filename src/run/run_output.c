@@ -10,6 +10,7 @@
 #include "io/output.h"
 #include "io/photon_map_file.h"
 #include "io/ply.h"
+#include "photon/phase.h"
 #include "run/run.h"
 
 /* What summary.json says of the run beyond the scene. */
@@ -21,6 +22,7 @@ static run_summary run_summary_of(const run_state *rs)
         .seed = rs->seed,
         .photons_per_channel = rs->photons_per_channel,
         .threads = rs->opt->threads > 0 ? rs->opt->threads : omp_get_max_threads(),
+        .mpi_ranks = rs->opt->team ? (int)rs->opt->team->members : 1,
         /* render: the statistics of the photon phase that made the map it read */
         .channel_stats =
             render_integrator_needs_photons(rs->scene->render.integrator) ? rs->stats : NULL,

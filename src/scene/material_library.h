@@ -21,7 +21,7 @@ typedef struct material_library_entry {
     char *basis;       /* "measured", "model", "fit" or "assumed" (library.json) */
     char *source;      /* the citation */
     char *note;        /* "" when none */
-    bool has_range;    /* valid_thz given: the range the source states */
+    bool has_range;    /* valid_thz given: the range the entry holds for (library.json) */
     double lo_hz, hi_hz;
     bool has_color;
     double color[3];

@@ -2,11 +2,48 @@
  * source and a model, water's index at 1 THz is the Liebe 1991 model's (computed
  * independently with complex arithmetic), the normal reflectance and attenuation follow
  * from n and k, an ITU-R P.2040 entry reports its rows, and an unknown name fails with
- * THZ_ERR_INPUT naming the known ones. */
+ * THZ_ERR_INPUT naming the known ones; a scene's materials report their reflection lobe. */
 #include <complex.h>
 #include <math.h>
 
 #include "api_test.h"
+
+/* thz_scene_material reports each material's `reflection` and Ward's slopes as given. */
+static void check_scene_reflection(void)
+{
+    static const char *json =
+        "{\"format\": \"thzmap-scene/1\", \"channels\": [{\"frequency_thz\": 0.5, "
+        "\"relative_width\": 0.01}], \"materials\": {"
+        "\"matte\": {\"reflectivity\": 0.1}, "
+        "\"mirror\": {\"library\": \"aluminium\", \"reflection\": \"specular\"}, "
+        "\"gloss\": {\"refractive_index\": [1.6, 0.02], \"reflection\": "
+        "{\"model\": \"ward\", \"alpha_x\": 0.15, \"alpha_y\": 0.4}}}, "
+        "\"objects\": [{\"name\": \"o\", \"type\": \"solid\", \"material\": \"gloss\", "
+        "\"temperature_k\": 300, \"shape\": {\"type\": \"box\", \"size_m\": [1, 1, 1]}}], "
+        "\"sensors\": [{\"name\": \"c\", \"position_m\": [0, -5, 0], \"look_at_m\": [0, 0, 0], "
+        "\"fov_deg\": 40, \"resolution\": [8, 8]}]}";
+    thz_error err = {0};
+    thz_scene *scene = NULL;
+    if (thz_scene_load_string(json, NULL, "reflection.json", &scene, &err) != THZ_OK) {
+        CHECK(0, "scene refused: %s", err.message);
+        return;
+    }
+    static const struct {
+        const char *name, *reflection;
+        double ax, ay;
+    } want[] = {
+        {"matte", "diffuse", 0, 0}, {"mirror", "specular", 0, 0}, {"gloss", "ward", 0.15, 0.4}};
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) {
+        thz_material_info m;
+        CHECK(thz_scene_material(scene, i, &m) == THZ_OK, "material %zu", i);
+        CHECK(m.name && strcmp(m.name, want[i].name) == 0, "material %zu is %s", i, m.name);
+        CHECK(m.reflection && strcmp(m.reflection, want[i].reflection) == 0, "%s: reflection %s",
+              want[i].name, m.reflection ? m.reflection : "(null)");
+        CHECK(m.ward_alpha_x == want[i].ax && m.ward_alpha_y == want[i].ay, "%s: alpha %g, %g",
+              want[i].name, m.ward_alpha_x, m.ward_alpha_y);
+    }
+    thz_scene_destroy(scene);
+}
 
 int main(int argc, char **argv)
 {
@@ -58,5 +95,6 @@ int main(int argc, char **argv)
     CHECK(thz_library_find(lib, "unobtainium", &none, &err) == THZ_ERR_INPUT, "unknown name");
     CHECK(strstr(err.message, "unobtainium") && strstr(err.message, "water"), "%s", err.message);
     thz_library_destroy(lib);
+    check_scene_reflection();
     return test_failures ? 1 : 0;
 }

@@ -16,7 +16,8 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 PY=/usr/bin/python3
 
 "$THZ" bands --help > "$TMP/help" || fail "--help exit status $?"
-for o in --count --from-thz --to-thz --step-ghz --targets --netd-k --humidity-range; do
+for o in --count --from-thz --to-thz --step-ghz --targets --netd-k --humidity-range --widths \
+    --thickness-range --angle-range-deg; do
     grep -q -- "$o" "$TMP/help" || fail "--help does not describe $o"
 done
 
@@ -124,6 +125,81 @@ assert "radiometer" in n["radiometer"]["source"] and all(x > 0 for x in r), n["r
 # T_rec dominates: NETD ~ (T + T_rec) / sqrt(B_n tau), B_n proportional to the frequency
 assert abs(r[0] / r[4] / math.sqrt(5.0) - 1.0) < 0.02, r
 assert n["given"]["netd_k"] == [0.7] * 5 and n["given"]["source"] == "--netd-k", n["given"]
+# the radiometer's NETD in each class's covariance is at the class's own Tb:
+# NETD ~ Tb + T_rec (T_rec = 2000 K), so the plates at 310 K read more noise than the room
+cl = json.load(open(f"{sys.argv[1]}/n-radiometer/bands.json"))["classes"]
+room, plate = cl[0], cl[1]
+for c in range(5):
+    ratio = plate["netd_k"][c] / room["netd_k"][c]
+    expect = (plate["mean_tb_k"][c] + 2000) / (room["mean_tb_k"][c] + 2000)
+    assert abs(ratio / expect - 1) < 1e-9 and abs(ratio - 1) > 1e-3, (c, ratio, expect)
+given = json.load(open(f"{sys.argv[1]}/n-given/bands.json"))["classes"]
+assert all(k["netd_k"] == [0.7] * 5 for k in given), given
+PYEOF
+
+# widths searched: every centre with a narrow (1 %) and a broad (30 %) width at one
+# NETD; the 80 GHz-wide features are diluted in a 120-240 GHz-wide channel, so the
+# narrow width is chosen at each feature and no centre is chosen twice
+"$THZ" bands "$IN/features.json" -o "$TMP/wd" --count 2 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 50 --paths 4 -q --widths 0.3,0.01 || fail "--widths run exit status $?"
+$PY - "$TMP/wd/bands.json" <<'PYEOF' || fail "widths: $(head -c 600 "$TMP/wd/bands.json")"
+import json, sys
+d = json.load(open(sys.argv[1]))
+sel, wid = d["selected_thz"], d["selected_relative_width"]
+assert sel == sorted(sel) and len(set(sel)) == 2, sel
+for feature in (0.40, 0.80):
+    assert any(abs(f - feature) <= 0.05 + 1e-9 for f in sel), f"no channel near {feature}: {sel}"
+assert wid == [0.01, 0.01], wid
+c = d["candidates"]
+assert c["relative_widths"] == [0.01, 0.3] and c["relative_width"] is None, c
+assert len(c["frequency_thz"]) == 34 and c["candidate_relative_width"][:2] == [0.01, 0.3], c
+for e in d["per_k"]:
+    assert len(e["selected_relative_width"]) == e["k"] and len(set(e["selected_thz"])) == e["k"], e
+# the widths are rendered: plate A's Tb at its 0.40 THz feature is higher in the narrow
+# channel than in the broad one, which averages the feature with its flanks
+i = c["frequency_thz"].index(0.4)
+a = next(k for k in d["classes"] if k["name"] == "A")["mean_tb_k"]
+assert a[i] > a[i + 1] + 1.0, (a[i], a[i + 1])
+PYEOF
+
+# nuisances of the cover's thickness and of the viewing angle: plate A (310 K) behind a
+# 0.5 mm shell at 280 K (alpha t = 1), whose pixels the truth names "cover"; varying the thickness by
+# +-50 % spreads that class and hardly B's (which nothing covers); turning the sensor by
+# 10 degrees spreads the classes too
+$PY - "$IN/features.json" "$TMP" <<'PYEOF' || fail "covered scene"
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["materials"]["cloth"] = {"reflectivity": 0.05, "attenuation_per_m": 2000}
+d["objects"].append({"name": "cover", "type": "shell", "thickness_m": 0.0005,
+                     "material": "cloth", "temperature_k": 280,
+                     "shape": {"type": "rectangle", "size_m": [0.34, 0.64]},
+                     "transform": {"rotate_deg": [90, 0, 0], "translate_m": [-0.35, 0.45, 0]}})
+json.dump(d, open(sys.argv[2] + "/covered.json", "w"))
+PYEOF
+NUIS="--count 1 --from-thz 0.2 --to-thz 1.0 --step-ghz 200 --paths 2 -q --targets cover,B,C
+      --temperature-range-k 0 --ambient-range-k 0 --humidity-range 0"
+# shellcheck disable=SC2086
+"$THZ" bands "$TMP/covered.json" -o "$TMP/c0" $NUIS || fail "covered scene exit status $?"
+# shellcheck disable=SC2086
+"$THZ" bands "$TMP/covered.json" -o "$TMP/ct" $NUIS --thickness-range 0.5 \
+    || fail "--thickness-range exit status $?"
+# shellcheck disable=SC2086
+"$THZ" bands "$TMP/covered.json" -o "$TMP/ca" $NUIS --angle-range-deg 10 \
+    || fail "--angle-range-deg exit status $?"
+$PY - "$TMP" <<'PYEOF' || fail "thickness and angle nuisances"
+import json, sys
+r = {k: json.load(open(f"{sys.argv[1]}/{k}/bands.json")) for k in ("c0", "ct", "ca")}
+sd = {k: {c["name"]: c["nuisance_sd_k"] for c in d["classes"]} for k, d in r.items()}
+assert r["c0"]["renders"] == 1 and all(x == 0 for v in sd["c0"].values() for x in v), sd["c0"]
+n = r["ct"]["nuisances"]
+# the nominal render, and a coarse nominal and the variant (1 sample per pixel, a
+# quarter of the paths)
+assert r["ct"]["renders"] == 3 and n["thickness_varied"] and n["thickness_range"] == 0.5, n
+assert all(c > 0.3 and c > 10 * b for c, b in zip(sd["ct"]["cover"], sd["ct"]["B"])), sd["ct"]
+n = r["ca"]["nuisances"]
+assert n["render_paths_per_sample"] == 1 and n["render_oversampling"] == 1, n
+assert r["ca"]["renders"] == 3 and n["angle_varied"] and not n["thickness_varied"], n
+assert max(max(v) for v in sd["ca"].values()) > 0.05, sd["ca"]
 PYEOF
 
 # bad input: exit status 2 and a message naming the problem
@@ -143,5 +219,10 @@ grep -q "nope" "$TMP/err" || fail "unknown target not named: $(cat "$TMP/err")"
 expect2 "missing scene" "$TMP/none.json" -o "$TMP/x" --count 1
 expect2 "count above candidates" "$IN/features.json" -o "$TMP/x" --count 3 --from-thz 0.5 \
     --to-thz 0.52 --step-ghz 20
+expect2 "width above 0.5" "$IN/features.json" -o "$TMP/x" --count 1 --widths 0.01,0.6
+expect2 "width twice" "$IN/features.json" -o "$TMP/x" --count 1 --widths 0.01,0.01
+grep -q "twice" "$TMP/err" || fail "a repeated width not named: $(cat "$TMP/err")"
+expect2 "angle above 90" "$IN/features.json" -o "$TMP/x" --count 1 --angle-range-deg 91
+expect2 "thickness range 1" "$IN/features.json" -o "$TMP/x" --count 1 --thickness-range 1
 [ -e "$TMP/x" ] && fail "a failed run left $TMP/x"
 echo ok

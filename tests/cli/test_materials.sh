@@ -62,6 +62,7 @@ PY
 grep -q '^source: H. J. Liebe' "$tmp/water" || fail "water: no source line"
 grep -q 'alpha (1/m)' "$tmp/water" || fail "water: the attenuation column has no unit"
 grep -q '^stated validity: 0.001 to 1 THz' "$tmp/water" || fail "water: no stated range"
+grep -q '^reflection: not part of the entry' "$tmp/water" || fail "water: no reflection line"
 
 "$thzmap" materials concrete >"$tmp/concrete" || fail "materials concrete: exit $?"
 grep -q '^data: 0.001 to 0.1 THz, 0.11 to 0.33 THz' "$tmp/concrete" ||

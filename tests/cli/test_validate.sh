@@ -70,6 +70,15 @@ status=$?
 expect_line "$tmp/out" 'pyramid: solid, material metal, 6 triangles, area 1\.009 m²'
 expect_line "$tmp/out" '^  0\.900 THz +[0-9.]+e-[0-9]+ W/Hz'
 
+# --- reflection lobes: each material's `reflection`, Ward's slopes as given ------------------
+"$thzmap" validate "$repo/examples/outdoor-concealed/scene.json" >"$tmp/out" 2>"$tmp/err" ||
+    fail "outdoor-concealed: exit $?: $(cat "$tmp/err")"
+expect_line "$tmp/out" '^  object: .*; reflection ward \(alpha_x 0\.1, alpha_y 0\.3\)$'
+expect_line "$tmp/out" '^  skin: .*; reflection diffuse$'
+"$thzmap" validate "$repo/examples/mirror-plate/scene.json" >"$tmp/out" 2>"$tmp/err" ||
+    fail "mirror-plate: exit $?: $(cat "$tmp/err")"
+expect_line "$tmp/out" '^  metal: .*; reflection specular$'
+
 # --- warnings ---------------------------------------------------------------------------
 "$thzmap" validate "$repo/tests/inputs/scenes/warnings.json" >"$tmp/out" 2>"$tmp/err"
 status=$?

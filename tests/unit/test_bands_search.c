@@ -1,8 +1,9 @@
 /* Band selection's criterion and search (analysis/bands_search.c): the Bhattacharyya
  * distance of two one-channel classes against its closed form; on synthetic classes
  * that differ only at known candidates, exhaustive search and SFFS both find them; the
- * best score never falls as K grows. */
+ * best score never falls as K grows; with widths searched no set holds a centre twice. */
 #include <setjmp.h>
+#include <stdbool.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -91,6 +92,44 @@ static void test_sffs_finds_features(void **state)
     check_search(10, "sffs");
 }
 
+/* Widths searched: candidates 2g and 2g + 1 are one centre g at two widths. Class 1's
+ * and 3's feature is at both candidates 4 and 5 (centre 2), with independent noise, so
+ * that a set with both beats any other without the one-width-per-centre rule; with it,
+ * no set holds a centre twice, and K above the centres is refused. */
+static void test_one_width_per_centre(void **state)
+{
+    (void)state;
+    make_classes();
+    for (size_t k = 0; k < NC; k++)
+        for (size_t c = 0; c < N; c++)
+            for (size_t d = 0; d < N; d++)
+                cov[k * N * N + c * N + d] = c == d ? 0.25 : 0.0;
+    for (size_t k = 1; k < NC; k += 2)
+        mean[k * N + 4] += 3.0;
+    size_t group[N];
+    for (size_t c = 0; c < N; c++)
+        group[c] = c / 2;
+    bands_classes cl = {.n_candidates = N, .n_classes = NC, .mean = mean, .cov = cov};
+    bands_search_result r;
+    thz_error err = {0};
+    for (int grouped = 0; grouped < 2; grouped++)
+        for (uint64_t limit = 10; limit <= 1000000; limit *= 100000) {
+            cl.group = grouped ? group : NULL;
+            assert_int_equal(bands_search(&cl, 3, limit, &r, &err), THZ_OK);
+            const size_t *three = r.sets + 2 * 3;
+            bool both = three[0] == 4 && three[1] == 5;
+            if (!grouped) /* without the rule the best set repeats centre 2 */
+                assert_true(both);
+            for (size_t k = 1; grouped && k <= 3; k++)
+                for (size_t i = 1; i < k; i++)
+                    assert_true(group[r.sets[(k - 1) * 3 + i]] !=
+                                group[r.sets[(k - 1) * 3 + i - 1]]);
+            bands_search_result_fini(&r);
+        }
+    cl.group = group;
+    assert_int_equal(bands_search(&cl, N / 2 + 1, 100, &r, &err), THZ_ERR_INPUT);
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -109,6 +148,7 @@ int main(void)
         cmocka_unit_test(test_closed_form),
         cmocka_unit_test(test_exhaustive_finds_features),
         cmocka_unit_test(test_sffs_finds_features),
+        cmocka_unit_test(test_one_width_per_centre),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

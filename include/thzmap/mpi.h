@@ -1,0 +1,45 @@
+/* Runs shared by MPI processes (docs/mpi.md), for programs launched by mpirun or srun.
+ *
+ * The library never initialises, finalises or aborts MPI: the program calls
+ * MPI_Init_thread (MPI_THREAD_FUNNELED is enough: only the thread that calls these
+ * functions and the runs uses MPI), destroys its contexts, then calls MPI_Finalize; when a
+ * call fails on any rank, the program ends the job (MPI_Abort), since the other ranks may
+ * be waiting for it. Every rank loads the same scene with the same run settings.
+ *
+ * Rank 0 calls thz_context_set_mpi and then thz_simulate as one process would: each photon
+ * phase is split by batches of photons across the ranks and gathered in photon order, so
+ * that rank 0's run (images, photon maps, statistics) is bit-identical to one process's
+ * with the same seed. The other ranks call thz_mpi_serve, which returns when rank 0
+ * destroys its context. Only rank 0 renders and writes.
+ */
+#ifndef THZMAP_MPI_H
+#define THZMAP_MPI_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* 1 when this library was built with MPI support, else 0. */
+THZ_API int thz_mpi_supported(void);
+
+/* Rank 0: simulate runs on ctx share their photon phases with the other ranks of
+ * MPI_COMM_WORLD. Collective with the other ranks' thz_mpi_serve. THZ_ERR_INPUT without
+ * MPI support. */
+THZ_API thz_status thz_context_set_mpi(thz_context *ctx, thz_error *err);
+
+/* Ranks other than 0: fire this rank's share of every photon phase rank 0 asks for (the
+ * scene with `settings`' overrides; ctx's thread count) until rank 0 destroys its
+ * context. A failure (a scene that differs from rank 0's, out of memory) returns it. */
+THZ_API thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene,
+                                 const thz_run_settings *settings, thz_error *err);
+
+/* Bytes this rank sent and received for shared photon phases through ctx. */
+THZ_API uint64_t thz_context_mpi_bytes(const thz_context *ctx);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,121 @@
+/* MPI runs through the public API (include/thzmap/mpi.h): the context's team of ranks.
+ * Without MPI support (CMake found no MPI) the functions say so and do nothing else. */
+#include "api/api.h"
+
+#ifdef THZ_HAVE_MPI
+#include "accel/accel.h"
+#include "mpi/mpi_team.h"
+#endif
+
+int thz_mpi_supported(void)
+{
+#ifdef THZ_HAVE_MPI
+    return 1;
+#else
+    return 0;
+#endif
+}
+
+#ifdef THZ_HAVE_MPI
+
+thz_status thz_context_set_mpi(thz_context *ctx, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    if (!ctx)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_context_set_mpi: no context");
+    if (ctx->team)
+        return THZ_OK;
+    thz_status st = mpi_team_create(&ctx->team, err);
+    if (st == THZ_OK && mpi_team_rank(ctx->team) != 0) {
+        mpi_team_destroy(ctx->team);
+        ctx->team = NULL;
+        st = thz_error_set(err, THZ_ERR_INTERNAL,
+                           "thz_context_set_mpi is for rank 0; the other ranks call "
+                           "thz_mpi_serve");
+    }
+    return api_done(ctx, st, err);
+}
+
+thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene, const thz_run_settings *settings,
+                         thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    if (!scene)
+        return api_done(ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_mpi_serve: no scene"), err);
+    mpi_team *team = NULL;
+    accel *acc = NULL;
+    thz_scene eff;
+    thz_status st = api_effective_scene(scene, settings, &eff, err);
+    if (st == THZ_OK)
+        st = mpi_team_create(&team, err);
+    if (st == THZ_OK && mpi_team_rank(team) == 0)
+        st = thz_error_set(err, THZ_ERR_INTERNAL,
+                           "thz_mpi_serve is for ranks other than 0, which leads the run");
+    if (st == THZ_OK && render_integrator_needs_photons(eff.render.integrator))
+        st = accel_create(&eff, &acc, err);
+    if (st == THZ_OK)
+        st = mpi_team_serve(team, &eff, acc, ctx ? ctx->threads : 0, err);
+    if (ctx && st == THZ_OK)
+        ctx->mpi_bytes = mpi_team_bytes(team);
+    accel_destroy(acc);
+    if (st == THZ_OK) /* a failed rank leaves the team to MPI_Abort */
+        mpi_team_destroy(team);
+    return api_done(ctx, st, err);
+}
+
+uint64_t thz_context_mpi_bytes(const thz_context *ctx)
+{
+    if (!ctx)
+        return 0;
+    return ctx->team ? mpi_team_bytes(ctx->team) : ctx->mpi_bytes;
+}
+
+const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx)
+{
+    return ctx && ctx->team ? mpi_team_phase(ctx->team) : NULL;
+}
+
+void api_mpi_release(thz_context *ctx)
+{
+    mpi_team_destroy(ctx->team);
+    ctx->team = NULL;
+}
+
+#else
+
+thz_status thz_context_set_mpi(thz_context *ctx, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    return api_done(
+        ctx, thz_error_set(err, THZ_ERR_INPUT, "this thzmap was built without MPI support"), err);
+}
+
+thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene, const thz_run_settings *settings,
+                         thz_error *err)
+{
+    (void)scene;
+    (void)settings;
+    return thz_context_set_mpi(ctx, err);
+}
+
+uint64_t thz_context_mpi_bytes(const thz_context *ctx)
+{
+    (void)ctx;
+    return 0;
+}
+
+const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx)
+{
+    (void)ctx;
+    return NULL;
+}
+
+void api_mpi_release(thz_context *ctx)
+{
+    (void)ctx;
+}
+
+#endif

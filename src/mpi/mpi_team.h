@@ -1,0 +1,52 @@
+/* Processes sharing a run over MPI (docs/mpi.md): the one module that includes <mpi.h>,
+ * compiled only when CMake finds MPI.
+ *
+ * Rank 0 (the lead) runs simulate as one process would; its photon phases go through
+ * the team (photon/phase.h "a phase shared by processes"): the lead broadcasts each
+ * phase's request, every rank fires its share of the batches, and the lead gathers the
+ * shares in rank order. The other ranks (members) only serve requests: mpi_team_serve
+ * loops until the lead's mpi_team_destroy tells them to stop. Only the lead renders and
+ * writes. The caller initialises MPI (MPI_THREAD_FUNNELED: only the thread that created
+ * the team calls MPI) and finalises it after destroying the team; the library never
+ * aborts: a failed rank returns its error, and the program ends the job (MPI_Abort).
+ *
+ * Waiting ranks poll (MPI_Test, then sleep up to 5 ms) rather than spin, so that ranks
+ * oversubscribing a machine leave its cores to the ranks that work.
+ */
+#ifndef THZ_MPI_MPI_TEAM_H
+#define THZ_MPI_MPI_TEAM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "accel/accel.h"
+#include "core/error.h"
+#include "photon/phase.h"
+#include "scene/scene.h"
+
+typedef struct mpi_team mpi_team;
+
+/* Collective over MPI_COMM_WORLD (every rank calls it): the team of all its ranks, on a
+ * communicator of its own. */
+thz_status mpi_team_create(mpi_team **out, thz_error *err);
+
+/* The lead tells the members to stop (their mpi_team_serve returns THZ_OK); every rank
+ * frees its communicator. NULL does nothing. */
+void mpi_team_destroy(mpi_team *team);
+
+size_t mpi_team_rank(const mpi_team *team);
+size_t mpi_team_size(const mpi_team *team);
+
+/* The lead's side of shared photon phases (valid while the team lives). */
+const photon_phase_team *mpi_team_phase(const mpi_team *team);
+
+/* A member's side: fires its share of each request the lead broadcasts, from scene and
+ * acc (the same scene, with the same overrides, as the lead's), with `threads` OpenMP
+ * threads, and sends it to the lead; returns THZ_OK when the lead stops the team. */
+thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *acc, int threads,
+                          thz_error *err);
+
+/* Bytes this rank sent and received through the team so far. */
+uint64_t mpi_team_bytes(const mpi_team *team);
+
+#endif

@@ -1,0 +1,169 @@
+#!/usr/bin/env bash
+# MPI runs (docs/mpi.md): `mpirun -np N thzmap simulate` gives, byte for byte, the files of
+# one process with the same seed (summary.json aside: wall times, threads, mpi_ranks),
+# for 2 and 3 ranks of 1 thread and 2 ranks of 2 threads, photon-map and final-gather
+# (with the saved photon map), and photon passes (several shared phases in one run); only rank 0 writes; a failed or killed rank fails the
+# run with a message and a non-zero exit, never a hang, and leaves no OUTDIR.
+# Usage: bash test_mpi.sh THZMAP_BINARY REPO_DIR
+set -u
+THZMAP=$1
+REPO=$(cd "$2" && pwd)
+PY=/usr/bin/python3
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+command -v mpirun >/dev/null || { echo "FAIL: mpirun is missing (scripts/install-deps.sh installs openmpi-bin)"; exit 1; }
+# CI runs as root, which Open MPI refuses unless told; --oversubscribe: 3 ranks on 2 cores
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export OMPI_MCA_rmaps_base_oversubscribe=1
+mpi() { timeout 120 mpirun --oversubscribe -np "$@"; }
+step() { echo "test_mpi: $(date +%T) $*"; }
+
+# A small camera on plate-in-box; 140 000 photons are 3 batches of 65 536 (the last
+# short), so that 2 ranks fire 2 + 1 and 3 ranks 1 + 1 + 1.
+$PY - "$REPO/examples/plate-in-box/scene.json" "$work/scene.json" <<'PY'
+import json, os, sys
+s = json.load(open(sys.argv[1]))
+s["materials"]["table"]["file"] = os.path.join(os.path.dirname(sys.argv[1]), "materials/sample.csv")
+s["sensors"][0]["resolution"] = [24, 24]
+s["sensors"][0]["oversampling"] = 1
+s["photons"]["per_channel"] = 140000
+json.dump(s, open(sys.argv[2], "w"))
+PY
+scene=$work/scene.json
+
+# Every file of $1 equals the one of the same name in $2 (summary.json without what
+# depends on the host and the ranks); at least 15 files ($3 names the comparison).
+same_run() {
+    local n=0 f b
+    for f in "$1"/*; do
+        b=$(basename "$f")
+        n=$((n + 1))
+        if [ "$b" = summary.json ]; then
+            $PY - "$f" "$2/$b" <<'PY' || fail "$3: summary.json differs beyond times and ranks"
+import json, sys
+def strip(path):
+    d = json.load(open(path))
+    for k in ("timings_s", "threads", "mpi_ranks"):
+        d.pop(k)
+    for c in d["channels"]:
+        c.pop("photon_phase_s"); c.pop("render_s")
+    return d
+a, b = strip(sys.argv[1]), strip(sys.argv[2])
+if a != b:
+    for k in a:
+        if a[k] != b.get(k):
+            print("summary.json key", k, "differs")
+    sys.exit(1)
+PY
+        else
+            cmp -s "$f" "$2/$b" || fail "$3: $b differs"
+        fi
+    done
+    [ "$n" -ge 15 ] || fail "$3: only $n files compared"
+    [ "$(ls "$1" | wc -l)" = "$(ls "$2" | wc -l)" ] || fail "$3: not the same files"
+}
+ranks_of() { $PY -c 'import json,sys; print(json.load(open(sys.argv[1]))["mpi_ranks"])' "$1/summary.json"; }
+
+step "bit-identical"
+# --- bit-identical to one process ----------------------------------------------------
+"$THZMAP" simulate "$scene" -o "$work/pm1" --integrator photon-map --threads 1 --quiet ||
+    fail "one process, photon-map: exit $?"
+[ "$(ranks_of "$work/pm1")" = 1 ] || fail "one process: mpi_ranks is not 1"
+mpi 2 "$THZMAP" simulate "$scene" -o "$work/pm2" --integrator photon-map --threads 1 \
+    > "$work/pm2.out" 2>&1 || { fail "2 ranks, photon-map: exit $?"; cat "$work/pm2.out"; }
+same_run "$work/pm2" "$work/pm1" "2 ranks x 1 thread, photon-map"
+[ "$(ranks_of "$work/pm2")" = 2 ] || fail "2 ranks: mpi_ranks is not 2"
+grep -q "2 MPI ranks (.* MB gathered)" "$work/pm2.out" || fail "2 ranks: no closing line naming the ranks"
+mpi 2 "$THZMAP" simulate "$scene" -o "$work/pm22" --integrator photon-map --threads 2 --quiet ||
+    fail "2 ranks x 2 threads: exit $?"
+same_run "$work/pm22" "$work/pm1" "2 ranks x 2 threads, photon-map"
+
+"$THZMAP" simulate "$scene" -o "$work/fg1" --integrator final-gather --save-photon-map \
+    --threads 2 --quiet || fail "one process, final-gather: exit $?"
+mpi 3 "$THZMAP" simulate "$scene" -o "$work/fg3" --integrator final-gather --save-photon-map \
+    --threads 1 --quiet || fail "3 ranks, final-gather: exit $?"
+[ -f "$work/fg3/photon-map.thzpm" ] || fail "3 ranks: no photon-map.thzpm"
+same_run "$work/fg3" "$work/fg1" "3 ranks x 1 thread, final-gather and its photon map"
+
+# photon passes (photon-map with a noise target): one shared phase per pass, 70 000
+# photons each (p95 5.5 K after one pass, so a 5 K target takes two or more)
+"$THZMAP" simulate "$scene" -o "$work/pp1" --integrator photon-map --photons 70000 \
+    --target-noise-k 5 --threads 1 --quiet || fail "one process, photon passes: exit $?"
+mpi 2 "$THZMAP" simulate "$scene" -o "$work/pp2" --integrator photon-map --photons 70000 \
+    --target-noise-k 5 --threads 1 --quiet || fail "2 ranks, photon passes: exit $?"
+same_run "$work/pp2" "$work/pp1" "2 ranks, photon passes"
+$PY -c 'import json,sys; sys.exit(json.load(open(sys.argv[1]))["channels"][0]["render_passes"] < 2)' \
+    "$work/pp2/summary.json" || fail "photon passes: fewer than 2 passes (the test tests one phase)"
+
+step "only rank 0"
+# --- only rank 0 writes: nothing else beside the outputs -----------------------------
+extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3|pp1|pp2')
+[ -z "$extra" ] || fail "files beside the outputs: $extra"
+
+
+# --- failures --------------------------------------------------------------------------
+step "bad input"
+# bad input on every rank: one message, exit 2, no OUTDIR
+echo '{"format": "thzmap-scene/1", "channels": 3}' > "$work/bad.json"
+mpi 2 "$THZMAP" simulate "$work/bad.json" -o "$work/bad" > "$work/bad.out" 2>&1
+rc=$?
+[ $rc = 2 ] || fail "bad scene under mpirun: exit $rc, not 2"
+[ "$(grep -c 'bad.json' "$work/bad.out")" = 1 ] || { fail "bad scene: not one message"; cat "$work/bad.out"; }
+[ ! -e "$work/bad" ] || fail "bad scene: OUTDIR created"
+step "rank 1 loads"
+# rank 1 loads another scene (a different seed): it refuses rank 0's request, the job ends
+sed 's/"seed": 1/"seed": 2/' "$scene" > "$work/other.json"
+grep -q '"seed": 2' "$work/other.json" || fail "test set-up: no seed in the scene"
+timeout 120 mpirun --oversubscribe -np 1 "$THZMAP" simulate "$scene" -o "$work/mix" --quiet \
+    --integrator photon-map : -np 1 "$THZMAP" simulate "$work/other.json" -o "$work/mix" \
+    --quiet --integrator photon-map > "$work/mix.out" 2>&1
+rc=$?
+[ $rc != 0 ] && [ $rc != 124 ] || fail "rank 1 with another seed: exit $rc"
+grep -q "MPI rank 1.*seed 2" "$work/mix.out" || { fail "rank 1's refusal not said"; cat "$work/mix.out"; }
+[ ! -e "$work/mix" ] || fail "rank 1 with another seed: OUTDIR created"
+step "rank 1 cannot"
+# rank 1 cannot load its scene (missing on its node): rank 0 says so, exit non-zero
+timeout 120 mpirun --oversubscribe -np 1 "$THZMAP" simulate "$scene" -o "$work/miss" --quiet \
+    : -np 1 "$THZMAP" simulate "$work/missing.json" -o "$work/miss" --quiet > "$work/miss.out" 2>&1
+rc=$?
+[ $rc != 0 ] && [ $rc != 124 ] || fail "rank 1 without its scene: exit $rc"
+grep -q "MPI rank 1 could not load" "$work/miss.out" || { fail "rank 1's failure not said"; cat "$work/miss.out"; }
+[ ! -e "$work/miss" ] || fail "rank 1 without its scene: OUTDIR created"
+step "a killed"
+# a killed rank: the job ends non-zero within the timeout, no results
+mpi 2 "$THZMAP" simulate "$scene" -o "$work/kill" --photons 3000000 --threads 1 --quiet \
+    --integrator photon-map > "$work/kill.out" 2>&1 &
+job=$!
+victim=
+for _ in $(seq 100); do
+    sleep 0.1
+    for p in $(pgrep -f -- "-o $work/kill" 2>/dev/null); do
+        if [ "$(cat "/proc/$p/comm" 2>/dev/null)" = thzmap ] &&
+            tr '\0' '\n' < "/proc/$p/environ" 2>/dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=1'; then
+            victim=$p
+        fi
+    done
+    [ -n "$victim" ] && break
+done
+if [ -n "$victim" ]; then
+    sleep 0.5
+    kill -KILL "$victim"
+    wait $job
+    rc=$?
+    [ $rc != 0 ] && [ $rc != 124 ] || fail "killed rank 1: exit $rc"
+    [ ! -e "$work/kill" ] || fail "killed rank 1: results in OUTDIR"
+else
+    fail "test set-up: rank 1's process not found"
+    kill $job
+fi
+step "other commands"
+# other commands refuse several ranks
+mpi 2 "$THZMAP" validate "$scene" > "$work/val.out" 2>&1
+rc=$?
+[ $rc = 2 ] || fail "validate under mpirun: exit $rc, not 2"
+grep -q "only simulate does" "$work/val.out" || fail "validate under mpirun: no message"
+
+[ $fails = 0 ] && echo "test_mpi: all passed"
+exit $((fails > 0))

@@ -1,0 +1,150 @@
+"""thzmap.bands and thzmap.classify (python/thzmap/band_selection.py, classification.py): the same
+results as `thzmap bands` and `thzmap classify` on the analysis test scenes, their
+structures match the C headers, and bad arguments raise before any work."""
+import ctypes
+import json
+import math
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+from conftest import REPO
+
+import thzmap
+from thzmap import band_selection as bands_module
+from thzmap import classification as classify_module
+
+SCENES = os.path.join(REPO, "tests", "inputs", "analysis")
+FEATURES = os.path.join(SCENES, "features.json")
+# 5 centres, 2 widths, 2 paths per sample: a second or two
+GRID = dict(from_thz=0.2, to_thz=1.0, step_ghz=200, paths=2)
+
+
+def test_structures_match_the_headers(tmp_path):
+    structs = {**bands_module.STRUCTS, **classify_module.STRUCTS}
+    expect, lines = {}, ["#include <stddef.h>", "#include <stdio.h>",
+                         "#include <thzmap/thzmap.h>", "int main(void) {"]
+    for cname, struct in structs.items():
+        expect[f"sizeof {cname}"] = ctypes.sizeof(struct)
+        lines.append(f'    printf("sizeof {cname} %zu\\n", sizeof({cname}));')
+        for field, _ in struct._fields_:
+            expect[f"offsetof {cname}.{field}"] = getattr(struct, field).offset
+            lines.append(f'    printf("offsetof {cname}.{field} %zu\\n", '
+                         f'offsetof({cname}, {field}));')
+    lines += ["    return 0;", "}"]
+    (tmp_path / "abi.c").write_text("\n".join(lines) + "\n")
+    cc = os.environ.get("THZMAP_CC") or shutil.which("cc")
+    if not cc:
+        pytest.fail("no C compiler (set THZMAP_CC)")
+    subprocess.run([cc, "-std=c17", "-I", os.path.join(REPO, "include"),
+                    str(tmp_path / "abi.c"), "-o", str(tmp_path / "abi")], check=True)
+    out = subprocess.run([str(tmp_path / "abi")], check=True, capture_output=True, text=True)
+    got = {k: int(v) for k, v in (line.rsplit(" ", 1) for line in out.stdout.splitlines())}
+    assert got == expect
+
+
+def test_bands_equals_the_command(tmp_path, thzmap_binary):
+    sel = thzmap.bands(FEATURES, 2, widths=[0.3, 0.01], netd_k=0.5, threads=1, **GRID)
+    subprocess.run([thzmap_binary, "bands", FEATURES, "-o", str(tmp_path / "cli"), "--count",
+                    "2", "--from-thz", "0.2", "--to-thz", "1.0", "--step-ghz", "200",
+                    "--paths", "2", "--widths", "0.3,0.01", "--netd-k", "0.5", "-q"],
+                   check=True)
+    with open(tmp_path / "cli" / "bands.json") as f:
+        cli = json.load(f)
+    assert sel.selected_thz == cli["selected_thz"] == sorted(sel.selected_thz)
+    assert sel.selected_relative_width == cli["selected_relative_width"]
+    assert len(sel.selected_relative_width) == 2 and sel.count == 2
+    assert sel.score == pytest.approx(cli["score"], rel=1e-9)
+    assert sel.scores == pytest.approx([e["score"] for e in cli["per_k"]], rel=1e-9)
+    assert sel.n_candidates == 10 and sel.n_classes == 4 and sel.search == "exhaustive"
+    report, cli_report = dict(sel.report), dict(cli)
+    report.pop("seconds"), cli_report.pop("seconds")
+    assert report == cli_report
+    sel.save(tmp_path / "py")
+    assert {"bands.json", "bands-score.png", "bands-spectra.png"} <= \
+        set(os.listdir(tmp_path / "py"))
+    assert "BandSelection" in repr(sel)
+
+
+def test_bands_takes_a_loaded_scene_and_targets():
+    scene = thzmap.load_scene(FEATURES)
+    sel = thzmap.bands(scene, 1, targets=["A", "B"], seed=3, **GRID)
+    assert [c["name"] for c in sel.report["classes"]] == ["A", "B", "background"]
+    assert sel.report["seed"] == 3 and 0.0 <= sel.score <= 2.0
+
+
+def test_bands_errors(tmp_path):
+    for kwargs in (dict(count=0), dict(count=1, widths=[0.6]), dict(count=1, widths=[]),
+                   dict(count=1, angle_range_deg=91), dict(count=1, targets=[""]),
+                   dict(count=1, netd_k=-1), dict(count=True)):
+        with pytest.raises(thzmap.ArgumentError):
+            thzmap.bands(FEATURES, **kwargs)
+    with pytest.raises(thzmap.ArgumentError):
+        thzmap.bands(thzmap.scene_from_json(open(FEATURES).read()), 1)
+    with pytest.raises(thzmap.Error, match="nope"):
+        thzmap.bands(FEATURES, 1, targets=["A", "nope"], **GRID)
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"format": "thzmap-scene/1",\n "name": }\n')
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.bands(bad, 1, **GRID)
+    assert e.value.line == 2
+
+
+@pytest.fixture(scope="module")
+def distinct_run(tmp_path_factory):
+    scene = thzmap.load_scene(os.path.join(SCENES, "distinct.json"))
+    result = thzmap.simulate(scene, seed=1)
+    out = tmp_path_factory.mktemp("distinct") / "run"
+    result.save(out)
+    return result, out
+
+
+def test_classify_equals_the_command(distinct_run, tmp_path, thzmap_binary):
+    result, run_dir = distinct_run
+    c = thzmap.classify(run_dir, "cam", method="lda", netd_k=0.5, seed=2)
+    subprocess.run([thzmap_binary, "classify", str(run_dir), "--sensor", "cam", "-o",
+                    str(tmp_path / "cli"), "--method", "lda", "--netd-k", "0.5", "--seed", "2"],
+                   check=True, capture_output=True)
+    with open(tmp_path / "cli" / "classification.json") as f:
+        cli = json.load(f)
+    assert c.accuracy == pytest.approx(cli["accuracy"], rel=1e-12)
+    assert c.confusion.tolist() == cli["confusion"]
+    assert int(c.confusion.sum()) == c.pixels == cli["pixels"]
+    assert c.classes == [k["name"] for k in cli["classes"]]
+    image = result.image("cam")
+    assert c.class_map.shape == (image.rows, image.columns)
+    truth = image.object_id.astype(np.int32)
+    assert np.array_equal(c.class_map < 0, truth < 0)
+    # a Result is classified as the directory it saves
+    same = thzmap.classify(result, "cam", method="lda", netd_k=0.5, seed=2)
+    assert same.confusion.tolist() == c.confusion.tolist()
+    assert same.method == "lda" and same.sensor == "cam"
+    same.save(tmp_path / "py")
+    assert {"classification.json", "cam.class.hdr", "cam.class.img", "cam.class.png"} <= \
+        set(os.listdir(tmp_path / "py"))
+
+
+def test_classify_noise_free_is_exact_and_noise_lowers_accuracy(distinct_run):
+    _, run_dir = distinct_run
+    exact = thzmap.classify(run_dir, "cam", method="lda")
+    assert exact.accuracy == 1.0 and all(a == 1.0 for a in exact.class_accuracy)
+    assert all(not math.isnan(a) for a in exact.auc)
+    noisy = thzmap.classify(run_dir, "cam", method="lda", netd_k=8.0)
+    assert noisy.accuracy < exact.accuracy
+
+
+def test_classify_errors(distinct_run, tmp_path):
+    _, run_dir = distinct_run
+    assert "sam" in classify_module.methods()
+    for kwargs in (dict(method="nope"), dict(train_fraction=1.0), dict(seed=-1),
+                   dict(netd_k=float("nan"))):
+        with pytest.raises(thzmap.ArgumentError):
+            thzmap.classify(run_dir, "cam", **kwargs)
+    with pytest.raises(thzmap.ArgumentError):
+        thzmap.classify(run_dir, "")
+    with pytest.raises(thzmap.Error):
+        thzmap.classify(run_dir, "nope")
+    with pytest.raises(thzmap.Error):
+        thzmap.classify(tmp_path / "missing", "cam")
