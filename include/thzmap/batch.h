@@ -2,8 +2,9 @@
  * includes this).
  *
  * A thz_sequence is a loaded and checked "thzmap-sequence/1" file (scene-format.md,
- * "Sequences, sweeps and movies"): a scene, keyframes interpolated in time (linear;
- * rotations by quaternion slerp; held beyond the ends) and an optional sweep that runs
+ * "Sequences, sweeps and movies"): a scene and keyframes interpolated in time (linear;
+ * rotations by quaternion slerp; held beyond the ends), or a plain list of scene files
+ * (one frame each, as it is), and an optional sweep that runs
  * the whole sequence once per value. Its frames are numbered 0 .. count - 1 over all
  * sweep values (sweep-major). Each frame is a complete scene: its JSON text, or the
  * loaded scene, on request.
@@ -52,21 +53,28 @@ THZ_API thz_status thz_sequence_frame(const thz_sequence *seq, size_t i, thz_fra
 
 /* The frame's scene as JSON text (compact, keys sorted), written into buf like
  * snprintf: returns the length without the NUL (0 when i is out of range). Its relative
- * file paths are relative to the directory of the sequence's scene file. */
+ * file paths are relative to the directory of the frame's scene file. */
 THZ_API size_t thz_sequence_frame_json(const thz_sequence *seq, size_t i, char *buf, size_t size);
 
 /* Loads frame i's scene (*out owns it). */
 THZ_API thz_status thz_sequence_frame_scene(const thz_sequence *seq, size_t i, thz_scene **out,
                                             thz_error *err);
 
-/* Progress of a batch, before each frame and once at the end (frame == n_frames). */
+/* Progress of a batch: before each frame (stage "frame"), while it runs (stage "run",
+ * as often as the frame's run reports progress), before the movies ("movie") and once
+ * at the end ("done"; frame == n_frames for these two). */
 typedef struct thz_batch_progress {
-    size_t frame; /* index of the frame about to be run (n_frames: done) */
+    size_t frame; /* index of the frame about to be run or running (n_frames: done) */
     size_t n_frames;
     size_t computed;   /* frames computed so far by this call */
     size_t reused;     /* frames found finished in OUTDIR and skipped */
     double seconds;    /* wall time of this call so far, s */
-    const char *stage; /* "frame", "movie", "done" */
+    const char *stage; /* "frame", "run", "movie", "done" */
+    /* (added after the fields above, for callers built earlier) the share of the whole
+     * batch done, 0..1, never falling: (frames done + the share of the running frame)
+     * / n_frames; a frame's share counts its channels equally, photons (when it fires
+     * any) the first half of each and rendering the second. */
+    double fraction;
 } thz_batch_progress;
 /* Return non-zero to cancel (THZ_ERR_CANCELLED; finished frames stay). */
 typedef int (*thz_batch_progress_fn)(void *user, const thz_batch_progress *progress);
@@ -75,6 +83,11 @@ typedef struct thz_batch_options {
     thz_batch_progress_fn progress; /* may be NULL */
     void *progress_user;
     int no_movies; /* non-zero: frames and batch.json only */
+    /* May be NULL. Else the batch keeps there the output directory of the frame it is
+     * running (NULL between frames), so that a handler run at exit (a library such as
+     * libgomp may call exit() when it cannot allocate) can thz_output_destroy it and
+     * leave no staging directory or lock behind; the thzmap program does. */
+    thz_output **open_output;
 } thz_batch_options;
 
 /* What a batch did. */
@@ -85,8 +98,10 @@ typedef struct thz_batch_result {
 
 /* Runs the sequence into outdir (created if missing) with ctx's threads and callbacks
  * (a frame's run reports through ctx's progress callback; returning non-zero there
- * cancels too). One batch at a time per outdir (THZ_ERR_IO naming the other process).
- * opt and result may be NULL. */
+ * cancels too; the batch replaces ctx's callback while it runs and restores it). When
+ * the frames do not all have the same sensors and channels there are no movies:
+ * ctx's warning callback says why. One batch at a time per outdir (THZ_ERR_IO naming the other
+ * process). opt and result may be NULL. */
 THZ_API thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *outdir,
                                  const thz_batch_options *opt, thz_batch_result *result,
                                  thz_error *err);

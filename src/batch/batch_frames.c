@@ -25,9 +25,20 @@ void thz_sequence_destroy(thz_sequence *seq)
     free(seq->hash);
     free(seq->sweep_label);
     free(seq->path);
-    free(seq->scene_path);
-    free(seq->scene_dir);
+    for (size_t k = 0; k < seq->n_scenes; k++) {
+        if (seq->scene_paths)
+            free(seq->scene_paths[k]);
+        if (seq->scene_dirs)
+            free(seq->scene_dirs[k]);
+    }
+    free(seq->scene_paths);
+    free(seq->scene_dirs);
     free(seq);
+}
+
+size_t batch_frame_scene(const thz_sequence *seq, size_t f)
+{
+    return seq->scene_list ? f % seq->frames : 0;
 }
 
 size_t thz_sequence_frame_count(const thz_sequence *seq)
@@ -77,5 +88,7 @@ thz_status thz_sequence_frame_scene(const thz_sequence *seq, size_t i, thz_scene
     *out = NULL;
     if (!seq || i >= seq->n_frames || !seq->frame_json[i])
         return thz_error_set(err, THZ_ERR_INPUT, "thz_sequence_frame_scene: no frame %zu", i);
-    return thz_scene_load_string(seq->frame_json[i], seq->scene_dir, seq->scene_path, out, err);
+    size_t k = batch_frame_scene(seq, i);
+    return thz_scene_load_string(seq->frame_json[i], seq->scene_dirs[k], seq->scene_paths[k], out,
+                                 err);
 }

@@ -1,8 +1,9 @@
 /* Sequences and batches (include/thzmap/batch.h): what a loaded sequence holds, and
  * what the files of src/batch/ share. batch_sequence.c loads and checks a sequence and
- * builds every frame's scene text; batch_frames.c gives the frames out; batch_interp.c
- * interpolates; batch_run.c runs the frames and writes batch.json; batch_movie.c makes
- * the movies from the frames' cubes, through batch_encode.c (the only file that
+ * builds every frame's scene text, from the scene files batch_scenes.c loads;
+ * batch_frames.c gives the frames out; batch_interp.c interpolates; batch_hash.c hashes
+ * a frame's inputs; batch_run.c runs the frames and writes batch.json; batch_movie.c
+ * makes the movies from the frames' cubes, through batch_encode.c (the only file that
  * includes FFmpeg). Nothing here is public.
  */
 #ifndef THZ_BATCH_BATCH_INTERNAL_H
@@ -18,8 +19,10 @@
 
 struct thz_sequence {
     char *path;         /* the sequence file as given */
-    char *scene_path;   /* its scene, resolved against the sequence's directory */
-    char *scene_dir;    /* the scene's directory: relative paths in frame scenes */
+    size_t n_scenes;    /* scene files: 1 ("scene"), or the length of "scenes" */
+    int scene_list;     /* "scenes": frame i of each sweep value is scene i */
+    char **scene_paths; /* per scene file, resolved against the sequence's directory */
+    char **scene_dirs;  /* per scene file, its directory: relative paths in its frames */
     double fps;         /* frames per second */
     size_t frames;      /* per sweep value */
     size_t n_sweeps;    /* sweep values (1 without a sweep) */
@@ -31,6 +34,18 @@ struct thz_sequence {
     char **sweep_label; /* per sweep value: "atmosphere.relative_humidity = 0.5, ..." */
 };
 
+/* The scene file of frame f (its index into scene_paths and scene_dirs). */
+size_t batch_frame_scene(const thz_sequence *seq, size_t f);
+
+/* Reads the sequence's "scene" or "scenes" (root: the sequence document; errors name
+ * label, the sequence file, and the JSON path) into seq's scene_paths, scene_dirs,
+ * n_scenes and scene_list, and their documents into *docs (n_scenes; free with
+ * batch_scenes_free, also after a failure). Refuses both keys, neither, an empty list,
+ * and keyframes or frames with a list. */
+thz_status batch_scenes_load(const char *label, const json_t *root, const char *seq_dir,
+                             thz_sequence *seq, json_t ***docs, thz_error *err);
+void batch_scenes_free(json_t **docs, size_t n);
+
 /* The keyframe segment j (0 .. k-2) holding time_s and the weight u in [0, 1] of its
  * end (held beyond the ends: u = 0 before the first, 1 after the last). */
 void batch_segment(const double *t, size_t k, double time_s, size_t *j, double *u);
@@ -38,6 +53,11 @@ void batch_segment(const double *t, size_t k, double time_s, size_t *j, double *
 /* 64-bit FNV-1a of n bytes, continuing from h (start with BATCH_HASH_INIT). */
 #define BATCH_HASH_INIT UINT64_C(14695981039346656037)
 uint64_t batch_hash_bytes(uint64_t h, const void *data, size_t n);
+/* Continues h over the content of every file that doc (a frame's scene) names in its
+ * "file" and "*_file" keys, relative to scene_dir; cache maps a path to its hash (hex),
+ * so each file is read once. An unreadable file hashes as 0 (the scene loader reports
+ * it). */
+uint64_t batch_hash_files(json_t *cache, const char *scene_dir, const json_t *doc, uint64_t h);
 
 /* Reads band `channel` of an ENVI float32 cube of `columns * rows * channels` values
  * into out (columns * rows); THZ_ERR_IO naming the file when it is missing or short. */
@@ -48,9 +68,11 @@ thz_status batch_read_band(const char *path, uint32_t columns, uint32_t rows, si
  * outdir ([sweep-NN/]S.band-NN.mp4, each written to a temporary name and renamed), on
  * one colour scale per sensor and channel over all frames; appends their descriptions
  * to `movies` (a JSON array, batch.json's "movies"). Deterministic: the same frames give
- * the same bytes. */
+ * the same bytes. When the frames do not all have the same sensors (names and sizes)
+ * and channels (frequencies and widths), writes none and says why in skipped (else
+ * skipped[0] = '\0'). */
 thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_t *movies,
-                              thz_error *err);
+                              char *skipped, size_t skipped_size, thz_error *err);
 
 /* ---- batch_reuse.c: photons shared by frames that differ only in their sensors ---- */
 

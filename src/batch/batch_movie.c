@@ -2,7 +2,9 @@
  * of the brightness temperature, read back from the frames' S.brightness_temperature
  * cubes (so that a resumed batch, whose earlier frames are only on disk, makes the same
  * movies as an uninterrupted one). One colour scale per sensor and channel: the least
- * and greatest finite Tb over every frame of every sweep value.
+ * and greatest finite Tb over every frame of every sweep value. Movies are made only
+ * when every frame has frame 0's sensors and channels (a list of scenes or a sweep may
+ * change them): else none, and batch.json and a warning say why.
  */
 #include <math.h>
 #include <stdio.h>
@@ -116,38 +118,96 @@ static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, s
     return THZ_OK;
 }
 
-thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_t *movies,
-                              thz_error *err)
+/* Whether scene b has the sensors (names, sizes) and channels (centres, widths) of a;
+ * if not, why, in why. */
+static int batch_same_frame_shape(const thz_scene *a, const thz_scene *b, char *why, size_t size)
 {
+    size_t ns = thz_scene_sensor_count(a), nc = thz_scene_channel_count(a);
+    if (thz_scene_sensor_count(b) != ns || thz_scene_channel_count(b) != nc) {
+        snprintf(why, size, "it has %zu sensors and %zu channels, frame 0 %zu and %zu",
+                 thz_scene_sensor_count(b), thz_scene_channel_count(b), ns, nc);
+        return 0;
+    }
+    for (size_t k = 0; k < ns; k++) {
+        thz_sensor_info x, y;
+        thz_scene_sensor(a, k, &x);
+        thz_scene_sensor(b, k, &y);
+        if (strcmp(x.name, y.name) || x.columns != y.columns || x.rows != y.rows) {
+            snprintf(why, size,
+                     "its sensor %zu is \"%s\" of %u x %u pixels, frame 0's \"%s\" of %u x %u",
+                     k + 1, y.name, y.columns, y.rows, x.name, x.columns, x.rows);
+            return 0;
+        }
+    }
+    for (size_t c = 0; c < nc; c++) {
+        thz_channel_info x, y;
+        thz_scene_channel(a, c, &x);
+        thz_scene_channel(b, c, &y);
+        if (x.frequency_hz != y.frequency_hz || x.bandwidth_hz != y.bandwidth_hz) {
+            snprintf(why, size,
+                     "its channel %zu is at %g THz, frame 0's at %g THz (or their widths differ)",
+                     c + 1, y.frequency_thz, x.frequency_thz);
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Loads the first frame's scene of every sweep value into sw; checks that every frame
+ * has frame 0's sensors and channels (else says why in skipped and returns THZ_OK). */
+static thz_status batch_movie_sensors(const thz_sequence *seq, sweep_sensors *sw, char *skipped,
+                                      size_t skipped_size, thz_error *err)
+{
+    for (size_t f = 0; f < seq->n_frames; f++) {
+        size_t s = f / seq->frames;
+        thz_scene *scene = NULL;
+        thz_status st = thz_sequence_frame_scene(seq, f, &scene, err);
+        if (st != THZ_OK)
+            return st;
+        char why[400];
+        if (f > 0 && !batch_same_frame_shape(sw[0].scene, scene, why, sizeof why)) {
+            snprintf(skipped, skipped_size,
+                     "no movies: frame %s has other sensors or channels than frame %s (%s); "
+                     "a movie needs the same ones in every frame",
+                     seq->frame_dir[f], seq->frame_dir[0], why);
+            thz_scene_destroy(scene);
+            return THZ_OK;
+        }
+        if (f % seq->frames == 0)
+            sw[s].scene = scene;
+        else
+            thz_scene_destroy(scene);
+    }
+    for (size_t s = 0; s < seq->n_sweeps; s++) {
+        sw[s].n = thz_scene_sensor_count(sw[s].scene);
+        sw[s].n_channels = thz_scene_channel_count(sw[s].scene);
+        sw[s].info = thz_calloc(sw[s].n ? sw[s].n : 1, sizeof *sw[s].info);
+        if (!sw[s].info)
+            return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        for (size_t k = 0; k < sw[s].n; k++)
+            thz_scene_sensor(sw[s].scene, k, &sw[s].info[k]);
+    }
+    return THZ_OK;
+}
+
+thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_t *movies,
+                              char *skipped, size_t skipped_size, thz_error *err)
+{
+    skipped[0] = '\0';
     sweep_sensors *sw = thz_calloc(seq->n_sweeps, sizeof *sw);
     if (!sw)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-    thz_status st = THZ_OK;
+    float *band = NULL;
+    thz_status st = batch_movie_sensors(seq, sw, skipped, skipped_size, err);
+    if (st != THZ_OK || skipped[0])
+        goto cleanup;
     size_t max_pixels = 0;
-    for (size_t s = 0; st == THZ_OK && s < seq->n_sweeps; s++) {
-        st = thz_sequence_frame_scene(seq, s * seq->frames, &sw[s].scene, err);
-        if (st != THZ_OK)
-            break;
-        sw[s].n = thz_scene_sensor_count(sw[s].scene);
-        sw[s].n_channels = thz_scene_channel_count(sw[s].scene);
-        sw[s].info = thz_calloc(sw[s].n, sizeof *sw[s].info);
-        if (!sw[s].info) {
-            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-            break;
-        }
-        for (size_t k = 0; k < sw[s].n; k++) {
-            thz_scene_sensor(sw[s].scene, k, &sw[s].info[k]);
-            size_t px = (size_t)sw[s].info[k].columns * sw[s].info[k].rows;
-            max_pixels = px > max_pixels ? px : max_pixels;
-        }
-        if (sw[s].n != sw[0].n || sw[s].n_channels != sw[0].n_channels)
-            st = thz_error_set(err, THZ_ERR_INPUT,
-                               "%s: sweep value %zu changes the scene's sensors or channels "
-                               "(movies need the same ones in every sweep value)",
-                               seq->path, s);
+    for (size_t k = 0; st == THZ_OK && k < sw[0].n; k++) {
+        size_t px = (size_t)sw[0].info[k].columns * sw[0].info[k].rows;
+        max_pixels = px > max_pixels ? px : max_pixels;
     }
-    float *band = st == THZ_OK ? thz_malloc_array(max_pixels ? max_pixels : 1, sizeof *band) : NULL;
-    if (st == THZ_OK && !band)
+    band = thz_malloc_array(max_pixels ? max_pixels : 1, sizeof *band);
+    if (!band)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     size_t n_sensors = st == THZ_OK ? sw[0].n : 0, n_channels = st == THZ_OK ? sw[0].n_channels : 0;
     for (size_t k = 0; st == THZ_OK && k < n_sensors; k++)
@@ -171,6 +231,7 @@ thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_
             for (size_t s = 0; st == THZ_OK && s < seq->n_sweeps; s++)
                 st = batch_one_movie(seq, outdir, s, &sw[s].info[k], c, lo, hi, band, movies, err);
         }
+cleanup:
     free(band);
     for (size_t s = 0; s < seq->n_sweeps; s++) {
         free(sw[s].info);

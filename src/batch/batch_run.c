@@ -5,9 +5,11 @@
  * frame.json carries the frame's hash is finished and is not run again, which is all
  * that resuming a killed batch needs: a frame appears whole or not at all.
  */
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <jansson.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +17,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "api/api.h"
 #include "batch/batch_internal.h"
 #include "core/alloc.h"
 #include "core/error.h"
@@ -31,6 +34,13 @@ typedef struct batch_state {
     int *reused_photons; /* per frame computed by this call: rendered from base's */
     batch_photon_cache cache; /* the photons of the current base frame */
     json_t *movies;           /* the movies' descriptions (batch.json "movies") */
+    char movies_skipped[700]; /* why there are none ("" when there are) */
+    const thz_batch_options *opt;
+    thz_progress_fn run_progress; /* the caller's progress callback on ctx, restored after */
+    void *run_progress_user;
+    size_t frame;       /* the frame running */
+    double frame_share; /* the share of it done, 0..1, never falling */
+    int photons_seen;   /* it fires photons (then they are half of each channel) */
     double t0, seconds_frames, seconds_movies;
     size_t computed, reused;
     size_t fired, rerendered; /* photon phases run, frames rendered from kept photons */
@@ -87,6 +97,49 @@ static int batch_frame_done(const batch_state *b, size_t f)
     return done;
 }
 
+/* Whether dir holds what a killed output commit leaves beside the directory it commits
+ * (.thzmap-H-lock, .thzmap-H-stage-..., .thzmap-H-old-...; io/output_stage.c). */
+static int batch_has_leftovers(const char *dir)
+{
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    int found = 0;
+    while (d && !found && (e = readdir(d)) != NULL)
+        found = !strncmp(e->d_name, ".thzmap-", 8) && strcmp(e->d_name, ".thzmap-batch-lock");
+    if (d)
+        closedir(d);
+    return found;
+}
+
+/* A batch killed inside a frame's commit after the exchange (while the replaced frame's
+ * files were being deleted) leaves them and the lock beside a frame that is finished,
+ * which no later run opens again: opening each finished frame's output and closing it
+ * without a commit cleans them up (thz_output_open removes what a dead run left). Only
+ * in the directories (OUTDIR, sweep-NN/) that hold such names; best effort: a frame
+ * another process holds is left for later. */
+static void batch_clean_finished(const batch_state *b)
+{
+    const thz_sequence *seq = b->seq;
+    for (size_t s = 0; s < seq->n_sweeps; s++) {
+        char parent[THZ_PATH_MAX], dir[THZ_PATH_MAX];
+        if (seq->has_sweep)
+            snprintf(parent, sizeof parent, "%s/sweep-%02zu", b->outdir, s);
+        else
+            snprintf(parent, sizeof parent, "%s", b->outdir);
+        if (!batch_has_leftovers(parent))
+            continue;
+        for (size_t f = s * seq->frames; f < (s + 1) * seq->frames; f++) {
+            if (b->state[f] != FRAME_REUSED ||
+                snprintf(dir, sizeof dir, "%s/%s", b->outdir, seq->frame_dir[f]) >= (int)sizeof dir)
+                continue;
+            thz_output *output = NULL;
+            thz_error ignored;
+            if (thz_output_open(dir, &output, &ignored) == THZ_OK)
+                thz_output_destroy(output);
+        }
+    }
+}
+
 /* Writes text to outdir/name through a temporary file and a rename. */
 static thz_status batch_write_atomic(const char *outdir, const char *name, const char *text,
                                      thz_error *err)
@@ -128,6 +181,9 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
         json_object_set_new(e, "index", json_integer((json_int_t)(f % seq->frames)));
         json_object_set_new(e, "time_s", json_real((double)(f % seq->frames) / seq->fps));
         json_object_set_new(e, "dir", json_string(seq->frame_dir[f]));
+        if (seq->scene_list)
+            json_object_set_new(e, "scene",
+                                json_string(seq->scene_paths[batch_frame_scene(seq, f)]));
         json_object_set_new(e, "input_hash", json_string(hex));
         json_object_set_new(e, "status", json_string(batch_state_name(b->state[f])));
         if (b->state[f] == FRAME_COMPUTED || b->state[f] == FRAME_REUSED)
@@ -158,7 +214,15 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
     json_object_set_new(root, "format", json_string("thzmap-batch/1"));
     json_object_set_new(root, "thzmap_version", json_string(THZ_VERSION_STRING));
     json_object_set_new(root, "sequence", json_string(seq->path));
-    json_object_set_new(root, "scene", json_string(seq->scene_path));
+    if (seq->scene_list) {
+        json_t *scenes = json_array();
+        for (size_t k = 0; k < seq->n_scenes; k++)
+            json_array_append_new(scenes, json_string(seq->scene_paths[k]));
+        json_object_set_new(root, "scene", json_null());
+        json_object_set_new(root, "scenes", scenes);
+    } else {
+        json_object_set_new(root, "scene", json_string(seq->scene_paths[0]));
+    }
     json_object_set_new(root, "fps", json_real(seq->fps));
     json_object_set_new(root, "frames_per_sweep", json_integer((json_int_t)seq->frames));
     json_object_set_new(root, "n_frames", json_integer((json_int_t)seq->n_frames));
@@ -174,6 +238,8 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
         json_object_set(root, "movies", b->movies);
     else
         json_object_set_new(root, "movies", json_array());
+    json_object_set_new(root, "movies_skipped",
+                        b->movies_skipped[0] ? json_string(b->movies_skipped) : json_null());
     json_object_set_new(root, "timings_s", t);
     char *text = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
     json_decref(root);
@@ -200,7 +266,9 @@ static char *batch_frame_json(const thz_sequence *seq, size_t f, long reused_fro
     json_object_set_new(root, "input_hash", json_string(hex));
     json_object_set_new(root, "photons_reused_from_frame",
                         reused_from >= 0 ? json_integer(reused_from) : json_null());
-    json_object_set_new(root, "scene_dir", json_string(seq->scene_dir));
+    size_t k = batch_frame_scene(seq, f);
+    json_object_set_new(root, "scene_file", json_string(seq->scene_paths[k]));
+    json_object_set_new(root, "scene_dir", json_string(seq->scene_dirs[k]));
     json_object_set_new(root, "scene", json_loads(seq->frame_json[f], 0, NULL));
     char *text = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
     json_decref(root);
@@ -235,6 +303,9 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
     int keep = photons && f + 1 < seq->n_frames && b->base[f + 1] == f;
     if (st == THZ_OK)
         st = thz_output_open(dir, &output, err);
+    thz_output **guard = b->opt ? b->opt->open_output : NULL;
+    if (guard)
+        *guard = output;
     thz_run_settings settings;
     thz_run_settings_init(&settings);
     settings.keep_photons = keep;
@@ -261,6 +332,8 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
         b->fired += (size_t)fired;
         b->rerendered += (size_t)reuse;
     }
+    if (guard)
+        *guard = NULL;
     thz_output_destroy(output);
     thz_run_destroy(run);
     thz_scene_destroy(scene);
@@ -276,13 +349,40 @@ static int batch_report(const thz_batch_options *opt, const batch_state *b, size
 {
     if (!opt || !opt->progress)
         return 0;
+    size_t n = b->seq->n_frames;
+    double done = (double)(b->computed + b->reused) + (frame < n ? b->frame_share : 0.0);
     thz_batch_progress p = {.frame = frame,
-                            .n_frames = b->seq->n_frames,
+                            .n_frames = n,
                             .computed = b->computed,
                             .reused = b->reused,
                             .seconds = batch_now_s() - b->t0,
-                            .stage = stage};
+                            .stage = stage,
+                            .fraction = n ? fmin(done / (double)n, 1.0) : 1.0};
     return opt->progress(opt->progress_user, &p);
+}
+
+/* ctx's progress callback while a frame runs: passes the run's progress on to the
+ * caller's own callback, and reports the batch's (stage "run") with the share of the
+ * frame done: each channel an equal share, its photons (when the frame fires any) the
+ * first half of it and its rendering the rest. */
+static int batch_on_run_progress(void *user, const thz_progress *p)
+{
+    batch_state *b = user;
+    int stop = b->run_progress ? b->run_progress(b->run_progress_user, p) : 0;
+    double frac = p->total ? (double)p->done / (double)p->total : 0.0;
+    int photons = !strcmp(p->stage, "photons");
+    b->photons_seen |= photons;
+    double in_channel = photons                      ? 0.5 * frac
+                        : strcmp(p->stage, "render") ? 1.0 /* output */
+                        : b->photons_seen            ? 0.5 + 0.5 * frac
+                                                     : frac;
+    double share = p->n_channels ? ((double)p->channel + in_channel) / (double)p->n_channels : 0.0;
+    if (!strcmp(p->stage, "output"))
+        share = 1.0;
+    /* a stage that starts over (truth maps, another sensor) does not move it back */
+    if (share > b->frame_share)
+        b->frame_share = fmin(share, 1.0);
+    return stop | batch_report(b->opt, b, b->frame, "run");
 }
 
 /* Takes OUTDIR's batch lock (held until fd is closed or the process ends). */
@@ -321,7 +421,7 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
         return thz_error_set(err, THZ_ERR_INPUT, "thz_batch_run: no %s",
                              seq ? "output directory" : "sequence");
     batch_state b = {
-        .seq = seq, .outdir = outdir, .t0 = batch_now_s(), .cache = {.base = SIZE_MAX}};
+        .seq = seq, .outdir = outdir, .opt = opt, .t0 = batch_now_s(), .cache = {.base = SIZE_MAX}};
     b.state = thz_calloc(seq->n_frames, sizeof *b.state);
     b.seconds = thz_calloc(seq->n_frames, sizeof *b.seconds);
     b.base = thz_calloc(seq->n_frames, sizeof *b.base);
@@ -339,8 +439,16 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
             b.state[f] = FRAME_REUSED;
             b.reused++;
         }
+    if (st == THZ_OK && b.reused > 0)
+        batch_clean_finished(&b);
     if (st == THZ_OK)
         st = batch_write_json(&b, err);
+    if (ctx) { /* the frames' runs report through batch_on_run_progress */
+        b.run_progress = ctx->progress;
+        b.run_progress_user = ctx->progress_user;
+        ctx->progress = batch_on_run_progress;
+        ctx->progress_user = &b;
+    }
     for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++) {
         if (b.state[f] == FRAME_REUSED)
             continue;
@@ -349,7 +457,11 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
             break;
         }
         double t0 = batch_now_s();
+        b.frame = f;
+        b.frame_share = 0.0;
+        b.photons_seen = 0;
         st = batch_run_frame(ctx, &b, f, err);
+        b.frame_share = 0.0;
         b.seconds_frames += batch_now_s() - t0;
         if (st == THZ_OK) {
             b.state[f] = FRAME_COMPUTED;
@@ -365,14 +477,21 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
             st = werr.status;
         }
     }
+    if (ctx) {
+        ctx->progress = b.run_progress;
+        ctx->progress_user = b.run_progress_user;
+    }
     if (st == THZ_OK && !(opt && opt->no_movies)) {
         if (batch_report(opt, &b, seq->n_frames, "movie"))
             st = thz_error_set(err, THZ_ERR_CANCELLED, "cancelled");
         double t0 = batch_now_s();
         b.movies = st == THZ_OK ? json_array() : NULL;
         if (st == THZ_OK)
-            st = b.movies ? batch_movies_write(seq, outdir, b.movies, err)
+            st = b.movies ? batch_movies_write(seq, outdir, b.movies, b.movies_skipped,
+                                               sizeof b.movies_skipped, err)
                           : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        if (st == THZ_OK && b.movies_skipped[0] && ctx && ctx->warning)
+            ctx->warning(ctx->warning_user, b.movies_skipped);
         b.seconds_movies = batch_now_s() - t0;
         if (st != THZ_OK) {
             json_decref(b.movies);

@@ -1,8 +1,9 @@
 /* Loading a sequence file ("thzmap-sequence/1"): its keys checked with JSON paths, its
  * keyframes gathered into tracks (one per value a keyframe names, e.g.
  * objects.person.transform.translate_m), every frame's scene built as JSON text from
- * the scene file (tracks interpolated at the frame's time, then the sweep value set)
- * and checked by loading it, and the hash of each frame's inputs.
+ * its scene file (the one "scene", tracks interpolated at the frame's time; or the
+ * frame's file of the list "scenes"; then the sweep value set) and checked by loading
+ * it, and the hash of each frame's inputs.
  */
 #include <jansson.h>
 #include <math.h>
@@ -16,9 +17,8 @@
 #include "core/error.h"
 #include "core/file.h"
 
-/* A sequence or scene file larger than this is refused before it is read: they are
- * kilobytes (the scene loader allows more for inline tables, but a batch holds every
- * frame's scene text). */
+/* A sequence file larger than this is refused before it is read: they are kilobytes
+ * (batch_scenes.c has the same limit for scene files). */
 #define SEQ_MAX_FILE_BYTES (64u * 1024u * 1024u)
 
 enum { SEQ_MAX_FRAMES = 100000, SEQ_MAX_SWEEPS = 10000, SEQ_MAX_DEPTH = 8 };
@@ -37,8 +37,10 @@ typedef struct seq_track {
 } seq_track;
 
 typedef struct seq_build {
-    const char *label; /* the sequence file, in messages */
-    json_t *scene;     /* the scene document */
+    const char *label;    /* the sequence file, in messages */
+    json_t **scenes;      /* the scene documents (seq->n_scenes) */
+    json_t *scene;        /* the one that keyframe and sweep paths are checked against */
+    char scene_name[160]; /* that scene, in messages: "the scene", "scenes[2] (b.json)" */
     seq_track *tracks;
     size_t n_tracks;
     json_t *sweep;       /* the sweep object, or NULL */
@@ -137,7 +139,7 @@ static thz_status seq_check_path(const seq_build *b, const char *where, const ch
     if ((!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors")) && depth >= 2 &&
         !seq_named(b->scene, seg[0], seg[1])) {
         char what[300];
-        snprintf(what, sizeof what, "the scene has no %s named \"%s\"",
+        snprintf(what, sizeof what, "%s has no %s named \"%s\"", b->scene_name,
                  !strcmp(seg[0], "objects") ? "object" : "sensor", seg[1]);
         return seq_fail(b, where, "%s", what);
     }
@@ -302,7 +304,7 @@ static size_t seq_split(char *buf, const char **seg)
     return depth;
 }
 
-static thz_status seq_check_sweep(seq_build *b, size_t *n_sweeps)
+static thz_status seq_check_sweep_in(seq_build *b, size_t *n_sweeps)
 {
     *n_sweeps = 1;
     if (!b->sweep)
@@ -334,6 +336,25 @@ static thz_status seq_check_sweep(seq_build *b, size_t *n_sweeps)
             return seq_fail(b, "sweep", "%s", "more than 10000 combinations of values");
     }
     return THZ_OK;
+}
+
+/* Checks the sweep's keys against every scene file (with "scenes", each must have the
+ * objects and sensors it names). */
+static thz_status seq_check_sweep(seq_build *b, const thz_sequence *seq, size_t *n_sweeps)
+{
+    thz_status st = THZ_OK;
+    for (size_t k = 0; st == THZ_OK && k < seq->n_scenes; k++) {
+        b->scene = b->scenes[k];
+        if (seq->scene_list) {
+            const char *name = strrchr(seq->scene_paths[k], '/');
+            snprintf(b->scene_name, sizeof b->scene_name, "scenes[%zu] (%s)", k,
+                     name ? name + 1 : seq->scene_paths[k]);
+        }
+        st = seq_check_sweep_in(b, n_sweeps);
+    }
+    b->scene = b->scenes[0];
+    snprintf(b->scene_name, sizeof b->scene_name, "the scene");
+    return st;
 }
 
 /* Sets sweep combination s (the first key varies slowest) into doc; its label. */
@@ -396,74 +417,13 @@ static int seq_apply_tracks(const seq_build *b, double time_s, json_t *doc)
     return 0;
 }
 
-/* The hash of a file the frames name ("file", "*_file" keys), cached per path; 0 when
- * it cannot be read (the scene loader then reports it). */
-static uint64_t seq_file_hash(seq_build *b, const char *scene_dir, const char *name)
-{
-    char path[4096];
-    if (name[0] == '/')
-        snprintf(path, sizeof path, "%s", name);
-    else
-        snprintf(path, sizeof path, "%s/%s", scene_dir, name);
-    json_t *cached = json_object_get(b->file_hashes, path);
-    if (cached)
-        return (uint64_t)strtoull(json_string_value(cached), NULL, 16);
-    uint64_t h = BATCH_HASH_INIT;
-    FILE *f = fopen(path, "rb");
-    if (f) {
-        unsigned char buf[65536];
-        size_t n;
-        while ((n = fread(buf, 1, sizeof buf, f)) > 0)
-            h = batch_hash_bytes(h, buf, n);
-        fclose(f);
-    } else {
-        h = 0;
-    }
-    char hex[17];
-    snprintf(hex, sizeof hex, "%016llx", (unsigned long long)h);
-    json_object_set_new(b->file_hashes, path, json_string(hex));
-    return h;
-}
-
-static uint64_t seq_hash_files(seq_build *b, const char *scene_dir, const json_t *v, uint64_t h)
-{
-    if (json_is_object(v)) {
-        const char *key;
-        json_t *child;
-        json_object_foreach((json_t *)v, key, child)
-        {
-            size_t len = strlen(key);
-            int is_file = !strcmp(key, "file") || (len > 5 && !strcmp(key + len - 5, "_file"));
-            if (is_file && json_is_string(child)) {
-                uint64_t fh = seq_file_hash(b, scene_dir, json_string_value(child));
-                h = batch_hash_bytes(h, &fh, sizeof fh);
-            } else {
-                h = seq_hash_files(b, scene_dir, child, h);
-            }
-        }
-    } else if (json_is_array(v)) {
-        for (size_t i = 0; i < json_array_size(v); i++)
-            h = seq_hash_files(b, scene_dir, json_array_get(v, i), h);
-    }
-    return h;
-}
-
-uint64_t batch_hash_bytes(uint64_t h, const void *data, size_t n)
-{
-    const unsigned char *p = data;
-    for (size_t i = 0; i < n; i++) {
-        h ^= p[i];
-        h *= UINT64_C(1099511628211);
-    }
-    return h;
-}
-
 /* Builds frame f's scene text, dir, hash and sweep label; checks that it loads. */
 static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
 {
     size_t s = f / seq->frames, i = f % seq->frames;
     double time_s = (double)i / seq->fps;
-    json_t *doc = json_deep_copy(b->scene);
+    size_t k = batch_frame_scene(seq, f);
+    json_t *doc = json_deep_copy(b->scenes[k]);
     char label[1024];
     if (!doc || seq_apply_tracks(b, time_s, doc) != 0 ||
         seq_apply_sweep(b, s, doc, label, sizeof label) != 0) {
@@ -477,8 +437,8 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
                                   sizeof("thzmap " THZ_VERSION_STRING) - 1);
     if (seq->frame_json[f])
         h = batch_hash_bytes(h, seq->frame_json[f], strlen(seq->frame_json[f]));
-    h = batch_hash_bytes(h, seq->scene_dir, strlen(seq->scene_dir));
-    seq->hash[f] = seq_hash_files(b, seq->scene_dir, doc, h);
+    h = batch_hash_bytes(h, seq->scene_dirs[k], strlen(seq->scene_dirs[k]));
+    seq->hash[f] = batch_hash_files(b->file_hashes, seq->scene_dirs[k], doc, h);
     json_decref(doc);
     char dir[64];
     if (seq->has_sweep)
@@ -491,7 +451,10 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
     thz_scene *scene = NULL;
     thz_status st = thz_sequence_frame_scene(seq, f, &scene, b->err);
     thz_scene_destroy(scene);
-    if (st != THZ_OK && b->err)
+    if (st != THZ_OK && b->err && seq->scene_list)
+        thz_error_prefix(b->err, "%s: frame %zu (scenes[%zu]%s%s): ", b->label, i, k,
+                         label[0] ? ", " : "", label);
+    else if (st != THZ_OK && b->err)
         thz_error_prefix(b->err, "%s: frame %zu (%s%st = %g s): ", b->label, i, label,
                          label[0] ? ", " : "", time_s);
     return st;
@@ -500,7 +463,9 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
 static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_sequence *seq,
                           json_t **keyframes)
 {
-    static const char *const keys[] = {"format", "scene", "fps", "frames", "keyframes", "sweep"};
+    static const char *const keys[] = {"format", "scene",     "scenes", "fps",
+                                       "frames", "keyframes", "sweep"};
+    enum { N_KEYS = sizeof keys / sizeof keys[0] };
     if (!json_is_object(root))
         return seq_fail(b, "(top level)", "expected an object, got %s", seq_type(root));
     const char *key;
@@ -508,27 +473,20 @@ static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_s
     json_object_foreach(root, key, v)
     {
         size_t i = 0;
-        while (i < 6 && strcmp(key, keys[i]))
+        while (i < N_KEYS && strcmp(key, keys[i]))
             i++;
-        if (i == 6)
-            return seq_fail(b, key, "%s",
-                            "unknown key (expected format, scene, fps, frames, keyframes, sweep)");
+        if (i == N_KEYS)
+            return seq_fail(
+                b, key, "%s",
+                "unknown key (expected format, scene or scenes, fps, frames, keyframes, sweep)");
     }
     const char *format = json_string_value(json_object_get(root, "format"));
     if (!format || strcmp(format, "thzmap-sequence/1"))
         return seq_fail(b, "format", "%s", "expected \"thzmap-sequence/1\"");
-    const char *scene = json_string_value(json_object_get(root, "scene"));
-    if (!scene || !scene[0])
-        return seq_fail(b, "scene", "%s", "expected the scene file's name (a string)");
-    char path[4096];
-    if (snprintf(path, sizeof path, "%s%s%s", scene[0] == '/' ? "" : seq_dir,
-                 scene[0] == '/' ? "" : "/", scene) >= (int)sizeof path)
-        return seq_fail(b, "scene", "%s", "path too long");
-    seq->scene_path = thz_strdup(path);
-    char *slash = strrchr(path, '/');
-    if (slash)
-        *slash = '\0';
-    seq->scene_dir = thz_strdup(slash ? (path[0] ? path : "/") : ".");
+    thz_status st = batch_scenes_load(b->label, root, seq_dir, seq, &b->scenes, b->err);
+    if (st != THZ_OK)
+        return st;
+    b->scene = b->scenes[0];
     *keyframes = json_object_get(root, "keyframes");
     json_t *fps = json_object_get(root, "fps"), *frames = json_object_get(root, "frames");
     if (fps && (!json_is_number(fps) || !(json_number_value(fps) > 0.0)))
@@ -539,11 +497,10 @@ static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_s
     if (frames && (!json_is_integer(frames) || json_integer_value(frames) < 1 ||
                    json_integer_value(frames) > SEQ_MAX_FRAMES))
         return seq_fail(b, "frames", "%s", "expected a whole number of frames from 1 to 100000");
-    seq->frames = frames ? (size_t)json_integer_value(frames) : 1;
     b->sweep = json_object_get(root, "sweep");
-    return seq->scene_path && seq->scene_dir
-               ? THZ_OK
-               : thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
+    /* a list: one frame per scene file, as it is */
+    seq->frames = seq->scene_list ? seq->n_scenes : frames ? (size_t)json_integer_value(frames) : 1;
+    return THZ_OK;
 }
 
 thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *err)
@@ -552,7 +509,8 @@ thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *er
     if (!path)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_sequence_load: no path");
     thz_sequence *seq = thz_calloc(1, sizeof *seq);
-    seq_build b = {.label = path, .err = err, .file_hashes = json_object()};
+    seq_build b = {
+        .label = path, .err = err, .file_hashes = json_object(), .scene_name = "the scene"};
     json_error_t je;
     /* a FIFO or device would block the open or never end (core/file.h) */
     thz_status st = file_check_regular(path, NULL, SEQ_MAX_FILE_BYTES, NULL, err);
@@ -573,21 +531,10 @@ thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *er
             *slash = '\0';
         st = seq_top(&b, root, slash ? (dir[0] ? dir : "/") : ".", seq, &keyframes);
     }
-    if (st == THZ_OK)
-        st = file_check_regular(seq->scene_path, NULL, SEQ_MAX_FILE_BYTES, NULL, err);
-    if (st == THZ_OK) {
-        b.scene = json_load_file(seq->scene_path, JSON_REJECT_DUPLICATES, &je);
-        if (!b.scene)
-            st = je.line > 0 ? thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s",
-                                             seq->scene_path, je.line, je.column, je.text)
-                             : thz_error_set(err, THZ_ERR_INPUT, "%s: scene: %s", path, je.text);
-        else if (!json_is_object(b.scene))
-            st = thz_error_set(err, THZ_ERR_INPUT, "%s: expected a scene object", seq->scene_path);
-    }
     if (st == THZ_OK && keyframes)
         st = seq_keyframes(&b, keyframes);
     if (st == THZ_OK)
-        st = seq_check_sweep(&b, &seq->n_sweeps);
+        st = seq_check_sweep(&b, seq, &seq->n_sweeps);
     if (st == THZ_OK) {
         seq->has_sweep = b.sweep != NULL;
         seq->n_frames = seq->frames * seq->n_sweeps;
@@ -606,7 +553,7 @@ thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *er
     }
     free(b.tracks);
     json_decref(b.file_hashes);
-    json_decref(b.scene);
+    batch_scenes_free(b.scenes, seq ? seq->n_scenes : 0);
     json_decref(root); /* the tracks' segments pointed into it: freed after them */
     if (st != THZ_OK) {
         thz_sequence_destroy(seq);

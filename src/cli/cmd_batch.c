@@ -1,8 +1,11 @@
-/* thzmap batch SEQUENCE.json -o OUTDIR: run a sequence of frames (keyframes, sweeps)
- * through the library's thz_batch_run, with progress over the whole batch on stderr and
- * Ctrl-C/SIGTERM ending it cleanly (finished frames stay; running it again resumes). */
+/* thzmap batch SEQUENCE.json -o OUTDIR: run a sequence of frames (keyframes, sweeps, a
+ * list of scenes) through the library's thz_batch_run, with progress over the whole
+ * batch on stderr (a line per frame, and within frames a redrawn line on a terminal or
+ * a line per tenth of the batch otherwise) and Ctrl-C/SIGTERM ending it cleanly
+ * (finished frames stay; running it again resumes). */
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "progress.h"
@@ -13,7 +16,8 @@ static void batch_usage(FILE *f)
 {
     fprintf(f, "usage: thzmap batch SEQUENCE.json -o OUTDIR [options]\n\n"
                "Runs every frame of a sequence file (thzmap-sequence/1: keyframes interpolated\n"
-               "in time, sweeps) as 'thzmap simulate' would, each into OUTDIR/frame-NNNNN/\n"
+               "in time, or a list of scene files; sweeps) as 'thzmap simulate' would, each\n"
+               "into OUTDIR/frame-NNNNN/"
                "(OUTDIR/sweep-NN/frame-NNNNN/ with a sweep); writes OUTDIR/batch.json and per\n"
                "sensor and channel a movie S.band-NN.mp4 of the brightness temperature.\n"
                "Frames that differ from the previous one only in their sensors are rendered\n"
@@ -29,7 +33,39 @@ static void batch_usage(FILE *f)
 
 typedef struct batch_cli {
     bool quiet;
+    bool tty;           /* stderr is a terminal: the progress within frames is redrawn */
+    bool line_open;     /* a redrawn line is on the terminal */
+    double last_draw_s; /* when it was drawn, s */
+    int last_tenth;     /* not a terminal: the last tenth of the batch printed */
 } batch_cli;
+
+/* Within a frame: the share of the whole batch done and its ETA, on a line redrawn at
+ * most every 0.1 s on a terminal, else a line each time it passes another tenth. */
+static void batch_show_run(batch_cli *b, const thz_batch_progress *p)
+{
+    double start = p->n_frames ? (double)p->reused / (double)p->n_frames : 0.0;
+    char eta[64] = "";
+    if (p->fraction - start > 0.01)
+        snprintf(eta, sizeof eta, ", ETA %.0f s",
+                 p->seconds * (1.0 - p->fraction) / (p->fraction - start));
+    if (b->tty) {
+        double now = cli_now_s();
+        if (now - b->last_draw_s < 0.1)
+            return;
+        b->last_draw_s = now;
+        fprintf(stderr, "\r\033[Kthzmap batch: frame %zu/%zu, %.0f %% of the batch, %.1f s%s",
+                p->frame + 1, p->n_frames, 100.0 * p->fraction, p->seconds, eta);
+        b->line_open = true;
+    } else {
+        int tenth = (int)(10.0 * p->fraction);
+        if (tenth <= b->last_tenth || tenth >= 10)
+            return;
+        b->last_tenth = tenth;
+        fprintf(stderr, "thzmap batch: %d %% of the batch done (in frame %zu/%zu), %.1f s%s\n",
+                10 * tenth, p->frame + 1, p->n_frames, p->seconds, eta);
+    }
+    fflush(stderr);
+}
 
 static int batch_on_progress(void *user, const thz_batch_progress *p)
 {
@@ -38,6 +74,14 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
         return 1;
     if (b->quiet)
         return 0;
+    if (!strcmp(p->stage, "run")) {
+        batch_show_run(b, p);
+        return 0;
+    }
+    if (b->line_open) {
+        fputs("\r\033[K", stderr);
+        b->line_open = false;
+    }
     size_t finished = p->computed + p->reused;
     if (!strcmp(p->stage, "frame")) {
         char eta[64] = "";
@@ -72,7 +116,7 @@ int cmd_batch(int argc, char **argv)
 {
     const char *seq_path = NULL, *outdir = NULL;
     uint64_t threads = 0;
-    batch_cli b = {0};
+    batch_cli b = {.tty = isatty(STDERR_FILENO) != 0};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (cli_is_help(arg)) {
@@ -123,9 +167,12 @@ int cmd_batch(int argc, char **argv)
                 thz_sequence_frame_count(seq), thz_sequence_frame_count(seq) == 1 ? "" : "s",
                 thz_sequence_sweep_count(seq), thz_sequence_sweep_count(seq) == 1 ? "" : "s",
                 thz_sequence_frames_per_sweep(seq), outdir);
-    thz_batch_options opt = {.progress = batch_on_progress, .progress_user = &b};
+    thz_batch_options opt = {
+        .progress = batch_on_progress, .progress_user = &b, .open_output = cli_exit_guard()};
     thz_batch_result res;
     thz_status st = thz_batch_run(ctx, seq, outdir, &opt, &res, &err);
+    if (b.line_open)
+        fputs("\r\033[K", stderr);
     int rc = CLI_EXIT_OK;
     if (st == THZ_ERR_CANCELLED) {
         fprintf(stderr,

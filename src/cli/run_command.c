@@ -181,6 +181,15 @@ static void cli_exit_cleanup(void)
                     "could be started); no results written, OUTDIR left as it was\n");
 }
 
+thz_output **cli_exit_guard(void)
+{
+    static bool handler_installed = false;
+    if (!handler_installed)
+        handler_installed = atexit(cli_exit_cleanup) == 0;
+    cli_output_pid = getpid();
+    return &cli_open_output;
+}
+
 /* The run: photons read (render) or fired, images rendered, results written through an
  * output directory opened first, so that a bad OUTDIR fails before any work. */
 static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_run_args *a,
@@ -189,11 +198,7 @@ static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_ru
     thz_output *output = NULL;
     thz_photons *photons = NULL;
     thz_status st = thz_output_open(a->outdir, &output, err);
-    static bool handler_installed = false;
-    if (!handler_installed)
-        handler_installed = atexit(cli_exit_cleanup) == 0;
-    cli_output_pid = getpid();
-    cli_open_output = output;
+    *cli_exit_guard() = output;
     long sensor = -1;
     if (st == THZ_OK && render && a->sensor_name) {
         sensor = thz_scene_sensor_index(scene, a->sensor_name);
@@ -213,7 +218,7 @@ static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_ru
         st = thz_output_add_run(ctx, output, *run, &a->write, err);
     if (st == THZ_OK)
         st = thz_output_commit(output, err);
-    cli_open_output = NULL;
+    *cli_exit_guard() = NULL;
     thz_output_destroy(output);
     return st;
 }

@@ -17,6 +17,10 @@
 #    frame 0 (summary.json aside); resumed after losing frames 1-2 or after a SIGKILL,
 #    it ends with the same files;
 #  - a sweep without keyframes: sweep-NN/frame-00000 per value;
+#  - a plain list of scenes ("scenes"): one frame each, as simulate's, resumed by input
+#    hash, with movies; scenes with other sensors: no movies, a warning; the batch's
+#    progress within a frame (the CLI's lines on a non-terminal);
+#  - libgomp calling exit() inside a frame leaves no staging directory or lock;
 #  - bad sequence files: exit 2, the JSON path in the message, nothing written.
 # argv: path to the thzmap binary, repository directory.
 set -u
@@ -260,6 +264,66 @@ b = json.load(open(sys.argv[1]))
 assert b["complete"] and b["photon_phases_fired"] <= 1, b
 PY
 
+# --- a plain list of scenes, and progress within a frame ---------------------------
+# frame 0 is scene.json, frame 1 sub/b.json (paths relative to the sequence file): as
+# they are, frame 1 equal to simulate's; the movies have 2 frames; a changed sub/b.json
+# redoes frame 1 only. Not quiet, on a non-terminal: the batch's progress passes a tenth
+# of the batch inside the first frame (its channel 1 is half of it: a quarter).
+mkdir -p "$work/sub"
+sed 's/"temperature_k": 300/"temperature_k": 306/' "$work/scene.json" > "$work/sub/b.json"
+echo '{"format": "thzmap-sequence/1", "scenes": ["scene.json", "sub/b.json"], "fps": 2}' > "$work/list.json"
+"$THZMAP" batch "$work/list.json" -o "$work/L" --threads 2 > /dev/null 2> "$work/L.err" ||
+    fail "list of scenes: exit $?: $(cat "$work/L.err")"
+grep -Eq '^thzmap batch: [1-4]0 % of the batch done \(in frame 1/2\)' "$work/L.err" ||
+    fail "no progress within frame 1 of 2: $(cat "$work/L.err")"
+"$THZMAP" simulate "$work/sub/b.json" -o "$work/SB" --threads 1 --quiet >/dev/null || fail "simulate of sub/b.json"
+same_files "$work/SB" "$work/L/frame-00001" "list frame 1 against simulate's"
+"$PY" - "$work/L" <<'PY' || fail "list of scenes: batch.json, frame.json"
+import json, sys
+b = json.load(open(sys.argv[1] + "/batch.json"))
+assert b["n_frames"] == 2 and b["frames_computed"] == 2 and b["complete"], b
+assert b["scene"] is None and [s.rsplit("/", 1)[-1] for s in b["scenes"]] == ["scene.json", "b.json"], b
+assert [f["time_s"] for f in b["frames"]] == [0, 0.5] and b["movies_skipped"] is None, b
+assert len(b["movies"]) == 2 and all(m["frames"] == 2 for m in b["movies"]), b["movies"]
+f = json.load(open(sys.argv[1] + "/frame-00001/frame.json"))
+assert f["scene_file"].endswith("sub/b.json") and f["scene_dir"].endswith("sub"), f
+assert [o["temperature_k"] for o in f["scene"]["objects"]] == [293, 306], f["scene"]
+PY
+ffprobe -v error -count_frames -show_entries stream=nb_read_frames -of default=nw=1 "$work/L/cam.band-02.mp4" |
+    grep -qx 'nb_read_frames=2' || fail "list of scenes: the movie has not 2 frames"
+sed -i 's/"temperature_k": 306/"temperature_k": 307/' "$work/sub/b.json"
+"$THZMAP" batch "$work/list.json" -o "$work/L" --quiet > /dev/null 2>&1 || fail "list, changed: exit $?"
+"$PY" - "$work/L/batch.json" <<'PY' || fail "a changed scene of the list must redo its frame only"
+import json, sys
+b = json.load(open(sys.argv[1]))
+assert b["frames_reused"] == 1 and b["frames_computed"] == 1, b
+assert [f["computed"] for f in b["frames"]] == ["an earlier run", "this run"], b["frames"]
+PY
+# scenes with other sensors: the frames, no movies, a warning saying why, exit 0
+sed 's/"resolution": \[16, 12\]/"resolution": [8, 6]/' "$work/scene.json" > "$work/small.json"
+echo '{"format": "thzmap-sequence/1", "scenes": ["scene.json", "small.json"]}' > "$work/mixed.json"
+"$THZMAP" batch "$work/mixed.json" -o "$work/M" --quiet > /dev/null 2> "$work/M.err" ||
+    fail "list of scenes with other sensors: exit $?"
+grep -q 'warning: no movies: frame frame-00001 has other sensors or channels' "$work/M.err" ||
+    fail "no warning about the movies: $(cat "$work/M.err")"
+ls "$work"/M/*.mp4 >/dev/null 2>&1 && fail "movies from frames of other sizes"
+"$PY" - "$work/M/batch.json" <<'PY' || fail "batch.json of a list with other sensors"
+import json, sys
+b = json.load(open(sys.argv[1]))
+assert b["movies"] == [] and "8 x 6" in b["movies_skipped"] and b["frames_computed"] == 2, b
+PY
+
+# --- libgomp's exit() inside a frame -------------------------------------------------
+# No thread can start with a stack larger than the address space: libgomp calls exit()
+# while frame 0 is open. The exit handler removes its staging directory and lock and
+# says so (any non-zero status: a sanitizer build may add its leak report).
+OMP_STACKSIZE=1000000G "$THZMAP" batch "$work/list.json" -o "$work/X" --threads 2 --quiet \
+    > /dev/null 2> "$work/X.err"
+[ $? -ne 0 ] || fail "libgomp exit: exit status 0"
+grep -q 'a library ended the process early' "$work/X.err" || fail "libgomp exit: $(cat "$work/X.err")"
+left=$(ls -A "$work/X" | grep -v -x -e batch.json -e .thzmap-batch-lock)
+[ -z "$left" ] || fail "libgomp exit left in OUTDIR: $left"
+
 # --- bad sequence files -------------------------------------------------------------
 bad() { # bad NAME EXPECTED-TEXT JSON
     printf '%s\n' "$3" > "$work/bad-$1.json"
@@ -294,6 +358,19 @@ bad syntax 'bad-syntax.json:1:' '{"format": "thzmap-sequence/1",, }'
 bad frame_scene 'frame 2 (t = 0.5 s): ' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 3, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 0.5, "objects": {"person": {"temperature_k": -10}}}]}'
 grep -qF 'objects[1].temperature_k' "$work/bad.err" || fail "bad frame_scene: the scene's JSON path: $(cat "$work/bad.err")"
+bad both 'bad-both.json: scenes: give either "scene"' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "scenes": ["scene.json"]}'
+bad empty_list 'bad-empty_list.json: scenes: expected a non-empty list of scene files, got an empty one' \
+    '{"format": "thzmap-sequence/1", "scenes": []}'
+bad missing 'bad-missing.json: scenes[1]: ' \
+    '{"format": "thzmap-sequence/1", "scenes": ["scene.json", "nowhere.json"]}'
+grep -qF 'nowhere.json' "$work/bad.err" || fail "bad missing: the file's name: $(cat "$work/bad.err")"
+bad list_keyframes 'bad-list_keyframes.json: keyframes: not with "scenes"' \
+    "{\"format\": \"thzmap-sequence/1\", \"scenes\": [\"scene.json\"], \"fps\": 4, \"keyframes\": [$K0]}"
+bad list_frames 'bad-list_frames.json: frames: not with "scenes"' \
+    '{"format": "thzmap-sequence/1", "scenes": ["scene.json"], "frames": 3}'
+bad list_sweep 'sweep.objects.nobody.temperature_k: scenes[0] (scene.json) has no object named "nobody"' \
+    '{"format": "thzmap-sequence/1", "scenes": ["scene.json"], "sweep": {"objects.nobody.temperature_k": [300]}}'
 "$THZMAP" batch "$seq" > /dev/null 2>&1
 [ $? -eq 2 ] || fail "batch without -o: expected exit 2"
 
