@@ -19,7 +19,7 @@ struct thz_context {
     void *progress_user;
     thz_warning_fn warning;
     void *warning_user;
-    thz_error last; /* the last failure of a call that took this context */
+    thz_error last;        /* the last failure of a call that took this context */
     struct mpi_team *team; /* rank 0 of an MPI run (api_mpi.c), else NULL */
     uint64_t mpi_bytes;    /* the other ranks: bytes their finished team moved */
 };

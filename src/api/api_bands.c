@@ -340,8 +340,8 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
                         .mean = b->values.mean,
                         .cov = b->values.cov,
                         .group = b->group};
-    st = bands_search(&cl, o->count, o->exhaustive_limit ? o->exhaustive_limit : 2000000, &b->search,
-                      err);
+    st = bands_search(&cl, o->count, o->exhaustive_limit ? o->exhaustive_limit : 2000000,
+                      &b->search, err);
     if (st != THZ_OK)
         goto done;
     bands_report rep = make_report(b);

@@ -53,9 +53,9 @@ typedef struct run_plan {
 } run_plan;
 
 typedef struct run_options {
-    int threads;              /* OpenMP threads, 0: all */
-    bool keep_photon_maps;    /* simulate: keep every channel's map in the run (to save it) */
-    const char *sensor_name;  /* only this sensor; NULL: all */
+    int threads;             /* OpenMP threads, 0: all */
+    bool keep_photon_maps;   /* simulate: keep every channel's map in the run (to save it) */
+    const char *sensor_name; /* only this sensor; NULL: all */
     /* simulate: the processes sharing each photon phase (photon/phase.h); NULL: alone */
     const struct photon_phase_team *team;
     thz_progress_fn progress; /* stages "photons", "render", "output"; may be NULL */
