@@ -8,6 +8,7 @@
 #include <stdlib.h>
 
 #include "core/alloc.h"
+#include "physics/spectrum.h"
 
 /* ---- measured response tables ---------------------------------------------------- */
 
@@ -23,15 +24,7 @@ static void channel_piece(const thz_channel *ch, size_t i, double *h, double *a,
  * f_i <= freq_hz. */
 static size_t channel_piece_at(const thz_channel *ch, double freq_hz)
 {
-    size_t lo = 0, hi = ch->n_response - 1; /* f_lo <= freq < f_hi, or freq == f_hi */
-    while (hi - lo > 1) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (ch->response_hz[mid] <= freq_hz)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return lo;
+    return spectrum_interval(ch->response_hz, ch->n_response, freq_hz);
 }
 
 thz_status channel_set_response(thz_channel *ch, size_t n, const double *freq_hz,
@@ -228,14 +221,7 @@ static double channel_sample_table_hz(const thz_channel *ch, double u1, double u
     const double *area = ch->response_area_hz;
     size_t n = ch->n_response;
     double target = u1 * area[n - 1];
-    size_t lo = 0, hi = n - 1; /* the piece is the first i with area[i + 1] > target */
-    while (hi - lo > 1) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (area[mid] > target)
-            hi = mid;
-        else
-            lo = mid;
-    }
+    size_t lo = spectrum_interval(area, n, target); /* the first i with area[i + 1] > target */
     while (lo > 0 && !(area[lo + 1] > area[lo]))
         lo--; /* u1 rounded onto the end of a zero piece: the last piece with area */
     double h, a, b;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "physics/spectrum.h"
 
 struct material_index {
     bool is_model;
@@ -88,14 +89,7 @@ static void table_at(const material_index *idx, double freq_hz, double *n, doubl
         *k = idx->k[last];
         return;
     }
-    size_t lo = 0, hi = last; /* freq[lo] < freq_hz < freq[hi] */
-    while (hi - lo > 1) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (idx->freq_hz[mid] <= freq_hz)
-            lo = mid;
-        else
-            hi = mid;
-    }
+    size_t lo = spectrum_interval(idx->freq_hz, idx->count, freq_hz), hi = lo + 1;
     double t = (freq_hz - idx->freq_hz[lo]) / (idx->freq_hz[hi] - idx->freq_hz[lo]);
     *n = idx->n[lo] + t * (idx->n[hi] - idx->n[lo]);
     *k = idx->k[lo] + t * (idx->k[hi] - idx->k[lo]);

@@ -6,6 +6,19 @@
 
 #include "core/alloc.h"
 
+size_t spectrum_interval(const double *t, size_t n, double x)
+{
+    size_t lo = 0, hi = n - 1; /* t[lo] <= x < t[hi], or x beyond an end */
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (t[mid] <= x)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 double spectrum_eval(const thz_spectrum *s, double freq_hz)
 {
     if (!s || s->n == 0)
@@ -18,15 +31,7 @@ double spectrum_eval(const thz_spectrum *s, double freq_hz)
         return s->value[0];
     if (!(freq_hz < f[n - 1]))
         return s->value[n - 1];
-    /* Binary search for f[lo] <= freq < f[hi]. */
-    size_t lo = 0, hi = n - 1;
-    while (hi - lo > 1) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (f[mid] <= freq_hz)
-            lo = mid;
-        else
-            hi = mid;
-    }
+    size_t lo = spectrum_interval(f, n, freq_hz), hi = lo + 1;
     double t = (freq_hz - f[lo]) / (f[hi] - f[lo]);
     return s->value[lo] + t * (s->value[hi] - s->value[lo]);
 }

@@ -13,6 +13,11 @@ typedef struct thz_spectrum {
     double *value;   /* n entries */
 } thz_spectrum;
 
+/* The interval of an ascending table t[0 .. n-1] (n >= 2) that holds x: the last
+ * lo < n - 1 with t[lo] <= x, by bisection (0 when x < t[1]). Every table lookup of
+ * the engine (spectra, indices, channel responses, quadrature nodes) goes through it. */
+size_t spectrum_interval(const double *t, size_t n, double x);
+
 /* Value at freq_hz. An absent spectrum (n == 0) evaluates to 0. */
 double spectrum_eval(const thz_spectrum *s, double freq_hz);
 

@@ -5,6 +5,7 @@
 
 #include "physics/channel.h"
 #include "physics/optics.h"
+#include "physics/spectrum.h"
 
 /* Distance from origin_m along dir to where the ray leaves the atmosphere's extent. */
 double render_exit_m(const render_context *ctx, vec3 origin_m, vec3 dir)
@@ -51,15 +52,7 @@ static double render_interp(const render_context *ctx, const double *table, uint
     } else {
         if (!(freq_hz >= f[0] && freq_hz < f[n - 1]))
             return NAN;
-        size_t lo = 0, hi = n - 1; /* f[lo] <= freq_hz < f[hi] */
-        while (hi - lo > 1) {
-            size_t mid = lo + (hi - lo) / 2;
-            if (f[mid] <= freq_hz)
-                lo = mid;
-            else
-                hi = mid;
-        }
-        i = lo;
+        i = spectrum_interval(f, n, freq_hz);
         t = (freq_hz - f[i]) / (f[i + 1] - f[i]);
     }
     const double *tb = &table[(size_t)object * n];
