@@ -12,10 +12,9 @@
 #include "batch/batch_internal.h"
 #include "core/alloc.h"
 #include "core/error.h"
-#include "core/file.h"
+#include "scene/load.h"
 
 /* Sequence and scene files are kilobytes; a batch holds every frame's scene text. */
-#define SCENES_MAX_FILE_BYTES (64u * 1024u * 1024u)
 
 enum { SCENES_MAX = 100000 };
 
@@ -40,15 +39,10 @@ static thz_status scenes_load_one(const char *label, const char *seq_dir, const 
     if (!seq->scene_paths[k] || !seq->scene_dirs[k])
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", label);
     snprintf(what, sizeof what, "%s: %s: %s", label, where, seq->scene_paths[k]);
-    thz_status st = file_check_regular(seq->scene_paths[k], what, SCENES_MAX_FILE_BYTES, NULL, err);
+    thz_status st =
+        load_json_file(seq->scene_paths[k], what, "scene", LOAD_MAX_SCENE_BYTES, &docs[k], err);
     if (st != THZ_OK)
         return st;
-    json_error_t je;
-    docs[k] = json_load_file(seq->scene_paths[k], JSON_REJECT_DUPLICATES, &je);
-    if (!docs[k])
-        return je.line > 0 ? thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s",
-                                           seq->scene_paths[k], je.line, je.column, je.text)
-                           : thz_error_set(err, THZ_ERR_INPUT, "%s: %s: %s", label, where, je.text);
     if (!json_is_object(docs[k]))
         return thz_error_set(err, THZ_ERR_INPUT, "%s: expected a scene object",
                              seq->scene_paths[k]);

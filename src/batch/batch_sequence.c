@@ -15,11 +15,10 @@
 #include "batch/batch_internal.h"
 #include "core/alloc.h"
 #include "core/error.h"
-#include "core/file.h"
+#include "scene/load.h"
 
 /* A sequence file larger than this is refused before it is read: they are kilobytes
  * (batch_scenes.c has the same limit for scene files). */
-#define SEQ_MAX_FILE_BYTES (64u * 1024u * 1024u)
 
 enum { SEQ_MAX_FRAMES = 100000, SEQ_MAX_SWEEPS = 10000, SEQ_MAX_DEPTH = 8 };
 
@@ -511,16 +510,12 @@ thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *er
     thz_sequence *seq = thz_calloc(1, sizeof *seq);
     seq_build b = {
         .label = path, .err = err, .file_hashes = json_object(), .scene_name = "the scene"};
-    json_error_t je;
-    /* a FIFO or device would block the open or never end (core/file.h) */
-    thz_status st = file_check_regular(path, NULL, SEQ_MAX_FILE_BYTES, NULL, err);
     json_t *root = NULL;
-    if (st == THZ_OK && (!seq || !b.file_hashes))
+    thz_status st = THZ_OK;
+    if (!seq || !b.file_hashes)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-    else if (st == THZ_OK && !(root = json_load_file(path, JSON_REJECT_DUPLICATES, &je)))
-        st = je.line > 0 ? thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s", path,
-                                         je.line, je.column, je.text)
-                         : thz_error_set(err, THZ_ERR_INPUT, "%s: %s", path, je.text);
+    else
+        st = load_json_file(path, NULL, "sequence", LOAD_MAX_SCENE_BYTES, &root, err);
     json_t *keyframes = NULL;
     if (st == THZ_OK) {
         seq->path = thz_strdup(path);

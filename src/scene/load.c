@@ -23,7 +23,6 @@
 #define LOAD_FORMAT_1_1 "thzmap-scene/1.1"
 /* A scene file larger than this is refused before it is read (as the CSV reader caps its
  * tables): scenes are kilobytes; inline tables may make them megabytes. */
-#define LOAD_MAX_SCENE_BYTES (256u * 1024u * 1024u)
 /* Explicit emissivity may differ from Kirchhoff's value by this much before validate
  * warns (physics.md "Surfaces"). */
 #define LOAD_KIRCHHOFF_TOLERANCE 0.01
@@ -298,38 +297,48 @@ static thz_status load_finish(thz_scene **scene, json_t *doc, thz_status st, thz
 }
 
 /* The error of a failed parse: out of memory, or the syntax error jansson found. */
-static thz_status load_syntax_error(const char *label, const json_error_t *je, bool out_of_memory,
-                                    thz_error *err)
+static thz_status load_syntax_error(const char *label, const char *what, const json_error_t *je,
+                                    bool out_of_memory, thz_error *err)
 {
     if (out_of_memory)
-        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while parsing the scene",
-                             label);
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while parsing the %s", label,
+                             what);
     if (je->line > 0)
         return thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s", label, je->line,
                              je->column, je->text);
     return thz_error_set(err, THZ_ERR_INPUT, "%s: invalid JSON: %s", label, je->text);
 }
 
-thz_status scene_load(const char *path, thz_scene **out, thz_error *err)
+thz_status load_json_file(const char *path, const char *label, const char *what, uint64_t max_bytes,
+                          json_t **out, thz_error *err)
 {
     *out = NULL;
-    thz_error_clear(err);
     /* a FIFO or device would block the open or never end (core/file.h) */
-    thz_status st = file_check_regular(path, NULL, LOAD_MAX_SCENE_BYTES, NULL, err);
+    thz_status st = file_check_regular(path, label, max_bytes, NULL, err);
     if (st != THZ_OK)
         return st;
     FILE *f = fopen(path, "rb");
     if (!f && errno == ENOMEM)
-        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while opening the scene", path);
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while opening the %s", path,
+                             what);
     if (!f)
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open scene file: %s", path,
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open %s file: %s", path, what,
                              strerror(errno));
     json_error_t je;
     bool oom = false;
-    json_t *doc = load_json_parse(f, NULL, &je, &oom);
+    *out = load_json_parse(f, NULL, &je, &oom);
     fclose(f);
-    if (!doc)
-        return load_syntax_error(path, &je, oom, err);
+    return *out ? THZ_OK : load_syntax_error(path, what, &je, oom, err);
+}
+
+thz_status scene_load(const char *path, thz_scene **out, thz_error *err)
+{
+    *out = NULL;
+    thz_error_clear(err);
+    json_t *doc;
+    thz_status st = load_json_file(path, NULL, "scene", LOAD_MAX_SCENE_BYTES, &doc, err);
+    if (st != THZ_OK)
+        return st;
     char *copy = thz_strdup(path);
     if (!copy) {
         json_decref(doc);
@@ -351,7 +360,7 @@ thz_status scene_load_string(const char *json_text, const char *base_dir, const 
     bool oom = false;
     json_t *doc = load_json_parse(NULL, json_text, &je, &oom);
     if (!doc)
-        return load_syntax_error(label, &je, oom, err);
+        return load_syntax_error(label, "scene", &je, oom, err);
     thz_status st = load_begin(label, base_dir ? base_dir : ".", out, err);
     return load_finish(out, doc, st, err);
 }

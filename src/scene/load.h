@@ -28,6 +28,17 @@
  * (load_json.c). */
 json_t *load_json_parse(FILE *f, const char *text, json_error_t *je, bool *out_of_memory);
 
+/* The most a scene file may hold (a sequence and the scenes it lists too). */
+#define LOAD_MAX_SCENE_BYTES (256u * 1024u * 1024u)
+
+/* Reads the JSON document of the file at path as the scene loader does: a regular file
+ * (no FIFO or device: core/file.h) of at most max_bytes, duplicate keys rejected,
+ * parsed by load_json_parse. Errors name label (NULL: path) for the file checks and path
+ * with line:column for syntax; running out of memory is THZ_ERR_NOMEM, "while parsing
+ * WHAT". *out is the caller's. */
+thz_status load_json_file(const char *path, const char *label, const char *what, uint64_t max_bytes,
+                          json_t **out, thz_error *err);
+
 /* Long enough for any path a sane scene produces; longer ones are cut (messages only). */
 #define LOAD_PATH_MAX 512
 
