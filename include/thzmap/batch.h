@@ -51,7 +51,7 @@ typedef struct thz_frame_info {
 /* Fills *out for frame i (0 .. count - 1); THZ_ERR_INPUT when out of range. */
 THZ_API thz_status thz_sequence_frame(const thz_sequence *seq, size_t i, thz_frame_info *out);
 
-/* The frame's scene as JSON text (compact, keys sorted), written into buf like
+/* The frame's scene as JSON text (compact, keys in document order), written into buf like
  * snprintf: returns the length without the NUL (0 when i is out of range). Its relative
  * file paths are relative to the directory of the frame's scene file. */
 THZ_API size_t thz_sequence_frame_json(const thz_sequence *seq, size_t i, char *buf, size_t size);

@@ -36,9 +36,8 @@ thz_status batch_photon_bases(const thz_sequence *seq, size_t *base, thz_error *
             return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", seq->frame_dir[f]);
         }
         /* the same text names the same files only from the same directory */
-        int same_dir = f > 0 && batch_frame_scene(seq, f) == batch_frame_scene(seq, f - 1);
-        same_dir |= f > 0 && !strcmp(seq->scene_dirs[batch_frame_scene(seq, f)],
-                                     seq->scene_dirs[batch_frame_scene(seq, f - 1)]);
+        int same_dir = f > 0 && !strcmp(seq->scene_dirs[batch_frame_scene(seq, f)],
+                                        seq->scene_dirs[batch_frame_scene(seq, f - 1)]);
         base[f] = prev && same_dir && !strcmp(prev, text) ? base[f - 1] : f;
         free(prev);
         prev = text;

@@ -370,15 +370,13 @@ static int batch_on_run_progress(void *user, const thz_progress *p)
     batch_state *b = user;
     int stop = b->run_progress ? b->run_progress(b->run_progress_user, p) : 0;
     double frac = p->total ? (double)p->done / (double)p->total : 0.0;
-    int photons = !strcmp(p->stage, "photons");
-    b->photons_seen |= photons;
-    double in_channel = photons                      ? 0.5 * frac
-                        : strcmp(p->stage, "render") ? 1.0 /* output */
-                        : b->photons_seen            ? 0.5 + 0.5 * frac
-                                                     : frac;
-    double share = p->n_channels ? ((double)p->channel + in_channel) / (double)p->n_channels : 0.0;
-    if (!strcmp(p->stage, "output"))
-        share = 1.0;
+    double share = !strcmp(p->stage, "output") ? 1.0 : b->frame_share; /* all channels done */
+    if (!strcmp(p->stage, "photons") || !strcmp(p->stage, "render")) {
+        int photons = p->stage[0] == 'p';
+        b->photons_seen |= photons;
+        double in_channel = photons ? 0.5 * frac : b->photons_seen ? 0.5 + 0.5 * frac : frac;
+        share = p->n_channels ? ((double)p->channel + in_channel) / (double)p->n_channels : 0.0;
+    }
     /* a stage that starts over (truth maps, another sensor) does not move it back */
     if (share > b->frame_share)
         b->frame_share = fmin(share, 1.0);

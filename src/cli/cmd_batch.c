@@ -17,7 +17,7 @@ static void batch_usage(FILE *f)
     fprintf(f, "usage: thzmap batch SEQUENCE.json -o OUTDIR [options]\n\n"
                "Runs every frame of a sequence file (thzmap-sequence/1: keyframes interpolated\n"
                "in time, or a list of scene files; sweeps) as 'thzmap simulate' would, each\n"
-               "into OUTDIR/frame-NNNNN/"
+               "into OUTDIR/frame-NNNNN/\n"
                "(OUTDIR/sweep-NN/frame-NNNNN/ with a sweep); writes OUTDIR/batch.json and per\n"
                "sensor and channel a movie S.band-NN.mp4 of the brightness temperature.\n"
                "Frames that differ from the previous one only in their sensors are rendered\n"

@@ -178,7 +178,8 @@ static void cli_exit_cleanup(void)
     cli_open_output = NULL;
     thz_output_destroy(output);
     fprintf(stderr, "thzmap: a library ended the process early (out of memory, or no thread "
-                    "could be started); no results written, OUTDIR left as it was\n");
+                    "could be started); the output being written was removed and its "
+                    "directory left as it was\n");
 }
 
 thz_output **cli_exit_guard(void)
@@ -314,6 +315,8 @@ int cli_run_command(int argc, char **argv, bool render)
     if (!ctx) {
         thz_scene_destroy(scene);
         fprintf(stderr, "thzmap %s: out of memory\n", cmd);
+        if (shared) /* the other ranks wait for this one: end them too */
+            cli_mpi_abort(CLI_EXIT_FAILURE);
         return CLI_EXIT_FAILURE;
     }
     cli_progress progress;
