@@ -218,6 +218,11 @@ thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *a
             return team_error(err, rc, "waiting for the lead's request");
         if (m.stop)
             return THZ_OK;
+        if (!acc) /* this rank's settings need no photons, the lead's do */
+            return thz_error_set(err, THZ_ERR_INPUT,
+                                 "MPI: the lead asks for photons but process %d's integrator "
+                                 "fires none (every process must run with the same options)",
+                                 team->rank);
         photon_phase_share share;
         thz_status st = photon_phase_fire_share(scene, acc, &m.rq, threads, (size_t)team->rank,
                                                 (size_t)team->size, &share, err);

@@ -263,10 +263,11 @@ thz_status photon_phase_fire_share(const thz_scene *scene, const accel *acc,
         return st;
     if (rq->seed != scene->photons.seed || rq->photons != scene->photons.per_channel)
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "photon phase: process %zu has seed %llu and %llu photons per "
-                             "channel, the lead %llu and %llu (every process must load the same "
-                             "scene with the same options)",
-                             member, (unsigned long long)scene->photons.seed,
+                             "%s: photon phase: process %zu has photons.seed %llu and "
+                             "photons.per_channel %llu, the lead %llu and %llu (every process "
+                             "must load the same scene with the same options)",
+                             scene->path ? scene->path : "scene", member,
+                             (unsigned long long)scene->photons.seed,
                              (unsigned long long)scene->photons.per_channel,
                              (unsigned long long)rq->seed, (unsigned long long)rq->photons);
     emission_table table;

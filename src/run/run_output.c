@@ -22,7 +22,10 @@ static run_summary run_summary_of(const run_state *rs)
         .seed = rs->seed,
         .photons_per_channel = rs->photons_per_channel,
         .threads = rs->opt->threads > 0 ? rs->opt->threads : omp_get_max_threads(),
-        .mpi_ranks = rs->opt->team ? (int)rs->opt->team->members : 1,
+        /* the processes that shared the photon phases (path fires none: 1) */
+        .mpi_ranks = rs->opt->team && render_integrator_needs_photons(rs->scene->render.integrator)
+                         ? (int)rs->opt->team->members
+                         : 1,
         /* render: the statistics of the photon phase that made the map it read */
         .channel_stats =
             render_integrator_needs_photons(rs->scene->render.integrator) ? rs->stats : NULL,
