@@ -234,14 +234,22 @@ def _load():
 
 
 lib, path = _load()
-for _name, (_restype, _argtypes) in _PROTOTYPES.items():
-    try:
-        _fn = getattr(lib, _name)
-    except AttributeError:
-        raise ImportError(f"thzmap: {path} has no function {_name}: it is older or newer "
-                          "than this package") from None
-    _fn.restype = _restype
-    _fn.argtypes = _argtypes
+
+
+def bind(prototypes):
+    """Gives the library's functions named in `prototypes` ({name: (restype, argtypes)})
+    their types; ImportError naming the first one the library lacks."""
+    for name, (restype, argtypes) in prototypes.items():
+        try:
+            fn = getattr(lib, name)
+        except AttributeError:
+            raise ImportError(f"thzmap: {path} has no function {name}: it is older or newer "
+                              "than this package") from None
+        fn.restype = restype
+        fn.argtypes = argtypes
+
+
+bind(_PROTOTYPES)
 
 
 class Handle:

@@ -55,16 +55,10 @@ _PROTOTYPES = {
     "thz_bands_json": (c_char_p, [_P]),
     "thz_bands_write": (c_int, [_P, c_char_p, _ERR]),
 }
-for _name, (_restype, _argtypes) in _PROTOTYPES.items():
-    try:
-        _fn = getattr(_lib.lib, _name)
-    except AttributeError:
-        raise ImportError(f"thzmap: {_lib.path} has no function {_name}: it is older or "
-                          "newer than this package") from None
-    _fn.restype = _restype
-    _fn.argtypes = _argtypes
+_lib.bind(_PROTOTYPES)
 
-# The CLI's bounds (cmd_bands.c), which the library checks too.
+# The CLI's bounds (cmd_bands.c); the library checks the count too, and caps the
+# candidates (centres x widths) at 4096.
 MAX_COUNT = 32
 MAX_WIDTHS = 16
 

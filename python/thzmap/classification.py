@@ -58,14 +58,7 @@ _PROTOTYPES = {
     "thz_classification_json": (c_char_p, [_P]),
     "thz_classification_write": (c_int, [_P, c_char_p, _ERR]),
 }
-for _name, (_restype, _argtypes) in _PROTOTYPES.items():
-    try:
-        _fn = getattr(_lib.lib, _name)
-    except AttributeError:
-        raise ImportError(f"thzmap: {_lib.path} has no function {_name}: it is older or "
-                          "newer than this package") from None
-    _fn.restype = _restype
-    _fn.argtypes = _argtypes
+_lib.bind(_PROTOTYPES)
 
 
 def methods():

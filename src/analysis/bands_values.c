@@ -195,8 +195,8 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
     return text;
 }
 
-/* One render of a variant: its Tb cube and radiance standard error (copied), and the
- * object_id truth (nominal only). */
+/* One render of a variant: its Tb cube and radiance standard error (copied), and its
+ * object_id truth (a turned sensor sees the classes at other pixels). */
 typedef struct render_out {
     float *tb, *stderr_l;
     int32_t *ids;

@@ -92,6 +92,11 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
                              o->relative_width);
     if (o->n_widths && !o->relative_widths)
         return thz_error_set(err, THZ_ERR_INPUT, "widths: %zu given but no list", o->n_widths);
+    if (o->n_widths && o->relative_width > 0.0)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "--relative-width %g and --widths: give one (the candidates' one "
+                             "width, or the widths searched)",
+                             o->relative_width);
     for (size_t i = 0; i < o->n_widths; i++) {
         if (!(o->relative_widths[i] > 0.0 && o->relative_widths[i] <= 0.5))
             return thz_error_set(err, THZ_ERR_INPUT, "--widths: %g: expected 0 < w <= 0.5",
@@ -106,12 +111,12 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
                              "%.0f centres x %zu widths: at most %d candidates (raise "
                              "--step-ghz or give fewer widths)",
                              n, o->n_widths, BANDS_MAX_CANDIDATES);
-    if (!(o->thickness_range >= 0.0 && o->thickness_range < 1.0) ||
-        !(o->angle_range_deg >= 0.0 && o->angle_range_deg <= 90.0))
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "thickness range %g (expected 0 <= f < 1), angle range %g degrees "
-                             "(expected 0 to 90)",
-                             o->thickness_range, o->angle_range_deg);
+    if (!(o->thickness_range >= 0.0 && o->thickness_range < 1.0))
+        return thz_error_set(err, THZ_ERR_INPUT, "--thickness-range %g: expected 0 <= F < 1",
+                             o->thickness_range);
+    if (!(o->angle_range_deg >= 0.0 && o->angle_range_deg <= 90.0))
+        return thz_error_set(err, THZ_ERR_INPUT, "--angle-range-deg %g degrees: expected 0 to 90",
+                             o->angle_range_deg);
     if (!(o->netd_k >= 0.0) || !(o->target_temperature_range_k >= 0.0) ||
         !(o->ambient_temperature_range_k >= 0.0) ||
         !(o->humidity_range >= 0.0 && o->humidity_range < 1.0))
