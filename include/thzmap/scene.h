@@ -49,7 +49,8 @@ typedef struct thz_channel_info {
     double relative_width;         /* FWHM / centre of the Gaussian; 0 for a measured response */
     double bandwidth_hz;           /* B_c: the response's integral (physics.md) */
     double emitted_power_w_per_hz; /* band mean of the scene's emitted power P_A */
-    /* (added with measured responses; after the older fields, for callers built earlier) */
+    /* (added with measured responses. The library fills the whole struct: a program built
+     * against an older header must be rebuilt; the ABI is not stable before 1.0) */
     double noise_bandwidth_hz; /* B_n = (int g)^2 / int g^2 */
     double fwhm_hz;            /* full width at half maximum of the response */
     size_t response_points;    /* points of the measured response table; 0: Gaussian */
@@ -81,7 +82,7 @@ typedef struct thz_material_info {
      * none, else "constant", "table", "debye", "double-debye", "lorentz", "drude" or
      * "itu-p2040". Absent reflectivity and attenuation then come from it. */
     const char *index_model;
-    /* (added with reflection lobes; after the older fields, for callers built earlier) */
+    /* (added with reflection lobes; as above, a program built earlier must be rebuilt) */
     const char *reflection; /* the `reflection` key: "diffuse", "specular" or "ward" */
     double ward_alpha_x;    /* Ward's slopes (0 < alpha <= 1) along each triangle's first edge */
     double ward_alpha_y;    /* (x) and across it (y); both 0 unless reflection is "ward" */

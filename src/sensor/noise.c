@@ -77,9 +77,11 @@ static thz_status noise_table_init(noise_table *t, const thz_sensor_noise *n, co
     }
     if (!(lo <= hi))
         return THZ_OK; /* sigma_L is 0 at Tb <= 0 */
+    /* one Tb in the whole plane: one interval of 1e-3 in ln Tb, whose first node is it */
+    size_t intervals = hi > lo ? NOISE_TABLE_INTERVALS : 1;
     t->s0 = log(lo);
-    t->h = hi > lo ? (log(hi) - t->s0) / (double)NOISE_TABLE_INTERVALS : 1.0;
-    t->n = NOISE_TABLE_INTERVALS + 3;
+    t->h = hi > lo ? (log(hi) - t->s0) / (double)intervals : 1e-3;
+    t->n = intervals + 3;
     t->sigma = thz_malloc_array(t->n, sizeof *t->sigma);
     if (!t->sigma)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the noise table");

@@ -8,8 +8,9 @@
  *   sigma_L = NETD dB_c/dT (Tb),
  * dB_c/dT the band mean of dB_nu/dT over the channel's quadrature. sigma_L(Tb) is
  * computed so at 1027 temperatures spanning the plane's positive Tb, uniform in ln Tb,
- * and interpolated by a cubic per pixel (relative error below 1e-6 for Tb from 1 mK to
- * 1000 K, 1e-14 over 250..320 K). Its random numbers
+ * and interpolated by a cubic per pixel: relative error below 1e-12 over 250..320 K; it
+ * grows with the plane's span and the frequency where Tb << h nu / k, where sigma_L is
+ * exponentially small (at 3 THz over 2.7..1000 K: about 1.5e-4). Its random numbers
  * come from rng_init(seed, channel, RNG_PURPOSE_SENSOR_NOISE, sensor << 32 | pixel): one
  * stream per (seed, sensor, channel, pixel), so the noise is independent between pixels
  * and channels and bit-identical for any thread count.

@@ -91,6 +91,7 @@ figure_crashes_only() {
   awk '
     BEGIN { libs = ENVIRON["FIGURE_LIBS"] }
     /==[0-9]+==ERROR: / {
+      if (in_stack) bad = 1 # the last report had no frame outside the runtime: no evidence
       reports++
       if ($0 !~ /ERROR: AddressSanitizer: /) bad = 1
       in_stack = 1; next
@@ -100,7 +101,7 @@ figure_crashes_only() {
       in_stack = 0
       if ($0 !~ libs) bad = 1
     }
-    END { exit !(reports > 0 && !bad) }' "$1"
+    END { exit !(reports > 0 && !bad && !in_stack) }' "$1"
 }
 export -f figure_crashes_only
 

@@ -97,7 +97,7 @@ done
 # ---- noise where Tb varies: a 1000 K ball in the 300 K furnace --------------------------
 # The radiometer's NETD follows each pixel's Tb, not the channel's reference temperature
 # (the box's 300 K): (measured - true Tb) / NETD(true Tb) has mean 0 and spread 1 on the
-# ball's pixels and on the box's (NETD at 1000 K is 1.6 x that at 300 K).
+# ball's pixels and on the box's (with T_rec = 500 K, NETD at 1000 K is 1500/800 = 1.875 x that at 300 K).
 cat > "$work/hot.json" <<EOF
 {"format": "thzmap-scene/1", "name": "hot",
  "channels": [{"frequency_thz": 0.35, "relative_width": 0.01}],
