@@ -14,8 +14,8 @@ typedef struct thz_spectrum {
 } thz_spectrum;
 
 /* The interval of an ascending table t[0 .. n-1] (n >= 2) that holds x: the last
- * lo < n - 1 with t[lo] <= x, by bisection (0 when x < t[1]). Every table lookup of
- * the engine (spectra, indices, channel responses, quadrature nodes) goes through it. */
+ * lo < n - 1 with t[lo] <= x, by bisection (0 when x < t[1]). The interval lookups in tables of
+ * spectra, complex indices, channel responses and quadrature nodes goes through it. */
 size_t spectrum_interval(const double *t, size_t n, double x);
 
 /* Value at freq_hz. An absent spectrum (n == 0) evaluates to 0. */
