@@ -62,6 +62,8 @@ thz_status api_effective_scene(const thz_scene *scene, const thz_run_settings *s
 /* The context's team of MPI ranks for shared photon phases, NULL when alone or built
  * without MPI; api_mpi_release ends it (thz_context_destroy). */
 const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx);
+/* The same team's side of render passes shared by pixel tiles. */
+const struct render_team *api_mpi_render_team(const thz_context *ctx);
 void api_mpi_release(thz_context *ctx);
 
 /* run_options from a context and settings. */

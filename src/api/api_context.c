@@ -117,6 +117,7 @@ void api_run_options(const thz_context *ctx, const thz_run_settings *settings, r
         opt->warning = ctx->warning;
         opt->warning_user = ctx->warning_user;
         opt->team = api_mpi_phase_team(ctx);
+        opt->render_team = api_mpi_render_team(ctx);
     }
     if (settings) {
         opt->keep_photon_maps = settings->keep_photons != 0;

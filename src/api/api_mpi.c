@@ -53,7 +53,7 @@ thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene, const thz_run
     if (st == THZ_OK && mpi_team_rank(team) == 0)
         st = thz_error_set(err, THZ_ERR_INTERNAL,
                            "thz_mpi_serve is for ranks other than 0, which leads the run");
-    if (st == THZ_OK && render_integrator_needs_photons(eff.render.integrator))
+    if (st == THZ_OK) /* every integrator renders tiles on every rank */
         st = accel_create(&eff, &acc, err);
     if (st == THZ_OK)
         st = mpi_team_serve(team, &eff, acc, ctx ? ctx->threads : 0, err);
@@ -75,6 +75,11 @@ uint64_t thz_context_mpi_bytes(const thz_context *ctx)
 const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx)
 {
     return ctx && ctx->team ? mpi_team_phase(ctx->team) : NULL;
+}
+
+const struct render_team *api_mpi_render_team(const thz_context *ctx)
+{
+    return ctx && ctx->team ? mpi_team_render(ctx->team) : NULL;
 }
 
 void api_mpi_release(thz_context *ctx)
@@ -108,6 +113,12 @@ uint64_t thz_context_mpi_bytes(const thz_context *ctx)
 }
 
 const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx)
+{
+    (void)ctx;
+    return NULL;
+}
+
+const struct render_team *api_mpi_render_team(const thz_context *ctx)
 {
     (void)ctx;
     return NULL;

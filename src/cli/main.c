@@ -21,7 +21,7 @@ static const command commands[] = {
     {"validate", cmd_validate, "check a scene; print its geometry and emitted power per channel",
      false},
     {"simulate", cmd_simulate, "fire photons and render every sensor of a scene", true},
-    {"render", cmd_render, "re-render sensors of a scene from a saved photon map", false},
+    {"render", cmd_render, "re-render sensors of a scene from a saved photon map", true},
     {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency", false},
     {"batch", cmd_batch, "run a sequence of frames (keyframes, sweeps) and make movies", false},
     {"materials", cmd_materials, "list the material library, or describe one material", false},
@@ -118,8 +118,8 @@ static int main_run(const command *c, int argc, char **argv)
     if (cli_mpi_size() > 1 && !c->shares_ranks) {
         if (cli_mpi_rank() == 0)
             fprintf(stderr,
-                    "thzmap %s: does not run over several MPI ranks (only simulate does); run "
-                    "it without mpirun\n",
+                    "thzmap %s: does not run over several MPI ranks (simulate, render and "
+                    "batch do); run it without mpirun\n",
                     c->name);
         return CLI_EXIT_USAGE;
     }

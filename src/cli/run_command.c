@@ -245,16 +245,12 @@ static int cli_run_load(const char *cmd, cli_run_args *a, bool render, thz_scene
                                     "integrator renders without one");
     for (size_t i = 0; i < thz_scene_warning_count(*scene); i++) /* --quiet hides progress only */
         fprintf(stderr, "thzmap %s: warning: %s\n", cmd, thz_scene_warning(*scene, i));
-    if (cli_mpi_size() > 1 && !thz_integrator_needs_photons(integrator))
-        fprintf(stderr,
-                "thzmap %s: warning: the %s integrator fires no photons: rank 0 renders alone "
-                "and the other %d MPI ranks wait (pixels are not shared yet)\n",
-                cmd, integrator, cli_mpi_size() - 1);
     return -1;
 }
 
-/* A rank other than 0 of an MPI run: fires its shares of rank 0's photon phases. A
- * failure ends the job, since rank 0 waits for the share. */
+/* A rank other than 0 of an MPI run: fires its shares of rank 0's photon phases and
+ * renders its pixel tiles of rank 0's render passes. A failure ends the job, since rank 0
+ * waits for the share. */
 static int cli_run_member(const char *cmd, const cli_run_args *a, const thz_scene *scene)
 {
     thz_error err = {0};

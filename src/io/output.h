@@ -59,7 +59,7 @@ typedef struct run_summary {
     uint64_t seed;
     uint64_t photons_per_channel;
     int threads;
-    int mpi_ranks; /* processes that shared the photon phases (docs/mpi.md); 1: alone */
+    int mpi_ranks; /* processes that shared the run (docs/mpi.md); 1: alone */
     const photon_stats *channel_stats;    /* n_channels entries, or NULL (render) */
     const run_noise *noise;               /* n_channels entries, or NULL */
     const run_noise *object_noise;        /* [channel * n_objects + object], or NULL */

@@ -1,5 +1,6 @@
-/* The MPI transport of shared photon phases: the lead's broadcast requests, the members'
- * shares in messages of at most 1 GiB, polling waits. */
+/* The MPI transport of shared photon phases and render passes: the lead's broadcast
+ * requests (and photon maps), the members' shares and tiles in messages of at most 1 GiB,
+ * polling waits. */
 #include "mpi/mpi_team.h"
 
 #include <mpi.h>
@@ -10,8 +11,9 @@
 #include <time.h>
 
 #include "core/alloc.h"
+#include "sensor/render_context.h"
 
-enum { TEAM_TAG_HEADER = 1, TEAM_TAG_RECORDS, TEAM_TAG_CHUNKS };
+enum { TEAM_TAG_HEADER = 1, TEAM_TAG_RECORDS, TEAM_TAG_CHUNKS, TEAM_TAG_TILES };
 
 /* MPI counts are int: larger payloads go in pieces of this many bytes. */
 #define TEAM_PIECE_BYTES ((size_t)1 << 30)
@@ -19,14 +21,23 @@ enum { TEAM_TAG_HEADER = 1, TEAM_TAG_RECORDS, TEAM_TAG_CHUNKS };
 struct mpi_team {
     MPI_Comm comm; /* a duplicate of MPI_COMM_WORLD, errors returned (not fatal) */
     int rank, size;
-    photon_phase_team phase; /* the lead's interface, impl = this team */
-    uint64_t bytes;          /* sent and received */
+    photon_phase_team phase; /* the lead's interfaces, impl = this team */
+    render_team render;
+    uint64_t bytes; /* sent and received */
 };
 
-/* What the lead broadcasts: a phase to fire, or the end of the team's work. */
+/* What the lead broadcasts: a phase to fire, a render channel to begin (the photon map's
+ * records follow) or end, a render pass, or the end of the team's work. */
+enum { TEAM_PHASE, TEAM_STOP, TEAM_RENDER_BEGIN, TEAM_RENDER_PASS, TEAM_RENDER_END };
+
 typedef struct team_message {
-    uint64_t stop;
-    photon_phase_request rq;
+    uint64_t kind;
+    photon_phase_request rq;    /* TEAM_PHASE */
+    render_channel_request rr;  /* TEAM_RENDER_BEGIN */
+    uint64_t map_count;         /* TEAM_RENDER_BEGIN: records of the map, 0: none (path) */
+    uint64_t map_batches;       /* its photon_map_batches */
+    double map_t0_k;            /* its reference temperature */
+    uint64_t sensor, pass;      /* TEAM_RENDER_PASS */
 } team_message;
 
 /* What a member sends first: the sizes of its share. */
@@ -70,6 +81,25 @@ static int team_bcast(mpi_team *t, team_message *m)
     return rc;
 }
 
+/* Broadcasts `bytes` bytes from the lead, in pieces. */
+static int team_bcast_bytes(mpi_team *t, void *data, size_t bytes)
+{
+    char *p = data;
+    while (bytes > 0) {
+        size_t n = bytes < TEAM_PIECE_BYTES ? bytes : TEAM_PIECE_BYTES;
+        MPI_Request req;
+        int rc = MPI_Ibcast(p, (int)n, MPI_BYTE, 0, t->comm, &req);
+        if (rc == MPI_SUCCESS)
+            rc = team_wait(&req);
+        if (rc != MPI_SUCCESS)
+            return rc;
+        t->bytes += n * (t->rank == 0 ? (uint64_t)(t->size - 1) : 1u);
+        p += n;
+        bytes -= n;
+    }
+    return MPI_SUCCESS;
+}
+
 /* Sends (to the lead) or receives (from rank `peer`) `bytes` bytes in pieces. */
 static int team_move(mpi_team *t, void *data, size_t bytes, int peer, int tag, bool send)
 {
@@ -92,7 +122,7 @@ static int team_move(mpi_team *t, void *data, size_t bytes, int peer, int tag, b
 
 static thz_status team_start(void *impl, const photon_phase_request *rq, thz_error *err)
 {
-    team_message m = {.stop = 0, .rq = *rq};
+    team_message m = {.kind = TEAM_PHASE, .rq = *rq};
     int rc = team_bcast(impl, &m);
     return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "broadcasting a photon phase");
 }
@@ -150,6 +180,67 @@ cleanup:
     return st;
 }
 
+static thz_status team_render_begin(void *impl, const render_channel_request *rq,
+                                    const photon_map *map, thz_error *err)
+{
+    mpi_team *t = impl;
+    team_message m = {.kind = TEAM_RENDER_BEGIN, .rr = *rq};
+    if (map) {
+        m.map_count = photon_map_count(map);
+        m.map_batches = photon_map_batches(map);
+        m.map_t0_k = photon_map_reference_temperature_k(map);
+    }
+    int rc = team_bcast(t, &m);
+    if (rc == MPI_SUCCESS && map) /* read only: MPI does not write a root's buffer */
+        rc = team_bcast_bytes(t, (void *)photon_map_records(map),
+                              m.map_count * sizeof(photon_record));
+    return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "sending the photon map");
+}
+
+static thz_status team_render_pass(void *impl, size_t sensor, uint32_t pass, thz_error *err)
+{
+    team_message m = {.kind = TEAM_RENDER_PASS, .sensor = sensor, .pass = pass};
+    int rc = team_bcast(impl, &m);
+    return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "broadcasting a render pass");
+}
+
+static thz_status team_render_end(void *impl, thz_error *err)
+{
+    team_message m = {.kind = TEAM_RENDER_END};
+    int rc = team_bcast(impl, &m);
+    return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "ending a render channel");
+}
+
+/* The lead receives each member's counts and tiles, in member order, into acc. */
+static thz_status team_render_gather(void *impl, render_accum *acc, uint32_t columns,
+                                     render_stats *stats, thz_error *err)
+{
+    mpi_team *t = impl;
+    size_t members = (size_t)t->size, per = render_tiles_doubles_per_pixel(acc), most = 0;
+    for (size_t r = 1; r < members; r++) {
+        size_t n = render_tiles_count(acc->pixels, columns, r, members);
+        most = n > most ? n : most;
+    }
+    double *tiles = thz_malloc_array(most > 0 ? most * per : 1, sizeof *tiles);
+    if (!tiles)
+        return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for %zu pixels' tiles",
+                             most);
+    int rc = MPI_SUCCESS;
+    for (size_t r = 1; rc == MPI_SUCCESS && r < members; r++) {
+        render_stats counts;
+        rc = team_move(t, &counts, sizeof counts, (int)r, TEAM_TAG_HEADER, false);
+        size_t n = render_tiles_count(acc->pixels, columns, r, members);
+        if (rc == MPI_SUCCESS)
+            rc = team_move(t, tiles, n * per * sizeof *tiles, (int)r, TEAM_TAG_TILES, false);
+        if (rc == MPI_SUCCESS) {
+            render_tiles_unpack(acc, columns, r, members, tiles);
+            render_stats_add_counts(stats, &counts);
+        }
+    }
+    free(tiles);
+    return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "receiving the render tiles");
+}
+
 thz_status mpi_team_create(mpi_team **out, thz_error *err)
 {
     *out = NULL;
@@ -170,6 +261,12 @@ thz_status mpi_team_create(mpi_team **out, thz_error *err)
     MPI_Comm_size(t->comm, &t->size);
     t->phase = (photon_phase_team){
         .members = (size_t)t->size, .start = team_start, .gather = team_gather, .impl = t};
+    t->render = (render_team){.members = (size_t)t->size,
+                              .channel_begin = team_render_begin,
+                              .pass_start = team_render_pass,
+                              .pass_gather = team_render_gather,
+                              .channel_end = team_render_end,
+                              .impl = t};
     *out = t;
     return THZ_OK;
 }
@@ -179,7 +276,7 @@ void mpi_team_destroy(mpi_team *team)
     if (!team)
         return;
     if (team->rank == 0) {
-        team_message m = {.stop = 1};
+        team_message m = {.kind = TEAM_STOP};
         team_bcast(team, &m);
     }
     MPI_Comm_free(&team->comm);
@@ -201,9 +298,125 @@ const photon_phase_team *mpi_team_phase(const mpi_team *team)
     return &team->phase;
 }
 
+const render_team *mpi_team_render(const mpi_team *team)
+{
+    return &team->render;
+}
+
 uint64_t mpi_team_bytes(const mpi_team *team)
 {
     return team ? team->bytes : 0;
+}
+
+/* A member's photon share of request rq, fired and sent to the lead. */
+static thz_status team_serve_phase(mpi_team *t, const thz_scene *scene, const accel *acc,
+                                   const photon_phase_request *rq, int threads, thz_error *err)
+{
+    photon_phase_share share;
+    thz_status st = photon_phase_fire_share(scene, acc, rq, threads, (size_t)t->rank,
+                                            (size_t)t->size, &share, err);
+    if (st != THZ_OK)
+        return st;
+    team_header head = {.count = share.count, .n_chunks = share.n_chunks};
+    int rc = team_move(t, &head, sizeof head, 0, TEAM_TAG_HEADER, true);
+    if (rc == MPI_SUCCESS)
+        rc = team_move(t, share.records, share.count * sizeof *share.records, 0, TEAM_TAG_RECORDS,
+                       true);
+    if (rc == MPI_SUCCESS)
+        rc = team_move(t, share.chunks, share.n_chunks * sizeof *share.chunks, 0, TEAM_TAG_CHUNKS,
+                       true);
+    photon_phase_share_fini(&share);
+    return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "sending the photon share");
+}
+
+/* A member's state of the render channel in progress: the lead's photon map, the
+ * channel's tables, and per scene sensor the statistics of this member's tiles. */
+typedef struct team_render {
+    photon_map *map;
+    render_context *ctx;
+    render_options ro;
+    render_accum *accs; /* per scene sensor, pixels 0 until its first pass */
+    size_t n_sensors;
+} team_render;
+
+static void team_render_fini(team_render *r)
+{
+    render_context_destroy(r->ctx);
+    photon_map_destroy(r->map);
+    for (size_t i = 0; r->accs && i < r->n_sensors; i++)
+        render_accum_fini(&r->accs[i]);
+    free(r->accs);
+    memset(r, 0, sizeof *r);
+}
+
+/* TEAM_RENDER_BEGIN: receives the lead's photon map and builds the same channel state. */
+static thz_status team_serve_begin(mpi_team *t, const thz_scene *scene, const accel *acc,
+                                   const team_message *m, int threads, team_render *r,
+                                   thz_error *err)
+{
+    team_render_fini(r);
+    if (m->rr.channel >= scene->n_channels)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "MPI: the lead renders channel %llu, the scene has %zu",
+                             (unsigned long long)m->rr.channel, scene->n_channels);
+    r->ro = (render_options){.threads = threads,
+                             .use_seed = m->rr.use_seed != 0,
+                             .seed = m->rr.seed,
+                             .member = (size_t)t->rank,
+                             .members = (size_t)t->size};
+    r->n_sensors = scene->n_sensors;
+    r->accs = thz_calloc(r->n_sensors ? r->n_sensors : 1, sizeof *r->accs);
+    if (!r->accs)
+        return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for the pixel statistics");
+    if (m->map_count > 0) {
+        photon_record *records = m->map_count <= SIZE_MAX / sizeof *records
+                                     ? thz_malloc_array(m->map_count, sizeof *records)
+                                     : NULL;
+        if (!records)
+            return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for %llu photon records",
+                                 (unsigned long long)m->map_count);
+        int rc = team_bcast_bytes(t, records, m->map_count * sizeof *records);
+        if (rc != MPI_SUCCESS) {
+            free(records);
+            return team_error(err, rc, "receiving the photon map");
+        }
+        /* takes records, also on failure; sorts them as the lead's map was sorted */
+        thz_status st = photon_map_create(records, m->map_count, scene->n_objects, threads,
+                                          &r->map, err);
+        if (st != THZ_OK)
+            return st;
+        photon_map_set_reference_temperature_k(r->map, m->map_t0_k);
+        photon_map_set_batches(r->map, (unsigned)m->map_batches);
+    }
+    return render_context_create(scene, acc, r->map, m->rr.channel, &r->ro, &r->ctx, err);
+}
+
+/* TEAM_RENDER_PASS: renders this member's tiles and sends them to the lead. */
+static thz_status team_serve_pass(mpi_team *t, const thz_scene *scene, const team_message *m,
+                                  team_render *r, thz_error *err)
+{
+    if (!r->ctx || m->sensor >= r->n_sensors)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "MPI: a render pass outside a channel");
+    const thz_sensor *sn = &scene->sensors[m->sensor];
+    render_accum *a = &r->accs[m->sensor];
+    size_t pixels = (size_t)sn->columns * sn->rows;
+    thz_status st = a->pixels ? THZ_OK : render_accum_init(a, pixels, err);
+    render_stats counts;
+    if (st == THZ_OK)
+        st = render_context_pass(r->ctx, m->sensor, (uint32_t)m->pass, a, &r->ro, &counts, err);
+    if (st != THZ_OK)
+        return st;
+    size_t n = render_tiles_count(pixels, sn->columns, r->ro.member, r->ro.members) *
+               render_tiles_doubles_per_pixel(a);
+    double *tiles = thz_malloc_array(n ? n : 1, sizeof *tiles);
+    if (!tiles)
+        return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for %zu pixels' tiles", n);
+    render_tiles_pack(a, sn->columns, r->ro.member, r->ro.members, tiles);
+    int rc = team_move(t, &counts, sizeof counts, 0, TEAM_TAG_HEADER, true);
+    if (rc == MPI_SUCCESS)
+        rc = team_move(t, tiles, n * sizeof *tiles, 0, TEAM_TAG_TILES, true);
+    free(tiles);
+    return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "sending the render tiles");
 }
 
 thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *acc, int threads,
@@ -211,33 +424,41 @@ thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *a
 {
     if (team->rank == 0)
         return thz_error_set(err, THZ_ERR_INTERNAL, "MPI: rank 0 leads, it does not serve");
-    for (;;) {
+    team_render render = {0};
+    thz_status st = THZ_OK;
+    while (st == THZ_OK) {
         team_message m;
         int rc = team_bcast(team, &m);
-        if (rc != MPI_SUCCESS)
-            return team_error(err, rc, "waiting for the lead's request");
-        if (m.stop)
-            return THZ_OK;
-        if (!acc) /* this rank's settings need no photons, the lead's do */
-            return thz_error_set(err, THZ_ERR_INPUT,
-                                 "MPI: the lead asks for photons but process %d's integrator "
-                                 "fires none (every process must run with the same options)",
-                                 team->rank);
-        photon_phase_share share;
-        thz_status st = photon_phase_fire_share(scene, acc, &m.rq, threads, (size_t)team->rank,
-                                                (size_t)team->size, &share, err);
-        if (st != THZ_OK)
-            return st;
-        team_header head = {.count = share.count, .n_chunks = share.n_chunks};
-        rc = team_move(team, &head, sizeof head, 0, TEAM_TAG_HEADER, true);
-        if (rc == MPI_SUCCESS)
-            rc = team_move(team, share.records, share.count * sizeof *share.records, 0,
-                           TEAM_TAG_RECORDS, true);
-        if (rc == MPI_SUCCESS)
-            rc = team_move(team, share.chunks, share.n_chunks * sizeof *share.chunks, 0,
-                           TEAM_TAG_CHUNKS, true);
-        photon_phase_share_fini(&share);
-        if (rc != MPI_SUCCESS)
-            return team_error(err, rc, "sending the photon share");
+        if (rc != MPI_SUCCESS) {
+            st = team_error(err, rc, "waiting for the lead's request");
+            break;
+        }
+        if (m.kind == TEAM_STOP)
+            break;
+        switch (m.kind) {
+        case TEAM_PHASE:
+            if (!render_integrator_needs_photons(scene->render.integrator))
+                st = thz_error_set(err, THZ_ERR_INPUT,
+                                   "MPI: the lead asks for photons but process %d's integrator "
+                                   "fires none (every process must run with the same options)",
+                                   team->rank);
+            else
+                st = team_serve_phase(team, scene, acc, &m.rq, threads, err);
+            break;
+        case TEAM_RENDER_BEGIN:
+            st = team_serve_begin(team, scene, acc, &m, threads, &render, err);
+            break;
+        case TEAM_RENDER_PASS:
+            st = team_serve_pass(team, scene, &m, &render, err);
+            break;
+        case TEAM_RENDER_END:
+            team_render_fini(&render);
+            break;
+        default:
+            st = thz_error_set(err, THZ_ERR_INTERNAL, "MPI: unknown request %llu from the lead",
+                               (unsigned long long)m.kind);
+        }
     }
+    team_render_fini(&render);
+    return st;
 }

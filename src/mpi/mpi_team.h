@@ -4,9 +4,11 @@
  * Rank 0 (the lead) runs simulate as one process would; its photon phases go through
  * the team (photon/phase.h "a phase shared by processes"): the lead broadcasts each
  * phase's request, every rank fires its share of the batches, and the lead gathers the
- * shares in rank order. The other ranks (members) only serve requests: mpi_team_serve
- * loops until the lead's mpi_team_destroy tells them to stop. Only the lead renders and
- * writes. The caller initialises MPI (MPI_THREAD_FUNNELED: only the thread that created
+ * shares in rank order. Its render passes go through the team too (sensor/render_tiles.h):
+ * the lead sends each channel's photon map, every rank renders its pixel tiles of each
+ * pass, and the lead copies the others' tiles into its images. The other ranks (members)
+ * only serve requests: mpi_team_serve loops until the lead's mpi_team_destroy tells them
+ * to stop. Only the lead writes. The caller initialises MPI (MPI_THREAD_FUNNELED: only the thread that created
  * the team calls MPI) and finalises it after destroying the team; the library never
  * aborts: a failed rank returns its error, and the program ends the job (MPI_Abort).
  *
@@ -23,6 +25,7 @@
 #include "core/error.h"
 #include "photon/phase.h"
 #include "scene/scene.h"
+#include "sensor/render_tiles.h"
 
 typedef struct mpi_team mpi_team;
 
@@ -40,9 +43,13 @@ size_t mpi_team_size(const mpi_team *team);
 /* The lead's side of shared photon phases (valid while the team lives). */
 const photon_phase_team *mpi_team_phase(const mpi_team *team);
 
-/* A member's side: fires its share of each request the lead broadcasts, from scene and
- * acc (the same scene, with the same overrides, as the lead's), with `threads` OpenMP
- * threads, and sends it to the lead; returns THZ_OK when the lead stops the team. */
+/* The lead's side of render passes shared by pixel tiles (sensor/render_tiles.h). */
+const render_team *mpi_team_render(const mpi_team *team);
+
+/* A member's side: fires its share of each photon phase the lead broadcasts, and renders
+ * its tiles of each render pass, from scene and acc (the same scene, with the same
+ * overrides, as the lead's), with `threads` OpenMP threads, and sends them to the lead;
+ * returns THZ_OK when the lead stops the team. */
 thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *acc, int threads,
                           thz_error *err);
 

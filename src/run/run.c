@@ -22,6 +22,7 @@
 #include "sensor/images.h"
 #include "sensor/measure.h"
 #include "sensor/render.h"
+#include "sensor/render_tiles.h"
 #include "sensor/truth.h"
 
 /* A noise target stops here at the latest (with a run warning). */
@@ -218,6 +219,9 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
                          .seed = rs->seed, /* the photon map's, for render */
                          .progress = rs->opt->progress,
                          .progress_user = rs->opt->progress_user};
+    const render_team *team = rs->opt->render_team;
+    if (team) /* this process renders its tiles, the others theirs */
+        ro.members = team->members;
     double t0 = thz_now_s();
     double target =
         render_integrator_has_passes(rs->scene->render.integrator) ? rs->target_noise_k : 0.0;
@@ -231,12 +235,22 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
     }
     /* the channel's tables, built once for all its passes and sensors */
     render_context *ctx = NULL;
+    if (st == THZ_OK && team) {
+        render_channel_request rq = {.channel = c, .use_seed = ro.use_seed, .seed = ro.seed};
+        st = team->channel_begin(team->impl, &rq, map, err);
+    }
     if (st == THZ_OK)
         st = render_context_create(rs->scene, rs->accel, map, c, &ro, &ctx, err);
     for (uint32_t pass = 0; st == THZ_OK; pass++) {
         for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
             render_stats rst;
-            st = render_context_pass(ctx, rs->selected[i], pass, &acc[i], &ro, &rst, err);
+            if (team)
+                st = team->pass_start(team->impl, rs->selected[i], pass, err);
+            if (st == THZ_OK)
+                st = render_context_pass(ctx, rs->selected[i], pass, &acc[i], &ro, &rst, err);
+            if (st == THZ_OK && team)
+                st = team->pass_gather(team->impl, &acc[i],
+                                       rs->scene->sensors[rs->selected[i]].columns, &rst, err);
             if (st != THZ_OK)
                 break;
             rs->last[c * rs->n_selected + i] = rst;
@@ -259,6 +273,8 @@ static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *
             break;
         }
     }
+    if (st == THZ_OK && team)
+        st = team->channel_end(team->impl, err);
     render_context_destroy(ctx);
     if (acc)
         for (size_t i = 0; i < rs->n_selected; i++)

@@ -58,6 +58,9 @@ typedef struct run_options {
     const char *sensor_name; /* only this sensor; NULL: all */
     /* simulate: the processes sharing each photon phase (photon/phase.h); NULL: alone */
     const struct photon_phase_team *team;
+    /* the processes sharing each render pass by pixel tiles (sensor/render_tiles.h);
+       NULL: alone */
+    const struct render_team *render_team;
     thz_progress_fn progress; /* stages "photons", "render", "output"; may be NULL */
     void *progress_user;
     thz_warning_fn warning; /* each run warning as it is added; may be NULL */

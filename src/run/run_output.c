@@ -12,6 +12,7 @@
 #include "io/ply.h"
 #include "photon/phase.h"
 #include "run/run.h"
+#include "sensor/render_tiles.h"
 
 /* What summary.json says of the run beyond the scene. */
 static run_summary run_summary_of(const run_state *rs)
@@ -22,10 +23,8 @@ static run_summary run_summary_of(const run_state *rs)
         .seed = rs->seed,
         .photons_per_channel = rs->photons_per_channel,
         .threads = rs->opt->threads > 0 ? rs->opt->threads : omp_get_max_threads(),
-        /* the processes that shared the photon phases (path fires none: 1) */
-        .mpi_ranks = rs->opt->team && render_integrator_needs_photons(rs->scene->render.integrator)
-                         ? (int)rs->opt->team->members
-                         : 1,
+        /* the processes that shared the run: its photon phases and render passes */
+        .mpi_ranks = rs->opt->render_team ? (int)rs->opt->render_team->members : 1,
         /* render: the statistics of the photon phase that made the map it read */
         .channel_stats =
             render_integrator_needs_photons(rs->scene->render.integrator) ? rs->stats : NULL,

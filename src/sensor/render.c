@@ -13,6 +13,7 @@
 #include "core/clock.h"
 #include "sensor/camera.h"
 #include "sensor/integrator.h"
+#include "sensor/render_tiles.h"
 
 static int render_threads(const render_options *opt)
 {
@@ -119,6 +120,7 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
     uint32_t block = (uint32_t)(65536 / (work_per_row ? work_per_row : 1));
     if (block < 1)
         block = 1;
+    size_t members = opt ? opt->members : 0, member = opt ? opt->member : 0;
     uint64_t n_samples = 0, n_escaped = 0, n_back = 0, n_widened = 0, n_starved = 0,
              n_truncated = 0, n_paths = 0;
 
@@ -138,14 +140,14 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads) \
     reduction(+ : n_samples, n_escaped, n_back, n_widened, n_starved, n_truncated, n_paths)
         for (int64_t px = first; px < last; px++) {
-            if (render_poll_stop(&poll))
+            uint32_t row = (uint32_t)(px / cols), col = (uint32_t)(px % cols);
+            if (render_tile_owner(col, row, members) != member || render_poll_stop(&poll))
                 continue;
             double *est = &scratch[(size_t)omp_get_thread_num() * per_thread];
             for (size_t j = 0; j < per_thread; j++)
                 est[j] = 0.0;
             double *pixel_batch = batched ? est + n_est : NULL;
             double *pixel_disk_var = batched ? est + n_est + PHOTON_MAP_BATCHES : NULL;
-            uint32_t row = (uint32_t)(px / cols), col = (uint32_t)(px % cols);
             double omega_sr = camera_pixel_solid_angle(&cam, col, row);
             double sample_sr = omega_sr / n2;
             double var_sum = 0.0;

@@ -79,6 +79,9 @@ typedef struct render_options {
      * so that reflected and transmitted terms do not vanish against B(T0). */
     bool path_t0_set;
     double path_t0_k;
+    /* pixel tiles shared by processes (render_tiles.h): render only member's tiles of
+     * `members`; members 0 or 1: every pixel */
+    size_t member, members;
 } render_options;
 
 /* Cancelling inside a parallel pixel loop, so that a run stops within a second however
