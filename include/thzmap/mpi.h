@@ -6,11 +6,13 @@
  * call fails on any rank, the program ends the job (MPI_Abort), since the other ranks may
  * be waiting for it. Every rank loads the same scene with the same run settings.
  *
- * Rank 0 calls thz_context_set_mpi and then thz_simulate as one process would: each photon
- * phase is split by batches of photons across the ranks and gathered in photon order, so
- * that rank 0's run (images, photon maps, statistics) is bit-identical to one process's
- * with the same seed. The other ranks call thz_mpi_serve, which returns when rank 0
- * destroys its context. Only rank 0 renders and writes.
+ * Rank 0 calls thz_context_set_mpi and then thz_simulate, thz_render_run or thz_batch_run
+ * as one process would: each photon phase is split by batches of photons across the ranks
+ * and gathered in photon order, and each render pass by pixel tiles, each rank rendering
+ * its tiles from the same photon map (rank 0 sends it), so that rank 0's run (images,
+ * photon maps, statistics) is bit-identical to one process's with the same seed. The
+ * other ranks call thz_mpi_serve (thz_mpi_serve_batch for a batch), which returns when
+ * rank 0 destroys its context. Only rank 0 writes.
  */
 #ifndef THZMAP_MPI_H
 #define THZMAP_MPI_H
@@ -34,6 +36,14 @@ THZ_API thz_status thz_context_set_mpi(thz_context *ctx, thz_error *err);
  * context. A failure (a scene that differs from rank 0's, out of memory) returns it. */
 THZ_API thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene,
                                  const thz_run_settings *settings, thz_error *err);
+
+/* Ranks other than 0 of a batch (thz_batch_run on rank 0 with thz_context_set_mpi): for
+ * each frame rank 0 runs, loads the frame's scene from seq (the same sequence file) and
+ * serves its photon phases and render passes as thz_mpi_serve does, until rank 0 destroys
+ * its context. */
+struct thz_sequence;
+THZ_API thz_status thz_mpi_serve_batch(thz_context *ctx, const struct thz_sequence *seq,
+                                       thz_error *err);
 
 /* Bytes this rank sent and received for shared photon phases through ctx. */
 THZ_API uint64_t thz_context_mpi_bytes(const thz_context *ctx);

@@ -65,6 +65,9 @@ const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx);
 /* The same team's side of render passes shared by pixel tiles. */
 const struct render_team *api_mpi_render_team(const thz_context *ctx);
 void api_mpi_release(thz_context *ctx);
+/* Rank 0 of a batch: the other ranks load scene `scene` (a frame of the sequence they
+ * serve, thz_mpi_serve_batch) for the runs that follow. Nothing when alone. */
+thz_status api_mpi_next_scene(thz_context *ctx, size_t scene, thz_error *err);
 
 /* run_options from a context and settings. */
 void api_run_options(const thz_context *ctx, const thz_run_settings *settings, run_options *opt);

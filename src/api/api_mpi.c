@@ -5,6 +5,7 @@
 #ifdef THZ_HAVE_MPI
 #include "accel/accel.h"
 #include "mpi/mpi_team.h"
+#include "thzmap/batch.h"
 #endif
 
 int thz_mpi_supported(void)
@@ -37,6 +38,33 @@ thz_status thz_context_set_mpi(thz_context *ctx, thz_error *err)
     return api_done(ctx, st, err);
 }
 
+/* Serves the lead's requests on `scene` (with settings' overrides) until it stops the
+ * team or, when next_scene is not NULL, names another scene. */
+static thz_status api_mpi_serve_scene(mpi_team *team, const thz_context *ctx,
+                                      const thz_scene *scene, const thz_run_settings *settings,
+                                      uint64_t *next_scene, thz_error *err)
+{
+    accel *acc = NULL;
+    thz_scene eff;
+    thz_status st = api_effective_scene(scene, settings, &eff, err);
+    if (st == THZ_OK) /* every integrator renders tiles on every rank */
+        st = accel_create(&eff, &acc, err);
+    if (st == THZ_OK)
+        st = mpi_team_serve(team, &eff, acc, ctx ? ctx->threads : 0, next_scene, err);
+    accel_destroy(acc);
+    return st;
+}
+
+/* A member's team, created collectively with the lead's; not for rank 0. */
+static thz_status api_mpi_member_team(mpi_team **team, thz_error *err)
+{
+    thz_status st = mpi_team_create(team, err);
+    if (st == THZ_OK && mpi_team_rank(*team) == 0)
+        st = thz_error_set(err, THZ_ERR_INTERNAL,
+                           "thz_mpi_serve is for ranks other than 0, which leads the run");
+    return st;
+}
+
 thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene, const thz_run_settings *settings,
                          thz_error *err)
 {
@@ -45,24 +73,46 @@ thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene, const thz_run
     if (!scene)
         return api_done(ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_mpi_serve: no scene"), err);
     mpi_team *team = NULL;
-    accel *acc = NULL;
-    thz_scene eff;
-    thz_status st = api_effective_scene(scene, settings, &eff, err);
+    thz_status st = api_mpi_member_team(&team, err);
     if (st == THZ_OK)
-        st = mpi_team_create(&team, err);
-    if (st == THZ_OK && mpi_team_rank(team) == 0)
-        st = thz_error_set(err, THZ_ERR_INTERNAL,
-                           "thz_mpi_serve is for ranks other than 0, which leads the run");
-    if (st == THZ_OK) /* every integrator renders tiles on every rank */
-        st = accel_create(&eff, &acc, err);
-    if (st == THZ_OK)
-        st = mpi_team_serve(team, &eff, acc, ctx ? ctx->threads : 0, err);
+        st = api_mpi_serve_scene(team, ctx, scene, settings, NULL, err);
     if (ctx && st == THZ_OK)
         ctx->mpi_bytes = mpi_team_bytes(team);
-    accel_destroy(acc);
     if (st == THZ_OK) /* a failed rank leaves the team to MPI_Abort */
         mpi_team_destroy(team);
     return api_done(ctx, st, err);
+}
+
+thz_status thz_mpi_serve_batch(thz_context *ctx, const thz_sequence *seq, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    if (!seq)
+        return api_done(ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_mpi_serve_batch: no sequence"),
+                        err);
+    mpi_team *team = NULL;
+    thz_status st = api_mpi_member_team(&team, err);
+    uint64_t frame = MPI_TEAM_STOPPED;
+    if (st == THZ_OK) { /* until the first frame the lead runs: the lead may have none */
+        st = mpi_team_serve(team, NULL, NULL, ctx ? ctx->threads : 0, &frame, err);
+    }
+    while (st == THZ_OK && frame != MPI_TEAM_STOPPED) {
+        thz_scene *scene = NULL;
+        st = thz_sequence_frame_scene(seq, (size_t)frame, &scene, err);
+        if (st == THZ_OK)
+            st = api_mpi_serve_scene(team, ctx, scene, NULL, &frame, err);
+        thz_scene_destroy(scene);
+    }
+    if (ctx && st == THZ_OK)
+        ctx->mpi_bytes = mpi_team_bytes(team);
+    if (st == THZ_OK)
+        mpi_team_destroy(team);
+    return api_done(ctx, st, err);
+}
+
+thz_status api_mpi_next_scene(thz_context *ctx, size_t scene, thz_error *err)
+{
+    return ctx && ctx->team ? mpi_team_next_scene(ctx->team, scene, err) : THZ_OK;
 }
 
 uint64_t thz_context_mpi_bytes(const thz_context *ctx)
@@ -104,6 +154,20 @@ thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene, const thz_run
     (void)scene;
     (void)settings;
     return thz_context_set_mpi(ctx, err);
+}
+
+thz_status thz_mpi_serve_batch(thz_context *ctx, const thz_sequence *seq, thz_error *err)
+{
+    (void)seq;
+    return thz_context_set_mpi(ctx, err);
+}
+
+thz_status api_mpi_next_scene(thz_context *ctx, size_t scene, thz_error *err)
+{
+    (void)ctx;
+    (void)scene;
+    (void)err;
+    return THZ_OK;
 }
 
 uint64_t thz_context_mpi_bytes(const thz_context *ctx)

@@ -301,6 +301,8 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
     int photons = st == THZ_OK && batch_uses_photons(scene);
     int reuse = photons && b->base[f] != f;
     int keep = photons && f + 1 < seq->n_frames && b->base[f + 1] == f;
+    if (st == THZ_OK) /* under MPI the other ranks serve this frame's scene */
+        st = api_mpi_next_scene(ctx, f, err);
     if (st == THZ_OK)
         st = thz_output_open(dir, &output, err);
     thz_output **guard = b->opt ? b->opt->open_output : NULL;

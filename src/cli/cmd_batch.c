@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "cli_mpi.h"
 #include "progress.h"
 #include "run_command.h"
 #include "thzmap/thzmap.h"
@@ -112,11 +113,29 @@ static void batch_on_warning(void *user, const char *message)
     fprintf(stderr, "thzmap batch: warning: %s\n", message);
 }
 
-int cmd_batch(int argc, char **argv)
+/* A rank other than 0 of an MPI batch: serves every frame rank 0 runs. A failure ends
+ * the job, since rank 0 waits for it. */
+static int batch_member(const thz_sequence *seq, int threads)
 {
-    const char *seq_path = NULL, *outdir = NULL;
-    uint64_t threads = 0;
-    batch_cli b = {.tty = isatty(STDERR_FILENO) != 0};
+    thz_error err = {0};
+    thz_context *ctx = thz_context_create();
+    if (!ctx) {
+        fprintf(stderr, "thzmap batch (MPI rank %d): out of memory\n", cli_mpi_rank());
+        cli_mpi_abort(CLI_EXIT_FAILURE);
+    }
+    thz_context_set_threads(ctx, threads);
+    if (thz_mpi_serve_batch(ctx, seq, &err) != THZ_OK) {
+        fprintf(stderr, "thzmap batch (MPI rank %d): %s\n", cli_mpi_rank(), err.message);
+        cli_mpi_abort(err.status == THZ_ERR_INPUT ? CLI_EXIT_USAGE : CLI_EXIT_FAILURE);
+    }
+    thz_context_destroy(ctx);
+    return CLI_EXIT_OK;
+}
+
+/* Parses argv; -1 to go on, or the exit status. */
+static int batch_parse(int argc, char **argv, const char **seq_path, const char **outdir,
+                       uint64_t *threads, batch_cli *b)
+{
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (cli_is_help(arg)) {
@@ -128,38 +147,72 @@ int cmd_batch(int argc, char **argv)
                 return cli_usage_error("batch", "%s needs a value", arg);
             const char *val = argv[++i];
             if (!strcmp(arg, "--threads")) {
-                if (!cli_parse_u64("batch", arg, val, 1, 4096, &threads))
+                if (!cli_parse_u64("batch", arg, val, 1, 4096, threads))
                     return CLI_EXIT_USAGE;
             } else {
-                outdir = val;
+                *outdir = val;
             }
         } else if (!strcmp(arg, "--quiet") || !strcmp(arg, "-q")) {
-            b.quiet = true;
+            b->quiet = true;
         } else if (arg[0] == '-' && arg[1]) {
             return cli_usage_error("batch", "unknown option '%s'", arg);
-        } else if (!seq_path) {
-            seq_path = arg;
+        } else if (!*seq_path) {
+            *seq_path = arg;
         } else {
             return cli_usage_error("batch", "unexpected argument '%s'", arg);
         }
     }
-    if (!seq_path)
+    if (!*seq_path)
         return cli_usage_error("batch", "no sequence file given");
-    if (!outdir)
+    if (!*outdir)
         return cli_usage_error("batch", "no output directory given (-o OUTDIR)");
+    return -1;
+}
+
+int cmd_batch(int argc, char **argv)
+{
+    const char *seq_path = NULL, *outdir = NULL;
+    uint64_t threads = 0;
+    batch_cli b = {.tty = isatty(STDERR_FILENO) != 0};
+    thz_sequence *seq = NULL;
+    /* Under mpirun every rank parses and loads alike; rank 0 alone says what is wrong. */
+    cli_mpi_quiet_begin();
+    int rc = batch_parse(argc, argv, &seq_path, &outdir, &threads, &b);
+    thz_error err = {0};
+    if (rc < 0 && thz_sequence_load(seq_path, &seq, &err) != THZ_OK)
+        rc = cli_fail(&err);
+    cli_mpi_quiet_end();
+    int lead_rc = rc, failed = cli_mpi_agree(rc < 0, rc, &lead_rc);
+    if (failed >= 0) {
+        thz_sequence_destroy(seq);
+        if (lead_rc >= 0)
+            return lead_rc;
+        if (cli_mpi_rank() == 0)
+            fprintf(stderr,
+                    "thzmap batch: MPI rank %d could not load the sequence rank 0 did (is %s "
+                    "the same file on every node?)\n",
+                    failed, seq_path);
+        return CLI_EXIT_FAILURE;
+    }
+    bool shared = cli_mpi_size() > 1;
+    if (shared && cli_mpi_rank() > 0) {
+        rc = batch_member(seq, (int)threads);
+        thz_sequence_destroy(seq);
+        return rc;
+    }
 
     cli_signals_install();
-    thz_error err = {0};
-    thz_sequence *seq = NULL;
-    if (thz_sequence_load(seq_path, &seq, &err) != THZ_OK)
-        return cli_fail(&err);
     thz_context *ctx = thz_context_create();
     if (!ctx) {
         thz_sequence_destroy(seq);
         fprintf(stderr, "thzmap batch: out of memory\n");
+        if (shared) /* the other ranks wait for this one: end them too */
+            cli_mpi_abort(CLI_EXIT_FAILURE);
         return CLI_EXIT_FAILURE;
     }
     thz_context_set_threads(ctx, (int)threads);
+    if (shared && thz_context_set_mpi(ctx, &err) != THZ_OK)
+        cli_mpi_abort(cli_fail(&err));
     thz_context_set_progress(ctx, batch_on_run_progress, &b);
     thz_context_set_warning(ctx, batch_on_warning, &b);
     if (!b.quiet)
@@ -173,7 +226,7 @@ int cmd_batch(int argc, char **argv)
     thz_status st = thz_batch_run(ctx, seq, outdir, &opt, &res, &err);
     if (b.line_open)
         fputs("\r\033[K", stderr);
-    int rc = CLI_EXIT_OK;
+    rc = CLI_EXIT_OK;
     if (st == THZ_ERR_CANCELLED) {
         fprintf(stderr,
                 "thzmap batch: interrupted after %zu new frame%s; finished frames stay in %s "
@@ -187,7 +240,9 @@ int cmd_batch(int argc, char **argv)
                "results in %s\n",
                res.n_frames, res.computed, res.reused, res.movies, res.seconds, outdir);
     }
-    thz_context_destroy(ctx);
+    if (shared && rc != CLI_EXIT_OK) /* the other ranks may be waiting for rank 0 */
+        cli_mpi_abort(rc);
+    thz_context_destroy(ctx); /* ends the other ranks' thz_mpi_serve_batch */
     thz_sequence_destroy(seq);
     return rc;
 }

@@ -23,7 +23,7 @@ static const command commands[] = {
     {"simulate", cmd_simulate, "fire photons and render every sensor of a scene", true},
     {"render", cmd_render, "re-render sensors of a scene from a saved photon map", true},
     {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency", false},
-    {"batch", cmd_batch, "run a sequence of frames (keyframes, sweeps) and make movies", false},
+    {"batch", cmd_batch, "run a sequence of frames (keyframes, sweeps) and make movies", true},
     {"materials", cmd_materials, "list the material library, or describe one material", false},
     {"bands", cmd_bands, "choose the channel frequencies that best separate a scene's targets",
      false},

@@ -27,17 +27,19 @@ struct mpi_team {
 };
 
 /* What the lead broadcasts: a phase to fire, a render channel to begin (the photon map's
- * records follow) or end, a render pass, or the end of the team's work. */
-enum { TEAM_PHASE, TEAM_STOP, TEAM_RENDER_BEGIN, TEAM_RENDER_PASS, TEAM_RENDER_END };
+ * records follow) or end, a render pass, another scene (batch frames), or the end of the
+ * team's work. */
+enum { TEAM_PHASE, TEAM_STOP, TEAM_RENDER_BEGIN, TEAM_RENDER_PASS, TEAM_RENDER_END, TEAM_SCENE };
 
 typedef struct team_message {
     uint64_t kind;
-    photon_phase_request rq;    /* TEAM_PHASE */
-    render_channel_request rr;  /* TEAM_RENDER_BEGIN */
-    uint64_t map_count;         /* TEAM_RENDER_BEGIN: records of the map, 0: none (path) */
-    uint64_t map_batches;       /* its photon_map_batches */
-    double map_t0_k;            /* its reference temperature */
-    uint64_t sensor, pass;      /* TEAM_RENDER_PASS */
+    photon_phase_request rq;   /* TEAM_PHASE */
+    render_channel_request rr; /* TEAM_RENDER_BEGIN */
+    uint64_t map_count;        /* TEAM_RENDER_BEGIN: records of the map, 0: none (path) */
+    uint64_t map_batches;      /* its photon_map_batches */
+    double map_t0_k;           /* its reference temperature */
+    uint64_t sensor, pass;     /* TEAM_RENDER_PASS */
+    uint64_t scene;            /* TEAM_SCENE: the caller's index of the next scene */
 } team_message;
 
 /* What a member sends first: the sizes of its share. */
@@ -223,8 +225,7 @@ static thz_status team_render_gather(void *impl, render_accum *acc, uint32_t col
     }
     double *tiles = thz_malloc_array(most > 0 ? most * per : 1, sizeof *tiles);
     if (!tiles)
-        return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for %zu pixels' tiles",
-                             most);
+        return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for %zu pixels' tiles", most);
     int rc = MPI_SUCCESS;
     for (size_t r = 1; rc == MPI_SUCCESS && r < members; r++) {
         render_stats counts;
@@ -296,6 +297,15 @@ size_t mpi_team_size(const mpi_team *team)
 const photon_phase_team *mpi_team_phase(const mpi_team *team)
 {
     return &team->phase;
+}
+
+thz_status mpi_team_next_scene(mpi_team *team, uint64_t scene, thz_error *err)
+{
+    if (team->rank != 0)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "MPI: only the lead changes scenes");
+    team_message m = {.kind = TEAM_SCENE, .scene = scene};
+    int rc = team_bcast(team, &m);
+    return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "broadcasting the next scene");
 }
 
 const render_team *mpi_team_render(const mpi_team *team)
@@ -381,8 +391,8 @@ static thz_status team_serve_begin(mpi_team *t, const thz_scene *scene, const ac
             return team_error(err, rc, "receiving the photon map");
         }
         /* takes records, also on failure; sorts them as the lead's map was sorted */
-        thz_status st = photon_map_create(records, m->map_count, scene->n_objects, threads,
-                                          &r->map, err);
+        thz_status st =
+            photon_map_create(records, m->map_count, scene->n_objects, threads, &r->map, err);
         if (st != THZ_OK)
             return st;
         photon_map_set_reference_temperature_k(r->map, m->map_t0_k);
@@ -420,8 +430,10 @@ static thz_status team_serve_pass(mpi_team *t, const thz_scene *scene, const tea
 }
 
 thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *acc, int threads,
-                          thz_error *err)
+                          uint64_t *next_scene, thz_error *err)
 {
+    if (next_scene)
+        *next_scene = MPI_TEAM_STOPPED;
     if (team->rank == 0)
         return thz_error_set(err, THZ_ERR_INTERNAL, "MPI: rank 0 leads, it does not serve");
     team_render render = {0};
@@ -435,6 +447,14 @@ thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *a
         }
         if (m.kind == TEAM_STOP)
             break;
+        if (m.kind == TEAM_SCENE && next_scene) {
+            *next_scene = m.scene;
+            break;
+        }
+        if (!scene && m.kind != TEAM_SCENE) {
+            st = thz_error_set(err, THZ_ERR_INTERNAL, "MPI: a request before the first scene");
+            break;
+        }
         switch (m.kind) {
         case TEAM_PHASE:
             if (!render_integrator_needs_photons(scene->render.integrator))
@@ -453,6 +473,12 @@ thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *a
             break;
         case TEAM_RENDER_END:
             team_render_fini(&render);
+            break;
+        case TEAM_SCENE:
+            st = thz_error_set(err, THZ_ERR_INPUT,
+                               "MPI: the lead runs several scenes (batch) while process %d "
+                               "serves one (every process must run the same command)",
+                               team->rank);
             break;
         default:
             st = thz_error_set(err, THZ_ERR_INTERNAL, "MPI: unknown request %llu from the lead",

@@ -8,8 +8,8 @@
  * the lead sends each channel's photon map, every rank renders its pixel tiles of each
  * pass, and the lead copies the others' tiles into its images. The other ranks (members)
  * only serve requests: mpi_team_serve loops until the lead's mpi_team_destroy tells them
- * to stop. Only the lead writes. The caller initialises MPI (MPI_THREAD_FUNNELED: only the thread that created
- * the team calls MPI) and finalises it after destroying the team; the library never
+ * to stop. Only the lead writes. The caller initialises MPI (MPI_THREAD_FUNNELED: only the thread
+ * that created the team calls MPI) and finalises it after destroying the team; the library never
  * aborts: a failed rank returns its error, and the program ends the job (MPI_Abort).
  *
  * Waiting ranks poll (MPI_Test, then sleep up to 5 ms) rather than spin, so that ranks
@@ -51,7 +51,14 @@ const render_team *mpi_team_render(const mpi_team *team);
  * overrides, as the lead's), with `threads` OpenMP threads, and sends them to the lead;
  * returns THZ_OK when the lead stops the team. */
 thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *acc, int threads,
-                          thz_error *err);
+                          uint64_t *next_scene, thz_error *err);
+
+/* Runs of several scenes (batch frames): the lead's mpi_team_next_scene makes the
+ * members' mpi_team_serve return THZ_OK with *next_scene = scene (the caller's index);
+ * they load that scene and serve again. When the lead stops the team, *next_scene is
+ * MPI_TEAM_STOPPED. next_scene NULL: one scene, a change of scene is an error. */
+#define MPI_TEAM_STOPPED UINT64_MAX
+thz_status mpi_team_next_scene(mpi_team *team, uint64_t scene, thz_error *err);
 
 /* Bytes this rank sent and received through the team so far. */
 uint64_t mpi_team_bytes(const mpi_team *team);

@@ -10,8 +10,7 @@ size_t render_tiles_count(size_t pixels, uint32_t columns, size_t member, size_t
 {
     size_t n = 0;
     for (size_t p = 0; p < pixels; p++)
-        n += render_tile_owner((uint32_t)(p % columns), (uint32_t)(p / columns), members) ==
-             member;
+        n += render_tile_owner((uint32_t)(p % columns), (uint32_t)(p / columns), members) == member;
     return n;
 }
 

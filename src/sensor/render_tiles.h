@@ -55,14 +55,14 @@ typedef struct render_channel_request {
 typedef struct render_team {
     size_t members; /* processes, the lead included */
     /* The members build the channel's state (they receive map's records). */
-    thz_status (*channel_begin)(void *impl, const render_channel_request *rq,
-                                const photon_map *map, thz_error *err);
+    thz_status (*channel_begin)(void *impl, const render_channel_request *rq, const photon_map *map,
+                                thz_error *err);
     /* Before the lead renders its tiles of a pass: the members start on theirs. */
     thz_status (*pass_start)(void *impl, size_t sensor, uint32_t pass, thz_error *err);
     /* After: the members' tiles copied into acc (columns wide), their counts added to
      * stats. */
-    thz_status (*pass_gather)(void *impl, render_accum *acc, uint32_t columns,
-                              render_stats *stats, thz_error *err);
+    thz_status (*pass_gather)(void *impl, render_accum *acc, uint32_t columns, render_stats *stats,
+                              thz_error *err);
     /* The members free the channel's state. */
     thz_status (*channel_end)(void *impl, thz_error *err);
     void *impl;
