@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
-# MPI runs (docs/mpi.md): `mpirun -np N thzmap simulate` gives, byte for byte, the files of
-# one process with the same seed (summary.json aside: wall times, threads, mpi_ranks),
-# for 2 and 3 ranks of 1 thread and 2 ranks of 2 threads, photon-map and final-gather
-# (with the saved photon map), and photon passes (several shared phases in one run); only rank 0 writes; a failed or killed rank fails the
-# run with a message and a non-zero exit, never a hang, and leaves no OUTDIR.
+# MPI runs (docs/mpi.md): `mpirun -np N thzmap simulate|render|batch` gives, byte for byte,
+# the files of one process with the same seed (summary.json and batch.json aside: wall
+# times, threads, mpi_ranks), for 2 and 3 ranks of 1 thread and 2 ranks of 2 threads,
+# photon-map and final-gather (with the saved photon map), photon passes (several shared
+# phases in one run), path with render passes, render from a saved map, and a batch of a
+# moving camera (fresh, and resumed under mpirun after losing a frame); only rank 0
+# writes; a failed or killed rank fails the run with a message and a non-zero exit, never
+# a hang, and leaves no OUTDIR.
 # Usage: bash test_mpi.sh THZMAP_BINARY REPO_DIR
 set -u
 THZMAP=$1
@@ -29,6 +32,7 @@ s["materials"]["table"]["file"] = os.path.join(os.path.dirname(sys.argv[1]), "ma
 s["sensors"][0]["resolution"] = [24, 24]
 s["sensors"][0]["oversampling"] = 1
 s["photons"]["per_channel"] = 140000
+s.setdefault("render", {}).update({"gather_rays": 4, "paths_per_sample": 2}) # cheap passes
 json.dump(s, open(sys.argv[2], "w"))
 PY
 scene=$work/scene.json
@@ -48,7 +52,7 @@ def strip(path):
     for k in ("timings_s", "threads", "mpi_ranks"):
         d.pop(k)
     for c in d["channels"]:
-        c.pop("photon_phase_s"); c.pop("render_s")
+        c.pop("photon_phase_s", None); c.pop("render_s", None)
     return d
 a, b = strip(sys.argv[1]), strip(sys.argv[2])
 if a != b:
@@ -97,9 +101,90 @@ same_run "$work/pp2" "$work/pp1" "2 ranks, photon passes"
 $PY -c 'import json,sys; sys.exit(json.load(open(sys.argv[1]))["channels"][0]["render_passes"] < 2)' \
     "$work/pp2/summary.json" || fail "photon passes: fewer than 2 passes (the test tests one phase)"
 
+step "render"
+# --- render by pixel tiles: render from a saved map, path with several passes --------
+"$THZMAP" render "$scene" --photon-map "$work/fg1/photon-map.thzpm" -o "$work/re1" \
+    --integrator final-gather --threads 1 --quiet || fail "one process, render: exit $?"
+mpi 2 "$THZMAP" render "$scene" --photon-map "$work/fg1/photon-map.thzpm" -o "$work/re2" \
+    --integrator final-gather --threads 1 --quiet || fail "2 ranks, render: exit $?"
+same_run "$work/re2" "$work/re1" "2 ranks, render final-gather from a saved map"
+[ "$(ranks_of "$work/re2")" = 2 ] || fail "render with 2 ranks: mpi_ranks is not 2"
+step "path"
+"$THZMAP" simulate "$scene" -o "$work/pa1" --integrator path --target-noise-k 0.06 \
+    --threads 2 --quiet || fail "one process, path: exit $?"
+mpi 3 "$THZMAP" simulate "$scene" -o "$work/pa3" --integrator path --target-noise-k 0.06 \
+    --threads 1 > "$work/pa3.out" 2>&1 || { fail "3 ranks, path: exit $?"; cat "$work/pa3.out"; }
+same_run "$work/pa3" "$work/pa1" "3 ranks, path with passes"
+$PY -c 'import json,sys; sys.exit(json.load(open(sys.argv[1]))["channels"][0]["render_passes"] < 2)' \
+    "$work/pa3/summary.json" || fail "path: fewer than 2 passes (the test tests one pass)"
+grep -q "warning" "$work/pa3.out" && fail "path under mpirun warned: $(grep warning "$work/pa3.out")"
+
+step "batch"
+# --- batch: frames shared by the ranks (a moving camera: frame 0 fires, 1-2 render
+# from its photons), then resumed under mpirun after losing frame 2 -----------------
+mkdir "$work/bt"
+cp "$REPO/tests/inputs/batch/scene.json" "$work/bt/"
+$PY - "$work/bt/scene.json" "$work/bt/seq.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["render"] = {"integrator": "photon-map"}
+s["photons"] = {"seed": 7, "per_channel": 20000}
+json.dump(s, open(sys.argv[1], "w"), indent=1)
+q = {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 2, "frames": 3,
+     "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [-0.3, -1.4, 0.9]}}},
+                   {"time_s": 1, "sensors": {"cam": {"position_m": [0.3, -1.4, 0.9]}}}]}
+json.dump(q, open(sys.argv[2], "w"))
+PY
+# Every file below $1 equals $2's (summary.json and batch.json: timings aside; $4 = 1:
+# batch.json's record of which run computed what, too).
+same_batch() {
+    local n=0 f r
+    while IFS= read -r f; do
+        r=${f#"$1"/}
+        n=$((n + 1))
+        case $(basename "$r") in
+        summary.json | batch.json)
+            $PY - "$f" "$2/$r" "$4" <<'PY' || fail "$3: $r differs beyond timings"
+import json, sys
+def strip(path):
+    d = json.load(open(path))
+    for k in ("timings_s", "threads", "mpi_ranks"):
+        d.pop(k, None)
+    for c in d.get("channels", []):
+        c.pop("photon_phase_s", None); c.pop("render_s", None)
+    for fr in d.get("frames", []) if isinstance(d.get("frames"), list) else []:
+        fr.pop("seconds", None)
+        if sys.argv[3] == "1":
+            fr.pop("computed", None); fr.pop("photons", None)
+    if sys.argv[3] == "1":
+        for k in ("frames_computed", "frames_reused", "photon_phases_fired", "frames_rerendered"):
+            d.pop(k, None)
+    return d
+sys.exit(strip(sys.argv[1]) != strip(sys.argv[2]))
+PY
+            ;;
+        *) cmp -s "$f" "$2/$r" || fail "$3: $r differs" ;;
+        esac
+    done < <(find "$1" -type f ! -name '.thzmap-batch-lock')
+    [ "$n" -ge 30 ] || fail "$3: only $n files compared"
+    [ "$(cd "$1" && find . -type f | sort)" = "$(cd "$2" && find . -type f | sort)" ] ||
+        fail "$3: not the same files"
+}
+"$THZMAP" batch "$work/bt/seq.json" -o "$work/bt1" --threads 1 --quiet > /dev/null ||
+    fail "one process, batch: exit $?"
+mpi 3 "$THZMAP" batch "$work/bt/seq.json" -o "$work/bt3" --threads 1 --quiet > /dev/null ||
+    fail "3 ranks, batch: exit $?"
+same_batch "$work/bt3" "$work/bt1" "3 ranks, batch" 0
+ls "$work/bt3"/*.mp4 > /dev/null 2>&1 || fail "3 ranks, batch: no movie"
+rm -rf "$work/bt3/frame-00002"
+mpi 2 "$THZMAP" batch "$work/bt/seq.json" -o "$work/bt3" --threads 1 --quiet > /dev/null ||
+    fail "2 ranks, resumed batch: exit $?"
+same_batch "$work/bt3" "$work/bt1" "2 ranks, batch resumed after losing frame 2" 1
+grep -q '"frames_reused": 2' "$work/bt3/batch.json" || fail "resumed batch: frames 0-1 not reused"
+
 step "only rank 0"
 # --- only rank 0 writes: nothing else beside the outputs -----------------------------
-extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3|pp1|pp2')
+extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3|pp1|pp2|re1|re2|pa1|pa3|pa3.out|bt|bt1|bt3')
 [ -z "$extra" ] || fail "files beside the outputs: $extra"
 
 
@@ -163,7 +248,7 @@ step "other commands"
 mpi 2 "$THZMAP" validate "$scene" > "$work/val.out" 2>&1
 rc=$?
 [ $rc = 2 ] || fail "validate under mpirun: exit $rc, not 2"
-grep -q "only simulate does" "$work/val.out" || fail "validate under mpirun: no message"
+grep -q "simulate, render and batch do" "$work/val.out" || fail "validate under mpirun: no message"
 
 [ $fails = 0 ] && echo "test_mpi: all passed"
 exit $((fails > 0))
