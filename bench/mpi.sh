@@ -1,29 +1,35 @@
 #!/bin/bash
-# Strong scaling of `mpirun -np N thzmap simulate` (docs/mpi.md, issue 19): the same run
-# (default: examples/plate-in-box, photon-map, 4 M photons = 62 batches, 1 thread per
-# rank) with 1 (plain thzmap, no mpirun), 2 and 4 ranks. Prints per run the wall time of
-# the command, of the photon phase (summary.json timings_s.photons: firing on every rank,
-# gathering and the map's index on rank 0) and of the rest, the speed-up and the
-# strong-scaling efficiency T1 / (N TN), each rank's CPU time (on a shared machine the
-# busiest rank's CPU time is the wall time idle cores would give), and the bytes rank 0
-# gathered; checks that the
-# images equal the 1-rank run's; then an estimate for 64 ranks on a cluster from those
-# measurements. Ranks beyond the machine's cores are oversubscribed (said in the output),
-# and the machine may be shared: the load average before and after is printed.
+# Strong scaling of `mpirun -np N thzmap simulate|render|batch` (docs/mpi.md, issue 19):
+# the same work with 1 (plain thzmap, no mpirun), 2 and 4 ranks of 1 thread:
+#   simulate: examples/plate-in-box (64 x 64, oversampling 2), photon-map, 4 M photons
+#             (62 batches): photons shared by batch, pixels by tile;
+#   render:   final-gather from a photon map of 1 M photons that simulate saved first
+#             (not timed): pixels shared by tile, the map sent by rank 0 to the others;
+#   batch:    4 frames of a camera moving in plate-in-box, photon-map, 1 M photons fired
+#             once (frame 0) and rendered 4 times: every frame shared as above.
+# Prints per run the wall time of the command, the speed-up and the strong-scaling
+# efficiency T1 / (N TN), each rank's CPU time (on a shared machine the busiest rank's
+# CPU time is the wall time idle cores would give, and CPU eff. = CPU(1) / (N max rank)
+# the efficiency they would give), and the megabytes rank 0 sent and received; checks
+# that every file equals the 1-rank run's (summary.json and batch.json aside); then an
+# estimate for 64 ranks on a cluster from those measurements. Ranks beyond the
+# machine's cores are oversubscribed (said in the output), and the machine may be
+# shared: the load average before and after is printed.
 # A measurement, not a test: nothing fails on the time.
-# usage: bench/mpi.sh [THZMAP_BINARY] [--photons N] [--scene SCENE.json] [--ranks "1 2 4"]
+# usage: bench/mpi.sh [THZMAP_BINARY] [--photons N] [--ranks "1 2 4"]
+#                     [--what "simulate render batch"]
 set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
 thzmap=$repo/build/thzmap
 if [ $# -gt 0 ] && [ "${1#--}" = "$1" ]; then thzmap=$1; shift; fi
 photons=4000000
-scene=$repo/examples/plate-in-box/scene.json
 ranks="1 2 4"
+what="simulate render batch"
 while [ $# -gt 0 ]; do
     case $1 in
     --photons) photons=$2; shift 2 ;;
-    --scene) scene=$2; shift 2 ;;
     --ranks) ranks=$2; shift 2 ;;
+    --what) what=$2; shift 2 ;;
     *) echo "bench/mpi.sh: unknown option $1" >&2; exit 2 ;;
     esac
 done
@@ -32,70 +38,102 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 cores=$(nproc)
-echo "bench/mpi.sh: $scene, $photons photons per channel, photon-map, 1 thread per rank," \
-    "$cores cores"
+scene=$repo/examples/plate-in-box/scene.json
+# the batch: plate-in-box with absolute paths, a camera moving 10 cm in 4 frames
+/usr/bin/python3 - "$scene" "$out/scene.json" "$out/seq.json" <<'PY'
+import json, os, sys
+s = json.load(open(sys.argv[1]))
+s["materials"]["table"]["file"] = os.path.join(os.path.dirname(sys.argv[1]), "materials/sample.csv")
+s["render"] = {"integrator": "photon-map"}
+json.dump(s, open(sys.argv[2], "w"))
+q = {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 3, "frames": 4,
+     "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [-0.05, -0.45, 0.4]}}},
+                   {"time_s": 1, "sensors": {"cam": {"position_m": [0.05, -0.45, 0.4]}}}]}
+json.dump(q, open(sys.argv[3], "w"))
+PY
+echo "bench/mpi.sh: $cores cores, 1 thread per rank; ranks: $ranks"
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
-for n in $ranks; do
-    launch=()
-    [ "$n" -gt 1 ] && launch=(mpirun --oversubscribe -np "$n")
-    # each rank's CPU seconds (user + system) in cpu.N.RANK
-    /usr/bin/time -f '%e' -o "$out/time.$n" "${launch[@]}" sh -c \
-        '/usr/bin/time -f "%U %S" -o "$0.${OMPI_COMM_WORLD_RANK:-0}" "$@"' "$out/cpu.$n" \
-        "$thzmap" simulate "$scene" \
-        -o "$out/r$n" --photons "$photons" --threads 1 --integrator photon-map >"$out/log.$n" 2>&1 ||
-        { cat "$out/log.$n"; exit 1; }
+if [[ " $what " == *" render "* ]]; then
+    "$thzmap" simulate "$scene" -o "$out/map" --photons 1000000 --integrator final-gather \
+        --save-photon-map --quiet
+fi
+for w in $what; do
+    case $w in
+    simulate) cmd=(simulate "$scene" --photons "$photons" --integrator photon-map) ;;
+    render) cmd=(render "$scene" --photon-map "$out/map/photon-map.thzpm" --integrator final-gather) ;;
+    batch) cmd=(batch "$out/seq.json") ;;
+    *) echo "bench/mpi.sh: unknown --what $w" >&2; exit 2 ;;
+    esac
+    for n in $ranks; do
+        launch=()
+        [ "$n" -gt 1 ] && launch=(mpirun --oversubscribe -np "$n")
+        # each rank's CPU seconds (user + system) in cpu.W.N.RANK
+        /usr/bin/time -f '%e' -o "$out/time.$w.$n" "${launch[@]}" sh -c \
+            '/usr/bin/time -f "%U %S" -o "$0.${OMPI_COMM_WORLD_RANK:-0}" "$@"' "$out/cpu.$w.$n" \
+            "$thzmap" "${cmd[@]}" -o "$out/$w.$n" --threads 1 >"$out/log.$w.$n" 2>&1 ||
+            { cat "$out/log.$w.$n"; exit 1; }
+    done
 done
 echo "load average after:  $(cut -d' ' -f1-3 /proc/loadavg)"
-/usr/bin/python3 - "$out" "$cores" "$ranks" <<'PY'
+/usr/bin/python3 - "$out" "$cores" "$ranks" "$what" <<'PY'
 import filecmp, json, os, re, sys
-out, cores, ranks = sys.argv[1], int(sys.argv[2]), [int(r) for r in sys.argv[3].split()]
-rows = {}
-for n in ranks:
-    d = json.load(open(f"{out}/r{n}/summary.json"))
-    wall = float(open(f"{out}/time.{n}").read().split()[-1])
-    log = open(f"{out}/log.{n}").read()
-    m = re.search(r"\(([0-9.e+]+) MB gathered\)", log)
-    stored = sum(c["photons_stored"] for c in d["channels"])
-    fired = sum(c["photons_fired"] for c in d["channels"])
-    cpu = [sum(float(x) for x in open(f"{out}/cpu.{n}.{r}").read().split()[-2:])
-           for r in range(n)]
-    rows[n] = dict(wall=wall, cpu_max=max(cpu), cpu_sum=sum(cpu), photons=d["timings_s"]["photons"], render=d["timings_s"]["render"],
-                   mb=float(m.group(1)) if m else 0.0, stored=stored, fired=fired)
-    if n != ranks[0]:
-        a, b = f"{out}/r{ranks[0]}", f"{out}/r{n}"
-        same = all(filecmp.cmp(f"{a}/{f}", f"{b}/{f}", shallow=False)
-                   for f in os.listdir(a) if f != "summary.json")
-        rows[n]["same"] = same
-r1 = rows[ranks[0]]
-print(f"{'ranks':>5} {'wall s':>7} {'photons s':>9} {'rest s':>7} {'speed-up':>8} "
-      f"{'efficiency':>10} {'phase eff.':>10} {'CPU s':>6} {'max rank':>8} {'CPU eff.':>8} "
-      f"{'MB gathered':>11}  note")
-for n in ranks:
-    r = rows[n]
-    note = "oversubscribed" if n > cores else ""
-    if "same" in r:
-        note += ("; " if note else "") + ("files = 1-rank run's" if r["same"] else "FILES DIFFER")
-    print(f"{n:>5} {r['wall']:>7.2f} {r['photons']:>9.2f} {r['wall'] - r['photons']:>7.2f} "
-          f"{r1['wall'] / r['wall']:>8.2f} {r1['wall'] / (n * r['wall']):>10.2f} "
-          f"{r1['photons'] / (n * r['photons']):>10.2f} {r['cpu_sum']:>6.2f} {r['cpu_max']:>8.2f} "
-          f"{r1['cpu_sum'] / (n * r['cpu_max']):>8.2f} {r['mb']:>11.3g}  {note}")
-print("(wall times: a shared machine's; CPU s: user + system of all ranks; max rank: of the "
-      "busiest rank, the wall time on idle dedicated cores; CPU eff. = CPU(1) / (N max rank))")
-# 64 ranks, from CPU times (the wall times of a shared machine say little): with 2 ranks,
-# rank 1 spends u + f / 2 (start: MPI, scene, ray-casting structure; half the firing) and
-# rank 0 that plus the serial part s (the map's index, rendering, writing); one process
-# spends u + f + s. On 64 dedicated cores: u + f / 64 + s + the gather over the network.
-if 2 in rows:
-    cpu1 = [sum(float(x) for x in open(f"{out}/cpu.2.{r}").read().split()[-2:]) for r in (0, 1)]
-    serial = max(0.0, cpu1[0] - cpu1[1])
-    f = max(0.0, 2 * (r1["cpu_sum"] - serial - cpu1[1]))
-    u = max(0.0, cpu1[1] - f / 2)
-    bytes64 = (r1["stored"] * 32 + r1["fired"] / 256 * 120) * 63 / 64
-    print(f"64 ranks (estimate from CPU times): start u = {u:.2f} s, firing f = {f:.2f} s "
-          f"(/ 64 = {f / 64:.3f} s), serial on rank 0 s = {serial:.2f} s, "
-          f"gather {bytes64 / 1e6:.3g} MB into rank 0 (32 B per stored photon)")
-    for name, bw in (("10 Gbit/s Ethernet", 1.25e9), ("100 Gbit/s InfiniBand", 12.5e9)):
-        t = u + f / 64 + serial + bytes64 / bw
-        print(f"  over {name}: gather {bytes64 / bw:.3f} s, {t:.2f} s end to end, speed-up "
-              f"{r1['cpu_sum'] / t:.2f} over one rank, efficiency {r1['cpu_sum'] / (64 * t):.3f}")
+out, cores = sys.argv[1], int(sys.argv[2])
+ranks, what = [int(r) for r in sys.argv[3].split()], sys.argv[4].split()
+def cpu_of(w, n):
+    return [sum(float(x) for x in open(f"{out}/cpu.{w}.{n}.{r}").read().split()[-2:])
+            for r in range(n)]
+def same_tree(a, b):
+    for root, _, files in os.walk(a):
+        for f in files:
+            if f in ("summary.json", "batch.json") or f.startswith("."):
+                continue
+            p = os.path.join(root, f)
+            q = os.path.join(b, os.path.relpath(p, a))
+            if not os.path.exists(q) or not filecmp.cmp(p, q, shallow=False):
+                return False
+    return True
+est = {}
+for w in what:
+    rows = {}
+    for n in ranks:
+        log = open(f"{out}/log.{w}.{n}").read()
+        m = re.search(r"\(([0-9.e+]+) MB communicated\)", log)
+        cpu = cpu_of(w, n)
+        rows[n] = dict(wall=float(open(f"{out}/time.{w}.{n}").read().split()[-1]),
+                       cpu_max=max(cpu), cpu_sum=sum(cpu), mb=float(m.group(1)) if m else 0.0)
+        if n != ranks[0]:
+            rows[n]["same"] = same_tree(f"{out}/{w}.{ranks[0]}", f"{out}/{w}.{n}")
+    r1 = rows[ranks[0]]
+    print(f"\n{w}:")
+    print(f"{'ranks':>5} {'wall s':>7} {'speed-up':>8} {'efficiency':>10} {'CPU s':>6} "
+          f"{'max rank':>8} {'CPU eff.':>8} {'MB comm.':>9}  note")
+    for n in ranks:
+        r = rows[n]
+        note = "oversubscribed" if n > cores else ""
+        if "same" in r:
+            note += ("; " if note else "") + ("files = 1-rank run's" if r["same"] else "FILES DIFFER")
+        print(f"{n:>5} {r['wall']:>7.2f} {r1['wall'] / r['wall']:>8.2f} "
+              f"{r1['wall'] / (n * r['wall']):>10.2f} {r['cpu_sum']:>6.2f} {r['cpu_max']:>8.2f} "
+              f"{r1['cpu_sum'] / (n * r['cpu_max']):>8.2f} {r['mb']:>9.3g}  {note}")
+    # 64 ranks, from CPU times (a shared machine's wall times say little): with 2 ranks,
+    # rank 1 spends u + f / 2 (its start: MPI, scene, ray-casting structure, the map's
+    # index when it receives one; half the shared work) and rank 0 that plus the part only
+    # it does, s (gathering, writing, movies); one process spends u + f + s. On 64
+    # dedicated cores: u + f / 64 + s + the messages over the network.
+    if 2 in rows:
+        c2 = cpu_of(w, 2)
+        serial = max(0.0, c2[0] - c2[1])
+        f = max(0.0, 2 * (r1["cpu_sum"] - serial - c2[1]))
+        u = max(0.0, c2[1] - f / 2)
+        # what rank 0 sends or receives grows with the ranks: photon shares (simulate)
+        # are gathered once whatever N, a map (render, batch) is broadcast along a tree
+        # (about 2x its size per rank for large messages), the tiles are gathered once
+        mb64 = rows[2]["mb"] * (1.0 if w == "simulate" else 2.0)
+        print(f"64 ranks (estimate from CPU times): start u = {u:.2f} s, shared work f = "
+              f"{f:.2f} s (/ 64 = {f / 64:.3f} s), rank 0 alone s = {serial:.2f} s, "
+              f"{mb64:.3g} MB through rank 0")
+        for name, bw in (("10 Gbit/s Ethernet", 1.25e9), ("100 Gbit/s InfiniBand", 12.5e9)):
+            t = u + f / 64 + serial + mb64 * 1e6 / bw
+            print(f"  over {name}: {t:.2f} s end to end, speed-up {r1['cpu_sum'] / t:.2f} over "
+                  f"one rank, efficiency {r1['cpu_sum'] / (64 * t):.3f}")
 PY

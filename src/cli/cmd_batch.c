@@ -236,9 +236,12 @@ int cmd_batch(int argc, char **argv)
     } else if (st != THZ_OK) {
         rc = cli_fail(&err);
     } else if (!b.quiet) {
-        printf("thzmap batch: %zu frames (%zu computed, %zu already done), %zu movies, %.2f s; "
-               "results in %s\n",
-               res.n_frames, res.computed, res.reused, res.movies, res.seconds, outdir);
+        printf("thzmap batch: %zu frames (%zu computed, %zu already done), %zu movies", res.n_frames,
+               res.computed, res.reused, res.movies);
+        if (shared)
+            printf(", %d MPI ranks (%.3g MB communicated)", cli_mpi_size(),
+                   1e-6 * (double)thz_context_mpi_bytes(ctx));
+        printf(", %.2f s; results in %s\n", res.seconds, outdir);
     }
     if (shared && rc != CLI_EXIT_OK) /* the other ranks may be waiting for rank 0 */
         cli_mpi_abort(rc);

@@ -354,7 +354,7 @@ int cli_run_command(int argc, char **argv, bool render)
             if (result.max_passes > 1)
                 printf(" after up to %u passes", result.max_passes);
             if (shared)
-                printf(", %d MPI ranks (%.3g MB gathered)", cli_mpi_size(),
+                printf(", %d MPI ranks (%.3g MB communicated)", cli_mpi_size(),
                        1e-6 * (double)thz_context_mpi_bytes(ctx));
             printf(", %.2f s; results in %s\n", result.seconds, a.outdir);
             thz_object_info obj;

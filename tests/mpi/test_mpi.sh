@@ -79,7 +79,7 @@ mpi 2 "$THZMAP" simulate "$scene" -o "$work/pm2" --integrator photon-map --threa
     > "$work/pm2.out" 2>&1 || { fail "2 ranks, photon-map: exit $?"; cat "$work/pm2.out"; }
 same_run "$work/pm2" "$work/pm1" "2 ranks x 1 thread, photon-map"
 [ "$(ranks_of "$work/pm2")" = 2 ] || fail "2 ranks: mpi_ranks is not 2"
-grep -q "2 MPI ranks (.* MB gathered)" "$work/pm2.out" || fail "2 ranks: no closing line naming the ranks"
+grep -q "2 MPI ranks (.* MB communicated)" "$work/pm2.out" || fail "2 ranks: no closing line naming the ranks"
 mpi 2 "$THZMAP" simulate "$scene" -o "$work/pm22" --integrator photon-map --threads 2 --quiet ||
     fail "2 ranks x 2 threads: exit $?"
 same_run "$work/pm22" "$work/pm1" "2 ranks x 2 threads, photon-map"
