@@ -225,7 +225,7 @@ typedef struct bench_targets {
 static void bench_target(bench_targets *t, const char *name, double value, const char *op,
                          double limit, bool met, const char *unit)
 {
-    printf("  %-48s %10.3f %s %-6g %-3s %s\n", name, value, op, limit, unit,
+    printf("  %-56s %10.3f %s %-6g %-3s %s\n", name, value, op, limit, unit,
            met ? "met" : "NOT met");
     json_t *o = json_object();
     json_object_set_new(o, "target", json_string(name));
@@ -618,7 +618,7 @@ int main(int argc, char **argv)
     }
     double dev = first > 0 ? (hi - first > first - lo ? hi / first - 1 : 1 - lo / first) : 0;
     char flat_name[96];
-    snprintf(flat_name, sizeof flat_name, "CPU time per photon, %.0f M..%.0f M: largest dev.",
+    snprintf(flat_name, sizeof flat_name, "CPU time per photon, %.3g M..%.3g M: largest deviation",
              sp.n ? 1e-6 * (double)sp.p[0].photons : 0.0,
              sp.n ? 1e-6 * (double)sp.p[sp.n - 1].photons : 0.0);
     bench_target(&t, flat_name, 100 * dev, "<=", 20, dev <= 0.2, "%");
