@@ -334,16 +334,18 @@ serve *serve_start(const serve_options *opt, char *why, size_t size, bool *usage
         return NULL;
     }
     struct stat st;
-    if (!realpath(opt->root, s->root) || stat(s->root, &st) != 0 || !S_ISDIR(st.st_mode) ||
-        chdir(s->root) != 0) {
-        snprintf(why, size, "--root %s: not a directory (%s)", opt->root, strerror(errno));
+    /* the bundle first: a relative path names it from the directory serve started in */
+    if (opt->web_dir && realpath(opt->web_dir, s->web_dir) && stat(s->web_dir, &st) == 0 &&
+        S_ISDIR(st.st_mode))
+        s->has_web = true;
+    bool found = realpath(opt->root, s->root) != NULL;
+    if (!found || stat(s->root, &st) != 0 || !S_ISDIR(st.st_mode) || chdir(s->root) != 0) {
+        snprintf(why, size, "--root %s: %s", opt->root,
+                 found && errno != EACCES ? "not a directory" : strerror(errno));
         *usage = true;
         free(s);
         return NULL;
     }
-    if (opt->web_dir && realpath(opt->web_dir, s->web_dir) && stat(s->web_dir, &st) == 0 &&
-        S_ISDIR(st.st_mode))
-        s->has_web = true;
     if (!serve_make_token(s->token)) {
         snprintf(why, size, "getrandom: %s", strerror(errno));
         free(s);

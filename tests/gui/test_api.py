@@ -466,6 +466,14 @@ def main():
                 t = time.time()
                 fn()
                 print("%-10s %.2f s" % (name, time.time() - t), flush=True)
+            # a second server on the same port, or on a root that is no directory: exit 2
+            for args in (["--port", str(srv.port), "--root", root],
+                         ["--port", "0", "--root", os.path.join(root, "s", "scene.json")],
+                         ["--port", "0", "--host", "localhost"]):
+                p = subprocess.run([BINARY, "serve"] + args, capture_output=True, text=True,
+                                   timeout=30)
+                check(p.returncode == 2 and "thzmap serve: " in p.stderr,
+                      "serve %s: exit %d %r" % (args, p.returncode, p.stderr))
         finally:
             rc = srv.stop(signal.SIGINT)
             check(rc == 130, "SIGINT: exit status %s, expected 130" % rc)
