@@ -55,8 +55,9 @@ enum MHD_Result serve_reply_json(serve_request *r, unsigned status, json_t *json
     return ret;
 }
 
-static enum MHD_Result serve_reply_errorv(serve_request *r, unsigned status, const char *json_path,
-                                          const char *fmt, va_list ap)
+__attribute__((format(printf, 4, 0))) static enum MHD_Result
+serve_reply_errorv(serve_request *r, unsigned status, const char *json_path, const char *fmt,
+                   va_list ap)
 {
     char message[1200];
     vsnprintf(message, sizeof message, fmt, ap);
