@@ -281,11 +281,17 @@ static enum MHD_Result serve_access(void *cls, struct MHD_Connection *conn, cons
             r->too_large = true;
             return MHD_YES;
         }
-        char *grown = realloc(r->body, r->body_size + n + 1);
-        if (!grown)
-            return MHD_NO;
-        memcpy(grown + r->body_size, upload_data, n);
-        r->body = grown;
+        if (r->body_size + n + 1 > r->body_cap) {
+            size_t cap = r->body_cap ? 2 * r->body_cap : 65536;
+            while (cap < r->body_size + n + 1)
+                cap *= 2;
+            char *grown = realloc(r->body, cap);
+            if (!grown)
+                return MHD_NO;
+            r->body = grown;
+            r->body_cap = cap;
+        }
+        memcpy(r->body + r->body_size, upload_data, n);
         r->body_size += n;
         r->body[r->body_size] = '\0';
         return MHD_YES;
