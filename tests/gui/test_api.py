@@ -316,8 +316,27 @@ def test_runs(srv, root):
     job = wait_state(srv, render["id"], ("done", "failed"))
     check(job and job["state"] == "done", "render: %r" % job)
     check(wait_state(srv, run_b["id"], ("done",)) is not None, "second run")
+    # batch (two still frames, no movies) and bands (3 candidates, choose 1)
+    with open(os.path.join(root, "s", "seq.json"), "w") as f:
+        json.dump({"format": "thzmap-sequence/1", "scene": "scene.json", "frames": 2}, f)
+    batch = srv.json("POST", "/api/runs", body={
+        "command": "batch", "scene": "s/seq.json", "out": "out/batch",
+        "options": {"no_movies": True}}, status=202)
+    bands = srv.json("POST", "/api/runs", body={
+        "command": "bands", "scene": "s/scene.json", "out": "out/bands",
+        "options": {"count": 1, "from_thz": 0.3, "to_thz": 0.4, "step_ghz": 50,
+                    "targets": ["target"], "seed": 3}}, status=202)
+    job = wait_state(srv, batch["id"], ("done", "failed"))
+    check(job and job["state"] == "done" and job["progress"] == 1.0, "batch: %r" % job)
+    res = srv.json("GET", "/api/outputs?dir=out/batch")
+    check(res and res["frames"] == ["frame-00000", "frame-00001"], "batch frames: %r" % res)
+    job = wait_state(srv, bands["id"], ("done", "failed"))
+    check(job and job["state"] == "done", "bands: %r" % job)
+    chosen = json.load(open(os.path.join(root, "out", "bands", "bands.json")))["selected_thz"]
+    check(len(chosen) == 1 and chosen[0] in (0.3, 0.35, 0.4), "bands chose %r" % chosen)
     listing = srv.json("GET", "/api/runs")
-    check(listing and [j["id"] for j in listing][:3] == [run["id"], run_b["id"], render["id"]],
+    check(listing and [j["id"] for j in listing][:5] == [run["id"], run_b["id"], render["id"],
+                                                          batch["id"], bands["id"]],
           "runs list")
     srv.json("GET", "/api/runs/999", status=404)
     srv.json("DELETE", "/api/runs/%d" % run["id"], status=409)
@@ -337,7 +356,7 @@ def test_runs(srv, root):
     print("cancel took %.2f s" % (time.time() - t0))
     check(not os.path.exists(os.path.join(root, "out", "long")) and
           not os.path.exists(os.path.join(root, "out", "q")), "a cancelled run left output")
-    check(sorted(os.listdir(os.path.join(root, "out"))) == ["a", "b", "r"],
+    check(sorted(os.listdir(os.path.join(root, "out"))) == ["a", "b", "bands", "batch", "r"],
           "out/ holds %r" % os.listdir(os.path.join(root, "out")))
 
 
