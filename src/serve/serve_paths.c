@@ -155,9 +155,11 @@ enum MHD_Result serve_files_list(serve_request *r)
                 break;
             items = grown;
         }
-        items[n++] = json_pack("{s:s, s:s, s:I, s:I}", "name", e->d_name, "type",
-                               S_ISDIR(st.st_mode) ? "dir" : "file", "size", (json_int_t)st.st_size,
-                               "mtime", (json_int_t)st.st_mtime);
+        /* (a name that is not UTF-8 cannot be told in JSON: left out) */
+        items[n] = json_pack("{s:s, s:s, s:I, s:I}", "name", e->d_name, "type",
+                             S_ISDIR(st.st_mode) ? "dir" : "file", "size", (json_int_t)st.st_size,
+                             "mtime", (json_int_t)st.st_mtime);
+        n += items[n] != NULL;
     }
     closedir(d);
     qsort(items, n, sizeof *items, serve_entry_cmp);
