@@ -28,6 +28,13 @@ static void serve_common_headers(struct MHD_Response *resp)
     MHD_add_response_header(resp, "Referrer-Policy", "no-referrer");
 }
 
+/* Answers other than the page's own files: nothing in them may run as a page. */
+static void serve_data_headers(struct MHD_Response *resp)
+{
+    serve_common_headers(resp);
+    MHD_add_response_header(resp, "Content-Security-Policy", "default-src 'none'; sandbox");
+}
+
 enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type, const void *data,
                             size_t size)
 {
@@ -37,7 +44,10 @@ enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type,
         return MHD_NO;
     if (type)
         MHD_add_response_header(resp, "Content-Type", type);
-    serve_common_headers(resp);
+    if (strncmp(r->url, "/api/", 5) == 0)
+        serve_data_headers(resp);
+    else
+        serve_common_headers(resp);
     enum MHD_Result ret = MHD_queue_response(r->conn, status, resp);
     MHD_destroy_response(resp);
     return ret;
@@ -93,7 +103,7 @@ enum MHD_Result serve_reply_binary(serve_request *r, const void *data, size_t si
     if (!resp)
         return MHD_NO;
     MHD_add_response_header(resp, "Content-Type", "application/octet-stream");
-    serve_common_headers(resp);
+    serve_data_headers(resp);
     for (size_t i = 0; headers && headers[i]; i += 2)
         MHD_add_response_header(resp, headers[i], headers[i + 1]);
     enum MHD_Result ret = MHD_queue_response(r->conn, 200, resp);

@@ -180,6 +180,12 @@ def test_paths(srv, root):
     st, _, data = srv.request("GET", "/api/file?path=s/scene.json")
     check(st == 200 and data == open(os.path.join(root, "s", "scene.json"), "rb").read(),
           "GET file: %d" % st)
+    # files of the root never run as pages: HTML goes as bytes, sandboxed
+    open(os.path.join(root, "s", "page.html"), "w").write("<script>alert(1)</script>")
+    st, h, _ = srv.request("GET", "/api/file?path=s/page.html")
+    check(st == 200 and h.get("Content-Type") == "application/octet-stream" and
+          "sandbox" in h.get("Content-Security-Policy", ""), "HTML from the root: %r" % h)
+    os.unlink(os.path.join(root, "s", "page.html"))
     text = b'{"edited": true}\n'
     res = srv.json("PUT", "/api/file?path=s/new.json", body=text)
     check(res and res["size"] == len(text) and
@@ -367,6 +373,9 @@ def test_results(srv, root):
     check(cam and "brightness_temperature" in cam[0]["cubes"] and
           "cam.visual.png" in cam[0]["images"] and res["photon_map"] == "out/a/photon-map.thzpm"
           and res["summary"]["seed"] == 1, "outputs: %r" % (res and res["sensors"]))
+    st, h, data = srv.request("GET", "/api/file?path=out/a/cam.visual.png")
+    check(st == 200 and h.get("Content-Type") == "image/png" and data[:4] == b"\x89PNG",
+          "a PNG of the run: %d %r" % (st, h.get("Content-Type")))
     cube = srv.json("GET", "/api/cube?path=out/a/cam.brightness_temperature.hdr")
     check(cube and (cube["rows"], cube["columns"], cube["bands"]) == (12, 16, 2) and
           cube["centres_thz"] == [0.35, 0.6] and cube["units"] == "K" and
