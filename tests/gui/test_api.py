@@ -110,7 +110,7 @@ def planck_tb(freq_hz, radiance):
     return h * freq_hz / k / math.log1p(2 * h * freq_hz ** 3 / (c * c * radiance))
 
 
-def wait_state(srv, run_id, states, limit_s=60):
+def wait_state(srv, run_id, states, limit_s=240):
     t0 = time.time()
     while time.time() - t0 < limit_s:
         job = srv.json("GET", "/api/runs/%d" % run_id)
