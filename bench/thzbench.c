@@ -4,8 +4,9 @@
  *   1. the paper's case (examples/teraeye) at full size, stage by stage, and end to end
  *      through run_simulate: wall times, photons/s, bytes per stored photon, peak memory;
  *   2. the tracing limit: a raw Embree probe casting as many rays as that photon phase;
- *   3. scaling in photons (1, 3, 10, 30 M in one channel), in triangles (about 1 k to
- *      1 M, a tessellated mesh scene) and in threads (1 against all);
+ *   3. scaling in photons (1, 3, 10, 30, 100 M in one channel, as memory allows), in
+ *      triangles (about 1 k to 1 M, a tessellated mesh scene) and in threads (1 against
+ *      all);
  *   4. rendering: gathers/s and time per pixel as the photons per pixel grow.
  *
  * Every measurement runs in a child process of its own (fork), so the peak memory the
@@ -34,6 +35,37 @@
 #ifndef THZ_SOURCE_DIR
 #define THZ_SOURCE_DIR "."
 #endif
+
+/* ---- Memory ------------------------------------------------------------------------- */
+
+/* Bytes the OS says are available (MemAvailable), or 0 if unknown. */
+static double bench_mem_available(void)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (!f)
+        return 0.0;
+    char line[256];
+    double kb = 0.0;
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "MemAvailable: %lf kB", &kb) == 1)
+            break;
+    fclose(f);
+    return 1024.0 * kb;
+}
+
+/* The peak of a photon phase of n photons of the paper's case, with margin: 1.3 stored
+ * records per photon (1.25 measured) of 32 bytes, their 8-byte Morton codes during the
+ * index build, the per-thread buffers and the render: 48 bytes per record, times 1.3. */
+static double bench_bytes_needed(uint64_t photons)
+{
+    return (double)photons * 1.3 * 48.0 * 1.3;
+}
+
+static bool bench_fits(uint64_t photons)
+{
+    double avail = bench_mem_available();
+    return avail <= 0.0 || bench_bytes_needed(photons) <= avail;
+}
 
 /* ---- Child processes ----------------------------------------------------------------- */
 
@@ -193,7 +225,7 @@ typedef struct bench_targets {
 static void bench_target(bench_targets *t, const char *name, double value, const char *op,
                          double limit, bool met, const char *unit)
 {
-    printf("  %-48s %10.3f %s %-6g %-3s %s\n", name, value, op, limit, unit,
+    printf("  %-56s %10.3f %s %-6g %-3s %s\n", name, value, op, limit, unit,
            met ? "met" : "NOT met");
     json_t *o = json_object();
     json_object_set_new(o, "target", json_string(name));
@@ -261,10 +293,23 @@ int main(int argc, char **argv)
 
     /* Counts: the issue's in full, about a thousandth of them with --small. */
     const uint64_t paper_photons = small ? 20000 : 0; /* 0: the scene's (10 M) */
-    const uint64_t full_series[] = {1000000, 3000000, 10000000, 30000000};
+    /* The issue's 1 M to 100 M; a point that would not fit in the memory available now
+     * is left out and said so (bench_fits). */
+    const uint64_t full_series[] = {1000000, 3000000, 10000000, 30000000, 100000000};
     const uint64_t small_series[] = {10000, 30000, 100000};
-    const uint64_t *series = small ? small_series : full_series;
-    const int n_series = small ? 3 : 4;
+    const uint64_t *all_series = small ? small_series : full_series;
+    const int n_all_series = small ? 3 : 5;
+    uint64_t series[8];
+    int n_series = 0;
+    for (int k = 0; k < n_all_series; k++) {
+        if (bench_fits(all_series[k]))
+            series[n_series++] = all_series[k];
+        else
+            printf("(%llu photons left out of the photon scaling: about %.1f GB needed, %.1f GB "
+                   "available)\n",
+                   (unsigned long long)all_series[k], 1e-9 * bench_bytes_needed(all_series[k]),
+                   1e-9 * bench_mem_available());
+    }
     const unsigned subdiv_lo = small ? 1 : 2, subdiv_hi = small ? 3 : 7;
     const uint64_t mesh_photons = small ? 10000 : 1000000;
     const uint64_t thread_photons = small ? 20000 : 3000000;
@@ -553,8 +598,10 @@ int main(int argc, char **argv)
     printf("\nTargets%s\n", small ? " (--small: not meaningful)" : "");
     bench_targets t = {.list = json_array()};
     double total = e2e ? e2e_r.s_total : paper.s_total;
-    bench_target(&t, "paper's case end to end", total, "<=", 20, total <= 20, "s");
-    bench_target(&t, "photon phase / raw Embree", ratio_phase, "<=", 1.5, ratio_phase <= 1.5, "x");
+    /* Issue 19's targets first (the older ones of issue 6 after them). */
+    bench_target(&t, "paper's case end to end", total, "<=", 10, total <= 10, "s");
+    bench_target(&t, "photon phase / raw Embree, same rays (bounces incl.)", ratio_phase, "<=", 2,
+                 ratio_phase <= 2, "x");
     bench_target(&t, "bytes per stored photon", bpp, "<=", 32, bpp <= 32.005, "B");
     double peak_ratio = bench_ratio((double)paper_peak, (double)paper.largest_map_bytes);
     bench_target(&t, "peak memory / photon map", peak_ratio, "<=", 1.5, peak_ratio <= 1.5, "x");
@@ -570,8 +617,11 @@ int main(int argc, char **argv)
         hi = ns > hi ? ns : hi;
     }
     double dev = first > 0 ? (hi - first > first - lo ? hi / first - 1 : 1 - lo / first) : 0;
-    bench_target(&t, "CPU time per photon, 1 M..30 M: largest deviation", 100 * dev, "<=", 20,
-                 dev <= 0.2, "%");
+    char flat_name[96];
+    snprintf(flat_name, sizeof flat_name, "CPU time per photon, %.3g M..%.3g M: largest deviation",
+             sp.n ? 1e-6 * (double)sp.p[0].photons : 0.0,
+             sp.n ? 1e-6 * (double)sp.p[sp.n - 1].photons : 0.0);
+    bench_target(&t, flat_name, 100 * dev, "<=", 20, dev <= 0.2, "%");
     double tri_ratio =
         tri.n ? bench_ratio(
                     bench_ratio(tri.p[tri.n - 1].cpu_photons, (double)tri.p[tri.n - 1].photons),
@@ -579,10 +629,22 @@ int main(int argc, char **argv)
               : 0;
     bench_target(&t, "CPU time per photon, 1 k..1 M triangles", tri_ratio, "<=", 3, tri_ratio <= 3,
                  "x");
-    bench_target(&t, "speed-up on all threads", speedup, ">=", 1.8, speedup >= 1.8, "x");
+    bench_target(&t, "photon phase speed-up on all threads", speedup, ">=", 1.85, speedup >= 1.85,
+                 "x");
     double render_share = bench_ratio(paper.s_render, paper.s_total);
     bench_target(&t, "rendering share of the paper's case", 100 * render_share, "<=", 20,
                  render_share <= 0.2, "%");
+    /* Issue 19's targets this harness does not measure (said, not hidden). */
+    const char *not_measured[] = {
+        "2-thread speed-up >= 1.85 x of every integrator (the photon phase's is above)",
+        "time to a converged image (RMS over the objects' pixels of the per-pixel noise, "
+        "0.05 K): path <= 1 s and final-gather <= 5 s per channel"};
+    json_t *jnm = json_array();
+    for (size_t k = 0; k < sizeof not_measured / sizeof *not_measured; k++) {
+        printf("  not measured here: %s\n", not_measured[k]);
+        json_array_append_new(jnm, json_string(not_measured[k]));
+    }
+    json_object_set_new(root, "targets_not_measured", jnm);
     json_object_set_new(root, "targets", t.list);
     json_object_set_new(root, "targets_met", json_integer(t.met));
     json_object_set_new(root, "load_average_end", bench_real(bench_load1()));

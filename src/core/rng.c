@@ -3,7 +3,7 @@
 
 #include <Random123/philox.h>
 
-static void rng_refill(rng_stream *rng)
+void rng_refill(rng_stream *rng)
 {
     philox4x32_ctr_t c = {{rng->ctr[0], rng->ctr[1], rng->ctr[2], rng->ctr[3]}};
     philox4x32_key_t k = {{rng->key[0], rng->key[1]}};
@@ -25,13 +25,6 @@ void rng_init(rng_stream *rng, uint64_t seed, uint32_t channel, uint32_t purpose
     rng->ctr[2] = (uint32_t)index;
     rng->ctr[3] = (uint32_t)(index >> 32);
     rng->used = 4;
-}
-
-uint32_t rng_next_u32(rng_stream *rng)
-{
-    if (rng->used >= 4)
-        rng_refill(rng);
-    return rng->buf[rng->used++];
 }
 
 double rng_uniform(rng_stream *rng)

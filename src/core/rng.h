@@ -34,11 +34,27 @@ enum {
 /* Starts the stream for unit `index` of `channel` under `seed` and `purpose`. */
 void rng_init(rng_stream *rng, uint64_t seed, uint32_t channel, uint32_t purpose, uint64_t index);
 
-/* Next 32 random bits. */
-uint32_t rng_next_u32(rng_stream *rng);
+/* The next Philox block into buf (an implementation detail of rng_next_u32). */
+void rng_refill(rng_stream *rng);
 
-/* Uniform double in [0, 1) with 53 random bits. */
+/* Next 32 random bits (inline: the photon phase draws a dozen words per photon). */
+static inline uint32_t rng_next_u32(rng_stream *rng)
+{
+    if (rng->used >= 4)
+        rng_refill(rng);
+    return rng->buf[rng->used++];
+}
+
+/* Uniform double in [0, 1) with 53 random bits (two words). */
 double rng_uniform(rng_stream *rng);
+
+/* Uniform double in [0, 1) with 32 random bits (one word): a multiple of 2^-32, at most
+ * 1 - 2^-32. The photon phase draws these (docs/physics.md "Random streams"): half the
+ * Philox blocks of rng_uniform, and 2^-32 is far below any probability it resolves. */
+static inline double rng_uniform32(rng_stream *rng)
+{
+    return (double)rng_next_u32(rng) * (1.0 / 4294967296.0);
+}
 
 /* Uniform double in (0, 1]: safe for log(). */
 double rng_uniform_open0(rng_stream *rng);

@@ -10,6 +10,11 @@ double sampling_uniform(void *rng)
     return rng_uniform(rng);
 }
 
+double sampling_uniform32(void *rng)
+{
+    return rng_uniform32(rng);
+}
+
 vec3 sampling_direction(vec3 n, double mu, double u)
 {
     vec3 t, b;

@@ -12,4 +12,7 @@ vec3 sampling_direction(vec3 n, double mu, double u);
 /* Adapter: rng_uniform as an optics_uniform_fn (rng is the rng_stream). */
 double sampling_uniform(void *rng);
 
+/* Adapter: rng_uniform32 (32-bit uniforms, the photon phase's) as an optics_uniform_fn. */
+double sampling_uniform32(void *rng);
+
 #endif

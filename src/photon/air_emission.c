@@ -118,10 +118,10 @@ static void air_emission_volume_point(const air_emission *a, rng_stream *rng, ve
 {
     double x[3];
     for (int k = 0; k < 3; k++)
-        x[k] = a->min_m[k] + rng_uniform(rng) * (a->max_m[k] - a->min_m[k]);
+        x[k] = a->min_m[k] + rng_uniform32(rng) * (a->max_m[k] - a->min_m[k]);
     *p = v3(x[0], x[1], x[2]);
-    double z = 1.0 - 2.0 * rng_uniform(rng);
-    double s = sqrt(fmax(0.0, 1.0 - z * z)), phi = 2.0 * M_PI * rng_uniform(rng);
+    double z = 1.0 - 2.0 * rng_uniform32(rng);
+    double s = sqrt(fmax(0.0, 1.0 - z * z)), phi = 2.0 * M_PI * rng_uniform32(rng);
     *dir = v3(s * cos(phi), s * sin(phi), z);
 }
 
@@ -129,7 +129,7 @@ static void air_emission_volume_point(const air_emission *a, rng_stream *rng, ve
  * into the box. */
 static void air_emission_face_point(const air_emission *a, rng_stream *rng, vec3 *p, vec3 *dir)
 {
-    double x = rng_uniform(rng) * a->face_cdf[5];
+    double x = rng_uniform32(rng) * a->face_cdf[5];
     int f = 0;
     while (f < 5 && !(a->face_cdf[f] > x))
         f++;
@@ -137,13 +137,13 @@ static void air_emission_face_point(const air_emission *a, rng_stream *rng, vec3
     bool at_max = f % 2 == 1;
     double c[3];
     for (int k = 0; k < 3; k++)
-        c[k] = a->min_m[k] + rng_uniform(rng) * (a->max_m[k] - a->min_m[k]);
+        c[k] = a->min_m[k] + rng_uniform32(rng) * (a->max_m[k] - a->min_m[k]);
     c[axis] = at_max ? a->max_m[axis] : a->min_m[axis];
     *p = v3(c[0], c[1], c[2]);
     double nv[3] = {0.0, 0.0, 0.0};
     nv[axis] = at_max ? -1.0 : 1.0;
-    double u = rng_uniform(rng);
-    *dir = sampling_direction(v3(nv[0], nv[1], nv[2]), sqrt(1.0 - u), rng_uniform(rng));
+    double u = rng_uniform32(rng);
+    *dir = sampling_direction(v3(nv[0], nv[1], nv[2]), sqrt(1.0 - u), rng_uniform32(rng));
 }
 
 /* Whether a boundary photon at p going along dir comes from outside: a ray from just
@@ -364,9 +364,9 @@ thz_status air_emission_init(air_emission *a, const thz_scene *scene, const acce
 /* An air photon: frequency from the histogram, point and direction uniform. */
 static bool air_emission_air_photon(const air_emission *a, rng_stream *rng, emission_photon *out)
 {
-    double x = rng_uniform(rng) * a->cdf[AIR_EMISSION_BINS - 1];
+    double x = rng_uniform32(rng) * a->cdf[AIR_EMISSION_BINS - 1];
     size_t lo = cdf_search(a->cdf, AIR_EMISSION_BINS, x);
-    double nu = a->lo_hz + ((double)lo + rng_uniform(rng)) * a->bin_hz;
+    double nu = a->lo_hz + ((double)lo + rng_uniform32(rng)) * a->bin_hz;
     /* sigma sqrt(2 pi) = B_c (channel_sigma_hz; kept as two factors, the outputs' rounding) */
     double sigma = channel_sigma_hz(&a->scene->channels[a->channel]);
     double f = air_emission_density(a, nu, NULL);
@@ -383,7 +383,7 @@ static bool air_emission_boundary_photon(const air_emission *a, rng_stream *rng,
                                          emission_photon *out)
 {
     const thz_channel *ch = &a->scene->channels[a->channel];
-    double u1 = rng_uniform(rng), u2 = rng_uniform(rng);
+    double u1 = rng_uniform32(rng), u2 = rng_uniform32(rng);
     double nu = channel_sample_hz(ch, u1, u2);
     out->freq_hz = nu;
     air_emission_face_point(a, rng, &out->position_m, &out->dir);
@@ -401,7 +401,7 @@ bool air_emission_sample(const air_emission *a, const emission_table *t, rng_str
     if (!a || !a->active)
         return emission_sample(t, rng, out);
     out->batch = 0;
-    double u = rng_uniform(rng);
+    double u = rng_uniform32(rng);
     if (u < a->p_air + a->p_boundary) {
         out->object = ACCEL_NO_OBJECT;
         out->triangle = 0;

@@ -152,7 +152,7 @@ static optics_point emission_kirchhoff_optics(optics_point o)
 static vec3 emission_point(const thz_mesh *m, const double *triangle_cdf, double area_m2,
                            rng_stream *rng, size_t *tri)
 {
-    size_t k = cdf_search(triangle_cdf, m->n_triangles, rng_uniform(rng) * area_m2);
+    size_t k = cdf_search(triangle_cdf, m->n_triangles, rng_uniform32(rng) * area_m2);
     while (m->areas_m2[k] <= 0.0 && k > 0)
         k--;
     *tri = k;
@@ -161,7 +161,7 @@ static vec3 emission_point(const thz_mesh *m, const double *triangle_cdf, double
     vec3 p0 = v3_from_floats(&m->positions[3 * (size_t)idx[0]]);
     vec3 p1 = v3_from_floats(&m->positions[3 * (size_t)idx[1]]);
     vec3 p2 = v3_from_floats(&m->positions[3 * (size_t)idx[2]]);
-    double ra = sqrt(rng_uniform(rng)), rb = rng_uniform(rng);
+    double ra = sqrt(rng_uniform32(rng)), rb = rng_uniform32(rng);
     return v3_add(v3_scale(p0, 1.0 - ra),
                   v3_add(v3_scale(p1, ra * (1.0 - rb)), v3_scale(p2, ra * rb)));
 }
@@ -184,8 +184,8 @@ static double emission_back_reach(const emission_table *t, const accel *acc, siz
         vec3 p = emission_point(m, triangle_cdf, m->total_area_m2, &rng, &tri);
         const float *nf = &m->normals[3 * tri];
         vec3 n = v3_scale(v3(nf[0], nf[1], nf[2]), -1.0);
-        double u = rng_uniform(&rng);
-        vec3 dir = sampling_direction(n, sqrt(1.0 - u), rng_uniform(&rng));
+        double u = rng_uniform32(&rng);
+        vec3 dir = sampling_direction(n, sqrt(1.0 - u), rng_uniform32(&rng));
         accel_hit from = {
             .object = (uint32_t)i, .triangle = (uint32_t)tri, .position_m = p, .side = 1};
         accel_hit hit;
@@ -390,7 +390,7 @@ bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *
 {
     out->batch = 0;
     const thz_channel *ch = &t->scene->channels[t->channel];
-    double u1 = rng_uniform(rng), u2 = rng_uniform(rng);
+    double u1 = rng_uniform32(rng), u2 = rng_uniform32(rng);
     double nu = channel_sample_hz(ch, u1, u2);
     out->freq_hz = nu;
     out->power_w_per_hz = 0.0;
@@ -410,7 +410,7 @@ bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *
     double frac = pos - (double)row;
     size_t ng = t->n_groups;
     double total = emission_cum(t, row, frac, ng - 1);
-    double x = rng_uniform(rng) * total;
+    double x = rng_uniform32(rng) * total;
     size_t lo = 0, hi = ng - 1;
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
@@ -424,9 +424,8 @@ bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *
 
     const emission_group *gr = &t->groups[g];
     size_t within = 0;
-    double uw = rng_uniform(rng);
-    if (gr->count > 1) {
-        within = cdf_search(gr->cdf, gr->count, uw * gr->cdf[gr->count - 1]);
+    if (gr->count > 1) { /* a draw only where there is a choice (docs/physics.md) */
+        within = cdf_search(gr->cdf, gr->count, rng_uniform32(rng) * gr->cdf[gr->count - 1]);
         while (t->sources[t->order[gr->first + within]].share <= 0.0 && within > 0)
             within--;
     }
@@ -445,12 +444,9 @@ bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *
     if (back) /* drawn r times as often as its power says (emission.h) */
         out->power_w_per_hz /= s->reach_share;
 
-    int side = 0;
-    double us = rng_uniform(rng);
-    if (s->sides == 2)
-        side = us < 0.5 ? 0 : 1;
-    if (back)
-        side = 1;
+    int side = back ? 1 : 0;
+    if (!back && s->sides == 2)
+        side = rng_uniform32(rng) < 0.5 ? 0 : 1;
 
     size_t tri;
     out->position_m = emission_point(m, s->triangle_cdf, s->area_m2, rng, &tri);
@@ -464,10 +460,10 @@ bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *
     optics_point law = s->kind == EMISSION_ABSORB ? emission_kirchhoff_optics(o) : o;
     double mu;
     if (back)
-        mu = sqrt(1.0 - rng_uniform(rng)); /* radiance -B0: cosine */
-    else if (!optics_sample_emission_mu(&law, sampling_uniform, rng, &mu))
-        mu = sqrt(1.0 - rng_uniform(rng)); /* eps = 0 (a -A B0 source) or unreachable */
-    out->dir = sampling_direction(n, mu, rng_uniform(rng));
+        mu = sqrt(1.0 - rng_uniform32(rng)); /* radiance -B0: cosine */
+    else if (!optics_sample_emission_mu(&law, sampling_uniform32, rng, &mu))
+        mu = sqrt(1.0 - rng_uniform32(rng)); /* eps = 0 (a -A B0 source) or unreachable */
+    out->dir = sampling_direction(n, mu, rng_uniform32(rng));
     out->object = s->object;
     out->triangle = (uint32_t)tri;
     out->side = side;

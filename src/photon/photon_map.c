@@ -252,7 +252,9 @@ static photon_cube photon_group_cube(const photon_bounds *b)
     photon_cube c;
     double side = 0.0;
     for (int a = 0; a < 3; a++) {
-        c.origin[a] = b->lo[a] <= b->hi[a] ? b->lo[a] : 0.0; /* empty group: any */
+        /* an empty group: any; + 0.0 makes a minimum of -0 +0 (photon_map_scan's threads
+         * may see -0 and +0 in either order) */
+        c.origin[a] = b->lo[a] <= b->hi[a] ? b->lo[a] + 0.0 : 0.0;
         side = b->hi[a] - b->lo[a] > side ? b->hi[a] - b->lo[a] : side;
     }
     if (!(side > 0.0))
@@ -290,6 +292,96 @@ static void photon_group(photon_record *r, size_t n_groups, size_t *start, size_
     }
 }
 
+/* One pass over the records, split over threads: checks their groups, clears the bits
+ * 16..17 of flags (a kd-tree's split axis in maps before the octree; kept zero), counts
+ * the records of each group into count[g] and takes the groups' bounding boxes. Each
+ * thread has counts and boxes of its own, summed after (integer sums, minima and maxima:
+ * exact, so the thread count changes nothing). Returns count when every record names a
+ * group, else the first that does not; SIZE_MAX when out of memory. */
+static size_t photon_map_scan(photon_record *r, size_t count, size_t n_groups, int threads,
+                              size_t *group_count, photon_bounds *bounds)
+{
+    int nt = 1;
+#ifdef _OPENMP
+    nt = threads > 0 ? threads : omp_get_max_threads();
+    if (nt < 1)
+        nt = 1;
+    if (count < 65536) /* not worth waking threads for */
+        nt = 1;
+#else
+    (void)threads;
+#endif
+    size_t *counts = thz_calloc((size_t)nt * n_groups + 1, sizeof *counts);
+    photon_bounds *boxes = thz_malloc_array((size_t)nt * n_groups + 1, sizeof *boxes);
+    size_t *first_bad = thz_malloc_array((size_t)nt, sizeof *first_bad);
+    if (!counts || !boxes || !first_bad) {
+        free(counts);
+        free(boxes);
+        free(first_bad);
+        return SIZE_MAX;
+    }
+    for (size_t g = 0; g < (size_t)nt * n_groups; g++)
+        for (int a = 0; a < 3; a++) {
+            boxes[g].lo[a] = INFINITY;
+            boxes[g].hi[a] = -INFINITY;
+        }
+#pragma omp parallel num_threads(nt)
+    {
+        int t = 0, n_threads = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        n_threads = omp_get_num_threads();
+#endif
+        size_t lo = count / (size_t)n_threads * (size_t)t,
+               hi = count / (size_t)n_threads * (size_t)(t + 1);
+        if (t == n_threads - 1)
+            hi = count;
+        size_t *cnt = counts + (size_t)t * n_groups;
+        photon_bounds *box = boxes + (size_t)t * n_groups;
+        first_bad[t] = count;
+        for (size_t i = lo; i < hi; i++) {
+            photon_record *p = &r[i];
+            if (p->object_side >= n_groups) {
+                first_bad[t] = i;
+                break;
+            }
+            p->flags &= ~(3u << 16);
+            cnt[p->object_side]++;
+            photon_bounds *bb = &box[p->object_side];
+            for (int a = 0; a < 3; a++) {
+                double v = p->position_m[a];
+                bb->lo[a] = v < bb->lo[a] ? v : bb->lo[a];
+                bb->hi[a] = v > bb->hi[a] ? v : bb->hi[a];
+            }
+        }
+        if (n_threads < nt && t == 0) /* fewer threads than asked: the rest scanned nothing */
+            for (int u = n_threads; u < nt; u++)
+                first_bad[u] = count;
+    }
+    size_t bad = count;
+    for (size_t g = 0; g < n_groups; g++) {
+        bounds[g] = boxes[g];
+        group_count[g] = counts[g];
+    }
+    for (int t = 0; t < nt; t++) {
+        bad = first_bad[t] < bad ? first_bad[t] : bad;
+        if (t == 0)
+            continue;
+        for (size_t g = 0; g < n_groups; g++) {
+            const photon_bounds *b = &boxes[(size_t)t * n_groups + g];
+            group_count[g] += counts[(size_t)t * n_groups + g];
+            for (int a = 0; a < 3; a++) {
+                bounds[g].lo[a] = b->lo[a] < bounds[g].lo[a] ? b->lo[a] : bounds[g].lo[a];
+                bounds[g].hi[a] = b->hi[a] > bounds[g].hi[a] ? b->hi[a] : bounds[g].hi[a];
+            }
+        }
+    }
+    free(counts);
+    free(boxes);
+    free(first_bad);
+    return bad;
+}
+
 thz_status photon_map_create(photon_record *photons, size_t count, size_t n_objects, int threads,
                              photon_map **out, thz_error *err)
 {
@@ -320,29 +412,16 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
                            n_objects);
         goto cleanup;
     }
-    /* One pass: check, count per group, and the groups' bounding boxes. */
-    for (size_t g = 0; g < n_groups; g++)
-        for (int a = 0; a < 3; a++) {
-            bounds[g].lo[a] = INFINITY;
-            bounds[g].hi[a] = -INFINITY;
-        }
-    for (size_t i = 0; i < count; i++) {
-        photon_record *p = &photons[i];
-        if (p->object_side >= n_groups) {
-            st = thz_error_set(err, THZ_ERR_INTERNAL,
-                               "photon map: photon %zu names object %u of %zu", i,
-                               (unsigned)photon_object(p), n_objects);
-            goto cleanup;
-        }
-        /* bits 16..17 held a kd-tree's split axis in maps before the octree; kept zero */
-        p->flags &= ~(3u << 16);
-        map->start[p->object_side + 1]++;
-        photon_bounds *bb = &bounds[p->object_side];
-        for (int a = 0; a < 3; a++) {
-            double v = p->position_m[a];
-            bb->lo[a] = v < bb->lo[a] ? v : bb->lo[a];
-            bb->hi[a] = v > bb->hi[a] ? v : bb->hi[a];
-        }
+    size_t bad = photon_map_scan(photons, count, n_groups, threads, map->start + 1, bounds);
+    if (bad == SIZE_MAX) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu objects",
+                           n_objects);
+        goto cleanup;
+    }
+    if (bad < count) {
+        st = thz_error_set(err, THZ_ERR_INTERNAL, "photon map: photon %zu names object %u of %zu",
+                           bad, (unsigned)photon_object(&photons[bad]), n_objects);
+        goto cleanup;
     }
     for (size_t g = 0; g < n_groups; g++)
         map->cubes[g] = photon_group_cube(&bounds[g]);

@@ -61,9 +61,9 @@ trace_event trace_roulette(const optics_point *o, double mu, double u)
 vec3 trace_diffuse_transmission_dir(const optics_point *o, vec3 n_out, rng_stream *rng)
 {
     double mu;
-    if (!optics_sample_transmission_mu(o, sampling_uniform, rng, &mu))
-        mu = sqrt(1.0 - rng_uniform(rng)); /* unreachable after a transmission event */
-    return sampling_direction(n_out, mu, rng_uniform(rng));
+    if (!optics_sample_transmission_mu(o, sampling_uniform32, rng, &mu))
+        mu = sqrt(1.0 - rng_uniform32(rng)); /* unreachable after a transmission event */
+    return sampling_direction(n_out, mu, rng_uniform32(rng));
 }
 
 /* Reflection by the material's lobe (brdf.h) from hit, arriving along *dir: the new
@@ -78,7 +78,7 @@ static bool trace_reflect_lobe(const thz_scene *scene, const thz_object *obj, co
     brdf_lobe lobe; /* sampling only: per reflection, R-bar would cost 48 Fresnel terms */
     brdf_lobe_init_sampling(&lobe, o, scene->materials[obj->material].ward_table);
     double w;
-    if (!brdf_sample(&lobe, &f, v3_scale(*dir, -1.0), sampling_uniform, rng, dir, &w))
+    if (!brdf_sample(&lobe, &f, v3_scale(*dir, -1.0), sampling_uniform32, rng, dir, &w))
         return false;
     if (w != 1.0) {
         c->terminated_power -= *power * (w - 1.0);
@@ -145,7 +145,7 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
         power *= tr;
         if (fabs(power) < w_min) {
             /* Low-power roulette: survive with probability |w| / w_min at +-w_min. */
-            if (rng_uniform(rng) * w_min < fabs(power)) {
+            if (rng_uniform32(rng) * w_min < fabs(power)) {
                 double survivor = copysign(w_min, power);
                 c->terminated_power -= survivor - power;
                 power = survivor;
@@ -181,11 +181,11 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
         vec3 n = v3(nf[0], nf[1], nf[2]);
         vec3 n_in = hit.side == 0 ? n : v3_scale(n, -1.0); /* towards where it came from */
 
-        switch (trace_roulette(&o, hit.cos_theta, rng_uniform(rng))) {
+        switch (trace_roulette(&o, hit.cos_theta, rng_uniform32(rng))) {
         case TRACE_REFLECT:
             c->reflected++;
             if (o.lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(&o)) {
-                dir = sampling_direction(n_in, sqrt(1.0 - rng_uniform(rng)), rng_uniform(rng));
+                dir = sampling_direction(n_in, sqrt(1.0 - rng_uniform32(rng)), rng_uniform32(rng));
             } else if (!trace_reflect_lobe(scene, obj, &hit, &o, rng, &dir, &power, c)) {
                 c->absorbed++; /* a glossy sample below the surface: lost */
                 c->absorbed_power += power;

@@ -127,6 +127,22 @@ static void test_uniform_distribution(void **state)
     assert_true(chi2 < 120.0);
 }
 
+/* The photon phase's 32-bit uniform (docs/physics.md "Random streams"): one word each,
+ * word / 2^32, so a stream of them is the stream of words, in [0, 1). */
+static void test_uniform32(void **state)
+{
+    (void)state;
+    rng_stream a, b;
+    rng_init(&a, 11, 3, RNG_PURPOSE_PHOTON, 123456789);
+    rng_init(&b, 11, 3, RNG_PURPOSE_PHOTON, 123456789);
+    for (int i = 0; i < 4099; i++) {
+        double u = rng_uniform32(&a);
+        uint32_t w = rng_next_u32(&b);
+        assert_true(u >= 0.0 && u < 1.0);
+        assert_true(u * 4294967296.0 == (double)w);
+    }
+}
+
 static void test_open0(void **state)
 {
     (void)state;
@@ -144,7 +160,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_known_answers), cmocka_unit_test(test_stream_layout),
         cmocka_unit_test(test_keying),        cmocka_unit_test(test_uniform_distribution),
-        cmocka_unit_test(test_open0),
+        cmocka_unit_test(test_uniform32),     cmocka_unit_test(test_open0),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
