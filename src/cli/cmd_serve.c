@@ -77,14 +77,11 @@ int cmd_serve(int argc, char **argv)
             print_help();
             return CLI_EXIT_OK;
         }
-        bool takes_value =
-            strcmp(arg, "--host") == 0 || strcmp(arg, "--port") == 0 || strcmp(arg, "--root") == 0;
-        if (!takes_value)
-            return cli_usage_error(
-                CMD, arg[0] == '-' ? "unknown option '%s'" : "unexpected argument '%s'", arg);
-        if (i + 1 >= argc)
-            return cli_usage_error(CMD, "%s needs a value", arg);
-        const char *val = argv[++i];
+        static const char *const with_value[] = {"--host", "--port", "--root", NULL};
+        char *val = NULL;
+        int rc = cli_option_value(CMD, argc, argv, &i, with_value, &val);
+        if (rc >= 0)
+            return rc;
         uint64_t port = 0;
         if (strcmp(arg, "--host") == 0) {
             opt.host = val;
