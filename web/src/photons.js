@@ -1,0 +1,68 @@
+// The photon map as a point cloud coloured by each photon's incoming direction (the
+// paper's Fig. 3): red, green, blue follow the direction's x, y, z (0.5 + 0.5·d).
+import * as THREE from "three";
+import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+import { getBytes, q } from "./api.js";
+
+export class PhotonView {
+  constructor(container) {
+    this.container = container;
+    this.renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+    this.renderer.setClearColor(0x111418);
+    container.appendChild(this.renderer.domElement);
+    this.scene = new THREE.Scene();
+    this.camera = new THREE.PerspectiveCamera(45, 1, 0.01, 1e4);
+    this.camera.up.set(0, 0, 1);
+    this.camera.position.set(2, -3, 2);
+    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.controls.addEventListener("change", () => this.render());
+    new ResizeObserver(() => this.resize()).observe(container);
+  }
+
+  resize() {
+    const w = this.container.clientWidth;
+    const h = this.container.clientHeight;
+    if (!w || !h) return;
+    this.renderer.setSize(w, h);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.render();
+  }
+
+  async load(path, channel, object, max) {
+    let url = `/api/photons?path=${q(path)}&channel=${q(channel)}&max=${q(max)}`;
+    if (object) url += `&object=${q(object)}`;
+    const f = new Float32Array(await getBytes(url));
+    const n = Math.floor(f.length / 6);
+    const pos = new Float32Array(3 * n);
+    const col = new Float32Array(3 * n);
+    for (let i = 0; i < n; i++) {
+      for (let k = 0; k < 3; k++) {
+        pos[3 * i + k] = f[6 * i + k];
+        col[3 * i + k] = 0.5 + 0.5 * f[6 * i + 3 + k];
+      }
+    }
+    if (this.points) {
+      this.scene.remove(this.points);
+      this.points.geometry.dispose();
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute("position", new THREE.BufferAttribute(pos, 3));
+    g.setAttribute("color", new THREE.BufferAttribute(col, 3));
+    g.computeBoundingSphere();
+    this.points = new THREE.Points(g, new THREE.PointsMaterial({ size: 2, sizeAttenuation: false, vertexColors: true }));
+    this.scene.add(this.points);
+    if (n) {
+      const { center, radius } = g.boundingSphere;
+      this.controls.target.copy(center);
+      this.camera.position.copy(center).add(new THREE.Vector3(0.8, -1.5, 0.9).multiplyScalar(radius * 1.6));
+      this.controls.update();
+    }
+    this.resize();
+    return n;
+  }
+
+  render() {
+    this.renderer.render(this.scene, this.camera);
+  }
+}
