@@ -26,7 +26,6 @@ export class Results {
     $("btn-diff").onclick = () => this.diff().catch(reportError);
     $("frame").oninput = () => this.openFrame(Number($("frame").value)).catch(reportError);
     $("btn-play").onclick = () => this.play();
-    this.photons = new PhotonView($("photon-view"));
     $("btn-photons").onclick = () => this.loadPhotons().catch(reportError);
   }
 
@@ -34,7 +33,7 @@ export class Results {
     $("image-pane").hidden = view !== "image";
     $("photon-pane").hidden = view !== "photons";
     $("diff-pane").hidden = view !== "diff";
-    if (view === "photons") this.photons.resize();
+    if (view === "photons") this.photons?.resize();
   }
 
   async browse(dir) {
@@ -257,6 +256,7 @@ export class Results {
   async loadPhotons() {
     if (!this.mapPath) throw new Error(`${this.runDir}: no photon-map.thzpm (run simulate with "save the photon map")`);
     const t0 = performance.now();
+    this.photons ||= new PhotonView($("photon-view")); // its WebGL context only when wanted
     const n = await this.photons.load(this.mapPath, $("ph-channel").value, $("ph-object").value, Number($("ph-max").value));
     $("ph-info").textContent = `${n} photons, ${Math.round(performance.now() - t0)} ms; colour: incoming direction (r, g, b = 0.5 + 0.5·x, y, z)`;
   }

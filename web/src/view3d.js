@@ -145,7 +145,16 @@ export class SceneView {
     if (hit) this.onPick(hit.object.userData.index);
   }
 
+  // one frame per animation frame, however many changes asked for it
   render() {
+    if (this.pending) return;
+    this.pending = requestAnimationFrame(() => {
+      this.pending = 0;
+      this.draw();
+    });
+  }
+
+  draw() {
     const r = this.renderer;
     const w = this.container.clientWidth;
     const h = this.container.clientHeight;
