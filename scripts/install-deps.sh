@@ -10,6 +10,7 @@ packages=(
   python3 python3-numpy python3-spectral gdal-bin python3-gdal
   python3-pytest python3-matplotlib python3-sklearn python3-tqdm
   strace zstd
+  libmicrohttpd-dev  # optional: thzmap serve, the browser GUI (docs/gui.md)
   libopenmpi-dev openmpi-bin  # optional: MPI runs (docs/mpi.md)
   libclang-rt-14-dev  # libFuzzer for clang -fsanitize=fuzzer (make fuzz)
   nodejs  # the web page's bundle (three.js, esbuild from npm; docs/gui.md)

@@ -116,6 +116,20 @@ THZ_API uint64_t thz_photons_per_channel(const thz_photons *photons);
 /* Fills *out with channel c's statistics; THZ_ERR_INPUT when c is out of range. */
 THZ_API thz_status thz_photons_stats(const thz_photons *photons, size_t c, thz_photon_stats *out);
 
+/* A stored photon of a channel's map, for display (the paper's Fig. 3). */
+typedef struct thz_photon_point {
+    float position_m[3];  /* hit point, world space, m */
+    float direction[3];   /* unit direction of travel as it arrived */
+    float power_w_per_hz; /* spectral power it carried there (negative in deviation maps) */
+    uint32_t object;      /* index of the object hit */
+} thz_photon_point;
+/* The photons stored in channel c's map (0 when it has none). */
+THZ_API size_t thz_photons_count(const thz_photons *photons, size_t c);
+/* Copies photons first .. first + n - 1 of channel c (in the map's order, grouped by
+ * object) into out[n]; returns how many were copied (fewer past the end). */
+THZ_API size_t thz_photons_points(const thz_photons *photons, size_t c, size_t first, size_t n,
+                                  thz_photon_point *out);
+
 /* ---- images ------------------------------------------------------------------------- */
 
 /* The planes of a sensor's image (scene-format.md "Outputs"). Row 0 is the top of the

@@ -152,6 +152,42 @@ THZ_API long thz_scene_object_index(const thz_scene *scene, const char *name);
 THZ_API size_t thz_scene_warning_count(const thz_scene *scene);
 THZ_API const char *thz_scene_warning(const thz_scene *scene, size_t i);
 
+/* An object's triangles in world space (transforms applied), in metres: n_vertices
+ * vertices of 3 floats (x, y, z) in `positions`, n_triangles triangles of 3 vertex
+ * indices in `indices`, counter-clockwise seen from the front, and one unit front normal
+ * of 3 floats per triangle in `normals`. The arrays belong to the scene. */
+typedef struct thz_object_mesh {
+    size_t n_vertices;
+    const float *positions;
+    size_t n_triangles;
+    const uint32_t *indices;
+    const float *normals;
+} thz_object_mesh;
+/* Fills *out for object i; THZ_ERR_INPUT (and *out zeroed) when i is out of range. */
+THZ_API thz_status thz_scene_object_mesh(const thz_scene *scene, size_t i, thz_object_mesh *out);
+
+/* A material's optics at one frequency, as the simulation uses them (physics.md
+ * "Surfaces"), for a half-space (thickness_m 0) or a slab of thickness_m (a shell). */
+typedef struct thz_surface_optics {
+    double reflectance_normal;  /* R at normal incidence */
+    double reflectance_mean;    /* hemispherical mean R-bar */
+    double emissivity_normal;   /* eps at normal incidence (explicit, or Kirchhoff's A) */
+    double emissivity_mean;     /* eps-bar */
+    double transmission_mean;   /* T-bar; 0 for a half-space */
+    double attenuation_per_m;   /* inside the material: alpha_M, or 4 pi k nu / c */
+    int has_index;              /* n and k below hold the complex index */
+    double n, k;
+} thz_surface_optics;
+/* Fills *out for material i at freq_hz > 0; THZ_ERR_INPUT (and *out zeroed) when i is
+ * out of range, freq_hz is not positive or thickness_m is negative. */
+THZ_API thz_status thz_scene_material_optics(const thz_scene *scene, size_t i, double freq_hz,
+                                             double thickness_m, thz_surface_optics *out);
+
+/* Planck's law B_nu(T) in W m^-2 sr^-1 Hz^-1 and its inverse, the brightness temperature
+ * in K of a radiance at freq_hz (0 for radiance <= 0), as the images use them. */
+THZ_API double thz_planck_radiance(double freq_hz, double temperature_k);
+THZ_API double thz_brightness_temperature(double freq_hz, double radiance);
+
 /* Integrators by name ("photon-map", "final-gather", "path"): 1 when `name` is one,
  * else 0; whether it needs a photon map (photon-map, final-gather); whether more
  * render passes lower its noise (final-gather, path). 0 for unknown names. */

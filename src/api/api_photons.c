@@ -267,3 +267,29 @@ thz_status thz_photons_stats(const thz_photons *ph, size_t c, thz_photon_stats *
     };
     return THZ_OK;
 }
+
+size_t thz_photons_count(const thz_photons *ph, size_t c)
+{
+    return thz_photons_has_channel(ph, c) ? photon_map_count(ph->maps[c]) : 0;
+}
+
+size_t thz_photons_points(const thz_photons *ph, size_t c, size_t first, size_t n,
+                          thz_photon_point *out)
+{
+    size_t count = thz_photons_count(ph, c);
+    if (first >= count)
+        return 0;
+    if (n > count - first)
+        n = count - first;
+    const photon_record *rec = photon_map_records(ph->maps[c]) + first;
+    for (size_t i = 0; i < n; i++) {
+        vec3 d = photon_decode_direction(rec[i].dir_oct);
+        out[i] = (thz_photon_point){
+            .position_m = {rec[i].position_m[0], rec[i].position_m[1], rec[i].position_m[2]},
+            .direction = {(float)d.x, (float)d.y, (float)d.z},
+            .power_w_per_hz = rec[i].power_w_per_hz,
+            .object = photon_object(&rec[i]),
+        };
+    }
+    return n;
+}

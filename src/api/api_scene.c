@@ -258,3 +258,59 @@ int thz_integrator_has_passes(const char *name)
     thz_integrator it;
     return name && render_integrator_parse(name, &it) && render_integrator_has_passes(it);
 }
+
+thz_status thz_scene_object_mesh(const thz_scene *s, size_t i, thz_object_mesh *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!s || i >= s->n_objects)
+        return THZ_ERR_INPUT;
+    const thz_mesh *m = &s->objects[i].mesh;
+    *out = (thz_object_mesh){
+        .n_vertices = m->n_vertices,
+        .positions = m->positions,
+        .n_triangles = m->n_triangles,
+        .indices = m->indices,
+        .normals = m->normals,
+    };
+    return THZ_OK;
+}
+
+thz_status thz_scene_material_optics(const thz_scene *s, size_t i, double freq_hz,
+                                     double thickness_m, thz_surface_optics *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!s || i >= s->n_materials || !(freq_hz > 0.0) || !(thickness_m >= 0.0))
+        return THZ_ERR_INPUT;
+    /* an object of this material, as the simulation would see it */
+    thz_object obj = {
+        .type = thickness_m > 0.0 ? OBJECT_SHELL : OBJECT_SOLID,
+        .material = i,
+        .thickness_m = thickness_m,
+    };
+    optics_point o = scene_object_optics(s, &obj, freq_hz);
+    optics_prepare(&o);
+    *out = (thz_surface_optics){
+        .reflectance_normal = optics_reflectance(&o, 1.0),
+        .reflectance_mean = optics_mean_reflectance(&o),
+        .emissivity_normal = optics_emissivity(&o, 1.0),
+        .emissivity_mean = optics_mean_emissivity(&o),
+        .transmission_mean = optics_mean_transmission(&o),
+        .attenuation_per_m = o.attenuation_per_m,
+        .has_index = o.has_index,
+        .n = o.has_index ? o.n : 0.0,
+        .k = o.has_index ? o.k : 0.0,
+    };
+    if (o.has_index && !o.attenuation_given)
+        out->attenuation_per_m = 4.0 * M_PI * o.k * freq_hz / THZ_SPEED_OF_LIGHT;
+    return THZ_OK;
+}
+
+double thz_planck_radiance(double freq_hz, double temperature_k)
+{
+    return planck_radiance(freq_hz, temperature_k);
+}
+
+double thz_brightness_temperature(double freq_hz, double radiance)
+{
+    return planck_brightness_temperature(freq_hz, radiance);
+}

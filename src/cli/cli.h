@@ -19,6 +19,7 @@ int cmd_batch(int argc, char **argv);
 int cmd_materials(int argc, char **argv);
 int cmd_classify(int argc, char **argv);
 int cmd_bands(int argc, char **argv);
+int cmd_serve(int argc, char **argv);
 
 /* Prints "thzmap: <message>" to stderr and returns the exit status for err. */
 int cli_fail(const thz_error *err);

@@ -28,6 +28,7 @@ static const command commands[] = {
     {"bands", cmd_bands, "choose the channel frequencies that best separate a scene's targets",
      false},
     {"classify", cmd_classify, "recognise materials in a run's cubes against its truth", false},
+    {"serve", cmd_serve, "serve the browser GUI (scene editor, runs, results) and its API", false},
 };
 
 static void print_usage(FILE *f)

@@ -1,0 +1,136 @@
+/* What the files of src/serve/ share: the server's state, a request being answered,
+ * replies, paths confined to the root, and the endpoints each file provides. */
+#ifndef THZ_SERVE_SERVE_INTERNAL_H
+#define THZ_SERVE_SERVE_INTERNAL_H
+
+#include <jansson.h>
+#include <limits.h>
+#include <microhttpd.h>
+#include <pthread.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "serve.h"
+#include "thzmap/thzmap.h"
+
+#define SERVE_MAX_BODY_BYTES (4u << 20)  /* request bodies; larger: 413 */
+#define SERVE_MAX_FILE_BYTES (64u << 20) /* GET /api/file; larger: 413 */
+#define SERVE_MAX_JOBS 64                /* queued and running jobs; more: 409 */
+#define SERVE_CUBE_CACHE 8               /* cubes kept open */
+
+typedef struct serve_job serve_job;
+typedef struct serve_cube_entry serve_cube_entry;
+
+struct serve {
+    struct MHD_Daemon *daemon;
+    unsigned port;
+    char token[33];
+    char root[PATH_MAX]; /* realpath of the root; the working directory */
+    char web_dir[PATH_MAX];
+    bool has_web;
+
+    /* jobs (serve_runs.c): lock guards the list and every job's fields */
+    pthread_mutex_t lock;
+    pthread_cond_t changed; /* a job changed state or progress, or stopping */
+    pthread_t worker;
+    bool worker_started;
+    bool stopping;
+    serve_job **jobs;
+    size_t n_jobs, cap_jobs;
+    int next_id;
+
+    /* cubes (serve_outputs.c) and the last photon map (serve_photons.c) */
+    pthread_mutex_t cache_lock;
+    serve_cube_entry *cubes; /* SERVE_CUBE_CACHE entries */
+    uint64_t cube_clock;
+    pthread_mutex_t photon_lock;
+    struct serve_photon_cache *photons;
+};
+
+/* A request: method, URL, the body so far, and the server. */
+typedef struct serve_request {
+    serve *s;
+    struct MHD_Connection *conn;
+    const char *method;
+    const char *url;
+    char *body;
+    size_t body_size;
+    bool too_large;
+    bool answered; /* a response was queued before the body (401, 403, 413) */
+} serve_request;
+
+/* ---- replies (serve_http.c); each returns what the access handler returns ---------- */
+enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type, const void *data,
+                            size_t size);
+/* Takes a reference to `json` (steals it). */
+enum MHD_Result serve_reply_json(serve_request *r, unsigned status, json_t *json);
+enum MHD_Result serve_reply_error(serve_request *r, unsigned status, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+/* 400 with "path": the JSON path of the problem in the request body. */
+enum MHD_Result serve_reply_bad_json(serve_request *r, const char *json_path, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+/* Binary data (application/octet-stream), copied; extra headers name/value pairs, NULL-ended. */
+enum MHD_Result serve_reply_binary(serve_request *r, const void *data, size_t size,
+                                   const char *const *headers);
+/* The 404/403/500 for a thz_error of the library (input: 400). */
+enum MHD_Result serve_reply_thz_error(serve_request *r, const thz_error *err);
+
+/* A query argument, or NULL. */
+const char *serve_arg(serve_request *r, const char *name);
+/* The body parsed as a JSON object; NULL after replying 400 (then return *result). */
+json_t *serve_body_object(serve_request *r, enum MHD_Result *result);
+
+/* ---- paths under the root (serve_paths.c) ------------------------------------------- */
+
+/* Why a path was refused. */
+typedef enum serve_path_status {
+    SERVE_PATH_OK = 0,
+    SERVE_PATH_FORBIDDEN, /* absolute, "..", outside the root through a symlink: 403 */
+    SERVE_PATH_MISSING,   /* does not exist (when it must): 404 */
+} serve_path_status;
+
+/* Checks REL (relative to the root, "" or "." is the root) and writes the path to use
+ * (relative to the working directory, which is the root) into out[PATH_MAX]. With
+ * must_exist false the path may not exist yet, but its deepest existing ancestor must
+ * lie inside the root. */
+serve_path_status serve_path(const serve *s, const char *rel, bool must_exist, char *out);
+/* serve_path for the query argument `name`; replies (403, 404, 400 when absent) and
+ * returns false when it is refused. */
+bool serve_path_arg(serve_request *r, const char *name, bool must_exist, char *out,
+                    enum MHD_Result *result);
+/* Whether a path (relative to the root) resolves inside the root. */
+bool serve_path_inside(const serve *s, const char *path);
+/* Reads a whole file (at most max bytes) into a malloc'd NUL-terminated buffer. */
+char *serve_read_file(const char *path, size_t max, size_t *size);
+
+/* ---- endpoints ----------------------------------------------------------------------- */
+typedef enum MHD_Result (*serve_handler)(serve_request *r);
+
+enum MHD_Result serve_files_list(serve_request *r);
+enum MHD_Result serve_file_get(serve_request *r);
+enum MHD_Result serve_file_put(serve_request *r);
+enum MHD_Result serve_static(serve_request *r);
+
+enum MHD_Result serve_validate(serve_request *r);
+enum MHD_Result serve_materials(serve_request *r);
+
+enum MHD_Result serve_runs(serve_request *r); /* /api/runs and /api/runs/... */
+/* The job worker (serve_runs.c): started by serve_start, stopped by serve_stop. */
+bool serve_runs_start(serve *s);
+/* Cancels the running job, drops the queued ones and joins the worker; the event
+ * streams end. serve_runs_free (after the daemon stopped) frees the jobs. */
+void serve_runs_stop(serve *s);
+void serve_runs_free(serve *s);
+
+enum MHD_Result serve_outputs(serve_request *r);
+enum MHD_Result serve_cube(serve_request *r);
+enum MHD_Result serve_cube_data(serve_request *r);
+enum MHD_Result serve_pixel(serve_request *r);
+enum MHD_Result serve_diff(serve_request *r);
+void serve_cubes_free(serve *s);
+
+enum MHD_Result serve_photons(serve_request *r);
+enum MHD_Result serve_photons_info(serve_request *r);
+void serve_photons_free(serve *s);
+
+#endif
