@@ -1,7 +1,7 @@
 // The JSON API of `thzmap serve` (docs/gui.md), same origin, authorised by the cookie the
 // token URL set. Every failure becomes an Error whose message is the server's.
 
-async function request(path, options = {}) {
+export async function request(path, options = {}) {
   const response = await fetch(path, { credentials: "same-origin", ...options });
   if (!response.ok) {
     let message = response.statusText;

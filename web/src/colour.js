@@ -47,7 +47,7 @@ export function formatNumber(v) {
   if (!Number.isFinite(v)) return String(v);
   const a = Math.abs(v);
   if (a !== 0 && (a < 1e-3 || a >= 1e5)) return v.toExponential(3);
-  return v.toFixed(a < 1 ? 4 : a < 100 ? 3 : 2);
+  return String(Number(v.toPrecision(a < 100 ? 4 : 5)));
 }
 
 // dB_nu/dT at frequency nu (Hz) and temperature T (K): W m-2 sr-1 Hz-1 K-1

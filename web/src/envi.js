@@ -61,17 +61,18 @@ export function forget(prefix) {
   for (const k of cache.keys()) if (k.startsWith(prefix)) cache.delete(k);
 }
 
-// [lo, hi] over the finite values that are not the ignore value
+// [lo, hi]: the 1st and 99th percentiles of the finite values that are not the ignore value
+// (a few hot pixels of a noisy run would take the whole scale); at most 200 000 sampled.
 export function range(values, ignore) {
-  let lo = Infinity;
-  let hi = -Infinity;
-  for (let i = 0; i < values.length; i++) {
+  const step = Math.max(1, Math.floor(values.length / 200000));
+  const kept = [];
+  for (let i = 0; i < values.length; i += step) {
     const v = values[i];
-    if (!Number.isFinite(v) || v === ignore) continue;
-    if (v < lo) lo = v;
-    if (v > hi) hi = v;
+    if (Number.isFinite(v) && v !== ignore) kept.push(v);
   }
-  if (lo > hi) return [0, 1];
-  if (lo === hi) return [lo - 0.5, hi + 0.5];
-  return [lo, hi];
+  if (!kept.length) return [0, 1];
+  const sorted = Float64Array.from(kept).sort();
+  const lo = sorted[Math.floor(0.01 * (sorted.length - 1))];
+  const hi = sorted[Math.ceil(0.99 * (sorted.length - 1))];
+  return lo === hi ? [lo - 0.5, hi + 0.5] : [lo, hi];
 }

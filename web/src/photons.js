@@ -1,8 +1,11 @@
 // The photon map as a point cloud coloured by each photon's incoming direction (the
 // paper's Fig. 3): red, green, blue follow the direction's x, y, z (0.5 + 0.5·d).
+// /api/photons answers 8 float32 per photon: x, y, z (m), dx, dy, dz (direction of travel
+// as it arrived), power (W/Hz), object index.
+const STRIDE = 8;
 import * as THREE from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
-import { getBytes, q } from "./api.js";
+import { q, request } from "./api.js";
 
 export class PhotonView {
   constructor(container) {
@@ -32,14 +35,16 @@ export class PhotonView {
   async load(path, channel, object, max) {
     let url = `/api/photons?path=${q(path)}&channel=${q(channel)}&max=${q(max)}`;
     if (object) url += `&object=${q(object)}`;
-    const f = new Float32Array(await getBytes(url));
-    const n = Math.floor(f.length / 6);
+    const response = await request(url);
+    const f = new Float32Array(await response.arrayBuffer());
+    this.total = Number(response.headers.get("X-Thzmap-Photons-Total")) || null;
+    const n = Math.floor(f.length / STRIDE);
     const pos = new Float32Array(3 * n);
     const col = new Float32Array(3 * n);
     for (let i = 0; i < n; i++) {
       for (let k = 0; k < 3; k++) {
-        pos[3 * i + k] = f[6 * i + k];
-        col[3 * i + k] = 0.5 + 0.5 * f[6 * i + 3 + k];
+        pos[3 * i + k] = f[STRIDE * i + k];
+        col[3 * i + k] = 0.5 + 0.5 * f[STRIDE * i + 3 + k];
       }
     }
     if (this.points) {

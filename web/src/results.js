@@ -130,7 +130,7 @@ export class Results {
     const tb = this.tb;
     const keepCh = $("res-channel").value;
     $("res-channel").replaceChildren(...Array.from({ length: tb.bands }, (_, b) =>
-      new Option(`${b + 1}: ${tb.bandNames[b] || ""} ${formatNumber(tb.freqThz[b])} THz`, b, false, String(b) === keepCh)));
+      new Option(`${b + 1}: ${tb.bandNames[b] || `${formatNumber(tb.freqThz[b])} THz`}`, b, false, String(b) === keepCh)));
     const phCh = $("ph-channel");
     phCh.replaceChildren(...Array.from({ length: tb.bands }, (_, b) => new Option(`${formatNumber(tb.freqThz[b])} THz`, b)));
     const names = this.truthId?.header["object names"] || [];
@@ -150,7 +150,9 @@ export class Results {
     paint($("image"), cube, values, lo, hi, viridis, ignore);
     drawColourBar($("colourbar"), lo, hi, cube.unit === "1" ? "(1)" : cube.unit);
     const which = cube.bands > 1 ? `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)` : "truth";
-    $("image-info").textContent = `${qn.replace(/_/g, " ")}, ${which}: ${formatNumber(lo)} to ${formatNumber(hi)} ${cube.unit}`;
+    $("image-info").textContent = `${qn.replace(/_/g, " ")}, ${which}; colours span the 1st to 99th ` +
+      `percentile${$("res-scale").value === "common" ? " of all channels" : ""}: ` +
+      `${formatNumber(lo)} to ${formatNumber(hi)} ${cube.unit}`;
   }
 
   pixelOf(e, canvas, cube) {
@@ -258,7 +260,9 @@ export class Results {
     const t0 = performance.now();
     this.photons ||= new PhotonView($("photon-view")); // its WebGL context only when wanted
     const n = await this.photons.load(this.mapPath, $("ph-channel").value, $("ph-object").value, Number($("ph-max").value));
-    $("ph-info").textContent = `${n} photons, ${Math.round(performance.now() - t0)} ms; colour: incoming direction (r, g, b = 0.5 + 0.5·x, y, z)`;
+    const of = this.photons.total ? ` of ${this.photons.total}` : "";
+    $("ph-info").textContent = `${n}${of} photons, ${Math.round(performance.now() - t0)} ms; ` +
+      "colour: direction of arrival (red, green, blue = 0.5 + 0.5 × its x, y, z)";
   }
 }
 

@@ -64,11 +64,10 @@ export class Runs {
         data = { message: e.data };
       }
       const run = this.runs.get(id) || { id };
-      Object.assign(run, data.run || {});
-      if (data.state) run.state = data.state;
-      else if (e.type === "progress" || data.done !== undefined) run.state = "running";
-      if (data.total) run.progress = { stage: data.stage, done: data.done, total: data.total };
-      if (data.message || data.line) this.log(`[${id}] ${data.message || data.line}`);
+      const before = run.message;
+      Object.assign(run, data); // the job's JSON: state, progress 0..1, message, error
+      if (run.message && run.message !== before) this.log(`[${id}] ${run.message}`);
+      if (run.error) this.log(`[${id}] error: ${run.error}`);
       this.runs.set(id, run);
       if (FINAL.has(run.state) || e.type === "end") this.finished(id, run);
       this.renderTable();
@@ -98,7 +97,7 @@ export class Runs {
     if (run.announced) return;
     run.announced = true;
     const ok = ["done", "finished", "succeeded"].includes(run.state);
-    status(`run ${id} ${run.state}${run.exit_status !== undefined ? ` (exit ${run.exit_status})` : ""}`, !ok);
+    status(`run ${id} ${run.state}${run.error ? `: ${run.error}` : ""}`, !ok);
     if (ok) document.dispatchEvent(new CustomEvent("run-finished", { detail: run }));
   }
 
@@ -117,11 +116,15 @@ export class Runs {
       tr.dataset.state = r.state;
       for (const v of [r.id, r.command, r.scene, r.out, r.state]) tr.insertCell().textContent = v ?? "";
       const cell = tr.insertCell();
-      if (r.progress && !FINAL.has(r.state)) {
+      if (typeof r.progress === "number" && !FINAL.has(r.state)) {
         const bar = document.createElement("progress");
-        bar.max = r.progress.total;
-        bar.value = r.progress.done;
-        cell.append(bar, ` ${r.progress.stage || ""} ${Math.round((100 * r.progress.done) / r.progress.total)} %`);
+        bar.max = 1;
+        bar.value = r.progress;
+        cell.append(bar, ` ${Math.round(100 * r.progress)} % ${r.message || ""}`);
+      } else if (r.state === "failed") {
+        cell.textContent = r.error || "";
+      } else if (typeof r.seconds === "number") {
+        cell.textContent = `${r.seconds.toFixed(1)} s`;
       }
       const act = tr.insertCell();
       if (!FINAL.has(r.state)) {

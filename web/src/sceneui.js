@@ -276,33 +276,39 @@ export class SceneEditor {
     const mats = this.info?.materials;
     const name = this.selection.kind === "object" ? o?.material : null;
     const m = Array.isArray(mats) ? mats.find((x) => x.name === name) : mats?.[name];
-    if (m) {
+    const sp = m?.spectra || m;
+    if (sp?.freq_thz) {
       const title = document.createElement("div");
-      title.textContent = `material ${name}`;
+      title.textContent = `material ${name}${m.index_model ? ` (index model ${m.index_model})` : ""}`;
       box.appendChild(title);
-      const f = m.freq_thz || m.frequency_thz || [];
+      const f = sp.freq_thz;
       const series = [];
-      if (m.R) series.push({ label: "R", x: f, y: m.R });
-      if (m.emissivity) series.push({ label: "ε", x: f, y: m.emissivity });
+      if (sp.R) series.push({ label: "R", x: f, y: sp.R });
+      if (sp.emissivity) series.push({ label: "ε", x: f, y: sp.emissivity });
       if (series.length) linePlot(box, series, { xLabel: "frequency (THz)", yLabel: "R, ε (1)", yMin: 0, yMax: 1 });
-      if (m.alpha) linePlot(box, [{ label: "α", x: f, y: m.alpha }], { xLabel: "frequency (THz)", yLabel: "α (1/m)" });
+      const alpha = sp.alpha_per_m || sp.alpha;
+      if (alpha) linePlot(box, [{ label: "α", x: f, y: alpha }], { xLabel: "frequency (THz)", yLabel: "α (1/m)" });
       const nk = [];
-      if (m.n) nk.push({ label: "n", x: f, y: m.n });
-      if (m.k) nk.push({ label: "k", x: f, y: m.k });
+      if (sp.n) nk.push({ label: "n", x: f, y: sp.n });
+      if (sp.k) nk.push({ label: "k", x: f, y: sp.k });
       if (nk.length) linePlot(box, nk, { xLabel: "frequency (THz)", yLabel: "n, k (1)" });
     } else {
-      box.textContent = name ? `no spectra for ${name}` : "select an object";
+      box.textContent = name ? `no spectra for ${name} (the scene must be valid)` : "select an object";
     }
     const atm = $("atmosphere-plot");
     atm.replaceChildren();
-    const channels = this.info?.channels || [];
-    const tr = this.info?.atmosphere?.transmittance;
-    if (Array.isArray(tr) && tr.length) {
-      const x = channels.map((c) => c.frequency_thz ?? c);
-      linePlot(atm, [{ label: `τ (${this.info.atmosphere.model || "model"})`, x, y: tr }],
-        { xLabel: "channel centre (THz)", yLabel: "transmittance (1)", yMin: 0, yMax: 1 });
+    const a = this.info?.atmosphere;
+    const x = (this.info?.channels || []).map((c) => c.centre_thz ?? c.frequency_thz);
+    const series = (a?.sensors || []).map((s) => ({
+      label: `${s.name} (${s.distance_m?.toFixed?.(2) ?? "?"} m)`, x, y: s.transmittance,
+    })).filter((s) => Array.isArray(s.y) && s.y.length === x.length);
+    if (series.length) {
+      const title = document.createElement("div");
+      title.textContent = `model ${a.model}: over each sensor's distance to what it looks at`;
+      atm.appendChild(title);
+      linePlot(atm, series, { xLabel: "channel centre (THz)", yLabel: "transmittance (1)", yMin: 0, yMax: 1 });
     } else {
-      atm.textContent = "no transmittance given";
+      atm.textContent = a ? `model ${a.model}` : "no transmittance (the scene must be valid)";
     }
   }
 }
