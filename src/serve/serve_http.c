@@ -45,7 +45,8 @@ enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type,
 
 enum MHD_Result serve_reply_json(serve_request *r, unsigned status, json_t *json)
 {
-    char *text = json ? json_dumps(json, JSON_COMPACT | JSON_ENSURE_ASCII) : NULL;
+    char *text =
+        json ? json_dumps(json, JSON_COMPACT | JSON_ENSURE_ASCII | JSON_REAL_PRECISION(9)) : NULL;
     json_decref(json);
     if (!text)
         return serve_reply(r, 500, "application/json", "{\"error\":\"out of memory\"}", 25);

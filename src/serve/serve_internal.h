@@ -13,6 +13,11 @@
 #include "serve.h"
 #include "thzmap/thzmap.h"
 
+/* Binary answers are the host's float32 arrays as they are, documented as little-endian. */
+#if __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "thzmap serve sends float32 arrays in the host's byte order, which must be little-endian"
+#endif
+
 #define SERVE_MAX_BODY_BYTES (4u << 20)  /* request bodies; larger: 413 */
 #define SERVE_MAX_FILE_BYTES (64u << 20) /* GET /api/file; larger: 413 */
 #define SERVE_MAX_JOBS 64                /* queued and running jobs; more: 409 */
@@ -128,6 +133,14 @@ enum MHD_Result serve_cube_data(serve_request *r);
 enum MHD_Result serve_pixel(serve_request *r);
 enum MHD_Result serve_diff(serve_request *r);
 void serve_cubes_free(serve *s);
+/* The cube of header `hdr` (a path under the root ending in .hdr), from the cache or
+ * read; valid while the caller holds s->cache_lock and gets no other cube. NULL with err
+ * filled when it cannot be read. */
+const thz_cube *serve_cube_get(serve *s, const char *hdr, thz_error *err);
+/* The standard error of Tb (K) from that of the radiance L: half the change of Tb over
+ * L +- sigma at the channel centre (where the images' Tb is defined), or over
+ * L .. L + sigma near L = 0. NaN without a positive centre or a sigma. */
+double serve_tb_stderr(double centre_hz, double l, double sigma);
 
 enum MHD_Result serve_photons(serve_request *r);
 enum MHD_Result serve_photons_info(serve_request *r);

@@ -1,0 +1,482 @@
+#!/usr/bin/python3
+"""The JSON API of `thzmap serve` (docs/gui.md), endpoint by endpoint, against a real
+server on a free port over a temporary root: the token (401, 403, the cookie), paths
+leaving the root (.., absolute, %2e%2e, symlinks), oversized and malformed bodies,
+validation, runs (server-sent events, cancel, SIGTERM), and the post-processor's
+answers compared with the ENVI files the run wrote.
+
+usage: test_api.py THZMAP_BINARY REPO_DIR
+"""
+import http.client
+import json
+import math
+import os
+import re
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+BINARY, REPO = sys.argv[1], sys.argv[2]
+FAILURES = []
+
+
+def check(cond, what):
+    if not cond:
+        FAILURES.append(what)
+        print("FAIL:", what, flush=True)
+
+
+class Server:
+    def __init__(self, root, env=None):
+        self.proc = subprocess.Popen([BINARY, "serve", "--port", "0", "--root", root],
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True, env=env)
+        line = self.proc.stdout.readline()
+        m = re.search(r"http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]{32}) ", line)
+        if not m:
+            self.proc.kill()
+            raise SystemExit("no URL printed: %r %s" % (line, self.proc.stderr.read()))
+        self.port, self.token = int(m.group(1)), m.group(2)
+
+    def request(self, method, path, body=None, headers=None, auth=True):
+        conn = http.client.HTTPConnection("127.0.0.1", self.port, timeout=60)
+        h = dict(headers or {})
+        if auth:
+            h["Authorization"] = "Bearer " + self.token
+        conn.request(method, path, body=body, headers=h)
+        resp = conn.getresponse()
+        data = resp.read()
+        conn.close()
+        return resp.status, dict(resp.getheaders()), data
+
+    def json(self, method, path, body=None, status=200):
+        if body is not None and not isinstance(body, (bytes, str)):
+            body = json.dumps(body)
+        st, _, data = self.request(method, path, body)
+        check(st == status, "%s %s: status %d, expected %d (%s)" % (method, path, st, status,
+                                                                     data[:300]))
+        try:
+            return json.loads(data)
+        except ValueError:
+            check(False, "%s %s: not JSON: %r" % (method, path, data[:200]))
+            return None
+
+    def stop(self, sig=signal.SIGINT):
+        self.proc.send_signal(sig)
+        try:
+            return self.proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            return None
+
+
+def make_root(root):
+    """A small scene: plate-in-box with 2 channels, 16 x 16 pixels, few photons."""
+    src = os.path.join(REPO, "examples", "plate-in-box")
+    shutil.copytree(os.path.join(src, "materials"), os.path.join(root, "s", "materials"))
+    scene = json.load(open(os.path.join(src, "scene.json")))
+    scene["channels"].append({"name": "0.6 THz", "frequency_thz": 0.6, "relative_width": 0.01})
+    scene["sensors"][0]["resolution"] = [16, 12]
+    scene["sensors"][0]["oversampling"] = 1
+    scene["photons"]["per_channel"] = 4000
+    scene.setdefault("render", {})["integrator"] = "photon-map"
+    with open(os.path.join(root, "s", "scene.json"), "w") as f:
+        json.dump(scene, f, indent=1)
+    os.symlink("/etc", os.path.join(root, "etc-link"))
+    web = os.path.join(root, "..", "web")
+    os.makedirs(os.path.join(web, "assets"))
+    open(os.path.join(web, "index.html"), "w").write("<!doctype html><title>t</title>")
+    open(os.path.join(web, "assets", "app.js"), "w").write("console.log(1)")
+    open(os.path.join(root, "..", "secret.json"), "w").write("{}")
+    return scene
+
+
+def read_img(path):
+    data = open(path, "rb").read()
+    return data, struct.unpack("<%df" % (len(data) // 4), data)
+
+
+def f32(values):
+    """JSON numbers (9 significant digits) as the float32 values they stand for."""
+    return [struct.unpack("<f", struct.pack("<f", v))[0] for v in values]
+
+
+def planck_tb(freq_hz, radiance):
+    h, k, c = 6.62607015e-34, 1.380649e-23, 299792458.0
+    return h * freq_hz / k / math.log1p(2 * h * freq_hz ** 3 / (c * c * radiance))
+
+
+def wait_state(srv, run_id, states, limit_s=60):
+    t0 = time.time()
+    while time.time() - t0 < limit_s:
+        job = srv.json("GET", "/api/runs/%d" % run_id)
+        if job and job["state"] in states:
+            return job
+        time.sleep(0.05)
+    check(False, "run %d never reached %s" % (run_id, states))
+    return None
+
+
+def test_auth(srv):
+    st, _, _ = srv.request("GET", "/api/info", auth=False)
+    check(st == 401, "no token: %d, expected 401" % st)
+    st, _, _ = srv.request("GET", "/api/info", auth=False,
+                           headers={"Authorization": "Bearer " + "0" * 32})
+    check(st == 403, "wrong bearer token: %d, expected 403" % st)
+    st, _, _ = srv.request("GET", "/api/info", auth=False,
+                           headers={"Cookie": "thzmap_token=" + "1" * 32})
+    check(st == 403, "wrong cookie: %d, expected 403" % st)
+    st, _, _ = srv.request("GET", "/?token=" + "2" * 32, auth=False)
+    check(st == 403, "login with a wrong token: %d, expected 403" % st)
+    st, h, _ = srv.request("GET", "/?token=" + srv.token, auth=False)
+    cookie = h.get("Set-Cookie", "")
+    check(st == 303 and h.get("Location") == "/", "login: %d %s" % (st, h))
+    check("thzmap_token=" + srv.token in cookie and "HttpOnly" in cookie and
+          "SameSite=Strict" in cookie, "login cookie: %r" % cookie)
+    st, _, data = srv.request("GET", "/api/info", auth=False,
+                              headers={"Cookie": "thzmap_token=" + srv.token})
+    check(st == 200 and json.loads(data)["version"], "cookie accepted: %d" % st)
+    st, h, data = srv.request("GET", "/")
+    check(st == 200 and b"<title>t</title>" in data, "index.html: %d %r" % (st, data[:80]))
+    st, h, data = srv.request("GET", "/assets/app.js")
+    check(st == 200 and data == b"console.log(1)" and "javascript" in h["Content-Type"],
+          "assets: %d %r" % (st, data))
+    info = srv.json("GET", "/api/info")
+    check(info and "photon-map" in info["integrators"] and "simulate" in info["commands"],
+          "info: %r" % info)
+    srv.json("GET", "/api/nothing", status=404)
+    srv.json("DELETE", "/api/info", status=405)
+
+
+def test_paths(srv, root):
+    for path in ["/api/file?path=../secret.json", "/api/file?path=/etc/passwd",
+                 "/api/file?path=%2e%2e/secret.json", "/api/file?path=s/%2E%2E/%2e%2e/secret.json",
+                 "/api/file?path=etc-link/passwd", "/api/files?dir=etc-link",
+                 "/api/files?dir=..", "/api/files?dir=/", "/api/cube?path=../x.hdr",
+                 "/api/outputs?dir=etc-link", "/api/pixel?dir=..&sensor=cam&row=0&col=0"]:
+        st, _, data = srv.request("GET", path)
+        check(st == 403 and "error" in json.loads(data), "%s: %d, expected 403" % (path, st))
+    for path in ["/assets/../../secret.json", "/assets/%2e%2e/%2e%2e/secret.json",
+                 "/assets/%2e%2e/index.html"]:
+        st, _, data = srv.request("GET", path)
+        check(st in (403, 404), "%s: %d, expected 403 or 404" % (path, st))
+    for path in ["/api/file?path=etc-link/x.json", "/api/file?path=../x.json",
+                 "/api/file?path=s/x.txt"]:
+        st, _, _ = srv.request("PUT", path, body=b"{}")
+        check(st == 403, "PUT %s: %d, expected 403" % (path, st))
+    check(not os.path.exists(os.path.join(root, "..", "x.json")), "a PUT escaped the root")
+    # the file endpoints inside the root
+    listing = srv.json("GET", "/api/files?dir=s")
+    names = {e["name"]: e for e in listing["entries"]} if listing else {}
+    check(names.get("scene.json", {}).get("type") == "file" and
+          names.get("materials", {}).get("type") == "dir", "files: %r" % listing)
+    root_list = srv.json("GET", "/api/files")
+    check(root_list and "etc-link" not in [e["name"] for e in root_list["entries"]],
+          "a symlink out of the root is listed")
+    st, _, data = srv.request("GET", "/api/file?path=s/scene.json")
+    check(st == 200 and data == open(os.path.join(root, "s", "scene.json"), "rb").read(),
+          "GET file: %d" % st)
+    text = b'{"edited": true}\n'
+    res = srv.json("PUT", "/api/file?path=s/new.json", body=text)
+    check(res and res["size"] == len(text) and
+          open(os.path.join(root, "s", "new.json"), "rb").read() == text, "PUT file: %r" % res)
+    check(sorted(os.listdir(os.path.join(root, "s"))) == ["materials", "new.json", "scene.json"],
+          "PUT left files behind: %r" % os.listdir(os.path.join(root, "s")))
+    srv.json("GET", "/api/file?path=s/none.json", status=404)
+
+
+def test_limits(srv):
+    # a declared length above 4 MiB is refused before the body is read
+    import socket
+    sock = socket.create_connection(("127.0.0.1", srv.port), timeout=30)
+    sock.sendall(("POST /api/validate HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer %s\r\n"
+                  "Content-Length: %d\r\n\r\n" % (srv.token, 5 << 20)).encode())
+    answer = sock.recv(4096).decode(errors="replace")
+    sock.close()
+    check(answer.startswith("HTTP/1.1 413"), "declared 5 MiB body: %r" % answer[:40])
+    # and so is a chunked body that grows past it
+    conn = http.client.HTTPConnection("127.0.0.1", srv.port, timeout=60)
+    conn.request("POST", "/api/validate", body=(b"x" * (1 << 20) for _ in range(5)),
+                 headers={"Authorization": "Bearer " + srv.token}, encode_chunked=True)
+    st = conn.getresponse().status
+    conn.close()
+    check(st == 413, "chunked 5 MiB body: %d, expected 413" % st)
+    err = srv.json("POST", "/api/validate", body="{bad", status=400)
+    check(err and err.get("path") == "$" and "line 1" in err["error"], "malformed: %r" % err)
+    err = srv.json("POST", "/api/validate", body={"text": 3}, status=400)
+    check(err and err.get("path") == "$.text", "text not a string: %r" % err)
+    err = srv.json("POST", "/api/runs", body={"command": 3}, status=400)
+    check(err and err.get("path") == "$.command", "bad command: %r" % err)
+    err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/scene.json",
+                                               "out": "o", "options": {"photons": "many"}},
+                   status=400)
+    check(err and err.get("path") == "$.options.photons", "bad option: %r" % err)
+    err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/scene.json",
+                                               "out": "o", "options": {"sensor": "cam"}},
+                   status=400)
+    check(err and err.get("path") == "$.options.sensor", "option of another command: %r" % err)
+    err = srv.json("POST", "/api/runs", body={"command": "bands", "scene": "s/scene.json",
+                                               "out": "o"}, status=400)
+    check(err and err.get("path") == "$.options.count", "bands without count: %r" % err)
+    srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "../secret.json",
+                                         "out": "o"}, status=403)
+    srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/scene.json",
+                                         "out": "etc-link/o"}, status=403)
+
+
+def test_validate(srv, scene):
+    text = json.dumps(scene)
+    res = srv.json("POST", "/api/validate", body={"path": "s/scene.json", "text": text})
+    sc = res and res["scene"]
+    check(res and res["ok"] and not res["errors"], "validate ok: %r" % (res and res["errors"]))
+    if sc:
+        check([c["centre_thz"] for c in sc["channels"]] == [0.35, 0.6], "channels")
+        check(abs(sc["channels"][0]["width_thz"] - 0.0035) < 1e-9, "channel width")
+        target = [o for o in sc["objects"] if o["name"] == "target"][0]
+        pos, idx = target["mesh"]["positions"], target["mesh"]["indices"]
+        check(len(idx) == 3 * target["triangles"] and max(idx) < len(pos) // 3, "mesh sizes")
+        zs = pos[2::3]  # the cylinder 0.75 m high translated by 0.001 m
+        check(abs(min(zs) - 0.001) < 1e-6 and abs(max(zs) - 0.751) < 1e-6, "mesh transformed")
+        paint = [m for m in sc["materials"] if m["name"] == "paint"][0]["spectra"]
+        i = min(range(len(paint["freq_thz"])), key=lambda j: abs(paint["freq_thz"][j] - 0.7))
+        f = paint["freq_thz"][i]  # R is a table (0.2, 0.05) .. (1.2, 0.12), linear
+        check(abs(paint["R"][i] - (0.05 + 0.07 * (f - 0.2))) < 1e-6 and
+              abs(paint["emissivity"][i] - (1 - paint["R"][i])) < 1e-9, "paint spectrum")
+        cam = sc["sensors"][0]
+        check(cam["rows"] == 12 and cam["columns"] == 16 and cam["fov_deg"] == 40, "sensor")
+        atm = sc["atmosphere"]
+        d = atm["sensors"][0]["distance_m"]
+        check(abs(atm["sensors"][0]["transmittance"][0] - math.exp(-0.05 * d)) < 1e-9 and
+              atm["channels"][0]["alpha_per_m"] == 0.05, "atmosphere: %r" % atm)
+    bad = json.loads(text)
+    bad["objects"][1]["temperature_k"] = -5
+    res = srv.json("POST", "/api/validate", body={"path": "s/scene.json", "text": json.dumps(bad)})
+    e = res and res["errors"] and res["errors"][0]
+    check(res and not res["ok"] and e and e["json_path"] == "objects[1].temperature_k" and
+          "-5" in e["message"], "validate error: %r" % res)
+    res = srv.json("POST", "/api/validate", body={"path": None, "text": '{"format":\n  x}'})
+    e = res and res["errors"] and res["errors"][0]
+    check(e and e["line"] == 2 and e["column"] and e["json_path"] is None, "syntax error: %r" % e)
+    # relative files resolve from the scene's directory: without it the table is missing
+    res = srv.json("POST", "/api/validate", body={"path": None, "text": text})
+    check(res and not res["ok"] and "sample.csv" in json.dumps(res["errors"]), "base_dir")
+
+
+def test_materials(srv):
+    lib = srv.json("GET", "/api/materials")
+    check(lib and len(lib["materials"]) > 0, "material library")
+    if lib and lib["materials"]:
+        name = lib["materials"][0]["name"]
+        m = srv.json("GET", "/api/materials/" + name)
+        sp = m and m["spectra"]
+        ok = sp and len(sp["freq_thz"]) == len(sp["n"]) and any(v is not None for v in sp["n"])
+        check(ok, "material spectra of %s" % name)
+    srv.json("GET", "/api/materials/no-such-material", status=404)
+
+
+def sse_events(srv, run_id):
+    conn = http.client.HTTPConnection("127.0.0.1", srv.port, timeout=60)
+    conn.request("GET", "/api/runs/%d/events" % run_id,
+                 headers={"Authorization": "Bearer " + srv.token})
+    resp = conn.getresponse()
+    check(resp.status == 200 and resp.getheader("Content-Type") == "text/event-stream", "SSE")
+    events, name = [], None
+    for raw in resp:
+        line = raw.decode().rstrip("\n")
+        if line.startswith("event: "):
+            name = line[7:]
+        elif line.startswith("data: "):
+            events.append((name, json.loads(line[6:])))
+            if name == "end":
+                break
+    conn.close()
+    return events
+
+
+def test_runs(srv, root):
+    run = srv.json("POST", "/api/runs", body={
+        "command": "simulate", "scene": "s/scene.json", "out": "out/a",
+        "options": {"seed": 1, "save_photon_map": True, "threads": 2}}, status=202)
+    events = sse_events(srv, run["id"])
+    progress = [d for n, d in events if n == "progress"]
+    check(events and events[-1][0] == "end" and progress and progress[-1]["state"] == "done",
+          "SSE to completion: %r" % events[-3:])
+    fractions = [d["progress"] for d in progress]
+    check(fractions == sorted(fractions) and fractions[-1] == 1.0, "progress: %r" % fractions)
+    run_b = srv.json("POST", "/api/runs", body={
+        "command": "simulate", "scene": "s/scene.json", "out": "out/b",
+        "options": {"seed": 2, "integrator": "photon-map"}}, status=202)
+    render = srv.json("POST", "/api/runs", body={
+        "command": "render", "scene": "s/scene.json", "out": "out/r",
+        "options": {"photon_map": "out/a/photon-map.thzpm", "sensor": "cam"}}, status=202)
+    job = wait_state(srv, render["id"], ("done", "failed"))
+    check(job and job["state"] == "done", "render: %r" % job)
+    check(wait_state(srv, run_b["id"], ("done",)) is not None, "second run")
+    listing = srv.json("GET", "/api/runs")
+    check(listing and [j["id"] for j in listing][:3] == [run["id"], run_b["id"], render["id"]],
+          "runs list")
+    srv.json("GET", "/api/runs/999", status=404)
+    srv.json("DELETE", "/api/runs/%d" % run["id"], status=409)
+    # cancel: a long run while it runs, and one still queued behind it
+    long_run = srv.json("POST", "/api/runs", body={
+        "command": "simulate", "scene": "s/scene.json", "out": "out/long",
+        "options": {"photons": 300000000}}, status=202)
+    queued = srv.json("POST", "/api/runs", body={
+        "command": "simulate", "scene": "s/scene.json", "out": "out/q"}, status=202)
+    wait_state(srv, long_run["id"], ("running",))
+    job = srv.json("DELETE", "/api/runs/%d" % queued["id"])
+    check(job and job["state"] == "cancelled", "cancel queued: %r" % job)
+    srv.json("DELETE", "/api/runs/%d" % long_run["id"])
+    t0 = time.time()
+    job = wait_state(srv, long_run["id"], ("cancelled", "done", "failed"))
+    check(job and job["state"] == "cancelled", "cancel running: %r" % job)
+    print("cancel took %.2f s" % (time.time() - t0))
+    check(not os.path.exists(os.path.join(root, "out", "long")) and
+          not os.path.exists(os.path.join(root, "out", "q")), "a cancelled run left output")
+    check(sorted(os.listdir(os.path.join(root, "out"))) == ["a", "b", "r"],
+          "out/ holds %r" % os.listdir(os.path.join(root, "out")))
+
+
+def test_results(srv, root):
+    out = os.path.join(root, "out", "a")
+    res = srv.json("GET", "/api/outputs?dir=out/a")
+    cam = res and [s for s in res["sensors"] if s["name"] == "cam"]
+    check(cam and "brightness_temperature" in cam[0]["cubes"] and
+          "cam.visual.png" in cam[0]["images"] and res["photon_map"] == "out/a/photon-map.thzpm"
+          and res["summary"]["seed"] == 1, "outputs: %r" % (res and res["sensors"]))
+    cube = srv.json("GET", "/api/cube?path=out/a/cam.brightness_temperature.hdr")
+    check(cube and (cube["rows"], cube["columns"], cube["bands"]) == (12, 16, 2) and
+          cube["centres_thz"] == [0.35, 0.6] and cube["units"] == "K" and
+          cube["band_names"] == ["0.35 THz", "0.6 THz"], "cube: %r" % cube)
+    raw, tb = read_img(os.path.join(out, "cam.brightness_temperature.img"))
+    st, _, data = srv.request("GET", "/api/cube/data?path=out/a/cam.brightness_temperature.hdr")
+    check(st == 200 and data == raw, "whole cube = the .img bytes")
+    st, _, data = srv.request("GET",
+                              "/api/cube/data?path=out/a/cam.brightness_temperature.hdr&band=1")
+    check(st == 200 and data == raw[16 * 12 * 4:], "band 1 = the .img's second band")
+    check(cube and f32([cube["min"][0], cube["max"][1]]) == [min(tb[:192]), max(tb[192:])],
+          "cube min/max")
+    srv.json("GET", "/api/cube/data?path=out/a/cam.brightness_temperature.hdr&band=2", status=400)
+    _, rad = read_img(os.path.join(out, "cam.radiance.img"))
+    _, se = read_img(os.path.join(out, "cam.radiance_stderr.img"))
+    _, temp = read_img(os.path.join(out, "cam.temperature.img"))
+    _, dist = read_img(os.path.join(out, "cam.distance.img"))
+    _, oid = read_img(os.path.join(out, "cam.object_id.img"))
+    names = ["room", "target", "cover"]
+    t0 = time.time()
+    for row, col in [(6, 8), (0, 0), (11, 15)]:
+        p = srv.json("GET", "/api/pixel?dir=out/a&sensor=cam&row=%d&col=%d" % (row, col))
+        i = row * 16 + col
+        check(p and f32(p["tb_K"]) == [tb[i], tb[192 + i]] and
+              f32(p["radiance"]) == [rad[i], rad[192 + i]] and p["channels_thz"] == [0.35, 0.6],
+              "pixel (%d, %d) Tb: %r" % (row, col, p))
+        if not p:
+            continue
+        for c, f in enumerate([0.35e12, 0.6e12]):
+            l, s = rad[c * 192 + i], se[c * 192 + i]
+            want = 0.5 * (planck_tb(f, l + s) - planck_tb(f, l - s))
+            check(abs(p["tb_stderr_K"][c] - want) <= 1e-5 * max(want, 1e-3),
+                  "pixel Tb standard error %r vs %r" % (p["tb_stderr_K"][c], want))
+        t = p["truth"]
+        check(t["object"] == names[int(oid[i])] and f32([t["temperature_K"]]) == [temp[i]] and
+              f32([t["distance_m"]]) == [dist[i]], "pixel truth: %r" % t)
+    print("3 pixel answers: %.1f ms each" % ((time.time() - t0) / 3 * 1e3))
+    srv.json("GET", "/api/pixel?dir=out/a&sensor=cam&row=12&col=0", status=404)
+    # A/B difference, in units of the combined standard error
+    st, h, data = srv.request("GET", "/api/diff?a=out/a&b=out/b&sensor=cam&band=0")
+    _, tb_b = read_img(os.path.join(root, "out", "b", "cam.brightness_temperature.img"))
+    _, rad_b = read_img(os.path.join(root, "out", "b", "cam.radiance.img"))
+    _, se_b = read_img(os.path.join(root, "out", "b", "cam.radiance_stderr.img"))
+    diff = struct.unpack("<192f", data) if st == 200 and len(data) == 768 else None
+    check(diff and h.get("X-Thzmap-Diff-Units") == "sigma", "diff: %d %r" % (st, h))
+    for i in range(0, 192, 7) if diff else []:
+        sa = 0.5 * (planck_tb(0.35e12, rad[i] + se[i]) - planck_tb(0.35e12, rad[i] - se[i]))
+        sb = 0.5 * (planck_tb(0.35e12, rad_b[i] + se_b[i]) -
+                    planck_tb(0.35e12, rad_b[i] - se_b[i]))
+        if sa * sa + sb * sb > 0:
+            want = (tb[i] - tb_b[i]) / math.sqrt(sa * sa + sb * sb)
+            check(abs(diff[i] - want) <= 1e-3 * max(1, abs(want)),
+                  "diff pixel %d: %r vs %r" % (i, diff[i], want))
+    srv.json("GET", "/api/diff?a=out/a&b=out/b&sensor=nope&band=0", status=400)
+
+
+def test_photons(srv, scene):
+    info = srv.json("GET", "/api/photons/info?path=out/a/photon-map.thzpm")
+    check(info and info["objects"] == ["room", "target", "cover"] and
+          info["channels"][0]["photons"] > 0, "photons info: %r" % info)
+    st, h, data = srv.request("GET", "/api/photons?path=out/a/photon-map.thzpm&channel=1"
+                                     "&object=target&max=100")
+    n, total = int(h.get("X-Thzmap-Photons", -1)), int(h.get("X-Thzmap-Photons-Total", -1))
+    check(st == 200 and n == min(100, total) and total > 100 and len(data) == 32 * n,
+          "photons: %d %r %d bytes" % (st, h, len(data)))
+    recs = [struct.unpack_from("<8f", data, 32 * k) for k in range(len(data) // 32)]
+    for x, y, z, dx, dy, dz, power, obj in recs:
+        # the target is a cylinder of radius 0.1 m from z = 0.001 to 0.751 m
+        ok = (obj == 1 and math.hypot(x, y) < 0.1 + 1e-4 and 0.001 - 1e-4 < z < 0.751 + 1e-4 and
+              abs(dx * dx + dy * dy + dz * dz - 1) < 1e-3 and power > 0)
+        if not ok:
+            check(False, "photon record %r" % ((x, y, z, dx, dy, dz, power, obj),))
+            break
+    st, h, data = srv.request("GET", "/api/photons?path=out/a/photon-map.thzpm&channel=0")
+    check(st == 200 and len(data) == 32 * info["channels"][0]["photons"], "all photons")
+    srv.json("GET", "/api/photons?path=out/a/photon-map.thzpm&channel=5", status=404)
+    srv.json("GET", "/api/photons?path=out/a/cam.radiance.img&channel=0&scene=s/scene.json",
+             status=400)
+
+
+def test_sigterm(root, env):
+    srv = Server(root, env)
+    before = sorted(os.listdir(os.path.join(root, "out")))
+    run = srv.json("POST", "/api/runs", body={
+        "command": "simulate", "scene": "s/scene.json", "out": "out/term",
+        "options": {"photons": 300000000}}, status=202)
+    wait_state(srv, run["id"], ("running",))
+    time.sleep(0.2)  # into the photon phase, its staging directory open
+    t0 = time.time()
+    rc = srv.stop(signal.SIGTERM)
+    print("SIGTERM during a run: exit %s after %.2f s" % (rc, time.time() - t0))
+    check(rc == 143, "SIGTERM: exit status %s, expected 143" % rc)
+    after = sorted(os.listdir(os.path.join(root, "out")))
+    check(after == before and
+          not os.path.exists(os.path.join(root, "out", "term")), "SIGTERM left output behind: %r -> %r" % (before, after))
+
+
+def main():
+    tmp = tempfile.mkdtemp(prefix="thzmap-serve-")
+    root = os.path.join(tmp, "root")
+    os.makedirs(root)
+    try:
+        scene = make_root(root)
+        env = dict(os.environ, THZMAP_WEB_DIR=os.path.join(tmp, "web"))
+        t0 = time.time()
+        srv = Server(root, env)
+        try:
+            for name, fn in [("auth", lambda: test_auth(srv)),
+                             ("paths", lambda: test_paths(srv, root)),
+                             ("limits", lambda: test_limits(srv)),
+                             ("validate", lambda: test_validate(srv, scene)),
+                             ("materials", lambda: test_materials(srv)),
+                             ("runs", lambda: test_runs(srv, root)),
+                             ("results", lambda: test_results(srv, root)),
+                             ("photons", lambda: test_photons(srv, scene))]:
+                t = time.time()
+                fn()
+                print("%-10s %.2f s" % (name, time.time() - t), flush=True)
+        finally:
+            rc = srv.stop(signal.SIGINT)
+            check(rc == 130, "SIGINT: exit status %s, expected 130" % rc)
+        test_sigterm(root, env)
+        print("total %.1f s" % (time.time() - t0))
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    if FAILURES:
+        print("%d failure(s)" % len(FAILURES))
+        sys.exit(1)
+    print("ok")
+
+
+main()
