@@ -5,14 +5,14 @@ Selenium (Debian's chromium, chromium-driver, python3-selenium):
     python3 test_e2e.py THZMAP_BINARY REPO_DIR SCREENSHOT_DIR
 
 It starts `thzmap serve` on a temporary root holding a copy of the paper's scene
-(examples/teraeye, trimmed to 32 x 32 pixels and 20 000 photons per channel so that a run
+(examples/teraeye, trimmed to 32 x 32 pixels and 10 000 photons per channel so that a run
 takes seconds), opens the page with the printed URL, and then, as a user would: opens the
 scene, changes a temperature, types an invalid one and finds the error at that field,
 runs the scene twice (seeds 1 and 2, queued), clicks a pixel and compares the spectrum the
 page shows with the ENVI cube read by numpy, loads the photon map and the A/B difference.
 Each view is saved as SCREENSHOT_DIR/gui-*.png (docs/images/ holds one such set).
 THZ_GUI_URL=http://... THZ_GUI_ROOT=DIR runs it against a server already running on DIR
-instead (developing the page against tests/gui/mock_server.py)."""
+instead (while developing the page)."""
 import json
 import os
 import re
@@ -44,7 +44,7 @@ def make_root(root):
     with open(path) as f:
         scene = json.load(f)
     scene["sensors"][0].update(resolution=[32, 32], oversampling=1)
-    scene["photons"]["per_channel"] = 20000
+    scene["photons"]["per_channel"] = 10000
     scene["render"] = {"integrator": "photon-map"}
     with open(path, "w") as f:
         json.dump(scene, f, indent=2)
@@ -72,7 +72,7 @@ def browser():
     options = webdriver.ChromeOptions()
     options.binary_location = "/usr/bin/chromium"
     for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage",
-                "--window-size=1500,950", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"):
+                "--window-size=1400,850", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"):
         options.add_argument(arg)
     return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
 

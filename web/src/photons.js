@@ -35,27 +35,28 @@ export class PhotonView {
   async load(path, channel, object, max) {
     let url = `/api/photons?path=${q(path)}&channel=${q(channel)}&max=${q(max)}`;
     if (object) url += `&object=${q(object)}`;
+    const t0 = performance.now();
     const response = await request(url);
     const f = new Float32Array(await response.arrayBuffer());
     this.total = Number(response.headers.get("X-Thzmap-Photons-Total")) || null;
+    const t1 = performance.now();
     const n = Math.floor(f.length / STRIDE);
-    const pos = new Float32Array(3 * n);
-    const col = new Float32Array(3 * n);
-    for (let i = 0; i < n; i++) {
-      for (let k = 0; k < 3; k++) {
-        pos[3 * i + k] = f[STRIDE * i + k];
-        col[3 * i + k] = 0.5 + 0.5 * f[STRIDE * i + 3 + k];
-      }
-    }
     if (this.points) {
       this.scene.remove(this.points);
       this.points.geometry.dispose();
     }
+    // the records as they came: no copy, the colour computed on the GPU
+    const records = new THREE.InterleavedBuffer(f.subarray(0, n * STRIDE), STRIDE);
     const g = new THREE.BufferGeometry();
-    g.setAttribute("position", new THREE.BufferAttribute(pos, 3));
-    g.setAttribute("color", new THREE.BufferAttribute(col, 3));
+    g.setAttribute("position", new THREE.InterleavedBufferAttribute(records, 3, 0));
+    g.setAttribute("direction", new THREE.InterleavedBufferAttribute(records, 3, 3));
     g.computeBoundingSphere();
-    this.points = new THREE.Points(g, new THREE.PointsMaterial({ size: 2, sizeAttenuation: false, vertexColors: true }));
+    this.points = new THREE.Points(g, new THREE.ShaderMaterial({
+      vertexShader: `attribute vec3 direction; varying vec3 colour;
+        void main() { colour = 0.5 + 0.5 * direction;
+          gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0); gl_PointSize = 2.0; }`,
+      fragmentShader: "varying vec3 colour; void main() { gl_FragColor = vec4(colour, 1.0); }",
+    }));
     this.scene.add(this.points);
     if (n) {
       const { center, radius } = g.boundingSphere;
@@ -64,10 +65,20 @@ export class PhotonView {
       this.controls.update();
     }
     this.resize();
+    this.draw();
+    this.timing = { fetch_ms: t1 - t0, draw_ms: performance.now() - t1 };
     return n;
   }
 
   render() {
+    if (this.pending) return;
+    this.pending = requestAnimationFrame(() => {
+      this.pending = 0;
+      this.draw();
+    });
+  }
+
+  draw() {
     this.renderer.render(this.scene, this.camera);
   }
 }

@@ -261,7 +261,9 @@ export class Results {
     this.photons ||= new PhotonView($("photon-view")); // its WebGL context only when wanted
     const n = await this.photons.load(this.mapPath, $("ph-channel").value, $("ph-object").value, Number($("ph-max").value));
     const of = this.photons.total ? ` of ${this.photons.total}` : "";
-    $("ph-info").textContent = `${n}${of} photons, ${Math.round(performance.now() - t0)} ms; ` +
+    const { fetch_ms: fetchMs, draw_ms: drawMs } = this.photons.timing;
+    $("ph-info").textContent = `${n}${of} photons, ${Math.round(performance.now() - t0)} ms ` +
+      `(${Math.round(fetchMs)} ms to fetch, ${Math.round(drawMs)} ms to draw); ` +
       "colour: direction of arrival (red, green, blue = 0.5 + 0.5 × its x, y, z)";
   }
 }
