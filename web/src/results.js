@@ -1,7 +1,7 @@
 // The post-processor: per-channel images with a colour bar in kelvin, truth maps, measured
 // cubes; a clicked pixel's spectrum with error bars and truth; A/B differences in units of
 // the combined standard error; batch frames played one after the other.
-import { getJSON, q, reportError, status } from "./api.js";
+import { getJSON, q, reportError, request, status } from "./api.js";
 import { loadCube, range } from "./envi.js";
 import { cssColour, diverging, drawColourBar, formatNumber, planckDerivative, viridis } from "./colour.js";
 import { linePlot } from "./plots.js";
@@ -212,47 +212,41 @@ export class Results {
     info.dataset.ms = (performance.now() - t0).toFixed(1);
   }
 
+  // the server's /api/diff: (Tb_A − Tb_B) / √(σ_A² + σ_B²), or Tb_A − Tb_B in K when a run
+  // has no standard errors (its X-Thzmap-Diff-Units header says which)
   async diff() {
     const sensor = $("res-sensor").value;
     const a = $("diff-a").value.trim();
     const b = $("diff-b").value.trim();
     const band = Number($("res-channel").value) || 0;
-    const [ta, sa, tb, sb] = await Promise.all([
-      loadCube(join(a, `${sensor}.brightness_temperature`)), loadCube(join(a, `${sensor}.radiance_stderr`)),
-      loadCube(join(b, `${sensor}.brightness_temperature`)), loadCube(join(b, `${sensor}.radiance_stderr`)),
-    ]);
-    if (ta.cols !== tb.cols || ta.rows !== tb.rows || ta.bands !== tb.bands) {
-      throw new Error(`${a} and ${b}: different image sizes or channels`);
-    }
-    const n = ta.cols * ta.rows;
-    const z = new Float32Array(n);
-    const nu = ta.freqThz[band] * 1e12;
+    const cube = await loadCube(join(a, `${sensor}.brightness_temperature`));
+    const response = await request(`/api/diff?a=${q(a)}&b=${q(b)}&sensor=${q(sensor)}&band=${band}`);
+    const z = new Float32Array(await response.arrayBuffer());
+    const sigma = response.headers.get("X-Thzmap-Diff-Units") !== "K";
     let beyond = 0;
     let count = 0;
-    for (let i = 0; i < n; i++) {
-      const j = band * n + i;
-      const t1 = ta.data[j];
-      const t2 = tb.data[j];
-      const s1 = t1 > 0 ? sa.data[j] / planckDerivative(nu, t1) : NaN;
-      const s2 = t2 > 0 ? sb.data[j] / planckDerivative(nu, t2) : NaN;
-      const s = Math.hypot(s1, s2);
-      z[i] = s > 0 ? (t1 - t2) / s : t1 === t2 ? 0 : NaN;
-      if (Number.isFinite(z[i])) {
-        count++;
-        if (Math.abs(z[i]) > 3) beyond++;
-      }
+    let hi = 0;
+    for (const v of z) {
+      if (!Number.isFinite(v)) continue;
+      count++;
+      if (Math.abs(v) > 3) beyond++;
+      hi = Math.max(hi, Math.abs(v));
     }
-    this.diffZ = { z, cube: ta };
-    paint($("diff-image"), ta, z, -4, 4, diverging, null);
-    drawColourBar($("diff-bar"), -4, 4, "σ", diverging);
-    $("diff-info").textContent = `(A − B) / √(σA² + σB²), channel ${band + 1} (${formatNumber(ta.freqThz[band])} THz): ` +
-      `${((100 * beyond) / Math.max(count, 1)).toFixed(2)} % of ${count} pixels beyond ±3 σ (0.27 % expected if A and B agree)`;
+    const span = sigma ? 4 : hi || 1;
+    this.diffZ = { z, cube, unit: sigma ? "σ" : "K" };
+    paint($("diff-image"), cube, z, -span, span, diverging, null);
+    drawColourBar($("diff-bar"), -span, span, this.diffZ.unit, diverging);
+    const channel = `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)`;
+    $("diff-info").textContent = sigma
+      ? `(A − B) / √(σA² + σB²), ${channel}: ${((100 * beyond) / Math.max(count, 1)).toFixed(2)} % of ` +
+        `${count} pixels beyond ±3 σ (0.27 % expected if A and B agree within their errors)`
+      : `A − B in K, ${channel} (a run without standard errors: no σ to compare with)`;
   }
 
   clickDiff(e) {
     if (!this.diffZ) return;
     const [row, col] = this.pixelOf(e, $("diff-image"), this.diffZ.cube);
-    $("pixel-info").textContent = `row ${row}, column ${col}: A − B = ${formatNumber(this.diffZ.z[row * this.diffZ.cube.cols + col])} σ`;
+    $("pixel-info").textContent = `row ${row}, column ${col}: A − B = ${formatNumber(this.diffZ.z[row * this.diffZ.cube.cols + col])} ${this.diffZ.unit}`;
   }
 
   async loadPhotons() {
