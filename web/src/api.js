@@ -20,9 +20,10 @@ export const q = (value) => encodeURIComponent(value);
 export const getJSON = async (path) => (await request(path)).json();
 export const getText = async (path) => (await request(path)).text();
 export const getBytes = async (path) => (await request(path)).arrayBuffer();
-export const sendJSON = async (method, path, body) =>
+export const sendJSON = async (method, path, body, signal) =>
   (await request(path, {
     method,
+    signal,
     headers: { "Content-Type": "application/json" },
     body: JSON.stringify(body),
   })).json();

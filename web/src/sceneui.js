@@ -124,17 +124,32 @@ export class SceneEditor {
     this.timer = setTimeout(() => this.validateNow(text), 200);
   }
 
+  // One validation in flight at a time: edits made meanwhile are validated, as one text,
+  // when it returns. A request without an answer in 10 s is asked again (twice at most).
   async validateNow(text) {
-    const seq = (this.seq = (this.seq || 0) + 1);
-    $("validation").textContent = "validating…";
-    let result;
-    try {
-      result = await sendJSON("POST", "/api/validate", { path: this.path, text });
-    } catch (e) {
-      reportError(e);
+    if (this.inflight) {
+      this.pendingText = text;
       return;
     }
-    if (seq !== this.seq) return; // a later edit's answer is what counts
+    this.inflight = true;
+    $("validation").textContent = "validating…";
+    let result = null;
+    for (let attempt = 0; attempt < 3 && !result; attempt++) {
+      try {
+        result = await sendJSON("POST", "/api/validate", { path: this.path, text }, AbortSignal.timeout(10000));
+      } catch (e) {
+        if (e.name !== "TimeoutError" || attempt === 2) reportError(e);
+        if (e.name !== "TimeoutError") break;
+      }
+    }
+    this.inflight = false;
+    if (this.pendingText !== undefined) {
+      const next = this.pendingText;
+      this.pendingText = undefined;
+      this.validateNow(next);
+      return; // a later edit's answer is what counts
+    }
+    if (!result) return;
     this.errors = (result.errors || []).map((e) => ({
       ...e,
       json_path: e.json_path || (String(e.message).match(/(?:^|: )([a-z_]+(?:\[\d+\])?(?:\.[a-z_]+(?:\[\d+\])?)*): /) || [])[1] || "",
