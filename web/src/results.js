@@ -146,13 +146,34 @@ export class Results {
     const band = Math.min(Number($("res-channel").value) || 0, cube.bands - 1);
     const values = cube.band(band);
     const ignore = cube.ignore ?? (qn.includes("brightness") ? 0 : null);
+    const names = cube.header["object names"];
+    if (qn === "object_id" && names) return this.showObjects(cube, names);
     const [lo, hi] = $("res-scale").value === "common" ? range(cube.data, ignore) : range(values, ignore);
     paint($("image"), cube, values, lo, hi, viridis, ignore);
-    drawColourBar($("colourbar"), lo, hi, cube.unit === "1" ? "(1)" : cube.unit);
+    const unit = cube.unit === "1" ? "(1)" : cube.unit;
+    drawColourBar($("colourbar"), lo, hi, unit);
     const which = cube.bands > 1 ? `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)` : "truth";
     $("image-info").textContent = `${qn.replace(/_/g, " ")}, ${which}; colours span the 1st to 99th ` +
       `percentile${$("res-scale").value === "common" ? " of all channels" : ""}: ` +
-      `${formatNumber(lo)} to ${formatNumber(hi)} ${cube.unit}`;
+      `${formatNumber(lo)} to ${formatNumber(hi)}${cube.unit === "1" ? "" : ` ${cube.unit}`}`;
+  }
+
+  // the truth map of objects: one colour per object, named beside the picture
+  showObjects(cube, names) {
+    const palette = names.map((_, i) => viridis(names.length > 1 ? i / (names.length - 1) : 0.5));
+    paint($("image"), cube, cube.band(0), 0, Math.max(names.length - 1, 1), viridis, -1);
+    const bar = $("colourbar");
+    bar.getContext("2d").clearRect(0, 0, bar.width, bar.height);
+    const seen = new Set(cube.band(0));
+    const info = $("image-info");
+    info.replaceChildren("object seen (grey: nothing hit): ");
+    names.forEach((n, i) => {
+      if (!seen.has(i)) return;
+      const sw = document.createElement("span");
+      sw.className = "swatch";
+      sw.style.background = cssColour(palette[i]);
+      info.append(sw, `${n}  `);
+    });
   }
 
   pixelOf(e, canvas, cube) {
@@ -287,4 +308,3 @@ function paint(canvas, cube, values, lo, hi, map, ignore) {
   }
   g.putImageData(img, 0, 0);
 }
-export { cssColour };
