@@ -38,5 +38,5 @@ if(NOT THZ_SANITIZE)
   add_test(NAME gui/test_e2e
     COMMAND /usr/bin/python3 ${CMAKE_SOURCE_DIR}/tests/gui/test_e2e.py
             $<TARGET_FILE:thzmap_cli> ${CMAKE_SOURCE_DIR} ${CMAKE_BINARY_DIR}/gui-screenshots)
-  set_tests_properties(gui/test_e2e PROPERTIES LABELS "gui;no-sanitizer" TIMEOUT 120)
+  set_tests_properties(gui/test_e2e PROPERTIES LABELS "gui;no-sanitizer" TIMEOUT 300)
 endif()

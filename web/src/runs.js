@@ -132,7 +132,7 @@ export class Runs {
         b.textContent = "Cancel";
         b.onclick = () => del(`/api/runs/${q(r.id)}`).then(() => this.refresh()).catch(reportError);
         act.appendChild(b);
-      } else if (r.out) {
+      } else if (r.out && ["done", "finished", "succeeded"].includes(r.state)) {
         const b = document.createElement("button");
         b.textContent = "Results";
         b.onclick = () => document.dispatchEvent(new CustomEvent("show-results", { detail: r.out }));

@@ -97,9 +97,14 @@ export class SceneView {
       this.meshes.push(mesh);
       shaded.computeBoundingBox();
       box.union(shaded.boundingBox);
-      if (this.options.normals) this.group.add(normalLines(shaded, index === this.selectedObject));
+      if (this.options.normals) {
+        const lines = normalLines(shaded, index === this.selectedObject);
+        lines.userData.helper = true;
+        this.group.add(lines);
+      }
     });
     (doc?.sensors || []).forEach((s, i) => this.group.add(frustum(s, i === this.selectedSensor)));
+    this.legend();
     if (!this.framed && !box.isEmpty()) {
       const centre = box.getCenter(new THREE.Vector3());
       const size = box.getSize(new THREE.Vector3()).length();
@@ -112,6 +117,21 @@ export class SceneView {
       this.framed = true;
     }
     this.render();
+  }
+
+  // the temperature colours' key beside the toolbar's "Colour by"
+  legend() {
+    const el = document.getElementById("legend3d");
+    if (this.options.colourBy !== "temperature" || !Number.isFinite(this.tRange[0])) {
+      el.textContent = "";
+      return;
+    }
+    const stops = [0, 0.25, 0.5, 0.75, 1].map((t) => `rgb(${viridis(t).map(Math.round).join(",")})`);
+    el.innerHTML = "";
+    const ramp = document.createElement("span");
+    ramp.className = "legend-ramp";
+    ramp.style.background = `linear-gradient(to right, ${stops.join(", ")})`;
+    el.append(`${this.tRange[0]} K `, ramp, ` ${this.tRange[1]} K`);
   }
 
   colourOf(o, doc) {
@@ -168,7 +188,7 @@ export class SceneView {
     const cam = sensorCamera(sensor);
     const pw = Math.round(Math.min(w * 0.3, 260));
     const ph = Math.round(pw / cam.aspect);
-    const frusta = this.group.children.filter((c) => c.userData.frustum);
+    const frusta = this.group.children.filter((c) => c.userData.helper); // frusta, normals
     frusta.forEach((f) => (f.visible = false));
     r.setScissorTest(true);
     r.setScissor(w - pw - 8, 8, pw, ph);
@@ -225,6 +245,6 @@ function frustum(sensor, selected) {
   pts.push(corners[2], up, up, corners[3]);
   const lines = new THREE.LineSegments(new THREE.BufferGeometry().setFromPoints(pts),
     new THREE.LineBasicMaterial({ color: selected ? 0xe06000 : 0x333333 }));
-  lines.userData.frustum = true;
+  lines.userData.helper = true;
   return lines;
 }
