@@ -167,8 +167,11 @@ def main():
         assert all(s in ("done", "finished", "succeeded") for s in ours(driver)), ours(driver)
         log("both runs done")
         # Post-processor: the image of the last run, a pixel on cylinder C
-        by_id("tab-results").click()
-        driver.execute_script("window.thzmap.results.open('teraeye/out-seed1')")
+        # the first run's Results button (the last run to finish opened by itself)
+        wait.until(lambda d: d.execute_script(
+            "const row = [...document.querySelectorAll('#runs tbody tr')]"
+            ".find((r) => r.cells[3].textContent === 'teraeye/out-seed1');"
+            "const b = row && row.querySelector('button'); if (b) b.click(); return !!b;"))
         wait.until(lambda d: "loaded" in by_id("status").text and "out-seed1" in by_id("status").text)
         out = os.path.join(root, "teraeye", "out-seed1")
         bands = len(json.load(open(os.path.join(out, "summary.json")))["channels"])

@@ -57,7 +57,9 @@ export class Results {
 
   // an output directory: of one run, or of a batch (frame-NNNNN/, sweep-NN/frame-NNNNN/)
   async open(dir) {
+    const seq = (this.openSeq = (this.openSeq || 0) + 1);
     const entries = await this.browse(dir);
+    if (seq !== this.openSeq) return; // another directory was asked for meanwhile
     const names = entries.map((e) => e.name);
     const frames = names.filter((n) => /^frame-\d{5}$/.test(n)).sort();
     const sweeps = names.filter((n) => /^sweep-\d{2}$/.test(n)).sort();
@@ -111,6 +113,7 @@ export class Results {
     if (names.includes("summary.json")) {
       this.summary = await getJSON(`/api/file?path=${q(join(dir, "summary.json"))}`).catch(() => null);
     }
+    if (this.runDir !== dir) return; // another run was opened meanwhile
     this.mapPath = names.includes("photon-map.thzpm") ? join(dir, "photon-map.thzpm") : null;
     if (!$("diff-a").value) $("diff-a").value = dir;
     await this.loadSensor();
@@ -125,6 +128,7 @@ export class Results {
     const t0 = performance.now();
     const want = ["brightness_temperature", "radiance_stderr", "temperature", "distance", "object_id"];
     const cubes = await Promise.all(want.map((qn) => (present.includes(qn) ? loadCube(`${base}.${qn}`) : null)));
+    if (base !== join(this.runDir, $("res-sensor").value)) return; // another run was opened meanwhile
     [this.tb, this.stderr, this.truthT, this.truthD, this.truthId] = cubes;
     this.base = base;
     const tb = this.tb;
