@@ -60,12 +60,9 @@ static void find_web_dir(char *out)
         char *slash = strrchr(exe, '/');
         if (slash) {
             *slash = '\0';
-            char candidate[PATH_MAX + 32];
-            snprintf(candidate, sizeof candidate, "%s/../share/thzmap/web", exe);
-            if (strlen(candidate) < PATH_MAX && is_dir(candidate)) {
-                snprintf(out, PATH_MAX, "%s", candidate);
+            int n_out = snprintf(out, PATH_MAX, "%s/../share/thzmap/web", exe);
+            if (n_out > 0 && n_out < PATH_MAX && is_dir(out))
                 return;
-            }
         }
     }
     snprintf(out, PATH_MAX, "%s", THZ_WEB_BUILD_DIR);

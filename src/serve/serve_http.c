@@ -28,6 +28,13 @@ static void serve_common_headers(struct MHD_Response *resp)
     MHD_add_response_header(resp, "Referrer-Policy", "no-referrer");
 }
 
+/* Answers other than the page's own files: nothing in them may run as a page. */
+static void serve_data_headers(struct MHD_Response *resp)
+{
+    serve_common_headers(resp);
+    MHD_add_response_header(resp, "Content-Security-Policy", "default-src 'none'; sandbox");
+}
+
 enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type, const void *data,
                             size_t size)
 {
@@ -37,7 +44,10 @@ enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type,
         return MHD_NO;
     if (type)
         MHD_add_response_header(resp, "Content-Type", type);
-    serve_common_headers(resp);
+    if (strncmp(r->url, "/api/", 5) == 0)
+        serve_data_headers(resp);
+    else
+        serve_common_headers(resp);
     enum MHD_Result ret = MHD_queue_response(r->conn, status, resp);
     MHD_destroy_response(resp);
     return ret;
@@ -55,8 +65,9 @@ enum MHD_Result serve_reply_json(serve_request *r, unsigned status, json_t *json
     return ret;
 }
 
-static enum MHD_Result serve_reply_errorv(serve_request *r, unsigned status, const char *json_path,
-                                          const char *fmt, va_list ap)
+__attribute__((format(printf, 4, 0))) static enum MHD_Result
+serve_reply_errorv(serve_request *r, unsigned status, const char *json_path, const char *fmt,
+                   va_list ap)
 {
     char message[1200];
     vsnprintf(message, sizeof message, fmt, ap);
@@ -92,7 +103,7 @@ enum MHD_Result serve_reply_binary(serve_request *r, const void *data, size_t si
     if (!resp)
         return MHD_NO;
     MHD_add_response_header(resp, "Content-Type", "application/octet-stream");
-    serve_common_headers(resp);
+    serve_data_headers(resp);
     for (size_t i = 0; headers && headers[i]; i += 2)
         MHD_add_response_header(resp, headers[i], headers[i + 1]);
     enum MHD_Result ret = MHD_queue_response(r->conn, 200, resp);
@@ -280,11 +291,17 @@ static enum MHD_Result serve_access(void *cls, struct MHD_Connection *conn, cons
             r->too_large = true;
             return MHD_YES;
         }
-        char *grown = realloc(r->body, r->body_size + n + 1);
-        if (!grown)
-            return MHD_NO;
-        memcpy(grown + r->body_size, upload_data, n);
-        r->body = grown;
+        if (r->body_size + n + 1 > r->body_cap) {
+            size_t cap = r->body_cap ? 2 * r->body_cap : 65536;
+            while (cap < r->body_size + n + 1)
+                cap *= 2;
+            char *grown = realloc(r->body, cap);
+            if (!grown)
+                return MHD_NO;
+            r->body = grown;
+            r->body_cap = cap;
+        }
+        memcpy(r->body + r->body_size, upload_data, n);
         r->body_size += n;
         r->body[r->body_size] = '\0';
         return MHD_YES;
@@ -334,16 +351,18 @@ serve *serve_start(const serve_options *opt, char *why, size_t size, bool *usage
         return NULL;
     }
     struct stat st;
-    if (!realpath(opt->root, s->root) || stat(s->root, &st) != 0 || !S_ISDIR(st.st_mode) ||
-        chdir(s->root) != 0) {
-        snprintf(why, size, "--root %s: not a directory (%s)", opt->root, strerror(errno));
+    /* the bundle first: a relative path names it from the directory serve started in */
+    if (opt->web_dir && realpath(opt->web_dir, s->web_dir) && stat(s->web_dir, &st) == 0 &&
+        S_ISDIR(st.st_mode))
+        s->has_web = true;
+    bool found = realpath(opt->root, s->root) != NULL;
+    if (!found || stat(s->root, &st) != 0 || !S_ISDIR(st.st_mode) || chdir(s->root) != 0) {
+        snprintf(why, size, "--root %s: %s", opt->root,
+                 found && errno != EACCES ? "not a directory" : strerror(errno));
         *usage = true;
         free(s);
         return NULL;
     }
-    if (opt->web_dir && realpath(opt->web_dir, s->web_dir) && stat(s->web_dir, &st) == 0 &&
-        S_ISDIR(st.st_mode))
-        s->has_web = true;
     if (!serve_make_token(s->token)) {
         snprintf(why, size, "getrandom: %s", strerror(errno));
         free(s);

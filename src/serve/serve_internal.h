@@ -60,6 +60,7 @@ typedef struct serve_request {
     const char *url;
     char *body;
     size_t body_size;
+    size_t body_cap; /* bytes allocated for body (doubling) */
     bool too_large;
     bool answered; /* a response was queued before the body (401, 403, 413) */
 } serve_request;

@@ -155,9 +155,11 @@ enum MHD_Result serve_files_list(serve_request *r)
                 break;
             items = grown;
         }
-        items[n++] = json_pack("{s:s, s:s, s:I, s:I}", "name", e->d_name, "type",
-                               S_ISDIR(st.st_mode) ? "dir" : "file", "size", (json_int_t)st.st_size,
-                               "mtime", (json_int_t)st.st_mtime);
+        /* (a name that is not UTF-8 cannot be told in JSON: left out) */
+        items[n] = json_pack("{s:s, s:s, s:I, s:I}", "name", e->d_name, "type",
+                             S_ISDIR(st.st_mode) ? "dir" : "file", "size", (json_int_t)st.st_size,
+                             "mtime", (json_int_t)st.st_mtime);
+        n += items[n] != NULL;
     }
     closedir(d);
     qsort(items, n, sizeof *items, serve_entry_cmp);
@@ -175,6 +177,28 @@ static bool serve_ends_with(const char *s, const char *suffix)
     return n >= m && strcmp(s + n - m, suffix) == 0;
 }
 
+/* The type a file under the root is served as: images, movies and text that a page can
+ * show; never HTML, SVG or scripts (a file in the root must not run in the page's
+ * origin), which go as plain bytes. */
+static const char *serve_data_type(const char *path)
+{
+    static const char *const types[][2] = {
+        {".json", "application/json"},
+        {".png", "image/png"},
+        {".jpg", "image/jpeg"},
+        {".jpeg", "image/jpeg"},
+        {".mp4", "video/mp4"},
+        {".csv", "text/plain; charset=utf-8"},
+        {".hdr", "text/plain; charset=utf-8"},
+        {".txt", "text/plain; charset=utf-8"},
+        {".md", "text/plain; charset=utf-8"},
+    };
+    for (size_t i = 0; i < sizeof types / sizeof types[0]; i++)
+        if (serve_ends_with(path, types[i][0]))
+            return types[i][1];
+    return "application/octet-stream";
+}
+
 enum MHD_Result serve_file_get(serve_request *r)
 {
     char path[PATH_MAX];
@@ -190,9 +214,7 @@ enum MHD_Result serve_file_get(serve_request *r)
     char *data = serve_read_file(path, SERVE_MAX_FILE_BYTES, &size);
     if (!data)
         return serve_reply_error(r, 500, "%s: %s", path, strerror(errno));
-    ret = serve_reply(
-        r, 200, serve_ends_with(path, ".json") ? "application/json" : "application/octet-stream",
-        data, size);
+    ret = serve_reply(r, 200, serve_data_type(path), data, size);
     free(data);
     return ret;
 }

@@ -110,7 +110,7 @@ def planck_tb(freq_hz, radiance):
     return h * freq_hz / k / math.log1p(2 * h * freq_hz ** 3 / (c * c * radiance))
 
 
-def wait_state(srv, run_id, states, limit_s=60):
+def wait_state(srv, run_id, states, limit_s=240):
     t0 = time.time()
     while time.time() - t0 < limit_s:
         job = srv.json("GET", "/api/runs/%d" % run_id)
@@ -180,6 +180,12 @@ def test_paths(srv, root):
     st, _, data = srv.request("GET", "/api/file?path=s/scene.json")
     check(st == 200 and data == open(os.path.join(root, "s", "scene.json"), "rb").read(),
           "GET file: %d" % st)
+    # files of the root never run as pages: HTML goes as bytes, sandboxed
+    open(os.path.join(root, "s", "page.html"), "w").write("<script>alert(1)</script>")
+    st, h, _ = srv.request("GET", "/api/file?path=s/page.html")
+    check(st == 200 and h.get("Content-Type") == "application/octet-stream" and
+          "sandbox" in h.get("Content-Security-Policy", ""), "HTML from the root: %r" % h)
+    os.unlink(os.path.join(root, "s", "page.html"))
     text = b'{"edited": true}\n'
     res = srv.json("PUT", "/api/file?path=s/new.json", body=text)
     check(res and res["size"] == len(text) and
@@ -316,8 +322,27 @@ def test_runs(srv, root):
     job = wait_state(srv, render["id"], ("done", "failed"))
     check(job and job["state"] == "done", "render: %r" % job)
     check(wait_state(srv, run_b["id"], ("done",)) is not None, "second run")
+    # batch (two still frames, no movies) and bands (3 candidates, choose 1)
+    with open(os.path.join(root, "s", "seq.json"), "w") as f:
+        json.dump({"format": "thzmap-sequence/1", "scene": "scene.json", "frames": 2}, f)
+    batch = srv.json("POST", "/api/runs", body={
+        "command": "batch", "scene": "s/seq.json", "out": "out/batch",
+        "options": {"no_movies": True}}, status=202)
+    bands = srv.json("POST", "/api/runs", body={
+        "command": "bands", "scene": "s/scene.json", "out": "out/bands",
+        "options": {"count": 1, "from_thz": 0.3, "to_thz": 0.4, "step_ghz": 50,
+                    "targets": ["target"], "seed": 3}}, status=202)
+    job = wait_state(srv, batch["id"], ("done", "failed"))
+    check(job and job["state"] == "done" and job["progress"] == 1.0, "batch: %r" % job)
+    res = srv.json("GET", "/api/outputs?dir=out/batch")
+    check(res and res["frames"] == ["frame-00000", "frame-00001"], "batch frames: %r" % res)
+    job = wait_state(srv, bands["id"], ("done", "failed"))
+    check(job and job["state"] == "done", "bands: %r" % job)
+    chosen = json.load(open(os.path.join(root, "out", "bands", "bands.json")))["selected_thz"]
+    check(len(chosen) == 1 and chosen[0] in (0.3, 0.35, 0.4), "bands chose %r" % chosen)
     listing = srv.json("GET", "/api/runs")
-    check(listing and [j["id"] for j in listing][:3] == [run["id"], run_b["id"], render["id"]],
+    check(listing and [j["id"] for j in listing][:5] == [run["id"], run_b["id"], render["id"],
+                                                          batch["id"], bands["id"]],
           "runs list")
     srv.json("GET", "/api/runs/999", status=404)
     srv.json("DELETE", "/api/runs/%d" % run["id"], status=409)
@@ -337,7 +362,7 @@ def test_runs(srv, root):
     print("cancel took %.2f s" % (time.time() - t0))
     check(not os.path.exists(os.path.join(root, "out", "long")) and
           not os.path.exists(os.path.join(root, "out", "q")), "a cancelled run left output")
-    check(sorted(os.listdir(os.path.join(root, "out"))) == ["a", "b", "r"],
+    check(sorted(os.listdir(os.path.join(root, "out"))) == ["a", "b", "bands", "batch", "r"],
           "out/ holds %r" % os.listdir(os.path.join(root, "out")))
 
 
@@ -348,6 +373,9 @@ def test_results(srv, root):
     check(cam and "brightness_temperature" in cam[0]["cubes"] and
           "cam.visual.png" in cam[0]["images"] and res["photon_map"] == "out/a/photon-map.thzpm"
           and res["summary"]["seed"] == 1, "outputs: %r" % (res and res["sensors"]))
+    st, h, data = srv.request("GET", "/api/file?path=out/a/cam.visual.png")
+    check(st == 200 and h.get("Content-Type") == "image/png" and data[:4] == b"\x89PNG",
+          "a PNG of the run: %d %r" % (st, h.get("Content-Type")))
     cube = srv.json("GET", "/api/cube?path=out/a/cam.brightness_temperature.hdr")
     check(cube and (cube["rows"], cube["columns"], cube["bands"]) == (12, 16, 2) and
           cube["centres_thz"] == [0.35, 0.6] and cube["units"] == "K" and
@@ -466,6 +494,14 @@ def main():
                 t = time.time()
                 fn()
                 print("%-10s %.2f s" % (name, time.time() - t), flush=True)
+            # a second server on the same port, or on a root that is no directory: exit 2
+            for args in (["--port", str(srv.port), "--root", root],
+                         ["--port", "0", "--root", os.path.join(root, "s", "scene.json")],
+                         ["--port", "0", "--host", "localhost"]):
+                p = subprocess.run([BINARY, "serve"] + args, capture_output=True, text=True,
+                                   timeout=30)
+                check(p.returncode == 2 and "thzmap serve: " in p.stderr,
+                      "serve %s: exit %d %r" % (args, p.returncode, p.stderr))
         finally:
             rc = srv.stop(signal.SIGINT)
             check(rc == 130, "SIGINT: exit status %s, expected 130" % rc)
