@@ -12,12 +12,23 @@
  *     triangle sharing an edge is not hit through rounding. For scenes up to ~50 m the
  *     offset stays well below 0.1 mm, so both surfaces of a 0.1 mm shell are resolved
  *     (tests/unit/test_accel.c checks exactly that).
+ *
+ * Threads. Embree builds on thzmap's own OpenMP threads (rtcJoinCommitScene with as
+ * many user threads as processors), never on TBB workers: TBB turns a worker it cannot
+ * start (no memory for the thread's stack or TLS) into std::terminate, which would end
+ * the process with no message and the output's staging files beside OUTDIR (issue 20;
+ * docs/reliability.md). libgomp's own failure to start a thread ends in exit(), which
+ * the CLI's exit handler cleans up after. The number of build threads is the number of
+ * processors whatever --threads says, as TBB's default was, so the structure (and every
+ * hit) is the same for any thread count.
  */
 #include "accel/accel.h"
 
 #include <embree3/rtcore.h>
 #include <float.h>
 #include <math.h>
+#include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "core/alloc.h"
@@ -95,7 +106,11 @@ thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err)
         goto cleanup;
     }
 
-    a->device = rtcNewDevice(NULL);
+    /* Every build thread a user thread: TBB starts none of its own (see the top). */
+    int build_threads = omp_get_num_procs();
+    char config[64];
+    snprintf(config, sizeof config, "threads=%d,user_threads=%d", build_threads, build_threads);
+    a->device = rtcNewDevice(config);
     if (!a->device) {
         st =
             thz_error_set(err, THZ_ERR_INTERNAL, "ray casting: cannot create the Embree device: %s",
@@ -148,7 +163,8 @@ thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err)
         if (st != THZ_OK)
             goto cleanup;
     }
-    rtcCommitScene(a->rtc);
+#pragma omp parallel num_threads(build_threads)
+    rtcJoinCommitScene(a->rtc);
     st = accel_check_device(a->device, "building the acceleration structure", err);
     if (st != THZ_OK)
         goto cleanup;

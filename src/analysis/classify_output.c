@@ -12,6 +12,7 @@
 #include "core/alloc.h"
 #include "core/path.h"
 #include "io/envi.h"
+#include "io/output.h"
 #include "io/png_image.h"
 
 /* A qualitative palette (sRGB 0..255): class k is drawn in colour k mod 10, pixels
@@ -156,10 +157,9 @@ thz_status classify_write_files(const char *dir, const classify_report *rep, con
     }
     const char *stem_sensor = rep->sensor ? rep->sensor : "cube";
     char stem[THZ_PATH_MAX], description[1024], png[THZ_PATH_MAX], name[THZ_PATH_MAX];
-    snprintf(stem, sizeof stem, "%s.class", stem_sensor);
-    for (char *p = stem; *p; p++)
-        if (*p == '/')
-            *p = '_';
+    st = output_file_name(stem, sizeof stem, stem_sensor, "class", "")
+             ? THZ_OK
+             : thz_error_set(err, THZ_ERR_IO, "sensor %.64s...: file name too long", stem_sensor);
     snprintf(description, sizeof description,
              "thzmap %s: class map of %s by %s: object index of the assigned class (-1: nothing "
              "hit) [1]",
@@ -175,7 +175,8 @@ thz_status classify_write_files(const char *dir, const classify_report *rep, con
                       .ignore_value = -1.0,
                       .object_names = (const char *const *)rep->object_names,
                       .n_object_names = rep->n_object_names};
-    st = envi_write_float32(dir, stem, &info, map, err);
+    if (st == THZ_OK)
+        st = envi_write_float32(dir, stem, &info, map, err);
     if (st == THZ_OK) {
         int n = snprintf(name, sizeof name, "%.4000s.png", stem);
         st = n > 0 && (size_t)n < sizeof name

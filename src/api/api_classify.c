@@ -10,6 +10,7 @@
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/file.h"
+#include "io/output.h"
 #include "core/path.h"
 #include "io/envi.h"
 #include "io/output.h"
@@ -279,17 +280,12 @@ thz_status thz_classify_cube(const thz_cube *cube, const thz_cube *truth,
     return classify_build(cube, truth, opt, NULL, NULL, out, err);
 }
 
-/* "S.<quantity>" as the run names its files (io/output_sensor.c: '/' in a sensor name
- * becomes '_'). */
+/* "S.<quantity>" as the run names its files (io/output.h). */
 static thz_status run_stem(char *buf, size_t size, const char *sensor, const char *quantity,
                            thz_error *err)
 {
-    int n = snprintf(buf, size, "%s.%s", sensor, quantity);
-    if (n < 0 || (size_t)n >= size)
+    if (!output_file_name(buf, size, sensor, quantity, ""))
         return thz_error_set(err, THZ_ERR_INPUT, "sensor name too long: %.64s...", sensor);
-    for (char *p = buf; *p; p++)
-        if (*p == '/')
-            *p = '_';
     return THZ_OK;
 }
 

@@ -34,6 +34,13 @@ double cli_now_s(void);
 /* True if arg is -h or --help. */
 bool cli_is_help(const char *arg);
 
+/* The option argv[*i] when it takes a value: -1 after setting *value to argv[*i + 1]
+ * and moving *i past it, when argv[*i] is one of with_value (NULL-terminated);
+ * otherwise the usage exit status after saying why (an unknown option, an unexpected
+ * argument, or an option without its value). */
+int cli_option_value(const char *command, int argc, char **argv, int *i,
+                     const char *const *with_value, char **value);
+
 /* Parse whole numbers and reals from option values; false (after printing a usage
  * error naming `option`) when the text is not one, or is out of [min, max]. Whole
  * numbers may be written with a fraction or an exponent when their value is whole

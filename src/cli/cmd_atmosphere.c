@@ -92,16 +92,10 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
             "--compare-model",     "--temperature-k", "--pressure-hpa", "--relative-humidity",
             "--water-vapour-g-m3", "--h2o-vmr",       "--h2o-lines",    "--o2-lines",
             "--distance-m",        "--plot",          "--scene",        NULL};
-        bool known = false;
-        for (size_t k = 0; with_value[k]; k++)
-            known = known || strcmp(a, with_value[k]) == 0;
-        if (!known)
-            return cli_usage_error(
-                CMD, strncmp(a, "--", 2) == 0 ? "unknown option '%s'" : "unexpected argument '%s'",
-                a);
-        if (i + 1 >= argc)
-            return cli_usage_error(CMD, "%s needs a value", a);
-        const char *v = argv[++i];
+        char *v = NULL;
+        int rc = cli_option_value(CMD, argc, argv, &i, with_value, &v);
+        if (rc >= 0)
+            return rc;
         if (strcmp(a, "--from-thz") == 0) {
             if (!cli_parse_double(CMD, a, v, 0.0, 1000.0, &o->from_thz))
                 return CLI_EXIT_USAGE;

@@ -130,14 +130,10 @@ int cmd_bands(int argc, char **argv)
                                                  "--seed",
                                                  "--threads",
                                                  NULL};
-        bool known = false;
-        for (size_t k = 0; with_value[k]; k++)
-            known = known || strcmp(a, with_value[k]) == 0;
-        if (!known)
-            return cli_usage_error(CMD, "unknown option '%s'", a);
-        if (i + 1 >= argc)
-            return cli_usage_error(CMD, "%s needs a value", a);
-        char *v = argv[++i];
+        char *v = NULL;
+        int rc = cli_option_value(CMD, argc, argv, &i, with_value, &v);
+        if (rc >= 0)
+            return rc;
         bool ok = true;
         if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
             outdir = v;

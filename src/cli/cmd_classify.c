@@ -60,14 +60,10 @@ int cmd_classify(int argc, char **argv)
         static const char *const with_value[] = {
             "--sensor",         "-o",     "--output", "--method",
             "--train-fraction", "--seed", "--netd-k", NULL};
-        bool known = false;
-        for (size_t k = 0; with_value[k]; k++)
-            known = known || strcmp(a, with_value[k]) == 0;
-        if (!known)
-            return cli_usage_error(CMD, "unknown option '%s'", a);
-        if (i + 1 >= argc)
-            return cli_usage_error(CMD, "%s needs a value", a);
-        const char *v = argv[++i];
+        char *v = NULL;
+        int rc = cli_option_value(CMD, argc, argv, &i, with_value, &v);
+        if (rc >= 0)
+            return rc;
         if (strcmp(a, "--sensor") == 0) {
             sensor = v;
         } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {

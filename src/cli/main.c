@@ -76,6 +76,22 @@ bool cli_is_help(const char *arg)
     return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
 }
 
+int cli_option_value(const char *cmd, int argc, char **argv, int *i, const char *const *with_value,
+                     char **value)
+{
+    const char *a = argv[*i];
+    bool known = false;
+    for (size_t k = 0; with_value[k] && !known; k++)
+        known = strcmp(a, with_value[k]) == 0;
+    if (!known)
+        return cli_usage_error(cmd,
+                               a[0] == '-' ? "unknown option '%s'" : "unexpected argument '%s'", a);
+    if (*i + 1 >= argc)
+        return cli_usage_error(cmd, "%s needs a value", a);
+    *value = argv[++*i];
+    return -1;
+}
+
 bool cli_parse_u64(const char *cmd, const char *option, const char *text, uint64_t min,
                    uint64_t max, uint64_t *out)
 {

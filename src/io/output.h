@@ -40,6 +40,13 @@ thz_status output_stage_commit(output_stage *stage, thz_error *err);
  * lock; frees. NULL: nothing. */
 void output_stage_destroy(output_stage *stage);
 
+/* The name of a sensor's file, "S.<quantity><ext>" with every '/' of the sensor's name
+ * replaced by '_' so that the file lands in its directory: the one rule by which runs
+ * name their files and readers (classify, the GUI) find them. False when it does not
+ * fit in size bytes. */
+bool output_file_name(char *buf, size_t size, const char *sensor, const char *quantity,
+                      const char *ext);
+
 /* Writes every file of sensor `sensor` into dir: the ENVI images S.radiance,
  * S.power, S.brightness_temperature, S.normalized (and S.radiance_stderr when
  * images->radiance_stderr is set), S.temperature, S.distance, S.object_id; S.visual.png;

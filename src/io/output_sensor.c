@@ -23,19 +23,25 @@ enum { OUT_TEXT = 1024 };
  * index (scene-format.md: every ENVI image is float32). */
 #define OUT_MAX_OBJECTS (1u << 24)
 
-/* The file name "S.<quantity><ext>", with '/' in the sensor name replaced so that every
- * file lands in dir. */
-static thz_status out_file_name(char *buf, size_t size, const char *sensor, const char *quantity,
-                                const char *ext, thz_error *err)
+bool output_file_name(char *buf, size_t size, const char *sensor, const char *quantity,
+                      const char *ext)
 {
     int n = snprintf(buf, size, "%s.%s%s", sensor, quantity, ext);
     if (n < 0 || (size_t)n >= size)
-        return thz_error_set(err, THZ_ERR_IO,
-                             "sensor %s: file name longer than the limit of %zu bytes: %s%s",
-                             sensor, size - 1, quantity, ext);
+        return false;
     for (char *p = buf; *p; p++)
         if (*p == '/')
             *p = '_';
+    return true;
+}
+
+static thz_status out_file_name(char *buf, size_t size, const char *sensor, const char *quantity,
+                                const char *ext, thz_error *err)
+{
+    if (!output_file_name(buf, size, sensor, quantity, ext))
+        return thz_error_set(err, THZ_ERR_IO,
+                             "sensor %s: file name longer than the limit of %zu bytes: %s%s",
+                             sensor, size - 1, quantity, ext);
     return THZ_OK;
 }
 
