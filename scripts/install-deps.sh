@@ -13,11 +13,16 @@ packages=(
   libmicrohttpd-dev  # optional: thzmap serve, the browser GUI (docs/gui.md)
   libopenmpi-dev openmpi-bin  # optional: MPI runs (docs/mpi.md)
   libclang-rt-14-dev  # libFuzzer for clang -fsanitize=fuzzer (make fuzz)
+  nodejs  # the web page's bundle (three.js, esbuild from npm; docs/gui.md)
+  chromium chromium-driver python3-selenium  # its end-to-end test (tests/gui)
 )
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# Debian's nodejs comes without npm (its package npm); NodeSource's nodejs includes it and
+# conflicts with Debian's npm: ask for the package only when there is no npm command.
+command -v npm >/dev/null 2>&1 || missing+=(npm)
 if [ ${#missing[@]} -eq 0 ]; then
   exit 0
 fi

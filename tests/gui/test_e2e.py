@@ -1,0 +1,239 @@
+#!/usr/bin/env python3
+"""End-to-end test of the browser page (issue 18) in a real headless Chromium, driven by
+Selenium (Debian's chromium, chromium-driver, python3-selenium):
+
+    python3 test_e2e.py THZMAP_BINARY REPO_DIR SCREENSHOT_DIR
+
+It starts `thzmap serve` on a temporary root holding a copy of the paper's scene
+(examples/teraeye, trimmed to 32 x 32 pixels and 10 000 photons per channel so that a run
+takes seconds), opens the page with the printed URL, and then, as a user would: opens the
+scene, changes a temperature, types an invalid one and finds the error at that field,
+runs the scene twice (seeds 1 and 2, queued), clicks a pixel and compares the spectrum the
+page shows with the ENVI cube read by numpy, loads the photon map and the A/B difference.
+Each view is saved as SCREENSHOT_DIR/gui-*.png (docs/images/ holds one such set).
+THZ_GUI_URL=http://... THZ_GUI_ROOT=DIR runs it against a server already running on DIR
+instead (while developing the page)."""
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+from selenium import webdriver
+from selenium.common.exceptions import StaleElementReferenceException
+from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.by import By
+from selenium.webdriver.common.keys import Keys
+from selenium.webdriver.support.ui import Select, WebDriverWait
+
+THZMAP, REPO, SHOTS = sys.argv[1], sys.argv[2], sys.argv[3]
+T0 = time.monotonic()
+
+
+def log(msg):
+    print(f"[{time.monotonic() - T0:5.1f} s] {msg}", flush=True)
+
+
+def make_root(root):
+    """The paper's scene, trimmed for speed; its materials as they are."""
+    shutil.copytree(os.path.join(REPO, "examples", "teraeye"), os.path.join(root, "teraeye"))
+    path = os.path.join(root, "teraeye", "scene.json")
+    with open(path) as f:
+        scene = json.load(f)
+    scene["sensors"][0].update(resolution=[32, 32], oversampling=1)
+    scene["photons"]["per_channel"] = 10000
+    scene["render"] = {"integrator": "photon-map"}
+    with open(path, "w") as f:
+        json.dump(scene, f, indent=2)
+    return scene
+
+
+def start_server(root):
+    if os.environ.get("THZ_GUI_URL"):
+        return None, os.environ["THZ_GUI_URL"]
+    proc = subprocess.Popen([THZMAP, "serve", "--root", root, "--port", "0"],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            break
+        m = re.search(r"http://\S+token=\S+", line)
+        if m:
+            return proc, m.group(0)
+    proc.kill()
+    raise SystemExit(f"FAIL: thzmap serve printed no URL with a token (exit {proc.wait()})")
+
+
+def browser():
+    options = webdriver.ChromeOptions()
+    options.binary_location = "/usr/bin/chromium"
+    for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage",
+                "--window-size=1400,850", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"):
+        options.add_argument(arg)
+    return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+
+
+def main():
+    os.makedirs(SHOTS, exist_ok=True)
+    if os.path.exists(os.path.join(SHOTS, "gui-failure.png")):
+        os.unlink(os.path.join(SHOTS, "gui-failure.png"))  # of an earlier run
+    root = os.environ.get("THZ_GUI_ROOT") or tempfile.mkdtemp(prefix="thzmap-gui-")
+    shutil.rmtree(os.path.join(root, "teraeye"), ignore_errors=True)
+    scene = make_root(root)
+    proc, url = start_server(root)
+    log(f"server at {url.split('?')[0]}")
+    driver = browser()
+    log("browser started")
+    # the page redraws what it shows: an element found may be replaced before it is read
+    patient = lambda seconds, poll=0.05: WebDriverWait(
+        driver, seconds, poll_frequency=poll, ignored_exceptions=[StaleElementReferenceException])
+    wait = patient(30)
+    by_id = lambda i: driver.find_element(By.ID, i)
+
+    def shot(name):
+        driver.save_screenshot(os.path.join(SHOTS, f"gui-{name}.png"))
+
+    def click_list(list_id, text):
+        # in the page's own turn: the list may be redrawn between finding and clicking
+        wait.until(lambda d: d.execute_script(
+            "const li = [...document.querySelectorAll(`#${arguments[0]} li`)]"
+            ".find((x) => x.textContent === arguments[1]); if (li) li.click(); return !!li;",
+            list_id, text))
+
+    def field(path):
+        return driver.find_element(By.CSS_SELECTOR, f'.field[data-path="{path}"]')
+
+    def type_into(path, text):
+        box = field(path).find_element(By.TAG_NAME, "input")
+        box.send_keys(Keys.CONTROL, "a")
+        box.send_keys(text)
+
+    try:
+        driver.get(url)
+        log("page loaded")
+        # Pre-processor: open the scene, see it valid and in 3D
+        click_list("files", "teraeye/")
+        click_list("files", "scene.json")
+        wait.until(lambda d: "valid" in by_id("validation-state").text and "✓" in by_id("validation-state").text)
+        names = [o["name"] for o in scene["objects"]]
+        c = names.index("cylinder-C")
+        click_list("objects", "cylinder-C")
+        path = f"objects[{c}].temperature_k"
+        assert field(path).find_element(By.TAG_NAME, "input").get_attribute("value") == "310"
+        time.sleep(0.3)
+        shot("scene")
+        log("scene opened and valid")
+        # an invalid temperature: the error is shown at the temperature field
+        type_into(path, "-5")
+        error_text = lambda d: d.execute_script(
+            "const e = document.querySelector(`.field[data-path='${arguments[0]}'] .err`);"
+            "return e ? e.textContent : '';", path)
+        wait.until(lambda d: "-5" in error_text(d))  # the answer for "-5", not for "-"
+        message = error_text(driver)
+        assert "expected" in message, message
+        assert "✗" in by_id("validation-state").text
+        shot("validation")
+        log(f"error at the field: {message!r}")
+        type_into(path, "330")
+        wait.until(lambda d: "✓" in by_id("validation-state").text)
+        assert '"temperature_k": 330' in by_id("scene-text").get_attribute("value")
+        by_id("btn-save").click()
+        wait.until(lambda d: "saved" in by_id("status").text)
+        with open(os.path.join(root, "teraeye", "scene.json")) as f:
+            assert json.load(f)["objects"][c]["temperature_k"] == 330
+        log("temperature changed to 330 K and saved")
+        # Run: two runs queued (seeds 1 and 2), streamed to completion
+        by_id("tab-run").click()
+        states = lambda d: d.execute_script(
+            "return [...document.querySelectorAll('#runs tbody tr')].map((r) => r.dataset.state)")
+        before = len(states(driver))
+        for seed in ("1", "2"):
+            by_id("run-seed").clear()
+            by_id("run-seed").send_keys(seed)
+            by_id("run-out").clear()
+            by_id("run-out").send_keys(f"teraeye/out-seed{seed}")
+            by_id("btn-run").click()
+            time.sleep(0.2)
+        final = ("done", "finished", "succeeded", "failed", "cancelled")
+        ours = lambda d: states(d)[:2]  # the newest first
+        patient(30).until(lambda d: len(states(d)) == before + 2)
+        shot("run")
+        patient(90, 0.1).until(lambda d: all(s in final for s in ours(d)))
+        assert all(s in ("done", "finished", "succeeded") for s in ours(driver)), ours(driver)
+        log("both runs done")
+        # Post-processor: the image of the last run, a pixel on cylinder C
+        # the first run's Results button (the last run to finish opened by itself)
+        wait.until(lambda d: d.execute_script(
+            "const row = [...document.querySelectorAll('#runs tbody tr')]"
+            ".find((r) => r.cells[3].textContent === 'teraeye/out-seed1');"
+            "const b = row && row.querySelector('button'); if (b) b.click(); return !!b;"))
+        wait.until(lambda d: "loaded" in by_id("status").text and "out-seed1" in by_id("status").text)
+        out = os.path.join(root, "teraeye", "out-seed1")
+        bands = len(json.load(open(os.path.join(out, "summary.json")))["channels"])
+        tb = np.fromfile(os.path.join(out, "cam.brightness_temperature.img"), "<f4").reshape(bands, 32, 32)
+        oid = np.fromfile(os.path.join(out, "cam.object_id.img"), "<f4").reshape(32, 32)
+        rows, cols = np.nonzero(oid == c)
+        row, col = int(rows[len(rows) // 2]), int(cols[len(cols) // 2])
+        canvas = by_id("image")
+        w, h = canvas.size["width"], canvas.size["height"]
+        t_click = time.monotonic()
+        webdriver.ActionChains(driver).move_to_element_with_offset(
+            canvas, int((col + 0.5) * w / 32 - w / 2), int((row + 0.5) * h / 32 - h / 2)).click().perform()
+        wait.until(lambda d: by_id("pixel-info").get_attribute("data-row") == str(row)
+                   and by_id("pixel-info").get_attribute("data-col") == str(col))
+        page_ms = float(by_id("pixel-info").get_attribute("data-ms"))
+        values = [float(td.get_attribute("data-value")) for td in driver.find_elements(By.CSS_SELECTOR, "#pixel-table td.tb")]
+        expected = [float(v) for v in tb[:, row, col]]
+        assert values == expected, f"page {values} != cube {expected}"
+        truth = by_id("pixel-truth").text
+        assert "cylinder-C" in truth and "330" in truth, truth
+        log(f"pixel ({row}, {col}): {len(values)} channels equal the cube; truth {truth!r}; "
+            f"answered in {page_ms:.1f} ms in the page, {1000 * (time.monotonic() - t_click):.0f} ms round trip")
+        assert page_ms < 100, page_ms
+        shot("results")
+        # the truth map, the photon map, the A/B difference
+        Select(by_id("res-quantity")).select_by_value("object_id")
+        time.sleep(0.2)
+        shot("truth")
+        Select(by_id("res-view")).select_by_value("photons")
+        by_id("ph-max").clear()
+        by_id("ph-max").send_keys("200000")
+        by_id("btn-photons").click()
+        wait.until(lambda d: "photons," in by_id("ph-info").text)
+        log(f"photon map: {by_id('ph-info').text}")
+        time.sleep(0.3)
+        shot("photons")
+        Select(by_id("res-view")).select_by_value("diff")
+        by_id("diff-a").clear()
+        by_id("diff-a").send_keys("teraeye/out-seed1")
+        by_id("diff-b").clear()
+        by_id("diff-b").send_keys("teraeye/out-seed2")
+        by_id("btn-diff").click()
+        wait.until(lambda d: "beyond" in by_id("diff-info").text)
+        log(f"A/B: {by_id('diff-info').text}")
+        shot("diff")
+        errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+        assert not errors, errors
+    except Exception:
+        shot("failure")
+        print("status line:", driver.find_element(By.ID, "status").text)
+        for e in driver.get_log("browser"):
+            print("browser:", e)
+        raise
+    finally:
+        driver.quit()
+        if proc:
+            proc.terminate()
+            proc.wait(timeout=10)
+        if not os.environ.get("THZ_GUI_ROOT"):
+            shutil.rmtree(root, ignore_errors=True)
+    log("PASS")
+
+
+if __name__ == "__main__":
+    main()

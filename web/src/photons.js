@@ -1,0 +1,84 @@
+// The photon map as a point cloud coloured by each photon's incoming direction (the
+// paper's Fig. 3): red, green, blue follow the direction's x, y, z (0.5 + 0.5·d).
+// /api/photons answers 8 float32 per photon: x, y, z (m), dx, dy, dz (direction of travel
+// as it arrived), power (W/Hz), object index.
+const STRIDE = 8;
+import * as THREE from "three";
+import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+import { q, request } from "./api.js";
+
+export class PhotonView {
+  constructor(container) {
+    this.container = container;
+    this.renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+    this.renderer.setClearColor(0x111418);
+    container.appendChild(this.renderer.domElement);
+    this.scene = new THREE.Scene();
+    this.camera = new THREE.PerspectiveCamera(45, 1, 0.01, 1e4);
+    this.camera.up.set(0, 0, 1);
+    this.camera.position.set(2, -3, 2);
+    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.controls.addEventListener("change", () => this.render());
+    new ResizeObserver(() => this.resize()).observe(container);
+  }
+
+  resize() {
+    const w = this.container.clientWidth;
+    const h = this.container.clientHeight;
+    if (!w || !h) return;
+    this.renderer.setSize(w, h);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.render();
+  }
+
+  async load(path, channel, object, max) {
+    let url = `/api/photons?path=${q(path)}&channel=${q(channel)}&max=${q(max)}`;
+    if (object) url += `&object=${q(object)}`;
+    const t0 = performance.now();
+    const response = await request(url);
+    const f = new Float32Array(await response.arrayBuffer());
+    this.total = Number(response.headers.get("X-Thzmap-Photons-Total")) || null;
+    const t1 = performance.now();
+    const n = Math.floor(f.length / STRIDE);
+    if (this.points) {
+      this.scene.remove(this.points);
+      this.points.geometry.dispose();
+    }
+    // the records as they came: no copy, the colour computed on the GPU
+    const records = new THREE.InterleavedBuffer(f.subarray(0, n * STRIDE), STRIDE);
+    const g = new THREE.BufferGeometry();
+    g.setAttribute("position", new THREE.InterleavedBufferAttribute(records, 3, 0));
+    g.setAttribute("direction", new THREE.InterleavedBufferAttribute(records, 3, 3));
+    g.computeBoundingSphere();
+    this.points = new THREE.Points(g, new THREE.ShaderMaterial({
+      vertexShader: `attribute vec3 direction; varying vec3 colour;
+        void main() { colour = 0.5 + 0.5 * direction;
+          gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0); gl_PointSize = 2.0; }`,
+      fragmentShader: "varying vec3 colour; void main() { gl_FragColor = vec4(colour, 1.0); }",
+    }));
+    this.scene.add(this.points);
+    if (n) {
+      const { center, radius } = g.boundingSphere;
+      this.controls.target.copy(center);
+      this.camera.position.copy(center).add(new THREE.Vector3(0.8, -1.5, 0.9).multiplyScalar(radius * 1.6));
+      this.controls.update();
+    }
+    this.resize();
+    this.draw();
+    this.timing = { fetch_ms: t1 - t0, draw_ms: performance.now() - t1 };
+    return n;
+  }
+
+  render() {
+    if (this.pending) return;
+    this.pending = requestAnimationFrame(() => {
+      this.pending = 0;
+      this.draw();
+    });
+  }
+
+  draw() {
+    this.renderer.render(this.scene, this.camera);
+  }
+}

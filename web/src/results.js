@@ -1,0 +1,314 @@
+// The post-processor: per-channel images with a colour bar in kelvin, truth maps, measured
+// cubes; a clicked pixel's spectrum with error bars and truth; A/B differences in units of
+// the combined standard error; batch frames played one after the other.
+import { getJSON, q, reportError, request, status } from "./api.js";
+import { loadCube, range } from "./envi.js";
+import { cssColour, diverging, drawColourBar, formatNumber, planckDerivative, viridis } from "./colour.js";
+import { linePlot } from "./plots.js";
+import { PhotonView } from "./photons.js";
+
+const $ = (id) => document.getElementById(id);
+const QUANTITIES = ["brightness_temperature", "measured_brightness_temperature", "temperature",
+  "distance", "object_id", "radiance", "radiance_stderr", "normalized", "power", "measured_radiance"];
+const join = (dir, name) => (dir ? `${dir}/${name}` : name);
+
+export class Results {
+  constructor() {
+    this.dir = "";
+    this.frames = [];
+    for (const id of ["res-sensor", "res-quantity", "res-channel", "res-scale"]) {
+      $(id).onchange = () => this.show().catch(reportError);
+    }
+    $("res-sensor").onchange = () => this.loadSensor().catch(reportError);
+    $("res-view").onchange = () => this.setView($("res-view").value);
+    $("image").addEventListener("click", (e) => this.click(e, $("image")).catch(reportError));
+    $("diff-image").addEventListener("click", (e) => this.clickDiff(e));
+    $("btn-diff").onclick = () => this.diff().catch(reportError);
+    $("frame").oninput = () => this.openFrame(Number($("frame").value)).catch(reportError);
+    $("btn-play").onclick = () => this.play();
+    $("btn-photons").onclick = () => this.loadPhotons().catch(reportError);
+  }
+
+  setView(view) {
+    $("image-pane").hidden = view !== "image";
+    $("photon-pane").hidden = view !== "photons";
+    $("diff-pane").hidden = view !== "diff";
+    if (view === "photons") this.photons?.resize();
+  }
+
+  async browse(dir) {
+    const listing = await getJSON(`/api/files?dir=${q(dir)}`);
+    $("outputs-dir").textContent = `/${dir}`;
+    const ul = $("outputs");
+    ul.replaceChildren();
+    const add = (label, fn) => {
+      const li = document.createElement("li");
+      li.textContent = label;
+      li.onclick = () => fn().catch(reportError);
+      ul.appendChild(li);
+    };
+    if (dir) add("..", () => this.browse(dir.split("/").slice(0, -1).join("/")));
+    const entries = listing.entries || [];
+    for (const e of entries) {
+      if (e.type === "dir" || e.type === "directory") add(`${e.name}/`, () => this.open(join(dir, e.name)));
+    }
+    return entries;
+  }
+
+  // an output directory: of one run, or of a batch (frame-NNNNN/, sweep-NN/frame-NNNNN/)
+  async open(dir) {
+    const seq = (this.openSeq = (this.openSeq || 0) + 1);
+    const entries = await this.browse(dir);
+    if (seq !== this.openSeq) return; // another directory was asked for meanwhile
+    const names = entries.map((e) => e.name);
+    const frames = names.filter((n) => /^frame-\d{5}$/.test(n)).sort();
+    const sweeps = names.filter((n) => /^sweep-\d{2}$/.test(n)).sort();
+    this.frames = frames.map((f) => join(dir, f));
+    for (const s of sweeps) {
+      const sub = await getJSON(`/api/files?dir=${q(join(dir, s))}`);
+      for (const e of (sub.entries || []).map((x) => x.name).filter((n) => /^frame-\d{5}$/.test(n)).sort()) {
+        this.frames.push(join(dir, `${s}/${e}`));
+      }
+    }
+    $("frames").hidden = this.frames.length === 0;
+    if (this.frames.length) {
+      $("frame").max = this.frames.length - 1;
+      $("frame").value = 0;
+      return this.openFrame(0);
+    }
+    if (names.some((n) => n.endsWith(".brightness_temperature.hdr"))) return this.openRun(dir, names);
+    status(`${dir}: no images here`);
+  }
+
+  async openFrame(i) {
+    const dir = this.frames[i];
+    $("frame-name").textContent = `${dir.split("/").slice(-2).join("/")} (${i + 1}/${this.frames.length})`;
+    const listing = await getJSON(`/api/files?dir=${q(dir)}`);
+    return this.openRun(dir, (listing.entries || []).map((e) => e.name));
+  }
+
+  play() {
+    if (this.playing) {
+      clearInterval(this.playing);
+      this.playing = null;
+      $("btn-play").textContent = "Play";
+      return;
+    }
+    $("btn-play").textContent = "Pause";
+    this.playing = setInterval(() => {
+      const next = (Number($("frame").value) + 1) % this.frames.length;
+      $("frame").value = next;
+      this.openFrame(next).catch(reportError);
+    }, 600);
+  }
+
+  async openRun(dir, names) {
+    this.runDir = dir;
+    this.names = names;
+    const sensors = [...new Set(names.filter((n) => n.endsWith(".brightness_temperature.hdr"))
+      .map((n) => n.slice(0, -".brightness_temperature.hdr".length)))];
+    const keep = $("res-sensor").value;
+    $("res-sensor").replaceChildren(...sensors.map((s) => new Option(s, s, false, s === keep)));
+    this.summary = null;
+    if (names.includes("summary.json")) {
+      this.summary = await getJSON(`/api/file?path=${q(join(dir, "summary.json"))}`).catch(() => null);
+    }
+    if (this.runDir !== dir) return; // another run was opened meanwhile
+    this.mapPath = names.includes("photon-map.thzpm") ? join(dir, "photon-map.thzpm") : null;
+    if (!$("diff-a").value) $("diff-a").value = dir;
+    await this.loadSensor();
+  }
+
+  async loadSensor() {
+    const sensor = $("res-sensor").value;
+    const base = join(this.runDir, sensor);
+    const present = QUANTITIES.filter((qn) => this.names.includes(`${sensor}.${qn}.hdr`));
+    const keep = $("res-quantity").value;
+    $("res-quantity").replaceChildren(...present.map((qn) => new Option(qn.replace(/_/g, " "), qn, false, qn === keep)));
+    const t0 = performance.now();
+    const want = ["brightness_temperature", "radiance_stderr", "temperature", "distance", "object_id"];
+    const cubes = await Promise.all(want.map((qn) => (present.includes(qn) ? loadCube(`${base}.${qn}`) : null)));
+    if (base !== join(this.runDir, $("res-sensor").value)) return; // another run was opened meanwhile
+    [this.tb, this.stderr, this.truthT, this.truthD, this.truthId] = cubes;
+    this.base = base;
+    const tb = this.tb;
+    const keepCh = $("res-channel").value;
+    $("res-channel").replaceChildren(...Array.from({ length: tb.bands }, (_, b) =>
+      new Option(`${b + 1}: ${tb.bandNames[b] || `${formatNumber(tb.freqThz[b])} THz`}`, b, false, String(b) === keepCh)));
+    const phCh = $("ph-channel");
+    phCh.replaceChildren(...Array.from({ length: tb.bands }, (_, b) => new Option(`${formatNumber(tb.freqThz[b])} THz`, b)));
+    const names = this.truthId?.header["object names"] || [];
+    $("ph-object").replaceChildren(new Option("all", ""), ...names.map((n) => new Option(n, n)));
+    status(`${base}: ${tb.cols} × ${tb.rows} pixels, ${tb.bands} channels, loaded in ${Math.round(performance.now() - t0)} ms`);
+    await this.show();
+  }
+
+  async show() {
+    const qn = $("res-quantity").value || "brightness_temperature";
+    const cube = await loadCube(`${this.base}.${qn}`);
+    this.shown = cube;
+    const band = Math.min(Number($("res-channel").value) || 0, cube.bands - 1);
+    const values = cube.band(band);
+    const ignore = cube.ignore ?? (qn.includes("brightness") ? 0 : null);
+    const names = cube.header["object names"];
+    if (qn === "object_id" && names) return this.showObjects(cube, names);
+    const [lo, hi] = $("res-scale").value === "common" ? range(cube.data, ignore) : range(values, ignore);
+    paint($("image"), cube, values, lo, hi, viridis, ignore);
+    const unit = cube.unit === "1" ? "(1)" : cube.unit;
+    drawColourBar($("colourbar"), lo, hi, unit);
+    const which = cube.bands > 1 ? `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)` : "truth";
+    $("image-info").textContent = `${qn.replace(/_/g, " ")}, ${which}; colours span the 1st to 99th ` +
+      `percentile${$("res-scale").value === "common" ? " of all channels" : ""}: ` +
+      `${formatNumber(lo)} to ${formatNumber(hi)}${cube.unit === "1" ? "" : ` ${cube.unit}`}`;
+  }
+
+  // the truth map of objects: one colour per object, named beside the picture
+  showObjects(cube, names) {
+    const palette = names.map((_, i) => viridis(names.length > 1 ? i / (names.length - 1) : 0.5));
+    paint($("image"), cube, cube.band(0), 0, Math.max(names.length - 1, 1), viridis, -1);
+    const bar = $("colourbar");
+    bar.getContext("2d").clearRect(0, 0, bar.width, bar.height);
+    const seen = new Set(cube.band(0));
+    const info = $("image-info");
+    info.replaceChildren("object seen (grey: nothing hit): ");
+    names.forEach((n, i) => {
+      if (!seen.has(i)) return;
+      const sw = document.createElement("span");
+      sw.className = "swatch";
+      sw.style.background = cssColour(palette[i]);
+      info.append(sw, `${n}  `);
+    });
+  }
+
+  pixelOf(e, canvas, cube) {
+    const r = canvas.getBoundingClientRect();
+    const col = Math.floor(((e.clientX - r.left) / r.width) * cube.cols);
+    const row = Math.floor(((e.clientY - r.top) / r.height) * cube.rows);
+    return [Math.min(Math.max(row, 0), cube.rows - 1), Math.min(Math.max(col, 0), cube.cols - 1)];
+  }
+
+  async click(e, canvas) {
+    const t0 = performance.now();
+    const [row, col] = this.pixelOf(e, canvas, this.tb);
+    const measured = $("res-quantity").value.startsWith("measured") &&
+      this.names.includes(`${$("res-sensor").value}.measured_brightness_temperature.hdr`);
+    const tb = measured ? await loadCube(`${this.base}.measured_brightness_temperature`) : this.tb;
+    const f = tb.freqThz;
+    const y = [];
+    const err = [];
+    for (let b = 0; b < tb.bands; b++) {
+      const t = tb.at(b, row, col);
+      y.push(t);
+      // σ_Tb = σ_L / (∂B/∂T) at the channel's centre and Tb (Tb is B_ν(ν_c, T) = L_c inverted)
+      const s = this.stderr ? this.stderr.at(b, row, col) : NaN;
+      err.push(t > 0 && Number.isFinite(s) ? s / planckDerivative(f[b] * 1e12, t) : NaN);
+    }
+    const id = this.truthId ? this.truthId.at(0, row, col) : -1;
+    const objectName = id >= 0 ? (this.truthId.header["object names"] || [])[id] ?? `object ${id}` : "nothing hit";
+    const truthT = this.truthT ? this.truthT.at(0, row, col) : NaN;
+    const truthD = this.truthD ? this.truthD.at(0, row, col) : NaN;
+    const info = $("pixel-info");
+    info.dataset.row = row;
+    info.dataset.col = col;
+    info.innerHTML = "";
+    info.append(`row ${row}, column ${col}${measured ? " (measured)" : ""}: `);
+    const truth = document.createElement("span");
+    truth.id = "pixel-truth";
+    truth.textContent = id >= 0
+      ? `${objectName}, ${formatNumber(truthT)} K at ${formatNumber(truthD)} m` : objectName;
+    info.appendChild(truth);
+    $("pixel-plot").replaceChildren();
+    linePlot($("pixel-plot"), [{ label: "Tb ± 1σ", x: f, y, err }], { xLabel: "frequency (THz)", yLabel: "Tb (K)" });
+    const table = $("pixel-table");
+    table.replaceChildren();
+    const head = table.createTHead().insertRow();
+    for (const h of ["channel", "THz", "Tb (K)", "σ (K)"]) head.insertCell().textContent = h;
+    const body = table.createTBody();
+    y.forEach((t, b) => {
+      const tr = body.insertRow();
+      tr.insertCell().textContent = tb.bandNames[b] || String(b + 1);
+      tr.insertCell().textContent = formatNumber(f[b]);
+      const c = tr.insertCell();
+      c.className = "tb";
+      c.dataset.value = String(t); // the float32 read from the cube, in full
+      c.textContent = t.toFixed(3);
+      tr.insertCell().textContent = Number.isFinite(err[b]) ? err[b].toFixed(3) : "–";
+    });
+    info.dataset.ms = (performance.now() - t0).toFixed(1);
+  }
+
+  // the server's /api/diff: (Tb_A − Tb_B) / √(σ_A² + σ_B²), or Tb_A − Tb_B in K when a run
+  // has no standard errors (its X-Thzmap-Diff-Units header says which)
+  async diff() {
+    const sensor = $("res-sensor").value;
+    const a = $("diff-a").value.trim();
+    const b = $("diff-b").value.trim();
+    const band = Number($("res-channel").value) || 0;
+    const cube = await loadCube(join(a, `${sensor}.brightness_temperature`));
+    const response = await request(`/api/diff?a=${q(a)}&b=${q(b)}&sensor=${q(sensor)}&band=${band}`);
+    const z = new Float32Array(await response.arrayBuffer());
+    const sigma = response.headers.get("X-Thzmap-Diff-Units") !== "K";
+    let beyond = 0;
+    let count = 0;
+    let hi = 0;
+    for (const v of z) {
+      if (!Number.isFinite(v)) continue;
+      count++;
+      if (Math.abs(v) > 3) beyond++;
+      hi = Math.max(hi, Math.abs(v));
+    }
+    const span = sigma ? 4 : hi || 1;
+    this.diffZ = { z, cube, unit: sigma ? "σ" : "K" };
+    paint($("diff-image"), cube, z, -span, span, diverging, null);
+    drawColourBar($("diff-bar"), -span, span, this.diffZ.unit, diverging);
+    const channel = `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)`;
+    $("diff-info").textContent = sigma
+      ? `(A − B) / √(σA² + σB²), ${channel}: ${((100 * beyond) / Math.max(count, 1)).toFixed(2)} % of ` +
+        `${count} pixels beyond ±3 σ (0.27 % expected if A and B agree within their errors)`
+      : `A − B in K, ${channel} (a run without standard errors: no σ to compare with)`;
+  }
+
+  clickDiff(e) {
+    if (!this.diffZ) return;
+    const [row, col] = this.pixelOf(e, $("diff-image"), this.diffZ.cube);
+    $("pixel-info").textContent = `row ${row}, column ${col}: A − B = ${formatNumber(this.diffZ.z[row * this.diffZ.cube.cols + col])} ${this.diffZ.unit}`;
+  }
+
+  async loadPhotons() {
+    if (!this.mapPath) throw new Error(`${this.runDir}: no photon-map.thzpm (run simulate with "save the photon map")`);
+    const t0 = performance.now();
+    this.photons ||= new PhotonView($("photon-view")); // its WebGL context only when wanted
+    const n = await this.photons.load(this.mapPath, $("ph-channel").value, $("ph-object").value, Number($("ph-max").value));
+    const of = this.photons.total ? ` of ${this.photons.total}` : "";
+    const { fetch_ms: fetchMs, draw_ms: drawMs } = this.photons.timing;
+    $("ph-info").textContent = `${n}${of} photons, ${Math.round(performance.now() - t0)} ms ` +
+      `(${Math.round(fetchMs)} ms to fetch, ${Math.round(drawMs)} ms to draw); ` +
+      "colour: direction of arrival (red, green, blue = 0.5 + 0.5 × its x, y, z)";
+  }
+}
+
+function paint(canvas, cube, values, lo, hi, map, ignore) {
+  canvas.width = cube.cols;
+  canvas.height = cube.rows;
+  const zoom = Math.max(1, Math.floor(512 / Math.max(cube.cols, cube.rows)));
+  canvas.style.width = `${cube.cols * zoom}px`;
+  canvas.style.height = `${cube.rows * zoom}px`;
+  const g = canvas.getContext("2d");
+  const img = g.createImageData(cube.cols, cube.rows);
+  const lut = Array.from({ length: 256 }, (_, i) => map(i / 255));
+  const scale = 255 / (hi - lo);
+  for (let i = 0; i < values.length; i++) {
+    const v = values[i];
+    const o = 4 * i;
+    if (!Number.isFinite(v) || v === ignore) {
+      img.data[o] = img.data[o + 1] = img.data[o + 2] = 40;
+    } else {
+      const c = lut[Math.min(255, Math.max(0, Math.round((v - lo) * scale)))];
+      img.data[o] = c[0];
+      img.data[o + 1] = c[1];
+      img.data[o + 2] = c[2];
+    }
+    img.data[o + 3] = 255;
+  }
+  g.putImageData(img, 0, 0);
+}
