@@ -150,7 +150,14 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
             double *pixel_disk_var = batched ? est + n_est + PHOTON_MAP_BATCHES : NULL;
             double omega_sr = camera_pixel_solid_angle(&cam, col, row);
             double sample_sr = omega_sr / n2;
-            double var_sum = 0.0;
+            /* Poisson variance of the pixel's mean: the samples' own footprints are
+             * disjoint, so their variances add; a footprint widened to the k-th nearest
+             * photon overlaps its neighbours' and shares their photons, so for a pixel
+             * with one, the bound of perfect correlation (the sum of standard errors,
+             * squared) instead: never less than the truth (tests/cli/
+             * test_deviation_maps.sh measured the sum of variances 2x short in sd). */
+            double var_sum = 0.0, sd_sum = 0.0;
+            bool pixel_widened = false;
             for (uint32_t j = 0; j < n; j++)
                 for (uint32_t i = 0; i < n; i++) {
                     render_sample s = {.variance = 0.0};
@@ -167,6 +174,8 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
                     };
                     integ->sample(ctx, cam.position_m, dir, sample_sr, &t, &s);
                     var_sum += s.variance;
+                    sd_sum += sqrt(s.variance);
+                    pixel_widened = pixel_widened || s.widened;
                     n_samples++;
                     n_escaped += s.escaped;
                     n_back += s.back_face;
@@ -177,7 +186,8 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
                 }
             size_t p = (size_t)px;
             if (!integ->purpose)
-                render_accum_set_poisson_pixel(acc, p, est[0], var_sum / (n2 * n2));
+                render_accum_set_poisson_pixel(
+                    acc, p, est[0], (pixel_widened ? sd_sum * sd_sum : var_sum) / (n2 * n2));
             else
                 render_accum_add_pixel(acc, p, est, n_est, pixel_batch, pixel_disk_var);
         }
