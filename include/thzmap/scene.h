@@ -169,13 +169,13 @@ THZ_API thz_status thz_scene_object_mesh(const thz_scene *scene, size_t i, thz_o
 /* A material's optics at one frequency, as the simulation uses them (physics.md
  * "Surfaces"), for a half-space (thickness_m 0) or a slab of thickness_m (a shell). */
 typedef struct thz_surface_optics {
-    double reflectance_normal;  /* R at normal incidence */
-    double reflectance_mean;    /* hemispherical mean R-bar */
-    double emissivity_normal;   /* eps at normal incidence (explicit, or Kirchhoff's A) */
-    double emissivity_mean;     /* eps-bar */
-    double transmission_mean;   /* T-bar; 0 for a half-space */
-    double attenuation_per_m;   /* inside the material: alpha_M, or 4 pi k nu / c */
-    int has_index;              /* n and k below hold the complex index */
+    double reflectance_normal; /* R at normal incidence */
+    double reflectance_mean;   /* hemispherical mean R-bar */
+    double emissivity_normal;  /* eps at normal incidence (explicit, or Kirchhoff's A) */
+    double emissivity_mean;    /* eps-bar */
+    double transmission_mean;  /* T-bar; 0 for a half-space */
+    double attenuation_per_m;  /* inside the material: alpha_M, or 4 pi k nu / c */
+    int has_index;             /* n and k below hold the complex index */
     double n, k;
 } thz_surface_optics;
 /* Fills *out for material i at freq_hz > 0; THZ_ERR_INPUT (and *out zeroed) when i is

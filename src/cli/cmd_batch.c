@@ -236,8 +236,8 @@ int cmd_batch(int argc, char **argv)
     } else if (st != THZ_OK) {
         rc = cli_fail(&err);
     } else if (!b.quiet) {
-        printf("thzmap batch: %zu frames (%zu computed, %zu already done), %zu movies", res.n_frames,
-               res.computed, res.reused, res.movies);
+        printf("thzmap batch: %zu frames (%zu computed, %zu already done), %zu movies",
+               res.n_frames, res.computed, res.reused, res.movies);
         if (shared)
             printf(", %d MPI ranks (%.3g MB communicated)", cli_mpi_size(),
                    1e-6 * (double)thz_context_mpi_bytes(ctx));

@@ -66,12 +66,12 @@ typedef struct run_summary {
     uint64_t seed;
     uint64_t photons_per_channel;
     int threads;
-    int mpi_ranks; /* processes that shared the run (docs/mpi.md); 1: alone */
-    const photon_stats *channel_stats;    /* n_channels entries, or NULL (render) */
-    const run_noise *noise;               /* n_channels entries, or NULL */
-    const run_noise *object_noise;        /* [channel * n_objects + object], or NULL */
-    const char *target_source;            /* "command line", "scene", "default", NULL */
-    const uint32_t *passes;               /* n_channels entries: render passes, or NULL */
+    int mpi_ranks;                     /* processes that shared the run (docs/mpi.md); 1: alone */
+    const photon_stats *channel_stats; /* n_channels entries, or NULL (render) */
+    const run_noise *noise;            /* n_channels entries, or NULL */
+    const run_noise *object_noise;     /* [channel * n_objects + object], or NULL */
+    const char *target_source;         /* "command line", "scene", "default", NULL */
+    const uint32_t *passes;            /* n_channels entries: render passes, or NULL */
     const double *seconds_render_channel; /* n_channels entries: render time (s), or NULL */
     double target_noise_k;                /* the run's noise target (K), 0: none */
     uint64_t *back_face_samples;          /* per sensor: samples that saw a back face, or NULL */
