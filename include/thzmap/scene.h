@@ -187,6 +187,10 @@ THZ_API thz_status thz_scene_material_optics(const thz_scene *scene, size_t i, d
  * in K of a radiance at freq_hz (0 for radiance <= 0), as the images use them. */
 THZ_API double thz_planck_radiance(double freq_hz, double temperature_k);
 THZ_API double thz_brightness_temperature(double freq_hz, double radiance);
+/* The standard error in K of a brightness temperature tb_k from its radiance's standard
+ * error stderr_l (W m^-2 sr^-1 Hz^-1) at freq_hz: stderr_l / (dB/dT at tb_k), as the
+ * noise figures of summary.json convert it (0 when tb_k <= 0). */
+THZ_API double thz_brightness_temperature_stderr(double freq_hz, double tb_k, double stderr_l);
 
 /* Integrators by name ("photon-map", "final-gather", "path"): 1 when `name` is one,
  * else 0; whether it needs a photon map (photon-map, final-gather); whether more

@@ -10,6 +10,7 @@
 #include "sensor/measure.h"
 #include "sensor/noise.h"
 #include "sensor/render.h"
+#include "sensor/render_accum.h"
 
 /* A loaded scene whose images would not fit in memory is refused (THZ_ERR_INPUT, naming
  * sensors[i].resolution). */
@@ -313,4 +314,9 @@ double thz_planck_radiance(double freq_hz, double temperature_k)
 double thz_brightness_temperature(double freq_hz, double radiance)
 {
     return planck_brightness_temperature(freq_hz, radiance);
+}
+
+double thz_brightness_temperature_stderr(double freq_hz, double tb_k, double stderr_l)
+{
+    return render_stderr_k(freq_hz, tb_k, stderr_l);
 }

@@ -271,10 +271,8 @@ double serve_tb_stderr(double centre_hz, double l, double sigma)
 {
     if (!(sigma >= 0.0) || !(centre_hz > 0.0))
         return NAN;
-    double up = thz_brightness_temperature(centre_hz, l + sigma);
-    if (l - sigma > 0.0)
-        return 0.5 * (up - thz_brightness_temperature(centre_hz, l - sigma));
-    return up - thz_brightness_temperature(centre_hz, l);
+    return thz_brightness_temperature_stderr(centre_hz, thz_brightness_temperature(centre_hz, l),
+                                             sigma);
 }
 
 static bool serve_long_arg(serve_request *r, const char *name, long *out)
