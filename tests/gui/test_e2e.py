@@ -190,6 +190,18 @@ def main():
         values = [float(td.get_attribute("data-value")) for td in driver.find_elements(By.CSS_SELECTOR, "#pixel-table td.tb")]
         expected = [float(v) for v in tb[:, row, col]]
         assert values == expected, f"page {values} != cube {expected}"
+        # the error bars: σ_Tb = σ_L / (∂B/∂T at the channel's centre and Tb), worked out here
+        # from the stderr cube (a factor 2 or π in the page's formula would show)
+        hdr = open(os.path.join(out, "cam.radiance_stderr.hdr")).read()
+        centre_hz = 1e9 * np.array([float(v) for v in
+                                    re.search(r"wavelength\s*=\s*\{([^}]*)\}", hdr).group(1).split(",")])
+        s_l = np.fromfile(os.path.join(out, "cam.radiance_stderr.img"), "<f4").reshape(bands, 32, 32)
+        t = tb[:, row, col].astype(float)
+        x = 6.62607015e-34 * centre_hz / (1.380649e-23 * t)
+        b_nu = 2 * 6.62607015e-34 * centre_hz ** 3 / 299792458.0 ** 2 / np.expm1(x)
+        sigma = s_l[:, row, col] / (b_nu * x * np.exp(x) / (np.expm1(x) * t))
+        shown = [float(td.get_attribute("data-value")) for td in driver.find_elements(By.CSS_SELECTOR, "#pixel-table td.sigma")]
+        assert np.allclose(shown, sigma, rtol=1e-5, atol=0), f"page σ {shown} != {list(sigma)}"
         truth = by_id("pixel-truth").text
         assert "cylinder-C" in truth and "330" in truth, truth
         log(f"pixel ({row}, {col}): {len(values)} channels equal the cube; truth {truth!r}; "
@@ -216,6 +228,10 @@ def main():
         by_id("btn-diff").click()
         wait.until(lambda d: "beyond" in by_id("diff-info").text)
         log(f"A/B: {by_id('diff-info').text}")
+        # two seeds agree within their errors: about 0.27 % beyond 3 σ; errors 2x too small
+        # would put some 13 % there
+        beyond = float(re.search(r"([0-9.]+) % of", by_id("diff-info").text).group(1))
+        assert beyond <= 5.0, by_id("diff-info").text
         shot("diff")
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         assert not errors, errors

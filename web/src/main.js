@@ -5,6 +5,7 @@ import { getJSON, reportError, status } from "./api.js";
 import { SceneEditor } from "./sceneui.js";
 import { Runs } from "./runs.js";
 import { Results } from "./results.js";
+import { forget } from "./envi.js";
 
 if (new URLSearchParams(location.search).has("token")) history.replaceState(null, "", "/");
 
@@ -21,7 +22,11 @@ const results = new Results();
 window.thzmap = { editor, runs, results, showTab }; // for the console and the end-to-end test
 
 document.addEventListener("scene-opened", (e) => runs.sceneOpened(e.detail));
-document.addEventListener("run-finished", (e) => results.open(e.detail.out).catch(reportError));
+// a run writes its cubes anew: drop what was read of them before (the cache is by path)
+document.addEventListener("run-finished", (e) => {
+  forget(`${e.detail.out.replace(/\/+$/, "")}/`);
+  results.open(e.detail.out).catch(reportError);
+});
 document.addEventListener("show-results", (e) => {
   showTab("results");
   results.open(e.detail).catch(reportError);

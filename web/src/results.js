@@ -200,7 +200,8 @@ export class Results {
       const t = tb.at(b, row, col);
       y.push(t);
       // σ_Tb = σ_L / (∂B/∂T) at the channel's centre and Tb (Tb is B_ν(ν_c, T) = L_c inverted)
-      const s = this.stderr ? this.stderr.at(b, row, col) : NaN;
+      // (none for a measured cube: its sensor noise is not in the simulation's σ)
+      const s = this.stderr && !measured ? this.stderr.at(b, row, col) : NaN;
       err.push(t > 0 && Number.isFinite(s) ? s / planckDerivative(f[b] * 1e12, t) : NaN);
     }
     const id = this.truthId ? this.truthId.at(0, row, col) : -1;
@@ -218,7 +219,7 @@ export class Results {
       ? `${objectName}, ${formatNumber(truthT)} K at ${formatNumber(truthD)} m` : objectName;
     info.appendChild(truth);
     $("pixel-plot").replaceChildren();
-    linePlot($("pixel-plot"), [{ label: "Tb ± 1σ", x: f, y, err }], { xLabel: "frequency (THz)", yLabel: "Tb (K)" });
+    linePlot($("pixel-plot"), [{ label: measured ? "measured Tb" : "Tb ± 1σ", x: f, y, err }], { xLabel: "frequency (THz)", yLabel: "Tb (K)" });
     const table = $("pixel-table");
     table.replaceChildren();
     const head = table.createTHead().insertRow();
@@ -232,7 +233,10 @@ export class Results {
       c.className = "tb";
       c.dataset.value = String(t); // the float32 read from the cube, in full
       c.textContent = t.toFixed(3);
-      tr.insertCell().textContent = Number.isFinite(err[b]) ? err[b].toFixed(3) : "–";
+      const e = tr.insertCell();
+      e.className = "sigma";
+      e.dataset.value = String(err[b]);
+      e.textContent = Number.isFinite(err[b]) ? err[b].toFixed(3) : "–";
     });
     info.dataset.ms = (performance.now() - t0).toFixed(1);
   }
@@ -250,14 +254,15 @@ export class Results {
     const sigma = response.headers.get("X-Thzmap-Diff-Units") !== "K";
     let beyond = 0;
     let count = 0;
-    let hi = 0;
     for (const v of z) {
       if (!Number.isFinite(v)) continue;
       count++;
       if (Math.abs(v) > 3) beyond++;
-      hi = Math.max(hi, Math.abs(v));
     }
-    const span = sigma ? 4 : hi || 1;
+    // in K: symmetric about 0 over the 1st-99th percentile, as the other images (one hot
+    // pixel would take the whole scale)
+    const [lo, hi] = sigma ? [-4, 4] : range(z, null);
+    const span = sigma ? 4 : Math.max(Math.abs(lo), Math.abs(hi)) || 1;
     this.diffZ = { z, cube, unit: sigma ? "σ" : "K" };
     paint($("diff-image"), cube, z, -span, span, diverging, null);
     drawColourBar($("diff-bar"), -span, span, this.diffZ.unit, diverging);
