@@ -19,8 +19,10 @@
  * the process with no message and the output's staging files beside OUTDIR (issue 20;
  * docs/reliability.md). libgomp's own failure to start a thread ends in exit(), which
  * the CLI's exit handler cleans up after. The number of build threads is the number of
- * processors whatever --threads says, as TBB's default was, so the structure (and every
- * hit) is the same for any thread count.
+ * processors this process may use whatever --threads says, as TBB's default was, so the
+ * structure (and every hit) is the same for any --threads. Whether Embree's structure
+ * depends on the number of build threads (MPI ranks bound to fewer cores than one process
+ * gets) is not known; the MPI tests compare processes on one machine.
  */
 #include "accel/accel.h"
 
@@ -163,11 +165,25 @@ thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err)
         if (st != THZ_OK)
             goto cleanup;
     }
+    /* Embree keeps its error per thread: a build failure is on whichever thread met it. */
+    enum RTCError build_error = RTC_ERROR_NONE;
 #pragma omp parallel num_threads(build_threads)
-    rtcJoinCommitScene(a->rtc);
-    st = accel_check_device(a->device, "building the acceleration structure", err);
-    if (st != THZ_OK)
+    {
+        rtcJoinCommitScene(a->rtc);
+        enum RTCError e = rtcGetDeviceError(a->device);
+        if (e != RTC_ERROR_NONE) {
+#pragma omp critical(accel_build_error)
+            if (build_error == RTC_ERROR_NONE)
+                build_error = e;
+        }
+    }
+    if (build_error != RTC_ERROR_NONE) {
+        st = thz_error_set(
+            err, build_error == RTC_ERROR_OUT_OF_MEMORY ? THZ_ERR_NOMEM : THZ_ERR_INTERNAL,
+            "ray casting: Embree failed while building the acceleration structure: %s",
+            accel_error_name(build_error));
         goto cleanup;
+    }
 
     double diag = 0.0;
     if (lo[0] <= hi[0]) {
