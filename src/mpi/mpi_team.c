@@ -35,7 +35,8 @@ typedef struct team_message {
     uint64_t kind;
     photon_phase_request rq;   /* TEAM_PHASE */
     render_channel_request rr; /* TEAM_RENDER_BEGIN */
-    uint64_t map_count;        /* TEAM_RENDER_BEGIN: records of the map, 0: none (path) */
+    uint64_t has_map;          /* TEAM_RENDER_BEGIN: 1 when rendered from a map (not path) */
+    uint64_t map_count;        /* its records (0 for an empty map: an isothermal deviation) */
     uint64_t map_batches;      /* its photon_map_batches */
     double map_t0_k;           /* its reference temperature */
     uint64_t sensor, pass;     /* TEAM_RENDER_PASS */
@@ -188,12 +189,13 @@ static thz_status team_render_begin(void *impl, const render_channel_request *rq
     mpi_team *t = impl;
     team_message m = {.kind = TEAM_RENDER_BEGIN, .rr = *rq};
     if (map) {
+        m.has_map = 1;
         m.map_count = photon_map_count(map);
         m.map_batches = photon_map_batches(map);
         m.map_t0_k = photon_map_reference_temperature_k(map);
     }
     int rc = team_bcast(t, &m);
-    if (rc == MPI_SUCCESS && map) /* read only: MPI does not write a root's buffer */
+    if (rc == MPI_SUCCESS && m.map_count > 0) /* read only: MPI does not write a root's buffer */
         rc = team_bcast_bytes(t, (void *)photon_map_records(map),
                               m.map_count * sizeof(photon_record));
     return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "sending the photon map");
@@ -378,17 +380,21 @@ static thz_status team_serve_begin(mpi_team *t, const thz_scene *scene, const ac
     r->accs = thz_calloc(r->n_sensors ? r->n_sensors : 1, sizeof *r->accs);
     if (!r->accs)
         return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for the pixel statistics");
-    if (m->map_count > 0) {
-        photon_record *records = m->map_count <= SIZE_MAX / sizeof *records
-                                     ? thz_malloc_array(m->map_count, sizeof *records)
-                                     : NULL;
-        if (!records)
-            return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for %llu photon records",
-                                 (unsigned long long)m->map_count);
-        int rc = team_bcast_bytes(t, records, m->map_count * sizeof *records);
-        if (rc != MPI_SUCCESS) {
-            free(records);
-            return team_error(err, rc, "receiving the photon map");
+    if (m->has_map) {
+        photon_record *records = NULL;
+        if (m->map_count > 0) {
+            records = m->map_count <= SIZE_MAX / sizeof *records
+                          ? thz_malloc_array(m->map_count, sizeof *records)
+                          : NULL;
+            if (!records)
+                return thz_error_set(err, THZ_ERR_NOMEM,
+                                     "MPI: out of memory for %llu photon records",
+                                     (unsigned long long)m->map_count);
+            int rc = team_bcast_bytes(t, records, m->map_count * sizeof *records);
+            if (rc != MPI_SUCCESS) {
+                free(records);
+                return team_error(err, rc, "receiving the photon map");
+            }
         }
         /* takes records, also on failure; sorts them as the lead's map was sorted */
         thz_status st =

@@ -2,7 +2,7 @@
 # MPI runs (docs/mpi.md): `mpirun -np N thzmap simulate|render|batch` gives, byte for byte,
 # the files of one process with the same seed (summary.json and batch.json aside: wall
 # times, threads, mpi_ranks), for 2 and 3 ranks of 1 thread and 2 ranks of 2 threads,
-# photon-map and final-gather (with the saved photon map), photon passes (several shared
+# photon-map and final-gather (with the saved photon map; also an empty deviation map), photon passes (several shared
 # phases in one run), path with render passes, render from a saved map, and a batch of a
 # moving camera (fresh, and resumed under mpirun after losing a frame); only rank 0
 # writes; a failed or killed rank fails the run with a message and a non-zero exit, never
@@ -119,6 +119,25 @@ $PY -c 'import json,sys; sys.exit(json.load(open(sys.argv[1]))["channels"][0]["r
     "$work/pa3/summary.json" || fail "path: fewer than 2 passes (the test tests one pass)"
 grep -q "warning" "$work/pa3.out" && fail "path under mpirun warned: $(grep warning "$work/pa3.out")"
 
+# An isothermal room: final-gather's deviation map holds no photon at all, which the other
+# ranks must render from as one process does (an empty map, not "no map").
+step "empty deviation map"
+mkdir -p "$work/in"
+$PY - "$scene" "$work/in/iso.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+for o in s["objects"]:
+    o["temperature_k"] = 295
+s["atmosphere"] = {"model": "none"}
+s["photons"]["per_channel"] = 20000
+json.dump(s, open(sys.argv[2], "w"))
+PY
+"$THZMAP" simulate "$work/in/iso.json" -o "$work/iso1" --integrator final-gather --threads 1 --quiet ||
+    fail "one process, isothermal final-gather: exit $?"
+mpi 2 "$THZMAP" simulate "$work/in/iso.json" -o "$work/iso2" --integrator final-gather \
+    --threads 1 > "$work/iso2.out" 2>&1 || { fail "2 ranks, empty map: exit $?"; cat "$work/iso2.out"; }
+same_run "$work/iso2" "$work/iso1" "2 ranks, final-gather from an empty deviation map"
+
 step "batch"
 # --- batch: frames shared by the ranks (a moving camera: frame 0 fires, 1-2 render
 # from its photons), then resumed under mpirun after losing frame 2 -----------------
@@ -184,7 +203,7 @@ grep -q '"frames_reused": 2' "$work/bt3/batch.json" || fail "resumed batch: fram
 
 step "only rank 0"
 # --- only rank 0 writes: nothing else beside the outputs -----------------------------
-extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3|pp1|pp2|re1|re2|pa1|pa3|pa3.out|bt|bt1|bt3')
+extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3|pp1|pp2|re1|re2|pa1|pa3|pa3.out|in|iso1|iso2|iso2.out|bt|bt1|bt3')
 [ -z "$extra" ] || fail "files beside the outputs: $extra"
 
 
