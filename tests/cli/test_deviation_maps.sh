@@ -6,8 +6,10 @@
 #    photon_reference_temperature_k 295 and energy_balance.relative_difference null;
 #    simulate --integrator photon-map keeps the paper's map (0);
 #  - final-gather, and photon-map rendered from final-gather's saved map, agree with
-#    path pixel by pixel within their reported standard errors (at most 1 % of the
-#    pixels beyond 5 combined errors, object edges included) and in the mean over the
+#    path pixel by pixel within their reported standard errors (at most 0.2 % of the
+#    pixels beyond 5 combined errors, object edges included: 0 to 1 of 4096 measured over
+#    3 seeds; photon-map's error without the correlated bound for widened footprints,
+#    2x too small, put 24 to 112 there) and in the mean over the
 #    picture within 0.02 K; a missing B0 or a sign error is off by ~300 K or by the
 #    target's contrast.
 # argv: path to the thzmap binary, repository directory.
@@ -84,7 +86,7 @@ for run in ("fg", "rerender"):
     dt = sum(t[i] - ref_t[i] for i in range(n)) / n
     print(f"{run}: {beyond} of {n} pixels beyond 5 combined standard errors, "
           f"mean Tb - path's {dt:+.4f} K")
-    if beyond > 0.01 * n:
+    if beyond > 0.002 * n:
         bad.append(f"{run}: {beyond} pixels beyond 5 standard errors of path")
     if abs(dt) > 0.02:
         bad.append(f"{run}: mean brightness temperature {dt:+.4f} K from path's")
