@@ -125,10 +125,10 @@ for w in what:
         serial = max(0.0, c2[0] - c2[1])
         f = max(0.0, 2 * (r1["cpu_sum"] - serial - c2[1]))
         u = max(0.0, c2[1] - f / 2)
-        # what rank 0 sends or receives grows with the ranks: photon shares (simulate)
-        # are gathered once whatever N, a map (render, batch) is broadcast along a tree
-        # (about 2x its size per rank for large messages), the tiles are gathered once
-        mb64 = rows[2]["mb"] * (1.0 if w == "simulate" else 2.0)
+        # what rank 0 sends or receives grows with the ranks: the photon map is broadcast
+        # along a tree to every rank (about 2x its size per rank for large messages; since
+        # the pixels are shared, simulate sends its map too), shares and tiles are gathered
+        mb64 = rows[2]["mb"] * 2.0
         print(f"64 ranks (estimate from CPU times): start u = {u:.2f} s, shared work f = "
               f"{f:.2f} s (/ 64 = {f / 64:.3f} s), rank 0 alone s = {serial:.2f} s, "
               f"{mb64:.3g} MB through rank 0")

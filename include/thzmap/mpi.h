@@ -45,7 +45,8 @@ struct thz_sequence;
 THZ_API thz_status thz_mpi_serve_batch(thz_context *ctx, const struct thz_sequence *seq,
                                        thz_error *err);
 
-/* Bytes this rank sent and received for shared photon phases through ctx. */
+/* Bytes this rank sent and received through ctx for shared photon phases and render
+ * tiles (photon maps broadcast included). */
 THZ_API uint64_t thz_context_mpi_bytes(const thz_context *ctx);
 
 #ifdef __cplusplus

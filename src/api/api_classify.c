@@ -10,7 +10,6 @@
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/file.h"
-#include "io/output.h"
 #include "core/path.h"
 #include "io/envi.h"
 #include "io/output.h"

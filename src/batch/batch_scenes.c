@@ -14,7 +14,6 @@
 #include "core/error.h"
 #include "scene/load.h"
 
-/* Sequence and scene files are kilobytes; a batch holds every frame's scene text. */
 
 enum { SCENES_MAX = 100000 };
 

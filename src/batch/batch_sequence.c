@@ -17,9 +17,6 @@
 #include "core/error.h"
 #include "scene/load.h"
 
-/* A sequence file larger than this is refused before it is read: they are kilobytes
- * (batch_scenes.c has the same limit for scene files). */
-
 enum { SEQ_MAX_FRAMES = 100000, SEQ_MAX_SWEEPS = 10000, SEQ_MAX_DEPTH = 8 };
 
 /* A value that keyframes name: its path (segments; objects and sensors by name), and

@@ -5,18 +5,11 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/cdf.h"
 
 size_t spectrum_interval(const double *t, size_t n, double x)
 {
-    size_t lo = 0, hi = n - 1; /* t[lo] <= x < t[hi], or x beyond an end */
-    while (hi - lo > 1) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (t[mid] <= x)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return lo;
+    return cdf_search(t + 1, n - 1, x); /* the first lo with x < t[lo + 1], else n - 2 */
 }
 
 double spectrum_eval(const thz_spectrum *s, double freq_hz)
