@@ -35,6 +35,11 @@ static void serve_data_headers(struct MHD_Response *resp)
     MHD_add_response_header(resp, "Content-Security-Policy", "default-src 'none'; sandbox");
 }
 
+/* A thread per connection, opened before the token is checked: bounded, so that whoever
+ * can connect cannot hold every thread (an event stream sends a keep-alive every 15 s,
+ * well within the idle limit). */
+enum { SERVE_MAX_CONNECTIONS = 64, SERVE_MAX_PER_IP = 32, SERVE_IDLE_S = 60 };
+
 enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type, const void *data,
                             size_t size)
 {
@@ -393,10 +398,11 @@ serve *serve_start(const serve_options *opt, char *why, size_t size, bool *usage
         serve_stop(s);
         return NULL;
     }
-    s->daemon =
-        MHD_start_daemon(flags, (uint16_t)opt->port, NULL, NULL, serve_access, s,
-                         MHD_OPTION_SOCK_ADDR, addr, MHD_OPTION_NOTIFY_COMPLETED, serve_completed,
-                         s, MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)600, MHD_OPTION_END);
+    s->daemon = MHD_start_daemon(
+        flags, (uint16_t)opt->port, NULL, NULL, serve_access, s, MHD_OPTION_SOCK_ADDR, addr,
+        MHD_OPTION_NOTIFY_COMPLETED, serve_completed, s, MHD_OPTION_CONNECTION_TIMEOUT,
+        (unsigned)SERVE_IDLE_S, MHD_OPTION_CONNECTION_LIMIT, (unsigned)SERVE_MAX_CONNECTIONS,
+        MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)SERVE_MAX_PER_IP, MHD_OPTION_END);
     if (!s->daemon) {
         snprintf(why, size,
                  "cannot listen on %s port %u (in use, or not an address of this "

@@ -138,9 +138,9 @@ void serve_cubes_free(serve *s);
  * read; valid while the caller holds s->cache_lock and gets no other cube. NULL with err
  * filled when it cannot be read. */
 const thz_cube *serve_cube_get(serve *s, const char *hdr, thz_error *err);
-/* The standard error of Tb (K) from that of the radiance L: half the change of Tb over
- * L +- sigma at the channel centre (where the images' Tb is defined), or over
- * L .. L + sigma near L = 0. NaN without a positive centre or a sigma. */
+/* The standard error of Tb (K) from that of the radiance L at the channel centre (where
+ * the images' Tb is defined): sigma / (dB/dT at Tb), thz_brightness_temperature_stderr.
+ * NaN without a positive centre, a sigma or a positive Tb (L <= 0). */
 double serve_tb_stderr(double centre_hz, double l, double sigma);
 
 enum MHD_Result serve_photons(serve_request *r);

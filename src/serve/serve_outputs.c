@@ -269,10 +269,10 @@ static json_t *serve_array(const double *v, size_t n)
 
 double serve_tb_stderr(double centre_hz, double l, double sigma)
 {
-    if (!(sigma >= 0.0) || !(centre_hz > 0.0))
+    double tb = centre_hz > 0.0 ? thz_brightness_temperature(centre_hz, l) : 0.0;
+    if (!(sigma >= 0.0) || !(tb > 0.0))
         return NAN;
-    return thz_brightness_temperature_stderr(centre_hz, thz_brightness_temperature(centre_hz, l),
-                                             sigma);
+    return thz_brightness_temperature_stderr(centre_hz, tb, sigma);
 }
 
 static bool serve_long_arg(serve_request *r, const char *name, long *out)
