@@ -14,7 +14,6 @@
 #include "core/error.h"
 #include "scene/load.h"
 
-
 enum { SCENES_MAX = 100000 };
 
 /* Resolves name against seq_dir into seq->scene_paths[k] and seq->scene_dirs[k] and
