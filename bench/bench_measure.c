@@ -6,6 +6,8 @@
 #include <string.h>
 #include <time.h>
 
+#include <jansson.h>
+
 #include "accel/accel.h"
 #include "bench_probe.h"
 #include "core/alloc.h"
@@ -147,19 +149,25 @@ cleanup:
     return st;
 }
 
-thz_status bench_measure_e2e(const char *scene_path, uint64_t photons, int threads,
-                             const char *outdir, bench_e2e *out, thz_error *err)
+thz_status bench_measure_e2e(const char *scene_path, const char *integrator, uint64_t photons,
+                             double target_noise_k, int threads, const char *outdir, bench_e2e *out,
+                             thz_error *err)
 {
     memset(out, 0, sizeof *out);
     thz_scene *s = NULL;
     double t0 = bench_now_s();
-    thz_status st = bench_load(scene_path, photons, &s, err);
+    thz_status st = thz_scene_load(scene_path, &s, err);
     if (st != THZ_OK)
         return st;
     double t1 = bench_now_s();
     /* through the public API, as `thzmap simulate` runs */
     thz_context *ctx = thz_context_create();
-    thz_run_settings settings = {.seconds_load = t1 - t0};
+    thz_run_settings settings;
+    thz_run_settings_init(&settings);
+    settings.seconds_load = t1 - t0;
+    settings.integrator = integrator;
+    settings.photons_per_channel = photons;
+    settings.target_noise_k = target_noise_k;
     thz_run *run = NULL;
     if (!ctx)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
@@ -170,11 +178,26 @@ thz_status bench_measure_e2e(const char *scene_path, uint64_t photons, int threa
         st = thz_run_write(ctx, run, outdir, NULL, err);
     double t2 = bench_now_s();
     thz_run_totals res;
-    thz_run_get_totals(run, &res);
+    memset(&res, 0, sizeof res);
+    if (st == THZ_OK)
+        thz_run_get_totals(run, &res);
+    thz_scene_info info;
+    if (thz_scene_get_info(s, &info) == THZ_OK)
+        snprintf(out->integrator, sizeof out->integrator, "%s",
+                 integrator ? integrator : info.integrator);
     out->s_load = t1 - t0;
     out->s_run = t2 - t1;
     out->s_total = t2 - t0;
-    out->stored = st == THZ_OK ? res.photons_stored : 0;
+    out->fired = res.photons_fired;
+    out->stored = res.photons_stored;
+    out->max_passes = res.max_passes;
+    out->worst_p95_stderr_k = res.worst_p95_stderr_k;
+    if (st == THZ_OK) { /* the target the run took (summary.json; null: none) */
+        const char *text = thz_run_summary_json(run);
+        json_t *sum = text ? json_loads(text, 0, NULL) : NULL;
+        out->target_noise_k = json_number_value(json_object_get(sum, "target_noise_k"));
+        json_decref(sum);
+    }
     thz_run_destroy(run);
     thz_context_destroy(ctx);
     thz_scene_destroy(s);

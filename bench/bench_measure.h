@@ -22,10 +22,15 @@ typedef struct bench_paper {
         s_total;
 } bench_paper;
 
-/* The same case through run_simulate (what `thzmap simulate` runs), end to end. */
+/* The same case end to end through the public API's thz_simulate and thz_run_write (what
+ * `thzmap simulate` runs). */
 typedef struct bench_e2e {
     double s_load, s_run, s_total;
-    uint64_t stored;
+    uint64_t fired, stored;
+    uint32_t max_passes;       /* render passes of the channel that took most */
+    double worst_p95_stderr_k; /* largest 95th percentile of the stderr of Tb_c, K */
+    double target_noise_k;     /* the run's noise target, K (0: none) */
+    char integrator[16];       /* the integrator that ran */
 } bench_e2e;
 
 /* 2. The raw Embree probe for n rays in the scene. */
@@ -51,8 +56,12 @@ typedef struct bench_series {
 
 thz_status bench_measure_paper(const char *scene_path, uint64_t photons, int threads,
                                const char *outdir, bench_paper *out, thz_error *err);
-thz_status bench_measure_e2e(const char *scene_path, uint64_t photons, int threads,
-                             const char *outdir, bench_e2e *out, thz_error *err);
+/* integrator NULL: the scene's (teraeye: the default, path); photons 0: the scene's;
+ * target_noise_k 0: the scene's or the default. Settings as `thzmap simulate SCENE
+ * [--integrator I] [--photons N] [--target-noise-k X]` would pass them. */
+thz_status bench_measure_e2e(const char *scene_path, const char *integrator, uint64_t photons,
+                             double target_noise_k, int threads, const char *outdir, bench_e2e *out,
+                             thz_error *err);
 /* Timed phases repeat `repeats` times (>= 1) and keep the fastest: on a shared machine
  * the minimum is the time least disturbed by other processes. */
 thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int threads, int repeats,

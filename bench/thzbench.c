@@ -1,18 +1,23 @@
-/* thzbench: the benchmark harness (issue 6). One command runs every measurement,
+/* thzbench: the benchmark harness (issues 6 and 19). One command runs every measurement,
  * prints a table and writes it as JSON:
  *
  *   1. the paper's case (examples/teraeye) at full size, stage by stage, and end to end
- *      through run_simulate: wall times, photons/s, bytes per stored photon, peak memory;
+ *      through thz_simulate twice: with the paper's method (photon-map, the same photon
+ *      count), which the 10 s target is judged on, and with the scene's default integrator
+ *      (path to its default noise target), which `thzmap simulate SCENE` runs;
  *   2. the tracing limit: a raw Embree probe casting as many rays as that photon phase;
  *   3. scaling in photons (1, 3, 10, 30, 100 M in one channel, as memory allows), in
  *      triangles (about 1 k to 1 M, a tessellated mesh scene) and in threads (1 against
  *      all);
- *   4. rendering: gathers/s and time per pixel as the photons per pixel grow.
+ *   4. rendering: gathers/s and time per pixel as the photons per pixel grow;
+ *   5. each integrator's render stage on 1 thread against all (bench_render.h);
+ *   6. the time to a converged image, path and final-gather: the RMS over the objects'
+ *      pixels of the per-pixel noise, extrapolated to 0.05 K (bench_render.h);
  *
- * Every measurement runs in a child process of its own (fork), so the peak memory the
- * OS reports for it (wait4's rusage) is that measurement's alone and no OpenMP state is
- * shared across measurements. --small shrinks every count so that the whole run takes
- * seconds (the CI test); it asserts nothing about speed.
+ * and ends with issue 19's targets and issue 6's, each with its value, limit and verdict.
+ * Every measurement runs in a child process of its own (bench_child.h). --small shrinks
+ * every count so that the whole run takes seconds (the CI test); it asserts nothing about
+ * speed.
  *
  * Usage: thzbench [--small] [--json PATH] [--threads N] [--scene PATH] [--no-e2e]
  */
@@ -21,145 +26,19 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
-#include <sys/time.h>
-#include <sys/types.h>
-#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <jansson.h>
 
+#include "bench_child.h"
 #include "bench_measure.h"
+#include "bench_render.h"
+#include "bench_report.h"
 
 #ifndef THZ_SOURCE_DIR
 #define THZ_SOURCE_DIR "."
 #endif
-
-/* ---- Memory ------------------------------------------------------------------------- */
-
-/* Bytes the OS says are available (MemAvailable), or 0 if unknown. */
-static double bench_mem_available(void)
-{
-    FILE *f = fopen("/proc/meminfo", "r");
-    if (!f)
-        return 0.0;
-    char line[256];
-    double kb = 0.0;
-    while (fgets(line, sizeof line, f))
-        if (sscanf(line, "MemAvailable: %lf kB", &kb) == 1)
-            break;
-    fclose(f);
-    return 1024.0 * kb;
-}
-
-/* The peak of a photon phase of n photons of the paper's case, with margin: 1.3 stored
- * records per photon (1.25 measured) of 32 bytes, their 8-byte Morton codes during the
- * index build, the per-thread buffers and the render: 48 bytes per record, times 1.3. */
-static double bench_bytes_needed(uint64_t photons)
-{
-    return (double)photons * 1.3 * 48.0 * 1.3;
-}
-
-static bool bench_fits(uint64_t photons)
-{
-    double avail = bench_mem_available();
-    return avail <= 0.0 || bench_bytes_needed(photons) <= avail;
-}
-
-/* ---- Child processes ----------------------------------------------------------------- */
-
-typedef thz_status (*bench_job_fn)(const void *arg, void *out, thz_error *err);
-
-typedef struct bench_child_header {
-    int status;
-    thz_error err;
-} bench_child_header;
-
-static bool bench_write_all(int fd, const void *buf, size_t n)
-{
-    const char *p = buf;
-    while (n > 0) {
-        ssize_t k = write(fd, p, n);
-        if (k < 0 && errno == EINTR)
-            continue;
-        if (k <= 0)
-            return false;
-        p += k;
-        n -= (size_t)k;
-    }
-    return true;
-}
-
-static bool bench_read_all(int fd, void *buf, size_t n)
-{
-    char *p = buf;
-    while (n > 0) {
-        ssize_t k = read(fd, p, n);
-        if (k < 0 && errno == EINTR)
-            continue;
-        if (k <= 0)
-            return false;
-        p += k;
-        n -= (size_t)k;
-    }
-    return true;
-}
-
-/* What the OS reports for a child: its peak resident memory and CPU time (user +
- * system, all threads: against wall time it shows how many cores the child got). */
-typedef struct bench_usage {
-    uint64_t peak_bytes;
-    double cpu_s;
-} bench_usage;
-
-/* Runs fn(arg, out) in a child; out (size bytes) comes back through a pipe. */
-static thz_status bench_fork(bench_job_fn fn, const void *arg, void *out, size_t size,
-                             bench_usage *usage, thz_error *err)
-{
-    int fds[2];
-    if (pipe(fds) != 0)
-        return thz_error_set(err, THZ_ERR_IO, "bench: pipe: %s", strerror(errno));
-    fflush(NULL);
-    pid_t pid = fork();
-    if (pid < 0) {
-        close(fds[0]);
-        close(fds[1]);
-        return thz_error_set(err, THZ_ERR_IO, "bench: fork: %s", strerror(errno));
-    }
-    if (pid == 0) {
-        close(fds[0]);
-        bench_child_header h;
-        memset(&h, 0, sizeof h);
-        memset(out, 0, size);
-        h.status = (int)fn(arg, out, &h.err);
-        bool ok = bench_write_all(fds[1], &h, sizeof h) && bench_write_all(fds[1], out, size);
-        close(fds[1]);
-        _exit(ok ? 0 : 1);
-    }
-    close(fds[1]);
-    bench_child_header h;
-    bool ok = bench_read_all(fds[0], &h, sizeof h) && bench_read_all(fds[0], out, size);
-    close(fds[0]);
-    int wstatus = 0;
-    struct rusage ru;
-    memset(&ru, 0, sizeof ru);
-    while (wait4(pid, &wstatus, 0, &ru) < 0 && errno == EINTR) {
-    }
-    if (usage) {
-        usage->peak_bytes = (uint64_t)ru.ru_maxrss * 1024u; /* Linux: kilobytes */
-        usage->cpu_s = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-                       (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
-    }
-    if (!ok || !WIFEXITED(wstatus) || WEXITSTATUS(wstatus) != 0)
-        return thz_error_set(err, THZ_ERR_INTERNAL, "bench: a measurement process failed");
-    if (h.status != THZ_OK) {
-        if (err)
-            *err = h.err;
-        return (thz_status)h.status;
-    }
-    return THZ_OK;
-}
 
 typedef struct bench_job {
     const char *scene;
@@ -180,10 +59,44 @@ static thz_status bench_job_paper(const void *arg, void *out, thz_error *err)
     return bench_measure_paper(j->scene, j->photons, j->threads, j->outdir, out, err);
 }
 
+typedef struct bench_e2e_job {
+    const char *scene, *outdir, *integrator;
+    uint64_t photons;
+    double target_noise_k;
+    int threads;
+} bench_e2e_job;
+
 static thz_status bench_job_e2e(const void *arg, void *out, thz_error *err)
 {
-    const bench_job *j = arg;
-    return bench_measure_e2e(j->scene, j->photons, j->threads, j->outdir, out, err);
+    const bench_e2e_job *j = arg;
+    return bench_measure_e2e(j->scene, j->integrator, j->photons, j->target_noise_k, j->threads,
+                             j->outdir, out, err);
+}
+
+typedef struct bench_speedup_job {
+    const char *scene;
+    bench_speedup_config cfg;
+} bench_speedup_job;
+
+static thz_status bench_job_speedup(const void *arg, void *out, thz_error *err)
+{
+    const bench_speedup_job *j = arg;
+    return bench_measure_speedup(j->scene, &j->cfg, out, err);
+}
+
+typedef struct bench_converge_job {
+    const char *scene, *integrator;
+    uint64_t photons;
+    uint32_t estimates[2];
+    uint32_t sensor_columns;
+    int threads;
+} bench_converge_job;
+
+static thz_status bench_job_converge(const void *arg, void *out, thz_error *err)
+{
+    const bench_converge_job *j = arg;
+    return bench_measure_converge(j->scene, j->integrator, j->photons, j->estimates,
+                                  j->sensor_columns, j->threads, out, err);
 }
 
 static thz_status bench_job_probe(const void *arg, void *out, thz_error *err)
@@ -199,46 +112,6 @@ static thz_status bench_job_series(const void *arg, void *out, thz_error *err)
                                 j->probe, j->repeats, out, err);
 }
 
-/* ---- Reporting ------------------------------------------------------------------------ */
-
-static double bench_load1(void)
-{
-    double l[3];
-    return getloadavg(l, 3) >= 1 ? l[0] : -1.0;
-}
-
-static double bench_ratio(double a, double b)
-{
-    return b > 0.0 ? a / b : 0.0;
-}
-
-static json_t *bench_real(double v)
-{
-    return json_real(v == v ? v : 0.0);
-}
-
-typedef struct bench_targets {
-    json_t *list;
-    int met, total;
-} bench_targets;
-
-static void bench_target(bench_targets *t, const char *name, double value, const char *op,
-                         double limit, bool met, const char *unit)
-{
-    printf("  %-56s %10.3f %s %-6g %-3s %s\n", name, value, op, limit, unit,
-           met ? "met" : "NOT met");
-    json_t *o = json_object();
-    json_object_set_new(o, "target", json_string(name));
-    json_object_set_new(o, "value", bench_real(value));
-    json_object_set_new(o, "limit", bench_real(limit));
-    json_object_set_new(o, "comparison", json_string(op));
-    json_object_set_new(o, "unit", json_string(unit));
-    json_object_set_new(o, "met", json_boolean(met));
-    json_array_append_new(t->list, o);
-    t->met += met;
-    t->total++;
-}
-
 static void bench_print_usage(FILE *f)
 {
     fprintf(f, "usage: thzbench [--small] [--json PATH] [--threads N] [--scene PATH] [--no-e2e]\n"
@@ -246,7 +119,7 @@ static void bench_print_usage(FILE *f)
                "  --json PATH  where the results go (default: thzbench.json)\n"
                "  --threads N  threads of the 'all threads' runs (default: all cores)\n"
                "  --scene PATH the paper's case (default: examples/teraeye/scene.json)\n"
-               "  --no-e2e     skip the end-to-end run through run_simulate\n");
+               "  --no-e2e     skip the end-to-end runs through thz_simulate\n");
 }
 
 int main(int argc, char **argv)
@@ -317,6 +190,24 @@ int main(int argc, char **argv)
     /* The probe, the scaling points and the renders are timed as the fastest of
      * `repeats` runs (the paper's case itself runs once). */
     const int repeats = small ? 1 : 3;
+    /* The integrators (sections 5 and 6). final-gather's deviation map: 1 M photons, as
+     * docs/integrators.md measures it. The speed-ups render channel 3 from one map (the
+     * paper's photon count for photon-map), with work that takes a few seconds on 1
+     * thread: photon-map 10 renders, final-gather one pass of the scene's 32 gather rays,
+     * path 10 passes of the scene's 16 paths (0: the scene's estimates per pass). */
+    const uint64_t fg_photons = small ? 20000 : 1000000;
+    const uint32_t speedup_estimates[3] = {0, small ? 2 : 0, small ? 2 : 0};
+    const uint32_t speedup_passes[3] = {1, 1, small ? 1 : 10};
+    const uint32_t speedup_renders[3] = {small ? 1 : 10, 1, 1};
+    /* Time to a converged image: one pass with J, then 4 J estimates per sample (path's
+     * paths, final-gather's gather rays), RMS to converged_k. */
+    const uint32_t conv_estimates[2][2] = {{small ? 2 : 4, small ? 4 : 16},
+                                           {small ? 2 : 8, small ? 4 : 32}};
+    const double converged_k = 0.05;
+    /* --small renders sections 5 and 6 on 16 x 16 pixels, one sample each */
+    const uint32_t small_columns = small ? 16 : 0;
+    /* The default end to end is path to 0.1 K (default target); --small loosens it. */
+    const double default_target_k = small ? 1.0 : 0.0;
 
     json_t *root = json_object();
     time_t now = time(NULL);
@@ -398,26 +289,41 @@ int main(int argc, char **argv)
     json_object_set_new(jpaper, "load_average", bench_real(load_paper));
     json_object_set_new(jpaper, "cpu_seconds", bench_real(paper_use.cpu_s));
 
-    bench_e2e e2e_r;
-    memset(&e2e_r, 0, sizeof e2e_r);
-    bench_usage e2e_use = {0, 0.0};
+    /* End to end through the public API. The paper's case is its method, photon-map with
+     * the photon count above: the <= 10 s target is judged on it. The default
+     * integrator (path, with its default noise target) is what `thzmap simulate
+     * SCENE` runs, reported on its own line. */
+    bench_e2e e2e_pm, e2e_def;
+    memset(&e2e_pm, 0, sizeof e2e_pm);
+    memset(&e2e_def, 0, sizeof e2e_def);
     if (e2e) {
+        bench_e2e_job je = {.scene = scene,
+                            .outdir = outdir,
+                            .integrator = "photon-map",
+                            .photons = paper.photons_per_channel,
+                            .threads = threads};
+        bench_usage use = {0, 0.0};
         double l = bench_load1();
-        st = bench_fork(bench_job_e2e, &jp, &e2e_r, sizeof e2e_r, &e2e_use, &err);
-        const uint64_t e2e_peak = e2e_use.peak_bytes;
+        st = bench_fork(bench_job_e2e, &je, &e2e_pm, sizeof e2e_pm, &use, &err);
         if (st != THZ_OK)
             goto fail;
-        printf("  end to end through run_simulate (thzmap simulate): %.3f s (load %.3f s), peak "
-               "memory %.1f MB, %.1f CPU s (load average %.2f)\n",
-               e2e_r.s_total, e2e_r.s_load, (double)e2e_peak / 1e6, e2e_use.cpu_s, l);
-        json_t *je = json_object();
-        json_object_set_new(je, "seconds", bench_real(e2e_r.s_total));
-        json_object_set_new(je, "seconds_load", bench_real(e2e_r.s_load));
-        json_object_set_new(je, "peak_memory_bytes", json_integer((json_int_t)e2e_peak));
-        json_object_set_new(je, "cpu_seconds", bench_real(e2e_use.cpu_s));
-        json_object_set_new(je, "photons_stored", json_integer((json_int_t)e2e_r.stored));
-        json_object_set_new(je, "load_average", bench_real(l));
-        json_object_set_new(jpaper, "run_simulate", je);
+        json_object_set_new(jpaper, "run_simulate",
+                            bench_report_e2e("the paper's method (judged against the 10 s target)",
+                                             &e2e_pm, &use, l));
+        bench_e2e_job jd = {.scene = scene,
+                            .outdir = outdir,
+                            .target_noise_k = default_target_k,
+                            .threads = threads};
+        l = bench_load1();
+        st = bench_fork(bench_job_e2e, &jd, &e2e_def, sizeof e2e_def, &use, &err);
+        if (st != THZ_OK)
+            goto fail;
+        json_object_set_new(jpaper, "run_simulate_default",
+                            bench_report_e2e(small ? "the scene's default integrator, as `thzmap "
+                                                     "simulate SCENE` (--small: looser target)"
+                                                   : "the scene's default integrator, as `thzmap "
+                                                     "simulate SCENE`",
+                                             &e2e_def, &use, l));
     }
     json_object_set_new(root, "paper_case", jpaper);
 
@@ -460,31 +366,8 @@ int main(int argc, char **argv)
     st = bench_fork(bench_job_series, &js, &sp, sizeof sp, NULL, &err);
     if (st != THZ_OK)
         goto fail;
-    printf("\n3. Scaling in photons (channel %zu of the paper's case; load average %.2f)\n",
-           series_channel + 1, load_sp);
-    printf("  %12s %12s %10s %10s %10s %10s %12s\n", "photons", "stored", "phase s", "ns/photon",
-           "trace ns", "index ns", "CPU ns/ph.");
-    json_t *jsp = json_array();
-    for (int k = 0; k < sp.n; k++) {
-        const bench_point *p = &sp.p[k];
-        double ns = 1e9 * bench_ratio(p->s_photons, (double)p->photons);
-        printf("  %12llu %12llu %10.3f %10.1f %10.1f %10.1f %12.1f\n",
-               (unsigned long long)p->photons, (unsigned long long)p->stored, p->s_photons, ns,
-               1e9 * bench_ratio(p->s_tracing, (double)p->photons),
-               1e9 * bench_ratio(p->s_index, (double)p->photons),
-               1e9 * bench_ratio(p->cpu_photons, (double)p->photons));
-        json_t *o = json_object();
-        json_object_set_new(o, "photons", json_integer((json_int_t)p->photons));
-        json_object_set_new(o, "stored", json_integer((json_int_t)p->stored));
-        json_object_set_new(o, "seconds", bench_real(p->s_photons));
-        json_object_set_new(o, "seconds_tracing", bench_real(p->s_tracing));
-        json_object_set_new(o, "seconds_index", bench_real(p->s_index));
-        json_object_set_new(o, "ns_per_photon", bench_real(ns));
-        json_object_set_new(o, "cpu_ns_per_photon",
-                            bench_real(1e9 * bench_ratio(p->cpu_photons, (double)p->photons)));
-        json_array_append_new(jsp, o);
-    }
-    json_object_set_new(root, "scaling_photons", jsp);
+    json_object_set_new(root, "scaling_photons",
+                        bench_report_photons(&sp, series_channel, load_sp));
 
     /* 3b. Triangles. */
     bench_series tri;
@@ -572,42 +455,86 @@ int main(int argc, char **argv)
     json_object_set_new(root, "scaling_threads", jth);
 
     /* 4. Rendering. */
-    printf("\n4. Rendering (channel %zu of the paper's case)\n", series_channel + 1);
-    printf("  %12s %14s %10s %12s %12s\n", "stored", "photons/pixel", "render s", "gathers/s",
-           "us/pixel");
-    json_t *jren = json_array();
-    for (int k = 0; k < sp.n; k++) {
-        const bench_point *p = &sp.p[k];
-        double ppp = bench_ratio((double)p->stored, (double)p->pixels);
-        double gps = bench_ratio((double)p->samples, p->s_render);
-        double upp = 1e6 * bench_ratio(p->s_render, (double)p->pixels);
-        printf("  %12llu %14.1f %10.3f %12.3g %12.2f\n", (unsigned long long)p->stored, ppp,
-               p->s_render, gps, upp);
-        json_t *o = json_object();
-        json_object_set_new(o, "photons_stored", json_integer((json_int_t)p->stored));
-        json_object_set_new(o, "photons_per_pixel", bench_real(ppp));
-        json_object_set_new(o, "gathers", json_integer((json_int_t)p->samples));
-        json_object_set_new(o, "seconds", bench_real(p->s_render));
-        json_object_set_new(o, "gathers_per_s", bench_real(gps));
-        json_object_set_new(o, "us_per_pixel", bench_real(upp));
-        json_array_append_new(jren, o);
-    }
-    json_object_set_new(root, "rendering", jren);
+    json_object_set_new(root, "rendering", bench_report_rendering(&sp, series_channel));
 
-    /* Targets. */
+    /* 5. The integrators' 2-thread speed-ups, and 6. the time to a converged image. */
+    bench_speedup spd[3];
+    const char *integrators[3] = {"photon-map", "final-gather", "path"};
+    memset(spd, 0, sizeof spd);
+    double load_spd = bench_load1();
+    for (int i = 0; i < 3; i++) {
+        bench_speedup_job jj = {.scene = scene,
+                                .cfg = {.integrator = integrators[i],
+                                        .channel = series_channel,
+                                        .photons = i == 0 ? paper.photons_per_channel : fg_photons,
+                                        .estimates = speedup_estimates[i],
+                                        .passes = speedup_passes[i],
+                                        .renders = speedup_renders[i],
+                                        .sensor_columns = small_columns,
+                                        .threads = threads,
+                                        .repeats = repeats}};
+        st = bench_fork(bench_job_speedup, &jj, &spd[i], sizeof spd[i], NULL, &err);
+        if (st != THZ_OK)
+            goto fail;
+    }
+    json_object_set_new(
+        root, "integrator_speedups",
+        bench_report_speedups(integrators, spd, 3, series_channel, threads, load_spd));
+
+    const char *conv_names[2] = {"path", "final-gather"};
+    const double conv_limit_s[2] = {1.0, 5.0};
+    double conv_worst[2] = {0.0, 0.0};
+    json_t *jconv = json_object();
+    for (int i = 0; i < 2; i++) {
+        bench_converge cv;
+        bench_converge_job jc = {.scene = scene,
+                                 .integrator = conv_names[i],
+                                 .photons = i == 1 ? fg_photons : 0,
+                                 .estimates = {conv_estimates[i][0], conv_estimates[i][1]},
+                                 .sensor_columns = small_columns,
+                                 .threads = threads};
+        double l = bench_load1();
+        st = bench_fork(bench_job_converge, &jc, &cv, sizeof cv, NULL, &err);
+        if (st != THZ_OK)
+            goto fail;
+        json_object_set_new(jconv, conv_names[i],
+                            bench_report_converge(conv_names[i], &cv, converged_k, conv_limit_s[i],
+                                                  l, &conv_worst[i]));
+    }
+    json_object_set_new(root, "converged_image", jconv);
+
+    /* Targets: issue 19's first, then the older ones of issue 6. */
     printf("\nTargets%s\n", small ? " (--small: not meaningful)" : "");
     bench_targets t = {.list = json_array()};
-    double total = e2e ? e2e_r.s_total : paper.s_total;
-    /* Issue 19's targets first (the older ones of issue 6 after them). */
-    bench_target(&t, "paper's case end to end", total, "<=", 10, total <= 10, "s");
+    double total = e2e ? e2e_pm.s_total : paper.s_total;
+    bench_target(&t,
+                 e2e ? "paper's case (photon-map) end to end, thz_simulate"
+                     : "paper's case (photon-map) end to end, stage by stage",
+                 total, "<=", 10, total <= 10, "s", true);
     bench_target(&t, "photon phase / raw Embree, same rays (bounces incl.)", ratio_phase, "<=", 2,
-                 ratio_phase <= 2, "x");
-    bench_target(&t, "bytes per stored photon", bpp, "<=", 32, bpp <= 32.005, "B");
-    double peak_ratio = bench_ratio((double)paper_peak, (double)paper.largest_map_bytes);
-    bench_target(&t, "peak memory / photon map", peak_ratio, "<=", 1.5, peak_ratio <= 1.5, "x");
+                 ratio_phase <= 2, "x", true);
+    /* The speed-ups are issue 19's for 2 threads: with another count they are measured
+     * but do not show the target. */
+    char name[128];
+    snprintf(name, sizeof name, "photon phase speed-up, %d threads against 1", threads);
+    bench_target(&t, name, speedup, ">=", 1.85, speedup >= 1.85, "x", threads == 2);
+    for (int i = 0; i < 3; i++) {
+        double x = bench_ratio(spd[i].s_1, spd[i].s_all);
+        snprintf(name, sizeof name, "render speed-up, %d threads against 1: %s", threads,
+                 integrators[i]);
+        bench_target(&t, name, x, ">=", 1.85, x >= 1.85, "x", threads == 2);
+    }
+    for (int i = 0; i < 2; i++) {
+        snprintf(name, sizeof name, "%s: s per channel to %g K objects' RMS (worst; extrap.)",
+                 conv_names[i], converged_k);
+        bench_target(&t, name, conv_worst[i], "<=", conv_limit_s[i],
+                     conv_worst[i] <= conv_limit_s[i], "s", true);
+    }
+    bench_target(&t, "bytes per stored photon", bpp, "<=", 32, bpp <= 32.005, "B", true);
     /* Flatness and triangle growth from the CPU time per photon: the wall time of a point
      * also counts the time slices other processes took, which on a shared machine varies
-     * from point to point; CPU time does not (both are in the table and the JSON). */
+     * from point to point; CPU time does not (both are in the table and the JSON). The
+     * flatness is shown only over the whole 1 M..100 M. */
     double lo = 0, hi = 0, first = 0;
     for (int k = 0; k < sp.n; k++) {
         double ns = bench_ratio(sp.p[k].cpu_photons, (double)sp.p[k].photons);
@@ -617,34 +544,24 @@ int main(int argc, char **argv)
         hi = ns > hi ? ns : hi;
     }
     double dev = first > 0 ? (hi - first > first - lo ? hi / first - 1 : 1 - lo / first) : 0;
-    char flat_name[96];
-    snprintf(flat_name, sizeof flat_name, "CPU time per photon, %.3g M..%.3g M: largest deviation",
+    snprintf(name, sizeof name, "CPU time per photon, %.3g M..%.3g M: largest deviation",
              sp.n ? 1e-6 * (double)sp.p[0].photons : 0.0,
              sp.n ? 1e-6 * (double)sp.p[sp.n - 1].photons : 0.0);
-    bench_target(&t, flat_name, 100 * dev, "<=", 20, dev <= 0.2, "%");
+    bool whole = sp.n > 0 && sp.p[0].photons <= 1000000 && sp.p[sp.n - 1].photons >= 100000000;
+    bench_target(&t, name, 100 * dev, "<=", 20, dev <= 0.2, "%", whole);
+    double peak_ratio = bench_ratio((double)paper_peak, (double)paper.largest_map_bytes);
+    bench_target(&t, "peak memory / photon map (issue 6)", peak_ratio, "<=", 1.5, peak_ratio <= 1.5,
+                 "x", true);
     double tri_ratio =
         tri.n ? bench_ratio(
                     bench_ratio(tri.p[tri.n - 1].cpu_photons, (double)tri.p[tri.n - 1].photons),
                     bench_ratio(tri.p[0].cpu_photons, (double)tri.p[0].photons))
               : 0;
-    bench_target(&t, "CPU time per photon, 1 k..1 M triangles", tri_ratio, "<=", 3, tri_ratio <= 3,
-                 "x");
-    bench_target(&t, "photon phase speed-up on all threads", speedup, ">=", 1.85, speedup >= 1.85,
-                 "x");
+    bench_target(&t, "CPU time per photon, 1 k..1 M triangles (issue 6)", tri_ratio, "<=", 3,
+                 tri_ratio <= 3, "x", true);
     double render_share = bench_ratio(paper.s_render, paper.s_total);
-    bench_target(&t, "rendering share of the paper's case", 100 * render_share, "<=", 20,
-                 render_share <= 0.2, "%");
-    /* Issue 19's targets this harness does not measure (said, not hidden). */
-    const char *not_measured[] = {
-        "2-thread speed-up >= 1.85 x of every integrator (the photon phase's is above)",
-        "time to a converged image (RMS over the objects' pixels of the per-pixel noise, "
-        "0.05 K): path <= 1 s and final-gather <= 5 s per channel"};
-    json_t *jnm = json_array();
-    for (size_t k = 0; k < sizeof not_measured / sizeof *not_measured; k++) {
-        printf("  not measured here: %s\n", not_measured[k]);
-        json_array_append_new(jnm, json_string(not_measured[k]));
-    }
-    json_object_set_new(root, "targets_not_measured", jnm);
+    bench_target(&t, "rendering share of the paper's case (issue 6)", 100 * render_share, "<=", 20,
+                 render_share <= 0.2, "%", true);
     json_object_set_new(root, "targets", t.list);
     json_object_set_new(root, "targets_met", json_integer(t.met));
     json_object_set_new(root, "load_average_end", bench_real(bench_load1()));

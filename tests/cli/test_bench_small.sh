@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# The benchmark harness (bench/thzbench, issue 6) in its --small form, so that the
+# The benchmark harness (bench/thzbench, issues 6 and 19) in its --small form, so that the
 # harness itself cannot rot: it runs, prints its table, and writes JSON that parses and
-# has every section and field the README's table is made from. Asserts nothing about
-# speed. The thzbench binary sits next to thzmap in the build directory.
+# has every section and field the README's table is made from, with finite numbers, and
+# a verdict for every target of issue 19. Asserts nothing about speed. The thzbench
+# binary sits next to thzmap in the build directory.
 # usage: test_bench_small.sh THZMAP_BINARY REPO_DIR
 set -u
 thzmap=$1
@@ -20,13 +21,22 @@ cat "$tmp/out"
 grep -q '^Targets' "$tmp/out" || { echo "FAIL: no table of targets"; exit 1; }
 
 python3 - "$tmp/bench.json" <<'PY'
-import json, sys
+import json, math, sys
 with open(sys.argv[1]) as f:
     r = json.load(f)
 def need(obj, keys, where):
     for k in keys:
         if k not in obj:
             sys.exit(f"FAIL: {where} has no '{k}'")
+def finite(obj, keys, where, positive=False):
+    need(obj, keys, where)
+    for k in keys:
+        vals = obj[k] if isinstance(obj[k], list) else [obj[k]]
+        for v in vals:
+            if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v) \
+                    or (positive and v <= 0):
+                sys.exit(f"FAIL: {where}.{k} is {obj[k]!r}, not a finite"
+                         f"{' positive' if positive else ''} number")
 need(r, ["small", "threads", "load_average_start", "paper_case", "tracing_limit",
          "scaling_photons", "scaling_triangles", "scaling_threads", "rendering", "targets"], "root")
 assert r["small"] is True
@@ -55,8 +65,56 @@ for k, keys in [("scaling_photons", ["photons", "stored", "seconds", "ns_per_pho
 tri = [pt["triangles"] for pt in r["scaling_triangles"]]
 assert tri == sorted(tri) and tri[0] < tri[-1], tri
 need(r["scaling_threads"], ["seconds_1", "seconds_all", "speedup", "raw_speedup"], "scaling_threads")
-assert len(r["targets"]) == 8
+
+# End to end: the paper's method (photon-map, the stage-by-stage photon count) and the
+# scene's default integrator (path, no photons), each on its own.
+e = p["run_simulate"]
+finite(e, ["seconds", "cpu_seconds", "peak_memory_bytes"], "run_simulate", positive=True)
+assert e["integrator"] == "photon-map", e["integrator"]
+assert e["photons_fired"] == p["photons_fired"], (e["photons_fired"], p["photons_fired"])
+d = p["run_simulate_default"]
+finite(d, ["seconds", "worst_p95_stderr_k", "peak_memory_bytes"], "run_simulate_default",
+       positive=True)
+assert d["integrator"] == "path" and d["photons_fired"] == 0, d
+
+# The integrators' speed-ups: all three, measured on both sides.
+s = r["integrator_speedups"]
+assert [x["integrator"] for x in s["integrators"]] == ["photon-map", "final-gather", "path"]
+for x in s["integrators"]:
+    finite(x, ["seconds_1", "seconds_all", "speedup", "cpu_seconds_1", "cpu_seconds_all",
+               "samples"], "integrator_speedups", positive=True)
+    assert (x["map_photons"] > 0) == (x["integrator"] != "path"), x
+
+# Time to a converged image: per channel, two runs of growing work, finite noise figures
+# over the objects' pixels (the enclosure left out), finite extrapolated seconds.
+for name in ["path", "final-gather"]:
+    c = r["converged_image"][name]
+    assert c["enclosure"] == "box", c["enclosure"]
+    # --small renders this section on 16 x 16 pixels
+    assert 0 < c["object_pixels"] < c["pixels"] == 16 * 16, (c["object_pixels"], c["pixels"])
+    assert len(c["runs"]) == 2 and c["runs"][0]["estimates_per_pass"] < c["runs"][1]["estimates_per_pass"]
+    for run in c["runs"]:
+        finite(run, ["rms_stderr_k", "seconds_render"], name, positive=True)
+        finite(run, ["seconds_photons"], name, positive=(name == "final-gather"))
+        assert len(run["rms_stderr_k"]) == 6
+    assert len(c["channels"]) == 6
+    for ch in c["channels"]:
+        finite(ch, ["seconds_to_target", "ratio_to_limit"], name, positive=True)
+        finite(ch, ["exponent"], name)
+    finite(c, ["worst_seconds_to_target"], name, positive=True)
+
+# Every target with a finite value, its limit and a verdict; none left unmeasured.
+assert "targets_not_measured" not in r
+names = [t["target"] for t in r["targets"]]
+for want in ["end to end", "raw Embree", "photon phase speed-up", "render speed-up",
+             "photon-map", "final-gather", "path", "to 0.05 K", "bytes per stored photon",
+             "CPU time per photon, 0.01 M"]:
+    if not any(want in n for n in names):
+        sys.exit(f"FAIL: no target mentions '{want}': {names}")
+assert len(r["targets"]) == 13, len(r["targets"])
 for t in r["targets"]:
-    need(t, ["target", "value", "limit", "met"], "targets[]")
+    need(t, ["target", "limit", "met", "verdict"], "targets[]")
+    finite(t, ["value", "limit"], f"target '{t['target']}'")
+    assert t["verdict"] in ("met", "not met", "not shown"), t
 print("bench JSON ok")
 PY

@@ -1,0 +1,238 @@
+/* The benchmark's printed table and its JSON: see bench_report.h. */
+#include "bench_report.h"
+
+#include <math.h>
+#include <stdio.h>
+
+double bench_ratio(double a, double b)
+{
+    return b > 0.0 ? a / b : 0.0;
+}
+
+json_t *bench_real(double v)
+{
+    return isfinite(v) ? json_real(v) : json_null();
+}
+
+void bench_target(bench_targets *t, const char *name, double value, const char *op, double limit,
+                  bool met, const char *unit, bool shown)
+{
+    bench_verdict v = !shown ? BENCH_NOT_SHOWN : met ? BENCH_MET : BENCH_NOT_MET;
+    const char *word = v == BENCH_MET ? "met" : v == BENCH_NOT_MET ? "NOT met" : "not shown";
+    printf("  %-66s %10.3f %s %-6g %-3s %s\n", name, value, op, limit, unit, word);
+    json_t *o = json_object();
+    json_object_set_new(o, "target", json_string(name));
+    json_object_set_new(o, "value", bench_real(value));
+    json_object_set_new(o, "limit", bench_real(limit));
+    json_object_set_new(o, "comparison", json_string(op));
+    json_object_set_new(o, "unit", json_string(unit));
+    json_object_set_new(o, "met", json_boolean(v == BENCH_MET));
+    json_object_set_new(o, "verdict",
+                        json_string(v == BENCH_MET       ? "met"
+                                    : v == BENCH_NOT_MET ? "not met"
+                                                         : "not shown"));
+    json_array_append_new(t->list, o);
+    t->met += v == BENCH_MET;
+    t->total++;
+}
+
+json_t *bench_report_photons(const bench_series *sp, size_t channel, double load)
+{
+    printf("\n3. Scaling in photons (channel %zu of the paper's case; load average %.2f)\n",
+           channel + 1, load);
+    printf("  %12s %12s %10s %10s %10s %10s %12s\n", "photons", "stored", "phase s", "ns/photon",
+           "trace ns", "index ns", "CPU ns/ph.");
+    json_t *jsp = json_array();
+    for (int k = 0; k < sp->n; k++) {
+        const bench_point *p = &sp->p[k];
+        double ns = 1e9 * bench_ratio(p->s_photons, (double)p->photons);
+        printf("  %12llu %12llu %10.3f %10.1f %10.1f %10.1f %12.1f\n",
+               (unsigned long long)p->photons, (unsigned long long)p->stored, p->s_photons, ns,
+               1e9 * bench_ratio(p->s_tracing, (double)p->photons),
+               1e9 * bench_ratio(p->s_index, (double)p->photons),
+               1e9 * bench_ratio(p->cpu_photons, (double)p->photons));
+        json_t *o = json_object();
+        json_object_set_new(o, "photons", json_integer((json_int_t)p->photons));
+        json_object_set_new(o, "stored", json_integer((json_int_t)p->stored));
+        json_object_set_new(o, "seconds", bench_real(p->s_photons));
+        json_object_set_new(o, "seconds_tracing", bench_real(p->s_tracing));
+        json_object_set_new(o, "seconds_index", bench_real(p->s_index));
+        json_object_set_new(o, "ns_per_photon", bench_real(ns));
+        json_object_set_new(o, "cpu_ns_per_photon",
+                            bench_real(1e9 * bench_ratio(p->cpu_photons, (double)p->photons)));
+        json_array_append_new(jsp, o);
+    }
+    return jsp;
+}
+
+json_t *bench_report_rendering(const bench_series *sp, size_t channel)
+{
+    printf("\n4. Rendering (channel %zu of the paper's case)\n", channel + 1);
+    printf("  %12s %14s %10s %12s %12s\n", "stored", "photons/pixel", "render s", "gathers/s",
+           "us/pixel");
+    json_t *jren = json_array();
+    for (int k = 0; k < sp->n; k++) {
+        const bench_point *p = &sp->p[k];
+        double ppp = bench_ratio((double)p->stored, (double)p->pixels);
+        double gps = bench_ratio((double)p->samples, p->s_render);
+        double upp = 1e6 * bench_ratio(p->s_render, (double)p->pixels);
+        printf("  %12llu %14.1f %10.3f %12.3g %12.2f\n", (unsigned long long)p->stored, ppp,
+               p->s_render, gps, upp);
+        json_t *o = json_object();
+        json_object_set_new(o, "photons_stored", json_integer((json_int_t)p->stored));
+        json_object_set_new(o, "photons_per_pixel", bench_real(ppp));
+        json_object_set_new(o, "gathers", json_integer((json_int_t)p->samples));
+        json_object_set_new(o, "seconds", bench_real(p->s_render));
+        json_object_set_new(o, "gathers_per_s", bench_real(gps));
+        json_object_set_new(o, "us_per_pixel", bench_real(upp));
+        json_array_append_new(jren, o);
+    }
+    return jren;
+}
+
+json_t *bench_report_e2e(const char *label, const bench_e2e *e, const bench_usage *use, double load)
+{
+    char target[64] = "no noise target";
+    if (e->target_noise_k > 0.0)
+        snprintf(target, sizeof target, "noise target %g K (p95 over pixels)", e->target_noise_k);
+    printf("  end to end, %s\n    %s: %.3f s (load %.3f s); %llu photons fired, %llu stored; "
+           "passes per channel up to %u, %s, worst p95 %.3f K;\n    peak memory %.1f MB, %.1f "
+           "CPU s (%.2f cores on average; load average %.2f)\n",
+           label, e->integrator, e->s_total, e->s_load, (unsigned long long)e->fired,
+           (unsigned long long)e->stored, (unsigned)e->max_passes, target, e->worst_p95_stderr_k,
+           (double)use->peak_bytes / 1e6, use->cpu_s, bench_ratio(use->cpu_s, e->s_total), load);
+    json_t *je = json_object();
+    json_object_set_new(je, "integrator", json_string(e->integrator));
+    json_object_set_new(je, "seconds", bench_real(e->s_total));
+    json_object_set_new(je, "seconds_load", bench_real(e->s_load));
+    json_object_set_new(je, "photons_fired", json_integer((json_int_t)e->fired));
+    json_object_set_new(je, "photons_stored", json_integer((json_int_t)e->stored));
+    json_object_set_new(je, "max_passes", json_integer((json_int_t)e->max_passes));
+    json_object_set_new(je, "target_noise_k",
+                        e->target_noise_k > 0.0 ? bench_real(e->target_noise_k) : json_null());
+    json_object_set_new(je, "worst_p95_stderr_k", bench_real(e->worst_p95_stderr_k));
+    json_object_set_new(je, "peak_memory_bytes", json_integer((json_int_t)use->peak_bytes));
+    json_object_set_new(je, "cpu_seconds", bench_real(use->cpu_s));
+    json_object_set_new(je, "load_average", bench_real(load));
+    return je;
+}
+
+json_t *bench_report_speedups(const char *const *names, const bench_speedup *r, int n,
+                              size_t channel, int threads, double load)
+{
+    printf("\n5. Integrators: the render stage on 1 thread against %d (channel %zu of the "
+           "paper's case; one map built once per integrator; fastest of alternating runs; "
+           "load average %.2f)\n",
+           threads, channel + 1, load);
+    printf("  %-13s %11s %9s %7s %8s %9s %10s %10s %9s %13s\n", "integrator", "map photons",
+           "est./pass", "passes", "renders", "samples", "1 thread s", "all s", "speed-up",
+           "CPU s 1 / all");
+    json_t *arr = json_array();
+    for (int i = 0; i < n; i++) {
+        const bench_speedup *p = &r[i];
+        double sp = bench_ratio(p->s_1, p->s_all);
+        printf("  %-13s %11llu %9u %7u %8u %9llu %10.3f %10.3f %9.2f %6.2f / %5.2f\n", names[i],
+               (unsigned long long)p->photons, (unsigned)p->estimates, (unsigned)p->passes,
+               (unsigned)p->renders, (unsigned long long)p->samples, p->s_1, p->s_all, sp, p->cpu_1,
+               p->cpu_all);
+        json_t *o = json_object();
+        json_object_set_new(o, "integrator", json_string(names[i]));
+        json_object_set_new(o, "map_photons", json_integer((json_int_t)p->photons));
+        json_object_set_new(o, "map_stored", json_integer((json_int_t)p->stored));
+        json_object_set_new(o, "map_seconds", bench_real(p->s_map));
+        json_object_set_new(o, "estimates_per_pass", json_integer(p->estimates));
+        json_object_set_new(o, "passes", json_integer(p->passes));
+        json_object_set_new(o, "renders", json_integer(p->renders));
+        json_object_set_new(o, "samples", json_integer((json_int_t)p->samples));
+        json_object_set_new(o, "seconds_1", bench_real(p->s_1));
+        json_object_set_new(o, "seconds_all", bench_real(p->s_all));
+        json_object_set_new(o, "speedup", bench_real(sp));
+        json_object_set_new(o, "cpu_seconds_1", bench_real(p->cpu_1));
+        json_object_set_new(o, "cpu_seconds_all", bench_real(p->cpu_all));
+        json_array_append_new(arr, o);
+    }
+    printf("  (samples: sample rays of one timed run; CPU s below threads x wall s means the "
+           "run did not get its cores)\n");
+    json_t *root = json_object();
+    json_object_set_new(root, "channel", json_integer((json_int_t)channel + 1));
+    json_object_set_new(root, "threads", json_integer(threads));
+    json_object_set_new(root, "integrators", arr);
+    json_object_set_new(root, "load_average", bench_real(load));
+    return root;
+}
+
+static json_t *bench_reals(const double *v, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; i < n; i++)
+        json_array_append_new(a, bench_real(v[i]));
+    return a;
+}
+
+json_t *bench_report_converge(const char *integrator, const bench_converge *cv, double target_k,
+                              double limit_s, double load, double *worst_s)
+{
+    const bench_converge_point *a = &cv->pt[0], *b = &cv->pt[1];
+    printf("\n6. Time to a converged image, %s (%llu photons per channel; load average %.2f)\n",
+           integrator, (unsigned long long)cv->photons, load);
+    printf("  noise: RMS over the objects' pixels of the per-pixel standard error of Tb; "
+           "objects' pixels: truth object neither nothing nor the enclosure '%s' (the object "
+           "whose box holds all others), %llu of %llu pixels\n",
+           cv->enclosure, (unsigned long long)cv->object_pixels, (unsigned long long)cv->pixels);
+    printf("  %-9s | %-28s | %-28s | %8s %11s %8s\n", "", "", "", "", "extrapolated", "");
+    printf("  %-9s | J=%-4u %7s %8s %8s | J=%-4u %7s %8s %8s | %8s %11s %8s\n", "channel",
+           (unsigned)a->estimates, "RMS K", "phot. s", "render s", (unsigned)b->estimates, "RMS K",
+           "phot. s", "render s", "exponent", "s to target", "/ limit");
+    json_t *chans = json_array();
+    *worst_s = 0.0;
+    for (size_t c = 0; c < cv->channels; c++) {
+        double s = bench_converge_seconds(cv, c, target_k);
+        double k = bench_converge_exponent(cv, c);
+        *worst_s = s > *worst_s ? s : *worst_s;
+        printf(
+            "  %5.3f THz | %-6s %7.4f %8.3f %8.3f | %-6s %7.4f %8.3f %8.3f | %8.2f %11.3f %8.2f\n",
+            cv->freq_thz[c], "", a->rms_k[c], a->s_photons[c], a->s_render[c], "", b->rms_k[c],
+            b->s_photons[c], b->s_render[c], k, s, bench_ratio(s, limit_s));
+        json_t *o = json_object();
+        json_object_set_new(o, "frequency_thz", bench_real(cv->freq_thz[c]));
+        json_object_set_new(o, "seconds_to_target", bench_real(s));
+        json_object_set_new(o, "ratio_to_limit", bench_real(bench_ratio(s, limit_s)));
+        json_object_set_new(o, "exponent", bench_real(k));
+        json_array_append_new(chans, o);
+    }
+    printf("  seconds to %g K per channel extrapolated, not run: the J=%u run's render time x "
+           "(RMS / %g K)^2, plus its photon phase (noise proportional to 1/sqrt(render "
+           "time): exponent -0.5; the exponent column is the two runs' own)\n",
+           target_k, (unsigned)b->estimates, target_k);
+    printf("  worst channel %.3f s against %g s: %.2f x the limit\n", *worst_s, limit_s,
+           bench_ratio(*worst_s, limit_s));
+    json_t *runs = json_array();
+    for (int k = 0; k < 2; k++) {
+        const bench_converge_point *p = &cv->pt[k];
+        json_t *o = json_object();
+        json_object_set_new(o, "estimates_per_pass", json_integer(p->estimates));
+        json_object_set_new(o, "passes", json_integer(1));
+        json_object_set_new(o, "seconds_wall", bench_real(p->s_wall));
+        json_object_set_new(o, "rms_stderr_k", bench_reals(p->rms_k, cv->channels));
+        json_object_set_new(o, "seconds_photons", bench_reals(p->s_photons, cv->channels));
+        json_object_set_new(o, "seconds_render", bench_reals(p->s_render, cv->channels));
+        json_array_append_new(runs, o);
+    }
+    json_t *root = json_object();
+    json_object_set_new(root, "integrator", json_string(integrator));
+    json_object_set_new(root, "photons_per_channel", json_integer((json_int_t)cv->photons));
+    json_object_set_new(root, "target_k", bench_real(target_k));
+    json_object_set_new(root, "limit_seconds_per_channel", bench_real(limit_s));
+    json_object_set_new(root, "enclosure", json_string(cv->enclosure));
+    json_object_set_new(root, "pixels", json_integer((json_int_t)cv->pixels));
+    json_object_set_new(root, "object_pixels", json_integer((json_int_t)cv->object_pixels));
+    json_object_set_new(root, "method",
+                        json_string("extrapolated: render time x (rms / target)^2 from the "
+                                    "larger run, plus its photon phase"));
+    json_object_set_new(root, "runs", runs);
+    json_object_set_new(root, "channels", chans);
+    json_object_set_new(root, "worst_seconds_to_target", bench_real(*worst_s));
+    json_object_set_new(root, "worst_ratio_to_limit", bench_real(bench_ratio(*worst_s, limit_s)));
+    json_object_set_new(root, "load_average", bench_real(load));
+    return root;
+}

@@ -1,0 +1,54 @@
+/* The benchmark's printed table and its JSON (bench/thzbench.c): the targets list, and
+ * sections that are tables of their own (photon scaling, rendering, end to end, the
+ * integrators' 2-thread speed-ups, time to a converged image), each printed to stdout and
+ * returned as JSON.
+ */
+#ifndef THZ_BENCH_REPORT_H
+#define THZ_BENCH_REPORT_H
+
+#include <stdbool.h>
+
+#include <jansson.h>
+
+#include "bench_child.h"
+#include "bench_measure.h"
+#include "bench_render.h"
+
+/* a / b, 0 when b is not positive. */
+double bench_ratio(double a, double b);
+/* A JSON number; NaN and infinities (which JSON cannot hold) become null. */
+json_t *bench_real(double v);
+
+/* A target's verdict. NOT_SHOWN: measured, but not over the whole range the target names
+ * (e.g. the photon scaling without its 100 M point), so neither met nor refuted. */
+typedef enum bench_verdict { BENCH_MET, BENCH_NOT_MET, BENCH_NOT_SHOWN } bench_verdict;
+
+typedef struct bench_targets {
+    json_t *list;
+    int met, total;
+} bench_targets;
+
+/* Prints one line of the targets table and appends it to t->list: name, value (unit),
+ * the comparison ("<=" or ">=") with limit, and the verdict: `met` unless `shown` is
+ * false (then "not shown"). */
+void bench_target(bench_targets *t, const char *name, double value, const char *op, double limit,
+                  bool met, const char *unit, bool shown);
+
+/* Section 3's photon scaling and section 4's rendering, from the same series. */
+json_t *bench_report_photons(const bench_series *sp, size_t channel, double load);
+json_t *bench_report_rendering(const bench_series *sp, size_t channel);
+
+/* One end-to-end run: a line under the label, and its JSON. */
+json_t *bench_report_e2e(const char *label, const bench_e2e *e, const bench_usage *use,
+                         double load);
+
+/* The integrators' speed-ups (n of them, names[i] the integrator of r[i]). */
+json_t *bench_report_speedups(const char *const *names, const bench_speedup *r, int n,
+                              size_t channel, int threads, double load);
+
+/* Time to a converged image of one integrator: per channel the two runs, the seconds to
+ * target_k (extrapolated) and their ratio to limit_s; *worst_s the largest over channels. */
+json_t *bench_report_converge(const char *integrator, const bench_converge *cv, double target_k,
+                              double limit_s, double load, double *worst_s);
+
+#endif
