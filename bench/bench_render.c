@@ -115,11 +115,12 @@ thz_status bench_measure_speedup(const char *scene_path, const bench_speedup_con
         if (s->render.integrator == INTEGRATOR_FINAL_GATHER)
             po.reference_temperature_k = scene_reference_temperature_k(s, cfg->channel);
         photon_stats ps;
+        memset(&ps, 0, sizeof ps);
         double t = bench_now_s();
         st = photon_phase_run(s, acc, cfg->channel, &po, &map, &ps, err);
         out->s_map = bench_now_s() - t;
-        out->photons = ps.fired;
-        out->stored = ps.stored;
+        out->photons = st == THZ_OK ? ps.fired : 0;
+        out->stored = st == THZ_OK ? ps.stored : 0;
     }
     out->estimates = render_estimates_per_pass(s);
     out->passes = cfg->passes;
