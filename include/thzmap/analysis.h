@@ -134,6 +134,8 @@ typedef struct thz_bands_options {
     double angle_range_deg; /* the viewing angle within +- this: the sensor turned about its
                                up axis around its look_at_m point (about its own position
                                when it gives a direction), 0 <= a <= 90 degrees; default 0 */
+    const char *root;       /* NULL (default), or the directory the scene and every file it names
+                               must lie under (thz_scene_load_within; thzmap serve --root) */
 } thz_bands_options;
 
 THZ_API void thz_bands_options_init(thz_bands_options *opt);

@@ -33,6 +33,12 @@ typedef struct thz_sequence thz_sequence;
  * the scene has no object named "person"`), and that every frame's scene loads (errors
  * name the frame). THZ_ERR_INPUT for bad input. *out owns the sequence. */
 THZ_API thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *err);
+/* The same confined to the directory `root` (NULL: not confined), as
+ * thz_scene_load_within (thzmap/scene.h): the sequence file, the scene files it names
+ * (absolute names refused, errors at their JSON path, e.g. `scenes[1]`) and every file
+ * those scenes name must lie under root; thz_sequence_frame_scene keeps to it too. */
+THZ_API thz_status thz_sequence_load_within(const char *path, const char *root, thz_sequence **out,
+                                            thz_error *err);
 THZ_API void thz_sequence_destroy(thz_sequence *seq);
 
 /* Frames over all sweep values; sweep values (1 without a sweep); frames per sweep value. */
@@ -56,7 +62,7 @@ THZ_API thz_status thz_sequence_frame(const thz_sequence *seq, size_t i, thz_fra
  * file paths are relative to the directory of the frame's scene file. */
 THZ_API size_t thz_sequence_frame_json(const thz_sequence *seq, size_t i, char *buf, size_t size);
 
-/* Loads frame i's scene (*out owns it). */
+/* Loads frame i's scene (*out owns it), within the sequence's root if it has one. */
 THZ_API thz_status thz_sequence_frame_scene(const thz_sequence *seq, size_t i, thz_scene **out,
                                             thz_error *err);
 

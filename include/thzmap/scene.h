@@ -25,6 +25,18 @@ THZ_API thz_status thz_scene_load(const char *path, thz_scene **out, thz_error *
  * (NULL: "<string>"). */
 THZ_API thz_status thz_scene_load_string(const char *json_text, const char *base_dir,
                                          const char *label, thz_scene **out, thz_error *err);
+/* Both confined to the directory `root` (NULL: not confined, as above), for a program
+ * that loads scenes on behalf of others (thzmap serve --root): every file the scene names
+ * (meshes, CSV tables, channel responses, line catalogues), and the scene file itself,
+ * must lie under root once symlinks are resolved, and is opened by that resolved path.
+ * A named file that is absolute, lies outside, or does not exist is refused with
+ * THZ_ERR_INPUT at the JSON path of the key naming it, in words that quote nothing of
+ * any file. Built-in data (the material library, the ITU tables) is not confined. */
+THZ_API thz_status thz_scene_load_within(const char *path, const char *root, thz_scene **out,
+                                         thz_error *err);
+THZ_API thz_status thz_scene_load_string_within(const char *json_text, const char *base_dir,
+                                                const char *label, const char *root,
+                                                thz_scene **out, thz_error *err);
 THZ_API void thz_scene_destroy(thz_scene *scene);
 
 /* The scene as a whole and its run settings (the `photons` and `render` blocks). */

@@ -30,7 +30,7 @@ class ThzBandsOptions(Structure):
                 ("paths_per_sample", c_uint32), ("has_seed", c_int), ("seed", c_uint64),
                 ("exhaustive_limit", c_uint64), ("relative_widths", POINTER(c_double)),
                 ("n_widths", c_size_t), ("thickness_range", c_double),
-                ("angle_range_deg", c_double)]
+                ("angle_range_deg", c_double), ("root", c_char_p)]
 
 
 class ThzBandsInfo(Structure):

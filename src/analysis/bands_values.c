@@ -208,7 +208,8 @@ static thz_status render_variant(thz_context *ctx, const char *text, const bands
 {
     thz_scene *scene = NULL;
     thz_image *img = NULL;
-    thz_status st = thz_scene_load_string(text, base_dir, s->scene_path, &scene, err);
+    thz_status st =
+        thz_scene_load_string_within(text, base_dir, s->scene_path, s->root, &scene, err);
     if (st != THZ_OK)
         return st;
     thz_run_settings rs;
@@ -472,7 +473,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     text = variant_text(root, s, is_class, VAR_NOMINAL, false, &changed);
     if (!text)
         goto nomem;
-    st = thz_scene_load_string(text, base_dir, s->scene_path, &scene, err);
+    st = thz_scene_load_string_within(text, base_dir, s->scene_path, s->root, &scene, err);
     if (st == THZ_OK)
         st = render_variant(ctx, text, s, base_dir, &nominal, err);
     free(text);

@@ -18,6 +18,7 @@
 
 typedef struct bands_setup {
     const char *scene_path;
+    const char *root;             /* NULL, or the directory its files are confined to */
     const double *candidates_thz; /* n_candidates centres (repeated once per width) */
     const double *widths;         /* n_candidates relative widths (FWHM / centre) */
     size_t n_candidates;

@@ -17,6 +17,7 @@ enum { BANDS_MAX_CANDIDATES = 4096 };
 
 struct thz_bands {
     char *scene_path, *scene_name, *sensor;
+    char *root; /* thz_bands_options.root, copied; NULL: not confined */
     double from_thz, to_thz, step_ghz;
     double *candidates_thz; /* per candidate: its centre (c = centre * n_widths + width) */
     double *widths;         /* per candidate: its relative width */
@@ -52,6 +53,7 @@ void thz_bands_destroy(thz_bands *b)
     if (!b)
         return;
     free(b->scene_path);
+    free(b->root);
     free(b->scene_name);
     free(b->sensor);
     free(b->candidates_thz);
@@ -191,7 +193,7 @@ static thz_status resolve_scene(thz_bands *b, const thz_bands_options *o, thz_er
 {
     thz_scene *scene = NULL;
     thz_atm *atm = NULL;
-    thz_status st = thz_scene_load(b->scene_path, &scene, err);
+    thz_status st = thz_scene_load_within(b->scene_path, b->root, &scene, err);
     if (st != THZ_OK)
         return st;
     thz_scene_info info;
@@ -296,13 +298,14 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
     b->n_widths = o->n_widths ? o->n_widths : 1;
     n *= b->n_widths;
     b->scene_path = thz_strdup(scene_path);
+    b->root = thz_strdup(o->root);
     b->candidates_thz = thz_calloc(n, sizeof *b->candidates_thz);
     b->widths = thz_calloc(n, sizeof *b->widths);
     b->group = thz_calloc(n, sizeof *b->group);
     b->width_list = thz_calloc(b->n_widths, sizeof *b->width_list);
     b->netd_k = thz_calloc(n, sizeof *b->netd_k);
-    if (!b->scene_path || !b->candidates_thz || !b->widths || !b->group || !b->width_list ||
-        !b->netd_k) {
+    if (!b->scene_path || (o->root && !b->root) || !b->candidates_thz || !b->widths || !b->group ||
+        !b->width_list || !b->netd_k) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
         goto done;
     }
@@ -322,6 +325,7 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
         b->netd_k[c] = o->netd_k; /* resolve_netd or bands_values may replace it */
     }
     b->setup = (bands_setup){.scene_path = b->scene_path,
+                             .root = b->root,
                              .candidates_thz = b->candidates_thz,
                              .widths = b->widths,
                              .n_candidates = n,

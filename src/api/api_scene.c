@@ -26,8 +26,9 @@ static thz_status api_scene_checked(thz_status st, thz_scene **out, thz_error *e
     return st;
 }
 
-thz_status thz_scene_load_string(const char *json_text, const char *base_dir, const char *label,
-                                 thz_scene **out, thz_error *err)
+thz_status thz_scene_load_string_within(const char *json_text, const char *base_dir,
+                                        const char *label, const char *root, thz_scene **out,
+                                        thz_error *err)
 {
     if (!out)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_scene_load_string: no place for the scene");
@@ -36,12 +37,31 @@ thz_status thz_scene_load_string(const char *json_text, const char *base_dir, co
         return thz_error_set(err, THZ_ERR_INPUT, "thz_scene_load_string: no JSON text");
     }
     return api_scene_checked(
-        scene_load_string(json_text, base_dir, label ? label : "<string>", out, err), out, err);
+        scene_load_string_within(json_text, base_dir, label ? label : "<string>", root, out, err),
+        out, err);
+}
+
+thz_status thz_scene_load_string(const char *json_text, const char *base_dir, const char *label,
+                                 thz_scene **out, thz_error *err)
+{
+    return thz_scene_load_string_within(json_text, base_dir, label, NULL, out, err);
+}
+
+thz_status thz_scene_load_within(const char *path, const char *root, thz_scene **out,
+                                 thz_error *err)
+{
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_scene_load: no place for the scene");
+    if (!path) {
+        *out = NULL;
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_scene_load: no path");
+    }
+    return api_scene_checked(scene_load_within(path, root, out, err), out, err);
 }
 
 thz_status thz_scene_load(const char *path, thz_scene **out, thz_error *err)
 {
-    return api_scene_checked(scene_load(path, out, err), out, err);
+    return thz_scene_load_within(path, NULL, out, err);
 }
 
 thz_status thz_scene_get_info(const thz_scene *s, thz_scene_info *out)

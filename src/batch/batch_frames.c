@@ -25,6 +25,7 @@ void thz_sequence_destroy(thz_sequence *seq)
     free(seq->hash);
     free(seq->sweep_label);
     free(seq->path);
+    free(seq->root);
     for (size_t k = 0; k < seq->n_scenes; k++) {
         if (seq->scene_paths)
             free(seq->scene_paths[k]);
@@ -89,6 +90,6 @@ thz_status thz_sequence_frame_scene(const thz_sequence *seq, size_t i, thz_scene
     if (!seq || i >= seq->n_frames || !seq->frame_json[i])
         return thz_error_set(err, THZ_ERR_INPUT, "thz_sequence_frame_scene: no frame %zu", i);
     size_t k = batch_frame_scene(seq, i);
-    return thz_scene_load_string(seq->frame_json[i], seq->scene_dirs[k], seq->scene_paths[k], out,
-                                 err);
+    return thz_scene_load_string_within(seq->frame_json[i], seq->scene_dirs[k], seq->scene_paths[k],
+                                        seq->root, out, err);
 }

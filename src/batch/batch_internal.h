@@ -19,6 +19,7 @@
 
 struct thz_sequence {
     char *path;         /* the sequence file as given */
+    char *root;         /* NULL, or the real path its files are confined to (load_within) */
     size_t n_scenes;    /* scene files: 1 ("scene"), or the length of "scenes" */
     int scene_list;     /* "scenes": frame i of each sweep value is scene i */
     char **scene_paths; /* per scene file, resolved against the sequence's directory */
@@ -41,7 +42,8 @@ size_t batch_frame_scene(const thz_sequence *seq, size_t f);
  * label, the sequence file, and the JSON path) into seq's scene_paths, scene_dirs,
  * n_scenes and scene_list, and their documents into *docs (n_scenes; free with
  * batch_scenes_free, also after a failure). Refuses both keys, neither, an empty list,
- * and keyframes or frames with a list. */
+ * and keyframes or frames with a list; with seq->root, scene files outside it
+ * (load_file_check). */
 thz_status batch_scenes_load(const char *label, const json_t *root, const char *seq_dir,
                              thz_sequence *seq, json_t ***docs, thz_error *err);
 void batch_scenes_free(json_t **docs, size_t n);

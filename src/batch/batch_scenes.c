@@ -17,7 +17,8 @@
 enum { SCENES_MAX = 100000 };
 
 /* Resolves name against seq_dir into seq->scene_paths[k] and seq->scene_dirs[k] and
- * loads the file into docs[k]; where: its JSON path in the sequence ("scenes[2]"). */
+ * loads the file into docs[k] (its real path when confined to seq->root); where: its
+ * JSON path in the sequence ("scenes[2]"). */
 static thz_status scenes_load_one(const char *label, const char *seq_dir, const char *where,
                                   const char *name, thz_sequence *seq, size_t k, json_t **docs,
                                   thz_error *err)
@@ -29,16 +30,26 @@ static thz_status scenes_load_one(const char *label, const char *seq_dir, const 
     if (snprintf(path, sizeof path, "%s%s%s", name[0] == '/' ? "" : seq_dir,
                  name[0] == '/' ? "" : "/", name) >= (int)sizeof path)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: %s: path too long", label, where);
+    char *real = NULL;
+    const char *refusal = NULL;
+    thz_status st = load_file_check(name, path, seq->root, &real, &refusal);
+    if (st == THZ_ERR_INPUT)
+        return thz_error_set(err, st, "%s: %s: \"%s\" %s", label, where, name, refusal);
+    if (st != THZ_OK)
+        return thz_error_set(err, st, "%s: out of memory", label);
     seq->scene_paths[k] = thz_strdup(path);
     char *slash = strrchr(path, '/');
     if (slash)
         *slash = '\0';
     seq->scene_dirs[k] = thz_strdup(slash ? (path[0] ? path : "/") : ".");
-    if (!seq->scene_paths[k] || !seq->scene_dirs[k])
+    if (!seq->scene_paths[k] || !seq->scene_dirs[k]) {
+        free(real);
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", label);
+    }
     snprintf(what, sizeof what, "%s: %s: %s", label, where, seq->scene_paths[k]);
-    thz_status st =
-        load_json_file(seq->scene_paths[k], what, "scene", LOAD_MAX_SCENE_BYTES, &docs[k], err);
+    st = load_json_file(seq->scene_paths[k], real, what, "scene", LOAD_MAX_SCENE_BYTES, &docs[k],
+                        err);
+    free(real);
     if (st != THZ_OK)
         return st;
     if (!json_is_object(docs[k]))

@@ -429,21 +429,17 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
     if (i == 0 && !seq->sweep_label[s])
         seq->sweep_label[s] = thz_strdup(label);
     seq->frame_json[f] = json_dumps(doc, JSON_COMPACT);
-    uint64_t h = batch_hash_bytes(BATCH_HASH_INIT, "thzmap " THZ_VERSION_STRING,
-                                  sizeof("thzmap " THZ_VERSION_STRING) - 1);
-    if (seq->frame_json[f])
-        h = batch_hash_bytes(h, seq->frame_json[f], strlen(seq->frame_json[f]));
-    h = batch_hash_bytes(h, seq->scene_dirs[k], strlen(seq->scene_dirs[k]));
-    seq->hash[f] = batch_hash_files(b->file_hashes, seq->scene_dirs[k], doc, h);
-    json_decref(doc);
     char dir[64];
     if (seq->has_sweep)
         snprintf(dir, sizeof dir, "sweep-%02zu/frame-%05zu", s, i);
     else
         snprintf(dir, sizeof dir, "frame-%05zu", i);
     seq->frame_dir[f] = thz_strdup(dir);
-    if (!seq->frame_json[f] || !seq->frame_dir[f] || !seq->sweep_label[s])
+    if (!seq->frame_json[f] || !seq->frame_dir[f] || !seq->sweep_label[s]) {
+        json_decref(doc);
         return thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
+    }
+    /* loaded (and so confined to seq->root) before the hash reads the files it names */
     thz_scene *scene = NULL;
     thz_status st = thz_sequence_frame_scene(seq, f, &scene, b->err);
     thz_scene_destroy(scene);
@@ -453,6 +449,14 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
     else if (st != THZ_OK && b->err)
         thz_error_prefix(b->err, "%s: frame %zu (%s%st = %g s): ", b->label, i, label,
                          label[0] ? ", " : "", time_s);
+    if (st == THZ_OK) {
+        uint64_t h = batch_hash_bytes(BATCH_HASH_INIT, "thzmap " THZ_VERSION_STRING,
+                                      sizeof("thzmap " THZ_VERSION_STRING) - 1);
+        h = batch_hash_bytes(h, seq->frame_json[f], strlen(seq->frame_json[f]));
+        h = batch_hash_bytes(h, seq->scene_dirs[k], strlen(seq->scene_dirs[k]));
+        seq->hash[f] = batch_hash_files(b->file_hashes, seq->scene_dirs[k], doc, h);
+    }
+    json_decref(doc);
     return st;
 }
 
@@ -499,7 +503,8 @@ static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_s
     return THZ_OK;
 }
 
-thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *err)
+thz_status thz_sequence_load_within(const char *path, const char *root_dir, thz_sequence **out,
+                                    thz_error *err)
 {
     *out = NULL;
     if (!path)
@@ -508,11 +513,23 @@ thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *er
     seq_build b = {
         .label = path, .err = err, .file_hashes = json_object(), .scene_name = "the scene"};
     json_t *root = NULL;
+    char *real = NULL;
+    const char *refusal = NULL;
     thz_status st = THZ_OK;
     if (!seq || !b.file_hashes)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     else
-        st = load_json_file(path, NULL, "sequence", LOAD_MAX_SCENE_BYTES, &root, err);
+        st = load_root_real(root_dir, &seq->root, err);
+    if (st == THZ_OK) {
+        st = load_file_confine(path, seq->root, &real, &refusal);
+        if (st == THZ_ERR_INPUT)
+            thz_error_set(err, st, "%s: the sequence file %s", path, refusal);
+        else if (st != THZ_OK)
+            thz_error_set(err, st, "out of memory");
+    }
+    if (st == THZ_OK)
+        st = load_json_file(path, real, NULL, "sequence", LOAD_MAX_SCENE_BYTES, &root, err);
+    free(real);
     json_t *keyframes = NULL;
     if (st == THZ_OK) {
         seq->path = thz_strdup(path);
@@ -553,4 +570,9 @@ thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *er
     }
     *out = seq;
     return THZ_OK;
+}
+
+thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *err)
+{
+    return thz_sequence_load_within(path, NULL, out, err);
 }

@@ -282,10 +282,16 @@ static thz_status load_begin(const char *path_or_label, const char *dir, thz_sce
     return THZ_OK;
 }
 
-static thz_status load_finish(thz_scene **scene, json_t *doc, thz_status st, thz_error *err)
+/* Loads the document into *scene; root (a real path or NULL) confines the files it names. */
+static thz_status load_finish(thz_scene **scene, json_t *doc, const char *root, thz_status st,
+                              thz_error *err)
 {
     if (st == THZ_OK) {
-        load_ctx ctx = {.label = (*scene)->path, .dir = (*scene)->dir, .scene = *scene, .err = err};
+        load_ctx ctx = {.label = (*scene)->path,
+                        .dir = (*scene)->dir,
+                        .root = root,
+                        .scene = *scene,
+                        .err = err};
         st = load_document(&ctx, doc);
     }
     json_decref(doc);
@@ -309,15 +315,19 @@ static thz_status load_syntax_error(const char *label, const char *what, const j
     return thz_error_set(err, THZ_ERR_INPUT, "%s: invalid JSON: %s", label, je->text);
 }
 
-thz_status load_json_file(const char *path, const char *label, const char *what, uint64_t max_bytes,
-                          json_t **out, thz_error *err)
+thz_status load_json_file(const char *path, const char *real, const char *label, const char *what,
+                          uint64_t max_bytes, json_t **out, thz_error *err)
 {
     *out = NULL;
+    if (!real)
+        real = path;
+    if (!label)
+        label = path;
     /* a FIFO or device would block the open or never end (core/file.h) */
-    thz_status st = file_check_regular(path, label, max_bytes, NULL, err);
+    thz_status st = file_check_regular(real, label, max_bytes, NULL, err);
     if (st != THZ_OK)
         return st;
-    FILE *f = fopen(path, "rb");
+    FILE *f = fopen(real, "rb");
     if (!f && errno == ENOMEM)
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while opening the %s", path,
                              what);
@@ -331,36 +341,69 @@ thz_status load_json_file(const char *path, const char *label, const char *what,
     return *out ? THZ_OK : load_syntax_error(path, what, &je, oom, err);
 }
 
-thz_status scene_load(const char *path, thz_scene **out, thz_error *err)
+thz_status scene_load_within(const char *path, const char *root, thz_scene **out, thz_error *err)
 {
     *out = NULL;
     thz_error_clear(err);
-    json_t *doc;
-    thz_status st = load_json_file(path, NULL, "scene", LOAD_MAX_SCENE_BYTES, &doc, err);
-    if (st != THZ_OK)
-        return st;
-    char *copy = thz_strdup(path);
-    if (!copy) {
-        json_decref(doc);
-        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    char *root_real = NULL, *real = NULL;
+    const char *refusal = NULL;
+    json_t *doc = NULL;
+    thz_status st = load_root_real(root, &root_real, err);
+    if (st == THZ_OK) {
+        st = load_file_confine(path, root_real, &real, &refusal);
+        if (st == THZ_ERR_INPUT)
+            thz_error_set(err, st, "%s: the scene file %s", path, refusal);
+        else if (st != THZ_OK)
+            thz_error_set(err, st, "out of memory");
     }
-    st = load_begin(path, dirname(copy), out, err);
+    if (st == THZ_OK)
+        st = load_json_file(path, real, NULL, "scene", LOAD_MAX_SCENE_BYTES, &doc, err);
+    free(real);
+    char *copy = st == THZ_OK ? thz_strdup(path) : NULL;
+    if (st == THZ_OK && !copy)
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    if (st == THZ_OK) {
+        st = load_begin(path, dirname(copy), out, err);
+        st = load_finish(out, doc, root_real, st, err);
+    } else {
+        json_decref(doc);
+    }
     free(copy);
-    return load_finish(out, doc, st, err);
+    free(root_real);
+    return st;
 }
 
-thz_status scene_load_string(const char *json_text, const char *base_dir, const char *label,
-                             thz_scene **out, thz_error *err)
+thz_status scene_load(const char *path, thz_scene **out, thz_error *err)
+{
+    return scene_load_within(path, NULL, out, err);
+}
+
+thz_status scene_load_string_within(const char *json_text, const char *base_dir, const char *label,
+                                    const char *root, thz_scene **out, thz_error *err)
 {
     *out = NULL;
     thz_error_clear(err);
     if (!label)
         label = "<scene>";
+    char *root_real = NULL;
+    thz_status st = load_root_real(root, &root_real, err);
+    if (st != THZ_OK)
+        return st;
     json_error_t je;
     bool oom = false;
     json_t *doc = load_json_parse(NULL, json_text, &je, &oom);
-    if (!doc)
+    if (!doc) {
+        free(root_real);
         return load_syntax_error(label, "scene", &je, oom, err);
-    thz_status st = load_begin(label, base_dir ? base_dir : ".", out, err);
-    return load_finish(out, doc, st, err);
+    }
+    st = load_begin(label, base_dir ? base_dir : ".", out, err);
+    st = load_finish(out, doc, root_real, st, err);
+    free(root_real);
+    return st;
+}
+
+thz_status scene_load_string(const char *json_text, const char *base_dir, const char *label,
+                             thz_scene **out, thz_error *err)
+{
+    return scene_load_string_within(json_text, base_dir, label, NULL, out, err);
 }

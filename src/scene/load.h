@@ -1,6 +1,7 @@
 /* Shared by the JSON loader's files (load.c: the document and its warnings; one file
  * per block: load_channels.c, load_materials.c, load_atmosphere.c, load_objects.c,
- * load_sensors.c, load_settings.c (photons and render); load_cursor.c: typed access),
+ * load_sensors.c, load_settings.c (photons and render); load_cursor.c: typed access;
+ * load_files.c: the files a scene names, confined to a root when one is set),
  * and by nothing else:
  * the only code that knows JSON. A "cursor" here is a JSON value together with its
  * path in the document (`objects[2].shape.radius_m`), which every content error
@@ -33,11 +34,12 @@ json_t *load_json_parse(FILE *f, const char *text, json_error_t *je, bool *out_o
 
 /* Reads the JSON document of the file at path as the scene loader does: a regular file
  * (no FIFO or device: core/file.h) of at most max_bytes, duplicate keys rejected,
- * parsed by load_json_parse. Errors name label (NULL: path) for the file checks and path
+ * parsed by load_json_parse. `real` (NULL: path) is what is opened: the real path
+ * load_file_confine checked. Errors name label (NULL: path) for the file checks and path
  * with line:column for syntax; running out of memory is THZ_ERR_NOMEM, "while parsing
  * WHAT". *out is the caller's. */
-thz_status load_json_file(const char *path, const char *label, const char *what, uint64_t max_bytes,
-                          json_t **out, thz_error *err);
+thz_status load_json_file(const char *path, const char *real, const char *label, const char *what,
+                          uint64_t max_bytes, json_t **out, thz_error *err);
 
 /* Long enough for any path a sane scene produces; longer ones are cut (messages only). */
 #define LOAD_PATH_MAX 512
@@ -45,6 +47,7 @@ thz_status load_json_file(const char *path, const char *label, const char *what,
 typedef struct load_ctx {
     const char *label; /* the scene file as named in messages */
     const char *dir;   /* relative file paths in the scene are relative to it */
+    const char *root;  /* NULL, or the real path every named file must lie under */
     thz_scene *scene;
     thz_error *err;
     /* what the atmosphere block gave (for the defaults and warnings that need objects) */
@@ -124,8 +127,27 @@ thz_status load_vector(load_ctx *ctx, const load_cursor *c, const char *key, siz
 thz_status load_choice(load_ctx *ctx, const load_cursor *c, const char *key,
                        const char *const *choices, bool required, size_t dflt, size_t *out);
 
-/* A path in the scene resolved against ctx->dir (absolute paths stay); malloc'd. */
-char *load_resolve_path(const load_ctx *ctx, const char *file);
+/* The files a scene or sequence names (load_files.c), the one place that resolves them
+ * and confines them to a root.
+ * load_file_confine: *real (malloc'd) is the file at path to open: path itself when root
+ * is NULL; else its real path (symlinks, "." and ".." resolved), which must be the root
+ * (a real path: load_root_real) or lie below it. Refused (THZ_ERR_INPUT, *refusal the
+ * reason, worded to follow the quoted name and to reveal nothing outside the root) when
+ * it lies outside, does not exist or does not resolve. THZ_ERR_NOMEM: out of memory.
+ * load_file_check: the same for a file another names as `name` (path: name resolved
+ * against the naming file's directory), refused also when name is absolute while root is
+ * set.
+ * load_root_real: the real path of root (NULL: none) into *real (malloc'd), or an input
+ * error when it is not a directory.
+ * load_file_path: name, given at cursor k of the scene, resolved against ctx->dir
+ * (absolute names stay; dir "." adds nothing) into *label (malloc'd, for messages) and
+ * checked within ctx->root into *path (malloc'd, to open); a refusal fails at k. */
+thz_status load_file_confine(const char *path, const char *root, char **real, const char **refusal);
+thz_status load_file_check(const char *name, const char *path, const char *root, char **real,
+                           const char **refusal);
+thz_status load_root_real(const char *root, char **real, thz_error *err);
+thz_status load_file_path(load_ctx *ctx, const load_cursor *k, const char *name, char **path,
+                          char **label);
 
 /* Member `key` of c, a file name, read as a CSV table. Errors name the JSON path and
  * the CSV file with its line and row. */

@@ -83,9 +83,10 @@ static thz_status load_lines(load_ctx *ctx, const load_cursor *c, thz_atmosphere
         const char *file = NULL;
         st = load_string(ctx, c, file_keys[i], false, NULL, &file);
         if (st == THZ_OK && file) {
-            paths[i] = load_resolve_path(ctx, file);
-            if (!paths[i])
-                st = thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+            load_cursor k = load_key(c, file_keys[i]);
+            char *label = NULL;
+            st = load_file_path(ctx, &k, file, &paths[i], &label);
+            free(label); /* the atmosphere's messages name the file it opens */
         }
     }
     if (st == THZ_OK) {

@@ -279,17 +279,6 @@ thz_status load_choice(load_ctx *ctx, const load_cursor *c, const char *key,
     return load_fail(ctx, &k, "expected one of %s, got \"%s\"", list, s);
 }
 
-char *load_resolve_path(const load_ctx *ctx, const char *file)
-{
-    if (file[0] == '/' || !ctx->dir || !ctx->dir[0] || strcmp(ctx->dir, ".") == 0)
-        return thz_strdup(file);
-    size_t n = strlen(ctx->dir) + strlen(file) + 2;
-    char *p = malloc(n);
-    if (p)
-        snprintf(p, n, "%s/%s", ctx->dir, file);
-    return p;
-}
-
 thz_status load_csv(load_ctx *ctx, const load_cursor *c, const char *key, csv_table *table)
 {
     const char *file = NULL;
@@ -299,12 +288,14 @@ thz_status load_csv(load_ctx *ctx, const load_cursor *c, const char *key, csv_ta
     load_cursor k = load_key(c, key);
     if (!file[0])
         return load_fail(ctx, &k, "expected a file name, got an empty string");
-    char *path = load_resolve_path(ctx, file);
-    if (!path)
-        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    char *path = NULL, *label = NULL;
+    st = load_file_path(ctx, &k, file, &path, &label);
+    if (st != THZ_OK)
+        return st;
     thz_error inner = {0};
-    st = csv_read(path, path, table, &inner);
+    st = csv_read(path, label, table, &inner);
     free(path);
+    free(label);
     if (st == THZ_ERR_INPUT)
         return load_fail(ctx, &k, "%s", inner.message);
     if (st != THZ_OK)

@@ -110,14 +110,14 @@ static thz_status load_shape(load_ctx *ctx, const load_cursor *c, thz_mesh *mesh
             st = load_fail(ctx, &k, "expected a mesh file name, got an empty string");
             break;
         }
-        char *path = load_resolve_path(ctx, file);
-        if (!path) {
-            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        char *path = NULL, *label = NULL;
+        st = load_file_path(ctx, &k, file, &path, &label);
+        if (st != THZ_OK)
             break;
-        }
         thz_error inner = {0};
-        st = mesh_import(path, path, mesh, &inner);
+        st = mesh_import(path, label, mesh, &inner);
         free(path);
+        free(label);
         if (st == THZ_ERR_INPUT)
             st = load_fail(ctx, &k, "%s", inner.message);
         else if (st != THZ_OK)

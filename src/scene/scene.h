@@ -166,6 +166,12 @@ thz_status scene_load(const char *path, thz_scene **out, thz_error *err);
 thz_status scene_load_string(const char *json_text, const char *base_dir, const char *label,
                              thz_scene **out, thz_error *err);
 
+/* Both with every file the scene names (and the scene file) confined to the directory
+ * root (NULL: not confined); = thz_scene_load_within, thz_scene_load_string_within. */
+thz_status scene_load_within(const char *path, const char *root, thz_scene **out, thz_error *err);
+thz_status scene_load_string_within(const char *json_text, const char *base_dir, const char *label,
+                                    const char *root, thz_scene **out, thz_error *err);
+
 /* An empty scene with the spec's defaults; NULL on allocation failure. */
 thz_scene *scene_create(void);
 void scene_destroy(thz_scene *scene);

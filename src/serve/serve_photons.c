@@ -80,7 +80,7 @@ static struct serve_photon_cache *serve_photon_map(serve_request *r, enum MHD_Re
     thz_error err = {0};
     thz_status status = c && ctx ? THZ_OK : THZ_ERR_NOMEM;
     if (status == THZ_OK)
-        status = thz_scene_load(scene, &c->scene, &err);
+        status = thz_scene_load_within(scene, s->root, &c->scene, &err);
     if (status == THZ_OK)
         status = thz_photons_load(ctx, c->scene, map, &c->photons, &err);
     thz_context_destroy(ctx);

@@ -120,7 +120,10 @@ static void serve_on_warning(void *user, const char *message)
 
 /* ---- running a job ----------------------------------------------------------------- */
 
-static thz_status serve_run_scene(thz_context *ctx, const serve_job *j, thz_error *err)
+/* The jobs load their scene or sequence within the root (thz_scene_load_within): a file
+ * it names outside the root fails the job before anything is written. */
+static thz_status serve_run_scene(thz_context *ctx, const serve *s, const serve_job *j,
+                                  thz_error *err)
 {
     thz_scene *scene = NULL;
     thz_photons *photons = NULL;
@@ -137,7 +140,7 @@ static thz_status serve_run_scene(thz_context *ctx, const serve_job *j, thz_erro
     settings.keep_photons = j->save_photon_map;
     thz_write_options write = {.photon_map = j->save_photon_map};
     long sensor = -1;
-    thz_status st = thz_scene_load(j->scene, &scene, err);
+    thz_status st = thz_scene_load_within(j->scene, s->root, &scene, err);
     if (st == THZ_OK)
         st = thz_output_open(j->out, &output, err);
     *cli_exit_guard() = output;
@@ -167,7 +170,7 @@ static thz_status serve_run_scene(thz_context *ctx, const serve_job *j, thz_erro
 static thz_status serve_run_batch(thz_context *ctx, serve_job_ctx *c, thz_error *err)
 {
     thz_sequence *seq = NULL;
-    thz_status st = thz_sequence_load(c->job->scene, &seq, err);
+    thz_status st = thz_sequence_load_within(c->job->scene, c->s->root, &seq, err);
     thz_batch_options opt = {.progress = serve_on_batch_progress,
                              .progress_user = c,
                              .no_movies = c->job->no_movies,
@@ -178,10 +181,12 @@ static thz_status serve_run_batch(thz_context *ctx, serve_job_ctx *c, thz_error 
     return st;
 }
 
-static thz_status serve_run_bands(thz_context *ctx, const serve_job *j, thz_error *err)
+static thz_status serve_run_bands(thz_context *ctx, const serve *s, const serve_job *j,
+                                  thz_error *err)
 {
     thz_bands_options opt;
     thz_bands_options_init(&opt);
+    opt.root = s->root;
     opt.count = j->count;
     if (j->from_thz > 0.0)
         opt.from_thz = j->from_thz;
@@ -216,8 +221,8 @@ static void serve_run_job(serve *s, serve_job *j)
         thz_context_set_progress(ctx, serve_on_progress, &c);
         thz_context_set_warning(ctx, serve_on_warning, &c);
         st = j->command == CMD_BATCH   ? serve_run_batch(ctx, &c, &err)
-             : j->command == CMD_BANDS ? serve_run_bands(ctx, j, &err)
-                                       : serve_run_scene(ctx, j, &err);
+             : j->command == CMD_BANDS ? serve_run_bands(ctx, s, j, &err)
+                                       : serve_run_scene(ctx, s, j, &err);
         thz_context_destroy(ctx);
     }
     pthread_mutex_lock(&s->lock);

@@ -215,7 +215,8 @@ enum MHD_Result serve_validate(serve_request *r)
     }
     thz_scene *scene = NULL;
     thz_error err = {0};
-    thz_status st = thz_scene_load_string(json_string_value(jtext), base, label, &scene, &err);
+    thz_status st = thz_scene_load_string_within(json_string_value(jtext), base, label, r->s->root,
+                                                 &scene, &err);
     json_t *errors = json_array(), *warnings = json_array();
     if (st != THZ_OK)
         json_array_append_new(errors, serve_scene_error(label, err.message));

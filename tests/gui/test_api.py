@@ -7,8 +7,8 @@ answers compared with the ENVI files the run wrote.
 
 usage: test_api.py THZMAP_BINARY REPO_DIR [--requests-only]
 
---requests-only: the endpoints that start no job (token, paths, limits, validation,
-materials), which fork nothing: the sanitizer build runs those (CMakeLists.txt says why
+--requests-only: the endpoints that start no job (token, paths, limits, validation, the
+files a scene names confined to the root, materials), which fork nothing: the sanitizer build runs those (CMakeLists.txt says why
 it runs no jobs).
 """
 import http.client
@@ -277,6 +277,69 @@ def test_validate(srv, scene):
     check(res and not res["ok"] and "sample.csv" in json.dumps(res["errors"]), "base_dir")
 
 
+MARKER = "OUTSIDE-MARKER-%d" % os.getpid()
+
+
+def write_outside(root):
+    """A table outside the root, its first line a marker no answer may contain, and a
+    symlink to it from inside; the scene files of the refused runs."""
+    outside = os.path.join(os.path.dirname(root), "outside.csv")
+    with open(outside, "w") as f:
+        f.write(MARKER + "\nfrequency_thz,reflectivity\n0.1,0.1\n2.0,0.2\n")
+    link = os.path.join(root, "s", "materials", "link.csv")
+    if not os.path.lexists(link):
+        os.symlink(outside, link)
+    return outside
+
+
+def test_confined(srv, root, scene):
+    """The files a scene names are confined to the root: a table named by '..', by an
+    absolute path or through a symlink is refused at its key, and nothing of it shows."""
+    outside = write_outside(root)
+    for name, why in (("../../outside.csv", "is outside the served root"),
+                      (outside, "is an absolute path"),
+                      ("materials/link.csv", "is outside the served root"),
+                      ("materials/missing.csv", "does not exist under the served root")):
+        bad = json.loads(json.dumps(scene))
+        bad["materials"]["table"]["file"] = name
+        st, _, data = srv.request("POST", "/api/validate",
+                                  json.dumps({"path": "s/scene.json", "text": json.dumps(bad)}))
+        res = json.loads(data) if st == 200 else None
+        e = res and res["errors"] and res["errors"][0]
+        check(e and not res["ok"] and e["json_path"] == "materials.table.file" and
+              why in e["message"] and name in e["message"], "validate %s: %r" % (name, res))
+        check(MARKER.encode() not in data and b"frequency_thz" not in data,
+              "validate %s: the answer quotes the file: %r" % (name, data[:300]))
+    # the same scene text naming the table inside validates
+    res = srv.json("POST", "/api/validate",
+                   body={"path": "s/scene.json", "text": json.dumps(scene)})
+    check(res and res["ok"], "validate inside: %r" % (res and res["errors"]))
+
+
+def test_runs_confined(srv, root, scene):
+    """Runs of a scene or sequence naming a file outside the root fail before writing."""
+    write_outside(root)
+    bad = json.loads(json.dumps(scene))
+    bad["materials"]["table"]["file"] = "../../outside.csv"
+    with open(os.path.join(root, "s", "outside-scene.json"), "w") as f:
+        json.dump(bad, f)
+    with open(os.path.join(root, "s", "outside-seq.json"), "w") as f:
+        json.dump({"format": "thzmap-sequence/1", "scene": "../../outside.csv"}, f)
+    runs = [srv.json("POST", "/api/runs", body={
+        "command": command, "scene": "s/" + file, "out": "out/refused-" + command,
+        "options": options}, status=202)
+        for command, file, options in (("simulate", "outside-scene.json", {}),
+                                       ("batch", "outside-seq.json", {"no_movies": True}),
+                                       ("bands", "outside-scene.json", {"count": 1}))]
+    for run in runs:
+        job = run and wait_state(srv, run["id"], ("done", "failed"))
+        check(job and job["state"] == "failed" and
+              "is outside the served root" in (job["error"] or "") and
+              MARKER not in json.dumps(job), "refused run: %r" % job)
+        check(not os.path.exists(os.path.join(root, "out", "refused-" + job["command"])),
+              "a refused run wrote %s" % job["command"])
+
+
 def test_materials(srv):
     lib = srv.json("GET", "/api/materials")
     check(lib and len(lib["materials"]) > 0, "material library")
@@ -367,6 +430,7 @@ def test_runs(srv, root):
     print("cancel took %.2f s" % (time.time() - t0))
     check(not os.path.exists(os.path.join(root, "out", "long")) and
           not os.path.exists(os.path.join(root, "out", "q")), "a cancelled run left output")
+    test_runs_confined(srv, root, json.load(open(os.path.join(root, "s", "scene.json"))))
     check(sorted(os.listdir(os.path.join(root, "out"))) == ["a", "b", "bands", "batch", "r"],
           "out/ holds %r" % os.listdir(os.path.join(root, "out")))
 
@@ -503,11 +567,12 @@ def main():
                              ("paths", lambda: test_paths(srv, root)),
                              ("limits", lambda: test_limits(srv)),
                              ("validate", lambda: test_validate(srv, scene)),
+                             ("confined", lambda: test_confined(srv, root, scene)),
                              ("materials", lambda: test_materials(srv)),
                              ("runs", lambda: test_runs(srv, root)),
                              ("results", lambda: test_results(srv, root)),
                              ("photons", lambda: test_photons(srv, scene))][
-                                 :5 if REQUESTS_ONLY else None]:
+                                 :6 if REQUESTS_ONLY else None]:
                 t = time.time()
                 fn()
                 print("%-10s %.2f s" % (name, time.time() - t), flush=True)
