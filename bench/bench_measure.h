@@ -13,6 +13,10 @@
 
 #include "core/error.h"
 
+/* Seconds on a monotonic clock, and CPU seconds of this process (all its threads). */
+double bench_now_s(void);
+double bench_cpu_s(void);
+
 /* 1. The paper's case, stage by stage (the stages of run_simulate, timed one by one). */
 typedef struct bench_paper {
     uint64_t photons_per_channel, channels, columns, rows, oversampling;

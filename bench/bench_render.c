@@ -1,5 +1,6 @@
 /* The integrators' measurements: see bench_render.h. */
 #include "bench_render.h"
+#include "bench_measure.h"
 
 #include <math.h>
 #include <stdbool.h>
@@ -18,20 +19,6 @@
 #include "sensor/render.h"
 #include "sensor/render_accum.h"
 #include "thzmap/thzmap.h"
-
-static double bench_now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double bench_cpu_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Sets the integrator by name and its estimates per pass (0: keep the scene's); one pass
  * per channel unless told otherwise (no noise target from the scene). */
