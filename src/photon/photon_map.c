@@ -311,8 +311,11 @@ static size_t photon_map_scan(photon_record *r, size_t count, size_t n_groups, i
 #else
     (void)threads;
 #endif
-    size_t *counts = thz_calloc((size_t)nt * n_groups + 1, sizeof *counts);
-    photon_bounds *boxes = thz_malloc_array((size_t)nt * n_groups + 1, sizeof *boxes);
+    /* Each thread's counts and boxes, written for every record, apart from the next
+     * thread's by a cache line at least (stride: n_groups + 8). */
+    const size_t stride = n_groups + 8;
+    size_t *counts = thz_calloc((size_t)nt * stride, sizeof *counts);
+    photon_bounds *boxes = thz_malloc_array((size_t)nt * stride, sizeof *boxes);
     size_t *first_bad = thz_malloc_array((size_t)nt, sizeof *first_bad);
     if (!counts || !boxes || !first_bad) {
         free(counts);
@@ -320,7 +323,7 @@ static size_t photon_map_scan(photon_record *r, size_t count, size_t n_groups, i
         free(first_bad);
         return SIZE_MAX;
     }
-    for (size_t g = 0; g < (size_t)nt * n_groups; g++)
+    for (size_t g = 0; g < (size_t)nt * stride; g++)
         for (int a = 0; a < 3; a++) {
             boxes[g].lo[a] = INFINITY;
             boxes[g].hi[a] = -INFINITY;
@@ -336,8 +339,8 @@ static size_t photon_map_scan(photon_record *r, size_t count, size_t n_groups, i
                hi = count / (size_t)n_threads * (size_t)(t + 1);
         if (t == n_threads - 1)
             hi = count;
-        size_t *cnt = counts + (size_t)t * n_groups;
-        photon_bounds *box = boxes + (size_t)t * n_groups;
+        size_t *cnt = counts + (size_t)t * stride;
+        photon_bounds *box = boxes + (size_t)t * stride;
         first_bad[t] = count;
         for (size_t i = lo; i < hi; i++) {
             photon_record *p = &r[i];
@@ -368,8 +371,8 @@ static size_t photon_map_scan(photon_record *r, size_t count, size_t n_groups, i
         if (t == 0)
             continue;
         for (size_t g = 0; g < n_groups; g++) {
-            const photon_bounds *b = &boxes[(size_t)t * n_groups + g];
-            group_count[g] += counts[(size_t)t * n_groups + g];
+            const photon_bounds *b = &boxes[(size_t)t * stride + g];
+            group_count[g] += counts[(size_t)t * stride + g];
             for (int a = 0; a < 3; a++) {
                 bounds[g].lo[a] = b->lo[a] < bounds[g].lo[a] ? b->lo[a] : bounds[g].lo[a];
                 bounds[g].hi[a] = b->hi[a] > bounds[g].hi[a] ? b->hi[a] : bounds[g].hi[a];

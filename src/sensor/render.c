@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdatomic.h>
 #include <omp.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -102,9 +103,11 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
     }
     batched = batched && acc->batch;
     /* per thread: the current pixel's n_est estimates, then its batch sums and Poisson
-     * variance */
-    size_t per_thread = n_est + PHOTON_MAP_BATCHES + 1;
-    double *scratch = thz_malloc_array((size_t)threads * per_thread, sizeof *scratch);
+     * variance; each thread's share on cache lines of its own (8 doubles), since they
+     * are written for every sample */
+    size_t per_thread = (n_est + PHOTON_MAP_BATCHES + 1 + 7) / 8 * 8;
+    double *scratch_mem = thz_malloc_array((size_t)threads * per_thread + 7, sizeof *scratch_mem);
+    double *scratch = scratch_mem ? scratch_mem + (8 - (uintptr_t)scratch_mem / 8 % 8) % 8 : NULL;
     if (!scratch)
         return thz_error_set(err, THZ_ERR_NOMEM,
                              "render: out of memory for %u estimates x %d "
@@ -209,7 +212,7 @@ cleanup:
         stats->paths = n_paths;
         stats->seconds = thz_now_s() - t0;
     }
-    free(scratch);
+    free(scratch_mem);
     return st;
 }
 

@@ -98,7 +98,9 @@ typedef struct render_poll {
     uint64_t done, total;
     double next_s;  /* thread 0 only */
     uint64_t calls; /* thread 0 only */
-    _Atomic int stop;
+    /* read by every thread for every pixel: on a cache line of its own, apart from
+     * what thread 0 writes (calls) */
+    _Alignas(64) _Atomic int stop;
 } render_poll;
 
 bool render_poll_stop(render_poll *poll);
