@@ -58,6 +58,20 @@ enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type,
     return ret;
 }
 
+enum MHD_Result serve_reply_fd(serve_request *r, const char *type, int fd, uint64_t size)
+{
+    struct MHD_Response *resp = MHD_create_response_from_fd64(size, fd);
+    if (!resp) {
+        close(fd);
+        return MHD_NO;
+    }
+    MHD_add_response_header(resp, "Content-Type", type);
+    serve_data_headers(resp);
+    enum MHD_Result ret = MHD_queue_response(r->conn, 200, resp);
+    MHD_destroy_response(resp);
+    return ret;
+}
+
 enum MHD_Result serve_reply_json(serve_request *r, unsigned status, json_t *json)
 {
     char *text =
@@ -100,13 +114,14 @@ enum MHD_Result serve_reply_bad_json(serve_request *r, const char *json_path, co
     return ret;
 }
 
-enum MHD_Result serve_reply_binary(serve_request *r, const void *data, size_t size,
+enum MHD_Result serve_reply_binary(serve_request *r, void *data, size_t size,
                                    const char *const *headers)
 {
-    struct MHD_Response *resp =
-        MHD_create_response_from_buffer(size, (void *)data, MHD_RESPMEM_MUST_COPY);
-    if (!resp)
+    struct MHD_Response *resp = MHD_create_response_from_buffer(size, data, MHD_RESPMEM_MUST_FREE);
+    if (!resp) {
+        free(data);
         return MHD_NO;
+    }
     MHD_add_response_header(resp, "Content-Type", "application/octet-stream");
     serve_data_headers(resp);
     for (size_t i = 0; headers && headers[i]; i += 2)

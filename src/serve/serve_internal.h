@@ -19,7 +19,7 @@
 #endif
 
 #define SERVE_MAX_BODY_BYTES (4u << 20)  /* request bodies; larger: 413 */
-#define SERVE_MAX_FILE_BYTES (64u << 20) /* GET /api/file; larger: 413 */
+#define SERVE_MAX_FILE_BYTES (64u << 20) /* the page's own files */
 #define SERVE_MAX_JOBS 64                /* queued and running jobs; more: 409 */
 #define SERVE_CUBE_CACHE 8               /* cubes kept open */
 
@@ -75,9 +75,13 @@ enum MHD_Result serve_reply_error(serve_request *r, unsigned status, const char 
 /* 400 with "path": the JSON path of the problem in the request body. */
 enum MHD_Result serve_reply_bad_json(serve_request *r, const char *json_path, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
-/* Binary data (application/octet-stream), copied; extra headers name/value pairs, NULL-ended. */
-enum MHD_Result serve_reply_binary(serve_request *r, const void *data, size_t size,
+/* Binary data (application/octet-stream) from malloc'd data, which the reply takes (and
+ * frees, also on failure): no copy; extra headers name/value pairs, NULL-ended. */
+enum MHD_Result serve_reply_binary(serve_request *r, void *data, size_t size,
                                    const char *const *headers);
+/* A whole file from its open descriptor fd (size bytes; the reply closes fd, also on
+ * failure): streamed, not read into memory. */
+enum MHD_Result serve_reply_fd(serve_request *r, const char *type, int fd, uint64_t size);
 /* The 404/403/500 for a thz_error of the library (input: 400). */
 enum MHD_Result serve_reply_thz_error(serve_request *r, const thz_error *err);
 

@@ -218,9 +218,7 @@ enum MHD_Result serve_cube_data(serve_request *r)
     pthread_mutex_unlock(&r->s->cache_lock);
     if (!copy)
         return serve_reply_error(r, 500, "out of memory");
-    ret = serve_reply_binary(r, copy, count * plane * sizeof *copy, NULL);
-    free(copy);
-    return ret;
+    return serve_reply_binary(r, copy, count * plane * sizeof *copy, NULL);
 }
 
 /* Reads DIR/SENSOR.QUANTITY.hdr's values at one pixel (all bands, up to max) into out;

@@ -205,18 +205,15 @@ enum MHD_Result serve_file_get(serve_request *r)
     enum MHD_Result ret = MHD_NO;
     if (!serve_path_arg(r, "path", true, path, &ret))
         return ret;
+    /* the descriptor of the checked path: what is sent is what was opened, streamed */
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
     struct stat st;
-    if (stat(path, &st) != 0 || !S_ISREG(st.st_mode))
+    if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        if (fd >= 0)
+            close(fd);
         return serve_reply_error(r, 400, "%s: not a file", path);
-    if ((uint64_t)st.st_size > SERVE_MAX_FILE_BYTES)
-        return serve_reply_error(r, 413, "%s: larger than %u bytes", path, SERVE_MAX_FILE_BYTES);
-    size_t size = 0;
-    char *data = serve_read_file(path, SERVE_MAX_FILE_BYTES, &size);
-    if (!data)
-        return serve_reply_error(r, 500, "%s: %s", path, strerror(errno));
-    ret = serve_reply(r, 200, serve_data_type(path), data, size);
-    free(data);
-    return ret;
+    }
+    return serve_reply_fd(r, serve_data_type(path), fd, (uint64_t)st.st_size);
 }
 
 /* Writes data to path through a temporary file in the same directory, renamed over it. */

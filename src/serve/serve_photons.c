@@ -1,6 +1,8 @@
 /* GET /api/photons and /api/photons/info: a saved photon map (.thzpm) read through the
- * library (thz_photons_load, which needs the scene it was made from) and sent as float32
- * records for the point cloud of the paper's Fig. 3. The last map read is kept. */
+ * library (thz_photons_load, which needs the scene it was made from) and sent for the
+ * point cloud of the paper's Fig. 3: as float32 records (format=records, the default), or
+ * as the page draws them (format=points: positions, then directions in 8 bits per axis,
+ * 15 bytes a photon instead of 32). The last map read is kept. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -125,12 +127,21 @@ enum MHD_Result serve_photons_info(serve_request *r)
     return ret;
 }
 
-/* Copies the photons of channel ch (of object `object`, or all when it is -1) into
- * out[8 * max], evenly strided over the `total` selected: min(total, max) of them,
- * which it returns. */
-static size_t serve_photon_copy(const thz_photons *ph, size_t ch, long object, size_t total,
-                                size_t max, float *out, thz_photon_point *buf)
+/* A unit vector's component as a signed normalised byte (-127..127 for -1..1). */
+static int8_t serve_snorm8(float v)
 {
+    float x = v < -1.0f ? -1.0f : v > 1.0f ? 1.0f : v;
+    return (int8_t)lrintf(127.0f * x);
+}
+
+/* Copies the photons of channel ch (of object `object`, or all when it is -1) into out,
+ * evenly strided over the `total` selected: min(total, max) of them, which it returns.
+ * Records: 8 floats each. Points: 3 floats each for the `max` positions, then 3 bytes of
+ * direction each (serve_snorm8) from byte 12 * max on. */
+static size_t serve_photon_copy(const thz_photons *ph, size_t ch, long object, size_t total,
+                                size_t max, bool points, float *out, thz_photon_point *buf)
+{
+    int8_t *dirs = (int8_t *)(out + 3 * (total < max ? total : max));
     size_t count = thz_photons_count(ph, ch), k = 0, taken = 0;
     for (size_t first = 0; first < count && taken < max; first += SERVE_PHOTON_CHUNK) {
         size_t n = thz_photons_points(ph, ch, first, SERVE_PHOTON_CHUNK, buf);
@@ -142,6 +153,13 @@ static size_t serve_photon_copy(const thz_photons *ph, size_t ch, long object, s
             k++;
             if (!take)
                 continue;
+            if (points) {
+                memcpy(out + 3 * taken, buf[i].position_m, 3 * sizeof *out);
+                for (int a = 0; a < 3; a++)
+                    dirs[3 * taken + (size_t)a] = serve_snorm8(buf[i].direction[a]);
+                taken++;
+                continue;
+            }
             float *o = out + SERVE_PHOTON_FLOATS * taken++;
             memcpy(o, buf[i].position_m, 3 * sizeof *o);
             memcpy(o + 3, buf[i].direction, 3 * sizeof *o);
@@ -156,7 +174,10 @@ enum MHD_Result serve_photons(serve_request *r)
 {
     enum MHD_Result ret = MHD_NO;
     const char *ch_arg = serve_arg(r, "channel"), *obj = serve_arg(r, "object");
-    const char *max_arg = serve_arg(r, "max");
+    const char *max_arg = serve_arg(r, "max"), *format = serve_arg(r, "format");
+    bool points = format && strcmp(format, "points") == 0;
+    if (format && !points && strcmp(format, "records") != 0)
+        return serve_reply_error(r, 400, "format=%s: expected records or points", format);
     char *end = NULL;
     long ch = ch_arg ? strtol(ch_arg, &end, 10) : -1;
     if (!ch_arg || !*ch_arg || *end || ch < 0)
@@ -186,10 +207,11 @@ enum MHD_Result serve_photons(serve_request *r)
     if (object < 0)
         total = count;
     size_t want = total < (size_t)max ? total : (size_t)max;
-    float *out = malloc(SERVE_PHOTON_FLOATS * want * sizeof *out + 1);
-    size_t taken =
-        buf && out ? serve_photon_copy(c->photons, (size_t)ch, object, total, (size_t)max, out, buf)
-                   : 0;
+    size_t bytes = points ? 15 * want : SERVE_PHOTON_FLOATS * want * sizeof(float);
+    float *out = malloc(bytes + 1);
+    size_t taken = buf && out ? serve_photon_copy(c->photons, (size_t)ch, object, total,
+                                                  (size_t)max, points, out, buf)
+                              : 0;
     pthread_mutex_unlock(&r->s->photon_lock);
     free(buf);
     if (!out || taken != want) {
@@ -200,7 +222,5 @@ enum MHD_Result serve_photons(serve_request *r)
     snprintf(sent, sizeof sent, "%zu", taken);
     snprintf(all, sizeof all, "%zu", total);
     const char *headers[] = {"X-Thzmap-Photons", sent, "X-Thzmap-Photons-Total", all, NULL};
-    ret = serve_reply_binary(r, out, SERVE_PHOTON_FLOATS * taken * sizeof *out, headers);
-    free(out);
-    return ret;
+    return serve_reply_binary(r, out, bytes, headers);
 }

@@ -230,6 +230,7 @@ enum MHD_Result serve_diff(serve_request *r)
                                  cols_s,
                                  NULL};
         ret = serve_reply_binary(r, tb_a, plane * sizeof *tb_a, headers);
+        tb_a = NULL; /* the reply's now */
     } else {
         ret = serve_reply_error(r, strstr(why, "memory") ? 500 : 400, "%s", why);
     }

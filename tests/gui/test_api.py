@@ -454,6 +454,17 @@ def test_photons(srv, scene):
         if not ok:
             check(False, "photon record %r" % ((x, y, z, dx, dy, dz, power, obj),))
             break
+    # the page's form: the same photons, positions then directions in signed bytes
+    st, h, pts = srv.request("GET", "/api/photons?format=points&path=out/a/photon-map.thzpm"
+                                    "&channel=1&object=target&max=100")
+    check(st == 200 and len(pts) == 15 * n, "points: %d, %d bytes for %d" % (st, len(pts), n))
+    for k, rec in enumerate(recs[:n] if len(pts) == 15 * n else []):
+        pos = struct.unpack_from("<3f", pts, 12 * k)
+        d = struct.unpack_from("<3b", pts, 12 * n + 3 * k)
+        if pos != rec[:3] or any(abs(d[a] / 127 - rec[3 + a]) > 0.5 / 127 + 1e-6 for a in range(3)):
+            check(False, "point %d: %r %r against record %r" % (k, pos, d, rec))
+            break
+    srv.json("GET", "/api/photons?format=xyz&path=out/a/photon-map.thzpm&channel=1", status=400)
     st, h, data = srv.request("GET", "/api/photons?path=out/a/photon-map.thzpm&channel=0")
     check(st == 200 and len(data) == 32 * info["channels"][0]["photons"], "all photons")
     srv.json("GET", "/api/photons?path=out/a/photon-map.thzpm&channel=5", status=404)

@@ -1,8 +1,8 @@
 // The photon map as a point cloud coloured by each photon's incoming direction (the
 // paper's Fig. 3): red, green, blue follow the direction's x, y, z (0.5 + 0.5·d).
-// /api/photons answers 8 float32 per photon: x, y, z (m), dx, dy, dz (direction of travel
-// as it arrived), power (W/Hz), object index.
-const STRIDE = 8;
+// /api/photons?format=points answers, for n photons, n × 3 float32 positions x, y, z (m),
+// then n × 3 signed bytes of the direction of travel as it arrived (−127..127 for −1..1):
+// 15 bytes a photon, drawn as they came.
 import * as THREE from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
 import { q, request } from "./api.js";
@@ -33,23 +33,22 @@ export class PhotonView {
   }
 
   async load(path, channel, object, max) {
-    let url = `/api/photons?path=${q(path)}&channel=${q(channel)}&max=${q(max)}`;
+    let url = `/api/photons?format=points&path=${q(path)}&channel=${q(channel)}&max=${q(max)}`;
     if (object) url += `&object=${q(object)}`;
     const t0 = performance.now();
     const response = await request(url);
-    const f = new Float32Array(await response.arrayBuffer());
+    const data = await response.arrayBuffer();
     this.total = Number(response.headers.get("X-Thzmap-Photons-Total")) || null;
     const t1 = performance.now();
-    const n = Math.floor(f.length / STRIDE);
+    const n = Math.floor(data.byteLength / 15);
     if (this.points) {
       this.scene.remove(this.points);
       this.points.geometry.dispose();
     }
-    // the records as they came: no copy, the colour computed on the GPU
-    const records = new THREE.InterleavedBuffer(f.subarray(0, n * STRIDE), STRIDE);
+    // the arrays as they came: no copy, the colour computed on the GPU
     const g = new THREE.BufferGeometry();
-    g.setAttribute("position", new THREE.InterleavedBufferAttribute(records, 3, 0));
-    g.setAttribute("direction", new THREE.InterleavedBufferAttribute(records, 3, 3));
+    g.setAttribute("position", new THREE.BufferAttribute(new Float32Array(data, 0, 3 * n), 3));
+    g.setAttribute("direction", new THREE.BufferAttribute(new Int8Array(data, 12 * n, 3 * n), 3, true));
     g.computeBoundingSphere();
     this.points = new THREE.Points(g, new THREE.ShaderMaterial({
       vertexShader: `attribute vec3 direction; varying vec3 colour;

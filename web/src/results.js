@@ -56,35 +56,31 @@ export class Results {
   }
 
   // an output directory: of one run, or of a batch (frame-NNNNN/, sweep-NN/frame-NNNNN/)
+  // what is in it comes from /api/outputs: its sensors and their cubes, summary.json, the
+  // photon map, a batch's frames (sweeps' included)
   async open(dir) {
     const seq = (this.openSeq = (this.openSeq || 0) + 1);
-    const entries = await this.browse(dir);
+    const [, outputs] = await Promise.all([this.browse(dir), getJSON(`/api/outputs?dir=${q(dir)}`)]);
     if (seq !== this.openSeq) return; // another directory was asked for meanwhile
-    const names = entries.map((e) => e.name);
-    const frames = names.filter((n) => /^frame-\d{5}$/.test(n)).sort();
-    const sweeps = names.filter((n) => /^sweep-\d{2}$/.test(n)).sort();
-    this.frames = frames.map((f) => join(dir, f));
-    for (const s of sweeps) {
-      const sub = await getJSON(`/api/files?dir=${q(join(dir, s))}`);
-      for (const e of (sub.entries || []).map((x) => x.name).filter((n) => /^frame-\d{5}$/.test(n)).sort()) {
-        this.frames.push(join(dir, `${s}/${e}`));
-      }
-    }
+    this.frames = outputs.frames.map((f) => join(dir, f));
     $("frames").hidden = this.frames.length === 0;
     if (this.frames.length) {
       $("frame").max = this.frames.length - 1;
       $("frame").value = 0;
       return this.openFrame(0);
     }
-    if (names.some((n) => n.endsWith(".brightness_temperature.hdr"))) return this.openRun(dir, names);
+    if (imageSensors(outputs).length) return this.openRun(dir, outputs);
     status(`${dir}: no images here`);
+  }
+
+  cubesOf(sensor) {
+    return this.outputs?.sensors.find((s) => s.name === sensor)?.cubes || [];
   }
 
   async openFrame(i) {
     const dir = this.frames[i];
     $("frame-name").textContent = `${dir.split("/").slice(-2).join("/")} (${i + 1}/${this.frames.length})`;
-    const listing = await getJSON(`/api/files?dir=${q(dir)}`);
-    return this.openRun(dir, (listing.entries || []).map((e) => e.name));
+    return this.openRun(dir, await getJSON(`/api/outputs?dir=${q(dir)}`));
   }
 
   play() {
@@ -102,19 +98,14 @@ export class Results {
     }, 600);
   }
 
-  async openRun(dir, names) {
+  async openRun(dir, outputs) {
     this.runDir = dir;
-    this.names = names;
-    const sensors = [...new Set(names.filter((n) => n.endsWith(".brightness_temperature.hdr"))
-      .map((n) => n.slice(0, -".brightness_temperature.hdr".length)))];
+    this.outputs = outputs;
+    const sensors = imageSensors(outputs);
     const keep = $("res-sensor").value;
     $("res-sensor").replaceChildren(...sensors.map((s) => new Option(s, s, false, s === keep)));
-    this.summary = null;
-    if (names.includes("summary.json")) {
-      this.summary = await getJSON(`/api/file?path=${q(join(dir, "summary.json"))}`).catch(() => null);
-    }
-    if (this.runDir !== dir) return; // another run was opened meanwhile
-    this.mapPath = names.includes("photon-map.thzpm") ? join(dir, "photon-map.thzpm") : null;
+    this.summary = outputs.summary;
+    this.mapPath = outputs.photon_map;
     if (!$("diff-a").value) $("diff-a").value = dir;
     await this.loadSensor();
   }
@@ -122,7 +113,7 @@ export class Results {
   async loadSensor() {
     const sensor = $("res-sensor").value;
     const base = join(this.runDir, sensor);
-    const present = QUANTITIES.filter((qn) => this.names.includes(`${sensor}.${qn}.hdr`));
+    const present = QUANTITIES.filter((qn) => this.cubesOf(sensor).includes(qn));
     const keep = $("res-quantity").value;
     $("res-quantity").replaceChildren(...present.map((qn) => new Option(qn.replace(/_/g, " "), qn, false, qn === keep)));
     const t0 = performance.now();
@@ -191,7 +182,7 @@ export class Results {
     const t0 = performance.now();
     const [row, col] = this.pixelOf(e, canvas, this.tb);
     const measured = $("res-quantity").value.startsWith("measured") &&
-      this.names.includes(`${$("res-sensor").value}.measured_brightness_temperature.hdr`);
+      this.cubesOf($("res-sensor").value).includes("measured_brightness_temperature");
     const tb = measured ? await loadCube(`${this.base}.measured_brightness_temperature`) : this.tb;
     const f = tb.freqThz;
     const y = [];
@@ -316,4 +307,9 @@ function paint(canvas, cube, values, lo, hi, map, ignore) {
     img.data[o + 3] = 255;
   }
   g.putImageData(img, 0, 0);
+}
+
+// the sensors of an /api/outputs answer that have brightness temperature images
+function imageSensors(outputs) {
+  return outputs.sensors.filter((s) => s.cubes.includes("brightness_temperature")).map((s) => s.name);
 }

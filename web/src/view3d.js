@@ -7,18 +7,17 @@ import { viridis } from "./colour.js";
 
 const flat = (a) => (a && Array.isArray(a[0]) ? a.flat() : a || []);
 
+// sensor: one of /api/validate's scene.sensors, as the library resolved it (position,
+// unit direction and up, horizontal angle of view, rows and columns): no defaults here.
 export function sensorCamera(sensor) {
-  const [cols, rows] = sensor.resolution || [64, 64];
-  const hfov = ((sensor.fov_deg || 40) * Math.PI) / 180;
+  const { columns: cols, rows } = sensor;
+  const hfov = (sensor.fov_deg * Math.PI) / 180;
   const vfov = 2 * Math.atan(Math.tan(hfov / 2) * (rows / cols));
   const cam = new THREE.PerspectiveCamera((vfov * 180) / Math.PI, cols / rows, 0.01, 1e4);
-  const pos = new THREE.Vector3(...(sensor.position_m || [0, 0, 0]));
+  const pos = new THREE.Vector3(...sensor.position_m);
   cam.position.copy(pos);
-  cam.up.set(...(sensor.up || [0, 0, 1]));
-  const target = sensor.look_at_m
-    ? new THREE.Vector3(...sensor.look_at_m)
-    : pos.clone().add(new THREE.Vector3(...(sensor.direction || [0, 1, 0])));
-  cam.lookAt(target);
+  cam.up.set(...sensor.up);
+  cam.lookAt(pos.clone().add(new THREE.Vector3(...sensor.direction)));
   cam.updateMatrixWorld();
   return cam;
 }
@@ -103,7 +102,7 @@ export class SceneView {
         this.group.add(lines);
       }
     });
-    (doc?.sensors || []).forEach((s, i) => this.group.add(frustum(s, i === this.selectedSensor)));
+    (info?.sensors || []).forEach((s, i) => this.group.add(frustum(s, i === this.selectedSensor)));
     this.legend();
     if (!this.framed && !box.isEmpty()) {
       const centre = box.getCenter(new THREE.Vector3());
@@ -182,7 +181,7 @@ export class SceneView {
     r.setScissorTest(false);
     r.clear();
     r.render(this.scene, this.camera);
-    const sensor = this.doc?.sensors?.[this.selectedSensor];
+    const sensor = this.info?.sensors?.[this.selectedSensor];
     if (!this.options.preview || !sensor) return;
     // the pinhole preview: what the sensor sees, its aspect, in the lower right corner
     const cam = sensorCamera(sensor);
