@@ -12,7 +12,8 @@
  * its tiles from the same photon map (rank 0 sends it), so that rank 0's run (images,
  * photon maps, statistics) is bit-identical to one process's with the same seed. The
  * other ranks call thz_mpi_serve (thz_mpi_serve_batch for a batch), which returns when
- * rank 0 destroys its context. Only rank 0 writes.
+ * rank 0 destroys its context. A batch deals whole frames to the ranks when it can, each
+ * computed alone and sent to rank 0 (docs/mpi.md "Batch frames"). Only rank 0 writes.
  */
 #ifndef THZMAP_MPI_H
 #define THZMAP_MPI_H
@@ -37,10 +38,13 @@ THZ_API thz_status thz_context_set_mpi(thz_context *ctx, thz_error *err);
 THZ_API thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene,
                                  const thz_run_settings *settings, thz_error *err);
 
-/* Ranks other than 0 of a batch (thz_batch_run on rank 0 with thz_context_set_mpi): for
- * each frame rank 0 runs, loads the frame's scene from seq (the same sequence file) and
- * serves its photon phases and render passes as thz_mpi_serve does, until rank 0 destroys
- * its context. */
+/* Ranks other than 0 of a batch (thz_batch_run on rank 0 with thz_context_set_mpi), until
+ * rank 0 destroys its context: when rank 0 deals whole frames (at least as many photon
+ * groups to run as ranks), computes this rank's frames alone on ctx's threads and sends
+ * each to rank 0, which writes them; else, for each frame rank 0 runs, loads the frame's
+ * scene from seq (the same sequence file) and serves its photon phases and render passes
+ * as thz_mpi_serve does. A frame that fails here is reported to rank 0 (whose
+ * thz_batch_run returns the failure) and this call keeps waiting for rank 0. */
 struct thz_sequence;
 THZ_API thz_status thz_mpi_serve_batch(thz_context *ctx, const struct thz_sequence *seq,
                                        thz_error *err);

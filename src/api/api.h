@@ -22,6 +22,7 @@ struct thz_context {
     thz_error last;        /* the last failure of a call that took this context */
     struct mpi_team *team; /* rank 0 of an MPI run (api_mpi.c), else NULL */
     uint64_t mpi_bytes;    /* the other ranks: bytes their finished team moved */
+    bool mpi_alone;        /* rank 0 while a batch deals frames: its runs share nothing */
 };
 
 /* Photon maps of every channel of a scene (a channel may have none). */
@@ -69,8 +70,26 @@ void api_mpi_release(thz_context *ctx);
  * serve, thz_mpi_serve_batch) for the runs that follow. Nothing when alone. */
 thz_status api_mpi_next_scene(thz_context *ctx, size_t scene, thz_error *err);
 
+/* Rank 0 of a batch dealing whole frames (docs/mpi.md "Batch frames"): the ranks of the
+ * context's team (1 when alone); api_mpi_deal sends every rank the list of frames to
+ * compute (each computes its share, batch_deal_serve) and makes rank 0's own runs share
+ * nothing until api_mpi_deal_end; api_mpi_receive takes rank `rank`'s next frame (*data
+ * malloc'd: run_pack's bytes after batch_deal.c's header, or when *status is not THZ_OK
+ * the error message). Nothing and THZ_OK when alone. */
+size_t api_mpi_ranks(const thz_context *ctx);
+thz_status api_mpi_deal(thz_context *ctx, const uint64_t *frames, size_t n, thz_error *err);
+void api_mpi_deal_end(thz_context *ctx);
+thz_status api_mpi_receive(thz_context *ctx, size_t rank, uint64_t *frame, thz_status *status,
+                           void **data, size_t *size, thz_error *err);
+
 /* run_options from a context and settings. */
 void api_run_options(const thz_context *ctx, const thz_run_settings *settings, run_options *opt);
+
+/* A run computed elsewhere (a batch frame dealt to another MPI rank), from run_pack's
+ * bytes (run/run_pack.h) for `scene` (borrowed, the frame's scene as this process loaded
+ * it): images and summary as the computing process had them, no photons. */
+thz_status api_run_unpack(const thz_scene *scene, const void *data, size_t size, thz_run **out,
+                          thz_error *err);
 
 /* Records a failure in ctx (may be NULL) and returns st. */
 thz_status api_done(thz_context *ctx, thz_status st, const thz_error *err);

@@ -4,8 +4,8 @@
 
 #ifdef THZ_HAVE_MPI
 #include "accel/accel.h"
+#include "batch/batch_internal.h"
 #include "mpi/mpi_team.h"
-#include "thzmap/batch.h"
 #endif
 
 int thz_mpi_supported(void)
@@ -83,6 +83,13 @@ thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene, const thz_run
     return api_done(ctx, st, err);
 }
 
+/* batch_deal_serve's way to rank 0: the team's result message. */
+static thz_status api_mpi_send_frame(void *user, uint64_t frame, thz_status status,
+                                     const void *data, size_t size, thz_error *err)
+{
+    return mpi_team_send_result(user, frame, status, data, size, err);
+}
+
 thz_status thz_mpi_serve_batch(thz_context *ctx, const thz_sequence *seq, thz_error *err)
 {
     thz_error local;
@@ -97,6 +104,15 @@ thz_status thz_mpi_serve_batch(thz_context *ctx, const thz_sequence *seq, thz_er
         st = mpi_team_serve(team, NULL, NULL, ctx ? ctx->threads : 0, &frame, err);
     }
     while (st == THZ_OK && frame != MPI_TEAM_STOPPED) {
+        if (frame == MPI_TEAM_DEALT) { /* whole frames: this rank's, then wait for the lead */
+            size_t n = 0;
+            const uint64_t *frames = mpi_team_dealt(team, &n);
+            st = batch_deal_serve(ctx, seq, frames, n, mpi_team_rank(team), mpi_team_size(team),
+                                  api_mpi_send_frame, team, err);
+            if (st == THZ_OK)
+                st = mpi_team_serve(team, NULL, NULL, ctx ? ctx->threads : 0, &frame, err);
+            continue;
+        }
         thz_scene *scene = NULL;
         st = thz_sequence_frame_scene(seq, (size_t)frame, &scene, err);
         if (st == THZ_OK)
@@ -110,9 +126,38 @@ thz_status thz_mpi_serve_batch(thz_context *ctx, const thz_sequence *seq, thz_er
     return api_done(ctx, st, err);
 }
 
+size_t api_mpi_ranks(const thz_context *ctx)
+{
+    return ctx && ctx->team ? mpi_team_size(ctx->team) : 1;
+}
+
+thz_status api_mpi_deal(thz_context *ctx, const uint64_t *frames, size_t n, thz_error *err)
+{
+    if (!ctx || !ctx->team)
+        return THZ_OK;
+    thz_status st = mpi_team_deal(ctx->team, frames, n, err);
+    ctx->mpi_alone = st == THZ_OK;
+    return st;
+}
+
+void api_mpi_deal_end(thz_context *ctx)
+{
+    if (ctx)
+        ctx->mpi_alone = false;
+}
+
+thz_status api_mpi_receive(thz_context *ctx, size_t rank, uint64_t *frame, thz_status *status,
+                           void **data, size_t *size, thz_error *err)
+{
+    if (!ctx || !ctx->team || rank == 0 || rank >= mpi_team_size(ctx->team))
+        return thz_error_set(err, THZ_ERR_INTERNAL, "MPI: no rank %zu to receive from", rank);
+    return mpi_team_receive_result(ctx->team, rank, frame, status, data, size, err);
+}
+
 thz_status api_mpi_next_scene(thz_context *ctx, size_t scene, thz_error *err)
 {
-    return ctx && ctx->team ? mpi_team_next_scene(ctx->team, scene, err) : THZ_OK;
+    return ctx && ctx->team && !ctx->mpi_alone ? mpi_team_next_scene(ctx->team, scene, err)
+                                               : THZ_OK;
 }
 
 uint64_t thz_context_mpi_bytes(const thz_context *ctx)
@@ -124,12 +169,12 @@ uint64_t thz_context_mpi_bytes(const thz_context *ctx)
 
 const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx)
 {
-    return ctx && ctx->team ? mpi_team_phase(ctx->team) : NULL;
+    return ctx && ctx->team && !ctx->mpi_alone ? mpi_team_phase(ctx->team) : NULL;
 }
 
 const struct render_team *api_mpi_render_team(const thz_context *ctx)
 {
-    return ctx && ctx->team ? mpi_team_render(ctx->team) : NULL;
+    return ctx && ctx->team && !ctx->mpi_alone ? mpi_team_render(ctx->team) : NULL;
 }
 
 void api_mpi_release(thz_context *ctx)
@@ -174,6 +219,37 @@ uint64_t thz_context_mpi_bytes(const thz_context *ctx)
 {
     (void)ctx;
     return 0;
+}
+
+size_t api_mpi_ranks(const thz_context *ctx)
+{
+    (void)ctx;
+    return 1;
+}
+
+thz_status api_mpi_deal(thz_context *ctx, const uint64_t *frames, size_t n, thz_error *err)
+{
+    (void)ctx;
+    (void)frames;
+    (void)n;
+    (void)err;
+    return THZ_OK;
+}
+
+void api_mpi_deal_end(thz_context *ctx)
+{
+    (void)ctx;
+}
+
+thz_status api_mpi_receive(thz_context *ctx, size_t rank, uint64_t *frame, thz_status *status,
+                           void **data, size_t *size, thz_error *err)
+{
+    (void)ctx;
+    (void)frame;
+    (void)status;
+    (void)data;
+    (void)size;
+    return thz_error_set(err, THZ_ERR_INTERNAL, "MPI: no rank %zu to receive from", rank);
 }
 
 const struct photon_phase_team *api_mpi_phase_team(const thz_context *ctx)

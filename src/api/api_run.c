@@ -6,6 +6,7 @@
 
 #include "api/api.h"
 #include "core/alloc.h"
+#include "run/run_pack.h"
 
 /* ---- images ------------------------------------------------------------------------- */
 
@@ -213,6 +214,27 @@ static thz_status api_run(thz_context *ctx, const thz_scene *scene, const thz_ph
     } else if (st == THZ_OK) {
         st = run_simulate(&run->effective, &opt, &run->rs, err);
     }
+    if (st == THZ_OK)
+        st = api_run_wrap(run, err);
+    if (st != THZ_OK) {
+        thz_run_destroy(run);
+        return st;
+    }
+    *out = run;
+    return THZ_OK;
+}
+
+thz_status api_run_unpack(const thz_scene *scene, const void *data, size_t size, thz_run **out,
+                          thz_error *err)
+{
+    *out = NULL;
+    thz_run *run = thz_calloc(1, sizeof *run);
+    if (!run)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    run->scene = scene;
+    thz_status st = api_effective_scene(scene, NULL, &run->effective, err);
+    if (st == THZ_OK)
+        st = run_unpack(&run->effective, data, size, &run->rs, err);
     if (st == THZ_OK)
         st = api_run_wrap(run, err);
     if (st != THZ_OK) {

@@ -2,7 +2,8 @@
  * what the files of src/batch/ share. batch_sequence.c loads and checks a sequence and
  * builds every frame's scene text, from the scene files batch_scenes.c loads;
  * batch_frames.c gives the frames out; batch_interp.c interpolates; batch_hash.c hashes
- * a frame's inputs; batch_run.c runs the frames and writes batch.json; batch_movie.c
+ * a frame's inputs; batch_run.c runs the frames and writes batch.json; batch_deal.c
+ * computes a frame and deals frames to MPI ranks; batch_movie.c
  * makes the movies from the frames' cubes, through batch_encode.c (the only file that
  * includes FFmpeg). Nothing here is public.
  */
@@ -103,6 +104,56 @@ void batch_photon_cache_keep(batch_photon_cache *c, size_t base, thz_scene **sce
 thz_status batch_render_reused(thz_context *ctx, const thz_sequence *seq, batch_photon_cache *c,
                                size_t base, const thz_scene *scene, thz_run **run, int *reused,
                                int *fired, thz_error *err);
+
+/* ---- batch_deal.c: frames computed apart from their writing; frames dealt to ranks -- */
+
+/* One frame on its way from its scene to its files. */
+typedef struct batch_frame {
+    thz_scene *scene; /* the frame's scene */
+    thz_run *run;     /* its run, once computed */
+    int reused;       /* rendered from its base frame's photons */
+    int fired;        /* fired photons: its own, or (resuming) its base's again */
+    int keep;         /* the next frame renders from its photons: keep scene and run */
+} batch_frame;
+
+/* Loads frame f's scene into *fr (emptied first) and decides, from its integrator and
+ * base[], whether it renders from its base's photons and whether its own are kept. */
+thz_status batch_frame_load(const thz_sequence *seq, const size_t *base, size_t f, batch_frame *fr,
+                            thz_error *err);
+/* Computes fr->run as one process does: `thzmap simulate` (keeping the photons when
+ * fr->keep), or `thzmap render` from the base's photons in cache (batch_render_reused,
+ * which updates fr->reused and fr->fired). */
+thz_status batch_frame_compute(thz_context *ctx, const thz_sequence *seq, const size_t *base,
+                               batch_photon_cache *cache, size_t f, batch_frame *fr,
+                               thz_error *err);
+/* After the frame is written or sent: its scene and run go into the cache when ok and
+ * fr->keep, else are freed; *fr is empty after. */
+void batch_frame_fini(batch_frame *fr, batch_photon_cache *cache, size_t f, int ok);
+
+/* The deal (docs/mpi.md "Batch frames"): the n frames (increasing) split into photon
+ * groups, the frames with the same base (consecutive in the list); group k goes to rank
+ * k mod members: owner[i] (may be NULL) for frames[i]. Returns the number of groups. */
+size_t batch_deal_owners(const size_t *base, const uint64_t *frames, size_t n, size_t members,
+                         size_t *owner);
+
+/* How a member's computed frame reaches rank 0: status THZ_OK and the frame's bytes, or
+ * the frame's failure and its message. */
+typedef thz_status (*batch_send_fn)(void *user, uint64_t frame, thz_status status, const void *data,
+                                    size_t size, thz_error *err);
+
+/* A member rank (`member` of `members`): computes its frames of the dealt list, in order,
+ * each alone on ctx's threads exactly as one process would, and sends each to rank 0.
+ * A frame that fails is sent as its failure (rank 0 reports it) and ends the loop with
+ * THZ_OK; only a failure to send returns an error. */
+thz_status batch_deal_serve(thz_context *ctx, const thz_sequence *seq, const uint64_t *frames,
+                            size_t n, size_t member, size_t members, batch_send_fn send_frame,
+                            void *send_user, thz_error *err);
+
+/* Rank 0: frame f from rank `rank` (its next one): fr's scene loaded here, its run from
+ * the received bytes; *seconds the time it took there, s. A failure the rank sent comes
+ * back as its status and message. */
+thz_status batch_deal_receive(thz_context *ctx, const thz_sequence *seq, size_t f, size_t rank,
+                              batch_frame *fr, double *seconds, thz_error *err);
 
 /* ---- batch_encode.c: one movie, frame by frame (the only code that includes FFmpeg) -- */
 

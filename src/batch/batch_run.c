@@ -3,7 +3,9 @@
  * frame's inputs; OUTDIR/batch.json rewritten (temporary file, then rename) after each
  * frame; the movies at the end, rebuilt from the frames' files. A frame directory whose
  * frame.json carries the frame's hash is finished and is not run again, which is all
- * that resuming a killed batch needs: a frame appears whole or not at all.
+ * that resuming a killed batch needs: a frame appears whole or not at all. Under MPI the
+ * pending frames are dealt to the ranks by photon groups when there are enough of them
+ * (batch_deal.c), and this process, rank 0, writes every frame in frame order.
  */
 #include <dirent.h>
 #include <errno.h>
@@ -31,6 +33,7 @@ typedef struct batch_state {
     frame_state *state;
     double *seconds;     /* per frame computed by this call, s */
     size_t *base;        /* per frame: the frame whose photons it renders from (batch_reuse.c) */
+    size_t *rank;        /* per frame: the MPI rank that computes it (0: this process) */
     int *reused_photons; /* per frame computed by this call: rendered from base's */
     batch_photon_cache cache; /* the photons of the current base frame */
     json_t *movies;           /* the movies' descriptions (batch.json "movies") */
@@ -275,74 +278,86 @@ static char *batch_frame_json(const thz_sequence *seq, size_t f, long reused_fro
     return text;
 }
 
-/* Whether frame f's scene uses photons, so that the frames after it can reuse them. */
-static int batch_uses_photons(const thz_scene *scene)
-{
-    thz_scene_info info;
-    return thz_scene_get_info(scene, &info) == THZ_OK &&
-           thz_integrator_needs_photons(info.integrator);
-}
-
-/* Runs frame f into its directory (atomically, with frame.json): as `thzmap simulate`
- * for a base frame (keeping its photons when the next frame reuses them), else as
- * `thzmap render` from its base frame's photons. */
+/* Runs frame f into its directory (atomically, with frame.json): computed here (as
+ * `thzmap simulate` for a base frame, keeping its photons when the next frame reuses them,
+ * else as `thzmap render` from its base frame's photons), or received from the MPI rank
+ * the frame was dealt to (b->rank[f] > 0), which computed it the same way. */
 static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, thz_error *err)
 {
     const thz_sequence *seq = b->seq;
     char dir[THZ_PATH_MAX];
     if (snprintf(dir, sizeof dir, "%s/%s", b->outdir, seq->frame_dir[f]) >= (int)sizeof dir)
         return thz_error_set(err, THZ_ERR_IO, "%s: path too long", b->outdir);
-    double t0 = batch_now_s();
-    thz_scene *scene = NULL;
+    double t0 = batch_now_s(), seconds = 0.0;
+    size_t rank = b->rank[f];
+    batch_frame fr = {0};
     thz_output *output = NULL;
-    thz_run *run = NULL;
     char *frame_json = NULL;
-    thz_status st = thz_sequence_frame_scene(seq, f, &scene, err);
-    int photons = st == THZ_OK && batch_uses_photons(scene);
-    int reuse = photons && b->base[f] != f;
-    int keep = photons && f + 1 < seq->n_frames && b->base[f + 1] == f;
-    if (st == THZ_OK) /* under MPI the other ranks serve this frame's scene */
+    thz_status st = rank == 0 ? batch_frame_load(seq, b->base, f, &fr, err) : THZ_OK;
+    if (st == THZ_OK && rank == 0) /* sharing within frames: the other ranks serve its scene */
         st = api_mpi_next_scene(ctx, f, err);
     if (st == THZ_OK)
         st = thz_output_open(dir, &output, err);
     thz_output **guard = b->opt ? b->opt->open_output : NULL;
     if (guard)
         *guard = output;
-    thz_run_settings settings;
-    thz_run_settings_init(&settings);
-    settings.keep_photons = keep;
-    int fired = !reuse;
-    if (st == THZ_OK && reuse)
-        st = batch_render_reused(ctx, seq, &b->cache, b->base[f], scene, &run, &reuse, &fired, err);
-    else if (st == THZ_OK)
-        st = thz_simulate(ctx, scene, &settings, &run, err);
+    if (st == THZ_OK)
+        st = rank == 0 ? batch_frame_compute(ctx, seq, b->base, &b->cache, f, &fr, err)
+                       : batch_deal_receive(ctx, seq, f, rank, &fr, &seconds, err);
     if (st == THZ_OK) {
-        frame_json = batch_frame_json(seq, f, reuse ? (long)b->base[f] : -1);
+        frame_json = batch_frame_json(seq, f, fr.reused ? (long)b->base[f] : -1);
         if (!frame_json)
             st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     }
     if (st == THZ_OK)
-        st = thz_output_add_run(ctx, output, run, NULL, err);
+        st = thz_output_add_run(ctx, output, fr.run, NULL, err);
     if (st == THZ_OK)
         st = thz_output_add_file(output, "frame.json", frame_json, strlen(frame_json), err);
     if (st == THZ_OK)
         st = thz_output_commit(output, err);
-    if (st == THZ_OK && keep)
-        batch_photon_cache_keep(&b->cache, f, &scene, &run);
     if (st == THZ_OK) {
-        b->reused_photons[f] = reuse;
-        b->fired += (size_t)fired;
-        b->rerendered += (size_t)reuse;
+        b->reused_photons[f] = fr.reused;
+        b->fired += (size_t)fr.fired;
+        b->rerendered += (size_t)fr.reused;
     }
     if (guard)
         *guard = NULL;
     thz_output_destroy(output);
-    thz_run_destroy(run);
-    thz_scene_destroy(scene);
+    batch_frame_fini(&fr, &b->cache, f, st == THZ_OK);
     free(frame_json);
-    b->seconds[f] = batch_now_s() - t0;
-    if (st != THZ_OK && st != THZ_ERR_CANCELLED && err)
-        thz_error_prefix(err, "%s: ", seq->frame_dir[f]);
+    b->seconds[f] = rank == 0 ? batch_now_s() - t0 : seconds;
+    if (st != THZ_OK && st != THZ_ERR_CANCELLED && err) {
+        if (rank == 0)
+            thz_error_prefix(err, "%s: ", seq->frame_dir[f]);
+        else
+            thz_error_prefix(err, "%s (MPI rank %zu): ", seq->frame_dir[f], rank);
+    }
+    return st;
+}
+
+/* Under MPI, with at least as many pending photon groups as ranks: deals the groups to the
+ * ranks (b->rank; docs/mpi.md "Batch frames") and tells them (*dealt = 1). Else every
+ * frame stays rank 0's, each shared with the other ranks (photon batches, pixel tiles). */
+static thz_status batch_deal(thz_context *ctx, batch_state *b, int *dealt, thz_error *err)
+{
+    *dealt = 0;
+    size_t ranks = api_mpi_ranks(ctx), nf = b->seq->n_frames, n = 0;
+    if (ranks < 2)
+        return THZ_OK;
+    uint64_t *pending = thz_calloc(nf ? nf : 1, sizeof *pending);
+    size_t *owner = thz_calloc(nf ? nf : 1, sizeof *owner);
+    thz_status st = pending && owner ? THZ_OK : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    for (size_t f = 0; st == THZ_OK && f < nf; f++)
+        if (b->state[f] == FRAME_PENDING)
+            pending[n++] = f;
+    if (st == THZ_OK && batch_deal_owners(b->base, pending, n, ranks, owner) >= ranks) {
+        st = api_mpi_deal(ctx, pending, n, err);
+        for (size_t i = 0; st == THZ_OK && i < n; i++)
+            b->rank[pending[i]] = owner[i];
+        *dealt = st == THZ_OK;
+    }
+    free(pending);
+    free(owner);
     return st;
 }
 
@@ -426,8 +441,9 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
     b.seconds = thz_calloc(seq->n_frames, sizeof *b.seconds);
     b.base = thz_calloc(seq->n_frames, sizeof *b.base);
     b.reused_photons = thz_calloc(seq->n_frames, sizeof *b.reused_photons);
-    int lock_fd = -1;
-    thz_status st = b.state && b.seconds && b.base && b.reused_photons
+    b.rank = thz_calloc(seq->n_frames, sizeof *b.rank);
+    int lock_fd = -1, dealt = 0;
+    thz_status st = b.state && b.seconds && b.base && b.reused_photons && b.rank
                         ? batch_photon_bases(seq, b.base, err)
                         : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     if (st == THZ_OK)
@@ -443,6 +459,8 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
         batch_clean_finished(&b);
     if (st == THZ_OK)
         st = batch_write_json(&b, err);
+    if (st == THZ_OK)
+        st = batch_deal(ctx, &b, &dealt, err);
     if (ctx) { /* the frames' runs report through batch_on_run_progress */
         b.run_progress = ctx->progress;
         b.run_progress_user = ctx->progress_user;
@@ -481,6 +499,8 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
         ctx->progress = b.run_progress;
         ctx->progress_user = b.run_progress_user;
     }
+    if (dealt)
+        api_mpi_deal_end(ctx);
     if (st == THZ_OK && !(opt && opt->no_movies)) {
         if (batch_report(opt, &b, seq->n_frames, "movie"))
             st = thz_error_set(err, THZ_ERR_CANCELLED, "cancelled");
@@ -515,6 +535,7 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
     free(b.seconds);
     free(b.base);
     free(b.reused_photons);
+    free(b.rank);
     if (lock_fd >= 0)
         close(lock_fd);
     return st;

@@ -13,7 +13,14 @@
 #include "core/alloc.h"
 #include "sensor/render_context.h"
 
-enum { TEAM_TAG_HEADER = 1, TEAM_TAG_RECORDS, TEAM_TAG_CHUNKS, TEAM_TAG_TILES };
+enum {
+    TEAM_TAG_HEADER = 1,
+    TEAM_TAG_RECORDS,
+    TEAM_TAG_CHUNKS,
+    TEAM_TAG_TILES,
+    TEAM_TAG_RESULT_HEADER,
+    TEAM_TAG_RESULT
+};
 
 /* MPI counts are int: larger payloads go in pieces of this many bytes. */
 #define TEAM_PIECE_BYTES ((size_t)1 << 30)
@@ -23,13 +30,23 @@ struct mpi_team {
     int rank, size;
     photon_phase_team phase; /* the lead's interfaces, impl = this team */
     render_team render;
-    uint64_t bytes; /* sent and received */
+    uint64_t bytes;  /* sent and received */
+    uint64_t *dealt; /* a member: the items the lead dealt last (mpi_team_deal) */
+    size_t n_dealt;
 };
 
 /* What the lead broadcasts: a phase to fire, a render channel to begin (the photon map's
- * records follow) or end, a render pass, another scene (batch frames), or the end of the
- * team's work. */
-enum { TEAM_PHASE, TEAM_STOP, TEAM_RENDER_BEGIN, TEAM_RENDER_PASS, TEAM_RENDER_END, TEAM_SCENE };
+ * records follow) or end, a render pass, another scene (batch frames), items dealt whole
+ * (batch frames: the list follows), or the end of the team's work. */
+enum {
+    TEAM_PHASE,
+    TEAM_STOP,
+    TEAM_RENDER_BEGIN,
+    TEAM_RENDER_PASS,
+    TEAM_RENDER_END,
+    TEAM_SCENE,
+    TEAM_DEAL
+};
 
 typedef struct team_message {
     uint64_t kind;
@@ -40,8 +57,15 @@ typedef struct team_message {
     uint64_t map_batches;      /* its photon_map_batches */
     double map_t0_k;           /* its reference temperature */
     uint64_t sensor, pass;     /* TEAM_RENDER_PASS */
-    uint64_t scene;            /* TEAM_SCENE: the caller's index of the next scene */
+    uint64_t scene;            /* TEAM_SCENE: the caller's index of the next scene; TEAM_DEAL:
+                                  the number of items dealt */
 } team_message;
+
+/* What a member sends before a dealt item's result: the item, the status (THZ_OK: the
+ * bytes are the result, else the error message) and the size of the bytes. */
+typedef struct team_result_header {
+    uint64_t item, status, size;
+} team_result_header;
 
 /* What a member sends first: the sizes of its share. */
 typedef struct team_header {
@@ -283,6 +307,7 @@ void mpi_team_destroy(mpi_team *team)
         team_bcast(team, &m);
     }
     MPI_Comm_free(&team->comm);
+    free(team->dealt);
     free(team);
 }
 
@@ -308,6 +333,74 @@ thz_status mpi_team_next_scene(mpi_team *team, uint64_t scene, thz_error *err)
     team_message m = {.kind = TEAM_SCENE, .scene = scene};
     int rc = team_bcast(team, &m);
     return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "broadcasting the next scene");
+}
+
+thz_status mpi_team_deal(mpi_team *team, const uint64_t *items, size_t n, thz_error *err)
+{
+    if (team->rank != 0)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "MPI: only the lead deals");
+    team_message m = {.kind = TEAM_DEAL, .scene = n};
+    int rc = team_bcast(team, &m);
+    if (rc == MPI_SUCCESS) /* read only: MPI does not write a root's buffer */
+        rc = team_bcast_bytes(team, (void *)items, n * sizeof *items);
+    return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "dealing the frames");
+}
+
+/* A member: TEAM_DEAL's list, into team->dealt. */
+static thz_status team_receive_deal(mpi_team *t, const team_message *m, thz_error *err)
+{
+    uint64_t *items = m->scene <= SIZE_MAX / sizeof *items
+                          ? thz_realloc_array(t->dealt, m->scene ? m->scene : 1, sizeof *items)
+                          : NULL;
+    if (!items)
+        return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for %llu dealt items",
+                             (unsigned long long)m->scene);
+    t->dealt = items;
+    t->n_dealt = (size_t)m->scene;
+    int rc = team_bcast_bytes(t, items, t->n_dealt * sizeof *items);
+    return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "receiving the dealt frames");
+}
+
+const uint64_t *mpi_team_dealt(const mpi_team *team, size_t *n)
+{
+    *n = team->n_dealt;
+    return team->dealt;
+}
+
+thz_status mpi_team_send_result(mpi_team *team, uint64_t item, thz_status status, const void *data,
+                                size_t size, thz_error *err)
+{
+    team_result_header h = {.item = item, .status = (uint64_t)status, .size = size};
+    int rc = team_move(team, &h, sizeof h, 0, TEAM_TAG_RESULT_HEADER, true);
+    if (rc == MPI_SUCCESS) /* read only: MPI does not write a send buffer */
+        rc = team_move(team, (void *)data, size, 0, TEAM_TAG_RESULT, true);
+    return rc == MPI_SUCCESS ? THZ_OK : team_error(err, rc, "sending a frame to rank 0");
+}
+
+thz_status mpi_team_receive_result(mpi_team *team, size_t rank, uint64_t *item, thz_status *status,
+                                   void **data, size_t *size, thz_error *err)
+{
+    *data = NULL;
+    *size = 0;
+    team_result_header h;
+    int rc = team_move(team, &h, sizeof h, (int)rank, TEAM_TAG_RESULT_HEADER, false);
+    if (rc != MPI_SUCCESS)
+        return team_error(err, rc, "receiving a frame's size");
+    char *bytes = h.size < SIZE_MAX ? thz_malloc_array((size_t)h.size + 1, 1) : NULL;
+    if (!bytes)
+        return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for a frame of %llu bytes",
+                             (unsigned long long)h.size);
+    rc = team_move(team, bytes, (size_t)h.size, (int)rank, TEAM_TAG_RESULT, false);
+    if (rc != MPI_SUCCESS) {
+        free(bytes);
+        return team_error(err, rc, "receiving a frame");
+    }
+    bytes[h.size] = '\0'; /* an error message is a string */
+    *item = h.item;
+    *status = (thz_status)h.status;
+    *data = bytes;
+    *size = (size_t)h.size;
+    return THZ_OK;
 }
 
 const render_team *mpi_team_render(const mpi_team *team)
@@ -457,7 +550,12 @@ thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *a
             *next_scene = m.scene;
             break;
         }
-        if (!scene && m.kind != TEAM_SCENE) {
+        if (m.kind == TEAM_DEAL && next_scene) {
+            st = team_receive_deal(team, &m, err);
+            *next_scene = MPI_TEAM_DEALT;
+            break;
+        }
+        if (!scene && m.kind != TEAM_SCENE && m.kind != TEAM_DEAL) {
             st = thz_error_set(err, THZ_ERR_INTERNAL, "MPI: a request before the first scene");
             break;
         }
@@ -481,6 +579,7 @@ thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *a
             team_render_fini(&render);
             break;
         case TEAM_SCENE:
+        case TEAM_DEAL:
             st = thz_error_set(err, THZ_ERR_INPUT,
                                "MPI: the lead runs several scenes (batch) while process %d "
                                "serves one (every process must run the same command)",

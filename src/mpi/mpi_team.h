@@ -60,6 +60,26 @@ thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *a
 #define MPI_TEAM_STOPPED UINT64_MAX
 thz_status mpi_team_next_scene(mpi_team *team, uint64_t scene, thz_error *err);
 
+/* Work dealt whole (batch frames, docs/mpi.md "Batch frames"): the lead's mpi_team_deal
+ * broadcasts n items (the caller's indices, the same list to every member); a member's
+ * mpi_team_serve (with next_scene) then returns THZ_OK with *next_scene = MPI_TEAM_DEALT
+ * and mpi_team_dealt gives the list (owned by the team, valid until the next serve).
+ * Each member computes the items the caller's rule gives it on its own, and sends each
+ * result (or its failure: a status and the message) to the lead with
+ * mpi_team_send_result, in its own order; the lead takes member r's next result with
+ * mpi_team_receive_result (waiting, polling, until r sends it). A member's send waits
+ * until the lead takes it. */
+#define MPI_TEAM_DEALT (UINT64_MAX - 1)
+thz_status mpi_team_deal(mpi_team *team, const uint64_t *items, size_t n, thz_error *err);
+const uint64_t *mpi_team_dealt(const mpi_team *team, size_t *n);
+/* status THZ_OK: data is the item's result; else data is the error message. */
+thz_status mpi_team_send_result(mpi_team *team, uint64_t item, thz_status status, const void *data,
+                                size_t size, thz_error *err);
+/* *data (malloc'd, *size bytes, followed by a '\0') is member `rank`'s next result, for
+ * `*item`, or when *status is not THZ_OK its error message. */
+thz_status mpi_team_receive_result(mpi_team *team, size_t rank, uint64_t *item, thz_status *status,
+                                   void **data, size_t *size, thz_error *err);
+
 /* Bytes this rank sent and received through the team so far. */
 uint64_t mpi_team_bytes(const mpi_team *team);
 

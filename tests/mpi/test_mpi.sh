@@ -3,8 +3,9 @@
 # the files of one process with the same seed (summary.json and batch.json aside: wall
 # times, threads, mpi_ranks), for 2 and 3 ranks of 1 thread and 2 ranks of 2 threads,
 # photon-map and final-gather (with the saved photon map; also an empty deviation map), photon passes (several shared
-# phases in one run), path with render passes, render from a saved map, and a batch of a
-# moving camera (fresh, and resumed under mpirun after losing a frame); only rank 0
+# phases in one run), path with render passes, render from a saved map, and a batch
+# (frames dealt whole by photon groups, fresh and resumed; one frame shared by the ranks;
+# a frame failing on rank 1 keeps the frames before it); only rank 0
 # writes; a failed or killed rank fails the run with a message and a non-zero exit, never
 # a hang, and leaves no OUTDIR.
 # Usage: bash test_mpi.sh THZMAP_BINARY REPO_DIR
@@ -139,8 +140,11 @@ mpi 2 "$THZMAP" simulate "$work/in/iso.json" -o "$work/iso2" --integrator final-
 same_run "$work/iso2" "$work/iso1" "2 ranks, final-gather from an empty deviation map"
 
 step "batch"
-# --- batch: frames shared by the ranks (a moving camera: frame 0 fires, 1-2 render
-# from its photons), then resumed under mpirun after losing frame 2 -----------------
+# --- batch: whole frames dealt to the ranks by photon groups (frames 0 and 1 fire, 2
+# fires and 3 renders from its photons: 3 groups), then resumed under mpirun after
+# losing frames 1 and 3 (2 groups for 2 ranks: rank 1 fires frame 2's photons again),
+# then after losing frame 3 (1 group for 3 ranks: rank 0 runs it, shared within the
+# frame); each against one process, byte for byte ---------------------------------------
 mkdir "$work/bt"
 cp "$REPO/tests/inputs/batch/scene.json" "$work/bt/"
 $PY - "$work/bt/scene.json" "$work/bt/seq.json" <<'PY'
@@ -149,9 +153,12 @@ s = json.load(open(sys.argv[1]))
 s["render"] = {"integrator": "photon-map"}
 s["photons"] = {"seed": 7, "per_channel": 20000}
 json.dump(s, open(sys.argv[1], "w"), indent=1)
-q = {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 2, "frames": 3,
-     "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [-0.3, -1.4, 0.9]}}},
-                   {"time_s": 1, "sensors": {"cam": {"position_m": [0.3, -1.4, 0.9]}}}]}
+q = {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 2, "frames": 4,
+     "keyframes": [{"time_s": 0, "objects": {"person": {"transform": {"translate_m": [-0.5, 0, 0.8]}}},
+                    "sensors": {"cam": {"position_m": [-0.3, -1.4, 0.9]}}},
+                   {"time_s": 1, "objects": {"person": {"transform": {"translate_m": [0.5, 0, 0.8]}}},
+                    "sensors": {"cam": {"position_m": [-0.3, -1.4, 0.9]}}},
+                   {"time_s": 1.5, "sensors": {"cam": {"position_m": [0.3, -1.4, 0.9]}}}]}
 json.dump(q, open(sys.argv[2], "w"))
 PY
 # Every file below $1 equals $2's (summary.json and batch.json: timings aside; $4 = 1:
@@ -185,25 +192,67 @@ PY
         *) cmp -s "$f" "$2/$r" || fail "$3: $r differs" ;;
         esac
     done < <(find "$1" -type f ! -name '.thzmap-batch-lock')
-    [ "$n" -ge 30 ] || fail "$3: only $n files compared"
+    [ "$n" -ge 40 ] || fail "$3: only $n files compared"
     [ "$(cd "$1" && find . -type f | sort)" = "$(cd "$2" && find . -type f | sort)" ] ||
         fail "$3: not the same files"
 }
+# mpi_ranks of each frame of $1 in frame order: 1 for a frame computed by one rank (dealt
+# whole), N for one the N ranks shared
+frame_ranks() {
+    local d
+    for d in "$1"/frame-*/; do ranks_of "$d"; done | tr '\n' ' ' | sed 's/ $//'
+}
+# the frames that fired photons, as batch.json says ($1), e.g. "0 1 2"
+fired_frames() {
+    $PY -c 'import json,sys; print(*[f["frame"] for f in json.load(open(sys.argv[1]))["frames"] if f.get("photons") == "fired"])' "$1"
+}
 "$THZMAP" batch "$work/bt/seq.json" -o "$work/bt1" --threads 1 --quiet > /dev/null ||
     fail "one process, batch: exit $?"
-mpi 3 "$THZMAP" batch "$work/bt/seq.json" -o "$work/bt3" --threads 1 --quiet > /dev/null ||
-    fail "3 ranks, batch: exit $?"
-same_batch "$work/bt3" "$work/bt1" "3 ranks, batch" 0
+[ "$(fired_frames "$work/bt1/batch.json")" = "0 1 2" ] && [ "$(ls -d "$work/bt1"/frame-* | wc -l)" = 4 ] ||
+    fail "test set-up: frames $(fired_frames "$work/bt1/batch.json") fire photons, not 0 1 2 (3 groups)"
+mpi 3 "$THZMAP" batch "$work/bt/seq.json" -o "$work/bt3" --threads 1 > "$work/bt3.out" 2>&1 ||
+    { fail "3 ranks, batch: exit $?"; cat "$work/bt3.out"; }
+same_batch "$work/bt3" "$work/bt1" "3 ranks, frames dealt" 0
 ls "$work/bt3"/*.mp4 > /dev/null 2>&1 || fail "3 ranks, batch: no movie"
-rm -rf "$work/bt3/frame-00002"
-mpi 2 "$THZMAP" batch "$work/bt/seq.json" -o "$work/bt3" --threads 1 --quiet > /dev/null ||
-    fail "2 ranks, resumed batch: exit $?"
-same_batch "$work/bt3" "$work/bt1" "2 ranks, batch resumed after losing frame 2" 1
-grep -q '"frames_reused": 2' "$work/bt3/batch.json" || fail "resumed batch: frames 0-1 not reused"
+[ "$(frame_ranks "$work/bt3")" = "1 1 1 1" ] ||
+    fail "3 ranks: frames not dealt whole (mpi_ranks per frame: $(frame_ranks "$work/bt3"))"
+rm -rf "$work/bt3/frame-00001" "$work/bt3/frame-00003"
+mpi 2 "$THZMAP" batch "$work/bt/seq.json" -o "$work/bt3" --threads 1 > "$work/bt2.out" 2>&1 ||
+    { fail "2 ranks, resumed batch: exit $?"; cat "$work/bt2.out"; }
+same_batch "$work/bt3" "$work/bt1" "2 ranks, frames 1 and 3 dealt after losing them" 1
+grep -q '"frames_reused": 2' "$work/bt3/batch.json" || fail "resumed batch: 2 frames not reused"
+[ "$(frame_ranks "$work/bt3")" = "1 1 1 1" ] ||
+    fail "resumed with 2 ranks: frames 1 and 3 not dealt (mpi_ranks: $(frame_ranks "$work/bt3"))"
+rm -rf "$work/bt3/frame-00003"
+mpi 3 "$THZMAP" batch "$work/bt/seq.json" -o "$work/bt3" --threads 1 > "$work/bt1s.out" 2>&1 ||
+    { fail "3 ranks, one frame to redo: exit $?"; cat "$work/bt1s.out"; }
+same_batch "$work/bt3" "$work/bt1" "3 ranks sharing frame 3 (1 group)" 1
+[ "$(frame_ranks "$work/bt3")" = "1 1 1 3" ] ||
+    fail "1 group for 3 ranks: frame 3 not shared by the 3 (mpi_ranks: $(frame_ranks "$work/bt3"))"
+
+# A frame that fails on rank 1 (frame 1 asks for 10^12 photons: refused for memory when it
+# runs): the run fails naming it, non-zero exit, frame 0 (rank 0's) stays committed.
+mkdir "$work/bf"
+$PY - "$work/bt/scene.json" "$work/bf" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+json.dump(s, open(f"{sys.argv[2]}/s0.json", "w"))
+s["photons"]["per_channel"] = 10**12
+json.dump(s, open(f"{sys.argv[2]}/s1.json", "w"))
+json.dump({"format": "thzmap-sequence/1", "scenes": ["s0.json", "s1.json"]},
+          open(f"{sys.argv[2]}/seq.json", "w"))
+PY
+mpi 2 "$THZMAP" batch "$work/bf/seq.json" -o "$work/bf/out" --threads 1 --quiet > "$work/bf.out" 2>&1
+rc=$?
+[ $rc != 0 ] && [ $rc != 124 ] || fail "a frame failing on rank 1: exit $rc"
+grep -q "frame-00001 (MPI rank 1)" "$work/bf.out" || { fail "rank 1's failure not said"; cat "$work/bf.out"; }
+[ -f "$work/bf/out/frame-00000/frame.json" ] || fail "a frame failing on rank 1: frame 0 not kept"
+[ ! -e "$work/bf/out/frame-00001" ] || fail "a frame failing on rank 1: frame 1 written"
+grep -q '"status": "failed"' "$work/bf/out/batch.json" || fail "a frame failing on rank 1: not failed in batch.json"
 
 step "only rank 0"
 # --- only rank 0 writes: nothing else beside the outputs -----------------------------
-extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3|pp1|pp2|re1|re2|pa1|pa3|pa3.out|in|iso1|iso2|iso2.out|bt|bt1|bt3')
+extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3|pp1|pp2|re1|re2|pa1|pa3|pa3.out|in|iso1|iso2|iso2.out|bt|bt1|bt3|bt3.out|bt2.out|bt1s.out|bf|bf.out')
 [ -z "$extra" ] || fail "files beside the outputs: $extra"
 
 
