@@ -98,6 +98,12 @@ THZ_API thz_status thz_photons_fire_channel(thz_context *ctx, const thz_scene *s
  * must outlive *out. */
 THZ_API thz_status thz_photons_load(thz_context *ctx, const thz_scene *scene, const char *path,
                                     thz_photons **out, thz_error *err);
+/* The same for channel `channel` alone (for a view of its photons: the other channels'
+ * records are checked and dropped, and hold no map, as after thz_photons_fire_channel;
+ * their statistics are read). THZ_ERR_INPUT when the scene has no such channel. */
+THZ_API thz_status thz_photons_load_channel(thz_context *ctx, const thz_scene *scene,
+                                            const char *path, size_t channel, thz_photons **out,
+                                            thz_error *err);
 /* Writes every channel's map to `path` (.thzpm, what `render` reads); THZ_ERR_INPUT
  * when a channel has no map. Writes the file directly (not staged). */
 THZ_API thz_status thz_photons_save(const thz_photons *photons, const char *path, thz_error *err);

@@ -1,4 +1,5 @@
 /* The photon phase as a handle: fire, load, save, merge, statistics. */
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -107,8 +108,9 @@ thz_status thz_photons_fire_channel(thz_context *ctx, const thz_scene *scene,
     return api_done(ctx, api_fire(ctx, scene, settings, channel, out, err), err);
 }
 
-thz_status thz_photons_load(thz_context *ctx, const thz_scene *scene, const char *path,
-                            thz_photons **out, thz_error *err)
+/* thz_photons_load of every channel (channel = SIZE_MAX) or of one. */
+static thz_status api_photons_load(thz_context *ctx, const thz_scene *scene, const char *path,
+                                   size_t channel, thz_photons **out, thz_error *err)
 {
     thz_error local;
     err = api_err(err, &local);
@@ -121,9 +123,12 @@ thz_status thz_photons_load(thz_context *ctx, const thz_scene *scene, const char
     thz_photons *ph = NULL;
     thz_status st = api_photons_create(scene, &ph, err);
     photon_map_file_info info;
+    int threads = ctx ? ctx->threads : 0;
     if (st == THZ_OK)
-        st = photon_map_file_read(path, scene, ctx ? ctx->threads : 0, ph->maps, ph->stats, &info,
-                                  err);
+        st = channel == SIZE_MAX
+                 ? photon_map_file_read(path, scene, threads, ph->maps, ph->stats, &info, err)
+                 : photon_map_file_read_channel(path, scene, threads, channel, ph->maps, ph->stats,
+                                                &info, err);
     if (st != THZ_OK) {
         thz_photons_destroy(ph);
         return api_done(ctx, st, err);
@@ -134,6 +139,18 @@ thz_status thz_photons_load(thz_context *ctx, const thz_scene *scene, const char
     ph->effective.photons.per_channel = info.photons_per_channel;
     *out = ph;
     return THZ_OK;
+}
+
+thz_status thz_photons_load(thz_context *ctx, const thz_scene *scene, const char *path,
+                            thz_photons **out, thz_error *err)
+{
+    return api_photons_load(ctx, scene, path, SIZE_MAX, out, err);
+}
+
+thz_status thz_photons_load_channel(thz_context *ctx, const thz_scene *scene, const char *path,
+                                    size_t channel, thz_photons **out, thz_error *err)
+{
+    return api_photons_load(ctx, scene, path, channel, out, err);
 }
 
 thz_status thz_photons_save(const thz_photons *ph, const char *path, thz_error *err)

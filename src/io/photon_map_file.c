@@ -447,7 +447,21 @@ static thz_status pmf_check_counts(pmf_reader *r, const uint8_t *header, size_t 
     return THZ_OK;
 }
 
-thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,
+/* Reads n bytes of r's current frame and drops them, through a bounded buffer. */
+static thz_status pmf_skip(pmf_reader *r, uint64_t n, thz_error *err)
+{
+    uint8_t buf[65536];
+    thz_status st = THZ_OK;
+    while (st == THZ_OK && n > 0) {
+        size_t k = n < sizeof buf ? (size_t)n : sizeof buf;
+        st = pmf_read(r, buf, k, err);
+        n -= k;
+    }
+    return st;
+}
+
+/* photon_map_file_read of every channel (want = SIZE_MAX) or of channel want alone. */
+static thz_status pmf_read_file(const char *path, const thz_scene *scene, int threads, size_t want,
                                 photon_map **maps, photon_stats *stats, photon_map_file_info *info,
                                 thz_error *err)
 {
@@ -612,6 +626,17 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
     for (size_t c = 0; c < nc; c++) {
         const uint8_t *p = header + 8 * (PMF_HEADER_FIXED + channel_words * c);
         uint64_t count = get_u64(p + 16);
+        if (want != SIZE_MAX && c != want) {
+            st = pmf_skip(&r, count * sizeof(photon_record), err);
+            if (st != THZ_OK)
+                goto cleanup;
+            if (stats) {
+                pmf_get_stats(p + 24, &stats[c]);
+                stats[c].seconds = 0.0;
+                stats[c].reference_temperature_k = version == 1u ? 0.0 : get_f64(p + 160);
+            }
+            continue;
+        }
         records[c] = thz_malloc_array((size_t)count, sizeof(photon_record));
         if (!records[c]) {
             st = thz_error_set(err, THZ_ERR_NOMEM,
@@ -651,6 +676,8 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
     }
 
     for (size_t c = 0; c < nc; c++) {
+        if (want != SIZE_MAX && c != want)
+            continue;
         const uint8_t *p = header + 8 * (PMF_HEADER_FIXED + channel_words * c);
         photon_record *rec = records[c];
         records[c] = NULL; /* photon_map_create owns it from here, also on failure */
@@ -687,4 +714,22 @@ cleanup:
     if (r.f)
         fclose(r.f);
     return st;
+}
+
+thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,
+                                photon_map **maps, photon_stats *stats, photon_map_file_info *info,
+                                thz_error *err)
+{
+    return pmf_read_file(path, scene, threads, SIZE_MAX, maps, stats, info, err);
+}
+
+thz_status photon_map_file_read_channel(const char *path, const thz_scene *scene, int threads,
+                                        size_t channel, photon_map **maps, photon_stats *stats,
+                                        photon_map_file_info *info, thz_error *err)
+{
+    if (channel >= scene->n_channels)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "photon map %s: no channel %zu (the scene has %zu)", path, channel,
+                             scene->n_channels);
+    return pmf_read_file(path, scene, threads, channel, maps, stats, info, err);
 }

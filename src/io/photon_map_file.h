@@ -60,5 +60,11 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
 thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,
                                 photon_map **maps, photon_stats *stats, photon_map_file_info *info,
                                 thz_error *err);
+/* The same, building channel `channel`'s map alone (maps[c] NULL for the others, whose
+ * records are read, checked against their checksum and dropped; stats for every
+ * channel): for a view of one channel, without the others' memory and index build. */
+thz_status photon_map_file_read_channel(const char *path, const thz_scene *scene, int threads,
+                                        size_t channel, photon_map **maps, photon_stats *stats,
+                                        photon_map_file_info *info, thz_error *err);
 
 #endif

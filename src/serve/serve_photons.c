@@ -19,6 +19,7 @@ struct serve_photon_cache {
     char scene_path[PATH_MAX];
     struct timespec mtime;
     off_t size;
+    size_t channel; /* the one channel read (thz_photons_load_channel) */
     thz_scene *scene;
     thz_photons *photons;
 };
@@ -56,9 +57,12 @@ static bool serve_photon_scene(serve_request *r, const char *map, char *out, enu
     return st == SERVE_PATH_OK;
 }
 
-/* The photon map of the request (path=, scene=), loaded or from the cache; NULL after
- * replying. The caller holds s->photon_lock. */
-static struct serve_photon_cache *serve_photon_map(serve_request *r, enum MHD_Result *ret)
+/* Channel `channel` of the photon map of the request (path=, scene=), read alone
+ * (thz_photons_load_channel: the view needs neither the other channels nor an index of
+ * theirs) or from the cache; NULL after replying (404 for a channel the scene does not
+ * have). The caller holds s->photon_lock. */
+static struct serve_photon_cache *serve_photon_map(serve_request *r, size_t channel,
+                                                   enum MHD_Result *ret)
 {
     serve *s = r->s;
     char map[PATH_MAX], scene[PATH_MAX], map_real[PATH_MAX], scene_real[PATH_MAX];
@@ -72,7 +76,7 @@ static struct serve_photon_cache *serve_photon_map(serve_request *r, enum MHD_Re
     struct serve_photon_cache *c = s->photons;
     if (c && strcmp(c->map_path, map_real) == 0 && strcmp(c->scene_path, scene_real) == 0 &&
         c->size == st.st_size && c->mtime.tv_sec == st.st_mtim.tv_sec &&
-        c->mtime.tv_nsec == st.st_mtim.tv_nsec)
+        c->mtime.tv_nsec == st.st_mtim.tv_nsec && c->channel == channel)
         return c;
     serve_photons_free(s);
     c = calloc(1, sizeof *c);
@@ -81,9 +85,16 @@ static struct serve_photon_cache *serve_photon_map(serve_request *r, enum MHD_Re
     thz_status status = c && ctx ? THZ_OK : THZ_ERR_NOMEM;
     if (status == THZ_OK)
         status = thz_scene_load_within(scene, s->root, &c->scene, &err);
-    if (status == THZ_OK)
-        status = thz_photons_load(ctx, c->scene, map, &c->photons, &err);
+    bool no_channel = status == THZ_OK && channel >= thz_scene_channel_count(c->scene);
+    if (status == THZ_OK && !no_channel)
+        status = thz_photons_load_channel(ctx, c->scene, map, channel, &c->photons, &err);
     thz_context_destroy(ctx);
+    if (no_channel) {
+        thz_scene_destroy(c->scene);
+        free(c);
+        *ret = serve_reply_error(r, 404, "no channel %zu in the scene", channel);
+        return NULL;
+    }
     if (status != THZ_OK) {
         if (c)
             thz_scene_destroy(c->scene);
@@ -96,6 +107,7 @@ static struct serve_photon_cache *serve_photon_map(serve_request *r, enum MHD_Re
     snprintf(c->scene_path, sizeof c->scene_path, "%s", scene_real);
     c->mtime = st.st_mtim;
     c->size = st.st_size;
+    c->channel = channel;
     s->photons = c;
     return c;
 }
@@ -104,16 +116,17 @@ enum MHD_Result serve_photons_info(serve_request *r)
 {
     enum MHD_Result ret = MHD_NO;
     pthread_mutex_lock(&r->s->photon_lock);
-    struct serve_photon_cache *c = serve_photon_map(r, &ret);
+    struct serve_photon_cache *c = serve_photon_map(r, 0, &ret);
     if (c) {
         json_t *channels = json_array(), *objects = json_array();
         for (size_t i = 0; i < thz_scene_channel_count(c->scene); i++) {
             thz_channel_info ch;
             thz_scene_channel(c->scene, i, &ch);
+            thz_photon_stats ps; /* read for every channel; only channel 0's map is built */
+            thz_photons_stats(c->photons, i, &ps);
             json_array_append_new(channels,
                                   json_pack("{s:s, s:f, s:I}", "name", ch.name, "centre_thz",
-                                            ch.frequency_thz, "photons",
-                                            (json_int_t)thz_photons_count(c->photons, i)));
+                                            ch.frequency_thz, "photons", (json_int_t)ps.stored));
         }
         for (size_t i = 0; i < thz_scene_object_count(c->scene); i++) {
             thz_object_info o;
@@ -186,16 +199,15 @@ enum MHD_Result serve_photons(serve_request *r)
     if (max_arg && ((max = strtoll(max_arg, &end, 10)) < 1 || *end || max > 20000000))
         return serve_reply_error(r, 400, "max=%s: expected 1 to 20000000", max_arg);
     pthread_mutex_lock(&r->s->photon_lock);
-    struct serve_photon_cache *c = serve_photon_map(r, &ret);
+    struct serve_photon_cache *c = serve_photon_map(r, (size_t)ch, &ret);
     if (!c) {
         pthread_mutex_unlock(&r->s->photon_lock);
         return ret;
     }
     long object = obj ? thz_scene_object_index(c->scene, obj) : -1;
-    if ((size_t)ch >= thz_scene_channel_count(c->scene) || (obj && object < 0)) {
+    if (obj && object < 0) {
         pthread_mutex_unlock(&r->s->photon_lock);
-        return serve_reply_error(r, 404, "no channel %ld or object '%s' in the scene", ch,
-                                 obj ? obj : "");
+        return serve_reply_error(r, 404, "no object '%s' in the scene", obj);
     }
     thz_photon_point *buf = malloc(SERVE_PHOTON_CHUNK * sizeof *buf);
     size_t total = 0, count = thz_photons_count(c->photons, (size_t)ch);

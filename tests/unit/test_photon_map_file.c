@@ -148,6 +148,53 @@ static void expect_refusal(const char *path, const thz_scene *scene, thz_status 
 
 /* A version-1 file (20 words per channel, no T0) made from a version-2 one: its header
  * frame without each channel's last word, the records frame as is. */
+/* One channel read alone (what a view of its photons needs): its map equals the full
+ * read's, the other holds none, every channel's statistics are read; a damaged byte in
+ * the skipped channel's records is still found (they are read, not jumped over). */
+static void test_one_channel(void **state)
+{
+    fixture *f = *state;
+    thz_error err;
+    for (size_t want = 0; want < 2; want++) {
+        photon_map *maps[2] = {NULL, NULL};
+        photon_stats stats[2];
+        assert_int_equal(
+            photon_map_file_read_channel(f->path, f->scene, 1, want, maps, stats, NULL, &err),
+            THZ_OK);
+        for (size_t c = 0; c < 2; c++) {
+            photon_stats a = f->stats[c];
+            a.seconds = a.seconds_emission_table = a.seconds_tracing = a.seconds_index = 0.0;
+            a.rays = 0;
+            assert_memory_equal(&a, &stats[c], sizeof a);
+        }
+        assert_null(maps[1 - want]);
+        assert_non_null(maps[want]);
+        assert_int_equal(photon_map_count(maps[want]), photon_map_count(f->maps[want]));
+        assert_memory_equal(photon_map_records(maps[want]), photon_map_records(f->maps[want]),
+                            photon_map_count(maps[want]) * sizeof(photon_record));
+        assert_true(photon_map_reference_temperature_k(maps[want]) ==
+                    photon_map_reference_temperature_k(f->maps[want]));
+        photon_map_destroy(maps[want]);
+    }
+    photon_map *maps[2] = {NULL, NULL};
+    assert_int_equal(photon_map_file_read_channel(f->path, f->scene, 1, 2, maps, NULL, NULL, &err),
+                     THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "no channel 2"));
+    /* the file is compressed: flip a byte near the end, in channel 1's records, and read
+     * channel 0 alone */
+    size_t n;
+    unsigned char *buf = slurp(f->path, &n);
+    buf[n - 16] ^= 0x40;
+    char bad[160];
+    snprintf(bad, sizeof bad, "%s/bad.thzpm", f->dir);
+    spit(bad, buf, n);
+    free(buf);
+    assert_int_not_equal(photon_map_file_read_channel(bad, f->scene, 1, 0, maps, NULL, NULL, &err),
+                         THZ_OK);
+    assert_null(maps[0]);
+    assert_null(maps[1]);
+}
+
 static void test_version_1(void **state)
 {
     fixture *f = *state;
@@ -366,6 +413,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_round_trip, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_one_channel, setup, teardown),
         cmocka_unit_test_setup_teardown(test_version_1, setup, teardown),
         cmocka_unit_test_setup_teardown(test_corrupted, setup, teardown),
         cmocka_unit_test_setup_teardown(test_truncated, setup, teardown),
