@@ -2,7 +2,7 @@
  * library (thz_photons_load, which needs the scene it was made from) and sent for the
  * point cloud of the paper's Fig. 3: as float32 records (format=records, the default), or
  * as the page draws them (format=points: positions, then directions in 8 bits per axis,
- * 15 bytes a photon instead of 32). The last map read is kept. */
+ * 15 bytes a photon instead of 32). The last channel read is kept (one channel of one map). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
