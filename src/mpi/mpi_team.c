@@ -177,8 +177,10 @@ static thz_status team_gather(void *impl, photon_phase_share *share, thz_error *
     records = count <= SIZE_MAX
                   ? thz_realloc_array(share->records, count ? count : 1, sizeof *records)
                   : NULL;
-    if (records)
+    if (records) {
         share->records = records;
+        share->capacity = count ? (size_t)count : 1;
+    }
     chunks = n_chunks <= SIZE_MAX
                  ? thz_realloc_array(share->chunks, n_chunks ? n_chunks : 1, sizeof *chunks)
                  : NULL;

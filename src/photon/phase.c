@@ -29,16 +29,18 @@ typedef struct phase_fire_args {
     uint64_t lo, hi;       /* fire photons [lo, hi) of K (lo a multiple of PHASE_BATCH) */
     uint64_t first_photon; /* index of the first photon (its random stream and batch) */
     int threads;
+    photon_map_pool *pool; /* the record array's first memory, or NULL */
     thz_progress_fn progress;
     void *progress_user;
 } phase_fire_args;
 
 /* Fires photons first_photon + lo..hi-1, returning their records in photon-index order (a
- * malloc'd array, never NULL on success) and the summed counters; chunk_out (may be NULL)
- * gets each chunk's counters in order (room for ceil((hi - lo) / PHASE_CHUNK)). */
+ * malloc'd array of *out_capacity, never NULL on success) and the summed counters;
+ * chunk_out (may be NULL) gets each chunk's counters in order (room for
+ * ceil((hi - lo) / PHASE_CHUNK)). */
 static thz_status phase_fire(const phase_fire_args *a, photon_record **out_records,
-                             size_t *out_count, trace_counters *total, trace_counters *chunk_out,
-                             thz_error *err)
+                             size_t *out_count, size_t *out_capacity, trace_counters *total,
+                             trace_counters *chunk_out, thz_error *err)
 {
     thz_status st = THZ_OK;
     int nthreads = a->threads > 0 ? a->threads : omp_get_max_threads();
@@ -46,8 +48,12 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
         nthreads = 1;
     trace_buffer *bufs = thz_calloc((size_t)nthreads, sizeof *bufs);
     phase_chunk *chunks = thz_calloc(PHASE_BATCH / PHASE_CHUNK, sizeof *chunks);
-    photon_record *records = thz_malloc_array(1, sizeof *records);
-    size_t count = 0, capacity = 1;
+    size_t count = 0, capacity = 0;
+    photon_record *records = a->pool ? photon_map_pool_take(a->pool, &capacity) : NULL;
+    if (!records) {
+        records = thz_malloc_array(1, sizeof *records);
+        capacity = 1;
+    }
     memset(total, 0, sizeof *total);
     if (!bufs || !chunks || !records) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "photon phase: out of memory");
@@ -161,13 +167,18 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
             }
         }
     }
-    if (capacity > count && count > 0) { /* give back the growth slack */
+    /* Give back the growth slack; from a pool, only beyond a quarter (the next channel's
+     * map, about as large, reuses it). */
+    if (count > 0 && (a->pool ? capacity - count > count / 4 : capacity > count)) {
         photon_record *p = thz_realloc_array(records, count, sizeof *p);
-        if (p)
+        if (p) {
             records = p;
+            capacity = count;
+        }
     }
     *out_records = records;
     *out_count = count;
+    *out_capacity = capacity;
     records = NULL;
 cleanup:
     if (bufs)
@@ -235,9 +246,10 @@ void photon_phase_share_range(uint64_t k, size_t member, size_t members, uint64_
  * their sum in *total. */
 static thz_status phase_fire_range(const thz_scene *scene, const accel *acc,
                                    const photon_phase_request *rq, const emission_table *table,
-                                   const air_emission *air, int threads, uint64_t lo, uint64_t hi,
-                                   thz_progress_fn progress, void *progress_user,
-                                   photon_phase_share *out, trace_counters *total, thz_error *err)
+                                   const air_emission *air, int threads, photon_map_pool *pool,
+                                   uint64_t lo, uint64_t hi, thz_progress_fn progress,
+                                   void *progress_user, photon_phase_share *out,
+                                   trace_counters *total, thz_error *err)
 {
     memset(out, 0, sizeof *out);
     size_t n_chunks = (size_t)((hi - lo + PHASE_CHUNK - 1) / PHASE_CHUNK);
@@ -255,9 +267,11 @@ static thz_status phase_fire_range(const thz_scene *scene, const accel *acc,
                          .hi = hi,
                          .first_photon = rq->first_photon,
                          .threads = threads,
+                         .pool = pool,
                          .progress = progress,
                          .progress_user = progress_user};
-    thz_status st = phase_fire(&a, &out->records, &out->count, total, out->chunks, err);
+    thz_status st =
+        phase_fire(&a, &out->records, &out->count, &out->capacity, total, out->chunks, err);
     if (st != THZ_OK)
         photon_phase_share_fini(out);
     return st;
@@ -290,8 +304,8 @@ thz_status photon_phase_fire_share(const thz_scene *scene, const accel *acc,
     uint64_t lo, hi;
     photon_phase_share_range(rq->photons, member, members, &lo, &hi);
     trace_counters total;
-    st = phase_fire_range(scene, acc, rq, &table, &air, threads, lo, hi, NULL, NULL, out, &total,
-                          err);
+    st = phase_fire_range(scene, acc, rq, &table, &air, threads, NULL, lo, hi, NULL, NULL, out,
+                          &total, err);
     emission_table_fini(&table);
     air_emission_fini(&air);
     return st;
@@ -334,9 +348,10 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     int threads = opt ? opt->threads : 0;
     photon_phase_share share;
     trace_counters c;
-    st =
-        phase_fire_range(scene, acc, &rq, &table, &air, threads, lo, hi, opt ? opt->progress : NULL,
-                         opt ? opt->progress_user : NULL, &share, &c, err);
+    photon_map_pool *pool = opt ? opt->pool : NULL;
+    st = phase_fire_range(scene, acc, &rq, &table, &air, threads, pool, lo, hi,
+                          opt ? opt->progress : NULL, opt ? opt->progress_user : NULL, &share, &c,
+                          err);
     emission_table_fini(&table);
     double air_power = air.band_power_w_per_hz;
     air_emission_fini(&air);
@@ -346,7 +361,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
         for (size_t k = 0; st == THZ_OK && k < share.n_chunks; k++)
             trace_counters_add(&c, &share.chunks[k]);
     }
-    size_t count = share.count;
+    size_t count = share.count, capacity = share.capacity;
     photon_record *records = share.records;
     share.records = NULL;
     photon_phase_share_fini(&share);
@@ -356,8 +371,8 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     }
     double t2 = omp_get_wtime();
 
-    /* photon_map_create takes ownership of records, also on failure. */
-    st = photon_map_create(records, count, scene->n_objects, threads, out_map, err);
+    /* photon_map_build takes ownership of records, also on failure. */
+    st = photon_map_build(records, count, capacity, scene->n_objects, threads, pool, out_map, err);
     if (st != THZ_OK)
         return st;
     photon_map_set_reference_temperature_k(*out_map, t0_k);
@@ -402,9 +417,9 @@ thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc,
                          .n_photons = pilot,
                          .hi = pilot};
     photon_record *records = NULL;
-    size_t count = 0;
+    size_t count = 0, capacity = 0;
     trace_counters c;
-    st = phase_fire(&a, &records, &count, &c, NULL, err);
+    st = phase_fire(&a, &records, &count, &capacity, &c, NULL, err);
     emission_table_fini(&table);
     air_emission_fini(&air);
     free(records);

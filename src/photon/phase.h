@@ -38,6 +38,9 @@ typedef struct photon_phase_options {
     uint64_t first_photon;
     /* The processes sharing the phase (NULL: this one alone); see photon_phase_team. */
     const struct photon_phase_team *team;
+    /* Memory kept between the run's maps (photon_map.h): the record array starts from its
+     * spare, and the index build uses its scratch. NULL: none. */
+    photon_map_pool *pool;
     thz_progress_fn progress;
     void *progress_user;
 } photon_phase_options;
@@ -70,7 +73,7 @@ typedef struct photon_phase_request {
  * chunks (PHASE_CHUNK photons; the last of the phase may be shorter), in order. */
 typedef struct photon_phase_share {
     photon_record *records;
-    size_t count;
+    size_t count, capacity;
     trace_counters *chunks;
     size_t n_chunks;
 } photon_phase_share;

@@ -109,6 +109,7 @@ typedef struct photon_cube {
 struct photon_map {
     photon_record *records;
     size_t count;
+    size_t capacity;    /* of records (photon_map_recycle) */
     size_t n_groups;    /* 2 n_objects */
     size_t *start;      /* n_groups + 1 offsets */
     photon_cube *cubes; /* n_groups */
@@ -385,8 +386,56 @@ static size_t photon_map_scan(photon_record *r, size_t count, size_t n_groups, i
     return bad;
 }
 
+void photon_map_pool_fini(photon_map_pool *pool)
+{
+    free(pool->records);
+    free(pool->codes);
+    memset(pool, 0, sizeof *pool);
+}
+
+photon_record *photon_map_pool_take(photon_map_pool *pool, size_t *capacity)
+{
+    photon_record *r = pool->records;
+    *capacity = r ? pool->records_capacity : 0;
+    pool->records = NULL;
+    pool->records_capacity = 0;
+    return r;
+}
+
+void photon_map_recycle(photon_map *map, photon_map_pool *pool)
+{
+    if (map && pool && map->capacity > pool->records_capacity) {
+        free(pool->records);
+        pool->records = map->records;
+        pool->records_capacity = map->capacity;
+        map->records = NULL;
+    }
+    photon_map_destroy(map);
+}
+
+/* The codes' scratch: the pool's (grown if need be, kept there) or, without a pool, a
+ * new array the caller frees. NULL when out of memory. */
+static uint64_t *photon_map_codes(photon_map_pool *pool, size_t count)
+{
+    size_t n = count ? count : 1;
+    if (!pool)
+        return thz_malloc_array(n, sizeof(uint64_t));
+    if (pool->codes_capacity < n) {
+        free(pool->codes);
+        pool->codes = thz_malloc_array(n, sizeof(uint64_t));
+        pool->codes_capacity = pool->codes ? n : 0;
+    }
+    return pool->codes;
+}
+
 thz_status photon_map_create(photon_record *photons, size_t count, size_t n_objects, int threads,
                              photon_map **out, thz_error *err)
+{
+    return photon_map_build(photons, count, count, n_objects, threads, NULL, out, err);
+}
+
+thz_status photon_map_build(photon_record *photons, size_t count, size_t capacity, size_t n_objects,
+                            int threads, photon_map_pool *pool, photon_map **out, thz_error *err)
 {
     thz_status st = THZ_OK;
     photon_map *map = NULL;
@@ -430,14 +479,16 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
         map->cubes[g] = photon_group_cube(&bounds[g]);
     photon_group(photons, n_groups, map->start, next);
     /* The records' Morton codes, sorted alongside them (8 bytes per record, freed when
-     * the map is built: the peak is 1.25 times the map). */
-    codes = thz_malloc_array(count ? count : 1, sizeof *codes);
+     * the map is built, or kept in the pool for the next: the peak is 1.25 times the
+     * map). */
+    codes = photon_map_codes(pool, count);
     if (!codes) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu photons", count);
         goto cleanup;
     }
     map->records = photons;
     map->count = count;
+    map->capacity = capacity > count ? capacity : count;
     map->n_groups = n_groups;
     photons = NULL; /* owned by map now */
 
@@ -470,7 +521,8 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
     map = NULL;
 cleanup:
     free(next);
-    free(codes);
+    if (!pool)
+        free(codes);
     free(bounds);
     free(photons);
     photon_map_destroy(map);

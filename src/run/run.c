@@ -113,6 +113,7 @@ void run_state_fini(run_state *rs)
         for (size_t c = 0; c < rs->scene->n_channels; c++)
             photon_map_destroy(rs->maps[c]);
     free(rs->maps);
+    photon_map_pool_fini(&rs->pool);
     free(rs->stats);
     free(rs->noise);
     free(rs->object_noise);
@@ -448,6 +449,7 @@ static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_ma
                                    .reference_temperature_k = run_photon_t0_k(scene, c),
                                    .first_photon = (uint64_t)n * k,
                                    .team = opt->team,
+                                   .pool = &rs->pool,
                                    .progress = opt->progress,
                                    .progress_user = opt->progress_user};
         photon_stats ps;
@@ -557,6 +559,7 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
             photon_phase_options po = {.threads = opt->threads,
                                        .reference_temperature_k = run_photon_t0_k(scene, c),
                                        .team = opt->team,
+                                       .pool = &rs->pool,
                                        .progress = opt->progress,
                                        .progress_user = opt->progress_user};
             double t0 = thz_now_s();
@@ -569,7 +572,7 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
         if (opt->keep_photon_maps)
             rs->maps[c] = map;
         else
-            photon_map_destroy(map);
+            photon_map_recycle(map, &rs->pool);
     }
     if (st == THZ_OK)
         st = run_finish(rs, t_start, err);

@@ -124,6 +124,7 @@ typedef struct run_state {
                                   (every pass casts the same sample rays, so the counts are
                                   a channel's, not the number of passes') */
     photon_map **maps;         /* per channel: kept for saving (simulate) */
+    photon_map_pool pool;      /* memory of the maps not kept, for the next channel's */
     photon_stats *stats;       /* per channel (simulate), or the read maps' (render) */
     run_noise *noise;          /* per channel */
     run_noise *object_noise;   /* [channel * n_objects + object] */

@@ -1,6 +1,7 @@
 /* Photon phase determinism: the photon maps and statistics from 1 and 2 threads are
- * byte-identical (and equal to a repeated run); progress reports batches on the calling
- * thread and cancels. Also measures photons per second on the box scene. */
+ * byte-identical (and equal to a repeated run, and to runs from a pool's memory); progress
+ * reports batches on the calling thread and cancels. Also measures photons per second on
+ * the box scene. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,14 +15,20 @@
 #include "accel/accel.h"
 #include "photon/phase.h"
 
-static void run(const thz_scene *s, const accel *acc, int threads, photon_map **map,
-                photon_stats *st)
+static void run_pooled(const thz_scene *s, const accel *acc, int threads, photon_map_pool *pool,
+                       photon_map **map, photon_stats *st)
 {
-    photon_phase_options opt = {.threads = threads};
+    photon_phase_options opt = {.threads = threads, .pool = pool};
     thz_error err;
     thz_status status = photon_phase_run(s, acc, 0, &opt, map, st, &err);
     if (status != THZ_OK)
         fail_msg("%s", err.message);
+}
+
+static void run(const thz_scene *s, const accel *acc, int threads, photon_map **map,
+                photon_stats *st)
+{
+    run_pooled(s, acc, threads, NULL, map, st);
 }
 
 static void assert_same(const photon_map *a, const photon_stats *sa, const photon_map *b,
@@ -68,6 +75,54 @@ static void test_threads_identical(void **state)
     photon_map_destroy(m1b);
     accel_destroy(acc);
     scene_destroy(s);
+}
+
+/* A run's maps built in the memory of the maps before (photon_map_pool) are the maps
+ * built without: the second run starts from the first's record array and codes (a
+ * smaller scene's map, in fewer records), the third from the larger of the two. */
+static void test_pool_reuses_memory(void **state)
+{
+    (void)state;
+    uint64_t k = ps_scaled(PHASE_BATCH + 30000);
+    thz_scene *s = ps_box_scene(k, 42, 0.3), *small = ps_box_scene(k / 3, 7, 0.3);
+    accel *acc, *acc_small;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    assert_int_equal(accel_create(small, &acc_small, &err), THZ_OK);
+    photon_map_pool pool = {0};
+    photon_map *plain, *plain_small, *m;
+    photon_stats sp, sp_small, sm;
+    run(s, acc, 2, &plain, &sp);
+    run(small, acc_small, 1, &plain_small, &sp_small);
+
+    run_pooled(s, acc, 2, &pool, &m, &sm);
+    assert_same(plain, &sp, m, &sm);
+    assert_null(pool.records); /* the run took the spare (none yet) */
+    assert_non_null(pool.codes);
+    assert_true(pool.codes_capacity >= photon_map_count(m));
+    const photon_record *first = photon_map_records(m);
+    photon_map_recycle(m, &pool);
+    assert_ptr_equal(pool.records, first);
+    assert_true(pool.records_capacity >= sp.stored);
+
+    run_pooled(small, acc_small, 1, &pool, &m, &sm); /* took the first run's array */
+    assert_null(pool.records);
+    assert_same(plain_small, &sp_small, m, &sm);
+    photon_map_recycle(m, &pool);
+    run_pooled(s, acc, 1, &pool, &m, &sm);
+    assert_same(plain, &sp, m, &sm);
+    photon_map_recycle(m, &pool);
+    photon_map_recycle(NULL, &pool);
+    photon_map_pool_fini(&pool);
+    assert_null(pool.records);
+    assert_null(pool.codes);
+
+    photon_map_destroy(plain);
+    photon_map_destroy(plain_small);
+    accel_destroy(acc);
+    accel_destroy(acc_small);
+    scene_destroy(s);
+    scene_destroy(small);
 }
 
 typedef struct progress_log {
@@ -130,6 +185,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_threads_identical),
+        cmocka_unit_test(test_pool_reuses_memory),
         cmocka_unit_test(test_progress_and_cancel),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
