@@ -180,14 +180,22 @@ def fire_photons(scene, integrator=None, photons=None, seed=None, first_photon=0
             call.ctx, scene._handle, ctypes.byref(s), out, call.err), scene)
 
 
-def load_photon_map(scene, path, threads=None, progress=None):
+def load_photon_map(scene, path, channel=None, threads=None, progress=None):
     """Reads a photon-map file made from this scene; the library refuses one made from
-    another geometry, material or channel set."""
+    another geometry, material or channel set. With `channel` (an index), that channel's
+    map alone is kept (the others' records are checked and dropped: has_channel is False
+    for them, their statistics are read), for a look at one channel's photons of a large
+    file."""
     scene = _scene_arg(scene)
     path = _path_arg("path", path)
+    if channel is None:
+        with Call(threads, progress) as call:
+            return _photons_call(call, lambda out: _lib.lib.thz_photons_load(
+                call.ctx, scene._handle, os.fsencode(path), out, call.err), scene)
+    c = _whole("channel", channel, 0, len(scene.channels) - 1)
     with Call(threads, progress) as call:
-        return _photons_call(call, lambda out: _lib.lib.thz_photons_load(
-            call.ctx, scene._handle, os.fsencode(path), out, call.err), scene)
+        return _photons_call(call, lambda out: _lib.lib.thz_photons_load_channel(
+            call.ctx, scene._handle, os.fsencode(path), c, out, call.err), scene)
 
 
 def merge_photon_maps(parts, threads=None):

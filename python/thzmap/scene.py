@@ -125,11 +125,24 @@ def _path_arg(name, value):
     return value
 
 
-def load_scene(path):
+def _root_arg(root):
+    """The library's `root` argument: None, or the directory as bytes."""
+    return None if root is None else os.fsencode(_path_arg("root", root))
+
+
+def load_scene(path, root=None):
     """Loads and checks the scene file at `path`. Raises SceneError (with .file, .path,
-    .line, .column) for a bad scene."""
+    .line, .column) for a bad scene. With `root` (a directory), the scene file and every
+    file it names must lie under root once symlinks are resolved (as `thzmap serve
+    --root` loads scenes on behalf of others); one that does not is a SceneError at the
+    JSON path of the key naming it."""
     path = _path_arg("path", path)
-    return _load(lambda out, err: _lib.lib.thz_scene_load(os.fsencode(path), out, err), path)
+    if root is None:
+        return _load(lambda out, err: _lib.lib.thz_scene_load(os.fsencode(path), out, err),
+                     path)
+    r = _root_arg(root)
+    return _load(lambda out, err: _lib.lib.thz_scene_load_within(
+        os.fsencode(path), r, out, err), path)
 
 
 def _check_json_values(value, path, label):
@@ -168,9 +181,10 @@ def _json_default(value):
     raise TypeError(type(value).__name__)
 
 
-def scene_from_json(text, base_dir=None, label="<string>"):
+def scene_from_json(text, base_dir=None, label="<string>", root=None):
     """A scene from JSON text; relative file paths in it are taken against `base_dir`
-    (default: the current directory); `label` names it in messages (SceneError.file)."""
+    (default: the current directory); `label` names it in messages (SceneError.file);
+    `root` confines the files it names as load_scene does."""
     if not isinstance(text, str):
         raise ArgumentError(f"text: expected a str, got {type(text).__name__}")
     if not isinstance(label, str) or "\0" in label:
@@ -179,11 +193,15 @@ def scene_from_json(text, base_dir=None, label="<string>"):
         raise ArgumentError("text: JSON text cannot contain a NUL character")
     base = None if base_dir is None else os.fsencode(_path_arg("base_dir", base_dir))
     data = text.encode("utf-8")
-    return _load(lambda out, err: _lib.lib.thz_scene_load_string(
-        data, base, label.encode("utf-8"), out, err), label)
+    if root is None:
+        return _load(lambda out, err: _lib.lib.thz_scene_load_string(
+            data, base, label.encode("utf-8"), out, err), label)
+    r = _root_arg(root)
+    return _load(lambda out, err: _lib.lib.thz_scene_load_string_within(
+        data, base, label.encode("utf-8"), r, out, err), label)
 
 
-def scene_from_dict(d, base_dir=None, label="<dict>"):
+def scene_from_dict(d, base_dir=None, label="<dict>", root=None):
     """A scene from a dict with the keys of a scene file; relative file paths in it are
     taken against `base_dir` (default: the current directory). Numbers may be numpy
     scalars or arrays. Raises SceneError naming the JSON path of a bad value."""
@@ -193,4 +211,4 @@ def scene_from_dict(d, base_dir=None, label="<dict>"):
         raise ArgumentError(f"label: expected a str, got {label!r}")
     _check_json_values(d, "", label)
     text = json.dumps(d, default=_json_default, allow_nan=False)
-    return scene_from_json(text, base_dir=base_dir, label=label)
+    return scene_from_json(text, base_dir=base_dir, label=label, root=root)
