@@ -15,7 +15,7 @@ static void check_azimuth(double u)
 {
     vec3 d = sampling_direction(v3(0.0, 0.0, 1.0), 0.0, u);
     double phi = 2.0 * M_PI * u;
-    if (fabs(d.x - cos(phi)) > 1e-13 || fabs(d.y - sin(phi)) > 1e-13 || fabs(d.z) > 1e-15)
+    if (fabs(d.x - cos(phi)) > 1e-14 || fabs(d.y - sin(phi)) > 1e-14 || fabs(d.z) > 1e-15)
         fail_msg("u = %.17g: (%.17g, %.17g) against (%.17g, %.17g)", u, d.x, d.y, cos(phi),
                  sin(phi));
 }
