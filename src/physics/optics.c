@@ -351,16 +351,29 @@ bool optics_sample_transmission_mu(const optics_point *o, optics_uniform_fn next
     }
 }
 
+/* eps does not depend on angle: no index (or an explicit eps), and a solid, an explicit
+ * eps or a shell of optical depth 0. */
+static bool optics_emission_is_constant(const optics_point *o)
+{
+    if (o->has_index && !o->explicit_emissivity)
+        return false;
+    return o->explicit_emissivity || !optics_is_shell(o) || optics_tau(o) == 0.0;
+}
+
+bool optics_emission_is_cosine(const optics_point *o)
+{
+    return optics_emission_is_constant(o) && optics_emissivity(o, 1.0) > 0.0;
+}
+
 bool optics_sample_emission_mu(const optics_point *o, optics_uniform_fn next, void *ctx, double *mu)
 {
     if (o->has_index && !o->explicit_emissivity)
         return optics_reject(o, optics_absorption, next, ctx, mu);
     double c = optics_cap(o);
     double tau = optics_tau(o);
-    if (o->explicit_emissivity || !optics_is_shell(o) || tau == 0.0) {
+    if (optics_emission_is_constant(o)) {
         /* eps does not depend on angle: cosine distribution. */
-        double eps = optics_emissivity(o, 1.0);
-        if (!(eps > 0.0))
+        if (!optics_emission_is_cosine(o))
             return false;
         *mu = sqrt(1.0 - next(ctx));
         return true;
