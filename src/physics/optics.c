@@ -26,9 +26,9 @@
  * - x <= 1: its series E3 = 1/2 - x + x^2/2 (3/2 - gamma - ln x)
  *   + sum_{i>=3} (-1)^(i+1) x^i / (i! (i - 2)), the sum to i = 18 (the rest < 1e-18);
  * - 1 < x <= 8: e^x E3(x) by Chebyshev series of 20 terms on [1, 2], [2, 4] and [4, 8]
- *   (interpolation at 22 Chebyshev points in 60-digit arithmetic from the series; E3's
- *   only singularity, the logarithm's at 0, bounds their decay to 1 / 5.8 per term: the
- *   21st is below 1e-17 of e^x E3);
+ *   (interpolated at 22 Chebyshev points in 60-digit arithmetic by
+ *   scripts/e3_chebyshev.py; E3's only singularity, the logarithm's at 0, bounds their
+ *   decay to 1 / 5.8 per term: the 21st is below 1e-17 of e^x E3);
  * - x > 8: the modified Lentz continued fraction (Numerical Recipes "expint" for
  *   n = 3), 20 iterations or fewer there. */
 static double optics_expint3(double x)
