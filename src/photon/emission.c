@@ -239,6 +239,7 @@ static bool emission_add_source(emission_table *t, const accel *acc, size_t i, e
     } else if (s->constant_optics) {
         s->optics = scene_object_optics(scene, obj, scene->channels[t->channel].center_hz);
         optics_prepare(&s->optics);
+        s->cosine_law = kind != EMISSION_ABSORB && optics_emission_is_cosine(&s->optics);
         double eps = optics_mean_emissivity(&s->optics);
         optics_point kirchhoff = emission_kirchhoff_optics(s->optics);
         double abs = optics_mean_emissivity(&kirchhoff);
@@ -435,8 +436,13 @@ bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *
     const thz_mesh *m = &obj->mesh;
 
     /* The exact signed power of the group drawn, at this frequency. */
-    optics_point o = s->constant_optics ? s->optics : scene_object_optics(t->scene, obj, nu);
-    double w = emission_power_with(t, gr, &o, nu);
+    const optics_point *o = &s->optics;
+    optics_point at_nu;
+    if (!s->constant_optics) {
+        at_nu = scene_object_optics(t->scene, obj, nu);
+        o = &at_nu;
+    }
+    double w = emission_power_with(t, gr, o, nu);
     if (w == 0.0 || isnan(w) || !(q > 0.0))
         return false;
     out->power_w_per_hz = w * (total / q) / (double)t->n_photons;
@@ -457,12 +463,14 @@ bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *
         n = v3_scale(n, -1.0);
     /* mu ~ eps(mu) mu, or A(mu) mu for the -A B0 part of an explicit-emissivity shell
      * (EMISSION_EPS_ABSORB is a solid's: eps and A both cosine). */
-    optics_point law = s->kind == EMISSION_ABSORB ? emission_kirchhoff_optics(o) : o;
     double mu;
-    if (back)
-        mu = sqrt(1.0 - rng_uniform32(rng)); /* radiance -B0: cosine */
-    else if (!optics_sample_emission_mu(&law, sampling_uniform32, rng, &mu))
-        mu = sqrt(1.0 - rng_uniform32(rng)); /* eps = 0 (a -A B0 source) or unreachable */
+    if (back || s->cosine_law) {
+        mu = sqrt(1.0 - rng_uniform32(rng)); /* radiance -B0, or constant eps: cosine */
+    } else {
+        optics_point law = s->kind == EMISSION_ABSORB ? emission_kirchhoff_optics(*o) : *o;
+        if (!optics_sample_emission_mu(&law, sampling_uniform32, rng, &mu))
+            mu = sqrt(1.0 - rng_uniform32(rng)); /* eps = 0 (a -A B0 source) or unreachable */
+    }
     out->dir = sampling_direction(n, mu, rng_uniform32(rng));
     out->object = s->object;
     out->triangle = (uint32_t)tri;

@@ -93,6 +93,8 @@ typedef struct emission_source {
                              (variable optics, the optics shared by the group) */
     double reach_share;   /* EMISSION_BACK: r in (0, 1], the photons carry 1 / r; else 1 */
     optics_point optics;  /* constant optics: the optics at every frequency */
+    bool cosine_law;      /* constant optics drawn by the cosine law (optics.h
+                             optics_emission_is_cosine): mu = sqrt(1 - u) directly */
     double *triangle_cdf; /* n_triangles cumulative areas, last = total; shared by an
                              object's sources, owned by the first (owns_cdf) */
     bool owns_cdf;

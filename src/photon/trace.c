@@ -99,6 +99,9 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
     c->fired_power += power;
     const double w_min = scene->photons.min_relative_power * fabs(power);
     const double nu = e->freq_hz;
+    /* The frequency is the path's: alpha(nu) once (atmosphere_transmittance per hit
+     * would evaluate it, an interpolation or a line sum, at every hit). */
+    const double alpha = atmosphere_alpha_per_m(&scene->atmosphere, nu);
 
     accel_hit from = {
         .object = e->object, .triangle = e->triangle, .position_m = e->position_m, .side = e->side};
@@ -132,17 +135,19 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
             c->absorbed++;
             return true;
         }
-        /* The free path runs from the surface point along dir, not from the offset
-         * origin: its length to the plane of the triangle hit. (From the offset origin
-         * it would be short by about eps/cos, a bias of alpha eps / cos.) */
-        const float *hn = &scene->objects[hit.object].mesh.normals[3 * (size_t)hit.triangle];
-        vec3 to_hit = v3_sub(hit.position_m, surface);
-        double d = hit.cos_theta > 1e-6
-                       ? fabs(v3_dot(to_hit, v3(hn[0], hn[1], hn[2]))) / hit.cos_theta
-                       : v3_length(to_hit);
-        double tr = atmosphere_transmittance(&scene->atmosphere, nu, d);
-        c->atmosphere_power += power * (1.0 - tr);
-        power *= tr;
+        if (alpha != 0.0) { /* as atmosphere_transmittance: alpha = 0 transmits all */
+            /* The free path runs from the surface point along dir, not from the offset
+             * origin: its length to the plane of the triangle hit. (From the offset
+             * origin it would be short by about eps/cos, a bias of alpha eps / cos.) */
+            const float *hn = &scene->objects[hit.object].mesh.normals[3 * (size_t)hit.triangle];
+            vec3 to_hit = v3_sub(hit.position_m, surface);
+            double d = hit.cos_theta > 1e-6
+                           ? fabs(v3_dot(to_hit, v3(hn[0], hn[1], hn[2]))) / hit.cos_theta
+                           : v3_length(to_hit);
+            double tr = exp(-alpha * d);
+            c->atmosphere_power += power * (1.0 - tr);
+            power *= tr;
+        }
         if (fabs(power) < w_min) {
             /* Low-power roulette: survive with probability |w| / w_min at +-w_min. */
             if (rng_uniform32(rng) * w_min < fabs(power)) {

@@ -1,13 +1,17 @@
 /* Channel responses (Gaussian or a measured table), sampling and band-mean quadrature
  * (physics.md "Channels"). Every function handles both: the Gaussian's arithmetic is
- * unchanged from before tables existed (outputs stay bit-identical); a table's is exact
- * for its piecewise-linear g. */
+ * that of before tables existed (Box-Muller's log and cos since computed without libm,
+ * to ~1e-16); a table's is exact for its piecewise-linear g. */
 #include "physics/channel.h"
 
+#include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/alloc.h"
+#include "core/sampling.h"
 #include "physics/spectrum.h"
 
 /* ---- measured response tables ---------------------------------------------------- */
@@ -121,7 +125,6 @@ static size_t channel_piece_panels(const thz_channel *ch, size_t i, size_t panel
 }
 
 #define CHANNEL_SQRT_2PI 2.5066282746310002
-#define CHANNEL_TWO_PI 6.283185307179586
 #define CHANNEL_HALF_SPAN_SIGMAS 6.0
 
 /* Node i of n (odd) in units of sigma from the centre: -6 .. +6, symmetric. */
@@ -233,13 +236,50 @@ static double channel_sample_table_hz(const thz_channel *ch, double u1, double u
     return ch->response_hz[lo] + t * h;
 }
 
+/* ln x for normal x > 0 without libm (relative error ~2e-16): x = 2^e m with
+ * m in [sqrt(1/2), sqrt(2)), ln m = 2 atanh(s) = 2 (s + s^3/3 + ...) with
+ * s = (m - 1) / (m + 1), |s| <= 0.172, so 11 terms leave s^22 / 23 < 1e-17; e ln 2 in
+ * two parts (fdlibm's ln2_hi has trailing zeros, so e ln2_hi is exact). */
+static double channel_log(double x)
+{
+    if (!(x >= DBL_MIN && x <= DBL_MAX))
+        return log(x);
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    int e = (int)(bits >> 52) - 1023;
+    bits = (bits & 0x000fffffffffffffull) | 0x3ff0000000000000ull;
+    double m;
+    memcpy(&m, &bits, sizeof m);
+    if (m > M_SQRT2) {
+        m *= 0.5;
+        e++;
+    }
+    double s = (m - 1.0) / (m + 1.0), s2 = s * s;
+    double p = 1.0 / 21.0; /* Horner in s^2, written out: constants, no divisions */
+    p = p * s2 + 1.0 / 19.0;
+    p = p * s2 + 1.0 / 17.0;
+    p = p * s2 + 1.0 / 15.0;
+    p = p * s2 + 1.0 / 13.0;
+    p = p * s2 + 1.0 / 11.0;
+    p = p * s2 + 1.0 / 9.0;
+    p = p * s2 + 1.0 / 7.0;
+    p = p * s2 + 1.0 / 5.0;
+    p = p * s2 + 1.0 / 3.0;
+    p = p * s2 + 1.0;
+    const double ln2_hi = 6.93147180369123816490e-01, ln2_lo = 1.90821492927058770002e-10;
+    return (double)e * ln2_hi + ((double)e * ln2_lo + 2.0 * s * p);
+}
+
 double channel_sample_hz(const thz_channel *ch, double u1, double u2)
 {
     if (channel_has_response(ch))
         return channel_sample_table_hz(ch, u1, u2);
-    /* Box-Muller; 1 - u1 lies in (0, 1] so the log is finite. */
-    double r = sqrt(-2.0 * log(1.0 - u1));
-    double z = r * cos(CHANNEL_TWO_PI * u2);
+    /* Box-Muller; 1 - u1 lies in (0, 1] so the log is finite. Its log and cos without
+     * libm (channel_log, sampling_cos_sin_turn): the photon phase draws one per photon. */
+    double r = sqrt(-2.0 * channel_log(1.0 - u1));
+    double cos_phi, sin_phi;
+    sampling_cos_sin_turn(u2, &cos_phi, &sin_phi);
+    double z = r * cos_phi;
     double nu = ch->center_hz + channel_sigma_hz(ch) * z;
     if (!(nu > 0.0)) {
         /* Reflect the (practically unreachable) non-positive tail about the centre. */

@@ -85,6 +85,11 @@ bool optics_sample_transmission_mu(const optics_point *o, optics_uniform_fn next
                                    double *mu);
 bool optics_sample_emission_mu(const optics_point *o, optics_uniform_fn next, void *ctx,
                                double *mu);
+
+/* Whether optics_sample_emission_mu draws the cosine law, mu = sqrt(1 - u) from one
+ * uniform u (eps does not depend on angle and is > 0): callers that sample many photons
+ * from the same optics may draw it themselves, with the same numbers. */
+bool optics_emission_is_cosine(const optics_point *o);
 bool optics_sample_reflection_mu(const optics_point *o, optics_uniform_fn next, void *ctx,
                                  double *mu);
 

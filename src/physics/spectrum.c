@@ -1,6 +1,7 @@
 /* Spectral properties: constants and linearly interpolated tables. */
 #include "physics/spectrum.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,9 +25,36 @@ double spectrum_eval(const thz_spectrum *s, double freq_hz)
         return s->value[0];
     if (!(freq_hz < f[n - 1]))
         return s->value[n - 1];
-    size_t lo = spectrum_interval(f, n, freq_hz), hi = lo + 1;
+    size_t lo;
+    if (s->inv_step_per_hz > 0.0) {
+        /* f[0] < freq_hz < f[n - 1] here; the guess is off by at most one on an even
+         * grid, and the comparisons make lo exactly spectrum_interval's. */
+        lo = (size_t)((freq_hz - f[0]) * s->inv_step_per_hz);
+        if (lo > n - 2)
+            lo = n - 2;
+        while (lo > 0 && f[lo] > freq_hz)
+            lo--;
+        while (lo < n - 2 && !(freq_hz < f[lo + 1]))
+            lo++;
+    } else {
+        lo = spectrum_interval(f, n, freq_hz);
+    }
+    size_t hi = lo + 1;
     double t = (freq_hz - f[lo]) / (f[hi] - f[lo]);
     return s->value[lo] + t * (s->value[hi] - s->value[lo]);
+}
+
+/* 1 / spacing when the n >= 2 frequencies strictly increase with steps equal to 1e-6
+ * (so that a guess from the mean step is off by at most one interval), else 0. */
+static double spectrum_even_grid(const double *f, size_t n)
+{
+    double step = (f[n - 1] - f[0]) / (double)(n - 1);
+    if (!(step > 0.0) || !isfinite(step))
+        return 0.0;
+    for (size_t i = 0; i + 1 < n; i++)
+        if (!(fabs((f[i + 1] - f[i]) - step) <= 1e-6 * step))
+            return 0.0;
+    return 1.0 / step;
 }
 
 bool spectrum_set_constant(thz_spectrum *s, double value)
@@ -62,6 +90,7 @@ bool spectrum_set_table(thz_spectrum *s, size_t n, const double *freq_hz, const 
     s->n = n;
     s->freq_hz = f;
     s->value = v;
+    s->inv_step_per_hz = spectrum_even_grid(f, n);
     return true;
 }
 
@@ -84,6 +113,7 @@ void spectrum_fini(thz_spectrum *s)
         return;
     free(s->freq_hz);
     free(s->value);
+    s->inv_step_per_hz = 0.0;
     s->n = 0;
     s->freq_hz = NULL;
     s->value = NULL;

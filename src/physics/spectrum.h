@@ -11,6 +11,10 @@ typedef struct thz_spectrum {
     size_t n;        /* 0: not given; 1: constant value[0]; >1: table */
     double *freq_hz; /* n entries for a table, NULL for a constant */
     double *value;   /* n entries */
+    /* A table on an even grid (spectrum_set_table checks): 1 / spacing, so that
+     * spectrum_eval guesses the interval and corrects it by comparisons instead of a
+     * bisection (the photon phase evaluates spectra per photon and per hit); 0: bisect. */
+    double inv_step_per_hz;
 } thz_spectrum;
 
 /* The interval of an ascending table t[0 .. n-1] (n >= 2) that holds x: the last

@@ -87,12 +87,61 @@ static void test_two_point_and_copy_absent(void **state)
     spectrum_fini(&c);
 }
 
+/* The interpolation by the interval lookup of spectrum_interval (the reference). */
+static double reference_eval(const double *f, const double *v, size_t n, double x)
+{
+    if (!(x > f[0]))
+        return v[0];
+    if (!(x < f[n - 1]))
+        return v[n - 1];
+    size_t lo = spectrum_interval(f, n, x);
+    return v[lo] + (x - f[lo]) / (f[lo + 1] - f[lo]) * (v[lo + 1] - v[lo]);
+}
+
+/* An even grid (the guessed interval) and an uneven one (bisection) give bit for bit
+ * what the bisection gives, at the nodes, next to them and between them. */
+static void test_even_grid_lookup(void **state)
+{
+    (void)state;
+    enum { N = 55 };
+    double f[N], g[N], v[N];
+    for (size_t i = 0; i < N; i++) {
+        f[i] = 0.1e12 + (double)i * 0.025e12; /* as a CSV in THz, every 25 GHz */
+        g[i] = 0.1e12 + (double)(i * i) * 1e9;
+        v[i] = sin((double)i);
+    }
+    thz_spectrum even = {0}, uneven = {0};
+    assert_true(spectrum_set_table(&even, N, f, v));
+    assert_true(spectrum_set_table(&uneven, N, g, v));
+    assert_true(even.inv_step_per_hz > 0.0);
+    assert_true(uneven.inv_step_per_hz == 0.0);
+    for (size_t i = 0; i < N; i++)
+        for (int d = -3; d <= 3; d++) {
+            double x = f[i] + (double)d * (d % 2 ? 1.0 : 1e6);
+            assert_true(spectrum_eval(&even, x) == reference_eval(f, v, N, x));
+            double y = g[i] + (double)d * (d % 2 ? 1.0 : 1e6);
+            assert_true(spectrum_eval(&uneven, y) == reference_eval(g, v, N, y));
+        }
+    for (int k = 0; k < 100000; k++) {
+        double x = 0.09e12 + k * 1.41421e7;
+        assert_true(spectrum_eval(&even, x) == reference_eval(f, v, N, x));
+    }
+    thz_spectrum copy = {0};
+    assert_true(spectrum_copy(&copy, &even));
+    assert_true(copy.inv_step_per_hz == even.inv_step_per_hz);
+    spectrum_fini(&even);
+    assert_true(even.inv_step_per_hz == 0.0);
+    spectrum_fini(&uneven);
+    spectrum_fini(&copy);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_absent_and_constant),
         cmocka_unit_test(test_table),
         cmocka_unit_test(test_two_point_and_copy_absent),
+        cmocka_unit_test(test_even_grid_lookup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
