@@ -35,6 +35,9 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 /* Ranges up to this many records (2 MB) are sorted 64 buckets at a time. */
 #define PHOTON_MAP_CACHED 65536
@@ -430,17 +433,40 @@ static void photon_build_sort_item(const photon_build *b, size_t k)
 
 /* ---- Scratch kept between builds ------------------------------------------------------ */
 
+/* Asks for the memory of a large array in huge pages (Linux, where transparent huge
+ * pages are on "madvise"): on this VM, a page new to the process costs ~12 us to fault
+ * in, and the 2 MB pages bring 160 MB of new memory from 470 ms to 15 ms (when the
+ * kernel has them free). Only the array's whole 2 MB-aligned pages. */
+static void photon_map_advise_huge(void *p, size_t bytes)
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    const uintptr_t huge = (uintptr_t)2 << 20;
+    uintptr_t lo = ((uintptr_t)p + huge - 1) & ~(huge - 1),
+              hi = ((uintptr_t)p + bytes) & ~(huge - 1);
+    if (p && hi > lo)
+        (void)madvise((void *)lo, hi - lo, MADV_HUGEPAGE); /* a hint: failure changes nothing */
+#else
+    (void)p;
+    (void)bytes;
+#endif
+}
+
 /* The build's second array: the pool's (grown if need be, kept there) or, without a
  * pool, a new one the caller frees. NULL when out of memory. */
 static photon_record *photon_map_scratch(photon_map_pool *pool, size_t count)
 {
     size_t n = count ? count : 1;
+    photon_record *s = NULL;
+    if (!pool || pool->scratch_capacity < n) {
+        s = thz_malloc_array(n, sizeof(photon_record));
+        photon_map_advise_huge(s, n * sizeof(photon_record));
+    }
     if (!pool)
-        return thz_malloc_array(n, sizeof(photon_record));
+        return s;
     if (pool->scratch_capacity < n) {
         free(pool->scratch);
-        pool->scratch = thz_malloc_array(n, sizeof(photon_record));
-        pool->scratch_capacity = pool->scratch ? n : 0;
+        pool->scratch = s;
+        pool->scratch_capacity = s ? n : 0;
     }
     return pool->scratch;
 }
