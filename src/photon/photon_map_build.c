@@ -75,17 +75,19 @@ static unsigned photon_code_digits(uint64_t code, int level, int levels)
     PHOTON_SPREAD7_4(i), PHOTON_SPREAD7_4(i + 4u), PHOTON_SPREAD7_4(i + 8u),                       \
         PHOTON_SPREAD7_4(i + 12u)
 
+/* 7 bits spread to every third bit. */
+static const uint32_t photon_spread7[128] = {PHOTON_SPREAD7_16(0u),  PHOTON_SPREAD7_16(16u),
+                                             PHOTON_SPREAD7_16(32u), PHOTON_SPREAD7_16(48u),
+                                             PHOTON_SPREAD7_16(64u), PHOTON_SPREAD7_16(80u),
+                                             PHOTON_SPREAD7_16(96u), PHOTON_SPREAD7_16(112u)};
+
 /* The low 21 bits of v spread to every third bit (bit i to bit 3i), 7 bits at a time from
- * a table: 2/3 of the instructions of the shift-and-mask version, whose codes took 43 %
+ * the table: 2/3 of the instructions of the shift-and-mask version, whose codes took 43 %
  * of the build's instructions. */
 static uint64_t photon_spread3(uint32_t v)
 {
-    static const uint32_t spread7[128] = {PHOTON_SPREAD7_16(0u),  PHOTON_SPREAD7_16(16u),
-                                          PHOTON_SPREAD7_16(32u), PHOTON_SPREAD7_16(48u),
-                                          PHOTON_SPREAD7_16(64u), PHOTON_SPREAD7_16(80u),
-                                          PHOTON_SPREAD7_16(96u), PHOTON_SPREAD7_16(112u)};
-    return (uint64_t)spread7[v & 127u] | (uint64_t)spread7[v >> 7 & 127u] << 21 |
-           (uint64_t)spread7[v >> 14 & 127u] << 42;
+    return (uint64_t)photon_spread7[v & 127u] | (uint64_t)photon_spread7[v >> 7 & 127u] << 21 |
+           (uint64_t)photon_spread7[v >> 14 & 127u] << 42;
 }
 
 /* The full Morton code (3 LEVELS bits; x the highest bit of each level). */
@@ -101,14 +103,11 @@ static uint64_t photon_morton(const photon_cube *c, const photon_record *p)
  * quantised coordinates' top bits alone. */
 static unsigned photon_first_digit(const photon_cube *c, const photon_record *p)
 {
-    _Static_assert(PHOTON_MAP_FIRST_LEVELS == 4, "spread4 spreads 4 bits");
-    /* bit i of the index to bit 3i */
-    static const uint16_t spread4[16] = {0,   1,   8,   9,   64,  65,  72,  73,
-                                         512, 513, 520, 521, 576, 577, 584, 585};
+    _Static_assert(PHOTON_MAP_FIRST_LEVELS <= 7, "the table spreads 7 bits");
     const int shift = PHOTON_MAP_LEVELS - PHOTON_MAP_FIRST_LEVELS;
-    return (unsigned)spread4[photon_quantize_axis(c, p, 0) >> shift] << 2 |
-           (unsigned)spread4[photon_quantize_axis(c, p, 1) >> shift] << 1 |
-           (unsigned)spread4[photon_quantize_axis(c, p, 2) >> shift];
+    return photon_spread7[photon_quantize_axis(c, p, 0) >> shift] << 2 |
+           photon_spread7[photon_quantize_axis(c, p, 1) >> shift] << 1 |
+           photon_spread7[photon_quantize_axis(c, p, 2) >> shift];
 }
 
 /* Swaps records i and j and their codes. */
