@@ -368,7 +368,8 @@ static void check_queries(const photon_map *map, size_t n, uint32_t obj)
 static void test_deterministic_crowded(void **state)
 {
     (void)state;
-    const size_t n = (size_t)(300000 * test_scale()), n_objects = 40;
+    /* at least 140000 at any scale: object 0's half must pass the split threshold */
+    const size_t n = (size_t)(140000 + 160000 * test_scale()), n_objects = 40;
     photon_record *src = make_crowded(n, n_objects);
     photon_map *a = build(src, n, n_objects, 1, 0);
     size_t total = 0;
@@ -376,6 +377,7 @@ static void test_deterministic_crowded(void **state)
         total += photon_map_object_count(a, obj, 3u);
     assert_int_equal(total, n);
     assert_int_equal(photon_map_object_count(a, 7, 3u), 0);
+    assert_true(photon_map_object_count(a, 0, 1u) >= 65536); /* the build's split threshold */
     const photon_record *ra = photon_map_records(a);
     for (size_t i = 1; i < n; i++)
         assert_true(ra[i - 1].object_side <= ra[i].object_side);
