@@ -17,10 +17,10 @@
  * The in-place build it replaces (a serial permutation by group, then per group an
  * American flag sort whose first pass over the largest group was serial too) swapped
  * the records along permutation cycles, a cache miss per record in the passes over the
- * whole array; it took 62 ns per record on 1 thread, and its serial passes held the
- * photon phase's 2-thread speed-up down. The price is memory: the second array is as
- * large as the records (the peak is twice the map, as the run's estimate allows), kept
- * in the pool between builds.
+ * whole array; it took 62 ns per record on 1 thread and 35-46 on 2 (the paper's case,
+ * 5.06 M records, warm memory, fastest of 6 builds on a loaded machine), this one 36 and
+ * 20. The price is memory: the second array is as large as the records (the peak is
+ * twice the map, as the run's estimate allows), kept in the pool between builds.
  */
 #include "photon/photon_map.h"
 
@@ -34,9 +34,6 @@
 
 #ifdef _OPENMP
 #include <omp.h>
-#endif
-#ifdef __linux__
-#include <sys/mman.h>
 #endif
 
 /* Ranges up to this many records (2 MB) are sorted 64 buckets at a time. */
@@ -145,9 +142,11 @@ static void photon_sort_small(photon_record *r, uint64_t *code, size_t n)
 }
 
 /* Sorts r[0..n) (with their Morton codes alongside), whose codes share the digits of
- * levels 1..level-1, by code and then bytes: American flag sort. Ranges larger than the
- * caches go three levels (512 buckets) at a time, since every pass over them costs a
- * cache miss per record; cached ones two levels (64 buckets) at a time. */
+ * levels 1..level-1, by code and then bytes: American flag sort, in place. The build
+ * uses it for the records whose codes tie in the 32 bits its radix sort looked at.
+ * Ranges larger than the caches go three levels (512 buckets) at a time, since every
+ * pass over them costs a cache miss per record; cached ones two levels (64 buckets) at
+ * a time. */
 static void photon_sort(photon_record *r, uint64_t *code, size_t n, int level)
 {
     if (n <= PHOTON_MAP_SORT_SMALL) {
@@ -455,59 +454,6 @@ static void photon_build_sort_item(const photon_build *b, size_t k)
                             1 + PHOTON_MAP_FIRST_LEVELS, false);
 }
 
-/* ---- Scratch kept between builds ------------------------------------------------------ */
-
-/* Asks for the memory of a large array in huge pages (Linux, where transparent huge
- * pages are on "madvise"): on this VM, a page new to the process costs ~12 us to fault
- * in, and the 2 MB pages bring 160 MB of new memory from 470 ms to 15 ms (when the
- * kernel has them free). Only the array's whole 2 MB-aligned pages. */
-static void photon_map_advise_huge(void *p, size_t bytes)
-{
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    const uintptr_t huge = (uintptr_t)2 << 20;
-    uintptr_t lo = ((uintptr_t)p + huge - 1) & ~(huge - 1),
-              hi = ((uintptr_t)p + bytes) & ~(huge - 1);
-    if (p && hi > lo)
-        (void)madvise((void *)lo, hi - lo, MADV_HUGEPAGE); /* a hint: failure changes nothing */
-#else
-    (void)p;
-    (void)bytes;
-#endif
-}
-
-/* The build's second array: the pool's (grown if need be, kept there) or, without a
- * pool, a new one the caller frees. NULL when out of memory. */
-static photon_record *photon_map_scratch(photon_map_pool *pool, size_t count)
-{
-    size_t n = count ? count : 1;
-    photon_record *s = NULL;
-    if (!pool || pool->scratch_capacity < n) {
-        s = thz_malloc_array(n, sizeof(photon_record));
-        photon_map_advise_huge(s, n * sizeof(photon_record));
-    }
-    if (!pool)
-        return s;
-    if (pool->scratch_capacity < n) {
-        free(pool->scratch);
-        pool->scratch = s;
-        pool->scratch_capacity = s ? n : 0;
-    }
-    return pool->scratch;
-}
-
-/* The build's counts and boxes, bytes of them: as photon_map_scratch. */
-static void *photon_map_index_scratch(photon_map_pool *pool, size_t bytes)
-{
-    if (!pool)
-        return malloc(bytes ? bytes : 1);
-    if (pool->index_bytes < bytes || !pool->index) {
-        free(pool->index);
-        pool->index = malloc(bytes ? bytes : 1);
-        pool->index_bytes = pool->index ? bytes : 0;
-    }
-    return pool->index;
-}
-
 /* ---- The build -------------------------------------------------------------------------- */
 
 /* More parts than this gain nothing (and keep the per-part arrays' sizes far from
@@ -576,10 +522,10 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
         map->start = thz_calloc(n_groups + 1, sizeof *map->start);
         map->cubes = thz_calloc(n_groups ? n_groups : 1, sizeof *map->cubes);
     }
-    index = photon_map_index_scratch(pool, photon_build_arrays(&b, NULL));
+    index = photon_map_pool_index(pool, photon_build_arrays(&b, NULL));
     /* The second array (32 bytes per record: the peak is twice the map), kept in the pool
      * for the next build. */
-    scratch = photon_map_scratch(pool, count);
+    scratch = photon_map_pool_scratch(pool, count);
     if (!map || !map->start || !map->cubes || !index || !scratch) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu photons", count);
         goto cleanup;

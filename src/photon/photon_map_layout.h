@@ -1,5 +1,6 @@
 /* The photon map's layout, shared by its build (photon_map_build.c) and its queries
- * (photon_map.c); photon_map.c's header says what the order of the records is and why.
+ * (photon_map.c), and the build's scratch from the pool; photon_map.c's header says what
+ * the order of the records is and why.
  * Internal to src/photon/.
  */
 #ifndef THZ_PHOTON_PHOTON_MAP_LAYOUT_H
@@ -39,5 +40,13 @@ static inline uint32_t photon_quantize_axis(const photon_cube *c, const photon_r
         return (1u << PHOTON_MAP_LEVELS) - 1;
     return (uint32_t)q;
 }
+
+/* The index build's second record array (count records): the pool's, grown if need be
+ * and kept there, or without a pool a new one the caller frees. NULL when out of
+ * memory. */
+photon_record *photon_map_pool_scratch(photon_map_pool *pool, size_t count);
+
+/* The index build's counts and boxes (bytes of them): as photon_map_pool_scratch. */
+void *photon_map_pool_index(photon_map_pool *pool, size_t bytes);
 
 #endif
