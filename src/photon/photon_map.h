@@ -71,8 +71,10 @@ void photon_map_destroy(photon_map *map);
 typedef struct photon_map_pool {
     photon_record *records; /* a spare record array (malloc'd), or NULL */
     size_t records_capacity;
-    uint64_t *codes; /* the index build's scratch: 8 bytes per record */
-    size_t codes_capacity;
+    photon_record *scratch; /* the index build's second record array */
+    size_t scratch_capacity;
+    void *index; /* the index build's counts and bounding boxes */
+    size_t index_bytes;
 } photon_map_pool;
 
 void photon_map_pool_fini(photon_map_pool *pool);

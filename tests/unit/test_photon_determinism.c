@@ -98,8 +98,8 @@ static void test_pool_reuses_memory(void **state)
     run_pooled(s, acc, 2, &pool, &m, &sm);
     assert_same(plain, &sp, m, &sm);
     assert_null(pool.records); /* the run took the spare (none yet) */
-    assert_non_null(pool.codes);
-    assert_true(pool.codes_capacity >= photon_map_count(m));
+    assert_non_null(pool.scratch);
+    assert_true(pool.scratch_capacity >= photon_map_count(m));
     const photon_record *first = photon_map_records(m);
     photon_map_recycle(m, &pool);
     assert_ptr_equal(pool.records, first);
@@ -115,7 +115,7 @@ static void test_pool_reuses_memory(void **state)
     photon_map_recycle(NULL, &pool);
     photon_map_pool_fini(&pool);
     assert_null(pool.records);
-    assert_null(pool.codes);
+    assert_null(pool.scratch);
 
     photon_map_destroy(plain);
     photon_map_destroy(plain_small);

@@ -288,6 +288,120 @@ static void noop_visit(void *ctx, const photon_record *p, double d2)
     (*(int *)ctx)++;
 }
 
+/* Many groups, one of them larger than the build's split threshold (65536 records, so
+ * its records go through the first-digit pass), positions on a coarse lattice or all on
+ * one point (long runs of equal codes, told apart by their bytes), exact duplicates and
+ * empty groups. */
+static photon_record *make_crowded(size_t n, size_t n_objects)
+{
+    photon_record *p = malloc(n * sizeof *p);
+    assert_non_null(p);
+    rng_stream rng;
+    rng_init(&rng, 13, 0, RNG_PURPOSE_TEST, 0);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t u = rng_next_u32(&rng);
+        uint32_t obj = u % 2 ? 0 : 1 + (u >> 1) % (uint32_t)(n_objects - 1);
+        uint32_t side = obj == 0 ? 0 : (u >> 20) & 1u;
+        if (obj == 7)
+            obj = 8; /* object 7 has no photons */
+        float pos[3];
+        for (int a = 0; a < 3; a++) {
+            double v = rng_uniform(&rng);
+            if (obj % 3 == 1 || (obj == 0 && i % 4 == 0))
+                v = floor(v * 8.0) / 8.0; /* a lattice: many records share a code */
+            pos[a] = (float)(v * (a == 2 && obj == 0 ? 1e-3 : 2.0));
+        }
+        if (obj == 5) /* all on one point */
+            pos[0] = pos[1] = pos[2] = 0.25f;
+        p[i] = (photon_record){
+            .position_m = {pos[0], pos[1], pos[2]},
+            .power_w_per_hz = (float)(i % 1000),
+            .freq_hz = 1e12f,
+            .dir_oct = rng_next_u32(&rng) % 4u,
+            .object_side = obj << 1 | side,
+            .flags = (uint32_t)(i % 3) | (i % 5 == 0 ? AXIS_MASK : 0u),
+        };
+        if (i % 13 == 6 && p[i - 1].object_side >> 1 != 7)
+            p[i] = p[i - 1]; /* fully identical record */
+    }
+    return p;
+}
+
+/* k-th nearest and radius counts of the big group against brute force. */
+static void check_queries(const photon_map *map, size_t n, uint32_t obj)
+{
+    const photon_record *r = photon_map_records(map);
+    double *d2s = malloc(n * sizeof *d2s);
+    assert_non_null(d2s);
+    rng_stream rng;
+    rng_init(&rng, 14, 0, RNG_PURPOSE_TEST, 0);
+    for (int trial = 0; trial < 12; trial++) {
+        size_t at = (size_t)(rng_uniform(&rng) * (double)n);
+        vec3 q = v3(r[at].position_m[0], r[at].position_m[1], r[at].position_m[2] + 1e-4 * trial);
+        size_t m = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (r[i].object_side != obj << 1)
+                continue;
+            double dx = (double)r[i].position_m[0] - q.x, dy = (double)r[i].position_m[1] - q.y,
+                   dz = (double)r[i].position_m[2] - q.z;
+            d2s[m++] = dx * dx + dy * dy + dz * dz;
+        }
+        qsort(d2s, m, sizeof *d2s, cmp_double);
+        static const size_t ks[] = {1, 9, 100, 1000};
+        for (size_t ki = 0; ki < sizeof ks / sizeof ks[0]; ki++) {
+            if (ks[ki] > m)
+                continue;
+            assert_true(photon_map_kth_distance2(map, obj, 1u, q, ks[ki]) == d2s[ks[ki] - 1]);
+            int visits = 0;
+            photon_map_radius(map, obj, 0, q, d2s[ks[ki] - 1], noop_visit, &visits);
+            size_t expect = ks[ki];
+            while (expect < m && d2s[expect] <= d2s[ks[ki] - 1])
+                expect++;
+            assert_int_equal((size_t)visits, expect);
+        }
+    }
+    free(d2s);
+}
+
+/* Byte-identical maps for 1, 2 and 3 threads, input reversed, and from a pool's reused
+ * memory, on the crowded records; queries right on the largest group. */
+static void test_deterministic_crowded(void **state)
+{
+    (void)state;
+    /* at least 140000 at any scale: object 0's half must pass the split threshold */
+    const size_t n = (size_t)(140000 + 160000 * test_scale()), n_objects = 40;
+    photon_record *src = make_crowded(n, n_objects);
+    photon_map *a = build(src, n, n_objects, 1, 0);
+    size_t total = 0;
+    for (uint32_t obj = 0; obj < n_objects; obj++)
+        total += photon_map_object_count(a, obj, 3u);
+    assert_int_equal(total, n);
+    assert_int_equal(photon_map_object_count(a, 7, 3u), 0);
+    assert_true(photon_map_object_count(a, 0, 1u) >= 65536); /* the build's split threshold */
+    const photon_record *ra = photon_map_records(a);
+    for (size_t i = 1; i < n; i++)
+        assert_true(ra[i - 1].object_side <= ra[i].object_side);
+    check_queries(a, n, 0);
+    for (int t = 2; t <= 3; t++) {
+        photon_map *b = build(src, n, n_objects, t, t == 3);
+        assert_memory_equal(ra, photon_map_records(b), n * sizeof(photon_record));
+        photon_map_destroy(b);
+    }
+    photon_map_pool pool = {0};
+    for (int round = 0; round < 2; round++) { /* the second reuses the first's scratch */
+        photon_record *p = malloc(n * sizeof *p);
+        assert_non_null(p);
+        memcpy(p, src, n * sizeof *p);
+        photon_map *c = NULL;
+        assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, &c, NULL), THZ_OK);
+        assert_memory_equal(ra, photon_map_records(c), n * sizeof(photon_record));
+        photon_map_recycle(c, &pool);
+    }
+    photon_map_pool_fini(&pool);
+    photon_map_destroy(a);
+    free(src);
+}
+
 static void test_empty_and_errors(void **state)
 {
     (void)state;
@@ -316,8 +430,11 @@ static void test_empty_and_errors(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_directions),           cmocka_unit_test(test_queries_vs_brute_force),
-        cmocka_unit_test(test_same_records_grouped), cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_directions),
+        cmocka_unit_test(test_queries_vs_brute_force),
+        cmocka_unit_test(test_same_records_grouped),
+        cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_deterministic_crowded),
         cmocka_unit_test(test_empty_and_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
