@@ -30,10 +30,6 @@
 #include "core/alloc.h"
 #include "photon/photon_map_layout.h"
 
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
-
 /* k up to this uses a heap on the stack; larger k allocates one per query. */
 #define PHOTON_MAP_STACK_K 256
 
@@ -131,24 +127,6 @@ void photon_map_recycle(photon_map *map, photon_map_pool *pool)
     photon_map_destroy(map);
 }
 
-/* Asks for the memory of a large array in huge pages (Linux, where transparent huge
- * pages are on "madvise"): on this VM, a page new to the process costs ~12 us to fault
- * in, and the 2 MB pages bring 160 MB of new memory from 470 ms to 15 ms (when the
- * kernel has them free). Only the array's whole 2 MB-aligned pages. */
-static void photon_map_advise_huge(void *p, size_t bytes)
-{
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    const uintptr_t huge = (uintptr_t)2 << 20;
-    uintptr_t lo = ((uintptr_t)p + huge - 1) & ~(huge - 1),
-              hi = ((uintptr_t)p + bytes) & ~(huge - 1);
-    if (p && hi > lo)
-        (void)madvise((void *)lo, hi - lo, MADV_HUGEPAGE); /* a hint: failure changes nothing */
-#else
-    (void)p;
-    (void)bytes;
-#endif
-}
-
 photon_record *photon_map_pool_scratch(photon_map_pool *pool, size_t count)
 {
     size_t n = count ? count : 1;
@@ -160,7 +138,7 @@ photon_record *photon_map_pool_scratch(photon_map_pool *pool, size_t count)
         pool->scratch_capacity = 0;
     }
     photon_record *s = thz_malloc_array(n, sizeof(photon_record));
-    photon_map_advise_huge(s, n * sizeof(photon_record));
+    thz_advise_huge_pages(s, n * sizeof(photon_record));
     if (pool && s) {
         pool->scratch = s;
         pool->scratch_capacity = n;
