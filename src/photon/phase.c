@@ -2,6 +2,7 @@
 #include "photon/phase.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,6 +51,7 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
     phase_chunk *chunks = thz_calloc(PHASE_BATCH / PHASE_CHUNK, sizeof *chunks);
     size_t count = 0, capacity = 0;
     photon_record *records = a->pool ? photon_map_pool_take(a->pool, &capacity) : NULL;
+    const bool pooled = records != NULL;
     if (!records) {
         records = thz_malloc_array(1, sizeof *records);
         capacity = 1;
@@ -167,9 +169,10 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
             }
         }
     }
-    /* Give back the growth slack; from a pool, only beyond a quarter (the next channel's
-     * map, about as large, reuses it). */
-    if (count > 0 && (a->pool ? capacity - count > count / 4 : capacity > count)) {
+    /* Give back the growth slack; in the pool's spare array, only beyond a quarter (the
+     * next channel's map, about as large, will reuse it): a map that is kept (--save-photon-
+     * map takes no spare) holds no slack. */
+    if (count > 0 && (pooled ? capacity - count > count / 4 : capacity > count)) {
         photon_record *p = thz_realloc_array(records, count, sizeof *p);
         if (p) {
             records = p;

@@ -94,8 +94,11 @@ thz_status run_check_run_memory(run_state *rs, bool photons, thz_error *err)
             sum = run_add_bytes(sum, b);
             max = b > max ? b : max;
         }
-        /* kept maps, plus one map while it is built (records and index) */
-        need.photon_bytes = run_add_bytes(rs->opt->keep_photon_maps ? sum : max, max);
+        /* While a map is built: kept maps (the one being built among them) and the
+         * build's scratch (as large), else the map in the pool's spare array (up to a
+         * quarter larger: phase.c) and the scratch. */
+        need.photon_bytes =
+            rs->opt->keep_photon_maps ? run_add_bytes(sum, max) : run_add_bytes(max, max + max / 4);
     }
     need.total_bytes = run_add_bytes(need.photon_bytes, need.image_bytes);
     rs->memory_bytes = need.total_bytes;
