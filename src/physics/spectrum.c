@@ -44,8 +44,9 @@ double spectrum_eval(const thz_spectrum *s, double freq_hz)
     return s->value[lo] + t * (s->value[hi] - s->value[lo]);
 }
 
-/* 1 / spacing when the n >= 2 frequencies strictly increase with steps equal to 1e-6
- * (so that a guess from the mean step is off by at most one interval), else 0. */
+/* 1 / spacing when the n >= 2 frequencies increase by steps equal to within 1e-6 of
+ * their mean (so that a guess from the mean step is off by at most one interval), else
+ * 0. */
 static double spectrum_even_grid(const double *f, size_t n)
 {
     double step = (f[n - 1] - f[0]) / (double)(n - 1);
