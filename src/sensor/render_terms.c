@@ -179,9 +179,15 @@ double render_emission(const render_context *ctx, uint32_t object, double mu,
     const double *planck = &ctx->planck[(size_t)object * n];
     double sum = 0.0;
     for (size_t k = 0; k < n; k++) {
-        double v = optics_emissivity(&op[k], mu) * planck[k];
-        if (ctx->deviation)
-            v -= optics_absorption(&op[k], mu) * ctx->b0[k];
+        double v;
+        if (ctx->deviation) {
+            /* optics_emissivity's rule, without computing the absorption twice */
+            double a = optics_absorption(&op[k], mu);
+            double eps = op[k].explicit_emissivity ? optics_emissivity(&op[k], mu) : a;
+            v = eps * planck[k] - a * ctx->b0[k];
+        } else {
+            v = optics_emissivity(&op[k], mu) * planck[k];
+        }
         if (ctx->atmosphere)
             v *= exp(-ctx->alpha_per_m[k] * distance_m);
         if (v != 0.0)

@@ -92,6 +92,36 @@ static void furnace_case(thz_integrator integrator, double t0_k)
     ident_run_fini(&r);
 }
 
+/* `path` with T0 away from the furnace's temperature (0 K: the plain transport of L;
+ * 280 K): no bracket vanishes, so every path goes on through many hits, without roulette
+ * while its weight times R + T is at least 0.3 (the ball's 0.6, the sheet's 0.5, the
+ * walls' 0.3 at weight 1) and by roulette below; every pixel, edges included, must
+ * still show B(T) within its own standard error. */
+static void furnace_path_t0_case(double t0_k)
+{
+    ident_run r;
+    ident_run_scene_t0(&r, furnace_json, 0, INTEGRATOR_PATH, ident_estimates(32), t0_k);
+    for (size_t c = 0; c < r.scene->n_channels; c++) {
+        double b = ident_band_planck(&r.scene->channels[c], 300.0);
+        /* with T0 = 0 K a path's terms are heavy-tailed (a long path's many terms): a
+         * pixel's tolerance uses at least the image's pooled standard error, as in the
+         * band test */
+        size_t np = (size_t)r.img.rows * r.img.columns;
+        double pooled = 0.0;
+        for (size_t i = 0; i < np; i++)
+            pooled += r.img.radiance_stderr[c * np + i] * (double)r.img.radiance_stderr[c * np + i];
+        ident_tally t = {.exact = false, .pooled_rel_se = sqrt(pooled / (double)np) / b};
+        for (uint32_t row = 0; row < r.img.rows; row++)
+            for (uint32_t col = 0; col < r.img.columns; col++)
+                ident_check_pixel(&t, &r, c, col, row, b, 1e-9);
+        char what[64];
+        snprintf(what, sizeof what, "furnace, path, T0 = %.0f K, channel %zu", t0_k, c);
+        assert_true(t.max_rel_se > 0.0); /* not exact: the brackets do not vanish */
+        ident_tally_assert(&t, what, 0.1 / sqrt(ident_scale()), 0.0);
+    }
+    ident_run_fini(&r);
+}
+
 static void test_furnace(void **state)
 {
     (void)state;
@@ -99,6 +129,8 @@ static void test_furnace(void **state)
         furnace_case(ident_integrators[k], NAN);
     /* photon-map reading a deviation map (render from a map final-gather's simulate saved) */
     furnace_case(INTEGRATOR_PHOTON_MAP, 300.0);
+    furnace_path_t0_case(0.0);
+    furnace_path_t0_case(280.0);
 }
 
 int main(void)
