@@ -45,8 +45,9 @@ static double knn_kth_smallest(double *v, size_t n, size_t k)
     return v[want];
 }
 
-double knn_collect(const photon_map *map, uint32_t object, double area_m2, int seen_side,
-                   unsigned mask, vec3 position, size_t k, knn_buffer *b, double *scratch)
+double knn_collect(const photon_map *map, const photon_map_directory *dir, uint32_t object,
+                   double area_m2, int seen_side, unsigned mask, vec3 position, size_t k,
+                   knn_buffer *b, double *scratch)
 {
     size_t available = photon_map_object_count(map, object, mask);
     if (available < k)
@@ -66,7 +67,7 @@ double knn_collect(const photon_map *map, uint32_t object, double area_m2, int s
             if (!(mask >> side & 1u))
                 continue;
             b->other_side = side != seen_side;
-            photon_map_radius(map, object, side, position, r2, knn_visit, b);
+            photon_map_radius_in(map, dir, object, side, position, r2, knn_visit, b);
         }
         if (b->total < k) {
             lo = r2;

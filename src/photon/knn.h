@@ -40,9 +40,11 @@ typedef struct knn_buffer {
  * radius query visits them) within the k-th nearest photon's distance or somewhat
  * beyond, and returns that squared distance (m^2); NAN when the search does not settle
  * (the caller falls back to photon_map_kth_distance2), INFINITY when the object holds
- * fewer than k photons. area_m2 is the object's area of one side (the first guess is k
- * photons at its mean density); scratch holds KNN_CAP doubles. Allocates nothing. */
-double knn_collect(const photon_map *map, uint32_t object, double area_m2, int seen_side,
-                   unsigned mask, vec3 position, size_t k, knn_buffer *b, double *scratch);
+ * fewer than k photons. dir is map's directory or NULL. area_m2 is the object's area of
+ * one side (the first guess is k photons at its mean density); scratch holds KNN_CAP
+ * doubles. Allocates nothing. */
+double knn_collect(const photon_map *map, const photon_map_directory *dir, uint32_t object,
+                   double area_m2, int seen_side, unsigned mask, vec3 position, size_t k,
+                   knn_buffer *b, double *scratch);
 
 #endif

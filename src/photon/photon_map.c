@@ -243,74 +243,11 @@ static double photon_distance2(const photon_record *p, const double q[3])
     return dx * dx + dy * dy + dz * dz;
 }
 
-/* A cell of a group's octree: its level, integer coordinates and record range. */
-typedef struct photon_cell {
-    int level;
-    uint32_t c[3];
-    size_t lo, hi;
-} photon_cell;
-
-/* Squared distance from q to the cell's box, the box widened by a millionth of its
- * side: quantisation rounds in double, so a point on a cell's face may sit in the
- * neighbouring cell; the widening keeps pruning conservative. */
-static double photon_cell_distance2(const photon_cube *cube, const photon_cell *cell,
-                                    const double q[3])
-{
-    double size = ldexp(cube->side, -cell->level);
-    double pad = 1e-6 * size;
-    double d2 = 0.0;
-    for (int a = 0; a < 3; a++) {
-        double lo = cube->origin[a] + (double)cell->c[a] * size - pad;
-        double hi = lo + size + 2.0 * pad;
-        double d = q[a] < lo ? lo - q[a] : (q[a] > hi ? q[a] - hi : 0.0);
-        d2 += d * d;
-    }
-    return d2;
-}
-
-/* First index in [lo, hi) whose quantised coordinate on axis a has bit `bit` set: the
- * range is sorted by that bit (a cell's records by x bit, then, within each half, by y
- * bit, then by z bit of the next level). */
-static size_t photon_bit_boundary(const photon_cube *cube, const photon_record *r, size_t lo,
-                                  size_t hi, int a, int bit)
-{
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (photon_quantize_axis(cube, &r[mid], a) >> bit & 1u)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
-
-/* Splits a cell's range into its 8 children's: b[d]..b[d+1] is child d. */
-static void photon_cell_split(const photon_cube *cube, const photon_record *r,
-                              const photon_cell *cell, size_t b[9])
-{
-    int bit = PHOTON_MAP_LEVELS - (cell->level + 1);
-    b[0] = cell->lo;
-    b[8] = cell->hi;
-    b[4] = photon_bit_boundary(cube, r, b[0], b[8], 0, bit);
-    b[2] = photon_bit_boundary(cube, r, b[0], b[4], 1, bit);
-    b[6] = photon_bit_boundary(cube, r, b[4], b[8], 1, bit);
-    for (int k = 1; k < 8; k += 2)
-        b[k] = photon_bit_boundary(cube, r, b[k - 1], b[k + 1], 2, bit);
-}
-
-static photon_cell photon_child(const photon_cell *cell, unsigned d, const size_t b[9])
-{
-    photon_cell ch = {.level = cell->level + 1,
-                      .c = {cell->c[0] << 1 | (d >> 2 & 1u), cell->c[1] << 1 | (d >> 1 & 1u),
-                            cell->c[2] << 1 | (d & 1u)},
-                      .lo = b[d],
-                      .hi = b[d + 1]};
-    return ch;
-}
-
 typedef struct photon_radius_query {
     const photon_cube *cube;
     const photon_record *r; /* the map's records */
+    int dir_level;          /* the group's directory: starts of its cells of this level */
+    const size_t *dir_starts;
     double q[3];
     double radius2, radius;
     photon_visit_fn visit;
@@ -331,6 +268,7 @@ static void photon_radius_axes(const photon_radius_query *qr, const photon_cell 
         photon_cell ch = {.level = cell->level + 1,
                           .c = {cell->c[0] << 1 | (bits >> 2 & 1u),
                                 cell->c[1] << 1 | (bits >> 1 & 1u), cell->c[2] << 1 | (bits & 1u)},
+                          .m = cell->m << 3 | bits,
                           .lo = lo,
                           .hi = hi};
         if (photon_cell_distance2(qr->cube, &ch, qr->q) <= qr->radius2)
@@ -341,8 +279,17 @@ static void photon_radius_axes(const photon_radius_query *qr, const photon_cell 
     double mid_m = qr->cube->origin[axis] + ((double)cell->c[axis] + 0.5) * size;
     bool low = qr->q[axis] - qr->radius <= mid_m + pad;
     bool high = qr->q[axis] + qr->radius >= mid_m - pad;
-    size_t m =
-        photon_bit_boundary(qr->cube, qr->r, lo, hi, axis, PHOTON_MAP_LEVELS - (cell->level + 1));
+    size_t m;
+    if (cell->level < qr->dir_level) {
+        /* the first record of the child whose digit has this axis's bit set and the
+         * bits so far, the later axes' bits clear: its first descendant of the
+         * directory's level */
+        uint64_t child = cell->m << 3 | ((uint64_t)bits << (3 - axis) | 1u << (2 - axis));
+        m = qr->dir_starts[child << 3 * (qr->dir_level - cell->level - 1)];
+    } else {
+        m = photon_bit_boundary(qr->cube, qr->r, lo, hi, axis,
+                                PHOTON_MAP_LEVELS - (cell->level + 1));
+    }
     if (low)
         photon_radius_axes(qr, cell, lo, m, axis + 1, bits << 1);
     if (high)
@@ -391,17 +338,27 @@ static photon_cell photon_root(size_t lo, size_t n)
 void photon_map_radius(const photon_map *map, uint32_t object, int side, vec3 position_m,
                        double radius2_m2, photon_visit_fn visit, void *ctx)
 {
+    photon_map_radius_in(map, NULL, object, side, position_m, radius2_m2, visit, ctx);
+}
+
+void photon_map_radius_in(const photon_map *map, const photon_map_directory *dir, uint32_t object,
+                          int side, vec3 position_m, double radius2_m2, photon_visit_fn visit,
+                          void *ctx)
+{
     size_t lo, n;
     if (!(radius2_m2 >= 0.0) || !photon_group_range(map, object, side, &lo, &n))
         return;
     size_t g = (size_t)object * 2 + (size_t)side;
-    photon_radius_query qr = {&map->cubes[g],
-                              map->records,
-                              {position_m.x, position_m.y, position_m.z},
-                              radius2_m2,
-                              sqrt(radius2_m2),
-                              visit,
-                              ctx};
+    bool indexed = dir && g < dir->n_groups && dir->level[g] > 0;
+    photon_radius_query qr = {.cube = &map->cubes[g],
+                              .r = map->records,
+                              .dir_level = indexed ? dir->level[g] : 0,
+                              .dir_starts = indexed ? dir->starts[g] : NULL,
+                              .q = {position_m.x, position_m.y, position_m.z},
+                              .radius2 = radius2_m2,
+                              .radius = sqrt(radius2_m2),
+                              .visit = visit,
+                              .ctx = ctx};
     photon_cell root = photon_root(lo, n);
     if (photon_cell_distance2(qr.cube, &root, qr.q) <= radius2_m2)
         photon_radius_rec(&qr, &root);

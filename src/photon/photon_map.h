@@ -124,6 +124,24 @@ typedef void (*photon_visit_fn)(void *ctx, const photon_record *p, double distan
 void photon_map_radius(const photon_map *map, uint32_t object, int side, vec3 position_m,
                        double radius2_m2, photon_visit_fn visit, void *ctx);
 
+/* A renderer's lookup table over a map's spatial index (photon_map_directory.c): for
+ * each group of records (object, side) with enough of them, the first record of every
+ * cell of one level of its octree, so that a radius query finds the cells above that
+ * level by index instead of by binary searches over the records, whose cache misses were
+ * most of final-gather's time. The queries visit the same photons in the same order with
+ * it or without it (it is built by those binary searches). It borrows the map, which
+ * must outlive it unchanged; it is not part of the map (photon_map_bytes). */
+typedef struct photon_map_directory photon_map_directory;
+thz_status photon_map_directory_create(const photon_map *map, photon_map_directory **out,
+                                       thz_error *err);
+void photon_map_directory_destroy(photon_map_directory *dir);
+size_t photon_map_directory_bytes(const photon_map_directory *dir);
+
+/* photon_map_radius through dir, map's directory (NULL: without). */
+void photon_map_radius_in(const photon_map *map, const photon_map_directory *dir, uint32_t object,
+                          int side, vec3 position_m, double radius2_m2, photon_visit_fn visit,
+                          void *ctx);
+
 /* The number of photons of `object` over the sides in side_mask (bit 0 front, bit 1
  * back). */
 size_t photon_map_object_count(const photon_map *map, uint32_t object, unsigned side_mask);

@@ -84,12 +84,12 @@ static void render_gather_pass(render_gather_state *g, uint32_t object, int seen
     g->transmitted = false;
     if (!(g->radius2_m2 > 0.0))
         return;
-    photon_map_radius(g->ctx->map, object, seen_side, position, g->radius2_m2, render_gather_visit,
-                      g);
+    photon_map_radius_in(g->ctx->map, g->ctx->dir, object, seen_side, position, g->radius2_m2,
+                         render_gather_visit, g);
     if (with_other_side) {
         g->transmitted = true;
-        photon_map_radius(g->ctx->map, object, 1 - seen_side, position, g->radius2_m2,
-                          render_gather_visit, g);
+        photon_map_radius_in(g->ctx->map, g->ctx->dir, object, 1 - seen_side, position,
+                             g->radius2_m2, render_gather_visit, g);
     }
 }
 
@@ -132,8 +132,8 @@ void render_gather(const render_context *ctx, const accel_hit *hit, vec3 ray_dir
             mask |= 1u << (1 - hit->side);
         knn_buffer b;
         double scratch[KNN_CAP];
-        double rk2 = knn_collect(ctx->map, hit->object, obj->mesh.total_area_m2, hit->side, mask,
-                                 hit->position_m, k, &b, scratch);
+        double rk2 = knn_collect(ctx->map, ctx->dir, hit->object, obj->mesh.total_area_m2,
+                                 hit->side, mask, hit->position_m, k, &b, scratch);
         bool collected = !isnan(rk2);
         if (!collected)
             rk2 = photon_map_kth_distance2(ctx->map, hit->object, mask, hit->position_m, k);

@@ -27,6 +27,7 @@ static void render_context_fini(render_context *ctx)
     free(ctx->pair_mean);
     free(ctx->air_planck);
     free(ctx->bg_planck);
+    photon_map_directory_destroy(ctx->dir);
     memset(ctx, 0, sizeof *ctx);
 }
 
@@ -167,6 +168,13 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
             ctx->air_planck[k] = atm->emitting ? planck_radiance(nu, atm->air.temperature_k) : 0.0;
             ctx->bg_planck[k] =
                 atm->emitting ? planck_radiance(nu, atm->background_temperature_k) : 0.0;
+        }
+    }
+    if (map) {
+        st = photon_map_directory_create(map, &ctx->dir, err);
+        if (st != THZ_OK) {
+            render_context_fini(ctx);
+            return st;
         }
     }
     if (map && scene->render.integrator == INTEGRATOR_FINAL_GATHER)

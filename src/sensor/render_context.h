@@ -25,6 +25,7 @@ struct render_context {
     const thz_scene *scene;
     const accel *accel;
     const photon_map *map;
+    photon_map_directory *dir; /* map's directory for the radius queries (NULL: none) */
     const thz_channel *channel;
     uint32_t channel_index;
     uint64_t seed;

@@ -1,6 +1,7 @@
 /* photon/knn: the k-nearest search by radius queries gives photon_map_kth_distance2's
  * distance exactly, whatever its first guess, and its buffer holds exactly the photons
- * within that distance, seen side first. */
+ * within that distance, seen side first; with the map's directory (photon_map.h) the
+ * radius queries visit the same photons in the same order as without. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -54,7 +55,9 @@ static void test_knn_matches_kth_distance(void **state)
     assert_int_equal(photon_map_create(make_photons(n, n_objects), n, n_objects, 0, &map, NULL),
                      THZ_OK);
     const photon_record *r = photon_map_records(map);
-    static knn_buffer b; /* ~48 KiB: not on the test's stack */
+    photon_map_directory *dir = NULL;
+    assert_int_equal(photon_map_directory_create(map, &dir, NULL), THZ_OK);
+    static knn_buffer b, b_dir; /* ~48 KiB each: not on the test's stack */
     static double scratch[KNN_CAP];
     static const size_t ks[] = {1, 2, 7, 64, 300, 1900, 5000, 20000};
     static const double areas[] = {1e-6, 1.0, 1e4}; /* bad first guesses too */
@@ -70,7 +73,19 @@ static void test_knn_matches_kth_distance(void **state)
                 for (size_t ai = 0; ai < sizeof areas / sizeof areas[0]; ai++) {
                     size_t k = ks[ki];
                     double want = photon_map_kth_distance2(map, obj, mask, q, k);
-                    double got = knn_collect(map, obj, areas[ai], seen, mask, q, k, &b, scratch);
+                    double got =
+                        knn_collect(map, NULL, obj, areas[ai], seen, mask, q, k, &b, scratch);
+                    /* through the directory: the same distance, the same buffer */
+                    double got_dir =
+                        knn_collect(map, dir, obj, areas[ai], seen, mask, q, k, &b_dir, scratch);
+                    assert_true(got_dir == got || (isnan(got) && isnan(got_dir)));
+                    assert_int_equal(b_dir.n, b.n);
+                    assert_int_equal(b_dir.total, b.total);
+                    for (size_t i = 0; i < b.n; i++) {
+                        assert_ptr_equal(b_dir.e[i].p, b.e[i].p);
+                        assert_true(b_dir.e[i].d2 == b.e[i].d2);
+                        assert_int_equal(b_dir.e[i].other_side, b.e[i].other_side);
+                    }
                     if (isnan(got))
                         continue; /* did not settle: the caller falls back */
                     assert_true(got == want);
@@ -99,11 +114,71 @@ static void test_knn_matches_kth_distance(void **state)
         }
     }
     assert_true(settled > 300); /* the search settles for every k <= KNN_CAP */
+    photon_map_directory_destroy(dir);
+    photon_map_destroy(map);
+}
+
+/* Every visit of a radius query, in order. */
+typedef struct visits {
+    const photon_record **p;
+    size_t n, cap;
+} visits;
+
+static void record_visit(void *ctx, const photon_record *p, double d2)
+{
+    (void)d2;
+    visits *v = ctx;
+    if (v->n < v->cap)
+        v->p[v->n] = p;
+    v->n++;
+}
+
+/* A map large enough for directories of several levels (50 000 records per group):
+ * radius queries of every size, through the directory and without, visit the same
+ * records in the same order; and the directory's bytes are a small part of the map's. */
+static void test_directory_same_visits(void **state)
+{
+    (void)state;
+    const size_t n = 300000;
+    const uint32_t n_objects = 3;
+    photon_map *map = NULL;
+    assert_int_equal(photon_map_create(make_photons(n, n_objects), n, n_objects, 0, &map, NULL),
+                     THZ_OK);
+    photon_map_directory *dir = NULL;
+    assert_int_equal(photon_map_directory_create(map, &dir, NULL), THZ_OK);
+    size_t dir_bytes = photon_map_directory_bytes(dir), map_bytes = photon_map_bytes(map);
+    print_message("directory %zu bytes for a map of %zu (%.2f %%)\n", dir_bytes, map_bytes,
+                  100.0 * (double)dir_bytes / (double)map_bytes);
+    /* each of the 6 groups (~50 000 records) indexed at level 3: 8^3 cells */
+    assert_true(dir_bytes >= 6 * (512 + 1) * sizeof(size_t));
+    assert_true(dir_bytes * 20 < map_bytes); /* a small part of the map */
+    const photon_record *a[4096], *b[4096];
+    visits va = {a, 0, 4096}, vb = {b, 0, 4096};
+    rng_stream rng;
+    rng_init(&rng, 7, 0, RNG_PURPOSE_TEST, 0);
+    size_t visited = 0;
+    for (int trial = 0; trial < 400; trial++) {
+        vec3 q = v3(rng_uniform(&rng) * 1.2 - 0.1, rng_uniform(&rng) * 1.2 - 0.1,
+                    rng_uniform(&rng) * 0.3 - 0.05);
+        double r = 1e-4 * pow(2.0, 10.0 * rng_uniform(&rng)); /* 0.1 mm to 10 cm */
+        uint32_t obj = (uint32_t)trial % n_objects;
+        int side = trial / n_objects % 2;
+        va.n = vb.n = 0;
+        photon_map_radius(map, obj, side, q, r * r, record_visit, &va);
+        photon_map_radius_in(map, dir, obj, side, q, r * r, record_visit, &vb);
+        assert_int_equal(va.n, vb.n);
+        for (size_t i = 0; i < va.n && i < va.cap; i++)
+            assert_ptr_equal(a[i], b[i]);
+        visited += va.n;
+    }
+    assert_true(visited > 10000);
+    photon_map_directory_destroy(dir);
     photon_map_destroy(map);
 }
 
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_knn_matches_kth_distance)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_knn_matches_kth_distance),
+                                       cmocka_unit_test(test_directory_same_visits)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,92 @@
+/* A renderer's lookup table over a photon map's spatial index: see photon_map.h. */
+#include <stdlib.h>
+
+#include "core/alloc.h"
+#include "photon/photon_map_layout.h"
+
+/* The directory's level for a group of n records: the deepest L <= PHOTON_DIR_MAX_LEVELS
+ * with PHOTON_DIR_MIN_PER_CELL records per cell of level L on average; 0 for groups too
+ * small to need one (their binary searches stay within a few cache lines). */
+static int photon_dir_level(size_t n)
+{
+    int level = 0;
+    while (level < PHOTON_DIR_MAX_LEVELS && (size_t)PHOTON_DIR_MIN_PER_CELL << 3 * (level + 1) <= n)
+        level++;
+    return level;
+}
+
+/* Descends from `cell` to the directory's level by the queries' own splits, writing the
+ * first record of every cell there (empty cells included: their start is where they would
+ * begin). */
+static void photon_dir_fill(const photon_cube *cube, const photon_record *r,
+                            const photon_cell *cell, int level, size_t *starts)
+{
+    if (cell->level == level) {
+        starts[cell->m] = cell->lo;
+        return;
+    }
+    size_t b[9];
+    photon_cell_split(cube, r, cell, b);
+    for (unsigned d = 0; d < 8; d++) {
+        photon_cell child = photon_child(cell, d, b);
+        photon_dir_fill(cube, r, &child, level, starts);
+    }
+}
+
+void photon_map_directory_destroy(photon_map_directory *dir)
+{
+    if (!dir)
+        return;
+    for (size_t g = 0; dir->starts && g < dir->n_groups; g++)
+        free(dir->starts[g]);
+    free(dir->starts);
+    free(dir->level);
+    free(dir);
+}
+
+thz_status photon_map_directory_create(const photon_map *map, photon_map_directory **out,
+                                       thz_error *err)
+{
+    *out = NULL;
+    photon_map_directory *dir = thz_calloc(1, sizeof *dir);
+    size_t n_groups = map ? map->n_groups : 0;
+    if (dir) {
+        dir->n_groups = n_groups;
+        dir->level = thz_calloc(n_groups ? n_groups : 1, sizeof *dir->level);
+        dir->starts = thz_calloc(n_groups ? n_groups : 1, sizeof *dir->starts);
+    }
+    if (!dir || !dir->level || !dir->starts) {
+        photon_map_directory_destroy(dir);
+        return thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for its directory");
+    }
+    for (size_t g = 0; g < n_groups; g++) {
+        size_t lo = map->start[g], hi = map->start[g + 1];
+        int level = photon_dir_level(hi - lo);
+        if (level == 0)
+            continue;
+        size_t cells = (size_t)1 << 3 * level;
+        size_t *starts = thz_malloc_array(cells + 1, sizeof *starts);
+        if (!starts) {
+            photon_map_directory_destroy(dir);
+            return thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for its directory");
+        }
+        photon_cell root = {.level = 0, .lo = lo, .hi = hi};
+        photon_dir_fill(&map->cubes[g], map->records, &root, level, starts);
+        starts[cells] = hi;
+        dir->starts[g] = starts;
+        dir->level[g] = level;
+    }
+    *out = dir;
+    return THZ_OK;
+}
+
+size_t photon_map_directory_bytes(const photon_map_directory *dir)
+{
+    if (!dir)
+        return 0;
+    size_t bytes = sizeof *dir + dir->n_groups * (sizeof *dir->level + sizeof *dir->starts);
+    for (size_t g = 0; g < dir->n_groups; g++)
+        if (dir->level[g] > 0)
+            bytes += (((size_t)1 << 3 * dir->level[g]) + 1) * sizeof(size_t);
+    return bytes;
+}
