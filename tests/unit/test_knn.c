@@ -39,6 +39,16 @@ static photon_record *make_photons(size_t n, uint32_t n_objects)
     return p;
 }
 
+/* The map of make_photons(n, n_objects) and its directory. */
+static photon_map *make_map(size_t n, uint32_t n_objects, photon_map_directory **dir)
+{
+    photon_map *map = NULL;
+    assert_int_equal(photon_map_create(make_photons(n, n_objects), n, n_objects, 0, &map, NULL),
+                     THZ_OK);
+    assert_int_equal(photon_map_directory_create(map, dir, NULL), THZ_OK);
+    return map;
+}
+
 static double dist2(const photon_record *r, vec3 q)
 {
     double dx = (double)r->position_m[0] - q.x, dy = (double)r->position_m[1] - q.y,
@@ -51,12 +61,9 @@ static void test_knn_matches_kth_distance(void **state)
     (void)state;
     const size_t n = 20000;
     const uint32_t n_objects = 3;
-    photon_map *map = NULL;
-    assert_int_equal(photon_map_create(make_photons(n, n_objects), n, n_objects, 0, &map, NULL),
-                     THZ_OK);
-    const photon_record *r = photon_map_records(map);
     photon_map_directory *dir = NULL;
-    assert_int_equal(photon_map_directory_create(map, &dir, NULL), THZ_OK);
+    photon_map *map = make_map(n, n_objects, &dir);
+    const photon_record *r = photon_map_records(map);
     static knn_buffer b, b_dir; /* ~48 KiB each: not on the test's stack */
     static double scratch[KNN_CAP];
     static const size_t ks[] = {1, 2, 7, 64, 300, 1900, 5000, 20000};
@@ -141,11 +148,8 @@ static void test_directory_same_visits(void **state)
     (void)state;
     const size_t n = 300000;
     const uint32_t n_objects = 3;
-    photon_map *map = NULL;
-    assert_int_equal(photon_map_create(make_photons(n, n_objects), n, n_objects, 0, &map, NULL),
-                     THZ_OK);
     photon_map_directory *dir = NULL;
-    assert_int_equal(photon_map_directory_create(map, &dir, NULL), THZ_OK);
+    photon_map *map = make_map(n, n_objects, &dir);
     size_t dir_bytes = photon_map_directory_bytes(dir), map_bytes = photon_map_bytes(map);
     print_message("directory %zu bytes for a map of %zu (%.2f %%)\n", dir_bytes, map_bytes,
                   100.0 * (double)dir_bytes / (double)map_bytes);
