@@ -275,6 +275,12 @@ double optics_emissivity(const optics_point *o, double mu)
     return optics_absorption(o, mu);
 }
 
+void optics_absorption_emissivity(const optics_point *o, double mu, double *a, double *eps)
+{
+    *a = optics_absorption(o, mu);
+    *eps = o->explicit_emissivity ? optics_emissivity(o, mu) : *a;
+}
+
 double optics_mean_transmission(const optics_point *o)
 {
     if (!optics_is_shell(o))

@@ -70,6 +70,10 @@ double optics_absorption(const optics_point *o, double mu);
 /* eps(theta): the explicit emissivity, or Kirchhoff's A(theta). */
 double optics_emissivity(const optics_point *o, double mu);
 
+/* A(theta) and eps(theta) together, as optics_absorption and optics_emissivity give
+ * them, the absorption computed once (band sums over hundreds of nodes). */
+void optics_absorption_emissivity(const optics_point *o, double mu, double *a, double *eps);
+
 /* Hemispherical means 2 int_0^1 X(mu) mu dmu of T and eps (T-bar, eps-bar). */
 double optics_mean_transmission(const optics_point *o);
 double optics_mean_emissivity(const optics_point *o);

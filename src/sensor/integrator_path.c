@@ -208,9 +208,8 @@ static double render_path_first(const render_context *ctx, const accel_hit *hit)
     double sum = 0.0;
     for (size_t k = 0; k < n; k++) {
         double tau = ctx->atmosphere ? exp(-ctx->alpha_per_m[k] * hit->distance_m) : 1.0;
-        double a = optics_absorption(&op[k], hit->cos_theta);
-        /* optics_emissivity's rule, without computing the absorption twice */
-        double eps = op[k].explicit_emissivity ? optics_emissivity(&op[k], hit->cos_theta) : a;
+        double a, eps;
+        optics_absorption_emissivity(&op[k], hit->cos_theta, &a, &eps);
         double free_path = ctx->emitting ? (1.0 - tau) * (ctx->air_planck[k] - ctx->b0[k])
                                          : (tau - 1.0) * ctx->b0[k];
         sum += ctx->quad.weight[k] * (free_path + tau * (eps * planck[k] - a * ctx->b0[k]));

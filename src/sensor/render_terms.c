@@ -181,9 +181,8 @@ double render_emission(const render_context *ctx, uint32_t object, double mu,
     for (size_t k = 0; k < n; k++) {
         double v;
         if (ctx->deviation) {
-            /* optics_emissivity's rule, without computing the absorption twice */
-            double a = optics_absorption(&op[k], mu);
-            double eps = op[k].explicit_emissivity ? optics_emissivity(&op[k], mu) : a;
+            double a, eps;
+            optics_absorption_emissivity(&op[k], mu, &a, &eps);
             v = eps * planck[k] - a * ctx->b0[k];
         } else {
             v = optics_emissivity(&op[k], mu) * planck[k];

@@ -106,6 +106,16 @@ static inline double ident_pooled_rel_se(const ident_run *r, size_t c, const dou
     return n ? sqrt(sum / (double)n) : 0.0;
 }
 
+/* The same against one expected value for every pixel of channel c. */
+static inline double ident_pooled_rel_se_of(const ident_run *r, size_t c, double expect)
+{
+    double sum = 0.0;
+    size_t n = (size_t)r->img.rows * r->img.columns;
+    for (size_t i = 0; i < n; i++)
+        sum += (double)r->img.radiance_stderr[c * n + i] * r->img.radiance_stderr[c * n + i];
+    return n ? sqrt(sum / (double)n) / expect : 0.0;
+}
+
 /* "integrator" or "integrator, T0 = 0 K", for messages. */
 static inline void ident_label(char *out, size_t size, thz_integrator integrator, double t0_k)
 {

@@ -131,11 +131,7 @@ static void band_reflection_case(thz_integrator integrator, double t0_k)
     double at_centre = band_r(&l, BAND_NU_C) * ident_band_planck(ch, 300.0);
     /* R B is heavy-tailed (the line is 9x the base over a small part of the band): a
      * pixel's tolerance uses at least the image's pooled standard error */
-    ident_tally t = {0};
-    double pooled = 0.0;
-    for (size_t i = 0; i < (size_t)r.img.rows * r.img.columns; i++)
-        pooled += r.img.radiance_stderr[i] * (double)r.img.radiance_stderr[i];
-    t.pooled_rel_se = sqrt(pooled / (double)((size_t)r.img.rows * r.img.columns)) / expect;
+    ident_tally t = {.pooled_rel_se = ident_pooled_rel_se_of(&r, 0, expect)};
     for (uint32_t row = 0; row < r.img.rows; row++)
         for (uint32_t col = 0; col < r.img.columns; col++) {
             assert_true(ident_pixel_interior(&r, col, row));

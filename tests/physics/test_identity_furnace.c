@@ -106,11 +106,7 @@ static void furnace_path_t0_case(double t0_k)
         /* with T0 = 0 K a path's terms are heavy-tailed (a long path's many terms): a
          * pixel's tolerance uses at least the image's pooled standard error, as in the
          * band test */
-        size_t np = (size_t)r.img.rows * r.img.columns;
-        double pooled = 0.0;
-        for (size_t i = 0; i < np; i++)
-            pooled += r.img.radiance_stderr[c * np + i] * (double)r.img.radiance_stderr[c * np + i];
-        ident_tally t = {.exact = false, .pooled_rel_se = sqrt(pooled / (double)np) / b};
+        ident_tally t = {.exact = false, .pooled_rel_se = ident_pooled_rel_se_of(&r, c, b)};
         for (uint32_t row = 0; row < r.img.rows; row++)
             for (uint32_t col = 0; col < r.img.columns; col++)
                 ident_check_pixel(&t, &r, c, col, row, b, 1e-9);
