@@ -234,9 +234,88 @@ static thz_status bench_channel_seconds(const thz_run *run, size_t nc, bench_con
     return st;
 }
 
+/* One run of the scene through thz_simulate with `estimates` per sample: its noise and
+ * its channels' seconds into pt. */
+static thz_status bench_converge_run(thz_context *ctx, thz_scene *s, const char *integrator,
+                                     uint32_t estimates, uint64_t photons, long enclosure,
+                                     bench_converge *out, bench_converge_point *pt, thz_error *err)
+{
+    thz_status st = bench_set_integrator(s, integrator, estimates, err);
+    if (st != THZ_OK)
+        return st;
+    thz_run_settings settings;
+    thz_run_settings_init(&settings);
+    settings.integrator = integrator;
+    if (render_integrator_needs_photons(s->render.integrator))
+        settings.photons_per_channel = photons ? photons : s->photons.per_channel;
+    thz_run *run = NULL;
+    double t = bench_now_s();
+    st = thz_simulate(ctx, s, &settings, &run, err);
+    pt->s_wall = bench_now_s() - t;
+    pt->estimates = render_estimates_per_pass(s);
+    if (st == THZ_OK)
+        st = bench_objects_rms(s, run, enclosure, out, pt, err);
+    if (st == THZ_OK)
+        st = bench_channel_seconds(run, s->n_channels, pt, err);
+    out->photons = settings.photons_per_channel;
+    thz_run_destroy(run);
+    return st;
+}
+
+/* Swaps channels a and b of the scene, with the sensors' per-channel NETDs. */
+static void bench_swap_channels(thz_scene *s, size_t a, size_t b)
+{
+    thz_channel t = s->channels[a];
+    s->channels[a] = s->channels[b];
+    s->channels[b] = t;
+    for (size_t i = 0; i < s->n_sensors; i++) {
+        double *netd = s->sensors[i].noise.netd_k;
+        if (netd) {
+            double d = netd[a];
+            netd[a] = netd[b];
+            netd[b] = d;
+        }
+    }
+}
+
+/* The third run: the worst channel alone (moved to the front, the others hidden from the
+ * run, then put back) with the estimates the larger run says it needs. */
+static thz_status bench_converge_confirm(thz_context *ctx, thz_scene *s, const char *integrator,
+                                         uint64_t photons, long enclosure, double target_k,
+                                         uint32_t max_confirm, bench_converge *out, thz_error *err)
+{
+    size_t w = 0, n = s->n_channels;
+    for (size_t c = 1; c < n; c++)
+        if (bench_converge_seconds(out, c, target_k) > bench_converge_seconds(out, w, target_k))
+            w = c;
+    double scale = out->pt[1].rms_k[w] / target_k;
+    double need = ceil((double)out->pt[1].estimates * scale * scale);
+    uint32_t j = need > (double)max_confirm ? max_confirm : (uint32_t)need;
+    j = j < 2 ? 2 : j;
+    bench_converge_point pt;
+    memset(&pt, 0, sizeof pt);
+    bench_converge probe = *out; /* pixel counts, which the one channel does not change */
+    probe.channels = 1;
+    bench_swap_channels(s, 0, w);
+    s->n_channels = 1;
+    thz_status st = bench_converge_run(ctx, s, integrator, j, photons, enclosure, &probe, &pt, err);
+    s->n_channels = n;
+    bench_swap_channels(s, 0, w);
+    if (st != THZ_OK)
+        return st;
+    out->confirm = (bench_converge_point){.estimates = pt.estimates, .s_wall = pt.s_wall};
+    out->confirm.rms_k[w] = pt.rms_k[0];
+    out->confirm.s_photons[w] = pt.s_photons[0];
+    out->confirm.s_render[w] = pt.s_render[0];
+    out->confirm_channel = w;
+    out->confirmed = true;
+    return THZ_OK;
+}
+
 thz_status bench_measure_converge(const char *scene_path, const char *integrator, uint64_t photons,
                                   const uint32_t estimates[2], uint32_t sensor_columns, int threads,
-                                  bench_converge *out, thz_error *err)
+                                  double target_k, uint32_t max_confirm, bench_converge *out,
+                                  thz_error *err)
 {
     memset(out, 0, sizeof *out);
     thz_scene *s = NULL;
@@ -263,28 +342,12 @@ thz_status bench_measure_converge(const char *scene_path, const char *integrator
             snprintf(out->enclosure, sizeof out->enclosure, "%s", oi.name);
         }
     }
-    for (int k = 0; st == THZ_OK && k < 2; k++) {
-        bench_converge_point *pt = &out->pt[k];
-        st = bench_set_integrator(s, integrator, estimates[k], err);
-        if (st != THZ_OK)
-            break;
-        thz_run_settings settings;
-        thz_run_settings_init(&settings);
-        settings.integrator = integrator;
-        if (render_integrator_needs_photons(s->render.integrator))
-            settings.photons_per_channel = photons ? photons : s->photons.per_channel;
-        thz_run *run = NULL;
-        double t = bench_now_s();
-        st = thz_simulate(ctx, s, &settings, &run, err);
-        pt->s_wall = bench_now_s() - t;
-        pt->estimates = render_estimates_per_pass(s);
-        if (st == THZ_OK)
-            st = bench_objects_rms(s, run, enclosure, out, pt, err);
-        if (st == THZ_OK)
-            st = bench_channel_seconds(run, out->channels, pt, err);
-        out->photons = settings.photons_per_channel;
-        thz_run_destroy(run);
-    }
+    for (int k = 0; st == THZ_OK && k < 2; k++)
+        st = bench_converge_run(ctx, s, integrator, estimates[k], photons, enclosure, out,
+                                &out->pt[k], err);
+    if (st == THZ_OK && max_confirm > 0)
+        st = bench_converge_confirm(ctx, s, integrator, photons, enclosure, target_k, max_confirm,
+                                    out, err);
     thz_scene_destroy(s);
     thz_context_destroy(ctx);
     return st;
@@ -295,6 +358,15 @@ double bench_converge_seconds(const bench_converge *cv, size_t c, double target_
     const bench_converge_point *p = &cv->pt[1];
     double scale = p->rms_k[c] / target_k;
     return p->s_photons[c] + p->s_render[c] * scale * scale;
+}
+
+double bench_converge_confirmed_seconds(const bench_converge *cv, double target_k)
+{
+    if (!cv->confirmed)
+        return NAN;
+    size_t c = cv->confirm_channel;
+    double scale = cv->confirm.rms_k[c] / target_k;
+    return cv->confirm.s_photons[c] + cv->confirm.s_render[c] * scale * scale;
 }
 
 double bench_converge_exponent(const bench_converge *cv, size_t c)

@@ -21,10 +21,16 @@
  * object's and the sensors (teraeye's "box"): the cylinders and the cover stripes.
  * Noise falling as 1/sqrt(render time) then gives the time to a target from the larger
  * run (bench_converge_seconds); the two runs' own exponent shows whether that holds.
+ * A third run then checks the worst channel by running it: that channel alone, with the
+ * J* estimates the larger run says it needs (J* = 4 J (RMS / target)^2, at most a given
+ * cap), so that its seconds to the target are measured at the target, not extrapolated
+ * across a cost per sample (the first ray, the first hit's band mean) that more
+ * estimates do not repeat.
  */
 #ifndef THZ_BENCH_RENDER_H
 #define THZ_BENCH_RENDER_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -76,18 +82,29 @@ typedef struct bench_converge {
     uint64_t pixels, object_pixels; /* over all sensors */
     char enclosure[64];             /* the enclosure's name ("" when none) */
     bench_converge_point pt[2];
+    /* The run at the target: channel `confirm_channel` alone with pt[2].estimates
+     * (confirm_channel < channels; pt[2]'s arrays hold it at that index). */
+    bool confirmed;
+    size_t confirm_channel;
+    bench_converge_point confirm;
 } bench_converge;
 
 /* estimates[0] < estimates[1] (each >= 2); photons for final-gather (0: the scene's);
- * sensor_columns as in bench_speedup_config. */
+ * sensor_columns as in bench_speedup_config. With max_confirm > 0, the third run (the
+ * worst channel by bench_converge_seconds to target_k, at most max_confirm estimates). */
 thz_status bench_measure_converge(const char *scene_path, const char *integrator, uint64_t photons,
                                   const uint32_t estimates[2], uint32_t sensor_columns, int threads,
-                                  bench_converge *out, thz_error *err);
+                                  double target_k, uint32_t max_confirm, bench_converge *out,
+                                  thz_error *err);
 
 /* Channel c's seconds to an RMS of target_k, photon phase included, with the render time
  * scaled from the larger run as (rms / target_k)^2 (noise proportional to
  * 1/sqrt(render time)). */
 double bench_converge_seconds(const bench_converge *cv, size_t c, double target_k);
+
+/* The same from the run at the target (its channel only; NAN when there was none): its
+ * render time x (rms / target_k)^2, a factor near 1, plus its photon phase. */
+double bench_converge_confirmed_seconds(const bench_converge *cv, double target_k);
 
 /* The exponent k of rms proportional to (render time)^k between the two runs of channel
  * c (-0.5 when the 1/sqrt law holds); 0 when it cannot be formed. */

@@ -86,7 +86,8 @@ for x in s["integrators"]:
     assert (x["map_photons"] > 0) == (x["integrator"] != "path"), x
 
 # Time to a converged image: per channel, two runs of growing work, finite noise figures
-# over the objects' pixels (the enclosure left out), finite extrapolated seconds.
+# over the objects' pixels (the enclosure left out), finite extrapolated seconds, and the
+# worst channel's run at the target.
 for name in ["path", "final-gather"]:
     c = r["converged_image"][name]
     assert c["enclosure"] == "box", c["enclosure"]
@@ -102,6 +103,17 @@ for name in ["path", "final-gather"]:
         finite(ch, ["seconds_to_target", "ratio_to_limit"], name, positive=True)
         finite(ch, ["exponent"], name)
     finite(c, ["worst_seconds_to_target"], name, positive=True)
+    # the worst channel run alone at the estimates its extrapolation asks for (--small caps
+    # them at 8): its noise where 1/sqrt(estimates) from the larger run puts it, and the
+    # worst figure no better than that run's
+    t = c["run_at_target"]
+    finite(t, ["rms_stderr_k", "seconds_render", "seconds_to_target"], name, positive=True)
+    w = [ch["frequency_thz"] for ch in c["channels"]].index(t["frequency_thz"])
+    j1, j2 = c["runs"][1]["estimates_per_pass"], t["estimates_per_pass"]
+    assert j1 <= j2 <= 8, (j1, j2)
+    expect = c["runs"][1]["rms_stderr_k"][w] * (j1 / j2) ** 0.5
+    assert expect / 1.5 < t["rms_stderr_k"] < expect * 1.5, (name, t["rms_stderr_k"], expect)
+    assert c["worst_seconds_to_target"] >= t["seconds_to_target"], c
 
 # Every target with a finite value, its limit and a verdict; none left unmeasured.
 assert "targets_not_measured" not in r
