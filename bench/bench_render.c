@@ -369,6 +369,22 @@ double bench_converge_confirmed_seconds(const bench_converge *cv, double target_
     return cv->confirm.s_photons[c] + cv->confirm.s_render[c] * scale * scale;
 }
 
+bool bench_converge_floor(const bench_converge *cv, double target_k, double *a_k2, double *floor2,
+                          double *need)
+{
+    size_t w = cv->confirm_channel;
+    const bench_converge_point *b = &cv->pt[1], *p = &cv->confirm;
+    double j1 = (double)b->estimates, j2 = (double)p->estimates;
+    if (!cv->confirmed || !(j2 > j1))
+        return false;
+    double v1 = b->rms_k[w] * b->rms_k[w], v2 = p->rms_k[w] * p->rms_k[w];
+    *a_k2 = (v1 - v2) / (1.0 / j1 - 1.0 / j2);
+    *floor2 = v2 - *a_k2 / j2;
+    double room = target_k * target_k - *floor2;
+    *need = room > 0.0 && *a_k2 > 0.0 ? ceil(*a_k2 / room) : 0.0;
+    return true;
+}
+
 double bench_converge_exponent(const bench_converge *cv, size_t c)
 {
     const bench_converge_point *a = &cv->pt[0], *b = &cv->pt[1];

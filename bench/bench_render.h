@@ -106,6 +106,13 @@ double bench_converge_seconds(const bench_converge *cv, size_t c, double target_
  * render time x (rms / target_k)^2, a factor near 1, plus its photon phase. */
 double bench_converge_confirmed_seconds(const bench_converge *cv, double target_k);
 
+/* Through the larger run and the run at the target (its channel): RMS^2 = a / J + floor^2,
+ * J the estimates per sample; the floor is what more estimates do not lower (final-gather's
+ * photon map). *need: the J that reaches target_k, 0 when none does. False without the run
+ * at the target. */
+bool bench_converge_floor(const bench_converge *cv, double target_k, double *a_k2, double *floor2,
+                          double *need);
+
 /* The exponent k of rms proportional to (render time)^k between the two runs of channel
  * c (-0.5 when the 1/sqrt law holds); 0 when it cannot be formed. */
 double bench_converge_exponent(const bench_converge *cv, size_t c);

@@ -219,7 +219,19 @@ json_t *bench_report_converge(const char *integrator, const bench_converge *cv, 
                "%.3f, plus its photon phase), %.2f x the limit\n",
                cv->freq_thz[w], (unsigned)p->estimates, p->rms_k[w], p->s_photons[w],
                p->s_render[w], target_k, confirmed, target_k,
-               (p->rms_k[w] / target_k) * (p->rms_k[w] / target_k), bench_ratio(confirmed, limit_s));
+               (p->rms_k[w] / target_k) * (p->rms_k[w] / target_k),
+               bench_ratio(confirmed, limit_s));
+        double a_k2, floor2, need;
+        if (bench_converge_floor(cv, target_k, &a_k2, &floor2, &need)) {
+            printf(
+                "  through the J=%u run and this one, RMS^2 = %.4g K^2 / J + floor^2 with a floor "
+                "%s%.4f K (what more estimates do not lower)",
+                (unsigned)b->estimates, a_k2, floor2 < 0.0 ? "-" : "", sqrt(fabs(floor2)));
+            if (need > 0.0)
+                printf(": %g K needs J = %.0f\n", target_k, need);
+            else
+                printf(": %g K cannot be reached by more estimates\n", target_k);
+        }
     }
     printf("  worst channel %.3f s against %g s: %.2f x the limit%s\n", *worst_s, limit_s,
            bench_ratio(*worst_s, limit_s),
@@ -247,6 +259,12 @@ json_t *bench_report_converge(const char *integrator, const bench_converge *cv, 
         json_object_set_new(jconf, "seconds_photons", bench_real(cv->confirm.s_photons[w]));
         json_object_set_new(jconf, "seconds_render", bench_real(cv->confirm.s_render[w]));
         json_object_set_new(jconf, "seconds_to_target", bench_real(confirmed));
+        double a_k2, floor2, need;
+        if (bench_converge_floor(cv, target_k, &a_k2, &floor2, &need)) {
+            json_object_set_new(jconf, "floor_k", bench_real(copysign(sqrt(fabs(floor2)), floor2)));
+            json_object_set_new(jconf, "estimates_for_target",
+                                need > 0.0 ? bench_real(need) : json_null());
+        }
     }
     json_t *root = json_object();
     json_object_set_new(root, "integrator", json_string(integrator));

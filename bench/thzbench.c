@@ -98,8 +98,8 @@ static thz_status bench_job_converge(const void *arg, void *out, thz_error *err)
 {
     const bench_converge_job *j = arg;
     return bench_measure_converge(j->scene, j->integrator, j->photons, j->estimates,
-                                  j->sensor_columns, j->threads, j->target_k, j->max_confirm,
-                                  out, err);
+                                  j->sensor_columns, j->threads, j->target_k, j->max_confirm, out,
+                                  err);
 }
 
 static thz_status bench_job_probe(const void *arg, void *out, thz_error *err)
