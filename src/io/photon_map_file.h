@@ -1,7 +1,7 @@
 /* photon-map.thzpm: every channel's photon map and photon-phase statistics, so that
  * `render` can reuse a simulation's photons (scene-format.md "Outputs").
  *
- * Layout (little-endian, version 2):
+ * Layout (little-endian, version 3):
  *   prefix, 24 bytes, uncompressed: magic "THZPMAP\x1a", u32 version, u32 flags (0;
  *     none is defined, a reader refuses any set bit),
  *     u64 total file size (detects truncation before decoding anything);
@@ -14,12 +14,14 @@
  *     reference temperature T0 in K (photon_map.h; 0 for the paper's map of L);
  *   zstd frame 2 (with content checksum and content size): the records of channel 0,
  *     1, ... as 32-byte photon_record images, `flags` holding only the bounce count and
- *     the batch (bits 24-26; the map's index is rebuilt on reading). Within a channel they are in a
- * canonical order (by object_side, then by their bytes) that does not depend on the photon map's
- * internal order, so that read + write reproduces a file byte for byte.
+ *     the batch (bits 24-26). Within a channel they are in the map's order, which depends
+ *     on the records alone (photon_map.c: by object_side, then Morton code in the
+ *     group's cube, then bytes), so that read + write reproduces a file byte for byte and
+ *     the reader's index build, finding them in order, moves nothing.
  *
- * Version 1 is version 2 without T0 (20 words per channel): it is still read, its maps
- * with T0 = 0.
+ * Version 2 is version 3 with the records of a group in the order of their bytes (the
+ * reader's build sorts them); version 1 is version 2 without T0 (20 words per channel),
+ * its maps with T0 = 0. Both are still read.
  */
 #ifndef THZ_IO_PHOTON_MAP_FILE_H
 #define THZ_IO_PHOTON_MAP_FILE_H
@@ -32,7 +34,7 @@
 #include "photon/photon_stats.h"
 #include "scene/scene.h"
 
-#define PHOTON_MAP_FILE_VERSION 2u
+#define PHOTON_MAP_FILE_VERSION 3u
 #define PHOTON_MAP_FILE_MAGIC "THZPMAP\x1a"
 
 /* What a file says beyond its maps. */
@@ -54,7 +56,7 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
  * (n_channels entries, may be NULL; seconds is 0; reference_temperature_k the map's)
  * and info (may be NULL). `threads` is passed to photon_map_create. Refuses, with a
  * message naming the file: a file that is not a photon map or has a version other than
- * 1 or 2 (THZ_ERR_INPUT), a truncated or corrupted one (THZ_ERR_IO; corruption is found by the
+ * 1 to 3 (THZ_ERR_INPUT), a truncated or corrupted one (THZ_ERR_IO; corruption is found by the
  * zstd checksums), and one made from another scene geometry, material set or channel
  * set (THZ_ERR_INPUT). */
 thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,

@@ -13,6 +13,9 @@
  *  4. sort: each digit's range of a large group, and each small group, is sorted alone
  *     (photon_build_sort_range), in cache but for the largest.
  *
+ * Records already in the map's order (a map's own, as a photon-map file keeps them) are
+ * found so by pass 1's check (photon_build_in_order) and not moved: no second array.
+ *
  * Each pass streams the records, or a cached range of them, from one array to the other.
  * The in-place build it replaces (a serial permutation by group, then per group an
  * American flag sort whose first pass over the largest group was serial too) swapped
@@ -313,6 +316,33 @@ static size_t photon_build_layout(photon_build *b)
     return b->count;
 }
 
+/* After pass 1, for part p: whether its records, and the one before them, are in the map's
+ * order already: groups ascending; within a group, Morton codes in the group's cube
+ * ascending, ties by bytes; flags bits 16..17 clear (what pass 2 clears). Read only. */
+static bool photon_build_in_order(const photon_build *b, int p)
+{
+    size_t lo, hi;
+    photon_part_range(b, p, &lo, &hi);
+    size_t first = lo > 0 ? lo - 1 : 0;
+    uint64_t prev_code = 0;
+    for (size_t i = first; i < hi; i++) {
+        const photon_record *q = &b->r[i];
+        if (q->flags & 3u << 16)
+            return false;
+        uint64_t code = photon_morton(&b->cubes[q->object_side], q);
+        if (i > first) {
+            const photon_record *before = q - 1;
+            if (before->object_side > q->object_side)
+                return false;
+            if (before->object_side == q->object_side &&
+                (prev_code > code || (prev_code == code && memcmp(before, q, sizeof *q) > 0)))
+                return false;
+        }
+        prev_code = code;
+    }
+    return true;
+}
+
 /* Pass 2 for part p: its records into their group's slots of the second array, a large
  * group's carrying their first digit in object_side (the group is known from the slot),
  * counted. Also clears bits 16..17 of flags (a kd-tree's split axis in maps before the
@@ -523,15 +553,11 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
         map->cubes = thz_calloc(n_groups ? n_groups : 1, sizeof *map->cubes);
     }
     index = photon_map_pool_index(pool, photon_build_arrays(&b, NULL));
-    /* The second array (32 bytes per record: the peak is twice the map), kept in the pool
-     * for the next build. */
-    scratch = photon_map_pool_scratch(pool, count);
-    if (!map || !map->start || !map->cubes || !index || !scratch) {
+    if (!map || !map->start || !map->cubes || !index) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu photons", count);
         goto cleanup;
     }
     photon_build_arrays(&b, index);
-    b.s = scratch;
     b.start = map->start;
     b.cubes = map->cubes;
 
@@ -544,6 +570,20 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
                            bad, (unsigned)photon_object(&photons[bad]), n_objects);
         goto cleanup;
     }
+    int ordered = 1;
+#pragma omp parallel for num_threads(b.parts) schedule(static, 1) reduction(&& : ordered)
+    for (int p = 0; p < b.parts; p++)
+        ordered = photon_build_in_order(&b, p) && ordered;
+    if (ordered)
+        goto built;
+    /* The second array (32 bytes per record: the peak is twice the map), kept in the pool
+     * for the next build. */
+    scratch = photon_map_pool_scratch(pool, count);
+    if (!scratch) {
+        st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu photons", count);
+        goto cleanup;
+    }
+    b.s = scratch;
     const size_t n_items = n_groups + b.n_large * PHOTON_MAP_DIGITS;
 #pragma omp parallel num_threads(b.parts)
     {
@@ -560,6 +600,7 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
             photon_build_sort_item(&b, k);
     }
 
+built:
     map->records = photons;
     map->count = count;
     map->capacity = capacity > count ? capacity : count;

@@ -1,9 +1,10 @@
 /* photon-map.thzpm: write + read gives the same maps, stats and reference temperatures
  * (channel 1 is a deviation map, T0 = 290 K), and read + write reproduces the file byte
- * for byte; a version-1 file (no T0) reads with T0 = 0; corrupted (one byte flipped), truncated,
- * forged (a record count the file cannot hold, refused before allocating), foreign and
- * mismatched (another geometry, channel set or temperatures) files are refused with
- * messages that name the file and say what is wrong. */
+ * for byte; the records are stored in the map's order, and a version-2 file (the same by
+ * group and bytes) reads into the same maps; a version-1 file (no T0) reads with T0 = 0;
+ * corrupted (one byte flipped), truncated, forged (a record count the file cannot hold,
+ * refused before allocating), foreign and mismatched (another geometry, channel set or
+ * temperatures) files are refused with messages that name the file and say what is wrong. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -250,6 +251,72 @@ static void test_version_1(void **state)
     free(out);
 }
 
+static int record_bytes_cmp(const void *a, const void *b)
+{
+    const photon_record *x = a, *y = b;
+    if (x->object_side != y->object_side)
+        return x->object_side < y->object_side ? -1 : 1;
+    return memcmp(x, y, sizeof *x);
+}
+
+/* Version 3 stores each channel's records as its map holds them (so a reader's build moves
+ * nothing); a version-2 file, the same records by group and then bytes, still reads into
+ * the same maps. */
+static void test_version_2_order(void **state)
+{
+    fixture *f = *state;
+    size_t n;
+    unsigned char *buf = slurp(f->path, &n);
+    assert_int_equal(buf[8], 3);
+    size_t h1 = ZSTD_findFrameCompressedSize(buf + 24, n - 24);
+    assert_false(ZSTD_isError(h1));
+    const unsigned char *frame = buf + 24 + h1;
+    size_t fsize = n - 24 - h1;
+    unsigned long long rsize = ZSTD_getFrameContentSize(frame, fsize);
+    size_t counts[2] = {photon_map_count(f->maps[0]), photon_map_count(f->maps[1])};
+    assert_int_equal(rsize, (counts[0] + counts[1]) * sizeof(photon_record));
+    photon_record *rec = malloc(rsize);
+    assert_int_equal(ZSTD_decompress(rec, rsize, frame, fsize), rsize);
+    assert_memory_equal(rec, photon_map_records(f->maps[0]), counts[0] * sizeof *rec);
+    assert_memory_equal(rec + counts[0], photon_map_records(f->maps[1]), counts[1] * sizeof *rec);
+
+    qsort(rec, counts[0], sizeof *rec, record_bytes_cmp);
+    qsort(rec + counts[0], counts[1], sizeof *rec, record_bytes_cmp);
+    assert_memory_not_equal(rec, photon_map_records(f->maps[0]), counts[0] * sizeof *rec);
+    ZSTD_CCtx *cctx = ZSTD_createCCtx();
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
+    size_t cap = ZSTD_compressBound(rsize);
+    unsigned char *out = malloc(24 + h1 + cap);
+    memcpy(out, buf, 24 + h1);
+    size_t r2 = ZSTD_compress2(cctx, out + 24 + h1, cap, rec, rsize);
+    assert_false(ZSTD_isError(r2));
+    ZSTD_freeCCtx(cctx);
+    size_t total = 24 + h1 + r2;
+    out[8] = 2; /* version */
+    for (int i = 0; i < 8; i++)
+        out[16 + i] = (unsigned char)((uint64_t)total >> (8 * i));
+    char v2[160];
+    snprintf(v2, sizeof v2, "%s/v2.thzpm", f->dir);
+    spit(v2, out, total);
+
+    for (int threads = 1; threads <= 2; threads++) {
+        photon_map *maps[2] = {NULL, NULL};
+        thz_error err;
+        assert_int_equal(photon_map_file_read(v2, f->scene, threads, maps, NULL, NULL, &err),
+                         THZ_OK);
+        for (size_t c = 0; c < 2; c++) {
+            assert_int_equal(photon_map_count(maps[c]), counts[c]);
+            assert_memory_equal(photon_map_records(maps[c]), photon_map_records(f->maps[c]),
+                                counts[c] * sizeof(photon_record));
+            photon_map_destroy(maps[c]);
+        }
+    }
+    free(buf);
+    free(rec);
+    free(out);
+}
+
 /* Reads `path` expecting failure with `status` and a message holding `what` and path. */
 static void expect_refusal(const char *path, const thz_scene *scene, thz_status status,
                            const char *what)
@@ -415,6 +482,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_round_trip, setup, teardown),
         cmocka_unit_test_setup_teardown(test_one_channel, setup, teardown),
         cmocka_unit_test_setup_teardown(test_version_1, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_version_2_order, setup, teardown),
         cmocka_unit_test_setup_teardown(test_corrupted, setup, teardown),
         cmocka_unit_test_setup_teardown(test_truncated, setup, teardown),
         cmocka_unit_test_setup_teardown(test_forged_count, setup, teardown),
