@@ -275,7 +275,7 @@ static void photon_radius_axes(const photon_radius_query *qr, const photon_cell 
             photon_radius_rec(qr, &ch);
         return;
     }
-    double size = ldexp(qr->cube->side, -cell->level), pad = 1e-6 * size;
+    double size = photon_cell_size(qr->cube, cell->level), pad = 1e-6 * size;
     double mid_m = qr->cube->origin[axis] + ((double)cell->c[axis] + 0.5) * size;
     bool low = qr->q[axis] - qr->radius <= mid_m + pad;
     bool high = qr->q[axis] + qr->radius >= mid_m - pad;
