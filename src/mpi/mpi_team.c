@@ -491,7 +491,8 @@ static thz_status team_serve_begin(mpi_team *t, const thz_scene *scene, const ac
                 return team_error(err, rc, "receiving the photon map");
             }
         }
-        /* takes records, also on failure; sorts them as the lead's map was sorted */
+        /* takes records, also on failure; they come in the lead's map's order, which the
+         * build checks in one pass and keeps */
         thz_status st =
             photon_map_create(records, m->map_count, scene->n_objects, threads, &r->map, err);
         if (st != THZ_OK)
