@@ -2,9 +2,11 @@
  * `gather_rays` secondary rays (cosine for reflection, by the BTDF T(theta) cos(theta)
  * for diffuse shells), each adding what render_photon_map_trace finds at its own hit with
  * the k-nearest-photon radius there (k = max(gather_min_photons, RENDER_SECONDARY_K));
- * the first hit's emission enters by its band mean. From a deviation map the terms are
- * those of L - B(T0) and the sample adds B(T0). One estimate per gather ray: more passes
- * lower the noise.
+ * the first hit's emission enters by its band mean, a gather ray's emission, air and B0
+ * terms at its own frequency nu_j (render_scatter.nu; each photon term at the photon's). A
+ * band mean over the quadrature per gather ray was 39 % of the instructions on the paper's
+ * scene, for no less noise. From a deviation map the terms are those of L - B(T0) and the
+ * sample adds B(T0). One estimate per gather ray: more passes lower the noise.
  */
 #include <math.h>
 
@@ -34,8 +36,11 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
     const float *nf = &obj->mesh.normals[3 * (size_t)hit->triangle];
     vec3 n = v3_from_floats(nf);
     vec3 n_seen = hit->side == 0 ? n : v3_scale(n, -1.0);
-    render_scatter s = {
-        .material = mat, .object = obj, .object_index = hit->object, .mu_o = hit->cos_theta};
+    render_scatter s = {.material = mat,
+                        .object = obj,
+                        .object_index = hit->object,
+                        .mu_o = hit->cos_theta,
+                        .nu = nu_j};
     vec3 dir;
     if (rng_uniform(rng) * (r + tr) < r) {
         s.inv_branch = (r + tr) / r;

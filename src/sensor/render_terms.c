@@ -5,6 +5,7 @@
 
 #include "physics/channel.h"
 #include "physics/optics.h"
+#include "physics/planck.h"
 #include "physics/spectrum.h"
 
 /* Distance from origin_m along dir to where the ray leaves the atmosphere's extent. */
@@ -152,6 +153,23 @@ static double render_node_weight(const render_context *ctx, const render_path *p
     return w;
 }
 
+/* The weight of a term at the gather ray's own frequency s->nu: its scattering at the
+ * first vertex (with 1 / P(branch)), the straight shells' T(theta) and exp(-alpha d). */
+static double render_weight_at(const render_context *ctx, const render_path *path,
+                               const render_scatter *s, double distance_m)
+{
+    double w = render_scatter_weight(ctx, s, s->nu) * render_path_weight(ctx, path, s->nu);
+    if (ctx->atmosphere && w != 0.0)
+        w *= render_tau(atmosphere_alpha_per_m(&ctx->scene->atmosphere, s->nu), distance_m);
+    return w;
+}
+
+/* B0 = B_nu(T0) at the gather ray's frequency (0 without a deviation map). */
+static double render_b0_at(const render_context *ctx, const render_scatter *s)
+{
+    return ctx->deviation ? planck_radiance(s->nu, ctx->t0_k) : 0.0;
+}
+
 /* Band mean of eps(theta) B_nu(T) at a hit (deviation: eps B - A(theta) B0; no cos
  * factor: physics.md "Surfaces") times exp(-alpha d), the straight-shell path weight and
  * the first vertex's scattering s (may be NULL; final-gather's secondary hits), all at
@@ -173,6 +191,15 @@ double render_emission(const render_context *ctx, uint32_t object, double mu,
             if (!isnan(v))
                 return v * s->inv_branch;
         }
+    }
+    if (s && s->nu > 0.0) { /* a gather ray's secondary hit: at its own frequency */
+        const thz_object *obj = &ctx->scene->objects[object];
+        optics_point o = scene_object_optics(ctx->scene, obj, s->nu);
+        double a, eps;
+        optics_absorption_emissivity(&o, mu, &a, &eps);
+        double bt = obj->temperature_k > 0.0 ? planck_radiance(s->nu, obj->temperature_k) : 0.0;
+        double v = eps * bt - a * render_b0_at(ctx, s);
+        return v != 0.0 ? v * render_weight_at(ctx, path, s, distance_m) : 0.0;
     }
     size_t n = ctx->quad.n;
     const optics_point *op = &ctx->optics[(size_t)object * n];
@@ -200,6 +227,8 @@ double render_emission(const render_context *ctx, uint32_t object, double mu,
 double render_b0_term(const render_context *ctx, const render_path *path, const render_scatter *s,
                       double distance_m)
 {
+    if (s && s->nu > 0.0)
+        return planck_radiance(s->nu, ctx->t0_k) * render_weight_at(ctx, path, s, distance_m);
     double sum = 0.0;
     for (size_t k = 0; k < ctx->quad.n; k++)
         sum += ctx->b0[k] * render_tau(ctx->alpha_per_m[k], distance_m) *
@@ -222,6 +251,21 @@ double render_air(const render_context *ctx, const render_path *path, const rend
 {
     if (!ctx->air_terms || (!escaped && !ctx->atmosphere))
         return 0.0; /* without attenuation a free path adds nothing */
+    if (s && s->nu > 0.0) {
+        const thz_atmosphere *atm = &ctx->scene->atmosphere;
+        double a = atmosphere_alpha_per_m(atm, s->nu), b0 = render_b0_at(ctx, s);
+        double t1 = render_tau(a, d1_m);
+        double air = atm->emitting ? planck_radiance(s->nu, atm->air.temperature_k) : 0.0;
+        double v = (air - b0) * (render_tau(a, d0_m) - t1);
+        if (escaped)
+            v += ((atm->emitting ? planck_radiance(s->nu, atm->background_temperature_k) : 0.0) -
+                  b0) *
+                 t1;
+        /* the attenuation is in the terms: the weight without it */
+        return v != 0.0
+                   ? v * render_scatter_weight(ctx, s, s->nu) * render_path_weight(ctx, path, s->nu)
+                   : 0.0;
+    }
     double sum = 0.0;
     for (size_t k = 0; k < ctx->quad.n; k++) {
         double a = ctx->alpha_per_m[k];

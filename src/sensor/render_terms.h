@@ -42,6 +42,9 @@ typedef struct render_scatter {
     brdf_frame frame;  /* lobe: the frame at x, and the directions away from x */
     vec3 w_gather, w_view;
     double pdf; /* lobe: the density of w_gather per solid angle at nu_j */
+    double nu;  /* > 0: the gather ray's frequency nu_j, at which its emission, air and
+                   B0 terms are then taken (one sample of the band, as its photon terms
+                   are); 0: their band means by the channel quadrature */
 } render_scatter;
 
 /* The optics of `object` (obj) at freq_hz with its means cached from the band's tables
