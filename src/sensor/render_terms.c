@@ -175,7 +175,9 @@ static double render_b0_at(const render_context *ctx, const render_scatter *s)
  * the first vertex's scattering s (may be NULL; final-gather's secondary hits), all at
  * each quadrature node: what the sensor sees carries no band noise of B. Without shells
  * or air between, the band means come from the tables (emission_mean or source_mean for
- * the sample's own hit, pair_mean for a reflected gather ray). */
+ * the sample's own hit, pair_mean for a reflected gather ray). Else a gather ray's
+ * (s->nu > 0) at its own frequency: the band's variation of its emission is small beside
+ * what the gather rays see, and the 401 nodes were 39 % of final-gather's work. */
 double render_emission(const render_context *ctx, uint32_t object, double mu,
                        const render_path *path, double distance_m, const render_scatter *s)
 {

@@ -74,7 +74,9 @@ double render_tbar(const render_context *ctx, const thz_object *obj, uint32_t ob
 double render_scatter_weight(const render_context *ctx, const render_scatter *s, double nu);
 
 /* Band mean of the emission at a hit of `object` seen at |cos| mu through path, at
- * distance_m, weighted by s (may be NULL); deviation: eps B - A B0. */
+ * distance_m, weighted by s (may be NULL); deviation: eps B - A B0. With s->nu > 0 (a
+ * gather ray), this and the two below are taken at s->nu alone: one unbiased sample of
+ * the band mean. */
 double render_emission(const render_context *ctx, uint32_t object, double mu,
                        const render_path *path, double distance_m, const render_scatter *s);
 
