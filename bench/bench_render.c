@@ -353,20 +353,26 @@ thz_status bench_measure_converge(const char *scene_path, const char *integrator
     return st;
 }
 
+/* Channel c of run p scaled to target_k: its render time x (rms / target_k)^2 (noise
+ * proportional to 1/sqrt(render time)) plus its photon phase; with `up_only`, a run below
+ * the target keeps its own time (no credit for the part it need not have run). */
+static double bench_point_seconds(const bench_converge_point *p, size_t c, double target_k,
+                                  bool up_only)
+{
+    double scale = p->rms_k[c] / target_k;
+    double factor = up_only && scale < 1.0 ? 1.0 : scale * scale;
+    return p->s_photons[c] + p->s_render[c] * factor;
+}
+
 double bench_converge_seconds(const bench_converge *cv, size_t c, double target_k)
 {
-    const bench_converge_point *p = &cv->pt[1];
-    double scale = p->rms_k[c] / target_k;
-    return p->s_photons[c] + p->s_render[c] * scale * scale;
+    return bench_point_seconds(&cv->pt[1], c, target_k, false);
 }
 
 double bench_converge_confirmed_seconds(const bench_converge *cv, double target_k)
 {
-    if (!cv->confirmed)
-        return NAN;
-    size_t c = cv->confirm_channel;
-    double scale = cv->confirm.rms_k[c] / target_k;
-    return cv->confirm.s_photons[c] + cv->confirm.s_render[c] * scale * scale;
+    return cv->confirmed ? bench_point_seconds(&cv->confirm, cv->confirm_channel, target_k, true)
+                         : NAN;
 }
 
 bool bench_converge_floor(const bench_converge *cv, double target_k, double *a_k2, double *floor2,

@@ -103,7 +103,8 @@ thz_status bench_measure_converge(const char *scene_path, const char *integrator
 double bench_converge_seconds(const bench_converge *cv, size_t c, double target_k);
 
 /* The same from the run at the target (its channel only; NAN when there was none): its
- * render time x (rms / target_k)^2, a factor near 1, plus its photon phase. */
+ * render time, times (rms / target_k)^2 only where its rms is above target_k, plus its
+ * photon phase. */
 double bench_converge_confirmed_seconds(const bench_converge *cv, double target_k);
 
 /* Through the larger run and the run at the target (its channel): RMS^2 = a / J + floor^2,

@@ -215,8 +215,8 @@ json_t *bench_report_converge(const char *integrator, const bench_converge *cv, 
             *worst_s = c != w && s > *worst_s ? s : *worst_s;
         }
         printf("  run at the target: %5.3f THz alone with J=%u: RMS %.4f K, photon phase %.3f s, "
-               "render %.3f s; to %g K %.3f s (its render time x (RMS / %g K)^2, a factor "
-               "%.3f, plus its photon phase), %.2f x the limit\n",
+               "render %.3f s; to %g K %.3f s (its render time, x (RMS / %g K)^2 = %.3f if that "
+               "is above 1, plus its photon phase), %.2f x the limit\n",
                cv->freq_thz[w], (unsigned)p->estimates, p->rms_k[w], p->s_photons[w],
                p->s_render[w], target_k, confirmed, target_k,
                (p->rms_k[w] / target_k) * (p->rms_k[w] / target_k),

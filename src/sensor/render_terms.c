@@ -230,7 +230,7 @@ double render_b0_term(const render_context *ctx, const render_path *path, const 
                       double distance_m)
 {
     if (s && s->nu > 0.0)
-        return planck_radiance(s->nu, ctx->t0_k) * render_weight_at(ctx, path, s, distance_m);
+        return render_b0_at(ctx, s) * render_weight_at(ctx, path, s, distance_m);
     double sum = 0.0;
     for (size_t k = 0; k < ctx->quad.n; k++)
         sum += ctx->b0[k] * render_tau(ctx->alpha_per_m[k], distance_m) *
@@ -257,12 +257,14 @@ double render_air(const render_context *ctx, const render_path *path, const rend
         const thz_atmosphere *atm = &ctx->scene->atmosphere;
         double a = atmosphere_alpha_per_m(atm, s->nu), b0 = render_b0_at(ctx, s);
         double t1 = render_tau(a, d1_m);
-        double air = atm->emitting ? planck_radiance(s->nu, atm->air.temperature_k) : 0.0;
+        double air = 0.0, bg = 0.0; /* air that does not emit: B_air = B_bg = 0 */
+        if (atm->emitting) {
+            air = planck_radiance(s->nu, atm->air.temperature_k);
+            bg = escaped ? planck_radiance(s->nu, atm->background_temperature_k) : 0.0;
+        }
         double v = (air - b0) * (render_tau(a, d0_m) - t1);
         if (escaped)
-            v += ((atm->emitting ? planck_radiance(s->nu, atm->background_temperature_k) : 0.0) -
-                  b0) *
-                 t1;
+            v += (bg - b0) * t1;
         /* the attenuation is in the terms: the weight without it */
         return v != 0.0
                    ? v * render_scatter_weight(ctx, s, s->nu) * render_path_weight(ctx, path, s->nu)

@@ -96,6 +96,27 @@ static void spit(const char *path, const unsigned char *buf, size_t n)
     fclose(fp);
 }
 
+/* src compressed into dst as one zstd frame with a checksum and its content size, as the
+ * writer makes them; returns its size. */
+static size_t compress_frame(unsigned char *dst, size_t cap, const void *src, size_t n)
+{
+    ZSTD_CCtx *cctx = ZSTD_createCCtx();
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
+    size_t r = ZSTD_compress2(cctx, dst, cap, src, n);
+    assert_false(ZSTD_isError(r));
+    ZSTD_freeCCtx(cctx);
+    return r;
+}
+
+/* The prefix of a file of `total` bytes: its size, and its version unless 0. */
+static void set_prefix(unsigned char *out, unsigned version, size_t total)
+{
+    if (version)
+        out[8] = (unsigned char)version;
+    for (int i = 0; i < 8; i++)
+        out[16 + i] = (unsigned char)((uint64_t)total >> (8 * i));
+}
+
 static void test_round_trip(void **state)
 {
     fixture *f = *state;
@@ -146,6 +167,27 @@ static void test_round_trip(void **state)
 
 static void expect_refusal(const char *path, const thz_scene *scene, thz_status status,
                            const char *what);
+
+/* The file at f->path with its header frame replaced by `header` (hsize bytes), and its
+ * version by `version` unless 0, as `out_path`. */
+static void spit_with_header(const fixture *f, const char *out_path, const unsigned char *header,
+                             size_t hsize, unsigned version)
+{
+    size_t n;
+    unsigned char *buf = slurp(f->path, &n);
+    size_t h1 = ZSTD_findFrameCompressedSize(buf + 24, n - 24);
+    assert_false(ZSTD_isError(h1));
+    size_t cap = ZSTD_compressBound(hsize);
+    unsigned char *out = malloc(24 + cap + (n - 24 - h1));
+    size_t h0 = compress_frame(out + 24, cap, header, hsize);
+    memcpy(out, buf, 24);
+    memcpy(out + 24 + h0, buf + 24 + h1, n - 24 - h1);
+    size_t total = 24 + h0 + (n - 24 - h1);
+    set_prefix(out, version, total);
+    spit(out_path, out, total);
+    free(buf);
+    free(out);
+}
 
 /* A version-1 file (20 words per channel, no T0) made from a version-2 one: its header
  * frame without each channel's last word, the records frame as is. */
@@ -213,22 +255,9 @@ static void test_version_1(void **state)
     for (size_t c = 0; c < nc; c++)
         memcpy(old + 8 * (fixed + 20 * c), header + 8 * (fixed + words * c), 8 * 20);
     size_t old_size = 8 * (fixed + 20 * nc);
-    ZSTD_CCtx *cctx = ZSTD_createCCtx();
-    ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
-    size_t cap = ZSTD_compressBound(old_size);
-    unsigned char *out = malloc(24 + cap + (n - 24 - h1));
-    size_t h0 = ZSTD_compress2(cctx, out + 24, cap, old, old_size);
-    assert_false(ZSTD_isError(h0));
-    ZSTD_freeCCtx(cctx);
-    memcpy(out, buf, 24);
-    memcpy(out + 24 + h0, buf + 24 + h1, n - 24 - h1);
-    size_t total = 24 + h0 + (n - 24 - h1);
-    out[8] = 1; /* version */
-    for (int i = 0; i < 8; i++)
-        out[16 + i] = (unsigned char)((uint64_t)total >> (8 * i));
     char v1[160];
     snprintf(v1, sizeof v1, "%s/v1.thzpm", f->dir);
-    spit(v1, out, total);
+    spit_with_header(f, v1, old, old_size, 1);
 
     photon_map *maps[2] = {NULL, NULL};
     photon_stats stats[2];
@@ -242,13 +271,11 @@ static void test_version_1(void **state)
         photon_map_destroy(maps[c]);
     }
     /* Another version number is refused. */
-    out[8] = 9;
-    spit(v1, out, total);
+    spit_with_header(f, v1, old, old_size, 9);
     expect_refusal(v1, f->scene, THZ_ERR_INPUT, "format version 9");
     free(buf);
     free(header);
     free(old);
-    free(out);
 }
 
 static int record_bytes_cmp(const void *a, const void *b)
@@ -283,19 +310,11 @@ static void test_version_2_order(void **state)
     qsort(rec, counts[0], sizeof *rec, record_bytes_cmp);
     qsort(rec + counts[0], counts[1], sizeof *rec, record_bytes_cmp);
     assert_memory_not_equal(rec, photon_map_records(f->maps[0]), counts[0] * sizeof *rec);
-    ZSTD_CCtx *cctx = ZSTD_createCCtx();
-    ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
-    ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
     size_t cap = ZSTD_compressBound(rsize);
     unsigned char *out = malloc(24 + h1 + cap);
     memcpy(out, buf, 24 + h1);
-    size_t r2 = ZSTD_compress2(cctx, out + 24 + h1, cap, rec, rsize);
-    assert_false(ZSTD_isError(r2));
-    ZSTD_freeCCtx(cctx);
-    size_t total = 24 + h1 + r2;
-    out[8] = 2; /* version */
-    for (int i = 0; i < 8; i++)
-        out[16 + i] = (unsigned char)((uint64_t)total >> (8 * i));
+    size_t total = 24 + h1 + compress_frame(out + 24 + h1, cap, rec, rsize);
+    set_prefix(out, 2, total);
     char v2[160];
     snprintf(v2, sizeof v2, "%s/v2.thzpm", f->dir);
     spit(v2, out, total);
@@ -370,32 +389,6 @@ static void test_corrupted(void **state)
     free(buf);
 }
 
-/* The file at f->path with its header frame replaced by `header` (hsize bytes), as
- * `out_path`. */
-static void spit_with_header(const fixture *f, const char *out_path, const unsigned char *header,
-                             size_t hsize)
-{
-    size_t n;
-    unsigned char *buf = slurp(f->path, &n);
-    size_t h1 = ZSTD_findFrameCompressedSize(buf + 24, n - 24);
-    assert_false(ZSTD_isError(h1));
-    ZSTD_CCtx *cctx = ZSTD_createCCtx();
-    ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
-    size_t cap = ZSTD_compressBound(hsize);
-    unsigned char *out = malloc(24 + cap + (n - 24 - h1));
-    size_t h0 = ZSTD_compress2(cctx, out + 24, cap, header, hsize);
-    assert_false(ZSTD_isError(h0));
-    ZSTD_freeCCtx(cctx);
-    memcpy(out, buf, 24);
-    memcpy(out + 24 + h0, buf + 24 + h1, n - 24 - h1);
-    size_t total = 24 + h0 + (n - 24 - h1);
-    for (int i = 0; i < 8; i++)
-        out[16 + i] = (unsigned char)((uint64_t)total >> (8 * i));
-    spit(out_path, out, total);
-    free(buf);
-    free(out);
-}
-
 /* A header (with a valid checksum) whose record count is a lie is refused before the
  * records are allocated: a huge count (2^40 records, 32 TB) and one too many. */
 static void test_forged_count(void **state)
@@ -417,7 +410,7 @@ static void test_forged_count(void **state)
     for (size_t k = 0; k < 2; k++) {
         for (int i = 0; i < 8; i++)
             count[i] = (unsigned char)(lies[k] >> (8 * i));
-        spit_with_header(f, bad, header, hsize);
+        spit_with_header(f, bad, header, hsize, 0);
         expect_refusal(bad, f->scene, THZ_ERR_IO, "bytes of photons");
     }
     free(buf);
