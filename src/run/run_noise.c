@@ -6,6 +6,7 @@
 
 #include "core/alloc.h"
 #include "sensor/render.h"
+#include "sensor/render_accum.h"
 
 typedef struct noise_pixel {
     int32_t object;
@@ -20,6 +21,12 @@ static int noise_cmp(const void *a, const void *b)
     return (x->stderr_k > y->stderr_k) - (x->stderr_k < y->stderr_k);
 }
 
+/* The nearest rank of the 95th percentile among n >= 1 sorted values: ceil(0.95 n). */
+static size_t noise_rank95(size_t n)
+{
+    return (95 * n + 99) / 100;
+}
+
 /* Figures of n values sorted by stderr_k. */
 static run_noise noise_of(const noise_pixel *v, size_t n)
 {
@@ -27,9 +34,42 @@ static run_noise noise_of(const noise_pixel *v, size_t n)
     if (n == 0)
         return r;
     r.median_k = n % 2 ? v[n / 2].stderr_k : 0.5 * (v[n / 2 - 1].stderr_k + v[n / 2].stderr_k);
-    size_t rank = (95 * n + 99) / 100; /* ceil(0.95 n), >= 1 */
-    r.p95_k = v[rank - 1].stderr_k;
+    r.p95_k = v[noise_rank95(n) - 1].stderr_k;
     return r;
+}
+
+static int noise_cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+double run_noise_map_floor_k(const render_accum *accs, const sensor_images *images, size_t n_images,
+                             size_t c, double freq_hz)
+{
+    size_t total = 0;
+    for (size_t i = 0; i < n_images; i++)
+        total += (size_t)images[i].columns * images[i].rows;
+    double *v = thz_malloc_array(total ? total : 1, sizeof *v);
+    if (!v)
+        return -1.0;
+    size_t m = 0;
+    for (size_t i = 0; i < n_images; i++) {
+        const sensor_images *img = &images[i];
+        size_t px = (size_t)img->columns * img->rows;
+        for (size_t p = 0; p < px && accs[i].batch && p < accs[i].pixels; p++) {
+            double tb = img->brightness_temperature[c * px + p];
+            if (tb > 0.0) /* the pixels run_noise_channel counts */
+                v[m++] = render_stderr_k(freq_hz, tb, render_accum_map_stderr(&accs[i], p));
+        }
+    }
+    double floor_k = 0.0;
+    if (m > 0) {
+        qsort(v, m, sizeof *v, noise_cmp_double);
+        floor_k = v[noise_rank95(m) - 1];
+    }
+    free(v);
+    return floor_k;
 }
 
 thz_status run_noise_channel(const sensor_images *images, size_t n_images, size_t c, double freq_hz,

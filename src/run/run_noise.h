@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "sensor/images.h"
+#include "sensor/render_accum.h"
 
 /* One set of pixels' figures; both 0 when there are no pixels. */
 typedef struct run_noise {
@@ -24,5 +25,13 @@ typedef struct run_noise {
  * errors are skipped. */
 thz_status run_noise_channel(const sensor_images *images, size_t n_images, size_t c, double freq_hz,
                              size_t n_objects, run_noise *all, run_noise *objects, thz_error *err);
+
+/* final-gather's floor in channel c (centre freq_hz): the 95th percentile, over the pixels
+ * run_noise_channel counts, of the photon map's share of the standard error of Tb_c
+ * (render_accum_map_stderr; accs[i] holds images[i]'s statistics), K. More gather rays
+ * from the same map do not lower it: the target's 95th percentile stays at least this.
+ * 0 without photon batches (path, photon-map); -1 when out of memory. */
+double run_noise_map_floor_k(const render_accum *accs, const sensor_images *images, size_t n_images,
+                             size_t c, double freq_hz);
 
 #endif

@@ -33,6 +33,26 @@ void render_accum_fini(render_accum *acc)
     memset(acc, 0, sizeof *acc);
 }
 
+/* The photon map's variance of pixel p's mean given the gather rays (final-gather from a
+ * batched map; acc->n >= 2): the spread of the pixel's photon part between the
+ * independent batches, s_B^2 / B, less what the spread of the estimates already holds of
+ * it (each gather disk's own Poisson variance, sum / N^2), at least 0. */
+static double render_accum_map_var(const render_accum *acc, size_t p)
+{
+    double n = (double)acc->n;
+    const double *s = &acc->batch[p * PHOTON_MAP_BATCHES];
+    double nb = (double)PHOTON_MAP_BATCHES, mean = 0.0, ss = 0.0;
+    for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
+        mean += s[b];
+    mean /= nb;
+    for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
+        ss += (s[b] - mean) * (s[b] - mean);
+    /* Z_b = B s_b / N estimates the photon part alone; var of their mean */
+    double map_var = ss * nb * nb / (n * n) / (nb - 1.0) / nb;
+    double diag = acc->disk_var[p] / (n * n);
+    return map_var > diag ? map_var - diag : 0.0;
+}
+
 double render_accum_stderr(const render_accum *acc, size_t p)
 {
     if (acc->poisson)
@@ -41,21 +61,16 @@ double render_accum_stderr(const render_accum *acc, size_t p)
         return 0.0;
     double n = (double)acc->n;
     double var = acc->m2[p] / ((n - 1.0) * n);
-    if (acc->batch) {
-        const double *s = &acc->batch[p * PHOTON_MAP_BATCHES];
-        double nb = (double)PHOTON_MAP_BATCHES, mean = 0.0, ss = 0.0;
-        for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
-            mean += s[b];
-        mean /= nb;
-        for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
-            ss += (s[b] - mean) * (s[b] - mean);
-        /* Z_b = B s_b / N estimates the photon part alone; var of their mean */
-        double map_var = ss * nb * nb / (n * n) / (nb - 1.0) / nb;
-        double diag = acc->disk_var[p] / (n * n);
-        if (map_var > diag)
-            var += map_var - diag;
-    }
+    if (acc->batch)
+        var += render_accum_map_var(acc, p);
     return sqrt(var);
+}
+
+double render_accum_map_stderr(const render_accum *acc, size_t p)
+{
+    if (acc->poisson || !acc->batch || acc->n < 2)
+        return 0.0;
+    return sqrt(render_accum_map_var(acc, p));
 }
 
 thz_status render_accum_want_batches(render_accum *acc, thz_error *err)

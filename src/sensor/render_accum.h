@@ -41,6 +41,11 @@ void render_accum_fini(render_accum *acc);
  * already holds of it (each gather disk's own Poisson variance, sum / N^2), at least 0. */
 double render_accum_stderr(const render_accum *acc, size_t p);
 
+/* The photon map's share of pixel p's standard error (the second term above): the part
+ * that more estimates from the same map do not lower, final-gather's floor. 0 without
+ * batches or with fewer than 2 estimates. */
+double render_accum_map_stderr(const render_accum *acc, size_t p);
+
 /* Allocates the photon batches and disk variances (final-gather from a batched map);
  * nothing if they are there. */
 thz_status render_accum_want_batches(render_accum *acc, thz_error *err);

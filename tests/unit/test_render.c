@@ -1,6 +1,6 @@
 /* Renderer behaviour beyond the physics identities: back faces, truth images,
- * oversampling, thread-count independence, cancellation, the integrator table and
- * deterministic passes. */
+ * oversampling, thread-count independence, cancellation, the integrator table,
+ * deterministic passes and the photon map's share of final-gather's standard error. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -279,6 +279,46 @@ static void test_stderr_in_kelvin(void **state)
     assert_true(render_stderr_k(nu, 0.0, dl) == 0.0);
 }
 
+/* The photon map's share of a final-gather pixel's standard error, by hand: batch sums
+ * alternating 1 and 3 (mean 2, squared deviations 8) over N = 4 estimates give the
+ * spread of Z_b = B s_b / N, 64 / (7 N^2) = 4/7, less the disks' Poisson variance
+ * 1.6 / N^2 = 0.1; the estimates' own spread adds to it in render_accum_stderr. */
+static void test_map_share_of_stderr(void **state)
+{
+    (void)state;
+    _Static_assert(PHOTON_MAP_BATCHES == 8, "the numbers below are for 8 batches");
+    render_accum acc;
+    thz_error err;
+    assert_int_equal(render_accum_init(&acc, 1, &err), THZ_OK);
+    const double est[4] = {1.0, 2.0, 4.0, 5.0}; /* mean 3, m2 10 */
+    double batch[PHOTON_MAP_BATCHES], disk_var = 1.6;
+    for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
+        batch[b] = b % 2 ? 3.0 : 1.0;
+    render_accum_add_pixel(&acc, 0, est, 4, NULL, NULL);
+    render_accum_end_pass(&acc, 4, false);
+    assert_true(render_accum_map_stderr(&acc, 0) == 0.0); /* no batches: path */
+    assert_true(fabs(render_accum_stderr(&acc, 0) - sqrt(10.0 / 12.0)) < 1e-12);
+    render_accum_fini(&acc);
+
+    assert_int_equal(render_accum_init(&acc, 1, &err), THZ_OK);
+    assert_int_equal(render_accum_want_batches(&acc, &err), THZ_OK);
+    render_accum_add_pixel(&acc, 0, est, 4, batch, &disk_var);
+    render_accum_end_pass(&acc, 4, false);
+    double map_var = 4.0 / 7.0 - 0.1;
+    assert_true(fabs(render_accum_map_stderr(&acc, 0) - sqrt(map_var)) < 1e-12);
+    assert_true(fabs(render_accum_stderr(&acc, 0) - sqrt(10.0 / 12.0 + map_var)) < 1e-12);
+    render_accum_fini(&acc);
+
+    /* disks noisier than the batches' spread: the map adds nothing */
+    assert_int_equal(render_accum_init(&acc, 1, &err), THZ_OK);
+    assert_int_equal(render_accum_want_batches(&acc, &err), THZ_OK);
+    disk_var = 16.0;
+    render_accum_add_pixel(&acc, 0, est, 4, batch, &disk_var);
+    render_accum_end_pass(&acc, 4, false);
+    assert_true(render_accum_map_stderr(&acc, 0) == 0.0);
+    render_accum_fini(&acc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -289,6 +329,7 @@ int main(void)
         cmocka_unit_test(test_integrator_table),
         cmocka_unit_test(test_passes_are_deterministic),
         cmocka_unit_test(test_stderr_in_kelvin),
+        cmocka_unit_test(test_map_share_of_stderr),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
