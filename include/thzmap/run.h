@@ -198,6 +198,14 @@ THZ_API thz_status thz_simulate(thz_context *ctx, const thz_scene *scene,
 THZ_API thz_status thz_render_run(thz_context *ctx, const thz_scene *scene,
                                   const thz_photons *photons, long sensor,
                                   const thz_run_settings *settings, thz_run **out, thz_error *err);
+/* The same from a photon-map file (.thzpm) made from `scene`, read one channel at a time
+ * as the render comes to it: it holds one channel's map, not every channel's as
+ * thz_photons_load + thz_render_run do (what `thzmap render --photon-map` runs). Refuses
+ * the file as thz_photons_load does, before any work; damage in a later channel's
+ * records is found when that channel is read, and fails the run then. */
+THZ_API thz_status thz_render_file(thz_context *ctx, const thz_scene *scene, const char *path,
+                                   long sensor, const thz_run_settings *settings, thz_run **out,
+                                   thz_error *err);
 THZ_API void thz_run_destroy(thz_run *run);
 
 /* The rendered sensors: count, and image i (borrowed from the run; NULL if out of range). */

@@ -186,6 +186,7 @@ _PROTOTYPES = {
     "thz_image_plane": (POINTER(c_float), [_P, c_int, POINTER(c_size_t)]),
     "thz_simulate": (c_int, [_P, _P, POINTER(ThzRunSettings), _PP, _ERR]),
     "thz_render_run": (c_int, [_P, _P, _P, c_long, POINTER(ThzRunSettings), _PP, _ERR]),
+    "thz_render_file": (c_int, [_P, _P, c_char_p, c_long, POINTER(ThzRunSettings), _PP, _ERR]),
     "thz_run_destroy": (None, [_P]),
     "thz_run_image_count": (c_size_t, [_P]),
     "thz_run_image": (_P, [_P, c_size_t]),

@@ -394,10 +394,13 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
            target_noise_k=None, max_seconds=None, progress=None):
     """`thzmap render` in memory: every sensor (or only `sensor`, a name or index)
     rendered from `photon_map` (a PhotonMap of this scene, or the path of a .thzpm
-    file). The path integrator needs no photon map (it then uses `seed`)."""
+    file, which is read one channel at a time as the render comes to it: one channel's
+    map in memory). The path integrator needs no photon map (it then uses `seed`)."""
     scene = _scene_arg(scene)
+    path = None
     if isinstance(photon_map, (str, bytes, os.PathLike)):
-        photon_map = load_photon_map(scene, photon_map, threads=threads)
+        path = _path_arg("photon_map", photon_map)
+        photon_map = None
     elif photon_map is not None and not isinstance(photon_map, PhotonMap):
         raise ArgumentError(f"photon_map: expected a PhotonMap or a path, got "
                             f"{type(photon_map).__name__}")
@@ -406,14 +409,20 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
                             "this one with load_photon_map(scene, path)")
     effective = integrator if integrator is not None else scene.info.integrator
     _integrator_arg(integrator)
-    if photon_map is None and _lib.lib.thz_integrator_needs_photons(effective.encode()):
+    if photon_map is None and path is None and \
+            _lib.lib.thz_integrator_needs_photons(effective.encode()):
         raise ArgumentError(f"photon_map: the {effective} integrator renders from a photon "
                             "map; give one (or integrator='path')")
-    if seed is not None and photon_map is not None:
-        raise ArgumentError("seed: a render from a photon map uses the map's seed "
-                            f"({photon_map.seed})")
+    if seed is not None and (photon_map is not None or path is not None):
+        raise ArgumentError("seed: a render from a photon map uses the map's seed" +
+                            (f" ({photon_map.seed})" if photon_map is not None else ""))
     index = -1 if sensor is None else scene.sensor_index(sensor)
     s = _settings(scene, integrator, None, seed, target_noise_k, max_seconds)
+    if path is not None:
+        with Call(threads, progress) as call:
+            return _run_call(call, lambda out: _lib.lib.thz_render_file(
+                call.ctx, scene._handle, os.fsencode(path), index, ctypes.byref(s), out,
+                call.err), scene)
     ptr = photon_map._ptr if photon_map is not None else None
     with Call(threads, progress) as call:
         return _run_call(call, lambda out: _lib.lib.thz_render_run(

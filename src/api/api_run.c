@@ -6,6 +6,7 @@
 
 #include "api/api.h"
 #include "core/alloc.h"
+#include "io/photon_map_file.h"
 #include "run/run_pack.h"
 
 /* ---- images ------------------------------------------------------------------------- */
@@ -183,10 +184,25 @@ static thz_status api_run_wrap(thz_run *run, thz_error *err)
     return run->summary ? THZ_OK : THZ_ERR_NOMEM;
 }
 
-/* simulate (photons NULL and !render) or render. */
+/* A photon-map file read one channel at a time (run_photons.next_map). */
+typedef struct api_map_stream {
+    photon_map_file_stream *file;
+    int threads;
+    photon_stats *stats;
+    photon_map_file_info info;
+} api_map_stream;
+
+static thz_status api_next_map(void *user, photon_map **map, thz_error *err)
+{
+    api_map_stream *s = user;
+    return photon_map_file_next(s->file, s->threads, map, err);
+}
+
+/* simulate (photons NULL and !render) or render, from photons or (stream not NULL) a
+ * file read a channel at a time. */
 static thz_status api_run(thz_context *ctx, const thz_scene *scene, const thz_photons *photons,
-                          bool render, const char *sensor_name, const thz_run_settings *settings,
-                          thz_run **out, thz_error *err)
+                          api_map_stream *stream, bool render, const char *sensor_name,
+                          const thz_run_settings *settings, thz_run **out, thz_error *err)
 {
     *out = NULL;
     if (!scene)
@@ -210,7 +226,16 @@ static thz_status api_run(thz_context *ctx, const thz_scene *scene, const thz_ph
                                .stats = photons->stats,
                                .seed = photons->seed,
                                .photons_per_channel = photons->photons_per_channel};
-        st = run_render(&run->effective, &opt, photons ? &in : NULL, &run->rs, err);
+        if (stream) {
+            in = (run_photons){.stats = stream->stats,
+                               .seed = stream->info.seed,
+                               .photons_per_channel = stream->info.photons_per_channel,
+                               .next_map = api_next_map,
+                               .next_user = stream,
+                               .next_map_bytes = photon_map_file_largest_count(stream->file) *
+                                                 (uint64_t)sizeof(photon_record)};
+        }
+        st = run_render(&run->effective, &opt, photons || stream ? &in : NULL, &run->rs, err);
     } else if (st == THZ_OK) {
         st = run_simulate(&run->effective, &opt, &run->rs, err);
     }
@@ -250,7 +275,21 @@ thz_status thz_simulate(thz_context *ctx, const thz_scene *scene, const thz_run_
 {
     thz_error local;
     err = api_err(err, &local);
-    return api_done(ctx, api_run(ctx, scene, NULL, false, NULL, settings, out, err), err);
+    return api_done(ctx, api_run(ctx, scene, NULL, NULL, false, NULL, settings, out, err), err);
+}
+
+/* The name of sensor `sensor` (NULL for -1: every sensor); THZ_ERR_INPUT when the scene
+ * has no such sensor. */
+static thz_status api_sensor_name(const thz_scene *scene, long sensor, const char **name,
+                                  thz_error *err)
+{
+    *name = NULL;
+    if (sensor < 0)
+        return THZ_OK;
+    if (!scene || (size_t)sensor >= scene->n_sensors)
+        return thz_error_set(err, THZ_ERR_INPUT, "render: the scene has no sensor %ld", sensor);
+    *name = scene->sensors[sensor].name;
+    return THZ_OK;
 }
 
 thz_status thz_render_run(thz_context *ctx, const thz_scene *scene, const thz_photons *photons,
@@ -259,18 +298,36 @@ thz_status thz_render_run(thz_context *ctx, const thz_scene *scene, const thz_ph
 {
     thz_error local;
     err = api_err(err, &local);
-    const char *name = NULL;
-    if (sensor >= 0) {
-        if (!scene || (size_t)sensor >= scene->n_sensors) {
-            *out = NULL;
-            return api_done(
-                ctx,
-                thz_error_set(err, THZ_ERR_INPUT, "render: the scene has no sensor %ld", sensor),
-                err);
-        }
-        name = scene->sensors[sensor].name;
-    }
-    return api_done(ctx, api_run(ctx, scene, photons, true, name, settings, out, err), err);
+    *out = NULL;
+    const char *name;
+    thz_status st = api_sensor_name(scene, sensor, &name, err);
+    if (st == THZ_OK)
+        st = api_run(ctx, scene, photons, NULL, true, name, settings, out, err);
+    return api_done(ctx, st, err);
+}
+
+thz_status thz_render_file(thz_context *ctx, const thz_scene *scene, const char *path, long sensor,
+                           const thz_run_settings *settings, thz_run **out, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    *out = NULL;
+    const char *name;
+    thz_status st = api_sensor_name(scene, sensor, &name, err);
+    if (st == THZ_OK && (!scene || !path))
+        st = thz_error_set(err, THZ_ERR_INPUT, "thz_render_file: no %s", scene ? "path" : "scene");
+    size_t nc = scene ? scene->n_channels : 0;
+    api_map_stream stream = {.threads = ctx ? ctx->threads : 0,
+                             .stats = thz_calloc(nc ? nc : 1, sizeof *stream.stats)};
+    if (st == THZ_OK && !stream.stats)
+        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the photon statistics");
+    if (st == THZ_OK)
+        st = photon_map_file_open(path, scene, stream.stats, &stream.info, &stream.file, err);
+    if (st == THZ_OK)
+        st = api_run(ctx, scene, NULL, &stream, true, name, settings, out, err);
+    photon_map_file_close(stream.file);
+    free(stream.stats);
+    return api_done(ctx, st, err);
 }
 
 thz_status thz_render_sensor(thz_context *ctx, const thz_scene *scene, const thz_photons *photons,

@@ -197,7 +197,6 @@ static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_ru
                           bool render, thz_run **run, thz_error *err)
 {
     thz_output *output = NULL;
-    thz_photons *photons = NULL;
     thz_status st = thz_output_open(a->outdir, &output, err);
     *cli_exit_guard() = output;
     long sensor = -1;
@@ -209,12 +208,12 @@ static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_ru
             err->status = st = THZ_ERR_INPUT;
         }
     }
+    /* render reads the photon-map file a channel at a time: one channel's map in memory */
     if (st == THZ_OK && render && a->photon_map_path)
-        st = thz_photons_load(ctx, scene, a->photon_map_path, &photons, err);
-    if (st == THZ_OK)
-        st = render ? thz_render_run(ctx, scene, photons, sensor, &a->settings, run, err)
+        st = thz_render_file(ctx, scene, a->photon_map_path, sensor, &a->settings, run, err);
+    else if (st == THZ_OK)
+        st = render ? thz_render_run(ctx, scene, NULL, sensor, &a->settings, run, err)
                     : thz_simulate(ctx, scene, &a->settings, run, err);
-    thz_photons_destroy(photons);
     if (st == THZ_OK)
         st = thz_output_add_run(ctx, output, *run, &a->write, err);
     if (st == THZ_OK)

@@ -69,4 +69,23 @@ thz_status photon_map_file_read_channel(const char *path, const thz_scene *scene
                                         size_t channel, photon_map **maps, photon_stats *stats,
                                         photon_map_file_info *info, thz_error *err);
 
+/* A file read one channel at a time, in channel order: for a render that holds one
+ * channel's map at once instead of all (run.h: run_photons.next_map). Opening checks
+ * what photon_map_file_read checks before the records (prefix, header and its checksum,
+ * the scene, the counts against the file's size) and fills stats and info as it does.
+ * Each photon_map_file_next reads the next channel's records and builds its map (the
+ * caller destroys it); the one after the last channel's also checks the records'
+ * checksum and the file's end. A corruption in a later channel's records is found when
+ * that channel is read, after the earlier ones were handed out: the caller fails then. */
+typedef struct photon_map_file_stream photon_map_file_stream;
+
+thz_status photon_map_file_open(const char *path, const thz_scene *scene, photon_stats *stats,
+                                photon_map_file_info *info, photon_map_file_stream **out,
+                                thz_error *err);
+thz_status photon_map_file_next(photon_map_file_stream *s, int threads, photon_map **map,
+                                thz_error *err);
+/* The record count of the file's largest channel (for a memory estimate). */
+size_t photon_map_file_largest_count(const photon_map_file_stream *s);
+void photon_map_file_close(photon_map_file_stream *s);
+
 #endif

@@ -567,7 +567,7 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
     thz_status st = run_begin(rs, scene, opt, "simulate", err);
     bool photons = render_integrator_needs_photons(scene->render.integrator);
     if (st == THZ_OK)
-        st = run_check_run_memory(rs, photons, err);
+        st = run_check_run_memory(rs, photons, 0, err);
     if (st == THZ_OK && opt->plan)
         st = run_tell_plan(rs, true, err);
     if (st == THZ_OK)
@@ -624,15 +624,16 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, const run_
                              "photons until it is met) or final-gather or path",
                              render_integrator_name(scene->render.integrator));
     bool photons = render_integrator_needs_photons(scene->render.integrator);
-    for (size_t c = 0; photons && c < scene->n_channels; c++)
-        if (!in || !in->maps[c])
+    bool stream = photons && in && !in->maps && in->next_map;
+    for (size_t c = 0; photons && !stream && c < scene->n_channels; c++)
+        if (!in || !in->maps || !in->maps[c])
             return thz_error_set(err, THZ_ERR_INPUT,
                                  "render: no photon map for channel %zu; only the path "
                                  "integrator renders without one",
                                  c);
     thz_status st = run_begin(rs, scene, opt, "render", err);
-    if (st == THZ_OK) /* the photon maps are in memory already: the images alone */
-        st = run_check_run_memory(rs, false, err);
+    if (st == THZ_OK) /* maps in memory already: the images alone; or one read at a time */
+        st = run_check_run_memory(rs, false, stream ? in->next_map_bytes : 0, err);
     if (st == THZ_OK && in) {
         if (in->stats)
             memcpy(rs->stats, in->stats, scene->n_channels * sizeof *rs->stats);
@@ -643,8 +644,14 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, const run_
         st = run_tell_plan(rs, false, err);
     if (st == THZ_OK)
         st = run_init_images(rs, err);
-    for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++)
-        st = run_render_channel(rs, c, photons ? in->maps[c] : NULL, err);
+    for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
+        photon_map *map = NULL;
+        if (stream)
+            st = in->next_map(in->next_user, &map, err);
+        if (st == THZ_OK)
+            st = run_render_channel(rs, c, !photons ? NULL : stream ? map : in->maps[c], err);
+        photon_map_destroy(map);
+    }
     if (st == THZ_OK)
         st = run_finish(rs, t_start, err);
     if (st != THZ_OK)

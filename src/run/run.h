@@ -78,13 +78,20 @@ typedef struct run_options {
     void *plan_user;
 } run_options;
 
-/* The photon maps a render run reads (borrowed): one per channel, their photon-phase
- * statistics, and the seed and photon count they were fired with. */
+/* The photon maps a render run reads: one per channel (borrowed), their photon-phase
+ * statistics, and the seed and photon count they were fired with. Or, with maps NULL,
+ * next_map hands over each channel's map when the run comes to it (channels 0, 1, ...
+ * in order; the run destroys it after rendering that channel), so that a render holds
+ * one channel's map at a time (io/photon_map_file.h: photon_map_file_next);
+ * next_map_bytes is the largest one's size, for the memory estimate. */
 typedef struct run_photons {
     photon_map *const *maps;
     const photon_stats *stats;
     uint64_t seed;
     uint64_t photons_per_channel;
+    thz_status (*next_map)(void *user, photon_map **map, thz_error *err);
+    void *next_user;
+    uint64_t next_map_bytes;
 } run_photons;
 
 /* What a finished run reports back (for the CLI's closing line). */
@@ -180,10 +187,10 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
  * anything): THZ_ERR_LIMIT naming the scene file and sensors[i].resolution. */
 thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err);
 
-/* Estimates the memory of the run in rs (its selected sensors' images and, when
- * `photons`, the photon maps it fires), stores it in rs->memory_bytes and refuses the run
- * as run_check_memory does. */
-thz_status run_check_run_memory(run_state *rs, bool photons, thz_error *err);
+/* Estimates the memory of the run in rs (its selected sensors' images, and, when
+ * `photons`, the photon maps it fires, else the held_bytes of maps the run reads one at
+ * a time), stores it in rs->memory_bytes and refuses the run as run_check_memory does. */
+thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t held_bytes, thz_error *err);
 
 /* Fire and render (simulate) or render from `in` (render; NULL only for path) into rs,
  * nothing written. On failure rs is finalised. */

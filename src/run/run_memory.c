@@ -79,9 +79,10 @@ static uint64_t run_add_bytes(uint64_t a, uint64_t b)
     return a > UINT64_MAX - b ? UINT64_MAX : a + b;
 }
 
-thz_status run_check_run_memory(run_state *rs, bool photons, thz_error *err)
+thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t held_bytes, thz_error *err)
 {
     run_memory need = {.image_bytes = run_image_bytes(rs),
+                       .photon_bytes = held_bytes,
                        .available_bytes = thz_physical_memory_bytes()};
     if (photons) {
         uint64_t sum = 0, max = 0;

@@ -126,7 +126,6 @@ static thz_status serve_run_scene(thz_context *ctx, const serve *s, const serve_
                                   thz_error *err)
 {
     thz_scene *scene = NULL;
-    thz_photons *photons = NULL;
     thz_run *run = NULL;
     thz_output *output = NULL;
     thz_run_settings settings;
@@ -149,11 +148,12 @@ static thz_status serve_run_scene(thz_context *ctx, const serve *s, const serve_
                  j->sensor);
         err->status = st = THZ_ERR_INPUT;
     }
+    /* a render reads the photon-map file a channel at a time, as `thzmap render` does */
     if (st == THZ_OK && j->command == CMD_RENDER && j->photon_map[0])
-        st = thz_photons_load(ctx, scene, j->photon_map, &photons, err);
-    if (st == THZ_OK)
+        st = thz_render_file(ctx, scene, j->photon_map, sensor, &settings, &run, err);
+    else if (st == THZ_OK)
         st = j->command == CMD_RENDER
-                 ? thz_render_run(ctx, scene, photons, sensor, &settings, &run, err)
+                 ? thz_render_run(ctx, scene, NULL, sensor, &settings, &run, err)
                  : thz_simulate(ctx, scene, &settings, &run, err);
     if (st == THZ_OK)
         st = thz_output_add_run(ctx, output, run, &write, err);
@@ -162,7 +162,6 @@ static thz_status serve_run_scene(thz_context *ctx, const serve *s, const serve_
     *cli_exit_guard() = NULL;
     thz_output_destroy(output);
     thz_run_destroy(run);
-    thz_photons_destroy(photons);
     thz_scene_destroy(scene);
     return st;
 }

@@ -1,5 +1,6 @@
 /* The API against the CLI: a scene from a JSON string, photons fired, saved and read
- * back, two sensors rendered in memory; every plane must equal, bit for bit, the ENVI
+ * back, two sensors rendered in memory (and by thz_render_file from the saved file);
+ * every plane must equal, bit for bit, the ENVI
  * image `thzmap simulate` writes for the same scene and seed (and the saved map the
  * CLI's photon-map.thzpm), whatever the thread counts (1 here, 2 for the CLI).
  * argv: the thzmap binary, the repository. */
@@ -99,6 +100,31 @@ int main(int argc, char **argv)
         CHECK(thz_image_plane(image, THZ_PLANE_VISUAL_RGB, &bands) && bands == 3, "visual bands");
         compare_with_files(image, path);
         thz_image_destroy(image);
+    }
+
+    /* thz_render_file, which reads the file a channel at a time: the same images, the
+     * file's seed and photons; a missing file or a sensor out of range refused */
+    {
+        thz_run *from_file = NULL;
+        char map_path[4200];
+        snprintf(map_path, sizeof map_path, "%s/api.thzpm", dir);
+        REQUIRE_OK(thz_render_file(ctx, scene, map_path, -1, NULL, &from_file, &err), &err);
+        CHECK(thz_run_image_count(from_file) == 2, "%zu images from the file",
+              thz_run_image_count(from_file));
+        for (size_t i = 0; i < thz_run_image_count(from_file); i++)
+            compare_with_files(thz_run_image(from_file, i), path);
+        const char *sj = thz_run_summary_json(from_file);
+        CHECK(sj && strstr(sj, "\"seed\": 4") && strstr(sj, "\"photons_fired\": 20000"),
+              "render_file summary: %.300s", sj ? sj : "(null)");
+        thz_run_destroy(from_file);
+        snprintf(map_path, sizeof map_path, "%s/missing.thzpm", dir);
+        thz_run *none = NULL;
+        CHECK(thz_render_file(ctx, scene, map_path, -1, NULL, &none, &err) == THZ_ERR_INPUT &&
+                  !none && strstr(err.message, "missing.thzpm"),
+              "a missing file: %s", err.message);
+        snprintf(map_path, sizeof map_path, "%s/api.thzpm", dir);
+        CHECK(thz_render_file(ctx, scene, map_path, 7, NULL, &none, &err) == THZ_ERR_INPUT && !none,
+              "sensor 7: %s", err.message);
     }
 
     /* a whole run in memory gives the same images, a summary, and kept photons */

@@ -95,6 +95,11 @@ def test_bad_render_arguments(tiny_dir):
         thzmap.render(scene, None)
     with pytest.raises(thzmap.ArgumentError):
         thzmap.render(scene, 3.0)
+    # a path is read a channel at a time by the library, which names the missing file
+    with pytest.raises(thzmap.Error, match="none.thzpm"):
+        thzmap.render(scene, tiny_dir / "none.thzpm")
+    with pytest.raises(thzmap.ArgumentError, match="map's seed"):
+        thzmap.render(scene, tiny_dir / "none.thzpm", seed=3)
     with pytest.raises(thzmap.ArgumentError):
         thzmap.scene_from_dict("not a dict")
     result = thzmap.render(scene, pm)

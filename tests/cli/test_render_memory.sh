@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# `thzmap render --photon-map` reads the file one channel at a time (thz_render_file):
+# on the paper's scene with 4 channels of 10^6 photons (16 x 16 pixels, photon-map),
+# its peak memory above that of a render that reads no map (path, without one) is at
+# most 1.5 x the largest channel's map, where holding every channel's map at once, as
+# it did before, takes 4 maps (measured: 1.0 x, and 3.8 x before); and its images are
+# those of the simulate that saved the map.
+# The peak is the child's maxrss (getrusage), so this runs without sanitizers.
+# argv: path to the thzmap binary, repository directory.
+set -u
+THZMAP=$1
+REPO=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+cp -r "$REPO/examples/teraeye" "$work/scene"
+python3 - "$work/scene/scene.json" <<'PY' || exit 1
+import json, sys
+path = sys.argv[1]
+with open(path) as f:
+    d = json.load(f)
+d["channels"] = {"from_thz": 0.3, "to_thz": 1.2, "count": 4, "relative_width": 0.01}
+d["photons"]["per_channel"] = 1000000
+d["sensors"][0]["resolution"] = [16, 16]
+d["render"] = {"integrator": "photon-map"}
+with open(path, "w") as f:
+    json.dump(d, f)
+PY
+S=$work/scene/scene.json
+M=$work/sim/photon-map.thzpm
+if ! "$THZMAP" simulate "$S" -o "$work/sim" --save-photon-map --quiet --threads 2; then
+    echo "FAIL: simulate"
+    exit 1
+fi
+
+# Peaks come from separate Python processes, so each RUSAGE_CHILDREN is one child's.
+peak() { # thzmap arguments; prints the peak resident memory in bytes
+    python3 - "$THZMAP" "$@" <<'PY'
+import resource, subprocess, sys
+p = subprocess.run([sys.argv[1], *sys.argv[2:], "--quiet", "--threads", "2"],
+                   capture_output=True, text=True)
+if p.returncode != 0:
+    sys.exit(f"thzmap {' '.join(sys.argv[2:])}: exit {p.returncode}\n{p.stdout}{p.stderr}")
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024)
+PY
+}
+bare=$(peak render "$S" -o "$work/bare" --integrator path) || exit 1
+full=$(peak render "$S" -o "$work/full" --photon-map "$M") || exit 1
+
+python3 - "$work" "$bare" "$full" <<'PY'
+import json, sys
+work, bare, full = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+bad = []
+with open(f"{work}/sim/summary.json") as f:
+    stored = [c["photons_stored"] for c in json.load(f)["channels"]]
+largest, total = 32 * max(stored), 32 * sum(stored)
+extra = full - bare
+print(f"render peak {full / 1e6:.1f} MB, {extra / 1e6:.1f} MB above the bare render's "
+      f"{bare / 1e6:.1f} MB; largest map {largest / 1e6:.1f} MB, all {total / 1e6:.1f} MB")
+if extra > 1.5 * largest:
+    bad.append(f"render holds {extra / largest:.2f} x the largest map (at most 1.5)")
+for name in ["radiance", "brightness_temperature", "radiance_stderr"]:
+    with open(f"{work}/sim/cam.{name}.img", "rb") as a, open(f"{work}/full/cam.{name}.img",
+                                                             "rb") as b:
+        if a.read() != b.read():
+            bad.append(f"cam.{name}.img differs from simulate's")
+for b in bad:
+    print("FAIL:", b)
+sys.exit(1 if bad else 0)
+PY
