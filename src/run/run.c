@@ -646,8 +646,11 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, const run_
         st = run_init_images(rs, err);
     for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
         photon_map *map = NULL;
-        if (stream)
+        if (stream) { /* reading the file is the render's photon time */
+            double t0 = thz_now_s();
             st = in->next_map(in->next_user, &map, err);
+            rs->seconds_photons += thz_now_s() - t0;
+        }
         if (st == THZ_OK)
             st = run_render_channel(rs, c, !photons ? NULL : stream ? map : in->maps[c], err);
         photon_map_destroy(map);
