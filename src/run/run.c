@@ -25,13 +25,6 @@
 #include "sensor/render_tiles.h"
 #include "sensor/truth.h"
 
-/* A noise target stops here at the latest (with a run warning). */
-#define RUN_MAX_PASSES 100000u
-/* final-gather stops at its photon map's floor from this pass on (run_at_map_floor): the
- * floor's estimate from one pass of 32 gather rays was within 2 % of its value after 11
- * on the paper's scene. */
-#define RUN_FLOOR_PASSES 2u
-
 thz_status run_check_options(const run_options *opt, thz_error *err)
 {
     if (opt->target_noise_k < 0.0 || !isfinite(opt->target_noise_k))
@@ -80,10 +73,7 @@ double run_target_noise_k(const thz_scene *scene, const run_options *opt, bool r
     return t;
 }
 
-static thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-
-static thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt, ...)
+thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt, ...)
 {
     char buf[512];
     va_list ap;
@@ -199,121 +189,6 @@ static thz_status run_init_images(run_state *rs, thz_error *err)
             return st;
     }
     return THZ_OK;
-}
-
-/* The 95th percentile over the rendered pixels of channel c (all selected sensors) of
- * the standard error of Tb_c in K (run_noise.h): what a noise target aims at. A
- * negative value (never below a target) on allocation failure: the caller stops. */
-static double run_channel_p95_stderr_k(const run_state *rs, size_t c)
-{
-    run_noise all;
-    thz_error ignored;
-    if (run_noise_channel(rs->images, rs->n_selected, c, rs->scene->channels[c].center_hz, 0, &all,
-                          NULL, &ignored) != THZ_OK)
-        return -1.0;
-    return all.p95_k;
-}
-
-/* final-gather: whether the photon map's own noise (run_noise_map_floor_k) keeps channel
- * c's 95th percentile at or above the target: more gather rays from the same map cannot
- * lower it, so the passes stop there, with a warning that says what would (*st: THZ_OK,
- * or the warning's failure). */
-static bool run_at_map_floor(run_state *rs, size_t c, const render_accum *acc, double target,
-                             thz_status *st, thz_error *err)
-{
-    double floor_k =
-        run_noise_map_floor_k(acc, rs->images, rs->n_selected, c, rs->scene->channels[c].center_hz);
-    if (floor_k < target) /* below, or no batches (0), or out of memory (-1): go on */
-        return false;
-    bool render = strcmp(rs->command, "render") == 0;
-    *st = run_add_warning(
-        rs, err,
-        "channel %zu: final-gather's photon map alone leaves %.3g K at the 95th percentile, "
-        "at or above the noise target of %g K, which more gather rays cannot lower: stopped "
-        "after %u passes. A map of more photons lowers it (%s %llu per channel), and the "
-        "path integrator has no such floor",
-        c, floor_k, target, rs->passes[c], render ? "the map read has" : "now",
-        (unsigned long long)rs->photons_per_channel);
-    return true;
-}
-
-/* Renders channel c of every selected sensor: one pass, or, with a noise target and an
- * integrator with passes, passes until the channel's median standard error reaches it
- * or the time limit passes. */
-static thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, thz_error *err)
-{
-    render_options ro = {.threads = rs->opt->threads,
-                         .use_seed = true,
-                         .seed = rs->seed, /* the photon map's, for render */
-                         .progress = rs->opt->progress,
-                         .progress_user = rs->opt->progress_user};
-    const render_team *team = rs->opt->render_team;
-    if (team) /* this process renders its tiles, the others theirs */
-        ro.members = team->members;
-    double t0 = thz_now_s();
-    double target =
-        render_integrator_has_passes(rs->scene->render.integrator) ? rs->target_noise_k : 0.0;
-    render_accum *acc = thz_calloc(rs->n_selected, sizeof *acc);
-    thz_status st = THZ_OK;
-    if (!acc)
-        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the pixel statistics");
-    for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
-        const thz_sensor *s = &rs->scene->sensors[rs->selected[i]];
-        st = render_accum_init(&acc[i], (size_t)s->columns * s->rows, err);
-    }
-    /* the channel's tables, built once for all its passes and sensors */
-    render_context *ctx = NULL;
-    if (st == THZ_OK && team) {
-        render_channel_request rq = {.channel = c, .use_seed = ro.use_seed, .seed = ro.seed};
-        st = team->channel_begin(team->impl, &rq, map, err);
-    }
-    if (st == THZ_OK)
-        st = render_context_create(rs->scene, rs->accel, map, c, &ro, &ctx, err);
-    for (uint32_t pass = 0; st == THZ_OK; pass++) {
-        for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {
-            render_stats rst;
-            if (team)
-                st = team->pass_start(team->impl, rs->selected[i], pass, err);
-            if (st == THZ_OK)
-                st = render_context_pass(ctx, rs->selected[i], pass, &acc[i], &ro, &rst, err);
-            if (st == THZ_OK && team)
-                st = team->pass_gather(team->impl, &acc[i],
-                                       rs->scene->sensors[rs->selected[i]].columns, &rst, err);
-            if (st != THZ_OK)
-                break;
-            rs->last[c * rs->n_selected + i] = rst;
-            st = render_accum_write(rs->scene, c, rs->selected[i], &acc[i], &rs->images[i], err);
-        }
-        if (st != THZ_OK)
-            break;
-        rs->passes[c] = pass + 1;
-        if (!(target > 0.0))
-            break;
-        if (run_channel_p95_stderr_k(rs, c) <= target)
-            break;
-        if (pass + 1 >= RUN_FLOOR_PASSES && run_at_map_floor(rs, c, acc, target, &st, err))
-            break;
-        if (rs->max_seconds > 0.0 && thz_now_s() - t0 >= rs->max_seconds)
-            break;
-        if (pass + 1 >= RUN_MAX_PASSES) {
-            st = run_add_warning(rs, err,
-                                 "channel %zu: stopped after %u passes above the noise target "
-                                 "of %g K",
-                                 c, (unsigned)RUN_MAX_PASSES, target);
-            break;
-        }
-    }
-    if (st == THZ_OK && team)
-        st = team->channel_end(team->impl, err);
-    render_context_destroy(ctx);
-    if (acc)
-        for (size_t i = 0; i < rs->n_selected; i++)
-            render_accum_fini(&acc[i]);
-    free(acc);
-    double seconds = thz_now_s() - t0;
-    rs->seconds_channel[c] += seconds; /* photon-map's photon passes render again */
-    rs->seconds_render += seconds;
-    return st;
 }
 
 /* The noise figures of every channel, overall and per object. */
@@ -442,99 +317,6 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
     double t0 = thz_now_s();
     st = accel_create(scene, &rs->accel, err);
     rs->seconds_accel = thz_now_s() - t0;
-    return st;
-}
-
-/* photon-map with a noise target (it cannot add render passes: it is deterministic given
- * its map): photon passes instead. Pass p fires photons p K .. (p + 1) K - 1 of the
- * channel, and the channel is rendered from the merge of all passes' photons
- * (photon_map_merge: (p + 1) K photons), until the median standard error reaches the
- * target, the time limit passes, or the next merge would not fit in half the memory.
- * *out_map is the merged map; the passes are bit-identical for any thread count. */
-static thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_error *err)
-{
-    const thz_scene *scene = rs->scene;
-    const run_options *opt = rs->opt;
-    double target = rs->target_noise_k, t_start = thz_now_s();
-    size_t cap = 16, n = 0;
-    photon_map **maps = thz_calloc(cap, sizeof *maps);
-    photon_map *merged = NULL;
-    thz_status st = THZ_OK;
-    if (!maps)
-        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the photon passes");
-    uint64_t k = scene->photons.per_channel;
-    double limit = 0.5 * (double)thz_physical_memory_bytes();
-    while (st == THZ_OK) {
-        if (n == cap) {
-            photon_map **m = thz_realloc_array(maps, 2 * cap, sizeof *m);
-            if (!m) {
-                st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the photon passes");
-                break;
-            }
-            maps = m;
-            cap *= 2;
-        }
-        photon_phase_options po = {.threads = opt->threads,
-                                   .reference_temperature_k = run_photon_t0_k(scene, c),
-                                   .first_photon = (uint64_t)n * k,
-                                   .team = opt->team,
-                                   .pool = &rs->pool,
-                                   .progress = opt->progress,
-                                   .progress_user = opt->progress_user};
-        photon_stats ps;
-        double t0 = thz_now_s();
-        st = photon_phase_run(scene, rs->accel, c, &po, &maps[n], &ps, err);
-        if (st != THZ_OK)
-            break;
-        n++;
-        photon_map_destroy(merged);
-        merged = NULL;
-        if (n > 1)
-            st = photon_map_merge((const photon_map *const *)maps, n, scene->n_objects,
-                                  opt->threads, &merged, err);
-        rs->seconds_photons += thz_now_s() - t0;
-        photon_stats_merge(&rs->stats[c], &ps, (uint32_t)n);
-        if (st != THZ_OK)
-            break;
-        const photon_map *map = n > 1 ? merged : maps[0];
-        rs->stats[c].stored = photon_map_count(map);
-        st = run_render_channel(rs, c, map, err);
-        rs->passes[c] = (uint32_t)n;
-        if (st != THZ_OK || run_channel_p95_stderr_k(rs, c) <= target)
-            break;
-        if (rs->max_seconds > 0.0 && thz_now_s() - t_start >= rs->max_seconds)
-            break;
-        /* the passes' maps and the next merge: twice the records, and their indexes */
-        double next = 2.2 * (double)photon_map_bytes(map) * (double)(n + 1) / (double)n;
-        if (limit > 0.0 && next > limit) { /* 0: the machine's memory is unknown */
-            st = run_add_warning(rs, err,
-                                 "channel %zu: stopped after %zu photon passes (%llu photons) "
-                                 "above the noise target of %g K: the next would need %.2f GiB "
-                                 "of memory",
-                                 c, n, (unsigned long long)(n * k), target, next / 1073741824.0);
-            break;
-        }
-        if (n >= RUN_MAX_PASSES) {
-            st = run_add_warning(rs, err,
-                                 "channel %zu: stopped after %u passes above the noise target "
-                                 "of %g K",
-                                 c, (unsigned)RUN_MAX_PASSES, target);
-            break;
-        }
-    }
-    if (st == THZ_OK && n > 0) {
-        if (n > 1) {
-            *out_map = merged;
-            merged = NULL;
-        } else {
-            *out_map = maps[0];
-            maps[0] = NULL;
-        }
-    }
-    photon_map_destroy(merged);
-    for (size_t i = 0; maps && i < n; i++)
-        photon_map_destroy(maps[i]);
-    free(maps);
     return st;
 }
 

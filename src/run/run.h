@@ -221,4 +221,21 @@ void run_state_fini(run_state *rs);
  * deviation map takes the renderer's reference temperature, photon-map 0. */
 double run_photon_t0_k(const thz_scene *scene, size_t c);
 
+/* ---- Internal to src/run/ ---- */
+
+/* Adds a run warning (summary.json "warnings", and run_options.warning). */
+thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* Renders channel c of every selected sensor from map (NULL for path): one pass, or,
+ * with a noise target and an integrator with passes, passes until the 95th percentile
+ * of the channel's standard error reaches it, the time limit passes, or final-gather's
+ * photon map alone keeps it above (run_passes.c). */
+thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, thz_error *err);
+
+/* photon-map with a noise target: photon passes, each rendered from the merge of all so
+ * far, until the target, the time limit or half the memory; *out_map the merged map
+ * (run_passes.c). */
+thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_error *err);
+
 #endif
