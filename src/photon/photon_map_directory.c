@@ -5,18 +5,12 @@
 #include "photon/photon_map_layout.h"
 
 /* The directory's level for a group of n records: the deepest L <= PHOTON_DIR_MAX_LEVELS
- * whose cells that a surface crosses hold PHOTON_DIR_MIN_PER_CELL records on average (a
- * surface crosses about 4^L of the 8^L cells: a group's records lie on its object's
- * surface), while its 8^L + 1 starts take at most PHOTON_DIR_MAX_SHARE of the records'
- * bytes; 0 for groups too small to need one (their binary searches stay within a few
- * cache lines). */
+ * with PHOTON_DIR_MIN_PER_CELL records per cell of level L on average; 0 for groups too
+ * small to need one (their binary searches stay within a few cache lines). */
 static int photon_dir_level(size_t n)
 {
     int level = 0;
-    while (level < PHOTON_DIR_MAX_LEVELS &&
-           (size_t)PHOTON_DIR_MIN_PER_CELL << 2 * (level + 1) <= n &&
-           (((size_t)1 << 3 * (level + 1)) + 1) * sizeof(size_t) <=
-               n * sizeof(photon_record) / PHOTON_DIR_MAX_SHARE)
+    while (level < PHOTON_DIR_MAX_LEVELS && (size_t)PHOTON_DIR_MIN_PER_CELL << 3 * (level + 1) <= n)
         level++;
     return level;
 }

@@ -35,16 +35,12 @@ struct photon_map {
     unsigned batches;   /* PHOTON_MAP_BATCHES, or 1: records without their batch */
 };
 
-/* A group's directory goes down to the deepest level L whose cells that its surface
- * crosses (about 4^L) hold at least PHOTON_DIR_MIN_PER_CELL records on average, at most
- * PHOTON_DIR_MAX_LEVELS (8^6 cells, 2 MB) and at most 1/PHOTON_DIR_MAX_SHARE of the
- * group's records' bytes: final-gather on the paper's scene spends 9-14 % less CPU with
- * it (16 and 6; 64 per cell helped less, 8 and 7 no more); counting the surface's cells
- * rather than all 8^L took it one or two levels deeper on maps of 10^6 photons, and the
- * render's instructions down 5 % more. */
+/* A group's directory goes down to the deepest level L whose cells hold at least
+ * PHOTON_DIR_MIN_PER_CELL records on average, at most PHOTON_DIR_MAX_LEVELS (8^6 cells,
+ * 2 MB): final-gather on the paper's scene spends 9-14 % less CPU with it (16 and 6;
+ * 64 per cell helped less, 8 and 7 no more). */
 #define PHOTON_DIR_MAX_LEVELS 6
 #define PHOTON_DIR_MIN_PER_CELL 16
-#define PHOTON_DIR_MAX_SHARE 8
 
 struct photon_map_directory {
     size_t n_groups;
