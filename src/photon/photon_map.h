@@ -132,8 +132,9 @@ void photon_map_radius(const photon_map *map, uint32_t object, int side, vec3 po
  * it or without it (it is built by those binary searches). It borrows the map, which
  * must outlive it unchanged; it is not part of the map (photon_map_bytes). */
 typedef struct photon_map_directory photon_map_directory;
-thz_status photon_map_directory_create(const photon_map *map, photon_map_directory **out,
-                                       thz_error *err);
+/* threads: OpenMP threads for its fill, 0: all. */
+thz_status photon_map_directory_create(const photon_map *map, int threads,
+                                       photon_map_directory **out, thz_error *err);
 void photon_map_directory_destroy(photon_map_directory *dir);
 size_t photon_map_directory_bytes(const photon_map_directory *dir);
 

@@ -1,4 +1,5 @@
 /* A renderer's lookup table over a photon map's spatial index: see photon_map.h. */
+#include <omp.h>
 #include <stdlib.h>
 
 #include "core/alloc.h"
@@ -44,8 +45,8 @@ void photon_map_directory_destroy(photon_map_directory *dir)
     free(dir);
 }
 
-thz_status photon_map_directory_create(const photon_map *map, photon_map_directory **out,
-                                       thz_error *err)
+thz_status photon_map_directory_create(const photon_map *map, int threads,
+                                       photon_map_directory **out, thz_error *err)
 {
     *out = NULL;
     photon_map_directory *dir = thz_calloc(1, sizeof *dir);
@@ -70,11 +71,27 @@ thz_status photon_map_directory_create(const photon_map *map, photon_map_directo
             photon_map_directory_destroy(dir);
             return thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for its directory");
         }
-        photon_cell root = {.level = 0, .lo = lo, .hi = hi};
-        photon_dir_fill(&map->cubes[g], map->records, &root, level, starts);
         starts[cells] = hi;
         dir->starts[g] = starts;
         dir->level[g] = level;
+    }
+    /* The fills, each group's 8 children of its root a task of their own: they write
+     * disjoint cells, so the directory is the same for any thread count. Serial, they
+     * were ~12 % of a photon-map render of the paper's 10 M-photon maps on 2 threads. */
+    int nt = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel num_threads(nt)
+#pragma omp single
+    for (size_t g = 0; g < n_groups; g++) {
+        if (dir->level[g] == 0)
+            continue;
+        photon_cell root = {.level = 0, .lo = map->start[g], .hi = map->start[g + 1]};
+        size_t b[9];
+        photon_cell_split(&map->cubes[g], map->records, &root, b);
+        for (unsigned d = 0; d < 8; d++) {
+            photon_cell child = photon_child(&root, d, b);
+#pragma omp task firstprivate(child, g)
+            photon_dir_fill(&map->cubes[g], map->records, &child, dir->level[g], dir->starts[g]);
+        }
     }
     *out = dir;
     return THZ_OK;

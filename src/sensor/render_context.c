@@ -65,7 +65,7 @@ static void render_pair_table(render_context *ctx)
  * not NAN, else scene_reference_temperature_k (path). */
 static thz_status render_context_init(render_context *ctx, const thz_scene *scene, const accel *a,
                                       const photon_map *map, size_t channel, bool map_t0,
-                                      double path_t0_k, thz_error *err)
+                                      double path_t0_k, int threads, thz_error *err)
 {
     memset(ctx, 0, sizeof *ctx);
     ctx->scene = scene;
@@ -171,7 +171,7 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         }
     }
     if (map) {
-        st = photon_map_directory_create(map, &ctx->dir, err);
+        st = photon_map_directory_create(map, threads, &ctx->dir, err);
         if (st != THZ_OK) {
             render_context_fini(ctx);
             return st;
@@ -202,7 +202,8 @@ thz_status render_context_create(const thz_scene *scene, const accel *a, const p
     render_context *ctx = thz_calloc(1, sizeof *ctx);
     if (!ctx)
         return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory");
-    st = render_context_init(ctx, scene, a, map, channel, integ->needs_photons, path_t0_k, err);
+    st = render_context_init(ctx, scene, a, map, channel, integ->needs_photons, path_t0_k,
+                             opt ? opt->threads : 0, err);
     if (st != THZ_OK) {
         render_context_destroy(ctx); /* fini is safe on what init left */
         return st;

@@ -45,7 +45,7 @@ static photon_map *make_map(size_t n, uint32_t n_objects, photon_map_directory *
     photon_map *map = NULL;
     assert_int_equal(photon_map_create(make_photons(n, n_objects), n, n_objects, 0, &map, NULL),
                      THZ_OK);
-    assert_int_equal(photon_map_directory_create(map, dir, NULL), THZ_OK);
+    assert_int_equal(photon_map_directory_create(map, 2, dir, NULL), THZ_OK);
     return map;
 }
 
