@@ -31,6 +31,9 @@ typedef struct phase_fire_args {
     uint64_t first_photon; /* index of the first photon (its random stream and batch) */
     int threads;
     photon_map_pool *pool; /* the record array's first memory, or NULL */
+    /* Progress after every batch but the last: the last is the caller's to report, once
+     * the map is built, so that a display timing the stages gives the index build to the
+     * photons and not to the render that follows. */
     thz_progress_fn progress;
     void *progress_user;
 } phase_fire_args;
@@ -156,7 +159,7 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
             goto cleanup;
         }
 
-        if (a->progress) { /* a share's progress, scaled to K */
+        if (a->progress && first + batch_n < a->hi) { /* a share's progress, scaled to K */
             double share = (double)(first + batch_n - a->lo) / (double)(a->hi - a->lo);
             thz_progress p = {.stage = "photons",
                               .channel = a->channel,
@@ -381,6 +384,18 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     photon_map_set_reference_temperature_k(*out_map, t0_k);
     photon_map_set_batches(*out_map, PHOTON_MAP_BATCHES);
     double t3 = omp_get_wtime();
+    if (opt && opt->progress) { /* the last batch's progress (phase_fire_args) */
+        thz_progress p = {.stage = "photons",
+                          .channel = channel,
+                          .n_channels = scene->n_channels,
+                          .done = rq.photons,
+                          .total = rq.photons};
+        if (opt->progress(opt->progress_user, &p) != 0) {
+            photon_map_destroy(*out_map);
+            *out_map = NULL;
+            return thz_error_set(err, THZ_ERR_CANCELLED, "photon phase: cancelled");
+        }
+    }
 
     if (stats) {
         photon_stats_init(stats);
