@@ -164,7 +164,7 @@ thz_status thz_photons_save(const thz_photons *ph, const char *path, thz_error *
                                  "%s: channel %zu has no photon map (fired one channel only?)",
                                  path, c);
     return photon_map_file_write(path, &ph->effective, (const photon_map *const *)ph->maps,
-                                 ph->stats, err);
+                                 ph->stats, 0, err);
 }
 
 /* Whether the parts can merge: one scene, seed, photon count and T0 per channel. */

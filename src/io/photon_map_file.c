@@ -7,6 +7,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <zstd.h>
+#include <zstd_errors.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "core/alloc.h"
 #include "io/photon_map_file_format.h"
@@ -38,8 +43,11 @@ static thz_status pmf_compress(pmf_writer *w, const void *src, size_t n, ZSTD_En
         ZSTD_outBuffer out = {w->out, w->out_cap, 0};
         size_t r = ZSTD_compressStream2(w->cctx, &out, &in, mode);
         if (ZSTD_isError(r))
-            return thz_error_set(err, THZ_ERR_INTERNAL, "cannot compress photon map %s: %s",
-                                 w->path, ZSTD_getErrorName(r));
+            return thz_error_set(
+                err,
+                ZSTD_getErrorCode(r) == ZSTD_error_memory_allocation ? THZ_ERR_NOMEM
+                                                                     : THZ_ERR_INTERNAL,
+                "cannot compress photon map %s: %s", w->path, ZSTD_getErrorName(r));
         thz_status st = pmf_write_bytes(w, w->out, out.pos, err);
         if (st != THZ_OK)
             return st;
@@ -89,7 +97,7 @@ static thz_status pmf_write_channel(pmf_writer *w, const photon_map *map, thz_er
 
 thz_status photon_map_file_write(const char *path, const thz_scene *scene,
                                  const photon_map *const *maps, const photon_stats *stats,
-                                 thz_error *err)
+                                 int threads, thz_error *err)
 {
     thz_status st = THZ_OK;
     size_t nc = scene->n_channels;
@@ -113,6 +121,14 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
                            ZSTD_getErrorName(r));
         goto cleanup;
     }
+    /* Workers: at least 1, whose output any count shares (0 is zstd's single-threaded
+     * mode, encoded otherwise). An error here means a libzstd without threads. */
+#ifdef _OPENMP
+    int workers = threads > 0 ? threads : omp_get_max_threads();
+#else
+    int workers = threads > 0 ? threads : 1;
+#endif
+    (void)ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_nbWorkers, workers > 1 ? workers : 1);
 
     scene_hash h;
     scene_hash_compute(scene, &h);
@@ -156,8 +172,12 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
     st = pmf_write_bytes(&w, prefix, sizeof prefix, err); /* size patched at the end */
     if (st == THZ_OK)
         st = pmf_begin_frame(&w, header_bytes, err);
+    /* the header streamed and then ended: a first call that ends the frame is zstd's
+     * one-shot compression, whose jobs, unlike the stream's, depend on the workers */
     if (st == THZ_OK)
-        st = pmf_compress(&w, header, header_bytes, ZSTD_e_end, err);
+        st = pmf_compress(&w, header, header_bytes, ZSTD_e_continue, err);
+    if (st == THZ_OK)
+        st = pmf_compress(&w, NULL, 0, ZSTD_e_end, err);
     if (st == THZ_OK)
         st = pmf_begin_frame(&w, total_records * sizeof(photon_record), err);
     for (size_t c = 0; c < nc && st == THZ_OK; c++)

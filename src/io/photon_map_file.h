@@ -46,10 +46,13 @@ typedef struct photon_map_file_info {
 
 /* Writes scene->n_channels maps (maps[c], borrowed) and their stats (n_channels entries,
  * may be NULL: zeros are written) to path, recording scene->photons' seed and count and
- * the scene's hashes. Errors name the file. */
+ * the scene's hashes. The records are compressed by `threads` zstd workers (0: as many
+ * as OpenMP's threads); zstd's streaming output is the same for any number of workers
+ * from 1 on, so the file is too (a libzstd built without threads: compressed in the
+ * calling thread, which zstd encodes differently). Errors name the file. */
 thz_status photon_map_file_write(const char *path, const thz_scene *scene,
                                  const photon_map *const *maps, const photon_stats *stats,
-                                 thz_error *err);
+                                 int threads, thz_error *err);
 
 /* Reads a photon-map file made from `scene`: fills maps[0..n_channels-1] (the caller
  * destroys them; all NULL on failure; each with its reference temperature set), stats

@@ -58,7 +58,7 @@ static thz_status run_save_photon_map(const run_state *rs, const char *dir, uint
     thz_status st = thz_path_join(path, sizeof path, dir, "photon-map.thzpm", err);
     const photon_map *const *maps = (const photon_map *const *)rs->maps;
     if (st == THZ_OK)
-        st = photon_map_file_write(path, rs->scene, maps, rs->stats, err);
+        st = photon_map_file_write(path, rs->scene, maps, rs->stats, rs->opt->threads, err);
     if (st == THZ_OK)
         st = thz_path_join(path, sizeof path, dir, "photon-map.ply", err);
     if (st != THZ_OK)

@@ -53,7 +53,7 @@ static int setup(void **state)
             return -1;
     }
     accel_destroy(acc);
-    if (photon_map_file_write(f->path, f->scene, (const photon_map *const *)f->maps, f->stats,
+    if (photon_map_file_write(f->path, f->scene, (const photon_map *const *)f->maps, f->stats, 1,
                               &err) != THZ_OK)
         return -1;
     *state = f;
@@ -149,7 +149,7 @@ static void test_round_trip(void **state)
     char again[160];
     snprintf(again, sizeof again, "%s/again.thzpm", f->dir);
     assert_int_equal(
-        photon_map_file_write(again, f->scene, (const photon_map *const *)maps, stats, &err),
+        photon_map_file_write(again, f->scene, (const photon_map *const *)maps, stats, 3, &err),
         THZ_OK);
     size_t n1, n2;
     unsigned char *b1 = slurp(f->path, &n1), *b2 = slurp(again, &n2);
@@ -194,6 +194,67 @@ static void spit_with_header(const fixture *f, const char *out_path, const unsig
 /* One channel read alone (what a view of its photons needs): its map equals the full
  * read's, the other holds none, every channel's statistics are read; a damaged byte in
  * the skipped channel's records is still found (they are read, not jumped over). */
+/* The records are compressed by zstd workers (photon_map_file.h): a map of several of
+ * zstd's jobs (20 MB of records) gives the same file written by 1, 2 or 5 of them, and
+ * reads back. */
+static void test_workers(void **state)
+{
+    fixture *f = *state;
+    thz_scene *scene = ps_box_scene(1000, 5, 0.2);
+    const size_t n = 640000, groups = 2 * scene->n_objects;
+    photon_record *r = malloc(n * sizeof *r);
+    assert_non_null(r);
+    uint64_t x = 12345;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t u[6];
+        for (int k = 0; k < 6; k++) {
+            x = x * 6364136223846793005u + 1442695040888963407u;
+            u[k] = (uint32_t)(x >> 32);
+        }
+        r[i] = (photon_record){
+            .position_m = {(float)u[0] * 0x1p-32f, (float)u[1] * 0x1p-32f, (float)u[2] * 0x1p-32f},
+            .power_w_per_hz = (float)u[3] * 0x1p-70f,
+            .freq_hz = 3.5e11f,
+            .dir_oct = u[4],
+            .object_side = (uint32_t)(u[5] % groups),
+            .flags = (uint32_t)(i % PHOTON_MAP_BATCHES) << PHOTON_BATCH_SHIFT};
+    }
+    photon_map *map;
+    thz_error err;
+    assert_int_equal(photon_map_create(r, n, scene->n_objects, 0, &map, &err), THZ_OK);
+    const int workers[3] = {1, 2, 5};
+    unsigned char *first = NULL;
+    size_t first_n = 0;
+    for (int k = 0; k < 3; k++) {
+        char path[160];
+        snprintf(path, sizeof path, "%s/workers-%d.thzpm", f->dir, workers[k]);
+        assert_int_equal(photon_map_file_write(path, scene, (const photon_map *const *)&map, NULL,
+                                               workers[k], &err),
+                         THZ_OK);
+        size_t m;
+        unsigned char *b = slurp(path, &m);
+        assert_true(m > (size_t)8 << 20); /* several jobs of a few MB */
+        if (!first) {
+            first = b;
+            first_n = m;
+            photon_map *back = NULL;
+            assert_int_equal(photon_map_file_read(path, scene, 0, &back, NULL, NULL, &err), THZ_OK);
+            assert_int_equal(photon_map_count(back), n);
+            assert_memory_equal(photon_map_records(back), photon_map_records(map),
+                                n * sizeof(photon_record));
+            photon_map_destroy(back);
+        } else {
+            assert_int_equal(m, first_n);
+            assert_memory_equal(b, first, m);
+            free(b);
+        }
+        unlink(path);
+    }
+    free(first);
+    photon_map_destroy(map);
+    scene_destroy(scene);
+}
+
 static void test_one_channel(void **state)
 {
     fixture *f = *state;
@@ -474,6 +535,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_round_trip, setup, teardown),
         cmocka_unit_test_setup_teardown(test_one_channel, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_workers, setup, teardown),
         cmocka_unit_test_setup_teardown(test_version_1, setup, teardown),
         cmocka_unit_test_setup_teardown(test_version_2_order, setup, teardown),
         cmocka_unit_test_setup_teardown(test_corrupted, setup, teardown),
