@@ -12,6 +12,9 @@
 #include "photon/emission.h"
 #include "photon/trace.h"
 
+/* Philox blocks computed ahead for each photon (rng_init_many): it draws about 3. */
+#define PHASE_RNG_BLOCKS 3u
+
 /* Where one chunk's records landed: a range of its thread's buffer. */
 typedef struct phase_chunk {
     int thread;
@@ -93,18 +96,26 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                 uint64_t lo = first + (uint64_t)k * PHASE_CHUNK;
                 uint64_t hi =
                     lo + PHASE_CHUNK < first + batch_n ? lo + PHASE_CHUNK : first + batch_n;
-                for (uint64_t i = lo; i < hi; i++) {
-                    rng_stream rng;
-                    uint64_t index = a->first_photon + i;
-                    rng_init(&rng, seed, channel, RNG_PURPOSE_PHOTON, index);
-                    emission_photon e;
-                    if (!air_emission_sample(a->air, a->table, &rng, &e))
-                        e.power_w_per_hz = 0.0;
-                    e.batch = (uint32_t)(index % PHOTON_MAP_BATCHES);
-                    if (!trace_photon(a->scene, a->acc, &e, &rng, &b, &counters)) {
+                bool bad = false;
+                for (uint64_t i0 = lo; i0 < hi && !bad; i0 += RNG_MANY) {
+                    /* the streams of RNG_MANY photons at once, with the blocks a photon
+                     * draws on average (about 3) */
+                    rng_stream rng[RNG_MANY];
+                    size_t n = hi - i0 < RNG_MANY ? (size_t)(hi - i0) : RNG_MANY;
+                    rng_init_many(rng, n, seed, channel, RNG_PURPOSE_PHOTON, a->first_photon + i0,
+                                  PHASE_RNG_BLOCKS);
+                    for (size_t j = 0; j < n; j++) {
+                        uint64_t index = a->first_photon + i0 + j;
+                        emission_photon e;
+                        if (!air_emission_sample(a->air, a->table, &rng[j], &e))
+                            e.power_w_per_hz = 0.0;
+                        e.batch = (uint32_t)(index % PHOTON_MAP_BATCHES);
+                        if (!trace_photon(a->scene, a->acc, &e, &rng[j], &b, &counters)) {
 #pragma omp atomic write
-                        failed = 1;
-                        break;
+                            failed = 1;
+                            bad = true;
+                            break;
+                        }
                     }
                 }
                 ch->thread = tid;

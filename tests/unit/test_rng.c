@@ -65,6 +65,30 @@ static void test_stream_layout(void **state)
     }
 }
 
+/* rng_init_many's streams are rng_init's, word for word, past the blocks it computed
+ * ahead and across a carry into the index's high word; at most RNG_MANY streams. */
+static void test_init_many(void **state)
+{
+    (void)state;
+    const uint64_t seed = 0x0123456789abcdefull, first = 0xfffffffaull; /* carries at +6 */
+    for (unsigned blocks = 0; blocks <= RNG_BUFFER_BLOCKS + 1; blocks++) {
+        for (size_t n = 1; n <= RNG_MANY; n += 5) {
+            rng_stream many[RNG_MANY];
+            rng_init_many(many, n, seed, 3, RNG_PURPOSE_PHOTON, first, blocks);
+            for (size_t j = 0; j < n; j++) {
+                rng_stream one;
+                rng_init(&one, seed, 3, RNG_PURPOSE_PHOTON, first + j);
+                for (int w = 0; w < 4 * (int)RNG_BUFFER_BLOCKS + 9; w++)
+                    assert_int_equal(rng_next_u32(&many[j]), rng_next_u32(&one));
+            }
+        }
+    }
+    rng_stream many[RNG_MANY + 1];
+    many[RNG_MANY].used = 12345u; /* beyond RNG_MANY: untouched */
+    rng_init_many(many, RNG_MANY + 1, seed, 0, RNG_PURPOSE_PHOTON, 0, 2);
+    assert_int_equal(many[RNG_MANY].used, 12345u);
+}
+
 static void test_keying(void **state)
 {
     (void)state;
@@ -158,9 +182,13 @@ static void test_open0(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_known_answers), cmocka_unit_test(test_stream_layout),
-        cmocka_unit_test(test_keying),        cmocka_unit_test(test_uniform_distribution),
-        cmocka_unit_test(test_uniform32),     cmocka_unit_test(test_open0),
+        cmocka_unit_test(test_known_answers),
+        cmocka_unit_test(test_stream_layout),
+        cmocka_unit_test(test_init_many),
+        cmocka_unit_test(test_keying),
+        cmocka_unit_test(test_uniform_distribution),
+        cmocka_unit_test(test_uniform32),
+        cmocka_unit_test(test_open0),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
