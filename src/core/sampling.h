@@ -9,6 +9,38 @@
 /* A unit direction about unit normal n with cos(theta) = mu and azimuth 2 pi u. */
 vec3 sampling_direction(vec3 n, double mu, double u);
 
+/* sampling_cos_sin_turn's body, inline for loops the compiler vectorises (its quadrant
+ * chosen by selects, not branches). */
+static inline void sampling_cos_sin_turn_inline(double u, double *c, double *s)
+{
+    double t = 4.0 * u;
+    int k = (int)(t + 0.5);
+    double x = (t - (double)k) * (M_PI / 2.0), x2 = x * x;
+    /* Horner in x^2, written out (a loop over a table is not unrolled at -O2). */
+    double sx = -1.0 / 1307674368000.0;
+    sx = sx * x2 + 1.0 / 6227020800.0;
+    sx = sx * x2 - 1.0 / 39916800.0;
+    sx = sx * x2 + 1.0 / 362880.0;
+    sx = sx * x2 - 1.0 / 5040.0;
+    sx = sx * x2 + 1.0 / 120.0;
+    sx = sx * x2 - 1.0 / 6.0;
+    sx = sx * x2 + 1.0;
+    double cx = 1.0 / 20922789888000.0;
+    cx = cx * x2 - 1.0 / 87178291200.0;
+    cx = cx * x2 + 1.0 / 479001600.0;
+    cx = cx * x2 - 1.0 / 3628800.0;
+    cx = cx * x2 + 1.0 / 40320.0;
+    cx = cx * x2 - 1.0 / 720.0;
+    cx = cx * x2 + 1.0 / 24.0;
+    cx = cx * x2 - 0.5;
+    cx = cx * x2 + 1.0;
+    sx *= x;
+    int q = k & 3; /* quadrant: (c, s) = (cx, sx), (-sx, cx), (-cx, -sx), (sx, -cx) */
+    double a = (q & 1) ? sx : cx, b = (q & 1) ? cx : sx;
+    *c = (q == 1 || q == 2) ? -a : a;
+    *s = (q >= 2) ? -b : b;
+}
+
 /* cos(2 pi u) and sin(2 pi u) for u in [0, 1] without libm, to 1e-16 (a quadrant
  * reduction of 4u, exact, and Taylor polynomials on |x| <= pi/4). */
 void sampling_cos_sin_turn(double u, double *cos_out, double *sin_out);

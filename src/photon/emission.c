@@ -389,10 +389,14 @@ static double emission_cum(const emission_table *t, size_t row, double frac, siz
 
 bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *out)
 {
-    out->batch = 0;
     const thz_channel *ch = &t->scene->channels[t->channel];
     double u1 = rng_uniform32(rng), u2 = rng_uniform32(rng);
-    double nu = channel_sample_hz(ch, u1, u2);
+    return emission_sample_at(t, rng, channel_sample_hz(ch, u1, u2), out);
+}
+
+bool emission_sample_at(const emission_table *t, rng_stream *rng, double nu, emission_photon *out)
+{
+    out->batch = 0;
     out->freq_hz = nu;
     out->power_w_per_hz = 0.0;
     if (t->n_groups == 0)

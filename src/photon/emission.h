@@ -169,5 +169,8 @@ double emission_band_magnitude_w_per_hz(const emission_table *t);
  * no power at the drawn frequency: the photon then has power 0 and nothing else is
  * set. The power is signed (negative where the source's eps B(T) < A B0). */
 bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *out);
+/* emission_sample after its first two draws, which gave the frequency nu (for a caller
+ * that draws the frequencies of many photons at once: channel_sample_many_hz). */
+bool emission_sample_at(const emission_table *t, rng_stream *rng, double nu, emission_photon *out);
 
 #endif

@@ -11,6 +11,7 @@
 #include "photon/air_emission.h"
 #include "photon/emission.h"
 #include "photon/trace.h"
+#include "physics/channel.h"
 
 /* Philox blocks computed ahead for each photon (rng_init_many): it draws about 3. */
 #define PHASE_RNG_BLOCKS 3u
@@ -97,6 +98,8 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                 uint64_t hi =
                     lo + PHASE_CHUNK < first + batch_n ? lo + PHASE_CHUNK : first + batch_n;
                 bool bad = false;
+                const bool air = a->air && a->air->active;
+                const thz_channel *chn = &a->scene->channels[a->channel];
                 for (uint64_t i0 = lo; i0 < hi && !bad; i0 += RNG_MANY) {
                     /* the streams of RNG_MANY photons at once, with the blocks a photon
                      * draws on average (about 3) */
@@ -104,10 +107,22 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                     size_t n = hi - i0 < RNG_MANY ? (size_t)(hi - i0) : RNG_MANY;
                     rng_init_many(rng, n, seed, channel, RNG_PURPOSE_PHOTON, a->first_photon + i0,
                                   PHASE_RNG_BLOCKS);
+                    /* without emitting air every photon's first two words are its
+                     * frequency's: all of them at once (channel_sample_many_hz) */
+                    double nu[RNG_MANY];
+                    if (!air) {
+                        double u1[RNG_MANY], u2[RNG_MANY];
+                        for (size_t j = 0; j < n; j++) {
+                            u1[j] = rng_uniform32(&rng[j]);
+                            u2[j] = rng_uniform32(&rng[j]);
+                        }
+                        channel_sample_many_hz(chn, u1, u2, n, nu);
+                    }
                     for (size_t j = 0; j < n; j++) {
                         uint64_t index = a->first_photon + i0 + j;
                         emission_photon e;
-                        if (!air_emission_sample(a->air, a->table, &rng[j], &e))
+                        if (!(air ? air_emission_sample(a->air, a->table, &rng[j], &e)
+                                  : emission_sample_at(a->table, &rng[j], nu[j], &e)))
                             e.power_w_per_hz = 0.0;
                         e.batch = (uint32_t)(index % PHOTON_MAP_BATCHES);
                         if (!trace_photon(a->scene, a->acc, &e, &rng[j], &b, &counters)) {

@@ -5,6 +5,7 @@
 #include "physics/channel.h"
 
 #include <float.h>
+#include <stdbool.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -240,20 +241,28 @@ static double channel_sample_table_hz(const thz_channel *ch, double u1, double u
  * m in [sqrt(1/2), sqrt(2)), ln m = 2 atanh(s) = 2 (s + s^3/3 + ...) with
  * s = (m - 1) / (m + 1), |s| <= 0.172, so 11 terms leave s^22 / 23 < 1e-17; e ln 2 in
  * two parts (fdlibm's ln2_hi has trailing zeros, so e ln2_hi is exact). */
+static inline double channel_log_normal(double x);
+
 static double channel_log(double x)
 {
     if (!(x >= DBL_MIN && x <= DBL_MAX))
         return log(x);
+    return channel_log_normal(x);
+}
+
+/* channel_log for a normal, finite x > 0; inline and branch-free, for loops the compiler
+ * vectorises. */
+static inline double channel_log_normal(double x)
+{
     uint64_t bits;
     memcpy(&bits, &x, sizeof bits);
     int e = (int)(bits >> 52) - 1023;
     bits = (bits & 0x000fffffffffffffull) | 0x3ff0000000000000ull;
     double m;
     memcpy(&m, &bits, sizeof m);
-    if (m > M_SQRT2) {
-        m *= 0.5;
-        e++;
-    }
+    bool high = m > M_SQRT2;
+    m = high ? m * 0.5 : m;
+    e += high;
     double s = (m - 1.0) / (m + 1.0), s2 = s * s;
     double p = 1.0 / 21.0; /* Horner in s^2, written out: constants, no divisions */
     p = p * s2 + 1.0 / 19.0;
@@ -288,6 +297,26 @@ double channel_sample_hz(const thz_channel *ch, double u1, double u2)
             nu = ch->center_hz;
     }
     return nu;
+}
+
+void channel_sample_many_hz(const thz_channel *ch, const double *u1, const double *u2, size_t n,
+                            double *nu)
+{
+    if (channel_has_response(ch)) {
+        for (size_t j = 0; j < n; j++)
+            nu[j] = channel_sample_table_hz(ch, u1[j], u2[j]);
+        return;
+    }
+    /* channel_sample_hz's arithmetic, its branches as selects (1 - u1 >= 2^-32 is normal) */
+    const double center = ch->center_hz, sigma = channel_sigma_hz(ch);
+    for (size_t j = 0; j < n; j++) {
+        double r = sqrt(-2.0 * channel_log_normal(1.0 - u1[j]));
+        double cos_phi, sin_phi;
+        sampling_cos_sin_turn_inline(u2[j], &cos_phi, &sin_phi);
+        double z = r * cos_phi;
+        double up = center + sigma * z, down = center - sigma * z;
+        nu[j] = up > 0.0 ? up : (down > 0.0 ? down : center);
+    }
 }
 
 /* A table's nodes: composite Simpson on each piece where g > 0 (panels as

@@ -76,6 +76,11 @@ double channel_response(const thz_channel *ch, double freq_hz);
  * always > 0. A table's piecewise-linear density is sampled exactly: u1 picks a piece by
  * its area, u2 the frequency within it by inverting the piece's linear density. */
 double channel_sample_hz(const thz_channel *ch, double u1, double u2);
+/* channel_sample_hz for n pairs (u1[j], u2[j]), u1 in [0, 1): the same frequencies, in a
+ * loop the compiler vectorises (the photon phase's Box-Muller, one log, square root and
+ * cosine per photon, was 5-7 % of its time one at a time). */
+void channel_sample_many_hz(const thz_channel *ch, const double *u1, const double *u2, size_t n,
+                            double *nu);
 
 /* Deterministic quadrature of the band mean: nodes over nu_c +- 6 sigma_c (a table:
  * composite Simpson on each piece where g_c > 0, the table's points among the nodes,
