@@ -5,6 +5,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <cmocka.h>
 
@@ -180,6 +181,42 @@ static void test_sampling(void **state)
     assert_true(channel_sample_hz(&wide, 1.0 - 1e-16, 0.5) > 0.0);
 }
 
+/* channel_sample_many_hz gives channel_sample_hz's frequencies bit for bit: every
+ * quadrant of the cosine (u2 at and beside the quarter turns), u1 at both ends of the
+ * 32-bit grid, and the reflected tail of a channel wider than its centre; batches of every
+ * size up to 16. (A measured response's table is sampled one at a time by both.) */
+static void test_sampling_many(void **state)
+{
+    (void)state;
+    const thz_channel gauss = {.name = "s", .center_hz = 0.8e12, .relative_width = 0.2};
+    const thz_channel wide = {.name = "w", .center_hz = 1e12, .relative_width = 3.0};
+    const thz_channel *chans[2] = {&gauss, &wide};
+    const double edges[] = {0.0,         0x1p-32,     0.125,          0.25 - 0x1p-32, 0.25,
+                            0.25 + 1e-9, 0.5,         0.75 - 0x1p-32, 0.75,           0.875,
+                            0.999,       1 - 0x1p-31, 1 - 0x1p-32};
+    const size_t ne = sizeof edges / sizeof edges[0];
+    for (int c = 0; c < 2; c++) {
+        double u1[256], u2[256], many[256];
+        size_t m = 0;
+        for (size_t a = 0; a < ne; a++)
+            for (size_t b = 0; b < ne; b++, m++) {
+                u1[m] = edges[a];
+                u2[m] = edges[b];
+            }
+        /* every pair, in batches of 1, 2, ..., 16, 1, ... */
+        for (size_t off = 0, k = 0; off < m; off += 1 + k % 16, k++) {
+            size_t n = 1 + k % 16 < m - off ? 1 + k % 16 : m - off;
+            channel_sample_many_hz(chans[c], u1 + off, u2 + off, n, many);
+            for (size_t j = 0; j < n; j++) {
+                double one = channel_sample_hz(chans[c], u1[off + j], u2[off + j]);
+                if (memcmp(&one, &many[j], sizeof one) != 0)
+                    fail_msg("channel %d, u1 = %.17g, u2 = %.17g: %.17g, one at a time %.17g", c,
+                             u1[off + j], u2[off + j], many[j], one);
+            }
+        }
+    }
+}
+
 /* Box-Muller's libm-free log and cos against libm's: the same frequencies to 1e-14 of
  * sigma, over every 32-bit u1 near 0 and 1 (the log's extremes) and a grid of both. */
 static void test_sampling_against_libm(void **state)
@@ -208,6 +245,7 @@ int main(void)
         cmocka_unit_test(test_quadrature_struct),
         cmocka_unit_test(test_sampling),
         cmocka_unit_test(test_sampling_against_libm),
+        cmocka_unit_test(test_sampling_many),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
