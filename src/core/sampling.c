@@ -23,15 +23,30 @@ void sampling_cos_sin_turn(double u, double *c, double *s)
     sampling_cos_sin_turn_inline(u, c, s);
 }
 
-vec3 sampling_direction(vec3 n, double mu, double u)
+/* sampling_direction's body (fmax(0, x) as a select: the same for every x, NaN too, and
+ * 1 - mu^2 is never -0), inline for sampling_direction_many's loop. */
+static inline vec3 sampling_direction_inline(vec3 n, double mu, double u)
 {
     vec3 t, b;
     v3_basis(n, &t, &b);
-    double s = sqrt(fmax(0.0, 1.0 - mu * mu));
+    double s2 = 1.0 - mu * mu;
+    double s = sqrt(s2 > 0.0 ? s2 : 0.0);
     double cos_phi, sin_phi;
-    sampling_cos_sin_turn(u, &cos_phi, &sin_phi);
+    sampling_cos_sin_turn_inline(u, &cos_phi, &sin_phi);
     vec3 d = v3_scale(n, mu);
     d = v3_madd(d, s * cos_phi, t);
     d = v3_madd(d, s * sin_phi, b);
     return v3_normalize(d);
+}
+
+vec3 sampling_direction(vec3 n, double mu, double u)
+{
+    return sampling_direction_inline(n, mu, u);
+}
+
+void sampling_direction_many(const vec3 *n, const double *mu, const double *u, size_t count,
+                             vec3 *out)
+{
+    for (size_t j = 0; j < count; j++)
+        out[j] = sampling_direction_inline(n[j], mu[j], u[j]);
 }

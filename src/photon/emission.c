@@ -396,6 +396,16 @@ bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *
 
 bool emission_sample_at(const emission_table *t, rng_stream *rng, double nu, emission_photon *out)
 {
+    emission_aim aim;
+    if (!emission_sample_aim(t, rng, nu, out, &aim))
+        return false;
+    out->dir = sampling_direction(aim.normal, aim.mu, aim.u);
+    return true;
+}
+
+bool emission_sample_aim(const emission_table *t, rng_stream *rng, double nu, emission_photon *out,
+                         emission_aim *aim)
+{
     out->batch = 0;
     out->freq_hz = nu;
     out->power_w_per_hz = 0.0;
@@ -475,7 +485,9 @@ bool emission_sample_at(const emission_table *t, rng_stream *rng, double nu, emi
         if (!optics_sample_emission_mu(&law, sampling_uniform32, rng, &mu))
             mu = sqrt(1.0 - rng_uniform32(rng)); /* eps = 0 (a -A B0 source) or unreachable */
     }
-    out->dir = sampling_direction(n, mu, rng_uniform32(rng));
+    aim->normal = n;
+    aim->mu = mu;
+    aim->u = rng_uniform32(rng);
     out->object = s->object;
     out->triangle = (uint32_t)tri;
     out->side = side;

@@ -172,5 +172,14 @@ bool emission_sample(const emission_table *t, rng_stream *rng, emission_photon *
 /* emission_sample after its first two draws, which gave the frequency nu (for a caller
  * that draws the frequencies of many photons at once: channel_sample_many_hz). */
 bool emission_sample_at(const emission_table *t, rng_stream *rng, double nu, emission_photon *out);
+/* emission_sample_at but for the direction, left to the caller (sampling_direction_many,
+ * for many photons at once): out->dir is sampling_direction(normal, mu, u). */
+typedef struct emission_aim {
+    vec3 normal; /* of the emitting side */
+    double mu;   /* cos(theta) drawn by the source's angular law */
+    double u;    /* the azimuth's draw */
+} emission_aim;
+bool emission_sample_aim(const emission_table *t, rng_stream *rng, double nu, emission_photon *out,
+                         emission_aim *aim);
 
 #endif

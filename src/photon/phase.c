@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/sampling.h"
 #include "photon/air_emission.h"
 #include "photon/emission.h"
 #include "photon/trace.h"
@@ -41,6 +42,44 @@ typedef struct phase_fire_args {
     thz_progress_fn progress;
     void *progress_user;
 } phase_fire_args;
+
+/* Emits n <= RNG_MANY photons from their streams rng[j] (power 0 where nothing is emitted),
+ * as air_emission_sample does one at a time. Without emitting air the work is done stage
+ * by stage over the photons: every photon's frequency (its first two words), then each
+ * photon's source, point and angle, then every direction. The frequencies and directions
+ * are loops the compiler vectorises, which the same arithmetic one photon at a time left
+ * to the scalar units (channel_sample_many_hz, sampling_direction_many). */
+static void phase_emit_block(const phase_fire_args *a, rng_stream *rng, size_t n,
+                             emission_photon *e)
+{
+    bool ok[RNG_MANY];
+    if (a->air && a->air->active) {
+        for (size_t j = 0; j < n; j++)
+            ok[j] = air_emission_sample(a->air, a->table, &rng[j], &e[j]);
+    } else {
+        double u1[RNG_MANY], u2[RNG_MANY], nu[RNG_MANY];
+        for (size_t j = 0; j < n; j++) {
+            u1[j] = rng_uniform32(&rng[j]);
+            u2[j] = rng_uniform32(&rng[j]);
+        }
+        channel_sample_many_hz(&a->scene->channels[a->channel], u1, u2, n, nu);
+        vec3 normal[RNG_MANY], dir[RNG_MANY];
+        double mu[RNG_MANY], u[RNG_MANY];
+        for (size_t j = 0; j < n; j++) {
+            emission_aim aim = {.normal = v3(0.0, 0.0, 1.0), .mu = 1.0, .u = 0.0};
+            ok[j] = emission_sample_aim(a->table, &rng[j], nu[j], &e[j], &aim);
+            normal[j] = aim.normal;
+            mu[j] = aim.mu;
+            u[j] = aim.u;
+        }
+        sampling_direction_many(normal, mu, u, n, dir);
+        for (size_t j = 0; j < n; j++)
+            e[j].dir = dir[j];
+    }
+    for (size_t j = 0; j < n; j++)
+        if (!ok[j])
+            e[j].power_w_per_hz = 0.0;
+}
 
 /* Fires photons first_photon + lo..hi-1, returning their records in photon-index order (a
  * malloc'd array of *out_capacity, never NULL on success) and the summed counters;
@@ -98,8 +137,6 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                 uint64_t hi =
                     lo + PHASE_CHUNK < first + batch_n ? lo + PHASE_CHUNK : first + batch_n;
                 bool bad = false;
-                const bool air = a->air && a->air->active;
-                const thz_channel *chn = &a->scene->channels[a->channel];
                 for (uint64_t i0 = lo; i0 < hi && !bad; i0 += RNG_MANY) {
                     /* the streams of RNG_MANY photons at once, with the blocks a photon
                      * draws on average (about 3) */
@@ -107,25 +144,12 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                     size_t n = hi - i0 < RNG_MANY ? (size_t)(hi - i0) : RNG_MANY;
                     rng_init_many(rng, n, seed, channel, RNG_PURPOSE_PHOTON, a->first_photon + i0,
                                   PHASE_RNG_BLOCKS);
-                    /* without emitting air every photon's first two words are its
-                     * frequency's: all of them at once (channel_sample_many_hz) */
-                    double nu[RNG_MANY];
-                    if (!air) {
-                        double u1[RNG_MANY], u2[RNG_MANY];
-                        for (size_t j = 0; j < n; j++) {
-                            u1[j] = rng_uniform32(&rng[j]);
-                            u2[j] = rng_uniform32(&rng[j]);
-                        }
-                        channel_sample_many_hz(chn, u1, u2, n, nu);
-                    }
+                    emission_photon e[RNG_MANY];
+                    phase_emit_block(a, rng, n, e);
                     for (size_t j = 0; j < n; j++) {
                         uint64_t index = a->first_photon + i0 + j;
-                        emission_photon e;
-                        if (!(air ? air_emission_sample(a->air, a->table, &rng[j], &e)
-                                  : emission_sample_at(a->table, &rng[j], nu[j], &e)))
-                            e.power_w_per_hz = 0.0;
-                        e.batch = (uint32_t)(index % PHOTON_MAP_BATCHES);
-                        if (!trace_photon(a->scene, a->acc, &e, &rng[j], &b, &counters)) {
+                        e[j].batch = (uint32_t)(index % PHOTON_MAP_BATCHES);
+                        if (!trace_photon(a->scene, a->acc, &e[j], &rng[j], &b, &counters)) {
 #pragma omp atomic write
                             failed = 1;
                             bad = true;

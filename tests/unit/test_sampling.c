@@ -1,10 +1,12 @@
 /* Sampling helpers: sampling_direction's azimuth (its libm-free cos and sin of 2 pi u)
- * against libm, its polar angle, and unit length. */
+ * against libm, its polar angle, and unit length; sampling_direction_many's directions
+ * against sampling_direction's. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include <cmocka.h>
 
@@ -51,11 +53,48 @@ static void test_polar_angle_and_length(void **state)
     }
 }
 
+/* sampling_direction_many gives sampling_direction's directions bit for bit: normals
+ * along and against every axis (Duff's basis switches at n.z = -0 / +0) and oblique, mu
+ * 0 and 1 and between, the azimuth's quadrant edges; batches of 1 to 16. */
+static void test_many(void **state)
+{
+    (void)state;
+    const vec3 normals[] = {v3(0, 0, 1),     v3(0, 0, -1),     v3(1, 0, 0),
+                            v3(-1, 0, 0),    v3(0, 1, 0),      v3(0, -1, -0.0),
+                            v3(0.6, 0, 0.8), v3(0, 0.6, -0.8), v3_normalize(v3(0.3, -0.5, 0.81))};
+    const double mus[] = {0.0, 1e-9, 0.5, 0.999999, 1.0};
+    const double us[] = {0.0, 0.25 - 0x1p-32, 0.25, 0.5, 0.75 + 0x1p-32, 1 - 0x1p-32};
+    enum { NN = 9, NM = 5, NU = 6, M = NN * NM * NU };
+    vec3 n[M], many[M];
+    double mu[M], u[M];
+    size_t m = 0;
+    for (int a = 0; a < NN; a++)
+        for (int b = 0; b < NM; b++)
+            for (int c = 0; c < NU; c++, m++) {
+                n[m] = normals[a];
+                mu[m] = mus[b];
+                u[m] = us[c];
+            }
+    for (size_t off = 0, k = 0; off < m; off += 1 + k % 16, k++) {
+        size_t count = 1 + k % 16 < m - off ? 1 + k % 16 : m - off;
+        sampling_direction_many(n + off, mu + off, u + off, count, many + off);
+    }
+    for (size_t j = 0; j < m; j++) {
+        vec3 one = sampling_direction(n[j], mu[j], u[j]);
+        if (memcmp(&one, &many[j], sizeof one) != 0)
+            fail_msg("n = (%g, %g, %g), mu = %.17g, u = %.17g: (%.17g, %.17g, %.17g), one at a "
+                     "time (%.17g, %.17g, %.17g)",
+                     n[j].x, n[j].y, n[j].z, mu[j], u[j], many[j].x, many[j].y, many[j].z, one.x,
+                     one.y, one.z);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_azimuth_against_libm),
         cmocka_unit_test(test_polar_angle_and_length),
+        cmocka_unit_test(test_many),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
