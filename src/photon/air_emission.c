@@ -395,21 +395,38 @@ static bool air_emission_boundary_photon(const air_emission *a, rng_stream *rng,
     return out->power_w_per_hz != 0.0;
 }
 
+bool air_emission_draw_class(const air_emission *a, rng_stream *rng, emission_photon *out,
+                             bool *surface)
+{
+    *surface = true;
+    if (!a || !a->active)
+        return true;
+    out->batch = 0;
+    double u = rng_uniform32(rng);
+    if (!(u < a->p_air + a->p_boundary))
+        return true;
+    *surface = false;
+    out->object = ACCEL_NO_OBJECT;
+    out->triangle = 0;
+    out->side = 0;
+    return u < a->p_air ? air_emission_air_photon(a, rng, out)
+                        : air_emission_boundary_photon(a, rng, out);
+}
+
+void air_emission_surface_share(const air_emission *a, emission_photon *out)
+{
+    if (a && a->active)
+        out->power_w_per_hz = a->p_surfaces > 0.0 ? out->power_w_per_hz / a->p_surfaces : 0.0;
+}
+
 bool air_emission_sample(const air_emission *a, const emission_table *t, rng_stream *rng,
                          emission_photon *out)
 {
-    if (!a || !a->active)
-        return emission_sample(t, rng, out);
-    out->batch = 0;
-    double u = rng_uniform32(rng);
-    if (u < a->p_air + a->p_boundary) {
-        out->object = ACCEL_NO_OBJECT;
-        out->triangle = 0;
-        out->side = 0;
-        return u < a->p_air ? air_emission_air_photon(a, rng, out)
-                            : air_emission_boundary_photon(a, rng, out);
-    }
-    bool ok = emission_sample(t, rng, out);
-    out->power_w_per_hz = a->p_surfaces > 0.0 ? out->power_w_per_hz / a->p_surfaces : 0.0;
+    bool surface;
+    bool ok = air_emission_draw_class(a, rng, out, &surface);
+    if (!surface)
+        return ok;
+    ok = emission_sample(t, rng, out);
+    air_emission_surface_share(a, out);
     return ok;
 }

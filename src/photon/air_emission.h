@@ -110,4 +110,12 @@ void air_emission_fini(air_emission *a);
 bool air_emission_sample(const air_emission *a, const emission_table *t, rng_stream *rng,
                          emission_photon *out);
 
+/* air_emission_sample in two parts around the surface photon's own draws, for a caller
+ * that draws many photons' at once: the class draw (and an air or boundary photon whole:
+ * *surface false, the return as air_emission_sample's), then, after emission_sample's
+ * draws for a surface photon, its power's share (air_emission_surface_share). */
+bool air_emission_draw_class(const air_emission *a, rng_stream *rng, emission_photon *out,
+                             bool *surface);
+void air_emission_surface_share(const air_emission *a, emission_photon *out);
+
 #endif

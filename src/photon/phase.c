@@ -44,37 +44,41 @@ typedef struct phase_fire_args {
 } phase_fire_args;
 
 /* Emits n <= RNG_MANY photons from their streams rng[j] (power 0 where nothing is emitted),
- * as air_emission_sample does one at a time. Without emitting air the work is done stage
- * by stage over the photons: every photon's frequency (its first two words), then each
- * photon's source, point and angle, then every direction. The frequencies and directions
- * are loops the compiler vectorises, which the same arithmetic one photon at a time left
- * to the scalar units (channel_sample_many_hz, sampling_direction_many). */
+ * as air_emission_sample does one at a time, stage by stage over the photons: each one's
+ * class (surface, air or boundary: the last two drawn whole), every surface photon's
+ * frequency, then each one's source, point and angle, then all their directions. The
+ * frequencies and directions are loops the compiler vectorises, which the same arithmetic
+ * one photon at a time left to the scalar units (channel_sample_many_hz,
+ * sampling_direction_many). */
 static void phase_emit_block(const phase_fire_args *a, rng_stream *rng, size_t n,
                              emission_photon *e)
 {
-    bool ok[RNG_MANY];
-    if (a->air && a->air->active) {
-        for (size_t j = 0; j < n; j++)
-            ok[j] = air_emission_sample(a->air, a->table, &rng[j], &e[j]);
-    } else {
-        double u1[RNG_MANY], u2[RNG_MANY], nu[RNG_MANY];
-        for (size_t j = 0; j < n; j++) {
-            u1[j] = rng_uniform32(&rng[j]);
-            u2[j] = rng_uniform32(&rng[j]);
-        }
-        channel_sample_many_hz(&a->scene->channels[a->channel], u1, u2, n, nu);
-        vec3 normal[RNG_MANY], dir[RNG_MANY];
-        double mu[RNG_MANY], u[RNG_MANY];
-        for (size_t j = 0; j < n; j++) {
-            emission_aim aim = {.normal = v3(0.0, 0.0, 1.0), .mu = 1.0, .u = 0.0};
-            ok[j] = emission_sample_aim(a->table, &rng[j], nu[j], &e[j], &aim);
-            normal[j] = aim.normal;
-            mu[j] = aim.mu;
-            u[j] = aim.u;
-        }
-        sampling_direction_many(normal, mu, u, n, dir);
-        for (size_t j = 0; j < n; j++)
-            e[j].dir = dir[j];
+    bool ok[RNG_MANY], surface[RNG_MANY];
+    size_t at[RNG_MANY], ns = 0; /* the surface photons */
+    for (size_t j = 0; j < n; j++) {
+        ok[j] = air_emission_draw_class(a->air, &rng[j], &e[j], &surface[j]);
+        if (surface[j])
+            at[ns++] = j;
+    }
+    double u1[RNG_MANY], u2[RNG_MANY], nu[RNG_MANY];
+    for (size_t k = 0; k < ns; k++) {
+        u1[k] = rng_uniform32(&rng[at[k]]);
+        u2[k] = rng_uniform32(&rng[at[k]]);
+    }
+    channel_sample_many_hz(&a->scene->channels[a->channel], u1, u2, ns, nu);
+    vec3 normal[RNG_MANY], dir[RNG_MANY];
+    double mu[RNG_MANY], u[RNG_MANY];
+    for (size_t k = 0; k < ns; k++) {
+        emission_aim aim = {.normal = v3(0.0, 0.0, 1.0), .mu = 1.0, .u = 0.0};
+        ok[at[k]] = emission_sample_aim(a->table, &rng[at[k]], nu[k], &e[at[k]], &aim);
+        normal[k] = aim.normal;
+        mu[k] = aim.mu;
+        u[k] = aim.u;
+    }
+    sampling_direction_many(normal, mu, u, ns, dir);
+    for (size_t k = 0; k < ns; k++) {
+        e[at[k]].dir = dir[k];
+        air_emission_surface_share(a->air, &e[at[k]]);
     }
     for (size_t j = 0; j < n; j++)
         if (!ok[j])
