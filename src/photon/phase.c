@@ -35,7 +35,8 @@ typedef struct phase_fire_args {
     uint64_t lo, hi;       /* fire photons [lo, hi) of K (lo a multiple of PHASE_BATCH) */
     uint64_t first_photon; /* index of the first photon (its random stream and batch) */
     int threads;
-    photon_map_pool *pool; /* the record array's first memory, or NULL */
+    photon_map_pool *pool;      /* the record array's first memory, or NULL */
+    const trace_optics *optics; /* the objects' constant optics, or NULL */
     /* Progress after every batch but the last: the last is the caller's to report, once
      * the map is built, so that a display timing the stages gives the index build to the
      * photons and not to the render that follows. */
@@ -153,7 +154,8 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                     for (size_t j = 0; j < n; j++) {
                         uint64_t index = a->first_photon + i0 + j;
                         e[j].batch = (uint32_t)(index % PHOTON_MAP_BATCHES);
-                        if (!trace_photon(a->scene, a->acc, &e[j], &rng[j], &b, &counters)) {
+                        if (!trace_photon(a->scene, a->acc, a->optics, &e[j], &rng[j], &b,
+                                          &counters)) {
 #pragma omp atomic write
                             failed = 1;
                             bad = true;
@@ -330,8 +332,13 @@ static thz_status phase_fire_range(const thz_scene *scene, const accel *acc,
                          .pool = pool,
                          .progress = progress,
                          .progress_user = progress_user};
-    thz_status st =
-        phase_fire(&a, &out->records, &out->count, &out->capacity, total, out->chunks, err);
+    trace_optics optics;
+    thz_status st = trace_optics_init(&optics, scene, err);
+    if (st == THZ_OK) {
+        a.optics = &optics;
+        st = phase_fire(&a, &out->records, &out->count, &out->capacity, total, out->chunks, err);
+        trace_optics_fini(&optics);
+    }
     if (st != THZ_OK)
         photon_phase_share_fini(out);
     return st;

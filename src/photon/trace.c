@@ -87,8 +87,36 @@ static bool trace_reflect_lobe(const thz_scene *scene, const thz_object *obj, co
     return true;
 }
 
-bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photon *e,
-                  rng_stream *rng, trace_buffer *buf, trace_counters *c)
+thz_status trace_optics_init(trace_optics *t, const thz_scene *scene, thz_error *err)
+{
+    size_t n = scene->n_objects ? scene->n_objects : 1;
+    t->optics = thz_calloc(n, sizeof *t->optics);
+    t->constant = thz_calloc(n, sizeof *t->constant);
+    if (!t->optics || !t->constant) {
+        trace_optics_fini(t);
+        return thz_error_set(err, THZ_ERR_NOMEM, "photon phase: out of memory");
+    }
+    for (size_t i = 0; i < scene->n_objects; i++) {
+        const thz_object *obj = &scene->objects[i];
+        const thz_material *m = &scene->materials[obj->material];
+        t->constant[i] = !m->index && m->reflectivity.n <= 1 && m->attenuation_per_m.n <= 1 &&
+                         m->emissivity.n <= 1;
+        if (t->constant[i])
+            t->optics[i] = scene_object_optics(scene, obj, 0.0);
+    }
+    return THZ_OK;
+}
+
+void trace_optics_fini(trace_optics *t)
+{
+    free(t->optics);
+    free(t->constant);
+    t->optics = NULL;
+    t->constant = NULL;
+}
+
+bool trace_photon(const thz_scene *scene, const accel *acc, const trace_optics *optics,
+                  const emission_photon *e, rng_stream *rng, trace_buffer *buf, trace_counters *c)
 {
     c->photons++;
     /* The power is signed in a deviation map (emission.h): the path is traced with its
@@ -181,7 +209,9 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photo
             c->absorbed_power += power;
             return true;
         }
-        optics_point o = scene_object_optics(scene, obj, nu);
+        optics_point o = optics && optics->constant[hit.object]
+                             ? optics->optics[hit.object]
+                             : scene_object_optics(scene, obj, nu);
         const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
         vec3 n = v3(nf[0], nf[1], nf[2]);
         vec3 n_in = hit.side == 0 ? n : v3_scale(n, -1.0); /* towards where it came from */

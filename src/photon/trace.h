@@ -28,6 +28,7 @@
 #include <stdint.h>
 
 #include "accel/accel.h"
+#include "core/error.h"
 #include "core/rng.h"
 #include "photon/emission.h"
 #include "photon/photon_map.h"
@@ -74,9 +75,22 @@ trace_event trace_roulette(const optics_point *o, double mu, double u);
  * normal of the side the photon leaves from), uniform azimuth. */
 vec3 trace_diffuse_transmission_dir(const optics_point *o, vec3 n_out, rng_stream *rng);
 
-/* Traces one emitted photon, appending its records to buf and its outcome to c.
- * Returns false only when buf cannot grow (out of memory). */
-bool trace_photon(const thz_scene *scene, const accel *acc, const emission_photon *e,
-                  rng_stream *rng, trace_buffer *buf, trace_counters *c);
+/* The objects' optics where they do not depend on frequency (a material without an index
+ * whose reflectivity, attenuation and emissivity are constants): evaluated once for a
+ * phase instead of at every hit (scene_object_optics gives the same point at any
+ * frequency, its freq_hz aside, which only an index reads). */
+typedef struct trace_optics {
+    optics_point *optics; /* per object; meaningful where constant */
+    bool *constant;       /* per object */
+} trace_optics;
+
+thz_status trace_optics_init(trace_optics *t, const thz_scene *scene, thz_error *err);
+void trace_optics_fini(trace_optics *t);
+
+/* Traces one emitted photon, appending its records to buf and its outcome to c; optics
+ * (may be NULL) the scene's trace_optics. Returns false only when buf cannot grow (out of
+ * memory). */
+bool trace_photon(const thz_scene *scene, const accel *acc, const trace_optics *optics,
+                  const emission_photon *e, rng_stream *rng, trace_buffer *buf, trace_counters *c);
 
 #endif

@@ -54,7 +54,7 @@ static void straight_down(double alpha, double d, uint64_t n, double *mean_power
         rng_stream rng;
         rng_init(&rng, 8, 0, RNG_PURPOSE_PHOTON, i);
         buf.count = 0;
-        assert_true(trace_photon(s, acc, &e, &rng, &buf, c));
+        assert_true(trace_photon(s, acc, NULL, &e, &rng, &buf, c));
         assert_true(buf.count <= 1);
         if (buf.count == 1) {
             *stored_power = buf.records[0].power_w_per_hz;

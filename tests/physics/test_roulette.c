@@ -140,7 +140,7 @@ static void test_transmission_in_scene(void **state)
             rng_stream rng;
             rng_init(&rng, 5, 0, RNG_PURPOSE_TEST, i);
             buf.count = 0;
-            assert_true(trace_photon(s, acc, &e, &rng, &buf, &c));
+            assert_true(trace_photon(s, acc, NULL, &e, &rng, &buf, &c));
             assert_true(buf.count >= 1);
             const photon_record *r = buf.records;
             assert_int_equal(photon_object(&r[0]), shell);
@@ -201,7 +201,7 @@ static void test_reflection_and_back_faces(void **state)
             rng_stream rng;
             rng_init(&rng, 6, 0, RNG_PURPOSE_TEST, i);
             buf.count = 0;
-            assert_true(trace_photon(s, acc, &e, &rng, &buf, &c));
+            assert_true(trace_photon(s, acc, NULL, &e, &rng, &buf, &c));
             assert_int_equal(buf.count, 2);
             assert_int_equal(photon_object(&buf.records[0]), plate);
             assert_int_equal(photon_side(&buf.records[0]), from_below);
@@ -232,7 +232,7 @@ static void test_reflection_and_back_faces(void **state)
             rng_stream rng;
             rng_init(&rng, 6, 1, RNG_PURPOSE_TEST, 0);
             buf.count = 0;
-            assert_true(trace_photon(s, acc, &e, &rng, &buf, &c));
+            assert_true(trace_photon(s, acc, NULL, &e, &rng, &buf, &c));
             assert_int_equal(buf.count, 1);
             assert_int_equal(photon_object(&buf.records[0]), one_sided);
             assert_int_equal(photon_side(&buf.records[0]), 1);
