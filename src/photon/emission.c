@@ -152,7 +152,11 @@ static optics_point emission_kirchhoff_optics(optics_point o)
 static vec3 emission_point(const thz_mesh *m, const double *triangle_cdf, double area_m2,
                            rng_stream *rng, size_t *tri)
 {
-    size_t k = cdf_search(triangle_cdf, m->n_triangles, rng_uniform32(rng) * area_m2);
+    /* the guide table follows the CDF in its block (emission_add_source) */
+    const uint32_t *guide = (const uint32_t *)(const void *)(triangle_cdf + m->n_triangles);
+    double u = rng_uniform32(rng);
+    size_t k =
+        cdf_search_guided(triangle_cdf, m->n_triangles, guide, m->n_triangles, u, u * area_m2);
     while (m->areas_m2[k] <= 0.0 && k > 0)
         k--;
     *tri = k;
@@ -222,15 +226,20 @@ static bool emission_add_source(emission_table *t, const accel *acc, size_t i, e
     s->triangle_cdf = prev && prev->object == s->object ? prev->triangle_cdf : NULL;
     s->owns_cdf = false;
     if (!s->triangle_cdf) {
-        s->triangle_cdf = thz_malloc_array(obj->mesh.n_triangles, sizeof *s->triangle_cdf);
+        /* the CDF, then its guide table (uint32_t, one entry per triangle), in one block */
+        size_t n = obj->mesh.n_triangles;
+        if (n > UINT32_MAX)
+            return false;
+        s->triangle_cdf = thz_malloc_array(n, sizeof(double) + sizeof(uint32_t));
         if (!s->triangle_cdf)
             return false;
         s->owns_cdf = true;
         double sum = 0.0;
-        for (size_t k = 0; k < obj->mesh.n_triangles; k++) {
+        for (size_t k = 0; k < n; k++) {
             sum += obj->mesh.areas_m2[k];
             s->triangle_cdf[k] = sum;
         }
+        cdf_guide_build(s->triangle_cdf, n, (uint32_t *)(void *)(s->triangle_cdf + n), n);
     }
     if (kind == EMISSION_BACK) {
         s->reach_share = emission_back_reach(t, acc, i, s->triangle_cdf);

@@ -42,9 +42,9 @@
  * photons (|w| / q differs from 1 by the interpolation error, ~1e-7 for smooth optics),
  * never the mean; narrow material lines are still integrated, since w_g is exact. Within
  * the group a source is drawn by its frequency-independent share, one of its emitting
- * sides uniformly, a triangle by an area CDF (binary search), a point uniformly on the
- * triangle, and a direction by the source's angular law about the emitting side's
- * normal and uniform azimuth.
+ * sides uniformly, a triangle by an area CDF (searched from a guide table), a point
+ * uniformly on the triangle, and a direction by the source's angular law about the
+ * emitting side's normal and uniform azimuth.
  *
  * Emitting sides: both sides of shells and two-sided solids, the front side of one-sided
  * solids (and with T0 > 0 their back side's -B0). Objects without area emit nothing;
@@ -95,8 +95,9 @@ typedef struct emission_source {
     optics_point optics;  /* constant optics: the optics at every frequency */
     bool cosine_law;      /* constant optics drawn by the cosine law (optics.h
                              optics_emission_is_cosine): mu = sqrt(1 - u) directly */
-    double *triangle_cdf; /* n_triangles cumulative areas, last = total; shared by an
-                             object's sources, owned by the first (owns_cdf) */
+    double *triangle_cdf; /* n_triangles cumulative areas, last = total, then their guide
+                             table (cdf.h: n_triangles uint32_t) in the same block; shared
+                             by an object's sources, owned by the first (owns_cdf) */
     bool owns_cdf;
 } emission_source;
 
