@@ -1,7 +1,8 @@
 # What the README's two set-up commands (scripts/setup.sh demo|check, which also install
 # thzmap under /usr/local first) run, and a few conveniences.
 #   make demo   installs what is missing, builds, and runs the paper's test scene
-#   make check  installs what is missing, builds, and runs all tests (also under ASan+UBSan),
+#   make check  installs what is missing, builds, and runs all tests (also under ASan+UBSan,
+#               and a clang build's outputs against the gcc build's),
 #               then fuzzes each reader for 30 s (fuzz-ci)
 #   make fuzz   fuzzes each reader for FUZZ_SECONDS (default 60) s (tests/fuzz/README.md)
 JOBS ?= $(shell nproc)
@@ -10,10 +11,11 @@ ASAN_BUILD ?= build-asan
 DEMO_OUT ?= out/teraeye
 PREFIX ?= /usr/local
 FUZZ_BUILD ?= build-fuzz
+CLANG_BUILD ?= build-clang
 FUZZ_SECONDS ?= 60
 FUZZ_CI_SECONDS ?= 30
 
-.PHONY: all deps build install demo check test test-asan fuzz-build fuzz fuzz-ci bench format clean
+.PHONY: all deps build install demo check test test-asan test-compilers fuzz-build fuzz fuzz-ci bench format clean
 
 all: build
 
@@ -56,13 +58,20 @@ fuzz: fuzz-build
 fuzz-ci: fuzz-build
 	bash tests/fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_CI_SECONDS)
 
-check: test test-asan fuzz-ci
+# The same outputs from a clang build as from the gcc one (tests/cli/test_compilers.sh).
+test-compilers: build
+	cmake -S . -B $(CLANG_BUILD) -G Ninja -DCMAKE_C_COMPILER=clang \
+	  -DCMAKE_BUILD_TYPE=Release >/dev/null
+	cmake --build $(CLANG_BUILD) -j $(JOBS) --target thzmap
+	bash tests/cli/test_compilers.sh $(BUILD)/thzmap $(CLANG_BUILD)/thzmap $(CURDIR)
+
+check: test test-asan test-compilers fuzz-ci
 
 format:
 	clang-format -i $$(git ls-files '*.c' '*.h')
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) $(CLANG_BUILD)
 
 # The benchmark (issue 6): the paper's case in full, scaling, rendering; see README.
 bench: build

@@ -24,7 +24,8 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
                                 render_sample *sec)
 {
     const thz_material *mat = &ctx->scene->materials[obj->material];
-    double nu_j = channel_sample_hz(ctx->channel, rng_uniform(rng), rng_uniform(rng));
+    double u2 = rng_uniform(rng); /* u2's words first (see integrator_path.c) */
+    double nu_j = channel_sample_hz(ctx->channel, rng_uniform(rng), u2);
     optics_point o;
     brdf_lobe lobe;
     render_lobe_at(ctx, obj, hit->object, nu_j, &o, &lobe);

@@ -55,7 +55,8 @@ static bool render_scatter_dir(const thz_scene *scene, const thz_object *obj, co
 {
     if (!transmitted) {
         if (o->lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(o)) {
-            *dir = sampling_direction(n_seen, sqrt(1.0 - rng_uniform32(rng)), rng_uniform32(rng));
+            double azimuth = rng_uniform32(rng); /* drawn first (see trace.c) */
+            *dir = sampling_direction(n_seen, sqrt(1.0 - rng_uniform32(rng)), azimuth);
             return true;
         }
         brdf_frame f = scene_triangle_frame(obj, hit->triangle, hit->side);
@@ -164,7 +165,8 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
                                 rng_stream *rng, render_sample *out)
 {
     const thz_scene *scene = ctx->scene;
-    double nu = channel_sample_hz(ctx->channel, rng_uniform32(rng), rng_uniform32(rng));
+    double u2 = rng_uniform32(rng); /* u2's word first, then u1's: an order fixed here */
+    double nu = channel_sample_hz(ctx->channel, rng_uniform32(rng), u2);
     double b0 = planck_radiance(nu, ctx->t0_k);
     double t_air = scene->atmosphere.air.temperature_k;
     double b_air = !ctx->emitting ? 0.0 : t_air == ctx->t0_k ? b0 : planck_radiance(nu, t_air);
