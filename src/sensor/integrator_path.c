@@ -43,6 +43,10 @@
  * (variance x instructions); above R of the cylinders (0.55) the gain is lost. */
 #define RENDER_PATH_MIN_WEIGHT 0.3
 
+/* Philox blocks computed ahead when a sample's paths start, 16 streams at a time
+ * (rng_init_many): a path draws its frequency (2 words), then 2 or 3 a bounce. */
+#define RENDER_PATH_RNG_BLOCKS 3u
+
 /* A scattered direction at `hit` (arriving along *dir; unit normal n_seen towards the
  * side the ray came from): by the material's lobe on that side (reflection: cosine for
  * a constant-R diffuse surface, else brdf_sample, whose weight multiplies *beta), or
@@ -154,7 +158,8 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
     return sum;
 }
 
-/* One path from the sample's first hit `first` (ray along dir0 from the sensor): the
+/* One path from the sample's first hit `first` (ray along dir0 from the sensor) at
+ * frequency nu (drawn from its stream rng's first two words by render_path_sample): the
  * random part of its estimate, beyond the deterministic first terms. At the first hit
  * the path splits instead of playing roulette: a reflected branch weighted R and, for
  * shells, a transmitted branch weighted T(theta), each continued by roulette. (Every path
@@ -162,11 +167,9 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
  * between what the reflection and the transmission see, the main noise of a wall that
  * reflects a warmer object.) */
 static double render_path_trace(const render_context *ctx, const accel_hit *first, vec3 dir0,
-                                rng_stream *rng, render_sample *out)
+                                double nu, rng_stream *rng, render_sample *out)
 {
     const thz_scene *scene = ctx->scene;
-    double u2 = rng_uniform32(rng); /* u2's word first, then u1's: an order fixed here */
-    double nu = channel_sample_hz(ctx->channel, rng_uniform32(rng), u2);
     double b0 = planck_radiance(nu, ctx->t0_k);
     double t_air = scene->atmosphere.air.temperature_k;
     double b_air = !ctx->emitting ? 0.0 : t_air == ctx->t0_k ? b0 : planck_radiance(nu, t_air);
@@ -240,9 +243,22 @@ void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir, doub
         return;
     }
     double fixed = ctx->b0_mean + render_path_first(ctx, &first);
-    for (uint32_t j = 0; j < t->n_est; j++) {
-        rng_stream rng;
-        rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_PATH, t->rng_index + j);
-        t->est[j] += t->weight * (fixed + render_path_trace(ctx, &first, dir, &rng, out));
+    /* 16 paths at a time: their streams started together (rng_init_many), their
+     * frequencies drawn together (channel_sample_many_hz, u2's word first), then each
+     * path traced; the same numbers as one path at a time (rng_init, channel_sample_hz) */
+    for (uint32_t j0 = 0; j0 < t->n_est; j0 += RNG_MANY) {
+        size_t n = t->n_est - j0 < RNG_MANY ? t->n_est - j0 : RNG_MANY;
+        rng_stream rng[RNG_MANY];
+        rng_init_many(rng, n, ctx->seed, ctx->channel_index, RNG_PURPOSE_PATH, t->rng_index + j0,
+                      RENDER_PATH_RNG_BLOCKS);
+        double u1[RNG_MANY], u2[RNG_MANY], nu[RNG_MANY];
+        for (size_t k = 0; k < n; k++) {
+            u2[k] = rng_uniform32(&rng[k]);
+            u1[k] = rng_uniform32(&rng[k]);
+        }
+        channel_sample_many_hz(ctx->channel, u1, u2, n, nu);
+        for (size_t k = 0; k < n; k++)
+            t->est[j0 + k] +=
+                t->weight * (fixed + render_path_trace(ctx, &first, dir, nu[k], &rng[k], out));
     }
 }
