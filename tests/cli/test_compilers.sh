@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The same scene and seed give the same files whichever compiler built thzmap: two
-# builds (gcc and clang, `make test-compilers`) run the same small scenes with each
-# integrator, and every output but summary.json (which holds timings) must be byte for
-# byte the same. Where C leaves an order unspecified, an argument list that draws two
+# The same scene and seed give the same files whichever compiler built thzmap, for
+# whichever processor: two builds (`make test-compilers`: gcc with -march=native, clang
+# for any x86-64, -DTHZ_NATIVE=OFF) run the same small scenes with each integrator, and
+# every output but summary.json (which holds timings) must be byte for byte the same. Where C leaves an order unspecified, an argument list that draws two
 # random numbers (f(u(rng), u(rng))), gcc and clang choose differently: the paths, the
 # photon maps and the gather rays of the two builds then differed in every image.
 # Scenes: the paper's room (path, photon-map, final-gather; 2 channels, 32 x 32) and the
