@@ -59,12 +59,12 @@ fuzz-ci: fuzz-build
 	bash tests/fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_CI_SECONDS)
 
 # The same outputs from a clang build for any x86-64 as from the gcc build for this
-# processor (-march=native): tests/cli/test_compilers.sh.
+# processor (-march=native): tests/builds/compare.sh.
 test-compilers: build
 	cmake -S . -B $(CLANG_BUILD) -G Ninja -DCMAKE_C_COMPILER=clang \
 	  -DCMAKE_BUILD_TYPE=Release -DTHZ_NATIVE=OFF >/dev/null
 	cmake --build $(CLANG_BUILD) -j $(JOBS) --target thzmap
-	bash tests/cli/test_compilers.sh $(BUILD)/thzmap $(CLANG_BUILD)/thzmap $(CURDIR)
+	bash tests/builds/compare.sh $(BUILD)/thzmap $(CLANG_BUILD)/thzmap $(CURDIR)
 
 check: test test-asan test-compilers fuzz-ci
 

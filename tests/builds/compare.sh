@@ -2,12 +2,14 @@
 # The same scene and seed give the same files whichever compiler built thzmap, for
 # whichever processor: two builds (`make test-compilers`: gcc with -march=native, clang
 # for any x86-64, -DTHZ_NATIVE=OFF) run the same small scenes with each integrator, and
-# every output but summary.json (which holds timings) must be byte for byte the same. Where C leaves an order unspecified, an argument list that draws two
-# random numbers (f(u(rng), u(rng))), gcc and clang choose differently: the paths, the
-# photon maps and the gather rays of the two builds then differed in every image.
+# every output but summary.json (which holds timings) must be byte for byte the same.
+# Where C leaves an order unspecified, an argument list that draws two random numbers
+# (f(u(rng), u(rng))), gcc and clang choose differently: the paths, the photon maps and
+# the gather rays of the two builds then differed in every image.
 # Scenes: the paper's room (path, photon-map, final-gather; 2 channels, 32 x 32) and the
 # outdoor example (emitting humid air, a glossy Ward lobe, straight transmission, library
 # materials from complex indices; the sensor's Airy PSF and radiometer noise).
+# Not a CTest test (CTest runs one build): make test-compilers runs it.
 # argv: the first build's thzmap, the second build's thzmap, repository directory.
 set -u
 A=$1
@@ -75,4 +77,4 @@ compare outdoor-photon-map "$work/outdoor.json" --integrator photon-map
 compare outdoor-final-gather "$work/outdoor.json" --integrator final-gather
 
 [ "$fails" = 0 ] || { echo "$fails failure(s)"; exit 1; }
-echo "test_compilers: all outputs the same"
+echo "compare.sh: all outputs the same"
