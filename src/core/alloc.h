@@ -33,13 +33,6 @@ static inline void *thz_realloc_array(void *p, size_t n, size_t size)
     return realloc(p, bytes ? bytes : 1);
 }
 
-/* Asks for the memory of a large array (its whole 2 MB-aligned pages) in huge pages, on
- * Linux where transparent huge pages are on "madvise"; a hint, failure changes nothing.
- * On this project's VMs a 4 KB page new to the process costs ~12 us to fault in, and
- * 2 MB pages bring 160 MB of new memory from 470 ms to 15-300 ms. For arrays written
- * whole soon after (photon records): a huge page is backed as soon as one byte is. */
-void thz_advise_huge_pages(void *p, size_t bytes);
-
 /* strdup that returns NULL for NULL. */
 char *thz_strdup(const char *s);
 
