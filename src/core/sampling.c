@@ -44,6 +44,13 @@ vec3 sampling_direction(vec3 n, double mu, double u)
     return sampling_direction_inline(n, mu, u);
 }
 
+vec3 sampling_cosine32(vec3 n, rng_stream *rng)
+{
+    double azimuth = rng_uniform32(rng);
+    double mu = sqrt(1.0 - rng_uniform32(rng));
+    return sampling_direction_inline(n, mu, azimuth);
+}
+
 void sampling_direction_many(const vec3 *n, const double *mu, const double *u, size_t count,
                              vec3 *out)
 {

@@ -10,6 +10,11 @@
 
 /* A unit direction about unit normal n with cos(theta) = mu and azimuth 2 pi u. */
 vec3 sampling_direction(vec3 n, double mu, double u);
+struct rng_stream;
+/* A cosine-distributed direction about unit normal n from the next two 32-bit uniforms
+ * of rng: the azimuth's word first, then the polar angle's (mu = sqrt(1 - u)). The order
+ * is fixed here, not left to the order a compiler evaluates a call's arguments in. */
+vec3 sampling_cosine32(vec3 n, struct rng_stream *rng);
 /* sampling_direction for count photons at once: the same directions, in a loop the
  * compiler vectorises. */
 void sampling_direction_many(const vec3 *n, const double *mu, const double *u, size_t count,

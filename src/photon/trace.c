@@ -220,10 +220,7 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const trace_optics *
         case TRACE_REFLECT:
             c->reflected++;
             if (o.lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(&o)) {
-                /* the azimuth's word first, then the polar angle's: an order fixed here,
-                 * not left to the compiler's order of evaluating arguments */
-                double azimuth = rng_uniform32(rng);
-                dir = sampling_direction(n_in, sqrt(1.0 - rng_uniform32(rng)), azimuth);
+                dir = sampling_cosine32(n_in, rng);
             } else if (!trace_reflect_lobe(scene, obj, &hit, &o, rng, &dir, &power, c)) {
                 c->absorbed++; /* a glossy sample below the surface: lost */
                 c->absorbed_power += power;

@@ -24,7 +24,9 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
                                 render_sample *sec)
 {
     const thz_material *mat = &ctx->scene->materials[obj->material];
-    double u2 = rng_uniform(rng); /* u2's words first (see integrator_path.c) */
+    /* u2's words first, then u1's: an order fixed here, not left to the order a compiler
+     * evaluates a call's arguments in (render_path_sample draws the same way) */
+    double u2 = rng_uniform(rng);
     double nu_j = channel_sample_hz(ctx->channel, rng_uniform(rng), u2);
     optics_point o;
     brdf_lobe lobe;

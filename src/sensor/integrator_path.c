@@ -59,8 +59,7 @@ static bool render_scatter_dir(const thz_scene *scene, const thz_object *obj, co
 {
     if (!transmitted) {
         if (o->lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(o)) {
-            double azimuth = rng_uniform32(rng); /* drawn first (see trace.c) */
-            *dir = sampling_direction(n_seen, sqrt(1.0 - rng_uniform32(rng)), azimuth);
+            *dir = sampling_cosine32(n_seen, rng);
             return true;
         }
         brdf_frame f = scene_triangle_frame(obj, hit->triangle, hit->side);

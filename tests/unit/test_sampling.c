@@ -1,6 +1,6 @@
 /* Sampling helpers: sampling_direction's azimuth (its libm-free cos and sin of 2 pi u)
  * against libm, its polar angle, and unit length; sampling_direction_many's directions
- * against sampling_direction's. */
+ * against sampling_direction's; sampling_cosine32's order of draws. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -10,6 +10,7 @@
 
 #include <cmocka.h>
 
+#include "core/rng.h"
 #include "core/sampling.h"
 
 /* With n = z the basis is (x, y), so the direction is (s cos 2 pi u, s sin 2 pi u, mu). */
@@ -89,12 +90,36 @@ static void test_many(void **state)
     }
 }
 
+/* sampling_cosine32 takes the azimuth from the stream's first word and mu = sqrt(1 - u)
+ * from its second (docs/physics.md "Random streams"): the photon phase's and path's
+ * streams, and so every image, depend on that order. */
+static void test_cosine32_order(void **state)
+{
+    (void)state;
+    const vec3 normals[] = {v3(0, 0, 1), v3(0, -1, 0), v3_normalize(v3(0.3, -0.5, 0.81))};
+    for (uint64_t i = 0; i < 64; i++) {
+        vec3 n = normals[i % 3];
+        rng_stream a, b;
+        rng_init(&a, 11, 2, RNG_PURPOSE_PATH, i);
+        rng_init(&b, 11, 2, RNG_PURPOSE_PATH, i);
+        vec3 d = sampling_cosine32(n, &a);
+        double w0 = rng_uniform32(&b), w1 = rng_uniform32(&b);
+        vec3 want = sampling_direction(n, sqrt(1.0 - w1), w0);
+        if (memcmp(&d, &want, sizeof d) != 0)
+            fail_msg("stream %u: (%.17g, %.17g, %.17g), want (%.17g, %.17g, %.17g)", (unsigned)i,
+                     d.x, d.y, d.z, want.x, want.y, want.z);
+        /* and it took exactly those two words */
+        assert_int_equal(rng_next_u32(&a), rng_next_u32(&b));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_azimuth_against_libm),
         cmocka_unit_test(test_polar_angle_and_length),
         cmocka_unit_test(test_many),
+        cmocka_unit_test(test_cosine32_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
