@@ -194,12 +194,17 @@ int main(int argc, char **argv)
     /* The probe, the scaling points and the renders are timed as the fastest of
      * `repeats` runs (the paper's case itself runs once). */
     const int repeats = small ? 1 : 3;
-    /* The integrators (sections 5 and 6). final-gather's deviation map: 1 M photons, as
+    /* The integrators (section 5). final-gather's deviation map: 1 M photons, as
      * docs/integrators.md measures it. The speed-ups render channel 3 from one map (the
      * paper's photon count for photon-map), with work that takes a few seconds on 1
      * thread: photon-map 10 renders, final-gather one pass of the scene's 32 gather rays,
      * path 10 passes of the scene's 16 paths (0: the scene's estimates per pass). */
     const uint64_t fg_photons = small ? 20000 : 1000000;
+    /* Time to a converged image (section 6), final-gather: 8 M photons, about the count
+     * that reaches 0.05 K soonest on the paper's scene (0.2 THz, 2 threads, the map's floor
+     * 0.048, 0.042, 0.036, 0.030, 0.026 K at 1, 2, 4, 8, 16 M photons: 0.05 K in about 84,
+     * 25, 16, 14.5, 18 s; docs/integrators.md) */
+    const uint64_t conv_fg_photons = small ? 20000 : 8000000;
     const uint32_t speedup_estimates[3] = {0, small ? 2 : 0, small ? 2 : 0};
     const uint32_t speedup_passes[3] = {1, 1, small ? 1 : 10};
     const uint32_t speedup_renders[3] = {small ? 1 : 10, 1, 1};
@@ -497,7 +502,7 @@ int main(int argc, char **argv)
         bench_converge cv;
         bench_converge_job jc = {.scene = scene,
                                  .integrator = conv_names[i],
-                                 .photons = i == 1 ? fg_photons : 0,
+                                 .photons = i == 1 ? conv_fg_photons : 0,
                                  .estimates = {conv_estimates[i][0], conv_estimates[i][1]},
                                  .sensor_columns = small_columns,
                                  .threads = threads,

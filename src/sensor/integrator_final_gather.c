@@ -5,8 +5,12 @@
  * the first hit's emission enters by its band mean, a gather ray's emission, air and B0
  * terms at its own frequency nu_j (render_scatter.nu; each photon term at the photon's). A
  * band mean over the quadrature per gather ray was 39 % of the instructions on the paper's
- * scene, for no less noise. From a deviation map the terms are those of L - B(T0) and the
- * sample adds B(T0). One estimate per gather ray: more passes lower the noise.
+ * scene, for no less noise. At a diffuse shell each gather ray splits: a reflected and a
+ * transmitted ray, each weighted by its own part (R, T), instead of one of them chosen with
+ * probability R : T, whose choice between what the two sides see (a warm object under a
+ * cover, the room around it) was most of the noise of the paper's covers. From a deviation
+ * map the terms are those of L - B(T0) and the sample adds B(T0). One estimate per gather
+ * ray: more passes lower the noise.
  */
 #include <math.h>
 
@@ -16,12 +20,22 @@
 #include "physics/optics.h"
 #include "sensor/integrator.h"
 
+/* What a gather ray estimates: the scattered radiance, reflected or diffusely transmitted
+ * as it draws with probability R : T (a solid: always reflected), or one of the two
+ * parts alone (a diffuse shell's split gather ray, weight 1). */
+typedef enum render_gather_part {
+    RENDER_GATHER_DRAWN,
+    RENDER_GATHER_REFLECTED,
+    RENDER_GATHER_TRANSMITTED
+} render_gather_part;
+
 /* One gather ray from first vertex `hit` (object obj, seen through `path`, at distance
- * distance_m from the sensor): its estimate of the scattered radiance towards the sensor. */
+ * distance_m from the sensor): its estimate of `part` of the scattered radiance towards
+ * the sensor. */
 static double render_gather_ray(const render_context *ctx, const accel_hit *hit, vec3 ray_dir,
                                 const thz_object *obj, bool diffuse_shell, const render_path *path,
-                                double distance_m, rng_stream *rng, render_sample *out,
-                                render_sample *sec)
+                                double distance_m, render_gather_part part, rng_stream *rng,
+                                render_sample *out, render_sample *sec)
 {
     const thz_material *mat = &ctx->scene->materials[obj->material];
     /* u2's words first, then u1's: an order fixed here, not left to the order a compiler
@@ -34,7 +48,9 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
     /* a mirror's reflection is traced by the sample (render_mirror), not gathered */
     double r = o.lobe == OPTICS_LOBE_SPECULAR ? 0.0 : optics_reflectance(&o, hit->cos_theta);
     double tr = diffuse_shell ? optics_transmission(&o, hit->cos_theta) : 0.0;
-    if (!(r + tr > 0.0))
+    if (part == RENDER_GATHER_REFLECTED     ? !(r > 0.0)
+        : part == RENDER_GATHER_TRANSMITTED ? !(tr > 0.0)
+                                            : !(r + tr > 0.0))
         return 0.0;
     const float *nf = &obj->mesh.normals[3 * (size_t)hit->triangle];
     vec3 n = v3_from_floats(nf);
@@ -45,8 +61,10 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
                         .mu_o = hit->cos_theta,
                         .nu = nu_j};
     vec3 dir;
-    if (rng_uniform(rng) * (r + tr) < r) {
-        s.inv_branch = (r + tr) / r;
+    bool reflected = part == RENDER_GATHER_REFLECTED ||
+                     (part == RENDER_GATHER_DRAWN && rng_uniform(rng) * (r + tr) < r);
+    if (reflected) {
+        s.inv_branch = part == RENDER_GATHER_DRAWN ? (r + tr) / r : 1.0;
         if (o.lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(&o)) {
             double mu = sqrt(1.0 - rng_uniform(rng));
             dir = sampling_direction(n_seen, mu, rng_uniform(rng));
@@ -67,7 +85,7 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
         }
     } else {
         s.transmitted = true;
-        s.inv_branch = (r + tr) / tr;
+        s.inv_branch = part == RENDER_GATHER_DRAWN ? (r + tr) / tr : 1.0;
         double mu;
         if (!optics_sample_transmission_mu(&o, sampling_uniform, rng, &mu))
             return 0.0;
@@ -119,22 +137,29 @@ static void render_final_gather_trace(const render_context *ctx, vec3 origin_m, 
             shell && ctx->scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
         bool mirror = ctx->scene->materials[obj->material].reflection == REFLECTION_SPECULAR;
         if (ctx->scatters[hit.object] && (!mirror || (shell && !straight))) {
-            /* streams: the sample's, one per gather ray; crossings of straight shells
-             * shift them so that each vertex has its own */
+            /* streams: the sample's, one per gather ray (a split ray's reflected part
+             * draws first, then its transmitted part); crossings of straight shells shift
+             * them so that each vertex has its own */
+            bool split = shell && !straight;
             for (uint32_t j = 0; j < t->n_est; j++) {
                 rng_stream rng;
                 rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_GATHER,
                          (t->rng_index + j) * (RENDER_MAX_CROSSINGS + 1) + path.n);
-                render_sample sec = {.variance = 0.0};
-                t->est[j] += t->weight * render_gather_ray(ctx, &hit, dir, obj, shell && !straight,
-                                                           &path, distance_m, &rng, out, &sec);
-                if (t->batch) {
-                    for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
-                        t->batch[b] += t->weight * sec.batch[b];
-                    *t->disk_var += t->weight * t->weight * sec.variance;
+                for (int k = 0; k < (split ? 2 : 1); k++) {
+                    render_gather_part part = !split   ? RENDER_GATHER_DRAWN
+                                              : k == 0 ? RENDER_GATHER_REFLECTED
+                                                       : RENDER_GATHER_TRANSMITTED;
+                    render_sample sec = {.variance = 0.0};
+                    t->est[j] += t->weight * render_gather_ray(ctx, &hit, dir, obj, split, &path,
+                                                               distance_m, part, &rng, out, &sec);
+                    if (t->batch) {
+                        for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
+                            t->batch[b] += t->weight * sec.batch[b];
+                        *t->disk_var += t->weight * t->weight * sec.variance;
+                    }
                 }
             }
-            out->paths += t->n_est;
+            out->paths += split ? 2 * t->n_est : t->n_est;
         }
         vec3 in_dir = dir;
         if (render_mirror(ctx, &hit, &path, &dir, &origin_m, out)) {
