@@ -96,7 +96,8 @@ static void render_gather_pass(render_gather_state *g, uint32_t object, int seen
 /* L_R (+ L_T for diffuse shells) at the hit by density estimation over the sample's
  * footprint (sample_sr > 0), widened to the k-th nearest photon when it holds fewer than
  * k; sample_sr = 0 asks for the k-th nearest radius directly. Adds the estimate to
- * *radiance and its Poisson variance to out->variance. */
+ * *radiance and its Poisson variance to out->variance. With `scatter` (final-gather's
+ * secondary hit) only with probability render_context.lookup_q, weighted by its inverse. */
 void render_gather(const render_context *ctx, const accel_hit *hit, vec3 ray_dir,
                    const render_path *path, const render_scatter *scatter, double distance_m,
                    double sample_sr, bool diffuse_shell, double *radiance, render_sample *out)
@@ -106,7 +107,14 @@ void render_gather(const render_context *ctx, const accel_hit *hit, vec3 ray_dir
     const thz_object *obj = &ctx->scene->objects[hit->object];
     const thz_material *mat = &ctx->scene->materials[obj->material];
     if (mat->reflection == REFLECTION_SPECULAR && !diffuse_shell)
-        return; /* a mirror's reflection is traced by the integrator */
+        return;         /* a mirror's reflection is traced by the integrator */
+    double inv_q = 1.0; /* final-gather: 1 / the probability of this lookup */
+    if (scatter) {
+        double q = ctx->lookup_q[hit->object];
+        if (!(scatter->lookup_u < q))
+            return;
+        inv_q = 1.0 / q;
+    }
     const float *nf = &obj->mesh.normals[3 * (size_t)hit->triangle];
     vec3 normal = v3_from_floats(nf);
     render_gather_state g = {
@@ -162,7 +170,7 @@ void render_gather(const render_context *ctx, const accel_hit *hit, vec3 ray_dir
             render_gather_pass(&g, hit->object, hit->side, diffuse_shell, hit->position_m);
         }
     }
-    double area = M_PI * g.radius2_m2;
+    double area = M_PI * g.radius2_m2 / inv_q; /* the weight 1/q folded in */
     *radiance += g.sum / area;
     out->variance += g.sum2 / (area * area);
     for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)

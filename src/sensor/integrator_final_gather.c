@@ -93,6 +93,7 @@ static double render_gather_ray(const render_context *ctx, const accel_hit *hit,
         s.mu_i = mu;
         s.pdf_ratio = optics_mean_transmission(&o) / optics_transmission(&o, mu);
     }
+    s.lookup_u = rng_uniform(rng); /* whether it looks up the photons where it ends */
     vec3 origin = render_leave(ctx, hit, dir);
     double l = render_photon_map_trace(ctx, origin, dir, hit->object, hit->triangle, *path,
                                        distance_m, &s, 0.0, sec);

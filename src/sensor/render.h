@@ -63,6 +63,17 @@
 #define RENDER_SECONDARY_K 64
 #endif
 
+/* final-gather: a gather ray ending on an object whose R + T (its largest hemispherical
+ * mean over the channel, or its reflectivity's largest value) is s looks up the photons
+ * there with probability min(1, s / RENDER_GATHER_LOOKUP_FULL), the estimate weighted by
+ * the inverse (Russian roulette, unbiased); from a map of L always. A wall of R = 0.1
+ * reflects little of the deviation that reaches it, so its lookup, the dearest part of a
+ * gather ray, is worth little of the noise: on the paper's scene (0.2 THz, 32 gather
+ * rays, 1 M photons) 0.5 took the render from 4.08 to 2.27 s at an objects' RMS of 0.0762
+ * against 0.0758 K; 0.3 gave 2.42 s and 0.0759 K, 1 gave 1.41 s and 0.0888 K. From a map
+ * of L a wall's photon term is R B(T), no small part of what a gather ray brings. */
+#define RENDER_GATHER_LOOKUP_FULL 0.5
+
 /* A `path` is cut after this many hits (counted in truncated_paths; the radiance beyond
  * is taken as B(T0), the control variate's value). */
 #define RENDER_MAX_BOUNCES 10000

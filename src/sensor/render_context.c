@@ -17,6 +17,7 @@ static void render_context_fini(render_context *ctx)
     free(ctx->alpha_per_m);
     free(ctx->emission_mean);
     free(ctx->scatters);
+    free(ctx->lookup_q);
     free(ctx->tbar);
     free(ctx->rbar);
     free(ctx->lobes);
@@ -89,6 +90,7 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->alpha_per_m = thz_malloc_array(n, sizeof *ctx->alpha_per_m);
     ctx->emission_mean = thz_malloc_array(n_obj, sizeof *ctx->emission_mean);
     ctx->scatters = thz_malloc_array(n_obj, sizeof *ctx->scatters);
+    ctx->lookup_q = thz_malloc_array(n_obj, sizeof *ctx->lookup_q);
     ctx->b0 = thz_malloc_array(n, sizeof *ctx->b0);
     ctx->source_mean = thz_malloc_array(n_obj, sizeof *ctx->source_mean);
     ctx->tbar = thz_calloc(cells ? cells : 1, sizeof *ctx->tbar);
@@ -97,8 +99,8 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->ward_scale = thz_calloc(cells ? cells : 1, sizeof *ctx->ward_scale);
     ctx->ward_comp = thz_calloc(cells ? cells : 1, sizeof *ctx->ward_comp);
     if (!ctx->planck || !ctx->optics || !ctx->alpha_per_m || !ctx->emission_mean ||
-        !ctx->scatters || !ctx->b0 || !ctx->source_mean || !ctx->tbar || !ctx->rbar ||
-        !ctx->lobes || !ctx->ward_scale || !ctx->ward_comp) {
+        !ctx->scatters || !ctx->lookup_q || !ctx->b0 || !ctx->source_mean || !ctx->tbar ||
+        !ctx->rbar || !ctx->lobes || !ctx->ward_scale || !ctx->ward_comp) {
         render_context_fini(ctx);
         return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
     }
@@ -131,11 +133,20 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         ctx->scatters[o] = r_max > 0.0 || diffuse || mat->index;
         for (size_t k = 0; (diffuse || mat->index) && k < n; k++)
             ctx->tbar[o * n + k] = optics_mean_transmission(&ctx->optics[o * n + k]);
+        double scattered = r_max; /* R + T, for lookup_q below */
+        for (size_t k = 0; k < n; k++)
+            scattered = fmax(scattered, ctx->rbar[o * n + k] + ctx->tbar[o * n + k]);
+        ctx->lookup_q[o] = ctx->scatters[o] ? scattered : 0.0;
     }
     ctx->t0_k = map_t0              ? photon_map_reference_temperature_k(map)
                 : !isnan(path_t0_k) ? path_t0_k
                                     : scene_reference_temperature_k(scene, channel);
     ctx->deviation = map_t0 && ctx->t0_k > 0.0;
+    /* lookups by roulette from a deviation map only (RENDER_GATHER_LOOKUP_FULL) */
+    for (size_t o = 0; o < n_obj; o++)
+        if (ctx->lookup_q[o] > 0.0)
+            ctx->lookup_q[o] =
+                ctx->deviation ? fmin(1.0, ctx->lookup_q[o] / RENDER_GATHER_LOOKUP_FULL) : 1.0;
     for (size_t k = 0; k < n; k++) {
         ctx->b0[k] = planck_radiance(ctx->quad.freq_hz[k], ctx->t0_k);
         ctx->b0_mean += ctx->quad.weight[k] * ctx->b0[k];

@@ -39,6 +39,9 @@ struct render_context {
                                 angle (solids without an index, explicit eps); NAN for the
                                 others */
     bool *scatters;          /* [object]: R > 0 somewhere, or a diffuse shell */
+    double *lookup_q;        /* final-gather, [object]: the probability that a gather ray
+                                ending there looks up its photons (RENDER_GATHER_LOOKUP_FULL;
+                                0 where nothing scatters) */
     double *tbar;            /* [object * quad.n + node]: T-bar of diffuse shells, else 0 */
     double *rbar;            /* [object * quad.n + node]: R-bar */
     brdf_lobe *lobes;        /* [object * quad.n + node]: the lobe at the node (its optics

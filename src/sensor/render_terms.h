@@ -41,10 +41,12 @@ typedef struct render_scatter {
     double inv_branch; /* 1 / P(branch) */
     brdf_frame frame;  /* lobe: the frame at x, and the directions away from x */
     vec3 w_gather, w_view;
-    double pdf; /* lobe: the density of w_gather per solid angle at nu_j */
-    double nu;  /* > 0: the gather ray's frequency nu_j, at which its emission, air and
-                   B0 terms are then taken (one sample of the band, as its photon terms
-                   are); 0: their band means by the channel quadrature */
+    double pdf;      /* lobe: the density of w_gather per solid angle at nu_j */
+    double lookup_u; /* a uniform: the photons at the gather ray's end are looked up when
+                        it is below render_context.lookup_q there (render_gather) */
+    double nu;       /* > 0: the gather ray's frequency nu_j, at which its emission, air and
+                        B0 terms are then taken (one sample of the band, as its photon terms
+                        are); 0: their band means by the channel quadrature */
 } render_scatter;
 
 /* The optics of `object` (obj) at freq_hz with its means cached from the band's tables
