@@ -98,9 +98,7 @@ thz_status trace_optics_init(trace_optics *t, const thz_scene *scene, thz_error 
     }
     for (size_t i = 0; i < scene->n_objects; i++) {
         const thz_object *obj = &scene->objects[i];
-        const thz_material *m = &scene->materials[obj->material];
-        t->constant[i] = !m->index && m->reflectivity.n <= 1 && m->attenuation_per_m.n <= 1 &&
-                         m->emissivity.n <= 1;
+        t->constant[i] = scene_object_optics_constant(scene, obj);
         if (t->constant[i])
             t->optics[i] = scene_object_optics(scene, obj, 0.0);
     }

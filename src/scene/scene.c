@@ -103,6 +103,13 @@ bool scene_add_warning(thz_scene *s, const char *fmt, ...)
     return true;
 }
 
+bool scene_object_optics_constant(const thz_scene *s, const thz_object *obj)
+{
+    const thz_material *m = &s->materials[obj->material];
+    return !m->index && m->reflectivity.n <= 1 && m->attenuation_per_m.n <= 1 &&
+           m->emissivity.n <= 1;
+}
+
 optics_point scene_object_optics(const thz_scene *s, const thz_object *obj, double freq_hz)
 {
     const thz_material *m = &s->materials[obj->material];

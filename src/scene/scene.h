@@ -184,6 +184,11 @@ bool scene_add_warning(thz_scene *scene, const char *fmt, ...)
  * evaluated there, and its thickness (0 for solids). */
 optics_point scene_object_optics(const thz_scene *scene, const thz_object *obj, double freq_hz);
 
+/* Whether scene_object_optics gives obj the same point at every frequency (its freq_hz
+ * aside, which only an index reads): no index, and R, alpha_M and eps constants. Such an
+ * object's optics can be evaluated once per phase or render. */
+bool scene_object_optics_constant(const thz_scene *scene, const thz_object *obj);
+
 /* The BRDF frame of triangle `tri` of `obj` seen from `side` (brdf.h): the normal on that
  * side, the tangent along the triangle's first edge v0 -> v1 (Ward's x axis), b = n x t. */
 brdf_frame scene_triangle_frame(const thz_object *obj, uint32_t tri, int side);

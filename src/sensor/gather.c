@@ -58,7 +58,7 @@ static void render_gather_visit(void *vstate, const photon_record *p, double dis
         f = brdf_eval(&l, &g->frame, v3_scale(dir, -1.0), g->w_view);
     } else {
         /* f_T = T(theta_p) T(theta_o) / (pi T-bar): the reciprocal BTDF */
-        optics_point o = scene_object_optics(scene, g->obj, nu);
+        optics_point o = render_optics_at(g->ctx, g->object_index, nu);
         double mu_p = fmax(fabs(along), 1e-12);
         double tbar = render_tbar(g->ctx, g->obj, g->object_index, nu);
         f = tbar > 0.0

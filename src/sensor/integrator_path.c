@@ -128,7 +128,7 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
             sum -= beta * b0;
             break;
         }
-        optics_point o = scene_object_optics(scene, obj, nu);
+        optics_point o = render_optics_at(ctx, hit.object, nu);
         double r = optics_reflectance(&o, hit.cos_theta);
         double tr = optics_transmission(&o, hit.cos_theta);
         double a = 1.0 - r - tr;
@@ -177,7 +177,7 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
     double alpha = atmosphere_alpha_per_m(&scene->atmosphere, nu);
     double beta = ctx->atmosphere ? render_tau(alpha, first->distance_m) : 1.0;
     const thz_object *obj = &scene->objects[first->object];
-    optics_point o = scene_object_optics(scene, obj, nu);
+    optics_point o = render_optics_at(ctx, first->object, nu);
     double r = optics_reflectance(&o, first->cos_theta);
     double tr = optics_transmission(&o, first->cos_theta);
     const float *nf = &obj->mesh.normals[3 * (size_t)first->triangle];

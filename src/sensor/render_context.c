@@ -14,6 +14,8 @@ static void render_context_fini(render_context *ctx)
     channel_quadrature_fini(&ctx->quad);
     free(ctx->planck);
     free(ctx->optics);
+    free(ctx->opt_fixed);
+    free(ctx->opt_const);
     free(ctx->alpha_per_m);
     free(ctx->emission_mean);
     free(ctx->scatters);
@@ -87,6 +89,8 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         return thz_error_set(err, THZ_ERR_LIMIT, "render: too many objects (%zu)", n_obj);
     ctx->planck = thz_malloc_array(cells, sizeof *ctx->planck);
     ctx->optics = thz_malloc_array(cells, sizeof *ctx->optics);
+    ctx->opt_fixed = thz_calloc(n_obj ? n_obj : 1, sizeof *ctx->opt_fixed);
+    ctx->opt_const = thz_calloc(n_obj ? n_obj : 1, sizeof *ctx->opt_const);
     ctx->alpha_per_m = thz_malloc_array(n, sizeof *ctx->alpha_per_m);
     ctx->emission_mean = thz_malloc_array(n_obj, sizeof *ctx->emission_mean);
     ctx->scatters = thz_malloc_array(n_obj, sizeof *ctx->scatters);
@@ -98,9 +102,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->lobes = thz_calloc(cells ? cells : 1, sizeof *ctx->lobes);
     ctx->ward_scale = thz_calloc(cells ? cells : 1, sizeof *ctx->ward_scale);
     ctx->ward_comp = thz_calloc(cells ? cells : 1, sizeof *ctx->ward_comp);
-    if (!ctx->planck || !ctx->optics || !ctx->alpha_per_m || !ctx->emission_mean ||
-        !ctx->scatters || !ctx->lookup_q || !ctx->b0 || !ctx->source_mean || !ctx->tbar ||
-        !ctx->rbar || !ctx->lobes || !ctx->ward_scale || !ctx->ward_comp) {
+    if (!ctx->planck || !ctx->optics || !ctx->opt_fixed || !ctx->opt_const || !ctx->alpha_per_m ||
+        !ctx->emission_mean || !ctx->scatters || !ctx->lookup_q || !ctx->b0 || !ctx->source_mean ||
+        !ctx->tbar || !ctx->rbar || !ctx->lobes || !ctx->ward_scale || !ctx->ward_comp) {
         render_context_fini(ctx);
         return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
     }
@@ -113,6 +117,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         const thz_object *obj = &scene->objects[o];
         const thz_material *mat = &scene->materials[obj->material];
         bool angle_free = (obj->type == OBJECT_SOLID && !mat->index) || mat->emissivity.n > 0;
+        ctx->opt_const[o] = scene_object_optics_constant(scene, obj);
+        if (ctx->opt_const[o])
+            ctx->opt_fixed[o] = scene_object_optics(scene, obj, 0.0);
         double mean = 0.0;
         for (size_t k = 0; k < n; k++) {
             double nu = ctx->quad.freq_hz[k];

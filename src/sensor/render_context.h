@@ -34,6 +34,8 @@ struct render_context {
     channel_quadrature quad; /* nodes and normalised weights of g_c */
     double *planck;          /* [object * quad.n + node]: B_nu(T_object), W m^-2 sr^-1 Hz^-1 */
     optics_point *optics;    /* [object * quad.n + node] */
+    optics_point *opt_fixed; /* [object]: the optics at any frequency where opt_const */
+    bool *opt_const;         /* [object]: scene_object_optics_constant (render_optics_at) */
     double *alpha_per_m;     /* [node]: atmospheric attenuation, 1/m */
     double *emission_mean;   /* [object]: band mean of eps B when eps does not depend on the
                                 angle (solids without an index, explicit eps); NAN for the

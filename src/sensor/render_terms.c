@@ -20,8 +20,7 @@ double render_path_weight(const render_context *ctx, const render_path *path, do
 {
     double w = 1.0;
     for (size_t i = 0; i < path->n; i++) {
-        const thz_object *obj = &ctx->scene->objects[path->object[i]];
-        optics_point o = scene_object_optics(ctx->scene, obj, freq_hz);
+        optics_point o = render_optics_at(ctx, path->object[i], freq_hz);
         w *= path->reflected[i] ? optics_reflectance(&o, path->mu[i])
                                 : optics_transmission(&o, path->mu[i]);
     }
@@ -75,7 +74,7 @@ double render_tbar(const render_context *ctx, const thz_object *obj, uint32_t ob
 void render_lobe_at(const render_context *ctx, const thz_object *obj, uint32_t object,
                     double freq_hz, optics_point *o, brdf_lobe *l)
 {
-    *o = scene_object_optics(ctx->scene, obj, freq_hz);
+    *o = render_optics_at(ctx, object, freq_hz);
     double rbar = render_interp(ctx, ctx->rbar, object, freq_hz);
     if (o->has_index) {
         if (isnan(rbar)) {
@@ -110,7 +109,7 @@ double render_scatter_weight(const render_context *ctx, const render_scatter *s,
     if (!s->transmitted)
         return spectrum_eval(&s->material->reflectivity, nu) * s->inv_branch;
     /* f_T cos_i / pdf = T(nu,mu_i) T(nu,mu_o) / Tbar(nu) x Tbar(nu_j) / T(nu_j,mu_i) */
-    optics_point o = scene_object_optics(ctx->scene, s->object, nu);
+    optics_point o = render_optics_at(ctx, s->object_index, nu);
     double tbar = render_tbar(ctx, s->object, s->object_index, nu);
     if (!(tbar > 0.0))
         return 0.0;
@@ -196,7 +195,7 @@ double render_emission(const render_context *ctx, uint32_t object, double mu,
     }
     if (s && s->nu > 0.0) { /* a gather ray's secondary hit: at its own frequency */
         const thz_object *obj = &ctx->scene->objects[object];
-        optics_point o = scene_object_optics(ctx->scene, obj, s->nu);
+        optics_point o = render_optics_at(ctx, object, s->nu);
         double a, eps;
         optics_absorption_emissivity(&o, mu, &a, &eps);
         double bt = obj->temperature_k > 0.0 ? planck_radiance(s->nu, obj->temperature_k) : 0.0;

@@ -55,6 +55,16 @@ typedef struct render_scatter {
 void render_lobe_at(const render_context *ctx, const thz_object *obj, uint32_t object,
                     double freq_hz, optics_point *o, brdf_lobe *l);
 
+/* scene_object_optics of `object` at freq_hz, from the context's table where it does not
+ * depend on frequency (the same point, its freq_hz aside, which only an index reads). */
+static inline optics_point render_optics_at(const render_context *ctx, uint32_t object,
+                                            double freq_hz)
+{
+    return ctx->opt_const[object]
+               ? ctx->opt_fixed[object]
+               : scene_object_optics(ctx->scene, &ctx->scene->objects[object], freq_hz);
+}
+
 /* exp(-alpha d), 1 where alpha = 0 (also for d infinite). */
 static inline double render_tau(double alpha_per_m, double distance_m)
 {

@@ -155,6 +155,44 @@ static void test_blocks(void **state)
     thz_scene_destroy(s);
 }
 
+/* scene_object_optics_constant: constants only, no index; such an object's optics are
+ * the same at every frequency (what the photon phase and the renderer cache), a table's
+ * are not. */
+static void test_optics_constant(void **state)
+{
+    (void)state;
+    thz_scene *s = load_ok(
+        HEAD CHANNELS
+        "\"materials\": {\"c\": {\"reflectivity\": 0.1, \"attenuation_per_m\": 5, "
+        "\"emissivity\": 0.8}, \"t\": {\"reflectivity\": [[0.2, 0.05], [1.2, 0.12]]}, "
+        "\"a\": {\"reflectivity\": 0.1, \"attenuation_per_m\": [[0.2, 60], [1.2, 900]]}, "
+        "\"i\": {\"refractive_index\": [2, 0.01]}}, "
+        "\"objects\": [{\"name\": \"c\", \"type\": \"solid\", \"material\": \"c\", "
+        "\"temperature_k\": 300, \"shape\": " BOX "}, "
+        "{\"name\": \"t\", \"type\": \"solid\", \"material\": \"t\", "
+        "\"temperature_k\": 300, \"shape\": " BOX "}, "
+        "{\"name\": \"a\", \"type\": \"shell\", \"thickness_m\": 0.001, \"material\": \"a\", "
+        "\"temperature_k\": 300, \"shape\": " BOX "}, "
+        "{\"name\": \"i\", \"type\": \"solid\", \"material\": \"i\", "
+        "\"temperature_k\": 300, \"shape\": " BOX "}], " SENSORS "}");
+    const bool expect[4] = {true, false, false, false};
+    for (size_t o = 0; o < 4; o++)
+        assert_int_equal(scene_object_optics_constant(s, &s->objects[o]), expect[o]);
+    for (size_t o = 0; o < 4; o++) {
+        optics_point lo = scene_object_optics(s, &s->objects[o], 0.3e12);
+        optics_point hi = scene_object_optics(s, &s->objects[o], 1.1e12);
+        bool same = lo.reflectivity == hi.reflectivity &&
+                    lo.attenuation_per_m == hi.attenuation_per_m &&
+                    lo.emissivity == hi.emissivity && lo.n == hi.n && lo.k == hi.k;
+        if (expect[o])
+            assert_true(same);
+    }
+    optics_point lo = scene_object_optics(s, &s->objects[1], 0.3e12);
+    optics_point hi = scene_object_optics(s, &s->objects[1], 1.1e12);
+    assert_true(lo.reflectivity != hi.reflectivity);
+    thz_scene_destroy(s);
+}
+
 static void test_csv_material_and_warnings(void **state)
 {
     (void)state;
@@ -312,6 +350,7 @@ int main(void)
         cmocka_unit_test(test_example),
         cmocka_unit_test(test_defaults_and_range),
         cmocka_unit_test(test_blocks),
+        cmocka_unit_test(test_optics_constant),
         cmocka_unit_test(test_csv_material_and_warnings),
         cmocka_unit_test(test_default_channel_names),
         cmocka_unit_test(test_sensor_model),
