@@ -107,8 +107,10 @@ void render_gather(const render_context *ctx, const accel_hit *hit, vec3 ray_dir
     const thz_object *obj = &ctx->scene->objects[hit->object];
     const thz_material *mat = &ctx->scene->materials[obj->material];
     if (mat->reflection == REFLECTION_SPECULAR && !diffuse_shell)
-        return;         /* a mirror's reflection is traced by the integrator */
-    double inv_q = 1.0; /* final-gather: 1 / the probability of this lookup */
+        return; /* a mirror's reflection is traced by the integrator */
+
+    /* final-gather: the lookup only with probability q, weighted 1/q */
+    double inv_q = 1.0;
     if (scatter) {
         double q = ctx->lookup_q[hit->object];
         if (!(scatter->lookup_u < q))
