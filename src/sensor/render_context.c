@@ -113,6 +113,10 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         if (ctx->alpha_per_m[k] != 0.0)
             ctx->atmosphere = true;
     }
+    ctx->t0_k = map_t0              ? photon_map_reference_temperature_k(map)
+                : !isnan(path_t0_k) ? path_t0_k
+                                    : scene_reference_temperature_k(scene, channel);
+    ctx->deviation = map_t0 && ctx->t0_k > 0.0;
     for (size_t o = 0; o < n_obj; o++) {
         const thz_object *obj = &scene->objects[o];
         const thz_material *mat = &scene->materials[obj->material];
@@ -140,20 +144,14 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         ctx->scatters[o] = r_max > 0.0 || diffuse || mat->index;
         for (size_t k = 0; (diffuse || mat->index) && k < n; k++)
             ctx->tbar[o * n + k] = optics_mean_transmission(&ctx->optics[o * n + k]);
-        double scattered = r_max; /* R + T, for lookup_q below */
+        /* by roulette on R + T from a deviation map only (RENDER_GATHER_LOOKUP_FULL) */
+        double scattered = r_max;
         for (size_t k = 0; k < n; k++)
             scattered = fmax(scattered, ctx->rbar[o * n + k] + ctx->tbar[o * n + k]);
-        ctx->lookup_q[o] = ctx->scatters[o] ? scattered : 0.0;
+        ctx->lookup_q[o] = !ctx->scatters[o] || !(scattered > 0.0) ? 0.0
+                           : ctx->deviation ? fmin(1.0, scattered / RENDER_GATHER_LOOKUP_FULL)
+                                            : 1.0;
     }
-    ctx->t0_k = map_t0              ? photon_map_reference_temperature_k(map)
-                : !isnan(path_t0_k) ? path_t0_k
-                                    : scene_reference_temperature_k(scene, channel);
-    ctx->deviation = map_t0 && ctx->t0_k > 0.0;
-    /* lookups by roulette from a deviation map only (RENDER_GATHER_LOOKUP_FULL) */
-    for (size_t o = 0; o < n_obj; o++)
-        if (ctx->lookup_q[o] > 0.0)
-            ctx->lookup_q[o] =
-                ctx->deviation ? fmin(1.0, ctx->lookup_q[o] / RENDER_GATHER_LOOKUP_FULL) : 1.0;
     for (size_t k = 0; k < n; k++) {
         ctx->b0[k] = planck_radiance(ctx->quad.freq_hz[k], ctx->t0_k);
         ctx->b0_mean += ctx->quad.weight[k] * ctx->b0[k];

@@ -178,15 +178,12 @@ static void test_optics_constant(void **state)
     const bool expect[4] = {true, false, false, false};
     for (size_t o = 0; o < 4; o++)
         assert_int_equal(scene_object_optics_constant(s, &s->objects[o]), expect[o]);
-    for (size_t o = 0; o < 4; o++) {
-        optics_point lo = scene_object_optics(s, &s->objects[o], 0.3e12);
-        optics_point hi = scene_object_optics(s, &s->objects[o], 1.1e12);
-        bool same = lo.reflectivity == hi.reflectivity &&
-                    lo.attenuation_per_m == hi.attenuation_per_m &&
-                    lo.emissivity == hi.emissivity && lo.n == hi.n && lo.k == hi.k;
-        if (expect[o])
-            assert_true(same);
-    }
+    /* the constant one: the same point at two frequencies */
+    optics_point c_lo = scene_object_optics(s, &s->objects[0], 0.3e12);
+    optics_point c_hi = scene_object_optics(s, &s->objects[0], 1.1e12);
+    assert_true(c_lo.reflectivity == c_hi.reflectivity &&
+                c_lo.attenuation_per_m == c_hi.attenuation_per_m &&
+                c_lo.emissivity == c_hi.emissivity);
     optics_point lo = scene_object_optics(s, &s->objects[1], 0.3e12);
     optics_point hi = scene_object_optics(s, &s->objects[1], 1.1e12);
     assert_true(lo.reflectivity != hi.reflectivity);
