@@ -132,7 +132,7 @@ photon_record *photon_map_pool_scratch(photon_map_pool *pool, size_t count)
     size_t n = count ? count : 1;
     if (pool && pool->scratch_capacity >= n)
         return pool->scratch;
-    if (pool) { /* the old one first: the peak stays twice the map */
+    if (pool) { /* the old one first: the peak stays the map and its scratch */
         free(pool->scratch);
         pool->scratch = NULL;
         pool->scratch_capacity = 0;

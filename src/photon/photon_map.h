@@ -71,7 +71,7 @@ void photon_map_destroy(photon_map *map);
 typedef struct photon_map_pool {
     photon_record *records; /* a spare record array (malloc'd), or NULL */
     size_t records_capacity;
-    photon_record *scratch; /* the index build's second record array */
+    photon_record *scratch; /* the index build's scratch records */
     size_t scratch_capacity;
     void *index; /* the index build's counts and bounding boxes */
     size_t index_bytes;
@@ -85,6 +85,14 @@ photon_record *photon_map_pool_take(photon_map_pool *pool, size_t *capacity);
 /* Destroys map, keeping its record array in pool when larger than the pool's spare
  * (pool NULL: photon_map_destroy). */
 void photon_map_recycle(photon_map *map, photon_map_pool *pool);
+
+/* The records of the index build's scratch for a map of count records: 3/8 of them
+ * (rounded up), more only where more than that share one 4096th of a large group's cube
+ * (photon_map_build.c). */
+static inline size_t photon_map_scratch_records(size_t count)
+{
+    return count / 8 * 3 + count % 8;
+}
 
 /* photon_map_create with the array's capacity (>= count, kept for photon_map_recycle)
  * and a pool (may be NULL) whose scratch the index build uses. */

@@ -1,29 +1,40 @@
 /* The photon map's build: the records grouped by (object, side), each group sorted by
- * Morton code and then bytes (photon_map.c says why that order), in passes that each
- * split the records over the threads:
+ * Morton code and then bytes (photon_map.c says why that order), with a scratch of 3/8
+ * of the records, in passes that each split the records over the threads:
  *
  *  1. scan: each part of the array (a contiguous range; one per thread) counts its records
  *     of each group and takes the groups' bounding boxes, which give the groups' cubes;
- *  2. group: each part moves its records to a second array, into its own slot of each
- *     group (after the earlier parts'); a record of a large group carries there, in its
- *     object_side, the first digit of its code (PHOTON_MAP_FIRST_LEVELS levels), and the
- *     part counts those digits;
- *  3. split: each part moves its records of the large groups back, into its slot of
- *     their digit's range (after the earlier digits' and the earlier parts');
- *  4. sort: each digit's range of a large group, and each small group, is sorted alone
- *     (photon_build_sort_range), in cache but for the largest.
+ *  2. key: each part writes each record's key into its object_side and counts the keys:
+ *     a small group is one key, a large group one per first digit of its records' codes
+ *     (PHOTON_MAP_FIRST_LEVELS levels: 4096), the keys in the map's order. The keys are
+ *     dealt into buckets, runs of consecutive keys that fit in the scratch (3 in the
+ *     paper's case);
+ *  3. partition: each part orders its records by bucket, in place (a few fronts streaming
+ *     through the part);
+ *  then for each bucket in turn:
+ *  4. scatter: each part moves its records of the bucket into the scratch, into its own
+ *     slot of each key's range (after the earlier keys' and the earlier parts'); then the
+ *     parts' records of the later buckets are moved up against the array's end
+ *     (photon_build_compact), which frees the bucket's range of the map;
+ *  5. sort: each key's range is sorted from the scratch into the map (photon_build_sort
+ *     _range), in cache but for the largest.
  *
  * Records already in the map's order (a map's own, as a photon-map file keeps them) are
- * found so by pass 1's check (photon_build_in_order) and not moved: no second array.
+ * found so by pass 1's check (photon_build_in_order) and not moved: no scratch.
  *
- * Each pass streams the records, or a cached range of them, from one array to the other.
- * The in-place build it replaces (a serial permutation by group, then per group an
- * American flag sort whose first pass over the largest group was serial too) swapped
- * the records along permutation cycles, a cache miss per record in the passes over the
- * whole array; it took 62 ns per record on 1 thread and 35-46 on 2 (the paper's case,
- * 5.06 M records, warm memory, fastest of 6 builds on a loaded machine), this one 36 and
- * 20. The price is memory: the second array is as large as the records (the peak is
- * twice the map, as the run's estimate allows), kept in the pool between builds.
+ * The order within a key's range before pass 5 does not matter: the map's order is total
+ * (code, then bytes; records equal in both are the same bytes), so the map is the same
+ * for any number of parts and any bucketing. The in-place build before these (a serial
+ * permutation by group, then per group an American flag sort whose first pass over the
+ * largest group was serial too) swapped the records along permutation cycles, a cache
+ * miss per record in the passes over the whole array: 62 ns per record on 1 thread and
+ * 35-46 on 2 (the paper's case, 5.06 M records, warm memory). A build with a second array
+ * as large as the records (grouping and digit passes from one to the other) took 36 and
+ * 20 but doubled the peak; this one takes as long (12.1 M records, 2 threads, alternating
+ * runs: 0.42-0.49 s against 0.36-0.45 s; 1 thread 0.65-0.75 s against 0.63-0.77 s) and
+ * its peak is the map and 3/8 of it. The scratch is larger only where more than 3/8 of
+ * the records share a key (a point holding most photons of a large group): a key's records
+ * must fit in it. It is kept in the pool between builds.
  */
 #include "photon/photon_map.h"
 
@@ -221,24 +232,33 @@ static photon_cube photon_group_cube(const photon_bounds *b)
 
 /* ---- The passes ------------------------------------------------------------------------ */
 
-/* One build: the records, the second array, and what the passes hand on. The per-part
- * arrays have a row per part, rows a cache line apart at least (stride n_groups + 8):
- * each part writes its own row for every record. */
+/* At most this many buckets: each holds at most the scratch's records, and two neighbours
+ * more than it (else they would be one), so with the scratch at least 3/8 of the records
+ * there are at most 2 x 8/3 + 1 < 7. */
+#define PHOTON_MAP_BUCKETS_MAX 8
+
+/* One build: the records, the scratch, and what the passes hand on. The per-part arrays
+ * have a row per part, rows a cache line apart at least (strides n_groups + 8 and
+ * n_keys + 8): each part writes its own row for every record. */
 typedef struct photon_build {
     photon_record *r; /* the records: the input, then the map */
-    photon_record *s; /* the second array, count records */
+    photon_record *s; /* the scratch: one bucket's records at a time */
+    size_t s_base;    /* the map position of s[0] while a bucket is there */
     size_t count, n_groups, stride;
     int parts;
     size_t *part_count;      /* [p][g]: part p's records of group g (pass 1) */
-    size_t *part_next;       /* [p][g]: its next slot in the second array (pass 2) */
     photon_bounds *part_box; /* [p][g]: the bounding box of those records */
     size_t *first_bad;       /* [p]: the part's first record naming no group, or count */
     size_t *start;           /* n_groups + 1: the map's group offsets */
     photon_cube *cubes;      /* n_groups: the map's cubes */
-    size_t *large_of;        /* [g]: g's index among the large groups, or SIZE_MAX */
-    size_t *large_group;     /* the large groups */
-    size_t n_large;
-    size_t *digit_next; /* [p][large][digit]: counts (pass 2), then slots (pass 3) */
+    size_t *key_base;        /* n_groups + 1: group g's keys are key_base[g] .. [g + 1] - 1 */
+    size_t n_keys, key_stride;
+    size_t *key_next;  /* [p][key]: part p's records of the key (pass 2), then slots */
+    size_t *key_start; /* n_keys + 1: the map position of each key's first record */
+    int n_buckets;
+    size_t bucket_key[PHOTON_MAP_BUCKETS_MAX + 1]; /* bucket k: keys [k], .. [k + 1] - 1 */
+    size_t *part_at; /* [p][k]: where part p's records of bucket k are; [p][n_buckets]: end */
+    size_t *part_in; /* [p][k]: how many */
 } photon_build;
 
 static void photon_part_range(const photon_build *b, int p, size_t *lo, size_t *hi)
@@ -281,8 +301,8 @@ static void photon_build_scan(photon_build *b, int p)
 }
 
 /* After pass 1: the groups' offsets and cubes (the parts' boxes and counts combined
- * exactly: minima, maxima and integer sums, so the number of parts changes nothing), each
- * part's first slot in each group, and the large groups. Returns count, or the first
+ * exactly: minima, maxima and integer sums, so the number of parts changes nothing) and
+ * keys (a large group one per first digit, any other one). Returns count, or the first
  * record that names no group. */
 static size_t photon_build_layout(photon_build *b)
 {
@@ -292,13 +312,12 @@ static size_t photon_build_layout(photon_build *b)
     if (bad < b->count)
         return bad;
     b->start[0] = 0;
-    b->n_large = 0;
+    b->key_base[0] = 0;
     for (size_t g = 0; g < b->n_groups; g++) {
         photon_bounds box = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
         size_t n = 0;
         for (int p = 0; p < b->parts; p++) {
             size_t at = (size_t)p * b->stride + g;
-            b->part_next[at] = b->start[g] + n;
             n += b->part_count[at];
             for (int a = 0; a < 3; a++) {
                 box.lo[a] = b->part_box[at].lo[a] < box.lo[a] ? b->part_box[at].lo[a] : box.lo[a];
@@ -307,12 +326,9 @@ static size_t photon_build_layout(photon_build *b)
         }
         b->start[g + 1] = b->start[g] + n;
         b->cubes[g] = photon_group_cube(&box);
-        b->large_of[g] = SIZE_MAX;
-        if (n >= PHOTON_MAP_LARGE) {
-            b->large_of[g] = b->n_large;
-            b->large_group[b->n_large++] = g;
-        }
+        b->key_base[g + 1] = b->key_base[g] + (n >= PHOTON_MAP_LARGE ? PHOTON_MAP_DIGITS : 1);
     }
+    b->n_keys = b->key_base[b->n_groups];
     return b->count;
 }
 
@@ -343,84 +359,162 @@ static bool photon_build_in_order(const photon_build *b, int p)
     return true;
 }
 
-/* Pass 2 for part p: its records into their group's slots of the second array, a large
- * group's carrying their first digit in object_side (the group is known from the slot),
- * counted. Also clears bits 16..17 of flags (a kd-tree's split axis in maps before the
- * octree; kept zero). */
-static void photon_build_group(photon_build *b, int p)
+/* Pass 2 for part p: each record's key into its object_side (the group is known from the
+ * key), counted. Also clears bits 16..17 of flags (a kd-tree's split axis in maps before
+ * the octree; kept zero). */
+static void photon_build_key(photon_build *b, int p)
 {
     size_t lo, hi;
     photon_part_range(b, p, &lo, &hi);
-    size_t *next = b->part_next + (size_t)p * b->stride;
-    size_t *digits = b->digit_next + (size_t)p * b->n_large * PHOTON_MAP_DIGITS;
-    memset(digits, 0, b->n_large * PHOTON_MAP_DIGITS * sizeof *digits);
+    size_t *cnt = b->key_next + (size_t)p * b->key_stride;
+    memset(cnt, 0, b->n_keys * sizeof *cnt);
     for (size_t i = lo; i < hi; i++) {
-        photon_record rec = b->r[i];
-        size_t g = rec.object_side;
-        rec.flags &= ~(3u << 16);
-        size_t large = b->large_of[g];
-        if (large != SIZE_MAX) {
-            unsigned d = photon_first_digit(&b->cubes[g], &rec);
-            digits[large * PHOTON_MAP_DIGITS + d]++;
-            rec.object_side = d;
-        }
-        b->s[next[g]++] = rec;
+        photon_record *q = &b->r[i];
+        size_t g = q->object_side, key = b->key_base[g];
+        if (b->key_base[g + 1] - key > 1)
+            key += photon_first_digit(&b->cubes[g], q);
+        q->object_side = (uint32_t)key;
+        q->flags &= ~(3u << 16);
+        cnt[key]++;
     }
 }
 
-/* After pass 2: the parts' first slots in each digit's range of each large group (the
- * digits in order, within a digit the parts in order). */
-static void photon_build_digit_slots(photon_build *b)
+/* After pass 2: the keys' map positions, the buckets (consecutive keys, as many as fit in
+ * the scratch of s_count records: s_count is at least the largest key's) and each part's
+ * records of each bucket (where pass 3 puts them). */
+static void photon_build_buckets(photon_build *b, size_t s_count)
 {
-    for (size_t l = 0; l < b->n_large; l++) {
-        size_t at = b->start[b->large_group[l]];
-        for (unsigned d = 0; d < PHOTON_MAP_DIGITS; d++) {
-            for (int p = 0; p < b->parts; p++) {
-                size_t *slot = &b->digit_next[((size_t)p * b->n_large + l) * PHOTON_MAP_DIGITS + d];
-                size_t n = *slot;
-                *slot = at;
-                at += n;
+    b->key_start[0] = 0;
+    b->n_buckets = 0;
+    b->bucket_key[0] = 0;
+    size_t in_bucket = 0;
+    for (size_t key = 0; key < b->n_keys; key++) {
+        size_t n = 0;
+        for (int p = 0; p < b->parts; p++)
+            n += b->key_next[(size_t)p * b->key_stride + key];
+        b->key_start[key + 1] = b->key_start[key] + n;
+        if (in_bucket + n > s_count) {
+            b->bucket_key[++b->n_buckets] = key;
+            in_bucket = 0;
+        }
+        in_bucket += n;
+    }
+    b->bucket_key[++b->n_buckets] = b->n_keys;
+    for (int p = 0; p < b->parts; p++) {
+        size_t lo, hi;
+        photon_part_range(b, p, &lo, &hi);
+        size_t *at = b->part_at + (size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1);
+        size_t *in = b->part_in + (size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1);
+        const size_t *cnt = b->key_next + (size_t)p * b->key_stride;
+        for (int k = 0; k < b->n_buckets; k++) {
+            at[k] = lo;
+            in[k] = 0;
+            for (size_t key = b->bucket_key[k]; key < b->bucket_key[k + 1]; key++)
+                in[k] += cnt[key];
+            lo += in[k];
+        }
+        at[b->n_buckets] = hi;
+    }
+}
+
+/* The bucket of a key. */
+static int photon_bucket_of(const photon_build *b, size_t key)
+{
+    int k = 0;
+    while (key >= b->bucket_key[k + 1])
+        k++;
+    return k;
+}
+
+/* Pass 3 for part p: its records in place, by bucket (American flag sort: each record out
+ * of place swapped straight to the next free slot of its bucket, a few fronts streaming
+ * through the part). */
+static void photon_build_partition(photon_build *b, int p)
+{
+    if (b->n_buckets == 1)
+        return;
+    const size_t *at = b->part_at + (size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1);
+    size_t next[PHOTON_MAP_BUCKETS_MAX];
+    for (int k = 0; k < b->n_buckets; k++)
+        next[k] = at[k];
+    for (int k = 0; k < b->n_buckets; k++) {
+        while (next[k] < at[k + 1]) {
+            int d = photon_bucket_of(b, b->r[next[k]].object_side);
+            if (d == k) {
+                next[k]++;
+            } else {
+                photon_record t = b->r[next[k]];
+                b->r[next[k]] = b->r[next[d]];
+                b->r[next[d]++] = t;
             }
         }
     }
 }
 
-/* Pass 3 for part p: its records of the large groups (where pass 2 put them: after the
- * earlier parts', up to its own next slot) back into their digit's slots, their
- * object_side restored. */
-static void photon_build_split(photon_build *b, int p)
+/* Before bucket k's pass 4: each part's first slot in the scratch for each of the bucket's
+ * keys (the keys in order, within a key the parts in order). */
+static void photon_build_slots(photon_build *b, int k)
 {
-    for (size_t l = 0; l < b->n_large; l++) {
-        size_t g = b->large_group[l];
-        size_t lo = p > 0 ? b->part_next[(size_t)(p - 1) * b->stride + g] : b->start[g];
-        size_t hi = b->part_next[(size_t)p * b->stride + g];
-        size_t *slot = b->digit_next + ((size_t)p * b->n_large + l) * PHOTON_MAP_DIGITS;
-        for (size_t i = lo; i < hi; i++) {
-            photon_record rec = b->s[i];
-            size_t j = slot[rec.object_side]++;
-            rec.object_side = (uint32_t)g;
-            b->r[j] = rec;
+    b->s_base = b->key_start[b->bucket_key[k]];
+    for (size_t key = b->bucket_key[k]; key < b->bucket_key[k + 1]; key++) {
+        size_t at = b->key_start[key] - b->s_base;
+        for (int p = 0; p < b->parts; p++) {
+            size_t *slot = &b->key_next[(size_t)p * b->key_stride + key];
+            size_t n = *slot;
+            *slot = at;
+            at += n;
         }
     }
 }
 
+/* Pass 4 for part p and bucket k: the part's records of the bucket into their keys' slots
+ * of the scratch. */
+static void photon_build_scatter(photon_build *b, int k, int p)
+{
+    size_t *slot = b->key_next + (size_t)p * b->key_stride;
+    size_t at = b->part_at[(size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1) + (size_t)k];
+    size_t in = b->part_in[(size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1) + (size_t)k];
+    for (size_t i = at; i < at + in; i++)
+        b->s[slot[b->r[i].object_side]++] = b->r[i];
+}
+
+/* After bucket k's pass 4: the parts' records of the later buckets moved up against the
+ * array's end (each part's after the later parts', which are there already), freeing the
+ * bucket's range of the map just after the earlier buckets'. */
+static void photon_build_compact(photon_build *b, int k)
+{
+    size_t shift = 0;
+    for (int p = b->parts - 2; p >= 0; p--) {
+        size_t *at = b->part_at + (size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1);
+        shift += b->part_in[(size_t)(p + 1) * (PHOTON_MAP_BUCKETS_MAX + 1) + (size_t)k];
+        size_t from = at[k] + b->part_in[(size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1) + (size_t)k];
+        size_t to = at[b->n_buckets];
+        if (shift == 0)
+            continue;
+        memmove(b->r + from + shift, b->r + from, (to - from) * sizeof *b->r);
+        for (int j = k + 1; j <= b->n_buckets; j++)
+            at[j] += shift;
+    }
+}
+
 /* Sorts records [lo, hi) of group g, whose codes share levels 1..level-1 (level 1 or
- * 1 + PHOTON_MAP_FIRST_LEVELS), into the map's range; they start there, or in the second
- * array's range (in_scratch). An LSD radix sort, 8 bits a pass, by the next 32 bits of
- * their codes (10 levels and 2 bits), carried in object_side (the group's, restored
- * after), the records going back and forth between the two ranges; then each run of
- * records whose 32 bits tie sorted by full code and bytes (photon_sort; their codes in
- * the second array's range, free by then). In place, the American flag sort swapped
- * every record along a cycle at every second level, 37 of the build's 66 ns per record
- * (paper's case, 1 thread); this moves it once a pass, at 4 passes. */
+ * 1 + PHOTON_MAP_FIRST_LEVELS), from the scratch (where pass 4 put them) into the map's
+ * range. An LSD radix sort, 8 bits a pass, by the next 32 bits of their codes (10 levels
+ * and 2 bits), carried in object_side (the group's, restored after), the records going
+ * back and forth between the two ranges; then each run of records whose 32 bits tie
+ * sorted by full code and bytes (photon_sort; their codes in the scratch's range, free by
+ * then). In place, the American flag sort swapped every record along a cycle at every
+ * second level, 37 of the build's 66 ns per record (paper's case, 1 thread); this moves it
+ * once a pass, at 4 passes. */
 static void photon_build_sort_range(const photon_build *b, size_t g, size_t lo, size_t hi,
-                                    int level, bool in_scratch)
+                                    int level)
 {
     _Static_assert(1 + PHOTON_MAP_FIRST_LEVELS <= 11, "the 32 bits must lie in the code");
     const size_t n = hi - lo;
     const int shift = 31 - 3 * (level - 1); /* the code's next 32 bits: [shift, shift + 32) */
     const photon_cube *cube = &b->cubes[g];
-    photon_record *src = (in_scratch ? b->s : b->r) + lo, *dst = (in_scratch ? b->r : b->s) + lo;
+    photon_record *scratch = b->s + (lo - b->s_base);
+    photon_record *src = scratch, *dst = b->r + lo;
     size_t count[4][256] = {{0}};
     for (size_t i = 0; i < n; i++) {
         uint32_t key = (uint32_t)(photon_morton(cube, &src[i]) >> shift);
@@ -454,7 +548,7 @@ static void photon_build_sort_range(const photon_build *b, size_t g, size_t lo, 
         while (j < n && r[j].object_side == key)
             r[j++].object_side = (uint32_t)g;
         if (j - i > 1) {
-            uint64_t *code = (uint64_t *)(void *)(b->s + lo + i);
+            uint64_t *code = (uint64_t *)(void *)(scratch + i);
             for (size_t k = i; k < j; k++)
                 code[k - i] = photon_morton(cube, &r[k]);
             photon_sort(r + i, code, j - i, level + 10);
@@ -463,25 +557,23 @@ static void photon_build_sort_range(const photon_build *b, size_t g, size_t lo, 
     }
 }
 
-/* Pass 4, item k: small group k (k < n_groups; copied back from the second array
- * first), or a digit's range of a large group. */
-static void photon_build_sort_item(const photon_build *b, size_t k)
+/* Pass 5, item `key` of the bucket in the scratch: the key's records sorted into the map
+ * (a small group's, or a large group's of one first digit). */
+static void photon_build_sort_key(const photon_build *b, size_t key)
 {
-    if (k < b->n_groups) {
-        size_t lo = b->start[k], hi = b->start[k + 1];
-        if (b->large_of[k] != SIZE_MAX || hi == lo)
-            return;
-        photon_build_sort_range(b, k, lo, hi, 1, true);
+    size_t lo = b->key_start[key], hi = b->key_start[key + 1];
+    if (hi == lo)
         return;
+    size_t g = 0, top = b->n_groups; /* the group: key_base[g] <= key < key_base[g + 1] */
+    while (top - g > 1) {
+        size_t mid = g + (top - g) / 2;
+        if (b->key_base[mid] <= key)
+            g = mid;
+        else
+            top = mid;
     }
-    size_t l = (k - b->n_groups) / PHOTON_MAP_DIGITS;
-    unsigned d = (unsigned)((k - b->n_groups) % PHOTON_MAP_DIGITS);
-    size_t g = b->large_group[l];
-    /* after pass 3, the last part's slot of each digit is where the digit's range ends */
-    const size_t *end =
-        b->digit_next + ((size_t)(b->parts - 1) * b->n_large + l) * PHOTON_MAP_DIGITS;
-    photon_build_sort_range(b, g, d > 0 ? end[d - 1] : b->start[g], end[d],
-                            1 + PHOTON_MAP_FIRST_LEVELS, false);
+    bool large = b->key_base[g + 1] - b->key_base[g] > 1;
+    photon_build_sort_range(b, g, lo, hi, large ? 1 + PHOTON_MAP_FIRST_LEVELS : 1);
 }
 
 /* ---- The build -------------------------------------------------------------------------- */
@@ -496,25 +588,36 @@ thz_status photon_map_create(photon_record *photons, size_t count, size_t n_obje
     return photon_map_build(photons, count, count, n_objects, threads, NULL, out, err);
 }
 
-/* Points b's per-part and per-group arrays into index (photon_map_index_scratch); returns
- * the bytes they take, or 0 with index NULL (to size it). */
+/* The most keys a build of count records in n_groups groups may have: a group is large
+ * (a key per first digit) from PHOTON_MAP_LARGE records on. */
+static size_t photon_build_max_keys(size_t count, size_t n_groups)
+{
+    size_t max_large = count / PHOTON_MAP_LARGE;
+    max_large = max_large < n_groups ? max_large : n_groups;
+    return n_groups + max_large * (PHOTON_MAP_DIGITS - 1);
+}
+
+/* Points b's per-part, per-group and per-key arrays into index
+ * (photon_map_pool_index); returns the bytes they take, or 0 with index NULL (to size
+ * it). */
 static size_t photon_build_arrays(photon_build *b, void *index)
 {
     const size_t parts = (size_t)b->parts, rows = parts * b->stride;
-    size_t max_large = b->count / PHOTON_MAP_LARGE;
-    max_large = max_large < b->n_groups ? max_large : b->n_groups;
+    const size_t max_keys = photon_build_max_keys(b->count, b->n_groups);
+    b->key_stride = max_keys + 8;
     size_t boxes = rows * sizeof(photon_bounds);
-    size_t sizes = 2 * rows + parts + 2 * b->n_groups + parts * max_large * PHOTON_MAP_DIGITS;
+    size_t sizes = rows + parts + (b->n_groups + 1) + parts * b->key_stride + (max_keys + 1) +
+                   2 * parts * (PHOTON_MAP_BUCKETS_MAX + 1);
     if (!index)
         return boxes + sizes * sizeof(size_t);
     b->part_box = index;
-    size_t *at = (size_t *)(void *)((char *)index + boxes);
-    b->part_count = at;
-    b->part_next = at + rows;
-    b->first_bad = at + 2 * rows;
-    b->large_of = b->first_bad + parts;
-    b->large_group = b->large_of + b->n_groups;
-    b->digit_next = b->large_group + b->n_groups;
+    b->part_count = (size_t *)(void *)((char *)index + boxes);
+    b->first_bad = b->part_count + rows;
+    b->key_base = b->first_bad + parts;
+    b->key_next = b->key_base + (b->n_groups + 1);
+    b->key_start = b->key_next + parts * b->key_stride;
+    b->part_at = b->key_start + (max_keys + 1);
+    b->part_in = b->part_at + parts * (PHOTON_MAP_BUCKETS_MAX + 1);
     return boxes + sizes * sizeof(size_t);
 }
 
@@ -535,6 +638,10 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
         goto cleanup;
     }
     const size_t n_groups = 2 * n_objects;
+    if (photon_build_max_keys(count, n_groups) > UINT32_MAX) { /* a key is an object_side */
+        st = thz_error_set(err, THZ_ERR_LIMIT, "photon map: %zu photons is too many", count);
+        goto cleanup;
+    }
     int nt = 1;
 #ifdef _OPENMP
     nt = threads > 0 ? threads : omp_get_max_threads();
@@ -576,28 +683,41 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
         ordered = photon_build_in_order(&b, p) && ordered;
     if (ordered)
         goto built;
-    /* The second array (32 bytes per record: the peak is twice the map), kept in the pool
-     * for the next build. */
-    scratch = photon_map_pool_scratch(pool, count);
+#pragma omp parallel for num_threads(b.parts) schedule(static, 1)
+    for (int p = 0; p < b.parts; p++)
+        photon_build_key(&b, p);
+    /* The scratch: 3/8 of the records, or the largest key's if more. */
+    size_t s_count = photon_map_scratch_records(count);
+    for (size_t key = 0; key < b.n_keys; key++) {
+        size_t n = 0;
+        for (int p = 0; p < b.parts; p++)
+            n += b.key_next[(size_t)p * b.key_stride + key];
+        s_count = n > s_count ? n : s_count;
+    }
+    scratch = photon_map_pool_scratch(pool, s_count);
     if (!scratch) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu photons", count);
         goto cleanup;
     }
     b.s = scratch;
-    const size_t n_items = n_groups + b.n_large * PHOTON_MAP_DIGITS;
+    photon_build_buckets(&b, s_count);
 #pragma omp parallel num_threads(b.parts)
     {
 #pragma omp for schedule(static, 1)
         for (int p = 0; p < b.parts; p++)
-            photon_build_group(&b, p);
+            photon_build_partition(&b, p);
+        for (int k = 0; k < b.n_buckets; k++) {
 #pragma omp single
-        photon_build_digit_slots(&b);
+            photon_build_slots(&b, k);
 #pragma omp for schedule(static, 1)
-        for (int p = 0; p < b.parts; p++)
-            photon_build_split(&b, p);
+            for (int p = 0; p < b.parts; p++)
+                photon_build_scatter(&b, k, p);
+#pragma omp single
+            photon_build_compact(&b, k);
 #pragma omp for schedule(dynamic, 1)
-        for (size_t k = 0; k < n_items; k++)
-            photon_build_sort_item(&b, k);
+            for (size_t key = b.bucket_key[k]; key < b.bucket_key[k + 1]; key++)
+                photon_build_sort_key(&b, key);
+        }
     }
 
 built:

@@ -136,7 +136,7 @@ static inline photon_cell photon_child(const photon_cell *cell, unsigned d, cons
     return ch;
 }
 
-/* The index build's second record array (count records): the pool's, grown if need be
+/* The index build's scratch (count records): the pool's, grown if need be
  * and kept there, or without a pool a new one the caller frees. NULL when out of
  * memory. */
 photon_record *photon_map_pool_scratch(photon_map_pool *pool, size_t count);

@@ -96,10 +96,13 @@ thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t held_bytes
             max = b > max ? b : max;
         }
         /* While a map is built: kept maps (the one being built among them) and the
-         * build's scratch (as large), else the map in the pool's spare array (up to a
+         * build's scratch (3/8 as large), else the map in the pool's spare array (up to a
          * quarter larger: phase.c) and the scratch. */
-        need.photon_bytes =
-            rs->opt->keep_photon_maps ? run_add_bytes(sum, max) : run_add_bytes(max, max + max / 4);
+        uint64_t scratch = photon_map_scratch_records(max / sizeof(photon_record)) *
+                           (uint64_t)sizeof(photon_record);
+        need.photon_bytes = rs->opt->keep_photon_maps
+                                ? run_add_bytes(sum, scratch)
+                                : run_add_bytes(run_add_bytes(max, max / 4), scratch);
     }
     need.total_bytes = run_add_bytes(need.photon_bytes, need.image_bytes);
     rs->memory_bytes = need.total_bytes;

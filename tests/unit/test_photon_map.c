@@ -395,6 +395,8 @@ static void test_deterministic_crowded(void **state)
         photon_map *c = NULL;
         assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, &c, NULL), THZ_OK);
         assert_memory_equal(ra, photon_map_records(c), n * sizeof(photon_record));
+        /* 3/8 of the records: no key holds more here (three buckets) */
+        assert_int_equal(pool.scratch_capacity, photon_map_scratch_records(n));
         photon_map_recycle(c, &pool);
     }
     photon_map_pool_fini(&pool);
@@ -440,6 +442,49 @@ static void test_in_order(void **state)
     free(src);
 }
 
+/* A key (a 4096th of a large group's cube) holding 60 % of the records: the scratch grows
+ * to hold it, and the map is the same for 1 and 2 threads, in order (a rebuild from it
+ * takes no scratch) and right for the queries. */
+static void test_crowded_key(void **state)
+{
+    (void)state;
+    const size_t n = 100000, n_objects = 2;
+    photon_record *src = make_photons(n, n_objects, 11);
+    for (size_t i = 0; i < n; i++) {
+        src[i].object_side = i % 10 == 9 ? 2u : 0u; /* 90 % in group 0: large */
+        if (i < 90000 && i % 3 != 2)                /* 60 % on one point */
+            src[i].position_m[0] = src[i].position_m[1] = src[i].position_m[2] = 0.5f;
+    }
+    size_t at_point = 0;
+    for (size_t i = 0; i < n; i++)
+        at_point += src[i].object_side == 0 && src[i].position_m[0] == 0.5f &&
+                    src[i].position_m[1] == 0.5f && src[i].position_m[2] == 0.5f;
+    assert_true(at_point > photon_map_scratch_records(n));
+    photon_map *a = build(src, n, n_objects, 1, 0);
+    photon_map_pool pool = {0};
+    photon_record *p = malloc(n * sizeof *p);
+    assert_non_null(p);
+    memcpy(p, src, n * sizeof *p);
+    photon_map *c = NULL;
+    assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, &c, NULL), THZ_OK);
+    assert_memory_equal(photon_map_records(a), photon_map_records(c), n * sizeof(photon_record));
+    /* the point's key and the few others in its cell, far less than all */
+    assert_in_range(pool.scratch_capacity, at_point, at_point + n / 100);
+    photon_map_destroy(c);
+    photon_map_pool_fini(&pool);
+    pool = (photon_map_pool){0};
+    p = malloc(n * sizeof *p);
+    assert_non_null(p);
+    memcpy(p, photon_map_records(a), n * sizeof *p);
+    assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, &c, NULL), THZ_OK);
+    assert_null(pool.scratch); /* in the map's order already */
+    photon_map_destroy(c);
+    photon_map_pool_fini(&pool);
+    check_queries(a, n, 0);
+    photon_map_destroy(a);
+    free(src);
+}
+
 static void test_empty_and_errors(void **state)
 {
     (void)state;
@@ -474,6 +519,7 @@ int main(void)
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_deterministic_crowded),
         cmocka_unit_test(test_in_order),
+        cmocka_unit_test(test_crowded_key),
         cmocka_unit_test(test_empty_and_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
