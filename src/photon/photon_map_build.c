@@ -16,8 +16,8 @@
  *     slot of each key's range (after the earlier keys' and the earlier parts'); then the
  *     parts' records of the later buckets are moved up against the array's end
  *     (photon_build_compact), which frees the bucket's range of the map;
- *  5. sort: each key's range is sorted from the scratch into the map (photon_build_sort
- *     _range), in cache but for the largest.
+ *  5. sort: each key's range is sorted from the scratch into the map (photon_sort_range in
+ *     photon_map_order.c), in cache but for the largest.
  *
  * Records already in the map's order (a map's own, as a photon-map file keeps them) are
  * found so by pass 1's check (photon_build_in_order) and not moved: no scratch.
@@ -30,9 +30,9 @@
  * miss per record in the passes over the whole array: 62 ns per record on 1 thread and
  * 35-46 on 2 (the paper's case, 5.06 M records, warm memory). A build with a second array
  * as large as the records (grouping and digit passes from one to the other) took 36 and
- * 20 but doubled the peak; this one takes as long (12.1 M records, 2 threads, alternating
- * runs: 0.42-0.49 s against 0.36-0.45 s; 1 thread 0.65-0.75 s against 0.63-0.77 s) and
- * its peak is the map and 3/8 of it. The scratch is larger only where more than 3/8 of
+ * 20 but doubled the peak; this one takes as long (12.1 M records, 2 threads, three
+ * alternating runs: 0.33-0.38 s against 0.33-0.38 s; 1 thread 0.60-0.67 s against
+ * 0.60-0.65 s) and its peak is the map and 3/8 of it. The scratch is larger only where more than 3/8 of
  * the records share a key (a point holding most photons of a large group): a key's records
  * must fit in it. It is kept in the pool between builds.
  */
@@ -45,166 +45,17 @@
 
 #include "core/alloc.h"
 #include "photon/photon_map_layout.h"
+#include "photon/photon_map_order.h"
 
 #ifdef _OPENMP
 #include <omp.h>
 #endif
 
-/* Ranges up to this many records (2 MB) are sorted 64 buckets at a time. */
-#define PHOTON_MAP_CACHED 65536
-/* Ranges up to this many records are sorted by insertion. */
-#define PHOTON_MAP_SORT_SMALL 16
-/* Groups of this many records or more are split by their first digit over the threads
- * (pass 3); smaller ones are sorted by one thread each. */
-#define PHOTON_MAP_LARGE PHOTON_MAP_CACHED
-/* Levels of the first digit of a large group: 4096 ranges, a few thousand records each
- * in the paper's case (a plane's records fill a sixteenth of them). */
-#define PHOTON_MAP_FIRST_LEVELS 4
-#define PHOTON_MAP_DIGITS (1u << (3 * PHOTON_MAP_FIRST_LEVELS))
+/* Groups of this many records or more are keyed by their first digit (PHOTON_MAP_DIGITS
+ * keys, sorted apart, over the threads); smaller ones are one key each. */
+#define PHOTON_MAP_LARGE 65536
 /* Below this many records, one part (not worth waking threads for). */
 #define PHOTON_MAP_PARTS_MIN 65536
-
-/* `levels` levels' digits of a Morton code from `level` on (3 bits each, the first
- * level's highest; levels past the last count as digit 0). */
-static unsigned photon_code_digits(uint64_t code, int level, int levels)
-{
-    int last = level + levels - 1; /* deepest level wanted */
-    int shift = 3 * (PHOTON_MAP_LEVELS - last);
-    uint64_t mask = ((uint64_t)1 << (3 * levels)) - 1;
-    if (shift >= 0)
-        return (unsigned)(code >> shift & mask);
-    return (unsigned)(code << -shift & mask);
-}
-
-/* 7 bits spread to every third bit (bit i to bit 3i), for the table below. */
-#define PHOTON_SPREAD7(i)                                                                          \
-    (((i)&1u) | ((i)&2u) << 2 | ((i)&4u) << 4 | ((i)&8u) << 6 | ((i)&16u) << 8 | ((i)&32u) << 10 | \
-     ((i)&64u) << 12)
-#define PHOTON_SPREAD7_4(i)                                                                        \
-    PHOTON_SPREAD7(i), PHOTON_SPREAD7(i + 1u), PHOTON_SPREAD7(i + 2u), PHOTON_SPREAD7(i + 3u)
-#define PHOTON_SPREAD7_16(i)                                                                       \
-    PHOTON_SPREAD7_4(i), PHOTON_SPREAD7_4(i + 4u), PHOTON_SPREAD7_4(i + 8u),                       \
-        PHOTON_SPREAD7_4(i + 12u)
-
-/* 7 bits spread to every third bit. */
-static const uint32_t photon_spread7[128] = {PHOTON_SPREAD7_16(0u),  PHOTON_SPREAD7_16(16u),
-                                             PHOTON_SPREAD7_16(32u), PHOTON_SPREAD7_16(48u),
-                                             PHOTON_SPREAD7_16(64u), PHOTON_SPREAD7_16(80u),
-                                             PHOTON_SPREAD7_16(96u), PHOTON_SPREAD7_16(112u)};
-
-/* The low 21 bits of v spread to every third bit (bit i to bit 3i), 7 bits at a time from
- * the table: 2/3 of the instructions of the shift-and-mask version, whose codes took 43 %
- * of the build's instructions. */
-static uint64_t photon_spread3(uint32_t v)
-{
-    return (uint64_t)photon_spread7[v & 127u] | (uint64_t)photon_spread7[v >> 7 & 127u] << 21 |
-           (uint64_t)photon_spread7[v >> 14 & 127u] << 42;
-}
-
-/* The full Morton code (3 LEVELS bits; x the highest bit of each level). */
-static uint64_t photon_morton(const photon_cube *c, const photon_record *p)
-{
-    return photon_spread3(photon_quantize_axis(c, p, 0)) << 2 |
-           photon_spread3(photon_quantize_axis(c, p, 1)) << 1 |
-           photon_spread3(photon_quantize_axis(c, p, 2));
-}
-
-/* The first PHOTON_MAP_FIRST_LEVELS levels' digits of the record's Morton code
- * (photon_code_digits(photon_morton(c, p), 1, PHOTON_MAP_FIRST_LEVELS)), from the
- * quantised coordinates' top bits alone. */
-static unsigned photon_first_digit(const photon_cube *c, const photon_record *p)
-{
-    _Static_assert(PHOTON_MAP_FIRST_LEVELS <= 7, "the table spreads 7 bits");
-    const int shift = PHOTON_MAP_LEVELS - PHOTON_MAP_FIRST_LEVELS;
-    return photon_spread7[photon_quantize_axis(c, p, 0) >> shift] << 2 |
-           photon_spread7[photon_quantize_axis(c, p, 1) >> shift] << 1 |
-           photon_spread7[photon_quantize_axis(c, p, 2) >> shift];
-}
-
-/* Swaps records i and j and their codes. */
-static void photon_swap2(photon_record *r, uint64_t *code, size_t i, size_t j)
-{
-    photon_record t = r[i];
-    r[i] = r[j];
-    r[j] = t;
-    uint64_t k = code[i];
-    code[i] = code[j];
-    code[j] = k;
-}
-
-static int photon_compare_bytes(const void *a, const void *b)
-{
-    return memcmp(a, b, sizeof(photon_record));
-}
-
-/* Insertion sort of a small range by (Morton code, bytes). */
-static void photon_sort_small(photon_record *r, uint64_t *code, size_t n)
-{
-    for (size_t i = 1; i < n; i++) {
-        photon_record x = r[i];
-        uint64_t k = code[i];
-        size_t j = i;
-        while (j > 0 &&
-               (code[j - 1] > k || (code[j - 1] == k && memcmp(&r[j - 1], &x, sizeof x) > 0))) {
-            r[j] = r[j - 1];
-            code[j] = code[j - 1];
-            j--;
-        }
-        r[j] = x;
-        code[j] = k;
-    }
-}
-
-/* Sorts r[0..n) (with their Morton codes alongside), whose codes share the digits of
- * levels 1..level-1, by code and then bytes: American flag sort, in place. The build
- * uses it for the records whose codes tie in the 32 bits its radix sort looked at.
- * Ranges larger than the caches go three levels (512 buckets) at a time, since every
- * pass over them costs a cache miss per record; cached ones two levels (64 buckets) at
- * a time. */
-static void photon_sort(photon_record *r, uint64_t *code, size_t n, int level)
-{
-    if (n <= PHOTON_MAP_SORT_SMALL) {
-        photon_sort_small(r, code, n);
-        return;
-    }
-    if (level > PHOTON_MAP_LEVELS) { /* one position: by bytes (the codes are equal) */
-        qsort(r, n, sizeof *r, photon_compare_bytes);
-        return;
-    }
-    const int levels = n <= PHOTON_MAP_CACHED ? 2 : 3;
-    const int nb = 1 << (3 * levels);
-    size_t count[512] = {0}, start[513], next[512];
-    for (size_t i = 0; i < n; i++)
-        count[photon_code_digits(code[i], level, levels)]++;
-    start[0] = 0;
-    for (int b = 0; b < nb; b++)
-        start[b + 1] = start[b] + count[b];
-    for (int b = 0; b < nb; b++)
-        next[b] = start[b];
-    for (int b = 0; b < nb; b++) {
-        while (next[b] < start[b + 1]) {
-            unsigned d = photon_code_digits(code[next[b]], level, levels);
-            if (d == (unsigned)b)
-                next[b]++;
-            else
-                photon_swap2(r, code, next[b], next[d]++);
-        }
-    }
-    for (int b = 0; b < nb; b++) {
-        photon_record *sub = r + start[b];
-        uint64_t *sub_code = code + start[b];
-        size_t m = count[b];
-        if (m == 0)
-            continue;
-        int sub_level = level + levels;
-        if (m >= 8192) {
-#pragma omp task firstprivate(sub, sub_code, m, sub_level)
-            photon_sort(sub, sub_code, m, sub_level);
-        } else {
-            photon_sort(sub, sub_code, m, sub_level);
-        }
-    }
-}
 
 /* A group's bounding box. */
 typedef struct photon_bounds {
@@ -497,66 +348,6 @@ static void photon_build_compact(photon_build *b, int k)
     }
 }
 
-/* Sorts records [lo, hi) of group g, whose codes share levels 1..level-1 (level 1 or
- * 1 + PHOTON_MAP_FIRST_LEVELS), from the scratch (where pass 4 put them) into the map's
- * range. An LSD radix sort, 8 bits a pass, by the next 32 bits of their codes (10 levels
- * and 2 bits), carried in object_side (the group's, restored after), the records going
- * back and forth between the two ranges; then each run of records whose 32 bits tie
- * sorted by full code and bytes (photon_sort; their codes in the scratch's range, free by
- * then). In place, the American flag sort swapped every record along a cycle at every
- * second level, 37 of the build's 66 ns per record (paper's case, 1 thread); this moves it
- * once a pass, at 4 passes. */
-static void photon_build_sort_range(const photon_build *b, size_t g, size_t lo, size_t hi,
-                                    int level)
-{
-    _Static_assert(1 + PHOTON_MAP_FIRST_LEVELS <= 11, "the 32 bits must lie in the code");
-    const size_t n = hi - lo;
-    const int shift = 31 - 3 * (level - 1); /* the code's next 32 bits: [shift, shift + 32) */
-    const photon_cube *cube = &b->cubes[g];
-    photon_record *scratch = b->s + (lo - b->s_base);
-    photon_record *src = scratch, *dst = b->r + lo;
-    size_t count[4][256] = {{0}};
-    for (size_t i = 0; i < n; i++) {
-        uint32_t key = (uint32_t)(photon_morton(cube, &src[i]) >> shift);
-        src[i].object_side = key;
-        for (int d = 0; d < 4; d++)
-            count[d][key >> 8 * d & 255u]++;
-    }
-    for (int d = 0; d < 4; d++) {
-        size_t at = 0, *next = count[d];
-        bool one = false; /* all in one bucket: nothing to move */
-        for (int k = 0; k < 256; k++) {
-            size_t c = next[k];
-            one = one || c == n;
-            next[k] = at;
-            at += c;
-        }
-        if (one)
-            continue;
-        for (size_t i = 0; i < n; i++)
-            dst[next[src[i].object_side >> 8 * d & 255u]++] = src[i];
-        photon_record *t = src;
-        src = dst;
-        dst = t;
-    }
-    photon_record *r = b->r + lo;
-    if (src != r)
-        memcpy(r, src, n * sizeof *r);
-    for (size_t i = 0; i < n;) {
-        uint32_t key = r[i].object_side;
-        size_t j = i;
-        while (j < n && r[j].object_side == key)
-            r[j++].object_side = (uint32_t)g;
-        if (j - i > 1) {
-            uint64_t *code = (uint64_t *)(void *)(scratch + i);
-            for (size_t k = i; k < j; k++)
-                code[k - i] = photon_morton(cube, &r[k]);
-            photon_sort(r + i, code, j - i, level + 10);
-        }
-        i = j;
-    }
-}
-
 /* Pass 5, item `key` of the bucket in the scratch: the key's records sorted into the map
  * (a small group's, or a large group's of one first digit). */
 static void photon_build_sort_key(const photon_build *b, size_t key)
@@ -573,7 +364,8 @@ static void photon_build_sort_key(const photon_build *b, size_t key)
             top = mid;
     }
     bool large = b->key_base[g + 1] - b->key_base[g] > 1;
-    photon_build_sort_range(b, g, lo, hi, large ? 1 + PHOTON_MAP_FIRST_LEVELS : 1);
+    photon_sort_range(&b->cubes[g], b->s + (lo - b->s_base), b->r + lo, hi - lo,
+                      large ? 1 + PHOTON_MAP_FIRST_LEVELS : 1, (uint32_t)g);
 }
 
 /* ---- The build -------------------------------------------------------------------------- */
@@ -687,13 +479,21 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
     for (int p = 0; p < b.parts; p++)
         photon_build_key(&b, p);
     /* The scratch: 3/8 of the records, or the largest key's if more. */
-    size_t s_count = photon_map_scratch_records(count);
+    size_t largest = 0;
     for (size_t key = 0; key < b.n_keys; key++) {
         size_t n = 0;
         for (int p = 0; p < b.parts; p++)
             n += b.key_next[(size_t)p * b.key_stride + key];
-        s_count = n > s_count ? n : s_count;
+        largest = n > largest ? n : largest;
     }
+    if (largest > UINT32_MAX) { /* the sort's pairs index a key's records in 32 bits */
+        st = thz_error_set(err, THZ_ERR_LIMIT,
+                           "photon map: %zu photons in one 4096th of an object's cube is too many",
+                           largest);
+        goto cleanup;
+    }
+    size_t s_count = photon_map_scratch_records(count);
+    s_count = largest > s_count ? largest : s_count;
     scratch = photon_map_pool_scratch(pool, s_count);
     if (!scratch) {
         st = thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for %zu photons", count);
