@@ -32,9 +32,9 @@
  * as large as the records (grouping and digit passes from one to the other) took 36 and
  * 20 but doubled the peak; this one takes as long (12.1 M records, 2 threads, three
  * alternating runs: 0.33-0.38 s against 0.33-0.38 s; 1 thread 0.60-0.67 s against
- * 0.60-0.65 s) and its peak is the map and 3/8 of it. The scratch is larger only where more than 3/8 of
- * the records share a key (a point holding most photons of a large group): a key's records
- * must fit in it. It is kept in the pool between builds.
+ * 0.60-0.65 s) and its peak is the map and 3/8 of it. The scratch is larger only where
+ * more than 3/8 of the records share a key (a point holding most photons of a large
+ * group): a key's records must fit in it. It is kept in the pool between builds.
  */
 #include "photon/photon_map.h"
 
