@@ -119,6 +119,16 @@ static void photon_part_range(const photon_build *b, int p, size_t *lo, size_t *
     *hi = p == b->parts - 1 ? b->count : step * (size_t)(p + 1);
 }
 
+/* Part p's rows of part_at and part_in. */
+static size_t *photon_part_at(const photon_build *b, int p)
+{
+    return b->part_at + (size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1);
+}
+static size_t *photon_part_in(const photon_build *b, int p)
+{
+    return b->part_in + (size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1);
+}
+
 /* Pass 1 for part p: counts and bounding boxes of its records' groups; stops at the
  * first record naming no group. Read only. */
 static void photon_build_scan(photon_build *b, int p)
@@ -230,20 +240,32 @@ static void photon_build_key(photon_build *b, int p)
     }
 }
 
-/* After pass 2: the keys' map positions, the buckets (consecutive keys, as many as fit in
- * the scratch of s_count records: s_count is at least the largest key's) and each part's
- * records of each bucket (where pass 3 puts them). */
-static void photon_build_buckets(photon_build *b, size_t s_count)
+/* After pass 2: the keys' map positions (the parts' counts summed); returns the largest
+ * key's records. */
+static size_t photon_build_key_starts(photon_build *b)
 {
+    size_t largest = 0;
     b->key_start[0] = 0;
-    b->n_buckets = 0;
-    b->bucket_key[0] = 0;
-    size_t in_bucket = 0;
     for (size_t key = 0; key < b->n_keys; key++) {
         size_t n = 0;
         for (int p = 0; p < b->parts; p++)
             n += b->key_next[(size_t)p * b->key_stride + key];
         b->key_start[key + 1] = b->key_start[key] + n;
+        largest = n > largest ? n : largest;
+    }
+    return largest;
+}
+
+/* Then the buckets (consecutive keys, as many as fit in the scratch of s_count records:
+ * s_count is at least the largest key's) and each part's records of each bucket (where
+ * pass 3 puts them). */
+static void photon_build_buckets(photon_build *b, size_t s_count)
+{
+    b->n_buckets = 0;
+    b->bucket_key[0] = 0;
+    size_t in_bucket = 0;
+    for (size_t key = 0; key < b->n_keys; key++) {
+        size_t n = b->key_start[key + 1] - b->key_start[key];
         if (in_bucket + n > s_count) {
             b->bucket_key[++b->n_buckets] = key;
             in_bucket = 0;
@@ -254,8 +276,7 @@ static void photon_build_buckets(photon_build *b, size_t s_count)
     for (int p = 0; p < b->parts; p++) {
         size_t lo, hi;
         photon_part_range(b, p, &lo, &hi);
-        size_t *at = b->part_at + (size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1);
-        size_t *in = b->part_in + (size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1);
+        size_t *at = photon_part_at(b, p), *in = photon_part_in(b, p);
         const size_t *cnt = b->key_next + (size_t)p * b->key_stride;
         for (int k = 0; k < b->n_buckets; k++) {
             at[k] = lo;
@@ -284,7 +305,7 @@ static void photon_build_partition(photon_build *b, int p)
 {
     if (b->n_buckets == 1)
         return;
-    const size_t *at = b->part_at + (size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1);
+    const size_t *at = photon_part_at(b, p);
     size_t next[PHOTON_MAP_BUCKETS_MAX];
     for (int k = 0; k < b->n_buckets; k++)
         next[k] = at[k];
@@ -323,8 +344,7 @@ static void photon_build_slots(photon_build *b, int k)
 static void photon_build_scatter(photon_build *b, int k, int p)
 {
     size_t *slot = b->key_next + (size_t)p * b->key_stride;
-    size_t at = b->part_at[(size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1) + (size_t)k];
-    size_t in = b->part_in[(size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1) + (size_t)k];
+    size_t at = photon_part_at(b, p)[k], in = photon_part_in(b, p)[k];
     for (size_t i = at; i < at + in; i++)
         b->s[slot[b->r[i].object_side]++] = b->r[i];
 }
@@ -336,9 +356,9 @@ static void photon_build_compact(photon_build *b, int k)
 {
     size_t shift = 0;
     for (int p = b->parts - 2; p >= 0; p--) {
-        size_t *at = b->part_at + (size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1);
-        shift += b->part_in[(size_t)(p + 1) * (PHOTON_MAP_BUCKETS_MAX + 1) + (size_t)k];
-        size_t from = at[k] + b->part_in[(size_t)p * (PHOTON_MAP_BUCKETS_MAX + 1) + (size_t)k];
+        size_t *at = photon_part_at(b, p);
+        shift += photon_part_in(b, p + 1)[k];
+        size_t from = at[k] + photon_part_in(b, p)[k];
         size_t to = at[b->n_buckets];
         if (shift == 0)
             continue;
@@ -479,13 +499,7 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
     for (int p = 0; p < b.parts; p++)
         photon_build_key(&b, p);
     /* The scratch: 3/8 of the records, or the largest key's if more. */
-    size_t largest = 0;
-    for (size_t key = 0; key < b.n_keys; key++) {
-        size_t n = 0;
-        for (int p = 0; p < b.parts; p++)
-            n += b.key_next[(size_t)p * b.key_stride + key];
-        largest = n > largest ? n : largest;
-    }
+    size_t largest = photon_build_key_starts(&b);
     if (largest > UINT32_MAX) { /* the sort's pairs index a key's records in 32 bits */
         st = thz_error_set(err, THZ_ERR_LIMIT,
                            "photon map: %zu photons in one 4096th of an object's cube is too many",
