@@ -5,7 +5,7 @@
 #  - a noise target below the map's own noise (0.001 K) stops after 2 passes, exit 0,
 #    with one warning that gives the floor F in K and the photons; F is above the target
 #    and at most the run's reported 95th percentile (the floor is a part of it);
-#  - a target of 1.4 F, which more gather rays do reach, runs past 2 passes to it, without
+#  - a target of 1.2 F, which more gather rays do reach, runs past 2 passes to it, without
 #    that warning;
 #  - render from the saved map stops the same way and names the map's photons;
 #  - path, which has no map, never stops there (it runs to --max-seconds).
@@ -64,9 +64,9 @@ PY
 ) || fail "simulate with a target below the floor: $floor"
 
 if [ -n "$floor" ] && [[ $floor =~ ^[0-9.e+-]+$ ]]; then
-    target=$(python3 -c "print(1.4 * $floor)")
+    target=$(python3 -c "print(1.2 * $floor)")
     run high simulate "$S" -o "$work/high" --target-noise-k "$target"
-    python3 - "$work/high/summary.json" "$target" <<'PY' || fail "simulate with a target of 1.4 x the floor"
+    python3 - "$work/high/summary.json" "$target" <<'PY' || fail "simulate with a target of 1.2 x the floor"
 import json, sys
 s, t = json.load(open(sys.argv[1])), float(sys.argv[2])
 c = s["channels"][0]
