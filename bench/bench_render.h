@@ -87,11 +87,16 @@ typedef struct bench_converge {
     bool confirmed;
     size_t confirm_channel;
     bench_converge_point confirm;
+    /* refined: the first run at the target missed it and `confirm` is a second run, with
+     * the J the fit through pt[1] and that first run (first_confirm) asked for */
+    bool refined;
+    bench_converge_point first_confirm;
 } bench_converge;
 
 /* estimates[0] < estimates[1] (each >= 2); photons for final-gather (0: the scene's);
  * sensor_columns as in bench_speedup_config. With max_confirm > 0, the third run (the
- * worst channel by bench_converge_seconds to target_k, at most max_confirm estimates). */
+ * worst channel by bench_converge_seconds to target_k, at most max_confirm estimates),
+ * and a fourth where the third misses the target (bench_converge.refined). */
 thz_status bench_measure_converge(const char *scene_path, const char *integrator, uint64_t photons,
                                   const uint32_t estimates[2], uint32_t sensor_columns, int threads,
                                   double target_k, uint32_t max_confirm, bench_converge *out,

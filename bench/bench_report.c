@@ -214,6 +214,11 @@ json_t *bench_report_converge(const char *integrator, const bench_converge *cv, 
             double s = bench_converge_seconds(cv, c, target_k);
             *worst_s = c != w && s > *worst_s ? s : *worst_s;
         }
+        if (cv->refined)
+            printf("  run at the target: %5.3f THz alone with J=%u: RMS %.4f K, above the target; "
+                   "the fit through the J=%u run and this one asked for J=%u, run next\n",
+                   cv->freq_thz[w], (unsigned)cv->first_confirm.estimates,
+                   cv->first_confirm.rms_k[w], (unsigned)b->estimates, (unsigned)p->estimates);
         printf("  run at the target: %5.3f THz alone with J=%u: RMS %.4f K, photon phase %.3f s, "
                "render %.3f s; to %g K %.3f s (its render time, x (RMS / %g K)^2 = %.3f if that "
                "is above 1, plus its photon phase), %.2f x the limit\n",
@@ -259,6 +264,10 @@ json_t *bench_report_converge(const char *integrator, const bench_converge *cv, 
         json_object_set_new(jconf, "seconds_photons", bench_real(cv->confirm.s_photons[w]));
         json_object_set_new(jconf, "seconds_render", bench_real(cv->confirm.s_render[w]));
         json_object_set_new(jconf, "seconds_to_target", bench_real(confirmed));
+        json_object_set_new(jconf, "first_estimates_per_pass",
+                            cv->refined ? json_integer(cv->first_confirm.estimates) : json_null());
+        json_object_set_new(jconf, "first_rms_stderr_k",
+                            cv->refined ? bench_real(cv->first_confirm.rms_k[w]) : json_null());
         double a_k2, floor2, need;
         if (bench_converge_floor(cv, target_k, &a_k2, &floor2, &need)) {
             json_object_set_new(jconf, "floor_k", bench_real(copysign(sqrt(fabs(floor2)), floor2)));

@@ -114,6 +114,9 @@ for name in ["path", "final-gather"]:
     expect = c["runs"][1]["rms_stderr_k"][w] * (j1 / j2) ** 0.5
     assert expect / 1.5 < t["rms_stderr_k"] < expect * 1.5, (name, t["rms_stderr_k"], expect)
     assert c["worst_seconds_to_target"] >= t["seconds_to_target"], c
+    # a first run at the target that missed it is reported beside the second (null: none)
+    first = t["first_estimates_per_pass"]
+    assert first is None or (first < j2 and t["first_rms_stderr_k"] > c["target_k"]), t
 
 # Every target with a finite value, its limit and a verdict; none left unmeasured.
 assert "targets_not_measured" not in r
