@@ -324,13 +324,13 @@ static thz_status bench_converge_confirm(thz_context *ctx, thz_scene *s, const c
     j = j < 2 ? 2 : j;
     thz_status st =
         bench_converge_confirm_at(ctx, s, integrator, photons, enclosure, w, j, out, err);
-    double a_k2, floor2;
+    double a_k2, floor2, fit_j;
     if (st == THZ_OK && out->confirm.rms_k[w] > target_k &&
-        bench_converge_floor(out, target_k, &a_k2, &floor2, &need) && need > (double)j &&
-        need <= (double)max_confirm) {
+        bench_converge_floor(out, target_k, &a_k2, &floor2, &fit_j) && fit_j > (double)j &&
+        fit_j <= (double)max_confirm) {
         out->first_confirm = out->confirm;
         out->refined = true;
-        st = bench_converge_confirm_at(ctx, s, integrator, photons, enclosure, w, (uint32_t)need,
+        st = bench_converge_confirm_at(ctx, s, integrator, photons, enclosure, w, (uint32_t)fit_j,
                                        out, err);
     }
     return st;

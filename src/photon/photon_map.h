@@ -86,9 +86,9 @@ photon_record *photon_map_pool_take(photon_map_pool *pool, size_t *capacity);
  * (pool NULL: photon_map_destroy). */
 void photon_map_recycle(photon_map *map, photon_map_pool *pool);
 
-/* The records of the index build's scratch for a map of count records: 3/8 of them
- * (rounded up), more only where more than that share one 4096th of a large group's cube
- * (photon_map_build.c). */
+/* The records of the index build's scratch for a map of count records: at least 3/8 of
+ * them (count / 8 x 3 + count % 8), more only where more than that share one 4096th of a
+ * large group's cube (photon_map_build.c). */
 static inline size_t photon_map_scratch_records(size_t count)
 {
     return count / 8 * 3 + count % 8;
