@@ -51,6 +51,24 @@ vec3 sampling_cosine32(vec3 n, rng_stream *rng)
     return sampling_direction_inline(n, mu, azimuth);
 }
 
+sampling_stratum sampling_stratum_of(rng_stream *set, uint32_t count, uint32_t which)
+{
+    uint32_t place[SAMPLING_STRATA_MAX];
+    for (uint32_t k = 0; k < count; k++)
+        place[k] = k;
+    double phi0 = rng_uniform(set);
+    for (uint32_t k = count; k-- > 1;) { /* Fisher-Yates */
+        uint32_t r = (uint32_t)(rng_uniform(set) * (double)(k + 1));
+        uint32_t t = place[k];
+        place[k] = place[r];
+        place[r] = t;
+    }
+    double azimuth = phi0 + (double)which / (double)count;
+    return (sampling_stratum){.polar_lo = (double)place[which] / (double)count,
+                              .polar_width = 1.0 / (double)count,
+                              .azimuth = azimuth < 1.0 ? azimuth : azimuth - 1.0};
+}
+
 void sampling_direction_many(const vec3 *n, const double *mu, const double *u, size_t count,
                              vec3 *out)
 {

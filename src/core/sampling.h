@@ -5,6 +5,7 @@
 #define THZ_CORE_SAMPLING_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "core/vec3.h"
 
@@ -15,6 +16,21 @@ struct rng_stream;
  * of rng: the azimuth's word first, then the polar angle's (mu = sqrt(1 - u)). The order
  * is fixed here, not left to the order a compiler evaluates a call's arguments in. */
 vec3 sampling_cosine32(vec3 n, struct rng_stream *rng);
+/* A set of at most SAMPLING_STRATA_MAX directions stratified together (final-gather's
+ * gather rays of a pixel's samples): member `which` of a set of `count` draws its polar
+ * uniform in [lo, lo + width) = [p, p + 1) / count, p its place in a random permutation of
+ * 0..count-1, and takes the azimuth uniform (phi0 + which / count) mod 1, phi0 shared.
+ * Alone, every member is uniform on [0, 1)^2, so the law it samples is unchanged; together
+ * the members meet each polar band once and are spread evenly in azimuth. */
+#define SAMPLING_STRATA_MAX 16u
+typedef struct sampling_stratum {
+    double polar_lo, polar_width; /* the polar uniform is polar_lo + polar_width u */
+    double azimuth;               /* the azimuth uniform itself */
+} sampling_stratum;
+/* Member which < count <= SAMPLING_STRATA_MAX of the set drawn from `set` (every member
+ * draws the same count words from a stream started the same way). */
+sampling_stratum sampling_stratum_of(struct rng_stream *set, uint32_t count, uint32_t which);
+
 /* sampling_direction for count photons at once: the same directions, in a loop the
  * compiler vectorises. */
 void sampling_direction_many(const vec3 *n, const double *mu, const double *u, size_t count,

@@ -1,8 +1,10 @@
 /* Sampling helpers: sampling_direction's azimuth (its libm-free cos and sin of 2 pi u)
  * against libm, its polar angle, and unit length; sampling_direction_many's directions
- * against sampling_direction's; sampling_cosine32's order of draws. */
+ * against sampling_direction's; sampling_cosine32's order of draws; the strata of
+ * sampling_stratum_of. */
 #include <math.h>
 #include <setjmp.h>
+#include <stdbool.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -113,6 +115,57 @@ static void test_cosine32_order(void **state)
     }
 }
 
+/* sampling_stratum_of: the members of a set meet each polar band once, with azimuths
+ * 1/count apart; and every member alone is uniform on [0, 1)^2 (its polar band and an
+ * azimuth bin independent), by a chi-square over 40 000 sets whose limit, dof + 6
+ * sqrt(2 dof), a correct sampler exceeds with probability below 1e-6 and a permutation
+ * drawn with r = u k (the classic off-by-one: the last member never keeps its place)
+ * exceeds by far. */
+static void test_strata(void **state)
+{
+    (void)state;
+    const uint32_t counts[] = {2, 4, 9, 16};
+    enum { SETS = 40000, AZIMUTH_BINS = 8 };
+    for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++) {
+        uint32_t count = counts[c];
+        static unsigned hist[2][SAMPLING_STRATA_MAX][AZIMUTH_BINS];
+        memset(hist, 0, sizeof hist);
+        for (uint64_t set = 0; set < SETS; set++) {
+            bool seen[SAMPLING_STRATA_MAX] = {false};
+            double azimuth0 = 0.0;
+            for (uint32_t m = 0; m < count; m++) {
+                rng_stream rng;
+                rng_init(&rng, 5, 1, RNG_PURPOSE_GATHER_STRATA, set);
+                sampling_stratum st = sampling_stratum_of(&rng, count, m);
+                assert_true(st.polar_width == 1.0 / count);
+                uint32_t band = (uint32_t)lround(st.polar_lo * count);
+                assert_true(band < count && fabs(st.polar_lo - (double)band / count) < 1e-15);
+                assert_false(seen[band]);
+                seen[band] = true;
+                assert_true(st.azimuth >= 0.0 && st.azimuth < 1.0);
+                if (m == 0)
+                    azimuth0 = st.azimuth;
+                double step = st.azimuth - azimuth0 - (double)m / count;
+                assert_true(fabs(step - round(step)) < 1e-14);
+                if (m == 0 || m == count - 1)
+                    hist[m ? 1 : 0][band][(int)(st.azimuth * AZIMUTH_BINS)]++;
+            }
+        }
+        for (int which = 0; which < 2; which++) {
+            double expect = (double)SETS / (count * AZIMUTH_BINS), chi2 = 0.0;
+            for (uint32_t b = 0; b < count; b++)
+                for (int a = 0; a < AZIMUTH_BINS; a++) {
+                    double d = hist[which][b][a] - expect;
+                    chi2 += d * d / expect;
+                }
+            double dof = count * AZIMUTH_BINS - 1.0;
+            if (!(chi2 < dof + 6.0 * sqrt(2.0 * dof)))
+                fail_msg("count %u, member %s: chi-square %.1f for %.0f degrees of freedom", count,
+                         which ? "last" : "first", chi2, dof);
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -120,6 +173,7 @@ int main(void)
         cmocka_unit_test(test_polar_angle_and_length),
         cmocka_unit_test(test_many),
         cmocka_unit_test(test_cosine32_order),
+        cmocka_unit_test(test_strata),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
