@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "accel/accel.h"
+#include "core/sampling.h"
 #include "photon/photon_map.h"
 #include "sensor/render_terms.h"
 
@@ -46,6 +47,14 @@ static inline void render_add_all(const render_target *t, double v)
     for (uint32_t j = 0; j < t->n_est; j++)
         t->est[j] += t->weight * v;
 }
+
+/* The stratum of estimate j's first scattered direction (final-gather's gather ray, path's
+ * first bounce) at the vertex after `crossings` straight shells: the j-th ones of a pixel's
+ * samples, in sets of up to SAMPLING_STRATA_MAX, are stratified together, from the set's
+ * own stream (RNG_PURPOSE_GATHER_STRATA; a fresh set for every j, so that the estimates
+ * stay independent). False where the sample's set has one member. */
+bool render_stratum(const render_context *ctx, const render_target *t, uint32_t j,
+                    uint32_t crossings, sampling_stratum *out);
 
 typedef struct render_integrator {
     thz_integrator id; /* its name: scene_integrator_names[id] */

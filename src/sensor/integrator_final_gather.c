@@ -11,9 +11,9 @@
  * cover, the room around it) was most of the noise of the paper's covers. From a deviation
  * map the terms are those of L - B(T0) and the sample adds B(T0). One estimate per gather
  * ray: more passes lower the noise. The j-th gather rays of a pixel's samples are
- * stratified together (sampling_stratum_of): their cosine directions meet each polar band
+ * stratified together (render_stratum): their cosine directions meet each polar band
  * once and spread evenly in azimuth, which took the paper's scene's variance per gather ray
- * at 0.2 THz to 0.74 x (docs/integrators.md); estimate j stays independent of the others.
+ * at 0.2 THz to 0.71 x (docs/integrators.md); estimate j stays independent of the others.
  */
 #include <math.h>
 
@@ -154,25 +154,12 @@ static void render_final_gather_trace(const render_context *ctx, vec3 origin_m, 
              * draws first, then its transmitted part); crossings of straight shells shift
              * them so that each vertex has its own */
             bool split = shell && !straight;
-            /* the strata: sets of up to SAMPLING_STRATA_MAX of the pixel's samples */
-            uint32_t set = t->stratum / SAMPLING_STRATA_MAX;
-            uint32_t members = t->n_strata - set * SAMPLING_STRATA_MAX;
-            if (members > SAMPLING_STRATA_MAX)
-                members = SAMPLING_STRATA_MAX;
             for (uint32_t j = 0; j < t->n_est; j++) {
                 rng_stream rng;
                 rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_GATHER,
                          (t->rng_index + j) * (RENDER_MAX_CROSSINGS + 1) + path.n);
                 sampling_stratum stratum;
-                if (members > 1) {
-                    rng_stream strata;
-                    rng_init(&strata, ctx->seed, ctx->channel_index, RNG_PURPOSE_GATHER_STRATA,
-                             (t->pixel_rng_index + (uint64_t)set * t->n_est + j) *
-                                     (RENDER_MAX_CROSSINGS + 1) +
-                                 path.n);
-                    stratum =
-                        sampling_stratum_of(&strata, members, t->stratum % SAMPLING_STRATA_MAX);
-                }
+                bool stratified = render_stratum(ctx, t, j, path.n, &stratum);
                 for (int k = 0; k < (split ? 2 : 1); k++) {
                     render_gather_part part = !split   ? RENDER_GATHER_DRAWN
                                               : k == 0 ? RENDER_GATHER_REFLECTED
@@ -180,8 +167,8 @@ static void render_final_gather_trace(const render_context *ctx, vec3 origin_m, 
                     render_sample sec = {.variance = 0.0};
                     t->est[j] +=
                         t->weight * render_gather_ray(ctx, &hit, dir, obj, split, &path, distance_m,
-                                                      part, &rng, members > 1 ? &stratum : NULL,
-                                                      out, &sec);
+                                                      part, &rng, stratified ? &stratum : NULL, out,
+                                                      &sec);
                     if (t->batch) {
                         for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
                             t->batch[b] += t->weight * sec.batch[b];

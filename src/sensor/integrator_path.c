@@ -20,7 +20,9 @@
  * the first free path and the first hit are known functions of nu there, so they enter
  * by their band mean (the channel quadrature, as photon-map's emission), not at the
  * path's nu; and the path splits there (a reflected branch weighted R, a transmitted one
- * weighted T(theta)) instead of playing roulette.
+ * weighted T(theta)) instead of playing roulette, its branches' directions stratified with
+ * those of the same estimate of the pixel's other samples (render_stratum: variance x 0.89
+ * on the paper's scene at 0.2 THz, docs/integrators.md).
  *
  * In an isothermal enclosure at T0 every bracket is exactly 0, so every path returns
  * Bbar0: N_c = 1 to rounding. T0 is the temperature of the object with the largest
@@ -50,16 +52,25 @@
 /* A scattered direction at `hit` (arriving along *dir; unit normal n_seen towards the
  * side the ray came from): by the material's lobe on that side (reflection: cosine for
  * a constant-R diffuse surface, else brdf_sample, whose weight multiplies *beta), or
- * leaving the other side with mu ~ T(mu) mu (diffuse transmission). False if nothing
- * can be sampled (T = 0 cannot happen after a transmission event; a glossy sample may
- * fall below the surface). */
+ * leaving the other side with mu ~ T(mu) mu (diffuse transmission). With a stratum (or
+ * NULL), a cosine direction takes its polar band and azimuth from it, a transmitted one
+ * its azimuth; the stream's words are drawn all the same. False if nothing can be sampled
+ * (T = 0 cannot happen after a transmission event; a glossy sample may fall below the
+ * surface). */
 static bool render_scatter_dir(const thz_scene *scene, const thz_object *obj, const accel_hit *hit,
                                const optics_point *o, vec3 n_seen, bool transmitted,
-                               rng_stream *rng, vec3 *dir, double *beta)
+                               const sampling_stratum *stratum, rng_stream *rng, vec3 *dir,
+                               double *beta)
 {
     if (!transmitted) {
         if (o->lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(o)) {
-            *dir = sampling_cosine32(n_seen, rng);
+            if (!stratum) {
+                *dir = sampling_cosine32(n_seen, rng);
+                return true;
+            }
+            (void)rng_uniform32(rng); /* the azimuth's word (sampling_cosine32's order) */
+            double u_polar = stratum->polar_lo + stratum->polar_width * rng_uniform32(rng);
+            *dir = sampling_direction(n_seen, sqrt(1.0 - u_polar), stratum->azimuth);
             return true;
         }
         brdf_frame f = scene_triangle_frame(obj, hit->triangle, hit->side);
@@ -74,7 +85,8 @@ static bool render_scatter_dir(const thz_scene *scene, const thz_object *obj, co
     double m;
     if (!optics_sample_transmission_mu(o, sampling_uniform32, rng, &m))
         return false;
-    *dir = sampling_direction(v3_scale(n_seen, -1.0), m, rng_uniform32(rng));
+    double u_azimuth = rng_uniform32(rng);
+    *dir = sampling_direction(v3_scale(n_seen, -1.0), m, stratum ? stratum->azimuth : u_azimuth);
     return true;
 }
 
@@ -151,7 +163,7 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
         const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
         vec3 n = v3_from_floats(nf);
         vec3 n_seen = hit.side == 0 ? n : v3_scale(n, -1.0);
-        if (!render_scatter_dir(scene, obj, &hit, &o, n_seen, transmitted, rng, &dir, &beta))
+        if (!render_scatter_dir(scene, obj, &hit, &o, n_seen, transmitted, NULL, rng, &dir, &beta))
             break;
     }
     return sum;
@@ -164,9 +176,11 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
  * shells, a transmitted branch weighted T(theta), each continued by roulette. (Every path
  * of a sample shares the first hit; roulette there would add the variance of choosing
  * between what the reflection and the transmission see, the main noise of a wall that
- * reflects a warmer object.) */
+ * reflects a warmer object.) The branches' directions come from `stratum` where it is
+ * not NULL (render_stratum). */
 static double render_path_trace(const render_context *ctx, const accel_hit *first, vec3 dir0,
-                                double nu, rng_stream *rng, render_sample *out)
+                                double nu, const sampling_stratum *stratum, rng_stream *rng,
+                                render_sample *out)
 {
     const thz_scene *scene = ctx->scene;
     double b0 = planck_radiance(nu, ctx->t0_k);
@@ -186,12 +200,14 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
     double sum = 0.0;
     vec3 dir = dir0;
     double beta_r = beta;
-    if (r > 0.0 && render_scatter_dir(scene, obj, first, &o, n_seen, false, rng, &dir, &beta_r))
+    if (r > 0.0 &&
+        render_scatter_dir(scene, obj, first, &o, n_seen, false, stratum, rng, &dir, &beta_r))
         sum += r * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta_r, rng, out);
     if (tr > 0.0) {
         bool straight = scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
         dir = dir0;
-        if (straight || render_scatter_dir(scene, obj, first, &o, n_seen, true, rng, &dir, &beta))
+        if (straight ||
+            render_scatter_dir(scene, obj, first, &o, n_seen, true, stratum, rng, &dir, &beta))
             sum += tr * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta, rng, out);
     }
     out->paths++;
@@ -256,8 +272,12 @@ void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir, doub
             u1[k] = rng_uniform32(&rng[k]);
         }
         channel_sample_many_hz(ctx->channel, u1, u2, n, nu);
-        for (size_t k = 0; k < n; k++)
+        for (size_t k = 0; k < n; k++) {
+            sampling_stratum stratum;
+            bool stratified = render_stratum(ctx, t, (uint32_t)(j0 + k), 0, &stratum);
             t->est[j0 + k] +=
-                t->weight * (fixed + render_path_trace(ctx, &first, dir, nu[k], &rng[k], out));
+                t->weight * (fixed + render_path_trace(ctx, &first, dir, nu[k],
+                                                       stratified ? &stratum : NULL, &rng[k], out));
+        }
     }
 }

@@ -7,7 +7,8 @@
  *     pixel away from object borders, within
  *     IDENT_Z combined standard errors plus a bias allowance (the density estimates'
  *     edge and disk bias, measured and printed), and their mean deviation over the
- *     picture stays within that allowance;
+ *     picture stays within that allowance; with 2 x 2 samples per pixel, whose first
+ *     scattered directions are stratified together, final-gather and path itself;
  *   honesty: over M runs with different seeds, the observed spread of each pixel
  *     matches its reported standard error: pooled over the pixels, the ratio of the
  *     observed variance to the mean reported variance is within 20 % of 1. With M runs
@@ -61,29 +62,38 @@ static void xval_scene(char *json, size_t size, uint32_t res, uint32_t oversampl
     snprintf(json, size, XVAL_JSON, res, res, oversampling, alpha_per_m, (unsigned long long)seed);
 }
 
-/* With n x n samples per pixel (n > 1: final-gather alone, whose j-th gather rays of a
- * pixel's samples are stratified together) the estimates per sample are divided by n^2, so
- * that a pixel gets as many as with n = 1. */
+/* The others against the reference, `path` with one sample per pixel. With n x n samples
+ * per pixel (n > 1), whose first scattered directions are stratified together
+ * (render_stratum), the others are final-gather and path itself, with the estimates per
+ * sample divided by n^2 so that a pixel gets as many as with n = 1: interior pixels' mean
+ * over their samples differs from their centre's value at second order only. */
 static void cross_validation(double alpha_per_m, uint32_t oversampling)
 {
-    char json[8192];
-    xval_scene(json, sizeof json, 20, oversampling, alpha_per_m, 21);
-    print_message("atmosphere: %g 1/m, %u x %u samples per pixel\n", alpha_per_m, oversampling,
-                  oversampling);
+    char json[8192], json_n[8192];
+    xval_scene(json, sizeof json, 20, 1, alpha_per_m, 21);
+    xval_scene(json_n, sizeof json_n, 20, oversampling, alpha_per_m, 21);
+    print_message("atmosphere: %g 1/m, the others with %u x %u samples per pixel\n", alpha_per_m,
+                  oversampling, oversampling);
     double per_pixel = (double)(oversampling * oversampling);
     ident_run ref;
-    ident_run_scene_with(&ref, json, 0, INTEGRATOR_PATH, ident_estimates(1024 / per_pixel));
+    ident_run_scene_with(&ref, json, 0, INTEGRATOR_PATH, ident_estimates(1024));
     size_t px = (size_t)ref.img.columns * ref.img.rows;
-    const thz_integrator others[] = {INTEGRATOR_PHOTON_MAP, INTEGRATOR_FINAL_GATHER};
+    const bool strata = oversampling > 1;
+    const thz_integrator others[] = {strata ? INTEGRATOR_PATH : INTEGRATOR_PHOTON_MAP,
+                                     INTEGRATOR_FINAL_GATHER};
     /* bias allowances, relative to L: the density estimates' edge and disk bias in this
      * scene (photon-map: footprint disks, widened where photons are sparse; final-gather:
      * the 64-photon disks of its secondary hits, over its deviation map: only the
-     * deviation from B(T0) is blurred) */
-    const double allowance[] = {0.01, 0.005};
-    for (size_t k = oversampling > 1 ? 1 : 0; k < 2; k++) {
+     * deviation from B(T0) is blurred); path against path none per pixel, and for the mean
+     * over the interior 0.02 %, about 10 of its standard errors (a polar band's uniform
+     * halved in path's strata fails by a pixel at z = -6.2, the azimuth's halved by far) */
+    const double allowance[] = {strata ? 0.0 : 0.01, 0.005};
+    const double mean_allowance[] = {strata ? 0.0002 : 0.01, 0.005};
+    for (size_t k = 0; k < 2; k++) {
         ident_run r;
-        ident_run_scene_with(&r, json, ident_photons(300000), others[k],
-                             ident_estimates(64 / per_pixel));
+        ident_run_scene_with(
+            &r, strata ? json_n : json, ident_photons(300000), others[k],
+            ident_estimates((others[k] == INTEGRATOR_PATH ? 1024 : 64) / per_pixel));
         size_t n = 0, failed = 0;
         double sum_rel = 0.0, worst_z = 0.0, sum_se_ref = 0.0;
         for (uint32_t row = 0; row < r.img.rows; row++)
@@ -116,7 +126,7 @@ static void cross_validation(double alpha_per_m, uint32_t oversampling)
                       100.0 * sum_se_ref / (double)n);
         assert_true(n > px / 3);
         assert_int_equal(failed, 0);
-        assert_true(fabs(mean_rel) <= allowance[k]);
+        assert_true(fabs(mean_rel) <= mean_allowance[k]);
         ident_run_fini(&r);
     }
     /* the reference is tight: its standard errors are far below the allowances */
@@ -144,7 +154,7 @@ static void test_cross_validation(void **state)
     cross_validation(0.0, 1);
     /* an attenuating atmosphere (e^-0.6 across the room): path's (tau - 1) B0 terms */
     cross_validation(0.3, 1);
-    /* final-gather's strata across a pixel's 2 x 2 samples keep it unbiased */
+    /* the strata across a pixel's 2 x 2 samples keep final-gather and path unbiased */
     cross_validation(0.0, 2);
 }
 
@@ -277,11 +287,12 @@ static void test_final_gather_one_map(void **state)
     assert_true(r >= 0.6 && r <= 1.2);
 }
 
-/* The strata of a pixel's samples' j-th gather rays: estimate j stays independent of the
- * others, so the spread between estimates still gives the error. One map and without its
- * term (batches withheld), the reported error is the gather rays' alone and must match the
- * spread over seeds; strata shared between estimates would make it fall short. */
-static void test_final_gather_strata(void **state)
+/* The strata of the j-th gather rays (paths) of a pixel's samples (render_stratum):
+ * estimate j stays independent of the others, so the spread between estimates still gives
+ * the error. For final-gather with one map and without its term (batches withheld), the
+ * reported error is the gather rays' alone and must match the spread over seeds; strata
+ * shared between estimates make it fall 2.8 x short. */
+static void test_strata_honest(void **state)
 {
     (void)state;
     double r = honesty_ratio(INTEGRATOR_FINAL_GATHER, (honesty_case){.fixed_map = true,
@@ -292,6 +303,8 @@ static void test_final_gather_strata(void **state)
     assert_true(fabs(r - 1.0) <= 0.2);
     r = honesty_ratio(INTEGRATOR_FINAL_GATHER,
                       (honesty_case){.photons = 100000, .estimates = 16, .oversampling = 2});
+    assert_true(fabs(r - 1.0) <= 0.2);
+    r = honesty_ratio(INTEGRATOR_PATH, (honesty_case){.estimates = 16, .oversampling = 2});
     assert_true(fabs(r - 1.0) <= 0.2);
 }
 
@@ -314,7 +327,7 @@ int main(void)
         cmocka_unit_test(test_stderr_is_honest_final_gather),
         cmocka_unit_test(test_stderr_is_honest_photon_map),
         cmocka_unit_test(test_final_gather_one_map),
-        cmocka_unit_test(test_final_gather_strata),
+        cmocka_unit_test(test_strata_honest),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
