@@ -32,7 +32,7 @@ enum {
     RNG_PURPOSE_AIR_VOLUME = 5,    /* photon/air_emission.c: the air's share of the extent */
     RNG_PURPOSE_BACK_FACE = 6,     /* photon/emission.c: back faces' reach shares */
     RNG_PURPOSE_SENSOR_NOISE = 7,  /* sensor/noise.c: radiometer noise, per pixel */
-    RNG_PURPOSE_GATHER_STRATA = 8, /* sensor/integrator_final_gather.c: a pixel's strata */
+    RNG_PURPOSE_GATHER_STRATA = 8, /* sensor/integrators.c: strata of a pixel's samples */
     RNG_PURPOSE_ANALYSIS = 9,      /* analysis/: training splits, noise added to cubes */
     RNG_PURPOSE_TEST = 15
 };

@@ -16,12 +16,13 @@ struct rng_stream;
  * of rng: the azimuth's word first, then the polar angle's (mu = sqrt(1 - u)). The order
  * is fixed here, not left to the order a compiler evaluates a call's arguments in. */
 vec3 sampling_cosine32(vec3 n, struct rng_stream *rng);
-/* A set of at most SAMPLING_STRATA_MAX directions stratified together (final-gather's
- * gather rays of a pixel's samples): member `which` of a set of `count` draws its polar
- * uniform in [lo, lo + width) = [p, p + 1) / count, p its place in a random permutation of
- * 0..count-1, and takes the azimuth uniform (phi0 + which / count) mod 1, phi0 shared.
- * Alone, every member is uniform on [0, 1)^2, so the law it samples is unchanged; together
- * the members meet each polar band once and are spread evenly in azimuth. */
+/* A set of at most SAMPLING_STRATA_MAX directions stratified together (the first
+ * scattered directions of a pixel's samples, render_stratum): member `which` of a set of
+ * `count` draws its polar uniform in [lo, lo + width) = [p, p + 1) / count, p its place in
+ * a random permutation of 0..count-1, and takes the azimuth uniform (phi0 + which / count)
+ * mod 1, phi0 shared. Alone, every member is uniform on [0, 1)^2, so the law it samples is
+ * unchanged; together the members meet each polar band once and are spread evenly in
+ * azimuth. */
 #define SAMPLING_STRATA_MAX 16u
 typedef struct sampling_stratum {
     double polar_lo, polar_width; /* the polar uniform is polar_lo + polar_width u */
