@@ -118,22 +118,28 @@ def test_two_threads_match_sequential_runs(tiny_dir):
 def test_the_gil_is_released_during_a_run(tiny_dir):
     """While one thread runs a simulate, the main thread keeps running Python code.
     Were the GIL held during the C call, the main thread could run only while the run
-    calls back into Python (its progress reports): about one tick per report."""
+    calls back into Python (its progress reports): about one tick per report. A run too
+    short to tell (a fast machine) is repeated with twice the photons."""
     d = tiny_scene_dict()
-    d["photons"]["per_channel"] = 400_000
-    scene = thzmap.scene_from_dict(d, base_dir=tiny_dir)
-    reports = []
-    done = threading.Event()
-    t = threading.Thread(target=lambda: (
-        thzmap.simulate(scene, threads=1, progress=reports.append), done.set()))
-    start = time.monotonic()
-    t.start()
-    ticks = 0
-    while not done.is_set():
-        time.sleep(0.001)
-        ticks += 1
-    t.join()
-    seconds = time.monotonic() - start
-    assert seconds > 0.3, "the run was too short to tell"
+    photons = 400_000
+    for _ in range(4):
+        d["photons"]["per_channel"] = photons
+        scene = thzmap.scene_from_dict(d, base_dir=tiny_dir)
+        reports = []
+        done = threading.Event()
+        t = threading.Thread(target=lambda: (
+            thzmap.simulate(scene, threads=1, progress=reports.append), done.set()))
+        start = time.monotonic()
+        t.start()
+        ticks = 0
+        while not done.is_set():
+            time.sleep(0.001)
+            ticks += 1
+        t.join()
+        seconds = time.monotonic() - start
+        if seconds > 0.3:
+            break
+        photons *= 2
+    assert seconds > 0.3, f"the run was too short to tell ({photons} photons, {seconds:.2f} s)"
     assert ticks > 5 * len(reports) + 20, \
         f"{ticks} ticks of the main thread for {len(reports)} reports in {seconds:.2f} s"
