@@ -31,10 +31,7 @@ typedef struct render_target {
     double *disk_var;   /* and += weight^2 x their disks' Poisson variance; else NULL */
     double weight;      /* 1 / n^2 */
     uint64_t rng_index; /* first index of this sample's random streams (x n_est) */
-    /* The sample is stratum `stratum` of its pixel's n_strata samples; the pixel's first
-     * sample's rng_index numbers the streams of the strata they share. */
-    uint32_t stratum, n_strata;
-    uint64_t pixel_rng_index;
+    uint32_t stratum, n_strata; /* the sample's place among its pixel's n_strata samples */
 } render_target;
 
 /* An integrator: the estimates of one sample ray. `sample_sr` is the sample's solid

@@ -70,16 +70,18 @@ uint32_t render_estimates_per_pass(const thz_scene *scene)
 bool render_stratum(const render_context *ctx, const render_target *t, uint32_t j,
                     uint32_t crossings, sampling_stratum *out)
 {
-    uint32_t set = t->stratum / SAMPLING_STRATA_MAX;
-    uint32_t members = t->n_strata - set * SAMPLING_STRATA_MAX;
+    uint32_t member = t->stratum % SAMPLING_STRATA_MAX;
+    uint32_t members = t->n_strata - (t->stratum - member);
     if (members > SAMPLING_STRATA_MAX)
         members = SAMPLING_STRATA_MAX;
     if (members < 2)
         return false;
+    /* the set's stream: numbered as estimate j of its first sample (samples of a pixel
+     * are consecutive, J streams apart), under a purpose of its own */
+    uint64_t first = t->rng_index - (uint64_t)member * t->n_est;
     rng_stream rng;
     rng_init(&rng, ctx->seed, ctx->channel_index, RNG_PURPOSE_GATHER_STRATA,
-             (t->pixel_rng_index + (uint64_t)set * t->n_est + j) * (RENDER_MAX_CROSSINGS + 1) +
-                 crossings);
-    *out = sampling_stratum_of(&rng, members, t->stratum % SAMPLING_STRATA_MAX);
+             (first + j) * (RENDER_MAX_CROSSINGS + 1) + crossings);
+    *out = sampling_stratum_of(&rng, members, member);
     return true;
 }

@@ -176,8 +176,6 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
                             render_rng_index(scene, sensor, pass, samples_per_pass, sample, n_est),
                         .stratum = j * n + i,
                         .n_strata = n * n,
-                        .pixel_rng_index = render_rng_index(scene, sensor, pass, samples_per_pass,
-                                                            (uint64_t)px * n * n, n_est),
                     };
                     integ->sample(ctx, cam.position_m, dir, sample_sr, &t, &s);
                     var_sum += s.variance;

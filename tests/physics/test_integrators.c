@@ -306,6 +306,9 @@ static void test_strata_honest(void **state)
     assert_true(fabs(r - 1.0) <= 0.2);
     r = honesty_ratio(INTEGRATOR_PATH, (honesty_case){.estimates = 16, .oversampling = 2});
     assert_true(fabs(r - 1.0) <= 0.2);
+    /* 5 x 5 samples: a set of 16 and one of 9 */
+    r = honesty_ratio(INTEGRATOR_PATH, (honesty_case){.estimates = 4, .oversampling = 5});
+    assert_true(fabs(r - 1.0) <= 0.2);
 }
 
 static void test_stderr_is_honest_photon_map(void **state)
