@@ -152,6 +152,12 @@ cleanup:
     return st;
 }
 
+/* thz_run_settings.plan: the estimate `thzmap simulate` prints before the work. */
+static void bench_e2e_plan(void *user, const thz_run_plan *plan)
+{
+    *(double *)user = plan->seconds_photons + plan->seconds_render;
+}
+
 thz_status bench_measure_e2e(const char *scene_path, const char *integrator, uint64_t photons,
                              double target_noise_k, int threads, const char *outdir, bench_e2e *out,
                              thz_error *err)
@@ -171,6 +177,8 @@ thz_status bench_measure_e2e(const char *scene_path, const char *integrator, uin
     settings.integrator = integrator;
     settings.photons_per_channel = photons;
     settings.target_noise_k = target_noise_k;
+    settings.plan = bench_e2e_plan;
+    settings.plan_user = &out->s_estimate;
     thz_run *run = NULL;
     if (!ctx)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");

@@ -34,6 +34,7 @@ typedef struct bench_e2e {
     uint32_t max_passes;       /* render passes of the channel that took most */
     double worst_p95_stderr_k; /* largest 95th percentile of the stderr of Tb_c, K */
     double target_noise_k;     /* the run's noise target, K (0: none) */
+    double s_estimate;         /* the run's own up-front estimate of its time (thz_run_plan) */
     char integrator[16];       /* the integrator that ran */
 } bench_e2e;
 

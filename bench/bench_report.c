@@ -97,10 +97,12 @@ json_t *bench_report_e2e(const char *label, const bench_e2e *e, const bench_usag
         snprintf(target, sizeof target, "noise target %g K (p95 over pixels)", e->target_noise_k);
     printf("  end to end, %s\n    %s: %.3f s (load %.3f s); %llu photons fired, %llu stored; "
            "passes per channel up to %u, %s, worst p95 %.3f K;\n    peak memory %.1f MB, %.1f "
-           "CPU s (%.2f cores on average; load average %.2f)\n",
+           "CPU s (%.2f cores on average; load average %.2f)\n    its estimate before the "
+           "work %.3f s, %.2f x the run\n",
            label, e->integrator, e->s_total, e->s_load, (unsigned long long)e->fired,
            (unsigned long long)e->stored, (unsigned)e->max_passes, target, e->worst_p95_stderr_k,
-           (double)use->peak_bytes / 1e6, use->cpu_s, bench_ratio(use->cpu_s, e->s_total), load);
+           (double)use->peak_bytes / 1e6, use->cpu_s, bench_ratio(use->cpu_s, e->s_total), load,
+           e->s_estimate, bench_ratio(e->s_estimate, e->s_run));
     json_t *je = json_object();
     json_object_set_new(je, "integrator", json_string(e->integrator));
     json_object_set_new(je, "seconds", bench_real(e->s_total));
@@ -114,6 +116,7 @@ json_t *bench_report_e2e(const char *label, const bench_e2e *e, const bench_usag
     json_object_set_new(je, "peak_memory_bytes", json_integer((json_int_t)use->peak_bytes));
     json_object_set_new(je, "cpu_seconds", bench_real(use->cpu_s));
     json_object_set_new(je, "load_average", bench_real(load));
+    json_object_set_new(je, "estimate_seconds", bench_real(e->s_estimate));
     return je;
 }
 
