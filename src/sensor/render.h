@@ -94,6 +94,9 @@ typedef struct render_options {
      * so that reflected and transmitted terms do not vanish against B(T0). */
     bool path_t0_set;
     double path_t0_k;
+    /* final-gather: cosine gather rays only, without the photon guide (guide.h); for the
+     * tests and measurements that compare the two */
+    bool unguided;
     /* pixel tiles shared by processes (render_tiles.h): render only member's tiles of
      * `members`; members 0 or 1: every pixel */
     size_t member, members;

@@ -226,6 +226,7 @@ thz_status render_context_create(const thz_scene *scene, const accel *a, const p
     }
     if (opt && opt->use_seed)
         ctx->seed = opt->seed;
+    ctx->guided = !(opt && opt->unguided);
     ctx->integrator = integ;
     *out = ctx;
     return THZ_OK;

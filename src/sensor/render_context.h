@@ -56,6 +56,7 @@ struct render_context {
     double *b0;              /* [node] B_nu(T0) */
     double *source_mean;     /* [object] band mean of eps B - A B0 for solids without an
                                 index; NAN for the others (angle-dependent) */
+    bool guided;             /* final-gather: the photon guide may steer gather rays */
     bool deviation;          /* photon-map, final-gather: the map holds L - B(T0), T0 > 0,
                                 so every source term is eps B - A B0 (escapes, back faces,
                                 the air: minus B0) and the sample adds B0 back */
