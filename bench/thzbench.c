@@ -200,12 +200,12 @@ int main(int argc, char **argv)
      * thread: photon-map 10 renders, final-gather one pass of the scene's 32 gather rays,
      * path 10 passes of the scene's 16 paths (0: the scene's estimates per pass). */
     const uint64_t fg_photons = small ? 20000 : 1000000;
-    /* Time to a converged image (section 6), final-gather: 8 M photons, about the count
-     * that reaches 0.05 K soonest on the paper's scene (0.2 THz, 2 threads, the map's floor
-     * 0.048, 0.042, 0.036, 0.030, 0.026 K at 1, 2, 4, 8, 16 M photons: 0.05 K in about 84,
-     * 25, 16, 14.5, 18 s; docs/integrators.md; with k = 32 at the gather rays' hits, 4, 8
-     * and 12 M photons: floors 0.035, 0.026, 0.021 K, 0.05 K in about 7.6, 7.4 and 10 s) */
-    const uint64_t conv_fg_photons = small ? 20000 : 8000000;
+    /* Time to a converged image (section 6), final-gather: 6 M photons, about the count
+     * that reaches 0.05 K soonest on the paper's scene with the photon guide (0.2 THz,
+     * fitted through 32 and 64 gather rays: at 4, 6 and 8 M photons the map's floor 0.037,
+     * 0.033, 0.030 K and 50, 39, 35 gather rays; docs/integrators.md). Before the guide
+     * the optimum was flat from 4 to 8 M and 8 M was kept. */
+    const uint64_t conv_fg_photons = small ? 20000 : 6000000;
     const uint32_t speedup_estimates[3] = {0, small ? 2 : 0, small ? 2 : 0};
     const uint32_t speedup_passes[3] = {1, 1, small ? 1 : 10};
     const uint32_t speedup_renders[3] = {small ? 1 : 10, 1, 1};
