@@ -1,11 +1,11 @@
 /* The up-front estimate of a simulate run's time: a pilot on a small copy of the first
  * rendered sensor (RUN_PILOT_SIDE^2 pixels, one sample each, pass 0 twice, the second
- * timed) and, for the integrators
- * that need photons, a pilot photon phase of RUN_PILOT_PHOTONS, both on channel 0.
- * Time per path sample (or gather sample) and per photon, times the run's counts,
- * gives the time; with a noise target the pilot's 95th percentile of the standard
- * error, scaled as 1/sqrt(samples), gives the passes. An estimate, not a promise: it
- * assumes every channel costs what channel 0 does.
+ * timed) and, for the integrators that need photons, a pilot
+ * photon phase of RUN_PILOT_PHOTONS: on channel 0 alone without a noise target, for every
+ * channel with one. Time per path sample (or gather sample) and per photon
+ * (the emission table once), times the run's counts, gives the time; with a noise target
+ * the pilot's 95th percentile of the standard error, scaled as 1/sqrt(samples), gives the
+ * channel's passes. An estimate, not a promise.
  */
 #ifndef THZ_RUN_RUN_ESTIMATE_H
 #define THZ_RUN_RUN_ESTIMATE_H
@@ -29,7 +29,8 @@ typedef struct run_estimate_input {
     int threads;
 } run_estimate_input;
 
-/* *seconds_photons and *seconds_render of the whole run, s; *passes per channel. */
+/* *seconds_photons and *seconds_render of the whole run, s; *passes: the most a channel
+ * needs. */
 thz_status run_estimate_time(const run_estimate_input *in, double *seconds_photons,
                              double *seconds_render, uint32_t *passes, thz_error *err);
 
