@@ -32,7 +32,8 @@ typedef struct thz_output thz_output;
  * passes from the pilot's noise). An estimate, not a promise. */
 typedef struct thz_run_plan {
     double seconds_photons, seconds_render; /* estimated, s */
-    uint32_t passes;                        /* estimated passes per channel */
+    uint32_t passes;                        /* estimated passes of the channel that
+                                               needs most */
     uint64_t memory_bytes;                  /* estimated peak, bytes */
     uint64_t available_bytes;               /* physical memory, 0 if unknown */
     double target_noise_k;                  /* the run's noise target, K; 0: none */

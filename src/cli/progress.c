@@ -160,7 +160,7 @@ void cli_progress_plan(void *user, const thz_run_plan *plan)
     char target[160] = "";
     if (plan->target_noise_k > 0.0)
         snprintf(target, sizeof target,
-                 ", about %u pass%s per channel to reach the noise target of %g K (%s)",
+                 ", up to about %u pass%s per channel to reach the noise target of %g K (%s)",
                  plan->passes, plan->passes == 1 ? "" : "es", plan->target_noise_k,
                  plan->target_source ? plan->target_source : "given");
     fprintf(p->out,
