@@ -47,10 +47,18 @@ bool render_poll_stop(render_poll *poll)
     if (now < poll->next_s)
         return false;
     poll->next_s = now + RENDER_POLL_S;
-    if (!render_report(poll->opt, poll->scene, poll->channel, poll->done, poll->total))
+    uint64_t done = poll->done;
+    if (poll->columns)
+        done += atomic_load_explicit(&poll->pixels, memory_order_relaxed) / poll->columns;
+    if (!render_report(poll->opt, poll->scene, poll->channel, done, poll->total))
         return false;
     atomic_store_explicit(&poll->stop, 1, memory_order_relaxed);
     return true;
+}
+
+void render_poll_pixel_done(render_poll *poll)
+{
+    atomic_fetch_add_explicit(&poll->pixels, 1, memory_order_relaxed);
 }
 
 /* The random-stream index of estimate 0 of sample `sample` (of `samples` per pass) of
@@ -117,12 +125,6 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
     uint32_t n = cam.oversampling, cols = cam.columns, rows = cam.rows;
     double n2 = (double)n * (double)n;
     uint64_t samples_per_pass = (uint64_t)cols * rows * n * n;
-    /* Rows per block: about 64k sample estimates between progress calls (fewer parallel
-     * regions: less waiting at their ends). */
-    uint64_t work_per_row = (uint64_t)cols * n * n * n_est;
-    uint32_t block = (uint32_t)(65536 / (work_per_row ? work_per_row : 1));
-    if (block < 1)
-        block = 1;
     size_t members = opt ? opt->members : 0, member = opt ? opt->member : 0;
     uint64_t n_samples = 0, n_escaped = 0, n_back = 0, n_widened = 0, n_starved = 0,
              n_truncated = 0, n_paths = 0;
@@ -131,75 +133,81 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
         st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
         goto cleanup;
     }
+    /* One parallel region for the whole frame, its progress and cancelling polled inside
+     * (render_poll): with a region per block of rows, the thread that finished its last
+     * chunk first waited at every block's end (path, 160 paths a sample: a region per row,
+     * about 3 % of the 2 threads' time spent waiting). */
     render_poll poll = {.opt = opt,
                         .scene = scene,
                         .channel = channel,
                         .total = rows,
+                        .columns = cols,
                         .next_s = thz_now_s() + RENDER_POLL_S};
-    for (uint32_t r0 = 0; r0 < rows; r0 += block) {
-        uint32_t r1 = r0 + block < rows ? r0 + block : rows;
-        int64_t first = (int64_t)r0 * cols, last = (int64_t)r1 * cols;
-        poll.done = r0;
+    const int64_t n_px = (int64_t)rows * cols;
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads) \
     reduction(+ : n_samples, n_escaped, n_back, n_widened, n_starved, n_truncated, n_paths)
-        for (int64_t px = first; px < last; px++) {
-            uint32_t row = (uint32_t)(px / cols), col = (uint32_t)(px % cols);
-            if (render_tile_owner(col, row, members) != member || render_poll_stop(&poll))
-                continue;
-            double *est = &scratch[(size_t)omp_get_thread_num() * per_thread];
-            for (size_t j = 0; j < per_thread; j++)
-                est[j] = 0.0;
-            double *pixel_batch = batched ? est + n_est : NULL;
-            double *pixel_disk_var = batched ? est + n_est + PHOTON_MAP_BATCHES : NULL;
-            double omega_sr = camera_pixel_solid_angle(&cam, col, row);
-            double sample_sr = omega_sr / n2;
-            /* Poisson variance of the pixel's mean: the samples' own footprints are
-             * disjoint, so their variances add; a footprint widened to the k-th nearest
-             * photon overlaps its neighbours' and shares their photons, so for a pixel
-             * with one, the bound of perfect correlation (the sum of standard errors,
-             * squared) instead: never less than the truth (tests/cli/
-             * test_deviation_maps.sh measured the sum of variances 2x short in sd). */
-            double var_sum = 0.0, sd_sum = 0.0;
-            bool pixel_widened = false;
-            for (uint32_t j = 0; j < n; j++)
-                for (uint32_t i = 0; i < n; i++) {
-                    render_sample s = {.variance = 0.0};
-                    vec3 dir = camera_sample_dir(&cam, col, row, i, j);
-                    uint64_t sample = (uint64_t)px * n * n + (uint64_t)j * n + i;
-                    render_target t = {
-                        .est = est,
-                        .n_est = n_est,
-                        .batch = pixel_batch,
-                        .disk_var = pixel_disk_var,
-                        .weight = 1.0 / n2,
-                        .rng_index =
-                            render_rng_index(scene, sensor, pass, samples_per_pass, sample, n_est),
-                        .stratum = j * n + i,
-                        .n_strata = n * n,
-                    };
-                    integ->sample(ctx, cam.position_m, dir, sample_sr, &t, &s);
-                    var_sum += s.variance;
-                    sd_sum += sqrt(s.variance);
-                    pixel_widened = pixel_widened || s.widened;
-                    n_samples++;
-                    n_escaped += s.escaped;
-                    n_back += s.back_face;
-                    n_widened += s.widened;
-                    n_starved += s.starved;
-                    n_truncated += s.truncated;
-                    n_paths += s.paths;
-                }
-            size_t p = (size_t)px;
-            if (!integ->purpose)
-                render_accum_set_poisson_pixel(
-                    acc, p, est[0], (pixel_widened ? sd_sum * sd_sum : var_sum) / (n2 * n2));
-            else
-                render_accum_add_pixel(acc, p, est, n_est, pixel_batch, pixel_disk_var);
+    for (int64_t px = 0; px < n_px; px++) {
+        uint32_t row = (uint32_t)(px / cols), col = (uint32_t)(px % cols);
+        if (render_tile_owner(col, row, members) != member) {
+            render_poll_pixel_done(&poll); /* another member's */
+            continue;
         }
-        if (atomic_load(&poll.stop) || render_report(opt, scene, channel, r1, rows)) {
-            st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
-            goto cleanup;
-        }
+        if (render_poll_stop(&poll))
+            continue;
+        double *est = &scratch[(size_t)omp_get_thread_num() * per_thread];
+        for (size_t j = 0; j < per_thread; j++)
+            est[j] = 0.0;
+        double *pixel_batch = batched ? est + n_est : NULL;
+        double *pixel_disk_var = batched ? est + n_est + PHOTON_MAP_BATCHES : NULL;
+        double omega_sr = camera_pixel_solid_angle(&cam, col, row);
+        double sample_sr = omega_sr / n2;
+        /* Poisson variance of the pixel's mean: the samples' own footprints are
+         * disjoint, so their variances add; a footprint widened to the k-th nearest
+         * photon overlaps its neighbours' and shares their photons, so for a pixel
+         * with one, the bound of perfect correlation (the sum of standard errors,
+         * squared) instead: never less than the truth (tests/cli/
+         * test_deviation_maps.sh measured the sum of variances 2x short in sd). */
+        double var_sum = 0.0, sd_sum = 0.0;
+        bool pixel_widened = false;
+        for (uint32_t j = 0; j < n; j++)
+            for (uint32_t i = 0; i < n; i++) {
+                render_sample s = {.variance = 0.0};
+                vec3 dir = camera_sample_dir(&cam, col, row, i, j);
+                uint64_t sample = (uint64_t)px * n * n + (uint64_t)j * n + i;
+                render_target t = {
+                    .est = est,
+                    .n_est = n_est,
+                    .batch = pixel_batch,
+                    .disk_var = pixel_disk_var,
+                    .weight = 1.0 / n2,
+                    .rng_index =
+                        render_rng_index(scene, sensor, pass, samples_per_pass, sample, n_est),
+                    .stratum = j * n + i,
+                    .n_strata = n * n,
+                };
+                integ->sample(ctx, cam.position_m, dir, sample_sr, &t, &s);
+                var_sum += s.variance;
+                sd_sum += sqrt(s.variance);
+                pixel_widened = pixel_widened || s.widened;
+                n_samples++;
+                n_escaped += s.escaped;
+                n_back += s.back_face;
+                n_widened += s.widened;
+                n_starved += s.starved;
+                n_truncated += s.truncated;
+                n_paths += s.paths;
+            }
+        size_t p = (size_t)px;
+        if (!integ->purpose)
+            render_accum_set_poisson_pixel(acc, p, est[0],
+                                           (pixel_widened ? sd_sum * sd_sum : var_sum) / (n2 * n2));
+        else
+            render_accum_add_pixel(acc, p, est, n_est, pixel_batch, pixel_disk_var);
+        render_poll_pixel_done(&poll);
+    }
+    if (atomic_load(&poll.stop) || render_report(opt, scene, channel, rows, rows)) {
+        st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
+        goto cleanup;
     }
     render_accum_end_pass(acc, n_est, integ->purpose == 0);
 

@@ -103,10 +103,11 @@ typedef struct render_options {
 } render_options;
 
 /* Cancelling inside a parallel pixel loop, so that a run stops within a second however
- * long a row or a block of rows takes: each thread calls render_poll_stop for each
- * pixel; on thread 0 (the caller's, where the callback may run) it calls the progress
- * callback, at most every RENDER_POLL_S, reporting `done` of `total` rows; once that
- * asks to stop, it returns true on every thread, which then skip their pixels. */
+ * long a row takes: each thread calls render_poll_stop for each pixel; on thread 0 (the
+ * caller's, where the callback may run) it calls the progress callback, at most every
+ * RENDER_POLL_S, reporting `done` of `total` rows (with `columns` set, the rows' worth of
+ * pixels counted by render_poll_pixel_done); once that asks to stop, it returns true on
+ * every thread, which then skip their pixels. */
 #define RENDER_POLL_S 0.1
 
 typedef struct render_poll {
@@ -114,14 +115,17 @@ typedef struct render_poll {
     const thz_scene *scene;
     size_t channel;
     uint64_t done, total;
-    double next_s;  /* thread 0 only */
-    uint64_t calls; /* thread 0 only */
+    uint64_t columns; /* pixels per row, or 0: `done` alone */
+    double next_s;    /* thread 0 only */
+    uint64_t calls;   /* thread 0 only */
     /* read by every thread for every pixel: on a cache line of its own, apart from
      * what thread 0 writes (calls) */
     _Alignas(64) _Atomic int stop;
+    _Alignas(64) _Atomic uint64_t pixels; /* pixels done, written by every thread */
 } render_poll;
 
 bool render_poll_stop(render_poll *poll);
+void render_poll_pixel_done(render_poll *poll);
 
 /* Counts of one render_sensor_channel call; add them up across calls. */
 typedef struct render_stats {
