@@ -12,6 +12,9 @@ if(NOT THZ_NPM OR NOT THZ_NODE)
 endif()
 set(THZ_WEB_NPM_DIR ${CMAKE_BINARY_DIR}/web-npm)
 set(THZ_WEB_DIR ${CMAKE_BINARY_DIR}/web)
+# The npm step runs in THZ_WEB_NPM_DIR: it must exist before the step's first command
+# (Ninja creates a custom command's working directory; the Makefile generators cd into it).
+file(MAKE_DIRECTORY ${THZ_WEB_NPM_DIR})
 add_custom_command(OUTPUT ${THZ_WEB_NPM_DIR}/npm-ci.stamp
   COMMAND ${CMAKE_COMMAND} -E make_directory ${THZ_WEB_NPM_DIR}
   COMMAND ${CMAKE_COMMAND} -E copy ${CMAKE_SOURCE_DIR}/web/package.json
