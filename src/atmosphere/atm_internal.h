@@ -12,6 +12,8 @@
 /* 1 hPa = 1 mbar; 1 cm^-1 = 29.9792458 GHz; 1 atm = 1013.25 hPa. */
 #define ATM_GHZ_PER_CM1 29.9792458
 #define ATM_HPA_PER_ATM 1013.25
+/* The second radiation constant hc/k, cm K (CODATA 2018). */
+#define ATM_HC_OVER_K_CM_K 1.438776877
 
 /* itu-p676 (atm_itu_p676.c). */
 thz_status atm_itu_create(atm_itu_data **out, const char *data_dir, thz_error *err);

@@ -25,13 +25,12 @@
  * O2 line (at the air's temperature) are dropped (3069 of 9597 lines are kept);
  * this changes alpha by < 1e-7 relative at 1 GHz - 3 THz even in dry air.
  */
-#include <ctype.h>
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "atmosphere/atm_catalog.h"
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
 #include "core/data_dir.h"
@@ -39,9 +38,6 @@
 #include "core/path.h"
 
 #define LINE_MIN_RELATIVE 1e-10
-/* Largest line catalogue or table read: HITRAN's whole H2O list (all bands) as .par is
- * about 50 MB; a .par of every molecule is streamed, a CSV is held in memory. */
-#define ATM_LINES_MAX_FILE_BYTES ((uint64_t)512 << 20)
 #define H2O_CUTOFF_GHZ 750.0     /* 25 cm^-1: MT_CKD's line cut-off */
 #define O2_DRY_AIR_VMR 0.20946   /* O2 fraction of dry air */
 #define VOIGT_DOPPLER_RATIO 1e-3 /* Voigt when gamma_D > this times gamma_L */
@@ -50,27 +46,10 @@
                                            Voigt = Lorentz to ~3e-7 relative */
 #define COUPLED_MATCH_GHZ 0.005         /* .par O2 lines this close to a coupled line are it */
 #define H_OVER_K_K_PER_GHZ 0.0479924307 /* h / k in K/GHz (CODATA 2018) */
-#define HC_OVER_K_CM_K 1.438776877      /* second radiation constant, cm K */
 #define BOLTZMANN_HPA_CM3 1.380649e-19  /* k in hPa cm^3 / K: n[cm^-3] = p[hPa] / (k T) */
 #define AMU_KG 1.66053906660e-27
 #define MT_CKD_P_REF_HPA 1013.0
 #define MT_CKD_T_REF_K 296.0
-
-/* One catalogue line as read (HITRAN reference state, am units). */
-typedef struct raw_line {
-    double nu0_ghz, s296_cm2_ghz, elower_k;
-    double gamma_air, gamma_self; /* GHz/hPa, HWHM at 296 K */
-    double n_air;
-    double delta_air; /* GHz/hPa */
-    int iso;
-    /* line mixing (coupled lines only) */
-    double y0, y1, yx, g0, g1, gx, d0, d1, dx, tref_k;
-} raw_line;
-
-typedef struct raw_catalog {
-    size_t n, cap;
-    raw_line *lines;
-} raw_catalog;
 
 /* A line at the air's state. */
 typedef struct lbl_line {
@@ -92,12 +71,6 @@ typedef struct lbl_species {
     lbl_line *lines; /* sorted by nu_ghz */
 } lbl_species;
 
-typedef struct partition_sums {
-    size_t n_t, n_iso;
-    double t0_k, dt_k;
-    double *q; /* n_t * n_iso */
-} partition_sums;
-
 struct atm_lines_data {
     atm_air_state air;
     double half_h_over_kt; /* h / (2 k T) in 1/GHz */
@@ -110,293 +83,6 @@ struct atm_lines_data {
     double n_h2o, n_foreign, n_ref; /* cm^-3 */
     double dry_hpa;
 };
-
-/* ---- Reading catalogues -------------------------------------------------------- */
-
-static thz_status catalog_push(raw_catalog *cat, const raw_line *line, thz_error *err)
-{
-    if (cat->n == cat->cap) {
-        size_t cap = cat->cap ? 2 * cat->cap : 4096;
-        raw_line *l = thz_realloc_array(cat->lines, cap, sizeof *l);
-        if (!l)
-            return thz_error_set(err, THZ_ERR_NOMEM, "out of memory reading a line catalogue");
-        cat->lines = l;
-        cat->cap = cap;
-    }
-    cat->lines[cat->n++] = *line;
-    return THZ_OK;
-}
-
-static bool has_suffix(const char *s, const char *suffix)
-{
-    size_t n = strlen(s), m = strlen(suffix);
-    if (n < m)
-        return false;
-    for (size_t i = 0; i < m; i++)
-        if (tolower((unsigned char)s[n - m + i]) != suffix[i])
-            return false;
-    return true;
-}
-
-static thz_status check_line(const raw_line *l, const char *path, size_t lineno, thz_error *err)
-{
-    if (!(l->nu0_ghz > 0.0) || !(l->s296_cm2_ghz >= 0.0) || !(l->gamma_air >= 0.0) ||
-        !(l->gamma_self >= 0.0) || !isfinite(l->n_air) || !isfinite(l->delta_air) ||
-        !isfinite(l->elower_k) || l->iso < 1)
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "%s:%zu: a line needs frequency > 0, intensity >= 0, widths >= 0, "
-                             "finite n_air, shift and lower-state energy, isotopologue >= 1",
-                             path, lineno);
-    return THZ_OK;
-}
-
-/* am 14.0 CSV catalogue (data/atmosphere/am14_*_lines*.csv); coupled adds mixing. */
-static thz_status read_csv_catalog(const char *path, bool coupled, raw_catalog *cat, thz_error *err)
-{
-    static const char *const base[] = {"freq_GHz",
-                                       "S296_cm2_GHz",
-                                       "Elower_K",
-                                       "gamma_air_GHz_per_mbar",
-                                       "gamma_self_GHz_per_mbar",
-                                       "n_air",
-                                       "delta_air_GHz_per_mbar",
-                                       "hitran_iso"};
-    static const char *const mix[] = {"y0_per_mbar",  "y1_per_mbar", "yx",           "g0_per_mbar2",
-                                      "g1_per_mbar2", "gx",          "d0_per_mbar2", "d1_per_mbar2",
-                                      "dx",           "Tref_K"};
-    enum { N_BASE = 8, N_MIX = 10 };
-    size_t col[N_BASE + N_MIX];
-    csv_table csv;
-    thz_status st = csv_read(path, NULL, &csv, err);
-    if (st != THZ_OK)
-        return st;
-    for (size_t i = 0; st == THZ_OK && i < N_BASE; i++)
-        st = csv_column_index(&csv, base[i], &col[i], err);
-    for (size_t i = 0; coupled && st == THZ_OK && i < N_MIX; i++)
-        st = csv_column_index(&csv, mix[i], &col[N_BASE + i], err);
-    for (size_t r = 0; st == THZ_OK && r < csv.n_rows; r++) {
-        raw_line l;
-        memset(&l, 0, sizeof l);
-        l.nu0_ghz = csv_value(&csv, r, col[0]);
-        l.s296_cm2_ghz = csv_value(&csv, r, col[1]);
-        l.elower_k = csv_value(&csv, r, col[2]);
-        l.gamma_air = csv_value(&csv, r, col[3]);
-        l.gamma_self = csv_value(&csv, r, col[4]);
-        l.n_air = csv_value(&csv, r, col[5]);
-        l.delta_air = csv_value(&csv, r, col[6]);
-        double iso = csv_value(&csv, r, col[7]);
-        l.iso = iso >= 1.0 && iso <= 99.0 ? (int)iso : 0;
-        if (coupled) {
-            double *m = &l.y0;
-            for (size_t i = 0; i < N_MIX; i++)
-                m[i] = csv_value(&csv, r, col[N_BASE + i]);
-            if (!(l.tref_k > 0.0))
-                st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: Tref_K must be > 0", path,
-                                   csv.row_lines[r]);
-        }
-        if (st == THZ_OK)
-            st = check_line(&l, path, csv.row_lines[r], err);
-        if (st == THZ_OK)
-            st = catalog_push(cat, &l, err);
-    }
-    csv_fini(&csv);
-    return st;
-}
-
-/* Parses columns [start, start+len) (0-based) of a .par record as a number. */
-static bool par_field(const char *rec, size_t start, size_t len, double *out)
-{
-    char buf[32];
-    memcpy(buf, rec + start, len);
-    buf[len] = '\0';
-    char *p = buf;
-    while (*p == ' ')
-        p++;
-    if (!*p)
-        return false;
-    char *end = NULL;
-    errno = 0;
-    *out = strtod(p, &end);
-    while (*end == ' ')
-        end++;
-    return !*end && errno != ERANGE && isfinite(*out);
-}
-
-/* HITRAN 2004+ 160-character records: molecule I2, isotopologue I1 (0 = 10, A = 11,
- * ...), nu F12.6 cm^-1, S E10.3 cm^-1/(molecule cm^-2), A E10.3, gamma_air F5.4 and
- * gamma_self F5.3 cm^-1/atm, E'' F10.4 cm^-1, n_air F4.2, delta_air F8.6 cm^-1/atm,
- * then quantum numbers, error and reference codes, flag, g' and g'' (unused). */
-static thz_status read_par_catalog(const char *path, int molecule, raw_catalog *cat, thz_error *err)
-{
-    thz_status st = THZ_OK;
-    char *line = NULL;
-    size_t cap = 0, lineno = 0, n_found = 0;
-    FILE *f = fopen(path, "r");
-    if (!f && errno == ENOMEM)
-        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while opening it", path);
-    if (!f)
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot open: %s", path, strerror(errno));
-    ssize_t len;
-    while ((len = getline(&line, &cap, f)) != -1) {
-        lineno++;
-        while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r'))
-            line[--len] = '\0';
-        if (len == 0)
-            continue;
-        if (len < 67) {
-            st = thz_error_set(err, THZ_ERR_INPUT,
-                               "%s:%zu: a HITRAN .par record has 160 characters, this line has "
-                               "%zd",
-                               path, lineno, len);
-            goto cleanup;
-        }
-        double mol;
-        if (!par_field(line, 0, 2, &mol)) {
-            st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu:1: expected the molecule number", path,
-                               lineno);
-            goto cleanup;
-        }
-        if ((int)mol != molecule)
-            continue; /* other molecules are skipped */
-        int iso;
-        char c = line[2];
-        if (c >= '1' && c <= '9')
-            iso = c - '0';
-        else if (c == '0')
-            iso = 10;
-        else if (c >= 'A' && c <= 'Z')
-            iso = 11 + (c - 'A');
-        else {
-            st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu:3: bad isotopologue code '%c'", path,
-                               lineno, c);
-            goto cleanup;
-        }
-        static const struct {
-            size_t start, len;
-            const char *name;
-        } fields[] = {{3, 12, "nu"},         {15, 10, "S"},   {35, 5, "gamma_air"},
-                      {40, 5, "gamma_self"}, {45, 10, "E''"}, {55, 4, "n_air"},
-                      {59, 8, "delta_air"}};
-        double v[7];
-        for (size_t i = 0; i < 7; i++) {
-            if (!par_field(line, fields[i].start, fields[i].len, &v[i])) {
-                st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu:%zu: expected a number for %s", path,
-                                   lineno, fields[i].start + 1, fields[i].name);
-                goto cleanup;
-            }
-        }
-        raw_line l;
-        memset(&l, 0, sizeof l);
-        l.nu0_ghz = v[0] * ATM_GHZ_PER_CM1;
-        l.s296_cm2_ghz = v[1] * ATM_GHZ_PER_CM1;
-        l.gamma_air = v[2] * ATM_GHZ_PER_CM1 / ATM_HPA_PER_ATM;
-        l.gamma_self = v[3] * ATM_GHZ_PER_CM1 / ATM_HPA_PER_ATM;
-        l.elower_k = v[4] * HC_OVER_K_CM_K;
-        l.n_air = v[5];
-        l.delta_air = v[6] * ATM_GHZ_PER_CM1 / ATM_HPA_PER_ATM;
-        l.iso = iso;
-        st = check_line(&l, path, lineno, err);
-        if (st == THZ_OK)
-            st = catalog_push(cat, &l, err);
-        if (st != THZ_OK)
-            goto cleanup;
-        n_found++;
-    }
-    if (ferror(f))
-        st = thz_error_set(err, THZ_ERR_IO, "%s: read error", path);
-    else if (n_found == 0)
-        st = thz_error_set(err, THZ_ERR_INPUT, "%s: no lines of molecule %d (%s) in this file",
-                           path, molecule, molecule == 1 ? "H2O" : "O2");
-cleanup:
-    free(line);
-    fclose(f);
-    return st;
-}
-
-static thz_status read_catalog(const char *path, int molecule, bool coupled, raw_catalog *cat,
-                               thz_error *err)
-{
-    if (has_suffix(path, ".par"))
-        return read_par_catalog(path, molecule, cat, err);
-    return read_csv_catalog(path, coupled, cat, err);
-}
-
-static thz_status read_partition_sums(const char *path, partition_sums *q, thz_error *err)
-{
-    csv_table csv;
-    memset(q, 0, sizeof *q);
-    thz_status st = csv_read(path, NULL, &csv, err);
-    if (st != THZ_OK)
-        return st;
-    size_t col_t;
-    st = csv_column_index(&csv, "T_K", &col_t, err);
-    size_t cols[32];
-    size_t n_iso = 0;
-    while (st == THZ_OK && n_iso < 32) {
-        char name[16];
-        snprintf(name, sizeof name, "Q_iso%zu", n_iso + 1);
-        if (csv_column_index(&csv, name, &cols[n_iso], NULL) != THZ_OK)
-            break;
-        n_iso++;
-    }
-    if (st == THZ_OK && (n_iso == 0 || csv.n_rows < 2))
-        st = thz_error_set(err, THZ_ERR_INPUT, "%s: needs columns T_K, Q_iso1, ... and >= 2 rows",
-                           path);
-    if (st != THZ_OK)
-        goto cleanup;
-    q->t0_k = csv_value(&csv, 0, col_t);
-    q->dt_k = csv_value(&csv, 1, col_t) - q->t0_k;
-    for (size_t r = 0; r < csv.n_rows; r++) {
-        double t = csv_value(&csv, r, col_t);
-        if (!(q->dt_k > 0.0) || fabs(t - (q->t0_k + (double)r * q->dt_k)) > 1e-6 * q->dt_k) {
-            st = thz_error_set(err, THZ_ERR_INPUT,
-                               "%s:%zu: temperatures must be evenly spaced and increasing", path,
-                               csv.row_lines[r]);
-            goto cleanup;
-        }
-    }
-    q->n_t = csv.n_rows;
-    q->n_iso = n_iso;
-    q->q = thz_malloc_array(q->n_t * n_iso, sizeof *q->q);
-    if (!q->q) {
-        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory reading %s", path);
-        goto cleanup;
-    }
-    for (size_t r = 0; r < csv.n_rows; r++) {
-        for (size_t i = 0; i < n_iso; i++) {
-            double v = csv_value(&csv, r, cols[i]);
-            if (!(v > 0.0)) {
-                st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: partition sums must be > 0", path,
-                                   csv.row_lines[r]);
-                goto cleanup;
-            }
-            q->q[r * n_iso + i] = v;
-        }
-    }
-cleanup:
-    if (st != THZ_OK) {
-        free(q->q);
-        q->q = NULL;
-    }
-    csv_fini(&csv);
-    return st;
-}
-
-/* Q(T) of isotopologue iso (1-based), linear in T; NAN outside the table. */
-static double partition_sum(const partition_sums *q, int iso, double t_k)
-{
-    if (iso < 1 || (size_t)iso > q->n_iso)
-        return NAN;
-    double x = (t_k - q->t0_k) / q->dt_k;
-    if (x < 0.0 || x > (double)(q->n_t - 1))
-        return NAN;
-    size_t i = (size_t)x;
-    if (i >= q->n_t - 1)
-        i = q->n_t - 2;
-    double u = x - (double)i;
-    const double *col = q->q + (size_t)(iso - 1);
-    return (1.0 - u) * col[i * q->n_iso] + u * col[(i + 1) * q->n_iso];
-}
 
 /* ---- Lines at the air's state ---------------------------------------------------- */
 
@@ -457,7 +143,7 @@ static thz_status species_build(lbl_species *sp, const raw_catalog *cat, const p
         if (l->elower_k < 0.0) { /* am's flag: strength independent of T */
             s_t[i] = l->s296_cm2_ghz;
         } else {
-            double q296 = partition_sum(q, l->iso, 296.0), qt = partition_sum(q, l->iso, t);
+            double q296 = atm_partition_sum(q, l->iso, 296.0), qt = atm_partition_sum(q, l->iso, t);
             if (!isfinite(q296) || !isfinite(qt)) {
                 free(s_t);
                 free(sp->lines);
@@ -601,7 +287,7 @@ static double continuum_per_cm(const atm_lines_data *d, double f_ghz)
         return 0.0;
     double nu = f_ghz / ATM_GHZ_PER_CM1;
     double t = d->air.temperature_k;
-    double rad = nu * tanh(HC_OVER_K_CM_K * nu / (2.0 * t));
+    double rad = nu * tanh(ATM_HC_OVER_K_CM_K * nu / (2.0 * t));
     double cs = catmull_rom(d->c_self, d->n_cont, d->cont_step_cm1, nu);
     double cf = catmull_rom(d->c_foreign, d->n_cont, d->cont_step_cm1, nu);
     double tx = catmull_rom(d->self_texp, d->n_cont, d->cont_step_cm1, nu);
@@ -772,22 +458,22 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
     const char *const inputs[] = {p_h2o, p_o2, p_o2c, p_qh2o, p_qo2, p_cont};
     for (size_t i = 0; st == THZ_OK && i < sizeof inputs / sizeof inputs[0]; i++)
         if (i < 5 || d->continuum)
-            st = file_check_regular(inputs[i], NULL, ATM_LINES_MAX_FILE_BYTES, NULL, err);
+            st = file_check_regular(inputs[i], NULL, ATM_CATALOG_MAX_FILE_BYTES, NULL, err);
     if (st == THZ_OK)
-        st = read_catalog(p_h2o, 1, false, &h2o, err);
+        st = atm_catalog_read(p_h2o, 1, &h2o, err);
     if (st == THZ_OK)
-        st = read_catalog(p_o2, 7, false, &o2, err);
+        st = atm_catalog_read(p_o2, 7, &o2, err);
     if (st == THZ_OK)
-        st = read_csv_catalog(p_o2c, true, &o2c, err);
+        st = atm_catalog_read_csv(p_o2c, true, &o2c, err);
     if (st == THZ_OK)
-        st = read_partition_sums(p_qh2o, &q_h2o, err);
+        st = atm_partition_sums_read(p_qh2o, &q_h2o, err);
     if (st == THZ_OK)
-        st = read_partition_sums(p_qo2, &q_o2, err);
+        st = atm_partition_sums_read(p_qo2, &q_o2, err);
     if (st == THZ_OK && d->continuum)
         st = read_continuum(d, p_cont, err);
     if (st != THZ_OK)
         goto cleanup;
-    if (has_suffix(p_o2, ".par"))
+    if (atm_catalog_is_par(p_o2))
         drop_coupled_duplicates(&o2, &o2c);
 
     double t = air->temperature_k, p = air->pressure_hpa, e = air->h2o_pressure_hpa;

@@ -1,7 +1,8 @@
-/* Fuzzes the `lines` atmosphere's file readers (src/atmosphere/atm_lines.c): the first
- * byte of the input picks which file the rest replaces (below); the other files are the
- * small fixtures of tests/fuzz/data/atmosphere/. An accepted set is then evaluated
- * across the model's frequency range.
+/* Fuzzes the `lines` atmosphere's file readers (src/atmosphere/atm_catalog.c and the
+ * continuum's in atm_lines.c, through atm_lines_create): the first byte of the input picks
+ * which file the rest replaces (below); the other files are the small fixtures of
+ * tests/fuzz/data/atmosphere/. An accepted set is then evaluated across the model's
+ * frequency range.
  */
 #include <math.h>
 #include <stdlib.h>
