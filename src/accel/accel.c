@@ -3,7 +3,8 @@
  * quality.
  *
  * Self-intersection rule. A ray leaving a surface is protected twice:
- *  1. the (object, triangle) it leaves from is rejected by a context filter function,
+ *  1. the (object, triangle) it leaves from is never returned: a ray whose closest hit
+ *     is that triangle is cast again with a context filter function that rejects it,
  *     so the leaving triangle can never be hit again at t ~ 0 whatever the rounding;
  *  2. its origin is moved off the surface along the geometric normal, towards the side
  *     the ray leaves on, by eps = max(1e-6 * bbox diagonal, 16 * FLT_EPSILON *
@@ -217,8 +218,6 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
     rtcInitIntersectContext(&ctx.base);
     ctx.ignore_object = ignore_object;
     ctx.ignore_triangle = ignore_triangle;
-    if (ignore_object != ACCEL_NO_OBJECT)
-        ctx.base.filter = accel_filter;
 
     struct RTCRayHit rh;
     rh.ray.org_x = (float)origin_m.x;
@@ -237,7 +236,20 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
 
+    /* Cast without the filter first: the closest hit, if it is not the ignored
+     * triangle, is the closest of the others too. Only a ray that met the triangle it
+     * leaves is cast again, with the filter (a callback on every candidate hit was 3.5 %
+     * of path's instructions). */
     rtcIntersect1(a->rtc, &ctx.base, &rh);
+    if (ignore_object != ACCEL_NO_OBJECT && rh.hit.geomID == ignore_object &&
+        rh.hit.primID == ignore_triangle) {
+        ctx.base.filter = accel_filter;
+        rh.ray.tfar = max_distance_m >= (double)FLT_MAX ? INFINITY : (float)max_distance_m;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(a->rtc, &ctx.base, &rh);
+    }
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return false;
 

@@ -88,6 +88,28 @@ static void test_hit_side_and_distance(void **state)
     assert_false(accel_intersect(f->acc, v3(0, 0, 1.0), v3(1, 0, 0), 4.0, ACCEL_NO_OBJECT, 0, &h));
 }
 
+/* The ignored triangle is never returned, even where it is the closest hit (from a
+ * point 0.1 m below it, far beyond the origin offset): the next surface is. Ignoring
+ * another triangle changes nothing. */
+static void test_ignored_closest(void **state)
+{
+    fixture *f = *state;
+    accel_hit h, g;
+    vec3 o = v3(3.3, -2.1, 3.9), up = v3(0, 0, 1);
+    assert_true(accel_intersect(f->acc, o, up, INFINITY, ACCEL_NO_OBJECT, 0, &h));
+    assert_int_equal(h.object, f->lower);
+    assert_true(accel_intersect(f->acc, o, up, INFINITY, h.object, h.triangle ^ 1u, &g));
+    assert_int_equal(g.object, f->lower);
+    assert_int_equal(g.triangle, h.triangle);
+    assert_float_equal(g.distance_m, h.distance_m, 0.0);
+    assert_true(accel_intersect(f->acc, o, up, INFINITY, h.object, h.triangle, &g));
+    assert_int_equal(g.object, f->upper);
+    assert_int_equal(g.side, 0);
+    assert_float_equal(g.distance_m, 0.1 + GAP_M, 1e-5);
+    /* and with a limit short of the next surface, nothing */
+    assert_false(accel_intersect(f->acc, o, up, 0.1 + 0.5 * GAP_M, h.object, h.triangle, &g));
+}
+
 /* Leaves the lower rectangle upwards from point p (on triangle tri) in direction dir and
  * checks that it hits the upper rectangle's front side after GAP/mu. */
 static void check_leave(const fixture *f, uint32_t tri, vec3 p, vec3 dir)
@@ -178,6 +200,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_hit_side_and_distance, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_ignored_closest, setup, teardown),
         cmocka_unit_test_setup_teardown(test_thin_shell_normal_and_grazing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_shared_edge, setup, teardown),
         cmocka_unit_test_setup_teardown(test_threads, setup, teardown),
