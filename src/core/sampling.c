@@ -51,22 +51,33 @@ vec3 sampling_cosine32(vec3 n, rng_stream *rng)
     return sampling_direction_inline(n, mu, azimuth);
 }
 
-sampling_stratum sampling_stratum_of(rng_stream *set, uint32_t count, uint32_t which)
+void sampling_set_draw(rng_stream *set, uint32_t count, sampling_set *out)
 {
-    uint32_t place[SAMPLING_STRATA_MAX];
+    out->count = count;
     for (uint32_t k = 0; k < count; k++)
-        place[k] = k;
-    double phi0 = rng_uniform(set);
+        out->place[k] = (uint8_t)k;
+    out->phi0 = rng_uniform(set);
     for (uint32_t k = count; k-- > 1;) { /* Fisher-Yates */
         uint32_t r = (uint32_t)(rng_uniform(set) * (double)(k + 1));
-        uint32_t t = place[k];
-        place[k] = place[r];
-        place[r] = t;
+        uint8_t t = out->place[k];
+        out->place[k] = out->place[r];
+        out->place[r] = t;
     }
-    double azimuth = phi0 + (double)which / (double)count;
-    return (sampling_stratum){.polar_lo = (double)place[which] / (double)count,
-                              .polar_width = 1.0 / (double)count,
+}
+
+sampling_stratum sampling_set_member(const sampling_set *s, uint32_t which)
+{
+    double azimuth = s->phi0 + (double)which / (double)s->count;
+    return (sampling_stratum){.polar_lo = (double)s->place[which] / (double)s->count,
+                              .polar_width = 1.0 / (double)s->count,
                               .azimuth = azimuth < 1.0 ? azimuth : azimuth - 1.0};
+}
+
+sampling_stratum sampling_stratum_of(rng_stream *set, uint32_t count, uint32_t which)
+{
+    sampling_set s;
+    sampling_set_draw(set, count, &s);
+    return sampling_set_member(&s, which);
 }
 
 void sampling_direction_many(const vec3 *n, const double *mu, const double *u, size_t count,

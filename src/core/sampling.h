@@ -31,6 +31,16 @@ typedef struct sampling_stratum {
 /* Member which < count <= SAMPLING_STRATA_MAX of the set drawn from `set` (every member
  * draws the same count words from a stream started the same way). */
 sampling_stratum sampling_stratum_of(struct rng_stream *set, uint32_t count, uint32_t which);
+/* sampling_stratum_of in two steps, for a caller that keeps the set for its members:
+ * what the members share (phi0 and the permutation, drawn from `set`), then one member's
+ * stratum; the same numbers. */
+typedef struct sampling_set {
+    double phi0;
+    uint32_t count;
+    uint8_t place[SAMPLING_STRATA_MAX];
+} sampling_set;
+void sampling_set_draw(struct rng_stream *set, uint32_t count, sampling_set *out);
+sampling_stratum sampling_set_member(const sampling_set *s, uint32_t which);
 
 /* sampling_direction for count photons at once: the same directions, in a loop the
  * compiler vectorises. */

@@ -23,6 +23,14 @@ typedef struct render_sample {
     uint64_t paths;
 } render_sample;
 
+/* The set of estimate j's strata (render_stratum), kept while the thread renders the
+ * set's samples, which draw it from the same stream: key is the set's stream index. */
+typedef struct render_strata {
+    uint64_t key;
+    sampling_set set;
+} render_strata;
+#define RENDER_STRATA_NONE UINT64_MAX
+
 /* Where a sample's estimates go: est[j] += weight x (estimate j), j < n_est. */
 typedef struct render_target {
     double *est;
@@ -32,6 +40,7 @@ typedef struct render_target {
     double weight;      /* 1 / n^2 */
     uint64_t rng_index; /* first index of this sample's random streams (x n_est) */
     uint32_t stratum, n_strata; /* the sample's place among its pixel's n_strata samples */
+    render_strata *strata;      /* n_est sets of the thread's own (crossings 0), or NULL */
 } render_target;
 
 /* An integrator: the estimates of one sample ray. `sample_sr` is the sample's solid

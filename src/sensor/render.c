@@ -116,11 +116,18 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
     size_t per_thread = (n_est + PHOTON_MAP_BATCHES + 1 + 7) / 8 * 8;
     double *scratch_mem = thz_malloc_array((size_t)threads * per_thread + 7, sizeof *scratch_mem);
     double *scratch = scratch_mem ? scratch_mem + (8 - (uintptr_t)scratch_mem / 8 % 8) % 8 : NULL;
-    if (!scratch)
+    /* per thread: the strata sets of its current pixel's estimates (render_stratum) */
+    render_strata *strata = thz_malloc_array((size_t)threads * n_est, sizeof *strata);
+    if (!scratch || !strata) {
+        free(scratch_mem);
+        free(strata);
         return thz_error_set(err, THZ_ERR_NOMEM,
                              "render: out of memory for %u estimates x %d "
                              "threads",
                              n_est, threads);
+    }
+    for (size_t k = 0; k < (size_t)threads * n_est; k++)
+        strata[k].key = RENDER_STRATA_NONE;
 
     uint32_t n = cam.oversampling, cols = cam.columns, rows = cam.rows;
     double n2 = (double)n * (double)n;
@@ -184,6 +191,7 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
                         render_rng_index(scene, sensor, pass, samples_per_pass, sample, n_est),
                     .stratum = j * n + i,
                     .n_strata = n * n,
+                    .strata = &strata[(size_t)omp_get_thread_num() * n_est],
                 };
                 integ->sample(ctx, cam.position_m, dir, sample_sr, &t, &s);
                 var_sum += s.variance;
@@ -223,6 +231,7 @@ cleanup:
         stats->seconds = thz_now_s() - t0;
     }
     free(scratch_mem);
+    free(strata);
     return st;
 }
 
