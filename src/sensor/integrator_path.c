@@ -40,10 +40,12 @@
  * product is at least this; below, roulette on R and T(theta), beta unchanged. Roulette's
  * choice between going on and stopping was the larger part of the noise where objects of
  * R ~ 0.5 face each other (the paper's cylinders and their covers): on the paper's scene
- * this takes the objects' RMS standard error at 0.2 THz from 0.188 to 0.136 K (16 paths,
- * variance x 0.52) for about 1.2x the render time. 0.15 to 0.4 give the same within 2 %
- * (variance x instructions); above R of the cylinders (0.55) the gain is lost. */
-#define RENDER_PATH_MIN_WEIGHT 0.3
+ * going on while beta (R + T) >= 0.3 took the objects' RMS standard error at 0.2 THz from
+ * 0.188 to 0.136 K (16 paths, variance x 0.52) for about 1.2x the render time. Since
+ * 2026-12-03 beta includes the first hit's branch weight (R or T(theta),
+ * render_path_trace), and the threshold is 0.15: in variance x instructions, 0.05 to 0.2
+ * do the same within 1 % (32 paths a sample; 0.1 to 0.2 with 108) and 0.3 is 8 % worse. */
+#define RENDER_PATH_MIN_WEIGHT 0.15
 
 /* Philox blocks computed ahead when a sample's paths start, 16 streams at a time
  * (rng_init_many): a path draws its frequency (2 words), then 2 or 3 a bounce. */
@@ -176,8 +178,11 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
  * shells, a transmitted branch weighted T(theta), each continued by roulette. (Every path
  * of a sample shares the first hit; roulette there would add the variance of choosing
  * between what the reflection and the transmission see, the main noise of a wall that
- * reflects a warmer object.) The branches' directions come from `stratum` where it is
- * not NULL (render_stratum). */
+ * reflects a warmer object.) A branch's weight is part of its beta, so that roulette
+ * weighs it by what it carries: a cover's reflected branch (R = 0.05) went on without
+ * roulette as far as its transmitted one (T = 0.93) when the weight multiplied the
+ * branch's sum instead (variance x instructions x 0.92 on the paper's scene at 0.2 THz).
+ * The branches' directions come from `stratum` where it is not NULL (render_stratum). */
 static double render_path_trace(const render_context *ctx, const accel_hit *first, vec3 dir0,
                                 double nu, const sampling_stratum *stratum, rng_stream *rng,
                                 render_sample *out)
@@ -202,13 +207,13 @@ static double render_path_trace(const render_context *ctx, const accel_hit *firs
     double beta_r = beta;
     if (r > 0.0 &&
         render_scatter_dir(scene, obj, first, &o, n_seen, false, stratum, rng, &dir, &beta_r))
-        sum += r * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta_r, rng, out);
+        sum += render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, r * beta_r, rng, out);
     if (tr > 0.0) {
         bool straight = scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT;
         dir = dir0;
         if (straight ||
             render_scatter_dir(scene, obj, first, &o, n_seen, true, stratum, rng, &dir, &beta))
-            sum += tr * render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, beta, rng, out);
+            sum += render_path_continue(ctx, first, dir, nu, b0, b_air, alpha, tr * beta, rng, out);
     }
     out->paths++;
     return sum;
