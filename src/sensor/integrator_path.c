@@ -11,10 +11,12 @@
  * or transmitted (straight: unchanged; diffuse: exit mu ~ T(mu) mu), which makes the BRDF
  * and BTDF weights exactly 1. While beta (R + T(theta)) is at least
  * RENDER_PATH_MIN_WEIGHT it always goes on, beta multiplied by R + T(theta), reflected
- * with probability R / (R + T); below, Russian roulette with probabilities R(theta) and
- * T(theta), beta unchanged. The estimate is Bbar0 + the sum, Bbar0 the band mean of B0 by
- * the channel quadrature; E[B0(nu)] = Bbar0, so it is unbiased for the band mean of L
- * for any T0 (B0 is an additive control variate, in space and in frequency).
+ * with probability R / (R + T); below, Russian roulette: on with probability
+ * beta (R + T(theta)) / RENDER_PATH_MIN_WEIGHT at weight RENDER_PATH_MIN_WEIGHT,
+ * reflected or transmitted in the same proportion. The estimate is Bbar0 + the sum,
+ * Bbar0 the band mean of B0 by the channel quadrature; E[B0(nu)] = Bbar0, so it is
+ * unbiased for the band mean of L for any T0 (B0 is an additive control variate, in
+ * space and in frequency).
  *
  * Two refinements at the sample's first hit, which all its paths share: the terms of
  * the first free path and the first hit are known functions of nu there, so they enter
@@ -37,14 +39,19 @@
 #include "sensor/integrator.h"
 
 /* A path goes on without roulette, its weight beta multiplied by R + T(theta), while that
- * product is at least this; below, roulette on R and T(theta), beta unchanged. Roulette's
+ * product is at least this; below, roulette on it, the survivors' weight this. Roulette's
  * choice between going on and stopping was the larger part of the noise where objects of
  * R ~ 0.5 face each other (the paper's cylinders and their covers): on the paper's scene
  * going on while beta (R + T) >= 0.3 took the objects' RMS standard error at 0.2 THz from
  * 0.188 to 0.136 K (16 paths, variance x 0.52) for about 1.2x the render time. Since
  * 2026-12-03 beta includes the first hit's branch weight (R or T(theta),
  * render_path_trace), and the threshold is 0.15: in variance x instructions, 0.05 to 0.2
- * do the same within 1 % (32 paths a sample; 0.1 to 0.2 with 108) and 0.3 is 8 % worse. */
+ * do the same within 1 % (32 paths a sample; 0.1 to 0.2 with 108) and 0.3 is 8 % worse.
+ * Below it, roulette kept beta and survived with probability R + T until 2026-12-03: a
+ * path leaving a wall (R = 0.1) went on at 10 % with its full weight. Surviving with
+ * probability beta (R + T) / 0.15 at weight 0.15 instead gives variance x instructions
+ * x 0.91 (108 paths, seeds 1 and 2); with 32 paths 0.15 and 0.2 do the same, 0.1 and
+ * 0.3 3-5 % worse. */
 #define RENDER_PATH_MIN_WEIGHT 0.15
 
 /* Philox blocks computed ahead when a sample's paths start, 16 streams at a time
@@ -156,9 +163,14 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
             beta *= keep;
             transmitted = !(u * keep < r);
         } else {
-            if (!(u < keep))
+            /* roulette: on with probability q = beta (R + T) / RENDER_PATH_MIN_WEIGHT at
+             * weight RENDER_PATH_MIN_WEIGHT (the same expectation), reflected or
+             * transmitted in proportion */
+            double q = beta * keep / RENDER_PATH_MIN_WEIGHT;
+            if (!(u < q))
                 break; /* absorbed */
-            transmitted = !(u < r);
+            transmitted = !(u / q * keep < r);
+            beta = RENDER_PATH_MIN_WEIGHT;
         }
         if (transmitted && scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT)
             continue; /* straight on, dir unchanged */
