@@ -4,16 +4,18 @@
  * for both transmission modes: `straight` sees the background through T(theta);
  * `diffuse` transmits T(theta_o) B(T_b) by reciprocity, the incident radiance being
  * uniform. At normal incidence this is the spec's T_0 form; each pixel is compared at
- * its own angle (one sample per pixel, through the pixel centre). For every integrator. */
+ * its own angle (one sample per pixel, through the pixel centre). For every integrator.
+ * A third case gives the diffuse shell R = 0.05, a reflected part light enough to be
+ * traced by roulette (path's first-hit branches, final-gather's split gather rays). */
 #include "identity.h"
 
-#define SHELL_R 0.2
 #define SHELL_ALPHA 200.0
 #define SHELL_T_M 0.002
 #define SHELL_TS 400.0
 #define SHELL_TB 250.0
 
-static void shell_case_with(const char *mode, uint64_t seed, thz_integrator integrator, double t0_k)
+static void shell_case_with(const char *mode, uint64_t seed, double refl, thz_integrator integrator,
+                            double t0_k)
 {
     char json[2048];
     snprintf(json, sizeof json,
@@ -33,7 +35,7 @@ static void shell_case_with(const char *mode, uint64_t seed, thz_integrator inte
              " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.3, 0],"
              "   \"direction\": [0, 1, 0], \"fov_deg\": 100, \"resolution\": [12, 12]}],"
              " \"photons\": {\"per_channel\": 300000, \"seed\": %llu}}",
-             mode, SHELL_R, SHELL_ALPHA, mode, SHELL_TB, SHELL_T_M, SHELL_TS,
+             mode, refl, SHELL_ALPHA, mode, SHELL_TB, SHELL_T_M, SHELL_TS,
              (unsigned long long)seed);
     ident_run r;
     ident_run_scene_t0(&r, json, ident_photons(300000), integrator, ident_estimates(32), t0_k);
@@ -44,10 +46,10 @@ static void shell_case_with(const char *mode, uint64_t seed, thz_integrator inte
     for (uint32_t row = 0; row < r.img.rows; row++)
         for (uint32_t col = 0; col < r.img.columns; col++) {
             double mu = fabs(camera_pixel_center_dir(&r.cam, col, row).y); /* normal is -y */
-            double tr = fmin(exp(-SHELL_ALPHA * SHELL_T_M / mu), 1.0 - SHELL_R);
+            double tr = fmin(exp(-SHELL_ALPHA * SHELL_T_M / mu), 1.0 - refl);
             t_min = fmin(t_min, tr);
             t_max = fmax(t_max, tr);
-            expects[row * r.img.columns + col] = (1.0 - SHELL_R - tr) * bs + (SHELL_R + tr) * bb;
+            expects[row * r.img.columns + col] = (1.0 - refl - tr) * bs + (refl + tr) * bb;
         }
     ident_tally t = {.pooled_rel_se = ident_pooled_rel_se(&r, 0, expects)};
     for (uint32_t row = 0; row < r.img.rows; row++)
@@ -60,29 +62,35 @@ static void shell_case_with(const char *mode, uint64_t seed, thz_integrator inte
     assert_true(t_max - t_min > 0.1); /* the view spans a real range of T(theta) */
     char label[64], what[128];
     ident_label(label, sizeof label, integrator, t0_k);
-    snprintf(what, sizeof what, "%s shell, %s", mode, label);
+    snprintf(what, sizeof what, "%s shell, R = %g, %s", mode, refl, label);
     ident_tally_assert(&t, what, 0.08 / sqrt(ident_scale()), 1e-5);
     ident_run_fini(&r);
 }
 
-static void shell_case(const char *mode, uint64_t seed)
+static void shell_case(const char *mode, uint64_t seed, double refl)
 {
     for (size_t k = 0; k < IDENT_N_INTEGRATORS; k++)
         for (size_t v = 0; v < IDENT_N_T0; v++)
             if (ident_t0_applies(ident_integrators[k], v))
-                shell_case_with(mode, seed, ident_integrators[k], ident_t0s[v]);
+                shell_case_with(mode, seed, refl, ident_integrators[k], ident_t0s[v]);
 }
 
 static void test_shell_straight(void **state)
 {
     (void)state;
-    shell_case("straight", 7);
+    shell_case("straight", 7, 0.2);
 }
 
 static void test_shell_diffuse(void **state)
 {
     (void)state;
-    shell_case("diffuse", 8);
+    shell_case("diffuse", 8, 0.2);
+}
+
+static void test_shell_diffuse_light_reflection(void **state)
+{
+    (void)state;
+    shell_case("diffuse", 9, 0.05);
 }
 
 int main(void)
@@ -90,6 +98,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_shell_straight),
         cmocka_unit_test(test_shell_diffuse),
+        cmocka_unit_test(test_shell_diffuse_light_reflection),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
