@@ -227,7 +227,8 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
     rh.ray.dir_y = (float)dir.y;
     rh.ray.dir_z = (float)dir.z;
     rh.ray.tnear = 0.0f;
-    rh.ray.tfar = max_distance_m >= (double)FLT_MAX ? INFINITY : (float)max_distance_m;
+    const float tfar = max_distance_m >= (double)FLT_MAX ? INFINITY : (float)max_distance_m;
+    rh.ray.tfar = tfar;
     rh.ray.time = 0.0f;
     rh.ray.mask = 0xffffffffu;
     rh.ray.id = 0;
@@ -244,7 +245,7 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
     if (ignore_object != ACCEL_NO_OBJECT && rh.hit.geomID == ignore_object &&
         rh.hit.primID == ignore_triangle) {
         ctx.base.filter = accel_filter;
-        rh.ray.tfar = max_distance_m >= (double)FLT_MAX ? INFINITY : (float)max_distance_m;
+        rh.ray.tfar = tfar;
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;

@@ -54,18 +54,30 @@
  * 0.3 3-5 % worse. */
 #define RENDER_PATH_MIN_WEIGHT 0.15
 
-/* Whether a first-hit branch of weight *w is traced: always where *w is at least
- * RENDER_PATH_MIN_WEIGHT; below, with probability *w / RENDER_PATH_MIN_WEIGHT, *w then
- * raised to it (the same expectation; one uniform drawn). A cover's reflected branch
- * (R = 0.05) cast its rays for 5 % of the path's weight. */
-static bool render_path_branch(double *w, rng_stream *rng)
+/* The path's roulette (the top of this file): a weight *w of at least
+ * RENDER_PATH_MIN_WEIGHT goes on as it is; a smaller one goes on with probability
+ * q = *w / RENDER_PATH_MIN_WEIGHT at weight RENDER_PATH_MIN_WEIGHT (the same
+ * expectation). u decides; *u_rest (u, or u / q) is uniform again given that it goes on. */
+static bool render_path_roulette(double *w, double u, double *u_rest)
 {
+    *u_rest = u;
     if (*w >= RENDER_PATH_MIN_WEIGHT)
         return true;
-    if (!(rng_uniform32(rng) * RENDER_PATH_MIN_WEIGHT < *w))
+    double q = *w / RENDER_PATH_MIN_WEIGHT;
+    if (!(u < q))
         return false;
+    *u_rest = u / q;
     *w = RENDER_PATH_MIN_WEIGHT;
     return true;
+}
+
+/* Whether a first-hit branch of weight *w is traced: by render_path_roulette, its
+ * uniform drawn only where *w is below RENDER_PATH_MIN_WEIGHT. A cover's reflected
+ * branch (R = 0.05) cast its rays for 5 % of the path's weight. */
+static bool render_path_branch(double *w, rng_stream *rng)
+{
+    double unused;
+    return *w >= RENDER_PATH_MIN_WEIGHT || render_path_roulette(w, rng_uniform32(rng), &unused);
 }
 
 /* Philox blocks computed ahead when a sample's paths start, 16 streams at a time
@@ -170,22 +182,13 @@ static double render_path_continue(const render_context *ctx, const accel_hit *f
         double eps = o.explicit_emissivity ? o.emissivity : a;
         double bt = obj->temperature_k == ctx->t0_k ? b0 : planck_radiance(nu, obj->temperature_k);
         sum += beta * (eps * bt - a * b0);
-        double u = rng_uniform32(rng), keep = r + tr;
-        bool transmitted;
-        if (beta * keep >= RENDER_PATH_MIN_WEIGHT) {
-            /* no roulette: on with weight R + T, reflected or transmitted in proportion */
-            beta *= keep;
-            transmitted = !(u * keep < r);
-        } else {
-            /* roulette: on with probability q = beta (R + T) / RENDER_PATH_MIN_WEIGHT at
-             * weight RENDER_PATH_MIN_WEIGHT (the same expectation), reflected or
-             * transmitted in proportion */
-            double q = beta * keep / RENDER_PATH_MIN_WEIGHT;
-            if (!(u < q))
-                break; /* absorbed */
-            transmitted = !(u / q * keep < r);
-            beta = RENDER_PATH_MIN_WEIGHT;
-        }
+        /* on with weight beta (R + T), or by roulette below the threshold; reflected or
+         * transmitted in proportion R : T */
+        double u = rng_uniform32(rng), keep = r + tr, w = beta * keep;
+        if (!render_path_roulette(&w, u, &u))
+            break; /* absorbed */
+        beta = w;
+        bool transmitted = !(u * keep < r);
         if (transmitted && scene->materials[obj->material].transmission == TRANSMISSION_STRAIGHT)
             continue; /* straight on, dir unchanged */
         const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
