@@ -18,9 +18,9 @@
  * in order, which the hardware prefetches; each split is three binary searches whose
  * probes it cannot: final-gather's render on the paper's scene (0.2 THz, 6 M photons,
  * 32 gather rays, rendered from one saved map, alternating builds) took 4.39 s on 1 thread
- * (median of 5) and 2.41 s on 2 (of 6) with 256, against 4.99 and 2.58 s with 48, for 2 %
- * fewer instructions; 128 and 192 fell between, 384 was slower. The visits, their order
- * and so every image are the same for any leaf size. */
+ * (median of 5) and 2.41 s on 2 (of 6) with 256, against 4.99 and 2.58 s with 48, for
+ * 0.4 % more instructions; 128 and 192 fell between, 384 was slower. The visits, their
+ * order and so every image are the same for any leaf size. */
 #define PHOTON_MAP_LEAF 256
 
 /* The cube a group's octree spans: origin (its bounding box's minimum) and side. */
