@@ -125,6 +125,40 @@ static void test_knn_matches_kth_distance(void **state)
     photon_map_destroy(map);
 }
 
+/* Most distances equal (1 000 photons at one point, 50 farther away): the k-th
+ * distance is still photon_map_kth_distance2's, for k inside the tie and just past it. */
+static void test_knn_equal_distances(void **state)
+{
+    (void)state;
+    const size_t n = 1050;
+    photon_record *p = malloc(n * sizeof *p);
+    assert_non_null(p);
+    rng_stream rng;
+    rng_init(&rng, 8, 0, RNG_PURPOSE_TEST, 0);
+    for (size_t i = 0; i < n; i++) {
+        float x = i < 1000 ? 0.25f : (float)(0.5 + 0.5 * rng_uniform(&rng));
+        p[i] = (photon_record){.position_m = {x, 0.5f, 0.1f},
+                               .power_w_per_hz = 1.0f,
+                               .freq_hz = 1e12f,
+                               .object_side = 0};
+    }
+    photon_map *map = NULL;
+    assert_int_equal(photon_map_create(p, n, 1, 0, &map, NULL), THZ_OK);
+    static knn_buffer b;
+    static double scratch[KNN_CAP];
+    static const size_t ks[] = {1, 2, 500, 999, 1000, 1001, 1002, 1050};
+    vec3 q = v3(0.2, 0.5, 0.1);
+    const photon_record at = {.position_m = {0.25f, 0.5f, 0.1f}};
+    const double tie = dist2(&at, q); /* the map owns p now */
+    for (size_t ki = 0; ki < sizeof ks / sizeof ks[0]; ki++) {
+        double want = photon_map_kth_distance2(map, 0, 1u, q, ks[ki]);
+        double got = knn_collect(map, NULL, 0, 1.0, 0, 1u, q, ks[ki], &b, scratch);
+        assert_true(got == want);
+        assert_true(ks[ki] > 1000 ? want > tie : want == tie);
+    }
+    photon_map_destroy(map);
+}
+
 /* Every visit of a radius query, in order. */
 typedef struct visits {
     const photon_record **p;
@@ -183,6 +217,7 @@ static void test_directory_same_visits(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_knn_matches_kth_distance),
+                                       cmocka_unit_test(test_knn_equal_distances),
                                        cmocka_unit_test(test_directory_same_visits)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
