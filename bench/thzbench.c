@@ -200,12 +200,14 @@ int main(int argc, char **argv)
      * thread: photon-map 10 renders, final-gather one pass of the scene's 32 gather rays,
      * path 10 passes of the scene's 16 paths (0: the scene's estimates per pass). */
     const uint64_t fg_photons = small ? 20000 : 1000000;
-    /* Time to a converged image (section 6), final-gather: 6 M photons, about the count
-     * that reaches 0.05 K soonest on the paper's scene with the photon guide (0.2 THz,
-     * fitted through 32 and 64 gather rays: at 4, 6 and 8 M photons the map's floor 0.037,
-     * 0.033, 0.030 K and 50, 39, 35 gather rays; docs/integrators.md). Before the guide
-     * the optimum was flat from 4 to 8 M and 8 M was kept. */
-    const uint64_t conv_fg_photons = small ? 20000 : 6000000;
+    /* Time to a converged image (section 6), final-gather: 4 M photons, about the count
+     * that reaches 0.05 K soonest on the paper's scene (0.2 THz, fitted through 32 and 64
+     * gather rays: at 3, 4, 5 and 6 M photons the map's floor 0.042, 0.037, 0.035,
+     * 0.033 K and 68, 50, 43, 39 gather rays; docs/integrators.md). A million photons
+     * more cost 0.8 CPU s and save about 5 gather rays, 0.45 CPU s (2026-12-04). Before
+     * the guide the optimum was flat from 4 to 8 M and 8 M was kept; with it, 6 M until
+     * the render got cheaper. */
+    const uint64_t conv_fg_photons = small ? 20000 : 4000000;
     const uint32_t speedup_estimates[3] = {0, small ? 2 : 0, small ? 2 : 0};
     const uint32_t speedup_passes[3] = {1, 1, small ? 1 : 10};
     const uint32_t speedup_renders[3] = {small ? 1 : 10, 1, 1};
