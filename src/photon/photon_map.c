@@ -255,6 +255,7 @@ typedef struct photon_radius_query {
     const size_t *dir_starts;
     double q[3];
     double radius2, radius;
+    float radius2_pre; /* a float bound that every record within the radius meets */
     photon_visit_fn visit;
     void *ctx;
 } photon_radius_query;
@@ -304,18 +305,27 @@ static void photon_radius_axes(const photon_radius_query *qr, const photon_cell 
 static void photon_radius_rec(const photon_radius_query *qr, const photon_cell *cell)
 {
     if (cell->hi - cell->lo <= PHOTON_MAP_LEAF || cell->level == PHOTON_MAP_LEVELS) {
-        /* 64 records at a time: which of them lie within the radius, as a mask of
-         * compares without branches (most do not: a branch per record mispredicts),
-         * then the visits in record order. */
+        /* 64 records at a time: which of them may lie within the radius, as a mask of
+         * compares without branches (most do not: a branch per record mispredicts), in
+         * floats against a bound that every record within the radius meets (twice the
+         * lanes of doubles), then each candidate's distance in double and the visits in
+         * record order: the same visits as a test in double alone. */
+        const float qf[3] = {(float)qr->q[0], (float)qr->q[1], (float)qr->q[2]};
+        const float r2f = qr->radius2_pre;
         for (size_t i0 = cell->lo; i0 < cell->hi; i0 += 64) {
             size_t n = cell->hi - i0 < 64 ? cell->hi - i0 : 64;
             uint64_t inside = 0;
-            for (size_t j = 0; j < n; j++)
-                inside |= (uint64_t)(photon_distance2(&qr->r[i0 + j], qr->q) <= qr->radius2) << j;
+            for (size_t j = 0; j < n; j++) {
+                const float *pp = qr->r[i0 + j].position_m;
+                float dx = pp[0] - qf[0], dy = pp[1] - qf[1], dz = pp[2] - qf[2];
+                inside |= (uint64_t)(dx * dx + dy * dy + dz * dz <= r2f) << j;
+            }
             while (inside) {
                 size_t i = i0 + (size_t)__builtin_ctzll(inside);
                 inside &= inside - 1;
-                qr->visit(qr->ctx, &qr->r[i], photon_distance2(&qr->r[i], qr->q));
+                double d2 = photon_distance2(&qr->r[i], qr->q);
+                if (d2 <= qr->radius2)
+                    qr->visit(qr->ctx, &qr->r[i], d2);
             }
         }
         return;
@@ -373,6 +383,14 @@ void photon_map_radius_in(const photon_map *map, const photon_map_directory *dir
                               .radius = sqrt(radius2_m2),
                               .visit = visit,
                               .ctx = ctx};
+    /* The float test's bound: q rounded to float moves it by at most u |q| a coordinate
+     * (u = 2^-24), each difference rounds by (1 + u) and the sum of squares by at most
+     * (1 + u)^3, so a record within the radius has a float distance^2 below
+     * (1 + 3.01 u) ((1 + u) r + 3 u max|q|)^2; the margin 8 u covers that and the
+     * bound's own rounding to float. */
+    double qmax = fmax(fabs(qr.q[0]), fmax(fabs(qr.q[1]), fabs(qr.q[2])));
+    double u = 0x1p-24, bound = (1.0 + u) * qr.radius + 3.0 * u * qmax;
+    qr.radius2_pre = (float)(bound * bound * (1.0 + 8.0 * u));
     photon_cell root = photon_root(lo, n);
     if (photon_cell_distance2(qr.cube, &root, qr.q) <= radius2_m2)
         photon_radius_rec(&qr, &root);

@@ -214,10 +214,56 @@ static void test_directory_same_visits(void **state)
     photon_map_destroy(map);
 }
 
+/* Radii through a photon exactly, far from the origin (where float positions are coarse):
+ * a radius query visits exactly the records whose distance in double is within it, the
+ * one on the boundary included (its leaf scan tests floats first, with a bound). */
+static void test_radius_boundary(void **state)
+{
+    (void)state;
+    const size_t n = 4000;
+    photon_record *p = malloc(n * sizeof *p);
+    assert_non_null(p);
+    rng_stream rng;
+    rng_init(&rng, 9, 0, RNG_PURPOSE_TEST, 0);
+    for (size_t i = 0; i < n; i++) {
+        float pos[3];
+        for (int a = 0; a < 3; a++) /* 1 km away, spread over 0.1 m */
+            pos[a] = (float)(1000.0 + 0.1 * rng_uniform(&rng));
+        p[i] = (photon_record){.position_m = {pos[0], pos[1], pos[2]},
+                               .power_w_per_hz = 1.0f,
+                               .freq_hz = 1e12f,
+                               .object_side = 0};
+    }
+    photon_map *map = NULL;
+    assert_int_equal(photon_map_create(p, n, 1, 0, &map, NULL), THZ_OK);
+    const photon_record *r = photon_map_records(map);
+    static const photon_record *seen[4000];
+    visits v = {seen, 0, 4000};
+    size_t on_boundary = 0;
+    for (int trial = 0; trial < 200; trial++) {
+        vec3 q = v3(1000.0 + 0.1 * rng_uniform(&rng), 1000.0 + 0.1 * rng_uniform(&rng),
+                    1000.0 + 0.1 * rng_uniform(&rng));
+        const photon_record *through = &r[rng_next_u32(&rng) % n];
+        double r2 = dist2(through, q);
+        size_t expect = 0;
+        for (size_t i = 0; i < n; i++)
+            expect += dist2(&r[i], q) <= r2;
+        v.n = 0;
+        photon_map_radius(map, 0, 0, q, r2, record_visit, &v);
+        assert_int_equal(v.n, expect);
+        for (size_t i = 0; i < v.n; i++) {
+            assert_true(dist2(v.p[i], q) <= r2);
+            on_boundary += v.p[i] == through;
+        }
+    }
+    assert_int_equal(on_boundary, 200);
+    photon_map_destroy(map);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_knn_matches_kth_distance),
-                                       cmocka_unit_test(test_knn_equal_distances),
-                                       cmocka_unit_test(test_directory_same_visits)};
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_knn_matches_kth_distance), cmocka_unit_test(test_knn_equal_distances),
+        cmocka_unit_test(test_directory_same_visits), cmocka_unit_test(test_radius_boundary)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
