@@ -125,31 +125,47 @@ static void test_knn_matches_kth_distance(void **state)
     photon_map_destroy(map);
 }
 
-/* Most distances equal (1 000 photons at one point, 50 farther away): the k-th
- * distance is still photon_map_kth_distance2's, for k inside the tie and just past it. */
-static void test_knn_equal_distances(void **state)
+/* A map of n photons of object 0, side 0, photon i at place(i): one object's layout. */
+static photon_map *map_of_places(size_t n, uint64_t seed,
+                                 void (*place)(size_t i, rng_stream *rng, float pos[3]))
 {
-    (void)state;
-    const size_t n = 1050;
     photon_record *p = malloc(n * sizeof *p);
     assert_non_null(p);
     rng_stream rng;
-    rng_init(&rng, 8, 0, RNG_PURPOSE_TEST, 0);
+    rng_init(&rng, seed, 0, RNG_PURPOSE_TEST, 0);
     for (size_t i = 0; i < n; i++) {
-        float x = i < 1000 ? 0.25f : (float)(0.5 + 0.5 * rng_uniform(&rng));
-        p[i] = (photon_record){.position_m = {x, 0.5f, 0.1f},
+        float pos[3];
+        place(i, &rng, pos);
+        p[i] = (photon_record){.position_m = {pos[0], pos[1], pos[2]},
                                .power_w_per_hz = 1.0f,
                                .freq_hz = 1e12f,
                                .object_side = 0};
     }
     photon_map *map = NULL;
     assert_int_equal(photon_map_create(p, n, 1, 0, &map, NULL), THZ_OK);
+    return map;
+}
+
+/* 1 000 photons at one point, 50 farther away along x. */
+static void place_tie(size_t i, rng_stream *rng, float pos[3])
+{
+    pos[0] = i < 1000 ? 0.25f : (float)(0.5 + 0.5 * rng_uniform(rng));
+    pos[1] = 0.5f;
+    pos[2] = 0.1f;
+}
+
+/* Most distances equal (1 000 photons at one point, 50 farther away): the k-th
+ * distance is still photon_map_kth_distance2's, for k inside the tie and just past it. */
+static void test_knn_equal_distances(void **state)
+{
+    (void)state;
+    photon_map *map = map_of_places(1050, 8, place_tie);
     static knn_buffer b;
     static double scratch[KNN_CAP];
     static const size_t ks[] = {1, 2, 500, 999, 1000, 1001, 1002, 1050};
     vec3 q = v3(0.2, 0.5, 0.1);
     const photon_record at = {.position_m = {0.25f, 0.5f, 0.1f}};
-    const double tie = dist2(&at, q); /* the map owns p now */
+    const double tie = dist2(&at, q);
     for (size_t ki = 0; ki < sizeof ks / sizeof ks[0]; ki++) {
         double want = photon_map_kth_distance2(map, 0, 1u, q, ks[ki]);
         double got = knn_collect(map, NULL, 0, 1.0, 0, 1u, q, ks[ki], &b, scratch);
@@ -214,6 +230,14 @@ static void test_directory_same_visits(void **state)
     photon_map_destroy(map);
 }
 
+/* 1 km from the origin, spread over 0.1 m. */
+static void place_far(size_t i, rng_stream *rng, float pos[3])
+{
+    (void)i;
+    for (int a = 0; a < 3; a++)
+        pos[a] = (float)(1000.0 + 0.1 * rng_uniform(rng));
+}
+
 /* Radii through a photon exactly, far from the origin (where float positions are coarse):
  * a radius query visits exactly the records whose distance in double is within it, the
  * one on the boundary included (its leaf scan tests floats first, with a bound). */
@@ -221,21 +245,9 @@ static void test_radius_boundary(void **state)
 {
     (void)state;
     const size_t n = 4000;
-    photon_record *p = malloc(n * sizeof *p);
-    assert_non_null(p);
+    photon_map *map = map_of_places(n, 9, place_far);
     rng_stream rng;
-    rng_init(&rng, 9, 0, RNG_PURPOSE_TEST, 0);
-    for (size_t i = 0; i < n; i++) {
-        float pos[3];
-        for (int a = 0; a < 3; a++) /* 1 km away, spread over 0.1 m */
-            pos[a] = (float)(1000.0 + 0.1 * rng_uniform(&rng));
-        p[i] = (photon_record){.position_m = {pos[0], pos[1], pos[2]},
-                               .power_w_per_hz = 1.0f,
-                               .freq_hz = 1e12f,
-                               .object_side = 0};
-    }
-    photon_map *map = NULL;
-    assert_int_equal(photon_map_create(p, n, 1, 0, &map, NULL), THZ_OK);
+    rng_init(&rng, 10, 0, RNG_PURPOSE_TEST, 0);
     const photon_record *r = photon_map_records(map);
     static const photon_record *seen[4000];
     visits v = {seen, 0, 4000};
