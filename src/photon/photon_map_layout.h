@@ -43,7 +43,7 @@ struct photon_map {
 
 /* A group's directory goes down to the deepest level L whose cells hold at least
  * PHOTON_DIR_MIN_PER_CELL records on average, at most PHOTON_DIR_MAX_LEVELS (8^6 cells,
- * 2 MB): at most 2 bytes per record (8 per cell of 4 records). Final-gather on the
+ * 2 MB): at most 2 bytes per record (8 bytes a cell, 4 records a cell). Final-gather on the
  * paper's scene spent 9-14 % less CPU with a directory (16 per cell and 6 levels, with
  * 48-record leaves; 64 per cell helped less, 8 and 7 levels no more). The photons lie on
  * surfaces, so the occupied cells hold many times the mean: with 256-record leaves, 4 per
