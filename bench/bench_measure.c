@@ -1,6 +1,7 @@
 /* The benchmark's measurements: see bench_measure.h. */
 #include "bench_measure.h"
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -321,6 +322,54 @@ thz_status bench_measure_series(const char *scene_path, size_t channel, const ui
     photon_map_pool_fini(&pool);
     if (s)
         bench_images_fini(img, s->n_sensors);
+    accel_destroy(acc);
+    thz_scene_destroy(s);
+    return st;
+}
+
+thz_status bench_measure_threads(const char *scene_path, size_t channel, uint64_t photons,
+                                 int threads, int repeats, bench_threads *out, thz_error *err)
+{
+    memset(out, 0, sizeof *out);
+    thz_scene *s = NULL;
+    accel *acc = NULL;
+    thz_status st = bench_load(scene_path, photons, &s, err);
+    if (st != THZ_OK)
+        return st;
+    if (channel >= s->n_channels)
+        channel = s->n_channels - 1;
+    st = accel_create(s, &acc, err);
+    photon_map_pool pool = {0};
+    const int n = 2 * (repeats > 0 ? repeats : 1);
+    for (int k = 0; st == THZ_OK && k < n; k++) {
+        const bool one = k % 2 == 0;
+        photon_phase_options po = {.threads = one ? 1 : threads, .pool = &pool};
+        photon_map *m = NULL;
+        photon_stats q;
+        memset(&q, 0, sizeof q);
+        double t = bench_now_s(), c = bench_cpu_s();
+        st = photon_phase_run(s, acc, channel, &po, &m, &q, err);
+        double dt = bench_now_s() - t, dc = bench_cpu_s() - c;
+        photon_map_recycle(m, &pool);
+        if (st != THZ_OK)
+            break;
+        double *best = one ? &out->s_1 : &out->s_all, *cpu = one ? &out->cpu_1 : &out->cpu_all;
+        if (k < 2 || dt < *best) {
+            *best = dt;
+            *cpu = dc;
+        }
+        out->photons = q.fired;
+        out->rays = q.rays;
+    }
+    for (int k = 0; st == THZ_OK && k < n; k++) {
+        const bool one = k % 2 == 0;
+        bench_probe_result r;
+        st = bench_probe_run(s, out->rays, one ? 1 : threads, &r, err);
+        double *best = one ? &out->probe_1 : &out->probe_all;
+        if (st == THZ_OK && (k < 2 || r.seconds < *best))
+            *best = r.seconds;
+    }
+    photon_map_pool_fini(&pool);
     accel_destroy(acc);
     thz_scene_destroy(s);
     return st;

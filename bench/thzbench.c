@@ -116,6 +116,20 @@ static thz_status bench_job_series(const void *arg, void *out, thz_error *err)
                                 j->probe, j->repeats, out, err);
 }
 
+typedef struct bench_threads_job {
+    const char *scene;
+    size_t channel;
+    uint64_t photons;
+    int threads, repeats;
+} bench_threads_job;
+
+static thz_status bench_job_threads(const void *arg, void *out, thz_error *err)
+{
+    const bench_threads_job *j = arg;
+    return bench_measure_threads(j->scene, j->channel, j->photons, j->threads, j->repeats, out,
+                                 err);
+}
+
 static void bench_print_usage(FILE *f)
 {
     fprintf(f, "usage: thzbench [--small] [--json PATH] [--threads N] [--scene PATH] [--no-e2e]\n"
@@ -434,39 +448,41 @@ int main(int argc, char **argv)
     }
     json_object_set_new(root, "scaling_triangles", jtri);
 
-    /* 3c. Threads: the photon phase and the raw probe, 1 thread against all. */
-    bench_series th1, thn;
-    bench_job j1 = {.scene = scene,
-                    .threads = 1,
-                    .channel = series_channel,
-                    .series = &thread_photons,
-                    .n_series = 1,
-                    .probe = 1,
-                    .repeats = repeats};
-    bench_job jn = j1;
-    jn.threads = threads;
+    /* 3c. Threads: the photon phase and the raw probe, 1 thread against all, alternating
+     * in one process (the VM's speed drifts by a quarter within half an hour: two runs
+     * one after the other compared two machines). */
+    bench_threads th;
+    bench_threads_job jthr = {.scene = scene,
+                              .channel = series_channel,
+                              .photons = thread_photons,
+                              .threads = threads,
+                              .repeats = repeats};
     double load_th = bench_load1();
-    bench_usage use1 = {0, 0.0}, usen = {0, 0.0};
-    st = bench_fork(bench_job_series, &j1, &th1, sizeof th1, &use1, &err);
-    if (st == THZ_OK)
-        st = bench_fork(bench_job_series, &jn, &thn, sizeof thn, &usen, &err);
+    st = bench_fork(bench_job_threads, &jthr, &th, sizeof th, NULL, &err);
     if (st != THZ_OK)
         goto fail;
-    double speedup = bench_ratio(th1.p[0].s_photons, thn.p[0].s_photons);
-    double speedup_raw = bench_ratio(th1.p[0].s_probe, thn.p[0].s_probe);
-    printf("\n   Threads (%llu photons, channel %zu; load average %.2f): photon phase %.3f s on 1, "
-           "%.3f s on %d: speed-up %.2f (raw Embree: %.2f); CPU s of the runs %.2f and %.2f\n",
-           (unsigned long long)thread_photons, series_channel + 1, load_th, th1.p[0].s_photons,
-           thn.p[0].s_photons, threads, speedup, speedup_raw, use1.cpu_s, usen.cpu_s);
+    double speedup = bench_ratio(th.s_1, th.s_all);
+    double speedup_raw = bench_ratio(th.probe_1, th.probe_all);
+    printf("\n   Threads (%llu photons, channel %zu, 1 and %d threads alternating, the fastest of "
+           "%d each; load average %.2f): photon phase %.3f s on 1, %.3f s on %d: speed-up %.2f "
+           "(raw Embree, %llu rays: %.3f and %.3f s, %.2f); CPU s of the fastest runs %.2f and "
+           "%.2f\n",
+           (unsigned long long)th.photons, series_channel + 1, threads, repeats, load_th, th.s_1,
+           th.s_all, threads, speedup, (unsigned long long)th.rays, th.probe_1, th.probe_all,
+           speedup_raw, th.cpu_1, th.cpu_all);
     json_t *jth = json_object();
-    json_object_set_new(jth, "photons", json_integer((json_int_t)thread_photons));
+    json_object_set_new(jth, "photons", json_integer((json_int_t)th.photons));
+    json_object_set_new(jth, "rays", json_integer((json_int_t)th.rays));
     json_object_set_new(jth, "threads", json_integer(threads));
-    json_object_set_new(jth, "seconds_1", bench_real(th1.p[0].s_photons));
-    json_object_set_new(jth, "seconds_all", bench_real(thn.p[0].s_photons));
+    json_object_set_new(jth, "alternating", json_true());
+    json_object_set_new(jth, "seconds_1", bench_real(th.s_1));
+    json_object_set_new(jth, "seconds_all", bench_real(th.s_all));
     json_object_set_new(jth, "speedup", bench_real(speedup));
+    json_object_set_new(jth, "raw_seconds_1", bench_real(th.probe_1));
+    json_object_set_new(jth, "raw_seconds_all", bench_real(th.probe_all));
     json_object_set_new(jth, "raw_speedup", bench_real(speedup_raw));
-    json_object_set_new(jth, "cpu_seconds_1", bench_real(use1.cpu_s));
-    json_object_set_new(jth, "cpu_seconds_all", bench_real(usen.cpu_s));
+    json_object_set_new(jth, "cpu_seconds_1", bench_real(th.cpu_1));
+    json_object_set_new(jth, "cpu_seconds_all", bench_real(th.cpu_all));
     json_object_set_new(jth, "load_average", bench_real(load_th));
     json_object_set_new(root, "scaling_threads", jth);
 

@@ -64,7 +64,10 @@ for k, keys in [("scaling_photons", ["photons", "stored", "seconds", "ns_per_pho
         need(pt, keys, f"{k}[{i}]")
 tri = [pt["triangles"] for pt in r["scaling_triangles"]]
 assert tri == sorted(tri) and tri[0] < tri[-1], tri
-need(r["scaling_threads"], ["seconds_1", "seconds_all", "speedup", "raw_speedup"], "scaling_threads")
+need(r["scaling_threads"],
+     ["seconds_1", "seconds_all", "speedup", "raw_seconds_1", "raw_seconds_all", "raw_speedup"],
+     "scaling_threads")
+assert r["scaling_threads"]["alternating"] is True
 
 # End to end: the paper's method (photon-map, the stage-by-stage photon count) and the
 # scene's default integrator (path, no photons), each on its own.
