@@ -328,7 +328,7 @@ thz_status bench_measure_series(const char *scene_path, size_t channel, const ui
 }
 
 thz_status bench_measure_threads(const char *scene_path, size_t channel, uint64_t photons,
-                                 int threads, int repeats, bench_threads *out, thz_error *err)
+                                 int threads, int pairs, bench_threads *out, thz_error *err)
 {
     memset(out, 0, sizeof *out);
     thz_scene *s = NULL;
@@ -340,8 +340,8 @@ thz_status bench_measure_threads(const char *scene_path, size_t channel, uint64_
         channel = s->n_channels - 1;
     st = accel_create(s, &acc, err);
     photon_map_pool pool = {0};
-    const int n = 2 * (repeats > 0 ? repeats : 1);
-    for (int k = 0; st == THZ_OK && k < n; k++) {
+    double t1 = 0.0, c1 = 0.0;
+    for (int k = 0; st == THZ_OK && k < 2 * pairs; k++) {
         const bool one = k % 2 == 0;
         photon_phase_options po = {.threads = one ? 1 : threads, .pool = &pool};
         photon_map *m = NULL;
@@ -353,21 +353,27 @@ thz_status bench_measure_threads(const char *scene_path, size_t channel, uint64_
         photon_map_recycle(m, &pool);
         if (st != THZ_OK)
             break;
-        double *best = one ? &out->s_1 : &out->s_all, *cpu = one ? &out->cpu_1 : &out->cpu_all;
-        if (k < 2 || dt < *best) {
-            *best = dt;
-            *cpu = dc;
+        if (one) {
+            t1 = dt;
+            c1 = dc;
+        } else {
+            bench_pairs_add(&out->phase, t1, dt, c1, dc);
         }
         out->photons = q.fired;
         out->rays = q.rays;
     }
-    for (int k = 0; st == THZ_OK && k < n; k++) {
+    for (int k = 0; st == THZ_OK && k < 2 * pairs; k++) {
         const bool one = k % 2 == 0;
         bench_probe_result r;
+        double c = bench_cpu_s();
         st = bench_probe_run(s, out->rays, one ? 1 : threads, &r, err);
-        double *best = one ? &out->probe_1 : &out->probe_all;
-        if (st == THZ_OK && (k < 2 || r.seconds < *best))
-            *best = r.seconds;
+        double dc = bench_cpu_s() - c;
+        if (st == THZ_OK && one) {
+            t1 = r.seconds;
+            c1 = dc;
+        } else if (st == THZ_OK) {
+            bench_pairs_add(&out->probe, t1, r.seconds, c1, dc);
+        }
     }
     photon_map_pool_fini(&pool);
     accel_destroy(acc);

@@ -11,6 +11,7 @@
 
 #include <stdint.h>
 
+#include "bench_pairs.h"
 #include "core/error.h"
 
 /* Seconds on a monotonic clock, and CPU seconds of this process (all its threads). */
@@ -80,18 +81,15 @@ thz_status bench_measure_series(const char *scene_path, size_t channel, const ui
                                 bench_series *out, thz_error *err);
 
 /* 3c. The photon phase of channel `channel` and the raw Embree probe for its rays, on 1
- * thread and on `threads`, alternating in one process (1, threads, 1, threads, ...)
- * `repeats` times each, the fastest of each side: a shared machine's speed drifts over
- * minutes, and runs side by side see the same machine. CPU seconds are those of the
- * fastest runs. */
+ * thread and on `threads`, in `pairs` alternating pairs each (bench_pairs.h), in one
+ * process. */
 typedef struct bench_threads {
     uint64_t photons, rays;
-    double s_1, s_all, cpu_1, cpu_all; /* the photon phase */
-    double probe_1, probe_all;         /* the probe */
+    bench_pairs phase, probe;
 } bench_threads;
 
 thz_status bench_measure_threads(const char *scene_path, size_t channel, uint64_t photons,
-                                 int threads, int repeats, bench_threads *out, thz_error *err);
+                                 int threads, int pairs, bench_threads *out, thz_error *err);
 
 /* Writes the tessellated-mesh scene of the triangle scaling into path: an enclosure and
  * four icospheres of `subdivisions` (20 * 4^s triangles each), one channel. */

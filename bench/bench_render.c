@@ -112,17 +112,18 @@ thz_status bench_measure_speedup(const char *scene_path, const bench_speedup_con
     out->estimates = render_estimates_per_pass(s);
     out->passes = cfg->passes;
     out->renders = cfg->renders;
-    /* alternating sides, the fastest of each */
-    for (int k = 0; st == THZ_OK && k < 2 * (cfg->repeats > 0 ? cfg->repeats : 1); k++) {
+    /* alternating pairs (bench_pairs.h) */
+    double t1 = 0.0, c1 = 0.0;
+    for (int k = 0; st == THZ_OK && k < 2 * (cfg->pairs > 0 ? cfg->pairs : 1); k++) {
         int threads = k % 2 == 0 ? 1 : cfg->threads;
         double t = bench_now_s(), c = bench_cpu_s();
         st = bench_render_run(s, acc, map, cfg, threads, &out->samples, err);
         double dt = bench_now_s() - t, dc = bench_cpu_s() - c;
-        double *best = k % 2 == 0 ? &out->s_1 : &out->s_all;
-        double *cpu = k % 2 == 0 ? &out->cpu_1 : &out->cpu_all;
-        if (k < 2 || dt < *best) {
-            *best = dt;
-            *cpu = dc;
+        if (k % 2 == 0) {
+            t1 = dt;
+            c1 = dc;
+        } else if (st == THZ_OK) {
+            bench_pairs_add(&out->runs, t1, dt, c1, dc);
         }
     }
     photon_map_destroy(map);

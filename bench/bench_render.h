@@ -6,8 +6,8 @@
  * run_simulate renders a channel (render_context_create, then its passes into the pixel
  * statistics) timed on 1 thread and on all, from one photon map built once before both
  * (the paper's map of L for photon-map, the deviation map from B(T0) for final-gather,
- * none for path). The runs alternate (1 thread, all, 1, all, ...) and each side keeps
- * its fastest, so that a change of load hits both alike.
+ * none for path). The runs alternate in pairs (1 thread, all, 1, all, ...) and the
+ * speed-up is the median of the pairs' ratios (bench_pairs.h).
  *
  * Time to a converged image: path or final-gather on the whole paper's scene through the
  * public API (thz_simulate, as `thzmap simulate --integrator NAME` runs it), twice, each
@@ -34,6 +34,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bench_pairs.h"
 #include "core/error.h"
 
 #define BENCH_MAX_CHANNELS 16
@@ -50,16 +51,15 @@ typedef struct bench_speedup_config {
     uint32_t sensor_columns; /* > 0: every sensor shrunk to this many columns (rows in
                                 proportion), 1 sample per pixel (--small); 0: as is */
     int threads;             /* the "all threads" side */
-    int repeats;             /* timed runs per side (>= 1), the fastest kept */
+    int pairs;               /* alternating pairs of timed runs (>= 1) */
 } bench_speedup_config;
 
 typedef struct bench_speedup {
     uint64_t photons, stored; /* of the map; 0 for path */
     uint32_t estimates, passes, renders;
-    uint64_t samples;      /* sample rays of one timed run */
-    double s_map;          /* photon phase that built the map (all threads), s */
-    double s_1, s_all;     /* fastest timed run on 1 thread and on `threads`, s */
-    double cpu_1, cpu_all; /* CPU seconds of those runs (all threads of the process) */
+    uint64_t samples; /* sample rays of one timed run */
+    double s_map;     /* photon phase that built the map (all threads), s */
+    bench_pairs runs; /* the timed runs on 1 thread and on `threads` */
 } bench_speedup;
 
 thz_status bench_measure_speedup(const char *scene_path, const bench_speedup_config *cfg,

@@ -120,24 +120,56 @@ json_t *bench_report_e2e(const char *label, const bench_e2e *e, const bench_usag
     return je;
 }
 
+static json_t *bench_reals(const double *v, size_t n);
+
+json_t *bench_report_pairs(const char *label, const bench_pairs *p)
+{
+    double lo, hi;
+    bench_pairs_range(p, &lo, &hi);
+    int m = bench_pairs_median_index(p);
+    double s1 = m >= 0 ? p->s_1[m] : 0.0, sa = m >= 0 ? p->s_all[m] : 0.0;
+    double c1 = m >= 0 ? p->cpu_1[m] : 0.0, ca = m >= 0 ? p->cpu_all[m] : 0.0;
+    if (label)
+        printf("     %-30s speed-up %.2f (pairs %.2f-%.2f; fastest over fastest %.2f); median "
+               "pair %.3f s / %.3f s, CPU %.2f s / %.2f s\n",
+               label, bench_pairs_speedup(p), lo, hi, bench_pairs_speedup_fastest(p), s1, sa, c1,
+               ca);
+    json_t *o = json_object();
+    json_object_set_new(o, "speedup", bench_real(bench_pairs_speedup(p)));
+    json_object_set_new(o, "speedup_fastest", bench_real(bench_pairs_speedup_fastest(p)));
+    json_object_set_new(o, "pair_min", bench_real(lo));
+    json_object_set_new(o, "pair_max", bench_real(hi));
+    json_object_set_new(o, "seconds_1", bench_reals(p->s_1, (size_t)p->n));
+    json_object_set_new(o, "seconds_all", bench_reals(p->s_all, (size_t)p->n));
+    json_object_set_new(o, "cpu_seconds_1", bench_reals(p->cpu_1, (size_t)p->n));
+    json_object_set_new(o, "cpu_seconds_all", bench_reals(p->cpu_all, (size_t)p->n));
+    return o;
+}
+
 json_t *bench_report_speedups(const char *const *names, const bench_speedup *r, int n,
                               size_t channel, int threads, double load)
 {
     printf("\n5. Integrators: the render stage on 1 thread against %d (channel %zu of the "
-           "paper's case; one map built once per integrator; fastest of alternating runs; "
-           "load average %.2f)\n",
+           "paper's case; one map built once per integrator; alternating pairs of runs, the "
+           "speed-up the median of their ratios; load average %.2f)\n",
            threads, channel + 1, load);
-    printf("  %-13s %11s %9s %7s %8s %9s %10s %10s %9s %13s\n", "integrator", "map photons",
-           "est./pass", "passes", "renders", "samples", "1 thread s", "all s", "speed-up",
-           "CPU s 1 / all");
+    printf("  %-13s %11s %9s %7s %8s %9s %6s %10s %10s %9s %11s %8s %13s\n", "integrator",
+           "map photons", "est./pass", "passes", "renders", "samples", "pairs", "1 thread s",
+           "all s", "speed-up", "pair range", "fastest", "CPU s 1 / all");
     json_t *arr = json_array();
     for (int i = 0; i < n; i++) {
         const bench_speedup *p = &r[i];
-        double sp = bench_ratio(p->s_1, p->s_all);
-        printf("  %-13s %11llu %9u %7u %8u %9llu %10.3f %10.3f %9.2f %6.2f / %5.2f\n", names[i],
-               (unsigned long long)p->photons, (unsigned)p->estimates, (unsigned)p->passes,
-               (unsigned)p->renders, (unsigned long long)p->samples, p->s_1, p->s_all, sp, p->cpu_1,
-               p->cpu_all);
+        double sp = bench_pairs_speedup(&p->runs), lo, hi;
+        bench_pairs_range(&p->runs, &lo, &hi);
+        int m = bench_pairs_median_index(&p->runs);
+        double s1 = m >= 0 ? p->runs.s_1[m] : 0.0, sa = m >= 0 ? p->runs.s_all[m] : 0.0;
+        double c1 = m >= 0 ? p->runs.cpu_1[m] : 0.0, ca = m >= 0 ? p->runs.cpu_all[m] : 0.0;
+        printf(
+            "  %-13s %11llu %9u %7u %8u %9llu %6d %10.3f %10.3f %9.2f %5.2f-%-5.2f %8.2f %6.2f / "
+            "%5.2f\n",
+            names[i], (unsigned long long)p->photons, (unsigned)p->estimates, (unsigned)p->passes,
+            (unsigned)p->renders, (unsigned long long)p->samples, p->runs.n, s1, sa, sp, lo, hi,
+            bench_pairs_speedup_fastest(&p->runs), c1, ca);
         json_t *o = json_object();
         json_object_set_new(o, "integrator", json_string(names[i]));
         json_object_set_new(o, "map_photons", json_integer((json_int_t)p->photons));
@@ -147,15 +179,16 @@ json_t *bench_report_speedups(const char *const *names, const bench_speedup *r, 
         json_object_set_new(o, "passes", json_integer(p->passes));
         json_object_set_new(o, "renders", json_integer(p->renders));
         json_object_set_new(o, "samples", json_integer((json_int_t)p->samples));
-        json_object_set_new(o, "seconds_1", bench_real(p->s_1));
-        json_object_set_new(o, "seconds_all", bench_real(p->s_all));
+        json_object_set_new(o, "seconds_1", bench_real(s1));
+        json_object_set_new(o, "seconds_all", bench_real(sa));
         json_object_set_new(o, "speedup", bench_real(sp));
-        json_object_set_new(o, "cpu_seconds_1", bench_real(p->cpu_1));
-        json_object_set_new(o, "cpu_seconds_all", bench_real(p->cpu_all));
+        json_object_set_new(o, "cpu_seconds_1", bench_real(c1));
+        json_object_set_new(o, "cpu_seconds_all", bench_real(ca));
+        json_object_set_new(o, "runs", bench_report_pairs(NULL, &p->runs));
         json_array_append_new(arr, o);
     }
-    printf("  (samples: sample rays of one timed run; CPU s below threads x wall s means the "
-           "run did not get its cores)\n");
+    printf("  (samples: sample rays of one timed run; seconds and CPU seconds of the median "
+           "pair; CPU s below threads x wall s means the run did not get its cores)\n");
     json_t *root = json_object();
     json_object_set_new(root, "channel", json_integer((json_int_t)channel + 1));
     json_object_set_new(root, "threads", json_integer(threads));

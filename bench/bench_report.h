@@ -42,6 +42,11 @@ json_t *bench_report_rendering(const bench_series *sp, size_t channel);
 json_t *bench_report_e2e(const char *label, const bench_e2e *e, const bench_usage *use,
                          double load);
 
+/* One speed-up from alternating pairs (bench_pairs.h): a line under `label` (NULL: none; the median
+ * of the pairs' ratios, their range, fastest over fastest, the median pair's seconds and
+ * CPU seconds), and its JSON. */
+json_t *bench_report_pairs(const char *label, const bench_pairs *p);
+
 /* The integrators' speed-ups (n of them, names[i] the integrator of r[i]). */
 json_t *bench_report_speedups(const char *const *names, const bench_speedup *r, int n,
                               size_t channel, int threads, double load);

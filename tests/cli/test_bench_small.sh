@@ -64,10 +64,16 @@ for k, keys in [("scaling_photons", ["photons", "stored", "seconds", "ns_per_pho
         need(pt, keys, f"{k}[{i}]")
 tri = [pt["triangles"] for pt in r["scaling_triangles"]]
 assert tri == sorted(tri) and tri[0] < tri[-1], tri
-need(r["scaling_threads"],
-     ["seconds_1", "seconds_all", "speedup", "raw_seconds_1", "raw_seconds_all", "raw_speedup"],
+# Speed-ups from alternating pairs (bench/bench_pairs.h): the median of the pairs' ratios,
+# each pair's seconds, and the machine's own ceiling measured alike.
+need(r["scaling_threads"], ["speedup", "raw_speedup", "photon_phase", "raw_probe", "ceiling"],
      "scaling_threads")
-assert r["scaling_threads"]["alternating"] is True
+for k in ["photon_phase", "raw_probe", "ceiling"]:
+    q = r["scaling_threads"][k]
+    finite(q, ["speedup", "speedup_fastest", "pair_min", "pair_max"], k, positive=True)
+    assert len(q["seconds_1"]) == len(q["seconds_all"]) >= 1, q
+    assert q["pair_min"] <= q["speedup"] <= q["pair_max"], q
+assert r["scaling_threads"]["speedup"] == r["scaling_threads"]["photon_phase"]["speedup"]
 
 # End to end: the paper's method (photon-map, the stage-by-stage photon count) and the
 # scene's default integrator (path, no photons), each on its own.
@@ -87,6 +93,7 @@ for x in s["integrators"]:
     finite(x, ["seconds_1", "seconds_all", "speedup", "cpu_seconds_1", "cpu_seconds_all",
                "samples"], "integrator_speedups", positive=True)
     assert (x["map_photons"] > 0) == (x["integrator"] != "path"), x
+    assert x["runs"]["pair_min"] <= x["speedup"] <= x["runs"]["pair_max"], x
 
 # Time to a converged image: per channel, two runs of growing work, finite noise figures
 # over the objects' pixels (the enclosure left out), finite extrapolated seconds, and the
