@@ -80,7 +80,7 @@ thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_
         return thz_error_set(err, THZ_ERR_INPUT, "thz_output_add_image: no %s",
                              output ? "image" : "output");
     return output_write_sensor(output_stage_dir(output->stage), image->scene, image->sensor,
-                               image->img, err);
+                               image->img, 0, err);
 }
 
 thz_status thz_run_write(thz_context *ctx, thz_run *run, const char *outdir,

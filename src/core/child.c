@@ -59,25 +59,24 @@ static bool child_collect(int fd, double deadline_s, thz_error *report, size_t *
     }
 }
 
-/* One child at a time per process: a fork while another thread is inside fork, malloc
- * or a child's set-up can leave the new child holding a lock no thread will release
- * (seen under AddressSanitizer: three threads plotting at once, a child hung until its
- * time limit). The figures were serialised before they moved into children, too. */
+/* Children are started one at a time per process: a fork while another thread is inside
+ * fork, malloc or a child's set-up can leave the new child holding a lock no thread will
+ * release (seen under AddressSanitizer: three threads plotting at once, a child hung until
+ * its time limit). The figures were serialised before they moved into children, too. A
+ * group (child_run_group) starts its children one after the other from one thread under
+ * this lock, and they then run at once. */
 static pthread_mutex_t child_lock = PTHREAD_MUTEX_INITIALIZER;
 
-static thz_status child_run_locked(const char *what, child_fn fn, void *arg, double timeout_s,
-                                   thz_error *err);
+/* A started child: its pid, the read end of its report pipe and its deadline. */
+typedef struct child_proc {
+    pid_t pid;
+    int fd;
+    double deadline_s;
+} child_proc;
 
-thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err)
-{
-    pthread_mutex_lock(&child_lock);
-    thz_status st = child_run_locked(what, fn, arg, timeout_s, err);
-    pthread_mutex_unlock(&child_lock);
-    return st;
-}
-
-static thz_status child_run_locked(const char *what, child_fn fn, void *arg, double timeout_s,
-                                   thz_error *err)
+/* Forks a child running fn(arg); child_lock held. */
+static thz_status child_start(const char *what, child_fn fn, void *arg, double timeout_s,
+                              child_proc *c, thz_error *err)
 {
     int fds[2];
     if (pipe2(fds, O_CLOEXEC) != 0)
@@ -109,15 +108,24 @@ static thz_status child_run_locked(const char *what, child_fn fn, void *arg, dou
         child_main(fds[1], fn, arg);
     }
     close(fds[1]);
+    c->pid = pid;
+    c->fd = fds[0];
+    c->deadline_s = thz_now_s() + timeout_s;
+    return THZ_OK;
+}
+
+/* Waits for a started child (killed at its deadline) and returns its status. */
+static thz_status child_finish(const char *what, child_proc *c, double timeout_s, thz_error *err)
+{
     thz_error report;
     memset(&report, 0, sizeof report);
     size_t got = 0;
-    bool timed_out = !child_collect(fds[0], thz_now_s() + timeout_s, &report, &got);
-    close(fds[0]);
+    bool timed_out = !child_collect(c->fd, c->deadline_s, &report, &got);
+    close(c->fd);
     if (timed_out)
-        kill(pid, SIGKILL);
+        kill(c->pid, SIGKILL);
     int ws = 0;
-    while (waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
+    while (waitpid(c->pid, &ws, 0) < 0 && errno == EINTR) {
     }
 
     if (timed_out)
@@ -137,4 +145,42 @@ static thz_status child_run_locked(const char *what, child_fn fn, void *arg, dou
     if (report.status == THZ_OK)
         return THZ_OK;
     return thz_error_set(err, report.status, "%s", report.message);
+}
+
+thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err)
+{
+    return child_run_group(&what, fn, &arg, 1, timeout_s, err);
+}
+
+thz_status child_run_group(const char *const *whats, child_fn fn, void *const *args, size_t n,
+                           double timeout_s, thz_error *err)
+{
+    if (n == 0)
+        return THZ_OK;
+    if (n > CHILD_GROUP_MAX)
+        return thz_error_set(err, THZ_ERR_INTERNAL, "%zu child processes at once (at most %d)", n,
+                             CHILD_GROUP_MAX);
+    child_proc procs[CHILD_GROUP_MAX];
+    thz_status st = THZ_OK;
+    size_t started = 0;
+    pthread_mutex_lock(&child_lock);
+    for (; started < n && st == THZ_OK; started++)
+        st = child_start(whats[started], fn, args[started], timeout_s, &procs[started], err);
+    if (st != THZ_OK)
+        started--; /* the one that failed to start */
+    pthread_mutex_unlock(&child_lock);
+    /* Each child's report is one write of about 1 KiB, which its pipe holds: the reports
+     * are read in order, the later children finishing meanwhile. The first failure in
+     * that order is the group's. */
+    for (size_t i = 0; i < started; i++) {
+        thz_error e;
+        memset(&e, 0, sizeof e);
+        thz_status s = child_finish(whats[i], &procs[i], timeout_s, &e);
+        if (s != THZ_OK && st == THZ_OK) {
+            st = s;
+            if (err)
+                *err = e;
+        }
+    }
+    return st;
 }

@@ -25,4 +25,16 @@ typedef thz_status (*child_fn)(void *arg, thz_error *err);
  * calling thread, so fn must not wait for other threads of the caller. */
 thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err);
 
+/* At most this many children in a group. */
+#define CHILD_GROUP_MAX 64
+
+/* Runs fn(args[i]) for i < n (n <= CHILD_GROUP_MAX) in n children at once: started one
+ * after the other by the calling thread (under child_run's lock), then each waited for,
+ * and killed timeout_s after its start if still running. Returns THZ_OK or the first
+ * failure in index order, its message as child_run gives it with whats[i] for `what`;
+ * a child that cannot start leaves the later ones unstarted (the earlier are still
+ * waited for). */
+thz_status child_run_group(const char *const *whats, child_fn fn, void *const *args, size_t n,
+                           double timeout_s, thz_error *err);
+
 #endif

@@ -55,9 +55,10 @@ bool output_file_name(char *buf, size_t size, const char *sensor, const char *qu
  * the images hold measured planes (sensor/measure.h), S.measured_radiance,
  * S.measured_brightness_temperature and S.measured-band-NN.png, titled with the model.
  * Checks PLplot's pngcairo device before writing anything (THZ_ERR_IO if missing).
- * Draws with PLplot, which is serialised process-wide (io/plot.h). */
+ * The PNG figures are drawn last, by up to `threads` child processes at once (0: one
+ * per processor; io/plot.h's batch): the same files for any count. */
 thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t sensor,
-                               const sensor_images *images, thz_error *err);
+                               const sensor_images *images, int threads, thz_error *err);
 
 /* What summary.json reports beyond the scene. */
 typedef struct run_summary {

@@ -55,6 +55,7 @@ typedef struct out_context {
     double *center_ghz;
     double *fwhm_ghz;
     const char **object_names; /* n_objects */
+    plot_batch *figures;       /* the PNG figures, drawn together at the end */
 } out_context;
 
 /* "dir/S.<quantity>.png" into path (THZ_PATH_MAX bytes). */
@@ -143,8 +144,9 @@ static thz_status out_band_preview(const out_context *ctx, size_t c, thz_error *
     snprintf(title, sizeof title, "%s: channel %zu, %s (%.4g GHz)", ctx->sensor->name, c + 1,
              ch->name, ch->center_hz / 1e9);
     size_t pixels = (size_t)ctx->images->columns * ctx->images->rows;
-    return plot_image(path, ctx->images->brightness_temperature + c * pixels, ctx->images->columns,
-                      ctx->images->rows, title, "brightness temperature T#db#u (K)", err);
+    return plot_batch_image(ctx->figures, path, ctx->images->brightness_temperature + c * pixels,
+                            ctx->images->columns, ctx->images->rows, title,
+                            "brightness temperature T#db#u (K)", err);
 }
 
 /* S.measured-band-NN.png: the measured brightness temperature of channel c, its title
@@ -161,9 +163,10 @@ static thz_status out_measured_preview(const out_context *ctx, size_t c, thz_err
     snprintf(title, sizeof title, "%s, %.4g GHz: %s", ctx->sensor->name, ch->center_hz / 1e9,
              model);
     size_t pixels = (size_t)ctx->images->columns * ctx->images->rows;
-    return plot_image(path, ctx->images->measured_brightness_temperature + c * pixels,
-                      ctx->images->columns, ctx->images->rows, title,
-                      "measured brightness temperature T#db#u (K)", err);
+    return plot_batch_image(ctx->figures, path,
+                            ctx->images->measured_brightness_temperature + c * pixels,
+                            ctx->images->columns, ctx->images->rows, title,
+                            "measured brightness temperature T#db#u (K)", err);
 }
 
 /* The measured cubes and their previews, when the sensor has a model. */
@@ -230,7 +233,8 @@ static thz_status out_spectra(const out_context *ctx, thz_error *err)
     snprintf(title, sizeof title, "%s: mean normalised radiance of each object in view",
              ctx->sensor->name);
     snprintf(y_label, sizeof y_label, "L / B(T#dref#u = %.6g K) (1)", ctx->sensor->normalize_to_k);
-    status = plot_lines(path, n_ch, x, n_lines, names, y, title, "frequency (THz)", y_label, err);
+    status = plot_batch_lines(ctx->figures, path, n_ch, x, n_lines, names, y, title,
+                              "frequency (THz)", y_label, err);
 cleanup:
     free(count);
     free(sum);
@@ -241,7 +245,7 @@ cleanup:
 }
 
 thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t sensor,
-                               const sensor_images *images, thz_error *err)
+                               const sensor_images *images, int threads, thz_error *err)
 {
     if (sensor >= scene->n_sensors || images->n_channels != scene->n_channels)
         return thz_error_set(err, THZ_ERR_INTERNAL,
@@ -261,7 +265,9 @@ thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t s
     ctx.center_ghz = thz_calloc(n_ch, sizeof *ctx.center_ghz);
     ctx.fwhm_ghz = thz_calloc(n_ch, sizeof *ctx.fwhm_ghz);
     ctx.object_names = thz_calloc(scene->n_objects, sizeof *ctx.object_names);
-    if (!ctx.channel_names || !ctx.center_ghz || !ctx.fwhm_ghz || !ctx.object_names) {
+    ctx.figures = plot_batch_create();
+    if (!ctx.channel_names || !ctx.center_ghz || !ctx.fwhm_ghz || !ctx.object_names ||
+        !ctx.figures) {
         status = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
         goto cleanup;
     }
@@ -312,7 +318,10 @@ thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t s
         status = out_spectra(&ctx, err);
     if (status == THZ_OK)
         status = out_measured(&ctx, err);
+    if (status == THZ_OK)
+        status = plot_batch_run(ctx.figures, threads, err);
 cleanup:
+    plot_batch_destroy(ctx.figures);
     free(ctx.channel_names);
     free(ctx.center_ghz);
     free(ctx.fwhm_ghz);

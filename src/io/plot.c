@@ -1,14 +1,7 @@
-/* PLplot figures (pngcairo): channel previews, per-object spectra and attenuation
- * spectra.
- *
- * PLplot, and the cairo, fontconfig and GLib it draws with, end the process (exit() or
- * abort()) or deadlock when an allocation fails, and PLplot also exits on some errors.
- * So PLplot never runs in the caller's process, which may hold a run's staging files:
- * every figure, and the device check, is drawn in a child process (core/child.h) that
- * writes the PNG and reports its status. Each child runs one plinit ... plend session
- * on its own copy of PLplot's global state, so figures need no lock.
+/* PLplot figures (pngcairo), drawn: channel previews, per-object spectra and attenuation
+ * spectra. Only in child processes (plot_child.c runs them; plot_draw.h says why).
  */
-#include "io/plot.h"
+#include "io/plot_draw.h"
 
 #include <errno.h>
 #include <math.h>
@@ -21,16 +14,13 @@
 #include <plplot/plplot.h>
 
 #include "core/alloc.h"
-#include "core/child.h"
 
 /* A filled circle (U+25CF) marks each data point; cairo renders UTF-8 text. */
 #define PLOT_MARK "\xe2\x97\x8f"
 
 enum { PLOT_MAX_DEVICES = 256, PLOT_TEXT = 512, PLOT_GRID_COLOR = 15 };
 
-/* How long a figure may take before its child is killed (a deadlocked GLib): far
- * beyond a normal figure (well under 1 s), plus time for the cells of a large image. */
-static double plot_timeout_s(size_t cells)
+double plot_timeout_s(size_t cells)
 {
     return 60.0 + 2e-6 * (double)cells;
 }
@@ -67,8 +57,7 @@ static int plot_compare_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* In the child. */
-static thz_status plot_check_device_child(void *arg, thz_error *err)
+thz_status plot_check_device_here(void *arg, thz_error *err)
 {
     (void)arg;
     /* PLplot exits the process when its driver directory holds no driver at all, so a
@@ -95,18 +84,12 @@ static thz_status plot_check_device_child(void *arg, thz_error *err)
                          "PLplot has no pngcairo device: install the package plplot-driver-cairo");
 }
 
-thz_status plot_check_device(thz_error *err)
-{
-    return child_run("checking PLplot's devices", plot_check_device_child, NULL, plot_timeout_s(0),
-                     err);
-}
-
 /* Starts a figure of width x height pixels into path: checks the device and that the
  * file can be created (PLplot prompts on stdin and exits when it cannot open it),
  * sets a white background with black text. In the child. */
 static thz_status plot_begin(const char *path, int width, int height, thz_error *err)
 {
-    thz_status status = plot_check_device_child(NULL, err);
+    thz_status status = plot_check_device_here(NULL, err);
     if (status != THZ_OK)
         return status;
     FILE *f = fopen(path, "wb");
@@ -154,10 +137,8 @@ static void plot_set_viridis(void)
     plscmap1l(1, N, pos, r, g, b, NULL);
 }
 
-/* plot_image's figure, in the child. */
-static thz_status plot_image_draw(const char *path, const float *values, uint32_t columns,
-                                  uint32_t rows, const char *title, const char *value_label,
-                                  thz_error *err)
+thz_status plot_image_draw(const char *path, const float *values, uint32_t columns, uint32_t rows,
+                           const char *title, const char *value_label, thz_error *err)
 {
     if (columns == 0 || rows == 0)
         return thz_error_set(err, THZ_ERR_INTERNAL, "%s: empty image", path);
@@ -249,10 +230,9 @@ cleanup:
     return status;
 }
 
-/* plot_lines's figure, in the child. */
-static thz_status plot_lines_draw(const char *path, size_t n_x, const double *x, size_t n_lines,
-                                  const char *const *names, const double *y, const char *title,
-                                  const char *x_label, const char *y_label, thz_error *err)
+thz_status plot_lines_draw(const char *path, size_t n_x, const double *x, size_t n_lines,
+                           const char *const *names, const double *y, const char *title,
+                           const char *x_label, const char *y_label, thz_error *err)
 {
     thz_status status = THZ_OK;
     PLFLT *px = thz_malloc_array(n_x ? n_x : 1, sizeof *px);
@@ -386,11 +366,10 @@ static double plot_log(double v, double floor_log)
     return v > 0.0 ? fmax(log10(v), floor_log) : floor_log;
 }
 
-/* plot_attenuation's figure, in the child. */
-static thz_status plot_attenuation_draw(const char *path, size_t n_x, const double *x,
-                                        size_t n_curves, const plot_curve *curves, size_t n_bands,
-                                        const plot_band *bands, const char *title,
-                                        const char *x_label, const char *y_label, thz_error *err)
+thz_status plot_attenuation_draw(const char *path, size_t n_x, const double *x, size_t n_curves,
+                                 const plot_curve *curves, size_t n_bands, const plot_band *bands,
+                                 const char *title, const char *x_label, const char *y_label,
+                                 thz_error *err)
 {
     if (n_x == 0 || n_curves == 0)
         return thz_error_set(err, THZ_ERR_INTERNAL, "%s: nothing to plot", path);
@@ -498,93 +477,4 @@ cleanup:
     free(widths);
     free(zeros_f);
     return status;
-}
-
-/* ---- the figures, each drawn in a child process ------------------------------------ */
-
-/* Every argument of a figure, passed to its child (which sees the caller's memory). */
-typedef struct plot_args {
-    const char *path, *title, *x_label, *y_label;
-    const float *values;
-    uint32_t columns, rows;
-    size_t n_x, n_lines, n_bands;
-    const double *x, *y;
-    const char *const *names;
-    const plot_curve *curves;
-    const plot_band *bands;
-} plot_args;
-
-static thz_status plot_image_child(void *arg, thz_error *err)
-{
-    const plot_args *a = arg;
-    return plot_image_draw(a->path, a->values, a->columns, a->rows, a->title, a->y_label, err);
-}
-
-static thz_status plot_lines_child(void *arg, thz_error *err)
-{
-    const plot_args *a = arg;
-    return plot_lines_draw(a->path, a->n_x, a->x, a->n_lines, a->names, a->y, a->title, a->x_label,
-                           a->y_label, err);
-}
-
-static thz_status plot_attenuation_child(void *arg, thz_error *err)
-{
-    const plot_args *a = arg;
-    return plot_attenuation_draw(a->path, a->n_x, a->x, a->n_lines, a->curves, a->n_bands, a->bands,
-                                 a->title, a->x_label, a->y_label, err);
-}
-
-/* Runs a figure's child; "plotting PATH" names it in the messages. */
-static thz_status plot_in_child(const char *path, child_fn fn, plot_args *a, size_t cells,
-                                thz_error *err)
-{
-    char what[PLOT_TEXT];
-    snprintf(what, sizeof what, "plotting %s", path);
-    return child_run(what, fn, a, plot_timeout_s(cells), err);
-}
-
-thz_status plot_image(const char *path, const float *values, uint32_t columns, uint32_t rows,
-                      const char *title, const char *value_label, thz_error *err)
-{
-    plot_args a = {.path = path,
-                   .values = values,
-                   .columns = columns,
-                   .rows = rows,
-                   .title = title,
-                   .y_label = value_label};
-    return plot_in_child(path, plot_image_child, &a, (size_t)columns * rows, err);
-}
-
-thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
-                      const char *const *names, const double *y, const char *title,
-                      const char *x_label, const char *y_label, thz_error *err)
-{
-    plot_args a = {.path = path,
-                   .n_x = n_x,
-                   .x = x,
-                   .n_lines = n_lines,
-                   .names = names,
-                   .y = y,
-                   .title = title,
-                   .x_label = x_label,
-                   .y_label = y_label};
-    return plot_in_child(path, plot_lines_child, &a, n_x * n_lines, err);
-}
-
-thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_t n_curves,
-                            const plot_curve *curves, size_t n_bands, const plot_band *bands,
-                            const char *title, const char *x_label, const char *y_label,
-                            thz_error *err)
-{
-    plot_args a = {.path = path,
-                   .n_x = n_x,
-                   .x = x,
-                   .n_lines = n_curves,
-                   .curves = curves,
-                   .n_bands = n_bands,
-                   .bands = bands,
-                   .title = title,
-                   .x_label = x_label,
-                   .y_label = y_label};
-    return plot_in_child(path, plot_attenuation_child, &a, n_x * n_curves, err);
 }

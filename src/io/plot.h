@@ -3,12 +3,12 @@
  * (one line per object against frequency, as the paper's Fig. 6), and the
  * attenuation spectrum of `thzmap atmosphere --plot` (log axis, shaded channels).
  *
- * Every figure (and the device check) is drawn in a child process (core/child.h):
- * PLplot, cairo, fontconfig and GLib end the process or deadlock when memory runs out,
- * so they never run in the caller's process. PLplot's global state therefore lives in
- * the child only, and figures may be drawn from several threads at once; code outside
- * this file must not call PLplot itself. A child that fails, dies or takes too long
- * (then killed) gives an error "... while plotting PATH ..." (THZ_ERR_IO).
+ * Every figure (and the device check) is drawn in a child process (core/child.h;
+ * plot_draw.h says why), one at a time or a batch by a few at once. PLplot's global
+ * state therefore lives in the children only, and figures may be drawn from several
+ * threads at once; code outside io/plot*.c must not call PLplot itself. A child that
+ * fails, dies or takes too long (then killed) gives an error "... while plotting PATH
+ * ..." (THZ_ERR_IO).
  */
 #ifndef THZ_IO_PLOT_H
 #define THZ_IO_PLOT_H
@@ -68,5 +68,26 @@ thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_
                             const plot_curve *curves, size_t n_bands, const plot_band *bands,
                             const char *title, const char *x_label, const char *y_label,
                             thz_error *err);
+
+/* A batch of figures drawn by a few child processes at once: plot_image's and
+ * plot_lines' figures, added in order (the batch copies every text and a line plot's
+ * arrays; an image's values must stay valid until plot_batch_run), then drawn by up to
+ * `processes` children (0: one per online processor), each drawing a contiguous share
+ * in order: one process start and one PLplot, cairo and fontconfig set-up per child
+ * rather than per figure, and the shares side by side. Returns THZ_OK or the failure of
+ * the first figure that failed, in the order they were added (a child stops at its
+ * first); the figures before it are written. */
+typedef struct plot_batch plot_batch;
+
+plot_batch *plot_batch_create(void); /* NULL: out of memory */
+void plot_batch_destroy(plot_batch *b);
+thz_status plot_batch_image(plot_batch *b, const char *path, const float *values, uint32_t columns,
+                            uint32_t rows, const char *title, const char *value_label,
+                            thz_error *err);
+thz_status plot_batch_lines(plot_batch *b, const char *path, size_t n_x, const double *x,
+                            size_t n_lines, const char *const *names, const double *y,
+                            const char *title, const char *x_label, const char *y_label,
+                            thz_error *err);
+thz_status plot_batch_run(plot_batch *b, int processes, thz_error *err);
 
 #endif

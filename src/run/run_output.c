@@ -86,7 +86,8 @@ thz_status run_write(run_state *rs, const char *dir, const run_write_options *wo
     double t0 = thz_now_s();
     thz_status st = THZ_OK;
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++)
-        st = output_write_sensor(dir, rs->scene, rs->selected[i], &rs->images[i], err);
+        st = output_write_sensor(dir, rs->scene, rs->selected[i], &rs->images[i], rs->opt->threads,
+                                 err);
     if (st == THZ_OK && wo->photon_map)
         st = run_save_photon_map(rs, dir, wo->ply_max_points, err);
     if (st != THZ_OK)

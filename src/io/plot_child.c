@@ -1,0 +1,307 @@
+/* PLplot's figures, each drawn in a child process (plot_draw.h says why): one at a time
+ * (plot_image, plot_lines, plot_attenuation) or a batch of them by a few children at once
+ * (plot_batch_*).
+ */
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/alloc.h"
+#include "core/child.h"
+#include "io/plot_draw.h"
+
+enum { PLOT_CHILD_TEXT = 4200 };
+
+thz_status plot_check_device(thz_error *err)
+{
+    return child_run("checking PLplot's devices", plot_check_device_here, NULL, plot_timeout_s(0),
+                     err);
+}
+
+/* Every argument of a figure, passed to its child (which sees the caller's memory). */
+typedef struct plot_args {
+    const char *path, *title, *x_label, *y_label;
+    const float *values;
+    uint32_t columns, rows;
+    size_t n_x, n_lines, n_bands;
+    const double *x, *y;
+    const char *const *names;
+    const plot_curve *curves;
+    const plot_band *bands;
+} plot_args;
+
+static thz_status plot_image_child(void *arg, thz_error *err)
+{
+    const plot_args *a = arg;
+    return plot_image_draw(a->path, a->values, a->columns, a->rows, a->title, a->y_label, err);
+}
+
+static thz_status plot_lines_child(void *arg, thz_error *err)
+{
+    const plot_args *a = arg;
+    return plot_lines_draw(a->path, a->n_x, a->x, a->n_lines, a->names, a->y, a->title, a->x_label,
+                           a->y_label, err);
+}
+
+static thz_status plot_attenuation_child(void *arg, thz_error *err)
+{
+    const plot_args *a = arg;
+    return plot_attenuation_draw(a->path, a->n_x, a->x, a->n_lines, a->curves, a->n_bands, a->bands,
+                                 a->title, a->x_label, a->y_label, err);
+}
+
+/* Runs a figure's child; "plotting PATH" names it in the messages. */
+static thz_status plot_in_child(const char *path, child_fn fn, plot_args *a, size_t cells,
+                                thz_error *err)
+{
+    char what[PLOT_CHILD_TEXT];
+    snprintf(what, sizeof what, "plotting %s", path);
+    return child_run(what, fn, a, plot_timeout_s(cells), err);
+}
+
+thz_status plot_image(const char *path, const float *values, uint32_t columns, uint32_t rows,
+                      const char *title, const char *value_label, thz_error *err)
+{
+    plot_args a = {.path = path,
+                   .values = values,
+                   .columns = columns,
+                   .rows = rows,
+                   .title = title,
+                   .y_label = value_label};
+    return plot_in_child(path, plot_image_child, &a, (size_t)columns * rows, err);
+}
+
+thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
+                      const char *const *names, const double *y, const char *title,
+                      const char *x_label, const char *y_label, thz_error *err)
+{
+    plot_args a = {.path = path,
+                   .n_x = n_x,
+                   .x = x,
+                   .n_lines = n_lines,
+                   .names = names,
+                   .y = y,
+                   .title = title,
+                   .x_label = x_label,
+                   .y_label = y_label};
+    return plot_in_child(path, plot_lines_child, &a, n_x * n_lines, err);
+}
+
+thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_t n_curves,
+                            const plot_curve *curves, size_t n_bands, const plot_band *bands,
+                            const char *title, const char *x_label, const char *y_label,
+                            thz_error *err)
+{
+    plot_args a = {.path = path,
+                   .n_x = n_x,
+                   .x = x,
+                   .n_lines = n_curves,
+                   .curves = curves,
+                   .n_bands = n_bands,
+                   .bands = bands,
+                   .title = title,
+                   .x_label = x_label,
+                   .y_label = y_label};
+    return plot_in_child(path, plot_attenuation_child, &a, n_x * n_curves, err);
+}
+
+/* ---- batches ------------------------------------------------------------------------ */
+
+typedef enum plot_item_kind { PLOT_ITEM_IMAGE, PLOT_ITEM_LINES } plot_item_kind;
+
+/* One figure of a batch: its own copies of every text and of a line plot's arrays; an
+ * image's values are the caller's. */
+typedef struct plot_item {
+    plot_item_kind kind;
+    char *path, *title, *x_label, *y_label;
+    const float *values;
+    uint32_t columns, rows;
+    size_t n_x, n_lines;
+    double *x, *y;
+    char **names;
+} plot_item;
+
+struct plot_batch {
+    plot_item *items;
+    size_t n, capacity;
+};
+
+plot_batch *plot_batch_create(void)
+{
+    return thz_calloc(1, sizeof(plot_batch));
+}
+
+static void plot_item_fini(plot_item *it)
+{
+    free(it->path);
+    free(it->title);
+    free(it->x_label);
+    free(it->y_label);
+    free(it->x);
+    free(it->y);
+    for (size_t i = 0; it->names && i < it->n_lines; i++)
+        free(it->names[i]);
+    free(it->names);
+}
+
+void plot_batch_destroy(plot_batch *b)
+{
+    if (!b)
+        return;
+    for (size_t i = 0; i < b->n; i++)
+        plot_item_fini(&b->items[i]);
+    free(b->items);
+    free(b);
+}
+
+static char *plot_strdup(const char *s)
+{
+    size_t n = strlen(s ? s : "") + 1;
+    char *d = malloc(n);
+    if (d)
+        memcpy(d, s ? s : "", n);
+    return d;
+}
+
+/* A new item at the batch's end (zeroed, its texts copied), or NULL. */
+static plot_item *plot_batch_add(plot_batch *b, plot_item_kind kind, const char *path,
+                                 const char *title, const char *x_label, const char *y_label)
+{
+    if (b->n == b->capacity) {
+        size_t cap = b->capacity ? 2 * b->capacity : 16;
+        plot_item *p = thz_realloc_array(b->items, cap, sizeof *p);
+        if (!p)
+            return NULL;
+        b->items = p;
+        b->capacity = cap;
+    }
+    plot_item *it = &b->items[b->n];
+    memset(it, 0, sizeof *it);
+    it->kind = kind;
+    it->path = plot_strdup(path);
+    it->title = plot_strdup(title);
+    it->x_label = plot_strdup(x_label);
+    it->y_label = plot_strdup(y_label);
+    if (!it->path || !it->title || !it->x_label || !it->y_label) {
+        plot_item_fini(it);
+        return NULL;
+    }
+    b->n++;
+    return it;
+}
+
+thz_status plot_batch_image(plot_batch *b, const char *path, const float *values, uint32_t columns,
+                            uint32_t rows, const char *title, const char *value_label,
+                            thz_error *err)
+{
+    plot_item *it = plot_batch_add(b, PLOT_ITEM_IMAGE, path, title, "", value_label);
+    if (!it)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+    it->values = values;
+    it->columns = columns;
+    it->rows = rows;
+    return THZ_OK;
+}
+
+thz_status plot_batch_lines(plot_batch *b, const char *path, size_t n_x, const double *x,
+                            size_t n_lines, const char *const *names, const double *y,
+                            const char *title, const char *x_label, const char *y_label,
+                            thz_error *err)
+{
+    plot_item *it = plot_batch_add(b, PLOT_ITEM_LINES, path, title, x_label, y_label);
+    if (!it)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+    it->n_x = n_x;
+    it->x = thz_malloc_array(n_x ? n_x : 1, sizeof *it->x);
+    const size_t n_y = n_x * n_lines;
+    it->y = thz_malloc_array(n_y > 0 ? n_y : 1, sizeof *it->y);
+    it->names = thz_calloc(n_lines ? n_lines : 1, sizeof *it->names);
+    bool ok = it->x && it->y && it->names;
+    for (size_t i = 0; ok && i < n_lines; i++) {
+        it->names[i] = plot_strdup(names[i]);
+        it->n_lines = i + 1;
+        ok = it->names[i] != NULL;
+    }
+    if (!ok) {
+        plot_item_fini(it);
+        b->n--;
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+    }
+    if (n_x)
+        memcpy(it->x, x, n_x * sizeof *x);
+    if (n_y > 0)
+        memcpy(it->y, y, n_y * sizeof *y);
+    return THZ_OK;
+}
+
+/* A child's share of a batch: items [lo, hi). */
+typedef struct plot_share {
+    const plot_batch *b;
+    size_t lo, hi;
+} plot_share;
+
+/* In the child: its figures in order, stopping at the first that fails. */
+static thz_status plot_share_child(void *arg, thz_error *err)
+{
+    const plot_share *sh = arg;
+    for (size_t i = sh->lo; i < sh->hi; i++) {
+        const plot_item *it = &sh->b->items[i];
+        thz_status st = it->kind == PLOT_ITEM_IMAGE
+                            ? plot_image_draw(it->path, it->values, it->columns, it->rows,
+                                              it->title, it->y_label, err)
+                            : plot_lines_draw(it->path, it->n_x, it->x, it->n_lines,
+                                              (const char *const *)it->names, it->y, it->title,
+                                              it->x_label, it->y_label, err);
+        if (st != THZ_OK)
+            return st;
+    }
+    return THZ_OK;
+}
+
+static size_t plot_item_cells(const plot_item *it)
+{
+    return it->kind == PLOT_ITEM_IMAGE ? (size_t)it->columns * it->rows : it->n_x * it->n_lines;
+}
+
+thz_status plot_batch_run(plot_batch *b, int processes, thz_error *err)
+{
+    if (!b || b->n == 0)
+        return THZ_OK;
+    size_t k = processes > 0 ? (size_t)processes : 0;
+    if (k == 0) {
+        long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+        k = cpus > 0 ? (size_t)cpus : 1;
+    }
+    k = k < b->n ? k : b->n;
+    k = k < CHILD_GROUP_MAX ? k : CHILD_GROUP_MAX;
+    plot_share shares[CHILD_GROUP_MAX];
+    void *args[CHILD_GROUP_MAX];
+    char(*whats)[PLOT_CHILD_TEXT] = thz_malloc_array(k, sizeof *whats);
+    if (!whats)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory while plotting %s",
+                             b->items[0].path);
+    const char *what_ptrs[CHILD_GROUP_MAX];
+    double timeout_s = 0.0;
+    for (size_t c = 0; c < k; c++) {
+        /* contiguous shares in order: the first failing child holds the first failing
+         * figure, whatever the number of children */
+        shares[c] = (plot_share){.b = b, .lo = b->n * c / k, .hi = b->n * (c + 1) / k};
+        args[c] = &shares[c];
+        size_t more = shares[c].hi - shares[c].lo - 1;
+        if (more)
+            snprintf(whats[c], sizeof whats[c], "plotting %s and %zu more figure%s",
+                     b->items[shares[c].lo].path, more, more == 1 ? "" : "s");
+        else
+            snprintf(whats[c], sizeof whats[c], "plotting %s", b->items[shares[c].lo].path);
+        what_ptrs[c] = whats[c];
+        double t = 0.0;
+        for (size_t i = shares[c].lo; i < shares[c].hi; i++)
+            t += plot_timeout_s(plot_item_cells(&b->items[i]));
+        timeout_s = t > timeout_s ? t : timeout_s;
+    }
+    thz_status st = child_run_group(what_ptrs, plot_share_child, args, k, timeout_s, err);
+    free(whats);
+    return st;
+}

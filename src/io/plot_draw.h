@@ -1,0 +1,31 @@
+/* The figures of io/plot.h as drawn, in the process that calls these (plot.c). Only a
+ * child process may call them (plot_child.c starts it): PLplot, and the cairo,
+ * fontconfig and GLib it draws with, end the process (exit() or abort()) or deadlock
+ * when an allocation fails, and PLplot also exits on some errors, so PLplot never runs
+ * in the caller's process, which may hold a run's staging files. Each figure is one
+ * plinit ... plend session of PLplot's global state, in whichever child draws it.
+ */
+#ifndef THZ_IO_PLOT_DRAW_H
+#define THZ_IO_PLOT_DRAW_H
+
+#include "io/plot.h"
+
+/* How long a figure may take before its child is killed (a deadlocked GLib): far
+ * beyond a normal figure (well under 1 s), plus time for the cells of a large image. */
+double plot_timeout_s(size_t cells);
+
+/* plot_check_device's check, here (a child_fn: arg unused). */
+thz_status plot_check_device_here(void *arg, thz_error *err);
+
+/* plot_image's, plot_lines' and plot_attenuation's figures, drawn here. */
+thz_status plot_image_draw(const char *path, const float *values, uint32_t columns, uint32_t rows,
+                           const char *title, const char *value_label, thz_error *err);
+thz_status plot_lines_draw(const char *path, size_t n_x, const double *x, size_t n_lines,
+                           const char *const *names, const double *y, const char *title,
+                           const char *x_label, const char *y_label, thz_error *err);
+thz_status plot_attenuation_draw(const char *path, size_t n_x, const double *x, size_t n_curves,
+                                 const plot_curve *curves, size_t n_bands, const plot_band *bands,
+                                 const char *title, const char *x_label, const char *y_label,
+                                 thz_error *err);
+
+#endif
