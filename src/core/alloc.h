@@ -33,6 +33,20 @@ static inline void *thz_realloc_array(void *p, size_t n, size_t size)
     return realloc(p, bytes ? bytes : 1);
 }
 
+/* An array's next capacity: `first` elements, then twice as many each time (amortised
+ * O(1) appends). Reallocates p for it and sets *capacity; NULL (p and *capacity
+ * untouched) on overflow or exhaustion. */
+static inline void *thz_grow_array(void *p, size_t *capacity, size_t first, size_t size)
+{
+    size_t cap = *capacity ? 2 * *capacity : first;
+    if (cap < *capacity)
+        return NULL;
+    void *q = thz_realloc_array(p, cap, size);
+    if (q)
+        *capacity = cap;
+    return q;
+}
+
 /* strdup that returns NULL for NULL. */
 char *thz_strdup(const char *s);
 

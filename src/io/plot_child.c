@@ -156,34 +156,23 @@ void plot_batch_destroy(plot_batch *b)
     free(b);
 }
 
-static char *plot_strdup(const char *s)
-{
-    size_t n = strlen(s ? s : "") + 1;
-    char *d = malloc(n);
-    if (d)
-        memcpy(d, s ? s : "", n);
-    return d;
-}
-
 /* A new item at the batch's end (zeroed, its texts copied), or NULL. */
 static plot_item *plot_batch_add(plot_batch *b, plot_item_kind kind, const char *path,
                                  const char *title, const char *x_label, const char *y_label)
 {
     if (b->n == b->capacity) {
-        size_t cap = b->capacity ? 2 * b->capacity : 16;
-        plot_item *p = thz_realloc_array(b->items, cap, sizeof *p);
+        plot_item *p = thz_grow_array(b->items, &b->capacity, 16, sizeof *p);
         if (!p)
             return NULL;
         b->items = p;
-        b->capacity = cap;
     }
     plot_item *it = &b->items[b->n];
     memset(it, 0, sizeof *it);
     it->kind = kind;
-    it->path = plot_strdup(path);
-    it->title = plot_strdup(title);
-    it->x_label = plot_strdup(x_label);
-    it->y_label = plot_strdup(y_label);
+    it->path = thz_strdup(path ? path : "");
+    it->title = thz_strdup(title ? title : "");
+    it->x_label = thz_strdup(x_label ? x_label : "");
+    it->y_label = thz_strdup(y_label ? y_label : "");
     if (!it->path || !it->title || !it->x_label || !it->y_label) {
         plot_item_fini(it);
         return NULL;
@@ -220,7 +209,7 @@ thz_status plot_batch_lines(plot_batch *b, const char *path, size_t n_x, const d
     it->names = thz_calloc(n_lines ? n_lines : 1, sizeof *it->names);
     bool ok = it->x && it->y && it->names;
     for (size_t i = 0; ok && i < n_lines; i++) {
-        it->names[i] = plot_strdup(names[i]);
+        it->names[i] = thz_strdup(names[i] ? names[i] : "");
         it->n_lines = i + 1;
         ok = it->names[i] != NULL;
     }

@@ -37,12 +37,10 @@ void trace_buffer_fini(trace_buffer *b)
 static bool trace_buffer_push(trace_buffer *b, const photon_record *r)
 {
     if (b->count == b->capacity) {
-        size_t cap = b->capacity ? 2 * b->capacity : 4096;
-        photon_record *p = thz_realloc_array(b->records, cap, sizeof *p);
+        photon_record *p = thz_grow_array(b->records, &b->capacity, 4096, sizeof *p);
         if (!p)
             return false;
         b->records = p;
-        b->capacity = cap;
     }
     b->records[b->count++] = *r;
     return true;
