@@ -48,13 +48,19 @@ double bench_pairs_speedup(const bench_pairs *p)
     return 0.5 * (a + b);
 }
 
-int bench_pairs_median_index(const bench_pairs *p)
+void bench_pairs_median_pair(const bench_pairs *p, double *s_1, double *s_all, double *cpu_1,
+                             double *cpu_all)
 {
+    *s_1 = *s_all = *cpu_1 = *cpu_all = 0.0;
     if (p->n <= 0)
-        return -1;
+        return;
     int order[BENCH_MAX_PAIRS];
     bench_pairs_order(p, order);
-    return order[(p->n - 1) / 2];
+    int m = order[(p->n - 1) / 2];
+    *s_1 = p->s_1[m];
+    *s_all = p->s_all[m];
+    *cpu_1 = p->cpu_1[m];
+    *cpu_all = p->cpu_all[m];
 }
 
 double bench_pairs_speedup_fastest(const bench_pairs *p)

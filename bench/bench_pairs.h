@@ -37,9 +37,10 @@ double bench_pairs_speedup_fastest(const bench_pairs *p);
 /* The smallest and largest ratio of a pair. */
 void bench_pairs_range(const bench_pairs *p, double *lo, double *hi);
 
-/* The pair whose ratio is the median (the lower middle one for an even count), for its
- * seconds; -1 with no pairs. */
-int bench_pairs_median_index(const bench_pairs *p);
+/* The seconds and CPU seconds of the pair whose ratio is the median (the lower middle
+ * one for an even count); zeros with no pairs. */
+void bench_pairs_median_pair(const bench_pairs *p, double *s_1, double *s_all, double *cpu_1,
+                             double *cpu_all);
 
 /* The machine's own ceiling in this run: a loop of pure arithmetic (xorshift and a
  * square root, no memory traffic), the same work split over 1 thread and over

@@ -126,12 +126,11 @@ json_t *bench_report_pairs(const char *label, const bench_pairs *p)
 {
     double lo, hi;
     bench_pairs_range(p, &lo, &hi);
-    int m = bench_pairs_median_index(p);
-    double s1 = m >= 0 ? p->s_1[m] : 0.0, sa = m >= 0 ? p->s_all[m] : 0.0;
-    double c1 = m >= 0 ? p->cpu_1[m] : 0.0, ca = m >= 0 ? p->cpu_all[m] : 0.0;
+    double s1, sa, c1, ca;
+    bench_pairs_median_pair(p, &s1, &sa, &c1, &ca);
     if (label)
-        printf("     %-30s speed-up %.2f (pairs %.2f-%.2f; fastest over fastest %.2f); median "
-               "pair %.3f s / %.3f s, CPU %.2f s / %.2f s\n",
+        printf("     %-30s speed-up %.2f x (pairs %.2f-%.2f x; fastest over fastest %.2f "
+               "x); median pair %.3f s / %.3f s, CPU %.2f s / %.2f s\n",
                label, bench_pairs_speedup(p), lo, hi, bench_pairs_speedup_fastest(p), s1, sa, c1,
                ca);
     json_t *o = json_object();
@@ -161,9 +160,8 @@ json_t *bench_report_speedups(const char *const *names, const bench_speedup *r, 
         const bench_speedup *p = &r[i];
         double sp = bench_pairs_speedup(&p->runs), lo, hi;
         bench_pairs_range(&p->runs, &lo, &hi);
-        int m = bench_pairs_median_index(&p->runs);
-        double s1 = m >= 0 ? p->runs.s_1[m] : 0.0, sa = m >= 0 ? p->runs.s_all[m] : 0.0;
-        double c1 = m >= 0 ? p->runs.cpu_1[m] : 0.0, ca = m >= 0 ? p->runs.cpu_all[m] : 0.0;
+        double s1, sa, c1, ca;
+        bench_pairs_median_pair(&p->runs, &s1, &sa, &c1, &ca);
         printf(
             "  %-13s %11llu %9u %7u %8u %9llu %6d %10.3f %10.3f %9.2f %5.2f-%-5.2f %8.2f %6.2f / "
             "%5.2f\n",

@@ -218,7 +218,7 @@ int main(int argc, char **argv)
     const int repeats = small ? 1 : 3;
     /* Thread speed-ups: alternating pairs of runs, the median of their ratios (an odd
      * count: one pair's) */
-    const int pairs = small ? 1 : 7;
+    const int pairs = small ? 3 : 7;
     /* The integrators (section 5). final-gather's deviation map: 1 M photons, as
      * docs/integrators.md measures it. The speed-ups render channel 3 from one map (the
      * paper's photon count for photon-map), with work that takes a few seconds on 1

@@ -247,7 +247,8 @@ typedef struct thz_write_options {
 /* Writes every file of the run into `outdir` (created if missing): per sensor as
  * thz_image_write, summary.json, and the photon map if asked (opt may be NULL). Files
  * appear only when all were written (thz_output); a failure or cancellation leaves
- * outdir as it was.
+ * outdir as it was. The PNG figures are drawn in child processes (docs/reliability.md),
+ * as many at once as the threads the run was made with; the files do not depend on it.
  * Records the time writing took in the summary.json it writes (the run is modified). */
 THZ_API thz_status thz_run_write(thz_context *ctx, thz_run *run, const char *outdir,
                                  const thz_write_options *opt, thz_error *err);
@@ -260,6 +261,8 @@ THZ_API thz_status thz_run_write(thz_context *ctx, thz_run *run, const char *out
 THZ_API thz_status thz_output_open(const char *outdir, thz_output **out, thz_error *err);
 THZ_API thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run,
                                       const thz_write_options *opt, thz_error *err);
+/* thz_output_add_image draws the image's figures with up to one child process per
+ * processor at once (it has no context). */
 THZ_API thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_error *err);
 /* Adds a file of the caller's (`name`: a plain file name, no '/') holding `size` bytes
  * of `data`, committed with the rest (e.g. a batch frame's frame.json). */

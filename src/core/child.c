@@ -24,7 +24,7 @@
  * nothing to do there. One of them, under LeakSanitizer, is a leak check of the caller's
  * heap as copied, with the caller's other threads missing ("Running thread ... was not
  * suspended"): a report that says nothing about the child, seen once a child drew
- * several figures (test_alloc_fail.sh, a failed allocation in the third). */
+ * several figures (test_alloc_fail.sh: PLplot's set-up of a later figure). */
 static void child_exit_now(void)
 {
     _exit(1);
@@ -176,17 +176,22 @@ thz_status child_run_group(const char *const *whats, child_fn fn, void *const *a
         return thz_error_set(err, THZ_ERR_INTERNAL, "%zu child processes at once (at most %d)", n,
                              CHILD_GROUP_MAX);
     child_proc procs[CHILD_GROUP_MAX];
-    thz_status st = THZ_OK;
+    thz_error start_err;
+    memset(&start_err, 0, sizeof start_err);
+    thz_status start_st = THZ_OK;
     size_t started = 0;
     pthread_mutex_lock(&child_lock);
-    for (; started < n && st == THZ_OK; started++)
-        st = child_start(whats[started], fn, args[started], timeout_s, &procs[started], err);
-    if (st != THZ_OK)
-        started--; /* the one that failed to start */
+    while (started < n && start_st == THZ_OK) {
+        start_st =
+            child_start(whats[started], fn, args[started], timeout_s, &procs[started], &start_err);
+        started += start_st == THZ_OK;
+    }
     pthread_mutex_unlock(&child_lock);
     /* Each child's report is one write of about 1 KiB, which its pipe holds: the reports
      * are read in order, the later children finishing meanwhile. The first failure in
-     * that order is the group's. */
+     * that order is the group's; a child that could not start comes after those that
+     * did. */
+    thz_status st = THZ_OK;
     for (size_t i = 0; i < started; i++) {
         thz_error e;
         memset(&e, 0, sizeof e);
@@ -196,6 +201,11 @@ thz_status child_run_group(const char *const *whats, child_fn fn, void *const *a
             if (err)
                 *err = e;
         }
+    }
+    if (st == THZ_OK && start_st != THZ_OK) {
+        st = start_st;
+        if (err)
+            *err = start_err;
     }
     return st;
 }

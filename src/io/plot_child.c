@@ -20,73 +20,20 @@ thz_status plot_check_device(thz_error *err)
                      err);
 }
 
-/* Every argument of a figure, passed to its child (which sees the caller's memory). */
-typedef struct plot_args {
+/* plot_attenuation's arguments, passed to its child (which sees the caller's memory). */
+typedef struct plot_attenuation_args {
     const char *path, *title, *x_label, *y_label;
-    const float *values;
-    uint32_t columns, rows;
-    size_t n_x, n_lines, n_bands;
-    const double *x, *y;
-    const char *const *names;
+    size_t n_x, n_curves, n_bands;
+    const double *x;
     const plot_curve *curves;
     const plot_band *bands;
-} plot_args;
-
-static thz_status plot_image_child(void *arg, thz_error *err)
-{
-    const plot_args *a = arg;
-    return plot_image_draw(a->path, a->values, a->columns, a->rows, a->title, a->y_label, err);
-}
-
-static thz_status plot_lines_child(void *arg, thz_error *err)
-{
-    const plot_args *a = arg;
-    return plot_lines_draw(a->path, a->n_x, a->x, a->n_lines, a->names, a->y, a->title, a->x_label,
-                           a->y_label, err);
-}
+} plot_attenuation_args;
 
 static thz_status plot_attenuation_child(void *arg, thz_error *err)
 {
-    const plot_args *a = arg;
-    return plot_attenuation_draw(a->path, a->n_x, a->x, a->n_lines, a->curves, a->n_bands, a->bands,
-                                 a->title, a->x_label, a->y_label, err);
-}
-
-/* Runs a figure's child; "plotting PATH" names it in the messages. */
-static thz_status plot_in_child(const char *path, child_fn fn, plot_args *a, size_t cells,
-                                thz_error *err)
-{
-    char what[PLOT_CHILD_TEXT];
-    snprintf(what, sizeof what, "plotting %s", path);
-    return child_run(what, fn, a, plot_timeout_s(cells), err);
-}
-
-thz_status plot_image(const char *path, const float *values, uint32_t columns, uint32_t rows,
-                      const char *title, const char *value_label, thz_error *err)
-{
-    plot_args a = {.path = path,
-                   .values = values,
-                   .columns = columns,
-                   .rows = rows,
-                   .title = title,
-                   .y_label = value_label};
-    return plot_in_child(path, plot_image_child, &a, (size_t)columns * rows, err);
-}
-
-thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
-                      const char *const *names, const double *y, const char *title,
-                      const char *x_label, const char *y_label, thz_error *err)
-{
-    plot_args a = {.path = path,
-                   .n_x = n_x,
-                   .x = x,
-                   .n_lines = n_lines,
-                   .names = names,
-                   .y = y,
-                   .title = title,
-                   .x_label = x_label,
-                   .y_label = y_label};
-    return plot_in_child(path, plot_lines_child, &a, n_x * n_lines, err);
+    const plot_attenuation_args *a = arg;
+    return plot_attenuation_draw(a->path, a->n_x, a->x, a->n_curves, a->curves, a->n_bands,
+                                 a->bands, a->title, a->x_label, a->y_label, err);
 }
 
 thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_t n_curves,
@@ -94,17 +41,19 @@ thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_
                             const char *title, const char *x_label, const char *y_label,
                             thz_error *err)
 {
-    plot_args a = {.path = path,
-                   .n_x = n_x,
-                   .x = x,
-                   .n_lines = n_curves,
-                   .curves = curves,
-                   .n_bands = n_bands,
-                   .bands = bands,
-                   .title = title,
-                   .x_label = x_label,
-                   .y_label = y_label};
-    return plot_in_child(path, plot_attenuation_child, &a, n_x * n_curves, err);
+    plot_attenuation_args a = {.path = path,
+                               .title = title,
+                               .x_label = x_label,
+                               .y_label = y_label,
+                               .n_x = n_x,
+                               .n_curves = n_curves,
+                               .n_bands = n_bands,
+                               .x = x,
+                               .curves = curves,
+                               .bands = bands};
+    char what[PLOT_CHILD_TEXT];
+    snprintf(what, sizeof what, "plotting %s", path);
+    return child_run(what, plot_attenuation_child, &a, plot_timeout_s(n_x * n_curves), err);
 }
 
 /* ---- batches ------------------------------------------------------------------------ */
@@ -292,5 +241,35 @@ thz_status plot_batch_run(plot_batch *b, int processes, thz_error *err)
     }
     thz_status st = child_run_group(what_ptrs, plot_share_child, args, k, timeout_s, err);
     free(whats);
+    return st;
+}
+
+/* ---- one figure: a batch of one ---------------------------------------------------- */
+
+thz_status plot_image(const char *path, const float *values, uint32_t columns, uint32_t rows,
+                      const char *title, const char *value_label, thz_error *err)
+{
+    plot_batch *b = plot_batch_create();
+    if (!b)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+    thz_status st = plot_batch_image(b, path, values, columns, rows, title, value_label, err);
+    if (st == THZ_OK)
+        st = plot_batch_run(b, 1, err);
+    plot_batch_destroy(b);
+    return st;
+}
+
+thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
+                      const char *const *names, const double *y, const char *title,
+                      const char *x_label, const char *y_label, thz_error *err)
+{
+    plot_batch *b = plot_batch_create();
+    if (!b)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+    thz_status st =
+        plot_batch_lines(b, path, n_x, x, n_lines, names, y, title, x_label, y_label, err);
+    if (st == THZ_OK)
+        st = plot_batch_run(b, 1, err);
+    plot_batch_destroy(b);
     return st;
 }

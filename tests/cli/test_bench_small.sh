@@ -73,6 +73,11 @@ for k in ["photon_phase", "raw_probe", "ceiling"]:
     finite(q, ["speedup", "speedup_fastest", "pair_min", "pair_max"], k, positive=True)
     assert len(q["seconds_1"]) == len(q["seconds_all"]) >= 1, q
     assert q["pair_min"] <= q["speedup"] <= q["pair_max"], q
+    # the median of the pairs' ratios (3 pairs with --small), not fastest over fastest
+    ratios = sorted(a / b for a, b in zip(q["seconds_1"], q["seconds_all"]))
+    assert len(ratios) == 3, ratios
+    assert abs(q["speedup"] - ratios[1]) <= 1e-9 * ratios[1], (q["speedup"], ratios)
+    assert abs(q["speedup_fastest"] - min(q["seconds_1"]) / min(q["seconds_all"])) <= 1e-9, q
 assert r["scaling_threads"]["speedup"] == r["scaling_threads"]["photon_phase"]["speedup"]
 
 # End to end: the paper's method (photon-map, the stage-by-stage photon count) and the
