@@ -1,6 +1,7 @@
 /* The benchmark's measurements: see bench_measure.h. */
 #include "bench_measure.h"
 
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -239,7 +240,7 @@ thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int thread
 
 thz_status bench_measure_series(const char *scene_path, size_t channel, const uint64_t *photons,
                                 int n, int threads, int render, int probe, int repeats,
-                                bench_series *out, thz_error *err)
+                                double min_seconds, bench_series *out, thz_error *err)
 {
     memset(out, 0, sizeof *out);
     thz_scene *s = NULL;
@@ -267,26 +268,41 @@ thz_status bench_measure_series(const char *scene_path, size_t channel, const ui
         photon_map *map = NULL;
         photon_stats ps;
         memset(&ps, 0, sizeof ps);
-        for (int rep = 0; st == THZ_OK && rep < (repeats > 0 ? repeats : 1); rep++) {
+        double wall[BENCH_MAX_RUNS], cpu[BENCH_MAX_RUNS];
+        photon_stats runs[BENCH_MAX_RUNS];
+        int want = repeats > 0 ? repeats : 1;
+        for (int rep = 0; st == THZ_OK && rep < want && rep < BENCH_MAX_RUNS; rep++) {
             photon_map *m = NULL;
-            photon_stats q;
             photon_map_recycle(map, &pool); /* one map at a time: the 100 M point's peak */
             map = NULL;
             double t = bench_now_s(), c = bench_cpu_s();
-            st = photon_phase_run(s, acc, channel, &po, &m, &q, err);
-            double dt = bench_now_s() - t, dc = bench_cpu_s() - c;
+            st = photon_phase_run(s, acc, channel, &po, &m, &runs[rep], err);
+            wall[rep] = bench_now_s() - t;
+            cpu[rep] = bench_cpu_s() - c;
             if (st != THZ_OK)
                 break;
-            if (rep == 0 || dc < p->cpu_photons)
-                p->cpu_photons = dc;
-            if (rep == 0 || dt < p->s_photons) { /* the fastest run */
-                p->s_photons = dt;
-                ps = q;
-            }
             map = m; /* every run's map is the same (deterministic): the last is kept */
+            p->runs = rep + 1;
+            if (rep == 0 && wall[0] > 0.0 && min_seconds > wall[0] * want) {
+                double more = ceil(min_seconds / wall[0]);
+                want = more < BENCH_MAX_RUNS ? (int)more : BENCH_MAX_RUNS;
+                want -= want % 2 == 0; /* odd: one median run */
+            }
         }
         if (st != THZ_OK)
             break;
+        p->s_photons = bench_median(wall, p->runs);
+        p->cpu_photons = bench_median(cpu, p->runs);
+        p->s_photons_fastest = wall[0];
+        p->cpu_photons_fastest = cpu[0];
+        int median_run = 0;
+        for (int rep = 0; rep < p->runs; rep++) {
+            p->s_photons_fastest = fmin(p->s_photons_fastest, wall[rep]);
+            p->cpu_photons_fastest = fmin(p->cpu_photons_fastest, cpu[rep]);
+            if (fabs(wall[rep] - p->s_photons) < fabs(wall[median_run] - p->s_photons))
+                median_run = rep;
+        }
+        ps = runs[median_run]; /* its stage split: the run nearest the median */
         p->photons = ps.fired;
         p->stored = ps.stored;
         p->rays = ps.rays;
@@ -340,40 +356,36 @@ thz_status bench_measure_threads(const char *scene_path, size_t channel, uint64_
         channel = s->n_channels - 1;
     st = accel_create(s, &acc, err);
     photon_map_pool pool = {0};
-    double t1 = 0.0, c1 = 0.0;
-    for (int k = 0; st == THZ_OK && k < 2 * pairs; k++) {
-        const bool one = k % 2 == 0;
-        photon_phase_options po = {.threads = one ? 1 : threads, .pool = &pool};
-        photon_map *m = NULL;
-        photon_stats q;
-        memset(&q, 0, sizeof q);
-        double t = bench_now_s(), c = bench_cpu_s();
-        st = photon_phase_run(s, acc, channel, &po, &m, &q, err);
-        double dt = bench_now_s() - t, dc = bench_cpu_s() - c;
-        photon_map_recycle(m, &pool);
+    /* Rounds of four runs: the photon phase on 1 thread and on all, then the probe for its
+     * rays on 1 and on all. Each speed-up's pairs alternate as before, and round k's
+     * all-thread runs of both give the phase over the probe at one machine speed. */
+    for (int k = 0; st == THZ_OK && k < pairs; k++) {
+        double t[2], c[2];
+        for (int side = 0; st == THZ_OK && side < 2; side++) {
+            photon_phase_options po = {.threads = side == 0 ? 1 : threads, .pool = &pool};
+            photon_map *m = NULL;
+            photon_stats q;
+            memset(&q, 0, sizeof q);
+            double t0 = bench_now_s(), c0 = bench_cpu_s();
+            st = photon_phase_run(s, acc, channel, &po, &m, &q, err);
+            t[side] = bench_now_s() - t0;
+            c[side] = bench_cpu_s() - c0;
+            photon_map_recycle(m, &pool);
+            out->photons = q.fired;
+            out->rays = q.rays;
+        }
         if (st != THZ_OK)
             break;
-        if (one) {
-            t1 = dt;
-            c1 = dc;
-        } else {
-            bench_pairs_add(&out->phase, t1, dt, c1, dc);
+        bench_pairs_add(&out->phase, t[0], t[1], c[0], c[1]);
+        for (int side = 0; st == THZ_OK && side < 2; side++) {
+            bench_probe_result r;
+            double c0 = bench_cpu_s();
+            st = bench_probe_run(s, out->rays, side == 0 ? 1 : threads, &r, err);
+            t[side] = r.seconds;
+            c[side] = bench_cpu_s() - c0;
         }
-        out->photons = q.fired;
-        out->rays = q.rays;
-    }
-    for (int k = 0; st == THZ_OK && k < 2 * pairs; k++) {
-        const bool one = k % 2 == 0;
-        bench_probe_result r;
-        double c = bench_cpu_s();
-        st = bench_probe_run(s, out->rays, one ? 1 : threads, &r, err);
-        double dc = bench_cpu_s() - c;
-        if (st == THZ_OK && one) {
-            t1 = r.seconds;
-            c1 = dc;
-        } else if (st == THZ_OK) {
-            bench_pairs_add(&out->probe, t1, r.seconds, c1, dc);
-        }
+        if (st == THZ_OK)
+            bench_pairs_add(&out->probe, t[0], t[1], c[0], c[1]);
     }
     photon_map_pool_fini(&pool);
     accel_destroy(acc);

@@ -53,6 +53,8 @@ typedef struct bench_point {
     double s_emission_table, s_tracing, s_index, s_photons, s_render, s_probe;
     double cpu_photons; /* CPU seconds of the process (all threads) in that photon phase:
                            time slices taken by other processes do not count */
+    int runs;           /* photon phase runs, of which s_photons and cpu_photons the medians */
+    double s_photons_fastest, cpu_photons_fastest;
 } bench_point;
 
 typedef struct bench_series {
@@ -75,14 +77,18 @@ thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int thread
 
 /* Photon phase (and, with render, a render of every sensor) of channel `channel` for each
  * of photons[0..n): one point each; with probe, also the raw Embree probe for the same
- * number of rays. */
+ * number of rays. The photon phase of a point runs at least `repeats` times and until its
+ * runs took min_seconds (an odd count, at most BENCH_MAX_RUNS), and its seconds and CPU
+ * seconds are the **median** run's: the fastest would favour the short points, whose
+ * runs can fall wholly in a few seconds when the VM runs faster (bench_pairs.h). */
 thz_status bench_measure_series(const char *scene_path, size_t channel, const uint64_t *photons,
                                 int n, int threads, int render, int probe, int repeats,
-                                bench_series *out, thz_error *err);
+                                double min_seconds, bench_series *out, thz_error *err);
 
 /* 3c. The photon phase of channel `channel` and the raw Embree probe for its rays, on 1
- * thread and on `threads`, in `pairs` alternating pairs each (bench_pairs.h), in one
- * process. */
+ * thread and on `threads`, in `pairs` rounds in one process: phase on 1 thread, on all,
+ * probe on 1, on all. phase and probe hold each one's alternating pairs (bench_pairs.h);
+ * bench_pairs_across(&phase, &probe) is the phase over the probe, round by round. */
 typedef struct bench_threads {
     uint64_t photons, rays;
     bench_pairs phase, probe;

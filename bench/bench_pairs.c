@@ -85,6 +85,37 @@ void bench_pairs_range(const bench_pairs *p, double *lo, double *hi)
     }
 }
 
+double bench_median(const double *v, int n)
+{
+    if (n <= 0)
+        return 0.0;
+    double w[BENCH_MAX_PAIRS > BENCH_MAX_RUNS ? BENCH_MAX_PAIRS : BENCH_MAX_RUNS];
+    if (n > (int)(sizeof w / sizeof w[0]))
+        n = (int)(sizeof w / sizeof w[0]);
+    for (int i = 0; i < n; i++) { /* insertion sort */
+        int j = i;
+        while (j > 0 && w[j - 1] > v[i]) {
+            w[j] = w[j - 1];
+            j--;
+        }
+        w[j] = v[i];
+    }
+    return 0.5 * (w[(n - 1) / 2] + w[n / 2]);
+}
+
+double bench_pairs_across(const bench_pairs *a, const bench_pairs *b, double *lo, double *hi)
+{
+    double r[BENCH_MAX_PAIRS];
+    int n = a->n < b->n ? a->n : b->n;
+    *lo = *hi = 0.0;
+    for (int i = 0; i < n; i++) {
+        r[i] = b->s_all[i] > 0.0 ? a->s_all[i] / b->s_all[i] : 0.0;
+        *lo = i == 0 || r[i] < *lo ? r[i] : *lo;
+        *hi = i == 0 || r[i] > *hi ? r[i] : *hi;
+    }
+    return bench_median(r, n);
+}
+
 /* n steps of xorshift64 and a square root from seed: registers only. */
 static double bench_ceiling_work(long n, uint64_t s)
 {

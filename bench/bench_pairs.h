@@ -42,6 +42,17 @@ void bench_pairs_range(const bench_pairs *p, double *lo, double *hi);
 void bench_pairs_median_pair(const bench_pairs *p, double *s_1, double *s_all, double *cpu_1,
                              double *cpu_all);
 
+/* The median of n values (of the middle two for an even count; n at most BENCH_MAX_PAIRS
+ * or BENCH_MAX_RUNS, the larger); 0 for none. */
+#define BENCH_MAX_RUNS 15
+double bench_median(const double *v, int n);
+
+/* Two measurements taken in the same rounds (pair i of a and pair i of b in one round of
+ * runs, one after the other): the median over the rounds of a's all-thread seconds over
+ * b's, and the smallest and largest round's ratio. A ratio of two kinds of work on one
+ * machine, measured as the speed-ups are: each round's two runs see the same machine. */
+double bench_pairs_across(const bench_pairs *a, const bench_pairs *b, double *lo, double *hi);
+
 /* The machine's own ceiling in this run: a loop of pure arithmetic (xorshift and a
  * square root, no memory traffic), the same work split over 1 thread and over
  * `threads`, in `pairs` alternating pairs of about 0.3 s on 1 thread. */

@@ -52,6 +52,7 @@ typedef struct bench_job {
     int n_series;
     int render, probe;
     int repeats;
+    double min_seconds; /* bench_measure_series: photon phase runs of a point, at least */
 } bench_job;
 
 static thz_status bench_job_paper(const void *arg, void *out, thz_error *err)
@@ -113,7 +114,7 @@ static thz_status bench_job_series(const void *arg, void *out, thz_error *err)
 {
     const bench_job *j = arg;
     return bench_measure_series(j->scene, j->channel, j->series, j->n_series, j->threads, j->render,
-                                j->probe, j->repeats, out, err);
+                                j->probe, j->repeats, j->min_seconds, out, err);
 }
 
 typedef struct bench_threads_job {
@@ -213,9 +214,11 @@ int main(int argc, char **argv)
     const uint64_t mesh_photons = small ? 10000 : 1000000;
     const uint64_t thread_photons = small ? 20000 : 3000000;
     const size_t series_channel = 2; /* 0.6 THz in the paper's case */
-    /* The probe, the scaling points and the renders are timed as the fastest of
-     * `repeats` runs (the paper's case itself runs once). */
+    /* The probe and the renders are timed as the fastest of `repeats` runs (the paper's
+     * case itself runs once); a scaling point's photon phase as the median of at least
+     * `repeats` runs that take at least series_seconds together (bench_measure.h). */
     const int repeats = small ? 1 : 3;
+    const double series_seconds = small ? 0.0 : 3.0;
     /* Thread speed-ups: alternating pairs of runs, the median of their ratios (an odd
      * count: one pair's) */
     const int pairs = small ? 3 : 7;
@@ -402,7 +405,8 @@ int main(int argc, char **argv)
                     .series = series,
                     .n_series = n_series,
                     .render = 1,
-                    .repeats = repeats};
+                    .repeats = repeats,
+                    .min_seconds = series_seconds};
     double load_sp = bench_load1();
     st = bench_fork(bench_job_series, &js, &sp, sizeof sp, NULL, &err);
     if (st != THZ_OK)
@@ -418,8 +422,8 @@ int main(int argc, char **argv)
     printf(
         "\n   Scaling in triangles (enclosure + 4 icospheres, %llu photons; load average %.2f)\n",
         (unsigned long long)mesh_photons, load_tri);
-    printf("  %12s %10s %10s %12s %12s %12s\n", "triangles", "phase s", "ns/photon", "raw ns/ray",
-           "phase/raw", "CPU ns/ph.");
+    printf("  %12s %5s %10s %10s %12s %12s %12s\n", "triangles", "runs", "phase s", "ns/photon",
+           "raw ns/ray", "phase/raw", "CPU ns/ph.");
     for (unsigned sd = subdiv_lo; sd <= subdiv_hi; sd++) {
         char path[4300];
         snprintf(path, sizeof path, "%s-s%u.json", meshdir, sd);
@@ -433,7 +437,8 @@ int main(int argc, char **argv)
                         .series = &mesh_photons,
                         .n_series = 1,
                         .probe = 1,
-                        .repeats = repeats};
+                        .repeats = repeats,
+                        .min_seconds = series_seconds};
         st = bench_fork(bench_job_series, &jm, &one, sizeof one, NULL, &err);
         remove(path);
         if (st != THZ_OK)
@@ -441,8 +446,9 @@ int main(int argc, char **argv)
         const bench_point *p = &one.p[0];
         tri.p[tri.n++] = *p;
         double ns = 1e9 * bench_ratio(p->s_photons, (double)p->photons);
-        printf("  %12llu %10.3f %10.1f %12.1f %12.2f %12.1f\n", (unsigned long long)p->triangles,
-               p->s_photons, ns, 1e9 * bench_ratio(p->s_probe, (double)p->rays),
+        printf("  %12llu %5d %10.3f %10.1f %12.1f %12.2f %12.1f\n",
+               (unsigned long long)p->triangles, p->runs, p->s_photons, ns,
+               1e9 * bench_ratio(p->s_probe, (double)p->rays),
                bench_ratio(p->s_photons, p->s_probe),
                1e9 * bench_ratio(p->cpu_photons, (double)p->photons));
         json_t *o = json_object();
@@ -451,8 +457,7 @@ int main(int argc, char **argv)
         json_object_set_new(o, "seconds", bench_real(p->s_photons));
         json_object_set_new(o, "ns_per_photon", bench_real(ns));
         json_object_set_new(o, "raw_seconds", bench_real(p->s_probe));
-        json_object_set_new(o, "cpu_ns_per_photon",
-                            bench_real(1e9 * bench_ratio(p->cpu_photons, (double)p->photons)));
+        bench_report_point_runs(o, p);
         json_object_set_new(o, "raw_ns_per_ray",
                             bench_real(1e9 * bench_ratio(p->s_probe, (double)p->rays)));
         json_array_append_new(jtri, o);
@@ -460,7 +465,8 @@ int main(int argc, char **argv)
     json_object_set_new(root, "scaling_triangles", jtri);
 
     /* 3c. Threads: the photon phase and the raw probe, 1 thread against all, in
-     * alternating pairs in one process (bench_pairs.h), with the machine's own ceiling. */
+     * alternating pairs in one process (bench_pairs.h), with the machine's own ceiling;
+     * and from the same rounds the phase over the probe on all threads. */
     bench_threads th;
     bench_threads_job jthr = {.scene = scene,
                               .channel = series_channel,
@@ -489,6 +495,16 @@ int main(int argc, char **argv)
     json_object_set_new(jth, "raw_probe", bench_report_pairs("raw Embree probe", &th.probe));
     json_object_set_new(jth, "ceiling",
                         bench_report_pairs("pure arithmetic (the machine)", &ceiling));
+    double across_lo, across_hi;
+    double across = bench_pairs_across(&th.phase, &th.probe, &across_lo, &across_hi);
+    printf("     photon phase / raw Embree probe, %d threads, round by round: %.2f x (rounds "
+           "%.2f-%.2f x)\n",
+           threads, across, across_lo, across_hi);
+    json_t *jacross = json_object();
+    json_object_set_new(jacross, "median", bench_real(across));
+    json_object_set_new(jacross, "round_min", bench_real(across_lo));
+    json_object_set_new(jacross, "round_max", bench_real(across_hi));
+    json_object_set_new(jth, "photon_phase_over_raw", jacross);
     json_object_set_new(jth, "load_average", bench_real(load_th));
     json_object_set_new(root, "scaling_threads", jth);
 
@@ -553,6 +569,9 @@ int main(int argc, char **argv)
                  total, "<=", 10, total <= 10, "s", true);
     bench_target(&t, "photon phase / raw Embree, same rays (bounces incl.)", ratio_phase, "<=", 2,
                  ratio_phase <= 2, "x", true);
+    printf("  (the same in %d rounds, channel %zu, %.3g M photons, each round's phase and probe "
+           "one after the other: %.3f x, rounds %.2f-%.2f x)\n",
+           th.phase.n, series_channel + 1, 1e-6 * (double)th.photons, across, across_lo, across_hi);
     /* The speed-ups are issue 19's for 2 threads: with another count they are measured
      * but do not show the target. */
     char name[128];

@@ -79,6 +79,22 @@ for k in ["photon_phase", "raw_probe", "ceiling"]:
     assert abs(q["speedup"] - ratios[1]) <= 1e-9 * ratios[1], (q["speedup"], ratios)
     assert abs(q["speedup_fastest"] - min(q["seconds_1"]) / min(q["seconds_all"])) <= 1e-9, q
 assert r["scaling_threads"]["speedup"] == r["scaling_threads"]["photon_phase"]["speedup"]
+# The photon phase over the probe from the same rounds: the median of round k's all-thread
+# phase over round k's all-thread probe, not a ratio of the two medians.
+th = r["scaling_threads"]
+ratios = sorted(a / b for a, b in zip(th["photon_phase"]["seconds_all"],
+                                      th["raw_probe"]["seconds_all"]))
+q = th["photon_phase_over_raw"]
+assert abs(q["median"] - ratios[1]) <= 1e-9 * ratios[1], (q, ratios)
+assert abs(q["round_min"] - ratios[0]) <= 1e-9 * ratios[0], q
+assert abs(q["round_max"] - ratios[2]) <= 1e-9 * ratios[2], q
+# A scaling point's photon phase: the median of its runs (one with --small), never below
+# its fastest run.
+for k in ["scaling_photons", "scaling_triangles"]:
+    for pt in r[k]:
+        assert pt["runs"] >= 1, pt
+        assert 0 < pt["cpu_ns_per_photon_fastest"] <= pt["cpu_ns_per_photon"], pt
+        assert 0 < pt["seconds_fastest"] <= pt["seconds"], pt
 
 # End to end: the paper's method (photon-map, the stage-by-stage photon count) and the
 # scene's default integrator (path, no photons), each on its own.
