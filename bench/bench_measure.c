@@ -238,10 +238,11 @@ thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int thread
     return st;
 }
 
-thz_status bench_measure_series(const char *scene_path, size_t channel, const uint64_t *photons,
-                                int n, int threads, int render, int probe, int repeats,
-                                double min_seconds, bench_series *out, thz_error *err)
+thz_status bench_measure_series(const char *scene_path, const bench_series_cfg *cfg,
+                                bench_series *out, thz_error *err)
 {
+    size_t channel = cfg->channel;
+    const int threads = cfg->threads, repeats = cfg->repeats > 0 ? cfg->repeats : 1;
     memset(out, 0, sizeof *out);
     thz_scene *s = NULL;
     accel *acc = NULL;
@@ -255,26 +256,43 @@ thz_status bench_measure_series(const char *scene_path, size_t channel, const ui
     for (size_t i = 0; i < s->n_objects; i++)
         triangles += s->objects[i].mesh.n_triangles;
     st = accel_create(s, &acc, err);
-    if (st == THZ_OK && render)
+    if (st == THZ_OK && cfg->render)
         st = bench_images_init(s, &img, err);
     /* Repeats build their maps in the memory of the map before, as a run's channels do
      * (photon_map_pool): the fastest repeat is a run's steady state, not its first channel. */
     photon_map_pool pool = {0};
     photon_phase_options po = {.threads = threads, .pool = &pool};
+    /* The reference runs in memory of its own: in the point's pool, its small map would
+     * take the point's large array and shrink it (phase.c), and the point would then pay
+     * for new memory (ef2613c: ~12 us a page here) */
+    photon_map_pool ref_pool = {0};
+    photon_phase_options po_ref = {.threads = threads, .pool = &ref_pool};
     render_options ro = {.threads = threads};
-    for (int k = 0; st == THZ_OK && k < n && k < BENCH_MAX_POINTS; k++) {
+    for (int k = 0; st == THZ_OK && k < cfg->n && k < BENCH_MAX_POINTS; k++) {
         bench_point *p = &out->p[k];
-        s->photons.per_channel = photons[k];
         photon_map *map = NULL;
         photon_stats ps;
         memset(&ps, 0, sizeof ps);
-        double wall[BENCH_MAX_RUNS], cpu[BENCH_MAX_RUNS];
+        double wall[BENCH_MAX_RUNS], cpu[BENCH_MAX_RUNS], rel[BENCH_MAX_RUNS];
         photon_stats runs[BENCH_MAX_RUNS];
-        int want = repeats > 0 ? repeats : 1;
+        int want = repeats;
         for (int rep = 0; st == THZ_OK && rep < want && rep < BENCH_MAX_RUNS; rep++) {
             photon_map *m = NULL;
             photon_map_recycle(map, &pool); /* one map at a time: the 100 M point's peak */
             map = NULL;
+            double ref_cpu = 0.0;
+            if (cfg->ref_photons) { /* the reference, just before: the same machine speed */
+                s->photons.per_channel = cfg->ref_photons;
+                photon_stats q;
+                double c = bench_cpu_s();
+                st = photon_phase_run(s, acc, channel, &po_ref, &m, &q, err);
+                ref_cpu = bench_cpu_s() - c;
+                photon_map_recycle(m, &ref_pool);
+                m = NULL;
+                if (st != THZ_OK)
+                    break;
+            }
+            s->photons.per_channel = cfg->photons[k];
             double t = bench_now_s(), c = bench_cpu_s();
             st = photon_phase_run(s, acc, channel, &po, &m, &runs[rep], err);
             wall[rep] = bench_now_s() - t;
@@ -283,8 +301,12 @@ thz_status bench_measure_series(const char *scene_path, size_t channel, const ui
                 break;
             map = m; /* every run's map is the same (deterministic): the last is kept */
             p->runs = rep + 1;
-            if (rep == 0 && wall[0] > 0.0 && min_seconds > wall[0] * want) {
-                double more = ceil(min_seconds / wall[0]);
+            rel[rep] =
+                ref_cpu > 0.0 && runs[rep].fired > 0
+                    ? (cpu[rep] / (double)runs[rep].fired) / (ref_cpu / (double)cfg->ref_photons)
+                    : 0.0;
+            if (rep == 0 && wall[0] > 0.0 && cfg->min_seconds > wall[0] * want) {
+                double more = ceil(cfg->min_seconds / wall[0]);
                 want = more < BENCH_MAX_RUNS ? (int)more : BENCH_MAX_RUNS;
                 want -= want % 2 == 0; /* odd: one median run */
             }
@@ -293,6 +315,7 @@ thz_status bench_measure_series(const char *scene_path, size_t channel, const ui
             break;
         p->s_photons = bench_median(wall, p->runs);
         p->cpu_photons = bench_median(cpu, p->runs);
+        p->cpu_vs_reference = cfg->ref_photons ? bench_median(rel, p->runs) : 0.0;
         p->s_photons_fastest = wall[0];
         p->cpu_photons_fastest = cpu[0];
         int median_run = 0;
@@ -310,7 +333,7 @@ thz_status bench_measure_series(const char *scene_path, size_t channel, const ui
         p->s_emission_table = ps.seconds_emission_table;
         p->s_tracing = ps.seconds_tracing;
         p->s_index = ps.seconds_index;
-        for (int rep = 0; render && st == THZ_OK && rep < (repeats > 0 ? repeats : 1); rep++) {
+        for (int rep = 0; cfg->render && st == THZ_OK && rep < repeats; rep++) {
             uint64_t samples = 0, pixels = 0;
             double t = bench_now_s();
             for (size_t i = 0; st == THZ_OK && i < s->n_sensors; i++) {
@@ -327,7 +350,7 @@ thz_status bench_measure_series(const char *scene_path, size_t channel, const ui
             }
         }
         photon_map_recycle(map, &pool);
-        for (int rep = 0; probe && st == THZ_OK && rep < (repeats > 0 ? repeats : 1); rep++) {
+        for (int rep = 0; cfg->probe && st == THZ_OK && rep < repeats; rep++) {
             bench_probe_result r;
             st = bench_probe_run(s, ps.rays, threads, &r, err);
             if (rep == 0 || r.seconds < p->s_probe)
@@ -336,6 +359,7 @@ thz_status bench_measure_series(const char *scene_path, size_t channel, const ui
         out->n = k + 1;
     }
     photon_map_pool_fini(&pool);
+    photon_map_pool_fini(&ref_pool);
     if (s)
         bench_images_fini(img, s->n_sensors);
     accel_destroy(acc);

@@ -55,6 +55,8 @@ typedef struct bench_point {
                            time slices taken by other processes do not count */
     int runs;           /* photon phase runs, of which s_photons and cpu_photons the medians */
     double s_photons_fastest, cpu_photons_fastest;
+    double cpu_vs_reference; /* median over the runs of CPU per photon over the reference
+                                run's before it (bench_series_cfg.ref_photons); 0: none */
 } bench_point;
 
 typedef struct bench_series {
@@ -80,10 +82,22 @@ thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int thread
  * number of rays. The photon phase of a point runs at least `repeats` times and until its
  * runs took min_seconds (an odd count, at most BENCH_MAX_RUNS), and its seconds and CPU
  * seconds are the **median** run's: the fastest would favour the short points, whose
- * runs can fall wholly in a few seconds when the VM runs faster (bench_pairs.h). */
-thz_status bench_measure_series(const char *scene_path, size_t channel, const uint64_t *photons,
-                                int n, int threads, int render, int probe, int repeats,
-                                double min_seconds, bench_series *out, thz_error *err);
+ * runs can fall wholly in a few seconds when the VM runs faster (bench_pairs.h). With
+ * ref_photons, each run follows a run of ref_photons photons (the reference), and the
+ * point's cpu_vs_reference is the median over its runs of its CPU time per photon over
+ * the reference's just before: the VM's speed drifts over minutes, and the points of a
+ * series run minutes apart. */
+typedef struct bench_series_cfg {
+    size_t channel;
+    const uint64_t *photons;
+    int n;
+    int threads, render, probe, repeats;
+    double min_seconds;
+    uint64_t ref_photons; /* 0: no reference runs */
+} bench_series_cfg;
+
+thz_status bench_measure_series(const char *scene_path, const bench_series_cfg *cfg,
+                                bench_series *out, thz_error *err);
 
 /* 3c. The photon phase of channel `channel` and the raw Embree probe for its rays, on 1
  * thread and on `threads`, in `pairs` rounds in one process: phase on 1 thread, on all,

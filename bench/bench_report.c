@@ -44,25 +44,28 @@ void bench_report_point_runs(json_t *o, const bench_point *p)
     json_object_set_new(o, "seconds_fastest", bench_real(p->s_photons_fastest));
     json_object_set_new(o, "cpu_ns_per_photon_fastest",
                         bench_real(1e9 * bench_ratio(p->cpu_photons_fastest, (double)p->photons)));
+    if (p->cpu_vs_reference > 0.0)
+        json_object_set_new(o, "cpu_vs_reference", bench_real(p->cpu_vs_reference));
 }
 
 json_t *bench_report_photons(const bench_series *sp, size_t channel, double load)
 {
     printf("\n3. Scaling in photons (channel %zu of the paper's case; load average %.2f): each "
-           "point the median of its runs\n",
-           channel + 1, load);
-    printf("  %12s %12s %5s %10s %10s %10s %10s %12s %12s\n", "photons", "stored", "runs",
-           "phase s", "ns/photon", "trace ns", "index ns", "CPU ns/ph.", "fastest CPU");
+           "point the median of its runs; each run after a reference run of %llu photons\n",
+           channel + 1, load, sp->n ? (unsigned long long)sp->p[0].photons : 0ull);
+    printf("  %12s %12s %5s %10s %10s %10s %10s %12s %12s %10s\n", "photons", "stored", "runs",
+           "phase s", "ns/photon", "trace ns", "index ns", "CPU ns/ph.", "fastest CPU",
+           "CPU vs ref");
     json_t *jsp = json_array();
     for (int k = 0; k < sp->n; k++) {
         const bench_point *p = &sp->p[k];
         double ns = 1e9 * bench_ratio(p->s_photons, (double)p->photons);
-        printf("  %12llu %12llu %5d %10.3f %10.1f %10.1f %10.1f %12.1f %12.1f\n",
+        printf("  %12llu %12llu %5d %10.3f %10.1f %10.1f %10.1f %12.1f %12.1f %10.3f\n",
                (unsigned long long)p->photons, (unsigned long long)p->stored, p->runs, p->s_photons,
                ns, 1e9 * bench_ratio(p->s_tracing, (double)p->photons),
                1e9 * bench_ratio(p->s_index, (double)p->photons),
                1e9 * bench_ratio(p->cpu_photons, (double)p->photons),
-               1e9 * bench_ratio(p->cpu_photons_fastest, (double)p->photons));
+               1e9 * bench_ratio(p->cpu_photons_fastest, (double)p->photons), p->cpu_vs_reference);
         json_t *o = json_object();
         json_object_set_new(o, "photons", json_integer((json_int_t)p->photons));
         json_object_set_new(o, "stored", json_integer((json_int_t)p->stored));

@@ -162,5 +162,13 @@ for t in r["targets"]:
     need(t, ["target", "limit", "met", "verdict"], "targets[]")
     finite(t, ["value", "limit"], f"target '{t['target']}'")
     assert t["verdict"] in ("met", "not met", "not shown"), t
+# Flatness: each point's CPU per photon against the reference runs just before its own
+# runs (the first point's count), not the points against each other.
+flat = [t for t in r["targets"] if t["target"].startswith("CPU time per photon, 0.01 M")][0]
+rel = [pt["cpu_vs_reference"] for pt in r["scaling_photons"]]
+assert all(x > 0 for x in rel), rel
+want = 100 * max(abs(x - 1) for x in rel)
+assert abs(flat["value"] - want) <= 1e-6 * max(want, 1), (flat, rel)
+finite(r, ["flatness_between_points_percent"], "root")
 print("bench JSON ok")
 PY
