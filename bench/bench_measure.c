@@ -238,6 +238,27 @@ thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int thread
     return st;
 }
 
+/* A series' reference run (cfg->ref_photons photons; none when 0) and its CPU seconds
+ * into *cpu_s, in its own memory (po_ref's pool); the scene's count is left at the
+ * reference's. */
+static thz_status bench_series_reference(thz_scene *s, const accel *acc, size_t channel,
+                                         const bench_series_cfg *cfg,
+                                         const photon_phase_options *po_ref, double *cpu_s,
+                                         thz_error *err)
+{
+    *cpu_s = 0.0;
+    if (!cfg->ref_photons)
+        return THZ_OK;
+    s->photons.per_channel = cfg->ref_photons;
+    photon_map *m = NULL;
+    photon_stats q;
+    double c = bench_cpu_s();
+    thz_status st = photon_phase_run(s, acc, channel, po_ref, &m, &q, err);
+    *cpu_s = bench_cpu_s() - c;
+    photon_map_recycle(m, po_ref->pool);
+    return st;
+}
+
 thz_status bench_measure_series(const char *scene_path, const bench_series_cfg *cfg,
                                 bench_series *out, thz_error *err)
 {
@@ -280,18 +301,10 @@ thz_status bench_measure_series(const char *scene_path, const bench_series_cfg *
             photon_map *m = NULL;
             photon_map_recycle(map, &pool); /* one map at a time: the 100 M point's peak */
             map = NULL;
-            double ref_cpu = 0.0;
-            if (cfg->ref_photons) { /* the reference, just before: the same machine speed */
-                s->photons.per_channel = cfg->ref_photons;
-                photon_stats q;
-                double c = bench_cpu_s();
-                st = photon_phase_run(s, acc, channel, &po_ref, &m, &q, err);
-                ref_cpu = bench_cpu_s() - c;
-                photon_map_recycle(m, &ref_pool);
-                m = NULL;
-                if (st != THZ_OK)
-                    break;
-            }
+            double ref_before = 0.0, ref_after = 0.0;
+            st = bench_series_reference(s, acc, channel, cfg, &po_ref, &ref_before, err);
+            if (st != THZ_OK)
+                break;
             s->photons.per_channel = cfg->photons[k];
             double t = bench_now_s(), c = bench_cpu_s();
             st = photon_phase_run(s, acc, channel, &po, &m, &runs[rep], err);
@@ -301,10 +314,12 @@ thz_status bench_measure_series(const char *scene_path, const bench_series_cfg *
                 break;
             map = m; /* every run's map is the same (deterministic): the last is kept */
             p->runs = rep + 1;
+            st = bench_series_reference(s, acc, channel, cfg, &po_ref, &ref_after, err);
+            if (st != THZ_OK)
+                break;
+            double ref = 0.5 * (ref_before + ref_after) / (double)cfg->ref_photons;
             rel[rep] =
-                ref_cpu > 0.0 && runs[rep].fired > 0
-                    ? (cpu[rep] / (double)runs[rep].fired) / (ref_cpu / (double)cfg->ref_photons)
-                    : 0.0;
+                ref > 0.0 && runs[rep].fired > 0 ? cpu[rep] / (double)runs[rep].fired / ref : 0.0;
             if (rep == 0 && wall[0] > 0.0 && cfg->min_seconds > wall[0] * want) {
                 double more = ceil(cfg->min_seconds / wall[0]);
                 want = more < BENCH_MAX_RUNS ? (int)more : BENCH_MAX_RUNS;

@@ -56,7 +56,7 @@ typedef struct bench_point {
     int runs;           /* photon phase runs, of which s_photons and cpu_photons the medians */
     double s_photons_fastest, cpu_photons_fastest;
     double cpu_vs_reference; /* median over the runs of CPU per photon over the reference
-                                run's before it (bench_series_cfg.ref_photons); 0: none */
+                                runs' around it (bench_series_cfg.ref_photons); 0: none */
 } bench_point;
 
 typedef struct bench_series {
@@ -83,10 +83,10 @@ thz_status bench_measure_probe(const char *scene_path, uint64_t rays, int thread
  * runs took min_seconds (an odd count, at most BENCH_MAX_RUNS), and its seconds and CPU
  * seconds are the **median** run's: the fastest would favour the short points, whose
  * runs can fall wholly in a few seconds when the VM runs faster (bench_pairs.h). With
- * ref_photons, each run follows a run of ref_photons photons (the reference), and the
- * point's cpu_vs_reference is the median over its runs of its CPU time per photon over
- * the reference's just before: the VM's speed drifts over minutes, and the points of a
- * series run minutes apart. */
+ * ref_photons, each run lies between two runs of ref_photons photons (the references),
+ * and the point's cpu_vs_reference is the median over its runs of its CPU time per
+ * photon over the mean of the two references' around it: the VM's speed drifts over
+ * minutes, and the points of a series run minutes apart. */
 typedef struct bench_series_cfg {
     size_t channel;
     const uint64_t *photons;
