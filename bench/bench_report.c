@@ -51,7 +51,7 @@ void bench_report_point_runs(json_t *o, const bench_point *p)
 json_t *bench_report_photons(const bench_series *sp, size_t channel, double load)
 {
     printf("\n3. Scaling in photons (channel %zu of the paper's case; load average %.2f): each "
-           "point the median of its runs; each run after a reference run of %llu photons\n",
+           "point the median of its runs; each run between two reference runs of %llu photons\n",
            channel + 1, load, sp->n ? (unsigned long long)sp->p[0].photons : 0ull);
     printf("  %12s %12s %5s %10s %10s %10s %10s %12s %12s %10s\n", "photons", "stored", "runs",
            "phase s", "ns/photon", "trace ns", "index ns", "CPU ns/ph.", "fastest CPU",
