@@ -280,12 +280,13 @@ thz_status bench_measure_series(const char *scene_path, const bench_series_cfg *
     if (st == THZ_OK && cfg->render)
         st = bench_images_init(s, &img, err);
     /* Repeats build their maps in the memory of the map before, as a run's channels do
-     * (photon_map_pool): the fastest repeat is a run's steady state, not its first channel. */
+     * (photon_map_pool): a repeat is a run's steady state, not its first channel (only a
+     * series' first run pays for new memory, and the median leaves it out). */
     photon_map_pool pool = {0};
     photon_phase_options po = {.threads = threads, .pool = &pool};
-    /* The reference runs in memory of its own: in the point's pool, its small map would
-     * take the point's large array and shrink it (phase.c), and the point would then pay
-     * for new memory (ef2613c: ~12 us a page here) */
+    /* The references run in memory of their own: in the point's pool, a reference's small
+     * map would take the point's large array and shrink it (phase.c), and the point would
+     * then pay for new memory (ef2613c: ~12 us a page here). */
     photon_map_pool ref_pool = {0};
     photon_phase_options po_ref = {.threads = threads, .pool = &ref_pool};
     render_options ro = {.threads = threads};
