@@ -265,6 +265,7 @@ thz_status bench_measure_series(const char *scene_path, const bench_series_cfg *
     size_t channel = cfg->channel;
     const int threads = cfg->threads, repeats = cfg->repeats > 0 ? cfg->repeats : 1;
     memset(out, 0, sizeof *out);
+    out->ref_photons = cfg->ref_photons;
     thz_scene *s = NULL;
     accel *acc = NULL;
     sensor_images *img = NULL;

@@ -61,6 +61,7 @@ typedef struct bench_point {
 
 typedef struct bench_series {
     int n;
+    uint64_t ref_photons; /* the reference runs' photons (bench_series_cfg); 0: none */
     bench_point p[BENCH_MAX_POINTS];
 } bench_series;
 

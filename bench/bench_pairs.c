@@ -40,12 +40,10 @@ static void bench_pairs_order(const bench_pairs *p, int *order)
 
 double bench_pairs_speedup(const bench_pairs *p)
 {
-    if (p->n <= 0)
-        return 0.0;
-    int order[BENCH_MAX_PAIRS];
-    bench_pairs_order(p, order);
-    double a = bench_pair_ratio(p, order[(p->n - 1) / 2]), b = bench_pair_ratio(p, order[p->n / 2]);
-    return 0.5 * (a + b);
+    double r[BENCH_MAX_PAIRS];
+    for (int i = 0; i < p->n; i++)
+        r[i] = bench_pair_ratio(p, i);
+    return bench_median(r, p->n);
 }
 
 void bench_pairs_median_pair(const bench_pairs *p, double *s_1, double *s_all, double *cpu_1,

@@ -42,9 +42,11 @@ void bench_pairs_range(const bench_pairs *p, double *lo, double *hi);
 void bench_pairs_median_pair(const bench_pairs *p, double *s_1, double *s_all, double *cpu_1,
                              double *cpu_all);
 
+/* Runs of one scaling point at most (bench_measure_series). */
+#define BENCH_MAX_RUNS 15
+
 /* The median of n values (of the middle two for an even count; n at most BENCH_MAX_PAIRS
  * or BENCH_MAX_RUNS, the larger); 0 for none. */
-#define BENCH_MAX_RUNS 15
 double bench_median(const double *v, int n);
 
 /* Two measurements taken in the same rounds (pair i of a and pair i of b in one round of

@@ -52,7 +52,7 @@ json_t *bench_report_photons(const bench_series *sp, size_t channel, double load
 {
     printf("\n3. Scaling in photons (channel %zu of the paper's case; load average %.2f): each "
            "point the median of its runs; each run between two reference runs of %llu photons\n",
-           channel + 1, load, sp->n ? (unsigned long long)sp->p[0].photons : 0ull);
+           channel + 1, load, (unsigned long long)sp->ref_photons);
     printf("  %12s %12s %5s %10s %10s %10s %10s %12s %12s %10s\n", "photons", "stored", "runs",
            "phase s", "ns/photon", "trace ns", "index ns", "CPU ns/ph.", "fastest CPU",
            "CPU vs ref");

@@ -34,11 +34,11 @@ typedef struct bench_targets {
 void bench_target(bench_targets *t, const char *name, double value, const char *op, double limit,
                   bool met, const char *unit, bool shown);
 
-/* Section 3's photon scaling and section 4's rendering, from the same series. */
-/* A scaling point's runs into its JSON object o: how many, the median's CPU ns per photon
- * and the fastest run's seconds and CPU ns per photon. */
+/* A scaling point's runs into its JSON object o: how many, the median's CPU ns per photon,
+ * the fastest run's seconds and CPU ns per photon, and its ratio to the reference runs. */
 void bench_report_point_runs(json_t *o, const bench_point *p);
 
+/* Section 3's photon scaling and section 4's rendering, from the same series. */
 json_t *bench_report_photons(const bench_series *sp, size_t channel, double load);
 json_t *bench_report_rendering(const bench_series *sp, size_t channel);
 

@@ -216,8 +216,9 @@ int main(int argc, char **argv)
      * `repeats` runs that take at least series_seconds together (bench_measure.h). */
     const int repeats = small ? 1 : 3;
     const double series_seconds = small ? 0.0 : 3.0;
-    /* Each run of a photon scaling point follows a reference run of the first point's
-     * count, whose CPU time per photon it is compared with (the flatness target). */
+    /* Each run of a photon scaling point lies between two reference runs of the first
+     * point's count, whose mean CPU time per photon it is compared with (the flatness
+     * target). */
     const uint64_t series_ref = all_series[0];
     /* Thread speed-ups: alternating pairs of runs, the median of their ratios (an odd
      * count: one pair's) */
@@ -597,10 +598,10 @@ int main(int argc, char **argv)
     /* Flatness and triangle growth from the CPU time per photon: the wall time of a point
      * also counts the time slices other processes took, which on a shared machine varies
      * from point to point; CPU time does not (both are in the table and the JSON). The
-     * flatness is each point's CPU time per photon over that of the reference run (the
-     * first point's count) just before each of its runs, the median over its runs: the
+     * flatness is each point's CPU time per photon over the mean of the two reference runs
+     * (the first point's count) around each of its runs, the median over its runs: the
      * VM's speed drifts over the minutes a series takes, so points compared with each
-     * other compare machine speeds too (the medians of the points, as before 12-04 10:30,
+     * other compare machine speeds too (the points' medians against each other are
      * printed below it). It is shown only over the whole 1 M..100 M. */
     double dev = 0, lo = 0, hi = 0, first = 0;
     for (int k = 0; k < sp.n; k++) {
