@@ -1,13 +1,18 @@
 #!/bin/bash
 # Strong scaling of `mpirun -np N thzmap simulate|render|batch` (docs/mpi.md, issue 19):
 # the same work with 1 (plain thzmap, no mpirun), 2 and 4 ranks of 1 thread:
-#   simulate: examples/plate-in-box (64 x 64, oversampling 2), photon-map, 4 M photons
-#             (62 batches): photons shared by batch, pixels by tile;
-#   render:   final-gather from a photon map of 1 M photons that simulate saved first
-#             (not timed): pixels shared by tile, the map sent by rank 0 to the others;
+#   simulate: examples/plate-in-box (64 x 64, oversampling 2), photon-map, 16 M photons
+#             (245 batches): photons shared by batch, pixels by tile;
+#   render:   final-gather, 512 gather rays (a pass; plate-in-box's default 32 reach its
+#             noise target in one pass) from a photon map of 1 M photons that simulate
+#             saved first (not timed): pixels shared by tile, the map sent by rank 0 to
+#             the others;
 #   batch:    8 frames of plate-in-box whose target warms by 1 K a frame, photon-map,
-#             250 k photons per frame: 8 photon groups, dealt whole to the ranks
+#             1 M photons per frame: 8 photon groups, dealt whole to the ranks
 #             (each frame computed by one rank, sent to rank 0, which writes it).
+# The workloads take several seconds on one rank (2026-12-04; they were a quarter of
+# these before, when the program was slower): mpirun's own start, about 0.35 s here,
+# would otherwise be much of a run.
 # Prints per run the wall time of the command, the speed-up and the strong-scaling
 # efficiency T1 / (N TN), each rank's CPU time (on a shared machine the busiest rank's
 # CPU time is the wall time idle cores would give, and CPU eff. = CPU(1) / (N max rank)
@@ -17,18 +22,20 @@
 # machine's cores are oversubscribed (said in the output), and the machine may be
 # shared: the load average before and after is printed.
 # A measurement, not a test: nothing fails on the time.
-# usage: bench/mpi.sh [THZMAP_BINARY] [--photons N] [--ranks "1 2 4"]
+# usage: bench/mpi.sh [THZMAP_BINARY] [--photons N] [--frame-photons N] [--ranks "1 2 4"]
 #                     [--what "simulate render batch"]
 set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
 thzmap=$repo/build/thzmap
 if [ $# -gt 0 ] && [ "${1#--}" = "$1" ]; then thzmap=$1; shift; fi
-photons=4000000
+photons=16000000
+frame_photons=1000000
 ranks="1 2 4"
 what="simulate render batch"
 while [ $# -gt 0 ]; do
     case $1 in
     --photons) photons=$2; shift 2 ;;
+    --frame-photons) frame_photons=$2; shift 2 ;;
     --ranks) ranks=$2; shift 2 ;;
     --what) what=$2; shift 2 ;;
     *) echo "bench/mpi.sh: unknown option $1" >&2; exit 2 ;;
@@ -42,12 +49,13 @@ cores=$(nproc)
 scene=$repo/examples/plate-in-box/scene.json
 # the batch: plate-in-box with absolute paths, the target warming from 305 to 312 K in
 # 8 frames (every frame fires its own photons: 8 groups to deal)
-/usr/bin/python3 - "$scene" "$out/scene.json" "$out/seq.json" <<'PY'
+/usr/bin/python3 - "$scene" "$out/scene.json" "$out/seq.json" "$frame_photons" "$out/render.json" <<'PY'
 import json, os, sys
 s = json.load(open(sys.argv[1]))
 s["materials"]["table"]["file"] = os.path.join(os.path.dirname(sys.argv[1]), "materials/sample.csv")
+json.dump(dict(s, render={"gather_rays": 512}), open(sys.argv[5], "w"))
 s["render"] = {"integrator": "photon-map"}
-s["photons"]["per_channel"] = 250000
+s["photons"]["per_channel"] = int(sys.argv[4])
 json.dump(s, open(sys.argv[2], "w"))
 q = {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 7, "frames": 8,
      "keyframes": [{"time_s": 0, "objects": {"target": {"temperature_k": 305}}},
@@ -63,7 +71,8 @@ fi
 for w in $what; do
     case $w in
     simulate) cmd=(simulate "$scene" --photons "$photons" --integrator photon-map) ;;
-    render) cmd=(render "$scene" --photon-map "$out/map/photon-map.thzpm" --integrator final-gather) ;;
+    render) cmd=(render "$out/render.json" --photon-map "$out/map/photon-map.thzpm"
+                 --integrator final-gather) ;;
     batch) cmd=(batch "$out/seq.json") ;;
     *) echo "bench/mpi.sh: unknown --what $w" >&2; exit 2 ;;
     esac
