@@ -146,6 +146,7 @@ static void photon_build_scan(photon_build *b, int p)
     }
     b->first_bad[p] = b->count;
     for (size_t i = lo; i < hi; i++) {
+        photon_prefetch(b->r, i + PHOTON_PREFETCH_AHEAD, hi);
         const photon_record *q = &b->r[i];
         if (q->object_side >= b->n_groups) {
             b->first_bad[p] = i;
@@ -203,6 +204,7 @@ static bool photon_build_in_order(const photon_build *b, int p)
     size_t first = lo > 0 ? lo - 1 : 0;
     uint64_t prev_code = 0;
     for (size_t i = first; i < hi; i++) {
+        photon_prefetch(b->r, i + PHOTON_PREFETCH_AHEAD, hi);
         const photon_record *q = &b->r[i];
         if (q->flags & 3u << 16)
             return false;
@@ -230,6 +232,7 @@ static void photon_build_key(photon_build *b, int p)
     size_t *cnt = b->key_next + (size_t)p * b->key_stride;
     memset(cnt, 0, b->n_keys * sizeof *cnt);
     for (size_t i = lo; i < hi; i++) {
+        photon_prefetch_write(b->r, i + PHOTON_PREFETCH_AHEAD, hi);
         photon_record *q = &b->r[i];
         size_t g = q->object_side, key = b->key_base[g];
         if (b->key_base[g + 1] - key > 1)
@@ -311,10 +314,12 @@ static void photon_build_partition(photon_build *b, int p)
         next[k] = at[k];
     for (int k = 0; k < b->n_buckets; k++) {
         while (next[k] < at[k + 1]) {
+            photon_prefetch_write(b->r, next[k] + PHOTON_PREFETCH_AHEAD, at[k + 1]);
             int d = photon_bucket_of(b, b->r[next[k]].object_side);
             if (d == k) {
                 next[k]++;
-            } else {
+            } else { /* and the front it swaps with, half as far: it moves less often */
+                photon_prefetch_write(b->r, next[d] + PHOTON_PREFETCH_AHEAD / 2, at[d + 1]);
                 photon_record t = b->r[next[k]];
                 b->r[next[k]] = b->r[next[d]];
                 b->r[next[d]++] = t;
@@ -345,8 +350,10 @@ static void photon_build_scatter(photon_build *b, int k, int p)
 {
     size_t *slot = b->key_next + (size_t)p * b->key_stride;
     size_t at = photon_part_at(b, p)[k], in = photon_part_in(b, p)[k];
-    for (size_t i = at; i < at + in; i++)
+    for (size_t i = at; i < at + in; i++) {
+        photon_prefetch(b->r, i + PHOTON_PREFETCH_AHEAD, at + in);
         b->s[slot[b->r[i].object_side]++] = b->r[i];
+    }
 }
 
 /* After bucket k's pass 4: the parts' records of the later buckets moved up against the

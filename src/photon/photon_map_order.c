@@ -128,6 +128,7 @@ void photon_sort_range(const photon_cube *cube, photon_record *scratch, photon_r
     uint64_t *half = (uint64_t *)(void *)r + 2 * n, *last = half + n;
     size_t count[4][256] = {{0}};
     for (size_t i = 0; i < n; i++) {
+        photon_prefetch(scratch, i + PHOTON_PREFETCH_AHEAD, n);
         uint32_t key = (uint32_t)(photon_morton(cube, &scratch[i]) >> shift);
         scratch[i].object_side = key; /* until the record is in its place */
         for (int d = 0; d < 4; d++)
