@@ -156,15 +156,15 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                     accel_hit hits[RNG_MANY];
                     bool found[RNG_MANY];
                     size_t ray_of[RNG_MANY], n_rays = 0;
-                    for (size_t j = 0; j < n; j++) /* SIZE_MAX: not traced, no ray */
-                        ray_of[j] =
-                            trace_first_ray(a->acc, &e[j], &rays[n_rays]) ? n_rays++ : SIZE_MAX;
+                    for (size_t j = 0; j < n; j++) {
+                        ray_of[j] = n_rays;
+                        n_rays += trace_first_ray(a->acc, &e[j], &rays[n_rays]);
+                    }
                     accel_intersect_many(a->acc, rays, n_rays, hits, found);
                     for (size_t j = 0; j < n; j++) {
                         uint64_t index = a->first_photon + i0 + j;
                         e[j].batch = (uint32_t)(index % PHOTON_MAP_BATCHES);
-                        const accel_hit *hit =
-                            ray_of[j] != SIZE_MAX && found[ray_of[j]] ? &hits[ray_of[j]] : NULL;
+                        const accel_hit *hit = found[ray_of[j]] ? &hits[ray_of[j]] : NULL;
                         if (!trace_photon_cast(a->scene, a->acc, a->optics, &e[j], hit, &rng[j], &b,
                                                &counters)) {
 #pragma omp atomic write
