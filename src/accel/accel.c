@@ -211,50 +211,51 @@ void accel_destroy(accel *a)
     free(a);
 }
 
-/* A ray for Embree: origin and direction in float, (0, tfar], no hit yet. */
-static void accel_ray_init(struct RTCRayHit *rh, vec3 origin_m, vec3 dir, float tfar)
+bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distance_m,
+                     uint32_t ignore_object, uint32_t ignore_triangle, accel_hit *hit)
 {
-    rh->ray.org_x = (float)origin_m.x;
-    rh->ray.org_y = (float)origin_m.y;
-    rh->ray.org_z = (float)origin_m.z;
-    rh->ray.dir_x = (float)dir.x;
-    rh->ray.dir_y = (float)dir.y;
-    rh->ray.dir_z = (float)dir.z;
-    rh->ray.tnear = 0.0f;
-    rh->ray.tfar = tfar;
-    rh->ray.time = 0.0f;
-    rh->ray.mask = 0xffffffffu;
-    rh->ray.id = 0;
-    rh->ray.flags = 0;
-    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh->hit.primID = RTC_INVALID_GEOMETRY_ID;
-    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-}
+    accel_context ctx;
+    rtcInitIntersectContext(&ctx.base);
+    ctx.ignore_object = ignore_object;
+    ctx.ignore_triangle = ignore_triangle;
 
-/* The hit of a ray cast without the filter, given as rh: cast again with the filter if
- * its closest hit is the triangle it leaves (the closest hit of the others is then
- * further); then *hit from it. False if nothing is hit. */
-static bool accel_finish(const accel *a, struct RTCRayHit *rh, vec3 dir, float tfar,
-                         uint32_t ignore_object, uint32_t ignore_triangle, accel_hit *hit)
-{
-    if (ignore_object != ACCEL_NO_OBJECT && rh->hit.geomID == ignore_object &&
-        rh->hit.primID == ignore_triangle) {
-        accel_context ctx;
-        rtcInitIntersectContext(&ctx.base);
+    struct RTCRayHit rh;
+    rh.ray.org_x = (float)origin_m.x;
+    rh.ray.org_y = (float)origin_m.y;
+    rh.ray.org_z = (float)origin_m.z;
+    rh.ray.dir_x = (float)dir.x;
+    rh.ray.dir_y = (float)dir.y;
+    rh.ray.dir_z = (float)dir.z;
+    rh.ray.tnear = 0.0f;
+    const float tfar = max_distance_m >= (double)FLT_MAX ? INFINITY : (float)max_distance_m;
+    rh.ray.tfar = tfar;
+    rh.ray.time = 0.0f;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+
+    /* Cast without the filter first: the closest hit, if it is not the ignored
+     * triangle, is the closest of the others too. Only a ray that met the triangle it
+     * leaves is cast again, with the filter (a callback on every candidate hit was 3.5 %
+     * of path's instructions). */
+    rtcIntersect1(a->rtc, &ctx.base, &rh);
+    if (ignore_object != ACCEL_NO_OBJECT && rh.hit.geomID == ignore_object &&
+        rh.hit.primID == ignore_triangle) {
         ctx.base.filter = accel_filter;
-        ctx.ignore_object = ignore_object;
-        ctx.ignore_triangle = ignore_triangle;
-        rh->ray.tfar = tfar;
-        rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh->hit.primID = RTC_INVALID_GEOMETRY_ID;
-        rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(a->rtc, &ctx.base, rh);
+        rh.ray.tfar = tfar;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(a->rtc, &ctx.base, &rh);
     }
-    if (rh->hit.geomID == RTC_INVALID_GEOMETRY_ID)
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return false;
 
-    const thz_mesh *m = &a->scene->objects[rh->hit.geomID].mesh;
-    uint32_t tri = rh->hit.primID;
+    const thz_mesh *m = &a->scene->objects[rh.hit.geomID].mesh;
+    uint32_t tri = rh.hit.primID;
     const float *nf = &m->normals[3 * (size_t)tri];
     vec3 n = v3(nf[0], nf[1], nf[2]);
     double c = v3_dot(dir, n);
@@ -265,86 +266,15 @@ static bool accel_finish(const accel *a, struct RTCRayHit *rh, vec3 dir, float t
     vec3 p0 = v3_from_floats(&m->positions[3 * (size_t)idx[0]]);
     vec3 p1 = v3_from_floats(&m->positions[3 * (size_t)idx[1]]);
     vec3 p2 = v3_from_floats(&m->positions[3 * (size_t)idx[2]]);
-    double u = rh->hit.u, v = rh->hit.v;
+    double u = rh.hit.u, v = rh.hit.v;
     hit->position_m = v3_add(v3_scale(p0, 1.0 - u - v), v3_add(v3_scale(p1, u), v3_scale(p2, v)));
-    hit->distance_m = rh->ray.tfar;
-    hit->object = rh->hit.geomID;
+    hit->distance_m = rh.ray.tfar;
+    hit->object = rh.hit.geomID;
     hit->triangle = tri;
     hit->side = c < 0.0 ? 0 : 1;
     double mu = fabs(c);
     hit->cos_theta = mu > 1.0 ? 1.0 : (mu > 1e-12 ? mu : 1e-12);
     return true;
-}
-
-bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distance_m,
-                     uint32_t ignore_object, uint32_t ignore_triangle, accel_hit *hit)
-{
-    /* Cast without the filter first: the closest hit, if it is not the ignored
-     * triangle, is the closest of the others too. Only a ray that met the triangle it
-     * leaves is cast again, with the filter (a callback on every candidate hit was 3.5 %
-     * of path's instructions). */
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    struct RTCRayHit rh;
-    const float tfar = max_distance_m >= (double)FLT_MAX ? INFINITY : (float)max_distance_m;
-    accel_ray_init(&rh, origin_m, dir, tfar);
-    rtcIntersect1(a->rtc, &ctx, &rh);
-    return accel_finish(a, &rh, dir, tfar, ignore_object, ignore_triangle, hit);
-}
-
-void accel_intersect_many(const accel *a, const accel_ray *rays, size_t n, accel_hit *hits,
-                          bool *found)
-{
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    for (size_t first = 0; first < n; first += ACCEL_PACKET) {
-        const accel_ray *r = rays + first;
-        size_t m = n - first < ACCEL_PACKET ? n - first : ACCEL_PACKET;
-        _Alignas(32) int valid[ACCEL_PACKET];
-        _Alignas(32) struct RTCRayHit8 p;
-        for (size_t j = 0; j < ACCEL_PACKET; j++) {
-            size_t k = j < m ? j : 0; /* an inactive lane repeats the first ray */
-            valid[j] = j < m ? -1 : 0;
-            p.ray.org_x[j] = (float)r[k].origin_m.x;
-            p.ray.org_y[j] = (float)r[k].origin_m.y;
-            p.ray.org_z[j] = (float)r[k].origin_m.z;
-            p.ray.dir_x[j] = (float)r[k].dir.x;
-            p.ray.dir_y[j] = (float)r[k].dir.y;
-            p.ray.dir_z[j] = (float)r[k].dir.z;
-            p.ray.tnear[j] = 0.0f;
-            p.ray.tfar[j] = INFINITY;
-            p.ray.time[j] = 0.0f;
-            p.ray.mask[j] = 0xffffffffu;
-            p.ray.id[j] = 0;
-            p.ray.flags[j] = 0;
-            p.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
-            p.hit.primID[j] = RTC_INVALID_GEOMETRY_ID;
-            p.hit.instID[0][j] = RTC_INVALID_GEOMETRY_ID;
-        }
-        rtcIntersect8(valid, a->rtc, &ctx, &p);
-        for (size_t j = 0; j < m; j++) {
-            struct RTCRayHit rh; /* lane j as accel_intersect's ray after its first cast */
-            rh.ray.org_x = p.ray.org_x[j];
-            rh.ray.org_y = p.ray.org_y[j];
-            rh.ray.org_z = p.ray.org_z[j];
-            rh.ray.dir_x = p.ray.dir_x[j];
-            rh.ray.dir_y = p.ray.dir_y[j];
-            rh.ray.dir_z = p.ray.dir_z[j];
-            rh.ray.tnear = 0.0f;
-            rh.ray.tfar = p.ray.tfar[j];
-            rh.ray.time = 0.0f;
-            rh.ray.mask = 0xffffffffu;
-            rh.ray.id = 0;
-            rh.ray.flags = 0;
-            rh.hit.u = p.hit.u[j];
-            rh.hit.v = p.hit.v[j];
-            rh.hit.geomID = p.hit.geomID[j];
-            rh.hit.primID = p.hit.primID[j];
-            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            found[first + j] = accel_finish(a, &rh, r[j].dir, INFINITY, r[j].ignore_object,
-                                            r[j].ignore_triangle, &hits[first + j]);
-        }
-    }
 }
 
 vec3 accel_offset_origin(const accel *a, const accel_hit *hit, vec3 dir)

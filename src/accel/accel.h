@@ -10,7 +10,6 @@
 #define THZ_ACCEL_ACCEL_H
 
 #include <stdbool.h>
-#include <stddef.h>
 #include <stdint.h>
 
 #include "core/error.h"
@@ -40,23 +39,6 @@ void accel_destroy(accel *a);
  * Returns false if nothing is hit. Thread-safe. */
 bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distance_m,
                      uint32_t ignore_object, uint32_t ignore_triangle, accel_hit *hit);
-
-/* Rays cast together by accel_intersect_many: Embree's packets of this many. */
-#define ACCEL_PACKET 8
-
-/* One ray of accel_intersect_many: unit dir, no distance limit. */
-typedef struct accel_ray {
-    vec3 origin_m, dir;
-    uint32_t ignore_object, ignore_triangle; /* as accel_intersect's */
-} accel_ray;
-
-/* accel_intersect(a, r.origin_m, r.dir, INFINITY, r.ignore_object, r.ignore_triangle,
- * &hits[i]) for each ray r = rays[i], i < n, its result in found[i], cast ACCEL_PACKET at
- * a time through Embree's ray packets. The hits are the same bytes as one ray at a time
- * (tests/unit/test_accel.c checks it); the packets take fewer instructions a ray for
- * incoherent rays too (the photon phase's first rays: README, issue 19). Thread-safe. */
-void accel_intersect_many(const accel *a, const accel_ray *rays, size_t n, accel_hit *hits,
-                          bool *found);
 
 /* The origin for a ray leaving `hit` into the hemisphere of `dir`: the hit point offset
  * slightly along the normal towards dir. */

@@ -151,22 +151,11 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                                   PHASE_RNG_BLOCKS);
                     emission_photon e[RNG_MANY];
                     phase_emit_block(a, rng, n, e);
-                    /* their first rays together, in Embree's packets (accel.h) */
-                    accel_ray rays[RNG_MANY];
-                    accel_hit hits[RNG_MANY];
-                    bool found[RNG_MANY];
-                    size_t ray_of[RNG_MANY], n_rays = 0;
-                    for (size_t j = 0; j < n; j++) {
-                        ray_of[j] = n_rays;
-                        n_rays += trace_first_ray(a->acc, &e[j], &rays[n_rays]);
-                    }
-                    accel_intersect_many(a->acc, rays, n_rays, hits, found);
                     for (size_t j = 0; j < n; j++) {
                         uint64_t index = a->first_photon + i0 + j;
                         e[j].batch = (uint32_t)(index % PHOTON_MAP_BATCHES);
-                        const accel_hit *hit = found[ray_of[j]] ? &hits[ray_of[j]] : NULL;
-                        if (!trace_photon_cast(a->scene, a->acc, a->optics, &e[j], hit, &rng[j], &b,
-                                               &counters)) {
+                        if (!trace_photon(a->scene, a->acc, a->optics, &e[j], &rng[j], &b,
+                                          &counters)) {
 #pragma omp atomic write
                             failed = 1;
                             bad = true;

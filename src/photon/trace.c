@@ -111,32 +111,14 @@ void trace_optics_fini(trace_optics *t)
     t->constant = NULL;
 }
 
-bool trace_first_ray(const accel *acc, const emission_photon *e, accel_ray *ray)
-{
-    if (e->power_w_per_hz == 0.0 || isnan(e->power_w_per_hz))
-        return false;
-    accel_hit from = {
-        .object = e->object, .triangle = e->triangle, .position_m = e->position_m, .side = e->side};
-    /* An air photon (air_emission.h) starts from its point in the volume itself. */
-    ray->origin_m =
-        e->object == ACCEL_NO_OBJECT ? e->position_m : accel_offset_origin(acc, &from, e->dir);
-    ray->dir = e->dir;
-    ray->ignore_object = e->object;
-    ray->ignore_triangle = e->triangle;
-    return true;
-}
-
-/* trace_photon; `first` (cast) its first ray's hit if cast is set (NULL: none). */
-static bool trace_path(const thz_scene *scene, const accel *acc, const trace_optics *optics,
-                       const emission_photon *e, bool cast, const accel_hit *first, rng_stream *rng,
-                       trace_buffer *buf, trace_counters *c)
+bool trace_photon(const thz_scene *scene, const accel *acc, const trace_optics *optics,
+                  const emission_photon *e, rng_stream *rng, trace_buffer *buf, trace_counters *c)
 {
     c->photons++;
     /* The power is signed in a deviation map (emission.h): the path is traced with its
      * magnitude and every record and sum keeps the sign. */
     double power = e->power_w_per_hz;
-    accel_ray ray;
-    if (!trace_first_ray(acc, e, &ray))
+    if (power == 0.0 || isnan(power))
         return true;
     c->fired_power += power;
     const double w_min = scene->photons.min_relative_power * fabs(power);
@@ -145,9 +127,14 @@ static bool trace_path(const thz_scene *scene, const accel *acc, const trace_opt
      * would evaluate it, an interpolation or a line sum, at every hit). */
     const double alpha = atmosphere_alpha_per_m(&scene->atmosphere, nu);
 
-    vec3 dir = ray.dir, origin = ray.origin_m;
+    accel_hit from = {
+        .object = e->object, .triangle = e->triangle, .position_m = e->position_m, .side = e->side};
+    vec3 dir = e->dir;
+    /* An air photon (air_emission.h) starts from its point in the volume itself. */
+    vec3 origin =
+        e->object == ACCEL_NO_OBJECT ? e->position_m : accel_offset_origin(acc, &from, dir);
     vec3 surface = e->position_m; /* the un-offset point the free path starts from */
-    uint32_t ignore_obj = ray.ignore_object, ignore_tri = ray.ignore_triangle;
+    uint32_t ignore_obj = e->object, ignore_tri = e->triangle;
 
     for (uint32_t bounce = 0;; bounce++) {
         if (bounce >= TRACE_MAX_BOUNCES) {
@@ -155,22 +142,15 @@ static bool trace_path(const thz_scene *scene, const accel *acc, const trace_opt
             c->terminated_power += power;
             return true;
         }
-        /* the hit by pointer: reading back a copy of *first stalled (its store not yet
-         * landed; 5 % of a 1-thread profile's samples) */
-        accel_hit cast_hit;
-        const accel_hit *hit = first;
+        accel_hit hit;
         c->rays++;
-        if (bounce > 0 || !cast)
-            hit = accel_intersect(acc, origin, dir, INFINITY, ignore_obj, ignore_tri, &cast_hit)
-                      ? &cast_hit
-                      : NULL;
-        if (!hit) {
+        if (!accel_intersect(acc, origin, dir, INFINITY, ignore_obj, ignore_tri, &hit)) {
             c->escaped++;
             c->escaped_power += power;
             return true;
         }
         if (bounce == 0 && e->object == ACCEL_NO_OBJECT &&
-            !scene_object_side_is_front(&scene->objects[hit->object], hit->side)) {
+            !scene_object_side_is_front(&scene->objects[hit.object], hit.side)) {
             /* An air photon born inside a solid (it meets a back face first): there is
              * no air there, so it was never emitted (counted absorbed, with no power).
              * Photons carry the power of the whole extent, so the rest fire the air's
@@ -183,10 +163,10 @@ static bool trace_path(const thz_scene *scene, const accel *acc, const trace_opt
             /* The free path runs from the surface point along dir, not from the offset
              * origin: its length to the plane of the triangle hit. (From the offset
              * origin it would be short by about eps/cos, a bias of alpha eps / cos.) */
-            const float *hn = &scene->objects[hit->object].mesh.normals[3 * (size_t)hit->triangle];
-            vec3 to_hit = v3_sub(hit->position_m, surface);
-            double d = hit->cos_theta > 1e-6
-                           ? fabs(v3_dot(to_hit, v3(hn[0], hn[1], hn[2]))) / hit->cos_theta
+            const float *hn = &scene->objects[hit.object].mesh.normals[3 * (size_t)hit.triangle];
+            vec3 to_hit = v3_sub(hit.position_m, surface);
+            double d = hit.cos_theta > 1e-6
+                           ? fabs(v3_dot(to_hit, v3(hn[0], hn[1], hn[2]))) / hit.cos_theta
                            : v3_length(to_hit);
             double tr = exp(-alpha * d);
             c->atmosphere_power += power * (1.0 - tr);
@@ -206,38 +186,38 @@ static bool trace_path(const thz_scene *scene, const accel *acc, const trace_opt
         }
 
         photon_record rec = {
-            .position_m = {(float)hit->position_m.x, (float)hit->position_m.y,
-                           (float)hit->position_m.z},
+            .position_m = {(float)hit.position_m.x, (float)hit.position_m.y,
+                           (float)hit.position_m.z},
             .power_w_per_hz = (float)power,
             .freq_hz = (float)nu,
             .dir_oct = photon_encode_direction(dir),
-            .object_side = hit->object << 1 | (uint32_t)hit->side,
+            .object_side = hit.object << 1 | (uint32_t)hit.side,
             .flags = (bounce < 0xffffu ? bounce : 0xffffu) | e->batch << PHOTON_BATCH_SHIFT,
         };
         if (!trace_buffer_push(buf, &rec))
             return false;
         c->hits++;
 
-        const thz_object *obj = &scene->objects[hit->object];
-        if (!scene_object_side_is_front(obj, hit->side)) {
+        const thz_object *obj = &scene->objects[hit.object];
+        if (!scene_object_side_is_front(obj, hit.side)) {
             c->back_face_hits++;
             c->absorbed++;
             c->absorbed_power += power;
             return true;
         }
-        optics_point o = optics && optics->constant[hit->object]
-                             ? optics->optics[hit->object]
+        optics_point o = optics && optics->constant[hit.object]
+                             ? optics->optics[hit.object]
                              : scene_object_optics(scene, obj, nu);
-        const float *nf = &obj->mesh.normals[3 * (size_t)hit->triangle];
+        const float *nf = &obj->mesh.normals[3 * (size_t)hit.triangle];
         vec3 n = v3(nf[0], nf[1], nf[2]);
-        vec3 n_in = hit->side == 0 ? n : v3_scale(n, -1.0); /* towards where it came from */
+        vec3 n_in = hit.side == 0 ? n : v3_scale(n, -1.0); /* towards where it came from */
 
-        switch (trace_roulette(&o, hit->cos_theta, rng_uniform32(rng))) {
+        switch (trace_roulette(&o, hit.cos_theta, rng_uniform32(rng))) {
         case TRACE_REFLECT:
             c->reflected++;
             if (o.lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(&o)) {
                 dir = sampling_cosine32(n_in, rng);
-            } else if (!trace_reflect_lobe(scene, obj, hit, &o, rng, &dir, &power, c)) {
+            } else if (!trace_reflect_lobe(scene, obj, &hit, &o, rng, &dir, &power, c)) {
                 c->absorbed++; /* a glossy sample below the surface: lost */
                 c->absorbed_power += power;
                 return true;
@@ -253,22 +233,9 @@ static bool trace_path(const thz_scene *scene, const accel *acc, const trace_opt
             c->absorbed_power += power;
             return true;
         }
-        origin = accel_offset_origin(acc, hit, dir);
-        surface = hit->position_m;
-        ignore_obj = hit->object;
-        ignore_tri = hit->triangle;
+        origin = accel_offset_origin(acc, &hit, dir);
+        surface = hit.position_m;
+        ignore_obj = hit.object;
+        ignore_tri = hit.triangle;
     }
-}
-
-bool trace_photon(const thz_scene *scene, const accel *acc, const trace_optics *optics,
-                  const emission_photon *e, rng_stream *rng, trace_buffer *buf, trace_counters *c)
-{
-    return trace_path(scene, acc, optics, e, false, NULL, rng, buf, c);
-}
-
-bool trace_photon_cast(const thz_scene *scene, const accel *acc, const trace_optics *optics,
-                       const emission_photon *e, const accel_hit *first, rng_stream *rng,
-                       trace_buffer *buf, trace_counters *c)
-{
-    return trace_path(scene, acc, optics, e, true, first, rng, buf, c);
 }

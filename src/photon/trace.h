@@ -93,15 +93,4 @@ void trace_optics_fini(trace_optics *t);
 bool trace_photon(const thz_scene *scene, const accel *acc, const trace_optics *optics,
                   const emission_photon *e, rng_stream *rng, trace_buffer *buf, trace_counters *c);
 
-/* The first ray of emitted photon e, into *ray; false if e is not traced (power 0 or NaN:
- * trace_photon only counts it). */
-bool trace_first_ray(const accel *acc, const emission_photon *e, accel_ray *ray);
-
-/* trace_photon with the first ray already cast (trace_first_ray's ray, through
- * accel_intersect_many: the photon phase casts its photons' first rays in packets):
- * first its hit, NULL if it hit nothing. The same path, records and counters. */
-bool trace_photon_cast(const thz_scene *scene, const accel *acc, const trace_optics *optics,
-                       const emission_photon *e, const accel_hit *first, rng_stream *rng,
-                       trace_buffer *buf, trace_counters *c);
-
 #endif

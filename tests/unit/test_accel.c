@@ -196,119 +196,6 @@ static void test_threads(void **state)
     }
 }
 
-/* accel_intersect_many against accel_intersect, ray by ray, to the bit: found, object,
- * triangle, side, distance, cosine and point. */
-static void check_many(const accel *acc, const accel_ray *rays, size_t n)
-{
-    accel_hit *many = calloc(n, sizeof *many);
-    bool *found = calloc(n, sizeof *found);
-    assert_non_null(many);
-    assert_non_null(found);
-    /* in runs of 1 to 21 rays: a partial packet, one, and several */
-    for (size_t at = 0, run = 1; at < n; at += run, run = run % 21 + 1) {
-        size_t m = n - at < run ? n - at : run;
-        accel_intersect_many(acc, rays + at, m, many + at, found + at);
-    }
-    size_t n_found = 0;
-    for (size_t i = 0; i < n; i++) {
-        accel_hit h;
-        bool hit = accel_intersect(acc, rays[i].origin_m, rays[i].dir, INFINITY,
-                                   rays[i].ignore_object, rays[i].ignore_triangle, &h);
-        assert_int_equal(found[i], hit);
-        if (!hit)
-            continue;
-        n_found++;
-        assert_int_equal(many[i].object, h.object);
-        assert_int_equal(many[i].triangle, h.triangle);
-        assert_int_equal(many[i].side, h.side);
-        assert_memory_equal(&many[i].distance_m, &h.distance_m, sizeof h.distance_m);
-        assert_memory_equal(&many[i].cos_theta, &h.cos_theta, sizeof h.cos_theta);
-        assert_memory_equal(&many[i].position_m, &h.position_m, sizeof h.position_m);
-    }
-    assert_true(n_found > 0);
-    free(many);
-    free(found);
-}
-
-/* Rays leaving the shell's surfaces (their own triangle ignored), from anywhere in the
- * room and from outside it (some miss). */
-static void test_packets(void **state)
-{
-    fixture *f = *state;
-    enum { N = 6000 };
-    static accel_ray rays[N];
-    rng_stream rng;
-    rng_init(&rng, 11, 0, RNG_PURPOSE_TEST, 0);
-    for (size_t i = 0; i < N; i++) {
-        accel_ray *r = &rays[i];
-        if (i % 3 == 0) { /* off the lower rectangle, on its diagonal half the time */
-            uint32_t tri = (uint32_t)(i / 3 % 2);
-            double t = 0.1 + 0.8 * rng_uniform(&rng), w = i / 6 % 2 ? 0.0 : 0.3;
-            vec3 p = v3(3.0 - 0.5 + t + (tri ? -w : w), -2.0 - 0.5 + t + (tri ? w : -w), 4.0);
-            r->dir =
-                sampling_direction(v3(0, 0, 1), fmax(1e-3, rng_uniform(&rng)), rng_uniform(&rng));
-            accel_hit from = at((uint32_t)f->lower, tri, p);
-            /* a third from the point itself and a third from behind the surface: their
-             * closest hit is often the triangle they leave, cast again with the filter */
-            r->origin_m = i % 9 == 0   ? accel_offset_origin(f->acc, &from, r->dir)
-                          : i % 9 == 3 ? p
-                                       : v3_madd(p, -1e-6, r->dir);
-            r->ignore_object = (uint32_t)f->lower;
-            r->ignore_triangle = tri;
-        } else {
-            double reach = i % 3 == 1 ? 4.0 : 12.0; /* in the room; or beyond its walls too */
-            r->origin_m =
-                v3(reach * (2 * rng_uniform(&rng) - 1), reach * (2 * rng_uniform(&rng) - 1),
-                   5.0 + reach * (2 * rng_uniform(&rng) - 1));
-            r->dir = v3_normalize(
-                v3(rng_uniform(&rng) - 0.5, rng_uniform(&rng) - 0.5, rng_uniform(&rng) - 0.5));
-            r->ignore_object = ACCEL_NO_OBJECT;
-            r->ignore_triangle = 0;
-        }
-    }
-    check_many(f->acc, rays, N);
-}
-
-/* The same in the paper's scene, for the rays the photon phase casts in packets: photons
- * leaving its surfaces in cosine directions. */
-static void test_packets_paper_scene(void **state)
-{
-    (void)state;
-    thz_scene *s = NULL;
-    accel *acc = NULL;
-    thz_error err;
-    assert_int_equal(scene_load(THZ_SOURCE_DIR "/examples/teraeye/scene.json", &s, &err), THZ_OK);
-    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
-    enum { N = 20000 };
-    static accel_ray rays[N];
-    rng_stream rng;
-    rng_init(&rng, 12, 0, RNG_PURPOSE_TEST, 0);
-    for (size_t i = 0; i < N; i++) {
-        uint32_t o = (uint32_t)(rng_uniform(&rng) * (double)s->n_objects);
-        const thz_mesh *m = &s->objects[o].mesh;
-        uint32_t tri = (uint32_t)(rng_uniform(&rng) * (double)m->n_triangles);
-        const uint32_t *idx = &m->indices[3 * (size_t)tri];
-        double a = sqrt(rng_uniform(&rng)), b = rng_uniform(&rng);
-        vec3 p = v3_add(
-            v3_scale(v3_from_floats(&m->positions[3 * (size_t)idx[0]]), 1.0 - a),
-            v3_add(v3_scale(v3_from_floats(&m->positions[3 * (size_t)idx[1]]), a * (1.0 - b)),
-                   v3_scale(v3_from_floats(&m->positions[3 * (size_t)idx[2]]), a * b)));
-        vec3 n = v3_from_floats(&m->normals[3 * (size_t)tri]);
-        int side = rng_uniform(&rng) < 0.5;
-        accel_ray *r = &rays[i];
-        r->dir = sampling_direction(side ? v3_scale(n, -1.0) : n, sqrt(1.0 - rng_uniform(&rng)),
-                                    rng_uniform(&rng));
-        accel_hit from = {.object = o, .triangle = tri, .position_m = p, .side = side};
-        /* one in four from the point itself: its own triangle's hit is filtered */
-        r->origin_m = i % 4 ? accel_offset_origin(acc, &from, r->dir) : p;
-        r->ignore_object = o;
-        r->ignore_triangle = tri;
-    }
-    check_many(acc, rays, N);
-    accel_destroy(acc);
-    scene_destroy(s);
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -317,8 +204,6 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_thin_shell_normal_and_grazing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_shared_edge, setup, teardown),
         cmocka_unit_test_setup_teardown(test_threads, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_packets, setup, teardown),
-        cmocka_unit_test(test_packets_paper_scene),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
