@@ -59,7 +59,12 @@ static void furnace_case(thz_integrator integrator, double t0_k)
         assert_int_equal(r.rstats[c].escaped_samples, 0);
         assert_int_equal(r.rstats[c].back_face_samples, 0);
         assert_int_equal(r.rstats[c].starved_gathers, 0);
-        ident_tally t = {.exact = exact};
+        /* a pixel's error at least the image's pooled error: a pixel looking through the
+         * straight veil has a heavy lower tail (its disk there catches a few heavy
+         * photons; README, "What stands in the way now"), and its own error estimate fails
+         * when they are missing: at seed 3, z = -4.36 against 5 with its own error alone */
+        ident_tally t = {.exact = exact,
+                         .pooled_rel_se = exact ? 0.0 : ident_pooled_rel_se_of(&r, c, b)};
         ident_check_furnace_channel(&t, &r, c, integrator, b);
         char what[64];
         snprintf(what, sizeof what, "furnace, %s, channel %zu", render_integrator_name(integrator),
