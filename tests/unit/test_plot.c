@@ -219,6 +219,7 @@ static void test_threads(void **state)
         snprintf(jobs[i].path, sizeof jobs[i].path, "%s/t%d.png", dir, i);
         assert_int_equal(pthread_create(&t[i], NULL, draw, &jobs[i]), 0);
     }
+    int drawn = 0;
     for (int i = 0; i < 3; i++) {
         pthread_join(t[i], NULL);
 #ifdef __SANITIZE_ADDRESS__
@@ -242,7 +243,11 @@ static void test_threads(void **state)
         assert_int_equal(w, 720);
         free(px);
         unlink(jobs[i].path);
+        drawn++;
     }
+    /* The sanitizer build's allowance is for one hung child, not for figures drawn side by
+     * side never working: at least one of the three must be drawn there too. */
+    assert_true(drawn >= 1);
     pthread_barrier_destroy(&start);
     pthread_barrier_destroy(&end);
     rmdir(dir);
