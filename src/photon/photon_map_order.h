@@ -67,9 +67,9 @@ static inline unsigned photon_first_digit(const photon_cube *c, const photon_rec
 
 /* Asks the memory for record i of r[0..n) ahead of its use (nothing at or past n). The
  * build's streaming passes waited on memory without it: on the 2-core development VM of
- * 2026-12-04 16:00 (README, "On a new VM") the six maps of the paper's case took 2.61 s
- * to build on 2 threads and 2.15 s with it (the passes that read the records in order
- * 14-35 % faster, the sort 23 %); the map is the same bytes. */
+ * 2026-12-04 16:00 (docs/benchmark.md, "Runs on the AVX-512 VM") the six maps of the
+ * paper's case took 2.61 s to build on 2 threads and 2.15 s with it (the passes that read
+ * the records in order 14-35 % faster, the sort 23 %); the map is the same bytes. */
 static inline void photon_prefetch(const photon_record *r, size_t i, size_t n)
 {
     if (i < n)

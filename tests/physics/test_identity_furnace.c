@@ -61,8 +61,9 @@ static void furnace_case(thz_integrator integrator, double t0_k)
         assert_int_equal(r.rstats[c].starved_gathers, 0);
         /* a pixel's error at least the image's pooled error: a pixel looking through the
          * straight veil has a heavy lower tail (its disk there catches a few heavy
-         * photons; README, "What stands in the way now"), and its own error estimate fails
-         * when they are missing: at seed 3, z = -4.36 against 5 with its own error alone */
+         * photons; docs/benchmark.md, "What stands in the way"), and its own error
+         * estimate fails when they are missing: at seed 3, z = -4.36 against 5 with its
+         * own error alone */
         ident_tally t = {.exact = exact,
                          .pooled_rel_se = exact ? 0.0 : ident_pooled_rel_se_of(&r, c, b)};
         ident_check_furnace_channel(&t, &r, c, integrator, b);
