@@ -15,6 +15,7 @@
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/path.h"
+#include "io/output.h"
 
 thz_status batch_read_band(const char *path, uint32_t columns, uint32_t rows, size_t channels,
                            size_t channel, float *out, thz_error *err)
@@ -51,8 +52,9 @@ typedef struct sweep_sensors {
 static thz_status batch_cube_path(const thz_sequence *seq, const char *outdir, size_t f,
                                   const char *sensor, char *path, size_t size, thz_error *err)
 {
-    if (snprintf(path, size, "%s/%s/%s.brightness_temperature.img", outdir, seq->frame_dir[f],
-                 sensor) >= (int)size)
+    char name[THZ_PATH_MAX];
+    if (!output_file_name(name, sizeof name, sensor, "brightness_temperature", ".img") ||
+        snprintf(path, size, "%s/%s/%s", outdir, seq->frame_dir[f], name) >= (int)size)
         return thz_error_set(err, THZ_ERR_IO, "%s: path too long", outdir);
     return THZ_OK;
 }
@@ -61,8 +63,10 @@ static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, s
                                   const thz_sensor_info *si, size_t c, double lo, double hi,
                                   float *band, json_t *movies, thz_error *err)
 {
-    char path[THZ_PATH_MAX], name[512], cube[THZ_PATH_MAX];
-    snprintf(name, sizeof name, "%s.band-%02zu.mp4", si->name, c + 1);
+    char path[THZ_PATH_MAX], name[512], cube[THZ_PATH_MAX], quantity[32];
+    snprintf(quantity, sizeof quantity, "band-%02zu", c + 1);
+    if (!output_file_name(name, sizeof name, si->name, quantity, ".mp4"))
+        return thz_error_set(err, THZ_ERR_IO, "%s: a movie's name too long", si->name);
     char sub[32] = "";
     if (seq->has_sweep)
         snprintf(sub, sizeof sub, "sweep-%02zu/", s);

@@ -191,6 +191,19 @@ thz_status stage_commit_swap(struct output_stage *stage, thz_error *err)
     thz_status status = stage_carry_files(stage, err);
     if (status != THZ_OK)
         return status;
+    /* The new OUTDIR is the stage: it takes the old one's permissions and, where this
+     * process may give them, its owner and group, or a private results directory would
+     * come back as the umask makes new ones. */
+    if (chmod(stage->dir, st.st_mode & 07777) != 0)
+        return thz_error_set(err, THZ_ERR_IO,
+                             "%s: cannot give the results the directory's permissions: %s; "
+                             "nothing committed, the previous results stay",
+                             stage->outdir, strerror(errno));
+    if ((st.st_uid != geteuid() || st.st_gid != getegid()) &&
+        chown(stage->dir, st.st_uid, st.st_gid) != 0) {
+        /* not allowed (another user's directory that this one may write in): kept as
+         * created, owned by whoever ran thzmap */
+    }
     if (renameat2(AT_FDCWD, stage->dir, AT_FDCWD, stage->target, RENAME_EXCHANGE) != 0) {
         int e = errno;
         if (e != EINVAL && e != ENOSYS && e != EOPNOTSUPP)

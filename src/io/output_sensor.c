@@ -30,8 +30,7 @@ bool output_file_name(char *buf, size_t size, const char *sensor, const char *qu
     if (n < 0 || (size_t)n >= size)
         return false;
     for (char *p = buf; *p; p++)
-        if (*p == '/')
-            *p = '_';
+        *p = sensor_file_char(*p);
     return true;
 }
 

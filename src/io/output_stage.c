@@ -111,7 +111,8 @@ static thz_status stage_split(output_stage *stage, char **base, thz_error *err)
 }
 
 /* target = OUTDIR without trailing '/'; the real path where its last part is "." or
- * "..", whose parent is not the directory holding it. */
+ * ".." (whose parent is not the directory holding it) or a symbolic link to a
+ * directory. */
 static thz_status stage_target(output_stage *stage, thz_error *err)
 {
     size_t len = strlen(stage->outdir);
@@ -122,10 +123,17 @@ static thz_status stage_target(output_stage *stage, thz_error *err)
         last--;
     size_t last_len = (size_t)(stage->outdir + len - last);
     bool dots = (last_len == 1 && last[0] == '.') || (last_len == 2 && !strncmp(last, "..", 2));
-    if (!dots) {
-        stage->target = stage_strndup(stage->outdir, len);
-        return stage->target ? THZ_OK : stage_nomem(stage->outdir, err);
-    }
+    stage->target = stage_strndup(stage->outdir, len);
+    if (!stage->target)
+        return stage_nomem(stage->outdir, err);
+    /* OUTDIR a symbolic link to a directory: the results go into the directory it names
+     * (the link stays), staged beside that directory. */
+    struct stat lst, st;
+    bool link_to_dir = lstat(stage->target, &lst) == 0 && S_ISLNK(lst.st_mode) &&
+                       stat(stage->target, &st) == 0 && S_ISDIR(st.st_mode);
+    if (!dots && !link_to_dir)
+        return THZ_OK;
+    free(stage->target);
     stage->target = realpath(stage->outdir, NULL);
     if (!stage->target)
         return thz_error_set(err, THZ_ERR_IO, "%s: %s", stage->outdir, strerror(errno));

@@ -41,6 +41,34 @@ static thz_status load_resolution(load_ctx *ctx, const load_cursor *c, uint32_t 
     return THZ_OK;
 }
 
+/* A name fit to begin file names, and not naming the files of an earlier sensor. */
+static thz_status load_sensor_file_name(load_ctx *ctx, const load_cursor *list, size_t index,
+                                        const char *name)
+{
+    load_cursor e = load_index(list, index), k = load_key(&e, "name");
+    size_t len = strlen(name);
+    if (len > SENSOR_NAME_MAX)
+        return load_fail(ctx, &k,
+                         "a name of %zu bytes (expected at most %d: it begins the names of the "
+                         "sensor's output files)",
+                         len, SENSOR_NAME_MAX);
+    for (size_t j = 0; j < index; j++) {
+        json_t *other = json_object_get(json_array_get(list->value, j), "name");
+        const char *o = json_is_string(other) ? json_string_value(other) : NULL;
+        if (!o || strlen(o) != len)
+            continue;
+        size_t i = 0;
+        while (i < len && sensor_file_char(o[i]) == sensor_file_char(name[i]))
+            i++;
+        if (i == len)
+            return load_fail(ctx, &k,
+                             "\"%s\" would write the same files as %s[%zu] \"%s\" (a '/' in a "
+                             "name becomes '_' in file names; expected names whose files differ)",
+                             name, list->path, j, o);
+    }
+    return THZ_OK;
+}
+
 static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t index, thz_sensor *sn)
 {
     static const char *const keys[] = {
@@ -54,6 +82,8 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
     thz_status st = load_expect_object(ctx, c, keys);
     if (st == THZ_OK)
         st = load_unique_name(ctx, list, index, "sensor", true, &name);
+    if (st == THZ_OK)
+        st = load_sensor_file_name(ctx, list, index, name);
     if (st != THZ_OK)
         return st;
     sn->name = thz_strdup(name);

@@ -86,6 +86,17 @@ typedef struct thz_sensor_noise {
     thz_radiometer radiometer;
 } thz_sensor_noise;
 
+/* A sensor's name begins the names of its output files (S.radiance.hdr, ...), where a
+ * '/' becomes '_' (sensor_file_char). The loader refuses names longer than this, which
+ * leaves room for the longest suffix within a file system's 255-byte file names, and two
+ * sensors whose files would have the same names ("a/b" and "a_b"). */
+#define SENSOR_NAME_MAX 200
+
+static inline char sensor_file_char(char c)
+{
+    return c == '/' ? '_' : c;
+}
+
 typedef struct thz_sensor {
     char *name;
     double position_m[3];

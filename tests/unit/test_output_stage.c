@@ -348,6 +348,65 @@ static void test_commit_keeps_subdirectories(void **state)
     free(tmp);
 }
 
+/* A private OUTDIR stays private: the committed directory (the stage, swapped in) takes
+ * the old one's permissions, not the umask's. */
+static void test_commit_keeps_permissions(void **state)
+{
+    (void)state;
+    char *tmp = make_tmp_dir();
+    char outdir[1024];
+    snprintf(outdir, sizeof outdir, "%s/out", tmp);
+    assert_int_equal(mkdir(outdir, 0700), 0);
+    assert_int_equal(chmod(outdir, 0710), 0); /* a mode no umask gives */
+    write_file(outdir, "notes.txt", "mine");
+    output_stage *stage = NULL;
+    assert_int_equal(output_stage_create(outdir, &stage, NULL), THZ_OK);
+    write_file(output_stage_dir(stage), "cam.img", "new");
+    assert_int_equal(output_stage_commit(stage, NULL), THZ_OK);
+    output_stage_destroy(stage);
+    struct stat st;
+    assert_int_equal(stat(outdir, &st), 0);
+    assert_int_equal(st.st_mode & 07777, 0710);
+    assert_file_text(outdir, "notes.txt", "mine");
+    rm(outdir, "cam.img");
+    rm(outdir, "notes.txt");
+    rmdir(outdir);
+    assert_int_equal(rmdir(tmp), 0);
+    free(tmp);
+}
+
+/* OUTDIR a symbolic link to a directory: the results go into that directory, the link
+ * stays a link, and nothing is left beside either. */
+static void test_commit_through_symlink(void **state)
+{
+    (void)state;
+    char *tmp = make_tmp_dir();
+    char real[1024], link_path[1024], outdir[1100];
+    snprintf(real, sizeof real, "%s/real", tmp);
+    snprintf(link_path, sizeof link_path, "%s/link", tmp);
+    assert_int_equal(mkdir(real, 0777), 0);
+    assert_int_equal(symlink("real", link_path), 0);
+    for (int slash = 0; slash < 2; slash++) {
+        snprintf(outdir, sizeof outdir, "%s%s", link_path, slash ? "/" : "");
+        output_stage *stage = NULL;
+        thz_error err = {0};
+        assert_int_equal(output_stage_create(outdir, &stage, &err), THZ_OK);
+        write_file(output_stage_dir(stage), "cam.img", slash ? "second" : "first");
+        assert_int_equal(output_stage_commit(stage, &err), THZ_OK);
+        output_stage_destroy(stage);
+        struct stat st;
+        assert_int_equal(lstat(link_path, &st), 0);
+        assert_true(S_ISLNK(st.st_mode));
+        assert_file_text(real, "cam.img", slash ? "second" : "first");
+        assert_int_equal(count_entries(tmp), 2); /* real and link: no stage, no lock */
+    }
+    rm(real, "cam.img");
+    rmdir(real);
+    unlink(link_path);
+    assert_int_equal(rmdir(tmp), 0);
+    free(tmp);
+}
+
 /* OUTDIR under a regular file cannot be made: an I/O error naming the path. */
 static void test_bad_outdir(void **state)
 {
@@ -526,6 +585,8 @@ int main(void)
         cmocka_unit_test(test_leftovers_cleaned),
         cmocka_unit_test(test_commit_keeps_subdirectories),
         cmocka_unit_test(test_commit_into_working_directory),
+        cmocka_unit_test(test_commit_keeps_permissions),
+        cmocka_unit_test(test_commit_through_symlink),
         cmocka_unit_test(test_bad_outdir),
         cmocka_unit_test(test_summary_json),
     };
