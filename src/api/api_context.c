@@ -1,8 +1,8 @@
 /* The context: threads, callbacks, the last error; and the helpers every API file
  * shares (settings into run options, overrides into a scene copy). */
-#include <stdlib.h>
-
+#include <inttypes.h>
 #include <stdint.h>
+#include <stdlib.h>
 
 #include "api/api.h"
 #include "core/alloc.h"
@@ -78,6 +78,11 @@ thz_status api_effective_scene(const thz_scene *scene, const thz_run_settings *s
     *out = *scene;
     if (!settings)
         return THZ_OK;
+    if (settings->has_seed && settings->seed > (uint64_t)INT64_MAX)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "seed: expected 0 to 9223372036854775807 (2^63 - 1, as photons.seed), "
+                             "got %" PRIu64,
+                             settings->seed);
     run_overrides ov = {.photons = settings->photons_per_channel,
                         .has_seed = settings->has_seed != 0,
                         .seed = settings->seed};

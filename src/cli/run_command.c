@@ -2,6 +2,7 @@
 #include "run_command.h"
 
 #include <errno.h>
+#include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -128,7 +129,7 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
                     return CLI_EXIT_USAGE;
                 a->settings.photons_per_channel = u;
             } else if (strcmp(arg, "--seed") == 0) {
-                if (!cli_parse_u64(cmd, arg, val, 0, UINT64_MAX, &u))
+                if (!cli_parse_u64(cmd, arg, val, 0, (uint64_t)INT64_MAX, &u))
                     return CLI_EXIT_USAGE;
                 a->settings.has_seed = 1;
                 a->settings.seed = u;
@@ -242,6 +243,20 @@ static int cli_run_load(const char *cmd, cli_run_args *a, bool render, thz_scene
     if (render && !a->photon_map_path && thz_integrator_needs_photons(integrator))
         return cli_usage_error(cmd, "no photon map given (--photon-map FILE); only the path "
                                     "integrator renders without one");
+    /* options the integrator has no use for: said, not silently dropped */
+    if (!render && a->settings.photons_per_channel && !thz_integrator_needs_photons(integrator))
+        fprintf(stderr,
+                "thzmap %s: warning: --photons %" PRIu64 " is not used: the %s integrator fires "
+                "no photons (give --integrator photon-map or final-gather to fire them)\n",
+                cmd, a->settings.photons_per_channel, integrator);
+    if (render && a->photon_map_path && !thz_integrator_needs_photons(integrator)) {
+        fprintf(stderr,
+                "thzmap %s: warning: --photon-map %s is not used: the %s integrator renders "
+                "without photons (give --integrator photon-map or final-gather to render from "
+                "it)\n",
+                cmd, a->photon_map_path, integrator);
+        a->photon_map_path = NULL;
+    }
     for (size_t i = 0; i < thz_scene_warning_count(*scene); i++) /* --quiet hides progress only */
         fprintf(stderr, "thzmap %s: warning: %s\n", cmd, thz_scene_warning(*scene, i));
     return -1;

@@ -179,6 +179,22 @@ grep -q "fires no photons" "$work/u.err" || fail "render photon-map noise target
 [ $? -eq 2 ] || fail "--photons 0 should exit 2"
 "$THZMAP" render "$work/scene.json" -o "$work/u" 2>/dev/null
 [ $? -eq 2 ] || fail "render without --photon-map should exit 2"
+# options the integrator has no use for are said to be unused, not silently dropped
+"$THZMAP" simulate "$work/scene.json" -o "$work/up" --integrator path --photons 1000 --quiet \
+    2> "$work/up.err" || fail "simulate --integrator path --photons exited $?"
+grep -q -- "--photons 1000 is not used: the path integrator fires no photons" "$work/up.err" \
+    || fail "path with --photons: no warning: $(cat "$work/up.err")"
+"$THZMAP" render "$work/scene.json" -o "$work/upr" --integrator path \
+    --photon-map "$work/t1/photon-map.thzpm" --quiet 2> "$work/upr.err" \
+    || fail "render --integrator path --photon-map exited $?"
+grep -q "is not used: the path integrator renders without photons" "$work/upr.err" \
+    || fail "render path with a map: no warning: $(cat "$work/upr.err")"
+grep -q '"photons_per_channel": 0,' "$work/upr/summary.json" \
+    || fail "render path with an unused map: summary.json counts its photons"
+# summary.json holds the seed exactly: one that JSON's integers cannot is refused
+"$THZMAP" simulate "$work/scene.json" -o "$work/u" --seed 9223372036854775808 2> "$work/u.err"
+[ $? -eq 2 ] || fail "--seed 2^63 should exit 2"
+grep -q "0 to 9223372036854775807" "$work/u.err" || fail "--seed 2^63 message: $(cat "$work/u.err")"
 "$THZMAP" simulate --help | grep -q -- "--save-photon-map" || fail "simulate --help"
 for opt in --integrator --target-noise-k --max-seconds; do
     "$THZMAP" simulate --help | grep -q -- "$opt" || fail "simulate --help lacks $opt"
