@@ -47,7 +47,7 @@ typedef void (*thz_plan_fn)(void *user, const thz_run_plan *plan);
  * defaults. */
 typedef struct thz_run_settings {
     uint64_t photons_per_channel; /* photons.per_channel; 0: the scene's */
-    int has_seed;                 /* non-zero: use `seed` instead of photons.seed */
+    int has_seed;                 /* non-zero: `seed`, 0 to INT64_MAX, not photons.seed */
     uint64_t seed;
     const char *integrator; /* "photon-map", "final-gather", "path"; NULL: the scene's */
     double target_noise_k;  /* > 0: add passes to each channel until the 95th percentile

@@ -205,7 +205,8 @@ enum MHD_Result serve_validate(serve_request *r)
         label = json_string_value(jpath);
         if (serve_path(r->s, label, false, base) != SERVE_PATH_OK) {
             /* label points into body: the reply is made before body is freed */
-            enum MHD_Result res = serve_reply_error(r, 403, "$.path: %s is outside the root", label);
+            enum MHD_Result res =
+                serve_reply_error(r, 403, "$.path: %s is outside the root", label);
             json_decref(body);
             return res;
         }
