@@ -98,6 +98,15 @@ int main(int argc, char **argv)
         CHECK(run == NULL, "%llu photons: a run came back", (unsigned long long)huge[k]);
         thz_run_destroy(run);
     }
+    /* and so is a photon phase alone whose maps would not fit (it once allocated until
+     * the kernel killed the process) */
+    thz_run_settings fire = {.photons_per_channel = (uint64_t)1 << 50,
+                             .integrator = "photon-map"};
+    thz_photons *ph = (thz_photons *)&fire;
+    st = thz_photons_fire(ctx, scene, &fire, &ph, &err);
+    CHECK(st == THZ_ERR_LIMIT && strstr(err.message, "GiB of memory"),
+          "firing 2^50 photons a channel: %s (%s)", thz_status_name(st), err.message);
+    CHECK(ph == NULL, "firing 2^50 photons a channel: photons came back");
 
     thz_context_destroy(ctx);
     thz_scene_destroy(scene);
