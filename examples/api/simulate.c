@@ -45,8 +45,9 @@ int main(int argc, char **argv)
     thz_context_set_warning(ctx, show_warning, NULL);
 
     thz_run_settings settings;
-    thz_run_settings_init(&settings); /* everything as the scene says ... */
-    settings.photons_per_channel = argc > 2 ? strtoull(argv[2], NULL, 10) : 100000; /* ... but */
+    thz_run_settings_init(&settings);   /* everything as the scene says, but: */
+    settings.integrator = "photon-map"; /* the paper's method (path would fire no photons) */
+    settings.photons_per_channel = argc > 2 ? strtoull(argv[2], NULL, 10) : 100000;
     st = thz_simulate(ctx, scene, &settings, &run, &err);
     if (st != THZ_OK)
         goto done;

@@ -2,8 +2,9 @@
 
     import thzmap
     scene = thzmap.load_scene("examples/teraeye/scene.json")
-    result = thzmap.simulate(scene, photons=100_000, seed=1, progress=True)
-    image = result.image("camera")
+    result = thzmap.simulate(scene, integrator="photon-map", photons=100_000, seed=1,
+                             progress=True)
+    image = result.image("cam")
     image.brightness_temperature      # numpy float32 (rows, columns, channels), K
     result.summary["channels"]        # summary.json as a dict
     result.save("out/teraeye")        # the files `thzmap simulate` writes

@@ -16,6 +16,7 @@ Runs on other threads are not interrupted by Ctrl-C (Python delivers it to the m
 thread only).
 """
 import ctypes
+import numbers
 import signal
 import threading
 import warnings
@@ -34,9 +35,10 @@ class Call:
 
     def __init__(self, threads=None, progress=None):
         if threads is not None:
-            if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+            if (isinstance(threads, bool) or not isinstance(threads, numbers.Integral)
+                    or threads < 1):
                 raise ArgumentError(f"threads: expected a whole number >= 1, got {threads!r}")
-            threads = min(threads, 1 << 20)
+            threads = min(int(threads), 1 << 20)
         self._report = make_reporter(progress)
         self._exc = None
         self._interrupted = False

@@ -90,10 +90,18 @@ def _scene_path(scene):
     """The scene file: bands renders variants of the file itself (its JSON), so a Scene
     must come from load_scene."""
     if isinstance(scene, Scene):
-        path = scene.info.path
-        if not path or not os.path.isfile(path):
+        if scene._file is None:
             raise ArgumentError("scene: bands works on a scene file; this Scene was not "
                                 "loaded from one (save its JSON and give the path)")
+        path = scene._file[0]
+        try:
+            st = os.stat(path)
+        except OSError as e:
+            raise ArgumentError(f"scene: {path}, the file this Scene was loaded from, "
+                                f"cannot be read now: {e.strerror}") from None
+        if (st.st_mtime_ns, st.st_size) != scene._file[1:]:
+            raise ArgumentError(f"scene: {path} has changed since this Scene was loaded "
+                                f"from it (bands renders the file; load it again)")
         return path
     if isinstance(scene, (str, bytes, os.PathLike)):
         return _path_arg("scene", scene)
@@ -173,11 +181,24 @@ def bands(scene, count, from_thz=None, to_thz=None, step_ghz=None, relative_widt
         o.step_ghz = _number("step_ghz", step_ghz, 0.0, 1e6, lo_open=True)
     if relative_width is not None:
         o.relative_width = _number("relative_width", relative_width, 0.0, 0.5, lo_open=True)
+    # the candidates' range (o holds the library's defaults where not given)
+    lo, hi, step = o.from_thz, o.to_thz, o.step_ghz
+    if lo > hi:
+        raise ArgumentError(f"from_thz {lo} > to_thz {hi}: expected from_thz <= to_thz")
+    centres = math.floor((hi - lo) * 1e3 / step + 1e-9) + 1
+    if o.count > centres:
+        raise ArgumentError(f"count {o.count}: only {centres} candidate centres from {lo} to "
+                            f"{hi} THz every {step} GHz")
+    if widths is not None and relative_width is not None:
+        raise ArgumentError("relative_width and widths: give one (the candidates' one width, "
+                            "or the widths searched)")
     keep = []  # buffers the options point into, alive until the call returns
     if widths is not None:
         widths = [_number("widths", w, 0.0, 0.5, lo_open=True) for w in widths]
         if not 1 <= len(widths) <= MAX_WIDTHS:
             raise ArgumentError(f"widths: expected 1 to {MAX_WIDTHS} relative widths")
+        if len(set(widths)) != len(widths):
+            raise ArgumentError(f"widths: a width given twice in {widths}")
         arr = (c_double * len(widths))(*widths)
         keep.append(arr)
         o.relative_widths, o.n_widths = arr, len(widths)
@@ -187,6 +208,8 @@ def bands(scene, count, from_thz=None, to_thz=None, step_ghz=None, relative_widt
         names = [_text("targets", t) for t in targets]
         if not names:
             raise ArgumentError("targets: expected at least one object name")
+        if len(set(names)) != len(names):
+            raise ArgumentError(f"targets: an object named twice in {list(targets)}")
         arr = (c_char_p * len(names))(*names)
         keep += [arr, names]
         o.targets, o.n_targets = arr, len(names)

@@ -83,7 +83,7 @@ def _settings(scene, integrator=None, photons=None, seed=None, target_noise_k=No
     if photons is not None:
         s.photons_per_channel = _whole("photons", photons, 1, MAX_PHOTONS)
     if seed is not None:
-        s.has_seed, s.seed = 1, _whole("seed", seed, 0)
+        s.has_seed, s.seed = 1, _whole("seed", seed, 0, (1 << 63) - 1)
     integrator = _integrator_arg(integrator)
     if integrator is not None:
         s.integrator = integrator.encode()  # the structure keeps the bytes alive

@@ -45,7 +45,9 @@ class Scene:
     """A loaded and checked thzmap-scene/1 document (read-only). Made by load_scene,
     scene_from_dict or scene_from_json; results and photon maps keep it alive."""
 
-    def __init__(self, handle, label, seconds_load):
+    def __init__(self, handle, label, seconds_load, file=None):
+        # file: (absolute path, mtime in ns, size) of the file load_scene read, else None
+        self._file = file
         self._owned = _lib.Handle(handle, _lib.lib.thz_scene_destroy)
         self._handle = handle
         self.label = label
@@ -101,7 +103,17 @@ class Scene:
                 f"{len(self.objects)} objects, sensors {self.sensor_names}>")
 
 
-def _load(loader, label):
+def _file_stamp(path):
+    """(absolute path, mtime in ns, size) of a scene file, or None if it cannot be read."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return (os.path.abspath(path), st.st_mtime_ns, st.st_size)
+
+
+def _load(loader, label, path=None):
+    stamp = _file_stamp(path) if path is not None else None
     handle = ctypes.c_void_p()
     err = _lib.ThzError()
     start = time.perf_counter()
@@ -113,7 +125,7 @@ def _load(loader, label):
             raise scene_error(message, label)
         from .errors import from_status
         raise from_status(status, message)
-    return Scene(handle.value, label, seconds)
+    return Scene(handle.value, label, seconds, stamp)
 
 
 def _path_arg(name, value):
@@ -139,10 +151,10 @@ def load_scene(path, root=None):
     path = _path_arg("path", path)
     if root is None:
         return _load(lambda out, err: _lib.lib.thz_scene_load(os.fsencode(path), out, err),
-                     path)
+                     path, path)
     r = _root_arg(root)
     return _load(lambda out, err: _lib.lib.thz_scene_load_within(
-        os.fsencode(path), r, out, err), path)
+        os.fsencode(path), r, out, err), path, path)
 
 
 def _check_json_values(value, path, label):
@@ -164,6 +176,9 @@ def _check_json_values(value, path, label):
         _check_json_values(value.tolist(), path, label)
     elif isinstance(value, bool) or value is None or isinstance(value, str):
         pass
+    elif isinstance(value, numbers.Integral) and not -(1 << 63) <= value < (1 << 63):
+        raise fail(f"expected a whole number from -2^63 to 2^63 - 1 (what a scene file's "
+                   f"integers can be), got {value}")
     elif isinstance(value, numbers.Real):
         if not math.isfinite(value):
             raise fail(f"expected a finite number, got {value}")

@@ -261,7 +261,7 @@ thz_status bands_search(const bands_classes *cl, size_t count, uint64_t exhausti
         groups += group_of(cl, c) != group_of(cl, c - 1);
     if (count < 1 || count > groups || count > BANDS_MAX_COUNT)
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "--count %zu: expected 1 to %zu (the candidate centres, at most %d)",
+                             "count %zu: expected 1 to %zu (the candidate centres, at most %d)",
                              count, groups, BANDS_MAX_COUNT);
     search s = {.cl = cl, .count = count, .r = out};
     out->count = count;

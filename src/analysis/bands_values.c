@@ -275,8 +275,8 @@ static thz_status assign_classes(const bands_setup *s, const thz_scene *scene, c
             if (!seen[s->targets[t]]) {
                 thz_object_info oi;
                 thz_scene_object(scene, (size_t)s->targets[t], &oi);
-                st = thz_error_set(err, THZ_ERR_INPUT,
-                                   "--targets: the sensor sees no pixel of '%s'", oi.name);
+                st = thz_error_set(err, THZ_ERR_INPUT, "targets: the sensor sees no pixel of '%s'",
+                                   oi.name);
                 goto done;
             }
             class_of[s->targets[t]] = (int32_t)nc++;

@@ -72,7 +72,7 @@ void thz_bands_destroy(thz_bands *b)
 static thz_status check_options(const thz_bands_options *o, size_t *n_candidates, thz_error *err)
 {
     if (o->count < 1 || o->count > BANDS_MAX_COUNT)
-        return thz_error_set(err, THZ_ERR_INPUT, "--count %zu: expected 1 to %d", o->count,
+        return thz_error_set(err, THZ_ERR_INPUT, "count %zu: expected 1 to %d", o->count,
                              BANDS_MAX_COUNT);
     if (!(o->from_thz > 0.0) || !(o->to_thz >= o->from_thz) || !(o->step_ghz > 0.0) ||
         !isfinite(o->to_thz))
@@ -84,11 +84,11 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
     if (n > BANDS_MAX_CANDIDATES)
         return thz_error_set(err, THZ_ERR_INPUT,
                              "%.0f candidates from %g to %g THz by %g GHz: at most %d (raise "
-                             "--step-ghz)",
+                             "the step)",
                              n, o->from_thz, o->to_thz, o->step_ghz, BANDS_MAX_CANDIDATES);
     if ((size_t)n < o->count)
-        return thz_error_set(err, THZ_ERR_INPUT, "--count %zu: only %.0f candidate centres",
-                             o->count, n);
+        return thz_error_set(err, THZ_ERR_INPUT, "count %zu: only %.0f candidate centres", o->count,
+                             n);
     if (!(o->relative_width >= 0.0 && o->relative_width <= 0.5))
         return thz_error_set(err, THZ_ERR_INPUT, "relative width %g: expected 0 < w <= 0.5",
                              o->relative_width);
@@ -96,28 +96,28 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
         return thz_error_set(err, THZ_ERR_INPUT, "widths: %zu given but no list", o->n_widths);
     if (o->n_widths && o->relative_width > 0.0)
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "--relative-width %g and --widths: give one (the candidates' one "
+                             "relative width %g and widths: give one (the candidates' one "
                              "width, or the widths searched)",
                              o->relative_width);
     for (size_t i = 0; i < o->n_widths; i++) {
         if (!(o->relative_widths[i] > 0.0 && o->relative_widths[i] <= 0.5))
-            return thz_error_set(err, THZ_ERR_INPUT, "--widths: %g: expected 0 < w <= 0.5",
+            return thz_error_set(err, THZ_ERR_INPUT, "widths: %g: expected 0 < w <= 0.5",
                                  o->relative_widths[i]);
         for (size_t j = 0; j < i; j++)
             if (o->relative_widths[j] == o->relative_widths[i])
-                return thz_error_set(err, THZ_ERR_INPUT, "--widths: %g given twice",
+                return thz_error_set(err, THZ_ERR_INPUT, "widths: %g given twice",
                                      o->relative_widths[i]);
     }
     if (n * (double)(o->n_widths ? o->n_widths : 1) > BANDS_MAX_CANDIDATES)
         return thz_error_set(err, THZ_ERR_INPUT,
                              "%.0f centres x %zu widths: at most %d candidates (raise "
-                             "--step-ghz or give fewer widths)",
+                             "the step or give fewer widths)",
                              n, o->n_widths, BANDS_MAX_CANDIDATES);
     if (!(o->thickness_range >= 0.0 && o->thickness_range < 1.0))
-        return thz_error_set(err, THZ_ERR_INPUT, "--thickness-range %g: expected 0 <= F < 1",
+        return thz_error_set(err, THZ_ERR_INPUT, "thickness range %g: expected 0 <= F < 1",
                              o->thickness_range);
     if (!(o->angle_range_deg >= 0.0 && o->angle_range_deg <= 90.0))
-        return thz_error_set(err, THZ_ERR_INPUT, "--angle-range-deg %g degrees: expected 0 to 90",
+        return thz_error_set(err, THZ_ERR_INPUT, "angle range %g degrees: expected 0 to 90",
                              o->angle_range_deg);
     if (!(o->netd_k >= 0.0) || !(o->target_temperature_range_k >= 0.0) ||
         !(o->ambient_temperature_range_k >= 0.0) ||
@@ -217,14 +217,13 @@ static thz_status resolve_scene(thz_bands *b, const thz_bands_options *o, thz_er
     for (size_t t = 0; t < o->n_targets; t++) {
         b->targets[t] = thz_scene_object_index(scene, o->targets[t]);
         if (b->targets[t] < 0) {
-            st = thz_error_set(err, THZ_ERR_INPUT, "--targets: %s has no object named '%s'",
+            st = thz_error_set(err, THZ_ERR_INPUT, "targets: %s has no object named '%s'",
                                b->scene_path, o->targets[t]);
             goto done;
         }
         for (size_t u = 0; u < t; u++)
             if (b->targets[u] == b->targets[t]) {
-                st =
-                    thz_error_set(err, THZ_ERR_INPUT, "--targets: '%s' named twice", o->targets[t]);
+                st = thz_error_set(err, THZ_ERR_INPUT, "targets: '%s' named twice", o->targets[t]);
                 goto done;
             }
     }

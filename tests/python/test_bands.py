@@ -78,11 +78,35 @@ def test_bands_takes_a_loaded_scene_and_targets():
 def test_bands_errors(tmp_path):
     for kwargs in (dict(count=0), dict(count=1, widths=[0.6]), dict(count=1, widths=[]),
                    dict(count=1, angle_range_deg=91), dict(count=1, targets=[""]),
-                   dict(count=1, netd_k=-1), dict(count=True)):
+                   dict(count=1, netd_k=-1), dict(count=True),
+                   dict(count=1, from_thz=1.0, to_thz=0.5), dict(count=1, widths=[0.01, 0.01]),
+                   dict(count=2, from_thz=0.5, to_thz=0.5), dict(count=1, targets=["A", "A"]),
+                   dict(count=1, relative_width=0.01, widths=[0.02])):
         with pytest.raises(thzmap.ArgumentError):
             thzmap.bands(FEATURES, **kwargs)
     with pytest.raises(thzmap.ArgumentError):
         thzmap.bands(thzmap.scene_from_json(open(FEATURES).read()), 1)
+    # a Scene made from a dict labelled with the file's name is not the file: refused,
+    # not run on the file as it is on disk
+    d = json.load(open(FEATURES))
+    d["objects"] = d["objects"][:2]
+    made = thzmap.scene_from_dict(d, base_dir=os.path.dirname(FEATURES), label=FEATURES)
+    with pytest.raises(thzmap.ArgumentError, match="not loaded from one"):
+        thzmap.bands(made, 1, **GRID)
+    # a Scene loaded from a file that changed since, or by a relative path from another
+    # working directory, is the file it was loaded from, or refused
+    copy = tmp_path / "scene.json"
+    copy.write_text(open(FEATURES).read())
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        loaded = thzmap.load_scene("scene.json")
+    finally:
+        os.chdir(cwd)
+    assert thzmap.bands(loaded, 1, seed=3, **GRID).score >= 0.0
+    copy.write_text(copy.read_text() + "\n")
+    with pytest.raises(thzmap.ArgumentError, match="has changed since"):
+        thzmap.bands(loaded, 1, **GRID)
     with pytest.raises(thzmap.Error, match="nope"):
         thzmap.bands(FEATURES, 1, targets=["A", "nope"], **GRID)
     bad = tmp_path / "bad.json"

@@ -73,7 +73,7 @@ def test_missing_file(tmp_path):
 
 @pytest.mark.parametrize("kwargs", [
     {"photons": 0}, {"photons": -5}, {"photons": 2.5}, {"photons": 1 << 64}, {"photons": 10**12 + 1},
-    {"seed": -1}, {"seed": "1"}, {"threads": 0}, {"threads": True},
+    {"seed": -1}, {"seed": "1"}, {"seed": 1 << 63}, {"threads": 0}, {"threads": True},
     {"integrator": "magic"}, {"integrator": "path\0"}, {"target_noise_k": math.nan},
     {"target_noise_k": -1}, {"max_seconds": 3}, {"progress": 42},
 ])
@@ -81,6 +81,25 @@ def test_bad_arguments_raise_before_the_library(tiny_dir, kwargs):
     scene = thzmap.load_scene(tiny_dir / "scene.json")
     with pytest.raises(thzmap.ArgumentError):
         thzmap.simulate(scene, **kwargs)
+
+
+def test_numpy_whole_numbers_are_whole_numbers(tiny_dir):
+    np = pytest.importorskip("numpy")
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    a = thzmap.simulate(scene, integrator="photon-map", photons=np.int64(500),
+                        seed=np.uint32(7), threads=np.int64(1))
+    b = thzmap.simulate(scene, integrator="photon-map", photons=500, seed=7, threads=1)
+    assert a.summary["seed"] == 7
+    assert (a.image(0).radiance == b.image(0).radiance).all()
+
+
+def test_scene_integers_beyond_64_bits_are_named(tiny_dir):
+    import json
+    d = json.loads((tiny_dir / "scene.json").read_text())
+    d.setdefault("photons", {})["seed"] = 1 << 63
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.scene_from_dict(d, base_dir=tiny_dir)
+    assert e.value.path == "photons.seed"
 
 
 def test_bad_render_arguments(tiny_dir):
