@@ -60,7 +60,8 @@ typedef struct thz_channel_info {
     double frequency_thz;          /* centre, as in the scene file */
     double relative_width;         /* FWHM / centre of the Gaussian; 0 for a measured response */
     double bandwidth_hz;           /* B_c: the response's integral (physics.md) */
-    double emitted_power_w_per_hz; /* band mean of the scene's emitted power P_A */
+    double emitted_power_w_per_hz; /* band mean of the surfaces' emitted power (P_A without
+                                      the air's, which thz_photons_stats adds) */
     /* (added with measured responses. The library fills the whole struct: a program built
      * against an older header must be rebuilt; the ABI is not stable before 1.0) */
     double noise_bandwidth_hz; /* B_n = (int g)^2 / int g^2 */

@@ -15,11 +15,13 @@ static void validate_usage(FILE *f)
                "Loads the scene, checks it completely (exit 0 when valid, 2 when not, naming\n"
                "the file and the line:column or JSON path of the problem) and prints its\n"
                "channels, materials, objects (triangles, area, temperature), sensors and the\n"
-               "total emitted spectral power P_A per channel; for sensors with optics or\n"
+               "surfaces' emitted spectral power per channel (P_A without the air's\n"
+               "emission, which a run adds: summary.json); for sensors with optics or\n"
                "noise, each channel's NETD (K) and diffraction spot (mrad, and its size at\n"
                "the nearest and farthest object centre). Warnings (emissivity breaking\n"
                "Kirchhoff's law, channel bands leaving a material table, inconsistent mesh\n"
-               "winding) go to standard error, prefixed \"warning: \".\n\n"
+               "winding) go to standard error as \"thzmap validate: warning: ...\", as every\n"
+               "command prints them.\n\n"
                "options:\n"
                "  -h, --help   show this help\n");
 }
@@ -205,7 +207,8 @@ static void validate_print(const thz_scene *s)
            si.min_relative_power, si.gather_min_photons);
     printf("render: integrator %s, gather_rays %u, paths_per_sample %u\n", si.integrator,
            si.gather_rays, si.paths_per_sample);
-    printf("\nemitted spectral power P_A (band mean):\n");
+    printf("\nemitted spectral power of the surfaces (band mean; P_A without the air's own "
+           "emission, which a run adds and reports in summary.json):\n");
     for (size_t c = 0; c < si.n_channels; c++) {
         thz_channel_info ch;
         thz_scene_channel(s, c, &ch);
@@ -237,7 +240,7 @@ int cmd_validate(int argc, char **argv)
     validate_print(scene);
     fflush(stdout);
     for (size_t i = 0; i < thz_scene_warning_count(scene); i++)
-        fprintf(stderr, "warning: %s\n", thz_scene_warning(scene, i));
+        fprintf(stderr, "thzmap validate: warning: %s\n", thz_scene_warning(scene, i));
     thz_scene_destroy(scene);
     return CLI_EXIT_OK;
 }

@@ -47,7 +47,7 @@ make_scene background "s['atmosphere']['background_temperature_k'] = 3"
 check_warning() { # $1: scene, $2: text the warning must contain
     "$THZMAP" validate "$work/$1.json" > /dev/null 2> "$work/$1.err" ||
         fail "$1: validate failed: $(cat "$work/$1.err")"
-    grep -q "^warning: .*$2" "$work/$1.err" || fail "$1: no warning with '$2': $(cat "$work/$1.err")"
+    grep -q "^thzmap validate: warning: .*$2" "$work/$1.err" || fail "$1: no warning with '$2': $(cat "$work/$1.err")"
 }
 check_warning celsius "look like degrees Celsius"
 check_warning millimetres "scales differ by orders of magnitude"

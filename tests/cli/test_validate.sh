@@ -83,10 +83,10 @@ expect_line "$tmp/out" '^  metal: .*; reflection specular$'
 "$thzmap" validate "$repo/tests/inputs/scenes/warnings.json" >"$tmp/out" 2>"$tmp/err"
 status=$?
 [[ $status -eq 0 ]] || fail "warnings scene: exit $status"
-[[ $(grep -c '^warning: ' "$tmp/err") -eq 4 ]] || fail "expected 4 warnings, got: $(cat "$tmp/err")"
-expect_line "$tmp/err" '^warning: object "part": inconsistent winding'
-expect_line "$tmp/err" '^warning: object "plate": the explicit emissivity .* Kirchhoff'
-expect_line "$tmp/err" '^warning: material "lossy", reflectivity: the table covers'
+[[ $(grep -c '^thzmap validate: warning: ' "$tmp/err") -eq 4 ]] || fail "expected 4 warnings, got: $(cat "$tmp/err")"
+expect_line "$tmp/err" '^thzmap validate: warning: object "part": inconsistent winding'
+expect_line "$tmp/err" '^thzmap validate: warning: object "plate": the explicit emissivity .* Kirchhoff'
+expect_line "$tmp/err" '^thzmap validate: warning: material "lossy", reflectivity: the table covers'
 
 # --- help and usage -----------------------------------------------------------------------
 "$thzmap" validate --help >"$tmp/out" 2>&1 || fail "validate --help failed"
