@@ -218,7 +218,7 @@ def bands(scene, count, from_thz=None, to_thz=None, step_ghz=None, relative_widt
         keep.append(name)
         o.sensor = name
     if netd_k is not None:
-        o.has_netd, o.netd_k = 1, _number("netd_k", netd_k, 0.0, 1e6)
+        o.has_netd, o.netd_k = 1, _number("netd_k", netd_k, 0.0, 1e6, lo_open=True)
     for field, value, hi in (("target_temperature_range_k", temperature_range_k, 1000.0),
                              ("ambient_temperature_range_k", ambient_range_k, 1000.0),
                              ("humidity_range", humidity_range, 0.99),

@@ -77,7 +77,9 @@ thz_status bands_score_set(const bands_classes *cl, const size_t *set, size_t m,
     return THZ_OK;
 not_definite:
     return thz_error_set(err, THZ_ERR_INPUT,
-                         "band selection: a class covariance is not positive definite");
+                         "band selection: a class's covariance over the chosen channels is "
+                         "not positive definite (its pixels do not vary in them; give the "
+                         "sensor noise, NETD > 0 K, or wider nuisance ranges)");
 }
 
 int bands_score_better(const bands_score *a, const bands_score *b)

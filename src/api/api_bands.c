@@ -119,6 +119,11 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
     if (!(o->angle_range_deg >= 0.0 && o->angle_range_deg <= 90.0))
         return thz_error_set(err, THZ_ERR_INPUT, "angle range %g degrees: expected 0 to 90",
                              o->angle_range_deg);
+    if (o->has_netd && !(o->netd_k > 0.0))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "NETD %g K: expected > 0 K (a sensor without noise leaves a class "
+                             "of identical pixels with no spread to separate by)",
+                             o->netd_k);
     if (!(o->netd_k >= 0.0) || !(o->target_temperature_range_k >= 0.0) ||
         !(o->ambient_temperature_range_k >= 0.0) ||
         !(o->humidity_range >= 0.0 && o->humidity_range < 1.0))

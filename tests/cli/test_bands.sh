@@ -216,6 +216,8 @@ expect2 "no -o" "$IN/features.json" --count 1
 expect2 "to below from" "$IN/features.json" -o "$TMP/x" --count 1 --from-thz 1 --to-thz 0.5
 expect2 "unknown target" "$IN/features.json" -o "$TMP/x" --count 1 --targets A,nope
 grep -q "nope" "$TMP/err" || fail "unknown target not named: $(cat "$TMP/err")"
+expect2 "no sensor noise" "$IN/features.json" -o "$TMP/x" --count 1 --netd-k 0
+grep -q "NETD 0 K: expected > 0 K" "$TMP/err" || fail "NETD 0 not named: $(cat "$TMP/err")"
 expect2 "missing scene" "$TMP/none.json" -o "$TMP/x" --count 1
 expect2 "count above candidates" "$IN/features.json" -o "$TMP/x" --count 3 --from-thz 0.5 \
     --to-thz 0.52 --step-ghz 20

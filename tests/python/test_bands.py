@@ -78,7 +78,7 @@ def test_bands_takes_a_loaded_scene_and_targets():
 def test_bands_errors(tmp_path):
     for kwargs in (dict(count=0), dict(count=1, widths=[0.6]), dict(count=1, widths=[]),
                    dict(count=1, angle_range_deg=91), dict(count=1, targets=[""]),
-                   dict(count=1, netd_k=-1), dict(count=True),
+                   dict(count=1, netd_k=-1), dict(count=1, netd_k=0), dict(count=True),
                    dict(count=1, from_thz=1.0, to_thz=0.5), dict(count=1, widths=[0.01, 0.01]),
                    dict(count=2, from_thz=0.5, to_thz=0.5), dict(count=1, targets=["A", "A"]),
                    dict(count=1, relative_width=0.01, widths=[0.02])):
