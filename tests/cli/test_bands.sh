@@ -228,7 +228,7 @@ expect2 "angle above 90" "$IN/features.json" -o "$TMP/x" --count 1 --angle-range
 grep -q -- "--angle-range-deg.*91" "$TMP/err" || fail "the bad angle not named: $(cat "$TMP/err")"
 expect2 "a width and widths" "$IN/features.json" -o "$TMP/x" --count 1 --relative-width 0.02 \
     --widths 0.01,0.05
-grep -q -- "--relative-width 0.02 and --widths" "$TMP/err" ||
+grep -q -- "relative width 0.02 and widths" "$TMP/err" ||
   fail "--relative-width with --widths not refused by name: $(cat "$TMP/err")"
 expect2 "thickness range 1" "$IN/features.json" -o "$TMP/x" --count 1 --thickness-range 1
 [ -e "$TMP/x" ] && fail "a failed run left $TMP/x"
