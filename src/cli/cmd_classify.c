@@ -110,12 +110,25 @@ int cmd_classify(int argc, char **argv)
         fprintf(stderr, "thzmap classify: %s by %s: %llu pixels, %zu classes, %llu training\n",
                 info.source, info.method, (unsigned long long)info.pixels, info.n_classes,
                 (unsigned long long)info.training_pixels);
-        for (size_t k = 0; k < info.n_classes; k++)
-            fprintf(stderr, "  %-24s accuracy %6.2f %%  AUC %.4f\n",
+        for (size_t k = 0; k < info.n_classes; k++) {
+            double auc = thz_classification_auc(c, k);
+            char auc_text[32] = "none (no held-out pixels)";
+            if (isfinite(auc))
+                snprintf(auc_text, sizeof auc_text, "%.4f", auc);
+            fprintf(stderr, "  %-24s accuracy %6.2f %%  AUC %s\n",
                     thz_classification_class_name(c, k),
-                    100.0 * thz_classification_class_accuracy(c, k), thz_classification_auc(c, k));
-        fprintf(stderr, "accuracy %.2f %% (held-out pixels %.2f %%); results in %s\n",
-                100.0 * info.accuracy, 100.0 * info.held_out_accuracy, outdir);
+                    100.0 * thz_classification_class_accuracy(c, k), auc_text);
+        }
+        if (info.held_out_pixels == 0)
+            fprintf(stderr,
+                    "thzmap classify: warning: no pixel was held out (every pixel trained the "
+                    "classifier: lower --train-fraction); the accuracies are on the training "
+                    "pixels\n");
+        char held[48] = "none held out";
+        if (info.held_out_pixels > 0 && isfinite(info.held_out_accuracy))
+            snprintf(held, sizeof held, "held-out pixels %.2f %%", 100.0 * info.held_out_accuracy);
+        fprintf(stderr, "accuracy %.2f %% (%s); results in %s\n", 100.0 * info.accuracy, held,
+                outdir);
     }
     thz_classification_destroy(c);
     return CLI_EXIT_OK;

@@ -30,6 +30,12 @@ for m in sam mahalanobis lda matched-filter ace; do
     done
 done
 
+# every pixel training (--train-fraction near 1): said, and no 'nan' printed
+"$THZ" classify "$TMP/run" --sensor cam -o "$TMP/c-all" --method lda --train-fraction 0.999 \
+    2> "$TMP/all.err" || fail "classify --train-fraction 0.999 exit status $?"
+grep -q "warning: no pixel was held out" "$TMP/all.err" || fail "no held-out warning: $(cat "$TMP/all.err")"
+grep -qi "nan" "$TMP/all.err" && fail "classify printed nan: $(cat "$TMP/all.err")"
+
 $PY - "$TMP/run" "$TMP/c-lda" <<'PYEOF' || fail "lda, noise-free"
 import json, sys
 import numpy as np
