@@ -164,6 +164,12 @@ typedef struct movie_layout {
     uint32_t pixel, image_x, image_y, width, height;
 } movie_layout;
 
+/* The frame rates a movie plays at: a sequence's fps beyond them (a frame an hour for a
+ * slow process) gives movies at the nearest end, which batch.json's movies[].fps says.
+ * The encoder's rational rate (at most 100000 in numerator and denominator) holds them. */
+#define MOVIE_FPS_MIN 0.01
+#define MOVIE_FPS_MAX 1000.0
+
 typedef struct movie_spec {
     const char *path; /* the .mp4 */
     uint32_t columns, rows;

@@ -72,10 +72,11 @@ static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, s
         snprintf(sub, sizeof sub, "sweep-%02zu/", s);
     if (snprintf(path, sizeof path, "%s/%s%s", outdir, sub, name) >= (int)sizeof path)
         return thz_error_set(err, THZ_ERR_IO, "%s: path too long", outdir);
+    double movie_fps = fmin(fmax(seq->fps, MOVIE_FPS_MIN), MOVIE_FPS_MAX);
     movie_spec spec = {.path = path,
                        .columns = si->columns,
                        .rows = si->rows,
-                       .fps = seq->fps,
+                       .fps = movie_fps,
                        .tb_min_k = lo,
                        .tb_max_k = hi};
     movie_writer *m = NULL;
@@ -106,7 +107,7 @@ static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, s
     json_object_set_new(e, "sweep", json_integer((json_int_t)s));
     json_object_set_new(e, "quantity", json_string("brightness_temperature"));
     json_object_set_new(e, "frames", json_integer((json_int_t)seq->frames));
-    json_object_set_new(e, "fps", json_real(seq->fps));
+    json_object_set_new(e, "fps", json_real(movie_fps));
     json_object_set_new(e, "codec", json_string(codec));
     json_object_set_new(scale, "min_k", json_real(lo));
     json_object_set_new(scale, "max_k", json_real(hi));

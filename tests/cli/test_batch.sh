@@ -291,6 +291,15 @@ assert [o["temperature_k"] for o in f["scene"]["objects"]] == [293, 306], f["sce
 PY
 ffprobe -v error -count_frames -show_entries stream=nb_read_frames -of default=nw=1 "$work/L/cam.band-02.mp4" |
     grep -qx 'nb_read_frames=2' || fail "list of scenes: the movie has not 2 frames"
+# a slow process (a frame every 10 000 s): the movie plays at the slowest rate held,
+# 0.01 frames/s, and batch.json says so (a rate of 1e-4 once failed the whole batch)
+echo '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1e-4, "frames": 2}' \
+    > "$work/slow.json"
+"$THZMAP" batch "$work/slow.json" -o "$work/S" --threads 2 --quiet > /dev/null 2>&1 ||
+    fail "a sequence at 1e-4 fps: exit $?"
+ffprobe -v error -show_entries stream=r_frame_rate -of default=nw=1 "$work/S/cam.band-01.mp4" |
+    grep -qx 'r_frame_rate=1/100' || fail "a sequence at 1e-4 fps: the movie is not at 0.01 fps"
+grep -q '"fps": 0.01' "$work/S/batch.json" || fail "a sequence at 1e-4 fps: batch.json's movie rate"
 sed -i 's/"temperature_k": 306/"temperature_k": 307/' "$work/sub/b.json"
 "$THZMAP" batch "$work/list.json" -o "$work/L" --quiet > /dev/null 2>&1 || fail "list, changed: exit $?"
 "$PY" - "$work/L/batch.json" <<'PY' || fail "a changed scene of the list must redo its frame only"
