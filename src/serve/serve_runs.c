@@ -82,6 +82,14 @@ static int serve_job_report(serve_job_ctx *c, double fraction, const char *messa
 static int serve_on_progress(void *user, const thz_progress *p)
 {
     serve_job_ctx *c = user;
+    if (c->job->command == CMD_BATCH) {
+        /* the batch's own callback reports the same events with the batch's share; a
+         * report from here would take its turn (ten a second) with a frozen share */
+        pthread_mutex_lock(&c->s->lock);
+        int stop = c->job->cancel || c->s->stopping;
+        pthread_mutex_unlock(&c->s->lock);
+        return stop;
+    }
     double frac = p->total ? (double)p->done / (double)p->total : 0.0;
     bool photons = strcmp(p->stage, "photons") == 0;
     if (photons)
@@ -95,7 +103,7 @@ static int serve_on_progress(void *user, const thz_progress *p)
     char message[256];
     snprintf(message, sizeof message, "channel %zu/%zu, %s %llu/%llu", p->channel + 1,
              p->n_channels, p->stage, (unsigned long long)p->done, (unsigned long long)p->total);
-    return serve_job_report(c, c->job->command == CMD_BATCH ? c->job->progress : share, message);
+    return serve_job_report(c, share, message);
 }
 
 static int serve_on_batch_progress(void *user, const thz_batch_progress *p)
@@ -232,7 +240,11 @@ static void serve_run_job(serve *s, serve_job *j)
         snprintf(j->message, sizeof j->message, "done; results in %.200s", j->out);
     } else if (st == THZ_ERR_CANCELLED) {
         j->state = JOB_CANCELLED;
-        snprintf(j->message, sizeof j->message, "cancelled; nothing written to %.200s", j->out);
+        if (j->command == CMD_BATCH) /* finished frames stay, for a later batch to reuse */
+            snprintf(j->message, sizeof j->message,
+                     "cancelled; the frames finished before stay in %.200s", j->out);
+        else
+            snprintf(j->message, sizeof j->message, "cancelled; nothing written to %.200s", j->out);
     } else {
         j->state = JOB_FAILED;
         snprintf(j->error, sizeof j->error, "%s",

@@ -405,6 +405,14 @@ def test_runs(srv, root):
         "command": "bands", "scene": "s/scene.json", "out": "out/bands",
         "options": {"count": 1, "from_thz": 0.3, "to_thz": 0.4, "step_ghz": 50,
                     "targets": ["target"], "seed": 3}}, status=202)
+    # the batch's progress is the batch's (its frames and share), not its runs' channels
+    # with a share frozen at 0 (the runs' reports once took every turn)
+    running = [d for n, d in sse_events(srv, batch["id"])
+               if n == "progress" and d["state"] == "running"]
+    check(not running or any(d["message"].startswith("frame ") for d in running),
+          "batch progress never names a frame: %r" % running[-3:])
+    check(all(not d["message"].startswith("channel ") for d in running),
+          "batch progress in a run's terms: %r" % running[-3:])
     job = wait_state(srv, batch["id"], ("done", "failed"))
     check(job and job["state"] == "done" and job["progress"] == 1.0, "batch: %r" % job)
     res = srv.json("GET", "/api/outputs?dir=out/batch")
