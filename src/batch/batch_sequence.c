@@ -125,8 +125,8 @@ static thz_status seq_check_path(const seq_build *b, const char *where, const ch
     int known = 0;
     for (size_t i = 0; i < sizeof seq_blocks / sizeof seq_blocks[0]; i++)
         known |= !strcmp(seg[0], seq_blocks[i]);
-    if (!known && depth >= 2 && (!strcmp(seg[0], "photons") || !strcmp(seg[0], "render")))
-        known = 1;
+    if (!known && (!strcmp(seg[0], "photons") || !strcmp(seg[0], "render")))
+        known = 1; /* a value of theirs, not the whole block: the leaf check below */
     if (!known)
         return seq_fail(b, where,
                         "\"%s\" cannot be set (expected objects, sensors, atmosphere, materials, "
@@ -219,7 +219,8 @@ static thz_status seq_walk(seq_build *b, char *where, size_t where_size, const c
     }
     if (depth == SEQ_MAX_DEPTH)
         return seq_fail(b, where, "%s", "nested too deeply");
-    if (depth == 2 && (!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors"))) {
+    /* the block's name even when it names nothing ("cameras": {} is a typo, not a no-op) */
+    if (depth == 1 || (depth == 2 && (!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors")))) {
         thz_status st = seq_check_path(b, where, seg, depth, 0);
         if (st != THZ_OK)
             return st;

@@ -351,6 +351,8 @@ bad order 'keyframes[1].time_s: expected keyframe times in increasing order' \
     "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"fps\": 4, \"keyframes\": [{\"time_s\": 1}, $K0]}"
 bad nobody 'keyframes[0].objects.nobody: the scene has no object named "nobody"' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "keyframes": [{"time_s": 0, "objects": {"nobody": {"temperature_k": 3}}}]}'
+bad empty_block 'keyframes[0].cameras: "cameras" cannot be set' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "keyframes": [{"time_s": 0, "cameras": {}}]}'
 bad string 'keyframes[0].objects.person.temperature_k: expected a number or an array of numbers, got a string' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": "hot"}}}]}'
 bad shape 'keyframes[1].sensors.cam.position_m: expected the same kind of value' \
