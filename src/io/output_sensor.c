@@ -158,7 +158,8 @@ static thz_status out_measured_preview(const out_context *ctx, size_t c, thz_err
     if (status != THZ_OK)
         return status;
     const thz_channel *ch = &ctx->scene->channels[c];
-    sensor_model_describe(ctx->sensor, c, ctx->images->noise_seed, model, sizeof model);
+    sensor_model_describe(ctx->sensor, c, ctx->images->n_channels, ctx->images->noise_seed, model,
+                          sizeof model);
     snprintf(title, sizeof title, "%s, %.4g GHz: %s", ctx->sensor->name, ch->center_hz / 1e9,
              model);
     size_t pixels = (size_t)ctx->images->columns * ctx->images->rows;
@@ -175,7 +176,8 @@ static thz_status out_measured(const out_context *ctx, thz_error *err)
     if (!img->measured_radiance)
         return THZ_OK;
     char model[512], what[OUT_TEXT];
-    sensor_model_describe(ctx->sensor, 0, img->noise_seed, model, sizeof model);
+    sensor_model_describe(ctx->sensor, SIZE_MAX, img->n_channels, img->noise_seed, model,
+                          sizeof model);
     snprintf(what, sizeof what, "measured band-mean spectral radiance L_c (%s)", model);
     thz_status status = out_image(ctx, OUT_CHANNELS, "measured_radiance", img->measured_radiance,
                                   what, "W m-2 sr-1 Hz-1", err);

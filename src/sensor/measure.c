@@ -34,8 +34,8 @@ const char *sensor_noise_name(const thz_sensor_noise *noise)
     return "none";
 }
 
-void sensor_model_describe(const thz_sensor *sn, size_t channel, uint64_t noise_seed, char *buf,
-                           size_t size)
+void sensor_model_describe(const thz_sensor *sn, size_t channel, size_t n_channels,
+                           uint64_t noise_seed, char *buf, size_t size)
 {
     int n = 0;
     if (sn->psf == PSF_AIRY)
@@ -46,10 +46,19 @@ void sensor_model_describe(const thz_sensor *sn, size_t channel, uint64_t noise_
         n = snprintf(buf, size, "no PSF");
     size_t used = n > 0 && (size_t)n < size ? (size_t)n : size - 1;
     const thz_sensor_noise *ns = &sn->noise;
-    if (ns->kind == NOISE_NETD)
+    if (ns->kind == NOISE_NETD && channel != SIZE_MAX) {
         snprintf(buf + used, size - used, "; NETD %g K; seed %llu", ns->netd_k[channel],
                  (unsigned long long)noise_seed);
-    else if (ns->kind == NOISE_RADIOMETER)
+    } else if (ns->kind == NOISE_NETD) { /* the whole cube: every channel's NETD */
+        int k = snprintf(buf + used, size - used, "; NETD per channel ");
+        for (size_t c = 0; c < n_channels && k > 0; c++) {
+            used += (size_t)k < size - used ? (size_t)k : size - used - 1;
+            k = snprintf(buf + used, size - used, "%s%g", c ? " / " : "", ns->netd_k[c]);
+        }
+        if (k > 0)
+            used += (size_t)k < size - used ? (size_t)k : size - used - 1;
+        snprintf(buf + used, size - used, " K; seed %llu", (unsigned long long)noise_seed);
+    } else if (ns->kind == NOISE_RADIOMETER)
         snprintf(buf + used, size - used, "; %s T_rec %g K tau %g s; seed %llu",
                  sensor_noise_name(ns), ns->receiver_temperature_k, ns->integration_time_s,
                  (unsigned long long)noise_seed);

@@ -28,9 +28,11 @@ const char *sensor_noise_name(const thz_sensor_noise *noise);
 
 /* A one-line description of sn's model in channel `channel` for titles and captions,
  * e.g. "Airy D 0.5 m; total-power T_rec 500 K tau 0.01 s; seed 1" or "no PSF; NETD
- * 0.3 K; seed 7" (the given NETD is the channel's; the seed is the noise's). */
-void sensor_model_describe(const thz_sensor *sn, size_t channel, uint64_t noise_seed, char *buf,
-                           size_t size);
+ * 0.3 K; seed 7" (the given NETD is the channel's; the seed is the noise's). With
+ * channel SIZE_MAX, of the whole cube of n_channels: every channel's given NETD
+ * ("NETD per channel 0.2 / 0.3 K"). */
+void sensor_model_describe(const thz_sensor *sn, size_t channel, size_t n_channels,
+                           uint64_t noise_seed, char *buf, size_t size);
 
 /* Allocates and fills img->measured_* of scene sensor `sensor` from img->radiance
  * (nothing when the sensor has no model). Bit-identical for any thread count. */

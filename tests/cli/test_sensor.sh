@@ -84,6 +84,9 @@ assert s["dicke"]["noise"]["model"] == "dicke", s["dicke"]
 assert s["netd"]["noise"]["netd_k"] == [0.5, 0.2] and s["netd"]["noise_seed"] == 7, s["netd"]
 assert s["tp"]["noise_seed"] == 1, s["tp"]
 EOF
+# the measured cube's header gives every channel's NETD, not the first one's
+grep -q "NETD per channel 0.5 / 0.2 K" "$work/n2/netd.measured_brightness_temperature.hdr" ||
+    fail "netd.measured_brightness_temperature.hdr: $(grep description "$work/n2/netd.measured_brightness_temperature.hdr")"
 # render from a saved photon map: the same measured cubes as simulate
 run pm simulate "$work/furnace.json" -o "$work/pm" --integrator photon-map --photons 20000 \
     --save-photon-map --threads 2
