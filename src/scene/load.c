@@ -100,6 +100,8 @@ static double load_kirchhoff_worst(thz_scene *s, const thz_object *obj, double *
 static void load_channel_band(const thz_channel *ch, double *lo_hz, double *hi_hz)
 {
     channel_support_hz(ch, 2.0 * CHANNEL_FWHM_PER_SIGMA, lo_hz, hi_hz);
+    if (*lo_hz < 0.0) /* a wide band: no frequency below 0 (nor a rounding's -6e-17 THz) */
+        *lo_hz = 0.0;
 }
 
 /* Warns about channel bands (load_channel_band) that leave table `sp`. */
