@@ -1,6 +1,7 @@
 /* thzmap bands: choose the K channel centres that best separate a scene's targets, from
  * a candidate grid, with the sensor's noise and nuisance variations as the classes'
  * spread (thzmap/analysis.h); writes bands.json and its figures. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -61,28 +62,49 @@ static void print_help(void)
            "  -h, --help                  this help\n");
 }
 
-/* Splits "a,b,c" in place into names. */
-static bool split_targets(char *list, const char **names, size_t *n)
+/* Splits "a,b,c" in place into at most `max` items; false for none, too many or an
+ * empty one ("a,,b", "a,": a typo, not a shorter list). */
+static bool split_list(char *list, char **items, size_t max, size_t *n)
 {
     *n = 0;
-    for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
-        if (*n == MAX_TARGETS)
+    for (char *p = list;;) {
+        char *comma = strchr(p, ',');
+        if (comma)
+            *comma = '\0';
+        if (!*p || *n == max)
             return false;
-        names[(*n)++] = tok;
+        items[(*n)++] = p;
+        if (!comma)
+            return true;
+        p = comma + 1;
     }
-    return *n > 0;
 }
 
-/* Parses "w1,w2,..." (relative widths) in place. */
+static bool split_targets(char *list, const char **names, size_t *n)
+{
+    char *items[MAX_TARGETS];
+    if (!split_list(list, items, MAX_TARGETS, n))
+        return false;
+    for (size_t i = 0; i < *n; i++)
+        names[i] = items[i];
+    return true;
+}
+
+/* Parses "w1,w2,..." (relative widths in (0, 0.5]) in place; false, saying nothing,
+ * when it is not such a list (the caller says what is expected). */
 static bool split_widths(char *list, double *w, size_t *n)
 {
-    *n = 0;
-    for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
-        if (*n == MAX_WIDTHS || !cli_parse_double(CMD, "--widths", tok, 1e-9, 0.5, &w[*n]))
+    char *items[MAX_WIDTHS];
+    if (!split_list(list, items, MAX_WIDTHS, n))
+        return false;
+    for (size_t i = 0; i < *n; i++) {
+        char *end = NULL;
+        errno = 0;
+        w[i] = strtod(items[i], &end);
+        if (end == items[i] || *end || errno || !(w[i] > 0.0 && w[i] <= 0.5))
             return false;
-        (*n)++;
     }
-    return *n > 0;
+    return true;
 }
 
 int cmd_bands(int argc, char **argv)

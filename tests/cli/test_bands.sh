@@ -222,6 +222,10 @@ expect2 "missing scene" "$TMP/none.json" -o "$TMP/x" --count 1
 expect2 "count above candidates" "$IN/features.json" -o "$TMP/x" --count 3 --from-thz 0.5 \
     --to-thz 0.52 --step-ghz 20
 expect2 "width above 0.5" "$IN/features.json" -o "$TMP/x" --count 1 --widths 0.01,0.6
+expect2 "an empty width" "$IN/features.json" -o "$TMP/x" --count 1 --widths 0.01,,0.2
+expect2 "an empty target" "$IN/features.json" -o "$TMP/x" --count 1 --targets A,,B
+expect2 "width above 0.5, said once" "$IN/features.json" -o "$TMP/x" --count 1 --widths 0.01,0.6
+[ "$(grep -c expects "$TMP/err")" = 1 ] || fail "a bad width said other than once: $(cat "$TMP/err")"
 expect2 "width twice" "$IN/features.json" -o "$TMP/x" --count 1 --widths 0.01,0.01
 grep -q "twice" "$TMP/err" || fail "a repeated width not named: $(cat "$TMP/err")"
 expect2 "angle above 90" "$IN/features.json" -o "$TMP/x" --count 1 --angle-range-deg 91
