@@ -224,7 +224,7 @@ typedef struct thz_run_totals {
     uint64_t photons_fired; /* over all channels (0 for a render run) */
     uint64_t photons_stored;
     uint64_t back_face_samples;
-    size_t n_warnings;            /* run warnings (in the summary) */
+    size_t n_warnings;            /* the run's own (summary.json adds the scene's) */
     double worst_median_stderr_k; /* largest median per-pixel standard error of Tb_c, K */
     uint32_t max_passes;          /* most render passes of any channel */
     double seconds;               /* wall time of the run */

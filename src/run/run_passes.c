@@ -112,8 +112,15 @@ thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, th
             break;
         if (pass + 1 >= RUN_FLOOR_PASSES && run_at_map_floor(rs, c, acc, target, &st, err))
             break;
-        if (rs->max_seconds > 0.0 && thz_now_s() - t0 >= rs->max_seconds)
+        if (rs->max_seconds > 0.0 && thz_now_s() - t0 >= rs->max_seconds) {
+            st = run_add_warning(rs, err,
+                                 "channel %zu: stopped by the time limit of %g s after %u "
+                                 "passes, at %.3g K (95th percentile of the pixels' standard "
+                                 "error) above the noise target of %g K",
+                                 c, rs->max_seconds, pass + 1, run_channel_p95_stderr_k(rs, c),
+                                 target);
             break;
+        }
         if (pass + 1 >= RUN_MAX_PASSES) {
             st = run_add_warning(rs, err,
                                  "channel %zu: stopped after %u passes above the noise target "
@@ -193,8 +200,14 @@ thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_
         rs->passes[c] = (uint32_t)n;
         if (st != THZ_OK || run_channel_p95_stderr_k(rs, c) <= target)
             break;
-        if (rs->max_seconds > 0.0 && thz_now_s() - t_start >= rs->max_seconds)
+        if (rs->max_seconds > 0.0 && thz_now_s() - t_start >= rs->max_seconds) {
+            st = run_add_warning(rs, err,
+                                 "channel %zu: stopped by the time limit of %g s after %zu "
+                                 "photon passes, at %.3g K (95th percentile of the pixels' "
+                                 "standard error) above the noise target of %g K",
+                                 c, rs->max_seconds, n, run_channel_p95_stderr_k(rs, c), target);
             break;
+        }
         /* the passes' maps and the next merge: twice the records, and their indexes */
         double next = 2.2 * (double)photon_map_bytes(map) * (double)(n + 1) / (double)n;
         if (limit > 0.0 && next > limit) { /* 0: the machine's memory is unknown */

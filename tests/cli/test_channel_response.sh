@@ -69,10 +69,10 @@ PY
 expect_line "$tmp/sim/cam.radiance.hdr" '^fwhm = \{20, 20, 3\.5\}'
 
 "$thzmap" render "$tmp/scene.json" --photon-map "$tmp/sim/photon-map.thzpm" -o "$tmp/r1" \
-    --quiet --threads 2 >/dev/null 2>"$tmp/err" || fail "render, same responses: $(cat "$tmp/err")"
+    --integrator final-gather --quiet --threads 2 >/dev/null 2>"$tmp/err" || fail "render, same responses: $(cat "$tmp/err")"
 scene 0.361 '{"model": "none"}' >"$tmp/other.json"
 "$thzmap" render "$tmp/other.json" --photon-map "$tmp/sim/photon-map.thzpm" -o "$tmp/r2" \
-    --quiet >/dev/null 2>"$tmp/err"
+    --integrator final-gather --quiet >/dev/null 2>"$tmp/err"
 status=$?
 [[ $status -eq 2 ]] || fail "render with another response: exit $status, expected 2"
 expect_line "$tmp/err" 'another channel set \(frequencies, widths or responses differ'

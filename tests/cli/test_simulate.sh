@@ -191,6 +191,13 @@ grep -q "is not used: the path integrator renders without photons" "$work/upr.er
     || fail "render path with a map: no warning: $(cat "$work/upr.err")"
 grep -q '"photons_per_channel": 0,' "$work/upr/summary.json" \
     || fail "render path with an unused map: summary.json counts its photons"
+# a time limit that stops the passes above the noise target says so
+"$THZMAP" simulate "$work/scene.json" -o "$work/ms" --integrator path --target-noise-k 0.0001 \
+    --max-seconds 0.2 --quiet 2> "$work/ms.err" || fail "simulate --max-seconds exited $?"
+grep -q "stopped by the time limit of 0.2 s after" "$work/ms.err" ||
+    fail "a run stopped by its time limit above the target: no warning: $(cat "$work/ms.err")"
+grep -q "stopped by the time limit" "$work/ms/summary.json" ||
+    fail "a run stopped by its time limit: summary.json has no warning"
 # summary.json holds the seed exactly: one that JSON's integers cannot is refused
 "$THZMAP" simulate "$work/scene.json" -o "$work/u" --seed 9223372036854775808 2> "$work/u.err"
 [ $? -eq 2 ] || fail "--seed 2^63 should exit 2"
