@@ -34,8 +34,9 @@ const thz_cube *serve_cube_get(serve *s, const char *hdr, thz_error *err)
     struct stat sh, si;
     size_t n = strlen(hdr);
     if (n < 5 || strcmp(hdr + n - 4, ".hdr") != 0 || !realpath(hdr, real) || stat(real, &sh) != 0) {
-        snprintf(err->message, sizeof err->message, "%s: no such ENVI header", hdr);
-        err->status = THZ_ERR_IO;
+        /* the request's fault, not the server's: 400 */
+        snprintf(err->message, sizeof err->message, "%s: no such ENVI header (.hdr)", hdr);
+        err->status = THZ_ERR_INPUT;
         return NULL;
     }
     snprintf(img, sizeof img, "%.*s.img", (int)(strlen(real) - 4), real);
