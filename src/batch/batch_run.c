@@ -27,6 +27,9 @@
 
 typedef enum frame_state { FRAME_PENDING, FRAME_REUSED, FRAME_COMPUTED, FRAME_FAILED } frame_state;
 
+/* How a frame computed by this call got its photons (batch.json's frames[].photons). */
+enum { BATCH_PHOTONS_FIRED = 0, BATCH_PHOTONS_REUSED, BATCH_PHOTONS_NONE };
+
 typedef struct batch_state {
     const thz_sequence *seq;
     const char *outdir;
@@ -34,7 +37,7 @@ typedef struct batch_state {
     double *seconds;     /* per frame computed by this call, s */
     size_t *base;        /* per frame: the frame whose photons it renders from (batch_reuse.c) */
     size_t *rank;        /* per frame: the MPI rank that computes it (0: this process) */
-    int *reused_photons; /* per frame computed by this call: rendered from base's */
+    int *reused_photons; /* per frame computed by this call: BATCH_PHOTONS_* */
     batch_photon_cache cache; /* the photons of the current base frame */
     json_t *movies;           /* the movies' descriptions (batch.json "movies") */
     char movies_skipped[700]; /* why there are none ("" when there are) */
@@ -195,7 +198,10 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
                 json_string(b->state[f] == FRAME_COMPUTED ? "this run" : "an earlier run"));
         if (b->state[f] == FRAME_COMPUTED)
             json_object_set_new(e, "photons",
-                                json_string(b->reused_photons[f] ? "reused" : "fired"));
+                                json_string(b->reused_photons[f] == BATCH_PHOTONS_REUSED ? "reused"
+                                            : b->reused_photons[f] == BATCH_PHOTONS_NONE
+                                                ? "none"
+                                                : "fired"));
         json_object_set_new(e, "photon_base_frame", json_integer((json_int_t)b->base[f]));
         json_object_set_new(e, "seconds",
                             b->state[f] == FRAME_COMPUTED ? json_real(b->seconds[f]) : json_null());
@@ -316,7 +322,14 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
     if (st == THZ_OK)
         st = thz_output_commit(output, err);
     if (st == THZ_OK) {
-        b->reused_photons[f] = fr.reused;
+        /* a frame whose integrator fires none (path) neither fired nor reused photons */
+        thz_run_totals totals;
+        thz_run_get_totals(fr.run, &totals);
+        if (!fr.reused && totals.photons_fired == 0)
+            fr.fired = 0;
+        b->reused_photons[f] = fr.reused                   ? BATCH_PHOTONS_REUSED
+                               : totals.photons_fired == 0 ? BATCH_PHOTONS_NONE
+                                                           : BATCH_PHOTONS_FIRED;
         b->fired += (size_t)fr.fired;
         b->rerendered += (size_t)fr.reused;
     }

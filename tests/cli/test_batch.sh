@@ -64,6 +64,9 @@ assert b["format"] == "thzmap-batch/1" and b["n_frames"] == 5, b
 assert b["frames_computed"] == 5 and b["frames_reused"] == 0 and b["complete"], b
 assert [f["time_s"] for f in b["frames"]] == [0, 0.25, 0.5, 0.75, 1.0], b["frames"]
 assert all(f["status"] == "done" and f["seconds"] > 0 for f in b["frames"])
+# path fires no photons: none fired, none reused (it once said "fired" for every frame)
+assert b["photon_phases_fired"] == 0, b
+assert all(f["photons"] == "none" for f in b["frames"]), b["frames"]
 m = {x["file"]: x for x in b["movies"]}
 assert set(m) == {"cam.band-01.mp4", "cam.band-02.mp4"}, m
 s = m["cam.band-01.mp4"]["colour_scale"]
