@@ -4,6 +4,7 @@
  * a line per tenth of the batch otherwise) and Ctrl-C/SIGTERM ending it cleanly
  * (finished frames stay; running it again resumes). */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -32,12 +33,21 @@ static void batch_usage(FILE *f)
                "  --quiet               no progress output (warnings are still printed)\n");
 }
 
+/* Distinct warnings remembered (more are printed each time). */
+#define BATCH_SEEN_MAX 64
+
 typedef struct batch_cli {
     bool quiet;
     bool tty;           /* stderr is a terminal: the progress within frames is redrawn */
     bool line_open;     /* a redrawn line is on the terminal */
     double last_draw_s; /* when it was drawn, s */
     int last_tenth;     /* not a terminal: the last tenth of the batch printed */
+    size_t frame;       /* the frame running (its warnings name it), when in_frame */
+    size_t n_frames;
+    bool in_frame;
+    /* warnings printed once: the later frames' same message counted, said at the end */
+    char *seen[BATCH_SEEN_MAX];
+    size_t seen_repeats[BATCH_SEEN_MAX], n_seen;
 } batch_cli;
 
 /* Within a frame: the share of the whole batch done and its ETA, on a line redrawn at
@@ -73,6 +83,9 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
     batch_cli *b = user;
     if (cli_interrupt_signal())
         return 1;
+    b->in_frame = !strcmp(p->stage, "frame") || !strcmp(p->stage, "run");
+    b->frame = p->frame;
+    b->n_frames = p->n_frames;
     if (b->quiet)
         return 0;
     if (!strcmp(p->stage, "run")) {
@@ -107,10 +120,26 @@ static int batch_on_run_progress(void *user, const thz_progress *p)
     return cli_interrupt_signal() != 0;
 }
 
+/* A frame's warning names the frame (a sequence's frames often warn alike). */
 static void batch_on_warning(void *user, const char *message)
 {
-    (void)user;
-    fprintf(stderr, "thzmap batch: warning: %s\n", message);
+    batch_cli *b = user;
+    for (size_t i = 0; i < b->n_seen; i++)
+        if (!strcmp(b->seen[i], message)) {
+            b->seen_repeats[i]++;
+            return;
+        }
+    if (b->n_seen < BATCH_SEEN_MAX && (b->seen[b->n_seen] = strdup(message)))
+        b->seen_repeats[b->n_seen++] = 0;
+    if (b->line_open) {
+        fputs("\r\033[K", stderr);
+        b->line_open = false;
+    }
+    if (b->in_frame)
+        fprintf(stderr, "thzmap batch: warning: frame %zu/%zu: %s\n", b->frame + 1, b->n_frames,
+                message);
+    else
+        fprintf(stderr, "thzmap batch: warning: %s\n", message);
 }
 
 /* A rank other than 0 of an MPI batch: serves every frame rank 0 runs. A failure ends
@@ -242,6 +271,12 @@ int cmd_batch(int argc, char **argv)
             printf(", %d MPI ranks (%.3g MB communicated)", cli_mpi_size(),
                    1e-6 * (double)thz_context_mpi_bytes(ctx));
         printf(", %.2f s; results in %s\n", res.seconds, outdir);
+    }
+    for (size_t i = 0; i < b.n_seen; i++) {
+        if (b.seen_repeats[i])
+            fprintf(stderr, "thzmap batch: warning: the same in %zu later frame%s: %s\n",
+                    b.seen_repeats[i], b.seen_repeats[i] == 1 ? "" : "s", b.seen[i]);
+        free(b.seen[i]);
     }
     if (shared && rc != CLI_EXIT_OK) /* the other ranks may be waiting for rank 0 */
         cli_mpi_abort(rc);

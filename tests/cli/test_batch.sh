@@ -336,6 +336,22 @@ grep -q 'a library ended the process early' "$work/X.err" || fail "libgomp exit:
 left=$(ls -A "$work/X" | grep -v -x -e batch.json -e .thzmap-batch-lock)
 [ -z "$left" ] || fail "libgomp exit left in OUTDIR: $left"
 
+# --- a warning every frame gives: said once, naming its frame, then counted ------------
+"$PY" - "$work/scene.json" "$work/few.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["render"] = {"integrator": "photon-map"}
+s["photons"] = {"per_channel": 500, "seed": 1}
+json.dump(s, open(sys.argv[2], "w"))
+PY
+echo '{"format": "thzmap-sequence/1", "scene": "few.json", "fps": 1, "frames": 3}' > "$work/few-seq.json"
+"$THZMAP" batch "$work/few-seq.json" -o "$work/F" --threads 2 --quiet > /dev/null 2> "$work/F.err" ||
+    fail "few photons: exit $?"
+[ "$(grep -c 'fewer photons than a density estimate needs' "$work/F.err")" = 2 ] &&
+    grep -q '^thzmap batch: warning: frame 1/3: ' "$work/F.err" &&
+    grep -q '^thzmap batch: warning: the same in 2 later frames: ' "$work/F.err" ||
+    fail "a warning of every frame: not once with its frame, then counted: $(cat "$work/F.err")"
+
 # --- bad sequence files -------------------------------------------------------------
 bad() { # bad NAME EXPECTED-TEXT JSON
     printf '%s\n' "$3" > "$work/bad-$1.json"
