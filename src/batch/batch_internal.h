@@ -29,6 +29,7 @@ struct thz_sequence {
     size_t frames;      /* per sweep value */
     size_t n_sweeps;    /* sweep values (1 without a sweep) */
     int has_sweep;      /* frame directories under sweep-NN/ */
+    int sweep_digits;   /* NN's digits: 2, more where there are more than 100 values */
     size_t n_frames;    /* frames * n_sweeps */
     char **frame_json;  /* per frame: the scene text (compact, keys in document order) */
     char **frame_dir;   /* per frame: "frame-NNNNN" or "sweep-NN/frame-NNNNN" */

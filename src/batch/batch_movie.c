@@ -69,7 +69,7 @@ static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, s
         return thz_error_set(err, THZ_ERR_IO, "%s: a movie's name too long", si->name);
     char sub[32] = "";
     if (seq->has_sweep)
-        snprintf(sub, sizeof sub, "sweep-%02zu/", s);
+        snprintf(sub, sizeof sub, "sweep-%0*zu/", seq->sweep_digits, s);
     if (snprintf(path, sizeof path, "%s/%s%s", outdir, sub, name) >= (int)sizeof path)
         return thz_error_set(err, THZ_ERR_IO, "%s: path too long", outdir);
     double movie_fps = fmin(fmax(seq->fps, MOVIE_FPS_MIN), MOVIE_FPS_MAX);

@@ -129,7 +129,7 @@ static void batch_clean_finished(const batch_state *b)
     for (size_t s = 0; s < seq->n_sweeps; s++) {
         char parent[THZ_PATH_MAX], dir[THZ_PATH_MAX];
         if (seq->has_sweep)
-            snprintf(parent, sizeof parent, "%s/sweep-%02zu", b->outdir, s);
+            snprintf(parent, sizeof parent, "%s/sweep-%0*zu", b->outdir, b->seq->sweep_digits, s);
         else
             snprintf(parent, sizeof parent, "%s", b->outdir);
         if (!batch_has_leftovers(parent))
@@ -210,7 +210,7 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
     }
     for (size_t s = 0; s < seq->n_sweeps && seq->has_sweep; s++) {
         char dir[32];
-        snprintf(dir, sizeof dir, "sweep-%02zu", s);
+        snprintf(dir, sizeof dir, "sweep-%0*zu", seq->sweep_digits, s);
         json_t *e = json_object();
         json_object_set_new(e, "dir", json_string(dir));
         json_object_set_new(e, "values", json_string(seq->sweep_label[s]));

@@ -432,7 +432,7 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
     seq->frame_json[f] = json_dumps(doc, JSON_COMPACT);
     char dir[64];
     if (seq->has_sweep)
-        snprintf(dir, sizeof dir, "sweep-%02zu/frame-%05zu", s, i);
+        snprintf(dir, sizeof dir, "sweep-%0*zu/frame-%05zu", seq->sweep_digits, s, i);
     else
         snprintf(dir, sizeof dir, "frame-%05zu", i);
     seq->frame_dir[f] = thz_strdup(dir);
@@ -547,6 +547,9 @@ thz_status thz_sequence_load_within(const char *path, const char *root_dir, thz_
         st = seq_check_sweep(&b, seq, &seq->n_sweeps);
     if (st == THZ_OK) {
         seq->has_sweep = b.sweep != NULL;
+        seq->sweep_digits = 2; /* sweep-00 .. sweep-99; more digits past 100 values */
+        for (size_t v = 100; v < seq->n_sweeps; v *= 10)
+            seq->sweep_digits++;
         seq->n_frames = seq->frames * seq->n_sweeps;
         seq->frame_json = thz_calloc(seq->n_frames, sizeof *seq->frame_json);
         seq->frame_dir = thz_calloc(seq->n_frames, sizeof *seq->frame_dir);
