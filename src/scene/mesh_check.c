@@ -419,6 +419,8 @@ thz_status mesh_check(const char *data, size_t size, mesh_format format, const c
     if (size > MESH_MAX_FILE_BYTES)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: %zu bytes, more than the limit of %llu",
                              label, size, (unsigned long long)MESH_MAX_FILE_BYTES);
+    if (format == MESH_FORMAT_OTHER)
+        return THZ_OK; /* assimp's alone to read (mesh_check.h) */
     thz_status st = format == MESH_FORMAT_OBJ   ? obj_check(&c, data, size)
                     : format == MESH_FORMAT_PLY ? mc_check_ply(&c, data, size)
                                                 : stl_check(&c, data, size);

@@ -40,20 +40,30 @@
 #define MESH_MAX_PLY_HEADER_BYTES 65536u
 #define MESH_MAX_LIST_VALUES (8u * MESH_MAX_POLYGON_VERTICES) /* other PLY lists */
 
-typedef enum mesh_format { MESH_FORMAT_OBJ, MESH_FORMAT_PLY, MESH_FORMAT_STL } mesh_format;
+/* OBJ, PLY and STL are checked before assimp reads them; MESH_FORMAT_OTHER is any other
+ * format assimp reads (by the extension), which only assimp checks, in its child process
+ * with a time and a memory limit (mesh_import.c). */
+typedef enum mesh_format {
+    MESH_FORMAT_OBJ,
+    MESH_FORMAT_PLY,
+    MESH_FORMAT_STL,
+    MESH_FORMAT_OTHER
+} mesh_format;
 
 /* "Wavefront OBJ (.obj), PLY (.ply) or STL (.stl)": the supported list, for messages. */
 extern const char *const mesh_supported_formats;
 
 /* The format of the file `path` from its extension (case-insensitive); THZ_ERR_INPUT
- * naming `label` (NULL: path) and the supported list when it is none of them. */
+ * naming `label` (NULL: path) and the checked formats when it is none of them (the
+ * importer then asks assimp whether it reads the extension). */
 thz_status mesh_check_format(const char *path, const char *label, mesh_format *format,
                              thz_error *err);
 
-/* The extension assimp is told ("obj", "ply", "stl"). */
+/* The extension assimp is told ("obj", "ply", "stl"; "" for MESH_FORMAT_OTHER). */
 const char *mesh_format_extension(mesh_format format);
 
-/* Checks the file's bytes data[0..size) as `format` (see the top of this header).
+/* Checks the file's bytes data[0..size) as `format` (see the top of this header;
+ * MESH_FORMAT_OTHER: its size only).
  * `label` names the file in messages. *triangles (may be NULL) receives the number of
  * triangles the file holds after triangulation. */
 thz_status mesh_check(const char *data, size_t size, mesh_format format, const char *label,

@@ -5,6 +5,7 @@
 #define _GNU_SOURCE /* memfd_create */
 #include "scene/mesh_import.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdbool.h>
@@ -13,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -296,12 +298,25 @@ static thz_status mesh_import_read(const char *path, const char *name, size_t si
     return THZ_OK;
 }
 
+/* Sanitizer builds reserve terabytes of address space: no RLIMIT_AS there. */
+#if defined(__SANITIZE_ADDRESS__)
+#define MESH_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
+#define MESH_SANITIZED 1
+#endif
+#endif
+#ifndef MESH_SANITIZED
+#define MESH_SANITIZED 0
+#endif
+
 /* What the import child needs, and the file (a memfd) it writes the mesh into. */
 typedef struct mesh_job {
     const char *name;
     const char *data;
     size_t size;
     mesh_format format;
+    char extension[16]; /* what assimp is told the file is */
     int fd;
 } mesh_job;
 
@@ -311,8 +326,8 @@ static thz_status mesh_import_assimp(const mesh_job *job, thz_mesh *mesh, thz_er
     const char *name = job->name;
     thz_status st = THZ_OK;
     memset(mesh, 0, sizeof *mesh);
-    char fake_name[16];
-    snprintf(fake_name, sizeof fake_name, "mesh.%s", mesh_format_extension(job->format));
+    char fake_name[32];
+    snprintf(fake_name, sizeof fake_name, "mesh.%s", job->extension);
     mesh_source src = {fake_name, job->data, job->size};
     struct aiFileIO io = {mesh_io_open, mesh_io_close, (aiUserData)&src};
     /* assimp reports an allocation failure (a std::bad_alloc it catches) as a reading
@@ -342,6 +357,11 @@ static thz_status mesh_import_assimp(const mesh_job *job, thz_mesh *mesh, thz_er
     }
     if (nv > UINT32_MAX) {
         st = thz_error_set(err, THZ_ERR_INPUT, "%s: more than %u vertices", name, UINT32_MAX);
+        goto cleanup;
+    }
+    if (nt > MESH_MAX_TRIANGLES) { /* the checked formats are refused before this */
+        st = thz_error_set(err, THZ_ERR_INPUT, "%s: %zu triangles, more than the limit of %u",
+                           name, nt, MESH_MAX_TRIANGLES);
         goto cleanup;
     }
     st = primitive_mesh_alloc(mesh, nv, nt, err);
@@ -391,6 +411,16 @@ static bool mesh_write_all(int fd, const void *p, size_t n)
 static thz_status mesh_import_child(void *arg, thz_error *err)
 {
     const mesh_job *job = arg;
+#if !MESH_SANITIZED
+    /* a format only assimp checks: a header that asks for more memory than the machine
+     * has fails here, in the child, not in the machine's other processes */
+    uint64_t have = thz_physical_memory_bytes();
+    if (job->format == MESH_FORMAT_OTHER && have > 0) {
+        rlim_t limit = (rlim_t)(have / 2);
+        struct rlimit rl = {limit, limit};
+        setrlimit(RLIMIT_AS, &rl);
+    }
+#endif
     thz_mesh mesh;
     thz_status st = mesh_import_assimp(job, &mesh, err);
     if (st != THZ_OK)
@@ -447,14 +477,43 @@ static thz_status mesh_import_receive(int fd, const char *name, thz_mesh *mesh, 
     return THZ_OK;
 }
 
+/* The file's format: one thzmap checks (OBJ, PLY, STL), else any other assimp reads by
+ * the file name's extension; THZ_ERR_INPUT when assimp reads none such. */
+static thz_status mesh_import_format(const char *path, const char *name, mesh_job *job,
+                                     thz_error *err)
+{
+    thz_error checked = {0};
+    if (mesh_check_format(path, name, &job->format, &checked) == THZ_OK) {
+        snprintf(job->extension, sizeof job->extension, "%s",
+                 mesh_format_extension(job->format));
+        return THZ_OK;
+    }
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(slash ? slash + 1 : path, '.');
+    size_t len = dot ? strlen(dot + 1) : 0;
+    bool plain = len > 0 && len < sizeof job->extension;
+    for (size_t i = 0; plain && i < len; i++)
+        plain = isalnum((unsigned char)dot[1 + i]) != 0;
+    if (plain && aiIsExtensionSupported(dot) == AI_TRUE) {
+        job->format = MESH_FORMAT_OTHER;
+        snprintf(job->extension, sizeof job->extension, "%s", dot + 1);
+        return THZ_OK;
+    }
+    return thz_error_set(err, THZ_ERR_INPUT,
+                         "%s: unsupported mesh format '%s': thzmap reads %s, and the other "
+                         "formats assimp reads, by the file name's extension",
+                         name, dot ? dot : "(no extension)", mesh_supported_formats);
+}
+
 thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_error *err)
 {
     const char *name = label ? label : path;
     memset(mesh, 0, sizeof *mesh);
-    mesh_format format;
+    mesh_job job = {.name = name};
     uint64_t size;
     char *data = NULL;
-    thz_status st = mesh_check_format(path, name, &format, err);
+    thz_status st = mesh_import_format(path, name, &job, err);
+    mesh_format format = job.format;
     if (st == THZ_OK)
         st = file_check_regular(path, name, MESH_MAX_FILE_BYTES, &size, err);
     if (st == THZ_OK)
@@ -474,7 +533,9 @@ thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_
         return thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO),
                              "%s: cannot import the mesh: memfd_create: %s", name, strerror(errno));
     }
-    mesh_job job = {.name = name, .data = data, .size = (size_t)size, .format = format, .fd = fd};
+    job.data = data;
+    job.size = (size_t)size;
+    job.fd = fd;
     char what[256];
     snprintf(what, sizeof what, "importing the mesh %s", name);
     st = child_run(what, mesh_import_child, &job, 60.0 + 1e-6 * (double)size, err);

@@ -173,8 +173,10 @@ CASES = [
     ("stl_ascii_garbage_after_solid.stl", ("solid x\n" + "f" * 100 + "\n").encode(),
      ":2: expected 'facet' or 'endsolid'"),
     # formats the check does not cover
-    ("unsupported.gltf", b'{"asset": {"version": "2.0"}}', "unsupported mesh format '.gltf'"),
-    ("unsupported.3ds", b"\x4d\x4d\x00\x00", "unsupported mesh format '.3ds'"),
+    ("unsupported.xyz9", b"v 0 0 0\n", "unsupported mesh format '.xyz9'"),
+    # formats only assimp reads: its own error, from its child process
+    ("no_scene.gltf", b'{"asset": {"version": "2.0"}}', "cannot read as a mesh: GLTF: No scene"),
+    ("corrupt.3ds", b"\x4d\x4d\x00\x00", "cannot read as a mesh: 3DS file is either empty"),
     ("no_extension", b"v 0 0 0\n", "unsupported mesh format '(no extension)'"),
 ]
 
