@@ -360,8 +360,8 @@ static thz_status mesh_import_assimp(const mesh_job *job, thz_mesh *mesh, thz_er
         goto cleanup;
     }
     if (nt > MESH_MAX_TRIANGLES) { /* the checked formats are refused before this */
-        st = thz_error_set(err, THZ_ERR_INPUT, "%s: %zu triangles, more than the limit of %u",
-                           name, nt, MESH_MAX_TRIANGLES);
+        st = thz_error_set(err, THZ_ERR_INPUT, "%s: %zu triangles, more than the limit of %u", name,
+                           nt, MESH_MAX_TRIANGLES);
         goto cleanup;
     }
     st = primitive_mesh_alloc(mesh, nv, nt, err);
@@ -484,8 +484,7 @@ static thz_status mesh_import_format(const char *path, const char *name, mesh_jo
 {
     thz_error checked = {0};
     if (mesh_check_format(path, name, &job->format, &checked) == THZ_OK) {
-        snprintf(job->extension, sizeof job->extension, "%s",
-                 mesh_format_extension(job->format));
+        snprintf(job->extension, sizeof job->extension, "%s", mesh_format_extension(job->format));
         return THZ_OK;
     }
     const char *slash = strrchr(path, '/');
