@@ -57,8 +57,7 @@ static thz_status api_fire_check_memory(const thz_scene *eff, const accel *acc, 
         if (only != SIZE_MAX && c != only)
             continue;
         uint64_t b = 0;
-        thz_status st =
-            photon_phase_estimate_bytes(eff, acc, c, run_photon_t0_k(eff, c), &b, err);
+        thz_status st = photon_phase_estimate_bytes(eff, acc, c, run_photon_t0_k(eff, c), &b, err);
         if (st != THZ_OK)
             return st;
         sum = sum > UINT64_MAX - b ? UINT64_MAX : sum + b;

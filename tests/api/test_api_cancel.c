@@ -100,8 +100,7 @@ int main(int argc, char **argv)
     }
     /* and so is a photon phase alone whose maps would not fit (it once allocated until
      * the kernel killed the process) */
-    thz_run_settings fire = {.photons_per_channel = (uint64_t)1 << 50,
-                             .integrator = "photon-map"};
+    thz_run_settings fire = {.photons_per_channel = (uint64_t)1 << 50, .integrator = "photon-map"};
     thz_photons *ph = (thz_photons *)&fire;
     st = thz_photons_fire(ctx, scene, &fire, &ph, &err);
     CHECK(st == THZ_ERR_LIMIT && strstr(err.message, "GiB of memory"),
