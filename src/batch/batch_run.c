@@ -300,6 +300,12 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
     thz_output *output = NULL;
     char *frame_json = NULL;
     thz_status st = rank == 0 ? batch_frame_load(seq, b->base, f, &fr, err) : THZ_OK;
+    /* the frame's scene warnings, as simulate prints its scene's (a caller may fold the
+     * repeats of later frames) */
+    for (size_t i = 0;
+         st == THZ_OK && fr.scene && ctx && ctx->warning && i < thz_scene_warning_count(fr.scene);
+         i++)
+        ctx->warning(ctx->warning_user, thz_scene_warning(fr.scene, i));
     if (st == THZ_OK && rank == 0) /* sharing within frames: the other ranks serve its scene */
         st = api_mpi_next_scene(ctx, f, err);
     if (st == THZ_OK)

@@ -369,6 +369,21 @@ echo '{"format": "thzmap-sequence/1", "scene": "few.json", "fps": 1, "frames": 3
     grep -q '^thzmap batch: warning: the same in 2 later frames: ' "$work/F.err" ||
     fail "a warning of every frame: not once with its frame, then counted: $(cat "$work/F.err")"
 
+# a frame's scene warnings are printed as simulate prints its scene's, folded alike
+"$PY" - "$work/scene.json" "$work/bg.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["atmosphere"] = {"model": "constant", "attenuation_per_m": 0.01, "background_temperature_k": 3}
+s["sensors"][0]["resolution"] = [4, 3]
+json.dump(s, open(sys.argv[2], "w"))
+PY
+echo '{"format": "thzmap-sequence/1", "scene": "bg.json", "fps": 1, "frames": 2}' > "$work/bg-seq.json"
+"$THZMAP" batch "$work/bg-seq.json" -o "$work/BG" --threads 2 --quiet > /dev/null 2> "$work/BG.err" ||
+    fail "scene warnings: exit $?"
+grep -q '^thzmap batch: warning: frame 1/2: atmosphere.background_temperature_k is given' "$work/BG.err" &&
+    grep -q '^thzmap batch: warning: the same in 1 later frame: atmosphere.background' "$work/BG.err" ||
+    fail "a frame's scene warning not printed once with its frame: $(cat "$work/BG.err")"
+
 # --- bad sequence files -------------------------------------------------------------
 bad() { # bad NAME EXPECTED-TEXT JSON
     printf '%s\n' "$3" > "$work/bad-$1.json"
