@@ -104,10 +104,11 @@ typedef struct thz_batch_result {
 
 /* Runs the sequence into outdir (created if missing) with ctx's threads and callbacks
  * (a frame's run reports through ctx's progress callback; returning non-zero there
- * cancels too; the batch replaces ctx's callback while it runs and restores it). When
- * the frames do not all have the same sensors and channels there are no movies:
- * ctx's warning callback says why. One batch at a time per outdir (THZ_ERR_IO naming the other
- * process). opt and result may be NULL. */
+ * cancels too; the batch replaces ctx's callback while it runs and restores it). Each
+ * frame's scene warnings and run warnings go to ctx's warning callback, frame by frame.
+ * When the frames do not all have the same sensors and channels there are no movies:
+ * ctx's warning callback says why. One batch at a time per outdir (THZ_ERR_IO naming the
+ * other process). opt and result may be NULL. */
 THZ_API thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *outdir,
                                  const thz_batch_options *opt, thz_batch_result *result,
                                  thz_error *err);
