@@ -75,8 +75,8 @@ static thz_status stage_make_dirs(const char *path, char **created, thz_error *e
         *p = '/';
     }
     struct stat st;
-    if (stat(copy, &st) != 0 || !S_ISDIR(st.st_mode))
-        status = thz_error_set(err, THZ_ERR_IO, "%s: not a directory", path);
+    if (stat(copy, &st) != 0 || !S_ISDIR(st.st_mode)) /* a file where OUTDIR's parent is */
+        status = thz_error_set(err, THZ_ERR_INPUT, "%s: not a directory", path);
 cleanup:
     free(copy);
     return status;
@@ -292,7 +292,11 @@ thz_status output_stage_create(const char *outdir, output_stage **out, thz_error
         goto cleanup;
     struct stat st;
     if (lstat(stage->target, &st) == 0 && !S_ISDIR(st.st_mode)) {
-        status = thz_error_set(err, THZ_ERR_IO, "%s: exists and is not a directory", outdir);
+        /* the user's choice of OUTDIR: bad usage (exit 2), not a failure of the machine */
+        status = thz_error_set(err, THZ_ERR_INPUT,
+                               "%s: exists and is not a directory (expected a directory for "
+                               "the results, or a name to create one)",
+                               outdir);
         goto cleanup;
     }
     char name[64], path[THZ_PATH_MAX];

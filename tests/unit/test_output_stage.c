@@ -387,7 +387,7 @@ static void test_commit_through_symlink(void **state)
     free(tmp);
 }
 
-/* OUTDIR under a regular file cannot be made: an I/O error naming the path. */
+/* OUTDIR under a regular file cannot be made: bad input (exit 2) naming the path. */
 static void test_bad_outdir(void **state)
 {
     (void)state;
@@ -397,9 +397,14 @@ static void test_bad_outdir(void **state)
     snprintf(outdir, sizeof outdir, "%s/file/out", tmp);
     output_stage *stage = (output_stage *)&stage;
     thz_error err = {0};
-    assert_int_equal(output_stage_create(outdir, &stage, &err), THZ_ERR_IO);
+    assert_int_equal(output_stage_create(outdir, &stage, &err), THZ_ERR_INPUT);
     assert_null(stage);
     assert_non_null(strstr(err.message, "/file"));
+    /* and OUTDIR itself a regular file */
+    snprintf(outdir, sizeof outdir, "%s/file", tmp);
+    assert_int_equal(output_stage_create(outdir, &stage, &err), THZ_ERR_INPUT);
+    assert_null(stage);
+    assert_non_null(strstr(err.message, "exists and is not a directory"));
     rm(tmp, "file");
     assert_int_equal(rmdir(tmp), 0);
     free(tmp);
