@@ -372,9 +372,9 @@ static inline void ident_tally_assert(const ident_tally *t, const char *what, do
 static inline void ident_check_furnace_channel(ident_tally *t, const ident_run *r, size_t c,
                                                thz_integrator integrator, double b)
 {
-    /* path, and final-gather with its deviation map, which is empty at T0; photon-map
-     * with a deviation map (t->exact set by the caller) */
-    bool exact = integrator == INTEGRATOR_PATH || integrator == INTEGRATOR_FINAL_GATHER || t->exact;
+    /* path, final-gather with its deviation map, which is empty at T0, and photon-map
+     * with a deviation map: t->exact, set by the caller */
+    bool exact = integrator == INTEGRATOR_PATH || t->exact;
     size_t loose_fail = 0;
     for (uint32_t row = 0; row < r->img.rows; row++)
         for (uint32_t col = 0; col < r->img.columns; col++) {

@@ -130,7 +130,7 @@ static void air_furnace_case(thz_integrator integrator)
         double b = ident_band_planck(ch, 300.0);
         assert_int_equal(r.rstats[c].escaped_samples, 0);
         assert_int_equal(r.rstats[c].back_face_samples, 0);
-        ident_tally t = {0};
+        ident_tally t = {.exact = exact};
         /* The photon terms are heavy-tailed here: a photon from the band's wings (alpha
          * small) arrives with e^{-alpha d} ~ 1, one from the line's core with ~0, so a
          * pixel whose disk happens to miss the rare large terms under-estimates its own
@@ -195,7 +195,7 @@ static void sky_case(thz_integrator integrator, bool extent)
         const thz_channel *ch = &r.scene->channels[c];
         double b = ident_band_planck(ch, 300.0);
         assert_true(r.rstats[c].escaped_samples > 20);
-        ident_tally t = {0};
+        ident_tally t = {.exact = exact};
         t.pooled_rel_se = ident_pooled_rel_se_of(&r, c, b);
         size_t sky = 0;
         for (uint32_t row = 0; row < r.img.rows; row++)
