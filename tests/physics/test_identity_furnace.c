@@ -85,7 +85,8 @@ static void furnace_case(thz_integrator integrator, double t0_k)
         double tb = r.img.brightness_temperature[i];
         assert_true(fabs(planck_radiance(ch->center_hz, tb) - l) <= 1e-5 * l);
         /* physics.md identity 1: Tb_c = T up to the band-width term of inverting at nu_c
-         * (~0.04 K at 1 %, growing as the width squared): checked where L is exact */
+         * (about 0.005 K at 1 %, growing as the width squared; the bound below is loose):
+         * checked where L is exact */
         double tb_band = planck_brightness_temperature(ch->center_hz, b);
         double w = ch->relative_width / 0.01;
         print_message("furnace, channel %zu: Tb of the band mean %.4f K (width term %+.4f K)\n", c,
