@@ -195,6 +195,13 @@ static serve_job *serve_parse_job(serve_request *r, json_t *body, enum MHD_Resul
         if (!serve_parse_option(r, j, key, v, ret))
             goto fail;
     }
+    if (j->command == CMD_SIMULATE && j->save_photon_map && j->integrator[0] &&
+        !thz_integrator_needs_photons(j->integrator)) { /* as the CLI refuses it */
+        *ret = serve_reply_bad_json(r, "$.options.save_photon_map",
+                                    "the path integrator fires no photons: no photon map to "
+                                    "save (give integrator final-gather or photon-map)");
+        goto fail;
+    }
     if (j->command == CMD_BANDS && j->count == 0) {
         *ret = serve_reply_bad_json(r, "$.options.count", "bands needs a count");
         goto fail;

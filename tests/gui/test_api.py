@@ -220,6 +220,11 @@ def test_limits(srv):
     check(err and err.get("path") == "$" and "line 1" in err["error"], "malformed: %r" % err)
     err = srv.json("POST", "/api/validate", body={"text": 3}, status=400)
     check(err and err.get("path") == "$.text", "text not a string: %r" % err)
+    err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/scene.json",
+                                               "out": "o", "options": {"integrator": "path",
+                                                                       "save_photon_map": True}},
+                   status=400)
+    check(err and err.get("path") == "$.options.save_photon_map", "path with a map: %r" % err)
     err = srv.json("POST", "/api/runs", body={"command": 3}, status=400)
     check(err and err.get("path") == "$.command", "bad command: %r" % err)
     err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/scene.json",
