@@ -210,7 +210,7 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
     if (st == THZ_OK)
         st = plot_lines(path, K, x, 1, score_name, y, title, "channels K",
                         "Jeffries-Matusita distance (0..2)", err);
-    int used = snprintf(title, sizeof title, "%s: mean T#db#u per class; chosen:", rep->scene_name);
+    int used = snprintf(title, sizeof title, "%s: mean Tb per class; chosen:", rep->scene_name);
     const size_t *set = r->sets + (K - 1) * K;
     for (size_t i = 0; i < K && used > 0 && (size_t)used < sizeof title; i++)
         used += nw > 1 ? snprintf(title + used, sizeof title - (size_t)used, " %.4g (%.3g)",

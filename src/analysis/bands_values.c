@@ -138,6 +138,10 @@ static uint32_t coarse_paths(uint32_t paths)
     return paths >= 4 ? paths / 4 : 1;
 }
 
+/* variant_text's *changed when the air's temperature is among the values changed (the
+ * objects' count 1 each, the other values 1) */
+#define VARIANT_AIR_CHANGED (1 << 30)
+
 static char *variant_text(const json_t *root, const bands_setup *s, const bool *is_class, int what,
                           bool coarse, int *changed)
 {
@@ -175,7 +179,7 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
             if (is_class[i] == (what == VAR_TARGETS))
                 *changed += add_number(json_array_get(objects, i), "temperature_k", dt, 1.0);
         if (what == VAR_AMBIENT && atm)
-            *changed += 2 * add_number(atm, "temperature_k", dt, 1.0);
+            *changed |= add_number(atm, "temperature_k", dt, 1.0) ? VARIANT_AIR_CHANGED : 0;
     } else if (what == VAR_HUMIDITY && atm) {
         /* downwards, which every humidity key accepts */
         for (size_t i = 0; i < 3; i++)
@@ -558,7 +562,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
         }
         v->humidity_varied = v->humidity_varied || what == VAR_HUMIDITY;
         v->air_temperature_varied =
-            v->air_temperature_varied || (what == VAR_AMBIENT && changed >= 2);
+            v->air_temperature_varied || (what == VAR_AMBIENT && (changed & VARIANT_AIR_CHANGED));
         v->thickness_varied = v->thickness_varied || what == VAR_THICKNESS;
         v->angle_varied = v->angle_varied || what == VAR_ANGLE;
         st = variant_means(ctx, text, s, base_dir, class_of, n_obj, nominal.pixels, cls, count, v,

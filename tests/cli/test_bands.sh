@@ -64,6 +64,10 @@ PYEOF
 $PY -c "import json,sys; d=json.load(open('$TMP/t/bands.json')); \
 names=[c['name'] for c in d['classes']]; assert names==['A','B','background'], names" \
     || fail "--targets classes"
+# the scene has no air: its temperature is not among the nuisances (two background
+# objects varied together once made it look so)
+$PY -c "import json; n=json.load(open('$TMP/t/bands.json'))['nuisances']; \
+assert not n['air_temperature_varied'], n" || fail "air temperature 'varied' in a scene without air"
 
 # a feature across the 556.9 GHz water line: dry air lets the choice sit on the line,
 # humid air moves it off (within the feature, 0.52-0.60 THz)
