@@ -1,8 +1,10 @@
 /* thzmap classify: material recognition on a run's brightness-temperature cubes
  * against its object_id truth (thzmap/analysis.h); writes classification.json, the
  * class map as ENVI and PNG, and prints the accuracies. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
@@ -79,8 +81,12 @@ int cmd_classify(int argc, char **argv)
                                        v);
             opt.method = v;
         } else if (strcmp(a, "--train-fraction") == 0) {
-            if (!cli_parse_double(CMD, a, v, 1e-9, 1.0 - 1e-9, &opt.train_fraction))
-                return CLI_EXIT_USAGE;
+            char *end = NULL;
+            errno = 0;
+            opt.train_fraction = strtod(v, &end);
+            if (end == v || *end || errno ||
+                !(opt.train_fraction > 0.0 && opt.train_fraction < 1.0))
+                return cli_usage_error(CMD, "%s expects a fraction 0 < F < 1, got '%s'", a, v);
         } else if (strcmp(a, "--seed") == 0) {
             if (!cli_parse_u64(CMD, a, v, 0, INT64_MAX, &opt.seed))
                 return CLI_EXIT_USAGE;

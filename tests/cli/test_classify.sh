@@ -30,6 +30,10 @@ for m in sam mahalanobis lda matched-filter ace; do
     done
 done
 
+# --train-fraction 1 is refused, saying the range as it is (0 < F < 1)
+"$THZ" classify "$TMP/run" --sensor cam -o "$TMP/c-one" --train-fraction 1 2> "$TMP/one.err"
+[ $? -eq 2 ] && grep -q "expects a fraction 0 < F < 1, got '1'" "$TMP/one.err" ||
+    fail "--train-fraction 1: $(cat "$TMP/one.err")"
 # every pixel training (--train-fraction near 1): said, and no 'nan' printed
 "$THZ" classify "$TMP/run" --sensor cam -o "$TMP/c-all" --method lda --train-fraction 0.999 \
     2> "$TMP/all.err" || fail "classify --train-fraction 0.999 exit status $?"
