@@ -20,7 +20,7 @@ echo "photons; about 25 s on 2 cores)"
 
 echo
 echo "rendering it again with the converged backward integrator (path, the default, to a"
-echo "95th percentile of the pixels' standard error of 0.1 K; about half a minute)"
+echo "95th percentile of the pixels' standard error of 0.1 K; a few seconds)"
 "$thzmap" render "$scene" --integrator path -o "$outdir/path"
 
 echo
