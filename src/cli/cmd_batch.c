@@ -30,7 +30,7 @@ static void batch_usage(FILE *f)
                "options:\n"
                "  -o, --output OUTDIR   where the results go (required)\n"
                "  --threads T           threads to use (default: all cores)\n"
-               "  --quiet               no progress output (warnings are still printed)\n");
+               "  -q, --quiet           no progress output (warnings are still printed)\n");
 }
 
 /* Distinct warnings remembered (more are printed each time). */
