@@ -55,8 +55,50 @@ _PATH = re.compile(r"^([A-Za-z_][\w-]*(?:\.[^:]*?|\[\d+\])*): (.*)$", re.S)
 _POSITION = re.compile(r"^(\d+)(?::(\d+))?: (.*)$", re.S)
 
 
-def scene_error(message, label):
-    """SceneError from the library's message about a scene labelled `label`."""
+_SEGMENT = re.compile(r"\.([^.\[]*)|\[(\d+)\]")
+_KEY = re.compile(r"^[A-Za-z_][\w-]*$")
+
+
+def _path_in(doc, path):
+    """Whether `path` (a loader's JSON path, "a.b[2].c") names a value of doc, or a key
+    its last object lacks (a "missing key" error). Keys with '.', '[' or ': ' in them
+    (materials may be named so) are matched against doc's own keys."""
+    node, rest = doc, "." + path
+    while rest:
+        if rest.startswith("[") and isinstance(node, list):
+            m = re.match(r"\[(\d+)\]", rest)
+            if not m or int(m.group(1)) >= len(node):
+                return False
+            node, rest = node[int(m.group(1))], rest[m.end():]
+            continue
+        if not rest.startswith(".") or not isinstance(node, dict):
+            return False
+        rest = rest[1:]
+        # the longest of node's keys that the path continues with
+        keys = [k for k in node if rest == k or rest.startswith(k + ".") or
+                rest.startswith(k + "[")]
+        if keys:
+            k = max(keys, key=len)
+            node, rest = node[k], rest[len(k):]
+            continue
+        return bool(_KEY.match(rest))  # the last key, missing from the document
+    return True
+
+
+def _split_with(doc, rest):
+    """(path, reason) where the text before one of rest's ": " is a path of doc (the
+    longest such), or None."""
+    best = None
+    for m in re.finditer(r": ", rest):
+        if _path_in(doc, rest[:m.start()]):
+            best = (rest[:m.start()], rest[m.end():])
+    return best
+
+
+def scene_error(message, label, doc=None):
+    """SceneError from the library's message about a scene labelled `label`; `doc`, the
+    scene's JSON as a dict where known, tells the JSON path from the reason when a key
+    holds ": " itself."""
     file = None
     rest = message
     if label is not None and message.startswith(label + ":"):
@@ -73,8 +115,11 @@ def scene_error(message, label):
         reason = m.group(3)
     else:
         rest = rest[1:] if rest.startswith(" ") else rest
+        split = _split_with(doc, rest) if isinstance(doc, dict) else None
         m = _PATH.match(rest)
-        if m:
+        if split:
+            path, reason = split
+        elif m:
             path, reason = m.group(1), m.group(2)
         else:
             reason = rest

@@ -112,7 +112,19 @@ def _file_stamp(path):
     return (os.path.abspath(path), st.st_mtime_ns, st.st_size)
 
 
-def _load(loader, label, path=None):
+def _document(path=None, text=None):
+    """The scene's JSON as a dict (to split a SceneError's path from its reason), or None."""
+    try:
+        if text is None:
+            with open(path, encoding="utf-8") as f:
+                text = f.read(1 << 26)
+        doc = json.loads(text)
+    except (OSError, ValueError, TypeError, RecursionError):
+        return None
+    return doc if isinstance(doc, dict) else None
+
+
+def _load(loader, label, path=None, text=None):
     stamp = _file_stamp(path) if path is not None else None
     handle = ctypes.c_void_p()
     err = _lib.ThzError()
@@ -122,7 +134,8 @@ def _load(loader, label, path=None):
     if status != _lib.OK:
         message = _lib.text(err.message)
         if status == _lib.ERR_INPUT:
-            raise scene_error(message, label)
+            raise scene_error(message, label,
+                              _document(path, text) if path is not None or text else None)
         from .errors import from_status
         raise from_status(status, message)
     return Scene(handle.value, label, seconds, stamp)
@@ -210,10 +223,10 @@ def scene_from_json(text, base_dir=None, label="<string>", root=None):
     data = text.encode("utf-8")
     if root is None:
         return _load(lambda out, err: _lib.lib.thz_scene_load_string(
-            data, base, label.encode("utf-8"), out, err), label)
+            data, base, label.encode("utf-8"), out, err), label, text=text)
     r = _root_arg(root)
     return _load(lambda out, err: _lib.lib.thz_scene_load_string_within(
-        data, base, label.encode("utf-8"), r, out, err), label)
+        data, base, label.encode("utf-8"), r, out, err), label, text=text)
 
 
 def scene_from_dict(d, base_dir=None, label="<dict>", root=None):

@@ -1,6 +1,7 @@
 """Errors: a bad scene raises SceneError naming the file and the JSON path (or line and
 column); wrong arguments raise ArgumentError before the library is called; nothing here
 may crash the interpreter."""
+import json
 import math
 
 import numpy as np
@@ -39,6 +40,25 @@ def test_bad_values_name_their_path(tiny_dir, edit, path):
     assert e.value.path == path
     assert e.value.file == "mine"
     assert str(e.value).startswith("mine: " + path + ": ")
+
+
+@pytest.mark.parametrize("name", ["foam:v2", "a: b", "a.b"])
+def test_a_material_name_with_colons_or_dots_is_one_key_of_the_path(tiny_dir, name):
+    d = tiny_scene_dict()
+    d["materials"][name] = d["materials"].pop("wall")
+    for o in d["objects"]:
+        if o["material"] == "wall":
+            o["material"] = name
+    d["materials"][name]["reflectivity"] = 1.5
+    want = "materials." + name + ".reflectivity"
+    with pytest.raises(thzmap.SceneError) as e:  # from a dict
+        thzmap.scene_from_dict(d, base_dir=tiny_dir)
+    assert e.value.path == want and e.value.reason.startswith("expected a number in [0, 1]")
+    path = tiny_dir / "colon.json"  # and from a file
+    path.write_text(json.dumps(d))
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.load_scene(path)
+    assert e.value.path == want and e.value.reason.startswith("expected a number"), e.value
 
 
 def test_relative_paths_need_the_base_dir(tmp_path):
