@@ -138,12 +138,10 @@ static uint32_t coarse_paths(uint32_t paths)
     return paths >= 4 ? paths / 4 : 1;
 }
 
-/* variant_text's *changed when the air's temperature is among the values changed (the
- * objects' count 1 each, the other values 1) */
-#define VARIANT_AIR_CHANGED (1 << 30)
-
+/* *air_changed (may be NULL): whether the air's temperature is among the values the
+ * variant changes (*changed counts them all) */
 static char *variant_text(const json_t *root, const bands_setup *s, const bool *is_class, int what,
-                          bool coarse, int *changed)
+                          bool coarse, int *changed, bool *air_changed)
 {
     json_t *doc = json_deep_copy(root);
     if (!doc)
@@ -171,6 +169,8 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
     if (coarse && sensor)
         json_object_set_new(sensor, "oversampling", json_integer(1));
     *changed = 0;
+    if (air_changed)
+        *air_changed = false;
     json_t *objects = json_object_get(doc, "objects");
     json_t *atm = json_object_get(doc, "atmosphere");
     if (what == VAR_TARGETS || what == VAR_AMBIENT) {
@@ -178,8 +178,12 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
         for (size_t i = 0; i < json_array_size(objects); i++)
             if (is_class[i] == (what == VAR_TARGETS))
                 *changed += add_number(json_array_get(objects, i), "temperature_k", dt, 1.0);
-        if (what == VAR_AMBIENT && atm)
-            *changed |= add_number(atm, "temperature_k", dt, 1.0) ? VARIANT_AIR_CHANGED : 0;
+        if (what == VAR_AMBIENT && atm) {
+            int air = add_number(atm, "temperature_k", dt, 1.0);
+            *changed += air;
+            if (air_changed)
+                *air_changed = air != 0;
+        }
     } else if (what == VAR_HUMIDITY && atm) {
         /* downwards, which every humidity key accepts */
         for (size_t i = 0; i < 3; i++)
@@ -474,7 +478,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     class_of = thz_calloc(n_obj ? n_obj : 1, sizeof *class_of);
     if (!is_class || !class_of)
         goto nomem;
-    text = variant_text(root, s, is_class, VAR_NOMINAL, false, &changed);
+    text = variant_text(root, s, is_class, VAR_NOMINAL, false, &changed, NULL);
     if (!text)
         goto nomem;
     st = thz_scene_load_string_within(text, base_dir, s->scene_path, s->root, &scene, err);
@@ -538,7 +542,8 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
         if (!(ranges[what] > 0.0))
             continue;
-        text = variant_text(root, s, is_class, what, true, &changed);
+        bool air = false;
+        text = variant_text(root, s, is_class, what, true, &changed, &air);
         if (!text)
             goto nomem;
         if (!changed) {
@@ -547,7 +552,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
             continue;
         }
         if (!coarse_mean) { /* the coarse nominal render the changes are taken against */
-            char *nominal_text = variant_text(root, s, is_class, VAR_NOMINAL, true, &changed);
+            char *nominal_text = variant_text(root, s, is_class, VAR_NOMINAL, true, &changed, NULL);
             coarse_mean = thz_calloc(nc * n, sizeof *coarse_mean);
             if (!nominal_text || !coarse_mean) {
                 free(nominal_text);
@@ -561,8 +566,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
             v->renders++;
         }
         v->humidity_varied = v->humidity_varied || what == VAR_HUMIDITY;
-        v->air_temperature_varied =
-            v->air_temperature_varied || (what == VAR_AMBIENT && (changed & VARIANT_AIR_CHANGED));
+        v->air_temperature_varied = v->air_temperature_varied || (what == VAR_AMBIENT && air);
         v->thickness_varied = v->thickness_varied || what == VAR_THICKNESS;
         v->angle_varied = v->angle_varied || what == VAR_ANGLE;
         st = variant_means(ctx, text, s, base_dir, class_of, n_obj, nominal.pixels, cls, count, v,

@@ -47,26 +47,14 @@ void thz_photons_destroy(thz_photons *ph)
 }
 
 /* Refuses, before any photon is fired, maps that would not fit in memory: the channels
- * fired are all kept, and the largest is built with its scratch (as run_check_run_memory
- * counts a simulate that keeps its maps). */
+ * fired are all kept (as a simulate that keeps its maps). */
 static thz_status api_fire_check_memory(const thz_scene *eff, const accel *acc, size_t only,
                                         thz_error *err)
 {
-    uint64_t sum = 0, max = 0;
-    for (size_t c = 0; c < eff->n_channels; c++) {
-        if (only != SIZE_MAX && c != only)
-            continue;
-        uint64_t b = 0;
-        thz_status st = photon_phase_estimate_bytes(eff, acc, c, run_photon_t0_k(eff, c), &b, err);
-        if (st != THZ_OK)
-            return st;
-        sum = sum > UINT64_MAX - b ? UINT64_MAX : sum + b;
-        max = b > max ? b : max;
-    }
-    uint64_t scratch =
-        photon_map_scratch_records(max / sizeof(photon_record)) * (uint64_t)sizeof(photon_record);
-    run_memory need = {.photon_bytes = sum > UINT64_MAX - scratch ? UINT64_MAX : sum + scratch,
-                       .available_bytes = thz_physical_memory_bytes()};
+    run_memory need = {.available_bytes = thz_physical_memory_bytes()};
+    thz_status st = run_photon_map_bytes(eff, acc, only, true, &need.photon_bytes, err);
+    if (st != THZ_OK)
+        return st;
     need.total_bytes = need.photon_bytes;
     return run_check_memory(eff, &need, err);
 }

@@ -45,7 +45,7 @@ thz_status batch_frame_load(const thz_sequence *seq, const size_t *base, size_t 
     int photons = st == THZ_OK && deal_uses_photons(fr->scene);
     fr->reused = photons && base[f] != f;
     fr->keep = photons && f + 1 < seq->n_frames && base[f + 1] == f;
-    fr->fired = !fr->reused;
+    fr->fired = photons && !fr->reused; /* path fires none */
     return st;
 }
 

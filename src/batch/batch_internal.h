@@ -37,6 +37,9 @@ struct thz_sequence {
     char **sweep_label; /* per sweep value: "atmosphere.relative_humidity = 0.5, ..." */
 };
 
+/* "sweep-NN" (sweep_digits digits) of sweep value s into buf. */
+void batch_sweep_dir(const thz_sequence *seq, size_t s, char *buf, size_t size);
+
 /* The scene file of frame f (its index into scene_paths and scene_dirs). */
 size_t batch_frame_scene(const thz_sequence *seq, size_t f);
 

@@ -67,9 +67,11 @@ static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, s
     snprintf(quantity, sizeof quantity, "band-%02zu", c + 1);
     if (!output_file_name(name, sizeof name, si->name, quantity, ".mp4"))
         return thz_error_set(err, THZ_ERR_IO, "%s: a movie's name too long", si->name);
-    char sub[32] = "";
-    if (seq->has_sweep)
-        snprintf(sub, sizeof sub, "sweep-%0*zu/", seq->sweep_digits, s);
+    char sub[40] = "";
+    if (seq->has_sweep) {
+        batch_sweep_dir(seq, s, sub, sizeof sub - 1);
+        strcat(sub, "/");
+    }
     if (snprintf(path, sizeof path, "%s/%s%s", outdir, sub, name) >= (int)sizeof path)
         return thz_error_set(err, THZ_ERR_IO, "%s: path too long", outdir);
     double movie_fps = fmin(fmax(seq->fps, MOVIE_FPS_MIN), MOVIE_FPS_MAX);

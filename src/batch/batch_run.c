@@ -130,9 +130,10 @@ static void batch_clean_finished(const batch_state *b)
 {
     const thz_sequence *seq = b->seq;
     for (size_t s = 0; s < seq->n_sweeps; s++) {
-        char parent[THZ_PATH_MAX], dir[THZ_PATH_MAX];
+        char parent[THZ_PATH_MAX], dir[THZ_PATH_MAX], sweep[32];
+        batch_sweep_dir(seq, s, sweep, sizeof sweep);
         if (seq->has_sweep)
-            snprintf(parent, sizeof parent, "%s/sweep-%0*zu", b->outdir, b->seq->sweep_digits, s);
+            snprintf(parent, sizeof parent, "%s/%s", b->outdir, sweep);
         else
             snprintf(parent, sizeof parent, "%s", b->outdir);
         if (!batch_has_leftovers(parent))
@@ -213,7 +214,7 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
     }
     for (size_t s = 0; s < seq->n_sweeps && seq->has_sweep; s++) {
         char dir[32];
-        snprintf(dir, sizeof dir, "sweep-%0*zu", seq->sweep_digits, s);
+        batch_sweep_dir(seq, s, dir, sizeof dir);
         json_t *e = json_object();
         json_object_set_new(e, "dir", json_string(dir));
         json_object_set_new(e, "values", json_string(seq->sweep_label[s]));
@@ -332,13 +333,9 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
         st = thz_output_commit(output, err);
     if (st == THZ_OK) {
         /* a frame whose integrator fires none (path) neither fired nor reused photons */
-        thz_run_totals totals;
-        thz_run_get_totals(fr.run, &totals);
-        if (!fr.reused && totals.photons_fired == 0)
-            fr.fired = 0;
-        b->reused_photons[f] = fr.reused                   ? BATCH_PHOTONS_REUSED
-                               : totals.photons_fired == 0 ? BATCH_PHOTONS_NONE
-                                                           : BATCH_PHOTONS_FIRED;
+        b->reused_photons[f] = fr.reused  ? BATCH_PHOTONS_REUSED
+                               : fr.fired ? BATCH_PHOTONS_FIRED
+                                          : BATCH_PHOTONS_NONE;
         b->fired += (size_t)fr.fired;
         b->rerendered += (size_t)fr.reused;
     }

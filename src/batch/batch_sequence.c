@@ -414,6 +414,11 @@ static int seq_apply_tracks(const seq_build *b, double time_s, json_t *doc)
     return 0;
 }
 
+void batch_sweep_dir(const thz_sequence *seq, size_t s, char *buf, size_t size)
+{
+    snprintf(buf, size, "sweep-%0*zu", seq->sweep_digits, s);
+}
+
 /* Builds frame f's scene text, dir, hash and sweep label; checks that it loads. */
 static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
 {
@@ -430,9 +435,10 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
     if (i == 0 && !seq->sweep_label[s])
         seq->sweep_label[s] = thz_strdup(label);
     seq->frame_json[f] = json_dumps(doc, JSON_COMPACT);
-    char dir[64];
+    char dir[64], sweep[32];
+    batch_sweep_dir(seq, s, sweep, sizeof sweep);
     if (seq->has_sweep)
-        snprintf(dir, sizeof dir, "sweep-%0*zu/frame-%05zu", seq->sweep_digits, s, i);
+        snprintf(dir, sizeof dir, "%s/frame-%05zu", sweep, i);
     else
         snprintf(dir, sizeof dir, "frame-%05zu", i);
     seq->frame_dir[f] = thz_strdup(dir);

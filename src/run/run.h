@@ -187,6 +187,12 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
  * anything): THZ_ERR_LIMIT naming the scene file and sensors[i].resolution. */
 thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err);
 
+/* Bytes the photon maps of channel `only` (SIZE_MAX: every channel) take while fired:
+ * all of them and the largest's build scratch when keep_all, else the largest (with the
+ * pool's spare quarter) and its scratch. */
+thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t only,
+                                bool keep_all, uint64_t *out, thz_error *err);
+
 /* Estimates the memory of the run in rs (its selected sensors' images, and, when
  * `photons`, the photon maps it fires, else the held_bytes of maps the run reads one at
  * a time), stores it in rs->memory_bytes and refuses the run as run_check_memory does. */

@@ -79,30 +79,41 @@ static uint64_t run_add_bytes(uint64_t a, uint64_t b)
     return a > UINT64_MAX - b ? UINT64_MAX : a + b;
 }
 
+thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t only,
+                                bool keep_all, uint64_t *out, thz_error *err)
+{
+    uint64_t sum = 0, max = 0;
+    for (size_t c = 0; c < scene->n_channels; c++) {
+        if (only != SIZE_MAX && c != only)
+            continue;
+        uint64_t b = 0;
+        thz_status st =
+            photon_phase_estimate_bytes(scene, acc, c, run_photon_t0_k(scene, c), &b, err);
+        if (st != THZ_OK)
+            return st;
+        sum = run_add_bytes(sum, b);
+        max = b > max ? b : max;
+    }
+    /* While a map is built: kept maps (the one being built among them) and the build's
+     * scratch (3/8 as large), else the map in the pool's spare array (up to a quarter
+     * larger: phase.c) and the scratch. */
+    uint64_t scratch =
+        photon_map_scratch_records(max / sizeof(photon_record)) * (uint64_t)sizeof(photon_record);
+    *out = keep_all ? run_add_bytes(sum, scratch)
+                    : run_add_bytes(run_add_bytes(max, max / 4), scratch);
+    return THZ_OK;
+}
+
 thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t held_bytes, thz_error *err)
 {
     run_memory need = {.image_bytes = run_image_bytes(rs),
                        .photon_bytes = held_bytes,
                        .available_bytes = thz_physical_memory_bytes()};
     if (photons) {
-        uint64_t sum = 0, max = 0;
-        for (size_t c = 0; c < rs->scene->n_channels; c++) {
-            uint64_t b = 0;
-            thz_status st = photon_phase_estimate_bytes(rs->scene, rs->accel, c,
-                                                        run_photon_t0_k(rs->scene, c), &b, err);
-            if (st != THZ_OK)
-                return st;
-            sum = run_add_bytes(sum, b);
-            max = b > max ? b : max;
-        }
-        /* While a map is built: kept maps (the one being built among them) and the
-         * build's scratch (3/8 as large), else the map in the pool's spare array (up to a
-         * quarter larger: phase.c) and the scratch. */
-        uint64_t scratch = photon_map_scratch_records(max / sizeof(photon_record)) *
-                           (uint64_t)sizeof(photon_record);
-        need.photon_bytes = rs->opt->keep_photon_maps
-                                ? run_add_bytes(sum, scratch)
-                                : run_add_bytes(run_add_bytes(max, max / 4), scratch);
+        thz_status st = run_photon_map_bytes(rs->scene, rs->accel, SIZE_MAX,
+                                             rs->opt->keep_photon_maps, &need.photon_bytes, err);
+        if (st != THZ_OK)
+            return st;
     }
     need.total_bytes = run_add_bytes(need.photon_bytes, need.image_bytes);
     rs->memory_bytes = need.total_bytes;

@@ -413,10 +413,20 @@ static thz_status mesh_import_child(void *arg, thz_error *err)
     const mesh_job *job = arg;
 #if !MESH_SANITIZED
     /* a format only assimp checks: a header that asks for more memory than the machine
-     * has fails here, in the child, not in the machine's other processes */
+     * has fails here, in the child, not in the machine's other processes. The limit is on
+     * top of the address space the child inherits (a Python or `thzmap serve` process may
+     * hold large results while it loads a scene). */
     uint64_t have = thz_physical_memory_bytes();
-    if (job->format == MESH_FORMAT_OTHER && have > 0) {
-        rlim_t limit = (rlim_t)(have / 2);
+    unsigned long long pages = 0;
+    FILE *statm = fopen("/proc/self/statm", "r");
+    if (statm) {
+        if (fscanf(statm, "%llu", &pages) != 1)
+            pages = 0;
+        fclose(statm);
+    }
+    long page = sysconf(_SC_PAGESIZE);
+    if (job->format == MESH_FORMAT_OTHER && have > 0 && statm && page > 0) {
+        rlim_t limit = (rlim_t)(pages * (unsigned long long)page + have / 2);
         struct rlimit rl = {limit, limit};
         setrlimit(RLIMIT_AS, &rl);
     }

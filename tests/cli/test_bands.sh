@@ -96,6 +96,8 @@ tb_dry = next(c for c in d["classes"] if c["name"] == "B")["mean_tb_k"]
 tb_humid = next(c for c in h["classes"] if c["name"] == "B")["mean_tb_k"]
 assert tb_dry[i_line] > max(tb_dry[i] for i in plateau) - 0.3, tb_dry
 assert tb_humid[i_line] < tb_humid[freqs.index(humid_f)] - 2.0, tb_humid
+# the air's temperature is given here: it is among the nuisances varied
+assert h["nuisances"]["air_temperature_varied"], h["nuisances"]
 PYEOF
 
 # the sensor's noise: a given netd_k per channel, interpolated to the candidates; a
