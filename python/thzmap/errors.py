@@ -55,7 +55,6 @@ _PATH = re.compile(r"^([A-Za-z_][\w-]*(?:\.[^:]*?|\[\d+\])*): (.*)$", re.S)
 _POSITION = re.compile(r"^(\d+)(?::(\d+))?: (.*)$", re.S)
 
 
-_SEGMENT = re.compile(r"\.([^.\[]*)|\[(\d+)\]")
 _KEY = re.compile(r"^[A-Za-z_][\w-]*$")
 
 
