@@ -15,7 +15,9 @@ _UNITS = {"photons": "photons", "render": "rows", "output": "steps"}
 
 
 class _Bar:
-    """A progress display: one tqdm bar per stage and channel."""
+    """A progress display: one tqdm bar per stage and channel, and a new one where a
+    report counts from the start again (the next pass of a run that adds passes), so that
+    no bar runs backwards."""
 
     def __init__(self):
         try:
@@ -31,7 +33,7 @@ class _Bar:
         key = (p.stage, p.channel)
         label = f"channel {p.channel + 1}/{p.n_channels} {p.stage}"
         if self._tqdm is not None:
-            if key != self._key:
+            if key != self._key or p.done < self._bar.n or p.total != self._bar.total:
                 self.close()
                 self._key = key
                 self._bar = self._tqdm(total=p.total, desc=label, unit=_UNITS.get(p.stage, ""),

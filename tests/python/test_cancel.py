@@ -106,3 +106,30 @@ def test_real_ctrl_c_from_outside(tiny_dir):
     assert lines[1] == "next ['cam']", out + err
     assert stopped_after < 10, stopped_after
     assert "Exception ignored" not in err and "Traceback" not in err, err
+
+
+def test_progress_bar_never_runs_backwards(monkeypatch):
+    """progress=True: a run that adds passes reports each pass's rows from 0 again; the
+    bar starts anew there instead of counting down."""
+    import types
+    from thzmap.progress import Progress, _Bar
+    bars = []
+
+    class FakeBar:
+        def __init__(self, total, **kw):
+            self.total, self.n, self.updates = total, 0, []
+            bars.append(self)
+
+        def update(self, k):
+            self.updates.append(k)
+            self.n += k
+
+        def close(self):
+            pass
+    monkeypatch.setitem(sys.modules, "tqdm", types.SimpleNamespace(tqdm=FakeBar))
+    bar = _Bar()
+    for done in (16, 64, 8, 64):  # pass 1 of 64 rows, then pass 2
+        bar(Progress("render", 0, 1, done, 64))
+    bar(Progress("render", 1, 1, 64, 64))
+    bar.close()
+    assert [b.updates for b in bars] == [[16, 48], [8, 56], [64]]
