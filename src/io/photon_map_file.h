@@ -59,9 +59,9 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
  * (n_channels entries, may be NULL; seconds is 0; reference_temperature_k the map's)
  * and info (may be NULL). `threads` is passed to photon_map_create. Refuses, with a
  * message naming the file: a file that is not a photon map or has a version other than
- * 1 to 3 (THZ_ERR_INPUT), a truncated or corrupted one (THZ_ERR_IO; corruption is found by the
- * zstd checksums), and one made from another scene geometry, material set or channel
- * set (THZ_ERR_INPUT). */
+ * 1 to 3, a truncated or corrupted one (corruption is found by the zstd checksums), and
+ * one made from another scene geometry, material set or channel
+ * set: all THZ_ERR_INPUT (a failed read of the device is THZ_ERR_IO). */
 thz_status photon_map_file_read(const char *path, const thz_scene *scene, int threads,
                                 photon_map **maps, photon_stats *stats, photon_map_file_info *info,
                                 thz_error *err);

@@ -28,9 +28,11 @@ typedef struct pmf_reader {
     bool frame_done; /* the current frame was completed (checksum verified) */
 } pmf_reader;
 
+/* A damaged file is bad input (exit status 2), as a damaged scene or mesh is; a failed read
+ * of the device is THZ_ERR_IO. */
 static thz_status pmf_corrupt(const pmf_reader *r, const char *why, thz_error *err)
 {
-    return thz_error_set(err, THZ_ERR_IO,
+    return thz_error_set(err, THZ_ERR_INPUT,
                          "photon map %s is corrupted (%s); run `thzmap simulate` again", r->path,
                          why);
 }
@@ -147,12 +149,12 @@ static thz_status pmf_check_counts(pmf_reader *r, const uint8_t *header, size_t 
     if (stated == ZSTD_CONTENTSIZE_ERROR)
         return pmf_corrupt(r, "bad records section", err);
     if (stated != ZSTD_CONTENTSIZE_UNKNOWN && stated != total)
-        return thz_error_set(err, THZ_ERR_IO,
+        return thz_error_set(err, THZ_ERR_INPUT,
                              "photon map %s is corrupted (its header counts %llu bytes of photons, "
                              "its records section holds %llu); run `thzmap simulate` again",
                              r->path, (unsigned long long)total, stated);
     if (total > SIZE_MAX || total / ZSTD_BLOCKSIZE_MAX > rest / 4 + 1)
-        return thz_error_set(err, THZ_ERR_IO,
+        return thz_error_set(err, THZ_ERR_INPUT,
                              "photon map %s is corrupted (its header counts %llu bytes of photons, "
                              "more than its %llu remaining bytes can hold); run `thzmap simulate` "
                              "again",
@@ -232,7 +234,7 @@ static thz_status pmf_open_prefix(photon_map_file_stream *s, long *actual, thz_e
         return thz_error_set(err, THZ_ERR_INPUT, "%s is not a thzmap photon map (.thzpm) file",
                              path);
     if (got < sizeof prefix)
-        return thz_error_set(err, THZ_ERR_IO,
+        return thz_error_set(err, THZ_ERR_INPUT,
                              "photon map %s is truncated (%ld bytes); run `thzmap simulate` again",
                              path, *actual);
     uint32_t version = (uint32_t)(get_u64(prefix + 8) & 0xffffffffu);
@@ -253,11 +255,11 @@ static thz_status pmf_open_prefix(photon_map_file_stream *s, long *actual, thz_e
     uint64_t stated = get_u64(prefix + 16);
     if ((uint64_t)*actual < stated)
         return thz_error_set(
-            err, THZ_ERR_IO,
+            err, THZ_ERR_INPUT,
             "photon map %s is truncated (%ld of %llu bytes); run `thzmap simulate` again", path,
             *actual, (unsigned long long)stated);
     if ((uint64_t)*actual > stated)
-        return thz_error_set(err, THZ_ERR_IO,
+        return thz_error_set(err, THZ_ERR_INPUT,
                              "photon map %s is corrupted (%ld bytes where its header says %llu); "
                              "run `thzmap simulate` again",
                              path, *actual, (unsigned long long)stated);

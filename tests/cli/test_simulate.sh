@@ -4,7 +4,7 @@
 #  - render from a saved photon map reproduces simulate's images byte for byte, and
 #    --sensor renders one sensor only;
 #  - SIGINT during a run exits 130, SIGTERM 143, and neither leaves result files in OUTDIR;
-#  - render refuses a photon map made from another scene;
+#  - render refuses a photon map made from another scene, and a damaged one (exit 2);
 #  - usage errors exit 2.
 # argv: path to the thzmap binary, repository directory.
 set -u
@@ -117,6 +117,20 @@ rc=$?
 [ $rc -eq 2 ] || fail "render with another scene's map exited $rc, expected 2"
 [ -s "$work/other.err" ] || fail "render with another scene's map said nothing"
 [ -z "$(ls -A "$work/o" 2>/dev/null)" ] || fail "refused render left files in OUTDIR"
+
+# --- a damaged map is bad input (exit 2, as a damaged scene or mesh), nothing written ----
+head -c 2000 "$work/t1/photon-map.thzpm" > "$work/cut.thzpm"
+cp "$work/t1/photon-map.thzpm" "$work/flip.thzpm"
+printf '\377' | dd of="$work/flip.thzpm" bs=1 seek=3000 conv=notrunc 2>/dev/null
+for m in cut flip; do
+    "$THZMAP" render "$work/scene.json" --photon-map "$work/$m.thzpm" -o "$work/d$m" \
+        --quiet 2> "$work/d$m.err"
+    rc=$?
+    [ $rc -eq 2 ] || fail "render from a damaged map ($m) exited $rc, expected 2"
+    grep -q "$m.thzpm is \(truncated\|corrupted\)" "$work/d$m.err" \
+        || fail "render from a damaged map ($m) said: $(cat "$work/d$m.err")"
+    [ ! -e "$work/d$m" ] || fail "render from a damaged map ($m) created OUTDIR"
+done
 
 # --- interruption ----------------------------------------------------------------------
 "$THZMAP" simulate "$work/scene.json" -o "$work/int" --photons 20000000 --threads 2 \

@@ -425,7 +425,7 @@ static void test_corrupted(void **state)
     for (size_t i = 0; i < sizeof where / sizeof where[0]; i++) {
         buf[where[i]] ^= 0x10;
         spit(bad, buf, n);
-        expect_refusal(bad, f->scene, THZ_ERR_IO, "corrupted");
+        expect_refusal(bad, f->scene, THZ_ERR_INPUT, "corrupted");
         buf[where[i]] ^= 0x10;
     }
     /* Unknown flags in the prefix (bytes 12-15; none is defined): refused, each bit. */
@@ -472,7 +472,7 @@ static void test_forged_count(void **state)
         for (int i = 0; i < 8; i++)
             count[i] = (unsigned char)(lies[k] >> (8 * i));
         spit_with_header(f, bad, header, hsize, 0);
-        expect_refusal(bad, f->scene, THZ_ERR_IO, "bytes of photons");
+        expect_refusal(bad, f->scene, THZ_ERR_INPUT, "bytes of photons");
     }
     free(buf);
     free(header);
@@ -488,7 +488,7 @@ static void test_truncated(void **state)
     const size_t lengths[] = {n - 1, n / 2, 100, 20, 0};
     for (size_t i = 0; i < sizeof lengths / sizeof lengths[0]; i++) {
         spit(bad, buf, lengths[i]);
-        expect_refusal(bad, f->scene, THZ_ERR_IO, "truncated");
+        expect_refusal(bad, f->scene, THZ_ERR_INPUT, "truncated");
     }
     free(buf);
     char missing[160];
