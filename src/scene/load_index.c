@@ -266,8 +266,10 @@ thz_status load_index_csv(load_ctx *ctx, const load_cursor *file, const csv_tabl
     thz_status st = load_csv_spectrum(ctx, file, t, "n", LOAD_INDEX_N, &n);
     if (st == THZ_OK)
         st = load_csv_spectrum(ctx, file, t, "k", LOAD_NONNEGATIVE, &k);
-    if (st == THZ_OK)
-        st = set_index(ctx, m, material_index_table(n.n, n.freq_hz, n.value, k.value));
+    if (st == THZ_OK) /* one row is a constant (no frequencies) */
+        st = set_index(ctx, m,
+                       n.freq_hz ? material_index_table(n.n, n.freq_hz, n.value, k.value)
+                                 : material_index_constant(n.value[0], k.value[0]));
     spectrum_fini(&n);
     spectrum_fini(&k);
     return st;

@@ -1,7 +1,7 @@
 /* The material library (data/materials/library.json) and the scene keys of a complex
  * index: every entry loads, has a source and evaluates to finite n, k with k > 0 and
  * n >= 1 (n > 0 for Drude metals) at 0.1-3 THz; `library`, `refractive_index`,
- * `permittivity_model` and CSV n, k columns in scenes, keys beside them overriding;
+ * `permittivity_model` and CSV n, k columns (one row: a constant) in scenes, keys beside them overriding;
  * refusals with their JSON paths (P.2040 outside its range names the range); the
  * absorption lines of explosives and drugs at their cited frequencies. */
 #include <math.h>
@@ -182,6 +182,11 @@ static void test_scene_keys(void **state)
     s = load_ok("1.0", "{\"file\": \"materials/nk.csv\"}");
     material_index_at(s->materials[0].index, 0.6e12, &n, &k);
     assert_true(fabs(n - 1.55) < 1e-12 && fabs(k - 0.02) < 1e-12);
+    scene_destroy(s);
+    /* one row: that n and k at every frequency (it crashed the loader) */
+    s = load_ok("1.0", "{\"file\": \"materials/nk1.csv\"}");
+    material_index_at(s->materials[0].index, 2e12, &n, &k);
+    assert_true(n == 2.5 && k == 0.04);
     scene_destroy(s);
     /* ITU-R P.2040 inside its range */
     s = load_ok("0.2", "{\"permittivity_model\": {\"model\": \"itu-p2040\", \"material\": "
