@@ -105,6 +105,15 @@ thz_status psf_kernel_init(psf_kernel *k, const thz_sensor *sn, const thz_channe
     } else {
         return thz_error_set(err, THZ_ERR_INTERNAL, "psf: sensor '%s' has no PSF", sn->name);
     }
+    if (radius_rad <= 0.5 * k->pitch_rad) { /* the support lies in the pixel: no blur */
+        k->weight = thz_malloc_array(1, sizeof *k->weight);
+        if (!k->weight)
+            return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for a PSF kernel");
+        k->half = 0;
+        k->subsamples = 1;
+        k->weight[0] = 1.0;
+        return THZ_OK;
+    }
     /* no wider than the image: beyond, the mirror border repeats the image anyway */
     double max_half = (double)(sn->columns > sn->rows ? sn->columns : sn->rows);
     k->half = (uint32_t)fmin(ceil(radius_rad / k->pitch_rad), max_half);

@@ -20,7 +20,9 @@
  * mean of P_c over its cell, sampled at n x n points (n chosen so that the sub-sample
  * spacing is at most an eighth of the PSF's FWHM, 1 <= n <= PSF_MAX_SUBSAMPLES): the
  * sharp image is taken as pixel-centre samples and each detector pixel integrates the
- * PSF over its cell. The kernel is normalised to sum exactly to 1.
+ * PSF over its cell. The kernel is normalised to sum exactly to 1. A PSF whose support
+ * lies within the central pixel (radius <= half the pitch: a large aperture or a tiny
+ * FWHM) is the one-pixel kernel 1 exactly: no blur.
  *
  * Border: the image is extended beyond each edge by mirror reflection about the edge
  * (pixel -1 is pixel 0, pixel -2 is pixel 1, ..., repeated for kernels wider than the

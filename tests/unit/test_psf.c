@@ -204,6 +204,30 @@ static void test_airy_narrow(void **state)
     free(in);
 }
 
+/* A PSF whose support lies within a pixel (a tiny FWHM, a huge aperture) is the one-pixel
+ * kernel 1: its sub-samples all fell outside the support, and the run failed with "empty
+ * kernel" (exit 1) on a scene validate accepted. */
+static void test_narrower_than_a_pixel(void **state)
+{
+    (void)state;
+    const thz_channel ch = {.name = "a", .center_hz = 3e12, .relative_width = 0.05};
+    const double pitch = 1e-2;
+    for (int form = 0; form < 2; form++) {
+        thz_sensor s = test_sensor(pitch, form ? 1e3 : 0.0); /* Airy: 25 lambda/D = pitch/4000 */
+        if (!form) {
+            s.psf = PSF_GAUSSIAN;
+            s.psf_fwhm_deg = 1e-3 * pitch * 180.0 / M_PI;
+        }
+        psf_kernel k;
+        thz_error err = {0};
+        if (psf_kernel_init(&k, &s, &ch, &err) != THZ_OK)
+            fail_msg("%s: %s", form ? "airy" : "gaussian", err.message);
+        assert_int_equal(k.half, 0);
+        assert_true(k.weight[0] == 1.0);
+        psf_kernel_fini(&k);
+    }
+}
+
 /* The Gaussian PSF through the direct path (few taps): power and uniformity. */
 static void test_gaussian_direct(void **state)
 {
@@ -235,6 +259,7 @@ int main(void)
         cmocka_unit_test(test_airy_profile_and_fwhm),
         cmocka_unit_test(test_airy_narrow),
         cmocka_unit_test(test_gaussian_direct),
+        cmocka_unit_test(test_narrower_than_a_pixel),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
