@@ -26,6 +26,8 @@
 /* Explicit emissivity may differ from Kirchhoff's value by this much before validate
  * warns (physics.md "Surfaces"). */
 #define LOAD_KIRCHHOFF_TOLERANCE 0.01
+/* Rounding slack for eps + R-bar <= 1 (load_materials.c's for eps + R). */
+#define LOAD_ENERGY_SLACK 1e-9
 
 /* ---- names ---------------------------------------------------------------------- */
 
@@ -102,6 +104,57 @@ static void load_channel_band(const thz_channel *ch, double *lo_hz, double *hi_h
     channel_support_hz(ch, 2.0 * CHANNEL_FWHM_PER_SIGMA, lo_hz, hi_hz);
     if (*lo_hz < 0.0) /* a wide band: no frequency below 0 (nor a rounding's -6e-17 THz) */
         *lo_hz = 0.0;
+}
+
+/* Whether obj's material gives an explicit emissivity beside an R that varies with angle
+ * (a complex index) at freq_hz; then *eps and *r_bar, R-bar = 2 int R(mu) mu dmu. */
+static bool load_index_energy(const thz_scene *s, const thz_object *obj, double freq_hz,
+                              double *eps, double *r_bar)
+{
+    optics_point o = scene_object_optics(s, obj, freq_hz);
+    if (!o.explicit_emissivity || !optics_reflectance_varies(&o))
+        return false;
+    *eps = optics_emissivity(&o, 1.0);
+    *r_bar = optics_mean_reflectance(&o);
+    return true;
+}
+
+/* Refuses an explicit emissivity beside a complex index (R varies with angle) where
+ * eps + R-bar > 1, R-bar of the half-space or the shell's slab: the surface would emit
+ * more than the isothermal radiation around it gives it to absorb. With a constant R,
+ * R-bar = R, the rule load_materials.c checks (physics.md "Surfaces"). Checked at each
+ * channel's centre and band ends and at the emissivity table's points. */
+static thz_status load_check_index_energy(load_ctx *ctx, const load_cursor *root)
+{
+    const thz_scene *s = ctx->scene;
+    for (size_t i = 0; i < s->n_objects; i++) {
+        const thz_object *obj = &s->objects[i];
+        const thz_material *m = &s->materials[obj->material];
+        if (m->emissivity.n == 0 || !m->index)
+            continue;
+        size_t n_table = m->emissivity.freq_hz ? m->emissivity.n : 0;
+        for (size_t j = 0; j < 3 * s->n_channels + n_table; j++) {
+            double f, band[3], eps, r_bar;
+            if (j < 3 * s->n_channels) {
+                band[0] = s->channels[j / 3].center_hz;
+                load_channel_band(&s->channels[j / 3], &band[1], &band[2]);
+                f = band[j % 3];
+            } else {
+                f = m->emissivity.freq_hz[j - 3 * s->n_channels];
+            }
+            if (f > 0.0 && load_index_energy(s, obj, f, &eps, &r_bar) &&
+                eps + r_bar > 1.0 + LOAD_ENERGY_SLACK) {
+                load_cursor mc = load_key(root, "materials"), c = load_key(&mc, m->name);
+                load_cursor e = load_key(&c, "emissivity");
+                return load_fail(ctx, e.value ? &e : &c,
+                                 "emissivity + the hemispherical mean reflectance of the "
+                                 "material's complex index must not exceed 1, got %g + %g = %g "
+                                 "at %.4g THz (object \"%s\")",
+                                 eps, r_bar, eps + r_bar, f * 1e-12, obj->name);
+            }
+        }
+    }
+    return THZ_OK;
 }
 
 /* Warns about channel bands (load_channel_band) that leave table `sp`. */
@@ -247,7 +300,9 @@ static thz_status load_document(load_ctx *ctx, json_t *doc)
         thz_error_prefix(ctx->err, "%s: atmosphere: ", ctx->label);
         return st;
     }
-    st = load_warnings(ctx, &root);
+    st = load_check_index_energy(ctx, &root);
+    if (st == THZ_OK)
+        st = load_warnings(ctx, &root);
     scene_check_inputs in = {.non_emitting_air = ctx->non_emitting_air,
                              .background_given = ctx->background_given};
     if (st == THZ_OK && !scene_checks_run(s, &in))
