@@ -77,6 +77,11 @@ static thz_status load_material_reflection(load_ctx *ctx, const load_cursor *c, 
     static const char *const models[] = {"ward", NULL};
     load_cursor r = load_key(c, "reflection");
     m->reflection = REFLECTION_DIFFUSE;
+    const char *forms = "expected \"diffuse\", \"specular\" or {\"model\": \"ward\", "
+                        "\"alpha_x\": ax, \"alpha_y\": ay}, got";
+    if (json_is_string(r.value) && strcmp(json_string_value(r.value), names[0]) != 0 &&
+        strcmp(json_string_value(r.value), names[1]) != 0)
+        return load_fail(ctx, &r, "%s \"%s\"", forms, json_string_value(r.value));
     if (!r.value || json_is_string(r.value)) {
         size_t which = 0;
         thz_status st = load_choice(ctx, c, "reflection", names, false, 0, &which);
@@ -84,10 +89,7 @@ static thz_status load_material_reflection(load_ctx *ctx, const load_cursor *c, 
         return st;
     }
     if (!json_is_object(r.value))
-        return load_fail(ctx, &r,
-                         "expected \"diffuse\", \"specular\" or {\"model\": \"ward\", "
-                         "\"alpha_x\": ax, \"alpha_y\": ay}, got %s",
-                         load_type_name(r.value));
+        return load_fail(ctx, &r, "%s %s", forms, load_type_name(r.value));
     thz_status st = load_expect_object(ctx, &r, ward_keys);
     size_t model = 0;
     const load_range slope = {0.0, 1.0, true, false};

@@ -94,6 +94,11 @@ CASES = [
     ("emissivity_plus_reflectivity_table",
      [(["materials", "paint", "emissivity"], [[0.1, 0.5], [1.0, 0.9]])],
      "materials.paint.emissivity: emissivity + reflectivity must not exceed 1"),
+    ("emissivity_plus_index_reflectance",
+     [(["format"], "thzmap-scene/1.1"),
+      (["materials", "wall"], {"refractive_index": [10, 0], "emissivity": 0.5})],
+     "materials.wall.emissivity: emissivity + the hemispherical mean reflectance of the "
+     "material's complex index must not exceed 1, got 0.5 + 0.640"),
     ("material_unknown_key", [(["materials", "wall", "reflectance"], 0.1)],
      "materials.wall.reflectance: unknown key"),
     ("material_missing_reflectivity", [(["materials", "wall"], {"color": [1, 1, 1]})],
@@ -282,6 +287,17 @@ CASES = [
      "sensors[0].noise.netd: unknown key"),
     ("sensor_noise_seed_negative", [(["sensors", 0, "noise_seed"], -1)],
      "sensors[0].noise_seed: expected a whole number"),
+    ("reflection_unknown", [(["materials", "wall", "reflection"], "glossy")],
+     'materials.wall.reflection: expected "diffuse", "specular" or {"model": "ward", '
+     '"alpha_x": ax, "alpha_y": ay}, got "glossy"'),
+    ("reflection_ward_alpha",
+     [(["materials", "wall", "reflection"], {"model": "ward", "alpha_x": 0, "alpha_y": 0.2})],
+     "materials.wall.reflection.alpha_x"),
+    ("reflection_ward_missing",
+     [(["materials", "wall", "reflection"], {"model": "ward", "alpha_x": 0.2})],
+     "materials.wall.reflection.alpha_y: missing key"),
+    ("reflection_number", [(["materials", "wall", "reflection"], 3)],
+     'materials.wall.reflection: expected "diffuse", "specular" or {"model": "ward"'),
 ]
 
 
