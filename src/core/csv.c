@@ -25,6 +25,20 @@ static char *csv_trim(char *s)
     return s;
 }
 
+/* A field trimmed, and without the double quotes around it that spreadsheets write
+ * ("frequency_thz"; a quote inside a field is not supported: fields hold names and
+ * numbers). */
+static char *csv_field(char *s)
+{
+    s = csv_trim(s);
+    size_t n = strlen(s);
+    if (n >= 2 && s[0] == '"' && s[n - 1] == '"' && !memchr(s + 1, '"', n - 2)) {
+        s[n - 1] = '\0';
+        s = csv_trim(s + 1);
+    }
+    return s;
+}
+
 /* Number of comma-separated fields in line. */
 static size_t csv_count_fields(const char *line)
 {
@@ -58,7 +72,7 @@ static thz_status csv_parse_header(csv_table *t, char *line, size_t line_no, thz
         char *comma = strchr(field, ',');
         if (comma)
             *comma = '\0';
-        char *name = csv_trim(field);
+        char *name = csv_field(field);
         if (!name[0])
             return thz_error_set(err, THZ_ERR_INPUT,
                                  "%s:%zu: header column %zu has no name (expected a header line "
@@ -97,7 +111,7 @@ static thz_status csv_parse_row(csv_table *t, char *line, size_t line_no, double
         char *comma = strchr(field, ',');
         if (comma)
             *comma = '\0';
-        char *text = csv_trim(field);
+        char *text = csv_field(field);
         char *end = NULL;
         errno = 0;
         double v = strtod(text, &end);
@@ -125,6 +139,8 @@ thz_status csv_parse(const char *text, const char *label, csv_table *t, thz_erro
     }
     size_t line_no = 0;
     char *line = copy;
+    if (strncmp(line, "\xef\xbb\xbf", 3) == 0) /* UTF-8's byte-order mark (spreadsheets) */
+        line += 3;
     while (line) {
         char *nl = strchr(line, '\n');
         if (nl)

@@ -106,12 +106,39 @@ static void test_parse_text(void **state)
     assert_int_equal(csv_parse("a\n1,\n", "mem", &t, &err), THZ_ERR_INPUT);
 }
 
+/* What spreadsheets write: a UTF-8 byte-order mark (before the header, or before a comment
+ * that precedes it) and fields in double quotes. The mark was part of the first name and
+ * the quotes of every name: "the header names no column 'frequency_thz'". */
+static void test_spreadsheet_csv(void **state)
+{
+    (void)state;
+    const char *texts[] = {"\xef\xbb\xbf" "frequency_thz,n\r\n0.2,2\r\n",
+                           "\xef\xbb\xbf# made by hand\nfrequency_thz,n\n0.2,2\n",
+                           "\"frequency_thz\",\"n\"\n\"0.2\", 2\n"};
+    for (size_t i = 0; i < 3; i++) {
+        csv_table t;
+        thz_error err = {0};
+        if (csv_parse(texts[i], "mem", &t, &err) != THZ_OK)
+            fail_msg("text %zu: %s", i, err.message);
+        assert_int_equal(csv_column(&t, "frequency_thz"), 0);
+        assert_int_equal(csv_column(&t, "n"), 1);
+        assert_true(t.n_rows == 1 && csv_value(&t, 0, 0) == 0.2 && csv_value(&t, 0, 1) == 2.0);
+        csv_fini(&t);
+    }
+    csv_table t;
+    thz_error err = {0};
+    assert_int_equal(csv_parse("\"a\"b\",n\n1,2\n", "mem", &t, &err), THZ_OK); /* kept whole */
+    assert_int_equal(csv_column(&t, "\"a\"b\""), 0);
+    csv_fini(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_good_file),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_parse_text),
+        cmocka_unit_test(test_spreadsheet_csv),
         cmocka_unit_test(test_fifo_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
