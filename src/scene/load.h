@@ -74,6 +74,9 @@ typedef struct load_range {
 #define LOAD_ANY ((load_range){-INFINITY, INFINITY, false, false})
 #define LOAD_NONNEGATIVE ((load_range){0.0, INFINITY, false, false})
 #define LOAD_POSITIVE ((load_range){0.0, INFINITY, true, false})
+/* A sensor's aperture area, m^2: up to a square kilometre, far beyond any sensor and far
+ * from the 32-bit power cube's overflow (aperture_diameter_m: the circle of that area). */
+#define LOAD_APERTURE_M2 ((load_range){0.0, 1e6, true, false})
 #define LOAD_UNIT ((load_range){0.0, 1.0, false, false})
 
 /* The root cursor of a document. */

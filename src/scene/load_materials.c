@@ -58,10 +58,12 @@ static thz_status load_check_energy(load_ctx *ctx, const load_cursor *c, const t
             double r = spectrum_eval(&m->reflectivity, f), e = spectrum_eval(&m->emissivity, f);
             if (e + r > 1.0 + LOAD_SUM_SLACK) {
                 load_cursor k = load_key(c, "emissivity");
+                char at[64] = ""; /* two constants: no frequency to name */
+                if (sp[which]->freq_hz)
+                    snprintf(at, sizeof at, " at %.4g THz", f * 1e-12);
                 return load_fail(ctx, &k,
-                                 "emissivity + reflectivity must not exceed 1, got %g + %g = %g "
-                                 "at %.4g THz",
-                                 e, r, e + r, f * 1e-12);
+                                 "emissivity + reflectivity must not exceed 1, got %g + %g = %g%s",
+                                 e, r, e + r, at);
             }
         }
     }

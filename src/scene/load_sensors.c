@@ -139,7 +139,7 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
     if (st == THZ_OK)
         st = load_resolution(ctx, c, &sn->columns, &sn->rows);
     if (st == THZ_OK)
-        st = load_number(ctx, c, "aperture_m2", LOAD_POSITIVE, false, 1e-2, &sn->aperture_m2);
+        st = load_number(ctx, c, "aperture_m2", LOAD_APERTURE_M2, false, 1e-2, &sn->aperture_m2);
     if (st == THZ_OK)
         st = load_integer(ctx, c, "oversampling", 1, LOAD_MAX_OVERSAMPLING, false, 1, &over);
     if (st == THZ_OK)

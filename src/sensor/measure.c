@@ -1,6 +1,8 @@
 /* Measured images: PSF, then noise, then the brightness temperature (measure.h). */
 #include "sensor/measure.h"
 
+#include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -75,6 +77,15 @@ static void measure_tb(const thz_channel *ch, const float *radiance, float *tb_k
                       : 0.0f;
 }
 
+/* Whether every measured radiance and brightness temperature is finite. */
+static bool measure_finite(const float *l, const float *tb, size_t pixels)
+{
+    bool ok = true;
+    for (size_t p = 0; p < pixels; p++)
+        ok &= isfinite(l[p]) && isfinite(tb[p]);
+    return ok;
+}
+
 thz_status sensor_measure(const thz_scene *scene, size_t sensor, uint64_t run_seed,
                           sensor_images *img, int threads, thz_error *err)
 {
@@ -113,6 +124,12 @@ thz_status sensor_measure(const thz_scene *scene, size_t sensor, uint64_t run_se
         }
         if (st == THZ_OK)
             measure_tb(ch, l, tb, pixels);
+        if (st == THZ_OK && !measure_finite(l, tb, pixels))
+            st = thz_error_set(err, THZ_ERR_INPUT,
+                               "sensor '%s', channel %zu: the noise takes the measured image "
+                               "beyond the range of its 32-bit values (an absurd netd_k, "
+                               "receiver_temperature_k or integration_time_s?)",
+                               sn->name, c + 1);
     }
     return st;
 }

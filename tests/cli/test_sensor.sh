@@ -170,6 +170,14 @@ rc=$?
 [ $rc -eq 2 ] || fail "a netd_k list of the wrong length: exit $rc, expected 2"
 grep -q 'sensors\[2\].noise.netd_k' "$work/bad.log" ||
     { fail "the error does not name sensors[2].noise.netd_k"; cat "$work/bad.log"; }
+# noise beyond the 32-bit outputs' range: refused (exit 2, nothing written), not inf written
+sed 's/"netd_k": \[0.5, 0.2\]/"netd_k": [0.5, 1e300]/' "$work/furnace.json" > "$work/huge.json"
+"$THZMAP" simulate "$work/huge.json" -o "$work/huge" --quiet > "$work/huge.log" 2>&1
+rc=$?
+[ $rc -eq 2 ] || fail "netd_k 1e300 K: exit $rc, expected 2"
+grep -q "sensor 'netd', channel 2: the noise takes the measured image beyond" "$work/huge.log" ||
+    { fail "netd_k 1e300 K: no message naming the sensor and channel"; cat "$work/huge.log"; }
+[ ! -e "$work/huge" ] || fail "netd_k 1e300 K: OUTDIR written"
 
 [ $fails -eq 0 ] && echo "PASS"
 exit $((fails > 0))
