@@ -4,9 +4,11 @@
 #include <jansson.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "batch/batch_internal.h"
+#include "core/file.h"
 
 /* The hash of a file the frames name ("file", "*_file" keys), cached per path; 0 when
  * it cannot be read (the scene loader then reports it). */
@@ -21,7 +23,10 @@ static uint64_t hash_file(json_t *cache, const char *scene_dir, const char *name
     if (cached)
         return (uint64_t)strtoull(json_string_value(cached), NULL, 16);
     uint64_t h = BATCH_HASH_INIT;
-    FILE *f = fopen(path, "rb");
+    thz_error ignored; /* a FIFO or device would block or never end (core/file.h) */
+    FILE *f = file_check_regular(path, path, UINT64_MAX, NULL, &ignored) == THZ_OK
+                  ? fopen(path, "rb")
+                  : NULL;
     if (f) {
         unsigned char buf[65536];
         size_t n;

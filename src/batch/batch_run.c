@@ -23,6 +23,7 @@
 #include "batch/batch_internal.h"
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/file.h"
 #include "core/path.h"
 
 typedef enum frame_state { FRAME_PENDING, FRAME_REUSED, FRAME_COMPUTED, FRAME_FAILED } frame_state;
@@ -92,11 +93,18 @@ static void batch_hex(uint64_t h, char hex[17])
 }
 
 /* Whether frame f's directory holds a finished frame with the same inputs. */
+/* A frame.json is a few kilobytes; anything far larger is not one. */
+#define BATCH_FRAME_JSON_MAX ((uint64_t)64 << 20)
+
 static int batch_frame_done(const batch_state *b, size_t f)
 {
     char path[THZ_PATH_MAX], hex[17];
     if (snprintf(path, sizeof path, "%s/%s/frame.json", b->outdir, b->seq->frame_dir[f]) >=
         (int)sizeof path)
+        return 0;
+    /* a FIFO or device there would block or never end (core/file.h) */
+    thz_error ignored;
+    if (file_check_regular(path, path, BATCH_FRAME_JSON_MAX, NULL, &ignored) != THZ_OK)
         return 0;
     json_t *doc = json_load_file(path, 0, NULL);
     batch_hex(b->seq->hash[f], hex);

@@ -96,11 +96,11 @@ static thz_status p2040_rows(load_ctx *ctx, const load_cursor *mc, const char *n
         return st;
     if (snprintf(path, sizeof path, "%s/%s", dir, P2040_FILE) >= (int)sizeof path)
         return thz_error_set(ctx->err, THZ_ERR_IO, "%s/%s: path too long", dir, P2040_FILE);
-    json_error_t je;
-    json_t *doc = json_load_file(path, JSON_REJECT_DUPLICATES, &je);
-    if (!doc)
-        return thz_error_set(ctx->err, THZ_ERR_IO, "%s:%d:%d: %s", path, je.line, je.column,
-                             je.text);
+    json_t *doc = NULL; /* as a scene is read: no FIFO or device, line:column of syntax */
+    st = load_json_file(path, NULL, NULL, "ITU-R P.2040 table", LOAD_MAX_SCENE_BYTES, &doc,
+                        ctx->err);
+    if (st != THZ_OK)
+        return st;
     json_t *all = json_object_get(doc, "materials"), *rows = json_object_get(all, name);
     if (!json_is_array(rows) || json_array_size(rows) == 0) {
         char names[1024] = "";

@@ -74,10 +74,10 @@ thz_status material_library_load(material_library **out, thz_error *err)
         return st;
     if (snprintf(path, sizeof path, "%s/%s", dir, MATERIAL_LIBRARY_FILE) >= (int)sizeof path)
         return thz_error_set(err, THZ_ERR_IO, "%s/%s: path too long", dir, MATERIAL_LIBRARY_FILE);
-    json_error_t je;
-    json_t *doc = json_load_file(path, JSON_REJECT_DUPLICATES, &je);
-    if (!doc)
-        return thz_error_set(err, THZ_ERR_IO, "%s:%d:%d: %s", path, je.line, je.column, je.text);
+    json_t *doc = NULL; /* as a scene is read: no FIFO or device, line:column of syntax */
+    st = load_json_file(path, NULL, NULL, "material library", LOAD_MAX_SCENE_BYTES, &doc, err);
+    if (st != THZ_OK)
+        return st;
     material_library *lib = thz_calloc(1, sizeof *lib);
     load_ctx ctx = {.label = path, .dir = dir, .err = err};
     load_cursor root = load_root(doc), c = load_key(&root, "materials");

@@ -436,6 +436,45 @@ bad list_sweep 'sweep.objects.nobody.temperature_k: scenes[0] (scene.json) has n
 "$THZMAP" batch "$seq" > /dev/null 2>&1
 [ $? -eq 2 ] || fail "batch without -o: expected exit 2"
 
+# A FIFO or device that a frame's scene names but the loader does not read (the continuum
+# table of a lines model without the continuum) and a FIFO frame.json in OUTDIR: the
+# frames' input hash and the resume check opened them and waited (or read /dev/zero) for ever.
+mkdir -p "$work/fifo"
+cp "$REPO/tests/inputs/atm_h2o_subset.csv" "$REPO/tests/inputs/atm_o2_subset.csv" "$work/fifo/"
+mkfifo "$work/fifo/fifo.csv"
+python3 - "$work/fifo" <<'PY'
+import json, sys
+d = sys.argv[1]
+scene = {"format": "thzmap-scene/1.1",
+         "channels": [{"frequency_thz": 0.35, "relative_width": 0.01}],
+         "materials": {"wall": {"reflectivity": 0.1}},
+         "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+                      "shape": {"type": "box", "size_m": [3, 3, 3], "inward": True}}],
+         "sensors": [{"name": "cam", "position_m": [0, -1.4, 0], "look_at_m": [0, 0, 0],
+                      "fov_deg": 40, "resolution": [4, 4]}],
+         "render": {"paths_per_sample": 1},
+         "atmosphere": {"model": "lines", "temperature_k": 295, "pressure_hpa": 1000,
+                        "relative_humidity": 0.5, "h2o_lines_file": "atm_h2o_subset.csv",
+                        "o2_lines_file": "atm_o2_subset.csv", "continuum": False}}
+for name, unread in (("fifo", "fifo.csv"), ("zero", "/dev/zero")):
+    scene["atmosphere"]["continuum_file"] = unread
+    json.dump(scene, open(f"{d}/{name}.json", "w"))
+    json.dump({"format": "thzmap-sequence/1", "scene": f"{name}.json", "frames": 1},
+              open(f"{d}/seq-{name}.json", "w"))
+PY
+for name in fifo zero; do
+    timeout 60 "$THZMAP" batch "$work/fifo/seq-$name.json" -o "$work/fifo/o-$name" --quiet \
+        > "$work/fifo/$name.log" 2>&1
+    rc=$?
+    [ $rc -eq 0 ] || fail "batch of a scene naming an unread $name: exit $rc: $(tail -2 "$work/fifo/$name.log")"
+done
+rm -f "$work/fifo/o-fifo/frame-00000/frame.json"
+mkfifo "$work/fifo/o-fifo/frame-00000/frame.json"
+timeout 60 "$THZMAP" batch "$work/fifo/seq-fifo.json" -o "$work/fifo/o-fifo" --quiet \
+    > "$work/fifo/resume.log" 2>&1
+rc=$?
+[ $rc -ne 124 ] || fail "batch resuming with a FIFO frame.json hung"
+
 if [ "$fails" -ne 0 ]; then
     echo "$fails failure(s)"
     exit 1
