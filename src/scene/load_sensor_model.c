@@ -94,8 +94,8 @@ thz_status load_sensor_model(load_ctx *ctx, const load_cursor *c, size_t n_chann
 {
     static const char *const psfs[] = {"none", "airy", "gaussian", NULL}; /* thz_psf_kind */
     const load_range diameter = {0.0, 2.0 * sqrt(LOAD_APERTURE_M2.hi / M_PI), true, false};
-    thz_status st = load_number(ctx, c, "aperture_diameter_m", diameter, false, 0.0,
-                                &sn->aperture_diameter_m);
+    thz_status st =
+        load_number(ctx, c, "aperture_diameter_m", diameter, false, 0.0, &sn->aperture_diameter_m);
     if (st != THZ_OK)
         return st;
     if (sn->aperture_diameter_m > 0.0 && !json_object_get(c->value, "aperture_m2"))
