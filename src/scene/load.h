@@ -74,6 +74,11 @@ typedef struct load_range {
 #define LOAD_ANY ((load_range){-INFINITY, INFINITY, false, false})
 #define LOAD_NONNEGATIVE ((load_range){0.0, INFINITY, false, false})
 #define LOAD_POSITIVE ((load_range){0.0, INFINITY, true, false})
+/* How far from the origin objects and sensors may lie, m: Embree, in single precision,
+ * aborts on rays whose origins pass about 1.8e18 m (objects 1e26 m across did), and at
+ * 1e9 m a float's step is 64 m already. */
+#define LOAD_MAX_COORDINATE_M 1e9
+#define LOAD_COORDINATE ((load_range){-LOAD_MAX_COORDINATE_M, LOAD_MAX_COORDINATE_M, false, false})
 /* A sensor's aperture area, m^2: up to a square kilometre, far beyond any sensor and far
  * from the 32-bit power cube's overflow (aperture_diameter_m: the circle of that area). */
 #define LOAD_APERTURE_M2 ((load_range){0.0, 1e6, true, false})

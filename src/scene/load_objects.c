@@ -230,6 +230,14 @@ static thz_status load_object(load_ctx *ctx, const load_cursor *list, size_t ind
                 ctx, transform.value ? &transform : &shape,
                 "the object's coordinates or area exceed the range of single-precision "
                 "floats (expected sizes in metres well below 1e30)");
+    for (int k = 0; k < 3; k++)
+        if (fmax(-o->mesh.bbox_min_m[k], o->mesh.bbox_max_m[k]) > LOAD_MAX_COORDINATE_M)
+            return load_fail(ctx, transform.value ? &transform : &shape,
+                             "the object reaches %g m from the origin; scenes must lie within "
+                             "%g m of it (expected metres: a mesh in millimetres needs "
+                             "\"transform\": {\"scale\": 0.001})",
+                             fmax(-o->mesh.bbox_min_m[k], o->mesh.bbox_max_m[k]),
+                             LOAD_MAX_COORDINATE_M);
     if (o->mesh.n_triangles == 0 || !(o->mesh.total_area_m2 > 0.0))
         return load_fail(ctx, &shape, "the shape has no triangles of non-zero area");
     return THZ_OK;

@@ -89,7 +89,7 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
     sn->name = thz_strdup(name);
     if (!sn->name)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
-    st = load_vector(ctx, c, "position_m", 3, LOAD_ANY, true, sn->position_m);
+    st = load_vector(ctx, c, "position_m", 3, LOAD_COORDINATE, true, sn->position_m);
     if (st != THZ_OK)
         return st;
     load_cursor look = load_key(c, "look_at_m"), dir = load_key(c, "direction");
@@ -102,7 +102,7 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
                          "look at or a viewing direction, 3 numbers)");
     if (look.value) {
         double p[3];
-        st = load_vector(ctx, c, "look_at_m", 3, LOAD_ANY, true, p);
+        st = load_vector(ctx, c, "look_at_m", 3, LOAD_COORDINATE, true, p);
         for (int i = 0; i < 3; i++)
             d[i] = p[i] - sn->position_m[i];
     } else {

@@ -292,6 +292,11 @@ CASES = [
     ("sensor_aperture_diameter_too_large",
      [(["format"], "thzmap-scene/1.1"), (["sensors", 0, "aperture_diameter_m"], 1e200)],
      "sensors[0].aperture_diameter_m: expected a number in (0, 1128.38], got 1e+200"),
+    ("object_too_far", [(["objects", 1, "transform"], {"translate_m": [0, 2e9, 0]})],
+     "objects[1].transform: the object reaches 2e+09 m from the origin; scenes must lie "
+     "within 1e+09 m of it"),
+    ("sensor_too_far", [(["sensors", 0, "position_m"], [0, -0.45, 1e30])],
+     "sensors[0].position_m[2]: expected a number in [-1e+09, 1e+09], got 1e+30"),
     ("reflection_unknown", [(["materials", "wall", "reflection"], "glossy")],
      'materials.wall.reflection: expected "diffuse", "specular" or {"model": "ward", '
      '"alpha_x": ax, "alpha_y": ay}, got "glossy"'),
