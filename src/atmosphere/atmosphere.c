@@ -242,6 +242,15 @@ static double table_midpoint_error(const thz_atmosphere *atm, const atm_band_tab
 }
 
 /* On failure t may hold the last grid tried; the caller frees t->alpha_per_m. */
+/* The first table point whose attenuation is not finite, or t->n. */
+static size_t table_first_nonfinite(const atm_band_table *t)
+{
+    for (size_t i = 0; i < t->n; i++)
+        if (!isfinite(t->alpha_per_m[i]))
+            return i;
+    return t->n;
+}
+
 static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, double lo_hz,
                               double hi_hz, atm_band_table *t, thz_error *err)
 {
@@ -270,6 +279,16 @@ static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, 
             break;
         }
         fill_table(atm, t, &prev, prev_mid);
+        size_t bad = table_first_nonfinite(t);
+        if (bad < t->n) {
+            st = thz_error_set(err, THZ_ERR_INPUT,
+                               "channel '%s': the atmosphere's attenuation at %.6g THz is not a "
+                               "finite number (%g /m); a line catalogue or table with values "
+                               "beyond the physical range?",
+                               ch->name, (t->lo_hz + (double)bad * t->step_hz) * 1e-12,
+                               t->alpha_per_m[bad]);
+            break;
+        }
         free(prev.alpha_per_m);
         free(prev_mid);
         prev.alpha_per_m = NULL;

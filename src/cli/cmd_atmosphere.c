@@ -212,13 +212,14 @@ static thz_status build_model(const options *o, const char *name, const thz_atm 
 
 typedef struct series {
     size_t n;
-    double *f_thz;
+    double *f_thz, *alpha_per_m;
     double *total_db, *h2o_lines_db, *h2o_cont_db, *o2_db, *dry_db, *compare_db;
 } series;
 
 static void series_fini(series *s)
 {
     free(s->f_thz);
+    free(s->alpha_per_m);
     free(s->total_db);
     free(s->h2o_lines_db);
     free(s->h2o_cont_db);
@@ -308,6 +309,7 @@ int cmd_atmosphere(int argc, char **argv)
     bool add_end = o.from_thz + (double)(n - 1) * step_thz < o.to_thz * (1.0 - 1e-12);
     s.n = n + (add_end ? 1 : 0);
     s.f_thz = series_array(s.n);
+    s.alpha_per_m = series_array(s.n);
     s.total_db = series_array(s.n);
     s.h2o_lines_db = series_array(s.n);
     s.h2o_cont_db = series_array(s.n);
@@ -315,13 +317,38 @@ int cmd_atmosphere(int argc, char **argv)
     s.dry_db = series_array(s.n);
     if (o.compare_model)
         s.compare_db = series_array(s.n);
-    if (!s.f_thz || !s.total_db || !s.h2o_lines_db || !s.h2o_cont_db || !s.o2_db || !s.dry_db ||
-        (o.compare_model && !s.compare_db)) {
+    if (!s.f_thz || !s.alpha_per_m || !s.total_db || !s.h2o_lines_db || !s.h2o_cont_db ||
+        !s.o2_db || !s.dry_db || (o.compare_model && !s.compare_db)) {
         fprintf(stderr, "thzmap atmosphere: out of memory\n");
         rc = CLI_EXIT_FAILURE;
         goto cleanup;
     }
 
+    for (size_t i = 0; i < s.n; i++) { /* all first: nothing is printed for a bad input */
+        double f_thz = i < n ? o.from_thz + (double)i * step_thz : o.to_thz;
+        double f_hz = f_thz * 1e12;
+        thz_atm_attenuation p;
+        thz_atm_attenuation_parts(atm, f_hz, &p);
+        if (!isfinite(p.total_per_m)) {
+            fprintf(stderr,
+                    "thzmap atmosphere: the attenuation at %.9g THz is not a finite number "
+                    "(%g /m); a line catalogue with values beyond the physical range?\n",
+                    f_thz, p.total_per_m);
+            if (o.plot)
+                remove(o.plot); /* the empty file that checked it could be created */
+            rc = CLI_EXIT_USAGE;
+            goto cleanup;
+        }
+        s.f_thz[i] = f_thz;
+        s.alpha_per_m[i] = p.total_per_m;
+        s.total_db[i] = db_per_km(p.total_per_m);
+        s.h2o_lines_db[i] = db_per_km(p.h2o_lines_per_m);
+        s.h2o_cont_db[i] = db_per_km(p.h2o_continuum_per_m);
+        s.o2_db[i] = db_per_km(p.o2_per_m);
+        s.dry_db[i] = db_per_km(p.dry_continuum_per_m);
+        if (s.compare_db)
+            s.compare_db[i] = db_per_km(thz_atm_attenuation_per_m(compare, f_hz));
+    }
     if (info.has_air)
         fprintf(out,
                 "# thzmap atmosphere: model %s; air %.2f K, %.2f hPa total, water vapour %.4g hPa "
@@ -342,19 +369,7 @@ int cmd_atmosphere(int argc, char **argv)
     fprintf(out, "\n");
 
     for (size_t i = 0; i < s.n; i++) {
-        double f_thz = i < n ? o.from_thz + (double)i * step_thz : o.to_thz;
-        double f_hz = f_thz * 1e12;
-        thz_atm_attenuation p;
-        thz_atm_attenuation_parts(atm, f_hz, &p);
-        double alpha = p.total_per_m;
-        s.f_thz[i] = f_thz;
-        s.total_db[i] = db_per_km(alpha);
-        s.h2o_lines_db[i] = db_per_km(p.h2o_lines_per_m);
-        s.h2o_cont_db[i] = db_per_km(p.h2o_continuum_per_m);
-        s.o2_db[i] = db_per_km(p.o2_per_m);
-        s.dry_db[i] = db_per_km(p.dry_continuum_per_m);
-        if (s.compare_db)
-            s.compare_db[i] = db_per_km(thz_atm_attenuation_per_m(compare, f_hz));
+        double f_thz = s.f_thz[i], alpha = s.alpha_per_m[i];
         fprintf(out, "%.9g,%.6e,%.6e", f_thz, alpha, s.total_db[i]);
         if (lines)
             fprintf(out, ",%.6e,%.6e,%.6e,%.6e", s.h2o_lines_db[i], s.h2o_cont_db[i], s.o2_db[i],

@@ -121,4 +121,34 @@ rc=$?
 [ $rc -eq 2 ] || fail "unwritable --plot: exit status $rc, expected 2 ($(cat "$TMP/err"))"
 grep -q "no-such-dir/a.png: cannot create" "$TMP/err" || fail "unwritable --plot message: $(cat "$TMP/err")"
 [ ! -s "$TMP/out" ] || fail "unwritable --plot: CSV printed before the failure"
+
+# A line catalogue with an absurd (finite) value: the attenuation is NaN; refused with
+# exit 2 and nothing printed or plotted, here and in a scene (it printed -nan rows and a
+# scene's images were NaN, exit 0).
+awk -F, 'BEGIN { OFS = "," } NR == 3 { $6 = "1e300" } NR <= 3' \
+    "$REPO/tests/inputs/atm_h2o_subset.csv" > "$TMP/huge.csv"
+"$THZ" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --h2o-lines "$TMP/huge.csv" \
+    --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" --plot "$TMP/huge.png" \
+    > "$TMP/out" 2> "$TMP/err"
+rc=$?
+[ $rc -eq 2 ] || fail "n_air 1e300: exit status $rc, expected 2"
+grep -q "the attenuation at 0.3 THz is not a finite number" "$TMP/err" ||
+    fail "n_air 1e300: message: $(cat "$TMP/err")"
+[ ! -s "$TMP/out" ] && [ ! -e "$TMP/huge.png" ] || fail "n_air 1e300: output written"
+cp "$REPO/tests/inputs/atm_o2_subset.csv" "$TMP/"
+cat > "$TMP/huge.json" <<'JSON'
+{"format": "thzmap-scene/1.1", "channels": [{"frequency_thz": 0.35, "relative_width": 0.01}],
+ "materials": {"wall": {"reflectivity": 0.1}},
+ "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+              "shape": {"type": "box", "size_m": [3, 3, 3], "inward": true}}],
+ "sensors": [{"name": "cam", "position_m": [0, -1.4, 0], "look_at_m": [0, 0, 0],
+              "fov_deg": 40, "resolution": [4, 4]}],
+ "atmosphere": {"model": "lines", "temperature_k": 295, "pressure_hpa": 1000,
+                "relative_humidity": 0.5, "h2o_lines_file": "huge.csv",
+                "o2_lines_file": "atm_o2_subset.csv"}}
+JSON
+"$THZ" validate "$TMP/huge.json" > "$TMP/out" 2> "$TMP/err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "attenuation at .* THz is not a finite number" "$TMP/err" ||
+    fail "a scene with n_air 1e300: exit status $rc: $(cat "$TMP/err")"
 echo "ok"
