@@ -56,7 +56,7 @@ static json_t *sum_u64(uint64_t v)
 {
     if (v <= (uint64_t)INT64_MAX) /* json_int_t is long long */
         return json_integer((json_int_t)v);
-    return json_real((double)v);
+    return sum_real((double)v);
 }
 
 static json_t *sum_string(const char *s)
@@ -77,11 +77,11 @@ static void sum_photon_stats(json_t *o, const photon_stats *s, bool *ok)
     sum_set(o, "photons_stored", sum_u64(s->stored), ok);
     sum_set(o, "emitted_power_w_per_hz", sum_real(s->emitted_power_w_per_hz), ok);
     sum_set(o, "photon_reference_temperature_k", sum_real(s->reference_temperature_k), ok);
-    sum_set(o, "fraction_absorbed", json_real(sum_ratio(s->absorbed, s->fired)), ok);
-    sum_set(o, "fraction_escaped", json_real(sum_ratio(s->escaped, s->fired)), ok);
-    sum_set(o, "fraction_terminated", json_real(sum_ratio(s->terminated, s->fired)), ok);
-    sum_set(o, "fraction_reflected", json_real(sum_ratio(s->reflected, s->hits)), ok);
-    sum_set(o, "fraction_transmitted", json_real(sum_ratio(s->transmitted, s->hits)), ok);
+    sum_set(o, "fraction_absorbed", sum_real(sum_ratio(s->absorbed, s->fired)), ok);
+    sum_set(o, "fraction_escaped", sum_real(sum_ratio(s->escaped, s->fired)), ok);
+    sum_set(o, "fraction_terminated", sum_real(sum_ratio(s->terminated, s->fired)), ok);
+    sum_set(o, "fraction_reflected", sum_real(sum_ratio(s->reflected, s->hits)), ok);
+    sum_set(o, "fraction_transmitted", sum_real(sum_ratio(s->transmitted, s->hits)), ok);
     sum_set(o, "back_face_hits", sum_u64(s->back_face_hits), ok);
     sum_set(o, "mean_bounces", sum_real(s->mean_bounces), ok);
     json_t *counts = json_object();
@@ -120,9 +120,9 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
     const thz_channel *ch = &scene->channels[c];
     json_t *o = json_object();
     sum_set(o, "name", json_string(ch->name), ok);
-    sum_set(o, "frequency_thz", json_real(ch->center_hz / 1e12), ok);
+    sum_set(o, "frequency_thz", sum_real(ch->center_hz / 1e12), ok);
     bool table = channel_has_response(ch);
-    sum_set(o, "relative_width", table ? json_null() : json_real(ch->relative_width), ok);
+    sum_set(o, "relative_width", table ? json_null() : sum_real(ch->relative_width), ok);
     sum_set(o, "response", json_string(table ? "table" : "gaussian"), ok);
     sum_set(o, "bandwidth_ghz", sum_real(channel_bandwidth_hz(ch) * 1e-9), ok);
     sum_set(o, "noise_bandwidth_ghz", sum_real(channel_noise_bandwidth_hz(ch) * 1e-9), ok);

@@ -56,6 +56,7 @@ thz_status channel_set_response(thz_channel *ch, size_t n, const double *freq_hz
         return thz_error_set(err, THZ_ERR_NOMEM, "channel '%s': out of memory", ch->name);
     }
     double moment = 0.0; /* int nu g dnu, Simpson: exact for the quadratic nu g */
+    double g2 = 0.0;     /* int g^2 dnu (the noise bandwidth's), exact on each piece */
     area[0] = 0.0;
     for (size_t i = 0; i < n; i++) {
         f[i] = freq_hz[i];
@@ -65,6 +66,22 @@ thz_status channel_set_response(thz_channel *ch, size_t n, const double *freq_hz
         double h = f[i] - f[i - 1];
         area[i] = area[i - 1] + 0.5 * h * (w[i - 1] + w[i]);
         moment += h / 6.0 * (w[i - 1] * (2.0 * f[i - 1] + f[i]) + w[i] * (f[i - 1] + 2.0 * f[i]));
+        g2 += h * (w[i - 1] * w[i - 1] + w[i - 1] * w[i] + w[i] * w[i]) / 3.0;
+    }
+    /* B_c = int g dnu is the table's own (physics.md: g_c is the table), so its scale
+     * counts: weights whose integrals leave the doubles' normal range (1e308, 1e-320) would
+     * give an infinite or NaN centre and bandwidths */
+    double b_c = area[n - 1];
+    if (!isnormal(b_c) || !isnormal(moment) || !isnormal(g2)) {
+        free(f);
+        free(w);
+        free(area);
+        bool named = ch->name[0] != '\0'; /* a scene's channel is named after this */
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s%s%sthe response's integrals (int g dnu = %g Hz, int g^2 dnu = %g "
+                             "Hz) leave the range of double precision; give weights of order 1",
+                             named ? "channel '" : "", named ? ch->name : "", named ? "': " : "",
+                             b_c, g2);
     }
     channel_fini(ch);
     ch->n_response = n;
