@@ -466,6 +466,12 @@ static thz_status team_serve_begin(mpi_team *t, const thz_scene *scene, const ac
         return thz_error_set(err, THZ_ERR_INPUT,
                              "MPI: the lead renders channel %llu, the scene has %zu",
                              (unsigned long long)m->rr.channel, scene->n_channels);
+    if (m->rr.integrator != (uint64_t)scene->render.integrator) /* path was refused before */
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "MPI: the lead renders with %s, process %d with %s (every process "
+                             "must run with the same options)",
+                             render_integrator_name((thz_integrator)m->rr.integrator), t->rank,
+                             render_integrator_name(scene->render.integrator));
     r->ro = (render_options){.threads = threads,
                              .use_seed = m->rr.use_seed != 0,
                              .seed = m->rr.seed,

@@ -83,7 +83,10 @@ thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, th
     /* the channel's tables, built once for all its passes and sensors */
     render_context *ctx = NULL;
     if (st == THZ_OK && team) {
-        render_channel_request rq = {.channel = c, .use_seed = ro.use_seed, .seed = ro.seed};
+        render_channel_request rq = {.channel = c,
+                                     .use_seed = ro.use_seed,
+                                     .seed = ro.seed,
+                                     .integrator = (uint64_t)rs->scene->render.integrator};
         st = team->channel_begin(team->impl, &rq, map, err);
     }
     if (st == THZ_OK)

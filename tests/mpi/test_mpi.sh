@@ -276,6 +276,17 @@ rc=$?
 [ $rc != 0 ] && [ $rc != 124 ] || fail "rank 1 with another seed: exit $rc"
 grep -q "MPI rank 1.*seed 2" "$work/mix.out" || { fail "rank 1's refusal not said"; cat "$work/mix.out"; }
 [ ! -e "$work/mix" ] || fail "rank 1 with another seed: OUTDIR created"
+step "rank 1 renders"
+# rank 1 with another integrator that fires photons too (final-gather against photon-map):
+# refused at the render's start; it ran and wrote images of nonsense, exit 0
+timeout 120 mpirun --oversubscribe -np 1 "$THZMAP" simulate "$scene" -o "$work/mixi" --quiet \
+    --integrator final-gather : -np 1 "$THZMAP" simulate "$scene" -o "$work/mixi" \
+    --quiet --integrator photon-map > "$work/mixi.out" 2>&1
+rc=$?
+[ $rc != 0 ] && [ $rc != 124 ] || fail "rank 1 with another integrator: exit $rc"
+grep -q "the lead renders with final-gather, process 1 with photon-map" "$work/mixi.out" ||
+    { fail "rank 1's other integrator not said"; cat "$work/mixi.out"; }
+[ ! -e "$work/mixi" ] || fail "rank 1 with another integrator: OUTDIR created"
 step "rank 1 cannot"
 # rank 1 cannot load its scene (missing on its node): rank 0 says so, exit non-zero
 timeout 120 mpirun --oversubscribe -np 1 "$THZMAP" simulate "$scene" -o "$work/miss" --quiet \
