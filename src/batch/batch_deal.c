@@ -178,7 +178,11 @@ thz_status batch_deal_receive(thz_context *ctx, const thz_sequence *seq, size_t 
         st = api_run_unpack(fr->scene, (const uint8_t *)data + sizeof h, size - sizeof h, &fr->run,
                             err);
     }
-    /* the run's warnings went to no one where it ran: said here, as one process says them */
+    /* the scene's and the run's warnings went to no one where it ran: said here, in the
+     * order one process says them */
+    for (size_t i = 0;
+         st == THZ_OK && ctx && ctx->warning && i < thz_scene_warning_count(fr->scene); i++)
+        ctx->warning(ctx->warning_user, thz_scene_warning(fr->scene, i));
     for (size_t i = 0; st == THZ_OK && ctx && ctx->warning && i < fr->run->rs.n_warnings; i++)
         ctx->warning(ctx->warning_user, fr->run->rs.warnings[i]);
     free(data);

@@ -325,9 +325,13 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
     thz_output **guard = b->opt ? b->opt->open_output : NULL;
     if (guard)
         *guard = output;
-    if (st == THZ_OK)
-        st = rank == 0 ? batch_frame_compute(ctx, seq, b->base, &b->cache, f, &fr, err)
-                       : batch_deal_receive(ctx, seq, f, rank, &fr, &seconds, err);
+    bool remote_failed = false; /* the rank it was dealt to failed (not this one writing) */
+    if (st == THZ_OK && rank == 0)
+        st = batch_frame_compute(ctx, seq, b->base, &b->cache, f, &fr, err);
+    else if (st == THZ_OK) {
+        st = batch_deal_receive(ctx, seq, f, rank, &fr, &seconds, err);
+        remote_failed = st != THZ_OK;
+    }
     if (st == THZ_OK) {
         frame_json = batch_frame_json(seq, f, fr.reused ? (long)b->base[f] : -1);
         if (!frame_json)
@@ -354,7 +358,7 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
     free(frame_json);
     b->seconds[f] = rank == 0 ? batch_now_s() - t0 : seconds;
     if (st != THZ_OK && st != THZ_ERR_CANCELLED && err) {
-        if (rank == 0)
+        if (!remote_failed)
             thz_error_prefix(err, "%s: ", seq->frame_dir[f]);
         else
             thz_error_prefix(err, "%s (MPI rank %zu): ", seq->frame_dir[f], rank);

@@ -322,6 +322,30 @@ else
     fail "test set-up: rank 1's process not found"
     kill $job
 fi
+step "dealt warnings"
+# A dealt batch says every frame's scene warnings, also of the frames other ranks computed
+# (they were lost), and blames rank 0's own failure to write a frame on no other rank.
+mkdir -p "$work/dw"
+$PY - "$REPO/tests/inputs/batch/scene.json" "$work/dw" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["render"] = {"integrator": "photon-map"}
+s["photons"] = {"seed": 7, "per_channel": 20000}
+json.dump(s, open(sys.argv[2] + "/s0.json", "w"))
+s["atmosphere"] = {"model": "constant", "attenuation_per_m": 0.05, "emitting": False}
+json.dump(s, open(sys.argv[2] + "/s1.json", "w"))
+json.dump({"format": "thzmap-sequence/1", "scenes": ["s0.json", "s1.json"]},
+          open(sys.argv[2] + "/seq.json", "w"))
+PY
+mpi 2 "$THZMAP" batch "$work/dw/seq.json" -o "$work/dw/two" -q --threads 1 > "$work/dw.out" 2>&1 ||
+    fail "dealt batch of two scenes: exit $?: $(tail -3 "$work/dw.out")"
+grep -q 'warning: frame 2/2: atmosphere: "emitting": false' "$work/dw.out" ||
+    { fail "dealt batch: frame 2's scene warning not said"; cat "$work/dw.out"; }
+mkdir "$work/dw/o2" && touch "$work/dw/o2/frame-00001"
+mpi 2 "$THZMAP" batch "$work/dw/seq.json" -o "$work/dw/o2" -q --threads 1 > "$work/dw2.out" 2>&1
+grep -q "frame-00001: .*exists and is not a directory" "$work/dw2.out" &&
+    ! grep -q "MPI rank 1" "$work/dw2.out" ||
+    { fail "rank 0's own write failure: message"; cat "$work/dw2.out"; }
 step "other commands"
 # other commands refuse several ranks
 mpi 2 "$THZMAP" validate "$scene" > "$work/val.out" 2>&1
