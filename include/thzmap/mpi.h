@@ -27,6 +27,13 @@ extern "C" {
 /* 1 when this library was built with MPI support, else 0. */
 THZ_API int thz_mpi_supported(void);
 
+/* For a SIGINT or SIGTERM handler (async-signal-safe; process-wide): a call of this
+ * process waiting for other ranks stops waiting and returns THZ_ERR_CANCELLED, so that
+ * rank 0 can clean up before it ends the job (a rank that has stopped or died would keep
+ * it waiting until mpirun kills it). A run that is computing is stopped by its progress
+ * callback, as without MPI. A no-op without MPI support. */
+THZ_API void thz_mpi_interrupt(void);
+
 /* Rank 0: simulate runs on ctx share their photon phases with the other ranks of
  * MPI_COMM_WORLD. Collective with the other ranks' thz_mpi_serve. THZ_ERR_INPUT without
  * MPI support. */

@@ -17,6 +17,13 @@ int thz_mpi_supported(void)
 #endif
 }
 
+void thz_mpi_interrupt(void)
+{
+#ifdef THZ_HAVE_MPI
+    mpi_team_interrupt();
+#endif
+}
+
 #ifdef THZ_HAVE_MPI
 
 thz_status thz_context_set_mpi(thz_context *ctx, thz_error *err)

@@ -15,6 +15,7 @@ static volatile sig_atomic_t cli_interrupted = 0;
 static void cli_on_signal(int sig)
 {
     cli_interrupted = sig;
+    thz_mpi_interrupt(); /* rank 0 waiting for another rank stops waiting (async-signal-safe) */
 }
 
 int cli_interrupt_signal(void)

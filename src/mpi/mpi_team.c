@@ -4,6 +4,7 @@
 #include "mpi/mpi_team.h"
 
 #include <mpi.h>
+#include <signal.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -72,8 +73,20 @@ typedef struct team_header {
     uint64_t count, n_chunks;
 } team_header;
 
+/* Set by a signal handler (mpi_team_interrupt): waits end with TEAM_INTERRUPTED. */
+static volatile sig_atomic_t team_interrupted = 0;
+/* team_wait's return when interrupted: MPI's error codes are >= 0. */
+#define TEAM_INTERRUPTED (-1)
+
+void mpi_team_interrupt(void)
+{
+    team_interrupted = 1;
+}
+
 static thz_status team_error(thz_error *err, int rc, const char *what)
 {
+    if (rc == TEAM_INTERRUPTED)
+        return thz_error_set(err, THZ_ERR_CANCELLED, "MPI: interrupted while %s", what);
     char text[MPI_MAX_ERROR_STRING] = "";
     int len = 0;
     if (MPI_Error_string(rc, text, &len) != MPI_SUCCESS)
@@ -82,11 +95,15 @@ static thz_status team_error(thz_error *err, int rc, const char *what)
 }
 
 /* Waits for req, polling with a pause that doubles from 50 us to 5 ms: a waiting rank
- * (a member while rank 0 renders, for seconds) leaves the cores to the working ones. */
+ * (a member while rank 0 renders, for seconds) leaves the cores to the working ones.
+ * TEAM_INTERRUPTED once mpi_team_interrupt was called (req is left pending: the job
+ * ends). */
 static int team_wait(MPI_Request *req)
 {
     long pause_ns = 50000;
     for (;;) {
+        if (team_interrupted)
+            return TEAM_INTERRUPTED;
         int done = 0;
         int rc = MPI_Test(req, &done, MPI_STATUS_IGNORE);
         if (rc != MPI_SUCCESS || done)

@@ -33,6 +33,10 @@ typedef struct mpi_team mpi_team;
  * communicator of its own. */
 thz_status mpi_team_create(mpi_team **out, thz_error *err);
 
+/* Async-signal-safe: every wait of this process's teams ends with THZ_ERR_CANCELLED
+ * (thz_mpi_interrupt). */
+void mpi_team_interrupt(void);
+
 /* The lead tells the members to stop (their mpi_team_serve returns THZ_OK); every rank
  * frees its communicator. NULL does nothing. */
 void mpi_team_destroy(mpi_team *team);

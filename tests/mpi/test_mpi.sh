@@ -322,6 +322,42 @@ else
     fail "test set-up: rank 1's process not found"
     kill $job
 fi
+step "a stopped"
+# a rank that stops and then dies while rank 0 waits for it: mpirun's SIGTERM reaches rank
+# 0 in its wait, which cleans up (no lock or stage beside OUTDIR, OUTDIR as it was) and
+# says so; it ignored the signal and was killed, leaving both
+mkdir -p "$work/stopped/out" && echo keep > "$work/stopped/out/marker"
+mpi 2 "$THZMAP" simulate "$scene" -o "$work/stopped/out" --integrator path --threads 1 \
+    --target-noise-k 0.0001 --max-seconds 60 --quiet > "$work/stopped.out" 2>&1 &
+job=$!
+victim=
+for _ in $(seq 100); do
+    sleep 0.1
+    for p in $(pgrep -f -- "-o $work/stopped/out" 2>/dev/null); do
+        if [ "$(cat "/proc/$p/comm" 2>/dev/null)" = thzmap ] &&
+            tr '\0' '\n' < "/proc/$p/environ" 2>/dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=1'; then
+            victim=$p
+        fi
+    done
+    [ -n "$victim" ] && break
+done
+if [ -n "$victim" ]; then
+    sleep 1
+    kill -STOP "$victim"
+    sleep 1
+    kill -KILL "$victim"
+    wait $job
+    rc=$?
+    [ $rc != 0 ] && [ $rc != 124 ] || fail "stopped rank 1: exit $rc"
+    [ "$(ls -A "$work/stopped")" = out ] ||
+        fail "stopped rank 1: left beside OUTDIR: $(ls -A "$work/stopped")"
+    [ "$(ls -A "$work/stopped/out")" = marker ] || fail "stopped rank 1: OUTDIR changed"
+    grep -q "interrupted; no results written" "$work/stopped.out" ||
+        { fail "stopped rank 1: rank 0 did not say it was interrupted"; cat "$work/stopped.out"; }
+else
+    fail "test set-up: rank 1's process not found"
+    kill $job
+fi
 step "dealt warnings"
 # A dealt batch says every frame's scene warnings, also of the frames other ranks computed
 # (they were lost), and blames rank 0's own failure to write a frame on no other rank.
