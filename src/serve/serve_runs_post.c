@@ -4,15 +4,21 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "serve_jobs.h"
 
-/* A string option (copied into out[size]); false after replying 400. */
+/* A string option of 1 to size - 1 bytes (copied into out); false after replying 400. */
 static bool serve_opt_string(serve_request *r, json_t *v, const char *path, char *out, size_t size,
                              enum MHD_Result *ret)
 {
-    if (!json_is_string(v) || json_string_length(v) == 0 || json_string_length(v) >= size) {
+    if (!json_is_string(v) || json_string_length(v) == 0) {
         *ret = serve_reply_bad_json(r, path, "expected a non-empty string");
+        return false;
+    }
+    if (json_string_length(v) >= size) {
+        *ret = serve_reply_bad_json(r, path, "expected at most %zu bytes, got %zu", size - 1,
+                                    json_string_length(v));
         return false;
     }
     snprintf(out, size, "%s", json_string_value(v));
@@ -58,20 +64,26 @@ static bool serve_opt_bool(serve_request *r, json_t *v, const char *path, bool *
     return true;
 }
 
-/* The path REL in `v` checked against the root into out; false after replying. */
+/* The path REL in `v` checked against the root into out; with must_exist, a regular
+ * file (a FIFO would hold the job, and the server's stop, until someone writes to it).
+ * False after replying. */
 static bool serve_opt_path(serve_request *r, json_t *v, const char *path, bool must_exist,
                            char *out, enum MHD_Result *ret)
 {
-    char rel[PATH_MAX];
+    char rel[SERVE_MAX_REL_BYTES];
     if (!serve_opt_string(r, v, path, rel, sizeof rel, ret))
         return false;
     serve_path_status st = serve_path(r->s, rel, must_exist, out);
-    if (st == SERVE_PATH_FORBIDDEN)
-        *ret = serve_reply_error(r, 403, "%s: %s is outside the root, absolute, or has '..'", path,
-                                 rel);
-    else if (st == SERVE_PATH_MISSING)
-        *ret = serve_reply_error(r, 404, "%s: %s: no such file", path, rel);
-    return st == SERVE_PATH_OK;
+    if (st != SERVE_PATH_OK) {
+        *ret = serve_reply_path(r, st, path, ": ", rel);
+        return false;
+    }
+    struct stat sb;
+    if (must_exist && (stat(out, &sb) != 0 || !S_ISREG(sb.st_mode))) {
+        *ret = serve_reply_bad_json(r, path, "%s: not a regular file", rel);
+        return false;
+    }
+    return true;
 }
 
 /* One key of "options"; false after replying 400. */
@@ -93,12 +105,13 @@ static bool serve_parse_option(serve_request *r, serve_job *j, const char *key, 
         return serve_opt_whole(r, v, path, 0, INT64_MAX, &j->seed, ret);
     }
     if (scene && strcmp(key, "integrator") == 0) {
-        if (!serve_opt_string(r, v, path, j->integrator, sizeof j->integrator, ret))
-            return false;
-        if (!thz_integrator_known(j->integrator)) {
+        /* a name too long for the buffer is no integrator either: the names are the limit */
+        if (!json_is_string(v) || !thz_integrator_known(json_string_value(v)) ||
+            json_string_length(v) >= sizeof j->integrator) {
             *ret = serve_reply_bad_json(r, path, "expected path, final-gather or photon-map");
             return false;
         }
+        snprintf(j->integrator, sizeof j->integrator, "%s", json_string_value(v));
         return true;
     }
     if (scene && strcmp(key, "target_noise_k") == 0)
