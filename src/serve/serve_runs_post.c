@@ -86,6 +86,35 @@ static bool serve_opt_path(serve_request *r, json_t *v, const char *path, bool m
     return true;
 }
 
+/* The integrator a simulate or render job runs: its option, else the scene's
+ * render.integrator, else "path", the scene format's default (docs/scene-format.md), into
+ * buf. NULL when the scene does not name one the loader would take: loading it then fails
+ * the job in the loader's words. *from says where the name came from. */
+static const char *serve_job_integrator(const serve_job *j, char *buf, size_t size,
+                                        const char **from)
+{
+    *from = "options.integrator";
+    if (j->integrator[0])
+        return j->integrator;
+    size_t n = 0;
+    char *text = serve_read_file(j->scene, SERVE_MAX_FILE_BYTES, &n);
+    json_t *doc = text ? json_loadb(text, n, JSON_REJECT_DUPLICATES, NULL) : NULL;
+    free(text);
+    json_t *render = json_object_get(doc, "render");
+    json_t *name = json_object_get(render, "integrator");
+    const char *out = NULL;
+    if (json_is_object(doc) && (!render || (json_is_object(render) && !name))) {
+        *from = "the default, the scene naming no render.integrator";
+        out = "path";
+    } else if (json_is_string(name) && thz_integrator_known(json_string_value(name))) {
+        *from = "the scene's render.integrator";
+        snprintf(buf, size, "%s", json_string_value(name));
+        out = buf;
+    }
+    json_decref(doc);
+    return out;
+}
+
 /* One key of "options"; false after replying 400. */
 static bool serve_parse_option(serve_request *r, serve_job *j, const char *key, json_t *v,
                                enum MHD_Result *ret)
@@ -208,11 +237,27 @@ static serve_job *serve_parse_job(serve_request *r, json_t *body, enum MHD_Resul
         if (!serve_parse_option(r, j, key, v, ret))
             goto fail;
     }
-    if (j->command == CMD_SIMULATE && j->save_photon_map && j->integrator[0] &&
-        !thz_integrator_needs_photons(j->integrator)) { /* as the CLI refuses it */
+    /* as the CLI refuses them: a map to save that the integrator makes none of, a render
+     * from a map without one */
+    char name[64];
+    const char *from = NULL;
+    const char *integrator = j->command == CMD_SIMULATE || j->command == CMD_RENDER
+                                 ? serve_job_integrator(j, name, sizeof name, &from)
+                                 : NULL;
+    if (integrator && j->command == CMD_SIMULATE && j->save_photon_map &&
+        !thz_integrator_needs_photons(integrator)) {
         *ret = serve_reply_bad_json(r, "$.options.save_photon_map",
-                                    "the path integrator fires no photons: no photon map to "
-                                    "save (give integrator final-gather or photon-map)");
+                                    "the %s integrator (%s) fires no photons: no photon map to "
+                                    "save (give integrator final-gather or photon-map)",
+                                    integrator, from);
+        goto fail;
+    }
+    if (integrator && j->command == CMD_RENDER && !j->photon_map[0] &&
+        thz_integrator_needs_photons(integrator)) {
+        *ret = serve_reply_bad_json(r, "$.options.photon_map",
+                                    "the %s integrator (%s) renders from a photon map: give "
+                                    "photon_map (only integrator path renders without one)",
+                                    integrator, from);
         goto fail;
     }
     if (j->command == CMD_BANDS && j->count == 0) {

@@ -107,6 +107,23 @@ def test_lengths(srv):
               "%s of %d bytes: %r" % (key, len(value), err))
 
 
+def test_integrators(srv):
+    """The integrator is the option's, else the scene's, else path (the default)."""
+    for scene, options, key in (
+            ("s/path.json", {"save_photon_map": True}, "save_photon_map"),
+            ("s/none.json", {"save_photon_map": True}, "save_photon_map"),
+            ("s/pm.json", {"integrator": "path", "save_photon_map": True}, "save_photon_map")):
+        err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": scene,
+                                                   "out": "o", "options": options}, status=400)
+        check(err and err.get("path") == "$.options." + key and "path integrator" in err["error"],
+              "simulate %s %r: %r" % (scene, options, err))
+    for scene, options in (("s/pm.json", {}), ("s/path.json", {"integrator": "final-gather"})):
+        err = srv.json("POST", "/api/runs", body={"command": "render", "scene": scene,
+                                                   "out": "o", "options": options}, status=400)
+        check(err and err.get("path") == "$.options.photon_map" and
+              "renders from a photon map" in err["error"], "render %s %r: %r" % (scene, options, err))
+
+
 def main():
     tmp = tempfile.mkdtemp(prefix="thzmap-refusals-")
     root = os.path.join(tmp, "root")
@@ -117,7 +134,8 @@ def main():
         env = dict(os.environ, THZMAP_WEB_DIR=os.path.join(tmp, "web"))
         srv = Server(BINARY, root, env, prefix=NO_DAC)
         try:
-            tests = [("files", lambda: test_files(srv, root)), ("lengths", lambda: test_lengths(srv))]
+            tests = [("files", lambda: test_files(srv, root)), ("lengths", lambda: test_lengths(srv)),
+                     ("integrators", lambda: test_integrators(srv))]
             for name, fn in tests:
                 t = time.time()
                 fn()
