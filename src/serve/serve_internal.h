@@ -66,6 +66,8 @@ typedef struct serve_request {
 } serve_request;
 
 /* ---- replies (serve_http.c); each returns what the access handler returns ---------- */
+/* The headers of every /api/ answer (docs/gui.md), for a response made by hand. */
+void serve_data_headers(struct MHD_Response *resp);
 enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type, const void *data,
                             size_t size);
 /* Takes a reference to `json` (steals it). */

@@ -124,6 +124,36 @@ def test_integrators(srv):
               "renders from a photon map" in err["error"], "render %s %r: %r" % (scene, options, err))
 
 
+def test_events(srv, root):
+    """A render of the path scene without a photon map runs; its event stream carries the
+    headers of every /api/ answer and reals of 9 significant digits."""
+    run = srv.json("POST", "/api/runs", body={"command": "render", "scene": "s/path.json",
+                                               "out": "out/path"}, status=202)
+    if not run:
+        return
+    sock = socket.create_connection(("127.0.0.1", srv.port), timeout=60)
+    sock.sendall(("GET /api/runs/%d/events HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer %s\r\n"
+                  "\r\n" % (run["id"], srv.token)).encode())
+    raw = b""
+    while b"event: end" not in raw:
+        chunk = sock.recv(65536)
+        if not chunk:
+            break
+        raw += chunk
+    sock.close()
+    head, _, body = raw.decode().partition("\r\n\r\n")
+    check("content-security-policy: default-src 'none'; sandbox" in head.lower() and
+          "x-content-type-options: nosniff" in head.lower(), "event stream headers: %r" % head)
+    datas = [json.loads(line[6:]) for line in body.splitlines() if line.startswith("data: {\"")]
+    check(datas and datas[-1]["state"] == "done", "render of the path scene: %r" % datas[-1:])
+    reals = [m for line in body.splitlines() if line.startswith("data: ")
+             for m in re.findall(r"(?<![\w.])-?\d+\.\d+(?:[eE][-+]?\d+)?", line)]
+    digits = lambda x: len(x.lstrip("-").split("e")[0].split("E")[0].replace(".", "").lstrip("0"))
+    check(reals and max(digits(x) for x in reals) <= 9,
+          "reals of more than 9 digits: %r" % [x for x in reals if digits(x) > 9][:5])
+    check(os.path.exists(os.path.join(root, "out", "path", "summary.json")), "no output written")
+
+
 def main():
     tmp = tempfile.mkdtemp(prefix="thzmap-refusals-")
     root = os.path.join(tmp, "root")
@@ -136,6 +166,8 @@ def main():
         try:
             tests = [("files", lambda: test_files(srv, root)), ("lengths", lambda: test_lengths(srv)),
                      ("integrators", lambda: test_integrators(srv))]
+            if not REQUESTS_ONLY:
+                tests.append(("events", lambda: test_events(srv, root)))
             for name, fn in tests:
                 t = time.time()
                 fn()
