@@ -29,7 +29,7 @@ static void serve_common_headers(struct MHD_Response *resp)
 }
 
 /* Answers other than the page's own files: nothing in them may run as a page. */
-static void serve_data_headers(struct MHD_Response *resp)
+void serve_data_headers(struct MHD_Response *resp)
 {
     serve_common_headers(resp);
     MHD_add_response_header(resp, "Content-Security-Policy", "default-src 'none'; sandbox");

@@ -66,6 +66,8 @@ typedef struct serve_request {
 } serve_request;
 
 /* ---- replies (serve_http.c); each returns what the access handler returns ---------- */
+/* The headers of every /api/ answer (docs/gui.md), for a response made by hand. */
+void serve_data_headers(struct MHD_Response *resp);
 enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type, const void *data,
                             size_t size);
 /* Takes a reference to `json` (steals it). */
@@ -97,7 +99,12 @@ typedef enum serve_path_status {
     SERVE_PATH_OK = 0,
     SERVE_PATH_FORBIDDEN, /* absolute, "..", outside the root through a symlink: 403 */
     SERVE_PATH_MISSING,   /* does not exist (when it must): 404 */
+    SERVE_PATH_DENIED,    /* a directory under the root the server may not enter: 403 */
+    SERVE_PATH_TOO_LONG,  /* SERVE_MAX_REL_BYTES or more: 400 */
 } serve_path_status;
+
+/* REL paths shorter than this (bytes) are checked; longer ones are refused as such. */
+#define SERVE_MAX_REL_BYTES (PATH_MAX - 2)
 
 /* Checks REL (relative to the root, "" or "." is the root) and writes the path to use
  * (relative to the working directory, which is the root) into out[PATH_MAX]. With
@@ -108,9 +115,17 @@ serve_path_status serve_path(const serve *s, const char *rel, bool must_exist, c
  * returns false when it is refused. */
 bool serve_path_arg(serve_request *r, const char *name, bool must_exist, char *out,
                     enum MHD_Result *result);
+/* The answer to a path serve_path refused (st not SERVE_PATH_OK), naming it as
+ * label, sep, rel ("path", "=", "a/b"), with the status of st. */
+enum MHD_Result serve_reply_path(serve_request *r, serve_path_status st, const char *label,
+                                 const char *sep, const char *rel);
 /* Whether a path (relative to the root) resolves inside the root. */
 bool serve_path_inside(const serve *s, const char *path);
-/* Reads a whole file (at most max bytes) into a malloc'd NUL-terminated buffer. */
+/* Opens a regular file for reading without ever blocking: a FIFO or a device is not
+ * opened (or only with O_NONBLOCK, and closed again). The descriptor, or -1 with errno
+ * set; EINVAL: not a regular file. */
+int serve_open_regular(const char *path);
+/* Reads a whole regular file (at most max bytes) into a malloc'd NUL-terminated buffer. */
 char *serve_read_file(const char *path, size_t max, size_t *size);
 
 /* ---- endpoints ----------------------------------------------------------------------- */

@@ -27,8 +27,8 @@ bool serve_path_inside(const serve *s, const char *path)
     return realpath(path, real) && serve_below(s->root, real);
 }
 
-/* Whether REL is relative and has no "." or ".." component (empty components, as in
- * "a//b" or a trailing '/', are allowed). */
+/* Whether REL is relative and has no ".." component ("." and empty components, as in
+ * "a/./b", "a//b" or a trailing '/', are allowed: they name the same file). */
 static bool serve_rel_clean(const char *rel)
 {
     if (rel[0] == '/')
@@ -36,7 +36,7 @@ static bool serve_rel_clean(const char *rel)
     for (const char *p = rel; *p;) {
         const char *end = strchr(p, '/');
         size_t n = end ? (size_t)(end - p) : strlen(p);
-        if ((n == 2 && p[0] == '.' && p[1] == '.') || (n == 1 && p[0] == '.' && p != rel))
+        if (n == 2 && p[0] == '.' && p[1] == '.')
             return false;
         p += n + (end != NULL);
     }
@@ -45,26 +45,35 @@ static bool serve_rel_clean(const char *rel)
 
 serve_path_status serve_path(const serve *s, const char *rel, bool must_exist, char *out)
 {
-    if (!rel || strlen(rel) >= PATH_MAX - 2 || !serve_rel_clean(rel))
+    if (rel && strlen(rel) >= SERVE_MAX_REL_BYTES)
+        return SERVE_PATH_TOO_LONG;
+    if (!rel || !serve_rel_clean(rel))
         return SERVE_PATH_FORBIDDEN;
     if (rel[0] == '\0' || strcmp(rel, ".") == 0 || strcmp(rel, "./") == 0) {
         strcpy(out, ".");
         return SERVE_PATH_OK;
     }
     snprintf(out, PATH_MAX, "%s", rel);
-    /* the path itself, or its deepest existing ancestor, must resolve inside the root */
+    /* the path itself, or its deepest existing (or enterable) ancestor, must resolve
+     * inside the root; a directory the server may not enter is told as such only when
+     * what leads to it lies inside the root (else it says nothing of what is outside) */
     char probe[PATH_MAX], real[PATH_MAX];
     snprintf(probe, sizeof probe, "%s", rel);
+    bool denied = false;
     for (;;) {
         if (realpath(probe, real))
             break;
-        if (errno != ENOENT && errno != ENOTDIR)
+        if (errno == EACCES) {
+            denied = true;
+        } else if (errno != ENOENT && errno != ENOTDIR) {
             return SERVE_PATH_FORBIDDEN;
-        struct stat lst;
-        if (lstat(probe, &lst) == 0) /* a dangling symlink: where it points is unknown */
-            return SERVE_PATH_FORBIDDEN;
-        if (must_exist)
-            return SERVE_PATH_MISSING;
+        } else if (!denied) {
+            struct stat lst;
+            if (lstat(probe, &lst) == 0) /* a dangling symlink: where it points is unknown */
+                return SERVE_PATH_FORBIDDEN;
+            if (must_exist)
+                return SERVE_PATH_MISSING;
+        }
         char *slash = strrchr(probe, '/');
         while (slash && slash > probe && slash[-1] == '/')
             slash--;
@@ -74,7 +83,28 @@ serve_path_status serve_path(const serve *s, const char *rel, bool must_exist, c
         }
         *slash = '\0';
     }
-    return serve_below(s->root, real) ? SERVE_PATH_OK : SERVE_PATH_FORBIDDEN;
+    if (!serve_below(s->root, real))
+        return SERVE_PATH_FORBIDDEN;
+    return denied ? SERVE_PATH_DENIED : SERVE_PATH_OK;
+}
+
+enum MHD_Result serve_reply_path(serve_request *r, serve_path_status st, const char *label,
+                                 const char *sep, const char *rel)
+{
+    switch (st) {
+    case SERVE_PATH_FORBIDDEN:
+        return serve_reply_error(r, 403, "%s%s%s: outside the root, absolute, or with '..'", label,
+                                 sep, rel);
+    case SERVE_PATH_DENIED:
+        return serve_reply_error(r, 403, "%s%s%s: permission denied", label, sep, rel);
+    case SERVE_PATH_MISSING:
+        return serve_reply_error(r, 404, "%s%s%s: no such file or directory", label, sep, rel);
+    case SERVE_PATH_TOO_LONG:
+        return serve_reply_error(r, 400, "%s: a path of %zu bytes, longer than the %d allowed",
+                                 label, strlen(rel), SERVE_MAX_REL_BYTES - 1);
+    default:
+        return serve_reply_error(r, 500, "%s%s%s: unexpected path status", label, sep, rel);
+    }
 }
 
 bool serve_path_arg(serve_request *r, const char *name, bool must_exist, char *out,
@@ -86,22 +116,46 @@ bool serve_path_arg(serve_request *r, const char *name, bool must_exist, char *o
         return false;
     }
     serve_path_status st = serve_path(r->s, rel, must_exist, out);
-    if (st == SERVE_PATH_FORBIDDEN)
-        *result =
-            serve_reply_error(r, 403, "%s=%s: outside the root, absolute, or with '..'", name, rel);
-    else if (st == SERVE_PATH_MISSING)
-        *result = serve_reply_error(r, 404, "%s=%s: no such file or directory", name, rel);
+    if (st != SERVE_PATH_OK) {
+        *result = serve_reply_path(r, st, name, "=", rel);
+    }
     return st == SERVE_PATH_OK;
+}
+
+int serve_open_regular(const char *path)
+{
+    /* stat first: opening a device may act on it; O_NONBLOCK: a FIFO swapped in between
+     * does not wait for a writer, and fstat tells what was opened */
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return -1;
+    if (!S_ISREG(st.st_mode)) {
+        errno = EINVAL;
+        return -1;
+    }
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
+        return -1;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        errno = EINVAL;
+        return -1;
+    }
+    return fd;
 }
 
 char *serve_read_file(const char *path, size_t max, size_t *size)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
+    int fd = serve_open_regular(path);
+    FILE *f = fd >= 0 ? fdopen(fd, "rb") : NULL;
+    if (!f) {
+        if (fd >= 0)
+            close(fd);
         return NULL;
+    }
     struct stat st;
     char *buf = NULL;
-    if (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && (uint64_t)st.st_size <= max &&
+    if (fstat(fileno(f), &st) == 0 && (uint64_t)st.st_size <= max &&
         (buf = malloc((size_t)st.st_size + 1))) {
         size_t n = fread(buf, 1, (size_t)st.st_size, f);
         if (n != (size_t)st.st_size) {
@@ -206,12 +260,20 @@ enum MHD_Result serve_file_get(serve_request *r)
     if (!serve_path_arg(r, "path", true, path, &ret))
         return ret;
     /* the descriptor of the checked path: what is sent is what was opened, streamed */
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    int fd = serve_open_regular(path);
+    if (fd < 0) {
+        int e = errno;
+        if (e == EACCES)
+            return serve_reply_error(r, 403, "%s: permission denied", path);
+        if (e == ENOENT)
+            return serve_reply_error(r, 404, "%s: no such file or directory", path);
+        return serve_reply_error(r, 400, "%s: %s", path,
+                                 e == EINVAL ? "not a regular file" : strerror(e));
+    }
     struct stat st;
-    if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        if (fd >= 0)
-            close(fd);
-        return serve_reply_error(r, 400, "%s: not a file", path);
+    if (fstat(fd, &st) != 0) {
+        close(fd);
+        return serve_reply_error(r, 500, "%s: %s", path, strerror(errno));
     }
     return serve_reply_fd(r, serve_data_type(path), fd, (uint64_t)st.st_size);
 }

@@ -353,7 +353,8 @@ static ssize_t serve_stream_read(void *cls, uint64_t pos, char *buf, size_t max)
     ssize_t n;
     if (j && j->version != st->seen) {
         json_t *o = serve_job_json(j);
-        char *text = o ? json_dumps(o, JSON_COMPACT | JSON_ENSURE_ASCII) : NULL;
+        char *text =
+            o ? json_dumps(o, JSON_COMPACT | JSON_ENSURE_ASCII | JSON_REAL_PRECISION(9)) : NULL;
         json_decref(o);
         st->seen = j->version;
         st->ended = serve_job_finished(j);
@@ -384,7 +385,7 @@ static enum MHD_Result serve_events(serve_request *r, long id)
         return MHD_NO;
     }
     MHD_add_response_header(resp, "Content-Type", "text/event-stream");
-    MHD_add_response_header(resp, "Cache-Control", "no-store");
+    serve_data_headers(resp); /* as every /api/ answer: CSP, nosniff, no-store */
     enum MHD_Result ret = MHD_queue_response(r->conn, 200, resp);
     MHD_destroy_response(resp);
     return ret;

@@ -4,15 +4,21 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "serve_jobs.h"
 
-/* A string option (copied into out[size]); false after replying 400. */
+/* A string option of 1 to size - 1 bytes (copied into out); false after replying 400. */
 static bool serve_opt_string(serve_request *r, json_t *v, const char *path, char *out, size_t size,
                              enum MHD_Result *ret)
 {
-    if (!json_is_string(v) || json_string_length(v) == 0 || json_string_length(v) >= size) {
+    if (!json_is_string(v) || json_string_length(v) == 0) {
         *ret = serve_reply_bad_json(r, path, "expected a non-empty string");
+        return false;
+    }
+    if (json_string_length(v) >= size) {
+        *ret = serve_reply_bad_json(r, path, "expected at most %zu bytes, got %zu", size - 1,
+                                    json_string_length(v));
         return false;
     }
     snprintf(out, size, "%s", json_string_value(v));
@@ -58,20 +64,55 @@ static bool serve_opt_bool(serve_request *r, json_t *v, const char *path, bool *
     return true;
 }
 
-/* The path REL in `v` checked against the root into out; false after replying. */
+/* The path REL in `v` checked against the root into out; with must_exist, a regular
+ * file (a FIFO would hold the job, and the server's stop, until someone writes to it).
+ * False after replying. */
 static bool serve_opt_path(serve_request *r, json_t *v, const char *path, bool must_exist,
                            char *out, enum MHD_Result *ret)
 {
-    char rel[PATH_MAX];
+    char rel[SERVE_MAX_REL_BYTES];
     if (!serve_opt_string(r, v, path, rel, sizeof rel, ret))
         return false;
     serve_path_status st = serve_path(r->s, rel, must_exist, out);
-    if (st == SERVE_PATH_FORBIDDEN)
-        *ret = serve_reply_error(r, 403, "%s: %s is outside the root, absolute, or has '..'", path,
-                                 rel);
-    else if (st == SERVE_PATH_MISSING)
-        *ret = serve_reply_error(r, 404, "%s: %s: no such file", path, rel);
-    return st == SERVE_PATH_OK;
+    if (st != SERVE_PATH_OK) {
+        *ret = serve_reply_path(r, st, path, ": ", rel);
+        return false;
+    }
+    struct stat sb;
+    if (must_exist && (stat(out, &sb) != 0 || !S_ISREG(sb.st_mode))) {
+        *ret = serve_reply_bad_json(r, path, "%s: not a regular file", rel);
+        return false;
+    }
+    return true;
+}
+
+/* The integrator a simulate or render job runs: its option, else the scene's
+ * render.integrator, else "path", the scene format's default (docs/scene-format.md), into
+ * buf. NULL when the scene does not name one the loader would take: loading it then fails
+ * the job in the loader's words. *from says where the name came from. */
+static const char *serve_job_integrator(const serve_job *j, char *buf, size_t size,
+                                        const char **from)
+{
+    *from = "options.integrator";
+    if (j->integrator[0])
+        return j->integrator;
+    size_t n = 0;
+    char *text = serve_read_file(j->scene, SERVE_MAX_FILE_BYTES, &n);
+    json_t *doc = text ? json_loadb(text, n, JSON_REJECT_DUPLICATES, NULL) : NULL;
+    free(text);
+    json_t *render = json_object_get(doc, "render");
+    json_t *name = json_object_get(render, "integrator");
+    const char *out = NULL;
+    if (json_is_object(doc) && (!render || (json_is_object(render) && !name))) {
+        *from = "the default, the scene naming no render.integrator";
+        out = "path";
+    } else if (json_is_string(name) && thz_integrator_known(json_string_value(name))) {
+        *from = "the scene's render.integrator";
+        snprintf(buf, size, "%s", json_string_value(name));
+        out = buf;
+    }
+    json_decref(doc);
+    return out;
 }
 
 /* One key of "options"; false after replying 400. */
@@ -93,12 +134,13 @@ static bool serve_parse_option(serve_request *r, serve_job *j, const char *key, 
         return serve_opt_whole(r, v, path, 0, INT64_MAX, &j->seed, ret);
     }
     if (scene && strcmp(key, "integrator") == 0) {
-        if (!serve_opt_string(r, v, path, j->integrator, sizeof j->integrator, ret))
-            return false;
-        if (!thz_integrator_known(j->integrator)) {
+        /* a name too long for the buffer is no integrator either: the names are the limit */
+        if (!json_is_string(v) || !thz_integrator_known(json_string_value(v)) ||
+            json_string_length(v) >= sizeof j->integrator) {
             *ret = serve_reply_bad_json(r, path, "expected path, final-gather or photon-map");
             return false;
         }
+        snprintf(j->integrator, sizeof j->integrator, "%s", json_string_value(v));
         return true;
     }
     if (scene && strcmp(key, "target_noise_k") == 0)
@@ -195,11 +237,27 @@ static serve_job *serve_parse_job(serve_request *r, json_t *body, enum MHD_Resul
         if (!serve_parse_option(r, j, key, v, ret))
             goto fail;
     }
-    if (j->command == CMD_SIMULATE && j->save_photon_map && j->integrator[0] &&
-        !thz_integrator_needs_photons(j->integrator)) { /* as the CLI refuses it */
+    /* as the CLI refuses them: a map to save that the integrator makes none of, a render
+     * from a map without one */
+    char name[64];
+    const char *from = NULL;
+    const char *integrator = j->command == CMD_SIMULATE || j->command == CMD_RENDER
+                                 ? serve_job_integrator(j, name, sizeof name, &from)
+                                 : NULL;
+    if (integrator && j->command == CMD_SIMULATE && j->save_photon_map &&
+        !thz_integrator_needs_photons(integrator)) {
         *ret = serve_reply_bad_json(r, "$.options.save_photon_map",
-                                    "the path integrator fires no photons: no photon map to "
-                                    "save (give integrator final-gather or photon-map)");
+                                    "the %s integrator (%s) fires no photons: no photon map to "
+                                    "save (give integrator final-gather or photon-map)",
+                                    integrator, from);
+        goto fail;
+    }
+    if (integrator && j->command == CMD_RENDER && !j->photon_map[0] &&
+        thz_integrator_needs_photons(integrator)) {
+        *ret = serve_reply_bad_json(r, "$.options.photon_map",
+                                    "the %s integrator (%s) renders from a photon map: give "
+                                    "photon_map (only integrator path renders without one)",
+                                    integrator, from);
         goto fail;
     }
     if (j->command == CMD_BANDS && j->count == 0) {

@@ -203,10 +203,10 @@ enum MHD_Result serve_validate(serve_request *r)
     const char *label = "<editor>";
     if (json_is_string(jpath)) {
         label = json_string_value(jpath);
-        if (serve_path(r->s, label, false, base) != SERVE_PATH_OK) {
+        serve_path_status st = serve_path(r->s, label, false, base);
+        if (st != SERVE_PATH_OK) {
             /* label points into body: the reply is made before body is freed */
-            enum MHD_Result res =
-                serve_reply_error(r, 403, "$.path: %s is outside the root", label);
+            enum MHD_Result res = serve_reply_path(r, st, "$.path", ": ", label);
             json_decref(body);
             return res;
         }

@@ -24,59 +24,14 @@ import sys
 import tempfile
 import time
 
+from serve_client import FAILURES, Server as Client, check
+
 BINARY, REPO = sys.argv[1], sys.argv[2]
 REQUESTS_ONLY = sys.argv[3:] == ["--requests-only"]
-FAILURES = []
 
 
-def check(cond, what):
-    if not cond:
-        FAILURES.append(what)
-        print("FAIL:", what, flush=True)
-
-
-class Server:
-    def __init__(self, root, env=None):
-        self.proc = subprocess.Popen([BINARY, "serve", "--port", "0", "--root", root],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     text=True, env=env)
-        line = self.proc.stdout.readline()
-        m = re.search(r"http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]{32}) ", line)
-        if not m:
-            self.proc.kill()
-            raise SystemExit("no URL printed: %r %s" % (line, self.proc.stderr.read()))
-        self.port, self.token = int(m.group(1)), m.group(2)
-
-    def request(self, method, path, body=None, headers=None, auth=True):
-        conn = http.client.HTTPConnection("127.0.0.1", self.port, timeout=60)
-        h = dict(headers or {})
-        if auth:
-            h["Authorization"] = "Bearer " + self.token
-        conn.request(method, path, body=body, headers=h)
-        resp = conn.getresponse()
-        data = resp.read()
-        conn.close()
-        return resp.status, dict(resp.getheaders()), data
-
-    def json(self, method, path, body=None, status=200):
-        if body is not None and not isinstance(body, (bytes, str)):
-            body = json.dumps(body)
-        st, _, data = self.request(method, path, body)
-        check(st == status, "%s %s: status %d, expected %d (%s)" % (method, path, st, status,
-                                                                     data[:300]))
-        try:
-            return json.loads(data)
-        except ValueError:
-            check(False, "%s %s: not JSON: %r" % (method, path, data[:200]))
-            return None
-
-    def stop(self, sig=signal.SIGINT):
-        self.proc.send_signal(sig)
-        try:
-            return self.proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            return None
+def Server(root, env=None):
+    return Client(BINARY, root, env)
 
 
 def make_root(root):

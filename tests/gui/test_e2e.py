@@ -49,6 +49,23 @@ def make_root(root):
     scene["render"] = {"integrator": "photon-map"}
     with open(path, "w") as f:
         json.dump(scene, f, indent=2)
+    # one channel, the path integrator (fires no photons, needs no map), 8 x 8 pixels
+    one = json.loads(json.dumps(scene))
+    one["channels"] = [{"name": "0.35 THz", "frequency_thz": 0.35, "relative_width": 0.01}]
+    one["sensors"][0].update(resolution=[8, 8])
+    one["render"] = {"integrator": "path", "paths_per_sample": 1}
+    with open(os.path.join(root, "teraeye", "path.json"), "w") as f:
+        json.dump(one, f, indent=2)
+    # and one that runs for minutes unless cancelled, in little memory
+    one["sensors"][0].update(resolution=[256, 256])
+    one["render"]["paths_per_sample"] = 100000
+    with open(os.path.join(root, "teraeye", "slow.json"), "w") as f:
+        json.dump(one, f, indent=2)
+    # files the scene panels once choked on (TypeErrors) before validating them
+    for name, doc in (("bad-objects.json", {"format": "thzmap-scene/1", "objects": {"a": 1}}),
+                      ("bad-null.json", {"objects": [None, 5]})):
+        with open(os.path.join(root, "teraeye", name), "w") as f:
+            json.dump(doc, f)
     return scene
 
 
@@ -76,6 +93,117 @@ def browser():
                 "--window-size=1400,850", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"):
         options.add_argument(arg)
     return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+
+
+def audit_fixes(driver, wait, patient, by_id, click_list, field, root):
+    """What the audit of the page found (each failed before its fix): files that broke the
+    scene panels, an object made a shell, a path-integrator scene simulated and rendered
+    from the form, its one channel captioned, fields of other commands not sent, the JSON
+    path of an error shown, and eight runs queued without the page freezing."""
+    status = lambda: by_id("status").text
+    state = lambda: by_id("validation-state").text
+    by_id("tab-scene").click()
+    for name in ("bad-objects.json", "bad-null.json"):
+        click_list("files", name)
+        wait.until(lambda d: f"opened teraeye/{name}" in status() or "Error" in status())
+        wait.until(lambda d: "✗" in state())
+        assert "Error" not in status(), status()
+        log(f"{name}: {state()}, status {status()!r}")
+    # the object's type decides its fields: a shell has a thickness
+    click_list("files", "path.json")
+    wait.until(lambda d: "✓" in state())
+    click_list("objects", "cylinder-A")
+    assert not driver.find_elements(By.CSS_SELECTOR, '.field[data-path="objects[1].thickness_m"]')
+    Select(field("objects[1].type").find_element(By.TAG_NAME, "select")).select_by_value("shell")
+    wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, '.field[data-path="objects[1].thickness_m"]'))
+    log("a shell shows its thickness")
+    # Run: the scene open is path.json (the path integrator): no map to save, none to read
+    by_id("tab-run").click()
+    wait.until(lambda d: by_id("run-scene").get_attribute("value") == "teraeye/path.json")
+    wait.until(lambda d: not by_id("run-save-map").is_selected() and not by_id("run-save-map").is_enabled())
+
+    def start(command, out, **fields):
+        Select(by_id("run-command")).select_by_visible_text(command)
+        for name, value in fields.items():
+            box = by_id(f"run-{name}")
+            if box.is_enabled():
+                box.clear()
+                box.send_keys(value)
+        by_id("run-out").clear()
+        by_id("run-out").send_keys(out)
+        before = status()
+        by_id("btn-run").click()
+        patient(10).until(lambda d: status() != before and ("queued" in status() or "/api/" in status()))
+        return status()
+
+    def final_state(out):
+        row = lambda d: d.execute_script(
+            "const r = [...document.querySelectorAll('#runs tbody tr')].find((x) => x.cells[3].textContent === arguments[0]);"
+            "return r ? r.dataset.state : null;", out)
+        patient(60, 0.1).until(lambda d: row(d) in ("done", "failed", "cancelled"))
+        return row(driver)
+
+    by_id("run-seed").clear()
+    by_id("run-seed").send_keys("3")  # left in the form: batch and render take no seed
+    said = start("simulate", "teraeye/out-path-sim")
+    assert "queued" in said, said
+    assert final_state("teraeye/out-path-sim") == "done"
+    # it opens in Results: its one channel is captioned as such
+    wait.until(lambda d: "out-path-sim" in status() and "loaded" in status())
+    by_id("tab-results").click()
+    Select(by_id("res-view")).select_by_value("image")
+    Select(by_id("res-quantity")).select_by_value("brightness_temperature")
+    caption = lambda: by_id("image-info").get_attribute("textContent")
+    wait.until(lambda d: caption().startswith("brightness temperature, "))
+    assert caption().startswith("brightness temperature, channel 1 (0.35 THz)"), caption()
+    log(f"one-channel run: {caption()[:60]!r}")
+    by_id("tab-run").click()
+    said = start("render", "teraeye/out-path-render", **{"photon-map": ""})
+    assert "queued" in said, said
+    assert not by_id("run-seed").is_enabled() and not by_id("run-photons").is_enabled()
+    assert final_state("teraeye/out-path-render") == "done"
+    # a render of the photon-map scene from its map, with the seed still filled in
+    by_id("run-scene").clear()
+    by_id("run-scene").send_keys("teraeye/scene.json")
+    said = start("render", "teraeye/out-render", **{"photon-map": "teraeye/out-seed1/photon-map.thzpm"})
+    assert "queued" in said, said
+    assert final_state("teraeye/out-render") == "done"
+    log("simulate and render of the path scene, render from a map: done")
+    # an error names where in the request it is
+    said = start("bands", "teraeye/out-bands", count="0")
+    assert "$.options.count" in said, said
+    log(f"error: {said!r}")
+    # eight runs queued: the page still answers (one stream, not one per run)
+    by_id("run-count").clear()
+    by_id("run-count").send_keys("4")
+    by_id("run-scene").clear()
+    by_id("run-scene").send_keys("teraeye/slow.json")
+    for k in range(8):
+        said = start("simulate", f"teraeye/out-many-{k}", photons="")
+        assert "queued" in said, said
+    answered = driver.execute_async_script(
+        "const done = arguments[arguments.length - 1];"
+        "const t = setTimeout(() => done('no answer in 5 s'), 5000);"
+        "fetch('/api/info').then((r) => { clearTimeout(t); done(r.status); }, (e) => done(String(e)));")
+    assert answered == 200, answered
+    # the page's own requests too: a validation of the scene
+    by_id("tab-scene").click()
+    click_list("files", "scene.json")
+    wait.until(lambda d: "✓" in state())
+    log("eight runs queued: the page still answers")
+    by_id("tab-run").click()
+    driver.execute_async_script(
+        "const done = arguments[arguments.length - 1];"
+        "fetch('/api/runs').then((r) => r.json()).then((runs) => Promise.all(runs"
+        ".filter((r) => r.state === 'queued' || r.state === 'running')"
+        ".map((r) => fetch(`/api/runs/${r.id}`, {method: 'DELETE'})))).then(() => done(), () => done());")
+    states = [final_state(f"teraeye/out-many-{k}") for k in range(8)]
+    assert states == ["cancelled"] * 8, states
+    # the errors the browser logged are the bands run's, asked for above
+    errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"
+              and "/api/runs - Failed to load resource" not in e["message"]
+              and "(at $.options.count)" not in e["message"]]
+    assert not errors, errors
 
 
 def main():
@@ -235,6 +363,7 @@ def main():
         shot("diff")
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         assert not errors, errors
+        audit_fixes(driver, wait, patient, by_id, click_list, field, root)
     except Exception:
         shot("failure")
         print("status line:", driver.find_element(By.ID, "status").text)

@@ -8,6 +8,8 @@ export async function request(path, options = {}) {
     try {
       const body = await response.json();
       message = body.error || body.message || JSON.stringify(body);
+      // where in the request body the problem is: "$.options.seed"
+      if (body.path) message += ` (at ${body.path})`;
     } catch (_) {
       /* not JSON: the status text says enough */
     }

@@ -10,6 +10,7 @@ import { PhotonView } from "./photons.js";
 const $ = (id) => document.getElementById(id);
 const QUANTITIES = ["brightness_temperature", "measured_brightness_temperature", "temperature",
   "distance", "object_id", "radiance", "radiance_stderr", "normalized", "power", "measured_radiance"];
+const TRUTH = new Set(["temperature", "distance", "object_id"]); // one band, not per channel
 const join = (dir, name) => (dir ? `${dir}/${name}` : name);
 
 export class Results {
@@ -147,7 +148,8 @@ export class Results {
     paint($("image"), cube, values, lo, hi, viridis, ignore);
     const unit = cube.unit === "1" ? "(1)" : cube.unit;
     drawColourBar($("colourbar"), lo, hi, unit);
-    const which = cube.bands > 1 ? `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)` : "truth";
+    // the truth maps hold one band whatever the run; a one-channel run's cubes one channel
+    const which = TRUTH.has(qn) ? "truth" : `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)`;
     $("image-info").textContent = `${qn.replace(/_/g, " ")}, ${which}; colours span the 1st to 99th ` +
       `percentile${$("res-scale").value === "common" ? " of all channels" : ""}: ` +
       `${formatNumber(lo)} to ${formatNumber(hi)}${cube.unit === "1" ? "" : ` ${cube.unit}`}`;

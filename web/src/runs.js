@@ -1,21 +1,43 @@
 // The Run tab: start simulate, render, batch or bands on the server (a queue: one runs,
-// the others wait), follow each run's progress by Server-Sent Events, cancel.
-import { del, getJSON, q, reportError, sendJSON, status } from "./api.js";
+// the others wait), follow the running run's progress by Server-Sent Events and the
+// others' by polling, cancel.
+import { del, getJSON, getText, q, reportError, sendJSON, status } from "./api.js";
 
 const $ = (id) => document.getElementById(id);
 const FINAL = new Set(["done", "finished", "succeeded", "failed", "cancelled", "canceled", "error"]);
 
+const POLL_MS = 1000; // the states of the runs not streamed, while any is unfinished
+// the form's fields each command takes (others are disabled and not sent)
+const FIELDS = {
+  simulate: ["run-photons", "run-seed", "run-save-map"],
+  render: ["run-photon-map"],
+  batch: [],
+  bands: ["run-seed", "run-count"],
+};
+
+// A browser holds at most 6 connections to a host, and an event stream holds one for as
+// long as its run lasts: the page streams only the running run (the server runs one at a
+// time) and asks GET /api/runs for the others' states, so that requests are never left
+// waiting for a connection however many runs are queued.
 export class Runs {
   constructor() {
     this.runs = new Map();
-    this.streams = new Map();
+    this.stream = null; // {id, source}: the running run's event stream
+    this.pollTimer = null;
+    this.integrator = null; // the run scene's integrator (null: not known)
     $("btn-run").onclick = () => this.start().catch(reportError);
-    $("run-command").onchange = () => this.defaults();
+    $("run-command").onchange = () => {
+      this.defaults();
+      this.updateForm();
+    };
+    $("run-scene").onchange = () => this.checkScene().catch(() => {});
+    this.updateForm();
   }
 
   sceneOpened(path) {
     $("run-scene").value = path;
     this.defaults();
+    this.checkScene().catch(() => {});
   }
 
   defaults() {
@@ -25,75 +47,145 @@ export class Runs {
     $("run-out").value = `${dir}out-${base}-${$("run-command").value}`;
   }
 
+  // the integrator the scene to run names (render.integrator; path when it names none),
+  // as the server decides it: a photon map is saved, or needed, only where one is made
+  async checkScene() {
+    const path = $("run-scene").value.trim();
+    if (!path.endsWith(".json")) {
+      this.integrator = null; // a sequence's or none yet: the server decides
+      this.updateForm();
+      return;
+    }
+    let integrator = null;
+    try {
+      const doc = JSON.parse(await getText(`/api/file?path=${q(path)}`));
+      const named = doc?.render?.integrator;
+      integrator = named === undefined ? "path" : typeof named === "string" ? named : null;
+    } finally {
+      if ($("run-scene").value === path) {
+        this.integrator = integrator;
+        this.updateForm();
+      }
+    }
+  }
+
+  updateForm() {
+    const takes = FIELDS[$("run-command").value] || [];
+    for (const id of new Set(Object.values(FIELDS).flat())) $(id).disabled = !takes.includes(id);
+    // the path integrator fires no photons: no map to save (the server refuses it); what
+    // the box said comes back with a scene that makes one
+    const box = $("run-save-map");
+    const noPhotons = this.integrator === "path";
+    if (noPhotons && box.dataset.wanted === undefined) {
+      box.dataset.wanted = String(box.checked);
+      box.checked = false;
+    } else if (!noPhotons && box.dataset.wanted !== undefined) {
+      box.checked = box.dataset.wanted === "true";
+      delete box.dataset.wanted;
+    }
+    box.disabled ||= noPhotons;
+    box.title = noPhotons ? "the scene's integrator, path, fires no photons: no map to save" : "";
+  }
+
   async start() {
+    const command = $("run-command").value;
+    if (command === "simulate" || command === "render") await this.checkScene().catch(() => {});
+    const takes = (id) => !$(id).disabled; // what updateForm left enabled for the command
     const options = {};
     const photons = $("run-photons").value;
     const seed = $("run-seed").value;
-    const command = $("run-command").value;
-    if (photons) options.photons = Number(photons);
-    if (seed) options.seed = Number(seed);
-    if (command === "simulate" && $("run-save-map").checked) options.save_photon_map = true;
-    if (command === "render") options.photon_map = $("run-photon-map").value;
-    if (command === "bands") options.count = Number($("run-count").value);
+    if (takes("run-photons") && photons) options.photons = Number(photons);
+    if (takes("run-seed") && seed) options.seed = Number(seed);
+    if (takes("run-save-map") && $("run-save-map").checked) options.save_photon_map = true;
+    const map = $("run-photon-map").value.trim();
+    if (takes("run-photon-map") && map) options.photon_map = map; // none: the path integrator
+    if (takes("run-count")) options.count = Number($("run-count").value);
     const body = { command, scene: $("run-scene").value, out: $("run-out").value, options };
     const { id } = await sendJSON("POST", "/api/runs", body);
     this.runs.set(String(id), { id, ...body, state: "queued" });
     status(`run ${id} queued`);
-    this.follow(String(id));
     this.renderTable();
+    this.watch();
   }
 
   async refresh() {
     const list = await getJSON("/api/runs");
-    for (const r of Array.isArray(list) ? list : list.runs || []) {
-      const id = String(r.id);
-      this.runs.set(id, { ...this.runs.get(id), ...r });
-      if (!FINAL.has(r.state) && !this.streams.has(id)) this.follow(id);
-    }
+    for (const r of Array.isArray(list) ? list : list.runs || []) this.update(String(r.id), r);
     this.renderTable();
+    this.watch();
+  }
+
+  // a run's new state, from the stream or a poll: logged, and announced once finished
+  update(id, data) {
+    const known = this.runs.get(id);
+    const run = known || { id };
+    const before = run.message;
+    const wasOpen = known !== undefined && !FINAL.has(known.state); // else finished before this page
+    Object.assign(run, data); // the job's JSON: state, progress 0..1, message, error
+    if (run.message && run.message !== before) this.log(`[${id}] ${run.message}`);
+    if (run.error && !run.errorLogged) {
+      run.errorLogged = true;
+      this.log(`[${id}] error: ${run.error}`);
+    }
+    this.runs.set(id, run);
+    if (FINAL.has(run.state) && wasOpen) this.finished(id, run);
+  }
+
+  // one stream, the running run's; a poll while any run is unfinished
+  watch() {
+    const open = [...this.runs.values()].filter((r) => !FINAL.has(r.state));
+    const running = open.filter((r) => r.state === "running").map((r) => String(r.id)).pop();
+    if (this.stream && this.stream.id !== running) this.closeStream();
+    if (running && !this.stream && !this.runs.get(running).streamFailed) this.follow(running);
+    clearTimeout(this.pollTimer);
+    this.pollTimer = open.length ? setTimeout(() => this.poll(), POLL_MS) : null;
+  }
+
+  poll() {
+    this.refresh().catch((e) => {
+      reportError(e);
+      clearTimeout(this.pollTimer);
+      this.pollTimer = setTimeout(() => this.poll(), 5 * POLL_MS);
+    });
+  }
+
+  closeStream() {
+    this.stream?.source.close();
+    this.stream = null;
   }
 
   follow(id) {
     const source = new EventSource(`/api/runs/${q(id)}/events`);
-    this.streams.set(id, source);
+    this.stream = { id, source };
     const handle = (e) => {
-      let data;
+      if (this.stream?.source !== source) return;
+      let data = {};
       try {
         data = JSON.parse(e.data);
       } catch (_) {
-        data = { message: e.data };
+        /* a comment or an empty end */
       }
-      const run = this.runs.get(id) || { id };
-      const before = run.message;
-      Object.assign(run, data); // the job's JSON: state, progress 0..1, message, error
-      if (run.message && run.message !== before) this.log(`[${id}] ${run.message}`);
-      if (run.error) this.log(`[${id}] error: ${run.error}`);
-      this.runs.set(id, run);
-      if (FINAL.has(run.state) || e.type === "end") this.finished(id, run);
-      this.renderTable();
-    };
-    source.onmessage = handle;
-    for (const type of ["progress", "state", "log", "end", "done"]) source.addEventListener(type, handle);
-    source.onerror = () => {
-      // the server closes the stream when the run ends: ask it for the final state
-      source.close();
-      this.streams.delete(id);
-      getJSON(`/api/runs`).then((list) => {
-        const r = (Array.isArray(list) ? list : list.runs || []).find((x) => String(x.id) === id);
-        if (r) {
-          const run = { ...this.runs.get(id), ...r };
-          this.runs.set(id, run);
-          if (FINAL.has(run.state)) this.finished(id, run);
-          else setTimeout(() => this.follow(id), 500);
-        }
+      if (e.type !== "end") this.update(id, data);
+      if (e.type === "end" || FINAL.has(this.runs.get(id)?.state)) {
+        this.closeStream();
+        this.refresh().catch(reportError); // the final state, and the next run to stream
+      } else {
         this.renderTable();
-      }).catch(reportError);
+      }
+    };
+    source.addEventListener("progress", handle);
+    source.addEventListener("end", handle);
+    source.onerror = () => {
+      // not the stream's normal end (handled above): polling follows this run instead
+      if (this.stream?.source !== source) return;
+      this.closeStream();
+      const run = this.runs.get(id);
+      if (run) run.streamFailed = true;
+      this.watch();
     };
   }
 
   finished(id, run) {
-    this.streams.get(id)?.close();
-    this.streams.delete(id);
     if (run.announced) return;
     run.announced = true;
     const ok = ["done", "finished", "succeeded"].includes(run.state);

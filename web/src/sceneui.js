@@ -82,9 +82,12 @@ export class SceneEditor {
       /* the validator reports where */
     }
     this.selection = { kind: "object", index: 0 };
-    this.renderLists();
-    this.renderProps();
-    this.validateNow(text);
+    try {
+      this.renderLists();
+      this.renderProps();
+    } finally {
+      this.validateNow(text); // whatever the panels made of it, the validator says what is wrong
+    }
   }
 
   async save() {
@@ -114,7 +117,10 @@ export class SceneEditor {
     $("scene-text").value = text;
     const keys = parsePath(path);
     if (keys[0] === "objects" && (keys[2] === "name" || keys[2] === "shape")) this.renderLists();
-    if (keys[2] === "shape" && keys[3] === "type") this.renderProps();
+    // the fields of an object depend on its type (a shell's thickness) and its shape's
+    if (keys[0] === "objects" && (keys[2] === "type" || (keys[2] === "shape" && keys[3] === "type"))) {
+      this.renderProps();
+    }
     if (keys[0] === "objects" && keys[2] === "material") this.renderPlots();
     this.scheduleValidate(text);
   }
@@ -218,7 +224,9 @@ export class SceneEditor {
   renderLists() {
     const fill = (ul, items, kind, prefix) => {
       ul.replaceChildren();
-      (items || []).forEach((item, i) => {
+      // a list as the file has it, however wrong: the validator names what is wrong
+      (Array.isArray(items) ? items : []).forEach((entry, i) => {
+        const item = entry !== null && typeof entry === "object" ? entry : {};
         const li = document.createElement("li");
         li.dataset.path = `${prefix}[${i}]`;
         if (kind === "object") {
@@ -227,7 +235,7 @@ export class SceneEditor {
           sw.style.background = cssColour(materialColour(this.doc, item.material).map((c) => c * 255));
           li.appendChild(sw);
         }
-        li.append(item.name || `${kind} ${i}`);
+        li.append(typeof item.name === "string" && item.name ? item.name : `${kind} ${i}`);
         li.classList.toggle("selected", this.selection.kind === kind && this.selection.index === i);
         li.onclick = () => this.select(kind, i);
         ul.appendChild(li);
@@ -244,8 +252,10 @@ export class SceneEditor {
     const { kind, index } = this.selection;
     const onChange = (path) => this.edited(path);
     const add = (spec) => box.appendChild(field(this.doc, spec, onChange));
-    if (kind === "object" && this.doc.objects?.[index]) {
-      const o = this.doc.objects[index];
+    const entry = (list) => (Array.isArray(list) && list[index] !== null && typeof list[index] === "object"
+      ? list[index] : null);
+    if (kind === "object" && entry(this.doc.objects)) {
+      const o = entry(this.doc.objects);
       const p = `objects[${index}]`;
       $("props-title").textContent = `Object ${o.name ?? index}`;
       add({ label: "name", path: `${p}.name`, kind: "text" });
@@ -268,8 +278,8 @@ export class SceneEditor {
       add({ label: "translate", path: `${p}.transform.translate_m`, kind: "vector", unit: "m", placeholder: "0, 0, 0" });
       add({ label: "rotate", path: `${p}.transform.rotate_deg`, kind: "vector", unit: "°", placeholder: "0, 0, 0" });
       add({ label: "scale", path: `${p}.transform.scale`, kind: "vector", placeholder: "1" });
-    } else if (kind === "sensor" && this.doc.sensors?.[index]) {
-      const s = this.doc.sensors[index];
+    } else if (kind === "sensor" && entry(this.doc.sensors)) {
+      const s = entry(this.doc.sensors);
       const p = `sensors[${index}]`;
       $("props-title").textContent = `Sensor ${s.name ?? index}`;
       add({ label: "name", path: `${p}.name`, kind: "text" });

@@ -1,0 +1,188 @@
+#!/usr/bin/python3
+"""What `thzmap serve` refuses, and in which words (docs/gui.md): files that are no
+regular files (a FIFO once held the request, and then the server's stop, for ever), files
+and directories the server may not read, paths with "." components, over-long strings,
+runs whose integrator (the option, or else the scene's render.integrator, or else path)
+contradicts save_photon_map or a missing photon_map; and the event stream's headers and
+numbers, as every other /api/ answer's.
+
+usage: test_api_refusals.py THZMAP_BINARY REPO_DIR [--requests-only]
+
+--requests-only: only the requests that start no job (test_api.py says why).
+"""
+import json
+import os
+import re
+import shutil
+import signal
+import socket
+import stat
+import sys
+import tempfile
+import time
+
+from serve_client import FAILURES, Server, check
+
+BINARY, REPO = sys.argv[1], sys.argv[2]
+REQUESTS_ONLY = sys.argv[3:] == ["--requests-only"]
+# root reads every file whatever its mode: the server runs without that capability, so
+# that a mode-000 file is as unreadable to it as to any other user
+NO_DAC = (["setpriv", "--bounding-set", "-dac_override,-dac_read_search"]
+          if os.geteuid() == 0 and shutil.which("setpriv") else [])
+
+
+def make_root(root):
+    """plate-in-box at 8 x 6 pixels, three times: integrator photon-map, path, and none."""
+    src = os.path.join(REPO, "examples", "plate-in-box")
+    shutil.copytree(os.path.join(src, "materials"), os.path.join(root, "s", "materials"))
+    scene = json.load(open(os.path.join(src, "scene.json")))
+    scene["sensors"][0].update(resolution=[8, 6], oversampling=1)
+    scene["photons"]["per_channel"] = 2000
+    scene.pop("render", None)
+    for name, render in (("pm", {"integrator": "photon-map"}),
+                         ("path", {"integrator": "path", "paths_per_sample": 1}), ("none", None)):
+        if render:
+            scene["render"] = render
+        else:
+            scene.pop("render", None)
+        with open(os.path.join(root, "s", name + ".json"), "w") as f:
+            json.dump(scene, f)
+    os.mkfifo(os.path.join(root, "s", "fifo.json"))
+    open(os.path.join(root, "s", "locked.json"), "w").write("{}")
+    os.chmod(os.path.join(root, "s", "locked.json"), 0)
+    os.makedirs(os.path.join(root, "s", "closed"))
+    open(os.path.join(root, "s", "closed", "x.json"), "w").write("{}")
+    os.chmod(os.path.join(root, "s", "closed"), 0)
+
+
+def get_within(srv, path, seconds):
+    """GET path: (status, JSON body), or (None, None) when no answer came in time."""
+    try:
+        st, _, data = srv.request("GET", path, timeout=seconds)
+        return st, json.loads(data)
+    except (socket.timeout, TimeoutError, ValueError):
+        return None, None
+
+
+def test_files(srv, root):
+    # a FIFO: refused at once, not opened to wait for a writer
+    st, err = get_within(srv, "/api/file?path=s/fifo.json", 5)
+    check(st == 400 and "not a regular file" in err["error"], "GET a FIFO: %s %r" % (st, err))
+    err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/fifo.json",
+                                               "out": "o"}, status=400)
+    check(err and err.get("path") == "$.scene" and "not a regular file" in err["error"],
+          "a FIFO's run: %r" % err)
+    # "." components name the same file wherever they are
+    want = open(os.path.join(root, "s", "pm.json"), "rb").read()
+    for path in ("s/./pm.json", "./s/pm.json", "s/.//./pm.json"):
+        st, _, data = srv.request("GET", "/api/file?path=" + path)
+        check(st == 200 and data == want, "GET %s: %d %r" % (path, st, data[:100]))
+    st, _, _ = srv.request("GET", "/api/file?path=s/./../../secret.json")
+    check(st == 403, "'..' after '.': %d, expected 403" % st)
+    # what the server may not read is said so, not "not a file" or "outside the root"
+    if os.geteuid() == 0 and not NO_DAC:
+        print("skipped: permission denied (root without setpriv reads everything)")
+        return
+    for path in ("s/locked.json", "s/closed/x.json"):
+        st, err = get_within(srv, "/api/file?path=" + path, 10)
+        check(st == 403 and "permission denied" in err["error"], "GET %s: %s %r" % (path, st, err))
+
+
+def test_lengths(srv):
+    long_path = "s/" + "d/" * 2100 + "scene.json"
+    st, err = get_within(srv, "/api/file?path=" + long_path, 10)
+    check(st == 400 and "longer than the 4093 allowed" in err["error"],
+          "GET a path of %d bytes: %s %r" % (len(long_path), st, err))
+    for key, value, words in (("scene", long_path, "at most 4093 bytes"),
+                              ("options.sensor", "c" * 300, "at most 255 bytes"),
+                              ("options.integrator", "i" * 100,
+                               "expected path, final-gather or photon-map")):
+        body = {"command": "render", "scene": "s/path.json", "out": "o", "options": {}}
+        if key == "scene":
+            body["scene"] = value
+        else:
+            body["options"][key.split(".")[1]] = value
+        err = srv.json("POST", "/api/runs", body=body, status=400)
+        check(err and err.get("path") == "$." + key and words in err["error"],
+              "%s of %d bytes: %r" % (key, len(value), err))
+
+
+def test_integrators(srv):
+    """The integrator is the option's, else the scene's, else path (the default)."""
+    for scene, options, key in (
+            ("s/path.json", {"save_photon_map": True}, "save_photon_map"),
+            ("s/none.json", {"save_photon_map": True}, "save_photon_map"),
+            ("s/pm.json", {"integrator": "path", "save_photon_map": True}, "save_photon_map")):
+        err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": scene,
+                                                   "out": "o", "options": options}, status=400)
+        check(err and err.get("path") == "$.options." + key and "path integrator" in err["error"],
+              "simulate %s %r: %r" % (scene, options, err))
+    for scene, options in (("s/pm.json", {}), ("s/path.json", {"integrator": "final-gather"})):
+        err = srv.json("POST", "/api/runs", body={"command": "render", "scene": scene,
+                                                   "out": "o", "options": options}, status=400)
+        check(err and err.get("path") == "$.options.photon_map" and
+              "renders from a photon map" in err["error"], "render %s %r: %r" % (scene, options, err))
+
+
+def test_events(srv, root):
+    """A render of the path scene without a photon map runs; its event stream carries the
+    headers of every /api/ answer and reals of 9 significant digits."""
+    run = srv.json("POST", "/api/runs", body={"command": "render", "scene": "s/path.json",
+                                               "out": "out/path"}, status=202)
+    if not run:
+        return
+    sock = socket.create_connection(("127.0.0.1", srv.port), timeout=60)
+    sock.sendall(("GET /api/runs/%d/events HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer %s\r\n"
+                  "\r\n" % (run["id"], srv.token)).encode())
+    raw = b""
+    while b"event: end" not in raw:
+        chunk = sock.recv(65536)
+        if not chunk:
+            break
+        raw += chunk
+    sock.close()
+    head, _, body = raw.decode().partition("\r\n\r\n")
+    check("content-security-policy: default-src 'none'; sandbox" in head.lower() and
+          "x-content-type-options: nosniff" in head.lower(), "event stream headers: %r" % head)
+    datas = [json.loads(line[6:]) for line in body.splitlines() if line.startswith("data: {\"")]
+    check(datas and datas[-1]["state"] == "done", "render of the path scene: %r" % datas[-1:])
+    reals = [m for line in body.splitlines() if line.startswith("data: ")
+             for m in re.findall(r"(?<![\w.])-?\d+\.\d+(?:[eE][-+]?\d+)?", line)]
+    digits = lambda x: len(x.lstrip("-").split("e")[0].split("E")[0].replace(".", "").lstrip("0"))
+    check(reals and max(digits(x) for x in reals) <= 9,
+          "reals of more than 9 digits: %r" % [x for x in reals if digits(x) > 9][:5])
+    check(os.path.exists(os.path.join(root, "out", "path", "summary.json")), "no output written")
+
+
+def main():
+    tmp = tempfile.mkdtemp(prefix="thzmap-refusals-")
+    root = os.path.join(tmp, "root")
+    os.makedirs(root)
+    try:
+        make_root(root)
+        open(os.path.join(tmp, "secret.json"), "w").write("{}")
+        env = dict(os.environ, THZMAP_WEB_DIR=os.path.join(tmp, "web"))
+        srv = Server(BINARY, root, env, prefix=NO_DAC)
+        try:
+            tests = [("files", lambda: test_files(srv, root)), ("lengths", lambda: test_lengths(srv)),
+                     ("integrators", lambda: test_integrators(srv))]
+            if not REQUESTS_ONLY:
+                tests.append(("events", lambda: test_events(srv, root)))
+            for name, fn in tests:
+                t = time.time()
+                fn()
+                print("%-12s %.2f s" % (name, time.time() - t), flush=True)
+        finally:
+            # the FIFO asked for above must not hold the stop
+            rc = srv.stop(signal.SIGINT, timeout=10)
+            check(rc == 130, "SIGINT: exit status %s, expected 130" % rc)
+    finally:
+        os.chmod(os.path.join(root, "s", "closed"), stat.S_IRWXU)
+        shutil.rmtree(tmp, ignore_errors=True)
+    if FAILURES:
+        print("%d failure(s)" % len(FAILURES))
+        sys.exit(1)
+    print("ok")
+
+
+main()
