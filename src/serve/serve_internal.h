@@ -128,6 +128,9 @@ int serve_open_regular(const char *path);
 /* Reads a whole regular file (at most max bytes) into a malloc'd NUL-terminated buffer. */
 char *serve_read_file(const char *path, size_t max, size_t *size);
 
+/* The JSON document of a regular file (serve_read_file: a FIFO does not block), or NULL. */
+json_t *serve_read_json(const char *path);
+
 /* ---- endpoints ----------------------------------------------------------------------- */
 typedef enum MHD_Result (*serve_handler)(serve_request *r);
 

@@ -144,6 +144,15 @@ int serve_open_regular(const char *path)
     return fd;
 }
 
+json_t *serve_read_json(const char *path)
+{
+    size_t n = 0;
+    char *text = serve_read_file(path, SERVE_MAX_FILE_BYTES, &n);
+    json_t *doc = text ? json_loadb(text, n, 0, NULL) : NULL;
+    free(text);
+    return doc;
+}
+
 char *serve_read_file(const char *path, size_t max, size_t *size)
 {
     int fd = serve_open_regular(path);

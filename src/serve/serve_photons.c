@@ -45,7 +45,7 @@ static bool serve_photon_scene(serve_request *r, const char *map, char *out, enu
     char *slash = strrchr(summary, '/');
     snprintf(slash ? slash + 1 : summary,
              sizeof summary - (size_t)(slash ? slash + 1 - summary : 0), "summary.json");
-    json_t *o = json_load_file(summary, 0, NULL);
+    json_t *o = serve_read_json(summary);
     const char *rel = json_string_value(json_object_get(json_object_get(o, "scene"), "path"));
     serve_path_status st = rel ? serve_path(r->s, rel, true, out) : SERVE_PATH_MISSING;
     json_decref(o);

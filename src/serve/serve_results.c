@@ -83,7 +83,7 @@ enum MHD_Result serve_outputs(serve_request *r)
     if (!names && n == 0 && !serve_is_dir(dir, "."))
         return serve_reply_error(r, 400, "%s: not a directory", dir);
     snprintf(path, sizeof path, "%s/summary.json", dir);
-    json_t *summary = json_load_file(path, 0, NULL);
+    json_t *summary = serve_read_json(path);
     json_t *sensors = json_array(), *frames = json_array();
     bool photon_map = false;
     /* the sensors: from S.QUANTITY.hdr of a known quantity (sensor names may hold dots) */

@@ -68,6 +68,12 @@ def test_files(srv, root):
     # a FIFO: refused at once, not opened to wait for a writer
     st, err = get_within(srv, "/api/file?path=s/fifo.json", 5)
     check(st == 400 and "not a regular file" in err["error"], "GET a FIFO: %s %r" % (st, err))
+    # a FIFO where a results directory's summary.json would be: /api/outputs answers
+    os.makedirs(os.path.join(root, "f"), exist_ok=True)
+    if not os.path.exists(os.path.join(root, "f", "summary.json")):
+        os.mkfifo(os.path.join(root, "f", "summary.json"))
+    st, _ = get_within(srv, "/api/outputs?dir=f", 5)
+    check(st is not None, "GET /api/outputs of a directory whose summary.json is a FIFO hung")
     err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/fifo.json",
                                                "out": "o"}, status=400)
     check(err and err.get("path") == "$.scene" and "not a regular file" in err["error"],
