@@ -92,10 +92,10 @@ static void batch_hex(uint64_t h, char hex[17])
     snprintf(hex, 17, "%016llx", (unsigned long long)h);
 }
 
-/* Whether frame f's directory holds a finished frame with the same inputs. */
 /* A frame.json is a few kilobytes; anything far larger is not one. */
 #define BATCH_FRAME_JSON_MAX ((uint64_t)64 << 20)
 
+/* Whether frame f's directory holds a finished frame with the same inputs. */
 static int batch_frame_done(const batch_state *b, size_t f)
 {
     char path[THZ_PATH_MAX], hex[17];
