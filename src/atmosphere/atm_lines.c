@@ -120,7 +120,8 @@ static double core(const struct lbl_line *l, double d)
  * density (cm^-3). Lines whose isotopologue has no partition sum are an error. */
 static thz_status species_build(lbl_species *sp, const raw_catalog *cat, const partition_sums *q,
                                 int molecule, lbl_shape shape, const atm_air_state *air,
-                                double p_self, double n_cm3, const char *what, thz_error *err)
+                                double p_self, double n_cm3, const char *what,
+                                const char *lines_path, const char *q_path, thz_error *err)
 {
     double t = air->temperature_k, p = air->pressure_hpa;
     double tr = 296.0 / t;
@@ -149,10 +150,10 @@ static thz_status species_build(lbl_species *sp, const raw_catalog *cat, const p
                 free(sp->lines);
                 sp->lines = NULL;
                 return thz_error_set(err, THZ_ERR_INPUT,
-                                     "%s lines: no partition sum for isotopologue %d at %g K "
-                                     "(the partition-sum table has %zu isotopologues); give a "
-                                     "table that has it or remove those lines",
-                                     what, l->iso, t, q->n_iso);
+                                     "%s: %s lines: no partition sum for isotopologue %d at %g "
+                                     "K in %s (it has %zu isotopologues); give a table that has "
+                                     "it or remove those lines",
+                                     lines_path, what, l->iso, t, q_path, q->n_iso);
             }
             double stim_t = -expm1(-l->nu0_ghz / kt_ghz);
             double stim_296 = -expm1(-l->nu0_ghz * H_OVER_K_K_PER_GHZ / 296.0);
@@ -485,12 +486,13 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
     double po2_hpa = O2_DRY_AIR_VMR * (p - e);
     double n_o2 = po2_hpa / (BOLTZMANN_HPA_CM3 * t);
     st = species_build(&d->h2o, &h2o, &q_h2o, 1, d->continuum ? SHAPE_VVH_CUTOFF : SHAPE_VVH, air,
-                       e, d->n_h2o, "H2O", err);
+                       e, d->n_h2o, "H2O", p_h2o, p_qh2o, err);
     if (st == THZ_OK)
-        st = species_build(&d->o2, &o2, &q_o2, 7, SHAPE_GROSS, air, po2_hpa, n_o2, "O2", err);
+        st = species_build(&d->o2, &o2, &q_o2, 7, SHAPE_GROSS, air, po2_hpa, n_o2, "O2", p_o2,
+                           p_qo2, err);
     if (st == THZ_OK)
         st = species_build(&d->o2_coupled, &o2c, &q_o2, 7, SHAPE_COUPLED, air, po2_hpa, n_o2,
-                           "O2 coupled", err);
+                           "O2 coupled", p_o2c, p_qo2, err);
 cleanup:
     free(h2o.lines);
     free(o2.lines);

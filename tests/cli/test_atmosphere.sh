@@ -135,6 +135,14 @@ rc=$?
 grep -q "the attenuation at 0.3 THz is not a finite number" "$TMP/err" ||
     fail "n_air 1e300: message: $(cat "$TMP/err")"
 [ ! -s "$TMP/out" ] && [ ! -e "$TMP/huge.png" ] || fail "n_air 1e300: output written"
+# an isotopologue the partition sums lack: the message names the catalogue and the table
+awk -F, 'BEGIN { OFS = "," } NR == 3 { $8 = "99" } { print }' \
+    "$REPO/tests/inputs/atm_h2o_subset.csv" > "$TMP/iso99.csv"
+"$THZ" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --h2o-lines "$TMP/iso99.csv" \
+    --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" > "$TMP/out" 2> "$TMP/err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "iso99.csv: H2O lines: no partition sum for isotopologue 99 at .* K in .*partition_sums" "$TMP/err" ||
+    fail "isotopologue 99: exit $rc: $(cat "$TMP/err")"
 cp "$REPO/tests/inputs/atm_o2_subset.csv" "$TMP/"
 cat > "$TMP/huge.json" <<'JSON'
 {"format": "thzmap-scene/1.1", "channels": [{"frequency_thz": 0.35, "relative_width": 0.01}],
