@@ -127,6 +127,14 @@ thz_status bench_measure_paper(const char *scene_path, uint64_t photons, int thr
         if (photon_map_bytes(map) > out->largest_map_bytes) {
             out->largest_map_bytes = photon_map_bytes(map);
             out->largest_map_stored = photon_map_count(map);
+            /* the directory every render of the map builds (render_context.c), untimed:
+             * part of the memory a stored photon costs */
+            photon_map_directory *dir = NULL;
+            st = photon_map_directory_create(map, threads, &dir, err);
+            out->largest_map_directory_bytes = photon_map_directory_bytes(dir);
+            photon_map_directory_destroy(dir);
+            if (st != THZ_OK)
+                break;
         }
         t = bench_now_s();
         for (size_t i = 0; st == THZ_OK && i < s->n_sensors; i++)

@@ -23,6 +23,7 @@ typedef struct bench_paper {
     uint64_t photons_per_channel, channels, columns, rows, oversampling;
     uint64_t fired, stored, rays;
     uint64_t largest_map_bytes, largest_map_stored;
+    uint64_t largest_map_directory_bytes; /* the renderers' lookup table over that map */
     double s_load, s_accel, s_emission_table, s_tracing, s_index, s_photons, s_render, s_output,
         s_total;
 } bench_paper;

@@ -279,8 +279,8 @@ static void bench_swap_channels(thz_scene *s, size_t a, size_t b)
     }
 }
 
-/* A third run: channel w alone (moved to the front, the others hidden from the run, then
- * put back) with j estimates per sample, kept as out->confirm. */
+/* A run at the target: channel w alone (moved to the front, the others hidden from the
+ * run, then put back) with j estimates per sample, kept at index w of out->confirm. */
 static thz_status bench_converge_confirm_at(thz_context *ctx, thz_scene *s, const char *integrator,
                                             uint64_t photons, long enclosure, size_t w, uint32_t j,
                                             bench_converge *out, thz_error *err)
@@ -297,43 +297,44 @@ static thz_status bench_converge_confirm_at(thz_context *ctx, thz_scene *s, cons
     bench_swap_channels(s, 0, w);
     if (st != THZ_OK)
         return st;
-    out->confirm = (bench_converge_point){.estimates = pt.estimates, .s_wall = pt.s_wall};
     out->confirm.rms_k[w] = pt.rms_k[0];
     out->confirm.s_photons[w] = pt.s_photons[0];
     out->confirm.s_render[w] = pt.s_render[0];
-    out->confirm_channel = w;
-    out->confirmed = true;
+    out->confirm_estimates[w] = pt.estimates;
     return THZ_OK;
 }
 
-/* The worst channel run with the estimates the larger run says it needs. Where that run
- * misses the target and the fit through the two (RMS^2 = a / J + floor^2) says more
- * estimates reach it, once more with the fit's J: scaling the miss by (RMS / target)^2
- * ignores the floor, so it promised less time than a run takes (final-gather, 0.2 THz:
- * 58 gather rays gave 0.0534 K, scaled to 66 where the fit asks for 71). */
+/* Every channel run with the estimates the larger run says it needs (the worst channel by
+ * extrapolation need not be the worst run: final-gather's extrapolation ignores the
+ * photon map's floor). Where a run misses the target and the fit through the two
+ * (RMS^2 = a / J + floor^2) says more estimates reach it, once more with the fit's J:
+ * scaling the miss by (RMS / target)^2 ignores the floor, so it promised less time than a
+ * run takes (final-gather, 0.2 THz: 58 gather rays gave 0.0534 K, scaled to 66 where the
+ * fit asks for 71). */
 static thz_status bench_converge_confirm(thz_context *ctx, thz_scene *s, const char *integrator,
                                          uint64_t photons, long enclosure, double target_k,
                                          uint32_t max_confirm, bench_converge *out, thz_error *err)
 {
-    size_t w = 0;
-    for (size_t c = 1; c < s->n_channels; c++)
-        if (bench_converge_seconds(out, c, target_k) > bench_converge_seconds(out, w, target_k))
-            w = c;
-    double scale = out->pt[1].rms_k[w] / target_k;
-    double need = ceil((double)out->pt[1].estimates * scale * scale);
-    uint32_t j = need > (double)max_confirm ? max_confirm : (uint32_t)need;
-    j = j < 2 ? 2 : j;
-    thz_status st =
-        bench_converge_confirm_at(ctx, s, integrator, photons, enclosure, w, j, out, err);
-    double a_k2, floor2, fit_j;
-    if (st == THZ_OK && out->confirm.rms_k[w] > target_k &&
-        bench_converge_floor(out, target_k, &a_k2, &floor2, &fit_j) && fit_j > (double)j &&
-        fit_j <= (double)max_confirm) {
-        out->first_confirm = out->confirm;
-        out->refined = true;
-        st = bench_converge_confirm_at(ctx, s, integrator, photons, enclosure, w, (uint32_t)fit_j,
-                                       out, err);
+    thz_status st = THZ_OK;
+    out->confirm = (bench_converge_point){0};
+    for (size_t w = 0; st == THZ_OK && w < s->n_channels; w++) {
+        double scale = out->pt[1].rms_k[w] / target_k;
+        double need = ceil((double)out->pt[1].estimates * scale * scale);
+        uint32_t j = need > (double)max_confirm ? max_confirm : (uint32_t)need;
+        j = j < 2 ? 2 : j;
+        st = bench_converge_confirm_at(ctx, s, integrator, photons, enclosure, w, j, out, err);
+        double a_k2, floor2, fit_j;
+        if (st == THZ_OK && out->confirm.rms_k[w] > target_k &&
+            bench_converge_floor(out, w, target_k, &a_k2, &floor2, &fit_j) && fit_j > (double)j &&
+            fit_j <= (double)max_confirm) {
+            out->first_estimates[w] = out->confirm_estimates[w];
+            out->first_rms_k[w] = out->confirm.rms_k[w];
+            out->refined[w] = true;
+            st = bench_converge_confirm_at(ctx, s, integrator, photons, enclosure, w,
+                                           (uint32_t)fit_j, out, err);
+        }
     }
+    out->confirmed = st == THZ_OK;
     return st;
 }
 
@@ -394,19 +395,18 @@ double bench_converge_seconds(const bench_converge *cv, size_t c, double target_
     return bench_point_seconds(&cv->pt[1], c, target_k, false);
 }
 
-double bench_converge_confirmed_seconds(const bench_converge *cv, double target_k)
+double bench_converge_confirmed_seconds(const bench_converge *cv, size_t c, double target_k)
 {
-    return cv->confirmed ? bench_point_seconds(&cv->confirm, cv->confirm_channel, target_k, true)
-                         : NAN;
+    return cv->confirm_estimates[c] ? bench_point_seconds(&cv->confirm, c, target_k, true) : NAN;
 }
 
-bool bench_converge_floor(const bench_converge *cv, double target_k, double *a_k2, double *floor2,
-                          double *need)
+bool bench_converge_floor(const bench_converge *cv, size_t c, double target_k, double *a_k2,
+                          double *floor2, double *need)
 {
-    size_t w = cv->confirm_channel;
+    size_t w = c;
     const bench_converge_point *b = &cv->pt[1], *p = &cv->confirm;
-    double j1 = (double)b->estimates, j2 = (double)p->estimates;
-    if (!cv->confirmed || !(j2 > j1))
+    double j1 = (double)b->estimates, j2 = (double)cv->confirm_estimates[c];
+    if (!cv->confirm_estimates[c] || !(j2 > j1))
         return false;
     double v1 = b->rms_k[w] * b->rms_k[w], v2 = p->rms_k[w] * p->rms_k[w];
     *a_k2 = (v1 - v2) / (1.0 / j1 - 1.0 / j2);

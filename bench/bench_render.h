@@ -82,21 +82,23 @@ typedef struct bench_converge {
     uint64_t pixels, object_pixels; /* over all sensors */
     char enclosure[64];             /* the enclosure's name ("" when none) */
     bench_converge_point pt[2];
-    /* The run at the target: channel `confirm_channel` alone with pt[2].estimates
-     * (confirm_channel < channels; pt[2]'s arrays hold it at that index). */
+    /* The runs at the target: each channel c alone with confirm_estimates[c] estimates
+     * per sample (confirm's arrays hold it at index c; its `estimates` is unused). */
     bool confirmed;
-    size_t confirm_channel;
     bench_converge_point confirm;
-    /* refined: the first run at the target missed it and `confirm` is a second run, with
-     * the J the fit through pt[1] and that first run (first_confirm) asked for */
-    bool refined;
-    bench_converge_point first_confirm;
+    uint32_t confirm_estimates[BENCH_MAX_CHANNELS];
+    /* refined[c]: channel c's first run at the target missed it and `confirm` holds a
+     * second, with the J the fit through pt[1] and that first run (first_estimates[c],
+     * first_rms_k[c]) asked for */
+    bool refined[BENCH_MAX_CHANNELS];
+    uint32_t first_estimates[BENCH_MAX_CHANNELS];
+    double first_rms_k[BENCH_MAX_CHANNELS];
 } bench_converge;
 
 /* estimates[0] < estimates[1] (each >= 2); photons for final-gather (0: the scene's);
- * sensor_columns as in bench_speedup_config. With max_confirm > 0, the third run (the
- * worst channel by bench_converge_seconds to target_k, at most max_confirm estimates),
- * and a fourth where the third misses the target (bench_converge.refined). */
+ * sensor_columns as in bench_speedup_config. With max_confirm > 0, then every channel run
+ * alone with the estimates bench_converge_seconds says reach target_k (at most
+ * max_confirm), and again where that run misses the target (bench_converge.refined). */
 thz_status bench_measure_converge(const char *scene_path, const char *integrator, uint64_t photons,
                                   const uint32_t estimates[2], uint32_t sensor_columns, int threads,
                                   double target_k, uint32_t max_confirm, bench_converge *out,
@@ -107,17 +109,17 @@ thz_status bench_measure_converge(const char *scene_path, const char *integrator
  * 1/sqrt(render time)). */
 double bench_converge_seconds(const bench_converge *cv, size_t c, double target_k);
 
-/* The same from the run at the target (its channel only; NAN when there was none): its
- * render time, times (rms / target_k)^2 only where its rms is above target_k, plus its
- * photon phase. */
-double bench_converge_confirmed_seconds(const bench_converge *cv, double target_k);
+/* The same from channel c's run at the target (NAN when there was none): its render
+ * time, times (rms / target_k)^2 only where its rms is above target_k, plus its photon
+ * phase. */
+double bench_converge_confirmed_seconds(const bench_converge *cv, size_t c, double target_k);
 
-/* Through the larger run and the run at the target (its channel): RMS^2 = a / J + floor^2,
- * J the estimates per sample; the floor is what more estimates do not lower (final-gather's
+/* Through the larger run and channel c's run at the target: RMS^2 = a / J + floor^2, J the
+ * estimates per sample; the floor is what more estimates do not lower (final-gather's
  * photon map). *need: the J that reaches target_k, 0 when none does. False without the run
  * at the target. */
-bool bench_converge_floor(const bench_converge *cv, double target_k, double *a_k2, double *floor2,
-                          double *need);
+bool bench_converge_floor(const bench_converge *cv, size_t c, double target_k, double *a_k2,
+                          double *floor2, double *need);
 
 /* The exponent k of rms proportional to (render time)^k between the two runs of channel
  * c (-0.5 when the 1/sqrt law holds); 0 when it cannot be formed. */

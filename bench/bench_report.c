@@ -252,44 +252,59 @@ json_t *bench_report_converge(const char *integrator, const bench_converge *cv, 
            "(RMS / %g K)^2, plus its photon phase (noise proportional to 1/sqrt(render "
            "time): exponent -0.5; the exponent column is the two runs' own)\n",
            target_k, (unsigned)b->estimates, target_k);
-    double confirmed = bench_converge_confirmed_seconds(cv, target_k);
+    json_t *jconf = json_null();
     if (cv->confirmed) {
-        /* the worst channel run at the target replaces its extrapolation */
-        size_t w = cv->confirm_channel;
+        /* every channel run at the target: their runs replace the extrapolations */
         const bench_converge_point *p = &cv->confirm;
-        *worst_s = confirmed;
-        for (size_t c = 0; c < cv->channels; c++) {
-            double s = bench_converge_seconds(cv, c, target_k);
-            *worst_s = c != w && s > *worst_s ? s : *worst_s;
-        }
-        if (cv->refined)
-            printf("  run at the target: %5.3f THz alone with J=%u: RMS %.4f K, above the target; "
-                   "the fit through the J=%u run and this one asked for J=%u, run next\n",
-                   cv->freq_thz[w], (unsigned)cv->first_confirm.estimates,
-                   cv->first_confirm.rms_k[w], (unsigned)b->estimates, (unsigned)p->estimates);
-        printf("  run at the target: %5.3f THz alone with J=%u: RMS %.4f K, photon phase %.3f s, "
-               "render %.3f s; to %g K %.3f s (its render time, x (RMS / %g K)^2 = %.3f if that "
-               "is above 1, plus its photon phase), %.2f x the limit\n",
-               cv->freq_thz[w], (unsigned)p->estimates, p->rms_k[w], p->s_photons[w],
-               p->s_render[w], target_k, confirmed, target_k,
-               (p->rms_k[w] / target_k) * (p->rms_k[w] / target_k),
-               bench_ratio(confirmed, limit_s));
-        double a_k2, floor2, need;
-        if (bench_converge_floor(cv, target_k, &a_k2, &floor2, &need)) {
-            printf(
-                "  through the J=%u run and this one, RMS^2 = %.4g K^2 / J + floor^2 with a floor "
-                "%s%.4f K (what more estimates do not lower)",
-                (unsigned)b->estimates, a_k2, floor2 < 0.0 ? "-" : "", sqrt(fabs(floor2)));
-            if (need > 0.0)
-                printf(": %g K needs J = %.0f\n", target_k, need);
-            else
-                printf(": %g K cannot be reached by more estimates\n", target_k);
+        *worst_s = 0.0;
+        jconf = json_array();
+        for (size_t w = 0; w < cv->channels; w++) {
+            double confirmed = bench_converge_confirmed_seconds(cv, w, target_k);
+            *worst_s = confirmed > *worst_s ? confirmed : *worst_s;
+            if (cv->refined[w])
+                printf("  run at the target: %5.3f THz alone with J=%u: RMS %.4f K, above the "
+                       "target; the fit through the J=%u run and this one asked for J=%u, run "
+                       "next\n",
+                       cv->freq_thz[w], (unsigned)cv->first_estimates[w], cv->first_rms_k[w],
+                       (unsigned)b->estimates, (unsigned)cv->confirm_estimates[w]);
+            printf("  run at the target: %5.3f THz alone with J=%u: RMS %.4f K, photon phase "
+                   "%.3f s, render %.3f s; to %g K %.3f s (its render time, x (RMS / %g K)^2 = "
+                   "%.3f if that is above 1, plus its photon phase), %.2f x the limit\n",
+                   cv->freq_thz[w], (unsigned)cv->confirm_estimates[w], p->rms_k[w],
+                   p->s_photons[w], p->s_render[w], target_k, confirmed, target_k,
+                   (p->rms_k[w] / target_k) * (p->rms_k[w] / target_k),
+                   bench_ratio(confirmed, limit_s));
+            json_t *o = json_object();
+            json_object_set_new(o, "frequency_thz", bench_real(cv->freq_thz[w]));
+            json_object_set_new(o, "estimates_per_pass", json_integer(cv->confirm_estimates[w]));
+            json_object_set_new(o, "rms_stderr_k", bench_real(p->rms_k[w]));
+            json_object_set_new(o, "seconds_photons", bench_real(p->s_photons[w]));
+            json_object_set_new(o, "seconds_render", bench_real(p->s_render[w]));
+            json_object_set_new(o, "seconds_to_target", bench_real(confirmed));
+            json_object_set_new(o, "first_estimates_per_pass",
+                                cv->refined[w] ? json_integer(cv->first_estimates[w])
+                                               : json_null());
+            json_object_set_new(o, "first_rms_stderr_k",
+                                cv->refined[w] ? bench_real(cv->first_rms_k[w]) : json_null());
+            double a_k2, floor2, need;
+            if (bench_converge_floor(cv, w, target_k, &a_k2, &floor2, &need)) {
+                printf("    through the J=%u run and this one, RMS^2 = %.4g K^2 / J + floor^2 "
+                       "with a floor %s%.4f K (what more estimates do not lower)",
+                       (unsigned)b->estimates, a_k2, floor2 < 0.0 ? "-" : "", sqrt(fabs(floor2)));
+                if (need > 0.0)
+                    printf(": %g K needs J = %.0f\n", target_k, need);
+                else
+                    printf(": %g K cannot be reached by more estimates\n", target_k);
+                json_object_set_new(o, "floor_k", bench_real(copysign(sqrt(fabs(floor2)), floor2)));
+                json_object_set_new(o, "estimates_for_target",
+                                    need > 0.0 ? bench_real(need) : json_null());
+            }
+            json_array_append_new(jconf, o);
         }
     }
     printf("  worst channel %.3f s against %g s: %.2f x the limit%s\n", *worst_s, limit_s,
            bench_ratio(*worst_s, limit_s),
-           cv->confirmed ? " (the run at the target for its channel, the others extrapolated)"
-                         : "");
+           cv->confirmed ? " (every channel run at the target)" : " (extrapolated)");
     json_t *runs = json_array();
     for (int k = 0; k < 2; k++) {
         const bench_converge_point *p = &cv->pt[k];
@@ -302,27 +317,6 @@ json_t *bench_report_converge(const char *integrator, const bench_converge *cv, 
         json_object_set_new(o, "seconds_render", bench_reals(p->s_render, cv->channels));
         json_array_append_new(runs, o);
     }
-    json_t *jconf = json_null();
-    if (cv->confirmed) {
-        size_t w = cv->confirm_channel;
-        jconf = json_object();
-        json_object_set_new(jconf, "frequency_thz", bench_real(cv->freq_thz[w]));
-        json_object_set_new(jconf, "estimates_per_pass", json_integer(cv->confirm.estimates));
-        json_object_set_new(jconf, "rms_stderr_k", bench_real(cv->confirm.rms_k[w]));
-        json_object_set_new(jconf, "seconds_photons", bench_real(cv->confirm.s_photons[w]));
-        json_object_set_new(jconf, "seconds_render", bench_real(cv->confirm.s_render[w]));
-        json_object_set_new(jconf, "seconds_to_target", bench_real(confirmed));
-        json_object_set_new(jconf, "first_estimates_per_pass",
-                            cv->refined ? json_integer(cv->first_confirm.estimates) : json_null());
-        json_object_set_new(jconf, "first_rms_stderr_k",
-                            cv->refined ? bench_real(cv->first_confirm.rms_k[w]) : json_null());
-        double a_k2, floor2, need;
-        if (bench_converge_floor(cv, target_k, &a_k2, &floor2, &need)) {
-            json_object_set_new(jconf, "floor_k", bench_real(copysign(sqrt(fabs(floor2)), floor2)));
-            json_object_set_new(jconf, "estimates_for_target",
-                                need > 0.0 ? bench_real(need) : json_null());
-        }
-    }
     json_t *root = json_object();
     json_object_set_new(root, "integrator", json_string(integrator));
     json_object_set_new(root, "photons_per_channel", json_integer((json_int_t)cv->photons));
@@ -333,11 +327,12 @@ json_t *bench_report_converge(const char *integrator, const bench_converge *cv, 
     json_object_set_new(root, "object_pixels", json_integer((json_int_t)cv->object_pixels));
     json_object_set_new(root, "method",
                         json_string("extrapolated: render time x (rms / target)^2 from the "
-                                    "larger run, plus its photon phase; the worst channel "
-                                    "then run alone at the estimates that predicts "
-                                    "(run_at_target), whose figure the worst replaces"));
+                                    "larger run, plus its photon phase; then every channel "
+                                    "run alone at the estimates that predicts "
+                                    "(runs_at_target), whose figures the worst is taken "
+                                    "from"));
     json_object_set_new(root, "runs", runs);
-    json_object_set_new(root, "run_at_target", jconf);
+    json_object_set_new(root, "runs_at_target", jconf);
     json_object_set_new(root, "channels", chans);
     json_object_set_new(root, "worst_seconds_to_target", bench_real(*worst_s));
     json_object_set_new(root, "worst_ratio_to_limit", bench_real(bench_ratio(*worst_s, limit_s)));

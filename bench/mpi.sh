@@ -16,7 +16,8 @@
 # Prints per run the wall time of the command, the speed-up and the strong-scaling
 # efficiency T1 / (N TN), each rank's CPU time (on a shared machine the busiest rank's
 # CPU time is the wall time idle cores would give, and CPU eff. = CPU(1) / (N max rank)
-# the efficiency they would give), and the megabytes rank 0 sent and received; checks
+# the efficiency they would give), and the megabytes communicated (each broadcast counted
+# once per receiving rank, each gather once); checks
 # that every file equals the 1-rank run's (summary.json and batch.json aside); then an
 # estimate for 64 ranks on a cluster from those measurements. Ranks beyond the
 # machine's cores are oversubscribed (said in the output), and the machine may be
@@ -87,10 +88,11 @@ for w in $what; do
     done
 done
 echo "load average after:  $(cut -d' ' -f1-3 /proc/loadavg)"
-/usr/bin/python3 - "$out" "$cores" "$ranks" "$what" <<'PY'
-import filecmp, json, os, re, sys
+/usr/bin/python3 - "$out" "$cores" "$ranks" "$what" "$photons" <<'PY'
+import filecmp, json, math, os, re, sys
 out, cores = sys.argv[1], int(sys.argv[2])
 ranks, what = [int(r) for r in sys.argv[3].split()], sys.argv[4].split()
+photons = int(float(sys.argv[5]))
 def cpu_of(w, n):
     return [sum(float(x) for x in open(f"{out}/cpu.{w}.{n}.{r}").read().split()[-2:])
             for r in range(n)]
@@ -131,24 +133,31 @@ for w in what:
     # rank 1 spends u + f / 2 (its start: MPI, scene, ray-casting structure, the map's
     # index when it receives one; half the shared work) and rank 0 that plus the part only
     # it does, s (gathering, writing, movies); one process spends u + f + s. On 64
-    # dedicated cores: u + f / 64 + s + the messages over the network. A batch deals whole
-    # frames: no more than 8 ranks (its 8 groups) share its work, f / 8 at best.
+    # dedicated cores: u + f x ceil(items / 64) / items + s + the messages over the
+    # network, items the pieces the shared work comes in (simulate: photon batches of
+    # 65 536, which dominate it; render: 16-pixel tiles, 256 and more; batch: its 8 photon
+    # groups, so no more than 8 ranks share its work).
     if 2 in rows:
         c2 = cpu_of(w, 2)
         serial = max(0.0, c2[0] - c2[1])
         f = max(0.0, 2 * (r1["cpu_sum"] - serial - c2[1]))
         u = max(0.0, c2[1] - f / 2)
-        # what rank 0 sends or receives grows with the ranks: the photon map is broadcast
-        # along a tree to every rank (about 2x its size per rank for large messages; since
-        # the pixels are shared, simulate sends its map too), shares and tiles are gathered;
-        # a dealt batch sends each frame computed elsewhere once (2 ranks: half of them)
-        mb64 = rows[2]["mb"] * 2.0
+        items = {"simulate": math.ceil(photons / 65536), "render": 256, "batch": 8}[w]
+        shared = f * math.ceil(items / 64) / items
+        # Bytes: the count adds a broadcast once for each rank that receives it and a
+        # gather (shares, tiles, frames dealt) once: MB(N) = (N - 1) b + g. From the 2- and
+        # 4-rank runs b and g; with 2 ranks alone, all of it as b (the larger estimate).
+        # At 64 ranks: (63 b + g) in all; through rank 0's link, a binomial-tree broadcast
+        # sends b at most log2(64) = 6 times and every gather arrives there: 6 b + g.
+        b = rows[2]["mb"] if 4 not in rows else max(0.0, (rows[4]["mb"] - rows[2]["mb"]) / 2)
+        g = max(0.0, rows[2]["mb"] - b)
+        total64, root64 = 63 * b + g, 6 * b + g
         print(f"64 ranks (estimate from CPU times): start u = {u:.2f} s, shared work f = "
-              f"{f:.2f} s (/ 64 = {f / 64:.3f} s), rank 0 alone s = {serial:.2f} s, "
-              f"{mb64:.3g} MB through rank 0")
-        share = 8 if w == "batch" else 64
+              f"{f:.2f} s (in {items} pieces: {shared:.3f} s on 64 ranks), rank 0 alone "
+              f"s = {serial:.2f} s; bytes: broadcast b = {b:.3g} MB, gathered g = {g:.3g} MB, "
+              f"{total64:.3g} MB in all, {root64:.3g} MB through rank 0's link")
         for name, bw in (("10 Gbit/s Ethernet", 1.25e9), ("100 Gbit/s InfiniBand", 12.5e9)):
-            t = u + f / share + serial + mb64 * 1e6 / bw
+            t = u + shared + serial + root64 * 1e6 / bw
             print(f"  over {name}: {t:.2f} s end to end, speed-up {r1['cpu_sum'] / t:.2f} over "
                   f"one rank, efficiency {r1['cpu_sum'] / (64 * t):.3f}")
 PY

@@ -282,7 +282,10 @@ int main(int argc, char **argv)
     const uint64_t paper_peak = paper_use.peak_bytes;
     if (st != THZ_OK)
         goto fail;
-    double bpp = bench_ratio((double)paper.largest_map_bytes, (double)paper.largest_map_stored);
+    /* a stored photon's memory: its record, its share of the index's offsets and cubes,
+     * and of the directory the renderers build over the map */
+    double bpp = bench_ratio((double)(paper.largest_map_bytes + paper.largest_map_directory_bytes),
+                             (double)paper.largest_map_stored);
     printf("\n1. Paper's case: %llu photons x %llu channels, %llux%llu pixels, oversampling %llu "
            "(load average %.2f)\n",
            (unsigned long long)paper.photons_per_channel, (unsigned long long)paper.channels,
@@ -302,9 +305,10 @@ int main(int argc, char **argv)
            bench_ratio((double)paper.stored, (double)paper.fired), (unsigned long long)paper.rays);
     printf("  %.1f CPU s over %.1f s wall: %.2f cores on average\n", paper_use.cpu_s, paper.s_total,
            bench_ratio(paper_use.cpu_s, paper.s_total));
-    printf("  largest photon map %.1f MB, %.2f bytes per stored photon; peak memory %.1f MB "
-           "(%.2f x the map)\n",
-           (double)paper.largest_map_bytes / 1e6, bpp, (double)paper_peak / 1e6,
+    printf("  largest photon map %.1f MB and its renderers' directory %.1f MB: %.3f bytes per "
+           "stored photon; peak memory %.1f MB (%.2f x the map without its directory)\n",
+           (double)paper.largest_map_bytes / 1e6, (double)paper.largest_map_directory_bytes / 1e6,
+           bpp, (double)paper_peak / 1e6,
            bench_ratio((double)paper_peak, (double)paper.largest_map_bytes));
     json_t *jpaper = json_object();
     json_object_set_new(jpaper, "photons_per_channel",
@@ -326,6 +330,10 @@ int main(int argc, char **argv)
     json_object_set_new(jpaper, "photons_per_s", bench_real(pps));
     json_object_set_new(jpaper, "largest_map_bytes",
                         json_integer((json_int_t)paper.largest_map_bytes));
+    json_object_set_new(jpaper, "largest_map_stored",
+                        json_integer((json_int_t)paper.largest_map_stored));
+    json_object_set_new(jpaper, "largest_map_directory_bytes",
+                        json_integer((json_int_t)paper.largest_map_directory_bytes));
     json_object_set_new(jpaper, "bytes_per_stored_photon", bench_real(bpp));
     json_object_set_new(jpaper, "peak_memory_bytes", json_integer((json_int_t)paper_peak));
     json_object_set_new(
@@ -589,12 +597,13 @@ int main(int argc, char **argv)
            "fastest %.3f x)\n",
            bench_pairs_speedup(&ceiling), bench_pairs_speedup_fastest(&ceiling));
     for (int i = 0; i < 2; i++) {
-        snprintf(name, sizeof name, "%s: s per channel to %g K objects' RMS (worst, run)",
+        snprintf(name, sizeof name, "%s: s per channel to %g K objects' RMS (worst of all run)",
                  conv_names[i], converged_k);
         bench_target(&t, name, conv_worst[i], "<=", conv_limit_s[i],
                      conv_worst[i] <= conv_limit_s[i], "s", true);
     }
-    bench_target(&t, "bytes per stored photon", bpp, "<=", 32, bpp <= 32.005, "B", true);
+    bench_target(&t, "bytes per stored photon (record, index, directory)", bpp, "<=", 32,
+                 bpp <= 32.0, "B", true);
     /* Flatness and triangle growth from the CPU time per photon: the wall time of a point
      * also counts the time slices other processes took, which on a shared machine varies
      * from point to point; CPU time does not (both are in the table and the JSON). The
