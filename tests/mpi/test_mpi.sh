@@ -24,6 +24,21 @@ export OMPI_MCA_rmaps_base_oversubscribe=1
 mpi() { timeout 120 mpirun --oversubscribe -np "$@"; }
 step() { echo "test_mpi: $(date +%T) $*"; }
 
+# The pid of MPI rank 1 among the thzmap processes whose command line holds $1, waiting
+# up to 10 s for it to start; empty when none did.
+rank1_of() {
+    for _ in $(seq 100); do
+        sleep 0.1
+        for p in $(pgrep -f -- "$1" 2>/dev/null); do
+            if [ "$(cat "/proc/$p/comm" 2>/dev/null)" = thzmap ] &&
+                tr '\0' '\n' < "/proc/$p/environ" 2>/dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=1'; then
+                echo "$p"
+                return
+            fi
+        done
+    done
+}
+
 # A small camera on plate-in-box; 140 000 photons are 3 batches of 65 536 (the last
 # short), so that 2 ranks fire 2 + 1 and 3 ranks 1 + 1 + 1.
 $PY - "$REPO/examples/plate-in-box/scene.json" "$work/scene.json" <<'PY'
@@ -300,17 +315,7 @@ step "a killed"
 mpi 2 "$THZMAP" simulate "$scene" -o "$work/kill" --photons 3000000 --threads 1 --quiet \
     --integrator photon-map > "$work/kill.out" 2>&1 &
 job=$!
-victim=
-for _ in $(seq 100); do
-    sleep 0.1
-    for p in $(pgrep -f -- "-o $work/kill" 2>/dev/null); do
-        if [ "$(cat "/proc/$p/comm" 2>/dev/null)" = thzmap ] &&
-            tr '\0' '\n' < "/proc/$p/environ" 2>/dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=1'; then
-            victim=$p
-        fi
-    done
-    [ -n "$victim" ] && break
-done
+victim=$(rank1_of "-o $work/kill")
 if [ -n "$victim" ]; then
     sleep 0.5
     kill -KILL "$victim"
@@ -330,17 +335,7 @@ mkdir -p "$work/stopped/out" && echo keep > "$work/stopped/out/marker"
 mpi 2 "$THZMAP" simulate "$scene" -o "$work/stopped/out" --integrator path --threads 1 \
     --target-noise-k 0.0001 --max-seconds 60 --quiet > "$work/stopped.out" 2>&1 &
 job=$!
-victim=
-for _ in $(seq 100); do
-    sleep 0.1
-    for p in $(pgrep -f -- "-o $work/stopped/out" 2>/dev/null); do
-        if [ "$(cat "/proc/$p/comm" 2>/dev/null)" = thzmap ] &&
-            tr '\0' '\n' < "/proc/$p/environ" 2>/dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=1'; then
-            victim=$p
-        fi
-    done
-    [ -n "$victim" ] && break
-done
+victim=$(rank1_of "-o $work/stopped/out")
 if [ -n "$victim" ]; then
     sleep 1
     kill -STOP "$victim"
