@@ -3,6 +3,7 @@
  * data, src/atmosphere/), and the emitting-atmosphere keys. docs/atmosphere.md
  * lists the keys. Every model but none emits unless "emitting": false (Kirchhoff). */
 #include <stdlib.h>
+#include <string.h>
 
 #include "scene/load.h"
 
@@ -98,8 +99,14 @@ static thz_status load_lines(load_ctx *ctx, const load_cursor *c, thz_atmosphere
         opt.continuum_file = paths[5];
         thz_error inner = {0};
         st = atmosphere_init_lines(atm, &air, &opt, &inner);
+        /* a file's own error (it starts with the file's path) names the key that gave it */
+        load_cursor at = *c;
+        for (size_t i = 0; st != THZ_OK && i < N_FILES; i++)
+            if (paths[i] && strncmp(inner.message, paths[i], strlen(paths[i])) == 0 &&
+                (inner.message[strlen(paths[i])] == ':' || inner.message[strlen(paths[i])] == ' '))
+                at = load_key(c, file_keys[i]);
         if (st != THZ_OK)
-            st = fail_from(ctx, c, st, &inner);
+            st = fail_from(ctx, &at, st, &inner);
     }
     for (size_t i = 0; i < N_FILES; i++)
         free(paths[i]);

@@ -159,4 +159,12 @@ JSON
 rc=$?
 [ $rc -eq 2 ] && grep -q "attenuation at .* THz is not a finite number" "$TMP/err" ||
     fail "a scene with n_air 1e300: exit status $rc: $(cat "$TMP/err")"
+# a catalogue's own error names the scene key that gave the file (it said "atmosphere:")
+awk -F, 'BEGIN { OFS = "," } NR == 3 { $2 = "-1" } NR <= 3' \
+    "$REPO/tests/inputs/atm_h2o_subset.csv" > "$TMP/neg.csv"
+sed 's/"h2o_lines_file": "huge.csv"/"h2o_lines_file": "neg.csv"/' "$TMP/huge.json" > "$TMP/neg.json"
+"$THZ" validate "$TMP/neg.json" > "$TMP/out" 2> "$TMP/err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "neg.json: atmosphere.h2o_lines_file: .*neg.csv:3: a line needs" "$TMP/err" ||
+    fail "a scene's bad catalogue: exit status $rc: $(cat "$TMP/err")"
 echo "ok"
