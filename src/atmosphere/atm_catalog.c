@@ -40,13 +40,19 @@ static bool has_suffix(const char *s, const char *suffix)
 
 static thz_status check_line(const raw_line *l, const char *path, size_t lineno, thz_error *err)
 {
-    if (!(l->nu0_ghz > 0.0) || !(l->s296_cm2_ghz >= 0.0) || !(l->gamma_air >= 0.0) ||
-        !(l->gamma_self >= 0.0) || !isfinite(l->n_air) || !isfinite(l->delta_air) ||
-        !isfinite(l->elower_k) || l->iso < 1)
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "%s:%zu: a line needs frequency > 0, intensity >= 0, widths >= 0, "
-                             "finite n_air, shift and lower-state energy, isotopologue >= 1",
-                             path, lineno);
+    /* the first rule the line breaks, by name (the fields' names differ between .par and
+     * CSV files; these are the quantities) */
+    const char *broken = !(l->nu0_ghz > 0.0)         ? "frequency must be > 0"
+                         : !(l->s296_cm2_ghz >= 0.0) ? "intensity must be >= 0"
+                         : !(l->gamma_air >= 0.0)    ? "air-broadened width must be >= 0"
+                         : !(l->gamma_self >= 0.0)   ? "self-broadened width must be >= 0"
+                         : !isfinite(l->n_air)       ? "n_air must be finite"
+                         : !isfinite(l->delta_air)   ? "pressure shift must be finite"
+                         : !isfinite(l->elower_k)    ? "lower-state energy must be finite"
+                         : l->iso < 1                ? "isotopologue must be >= 1"
+                                                     : NULL;
+    if (broken)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: the line's %s", path, lineno, broken);
     return THZ_OK;
 }
 

@@ -165,6 +165,6 @@ awk -F, 'BEGIN { OFS = "," } NR == 3 { $2 = "-1" } NR <= 3' \
 sed 's/"h2o_lines_file": "huge.csv"/"h2o_lines_file": "neg.csv"/' "$TMP/huge.json" > "$TMP/neg.json"
 "$THZ" validate "$TMP/neg.json" > "$TMP/out" 2> "$TMP/err"
 rc=$?
-[ $rc -eq 2 ] && grep -q "neg.json: atmosphere.h2o_lines_file: .*neg.csv:3: a line needs" "$TMP/err" ||
+[ $rc -eq 2 ] && grep -q "neg.json: atmosphere.h2o_lines_file: .*neg.csv:3: the line's intensity must be >= 0" "$TMP/err" ||
     fail "a scene's bad catalogue: exit status $rc: $(cat "$TMP/err")"
 echo "ok"
