@@ -31,7 +31,8 @@ THZ_API int thz_mpi_supported(void);
  * process waiting for other ranks stops waiting and returns THZ_ERR_CANCELLED, so that
  * rank 0 can clean up before it ends the job (a rank that has stopped or died would keep
  * it waiting until mpirun kills it). A run that is computing is stopped by its progress
- * callback, as without MPI. A no-op without MPI support. */
+ * callback, as without MPI. It stays in force for the rest of the process (the job is to
+ * end: the program calls MPI_Abort). A no-op without MPI support. */
 THZ_API void thz_mpi_interrupt(void);
 
 /* Rank 0: simulate runs on ctx share their photon phases with the other ranks of
