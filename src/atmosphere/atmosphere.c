@@ -241,7 +241,6 @@ static double table_midpoint_error(const thz_atmosphere *atm, const atm_band_tab
     return worst;
 }
 
-/* On failure t may hold the last grid tried; the caller frees t->alpha_per_m. */
 /* The first table point whose attenuation is not finite, or t->n. */
 static size_t table_first_nonfinite(const atm_band_table *t)
 {
@@ -250,6 +249,8 @@ static size_t table_first_nonfinite(const atm_band_table *t)
             return i;
     return t->n;
 }
+
+/* On failure t may hold the last grid tried; the caller frees t->alpha_per_m. */
 
 static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, double lo_hz,
                               double hi_hz, atm_band_table *t, thz_error *err)

@@ -112,8 +112,9 @@ static void test_parse_text(void **state)
 static void test_spreadsheet_csv(void **state)
 {
     (void)state;
-    const char *texts[] = {"\xef\xbb\xbf" "frequency_thz,n\r\n0.2,2\r\n",
-                           "\xef\xbb\xbf# made by hand\nfrequency_thz,n\n0.2,2\n",
+    /* the mark EF BB BF in octal: a hex escape would run on into the "f" after it */
+    const char *texts[] = {"\357\273\277frequency_thz,n\r\n0.2,2\r\n",
+                           "\357\273\277# made by hand\nfrequency_thz,n\n0.2,2\n",
                            "\"frequency_thz\",\"n\"\n\"0.2\", 2\n"};
     for (size_t i = 0; i < 3; i++) {
         csv_table t;
@@ -135,10 +136,8 @@ static void test_spreadsheet_csv(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_good_file),
-        cmocka_unit_test(test_errors),
-        cmocka_unit_test(test_parse_text),
-        cmocka_unit_test(test_spreadsheet_csv),
+        cmocka_unit_test(test_good_file),    cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_parse_text),   cmocka_unit_test(test_spreadsheet_csv),
         cmocka_unit_test(test_fifo_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

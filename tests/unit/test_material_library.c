@@ -1,8 +1,8 @@
 /* The material library (data/materials/library.json) and the scene keys of a complex
  * index: every entry loads, has a source and evaluates to finite n, k with k > 0 and
  * n >= 1 (n > 0 for Drude metals) at 0.1-3 THz; `library`, `refractive_index`,
- * `permittivity_model` and CSV n, k columns (one row: a constant) in scenes, keys beside them overriding;
- * refusals with their JSON paths (P.2040 outside its range names the range); the
+ * `permittivity_model` and CSV n, k columns (one row: a constant) in scenes, keys beside them
+ * overriding; refusals with their JSON paths (P.2040 outside its range names the range); the
  * absorption lines of explosives and drugs at their cited frequencies. */
 #include <math.h>
 #include <setjmp.h>
