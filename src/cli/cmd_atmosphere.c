@@ -329,11 +329,13 @@ int cmd_atmosphere(int argc, char **argv)
         double f_hz = f_thz * 1e12;
         thz_atm_attenuation p;
         thz_atm_attenuation_parts(atm, f_hz, &p);
-        if (!isfinite(p.total_per_m)) {
+        double other = compare ? thz_atm_attenuation_per_m(compare, f_hz) : 0.0;
+        if (!isfinite(p.total_per_m) || !isfinite(other)) {
+            bool mine = !isfinite(p.total_per_m);
             fprintf(stderr,
-                    "thzmap atmosphere: the attenuation at %.9g THz is not a finite number "
+                    "thzmap atmosphere: the attenuation%s at %.9g THz is not a finite number "
                     "(%g /m); a line catalogue with values beyond the physical range?\n",
-                    f_thz, p.total_per_m);
+                    mine ? "" : " of --compare-model", f_thz, mine ? p.total_per_m : other);
             if (o.plot)
                 remove(o.plot); /* the empty file that checked it could be created */
             rc = CLI_EXIT_USAGE;
@@ -347,7 +349,7 @@ int cmd_atmosphere(int argc, char **argv)
         s.o2_db[i] = db_per_km(p.o2_per_m);
         s.dry_db[i] = db_per_km(p.dry_continuum_per_m);
         if (s.compare_db)
-            s.compare_db[i] = db_per_km(thz_atm_attenuation_per_m(compare, f_hz));
+            s.compare_db[i] = db_per_km(other);
     }
     if (info.has_air)
         fprintf(out,

@@ -135,6 +135,13 @@ rc=$?
 grep -q "the attenuation at 0.3 THz is not a finite number" "$TMP/err" ||
     fail "n_air 1e300: message: $(cat "$TMP/err")"
 [ ! -s "$TMP/out" ] && [ ! -e "$TMP/huge.png" ] || fail "n_air 1e300: output written"
+"$THZ" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --model itu-p676 \
+    --compare-model lines --h2o-lines "$TMP/huge.csv" \
+    --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" --plot "$TMP/cmp.png" > "$TMP/out" 2> "$TMP/err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "attenuation of --compare-model at 0.3 THz is not a finite number" "$TMP/err" ||
+    fail "n_air 1e300 in --compare-model: exit $rc: $(cat "$TMP/err")"
+[ ! -s "$TMP/out" ] && [ ! -e "$TMP/cmp.png" ] || fail "n_air 1e300 in --compare-model: output written"
 # an isotopologue the partition sums lack: the message names the catalogue and the table
 awk -F, 'BEGIN { OFS = "," } NR == 3 { $8 = "99" } { print }' \
     "$REPO/tests/inputs/atm_h2o_subset.csv" > "$TMP/iso99.csv"
