@@ -80,8 +80,10 @@ typedef struct load_range {
 #define LOAD_MAX_COORDINATE_M 1e9
 #define LOAD_COORDINATE ((load_range){-LOAD_MAX_COORDINATE_M, LOAD_MAX_COORDINATE_M, false, false})
 /* A sensor's aperture area, m^2: up to a square kilometre, far beyond any sensor and far
- * from the 32-bit power cube's overflow (aperture_diameter_m: the circle of that area). */
+ * from the 32-bit power cube's overflow; its diameter, m, up to a kilometre (a circle of
+ * 0.79 km^2). */
 #define LOAD_APERTURE_M2 ((load_range){0.0, 1e6, true, false})
+#define LOAD_MAX_APERTURE_DIAMETER_M 1000.0
 #define LOAD_UNIT ((load_range){0.0, 1.0, false, false})
 
 /* The root cursor of a document. */

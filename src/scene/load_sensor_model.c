@@ -93,7 +93,7 @@ static thz_status load_noise(load_ctx *ctx, const load_cursor *c, size_t n_chann
 thz_status load_sensor_model(load_ctx *ctx, const load_cursor *c, size_t n_channels, thz_sensor *sn)
 {
     static const char *const psfs[] = {"none", "airy", "gaussian", NULL}; /* thz_psf_kind */
-    const load_range diameter = {0.0, 2.0 * sqrt(LOAD_APERTURE_M2.hi / M_PI), true, false};
+    const load_range diameter = {0.0, LOAD_MAX_APERTURE_DIAMETER_M, true, false};
     thz_status st =
         load_number(ctx, c, "aperture_diameter_m", diameter, false, 0.0, &sn->aperture_diameter_m);
     if (st != THZ_OK)

@@ -262,7 +262,7 @@ CASES = [
     ("sensor_psf_fwhm_without_gaussian", [(["sensors", 0, "psf_fwhm_deg"], 1.0)],
      "sensors[0].psf_fwhm_deg: psf_fwhm_deg is for \"psf\": \"gaussian\" only"),
     ("sensor_aperture_diameter_zero", [(["sensors", 0, "aperture_diameter_m"], 0)],
-     "sensors[0].aperture_diameter_m: expected a number in (0, 1128.38]"),
+     "sensors[0].aperture_diameter_m: expected a number in (0, 1000]"),
     ("sensor_noise_both_forms",
      [(["sensors", 0, "noise"], {"netd_k": 0.3, "integration_time_s": 0.01})],
      "sensors[0].noise: give either netd_k or the radiometer form"),
@@ -291,7 +291,7 @@ CASES = [
      "sensors[0].aperture_m2: expected a number in (0, 1e+06], got 1e+07"),
     ("sensor_aperture_diameter_too_large",
      [(["format"], "thzmap-scene/1.1"), (["sensors", 0, "aperture_diameter_m"], 1e200)],
-     "sensors[0].aperture_diameter_m: expected a number in (0, 1128.38], got 1e+200"),
+     "sensors[0].aperture_diameter_m: expected a number in (0, 1000], got 1e+200"),
     ("object_too_far", [(["objects", 1, "transform"], {"translate_m": [0, 2e9, 0]})],
      "objects[1].transform: the object reaches 2e+09 m from the origin; scenes must lie "
      "within 1e+09 m of it"),
