@@ -1,10 +1,11 @@
 /* POST /api/runs: the job a request body describes, checked (every error names the JSON
  * path of the body it is about), and queued. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
+#include <unistd.h>
 
 #include "serve_jobs.h"
 
@@ -78,12 +79,18 @@ static bool serve_opt_path(serve_request *r, json_t *v, const char *path, bool m
         *ret = serve_reply_path(r, st, path, ": ", rel);
         return false;
     }
-    struct stat sb;
-    if (must_exist && (stat(out, &sb) != 0 || !S_ISREG(sb.st_mode))) {
-        *ret = serve_reply_bad_json(r, path, "%s: not a regular file", rel);
-        return false;
+    if (!must_exist)
+        return true;
+    int fd = serve_open_regular(out); /* a regular file this server may read, as GET's */
+    if (fd >= 0) {
+        close(fd);
+        return true;
     }
-    return true;
+    if (errno == EACCES)
+        *ret = serve_reply_error(r, 403, "%s: %s: permission denied", path, rel);
+    else
+        *ret = serve_reply_bad_json(r, path, "%s: not a regular file", rel);
+    return false;
 }
 
 /* The integrator a simulate or render job runs: its option, else the scene's

@@ -92,6 +92,11 @@ def test_files(srv, root):
     for path in ("s/locked.json", "s/closed/x.json"):
         st, err = get_within(srv, "/api/file?path=" + path, 10)
         check(st == 403 and "permission denied" in err["error"], "GET %s: %s %r" % (path, st, err))
+        # and a run asked of such a scene is refused at once, not queued to fail
+        st, _, data = srv.request("POST", "/api/runs", body=json.dumps(
+            {"command": "simulate", "scene": path, "out": "o"}))
+        check(st == 403 and b"permission denied" in data, "POST a run of %s: %s %r"
+              % (path, st, data[:200]))
 
 
 def test_lengths(srv):
