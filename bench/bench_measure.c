@@ -133,8 +133,10 @@ thz_status bench_measure_paper(const char *scene_path, uint64_t photons, int thr
             st = photon_map_directory_create(map, threads, &dir, err);
             out->largest_map_directory_bytes = photon_map_directory_bytes(dir);
             photon_map_directory_destroy(dir);
-            if (st != THZ_OK)
+            if (st != THZ_OK) {
+                photon_map_destroy(map);
                 break;
+            }
         }
         t = bench_now_s();
         for (size_t i = 0; st == THZ_OK && i < s->n_sensors; i++)

@@ -152,9 +152,10 @@ thz_status batch_deal_serve(thz_context *ctx, const thz_sequence *seq, const uin
 }
 
 thz_status batch_deal_receive(thz_context *ctx, const thz_sequence *seq, size_t f, size_t rank,
-                              batch_frame *fr, double *seconds, thz_error *err)
+                              batch_frame *fr, double *seconds, bool *theirs, thz_error *err)
 {
     memset(fr, 0, sizeof *fr);
+    *theirs = false;
     uint64_t item = 0;
     thz_status status = THZ_OK;
     void *data = NULL;
@@ -163,8 +164,10 @@ thz_status batch_deal_receive(thz_context *ctx, const thz_sequence *seq, size_t 
     if (st == THZ_OK && item != f)
         st = thz_error_set(err, THZ_ERR_INTERNAL, "MPI: rank %zu sent frame %llu, not %zu", rank,
                            (unsigned long long)item, f);
-    else if (st == THZ_OK && status != THZ_OK)
+    else if (st == THZ_OK && status != THZ_OK) {
         st = thz_error_set(err, status, "%s", (const char *)data);
+        *theirs = true;
+    }
     deal_header h;
     if (st == THZ_OK && size < sizeof h)
         st = thz_error_set(err, THZ_ERR_INTERNAL, "MPI: rank %zu sent %zu bytes", rank, size);

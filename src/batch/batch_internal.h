@@ -10,6 +10,7 @@
 #ifndef THZ_BATCH_BATCH_INTERNAL_H
 #define THZ_BATCH_BATCH_INTERNAL_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -155,9 +156,9 @@ thz_status batch_deal_serve(thz_context *ctx, const thz_sequence *seq, const uin
 
 /* Rank 0: frame f from rank `rank` (its next one): fr's scene loaded here, its run from
  * the received bytes; *seconds the time it took there, s. A failure the rank sent comes
- * back as its status and message. */
+ * back as its status and message, with *theirs set (else false: this rank's own). */
 thz_status batch_deal_receive(thz_context *ctx, const thz_sequence *seq, size_t f, size_t rank,
-                              batch_frame *fr, double *seconds, thz_error *err);
+                              batch_frame *fr, double *seconds, bool *theirs, thz_error *err);
 
 /* ---- batch_encode.c: one movie, frame by frame (the only code that includes FFmpeg) -- */
 

@@ -325,13 +325,11 @@ static thz_status batch_run_frame(thz_context *ctx, batch_state *b, size_t f, th
     thz_output **guard = b->opt ? b->opt->open_output : NULL;
     if (guard)
         *guard = output;
-    bool remote_failed = false; /* the rank it was dealt to failed (not this one writing) */
+    bool remote_failed = false; /* the rank it was dealt to failed (not this one) */
     if (st == THZ_OK && rank == 0)
         st = batch_frame_compute(ctx, seq, b->base, &b->cache, f, &fr, err);
-    else if (st == THZ_OK) {
-        st = batch_deal_receive(ctx, seq, f, rank, &fr, &seconds, err);
-        remote_failed = st != THZ_OK;
-    }
+    else if (st == THZ_OK)
+        st = batch_deal_receive(ctx, seq, f, rank, &fr, &seconds, &remote_failed, err);
     if (st == THZ_OK) {
         frame_json = batch_frame_json(seq, f, fr.reused ? (long)b->base[f] : -1);
         if (!frame_json)
