@@ -104,14 +104,20 @@ static double sum(const float *v)
     return s;
 }
 
-/* A wide PSF (FWHM ~ 12 pixels: the FFT path): profile, FWHM, power. */
+/* A wide PSF (FWHM ~ 12 pixels: the FFT path): profile, FWHM, power. Channel c, 30 %
+ * wide, tells the band average from the pattern at the centre frequency alone: they
+ * differ by 1 % of the peak 2 pixels out, twice the profile's tolerance (a PSF taken at
+ * the centre frequency failed here and passed channels a and b, 1 and 5 % wide, where
+ * the two differ by 3e-5 and 6e-4 of the peak, below what a cell-integrated kernel
+ * compared with point values can resolve). */
 static void test_airy_profile_and_fwhm(void **state)
 {
     (void)state;
     const double d_m = 0.05, pitch = 1.5e-3;
-    const thz_channel chans[2] = {{.name = "a", .center_hz = 0.35e12, .relative_width = 0.01},
-                                  {.name = "b", .center_hz = 0.5e12, .relative_width = 0.05}};
-    for (int c = 0; c < 2; c++) {
+    const thz_channel chans[3] = {{.name = "a", .center_hz = 0.35e12, .relative_width = 0.01},
+                                  {.name = "b", .center_hz = 0.5e12, .relative_width = 0.05},
+                                  {.name = "c", .center_hz = 0.5e12, .relative_width = 0.3}};
+    for (int c = 0; c < 3; c++) {
         const thz_channel *ch = &chans[c];
         thz_sensor s = test_sensor(pitch, d_m);
         float *in = calloc(N * N, sizeof *in);
@@ -143,7 +149,7 @@ static void test_airy_profile_and_fwhm(void **state)
         if (fabs(fwhm / fwhm_want - 1.0) > 0.03)
             fail_msg("channel %d: FWHM %.4g mrad, band-averaged Airy %.4g mrad", c, fwhm * 1e3,
                      fwhm_want * 1e3);
-        if (fabs(fwhm_want / fwhm_mono - 1.0) > 0.01)
+        if (ch->relative_width < 0.1 && fabs(fwhm_want / fwhm_mono - 1.0) > 0.01)
             fail_msg("channel %d: band-averaged FWHM %.4g mrad far from 1.029 lambda/D = %.4g", c,
                      fwhm_want * 1e3, fwhm_mono * 1e3);
         if (fabs(sum(out) - 1.0) > 0.005)
