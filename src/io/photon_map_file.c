@@ -73,25 +73,16 @@ static thz_status pmf_begin_frame(pmf_writer *w, uint64_t content_bytes, thz_err
 /* Compresses one channel's records in the map's own order, which depends only on the
  * records (photon_map.c: by object and side, Morton code in the group's cube, bytes), so
  * a reader's build finds them in order and moves nothing, and read + write gives the file
- * back byte for byte. A chunk at a time, keeping only the flags the phase stored (the
- * upper bits are the map's: maps before the octree kept a kd-tree split axis there). */
+ * back byte for byte. A chunk at a time. */
 static thz_status pmf_write_channel(pmf_writer *w, const photon_map *map, thz_error *err)
 {
     const photon_record *r = photon_map_records(map);
     size_t n = photon_map_count(map);
-    photon_record *tmp = thz_malloc_array(PMF_CHUNK, sizeof *tmp);
-    if (!tmp)
-        return thz_error_set(err, THZ_ERR_NOMEM, "cannot write photon map %s: out of memory",
-                             w->path);
     thz_status st = THZ_OK;
     for (size_t i = 0; i < n && st == THZ_OK; i += PMF_CHUNK) {
         size_t m = n - i < PMF_CHUNK ? n - i : PMF_CHUNK;
-        memcpy(tmp, r + i, m * sizeof *tmp);
-        for (size_t k = 0; k < m; k++)
-            tmp[k].flags &= PMF_FLAGS_STORED;
-        st = pmf_compress(w, tmp, m * sizeof *tmp, ZSTD_e_continue, err);
+        st = pmf_compress(w, r + i, m * sizeof *r, ZSTD_e_continue, err);
     }
-    free(tmp);
     return st;
 }
 

@@ -1,7 +1,7 @@
 /* photon-map.thzpm: every channel's photon map and photon-phase statistics, so that
  * `render` can reuse a simulation's photons (scene-format.md "Outputs").
  *
- * Layout (little-endian, version 3):
+ * Layout (little-endian, version 4):
  *   prefix, 24 bytes, uncompressed: magic "THZPMAP\x1a", u32 version, u32 flags (0;
  *     none is defined, a reader refuses any set bit),
  *     u64 total file size (detects truncation before decoding anything);
@@ -13,15 +13,17 @@
  *     that a file depends only on the scene, seed and photon count), then f64 the map's
  *     reference temperature T0 in K (photon_map.h; 0 for the paper's map of L);
  *   zstd frame 2 (with content checksum and content size): the records of channel 0,
- *     1, ... as 32-byte photon_record images, `flags` holding only the bounce count and
- *     the batch (bits 24-26). Within a channel they are in the map's order, which depends
- *     on the records alone (photon_map.c: by object_side, then Morton code in the
- *     group's cube, then bytes), so that read + write reproduces a file byte for byte and
- *     the reader's index build, finding them in order, moves nothing.
+ *     1, ... as 28-byte photon_record images (photon_map.h: the tag holds the group,
+ *     the first-hit bit and the batch). Within a channel they are in the map's order,
+ *     which depends on the records alone (photon_map.c: by group, then Morton code in
+ *     the group's cube, then bytes), so that read + write reproduces a file byte for
+ *     byte and the reader's index build, finding them in order, moves nothing.
  *
- * Version 2 is version 3 with the records of a group in the order of their bytes (the
- * reader's build sorts them); version 1 is version 2 without T0 (20 words per channel),
- * its maps with T0 = 0. Both are still read.
+ * Version 3 is version 4 with 32-byte records (PMF_RECORD_BYTES_V3: u32 object << 1 |
+ * side, u32 the bounce count and the batch, where the tag is); the reader converts them
+ * and sorts them again (their order of bytes was another). Version 2 is version 3 with
+ * the records of a group in the order of their bytes; version 1 is version 2 without T0
+ * (20 words per channel), its maps with T0 = 0 and no batches. All are still read.
  */
 #ifndef THZ_IO_PHOTON_MAP_FILE_H
 #define THZ_IO_PHOTON_MAP_FILE_H
@@ -34,7 +36,7 @@
 #include "photon/photon_stats.h"
 #include "scene/scene.h"
 
-#define PHOTON_MAP_FILE_VERSION 3u
+#define PHOTON_MAP_FILE_VERSION 4u
 #define PHOTON_MAP_FILE_MAGIC "THZPMAP\x1a"
 
 /* What a file says beyond its maps. */

@@ -22,10 +22,17 @@
 /* zstd level 1: at 3 it took twice the time (the paper's case, one channel of 10 M photons:
  * 2.9 s against 1.5 s) for a file 1.2 % smaller */
 #define PMF_LEVEL 1
-#define PMF_FLAGS_STORED                                                                           \
-    (0xffffu | (PHOTON_MAP_BATCHES - 1u) << PHOTON_BATCH_SHIFT) /* bounces, batch */
+/* Versions 1 to 3 held 32-byte records: photon_record's first 24 bytes, then u32 object
+ * index << 1 | side, u32 the bounce count (low 16 bits) and the batch (bits 24-26). */
+#define PMF_RECORD_BYTES_V3 32u
 #define PMF_MAX_HEADER_BYTES (16u << 20)
 #define PMF_FRAME_HEADER_MAX 18u /* bytes: zstd's largest frame header */
+
+/* The bytes of a record in a file of `version`. */
+static inline size_t pmf_record_bytes(uint32_t version)
+{
+    return version >= 4u ? sizeof(photon_record) : PMF_RECORD_BYTES_V3;
+}
 
 /* ---- little-endian words ---------------------------------------------------- */
 
@@ -41,6 +48,11 @@ static inline uint64_t get_u64(const uint8_t *p)
     for (int i = 0; i < 8; i++)
         v |= (uint64_t)p[i] << (8 * i);
     return v;
+}
+
+static inline uint32_t get_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
 static inline void put_f64(uint8_t *p, double x)

@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -130,14 +131,15 @@ static thz_status pmf_peek(pmf_reader *r, size_t n, thz_error *err)
  * rest of the file (file_bytes in all) can decompress to: a zstd block holds at most
  * ZSTD_BLOCKSIZE_MAX bytes and takes at least 4 (a 3-byte header and one RLE byte). */
 static thz_status pmf_check_counts(pmf_reader *r, const uint8_t *header, size_t channel_words,
-                                   size_t nc, uint64_t file_bytes, thz_error *err)
+                                   size_t record_bytes, size_t nc, uint64_t file_bytes,
+                                   thz_error *err)
 {
     uint64_t total = 0;
     for (size_t c = 0; c < nc; c++) {
         uint64_t count = get_u64(header + 8 * (PMF_HEADER_FIXED + channel_words * c) + 16);
-        if (count > (UINT64_MAX - total) / sizeof(photon_record))
+        if (count > (UINT64_MAX - total) / record_bytes)
             return pmf_corrupt(r, "impossible record count", err);
-        total += count * sizeof(photon_record);
+        total += count * record_bytes;
     }
     thz_status st = pmf_peek(r, PMF_FRAME_HEADER_MAX, err);
     if (st != THZ_OK)
@@ -352,8 +354,8 @@ thz_status photon_map_file_open(const char *path, const thz_scene *scene, photon
     /* Frame 2: the records. Before any is allocated, the counts must fit what the rest of
      * the file can hold. */
     if (st == THZ_OK)
-        st = pmf_check_counts(&s->r, s->header, s->channel_words, scene->n_channels,
-                              (uint64_t)actual, err);
+        st = pmf_check_counts(&s->r, s->header, s->channel_words, pmf_record_bytes(s->version),
+                              scene->n_channels, (uint64_t)actual, err);
     if (st != THZ_OK) {
         photon_map_file_close(s);
         return st;
@@ -383,6 +385,31 @@ size_t photon_map_file_largest_count(const photon_map_file_stream *s)
     return most;
 }
 
+/* n records of a file of version 1 to 3 into records: each 32-byte image's object and
+ * side, bounce count and batch into the tag (PMF_RECORD_BYTES_V3). */
+static thz_status pmf_read_v3(pmf_reader *r, photon_record *records, size_t n, thz_error *err)
+{
+    enum { CHUNK = 1024 };
+    uint8_t buf[CHUNK * PMF_RECORD_BYTES_V3];
+    for (size_t i = 0; i < n; i += CHUNK) {
+        size_t m = n - i < CHUNK ? n - i : CHUNK;
+        thz_status st = pmf_read(r, buf, m * PMF_RECORD_BYTES_V3, err);
+        if (st != THZ_OK)
+            return st;
+        for (size_t k = 0; k < m; k++) {
+            const uint8_t *b = buf + k * PMF_RECORD_BYTES_V3;
+            photon_record *q = &records[i + k];
+            memcpy(q, b, offsetof(photon_record, tag));
+            uint32_t object_side = get_u32(b + 24), flags = get_u32(b + 28);
+            if (object_side >> 1 >= PHOTON_MAX_OBJECTS)
+                return pmf_corrupt(r, "a photon names an object the scene does not have", err);
+            q->tag = photon_tag(object_side >> 1, (int)(object_side & 1u), (flags & 0xffffu) == 0,
+                                flags >> 24);
+        }
+    }
+    return THZ_OK;
+}
+
 /* The next channel's records: into a new array (*records, *count) when keep, else
  * checked against the checksum and dropped. After the last channel's, the records
  * frame's end and the file's. */
@@ -396,7 +423,7 @@ static thz_status pmf_next_records(photon_map_file_stream *s, bool keep, photon_
     size_t n = (size_t)get_u64(pmf_channel_words(s, s->next) + 16);
     thz_status st = THZ_OK;
     if (!keep) {
-        st = pmf_skip(r, (uint64_t)n * sizeof(photon_record), err);
+        st = pmf_skip(r, (uint64_t)n * pmf_record_bytes(s->version), err);
     } else {
         *records = thz_malloc_array(n ? n : 1, sizeof(photon_record));
         *count = n;
@@ -404,9 +431,10 @@ static thz_status pmf_next_records(photon_map_file_stream *s, bool keep, photon_
             return thz_error_set(err, THZ_ERR_NOMEM,
                                  "cannot read photon map %s: out of memory for %zu photons",
                                  r->path, n);
-        st = pmf_read(r, *records, n * sizeof(photon_record), err);
+        st = s->version >= 4u ? pmf_read(r, *records, n * sizeof(photon_record), err)
+                              : pmf_read_v3(r, *records, n, err);
         for (size_t i = 0; st == THZ_OK && i < n; i++)
-            if (((*records)[i].object_side >> 1) >= s->scene->n_objects)
+            if (photon_object(&(*records)[i]) >= s->scene->n_objects)
                 st = pmf_corrupt(r, "a photon names an object the scene does not have", err);
         if (st != THZ_OK) {
             free(*records);

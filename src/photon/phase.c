@@ -257,9 +257,10 @@ static thz_status phase_check(const thz_scene *scene, size_t channel, thz_error 
     if (channel >= scene->n_channels)
         return thz_error_set(err, THZ_ERR_INTERNAL, "photon phase: no channel %zu (scene has %zu)",
                              channel, scene->n_channels);
-    if (scene->n_objects > (UINT32_MAX >> 1))
-        return thz_error_set(err, THZ_ERR_LIMIT, "photon phase: too many objects (%zu)",
-                             scene->n_objects);
+    if (scene->n_objects > PHOTON_MAX_OBJECTS)
+        return thz_error_set(err, THZ_ERR_LIMIT,
+                             "photon phase: %zu objects is too many (a photon map holds %zu)",
+                             scene->n_objects, PHOTON_MAX_OBJECTS);
     return THZ_OK;
 }
 

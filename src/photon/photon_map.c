@@ -251,8 +251,9 @@ static double photon_distance2(const photon_record *p, const double q[3])
 typedef struct photon_radius_query {
     const photon_cube *cube;
     const photon_record *r; /* the map's records */
-    int dir_level;          /* the group's directory: starts of its cells of this level */
-    const size_t *dir_starts;
+    int dir_level;          /* the group's directory: starts of its cells of this level, */
+    const uint32_t *dir_starts;
+    size_t dir_base; /* ... as offsets from the group's first record */
     double q[3];
     double radius2, radius;
     float radius2_pre; /* a float bound that every record within the radius meets */
@@ -291,7 +292,7 @@ static void photon_radius_axes(const photon_radius_query *qr, const photon_cell 
          * bits so far, the later axes' bits clear: its first descendant of the
          * directory's level */
         uint64_t child = cell->m << 3 | ((uint64_t)bits << (3 - axis) | 1u << (2 - axis));
-        m = qr->dir_starts[child << 3 * (qr->dir_level - cell->level - 1)];
+        m = qr->dir_base + qr->dir_starts[child << 3 * (qr->dir_level - cell->level - 1)];
     } else {
         m = photon_bit_boundary(qr->cube, qr->r, lo, hi, axis,
                                 PHOTON_MAP_LEVELS - (cell->level + 1));
@@ -378,6 +379,7 @@ void photon_map_radius_in(const photon_map *map, const photon_map_directory *dir
                               .r = map->records,
                               .dir_level = indexed ? dir->level[g] : 0,
                               .dir_starts = indexed ? dir->starts[g] : NULL,
+                              .dir_base = lo,
                               .q = {position_m.x, position_m.y, position_m.z},
                               .radius2 = radius2_m2,
                               .radius = sqrt(radius2_m2),

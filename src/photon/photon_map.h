@@ -2,7 +2,7 @@
  * position, direction, frequency, object and side (physics.md "Photon phase"), and a
  * spatial index per (object, side) answering radius and k-nearest queries.
  *
- * The record is 32 bytes: see photon_record below for what each field holds and why.
+ * The record is 28 bytes: see photon_record below for what each field holds and why.
  */
 #ifndef THZ_PHOTON_PHOTON_MAP_H
 #define THZ_PHOTON_PHOTON_MAP_H
@@ -13,15 +13,17 @@
 #include "core/error.h"
 #include "core/vec3.h"
 
-/* One stored photon hit (32 bytes). */
+/* One stored photon hit (28 bytes). */
 typedef struct photon_record {
     float position_m[3];  /* hit point */
     float power_w_per_hz; /* incident spectral power carried (already attenuated) */
     float freq_hz;        /* the photon's own frequency (float: 60 kHz resolution at 1 THz) */
     uint32_t dir_oct;     /* incoming unit direction, octahedral 2 x 16 bit */
-    uint32_t object_side; /* object index << 1 | side (0 front, 1 back) */
-    uint32_t flags;       /* bounce count in the low 16 bits; the batch in bits 24-26 */
+    uint32_t tag;         /* group (object index << 1 | side: 0 front, 1 back) << 4, whether
+                           * the hit is the photon's first (bit 3), its batch (bits 0-2) */
 } photon_record;
+
+_Static_assert(sizeof(photon_record) == 28, "photon_record must stay 28 bytes");
 
 /* Photon batches: photon i of the phase (all records of its path) belongs to batch
  * i mod PHOTON_MAP_BATCHES. The batches are independent, identically distributed maps of
@@ -29,26 +31,48 @@ typedef struct photon_record {
  * to a pixel measures the photon map's own noise there (final-gather's standard error,
  * docs/integrators.md). */
 #define PHOTON_MAP_BATCHES 8u
-#define PHOTON_BATCH_SHIFT 24
+/* The tag's fields: the batch in its low bits, then the first-hit bit, then the group. */
+#define PHOTON_TAG_FIRST_HIT 8u
+#define PHOTON_TAG_GROUP_SHIFT 4
+/* The most objects a photon map holds (67 M): their groups (two each) take half the
+ * tag's 2^28 group values, the other half left for the index build's keys
+ * (photon_map_build.c). */
+#define PHOTON_MAX_OBJECTS ((size_t)1 << (32 - PHOTON_TAG_GROUP_SHIFT - 2))
+
+/* The tag of a hit on `side` of `object` by a photon of `batch`, first_hit nonzero at the
+ * photon's first hit. */
+static inline uint32_t photon_tag(uint32_t object, int side, int first_hit, unsigned batch)
+{
+    return (object << 1 | (uint32_t)side) << PHOTON_TAG_GROUP_SHIFT |
+           (first_hit ? PHOTON_TAG_FIRST_HIT : 0u) | (batch & (PHOTON_MAP_BATCHES - 1u));
+}
 
 static inline unsigned photon_batch(const photon_record *p)
 {
-    return (p->flags >> PHOTON_BATCH_SHIFT) & (PHOTON_MAP_BATCHES - 1u);
+    return p->tag & (PHOTON_MAP_BATCHES - 1u);
 }
-
-_Static_assert(sizeof(photon_record) == 32, "photon_record must stay 32 bytes");
 
 /* Direction (unit) <-> 32-bit octahedral code, error < 1e-4 rad. */
 uint32_t photon_encode_direction(vec3 dir);
 vec3 photon_decode_direction(uint32_t code);
 
+/* The record's group: object index << 1 | side, the map's order's first key. */
+static inline uint32_t photon_group(const photon_record *p)
+{
+    return p->tag >> PHOTON_TAG_GROUP_SHIFT;
+}
 static inline uint32_t photon_object(const photon_record *p)
 {
-    return p->object_side >> 1;
+    return p->tag >> (PHOTON_TAG_GROUP_SHIFT + 1);
 }
 static inline int photon_side(const photon_record *p)
 {
-    return (int)(p->object_side & 1u);
+    return (int)(p->tag >> PHOTON_TAG_GROUP_SHIFT & 1u);
+}
+/* Whether the hit is its photon's first (where it was emitted to, before any bounce). */
+static inline int photon_first_hit(const photon_record *p)
+{
+    return (p->tag & PHOTON_TAG_FIRST_HIT) != 0;
 }
 
 typedef struct photon_map photon_map;

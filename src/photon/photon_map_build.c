@@ -4,7 +4,8 @@
  *
  *  1. scan: each part of the array (a contiguous range; one per thread) counts its records
  *     of each group and takes the groups' bounding boxes, which give the groups' cubes;
- *  2. key: each part writes each record's key into its object_side and counts the keys:
+ *  2. key: each part writes each record's key into its tag's group bits (the tag's own
+ *     bits kept; the group is known from the key) and counts the keys:
  *     a small group is one key, a large group one per first digit of its records' codes
  *     (PHOTON_MAP_FIRST_LEVELS levels: 4096), the keys in the map's order. The keys are
  *     dealt into buckets, runs of consecutive keys that fit in the scratch (3 in the
@@ -56,6 +57,12 @@
 #define PHOTON_MAP_LARGE 65536
 /* Below this many records, one part (not worth waking threads for). */
 #define PHOTON_MAP_PARTS_MIN 65536
+
+/* A record's group before pass 2, its key after (the tag's upper bits). */
+static inline size_t photon_build_key_of(const photon_record *q)
+{
+    return q->tag >> PHOTON_TAG_GROUP_SHIFT;
+}
 
 /* A group's bounding box. */
 typedef struct photon_bounds {
@@ -148,12 +155,13 @@ static void photon_build_scan(photon_build *b, int p)
     for (size_t i = lo; i < hi; i++) {
         photon_prefetch(b->r, i + PHOTON_PREFETCH_AHEAD, hi);
         const photon_record *q = &b->r[i];
-        if (q->object_side >= b->n_groups) {
+        size_t g = photon_group(q);
+        if (g >= b->n_groups) {
             b->first_bad[p] = i;
             return;
         }
-        cnt[q->object_side]++;
-        photon_bounds *bb = &box[q->object_side];
+        cnt[g]++;
+        photon_bounds *bb = &box[g];
         for (int a = 0; a < 3; a++) {
             double v = q->position_m[a];
             bb->lo[a] = v < bb->lo[a] ? v : bb->lo[a];
@@ -196,7 +204,7 @@ static size_t photon_build_layout(photon_build *b)
 
 /* After pass 1, for part p: whether its records, and the one before them, are in the map's
  * order already: groups ascending; within a group, Morton codes in the group's cube
- * ascending, ties by bytes; flags bits 16..17 clear (what pass 2 clears). Read only. */
+ * ascending, ties by bytes. Read only. */
 static bool photon_build_in_order(const photon_build *b, int p)
 {
     size_t lo, hi;
@@ -206,14 +214,12 @@ static bool photon_build_in_order(const photon_build *b, int p)
     for (size_t i = first; i < hi; i++) {
         photon_prefetch(b->r, i + PHOTON_PREFETCH_AHEAD, hi);
         const photon_record *q = &b->r[i];
-        if (q->flags & 3u << 16)
-            return false;
-        uint64_t code = photon_morton(&b->cubes[q->object_side], q);
+        uint64_t code = photon_morton(&b->cubes[photon_group(q)], q);
         if (i > first) {
             const photon_record *before = q - 1;
-            if (before->object_side > q->object_side)
+            if (photon_group(before) > photon_group(q))
                 return false;
-            if (before->object_side == q->object_side &&
+            if (photon_group(before) == photon_group(q) &&
                 (prev_code > code || (prev_code == code && memcmp(before, q, sizeof *q) > 0)))
                 return false;
         }
@@ -222,9 +228,8 @@ static bool photon_build_in_order(const photon_build *b, int p)
     return true;
 }
 
-/* Pass 2 for part p: each record's key into its object_side (the group is known from the
- * key), counted. Also clears bits 16..17 of flags (a kd-tree's split axis in maps before
- * the octree; kept zero). */
+/* Pass 2 for part p: each record's key into its tag's group bits (the group is known from
+ * the key), counted. */
 static void photon_build_key(photon_build *b, int p)
 {
     size_t lo, hi;
@@ -234,11 +239,11 @@ static void photon_build_key(photon_build *b, int p)
     for (size_t i = lo; i < hi; i++) {
         photon_prefetch_write(b->r, i + PHOTON_PREFETCH_AHEAD, hi);
         photon_record *q = &b->r[i];
-        size_t g = q->object_side, key = b->key_base[g];
+        size_t g = photon_group(q), key = b->key_base[g];
         if (b->key_base[g + 1] - key > 1)
             key += photon_first_digit(&b->cubes[g], q);
-        q->object_side = (uint32_t)key;
-        q->flags &= ~(3u << 16);
+        q->tag = (uint32_t)key << PHOTON_TAG_GROUP_SHIFT |
+                 (q->tag & ((1u << PHOTON_TAG_GROUP_SHIFT) - 1u));
         cnt[key]++;
     }
 }
@@ -315,7 +320,7 @@ static void photon_build_partition(photon_build *b, int p)
     for (int k = 0; k < b->n_buckets; k++) {
         while (next[k] < at[k + 1]) {
             photon_prefetch_write(b->r, next[k] + PHOTON_PREFETCH_AHEAD, at[k + 1]);
-            int d = photon_bucket_of(b, b->r[next[k]].object_side);
+            int d = photon_bucket_of(b, photon_build_key_of(&b->r[next[k]]));
             if (d == k) {
                 next[k]++;
             } else { /* and the front it swaps with (16 ahead did as well as 32) */
@@ -352,7 +357,7 @@ static void photon_build_scatter(photon_build *b, int k, int p)
     size_t at = photon_part_at(b, p)[k], in = photon_part_in(b, p)[k];
     for (size_t i = at; i < at + in; i++) {
         photon_prefetch(b->r, i + PHOTON_PREFETCH_AHEAD, at + in);
-        b->s[slot[b->r[i].object_side]++] = b->r[i];
+        b->s[slot[photon_build_key_of(&b->r[i])]++] = b->r[i];
     }
 }
 
@@ -452,12 +457,13 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
         st = thz_error_set(err, THZ_ERR_INTERNAL, "photon map: %zu photons but no array", count);
         goto cleanup;
     }
-    if (n_objects > (SIZE_MAX - 1) / 2 || n_objects > UINT32_MAX / 2) {
+    if (n_objects > PHOTON_MAX_OBJECTS) {
         st = thz_error_set(err, THZ_ERR_LIMIT, "photon map: %zu objects is too many", n_objects);
         goto cleanup;
     }
     const size_t n_groups = 2 * n_objects;
-    if (photon_build_max_keys(count, n_groups) > UINT32_MAX) { /* a key is an object_side */
+    /* a key is a tag's group bits */
+    if (photon_build_max_keys(count, n_groups) > UINT32_MAX >> PHOTON_TAG_GROUP_SHIFT) {
         st = thz_error_set(err, THZ_ERR_LIMIT, "photon map: %zu photons is too many", count);
         goto cleanup;
     }

@@ -7,10 +7,13 @@
 
 /* The directory's level for a group of n records: the deepest L <= PHOTON_DIR_MAX_LEVELS
  * with PHOTON_DIR_MIN_PER_CELL records per cell of level L on average; 0 for groups too
- * small to need one (their binary searches stay within a few cache lines). */
+ * small to need one (their binary searches stay within a few cache lines), and for
+ * groups of 2^32 records or more (its offsets are 32 bits). */
 static int photon_dir_level(size_t n)
 {
     int level = 0;
+    if (n > UINT32_MAX)
+        return 0;
     while (level < PHOTON_DIR_MAX_LEVELS && (size_t)PHOTON_DIR_MIN_PER_CELL << 3 * (level + 1) <= n)
         level++;
     return level;
@@ -20,17 +23,17 @@ static int photon_dir_level(size_t n)
  * first record of every cell there (empty cells included: their start is where they would
  * begin). */
 static void photon_dir_fill(const photon_cube *cube, const photon_record *r,
-                            const photon_cell *cell, int level, size_t *starts)
+                            const photon_cell *cell, int level, size_t base, uint32_t *starts)
 {
     if (cell->level == level) {
-        starts[cell->m] = cell->lo;
+        starts[cell->m] = (uint32_t)(cell->lo - base);
         return;
     }
     size_t b[9];
     photon_cell_split(cube, r, cell, b);
     for (unsigned d = 0; d < 8; d++) {
         photon_cell child = photon_child(cell, d, b);
-        photon_dir_fill(cube, r, &child, level, starts);
+        photon_dir_fill(cube, r, &child, level, base, starts);
     }
 }
 
@@ -66,12 +69,12 @@ thz_status photon_map_directory_create(const photon_map *map, int threads,
         if (level == 0)
             continue;
         size_t cells = (size_t)1 << 3 * level;
-        size_t *starts = thz_malloc_array(cells + 1, sizeof *starts);
+        uint32_t *starts = thz_malloc_array(cells + 1, sizeof *starts);
         if (!starts) {
             photon_map_directory_destroy(dir);
             return thz_error_set(err, THZ_ERR_NOMEM, "photon map: out of memory for its directory");
         }
-        starts[cells] = hi;
+        starts[cells] = (uint32_t)(hi - lo);
         dir->starts[g] = starts;
         dir->level[g] = level;
     }
@@ -90,7 +93,8 @@ thz_status photon_map_directory_create(const photon_map *map, int threads,
         for (unsigned d = 0; d < 8; d++) {
             photon_cell child = photon_child(&root, d, b);
 #pragma omp task firstprivate(child, g)
-            photon_dir_fill(&map->cubes[g], map->records, &child, dir->level[g], dir->starts[g]);
+            photon_dir_fill(&map->cubes[g], map->records, &child, dir->level[g], map->start[g],
+                            dir->starts[g]);
         }
     }
     *out = dir;
@@ -104,6 +108,6 @@ size_t photon_map_directory_bytes(const photon_map_directory *dir)
     size_t bytes = sizeof *dir + dir->n_groups * (sizeof *dir->level + sizeof *dir->starts);
     for (size_t g = 0; g < dir->n_groups; g++)
         if (dir->level[g] > 0)
-            bytes += (((size_t)1 << 3 * dir->level[g]) + 1) * sizeof(size_t);
+            bytes += (((size_t)1 << 3 * dir->level[g]) + 1) * sizeof(uint32_t);
     return bytes;
 }

@@ -43,7 +43,7 @@ struct photon_map {
 
 /* A group's directory goes down to the deepest level L whose cells hold at least
  * PHOTON_DIR_MIN_PER_CELL records on average, at most PHOTON_DIR_MAX_LEVELS (8^6 cells,
- * 2 MB): at most 2 bytes per record (8 bytes a cell, 4 records a cell). Final-gather on the
+ * 1 MB): at most 1 byte per record (4 bytes a cell, 4 records a cell). Final-gather on the
  * paper's scene spent 9-14 % less CPU with a directory (16 per cell and 6 levels, with
  * 48-record leaves; 64 per cell helped less, 8 and 7 levels no more). The photons lie on
  * surfaces, so the occupied cells hold many times the mean: with 256-record leaves, 4 per
@@ -55,8 +55,9 @@ struct photon_map {
 
 struct photon_map_directory {
     size_t n_groups;
-    int *level;      /* [group] L: starts[group] holds the 8^L cells of level L; 0: none */
-    size_t **starts; /* [group] 8^L + 1 record indices: each cell's first, then the end */
+    int *level;        /* [group] L: starts[group] holds the 8^L cells of level L; 0: none */
+    uint32_t **starts; /* [group] 8^L + 1 offsets from the group's first record: each
+                        * cell's first, then the group's end */
 };
 
 static inline uint32_t photon_quantize_axis(const photon_cube *c, const photon_record *p, int a)

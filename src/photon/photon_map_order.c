@@ -109,28 +109,45 @@ static void photon_sort(photon_record *r, uint64_t *code, size_t n, int level)
     }
 }
 
+/* The pairs of photon_sort_range live in the destination's bytes, where a record's start
+ * need not be 8-byte aligned: loaded and stored through memcpy (a plain move). */
+static inline uint64_t photon_pair_get(const unsigned char *pairs, size_t i)
+{
+    uint64_t v;
+    memcpy(&v, pairs + 8 * i, sizeof v);
+    return v;
+}
+static inline void photon_pair_set(unsigned char *pairs, size_t i, uint64_t v)
+{
+    memcpy(pairs + 8 * i, &v, sizeof v);
+}
+
 /* An LSD radix sort, 8 bits a pass, of 64-bit pairs: the next 32 bits of a record's code
- * (10 levels and 2 bits) above its index. The pairs live in r's last half (two arrays of
- * 8 bytes per record), the sorted ones in its last quarter, so that moving the records
- * into their places, first to last, overwrites only pairs already read (record i ends at
- * byte 32 i + 32; pair j > i starts at byte 24 n + 8 j >= 32 i + 32). Then each run of
- * records whose 32 bits tie is sorted by full code and bytes (photon_sort; their codes in
- * the scratch, free by then). Sorting the records themselves moved 32 bytes a pass instead
- * of 8: 9 % more build time (12.1 M records, 2 threads, six alternating runs each: 0.408
- * against 0.375 s). In place, the American flag sort swapped every record along a cycle at
- * every second level: 37 of the build's 66 ns per record (paper's case, 1 thread). */
+ * (10 levels and 2 bits) above its index. The pairs live in the last 16 bytes per record
+ * of r (two arrays of 8 bytes per record), the sorted ones last, so that moving the
+ * records into their places, first to last, overwrites only pairs already read (record i
+ * ends at byte R i + R, R = sizeof(photon_record); pair j > i starts at byte
+ * (R - 8) n + 8 j >= R i + R). The move marks the first record of each run of records
+ * whose 32 bits tie (the tag's group bits, all g's in this range, free until then); each
+ * run is then sorted by full code and bytes (photon_sort; their codes in the scratch, free
+ * by then). Sorting the records themselves moved 32 bytes a pass instead of 8: 9 % more
+ * build time (12.1 M records, 2 threads, six alternating runs each: 0.408 against
+ * 0.375 s). In place, the American flag sort swapped every record along a cycle at every
+ * second level: 37 of the build's 66 ns per record (paper's case, 1 thread). */
 void photon_sort_range(const photon_cube *cube, photon_record *scratch, photon_record *r, size_t n,
                        int level, uint32_t g)
 {
     _Static_assert(1 + PHOTON_MAP_FIRST_LEVELS <= 11, "the 32 bits must lie in the code");
-    _Static_assert(sizeof(photon_record) == 4 * sizeof(uint64_t), "pairs: 4 per record");
+    _Static_assert(sizeof(photon_record) >= 16, "pairs: 2 per record");
     const int shift = 31 - 3 * (level - 1); /* the code's next 32 bits: [shift, shift + 32) */
-    uint64_t *half = (uint64_t *)(void *)r + 2 * n, *last = half + n;
+    const uint32_t low = (1u << PHOTON_TAG_GROUP_SHIFT) - 1u; /* the tag's own bits */
+    unsigned char *half = (unsigned char *)r + (sizeof(photon_record) - 16) * n,
+                  *last = half + 8 * n;
     size_t count[4][256] = {{0}};
     for (size_t i = 0; i < n; i++) {
         photon_prefetch(scratch, i + PHOTON_PREFETCH_AHEAD, n);
         uint32_t key = (uint32_t)(photon_morton(cube, &scratch[i]) >> shift);
-        scratch[i].object_side = key; /* until the record is in its place */
+        photon_pair_set(half, i, (uint64_t)key << 32 | i);
         for (int d = 0; d < 4; d++)
             count[d][key >> 8 * d & 255u]++;
     }
@@ -142,9 +159,12 @@ void photon_sort_range(const photon_cube *cube, photon_record *scratch, photon_r
             moves[d] = count[d][k] != n;
         passes += moves[d];
     }
-    uint64_t *src = passes % 2 ? half : last, *dst = passes % 2 ? last : half;
-    for (size_t i = 0; i < n; i++)
-        src[i] = (uint64_t)scratch[i].object_side << 32 | i;
+    unsigned char *src = half, *dst = last;
+    if (passes % 2 == 0) { /* an even number of passes ends where it starts: start in last */
+        memcpy(last, half, 8 * n);
+        src = last;
+        dst = half;
+    }
     for (int d = 0; d < 4; d++) {
         if (!moves[d])
             continue;
@@ -154,21 +174,32 @@ void photon_sort_range(const photon_cube *cube, photon_record *scratch, photon_r
             next[k] = at;
             at += c;
         }
-        for (size_t i = 0; i < n; i++)
-            dst[next[src[i] >> (32 + 8 * d) & 255u]++] = src[i];
-        uint64_t *t = src;
+        for (size_t i = 0; i < n; i++) {
+            uint64_t pair = photon_pair_get(src, i);
+            photon_pair_set(dst, next[pair >> (32 + 8 * d) & 255u]++, pair);
+        }
+        unsigned char *t = src;
         src = dst;
         dst = t;
     }
-    for (size_t i = 0; i < n; i++) /* src == last: record i overwrites pairs before i only */
-        r[i] = scratch[last[i] & 0xffffffffu];
+    uint32_t prev = 0;
+    for (size_t i = 0; i < n; i++) { /* src == last: record i overwrites pairs up to i only */
+        uint64_t pair = photon_pair_get(last, i);
+        uint32_t key = (uint32_t)(pair >> 32);
+        photon_record q = scratch[pair & 0xffffffffu];
+        q.tag = (q.tag & low) | (uint32_t)(i == 0 || key != prev) << PHOTON_TAG_GROUP_SHIFT;
+        prev = key;
+        r[i] = q;
+    }
     for (size_t i = 0; i < n;) {
-        uint32_t key = r[i].object_side;
-        size_t j = i;
-        while (j < n && r[j].object_side == key)
-            r[j++].object_side = g;
-        if (j - i > 1) {
-            uint64_t *code = (uint64_t *)(void *)(scratch + i);
+        size_t j = i + 1;
+        while (j < n && (r[j].tag & ~low) == 0)
+            j++;
+        for (size_t k = i; k < j; k++)
+            r[k].tag = g << PHOTON_TAG_GROUP_SHIFT | (r[k].tag & low);
+        if (j - i > 1) { /* the codes 8-byte aligned in the run's 28 or more bytes a record */
+            uintptr_t at = ((uintptr_t)(void *)(scratch + i) + 7u) & ~(uintptr_t)7u;
+            uint64_t *code = (uint64_t *)(void *)at;
             for (size_t k = i; k < j; k++)
                 code[k - i] = photon_morton(cube, &r[k]);
             photon_sort(r + i, code, j - i, level + 10);

@@ -61,7 +61,7 @@ static inline unsigned photon_first_digit(const photon_cube *c, const photon_rec
            photon_spread7[photon_quantize_axis(c, p, 2) >> shift];
 }
 
-/* How far ahead (records; 1 KB) the build's passes ask for the records they stream
+/* How far ahead (records; 896 bytes) the build's passes ask for the records they stream
  * through. */
 #define PHOTON_PREFETCH_AHEAD 32
 
@@ -85,7 +85,7 @@ static inline void photon_prefetch_write(photon_record *r, size_t i, size_t n)
 
 /* Sorts the n records at scratch, of group g, whose codes share levels 1..level-1 (level 1
  * or 1 + PHOTON_MAP_FIRST_LEVELS), by code and then bytes into r[0..n) (n < 2^32), their
- * object_side set to g; scratch's n records are left undefined. */
+ * tags' group set to g (their own bits kept); scratch's n records are left undefined. */
 void photon_sort_range(const photon_cube *cube, photon_record *scratch, photon_record *r, size_t n,
                        int level, uint32_t g);
 

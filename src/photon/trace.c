@@ -191,8 +191,7 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const trace_optics *
             .power_w_per_hz = (float)power,
             .freq_hz = (float)nu,
             .dir_oct = photon_encode_direction(dir),
-            .object_side = hit.object << 1 | (uint32_t)hit.side,
-            .flags = (bounce < 0xffffu ? bounce : 0xffffu) | e->batch << PHOTON_BATCH_SHIFT,
+            .tag = photon_tag(hit.object, hit.side, bounce == 0, e->batch),
         };
         if (!trace_buffer_push(buf, &rec))
             return false;

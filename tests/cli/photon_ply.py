@@ -47,16 +47,20 @@ def read_ply(path):
 
 def read_thzpm(path):
     """The records of each channel, from the zstd frames after the 24-byte prefix."""
-    raw = open(path, "rb").read()[24:]
+    data = open(path, "rb").read()
+    if struct.unpack_from("<I", data, 8)[0] != 4:
+        fail(f"{path}: not a version-4 photon map")
+    raw = data[24:]
     out = subprocess.run(["zstd", "-dc"], input=raw, capture_output=True, check=True).stdout
     n_channels = struct.unpack_from("<Q", out, 8 * 3)[0]  # after the 3 scene hashes
     header = 8 * (7 + 21 * n_channels)
     counts = [struct.unpack_from("<Q", out, 8 * (7 + 21 * c + 2))[0] for c in range(n_channels)]
     records, at = [], header
     for c, n in enumerate(counts):
-        for r in struct.iter_unpack("<3f f f I I I", out[at:at + 32 * n]):
-            records.append((c, r[0], r[1], r[2], r[3], r[6] >> 1))
-        at += 32 * n
+        # version 4's 28-byte records: the tag holds object << 5 | side << 4 | bits
+        for r in struct.iter_unpack("<3f f f I I", out[at:at + 28 * n]):
+            records.append((c, r[0], r[1], r[2], r[3], r[6] >> 5))
+        at += 28 * n
     if at != len(out):
         fail(f"{path}: {len(out) - at} bytes after the records")
     return records

@@ -49,7 +49,7 @@ need(p["seconds"], ["load", "accel", "emission_table", "tracing", "index", "phot
 assert p["channels"] == 6 and p["resolution"] == [64, 64] and p["oversampling"] == 2
 assert p["photons_fired"] == 6 * p["photons_per_channel"] > 0
 assert p["photons_stored"] > 0 and p["rays"] >= p["photons_stored"]
-assert p["peak_memory_bytes"] > 0 and p["bytes_per_stored_photon"] >= 32
+assert p["peak_memory_bytes"] > 0 and p["bytes_per_stored_photon"] >= 28  # a record's bytes
 # a stored photon's memory counts the renderers' directory over its map too
 need(p, ["largest_map_bytes", "largest_map_stored", "largest_map_directory_bytes"], "paper_case")
 bpp = (p["largest_map_bytes"] + p["largest_map_directory_bytes"]) / p["largest_map_stored"]

@@ -57,14 +57,14 @@ work, bare, full, sim = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys
 bad = []
 with open(f"{work}/sim/summary.json") as f:
     stored = [c["photons_stored"] for c in json.load(f)["channels"]]
-largest, total = 32 * max(stored), 32 * sum(stored)
+largest, total = 28 * max(stored), 28 * sum(stored)  # bytes of a record
 extra = full - bare
 print(f"render peak {full / 1e6:.1f} MB, {extra / 1e6:.1f} MB above the bare render's "
       f"{bare / 1e6:.1f} MB; largest map {largest / 1e6:.1f} MB, all {total / 1e6:.1f} MB")
 if extra > 1.5 * largest:
     bad.append(f"render holds {extra / largest:.2f} x the largest map (at most 1.5)")
 with open(f"{work}/sim2/summary.json") as f:
-    largest3 = 32 * max(c["photons_stored"] for c in json.load(f)["channels"])
+    largest3 = 28 * max(c["photons_stored"] for c in json.load(f)["channels"])
 held = (sim - bare) / largest3
 print(f"simulate (3e6 photons) peak {sim / 1e6:.1f} MB, {held:.2f} x its largest map "
       f"({largest3 / 1e6:.1f} MB) above the bare render")

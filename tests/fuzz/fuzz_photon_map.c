@@ -3,7 +3,8 @@
  * - an input that starts with the magic "THZPMAP" is the .thzpm file itself (the prefix,
  *   the zstd frames, their checksums);
  * - any other input is the content of a file of this scene: its first byte chooses
- *   version 1 (bit 0 set) or 2, whether the header's record counts are kept as they are
+ *   version 1 (bit 0 set), 4 (bit 3 set) or 3 (32-byte records, which the reader
+ *   converts; 1 as well), whether the header's record counts are kept as they are
  *   (bit 1; else they split the records given among the channels) and whether the records
  *   frame omits its content size (bit 2); then come the header words (the scene's hashes
  *   and counts are filled in) and the records.
@@ -67,7 +68,8 @@ static void put_frame(uint8_t *out, size_t cap, size_t *pos, const void *src, si
 static size_t build_file(const uint8_t *data, size_t size, uint8_t **file)
 {
     unsigned options = size > 0 ? data[0] : 0u;
-    unsigned version = (options & 1u) ? 1u : 2u;
+    unsigned version = (options & 1u) ? 1u : (options & 8u) ? 4u : 3u;
+    size_t record_bytes = version < 4u ? 32u : sizeof(photon_record);
     size_t words = version == 1u ? 20u : 21u, nc = scene->n_channels;
     size_t header_bytes = 8 * (HEADER_FIXED + words * nc);
     const uint8_t *rest = size > 0 ? data + 1 : data;
@@ -75,7 +77,7 @@ static size_t build_file(const uint8_t *data, size_t size, uint8_t **file)
     uint8_t *header = calloc(header_bytes, 1);
     memcpy(header, rest, rest_n < header_bytes ? rest_n : header_bytes);
     const uint8_t *records = rest_n > header_bytes ? rest + header_bytes : NULL;
-    size_t n_records = records ? (rest_n - header_bytes) / sizeof(photon_record) : 0;
+    size_t n_records = records ? (rest_n - header_bytes) / record_bytes : 0;
 
     scene_hash h;
     scene_hash_compute(scene, &h);
@@ -92,7 +94,7 @@ static size_t build_file(const uint8_t *data, size_t size, uint8_t **file)
         left -= n;
     }
 
-    size_t records_bytes = n_records * sizeof(photon_record);
+    size_t records_bytes = n_records * record_bytes;
     size_t cap = 24 + ZSTD_compressBound(header_bytes) + ZSTD_compressBound(records_bytes);
     uint8_t *out = calloc(cap, 1);
     memcpy(out, PHOTON_MAP_FILE_MAGIC, 8);

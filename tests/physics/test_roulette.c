@@ -148,7 +148,8 @@ static void test_transmission_in_scene(void **state)
             if (buf.count == 2) {
                 through++;
                 assert_int_equal(photon_object(&r[1]), floor);
-                assert_int_equal(r[1].flags & 0xffffu, 1);
+                assert_false(photon_first_hit(&r[1]));
+                assert_true(photon_first_hit(&r[0]));
                 assert_true(r[1].power_w_per_hz == 1.0f);
                 vec3 d = photon_decode_direction(r[1].dir_oct);
                 assert_true(d.z < 0.0);

@@ -155,7 +155,7 @@ static void test_progress_and_cancel(void **state)
     thz_error err;
     assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
 
-    /* Estimate before: stored records per photon times K times 32 bytes. */
+    /* Estimate before: stored records per photon times K times the record's bytes. */
     uint64_t bytes = 0;
     assert_int_equal(photon_phase_estimate_bytes(s, acc, 0, 0.0, &bytes, &err), THZ_OK);
 

@@ -18,8 +18,6 @@
 #include "core/rng.h"
 #include "photon/photon_map.h"
 
-#define AXIS_MASK (3u << 16)
-
 static double test_scale(void)
 {
     const char *s = getenv("THZ_TEST_SCALE");
@@ -104,10 +102,9 @@ static photon_record *make_photons(size_t n, size_t n_objects, uint64_t stream)
             .power_w_per_hz = (float)i,
             .freq_hz = 1e12f,
             .dir_oct = rng_next_u32(&rng),
-            .object_side = obj << 1 | side,
-            .flags = (uint32_t)(i % 5) | (i % 3 == 0 ? AXIS_MASK : 0u),
+            .tag = photon_tag(obj, (int)side, i % 5 == 0, (unsigned)(i % 3)),
         };
-        if (i % 11 == 5 && i > 0 && (p[i - 1].object_side >> 1) != 3)
+        if (i % 11 == 5 && i > 0 && photon_object(&p[i - 1]) != 3)
             p[i] = p[i - 1]; /* fully identical record */
     }
     return p;
@@ -173,7 +170,7 @@ static void test_queries_vs_brute_force(void **state)
                     assert_false(v.bad);
                     size_t expect = 0;
                     for (size_t i = 0; i < n; i++) {
-                        if (r[i].object_side != (obj << 1 | (uint32_t)side))
+                        if (photon_group(&r[i]) != (obj << 1 | (uint32_t)side))
                             continue;
                         double dx = (double)r[i].position_m[0] - q.x,
                                dy = (double)r[i].position_m[1] - q.y,
@@ -189,7 +186,7 @@ static void test_queries_vs_brute_force(void **state)
             for (unsigned mask = 0; mask < 4; mask++) {
                 size_t m = 0;
                 for (size_t i = 0; i < n; i++) {
-                    if (r[i].object_side >> 1 != obj || !(mask >> (r[i].object_side & 1) & 1))
+                    if (photon_object(&r[i]) != obj || !(mask >> photon_side(&r[i]) & 1))
                         continue;
                     double dx = (double)r[i].position_m[0] - q.x,
                            dy = (double)r[i].position_m[1] - q.y,
@@ -224,10 +221,8 @@ static void test_same_records_grouped(void **state)
     photon_record *in = make_photons(n, n_objects, 2);
     photon_record *copy = malloc(n * sizeof *copy);
     assert_non_null(copy);
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n; i++)
         copy[i] = in[i];
-        copy[i].flags &= ~AXIS_MASK;
-    }
     photon_map *map = NULL;
     assert_int_equal(photon_map_create(in, n, n_objects, 1, &map, NULL), THZ_OK);
     const photon_record *r = photon_map_records(map);
@@ -235,11 +230,9 @@ static void test_same_records_grouped(void **state)
     assert_non_null(out);
     for (size_t i = 0; i < n; i++) {
         out[i] = r[i];
-        /* grouped by object_side; bounce counts kept */
+        /* grouped; first-hit bits and batches kept */
         if (i > 0)
-            assert_true(r[i - 1].object_side <= r[i].object_side);
-        assert_true(((r[i].flags & AXIS_MASK) >> 16) < 3);
-        out[i].flags &= ~AXIS_MASK;
+            assert_true(photon_group(&r[i - 1]) <= photon_group(&r[i]));
     }
     qsort(out, n, sizeof *out, cmp_record);
     qsort(copy, n, sizeof *copy, cmp_record);
@@ -318,10 +311,9 @@ static photon_record *make_crowded(size_t n, size_t n_objects)
             .power_w_per_hz = (float)(i % 1000),
             .freq_hz = 1e12f,
             .dir_oct = rng_next_u32(&rng) % 4u,
-            .object_side = obj << 1 | side,
-            .flags = (uint32_t)(i % 3) | (i % 5 == 0 ? AXIS_MASK : 0u),
+            .tag = photon_tag(obj, (int)side, i % 5 == 0, (unsigned)(i % 3)),
         };
-        if (i % 13 == 6 && p[i - 1].object_side >> 1 != 7)
+        if (i % 13 == 6 && photon_object(&p[i - 1]) != 7)
             p[i] = p[i - 1]; /* fully identical record */
     }
     return p;
@@ -340,7 +332,7 @@ static void check_queries(const photon_map *map, size_t n, uint32_t obj)
         vec3 q = v3(r[at].position_m[0], r[at].position_m[1], r[at].position_m[2] + 1e-4 * trial);
         size_t m = 0;
         for (size_t i = 0; i < n; i++) {
-            if (r[i].object_side != obj << 1)
+            if (photon_group(&r[i]) != obj << 1)
                 continue;
             double dx = (double)r[i].position_m[0] - q.x, dy = (double)r[i].position_m[1] - q.y,
                    dz = (double)r[i].position_m[2] - q.z;
@@ -380,7 +372,7 @@ static void test_deterministic_crowded(void **state)
     assert_true(photon_map_object_count(a, 0, 1u) >= 65536); /* the build's split threshold */
     const photon_record *ra = photon_map_records(a);
     for (size_t i = 1; i < n; i++)
-        assert_true(ra[i - 1].object_side <= ra[i].object_side);
+        assert_true(photon_group(&ra[i - 1]) <= photon_group(&ra[i]));
     check_queries(a, n, 0);
     for (int t = 2; t <= 3; t++) {
         photon_map *b = build(src, n, n_objects, t, t == 3);
@@ -406,7 +398,7 @@ static void test_deterministic_crowded(void **state)
 
 /* Records already in the map's order (a map's own, as a photon-map file keeps them) give
  * the same map without the second array; one pair out of order where the two threads'
- * parts meet, or a stale kd-tree axis bit, and the full build runs and gives it too. */
+ * parts meet, and the full build runs and gives it too. */
 static void test_in_order(void **state)
 {
     (void)state;
@@ -414,20 +406,18 @@ static void test_in_order(void **state)
     photon_record *src = make_crowded(n, n_objects);
     photon_map *a = build(src, n, n_objects, 2, 0);
     const photon_record *ra = photon_map_records(a);
-    for (int variant = 0; variant < 3; variant++) {
+    for (int variant = 0; variant < 2; variant++) {
         photon_record *p = malloc(n * sizeof *p);
         assert_non_null(p);
         memcpy(p, ra, n * sizeof *p);
         size_t at = n / 2; /* the second part's first record */
         if (variant == 1) {
-            while (ra[at - 1].object_side != ra[at].object_side ||
+            while (photon_group(&ra[at - 1]) != photon_group(&ra[at]) ||
                    memcmp(&ra[at - 1], &ra[at], sizeof *ra) == 0)
                 at++;
             photon_record t = p[at - 1];
             p[at - 1] = p[at];
             p[at] = t;
-        } else if (variant == 2) {
-            p[at].flags |= AXIS_MASK;
         }
         photon_map_pool pool = {0};
         photon_map *c = NULL;
@@ -451,13 +441,13 @@ static void test_crowded_key(void **state)
     const size_t n = 100000, n_objects = 2;
     photon_record *src = make_photons(n, n_objects, 11);
     for (size_t i = 0; i < n; i++) {
-        src[i].object_side = i % 10 == 9 ? 2u : 0u; /* 90 % in group 0: large */
-        if (i < 90000 && i % 3 != 2)                /* 60 % on one point */
+        src[i].tag = photon_tag(i % 10 == 9, 0, 0, 0); /* 90 % in group 0: large */
+        if (i < 90000 && i % 3 != 2)                   /* 60 % on one point */
             src[i].position_m[0] = src[i].position_m[1] = src[i].position_m[2] = 0.5f;
     }
     size_t at_point = 0;
     for (size_t i = 0; i < n; i++)
-        at_point += src[i].object_side == 0 && src[i].position_m[0] == 0.5f &&
+        at_point += photon_group(&src[i]) == 0 && src[i].position_m[0] == 0.5f &&
                     src[i].position_m[1] == 0.5f && src[i].position_m[2] == 0.5f;
     assert_true(at_point > photon_map_scratch_records(n));
     photon_map *a = build(src, n, n_objects, 1, 0);
@@ -503,7 +493,7 @@ static void test_empty_and_errors(void **state)
 
     /* an object index beyond n_objects is refused (and the array freed) */
     photon_record *p = make_photons(10, 5, 4);
-    p[4].object_side = 10 << 1;
+    p[4].tag = photon_tag(10, 0, 0, 0);
     map = NULL;
     assert_int_equal(photon_map_create(p, 10, 5, 0, &map, &err), THZ_ERR_INTERNAL);
     assert_null(map);

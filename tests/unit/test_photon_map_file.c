@@ -1,12 +1,14 @@
 /* photon-map.thzpm: write + read gives the same maps, stats and reference temperatures
  * (channel 1 is a deviation map, T0 = 290 K), and read + write reproduces the file byte
- * for byte; the records are stored in the map's order, and a version-2 file (the same by
- * group and bytes) reads into the same maps; a version-1 file (no T0) reads with T0 = 0;
+ * for byte; the records are stored in the map's order, and files of versions 3 (32-byte
+ * records) and 2 (those by group and bytes) read into the same maps; a version-1 file (no
+ * T0, no batches) reads with T0 = 0;
  * corrupted (one byte flipped), truncated, forged (a record count the file cannot hold,
  * refused before allocating), foreign and mismatched (another geometry, channel set or
  * temperatures) files are refused with messages that name the file and say what is wrong. */
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -189,11 +191,6 @@ static void spit_with_header(const fixture *f, const char *out_path, const unsig
     free(out);
 }
 
-/* A version-1 file (20 words per channel, no T0) made from a version-2 one: its header
- * frame without each channel's last word, the records frame as is. */
-/* One channel read alone (what a view of its photons needs): its map equals the full
- * read's, the other holds none, every channel's statistics are read; a damaged byte in
- * the skipped channel's records is still found (they are read, not jumped over). */
 /* The records are compressed by zstd workers (photon_map_file.h): a map of several of
  * zstd's jobs (20 MB of records) gives the same file written by 1, 2 or 5 of them, and
  * reads back. */
@@ -216,8 +213,8 @@ static void test_workers(void **state)
             .power_w_per_hz = (float)u[3] * 0x1p-70f,
             .freq_hz = 3.5e11f,
             .dir_oct = u[4],
-            .object_side = (uint32_t)(u[5] % groups),
-            .flags = (uint32_t)(i % PHOTON_MAP_BATCHES) << PHOTON_BATCH_SHIFT};
+            .tag = photon_tag((uint32_t)(u[5] % groups) >> 1, (int)(u[5] % groups & 1u), 0,
+                              (unsigned)(i % PHOTON_MAP_BATCHES))};
     }
     photon_map *map;
     thz_error err;
@@ -255,6 +252,9 @@ static void test_workers(void **state)
     scene_destroy(scene);
 }
 
+/* One channel read alone (what a view of its photons needs): its map equals the full
+ * read's, the other holds none, every channel's statistics are read; a damaged byte in
+ * the skipped channel's records is still found (they are read, not jumped over). */
 static void test_one_channel(void **state)
 {
     fixture *f = *state;
@@ -299,16 +299,95 @@ static void test_one_channel(void **state)
     assert_null(maps[1]);
 }
 
-static void test_version_1(void **state)
+/* Compares two version-3 record images: by object << 1 | side, then bytes (version 2's
+ * order). */
+static int image_cmp(const void *a, const void *b)
 {
-    fixture *f = *state;
+    uint32_t x, y;
+    memcpy(&x, (const unsigned char *)a + 24, 4);
+    memcpy(&y, (const unsigned char *)b + 24, 4);
+    if (x != y)
+        return x < y ? -1 : 1;
+    return memcmp(a, b, 32);
+}
+
+/* A file of version 1, 2 or 3 made from f's: the header frame `header` (hsize bytes) and
+ * the maps' records as those versions' 32-byte images (after the first 24 bytes, u32
+ * object << 1 | side and u32 the bounce count, here 0 at a first hit and 1 after, | the
+ * batch << 24 but in version 1), each channel's in its map's order or, by_bytes, by
+ * group and then bytes. The record `forge` (SIZE_MAX: none) names object 2^30. */
+static void spit_old_version(const fixture *f, const char *out_path, const unsigned char *header,
+                             size_t hsize, unsigned version, bool by_bytes, size_t forge)
+{
+    size_t counts[2] = {photon_map_count(f->maps[0]), photon_map_count(f->maps[1])};
+    size_t n = counts[0] + counts[1], isize = 32 * n;
+    unsigned char *img = malloc(isize);
+    assert_non_null(img);
+    for (size_t c = 0, at = 0; c < 2; at += counts[c], c++) {
+        const photon_record *r = photon_map_records(f->maps[c]);
+        for (size_t i = 0; i < counts[c]; i++) {
+            unsigned char *b = img + 32 * (at + i);
+            memcpy(b, &r[i], 24);
+            uint32_t object_side = photon_group(&r[i]);
+            uint32_t flags = (photon_first_hit(&r[i]) ? 0u : 1u) |
+                             (version == 1 ? 0u : photon_batch(&r[i]) << 24);
+            if (at + i == forge)
+                object_side = 1u << 31;
+            memcpy(b + 24, &object_side, 4);
+            memcpy(b + 28, &flags, 4);
+        }
+        if (by_bytes)
+            qsort(img + 32 * at, counts[c], 32, image_cmp);
+    }
+    size_t hcap = ZSTD_compressBound(hsize), rcap = ZSTD_compressBound(isize);
+    unsigned char *out = malloc(24 + hcap + rcap);
+    assert_non_null(out);
+    size_t h0 = compress_frame(out + 24, hcap, header, hsize);
+    size_t total = 24 + h0 + compress_frame(out + 24 + h0, rcap, img, isize);
+    memcpy(out, "THZPMAP\x1a", 8);
+    memset(out + 8, 0, 16);
+    set_prefix(out, version, total);
+    spit(out_path, out, total);
+    free(img);
+    free(out);
+}
+
+/* f's file's header frame (*hsize bytes, malloc'd). */
+static unsigned char *header_of(const fixture *f, size_t *hsize)
+{
     size_t n;
     unsigned char *buf = slurp(f->path, &n);
     size_t h1 = ZSTD_findFrameCompressedSize(buf + 24, n - 24);
     assert_false(ZSTD_isError(h1));
-    unsigned long long hsize = ZSTD_getFrameContentSize(buf + 24, h1);
-    unsigned char *header = malloc(hsize);
-    assert_int_equal(ZSTD_decompress(header, hsize, buf + 24, h1), hsize);
+    unsigned long long size = ZSTD_getFrameContentSize(buf + 24, h1);
+    unsigned char *header = malloc(size);
+    assert_int_equal(ZSTD_decompress(header, size, buf + 24, h1), size);
+    free(buf);
+    *hsize = size;
+    return header;
+}
+
+/* The records of a and b equal, the batches aside (version 1 has none). */
+static void assert_same_but_batches(const photon_map *a, const photon_map *b)
+{
+    size_t n = photon_map_count(a);
+    assert_int_equal(photon_map_count(b), n);
+    const photon_record *x = photon_map_records(a), *y = photon_map_records(b);
+    for (size_t i = 0; i < n; i++) {
+        photon_record p = x[i], q = y[i];
+        p.tag &= ~(PHOTON_MAP_BATCHES - 1u);
+        q.tag &= ~(PHOTON_MAP_BATCHES - 1u);
+        assert_memory_equal(&p, &q, sizeof p);
+    }
+}
+
+/* A version-1 file (20 words per channel, no T0, no batches) reads into the maps without
+ * their batches, T0 = 0. */
+static void test_version_1(void **state)
+{
+    fixture *f = *state;
+    size_t hsize;
+    unsigned char *header = header_of(f, &hsize);
     const size_t fixed = 7, words = 21, nc = 2;
     assert_int_equal(hsize, 8 * (fixed + words * nc));
     unsigned char *old = malloc(hsize);
@@ -318,14 +397,15 @@ static void test_version_1(void **state)
     size_t old_size = 8 * (fixed + 20 * nc);
     char v1[160];
     snprintf(v1, sizeof v1, "%s/v1.thzpm", f->dir);
-    spit_with_header(f, v1, old, old_size, 1);
+    spit_old_version(f, v1, old, old_size, 1, true, SIZE_MAX);
 
     photon_map *maps[2] = {NULL, NULL};
     photon_stats stats[2];
     thz_error err;
     assert_int_equal(photon_map_file_read(v1, f->scene, 1, maps, stats, NULL, &err), THZ_OK);
     for (size_t c = 0; c < 2; c++) {
-        assert_int_equal(photon_map_count(maps[c]), photon_map_count(f->maps[c]));
+        assert_same_but_batches(maps[c], f->maps[c]);
+        assert_int_equal(photon_map_batches(maps[c]), 1);
         assert_true(photon_map_reference_temperature_k(maps[c]) == 0.0);
         assert_true(stats[c].reference_temperature_k == 0.0);
         assert_true(stats[c].fired_power_w_per_hz == f->stats[c].fired_power_w_per_hz);
@@ -334,28 +414,20 @@ static void test_version_1(void **state)
     /* Another version number is refused. */
     spit_with_header(f, v1, old, old_size, 9);
     expect_refusal(v1, f->scene, THZ_ERR_INPUT, "format version 9");
-    free(buf);
     free(header);
     free(old);
 }
 
-static int record_bytes_cmp(const void *a, const void *b)
-{
-    const photon_record *x = a, *y = b;
-    if (x->object_side != y->object_side)
-        return x->object_side < y->object_side ? -1 : 1;
-    return memcmp(x, y, sizeof *x);
-}
-
-/* Version 3 stores each channel's records as its map holds them (so a reader's build moves
- * nothing); a version-2 file, the same records by group and then bytes, still reads into
- * the same maps. */
-static void test_version_2_order(void **state)
+/* Version 4 stores each channel's records as its map holds them (so a reader's build moves
+ * nothing); files of version 3 (32-byte records in their maps' order) and 2 (by group and
+ * then bytes) read into the same maps byte for byte, the bounce count's zero as the
+ * first-hit bit, and one naming an object past any map's is refused. */
+static void test_versions_2_and_3(void **state)
 {
     fixture *f = *state;
     size_t n;
     unsigned char *buf = slurp(f->path, &n);
-    assert_int_equal(buf[8], 3);
+    assert_int_equal(buf[8], 4);
     size_t h1 = ZSTD_findFrameCompressedSize(buf + 24, n - 24);
     assert_false(ZSTD_isError(h1));
     const unsigned char *frame = buf + 24 + h1;
@@ -367,34 +439,32 @@ static void test_version_2_order(void **state)
     assert_int_equal(ZSTD_decompress(rec, rsize, frame, fsize), rsize);
     assert_memory_equal(rec, photon_map_records(f->maps[0]), counts[0] * sizeof *rec);
     assert_memory_equal(rec + counts[0], photon_map_records(f->maps[1]), counts[1] * sizeof *rec);
-
-    qsort(rec, counts[0], sizeof *rec, record_bytes_cmp);
-    qsort(rec + counts[0], counts[1], sizeof *rec, record_bytes_cmp);
-    assert_memory_not_equal(rec, photon_map_records(f->maps[0]), counts[0] * sizeof *rec);
-    size_t cap = ZSTD_compressBound(rsize);
-    unsigned char *out = malloc(24 + h1 + cap);
-    memcpy(out, buf, 24 + h1);
-    size_t total = 24 + h1 + compress_frame(out + 24 + h1, cap, rec, rsize);
-    set_prefix(out, 2, total);
-    char v2[160];
-    snprintf(v2, sizeof v2, "%s/v2.thzpm", f->dir);
-    spit(v2, out, total);
-
-    for (int threads = 1; threads <= 2; threads++) {
-        photon_map *maps[2] = {NULL, NULL};
-        thz_error err;
-        assert_int_equal(photon_map_file_read(v2, f->scene, threads, maps, NULL, NULL, &err),
-                         THZ_OK);
-        for (size_t c = 0; c < 2; c++) {
-            assert_int_equal(photon_map_count(maps[c]), counts[c]);
-            assert_memory_equal(photon_map_records(maps[c]), photon_map_records(f->maps[c]),
-                                counts[c] * sizeof(photon_record));
-            photon_map_destroy(maps[c]);
-        }
-    }
     free(buf);
     free(rec);
-    free(out);
+
+    size_t hsize;
+    unsigned char *header = header_of(f, &hsize);
+    for (unsigned version = 2; version <= 3; version++) {
+        char path[160];
+        snprintf(path, sizeof path, "%s/v%u.thzpm", f->dir, version);
+        spit_old_version(f, path, header, hsize, version, version == 2, SIZE_MAX);
+        for (int threads = 1; threads <= 2; threads++) {
+            photon_map *maps[2] = {NULL, NULL};
+            thz_error err;
+            assert_int_equal(photon_map_file_read(path, f->scene, threads, maps, NULL, NULL, &err),
+                             THZ_OK);
+            for (size_t c = 0; c < 2; c++) {
+                assert_int_equal(photon_map_count(maps[c]), counts[c]);
+                assert_int_equal(photon_map_batches(maps[c]), PHOTON_MAP_BATCHES);
+                assert_memory_equal(photon_map_records(maps[c]), photon_map_records(f->maps[c]),
+                                    counts[c] * sizeof(photon_record));
+                photon_map_destroy(maps[c]);
+            }
+        }
+        spit_old_version(f, path, header, hsize, version, version == 2, counts[0] + 7);
+        expect_refusal(path, f->scene, THZ_ERR_INPUT, "names an object");
+    }
+    free(header);
 }
 
 /* Reads `path` expecting failure with `status` and a message holding `what` and path. */
@@ -537,7 +607,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_one_channel, setup, teardown),
         cmocka_unit_test_setup_teardown(test_workers, setup, teardown),
         cmocka_unit_test_setup_teardown(test_version_1, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_version_2_order, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_versions_2_and_3, setup, teardown),
         cmocka_unit_test_setup_teardown(test_corrupted, setup, teardown),
         cmocka_unit_test_setup_teardown(test_truncated, setup, teardown),
         cmocka_unit_test_setup_teardown(test_forged_count, setup, teardown),

@@ -27,7 +27,7 @@ static photon_map *make_map(size_t n, uint32_t salt)
         r[i].freq_hz = 3.5e11f;
         vec3 d = v3_normalize(v3(cos(t), sin(t), -0.5 - 0.4 * sin(3 * t)));
         r[i].dir_oct = photon_encode_direction(d);
-        r[i].object_side = (uint32_t)(i % 3) << 1 | (uint32_t)(i % 2);
+        r[i].tag = photon_tag((uint32_t)(i % 3), (int)(i % 2), 0, 0);
     }
     photon_map *map;
     thz_error err;
