@@ -498,6 +498,17 @@ static void test_empty_and_errors(void **state)
     assert_int_equal(photon_map_create(p, 10, 5, 0, &map, &err), THZ_ERR_INTERNAL);
     assert_null(map);
     assert_true(strstr(err.message, "object 10") != NULL);
+
+    /* more objects than a tag's group bits hold: refused, not wrapped into other groups */
+    map = NULL;
+    assert_int_equal(photon_map_create(NULL, 0, PHOTON_MAX_OBJECTS + 1, 0, &map, &err),
+                     THZ_ERR_LIMIT);
+    assert_null(map);
+    assert_true(strstr(err.message, "objects") != NULL);
+    /* the most a map holds: its last object's back side is the tag's last group */
+    assert_int_equal(photon_group(&(photon_record){
+                         .tag = photon_tag((uint32_t)PHOTON_MAX_OBJECTS - 1, 1, 1, 7)}),
+                     2 * PHOTON_MAX_OBJECTS - 1);
 }
 
 int main(void)
