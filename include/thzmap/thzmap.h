@@ -88,8 +88,15 @@ typedef struct thz_context thz_context;
 /* Creates a context (all cores, no callbacks). NULL only when out of memory. */
 THZ_API thz_context *thz_context_create(void);
 THZ_API void thz_context_destroy(thz_context *ctx);
-/* OpenMP threads of the runs started with ctx; 0 (the default) means all cores. Runs
- * give bit-identical results for any thread count. */
+/* The most threads a context may run with (the CLI's --threads limit). */
+#define THZ_MAX_THREADS 4096
+
+/* OpenMP threads of the runs started with ctx; 0 (the default) means all cores, and a
+ * negative count means 0. Runs give bit-identical results for any thread count. The
+ * count is stored as given; the calls that run with ctx (thz_simulate, thz_render_*,
+ * thz_photons_fire*, _load*, _merge, thz_batch_run, thz_bands_select, thz_mpi_serve*)
+ * refuse more than THZ_MAX_THREADS with THZ_ERR_INPUT before any work (OpenMP itself
+ * fails on such counts by exiting the process). */
 THZ_API void thz_context_set_threads(thz_context *ctx, int threads);
 THZ_API int thz_context_threads(const thz_context *ctx);
 /* The progress callback (NULL: none); `user` is passed back to it. */

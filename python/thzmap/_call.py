@@ -30,15 +30,21 @@ class RunWarning(UserWarning):
     """A warning of a run (also recorded in its summary)."""
 
 
+# The most threads a run may use: the C library's THZ_MAX_THREADS (thzmap.h), which
+# refuses more; the thzmap program's --threads takes 1 to this too.
+MAX_THREADS = 4096
+
+
 class Call:
     """Use as `with Call(threads, progress) as call: status = call.run(fn, ...)`."""
 
     def __init__(self, threads=None, progress=None):
         if threads is not None:
             if (isinstance(threads, bool) or not isinstance(threads, numbers.Integral)
-                    or threads < 1):
-                raise ArgumentError(f"threads: expected a whole number >= 1, got {threads!r}")
-            threads = min(int(threads), 1 << 20)
+                    or not 1 <= threads <= MAX_THREADS):
+                raise ArgumentError(
+                    f"threads: expected a whole number from 1 to {MAX_THREADS}, got {threads!r}")
+            threads = int(threads)
         self._report = make_reporter(progress)
         self._exc = None
         self._interrupted = False

@@ -82,6 +82,10 @@ void api_mpi_deal_end(thz_context *ctx);
 thz_status api_mpi_receive(thz_context *ctx, size_t rank, uint64_t *frame, thz_status *status,
                            void **data, size_t *size, thz_error *err);
 
+/* THZ_ERR_INPUT when ctx (may be NULL) holds more threads than THZ_MAX_THREADS; `what`
+ * names the call in the message. Every call that runs with a context's threads checks. */
+thz_status api_check_threads(const thz_context *ctx, const char *what, thz_error *err);
+
 /* run_options from a context and settings. */
 void api_run_options(const thz_context *ctx, const thz_run_settings *settings, run_options *opt);
 

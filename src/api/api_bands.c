@@ -293,6 +293,8 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
     if (!scene_path || !o)
         return api_done(ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_bands_select: no scene"), err);
     thz_status st = check_options(o, &n, err);
+    if (st == THZ_OK)
+        st = api_check_threads(ctx, "thz_bands_select", err);
     if (st != THZ_OK)
         return api_done(ctx, st, err);
     thz_bands *b = thz_calloc(1, sizeof *b);

@@ -26,6 +26,16 @@ void thz_context_set_threads(thz_context *ctx, int threads)
         ctx->threads = threads > 0 ? threads : 0;
 }
 
+thz_status api_check_threads(const thz_context *ctx, const char *what, thz_error *err)
+{
+    if (ctx && ctx->threads > THZ_MAX_THREADS)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: threads %d: expected 0 (all cores) to %d "
+                             "(thz_context_set_threads)",
+                             what, ctx->threads, THZ_MAX_THREADS);
+    return THZ_OK;
+}
+
 int thz_context_threads(const thz_context *ctx)
 {
     return ctx ? ctx->threads : 0;

@@ -80,7 +80,9 @@ thz_status thz_mpi_serve(thz_context *ctx, const thz_scene *scene, const thz_run
     if (!scene)
         return api_done(ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_mpi_serve: no scene"), err);
     mpi_team *team = NULL;
-    thz_status st = api_mpi_member_team(&team, err);
+    thz_status st = api_check_threads(ctx, "thz_mpi_serve", err);
+    if (st == THZ_OK)
+        st = api_mpi_member_team(&team, err);
     if (st == THZ_OK)
         st = api_mpi_serve_scene(team, ctx, scene, settings, NULL, err);
     if (ctx && st == THZ_OK)
@@ -105,7 +107,9 @@ thz_status thz_mpi_serve_batch(thz_context *ctx, const thz_sequence *seq, thz_er
         return api_done(ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_mpi_serve_batch: no sequence"),
                         err);
     mpi_team *team = NULL;
-    thz_status st = api_mpi_member_team(&team, err);
+    thz_status st = api_check_threads(ctx, "thz_mpi_serve_batch", err);
+    if (st == THZ_OK)
+        st = api_mpi_member_team(&team, err);
     uint64_t frame = MPI_TEAM_STOPPED;
     if (st == THZ_OK) { /* until the first frame the lead runs: the lead may have none */
         st = mpi_team_serve(team, NULL, NULL, ctx ? ctx->threads : 0, &frame, err);

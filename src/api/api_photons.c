@@ -67,6 +67,9 @@ static thz_status api_fire(thz_context *ctx, const thz_scene *scene,
     *out = NULL;
     if (!scene)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_photons_fire: no scene");
+    thz_status checked = api_check_threads(ctx, "thz_photons_fire", err);
+    if (checked != THZ_OK)
+        return checked;
     if (only != SIZE_MAX && only >= scene->n_channels)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_photons_fire_channel: channel %zu of %zu",
                              only, scene->n_channels);
@@ -138,7 +141,9 @@ static thz_status api_photons_load(thz_context *ctx, const thz_scene *scene, con
             thz_error_set(err, THZ_ERR_INPUT, "thz_photons_load: no %s", scene ? "path" : "scene"),
             err);
     thz_photons *ph = NULL;
-    thz_status st = api_photons_create(scene, &ph, err);
+    thz_status st = api_check_threads(ctx, "thz_photons_load", err);
+    if (st == THZ_OK)
+        st = api_photons_create(scene, &ph, err);
     photon_map_file_info info;
     int threads = ctx ? ctx->threads : 0;
     if (st == THZ_OK)
@@ -219,6 +224,8 @@ thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, 
     *out = NULL;
     thz_photons *ph = NULL;
     thz_status st = api_merge_check(parts, n, err);
+    if (st == THZ_OK)
+        st = api_check_threads(ctx, "thz_photons_merge", err);
     if (st == THZ_OK)
         st = api_photons_create(parts[0]->scene, &ph, err);
     const photon_map **maps = st == THZ_OK ? thz_calloc(n, sizeof *maps) : NULL;

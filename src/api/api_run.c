@@ -207,6 +207,9 @@ static thz_status api_run(thz_context *ctx, const thz_scene *scene, const thz_ph
     *out = NULL;
     if (!scene)
         return thz_error_set(err, THZ_ERR_INPUT, "no scene");
+    thz_status checked = api_check_threads(ctx, render ? "render" : "simulate", err);
+    if (checked != THZ_OK)
+        return checked;
     if (photons && photons->scene != scene)
         return thz_error_set(err, THZ_ERR_INPUT,
                              "the photons were fired or loaded for another scene handle");
@@ -316,6 +319,8 @@ thz_status thz_render_file(thz_context *ctx, const thz_scene *scene, const char 
     thz_status st = api_sensor_name(scene, sensor, &name, err);
     if (st == THZ_OK && (!scene || !path))
         st = thz_error_set(err, THZ_ERR_INPUT, "thz_render_file: no %s", scene ? "path" : "scene");
+    if (st == THZ_OK)
+        st = api_check_threads(ctx, "render", err);
     size_t nc = scene ? scene->n_channels : 0;
     api_map_stream stream = {.threads = ctx ? ctx->threads : 0,
                              .stats = thz_calloc(nc ? nc : 1, sizeof *stream.stats)};

@@ -464,6 +464,9 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
     if (!seq || !outdir || !outdir[0])
         return thz_error_set(err, THZ_ERR_INPUT, "thz_batch_run: no %s",
                              seq ? "output directory" : "sequence");
+    thz_status checked = api_check_threads(ctx, "thz_batch_run", err);
+    if (checked != THZ_OK)
+        return checked;
     batch_state b = {
         .seq = seq, .outdir = outdir, .opt = opt, .t0 = batch_now_s(), .cache = {.base = SIZE_MAX}};
     b.state = thz_calloc(seq->n_frames, sizeof *b.state);

@@ -207,7 +207,7 @@ int cmd_bands(int argc, char **argv)
             opt.has_seed = 1;
             opt.seed = seed;
         } else if (strcmp(a, "--threads") == 0) {
-            ok = cli_parse_u64(CMD, a, v, 1, 4096, &threads);
+            ok = cli_parse_u64(CMD, a, v, 1, THZ_MAX_THREADS, &threads);
         }
         if (!ok)
             return CLI_EXIT_USAGE;

@@ -176,7 +176,7 @@ static int batch_parse(int argc, char **argv, const char **seq_path, const char 
                 return cli_usage_error("batch", "%s needs a value", arg);
             const char *val = argv[++i];
             if (!strcmp(arg, "--threads")) {
-                if (!cli_parse_u64("batch", arg, val, 1, 4096, threads))
+                if (!cli_parse_u64("batch", arg, val, 1, THZ_MAX_THREADS, threads))
                     return CLI_EXIT_USAGE;
             } else {
                 *outdir = val;

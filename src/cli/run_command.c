@@ -105,7 +105,7 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
             if (strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0) {
                 a->outdir = val;
             } else if (strcmp(arg, "--threads") == 0) {
-                if (!cli_parse_u64(cmd, arg, val, 1, 4096, &u))
+                if (!cli_parse_u64(cmd, arg, val, 1, THZ_MAX_THREADS, &u))
                     return CLI_EXIT_USAGE;
                 a->threads = (int)u;
             } else if (strcmp(arg, "--integrator") == 0) {

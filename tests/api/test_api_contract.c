@@ -2,6 +2,9 @@
  * a message naming the text's label and the JSON path or line:column; out-of-range
  * indices, foreign photons, unknown integrators and half-fired photons are refused;
  * photons fired in disjoint ranges merge. argv: the thzmap binary (unused), the repo. */
+#include <math.h>
+#include <sys/stat.h>
+
 #include "api_test.h"
 
 static void expect_input_error(thz_status st, const thz_error *err, const char *needle,
@@ -23,6 +26,35 @@ static char *scene_with(const char *from, const char *to)
         exit(1);
     snprintf(s, n, "%.*s%s%s", (int)(at - test_scene_json), test_scene_json, to, at + strlen(from));
     return s;
+}
+
+/* A context with more threads than THZ_MAX_THREADS runs nothing (OpenMP would exit the
+ * process or crash on such counts): every call that runs with it refuses, naming the
+ * limit. The count itself is kept as given. */
+static void check_thread_limit(thz_scene *scene, const thz_photons *photons)
+{
+    thz_error err = {0};
+    thz_context *ctx = thz_context_create();
+    thz_context_set_threads(ctx, THZ_MAX_THREADS + 1);
+    CHECK(thz_context_threads(ctx) == THZ_MAX_THREADS + 1, "threads %d", thz_context_threads(ctx));
+    thz_run_settings settings = {.photons_per_channel = 1000};
+    thz_run *run = (thz_run *)&err;
+    expect_input_error(thz_simulate(ctx, scene, &settings, &run, &err), &err, "4096",
+                       "simulate with 4097 threads");
+    CHECK(run == NULL, "a run came back");
+    expect_input_error(thz_render_run(ctx, scene, photons, -1, NULL, &run, &err), &err, "4096",
+                       "render with 4097 threads");
+    thz_photons *ph = (thz_photons *)&err;
+    expect_input_error(thz_photons_fire(ctx, scene, &settings, &ph, &err), &err, "4096",
+                       "photons with 4097 threads");
+    CHECK(ph == NULL, "photons came back");
+    expect_input_error(thz_photons_merge(ctx, &photons, 1, &ph, &err), &err, "4096",
+                       "merge with 4097 threads");
+    CHECK(thz_context_last_status(ctx) == THZ_ERR_INPUT, "last status %d",
+          thz_context_last_status(ctx));
+    thz_context_set_threads(ctx, THZ_MAX_THREADS);
+    CHECK(thz_context_threads(ctx) == THZ_MAX_THREADS, "threads %d", thz_context_threads(ctx));
+    thz_context_destroy(ctx);
 }
 
 int main(int argc, char **argv)
@@ -130,6 +162,15 @@ int main(int argc, char **argv)
     thz_output *output = NULL;
     expect_input_error(thz_output_open("", &output, &err), &err, "no output directory",
                        "empty OUTDIR");
+
+    settings = (thz_run_settings){.photons_per_channel = 2000};
+    thz_run *run = NULL;
+    REQUIRE_OK(thz_simulate(ctx, a, &settings, &run, &err), &err);
+    snprintf(path, sizeof path, "%s/a.json", dir);
+    test_write_file(path, test_scene_json);
+    snprintf(path, sizeof path, "%s/a.thzpm", dir);
+    check_thread_limit(a, merged);
+    thz_run_destroy(run);
 
     thz_photons_destroy(one);
     thz_photons_destroy(merged);

@@ -103,6 +103,17 @@ def test_bad_arguments_raise_before_the_library(tiny_dir, kwargs):
         thzmap.simulate(scene, **kwargs)
 
 
+@pytest.mark.parametrize("threads", [4097, 40000, 1 << 20, 1 << 40])
+def test_threads_beyond_the_library_limit_are_refused(tiny_dir, threads):
+    # The library refuses more than THZ_MAX_THREADS (4096, as the CLI's --threads);
+    # OpenMP exits the process or crashes on such counts. The package names the limit.
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    with pytest.raises(thzmap.ArgumentError, match="1 to 4096"):
+        thzmap.simulate(scene, integrator="path", threads=threads)
+    with pytest.raises(thzmap.ArgumentError, match="1 to 4096"):
+        thzmap.fire_photons(scene, photons=500, threads=threads)
+
+
 def test_numpy_whole_numbers_are_whole_numbers(tiny_dir):
     np = pytest.importorskip("numpy")
     scene = thzmap.load_scene(tiny_dir / "scene.json")
