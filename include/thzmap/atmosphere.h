@@ -59,20 +59,22 @@ typedef struct thz_atm_info {
 } thz_atm_info;
 THZ_API void thz_atm_get_info(const thz_atm *atm, thz_atm_info *out);
 
-/* THZ_ERR_INPUT when [lo_hz, hi_hz] leaves the model's range; `what` names the range
- * in the message (e.g. an option). */
+/* THZ_ERR_INPUT when [lo_hz, hi_hz] leaves the model's range, is not finite or runs
+ * backwards (lo_hz > hi_hz); `what` names the range in the message (e.g. an option). */
 THZ_API thz_status thz_atm_check_range(const thz_atm *atm, double lo_hz, double hi_hz,
                                        const char *what, thz_error *err);
 
 /* alpha at freq_hz in 1/m, per part (parts a model lacks are 0; itu-p676 puts all of
- * its water vapour into h2o_lines_per_m); total_per_m is their sum. */
+ * its water vapour into h2o_lines_per_m); total_per_m is their sum. Every part is NaN
+ * at a non-finite freq_hz or for a NULL atm. */
 typedef struct thz_atm_attenuation {
     double total_per_m;
     double h2o_lines_per_m, h2o_continuum_per_m, o2_per_m, dry_continuum_per_m;
 } thz_atm_attenuation;
 THZ_API void thz_atm_attenuation_parts(const thz_atm *atm, double freq_hz,
                                        thz_atm_attenuation *out);
-/* alpha at freq_hz in 1/m, computed directly (no tabulation). */
+/* alpha at freq_hz in 1/m, computed directly (no tabulation); NaN at a non-finite
+ * freq_hz or for a NULL atm. */
 THZ_API double thz_atm_attenuation_per_m(const thz_atm *atm, double freq_hz);
 
 /* THZ_OK when PLplot's pngcairo device is there, else THZ_ERR_IO naming the package. */

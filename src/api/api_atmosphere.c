@@ -1,5 +1,6 @@
 /* Atmosphere models through the public API (`thzmap atmosphere`): a model made from
  * options or borrowed from a scene, its attenuation, and its figure. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -142,6 +143,12 @@ thz_status thz_atm_check_range(const thz_atm *a, double lo_hz, double hi_hz, con
 
 void thz_atm_attenuation_parts(const thz_atm *a, double freq_hz, thz_atm_attenuation *out)
 {
+    if (!out)
+        return;
+    if (!a || !isfinite(freq_hz)) {
+        *out = (thz_atm_attenuation){NAN, NAN, NAN, NAN, NAN};
+        return;
+    }
     atm_alpha_parts p;
     atmosphere_alpha_parts(a->atm, freq_hz, &p);
     *out = (thz_atm_attenuation){.total_per_m = atmosphere_alpha_parts_sum(&p),
@@ -153,6 +160,8 @@ void thz_atm_attenuation_parts(const thz_atm *a, double freq_hz, thz_atm_attenua
 
 double thz_atm_attenuation_per_m(const thz_atm *a, double freq_hz)
 {
+    if (!a || !isfinite(freq_hz))
+        return NAN;
     return atmosphere_alpha_direct_per_m(a->atm, freq_hz);
 }
 

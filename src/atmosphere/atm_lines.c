@@ -265,10 +265,13 @@ cleanup:
     return st;
 }
 
-/* Catmull-Rom spline through the table at wavenumber nu (as am interpolates it). */
+/* Catmull-Rom spline through the table at wavenumber nu (as am interpolates it); NaN
+ * at a NaN nu (which no comparison below would stop before the index). */
 static double catmull_rom(const double *v, size_t n, double step, double nu)
 {
     double x = nu / step;
+    if (isnan(x))
+        return NAN;
     if (x <= 0.0)
         return v[0];
     if (x >= (double)(n - 1))

@@ -80,6 +80,11 @@ thz_status atmosphere_init_lines(thz_atmosphere *atm, const atm_air_state *air,
 thz_status atmosphere_check_range(const thz_atmosphere *atm, double lo_hz, double hi_hz,
                                   const char *what, thz_error *err)
 {
+    if (!isfinite(lo_hz) || !isfinite(hi_hz) || lo_hz > hi_hz)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: %.6g to %.6g THz: expected finite frequencies, the first not "
+                             "above the second",
+                             what, lo_hz * 1e-12, hi_hz * 1e-12);
     double lo, hi;
     atmosphere_model_range_hz(atm->model, &lo, &hi);
     if (lo_hz < lo || hi_hz > hi)

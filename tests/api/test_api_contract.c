@@ -57,6 +57,35 @@ static void check_thread_limit(thz_scene *scene, const thz_photons *photons)
     thz_context_destroy(ctx);
 }
 
+/* The atmosphere refuses non-finite and reversed ranges, and its attenuation at a
+ * non-finite frequency is NaN (read out of bounds before). */
+static void check_atmosphere_frequencies(void)
+{
+    thz_error err = {0};
+    thz_atm_options opt;
+    thz_atm_options_init(&opt);
+    thz_atm *atm = NULL;
+    REQUIRE_OK(thz_atm_create(&opt, NULL, &atm, &err), &err);
+    expect_input_error(thz_atm_check_range(atm, NAN, NAN, "f", &err), &err, "finite",
+                       "check_range NaN");
+    expect_input_error(thz_atm_check_range(atm, 0.3e12, INFINITY, "f", &err), &err, "finite",
+                       "check_range infinity");
+    expect_input_error(thz_atm_check_range(atm, 0.9e12, 0.3e12, "f", &err), &err, "f: 0.9 to 0.3",
+                       "check_range reversed");
+    CHECK(thz_atm_check_range(atm, 0.3e12, 0.9e12, "f", &err) == THZ_OK, "%s", err.message);
+    CHECK(isnan(thz_atm_attenuation_per_m(atm, NAN)), "alpha(NaN) %g",
+          thz_atm_attenuation_per_m(atm, NAN));
+    CHECK(isnan(thz_atm_attenuation_per_m(atm, INFINITY)), "alpha(inf) %g",
+          thz_atm_attenuation_per_m(atm, INFINITY));
+    thz_atm_attenuation parts;
+    thz_atm_attenuation_parts(atm, NAN, &parts);
+    CHECK(isnan(parts.total_per_m) && isnan(parts.h2o_continuum_per_m), "parts(NaN) %g",
+          parts.total_per_m);
+    double alpha = thz_atm_attenuation_per_m(atm, 0.35e12);
+    CHECK(alpha > 0 && isfinite(alpha), "alpha(0.35 THz) %g", alpha);
+    thz_atm_destroy(atm);
+}
+
 int main(int argc, char **argv)
 {
     (void)argc;
@@ -170,6 +199,7 @@ int main(int argc, char **argv)
     test_write_file(path, test_scene_json);
     snprintf(path, sizeof path, "%s/a.thzpm", dir);
     check_thread_limit(a, merged);
+    check_atmosphere_frequencies();
     thz_run_destroy(run);
 
     thz_photons_destroy(one);
