@@ -162,7 +162,8 @@ typedef enum thz_plane {
 
 /* Renders sensor `sensor` of the scene: from `photons` (their seed, every channel), or
  * with photons NULL for the path integrator (seed from settings or the scene). With a
- * noise target, passes stop on this sensor's median error. *out owns the image. */
+ * noise target, passes stop on this sensor's median error. *out owns the image, which
+ * borrows the scene (destroy or write it first). */
 THZ_API thz_status thz_render_sensor(thz_context *ctx, const thz_scene *scene,
                                      const thz_photons *photons, size_t sensor,
                                      const thz_run_settings *settings, thz_image **out,
@@ -172,7 +173,8 @@ THZ_API void thz_image_destroy(thz_image *image);
 THZ_API uint32_t thz_image_columns(const thz_image *image);
 THZ_API uint32_t thz_image_rows(const thz_image *image);
 THZ_API size_t thz_image_channel_count(const thz_image *image);
-/* The sensor's index in its scene and its name. */
+/* The sensor's index in its scene and its name (the image's own copy: valid after the
+ * scene is destroyed, until the image or its run is). */
 THZ_API size_t thz_image_sensor(const thz_image *image);
 THZ_API const char *thz_image_sensor_name(const thz_image *image);
 /* The plane's values (owned by the image) and its band count (1, 3 or the channels)
@@ -190,7 +192,7 @@ THZ_API thz_status thz_image_write(thz_context *ctx, const thz_image *image, con
 
 /* `thzmap simulate` in memory: per channel the photon phase (none for path), then every
  * sensor rendered. *out owns the images, the photons if settings->keep_photons, and the
- * summary. */
+ * summary; it borrows the scene, which must outlive it (thz_run_write reads it). */
 THZ_API thz_status thz_simulate(thz_context *ctx, const thz_scene *scene,
                                 const thz_run_settings *settings, thz_run **out, thz_error *err);
 /* `thzmap render` in memory: every sensor (or only sensor `sensor`, if it is not -1)

@@ -12,6 +12,10 @@
  *     (may be NULL); on failure every out-handle is set to NULL;
  *   - parameters are borrowed; strings and arrays returned by accessors belong to the
  *     handle they came from and live as long as it;
+ *   - photons, runs and images (a run's or thz_render_sensor's) and a scene's thz_atm
+ *     borrow the scene they were made from: destroy them, and finish writing them
+ *     (thz_run_write, thz_image_write, thz_output_add_*, thz_photons_save), before the
+ *     scene. Their accessors' strings are their own (thz_image_sensor_name is a copy);
  *   - no globals: handles are independent. A handle may be used from any thread, but
  *     by one thread at a time, except that a scene is read-only after loading and
  *     may be shared by concurrent runs;

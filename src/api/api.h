@@ -40,6 +40,7 @@ struct thz_photons {
 struct thz_image {
     const thz_scene *scene; /* the (effective) scene it was rendered in; borrowed */
     size_t sensor;
+    char *sensor_name;        /* owned: the accessor's string outlives the scene */
     const sensor_images *img; /* borrowed from a run */
     float *object_id;         /* object_id as float, -1: nothing hit */
     struct thz_run *run;      /* a standalone image owns its run (the planes live there) */

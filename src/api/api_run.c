@@ -18,6 +18,9 @@ thz_status api_image_init_borrowed(thz_image *image, const thz_scene *scene, siz
     image->scene = scene;
     image->sensor = sensor;
     image->img = img;
+    image->sensor_name = thz_strdup(scene->sensors[sensor].name);
+    if (!image->sensor_name)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the sensor's name");
     size_t pixels = (size_t)img->columns * img->rows;
     image->object_id = thz_malloc_array(pixels ? pixels : 1, sizeof *image->object_id);
     if (!image->object_id)
@@ -31,6 +34,8 @@ void api_image_fini(thz_image *image)
 {
     free(image->object_id);
     image->object_id = NULL;
+    free(image->sensor_name);
+    image->sensor_name = NULL;
 }
 
 void thz_image_destroy(thz_image *image)
@@ -63,7 +68,7 @@ size_t thz_image_sensor(const thz_image *image)
 
 const char *thz_image_sensor_name(const thz_image *image)
 {
-    return image ? image->scene->sensors[image->sensor].name : NULL;
+    return image ? image->sensor_name : NULL;
 }
 
 const float *thz_image_plane(const thz_image *image, thz_plane plane, size_t *n_bands)

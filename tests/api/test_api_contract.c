@@ -57,6 +57,30 @@ static void check_thread_limit(thz_scene *scene, const thz_photons *photons)
     thz_context_destroy(ctx);
 }
 
+/* An image's sensor name is its own: it outlives the scene the image was rendered in
+ * (read freed memory before; the ASan build sees it). */
+static void check_image_name_lifetime(thz_context *ctx)
+{
+    thz_error err = {0};
+    thz_scene *scene = NULL;
+    REQUIRE_OK(thz_scene_load_string(test_scene_json, NULL, "life.json", &scene, &err), &err);
+    thz_run_settings settings = {.photons_per_channel = 2000};
+    thz_run *run = NULL;
+    thz_photons *photons = NULL;
+    thz_image *image = NULL;
+    REQUIRE_OK(thz_simulate(ctx, scene, &settings, &run, &err), &err);
+    REQUIRE_OK(thz_photons_fire(ctx, scene, &settings, &photons, &err), &err);
+    REQUIRE_OK(thz_render_sensor(ctx, scene, photons, 1, NULL, &image, &err), &err);
+    thz_photons_destroy(photons);
+    thz_scene_destroy(scene);
+    const char *name = thz_image_sensor_name(thz_run_image(run, 1));
+    CHECK(name && strcmp(name, "side") == 0, "run image 1 is %s", name ? name : "NULL");
+    name = thz_image_sensor_name(image);
+    CHECK(name && strcmp(name, "side") == 0, "image is %s", name ? name : "NULL");
+    thz_image_destroy(image);
+    thz_run_destroy(run);
+}
+
 /* The atmosphere refuses non-finite and reversed ranges, and its attenuation at a
  * non-finite frequency is NaN (read out of bounds before). */
 static void check_atmosphere_frequencies(void)
@@ -199,6 +223,7 @@ int main(int argc, char **argv)
     test_write_file(path, test_scene_json);
     snprintf(path, sizeof path, "%s/a.thzpm", dir);
     check_thread_limit(a, merged);
+    check_image_name_lifetime(ctx);
     check_atmosphere_frequencies();
     thz_run_destroy(run);
 
