@@ -109,7 +109,10 @@ THZ_API thz_status thz_photons_load_channel(thz_context *ctx, const thz_scene *s
  * when a channel has no map. Writes the file directly (not staged). */
 THZ_API thz_status thz_photons_save(const thz_photons *photons, const char *path, thz_error *err);
 /* Merges n photon sets of one scene, seed and integrator, fired with disjoint photon
- * ranges, into one of all their photons (*out; the parts stay the caller's). */
+ * ranges (or for different channels), into one of all their photons (*out; the parts
+ * stay the caller's). Each channel of *out holds the parts' photons of that channel;
+ * its photons_per_channel is per channel the sum over the parts that hold the channel,
+ * and the largest of these sums when they differ between channels. */
 THZ_API thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, size_t n,
                                      thz_photons **out, thz_error *err);
 THZ_API void thz_photons_destroy(thz_photons *photons);
@@ -117,7 +120,8 @@ THZ_API void thz_photons_destroy(thz_photons *photons);
 THZ_API size_t thz_photons_channel_count(const thz_photons *photons);
 /* Whether channel c holds a map (1) or not (0). */
 THZ_API int thz_photons_has_channel(const thz_photons *photons, size_t c);
-/* The seed and photons per channel they were fired with. */
+/* The seed and photons per channel they were fired with (merged photons: see
+ * thz_photons_merge; thz_photons_stats' `fired` is each channel's own count). */
 THZ_API uint64_t thz_photons_seed(const thz_photons *photons);
 THZ_API uint64_t thz_photons_per_channel(const thz_photons *photons);
 /* Fills *out with channel c's statistics; THZ_ERR_INPUT when c is out of range. */

@@ -231,12 +231,15 @@ thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, 
     const photon_map **maps = st == THZ_OK ? thz_calloc(n, sizeof *maps) : NULL;
     if (st == THZ_OK && !maps)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for merging photon maps");
+    uint64_t per_channel = 0; /* the largest over channels of the parts' sum */
     for (size_t c = 0; st == THZ_OK && c < ph->n_channels; c++) {
         size_t m = 0;
+        uint64_t fired = 0;
         for (size_t i = 0; i < n; i++) {
             if (!parts[i]->maps[c])
                 continue;
             maps[m++] = parts[i]->maps[c];
+            fired += parts[i]->photons_per_channel;
             photon_stats_merge(&ph->stats[c], &parts[i]->stats[c], (uint32_t)m);
         }
         if (m > 0)
@@ -244,6 +247,8 @@ thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, 
                                   &ph->maps[c], err);
         if (st == THZ_OK && ph->maps[c])
             ph->stats[c].stored = photon_map_count(ph->maps[c]);
+        if (fired > per_channel)
+            per_channel = fired;
     }
     free(maps);
     if (st != THZ_OK) {
@@ -252,7 +257,7 @@ thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, 
     }
     ph->effective = parts[0]->effective;
     ph->seed = parts[0]->seed;
-    ph->photons_per_channel = parts[0]->photons_per_channel * n;
+    ph->photons_per_channel = per_channel;
     ph->effective.photons.per_channel = ph->photons_per_channel;
     *out = ph;
     return THZ_OK;

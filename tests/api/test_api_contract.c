@@ -57,6 +57,45 @@ static void check_thread_limit(thz_scene *scene, const thz_photons *photons)
     thz_context_destroy(ctx);
 }
 
+/* Photons fired one channel per part merge into photons of every channel, and each
+ * channel counts the photons of the parts that hold it (not the parts' count times the
+ * parts); when the channels differ, photons_per_channel is the largest. */
+static void check_merge_per_channel(thz_context *ctx, thz_scene *scene)
+{
+    thz_error err = {0};
+    thz_run_settings settings = {.photons_per_channel = 3000};
+    thz_photons *part[3] = {NULL, NULL, NULL}, *merged = NULL;
+    REQUIRE_OK(thz_photons_fire_channel(ctx, scene, &settings, 0, &part[0], &err), &err);
+    REQUIRE_OK(thz_photons_fire_channel(ctx, scene, &settings, 1, &part[1], &err), &err);
+    REQUIRE_OK(thz_photons_merge(ctx, (const thz_photons *const *)part, 2, &merged, &err), &err);
+    CHECK(thz_photons_has_channel(merged, 0) && thz_photons_has_channel(merged, 1),
+          "a channel is missing");
+    CHECK(thz_photons_per_channel(merged) == 3000, "one channel per part: %llu per channel",
+          (unsigned long long)thz_photons_per_channel(merged));
+    thz_run *run = NULL;
+    REQUIRE_OK(thz_render_run(ctx, scene, merged, 1, NULL, &run, &err), &err);
+    const char *summary = thz_run_summary_json(run);
+    CHECK(summary && strstr(summary, "\"photons_per_channel\": 3000,"), "summary: %.300s",
+          summary ? strstr(summary, "photons_per_channel") : "(none)");
+    thz_run_destroy(run);
+    thz_photons_destroy(merged);
+    /* every channel, and channel 1 once more: 3000 in channel 0, 6000 in channel 1 */
+    settings.first_photon = 3000;
+    REQUIRE_OK(thz_photons_fire(ctx, scene, &settings, &part[2], &err), &err);
+    const thz_photons *mixed[2] = {part[1], part[2]};
+    REQUIRE_OK(thz_photons_merge(ctx, mixed, 2, &merged, &err), &err);
+    thz_photon_stats s0, s1;
+    thz_photons_stats(merged, 0, &s0);
+    thz_photons_stats(merged, 1, &s1);
+    CHECK(s0.fired == 3000 && s1.fired == 6000, "fired %llu and %llu", (unsigned long long)s0.fired,
+          (unsigned long long)s1.fired);
+    CHECK(thz_photons_per_channel(merged) == 6000, "mixed parts: %llu per channel",
+          (unsigned long long)thz_photons_per_channel(merged));
+    thz_photons_destroy(merged);
+    for (size_t i = 0; i < 3; i++)
+        thz_photons_destroy(part[i]);
+}
+
 /* An image's sensor name is its own: it outlives the scene the image was rendered in
  * (read freed memory before; the ASan build sees it). */
 static void check_image_name_lifetime(thz_context *ctx)
@@ -223,6 +262,7 @@ int main(int argc, char **argv)
     test_write_file(path, test_scene_json);
     snprintf(path, sizeof path, "%s/a.thzpm", dir);
     check_thread_limit(a, merged);
+    check_merge_per_channel(ctx, a);
     check_image_name_lifetime(ctx);
     check_atmosphere_frequencies();
     thz_run_destroy(run);
