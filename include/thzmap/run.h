@@ -271,7 +271,8 @@ THZ_API thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_
  * processor at once (it has no context). */
 THZ_API thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_error *err);
 /* Adds a file of the caller's (`name`: a plain file name, no '/') holding `size` bytes
- * of `data`, committed with the rest (e.g. a batch frame's frame.json). */
+ * of `data` (may be NULL when size is 0), committed with the rest (e.g. a batch frame's
+ * frame.json). */
 THZ_API thz_status thz_output_add_file(thz_output *output, const char *name, const void *data,
                                        size_t size, thz_error *err);
 THZ_API thz_status thz_output_commit(thz_output *output, thz_error *err);
