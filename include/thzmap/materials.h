@@ -43,15 +43,18 @@ typedef struct thz_library_material_info {
     size_t n_data_ranges; /* a table's range, or each itu-p2040 row's (thz_library_get_range) */
 } thz_library_material_info;
 
-/* Entry i (0-based, < count) in the library file's order. */
+/* Entry i (0-based, < count) in the library file's order; a zeroed *out (name NULL)
+ * when i is out of range or lib is NULL. */
 THZ_API void thz_library_get_info(const thz_library *lib, size_t i, thz_library_material_info *out);
 
 /* Data range r (< n_data_ranges) of entry i in THz; an itu-p2040 entry is valid only
- * within the union of its rows' ranges, which a scene's channel bands must not leave. */
+ * within the union of its rows' ranges, which a scene's channel bands must not leave.
+ * 0 to 0 when i or r is out of range. */
 THZ_API void thz_library_get_range(const thz_library *lib, size_t i, size_t r, double *from_thz,
                                    double *to_thz);
 /* True when freq_hz lies in one of entry i's itu-p2040 rows or in its stated validity
- * (valid_from/to_thz); always true for entries that state neither. */
+ * (valid_from/to_thz); always true for entries that state neither; false when i is out
+ * of range. */
 THZ_API int thz_library_in_range(const thz_library *lib, size_t i, double freq_hz);
 
 /* The complex index n + ik (k >= 0) and relative permittivity eps' + i eps'' of entry
@@ -62,6 +65,7 @@ typedef struct thz_library_optics {
     double attenuation_per_m;  /* 4 pi k nu / c, the power attenuation in the medium */
     double normal_reflectance; /* |(n + ik - 1)/(n + ik + 1)|^2 from air */
 } thz_library_optics;
+/* All zero when i is out of range. */
 THZ_API void thz_library_optics_at(const thz_library *lib, size_t i, double freq_hz,
                                    thz_library_optics *out);
 

@@ -41,7 +41,13 @@ void thz_library_destroy(thz_library *lib)
 
 size_t thz_library_count(const thz_library *lib)
 {
-    return lib->lib->n;
+    return lib ? lib->lib->n : 0;
+}
+
+/* Entry i, or NULL when lib is NULL or i is out of range. */
+static const material_library_entry *api_entry(const thz_library *lib, size_t i)
+{
+    return lib && i < lib->lib->n ? &lib->lib->entries[i] : NULL;
 }
 
 thz_status thz_library_find(const thz_library *lib, const char *name, size_t *index, thz_error *err)
@@ -63,7 +69,13 @@ thz_status thz_library_find(const thz_library *lib, const char *name, size_t *in
 
 void thz_library_get_info(const thz_library *lib, size_t i, thz_library_material_info *out)
 {
-    const material_library_entry *e = &lib->lib->entries[i];
+    if (!out)
+        return;
+    const material_library_entry *e = api_entry(lib, i);
+    if (!e) {
+        *out = (thz_library_material_info){0};
+        return;
+    }
     double lo = 0, hi = 0;
     bool data_range = material_index_range(e->index, &lo, &hi);
     *out = (thz_library_material_info){.name = e->name,
@@ -84,15 +96,21 @@ void thz_library_get_info(const thz_library *lib, size_t i, thz_library_material
 void thz_library_get_range(const thz_library *lib, size_t i, size_t r, double *from_thz,
                            double *to_thz)
 {
-    double lo, hi;
-    material_index_range_at(lib->lib->entries[i].index, r, &lo, &hi);
-    *from_thz = lo * 1e-12;
-    *to_thz = hi * 1e-12;
+    const material_library_entry *e = api_entry(lib, i);
+    double lo = 0.0, hi = 0.0;
+    if (e && r < material_index_n_ranges(e->index))
+        material_index_range_at(e->index, r, &lo, &hi);
+    if (from_thz)
+        *from_thz = lo * 1e-12;
+    if (to_thz)
+        *to_thz = hi * 1e-12;
 }
 
 int thz_library_in_range(const thz_library *lib, size_t i, double freq_hz)
 {
-    const material_library_entry *e = &lib->lib->entries[i];
+    const material_library_entry *e = api_entry(lib, i);
+    if (!e)
+        return 0;
     if (e->has_range && (freq_hz < e->lo_hz || freq_hz > e->hi_hz))
         return 0;
     const permittivity_model *pm = material_index_model_of(e->index);
@@ -104,7 +122,14 @@ int thz_library_in_range(const thz_library *lib, size_t i, double freq_hz)
 void thz_library_optics_at(const thz_library *lib, size_t i, double freq_hz,
                            thz_library_optics *out)
 {
-    const material_index *idx = lib->lib->entries[i].index;
+    if (!out)
+        return;
+    const material_library_entry *e = api_entry(lib, i);
+    if (!e) {
+        *out = (thz_library_optics){0};
+        return;
+    }
+    const material_index *idx = e->index;
     double n = 0, k = 0, re = 0, im = 0;
     material_index_at(idx, freq_hz, &n, &k);
     material_index_permittivity(idx, freq_hz, &re, &im);

@@ -168,6 +168,29 @@ static void check_output_order(thz_context *ctx, thz_run *run, const char *dir)
     CHECK(stat(path, &info) == 0, "destroying a committed output removed %s", path);
 }
 
+/* The material library: indices past the end give a zeroed info and an empty range, not
+ * a read beyond its entries. */
+static void check_library_bounds(void)
+{
+    thz_error err = {0};
+    thz_library *lib = NULL;
+    REQUIRE_OK(thz_library_load(&lib, &err), &err);
+    size_t n = thz_library_count(lib);
+    thz_library_material_info info;
+    memset(&info, 0xff, sizeof info);
+    thz_library_get_info(lib, n + 5, &info);
+    CHECK(info.name == NULL && info.n_data_ranges == 0, "entry %zu past the end has a name", n + 5);
+    double lo = -1, hi = -1;
+    for (size_t i = 0; i < n; i++) {
+        thz_library_get_range(lib, i, 1000, &lo, &hi);
+        CHECK(lo == 0 && hi == 0, "entry %zu range 1000: %g to %g", i, lo, hi);
+    }
+    thz_library_get_range(lib, n, 0, &lo, &hi);
+    CHECK(lo == 0 && hi == 0, "entry %zu: %g to %g", n, lo, hi);
+    CHECK(!thz_library_in_range(lib, n, 1e12), "entry past the end in range");
+    thz_library_destroy(lib);
+}
+
 int main(int argc, char **argv)
 {
     (void)argc;
@@ -285,6 +308,7 @@ int main(int argc, char **argv)
     check_image_name_lifetime(ctx);
     check_atmosphere_frequencies();
     check_output_order(ctx, run, dir);
+    check_library_bounds();
     thz_run_destroy(run);
 
     thz_photons_destroy(one);
