@@ -275,6 +275,8 @@ THZ_API thz_status thz_output_add_image(thz_output *output, const thz_image *ima
  * frame.json). */
 THZ_API thz_status thz_output_add_file(thz_output *output, const char *name, const void *data,
                                        size_t size, thz_error *err);
+/* Once committed, the output takes nothing more: thz_output_commit again and the
+ * thz_output_add_* functions return THZ_ERR_INPUT ("already committed"). */
 THZ_API thz_status thz_output_commit(thz_output *output, thz_error *err);
 THZ_API void thz_output_destroy(thz_output *output);
 

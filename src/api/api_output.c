@@ -1,6 +1,7 @@
 /* Writing results: an atomic output directory (io/output.h's staging) that runs and
  * images are added to, and the one-call writers built on it. */
 #include <errno.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,7 +13,20 @@
 
 struct thz_output {
     output_stage *stage;
+    bool committed; /* the staging directory is gone: nothing more can be added */
 };
+
+/* THZ_ERR_INPUT when output is NULL or already committed; `what` names the call. */
+static thz_status api_output_check(const thz_output *output, const char *what, thz_error *err)
+{
+    if (!output)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: no output", what);
+    if (output->committed)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: the output is already committed (open another to write more)",
+                             what);
+    return THZ_OK;
+}
 
 thz_status thz_output_open(const char *outdir, thz_output **out, thz_error *err)
 {
@@ -41,9 +55,12 @@ void thz_output_destroy(thz_output *output)
 
 thz_status thz_output_commit(thz_output *output, thz_error *err)
 {
-    if (!output)
-        return thz_error_set(err, THZ_ERR_INPUT, "thz_output_commit: no output");
-    return output_stage_commit(output->stage, err);
+    thz_status st = api_output_check(output, "thz_output_commit", err);
+    if (st != THZ_OK)
+        return st;
+    st = output_stage_commit(output->stage, err);
+    output->committed = st == THZ_OK;
+    return st;
 }
 
 thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run,
@@ -51,11 +68,11 @@ thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run
 {
     thz_error local;
     err = api_err(err, &local);
-    if (!output || !run)
-        return api_done(ctx,
-                        thz_error_set(err, THZ_ERR_INPUT, "thz_output_add_run: no %s",
-                                      output ? "run" : "output"),
-                        err);
+    if (output && !run)
+        return api_done(ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_output_add_run: no run"), err);
+    thz_status st = api_output_check(output, "thz_output_add_run", err);
+    if (st != THZ_OK)
+        return api_done(ctx, st, err);
     run_write_options wo = {0};
     if (opt) {
         wo.photon_map = opt->photon_map != 0;
@@ -76,9 +93,11 @@ thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run
 
 thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_error *err)
 {
-    if (!output || !image)
-        return thz_error_set(err, THZ_ERR_INPUT, "thz_output_add_image: no %s",
-                             output ? "image" : "output");
+    if (output && !image)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_output_add_image: no image");
+    thz_status st = api_output_check(output, "thz_output_add_image", err);
+    if (st != THZ_OK)
+        return st;
     return output_write_sensor(output_stage_dir(output->stage), image->scene, image->sensor,
                                image->img, 0, err);
 }
@@ -116,13 +135,15 @@ thz_status thz_image_write(thz_context *ctx, const thz_image *image, const char 
 thz_status thz_output_add_file(thz_output *output, const char *name, const void *data, size_t size,
                                thz_error *err)
 {
-    if (!output || !name || !name[0] || strchr(name, '/') || !strcmp(name, ".") ||
-        !strcmp(name, "..") || (size && !data))
+    thz_status st = api_output_check(output, "thz_output_add_file", err);
+    if (st != THZ_OK)
+        return st;
+    if (!name || !name[0] || strchr(name, '/') || !strcmp(name, ".") || !strcmp(name, "..") ||
+        (size && !data))
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "thz_output_add_file: expected an output, a "
-                             "plain file name and data");
+                             "thz_output_add_file: expected a plain file name and data");
     char path[THZ_PATH_MAX];
-    thz_status st = thz_path_join(path, sizeof path, output_stage_dir(output->stage), name, err);
+    st = thz_path_join(path, sizeof path, output_stage_dir(output->stage), name, err);
     if (st != THZ_OK)
         return st;
     FILE *f = fopen(path, "wb");

@@ -149,11 +149,10 @@ static void check_atmosphere_frequencies(void)
     thz_atm_destroy(atm);
 }
 
-/* A file of 0 bytes may have no data (fwrite(NULL, ...) before: UBSan's error). */
+/* An output takes nothing after its commit, and says so (THZ_ERR_INPUT, not an I/O
+ * error about its vanished staging directory); a file of 0 bytes may have no data. */
 static void check_output_order(thz_context *ctx, thz_run *run, const char *dir)
 {
-    (void)ctx;
-    (void)run;
     thz_error err = {0};
     char outdir[4200], path[4300];
     snprintf(outdir, sizeof outdir, "%s/order", dir);
@@ -164,6 +163,13 @@ static void check_output_order(thz_context *ctx, thz_run *run, const char *dir)
     struct stat info;
     snprintf(path, sizeof path, "%s/empty.txt", outdir);
     CHECK(stat(path, &info) == 0 && info.st_size == 0, "%s: not an empty file", path);
+    expect_input_error(thz_output_commit(out, &err), &err, "already committed", "commit twice");
+    expect_input_error(thz_output_add_file(out, "late.txt", "x", 1, &err), &err,
+                       "already committed", "add_file after commit");
+    expect_input_error(thz_output_add_run(ctx, out, run, NULL, &err), &err, "already committed",
+                       "add_run after commit");
+    expect_input_error(thz_output_add_image(out, thz_run_image(run, 0), &err), &err,
+                       "already committed", "add_image after commit");
     thz_output_destroy(out);
     CHECK(stat(path, &info) == 0, "destroying a committed output removed %s", path);
 }
