@@ -82,7 +82,8 @@ static bool run_write_report(const run_state *rs, const run_write_options *wo, u
 thz_status run_write(run_state *rs, const char *dir, const run_write_options *wo, thz_error *err)
 {
     if (run_write_report(rs, wo, 0))
-        return thz_error_set(err, THZ_ERR_CANCELLED, "%s: cancelled", rs->command);
+        return thz_error_set(err, THZ_ERR_CANCELLED, "writing the %s results: cancelled",
+                             rs->command);
     double t0 = thz_now_s();
     thz_status st = THZ_OK;
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++)
@@ -98,6 +99,7 @@ thz_status run_write(run_state *rs, const char *dir, const run_write_options *wo
     if (st != THZ_OK)
         return st;
     if (run_write_report(rs, wo, 1))
-        return thz_error_set(err, THZ_ERR_CANCELLED, "%s: cancelled", rs->command);
+        return thz_error_set(err, THZ_ERR_CANCELLED, "writing the %s results: cancelled",
+                             rs->command);
     return THZ_OK;
 }

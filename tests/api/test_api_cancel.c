@@ -1,7 +1,7 @@
 /* Cancelling from the progress callback: a run stopped in its photon phase, in its
  * rendering, or while it is written returns THZ_ERR_CANCELLED, hands nothing back, and
- * leaves no output directory contents (the output directory it created is removed).
- * argv: the thzmap binary (unused), the repository. */
+ * leaves no output directory contents (the output directory it created is removed); a
+ * cancelled write says so. argv: the thzmap binary (unused), the repository. */
 #include <dirent.h>
 #include <sys/stat.h>
 
@@ -77,6 +77,9 @@ int main(int argc, char **argv)
     snprintf(out, sizeof out, "%s/out-write", dir);
     thz_status st = thz_run_write(ctx, run, out, NULL, &err);
     CHECK(st == THZ_ERR_CANCELLED, "write: %s (%s)", thz_status_name(st), err.message);
+    /* the message names the write, not the run that was over ("simulate: cancelled") */
+    CHECK(strstr(err.message, "writing the simulate results: cancelled") != NULL,
+          "write cancelled: '%s'", err.message);
     struct stat info;
     CHECK(stat(out, &info) != 0, "%s exists after a cancelled write", out);
     /* and without cancelling, it is written */
