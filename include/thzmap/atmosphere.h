@@ -82,8 +82,10 @@ THZ_API thz_status thz_plot_check(thz_error *err);
 
 /* The attenuation figure of `thzmap atmosphere --plot`: the parts of `atm` and its
  * total (and compare_db's, if not NULL) in dB/km on a log axis against THz, the
- * scene's channels (if scene is not NULL) shaded. Arrays have n entries. Draws with
- * PLplot, serialised process-wide. */
+ * scene's channels (if scene is not NULL) shaded. Arrays have n > 0 entries; f_thz and
+ * total_db are required, and the parts atm's model has (lines: all four; itu-p676:
+ * h2o_lines_db, o2_db, dry_db); else, or without a path, THZ_ERR_INPUT. NULL names:
+ * the models' own. Draws with PLplot, serialised process-wide. */
 typedef struct thz_atm_plot {
     const char *path; /* PNG file */
     const thz_atm *atm;

@@ -170,10 +170,46 @@ thz_status thz_plot_check(thz_error *err)
     return plot_check_device(err);
 }
 
+/* THZ_ERR_INPUT unless the figure has a path, an atmosphere, n > 0 points and every
+ * curve it draws for that atmosphere's model. */
+static thz_status api_plot_check(const thz_atm_plot *d, thz_error *err)
+{
+    if (!d || !d->atm)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_atm_draw_plot: no %s",
+                             d ? "atmosphere" : "figure");
+    if (!d->path || !d->path[0])
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_atm_draw_plot: no path for the PNG file");
+    if (d->n == 0)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "thz_atm_draw_plot: no points (expected n > 0 frequencies)");
+    atm_model model = d->atm->atm->model;
+    bool lines = model == ATM_LINES, parts = lines || model == ATM_ITU_P676;
+    const char *missing = !d->f_thz                       ? "f_thz"
+                          : !d->total_db                  ? "total_db"
+                          : parts && !d->h2o_lines_db     ? "h2o_lines_db"
+                          : lines && !d->h2o_continuum_db ? "h2o_continuum_db"
+                          : parts && !d->o2_db            ? "o2_db"
+                          : parts && !d->dry_db           ? "dry_db"
+                                                          : NULL;
+    if (missing)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "thz_atm_draw_plot: %s is NULL (expected %zu values for model '%s')",
+                             missing, d->n, atmosphere_model_name(model));
+    return THZ_OK;
+}
+
 thz_status thz_atm_draw_plot(const thz_atm_plot *d, thz_error *err)
 {
+    thz_status checked = api_plot_check(d, err);
+    if (checked != THZ_OK)
+        return checked;
     const thz_atmosphere *atm = d->atm->atm;
     const thz_atmosphere *compare = d->compare ? d->compare->atm : NULL;
+    /* names the caller left NULL: the models' own */
+    const char *model_name = d->model_name ? d->model_name : atmosphere_model_name(atm->model);
+    const char *compare_name = d->compare_name ? d->compare_name
+                               : compare       ? atmosphere_model_name(compare->model)
+                                               : "comparison";
     plot_curve curves[6];
     size_t n = 0;
     if (atm->model == ATM_LINES || atm->model == ATM_ITU_P676) {
@@ -189,10 +225,10 @@ thz_status thz_atm_draw_plot(const thz_atm_plot *d, thz_error *err)
         curves[n++] = (plot_curve){"dry-air continuum", d->dry_db, {148, 103, 189}, 1.0, false};
     }
     char total_text[96], compare_text[96];
-    snprintf(total_text, sizeof total_text, "total, %s", d->model_name);
+    snprintf(total_text, sizeof total_text, "total, %s", model_name);
     curves[n++] = (plot_curve){total_text, d->total_db, {0, 0, 0}, 2.0, false};
     if (d->compare_db) {
-        snprintf(compare_text, sizeof compare_text, "total, %s", d->compare_name);
+        snprintf(compare_text, sizeof compare_text, "total, %s", compare_name);
         curves[n++] = (plot_curve){compare_text, d->compare_db, {255, 127, 14}, 2.0, true};
     }
 
@@ -224,15 +260,15 @@ thz_status thz_atm_draw_plot(const thz_atm_plot *d, thz_error *err)
     const atm_air_state *air = with_air ? &with_air->air : NULL;
     if (with_air == atm)
         snprintf(title, sizeof title,
-                 "atmosphere '%s': %.2f K, %.1f hPa, water vapour %.2f g/m\u00b3", d->model_name,
+                 "atmosphere '%s': %.2f K, %.1f hPa, water vapour %.2f g/m\u00b3", model_name,
                  air->temperature_k, air->pressure_hpa, atm_air_h2o_density_g_m3(air));
     else if (with_air)
         snprintf(title, sizeof title,
-                 "atmosphere '%s'; %s air: %.2f K, %.1f hPa, %.2f g/m\u00b3 vapour", d->model_name,
-                 d->compare_name, air->temperature_k, air->pressure_hpa,
+                 "atmosphere '%s'; %s air: %.2f K, %.1f hPa, %.2f g/m\u00b3 vapour", model_name,
+                 compare_name, air->temperature_k, air->pressure_hpa,
                  atm_air_h2o_density_g_m3(air));
     else
-        snprintf(title, sizeof title, "atmosphere '%s'", d->model_name);
+        snprintf(title, sizeof title, "atmosphere '%s'", model_name);
     thz_status st = plot_attenuation(d->path, d->n, d->f_thz, n, curves, n_bands, bands, title,
                                      "frequency (THz)", "attenuation (dB/km)", err);
     free(bands);

@@ -149,6 +149,40 @@ static void check_atmosphere_frequencies(void)
     thz_atm_destroy(atm);
 }
 
+/* The figure refuses what it cannot draw: no points, no path, a curve's array missing
+ * (a crash in the drawing child before). */
+static void check_atmosphere_plot(void)
+{
+    thz_error err = {0};
+    thz_atm_options opt;
+    thz_atm_options_init(&opt);
+    opt.model = "itu-p676";
+    thz_atm *atm = NULL;
+    REQUIRE_OK(thz_atm_create(&opt, NULL, &atm, &err), &err);
+    double f[2] = {0.3, 0.4}, db[2] = {1, 2};
+    thz_atm_plot plot = {.path = "/nonexistent/never.png",
+                         .atm = atm,
+                         .model_name = "itu-p676",
+                         .n = 2,
+                         .f_thz = f,
+                         .total_db = db,
+                         .h2o_lines_db = db,
+                         .o2_db = NULL,
+                         .dry_db = db};
+    expect_input_error(thz_atm_draw_plot(&plot, &err), &err, "o2_db", "plot without O2");
+    plot.o2_db = db;
+    plot.n = 0;
+    expect_input_error(thz_atm_draw_plot(&plot, &err), &err, "n > 0", "plot of no points");
+    plot.n = 2;
+    plot.path = NULL;
+    expect_input_error(thz_atm_draw_plot(&plot, &err), &err, "no path", "plot without path");
+    plot.path = "/nonexistent/never.png";
+    plot.f_thz = NULL;
+    expect_input_error(thz_atm_draw_plot(&plot, &err), &err, "f_thz", "plot without f");
+    expect_input_error(thz_atm_draw_plot(NULL, &err), &err, "no figure", "NULL plot");
+    thz_atm_destroy(atm);
+}
+
 /* An output takes nothing after its commit, and says so (THZ_ERR_INPUT, not an I/O
  * error about its vanished staging directory); a file of 0 bytes may have no data. */
 static void check_output_order(thz_context *ctx, thz_run *run, const char *dir)
@@ -313,6 +347,7 @@ int main(int argc, char **argv)
     check_merge_per_channel(ctx, a);
     check_image_name_lifetime(ctx);
     check_atmosphere_frequencies();
+    check_atmosphere_plot();
     check_output_order(ctx, run, dir);
     check_library_bounds();
     thz_run_destroy(run);
