@@ -107,7 +107,8 @@ typedef struct thz_bands_options {
     double step_ghz;            /* default 10 */
     double relative_width;      /* of every candidate; 0: the scene's first channel's */
     const char *sensor;         /* NULL: the scene's first */
-    const char *const *targets; /* object names; n_targets 0: every object the sensor sees */
+    const char *const *targets; /* n_targets object names (not NULL; else THZ_ERR_INPUT);
+                                   n_targets 0: every object the sensor sees */
     size_t n_targets;
     int has_netd;  /* non-zero: netd_k for every candidate; 0: the sensor's noise (its netd_k
                       interpolated in frequency to the candidates, or its radiometer NETD

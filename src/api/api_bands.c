@@ -129,6 +129,13 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
         !(o->humidity_range >= 0.0 && o->humidity_range < 1.0))
         return thz_error_set(err, THZ_ERR_INPUT,
                              "NETD and ranges must be >= 0 (and the humidity range below 1)");
+    if (o->n_targets && !o->targets)
+        return thz_error_set(err, THZ_ERR_INPUT, "targets: %zu given but no list", o->n_targets);
+    for (size_t t = 0; t < o->n_targets; t++)
+        if (!o->targets[t] || !o->targets[t][0])
+            return thz_error_set(err, THZ_ERR_INPUT,
+                                 "targets[%zu]: expected an object's name, got %s", t,
+                                 o->targets[t] ? "\"\"" : "NULL");
     if (o->paths_per_sample < 1)
         return thz_error_set(err, THZ_ERR_INPUT, "paths per sample: expected at least 1");
     if (o->has_seed && o->seed > (uint64_t)INT64_MAX) /* bands.json records it exactly */

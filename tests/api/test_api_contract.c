@@ -183,6 +183,25 @@ static void check_atmosphere_plot(void)
     thz_atm_destroy(atm);
 }
 
+/* Band selection refuses targets that name nothing, before loading the scene. */
+static void check_bands_targets(thz_context *ctx, const char *scene_path)
+{
+    thz_error err = {0};
+    thz_bands_options o;
+    thz_bands_options_init(&o);
+    o.count = 1;
+    o.n_targets = 1;
+    thz_bands *bands = (thz_bands *)&err;
+    expect_input_error(thz_bands_select(ctx, scene_path, &o, &bands, &err), &err,
+                       "targets: 1 given but no list", "targets NULL");
+    CHECK(bands == NULL, "bands came back");
+    const char *names[2] = {"plate", NULL};
+    o.targets = names;
+    o.n_targets = 2;
+    expect_input_error(thz_bands_select(ctx, scene_path, &o, &bands, &err), &err,
+                       "targets[1]: expected an object's name, got NULL", "target NULL");
+}
+
 /* An output takes nothing after its commit, and says so (THZ_ERR_INPUT, not an I/O
  * error about its vanished staging directory); a file of 0 bytes may have no data. */
 static void check_output_order(thz_context *ctx, thz_run *run, const char *dir)
@@ -342,6 +361,7 @@ int main(int argc, char **argv)
     REQUIRE_OK(thz_simulate(ctx, a, &settings, &run, &err), &err);
     snprintf(path, sizeof path, "%s/a.json", dir);
     test_write_file(path, test_scene_json);
+    check_bands_targets(ctx, path);
     snprintf(path, sizeof path, "%s/a.thzpm", dir);
     check_thread_limit(a, merged);
     check_merge_per_channel(ctx, a);
