@@ -199,9 +199,10 @@ THZ_API thz_status thz_image_write(thz_context *ctx, const thz_image *image, con
  * summary; it borrows the scene, which must outlive it (thz_run_write reads it). */
 THZ_API thz_status thz_simulate(thz_context *ctx, const thz_scene *scene,
                                 const thz_run_settings *settings, thz_run **out, thz_error *err);
-/* `thzmap render` in memory: every sensor (or only sensor `sensor`, if it is not -1)
- * rendered from `photons` (NULL only for path). The run's seed and photon count are the
- * photons'. `photons` must have been made for `scene`. */
+/* `thzmap render` in memory: every sensor (sensor -1) or only sensor `sensor` (0 ..
+ * count - 1; any other index is refused with THZ_ERR_INPUT) rendered from `photons`
+ * (NULL only for path). The run's seed and photon count are the photons'. `photons`
+ * must have been made for `scene`; the run borrows the scene as thz_simulate's does. */
 THZ_API thz_status thz_render_run(thz_context *ctx, const thz_scene *scene,
                                   const thz_photons *photons, long sensor,
                                   const thz_run_settings *settings, thz_run **out, thz_error *err);

@@ -287,13 +287,17 @@ thz_status thz_simulate(thz_context *ctx, const thz_scene *scene, const thz_run_
 }
 
 /* The name of sensor `sensor` (NULL for -1: every sensor); THZ_ERR_INPUT when the scene
- * has no such sensor. */
+ * has no such sensor (any other negative index too). */
 static thz_status api_sensor_name(const thz_scene *scene, long sensor, const char **name,
                                   thz_error *err)
 {
     *name = NULL;
-    if (sensor < 0)
+    if (sensor == -1)
         return THZ_OK;
+    if (sensor < -1)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "render: sensor %ld: expected -1 (every sensor) or a sensor's index",
+                             sensor);
     if (!scene || (size_t)sensor >= scene->n_sensors)
         return thz_error_set(err, THZ_ERR_INPUT, "render: the scene has no sensor %ld", sensor);
     *name = scene->sensors[sensor].name;

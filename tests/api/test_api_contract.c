@@ -96,6 +96,23 @@ static void check_merge_per_channel(thz_context *ctx, thz_scene *scene)
         thz_photons_destroy(part[i]);
 }
 
+/* A sensor index below -1 is no sensor (only -1 means every sensor). */
+static void check_sensor_index(thz_context *ctx, thz_scene *scene, const thz_photons *photons,
+                               const char *map_path)
+{
+    thz_error err = {0};
+    thz_run *run = (thz_run *)&err;
+    expect_input_error(thz_render_run(ctx, scene, photons, -5, NULL, &run, &err), &err, "sensor -5",
+                       "render_run sensor -5");
+    CHECK(run == NULL, "a run came back");
+    run = (thz_run *)&err;
+    expect_input_error(thz_render_file(ctx, scene, map_path, -2, NULL, &run, &err), &err,
+                       "sensor -2", "render_file sensor -2");
+    CHECK(run == NULL, "a run came back");
+    expect_input_error(thz_render_file(ctx, scene, map_path, 2, NULL, &run, &err), &err, "sensor 2",
+                       "render_file sensor 2");
+}
+
 /* An image's sensor name is its own: it outlives the scene the image was rendered in
  * (read freed memory before; the ASan build sees it). */
 static void check_image_name_lifetime(thz_context *ctx)
@@ -365,6 +382,7 @@ int main(int argc, char **argv)
     snprintf(path, sizeof path, "%s/a.thzpm", dir);
     check_thread_limit(a, merged);
     check_merge_per_channel(ctx, a);
+    check_sensor_index(ctx, a, merged, path);
     check_image_name_lifetime(ctx);
     check_atmosphere_frequencies();
     check_atmosphere_plot();
