@@ -22,8 +22,8 @@ typedef struct thz_library thz_library;
 THZ_API thz_status thz_library_load(thz_library **out, thz_error *err);
 THZ_API void thz_library_destroy(thz_library *lib);
 
-/* The number of entries, and the index of the entry called name (THZ_ERR_INPUT naming
- * the known names when there is none). */
+/* The number of entries (0 for a NULL lib), and the index of the entry called name
+ * (THZ_ERR_INPUT naming the known names when there is none). */
 THZ_API size_t thz_library_count(const thz_library *lib);
 THZ_API thz_status thz_library_find(const thz_library *lib, const char *name, size_t *index,
                                     thz_error *err);

@@ -137,7 +137,8 @@ typedef struct thz_photon_point {
 /* The photons stored in channel c's map (0 when it has none). */
 THZ_API size_t thz_photons_count(const thz_photons *photons, size_t c);
 /* Copies photons first .. first + n - 1 of channel c (in the map's order, grouped by
- * object) into out[n]; returns how many were copied (fewer past the end). */
+ * object) into out[n]; returns how many were copied (fewer past the end; 0 when out is
+ * NULL). */
 THZ_API size_t thz_photons_points(const thz_photons *photons, size_t c, size_t first, size_t n,
                                   thz_photon_point *out);
 

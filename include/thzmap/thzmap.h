@@ -9,7 +9,10 @@
  *   - opaque handles; the function that creates one says so, its _destroy frees it,
  *     and _destroy(NULL) does nothing;
  *   - fallible functions return a thz_status and fill a caller-supplied thz_error
- *     (may be NULL); on failure every out-handle is set to NULL;
+ *     (may be NULL); on failure every out-handle is set to NULL. A NULL out-handle,
+ *     info struct or handle is refused with THZ_ERR_INPUT (e.g. "thz_simulate: no place
+ *     for the run"); functions returning a value give a neutral one (0, NULL, NaN) and
+ *     void ones do nothing;
  *   - parameters are borrowed; strings and arrays returned by accessors belong to the
  *     handle they came from and live as long as it;
  *   - photons, runs and images (a run's or thz_render_sensor's) and a scene's thz_atm

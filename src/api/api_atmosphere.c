@@ -48,6 +48,8 @@ void thz_atm_options_init(thz_atm_options *opt)
 
 thz_status thz_atm_check_air(const thz_atm_options *opt, thz_error *err)
 {
+    if (!opt)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_atm_check_air: no options");
     atm_air_state air;
     return atm_air_state_init(&air, opt->temperature_k, opt->pressure_hpa,
                               api_humidity_kind(opt->humidity_kind), opt->humidity, err);
@@ -56,7 +58,13 @@ thz_status thz_atm_check_air(const thz_atm_options *opt, thz_error *err)
 thz_status thz_atm_create(const thz_atm_options *opt, const thz_atm *air_from, thz_atm **out,
                           thz_error *err)
 {
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_atm_create: no place for the atmosphere");
     *out = NULL;
+    if (!opt)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "thz_atm_create: no options (thz_atm_options_init gives the "
+                             "defaults)");
     const char *name = opt->model ? opt->model : "lines";
     atm_model model;
     if (!atmosphere_model_from_name(name, &model) ||
@@ -99,6 +107,8 @@ thz_status thz_atm_create(const thz_atm_options *opt, const thz_atm *air_from, t
 
 thz_status thz_atm_from_scene(const thz_scene *scene, thz_atm **out, thz_error *err)
 {
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_atm_from_scene: no place for the atmosphere");
     *out = NULL;
     if (!scene)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_atm_from_scene: no scene");
@@ -120,6 +130,8 @@ void thz_atm_destroy(thz_atm *a)
 
 void thz_atm_get_info(const thz_atm *a, thz_atm_info *out)
 {
+    if (!out)
+        return;
     memset(out, 0, sizeof *out);
     if (!a)
         return;
@@ -138,6 +150,8 @@ void thz_atm_get_info(const thz_atm *a, thz_atm_info *out)
 thz_status thz_atm_check_range(const thz_atm *a, double lo_hz, double hi_hz, const char *what,
                                thz_error *err)
 {
+    if (!a)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_atm_check_range: no atmosphere");
     return atmosphere_check_range(a->atm, lo_hz, hi_hz, what ? what : "range", err);
 }
 

@@ -18,6 +18,8 @@ struct thz_library {
 
 thz_status thz_library_load(thz_library **out, thz_error *err)
 {
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_library_load: no place for the library");
     *out = NULL;
     thz_library *l = thz_calloc(1, sizeof *l);
     if (!l)
@@ -52,6 +54,11 @@ static const material_library_entry *api_entry(const thz_library *lib, size_t i)
 
 thz_status thz_library_find(const thz_library *lib, const char *name, size_t *index, thz_error *err)
 {
+    if (!lib || !name || !index)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_library_find: no %s",
+                             !lib    ? "library"
+                             : !name ? "name"
+                                     : "place for the index");
     const material_library_entry *e = material_library_find(lib->lib, name);
     if (e) {
         *index = (size_t)(e - lib->lib->entries);

@@ -30,6 +30,8 @@ static thz_status api_output_check(const thz_output *output, const char *what, t
 
 thz_status thz_output_open(const char *outdir, thz_output **out, thz_error *err)
 {
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_output_open: no place for the output");
     *out = NULL;
     if (!outdir || !outdir[0])
         return thz_error_set(err, THZ_ERR_INPUT, "no output directory given");

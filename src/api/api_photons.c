@@ -64,6 +64,8 @@ static thz_status api_fire(thz_context *ctx, const thz_scene *scene,
                            const thz_run_settings *settings, size_t only, thz_photons **out,
                            thz_error *err)
 {
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_photons_fire: no place for the photons");
     *out = NULL;
     if (!scene)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_photons_fire: no scene");
@@ -134,6 +136,10 @@ static thz_status api_photons_load(thz_context *ctx, const thz_scene *scene, con
 {
     thz_error local;
     err = api_err(err, &local);
+    if (!out)
+        return api_done(
+            ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_photons_load: no place for the photons"),
+            err);
     *out = NULL;
     if (!scene || !path)
         return api_done(
@@ -221,6 +227,10 @@ thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, 
 {
     thz_error local;
     err = api_err(err, &local);
+    if (!out)
+        return api_done(
+            ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_photons_merge: no place for the photons"),
+            err);
     *out = NULL;
     thz_photons *ph = NULL;
     thz_status st = api_merge_check(parts, n, err);
@@ -285,6 +295,8 @@ uint64_t thz_photons_per_channel(const thz_photons *ph)
 
 thz_status thz_photons_stats(const thz_photons *ph, size_t c, thz_photon_stats *out)
 {
+    if (!out)
+        return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
     if (!ph || c >= ph->n_channels)
         return THZ_ERR_INPUT;
@@ -323,7 +335,7 @@ size_t thz_photons_points(const thz_photons *ph, size_t c, size_t first, size_t 
                           thz_photon_point *out)
 {
     size_t count = thz_photons_count(ph, c);
-    if (first >= count)
+    if (!out || first >= count)
         return 0;
     if (n > count - first)
         n = count - first;

@@ -283,6 +283,9 @@ thz_status thz_simulate(thz_context *ctx, const thz_scene *scene, const thz_run_
 {
     thz_error local;
     err = api_err(err, &local);
+    if (!out)
+        return api_done(
+            ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_simulate: no place for the run"), err);
     return api_done(ctx, api_run(ctx, scene, NULL, NULL, false, NULL, settings, out, err), err);
 }
 
@@ -310,6 +313,9 @@ thz_status thz_render_run(thz_context *ctx, const thz_scene *scene, const thz_ph
 {
     thz_error local;
     err = api_err(err, &local);
+    if (!out)
+        return api_done(
+            ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_render_run: no place for the run"), err);
     *out = NULL;
     const char *name;
     thz_status st = api_sensor_name(scene, sensor, &name, err);
@@ -323,6 +329,9 @@ thz_status thz_render_file(thz_context *ctx, const thz_scene *scene, const char 
 {
     thz_error local;
     err = api_err(err, &local);
+    if (!out)
+        return api_done(
+            ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_render_file: no place for the run"), err);
     *out = NULL;
     const char *name;
     thz_status st = api_sensor_name(scene, sensor, &name, err);
@@ -350,6 +359,10 @@ thz_status thz_render_sensor(thz_context *ctx, const thz_scene *scene, const thz
 {
     thz_error local;
     err = api_err(err, &local);
+    if (!out)
+        return api_done(
+            ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_render_sensor: no place for the image"),
+            err);
     *out = NULL;
     thz_image *image = thz_calloc(1, sizeof *image);
     if (!image)
@@ -389,6 +402,8 @@ const char *thz_run_summary_json(const thz_run *run)
 
 void thz_run_get_totals(const thz_run *run, thz_run_totals *out)
 {
+    if (!out)
+        return;
     memset(out, 0, sizeof *out);
     if (!run)
         return;

@@ -66,6 +66,8 @@ thz_status thz_scene_load(const char *path, thz_scene **out, thz_error *err)
 
 thz_status thz_scene_get_info(const thz_scene *s, thz_scene_info *out)
 {
+    if (!out)
+        return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
     if (!s)
         return THZ_ERR_INPUT;
@@ -91,6 +93,8 @@ thz_status thz_scene_get_info(const thz_scene *s, thz_scene_info *out)
 
 thz_status thz_scene_channel(const thz_scene *s, size_t i, thz_channel_info *out)
 {
+    if (!out)
+        return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
     if (!s || i >= s->n_channels)
         return THZ_ERR_INPUT;
@@ -130,6 +134,8 @@ static thz_spectrum_info api_spectrum(const thz_spectrum *sp)
 
 thz_status thz_scene_material(const thz_scene *s, size_t i, thz_material_info *out)
 {
+    if (!out)
+        return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
     if (!s || i >= s->n_materials)
         return THZ_ERR_INPUT;
@@ -153,6 +159,8 @@ thz_status thz_scene_material(const thz_scene *s, size_t i, thz_material_info *o
 
 thz_status thz_scene_object(const thz_scene *s, size_t i, thz_object_info *out)
 {
+    if (!out)
+        return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
     if (!s || i >= s->n_objects)
         return THZ_ERR_INPUT;
@@ -175,6 +183,8 @@ thz_status thz_scene_object(const thz_scene *s, size_t i, thz_object_info *out)
 
 thz_status thz_scene_sensor(const thz_scene *s, size_t i, thz_sensor_info *out)
 {
+    if (!out)
+        return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
     if (!s || i >= s->n_sensors)
         return THZ_ERR_INPUT;
@@ -198,6 +208,8 @@ thz_status thz_scene_sensor(const thz_scene *s, size_t i, thz_sensor_info *out)
 thz_status thz_scene_sensor_channel(const thz_scene *s, size_t sensor, size_t channel,
                                     thz_sensor_channel_info *out)
 {
+    if (!out)
+        return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
     if (!s || sensor >= s->n_sensors || channel >= s->n_channels)
         return THZ_ERR_INPUT;
@@ -282,6 +294,8 @@ int thz_integrator_has_passes(const char *name)
 
 thz_status thz_scene_object_mesh(const thz_scene *s, size_t i, thz_object_mesh *out)
 {
+    if (!out)
+        return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
     if (!s || i >= s->n_objects)
         return THZ_ERR_INPUT;
@@ -299,6 +313,8 @@ thz_status thz_scene_object_mesh(const thz_scene *s, size_t i, thz_object_mesh *
 thz_status thz_scene_material_optics(const thz_scene *s, size_t i, double freq_hz,
                                      double thickness_m, thz_surface_optics *out)
 {
+    if (!out)
+        return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
     if (!s || i >= s->n_materials || !(freq_hz > 0.0) || !(thickness_m >= 0.0))
         return THZ_ERR_INPUT;

@@ -1,7 +1,12 @@
 /* The API's contracts: _destroy(NULL) does nothing; bad input gives THZ_ERR_INPUT with
  * a message naming the text's label and the JSON path or line:column; out-of-range
  * indices, foreign photons, unknown integrators and half-fired photons are refused;
- * photons fired in disjoint ranges merge. argv: the thzmap binary (unused), the repo. */
+ * photons fired in disjoint ranges merge, and per channel count what each channel got;
+ * a context's threads beyond THZ_MAX_THREADS, NULL out-handles, info structs and handles,
+ * non-finite or reversed frequency ranges, sensor indices below -1, library indices past
+ * the end, additions to a committed output and incomplete figures are refused or give a
+ * neutral value, never a crash; an image's sensor name outlives the scene. argv: the
+ * thzmap binary (unused), the repo. */
 #include <math.h>
 #include <sys/stat.h>
 
@@ -267,6 +272,90 @@ static void check_library_bounds(void)
     thz_library_destroy(lib);
 }
 
+/* Every NULL out-handle, info struct and handle in one table: the status functions give
+ * THZ_ERR_INPUT (with a message when they take a thz_error), never a store through NULL.
+ * Row i's call; -1 past the last row. */
+static int null_row(size_t i, thz_context *ctx, thz_scene *scene, thz_photons *ph, thz_atm *atm,
+                    thz_library *lib, thz_error *err, const char **what)
+{
+    const thz_photons *parts[1] = {ph};
+    thz_atm_options opt;
+    thz_atm_options_init(&opt);
+    size_t index;
+    switch (i) {
+#define ROW(n, call)                                                                               \
+    case n:                                                                                        \
+        *what = #call;                                                                             \
+        return call
+        ROW(0, thz_simulate(ctx, scene, NULL, NULL, err));
+        ROW(1, thz_render_run(ctx, scene, ph, -1, NULL, NULL, err));
+        ROW(2, thz_render_sensor(ctx, scene, ph, 0, NULL, NULL, err));
+        ROW(3, thz_render_file(ctx, scene, "x.thzpm", -1, NULL, NULL, err));
+        ROW(4, thz_photons_fire(ctx, scene, NULL, NULL, err));
+        ROW(5, thz_photons_fire_channel(ctx, scene, NULL, 0, NULL, err));
+        ROW(6, thz_photons_load(ctx, scene, "x.thzpm", NULL, err));
+        ROW(7, thz_photons_merge(ctx, parts, 1, NULL, err));
+        ROW(8, thz_output_open("never", NULL, err));
+        ROW(9, thz_atm_create(&opt, NULL, NULL, err));
+        ROW(10, thz_atm_from_scene(scene, NULL, err));
+        ROW(11, thz_library_load(NULL, err));
+        ROW(12, thz_atm_create(NULL, NULL, &atm, err));
+        ROW(13, thz_library_find(NULL, "water", &index, err));
+        ROW(14, thz_library_find(lib, NULL, &index, err));
+        ROW(15, thz_library_find(lib, "water", NULL, err));
+        ROW(16, thz_atm_check_range(NULL, 1e11, 2e11, "f", err));
+        ROW(17, thz_atm_check_air(NULL, err));
+        ROW(18, thz_atm_draw_plot(NULL, err));
+        /* no thz_error: the status alone */
+        ROW(19, thz_scene_get_info(scene, NULL));
+        ROW(20, thz_scene_channel(scene, 0, NULL));
+        ROW(21, thz_scene_material(scene, 0, NULL));
+        ROW(22, thz_scene_object(scene, 0, NULL));
+        ROW(23, thz_scene_sensor(scene, 0, NULL));
+        ROW(24, thz_scene_sensor_channel(scene, 0, 0, NULL));
+        ROW(25, thz_scene_object_mesh(scene, 0, NULL));
+        ROW(26, thz_scene_material_optics(scene, 0, 3e11, 0, NULL));
+        ROW(27, thz_photons_stats(ph, 0, NULL));
+#undef ROW
+    }
+    return -1;
+}
+
+static void check_null_arguments(thz_context *ctx, thz_scene *scene, thz_photons *ph, thz_run *run)
+{
+    thz_error err = {0};
+    thz_atm *atm = NULL;
+    thz_library *lib = NULL;
+    REQUIRE_OK(thz_atm_from_scene(scene, &atm, &err), &err);
+    REQUIRE_OK(thz_library_load(&lib, &err), &err);
+    const char *what = "";
+    int st;
+    for (size_t i = 0; (st = null_row(i, ctx, scene, ph, atm, lib, &err, &what)) >= 0; i++) {
+        CHECK(st == THZ_ERR_INPUT, "%s: %s (%s)", what, thz_status_name((thz_status)st),
+              err.message);
+        CHECK(i >= 19 || strstr(err.message, "no "), "%s: message '%s'", what, err.message);
+        err = (thz_error){0};
+    }
+    /* the functions that return values give their neutral one */
+    CHECK(thz_library_count(NULL) == 0, "count of no library");
+    CHECK(isnan(thz_atm_attenuation_per_m(NULL, 3e11)), "alpha of no atmosphere");
+    thz_atm_attenuation parts = {0};
+    thz_atm_attenuation_parts(NULL, 3e11, &parts);
+    CHECK(isnan(parts.total_per_m), "parts of no atmosphere: %g", parts.total_per_m);
+    thz_atm_attenuation_parts(atm, 3e11, NULL);
+    thz_atm_get_info(atm, NULL);
+    thz_run_get_totals(run, NULL);
+    CHECK(thz_photons_points(ph, 0, 0, 10, NULL) == 0, "points into NULL");
+    thz_library_get_info(lib, 0, NULL);
+    thz_library_get_range(lib, 0, 0, NULL, NULL);
+    thz_library_optics_at(lib, 0, 1e12, NULL);
+    thz_library_optics optics;
+    thz_library_optics_at(NULL, 0, 1e12, &optics);
+    CHECK(optics.n == 0 && optics.k == 0, "optics of no library: %g", optics.n);
+    thz_library_destroy(lib);
+    thz_atm_destroy(atm);
+}
+
 int main(int argc, char **argv)
 {
     (void)argc;
@@ -388,6 +477,7 @@ int main(int argc, char **argv)
     check_atmosphere_plot();
     check_output_order(ctx, run, dir);
     check_library_bounds();
+    check_null_arguments(ctx, a, merged, run);
     thz_run_destroy(run);
 
     thz_photons_destroy(one);
