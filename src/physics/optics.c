@@ -210,11 +210,19 @@ double optics_mean_reflectance(const optics_point *o)
 typedef double (*optics_law_fn)(const optics_point *o, double mu);
 
 /* Samples mu with density proportional to law(mu) mu, law in [0, 1], by rejection from
- * the cosine law (acceptance = the law's hemispherical mean). */
-static bool optics_reject(const optics_point *o, optics_law_fn law, optics_uniform_fn next,
-                          void *ctx, double *mu)
+ * the cosine law (acceptance = the law's hemispherical mean, `mean`). After
+ * OPTICS_QUICK_TRIES rejections it asks the mean: below OPTICS_MIN_MEAN (an index of 1, a
+ * surface that reflects or absorbs next to nothing) it gives up at once, where the
+ * proposals went on to OPTICS_MAX_TRIES for every sample (seconds a photon or gather
+ * ray: final-gather on such a material ran for hours and ignored SIGTERM meanwhile).
+ * Draws that succeed are the same as before, from the same numbers. */
+static bool optics_reject(const optics_point *o, optics_law_fn law,
+                          double (*mean)(const optics_point *), optics_uniform_fn next, void *ctx,
+                          double *mu)
 {
     for (long i = 0; i < OPTICS_MAX_TRIES; i++) {
+        if (i == OPTICS_QUICK_TRIES && !(mean(o) >= OPTICS_MIN_MEAN))
+            return false;
         double cand = sqrt(1.0 - next(ctx));
         if (cand > 0.0 && next(ctx) < law(o, cand)) {
             *mu = cand;
@@ -233,7 +241,7 @@ bool optics_sample_reflection_mu(const optics_point *o, optics_uniform_fn next, 
         *mu = sqrt(1.0 - next(ctx));
         return true;
     }
-    return optics_reject(o, optics_reflectance, next, ctx, mu);
+    return optics_reject(o, optics_reflectance, optics_mean_reflectance, next, ctx, mu);
 }
 
 double optics_transmission(const optics_point *o, double mu)
@@ -315,7 +323,7 @@ bool optics_sample_transmission_mu(const optics_point *o, optics_uniform_fn next
     if (!optics_is_shell(o))
         return false;
     if (o->has_index)
-        return optics_reject(o, optics_transmission, next, ctx, mu);
+        return optics_reject(o, optics_transmission, optics_mean_transmission, next, ctx, mu);
     double c = optics_cap(o);
     double tau = optics_tau(o);
     if (c == 0.0)
@@ -374,7 +382,7 @@ bool optics_emission_is_cosine(const optics_point *o)
 bool optics_sample_emission_mu(const optics_point *o, optics_uniform_fn next, void *ctx, double *mu)
 {
     if (o->has_index && !o->explicit_emissivity)
-        return optics_reject(o, optics_absorption, next, ctx, mu);
+        return optics_reject(o, optics_absorption, optics_mean_emissivity, next, ctx, mu);
     double c = optics_cap(o);
     double tau = optics_tau(o);
     if (optics_emission_is_constant(o)) {

@@ -82,8 +82,13 @@ double optics_mean_emissivity(const optics_point *o);
  * distribution, physics.md), eps(mu) mu (emission) or R(mu) mu (the diffuse BRDF's, the
  * cosine law when R is constant), using uniforms from `next` (called as many times as
  * needed, e.g. by rejection). Returns false if the distribution is identically zero (or,
- * with an index, after OPTICS_MAX_TRIES rejected proposals: a mean below ~1e-5). */
+ * with an index, where its hemispherical mean is below OPTICS_MIN_MEAN, or after
+ * OPTICS_MAX_TRIES rejected proposals). */
 #define OPTICS_MAX_TRIES 1000000
+/* After this many rejections the sampler asks the distribution's hemispherical mean and
+ * gives up at once below OPTICS_MIN_MEAN (optics.c). */
+#define OPTICS_QUICK_TRIES 64
+#define OPTICS_MIN_MEAN 1e-5
 typedef double (*optics_uniform_fn)(void *ctx);
 bool optics_sample_transmission_mu(const optics_point *o, optics_uniform_fn next, void *ctx,
                                    double *mu);

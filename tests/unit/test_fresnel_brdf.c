@@ -109,6 +109,38 @@ static void test_sample_reflection(void **state)
     }
 }
 
+/* Counts the uniforms a sampler draws. */
+static double counted_uniform(void *ctx)
+{
+    long *calls = ctx;
+    ++*calls;
+    return 0.5 + 0.25 * sin((double)*calls); /* any numbers in (0, 1) */
+}
+
+/* An index of 1 reflects nothing (R = 0 at every angle); an index of 1e10 absorbs about
+ * 4e-10 of what it meets: sampling their laws gives up after OPTICS_QUICK_TRIES
+ * proposals, not OPTICS_MAX_TRIES (final-gather on such a surface ran for minutes per
+ * thousand gather rays). A law of mean 2e-4 (an index of 1.03) is still sampled. */
+static void test_sample_negligible(void **state)
+{
+    (void)state;
+    optics_point none = {.has_index = true, .n = 1.0, .k = 0.0, .freq_hz = 1e12};
+    optics_point metal = {.has_index = true, .n = 1e10, .k = 0.0, .freq_hz = 1e12};
+    long calls = 0;
+    double mu;
+    assert_false(optics_sample_reflection_mu(&none, counted_uniform, &calls, &mu));
+    assert_true(calls <= 2 * OPTICS_QUICK_TRIES + 2);
+    calls = 0;
+    assert_false(optics_sample_emission_mu(&metal, counted_uniform, &calls, &mu));
+    assert_true(calls <= 2 * OPTICS_QUICK_TRIES + 2);
+    optics_point faint = {.has_index = true, .n = 1.03, .k = 0.0, .freq_hz = 1e12};
+    assert_true(optics_mean_reflectance(&faint) > OPTICS_MIN_MEAN);
+    rng_stream rng;
+    rng_init(&rng, 12, 0, 0, 0);
+    for (int i = 0; i < 100; i++)
+        assert_true(optics_sample_reflection_mu(&faint, sampling_uniform, &rng, &mu));
+}
+
 static vec3 dir_at(double mu, double phi)
 {
     double s = sqrt(fmax(0.0, 1 - mu * mu));
@@ -188,6 +220,7 @@ int main(void)
         cmocka_unit_test(test_slab),
         cmocka_unit_test(test_means),
         cmocka_unit_test(test_sample_reflection),
+        cmocka_unit_test(test_sample_negligible),
         cmocka_unit_test(test_ward),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
