@@ -252,7 +252,7 @@ class Image:
                 raise ArgumentError(f"plane: expected one of {', '.join(_PLANES)}, "
                                     f"got {plane!r}")
             plane = _PLANES[plane]
-        elif plane not in _PLANES.values():
+        elif isinstance(plane, bool) or plane not in _PLANES.values():
             raise ArgumentError(f"plane: expected a plane name, got {plane!r}")
         n = ctypes.c_size_t()
         p = _lib.lib.thz_image_plane(self._ptr, plane, ctypes.byref(n))

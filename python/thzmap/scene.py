@@ -145,6 +145,8 @@ def _path_arg(name, value):
     if not isinstance(value, (str, bytes, os.PathLike)):
         raise ArgumentError(f"{name}: expected a path, got {value!r}")
     value = os.fsdecode(value)
+    if not value:
+        raise ArgumentError(f"{name}: expected a path, got an empty one")
     if "\0" in value:
         raise ArgumentError(f"{name}: a path cannot contain a NUL character")
     return value

@@ -201,3 +201,16 @@ def test_every_bad_scene_of_the_cli_tests(path, want):
             or path.endswith("not_an_object.json"))
     if e.value.path is not None:
         assert str(e.value) == f"{path}: {e.value.path}: {e.value.reason}"
+
+
+def test_empty_paths_and_boolean_planes_are_argument_errors(tiny_dir, tmp_path):
+    # An empty outdir reached the library ("no output directory given", thzmap.Error);
+    # a bool passed as plane 1. Both are the caller's wrong arguments.
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    result = thzmap.simulate(scene, integrator="path", threads=1)
+    with pytest.raises(thzmap.ArgumentError, match="empty"):
+        result.save("")
+    with pytest.raises(thzmap.ArgumentError, match="empty"):
+        thzmap.load_scene("")
+    with pytest.raises(thzmap.ArgumentError, match="plane"):
+        result.image(0).plane(True)
