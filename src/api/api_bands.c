@@ -295,6 +295,10 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
 {
     thz_error local;
     err = api_err(err, &local);
+    if (!out)
+        return api_done(
+            ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_bands_select: no place for the bands"),
+            err);
     *out = NULL;
     size_t n = 0;
     if (!scene_path || !o)

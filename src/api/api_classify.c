@@ -36,6 +36,8 @@ struct thz_classification {
 
 thz_status thz_cube_read(const char *dir, const char *stem, thz_cube **out, thz_error *err)
 {
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_cube_read: no place for the cube");
     *out = NULL;
     if (!dir || !stem)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_cube_read: no directory or stem");
@@ -177,6 +179,8 @@ static thz_status classify_build(const thz_cube *cube, const thz_cube *truth,
                                  const thz_classify_options *opt, const char *run_dir,
                                  const char *sensor, thz_classification **out, thz_error *err)
 {
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_classify: no place for the classification");
     *out = NULL;
     thz_classify_options defaults;
     thz_classify_options_init(&defaults);
@@ -292,6 +296,9 @@ thz_status thz_classify_run(const char *run_dir, const char *sensor,
                             const thz_classify_options *opt, thz_classification **out,
                             thz_error *err)
 {
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "thz_classify_run: no place for the classification");
     *out = NULL;
     if (!run_dir || !sensor || !sensor[0])
         return thz_error_set(err, THZ_ERR_INPUT, "no run directory or sensor given");

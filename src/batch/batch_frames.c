@@ -86,6 +86,9 @@ size_t thz_sequence_frame_json(const thz_sequence *seq, size_t i, char *buf, siz
 thz_status thz_sequence_frame_scene(const thz_sequence *seq, size_t i, thz_scene **out,
                                     thz_error *err)
 {
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "thz_sequence_frame_scene: no place for the scene");
     *out = NULL;
     if (!seq || i >= seq->n_frames || !seq->frame_json[i])
         return thz_error_set(err, THZ_ERR_INPUT, "thz_sequence_frame_scene: no frame %zu", i);

@@ -513,6 +513,8 @@ static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_s
 thz_status thz_sequence_load_within(const char *path, const char *root_dir, thz_sequence **out,
                                     thz_error *err)
 {
+    if (!out)
+        return thz_error_set(err, THZ_ERR_INPUT, "thz_sequence_load: no place for the sequence");
     *out = NULL;
     if (!path)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_sequence_load: no path");

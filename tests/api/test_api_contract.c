@@ -282,6 +282,8 @@ static int null_row(size_t i, thz_context *ctx, thz_scene *scene, thz_photons *p
     thz_atm_options opt;
     thz_atm_options_init(&opt);
     size_t index;
+    thz_bands_options bopt;
+    thz_bands_options_init(&bopt);
     switch (i) {
 #define ROW(n, call)                                                                               \
     case n:                                                                                        \
@@ -307,15 +309,21 @@ static int null_row(size_t i, thz_context *ctx, thz_scene *scene, thz_photons *p
         ROW(17, thz_atm_check_air(NULL, err));
         ROW(18, thz_atm_draw_plot(NULL, err));
         /* no thz_error: the status alone */
-        ROW(19, thz_scene_get_info(scene, NULL));
-        ROW(20, thz_scene_channel(scene, 0, NULL));
-        ROW(21, thz_scene_material(scene, 0, NULL));
-        ROW(22, thz_scene_object(scene, 0, NULL));
-        ROW(23, thz_scene_sensor(scene, 0, NULL));
-        ROW(24, thz_scene_sensor_channel(scene, 0, 0, NULL));
-        ROW(25, thz_scene_object_mesh(scene, 0, NULL));
-        ROW(26, thz_scene_material_optics(scene, 0, 3e11, 0, NULL));
-        ROW(27, thz_photons_stats(ph, 0, NULL));
+        ROW(19, thz_bands_select(ctx, "x.json", &bopt, NULL, err));
+        ROW(20, thz_cube_read("d", "s", NULL, err));
+        ROW(21, thz_classify_cube(NULL, NULL, NULL, NULL, err));
+        ROW(22, thz_classify_run("d", "cam", NULL, NULL, err));
+        ROW(23, thz_sequence_load("x.json", NULL, err));
+        ROW(24, thz_sequence_frame_scene(NULL, 0, NULL, err));
+        ROW(25, thz_scene_get_info(scene, NULL));
+        ROW(26, thz_scene_channel(scene, 0, NULL));
+        ROW(27, thz_scene_material(scene, 0, NULL));
+        ROW(28, thz_scene_object(scene, 0, NULL));
+        ROW(29, thz_scene_sensor(scene, 0, NULL));
+        ROW(30, thz_scene_sensor_channel(scene, 0, 0, NULL));
+        ROW(31, thz_scene_object_mesh(scene, 0, NULL));
+        ROW(32, thz_scene_material_optics(scene, 0, 3e11, 0, NULL));
+        ROW(33, thz_photons_stats(ph, 0, NULL));
 #undef ROW
     }
     return -1;
@@ -333,7 +341,7 @@ static void check_null_arguments(thz_context *ctx, thz_scene *scene, thz_photons
     for (size_t i = 0; (st = null_row(i, ctx, scene, ph, atm, lib, &err, &what)) >= 0; i++) {
         CHECK(st == THZ_ERR_INPUT, "%s: %s (%s)", what, thz_status_name((thz_status)st),
               err.message);
-        CHECK(i >= 19 || strstr(err.message, "no "), "%s: message '%s'", what, err.message);
+        CHECK(i >= 25 || strstr(err.message, "no "), "%s: message '%s'", what, err.message);
         err = (thz_error){0};
     }
     /* the functions that return values give their neutral one */
