@@ -85,6 +85,12 @@ typedef struct load_range {
 #define LOAD_APERTURE_M2 ((load_range){0.0, 1e6, true, false})
 #define LOAD_MAX_APERTURE_DIAMETER_M 1000.0
 #define LOAD_UNIT ((load_range){0.0, 1.0, false, false})
+/* The atmosphere's attenuation (constant and table), 1/m: up to 1e10 (a mean free path
+ * of 0.1 nm, far beyond any medium). The photon map's air photons carry power
+ * 4 pi alpha B V / N, and at 1e200 /m their squares (the standard error) overflowed
+ * into NaN images; 1e100 still gave the exact answer. */
+#define LOAD_MAX_ATTENUATION_PER_M 1e10
+#define LOAD_ATTENUATION ((load_range){0.0, LOAD_MAX_ATTENUATION_PER_M, false, false})
 
 /* The root cursor of a document. */
 load_cursor load_root(json_t *value);
