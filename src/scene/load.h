@@ -85,6 +85,14 @@ typedef struct load_range {
 #define LOAD_APERTURE_M2 ((load_range){0.0, 1e6, true, false})
 #define LOAD_MAX_APERTURE_DIAMETER_M 1000.0
 #define LOAD_UNIT ((load_range){0.0, 1.0, false, false})
+/* Temperatures, K, of objects, the background, the normalisation and the receiver: up to
+ * 1e6 K, far above any scene a terahertz camera sees. Planck's law and the float outputs
+ * overflowed from 4e38 K (truth temperature and brightness temperature inf), 1e50 K
+ * (normalized) and 1e56 K (radiance); 1e30 K was still right. */
+#define LOAD_MAX_TEMPERATURE_K 1e6
+#define LOAD_TEMPERATURE ((load_range){0.0, LOAD_MAX_TEMPERATURE_K, false, false})
+/* The background's, K: what atmosphere_set_emitting accepts, checked here to name the path. */
+#define LOAD_BACKGROUND_TEMPERATURE ((load_range){0.0, 10000.0, false, false})
 /* The atmosphere's attenuation (constant and table), 1/m: up to 1e10 (a mean free path
  * of 0.1 nm, far beyond any medium). The photon map's air photons carry power
  * 4 pi alpha B V / N, and at 1e200 /m their squares (the standard error) overflowed

@@ -146,7 +146,8 @@ static thz_status load_emitting(load_ctx *ctx, const load_cursor *c, thz_atmosph
     }
     double t_bg = t_air;
     ctx->background_given = bg.value != NULL;
-    st = load_number(ctx, c, "background_temperature_k", LOAD_NONNEGATIVE, false, t_air, &t_bg);
+    st = load_number(ctx, c, "background_temperature_k", LOAD_BACKGROUND_TEMPERATURE, false, t_air,
+                     &t_bg);
     if (st != THZ_OK)
         return st;
     thz_error inner = {0};

@@ -74,7 +74,7 @@ static thz_status load_noise(load_ctx *ctx, const load_cursor *c, size_t n_chann
                          "\"integration_time_s\": tau, \"radiometer\": \"total-power\" | "
                          "\"dicke\"}, got an empty object");
     size_t type = 0;
-    st = load_number(ctx, &k, "receiver_temperature_k", LOAD_NONNEGATIVE, true, 0.0,
+    st = load_number(ctx, &k, "receiver_temperature_k", LOAD_TEMPERATURE, true, 0.0,
                      &noise->receiver_temperature_k);
     if (st == THZ_OK)
         st = load_number(ctx, &k, "integration_time_s", LOAD_POSITIVE, true, 0.0,

@@ -143,8 +143,9 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
     if (st == THZ_OK)
         st = load_integer(ctx, c, "oversampling", 1, LOAD_MAX_OVERSAMPLING, false, 1, &over);
     if (st == THZ_OK)
-        st =
-            load_number(ctx, c, "normalize_to_k", LOAD_POSITIVE, false, 295.0, &sn->normalize_to_k);
+        st = load_number(ctx, c, "normalize_to_k",
+                         (load_range){0.0, LOAD_MAX_TEMPERATURE_K, true, false}, false, 295.0,
+                         &sn->normalize_to_k);
     if (st != THZ_OK)
         return st;
     sn->oversampling = (uint32_t)over;
