@@ -81,8 +81,11 @@ typedef struct load_range {
 #define LOAD_COORDINATE ((load_range){-LOAD_MAX_COORDINATE_M, LOAD_MAX_COORDINATE_M, false, false})
 /* A sensor's aperture area, m^2: up to a square kilometre, far beyond any sensor and far
  * from the 32-bit power cube's overflow; its diameter, m, up to a kilometre (a circle of
- * 0.79 km^2). */
-#define LOAD_APERTURE_M2 ((load_range){0.0, 1e6, true, false})
+ * 0.79 km^2). Down to a square micrometre and a micrometre: from D = 1e-20 m the power
+ * cube (float, proportional to the area) was all 0, and at 1e-170 m the Airy profile's
+ * D^2 underflowed into an empty PSF kernel (an internal error, no JSON path). */
+#define LOAD_APERTURE_M2 ((load_range){1e-12, 1e6, false, false})
+#define LOAD_MIN_APERTURE_DIAMETER_M 1e-6
 #define LOAD_MAX_APERTURE_DIAMETER_M 1000.0
 #define LOAD_UNIT ((load_range){0.0, 1.0, false, false})
 /* Temperatures, K, of objects, the background, the normalisation and the receiver: up to
