@@ -103,6 +103,13 @@ typedef struct load_range {
 #define LOAD_MAX_ATTENUATION_PER_M 1e10
 #define LOAD_ATTENUATION ((load_range){0.0, LOAD_MAX_ATTENUATION_PER_M, false, false})
 
+/* v as the shortest %g that reads back as v (6 to 17 digits) into out, returned: a value
+ * just past a bound shows why it is out (0.5000001, not %g's 0.5). LOAD_G(v) formats
+ * into a buffer of its own that lives until the end of the enclosing block. */
+#define LOAD_NUMBER_CHARS 32
+const char *load_number_text(double v, char *out);
+#define LOAD_G(v) load_number_text((v), (char[LOAD_NUMBER_CHARS]){0})
+
 /* The root cursor of a document. */
 load_cursor load_root(json_t *value);
 

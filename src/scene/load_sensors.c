@@ -96,11 +96,17 @@ static thz_status load_normalize_floor(load_ctx *ctx, const load_cursor *c, doub
     if (t_ref >= floor_k)
         return THZ_OK;
     load_cursor k = load_key(c, "normalize_to_k");
+    char shown[LOAD_NUMBER_CHARS]; /* 4 digits, rounded up: a value as shown is accepted */
+    for (double up = floor_k;; up *= 1.0 + 1e-5) {
+        snprintf(shown, sizeof shown, "%.4g", up);
+        if (strtod(shown, NULL) >= floor_k)
+            break;
+    }
     return load_fail(ctx, &k,
-                     "expected a temperature >= %.4g K (h nu / k T_ref at most %g at %.4g THz, "
+                     "expected a temperature >= %s K (h nu / k T_ref at most %g at %.4g THz, "
                      "the top of channel \"%s\"'s band; colder, B(T_ref) is too small for the "
-                     "normalised cube), got %g K%s",
-                     floor_k, LOAD_NORMALIZE_MAX_X, top * 1e-12, s->channels[at].name, t_ref,
+                     "normalised cube), got %s K%s",
+                     shown, LOAD_NORMALIZE_MAX_X, top * 1e-12, s->channels[at].name, LOAD_G(t_ref),
                      k.value ? "" : " (the default)");
 }
 

@@ -63,6 +63,8 @@ CASES = [
      "channels[0].frequency_thz: expected a number > 0, got a string"),
     ("channel_width_too_wide", [(["channels", 0, "relative_width"], 0.6)],
      "channels[0].relative_width: expected a number in (0, 0.5], got 0.6"),
+    ("channel_width_just_too_wide", [(["channels", 0, "relative_width"], 0.5000001)],
+     "channels[0].relative_width: expected a number in (0, 0.5], got 0.5000001"),
     ("channel_width_zero", [(["channels", 0, "relative_width"], 0)],
      "channels[0].relative_width: expected a number in (0, 0.5]"),
     ("channel_unknown_key", [(["channels", 0, "width"], 0.1)], "channels[0].width: unknown key"),
@@ -194,7 +196,7 @@ CASES = [
      "sensors[0].normalize_to_k: expected a temperature >= 0.3427 K (h nu / k T_ref at most 50 "
      "at 0.357 THz"),
     ("sensor_normalize_default_too_cold", [(["channels", 0, "frequency_thz"], 400)],
-     "sensors[0].normalize_to_k: expected a temperature >= 391.6 K"),
+     "sensors[0].normalize_to_k: expected a temperature >= 391.7 K"),
     ("sensor_normalize_huge", [(["sensors", 0, "normalize_to_k"], 1e300)],
      "sensors[0].normalize_to_k: expected a number in (0, 1e+06], got 1e+300"),
     ("sensor_noise_receiver_temperature_huge",
