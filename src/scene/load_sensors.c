@@ -76,7 +76,10 @@ static thz_status load_sensor_file_name(load_ctx *ctx, const load_cursor *list, 
  * band-mean B(T_ref) stays above exp(-50) of the Rayleigh-Jeans value and
  * B(T) / B(T_ref) for T up to LOAD_MAX_TEMPERATURE_K fits the float normalised cube. At
  * 0.35 THz T_ref 0.1 K gave an inf cube and 0.02 K one of 0 (B(T_ref) underflowed); 80
- * instead of 50 would still overflow (kT/h nu e^80 > 3.4e38 for 1e6 K at 0.35 THz). */
+ * instead of 50 would still overflow (kT/h nu e^80 > 3.4e38 for 1e6 K at 0.35 THz).
+ * Only a given normalize_to_k is held to it: the default 295 K fails it only for bands
+ * beyond 307 THz, which validate already warns about as outside 0.05 to 10 THz (a GHz
+ * value given in THz), and refusing there would hide that warning. */
 #define LOAD_NORMALIZE_MAX_X 50.0
 
 static thz_status load_normalize_floor(load_ctx *ctx, const load_cursor *c, double t_ref)
@@ -93,9 +96,9 @@ static thz_status load_normalize_floor(load_ctx *ctx, const load_cursor *c, doub
         }
     }
     double floor_k = THZ_PLANCK_H * top / (THZ_BOLTZMANN_K * LOAD_NORMALIZE_MAX_X);
-    if (t_ref >= floor_k)
-        return THZ_OK;
     load_cursor k = load_key(c, "normalize_to_k");
+    if (t_ref >= floor_k || !k.value) /* the default 295 K: see the comment above */
+        return THZ_OK;
     char shown[LOAD_NUMBER_CHARS]; /* 4 digits, rounded up: a value as shown is accepted */
     for (double up = floor_k;; up *= 1.0 + 1e-5) {
         snprintf(shown, sizeof shown, "%.4g", up);
@@ -105,9 +108,8 @@ static thz_status load_normalize_floor(load_ctx *ctx, const load_cursor *c, doub
     return load_fail(ctx, &k,
                      "expected a temperature >= %s K (h nu / k T_ref at most %g at %.4g THz, "
                      "the top of channel \"%s\"'s band; colder, B(T_ref) is too small for the "
-                     "normalised cube), got %s K%s",
-                     shown, LOAD_NORMALIZE_MAX_X, top * 1e-12, s->channels[at].name, LOAD_G(t_ref),
-                     k.value ? "" : " (the default)");
+                     "normalised cube), got %s K",
+                     shown, LOAD_NORMALIZE_MAX_X, top * 1e-12, s->channels[at].name, LOAD_G(t_ref));
 }
 
 static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t index, thz_sensor *sn)
