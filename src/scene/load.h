@@ -81,10 +81,34 @@ typedef struct load_range {
 #define LOAD_COORDINATE ((load_range){-LOAD_MAX_COORDINATE_M, LOAD_MAX_COORDINATE_M, false, false})
 /* A sensor's aperture area, m^2: up to a square kilometre, far beyond any sensor and far
  * from the 32-bit power cube's overflow; its diameter, m, up to a kilometre (a circle of
- * 0.79 km^2). */
-#define LOAD_APERTURE_M2 ((load_range){0.0, 1e6, true, false})
+ * 0.79 km^2). Down to a square micrometre and a micrometre: from D = 1e-20 m the power
+ * cube (float, proportional to the area) was all 0, and at 1e-170 m the Airy profile's
+ * D^2 underflowed into an empty PSF kernel (an internal error, no JSON path). */
+#define LOAD_APERTURE_M2 ((load_range){1e-12, 1e6, false, false})
+#define LOAD_MIN_APERTURE_DIAMETER_M 1e-6
 #define LOAD_MAX_APERTURE_DIAMETER_M 1000.0
 #define LOAD_UNIT ((load_range){0.0, 1.0, false, false})
+/* Temperatures, K, of objects, the background, the normalisation and the receiver: up to
+ * 1e6 K, far above any scene a terahertz camera sees. Planck's law and the float outputs
+ * overflowed from 4e38 K (truth temperature and brightness temperature inf), 1e50 K
+ * (normalized) and 1e56 K (radiance); 1e30 K was still right. */
+#define LOAD_MAX_TEMPERATURE_K 1e6
+#define LOAD_TEMPERATURE ((load_range){0.0, LOAD_MAX_TEMPERATURE_K, false, false})
+/* The background's, K: what atmosphere_set_emitting accepts, checked here to name the path. */
+#define LOAD_BACKGROUND_TEMPERATURE ((load_range){0.0, 10000.0, false, false})
+/* The atmosphere's attenuation (constant and table), 1/m: up to 1e10 (a mean free path
+ * of 0.1 nm, far beyond any medium). The photon map's air photons carry power
+ * 4 pi alpha B V / N, and at 1e200 /m their squares (the standard error) overflowed
+ * into NaN images; 1e100 still gave the exact answer. */
+#define LOAD_MAX_ATTENUATION_PER_M 1e10
+#define LOAD_ATTENUATION ((load_range){0.0, LOAD_MAX_ATTENUATION_PER_M, false, false})
+
+/* v as the shortest %g that reads back as v (6 to 17 digits) into out, returned: a value
+ * just past a bound shows why it is out (0.5000001, not %g's 0.5). LOAD_G(v) formats
+ * into a buffer of its own that lives until the end of the enclosing block. */
+#define LOAD_NUMBER_CHARS 32
+const char *load_number_text(double v, char *out);
+#define LOAD_G(v) load_number_text((v), (char[LOAD_NUMBER_CHARS]){0})
 
 /* The root cursor of a document. */
 load_cursor load_root(json_t *value);

@@ -146,7 +146,8 @@ static thz_status load_emitting(load_ctx *ctx, const load_cursor *c, thz_atmosph
     }
     double t_bg = t_air;
     ctx->background_given = bg.value != NULL;
-    st = load_number(ctx, c, "background_temperature_k", LOAD_NONNEGATIVE, false, t_air, &t_bg);
+    st = load_number(ctx, c, "background_temperature_k", LOAD_BACKGROUND_TEMPERATURE, false, t_air,
+                     &t_bg);
     if (st != THZ_OK)
         return st;
     thz_error inner = {0};
@@ -156,9 +157,9 @@ static thz_status load_emitting(load_ctx *ctx, const load_cursor *c, thz_atmosph
     if (!lo.value && !hi.value)
         return THZ_OK;
     double min_m[3], max_m[3];
-    st = load_vector(ctx, c, "extent_min_m", 3, LOAD_ANY, true, min_m);
+    st = load_vector(ctx, c, "extent_min_m", 3, LOAD_COORDINATE, true, min_m);
     if (st == THZ_OK)
-        st = load_vector(ctx, c, "extent_max_m", 3, LOAD_ANY, true, max_m);
+        st = load_vector(ctx, c, "extent_max_m", 3, LOAD_COORDINATE, true, max_m);
     if (st != THZ_OK)
         return st;
     st = atmosphere_set_extent(atm, min_m, max_m, &inner);
@@ -220,7 +221,7 @@ thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *
         double alpha = 0.0;
         st = load_expect_object(ctx, c, keys_constant);
         if (st == THZ_OK)
-            st = load_number(ctx, c, "attenuation_per_m", LOAD_NONNEGATIVE, true, 0.0, &alpha);
+            st = load_number(ctx, c, "attenuation_per_m", LOAD_ATTENUATION, true, 0.0, &alpha);
         if (st != THZ_OK)
             break;
         if (!spectrum_set_constant(&atm->attenuation_per_m, alpha)) {
@@ -240,7 +241,7 @@ thz_status load_atmosphere(load_ctx *ctx, const load_cursor *c, thz_atmosphere *
         load_cursor file = load_key(c, "file");
         st = load_csv_columns(ctx, &file, &table, columns, "attenuation_per_m");
         if (st == THZ_OK)
-            st = load_csv_spectrum(ctx, &file, &table, "attenuation_per_m", LOAD_NONNEGATIVE,
+            st = load_csv_spectrum(ctx, &file, &table, "attenuation_per_m", LOAD_ATTENUATION,
                                    &atm->attenuation_per_m);
         if (st == THZ_OK)
             atm->model = ATM_TABLE;

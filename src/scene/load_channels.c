@@ -126,7 +126,8 @@ static thz_status load_channel_range(load_ctx *ctx, const load_cursor *c)
     if (count == 1 && to != from)
         return load_fail(ctx, &k, "with count 1, to_thz must equal from_thz (%g)", from);
     if (count > 1 && !(to > from))
-        return load_fail(ctx, &k, "expected a number > from_thz (%g), got %g", from, to);
+        return load_fail(ctx, &k, "expected a number > from_thz (%s), got %s", LOAD_G(from),
+                         LOAD_G(to));
     s->channels = thz_calloc(count, sizeof *s->channels);
     if (!s->channels)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");

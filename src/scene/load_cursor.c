@@ -115,6 +115,16 @@ thz_status load_require(load_ctx *ctx, const load_cursor *c, const char *key, co
     return load_fail(ctx, &k, "missing key (expected %s)", what);
 }
 
+const char *load_number_text(double v, char *out)
+{
+    for (int digits = 6; digits <= 17; digits++) {
+        snprintf(out, LOAD_NUMBER_CHARS, "%.*g", digits, v);
+        if (!isfinite(v) || strtod(out, NULL) == v)
+            break;
+    }
+    return out;
+}
+
 static void load_format_range(char *out, size_t n, load_range r)
 {
     if (isinf(r.lo) && isinf(r.hi))
@@ -147,7 +157,7 @@ thz_status load_number_value(load_ctx *ctx, const load_cursor *c, load_range r, 
         return load_fail(ctx, c, "expected %s, got %s", expected, load_type_name(c->value));
     double v = json_number_value(c->value);
     if (!load_in_range(v, r))
-        return load_fail(ctx, c, "expected %s, got %g", expected, v);
+        return load_fail(ctx, c, "expected %s, got %s", expected, LOAD_G(v));
     *out = v;
     return THZ_OK;
 }
@@ -195,8 +205,8 @@ thz_status load_integer(load_ctx *ctx, const load_cursor *c, const char *key, ui
             *out = (uint64_t)v;
             return THZ_OK;
         }
-        return load_fail(ctx, &k, "expected a whole number from %llu to %llu, got %g",
-                         (unsigned long long)min, (unsigned long long)max, v);
+        return load_fail(ctx, &k, "expected a whole number from %llu to %llu, got %s",
+                         (unsigned long long)min, (unsigned long long)max, LOAD_G(v));
     }
     return load_fail(ctx, &k, "expected a whole number from %llu to %llu, got %s",
                      (unsigned long long)min, (unsigned long long)max, what);
@@ -348,8 +358,8 @@ thz_status load_csv_spectrum(load_ctx *ctx, const load_cursor *c, const csv_tabl
         double thz = csv_value(t, i, (size_t)fc);
         if (!(thz > 0.0)) {
             st = load_fail(ctx, c,
-                           "%s:%zu: row %zu, column 'frequency_thz': expected a number > 0, got %g",
-                           t->label, t->row_lines[i], i + 1, thz);
+                           "%s:%zu: row %zu, column 'frequency_thz': expected a number > 0, got %s",
+                           t->label, t->row_lines[i], i + 1, LOAD_G(thz));
             goto cleanup;
         }
         if (i > 0 && !(thz * 1e12 > f[i - 1])) {
@@ -362,8 +372,8 @@ thz_status load_csv_spectrum(load_ctx *ctx, const load_cursor *c, const csv_tabl
         f[i] = thz * 1e12;
         v[i] = csv_value(t, i, (size_t)vc);
         if (!load_in_range(v[i], r)) {
-            st = load_fail(ctx, c, "%s:%zu: row %zu, column '%s': expected %s, got %g", t->label,
-                           t->row_lines[i], i + 1, column, expected, v[i]);
+            st = load_fail(ctx, c, "%s:%zu: row %zu, column '%s': expected %s, got %s", t->label,
+                           t->row_lines[i], i + 1, column, expected, LOAD_G(v[i]));
             goto cleanup;
         }
     }

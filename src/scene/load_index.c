@@ -11,7 +11,14 @@
 #include "core/path.h"
 #include "scene/load.h"
 
-#define LOAD_INDEX_N ((load_range){0.0, INFINITY, true, false})
+/* n and k, each at most 1e100: fresnel_interface squares n + ik, and [1e300, 1e300] (or
+ * [1e-300, 1e300]) overflowed it into a photon map at 11.83 K where path read 295 K;
+ * [1e150, 1e150] still agreed. The permittivity models' parameters are held to 1e200
+ * (n = sqrt(eps) <= 1e100), and every index is checked at the channels' frequencies. */
+#define LOAD_MAX_INDEX 1e100
+#define LOAD_INDEX_N ((load_range){0.0, LOAD_MAX_INDEX, true, false})
+#define LOAD_INDEX_K ((load_range){0.0, LOAD_MAX_INDEX, false, false})
+#define LOAD_MAX_PERMITTIVITY 1e200
 
 /* The ITU-R P.2040 table shipped in the data directory. */
 #define P2040_FILE "materials/itu-r-p2040.json"
@@ -54,7 +61,7 @@ static thz_status index_table(load_ctx *ctx, const load_cursor *k, thz_material 
         if (st == THZ_OK)
             st = load_number_value(ctx, &nc, LOAD_INDEX_N, &n[i]);
         if (st == THZ_OK)
-            st = load_number_value(ctx, &kc, LOAD_NONNEGATIVE, &kk[i]);
+            st = load_number_value(ctx, &kc, LOAD_INDEX_K, &kk[i]);
     }
     if (st == THZ_OK)
         st = set_index(ctx, m, material_index_table(count, f, n, kk));
@@ -80,7 +87,7 @@ static thz_status refractive_index(load_ctx *ctx, const load_cursor *k, thz_mate
     double n, kk;
     thz_status st = load_number_value(ctx, &nc, LOAD_INDEX_N, &n);
     if (st == THZ_OK)
-        st = load_number_value(ctx, &kc, LOAD_NONNEGATIVE, &kk);
+        st = load_number_value(ctx, &kc, LOAD_INDEX_K, &kk);
     if (st == THZ_OK)
         st = set_index(ctx, m, material_index_constant(n, kk));
     return st;
@@ -179,7 +186,7 @@ static thz_status permittivity(load_ctx *ctx, const load_cursor *c, thz_material
         {"model", "eps_inf", "oscillators", NULL},
         {"model", "plasma_frequency_thz", "collision_frequency_thz", NULL},
         {"model", "material", NULL}};
-    const load_range eps = {1.0, INFINITY, false, false};
+    const load_range eps = {1.0, LOAD_MAX_PERMITTIVITY, false, false};
     if (!json_is_object(c->value))
         return load_fail(ctx, c, "expected an object {\"model\": ...}, got %s",
                          load_type_name(c->value));
@@ -265,7 +272,7 @@ thz_status load_index_csv(load_ctx *ctx, const load_cursor *file, const csv_tabl
     thz_spectrum n = {0}, k = {0};
     thz_status st = load_csv_spectrum(ctx, file, t, "n", LOAD_INDEX_N, &n);
     if (st == THZ_OK)
-        st = load_csv_spectrum(ctx, file, t, "k", LOAD_NONNEGATIVE, &k);
+        st = load_csv_spectrum(ctx, file, t, "k", LOAD_INDEX_K, &k);
     if (st == THZ_OK) /* one row is a constant (no frequencies) */
         st = set_index(ctx, m,
                        n.freq_hz ? material_index_table(n.n, n.freq_hz, n.value, k.value)
@@ -327,12 +334,50 @@ static thz_status warn_outside(load_ctx *ctx, const load_cursor *c, const char *
     return THZ_OK;
 }
 
+/* Refuses an index whose n or k, at some channel's centre or band end (index_band_hz,
+ * ends above 0), is not finite or leaves (0, LOAD_MAX_INDEX] and [0, LOAD_MAX_INDEX]: a
+ * permittivity model's extreme parameters (eps_s and tau_ps of 1e300, a resonance or a
+ * plasma frequency far beyond the band) give what no constant index may. */
+static thz_status index_check_values(load_ctx *ctx, const load_cursor *c, const thz_material *m)
+{
+    const thz_scene *s = ctx->scene;
+    for (size_t i = 0; i < s->n_channels; i++) {
+        const thz_channel *ch = &s->channels[i];
+        double f[3] = {ch->center_hz, 0.0, 0.0};
+        index_band_hz(ch, &f[1], &f[2]);
+        for (size_t j = 0; j < 3; j++) {
+            double n = 0.0, k = 0.0;
+            if (!(f[j] > 0.0) || !material_index_at(m->index, f[j], &n, &k))
+                continue;
+            if (n > 0.0 && n <= LOAD_MAX_INDEX && k >= 0.0 && k <= LOAD_MAX_INDEX)
+                continue;
+            static const char *const keys[] = {"permittivity_model", "refractive_index", "library",
+                                               "file"};
+            load_cursor at = *c;
+            for (size_t q = 0; q < sizeof keys / sizeof *keys; q++) {
+                load_cursor kq = load_key(c, keys[q]);
+                if (kq.value) {
+                    at = kq;
+                    break;
+                }
+            }
+            return load_fail(ctx, &at,
+                             "the complex index of material \"%s\" at %.4g THz (channel \"%s\") "
+                             "is n = %g, k = %g; expected n in (0, %g] and k in [0, %g]",
+                             m->name, f[j] * 1e-12, ch->name, n, k, LOAD_MAX_INDEX, LOAD_MAX_INDEX);
+        }
+    }
+    return THZ_OK;
+}
+
 thz_status load_index_check_channels(load_ctx *ctx, const load_cursor *c, const thz_material *m,
                                      const double *lib_range_hz)
 {
     if (!m->index)
         return THZ_OK;
-    thz_status st = THZ_OK;
+    thz_status st = index_check_values(ctx, c, m);
+    if (st != THZ_OK)
+        return st;
     double t_lo, t_hi;
     if (lib_range_hz && lib_range_hz[1] > 0.0) {
         load_cursor k = load_key(c, "library");

@@ -197,7 +197,7 @@ static thz_status load_object(load_ctx *ctx, const load_cursor *list, size_t ind
         return load_fail(ctx, &k, "unknown material \"%s\" (expected a key of \"materials\")",
                          material);
     }
-    st = load_number(ctx, c, "temperature_k", LOAD_NONNEGATIVE, true, 0, &o->temperature_k);
+    st = load_number(ctx, c, "temperature_k", LOAD_TEMPERATURE, true, 0, &o->temperature_k);
     if (st != THZ_OK)
         return st;
     load_cursor thick = load_key(c, "thickness_m");

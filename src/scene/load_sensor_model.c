@@ -74,7 +74,7 @@ static thz_status load_noise(load_ctx *ctx, const load_cursor *c, size_t n_chann
                          "\"integration_time_s\": tau, \"radiometer\": \"total-power\" | "
                          "\"dicke\"}, got an empty object");
     size_t type = 0;
-    st = load_number(ctx, &k, "receiver_temperature_k", LOAD_NONNEGATIVE, true, 0.0,
+    st = load_number(ctx, &k, "receiver_temperature_k", LOAD_TEMPERATURE, true, 0.0,
                      &noise->receiver_temperature_k);
     if (st == THZ_OK)
         st = load_number(ctx, &k, "integration_time_s", LOAD_POSITIVE, true, 0.0,
@@ -93,7 +93,8 @@ static thz_status load_noise(load_ctx *ctx, const load_cursor *c, size_t n_chann
 thz_status load_sensor_model(load_ctx *ctx, const load_cursor *c, size_t n_channels, thz_sensor *sn)
 {
     static const char *const psfs[] = {"none", "airy", "gaussian", NULL}; /* thz_psf_kind */
-    const load_range diameter = {0.0, LOAD_MAX_APERTURE_DIAMETER_M, true, false};
+    const load_range diameter = {LOAD_MIN_APERTURE_DIAMETER_M, LOAD_MAX_APERTURE_DIAMETER_M, false,
+                                 false};
     thz_status st =
         load_number(ctx, c, "aperture_diameter_m", diameter, false, 0.0, &sn->aperture_diameter_m);
     if (st != THZ_OK)

@@ -7,6 +7,8 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "physics/channel.h"
+#include "physics/planck.h"
 #include "scene/load.h"
 #include "core/vec3.h"
 
@@ -67,6 +69,47 @@ static thz_status load_sensor_file_name(load_ctx *ctx, const load_cursor *list, 
                              name, list->path, j, o);
     }
     return THZ_OK;
+}
+
+/* The coldest normalize_to_k: h nu / (k T_ref) <= LOAD_NORMALIZE_MAX_X at the top of every
+ * channel's band (centre + 2 FWHM, or where a measured response ends), so that the
+ * band-mean B(T_ref) stays above exp(-50) of the Rayleigh-Jeans value and
+ * B(T) / B(T_ref) for T up to LOAD_MAX_TEMPERATURE_K fits the float normalised cube. At
+ * 0.35 THz T_ref 0.1 K gave an inf cube and 0.02 K one of 0 (B(T_ref) underflowed); 80
+ * instead of 50 would still overflow (kT/h nu e^80 > 3.4e38 for 1e6 K at 0.35 THz).
+ * Only a given normalize_to_k is held to it: the default 295 K fails it only for bands
+ * beyond 307 THz, which validate already warns about as outside 0.05 to 10 THz (a GHz
+ * value given in THz), and refusing there would hide that warning. */
+#define LOAD_NORMALIZE_MAX_X 50.0
+
+static thz_status load_normalize_floor(load_ctx *ctx, const load_cursor *c, double t_ref)
+{
+    const thz_scene *s = ctx->scene;
+    double top = 0.0;
+    size_t at = 0;
+    for (size_t i = 0; i < s->n_channels; i++) {
+        double lo, hi;
+        channel_support_hz(&s->channels[i], 2.0 * CHANNEL_FWHM_PER_SIGMA, &lo, &hi);
+        if (hi > top) {
+            top = hi;
+            at = i;
+        }
+    }
+    double floor_k = THZ_PLANCK_H * top / (THZ_BOLTZMANN_K * LOAD_NORMALIZE_MAX_X);
+    load_cursor k = load_key(c, "normalize_to_k");
+    if (t_ref >= floor_k || !k.value) /* the default 295 K: see the comment above */
+        return THZ_OK;
+    char shown[LOAD_NUMBER_CHARS]; /* 4 digits, rounded up: a value as shown is accepted */
+    for (double up = floor_k;; up *= 1.0 + 1e-5) {
+        snprintf(shown, sizeof shown, "%.4g", up);
+        if (strtod(shown, NULL) >= floor_k)
+            break;
+    }
+    return load_fail(ctx, &k,
+                     "expected a temperature >= %s K (h nu / k T_ref at most %g at %.4g THz, "
+                     "the top of channel \"%s\"'s band; colder, B(T_ref) is too small for the "
+                     "normalised cube), got %s K",
+                     shown, LOAD_NORMALIZE_MAX_X, top * 1e-12, s->channels[at].name, LOAD_G(t_ref));
 }
 
 static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t index, thz_sensor *sn)
@@ -143,8 +186,11 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
     if (st == THZ_OK)
         st = load_integer(ctx, c, "oversampling", 1, LOAD_MAX_OVERSAMPLING, false, 1, &over);
     if (st == THZ_OK)
-        st =
-            load_number(ctx, c, "normalize_to_k", LOAD_POSITIVE, false, 295.0, &sn->normalize_to_k);
+        st = load_number(ctx, c, "normalize_to_k",
+                         (load_range){0.0, LOAD_MAX_TEMPERATURE_K, true, false}, false, 295.0,
+                         &sn->normalize_to_k);
+    if (st == THZ_OK)
+        st = load_normalize_floor(ctx, c, sn->normalize_to_k);
     if (st != THZ_OK)
         return st;
     sn->oversampling = (uint32_t)over;

@@ -319,7 +319,7 @@ static void test_refusals(void **state)
     load_bad(HEAD CHANNELS MATERIALS
              "\"objects\": [{\"name\": \"o\", \"type\": \"solid\", \"material\": \"m\", "
              "\"temperature_k\": -1, \"shape\": " BOX "}], " SENSORS "}",
-             "objects[0].temperature_k: expected a number >= 0, got -1");
+             "objects[0].temperature_k: expected a number in [0, 1e+06], got -1");
     load_bad(HEAD CHANNELS MATERIALS OBJECT("{\"type\": \"cone\"}") SENSORS "}",
              "objects[0].shape.type: expected one of");
     load_bad(HEAD CHANNELS MATERIALS OBJECT("{\"type\": \"mesh\", \"file\": \"nope.obj\"}") SENSORS
