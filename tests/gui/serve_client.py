@@ -6,6 +6,7 @@ import json
 import re
 import signal
 import subprocess
+import sys
 
 FAILURES = []
 
@@ -14,6 +15,14 @@ def check(cond, what):
     if not cond:
         FAILURES.append(what)
         print("FAIL:", what, flush=True)
+
+
+def finish():
+    """Ends a test script: exit 1 with the count when any check failed, else "ok"."""
+    if FAILURES:
+        print("%d failure(s)" % len(FAILURES))
+        sys.exit(1)
+    print("ok")
 
 
 class Server:

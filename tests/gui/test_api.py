@@ -24,7 +24,7 @@ import sys
 import tempfile
 import time
 
-from serve_client import FAILURES, Server as Client, check
+from serve_client import Server as Client, check, finish
 
 BINARY, REPO = sys.argv[1], sys.argv[2]
 REQUESTS_ONLY = sys.argv[3:] == ["--requests-only"]
@@ -569,10 +569,7 @@ def main():
         print("total %.1f s" % (time.time() - t0))
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    if FAILURES:
-        print("%d failure(s)" % len(FAILURES))
-        sys.exit(1)
-    print("ok")
+    finish()
 
 
 main()

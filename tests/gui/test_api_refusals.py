@@ -21,7 +21,7 @@ import sys
 import tempfile
 import time
 
-from serve_client import FAILURES, Server, check
+from serve_client import Server, check, finish
 
 BINARY, REPO = sys.argv[1], sys.argv[2]
 REQUESTS_ONLY = sys.argv[3:] == ["--requests-only"]
@@ -190,10 +190,7 @@ def main():
     finally:
         os.chmod(os.path.join(root, "s", "closed"), stat.S_IRWXU)
         shutil.rmtree(tmp, ignore_errors=True)
-    if FAILURES:
-        print("%d failure(s)" % len(FAILURES))
-        sys.exit(1)
-    print("ok")
+    finish()
 
 
 main()
