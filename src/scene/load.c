@@ -97,9 +97,7 @@ static double load_kirchhoff_worst(thz_scene *s, const thz_object *obj, double *
     return worst;
 }
 
-/* The band of a channel the table warnings check: the Gaussian's centre +- 2 FWHM, a
- * measured response's span where it is > 0. */
-static void load_channel_band(const thz_channel *ch, double *lo_hz, double *hi_hz)
+void load_channel_band(const thz_channel *ch, double *lo_hz, double *hi_hz)
 {
     channel_support_hz(ch, 2.0 * CHANNEL_FWHM_PER_SIGMA, lo_hz, hi_hz);
     if (*lo_hz < 0.0) /* a wide band: no frequency below 0 (nor a rounding's -6e-17 THz) */

@@ -110,6 +110,11 @@ typedef struct load_range {
 const char *load_number_text(double v, char *out);
 #define LOAD_G(v) load_number_text((v), (char[LOAD_NUMBER_CHARS]){0})
 
+/* The band of a channel that the scene's tables and indices must cover and that the
+ * load checks evaluate: the Gaussian's centre +- 2 FWHM, a measured response's span where
+ * it is > 0; never below 0 Hz. */
+void load_channel_band(const thz_channel *ch, double *lo_hz, double *hi_hz);
+
 /* The root cursor of a document. */
 load_cursor load_root(json_t *value);
 

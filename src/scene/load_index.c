@@ -282,20 +282,13 @@ thz_status load_index_csv(load_ctx *ctx, const load_cursor *file, const csv_tabl
     return st;
 }
 
-/* The band a channel needs the index over, as load.c's table warnings take it: centre
- * +- 2 FWHM for the Gaussian; for a measured response (relative_width 0), where it is > 0. */
-static void index_band_hz(const thz_channel *ch, double *lo_hz, double *hi_hz)
-{
-    channel_support_hz(ch, 2.0 * CHANNEL_FWHM_PER_SIGMA, lo_hz, hi_hz);
-}
-
-/* How index_band_hz chose the band, for messages. */
+/* How load_channel_band chose the band, for messages. */
 static const char *index_band_how(const thz_channel *ch)
 {
     return channel_has_response(ch) ? "where its response is > 0" : "centre +- 2 FWHM";
 }
 
-/* The first channel whose band (index_band_hz) leaves [lo_hz, hi_hz], and how many do;
+/* The first channel whose band (load_channel_band) leaves [lo_hz, hi_hz], and how many do;
  * n_channels when none. */
 static size_t band_outside(const thz_scene *s, double lo_hz, double hi_hz, size_t *count)
 {
@@ -303,7 +296,7 @@ static size_t band_outside(const thz_scene *s, double lo_hz, double hi_hz, size_
     *count = 0;
     for (size_t i = 0; i < s->n_channels; i++) {
         double lo, hi;
-        index_band_hz(&s->channels[i], &lo, &hi);
+        load_channel_band(&s->channels[i], &lo, &hi);
         if (lo < lo_hz || hi > hi_hz) {
             if (first == s->n_channels)
                 first = i;
@@ -323,7 +316,7 @@ static thz_status warn_outside(load_ctx *ctx, const load_cursor *c, const char *
         return THZ_OK;
     const thz_channel *ch = &ctx->scene->channels[first];
     double lo, hi;
-    index_band_hz(ch, &lo, &hi);
+    load_channel_band(ch, &lo, &hi);
     if (!scene_add_warning(ctx->scene,
                            "%s: %s covers %.4g to %.4g THz but channel \"%s\" (band %.4g to "
                            "%.4g THz, %s)%s reaches beyond it; %s",
@@ -334,7 +327,7 @@ static thz_status warn_outside(load_ctx *ctx, const load_cursor *c, const char *
     return THZ_OK;
 }
 
-/* Refuses an index whose n or k, at some channel's centre or band end (index_band_hz,
+/* Refuses an index whose n or k, at some channel's centre or band end (load_channel_band,
  * ends above 0), is not finite or leaves (0, LOAD_MAX_INDEX] and [0, LOAD_MAX_INDEX]: a
  * permittivity model's extreme parameters (eps_s and tau_ps of 1e300, a resonance or a
  * plasma frequency far beyond the band) give what no constant index may. */
@@ -344,7 +337,7 @@ static thz_status index_check_values(load_ctx *ctx, const load_cursor *c, const 
     for (size_t i = 0; i < s->n_channels; i++) {
         const thz_channel *ch = &s->channels[i];
         double f[3] = {ch->center_hz, 0.0, 0.0};
-        index_band_hz(ch, &f[1], &f[2]);
+        load_channel_band(ch, &f[1], &f[2]);
         for (size_t j = 0; j < 3; j++) {
             double n = 0.0, k = 0.0;
             if (!(f[j] > 0.0) || !material_index_at(m->index, f[j], &n, &k))
@@ -395,7 +388,7 @@ thz_status load_index_check_channels(load_ctx *ctx, const load_cursor *c, const 
     for (size_t i = 0; i < s->n_channels; i++) {
         const thz_channel *ch = &s->channels[i];
         double lo, hi;
-        index_band_hz(ch, &lo, &hi);
+        load_channel_band(ch, &lo, &hi);
         if (permittivity_covers(pm, lo, hi))
             continue;
         char ranges[512] = "";

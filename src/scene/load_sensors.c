@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "core/alloc.h"
-#include "physics/channel.h"
 #include "physics/planck.h"
 #include "scene/load.h"
 #include "core/vec3.h"
@@ -89,7 +88,7 @@ static thz_status load_normalize_floor(load_ctx *ctx, const load_cursor *c, doub
     size_t at = 0;
     for (size_t i = 0; i < s->n_channels; i++) {
         double lo, hi;
-        channel_support_hz(&s->channels[i], 2.0 * CHANNEL_FWHM_PER_SIGMA, &lo, &hi);
+        load_channel_band(&s->channels[i], &lo, &hi);
         if (hi > top) {
             top = hi;
             at = i;
