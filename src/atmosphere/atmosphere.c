@@ -12,8 +12,15 @@
 
 /* Tabulation: the grid step starts from the line widths in the band (see
  * model_first_step_hz) and is halved until the cubic interpolation agrees with
- * direct evaluation to TABLE_TOLERANCE (relative) at every grid midpoint. */
+ * direct evaluation to TABLE_TOLERANCE at every grid midpoint: relative to alpha there,
+ * or to TABLE_FLOOR times the band's largest alpha where alpha is smaller. Below that
+ * floor the relative error is not worth chasing: an error of 1e-5 x 1e-9 of the band's
+ * peak changes a transmittance exp(-alpha d) by 1e-14 alpha_peak d relative, and in near
+ * vacuum (1e-10 hPa) the Voigt wings far from a line, there 1e-12 of its peak, carry
+ * the series' own rounding: a step ever smaller never met 1e-5 relative, and the band
+ * was refused after minutes of halving. */
 #define TABLE_TOLERANCE 1e-5
+#define TABLE_FLOOR 1e-9
 #define TABLE_MAX_POINTS ((size_t)4000000)
 #define TABLE_MAX_REFINEMENTS 8
 #define BAND_SIGMAS 6.0
@@ -228,18 +235,23 @@ static void fill_table(const thz_atmosphere *atm, atm_band_table *t, const atm_b
     }
 }
 
-/* Largest relative difference between interpolation and direct evaluation at the
- * midpoints i + 1/2, 1 <= i < n - 2, of the grid; the direct values go to mid[i]. */
+/* Largest difference between interpolation and direct evaluation at the midpoints
+ * i + 1/2, 1 <= i < n - 2, of the grid, relative to the larger of alpha there and
+ * TABLE_FLOOR times the grid's largest |alpha|; the direct values go to mid[i]. */
 static double table_midpoint_error(const thz_atmosphere *atm, const atm_band_table *t, double *mid)
 {
     long n = (long)t->n;
+    double peak = 0.0;
+    for (long i = 0; i < n; i++)
+        peak = fmax(peak, fabs(t->alpha_per_m[i]));
+    const double floor_per_m = fmax(TABLE_FLOOR * peak, 1e-300);
     double worst = 0.0;
 #pragma omp parallel for schedule(dynamic, 64) reduction(max : worst)
     for (long i = 1; i < n - 2; i++) {
         double f = table_freq_hz(t, (double)i + 0.5);
         double direct = atmosphere_alpha_direct_per_m(atm, f);
         mid[i] = direct;
-        double rel = fabs(table_eval(t, f) - direct) / fmax(fabs(direct), 1e-300);
+        double rel = fabs(table_eval(t, f) - direct) / fmax(fabs(direct), floor_per_m);
         if (rel > worst)
             worst = rel;
     }
