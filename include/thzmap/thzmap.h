@@ -58,7 +58,8 @@ typedef enum thz_status {
 } thz_status;
 
 /* An error: the status and a one-line message naming the file and the position
- * (line:column or JSON path) where it applies. */
+ * (line:column or JSON path) where it applies. The message is valid UTF-8 without
+ * control characters: bytes of a refused input that are neither appear as \xNN. */
 typedef struct thz_error {
     thz_status status;
     char message[1024];

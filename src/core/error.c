@@ -6,6 +6,57 @@
 #include <stdio.h>
 #include <string.h>
 
+/* The length of the valid UTF-8 character at s (at most n bytes), or 0 when s does not
+ * start one (a stray continuation byte, an overlong form, a surrogate, beyond U+10FFFF or
+ * cut short). */
+static size_t utf8_char_length(const unsigned char *s, size_t n)
+{
+    unsigned char c = s[0];
+    size_t len = c >= 0xc2 && c <= 0xdf   ? 2
+                 : c >= 0xe0 && c <= 0xef ? 3
+                 : c >= 0xf0 && c <= 0xf4 ? 4
+                                          : 0;
+    if (len == 0 || len > n)
+        return 0;
+    for (size_t i = 1; i < len; i++)
+        if ((s[i] & 0xc0) != 0x80)
+            return 0;
+    if ((c == 0xe0 && s[1] < 0xa0) || (c == 0xed && s[1] >= 0xa0) || (c == 0xf0 && s[1] < 0x90) ||
+        (c == 0xf4 && s[1] >= 0x90))
+        return 0;
+    return len;
+}
+
+/* Rewrites msg (a C string in cap bytes) so that it is one line of valid UTF-8: each
+ * control byte and each byte that starts no valid UTF-8 character becomes the four
+ * characters \xNN. Messages quote what they refused (a CSV cell, a mesh token), and
+ * raw bytes from a file would reach the terminal as control sequences, and the GUI
+ * server's and Python's JSON and str as invalid text. Idempotent (what it writes is
+ * ASCII it leaves alone); cut at a character where the escapes overflow cap. */
+static void error_clean(char *msg, size_t cap)
+{
+    char in[sizeof((thz_error *)0)->message];
+    size_t n = strnlen(msg, cap - 1);
+    if (n >= sizeof in)
+        n = sizeof in - 1;
+    memcpy(in, msg, n);
+    size_t out = 0;
+    for (size_t i = 0; i < n;) {
+        const unsigned char *c = (const unsigned char *)in + i;
+        size_t len = *c >= 0x80 ? utf8_char_length(c, n - i) : (*c < 0x20 || *c == 0x7f ? 0 : 1);
+        size_t need = len ? len : 4;
+        if (out + need > cap - 1)
+            break;
+        if (len)
+            memcpy(msg + out, c, len);
+        else
+            snprintf(msg + out, 5, "\\x%02x", *c);
+        out += need;
+        i += len ? len : 1;
+    }
+    msg[out] = '\0';
+}
+
 thz_status thz_error_set(thz_error *err, thz_status status, const char *fmt, ...)
 {
     if (err) {
@@ -13,6 +64,7 @@ thz_status thz_error_set(thz_error *err, thz_status status, const char *fmt, ...
         va_start(ap, fmt);
         vsnprintf(err->message, sizeof err->message, fmt, ap);
         va_end(ap);
+        error_clean(err->message, sizeof err->message);
         err->status = status;
     }
     return status;
@@ -38,6 +90,7 @@ void thz_error_prefix(thz_error *err, const char *fmt, ...)
     memcpy(joined + n, err->message, rest);
     joined[n + rest] = '\0';
     memcpy(err->message, joined, sizeof joined);
+    error_clean(err->message, sizeof err->message);
 }
 
 thz_status thz_errno_status(int errnum, thz_status otherwise)

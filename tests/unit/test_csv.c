@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "core/csv.h"
+#include "core/error.h"
 
 #define INPUTS THZ_SOURCE_DIR "/tests/inputs/csv/"
 
@@ -106,6 +107,33 @@ static void test_parse_text(void **state)
     assert_int_equal(csv_parse("a\n1,\n", "mem", &t, &err), THZ_ERR_INPUT);
 }
 
+/* A refused cell is quoted in the message; bytes that are no UTF-8 text, and control
+ * bytes (an escape sequence for the terminal), come out as \xNN, valid UTF-8 as it is.
+ * Raw, they reached the terminal, and the GUI server's JSON reply (which jansson refuses
+ * to build from invalid UTF-8) said "out of memory" instead of the message. */
+static void test_bytes_escaped(void **state)
+{
+    (void)state;
+    csv_table t;
+    thz_error err = {0};
+    assert_int_equal(csv_parse("a,b\n1,\xff\xfe\x1b[31m\xe2\x82\n", "mem", &t, &err),
+                     THZ_ERR_INPUT);
+    if (!strstr(err.message, "got '\\xff\\xfe\\x1b[31m\\xe2\\x82'"))
+        fail_msg("message '%s'", err.message);
+    assert_int_equal(csv_parse("a,b\n1,2\xc2\xb5m\n", "mem", &t, &err), THZ_ERR_INPUT);
+    if (!strstr(err.message, "got '2\xc2\xb5m'")) /* 2 micro m */
+        fail_msg("message '%s'", err.message);
+    thz_error long_err = {0}; /* escapes that overflow the message stop at a character */
+    char cell[2000];
+    memset(cell, 0xff, sizeof cell - 1);
+    cell[sizeof cell - 1] = '\0';
+    thz_error_set(&long_err, THZ_ERR_INPUT, "%s", cell);
+    size_t n = strlen(long_err.message);
+    assert_true(n <= sizeof long_err.message - 1 && n >= sizeof long_err.message - 4);
+    assert_int_equal(n % 4, 0);
+    assert_memory_equal(long_err.message + n - 4, "\\xff", 4);
+}
+
 /* What spreadsheets write: a UTF-8 byte-order mark (before the header, or before a comment
  * that precedes it) and fields in double quotes. The mark was part of the first name and
  * the quotes of every name: "the header names no column 'frequency_thz'". */
@@ -138,7 +166,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_good_file),    cmocka_unit_test(test_errors),
         cmocka_unit_test(test_parse_text),   cmocka_unit_test(test_spreadsheet_csv),
-        cmocka_unit_test(test_fifo_refused),
+        cmocka_unit_test(test_fifo_refused), cmocka_unit_test(test_bytes_escaped),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
