@@ -88,6 +88,12 @@ typedef struct load_range {
 #define LOAD_MIN_APERTURE_DIAMETER_M 1e-6
 #define LOAD_MAX_APERTURE_DIAMETER_M 1000.0
 #define LOAD_UNIT ((load_range){0.0, 1.0, false, false})
+/* A channel's frequencies, THz (its centre, a range's ends, where a measured response is
+ * > 0): up to 10 000 THz (30 nm, beyond the ultraviolet; thermal infrared cameras sit at
+ * 10-100 THz). At 1e300 THz the band's top overflowed to inf: the run wrote wavelength
+ * {inf} into the ENVI header and null into summary.json. */
+#define LOAD_MAX_FREQUENCY_THZ 1e4
+#define LOAD_FREQUENCY ((load_range){0.0, LOAD_MAX_FREQUENCY_THZ, true, false})
 /* Temperatures, K, of objects, the background, the normalisation and the receiver: up to
  * 1e6 K, far above any scene a terahertz camera sees. Planck's law and the float outputs
  * overflowed from 4e38 K (truth temperature and brightness temperature inf), 1e50 K

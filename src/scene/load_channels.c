@@ -113,9 +113,9 @@ static thz_status load_channel_range(load_ctx *ctx, const load_cursor *c)
     uint64_t count;
     thz_status st = load_expect_object(ctx, c, keys);
     if (st == THZ_OK)
-        st = load_number(ctx, c, "from_thz", LOAD_POSITIVE, true, 0, &from);
+        st = load_number(ctx, c, "from_thz", LOAD_FREQUENCY, true, 0, &from);
     if (st == THZ_OK)
-        st = load_number(ctx, c, "to_thz", LOAD_POSITIVE, true, 0, &to);
+        st = load_number(ctx, c, "to_thz", LOAD_FREQUENCY, true, 0, &to);
     if (st == THZ_OK)
         st = load_integer(ctx, c, "count", 1, LOAD_MAX_CHANNELS, true, 0, &count);
     if (st == THZ_OK)
@@ -203,7 +203,7 @@ static thz_status load_channel_response(load_ctx *ctx, const load_cursor *e, thz
                          "response_file)",
                          given ? "conflicting responses" : "missing spectral response");
     double thz = 0.0;
-    thz_status st = load_number(ctx, e, "frequency_thz", LOAD_POSITIVE, which == 0, 0.0, &thz);
+    thz_status st = load_number(ctx, e, "frequency_thz", LOAD_FREQUENCY, which == 0, 0.0, &thz);
     if (st != THZ_OK)
         return st;
     if (which == 0) {
@@ -220,9 +220,15 @@ static thz_status load_channel_response(load_ctx *ctx, const load_cursor *e, thz
             st = load_fail(ctx, e, "%s", inner.message);
     }
     spectrum_fini(&table);
-    double lo, hi;
-    if (st == THZ_OK && thz > 0.0) {
+    double lo = 0.0, hi = 0.0;
+    if (st == THZ_OK)
         channel_support_hz(ch, 0.0, &lo, &hi);
+    if (st == THZ_OK && hi > LOAD_MAX_FREQUENCY_THZ * 1e12)
+        st = load_fail(ctx, e,
+                       "expected a response that is 0 above %g THz (the frequencies' limit), it "
+                       "is > 0 up to %s THz",
+                       LOAD_MAX_FREQUENCY_THZ, LOAD_G(hi * 1e-12));
+    if (st == THZ_OK && thz > 0.0) {
         if (!(ch->center_hz >= lo && ch->center_hz <= hi)) {
             load_cursor k = load_key(e, "frequency_thz");
             st = load_fail(ctx, &k,
