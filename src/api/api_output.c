@@ -151,7 +151,12 @@ thz_status thz_output_add_file(thz_output *output, const char *name, const void 
     FILE *f = fopen(path, "wb");
     if (!f)
         return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
-    int ok = size == 0 || fwrite(data, 1, size, f) == size; /* data may be NULL for 0 bytes */
-    ok &= fclose(f) == 0;
-    return ok ? THZ_OK : thz_error_set(err, THZ_ERR_IO, "%s: cannot write", path);
+    int why = 0; /* the first failure's errno: a full disk says so */
+    errno = 0;
+    if (size > 0 && fwrite(data, 1, size, f) != size) /* data may be NULL for 0 bytes */
+        why = errno ? errno : EIO;
+    if (fclose(f) != 0 && !why)
+        why = errno ? errno : EIO;
+    return why ? thz_error_set(err, THZ_ERR_IO, "%s: cannot write: %s", path, strerror(why))
+               : THZ_OK;
 }

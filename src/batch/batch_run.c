@@ -170,12 +170,18 @@ static thz_status batch_write_atomic(const char *outdir, const char *name, const
     if (!f)
         return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", tmp, strerror(errno));
     size_t n = strlen(text);
-    int ok = fwrite(text, 1, n, f) == n && fputc('\n', f) != EOF;
-    ok &= fflush(f) == 0 && fsync(fileno(f)) == 0;
-    ok &= fclose(f) == 0;
-    if (!ok || rename(tmp, path) != 0) {
+    int why = 0; /* the first failure's errno: a full disk says so */
+    errno = 0;
+    if (fwrite(text, 1, n, f) != n || fputc('\n', f) == EOF || fflush(f) != 0 ||
+        fsync(fileno(f)) != 0)
+        why = errno ? errno : EIO;
+    if (fclose(f) != 0 && !why)
+        why = errno ? errno : EIO;
+    if (!why && rename(tmp, path) != 0)
+        why = errno ? errno : EIO;
+    if (why) {
         unlink(tmp);
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot write", path);
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot write: %s", path, strerror(why));
     }
     return THZ_OK;
 }

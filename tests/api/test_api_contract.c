@@ -8,6 +8,8 @@
  * neutral value, never a crash; an image's sensor name outlives the scene. argv: the
  * thzmap binary (unused), the repo. */
 #include <math.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 
 #include "api_test.h"
@@ -249,6 +251,32 @@ static void check_output_order(thz_context *ctx, thz_run *run, const char *dir)
     CHECK(stat(path, &info) == 0, "destroying a committed output removed %s", path);
 }
 
+/* A file that cannot be written whole (a full disk; here a file-size limit with SIGXFSZ
+ * ignored, so that write() fails with EFBIG) is an I/O error that gives the system's
+ * reason, and the uncommitted output leaves nothing at its directory. */
+static void check_output_write_fails(const char *dir)
+{
+    thz_error err = {0};
+    char outdir[4200];
+    snprintf(outdir, sizeof outdir, "%s/too-large", dir);
+    thz_output *out = NULL;
+    REQUIRE_OK(thz_output_open(outdir, &out, &err), &err);
+    static char data[65536];
+    struct rlimit before;
+    CHECK(getrlimit(RLIMIT_FSIZE, &before) == 0, "getrlimit");
+    struct rlimit small = {.rlim_cur = 4096, .rlim_max = before.rlim_max};
+    void (*was)(int) = signal(SIGXFSZ, SIG_IGN);
+    CHECK(setrlimit(RLIMIT_FSIZE, &small) == 0, "setrlimit");
+    thz_status st = thz_output_add_file(out, "big.bin", data, sizeof data, &err);
+    CHECK(setrlimit(RLIMIT_FSIZE, &before) == 0, "setrlimit back");
+    signal(SIGXFSZ, was);
+    CHECK(st == THZ_ERR_IO && strstr(err.message, "big.bin: cannot write: File too large"),
+          "a write past the limit: status %d, '%s'", (int)st, err.message);
+    thz_output_destroy(out);
+    struct stat info;
+    CHECK(stat(outdir, &info) != 0, "%s exists after a failed, uncommitted output", outdir);
+}
+
 /* The material library: indices past the end give a zeroed info and an empty range, not
  * a read beyond its entries. */
 static void check_library_bounds(void)
@@ -484,6 +512,7 @@ int main(int argc, char **argv)
     check_atmosphere_frequencies();
     check_atmosphere_plot();
     check_output_order(ctx, run, dir);
+    check_output_write_fails(dir);
     check_library_bounds();
     check_null_arguments(ctx, a, merged, run);
     thz_run_destroy(run);
