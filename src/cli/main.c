@@ -165,7 +165,14 @@ int main(int argc, char **argv)
             return rc;
         return cli_mpi_finalize(main_run(&commands[i], argc - 1, argv + 1));
     }
-    fprintf(stderr, "thzmap: unknown command '%s'\n\n", argv[1]);
-    print_usage(stderr);
-    return CLI_EXIT_USAGE;
+    /* under mpirun, rank 0 alone says so (every rank printed the usage) */
+    const char *unknown = argv[1];
+    int rc = cli_mpi_init(&argc, &argv);
+    if (rc >= 0)
+        return rc;
+    if (cli_mpi_rank() == 0) {
+        fprintf(stderr, "thzmap: unknown command '%s'\n\n", unknown);
+        print_usage(stderr);
+    }
+    return cli_mpi_finalize(CLI_EXIT_USAGE);
 }

@@ -383,6 +383,15 @@ mpi 2 "$THZMAP" validate "$scene" > "$work/val.out" 2>&1
 rc=$?
 [ $rc = 2 ] || fail "validate under mpirun: exit $rc, not 2"
 grep -q "simulate, render and batch do" "$work/val.out" || fail "validate under mpirun: no message"
+[ "$(grep -c "simulate, render and batch do" "$work/val.out")" = 1 ] ||
+    fail "validate under mpirun: the message more than once"
+# an unknown command: exit 2, the message and the usage once (each rank printed both)
+mpi 2 "$THZMAP" bogus > "$work/bogus.out" 2>&1
+rc=$?
+[ $rc = 2 ] || fail "unknown command under mpirun: exit $rc, not 2"
+[ "$(grep -c "unknown command 'bogus'" "$work/bogus.out")" = 1 ] &&
+    [ "$(grep -c "^usage: thzmap" "$work/bogus.out")" = 1 ] ||
+    { fail "unknown command under mpirun: not printed once"; cat "$work/bogus.out"; }
 
 [ $fails = 0 ] && echo "test_mpi: all passed"
 exit $((fails > 0))
