@@ -1,6 +1,7 @@
 /* A channel's passes (run.h): render passes until the noise target, the time limit or
  * final-gather's photon-map floor; photon-map's photon passes. */
 #include <stdbool.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "core/alloc.h"
@@ -37,6 +38,20 @@ static double run_channel_p95_stderr_k(const run_state *rs, size_t c)
  * c's 95th percentile at or above the target: more gather rays from the same map cannot
  * lower it, so the passes stop there, with a warning that says what would (*st: THZ_OK,
  * or the warning's failure). */
+/* How a warning names channel c: as the progress lines count it, and by its name (the
+ * frequency unless the scene names it), "channel 1/6 (0.200 THz)". */
+typedef struct run_channel_label {
+    char text[160];
+} run_channel_label;
+
+static run_channel_label run_channel_name(const run_state *rs, size_t c)
+{
+    run_channel_label l;
+    snprintf(l.text, sizeof l.text, "channel %zu/%zu (%s)", c + 1, rs->scene->n_channels,
+             rs->scene->channels[c].name);
+    return l;
+}
+
 static bool run_at_map_floor(run_state *rs, size_t c, const render_accum *acc, double target,
                              thz_status *st, thz_error *err)
 {
@@ -47,12 +62,12 @@ static bool run_at_map_floor(run_state *rs, size_t c, const render_accum *acc, d
     bool render = strcmp(rs->command, "render") == 0;
     *st = run_add_warning(
         rs, err,
-        "channel %zu: final-gather's photon map alone leaves %.3g K at the 95th percentile, "
+        "%s: final-gather's photon map alone leaves %.3g K at the 95th percentile, "
         "at or above the noise target of %g K, which more gather rays cannot lower: stopped "
         "after %u passes. A map of more photons lowers it (%s %llu per channel), and the "
         "path integrator has no such floor",
-        c, floor_k, target, rs->passes[c], render ? "the map read has" : "now",
-        (unsigned long long)rs->photons_per_channel);
+        run_channel_name(rs, c).text, floor_k, target, rs->passes[c],
+        render ? "the map read has" : "now", (unsigned long long)rs->photons_per_channel);
     return true;
 }
 
@@ -117,18 +132,18 @@ thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, th
             break;
         if (rs->max_seconds > 0.0 && thz_now_s() - t0 >= rs->max_seconds) {
             st = run_add_warning(rs, err,
-                                 "channel %zu: stopped by the time limit of %g s after %u "
-                                 "passes, at %.3g K (95th percentile of the pixels' standard "
+                                 "%s: stopped by the time limit of %g s after %u "
+                                 "pass%s, at %.3g K (95th percentile of the pixels' standard "
                                  "error) above the noise target of %g K",
-                                 c, rs->max_seconds, pass + 1, run_channel_p95_stderr_k(rs, c),
-                                 target);
+                                 run_channel_name(rs, c).text, rs->max_seconds, pass + 1,
+                                 pass == 0 ? "" : "es", run_channel_p95_stderr_k(rs, c), target);
             break;
         }
         if (pass + 1 >= RUN_MAX_PASSES) {
             st = run_add_warning(rs, err,
-                                 "channel %zu: stopped after %u passes above the noise target "
+                                 "%s: stopped after %u passes above the noise target "
                                  "of %g K",
-                                 c, (unsigned)RUN_MAX_PASSES, target);
+                                 run_channel_name(rs, c).text, (unsigned)RUN_MAX_PASSES, target);
             break;
         }
     }
@@ -205,27 +220,29 @@ thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_
             break;
         if (rs->max_seconds > 0.0 && thz_now_s() - t_start >= rs->max_seconds) {
             st = run_add_warning(rs, err,
-                                 "channel %zu: stopped by the time limit of %g s after %zu "
-                                 "photon passes, at %.3g K (95th percentile of the pixels' "
+                                 "%s: stopped by the time limit of %g s after %zu "
+                                 "photon pass%s, at %.3g K (95th percentile of the pixels' "
                                  "standard error) above the noise target of %g K",
-                                 c, rs->max_seconds, n, run_channel_p95_stderr_k(rs, c), target);
+                                 run_channel_name(rs, c).text, rs->max_seconds, n,
+                                 n == 1 ? "" : "es", run_channel_p95_stderr_k(rs, c), target);
             break;
         }
         /* the passes' maps and the next merge: twice the records, and their indexes */
         double next = 2.2 * (double)photon_map_bytes(map) * (double)(n + 1) / (double)n;
         if (limit > 0.0 && next > limit) { /* 0: the machine's memory is unknown */
             st = run_add_warning(rs, err,
-                                 "channel %zu: stopped after %zu photon passes (%llu photons) "
+                                 "%s: stopped after %zu photon passes (%llu photons) "
                                  "above the noise target of %g K: the next would need %.2f GiB "
                                  "of memory",
-                                 c, n, (unsigned long long)(n * k), target, next / 1073741824.0);
+                                 run_channel_name(rs, c).text, n, (unsigned long long)(n * k),
+                                 target, next / 1073741824.0);
             break;
         }
         if (n >= RUN_MAX_PASSES) {
             st = run_add_warning(rs, err,
-                                 "channel %zu: stopped after %u passes above the noise target "
+                                 "%s: stopped after %u passes above the noise target "
                                  "of %g K",
-                                 c, (unsigned)RUN_MAX_PASSES, target);
+                                 run_channel_name(rs, c).text, (unsigned)RUN_MAX_PASSES, target);
             break;
         }
     }

@@ -212,6 +212,9 @@ grep -q '"photons_per_channel": 0,' "$work/upr/summary.json" \
     --max-seconds 0.2 --quiet 2> "$work/ms.err" || fail "simulate --max-seconds exited $?"
 grep -q "stopped by the time limit of 0.2 s after" "$work/ms.err" ||
     fail "a run stopped by its time limit above the target: no warning: $(cat "$work/ms.err")"
+# ... naming the channel as the progress lines count it (it said "channel 0"), and its name
+grep -q "warning: channel 1/[0-9]* ([^)]* THz): stopped" "$work/ms.err" ||
+    fail "the time limit's warning does not name the channel 1/N (name): $(head -n 1 "$work/ms.err")"
 grep -q "stopped by the time limit" "$work/ms/summary.json" ||
     fail "a run stopped by its time limit: summary.json has no warning"
 # summary.json holds the seed exactly: one that JSON's integers cannot is refused
