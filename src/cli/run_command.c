@@ -375,10 +375,16 @@ int cli_run_command(int argc, char **argv, bool render)
             thz_channel_info ch;
             if (result.worst_object >= 0 && result.worst_p95_stderr_k > 0.0 &&
                 thz_scene_object(scene, (size_t)result.worst_object, &obj) == THZ_OK &&
-                thz_scene_channel(scene, result.worst_object_channel, &ch) == THZ_OK)
+                thz_scene_channel(scene, result.worst_object_channel, &ch) == THZ_OK) {
+                /* a channel named by its frequency (the default) is not named twice */
+                char freq[64] = "";
+                size_t n = strlen(ch.name);
+                if (n < 4 || strcmp(ch.name + n - 4, " THz") != 0)
+                    snprintf(freq, sizeof freq, " (%.4g THz)", ch.frequency_thz);
                 printf("thzmap %s: noisiest object: '%s', 95th percentile standard error "
-                       "%.3g K at %s\n",
-                       cmd, obj.name, result.worst_object_p95_stderr_k, ch.name);
+                       "%.3g K at %s%s\n",
+                       cmd, obj.name, result.worst_object_p95_stderr_k, ch.name, freq);
+            }
         }
     }
     if (shared && rc != CLI_EXIT_OK) /* the other ranks may be waiting for rank 0 */

@@ -81,6 +81,15 @@ grep -q "channel 2/2, photons: 20000 photons in .* s (.* photons/s)" "$work/p.er
     || fail "no photon progress line: $(cat "$work/p.err")"
 grep -q "channel 1/2, render: " "$work/p.err" || fail "no render progress line"
 grep -q "results in $work/p" "$work/p.out" || fail "no closing line: $(cat "$work/p.out")"
+# the noisiest object's channel: by its name, with the frequency where the name is not one
+grep -q "noisiest object: '.*', 95th percentile standard error .* K at 0\.[0-9]* THz$" \
+    "$work/p.out" || fail "noisiest object's channel: $(tail -n 1 "$work/p.out")"
+sed 's/{"frequency_thz": 0.35,/{"name": "low", "frequency_thz": 0.35,/; s/{"frequency_thz": 0.9,/{"name": "high", "frequency_thz": 0.9,/' \
+    "$work/scene.json" > "$work/named.json"
+"$THZMAP" simulate "$work/named.json" -o "$work/pn" --photons 20000 > "$work/pn.out" 2>/dev/null ||
+    fail "simulate with named channels exited $?"
+grep -q "K at \(low (0.35 THz)\|high (0.9 THz)\)$" "$work/pn.out" ||
+    fail "a named channel is not given its frequency: $(tail -n 1 "$work/pn.out")"
 "$THZMAP" simulate "$work/scene.json" -o "$work/q" --photons 20000 --quiet > "$work/q.out" 2> "$work/q.err"
 [ -s "$work/q.err" ] && fail "--quiet printed to stderr: $(cat "$work/q.err")"
 [ -s "$work/q.out" ] && fail "--quiet printed to stdout: $(cat "$work/q.out")"
