@@ -268,7 +268,9 @@ static thz_status batch_write_json(const batch_state *b, thz_error *err)
     json_object_set_new(root, "movies_skipped",
                         b->movies_skipped[0] ? json_string(b->movies_skipped) : json_null());
     json_object_set_new(root, "timings_s", t);
-    char *text = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
+    /* 12 digits, as summary.json: its reals are times and statistics (17 printed float
+     * noise such as 293.0049133300781 K) */
+    char *text = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(12));
     json_decref(root);
     if (!text)
         return thz_error_set(err, THZ_ERR_NOMEM, "batch.json: out of memory");
@@ -297,6 +299,8 @@ static char *batch_frame_json(const thz_sequence *seq, size_t f, long reused_fro
     json_object_set_new(root, "scene_file", json_string(seq->scene_paths[k]));
     json_object_set_new(root, "scene_dir", json_string(seq->scene_dirs[k]));
     json_object_set_new(root, "scene", json_loads(seq->frame_json[f], 0, NULL));
+    /* 17 digits: the scene must read back to the same doubles, to rerun the frame to the
+     * same bytes (0.3 prints as 0.29999999999999999, the same double) */
     char *text = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
     json_decref(root);
     return text;
