@@ -100,16 +100,15 @@ static int serve_on_progress(void *user, const thz_progress *p)
     share /= (double)(p->n_channels ? p->n_channels : 1);
     if (strcmp(p->stage, "output") == 0)
         share = 1.0;
-    /* with the unit of the stage's count: photons, rows; the output has no channel */
+    /* with the unit of the stage's count (rows; the photons stage's is its name); the output
+     * has no channel */
     char message[256];
     if (strcmp(p->stage, "output") == 0)
         snprintf(message, sizeof message, "writing the results");
     else
         snprintf(message, sizeof message, "channel %zu/%zu, %s %llu/%llu%s", p->channel + 1,
                  p->n_channels, p->stage, (unsigned long long)p->done, (unsigned long long)p->total,
-                 photons                           ? " photons"
-                 : strcmp(p->stage, "render") == 0 ? " rows"
-                                                   : "");
+                 strcmp(p->stage, "render") == 0 ? " rows" : ""); /* "photons 2000/8000" */
     return serve_job_report(c, share, message);
 }
 

@@ -348,7 +348,7 @@ def test_runs(srv, root):
     check(fractions == sorted(fractions) and fractions[-1] == 1.0, "progress: %r" % fractions)
     # each count with its unit, and the output without a stale channel ("output 0/1")
     counts = [d["message"] for d in progress if d["message"].startswith("channel ")]
-    check(counts and all(re.search(r" [0-9]+/[0-9]+ (photons|rows)$", m) for m in counts),
+    check(counts and all(re.search(r"(photons [0-9]+/[0-9]+| [0-9]+/[0-9]+ rows)$", m) for m in counts),
           "progress counts without their unit: %r" % counts[-3:])
     check(not any("output" in d["message"] for d in progress),
           "output progress in a channel's terms: %r" % [d["message"] for d in progress][-3:])
