@@ -260,6 +260,34 @@ static enum MHD_Result serve_route_request(serve_request *r)
     return serve_static(r);
 }
 
+/* Whether text is valid UTF-8 (jansson's own test: it refuses other strings). */
+static bool serve_is_utf8(const char *text)
+{
+    json_t *t = json_string(text);
+    json_decref(t);
+    return t != NULL;
+}
+
+void serve_text_fit(char *text)
+{
+    size_t n = strlen(text);
+    json_t *t = NULL;
+    while (n > 0 && !(t = json_stringn(text, n)))
+        n--;
+    json_decref(t);
+    text[n] = '\0';
+}
+
+/* MHD's iterator over the query: counts the arguments that are not UTF-8. */
+static enum MHD_Result serve_count_bad_arg(void *cls, enum MHD_ValueKind kind, const char *key,
+                                           const char *value)
+{
+    (void)kind;
+    if (!serve_is_utf8(key) || (value && !serve_is_utf8(value)))
+        ++*(int *)cls;
+    return MHD_YES;
+}
+
 /* MHD's access handler: called first with the headers (check the token and the size),
  * then with each piece of the body, then once more to answer. */
 static enum MHD_Result serve_access(void *cls, struct MHD_Connection *conn, const char *url,
@@ -297,6 +325,15 @@ static enum MHD_Result serve_access(void *cls, struct MHD_Connection *conn, cons
             r->answered = true;
             return serve_reply_error(r, 413, "request body larger than %u bytes",
                                      SERVE_MAX_BODY_BYTES);
+        }
+        /* the answers quote the URL and the query (paths, names), as JSON: jansson refuses
+         * other bytes than UTF-8, and they became 500 "out of memory" (a PUT had written
+         * its file by then) */
+        int bad = 0;
+        MHD_get_connection_values(conn, MHD_GET_ARGUMENT_KIND, serve_count_bad_arg, &bad);
+        if (bad || !serve_is_utf8(url)) {
+            r->answered = true;
+            return serve_reply_error(r, 400, "the URL or its query is not UTF-8 text");
         }
         return MHD_YES;
     }

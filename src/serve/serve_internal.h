@@ -72,6 +72,9 @@ enum MHD_Result serve_reply(serve_request *r, unsigned status, const char *type,
                             size_t size);
 /* Takes a reference to `json` (steals it). */
 enum MHD_Result serve_reply_json(serve_request *r, unsigned status, json_t *json);
+/* Cuts text at its end until it is valid UTF-8: a message cut to its buffer's size may end
+ * inside a character, and jansson refuses such a string. */
+void serve_text_fit(char *text);
 enum MHD_Result serve_reply_error(serve_request *r, unsigned status, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 /* 400 with "path": the JSON path of the problem in the request body. */

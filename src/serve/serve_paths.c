@@ -290,8 +290,12 @@ enum MHD_Result serve_file_get(serve_request *r)
 /* Writes data to path through a temporary file in the same directory, renamed over it. */
 static int serve_write_atomic(const char *path, const char *data, size_t size)
 {
+    /* in the same directory, with a short name of its own: "<name>.tmp-XXXXXX" passed the
+     * 255 bytes a name may have for names from 245 bytes on */
     char tmp[PATH_MAX + 32];
-    snprintf(tmp, sizeof tmp, "%s.tmp-XXXXXX", path);
+    const char *slash = strrchr(path, '/');
+    int dir_len = slash ? (int)(slash - path + 1) : 0;
+    snprintf(tmp, sizeof tmp, "%.*s.thzmap-put-XXXXXX", dir_len, path);
     int fd = mkstemp(tmp);
     if (fd < 0)
         return errno;

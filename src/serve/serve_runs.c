@@ -31,12 +31,20 @@ bool serve_job_finished(const serve_job *j)
 static json_t *serve_job_json(const serve_job *j)
 {
     double end = serve_job_finished(j) ? j->t_end : serve_now_s();
+    /* a message cut to its size may end inside a character (an out path of accented
+     * names): jansson refused it, and the job vanished from the list while its page polled
+     * it for ever */
+    char message[sizeof j->message], error[sizeof j->error];
+    snprintf(message, sizeof message, "%s", j->message);
+    snprintf(error, sizeof error, "%s", j->error);
+    serve_text_fit(message);
+    serve_text_fit(error);
     json_t *o = json_pack("{s:i, s:s, s:s, s:s, s:s, s:f, s:s, s:f}", "id", j->id, "command",
                           serve_command_names[j->command], "scene", j->scene, "out", j->out,
                           "state", serve_state_names[j->state], "progress", j->progress, "message",
-                          j->message, "seconds", j->t_start > 0.0 ? end - j->t_start : 0.0);
+                          message, "seconds", j->t_start > 0.0 ? end - j->t_start : 0.0);
     if (o)
-        json_object_set_new(o, "error", j->error[0] ? json_string(j->error) : json_null());
+        json_object_set_new(o, "error", error[0] ? json_string(error) : json_null());
     return o;
 }
 

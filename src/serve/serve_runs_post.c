@@ -131,7 +131,11 @@ static bool serve_parse_option(serve_request *r, serve_job *j, const char *key, 
     uint64_t u = 0;
     bool scene = j->command == CMD_SIMULATE || j->command == CMD_RENDER;
     if (strcmp(key, "threads") == 0) {
-        if (!serve_opt_whole(r, v, path, 0, 4096, &u, ret))
+        /* at most the machine's processors: more gain nothing, and where the system
+         * refuses the threads OpenMP ends the process, and with it the server's every job
+         * (1024 under `ulimit -u 512` did) */
+        long procs = sysconf(_SC_NPROCESSORS_ONLN);
+        if (!serve_opt_whole(r, v, path, 0, procs > 0 ? (uint64_t)procs : 1, &u, ret))
             return false;
         j->threads = (int)u;
         return true;

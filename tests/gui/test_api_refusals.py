@@ -118,6 +118,30 @@ def test_lengths(srv):
               "%s of %d bytes: %r" % (key, len(value), err))
 
 
+def test_text_and_limits(srv, root):
+    """Bytes that are not UTF-8 in the URL or query are refused with 400 (the answers, which
+    quote them, were 500 "out of memory": jansson refuses such strings; a PUT had written
+    its file first); a run asks for at most the machine's processors (more made OpenMP end
+    the server where the system refused the threads); a PUT of a 255-byte name works (its
+    temporary name passed the limit on names)."""
+    for method, url in (("GET", "/api/file?path=missing%FF.json"), ("GET", "/api/nope%FF"),
+                        ("GET", "/api/files?dir=nodir%C3"), ("PUT", "/api/file?path=s/n%FF.json")):
+        st, _, data = srv.request(method, url, body="{}" if method == "PUT" else None)
+        check(st == 400 and b"not UTF-8 text" in data, "%s %s: %s %r" % (method, url, st, data))
+    check(not [n for n in os.listdir(os.path.join(root, "s").encode()) if b"\xff" in n],
+          "a refused PUT wrote its file")
+    procs = os.cpu_count() or 1
+    err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/path.json",
+                                               "out": "o", "options": {"threads": procs + 1}},
+                   status=400)
+    check(err and err.get("path") == "$.options.threads" and
+          ("from 0 to %d" % procs) in err["error"], "threads %d: %r" % (procs + 1, err))
+    name = "s/" + "n" * 250 + ".json"
+    st, _, data = srv.request("PUT", "/api/file?path=" + name, body="{}")
+    check(st == 200, "PUT a 255-byte name: %s %r" % (st, data[:200]))
+    os.remove(os.path.join(root, name))
+
+
 def test_integrators(srv):
     """The integrator is the option's, else the scene's, else path (the default)."""
     for scene, options, key in (
@@ -163,6 +187,23 @@ def test_events(srv, root):
     check(reals and max(digits(x) for x in reals) <= 9,
           "reals of more than 9 digits: %r" % [x for x in reals if digits(x) > 9][:5])
     check(os.path.exists(os.path.join(root, "out", "path", "summary.json")), "no output written")
+    # an out path of two-byte characters whose "done; results in ..." message is cut inside
+    # one: the job stays in the list, its answer 200 (it was 500 and gone from the list)
+    out = "o/x" + "\u00e9" * 100 + "/" + "\u00e9" * 20
+    run = srv.json("POST", "/api/runs", body={"command": "render", "scene": "s/path.json",
+                                               "out": out}, status=202)
+    job = None
+    for _ in range(600):
+        st, _, data = srv.request("GET", "/api/runs/%d" % run["id"])
+        job = json.loads(data) if st == 200 else None
+        if not job or job["state"] not in ("queued", "running"):
+            break
+        time.sleep(0.1)
+    check(job and job["state"] == "done" and job["message"].startswith("done; results in o/x"),
+          "a run into %d bytes of accented names: %r" % (len(out.encode()), job))
+    st, _, data = srv.request("GET", "/api/runs")
+    check(st == 200 and run["id"] in [j["id"] for j in json.loads(data)],
+          "the run is missing from the list: %s %r" % (st, data[:200]))
 
 
 def main():
@@ -176,7 +217,8 @@ def main():
         srv = Server(BINARY, root, env, prefix=NO_DAC)
         try:
             tests = [("files", lambda: test_files(srv, root)), ("lengths", lambda: test_lengths(srv)),
-                     ("integrators", lambda: test_integrators(srv))]
+                     ("integrators", lambda: test_integrators(srv)),
+                     ("text", lambda: test_text_and_limits(srv, root))]
             if not REQUESTS_ONLY:
                 tests.append(("events", lambda: test_events(srv, root)))
             for name, fn in tests:
