@@ -21,6 +21,7 @@
 #define SERVE_MAX_BODY_BYTES (4u << 20)  /* request bodies; larger: 413 */
 #define SERVE_MAX_FILE_BYTES (64u << 20) /* the page's own files */
 #define SERVE_MAX_JOBS 64                /* queued and running jobs; more: 409 */
+#define SERVE_KEPT_FINISHED 256          /* finished jobs kept (the oldest go): 14 KB each */
 #define SERVE_CUBE_CACHE 8               /* cubes kept open */
 
 typedef struct serve_job serve_job;

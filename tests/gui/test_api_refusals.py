@@ -204,6 +204,31 @@ def test_events(srv, root):
     st, _, data = srv.request("GET", "/api/runs")
     check(st == 200 and run["id"] in [j["id"] for j in json.loads(data)],
           "the run is missing from the list: %s %r" % (st, data[:200]))
+    # finished jobs beyond the last 256 go (every job stayed, 14 KB each, until the stop)
+    with open(os.path.join(root, "s", "broken.json"), "w") as f:
+        f.write("{")
+    ids = []
+    while len(ids) < 270:
+        st, _, data = srv.request("POST", "/api/runs", body=json.dumps(
+            {"command": "simulate", "scene": "s/broken.json", "out": "o"}))
+        if st == 202:
+            ids.append(json.loads(data)["id"])
+        else:
+            check(st == 409, "POST a failing run: %s %r" % (st, data[:200]))
+            time.sleep(0.05)
+    for _ in range(600):
+        st, _, data = srv.request("GET", "/api/runs/%d" % ids[-1])
+        if st == 200 and json.loads(data)["state"] not in ("queued", "running"):
+            break
+        time.sleep(0.05)
+    srv.request("POST", "/api/runs", body=json.dumps(
+        {"command": "simulate", "scene": "s/broken.json", "out": "o"}))  # prunes
+    st, _, data = srv.request("GET", "/api/runs")
+    listed = [j["id"] for j in json.loads(data)] if st == 200 else []
+    check(len(listed) <= 257 and ids[-1] in listed and run["id"] not in listed,
+          "after 270 more jobs: %d listed, the first kept: %s" % (len(listed), listed[:1]))
+    st, _, _ = srv.request("GET", "/api/runs/%d" % run["id"])
+    check(st == 404, "a job pruned from the list: %s, expected 404" % st)
 
 
 def main():
