@@ -22,6 +22,7 @@
 #define SERVE_MAX_FILE_BYTES (64u << 20) /* the page's own files */
 #define SERVE_MAX_JOBS 64                /* queued and running jobs; more: 409 */
 #define SERVE_KEPT_FINISHED 256          /* finished jobs kept (the oldest go): 14 KB each */
+#define SERVE_PREVIEW_TRIANGLES 300000   /* /api/validate's meshes: the rest "mesh": null */
 #define SERVE_CUBE_CACHE 8               /* cubes kept open */
 
 typedef struct serve_job serve_job;

@@ -223,6 +223,18 @@ def test_validate(srv, scene):
         d = atm["sensors"][0]["distance_m"]
         check(abs(atm["sensors"][0]["transmittance"][0] - math.exp(-0.05 * d)) < 1e-9 and
               atm["channels"][0]["alpha_per_m"] == 0.05, "atmosphere: %r" % atm)
+    # the meshes of an answer stop at 300 000 triangles (a cylinder of 1 000 000 segments, a
+    # 1.7 KB body, made a 1 GB server and a 170 MB answer): later objects' are null
+    big = json.loads(text)
+    big["objects"][1]["shape"]["segments"] = 50000  # 200 000 triangles with the caps
+    big["objects"].append(json.loads(json.dumps(big["objects"][1])))
+    big["objects"][-1]["name"] = "target-2"
+    res = srv.json("POST", "/api/validate", body={"path": "s/scene.json", "text": json.dumps(big)})
+    objs = res and res["scene"] and {o["name"]: o for o in res["scene"]["objects"]}
+    check(objs and objs["target"]["mesh"] and objs["target-2"]["mesh"] is None and
+          objs["target-2"]["triangles"] == objs["target"]["triangles"] > 300000 // 2,
+          "a scene of two large meshes: %r" % (objs and {n: (o["triangles"], o["mesh"] is None)
+                                                          for n, o in objs.items()}))
     bad = json.loads(text)
     bad["objects"][1]["temperature_k"] = -5
     res = srv.json("POST", "/api/validate", body={"path": "s/scene.json", "text": json.dumps(bad)})
