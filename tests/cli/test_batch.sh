@@ -279,6 +279,9 @@ echo '{"format": "thzmap-sequence/1", "scenes": ["scene.json", "sub/b.json"], "f
     fail "list of scenes: exit $?: $(cat "$work/L.err")"
 grep -Eq '^thzmap batch: [1-4]0 % of the batch done \(in frame 1/2\)' "$work/L.err" ||
     fail "no progress within frame 1 of 2: $(cat "$work/L.err")"
+# frames of a fraction of a second: an ETA below 1 s reads "< 1 s", never "0 s" while
+# frames remain
+grep -q 'ETA 0 s' "$work/L.err" && fail "an ETA of '0 s' while frames remained: $(cat "$work/L.err")"
 "$THZMAP" simulate "$work/sub/b.json" -o "$work/SB" --threads 1 --quiet >/dev/null || fail "simulate of sub/b.json"
 same_files "$work/SB" "$work/L/frame-00001" "list frame 1 against simulate's"
 "$PY" - "$work/L" <<'PY' || fail "list of scenes: batch.json, frame.json"
