@@ -157,6 +157,13 @@ def test_classify_noise_free_is_exact_and_noise_lowers_accuracy(distinct_run):
     assert all(not math.isnan(a) for a in exact.auc)
     noisy = thzmap.classify(run_dir, "cam", method="lda", netd_k=8.0)
     assert noisy.accuracy < exact.accuracy
+    # a class's accuracy is over all its pixels (training ones too): its confusion row
+    rows = noisy.confusion.sum(axis=1)
+    assert noisy.class_accuracy == pytest.approx(list(np.diag(noisy.confusion) / rows), rel=1e-12)
+    assert noisy.held_out_pixels < int(rows.sum())
+    doc = " ".join(thzmap.Classification.__doc__.split())
+    assert "class_accuracy (per class, over all its pixels" in doc
+    assert "auc (per class, one against the rest on the held-out pixels)" in doc
 
 
 def test_classify_errors(distinct_run, tmp_path):
