@@ -66,6 +66,9 @@ def test_bands_equals_the_command(tmp_path, thzmap_binary):
     assert {"bands.json", "bands-score.png", "bands-spectra.png"} <= \
         set(os.listdir(tmp_path / "py"))
     assert "BandSelection" in repr(sel)
+    # each width named as one: "0.4 THz (relative width 0.01)", not "0.4 THz (0.01)"
+    for f, w in zip(sel.selected_thz, sel.selected_relative_width):
+        assert f"{f:.4g} THz (relative width {w:.3g})" in repr(sel), repr(sel)
 
 
 def test_bands_takes_a_loaded_scene_and_targets():
