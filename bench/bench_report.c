@@ -53,14 +53,14 @@ json_t *bench_report_photons(const bench_series *sp, size_t channel, double load
     printf("\n3. Scaling in photons (channel %zu of the paper's case; load average %.2f): each "
            "point the median of its runs; each run between two reference runs of %llu photons\n",
            channel + 1, load, (unsigned long long)sp->ref_photons);
-    printf("  %12s %12s %5s %10s %10s %10s %10s %12s %12s %10s\n", "photons", "stored", "runs",
-           "phase s", "ns/photon", "trace ns", "index ns", "CPU ns/ph.", "fastest CPU",
-           "CPU vs ref");
+    printf("  %12s %12s %5s %10s %10s %16s %16s %14s %22s %10s\n", "photons", "stored", "runs",
+           "phase s", "ns/photon", "trace ns/photon", "index ns/photon", "CPU ns/photon",
+           "fastest CPU ns/photon", "CPU vs ref");
     json_t *jsp = json_array();
     for (int k = 0; k < sp->n; k++) {
         const bench_point *p = &sp->p[k];
         double ns = 1e9 * bench_ratio(p->s_photons, (double)p->photons);
-        printf("  %12llu %12llu %5d %10.3f %10.1f %10.1f %10.1f %12.1f %12.1f %10.3f\n",
+        printf("  %12llu %12llu %5d %10.3f %10.1f %16.1f %16.1f %14.1f %22.1f %10.3f\n",
                (unsigned long long)p->photons, (unsigned long long)p->stored, p->runs, p->s_photons,
                ns, 1e9 * bench_ratio(p->s_tracing, (double)p->photons),
                1e9 * bench_ratio(p->s_index, (double)p->photons),
@@ -166,7 +166,7 @@ json_t *bench_report_speedups(const char *const *names, const bench_speedup *r, 
            "paper's case; one map built once per integrator; alternating pairs of runs, the "
            "speed-up the median of their ratios; load average %.2f)\n",
            threads, channel + 1, load);
-    printf("  %-13s %11s %9s %7s %8s %9s %6s %10s %10s %9s %11s %8s %13s\n", "integrator",
+    printf("  %-13s %11s %9s %7s %8s %9s %6s %10s %10s %9s %13s %8s %13s\n", "integrator",
            "map photons", "est./pass", "passes", "renders", "samples", "pairs", "1 thread s",
            "all s", "speed-up", "pair range", "fastest", "CPU s 1 / all");
     json_t *arr = json_array();
@@ -176,12 +176,13 @@ json_t *bench_report_speedups(const char *const *names, const bench_speedup *r, 
         bench_pairs_range(&p->runs, &lo, &hi);
         double s1, sa, c1, ca;
         bench_pairs_median_pair(&p->runs, &s1, &sa, &c1, &ca);
-        printf(
-            "  %-13s %11llu %9u %7u %8u %9llu %6d %10.3f %10.3f %9.2f %5.2f-%-5.2f %8.2f %6.2f / "
-            "%5.2f\n",
-            names[i], (unsigned long long)p->photons, (unsigned)p->estimates, (unsigned)p->passes,
-            (unsigned)p->renders, (unsigned long long)p->samples, p->runs.n, s1, sa, sp, lo, hi,
-            bench_pairs_speedup_fastest(&p->runs), c1, ca);
+        char range[48];
+        snprintf(range, sizeof range, "%.2f-%.2f x", lo, hi);
+        printf("  %-13s %11llu %9u %7u %8u %9llu %6d %10.3f %10.3f %7.2f x %13s %6.2f x %6.2f / "
+               "%5.2f\n",
+               names[i], (unsigned long long)p->photons, (unsigned)p->estimates,
+               (unsigned)p->passes, (unsigned)p->renders, (unsigned long long)p->samples, p->runs.n,
+               s1, sa, sp, range, bench_pairs_speedup_fastest(&p->runs), c1, ca);
         json_t *o = json_object();
         json_object_set_new(o, "integrator", json_string(names[i]));
         json_object_set_new(o, "map_photons", json_integer((json_int_t)p->photons));
@@ -288,9 +289,12 @@ json_t *bench_report_converge(const char *integrator, const bench_converge *cv, 
                                 cv->refined[w] ? bench_real(cv->first_rms_k[w]) : json_null());
             double a_k2, floor2, need;
             if (bench_converge_floor(cv, w, target_k, &a_k2, &floor2, &need)) {
-                printf("    through the J=%u run and this one, RMS^2 = %.4g K^2 / J + floor^2 "
-                       "with a floor %s%.4f K (what more estimates do not lower)",
-                       (unsigned)b->estimates, a_k2, floor2 < 0.0 ? "-" : "", sqrt(fabs(floor2)));
+                printf("    through the J=%u run and this one, RMS^2 = %.4g K^2 / J + floor^2 ",
+                       (unsigned)b->estimates, a_k2);
+                if (floor2 < 0.0) /* no floor is a negative K: the two runs' noise, not one */
+                    printf("with no floor (the fit's floor^2 < 0)");
+                else
+                    printf("with a floor %.4f K (what more estimates do not lower)", sqrt(floor2));
                 if (need > 0.0)
                     printf(": %g K needs J = %.0f\n", target_k, need);
                 else

@@ -393,7 +393,8 @@ int main(int argc, char **argv)
            "(load average %.2f)\n",
            (unsigned long long)probe.rays, bench_ratio((double)probe.hits, (double)probe.rays),
            probe.seconds, bench_ratio((double)probe.rays, probe.seconds), load_probe);
-    printf("  photon phase / raw trace = %.2f (tracing alone: %.2f)\n", ratio_phase, ratio_trace);
+    printf("  photon phase / raw trace = %.2f x (tracing alone: %.2f x)\n", ratio_phase,
+           ratio_trace);
     json_t *jt = json_object();
     json_object_set_new(jt, "rays", json_integer((json_int_t)probe.rays));
     json_object_set_new(jt, "hit_fraction",

@@ -150,7 +150,7 @@ class BandSelection:
             raise from_status(status, _lib.text(err.message))
 
     def __repr__(self):
-        chosen = ", ".join(f"{f:.4g} THz ({w:.3g})"
+        chosen = ", ".join(f"{f:.4g} THz (relative width {w:.3g})"
                            for f, w in zip(self.selected_thz, self.selected_relative_width))
         return f"<thzmap.BandSelection: {chosen}; worst-pair JM {self.score:.4f}>"
 

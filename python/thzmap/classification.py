@@ -76,7 +76,8 @@ class Classification:
     """The result of classify(). accuracy (over every pixel that sees an object, 0..1),
     held_out_accuracy (over the pixels that did not train; NaN: none), classes (names,
     in the order of the confusion matrix), class_objects (their object indices),
-    class_accuracy and auc (per class, on the held-out pixels), confusion (numpy uint64
+    class_accuracy (per class, over all its pixels: the confusion matrix's row), auc (per
+    class, one against the rest on the held-out pixels), confusion (numpy uint64
     (classes, classes): rows the truth, columns the assigned class; it sums to
     `pixels`), class_map (numpy int32 (rows, columns): the object index of each pixel's
     class, -1 where nothing is hit), report (the dict of classification.json).

@@ -228,8 +228,8 @@ class Image:
     """One sensor's rendered image. Cubes are numpy float32 arrays shaped (rows, columns,
     channels): radiance (W m^-2 sr^-1 Hz^-1), radiance_stderr (None when not estimated),
     power (W), brightness_temperature (K), normalized (1). Maps shaped (rows, columns):
-    temperature (K, 0 where nothing is hit), distance (m, 0: none), object_id (index of
-    the object seen as float, -1: none); visual (rows, columns, 3) rgb 0..1;
+    temperature (K, -1 where nothing is hit), distance (m, -1: none), object_id (index
+    of the object seen as float, -1: none), as in the ENVI files; visual (rows, columns, 3) rgb 0..1;
     measured_radiance and measured_brightness_temperature (the sensor's PSF and noise
     applied; None when the sensor has neither) shaped like the cubes. Row 0 is the
     top of the picture. The arrays are read-only views of the library's buffers."""

@@ -3,6 +3,7 @@
 
 #include <jansson.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -159,6 +160,19 @@ char *bands_json(const bands_report *rep, thz_error *err)
     return text;
 }
 
+/* Appends to title (size bytes, *used of them taken); stops quietly when it is full. */
+__attribute__((format(printf, 4, 5))) static void
+bands_title_add(char *title, size_t size, size_t *used, const char *fmt, ...)
+{
+    if (*used >= size)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(title + *used, size - *used, fmt, ap);
+    va_end(ap);
+    *used = n < 0 ? size : *used + (size_t)n;
+}
+
 static thz_status join(char *path, const char *dir, const char *name, thz_error *err)
 {
     return thz_path_join(path, THZ_PATH_MAX, dir, name, err);
@@ -208,17 +222,32 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
     snprintf(title, sizeof title, "%s: best set of K channels (%s)", rep->scene_name, r->search);
     st = join(path, dir, "bands-score.png", err);
     if (st == THZ_OK)
-        st = plot_lines(path, K, x, 1, score_name, y, title, "channels K",
-                        "Jeffries-Matusita distance (0..2)", err);
-    int used = snprintf(title, sizeof title, "%s: mean Tb per class; chosen:", rep->scene_name);
+        st = plot_lines_whole_x(path, K, x, 1, score_name, y, title, "channels K",
+                                "Jeffries-Matusita distance (0..2)", err);
+    /* The chosen centres, each width's together: "0.28 THz (relative width 0.01); 0.12,
+     * 0.3 THz (relative width 0.03)" (a bare "(0.01)" read as a frequency) */
+    size_t used = 0;
+    bands_title_add(title, sizeof title, &used, "%s: mean Tb per class; chosen:", rep->scene_name);
     const size_t *set = r->sets + (K - 1) * K;
-    for (size_t i = 0; i < K && used > 0 && (size_t)used < sizeof title; i++)
-        used += nw > 1 ? snprintf(title + used, sizeof title - (size_t)used, " %.4g (%.3g)",
-                                  s->candidates_thz[set[i]], s->widths[set[i]])
-                       : snprintf(title + used, sizeof title - (size_t)used, " %.4g",
-                                  s->candidates_thz[set[i]]);
-    if (used > 0 && (size_t)used < sizeof title)
-        snprintf(title + used, sizeof title - (size_t)used, " THz");
+    bool first_group = true;
+    for (size_t w = 0; w < nw; w++) {
+        size_t in_group = 0;
+        for (size_t i = 0; i < K; i++)
+            if (set[i] % nw == w) /* candidates are centre-major */
+                bands_title_add(title, sizeof title, &used, "%s %.4g",
+                                in_group++    ? ","
+                                : first_group ? ""
+                                              : ";",
+                                s->candidates_thz[set[i]]);
+        if (!in_group)
+            continue;
+        first_group = false;
+        if (nw > 1)
+            bands_title_add(title, sizeof title, &used, " THz (relative width %.3g)",
+                            rep->width_list[w]);
+        else
+            bands_title_add(title, sizeof title, &used, " THz");
+    }
     if (st == THZ_OK)
         st = join(path, dir, "bands-spectra.png", err);
     if (st == THZ_OK)

@@ -274,11 +274,11 @@ thz_status thz_atm_draw_plot(const thz_atm_plot *d, thz_error *err)
     const atm_air_state *air = with_air ? &with_air->air : NULL;
     if (with_air == atm)
         snprintf(title, sizeof title,
-                 "atmosphere '%s': %.2f K, %.1f hPa, water vapour %.2f g/m\u00b3", model_name,
+                 "atmosphere '%s': %.2f K, %.6g hPa, water vapour %.2f g/m\u00b3", model_name,
                  air->temperature_k, air->pressure_hpa, atm_air_h2o_density_g_m3(air));
     else if (with_air)
         snprintf(title, sizeof title,
-                 "atmosphere '%s'; %s air: %.2f K, %.1f hPa, %.2f g/m\u00b3 vapour", model_name,
+                 "atmosphere '%s'; %s air: %.2f K, %.6g hPa, %.2f g/m\u00b3 vapour", model_name,
                  compare_name, air->temperature_k, air->pressure_hpa,
                  atm_air_h2o_density_g_m3(air));
     else

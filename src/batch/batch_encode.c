@@ -196,6 +196,23 @@ void movie_layout_of(uint32_t columns, uint32_t rows, movie_layout *out)
                           .height = (h + 1) & ~1u};
 }
 
+/* The decimals of a frame time: the fewest (at most 2 beyond the interval's first
+ * significant digit) that write every multiple of the frame interval dt exactly (0.25 s
+ * at 4 fps, 0.125 s at 8), else those that tell frames apart (30 fps: 2). */
+static int movie_time_decimals(double dt)
+{
+    if (!(dt > 0.0) || !isfinite(dt))
+        return 2;
+    int d0 = (int)ceil(-log10(dt) - 1e-9);
+    d0 = d0 > 0 ? d0 : 0;
+    for (int d = d0; d <= d0 + 2; d++) {
+        double scaled = dt * pow(10.0, d);
+        if (fabs(scaled - round(scaled)) <= 1e-9 * scaled)
+            return d;
+    }
+    return d0;
+}
+
 /* Draws frame tb (K) into m->rgb. */
 static void movie_draw(movie_writer *m, const float *tb, double time_s)
 {
@@ -215,12 +232,23 @@ static void movie_draw(movie_writer *m, const float *tb, double time_s)
         for (uint32_t x = bx; x < bx + MOVIE_BAR; x++)
             movie_colour((double)(bottom - 1 - y) / (double)(bottom - 1 - top),
                          &m->rgb[((size_t)y * l->width + x) * 3]);
-    char text[32];
-    snprintf(text, sizeof text, "%.1fK", s->tb_max_k);
-    movie_text(m, bx + MOVIE_BAR + 4, top, text);
-    snprintf(text, sizeof text, "%.1fK", s->tb_min_k);
-    movie_text(m, bx + MOVIE_BAR + 4, bottom - 5 * MOVIE_GLYPH, text);
-    snprintf(text, sizeof text, "t=%.2fs", time_s);
+    /* a space before the unit ("300.0 K", "t = 0.25 s") where the text fits the frame's
+     * width, else without; the time's decimals those of the frame interval (fps up to
+     * 1000: 0.001 s) */
+    char text[48];
+    uint32_t lx = bx + MOVIE_BAR + 4;
+    const double ends[2] = {s->tb_max_k, s->tb_min_k};
+    const uint32_t ys[2] = {top, bottom - 5 * MOVIE_GLYPH};
+    for (int e = 0; e < 2; e++) {
+        snprintf(text, sizeof text, "%.1f K", ends[e]);
+        if (lx + strlen(text) * 4 * MOVIE_GLYPH > l->width)
+            snprintf(text, sizeof text, "%.1fK", ends[e]);
+        movie_text(m, lx, ys[e], text);
+    }
+    int d = movie_time_decimals(s->frame_interval_s > 0.0 ? s->frame_interval_s : 1.0 / s->fps);
+    snprintf(text, sizeof text, "t = %.*f s", d, time_s);
+    if (2 + strlen(text) * 4 * MOVIE_GLYPH > l->width)
+        snprintf(text, sizeof text, "t=%.*fs", d, time_s);
     movie_text(m, 2, 3, text);
 }
 

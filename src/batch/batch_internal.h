@@ -179,6 +179,8 @@ typedef struct movie_spec {
     const char *path; /* the .mp4 */
     uint32_t columns, rows;
     double fps;
+    double frame_interval_s;   /* the sequence's time between frames (1 / its fps, which fps
+                                  may clamp): the caption's decimals; 0: 1 / fps */
     double tb_min_k, tb_max_k; /* the colour scale, K */
 } movie_spec;
 

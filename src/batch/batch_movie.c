@@ -79,6 +79,7 @@ static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, s
                        .columns = si->columns,
                        .rows = si->rows,
                        .fps = movie_fps,
+                       .frame_interval_s = 1.0 / seq->fps,
                        .tb_min_k = lo,
                        .tb_max_k = hi};
     movie_writer *m = NULL;

@@ -354,11 +354,14 @@ int cmd_atmosphere(int argc, char **argv)
     if (info.has_air)
         fprintf(out,
                 "# thzmap atmosphere: model %s; air %.2f K, %.2f hPa total, water vapour %.4g hPa "
-                "(%.4g g/m^3, volume mixing ratio %.4g)\n",
+                "(%.4g g/m^3, volume mixing ratio %.4g)",
                 model_name, info.temperature_k, info.pressure_hpa, info.h2o_pressure_hpa,
                 info.h2o_density_g_m3, info.h2o_vmr);
     else
-        fprintf(out, "# thzmap atmosphere: model %s\n", model_name);
+        fprintf(out, "# thzmap atmosphere: model %s", model_name);
+    if (o.have_distance) /* what the transmittance column is of */
+        fprintf(out, "; transmittance over a path of %.9g m", o.distance_m);
+    fprintf(out, "\n");
     fprintf(out, "frequency_thz,attenuation_per_m,attenuation_db_per_km");
     bool lines = strcmp(info.model, "lines") == 0, itu = strcmp(info.model, "itu-p676") == 0;
     if (lines)

@@ -55,10 +55,12 @@ typedef struct batch_cli {
 static void batch_show_run(batch_cli *b, const thz_batch_progress *p)
 {
     double start = p->n_frames ? (double)p->reused / (double)p->n_frames : 0.0;
-    char eta[64] = "";
-    if (p->fraction - start > 0.01)
-        snprintf(eta, sizeof eta, ", ETA %.0f s",
-                 p->seconds * (1.0 - p->fraction) / (p->fraction - start));
+    char eta[64] = "", left[32];
+    if (p->fraction - start > 0.01) {
+        cli_format_seconds_left(left, sizeof left,
+                                p->seconds * (1.0 - p->fraction) / (p->fraction - start));
+        snprintf(eta, sizeof eta, ", ETA %s", left);
+    }
     if (b->tty) {
         double now = cli_now_s();
         if (now - b->last_draw_s < 0.1)
@@ -98,10 +100,12 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
     }
     size_t finished = p->computed + p->reused;
     if (!strcmp(p->stage, "frame")) {
-        char eta[64] = "";
-        if (p->computed > 0) {
+        char eta[64] = "", left[32];
+        if (p->computed > 0 && finished < p->n_frames) { /* no ETA once every frame is done */
             double per_frame = p->seconds / (double)p->computed;
-            snprintf(eta, sizeof eta, ", ETA %.0f s", per_frame * (double)(p->n_frames - finished));
+            cli_format_seconds_left(left, sizeof left,
+                                    per_frame * (double)(p->n_frames - finished));
+            snprintf(eta, sizeof eta, ", ETA %s", left);
         }
         fprintf(stderr, "thzmap batch: frame %zu/%zu (%zu done, %zu reused), %.1f s%s\n",
                 p->frame + 1, p->n_frames, finished, p->reused, p->seconds, eta);

@@ -113,8 +113,11 @@ int cmd_classify(int argc, char **argv)
     if (!quiet) {
         thz_classification_info info;
         thz_classification_get_info(c, &info);
-        fprintf(stderr, "thzmap classify: %s by %s: %llu pixels, %zu classes, %llu training\n",
-                info.source, info.method, (unsigned long long)info.pixels, info.n_classes,
+        char noise[64] = ""; /* classification.json's added_netd_k */
+        if (opt.netd_k > 0.0)
+            snprintf(noise, sizeof noise, " with %g K of added noise", opt.netd_k);
+        fprintf(stderr, "thzmap classify: %s%s by %s: %llu pixels, %zu classes, %llu training\n",
+                info.source, noise, info.method, (unsigned long long)info.pixels, info.n_classes,
                 (unsigned long long)info.training_pixels);
         for (size_t k = 0; k < info.n_classes; k++) {
             double auc = thz_classification_auc(c, k);

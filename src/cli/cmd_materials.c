@@ -110,8 +110,14 @@ static int describe(const thz_library *lib, const char *name, const double *thz,
         printf("%10.4g %10.5g %10.5g %11.5g %11.5g %13.5g %9.5f%s\n", thz[j], o.n, o.k, o.eps_real,
                o.eps_imag, o.attenuation_per_m, o.normal_reflectance, out ? " *" : "");
     }
-    if (outside)
-        printf("\n* outside the range the source states\n");
+    /* what thz_library_in_range tests: the stated validity, and an itu-p2040 entry's
+     * rows (the data's ranges listed above) */
+    if (outside) {
+        bool rows = strcmp(info.model, "itu-p2040") == 0;
+        printf("\n* outside %s%s%s\n", info.has_valid_range ? "the stated validity" : "",
+               info.has_valid_range && rows ? " and " : "",
+               rows ? "the ranges the data cover" : "");
+    }
     return CLI_EXIT_OK;
 }
 

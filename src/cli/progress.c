@@ -65,11 +65,13 @@ static void cli_progress_draw_tty(cli_progress *p, const thz_progress *pr, doubl
         p->line_open = true;
         return;
     }
-    fprintf(p->out, "\r\033[Kthzmap %s: channel %zu/%zu, %s %llu/%llu (%.0f %%)", p->command,
+    const char *unit = cli_stage_unit(pr->stage);
+    bool named = strcmp(unit, pr->stage) == 0; /* "photons 500/1000", not "... photons" */
+    fprintf(p->out, "\r\033[Kthzmap %s: channel %zu/%zu, %s %llu/%llu%s%s (%.0f %%)", p->command,
             pr->channel + 1, pr->n_channels, pr->stage, (unsigned long long)pr->done,
-            (unsigned long long)pr->total, 100.0 * frac);
+            (unsigned long long)pr->total, named ? "" : " ", named ? "" : unit, 100.0 * frac);
     if (rate > 0.0)
-        fprintf(p->out, ", %.3g %s/s", rate, cli_stage_unit(pr->stage));
+        fprintf(p->out, ", %.3g %s/s", rate, unit);
     /* the whole run: the share of the channels done so far (photons the first half of a
      * channel when it fires any), else the estimate less the time spent */
     double run_elapsed = now - p->run_start_s;
@@ -78,8 +80,11 @@ static void cli_progress_draw_tty(cli_progress *p, const thz_progress *pr, doubl
                                                                             : frac);
     share /= (double)(pr->n_channels ? pr->n_channels : 1);
     double eta = share > 0.02 ? run_elapsed * (1.0 - share) / share : p->estimate_s - run_elapsed;
-    if (eta > 0.0 && p->run_start_s > 0.0)
-        fprintf(p->out, ", run ETA %.0f s", eta);
+    if (eta > 0.0 && p->run_start_s > 0.0) {
+        char left[32];
+        cli_format_seconds_left(left, sizeof left, eta);
+        fprintf(p->out, ", run ETA %s", left);
+    }
     fflush(p->out);
     p->line_open = true;
 }
@@ -107,13 +112,16 @@ int cli_progress_report(void *user, const thz_progress *pr)
     double now = cli_now_s();
     double previous = p->last_report_s;
     p->last_report_s = now;
-    bool new_stage = !p->stage || strcmp(p->stage, pr->stage) != 0 || p->channel != pr->channel ||
-                     pr->done < p->last_done;
-    if (new_stage) {
+    bool other_stage = !p->stage || strcmp(p->stage, pr->stage) != 0 || p->channel != pr->channel;
+    if (other_stage || pr->done < p->last_done) {
         p->stage = pr->stage;
         p->channel = pr->channel;
         p->completed = false;
-        p->stage_start_s = previous;
+        /* A channel's stage reports done = 0 when it starts (thz_progress): its clock
+         * starts now, not at the report before, which may be the set-up before the run
+         * or the previous stage. A pass that starts over counts from the end of the
+         * previous pass (the time between belongs to the channel's rendering). */
+        p->stage_start_s = other_stage && pr->done == 0 ? now : previous;
         p->last_draw_s = 0.0;
     }
     p->last_done = pr->done;
@@ -164,11 +172,31 @@ void cli_progress_plan(void *user, const thz_run_plan *plan)
                  ", up to about %u pass%s per channel to reach the noise target of %g K (%s)",
                  plan->passes, plan->passes == 1 ? "" : "es", plan->target_noise_k,
                  plan->target_source ? plan->target_source : "given");
-    fprintf(p->out,
-            "thzmap %s: estimate: %.3g s (photons %.3g s, rendering %.3g s)%s; memory %.3g GiB "
-            "of %.3g GiB\n",
-            p->command, total, plan->seconds_photons, plan->seconds_render, target,
-            (double)plan->memory_bytes / 1073741824.0,
-            (double)plan->available_bytes / 1073741824.0);
+    char memory[32], available[40] = "";
+    cli_format_bytes(memory, sizeof memory, plan->memory_bytes);
+    if (plan->available_bytes > 0) { /* 0: unknown */
+        strcpy(available, " of ");
+        cli_format_bytes(available + 4, sizeof available - 4, plan->available_bytes);
+    }
+    fprintf(
+        p->out, "thzmap %s: estimate: %.3g s (photons %.3g s, rendering %.3g s)%s; memory %s%s\n",
+        p->command, total, plan->seconds_photons, plan->seconds_render, target, memory, available);
     fflush(p->out);
+}
+
+void cli_format_seconds_left(char *buf, size_t size, double seconds)
+{
+    if (seconds < 1.0) /* "0 s" would say the work is done */
+        snprintf(buf, size, "< 1 s");
+    else
+        snprintf(buf, size, "%.0f s", seconds);
+}
+
+void cli_format_bytes(char *buf, size_t size, uint64_t bytes)
+{
+    double gib = (double)bytes / 1073741824.0;
+    if (gib >= 1.0)
+        snprintf(buf, size, "%.3g GiB", gib);
+    else
+        snprintf(buf, size, "%.3g MiB", (double)bytes / 1048576.0);
 }

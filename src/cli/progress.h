@@ -25,8 +25,8 @@ typedef struct cli_progress {
     size_t channel;
     uint64_t last_done;
     bool completed;       /* the completion of the current stage was shown */
-    double stage_start_s; /* taken as the time of the report before the stage's first one:
-                             stages may report only when a batch is done */
+    double stage_start_s; /* a channel's stage: its first report (done = 0, when it
+                             starts); a pass that starts over: the report before */
     double last_report_s;
     double last_draw_s;
     double run_start_s; /* when the plan was told (0: no plan) */
@@ -49,6 +49,13 @@ void cli_progress_plan(void *user, const thz_run_plan *plan);
 
 /* Ends the terminal line, if one is open. */
 void cli_progress_finish(cli_progress *p);
+
+/* A time still to go, "12 s", for an ETA: "< 1 s" below 1 s (never "0 s" while work
+ * remains). */
+void cli_format_seconds_left(char *buf, size_t size, double seconds);
+
+/* A size in memory, "1.5 GiB", or in MiB below 1 GiB ("0.625 MiB", not "0.00061 GiB"). */
+void cli_format_bytes(char *buf, size_t size, uint64_t bytes);
 
 /* Installs the SIGINT/SIGTERM handler (one-shot: a second signal kills at once). */
 void cli_signals_install(void);

@@ -35,10 +35,16 @@ thz_status plot_image(const char *path, const float *values, uint32_t columns, u
                       const char *title, const char *value_label, thz_error *err);
 
 /* Line plot: n_lines curves over n_x abscissae x (in `x_label` units), curve i at
- * y[i * n_x + j]; non-finite points are left out. A legend names each curve. */
+ * y[i * n_x + j]; non-finite points are left out. A legend names each curve. A title
+ * too wide for the figure is wrapped at spaces onto more lines (the plot shrinks from
+ * the top to make room). */
 thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
                       const char *const *names, const double *y, const char *title,
                       const char *x_label, const char *y_label, thz_error *err);
+/* The same for x of whole numbers (a count): ticks at whole numbers only. */
+thz_status plot_lines_whole_x(const char *path, size_t n_x, const double *x, size_t n_lines,
+                              const char *const *names, const double *y, const char *title,
+                              const char *x_label, const char *y_label, thz_error *err);
 
 /* A curve of plot_attenuation: n_x values y over the figure's abscissae, drawn in
  * colour rgb with line width `width` (1 = thin), dashed or solid. `name` is PLplot
@@ -52,7 +58,8 @@ typedef struct plot_curve {
 } plot_curve;
 
 /* A frequency band of plot_attenuation, in x units: shaded from lo to hi, a dashed
- * line at centre, and `name` (shown as given) written upwards beside it. */
+ * line at centre, and `name` (shown as given) written upwards beside it, inside the
+ * plot (on the line's right for a band at the left end). */
 typedef struct plot_band {
     const char *name;
     double lo, centre, hi;

@@ -70,6 +70,7 @@ typedef struct plot_item {
     size_t n_x, n_lines;
     double *x, *y;
     char **names;
+    bool whole_x; /* a line plot's x: whole numbers (plot_lines_whole_x) */
 } plot_item;
 
 struct plot_batch {
@@ -143,10 +144,10 @@ thz_status plot_batch_image(plot_batch *b, const char *path, const float *values
     return THZ_OK;
 }
 
-thz_status plot_batch_lines(plot_batch *b, const char *path, size_t n_x, const double *x,
-                            size_t n_lines, const char *const *names, const double *y,
-                            const char *title, const char *x_label, const char *y_label,
-                            thz_error *err)
+static thz_status plot_batch_lines_x(plot_batch *b, const char *path, size_t n_x, const double *x,
+                                     size_t n_lines, const char *const *names, const double *y,
+                                     const char *title, const char *x_label, const char *y_label,
+                                     bool whole_x, thz_error *err)
 {
     plot_item *it = plot_batch_add(b, PLOT_ITEM_LINES, path, title, x_label, y_label);
     if (!it)
@@ -171,7 +172,17 @@ thz_status plot_batch_lines(plot_batch *b, const char *path, size_t n_x, const d
         memcpy(it->x, x, n_x * sizeof *x);
     if (n_y > 0)
         memcpy(it->y, y, n_y * sizeof *y);
+    it->whole_x = whole_x;
     return THZ_OK;
+}
+
+thz_status plot_batch_lines(plot_batch *b, const char *path, size_t n_x, const double *x,
+                            size_t n_lines, const char *const *names, const double *y,
+                            const char *title, const char *x_label, const char *y_label,
+                            thz_error *err)
+{
+    return plot_batch_lines_x(b, path, n_x, x, n_lines, names, y, title, x_label, y_label, false,
+                              err);
 }
 
 /* A child's share of a batch: items [lo, hi). */
@@ -191,7 +202,7 @@ static thz_status plot_share_child(void *arg, thz_error *err)
                                               it->title, it->y_label, err)
                             : plot_lines_draw(it->path, it->n_x, it->x, it->n_lines,
                                               (const char *const *)it->names, it->y, it->title,
-                                              it->x_label, it->y_label, err);
+                                              it->x_label, it->y_label, it->whole_x, err);
         if (st != THZ_OK)
             return st;
     }
@@ -259,17 +270,32 @@ thz_status plot_image(const char *path, const float *values, uint32_t columns, u
     return st;
 }
 
-thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
-                      const char *const *names, const double *y, const char *title,
-                      const char *x_label, const char *y_label, thz_error *err)
+static thz_status plot_lines_one(const char *path, size_t n_x, const double *x, size_t n_lines,
+                                 const char *const *names, const double *y, const char *title,
+                                 const char *x_label, const char *y_label, bool whole_x,
+                                 thz_error *err)
 {
     plot_batch *b = plot_batch_create();
     if (!b)
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
-    thz_status st =
-        plot_batch_lines(b, path, n_x, x, n_lines, names, y, title, x_label, y_label, err);
+    thz_status st = plot_batch_lines_x(b, path, n_x, x, n_lines, names, y, title, x_label, y_label,
+                                       whole_x, err);
     if (st == THZ_OK)
         st = plot_batch_run(b, 1, err);
     plot_batch_destroy(b);
     return st;
+}
+
+thz_status plot_lines(const char *path, size_t n_x, const double *x, size_t n_lines,
+                      const char *const *names, const double *y, const char *title,
+                      const char *x_label, const char *y_label, thz_error *err)
+{
+    return plot_lines_one(path, n_x, x, n_lines, names, y, title, x_label, y_label, false, err);
+}
+
+thz_status plot_lines_whole_x(const char *path, size_t n_x, const double *x, size_t n_lines,
+                              const char *const *names, const double *y, const char *title,
+                              const char *x_label, const char *y_label, thz_error *err)
+{
+    return plot_lines_one(path, n_x, x, n_lines, names, y, title, x_label, y_label, true, err);
 }

@@ -22,7 +22,11 @@ thz_status plot_image_draw(const char *path, const float *values, uint32_t colum
                            const char *title, const char *value_label, thz_error *err);
 thz_status plot_lines_draw(const char *path, size_t n_x, const double *x, size_t n_lines,
                            const char *const *names, const double *y, const char *title,
-                           const char *x_label, const char *y_label, thz_error *err);
+                           const char *x_label, const char *y_label, bool whole_x, thz_error *err);
+
+/* The interval of labelled ticks on an axis of whole numbers spanning `span`: 1, 2, 5,
+ * 10, 20, ... (never below 1), for about 4 to 10 ticks. */
+double plot_whole_tick(double span);
 thz_status plot_attenuation_draw(const char *path, size_t n_x, const double *x, size_t n_curves,
                                  const plot_curve *curves, size_t n_bands, const plot_band *bands,
                                  const char *title, const char *x_label, const char *y_label,

@@ -388,6 +388,15 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     thz_status st = phase_check(scene, channel, err);
     if (st != THZ_OK)
         return st;
+    if (opt && opt->progress) { /* the stage starts (its time, stats->seconds, too) */
+        thz_progress p = {.stage = "photons",
+                          .channel = channel,
+                          .n_channels = scene->n_channels,
+                          .done = 0,
+                          .total = scene->photons.per_channel};
+        if (opt->progress(opt->progress_user, &p) != 0)
+            return thz_error_set(err, THZ_ERR_CANCELLED, "photon phase: cancelled");
+    }
     double t0_k = opt ? opt->reference_temperature_k : 0.0;
     if (!(t0_k >= 0.0) || !isfinite(t0_k))
         return thz_error_set(err, THZ_ERR_INPUT,

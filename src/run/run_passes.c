@@ -87,8 +87,19 @@ thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, th
     double t0 = thz_now_s();
     double target =
         render_integrator_has_passes(rs->scene->render.integrator) ? rs->target_noise_k : 0.0;
-    render_accum *acc = thz_calloc(rs->n_selected, sizeof *acc);
     thz_status st = THZ_OK;
+    /* the stage starts here, before the channel's tables (its time, render_s, does too):
+     * a display of the stage's time starts its clock at this report */
+    if (ro.progress && rs->n_selected > 0) {
+        thz_progress p = {.stage = "render",
+                          .channel = c,
+                          .n_channels = rs->scene->n_channels,
+                          .done = 0,
+                          .total = rs->scene->sensors[rs->selected[0]].rows};
+        if (ro.progress(ro.progress_user, &p) != 0)
+            return thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
+    }
+    render_accum *acc = thz_calloc(rs->n_selected, sizeof *acc);
     if (!acc)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the pixel statistics");
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++) {

@@ -17,6 +17,9 @@ grep -q -- "--from-thz" "$TMP/help" || fail "--help does not describe --from-thz
 "$THZ" atmosphere --from-thz 0.1 --to-thz 0.2 --step-ghz 10 --distance-m 100 > "$TMP/a.csv" \
     || fail "lines run exit status $?"
 grep -v '^#' "$TMP/a.csv" > "$TMP/a.data"
+# the comment line records the path the transmittance column is of
+grep -q '^# thzmap atmosphere: model lines; air .*; transmittance over a path of 100 m$' "$TMP/a.csv" ||
+    fail "the comment line lacks --distance-m: $(head -1 "$TMP/a.csv")"
 head -1 "$TMP/a.data" | grep -qx "frequency_thz,attenuation_per_m,attenuation_db_per_km,h2o_lines_db_per_km,h2o_continuum_db_per_km,o2_db_per_km,dry_continuum_db_per_km,transmittance" \
     || fail "unexpected header: $(head -1 "$TMP/a.data")"
 [ "$(tail -n +2 "$TMP/a.data" | wc -l)" -eq 11 ] || fail "expected 11 rows"

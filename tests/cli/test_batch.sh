@@ -5,7 +5,8 @@
 #    0.25 m, 302 and 306 K), and their files equal, bit for bit, `thzmap simulate` of
 #    hand-written scenes with those values (summary.json aside: timings);
 #  - the movies: H.264, 5 frames, 1.25 s, the size batch.json states; decoded, the
-#    pixels' lightness ranks like the frame's brightness temperatures;
+#    pixels' lightness ranks like the frame's brightness temperatures, and each frame's
+#    caption reads its time ("t = 0.25 s");
 #  - resuming: a batch interrupted by SIGTERM (exit 143) after a frame, then killed
 #    with SIGKILL after more, and run again, redoes no finished frame (frame.json's
 #    inode and time unchanged; batch.json's counts) and ends with every file identical
@@ -131,6 +132,26 @@ for i in range(5):
     assert far.sum() > 100, far.sum()
     bad = (far & (dy <= 0)).sum()
     assert bad == 0, (i, bad, far.sum())
+# the caption: the frame's time with the interval's decimals (4 fps: 0.25 s) and a space
+# before the unit, in the movies' 3x5 font (2 pixels a dot) at (2, 3)
+chars = "0123456789.-=tsK"
+glyphs = [(7, 5, 5, 5, 7), (2, 6, 2, 2, 7), (7, 1, 7, 4, 7), (7, 1, 7, 1, 7), (5, 5, 7, 1, 1),
+          (7, 4, 7, 1, 7), (7, 4, 7, 5, 7), (7, 1, 1, 1, 1), (7, 5, 7, 5, 7), (7, 5, 7, 1, 7),
+          (0, 0, 0, 0, 2), (0, 0, 7, 0, 0), (0, 7, 0, 7, 0), (2, 7, 2, 2, 1), (3, 4, 2, 1, 6),
+          (5, 6, 4, 6, 5)]
+def caption(text):
+    mask = np.zeros((10, 8 * len(text) + 8), bool)
+    for n, ch in enumerate(text):
+        rows = glyphs[chars.index(ch)] if ch in chars else (0,) * 5
+        for r in range(10):
+            for c in range(6):
+                mask[r, 8 * n + c] = rows[r // 2] >> (2 - c // 2) & 1
+    return mask
+for i in range(5):
+    want = caption("t = %.2f s" % (i / 4))
+    got = video[i][3:13, 2:2 + want.shape[1]] > 127
+    wrong = (got != want).sum()
+    assert wrong <= 0.05 * want.sum(), (i, "caption", wrong, want.sum())
 PY
 
 # --- interrupted, killed, resumed ---------------------------------------------------
@@ -279,6 +300,9 @@ echo '{"format": "thzmap-sequence/1", "scenes": ["scene.json", "sub/b.json"], "f
     fail "list of scenes: exit $?: $(cat "$work/L.err")"
 grep -Eq '^thzmap batch: [1-4]0 % of the batch done \(in frame 1/2\)' "$work/L.err" ||
     fail "no progress within frame 1 of 2: $(cat "$work/L.err")"
+# frames of a fraction of a second: an ETA below 1 s reads "< 1 s", never "0 s" while
+# frames remain
+grep -q 'ETA 0 s' "$work/L.err" && fail "an ETA of '0 s' while frames remained: $(cat "$work/L.err")"
 "$THZMAP" simulate "$work/sub/b.json" -o "$work/SB" --threads 1 --quiet >/dev/null || fail "simulate of sub/b.json"
 same_files "$work/SB" "$work/L/frame-00001" "list frame 1 against simulate's"
 "$PY" - "$work/L" <<'PY' || fail "list of scenes: batch.json, frame.json"

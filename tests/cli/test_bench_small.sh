@@ -19,6 +19,18 @@ status=$?
 cat "$tmp/out"
 [[ $status -eq 0 ]] || { echo "FAIL: thzbench --small exited $status: $(cat "$tmp/err")"; exit 1; }
 grep -q '^Targets' "$tmp/out" || { echo "FAIL: no table of targets"; exit 1; }
+# every ratio printed with its x, every time per photon said so, no negative floor in K
+printed_fails=0
+printed() { # printed EXTENDED-REGEX WHAT
+    grep -Eq -- "$1" "$tmp/out" || { echo "FAIL: the table lacks $2"; printed_fails=1; }
+}
+printed 'photon phase / raw trace = [0-9.]+ x \(tracing alone: [0-9.]+ x\)' "the tracing ratios' x"
+printed 'trace ns/photon +index ns/photon +CPU ns/photon +fastest CPU ns/photon' \
+    "section 3's per-photon headers"
+printed '^  path +[0-9]+( +[0-9.]+){7} +[0-9.]+ x +[0-9.]+-[0-9.]+ x +[0-9.]+ x ' \
+    "section 5's speed-up, pair range and fastest with their x"
+grep -q 'with a floor -' "$tmp/out" && { echo "FAIL: a negative floor in K"; printed_fails=1; }
+[[ $printed_fails -eq 0 ]] || exit 1
 
 python3 - "$tmp/bench.json" <<'PY'
 import json, math, sys

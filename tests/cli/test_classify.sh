@@ -71,6 +71,12 @@ for n in 0 0.5 1 2 4 8; do
     "$THZ" classify "$TMP/run" --sensor cam -o "$TMP/n-$n" --method lda --netd-k $n -q ||
         fail "--netd-k $n exit status $?"
 done
+# the summary says the noise was added (classification.json's added_netd_k)
+"$THZ" classify "$TMP/run" --sensor cam -o "$TMP/n-said" --method lda --netd-k 0.5 \
+    2> "$TMP/said.err" || fail "--netd-k 0.5 (not quiet) exit status $?"
+grep -q '^thzmap classify: .* with 0.5 K of added noise by lda: ' "$TMP/said.err" ||
+    fail "the summary omits the added noise: $(head -1 "$TMP/said.err")"
+grep -q "added noise" "$TMP/all.err" && fail "a run without --netd-k said noise was added"
 $PY - "$TMP" <<'PYEOF' || fail "accuracy against NETD"
 import json, sys
 acc = [json.load(open(f"{sys.argv[1]}/n-{n}/classification.json"))["accuracy"]

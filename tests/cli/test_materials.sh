@@ -68,6 +68,12 @@ grep -q '^reflection: not part of the entry' "$tmp/water" || fail "water: no ref
 grep -q '^data: 0.001 to 0.1 THz, 0.11 to 0.33 THz' "$tmp/concrete" ||
     fail "concrete: P.2040 rows not listed: $(cat "$tmp/concrete")"
 grep -Eq '^ +1 .* \*$' "$tmp/concrete" || fail "concrete: 1 THz not marked outside the range"
+# the footnote says what the stars mark: concrete states no validity, its rows' ranges do
+grep -qx '\* outside the ranges the data cover' "$tmp/concrete" ||
+    fail "concrete: the footnote does not name the data's ranges: $(tail -1 "$tmp/concrete")"
+"$thzmap" materials rdx >"$tmp/rdx" || fail "materials rdx: exit $?"
+grep -qx '\* outside the stated validity' "$tmp/rdx" ||
+    fail "rdx: the footnote does not name the stated validity: $(tail -1 "$tmp/rdx")"
 
 # --- usage errors ------------------------------------------------------------------
 expect_exit() { # expect_exit STATUS PATTERN ARGS...

@@ -94,6 +94,46 @@ grep -q "K at \(low (0.35 THz)\|high (0.9 THz)\)$" "$work/pn.out" ||
 [ -s "$work/q.err" ] && fail "--quiet printed to stderr: $(cat "$work/q.err")"
 [ -s "$work/q.out" ] && fail "--quiet printed to stdout: $(cat "$work/q.out")"
 
+# --- the progress lines' times are the stages' own, as summary.json's -----------------
+# photon_phase_s, and render_s (all of a channel's passes, a line each): channel 1's
+# once counted the set-up before it (loading, the ray casting's build, the estimate's
+# pilot run), 0.19 s against 0.04 s. Each line's time has two decimals.
+"$THZMAP" simulate "$REPO/examples/teraeye/scene.json" -o "$work/pt" --integrator photon-map \
+    --photons 20000 --threads 2 > /dev/null 2> "$work/pt.err" || fail "teraeye photon-map exited $?"
+"$THZMAP" simulate "$REPO/examples/teraeye/scene.json" -o "$work/pp" --integrator path \
+    --target-noise-k 0.3 --threads 2 > /dev/null 2> "$work/pp.err" || fail "teraeye path exited $?"
+python3 - "$work/pt" "$work/pp" <<'PY' || fail "progress times differ from summary.json's"
+import json, re, sys
+for out in sys.argv[1:3]:
+    lines = open(out + ".err").read()
+    channels = json.load(open(out + "/summary.json"))["channels"]
+    for c, ch in enumerate(channels, 1):
+        for stage, key in (("photons", "photon_phase_s"), ("render", "render_s")):
+            times = [float(t) for t in re.findall(
+                r"channel %d/%d, %s: \d+ \w+ in ([0-9.]+) s" % (c, len(channels), stage), lines)]
+            if key not in ch:
+                assert not times, (out, c, stage, times)
+                continue
+            printed = sum(times)
+            assert times and abs(printed - ch[key]) <= 0.006 * len(times) + 0.02 + 0.05 * ch[key], \
+                (out, "channel %d" % c, stage, times, key, ch[key])
+PY
+
+# --- on a terminal: one line redrawn, rows named, no "ETA 0 s", memory in MiB below 1 GiB ---
+if command -v script > /dev/null; then
+    script -qec "'$THZMAP' simulate '$REPO/examples/teraeye/scene.json' -o '$work/tty' \
+        --integrator photon-map --photons 100000 --threads 2" /dev/null > "$work/tty.log" 2>&1 ||
+        fail "simulate on a terminal exited $?"
+    tr '\r' '\n' < "$work/tty.log" > "$work/tty.txt"
+    grep -Eq 'channel 6/6, render 64/64 rows \(100 %\)' "$work/tty.txt" ||
+        fail "no 'render 64/64 rows (100 %)' on the terminal: $(head -c 600 "$work/tty.txt")"
+    grep -Eq 'channel 1/6, photons [0-9]+/100000 \(' "$work/tty.txt" ||
+        fail "no photon count on the terminal: $(head -c 600 "$work/tty.txt")"
+    grep -q 'ETA 0 s' "$work/tty.txt" && fail "an ETA of '0 s' while work remained"
+    grep -Eq 'estimate: .*; memory [0-9.]+ MiB of [0-9.]+ GiB$' "$work/tty.txt" ||
+        fail "the estimate's memory is not in MiB: $(grep estimate "$work/tty.txt")"
+fi
+
 # --- render from the saved map ---------------------------------------------------------
 "$THZMAP" render "$work/scene.json" --photon-map "$work/t1/photon-map.thzpm" -o "$work/r" \
     --threads 2 --quiet || fail "render exited $?"

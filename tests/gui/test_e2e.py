@@ -249,6 +249,17 @@ def main():
         click_list("files", "scene.json")
         wait.until(lambda d: "valid" in by_id("validation-state").text and "✓" in by_id("validation-state").text)
         names = [o["name"] for o in scene["objects"]]
+        # the box's wall does not attenuate: its α plot is flat at 0, on an axis from 0 up
+        # (a flat curve's axis once ran -0.5 to 0.5 1/m)
+        click_list("objects", "box")
+        alpha_ticks = lambda d: d.execute_script(
+            "const svg = [...document.querySelectorAll('#material-plots svg')].find((s) =>"
+            " [...s.querySelectorAll('text')].some((t) => t.textContent === 'α (1/m)'));"
+            "return svg ? [...svg.querySelectorAll('text[text-anchor=end]')]"
+            ".map((t) => t.textContent) : null;")
+        wait.until(lambda d: alpha_ticks(d))
+        ticks = [float(v) for v in alpha_ticks(driver)]
+        assert min(ticks) == 0 and max(ticks) > 0, f"the α axis of a flat α = 0: {ticks}"
         c = names.index("cylinder-C")
         click_list("objects", "cylinder-C")
         path = f"objects[{c}].temperature_k"
@@ -330,6 +341,16 @@ def main():
         sigma = s_l[:, row, col] / (b_nu * x * np.exp(x) / (np.expm1(x) * t))
         shown = [float(td.get_attribute("data-value")) for td in driver.find_elements(By.CSS_SELECTOR, "#pixel-table td.sigma")]
         assert np.allclose(shown, sigma, rtol=1e-5, atol=0), f"page σ {shown} != {list(sigma)}"
+        # as printed: σ to two significant digits, Tb to the same decimal place
+        texts = driver.execute_script(
+            "return [...document.querySelectorAll('#pixel-table tbody tr')].map((r) =>"
+            " [r.querySelector('td.tb').textContent, r.querySelector('td.sigma').textContent]);")
+        for (tb_text, s_text), t_b, s_b in zip(texts, expected, shown):
+            places = min(6, max(0, 1 - int(np.floor(np.log10(s_b))))) if s_b > 0 else 3
+            decimals = lambda v: len(v.split(".")[1]) if "." in v else 0
+            assert decimals(tb_text) == decimals(s_text) == places, (tb_text, s_text, s_b)
+            assert abs(float(tb_text) - t_b) <= 0.5 * 10.0 ** -places * (1 + 1e-9), (tb_text, t_b)
+            assert abs(float(s_text) - s_b) <= 0.5 * 10.0 ** -places * (1 + 1e-9), (s_text, s_b)
         truth = by_id("pixel-truth").text
         assert "cylinder-C" in truth and "330" in truth, truth
         log(f"pixel ({row}, {col}): {len(values)} channels equal the cube; truth {truth!r}; "

@@ -154,3 +154,23 @@ def test_measured_planes(tiny_dir, thzmap_binary):
         assert a.shape == (im.rows, im.columns, im.n_channels)
         assert_bitwise_equal(a, read_envi(out, "cam", q, im.rows, im.columns), q)
     assert not np.array_equal(im.measured_brightness_temperature, im.brightness_temperature)
+
+
+def test_maps_hold_minus_one_where_nothing_is_hit(tmp_path):
+    """temperature, distance and object_id read -1 where a pixel sees nothing (as the
+    ENVI files), and Image's docstring says so (it once said 0 for temperature and
+    distance)."""
+    d = tiny_scene_dict()
+    d["objects"] = [o for o in d["objects"] if o["name"] != "room"]  # open to the sky
+    d["render"] = {"integrator": "path", "paths_per_sample": 1}
+    d["materials"].pop("table")
+    with open(tmp_path / "scene.json", "w") as f:
+        json.dump(d, f)
+    im = thzmap.simulate(thzmap.load_scene(tmp_path / "scene.json"), seed=SEED).image("cam")
+    none = im.object_id == -1
+    assert none.any() and (~none).any()
+    for q in ("temperature", "distance"):
+        assert np.all(getattr(im, q)[none] == -1), q
+        assert np.all(getattr(im, q)[~none] > 0), q
+    doc = " ".join(thzmap.Image.__doc__.split())
+    assert "temperature (K, -1 where nothing is hit), distance (m, -1: none)" in doc

@@ -66,6 +66,9 @@ def test_bands_equals_the_command(tmp_path, thzmap_binary):
     assert {"bands.json", "bands-score.png", "bands-spectra.png"} <= \
         set(os.listdir(tmp_path / "py"))
     assert "BandSelection" in repr(sel)
+    # each width named as one: "0.4 THz (relative width 0.01)", not "0.4 THz (0.01)"
+    for f, w in zip(sel.selected_thz, sel.selected_relative_width):
+        assert f"{f:.4g} THz (relative width {w:.3g})" in repr(sel), repr(sel)
 
 
 def test_bands_takes_a_loaded_scene_and_targets():
@@ -157,6 +160,13 @@ def test_classify_noise_free_is_exact_and_noise_lowers_accuracy(distinct_run):
     assert all(not math.isnan(a) for a in exact.auc)
     noisy = thzmap.classify(run_dir, "cam", method="lda", netd_k=8.0)
     assert noisy.accuracy < exact.accuracy
+    # a class's accuracy is over all its pixels (training ones too): its confusion row
+    rows = noisy.confusion.sum(axis=1)
+    assert noisy.class_accuracy == pytest.approx(list(np.diag(noisy.confusion) / rows), rel=1e-12)
+    assert noisy.held_out_pixels < int(rows.sum())
+    doc = " ".join(thzmap.Classification.__doc__.split())
+    assert "class_accuracy (per class, over all its pixels" in doc
+    assert "auc (per class, one against the rest on the held-out pixels)" in doc
 
 
 def test_classify_errors(distinct_run, tmp_path):

@@ -20,6 +20,7 @@
 
 #include "core/alloc.h"
 #include "io/plot.h"
+#include "io/plot_draw.h"
 
 static char *make_tmp_dir(void)
 {
@@ -174,6 +175,63 @@ static void test_lines(void **state)
     /* No curve at all (no object in view) is still a figure. */
     assert_int_equal(plot_lines(path, NX, x, 0, NULL, NULL, "empty", "f (THz)", "N (1)", &err),
                      THZ_OK);
+    unlink(path);
+    rmdir(dir);
+    free(dir);
+}
+
+/* A title wider than the figure (bands-spectra.png's list of chosen channels) is wrapped
+ * onto more lines, none cut at the figure's edges: no dark pixel in the outermost columns,
+ * and dark pixels (the title) in the rows above the plot. */
+static void test_long_title(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    char path[1024];
+    snprintf(path, sizeof path, "%s/title.png", dir);
+    double x[3] = {0.2, 0.3, 0.4}, y[3] = {250.0, 260.0, 255.0};
+    const char *names[] = {"body"};
+    const char *title = "outdoor-concealed: mean Tb per class; chosen: 0.28 THz (relative width "
+                        "0.01); 0.12, 0.3 THz (relative width 0.03); 0.44, 0.52, 0.61 THz "
+                        "(relative width 0.05)";
+    thz_error err = {0};
+    if (plot_lines(path, 3, x, 1, names, y, title, "frequency (THz)", "T (K)", &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    unsigned char *px = NULL;
+    uint32_t w = 0, h = 0;
+    read_png(path, &px, &w, &h);
+    size_t dark_top = 0;
+    for (uint32_t r = 0; r < h; r++)
+        for (uint32_t c = 0; c < w; c++) {
+            const unsigned char *p = px + 3 * ((size_t)r * w + c);
+            bool dark = p[0] < 128 && p[1] < 128 && p[2] < 128;
+            if (dark && (c < 3 || c + 3 >= w))
+                fail_msg("a dark pixel at column %u, row %u: the title is cut", c, r);
+            dark_top += dark && r < h / 8;
+        }
+    assert_true(dark_top > 500);
+    free(px);
+    unlink(path);
+    rmdir(dir);
+    free(dir);
+}
+
+/* A count's axis (bands-score.png's K) has its ticks at whole numbers. */
+static void test_whole_ticks(void **state)
+{
+    (void)state;
+    const double spans[] = {0.2, 2.2, 3.1, 9.0, 17.0, 33.0, 250.0};
+    const double want[] = {1.0, 1.0, 1.0, 2.0, 5.0, 5.0, 50.0};
+    for (size_t i = 0; i < sizeof spans / sizeof spans[0]; i++)
+        assert_true(plot_whole_tick(spans[i]) == want[i]);
+    char *dir = make_tmp_dir();
+    char path[1024];
+    snprintf(path, sizeof path, "%s/k.png", dir);
+    double k[3] = {1, 2, 3}, jm[3] = {0.7, 1.3, 1.5};
+    const char *names[] = {"worst pair"};
+    thz_error err = {0};
+    if (plot_lines_whole_x(path, 3, k, 1, names, jm, "K", "channels K", "JM", &err) != THZ_OK)
+        fail_msg("%s", err.message);
     unlink(path);
     rmdir(dir);
     free(dir);
@@ -417,6 +475,7 @@ int main(void)
         cmocka_unit_test(test_image_colours), cmocka_unit_test(test_odd_images),
         cmocka_unit_test(test_lines),         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_attenuation),   cmocka_unit_test(test_batch),
+        cmocka_unit_test(test_long_title),    cmocka_unit_test(test_whole_ticks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -11,7 +11,8 @@ function el(name, attrs, parent) {
   return node;
 }
 
-// series: [{label, x: [], y: [], err?: [], colour?}], axes {xLabel, yLabel, yMin?, yMax?}
+// series: [{label, x: [], y: [], err?: [], colour?}], axes {xLabel, yLabel, yMin?, yMax?}:
+// yMin/yMax fix an end of the y axis (a quantity that cannot go below 0: yMin 0)
 export function linePlot(container, series, axes) {
   const W = 320;
   const Hh = 150;
@@ -26,7 +27,13 @@ export function linePlot(container, series, axes) {
   if (!Number.isFinite(x0)) [x0, x1] = [0, 1];
   if (!Number.isFinite(y0) || !Number.isFinite(y1)) [y0, y1] = [0, 1];
   if (x1 === x0) [x0, x1] = [x0 - 0.5, x1 + 0.5];
-  if (y1 === y0) [y0, y1] = [y0 - 0.5, y1 + 0.5];
+  // a flat curve: a unit range about it, but never past a bound the caller set (α ≡ 0
+  // with yMin 0: 0…1, not −0.5…0.5)
+  if (y1 === y0) {
+    if (axes.yMin !== undefined && axes.yMax === undefined) y1 = y0 + 1;
+    else if (axes.yMax !== undefined && axes.yMin === undefined) y0 = y1 - 1;
+    else [y0, y1] = [y0 - 0.5, y1 + 0.5];
+  }
   const px = (x) => m.l + ((x - x0) / (x1 - x0)) * (W - m.l - m.r);
   const py = (y) => Hh - m.b - ((y - y0) / (y1 - y0)) * (Hh - m.t - m.b);
   el("rect", { x: m.l, y: m.t, width: W - m.l - m.r, height: Hh - m.t - m.b, fill: "none", stroke: "#bbb" }, svg);

@@ -222,14 +222,18 @@ export class Results {
       const tr = body.insertRow();
       tr.insertCell().textContent = tb.bandNames[b] || String(b + 1);
       tr.insertCell().textContent = formatNumber(f[b]);
+      // σ to two significant digits and Tb to the same place: no digits σ cannot back
+      // (23.5 K of σ: Tb 301 K, not 301.234); 3 decimals without a σ
+      const s = err[b];
+      const places = Number.isFinite(s) && s > 0 ? Math.min(6, Math.max(0, 1 - Math.floor(Math.log10(s)))) : 3;
       const c = tr.insertCell();
       c.className = "tb";
       c.dataset.value = String(t); // the float32 read from the cube, in full
-      c.textContent = t.toFixed(3);
+      c.textContent = t.toFixed(places);
       const e = tr.insertCell();
       e.className = "sigma";
-      e.dataset.value = String(err[b]);
-      e.textContent = Number.isFinite(err[b]) ? err[b].toFixed(3) : "–";
+      e.dataset.value = String(s);
+      e.textContent = Number.isFinite(s) ? s.toFixed(places) : "–";
     });
     info.dataset.ms = (performance.now() - t0).toFixed(1);
   }

@@ -312,7 +312,7 @@ export class SceneEditor {
       if (sp.emissivity) series.push({ label: "ε", x: f, y: sp.emissivity });
       if (series.length) linePlot(box, series, { xLabel: "frequency (THz)", yLabel: "R, ε (1)", yMin: 0, yMax: 1 });
       const alpha = sp.alpha_per_m || sp.alpha;
-      if (alpha) linePlot(box, [{ label: "α", x: f, y: alpha }], { xLabel: "frequency (THz)", yLabel: "α (1/m)" });
+      if (alpha) linePlot(box, [{ label: "α", x: f, y: alpha }], { xLabel: "frequency (THz)", yLabel: "α (1/m)", yMin: 0 });
       const nk = [];
       if (sp.n) nk.push({ label: "n", x: f, y: sp.n });
       if (sp.k) nk.push({ label: "k", x: f, y: sp.k });
