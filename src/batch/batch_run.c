@@ -552,6 +552,10 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
             st = b.movies ? batch_movies_write(seq, outdir, b.movies, b.movies_skipped,
                                                sizeof b.movies_skipped, err)
                           : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        /* an interrupt while the movies were encoded (they are not cancellable one by
+         * one) still stops the batch: it said "complete" and exited 0 */
+        if (st == THZ_OK && batch_report(opt, &b, seq->n_frames, "movie"))
+            st = thz_error_set(err, THZ_ERR_CANCELLED, "cancelled");
         if (st == THZ_OK && b.movies_skipped[0] && ctx && ctx->warning)
             ctx->warning(ctx->warning_user, b.movies_skipped);
         b.seconds_movies = batch_now_s() - t0;

@@ -5,7 +5,9 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <stdbool.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "thzmap/thzmap.h"
@@ -293,7 +295,11 @@ int cmd_atmosphere(int argc, char **argv)
             rc = cli_fail(&err);
             goto cleanup;
         }
-        FILE *f = fopen(o.plot, "wb");
+        /* opened to append, not "wb": that emptied an existing figure before the work,
+         * and a run stopped or failing before the plot left it 0 bytes; a new file made
+         * for the check goes again until the plot writes it */
+        bool existed = access(o.plot, F_OK) == 0;
+        FILE *f = fopen(o.plot, "ab");
         if (!f) {
             err.status = THZ_ERR_INPUT;
             snprintf(err.message, sizeof err.message, "--plot %s: cannot create: %s", o.plot,
@@ -302,6 +308,8 @@ int cmd_atmosphere(int argc, char **argv)
             goto cleanup;
         }
         fclose(f);
+        if (!existed)
+            unlink(o.plot);
     }
 
     double step_thz = o.step_ghz * 1e-3;

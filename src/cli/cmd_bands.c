@@ -244,7 +244,8 @@ int cmd_bands(int argc, char **argv)
     if (st == THZ_OK)
         st = thz_bands_write(b, outdir, &err);
     cli_progress_finish(&progress);
-    if (st == THZ_ERR_CANCELLED && cli_interrupt_signal()) {
+    /* a failure under an interrupt is the interrupt's (a child ended by the same Ctrl-C) */
+    if (st != THZ_OK && cli_interrupt_signal()) {
         fprintf(stderr, "thzmap bands: interrupted; nothing written\n");
         rc = 128 + cli_interrupt_signal();
     } else if (st != THZ_OK) {

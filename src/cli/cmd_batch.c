@@ -260,7 +260,8 @@ int cmd_batch(int argc, char **argv)
     if (b.line_open)
         fputs("\r\033[K", stderr);
     rc = CLI_EXIT_OK;
-    if (st == THZ_ERR_CANCELLED) {
+    /* a failure under an interrupt is the interrupt's (a child ended by the same Ctrl-C) */
+    if (st == THZ_ERR_CANCELLED || (st != THZ_OK && cli_interrupt_signal())) {
         fprintf(stderr,
                 "thzmap batch: interrupted after %zu new frame%s; finished frames stay in %s "
                 "(run the same command again to resume)\n",

@@ -3,6 +3,7 @@
  * class map as ENVI and PNG, and prints the accuracies. */
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -106,7 +107,19 @@ int cmd_classify(int argc, char **argv)
     thz_classification *c = NULL;
     if (thz_classify_run(run_dir, sensor, &opt, &c, &err) != THZ_OK)
         return cli_fail(&err);
-    if (thz_classification_write(c, outdir, &err) != THZ_OK) {
+    /* the write commits OUTDIR through a lock and a staging directory: a signal inside it
+     * left both beside OUTDIR. Held until the write is whole, it then ends the process as
+     * before (the classification fits no progress callback to stop sooner). */
+    sigset_t stop, before;
+    sigemptyset(&stop);
+    sigaddset(&stop, SIGINT);
+    sigaddset(&stop, SIGTERM);
+    sigaddset(&stop, SIGHUP);
+    sigaddset(&stop, SIGPIPE);
+    sigprocmask(SIG_BLOCK, &stop, &before);
+    thz_status written = thz_classification_write(c, outdir, &err);
+    sigprocmask(SIG_SETMASK, &before, NULL);
+    if (written != THZ_OK) {
         thz_classification_destroy(c);
         return cli_fail(&err);
     }

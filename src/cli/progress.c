@@ -32,6 +32,12 @@ void cli_signals_install(void)
     sa.sa_flags = SA_RESETHAND; /* a second Ctrl-C ends the process at once */
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    /* a closed terminal or ssh session stops the run as Ctrl-C does (it was killed
+     * mid-commit, leaving its lock and staging directory beside OUTDIR) */
+    sigaction(SIGHUP, &sa, NULL);
+    /* progress piped to a reader that left (`2>&1 | head -1`): the writes fail, the run
+     * goes on (SIGPIPE killed it mid-commit too) */
+    signal(SIGPIPE, SIG_IGN);
 }
 
 void cli_progress_init(cli_progress *p, const char *command, bool quiet)

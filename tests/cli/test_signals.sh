@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Signals other than Ctrl-C (test_render_cancel.sh and the commit-kill tests cover SIGINT
+# and SIGKILL): a reader of the progress that leaves (SIGPIPE) does not stop the run
+# mid-commit; a closed terminal (SIGHUP) stops it as Ctrl-C does, exit 128 + 1, nothing
+# written and nothing left beside OUTDIR. `atmosphere --plot` stopped early keeps an
+# existing figure (it was emptied before the work).
+# argv: path to the thzmap binary, repository directory.
+set -u
+THZMAP=$1
+REPO=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+scene=$REPO/examples/plate-in-box/scene.json
+leftovers() { find "$work" -maxdepth 1 -name '.thzmap-*' | head -n 3; }
+
+# SIGPIPE: the progress goes to `head -1`, which exits after the first line
+"$THZMAP" simulate "$scene" -o "$work/pipe" --photons 300000 --integrator photon-map 2>&1 |
+    head -n 1 > /dev/null
+rc=${PIPESTATUS[0]}
+[ "$rc" = 0 ] || fail "simulate into a closed pipe: exit $rc, expected 0"
+[ -s "$work/pipe/summary.json" ] || fail "simulate into a closed pipe: no results"
+[ -z "$(leftovers)" ] || fail "simulate into a closed pipe left: $(leftovers)"
+
+# SIGHUP during the photon phase
+"$THZMAP" simulate "$scene" -o "$work/hup" --photons 50000000 --integrator photon-map \
+    2> "$work/hup.err" &
+pid=$!
+for _ in $(seq 600); do # the estimate's line: the run (and its handler) has begun
+    grep -q "estimate:" "$work/hup.err" 2>/dev/null && break
+    sleep 0.1
+done
+sleep 0.3
+kill -HUP $pid
+wait $pid
+rc=$?
+[ "$rc" = 129 ] || fail "SIGHUP: exit $rc, expected 129"
+grep -q "interrupted; no results written" "$work/hup.err" ||
+    fail "SIGHUP: no message: $(tail -n 1 "$work/hup.err")"
+[ ! -e "$work/hup" ] || fail "SIGHUP: OUTDIR written"
+[ -z "$(leftovers)" ] || fail "SIGHUP left: $(leftovers)"
+
+# atmosphere --plot into a closed pipe: the figure there stays as it was
+if "$THZMAP" atmosphere --from-thz 0.1 --to-thz 1 --step-ghz 10 --plot "$work/atm.png" \
+    > /dev/null 2>&1; then
+    size=$(stat -c %s "$work/atm.png")
+    "$THZMAP" atmosphere --from-thz 0.1 --to-thz 1 --step-ghz 0.1 --plot "$work/atm.png" |
+        head -n 1 > /dev/null
+    [ "$(stat -c %s "$work/atm.png")" = "$size" ] ||
+        fail "atmosphere --plot stopped early changed the figure ($size bytes before)"
+fi
+
+[ "$fails" -eq 0 ] && echo "signals: all passed"
+exit $((fails > 0))
