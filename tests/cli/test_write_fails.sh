@@ -14,26 +14,10 @@ trap 'rm -rf "$work"' EXIT
 fails=0
 fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 
-cat > "$work/scene.json" <<'JSON'
-{
-  "format": "thzmap-scene/1",
-  "name": "write-fails",
-  "channels": [{"frequency_thz": 0.35, "relative_width": 0.05}],
-  "materials": {"wall": {"reflectivity": 0.2}, "paint": {"reflectivity": 0.5}},
-  "objects": [
-    {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
-     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}},
-    {"name": "plate", "type": "solid", "material": "paint", "temperature_k": 310,
-     "shape": {"type": "box", "size_m": [0.5, 0.05, 0.5]}}
-  ],
-  "sensors": [
-    {"name": "cam", "position_m": [0, -0.9, 0], "look_at_m": [0, 0, 0], "fov_deg": 60,
-     "resolution": [64, 64]}
-  ],
-  "photons": {"per_channel": 20000, "seed": 1},
-  "render": {"integrator": "photon-map"}
-}
-JSON
+# the example's scene (64 x 64 pixels: 16 KB a plane, past the limit), fewer photons
+cp -r "$REPO/examples/plate-in-box/." "$work/"
+sed -i 's/"per_channel": [0-9]*/"per_channel": 20000/' "$work/scene.json"
+PM="--integrator photon-map"
 
 # limited CMD...: runs CMD with files limited to 8 KB and SIGXFSZ ignored.
 limited() { (trap '' XFSZ; ulimit -f 8; exec "$@"); }
@@ -52,15 +36,15 @@ check() {
 }
 
 # simulate into a new OUTDIR: no OUTDIR afterwards
-limited "$THZMAP" simulate "$work/scene.json" -o "$work/new" -q 2>"$work/err1"
+limited "$THZMAP" simulate "$work/scene.json" -o "$work/new" -q $PM 2>"$work/err1"
 check "simulate, new OUTDIR" $? "$work/err1" "$work"
 [ ! -e "$work/new" ] || fail "simulate: a failed run created its OUTDIR: $(ls "$work/new")"
 
 # simulate over an earlier run: that run's files stay as they were
-"$THZMAP" simulate "$work/scene.json" -o "$work/old" -q --save-photon-map 2>"$work/err0" ||
+"$THZMAP" simulate "$work/scene.json" -o "$work/old" -q --save-photon-map $PM 2>"$work/err0" ||
     fail "simulate without a limit: $(cat "$work/err0")"
 (cd "$work/old" && sha256sum ./* > "$work/old.sums")
-limited "$THZMAP" simulate "$work/scene.json" -o "$work/old" -q --seed 2 2>"$work/err2"
+limited "$THZMAP" simulate "$work/scene.json" -o "$work/old" -q --seed 2 $PM 2>"$work/err2"
 check "simulate over a run" $? "$work/err2" "$work"
 (cd "$work/old" && sha256sum -c --quiet "$work/old.sums") >/dev/null 2>&1 ||
     fail "simulate: the earlier run's files changed"
@@ -69,7 +53,7 @@ check "simulate over a run" $? "$work/err2" "$work"
 
 # render from the saved map
 limited "$THZMAP" render "$work/scene.json" --photon-map "$work/old/photon-map.thzpm" \
-    -o "$work/rendered" -q 2>"$work/err3"
+    -o "$work/rendered" -q $PM 2>"$work/err3"
 check "render" $? "$work/err3" "$work"
 [ ! -e "$work/rendered" ] || fail "render: a failed run created its OUTDIR"
 
@@ -77,8 +61,8 @@ check "render" $? "$work/err3" "$work"
 cat > "$work/sequence.json" <<'JSON'
 {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 2, "frames": 2,
  "keyframes": [
-   {"time_s": 0, "objects": {"plate": {"transform": {"translate_m": [-0.2, 0, 0]}}}},
-   {"time_s": 0.5, "objects": {"plate": {"transform": {"translate_m": [0.2, 0, 0]}}}}]}
+   {"time_s": 0, "objects": {"target": {"transform": {"translate_m": [-0.2, 0, 0]}}}},
+   {"time_s": 0.5, "objects": {"target": {"transform": {"translate_m": [0.2, 0, 0]}}}}]}
 JSON
 # batch: a two-frame sequence; OUTDIR keeps its lock and the state that says which frame
 # failed (a rerun resumes from it), and no frame directory
