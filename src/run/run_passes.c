@@ -34,10 +34,6 @@ static double run_channel_p95_stderr_k(const run_state *rs, size_t c)
     return all.p95_k;
 }
 
-/* final-gather: whether the photon map's own noise (run_noise_map_floor_k) keeps channel
- * c's 95th percentile at or above the target: more gather rays from the same map cannot
- * lower it, so the passes stop there, with a warning that says what would (*st: THZ_OK,
- * or the warning's failure). */
 /* How a warning names channel c: as the progress lines count it, and by its name (the
  * frequency unless the scene names it), "channel 1/6 (0.200 THz)". */
 typedef struct run_channel_label {
@@ -52,6 +48,10 @@ static run_channel_label run_channel_name(const run_state *rs, size_t c)
     return l;
 }
 
+/* final-gather: whether the photon map's own noise (run_noise_map_floor_k) keeps channel
+ * c's 95th percentile at or above the target: more gather rays from the same map cannot
+ * lower it, so the passes stop there, with a warning that says what would (*st: THZ_OK,
+ * or the warning's failure). */
 static bool run_at_map_floor(run_state *rs, size_t c, const render_accum *acc, double target,
                              thz_status *st, thz_error *err)
 {
