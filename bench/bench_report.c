@@ -60,7 +60,7 @@ json_t *bench_report_photons(const bench_series *sp, size_t channel, double load
     for (int k = 0; k < sp->n; k++) {
         const bench_point *p = &sp->p[k];
         double ns = 1e9 * bench_ratio(p->s_photons, (double)p->photons);
-        printf("  %12llu %12llu %5d %10.3f %10.1f %16.1f %16.1f %14.1f %22.1f %10.3f\n",
+        printf("  %12llu %12llu %5d %10.3f %10.1f %16.1f %16.1f %14.1f %22.1f %8.3f x\n",
                (unsigned long long)p->photons, (unsigned long long)p->stored, p->runs, p->s_photons,
                ns, 1e9 * bench_ratio(p->s_tracing, (double)p->photons),
                1e9 * bench_ratio(p->s_index, (double)p->photons),
@@ -238,10 +238,10 @@ json_t *bench_report_converge(const char *integrator, const bench_converge *cv, 
         double s = bench_converge_seconds(cv, c, target_k);
         double k = bench_converge_exponent(cv, c);
         *worst_s = s > *worst_s ? s : *worst_s;
-        printf(
-            "  %5.3f THz | %-6s %7.4f %8.3f %8.3f | %-6s %7.4f %8.3f %8.3f | %8.2f %11.3f %8.2f\n",
-            cv->freq_thz[c], "", a->rms_k[c], a->s_photons[c], a->s_render[c], "", b->rms_k[c],
-            b->s_photons[c], b->s_render[c], k, s, bench_ratio(s, limit_s));
+        printf("  %5.3f THz | %-6s %7.4f %8.3f %8.3f | %-6s %7.4f %8.3f %8.3f | %8.2f %11.3f %6.2f "
+               "x\n",
+               cv->freq_thz[c], "", a->rms_k[c], a->s_photons[c], a->s_render[c], "", b->rms_k[c],
+               b->s_photons[c], b->s_render[c], k, s, bench_ratio(s, limit_s));
         json_t *o = json_object();
         json_object_set_new(o, "frequency_thz", bench_real(cv->freq_thz[c]));
         json_object_set_new(o, "seconds_to_target", bench_real(s));

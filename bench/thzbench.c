@@ -457,7 +457,7 @@ int main(int argc, char **argv)
         const bench_point *p = &one.p[0];
         tri.p[tri.n++] = *p;
         double ns = 1e9 * bench_ratio(p->s_photons, (double)p->photons);
-        printf("  %12llu %5d %10.3f %10.1f %12.1f %12.2f %12.1f\n",
+        printf("  %12llu %5d %10.3f %10.1f %12.1f %10.2f x %12.1f\n",
                (unsigned long long)p->triangles, p->runs, p->s_photons, ns,
                1e9 * bench_ratio(p->s_probe, (double)p->rays),
                bench_ratio(p->s_photons, p->s_probe),
