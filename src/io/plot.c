@@ -349,6 +349,15 @@ static void plot_draw_title(char lines[][PLOT_TEXT], size_t n_lines, double vx0,
     }
 }
 
+int plot_label_digits(double lo, double hi)
+{
+    double mag = fmax(fabs(lo), fabs(hi)), span = hi - lo;
+    if (!(span > 0.0) || !(mag > 0.0))
+        return 4;
+    double d = ceil(log10(mag / (span / 8.0))) + 1.0;
+    return d > 4.0 ? (d < 12.0 ? (int)d : 12) : 4;
+}
+
 double plot_whole_tick(double span)
 {
     /* about 4 to 10 labelled ticks, at 1, 2 or 5 times a power of ten, never below 1 */
@@ -438,14 +447,23 @@ thz_status plot_lines_draw(const char *path, size_t n_x, const double *x, size_t
         plscol0(PLOT_GRID_COLOR, 210, 210, 210);
         size_t n_title = 0;
         double top = plot_title_layout(t_title, 0.90, title_lines, &n_title);
-        plvpor(0.10, 0.66, 0.12, top);
+        /* longer y labels: the axis title further out, the viewport narrower to keep it
+         * on the figure (a label's character is about 0.76 character heights wide, a
+         * character height 1.6 % of the figure's width) */
+        int y_digits = plot_label_digits(ymin - ypad, ymax + ypad);
+        double y_title = y_digits > 4 ? 2.0 + 0.76 * (y_digits + 1 + (ymin - ypad < 0.0)) : 5.0;
+        double left = 0.10 + 0.0163 * fmax(y_title - 5.0, 0.0);
+        plvpor(left, 0.66, 0.12, top);
         plwind(xmin - xpad, xmax + xpad, ymin - ypad, ymax + ypad);
+        if (y_digits > 4)
+            plsyax(y_digits, 0);
         plcol0(PLOT_GRID_COLOR);
         plbox("g", x_tick, x_sub, "g", 0.0, 0);
         plcol0(1);
         plbox("bcnst", x_tick, x_sub, "bcnstv", 0.0, 0);
-        pllab(x_label, y_label, "");
-        plot_draw_title(title_lines, n_title, 0.10, 0.66);
+        pllab(x_label, "", "");
+        plmtex("l", y_title, 0.5, 0.5, y_label);
+        plot_draw_title(title_lines, n_title, left, 0.66);
         for (size_t i = 0; i < n_lines; i++) {
             PLINT m = 0;
             for (size_t j = 0; j < n_x; j++) {

@@ -27,6 +27,11 @@ thz_status plot_lines_draw(const char *path, size_t n_x, const double *x, size_t
 /* The interval of labelled ticks on an axis of whole numbers spanning `span`: 1, 2, 5,
  * 10, 20, ... (never below 1), for about 4 to 10 ticks. */
 double plot_whole_tick(double span);
+/* PLplot labels an axis with at most 4 significant digits unless told more (plsyax), so
+ * values that differ only in the 5th (300.012 to 300.021 K) got one label at every tick:
+ * the digits (4 to 12) that tell apart ticks about (hi - lo) / 8 apart, as
+ * plot_whole_tick's are. */
+int plot_label_digits(double lo, double hi);
 thz_status plot_attenuation_draw(const char *path, size_t n_x, const double *x, size_t n_curves,
                                  const plot_curve *curves, size_t n_bands, const plot_band *bands,
                                  const char *title, const char *x_label, const char *y_label,

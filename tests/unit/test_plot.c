@@ -237,6 +237,39 @@ static void test_whole_ticks(void **state)
     free(dir);
 }
 
+/* Ticks of an axis whose values differ only in the 5th digit get labels that differ
+ * (they were all "300.0"); ordinary ranges keep PLplot's 4 digits. */
+static void test_label_digits(void **state)
+{
+    (void)state;
+    const double lo[] = {300.010, 0.30010, -1e6 - 3.0, 200.0, 0.0, 5.0};
+    const double hi[] = {300.022, 0.30022, -1e6 + 3.0, 300.0, 1e-3, 5.0};
+    const int want[] = {7, 6, 8, 4, 4, 4};
+    for (size_t i = 0; i < sizeof lo / sizeof lo[0]; i++) {
+        int d = plot_label_digits(lo[i], hi[i]);
+        assert_int_equal(d, want[i]);
+        if (!(hi[i] > lo[i]))
+            continue;
+        char a[64], b[64]; /* neighbouring ticks at the spacing named, apart */
+        double step = (hi[i] - lo[i]) / 8.0, mid = 0.5 * (lo[i] + hi[i]);
+        snprintf(a, sizeof a, "%.*g", d, mid);
+        snprintf(b, sizeof b, "%.*g", d, mid + step);
+        assert_string_not_equal(a, b);
+    }
+    char *dir = make_tmp_dir();
+    char path[1024];
+    snprintf(path, sizeof path, "%s/close.png", dir);
+    double x[3] = {0.2, 0.6, 1.0}, tb[3] = {300.012, 300.021, 300.016};
+    const char *names[] = {"target"};
+    thz_error err = {0};
+    if (plot_lines(path, 3, x, 1, names, tb, "close values", "frequency (THz)", "Tb (K)", &err) !=
+        THZ_OK)
+        fail_msg("%s", err.message);
+    unlink(path);
+    rmdir(dir);
+    free(dir);
+}
+
 typedef struct job {
     char path[1024];
     thz_status status;
@@ -476,6 +509,7 @@ int main(void)
         cmocka_unit_test(test_lines),         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_attenuation),   cmocka_unit_test(test_batch),
         cmocka_unit_test(test_long_title),    cmocka_unit_test(test_whole_ticks),
+        cmocka_unit_test(test_label_digits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
