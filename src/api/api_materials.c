@@ -92,11 +92,11 @@ void thz_library_get_info(const thz_library *lib, size_t i, thz_library_material
                                        .note = e->note,
                                        .model = material_index_form(e->index),
                                        .has_valid_range = e->has_range,
-                                       .valid_from_thz = e->lo_hz * 1e-12,
-                                       .valid_to_thz = e->hi_hz * 1e-12,
+                                       .valid_from_thz = e->lo_hz / 1e12,
+                                       .valid_to_thz = e->hi_hz / 1e12,
                                        .has_data_range = data_range,
-                                       .data_from_thz = data_range ? lo * 1e-12 : 0.0,
-                                       .data_to_thz = data_range ? hi * 1e-12 : 0.0,
+                                       .data_from_thz = data_range ? lo / 1e12 : 0.0,
+                                       .data_to_thz = data_range ? hi / 1e12 : 0.0,
                                        .n_data_ranges = material_index_n_ranges(e->index)};
 }
 
@@ -108,9 +108,9 @@ void thz_library_get_range(const thz_library *lib, size_t i, size_t r, double *f
     if (e && r < material_index_n_ranges(e->index))
         material_index_range_at(e->index, r, &lo, &hi);
     if (from_thz)
-        *from_thz = lo * 1e-12;
+        *from_thz = lo / 1e12;
     if (to_thz)
-        *to_thz = hi * 1e-12;
+        *to_thz = hi / 1e12;
 }
 
 int thz_library_in_range(const thz_library *lib, size_t i, double freq_hz)

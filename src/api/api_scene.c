@@ -2,6 +2,8 @@
  * images fit in memory, which the loader cannot make: it knows no images), read access
  * by value. (Destroying is scene/scene.c's thz_scene_destroy.) */
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "api/api.h"
@@ -102,7 +104,7 @@ thz_status thz_scene_channel(const thz_scene *s, size_t i, thz_channel_info *out
     *out = (thz_channel_info){
         .name = ch->name,
         .frequency_hz = ch->center_hz,
-        .frequency_thz = ch->center_hz * 1e-12,
+        .frequency_thz = ch->center_hz / 1e12, /* 0.8, not 0.7999999999999999 */
         .relative_width = ch->relative_width,
         .bandwidth_hz = channel_bandwidth_hz(ch),
         .emitted_power_w_per_hz = scene_band_emitted_power_w_per_hz(s, i),
@@ -111,6 +113,20 @@ thz_status thz_scene_channel(const thz_scene *s, size_t i, thz_channel_info *out
         .response_points = ch->n_response,
     };
     return THZ_OK;
+}
+
+/* A mesh coordinate (a float) as the double of its shortest decimal: 0.6, which the
+ * scene file said, rather than 0.6000000238418579, the float's exact value. */
+static double api_float_decimal(double v)
+{
+    float f = (float)v;
+    char text[32];
+    for (int digits = 1; digits <= 9; digits++) {
+        snprintf(text, sizeof text, "%.*g", digits, (double)f);
+        if (strtof(text, NULL) == f)
+            return strtod(text, NULL);
+    }
+    return v;
 }
 
 static thz_spectrum_info api_spectrum(const thz_spectrum *sp)
@@ -126,8 +142,8 @@ static thz_spectrum_info api_spectrum(const thz_spectrum *sp)
     }
     info.kind = THZ_SPECTRUM_TABLE;
     info.n_points = sp->n;
-    info.from_thz = sp->freq_hz[0] * 1e-12;
-    info.to_thz = sp->freq_hz[sp->n - 1] * 1e-12;
+    info.from_thz = sp->freq_hz[0] / 1e12;
+    info.to_thz = sp->freq_hz[sp->n - 1] / 1e12;
     spectrum_range(sp, &info.min_value, &info.max_value);
     return info;
 }
@@ -176,8 +192,10 @@ thz_status thz_scene_object(const thz_scene *s, size_t i, thz_object_info *out)
         .triangles = o->mesh.n_triangles,
         .area_m2 = o->mesh.total_area_m2,
     };
-    memcpy(out->bbox_min_m, o->mesh.bbox_min_m, sizeof out->bbox_min_m);
-    memcpy(out->bbox_max_m, o->mesh.bbox_max_m, sizeof out->bbox_max_m);
+    for (int a = 0; a < 3; a++) {
+        out->bbox_min_m[a] = api_float_decimal(o->mesh.bbox_min_m[a]);
+        out->bbox_max_m[a] = api_float_decimal(o->mesh.bbox_max_m[a]);
+    }
     return THZ_OK;
 }
 

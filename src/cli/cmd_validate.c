@@ -1,6 +1,7 @@
 /* thzmap validate SCENE.json: loads and checks a scene, prints what it holds (its
  * channels, materials, objects with their geometry, sensors, and the emitted spectral
  * power per channel) and its warnings. Exit 0 when the scene is valid, 2 when not. */
+#include <float.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -184,11 +185,22 @@ static void validate_print(const thz_scene *s)
             snprintf(kind, sizeof kind, "shell %g mm", o.thickness_m * 1e3);
         else
             snprintf(kind, sizeof kind, "%s", o.two_sided ? "solid two-sided" : "solid");
+        /* the vertices are floats: a coordinate below their resolution at the object's
+         * extent is rounding (a rotated screen's bottom at 2.384e-08 m), shown as 0 */
+        double b[6], extent = 0.0;
+        for (int a = 0; a < 3; a++) {
+            b[a] = o.bbox_min_m[a];
+            b[3 + a] = o.bbox_max_m[a];
+        }
+        for (int k = 0; k < 6; k++)
+            extent = fmax(extent, fabs(b[k]));
+        for (int k = 0; k < 6; k++)
+            if (fabs(b[k]) < 4.0 * FLT_EPSILON * extent)
+                b[k] = 0.0;
         printf("  [%zu] %s: %s, material %s, %zu triangles, area %.6g m², temperature %.2f K, "
                "bounds [%.4g, %.4g, %.4g] to [%.4g, %.4g, %.4g] m\n",
-               i, o.name, kind, o.material_name, o.triangles, o.area_m2, o.temperature_k,
-               o.bbox_min_m[0], o.bbox_min_m[1], o.bbox_min_m[2], o.bbox_max_m[0], o.bbox_max_m[1],
-               o.bbox_max_m[2]);
+               i, o.name, kind, o.material_name, o.triangles, o.area_m2, o.temperature_k, b[0],
+               b[1], b[2], b[3], b[4], b[5]);
     }
     printf("  total: %zu triangles, area %.6g m²\n", total_triangles, total_area);
     printf("\nsensors: %zu\n", si.n_sensors);

@@ -34,6 +34,11 @@ expect_line "$tmp/out" 'cam: 64 x 64 pixels, fov 40 deg, oversampling 2 x 2, ape
 expect_line "$tmp/out" '^atmosphere: constant'
 expect_line "$tmp/out" '^  table: reflectivity table \(5 points'
 
+# a rotated rectangle's bottom edge lies at z = 2.4e-08 m in float vertices: shown as 0
+"$thzmap" validate "$repo/examples/walker/scene.json" >"$tmp/walker" 2>"$tmp/err" ||
+    fail "walker: exit $?: $(cat "$tmp/err")"
+expect_line "$tmp/walker" 'screen: .* bounds \[-0\.6, 0, 0\] to \[0\.6, 0, 1\.8\] m$'
+
 # P_A = sum pi eps-bar A B(T) over emitting sides, here at the channel centre (the
 # band mean over a 1 % band differs by ~1e-5), computed independently in Python.
 pa=$(awk '/^emitted spectral power/ {getline; print $(NF-1)}' "$tmp/out")

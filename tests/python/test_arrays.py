@@ -8,7 +8,7 @@ import os
 import numpy as np
 import pytest
 import thzmap
-from conftest import (CUBES, MAPS, assert_bitwise_equal, read_envi, run_cli,
+from conftest import (CUBES, MAPS, REPO, assert_bitwise_equal, read_envi, run_cli,
                       tiny_scene_dict)
 
 SEED = 7
@@ -131,6 +131,18 @@ def test_scene_accessors(tiny_dir):
     table = [m for m in scene.materials if m.name == "table"][0]
     assert table.reflectivity.kind == "table"
     assert scene.info.path == "tiny"
+
+
+def test_scene_values_as_written():
+    """A channel's frequency_thz is the scene file's number (0.8, not the 0.7999999999999999
+    of 8e11 Hz x 1e-12), and an object's bounds are its float vertices' shortest decimals
+    (0.6, not 0.6000000238418579)."""
+    scene = thzmap.load_scene(os.path.join(REPO, "examples", "walker", "scene.json"))
+    assert [c.frequency_thz for c in scene.channels] == [0.3, 0.8]
+    screen = [o for o in scene.objects if o.name == "screen"][0]
+    assert screen.bbox_min_m[0] == -0.6 and screen.bbox_max_m[0] == 0.6
+    assert screen.bbox_max_m[2] == 1.8
+    assert abs(screen.bbox_min_m[2]) < 1e-7  # the rotation's float rounding: kept, not hidden
 
 
 def test_measured_planes(tiny_dir, thzmap_binary):
