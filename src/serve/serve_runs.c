@@ -361,7 +361,10 @@ static ssize_t serve_stream_read(void *cls, uint64_t pos, char *buf, size_t max)
     struct timespec until;
     clock_gettime(CLOCK_REALTIME, &until);
     until.tv_sec += 15;
-    while (j && !s->stopping && j->version == st->seen)
+    /* at stop every job is cancelled and the worker joined before the daemon stops, so
+     * a running job soon ends: its stream waits for that final state (the page shows it)
+     * rather than ending at once */
+    while (j && j->version == st->seen && !(s->stopping && serve_job_finished(j)))
         if (pthread_cond_timedwait(&s->changed, &s->lock, &until) != 0)
             break;
     ssize_t n;
@@ -376,7 +379,7 @@ static ssize_t serve_stream_read(void *cls, uint64_t pos, char *buf, size_t max)
                             st->ended ? "event: end\ndata: {}\n\n" : "")
                  : snprintf(buf, max, ": out of memory\n\n");
         free(text);
-    } else if (!j || s->stopping) {
+    } else if (!j || (s->stopping && serve_job_finished(j))) {
         st->ended = true;
         n = snprintf(buf, max, "event: end\ndata: {}\n\n");
     } else {

@@ -22,6 +22,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 from serve_client import Server as Client, check, finish
@@ -538,11 +539,19 @@ def test_sigterm(root, env):
         "command": "simulate", "scene": "s/scene.json", "out": "out/term",
         "options": {"photons": 300000000}}, status=202)
     wait_state(srv, run["id"], ("running",))
+    # a page following the run: its stream ends with the run's final state, not just "end"
+    streamed = []
+    follower = threading.Thread(target=lambda: streamed.extend(sse_events(srv, run["id"])))
+    follower.start()
     time.sleep(0.2)  # into the photon phase, its staging directory open
     t0 = time.time()
     rc = srv.stop(signal.SIGTERM)
     print("SIGTERM during a run: exit %s after %.2f s" % (rc, time.time() - t0))
     check(rc == 143, "SIGTERM: exit status %s, expected 143" % rc)
+    follower.join(timeout=30)
+    states = [d.get("state") for n, d in streamed if n == "progress"]
+    check(streamed and streamed[-1][0] == "end" and states and states[-1] == "cancelled",
+          "the event stream at SIGTERM: %r" % streamed[-3:])
     after = sorted(os.listdir(os.path.join(root, "out")))
     check(after == before and
           not os.path.exists(os.path.join(root, "out", "term")), "SIGTERM left output behind: %r -> %r" % (before, after))
