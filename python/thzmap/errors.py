@@ -11,7 +11,7 @@ from . import _lib
 
 class Error(Exception):
     """A failure reported by libthzmap. `status` is the library's status name
-    ("bad input", "I/O error", ...), `message` its one-line message."""
+    ("bad input", "input/output error", ...), `message` its one-line message."""
 
     def __init__(self, message, status=None):
         super().__init__(message)

@@ -71,20 +71,26 @@ cleanup:
     return st;
 }
 
+/* The tables in the data directory. */
+#define ITU_O2_FILE "atmosphere/itu_r_p676_13_oxygen_lines.csv"
+#define ITU_H2O_FILE "atmosphere/itu_r_p676_13_water_vapour_lines.csv"
+
 thz_status atm_itu_create(atm_itu_data **out, const char *data_dir, thz_error *err)
 {
-    char dir[THZ_PATH_MAX];
+    char dir[THZ_PATH_MAX], path[THZ_PATH_MAX];
     thz_status st = thz_data_dir_find(data_dir, dir, sizeof dir, err);
+    if (st == THZ_OK)
+        st = thz_data_file(data_dir, ITU_O2_FILE, path, sizeof path, err);
+    if (st == THZ_OK)
+        st = thz_data_file(data_dir, ITU_H2O_FILE, path, sizeof path, err);
     if (st != THZ_OK)
         return st;
     atm_itu_data *itu = thz_calloc(1, sizeof *itu);
     if (!itu)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-    st = read_lines(dir, "atmosphere/itu_r_p676_13_oxygen_lines.csv", "a", &itu->o2, &itu->n_o2,
-                    err);
+    st = read_lines(dir, ITU_O2_FILE, "a", &itu->o2, &itu->n_o2, err);
     if (st == THZ_OK)
-        st = read_lines(dir, "atmosphere/itu_r_p676_13_water_vapour_lines.csv", "b", &itu->h2o,
-                        &itu->n_h2o, err);
+        st = read_lines(dir, ITU_H2O_FILE, "b", &itu->h2o, &itu->n_h2o, err);
     if (st != THZ_OK) {
         atm_itu_destroy(itu);
         return st;

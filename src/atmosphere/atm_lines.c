@@ -413,8 +413,10 @@ double atm_lines_grid_step_hz(const atm_lines_data *d, double lo_hz, double hi_h
 
 /* ---- Set-up -------------------------------------------------------------------- */
 
-static thz_status resolve(char *buf, size_t n, const char *given, const char *dir, const char *name,
-                          thz_error *err)
+/* A catalogue's path: the file given, else the data directory's (checked there: a
+ * missing one is thzmap's installation's fault, thz_data_file). */
+static thz_status resolve(char *buf, size_t n, const char *given, const char *data_dir,
+                          const char *name, thz_error *err)
 {
     if (given) {
         if (strlen(given) >= n)
@@ -422,40 +424,38 @@ static thz_status resolve(char *buf, size_t n, const char *given, const char *di
         strcpy(buf, given);
         return THZ_OK;
     }
-    return thz_path_join(buf, n, dir, name, err);
+    return thz_data_file(data_dir, name, buf, n, err);
 }
 
 thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
                             const atm_lines_options *opt, thz_error *err)
 {
     enum { PATH = 4096 };
-    char dir[PATH];
-    char p_h2o[PATH], p_o2[PATH], p_o2c[PATH], p_qh2o[PATH], p_qo2[PATH], p_cont[PATH];
+    char p_h2o[PATH], p_o2[PATH], p_o2c[PATH], p_qh2o[PATH], p_qo2[PATH], p_cont[PATH] = "";
     raw_catalog h2o = {0}, o2 = {0}, o2c = {0};
     partition_sums q_h2o = {0}, q_o2 = {0};
-    thz_status st = thz_data_dir_find(opt->data_dir, dir, sizeof dir, err);
-    if (st != THZ_OK)
-        return st;
     atm_lines_data *d = thz_calloc(1, sizeof *d);
     if (!d)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     d->air = *air;
     d->continuum = opt->continuum;
-    st = resolve(p_h2o, PATH, opt->h2o_lines_file, dir, "atmosphere/am14_h2o_lines.csv", err);
+    const char *data = opt->data_dir;
+    thz_status st =
+        resolve(p_h2o, PATH, opt->h2o_lines_file, data, "atmosphere/am14_h2o_lines.csv", err);
     if (st == THZ_OK)
-        st = resolve(p_o2, PATH, opt->o2_lines_file, dir, "atmosphere/am14_o2_lines_uncoupled.csv",
+        st = resolve(p_o2, PATH, opt->o2_lines_file, data, "atmosphere/am14_o2_lines_uncoupled.csv",
                      err);
     if (st == THZ_OK)
-        st = resolve(p_o2c, PATH, opt->o2_coupled_lines_file, dir,
+        st = resolve(p_o2c, PATH, opt->o2_coupled_lines_file, data,
                      "atmosphere/am14_o2_lines_coupled.csv", err);
     if (st == THZ_OK)
-        st = resolve(p_qh2o, PATH, opt->h2o_partition_sums_file, dir,
+        st = resolve(p_qh2o, PATH, opt->h2o_partition_sums_file, data,
                      "atmosphere/am14_h2o_partition_sums_tips2021.csv", err);
     if (st == THZ_OK)
-        st = resolve(p_qo2, PATH, opt->o2_partition_sums_file, dir,
+        st = resolve(p_qo2, PATH, opt->o2_partition_sums_file, data,
                      "atmosphere/am14_o2_partition_sums_tips2021.csv", err);
-    if (st == THZ_OK)
-        st = resolve(p_cont, PATH, opt->continuum_file, dir,
+    if (st == THZ_OK && d->continuum)
+        st = resolve(p_cont, PATH, opt->continuum_file, data,
                      "atmosphere/mt_ckd_4.2_h2o_continuum_0-520cm-1.csv", err);
     /* Regular files of bounded size only: the readers grow their buffers line by line, and
      * /dev/zero or a FIFO would grow them, or block, without end. */

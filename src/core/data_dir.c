@@ -3,6 +3,7 @@
 #include "core/data_dir.h"
 
 #include <dlfcn.h>
+#include <errno.h>
 #include <limits.h>
 #include <link.h>
 #include <stdbool.h>
@@ -68,14 +69,48 @@ static bool installed_dir(char *out, size_t size)
     return copy_path(out, size, resolved, NULL) == THZ_OK;
 }
 
+/* The rule of data_dir.h; *source says which step chose the directory, in words. */
+static thz_status data_dir_choose(const char *given, char *out, size_t size, const char **source,
+                                  thz_error *err)
+{
+    if (given && given[0]) {
+        *source = "as given";
+        return copy_path(out, size, given, err);
+    }
+    const char *env = getenv("THZMAP_DATA_DIR");
+    if (env && env[0]) {
+        *source = "from THZMAP_DATA_DIR";
+        return copy_path(out, size, env, err);
+    }
+    if (installed_dir(out, size)) {
+        *source = "installed with the library";
+        return THZ_OK;
+    }
+    *source = "the build's, as no share/thzmap lies beside the library";
+    return copy_path(out, size, THZ_DATA_DIR, err);
+}
+
 thz_status thz_data_dir_find(const char *given, char *out, size_t size, thz_error *err)
 {
-    if (given && given[0])
-        return copy_path(out, size, given, err);
-    const char *env = getenv("THZMAP_DATA_DIR");
-    if (env && env[0])
-        return copy_path(out, size, env, err);
-    if (installed_dir(out, size))
-        return THZ_OK;
-    return copy_path(out, size, THZ_DATA_DIR, err);
+    const char *source;
+    return data_dir_choose(given, out, size, &source, err);
+}
+
+thz_status thz_data_file(const char *given, const char *name, char *out, size_t size,
+                         thz_error *err)
+{
+    char dir[THZ_PATH_MAX];
+    const char *source;
+    thz_status st = data_dir_choose(given, dir, sizeof dir, &source, err);
+    if (st == THZ_OK)
+        st = thz_path_join(out, size, dir, name, err);
+    if (st != THZ_OK)
+        return st;
+    if (access(out, R_OK) != 0)
+        return thz_error_set(err, THZ_ERR_IO,
+                             "%s: cannot read thzmap's own data file (%s); the data directory "
+                             "%s (%s) lacks it: reinstall thzmap, or set THZMAP_DATA_DIR to a "
+                             "complete copy of its data",
+                             out, strerror(errno), dir, source);
+    return THZ_OK;
 }

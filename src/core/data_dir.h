@@ -24,4 +24,11 @@
  * it does not fit (out then holds ""). Thread-safe; reads the environment. */
 thz_status thz_data_dir_find(const char *given, char *out, size_t size, thz_error *err);
 
+/* The path of the data file `name` ("atmosphere/am14_h2o_lines.csv") in that directory,
+ * into out, checked readable. A file missing there is THZ_ERR_IO, not bad input: thzmap
+ * installed in part, or THZMAP_DATA_DIR naming an incomplete copy; the message names the
+ * file, the directory, which rule chose it, and the remedy. */
+thz_status thz_data_file(const char *given, const char *name, char *out, size_t size,
+                         thz_error *err);
+
 #endif

@@ -97,12 +97,10 @@ static thz_status refractive_index(load_ctx *ctx, const load_cursor *k, thz_mate
 static thz_status p2040_rows(load_ctx *ctx, const load_cursor *mc, const char *name,
                              permittivity_model *pm)
 {
-    char dir[THZ_PATH_MAX], path[THZ_PATH_MAX];
-    thz_status st = thz_data_dir_find(NULL, dir, sizeof dir, ctx->err);
+    char path[THZ_PATH_MAX];
+    thz_status st = thz_data_file(NULL, P2040_FILE, path, sizeof path, ctx->err);
     if (st != THZ_OK)
         return st;
-    if (snprintf(path, sizeof path, "%s/%s", dir, P2040_FILE) >= (int)sizeof path)
-        return thz_error_set(ctx->err, THZ_ERR_IO, "%s/%s: path too long", dir, P2040_FILE);
     json_t *doc = NULL; /* as a scene is read: no FIFO or device, line:column of syntax */
     st = load_json_file(path, NULL, NULL, "ITU-R P.2040 table", LOAD_MAX_SCENE_BYTES, &doc,
                         ctx->err);

@@ -70,10 +70,10 @@ thz_status material_library_load(material_library **out, thz_error *err)
     *out = NULL;
     char dir[THZ_PATH_MAX], path[THZ_PATH_MAX];
     thz_status st = thz_data_dir_find(NULL, dir, sizeof dir, err);
+    if (st == THZ_OK)
+        st = thz_data_file(NULL, MATERIAL_LIBRARY_FILE, path, sizeof path, err);
     if (st != THZ_OK)
         return st;
-    if (snprintf(path, sizeof path, "%s/%s", dir, MATERIAL_LIBRARY_FILE) >= (int)sizeof path)
-        return thz_error_set(err, THZ_ERR_IO, "%s/%s: path too long", dir, MATERIAL_LIBRARY_FILE);
     json_t *doc = NULL; /* as a scene is read: no FIFO or device, line:column of syntax */
     st = load_json_file(path, NULL, NULL, "material library", LOAD_MAX_SCENE_BYTES, &doc, err);
     if (st != THZ_OK)

@@ -5,8 +5,8 @@
 # command and option of the CLI's --help in it) and the run-time data. Builds every
 # examples/api/*.c against P with pkg-config alone and runs it on the installed
 # library. Proves that the installed library and CLI read their data from
-# P/share/thzmap (a catalogue missing there makes them fail naming that path while
-# the build's data/ is complete), also after P is moved, and that THZMAP_DATA_DIR
+# P/share/thzmap (a catalogue missing there makes them fail, exit 1 as an I/O error and
+# not bad input, naming that path and the remedy, while the build's data/ is complete), also after P is moved, and that THZMAP_DATA_DIR
 # overrides. Writes nothing into the build tree but what `cmake --install` writes.
 # usage: test_install.sh THZMAP_BINARY REPO_DIR
 set -u
@@ -94,7 +94,13 @@ else
     for section in NAME SYNOPSIS DESCRIPTION COMMANDS FILES ENVIRONMENT 'EXIT STATUS'; do
         grep -q "^$section" "$tmp/man.txt" || fail "thzmap.1 has no $section section"
     done
-    grep -q 'THZMAP_DATA_DIR' "$tmp/man.txt" || fail "thzmap.1 does not describe THZMAP_DATA_DIR"
+    # every environment variable the program reads
+    awk '/^ENVIRONMENT/ {f = 1; next} /^[A-Z]/ {f = 0} f' "$tmp/man.txt" >"$tmp/man.environment"
+    variables=$(grep -rhoE 'getenv\("[A-Z_]+"\)' "$repo/src" | sed -E 's/getenv\("([A-Z_]+)"\)/\1/' | sort -u)
+    [[ $variables == *THZMAP_DATA_DIR* ]] || fail "no getenv(\"THZMAP_DATA_DIR\") found in src/"
+    for v in $variables; do
+        grep -Eq "^ +$v\$" "$tmp/man.environment" || fail "thzmap.1 ENVIRONMENT does not describe $v (src/ reads it)"
+    done
     commands=$("$thzmap" --help | awk '/^commands:/ {f = 1; next} f && /^  [a-z]/ {print $1}')
     [[ -n $commands ]] || fail "no commands in thzmap --help"
     awk '/^COMMANDS/ {f = 1; next} /^[A-Z]/ {f = 0} f' "$tmp/man.txt" >"$tmp/man.commands"
@@ -184,20 +190,20 @@ if [[ -x $load ]]; then
     mv "$P/share/thzmap/$catalogue" "$tmp/catalogue.csv"
     "$thzmap" validate "$tmp/lines/scene.json" >/dev/null 2>&1 ||
         fail "the build tree's thzmap no longer loads the lines scene (its data/ must be untouched)"
-    expect_load "installed, catalogue missing" 2 "$P/share/thzmap/$catalogue"
-    expect_cli "installed, catalogue missing" 2 "$P/share/thzmap/$catalogue"
+    expect_load "installed, catalogue missing" 1 "$P/share/thzmap/$catalogue: cannot read thzmap's own data file"
+    expect_cli "installed, catalogue missing" 1 "(installed with the library) lacks it: reinstall thzmap, or set THZMAP_DATA_DIR"
     # Moved as a whole, the tree still finds its own data (nothing of P compiled in).
     mv "$P" "$tmp/moved"
     P=$tmp/moved lib=$tmp/moved/lib
-    expect_load "moved prefix, catalogue missing" 2 "$P/share/thzmap/$catalogue"
-    expect_cli "moved prefix, catalogue missing" 2 "$P/share/thzmap/$catalogue"
+    expect_load "moved prefix, catalogue missing" 1 "$P/share/thzmap/$catalogue"
+    expect_cli "moved prefix, catalogue missing" 1 "$P/share/thzmap/$catalogue"
     mv "$tmp/catalogue.csv" "$P/share/thzmap/$catalogue"
     expect_load "moved prefix, complete" 0 ""
     # THZMAP_DATA_DIR overrides the installed directory, also to fail.
     mkdir -p "$tmp/alt"
     cp -r "$repo/data/." "$tmp/alt/"
     rm "$tmp/alt/$catalogue"
-    expect_load "THZMAP_DATA_DIR without the catalogue" 2 "$tmp/alt/$catalogue" THZMAP_DATA_DIR="$tmp/alt"
+    expect_load "THZMAP_DATA_DIR without the catalogue" 1 "$tmp/alt (from THZMAP_DATA_DIR) lacks it" THZMAP_DATA_DIR="$tmp/alt"
     cp "$repo/data/$catalogue" "$tmp/alt/$catalogue"
     mv "$P/share/thzmap/$catalogue" "$tmp/catalogue.csv"
     expect_load "THZMAP_DATA_DIR complete, installed incomplete" 0 "" THZMAP_DATA_DIR="$tmp/alt"

@@ -3,6 +3,8 @@ column); wrong arguments raise ArgumentError before the library is called; nothi
 may crash the interpreter."""
 import json
 import math
+import os
+import shutil
 
 import numpy as np
 import pytest
@@ -214,3 +216,20 @@ def test_empty_paths_and_boolean_planes_are_argument_errors(tiny_dir, tmp_path):
         thzmap.load_scene("")
     with pytest.raises(thzmap.ArgumentError, match="plane"):
         result.image(0).plane(True)
+
+
+def test_a_data_file_missing_is_no_scene_error(tmp_path, monkeypatch):
+    """A valid scene whose library material thzmap's own data directory lacks: an I/O
+    error naming the file and THZMAP_DATA_DIR (the installation's fault), not a
+    SceneError (bad input)."""
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    data = tmp_path / "data"
+    shutil.copytree(os.path.join(repo, "data"), data)
+    (data / "materials" / "library.json").unlink()
+    monkeypatch.setenv("THZMAP_DATA_DIR", str(data))
+    with pytest.raises(thzmap.Error) as e:
+        thzmap.load_scene(os.path.join(repo, "examples", "outdoor-concealed", "scene.json"))
+    assert not isinstance(e.value, thzmap.SceneError)
+    assert e.value.status == "input/output error"
+    assert str(data / "materials" / "library.json") in e.value.message
+    assert "THZMAP_DATA_DIR" in e.value.message
