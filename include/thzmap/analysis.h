@@ -3,10 +3,10 @@
  * object_id truth (`thzmap classify`), and the choice of channel frequencies that best
  * separate a scene's targets (`thzmap bands`). docs/analysis.md describes the methods.
  */
+#include "thzmap/thzmap.h" /* every part, in order: this one among them */
+
 #ifndef THZMAP_ANALYSIS_H
 #define THZMAP_ANALYSIS_H
-
-#include "thzmap/thzmap.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -5,10 +5,10 @@
  * and humidity: "lines" (line-by-line from catalogues), "itu-p676" (1-1000 GHz) or
  * "none"; or a scene's atmosphere, whatever its model. Read-only once made.
  */
+#include "thzmap/thzmap.h" /* every part, in order: this one among them */
+
 #ifndef THZMAP_ATMOSPHERE_H
 #define THZMAP_ATMOSPHERE_H
-
-#include "thzmap/thzmap.h"
 
 #ifdef __cplusplus
 extern "C" {

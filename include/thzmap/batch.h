@@ -17,10 +17,10 @@
  * A frame whose scene differs from the previous frame's only in its sensors is rendered
  * (as thz_render_run) from the photons of the first frame of that run, fired once.
  */
+#include "thzmap/thzmap.h" /* every part, in order: this one among them */
+
 #ifndef THZMAP_BATCH_H
 #define THZMAP_BATCH_H
-
-#include "thzmap/thzmap.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -6,10 +6,10 @@
  * the installed or source data/); read-only once opened. Strings in the info structs
  * belong to the library.
  */
+#include "thzmap/thzmap.h" /* every part, in order: this one among them */
+
 #ifndef THZMAP_MATERIALS_H
 #define THZMAP_MATERIALS_H
-
-#include "thzmap/thzmap.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -15,6 +15,8 @@
  * rank 0 destroys its context. A batch deals whole frames to the ranks when it can, each
  * computed alone and sent to rank 0 (docs/mpi.md "Batch frames"). Only rank 0 writes.
  */
+#include "thzmap/thzmap.h" /* every part, in order: this one among them */
+
 #ifndef THZMAP_MPI_H
 #define THZMAP_MPI_H
 

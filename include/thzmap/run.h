@@ -11,10 +11,10 @@
  * for any thread count, in memory or written. Long calls report progress and can be
  * cancelled through the context (THZ_ERR_CANCELLED: nothing is returned or written).
  */
+#include "thzmap/thzmap.h" /* every part, in order: this one among them */
+
 #ifndef THZMAP_RUN_H
 #define THZMAP_RUN_H
-
-#include "thzmap/thzmap.h"
 
 #ifdef __cplusplus
 extern "C" {

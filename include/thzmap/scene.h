@@ -6,10 +6,10 @@
  * order of the scene file; info structs are filled by value, their strings belong to
  * the scene.
  */
+#include "thzmap/thzmap.h" /* every part, in order: this one among them */
+
 #ifndef THZMAP_SCENE_H
 #define THZMAP_SCENE_H
-
-#include "thzmap/thzmap.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -123,6 +123,8 @@ THZ_API const char *thz_context_last_message(const thz_context *ctx);
 }
 #endif
 
+/* The parts, in the order their types build on each other. Each part includes this file
+ * before its own guard, so any part included alone brings in all of them, in this order. */
 #include "thzmap/scene.h"
 #include "thzmap/run.h"
 #include "thzmap/atmosphere.h"

@@ -173,7 +173,7 @@ thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err)
         rtcJoinCommitScene(a->rtc);
         enum RTCError e = rtcGetDeviceError(a->device);
         if (e != RTC_ERROR_NONE) {
-#pragma omp critical(accel_build_error)
+#pragma omp critical /* unnamed: a named one is a global symbol of the library */
             if (build_error == RTC_ERROR_NONE)
                 build_error = e;
         }

@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# The library's public surface, three ways that must agree: the THZ_API declarations
+# in include/thzmap/*.h, the dynamic symbols libthzmap.so exports (exactly those: a
+# named OpenMP critical section once exported a lock of its own), and docs/api.md's
+# function list (every function, nothing else). And every public header compiles on
+# its own, as C17 and as C++17, with the warnings as errors.
+# usage: test_api_surface.sh THZMAP_BINARY REPO_DIR
+set -u
+thzmap=$1
+repo=$2
+build=$(cd "$(dirname "$thzmap")" && pwd)
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+
+fail() {
+    echo "FAIL: $*"
+    failures=$((failures + 1))
+}
+
+lib=$build/libthzmap.so
+[[ -f $lib ]] || fail "no $lib"
+
+# --- declared, exported, documented ----------------------------------------------------------
+/usr/bin/python3 - "$repo" >"$tmp/declared" <<'PY' || fail "could not read the headers"
+import glob, re, sys
+text = "".join(open(h).read() for h in sorted(glob.glob(sys.argv[1] + "/include/thzmap/*.h")))
+text = re.sub(r"/\*.*?\*/", " ", text, flags=re.S)
+for name in sorted(set(re.findall(r"\bTHZ_API\b[^;{]*?\b(thz_\w+)\s*\(", text))):
+    print(name)
+PY
+[[ $(wc -l <"$tmp/declared") -gt 100 ]] || fail "only $(wc -l <"$tmp/declared") THZ_API functions found in include/thzmap/"
+
+nm -D --defined-only "$lib" | awk '{print $3}' | sort -u >"$tmp/exported"
+comm -13 "$tmp/declared" "$tmp/exported" >"$tmp/extra"
+comm -23 "$tmp/declared" "$tmp/exported" >"$tmp/missing"
+[[ -s $tmp/extra ]] && fail "libthzmap.so exports symbols no header declares: $(tr '\n' ' ' <"$tmp/extra")"
+[[ -s $tmp/missing ]] && fail "declared but not exported: $(tr '\n' ' ' <"$tmp/missing")"
+
+# docs/api.md's table: "thz_photons_fire, _fire_channel": a name starting with "_" continues
+# a prefix of the last full name (thz_photons + _fire_channel)
+/usr/bin/python3 - "$repo/docs/api.md" "$tmp/declared" >"$tmp/docs.check" <<'PY'
+import re, sys
+doc = open(sys.argv[1]).read()
+declared = set(open(sys.argv[2]).read().split())
+table = doc.split("## Function list", 1)[1].split("\n## ", 1)[0]
+listed, bad = set(), []
+for row in table.splitlines():
+    cells = row.split("|")
+    if len(cells) < 3:
+        continue
+    last = None
+    for name in re.findall(r"`([A-Za-z_]\w*)`", cells[2]):
+        if name.startswith("thz_"):
+            last = name
+            full = name
+        elif name.startswith("_") and last:
+            parts = last.split("_")
+            full = next((p + name for p in ("_".join(parts[:k]) for k in range(len(parts), 1, -1))
+                         if p + name in declared), None)
+        else:
+            full = None
+        if full in declared:
+            listed.add(full)
+        else:
+            bad.append(name if full is None else full)
+for name in sorted(declared - listed):
+    print("not in docs/api.md's function list:", name)
+for name in bad:
+    print("docs/api.md's function list names no declared function:", name)
+PY
+[[ -s $tmp/docs.check ]] && fail "$(cat "$tmp/docs.check")"
+
+# --- each header alone ---------------------------------------------------------------------
+for h in "$repo"/include/thzmap/*.h; do
+    name=$(basename "$h")
+    printf '#include <thzmap/%s>\nint thz_surface_test_unused;\n' "$name" >"$tmp/alone.c"
+    cc -std=c17 -Wall -Wextra -Wpedantic -Werror -fsyntax-only -I"$repo/include" "$tmp/alone.c" \
+        >"$tmp/cc.out" 2>&1 || fail "<thzmap/$name> alone does not compile as C17: $(head -c 600 "$tmp/cc.out")"
+    c++ -std=c++17 -Wall -Wextra -Wpedantic -Werror -fsyntax-only -I"$repo/include" -x c++ \
+        "$tmp/alone.c" >"$tmp/cxx.out" 2>&1 ||
+        fail "<thzmap/$name> alone does not compile as C++17: $(head -c 600 "$tmp/cxx.out")"
+done
+
+if [[ $failures -ne 0 ]]; then
+    echo "$failures failure(s)"
+    exit 1
+fi
+echo "ok: $(wc -l <"$tmp/declared") functions declared, exported and listed; every header compiles alone"
