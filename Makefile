@@ -15,14 +15,19 @@ CLANG_BUILD ?= build-clang
 FUZZ_SECONDS ?= 60
 FUZZ_CI_SECONDS ?= 30
 
-.PHONY: all deps build install demo check test test-asan test-compilers fuzz-build fuzz fuzz-ci bench format clean
+.PHONY: all deps deps-build build install uninstall demo check test test-asan test-compilers fuzz-build fuzz fuzz-ci bench format clean
 
 all: build
 
-deps:
-	@bash scripts/install-deps.sh
+# What building and running need (deps-build), and that with what the tests need (deps):
+# scripts/install-deps.sh says which packages are which.
+deps-build:
+	@bash scripts/install-deps.sh build
 
-build: deps
+deps:
+	@bash scripts/install-deps.sh all
+
+build: deps-build
 	cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 	cmake --build $(BUILD) -j $(JOBS)
 
@@ -30,12 +35,17 @@ build: deps
 # PREFIX; the set-up commands run it (as root) before the demo or the tests.
 install: build
 	cmake --install $(BUILD) --prefix $(PREFIX) >/dev/null
-	@echo "installed thzmap under $(PREFIX)"
+	@echo "installed thzmap under $(DESTDIR)$(PREFIX)"
+
+# Removes what `make install` put under PREFIX (scripts/uninstall.sh: the list from this
+# build, the directories of thzmap's own when empty).
+uninstall:
+	bash scripts/uninstall.sh $(BUILD) $(PREFIX)
 
 demo: build
 	bash scripts/demo.sh $(BUILD)/thzmap $(DEMO_OUT)
 
-test: build
+test: deps build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 test-asan: deps
@@ -62,7 +72,7 @@ fuzz-ci: fuzz-build
 # processor (-march=native): tests/builds/compare.sh. Everything is built with clang
 # (tests, bench, the web page's server), so that its -Werror covers all the C, not only
 # the program.
-test-compilers: build
+test-compilers: deps build
 	cmake -S . -B $(CLANG_BUILD) -G Ninja -DCMAKE_C_COMPILER=clang \
 	  -DCMAKE_BUILD_TYPE=Release -DTHZ_NATIVE=OFF >/dev/null
 	cmake --build $(CLANG_BUILD) -j $(JOBS)

@@ -1,21 +1,36 @@
 #!/usr/bin/env bash
-# Installs the Debian packages thzmap needs to build, test and run, if any is missing.
-# Run as root on Debian 12 (bookworm). Idempotent: does nothing when all are present.
+# Installs the Debian packages thzmap needs, if any is missing.
+#   install-deps.sh build   what building, installing and running need (make build,
+#                           make install, make demo): a user installing into a prefix
+#                           of their own needs only these
+#   install-deps.sh         those and what the tests, the fuzzing and the benchmark's
+#                           comparisons need (make test, make check, make fuzz)
+# Run as root on Debian 12 (bookworm). Idempotent: does nothing when all are present;
+# without root it names the missing packages and exits 1.
 set -euo pipefail
 packages=(
-  build-essential cmake ninja-build pkg-config clang libomp-dev groff-base
+  build-essential cmake ninja-build pkg-config
   libembree-dev libjansson-dev libassimp-dev librandom123-dev libpng-dev libzstd-dev
   libplplot-dev plplot-driver-cairo libcmocka-dev libfftw3-dev
-  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev ffmpeg
-  python3 python3-numpy python3-spectral gdal-bin python3-gdal
-  python3-pytest python3-matplotlib python3-sklearn python3-tqdm
-  strace zstd
+  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
+  python3 python3-numpy  # the Python package
   libmicrohttpd-dev  # optional: thzmap serve, the browser GUI (docs/gui.md)
   libopenmpi-dev openmpi-bin  # optional: MPI runs (docs/mpi.md)
-  libclang-rt-14-dev  # libFuzzer for clang -fsanitize=fuzzer (make fuzz)
   nodejs  # the web page's bundle (three.js, esbuild from npm; docs/gui.md)
-  chromium chromium-driver python3-selenium  # its end-to-end test (tests/gui)
 )
+case "${1:-all}" in
+  build) ;;
+  all)
+    packages+=(
+      clang libomp-dev  # the clang build the tests compare (make test-compilers)
+      groff-base ffmpeg strace zstd  # the man page's, movies' and I/O checks
+      python3-spectral gdal-bin python3-gdal  # reading the ENVI cubes back
+      python3-pytest python3-matplotlib python3-sklearn python3-tqdm
+      libclang-rt-14-dev  # libFuzzer for clang -fsanitize=fuzzer (make fuzz)
+      chromium chromium-driver python3-selenium  # the web page's end-to-end test (tests/gui)
+    ) ;;
+  *) echo "usage: install-deps.sh [build|all]" >&2; exit 2 ;;
+esac
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -3,7 +3,8 @@
  * Everything the `thzmap` program does, in memory: a context (threads, progress and
  * cancellation, warnings), scenes (from a file or a JSON string) with read access,
  * the photon phase as a handle, rendering into image handles whose planes are float
- * arrays, whole runs, and writing results to a directory. docs/api.md is the tour.
+ * arrays, whole runs, and writing results to a directory. docs/api.md is the tour (the
+ * docs/ named in these headers are installed as PREFIX/share/doc/thzmap/).
  *
  * Conventions, as in Embree's rtcore_device.h:
  *   - opaque handles; the function that creates one says so, its _destroy frees it,

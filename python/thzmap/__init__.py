@@ -10,7 +10,8 @@
     result.save("out/teraeye")        # the files `thzmap simulate` writes
 
 A binding of libthzmap's C API (include/thzmap/) through ctypes; docs/python.md tells
-the whole story (installation, threads, cancellation, memory ownership).
+the whole story (installation, threads, cancellation, memory ownership); installed,
+docs/ is PREFIX/share/doc/thzmap/.
 """
 from . import _lib
 from ._call import RunWarning

@@ -7,7 +7,8 @@
 # library. Proves that the installed library and CLI read their data from
 # P/share/thzmap (a catalogue missing there makes them fail, exit 1 as an I/O error and
 # not bad input, naming that path and the remedy, while the build's data/ is complete), also after P is moved, and that THZMAP_DATA_DIR
-# overrides. Writes nothing into the build tree but what `cmake --install` writes.
+# overrides; and that scripts/uninstall.sh (make uninstall) removes it all again. Writes
+# nothing into the build tree but what `cmake --install` writes.
 # usage: test_install.sh THZMAP_BINARY REPO_DIR
 set -u
 thzmap=$1
@@ -68,6 +69,12 @@ for h in "$repo"/include/thzmap/*.h; do
     cmp -s "$h" "$P/include/thzmap/$(basename "$h")" || fail "header $(basename "$h") not installed as is"
 done
 [[ -f $lib/pkgconfig/thzmap.pc ]] || fail "no lib/pkgconfig/thzmap.pc"
+# the docs the headers, the man page and the Python package name as docs/
+for d in "$repo"/docs/*.md README.md; do
+    [[ $d == README.md ]] && d=$repo/README.md
+    cmp -s "$d" "$P/share/doc/thzmap/$(basename "$d")" || fail "$(basename "$d") not installed under share/doc/thzmap"
+done
+[[ -e $P/share/doc/thzmap/thzmap.1 ]] && fail "the man page is also under share/doc/thzmap"
 (cd "$repo/data" && find . -type f) | sort >"$tmp/data.list"
 [[ -s $tmp/data.list ]] || fail "the repository has no data/ files"
 while read -r f; do
@@ -213,6 +220,28 @@ if [[ -x $load ]]; then
     expect_load "no installed data directory" 0 ""
 else
     fail "examples/api/load_scene.c did not build: cannot check the data directory"
+fi
+
+# --- make uninstall (scripts/uninstall.sh) removes what the install put there, no more --------
+U=$tmp/uninstall
+if cmake --install "$build" --prefix "$U" >"$tmp/install2.log" 2>&1; then
+    python_dir=$(find "$U" -type d -path '*-packages/thzmap' | head -1)
+    [[ -n $python_dir ]] && mkdir -p "$python_dir/__pycache__" && touch "$python_dir/__pycache__/x.pyc"
+    touch "$U/lib/someone-else.so"
+    mkdir -p "$U/share/man/man1"
+    if bash "$repo/scripts/uninstall.sh" "$build" "$U" >"$tmp/uninstall.log" 2>&1; then
+        (cd "$U" && find . -type f) >"$tmp/left"
+        [[ $(cat "$tmp/left") == "./lib/someone-else.so" ]] ||
+            fail "uninstall left (or removed) files: $(tr '\n' ' ' <"$tmp/left")"
+        for d in include/thzmap share/thzmap share/doc/thzmap "${python_dir#"$U"/}"; do
+            [[ -e $U/$d ]] && fail "uninstall left the directory $d"
+        done
+        [[ -d $U/share/man/man1 && -d $U/lib ]] || fail "uninstall removed a shared directory"
+    else
+        fail "uninstall.sh failed: $(cat "$tmp/uninstall.log")"
+    fi
+else
+    fail "the second cmake --install failed: $(cat "$tmp/install2.log")"
 fi
 
 finish
