@@ -41,13 +41,30 @@ thz_status load_unique_name(load_ctx *ctx, const load_cursor *list, size_t i, co
     load_cursor k = load_key(&e, "name");
     if (!(*out)[0])
         return load_fail(ctx, &k, "expected a non-empty %s name", what);
-    for (size_t j = 0; j < i; j++) {
-        json_t *other = json_object_get(json_array_get(list->value, j), "name");
-        if (json_is_string(other) && strcmp(json_string_value(other), *out) == 0)
-            return load_fail(ctx, &k,
-                             "%s name \"%s\" is already used by %s[%zu] (expected unique names)",
-                             what, *out, list->path, j);
+    if (ctx->names_of != list->value || ctx->names_next != i) { /* names before i, afresh */
+        json_decref(ctx->names);
+        ctx->names = json_object();
+        ctx->names_of = list->value;
+        for (size_t j = 0; ctx->names && j < i; j++) {
+            json_t *other = json_object_get(json_array_get(list->value, j), "name");
+            if (json_is_string(other) && !json_object_get(ctx->names, json_string_value(other)) &&
+                json_object_set_new(ctx->names, json_string_value(other),
+                                    json_integer((json_int_t)j)))
+                break;
+        }
     }
+    json_t *earlier = ctx->names ? json_object_get(ctx->names, *out) : NULL;
+    if (earlier)
+        return load_fail(ctx, &k,
+                         "%s name \"%s\" is already used by %s[%zu] (expected unique names)", what,
+                         *out, list->path, (size_t)json_integer_value(earlier));
+    if (!ctx->names || json_object_set_new(ctx->names, *out, json_integer((json_int_t)i))) {
+        json_decref(ctx->names);
+        ctx->names = NULL;
+        ctx->names_of = NULL;
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory checking %s names", what);
+    }
+    ctx->names_next = i + 1;
     return THZ_OK;
 }
 
@@ -348,6 +365,7 @@ static thz_status load_finish(thz_scene **scene, json_t *doc, const char *root, 
                         .scene = *scene,
                         .err = err};
         st = load_document(&ctx, doc);
+        json_decref(ctx.names);
     }
     json_decref(doc);
     if (st != THZ_OK) {

@@ -54,6 +54,11 @@ typedef struct load_ctx {
     bool non_emitting_air;      /* "emitting": false */
     bool air_temperature_given; /* the air's (itu-p676, lines) or temperature_k */
     bool background_given;      /* background_temperature_k */
+    /* load_unique_name's names of the list it checks (an object: name -> index), so that
+     * n names cost n lookups, not n^2 / 2 comparisons (20 000 objects took 7.6 s) */
+    json_t *names;
+    const json_t *names_of; /* the list they are of */
+    size_t names_next;      /* the index they were checked up to */
 } load_ctx;
 
 /* The temperature of emitting air whose model has none (constant, table) when the

@@ -267,6 +267,33 @@ static void test_default_channel_names(void **state)
              "channels[0]");
 }
 
+/* Unique names per list, through the loader's hash of the names seen: a repeat names the
+ * first holder however far back, each list on its own (an object and a sensor may share a
+ * name), and loading one scene after a refused one starts afresh. */
+static void test_unique_names(void **state)
+{
+    (void)state;
+#define NAMED(n)                                                                                   \
+    "{\"name\": \"" n "\", \"type\": \"solid\", \"material\": \"m\", \"temperature_k\": 300, "     \
+    "\"shape\": " BOX "}"
+#define CAMERA(n)                                                                                  \
+    "{\"name\": \"" n                                                                              \
+    "\", \"position_m\": [0, -5, 0], \"look_at_m\": [0, 0, 0], \"fov_deg\": 40, "                  \
+    "\"resolution\": [16, 8]}"
+    load_bad(HEAD CHANNELS MATERIALS "\"objects\": [" NAMED("a") ", " NAMED("b") ", " NAMED(
+                 "c") ", " NAMED("d") ", " NAMED("b") "], \"sensors\": [" CAMERA("c") "]}",
+             "objects[4].name: object name \"b\" is already used by objects[1]");
+    thz_scene *s = load_ok(HEAD CHANNELS MATERIALS "\"objects\": [" NAMED("a") ", " NAMED(
+        "b") "], \"sensors\": [" CAMERA("b") ", " CAMERA("a") "]}");
+    assert_int_equal(s->n_objects, 2);
+    thz_scene_destroy(s);
+    load_bad(HEAD CHANNELS MATERIALS "\"objects\": [" NAMED("a") "], \"sensors\": [" CAMERA(
+                 "x") ", " CAMERA("y") ", " CAMERA("x") "]}",
+             "sensors[2].name: sensor name \"x\" is already used by sensors[0]");
+#undef NAMED
+#undef CAMERA
+}
+
 /* Sensor optics and noise: defaults, A_S from D, NETD for every channel. */
 static void test_sensor_model(void **state)
 {
@@ -350,6 +377,7 @@ int main(void)
         cmocka_unit_test(test_optics_constant),
         cmocka_unit_test(test_csv_material_and_warnings),
         cmocka_unit_test(test_default_channel_names),
+        cmocka_unit_test(test_unique_names),
         cmocka_unit_test(test_sensor_model),
         cmocka_unit_test(test_refusals),
     };
