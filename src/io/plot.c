@@ -14,6 +14,7 @@
 #include <plplot/plplot.h>
 
 #include "core/alloc.h"
+#include "core/order.h"
 
 /* A filled circle (U+25CF) marks each data point; cairo renders UTF-8 text. */
 #define PLOT_MARK "\xe2\x97\x8f"
@@ -51,11 +52,9 @@ static void plot_escape(char *dst, size_t size, const char *src)
     dst[j] = '\0';
 }
 
-static int plot_compare_float(const void *a, const void *b)
-{
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
-}
+/* The most cells an image preview draws along its longer side: about twice the pixels
+ * its figure gives the image (720 wide), so a larger image loses nothing to the eye. */
+#define PLOT_IMAGE_CELLS 1024
 
 thz_status plot_check_device_here(void *arg, thz_error *err)
 {
@@ -142,34 +141,42 @@ thz_status plot_image_draw(const char *path, const float *values, uint32_t colum
 {
     if (columns == 0 || rows == 0)
         return thz_error_set(err, THZ_ERR_INTERNAL, "%s: empty image", path);
+    /* An image larger than the figure shows is drawn from blocks of f x f pixels, each
+     * the mean of its finite pixels: plimage draws a rectangle per cell, and a 4096 x 4096
+     * preview took 10 s for the figure's ~500 pixels across (scale audit). The colour bar
+     * still comes from every pixel. */
+    uint32_t longest = columns > rows ? columns : rows;
+    uint32_t f =
+        longest > PLOT_IMAGE_CELLS ? (longest + PLOT_IMAGE_CELLS - 1) / PLOT_IMAGE_CELLS : 1;
+    size_t bx = (columns + (size_t)f - 1) / f, by = (rows + (size_t)f - 1) / f;
     /* plimage draws (nx-1) x (ny-1) cells coloured by their lower corner: pass one more
-     * column and row (copies of the last) so that every pixel is one whole cell. */
-    size_t nx = (size_t)columns + 1, ny = (size_t)rows + 1;
+     * column and row (copies of the last) so that every block is one whole cell. */
+    size_t nx = bx + 1, ny = by + 1;
     PLFLT *grid = thz_malloc_array(nx * ny, sizeof *grid);
     PLFLT **cols = thz_malloc_array(nx, sizeof *cols);
-    float *sorted = thz_malloc_array((size_t)columns * rows, sizeof *sorted);
+    double *finite = thz_malloc_array((size_t)columns * rows, sizeof *finite);
     thz_status status = THZ_OK;
-    if (!grid || !cols || !sorted) {
+    if (!grid || !cols || !finite) {
         status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
         goto cleanup;
     }
     /* The colour bar spans the 1st to 99th percentile of the finite values, so that a
      * few noisy pixels do not flatten the picture; values beyond are drawn in the end
      * colours, and the bar then shows a triangular cap at that end. */
-    double vmin = 0.0, vmax = 1.0;
+    double vmin = 0.0, vmax = 1.0, lowest = INFINITY, highest = -INFINITY;
     bool clipped_low = false, clipped_high = false;
     size_t n_finite = 0;
     for (size_t i = 0; i < (size_t)columns * rows; i++)
-        if (isfinite(values[i]))
-            sorted[n_finite++] = values[i];
+        if (isfinite(values[i])) {
+            finite[n_finite++] = values[i];
+            lowest = fmin(lowest, values[i]);
+            highest = fmax(highest, values[i]);
+        }
     if (n_finite > 0) {
-        qsort(sorted, n_finite, sizeof *sorted, plot_compare_float);
-        size_t lo = (size_t)floor(0.01 * (double)(n_finite - 1));
-        size_t hi = (size_t)ceil(0.99 * (double)(n_finite - 1));
-        vmin = sorted[lo];
-        vmax = sorted[hi];
-        clipped_low = sorted[0] < vmin;
-        clipped_high = sorted[n_finite - 1] > vmax;
+        vmin = order_select(finite, n_finite, (size_t)floor(0.01 * (double)(n_finite - 1)));
+        vmax = order_select(finite, n_finite, (size_t)ceil(0.99 * (double)(n_finite - 1)));
+        clipped_low = lowest < vmin;
+        clipped_high = highest > vmax;
     }
     double scale = fmax(fabs(vmin), fabs(vmax));
     if (vmax - vmin <= 1e-9 * scale) { /* a flat image still needs a scale */
@@ -179,11 +186,18 @@ thz_status plot_image_draw(const char *path, const float *values, uint32_t colum
     }
     for (size_t i = 0; i < nx; i++) {
         cols[i] = grid + i * ny;
-        size_t c = i < columns ? i : columns - 1;
+        size_t c0 = (i < bx ? i : bx - 1) * f, c1 = c0 + f < columns ? c0 + f : columns;
         for (size_t j = 0; j < ny; j++) {
-            size_t r = j < rows ? j : rows - 1;
-            float v = values[r * columns + c];
-            cols[i][j] = isfinite(v) ? fmin(fmax(v, vmin), vmax) : vmin;
+            size_t r0 = (j < by ? j : by - 1) * f, r1 = r0 + f < rows ? r0 + f : rows;
+            double sum = 0.0;
+            size_t n = 0;
+            for (size_t r = r0; r < r1; r++)
+                for (size_t c = c0; c < c1; c++)
+                    if (isfinite(values[r * columns + c])) {
+                        sum += values[r * columns + c];
+                        n++;
+                    }
+            cols[i][j] = n ? fmin(fmax(sum / (double)n, vmin), vmax) : vmin;
         }
     }
     char t_title[PLOT_TEXT], t_label[PLOT_TEXT];
@@ -200,8 +214,8 @@ thz_status plot_image_draw(const char *path, const float *values, uint32_t colum
         /* Row 0 at the top: the y axis runs from `rows` at the bottom to 0 on top. */
         plwind(0.0, columns, rows, 0.0);
         plot_set_viridis();
-        plimage((PLFLT_MATRIX)cols, (PLINT)nx, (PLINT)ny, 0.0, columns, 0.0, rows, vmin, vmax, 0.0,
-                columns, 0.0, rows);
+        plimage((PLFLT_MATRIX)cols, (PLINT)nx, (PLINT)ny, 0.0, (double)(bx * f), 0.0,
+                (double)(by * f), vmin, vmax, 0.0, columns, 0.0, rows);
         plcol0(1);
         plbox("bcnst", 0.0, 0, "bcnstv", 0.0, 0);
         pllab("column (pixel)", "row (pixel)", t_title);
@@ -224,7 +238,7 @@ thz_status plot_image_draw(const char *path, const float *values, uint32_t colum
         status = plot_end(path, err);
     }
 cleanup:
-    free(sorted);
+    free(finite);
     free(cols);
     free(grid);
     return status;

@@ -1,10 +1,12 @@
 /* Noise figures of a run (run_noise.h). */
 #include "run/run_noise.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 
 #include "core/alloc.h"
+#include "core/order.h"
 #include "sensor/render.h"
 #include "sensor/render_accum.h"
 
@@ -13,23 +15,23 @@ typedef struct noise_pixel {
     double stderr_k;
 } noise_pixel;
 
-static int noise_cmp(const void *a, const void *b)
-{
-    const noise_pixel *x = a, *y = b;
-    if (x->object != y->object)
-        return (x->object > y->object) - (x->object < y->object);
-    return (x->stderr_k > y->stderr_k) - (x->stderr_k < y->stderr_k);
-}
-
-/* Figures of n values sorted by stderr_k. */
-static run_noise noise_of(const noise_pixel *v, size_t n)
+/* Figures of n values in any order (reordered). */
+static run_noise noise_of(double *x, size_t n)
 {
     run_noise r = {.pixels = n};
     if (n == 0)
         return r;
-    r.median_k = n % 2 ? v[n / 2].stderr_k : 0.5 * (v[n / 2 - 1].stderr_k + v[n / 2].stderr_k);
+    double upper = order_select(x, n, n / 2);
+    if (n % 2) {
+        r.median_k = upper;
+    } else { /* the largest of the lower half, which the selection left below n / 2 */
+        double lower = x[0];
+        for (size_t k = 1; k < n / 2; k++)
+            lower = x[k] > lower ? x[k] : lower;
+        r.median_k = 0.5 * (lower + upper);
+    }
     size_t rank = (95 * n + 99) / 100; /* ceil(0.95 n), >= 1 */
-    r.p95_k = v[rank - 1].stderr_k;
+    r.p95_k = order_select(x, n, rank - 1);
     return r;
 }
 
@@ -56,7 +58,8 @@ static noise_pixel *noise_collect(const sensor_images *images, size_t n_images, 
                 continue;
             double l = accs ? render_accum_map_stderr(&accs[i], p)
                             : (double)img->radiance_stderr[c * px + p];
-            v[(*m)++] = (noise_pixel){img->object_id[p], render_stderr_k(freq_hz, tb, l)};
+            double se = render_stderr_k(freq_hz, tb, l);
+            v[(*m)++] = (noise_pixel){img->object_id[p], se == se ? se : INFINITY};
         }
     }
     return v;
@@ -67,12 +70,15 @@ double run_noise_map_floor_k(const render_accum *accs, const sensor_images *imag
 {
     size_t m;
     noise_pixel *v = noise_collect(images, n_images, c, freq_hz, accs, &m);
-    if (!v)
+    double *x = v ? thz_malloc_array(m ? m : 1, sizeof *x) : NULL;
+    if (!x) {
+        free(v);
         return -1.0;
-    for (size_t k = 0; k < m; k++) /* by value alone */
-        v[k].object = 0;
-    qsort(v, m, sizeof *v, noise_cmp);
-    double floor_k = noise_of(v, m).p95_k;
+    }
+    for (size_t k = 0; k < m; k++)
+        x[k] = v[k].stderr_k;
+    double floor_k = noise_of(x, m).p95_k;
+    free(x);
     free(v);
     return floor_k;
 }
@@ -82,23 +88,31 @@ thz_status run_noise_channel(const sensor_images *images, size_t n_images, size_
 {
     size_t m;
     noise_pixel *v = noise_collect(images, n_images, c, freq_hz, NULL, &m);
-    if (!v)
+    /* the values grouped by object (a counting sort; group 0 the pixels of no object
+     * in range), then each group's figures and the whole array's */
+    double *x = v ? thz_malloc_array(m ? m : 1, sizeof *x) : NULL;
+    size_t *at = x ? thz_calloc(n_objects + 2, sizeof *at) : NULL;
+    if (!at) {
+        free(x);
+        free(v);
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the noise figures");
-    qsort(v, m, sizeof *v, noise_cmp); /* by object, then by value */
-    for (size_t o = 0; objects && o < n_objects; o++)
-        objects[o] = (run_noise){0};
-    for (size_t k = 0; objects && k < m;) {
-        size_t j = k;
-        while (j < m && v[j].object == v[k].object)
-            j++;
-        if (v[k].object >= 0 && (size_t)v[k].object < n_objects)
-            objects[v[k].object] = noise_of(&v[k], j - k);
-        k = j;
     }
-    for (size_t k = 0; k < m; k++) /* then all pixels, by value alone */
-        v[k].object = 0;
-    qsort(v, m, sizeof *v, noise_cmp);
-    *all = noise_of(v, m);
+    for (size_t k = 0; k < m; k++) {
+        int32_t o = v[k].object;
+        at[o >= 0 && (size_t)o < n_objects ? (size_t)o + 2 : 1]++;
+    }
+    for (size_t g = 1; g < n_objects + 2; g++)
+        at[g] += at[g - 1]; /* at[g]: the end of group g - 1, the start of group g */
+    for (size_t k = 0; k < m; k++) {
+        int32_t o = v[k].object;
+        x[at[o >= 0 && (size_t)o < n_objects ? (size_t)o + 1 : 0]++] = v[k].stderr_k;
+    }
+    /* at[g] is now the end of group g: object o's values are x[at[o] .. at[o + 1]) */
+    for (size_t o = 0; objects && o < n_objects; o++)
+        objects[o] = noise_of(x + at[o], at[o + 1] - at[o]);
+    *all = noise_of(x, m);
+    free(at);
+    free(x);
     free(v);
     return THZ_OK;
 }

@@ -115,6 +115,38 @@ static void test_image_colours(void **state)
     free(dir);
 }
 
+/* An image wider than the figure shows (drawn from 3 x 3 blocks): the narrow strips of
+ * its lowest values on the left edge and its highest on the right edge still show, in
+ * the colour map's end colours (the blocks cover the whole image, to its last column). */
+static void test_large_image(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    char path[1024];
+    snprintf(path, sizeof path, "%s/large.png", dir);
+    enum { C = 2100, R = 700 };
+    float *v = thz_malloc_array((size_t)C * R, sizeof *v);
+    assert_non_null(v);
+    for (size_t r = 0; r < R; r++)
+        for (size_t c = 0; c < C; c++)
+            v[r * C + c] = c < 9 ? 250.0f : c >= C - 9 ? 350.0f : (r % 2 ? NAN : 300.0f);
+    thz_error err = {0};
+    if (plot_image(path, v, C, R, "large", "T (K)", &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    unsigned char *px = NULL;
+    uint32_t w = 0, h = 0;
+    read_png(path, &px, &w, &h);
+    assert_int_equal(w, 720);
+    size_t n = (size_t)w * h;
+    assert_true(has_colour(px, n, 68, 1, 84, 6));    /* the left strip */
+    assert_true(has_colour(px, n, 253, 231, 37, 6)); /* the right strip, the last columns */
+    free(px);
+    free(v);
+    unlink(path);
+    rmdir(dir);
+    free(dir);
+}
+
 static void test_odd_images(void **state)
 {
     (void)state;
@@ -509,7 +541,7 @@ int main(void)
         cmocka_unit_test(test_lines),         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_attenuation),   cmocka_unit_test(test_batch),
         cmocka_unit_test(test_long_title),    cmocka_unit_test(test_whole_ticks),
-        cmocka_unit_test(test_label_digits),
+        cmocka_unit_test(test_label_digits),  cmocka_unit_test(test_large_image),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

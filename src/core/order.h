@@ -1,0 +1,15 @@
+/* Order statistics without sorting: the k-th smallest of n values in linear time, where
+ * sorting every pixel of a channel twice for its noise figures took 7 s for a 4096 x 4096
+ * sensor, and sorting it for a preview's colour scale 2 s. Exact whatever the order the
+ * values come in, so the result is a sort's x[k]: the same figures for any thread count.
+ */
+#ifndef THZ_CORE_ORDER_H
+#define THZ_CORE_ORDER_H
+
+#include <stddef.h>
+
+/* The k-th smallest of x[0..n) (0-based), 0 <= k < n; x is reordered so that
+ * x[0..k) <= x[k] <= x[k+1..n). No NaN in x (the caller maps them). */
+double order_select(double *x, size_t n, size_t k);
+
+#endif
