@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# batch.json is rewritten as frames finish, not after every frame: a long sequence's file
+# is megabytes, and writing it each frame made a 20 000-frame batch take 2.3 times as long
+# per frame as a 100-frame one. 40 quick frames: batch.json is renamed into place at most
+# once at the start, once a second, after the last frame and at the end (strace counts
+# the renames), and the final file is complete and lists every frame.
+# usage: test_batch_json_rate.sh THZMAP_BINARY REPO_DIR
+set -u
+thzmap=$1
+repo=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+fail() {
+    echo "FAIL: $*"
+    failures=$((failures + 1))
+}
+command -v strace >/dev/null || { echo "FAIL: strace is not installed (scripts/install-deps.sh)"; exit 1; }
+/usr/bin/python3 - "$repo/examples/walker/scene.json" "$tmp" <<'PY'
+import json, sys
+sc = json.load(open(sys.argv[1]))
+for m in sc["materials"].values():  # absolute paths: the scene moves to tmp
+    for k, v in list(m.items()):
+        if k == "file" or k.endswith("_file"):
+            m[k] = sys.argv[1].rsplit("/", 1)[0] + "/" + v
+sc["sensors"][0]["resolution"] = [16, 12]
+sc["render"] = {"integrator": "path", "paths_per_sample": 1}
+json.dump(sc, open(sys.argv[2] + "/scene.json", "w"))
+json.dump({"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 25, "frames": 40,
+           "keyframes": [{"time_s": 0, "objects": {"person": {"transform": {"translate_m": [-1.6, 0.6, 0]}}}},
+                         {"time_s": 1.6, "objects": {"person": {"transform": {"translate_m": [1.6, 0.6, 0]}}}}]},
+          open(sys.argv[2] + "/seq.json", "w"))
+PY
+t0=$(date +%s.%N)
+strace -f -qq -e trace=rename,renameat,renameat2 -o "$tmp/trace" \
+    "$thzmap" batch "$tmp/seq.json" -o "$tmp/out" --quiet >"$tmp/log" 2>&1
+status=$?
+t1=$(date +%s.%N)
+[[ $status -eq 0 ]] || fail "batch: exit $status: $(tail -5 "$tmp/log")"
+writes=$(grep -c 'batch\.json"' "$tmp/trace")
+allowed=$(/usr/bin/python3 -c "import math; print(3 + math.ceil($t1 - $t0))")
+[[ $writes -ge 2 && $writes -le $allowed ]] ||
+    fail "batch.json written $writes times for 40 frames in $(/usr/bin/python3 -c "print(round($t1 - $t0, 2))") s (expected 2 to $allowed)"
+/usr/bin/python3 - "$tmp/out/batch.json" <<'PY' || fail "the final batch.json"
+import json, sys
+b = json.load(open(sys.argv[1]))
+assert b["complete"] and b["frames_done"] == 40 and len(b["frames"]) == 40, b["frames_done"]
+assert all(f["status"] == "done" for f in b["frames"])
+PY
+if [[ $failures -ne 0 ]]; then
+    echo "$failures failure(s)"
+    exit 1
+fi
+echo "ok: batch.json written $writes times for 40 frames in $(/usr/bin/python3 -c "print(round($t1 - $t0, 2))") s"
