@@ -150,7 +150,7 @@ thz_status bench_measure_paper(const char *scene_path, uint64_t photons, int thr
     if (st == THZ_OK)
         st = output_stage_create(outdir, &stage, err);
     for (size_t i = 0; st == THZ_OK && i < s->n_sensors; i++)
-        st = output_write_sensor(output_stage_dir(stage), s, i, &img[i], threads, err);
+        st = output_write_sensor(output_stage_dir(stage), s, i, &img[i], threads, NULL, err);
     if (st == THZ_OK)
         st = output_stage_commit(stage, err);
     out->s_output = bench_now_s() - t;

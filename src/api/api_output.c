@@ -101,7 +101,7 @@ thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_
     if (st != THZ_OK)
         return st;
     return output_write_sensor(output_stage_dir(output->stage), image->scene, image->sensor,
-                               image->img, 0, err);
+                               image->img, 0, NULL, err);
 }
 
 thz_status thz_run_write(thz_context *ctx, thz_run *run, const char *outdir,

@@ -46,20 +46,28 @@ static _Noreturn void child_main(int fd, child_fn fn, void *arg)
     _exit(n == (ssize_t)sizeof e ? 0 : 1);
 }
 
+/* How waiting for a child's report ended. */
+typedef enum child_wait { CHILD_REPORTED, CHILD_LATE, CHILD_CANCELLED } child_wait;
+
 /* Reads the child's report into *report (*got bytes so far) until its end of the pipe
- * closes, which happens when it exits; false when the deadline passes first. */
-static bool child_collect(int fd, double deadline_s, thz_error *report, size_t *got)
+ * closes, which happens when it exits; CHILD_LATE when the deadline passes first,
+ * CHILD_CANCELLED when `cancel` says stop. */
+static child_wait child_collect(int fd, double deadline_s, const child_cancel *cancel,
+                                thz_error *report, size_t *got)
 {
+    int slice_ms = cancel && cancel->fn ? 100 : 1000;
     for (;;) {
+        if (cancel && cancel->fn && cancel->fn(cancel->user))
+            return CHILD_CANCELLED;
         double left_s = deadline_s - thz_now_s();
         if (left_s <= 0.0)
-            return false;
+            return CHILD_LATE;
         struct pollfd p = {.fd = fd, .events = POLLIN};
-        int r = poll(&p, 1, left_s > 1.0 ? 1000 : (int)(left_s * 1e3) + 1);
+        int r = poll(&p, 1, left_s * 1e3 > slice_ms ? slice_ms : (int)(left_s * 1e3) + 1);
         if (r < 0 && errno == EINTR)
             continue;
         if (r < 0)
-            return true; /* cannot wait here: waitpid blocks instead */
+            return CHILD_REPORTED; /* cannot wait here: waitpid blocks instead */
         if (r == 0)
             continue;
         char buf[2048];
@@ -67,7 +75,7 @@ static bool child_collect(int fd, double deadline_s, thz_error *report, size_t *
         if (n < 0 && errno == EINTR)
             continue;
         if (n <= 0)
-            return true;
+            return CHILD_REPORTED;
         size_t room = sizeof *report - *got, take = (size_t)n < room ? (size_t)n : room;
         memcpy((char *)report + *got, buf, take);
         *got += take;
@@ -129,13 +137,29 @@ static thz_status child_start(const char *what, child_fn fn, void *arg, double t
     return THZ_OK;
 }
 
-/* Waits for a started child (killed at its deadline) and returns its status. */
-static thz_status child_finish(const char *what, child_proc *c, double timeout_s, thz_error *err)
+/* Ends a started child at once and waits for it. */
+static void child_kill(child_proc *c)
+{
+    close(c->fd);
+    kill(c->pid, SIGKILL);
+    while (waitpid(c->pid, NULL, 0) < 0 && errno == EINTR) {
+    }
+}
+
+/* Waits for a started child (killed at its deadline, or when cancelled) and returns its
+ * status. */
+static thz_status child_finish(const char *what, child_proc *c, double timeout_s,
+                               const child_cancel *cancel, thz_error *err)
 {
     thz_error report;
     memset(&report, 0, sizeof report);
     size_t got = 0;
-    bool timed_out = !child_collect(c->fd, c->deadline_s, &report, &got);
+    child_wait w = child_collect(c->fd, c->deadline_s, cancel, &report, &got);
+    if (w == CHILD_CANCELLED) {
+        child_kill(c);
+        return thz_error_set(err, THZ_ERR_CANCELLED, "cancelled while %s", what);
+    }
+    bool timed_out = w == CHILD_LATE;
     close(c->fd);
     if (timed_out)
         kill(c->pid, SIGKILL);
@@ -164,11 +188,11 @@ static thz_status child_finish(const char *what, child_proc *c, double timeout_s
 
 thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err)
 {
-    return child_run_group(&what, fn, &arg, 1, timeout_s, err);
+    return child_run_group(&what, fn, &arg, 1, timeout_s, NULL, err);
 }
 
 thz_status child_run_group(const char *const *whats, child_fn fn, void *const *args, size_t n,
-                           double timeout_s, thz_error *err)
+                           double timeout_s, const child_cancel *cancel, thz_error *err)
 {
     if (n == 0)
         return THZ_OK;
@@ -195,7 +219,14 @@ thz_status child_run_group(const char *const *whats, child_fn fn, void *const *a
     for (size_t i = 0; i < started; i++) {
         thz_error e;
         memset(&e, 0, sizeof e);
-        thz_status s = child_finish(whats[i], &procs[i], timeout_s, &e);
+        thz_status s = child_finish(whats[i], &procs[i], timeout_s, cancel, &e);
+        if (s == THZ_ERR_CANCELLED) { /* the others too, at once */
+            for (size_t j = i + 1; j < started; j++)
+                child_kill(&procs[j]);
+            if (err)
+                *err = e;
+            return s;
+        }
         if (s != THZ_OK && st == THZ_OK) {
             st = s;
             if (err)

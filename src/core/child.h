@@ -28,13 +28,21 @@ thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s,
 /* At most this many children in a group. */
 #define CHILD_GROUP_MAX 64
 
+/* Whether to stop (a run's progress callback behind it): asked about ten times a second
+ * while a group's children run, on the thread waiting for them. */
+typedef struct child_cancel {
+    int (*fn)(void *user); /* non-zero: stop */
+    void *user;
+} child_cancel;
+
 /* Runs fn(args[i]) for i < n (n <= CHILD_GROUP_MAX) in n children at once: started one
  * after the other by the calling thread (under child_run's lock), then each waited for,
  * and killed timeout_s after its start if still running. Returns THZ_OK or the first
  * failure in index order, its message as child_run gives it with whats[i] for `what`;
  * a child that cannot start leaves the later ones unstarted (the earlier are still
- * waited for). */
+ * waited for). When `cancel` (may be NULL) says stop, every child still running is
+ * killed and the group returns THZ_ERR_CANCELLED. */
 thz_status child_run_group(const char *const *whats, child_fn fn, void *const *args, size_t n,
-                           double timeout_s, thz_error *err);
+                           double timeout_s, const child_cancel *cancel, thz_error *err);
 
 #endif

@@ -13,6 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/child.h"
 #include "core/error.h"
 #include "photon/photon_stats.h"
 #include "run/run_noise.h"
@@ -56,9 +57,11 @@ bool output_file_name(char *buf, size_t size, const char *sensor, const char *qu
  * S.measured_brightness_temperature and S.measured-band-NN.png, titled with the model.
  * Checks PLplot's pngcairo device before writing anything (THZ_ERR_IO if missing).
  * The PNG figures are drawn last, by up to `threads` child processes at once (0: one
- * per processor; io/plot.h's batch): the same files for any count. */
+ * per processor; io/plot.h's batch): the same files for any count. `cancel` (may be
+ * NULL) stops them (THZ_ERR_CANCELLED). */
 thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t sensor,
-                               const sensor_images *images, int threads, thz_error *err);
+                               const sensor_images *images, int threads, const child_cancel *cancel,
+                               thz_error *err);
 
 /* What summary.json reports beyond the scene. */
 typedef struct run_summary {

@@ -246,7 +246,8 @@ cleanup:
 }
 
 thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t sensor,
-                               const sensor_images *images, int threads, thz_error *err)
+                               const sensor_images *images, int threads, const child_cancel *cancel,
+                               thz_error *err)
 {
     if (sensor >= scene->n_sensors || images->n_channels != scene->n_channels)
         return thz_error_set(err, THZ_ERR_INTERNAL,
@@ -320,7 +321,7 @@ thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t s
     if (status == THZ_OK)
         status = out_measured(&ctx, err);
     if (status == THZ_OK)
-        status = plot_batch_run(ctx.figures, threads, err);
+        status = plot_batch_run(ctx.figures, threads, cancel, err);
 cleanup:
     plot_batch_destroy(ctx.figures);
     free(ctx.channel_names);

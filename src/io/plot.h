@@ -17,6 +17,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/child.h"
 #include "core/error.h"
 
 /* THZ_OK if PLplot has the pngcairo device; otherwise THZ_ERR_IO with a message
@@ -95,6 +96,7 @@ thz_status plot_batch_lines(plot_batch *b, const char *path, size_t n_x, const d
                             size_t n_lines, const char *const *names, const double *y,
                             const char *title, const char *x_label, const char *y_label,
                             thz_error *err);
-thz_status plot_batch_run(plot_batch *b, int processes, thz_error *err);
+/* `cancel` (may be NULL) stops the drawing: THZ_ERR_CANCELLED, the children killed. */
+thz_status plot_batch_run(plot_batch *b, int processes, const child_cancel *cancel, thz_error *err);
 
 #endif

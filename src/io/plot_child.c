@@ -214,7 +214,7 @@ static size_t plot_item_cells(const plot_item *it)
     return it->kind == PLOT_ITEM_IMAGE ? (size_t)it->columns * it->rows : it->n_x * it->n_lines;
 }
 
-thz_status plot_batch_run(plot_batch *b, int processes, thz_error *err)
+thz_status plot_batch_run(plot_batch *b, int processes, const child_cancel *cancel, thz_error *err)
 {
     if (!b || b->n == 0)
         return THZ_OK;
@@ -250,7 +250,7 @@ thz_status plot_batch_run(plot_batch *b, int processes, thz_error *err)
             t += plot_timeout_s(plot_item_cells(&b->items[i]));
         timeout_s = t > timeout_s ? t : timeout_s;
     }
-    thz_status st = child_run_group(what_ptrs, plot_share_child, args, k, timeout_s, err);
+    thz_status st = child_run_group(what_ptrs, plot_share_child, args, k, timeout_s, cancel, err);
     free(whats);
     return st;
 }
@@ -265,7 +265,7 @@ thz_status plot_image(const char *path, const float *values, uint32_t columns, u
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
     thz_status st = plot_batch_image(b, path, values, columns, rows, title, value_label, err);
     if (st == THZ_OK)
-        st = plot_batch_run(b, 1, err);
+        st = plot_batch_run(b, 1, NULL, err);
     plot_batch_destroy(b);
     return st;
 }
@@ -281,7 +281,7 @@ static thz_status plot_lines_one(const char *path, size_t n_x, const double *x, 
     thz_status st = plot_batch_lines_x(b, path, n_x, x, n_lines, names, y, title, x_label, y_label,
                                        whole_x, err);
     if (st == THZ_OK)
-        st = plot_batch_run(b, 1, err);
+        st = plot_batch_run(b, 1, NULL, err);
     plot_batch_destroy(b);
     return st;
 }

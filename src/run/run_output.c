@@ -79,6 +79,18 @@ static bool run_write_report(const run_state *rs, const run_write_options *wo, u
     return wo->progress(wo->progress_user, &p) != 0;
 }
 
+/* child_cancel's question while the figures are drawn: the progress callback's. */
+typedef struct run_write_asking {
+    const run_state *rs;
+    const run_write_options *wo;
+} run_write_asking;
+
+static int run_write_cancelled(void *user)
+{
+    const run_write_asking *a = user;
+    return run_write_report(a->rs, a->wo, 0);
+}
+
 thz_status run_write(run_state *rs, const char *dir, const run_write_options *wo, thz_error *err)
 {
     if (run_write_report(rs, wo, 0))
@@ -86,9 +98,11 @@ thz_status run_write(run_state *rs, const char *dir, const run_write_options *wo
                              rs->command);
     double t0 = thz_now_s();
     thz_status st = THZ_OK;
+    run_write_asking asking = {rs, wo};
+    child_cancel cancel = {run_write_cancelled, &asking};
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++)
         st = output_write_sensor(dir, rs->scene, rs->selected[i], &rs->images[i], rs->opt->threads,
-                                 err);
+                                 &cancel, err);
     if (st == THZ_OK && wo->photon_map)
         st = run_save_photon_map(rs, dir, wo->ply_max_points, err);
     if (st != THZ_OK)

@@ -2,7 +2,8 @@
 # Signals other than Ctrl-C (test_render_cancel.sh and the commit-kill tests cover SIGINT
 # and SIGKILL): a reader of the progress that leaves (SIGPIPE) does not stop the run
 # mid-commit; a closed terminal (SIGHUP) stops it as Ctrl-C does, exit 128 + 1, nothing
-# written and nothing left beside OUTDIR. `atmosphere --plot` stopped early keeps an
+# written and nothing left beside OUTDIR; SIGINT to the program alone while it draws its
+# figures stops the drawing at once. `atmosphere --plot` stopped early keeps an
 # existing figure (it was emptied before the work).
 # argv: path to the thzmap binary, repository directory.
 set -u
@@ -40,6 +41,41 @@ grep -q "interrupted; no results written" "$work/hup.err" ||
     fail "SIGHUP: no message: $(tail -n 1 "$work/hup.err")"
 [ ! -e "$work/hup" ] || fail "SIGHUP: OUTDIR written"
 [ -z "$(leftovers)" ] || fail "SIGHUP left: $(leftovers)"
+
+# SIGINT to the program alone (`kill -INT`, as a batch system may send it; a terminal's
+# Ctrl-C also ends the figure children) while hundreds of figures are drawn: it stops
+# drawing and exits 130 at once, not when every figure is done
+/usr/bin/python3 - "$scene" "$work/many.json" <<'PY'
+import json, os, sys
+sc = json.load(open(sys.argv[1]))
+base = os.path.dirname(os.path.abspath(sys.argv[1]))
+for m in sc["materials"].values():
+    for k, v in list(m.items()):
+        if k == "file" or k.endswith("_file"):
+            m[k] = os.path.join(base, v)
+sc["channels"] = {"from_thz": 0.3, "to_thz": 1.2, "count": 900, "relative_width": 0.01}
+sc["sensors"][0]["resolution"] = [16, 12]
+sc["render"] = {"integrator": "path", "paths_per_sample": 1}
+json.dump(sc, open(sys.argv[2], "w"))
+PY
+"$THZMAP" simulate "$work/many.json" -o "$work/many" --threads 2 2> "$work/many.err" &
+pid=$!
+for _ in $(seq 1200); do # a figure child: the drawing has begun
+    kill -0 $pid 2>/dev/null || break
+    [ -n "$(pgrep -P $pid)" ] && grep -q "channel 900/900, render" "$work/many.err" && break
+    sleep 0.05
+done
+t0=$(date +%s%N)
+kill -INT $pid
+wait $pid
+rc=$?
+ms=$((($(date +%s%N) - t0) / 1000000))
+[ "$rc" = 130 ] || fail "SIGINT while drawing: exit $rc, expected 130: $(tail -n 1 "$work/many.err")"
+[ "$ms" -lt 1500 ] || fail "SIGINT while drawing: exit after $ms ms"
+[ ! -e "$work/many" ] || fail "SIGINT while drawing: OUTDIR written"
+[ -z "$(leftovers)" ] || fail "SIGINT while drawing left: $(leftovers)"
+sleep 0.2
+[ -z "$(pgrep -P $pid)" ] || fail "SIGINT while drawing: figure children left running"
 
 # atmosphere --plot into a closed pipe: the figure there stays as it was
 if "$THZMAP" atmosphere --from-thz 0.1 --to-thz 1 --step-ghz 10 --plot "$work/atm.png" \

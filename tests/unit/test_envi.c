@@ -200,7 +200,7 @@ static void test_sensor_files(void **state)
     sensor_images img;
     fill_images(&img, 1);
     thz_error err = {0};
-    thz_status st = output_write_sensor(dir, scene, 0, &img, 0, &err);
+    thz_status st = output_write_sensor(dir, scene, 0, &img, 0, NULL, &err);
     if (st != THZ_OK)
         fail_msg("output_write_sensor: %s", err.message);
 
@@ -294,7 +294,7 @@ static void test_no_stderr(void **state)
     sensor_images img;
     fill_images(&img, 0);
     thz_error err = {0};
-    assert_int_equal(output_write_sensor(dir, scene, 0, &img, 0, &err), THZ_OK);
+    assert_int_equal(output_write_sensor(dir, scene, 0, &img, 0, NULL, &err), THZ_OK);
     char path[1024];
     snprintf(path, sizeof path, "%s/cam.radiance_stderr.hdr", dir);
     assert_int_not_equal(access(path, F_OK), 0);
@@ -331,7 +331,7 @@ static void test_path_too_long(void **state)
     outdir[0] = '/';
     outdir[4080] = '\0';
     thz_error err = {0};
-    assert_int_equal(output_write_sensor(outdir, scene, 0, &img, 0, &err), THZ_ERR_IO);
+    assert_int_equal(output_write_sensor(outdir, scene, 0, &img, 0, NULL, &err), THZ_ERR_IO);
     assert_non_null(strstr(err.message, "path of 4097 bytes, longer than the limit of 4095"));
     memset(outdir, 'd', 4090);
     outdir[0] = '/';

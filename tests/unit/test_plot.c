@@ -446,7 +446,7 @@ static void test_batch(void **state)
         for (int i = 0; i < BATCH_FIGURES; i++)
             assert_int_equal(batch_figure(b, dir, prefix, i, values), THZ_OK);
         thz_error err;
-        assert_int_equal(plot_batch_run(b, processes[k], &err), THZ_OK);
+        assert_int_equal(plot_batch_run(b, processes[k], NULL, &err), THZ_OK);
         plot_batch_destroy(b);
         for (int i = 0; i < BATCH_FIGURES; i++) {
             char a[512], c[512];
@@ -471,7 +471,7 @@ static void test_batch(void **state)
         }
         thz_error err;
         memset(&err, 0, sizeof err);
-        assert_int_equal(plot_batch_run(b, processes[k], &err), THZ_ERR_IO);
+        assert_int_equal(plot_batch_run(b, processes[k], NULL, &err), THZ_ERR_IO);
         plot_batch_destroy(b);
         if (!strstr(err.message, "bad1.png"))
             fail_msg("%d processes: the error names another figure: %s", processes[k], err.message);
@@ -486,7 +486,7 @@ static void test_batch(void **state)
         snprintf(a, sizeof a, "%s/one%d.png", dir, i);
         unlink(a);
     }
-    assert_int_equal(plot_batch_run(NULL, 2, NULL), THZ_OK); /* nothing to draw */
+    assert_int_equal(plot_batch_run(NULL, 2, NULL, NULL), THZ_OK); /* nothing to draw */
     rmdir(dir);
     free(dir);
 }
