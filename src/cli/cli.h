@@ -50,4 +50,13 @@ bool cli_parse_u64(const char *command, const char *option, const char *text, ui
 bool cli_parse_double(const char *command, const char *option, const char *text, double min,
                       double max, double *out);
 
+/* Mends or refuses the process's start (cli_env.c): closed standard streams reopened on
+ * /dev/null, SIGXFSZ ignored, a stack limit or OMP_STACKSIZE below what the threads need
+ * refused with a message. The exit status to end with, or -1 to go on. */
+int cli_environment_check(void);
+/* rc, or CLI_EXIT_FAILURE (with a message) when the standard output could not be written
+ * (a full disk, a closed descriptor): a command whose product is what it prints must not
+ * end with 0 then. A reader that left a pipe is no failure. */
+int cli_stdout_finish(int rc);
+
 #endif

@@ -145,29 +145,32 @@ static int main_run(const command *c, int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    int rc = cli_environment_check();
+    if (rc >= 0)
+        return rc;
     if (argc < 2) {
         print_usage(stderr);
         return CLI_EXIT_USAGE;
     }
     if (cli_is_help(argv[1])) {
         print_usage(stdout);
-        return CLI_EXIT_OK;
+        return cli_stdout_finish(CLI_EXIT_OK);
     }
     if (strcmp(argv[1], "--version") == 0) {
         printf("thzmap %s\n", thz_version());
-        return CLI_EXIT_OK;
+        return cli_stdout_finish(CLI_EXIT_OK);
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {
         if (strcmp(argv[1], commands[i].name) != 0)
             continue;
-        int rc = cli_mpi_init(&argc, &argv);
+        rc = cli_mpi_init(&argc, &argv);
         if (rc >= 0)
             return rc;
-        return cli_mpi_finalize(main_run(&commands[i], argc - 1, argv + 1));
+        return cli_mpi_finalize(cli_stdout_finish(main_run(&commands[i], argc - 1, argv + 1)));
     }
     /* under mpirun, rank 0 alone says so (every rank printed the usage) */
     const char *unknown = argv[1];
-    int rc = cli_mpi_init(&argc, &argv);
+    rc = cli_mpi_init(&argc, &argv);
     if (rc >= 0)
         return rc;
     if (cli_mpi_rank() == 0) {

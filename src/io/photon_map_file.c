@@ -13,6 +13,7 @@
 #include <omp.h>
 #endif
 
+#include "core/threads.h"
 #include "core/alloc.h"
 #include "io/photon_map_file_format.h"
 #include "scene/scene_hash.h"
@@ -115,7 +116,7 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
     /* Workers: at least 1, whose output any count shares (0 is zstd's single-threaded
      * mode, encoded otherwise). An error here means a libzstd without threads. */
 #ifdef _OPENMP
-    int workers = threads > 0 ? threads : omp_get_max_threads();
+    int workers = thz_threads_or_all(threads);
 #else
     int workers = threads > 0 ? threads : 1;
 #endif

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/threads.h"
 #include "core/alloc.h"
 #include "core/sampling.h"
 #include "photon/air_emission.h"
@@ -95,7 +96,7 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                              trace_counters *chunk_out, thz_error *err)
 {
     thz_status st = THZ_OK;
-    int nthreads = a->threads > 0 ? a->threads : omp_get_max_threads();
+    int nthreads = thz_threads_or_all(a->threads);
     if (nthreads < 1)
         nthreads = 1;
     trace_buffer *bufs = thz_calloc((size_t)nthreads, sizeof *bufs);

@@ -44,6 +44,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/threads.h"
 #include "core/alloc.h"
 #include "photon/photon_map_layout.h"
 #include "photon/photon_map_order.h"
@@ -469,7 +470,7 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
     }
     int nt = 1;
 #ifdef _OPENMP
-    nt = threads > 0 ? threads : omp_get_max_threads();
+    nt = thz_threads_or_all(threads);
 #else
     (void)threads;
 #endif

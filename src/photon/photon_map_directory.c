@@ -2,6 +2,7 @@
 #include <omp.h>
 #include <stdlib.h>
 
+#include "core/threads.h"
 #include "core/alloc.h"
 #include "photon/photon_map_layout.h"
 
@@ -81,7 +82,7 @@ thz_status photon_map_directory_create(const photon_map *map, int threads,
     /* The fills, each group's 8 children of its root a task of their own: they write
      * disjoint cells, so the directory is the same for any thread count. Serial, they
      * were ~12 % of a photon-map render of the paper's 10 M-photon maps on 2 threads. */
-    int nt = threads > 0 ? threads : omp_get_max_threads();
+    int nt = thz_threads_or_all(threads);
 #pragma omp parallel num_threads(nt)
 #pragma omp single
     for (size_t g = 0; g < n_groups; g++) {

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/threads.h"
 #include "core/clock.h"
 #include "core/path.h"
 #include "io/output.h"
@@ -22,7 +23,7 @@ static run_summary run_summary_of(const run_state *rs)
         .integrator = render_integrator_name(rs->scene->render.integrator),
         .seed = rs->seed,
         .photons_per_channel = rs->photons_per_channel,
-        .threads = rs->opt->threads > 0 ? rs->opt->threads : omp_get_max_threads(),
+        .threads = thz_threads_or_all(rs->opt->threads),
         /* the processes that shared the run: its photon phases and render passes */
         .mpi_ranks = rs->opt->render_team ? (int)rs->opt->render_team->members : 1,
         /* render: the statistics of the photon phase that made the map it read */

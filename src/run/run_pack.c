@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/threads.h"
 #include "core/alloc.h"
 
 #define PACK_MAGIC "THZRUN01"
@@ -178,7 +179,7 @@ thz_status run_pack(const run_state *rs, uint8_t **data, size_t *size, thz_error
     put_u64(&o, rs->seed);
     put_u64(&o, rs->photons_per_channel);
     /* the options summary.json reports; the threads this process ran with */
-    int threads = rs->opt->threads > 0 ? rs->opt->threads : omp_get_max_threads();
+    int threads = thz_threads_or_all(rs->opt->threads);
     put_u64(&o, (uint64_t)threads);
     put_f64(&o, rs->opt->seconds_load);
     put_f64(&o, rs->opt->target_noise_k);

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/threads.h"
 #include "core/alloc.h"
 #include "core/rng.h"
 #include "physics/planck.h"
@@ -126,7 +127,7 @@ thz_status noise_apply(const thz_sensor *sn, size_t sensor, const thz_channel *c
     thz_status st = noise_table_init(&table, &sn->noise, ch, c, tb_k, (size_t)pixels, err);
     if (st != THZ_OK)
         return st;
-    int nt = threads > 0 ? threads : omp_get_max_threads();
+    int nt = thz_threads_or_all(threads);
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (long long p = 0; p < pixels; p++) {
         double sigma_l = noise_table_at(&table, tb_k[p]);

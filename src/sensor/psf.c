@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/threads.h"
 #include "core/alloc.h"
 #include "physics/planck.h"
 #include "sensor/camera.h"
@@ -195,7 +196,7 @@ static thz_status psf_direct(const psf_kernel *k, const float *in, float *out, u
         free(my);
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the PSF's border");
     }
-    int nt = threads > 0 ? threads : omp_get_max_threads();
+    int nt = thz_threads_or_all(threads);
 #pragma omp parallel for schedule(static) num_threads(nt)
     for (long long r = 0; r < (long long)rows; r++) {
         for (long long c = 0; c < (long long)columns; c++) {

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/threads.h"
 #include "core/alloc.h"
 #include "core/clock.h"
 #include "sensor/camera.h"
@@ -18,7 +19,7 @@
 
 static int render_threads(const render_options *opt)
 {
-    int n = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
+    int n = thz_threads_or_all(opt ? opt->threads : 0);
     return n > 0 ? n : 1;
 }
 

@@ -5,6 +5,7 @@
 #include <omp.h>
 #include <stdatomic.h>
 
+#include "core/threads.h"
 #include "core/clock.h"
 
 #include "sensor/camera.h"
@@ -23,7 +24,7 @@ thz_status render_sensor_truth(const thz_scene *scene, const accel *a, size_t se
     if (st != THZ_OK)
         return st;
     int64_t n_px = (int64_t)cam.columns * cam.rows;
-    int threads = opt && opt->threads > 0 ? opt->threads : omp_get_max_threads();
+    int threads = thz_threads_or_all(opt ? opt->threads : 0);
     /* about 16 M pixels take seconds: poll for cancelling */
     render_poll poll = {
         .opt = opt, .scene = scene, .total = sn->rows, .next_s = thz_now_s() + RENDER_POLL_S};

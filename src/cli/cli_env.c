@@ -1,0 +1,118 @@
+/* The process thzmap starts in: standard streams, signals and limits it cannot work
+ * with, mended or refused before any work; and its standard output checked at the end. */
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+
+/* The least stack a thread of thzmap's needs, with room: a photon-map gather takes 66 KiB
+ * of it, and 64 KiB stacks (OMP_STACKSIZE=64K, ulimit -s 64) ended runs in SIGSEGV. */
+#define CLI_MIN_STACK_BYTES (256u * 1024u)
+
+/* OMP_STACKSIZE as libgomp reads it (a size, K by default; B, K, M, G suffixes), in
+ * bytes; 0 when unset or not a size (libgomp then warns and keeps its default). */
+static unsigned long long cli_omp_stack_bytes(void)
+{
+    const char *s = getenv("OMP_STACKSIZE");
+    if (!s || !*s)
+        return 0;
+    char *end = NULL;
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (errno || end == s)
+        return 0;
+    while (*end == ' ' || *end == '\t')
+        end++;
+    unsigned long long unit = 1024;
+    if (*end) {
+        switch (*end) {
+        case 'b':
+        case 'B':
+            unit = 1;
+            break;
+        case 'k':
+        case 'K':
+            unit = 1024;
+            break;
+        case 'm':
+        case 'M':
+            unit = 1024ull * 1024;
+            break;
+        case 'g':
+        case 'G':
+            unit = 1024ull * 1024 * 1024;
+            break;
+        default:
+            return 0;
+        }
+        end++;
+        while (*end == ' ' || *end == '\t')
+            end++;
+        if (*end)
+            return 0;
+    }
+    return v > ~0ull / unit ? ~0ull : v * unit;
+}
+
+int cli_environment_check(void)
+{
+    /* Standard streams closed at start: the first files opened would take their numbers
+     * (the lock file beside OUTDIR received the progress lines). /dev/null takes them. */
+    for (int fd = 0; fd <= 2; fd++) {
+        if (fcntl(fd, F_GETFD) >= 0 || errno != EBADF)
+            continue;
+        int n = open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY);
+        if (n >= 0 && n != fd) {
+            dup2(n, fd);
+            close(n);
+        }
+    }
+    /* A file-size limit (ulimit -f): a write past it fails with EFBIG, which the writers
+     * report and clean up after, instead of SIGXFSZ ending the process and leaving the
+     * lock and the staging directory. */
+    signal(SIGXFSZ, SIG_IGN);
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_STACK, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY &&
+        rl.rlim_cur < CLI_MIN_STACK_BYTES) {
+        fprintf(stderr,
+                "thzmap: the stack size limit (ulimit -s) is %llu KiB; thzmap's threads need at "
+                "least %u KiB (ulimit -s 8192, the usual limit, is plenty)\n",
+                (unsigned long long)rl.rlim_cur / 1024, CLI_MIN_STACK_BYTES / 1024);
+        return CLI_EXIT_USAGE;
+    }
+    unsigned long long omp = cli_omp_stack_bytes();
+    if (omp > 0 && omp < CLI_MIN_STACK_BYTES) {
+        fprintf(stderr,
+                "thzmap: OMP_STACKSIZE=%s gives each thread %llu KiB of stack; thzmap's threads "
+                "need at least %u KiB (unset it, or set 1M or more)\n",
+                getenv("OMP_STACKSIZE"), omp / 1024, CLI_MIN_STACK_BYTES / 1024);
+        return CLI_EXIT_USAGE;
+    }
+    return -1;
+}
+
+int cli_stdout_finish(int rc)
+{
+    errno = 0;
+    bool failed = fflush(stdout) != 0 || ferror(stdout);
+    if (!failed)
+        return rc;
+    int e = errno;
+    /* a reader of the output that left (`| head -1`) under an ignored SIGPIPE: the run's
+     * results stand (without that, SIGPIPE ends the process, 141) */
+    struct stat st;
+    if (e == EPIPE || (e == 0 && fstat(STDOUT_FILENO, &st) == 0 && S_ISFIFO(st.st_mode)))
+        return rc;
+    fprintf(stderr, "thzmap: cannot write the standard output%s%s\n", e ? ": " : "",
+            e ? strerror(e) : "");
+    return rc != CLI_EXIT_OK ? rc : CLI_EXIT_FAILURE;
+}

@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# The process thzmap starts in (docs/reliability.md "The environment"): a standard output
+# that cannot be written fails the commands whose product it is (exit 1, a message); a
+# file-size limit fails a run cleanly (exit 1, nothing left) instead of SIGXFSZ killing it;
+# a stack limit or OMP_STACKSIZE too small for its threads is refused up front (exit 2,
+# they ended in SIGSEGV); OMP_NUM_THREADS beyond 4096 runs with 4096, the same bytes (it
+# crashed libgomp); closed standard streams do not end up as the lock file's descriptor.
+# usage: test_environment.sh THZMAP_BINARY REPO_DIR
+set -u
+T=$1
+repo=$2
+S=$repo/examples/plate-in-box/scene.json
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+leftovers() { find "$work" -maxdepth 1 -name '.thzmap-*' | head -n 3; }
+R=(--photons 20000 --integrator photon-map --threads 2 -q)
+
+# expect WHAT STATUS PATTERN: the last command's status and stderr ($work/err)
+expect() {
+    [[ $2 == "$3" ]] || fail "$1: exit $2, expected $3: $(head -c 300 "$work/err")"
+    [[ -z $4 ]] || grep -q -- "$4" "$work/err" || fail "$1: no '$4' in: $(head -c 300 "$work/err")"
+}
+
+# --- a standard output that cannot be written --------------------------------------------
+"$T" --version >/dev/full 2>"$work/err"
+expect "--version >/dev/full" $? 1 "cannot write the standard output"
+"$T" validate "$S" >/dev/full 2>"$work/err"
+expect "validate >/dev/full" $? 1 "cannot write the standard output"
+"$T" materials >/dev/full 2>"$work/err"
+expect "materials >/dev/full" $? 1 "cannot write the standard output"
+"$T" validate "$S" 2>"$work/err" | head -c 10 >/dev/null
+expect "validate | head" "${PIPESTATUS[0]}" 0 ""
+
+# --- stderr closed: the lock file does not take its descriptor ----------------------------
+"$T" simulate "$S" -o "$work/closed" --photons 20000 --integrator photon-map 2>&- >"$work/out"
+rc=$?
+[[ $rc -eq 0 ]] || fail "simulate with stderr closed: exit $rc"
+[[ -s $work/closed/summary.json ]] || fail "simulate with stderr closed: no results"
+[[ -z $(leftovers) ]] || fail "simulate with stderr closed left: $(leftovers)"
+
+# --- a file-size limit --------------------------------------------------------------------
+"$T" simulate "$S" -o "$work/before" "${R[@]}" --seed 1 2>"$work/err" || fail "the first run failed"
+cp -r "$work/before" "$work/limited"
+(ulimit -f 10; exec "$T" simulate "$S" -o "$work/limited" "${R[@]}" --seed 7) 2>"$work/err"
+expect "ulimit -f 10" $? 1 "File too large"
+diff -r "$work/before" "$work/limited" >/dev/null || fail "ulimit -f: OUTDIR changed"
+[[ -z $(leftovers) ]] || fail "ulimit -f left: $(leftovers)"
+
+# --- stacks too small, threads too many ---------------------------------------------------
+(ulimit -s 64; exec "$T" simulate "$S" -o "$work/s64" "${R[@]}") 2>"$work/err"
+expect "ulimit -s 64" $? 2 "stack size limit (ulimit -s) is 64 KiB"
+OMP_STACKSIZE=64K "$T" simulate "$S" -o "$work/o64" "${R[@]}" 2>"$work/err"
+expect "OMP_STACKSIZE=64K" $? 2 "OMP_STACKSIZE=64K"
+[[ ! -e $work/s64 && ! -e $work/o64 ]] || fail "a refused stack wrote OUTDIR"
+OMP_STACKSIZE=2M "$T" validate "$S" >/dev/null 2>"$work/err"
+expect "OMP_STACKSIZE=2M" $? 0 ""
+OMP_NUM_THREADS=100000 "$T" simulate "$S" -o "$work/many" --photons 20000 \
+    --integrator photon-map -q --seed 1 2>"$work/err"
+expect "OMP_NUM_THREADS=100000" $? 0 ""
+cmp -s "$work/many/cam.radiance.img" "$work/before/cam.radiance.img" ||
+    fail "OMP_NUM_THREADS=100000: not the bytes of 2 threads"
+
+[[ $fails -eq 0 ]] && echo "environment: all passed"
+exit $((fails > 0))
