@@ -299,6 +299,24 @@ thz_status output_stage_create(const char *outdir, output_stage **out, thz_error
                                outdir);
         goto cleanup;
     }
+    /* Known before the run, not after it: a name the file system cannot hold (the stage's
+     * own name is short, so only the last move failed), and an OUTDIR this user cannot
+     * write, whose files a run would swap out of sight but could not delete. */
+    long name_max = pathconf(stage->parent, _PC_NAME_MAX);
+    if (name_max > 0 && strlen(base) > (size_t)name_max) {
+        status = thz_error_set(err, THZ_ERR_INPUT,
+                               "%s: its name is %zu bytes long, more than the %ld the file system "
+                               "allows",
+                               outdir, strlen(base), name_max);
+        goto cleanup;
+    }
+    if (lstat(stage->target, &st) == 0 && access(stage->target, W_OK) != 0) {
+        status = thz_error_set(err, THZ_ERR_IO,
+                               "%s: exists and is not writable (%s): make it writable, or choose "
+                               "another output directory",
+                               outdir, strerror(errno));
+        goto cleanup;
+    }
     char name[64], path[THZ_PATH_MAX];
     snprintf(name, sizeof name, ".thzmap-%016" PRIx64, stage_name_hash(base));
     status = thz_path_join(path, sizeof path, stage->parent, name, err);

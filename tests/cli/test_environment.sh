@@ -4,7 +4,8 @@
 # file-size limit fails a run cleanly (exit 1, nothing left) instead of SIGXFSZ killing it;
 # a stack limit or OMP_STACKSIZE too small for its threads is refused up front (exit 2,
 # they ended in SIGSEGV); OMP_NUM_THREADS beyond 4096 runs with 4096, the same bytes (it
-# crashed libgomp); closed standard streams do not end up as the lock file's descriptor.
+# crashed libgomp); closed standard streams do not end up as the lock file's descriptor;
+# an OUTDIR whose name is too long or that is not writable is refused before the run.
 # usage: test_environment.sh THZMAP_BINARY REPO_DIR
 set -u
 T=$1
@@ -61,6 +62,26 @@ OMP_NUM_THREADS=100000 "$T" simulate "$S" -o "$work/many" --photons 20000 \
 expect "OMP_NUM_THREADS=100000" $? 0 ""
 cmp -s "$work/many/cam.radiance.img" "$work/before/cam.radiance.img" ||
     fail "OMP_NUM_THREADS=100000: not the bytes of 2 threads"
+
+# --- OUTDIR refused before the run: a name too long, a directory not writable ------------
+long=$work/$(printf 'b%.0s' $(seq 256))
+"$T" simulate "$S" -o "$long" --photons 20000000 --integrator photon-map -q 2>"$work/err"
+expect "a 256-byte OUTDIR name" $? 2 "its name is 256 bytes long"
+[[ -z $(leftovers) ]] || fail "a 256-byte OUTDIR name left: $(leftovers)"
+if [[ $(id -u) -eq 0 ]] && command -v runuser >/dev/null; then
+    # as another user (root may write anywhere): OUTDIR theirs but read-only, parent writable
+    mkdir "$work/ro" && chmod 755 "$work" && chown nobody "$work/ro"
+    runuser -u nobody -- "$T" simulate "$S" -o "$work/ro/own" "${R[@]}" 2>"$work/err" ||
+        fail "nobody's first run: $(cat "$work/err")"
+    echo notes >"$work/ro/own/notes.txt"
+    chmod 555 "$work/ro/own"
+    runuser -u nobody -- "$T" simulate "$S" -o "$work/ro/own" "${R[@]}" --seed 9 2>"$work/err"
+    expect "a read-only OUTDIR" $? 1 "exists and is not writable"
+    [[ $(ls -A "$work/ro" | tr '\n' ' ') == "own " ]] ||
+        fail "a read-only OUTDIR: beside it: $(ls -A "$work/ro" | tr '\n' ' ')"
+    [[ -f $work/ro/own/notes.txt ]] || fail "a read-only OUTDIR lost the user's notes"
+    chmod 755 "$work/ro/own"
+fi
 
 [[ $fails -eq 0 ]] && echo "environment: all passed"
 exit $((fails > 0))
