@@ -3,6 +3,7 @@
 
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -46,7 +47,10 @@ void cli_progress_init(cli_progress *p, const char *command, bool quiet)
     p->out = stderr;
     p->command = command;
     p->quiet = quiet;
-    p->tty = isatty(fileno(stderr)) != 0;
+    /* a line redrawn in place needs a terminal that moves the cursor: not TERM=dumb (an
+     * Emacs buffer, some CI consoles showed ^M^[[K), nor one with no TERM at all */
+    const char *term = getenv("TERM");
+    p->tty = isatty(fileno(stderr)) != 0 && term && *term && strcmp(term, "dumb") != 0;
     p->last_report_s = cli_now_s();
 }
 

@@ -50,26 +50,41 @@ static _Noreturn void child_main(int fd, child_fn fn, void *arg)
 typedef enum child_wait { CHILD_REPORTED, CHILD_LATE, CHILD_CANCELLED } child_wait;
 
 /* Reads the child's report into *report (*got bytes so far) until its end of the pipe
- * closes, which happens when it exits; CHILD_LATE when the deadline passes first,
- * CHILD_CANCELLED when `cancel` says stop. */
-static child_wait child_collect(int fd, double deadline_s, const child_cancel *cancel,
-                                thz_error *report, size_t *got)
+ * closes, which happens when it exits; CHILD_LATE when the deadline, moved on by the
+ * time the process spent stopped (*paused_s, for the whole group), passes first,
+ * CHILD_CANCELLED when `cancel` says stop. A poll that times out more than a second after
+ * its own wait had the process stopped (Ctrl-Z, a scheduler's suspend) or starved: that
+ * time is not the child's, whose own clock stood still with the process group; a job
+ * suspended for over a minute while drawing failed on resuming. A report that arrived
+ * while the process was stopped is taken, whatever the clock says by then. */
+static child_wait child_collect(int fd, double deadline_s, double *paused_s,
+                                const child_cancel *cancel, thz_error *report, size_t *got)
 {
     int slice_ms = cancel && cancel->fn ? 100 : 1000;
+    bool fresh = false; /* the last poll brought the report: the child is not late */
     for (;;) {
         if (cancel && cancel->fn && cancel->fn(cancel->user))
             return CHILD_CANCELLED;
-        double left_s = deadline_s - thz_now_s();
-        if (left_s <= 0.0)
+        double before_s = thz_now_s();
+        double left_s = deadline_s + *paused_s - before_s;
+        if (left_s <= 0.0 && !fresh)
             return CHILD_LATE;
+        int wait_ms = left_s <= 0.0             ? 100
+                      : left_s * 1e3 > slice_ms ? slice_ms
+                                                : (int)(left_s * 1e3) + 1;
         struct pollfd p = {.fd = fd, .events = POLLIN};
-        int r = poll(&p, 1, left_s * 1e3 > slice_ms ? slice_ms : (int)(left_s * 1e3) + 1);
+        int r = poll(&p, 1, wait_ms);
+        fresh = false;
+        if (r == 0) { /* a wait that ended long after its time: the process was stopped */
+            double beyond_s = thz_now_s() - before_s - 1e-3 * wait_ms;
+            if (beyond_s > 1.0)
+                *paused_s += beyond_s;
+            continue;
+        }
         if (r < 0 && errno == EINTR)
             continue;
         if (r < 0)
             return CHILD_REPORTED; /* cannot wait here: waitpid blocks instead */
-        if (r == 0)
-            continue;
         char buf[2048];
         ssize_t n = read(fd, buf, sizeof buf);
         if (n < 0 && errno == EINTR)
@@ -79,6 +94,7 @@ static child_wait child_collect(int fd, double deadline_s, const child_cancel *c
         size_t room = sizeof *report - *got, take = (size_t)n < room ? (size_t)n : room;
         memcpy((char *)report + *got, buf, take);
         *got += take;
+        fresh = true;
     }
 }
 
@@ -112,10 +128,15 @@ static thz_status child_start(const char *what, child_fn fn, void *arg, double t
         int e = errno;
         close(fds[0]);
         close(fds[1]);
-        if (e == ENOMEM || e == EAGAIN)
+        if (e == ENOMEM)
             return thz_error_set(err, THZ_ERR_NOMEM,
                                  "out of memory while %s: cannot start a process: %s", what,
                                  strerror(e));
+        if (e == EAGAIN) /* the process limit, as often as memory: say both */
+            return thz_error_set(err, THZ_ERR_IO,
+                                 "failed while %s: cannot start a process: %s (the limit on "
+                                 "processes, ulimit -u, is reached, or memory is short)",
+                                 what, strerror(e));
         return thz_error_set(err, THZ_ERR_IO, "failed while %s: cannot start a process: %s", what,
                              strerror(e));
     }
@@ -148,13 +169,13 @@ static void child_kill(child_proc *c)
 
 /* Waits for a started child (killed at its deadline, or when cancelled) and returns its
  * status. */
-static thz_status child_finish(const char *what, child_proc *c, double timeout_s,
+static thz_status child_finish(const char *what, child_proc *c, double timeout_s, double *paused_s,
                                const child_cancel *cancel, thz_error *err)
 {
     thz_error report;
     memset(&report, 0, sizeof report);
     size_t got = 0;
-    child_wait w = child_collect(c->fd, c->deadline_s, cancel, &report, &got);
+    child_wait w = child_collect(c->fd, c->deadline_s, paused_s, cancel, &report, &got);
     if (w == CHILD_CANCELLED) {
         child_kill(c);
         return thz_error_set(err, THZ_ERR_CANCELLED, "cancelled while %s", what);
@@ -216,10 +237,11 @@ thz_status child_run_group(const char *const *whats, child_fn fn, void *const *a
      * that order is the group's; a child that could not start comes after those that
      * did. */
     thz_status st = THZ_OK;
+    double paused_s = 0.0;
     for (size_t i = 0; i < started; i++) {
         thz_error e;
         memset(&e, 0, sizeof e);
-        thz_status s = child_finish(whats[i], &procs[i], timeout_s, cancel, &e);
+        thz_status s = child_finish(whats[i], &procs[i], timeout_s, &paused_s, cancel, &e);
         if (s == THZ_ERR_CANCELLED) { /* the others too, at once */
             for (size_t j = i + 1; j < started; j++)
                 child_kill(&procs[j]);

@@ -121,9 +121,19 @@ PY
 
 # --- on a terminal: one line redrawn, rows named, no "ETA 0 s", memory in MiB below 1 GiB ---
 if command -v script > /dev/null; then
-    script -qec "'$THZMAP' simulate '$REPO/examples/teraeye/scene.json' -o '$work/tty' \
+    TERM=xterm script -qec "'$THZMAP' simulate '$REPO/examples/teraeye/scene.json' -o '$work/tty' \
         --integrator photon-map --photons 100000 --threads 2" /dev/null > "$work/tty.log" 2>&1 ||
         fail "simulate on a terminal exited $?"
+    # a terminal that cannot move its cursor (TERM=dumb, or none): lines, no escape codes
+    for term in dumb ""; do
+        TERM=$term script -qec "'$THZMAP' simulate '$REPO/examples/plate-in-box/scene.json' \
+            -o '$work/dumb' --integrator photon-map --photons 100000 --threads 2" /dev/null \
+            > "$work/dumb.log" 2>&1 || fail "simulate on TERM='$term' exited $?"
+        grep -q $'\033' "$work/dumb.log" && fail "escape codes on TERM='$term': $(head -c 300 "$work/dumb.log" | cat -v)"
+        grep -q 'channel 1/1, render: 64 rows in' "$work/dumb.log" ||
+            fail "no progress lines on TERM='$term': $(head -c 300 "$work/dumb.log" | cat -v)"
+        rm -rf "$work/dumb"
+    done
     tr '\r' '\n' < "$work/tty.log" > "$work/tty.txt"
     grep -Eq 'channel 6/6, render 64/64 rows \(100 %\)' "$work/tty.txt" ||
         fail "no 'render 64/64 rows (100 %)' on the terminal: $(head -c 600 "$work/tty.txt")"
