@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/json_text.h"
 #include "core/alloc.h"
 #include "core/path.h"
 #include "io/plot.h"
@@ -76,7 +77,7 @@ char *bands_json(const bands_report *rep, thz_error *err)
     bool ok = true;
     json_t *root = json_object();
     put(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
-    put(root, "scene", json_string(rep->scene_path), &ok);
+    put(root, "scene", thz_json_text(rep->scene_path), &ok);
     put(root, "scene_name", json_string(rep->scene_name), &ok);
     put(root, "sensor", json_string(rep->sensor), &ok);
     put(root, "count", json_integer((json_int_t)K), &ok);

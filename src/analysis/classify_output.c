@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/json_text.h"
 #include "core/alloc.h"
 #include "core/path.h"
 #include "io/envi.h"
@@ -48,7 +49,7 @@ char *classify_json(const classify_report *rep, thz_error *err)
     if (!root)
         goto nomem;
     put(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
-    put(root, "run_dir", rep->run_dir ? json_string(rep->run_dir) : json_null(), &ok);
+    put(root, "run_dir", thz_json_text(rep->run_dir), &ok);
     put(root, "sensor", rep->sensor ? json_string(rep->sensor) : json_null(), &ok);
     put(root, "source", json_string(rep->source), &ok);
     put(root, "method", json_string(classify_method_name(rep->method)), &ok);

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "batch/batch_internal.h"
+#include "core/json_text.h"
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/path.h"
@@ -104,7 +105,7 @@ static thz_status batch_one_movie(const thz_sequence *seq, const char *outdir, s
     json_t *e = json_object(), *scale = json_object(), *layout = json_object();
     char file[600];
     snprintf(file, sizeof file, "%s%s", sub, name);
-    json_object_set_new(e, "file", json_string(file));
+    json_object_set_new(e, "file", thz_json_text(file));
     json_object_set_new(e, "sensor", json_string(si->name));
     json_object_set_new(e, "band", json_integer((json_int_t)(c + 1)));
     json_object_set_new(e, "sweep", json_integer((json_int_t)s));

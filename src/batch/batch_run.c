@@ -1,9 +1,9 @@
 /* Running a sequence (thz_batch_run): every frame as `thzmap simulate` would, each into
  * its own atomic output directory (thz_output) holding frame.json with the hash of the
  * frame's inputs; OUTDIR/batch.json rewritten (temporary file, then rename) as frames
- * finish (batch_json_due) and at the end; the movies at the end, rebuilt from the frames' files. A frame directory whose
- * frame.json carries the frame's hash is finished and is not run again, which is all
- * that resuming a killed batch needs: a frame appears whole or not at all. Under MPI the
+ * finish (batch_json_due) and at the end; the movies at the end, rebuilt from the frames' files. A
+ * frame directory whose frame.json carries the frame's hash is finished and is not run again, which
+ * is all that resuming a killed batch needs: a frame appears whole or not at all. Under MPI the
  * pending frames are dealt to the ranks by photon groups when there are enough of them
  * (batch_deal.c), and this process, rank 0, writes every frame in frame order.
  */
@@ -21,6 +21,7 @@
 
 #include "api/api.h"
 #include "batch/batch_internal.h"
+#include "core/json_text.h"
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/file.h"
@@ -206,10 +207,10 @@ static thz_status batch_write_json(batch_state *b, thz_error *err)
         json_object_set_new(e, "sweep", json_integer((json_int_t)(f / seq->frames)));
         json_object_set_new(e, "index", json_integer((json_int_t)(f % seq->frames)));
         json_object_set_new(e, "time_s", json_real((double)(f % seq->frames) / seq->fps));
-        json_object_set_new(e, "dir", json_string(seq->frame_dir[f]));
+        json_object_set_new(e, "dir", thz_json_text(seq->frame_dir[f]));
         if (seq->scene_list)
             json_object_set_new(e, "scene",
-                                json_string(seq->scene_paths[batch_frame_scene(seq, f)]));
+                                thz_json_text(seq->scene_paths[batch_frame_scene(seq, f)]));
         json_object_set_new(e, "input_hash", json_string(hex));
         json_object_set_new(e, "status", json_string(batch_state_name(b->state[f])));
         if (b->state[f] == FRAME_COMPUTED || b->state[f] == FRAME_REUSED)
@@ -242,15 +243,15 @@ static thz_status batch_write_json(batch_state *b, thz_error *err)
     json_object_set_new(t, "total", json_real(batch_now_s() - b->t0));
     json_object_set_new(root, "format", json_string("thzmap-batch/1"));
     json_object_set_new(root, "thzmap_version", json_string(THZ_VERSION_STRING));
-    json_object_set_new(root, "sequence", json_string(seq->path));
+    json_object_set_new(root, "sequence", thz_json_text(seq->path));
     if (seq->scene_list) {
         json_t *scenes = json_array();
         for (size_t k = 0; k < seq->n_scenes; k++)
-            json_array_append_new(scenes, json_string(seq->scene_paths[k]));
+            json_array_append_new(scenes, thz_json_text(seq->scene_paths[k]));
         json_object_set_new(root, "scene", json_null());
         json_object_set_new(root, "scenes", scenes);
     } else {
-        json_object_set_new(root, "scene", json_string(seq->scene_paths[0]));
+        json_object_set_new(root, "scene", thz_json_text(seq->scene_paths[0]));
     }
     json_object_set_new(root, "fps", json_real(seq->fps));
     json_object_set_new(root, "frames_per_sweep", json_integer((json_int_t)seq->frames));
@@ -268,7 +269,7 @@ static thz_status batch_write_json(batch_state *b, thz_error *err)
     else
         json_object_set_new(root, "movies", json_array());
     json_object_set_new(root, "movies_skipped",
-                        b->movies_skipped[0] ? json_string(b->movies_skipped) : json_null());
+                        b->movies_skipped[0] ? thz_json_text(b->movies_skipped) : json_null());
     json_object_set_new(root, "timings_s", t);
     /* 12 digits, as summary.json: its reals are times and statistics (17 printed float
      * noise such as 293.0049133300781 K) */
@@ -313,8 +314,8 @@ static char *batch_frame_json(const thz_sequence *seq, size_t f, long reused_fro
     json_object_set_new(root, "photons_reused_from_frame",
                         reused_from >= 0 ? json_integer(reused_from) : json_null());
     size_t k = batch_frame_scene(seq, f);
-    json_object_set_new(root, "scene_file", json_string(seq->scene_paths[k]));
-    json_object_set_new(root, "scene_dir", json_string(seq->scene_dirs[k]));
+    json_object_set_new(root, "scene_file", thz_json_text(seq->scene_paths[k]));
+    json_object_set_new(root, "scene_dir", thz_json_text(seq->scene_dirs[k]));
     json_object_set_new(root, "scene", json_loads(seq->frame_json[f], 0, NULL));
     /* 17 digits: the scene must read back to the same doubles, to rerun the frame to the
      * same bytes (0.3 prints as 0.29999999999999999, the same double) */

@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* The length of the valid UTF-8 character at s (at most n bytes), or 0 when s does not
@@ -27,12 +28,34 @@ static size_t utf8_char_length(const unsigned char *s, size_t n)
     return len;
 }
 
-/* Rewrites msg (a C string in cap bytes) so that it is one line of valid UTF-8: each
- * control byte and each byte that starts no valid UTF-8 character becomes the four
- * characters \xNN. Messages quote what they refused (a CSV cell, a mesh token), and
- * raw bytes from a file would reach the terminal as control sequences, and the GUI
- * server's and Python's JSON and str as invalid text. Idempotent (what it writes is
- * ASCII it leaves alone); cut at a character where the escapes overflow cap. */
+/* Writes the text of in[0..n) into out (room for cap bytes and the NUL), each control
+ * byte and each byte that starts no valid UTF-8 character as the four characters \xNN;
+ * cut at a character where the escapes overflow. Returns the bytes written. */
+static size_t text_clean_into(char *out, size_t cap, const char *in, size_t n)
+{
+    size_t w = 0;
+    for (size_t i = 0; i < n;) {
+        const unsigned char *c = (const unsigned char *)in + i;
+        size_t len = *c >= 0x80 ? utf8_char_length(c, n - i) : (*c < 0x20 || *c == 0x7f ? 0 : 1);
+        size_t need = len ? len : 4;
+        if (w + need > cap)
+            break;
+        if (len)
+            memcpy(out + w, c, len);
+        else
+            snprintf(out + w, 5, "\\x%02x", *c);
+        w += need;
+        i += len ? len : 1;
+    }
+    out[w] = '\0';
+    return w;
+}
+
+/* Rewrites msg (a C string in cap bytes) so that it is one line of valid UTF-8 (as
+ * text_clean_into). Messages quote what they refused (a CSV cell, a mesh token), and raw
+ * bytes from a file would reach the terminal as control sequences, and the GUI server's
+ * and Python's JSON and str as invalid text. Idempotent (what it writes is ASCII it
+ * leaves alone). */
 static void error_clean(char *msg, size_t cap)
 {
     char in[sizeof((thz_error *)0)->message];
@@ -40,21 +63,16 @@ static void error_clean(char *msg, size_t cap)
     if (n >= sizeof in)
         n = sizeof in - 1;
     memcpy(in, msg, n);
-    size_t out = 0;
-    for (size_t i = 0; i < n;) {
-        const unsigned char *c = (const unsigned char *)in + i;
-        size_t len = *c >= 0x80 ? utf8_char_length(c, n - i) : (*c < 0x20 || *c == 0x7f ? 0 : 1);
-        size_t need = len ? len : 4;
-        if (out + need > cap - 1)
-            break;
-        if (len)
-            memcpy(msg + out, c, len);
-        else
-            snprintf(msg + out, 5, "\\x%02x", *c);
-        out += need;
-        i += len ? len : 1;
-    }
-    msg[out] = '\0';
+    text_clean_into(msg, cap - 1, in, n);
+}
+
+char *thz_text_clean(const char *s)
+{
+    size_t n = strlen(s);
+    char *out = malloc(4 * n + 1);
+    if (out)
+        text_clean_into(out, 4 * n, s, n);
+    return out;
 }
 
 thz_status thz_error_set(thz_error *err, thz_status status, const char *fmt, ...)

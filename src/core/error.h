@@ -21,6 +21,11 @@ void thz_error_prefix(thz_error *err, const char *fmt, ...) __attribute__((forma
  * `otherwise` for anything else. */
 thz_status thz_errno_status(int errnum, thz_status otherwise);
 
+/* A malloc'd copy of s that is valid UTF-8 without control characters: each control
+ * byte and each byte that starts no valid UTF-8 character becomes the four characters
+ * \xNN, as in every error message. NULL when out of memory. */
+char *thz_text_clean(const char *s);
+
 /* Clears err to THZ_OK and an empty message. */
 void thz_error_clear(thz_error *err);
 

@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/json_text.h"
 #include "core/path.h"
 #include "physics/channel.h"
 #include "sensor/measure.h"
@@ -61,7 +62,7 @@ static json_t *sum_u64(uint64_t v)
 
 static json_t *sum_string(const char *s)
 {
-    return s ? json_string(s) : json_null();
+    return thz_json_text(s); /* a path need not be UTF-8 */
 }
 
 static double sum_ratio(uint64_t part, uint64_t whole)

@@ -5,7 +5,8 @@
 # a stack limit or OMP_STACKSIZE too small for its threads is refused up front (exit 2,
 # they ended in SIGSEGV); OMP_NUM_THREADS beyond 4096 runs with 4096, the same bytes (it
 # crashed libgomp); closed standard streams do not end up as the lock file's descriptor;
-# an OUTDIR whose name is too long or that is not writable is refused before the run.
+# an OUTDIR whose name is too long or that is not writable is refused before the run; a
+# scene path that is not UTF-8 is written into summary.json with its bytes escaped.
 # usage: test_environment.sh THZMAP_BINARY REPO_DIR
 set -u
 T=$1
@@ -62,6 +63,15 @@ OMP_NUM_THREADS=100000 "$T" simulate "$S" -o "$work/many" --photons 20000 \
 expect "OMP_NUM_THREADS=100000" $? 0 ""
 cmp -s "$work/many/cam.radiance.img" "$work/before/cam.radiance.img" ||
     fail "OMP_NUM_THREADS=100000: not the bytes of 2 threads"
+
+# --- a scene in a directory whose name is not UTF-8 (Latin-1 bytes): summary.json says
+#     where, the bytes written as \xNN (it failed as "out of memory" after the run) ----
+odd=$work/$'sc\xff\xfe'
+mkdir "$odd" && cp -r "$repo/examples/plate-in-box/." "$odd/"
+"$T" simulate "$odd/scene.json" -o "$work/odd" "${R[@]}" 2>"$work/err"
+expect "a scene path that is not UTF-8" $? 0 ""
+/usr/bin/python3 -c 'import json, sys; p = json.load(open(sys.argv[1]))["scene"]["path"]; assert p.endswith("sc\\xff\\xfe/scene.json"), p' \
+    "$work/odd/summary.json" || fail "summary.json's scene path: $(grep '"path"' "$work/odd/summary.json")"
 
 # --- OUTDIR refused before the run: a name too long, a directory not writable ------------
 long=$work/$(printf 'b%.0s' $(seq 256))
