@@ -17,6 +17,10 @@
 /* The least stack a thread of thzmap's needs, with room: a photon-map gather takes 66 KiB
  * of it, and 64 KiB stacks (OMP_STACKSIZE=64K, ulimit -s 64) ended runs in SIGSEGV. */
 #define CLI_MIN_STACK_BYTES (256u * 1024u)
+/* Open files: a run holds a few (the lock, the output files, PLplot's driver and fonts
+ * in the figure children); 16 sufficed for the examples, 8 did not. */
+#define CLI_MIN_FILES 32u
+#define CLI_WANT_FILES 1024u
 
 /* OMP_STACKSIZE as libgomp reads it (a size, K by default; B, K, M, G suffixes), in
  * bytes; 0 when unset or not a size (libgomp then warns and keeps its default). */
@@ -80,7 +84,26 @@ int cli_environment_check(void)
      * report and clean up after, instead of SIGXFSZ ending the process and leaving the
      * lock and the staging directory. */
     signal(SIGXFSZ, SIG_IGN);
+    /* Few open files (ulimit -n 8): PLplot could not load its driver, and the message
+     * named a missing package. The soft limit is raised towards the hard one, which any
+     * process may do; below CLI_MIN_FILES even then, refused. */
     struct rlimit rl;
+    if (getrlimit(RLIMIT_NOFILE, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY &&
+        rl.rlim_cur < CLI_WANT_FILES) {
+        rlim_t want = rl.rlim_max == RLIM_INFINITY || rl.rlim_max > CLI_WANT_FILES ? CLI_WANT_FILES
+                                                                                   : rl.rlim_max;
+        struct rlimit raised = {want, rl.rlim_max};
+        if (want > rl.rlim_cur && setrlimit(RLIMIT_NOFILE, &raised) == 0)
+            rl.rlim_cur = want;
+        if (rl.rlim_cur < CLI_MIN_FILES) {
+            fprintf(stderr,
+                    "thzmap: the limit on open files (ulimit -n) is %llu, and no more than %llu "
+                    "may be had; thzmap needs at least %u\n",
+                    (unsigned long long)rl.rlim_cur, (unsigned long long)rl.rlim_max,
+                    CLI_MIN_FILES);
+            return CLI_EXIT_USAGE;
+        }
+    }
     if (getrlimit(RLIMIT_STACK, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY &&
         rl.rlim_cur < CLI_MIN_STACK_BYTES) {
         fprintf(stderr,

@@ -291,6 +291,14 @@ thz_status output_stage_create(const char *outdir, output_stage **out, thz_error
     if (status != THZ_OK)
         goto cleanup;
     struct stat st;
+    struct stat to;
+    if (lstat(stage->target, &st) == 0 && S_ISLNK(st.st_mode) && stat(stage->target, &to) != 0) {
+        status = thz_error_set(err, THZ_ERR_INPUT,
+                               "%s: is a symbolic link to a missing path (expected a directory "
+                               "for the results, or a name to create one)",
+                               outdir);
+        goto cleanup;
+    }
     if (lstat(stage->target, &st) == 0 && !S_ISDIR(st.st_mode)) {
         /* the user's choice of OUTDIR: bad usage (exit 2), not a failure of the machine */
         status = thz_error_set(err, THZ_ERR_INPUT,

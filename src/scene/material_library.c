@@ -65,6 +65,20 @@ static thz_status load_entry(load_ctx *ctx, const load_cursor *c, material_libra
     return st;
 }
 
+/* A library file that does not read as one is thzmap's installation's fault, not the
+ * user's input: THZ_ERR_IO (exit 1), not THZ_ERR_INPUT (exit 2). */
+static thz_status material_library_broken(thz_status st, thz_error *err)
+{
+    if (st != THZ_ERR_INPUT)
+        return st;
+    if (err) {
+        err->status = THZ_ERR_IO;
+        thz_error_prefix(err, "thzmap's own data is damaged (reinstall thzmap, or check "
+                              "THZMAP_DATA_DIR): ");
+    }
+    return THZ_ERR_IO;
+}
+
 thz_status material_library_load(material_library **out, thz_error *err)
 {
     *out = NULL;
@@ -77,7 +91,7 @@ thz_status material_library_load(material_library **out, thz_error *err)
     json_t *doc = NULL; /* as a scene is read: no FIFO or device, line:column of syntax */
     st = load_json_file(path, NULL, NULL, "material library", LOAD_MAX_SCENE_BYTES, &doc, err);
     if (st != THZ_OK)
-        return st;
+        return material_library_broken(st, err);
     material_library *lib = thz_calloc(1, sizeof *lib);
     load_ctx ctx = {.label = path, .dir = dir, .err = err};
     load_cursor root = load_root(doc), c = load_key(&root, "materials");
@@ -117,7 +131,7 @@ done:
     json_decref(doc);
     if (st != THZ_OK) {
         material_library_destroy(lib);
-        return st;
+        return material_library_broken(st, err);
     }
     *out = lib;
     return THZ_OK;

@@ -50,6 +50,17 @@ expect "ulimit -f 10" $? 1 "File too large"
 diff -r "$work/before" "$work/limited" >/dev/null || fail "ulimit -f: OUTDIR changed"
 [[ -z $(leftovers) ]] || fail "ulimit -f left: $(leftovers)"
 
+# --- few open files: a soft limit raised, a hard one refused ------------------------------
+(ulimit -Sn 8; exec "$T" simulate "$S" -o "$work/soft8" "${R[@]}") 2>"$work/err"
+expect "ulimit -Sn 8" $? 0 ""
+(ulimit -n 8; exec "$T" simulate "$S" -o "$work/hard8" "${R[@]}") 2>"$work/err"
+expect "ulimit -n 8" $? 2 "limit on open files (ulimit -n) is 8"
+
+# --- a dangling symbolic link as OUTDIR ------------------------------------------------------
+ln -s "$work/nowhere/x" "$work/dangling"
+"$T" simulate "$S" -o "$work/dangling" "${R[@]}" 2>"$work/err"
+expect "a dangling symlink OUTDIR" $? 2 "symbolic link to a missing path"
+
 # --- stacks too small, threads too many ---------------------------------------------------
 (ulimit -s 64; exec "$T" simulate "$S" -o "$work/s64" "${R[@]}") 2>"$work/err"
 expect "ulimit -s 64" $? 2 "stack size limit (ulimit -s) is 64 KiB"

@@ -233,3 +233,18 @@ def test_a_data_file_missing_is_no_scene_error(tmp_path, monkeypatch):
     assert e.value.status == "input/output error"
     assert str(data / "materials" / "library.json") in e.value.message
     assert "THZMAP_DATA_DIR" in e.value.message
+
+
+def test_a_damaged_data_file_is_no_scene_error(tmp_path, monkeypatch):
+    """thzmap's own material library damaged: an I/O error that says so (exit 1 in the
+    CLI), not bad input in the user's scene."""
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    data = tmp_path / "data"
+    shutil.copytree(os.path.join(repo, "data"), data)
+    (data / "materials" / "library.json").write_text('{"format": "thzmap-materials/1", ')
+    monkeypatch.setenv("THZMAP_DATA_DIR", str(data))
+    with pytest.raises(thzmap.Error) as e:
+        thzmap.load_scene(os.path.join(repo, "examples", "outdoor-concealed", "scene.json"))
+    assert not isinstance(e.value, thzmap.SceneError)
+    assert e.value.status == "input/output error"
+    assert "thzmap's own data is damaged" in e.value.message
