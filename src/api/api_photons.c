@@ -51,11 +51,12 @@ void thz_photons_destroy(thz_photons *ph)
 static thz_status api_fire_check_memory(const thz_scene *eff, const accel *acc, size_t only,
                                         thz_error *err)
 {
-    run_memory need = {.available_bytes = thz_physical_memory_bytes()};
+    run_memory need = {.held_bytes = thz_process_memory_bytes(),
+                       .available_bytes = thz_memory_limit_bytes()};
     thz_status st = run_photon_map_bytes(eff, acc, only, true, &need.photon_bytes, err);
     if (st != THZ_OK)
         return st;
-    need.total_bytes = need.photon_bytes;
+    need.total_bytes = need.photon_bytes + need.held_bytes;
     return run_check_memory(eff, &need, err);
 }
 

@@ -53,5 +53,13 @@ char *thz_strdup(const char *s);
 /* Bytes of physical memory of this machine (0 if unknown). Used to refuse runs whose
  * images or photon maps would not fit, before they start. */
 uint64_t thz_physical_memory_bytes(void);
+/* The memory a run may count on (0 if unknown): the machine's, or less where the process
+ * is held to less: its address-space limit (ulimit -v), its cgroup's memory limit (a
+ * container, a Slurm job). Runs are refused against it before they start: under
+ * `ulimit -v 6G` a run estimated at 14.9 GiB was accepted and failed after 26 s. */
+uint64_t thz_memory_limit_bytes(void);
+/* The memory this process holds now (its resident set; 0 if unknown): the scene's
+ * meshes and the ray-casting structure, which a run's estimate counts. */
+uint64_t thz_process_memory_bytes(void);
 
 #endif

@@ -330,7 +330,7 @@ static thz_status run_tell_plan(run_state *rs, bool fires_photons, thz_error *er
                              .target_noise_k = rs->target_noise_k,
                              .threads = rs->opt->threads};
     run_plan plan = {.memory_bytes = rs->memory_bytes,
-                     .available_bytes = thz_physical_memory_bytes(),
+                     .available_bytes = thz_memory_limit_bytes(),
                      .target_noise_k = rs->target_noise_k,
                      .target_source = rs->target_source};
     thz_status st =

@@ -174,13 +174,16 @@ void run_apply_overrides(thz_scene *scene, const run_overrides *ov);
  * scene key of the larger part. */
 typedef struct run_memory {
     uint64_t photon_bytes;
-    uint64_t image_bytes;
-    uint64_t total_bytes;
-    uint64_t available_bytes; /* physical memory, 0 if unknown */
+    uint64_t image_bytes;     /* the images, their statistics, the renderer's tables */
+    uint64_t held_bytes;      /* what the process holds already: the scene, its meshes'
+                               * ray-casting structure (thz_process_memory_bytes) */
+    uint64_t total_bytes;     /* all three */
+    uint64_t available_bytes; /* thz_memory_limit_bytes, 0 if unknown */
 } run_memory;
 
-/* THZ_OK, or THZ_ERR_LIMIT when `need` exceeds 90 % of the machine's memory, with a
- * message naming `photons.per_channel` or `sensors[i].resolution`. */
+/* THZ_OK, or THZ_ERR_LIMIT when `need` exceeds 90 % of the memory the process may have
+ * (thz_memory_limit_bytes), with a message naming `photons.per_channel`,
+ * `sensors[i].resolution` or the scene's size. */
 thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err);
 
 /* The same for each sensor's images alone (what loading can tell without building
@@ -193,10 +196,11 @@ thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err);
 thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t only,
                                 bool keep_all, uint64_t *out, thz_error *err);
 
-/* Estimates the memory of the run in rs (its selected sensors' images, and, when
- * `photons`, the photon maps it fires, else the held_bytes of maps the run reads one at
- * a time), stores it in rs->memory_bytes and refuses the run as run_check_memory does. */
-thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t held_bytes, thz_error *err);
+/* Estimates the memory of the run in rs (what the process holds already, its selected
+ * sensors' images and the renderer's tables, and, when `photons`, the photon maps it
+ * fires, else the map_bytes of maps the run reads one at a time), stores it in
+ * rs->memory_bytes and refuses the run as run_check_memory does. */
+thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t map_bytes, thz_error *err);
 
 /* Fire and render (simulate) or render from `in` (render; NULL only for path) into rs,
  * nothing written. On failure rs is finalised. */

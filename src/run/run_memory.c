@@ -8,6 +8,7 @@
 #include "run/run.h"
 #include "sensor/images.h"
 #include "sensor/measure.h"
+#include "sensor/render.h"
 
 thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err)
 {
@@ -18,7 +19,9 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
         return THZ_OK;
     double gib = 1024.0 * 1024.0 * 1024.0;
     char key[128];
-    if (need->photon_bytes >= need->image_bytes) {
+    if (need->held_bytes > need->photon_bytes && need->held_bytes > need->image_bytes) {
+        snprintf(key, sizeof key, "the meshes' triangles or the number of objects");
+    } else if (need->photon_bytes >= need->image_bytes) {
         snprintf(key, sizeof key, "photons.per_channel (now %llu; or --photons)",
                  (unsigned long long)scene->photons.per_channel);
     } else {
@@ -31,14 +34,17 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
     }
     return thz_error_set(err, THZ_ERR_LIMIT,
                          "the run would need %.2f GiB of memory (photon maps %.2f GiB, images "
-                         "%.2f GiB) but this machine has %.2f GiB; lower %s",
+                         "and tables %.2f GiB, the scene as loaded %.2f GiB) but this process "
+                         "may have %.2f GiB (the machine's memory, or less under ulimit -v or "
+                         "a cgroup limit); lower %s",
                          (double)need->total_bytes / gib, (double)need->photon_bytes / gib,
-                         (double)need->image_bytes / gib, (double)need->available_bytes / gib, key);
+                         (double)need->image_bytes / gib, (double)need->held_bytes / gib,
+                         (double)need->available_bytes / gib, key);
 }
 
 thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err)
 {
-    uint64_t have = thz_physical_memory_bytes();
+    uint64_t have = thz_memory_limit_bytes();
     for (size_t s = 0; s < scene->n_sensors && have > 0; s++) {
         const thz_sensor *sn = &scene->sensors[s];
         uint64_t need = sensor_images_bytes(sn->columns, sn->rows, scene->n_channels);
@@ -68,8 +74,11 @@ static uint64_t run_image_bytes(const run_state *rs)
         if (sensor_has_model(s)) /* measured radiance and Tb */
             total += 2u * sizeof(float) * s->columns * s->rows * rs->scene->n_channels;
         total += (uint64_t)s->columns * s->rows * per_pixel * sizeof(double);
+        /* the noise figures' copy of a channel's pixels (run_noise.c: object and value,
+         * then the values grouped) */
+        total += (uint64_t)s->columns * s->rows * (sizeof(int32_t) + 2u * sizeof(double));
     }
-    return total;
+    return total + render_context_bytes(rs->scene);
 }
 
 /* a + b, or UINT64_MAX when the sum does not fit (estimates of absurd runs saturate, so
@@ -104,18 +113,20 @@ thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t
     return THZ_OK;
 }
 
-thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t held_bytes, thz_error *err)
+thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t map_bytes, thz_error *err)
 {
     run_memory need = {.image_bytes = run_image_bytes(rs),
-                       .photon_bytes = held_bytes,
-                       .available_bytes = thz_physical_memory_bytes()};
+                       .photon_bytes = map_bytes,
+                       .held_bytes = thz_process_memory_bytes(),
+                       .available_bytes = thz_memory_limit_bytes()};
     if (photons) {
         thz_status st = run_photon_map_bytes(rs->scene, rs->accel, SIZE_MAX,
                                              rs->opt->keep_photon_maps, &need.photon_bytes, err);
         if (st != THZ_OK)
             return st;
     }
-    need.total_bytes = run_add_bytes(need.photon_bytes, need.image_bytes);
+    need.total_bytes =
+        run_add_bytes(run_add_bytes(need.photon_bytes, need.image_bytes), need.held_bytes);
     rs->memory_bytes = need.total_bytes;
     return run_check_memory(rs->scene, &need, err);
 }

@@ -232,6 +232,19 @@ thz_status render_context_create(const thz_scene *scene, const accel *a, const p
     return THZ_OK;
 }
 
+uint64_t render_context_bytes(const thz_scene *scene)
+{
+    /* as render_context_init allocates: planck, optics, tbar, rbar, lobes, ward_scale and
+     * ward_comp per cell; the per-object arrays; the pair table */
+    uint64_t n_obj = scene->n_objects, cells = n_obj * CHANNEL_QUADRATURE_NODES;
+    uint64_t per_cell = 5u * sizeof(double) + sizeof(optics_point) + sizeof(brdf_lobe);
+    uint64_t per_object = sizeof(optics_point) + 2u * sizeof(bool) + 3u * sizeof(double);
+    uint64_t bytes = cells * per_cell + n_obj * per_object + sizeof(render_context);
+    if (n_obj <= RENDER_PAIR_OBJECTS)
+        bytes += n_obj * n_obj * sizeof(double);
+    return bytes;
+}
+
 void render_context_destroy(render_context *ctx)
 {
     if (!ctx)
