@@ -239,14 +239,25 @@ static thz_status load_warnings(load_ctx *ctx, const load_cursor *root)
         }
         if (!load_is_mesh_file(root, i))
             continue;
-        size_t conflicts = mesh_import_winding_conflicts(&obj->mesh);
-        if (conflicts == SIZE_MAX)
+        mesh_defects d;
+        if (!mesh_import_defects(&obj->mesh, &d))
             return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
-        if (ok && conflicts > 0)
+        if (ok && d.repeated > 0)
+            ok = scene_add_warning(s,
+                                   "object \"%s\": %zu triangle(s) repeat another's three corners: "
+                                   "each counts its area and emits again, so the surface there is "
+                                   "too bright; remove the repeats",
+                                   obj->name, d.repeated);
+        if (ok && d.degenerate > 0)
+            ok = scene_add_warning(s,
+                                   "object \"%s\": %zu triangle(s) of no area (corners on one "
+                                   "line): they emit nothing and stop nothing",
+                                   obj->name, d.degenerate);
+        if (ok && d.winding_conflicts > 0)
             ok = scene_add_warning(s,
                                    "object \"%s\": inconsistent winding: %zu edge(s) used twice "
                                    "in the same direction, so some normals point the wrong way",
-                                   obj->name, conflicts);
+                                   obj->name, d.winding_conflicts);
     }
     if (!ok)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");

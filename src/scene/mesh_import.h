@@ -10,6 +10,7 @@
 #ifndef THZ_SCENE_MESH_IMPORT_H
 #define THZ_SCENE_MESH_IMPORT_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "core/error.h"
@@ -21,11 +22,20 @@
  * or holds no triangles; THZ_ERR_NOMEM when memory runs out. */
 thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_error *err);
 
-/* Number of directed edges used by more than one triangle (in the same direction):
- * 0 for a consistently wound mesh. An edge shared by two triangles must run in
- * opposite directions in them; the same direction twice means one of them is wound
- * the other way, and its normal points to the wrong side. Returns SIZE_MAX on
- * allocation failure. */
-size_t mesh_import_winding_conflicts(const thz_mesh *mesh);
+/* What a mesh file may hold that its scene should not (load.c warns of each). */
+typedef struct mesh_defects {
+    /* triangles with the same three corners as an earlier one (either way round): each
+     * counts its area and emits again, so the surface there is too bright */
+    size_t repeated;
+    /* triangles of no area (corners on one line): they emit and stop nothing */
+    size_t degenerate;
+    /* directed edges that two of the other triangles run the same way: 0 for a
+     * consistently wound mesh (a shared edge runs opposite ways in its two triangles; the
+     * same way twice means one is wound the other way and its normal points wrong) */
+    size_t winding_conflicts;
+} mesh_defects;
+
+/* Counts the defects of an imported mesh into *out; false when out of memory. */
+bool mesh_import_defects(const thz_mesh *mesh, mesh_defects *out);
 
 #endif

@@ -39,7 +39,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             abort(); /* mesh_import.h: a file without triangles is refused */
         if (!mesh_finalize(&mesh))
             abort();
-        (void)mesh_import_winding_conflicts(&mesh);
+        mesh_defects d;
+        (void)mesh_import_defects(&mesh, &d);
     } else {
         fuzz_report(err.message);
         if (!err.message[0])

@@ -6,6 +6,9 @@
  * assimp does not read either are refused with the file named. The malformed-file corpus
  * is tests/cli/test_bad_meshes.sh. */
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <unistd.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -21,6 +24,14 @@
 
 /* Unit right tetrahedron: three right triangles of area 1/2 and one equilateral
  * triangle of edge sqrt 2. */
+/* The winding conflicts mesh_import_defects counts. */
+static size_t winding_conflicts(const thz_mesh *m)
+{
+    mesh_defects d;
+    assert_true(mesh_import_defects(m, &d));
+    return d.winding_conflicts;
+}
+
 static const double tetra_area = 1.5 + 0.8660254037844386;
 
 static void check_outward(const thz_mesh *m, const double centre[3])
@@ -49,7 +60,7 @@ static void check_tetra(const char *file, double z_offset)
     assert_true(fabs(m.total_area_m2 - tetra_area) < 1e-6);
     const double centre[3] = {0.25, 0.25, 0.25 + z_offset};
     check_outward(&m, centre);
-    assert_int_equal(mesh_import_winding_conflicts(&m), 0);
+    assert_int_equal(winding_conflicts(&m), 0);
     assert_true(fabs(m.bbox_min_m[2] - z_offset) < 1e-6);
     assert_true(fabs(m.bbox_max_m[2] - (1 + z_offset)) < 1e-6);
     for (int k = 0; k < 4; k++)
@@ -82,7 +93,7 @@ static void test_quads(void **state)
     assert_true(fabs(m.total_area_m2 - 6.0) < 1e-6);
     const double centre[3] = {0.5, 0.5, 0.5};
     check_outward(&m, centre);
-    assert_int_equal(mesh_import_winding_conflicts(&m), 0);
+    assert_int_equal(winding_conflicts(&m), 0);
     mesh_fini(&m);
 }
 
@@ -124,8 +135,40 @@ static void test_bad_winding(void **state)
     assert_int_equal(mesh_import(MESHES "tetra_bad_winding.obj", NULL, &m, &err), THZ_OK);
     assert_int_equal(m.n_triangles, 4);
     /* the flipped face runs all three of its edges the same way as its neighbours */
-    assert_int_equal(mesh_import_winding_conflicts(&m), 3);
+    assert_int_equal(winding_conflicts(&m), 3);
     mesh_fini(&m);
+}
+
+/* A repeated triangle (either way round) and one of no area are counted as such; the
+ * repeat is no winding conflict (it was reported as "inconsistent winding"). */
+static void test_repeats_and_no_area(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/thz-test-mesh-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[64];
+    snprintf(path, sizeof path, "%s/m.obj", dir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    /* a tetrahedron, one face twice (the second the other way round, as coincident faces
+     * of a scan are), and a face whose corners lie on one line */
+    fputs("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 2 0 0\n"
+          "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\nf 1 2 4\nf 1 4 2\nf 1 2 5\n",
+          f);
+    fclose(f);
+    thz_mesh m;
+    thz_error err = {0};
+    if (mesh_import(path, NULL, &m, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    assert_true(mesh_finalize(&m));
+    mesh_defects d;
+    assert_true(mesh_import_defects(&m, &d));
+    assert_int_equal(d.repeated, 2);
+    assert_int_equal(d.degenerate, 1);
+    assert_int_equal(d.winding_conflicts, 0);
+    mesh_fini(&m);
+    unlink(path);
+    rmdir(dir);
 }
 
 static void test_points_lines_negative_zero(void **state)
@@ -171,6 +214,7 @@ int main(void)
         cmocka_unit_test(test_quads),
         cmocka_unit_test(test_examples_unchanged),
         cmocka_unit_test(test_bad_winding),
+        cmocka_unit_test(test_repeats_and_no_area),
         cmocka_unit_test(test_points_lines_negative_zero),
         cmocka_unit_test(test_refused),
     };
