@@ -229,11 +229,23 @@ static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_ru
 static int cli_run_load(const char *cmd, cli_run_args *a, bool render, thz_scene **scene)
 {
     thz_error err = {0};
+    double t0 = cli_now_s();
     thz_status st = thz_scene_load(a->scene_path, scene, &err);
     if (st != THZ_OK)
         return cli_fail(&err);
     thz_scene_info info;
     thz_scene_get_info(*scene, &info);
+    double load_s = cli_now_s() - t0;
+    if (!a->quiet && load_s >= 1.0) { /* what the silence before the estimate was */
+        size_t triangles = 0;
+        for (size_t i = 0; i < info.n_objects; i++) {
+            thz_object_info o;
+            if (thz_scene_object(*scene, i, &o) == THZ_OK)
+                triangles += o.triangles;
+        }
+        fprintf(stderr, "thzmap %s: loaded %s in %.1f s (%zu object%s, %zu triangles)\n", cmd,
+                a->scene_path, load_s, info.n_objects, info.n_objects == 1 ? "" : "s", triangles);
+    }
     const char *integrator = a->settings.integrator ? a->settings.integrator : info.integrator;
     if (a->write.photon_map && !thz_integrator_needs_photons(integrator))
         return cli_usage_error(cmd,

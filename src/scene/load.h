@@ -59,6 +59,11 @@ typedef struct load_ctx {
     json_t *names;
     const json_t *names_of; /* the list they are of */
     size_t names_next;      /* the index they were checked up to */
+    /* Mesh files more than one object names (load_objects.c): imported once, each object
+     * a copy (three objects of one 5 M-triangle scan were imported three times, 30 s) */
+    json_t *mesh_uses; /* file name as written -> objects naming it */
+    struct load_mesh_copy *mesh_copies;
+    size_t n_mesh_copies;
 } load_ctx;
 
 /* The temperature of emitting air whose model has none (constant, table) when the

@@ -20,6 +20,92 @@ static thz_status load_segments(load_ctx *ctx, const load_cursor *c, unsigned *o
     return st;
 }
 
+/* A mesh file as imported, before any object's transform. */
+struct load_mesh_copy {
+    const char *file; /* as the scene writes it (the document's string) */
+    thz_mesh mesh;
+};
+
+/* dst (empty) as a copy of src's vertices and triangles; false when out of memory. */
+static bool load_mesh_duplicate(thz_mesh *dst, const thz_mesh *src, thz_error *err)
+{
+    if (primitive_mesh_alloc(dst, src->n_vertices, src->n_triangles, err) != THZ_OK)
+        return false;
+    memcpy(dst->positions, src->positions, 3 * src->n_vertices * sizeof *src->positions);
+    memcpy(dst->indices, src->indices, 3 * src->n_triangles * sizeof *src->indices);
+    dst->n_vertices = src->n_vertices;
+    dst->n_triangles = src->n_triangles;
+    return true;
+}
+
+/* The mesh file `file` into mesh: imported, or copied from its earlier import when more
+ * than one object names it (kept for the later ones). */
+static thz_status load_mesh_file(load_ctx *ctx, const load_cursor *k, const char *file,
+                                 thz_mesh *mesh)
+{
+    for (size_t i = 0; i < ctx->n_mesh_copies; i++)
+        if (strcmp(ctx->mesh_copies[i].file, file) == 0)
+            return load_mesh_duplicate(mesh, &ctx->mesh_copies[i].mesh, ctx->err)
+                       ? THZ_OK
+                       : thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    char *path = NULL, *label = NULL;
+    thz_status st = load_file_path(ctx, k, file, &path, &label);
+    if (st != THZ_OK)
+        return st;
+    thz_error inner = {0};
+    st = mesh_import(path, label, mesh, &inner);
+    free(path);
+    free(label);
+    if (st == THZ_ERR_INPUT)
+        return load_fail(ctx, k, "%s", inner.message);
+    if (st != THZ_OK)
+        return thz_error_set(ctx->err, st, "%s", inner.message);
+    json_t *uses = json_object_get(ctx->mesh_uses, file);
+    if (json_integer_value(uses) < 2)
+        return THZ_OK;
+    struct load_mesh_copy *more =
+        realloc(ctx->mesh_copies, (ctx->n_mesh_copies + 1) * sizeof *ctx->mesh_copies);
+    if (!more)
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    ctx->mesh_copies = more;
+    struct load_mesh_copy *c = &more[ctx->n_mesh_copies];
+    *c = (struct load_mesh_copy){.file = file};
+    if (!load_mesh_duplicate(&c->mesh, mesh, ctx->err))
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    ctx->n_mesh_copies++;
+    return THZ_OK;
+}
+
+/* Counts the objects naming each mesh file (ctx->mesh_uses). */
+static thz_status load_count_mesh_uses(load_ctx *ctx, const load_cursor *list, size_t n)
+{
+    ctx->mesh_uses = json_object();
+    if (!ctx->mesh_uses)
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < n; i++) {
+        json_t *shape = json_object_get(json_array_get(list->value, i), "shape");
+        const char *type = json_string_value(json_object_get(shape, "type"));
+        const char *file = json_string_value(json_object_get(shape, "file"));
+        if (!type || strcmp(type, "mesh") != 0 || !file || !file[0])
+            continue;
+        json_int_t uses = json_integer_value(json_object_get(ctx->mesh_uses, file));
+        if (json_object_set_new(ctx->mesh_uses, file, json_integer(uses + 1)) != 0)
+            return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    }
+    return THZ_OK;
+}
+
+static void load_mesh_copies_free(load_ctx *ctx)
+{
+    for (size_t i = 0; i < ctx->n_mesh_copies; i++)
+        mesh_fini(&ctx->mesh_copies[i].mesh);
+    free(ctx->mesh_copies);
+    ctx->mesh_copies = NULL;
+    ctx->n_mesh_copies = 0;
+    json_decref(ctx->mesh_uses);
+    ctx->mesh_uses = NULL;
+}
+
 static thz_status load_shape(load_ctx *ctx, const load_cursor *c, thz_mesh *mesh)
 {
     static const char *const types[] = {"box",  "cylinder", "sphere", "rectangle",
@@ -110,18 +196,7 @@ static thz_status load_shape(load_ctx *ctx, const load_cursor *c, thz_mesh *mesh
             st = load_fail(ctx, &k, "expected a mesh file name, got an empty string");
             break;
         }
-        char *path = NULL, *label = NULL;
-        st = load_file_path(ctx, &k, file, &path, &label);
-        if (st != THZ_OK)
-            break;
-        thz_error inner = {0};
-        st = mesh_import(path, label, mesh, &inner);
-        free(path);
-        free(label);
-        if (st == THZ_ERR_INPUT)
-            st = load_fail(ctx, &k, "%s", inner.message);
-        else if (st != THZ_OK)
-            st = thz_error_set(err, st, "%s", inner.message);
+        st = load_mesh_file(ctx, &k, file, mesh);
         break;
     }
     }
@@ -255,9 +330,11 @@ thz_status load_objects(load_ctx *ctx, const load_cursor *root)
     s->objects = thz_calloc(n, sizeof *s->objects);
     if (!s->objects)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    st = load_count_mesh_uses(ctx, &c, n);
     for (size_t i = 0; i < n && st == THZ_OK; i++) {
         s->n_objects = i + 1;
         st = load_object(ctx, &c, i, &s->objects[i]);
     }
+    load_mesh_copies_free(ctx);
     return st;
 }

@@ -24,6 +24,7 @@
 #include <assimp/scene.h>
 
 #include "core/alloc.h"
+#include "core/order.h"
 #include "core/child.h"
 #include "core/file.h"
 #include "scene/mesh_check.h"
@@ -555,12 +556,6 @@ thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_
     return st;
 }
 
-static int mesh_import_edge_cmp(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return x < y ? -1 : x > y;
-}
-
 /* A triangle by its corners in increasing order, and its index. */
 typedef struct mesh_corners {
     uint32_t v[3];
@@ -636,7 +631,7 @@ bool mesh_import_defects(const thz_mesh *mesh, mesh_defects *out)
                 edges[m++] = ((uint64_t)a << 32) | b;
         }
     }
-    qsort(edges, m, sizeof *edges, mesh_import_edge_cmp);
+    order_sort_u64(edges, m);
     for (size_t i = 1; i < m; i++)
         if (edges[i] == edges[i - 1] && (i < 2 || edges[i - 1] != edges[i - 2]))
             out->winding_conflicts++;

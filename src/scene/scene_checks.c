@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/order.h"
 #include "core/vec3.h"
 
 /* Per object: closed, signed volume (m^3; < 0: inward normals), bbox diagonal (m). */
@@ -38,21 +39,6 @@ static int check_vkey_cmp(const void *a, const void *b)
     return 0;
 }
 
-/* An edge by its welded ends (lower index first) and whether a triangle runs it the
- * other way round. */
-typedef struct check_edge {
-    uint64_t key;
-    bool reversed;
-} check_edge;
-
-static int check_edge_cmp(const void *a, const void *b)
-{
-    const check_edge *x = a, *y = b;
-    if (x->key != y->key)
-        return (x->key > y->key) - (x->key < y->key);
-    return (int)x->reversed - (int)y->reversed;
-}
-
 /* Whether every edge, its ends welded by position, is shared by exactly two triangles
  * that run it in opposite directions (closed and consistently wound, so that the signed
  * volume tells outward from inward). -1 on allocation failure. */
@@ -61,9 +47,12 @@ static int check_mesh_closed(const thz_mesh *m)
     size_t nv = m->n_vertices, ne = 3 * m->n_triangles;
     check_vkey *keys = thz_malloc_array(nv ? nv : 1, sizeof *keys);
     uint32_t *weld = thz_malloc_array(nv ? nv : 1, sizeof *weld);
-    check_edge *edges = thz_malloc_array(ne ? ne : 1, sizeof *edges);
+    /* every edge by its welded ends (lower index first), and apart those that a triangle
+     * runs the other way round: closed when every edge comes twice and once reversed */
+    uint64_t *edges = thz_malloc_array(ne ? ne : 1, sizeof *edges);
+    uint64_t *reversed = thz_malloc_array(ne ? ne : 1, sizeof *reversed);
     int closed = -1;
-    if (!keys || !weld || !edges)
+    if (!keys || !weld || !edges || !reversed)
         goto cleanup;
     for (size_t v = 0; v < nv; v++) {
         memcpy(keys[v].p, &m->positions[3 * v], sizeof keys[v].p);
@@ -74,29 +63,30 @@ static int check_mesh_closed(const thz_mesh *m)
         weld[keys[v].index] = v > 0 && check_vkey_cmp(&keys[v], &keys[v - 1]) == 0
                                   ? weld[keys[v - 1].index]
                                   : keys[v].index;
-    size_t n = 0;
+    size_t n = 0, nr = 0;
     for (size_t t = 0; t < m->n_triangles; t++) {
         if (!(m->areas_m2[t] > 0.0))
             continue; /* degenerate triangles neither open nor close a mesh */
         for (int k = 0; k < 3; k++) {
             uint64_t a = weld[m->indices[3 * t + (size_t)k]];
             uint64_t b = weld[m->indices[3 * t + (size_t)(k + 1) % 3]];
-            edges[n++] = (check_edge){a < b ? a << 32 | b : b << 32 | a, a > b};
+            uint64_t key = a < b ? a << 32 | b : b << 32 | a;
+            edges[n++] = key;
+            if (a > b)
+                reversed[nr++] = key;
         }
     }
-    qsort(edges, n, sizeof *edges, check_edge_cmp);
-    closed = n > 0;
-    for (size_t i = 0; i < n && closed;) {
-        size_t j = i;
-        while (j < n && edges[j].key == edges[i].key)
-            j++;
-        closed = j - i == 2 && edges[i].reversed != edges[i + 1].reversed;
-        i = j;
-    }
+    order_sort_u64(edges, n);
+    order_sort_u64(reversed, nr);
+    closed = n > 0 && 2 * nr == n;
+    for (size_t i = 0; i < nr && closed; i++)
+        closed = edges[2 * i] == reversed[i] && edges[2 * i + 1] == reversed[i] &&
+                 (2 * i + 2 >= n || edges[2 * i + 2] != reversed[i]);
 cleanup:
     free(keys);
     free(weld);
     free(edges);
+    free(reversed);
     return closed;
 }
 

@@ -1,0 +1,61 @@
+/* core/order.c's radix sort of 64-bit keys against qsort: random keys, keys that share
+ * digits (passes skipped), duplicates, one and no key. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/order.h"
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static uint64_t state = 0x9e3779b97f4a7c15u;
+static uint64_t next(void)
+{
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    return state;
+}
+
+static void check(size_t n, uint64_t mask, uint64_t base)
+{
+    uint64_t *a = malloc((n ? n : 1) * sizeof *a), *b = malloc((n ? n : 1) * sizeof *b);
+    assert_non_null(a);
+    assert_non_null(b);
+    for (size_t i = 0; i < n; i++)
+        a[i] = b[i] = base | (next() & mask);
+    order_sort_u64(a, n);
+    qsort(b, n, sizeof *b, cmp_u64);
+    assert_memory_equal(a, b, n * sizeof *a + (n == 0));
+    free(a);
+    free(b);
+}
+
+static void test_sort_u64(void **state_)
+{
+    (void)state_;
+    check(0, ~0ull, 0);
+    check(1, ~0ull, 0);
+    check(2, ~0ull, 0);
+    check(100000, ~0ull, 0);                      /* every digit differs */
+    check(100000, 0xffffull << 32, 0x1234ull);    /* only the third digit varies */
+    check(100000, 0x7, 0xabcdef0123456780ull);    /* many duplicates */
+    check(100000, 0xffffffffull << 32 | 0xff, 0); /* edges' keys: two indices */
+    check(3, 0, 42);                              /* all equal */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_sort_u64)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
