@@ -294,6 +294,32 @@ static void test_unique_names(void **state)
 #undef CAMERA
 }
 
+/* One mesh file named by three objects (imported once, each object a copy): each takes
+ * its own transform, and the copies do not share arrays. */
+static void test_mesh_file_named_thrice(void **state)
+{
+    (void)state;
+#define TETRA(n, x)                                                                                \
+    "{\"name\": \"" n "\", \"type\": \"solid\", \"material\": \"m\", \"temperature_k\": 300, "     \
+    "\"shape\": {\"type\": \"mesh\", \"file\": \"../meshes/tetra.obj\"}, "                         \
+    "\"transform\": {\"translate_m\": [" x ", 0, 0]}}"
+    thz_scene *s = load_ok(HEAD CHANNELS MATERIALS "\"objects\": [" TETRA("a", "0") ", " TETRA(
+        "b", "5") ", " TETRA("c", "-3") "], " SENSORS "}");
+    assert_int_equal(s->n_objects, 3);
+    const double x0[3] = {0.0, 5.0, -3.0};
+    for (size_t i = 0; i < 3; i++) {
+        const thz_mesh *m = &s->objects[i].mesh;
+        assert_int_equal(m->n_triangles, 4);
+        assert_true(fabs(m->bbox_min_m[0] - x0[i]) < 1e-6);
+        assert_true(fabs(m->bbox_max_m[0] - (x0[i] + 1.0)) < 1e-6);
+        for (size_t j = 0; j < i; j++)
+            assert_true(m->positions != s->objects[j].mesh.positions &&
+                        m->indices != s->objects[j].mesh.indices);
+    }
+    thz_scene_destroy(s);
+#undef TETRA
+}
+
 /* Sensor optics and noise: defaults, A_S from D, NETD for every channel. */
 static void test_sensor_model(void **state)
 {
@@ -378,6 +404,7 @@ int main(void)
         cmocka_unit_test(test_csv_material_and_warnings),
         cmocka_unit_test(test_default_channel_names),
         cmocka_unit_test(test_unique_names),
+        cmocka_unit_test(test_mesh_file_named_thrice),
         cmocka_unit_test(test_sensor_model),
         cmocka_unit_test(test_refusals),
     };
