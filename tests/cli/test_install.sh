@@ -106,7 +106,7 @@ else
     variables=$(grep -rhoE 'getenv\("[A-Z_]+"\)' "$repo/src" | sed -E 's/getenv\("([A-Z_]+)"\)/\1/' | sort -u)
     [[ $variables == *THZMAP_DATA_DIR* ]] || fail "no getenv(\"THZMAP_DATA_DIR\") found in src/"
     for v in $variables; do
-        grep -Eq "^ +$v\$" "$tmp/man.environment" || fail "thzmap.1 ENVIRONMENT does not describe $v (src/ reads it)"
+        grep -Eq "^ +$v( |\$)" "$tmp/man.environment" || fail "thzmap.1 ENVIRONMENT does not describe $v (src/ reads it)"
     done
     commands=$("$thzmap" --help | awk '/^commands:/ {f = 1; next} f && /^  [a-z]/ {print $1}')
     [[ -n $commands ]] || fail "no commands in thzmap --help"
