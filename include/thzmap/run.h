@@ -34,11 +34,14 @@ typedef struct thz_run_plan {
     double seconds_photons, seconds_render; /* estimated, s */
     uint32_t passes;                        /* estimated passes of the channel that
                                                needs most */
-    uint64_t memory_bytes;                  /* estimated peak, bytes */
-    uint64_t available_bytes;               /* physical memory, 0 if unknown */
-    double target_noise_k;                  /* the run's noise target, K; 0: none */
-    const char *target_source;              /* "command line" (settings), "scene",
-                                               "default" or NULL */
+    uint64_t memory_bytes;                  /* estimated peak, bytes: what the process holds already
+                                               (the scene, its ray-casting structure) and the run adds */
+    uint64_t available_bytes;  /* what the process may have: the machine's memory, or less
+                                  under an address-space (ulimit -v) or cgroup limit; 0 if
+                                  unknown */
+    double target_noise_k;     /* the run's noise target, K; 0: none */
+    const char *target_source; /* "command line" (settings), "scene",
+                                  "default" or NULL */
 } thz_run_plan;
 typedef void (*thz_plan_fn)(void *user, const thz_run_plan *plan);
 
