@@ -32,16 +32,17 @@ typedef struct thz_output thz_output;
  * passes from the pilot's noise). An estimate, not a promise. */
 typedef struct thz_run_plan {
     double seconds_photons, seconds_render; /* estimated, s */
-    uint32_t passes;                        /* estimated passes of the channel that
-                                               needs most */
-    uint64_t memory_bytes;                  /* estimated peak, bytes: what the process holds already
-                                               (the scene, its ray-casting structure) and the run adds */
-    uint64_t available_bytes;  /* what the process may have: the machine's memory, or less
-                                  under an address-space (ulimit -v) or cgroup limit; 0 if
-                                  unknown */
-    double target_noise_k;     /* the run's noise target, K; 0: none */
-    const char *target_source; /* "command line" (settings), "scene",
-                                  "default" or NULL */
+    /* estimated passes of the channel that needs most */
+    uint32_t passes;
+    /* estimated peak, bytes: what the process holds already (the scene, its ray-casting
+     * structure) and what the run adds */
+    uint64_t memory_bytes;
+    /* what the process may have: the machine's memory, or less under an address-space
+     * (ulimit -v) or cgroup limit; 0 if unknown */
+    uint64_t available_bytes;
+    double target_noise_k; /* the run's noise target, K; 0: none */
+    /* "command line" (settings), "scene", "default" or NULL */
+    const char *target_source;
 } thz_run_plan;
 typedef void (*thz_plan_fn)(void *user, const thz_run_plan *plan);
 
