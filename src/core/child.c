@@ -58,12 +58,12 @@ typedef enum child_wait { CHILD_REPORTED, CHILD_LATE, CHILD_CANCELLED } child_wa
  * suspended for over a minute while drawing failed on resuming. A report that arrived
  * while the process was stopped is taken, whatever the clock says by then. */
 static child_wait child_collect(int fd, double deadline_s, double *paused_s,
-                                const child_cancel *cancel, thz_error *report, size_t *got)
+                                const cancel_check *cancel, thz_error *report, size_t *got)
 {
     int slice_ms = cancel && cancel->fn ? 100 : 1000;
     bool fresh = false; /* the last poll brought the report: the child is not late */
     for (;;) {
-        if (cancel && cancel->fn && cancel->fn(cancel->user))
+        if (cancel_now(cancel))
             return CHILD_CANCELLED;
         double before_s = thz_now_s();
         double left_s = deadline_s + *paused_s - before_s;
@@ -170,7 +170,7 @@ static void child_kill(child_proc *c)
 /* Waits for a started child (killed at its deadline, or when cancelled) and returns its
  * status. */
 static thz_status child_finish(const char *what, child_proc *c, double timeout_s, double *paused_s,
-                               const child_cancel *cancel, thz_error *err)
+                               const cancel_check *cancel, thz_error *err)
 {
     thz_error report;
     memset(&report, 0, sizeof report);
@@ -213,7 +213,7 @@ thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s,
 }
 
 thz_status child_run_group(const char *const *whats, child_fn fn, void *const *args, size_t n,
-                           double timeout_s, const child_cancel *cancel, thz_error *err)
+                           double timeout_s, const cancel_check *cancel, thz_error *err)
 {
     if (n == 0)
         return THZ_OK;

@@ -10,6 +10,7 @@
 #ifndef THZ_CORE_CHILD_H
 #define THZ_CORE_CHILD_H
 
+#include "core/cancel.h"
 #include "core/error.h"
 
 /* The work: returns a status and fills err like any fallible function. */
@@ -28,13 +29,6 @@ thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s,
 /* At most this many children in a group. */
 #define CHILD_GROUP_MAX 64
 
-/* Whether to stop (a run's progress callback behind it): asked about ten times a second
- * while a group's children run, on the thread waiting for them. */
-typedef struct child_cancel {
-    int (*fn)(void *user); /* non-zero: stop */
-    void *user;
-} child_cancel;
-
 /* Runs fn(args[i]) for i < n (n <= CHILD_GROUP_MAX) in n children at once: started one
  * after the other by the calling thread (under child_run's lock), then each waited for,
  * and killed timeout_s after its start if still running. Returns THZ_OK or the first
@@ -43,6 +37,6 @@ typedef struct child_cancel {
  * waited for). When `cancel` (may be NULL) says stop, every child still running is
  * killed and the group returns THZ_ERR_CANCELLED. */
 thz_status child_run_group(const char *const *whats, child_fn fn, void *const *args, size_t n,
-                           double timeout_s, const child_cancel *cancel, thz_error *err);
+                           double timeout_s, const cancel_check *cancel, thz_error *err);
 
 #endif

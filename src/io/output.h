@@ -60,7 +60,7 @@ bool output_file_name(char *buf, size_t size, const char *sensor, const char *qu
  * per processor; io/plot.h's batch): the same files for any count. `cancel` (may be
  * NULL) stops them (THZ_ERR_CANCELLED). */
 thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t sensor,
-                               const sensor_images *images, int threads, const child_cancel *cancel,
+                               const sensor_images *images, int threads, const cancel_check *cancel,
                                thz_error *err);
 
 /* What summary.json reports beyond the scene. */

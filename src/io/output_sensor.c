@@ -246,7 +246,7 @@ cleanup:
 }
 
 thz_status output_write_sensor(const char *dir, const thz_scene *scene, size_t sensor,
-                               const sensor_images *images, int threads, const child_cancel *cancel,
+                               const sensor_images *images, int threads, const cancel_check *cancel,
                                thz_error *err)
 {
     if (sensor >= scene->n_sensors || images->n_channels != scene->n_channels)

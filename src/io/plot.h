@@ -97,6 +97,6 @@ thz_status plot_batch_lines(plot_batch *b, const char *path, size_t n_x, const d
                             const char *title, const char *x_label, const char *y_label,
                             thz_error *err);
 /* `cancel` (may be NULL) stops the drawing: THZ_ERR_CANCELLED, the children killed. */
-thz_status plot_batch_run(plot_batch *b, int processes, const child_cancel *cancel, thz_error *err);
+thz_status plot_batch_run(plot_batch *b, int processes, const cancel_check *cancel, thz_error *err);
 
 #endif

@@ -214,7 +214,7 @@ static size_t plot_item_cells(const plot_item *it)
     return it->kind == PLOT_ITEM_IMAGE ? (size_t)it->columns * it->rows : it->n_x * it->n_lines;
 }
 
-thz_status plot_batch_run(plot_batch *b, int processes, const child_cancel *cancel, thz_error *err)
+thz_status plot_batch_run(plot_batch *b, int processes, const cancel_check *cancel, thz_error *err)
 {
     if (!b || b->n == 0)
         return THZ_OK;

@@ -306,6 +306,25 @@ void photon_phase_share_range(uint64_t k, size_t member, size_t members, uint64_
     *hi = b_hi * PHASE_BATCH < k ? b_hi * PHASE_BATCH : k;
 }
 
+/* The index build's question (photon_map_build's cancel): the photons stage's progress,
+ * its last photon not yet counted. */
+typedef struct phase_build_asking {
+    const photon_phase_options *opt;
+    size_t channel, n_channels;
+    uint64_t photons;
+} phase_build_asking;
+
+static int phase_build_cancelled(void *user)
+{
+    const phase_build_asking *a = user;
+    thz_progress p = {.stage = "photons",
+                      .channel = a->channel,
+                      .n_channels = a->n_channels,
+                      .done = a->photons ? a->photons - 1 : 0,
+                      .total = a->photons};
+    return a->opt->progress(a->opt->progress_user, &p);
+}
+
 /* Fires photons [lo, hi) of rq from its sources: the share's records and chunk counters,
  * their sum in *total. */
 static thz_status phase_fire_range(const thz_scene *scene, const accel *acc,
@@ -449,8 +468,13 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     }
     double t2 = omp_get_wtime();
 
-    /* photon_map_build takes ownership of records, also on failure. */
-    st = photon_map_build(records, count, capacity, scene->n_objects, threads, pool, out_map, err);
+    /* photon_map_build takes ownership of records, also on failure. It asks for a stop
+     * between its passes through the progress callback: the stage's last unit, which it
+     * completes, still to come. */
+    phase_build_asking asking = {opt, channel, scene->n_channels, rq.photons};
+    cancel_check cancel = {phase_build_cancelled, &asking};
+    st = photon_map_build(records, count, capacity, scene->n_objects, threads, pool,
+                          opt && opt->progress ? &cancel : NULL, out_map, err);
     if (st != THZ_OK)
         return st;
     photon_map_set_reference_temperature_k(*out_map, t0_k);

@@ -10,6 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/cancel.h"
 #include "core/error.h"
 #include "core/vec3.h"
 
@@ -119,9 +120,12 @@ static inline size_t photon_map_scratch_records(size_t count)
 }
 
 /* photon_map_create with the array's capacity (>= count, kept for photon_map_recycle)
- * and a pool (may be NULL) whose scratch the index build uses. */
+ * and a pool (may be NULL) whose scratch the index build uses; `cancel` (may be NULL) is
+ * asked between the build's passes, on the calling thread (THZ_ERR_CANCELLED: 10^8
+ * photons' build held a stop for 3 to 7 s). */
 thz_status photon_map_build(photon_record *photons, size_t count, size_t capacity, size_t n_objects,
-                            int threads, photon_map_pool *pool, photon_map **out, thz_error *err);
+                            int threads, photon_map_pool *pool, const cancel_check *cancel,
+                            photon_map **out, thz_error *err);
 
 /* One map of the photons of n maps of one channel fired with the same K and disjoint
  * photon ranges (photon_phase_options.first_photon): their records in order, each power

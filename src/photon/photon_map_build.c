@@ -410,7 +410,7 @@ static void photon_build_sort_key(const photon_build *b, size_t key)
 thz_status photon_map_create(photon_record *photons, size_t count, size_t n_objects, int threads,
                              photon_map **out, thz_error *err)
 {
-    return photon_map_build(photons, count, count, n_objects, threads, NULL, out, err);
+    return photon_map_build(photons, count, count, n_objects, threads, NULL, NULL, out, err);
 }
 
 /* The most keys a build of count records in n_groups groups may have: a group is large
@@ -447,7 +447,8 @@ static size_t photon_build_arrays(photon_build *b, void *index)
 }
 
 thz_status photon_map_build(photon_record *photons, size_t count, size_t capacity, size_t n_objects,
-                            int threads, photon_map_pool *pool, photon_map **out, thz_error *err)
+                            int threads, photon_map_pool *pool, const cancel_check *cancel,
+                            photon_map **out, thz_error *err)
 {
     thz_status st = THZ_OK;
     photon_map *map = NULL;
@@ -509,6 +510,8 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
         ordered = photon_build_in_order(&b, p) && ordered;
     if (ordered)
         goto built;
+    if (cancel_now(cancel))
+        goto cancelled;
 #pragma omp parallel for num_threads(b.parts) schedule(static, 1)
     for (int p = 0; p < b.parts; p++)
         photon_build_key(&b, p);
@@ -529,12 +532,18 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
     }
     b.s = scratch;
     photon_build_buckets(&b, s_count);
+    if (cancel_now(cancel))
+        goto cancelled;
+#pragma omp parallel for num_threads(b.parts) schedule(static, 1)
+    for (int p = 0; p < b.parts; p++)
+        photon_build_partition(&b, p);
+    /* a region per bucket (at most PHOTON_MAP_BUCKETS_MAX), so that a stop is asked between
+     * them on this thread */
+    for (int k = 0; k < b.n_buckets; k++) {
+        if (cancel_now(cancel))
+            goto cancelled;
 #pragma omp parallel num_threads(b.parts)
-    {
-#pragma omp for schedule(static, 1)
-        for (int p = 0; p < b.parts; p++)
-            photon_build_partition(&b, p);
-        for (int k = 0; k < b.n_buckets; k++) {
+        {
 #pragma omp single
             photon_build_slots(&b, k);
 #pragma omp for schedule(static, 1)
@@ -556,6 +565,9 @@ built:
     photons = NULL; /* owned by map now */
     *out = map;
     map = NULL;
+    goto cleanup;
+cancelled:
+    st = thz_error_set(err, THZ_ERR_CANCELLED, "photon map: cancelled");
 cleanup:
     if (!pool) {
         free(scratch);

@@ -80,7 +80,7 @@ static bool run_write_report(const run_state *rs, const run_write_options *wo, u
     return wo->progress(wo->progress_user, &p) != 0;
 }
 
-/* child_cancel's question while the figures are drawn: the progress callback's. */
+/* cancel_check's question while the figures are drawn: the progress callback's. */
 typedef struct run_write_asking {
     const run_state *rs;
     const run_write_options *wo;
@@ -100,7 +100,7 @@ thz_status run_write(run_state *rs, const char *dir, const run_write_options *wo
     double t0 = thz_now_s();
     thz_status st = THZ_OK;
     run_write_asking asking = {rs, wo};
-    child_cancel cancel = {run_write_cancelled, &asking};
+    cancel_check cancel = {run_write_cancelled, &asking};
     for (size_t i = 0; i < rs->n_selected && st == THZ_OK; i++)
         st = output_write_sensor(dir, rs->scene, rs->selected[i], &rs->images[i], rs->opt->threads,
                                  &cancel, err);

@@ -97,7 +97,7 @@ static void test_cancel_ends_the_group(void **state)
     void *args[3] = {&work[0], &work[1], &work[2]};
     const char *whats[3] = {"one", "two", "three"};
     cancel_after_s = thz_now_s() + 0.3;
-    child_cancel cancel = {cancel_late, &cancel_after_s};
+    cancel_check cancel = {cancel_late, &cancel_after_s};
     thz_error err = {0};
     double t0 = thz_now_s();
     assert_int_equal(child_run_group(whats, sleeper, args, 3, 60.0, &cancel, &err),

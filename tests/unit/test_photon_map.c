@@ -385,13 +385,55 @@ static void test_deterministic_crowded(void **state)
         assert_non_null(p);
         memcpy(p, src, n * sizeof *p);
         photon_map *c = NULL;
-        assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, &c, NULL), THZ_OK);
+        assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, NULL, &c, NULL), THZ_OK);
         assert_memory_equal(ra, photon_map_records(c), n * sizeof(photon_record));
         /* 3/8 of the records: no key holds more here (three buckets) */
         assert_int_equal(pool.scratch_capacity, photon_map_scratch_records(n));
         photon_map_recycle(c, &pool);
     }
     photon_map_pool_fini(&pool);
+    photon_map_destroy(a);
+    free(src);
+}
+
+/* A build asks its cancel between passes: stopped at each of its questions in turn, it
+ * returns THZ_ERR_CANCELLED (nothing leaked: the sanitizer build), and never stopped it
+ * builds the same map as without one. */
+static int stop_at;
+static int asked;
+static int stop_at_question(void *user)
+{
+    (void)user;
+    return ++asked == stop_at;
+}
+
+static void test_cancel(void **state)
+{
+    (void)state;
+    const size_t n = 140000, n_objects = 40; /* three buckets: five questions */
+    photon_record *src = make_crowded(n, n_objects);
+    photon_map *a = build(src, n, n_objects, 1, 0);
+    cancel_check cancel = {stop_at_question, NULL};
+    int questions = 0;
+    for (stop_at = 1;; stop_at++) {
+        asked = 0;
+        photon_record *p = malloc(n * sizeof *p);
+        assert_non_null(p);
+        memcpy(p, src, n * sizeof *p);
+        photon_map *c = NULL;
+        thz_error err = {0};
+        thz_status st = photon_map_build(p, n, n, n_objects, 2, NULL, &cancel, &c, &err);
+        if (st == THZ_OK) {
+            assert_memory_equal(photon_map_records(a), photon_map_records(c),
+                                n * sizeof(photon_record));
+            photon_map_destroy(c);
+            break;
+        }
+        assert_int_equal(st, THZ_ERR_CANCELLED);
+        assert_null(c);
+        questions++;
+    }
+    assert_true(questions >= 3); /* before the keys, before the partition, each bucket */
     photon_map_destroy(a);
     free(src);
 }
@@ -421,7 +463,7 @@ static void test_in_order(void **state)
         }
         photon_map_pool pool = {0};
         photon_map *c = NULL;
-        assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, &c, NULL), THZ_OK);
+        assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, NULL, &c, NULL), THZ_OK);
         assert_memory_equal(ra, photon_map_records(c), n * sizeof(photon_record));
         /* the second array is taken only when something is out of order */
         assert_true((pool.scratch == NULL) == (variant == 0));
@@ -456,7 +498,7 @@ static void test_crowded_key(void **state)
     assert_non_null(p);
     memcpy(p, src, n * sizeof *p);
     photon_map *c = NULL;
-    assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, &c, NULL), THZ_OK);
+    assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, NULL, &c, NULL), THZ_OK);
     assert_memory_equal(photon_map_records(a), photon_map_records(c), n * sizeof(photon_record));
     /* the point's key and the few others in its cell, far less than all */
     assert_in_range(pool.scratch_capacity, at_point, at_point + n / 100);
@@ -466,7 +508,7 @@ static void test_crowded_key(void **state)
     p = malloc(n * sizeof *p);
     assert_non_null(p);
     memcpy(p, photon_map_records(a), n * sizeof *p);
-    assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, &c, NULL), THZ_OK);
+    assert_int_equal(photon_map_build(p, n, n, n_objects, 2, &pool, NULL, &c, NULL), THZ_OK);
     assert_null(pool.scratch); /* in the map's order already */
     photon_map_destroy(c);
     photon_map_pool_fini(&pool);
@@ -519,6 +561,7 @@ int main(void)
         cmocka_unit_test(test_same_records_grouped),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_deterministic_crowded),
+        cmocka_unit_test(test_cancel),
         cmocka_unit_test(test_in_order),
         cmocka_unit_test(test_crowded_key),
         cmocka_unit_test(test_empty_and_errors),
