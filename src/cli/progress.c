@@ -54,6 +54,35 @@ void cli_progress_init(cli_progress *p, const char *command, bool quiet)
     p->last_report_s = cli_now_s();
 }
 
+void cli_progress_sensors(cli_progress *p, const thz_scene *scene, long only)
+{
+    p->scene = scene;
+    p->only_sensor = only;
+    p->n_sensors = only >= 0 ? 1 : thz_scene_sensor_count(scene);
+}
+
+/* ", sensor 'NAME' (k/S)" for a render report of a run of several sensors, else "". */
+static void cli_progress_sensor_text(const cli_progress *p, const thz_progress *pr, char *out,
+                                     size_t size)
+{
+    out[0] = '\0';
+    if (!p->scene || p->n_sensors < 2 || strcmp(pr->stage, "render") != 0)
+        return;
+    size_t k = p->restarts % p->n_sensors;
+    thz_sensor_info info;
+    if (thz_scene_sensor(p->scene, k, &info) == THZ_OK)
+        snprintf(out, size, ", sensor '%s' (%zu/%zu)", info.name, k + 1, p->n_sensors);
+}
+
+/* The share of the channel's render done: the sensors before this one in the pass, and
+ * this one's rows. */
+static double cli_render_share(const cli_progress *p, double rows_frac)
+{
+    if (!p->scene || p->n_sensors < 2)
+        return rows_frac;
+    return ((double)(p->restarts % p->n_sensors) + rows_frac) / (double)p->n_sensors;
+}
+
 /* The unit a stage counts in. */
 static const char *cli_stage_unit(const char *stage)
 {
@@ -77,17 +106,21 @@ static void cli_progress_draw_tty(cli_progress *p, const thz_progress *pr, doubl
     }
     const char *unit = cli_stage_unit(pr->stage);
     bool named = strcmp(unit, pr->stage) == 0; /* "photons 500/1000", not "... photons" */
-    fprintf(p->out, "\r\033[Kthzmap %s: channel %zu/%zu, %s %llu/%llu%s%s (%.0f %%)", p->command,
+    char sensor[160];
+    cli_progress_sensor_text(p, pr, sensor, sizeof sensor);
+    fprintf(p->out, "\r\033[Kthzmap %s: channel %zu/%zu, %s %llu/%llu%s%s (%.0f %%)%s", p->command,
             pr->channel + 1, pr->n_channels, pr->stage, (unsigned long long)pr->done,
-            (unsigned long long)pr->total, named ? "" : " ", named ? "" : unit, 100.0 * frac);
+            (unsigned long long)pr->total, named ? "" : " ", named ? "" : unit, 100.0 * frac,
+            sensor);
     if (rate > 0.0)
         fprintf(p->out, ", %.3g %s/s", rate, unit);
     /* the whole run: the share of the channels done so far (photons the first half of a
      * channel when it fires any), else the estimate less the time spent */
     double run_elapsed = now - p->run_start_s;
+    double render = cli_render_share(p, frac);
     double share = (double)pr->channel + (strcmp(pr->stage, "photons") == 0 ? 0.5 * frac
-                                          : p->photons_seen                 ? 0.5 + 0.5 * frac
-                                                                            : frac);
+                                          : p->photons_seen                 ? 0.5 + 0.5 * render
+                                                                            : render);
     share /= (double)(pr->n_channels ? pr->n_channels : 1);
     double eta = share > 0.02 ? run_elapsed * (1.0 - share) / share : p->estimate_s - run_elapsed;
     if (eta > 0.0 && p->run_start_s > 0.0) {
@@ -108,6 +141,9 @@ static void cli_progress_line(cli_progress *p, const thz_progress *pr, double no
             elapsed);
     if (elapsed > 0.0 && strcmp(pr->stage, "output") != 0)
         fprintf(p->out, " (%.3g %s/s)", (double)pr->done / elapsed, unit);
+    char sensor[160];
+    cli_progress_sensor_text(p, pr, sensor, sizeof sensor);
+    fputs(sensor, p->out);
     fputc('\n', p->out);
     fflush(p->out);
 }
@@ -123,6 +159,10 @@ int cli_progress_report(void *user, const thz_progress *pr)
     double previous = p->last_report_s;
     p->last_report_s = now;
     bool other_stage = !p->stage || strcmp(p->stage, pr->stage) != 0 || p->channel != pr->channel;
+    if (other_stage)
+        p->restarts = 0;
+    else if (pr->done < p->last_done) /* the next sensor, or the next pass */
+        p->restarts++;
     if (other_stage || pr->done < p->last_done) {
         p->stage = pr->stage;
         p->channel = pr->channel;

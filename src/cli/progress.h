@@ -32,7 +32,17 @@ typedef struct cli_progress {
     double run_start_s; /* when the plan was told (0: no plan) */
     double estimate_s;  /* the plan's estimate of the whole run, s */
     bool photons_seen;  /* the run fires photons (half of each channel's share) */
+    /* The sensors a run renders, one after the other in each pass (cli_progress_sensors;
+     * none: not told): each starts its rows from 0, which the lines name and the run's
+     * ETA counts (10 sensors made it swing between 10 s and 1 s). */
+    const thz_scene *scene;
+    long only_sensor; /* the one sensor rendered, or -1: all of the scene's */
+    size_t n_sensors;
+    size_t restarts; /* of the channel's render rows: pass * n_sensors + sensor */
 } cli_progress;
+
+/* Tells p the sensors the run renders: all of the scene's, or `only` (>= 0). */
+void cli_progress_sensors(cli_progress *p, const thz_scene *scene, long only);
 
 void cli_progress_init(cli_progress *p, const char *command, bool quiet);
 

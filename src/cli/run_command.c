@@ -343,6 +343,9 @@ int cli_run_command(int argc, char **argv, bool render)
     }
     cli_progress progress;
     cli_progress_init(&progress, cmd, a.quiet);
+    cli_progress_sensors(&progress, scene,
+                         render && a.sensor_name ? thz_scene_sensor_index(scene, a.sensor_name)
+                                                 : -1);
     thz_context_set_threads(ctx, a.threads);
     if (shared && thz_context_set_mpi(ctx, &err) != THZ_OK)
         cli_mpi_abort(cli_fail(&err));

@@ -80,6 +80,13 @@ ls -A "$work/t1" | grep -q '^\.' && fail "a hidden (staging) entry was left in O
 grep -q "channel 2/2, photons: 20000 photons in .* s (.* photons/s)" "$work/p.err" \
     || fail "no photon progress line: $(cat "$work/p.err")"
 grep -q "channel 1/2, render: " "$work/p.err" || fail "no render progress line"
+# two sensors: each render line names its sensor, in the scene's order (the run's ETA on a
+# terminal counts them too: with ten it swung between 10 s and 1 s)
+for c in 1 2; do
+    grep -Eq "channel $c/2, render: .*, sensor 'cam' \(1/2\)$" "$work/p.err" &&
+        grep -Eq "channel $c/2, render: .*, sensor 'side' \(2/2\)$" "$work/p.err" ||
+        fail "channel $c's render lines do not name their sensors: $(grep render "$work/p.err")"
+done
 grep -q "results in $work/p" "$work/p.out" || fail "no closing line: $(cat "$work/p.out")"
 # the noisiest object's channel: by its name, with the frequency where the name is not one
 grep -q "noisiest object: '.*', 95th percentile standard error .* K at 0\.[0-9]* THz$" \
