@@ -14,9 +14,37 @@
 
 enum { PLOT_CHILD_TEXT = 4200 };
 
+/* PLplot reads the working directory into 1024 bytes and ends the process when it is
+ * longer ("get_tmpdir_list: getcwd error"): every figure failed from a directory deeper
+ * than that. In a figure's child, before PLplot: such a child moves to "/" and keeps the
+ * directory it came from in cwd (else cwd is ""), for plot_child_path. */
+static void plot_child_short_cwd(char *cwd, size_t size)
+{
+    char probe[1024];
+    cwd[0] = '\0';
+    if (getcwd(probe, sizeof probe) || !getcwd(cwd, size) || chdir("/") != 0)
+        cwd[0] = '\0';
+}
+
+/* path as the child must name it: as given, or after cwd when the child moved. */
+static const char *plot_child_path(const char *cwd, const char *path, char *buf, size_t size)
+{
+    if (!cwd[0] || path[0] == '/')
+        return path;
+    int n = snprintf(buf, size, "%s/%s", cwd, path);
+    return n > 0 && (size_t)n < size ? buf : path;
+}
+
+static thz_status plot_check_device_child(void *arg, thz_error *err)
+{
+    char cwd[PLOT_CHILD_TEXT];
+    plot_child_short_cwd(cwd, sizeof cwd);
+    return plot_check_device_here(arg, err);
+}
+
 thz_status plot_check_device(thz_error *err)
 {
-    return child_run("checking PLplot's devices", plot_check_device_here, NULL, plot_timeout_s(0),
+    return child_run("checking PLplot's devices", plot_check_device_child, NULL, plot_timeout_s(0),
                      err);
 }
 
@@ -32,8 +60,11 @@ typedef struct plot_attenuation_args {
 static thz_status plot_attenuation_child(void *arg, thz_error *err)
 {
     const plot_attenuation_args *a = arg;
-    return plot_attenuation_draw(a->path, a->n_x, a->x, a->n_curves, a->curves, a->n_bands,
-                                 a->bands, a->title, a->x_label, a->y_label, err);
+    char cwd[PLOT_CHILD_TEXT], path[2 * PLOT_CHILD_TEXT];
+    plot_child_short_cwd(cwd, sizeof cwd);
+    return plot_attenuation_draw(plot_child_path(cwd, a->path, path, sizeof path), a->n_x, a->x,
+                                 a->n_curves, a->curves, a->n_bands, a->bands, a->title, a->x_label,
+                                 a->y_label, err);
 }
 
 thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_t n_curves,
@@ -195,14 +226,17 @@ typedef struct plot_share {
 static thz_status plot_share_child(void *arg, thz_error *err)
 {
     const plot_share *sh = arg;
+    char cwd[PLOT_CHILD_TEXT], buf[2 * PLOT_CHILD_TEXT];
+    plot_child_short_cwd(cwd, sizeof cwd);
     for (size_t i = sh->lo; i < sh->hi; i++) {
         const plot_item *it = &sh->b->items[i];
-        thz_status st = it->kind == PLOT_ITEM_IMAGE
-                            ? plot_image_draw(it->path, it->values, it->columns, it->rows,
-                                              it->title, it->y_label, err)
-                            : plot_lines_draw(it->path, it->n_x, it->x, it->n_lines,
-                                              (const char *const *)it->names, it->y, it->title,
-                                              it->x_label, it->y_label, it->whole_x, err);
+        const char *path = plot_child_path(cwd, it->path, buf, sizeof buf);
+        thz_status st =
+            it->kind == PLOT_ITEM_IMAGE
+                ? plot_image_draw(path, it->values, it->columns, it->rows, it->title, it->y_label,
+                                  err)
+                : plot_lines_draw(path, it->n_x, it->x, it->n_lines, (const char *const *)it->names,
+                                  it->y, it->title, it->x_label, it->y_label, it->whole_x, err);
         if (st != THZ_OK)
             return st;
     }

@@ -84,6 +84,15 @@ expect "a scene path that is not UTF-8" $? 0 ""
 /usr/bin/python3 -c 'import json, sys; p = json.load(open(sys.argv[1]))["scene"]["path"]; assert p.endswith("sc\\xff\\xfe/scene.json"), p' \
     "$work/odd/summary.json" || fail "summary.json's scene path: $(grep '"path"' "$work/odd/summary.json")"
 
+# --- a working directory deeper than 1024 bytes (PLplot's getcwd buffer: every figure
+#     failed, PLplot ending its process) ------------------------------------------------
+deep=$work
+for _ in $(seq 11); do deep=$deep/$(printf 'd%.0s' $(seq 100)); done
+mkdir -p "$deep"
+(cd "$deep" && exec "$T" simulate "$S" -o out "${R[@]}") 2>"$work/err"
+expect "a working directory of ${#deep} bytes" $? 0 ""
+[[ -s $deep/out/cam.band-01.png ]] || fail "a deep working directory: no figure"
+
 # --- OUTDIR refused before the run: a name too long, a directory not writable ------------
 long=$work/$(printf 'b%.0s' $(seq 256))
 "$T" simulate "$S" -o "$long" --photons 20000000 --integrator photon-map -q 2>"$work/err"
