@@ -229,10 +229,10 @@ class Image:
     channels): radiance (W m^-2 sr^-1 Hz^-1), radiance_stderr (None when not estimated),
     power (W), brightness_temperature (K), normalized (1). Maps shaped (rows, columns):
     temperature (K, -1 where nothing is hit), distance (m, -1: none), object_id (index
-    of the object seen as float, -1: none), as in the ENVI files; visual (rows, columns, 3) rgb 0..1;
-    measured_radiance and measured_brightness_temperature (the sensor's PSF and noise
-    applied; None when the sensor has neither) shaped like the cubes. Row 0 is the
-    top of the picture. The arrays are read-only views of the library's buffers."""
+    of the object seen as float, -1: none), as in the ENVI files; visual (rows, columns,
+    3) rgb 0..1; measured_radiance and measured_brightness_temperature (the sensor's PSF
+    and noise applied; None when the sensor has neither) shaped like the cubes. Row 0 is
+    the top of the picture. The arrays are read-only views of the library's buffers."""
 
     def __init__(self, run_owner, ptr, scene):
         self._run = run_owner

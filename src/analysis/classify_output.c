@@ -9,8 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/json_text.h"
 #include "core/alloc.h"
+#include "core/json_text.h"
 #include "core/path.h"
 #include "io/envi.h"
 #include "io/output.h"

@@ -12,9 +12,9 @@
 #include <string.h>
 
 #include "batch/batch_internal.h"
-#include "core/json_text.h"
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/path.h"
 #include "io/output.h"
 

@@ -1,11 +1,12 @@
 /* Running a sequence (thz_batch_run): every frame as `thzmap simulate` would, each into
  * its own atomic output directory (thz_output) holding frame.json with the hash of the
  * frame's inputs; OUTDIR/batch.json rewritten (temporary file, then rename) as frames
- * finish (batch_json_due) and at the end; the movies at the end, rebuilt from the frames' files. A
- * frame directory whose frame.json carries the frame's hash is finished and is not run again, which
- * is all that resuming a killed batch needs: a frame appears whole or not at all. Under MPI the
- * pending frames are dealt to the ranks by photon groups when there are enough of them
- * (batch_deal.c), and this process, rank 0, writes every frame in frame order.
+ * finish (batch_json_due) and at the end; the movies last, rebuilt from the frames' files.
+ * A frame directory whose frame.json carries the frame's hash is finished and is not run
+ * again, which is all that resuming a killed batch needs: a frame appears whole or not at
+ * all. Under MPI the pending frames are dealt to the ranks by photon groups when there
+ * are enough of them (batch_deal.c), and this process, rank 0, writes every frame in
+ * frame order.
  */
 #include <dirent.h>
 #include <errno.h>
@@ -21,10 +22,10 @@
 
 #include "api/api.h"
 #include "batch/batch_internal.h"
-#include "core/json_text.h"
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/file.h"
+#include "core/json_text.h"
 #include "core/path.h"
 
 typedef enum frame_state { FRAME_PENDING, FRAME_REUSED, FRAME_COMPUTED, FRAME_FAILED } frame_state;

@@ -57,7 +57,6 @@ void cli_progress_init(cli_progress *p, const char *command, bool quiet)
 void cli_progress_sensors(cli_progress *p, const thz_scene *scene, long only)
 {
     p->scene = scene;
-    p->only_sensor = only;
     p->n_sensors = only >= 0 ? 1 : thz_scene_sensor_count(scene);
 }
 

@@ -36,7 +36,6 @@ typedef struct cli_progress {
      * none: not told): each starts its rows from 0, which the lines name and the run's
      * ETA counts (10 sensors made it swing between 10 s and 1 s). */
     const thz_scene *scene;
-    long only_sensor; /* the one sensor rendered, or -1: all of the scene's */
     size_t n_sensors;
     size_t restarts; /* of the channel's render rows: pass * n_sensors + sensor */
 } cli_progress;

@@ -13,7 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "core/child.h"
+#include "core/cancel.h"
 #include "core/error.h"
 #include "photon/photon_stats.h"
 #include "run/run_noise.h"

@@ -13,8 +13,8 @@
 #include <omp.h>
 #endif
 
-#include "core/threads.h"
 #include "core/alloc.h"
+#include "core/threads.h"
 #include "io/photon_map_file_format.h"
 #include "scene/scene_hash.h"
 

@@ -17,7 +17,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "core/child.h"
+#include "core/cancel.h"
 #include "core/error.h"
 
 /* THZ_OK if PLplot has the pngcairo device; otherwise THZ_ERR_IO with a message

@@ -7,9 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/threads.h"
 #include "core/alloc.h"
 #include "core/sampling.h"
+#include "core/threads.h"
 #include "photon/air_emission.h"
 #include "photon/emission.h"
 #include "photon/trace.h"

@@ -44,8 +44,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/threads.h"
 #include "core/alloc.h"
+#include "core/threads.h"
 #include "photon/photon_map_layout.h"
 #include "photon/photon_map_order.h"
 

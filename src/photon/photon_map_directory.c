@@ -2,8 +2,8 @@
 #include <omp.h>
 #include <stdlib.h>
 
-#include "core/threads.h"
 #include "core/alloc.h"
+#include "core/threads.h"
 #include "photon/photon_map_layout.h"
 
 /* The directory's level for a group of n records: the deepest L <= PHOTON_DIR_MAX_LEVELS

@@ -20,7 +20,12 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
     double gib = 1024.0 * 1024.0 * 1024.0;
     char key[128];
     if (need->held_bytes > need->photon_bytes && need->held_bytes > need->image_bytes) {
-        snprintf(key, sizeof key, "the meshes' triangles or the number of objects");
+        size_t big = 0; /* the object of most triangles */
+        for (size_t o = 1; o < scene->n_objects; o++)
+            if (scene->objects[o].mesh.n_triangles > scene->objects[big].mesh.n_triangles)
+                big = o;
+        snprintf(key, sizeof key, "objects[%zu].shape (%zu triangles) or the number of objects",
+                 big, scene->n_objects ? scene->objects[big].mesh.n_triangles : (size_t)0);
     } else if (need->photon_bytes >= need->image_bytes) {
         snprintf(key, sizeof key, "photons.per_channel (now %llu; or --photons)",
                  (unsigned long long)scene->photons.per_channel);

@@ -5,9 +5,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/threads.h"
 #include "core/clock.h"
 #include "core/path.h"
+#include "core/threads.h"
 #include "io/output.h"
 #include "io/photon_map_file.h"
 #include "io/ply.h"

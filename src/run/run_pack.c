@@ -8,8 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/threads.h"
 #include "core/alloc.h"
+#include "core/threads.h"
 
 #define PACK_MAGIC "THZRUN01"
 

@@ -18,9 +18,9 @@
 #include <math.h>
 #include <stdio.h>
 
+#include "core/csv.h"
 #include "core/error.h"
 #include "physics/spectrum.h"
-#include "core/csv.h"
 #include "scene/scene.h"
 
 /* Parses the JSON text of file f (or, when f is NULL, the string text), rejecting

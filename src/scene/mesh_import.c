@@ -24,9 +24,9 @@
 #include <assimp/scene.h>
 
 #include "core/alloc.h"
-#include "core/order.h"
 #include "core/child.h"
 #include "core/file.h"
+#include "core/order.h"
 #include "scene/mesh_check.h"
 #include "scene/primitives.h"
 

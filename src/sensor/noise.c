@@ -6,9 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/threads.h"
 #include "core/alloc.h"
 #include "core/rng.h"
+#include "core/threads.h"
 #include "physics/planck.h"
 
 /* sigma_L(Tb) is tabulated per channel over the plane's range of Tb at this many

@@ -9,8 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/threads.h"
 #include "core/alloc.h"
+#include "core/threads.h"
 #include "physics/planck.h"
 #include "sensor/camera.h"
 

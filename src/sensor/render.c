@@ -10,9 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/threads.h"
 #include "core/alloc.h"
 #include "core/clock.h"
+#include "core/threads.h"
 #include "sensor/camera.h"
 #include "sensor/integrator.h"
 #include "sensor/render_tiles.h"

@@ -5,8 +5,8 @@
 #include <omp.h>
 #include <stdatomic.h>
 
-#include "core/threads.h"
 #include "core/clock.h"
+#include "core/threads.h"
 
 #include "sensor/camera.h"
 
