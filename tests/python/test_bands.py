@@ -7,6 +7,7 @@ import math
 import os
 import shutil
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -88,10 +89,10 @@ def test_bands_errors(tmp_path):
         with pytest.raises(thzmap.ArgumentError):
             thzmap.bands(FEATURES, **kwargs)
     with pytest.raises(thzmap.ArgumentError):
-        thzmap.bands(thzmap.scene_from_json(open(FEATURES).read()), 1)
+        thzmap.bands(thzmap.scene_from_json(Path(FEATURES).read_text()), 1)
     # a Scene made from a dict labelled with the file's name is not the file: refused,
     # not run on the file as it is on disk
-    d = json.load(open(FEATURES))
+    d = json.loads(Path(FEATURES).read_text())
     d["objects"] = d["objects"][:2]
     made = thzmap.scene_from_dict(d, base_dir=os.path.dirname(FEATURES), label=FEATURES)
     with pytest.raises(thzmap.ArgumentError, match="not loaded from one"):
@@ -99,7 +100,7 @@ def test_bands_errors(tmp_path):
     # a Scene loaded from a file that changed since, or by a relative path from another
     # working directory, is the file it was loaded from, or refused
     copy = tmp_path / "scene.json"
-    copy.write_text(open(FEATURES).read())
+    copy.write_text(Path(FEATURES).read_text())
     cwd = os.getcwd()
     os.chdir(tmp_path)
     try:
