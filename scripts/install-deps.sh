@@ -23,6 +23,7 @@ case "${1:-all}" in
   all)
     packages+=(
       clang libomp-dev  # the clang build the tests compare (make test-compilers)
+      clang-format  # the code's layout (.clang-format: make format, tests/cli/test_format.sh)
       groff-base ffmpeg strace zstd  # the man page's, movies' and I/O checks
       python3-spectral gdal-bin python3-gdal  # reading the ENVI cubes back
       python3-pytest python3-matplotlib python3-sklearn python3-tqdm
