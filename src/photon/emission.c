@@ -285,9 +285,11 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, const 
     t->channel = channel;
     t->n_photons = n_photons ? n_photons : 1;
     t->t0_k = t0_k;
-    /* At most two sources per object (with T0 > 0: explicit-emissivity shells, one-sided
-     * solids with their back side). */
-    size_t cap = 2 * scene->n_objects;
+    /* At most three sources per object (with T0 > 0: an explicit-emissivity shell or
+     * solid with a complex index is two, eps B(T) and -A(mu) B0, and a one-sided solid
+     * adds its back side); emission_add_source writes a slot before it knows whether the
+     * source has power. */
+    size_t cap = 3 * scene->n_objects;
     t->sources = thz_calloc(cap ? cap : 1, sizeof *t->sources);
     if (!t->sources)
         return thz_error_set(err, THZ_ERR_NOMEM, "photon emission: out of memory");

@@ -72,12 +72,14 @@ typedef enum emission_kind {
     EMISSION_KIRCHHOFF = 0, /* W eps-bar (B(T) - B0), mu ~ A(mu) mu (eps = A) */
     EMISSION_EPS,           /* W eps B(T), cosine: explicit eps (shells; solids when T0 = 0) */
     EMISSION_EPS_ABSORB,    /* W (eps B(T) - (1 - R) B0), cosine: explicit-eps solids, T0 > 0 */
-    EMISSION_ABSORB,        /* -W A-bar B0, mu ~ A(mu) mu: explicit-eps shells, T0 > 0 */
+    EMISSION_ABSORB,        /* -W A-bar B0, mu ~ A(mu) mu: explicit-eps shells and solids with an
+                             * index, T0 > 0 */
     EMISSION_BACK           /* -pi A B0, cosine, from side 1: one-sided solids, T0 > 0 */
 } emission_kind;
 
-/* One emitting object (an explicit-emissivity shell with T0 > 0 is two sources, and so
- * is a one-sided solid with T0 > 0 whose back side reaches a front face). */
+/* One source of an emitting object. With T0 > 0 an object can be up to three: an
+ * explicit-emissivity shell, or solid with a complex index, is two (eps B(T) and
+ * -A(mu) B0), and a one-sided solid whose back side reaches a front face adds that. */
 typedef struct emission_source {
     uint32_t object; /* index into scene->objects */
     emission_kind kind;

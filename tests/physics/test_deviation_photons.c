@@ -14,6 +14,7 @@
  *   far beyond them.
  * - Determinism across 1 and 2 threads with T0 > 0; the energy balance closes exactly.
  */
+#include <complex.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -25,6 +26,7 @@
 #include "accel/accel.h"
 #include "physics/channel.h"
 #include "physics/planck.h"
+#include "photon/emission.h"
 #include "photon/phase.h"
 #include "photon_scenes.h"
 
@@ -519,6 +521,95 @@ static void test_threads_identical(void **state)
     scene_destroy(s);
 }
 
+/* The unpolarised Fresnel reflectance of air -> n + ik at cos(theta) = mu, written out
+ * independently of fresnel.c. */
+static double fresnel_r(double n, double k, double mu)
+{
+    double complex m = n + I * k, sin2 = 1.0 - mu * mu;
+    double complex cos_t = csqrt(1.0 - sin2 / (m * m));
+    double complex rs = (mu - m * cos_t) / (mu + m * cos_t);
+    double complex rp = (m * mu - cos_t) / (m * mu + cos_t);
+    return 0.5 * (cabs(rs) * cabs(rs) + cabs(rp) * cabs(rp));
+}
+
+/* A one-sided 0.5 m cube of index 2 + 0.1i with an explicit emissivity 0.5, at 300 K, with
+ * T0 = 100 K: two sources, eps B(T) and -A(mu) B0 with A = 1 - R(mu) (its back side,
+ * inside, reaches no front face). Alone, the table holds those two (the cube once wrote a
+ * third slot, its back side's, past a table of two per object); in a black room at T0
+ * (no source there) the fired power is pi S (eps B(T) - A-bar B0), from the first hits. */
+static void test_index_explicit_solid(void **state)
+{
+    (void)state;
+    const double n = 2.0, k = 0.1, eps = 0.5, t_k = 300.0, t0 = 100.0, side = 0.5;
+    static const char *room = "{\"name\": \"room\", \"type\": \"solid\", \"material\": \"black\","
+                              " \"temperature_k\": 100, \"shape\": {\"type\": \"box\","
+                              " \"size_m\": [4, 4, 4], \"inward\": true}}, ";
+    for (int with_room = 0; with_room < 2; with_room++) {
+        char json[2000];
+        snprintf(json, sizeof json,
+                 "{\"format\": \"thzmap-scene/1\", \"name\": \"index-eps\","
+                 " \"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.05}],"
+                 " \"materials\": {\"black\": {\"reflectivity\": 0.0},"
+                 "   \"glass\": {\"refractive_index\": [%g, %g], \"emissivity\": %g}},"
+                 " \"objects\": [%s{\"name\": \"cube\", \"type\": \"solid\","
+                 "   \"material\": \"glass\", \"temperature_k\": %g,"
+                 "   \"shape\": {\"type\": \"box\", \"size_m\": [%g, %g, %g]}}],"
+                 " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -1.5, 0],"
+                 "   \"look_at_m\": [0, 0, 0], \"fov_deg\": 40, \"resolution\": [4, 4]}],"
+                 " \"photons\": {\"per_channel\": 1000, \"seed\": 3}}",
+                 n, k, eps, with_room ? room : "", t_k, side, side, side);
+        thz_scene *s;
+        accel *acc;
+        thz_error err;
+        if (scene_load_string(json, ".", "index-eps", &s, &err) != THZ_OK)
+            fail_msg("%s", err.message);
+        if (accel_create(s, &acc, &err) != THZ_OK)
+            fail_msg("%s", err.message);
+        if (!with_room) {
+            emission_table t;
+            if (emission_table_init(&t, s, acc, 0, 1000, t0, &err) != THZ_OK)
+                fail_msg("%s", err.message);
+            assert_int_equal(t.n_sources, 2);
+            assert_int_equal(t.sources[0].kind, EMISSION_EPS);
+            assert_int_equal(t.sources[1].kind, EMISSION_ABSORB);
+            emission_table_fini(&t);
+            accel_destroy(acc);
+            scene_destroy(s);
+            continue;
+        }
+        /* A-bar = 2 int_0^1 (1 - R(mu)) mu dmu (Simpson) */
+        const int steps = 20000;
+        double h = 1.0 / steps, sum = 0.0;
+        for (int i = 1; i <= steps; i++) {
+            double mu = i * h, w = i == steps ? 1 : (i % 2 ? 4 : 2);
+            sum += w * (1.0 - fresnel_r(n, k, mu)) * mu;
+        }
+        double abar = 2.0 * sum * h / 3.0;
+        double area = 6.0 * side * side;
+        double expected = M_PI * area * (eps * band_b(s, t_k) - abar * band_b(s, t0));
+        uint64_t photons = ps_scaled(200000);
+        s->photons.per_channel = photons;
+        photon_phase_options opt = {.threads = 2, .reference_temperature_k = t0};
+        photon_map *map;
+        photon_stats st;
+        assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+        power_moments m = first_hits(map);
+        double tol = five_sigma(&m, photons);
+        printf("# index solid, explicit eps: A-bar %.4f, fired %.6e W/Hz, expected %.6e "
+               "(tolerance %.2e); %zu negative and %zu positive photons\n",
+               abar, st.fired_power_w_per_hz, expected, tol, m.n_neg, m.n_pos);
+        assert_int_equal(m.n_neg + m.n_pos, photons); /* every photon hits the room */
+        assert_true(fabs(st.fired_power_w_per_hz - expected) <= tol);
+        /* a factor 2, a sign or the -A B0 source left out (-127 %) would fail */
+        assert_true(tol < 0.1 * fabs(expected));
+        assert_true(m.n_neg > 0 && m.n_pos > 0);
+        assert_balance(&st, m.sum_abs);
+        photon_map_destroy(map);
+        accel_destroy(acc);
+        scene_destroy(s);
+    }
+}
+
 /* The memory estimate's pilot fires the same kind of map: a deviation map stores a
  * different number of hits per photon than the paper's (its sources are other objects). */
 static void test_estimate_bytes(void **state)
@@ -551,10 +642,11 @@ static void test_estimate_bytes(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_t0_zero_checksums), cmocka_unit_test(test_furnace),
-        cmocka_unit_test(test_fired_power),       cmocka_unit_test(test_explicit_shell),
-        cmocka_unit_test(test_absorbing_air),     cmocka_unit_test(test_open_boundary),
-        cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_estimate_bytes),
+        cmocka_unit_test(test_t0_zero_checksums),    cmocka_unit_test(test_furnace),
+        cmocka_unit_test(test_fired_power),          cmocka_unit_test(test_explicit_shell),
+        cmocka_unit_test(test_absorbing_air),        cmocka_unit_test(test_open_boundary),
+        cmocka_unit_test(test_threads_identical),    cmocka_unit_test(test_estimate_bytes),
+        cmocka_unit_test(test_index_explicit_solid),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

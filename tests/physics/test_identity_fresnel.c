@@ -4,7 +4,9 @@
  *    degrees, shows L = (1 - R(theta)) B(T1) + R(theta) B(T2) per pixel, R the Fresnel
  *    reflectance (computed here independently in complex arithmetic) at the pixel's own
  *    angle; T2 = 0 K is the issue's check Tb = B^-1((1 - R) B(T1)), T2 = 350 K checks the
- *    angle-dependent diffuse BRDF's weights too;
+ *    angle-dependent diffuse BRDF's weights too; with an explicit emissivity e (which
+ *    replaces 1 - R, constant over angle) L = e B(T1) + R(theta) B(T2), from the
+ *    deviation maps too;
  *  - a mirror (`specular`, R = 0.9) at 0 K shows the image of a hot disk at exactly the
  *    pixels whose mirrored ray meets the disk, with 0.9 B(T_disk), and 0 elsewhere. */
 #include <complex.h>
@@ -25,15 +27,20 @@ static double test_fresnel(double n, double k, double mu)
     return 0.5 * (cabs(rs) * cabs(rs) + cabs(rp) * cabs(rp));
 }
 
-static void plate_case(thz_integrator integrator, double angle_deg, double room_k, double t0_k)
+static void plate_case(thz_integrator integrator, double angle_deg, double room_k, double t0_k,
+                       double eps)
 {
-    char json[3000];
+    char json[3000], eps_key[64] = "", eps_text[32] = "1 - R";
     double th = angle_deg * M_PI / 180.0;
+    if (!isnan(eps)) {
+        snprintf(eps_key, sizeof eps_key, ", \"emissivity\": %g", eps);
+        snprintf(eps_text, sizeof eps_text, "%g", eps);
+    }
     snprintf(json, sizeof json,
              "{\"format\": \"thzmap-scene/1\", \"name\": \"fresnel-plate\","
              " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.05}],"
              " \"materials\": {\"black\": {\"reflectivity\": 0.0},"
-             "   \"glassy\": {\"refractive_index\": [%g, %g]}},"
+             "   \"glassy\": {\"refractive_index\": [%g, %g]%s}},"
              " \"objects\": ["
              "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"black\","
              "    \"temperature_k\": %g,"
@@ -45,7 +52,7 @@ static void plate_case(thz_integrator integrator, double angle_deg, double room_
              "   \"direction\": [0, %.17g, %.17g], \"up\": [1, 0, 0], \"fov_deg\": 6,"
              "   \"resolution\": [6, 6], \"oversampling\": 1, \"normalize_to_k\": 300}],"
              " \"photons\": {\"per_channel\": 400000, \"seed\": 7, \"gather_min_photons\": 256}}",
-             PLATE_N, PLATE_K, room_k, -sin(th), 0.05 + cos(th), sin(th), -cos(th));
+             PLATE_N, PLATE_K, eps_key, room_k, -sin(th), 0.05 + cos(th), sin(th), -cos(th));
     ident_run r;
     ident_run_scene_t0(&r, json, ident_photons(400000), integrator, ident_estimates(32), t0_k);
     const thz_channel *ch = &r.scene->channels[0];
@@ -58,7 +65,8 @@ static void plate_case(thz_integrator integrator, double angle_deg, double room_
             double refl = test_fresnel(PLATE_N, PLATE_K, fabs(d.z));
             rmin = fmin(rmin, refl);
             rmax = fmax(rmax, refl);
-            expects[row * r.img.columns + col] = (1.0 - refl) * b1 + refl * b2;
+            double e = isnan(eps) ? 1.0 - refl : eps;
+            expects[row * r.img.columns + col] = e * b1 + refl * b2;
         }
     ident_tally t = {.pooled_rel_se = ident_pooled_rel_se(&r, 0, expects)};
     for (uint32_t row = 0; row < r.img.rows; row++)
@@ -66,10 +74,11 @@ static void plate_case(thz_integrator integrator, double angle_deg, double room_
             assert_int_equal(r.img.object_id[row * r.img.columns + col], 1);
             ident_check_pixel(&t, &r, 0, col, row, expects[row * r.img.columns + col], 1e-4);
         }
-    char what[200], label[64];
+    char what[320], label[64];
     ident_label(label, sizeof label, integrator, t0_k);
-    snprintf(what, sizeof what, "Fresnel plate %g + %gi at %g deg (R %.4f..%.4f), room %g K, %s",
-             PLATE_N, PLATE_K, angle_deg, rmin, rmax, room_k, label);
+    snprintf(what, sizeof what,
+             "Fresnel plate %g + %gi, emissivity %s, at %g deg (R %.4f..%.4f), room %g K, %s",
+             PLATE_N, PLATE_K, eps_text, angle_deg, rmin, rmax, room_k, label);
     ident_tally_assert(&t, what, 0.08 / sqrt(ident_scale()), 1e-4);
     ident_run_fini(&r);
 }
@@ -80,13 +89,16 @@ static void test_fresnel_plate(void **state)
     const double angles[] = {0.0, 45.0, 75.0};
     for (size_t k = 0; k < IDENT_N_INTEGRATORS; k++)
         for (size_t a = 0; a < 3; a++) {
-            plate_case(ident_integrators[k], angles[a], 0.0, NAN);
+            plate_case(ident_integrators[k], angles[a], 0.0, NAN, NAN);
             /* a warm room: the reflected part's weights (T0 = 0 K: not cancelled by the
-             * control variate) */
+             * control variate); and with an explicit emissivity, whose deviation map at
+             * T0 = 350 K has two sources on the plate, e B(T1) and -A(theta) B0 */
             if (a == 2)
                 for (size_t v = 0; v < IDENT_N_T0; v++)
-                    if (ident_t0_applies(ident_integrators[k], v))
-                        plate_case(ident_integrators[k], angles[a], 350.0, ident_t0s[v]);
+                    if (ident_t0_applies(ident_integrators[k], v)) {
+                        plate_case(ident_integrators[k], angles[a], 350.0, ident_t0s[v], NAN);
+                        plate_case(ident_integrators[k], angles[a], 350.0, ident_t0s[v], 0.6);
+                    }
         }
 }
 
