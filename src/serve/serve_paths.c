@@ -225,7 +225,8 @@ enum MHD_Result serve_files_list(serve_request *r)
         n += items[n] != NULL;
     }
     closedir(d);
-    qsort(items, n, sizeof *items, serve_entry_cmp);
+    if (n > 1) /* (items is NULL when nothing was listed) */
+        qsort(items, n, sizeof *items, serve_entry_cmp);
     for (size_t i = 0; i < n; i++)
         json_array_append_new(list, items[i]);
     free(items);

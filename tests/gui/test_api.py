@@ -135,6 +135,14 @@ def test_paths(srv, root):
     names = {e["name"]: e for e in listing["entries"]} if listing else {}
     check(names.get("scene.json", {}).get("type") == "file" and
           names.get("materials", {}).get("type") == "dir", "files: %r" % listing)
+    # an empty directory, and one with nothing listable (a FIFO): no entries (the
+    # listing once sorted a NULL array, which the sanitizer build's server died of)
+    os.mkdir(os.path.join(root, "empty"))
+    os.mkdir(os.path.join(root, "pipes"))
+    os.mkfifo(os.path.join(root, "pipes", "fifo"))
+    for d in ("empty", "pipes"):
+        listing = srv.json("GET", "/api/files?dir=" + d)
+        check(listing is not None and listing["entries"] == [], "files of %s: %r" % (d, listing))
     root_list = srv.json("GET", "/api/files")
     check(root_list and "etc-link" not in [e["name"] for e in root_list["entries"]],
           "a symlink out of the root is listed")
