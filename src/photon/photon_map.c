@@ -508,7 +508,9 @@ double photon_map_kth_distance2(const photon_map *map, uint32_t object, unsigned
         photon_cell root = photon_root(lo[s], n[s]);
         photon_knn_rec(&h, &root);
     }
-    double result = h.heap[0];
+    /* fewer than k found only from a position that is not a number (every comparison
+     * false): as with fewer than k photons */
+    double result = h.size == k ? h.heap[0] : INFINITY;
     if (h.heap != stack_heap)
         free(h.heap);
     return result;
