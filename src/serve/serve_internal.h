@@ -24,6 +24,7 @@
 #define SERVE_KEPT_FINISHED 256          /* finished jobs kept (the oldest go): 14 KB each */
 #define SERVE_PREVIEW_TRIANGLES 300000   /* /api/validate's meshes: the rest "mesh": null */
 #define SERVE_CUBE_CACHE 8               /* cubes kept open */
+#define SERVE_STREAMS_END_S 2            /* at stop, the event streams' time to end */
 
 typedef struct serve_job serve_job;
 typedef struct serve_cube_entry serve_cube_entry;
@@ -42,6 +43,7 @@ struct serve {
     pthread_t worker;
     bool worker_started;
     bool stopping;
+    size_t streams; /* event streams the daemon has not yet let go of */
     serve_job **jobs;
     size_t n_jobs, cap_jobs;
     int next_id;

@@ -319,6 +319,18 @@ void serve_runs_stop(serve *s)
     if (s->worker_started)
         pthread_join(s->worker, NULL);
     s->worker_started = false;
+    /* Every job is final now: give the event streams a moment to send it and their end
+     * (the daemon's stop closes their connections at once, and a page following a run
+     * would not learn that it was cancelled); a client that does not read is not waited
+     * for beyond that. */
+    struct timespec until;
+    clock_gettime(CLOCK_REALTIME, &until);
+    until.tv_sec += SERVE_STREAMS_END_S;
+    pthread_mutex_lock(&s->lock);
+    while (s->streams > 0)
+        if (pthread_cond_timedwait(&s->changed, &s->lock, &until) != 0)
+            break;
+    pthread_mutex_unlock(&s->lock);
 }
 
 void serve_runs_free(serve *s)
@@ -389,16 +401,32 @@ static ssize_t serve_stream_read(void *cls, uint64_t pos, char *buf, size_t max)
     return n < 0 || (size_t)n >= max ? MHD_CONTENT_READER_END_WITH_ERROR : n;
 }
 
+/* The daemon lets go of a stream (its response destroyed): one stream fewer to wait for
+ * at stop. */
+static void serve_stream_free(void *cls)
+{
+    serve_stream *st = cls;
+    serve *s = st->s;
+    pthread_mutex_lock(&s->lock);
+    s->streams--;
+    pthread_cond_broadcast(&s->changed);
+    pthread_mutex_unlock(&s->lock);
+    free(st);
+}
+
 static enum MHD_Result serve_events(serve_request *r, long id)
 {
     serve_stream *st = calloc(1, sizeof *st);
     if (!st)
         return MHD_NO;
     *st = (serve_stream){.s = r->s, .id = (int)id};
-    struct MHD_Response *resp =
-        MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 8192, serve_stream_read, st, free);
+    pthread_mutex_lock(&r->s->lock);
+    r->s->streams++;
+    pthread_mutex_unlock(&r->s->lock);
+    struct MHD_Response *resp = MHD_create_response_from_callback(
+        MHD_SIZE_UNKNOWN, 8192, serve_stream_read, st, serve_stream_free);
     if (!resp) {
-        free(st);
+        serve_stream_free(st);
         return MHD_NO;
     }
     MHD_add_response_header(resp, "Content-Type", "text/event-stream");
