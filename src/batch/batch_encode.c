@@ -321,7 +321,10 @@ thz_status movie_open(const movie_spec *spec, movie_writer **out, thz_error *err
     m->codec = m->av.avcodec_alloc_context3(codec);
     m->frame = m->av.av_frame_alloc();
     m->packet = m->av.av_packet_alloc();
-    m->rgb = thz_malloc_array((size_t)m->layout.width * m->layout.height, 3);
+    /* with FFmpeg's padding after the pixels, zeroed: swscale reads its input in vector-
+     * wide loads, past the last row's end (valgrind saw 4 bytes read beyond) */
+    m->rgb = thz_calloc(
+        (size_t)m->layout.width * m->layout.height * 3 + AV_INPUT_BUFFER_PADDING_SIZE, 1);
     if (!m->stream || !m->codec || !m->frame || !m->packet || !m->rgb)
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", spec->path);
     AVCodecContext *c = m->codec;
