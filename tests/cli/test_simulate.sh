@@ -188,8 +188,14 @@ rc=$?
 
 # --- a damaged map is bad input (exit 2, as a damaged scene or mesh), nothing written ----
 head -c 2000 "$work/t1/photon-map.thzpm" > "$work/cut.thzpm"
-cp "$work/t1/photon-map.thzpm" "$work/flip.thzpm"
-printf '\377' | dd of="$work/flip.thzpm" bs=1 seek=3000 conv=notrunc 2>/dev/null
+# byte 3000 inverted (writing 0xff there changed nothing where it was 0xff already)
+python3 - "$work/t1/photon-map.thzpm" "$work/flip.thzpm" <<'PY' || fail "could not flip a byte"
+import sys
+data = bytearray(open(sys.argv[1], "rb").read())
+data[3000] ^= 0xFF
+open(sys.argv[2], "wb").write(data)
+PY
+cmp -s "$work/t1/photon-map.thzpm" "$work/flip.thzpm" && fail "the flipped map is the same bytes"
 for m in cut flip; do
     "$THZMAP" render "$work/scene.json" --photon-map "$work/$m.thzpm" -o "$work/d$m" \
         --quiet 2> "$work/d$m.err"
