@@ -24,6 +24,13 @@
  * structure (and every hit) is the same for any --threads. Whether Embree's structure
  * depends on the number of build threads (MPI ranks bound to fewer cores than one process
  * gets) is not known; the MPI tests compare processes on one machine.
+ *
+ * Processors. Embree picks its kernels by the processor's instruction sets (SSE, AVX2,
+ * AVX-512: different SIMD widths), and their hit distances differ in the last bits, so
+ * the photons' paths and every image differ (by far less than their noise) between
+ * machines of different sets. THZMAP_EMBREE_MAX_ISA caps the set Embree may use: with one
+ * that every machine has, their results are the same bytes (docs/scene-format.md
+ * "Reproducibility").
  */
 #include "accel/accel.h"
 
@@ -33,6 +40,7 @@
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/alloc.h"
 
@@ -94,6 +102,29 @@ static thz_status accel_check_device(RTCDevice device, const char *what, thz_err
                          "ray casting: Embree failed while %s: %s", what, accel_error_name(e));
 }
 
+/* The instruction sets THZMAP_EMBREE_MAX_ISA may name, as Embree spells them. */
+static const char *const accel_isas[] = {"sse2", "sse4.2", "avx", "avx2", "avx512"};
+#define ACCEL_N_ISAS (sizeof accel_isas / sizeof accel_isas[0])
+
+/* THZMAP_EMBREE_MAX_ISA's set (*isa NULL when unset or empty); THZ_ERR_INPUT for a value
+ * that names none. */
+static thz_status accel_max_isa(const char **isa, thz_error *err)
+{
+    *isa = NULL;
+    const char *v = getenv("THZMAP_EMBREE_MAX_ISA");
+    if (!v || !v[0])
+        return THZ_OK;
+    for (size_t i = 0; i < ACCEL_N_ISAS; i++)
+        if (strcmp(v, accel_isas[i]) == 0) {
+            *isa = accel_isas[i];
+            return THZ_OK;
+        }
+    return thz_error_set(err, THZ_ERR_INPUT,
+                         "THZMAP_EMBREE_MAX_ISA: expected one of sse2, sse4.2, avx, avx2, "
+                         "avx512 (or unset), got \"%.40s\"",
+                         v);
+}
+
 thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err)
 {
     thz_status st = THZ_OK;
@@ -109,10 +140,16 @@ thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err)
         goto cleanup;
     }
 
-    /* Every build thread a user thread: TBB starts none of its own (see the top). */
+    /* Every build thread a user thread: TBB starts none of its own (see the top); the
+     * instruction sets capped where the environment says (see the top). */
+    const char *isa = NULL;
+    st = accel_max_isa(&isa, err);
+    if (st != THZ_OK)
+        goto cleanup;
     int build_threads = omp_get_num_procs();
-    char config[64];
-    snprintf(config, sizeof config, "threads=%d,user_threads=%d", build_threads, build_threads);
+    char config[96];
+    snprintf(config, sizeof config, "threads=%d,user_threads=%d%s%s", build_threads, build_threads,
+             isa ? ",max_isa=" : "", isa ? isa : "");
     a->device = rtcNewDevice(config);
     if (!a->device) {
         st =

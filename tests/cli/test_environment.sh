@@ -6,7 +6,8 @@
 # they ended in SIGSEGV); OMP_NUM_THREADS beyond 4096 runs with 4096, the same bytes (it
 # crashed libgomp); closed standard streams do not end up as the lock file's descriptor;
 # an OUTDIR whose name is too long or that is not writable is refused before the run; a
-# scene path that is not UTF-8 is written into summary.json with its bytes escaped.
+# scene path that is not UTF-8 is written into summary.json with its bytes escaped;
+# THZMAP_EMBREE_MAX_ISA takes Embree's instruction sets and refuses anything else.
 # usage: test_environment.sh THZMAP_BINARY REPO_DIR
 set -u
 T=$1
@@ -112,6 +113,20 @@ if [[ $(id -u) -eq 0 ]] && command -v runuser >/dev/null; then
     [[ -f $work/ro/own/notes.txt ]] || fail "a read-only OUTDIR lost the user's notes"
     chmod 755 "$work/ro/own"
 fi
+
+# --- THZMAP_EMBREE_MAX_ISA: a set the processor has at most, or refused -------------------
+"$T" simulate "$S" -o "$work/isa-default" "${R[@]}" 2>"$work/err"
+expect "simulate" $? 0 ""
+THZMAP_EMBREE_MAX_ISA=avx512 "$T" simulate "$S" -o "$work/isa-avx512" "${R[@]}" 2>"$work/err"
+expect "THZMAP_EMBREE_MAX_ISA=avx512" $? 0 ""
+for f in "$work/isa-default"/*.img; do # the widest set there is: the processor's own kernels
+    cmp -s "$f" "$work/isa-avx512/${f##*/}" || fail "THZMAP_EMBREE_MAX_ISA=avx512 changed ${f##*/}"
+done
+THZMAP_EMBREE_MAX_ISA=sse4.2 "$T" simulate "$S" -o "$work/isa-sse" "${R[@]}" 2>"$work/err"
+expect "THZMAP_EMBREE_MAX_ISA=sse4.2" $? 0 ""
+THZMAP_EMBREE_MAX_ISA=avx3 "$T" simulate "$S" -o "$work/isa-bad" "${R[@]}" 2>"$work/err"
+expect "THZMAP_EMBREE_MAX_ISA=avx3" $? 2 'THZMAP_EMBREE_MAX_ISA: expected one of sse2, sse4.2'
+[[ ! -e $work/isa-bad && -z $(leftovers) ]] || fail "THZMAP_EMBREE_MAX_ISA=avx3 left files"
 
 [[ $fails -eq 0 ]] && echo "environment: all passed"
 exit $((fails > 0))
