@@ -71,12 +71,15 @@ fuzz-ci: fuzz-build
 # The same outputs from a clang build for any x86-64 as from the gcc build for this
 # processor (-march=native): tests/builds/compare.sh. Everything is built with clang
 # (tests, bench, the web page's server), so that its -Werror covers all the C, not only
-# the program.
+# the program. That build, for any x86-64, also runs under valgrind's memcheck
+# (tests/builds/memcheck.sh: memory read before it is written, and what ASan does not
+# instrument).
 test-compilers: deps build
 	cmake -S . -B $(CLANG_BUILD) -G Ninja -DCMAKE_C_COMPILER=clang \
 	  -DCMAKE_BUILD_TYPE=Release -DTHZ_NATIVE=OFF >/dev/null
 	cmake --build $(CLANG_BUILD) -j $(JOBS)
 	bash tests/builds/compare.sh $(BUILD)/thzmap $(CLANG_BUILD)/thzmap $(CURDIR)
+	bash tests/builds/memcheck.sh $(CLANG_BUILD)/thzmap $(CURDIR)
 
 check: test test-asan test-compilers fuzz-ci
 
