@@ -245,8 +245,9 @@ static thz_status run_render_warnings(run_state *rs, thz_error *err)
         if (st == THZ_OK && r->truncated_paths)
             st = run_add_warning(rs, err,
                                  "sensor '%s': %llu samples were cut short: after %d straight "
-                                 "shells (what lies behind was dropped) or, with path, after %d "
-                                 "hits (the rest taken as B(T0))",
+                                 "shells and mirror reflections in a row (what lies beyond "
+                                 "was dropped) or, with path, after %d hits (the rest taken "
+                                 "as B(T0))",
                                  name, (unsigned long long)r->truncated_paths, RENDER_MAX_CROSSINGS,
                                  RENDER_MAX_BOUNCES);
     }

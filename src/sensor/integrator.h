@@ -91,9 +91,10 @@ double render_photon_map_trace(const render_context *ctx, vec3 origin_m, vec3 di
  * entries of the path the mirror branch is dropped (counted in truncated_paths). */
 #define RENDER_MIRROR_BRANCHES 8
 
-/* At a hit of a mirror (`specular` reflection): appends the bounce (R(theta)) to path,
- * turns *dir into the mirrored direction and *origin_m into its start, and returns true;
- * false for other surfaces (and when the path is full: counted as truncated). */
+/* At a hit of a mirror (`specular` reflection, R > 0 somewhere): appends the bounce
+ * (R(theta)) to path, turns *dir into the mirrored direction and *origin_m into its start,
+ * and returns true; false for other surfaces (and when the path is full: counted as
+ * truncated). */
 bool render_mirror(const render_context *ctx, const accel_hit *hit, render_path *path, vec3 *dir,
                    vec3 *origin_m, render_sample *out);
 

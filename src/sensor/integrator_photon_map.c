@@ -12,7 +12,7 @@ bool render_mirror(const render_context *ctx, const accel_hit *hit, render_path 
                    vec3 *origin_m, render_sample *out)
 {
     const thz_object *obj = &ctx->scene->objects[hit->object];
-    if (ctx->scene->materials[obj->material].reflection != REFLECTION_SPECULAR)
+    if (!ctx->mirror[hit->object])
         return false;
     if (path->n == RENDER_MAX_CROSSINGS) {
         out->truncated = 1;

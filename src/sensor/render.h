@@ -52,8 +52,9 @@
 #include "sensor/images.h"
 #include "sensor/render_accum.h"
 
-/* A sample ray continues through at most this many `straight` shells; beyond, what
- * lies behind is dropped (counted in render_stats.truncated_paths). */
+/* A sample ray continues through at most this many `straight` shells and mirror
+ * reflections in a row; beyond, what lies behind is dropped (counted in
+ * render_stats.truncated_paths). */
 #define RENDER_MAX_CROSSINGS 32
 
 /* final-gather's density estimate at a secondary hit uses the disk of the k-th nearest
@@ -134,8 +135,8 @@ typedef struct render_stats {
     uint64_t back_face_samples; /* rays that saw the back of a one-sided solid (radiance 0) */
     uint64_t widened_gathers;   /* footprints with < k photons, widened to the k-th nearest */
     uint64_t starved_gathers;   /* objects with < k photons where the gather looked: term 0 */
-    uint64_t truncated_paths;   /* rays cut after RENDER_MAX_CROSSINGS straight shells, or
-                                   paths after RENDER_MAX_BOUNCES hits */
+    uint64_t truncated_paths;   /* rays cut after RENDER_MAX_CROSSINGS straight shells and
+                                   mirror reflections, or paths after RENDER_MAX_BOUNCES hits */
     uint64_t paths;             /* path: paths traced; final-gather: gather rays cast */
     double seconds;             /* wall time (not reproducible) */
 } render_stats;

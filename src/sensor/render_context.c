@@ -19,6 +19,7 @@ static void render_context_fini(render_context *ctx)
     free(ctx->alpha_per_m);
     free(ctx->emission_mean);
     free(ctx->scatters);
+    free(ctx->mirror);
     free(ctx->lookup_q);
     free(ctx->tbar);
     free(ctx->rbar);
@@ -94,6 +95,7 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->alpha_per_m = thz_malloc_array(n, sizeof *ctx->alpha_per_m);
     ctx->emission_mean = thz_malloc_array(n_obj, sizeof *ctx->emission_mean);
     ctx->scatters = thz_malloc_array(n_obj, sizeof *ctx->scatters);
+    ctx->mirror = thz_malloc_array(n_obj, sizeof *ctx->mirror);
     ctx->lookup_q = thz_malloc_array(n_obj, sizeof *ctx->lookup_q);
     ctx->b0 = thz_malloc_array(n, sizeof *ctx->b0);
     ctx->source_mean = thz_malloc_array(n_obj, sizeof *ctx->source_mean);
@@ -103,7 +105,7 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->ward_scale = thz_calloc(cells ? cells : 1, sizeof *ctx->ward_scale);
     ctx->ward_comp = thz_calloc(cells ? cells : 1, sizeof *ctx->ward_comp);
     if (!ctx->planck || !ctx->optics || !ctx->opt_fixed || !ctx->opt_const || !ctx->alpha_per_m ||
-        !ctx->emission_mean || !ctx->scatters || !ctx->lookup_q || !ctx->b0 || !ctx->source_mean ||
+        !ctx->emission_mean || !ctx->scatters || !ctx->mirror || !ctx->lookup_q || !ctx->b0 || !ctx->source_mean ||
         !ctx->tbar || !ctx->rbar || !ctx->lobes || !ctx->ward_scale || !ctx->ward_comp) {
         render_context_fini(ctx);
         return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
@@ -142,6 +144,7 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
         spectrum_range(&mat->reflectivity, &r_min, &r_max);
         bool diffuse = obj->type == OBJECT_SHELL && mat->transmission == TRANSMISSION_DIFFUSE;
         ctx->scatters[o] = r_max > 0.0 || diffuse || mat->index;
+        ctx->mirror[o] = mat->reflection == REFLECTION_SPECULAR && (r_max > 0.0 || mat->index);
         for (size_t k = 0; (diffuse || mat->index) && k < n; k++)
             ctx->tbar[o * n + k] = optics_mean_transmission(&ctx->optics[o * n + k]);
         /* by roulette on R + T from a deviation map only (RENDER_GATHER_LOOKUP_FULL) */
@@ -238,7 +241,7 @@ uint64_t render_context_bytes(const thz_scene *scene)
      * ward_comp per cell; the per-object arrays; the pair table */
     uint64_t n_obj = scene->n_objects, cells = n_obj * CHANNEL_QUADRATURE_NODES;
     uint64_t per_cell = 5u * sizeof(double) + sizeof(optics_point) + sizeof(brdf_lobe);
-    uint64_t per_object = sizeof(optics_point) + 2u * sizeof(bool) + 3u * sizeof(double);
+    uint64_t per_object = sizeof(optics_point) + 3u * sizeof(bool) + 3u * sizeof(double);
     uint64_t bytes = cells * per_cell + n_obj * per_object + sizeof(render_context);
     if (n_obj <= RENDER_PAIR_OBJECTS)
         bytes += n_obj * n_obj * sizeof(double);

@@ -41,6 +41,8 @@ struct render_context {
                                 angle (solids without an index, explicit eps); NAN for the
                                 others */
     bool *scatters;          /* [object]: R > 0 somewhere, or a diffuse shell */
+    bool *mirror;            /* [object]: specular reflection with R > 0 somewhere (a mirror
+                                of R = 0 reflects nothing: render_mirror follows no branch) */
     double *lookup_q;        /* final-gather, [object]: the probability that a gather ray
                                 ending there looks up its photons (RENDER_GATHER_LOOKUP_FULL;
                                 0 where nothing scatters) */

@@ -6,6 +6,7 @@
 #  - SIGINT during a run exits 130, SIGTERM 143, and neither leaves result files in OUTDIR;
 #  - render refuses a photon map made from another scene, and a damaged one (exit 2);
 #  - photon-map's gather disks shrink with the oversampling (a pixel's standard error);
+#  - a mirror of R = 0 starts no mirror chain, one of R > 0 is cut after 32 reflections;
 #  - usage errors exit 2.
 # argv: path to the thzmap binary, repository directory.
 set -u
@@ -399,6 +400,30 @@ ratio = m[1] / m[0]
 print(f"photon-map median pixel standard error, oversampling 2 / 1: {ratio:.2f}")
 sys.exit(0 if 0.8 < ratio < 1.6 else 1)
 PY
+
+# --- a closed mirror shell: R = 0 starts no mirror chain; R = 0.5 is cut after 32 --------
+for r in 0.0 0.5; do
+    cat > "$work/mirror-$r.json" <<JSON
+{"format": "thzmap-scene/1", "channels": [{"frequency_thz": 0.3, "relative_width": 0.02}],
+ "materials": {"wall": {"reflectivity": 0.1},
+   "m": {"reflectivity": $r, "attenuation_per_m": 0, "reflection": "specular"}},
+ "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true},
+     "transform": {"translate_m": [0, 0, 1]}},
+   {"name": "cover", "type": "shell", "thickness_m": 0.002, "material": "m",
+     "temperature_k": 300, "shape": {"type": "box", "size_m": [0.4, 0.4, 0.4]},
+     "transform": {"translate_m": [0, 0, 0.4]}}],
+ "sensors": [{"name": "cam", "position_m": [0, -0.9, 0.5], "look_at_m": [0, 0, 0.4],
+   "fov_deg": 40, "resolution": [8, 8]}],
+ "photons": {"per_channel": 5000, "seed": 1}, "render": {"gather_rays": 4}}
+JSON
+    "$THZMAP" simulate "$work/mirror-$r.json" -o "$work/mirror-$r" --integrator final-gather \
+        2> "$work/mirror-$r.err" || fail "mirror shell, R = $r: exit $?"
+done
+grep -q 'cut short' "$work/mirror-0.0.err" &&
+    fail "a mirror of R = 0 was followed: $(grep 'cut short' "$work/mirror-0.0.err")"
+grep -q 'cut short: after 32 straight shells and mirror reflections in a row' \
+    "$work/mirror-0.5.err" || fail "a closed mirror of R = 0.5: $(cat "$work/mirror-0.5.err")"
 
 if [ $fails -ne 0 ]; then
     echo "$fails check(s) failed"
