@@ -105,8 +105,9 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->ward_scale = thz_calloc(cells ? cells : 1, sizeof *ctx->ward_scale);
     ctx->ward_comp = thz_calloc(cells ? cells : 1, sizeof *ctx->ward_comp);
     if (!ctx->planck || !ctx->optics || !ctx->opt_fixed || !ctx->opt_const || !ctx->alpha_per_m ||
-        !ctx->emission_mean || !ctx->scatters || !ctx->mirror || !ctx->lookup_q || !ctx->b0 || !ctx->source_mean ||
-        !ctx->tbar || !ctx->rbar || !ctx->lobes || !ctx->ward_scale || !ctx->ward_comp) {
+        !ctx->emission_mean || !ctx->scatters || !ctx->mirror || !ctx->lookup_q || !ctx->b0 ||
+        !ctx->source_mean || !ctx->tbar || !ctx->rbar || !ctx->lobes || !ctx->ward_scale ||
+        !ctx->ward_comp) {
         render_context_fini(ctx);
         return thz_error_set(err, THZ_ERR_NOMEM, "render: out of memory for the band tables");
     }
