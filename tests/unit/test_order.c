@@ -3,6 +3,7 @@
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdbool.h>
 #include <stdint.h>
 
 #include <cmocka.h>
@@ -11,6 +12,7 @@
 #include <string.h>
 
 #include "core/order.h"
+#include "core/rng.h"
 
 static int cmp_u64(const void *a, const void *b)
 {
@@ -18,13 +20,17 @@ static int cmp_u64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static uint64_t state = 0x9e3779b97f4a7c15u;
+/* 64 random bits from the project's own streams */
 static uint64_t next(void)
 {
-    state ^= state << 13;
-    state ^= state >> 7;
-    state ^= state << 17;
-    return state;
+    static rng_stream rng;
+    static bool started;
+    if (!started) {
+        rng_init(&rng, 1, 0, RNG_PURPOSE_TEST, 0);
+        started = true;
+    }
+    uint64_t hi = rng_next_u32(&rng);
+    return hi << 32 | rng_next_u32(&rng);
 }
 
 static void check(size_t n, uint64_t mask, uint64_t base)

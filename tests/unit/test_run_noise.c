@@ -7,6 +7,7 @@
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdbool.h>
 #include <stdint.h>
 
 #include <cmocka.h>
@@ -15,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/rng.h"
 #include "run/run_noise.h"
 #include "sensor/render.h"
 
@@ -36,13 +38,17 @@ static run_noise by_sort(double *x, size_t n)
     return r;
 }
 
-static uint64_t rng_state = 88172645463325252u;
+/* 64 random bits from the project's own streams */
 static uint64_t next(void)
 {
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return rng_state;
+    static rng_stream rng;
+    static bool started;
+    if (!started) {
+        rng_init(&rng, 2, 0, RNG_PURPOSE_TEST, 0);
+        started = true;
+    }
+    uint64_t hi = rng_next_u32(&rng);
+    return hi << 32 | rng_next_u32(&rng);
 }
 
 /* One image of `px` pixels in one channel: object ids in -1 .. n_objects + 1 (the last two
