@@ -73,8 +73,11 @@ THZ_API const char *thz_status_name(thz_status status);
 
 /* ---- context ---------------------------------------------------------------------- */
 
-/* Progress of a long run. `stage` is a static string: "photons" (done/total in photons
- * of the channel), "render" (rows of a sensor), "output" (0/1, then 1/1). A channel's
+/* Progress of a long run. `stage` is a static string: "prepare" (done/total in objects
+ * whose back-side sources a deviation map needs, once per run before the first channel's
+ * photons, channel 0; only where there are such objects: one-sided solids), "photons"
+ * (done/total in photons of the channel), "render" (rows of a sensor), "output" (0/1,
+ * then 1/1). A channel's
  * "photons" and "render" first report done = 0 when they start (a clock of the stage
  * starts there, as summary.json's photon_phase_s and render_s do); each further render
  * pass, and each further sensor, reports its rows from 0 again. */

@@ -7,11 +7,13 @@ import time
 from .errors import ArgumentError
 
 Progress = collections.namedtuple("Progress", "stage channel n_channels done total")
-Progress.__doc__ = """One progress report. `stage` is "photons" (done/total photons of the
-channel), "render" (rows of a sensor) or "output" (0/1, then 1/1); `channel` is the
-0-based index of the channel among `n_channels`."""
+Progress.__doc__ = """One progress report. `stage` is "prepare" (objects whose back-side
+sources are set up, once per run before the first channel's photons, where a deviation map
+needs them), "photons" (done/total photons of the channel), "render" (rows of a sensor) or
+"output" (0/1, then 1/1); `channel` is the 0-based index of the channel among
+`n_channels`."""
 
-_UNITS = {"photons": "photons", "render": "rows", "output": "steps"}
+_UNITS = {"prepare": "objects", "photons": "photons", "render": "rows", "output": "steps"}
 
 
 class _Bar:

@@ -7,6 +7,7 @@
 #include "api/api.h"
 #include "core/alloc.h"
 #include "io/photon_map_file.h"
+#include "photon/emission_reach.h"
 #include "photon/phase.h"
 #include "photon/photon_map.h"
 #include "run/run.h"
@@ -49,11 +50,11 @@ void thz_photons_destroy(thz_photons *ph)
 /* Refuses, before any photon is fired, maps that would not fit in memory: the channels
  * fired are all kept (as a simulate that keeps its maps). */
 static thz_status api_fire_check_memory(const thz_scene *eff, const accel *acc, size_t only,
-                                        thz_error *err)
+                                        emission_reach *reach, thz_error *err)
 {
     run_memory need = {.held_bytes = thz_process_memory_bytes(),
                        .available_bytes = thz_memory_limit_bytes()};
-    thz_status st = run_photon_map_bytes(eff, acc, only, true, &need.photon_bytes, err);
+    thz_status st = run_photon_map_bytes(eff, acc, only, true, reach, &need.photon_bytes, err);
     if (st != THZ_OK)
         return st;
     need.total_bytes = need.photon_bytes + need.held_bytes;
@@ -89,18 +90,28 @@ static thz_status api_fire(thz_context *ctx, const thz_scene *scene,
                            render_integrator_name(eff->render.integrator));
     if (st == THZ_OK)
         st = accel_create(eff, &acc, err);
+    emission_reach reach = {0};
+    photon_phase_options prepare = {.threads = ctx ? ctx->threads : 0,
+                                    .reach = &reach,
+                                    .progress = ctx ? ctx->progress : NULL,
+                                    .progress_user = ctx ? ctx->progress_user : NULL};
+    for (size_t c = 0; st == THZ_OK && c < scene->n_channels && !reach.done; c++)
+        if ((only == SIZE_MAX || c == only) && run_photon_t0_k(eff, c) > 0.0)
+            st = photon_phase_prepare(eff, acc, &prepare, err);
     if (st == THZ_OK)
-        st = api_fire_check_memory(eff, acc, only, err);
+        st = api_fire_check_memory(eff, acc, only, &reach, err);
     for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {
         if (only != SIZE_MAX && c != only)
             continue;
         photon_phase_options po = {.threads = ctx ? ctx->threads : 0,
                                    .reference_temperature_k = run_photon_t0_k(eff, c),
                                    .first_photon = settings ? settings->first_photon : 0,
+                                   .reach = &reach,
                                    .progress = ctx ? ctx->progress : NULL,
                                    .progress_user = ctx ? ctx->progress_user : NULL};
         st = photon_phase_run(eff, acc, c, &po, &ph->maps[c], &ph->stats[c], err);
     }
+    emission_reach_fini(&reach);
     accel_destroy(acc);
     if (st != THZ_OK) {
         thz_photons_destroy(ph);

@@ -89,6 +89,8 @@ static const char *cli_stage_unit(const char *stage)
         return "photons";
     if (strcmp(stage, "render") == 0)
         return "rows";
+    if (strcmp(stage, "prepare") == 0)
+        return "objects";
     return "steps";
 }
 
@@ -99,6 +101,16 @@ static void cli_progress_draw_tty(cli_progress *p, const thz_progress *pr, doubl
     double rate = elapsed > 0.0 ? (double)pr->done / elapsed : 0.0;
     if (strcmp(pr->stage, "output") == 0) {
         fprintf(p->out, "\r\033[Kthzmap %s: writing the results", p->command);
+        fflush(p->out);
+        p->line_open = true;
+        return;
+    }
+    if (strcmp(pr->stage, "prepare") == 0) { /* before the channels: the run's, not one's */
+        fprintf(p->out,
+                "\r\033[Kthzmap %s: preparing the back-side sources: %llu/%llu objects (%.0f %%), "
+                "%.1f s",
+                p->command, (unsigned long long)pr->done, (unsigned long long)pr->total,
+                100.0 * frac, elapsed);
         fflush(p->out);
         p->line_open = true;
         return;
@@ -135,6 +147,12 @@ static void cli_progress_line(cli_progress *p, const thz_progress *pr, double no
 {
     double elapsed = now - p->stage_start_s;
     const char *unit = cli_stage_unit(pr->stage);
+    if (strcmp(pr->stage, "prepare") == 0) {
+        fprintf(p->out, "thzmap %s: back-side sources: %llu objects in %.2f s\n", p->command,
+                (unsigned long long)pr->done, elapsed);
+        fflush(p->out);
+        return;
+    }
     fprintf(p->out, "thzmap %s: channel %zu/%zu, %s: %llu %s in %.2f s", p->command,
             pr->channel + 1, pr->n_channels, pr->stage, (unsigned long long)pr->done, unit,
             elapsed);

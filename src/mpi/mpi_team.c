@@ -12,6 +12,7 @@
 #include <time.h>
 
 #include "core/alloc.h"
+#include "photon/emission_reach.h"
 #include "sensor/render_context.h"
 
 enum {
@@ -434,10 +435,11 @@ uint64_t mpi_team_bytes(const mpi_team *team)
 
 /* A member's photon share of request rq, fired and sent to the lead. */
 static thz_status team_serve_phase(mpi_team *t, const thz_scene *scene, const accel *acc,
-                                   const photon_phase_request *rq, int threads, thz_error *err)
+                                   const photon_phase_request *rq, int threads,
+                                   emission_reach *reach, thz_error *err)
 {
     photon_phase_share share;
-    thz_status st = photon_phase_fire_share(scene, acc, rq, threads, (size_t)t->rank,
+    thz_status st = photon_phase_fire_share(scene, acc, rq, threads, reach, (size_t)t->rank,
                                             (size_t)t->size, &share, err);
     if (st != THZ_OK)
         return st;
@@ -562,6 +564,7 @@ thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *a
     if (team->rank == 0)
         return thz_error_set(err, THZ_ERR_INTERNAL, "MPI: rank 0 leads, it does not serve");
     team_render render = {0};
+    emission_reach reach = {0}; /* the scene's, for every deviation map it is asked for */
     thz_status st = THZ_OK;
     while (st == THZ_OK) {
         team_message m;
@@ -593,7 +596,7 @@ thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *a
                                    "fires none (every process must run with the same options)",
                                    team->rank);
             else
-                st = team_serve_phase(team, scene, acc, &m.rq, threads, err);
+                st = team_serve_phase(team, scene, acc, &m.rq, threads, &reach, err);
             break;
         case TEAM_RENDER_BEGIN:
             st = team_serve_begin(team, scene, acc, &m, threads, &render, err);
@@ -617,5 +620,6 @@ thz_status mpi_team_serve(mpi_team *team, const thz_scene *scene, const accel *a
         }
     }
     team_render_fini(&render);
+    emission_reach_fini(&reach);
     return st;
 }

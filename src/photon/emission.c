@@ -9,6 +9,7 @@
 #include "core/alloc.h"
 #include "core/cdf.h"
 #include "core/sampling.h"
+#include "photon/emission_reach.h"
 #include "physics/planck.h"
 
 static bool spectrum_is_constant(const thz_spectrum *s)
@@ -147,12 +148,27 @@ static optics_point emission_kirchhoff_optics(optics_point o)
     return o;
 }
 
-/* A point uniform on mesh m (triangle by the area CDF, then uniform on it); *tri is
- * its triangle. */
-static vec3 emission_point(const thz_mesh *m, const double *triangle_cdf, double area_m2,
-                           rng_stream *rng, size_t *tri)
+double *emission_triangle_cdf(const thz_mesh *m)
 {
-    /* the guide table follows the CDF in its block (emission_add_source) */
+    size_t n = m->n_triangles;
+    if (n > UINT32_MAX)
+        return NULL;
+    double *cdf = thz_malloc_array(n, sizeof(double) + sizeof(uint32_t));
+    if (!cdf)
+        return NULL;
+    double sum = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        sum += m->areas_m2[k];
+        cdf[k] = sum;
+    }
+    cdf_guide_build(cdf, n, (uint32_t *)(void *)(cdf + n), n);
+    return cdf;
+}
+
+vec3 emission_point(const thz_mesh *m, const double *triangle_cdf, double area_m2, rng_stream *rng,
+                    size_t *tri)
+{
+    /* the guide table follows the CDF in its block (emission_triangle_cdf) */
     const uint32_t *guide = (const uint32_t *)(const void *)(triangle_cdf + m->n_triangles);
     double u = rng_uniform32(rng);
     size_t k =
@@ -170,40 +186,11 @@ static vec3 emission_point(const thz_mesh *m, const double *triangle_cdf, double
                   v3_add(v3_scale(p1, ra * (1.0 - rb)), v3_scale(p2, ra * rb)));
 }
 
-/* The reach share of object i's back side (emission.h): the share of EMISSION_REACH_RAYS
- * cosine rays from uniform back-side points, traced as trace_photon starts a photon,
- * whose first hit is a front face. The streams depend on the seed only (channel 0), so
- * every channel gets the same share. */
-static double emission_back_reach(const emission_table *t, const accel *acc, size_t i,
-                                  const double *triangle_cdf)
-{
-    const thz_scene *scene = t->scene;
-    const thz_mesh *m = &scene->objects[i].mesh;
-    uint64_t reach = 0;
-    for (uint64_t k = 0; k < EMISSION_REACH_RAYS; k++) {
-        rng_stream rng;
-        rng_init(&rng, scene->photons.seed, 0, RNG_PURPOSE_BACK_FACE,
-                 (uint64_t)i * EMISSION_REACH_RAYS + k);
-        size_t tri;
-        vec3 p = emission_point(m, triangle_cdf, m->total_area_m2, &rng, &tri);
-        const float *nf = &m->normals[3 * tri];
-        vec3 n = v3_scale(v3(nf[0], nf[1], nf[2]), -1.0);
-        double u = rng_uniform32(&rng);
-        vec3 dir = sampling_direction(n, sqrt(1.0 - u), rng_uniform32(&rng));
-        accel_hit from = {
-            .object = (uint32_t)i, .triangle = (uint32_t)tri, .position_m = p, .side = 1};
-        accel_hit hit;
-        reach += accel_intersect(acc, accel_offset_origin(acc, &from, dir), dir, INFINITY,
-                                 (uint32_t)i, (uint32_t)tri, &hit) &&
-                 scene_object_side_is_front(&scene->objects[hit.object], hit.side);
-    }
-    return (double)reach / EMISSION_REACH_RAYS;
-}
-
-/* Adds object i's source of `kind`; false only when out of memory. A source without
- * power (constant optics, zero weights; a back side that reaches no front face) is not
- * added. An object's sources share one triangle CDF. */
-static bool emission_add_source(emission_table *t, const accel *acc, size_t i, emission_kind kind)
+/* Adds object i's source of `kind` (EMISSION_BACK: whose reach share is reach_share);
+ * false only when out of memory. A source without power (constant optics, zero weights; a
+ * back side that reaches no front face) is not added. An object's sources share one
+ * triangle CDF. */
+static bool emission_add_source(emission_table *t, size_t i, emission_kind kind, double reach_share)
 {
     const thz_scene *scene = t->scene;
     const thz_object *obj = &scene->objects[i];
@@ -226,23 +213,13 @@ static bool emission_add_source(emission_table *t, const accel *acc, size_t i, e
     s->triangle_cdf = prev && prev->object == s->object ? prev->triangle_cdf : NULL;
     s->owns_cdf = false;
     if (!s->triangle_cdf) {
-        /* the CDF, then its guide table (uint32_t, one entry per triangle), in one block */
-        size_t n = obj->mesh.n_triangles;
-        if (n > UINT32_MAX)
-            return false;
-        s->triangle_cdf = thz_malloc_array(n, sizeof(double) + sizeof(uint32_t));
+        s->triangle_cdf = emission_triangle_cdf(&obj->mesh);
         if (!s->triangle_cdf)
             return false;
         s->owns_cdf = true;
-        double sum = 0.0;
-        for (size_t k = 0; k < n; k++) {
-            sum += obj->mesh.areas_m2[k];
-            s->triangle_cdf[k] = sum;
-        }
-        cdf_guide_build(s->triangle_cdf, n, (uint32_t *)(void *)(s->triangle_cdf + n), n);
     }
     if (kind == EMISSION_BACK) {
-        s->reach_share = emission_back_reach(t, acc, i, s->triangle_cdf);
+        s->reach_share = reach_share;
         s->weight0 = M_PI * s->area_m2 * s->reach_share;
         s->share = s->weight0;
     } else if (s->constant_optics) {
@@ -271,7 +248,8 @@ static bool emission_add_source(emission_table *t, const accel *acc, size_t i, e
 }
 
 thz_status emission_table_init(emission_table *t, const thz_scene *scene, const accel *acc,
-                               size_t channel, uint64_t n_photons, double t0_k, thz_error *err)
+                               size_t channel, uint64_t n_photons, double t0_k,
+                               const emission_reach *reach, thz_error *err)
 {
     memset(t, 0, sizeof *t);
     if (!(t0_k >= 0.0) || !isfinite(t0_k))
@@ -281,6 +259,19 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, const 
     if (t0_k > 0.0 && !acc)
         return thz_error_set(err, THZ_ERR_INTERNAL,
                              "photon emission: a deviation map needs the scene's ray caster");
+    emission_reach own = {0};
+    if (t0_k > 0.0 && (!reach || !reach->done)) {
+        thz_status st = emission_reach_compute(&own, scene, acc, 0, NULL, NULL, err);
+        if (st != THZ_OK)
+            return st;
+        reach = &own;
+    }
+    if (t0_k > 0.0 && reach->n_objects != scene->n_objects) {
+        emission_reach_fini(&own);
+        return thz_error_set(err, THZ_ERR_INTERNAL,
+                             "photon emission: reach shares of %zu objects for a scene of %zu",
+                             reach->n_objects, scene->n_objects);
+    }
     t->scene = scene;
     t->channel = channel;
     t->n_photons = n_photons ? n_photons : 1;
@@ -291,8 +282,10 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, const 
      * source has power. */
     size_t cap = 3 * scene->n_objects;
     t->sources = thz_calloc(cap ? cap : 1, sizeof *t->sources);
-    if (!t->sources)
+    if (!t->sources) {
+        emission_reach_fini(&own);
         return thz_error_set(err, THZ_ERR_NOMEM, "photon emission: out of memory");
+    }
     bool ok = true;
     for (size_t i = 0; i < scene->n_objects && ok; i++) {
         const thz_object *obj = &scene->objects[i];
@@ -302,23 +295,24 @@ thz_status emission_table_init(emission_table *t, const thz_scene *scene, const 
         bool explicit_eps = scene->materials[obj->material].emissivity.n > 0;
         if (!(t0_k > 0.0)) { /* the paper's sources: eps B(T) */
             if (hot)
-                ok = emission_add_source(t, acc, i,
-                                         explicit_eps ? EMISSION_EPS : EMISSION_KIRCHHOFF);
+                ok = emission_add_source(t, i, explicit_eps ? EMISSION_EPS : EMISSION_KIRCHHOFF,
+                                         1.0);
         } else if (!explicit_eps) { /* A (B(T) - B0): nothing at T0 */
             if (obj->temperature_k != t0_k)
-                ok = emission_add_source(t, acc, i, EMISSION_KIRCHHOFF);
+                ok = emission_add_source(t, i, EMISSION_KIRCHHOFF, 1.0);
         } else if (obj->type == OBJECT_SHELL || scene->materials[obj->material].index) {
             /* eps B(T) and -A(mu) B0: two laws (A of a solid depends on angle with an index) */
             if (hot)
-                ok = emission_add_source(t, acc, i, EMISSION_EPS);
+                ok = emission_add_source(t, i, EMISSION_EPS, 1.0);
             if (ok)
-                ok = emission_add_source(t, acc, i, EMISSION_ABSORB);
+                ok = emission_add_source(t, i, EMISSION_ABSORB, 1.0);
         } else {
-            ok = emission_add_source(t, acc, i, EMISSION_EPS_ABSORB);
+            ok = emission_add_source(t, i, EMISSION_EPS_ABSORB, 1.0);
         }
-        if (ok && t0_k > 0.0 && !scene_object_side_is_front(obj, 1))
-            ok = emission_add_source(t, acc, i, EMISSION_BACK);
+        if (ok && t0_k > 0.0 && emission_reach_needed(scene, i))
+            ok = emission_add_source(t, i, EMISSION_BACK, reach->share[i]);
     }
+    emission_reach_fini(&own);
     if (!ok || !emission_group_sources(t) || !emission_tabulate(t)) {
         emission_table_fini(t);
         return thz_error_set(err, THZ_ERR_NOMEM, "photon emission: out of memory");

@@ -63,7 +63,8 @@
 #include "core/vec3.h"
 #include "scene/scene.h"
 
-/* Rays per one-sided solid for the reach share of its back side's source (T0 > 0). */
+/* Rays per one-sided solid for the reach share of its back side's source (T0 > 0;
+ * emission_reach.h). */
 #define EMISSION_REACH_RAYS 16384
 
 /* Kind of a source: how its power and direction depend on B(T), B0 and the optics.
@@ -153,12 +154,16 @@ typedef struct emission_photon {
     uint32_t batch; /* photon_map.h: set by the phase (photon index mod batches) */
 } emission_photon;
 
+struct emission_reach; /* photon/emission_reach.h */
+
 /* Prepares channel `channel`'s sources for K = n_photons photons of the map of
- * L - B_nu(t0_k) (t0_k = 0: the paper's map of L; t0_k must be >= 0). acc (borrowed,
- * the scene's) estimates the back faces' reach shares; it may be NULL only with
- * t0_k = 0. */
+ * L - B_nu(t0_k) (t0_k = 0: the paper's map of L; t0_k must be >= 0). With t0_k > 0 the
+ * one-sided solids' back sides take their reach shares from reach, computed for this
+ * scene (emission_reach_compute); reach NULL or not done: computed here, on all threads.
+ * acc (borrowed, the scene's) may be NULL only with t0_k = 0. */
 thz_status emission_table_init(emission_table *t, const thz_scene *scene, const accel *acc,
-                               size_t channel, uint64_t n_photons, double t0_k, thz_error *err);
+                               size_t channel, uint64_t n_photons, double t0_k,
+                               const struct emission_reach *reach, thz_error *err);
 void emission_table_fini(emission_table *t);
 
 /* Exact signed power w_g(freq_hz) of group g (W/Hz). */
@@ -184,5 +189,13 @@ typedef struct emission_aim {
 } emission_aim;
 bool emission_sample_aim(const emission_table *t, rng_stream *rng, double nu, emission_photon *out,
                          emission_aim *aim);
+
+/* Internal to src/photon/: an object's triangle CDF (n_triangles cumulative areas, then
+ * their guide table, cdf.h: n_triangles uint32_t, in one malloc'd block; NULL when out of
+ * memory or beyond 2^32 triangles), and a point uniform on mesh m by it (*tri its
+ * triangle), from three draws of rng. */
+double *emission_triangle_cdf(const thz_mesh *m);
+vec3 emission_point(const thz_mesh *m, const double *triangle_cdf, double area_m2, rng_stream *rng,
+                    size_t *tri);
 
 #endif

@@ -12,6 +12,7 @@
 #include "core/threads.h"
 #include "photon/air_emission.h"
 #include "photon/emission.h"
+#include "photon/emission_reach.h"
 #include "photon/trace.h"
 #include "physics/channel.h"
 
@@ -266,16 +267,17 @@ static thz_status phase_check(const thz_scene *scene, size_t channel, thz_error 
 }
 
 /* The sources of channel `channel` for K = n_photons photons of the map of
- * L - B(t0_k), as both the run and its pilot fire them: the surfaces' table and the air
+ * L - B(t0_k) (reach: the back sides' reach shares, emission_table_init), as both the run
+ * and its pilot fire them: the surfaces' table and the air
  * and boundary beside them, whose class probabilities weigh the surfaces by their
  * physical band power P_A with T0 = 0, else by the band mean of their signed sources'
  * magnitude. *surface_power_w_per_hz is P_A (statistics). Both are finalised on failure. */
 static thz_status phase_sources_init(const thz_scene *scene, const accel *acc, size_t channel,
-                                     uint64_t n_photons, double t0_k, emission_table *table,
-                                     air_emission *air, double *surface_power_w_per_hz,
-                                     thz_error *err)
+                                     uint64_t n_photons, double t0_k, const emission_reach *reach,
+                                     emission_table *table, air_emission *air,
+                                     double *surface_power_w_per_hz, thz_error *err)
 {
-    thz_status st = emission_table_init(table, scene, acc, channel, n_photons, t0_k, err);
+    thz_status st = emission_table_init(table, scene, acc, channel, n_photons, t0_k, reach, err);
     if (st != THZ_OK)
         return st;
     double surface_power = scene_band_emitted_power_w_per_hz(scene, channel);
@@ -306,23 +308,33 @@ void photon_phase_share_range(uint64_t k, size_t member, size_t members, uint64_
     *hi = b_hi * PHASE_BATCH < k ? b_hi * PHASE_BATCH : k;
 }
 
-/* The index build's question (photon_map_build's cancel): the photons stage's progress,
- * its last photon not yet counted. */
-typedef struct phase_build_asking {
+/* The question of a step that reports no progress of its own (emission_reach_compute's
+ * and photon_map_build's cancel): the photons stage's progress as it stands, `done` of
+ * `photons` (the index build: its last photon not yet counted). */
+typedef struct phase_asking {
     const photon_phase_options *opt;
     size_t channel, n_channels;
-    uint64_t photons;
-} phase_build_asking;
+    uint64_t done, photons;
+} phase_asking;
 
-static int phase_build_cancelled(void *user)
+static int phase_cancelled(void *user)
 {
-    const phase_build_asking *a = user;
+    const phase_asking *a = user;
     thz_progress p = {.stage = "photons",
                       .channel = a->channel,
                       .n_channels = a->n_channels,
-                      .done = a->photons ? a->photons - 1 : 0,
+                      .done = a->done,
                       .total = a->photons};
     return a->opt->progress(a->opt->progress_user, &p);
+}
+
+thz_status photon_phase_prepare(const thz_scene *scene, const accel *acc,
+                                const photon_phase_options *opt, thz_error *err)
+{
+    if (!opt || !opt->reach || opt->reach->done)
+        return THZ_OK;
+    return emission_reach_compute(opt->reach, scene, acc, opt->threads, opt->progress,
+                                  opt->progress_user, err);
 }
 
 /* Fires photons [lo, hi) of rq from its sources: the share's records and chunk counters,
@@ -366,8 +378,9 @@ static thz_status phase_fire_range(const thz_scene *scene, const accel *acc,
 }
 
 thz_status photon_phase_fire_share(const thz_scene *scene, const accel *acc,
-                                   const photon_phase_request *rq, int threads, size_t member,
-                                   size_t members, photon_phase_share *out, thz_error *err)
+                                   const photon_phase_request *rq, int threads,
+                                   emission_reach *reach, size_t member, size_t members,
+                                   photon_phase_share *out, thz_error *err)
 {
     memset(out, 0, sizeof *out);
     thz_status st = phase_check(scene, (size_t)rq->channel, err);
@@ -385,8 +398,12 @@ thz_status photon_phase_fire_share(const thz_scene *scene, const accel *acc,
     emission_table table;
     air_emission air;
     double surface_power;
+    if (reach && rq->reference_temperature_k > 0.0)
+        st = emission_reach_compute(reach, scene, acc, threads, NULL, NULL, err);
+    if (st != THZ_OK)
+        return st;
     st = phase_sources_init(scene, acc, (size_t)rq->channel, rq->photons,
-                            rq->reference_temperature_k, &table, &air, &surface_power, err);
+                            rq->reference_temperature_k, reach, &table, &air, &surface_power, err);
     if (st != THZ_OK)
         return st;
     uint64_t lo, hi;
@@ -403,24 +420,39 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
                             const photon_phase_options *opt, photon_map **out_map,
                             photon_stats *stats, thz_error *err)
 {
-    double t0 = omp_get_wtime();
     *out_map = NULL;
     thz_status st = phase_check(scene, channel, err);
     if (st != THZ_OK)
         return st;
+    double t0_k = opt ? opt->reference_temperature_k : 0.0;
+    if (!(t0_k >= 0.0) || !isfinite(t0_k))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "photon phase: reference temperature must be >= 0 K, got %g K", t0_k);
+    /* The back sides' reach shares: the run's (photon_phase_prepare, or computed here on
+     * its first need and kept), else this phase's own; before the stage starts, as their
+     * own stage "prepare". */
+    emission_reach own = {0}, *reach = opt && opt->reach ? opt->reach : &own;
+    double seconds_reach = 0.0;
+    if (t0_k > 0.0 && !reach->done) {
+        st = emission_reach_compute(reach, scene, acc, opt ? opt->threads : 0,
+                                    opt ? opt->progress : NULL, opt ? opt->progress_user : NULL,
+                                    err);
+        seconds_reach = reach->seconds;
+        if (st != THZ_OK)
+            return st;
+    }
+    double t0 = omp_get_wtime();
     if (opt && opt->progress) { /* the stage starts (its time, stats->seconds, too) */
         thz_progress p = {.stage = "photons",
                           .channel = channel,
                           .n_channels = scene->n_channels,
                           .done = 0,
                           .total = scene->photons.per_channel};
-        if (opt->progress(opt->progress_user, &p) != 0)
+        if (opt->progress(opt->progress_user, &p) != 0) {
+            emission_reach_fini(&own);
             return thz_error_set(err, THZ_ERR_CANCELLED, "photon phase: cancelled");
+        }
     }
-    double t0_k = opt ? opt->reference_temperature_k : 0.0;
-    if (!(t0_k >= 0.0) || !isfinite(t0_k))
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "photon phase: reference temperature must be >= 0 K, got %g K", t0_k);
     const photon_phase_team *team = opt ? opt->team : NULL;
     photon_phase_request rq = {.channel = channel,
                                .photons = scene->photons.per_channel,
@@ -431,14 +463,17 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     if (team) { /* the others start on their shares while the lead builds its table */
         photon_phase_share_range(rq.photons, 0, team->members, &lo, &hi);
         st = team->start(team->impl, &rq, err);
-        if (st != THZ_OK)
+        if (st != THZ_OK) {
+            emission_reach_fini(&own);
             return st;
+        }
     }
     emission_table table;
     air_emission air;
     double surface_power;
-    st = phase_sources_init(scene, acc, channel, rq.photons, t0_k, &table, &air, &surface_power,
-                            err);
+    st = phase_sources_init(scene, acc, channel, rq.photons, t0_k, reach, &table, &air,
+                            &surface_power, err);
+    emission_reach_fini(&own);
     if (st != THZ_OK)
         return st;
     double t1 = omp_get_wtime();
@@ -471,8 +506,9 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
     /* photon_map_build takes ownership of records, also on failure. It asks for a stop
      * between its passes through the progress callback: the stage's last unit, which it
      * completes, still to come. */
-    phase_build_asking asking = {opt, channel, scene->n_channels, rq.photons};
-    cancel_check cancel = {phase_build_cancelled, &asking};
+    phase_asking asking = {opt, channel, scene->n_channels, rq.photons ? rq.photons - 1 : 0,
+                           rq.photons};
+    cancel_check cancel = {phase_cancelled, &asking};
     st = photon_map_build(records, count, capacity, scene->n_objects, threads, pool,
                           opt && opt->progress ? &cancel : NULL, out_map, err);
     if (st != THZ_OK)
@@ -499,6 +535,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
         stats->emitted_power_w_per_hz = surface_power + air_power; /* + air, boundary */
         stats->reference_temperature_k = t0_k;
         stats->seconds_emission_table = t1 - t0;
+        stats->seconds_reach = seconds_reach;
         stats->seconds_tracing = t2 - t1;
         stats->seconds_index = t3 - t2;
         stats->seconds = omp_get_wtime() - t0;
@@ -507,7 +544,8 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
 }
 
 thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc, size_t channel,
-                                       double t0_k, uint64_t *bytes, thz_error *err)
+                                       double t0_k, emission_reach *reach, uint64_t *bytes,
+                                       thz_error *err)
 {
     *bytes = 0;
     thz_status st = phase_check(scene, channel, err);
@@ -520,7 +558,11 @@ thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc,
     emission_table table;
     air_emission air;
     double surface_power;
-    st = phase_sources_init(scene, acc, channel, k, t0_k, &table, &air, &surface_power, err);
+    if (reach && t0_k > 0.0)
+        st = emission_reach_compute(reach, scene, acc, 0, NULL, NULL, err);
+    if (st != THZ_OK)
+        return st;
+    st = phase_sources_init(scene, acc, channel, k, t0_k, reach, &table, &air, &surface_power, err);
     if (st != THZ_OK)
         return st;
     phase_fire_args a = {.scene = scene,

@@ -41,9 +41,20 @@ typedef struct photon_phase_options {
     /* Memory kept between the run's maps (photon_map.h): the record array starts from its
      * spare, and the index build uses its scratch. NULL: none. */
     photon_map_pool *pool;
+    /* The one-sided solids' reach shares (emission_reach.h) kept between the run's maps:
+     * computed by the first deviation map (T0 > 0) that needs them, then reused. NULL:
+     * computed for this phase alone. */
+    struct emission_reach *reach;
     thz_progress_fn progress;
     void *progress_user;
 } photon_phase_options;
+
+/* Computes opt->reach now, if given and not done, for the deviation maps of a run
+ * (T0 > 0) that are to come: so that the memory and time estimates' pilots, which report
+ * no progress, find it done. Asks opt->progress (stage "photons", channel 0, nothing done)
+ * between its rounds: THZ_ERR_CANCELLED. */
+thz_status photon_phase_prepare(const thz_scene *scene, const accel *acc,
+                                const photon_phase_options *opt, thz_error *err);
 
 /* Fires scene->photons.per_channel photons for channel `channel` and builds its photon
  * map (*out_map, owned by the caller). stats (may be NULL) is filled completely. Between
@@ -85,10 +96,12 @@ void photon_phase_share_fini(photon_phase_share *s);
 void photon_phase_share_range(uint64_t k, size_t member, size_t members, uint64_t *lo,
                               uint64_t *hi);
 
-/* Fires member `member` of `members`'s share of rq (threads as photon_phase_options). */
+/* Fires member `member` of `members`'s share of rq (threads and reach as
+ * photon_phase_options). */
 thz_status photon_phase_fire_share(const thz_scene *scene, const accel *acc,
-                                   const photon_phase_request *rq, int threads, size_t member,
-                                   size_t members, photon_phase_share *out, thz_error *err);
+                                   const photon_phase_request *rq, int threads,
+                                   struct emission_reach *reach, size_t member, size_t members,
+                                   photon_phase_share *out, thz_error *err);
 
 /* How the lead reaches the other members; implemented over MPI by src/mpi/. */
 typedef struct photon_phase_team {
@@ -105,9 +118,11 @@ typedef struct photon_phase_team {
  * against 1.26 on the paper's scene): a pilot of PHASE_PILOT photons
  * (fewer if K is smaller) gives the mean number of stored hits per photon, times K,
  * times sizeof(photon_record), times 1.05 for the pilot's statistical error. The
- * photon map's spatial index comes on top (see photon_map.h). */
+ * photon map's spatial index comes on top (see photon_map.h). reach as
+ * photon_phase_options (NULL: the pilot's own). */
 #define PHASE_PILOT 4096u
 thz_status photon_phase_estimate_bytes(const thz_scene *scene, const accel *acc, size_t channel,
-                                       double t0_k, uint64_t *bytes, thz_error *err);
+                                       double t0_k, struct emission_reach *reach, uint64_t *bytes,
+                                       thz_error *err);
 
 #endif

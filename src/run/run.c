@@ -108,6 +108,7 @@ void run_state_fini(run_state *rs)
             photon_map_destroy(rs->maps[c]);
     free(rs->maps);
     photon_map_pool_fini(&rs->pool);
+    emission_reach_fini(&rs->reach);
     free(rs->stats);
     free(rs->noise);
     free(rs->object_noise);
@@ -321,6 +322,24 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
     return st;
 }
 
+/* The back sides' reach shares of the run's deviation maps (photon_phase_prepare), before
+ * the estimates' pilots need them: computed once, with the run's threads, and stoppable. */
+static thz_status run_prepare_photons(run_state *rs, thz_error *err)
+{
+    bool deviation = false;
+    for (size_t c = 0; c < rs->scene->n_channels; c++)
+        deviation = deviation || run_photon_t0_k(rs->scene, c) > 0.0;
+    if (!deviation)
+        return THZ_OK;
+    photon_phase_options po = {.threads = rs->opt->threads,
+                               .reach = &rs->reach,
+                               .progress = rs->opt->progress,
+                               .progress_user = rs->opt->progress_user};
+    thz_status st = photon_phase_prepare(rs->scene, rs->accel, &po, err);
+    rs->seconds_photons += rs->reach.seconds; /* summary.json's timings_s.photons */
+    return st;
+}
+
 /* Estimates the run's time (a pilot) and tells opt->plan; render fires no photons. */
 static thz_status run_tell_plan(run_state *rs, bool fires_photons, thz_error *err)
 {
@@ -329,7 +348,8 @@ static thz_status run_tell_plan(run_state *rs, bool fires_photons, thz_error *er
                              .selected = rs->selected,
                              .n_selected = rs->n_selected,
                              .target_noise_k = rs->target_noise_k,
-                             .threads = rs->opt->threads};
+                             .threads = rs->opt->threads,
+                             .reach = &rs->reach};
     run_plan plan = {.memory_bytes = rs->memory_bytes,
                      .available_bytes = thz_memory_limit_bytes(),
                      .target_noise_k = rs->target_noise_k,
@@ -349,6 +369,8 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
     double t_start = thz_now_s();
     thz_status st = run_begin(rs, scene, opt, "simulate", err);
     bool photons = render_integrator_needs_photons(scene->render.integrator);
+    if (st == THZ_OK && photons)
+        st = run_prepare_photons(rs, err);
     if (st == THZ_OK)
         st = run_check_run_memory(rs, photons, 0, err);
     if (st == THZ_OK && opt->plan)
@@ -372,6 +394,7 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
                                        .reference_temperature_k = run_photon_t0_k(scene, c),
                                        .team = opt->team,
                                        .pool = &rs->pool,
+                                       .reach = &rs->reach,
                                        .progress = opt->progress,
                                        .progress_user = opt->progress_user};
             double t0 = thz_now_s();

@@ -26,6 +26,7 @@
 
 #include "accel/accel.h"
 #include "core/error.h"
+#include "photon/emission_reach.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
 #include "run/run_noise.h"
@@ -132,6 +133,7 @@ typedef struct run_state {
                                   a channel's, not the number of passes') */
     photon_map **maps;         /* per channel: kept for saving (simulate) */
     photon_map_pool pool;      /* memory of the maps not kept, for the next channel's */
+    emission_reach reach;      /* the back sides' reach shares of its deviation maps */
     photon_stats *stats;       /* per channel (simulate), or the read maps' (render) */
     run_noise *noise;          /* per channel */
     run_noise *object_noise;   /* [channel * n_objects + object] */
@@ -192,9 +194,10 @@ thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err);
 
 /* Bytes the photon maps of channel `only` (SIZE_MAX: every channel) take while fired:
  * all of them and the largest's build scratch when keep_all, else the largest (with the
- * pool's spare quarter) and its scratch. */
+ * pool's spare quarter) and its scratch. reach as photon_phase_options (may be NULL). */
 thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t only,
-                                bool keep_all, uint64_t *out, thz_error *err);
+                                bool keep_all, emission_reach *reach, uint64_t *out,
+                                thz_error *err);
 
 /* Estimates the memory of the run in rs (what the process holds already, its selected
  * sensors' images and the renderer's tables, and, when `photons`, the photon maps it

@@ -38,14 +38,16 @@ static thz_status estimate_channel(const run_estimate_input *in, thz_scene *pilo
                                    .reference_temperature_k =
                                        scene->render.integrator == INTEGRATOR_FINAL_GATHER
                                            ? scene_reference_temperature_k(scene, c)
-                                           : 0.0};
+                                           : 0.0,
+                                   .reach = in->reach};
         photon_stats ps;
         st = photon_phase_run(pilot, in->accel, c, &po, &map, &ps, err);
         if (st != THZ_OK)
             return st;
         /* The emission table is built once per channel, whatever the photon count: timed
          * per photon with the pilot's, it made a final-gather run's estimate 4 x its time
-         * (its frequency-dependent table 32 ms against 12 ms for 20 000 photons). */
+         * (its frequency-dependent table 32 ms against 12 ms for 20 000 photons). The back
+         * sides' reach shares are the run's, computed before (photon_phase_prepare). */
         double per_photon = (ps.seconds_tracing + ps.seconds_index) / RUN_PILOT_PHOTONS;
         *seconds_photons =
             ps.seconds_emission_table + per_photon * (double)scene->photons.per_channel;

@@ -27,6 +27,7 @@ typedef struct run_estimate_input {
     size_t n_selected;
     double target_noise_k; /* 0: one pass */
     int threads;
+    struct emission_reach *reach; /* the run's (photon_phase_options), or NULL */
 } run_estimate_input;
 
 /* *seconds_photons and *seconds_render of the whole run, s; *passes: the most a channel

@@ -94,7 +94,7 @@ static uint64_t run_add_bytes(uint64_t a, uint64_t b)
 }
 
 thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t only,
-                                bool keep_all, uint64_t *out, thz_error *err)
+                                bool keep_all, emission_reach *reach, uint64_t *out, thz_error *err)
 {
     uint64_t sum = 0, max = 0;
     for (size_t c = 0; c < scene->n_channels; c++) {
@@ -102,7 +102,7 @@ thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t
             continue;
         uint64_t b = 0;
         thz_status st =
-            photon_phase_estimate_bytes(scene, acc, c, run_photon_t0_k(scene, c), &b, err);
+            photon_phase_estimate_bytes(scene, acc, c, run_photon_t0_k(scene, c), reach, &b, err);
         if (st != THZ_OK)
             return st;
         sum = run_add_bytes(sum, b);
@@ -125,8 +125,9 @@ thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t map_bytes,
                        .held_bytes = thz_process_memory_bytes(),
                        .available_bytes = thz_memory_limit_bytes()};
     if (photons) {
-        thz_status st = run_photon_map_bytes(rs->scene, rs->accel, SIZE_MAX,
-                                             rs->opt->keep_photon_maps, &need.photon_bytes, err);
+        thz_status st =
+            run_photon_map_bytes(rs->scene, rs->accel, SIZE_MAX, rs->opt->keep_photon_maps,
+                                 &rs->reach, &need.photon_bytes, err);
         if (st != THZ_OK)
             return st;
     }

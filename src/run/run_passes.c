@@ -206,6 +206,7 @@ thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_
                                    .first_photon = (uint64_t)n * k,
                                    .team = opt->team,
                                    .pool = &rs->pool,
+                                   .reach = &rs->reach,
                                    .progress = opt->progress,
                                    .progress_user = opt->progress_user};
         photon_stats ps;

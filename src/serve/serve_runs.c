@@ -108,11 +108,16 @@ static int serve_on_progress(void *user, const thz_progress *p)
     share /= (double)(p->n_channels ? p->n_channels : 1);
     if (strcmp(p->stage, "output") == 0)
         share = 1.0;
+    if (strcmp(p->stage, "prepare") == 0) /* before the first channel */
+        share = 0.0;
     /* with the unit of the stage's count (rows; the photons stage's is its name); the output
      * has no channel */
     char message[256];
     if (strcmp(p->stage, "output") == 0)
         snprintf(message, sizeof message, "writing the results");
+    else if (strcmp(p->stage, "prepare") == 0)
+        snprintf(message, sizeof message, "preparing the back-side sources: %llu/%llu objects",
+                 (unsigned long long)p->done, (unsigned long long)p->total);
     else
         snprintf(message, sizeof message, "channel %zu/%zu, %s %llu/%llu%s", p->channel + 1,
                  p->n_channels, p->stage, (unsigned long long)p->done, (unsigned long long)p->total,

@@ -24,6 +24,27 @@ static int cancel_progress(void *user, const thz_progress *p)
     return 0;
 }
 
+/* Which stages a run reported, in what order. */
+typedef struct stage_log {
+    int prepare_done;          /* "prepare" reports with done == total */
+    int prepare_after_photons; /* "prepare" reports after a "photons" one */
+    int photons_seen;
+    uint64_t prepare_total;
+} stage_log;
+
+static int log_progress(void *user, const thz_progress *p)
+{
+    stage_log *l = user;
+    if (strcmp(p->stage, "photons") == 0)
+        l->photons_seen = 1;
+    if (strcmp(p->stage, "prepare") == 0) {
+        l->prepare_after_photons += l->photons_seen;
+        l->prepare_done += p->done == p->total;
+        l->prepare_total = p->total;
+    }
+    return 0;
+}
+
 /* 1 when path does not exist or is an empty directory. */
 static int empty_or_missing(const char *path)
 {
@@ -66,6 +87,26 @@ int main(int argc, char **argv)
         thz_output_destroy(output);
         CHECK(empty_or_missing(out), "%s holds files after cancelling", out);
     }
+
+    /* final-gather's deviation map: the one-sided solids' back-side sources are set up once
+     * for the run (stage "prepare", before the first channel's photons and the estimates'
+     * pilots), not once per channel; a stop there cancels the run */
+    thz_run_settings gather = {.integrator = "final-gather", .photons_per_channel = 20000};
+    stage_log log = {0};
+    thz_context_set_progress(ctx, log_progress, &log);
+    thz_run *gathered = NULL;
+    REQUIRE_OK(thz_simulate(ctx, scene, &gather, &gathered, &err), &err);
+    CHECK(log.prepare_done == 1, "the back-side sources were set up %d times", log.prepare_done);
+    CHECK(log.prepare_after_photons == 0, "a prepare report came after the photons began");
+    CHECK(log.prepare_total == 2, "prepare counted %llu objects, not the room and the plate",
+          (unsigned long long)log.prepare_total);
+    thz_run_destroy(gathered);
+    cancel_at in_prepare = {.stage = "prepare"};
+    thz_context_set_progress(ctx, cancel_progress, &in_prepare);
+    gathered = (thz_run *)&in_prepare;
+    thz_status stopped = thz_simulate(ctx, scene, &gather, &gathered, &err);
+    CHECK(stopped == THZ_ERR_CANCELLED && in_prepare.cancelled && gathered == NULL,
+          "cancelled in prepare: %s (%s)", thz_status_name(stopped), err.message);
 
     /* while writing: OUTDIR, created by the write, is gone again */
     thz_context_set_progress(ctx, NULL, NULL);

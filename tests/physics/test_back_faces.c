@@ -19,6 +19,7 @@
 #include "identity.h"
 
 #include "photon/emission.h"
+#include "photon/emission_reach.h"
 
 #define OPEN_JSON                                                                                  \
     "{\"format\": \"thzmap-scene/1\", \"name\": \"open-backs\","                                   \
@@ -45,7 +46,7 @@ static void test_back_source_power(void **state)
     const double t0 = 293.0; /* the plates' temperature: only their backs emit */
     uint64_t n = ident_photons(200000);
     emission_table t;
-    assert_int_equal(emission_table_init(&t, s, acc, 0, n, t0, &err), THZ_OK);
+    assert_int_equal(emission_table_init(&t, s, acc, 0, n, t0, NULL, &err), THZ_OK);
     assert_int_equal(t.n_sources, 1);
     const emission_source *src = &t.sources[0];
     double area = s->objects[0].mesh.total_area_m2;
@@ -80,7 +81,7 @@ static void test_back_source_power(void **state)
     /* The paper's map (T0 = 0) has no back sources (and needs no ray caster). */
     for (size_t i = 0; i < s->n_objects; i++)
         s->objects[i].temperature_k = 0.0;
-    assert_int_equal(emission_table_init(&t, s, NULL, 0, n, 0.0, &err), THZ_OK);
+    assert_int_equal(emission_table_init(&t, s, NULL, 0, n, 0.0, NULL, &err), THZ_OK);
     assert_int_equal(t.n_sources, 0);
     emission_table_fini(&t);
     accel_destroy(acc);
@@ -155,10 +156,99 @@ static void test_cross_validation(void **state)
     cross_validate(250.0); /* cold */
 }
 
+/* A sleeve (a one-sided open cylinder, r = 0.1 m, h = 0.4 m, 64 segments: its back side is
+ * inside) in a closed room (an inward box: its back side is outside). */
+#define SLEEVE_JSON                                                                                \
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"sleeve\","                                       \
+    " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.05}],"                         \
+    " \"materials\": {\"grey\": {\"reflectivity\": 0.3}},"                                         \
+    " \"objects\": ["                                                                              \
+    "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 295," \
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2], \"inward\": true}},"                \
+    "   {\"name\": \"sleeve\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": "   \
+    "300, \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.1, \"height_m\": 0.4,"               \
+    "    \"caps\": false}, \"transform\": {\"translate_m\": [0, 0, -0.2]}}],"                      \
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.9, 0], \"direction\": [0, 1, 0],"   \
+    "   \"up\": [0, 0, 1], \"fov_deg\": 40, \"resolution\": [4, 4], \"aperture_m2\": 0.01}],"      \
+    " \"photons\": {\"per_channel\": 1000, \"seed\": 11}}"
+
+typedef struct reach_calls {
+    int calls, stop_at;
+    uint64_t first_done, last_done, total;
+} reach_calls;
+
+static int reach_progress(void *user, const thz_progress *p)
+{
+    reach_calls *c = user;
+    assert_string_equal(p->stage, "prepare");
+    if (c->calls == 0)
+        c->first_done = p->done;
+    assert_true(p->done >= c->last_done); /* never backwards */
+    c->last_done = p->done;
+    c->total = p->total;
+    return ++c->calls == c->stop_at;
+}
+
+/* The reach shares (emission_reach.h): the sleeve's inside reaches the room through its
+ * ends alone. By reciprocity its share is 2 A_end (1 - F_ee) / A_wall, A_end the ends'
+ * (64-gon) area, A_wall the inside's, F_ee the view factor between the two ends (coaxial
+ * disks of radius r at distance h: (X - sqrt(X^2 - 4)) / 2, X = 2 + (h / r)^2); the room's
+ * back side (outside) reaches nothing: exactly 0. The same shares on 1 and 2 threads, and
+ * a stop asked between rounds. */
+static void test_reach_shares(void **state)
+{
+    (void)state;
+    thz_error err;
+    thz_scene *s = NULL;
+    assert_int_equal(scene_load_string(SLEEVE_JSON, ".", "sleeve", &s, &err), THZ_OK);
+    accel *acc = NULL;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    assert_true(emission_reach_needed(s, 0) && emission_reach_needed(s, 1));
+    emission_reach one = {0}, two = {0};
+    reach_calls calls = {0};
+    assert_int_equal(emission_reach_compute(&one, s, acc, 1, reach_progress, &calls, &err), THZ_OK);
+    assert_true(one.done);
+    assert_int_equal(calls.first_done, 0);
+    assert_int_equal(calls.last_done, 2);
+    assert_int_equal(calls.total, 2);
+    assert_int_equal(emission_reach_compute(&two, s, acc, 2, NULL, NULL, &err), THZ_OK);
+    assert_memory_equal(one.share, two.share, 2 * sizeof *one.share);
+
+    const double r = 0.1, h = 0.4, n = 64.0;
+    double a_end = 0.5 * n * r * r * sin(2.0 * M_PI / n);
+    double a_wall = n * 2.0 * r * sin(M_PI / n) * h;
+    double x = 2.0 + (h / r) * (h / r), f_ee = 0.5 * (x - sqrt(x * x - 4.0));
+    double expected = 2.0 * a_end * (1.0 - f_ee) / a_wall;
+    double se = sqrt(expected * (1.0 - expected) / EMISSION_REACH_RAYS);
+    print_message("sleeve's reach share %.5f, expected %.5f (%.2f se)\n", one.share[1], expected,
+                  (one.share[1] - expected) / se);
+    assert_true(fabs(one.share[1] - expected) <= 4.0 * se + 0.002); /* + the 64-gon's F_ee */
+    assert_true(one.share[0] == 0.0);
+
+    /* computed once: a second call on a done set casts nothing and reports nothing */
+    calls = (reach_calls){0};
+    assert_int_equal(emission_reach_compute(&one, s, acc, 1, reach_progress, &calls, &err), THZ_OK);
+    assert_int_equal(calls.calls, 0);
+
+    /* a stop at the first report: cancelled, nothing kept */
+    emission_reach stopped = {0};
+    calls = (reach_calls){.stop_at = 1};
+    assert_int_equal(emission_reach_compute(&stopped, s, acc, 2, reach_progress, &calls, &err),
+                     THZ_ERR_CANCELLED);
+    assert_false(stopped.done);
+    assert_null(stopped.share);
+
+    emission_reach_fini(&one);
+    emission_reach_fini(&two);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_back_source_power),
+        cmocka_unit_test(test_reach_shares),
         cmocka_unit_test(test_cross_validation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

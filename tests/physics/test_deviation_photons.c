@@ -575,7 +575,7 @@ static void test_index_explicit_solid(void **state)
             fail_msg("%s", err.message);
         if (!with_room) {
             emission_table t;
-            if (emission_table_init(&t, s, acc, 0, 1000, t0, &err) != THZ_OK)
+            if (emission_table_init(&t, s, acc, 0, 1000, t0, NULL, &err) != THZ_OK)
                 fail_msg("%s", err.message);
             assert_int_equal(t.n_sources, 2);
             assert_int_equal(t.sources[0].kind, EMISSION_EPS);
@@ -631,7 +631,7 @@ static void test_estimate_bytes(void **state)
     for (int t = 0; t < 2; t++) {
         double t0_k = t == 0 ? 0.0 : 295.0;
         uint64_t bytes = 0;
-        assert_int_equal(photon_phase_estimate_bytes(s, acc, 0, t0_k, &bytes, &err), THZ_OK);
+        assert_int_equal(photon_phase_estimate_bytes(s, acc, 0, t0_k, NULL, &bytes, &err), THZ_OK);
         photon_phase_options opt = {.threads = 2, .reference_temperature_k = t0_k};
         photon_map *map = NULL;
         photon_stats st;

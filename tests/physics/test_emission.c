@@ -57,7 +57,7 @@ static void test_frequencies_follow_band(void **state)
     ps_finalize(s);
     emission_table t;
     thz_error err;
-    assert_int_equal(emission_table_init(&t, s, NULL, 0, n, 0.0, &err), THZ_OK);
+    assert_int_equal(emission_table_init(&t, s, NULL, 0, n, 0.0, NULL, &err), THZ_OK);
     const thz_channel *ch = &s->channels[0];
     double sigma = channel_sigma_hz(ch);
     enum { BINS = 16 };
@@ -148,7 +148,7 @@ static void test_source_fractions(void **state)
 
     emission_table t;
     thz_error err;
-    assert_int_equal(emission_table_init(&t, s, NULL, 0, n, 0.0, &err), THZ_OK);
+    assert_int_equal(emission_table_init(&t, s, NULL, 0, n, 0.0, NULL, &err), THZ_OK);
     assert_int_equal(t.n_sources, 6);
     assert_int_equal(t.n_groups, 5);
     uint64_t count[7] = {0}, side1[7] = {0};
@@ -229,7 +229,7 @@ static void test_direction_distribution(void **state)
         optics_point o = scene_object_optics(s, &s->objects[obj], s->channels[0].center_hz);
         emission_table t;
         thz_error err;
-        assert_int_equal(emission_table_init(&t, s, NULL, 0, n, 0.0, &err), THZ_OK);
+        assert_int_equal(emission_table_init(&t, s, NULL, 0, n, 0.0, NULL, &err), THZ_OK);
         enum { BINS = 20 };
         uint64_t hist[BINS] = {0};
         for (uint64_t i = 0; i < n; i++) {
@@ -295,7 +295,7 @@ static void test_line_between_nodes(void **state)
 
     emission_table t;
     thz_error err;
-    assert_int_equal(emission_table_init(&t, s, NULL, 0, n, 0.0, &err), THZ_OK);
+    assert_int_equal(emission_table_init(&t, s, NULL, 0, n, 0.0, NULL, &err), THZ_OK);
     assert_int_equal(t.n_groups, 2);
     double pa = 0.0, fired = 0.0;
     uint64_t zero = 0;

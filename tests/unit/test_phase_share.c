@@ -42,8 +42,8 @@ static thz_status fake_gather(void *impl, photon_phase_share *share, thz_error *
     fake_team *t = impl;
     for (size_t m = 1; m < t->members; m++) {
         photon_phase_share part;
-        thz_status st = photon_phase_fire_share(t->scene, t->acc, &t->rq, t->threads, m, t->members,
-                                                &part, err);
+        thz_status st = photon_phase_fire_share(t->scene, t->acc, &t->rq, t->threads, NULL, m,
+                                                t->members, &part, err);
         if (st != THZ_OK)
             return st;
         share->records =
@@ -158,10 +158,11 @@ static void test_member_refuses_other_seed(void **state)
     assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
     photon_phase_request rq = {.channel = 0, .photons = 1000, .seed = 8};
     photon_phase_share part;
-    assert_int_equal(photon_phase_fire_share(s, acc, &rq, 1, 1, 2, &part, &err), THZ_ERR_INPUT);
+    assert_int_equal(photon_phase_fire_share(s, acc, &rq, 1, NULL, 1, 2, &part, &err),
+                     THZ_ERR_INPUT);
     assert_non_null(strstr(err.message, "seed 7"));
     rq.seed = 7;
-    assert_int_equal(photon_phase_fire_share(s, acc, &rq, 1, 1, 2, &part, &err), THZ_OK);
+    assert_int_equal(photon_phase_fire_share(s, acc, &rq, 1, NULL, 1, 2, &part, &err), THZ_OK);
     assert_int_equal(part.n_chunks, 0); /* one batch: member 0's */
     photon_phase_share_fini(&part);
     accel_destroy(acc);

@@ -163,7 +163,7 @@ static void test_progress_and_cancel(void **state)
 
     /* Estimate before: stored records per photon times K times the record's bytes. */
     uint64_t bytes = 0;
-    assert_int_equal(photon_phase_estimate_bytes(s, acc, 0, 0.0, &bytes, &err), THZ_OK);
+    assert_int_equal(photon_phase_estimate_bytes(s, acc, 0, 0.0, NULL, &bytes, &err), THZ_OK);
 
     progress_log log = {.main_thread_ok = 1};
     photon_phase_options opt = {.threads = 2, .progress = on_progress, .progress_user = &log};
