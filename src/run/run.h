@@ -246,9 +246,17 @@ thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt, ...)
  * photon map alone keeps it above (run_passes.c). */
 thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, thz_error *err);
 
-/* photon-map with a noise target: photon passes, each rendered from the merge of all so
- * far, until the target, the time limit or half the memory; *out_map the merged map
+/* photon-map with a noise target: photon passes, rendered at checks from the merge of all
+ * so far, until the target, the time limit or half the memory; *out_map the merged map
  * (run_passes.c). */
 thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_error *err);
+
+/* The next check after one at pass n whose noise asks for `need` passes in all: at most
+ * a quarter more than n, at least n + 1 (run_photon_passes). */
+uint32_t run_photon_next_check(uint32_t n, double need);
+
+/* How many checks run_photon_passes renders before `passes` passes if every check asks
+ * for more than a quarter more (the most; the time estimate's count of renders). */
+uint32_t run_photon_checks(uint32_t passes);
 
 #endif

@@ -7,6 +7,7 @@
 #include "core/clock.h"
 #include "photon/phase.h"
 #include "photon/photon_map.h"
+#include "run/run.h"
 #include "run/run_noise.h"
 #include "sensor/images.h"
 #include "sensor/render.h"
@@ -132,7 +133,9 @@ thz_status run_estimate_time(const run_estimate_input *in, double *seconds_photo
         }
         double channels = piloted == 1 ? (double)scene->n_channels : 1.0;
         *passes = passes_c > *passes ? passes_c : *passes;
-        *seconds_render += per_sample * samples * passes_c * channels;
+        /* photon-map's passes render at checks only (run_photon_passes) */
+        double renders = paper_map ? (double)run_photon_checks(passes_c) : (double)passes_c;
+        *seconds_render += per_sample * samples * renders * channels;
         *seconds_photons += (paper_map ? photons_s * passes_c : photons_s) * channels;
     }
     return THZ_OK;

@@ -179,6 +179,20 @@ thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, th
  * standard error reaches the target, the time limit passes, or the next merge would not
  * fit in half the memory.
  * *out_map is the merged map; the passes are bit-identical for any thread count. */
+uint32_t run_photon_next_check(uint32_t n, double need)
+{
+    need = fmin(fmin(need, ceil(1.25 * (double)n)), (double)RUN_MAX_PASSES);
+    return need > (double)n ? (uint32_t)need : n + 1;
+}
+
+uint32_t run_photon_checks(uint32_t passes)
+{
+    uint32_t checks = 1;
+    for (uint32_t n = 1; n < passes; checks++)
+        n = run_photon_next_check(n, INFINITY);
+    return checks;
+}
+
 thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_error *err)
 {
     const thz_scene *scene = rs->scene;
@@ -273,8 +287,7 @@ thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_
          * made a run of 450 passes take 5 minutes. Between checks the passes are only
          * fired; a time limit checks at once. */
         double need = ceil((double)n * (p95 / target) * (p95 / target));
-        need = fmin(fmin(need, ceil(1.25 * (double)n)), fmin(most, (double)RUN_MAX_PASSES));
-        check = need > (double)n ? (size_t)need : n + 1;
+        check = run_photon_next_check((uint32_t)n, fmin(need, most));
     }
     if (st == THZ_OK && n > 0) {
         if (n > 1) {
