@@ -5,9 +5,11 @@
 #include <float.h>
 #include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "accel/accel.h"
 #include "core/alloc.h"
 #include "core/cdf.h"
 #include "core/rng.h"
@@ -99,7 +101,14 @@ thz_status bench_probe_run(const thz_scene *scene, uint64_t n_rays, int threads,
     RTCScene rtc = NULL;
     bench_ray *pool = NULL;
     double t0 = omp_get_wtime();
-    dev = rtcNewDevice(NULL);
+    /* the program's kernels (accel_create caps them at AVX2 unless told otherwise) */
+    const char *isa = NULL;
+    st = accel_max_isa(&isa, err);
+    if (st != THZ_OK)
+        return st;
+    char config[48];
+    snprintf(config, sizeof config, "max_isa=%s", isa);
+    dev = rtcNewDevice(config);
     if (!dev)
         return thz_error_set(err, THZ_ERR_INTERNAL, "probe: cannot create the Embree device");
     rtc = rtcNewScene(dev);

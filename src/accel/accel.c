@@ -108,9 +108,7 @@ static thz_status accel_check_device(RTCDevice device, const char *what, thz_err
 static const char *const accel_isas[] = {"sse2", "sse4.2", "avx", "avx2", "avx512"};
 #define ACCEL_N_ISAS (sizeof accel_isas / sizeof accel_isas[0])
 
-/* THZMAP_EMBREE_MAX_ISA's set (avx2 when unset or empty); THZ_ERR_INPUT for a value that
- * names none. */
-static thz_status accel_max_isa(const char **isa, thz_error *err)
+thz_status accel_max_isa(const char **isa, thz_error *err)
 {
     *isa = "avx2";
     const char *v = getenv("THZMAP_EMBREE_MAX_ISA");

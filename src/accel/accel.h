@@ -29,6 +29,12 @@ typedef struct accel_hit {
 
 /* Builds the acceleration structure for the scene (borrowed; must outlive it). */
 thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err);
+
+/* The instruction set accel_create caps Embree's kernels at (Embree's `max_isa`):
+ * THZMAP_EMBREE_MAX_ISA's, avx2 when unset or empty; THZ_ERR_INPUT for a value that names
+ * none. For a caller that makes an Embree device of its own to compare with (the
+ * benchmark's probe). */
+thz_status accel_max_isa(const char **isa, thz_error *err);
 void accel_destroy(accel *a);
 
 /* Sentinel for "nothing to ignore". */
