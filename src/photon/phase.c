@@ -308,9 +308,9 @@ void photon_phase_share_range(uint64_t k, size_t member, size_t members, uint64_
     *hi = b_hi * PHASE_BATCH < k ? b_hi * PHASE_BATCH : k;
 }
 
-/* The question of a step that reports no progress of its own (emission_reach_compute's
- * and photon_map_build's cancel): the photons stage's progress as it stands, `done` of
- * `photons` (the index build: its last photon not yet counted). */
+/* The question of a step that reports no progress of its own (photon_map_build's
+ * cancel): the photons stage's progress as it stands, `done` of `photons` (the index
+ * build: its last photon not yet counted). */
 typedef struct phase_asking {
     const photon_phase_options *opt;
     size_t channel, n_channels;

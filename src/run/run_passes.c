@@ -172,13 +172,6 @@ thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, th
     return st;
 }
 
-/* photon-map with a noise target (it cannot add render passes: it is deterministic given
- * its map): photon passes instead. Pass p fires photons p K .. (p + 1) K - 1 of the
- * channel, and the channel is rendered from the merge of all passes' photons
- * (photon_map_merge: (p + 1) K photons), until the 95th percentile of the channel's
- * standard error reaches the target, the time limit passes, or the next merge would not
- * fit in half the memory.
- * *out_map is the merged map; the passes are bit-identical for any thread count. */
 uint32_t run_photon_next_check(uint32_t n, double need)
 {
     need = fmin(fmin(need, ceil(1.25 * (double)n)), (double)RUN_MAX_PASSES);
@@ -193,6 +186,13 @@ uint32_t run_photon_checks(uint32_t passes)
     return checks;
 }
 
+/* photon-map with a noise target (it cannot add render passes: it is deterministic given
+ * its map): photon passes instead. Pass p fires photons p K .. (p + 1) K - 1 of the
+ * channel, and at checks (run_photon_next_check) the channel is rendered from the merge
+ * of all passes' photons (photon_map_merge: (p + 1) K photons), until the 95th percentile
+ * of the channel's standard error reaches the target, the time limit passes, or the next
+ * merge would not fit in half the memory.
+ * *out_map is the merged map; the passes are bit-identical for any thread count. */
 thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_error *err)
 {
     const thz_scene *scene = rs->scene;
