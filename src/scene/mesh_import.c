@@ -334,8 +334,7 @@ static thz_status mesh_import_assimp(const mesh_job *job, thz_mesh *mesh, thz_er
     /* assimp reports an allocation failure (a std::bad_alloc it catches) as a reading
      * error; the C library's ENOMEM in errno tells it apart from a bad file */
     errno = 0;
-    const struct aiScene *sc =
-        aiImportFileEx(fake_name, aiProcess_Triangulate, &io);
+    const struct aiScene *sc = aiImportFileEx(fake_name, aiProcess_Triangulate, &io);
     if (!sc && errno == ENOMEM)
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while importing the mesh",
                              name);
