@@ -358,6 +358,14 @@ PY
 for f in cam.radiance.img cam.radiance_stderr.img; do
     cmp -s "$work/pmn1/$f" "$work/pmr/$f" || fail "render from the merged map differs in $f"
 done
+# final-gather's deviation map sets up the one-sided solids' back-side sources once per
+# run, before its estimate (progress stage "prepare": the room and the plate here)
+"$THZMAP" simulate "$work/scene.json" -o "$work/fgp" --integrator final-gather --photons 20000 \
+    2> "$work/fgp.err" || fail "simulate final-gather (progress) exited $?"
+[[ $(grep -c "back-side sources: 2 objects in" "$work/fgp.err") == 1 ]] &&
+    grep -A1 "back-side sources" "$work/fgp.err" | grep -q "estimate:" ||
+    fail "final-gather's back-side sources not reported once, before the estimate: $(cat "$work/fgp.err")"
+grep -q "back-side sources" "$work/pmn1.err" && fail "photon-map reported back-side sources"
 # final-gather from a saved map (seeded elsewhere than the scene) re-renders byte for byte
 "$THZMAP" simulate "$work/scene.json" -o "$work/fgs" --integrator final-gather --photons 20000 \
     --seed 9 --save-photon-map --quiet || fail "simulate final-gather --save-photon-map exited $?"
