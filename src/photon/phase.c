@@ -432,12 +432,10 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
      * its first need and kept), else this phase's own; before the stage starts, as their
      * own stage "prepare". */
     emission_reach own = {0}, *reach = opt && opt->reach ? opt->reach : &own;
-    double seconds_reach = 0.0;
     if (t0_k > 0.0 && !reach->done) {
         st = emission_reach_compute(reach, scene, acc, opt ? opt->threads : 0,
                                     opt ? opt->progress : NULL, opt ? opt->progress_user : NULL,
                                     err);
-        seconds_reach = reach->seconds;
         if (st != THZ_OK)
             return st;
     }
@@ -535,7 +533,6 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
         stats->emitted_power_w_per_hz = surface_power + air_power; /* + air, boundary */
         stats->reference_temperature_k = t0_k;
         stats->seconds_emission_table = t1 - t0;
-        stats->seconds_reach = seconds_reach;
         stats->seconds_tracing = t2 - t1;
         stats->seconds_index = t3 - t2;
         stats->seconds = omp_get_wtime() - t0;

@@ -60,7 +60,6 @@ void photon_stats_merge(photon_stats *sum, const photon_stats *p, uint32_t passe
     sum->mean_bounces = sum->fired ? (double)sum->hits / (double)sum->fired : 0.0;
     sum->seconds += p->seconds;
     sum->seconds_emission_table += p->seconds_emission_table;
-    sum->seconds_reach += p->seconds_reach;
     sum->seconds_tracing += p->seconds_tracing;
     sum->seconds_index += p->seconds_index;
 }

@@ -34,12 +34,9 @@ typedef struct photon_stats {
                                          terminated; should be 0) */
     /* Where the phase's time went (added for the benchmark, issue 6; wall times, not
      * reproducible): seconds = seconds_emission_table + seconds_tracing + seconds_index
-     * + a little bookkeeping; seconds_reach before them, not in seconds. */
+     * + a little bookkeeping. */
     uint64_t rays;                 /* rays cast: one per hit, escape or low-power stop */
     double seconds_emission_table; /* emission_table_init */
-    double seconds_reach;          /* the back sides' reach shares, when this phase computed
-                                      them before it started (emission_reach.h; 0 when it
-                                      had them) */
     double seconds_tracing;        /* firing, tracing and merging the records of every batch */
     double seconds_index;          /* photon_map_create: grouping and the spatial index */
     /* Reference temperature T0 of the map (K; 0: the paper's map of L). With T0 > 0 the
