@@ -95,9 +95,8 @@ static thz_status api_fire(thz_context *ctx, const thz_scene *scene,
                                     .reach = &reach,
                                     .progress = ctx ? ctx->progress : NULL,
                                     .progress_user = ctx ? ctx->progress_user : NULL};
-    for (size_t c = 0; st == THZ_OK && c < scene->n_channels && !reach.done; c++)
-        if ((only == SIZE_MAX || c == only) && run_photon_t0_k(eff, c) > 0.0)
-            st = photon_phase_prepare(eff, acc, &prepare, err);
+    if (st == THZ_OK)
+        st = run_prepare_reach(eff, acc, only, &prepare, err);
     if (st == THZ_OK)
         st = api_fire_check_memory(eff, acc, only, &reach, err);
     for (size_t c = 0; st == THZ_OK && c < scene->n_channels; c++) {

@@ -324,18 +324,22 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
 
 /* The back sides' reach shares of the run's deviation maps (photon_phase_prepare), before
  * the estimates' pilots need them: computed once, with the run's threads, and stoppable. */
+thz_status run_prepare_reach(const thz_scene *scene, const accel *acc, size_t only,
+                             const photon_phase_options *po, thz_error *err)
+{
+    for (size_t c = 0; c < scene->n_channels; c++)
+        if ((only == SIZE_MAX || c == only) && run_photon_t0_k(scene, c) > 0.0)
+            return photon_phase_prepare(scene, acc, po, err);
+    return THZ_OK;
+}
+
 static thz_status run_prepare_photons(run_state *rs, thz_error *err)
 {
-    bool deviation = false;
-    for (size_t c = 0; c < rs->scene->n_channels; c++)
-        deviation = deviation || run_photon_t0_k(rs->scene, c) > 0.0;
-    if (!deviation)
-        return THZ_OK;
     photon_phase_options po = {.threads = rs->opt->threads,
                                .reach = &rs->reach,
                                .progress = rs->opt->progress,
                                .progress_user = rs->opt->progress_user};
-    thz_status st = photon_phase_prepare(rs->scene, rs->accel, &po, err);
+    thz_status st = run_prepare_reach(rs->scene, rs->accel, SIZE_MAX, &po, err);
     rs->seconds_photons += rs->reach.seconds; /* summary.json's timings_s.photons */
     return st;
 }

@@ -27,6 +27,7 @@
 #include "accel/accel.h"
 #include "core/error.h"
 #include "photon/emission_reach.h"
+#include "photon/phase.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
 #include "run/run_noise.h"
@@ -245,6 +246,12 @@ thz_status run_add_warning(run_state *rs, thz_error *err, const char *fmt, ...)
  * of the channel's standard error reaches it, the time limit passes, or final-gather's
  * photon map alone keeps it above (run_passes.c). */
 thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, thz_error *err);
+
+/* photon_phase_prepare for the deviation maps (T0 > 0, run_photon_t0_k) of channel `only`
+ * of scene (SIZE_MAX: every channel), before the estimates' pilots need po->reach;
+ * nothing where none fires one (run.c). */
+thz_status run_prepare_reach(const thz_scene *scene, const accel *acc, size_t only,
+                             const photon_phase_options *po, thz_error *err);
 
 /* photon-map with a noise target: photon passes, rendered at checks from the merge of all
  * so far, until the target, the time limit or half the memory; *out_map the merged map
