@@ -61,6 +61,13 @@ static inline uint32_t rng_next_u32(rng_stream *rng)
     return rng->buf[rng->used++];
 }
 
+/* Next 64 random bits: two words, the first the high half. */
+static inline uint64_t rng_next_u64(rng_stream *rng)
+{
+    uint64_t hi = rng_next_u32(rng);
+    return hi << 32 | rng_next_u32(rng);
+}
+
 /* Uniform double in [0, 1) with 53 random bits (two words). */
 double rng_uniform(rng_stream *rng);
 

@@ -30,8 +30,7 @@ static uint64_t next(void)
         rng_init(&rng, 1, 0, RNG_PURPOSE_TEST, 0);
         started = true;
     }
-    uint64_t hi = rng_next_u32(&rng);
-    return hi << 32 | rng_next_u32(&rng);
+    return rng_next_u64(&rng);
 }
 
 static void check(size_t n, uint64_t mask, uint64_t base)

@@ -47,8 +47,7 @@ static uint64_t next(void)
         rng_init(&rng, 2, 0, RNG_PURPOSE_TEST, 0);
         started = true;
     }
-    uint64_t hi = rng_next_u32(&rng);
-    return hi << 32 | rng_next_u32(&rng);
+    return rng_next_u64(&rng);
 }
 
 /* One image of `px` pixels in one channel: object ids in -1 .. n_objects + 1 (the last two
