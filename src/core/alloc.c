@@ -6,6 +6,28 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <unistd.h>
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
+void thz_populate(void *p, size_t bytes)
+{
+#if defined(__linux__)
+#ifndef MADV_POPULATE_WRITE
+#define MADV_POPULATE_WRITE 23 /* Linux 5.14; older headers lack it, older kernels refuse it */
+#endif
+    /* The whole pages the range touches: they are mapped, as the range is. */
+    long size = sysconf(_SC_PAGESIZE);
+    if (!p || bytes == 0 || size <= 0)
+        return;
+    const uintptr_t page = (uintptr_t)size;
+    uintptr_t lo = (uintptr_t)p & ~(page - 1), hi = ((uintptr_t)p + bytes + page - 1) & ~(page - 1);
+    (void)madvise((void *)lo, hi - lo, MADV_POPULATE_WRITE);
+#else
+    (void)p;
+    (void)bytes;
+#endif
+}
 
 char *thz_strdup(const char *s)
 {

@@ -47,6 +47,14 @@ static inline void *thz_grow_array(void *p, size_t *capacity, size_t first, size
     return q;
 }
 
+/* Asks the kernel to map the pages under [p, p + bytes) for writing now, in one call
+ * (MADV_POPULATE_WRITE, Linux 5.14 on), rather than a fault on each page's first write; the
+ * contents are unchanged. A hint: where it is not supported nothing happens. For memory
+ * about to be written whole: on this project's VMs (a shadow-paging hypervisor) a 4 KB page
+ * new to the process cost ~10 us on its first write, and the call halves that (512 MB, 2
+ * threads: 0.78 -> 0.42 s, 2026-12-05). */
+void thz_populate(void *p, size_t bytes);
+
 /* strdup that returns NULL for NULL. */
 char *thz_strdup(const char *s);
 

@@ -88,6 +88,24 @@ static void phase_emit_block(const phase_fire_args *a, rng_stream *rng, size_t n
             e[j].power_w_per_hz = 0.0;
 }
 
+/* The capacity the record array grows to when it must hold `need` records after `done` of
+ * the `total` photons it is for: the records per photon so far, extrapolated to all of them
+ * with a sixteenth and a batch to spare, so that the growth after the first batch is
+ * normally the last; and at least a quarter more than `capacity`, should it not be.
+ * (Doubling from one record grew it about 24 times in the paper's first channel, by realloc,
+ * which moves what was written (mremap) where it cannot extend in place; under this
+ * project's VMs' shadow-paging hypervisor every page moved faults again when next read: the
+ * index build's first pass over that channel took 0.25 s instead of 0.02, 2026-12-05.) */
+static size_t phase_grow_capacity(size_t capacity, size_t need, uint64_t done, uint64_t total)
+{
+    double want = (double)need / (double)(done ? done : 1) * (double)total * (17.0 / 16.0) +
+                  (double)PHASE_BATCH;
+    double at_least = (double)capacity * 1.25;
+    want = want > at_least ? want : at_least;
+    size_t cap = want < (double)(SIZE_MAX / 2) ? (size_t)want : SIZE_MAX / 2;
+    return cap > need ? cap : need;
+}
+
 /* Fires photons first_photon + lo..hi-1, returning their records in photon-index order (a
  * malloc'd array of *out_capacity, never NULL on success) and the summed counters;
  * chunk_out (may be NULL) gets each chunk's counters in order (room for
@@ -184,9 +202,8 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                         *chunk_out++ = chunks[k].counters;
                 }
                 if (!failed && count + added > capacity) {
-                    size_t cap = capacity;
-                    while (cap < count + added)
-                        cap = cap > SIZE_MAX / 2 ? count + added : 2 * cap;
+                    size_t cap = phase_grow_capacity(capacity, count + added,
+                                                     first + batch_n - a->lo, a->hi - a->lo);
                     photon_record *p = thz_realloc_array(records, cap, sizeof *p);
                     if (p) {
                         records = p;
@@ -199,6 +216,14 @@ static thz_status phase_fire(const phase_fire_args *a, photon_record **out_recor
                     count += added;
             }
             if (!failed) {
+                /* The batch's range of the array, each thread its share, mapped in one call
+                 * before the copies write it (thz_populate; in the first channel of a run
+                 * the array is new to the process) */
+                size_t from = chunks[0].offset, nt = (size_t)omp_get_num_threads(),
+                       t = (size_t)omp_get_thread_num();
+                thz_populate(records + from + (count - from) * t / nt,
+                             ((count - from) * (t + 1) / nt - (count - from) * t / nt) *
+                                 sizeof *records);
 #pragma omp for schedule(static)
                 for (long k = 0; k < n_chunks; k++) {
                     const phase_chunk *ch = &chunks[k];

@@ -144,6 +144,7 @@ photon_record *photon_map_pool_scratch(photon_map_pool *pool, size_t count)
      * 2.41 s against 2.85 on average; a kernel whose huge pages are "always" still
      * gives them where it has them free. */
     photon_record *s = thz_malloc_array(n, sizeof(photon_record));
+    thz_populate(s, s ? n * sizeof(photon_record) : 0); /* written by every build */
     if (pool && s) {
         pool->scratch = s;
         pool->scratch_capacity = n;
