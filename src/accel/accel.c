@@ -26,13 +26,20 @@
  * gets) is not known; the MPI tests compare processes on one machine.
  *
  * Processors. Embree picks its kernels by the processor's instruction sets (SSE, AVX2,
- * AVX-512: different SIMD widths), and their hit distances differ in the last bits, so
- * the photons' paths and every image differ (by far less than their noise) between
- * machines of different sets. THZMAP_EMBREE_MAX_ISA caps the set Embree may use: with one
- * that every machine has, their results are the same bytes (docs/scene-format.md
- * "Reproducibility"). Unset, the cap is AVX2: every processor with AVX2 (2013 on) runs the
- * same kernels, and AVX-512's were no faster for thzmap's single rays (the paper's case,
- * 2 threads: 11.45-11.92 s either way; SSE4.2's 12.8 s).
+ * AVX-512: different SIMD widths), and their hit distances and barycentric coordinates
+ * differ in the last bits between those sets and between processors of one set (an AMD
+ * and an Intel machine with SSE4.2's kernels). thzmap takes from Embree only which
+ * triangle is hit and computes the point and distance itself (accel_intersect), so the
+ * photons' paths and the images are the same bytes whatever the kernels (test_environment.sh,
+ * test_deviation_photons). What can still differ is the rare ray that meets the edge two
+ * triangles share within single-precision rounding: other kernels, or another maker's
+ * processor, may return either triangle (the paper's case with path or final-gather: 1
+ * or 2 of 24,576 values differed in their last bits between SSE4.2's and AVX-512's
+ * kernels; none with photon-map). THZMAP_EMBREE_MAX_ISA caps the set Embree may use, so
+ * that machines run the same kernels; unset, the cap is AVX2: every processor with AVX2
+ * (2013 on) runs the same kernels, and AVX-512's were no faster for thzmap's single rays
+ * (the paper's case, 2 threads: 11.45-11.92 s either way; SSE4.2's 12.8 s)
+ * (docs/scene-format.md "Reproducibility").
  */
 #include "accel/accel.h"
 
@@ -297,15 +304,41 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
     vec3 n = v3(nf[0], nf[1], nf[2]);
     double c = v3_dot(dir, n);
 
-    /* The hit point from the barycentric coordinates lies on the triangle's plane to
-     * float precision, however long the ray; origin + t dir would not. */
+    /* Where the ray meets the triangle's plane, in double from the ray as the caller gave
+     * it: on that plane to double precision however long the ray, and the same on every
+     * machine. Embree's distance and barycentric coordinates are scaled by approximate
+     * reciprocals (rcpps, rcp14 with a Newton step) whose last bits differ between
+     * instruction sets and between processors (an AMD and an Intel machine, the same SSE4.2
+     * kernels), and with them every path after the first hit. So Embree decides which
+     * triangle is hit, and this where. The plane is the one through the first corner with
+     * the mesh's unit normal; that normal, rounded to float, tilts it by ~1e-7 rad, so a
+     * ray at a grazing angle would slide along it by ~1e-7 of the triangle's size over
+     * |cos|: below |cos| = 0.01 (about 1e-4 of the rays) the plane is the corners' own,
+     * from their cross product in double (a few percent slower for every ray). A ray
+     * parallel to it to 1e-12 keeps Embree's point. */
     const uint32_t *idx = &m->indices[3 * (size_t)tri];
     vec3 p0 = v3_from_floats(&m->positions[3 * (size_t)idx[0]]);
-    vec3 p1 = v3_from_floats(&m->positions[3 * (size_t)idx[1]]);
-    vec3 p2 = v3_from_floats(&m->positions[3 * (size_t)idx[2]]);
-    double u = rh.hit.u, v = rh.hit.v;
-    hit->position_m = v3_add(v3_scale(p0, 1.0 - u - v), v3_add(v3_scale(p1, u), v3_scale(p2, v)));
-    hit->distance_m = rh.ray.tfar;
+    vec3 plane = n;
+    double along = c;
+    if (fabs(c) < 0.01) {
+        vec3 p1 = v3_from_floats(&m->positions[3 * (size_t)idx[1]]);
+        vec3 p2 = v3_from_floats(&m->positions[3 * (size_t)idx[2]]);
+        plane = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
+        along = v3_dot(dir, plane);
+    }
+    if (along * along > 1e-24 * v3_dot(plane, plane)) {
+        double t = v3_dot(v3_sub(p0, origin_m), plane) / along;
+        t = t > 0.0 ? t : 0.0;
+        hit->position_m = v3_madd(origin_m, t, dir);
+        hit->distance_m = t;
+    } else {
+        vec3 p1 = v3_from_floats(&m->positions[3 * (size_t)idx[1]]);
+        vec3 p2 = v3_from_floats(&m->positions[3 * (size_t)idx[2]]);
+        double u = rh.hit.u, v = rh.hit.v;
+        hit->position_m =
+            v3_add(v3_scale(p0, 1.0 - u - v), v3_add(v3_scale(p1, u), v3_scale(p2, v)));
+        hit->distance_m = rh.ray.tfar;
+    }
     hit->object = rh.hit.geomID;
     hit->triangle = tri;
     hit->side = c < 0.0 ? 0 : 1;
