@@ -33,12 +33,13 @@
  * photons' paths and the images are the same bytes whatever the kernels (test_environment.sh,
  * test_deviation_photons). What can still differ is the rare ray that meets the edge two
  * triangles share within single-precision rounding: other kernels, or another maker's
- * processor, may return either triangle (the paper's case with path or final-gather: 1
- * or 2 of 24,576 values differed in their last bits between SSE4.2's and AVX-512's
- * kernels; none with photon-map). THZMAP_EMBREE_MAX_ISA caps the set Embree may use, so
- * that machines run the same kernels; unset, the cap is AVX2: every processor with AVX2
- * (2013 on) runs the same kernels, and AVX-512's were no faster for thzmap's single rays
- * (the paper's case, 2 threads: 11.45-11.92 s either way; SSE4.2's 12.8 s)
+ * processor, may return either triangle, and the point moves in its last bits (the
+ * paper's case, SSE4.2's kernels against AVX-512's: 1 or 2 of 24,576 values differed
+ * with path and final-gather; with photon-map none at 1 M photons a channel and one at
+ * 10 M, by 0.4 %, a photon having crossed the edge of a pixel's gather). THZMAP_EMBREE_MAX_ISA caps
+ * the set Embree may use, so that machines run the same kernels; unset, the cap is AVX2: every
+ * processor with AVX2 (2013 on) runs the same kernels, and AVX-512's were no faster for thzmap's
+ * single rays (the paper's case, 2 threads: 11.45-11.92 s either way; SSE4.2's 12.8 s)
  * (docs/scene-format.md "Reproducibility").
  */
 #include "accel/accel.h"
