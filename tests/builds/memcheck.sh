@@ -5,7 +5,9 @@
 # frame). Small scenes: simulate with each integrator (the paper's room, 2 channels;
 # final-gather with its deviation map), render from the saved photon map, and a batch
 # of three frames with its movie. Any memcheck error fails the run (exit 99), as do an
-# exit status other than 0 and a missing output.
+# exit status other than 0 and a missing output. Where valgrind cannot decode an
+# instruction a library runs (RDTSCP on a processor whose CPUID hides it), that run is
+# said to be skipped and runs without valgrind instead (memcheck() below).
 # Not a CTest test (the release build is -march=native): make test-compilers runs it on
 # the clang build.
 # argv: thzmap (built with -DTHZ_NATIVE=OFF), repository directory.
@@ -52,6 +54,22 @@ memcheck() { # memcheck NAME ARGS...: runs thzmap ARGS under memcheck
     valgrind --tool=memcheck --error-exitcode=99 --num-callers=30 \
         --log-file="$work/$name.%p.log" "$THZ" "$@" --quiet >"$work/$name.out" 2>&1
     local rc=$?
+    if [[ $rc -eq 132 ]] && ! grep -qw rdtscp /proc/cpuinfo &&
+        grep -q 'unhandled instruction bytes: 0xF 0x1 0xF9 ' "$work/$name".*.log; then
+        # RDTSCP (0F 01 F9), which libhwy (FFmpeg -> libjxl) executes when the movie
+        # encoder is loaded, on a processor whose CPUID hides it (seen on an AMD VM,
+        # 2026-12-05): valgrind 3.19 decodes it only where CPUID shows it, and stops the
+        # program. A limit of the tool on this machine, not a memory error: the same run
+        # without valgrind must still succeed (ASan's run of the batch tests covers
+        # thzmap's own code; FFmpeg's goes unchecked here).
+        echo "SKIP: $name under memcheck: valgrind cannot run RDTSCP (libhwy, loaded with" \
+            "FFmpeg) on this processor, whose CPUID hides it; running it without valgrind"
+        "$THZ" "$@" --quiet >"$work/$name.out" 2>&1 || {
+            fail "$name (without valgrind): exit $?"
+            cat "$work/$name.out"
+        }
+        return
+    fi
     if [[ $rc -ne 0 ]]; then
         fail "$name: exit $rc"
         cat "$work/$name.out"
