@@ -51,8 +51,9 @@ typedef struct photon_phase_options {
 
 /* Computes opt->reach now, if given and not done, for the deviation maps of a run
  * (T0 > 0) that are to come: so that the memory and time estimates' pilots, which report
- * no progress, find it done. Asks opt->progress (stage "photons", channel 0, nothing done)
- * between its rounds: THZ_ERR_CANCELLED. */
+ * no progress, find it done. Reports to opt->progress (stage "prepare", done/total in
+ * objects, channel 0; emission_reach_compute) between its rounds, and stops when it asks:
+ * THZ_ERR_CANCELLED. */
 thz_status photon_phase_prepare(const thz_scene *scene, const accel *acc,
                                 const photon_phase_options *opt, thz_error *err);
 
