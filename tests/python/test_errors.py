@@ -5,6 +5,7 @@ import json
 import math
 import os
 import shutil
+import threading
 
 import numpy as np
 import pytest
@@ -203,6 +204,31 @@ def test_every_bad_scene_of_the_cli_tests(path, want):
             or path.endswith("not_an_object.json"))
     if e.value.path is not None:
         assert str(e.value) == f"{path}: {e.value.path}: {e.value.reason}"
+
+
+def test_a_fifo_scene_is_refused_without_waiting_for_a_writer(tmp_path):
+    """The loader refuses a FIFO; the package then re-read the file for the error's JSON
+    path and waited for a writer that never came."""
+    fifo = str(tmp_path / "scene.json")
+    os.mkfifo(fifo)
+    caught = {}
+
+    def load():
+        try:
+            thzmap.load_scene(fifo)
+        except thzmap.SceneError as e:
+            caught["error"] = e
+
+    t = threading.Thread(target=load)
+    t.start()
+    t.join(30)
+    if t.is_alive():
+        with open(fifo, "w"):  # the writer it waits for, so that the thread ends
+            pass
+        t.join()
+        pytest.fail("load_scene of a FIFO waited for a writer")
+    assert "FIFO" in str(caught["error"])
+    assert caught["error"].file == fifo
 
 
 def test_empty_paths_and_boolean_planes_are_argument_errors(tiny_dir, tmp_path):
