@@ -361,7 +361,11 @@ left=$(ls -A "$work/X" | grep -v -x -e batch.json -e .thzmap-batch-lock)
 [ -z "$left" ] || fail "libgomp exit left in OUTDIR: $left"
 
 # --- 101 sweep values: sweep-000 .. sweep-100, which sort in order (sweep-NN to 100) ----
-"$PY" - "$work/scene.json" "$work/tiny.json" "$work/s101.json" <<'PY'
+# Not in the sanitizer build (THZ_TEST_SCALE < 1): 101 frames took 42 s there, for a
+# check of directory names; the sweeps' code runs under the sanitizers in "a sweep
+# without keyframes" above.
+if awk -v s="${THZ_TEST_SCALE:-1}" 'BEGIN { exit !(s >= 1) }'; then
+    "$PY" - "$work/scene.json" "$work/tiny.json" "$work/s101.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
 s["sensors"][0]["resolution"] = [4, 3]
@@ -370,12 +374,13 @@ json.dump({"format": "thzmap-sequence/1", "scene": "tiny.json", "frames": 1,
            "sweep": {"objects.person.temperature_k": [300 + 0.1 * i for i in range(101)]}},
           open(sys.argv[3], "w"))
 PY
-"$THZMAP" batch "$work/s101.json" -o "$work/S101" --threads 2 --quiet > /dev/null 2>&1 ||
-    fail "101 sweep values: exit $?"
-[ "$(ls -d "$work/S101"/sweep-* | sed 's|.*/||' | sort | head -1)" = sweep-000 ] &&
-    [ "$(ls -d "$work/S101"/sweep-* | sed 's|.*/||' | sort | tail -1)" = sweep-100 ] &&
-    grep -q '"dir": "sweep-100"' "$work/S101/batch.json" ||
-    fail "101 sweep values: not sweep-000 .. sweep-100: $(ls "$work/S101" | head -3)"
+    "$THZMAP" batch "$work/s101.json" -o "$work/S101" --threads 2 --quiet > /dev/null 2>&1 ||
+        fail "101 sweep values: exit $?"
+    [ "$(ls -d "$work/S101"/sweep-* | sed 's|.*/||' | sort | head -1)" = sweep-000 ] &&
+        [ "$(ls -d "$work/S101"/sweep-* | sed 's|.*/||' | sort | tail -1)" = sweep-100 ] &&
+        grep -q '"dir": "sweep-100"' "$work/S101/batch.json" ||
+        fail "101 sweep values: not sweep-000 .. sweep-100: $(ls "$work/S101" | head -3)"
+fi
 
 # --- a warning every frame gives: said once, naming its frame, then counted ------------
 "$PY" - "$work/scene.json" "$work/few.json" <<'PY'
