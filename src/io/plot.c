@@ -21,9 +21,16 @@
 
 enum { PLOT_MAX_DEVICES = 256, PLOT_TEXT = 512, PLOT_GRID_COLOR = 15 };
 
+static double plot_timeout_base = 60.0;
+
 double plot_timeout_s(size_t cells)
 {
-    return 60.0 + 2e-6 * (double)cells;
+    return plot_timeout_base + 2e-6 * (double)cells;
+}
+
+void plot_set_timeout_base_s(double base_s)
+{
+    plot_timeout_base = base_s;
 }
 
 /* Colour stops of the perceptual "viridis" map (van der Walt and Smith, 2015), taken

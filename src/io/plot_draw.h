@@ -11,8 +11,12 @@
 #include "io/plot.h"
 
 /* How long a figure may take before its child is killed (a deadlocked GLib): far
- * beyond a normal figure (well under 1 s), plus time for the cells of a large image. */
+ * beyond a normal figure (well under 1 s; base_s, 60 s), plus time for the cells of a
+ * large image. */
 double plot_timeout_s(size_t cells);
+/* Sets that limit's base (60 s) for the figures drawn from now on; for tests only (a
+ * sanitizer build's known hang, test_plot.c), before any thread draws. */
+void plot_set_timeout_base_s(double base_s);
 
 /* plot_check_device's check, here (a child_fn: arg unused). */
 thz_status plot_check_device_here(void *arg, thz_error *err);
