@@ -313,26 +313,27 @@ static thz_status load_document(load_ctx *ctx, json_t *doc)
         st = load_render(ctx, &root);
     if (st != THZ_OK)
         return st;
-    bool ok = true;
-    size_t enclosure = scene_checks_enclosure(s, &ok);
-    if (!ok)
+    /* The meshes' closedness and volumes, for the enclosure here and the checks below. */
+    check_object *info = scene_checks_objects(s);
+    if (!info)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    size_t enclosure = scene_checks_enclosure(s, info);
     st = load_atmosphere_defaults(ctx, enclosure == SIZE_MAX ? 0.0
                                                              : s->objects[enclosure].temperature_k);
-    if (st != THZ_OK)
-        return st;
-    st = atmosphere_prepare(&s->atmosphere, s->channels, s->n_channels, ctx->err);
-    if (st != THZ_OK) {
-        thz_error_prefix(ctx->err, "%s: atmosphere: ", ctx->label);
-        return st;
+    if (st == THZ_OK) {
+        st = atmosphere_prepare(&s->atmosphere, s->channels, s->n_channels, ctx->err);
+        if (st != THZ_OK)
+            thz_error_prefix(ctx->err, "%s: atmosphere: ", ctx->label);
     }
-    st = load_check_index_energy(ctx, &root);
+    if (st == THZ_OK)
+        st = load_check_index_energy(ctx, &root);
     if (st == THZ_OK)
         st = load_warnings(ctx, &root);
     scene_check_inputs in = {.non_emitting_air = ctx->non_emitting_air,
                              .background_given = ctx->background_given};
-    if (st == THZ_OK && !scene_checks_run(s, &in))
+    if (st == THZ_OK && !scene_checks_run(s, info, &in))
         st = thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
+    free(info);
     return st;
 }
 

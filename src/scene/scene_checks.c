@@ -11,11 +11,11 @@
 #include "core/vec3.h"
 
 /* Per object: closed, signed volume (m^3; < 0: inward normals), bbox diagonal (m). */
-typedef struct check_object {
+struct check_object {
     bool closed;
     double volume_m3;
     double diagonal_m;
-} check_object;
+};
 
 static vec3 check_vertex(const thz_mesh *m, uint32_t v)
 {
@@ -54,6 +54,10 @@ static int check_mesh_closed(const thz_mesh *m)
     int closed = -1;
     if (!keys || !weld || !edges || !reversed)
         goto cleanup;
+    /* written whole (edges but for degenerate triangles' 3): map their pages at once */
+    thz_populate(keys, nv * sizeof *keys);
+    thz_populate(weld, nv * sizeof *weld);
+    thz_populate(edges, ne * sizeof *edges);
     for (size_t v = 0; v < nv; v++) {
         memcpy(keys[v].p, &m->positions[3 * v], sizeof keys[v].p);
         keys[v].index = (uint32_t)v;
@@ -131,7 +135,7 @@ static bool check_inside(const thz_mesh *m, const double p_m[3])
     return crossings % 2 == 1;
 }
 
-static check_object *check_objects(const thz_scene *s)
+check_object *scene_checks_objects(const thz_scene *s)
 {
     check_object *info = thz_calloc(s->n_objects ? s->n_objects : 1, sizeof *info);
     for (size_t i = 0; info && i < s->n_objects; i++) {
@@ -156,8 +160,7 @@ static bool check_is_enclosure(const check_object *o)
     return o->closed && o->volume_m3 < 0.0;
 }
 
-/* The innermost enclosure that contains every sensor; SIZE_MAX if none. */
-static size_t check_enclosure(const thz_scene *s, const check_object *info)
+size_t scene_checks_enclosure(const thz_scene *s, const check_object *info)
 {
     size_t best = SIZE_MAX;
     for (size_t i = 0; i < s->n_objects; i++) {
@@ -170,18 +173,6 @@ static size_t check_enclosure(const thz_scene *s, const check_object *info)
             best = i;
     }
     return best;
-}
-
-size_t scene_checks_enclosure(const thz_scene *scene, bool *ok)
-{
-    check_object *info = check_objects(scene);
-    if (!info) {
-        *ok = false;
-        return SIZE_MAX;
-    }
-    size_t e = check_enclosure(scene, info);
-    free(info);
-    return e;
 }
 
 /* ---- the checks ----------------------------------------------------------------- */
@@ -331,15 +322,10 @@ static bool check_atmosphere(thz_scene *s, const scene_check_inputs *in, size_t 
     return ok;
 }
 
-bool scene_checks_run(thz_scene *scene, const scene_check_inputs *in)
+bool scene_checks_run(thz_scene *scene, const check_object *info, const scene_check_inputs *in)
 {
-    check_object *info = check_objects(scene);
-    if (!info)
-        return false;
-    size_t enclosure = check_enclosure(scene, info);
-    bool ok = check_celsius(scene) && check_scales(scene, info, enclosure) &&
-              check_frequencies(scene) && check_sensors(scene, info) &&
-              check_atmosphere(scene, in, enclosure);
-    free(info);
-    return ok;
+    size_t enclosure = scene_checks_enclosure(scene, info);
+    return check_celsius(scene) && check_scales(scene, info, enclosure) &&
+           check_frequencies(scene) && check_sensors(scene, info) &&
+           check_atmosphere(scene, in, enclosure);
 }

@@ -30,11 +30,20 @@ typedef struct scene_check_inputs {
     bool background_given; /* background_temperature_k given */
 } scene_check_inputs;
 
+/* What the checks know of each object's mesh: closed or not, its signed volume, its size.
+ * Computed once per load (scene_checks_objects): the closedness sorts every edge, seconds
+ * for millions of triangles. */
+typedef struct check_object check_object;
+
+/* Per object of scene, for the two calls below while its meshes stay as they are; NULL on
+ * allocation failure. Freed with free(). */
+check_object *scene_checks_objects(const thz_scene *scene);
+
 /* The innermost enclosure containing every sensor, or SIZE_MAX when there is none (then
- * rays can leave the scene). Sets *ok = false on allocation failure. */
-size_t scene_checks_enclosure(const thz_scene *scene, bool *ok);
+ * rays can leave the scene). */
+size_t scene_checks_enclosure(const thz_scene *scene, const check_object *info);
 
 /* Adds the warnings (and marks misplaced sensors). False only on allocation failure. */
-bool scene_checks_run(thz_scene *scene, const scene_check_inputs *in);
+bool scene_checks_run(thz_scene *scene, const check_object *info, const scene_check_inputs *in);
 
 #endif
