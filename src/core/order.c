@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/alloc.h"
 #include "core/threads.h"
 
 static int order_cmp(const void *a, const void *b)
@@ -74,6 +75,8 @@ void order_sort_u64(uint64_t *x, size_t n)
     enum { BITS = 16, BUCKETS = 1 << BITS }; /* 11-bit digits took 6 passes, 13 % slower */
     int nt = n >= ORDER_PARALLEL_MIN ? thz_threads_all() : 1;
     uint64_t *tmp = malloc(n * sizeof *tmp);
+    if (tmp && n >= ORDER_PARALLEL_MIN)
+        thz_populate(tmp, n * sizeof *tmp); /* each pass writes it whole */
     size_t *count = tmp ? calloc((size_t)nt * BUCKETS, sizeof *count) : NULL;
     if (!count) { /* no room for the passes: the library's sort, slower but in place */
         free(tmp);

@@ -157,6 +157,7 @@ static bool mesh_import_weld(thz_mesh *mesh)
         free(pos);
         return false;
     }
+    thz_populate(rec, n * sizeof *rec); /* written whole but for unused vertices */
     for (size_t i = 0; i < 3 * mesh->n_triangles; i++)
         remap[mesh->indices[i]] = 1;
     size_t used = 0;
@@ -287,6 +288,7 @@ static thz_status mesh_import_read(const char *path, const char *name, size_t si
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while reading %zu bytes", name,
                              size);
     }
+    thz_populate(*data, size); /* the kernel's copy into fresh pages faults on each */
     size_t got = fread(*data, 1, size, f);
     int more = fgetc(f) != EOF, failed = ferror(f);
     fclose(f);
@@ -477,6 +479,8 @@ static thz_status mesh_import_receive(int fd, const char *name, thz_mesh *mesh, 
     thz_status st = primitive_mesh_alloc(mesh, (size_t)nv, (size_t)nt, err);
     if (st != THZ_OK)
         return st;
+    thz_populate(mesh->positions, 12 * (size_t)nv); /* as mesh_import_read's */
+    thz_populate(mesh->indices, 12 * (size_t)nt);
     if (!mesh_read_all(fd, mesh->positions, 12 * (size_t)nv, sizeof counts) ||
         !mesh_read_all(fd, mesh->indices, 12 * (size_t)nt, (off_t)(sizeof counts + 12 * nv))) {
         mesh_fini(mesh);
@@ -597,6 +601,8 @@ bool mesh_import_defects(const thz_mesh *mesh, mesh_defects *out)
         free(edges);
         return false;
     }
+    thz_populate(tri, nt * sizeof *tri); /* written whole, edges nearly: pages at once */
+    thz_populate(edges, 3 * nt * sizeof *edges);
     for (size_t t = 0; t < nt; t++) {
         const uint32_t *v = &mesh->indices[3 * t];
         uint32_t a = v[0], b = v[1], c = v[2], x;
