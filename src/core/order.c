@@ -70,10 +70,16 @@ static int order_u64_cmp(const void *a, const void *b)
 
 void order_sort_u64(uint64_t *x, size_t n)
 {
+    order_sort_u64_threads(x, n, thz_threads_all());
+}
+
+void order_sort_u64_threads(uint64_t *x, size_t n, int threads)
+{
     if (n < 2)
         return;
     enum { BITS = 16, BUCKETS = 1 << BITS }; /* 11-bit digits took 6 passes, 13 % slower */
-    int nt = n >= ORDER_PARALLEL_MIN ? thz_threads_all() : 1;
+    /* One thread: no OpenMP team at all (if clauses below), as a forked child needs. */
+    int nt = n >= ORDER_PARALLEL_MIN && threads > 1 ? threads : 1;
     uint64_t *tmp = malloc(n * sizeof *tmp);
     if (tmp && n >= ORDER_PARALLEL_MIN)
         thz_populate(tmp, n * sizeof *tmp); /* each pass writes it whole */
@@ -84,13 +90,13 @@ void order_sort_u64(uint64_t *x, size_t n)
         return;
     }
     uint64_t any = 0; /* the bits some key has: the digits above them need no pass */
-#pragma omp parallel for num_threads(nt) schedule(static) reduction(| : any)
+#pragma omp parallel for num_threads(nt) if (nt > 1) schedule(static) reduction(| : any)
     for (size_t i = 0; i < n; i++)
         any |= x[i];
     uint64_t *src = x, *dst = tmp;
     for (int shift = 0; shift < 64 && any >> shift; shift += BITS) {
         int moved = 0;
-#pragma omp parallel num_threads(nt)
+#pragma omp parallel num_threads(nt) if (nt > 1)
         {
             int t = 0, parts = 1;
 #ifdef _OPENMP

@@ -18,5 +18,9 @@ double order_select(double *x, size_t n, size_t k);
  * three 5 M-triangle meshes spent loading (the edges' checks). Falls back to qsort when
  * its scratch (8 bytes a key) cannot be had. */
 void order_sort_u64(uint64_t *x, size_t n);
+/* The same with at most `threads` threads. With 1 it starts no OpenMP team (a team of
+ * one, the if clause's): so in a forked child (core/child.h), where the threads of the
+ * parent's OpenMP pool do not exist and a team of two waits for them for ever. */
+void order_sort_u64_threads(uint64_t *x, size_t n, int threads);
 
 #endif

@@ -3,8 +3,9 @@
  * outward normals; quads are triangulated; vertices of points and lines are dropped
  * and -0.0 welds with 0; the winding check finds a flipped face; a format only assimp
  * reads (glTF) gives the same tetrahedron; missing, empty and garbage files and formats
- * assimp does not read either are refused with the file named. The malformed-file corpus
- * is tests/cli/test_bad_meshes.sh. */
+ * assimp does not read either are refused with the file named; a large STL's weld puts
+ * its positions in (x, y, z) order, each corner where it was, also after the process used
+ * a team of OpenMP threads. The malformed-file corpus is tests/cli/test_bad_meshes.sh. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,6 +18,7 @@
 
 #include <cmocka.h>
 
+#include "core/order.h"
 #include "scene/mesh_import.h"
 #include "scene/scene.h"
 
@@ -171,6 +173,82 @@ static void test_repeats_and_no_area(void **state)
     rmdir(dir);
 }
 
+/* Lexicographic order of two positions, as the weld defines it (floats compared). */
+static int position_cmp(const float *x, const float *y)
+{
+    for (int k = 0; k < 3; k++)
+        if (x[k] != y[k])
+            return x[k] < y[k] ? -1 : 1;
+    return 0;
+}
+
+/* 400,000 triangles of a binary STL (1.2 M corners, each its own vertex there) whose
+ * coordinates come from 9 values, negatives and -0 among them: after the import every
+ * position is unique and in (x, y, z) order, and each triangle's corners are the file's.
+ * The process first sorts with a team of two OpenMP threads: the weld runs in the import's
+ * forked child, where a team of two would wait for the parent's threads for ever (the
+ * child would be killed at its time limit and the import fail). */
+static void test_weld_order(void **state)
+{
+    (void)state;
+    size_t nk = (size_t)1 << 21;
+    uint64_t *keys = malloc(nk * sizeof *keys);
+    assert_non_null(keys);
+    uint64_t r = 12345;
+    for (size_t i = 0; i < nk; i++) {
+        r = r * 6364136223846793005u + 1442695040888963407u;
+        keys[i] = r;
+    }
+    order_sort_u64_threads(keys, nk, 2);
+    for (size_t i = 1; i < nk; i++)
+        assert_true(keys[i - 1] <= keys[i]);
+    free(keys);
+
+    enum { NT = 400000 };
+    static const float values[9] = {-2.5f, -1.0f, -0.0f, 0.0f, 1e-30f, 0.5f, 1.0f, 3.25f, 7.0f};
+    float *corners = malloc((size_t)NT * 9 * sizeof *corners);
+    assert_non_null(corners);
+    char path[] = "/tmp/thz-test-weld-XXXXXX.stl";
+    int fd = mkstemps(path, 4);
+    assert_true(fd >= 0);
+    FILE *f = fdopen(fd, "wb");
+    assert_non_null(f);
+    char header[80] = {0};
+    uint32_t n = NT;
+    assert_int_equal(fwrite(header, 1, 80, f), 80);
+    assert_int_equal(fwrite(&n, 4, 1, f), 1);
+    for (size_t t = 0; t < NT; t++) {
+        float rec[12] = {0}; /* the normal (0: assimp computes none from it), 3 corners */
+        for (int j = 0; j < 9; j++) {
+            r = r * 6364136223846793005u + 1442695040888963407u;
+            rec[3 + j] = corners[9 * t + (size_t)j] = values[(r >> 33) % 9];
+        }
+        uint16_t attr = 0;
+        assert_int_equal(fwrite(rec, sizeof rec, 1, f), 1);
+        assert_int_equal(fwrite(&attr, 2, 1, f), 1);
+    }
+    assert_int_equal(fclose(f), 0);
+
+    thz_mesh m;
+    thz_error err = {0};
+    if (mesh_import(path, NULL, &m, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    unlink(path);
+    assert_int_equal(m.n_triangles, NT);
+    assert_true(m.n_vertices <= 729);
+    for (size_t v = 1; v < m.n_vertices; v++)
+        assert_true(position_cmp(&m.positions[3 * (v - 1)], &m.positions[3 * v]) < 0);
+    for (size_t i = 0; i < 3 * m.n_vertices; i++)
+        assert_false(signbit(m.positions[i]) && m.positions[i] == 0.0f);
+    for (size_t t = 0; t < NT; t++)
+        for (int c = 0; c < 3; c++)
+            assert_int_equal(position_cmp(&m.positions[3 * (size_t)m.indices[3 * t + (size_t)c]],
+                                          &corners[9 * t + 3 * (size_t)c]),
+                             0);
+    mesh_fini(&m);
+    free(corners);
+}
+
 static void test_points_lines_negative_zero(void **state)
 {
     (void)state;
@@ -216,6 +294,7 @@ int main(void)
         cmocka_unit_test(test_bad_winding),
         cmocka_unit_test(test_repeats_and_no_area),
         cmocka_unit_test(test_points_lines_negative_zero),
+        cmocka_unit_test(test_weld_order),
         cmocka_unit_test(test_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
