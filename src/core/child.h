@@ -23,7 +23,9 @@ typedef thz_status (*child_fn)(void *arg, thz_error *err);
  * exit()), or runs longer than timeout_s (it is then killed): THZ_ERR_IO, the message
  * saying which. Calls from several threads run one child at a time (a process-wide
  * lock, released in the child, so fn may call child_run too); the child runs only the
- * calling thread, so fn must not wait for other threads of the caller. */
+ * calling thread, so fn must not wait for other threads of the caller, nor start a team
+ * of OpenMP threads: libgomp's pool is the parent's, whose threads the child lacks, and a
+ * team of two waits for them for ever (a team of one, an `if` clause's, runs). */
 thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err);
 
 /* At most this many children in a group. */
