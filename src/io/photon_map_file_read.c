@@ -42,6 +42,11 @@ static thz_status pmf_zstd_error(const pmf_reader *r, size_t code, thz_error *er
 {
     if (ZSTD_getErrorCode(code) == ZSTD_error_checksum_wrong)
         return pmf_corrupt(r, "checksum mismatch", err);
+    /* zstd's own window buffer, allocated as the first frame is read: the machine's fault,
+     * not the file's (test_alloc_fail found it called corrupt, exit status 2) */
+    if (ZSTD_getErrorCode(code) == ZSTD_error_memory_allocation)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory while reading photon map %s",
+                             r->path);
     return pmf_corrupt(r, ZSTD_getErrorName(code), err);
 }
 
