@@ -8,6 +8,10 @@
  *   THZ_FAIL_ALLOC_AT=N       call N returns NULL (ENOMEM); 0 or unset: none fails
  *   THZ_FAIL_ALLOC_REPORT=F   at exit, append "PID COUNT FAILED" to file F: the calls
  *                             counted in this process and whether call N failed in it
+ *   THZ_FAIL_ALLOC_IN=NAME:K  instead, the Kth call made from the code of the loaded
+ *                             library whose file name contains NAME fails (calls from it
+ *                             counted apart; "libzstd.so:2"); for a library's own
+ *                             allocations, which a change elsewhere would move in N
  *   THZ_FAIL_ALLOC_BACKTRACE=1  print the stack of the failing call to stderr
  * (or run under gdb with a breakpoint on failalloc_hit).
  * A forked child inherits the count and goes on numbering from there; it reports too
@@ -135,14 +139,48 @@ EXPORT __attribute__((noinline)) void failalloc_hit(uint64_t n)
     }
 }
 
+/* THZ_FAIL_ALLOC_IN: the library's mapped range, its calls counted so far, and K. */
+static uintptr_t in_lo, in_hi;
+static atomic_uint_least64_t in_counted;
+static uint64_t in_k;
+
+/* dl_iterate_phdr's callback: the range of the first object whose name contains data. */
+static int find_in(struct dl_phdr_info *info, size_t size, void *data)
+{
+    (void)size;
+    if (!info->dlpi_name || !strstr(info->dlpi_name, (const char *)data))
+        return 0;
+    uintptr_t lo = UINTPTR_MAX, hi = 0;
+    for (int i = 0; i < info->dlpi_phnum; i++) {
+        const ElfW(Phdr) *ph = &info->dlpi_phdr[i];
+        if (ph->p_type != PT_LOAD)
+            continue;
+        uintptr_t a = info->dlpi_addr + ph->p_vaddr;
+        lo = a < lo ? a : lo;
+        hi = a + ph->p_memsz > hi ? a + ph->p_memsz : hi;
+    }
+    in_lo = lo;
+    in_hi = hi;
+    return 1;
+}
+
 /* Set while the calling thread is inside pthread_getattr_np for the sanitizer (below). */
 static _Thread_local int exempt;
 
-/* True when this call is the one to fail. */
-static int should_fail(void)
+/* True when this call (from code at caller) is the one to fail. */
+static int should_fail(const void *caller)
 {
     if (!atomic_load_explicit(&armed, memory_order_relaxed) || exempt)
         return 0;
+    if (in_k) {
+        uintptr_t c = (uintptr_t)caller;
+        if (c < in_lo || c >= in_hi ||
+            atomic_fetch_add_explicit(&in_counted, 1, memory_order_relaxed) + 1 != in_k)
+            return 0;
+        atomic_store(&failed, 1);
+        failalloc_hit(in_k);
+        return 1;
+    }
     uint64_t n = atomic_fetch_add_explicit(&counted, 1, memory_order_relaxed) + 1;
     if (fail_at && n == fail_at) {
         atomic_store(&failed, 1);
@@ -178,6 +216,15 @@ __attribute__((constructor)) static void failalloc_init(void)
     }
     const char *at = getenv("THZ_FAIL_ALLOC_AT");
     fail_at = at ? strtoull(at, NULL, 10) : 0;
+    const char *in = getenv("THZ_FAIL_ALLOC_IN");
+    const char *colon = in ? strrchr(in, ':') : NULL;
+    if (colon && colon > in && colon - in < 256) {
+        char name[256];
+        memcpy(name, in, (size_t)(colon - in));
+        name[colon - in] = '\0';
+        dl_iterate_phdr(find_in, name);
+        in_k = in_hi > in_lo ? strtoull(colon + 1, NULL, 10) : 0;
+    }
     atomic_store(&armed, 1);
 }
 
@@ -224,7 +271,7 @@ EXPORT void *malloc(size_t n)
         if (!real_malloc)
             return boot_alloc(n);
     }
-    if (should_fail()) {
+    if (should_fail(__builtin_return_address(0))) {
         errno = ENOMEM;
         return NULL;
     }
@@ -238,7 +285,7 @@ EXPORT void *calloc(size_t n, size_t size)
         if (!real_calloc)
             return boot_alloc(n * size); /* the arena is zeroed */
     }
-    if (should_fail()) {
+    if (should_fail(__builtin_return_address(0))) {
         errno = ENOMEM;
         return NULL;
     }
@@ -256,7 +303,7 @@ EXPORT void *realloc(void *p, size_t n)
     }
     if (!real_realloc)
         resolve();
-    if (should_fail()) {
+    if (should_fail(__builtin_return_address(0))) {
         errno = ENOMEM;
         return NULL;
     }
@@ -285,7 +332,7 @@ EXPORT int posix_memalign(void **out, size_t align, size_t n)
 {
     if (!real_posix_memalign)
         resolve();
-    if (should_fail())
+    if (should_fail(__builtin_return_address(0)))
         return ENOMEM;
     return real_posix_memalign(out, align, n);
 }
@@ -294,7 +341,7 @@ EXPORT void *aligned_alloc(size_t align, size_t n)
 {
     if (!real_aligned_alloc)
         resolve();
-    if (should_fail()) {
+    if (should_fail(__builtin_return_address(0))) {
         errno = ENOMEM;
         return NULL;
     }
@@ -305,7 +352,7 @@ EXPORT void *memalign(size_t align, size_t n)
 {
     if (!real_memalign)
         resolve();
-    if (should_fail()) {
+    if (should_fail(__builtin_return_address(0))) {
         errno = ENOMEM;
         return NULL;
     }
