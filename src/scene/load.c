@@ -331,7 +331,7 @@ static thz_status load_document(load_ctx *ctx, json_t *doc)
         st = load_warnings(ctx, &root);
     scene_check_inputs in = {.non_emitting_air = ctx->non_emitting_air,
                              .background_given = ctx->background_given};
-    if (st == THZ_OK && !scene_checks_run(s, info, &in))
+    if (st == THZ_OK && !scene_checks_run(s, info, enclosure, &in))
         st = thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
     free(info);
     return st;

@@ -322,9 +322,9 @@ static bool check_atmosphere(thz_scene *s, const scene_check_inputs *in, size_t 
     return ok;
 }
 
-bool scene_checks_run(thz_scene *scene, const check_object *info, const scene_check_inputs *in)
+bool scene_checks_run(thz_scene *scene, const check_object *info, size_t enclosure,
+                      const scene_check_inputs *in)
 {
-    size_t enclosure = scene_checks_enclosure(scene, info);
     return check_celsius(scene) && check_scales(scene, info, enclosure) &&
            check_frequencies(scene) && check_sensors(scene, info) &&
            check_atmosphere(scene, in, enclosure);

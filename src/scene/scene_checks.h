@@ -43,7 +43,9 @@ check_object *scene_checks_objects(const thz_scene *scene);
  * rays can leave the scene). */
 size_t scene_checks_enclosure(const thz_scene *scene, const check_object *info);
 
-/* Adds the warnings (and marks misplaced sensors). False only on allocation failure. */
-bool scene_checks_run(thz_scene *scene, const check_object *info, const scene_check_inputs *in);
+/* Adds the warnings (and marks misplaced sensors); enclosure: scene_checks_enclosure's.
+ * False only on allocation failure. */
+bool scene_checks_run(thz_scene *scene, const check_object *info, size_t enclosure,
+                      const scene_check_inputs *in);
 
 #endif

@@ -172,6 +172,7 @@ static int should_fail(const void *caller)
 {
     if (!atomic_load_explicit(&armed, memory_order_relaxed) || exempt)
         return 0;
+    uint64_t n = atomic_fetch_add_explicit(&counted, 1, memory_order_relaxed) + 1;
     if (in_k) {
         uintptr_t c = (uintptr_t)caller;
         if (c < in_lo || c >= in_hi ||
@@ -181,7 +182,6 @@ static int should_fail(const void *caller)
         failalloc_hit(in_k);
         return 1;
     }
-    uint64_t n = atomic_fetch_add_explicit(&counted, 1, memory_order_relaxed) + 1;
     if (fail_at && n == fail_at) {
         atomic_store(&failed, 1);
         failalloc_hit(n);
