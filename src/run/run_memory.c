@@ -1,5 +1,6 @@
 /* The memory a run needs, estimated before it starts, and the refusal of a run that
  * would not fit (run.h: run_memory). */
+#include <math.h>
 #include <stdio.h>
 
 #include "core/alloc.h"
@@ -9,6 +10,25 @@
 #include "sensor/images.h"
 #include "sensor/measure.h"
 #include "sensor/render.h"
+
+/* The photons per channel whose maps would fit in limit beside the rest of the run: the
+ * maps' bytes grow in proportion to the photons (records per photon, the build's scratch
+ * a fixed share of them), so per_channel scaled by the room over the maps' bytes, less 3 %
+ * (the process's own memory, in the room, moves a little from run to run), rounded down to
+ * two significant digits; 0 if none fit. */
+static uint64_t run_photons_that_fit(uint64_t per_channel, const run_memory *need, double limit)
+{
+    double room = limit - (double)need->image_bytes - (double)need->held_bytes;
+    if (!(room > 0.0) || need->photon_bytes == 0)
+        return 0;
+    double fit = 0.97 * (double)per_channel * room / (double)need->photon_bytes;
+    if (!(fit >= 1.0))
+        return 0;
+    double unit = 1.0;
+    while (fit >= 100.0 * unit)
+        unit *= 10.0;
+    return (uint64_t)(floor(fit / unit) * unit);
+}
 
 thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err)
 {
@@ -27,8 +47,12 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
         snprintf(key, sizeof key, "objects[%zu].shape (%zu triangles) or the number of objects",
                  big, scene->n_objects ? scene->objects[big].mesh.n_triangles : (size_t)0);
     } else if (need->photon_bytes >= need->image_bytes) {
-        snprintf(key, sizeof key, "photons.per_channel (now %llu; or --photons)",
-                 (unsigned long long)scene->photons.per_channel);
+        uint64_t fit = run_photons_that_fit(scene->photons.per_channel, need, limit);
+        char most[64] = "";
+        if (fit > 0)
+            snprintf(most, sizeof most, "; at most about %llu fit", (unsigned long long)fit);
+        snprintf(key, sizeof key, "photons.per_channel (now %llu%s; or --photons)",
+                 (unsigned long long)scene->photons.per_channel, most);
     } else {
         size_t big = 0;
         for (size_t s = 1; s < scene->n_sensors; s++)

@@ -8,7 +8,10 @@
 # at 3 x 10^6 photons per channel, holds at most 1.5 x its largest map above the bare
 # render: one channel's map at a time and the index build's scratch of 3/8 of it
 # (measured: 1.41 x; 2.04 x with the build's former second array as large as the map).
-# The peak is the child's maxrss (getrusage), so this runs without sanitizers.
+# A run too large for the memory it may have (here ulimit -v) is refused with the photon
+# count that would fit, and that count is indeed accepted (10 % more refused).
+# The peak is the child's maxrss (getrusage), and the sanitizers reserve more address
+# space than ulimit -v allows, so this runs without sanitizers.
 # argv: path to the thzmap binary, repository directory.
 set -u
 THZMAP=$1
@@ -50,6 +53,42 @@ PY
 bare=$(peak render "$S" -o "$work/bare" --integrator path) || exit 1
 full=$(peak render "$S" -o "$work/full" --photon-map "$M") || exit 1
 sim=$(peak simulate "$S" -o "$work/sim2" --photons 3e6) || exit 1
+
+# --- a run too large is refused with the photons per channel that would fit ------------
+AS_KIB=2500000 # ulimit -v: about 2.4 GiB for this process's address space
+fits() { # PHOTONS: prints the count the refusal names, or nothing if the run was accepted
+    (ulimit -v $AS_KIB; exec "$THZMAP" simulate "$S" -o "$work/big" --photons "$1" \
+        --threads 2) > /dev/null 2> "$work/big.err" &
+    local pid=$!
+    # accepted runs print their estimate once the memory check passed: stop them there
+    for _ in $(seq 600); do
+        kill -0 $pid 2>/dev/null || break
+        grep -q 'estimate:' "$work/big.err" && { kill -INT $pid; break; }
+        sleep 0.1
+    done
+    wait $pid
+    echo "exit $?" >> "$work/big.err"
+    sed -n 's/.*; at most about \([0-9]*\) fit;.*/\1/p' "$work/big.err"
+}
+n=$(fits 1e9)
+grep -q 'would need' "$work/big.err" || { echo "FAIL: 1e9 photons not refused: $(cat "$work/big.err")"; exit 1; }
+grep -q 'exit 2$' "$work/big.err" || { echo "FAIL: the refusal's exit status: $(cat "$work/big.err")"; exit 1; }
+if [[ ! $n =~ ^[1-9][0-9]*$ ]] || (( n >= 1000000000 )); then
+    echo "FAIL: the refusal names no count that fits: $(cat "$work/big.err")"
+    exit 1
+fi
+m=$(fits $((n + n / 10)))
+grep -q 'would need' "$work/big.err" || { echo "FAIL: $((n + n / 10)) photons (10 % over $n) not refused"; exit 1; }
+# the same count within rounding (the process's own memory moves a little between runs)
+(( m >= n - n / 10 && m <= n + n / 10 )) ||
+    { echo "FAIL: the refusal of $((n + n / 10)) names $m, that of 1e9 $n"; exit 1; }
+fits "$n" > /dev/null
+if grep -q 'would need' "$work/big.err" || ! grep -q 'estimate:' "$work/big.err"; then
+    echo "FAIL: $n photons, the count the refusal named, not accepted: $(cat "$work/big.err")"
+    exit 1
+fi
+[ -z "$(ls -A "$work/big" 2>/dev/null)" ] || { echo "FAIL: the refused or interrupted runs left files"; exit 1; }
+echo "refused 1e9 photons a channel under ulimit -v $AS_KIB KiB; $n fit and start"
 
 python3 - "$work" "$bare" "$full" "$sim" <<'PY'
 import json, sys
