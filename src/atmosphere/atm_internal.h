@@ -31,6 +31,21 @@ void atm_lines_parts(const atm_lines_data *lines, double freq_hz, atm_alpha_part
  * of alpha; INFINITY if no line shapes the band. */
 double atm_lines_grid_step_hz(const atm_lines_data *lines, double lo_hz, double hi_hz);
 
+/* alpha of the `lines` model over one band [lo_hz, hi_hz] and an eighth of its width
+ * beyond each end (a table's grid and midpoints), as atm_lines_parts sums it but faster:
+ * the lines near each piece of the band summed at each frequency, the sums of the others,
+ * smooth there, as Chebyshev series fitted once (atm_lines_band.c). points: about how many
+ * frequencies will be asked (the table's first grid), which sets the number of pieces. */
+typedef struct atm_lines_band atm_lines_band;
+thz_status atm_lines_band_create(const atm_lines_data *lines, double lo_hz, double hi_hz,
+                                 size_t points, atm_lines_band **out, thz_error *err);
+void atm_lines_band_destroy(atm_lines_band *band);
+/* alpha in 1/m at freq_hz (outside the band's interval: summed directly). */
+double atm_lines_band_alpha_per_m(const atm_lines_band *band, double freq_hz);
+/* The band's pieces, the lines summed directly over all pieces (a line near two pieces
+ * counts twice), and the lines in all. */
+void atm_lines_band_counts(const atm_lines_band *band, size_t *pieces, size_t *near, size_t *all);
+
 /* The Voigt profile (area 1, in 1/Hz units of its arguments) at offset x from the
  * centre, for Lorentz HWHM gamma_l and Doppler HWHM gamma_d; Weideman's (1994)
  * 32-term rational series for the Faddeeva function (atm_voigt.c). */

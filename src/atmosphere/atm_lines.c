@@ -32,57 +32,21 @@
 
 #include "atmosphere/atm_catalog.h"
 #include "atmosphere/atm_internal.h"
+#include "atmosphere/atm_lines_data.h"
 #include "core/alloc.h"
 #include "core/data_dir.h"
 #include "core/file.h"
 #include "core/path.h"
 
 #define LINE_MIN_RELATIVE 1e-10
-#define H2O_CUTOFF_GHZ 750.0     /* 25 cm^-1: MT_CKD's line cut-off */
-#define O2_DRY_AIR_VMR 0.20946   /* O2 fraction of dry air */
-#define VOIGT_DOPPLER_RATIO 1e-3 /* Voigt when gamma_D > this times gamma_L */
-#define VOIGT_WINDOW                                                                               \
-    3000.0                              /* ... within this many gamma_D of the centre; beyond,     \
-                                           Voigt = Lorentz to ~3e-7 relative */
+#define O2_DRY_AIR_VMR 0.20946          /* O2 fraction of dry air */
+#define VOIGT_DOPPLER_RATIO 1e-3        /* Voigt when gamma_D > this times gamma_L */
 #define COUPLED_MATCH_GHZ 0.005         /* .par O2 lines this close to a coupled line are it */
 #define H_OVER_K_K_PER_GHZ 0.0479924307 /* h / k in K/GHz (CODATA 2018) */
 #define BOLTZMANN_HPA_CM3 1.380649e-19  /* k in hPa cm^3 / K: n[cm^-3] = p[hPa] / (k T) */
 #define AMU_KG 1.66053906660e-27
 #define MT_CKD_P_REF_HPA 1013.0
 #define MT_CKD_T_REF_K 296.0
-
-/* A line at the air's state. */
-typedef struct lbl_line {
-    double nu_ghz;      /* shifted centre */
-    double amp;         /* n S(T) / pi in cm^-1 GHz: alpha = amp * shape [1/GHz] */
-    double inv_vvh0;    /* 1 / (nu0 tanh(h nu0 / 2kT)), the VVH normalisation */
-    double gamma_ghz;   /* Lorentz HWHM */
-    double gamma_d_ghz; /* Doppler HWHM */
-    double y, g;        /* mixing: Y (dimensionless) and G (1 for uncoupled) */
-    double pedestal;    /* cut-off shapes: L(cutoff) */
-    bool voigt;
-} lbl_line;
-
-typedef enum lbl_shape { SHAPE_VVH_CUTOFF, SHAPE_VVH, SHAPE_GROSS, SHAPE_COUPLED } lbl_shape;
-
-typedef struct lbl_species {
-    lbl_shape shape;
-    size_t n;
-    lbl_line *lines; /* sorted by nu_ghz */
-} lbl_species;
-
-struct atm_lines_data {
-    atm_air_state air;
-    double half_h_over_kt; /* h / (2 k T) in 1/GHz */
-    lbl_species h2o, o2, o2_coupled;
-    bool continuum;
-    /* MT_CKD on a uniform grid from 0 in steps of cont_step_cm1 */
-    size_t n_cont;
-    double cont_step_cm1;
-    double *c_foreign, *c_self, *self_texp;
-    double n_h2o, n_foreign, n_ref; /* cm^-3 */
-    double dry_hpa;
-};
 
 /* ---- Lines at the air's state ---------------------------------------------------- */
 
@@ -100,19 +64,6 @@ static int compare_lines(const void *a, const void *b)
 {
     double x = ((const lbl_line *)a)->nu_ghz, y = ((const lbl_line *)b)->nu_ghz;
     return (x > y) - (x < y);
-}
-
-static double lorentz(double d, double gamma)
-{
-    return gamma / (d * d + gamma * gamma);
-}
-
-/* The resonant core, scaled like lorentz(): pi times the area-normalised profile. */
-static double core(const struct lbl_line *l, double d)
-{
-    if (l->voigt && fabs(d) < VOIGT_WINDOW * l->gamma_d_ghz)
-        return M_PI * atm_voigt(d, l->gamma_ghz, l->gamma_d_ghz);
-    return lorentz(d, l->gamma_ghz);
 }
 
 /* Converts the raw catalogue into lines at the state: strengths, widths, shifts and
@@ -309,6 +260,11 @@ static double dry_continuum_per_cm(const atm_lines_data *d, double f_ghz)
     return 0.1820 * f_ghz * n2 / ATM_NEPER_TO_DB * 1e-5; /* dB/km -> 1/cm */
 }
 
+double atm_lines_continua_per_cm(const atm_lines_data *d, double f_ghz)
+{
+    return continuum_per_cm(d, f_ghz) + dry_continuum_per_cm(d, f_ghz);
+}
+
 /* ---- Line sums ---------------------------------------------------------------- */
 
 /* First index with nu_ghz >= f. */
@@ -334,40 +290,8 @@ static double species_sum(const lbl_species *sp, double f, double vvh)
         i0 = lower_bound(sp, f - H2O_CUTOFF_GHZ);
         i1 = lower_bound(sp, f + H2O_CUTOFF_GHZ);
     }
-    for (size_t i = i0; i < i1; i++) {
-        const lbl_line *l = &sp->lines[i];
-        double d1 = f - l->nu_ghz, d2 = f + l->nu_ghz;
-        double g = l->gamma_ghz;
-        double term;
-        switch (sp->shape) {
-        case SHAPE_COUPLED:
-            term = (g * l->g + d1 * l->y) / (d1 * d1 + g * g) +
-                   (g * l->g - d2 * l->y) / (d2 * d2 + g * g);
-            break;
-        case SHAPE_VVH_CUTOFF:
-            term = 0.0;
-            if (fabs(d1) < H2O_CUTOFF_GHZ)
-                term += core(l, d1) - l->pedestal;
-            if (d2 < H2O_CUTOFF_GHZ)
-                term += lorentz(d2, g) - l->pedestal;
-            break;
-        case SHAPE_GROSS: {
-            /* Gross: (1/pi) 4 nu^2 gamma / ((nu^2 - nu0^2)^2 + 4 nu^2 gamma^2); where
-             * Doppler matters, times Voigt / Lorentz of the resonant core */
-            double dd = f * f - l->nu_ghz * l->nu_ghz;
-            term = 4.0 * f * f * g / (dd * dd + 4.0 * f * f * g * g);
-            if (l->voigt)
-                term *= core(l, d1) / lorentz(d1, g);
-            sum += l->amp * term;
-            continue;
-        }
-        case SHAPE_VVH:
-        default:
-            term = core(l, d1) + lorentz(d2, g);
-            break;
-        }
-        sum += l->amp * term * vvh * l->inv_vvh0;
-    }
+    for (size_t i = i0; i < i1; i++)
+        sum += lbl_line_alpha(sp->shape, &sp->lines[i], f, vvh);
     return sum;
 }
 

@@ -13,8 +13,9 @@
 
 /* Tabulation: the grid step starts from the line widths in the band (see
  * model_first_step_hz) and is halved until the cubic interpolation agrees with
- * direct evaluation to TABLE_TOLERANCE at every grid midpoint: relative to alpha there,
- * or to TABLE_FLOOR times the band's largest alpha where alpha is smaller. Below that
+ * evaluation at the point (for `lines`, its band's: atm_lines_band.c) to TABLE_TOLERANCE
+ * at every grid midpoint: relative to alpha there, or to TABLE_FLOOR times the band's
+ * largest alpha where alpha is smaller. Below that
  * floor the relative error is not worth chasing: an error of 1e-5 x 1e-9 of the band's
  * peak changes a transmittance exp(-alpha d) by 1e-14 alpha_peak d relative, and in near
  * vacuum (1e-10 hPa) the Voigt wings far from a line, there 1e-12 of its peak, carry
@@ -218,8 +219,17 @@ static double table_freq_hz(const atm_band_table *t, double x)
  * 2i - 1 (odd) and the previous midpoint i + 1/2 the new point 2i (even): those are
  * copied where the frequency is the same to the bit, the rest (the ends, and any
  * point where rounding moved the frequency) evaluated directly. */
-static void fill_table(const thz_atmosphere *atm, atm_band_table *t, const atm_band_table *prev,
-                       const double *prev_mid)
+/* alpha at freq_hz for a band's table: through the lines model's band (near lines summed,
+ * far ones fitted) where there is one, else directly. */
+static double band_alpha_per_m(const thz_atmosphere *atm, const atm_lines_band *band,
+                               double freq_hz)
+{
+    return band ? atm_lines_band_alpha_per_m(band, freq_hz)
+                : atmosphere_alpha_direct_per_m(atm, freq_hz);
+}
+
+static void fill_table(const thz_atmosphere *atm, const atm_lines_band *band, atm_band_table *t,
+                       const atm_band_table *prev, const double *prev_mid)
 {
     long n = (long)t->n;
 #pragma omp parallel for schedule(dynamic, 64) num_threads(thz_threads_all())
@@ -232,14 +242,15 @@ static void fill_table(const thz_atmosphere *atm, atm_band_table *t, const atm_b
                  table_freq_hz(prev, (double)i + 0.5) == f)
             t->alpha_per_m[j] = prev_mid[i];
         else
-            t->alpha_per_m[j] = atmosphere_alpha_direct_per_m(atm, f);
+            t->alpha_per_m[j] = band_alpha_per_m(atm, band, f);
     }
 }
 
-/* Largest difference between interpolation and direct evaluation at the midpoints
+/* Largest difference between interpolation and evaluation at the midpoints
  * i + 1/2, 1 <= i < n - 2, of the grid, relative to the larger of alpha there and
- * TABLE_FLOOR times the grid's largest |alpha|; the direct values go to mid[i]. */
-static double table_midpoint_error(const thz_atmosphere *atm, const atm_band_table *t, double *mid)
+ * TABLE_FLOOR times the grid's largest |alpha|; the evaluated values go to mid[i]. */
+static double table_midpoint_error(const thz_atmosphere *atm, const atm_lines_band *band,
+                                   const atm_band_table *t, double *mid)
 {
     long n = (long)t->n;
     double peak = 0.0;
@@ -250,7 +261,7 @@ static double table_midpoint_error(const thz_atmosphere *atm, const atm_band_tab
 #pragma omp parallel for schedule(dynamic, 64) reduction(max : worst) num_threads(thz_threads_all())
     for (long i = 1; i < n - 2; i++) {
         double f = table_freq_hz(t, (double)i + 0.5);
-        double direct = atmosphere_alpha_direct_per_m(atm, f);
+        double direct = band_alpha_per_m(atm, band, f);
         mid[i] = direct;
         double rel = fabs(table_eval(t, f) - direct) / fmax(fabs(direct), floor_per_m);
         if (rel > worst)
@@ -276,8 +287,16 @@ static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, 
     double step = fmin(model_first_step_hz(atm, lo_hz, hi_hz), (hi_hz - lo_hz) / 32.0);
     atm_band_table prev = {0};
     double *prev_mid = NULL, *mid = NULL;
-    thz_status st = THZ_OK;
     memset(t, 0, sizeof *t);
+    /* the lines' band, its pieces set by the first grid's points (model_first_step_hz
+     * is INFINITY where no line shapes the band; the step above is finite) */
+    atm_lines_band *band = NULL;
+    size_t points = (size_t)fmin(ceil((hi_hz - lo_hz) / step) + 3.0, (double)TABLE_MAX_POINTS);
+    thz_status st = atm->model == ATM_LINES
+                        ? atm_lines_band_create(atm->lines, lo_hz, hi_hz, points, &band, err)
+                        : THZ_OK;
+    if (st != THZ_OK)
+        return st;
     for (int refine = 0;; refine++) {
         double n_real = ceil((hi_hz - lo_hz) / step) + 3.0;
         if (n_real > (double)TABLE_MAX_POINTS) {
@@ -297,7 +316,7 @@ static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, 
             st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory tabulating the atmosphere");
             break;
         }
-        fill_table(atm, t, &prev, prev_mid);
+        fill_table(atm, band, t, &prev, prev_mid);
         size_t bad = table_first_nonfinite(t);
         if (bad < t->n) {
             st = thz_error_set(err, THZ_ERR_INPUT,
@@ -312,7 +331,7 @@ static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, 
         free(prev_mid);
         prev.alpha_per_m = NULL;
         prev_mid = NULL;
-        double e = table_midpoint_error(atm, t, mid);
+        double e = table_midpoint_error(atm, band, t, mid);
         if (e <= TABLE_TOLERANCE)
             break;
         if (refine == TABLE_MAX_REFINEMENTS) {
@@ -331,6 +350,7 @@ static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, 
     free(mid);
     free(prev_mid);
     free(prev.alpha_per_m);
+    atm_lines_band_destroy(band);
     return st;
 }
 
