@@ -298,7 +298,7 @@ static double species_sum(const lbl_species *sp, double f, double vvh)
 void atm_lines_parts(const atm_lines_data *d, double freq_hz, atm_alpha_parts *parts)
 {
     double f = freq_hz * 1e-9;
-    double vvh = f * tanh(f * d->half_h_over_kt);
+    double vvh = lbl_vvh(d, f);
     memset(parts, 0, sizeof *parts);
     parts->h2o_lines_per_m = 100.0 * species_sum(&d->h2o, f, vvh);
     parts->o2_per_m = 100.0 * (species_sum(&d->o2, f, vvh) + species_sum(&d->o2_coupled, f, vvh));

@@ -74,11 +74,6 @@ static bool line_near(lbl_shape shape, const lbl_line *l, double c, double reach
     return false;
 }
 
-static double band_vvh(const atm_lines_data *d, double f)
-{
-    return f * tanh(f * d->half_h_over_kt);
-}
-
 /* The node x_k = cos(pi (k + 1/2) / N) of the interval c +- hw, in GHz. */
 static double node_ghz(double c, double hw, int k)
 {
@@ -112,7 +107,7 @@ static double chebyshev_eval(const double *coef, double x)
 /* The far lines' alpha in 1/cm at f GHz: every line but the band's near ones. */
 static double band_far_sum(const atm_lines_band *b, double f)
 {
-    double vvh = band_vvh(b->d, f), sum = 0.0;
+    double vvh = lbl_vvh(b->d, f), sum = 0.0;
     size_t k = 0;
     for (uint32_t s = 0; s < SPECIES; s++) {
         const lbl_species *sp = b->species[s];
@@ -156,7 +151,7 @@ static void piece_fit(atm_lines_band *b, size_t p)
     size_t n_mine = b->piece_start[p + 1] - b->piece_start[p];
     double at_node[NODES];
     for (int k = 0; k < NODES; k++) {
-        double f = node_ghz(piece_centre(b, p), b->piece_hw_ghz, k), vvh = band_vvh(b->d, f);
+        double f = node_ghz(piece_centre(b, p), b->piece_hw_ghz, k), vvh = lbl_vvh(b->d, f);
         double sum = 0.0;
         size_t m = 0;
         for (size_t j = 0; j < b->n_near; j++) {
@@ -284,7 +279,7 @@ double atm_lines_band_alpha_per_m(const atm_lines_band *b, double freq_hz)
     double sum =
         chebyshev_eval(b->coef, x) +
         chebyshev_eval(b->piece_coef + p * NODES, (f - piece_centre(b, p)) / b->piece_hw_ghz);
-    double vvh = band_vvh(b->d, f);
+    double vvh = lbl_vvh(b->d, f);
     for (size_t k = b->piece_start[p]; k < b->piece_start[p + 1]; k++) {
         lbl_shape shape;
         const lbl_line *l = band_line(b, b->near[b->piece_near[k]], &shape);

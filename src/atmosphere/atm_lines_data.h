@@ -61,6 +61,13 @@ static inline double core(const struct lbl_line *l, double d)
     return lorentz(d, l->gamma_ghz);
 }
 
+/* The Van Vleck-Huber factor f tanh(h f / 2kT) at f GHz, which the lines' shapes but
+ * Gross's carry (lbl_line_alpha's vvh). */
+static inline double lbl_vvh(const atm_lines_data *d, double f)
+{
+    return f * tanh(f * d->half_h_over_kt);
+}
+
 /* Line l's alpha in 1/cm at f GHz, for a species of the given shape; vvh = f tanh(h f /
  * 2kT). */
 static inline double lbl_line_alpha(lbl_shape shape, const lbl_line *l, double f, double vvh)

@@ -15,12 +15,11 @@
  * model_first_step_hz) and is halved until the cubic interpolation agrees with
  * evaluation at the point (for `lines`, its band's: atm_lines_band.c) to TABLE_TOLERANCE
  * at every grid midpoint: relative to alpha there, or to TABLE_FLOOR times the band's
- * largest alpha where alpha is smaller. Below that
- * floor the relative error is not worth chasing: an error of 1e-5 x 1e-9 of the band's
- * peak changes a transmittance exp(-alpha d) by 1e-14 alpha_peak d relative, and in near
- * vacuum (1e-10 hPa) the Voigt wings far from a line, there 1e-12 of its peak, carry
- * the series' own rounding: a step ever smaller never met 1e-5 relative, and the band
- * was refused after minutes of halving. */
+ * largest alpha where alpha is smaller. Below that floor the relative error is not worth chasing:
+ * an error of 1e-5 x 1e-9 of the band's peak changes a transmittance exp(-alpha d) by 1e-14
+ * alpha_peak d relative, and in near vacuum (1e-10 hPa) the Voigt wings far from a line, there
+ * 1e-12 of its peak, carry the series' own rounding: a step ever smaller never met 1e-5 relative,
+ * and the band was refused after minutes of halving. */
 #define TABLE_TOLERANCE 1e-5
 #define TABLE_FLOOR 1e-9
 #define TABLE_MAX_POINTS ((size_t)4000000)
@@ -213,12 +212,6 @@ static double table_freq_hz(const atm_band_table *t, double x)
     return t->lo_hz + x * t->step_hz;
 }
 
-/* Fills t->alpha_per_m. After a halving (prev: the previous table, prev_mid: direct
- * alpha at its midpoints, or NULL on the first pass) the grid starts half a step
- * lower, lo - h/2 = (lo - h) + h/2, so the previous grid point i is the new point
- * 2i - 1 (odd) and the previous midpoint i + 1/2 the new point 2i (even): those are
- * copied where the frequency is the same to the bit, the rest (the ends, and any
- * point where rounding moved the frequency) evaluated directly. */
 /* alpha at freq_hz for a band's table: through the lines model's band (near lines summed,
  * far ones fitted) where there is one, else directly. */
 static double band_alpha_per_m(const thz_atmosphere *atm, const atm_lines_band *band,
@@ -228,6 +221,12 @@ static double band_alpha_per_m(const thz_atmosphere *atm, const atm_lines_band *
                 : atmosphere_alpha_direct_per_m(atm, freq_hz);
 }
 
+/* Fills t->alpha_per_m. After a halving (prev: the previous table, prev_mid: the
+ * evaluated alpha at its midpoints, or NULL on the first pass) the grid starts half a step
+ * lower, lo - h/2 = (lo - h) + h/2, so the previous grid point i is the new point
+ * 2i - 1 (odd) and the previous midpoint i + 1/2 the new point 2i (even): those are
+ * copied where the frequency is the same to the bit, the rest (the ends, and any
+ * point where rounding moved the frequency) evaluated (band_alpha_per_m). */
 static void fill_table(const thz_atmosphere *atm, const atm_lines_band *band, atm_band_table *t,
                        const atm_band_table *prev, const double *prev_mid)
 {
