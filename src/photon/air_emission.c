@@ -418,15 +418,3 @@ void air_emission_surface_share(const air_emission *a, emission_photon *out)
     if (a && a->active)
         out->power_w_per_hz = a->p_surfaces > 0.0 ? out->power_w_per_hz / a->p_surfaces : 0.0;
 }
-
-bool air_emission_sample(const air_emission *a, const emission_table *t, rng_stream *rng,
-                         emission_photon *out)
-{
-    bool surface;
-    bool ok = air_emission_draw_class(a, rng, out, &surface);
-    if (!surface)
-        return ok;
-    ok = emission_sample(t, rng, out);
-    air_emission_surface_share(a, out);
-    return ok;
-}

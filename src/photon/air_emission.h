@@ -105,15 +105,11 @@ thz_status air_emission_init(air_emission *a, const thz_scene *scene, const acce
                              double t0_k, thz_error *err);
 void air_emission_fini(air_emission *a);
 
-/* Draws one photon of any class (see above); the same contract as emission_sample,
- * which it calls for surface photons. Allocates nothing. */
-bool air_emission_sample(const air_emission *a, const emission_table *t, rng_stream *rng,
-                         emission_photon *out);
-
-/* air_emission_sample in two parts around the surface photon's own draws, for a caller
- * that draws many photons' at once: the class draw (and an air or boundary photon whole:
- * *surface false, the return as air_emission_sample's), then, after emission_sample's
- * draws for a surface photon, its power's share (air_emission_surface_share). */
+/* One photon of any class (see above), in two parts around a surface photon's own draws
+ * (the caller draws many photons' at once): the class draw, and an air or boundary
+ * photon whole (*surface false; the return as emission_sample's: false if nothing could
+ * be drawn); then, after emission_sample's draws for a surface photon, its power's share
+ * (air_emission_surface_share). Allocate nothing. */
 bool air_emission_draw_class(const air_emission *a, rng_stream *rng, emission_photon *out,
                              bool *surface);
 void air_emission_surface_share(const air_emission *a, emission_photon *out);

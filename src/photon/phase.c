@@ -47,7 +47,7 @@ typedef struct phase_fire_args {
 } phase_fire_args;
 
 /* Emits n <= RNG_MANY photons from their streams rng[j] (power 0 where nothing is emitted),
- * as air_emission_sample does one at a time, stage by stage over the photons: each one's
+ * stage by stage over the photons: each one's
  * class (surface, air or boundary: the last two drawn whole), every surface photon's
  * frequency, then each one's source, point and angle, then all their directions. The
  * frequencies and directions are loops the compiler vectorises, which the same arithmetic

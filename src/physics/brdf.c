@@ -176,14 +176,6 @@ static double brdf_complement(const brdf_lobe *l, vec3 w)
     return c > 0.0 ? c : 0.0;
 }
 
-double brdf_lobe_albedo(const brdf_lobe *l, const brdf_frame *f, vec3 w)
-{
-    if (!l->ward)
-        return 0.0;
-    vec3 lw = brdf_local(f, w);
-    return l->scale * brdf_ward_albedo_at(l->ward, lw.z, atan2(lw.y, lw.x));
-}
-
 double brdf_eval(const brdf_lobe *l, const brdf_frame *f, vec3 wi, vec3 wo)
 {
     const optics_point *o = l->o;

@@ -73,7 +73,4 @@ bool brdf_sample(const brdf_lobe *l, const brdf_frame *f, vec3 wi, optics_unifor
  * frequencies. */
 double brdf_pdf(const brdf_lobe *l, const brdf_frame *f, vec3 wi, vec3 wo);
 
-/* Ward's lobe part alone: s a_W(w), the directional albedo of the glossy part. */
-double brdf_lobe_albedo(const brdf_lobe *l, const brdf_frame *f, vec3 w);
-
 #endif
