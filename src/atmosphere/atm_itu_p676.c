@@ -41,7 +41,7 @@ static thz_status read_lines(const char *dir, const char *name, const char *pref
     size_t cols[ITU_COEFFS + 1];
     st = csv_column_index(&csv, "f0_GHz", &cols[0], err);
     for (int i = 0; st == THZ_OK && i < ITU_COEFFS; i++) {
-        char name_i[8];
+        char name_i[16];
         snprintf(name_i, sizeof name_i, "%s%d", prefix, i + 1);
         st = csv_column_index(&csv, name_i, &cols[i + 1], err);
     }
