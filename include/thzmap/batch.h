@@ -58,8 +58,9 @@ typedef struct thz_frame_info {
 THZ_API thz_status thz_sequence_frame(const thz_sequence *seq, size_t i, thz_frame_info *out);
 
 /* The frame's scene as JSON text (compact, keys in document order), written into buf like
- * snprintf: returns the length without the NUL (0 when i is out of range). Its relative
- * file paths are relative to the directory of the frame's scene file. */
+ * snprintf: returns the length without the NUL (0, and an empty text in buf, when i is out
+ * of range). Its relative file paths are relative to the directory of the frame's scene
+ * file. */
 THZ_API size_t thz_sequence_frame_json(const thz_sequence *seq, size_t i, char *buf, size_t size);
 
 /* Loads frame i's scene (*out owns it), within the sequence's root if it has one. */

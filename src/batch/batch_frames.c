@@ -72,8 +72,11 @@ thz_status thz_sequence_frame(const thz_sequence *seq, size_t i, thz_frame_info 
 
 size_t thz_sequence_frame_json(const thz_sequence *seq, size_t i, char *buf, size_t size)
 {
-    if (!seq || i >= seq->n_frames || !seq->frame_json[i])
+    if (!seq || i >= seq->n_frames || !seq->frame_json[i]) {
+        if (buf && size > 0) /* an empty text, not what the buffer held */
+            buf[0] = '\0';
         return 0;
+    }
     size_t len = strlen(seq->frame_json[i]);
     if (buf && size > 0) {
         size_t n = len < size - 1 ? len : size - 1;

@@ -433,6 +433,11 @@ int main(int argc, char **argv)
     CHECK(thz_integrator_known("path") && !thz_integrator_known("magic"), "integrator names");
     CHECK(thz_integrator_needs_photons("final-gather") && !thz_integrator_needs_photons("path"),
           "needs photons");
+    CHECK(thz_integrator_has_passes("final-gather") && thz_integrator_has_passes("path") &&
+              !thz_integrator_has_passes("photon-map") && !thz_integrator_has_passes("magic"),
+          "has passes");
+    CHECK(thz_mpi_supported() == THZ_TEST_MPI_BUILT, "thz_mpi_supported() %d, the build %d",
+          thz_mpi_supported(), THZ_TEST_MPI_BUILT);
 
     thz_context *ctx = thz_context_create();
     thz_run_settings settings = {.integrator = "magic"};

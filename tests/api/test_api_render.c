@@ -99,6 +99,22 @@ int main(int argc, char **argv)
         CHECK(thz_image_plane(image, THZ_PLANE_RADIANCE, &bands) && bands == 2, "radiance bands");
         CHECK(thz_image_plane(image, THZ_PLANE_VISUAL_RGB, &bands) && bands == 3, "visual bands");
         compare_with_files(image, path);
+        if (s == 0) { /* written alone: the same files, its figures, nothing of a run */
+            char one[4200], file[4300];
+            snprintf(one, sizeof one, "%s/image-only", dir);
+            REQUIRE_OK(thz_image_write(ctx, image, one, &err), &err);
+            compare_with_files(image, one);
+            const char *want[] = {"cam.band-01.png", "cam.band-02.png", "cam.spectra.png",
+                                  "cam.visual.png", "cam.radiance.hdr"};
+            for (size_t k = 0; k < sizeof want / sizeof *want; k++) {
+                snprintf(file, sizeof file, "%s/%s", one, want[k]);
+                CHECK(access(file, F_OK) == 0, "thz_image_write did not write %s", file);
+            }
+            snprintf(file, sizeof file, "%s/summary.json", one);
+            CHECK(access(file, F_OK) != 0, "thz_image_write wrote a run's %s", file);
+            snprintf(file, sizeof file, "%s/side.radiance.img", one);
+            CHECK(access(file, F_OK) != 0, "thz_image_write wrote the other sensor's %s", file);
+        }
         thz_image_destroy(image);
     }
 

@@ -1,0 +1,152 @@
+/* Sequences through the API (thzmap/batch.h; scene-format.md "Sequences, sweeps and
+ * movies"), without running them: frame numbering over a sweep (sweep-major), each frame's
+ * time, directory and input hash, its scene as JSON text and as a loaded scene, with
+ * keyframe values interpolated linearly in time and held beyond the ends, and frames out
+ * of range refused. The values are worked out by hand from the files below.
+ * argv: the thzmap binary (unused), the repository. */
+#include <math.h>
+
+#include "api_test.h"
+
+static const char scene_json[] =
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"seq-test\",\n"
+    " \"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.05}],\n"
+    " \"materials\": {\"wall\": {\"reflectivity\": 0.2}},\n"
+    " \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.05},\n"
+    " \"objects\": [\n"
+    "  {\"name\": \"room\", \"type\": \"solid\", \"material\": \"wall\", \"temperature_k\": 295,\n"
+    "   \"shape\": {\"type\": \"box\", \"size_m\": [4, 4, 4], \"inward\": true}},\n"
+    "  {\"name\": \"plate\", \"type\": \"solid\", \"material\": \"wall\", \"temperature_k\": 300,\n"
+    "   \"shape\": {\"type\": \"box\", \"size_m\": [0.2, 0.2, 0.2]},\n"
+    "   \"transform\": {\"translate_m\": [0, 0.5, 0]}}],\n"
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -1.5, 0], \"look_at_m\": [0, 0, 0],\n"
+    "   \"fov_deg\": 60, \"resolution\": [8, 6]}],\n"
+    " \"photons\": {\"per_channel\": 1000, \"seed\": 1}}\n";
+
+/* 5 frames at 2 fps (t = 0, 0.5, 1, 1.5, 2 s); the plate moves from x = -1 to x = 1
+ * between t = 0.5 and 1.5 s and warms from 300 to 320 K; held outside; two sweep values
+ * of the air's attenuation: 10 frames in all. */
+static const char sequence_json[] =
+    "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"fps\": 2, \"frames\": 5,\n"
+    " \"keyframes\": [\n"
+    "  {\"time_s\": 0.5, \"objects\": {\"plate\": {\n"
+    "     \"transform\": {\"translate_m\": [-1, 0.5, 0]}, \"temperature_k\": 300}}},\n"
+    "  {\"time_s\": 1.5, \"objects\": {\"plate\": {\n"
+    "     \"transform\": {\"translate_m\": [1, 0.5, 0]}, \"temperature_k\": 320}}}],\n"
+    " \"sweep\": {\"atmosphere.attenuation_per_m\": [0.01, 0.2]}}\n";
+
+/* The plate's centre x (its bounding box's middle) and temperature in frame i's scene. */
+static void plate_in_frame(const thz_sequence *seq, size_t i, double *x, double *t_k)
+{
+    thz_error err = {0};
+    thz_scene *scene = NULL;
+    *x = NAN;
+    *t_k = NAN;
+    thz_status st = thz_sequence_frame_scene(seq, i, &scene, &err);
+    CHECK(st == THZ_OK, "frame %zu's scene: %s", i, err.message);
+    if (st != THZ_OK)
+        return;
+    long k = thz_scene_object_index(scene, "plate");
+    thz_object_info oi;
+    if (k >= 0 && thz_scene_object(scene, (size_t)k, &oi) == THZ_OK) {
+        *x = 0.5 * (oi.bbox_min_m[0] + oi.bbox_max_m[0]);
+        *t_k = oi.temperature_k;
+    }
+    thz_scene_destroy(scene);
+}
+
+int main(int argc, char **argv)
+{
+    (void)argc;
+    (void)argv;
+    char dir[4096], path[4200];
+    test_temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/scene.json", dir);
+    test_write_file(path, scene_json);
+    snprintf(path, sizeof path, "%s/sequence.json", dir);
+    test_write_file(path, sequence_json);
+
+    thz_error err = {0};
+    thz_sequence *seq = NULL;
+    REQUIRE_OK(thz_sequence_load(path, &seq, &err), &err);
+    CHECK(thz_sequence_frame_count(seq) == 10 && thz_sequence_sweep_count(seq) == 2 &&
+              thz_sequence_frames_per_sweep(seq) == 5,
+          "%zu frames, %zu sweep values, %zu per value", thz_sequence_frame_count(seq),
+          thz_sequence_sweep_count(seq), thz_sequence_frames_per_sweep(seq));
+
+    /* numbering: sweep-major, times i / fps, directories by sweep and frame */
+    thz_frame_info fi[10];
+    for (size_t i = 0; i < 10; i++) {
+        REQUIRE_OK(thz_sequence_frame(seq, i, &fi[i]), &err);
+        char want[64];
+        snprintf(want, sizeof want, "sweep-%02zu/frame-%05zu", i / 5, i % 5);
+        CHECK(fi[i].sweep == i / 5 && fi[i].index == i % 5, "frame %zu: sweep %zu, index %zu", i,
+              fi[i].sweep, fi[i].index);
+        CHECK(fi[i].time_s == (double)(i % 5) / 2.0, "frame %zu at %g s", i, fi[i].time_s);
+        CHECK(fi[i].dir && strcmp(fi[i].dir, want) == 0, "frame %zu's directory %s, not %s", i,
+              fi[i].dir ? fi[i].dir : "(null)", want);
+    }
+    /* the hash names the inputs: frames 0 and 1 (the plate held at its first keyframe)
+     * have the same scene, and so frames 3 and 4 (held at the last); every other pair
+     * differs, across the sweep too */
+    for (size_t i = 0; i < 10; i++)
+        for (size_t j = i + 1; j < 10; j++) {
+            int same_scene = j == i + 1 && (i % 5 == 0 || i % 5 == 3);
+            CHECK((fi[i].hash == fi[j].hash) == same_scene, "frames %zu and %zu: hashes %s", i, j,
+                  fi[i].hash == fi[j].hash ? "equal" : "differ");
+        }
+    thz_frame_info none = {.index = 99};
+    CHECK(thz_sequence_frame(seq, 10, &none) == THZ_ERR_INPUT, "frame 10 of 10 accepted");
+
+    /* interpolation: held before 0.5 s and after 1.5 s, linear between */
+    const double want_x[5] = {-1.0, -1.0, 0.0, 1.0, 1.0};
+    const double want_t[5] = {300.0, 300.0, 310.0, 320.0, 320.0};
+    for (size_t i = 0; i < 10; i++) {
+        double x, t_k;
+        plate_in_frame(seq, i, &x, &t_k);
+        CHECK(fabs(x - want_x[i % 5]) < 1e-6 && fabs(t_k - want_t[i % 5]) < 1e-9,
+              "frame %zu: plate at x = %g m, %g K; expected %g m, %g K", i, x, t_k, want_x[i % 5],
+              want_t[i % 5]);
+    }
+
+    /* the JSON text: snprintf's contract, the sweep's value in place, loadable as the scene */
+    size_t n = thz_sequence_frame_json(seq, 7, NULL, 0);
+    CHECK(n > 100, "frame 7's JSON: %zu characters", n);
+    char *text = malloc(n + 1);
+    char small[16];
+    CHECK(thz_sequence_frame_json(seq, 7, small, sizeof small) == n && small[15] == '\0' &&
+              strlen(small) == 15,
+          "a short buffer: truncated with a NUL, the full length returned");
+    CHECK(text && thz_sequence_frame_json(seq, 7, text, n + 1) == n && strlen(text) == n,
+          "the full text");
+    if (text) {
+        CHECK(strncmp(text, small, 15) == 0, "the truncated text is not the text's start");
+        CHECK(strstr(text, "\"attenuation_per_m\":0.2") != NULL,
+              "frame 7 (sweep 1) lacks the sweep's attenuation 0.2: %.400s", text);
+        CHECK(strchr(text, '\n') == NULL, "not compact: %.200s", text);
+        thz_scene *scene = NULL;
+        REQUIRE_OK(thz_scene_load_string(text, dir, "frame-7.json", &scene, &err), &err);
+        long k = thz_scene_object_index(scene, "plate");
+        thz_object_info oi;
+        CHECK(k >= 0 && thz_scene_object(scene, (size_t)k, &oi) == THZ_OK &&
+                  fabs(0.5 * (oi.bbox_min_m[0] + oi.bbox_max_m[0])) < 1e-6 &&
+                  oi.temperature_k == 310.0,
+              "frame 7 from its JSON text: the plate not at x = 0 m, 310 K");
+        thz_scene_destroy(scene);
+    }
+    free(text);
+    CHECK(thz_sequence_frame_json(seq, 10, small, sizeof small) == 0 && small[0] == '\0',
+          "frame 10's JSON: not refused");
+
+    thz_scene *bad = NULL;
+    CHECK(thz_sequence_frame_scene(seq, 10, &bad, &err) == THZ_ERR_INPUT && bad == NULL,
+          "frame 10's scene: not refused");
+    thz_sequence_destroy(seq);
+
+    if (test_failures == 0)
+        test_remove_dir(dir);
+    else
+        fprintf(stderr, "kept %s\n", dir);
+    printf("%s: %d failures\n", argv[0], test_failures);
+    return test_failures ? 1 : 0;
+}
