@@ -23,8 +23,8 @@
 
 /* A black corridor at 300 K seen along y through alpha = 0.2 /m of the paper's
  * non-emitting air (the closed forms below are Beer-Lambert's), a grey box (R = 0.5)
- * in it, and a second camera outside the corridor looking at its outside (back faces of
- * the inward box). */
+ * in it, a second camera outside the corridor looking at its outside (back faces of
+ * the inward box), and a third beside it looking away (at nothing). */
 static const char *render_json =
     "{\"format\": \"thzmap-scene/1\", \"name\": \"render-unit\","
     " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.02}],"
@@ -42,6 +42,8 @@ static const char *render_json =
     "   {\"name\": \"inside\", \"position_m\": [0, -2.9, 0], \"direction\": [0, 1, 0],"
     "    \"fov_deg\": 6, \"resolution\": [5, 4], \"oversampling\": 3},"
     "   {\"name\": \"outside\", \"position_m\": [0, -5, 0], \"direction\": [0, 1, 0],"
+    "    \"fov_deg\": 5, \"resolution\": [4, 4]},"
+    "   {\"name\": \"away\", \"position_m\": [0, -5, 0], \"direction\": [0, -1, 0],"
     "    \"fov_deg\": 5, \"resolution\": [4, 4]}],"
     " \"photons\": {\"per_channel\": 20000, \"seed\": 2},"
     " \"render\": {\"integrator\": \"photon-map\"}}";
@@ -137,6 +139,48 @@ static void test_back_faces_are_black_and_counted(void **state)
         assert_int_equal(img.object_id[p], 0); /* the truth still names what is there */
     }
     sensor_images_fini(&img);
+}
+
+/* The same for every integrator, from a map of L (T0 = 0) and of the deviation L - B0
+ * (T0 = 290 K; path's T0 likewise): a sample that sees a back face first, or nothing
+ * (the air does not emit), is 0 whatever the reference, the deviation's -B0 there and
+ * the air's (tau - 1) B0 on the way cancelling B0 (to rounding: 1e-9 of B0, where the
+ * emission of the corridor's 300 K would be 3 % of it). Final-gather's direct back face
+ * and path's escape with a reference were run by no test. */
+static void test_back_faces_every_integrator(void **state)
+{
+    fixture *f = *state;
+    const thz_integrator kinds[] = {INTEGRATOR_PHOTON_MAP, INTEGRATOR_FINAL_GATHER,
+                                    INTEGRATOR_PATH};
+    const double t0s[] = {0.0, 290.0};
+    double b0 = ident_band_planck(&f->scene->channels[0], 290.0);
+    for (size_t t = 0; t < 2; t++) {
+        photon_map *map = NULL;
+        photon_phase_options po = {.threads = 2, .reference_temperature_k = t0s[t]};
+        thz_error err;
+        assert_int_equal(photon_phase_run(f->scene, f->acc, 0, &po, &map, NULL, &err), THZ_OK);
+        for (size_t k = 0; k < 6; k++) {
+            size_t sensor = 1 + k / 3; /* outside, then away */
+            f->scene->render.integrator = kinds[k % 3];
+            const thz_sensor *s = &f->scene->sensors[sensor];
+            sensor_images img;
+            render_stats st;
+            assert_int_equal(sensor_images_init(&img, s->columns, s->rows, 1, 1, NULL), THZ_OK);
+            render_options ro = {.threads = 2, .path_t0_set = true, .path_t0_k = t0s[t]};
+            assert_int_equal(
+                render_sensor_channel(f->scene, f->acc, map, 0, sensor, &img, &ro, &st, &err),
+                THZ_OK);
+            assert_int_equal(sensor == 1 ? st.back_face_samples : st.escaped_samples, st.samples);
+            for (size_t p = 0; p < 16; p++)
+                if (!(fabs(img.radiance[p]) <= 1e-9 * b0))
+                    fail_msg("%s, %s, T0 = %g K, pixel %zu: %g W/(m^2 sr Hz), not 0",
+                             render_integrator_name(kinds[k % 3]), s->name, t0s[t], p,
+                             img.radiance[p]);
+            sensor_images_fini(&img);
+        }
+        photon_map_destroy(map);
+    }
+    f->scene->render.integrator = INTEGRATOR_PHOTON_MAP;
 }
 
 static void test_thread_count_does_not_matter(void **state)
@@ -326,6 +370,7 @@ int main(void)
         cmocka_unit_test(test_back_faces_are_black_and_counted),
         cmocka_unit_test(test_thread_count_does_not_matter),
         cmocka_unit_test(test_cancel),
+        cmocka_unit_test(test_back_faces_every_integrator),
         cmocka_unit_test(test_integrator_table),
         cmocka_unit_test(test_passes_are_deterministic),
         cmocka_unit_test(test_stderr_in_kelvin),
