@@ -26,6 +26,7 @@
 #include "accel/accel.h"
 #include "physics/channel.h"
 #include "physics/planck.h"
+#include "physics/spectrum.h"
 #include "photon/emission.h"
 #include "photon/phase.h"
 #include "photon_scenes.h"
@@ -620,6 +621,83 @@ static void test_index_explicit_solid(void **state)
     }
 }
 
+/* (1 - R(nu)) B_nu(T0) of a material, for a band mean. */
+typedef struct absorb_ctx {
+    const thz_spectrum *reflectivity;
+    double t0_k;
+} absorb_ctx;
+
+static double absorb_b0_at(double freq_hz, void *ctx)
+{
+    const absorb_ctx *c = ctx;
+    return (1.0 - spectrum_eval(c->reflectivity, freq_hz)) * planck_radiance(freq_hz, c->t0_k);
+}
+
+/* A one-sided 0.5 m cube with an explicit emissivity 0.3 and a reflectivity that varies
+ * over the band (0.1, 0.5, 0.2 at 0.30, 0.35, 0.40 THz), at 300 K, in a black room at
+ * T0 = 100 K (no source there): one source eps B(T) - (1 - R(nu)) B0 whose two terms
+ * change their ratio across the band (EMISSION_EPS_ABSORB without constant optics, which
+ * no other test fires). Fired power, from the first hits: pi S (eps Bbar(T) - the band
+ * mean of (1 - R) B0). */
+static void test_spectral_explicit_solid(void **state)
+{
+    (void)state;
+    const double eps = 0.3, t_k = 300.0, t0 = 100.0, side = 0.5;
+    const char *json =
+        "{\"format\": \"thzmap-scene/1\", \"name\": \"spectral-eps\","
+        " \"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.1}],"
+        " \"materials\": {\"black\": {\"reflectivity\": 0.0},"
+        "   \"tile\": {\"reflectivity\": [[0.30, 0.1], [0.35, 0.5], [0.40, 0.2]],"
+        "              \"emissivity\": 0.3}},"
+        " \"objects\": [{\"name\": \"room\", \"type\": \"solid\", \"material\": \"black\","
+        "   \"temperature_k\": 100, \"shape\": {\"type\": \"box\", \"size_m\": [4, 4, 4],"
+        "   \"inward\": true}},"
+        "  {\"name\": \"cube\", \"type\": \"solid\", \"material\": \"tile\","
+        "   \"temperature_k\": 300, \"shape\": {\"type\": \"box\", \"size_m\": [0.5, 0.5, 0.5]}}],"
+        " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -1.5, 0],"
+        "   \"look_at_m\": [0, 0, 0], \"fov_deg\": 40, \"resolution\": [4, 4]}],"
+        " \"photons\": {\"per_channel\": 1000, \"seed\": 3}}";
+    thz_scene *s;
+    accel *acc;
+    thz_error err;
+    if (scene_load_string(json, ".", "spectral-eps", &s, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    if (accel_create(s, &acc, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    emission_table t;
+    if (emission_table_init(&t, s, acc, 0, 1000, t0, NULL, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    assert_int_equal(t.n_sources, 1);
+    assert_int_equal(t.sources[0].kind, EMISSION_EPS_ABSORB);
+    emission_table_fini(&t);
+
+    const thz_material *tile = &s->materials[s->objects[1].material];
+    absorb_ctx ac = {.reflectivity = &tile->reflectivity, .t0_k = t0};
+    double absorbed = channel_band_mean(&s->channels[0], absorb_b0_at, &ac);
+    double area = 6.0 * side * side;
+    double expected = M_PI * area * (eps * band_b(s, t_k) - absorbed);
+    uint64_t photons = ps_scaled(200000);
+    s->photons.per_channel = photons;
+    photon_phase_options opt = {.threads = 2, .reference_temperature_k = t0};
+    photon_map *map;
+    photon_stats st;
+    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+    power_moments m = first_hits(map);
+    double tol = five_sigma(&m, photons);
+    printf("# spectral solid, explicit eps: (1 - R) B0 band mean %.4e, fired %.6e W/Hz, "
+           "expected %.6e (tolerance %.2e); %zu negative and %zu positive photons\n",
+           absorbed, st.fired_power_w_per_hz, expected, tol, m.n_neg, m.n_pos);
+    assert_int_equal(m.n_neg + m.n_pos, photons); /* every photon hits the room */
+    assert_true(fabs(st.fired_power_w_per_hz - expected) <= tol);
+    /* a factor 2, a sign, or R taken at the centre for the whole band (1 - R = 0.5 there;
+     * the band's (1 - R) B0 is 0.54 of its B0) would fail: the last moves the power 10 % */
+    assert_true(tol < 0.05 * fabs(expected));
+    assert_balance(&st, m.sum_abs);
+    photon_map_destroy(map);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
 /* The memory estimate's pilot fires the same kind of map: a deviation map stores a
  * different number of hits per photon than the paper's (its sources are other objects). */
 static void test_estimate_bytes(void **state)
@@ -656,7 +734,7 @@ int main(void)
         cmocka_unit_test(test_fired_power),          cmocka_unit_test(test_explicit_shell),
         cmocka_unit_test(test_absorbing_air),        cmocka_unit_test(test_open_boundary),
         cmocka_unit_test(test_threads_identical),    cmocka_unit_test(test_estimate_bytes),
-        cmocka_unit_test(test_index_explicit_solid),
+        cmocka_unit_test(test_index_explicit_solid), cmocka_unit_test(test_spectral_explicit_solid),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
