@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include "core/rng.h"
+#include "physics/fresnel.h"
 #include "physics/optics.h"
 
 static double test_scale(void)
@@ -251,6 +252,42 @@ static void check_histogram(const optics_point *o, sample_fn sample, mu_fn x, ui
     assert_true(chi2 < 60.0);
 }
 
+/* A shell with an index and `reflectivity` or `attenuation_per_m` beside it
+ * (scene-format.md: "given beside an index override it"): R(theta) is the given constant
+ * and T(theta) the slab's, capped at 1 - R; alpha_M replaces 4 pi k nu / c inside the
+ * slab. The slab itself is test_fresnel_brdf's; here the overrides. */
+static void test_index_shell_overrides(void **state)
+{
+    (void)state;
+    const double n = 1.5, k = 0.02, t = 1e-3, nu = 0.5e12, r_given = 0.5, alpha_given = 40.0;
+    optics_point plain = {.has_index = true, .n = n, .k = k, .freq_hz = nu, .thickness_m = t};
+    optics_point r_over = plain, a_over = plain;
+    r_over.reflectivity_given = true;
+    r_over.reflectivity = r_given;
+    a_over.attenuation_given = true;
+    a_over.attenuation_per_m = alpha_given;
+    assert_true(optics_reflectance_varies(&plain));
+    assert_false(optics_reflectance_varies(&r_over));
+    int capped = 0, uncapped = 0;
+    for (int i = 1; i <= 100; i++) {
+        double mu = i / 100.0;
+        double t_slab = optics_transmission(&plain, mu);
+        assert_true(optics_reflectance(&r_over, mu) == r_given);
+        double expect_t = t_slab < 1.0 - r_given ? t_slab : 1.0 - r_given;
+        assert_true(fabs(optics_transmission(&r_over, mu) - expect_t) <= 1e-15);
+        assert_true(fabs(optics_absorption(&r_over, mu) - (1.0 - r_given - expect_t)) <= 1e-15);
+        capped += t_slab > 1.0 - r_given;
+        uncapped += t_slab < 1.0 - r_given;
+        double rs, ts;
+        fresnel_slab(n, k, mu, alpha_given, t, &rs, &ts);
+        assert_true(fabs(optics_reflectance(&a_over, mu) - rs) <= 1e-15);
+        assert_true(fabs(optics_transmission(&a_over, mu) - ts) <= 1e-15);
+    }
+    assert_true(capped > 0 && uncapped > 0); /* both sides of the cap */
+    /* 4 pi k nu / c = 419 /m: the given 40 /m lets through more at normal incidence */
+    assert_true(optics_transmission(&a_over, 1.0) > optics_transmission(&plain, 1.0) + 0.2);
+}
+
 static void test_sample_transmission(void **state)
 {
     (void)state;
@@ -320,10 +357,11 @@ static void test_sample_zero(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_pointwise),           cmocka_unit_test(test_mean_transmission_e3),
-        cmocka_unit_test(test_e3_pieces),           cmocka_unit_test(test_means_capped),
-        cmocka_unit_test(test_kirchhoff_violation), cmocka_unit_test(test_sample_transmission),
-        cmocka_unit_test(test_sample_emission),     cmocka_unit_test(test_sample_zero),
+        cmocka_unit_test(test_index_shell_overrides), cmocka_unit_test(test_pointwise),
+        cmocka_unit_test(test_mean_transmission_e3),  cmocka_unit_test(test_e3_pieces),
+        cmocka_unit_test(test_means_capped),          cmocka_unit_test(test_kirchhoff_violation),
+        cmocka_unit_test(test_sample_transmission),   cmocka_unit_test(test_sample_emission),
+        cmocka_unit_test(test_sample_zero),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
