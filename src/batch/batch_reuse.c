@@ -13,7 +13,7 @@
 #include "batch/batch_internal.h"
 #include "core/alloc.h"
 #include "core/error.h"
-#include "thzmap/atmosphere.h"
+#include "scene/scene_hash.h"
 
 /* Frame f's scene text without its "sensors" (NULL when out of memory). */
 static char *reuse_scene_without_sensors(const thz_sequence *seq, size_t f)
@@ -64,18 +64,19 @@ void batch_photon_cache_keep(batch_photon_cache *c, size_t base, thz_scene **sce
     *run = NULL;
 }
 
-/* The air's temperature of a scene, which defaults to the temperature of the enclosure
- * around the sensors (scene-format.md "atmosphere"), so moving a sensor can change it;
- * -1 when unknown. */
-static double reuse_air_temperature_k(const thz_scene *scene)
+/* Whether photons fired for `base` are the ones `scene` would fire: the same fingerprint
+ * of everything a photon map depends on (scene_hash.h; what render checks a map file
+ * against). The two texts differ only in their sensors, but the sensors decide the air's
+ * default temperature and background, the enclosure's around them (scene-format.md), so
+ * a sensor moving into another enclosure changes the map. (Only the air state of the
+ * itu-p676 and lines models was compared before: a constant or table model's emitting air
+ * was reused at the first enclosure's temperature.) */
+static bool reuse_fits(const thz_scene *scene, const thz_scene *base)
 {
-    thz_atm *atm = NULL;
-    thz_atm_info info = {0};
-    if (thz_atm_from_scene(scene, &atm, NULL) != THZ_OK)
-        return -1.0;
-    thz_atm_get_info(atm, &info);
-    thz_atm_destroy(atm);
-    return info.has_air ? info.temperature_k : 0.0;
+    scene_hash a, b;
+    scene_hash_compute(scene, &a);
+    scene_hash_compute(base, &b);
+    return a.geometry == b.geometry && a.optics == b.optics && a.channels == b.channels;
 }
 
 thz_status batch_render_reused(thz_context *ctx, const thz_sequence *seq, batch_photon_cache *c,
@@ -98,8 +99,7 @@ thz_status batch_render_reused(thz_context *ctx, const thz_sequence *seq, batch_
     }
     thz_run_settings settings;
     thz_run_settings_init(&settings);
-    double air_k = reuse_air_temperature_k(scene);
-    if (air_k < 0.0 || air_k != reuse_air_temperature_k(c->scene)) {
+    if (!reuse_fits(scene, c->scene)) {
         *fired = 1; /* the sensors moved into another enclosure: fire this frame's own */
         return thz_simulate(ctx, scene, &settings, run, err);
     }

@@ -288,6 +288,48 @@ b = json.load(open(sys.argv[1]))
 assert b["complete"] and b["photon_phases_fired"] <= 1, b
 PY
 
+# --- a sensor moving into another enclosure: that frame fires its own photons --------
+# The air's temperature defaults to the enclosure around the sensors (scene-format.md),
+# so the two rooms' air emits at 290 and 310 K: a frame reusing the first room's photons
+# would see the wrong air. Each frame equals simulate's of its own scene.
+cat > "$work/rooms.json" <<'JSON'
+{"format": "thzmap-scene/1", "name": "two-rooms",
+ "channels": [{"frequency_thz": 0.5, "relative_width": 0.05}],
+ "materials": {"wall": {"reflectivity": 0.3}},
+ "atmosphere": {"model": "constant", "attenuation_per_m": 0.5},
+ "objects": [
+  {"name": "a", "type": "solid", "material": "wall", "temperature_k": 290,
+   "shape": {"type": "box", "size_m": [1.5, 1.5, 1.5], "inward": true},
+   "transform": {"translate_m": [-2, 0, 0]}},
+  {"name": "b", "type": "solid", "material": "wall", "temperature_k": 310,
+   "shape": {"type": "box", "size_m": [1.5, 1.5, 1.5], "inward": true},
+   "transform": {"translate_m": [2, 0, 0]}}],
+ "sensors": [{"name": "cam", "position_m": [-2, -0.5, 0], "direction": [0, 1, 0],
+              "fov_deg": 40, "resolution": [6, 4]}],
+ "photons": {"per_channel": 20000, "seed": 5},
+ "render": {"integrator": "photon-map"}}
+JSON
+echo '{"format": "thzmap-sequence/1", "scene": "rooms.json", "fps": 1, "frames": 2,
+ "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [-2, -0.5, 0]}}},
+               {"time_s": 1, "sensors": {"cam": {"position_m": [2, -0.5, 0]}}}]}' > "$work/rooms-seq.json"
+"$THZMAP" batch "$work/rooms-seq.json" -o "$work/R" --threads 2 --quiet > /dev/null 2>&1 ||
+    fail "two-room batch: exit $?"
+"$PY" - "$work/R" <<'PY' || fail "two-room batch: the frame in the other room must fire its own photons"
+import json, sys
+b = json.load(open(sys.argv[1] + "/batch.json"))
+assert b["photon_phases_fired"] == 2, b
+assert [f["photons"] for f in b["frames"]] == ["fired", "fired"], b["frames"]
+for i in range(2):
+    f = json.load(open(f"{sys.argv[1]}/frame-{i:05d}/frame.json"))
+    assert f["photons_reused_from_frame"] is None, (i, f["photons_reused_from_frame"])
+    json.dump(f["scene"], open(f"{sys.argv[1]}/../rooms-frame-{i}.json", "w"))
+PY
+for i in 0 1; do
+    "$THZMAP" simulate "$work/rooms-frame-$i.json" -o "$work/RS$i" --threads 1 --quiet > /dev/null ||
+        fail "simulate of two-room frame $i"
+    same_files "$work/RS$i" "$work/R/frame-0000$i" "two-room frame $i against simulate's"
+done
+
 # --- a plain list of scenes, and progress within a frame ---------------------------
 # frame 0 is scene.json, frame 1 sub/b.json (paths relative to the sequence file): as
 # they are, frame 1 equal to simulate's; the movies have 2 frames; a changed sub/b.json
