@@ -17,30 +17,35 @@ static const char scene_json[] =
     "  {\"name\": \"room\", \"type\": \"solid\", \"material\": \"wall\", \"temperature_k\": 295,\n"
     "   \"shape\": {\"type\": \"box\", \"size_m\": [4, 4, 4], \"inward\": true}},\n"
     "  {\"name\": \"plate\", \"type\": \"solid\", \"material\": \"wall\", \"temperature_k\": 300,\n"
-    "   \"shape\": {\"type\": \"box\", \"size_m\": [0.2, 0.2, 0.2]},\n"
+    "   \"shape\": {\"type\": \"box\", \"size_m\": [0.4, 0.1, 0.1]},\n"
     "   \"transform\": {\"translate_m\": [0, 0.5, 0]}}],\n"
     " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -1.5, 0], \"look_at_m\": [0, 0, 0],\n"
     "   \"fov_deg\": 60, \"resolution\": [8, 6]}],\n"
     " \"photons\": {\"per_channel\": 1000, \"seed\": 1}}\n";
 
-/* 5 frames at 2 fps (t = 0, 0.5, 1, 1.5, 2 s); the plate moves from x = -1 to x = 1
- * between t = 0.5 and 1.5 s and warms from 300 to 320 K; held outside; two sweep values
- * of the air's attenuation: 10 frames in all. */
+/* 5 frames at 2 fps (t = 0, 0.5, 1, 1.5, 2 s); the plate (0.4 m along x, 0.1 m across)
+ * moves from x = -1 to x = 1 between t = 0.5 and 1.5 s, turns by 90 degrees about z (by
+ * quaternion slerp: 45 degrees at t = 1 s) and warms from 300 to 320 K; held outside;
+ * two sweep values of the air's attenuation: 10 frames in all. */
 static const char sequence_json[] =
     "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"fps\": 2, \"frames\": 5,\n"
     " \"keyframes\": [\n"
     "  {\"time_s\": 0.5, \"objects\": {\"plate\": {\n"
-    "     \"transform\": {\"translate_m\": [-1, 0.5, 0]}, \"temperature_k\": 300}}},\n"
+    "     \"transform\": {\"translate_m\": [-1, 0.5, 0], \"rotate_deg\": [0, 0, 0]},\n"
+    "     \"temperature_k\": 300}}},\n"
     "  {\"time_s\": 1.5, \"objects\": {\"plate\": {\n"
-    "     \"transform\": {\"translate_m\": [1, 0.5, 0]}, \"temperature_k\": 320}}}],\n"
+    "     \"transform\": {\"translate_m\": [1, 0.5, 0], \"rotate_deg\": [0, 0, 90]},\n"
+    "     \"temperature_k\": 320}}}],\n"
     " \"sweep\": {\"atmosphere.attenuation_per_m\": [0.01, 0.2]}}\n";
 
-/* The plate's centre x (its bounding box's middle) and temperature in frame i's scene. */
-static void plate_in_frame(const thz_sequence *seq, size_t i, double *x, double *t_k)
+/* The plate's centre x (its bounding box's middle), its extent along x and its
+ * temperature in frame i's scene. */
+static void plate_in_frame(const thz_sequence *seq, size_t i, double *x, double *width, double *t_k)
 {
     thz_error err = {0};
     thz_scene *scene = NULL;
     *x = NAN;
+    *width = NAN;
     *t_k = NAN;
     thz_status st = thz_sequence_frame_scene(seq, i, &scene, &err);
     CHECK(st == THZ_OK, "frame %zu's scene: %s", i, err.message);
@@ -50,6 +55,7 @@ static void plate_in_frame(const thz_sequence *seq, size_t i, double *x, double 
     thz_object_info oi;
     if (k >= 0 && thz_scene_object(scene, (size_t)k, &oi) == THZ_OK) {
         *x = 0.5 * (oi.bbox_min_m[0] + oi.bbox_max_m[0]);
+        *width = oi.bbox_max_m[0] - oi.bbox_min_m[0];
         *t_k = oi.temperature_k;
     }
     thz_scene_destroy(scene);
@@ -98,15 +104,19 @@ int main(int argc, char **argv)
     thz_frame_info none = {.index = 99};
     CHECK(thz_sequence_frame(seq, 10, &none) == THZ_ERR_INPUT, "frame 10 of 10 accepted");
 
-    /* interpolation: held before 0.5 s and after 1.5 s, linear between */
+    /* interpolation: held before 0.5 s and after 1.5 s, linear between; the plate's extent
+     * along x is 0.4 m unturned, (0.4 + 0.1) / sqrt 2 at 45 degrees, 0.1 m at 90 */
     const double want_x[5] = {-1.0, -1.0, 0.0, 1.0, 1.0};
     const double want_t[5] = {300.0, 300.0, 310.0, 320.0, 320.0};
+    const double want_w[5] = {0.4, 0.4, 0.5 / sqrt(2.0), 0.1, 0.1};
     for (size_t i = 0; i < 10; i++) {
-        double x, t_k;
-        plate_in_frame(seq, i, &x, &t_k);
+        double x, w, t_k;
+        plate_in_frame(seq, i, &x, &w, &t_k);
         CHECK(fabs(x - want_x[i % 5]) < 1e-6 && fabs(t_k - want_t[i % 5]) < 1e-9,
               "frame %zu: plate at x = %g m, %g K; expected %g m, %g K", i, x, t_k, want_x[i % 5],
               want_t[i % 5]);
+        CHECK(fabs(w - want_w[i % 5]) < 1e-6, "frame %zu: plate %g m wide along x, expected %g m",
+              i, w, want_w[i % 5]);
     }
 
     /* the JSON text: snprintf's contract, the sweep's value in place, loadable as the scene */
