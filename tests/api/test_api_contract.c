@@ -171,6 +171,57 @@ static void check_atmosphere_frequencies(void)
     double alpha = thz_atm_attenuation_per_m(atm, 0.35e12);
     CHECK(alpha > 0 && isfinite(alpha), "alpha(0.35 THz) %g", alpha);
     thz_atm_destroy(atm);
+
+    /* the humidity as a volume mixing ratio of the total air: 1 % of 1000 hPa is 10 hPa of
+     * water vapour, 7.52 g/m^3 at 288.15 K (ideal gas, 18.015 g/mol), and the same air as
+     * a density gives the same attenuation */
+    opt.pressure_hpa = 1000.0;
+    opt.humidity_kind = THZ_HUMIDITY_VMR;
+    opt.humidity = 0.01;
+    REQUIRE_OK(thz_atm_create(&opt, NULL, &atm, &err), &err);
+    thz_atm_info info;
+    thz_atm_get_info(atm, &info);
+    double rho = 1000.0 * 18.015 / (8.314462618 * 288.15);
+    CHECK(fabs(info.h2o_pressure_hpa - 10.0) < 1e-9 && fabs(info.h2o_vmr - 0.01) < 1e-12 &&
+              fabs(info.h2o_density_g_m3 - rho) < 1e-3 * rho,
+          "VMR 0.01 of 1000 hPa: %g hPa of water vapour, VMR %g, %g g/m^3 (expected %g)",
+          info.h2o_pressure_hpa, info.h2o_vmr, info.h2o_density_g_m3, rho);
+    double alpha_vmr = thz_atm_attenuation_per_m(atm, 0.35e12);
+    thz_atm_destroy(atm);
+    opt.humidity_kind = THZ_HUMIDITY_DENSITY_G_M3;
+    opt.humidity = info.h2o_density_g_m3;
+    REQUIRE_OK(thz_atm_create(&opt, NULL, &atm, &err), &err);
+    double alpha_rho = thz_atm_attenuation_per_m(atm, 0.35e12);
+    CHECK(fabs(alpha_vmr - alpha_rho) <= 1e-9 * alpha_rho,
+          "VMR 0.01: alpha %g /m, as %g g/m^3 %g /m", alpha_vmr, info.h2o_density_g_m3, alpha_rho);
+    thz_atm_destroy(atm);
+}
+
+/* A sensor's optics and noise per channel (thz_scene_sensor_channel): cam has an Airy
+ * PSF of D = 1 cm and a Dicke radiometer, side a Gaussian PSF of FWHM 8 degrees and
+ * NETDs of 0.3 and 0.5 K with noise seed 3. */
+static void check_sensor_channel(const thz_scene *scene)
+{
+    thz_sensor_channel_info ci;
+    thz_error err = {0};
+    REQUIRE_OK(thz_scene_sensor_channel(scene, 0, 0, &ci), &err);
+    double airy = 1.22 * 299792458.0 / 0.35e12 / 0.01;
+    CHECK(strcmp(ci.psf, "airy") == 0 && fabs(ci.spot_rad - airy) < 1e-12 * airy &&
+              ci.aperture_diameter_m == 0.01,
+          "cam at 0.35 THz: %s PSF, spot %g rad (expected %g)", ci.psf, ci.spot_rad, airy);
+    CHECK(strcmp(ci.noise, "dicke") == 0 && ci.netd_k > 0.0 && ci.netd_at_k > 0.0 &&
+              ci.noise_bandwidth_hz > 0.0 && !ci.noise_seed_given,
+          "cam's noise: %s, NETD %g K at %g K, B_n %g Hz", ci.noise, ci.netd_k, ci.netd_at_k,
+          ci.noise_bandwidth_hz);
+    REQUIRE_OK(thz_scene_sensor_channel(scene, 1, 1, &ci), &err);
+    double fwhm = 8.0 * M_PI / 180.0;
+    CHECK(strcmp(ci.psf, "gaussian") == 0 && fabs(ci.spot_rad - fwhm) < 1e-15,
+          "side: %s PSF, spot %g rad (expected %g)", ci.psf, ci.spot_rad, fwhm);
+    CHECK(strcmp(ci.noise, "netd") == 0 && ci.netd_k == 0.5 && ci.netd_at_k == 0.0 &&
+              ci.noise_seed_given && ci.noise_seed == 3,
+          "side at 0.9 THz: %s, NETD %g K, seed %d %llu", ci.noise, ci.netd_k, ci.noise_seed_given,
+          (unsigned long long)ci.noise_seed);
+    CHECK(thz_scene_sensor_channel(scene, 1, 2, &ci) == THZ_ERR_INPUT, "channel 2 of 2");
 }
 
 /* The figure refuses what it cannot draw: no points, no path, a curve's array missing
@@ -433,6 +484,7 @@ int main(int argc, char **argv)
     CHECK(thz_integrator_known("path") && !thz_integrator_known("magic"), "integrator names");
     CHECK(thz_integrator_needs_photons("final-gather") && !thz_integrator_needs_photons("path"),
           "needs photons");
+    check_sensor_channel(a);
     CHECK(thz_integrator_has_passes("final-gather") && thz_integrator_has_passes("path") &&
               !thz_integrator_has_passes("photon-map") && !thz_integrator_has_passes("magic"),
           "has passes");
