@@ -54,8 +54,13 @@ THZ_API void thz_atm_destroy(thz_atm *atm);
 
 typedef struct thz_atm_info {
     const char *model; /* static */
-    int has_air;       /* 0: the fields below are 0 */
+    int has_air;       /* itu-p676 and lines; 0: the five fields after it are 0 */
     double temperature_k, pressure_hpa, h2o_pressure_hpa, h2o_density_g_m3, h2o_vmr;
+    /* (added with the emission's fields; the library fills the whole struct: a program
+     * built against an older header must be rebuilt, the ABI is not stable before 1.0) */
+    int emitting;                    /* the air emits B_nu(T) per optical depth (any model) */
+    double emission_temperature_k;   /* that T, K: a scene's default is its enclosure's */
+    double background_temperature_k; /* what rays leaving the scene see, K */
 } thz_atm_info;
 THZ_API void thz_atm_get_info(const thz_atm *atm, thz_atm_info *out);
 

@@ -137,6 +137,11 @@ void thz_atm_get_info(const thz_atm *a, thz_atm_info *out)
         return;
     const thz_atmosphere *atm = a->atm;
     out->model = atmosphere_model_name(atm->model);
+    if (atm->emitting && atm->model != ATM_NONE) {
+        out->emitting = 1;
+        out->emission_temperature_k = atm->air.temperature_k;
+        out->background_temperature_k = atm->background_temperature_k;
+    }
     if (!atm->has_air)
         return;
     out->has_air = 1;

@@ -27,6 +27,27 @@ static void validate_usage(FILE *f)
                "  -h, --help   show this help\n");
 }
 
+/* The atmosphere's line: its model, the air's state (itu-p676, lines) and what the air
+ * emits at, which defaults to the temperature of the enclosure around the sensors. */
+static void validate_print_atmosphere(const thz_scene *s, const char *model)
+{
+    printf("\natmosphere: %s", model);
+    thz_atm *atm = NULL;
+    thz_atm_info ai = {0};
+    if (thz_atm_from_scene(s, &atm, NULL) == THZ_OK)
+        thz_atm_get_info(atm, &ai);
+    thz_atm_destroy(atm);
+    if (ai.has_air)
+        printf("; air at %.2f K and %.2f hPa, water vapour %.4g hPa (%.4g g/m³)", ai.temperature_k,
+               ai.pressure_hpa, ai.h2o_pressure_hpa, ai.h2o_density_g_m3);
+    if (ai.emitting)
+        printf("; emitting at %.2f K, background %.2f K", ai.emission_temperature_k,
+               ai.background_temperature_k);
+    else if (strcmp(model, "none") != 0)
+        printf("; not emitting");
+    printf("\n");
+}
+
 /* "0.05", or "table (3 points, 0.2 to 1.2 THz; 0.05 to 0.12)". */
 static void validate_describe_spectrum(char *out, size_t n, const thz_spectrum_info *sp)
 {
@@ -171,7 +192,7 @@ static void validate_print(const thz_scene *s)
             printf("; reflection %s", mat.reflection);
         printf("\n");
     }
-    printf("\natmosphere: %s\n", si.atmosphere_model);
+    validate_print_atmosphere(s, si.atmosphere_model);
     printf("\nobjects: %zu\n", si.n_objects);
     double total_area = 0.0;
     size_t total_triangles = 0;

@@ -181,6 +181,9 @@ static void check_atmosphere_frequencies(void)
     REQUIRE_OK(thz_atm_create(&opt, NULL, &atm, &err), &err);
     thz_atm_info info;
     thz_atm_get_info(atm, &info);
+    CHECK(info.has_air && !info.emitting && info.emission_temperature_k == 0.0,
+          "a model made from options has air and emits nothing: %d, %d", info.has_air,
+          info.emitting);
     double rho = 1000.0 * 18.015 / (8.314462618 * 288.15);
     CHECK(fabs(info.h2o_pressure_hpa - 10.0) < 1e-9 && fabs(info.h2o_vmr - 0.01) < 1e-12 &&
               fabs(info.h2o_density_g_m3 - rho) < 1e-3 * rho,
@@ -485,6 +488,17 @@ int main(int argc, char **argv)
     CHECK(thz_integrator_needs_photons("final-gather") && !thz_integrator_needs_photons("path"),
           "needs photons");
     check_sensor_channel(a);
+    { /* the scene's constant air emits at its room's 295 K (the enclosure's, by default) */
+        thz_atm *sa = NULL;
+        thz_atm_info ai;
+        REQUIRE_OK(thz_atm_from_scene(a, &sa, &err), &err);
+        thz_atm_get_info(sa, &ai);
+        CHECK(strcmp(ai.model, "constant") == 0 && !ai.has_air && ai.emitting &&
+                  ai.emission_temperature_k == 295.0 && ai.background_temperature_k == 295.0,
+              "scene's atmosphere: %s, emitting %d at %g K, background %g K", ai.model, ai.emitting,
+              ai.emission_temperature_k, ai.background_temperature_k);
+        thz_atm_destroy(sa);
+    }
     CHECK(thz_integrator_has_passes("final-gather") && thz_integrator_has_passes("path") &&
               !thz_integrator_has_passes("photon-map") && !thz_integrator_has_passes("magic"),
           "has passes");

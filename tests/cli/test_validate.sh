@@ -31,9 +31,27 @@ expect_line "$tmp/out" '^  \[0\] room: solid, material wall, 12 triangles, area 
 expect_line "$tmp/out" '^  \[1\] target: solid, material paint, 256 triangles, area 0\.533781 m², temperature 310\.00 K'
 expect_line "$tmp/out" '^  \[2\] cover: shell 0\.5 mm, material cloth, 128 triangles, area 0\.0634347 m², temperature 300\.00 K'
 expect_line "$tmp/out" 'cam: 64 x 64 pixels, fov 40 deg, oversampling 2 x 2, aperture 0\.01 m²'
-expect_line "$tmp/out" '^atmosphere: constant'
+# the air emits at the enclosure's temperature unless told otherwise
+expect_line "$tmp/out" '^atmosphere: constant; emitting at 295\.00 K, background 295\.00 K$'
 expect_line "$tmp/out" '^  table: reflectivity table \(5 points'
 
+# the air's state: 50 % relative humidity at 288 K is about 8.5 hPa of water vapour
+# (half of 17.0 hPa), 216.7 e / T = 6.4 g/m³; the given background
+"$thzmap" validate "$repo/examples/outdoor-concealed/scene.json" >"$tmp/outdoor" 2>"$tmp/err" ||
+    fail "outdoor-concealed: exit $?: $(cat "$tmp/err")"
+expect_line "$tmp/outdoor" '^atmosphere: itu-p676; air at 288\.00 K and 1013\.00 hPa, water vapour 8\.[45][0-9]* hPa \(6\.[34][0-9]* g/m³\); emitting at 288\.00 K, background 40\.00 K$'
+cat > "$tmp/cold-air.json" <<'JSON'
+{"format": "thzmap-scene/1", "name": "cold-air",
+ "channels": [{"frequency_thz": 0.35, "relative_width": 0.05}],
+ "materials": {"wall": {"reflectivity": 0.1}},
+ "atmosphere": {"model": "constant", "attenuation_per_m": 0.05, "emitting": false},
+ "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+              "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}}],
+ "sensors": [{"name": "cam", "position_m": [0, 0, 0], "direction": [0, 1, 0], "fov_deg": 40,
+              "resolution": [4, 4]}]}
+JSON
+"$thzmap" validate "$tmp/cold-air.json" >"$tmp/cold" 2>/dev/null || fail "cold-air: exit $?"
+expect_line "$tmp/cold" '^atmosphere: constant; not emitting$'
 # a rotated rectangle's bottom edge lies at z = 2.4e-08 m in float vertices: shown as 0
 "$thzmap" validate "$repo/examples/walker/scene.json" >"$tmp/walker" 2>"$tmp/err" ||
     fail "walker: exit $?: $(cat "$tmp/err")"
