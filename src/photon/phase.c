@@ -47,12 +47,11 @@ typedef struct phase_fire_args {
 } phase_fire_args;
 
 /* Emits n <= RNG_MANY photons from their streams rng[j] (power 0 where nothing is emitted),
- * stage by stage over the photons: each one's
- * class (surface, air or boundary: the last two drawn whole), every surface photon's
- * frequency, then each one's source, point and angle, then all their directions. The
- * frequencies and directions are loops the compiler vectorises, which the same arithmetic
- * one photon at a time left to the scalar units (channel_sample_many_hz,
- * sampling_direction_many). */
+ * stage by stage over the photons: each one's class (surface, air or boundary: the last
+ * two drawn whole), every surface photon's frequency, then each one's source, point and
+ * angle, then all their directions. The frequencies and directions are loops the compiler
+ * vectorises, which the same arithmetic one photon at a time left to the scalar units
+ * (channel_sample_many_hz, sampling_direction_many). */
 static void phase_emit_block(const phase_fire_args *a, rng_stream *rng, size_t n,
                              emission_photon *e)
 {
