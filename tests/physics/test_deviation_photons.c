@@ -543,6 +543,33 @@ static double fresnel_r(double n, double k, double mu)
     return 0.5 * (cabs(rs) * cabs(rs) + cabs(rp) * cabs(rp));
 }
 
+/* Fires ps_scaled(200000) photons of channel 0 of s, every one of which hits a room,
+ * with reference T0 on 2 threads; checks that every photon hit, that the fired power is
+ * `expected` within 5 standard errors of the mean photon power (from the first hits), that
+ * those are below max_rel of it, and the energy balance. Returns the moments. */
+static power_moments fired_in_room(thz_scene *s, const accel *acc, double t0, double expected,
+                                   double max_rel, const char *what)
+{
+    uint64_t photons = ps_scaled(200000);
+    s->photons.per_channel = photons;
+    photon_phase_options opt = {.threads = 2, .reference_temperature_k = t0};
+    photon_map *map;
+    photon_stats st;
+    thz_error err;
+    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+    power_moments m = first_hits(map);
+    double tol = five_sigma(&m, photons);
+    printf("# %s: fired %.6e W/Hz, expected %.6e (tolerance %.2e); %zu negative and %zu "
+           "positive photons\n",
+           what, st.fired_power_w_per_hz, expected, tol, m.n_neg, m.n_pos);
+    assert_int_equal(m.n_neg + m.n_pos, photons); /* every photon hits the room */
+    assert_true(fabs(st.fired_power_w_per_hz - expected) <= tol);
+    assert_true(tol < max_rel * fabs(expected));
+    assert_balance(&st, m.sum_abs);
+    photon_map_destroy(map);
+    return m;
+}
+
 /* A one-sided 0.5 m cube of index 2 + 0.1i with an explicit emissivity 0.5, at 300 K, with
  * T0 = 100 K: two sources, eps B(T) and -A(mu) B0 with A = 1 - R(mu) (its back side,
  * inside, reaches no front face). Alone, the table holds those two (the cube once wrote a
@@ -598,24 +625,10 @@ static void test_index_explicit_solid(void **state)
         double abar = 2.0 * sum * h / 3.0;
         double area = 6.0 * side * side;
         double expected = M_PI * area * (eps * band_b(s, t_k) - abar * band_b(s, t0));
-        uint64_t photons = ps_scaled(200000);
-        s->photons.per_channel = photons;
-        photon_phase_options opt = {.threads = 2, .reference_temperature_k = t0};
-        photon_map *map;
-        photon_stats st;
-        assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
-        power_moments m = first_hits(map);
-        double tol = five_sigma(&m, photons);
-        printf("# index solid, explicit eps: A-bar %.4f, fired %.6e W/Hz, expected %.6e "
-               "(tolerance %.2e); %zu negative and %zu positive photons\n",
-               abar, st.fired_power_w_per_hz, expected, tol, m.n_neg, m.n_pos);
-        assert_int_equal(m.n_neg + m.n_pos, photons); /* every photon hits the room */
-        assert_true(fabs(st.fired_power_w_per_hz - expected) <= tol);
+        printf("# index solid, explicit eps: A-bar %.4f\n", abar);
         /* a factor 2, a sign or the -A B0 source left out (-127 %) would fail */
-        assert_true(tol < 0.1 * fabs(expected));
+        power_moments m = fired_in_room(s, acc, t0, expected, 0.1, "index solid, explicit eps");
         assert_true(m.n_neg > 0 && m.n_pos > 0);
-        assert_balance(&st, m.sum_abs);
-        photon_map_destroy(map);
         accel_destroy(acc);
         scene_destroy(s);
     }
@@ -676,24 +689,10 @@ static void test_spectral_explicit_solid(void **state)
     double absorbed = channel_band_mean(&s->channels[0], absorb_b0_at, &ac);
     double area = 6.0 * side * side;
     double expected = M_PI * area * (eps * band_b(s, t_k) - absorbed);
-    uint64_t photons = ps_scaled(200000);
-    s->photons.per_channel = photons;
-    photon_phase_options opt = {.threads = 2, .reference_temperature_k = t0};
-    photon_map *map;
-    photon_stats st;
-    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
-    power_moments m = first_hits(map);
-    double tol = five_sigma(&m, photons);
-    printf("# spectral solid, explicit eps: (1 - R) B0 band mean %.4e, fired %.6e W/Hz, "
-           "expected %.6e (tolerance %.2e); %zu negative and %zu positive photons\n",
-           absorbed, st.fired_power_w_per_hz, expected, tol, m.n_neg, m.n_pos);
-    assert_int_equal(m.n_neg + m.n_pos, photons); /* every photon hits the room */
-    assert_true(fabs(st.fired_power_w_per_hz - expected) <= tol);
+    printf("# spectral solid, explicit eps: (1 - R) B0 band mean %.4e W/(m^2 sr Hz)\n", absorbed);
     /* a factor 2, a sign, or R taken at the centre for the whole band (1 - R = 0.5 there;
      * the band's (1 - R) B0 is 0.54 of its B0) would fail: the last moves the power 10 % */
-    assert_true(tol < 0.05 * fabs(expected));
-    assert_balance(&st, m.sum_abs);
-    photon_map_destroy(map);
+    fired_in_room(s, acc, t0, expected, 0.05, "spectral solid, explicit eps");
     accel_destroy(acc);
     scene_destroy(s);
 }
