@@ -137,4 +137,16 @@ static inline void test_remove_dir(const char *dir)
         fprintf(stderr, "warning: could not remove %s\n", dir);
 }
 
+/* The end of a test: its directory removed when it passed (kept, and said so, when it
+ * failed), its failure count printed; the exit status. */
+static inline int test_finish(const char *program, const char *dir)
+{
+    if (test_failures == 0)
+        test_remove_dir(dir);
+    else
+        fprintf(stderr, "kept %s\n", dir);
+    printf("%s: %d failures\n", program, test_failures);
+    return test_failures ? 1 : 0;
+}
+
 #endif

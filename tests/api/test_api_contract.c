@@ -597,7 +597,5 @@ int main(int argc, char **argv)
     thz_scene_destroy(a);
     thz_scene_destroy(b);
     thz_context_destroy(ctx);
-    test_remove_dir(dir);
-    printf("%s: %d failures\n", argv[0], test_failures);
-    return test_failures ? 1 : 0;
+    return test_finish(argv[0], dir);
 }

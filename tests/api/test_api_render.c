@@ -171,10 +171,5 @@ int main(int argc, char **argv)
     thz_photons_destroy(photons);
     thz_context_destroy(ctx);
     thz_scene_destroy(scene);
-    if (test_failures == 0)
-        test_remove_dir(dir);
-    else
-        fprintf(stderr, "kept %s\n", dir);
-    printf("%s: %d failures\n", argv[0], test_failures);
-    return test_failures ? 1 : 0;
+    return test_finish(argv[0], dir);
 }

@@ -153,10 +153,5 @@ int main(int argc, char **argv)
           "frame 10's scene: not refused");
     thz_sequence_destroy(seq);
 
-    if (test_failures == 0)
-        test_remove_dir(dir);
-    else
-        fprintf(stderr, "kept %s\n", dir);
-    printf("%s: %d failures\n", argv[0], test_failures);
-    return test_failures ? 1 : 0;
+    return test_finish(argv[0], dir);
 }
