@@ -1,7 +1,8 @@
 /* Band selection's criterion and search (analysis/bands_search.c): the Bhattacharyya
  * distance of two one-channel classes against its closed form; on synthetic classes
  * that differ only at known candidates, exhaustive search and SFFS both find them; the
- * best score never falls as K grows; with widths searched no set holds a centre twice. */
+ * best score never falls as K grows; SFFS drops a band again when a smaller set without it
+ * is better; with widths searched no set holds a centre twice. */
 #include <setjmp.h>
 #include <stdbool.h>
 #include <stdarg.h>
@@ -130,6 +131,40 @@ static void test_one_width_per_centre(void **state)
     assert_int_equal(bands_search(&cl, N / 2 + 1, 100, &r, &err), THZ_ERR_INPUT);
 }
 
+/* SFFS's conditional exclusion (the "floating" step): candidate 0 separates the two
+ * classes alone (means 2 apart, variance 1: B = 0.5); candidates 1 and 2 have the same
+ * means and variances in both classes, but correlation +0.99 in one and -0.99 in the
+ * other, so that together they separate them far better: B = ln(1 / (1 - 0.99^2)) / 2
+ * = 1.96. Forward selection takes 0, then 0 with 1 or 2 (B = 0.5), then all three; only
+ * dropping 0 again finds {1, 2}, the best pair. */
+static void test_sffs_drops_a_band(void **state)
+{
+    (void)state;
+    const double rho = 0.99;
+    double m[2 * 3] = {300.0, 300.0, 300.0, 302.0, 300.0, 300.0};
+    double c[2 * 9] = {0};
+    for (size_t k = 0; k < 2; k++) {
+        for (size_t i = 0; i < 3; i++)
+            c[k * 9 + i * 3 + i] = 1.0;
+        c[k * 9 + 1 * 3 + 2] = c[k * 9 + 2 * 3 + 1] = k == 0 ? rho : -rho;
+    }
+    bands_classes cl = {.n_candidates = 3, .n_classes = 2, .mean = m, .cov = c};
+    bands_search_result r;
+    thz_error err = {0};
+    assert_int_equal(bands_search(&cl, 3, 2, &r, &err), THZ_OK); /* 7 sets > 2: SFFS */
+    assert_string_equal(r.search, "sffs");
+    assert_int_equal(r.sets[0], 0);
+    assert_true(fabs(r.scores[0].worst_b - 0.5) < 1e-12);
+    const size_t *two = r.sets + 1 * 3;
+    if (!(two[0] == 1 && two[1] == 2))
+        fail_msg("best pair {%zu, %zu}, B = %g; expected {1, 2}", two[0], two[1],
+                 r.scores[1].worst_b);
+    double b_pair = 0.5 * log(1.0 / (1.0 - rho * rho));
+    assert_true(fabs(r.scores[1].worst_b - b_pair) < 1e-9);
+    assert_true(fabs(r.scores[2].worst_b - (0.5 + b_pair)) < 1e-9); /* independent parts add */
+    bands_search_result_fini(&r);
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -148,6 +183,7 @@ int main(void)
         cmocka_unit_test(test_closed_form),
         cmocka_unit_test(test_exhaustive_finds_features),
         cmocka_unit_test(test_sffs_finds_features),
+        cmocka_unit_test(test_sffs_drops_a_band),
         cmocka_unit_test(test_one_width_per_centre),
         cmocka_unit_test(test_bad_input),
     };
