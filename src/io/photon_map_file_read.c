@@ -321,11 +321,20 @@ static thz_status pmf_open_header(photon_map_file_stream *s, thz_error *err)
                              "widths or responses differ from %s); run `thzmap simulate` on "
                              "this scene",
                              path, name);
+    /* The sensors are not in the fingerprint, but an emitting air's default temperature
+     * and background are the enclosure's around them: a user who only moved the camera
+     * into another room is told why. */
+    bool air = scene->atmosphere.emitting && scene->atmosphere.model != ATM_NONE;
     if (get_u64(header + 8) != h.optics)
         return thz_error_set(err, THZ_ERR_INPUT,
                              "photon map %s was made from another scene (materials, temperatures "
-                             "or atmosphere differ from %s); run `thzmap simulate` on this scene",
-                             path, name);
+                             "or atmosphere differ from %s%s); run `thzmap simulate` on this "
+                             "scene",
+                             path, name,
+                             air ? "; the air's temperature and background, unless given, are "
+                                   "the enclosure's around the sensors, which a sensor moved "
+                                   "into another enclosure changes"
+                                 : "");
     for (size_t c = 0; c < scene->n_channels; c++) {
         double t0_k = s->version == 1u ? 0.0 : get_f64(pmf_channel_words(s, c) + 160);
         if (!(t0_k >= 0.0) || !isfinite(t0_k))

@@ -329,6 +329,14 @@ for i in 0 1; do
         fail "simulate of two-room frame $i"
     same_files "$work/RS$i" "$work/R/frame-0000$i" "two-room frame $i against simulate's"
 done
+# render refuses the first room's map for the second, and says why the camera matters
+"$THZMAP" simulate "$work/rooms-frame-0.json" -o "$work/RM" --save-photon-map --quiet > /dev/null ||
+    fail "simulate --save-photon-map of two-room frame 0"
+"$THZMAP" render "$work/rooms-frame-1.json" --photon-map "$work/RM/photon-map.thzpm" \
+    -o "$work/RR" --quiet 2> "$work/RR.err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "enclosure's around the sensors" "$work/RR.err" ||
+    fail "render of the second room from the first room's map: exit $rc: $(cat "$work/RR.err")"
 
 # --- a plain list of scenes, and progress within a frame ---------------------------
 # frame 0 is scene.json, frame 1 sub/b.json (paths relative to the sequence file): as
