@@ -192,9 +192,23 @@ NUIS="--count 1 --from-thz 0.2 --to-thz 1.0 --step-ghz 200 --paths 2 -q --target
 # shellcheck disable=SC2086
 "$THZ" bands "$TMP/covered.json" -o "$TMP/ca" $NUIS --angle-range-deg 10 \
     || fail "--angle-range-deg exit status $?"
+# the same camera given by a direction instead of look_at_m: turned about its position
+$PY - "$TMP/covered.json" "$TMP/covered-dir.json" <<'PYEOF'
+import json, math, sys
+d = json.load(open(sys.argv[1]))
+for sn in d["sensors"]:
+    at = sn.pop("look_at_m")
+    v = [a - p for a, p in zip(at, sn["position_m"])]
+    n = math.sqrt(sum(x * x for x in v))
+    sn["direction"] = [x / n for x in v]
+json.dump(d, open(sys.argv[2], "w"))
+PYEOF
+# shellcheck disable=SC2086
+"$THZ" bands "$TMP/covered-dir.json" -o "$TMP/cd" $NUIS --angle-range-deg 10 \
+    || fail "--angle-range-deg with a sensor direction: exit status $?"
 $PY - "$TMP" <<'PYEOF' || fail "thickness and angle nuisances"
 import json, sys
-r = {k: json.load(open(f"{sys.argv[1]}/{k}/bands.json")) for k in ("c0", "ct", "ca")}
+r = {k: json.load(open(f"{sys.argv[1]}/{k}/bands.json")) for k in ("c0", "ct", "ca", "cd")}
 sd = {k: {c["name"]: c["nuisance_sd_k"] for c in d["classes"]} for k, d in r.items()}
 assert r["c0"]["renders"] == 1 and all(x == 0 for v in sd["c0"].values() for x in v), sd["c0"]
 n = r["ct"]["nuisances"]
@@ -206,6 +220,8 @@ n = r["ca"]["nuisances"]
 assert n["render_paths_per_sample"] == 1 and n["render_oversampling"] == 1, n
 assert r["ca"]["renders"] == 3 and n["angle_varied"] and not n["thickness_varied"], n
 assert max(max(v) for v in sd["ca"].values()) > 0.05, sd["ca"]
+assert r["cd"]["nuisances"]["angle_varied"], r["cd"]["nuisances"]
+assert max(max(v) for v in sd["cd"].values()) > 0.05, sd["cd"]
 PYEOF
 
 # bad input: exit status 2 and a message naming the problem
