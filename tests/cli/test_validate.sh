@@ -111,6 +111,34 @@ expect_line "$tmp/err" '^thzmap validate: warning: object "part": inconsistent w
 expect_line "$tmp/err" '^thzmap validate: warning: object "plate": the explicit emissivity .* Kirchhoff'
 expect_line "$tmp/err" '^thzmap validate: warning: material "lossy", reflectivity: the table covers'
 
+# a mesh file with a triangle repeated (the other way round) and one of no area: each
+# named, as the import counts them
+mkdir -p "$tmp/defects"
+cat > "$tmp/defects/tile.obj" <<'OBJ'
+v 0 0 0
+v 1 0 0
+v 0 1 0
+v 1 1 0
+v 2 2 0
+f 1 2 3
+f 2 4 3
+f 3 2 1
+f 1 4 5
+OBJ
+cat > "$tmp/defects/scene.json" <<'JSON'
+{"format": "thzmap-scene/1", "name": "defects",
+ "channels": [{"frequency_thz": 0.35, "relative_width": 0.05}],
+ "materials": {"wall": {"reflectivity": 0.1}},
+ "objects": [{"name": "tile", "type": "shell", "thickness_m": 0.001, "material": "wall",
+              "temperature_k": 300, "shape": {"type": "mesh", "file": "tile.obj"}}],
+ "sensors": [{"name": "cam", "position_m": [0.5, 0.5, 2], "look_at_m": [0.5, 0.5, 0], "up": [0, 1, 0],
+              "fov_deg": 40, "resolution": [4, 4]}]}
+JSON
+"$thzmap" validate "$tmp/defects/scene.json" >"$tmp/out" 2>"$tmp/err" ||
+    fail "defects: exit $?: $(cat "$tmp/err")"
+expect_line "$tmp/err" '^thzmap validate: warning: object "tile": 1 triangle\(s\) repeat another.s three corners'
+expect_line "$tmp/err" '^thzmap validate: warning: object "tile": 1 triangle\(s\) of no area'
+
 # --- help and usage -----------------------------------------------------------------------
 "$thzmap" validate --help >"$tmp/out" 2>&1 || fail "validate --help failed"
 expect_line "$tmp/out" '^usage: thzmap validate SCENE\.json'
