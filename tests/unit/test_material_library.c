@@ -255,6 +255,11 @@ static void test_refusals(void **state)
              "\"eps_s\": 7, \"tau_ps\": 8}}",
              "expected eps_s >= eps_inf");
     load_bad("1.0",
+             "{\"permittivity_model\": {\"model\": \"double-debye\", \"eps_inf\": 3, "
+             "\"eps_2\": 80, \"eps_s\": 70, \"tau1_ps\": 8, \"tau2_ps\": 0.2}}",
+             "materials.m.permittivity_model.eps_2: expected eps_s >= eps_2 >= eps_inf, got 70, "
+             "80, 3");
+    load_bad("1.0",
              "{\"permittivity_model\": {\"model\": \"drude\", "
              "\"plasma_frequency_thz\": 2000}}",
              "permittivity_model.collision_frequency_thz: missing key");
