@@ -144,9 +144,10 @@ static void test_back_faces_are_black_and_counted(void **state)
 /* The same for every integrator, from a map of L (T0 = 0) and of the deviation L - B0
  * (T0 = 290 K; path's T0 likewise): a sample that sees a back face first, or nothing
  * (the air does not emit), is 0 whatever the reference, the deviation's -B0 there and
- * the air's (tau - 1) B0 on the way cancelling B0 (to rounding: 1e-9 of B0, where the
- * emission of the corridor's 300 K would be 3 % of it). Final-gather's direct back face
- * and path's escape with a reference were run by no test. */
+ * the air's (tau - 1) B0 on the way cancelling B0 (to rounding: 1e-9 of B0, where a
+ * sign error or the corridor's emission leaking in would be about B0 itself).
+ * Final-gather's direct back face and path's escape with a reference were run by no
+ * test. */
 static void test_back_faces_every_integrator(void **state)
 {
     fixture *f = *state;
