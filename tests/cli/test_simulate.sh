@@ -440,6 +440,31 @@ grep -q 'cut short' "$work/mirror-0.0.err" &&
 grep -q 'cut short: after 32 straight shells and mirror reflections in a row' \
     "$work/mirror-0.5.err" || fail "a closed mirror of R = 0.5: $(cat "$work/mirror-0.5.err")"
 
+# --- path in a closed cavity of perfect mirrors: every path is cut after 10000 hits ----
+# Nothing absorbs or emits, so a path never ends by itself; the run must end, say so, and
+# take the rest as B(T0), the walls' 300 K (the cavity in equilibrium; 300.02 K from the
+# band mean of a 2 % channel through the centre's inverse Planck).
+cat > "$work/cavity.json" <<'JSON'
+{"format": "thzmap-scene/1", "channels": [{"frequency_thz": 0.3, "relative_width": 0.02}],
+ "materials": {"mirror": {"reflectivity": 1.0, "reflection": "specular"}},
+ "objects": [{"name": "cavity", "type": "solid", "material": "mirror", "temperature_k": 300,
+     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}}],
+ "sensors": [{"name": "cam", "position_m": [0.1, -0.3, 0.2], "look_at_m": [0.3, 0.5, 0.1],
+   "fov_deg": 40, "resolution": [2, 2]}],
+ "photons": {"seed": 1}, "render": {"integrator": "path", "paths_per_sample": 1}}
+JSON
+"$THZMAP" simulate "$work/cavity.json" -o "$work/cavity" --quiet 2> "$work/cavity.err" ||
+    fail "mirror cavity: exit $?: $(cat "$work/cavity.err")"
+grep -q "4 samples were cut short: .* after 10000 hits (the rest taken as B(T0))" \
+    "$work/cavity.err" || fail "mirror cavity: no cut paths reported: $(cat "$work/cavity.err")"
+/usr/bin/python3 - "$work/cavity/cam.brightness_temperature.img" <<'PY' ||
+import sys
+import numpy as np
+tb = np.fromfile(sys.argv[1], dtype="<f4")
+assert tb.size == 4 and np.all(np.abs(tb - 300.0) < 0.05), tb
+PY
+    fail "mirror cavity: the cut paths are not B(T0) = B(300 K)"
+
 if [ $fails -ne 0 ]; then
     echo "$fails check(s) failed"
     exit 1
