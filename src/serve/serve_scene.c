@@ -183,11 +183,18 @@ static json_t *serve_scene_json(const thz_scene *scene)
                                                      "distance_m", d, "transmittance", t));
     }
     free(alpha);
+    /* what the air emits at, K (null: it does not emit), and the background's: both
+     * default to the enclosure's around the sensors */
+    thz_atm_info ai = {0};
+    thz_atm_get_info(atm, &ai);
     thz_atm_destroy(atm);
-    return json_pack("{s:s, s:o, s:o, s:o, s:o, s:{s:s, s:o, s:o}, s:{s:s, s:I, s:I}}", "name",
-                     info.name, "channels", channels, "materials", materials, "objects", objects,
-                     "sensors", sensors, "atmosphere", "model", info.atmosphere_model, "channels",
-                     atm_channels, "sensors", atm_sensors, "settings", "integrator",
+    json_t *emit_k = ai.emitting ? json_real(ai.emission_temperature_k) : json_null();
+    json_t *background_k = ai.emitting ? json_real(ai.background_temperature_k) : json_null();
+    return json_pack("{s:s, s:o, s:o, s:o, s:o, s:{s:s, s:o, s:o, s:o, s:o}, s:{s:s, s:I, s:I}}",
+                     "name", info.name, "channels", channels, "materials", materials, "objects",
+                     objects, "sensors", sensors, "atmosphere", "model", info.atmosphere_model,
+                     "channels", atm_channels, "sensors", atm_sensors, "emission_temperature_k",
+                     emit_k, "background_temperature_k", background_k, "settings", "integrator",
                      info.integrator, "photons_per_channel", (json_int_t)info.photons_per_channel,
                      "seed", (json_int_t)info.seed);
 }

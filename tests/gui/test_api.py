@@ -232,6 +232,9 @@ def test_validate(srv, scene):
         d = atm["sensors"][0]["distance_m"]
         check(abs(atm["sensors"][0]["transmittance"][0] - math.exp(-0.05 * d)) < 1e-9 and
               atm["channels"][0]["alpha_per_m"] == 0.05, "atmosphere: %r" % atm)
+        # the air emits at the enclosure's temperature (the room's 295 K), as validate says
+        check(atm["emission_temperature_k"] == 295.0 and atm["background_temperature_k"] == 295.0,
+              "the air's emission: %r" % atm)
     # the meshes of an answer stop at 300 000 triangles (a cylinder of 1 000 000 segments, a
     # 1.7 KB body, made a 1 GB server and a 170 MB answer): later objects' are null
     big = json.loads(text)

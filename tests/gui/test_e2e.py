@@ -264,6 +264,10 @@ def main():
         click_list("objects", "cylinder-C")
         path = f"objects[{c}].temperature_k"
         assert field(path).find_element(By.TAG_NAME, "input").get_attribute("value") == "310"
+        # the atmosphere's caption: the paper's scene has none (nothing emits, no background)
+        atm_title = driver.execute_script(
+            "const d = document.querySelector('#atmosphere-plot div'); return d ? d.textContent : '';")
+        assert atm_title.startswith("model none: over each sensor"), f"atmosphere caption: {atm_title!r}"
         time.sleep(0.3)
         shot("scene")
         log("scene opened and valid")

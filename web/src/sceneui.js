@@ -329,7 +329,11 @@ export class SceneEditor {
     })).filter((s) => Array.isArray(s.y) && s.y.length === x.length);
     if (series.length) {
       const title = document.createElement("div");
-      title.textContent = `model ${a.model}: over each sensor's distance to what it looks at`;
+      // what the air emits at and the background (by default the enclosure's)
+      const air = a.model === "none" ? ""
+        : a.emission_temperature_k == null ? " (not emitting)"
+          : ` (emitting at ${a.emission_temperature_k.toFixed(2)} K, background ${a.background_temperature_k.toFixed(2)} K)`;
+      title.textContent = `model ${a.model}${air}: over each sensor's distance to what it looks at`;
       atm.appendChild(title);
       linePlot(atm, series, { xLabel: "channel centre (THz)", yLabel: "transmittance (1)", yMin: 0, yMax: 1 });
     } else {
