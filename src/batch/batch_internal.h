@@ -16,6 +16,7 @@
 
 #include <jansson.h>
 
+#include "scene/scene_hash.h"
 #include "thzmap/batch.h"
 #include "thzmap/thzmap.h"
 
@@ -96,6 +97,8 @@ typedef struct batch_photon_cache {
     thz_scene *scene;   /* the base's scene (the photons point to it) */
     thz_run *run;       /* the base frame's run, holding its photons; or NULL */
     thz_photons *fired; /* fired again by batch_render_reused; or NULL */
+    bool hashed;        /* hash holds the base scene's photon-map fingerprint */
+    scene_hash hash;    /* (computed once per base, at its first reuse) */
 } batch_photon_cache;
 
 void batch_photon_cache_clear(batch_photon_cache *c);
@@ -104,8 +107,9 @@ void batch_photon_cache_clear(batch_photon_cache *c);
 void batch_photon_cache_keep(batch_photon_cache *c, size_t base, thz_scene **scene, thz_run **run);
 /* Renders `scene` (a frame whose base is `base`) from the base's photons (*reused = 1),
  * firing them into the cache first when it holds another base's (*fired = 1 then). When
- * the air's temperature differs from the base's (it defaults to that of the enclosure
- * around the sensors), simulates the frame instead (*reused = 0, *fired = 1). */
+ * the frame's photon-map fingerprint differs from the base's (a sensor moved into another
+ * enclosure changes an emitting air's default temperature), simulates the frame instead
+ * (*reused = 0, *fired = 1). */
 thz_status batch_render_reused(thz_context *ctx, const thz_sequence *seq, batch_photon_cache *c,
                                size_t base, const thz_scene *scene, thz_run **run, int *reused,
                                int *fired, thz_error *err);

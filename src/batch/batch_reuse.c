@@ -13,7 +13,6 @@
 #include "batch/batch_internal.h"
 #include "core/alloc.h"
 #include "core/error.h"
-#include "scene/scene_hash.h"
 
 /* Frame f's scene text without its "sensors" (NULL when out of memory). */
 static char *reuse_scene_without_sensors(const thz_sequence *seq, size_t f)
@@ -64,19 +63,23 @@ void batch_photon_cache_keep(batch_photon_cache *c, size_t base, thz_scene **sce
     *run = NULL;
 }
 
-/* Whether photons fired for `base` are the ones `scene` would fire: the same fingerprint
+/* Whether the cached base's photons are the ones `scene` would fire: the same fingerprint
  * of everything a photon map depends on (scene_hash.h; what render checks a map file
  * against). The two texts differ only in their sensors, but the sensors decide the air's
  * default temperature and background, the enclosure's around them (scene-format.md), so
  * a sensor moving into another enclosure changes the map. (Only the air state of the
  * itu-p676 and lines models was compared before: a constant or table model's emitting air
  * was reused at the first enclosure's temperature.) */
-static bool reuse_fits(const thz_scene *scene, const thz_scene *base)
+static bool reuse_fits(const thz_scene *scene, batch_photon_cache *c)
 {
-    scene_hash a, b;
+    if (!c->hashed) {
+        scene_hash_compute(c->scene, &c->hash);
+        c->hashed = true;
+    }
+    scene_hash a;
     scene_hash_compute(scene, &a);
-    scene_hash_compute(base, &b);
-    return a.geometry == b.geometry && a.optics == b.optics && a.channels == b.channels;
+    return a.geometry == c->hash.geometry && a.optics == c->hash.optics &&
+           a.channels == c->hash.channels;
 }
 
 thz_status batch_render_reused(thz_context *ctx, const thz_sequence *seq, batch_photon_cache *c,
@@ -99,7 +102,7 @@ thz_status batch_render_reused(thz_context *ctx, const thz_sequence *seq, batch_
     }
     thz_run_settings settings;
     thz_run_settings_init(&settings);
-    if (!reuse_fits(scene, c->scene)) {
+    if (!reuse_fits(scene, c)) {
         *fired = 1; /* the sensors moved into another enclosure: fire this frame's own */
         return thz_simulate(ctx, scene, &settings, run, err);
     }
