@@ -1,8 +1,8 @@
 /* The up-front estimate of a simulate run's time: a pilot on a small copy of the first
- * rendered sensor (RUN_PILOT_SIDE^2 pixels, one sample each, pass 0 twice, the second
- * timed) and, for the integrators that need photons, a pilot
- * photon phase of RUN_PILOT_PHOTONS: on channel 0 alone without a noise target, for every
- * channel with one. Time per path sample (or gather sample) and per photon
+ * rendered sensor (at most RUN_PILOT_SIDE^2 pixels, one sample each, pass 0 twice, the
+ * second timed) and, for the integrators that need photons, a pilot photon phase of
+ * RUN_PILOT_PHOTONS (or the run's photons, if fewer): on channel 0 alone without a noise
+ * target, for every channel with one. Time per path sample (or gather sample) and per photon
  * (the emission table once), times the run's counts, gives the time; with a noise target
  * the pilot's 95th percentile of the standard error, scaled as 1/sqrt(samples), gives the
  * channel's passes. An estimate, not a promise.
@@ -29,6 +29,12 @@ typedef struct run_estimate_input {
     int threads;
     struct emission_reach *reach; /* the run's (photon_phase_options), or NULL */
 } run_estimate_input;
+
+/* The pilot's copy of sensor (*cam: at most RUN_PILOT_SIDE pixels a side, never more
+ * than the sensor's; oversampling 1) and its photons per channel (RUN_PILOT_PHOTONS, or
+ * the scene's if fewer): a pilot never does more work than the run. */
+void run_estimate_pilot(const thz_scene *scene, const thz_sensor *sensor, thz_sensor *cam,
+                        uint64_t *photons);
 
 /* *seconds_photons and *seconds_render of the whole run, s; *passes: the most a channel
  * needs. */

@@ -1,0 +1,106 @@
+/* The up-front estimate's pilot (run_estimate.c) never does more work than the run it
+ * estimates: its copy of the sensor has at most RUN_PILOT_SIDE pixels a side and no more
+ * than the sensor's, one sample a pixel, and it fires at most RUN_PILOT_PHOTONS photons and
+ * no more than the run's. A 2 x 2 camera's pilot once rendered 32 x 32 pixels: 1.4 s before
+ * a render of 5 ms. The copy is otherwise the sensor (its position and field). Then the
+ * estimate itself, on a small scene with a noise target, with a pilot of the run's size. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <string.h>
+
+#include "accel/accel.h"
+#include "run/run_estimate.h"
+#include "scene/scene.h"
+
+/* A closed box and one sensor of COLUMNS x ROWS, oversampling OVERSAMPLING, PHOTONS a
+ * channel. */
+static thz_scene *load(unsigned columns, unsigned rows, unsigned oversampling, double photons)
+{
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{\"format\": \"thzmap-scene/1\","
+             " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.05}],"
+             " \"materials\": {\"wall\": {\"reflectivity\": 0.3}},"
+             " \"objects\": [{\"name\": \"room\", \"type\": \"solid\", \"material\": \"wall\","
+             "   \"temperature_k\": 300,"
+             "   \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2], \"inward\": true}}],"
+             " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0.1, -0.5, 0.2],"
+             "   \"look_at_m\": [0, 0.5, 0], \"fov_deg\": 50, \"resolution\": [%u, %u],"
+             "   \"oversampling\": %u}],"
+             " \"photons\": {\"per_channel\": %.0f, \"seed\": 5},"
+             " \"render\": {\"integrator\": \"photon-map\"}}",
+             columns, rows, oversampling, photons);
+    thz_scene *s = NULL;
+    thz_error err;
+    if (scene_load_string(json, ".", "estimate-unit", &s, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    return s;
+}
+
+static void check_pilot(unsigned columns, unsigned rows, double photons, unsigned want_columns,
+                        unsigned want_rows, uint64_t want_photons)
+{
+    thz_scene *s = load(columns, rows, 3, photons);
+    thz_sensor cam;
+    uint64_t k = 0;
+    run_estimate_pilot(s, &s->sensors[0], &cam, &k);
+    assert_int_equal(cam.columns, want_columns);
+    assert_int_equal(cam.rows, want_rows);
+    assert_int_equal(cam.oversampling, 1);
+    assert_int_equal(k, want_photons);
+    /* the same camera otherwise */
+    assert_memory_equal(cam.position_m, s->sensors[0].position_m, sizeof cam.position_m);
+    assert_true(cam.fov_deg == s->sensors[0].fov_deg);
+    scene_destroy(s);
+}
+
+static void test_pilot_no_larger_than_the_run(void **state)
+{
+    (void)state;
+    check_pilot(2, 2, 500, 2, 2, 500);         /* both smaller than the pilot's */
+    check_pilot(640, 20, 1e6, 32, 20, 20000);  /* one side smaller */
+    check_pilot(32, 33, 20000, 32, 32, 20000); /* at the limits */
+    check_pilot(1, 1000, 19999, 1, 32, 19999); /* a column */
+    check_pilot(4096, 4096, 1e9, 32, 32, RUN_PILOT_PHOTONS);
+}
+
+/* The estimate of a small photon-map run with a noise target: its pilot fires the run's
+ * 300 photons and renders its 3 x 2 pixels. */
+static void test_estimate_small_run(void **state)
+{
+    (void)state;
+    thz_scene *s = load(3, 2, 1, 300);
+    accel *acc;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    size_t selected = 0;
+    run_estimate_input in = {.scene = s,
+                             .accel = acc,
+                             .selected = &selected,
+                             .n_selected = 1,
+                             .target_noise_k = 0.01,
+                             .threads = 1};
+    double photons_s = -1.0, render_s = -1.0;
+    uint32_t passes = 0;
+    assert_int_equal(run_estimate_time(&in, &photons_s, &render_s, &passes, &err), THZ_OK);
+    assert_true(photons_s > 0.0 && render_s > 0.0);
+    /* 300 photons cannot reach 0.01 K in a 300 K room: several passes of 300 */
+    assert_true(passes > 1);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_pilot_no_larger_than_the_run),
+        cmocka_unit_test(test_estimate_small_run),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
