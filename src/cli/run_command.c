@@ -352,8 +352,10 @@ int cli_run_command(int argc, char **argv, bool render)
         cli_mpi_abort(cli_fail(&err));
     thz_context_set_progress(ctx, cli_progress_report, &progress);
     thz_context_set_warning(ctx, cli_progress_warning, &progress);
-    a.settings.plan = cli_progress_plan;
-    a.settings.plan_user = &progress;
+    if (!a.quiet) { /* the estimate is printed only; its pilot costs a moment */
+        a.settings.plan = cli_progress_plan;
+        a.settings.plan_user = &progress;
+    }
     a.settings.seconds_load = cli_now_s() - t0;
     double t_run = cli_now_s();
     thz_run *run = NULL;
