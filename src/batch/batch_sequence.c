@@ -477,6 +477,16 @@ static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_s
         return seq_fail(b, "(top level)", "expected an object, got %s", seq_type(root));
     const char *key;
     json_t *v;
+    /* the format first: a scene file given here would otherwise be told its first key is
+     * unknown */
+    const char *format = json_string_value(json_object_get(root, "format"));
+    if (format && !strncmp(format, "thzmap-scene/", 13))
+        return seq_fail(b, "format",
+                        "expected \"thzmap-sequence/1\", got \"%s\" (a scene file, which "
+                        "`thzmap simulate` runs; a sequence names it in \"scene\")",
+                        format);
+    if (!format || strcmp(format, "thzmap-sequence/1"))
+        return seq_fail(b, "format", "%s", "expected \"thzmap-sequence/1\"");
     json_object_foreach(root, key, v)
     {
         size_t i = 0;
@@ -487,9 +497,6 @@ static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_s
                 b, key, "%s",
                 "unknown key (expected format, scene or scenes, fps, frames, keyframes, sweep)");
     }
-    const char *format = json_string_value(json_object_get(root, "format"));
-    if (!format || strcmp(format, "thzmap-sequence/1"))
-        return seq_fail(b, "format", "%s", "expected \"thzmap-sequence/1\"");
     thz_status st = batch_scenes_load(b->label, root, seq_dir, seq, &b->scenes, b->err);
     if (st != THZ_OK)
         return st;

@@ -281,8 +281,10 @@ static thz_status load_document(load_ctx *ctx, json_t *doc)
     thz_status st = load_string(ctx, &root, "format", true, NULL, &format);
     if (st == THZ_OK && strcmp(format, LOAD_FORMAT) != 0 && strcmp(format, LOAD_FORMAT_1_1) != 0) {
         load_cursor k = load_key(&root, "format");
-        return load_fail(ctx, &k, "expected \"%s\" or \"%s\", got \"%s\"", LOAD_FORMAT,
-                         LOAD_FORMAT_1_1, format);
+        bool sequence = strcmp(format, "thzmap-sequence/1") == 0;
+        return load_fail(ctx, &k, "expected \"%s\" or \"%s\", got \"%s\"%s", LOAD_FORMAT,
+                         LOAD_FORMAT_1_1, format,
+                         sequence ? " (a sequence file, which `thzmap batch` runs)" : "");
     }
     if (st == THZ_OK)
         st = load_expect_object(ctx, &root, keys);

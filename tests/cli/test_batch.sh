@@ -475,6 +475,9 @@ bad() { # bad NAME EXPECTED-TEXT JSON
 K0='{"time_s": 0, "objects": {"person": {"temperature_k": 300}}}'
 bad format 'bad-format.json: format: expected "thzmap-sequence/1"' \
     '{"format": "thzmap-scene/1", "scene": "scene.json"}'
+# a scene file given as a sequence: its format named first, not its first key as unknown
+bad scene_file 'bad-scene_file.json: format: expected "thzmap-sequence/1", got "thzmap-scene/1" (a scene file, which `thzmap simulate` runs' \
+    '{"format": "thzmap-scene/1", "name": "room", "channels": []}'
 bad unknown 'bad-unknown.json: fsp: unknown key' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fsp": 4}'
 bad order 'keyframes[1].time_s: expected keyframe times in increasing order' \
@@ -495,6 +498,12 @@ bad sweep 'sweep.objects.person.temperature_k: expected a non-empty array' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "sweep": {"objects.person.temperature_k": []}}'
 mkfifo "$work/pipe.json" # a FIFO as the scene would block the open: refused at once
 bad fifo_scene 'pipe.json: is a FIFO' '{"format": "thzmap-sequence/1", "scene": "pipe.json"}'
+# and the other way round: simulate given a sequence file
+"$THZMAP" simulate "$work/list.json" -o "$work/bad-out" 2> "$work/bad.err"
+rc=$?
+{ [ $rc -eq 2 ] && [ ! -e "$work/bad-out" ] &&
+    grep -qF 'list.json: format: expected "thzmap-scene/1" or "thzmap-scene/1.1", got "thzmap-sequence/1" (a sequence file, which `thzmap batch` runs)' "$work/bad.err"; } ||
+  fail "simulate given a sequence file: exit $rc: $(cat "$work/bad.err")"
 bad syntax 'bad-syntax.json:1:' '{"format": "thzmap-sequence/1",, }'
 bad frame_scene 'frame 2 (t = 0.5 s): ' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 3, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 0.5, "objects": {"person": {"temperature_k": -10}}}]}'
