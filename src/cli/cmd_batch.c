@@ -10,6 +10,7 @@
 
 #include "cli.h"
 #include "cli_mpi.h"
+#include "frame_warnings.h"
 #include "progress.h"
 #include "run_command.h"
 #include "thzmap/thzmap.h"
@@ -33,9 +34,6 @@ static void batch_usage(FILE *f)
                "  -q, --quiet           no progress output (warnings are still printed)\n");
 }
 
-/* Distinct warnings remembered (more are printed each time). */
-#define BATCH_SEEN_MAX 64
-
 typedef struct batch_cli {
     bool quiet;
     bool tty;           /* stderr is a terminal: the progress within frames is redrawn */
@@ -45,9 +43,7 @@ typedef struct batch_cli {
     size_t frame;       /* the frame running (its warnings name it), when in_frame */
     size_t n_frames;
     bool in_frame;
-    /* warnings printed once: the later frames' same message counted, said at the end */
-    char *seen[BATCH_SEEN_MAX];
-    size_t seen_repeats[BATCH_SEEN_MAX], n_seen;
+    cli_frame_warnings warnings; /* printed once, the later frames' same counted */
 } batch_cli;
 
 /* Within a frame: the share of the whole batch done and its ETA, on a line redrawn at
@@ -128,13 +124,8 @@ static int batch_on_run_progress(void *user, const thz_progress *p)
 static void batch_on_warning(void *user, const char *message)
 {
     batch_cli *b = user;
-    for (size_t i = 0; i < b->n_seen; i++)
-        if (!strcmp(b->seen[i], message)) {
-            b->seen_repeats[i]++;
-            return;
-        }
-    if (b->n_seen < BATCH_SEEN_MAX && (b->seen[b->n_seen] = strdup(message)))
-        b->seen_repeats[b->n_seen++] = 0;
+    if (!cli_frame_warnings_first(&b->warnings, message))
+        return;
     if (b->line_open) {
         fputs("\r\033[K", stderr);
         b->line_open = false;
@@ -277,12 +268,7 @@ int cmd_batch(int argc, char **argv)
                    1e-6 * (double)thz_context_mpi_bytes(ctx));
         printf(", %.2f s; results in %s\n", res.seconds, outdir);
     }
-    for (size_t i = 0; i < b.n_seen; i++) {
-        if (b.seen_repeats[i])
-            fprintf(stderr, "thzmap batch: warning: the same in %zu later frame%s: %s\n",
-                    b.seen_repeats[i], b.seen_repeats[i] == 1 ? "" : "s", b.seen[i]);
-        free(b.seen[i]);
-    }
+    cli_frame_warnings_finish(&b.warnings, "batch", true);
     if (shared && rc != CLI_EXIT_OK) /* the other ranks may be waiting for rank 0 */
         cli_mpi_abort(rc);
     thz_context_destroy(ctx); /* ends the other ranks' thz_mpi_serve_batch */
