@@ -1,18 +1,22 @@
 /* thzmap validate SCENE.json: loads and checks a scene, prints what it holds (its
  * channels, materials, objects with their geometry, sensors, and the emitted spectral
- * power per channel) and its warnings. Exit 0 when the scene is valid, 2 when not. */
+ * power per channel) and its warnings. Exit 0 when the scene is valid, 2 when not.
+ * thzmap validate SEQUENCE.json: the same for a sequence's frames. */
 #include <float.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
+#include "frame_warnings.h"
 #include "thzmap/thzmap.h"
 
 static void validate_usage(FILE *f)
 {
-    fprintf(f, "usage: thzmap validate SCENE.json\n\n"
+    fprintf(f, "usage: thzmap validate SCENE.json\n"
+               "       thzmap validate SEQUENCE.json\n\n"
                "Loads the scene, checks it completely (exit 0 when valid, 2 when not, naming\n"
                "the file and the line:column or JSON path of the problem) and prints its\n"
                "channels, materials, objects (triangles, area, temperature), sensors and the\n"
@@ -23,6 +27,10 @@ static void validate_usage(FILE *f)
                "Kirchhoff's law, channel bands leaving a material table, inconsistent mesh\n"
                "winding) go to standard error as \"thzmap validate: warning: ...\", as every\n"
                "command prints them.\n\n"
+               "Given a sequence file (\"thzmap-sequence/1\", which `thzmap batch` runs), it\n"
+               "checks the sequence and every frame's scene, prints the number of frames and\n"
+               "the first frame's scene as above, and each frame's warnings once, naming the\n"
+               "first frame that has it and then how many later frames repeat it.\n\n"
                "options:\n"
                "  -h, --help   show this help\n");
 }
@@ -249,6 +257,50 @@ static void validate_print(const thz_scene *s)
     }
 }
 
+/* thzmap validate SEQUENCE.json: the sequence loads (so does every frame's scene); its
+ * frames, the first frame's scene as a scene's, and every frame's warnings, each printed
+ * once with its first frame and then the number of later frames that repeat it, as
+ * `thzmap batch` prints them. */
+static int validate_sequence(const char *path)
+{
+    thz_sequence *seq = NULL;
+    thz_error err = {0};
+    if (thz_sequence_load(path, &seq, &err) != THZ_OK)
+        return cli_fail(&err);
+    size_t n = thz_sequence_frame_count(seq), per = thz_sequence_frames_per_sweep(seq);
+    thz_frame_info last;
+    thz_sequence_frame(seq, per - 1, &last);
+    printf("sequence (%s): valid\n", path);
+    printf("frames: %zu (%zu sweep value%s x %zu frame%s, t = 0 to %g s)\n", n,
+           thz_sequence_sweep_count(seq), thz_sequence_sweep_count(seq) == 1 ? "" : "s", per,
+           per == 1 ? "" : "s", last.time_s);
+    cli_frame_warnings warnings = {0};
+    int rc = CLI_EXIT_OK;
+    for (size_t f = 0; f < n && rc == CLI_EXIT_OK; f++) {
+        thz_scene *scene = NULL;
+        if (thz_sequence_frame_scene(seq, f, &scene, &err) != THZ_OK) {
+            rc = cli_fail(&err);
+            break;
+        }
+        if (f == 0) {
+            thz_frame_info fi;
+            thz_sequence_frame(seq, 0, &fi);
+            printf("\nthe first frame's scene (%s):\n\n", fi.dir);
+            validate_print(scene);
+            fflush(stdout);
+        }
+        for (size_t i = 0; i < thz_scene_warning_count(scene); i++) {
+            const char *w = thz_scene_warning(scene, i);
+            if (cli_frame_warnings_first(&warnings, w))
+                fprintf(stderr, "thzmap validate: warning: frame %zu/%zu: %s\n", f + 1, n, w);
+        }
+        thz_scene_destroy(scene);
+    }
+    cli_frame_warnings_finish(&warnings, "validate", rc == CLI_EXIT_OK);
+    thz_sequence_destroy(seq);
+    return rc;
+}
+
 int cmd_validate(int argc, char **argv)
 {
     const char *path = NULL;
@@ -268,8 +320,12 @@ int cmd_validate(int argc, char **argv)
         return cli_usage_error("validate", "expected a scene file (thzmap validate SCENE.json)");
     thz_scene *scene = NULL;
     thz_error err = {0};
-    if (thz_scene_load(path, &scene, &err) != THZ_OK)
+    if (thz_scene_load(path, &scene, &err) != THZ_OK) {
+        /* a sequence file (the scene loader names its format) */
+        if (err.status == THZ_ERR_INPUT && strstr(err.message, "got \"thzmap-sequence/1\""))
+            return validate_sequence(path);
         return cli_fail(&err);
+    }
     validate_print(scene);
     fflush(stdout);
     for (size_t i = 0; i < thz_scene_warning_count(scene); i++)

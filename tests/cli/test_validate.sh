@@ -157,5 +157,54 @@ timeout 10 "$thzmap" validate "$tmp/pipe.json" 2>"$tmp/err"
 [[ $? -eq 2 ]] || fail "validate of a FIFO must exit 2 at once"
 expect_line "$tmp/err" 'pipe\.json: is a FIFO'
 
+# --- a sequence file: its frames, the first frame's scene, every frame's warnings ----
+"$thzmap" validate "$repo/examples/walker/sequence.json" >"$tmp/walker" 2>"$tmp/err"
+status=$?
+[[ $status -eq 0 ]] || fail "walker sequence: exit $status: $(cat "$tmp/err")"
+[[ -s $tmp/err ]] && fail "walker sequence: unexpected warnings: $(cat "$tmp/err")"
+expect_line "$tmp/walker" '^sequence \(.*/walker/sequence\.json\): valid$'
+expect_line "$tmp/walker" '^frames: 25 \(1 sweep value x 25 frames, t = 0 to 3 s\)$'
+expect_line "$tmp/walker" "^the first frame's scene \(frame-00000\):$"
+expect_line "$tmp/walker" '^scene "walker"'
+# the plate in its box with a background given (a warning while the camera is in the
+# room: frame 0 of each sweep value, counting from 0), the camera leaving the room at
+# t = 1 s (a warning in frames 1 and 2 of each), swept over two temperatures of the
+# target; the warnings count the frames from 1 of 6
+cp -r "$repo/examples/plate-in-box" "$tmp/seq"
+/usr/bin/python3 - "$tmp/seq/scene.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["atmosphere"]["background_temperature_k"] = 3
+json.dump(s, open(sys.argv[1], "w"))
+PY
+cat > "$tmp/seq/sequence.json" <<'JSON'
+{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 3,
+ "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [0, -0.45, 0.4]}}},
+               {"time_s": 1, "sensors": {"cam": {"position_m": [0, -3, 0.4]}}}],
+ "sweep": {"objects.target.temperature_k": [300, 320]}}
+JSON
+"$thzmap" validate "$tmp/seq/sequence.json" >"$tmp/seq.out" 2>"$tmp/seq.err"
+status=$?
+[[ $status -eq 0 ]] || fail "a sequence with warnings: exit $status: $(cat "$tmp/seq.err")"
+expect_line "$tmp/seq.out" '^frames: 6 \(2 sweep values x 3 frames, t = 0 to 2 s\)$'
+# each warning once, with the first frame that has it, then its repeats
+[[ $(grep -c 'background_temperature_k is given' "$tmp/seq.err") -eq 2 ]] &&
+    [[ $(grep -c 'is outside the enclosure' "$tmp/seq.err") -eq 2 ]] ||
+    fail "the warnings: not each once and once repeated: $(cat "$tmp/seq.err")"
+expect_line "$tmp/seq.err" '^thzmap validate: warning: frame 1/6: atmosphere\.background_temperature_k is given'
+expect_line "$tmp/seq.err" '^thzmap validate: warning: the same in 1 later frame: atmosphere\.background_temperature_k'
+expect_line "$tmp/seq.err" '^thzmap validate: warning: frame 2/6: sensor "cam" at \[0, -3, 0\.4\] m is outside'
+expect_line "$tmp/seq.err" '^thzmap validate: warning: the same in 3 later frames: sensor "cam" .* is outside'
+# a frame whose scene is bad: exit 2, naming the frame (from 0, as batch does) and the
+# scene's JSON path
+cat > "$tmp/seq/bad.json" <<'JSON'
+{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 3,
+ "keyframes": [{"time_s": 0, "objects": {"target": {"temperature_k": 300}}},
+               {"time_s": 2, "objects": {"target": {"temperature_k": -300}}}]}
+JSON
+"$thzmap" validate "$tmp/seq/bad.json" >/dev/null 2>"$tmp/err"
+[[ $? -eq 2 ]] || fail "a sequence with a bad frame must exit 2: $(cat "$tmp/err")"
+expect_line "$tmp/err" 'bad\.json: frame 2 \(t = 2 s\): .*scene\.json: objects\[1\]\.temperature_k'
+
 [[ $failures -eq 0 ]] && echo "validate: all checks passed"
 [[ $failures -eq 0 ]]
