@@ -47,7 +47,8 @@ static void cli_run_usage(FILE *f, bool render)
                    "                        photon-map.ply\n"
                    "  --ply-max-points N    at most N photons (evenly strided) in\n"
                    "                        photon-map.ply (default 2000000)\n"
-                   "  -q, --quiet           no progress output (warnings are still printed)\n");
+                   "  -q, --quiet           no progress output and no up-front estimate\n"
+                   "                        (warnings are still printed)\n");
     else
         fprintf(f, "usage: thzmap render SCENE.json --photon-map FILE -o OUTDIR [options]\n\n"
                    "Renders the scene's sensors again from a photon map saved by\n"
@@ -65,7 +66,8 @@ static void cli_run_usage(FILE *f, bool render)
                    "                        (each pass deterministic; default as in simulate)\n"
                    "  --max-seconds S       stop adding passes once a channel has rendered for\n"
                    "                        S s (time-dependent result)\n"
-                   "  -q, --quiet           no progress output (warnings are still printed)\n");
+                   "  -q, --quiet           no progress output and no up-front estimate\n"
+                   "                        (warnings are still printed)\n");
 }
 
 typedef struct cli_run_args {
