@@ -23,13 +23,15 @@ from .progress import Progress
 from .run import (Image, PhotonMap, Result, fire_photons, load_photon_map,
                   merge_photon_maps, render, simulate)
 from .scene import Scene, load_scene, scene_from_dict, scene_from_json
+from .sequence import BatchProgress, BatchResult, Frame, Sequence, batch, load_sequence
 
 __version__ = _lib.text(_lib.lib.thz_version())
 library_path = _lib.path
 """The libthzmap file this package uses."""
 
-__all__ = ["ArgumentError", "BandSelection", "CancelledError", "Classification", "Error",
-           "Image", "OutOfMemoryError",
-           "PhotonMap", "Progress", "Result", "RunWarning", "Scene", "SceneError",
-           "bands", "classify", "fire_photons", "library_path", "load_photon_map", "load_scene",
-           "merge_photon_maps", "render", "scene_from_dict", "scene_from_json", "simulate"]
+__all__ = ["ArgumentError", "BandSelection", "BatchProgress", "BatchResult", "CancelledError",
+           "Classification", "Error", "Frame", "Image", "OutOfMemoryError",
+           "PhotonMap", "Progress", "Result", "RunWarning", "Scene", "SceneError", "Sequence",
+           "bands", "batch", "classify", "fire_photons", "library_path", "load_photon_map",
+           "load_scene", "load_sequence", "merge_photon_maps", "render", "scene_from_dict",
+           "scene_from_json", "simulate"]

@@ -64,12 +64,22 @@ class Call:
 
     # -- callbacks (run on the calling thread, with the GIL, inside the C call) ------------
     def _on_progress(self, user, p):
+        return self.guarded(self._report_progress, p)
+
+    def _report_progress(self, p):
+        if self._report is None:
+            return False
+        c = p.contents
+        return self._report(Progress(_lib.text(c.stage), c.channel, c.n_channels, c.done,
+                                     c.total))
+
+    def guarded(self, report, *args):
+        """The body of a C progress callback: calls report(*args) unless Ctrl-C was
+        pressed (a true return value cancels), keeps any exception it raises for check()
+        (and cancels), and returns what the library expects: 1 to cancel, else 0."""
         try:
-            if self._report is not None and not self._interrupted:
-                c = p.contents
-                info = Progress(_lib.text(c.stage), c.channel, c.n_channels, c.done, c.total)
-                if self._report(info):
-                    self._cancelled = True
+            if not self._interrupted and report(*args):
+                self._cancelled = True
         except BaseException as e:  # noqa: B902 - every exception must stop at this frame
             if self._exc is None:
                 self._exc = e

@@ -139,13 +139,18 @@ def _load(loader, label, path=None, text=None):
     status = loader(ctypes.byref(handle), ctypes.byref(err))
     seconds = time.perf_counter() - start
     if status != _lib.OK:
-        message = _lib.text(err.message)
-        if status == _lib.ERR_INPUT:
-            raise scene_error(message, label,
-                              _document(path, text) if path is not None or text else None)
-        from .errors import from_status
-        raise from_status(status, message)
+        raise _load_error(status, _lib.text(err.message), label, path, text)
     return Scene(handle.value, label, seconds, stamp)
+
+
+def _load_error(status, message, label, path=None, text=None):
+    """The exception for a failed load of the file at `path` (or of JSON `text`):
+    SceneError for bad input, with its JSON path told from the reason by the document."""
+    if status == _lib.ERR_INPUT:
+        return scene_error(message, label,
+                           _document(path, text) if path is not None or text else None)
+    from .errors import from_status
+    return from_status(status, message)
 
 
 def _path_arg(name, value):

@@ -9,7 +9,7 @@ import subprocess
 
 import pytest
 from conftest import REPO
-from thzmap import _lib
+from thzmap import _lib, sequence
 
 ENUMS = {"THZ_OK": _lib.OK, "THZ_ERR_INPUT": _lib.ERR_INPUT, "THZ_ERR_IO": _lib.ERR_IO,
          "THZ_ERR_NOMEM": _lib.ERR_NOMEM, "THZ_ERR_LIMIT": _lib.ERR_LIMIT,
@@ -29,7 +29,7 @@ ENUMS = {"THZ_OK": _lib.OK, "THZ_ERR_INPUT": _lib.ERR_INPUT, "THZ_ERR_IO": _lib.
 
 def expected():
     out = {}
-    for cname, struct in _lib.STRUCTS.items():
+    for cname, struct in {**_lib.STRUCTS, **sequence.STRUCTS}.items():
         out[f"sizeof {cname}"] = ctypes.sizeof(struct)
         for field, _ in struct._fields_:
             out[f"offsetof {cname}.{field}"] = getattr(struct, field).offset

@@ -1,0 +1,166 @@
+"""thzmap.load_sequence and thzmap.batch: a sequence's frames as the library interpolates
+them, a batch in memory equal byte for byte to `thzmap batch` (timings aside), resuming,
+cancelling, progress, frame warnings named and folded as the program prints them, and
+errors with the file and JSON path."""
+import json
+import os
+import shutil
+import warnings
+
+import pytest
+from conftest import PLATE, REPO, run_cli
+
+import thzmap
+
+BATCH = os.path.join(REPO, "tests", "inputs", "batch")
+SEQUENCE = os.path.join(BATCH, "sequence.json")  # 5 frames at 4 fps, the person 300 -> 308 K
+
+
+def test_frames_are_the_keyframes_interpolated():
+    seq = thzmap.load_sequence(SEQUENCE)
+    assert (len(seq), seq.n_sweeps, seq.frames_per_sweep) == (5, 1, 5)
+    assert [f.dir for f in seq.frames] == [f"frame-{i:05d}" for i in range(5)]
+    assert [f.time_s for f in seq.frames] == [0.0, 0.25, 0.5, 0.75, 1.0]
+    assert seq.frame(-1) == seq.frame(4)
+    # linear between t = 0 s (300 K, x = -0.5 m) and t = 1 s (308 K, x = 0.5 m)
+    for i, (t_k, x_m) in enumerate([(300, -0.5), (302, -0.25), (304, 0), (306, 0.25),
+                                    (308, 0.5)]):
+        person = seq.frame_dict(i)["objects"][1]
+        assert person["temperature_k"] == pytest.approx(t_k, abs=1e-12)
+        assert person["transform"]["translate_m"][0] == pytest.approx(x_m, abs=1e-12)
+    scene = seq.frame_scene(2)
+    assert [o.temperature_k for o in scene.objects] == [293, 304]
+    assert scene.warnings == []
+    # each frame's inputs hashed apart
+    assert len({f.hash for f in seq.frames}) == 5
+    with pytest.raises(thzmap.ArgumentError, match="has 5 frames"):
+        seq.frame(5)
+
+
+def _tree(outdir):
+    """Every file under outdir (the lock aside) with its bytes; batch.json and the
+    frames' summary.json without their timings."""
+    out = {}
+    for d, _, files in os.walk(outdir):
+        for name in files:
+            if name == ".thzmap-batch-lock":
+                continue
+            path = os.path.join(d, name)
+            with open(path, "rb") as f:
+                data = f.read()
+            if name in ("batch.json", "summary.json"):
+                data = _without_timings(json.loads(data))
+            out[os.path.relpath(path, outdir)] = data
+    return out
+
+
+def _without_timings(value):
+    if isinstance(value, dict):
+        return {k: _without_timings(v) for k, v in value.items()
+                if "seconds" not in k and not k.endswith("_s") or k == "time_s"}
+    if isinstance(value, list):
+        return [_without_timings(v) for v in value]
+    return value
+
+
+def test_batch_equals_the_command(tmp_path, thzmap_binary):
+    run_cli(thzmap_binary, "batch", SEQUENCE, "-o", tmp_path / "cli", "--quiet",
+            "--threads", "2")
+    result = thzmap.batch(SEQUENCE, tmp_path / "py", threads=2)
+    assert (result.n_frames, result.computed, result.reused, result.movies) == (5, 5, 0, 2)
+    assert result.summary["frames_computed"] == 5 and result.summary["complete"] is True
+    cli, py = _tree(tmp_path / "cli"), _tree(tmp_path / "py")
+    assert sorted(cli) == sorted(py)
+    assert "cam.band-01.mp4" in py and "frame-00004/cam.brightness_temperature.img" in py
+    differ = [name for name in cli if cli[name] != py[name]]
+    assert differ == [], f"files that differ from thzmap batch's: {differ}"
+
+
+def test_batch_resumes_reports_and_cancels(tmp_path):
+    seq = thzmap.load_sequence(SEQUENCE)
+    out = tmp_path / "out"
+
+    def stop_in_frame_2(p):
+        return p.stage == "run" and p.frame == 2
+
+    with pytest.raises(thzmap.CancelledError):
+        thzmap.batch(seq, out, progress=stop_in_frame_2, movies=False)
+    finished = sorted(d for d in os.listdir(out) if d.startswith("frame-"))
+    assert finished == ["frame-00000", "frame-00001"]  # finished frames stay, no staging
+
+    reports = []
+    result = thzmap.batch(seq, out, progress=reports.append, movies=False)
+    assert (result.computed, result.reused, result.movies) == (3, 2, 0)
+    assert reports[0].stage == "frame" and reports[-1].stage == "done"
+    assert reports[-1].frame == 5 and reports[-1].fraction == 1.0
+    fractions = [p.fraction for p in reports]
+    assert fractions == sorted(fractions) and fractions[0] < 1.0
+    assert {p.frame for p in reports if p.stage == "run"} == {2, 3, 4}
+
+    # an exception in the callback cancels, and is raised again after the call
+    shutil.rmtree(out)
+
+    def boom(p):
+        raise RuntimeError("from the callback")
+
+    with pytest.raises(RuntimeError, match="from the callback"):
+        thzmap.batch(seq, out, progress=boom)
+
+
+def test_batch_warnings_name_their_frame_once(tmp_path):
+    # As test_validate.sh's sequence: the plate in its box with a background given (a
+    # warning while the camera is in the room: the first frame of each sweep value), the
+    # camera leaving the room at t = 1 s (frames 2 and 3 of each: a scene warning and a
+    # run warning), swept over two temperatures of the target: 6 frames
+    shutil.copytree(PLATE, tmp_path / "plate")
+    with open(tmp_path / "plate" / "scene.json") as f:
+        scene = json.load(f)
+    scene["atmosphere"]["background_temperature_k"] = 3
+    scene["sensors"][0]["resolution"] = [8, 6]
+    scene["render"] = {"integrator": "path", "paths_per_sample": 1}
+    with open(tmp_path / "plate" / "scene.json", "w") as f:
+        json.dump(scene, f)
+    cam = [{"time_s": t, "sensors": {"cam": {"position_m": [0, y, 0.4]}}}
+           for t, y in ((0, -0.45), (1, -3))]
+    with open(tmp_path / "plate" / "sequence.json", "w") as f:
+        json.dump({"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1,
+                   "frames": 3, "keyframes": cam,
+                   "sweep": {"objects.target.temperature_k": [300, 320]}}, f)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        thzmap.batch(tmp_path / "plate" / "sequence.json", tmp_path / "out", movies=False)
+    texts = [str(w.message) for w in caught if issubclass(w.category, thzmap.RunWarning)]
+    background = [t for t in texts if "background_temperature_k is given" in t]
+    outside = [t for t in texts if "is outside the enclosure" in t]
+    back_side = [t for t in texts if "saw the back side" in t]
+    assert len(texts) == 6 and len(background) == len(outside) == len(back_side) == 2, texts
+    assert background[0].startswith("frame 1/6: atmosphere.background_temperature_k")
+    assert background[1].startswith("the same in 1 later frame: atmosphere.background")
+    assert outside[0].startswith('frame 2/6: sensor "cam" at [0, -3, 0.4] m is outside')
+    assert outside[1].startswith('the same in 3 later frames: sensor "cam" at')
+    assert back_side[0].startswith("frame 2/6: sensor 'cam': ")
+    assert back_side[1].startswith("the same in 3 later frames: sensor 'cam': ")
+
+
+def test_errors(tmp_path):
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.load_sequence(os.path.join(BATCH, "scene.json"))
+    assert e.value.path == "format" and "a scene file" in e.value.reason
+    shutil.copy(os.path.join(BATCH, "scene.json"), tmp_path / "scene.json")
+    bad = {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 2,
+           "keyframes": [{"time_s": 0, "objects": {"nobody": {"temperature_k": 300}}}]}
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.load_sequence(tmp_path / "bad.json")
+    assert e.value.file == str(tmp_path / "bad.json")
+    assert e.value.path == "keyframes[0].objects.nobody", e.value
+    with pytest.raises(thzmap.Error, match="cannot"):
+        thzmap.load_sequence(tmp_path / "missing.json")
+    with pytest.raises(thzmap.ArgumentError, match="sequence: expected"):
+        thzmap.batch(42, tmp_path / "out")
+    with pytest.raises(thzmap.ArgumentError, match="movies"):
+        thzmap.batch(SEQUENCE, tmp_path / "out", movies="no")
+    (tmp_path / "file").write_text("")
+    with pytest.raises(thzmap.Error) as e:
+        thzmap.batch(SEQUENCE, tmp_path / "file", movies=False)
+    assert e.value.status == "bad input" and "not a directory" in e.value.message
