@@ -39,6 +39,22 @@ THZ_API thz_status thz_scene_load_string_within(const char *json_text, const cha
                                                 thz_scene **out, thz_error *err);
 THZ_API void thz_scene_destroy(thz_scene *scene);
 
+/* The kinds of file thzmap reads, as thz_file_identify tells them apart. */
+typedef enum thz_file_kind {
+    THZ_FILE_OTHER = 0,     /* none of these: not JSON, or JSON of another format */
+    THZ_FILE_SCENE = 1,     /* a JSON object whose "format" is "thzmap-scene/1" or "/1.1" */
+    THZ_FILE_SEQUENCE = 2,  /* "format": "thzmap-sequence/1" (thzmap/batch.h) */
+    THZ_FILE_PHOTON_MAP = 3 /* a photon-map file (thz_photons_save), by its first bytes */
+} thz_file_kind;
+
+/* What kind of thzmap file `path` is, for a program that takes any of them (thzmap
+ * validate does): a photon-map file by its magic, a scene or sequence by the "format" of
+ * its JSON object. It tells, it does not check: the loader says whether the file is valid.
+ * THZ_OK with THZ_FILE_OTHER for any other file (also one that is not JSON, or JSON larger
+ * than a scene may be); THZ_ERR_INPUT when path is not a regular file (a directory, a FIFO,
+ * missing) or cannot be read; THZ_ERR_NOMEM. */
+THZ_API thz_status thz_file_identify(const char *path, thz_file_kind *out, thz_error *err);
+
 /* The scene as a whole and its run settings (the `photons` and `render` blocks). */
 typedef struct thz_scene_info {
     const char *name;

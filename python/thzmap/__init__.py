@@ -22,7 +22,7 @@ from .errors import (ArgumentError, CancelledError, Error, OutOfMemoryError,
 from .progress import Progress
 from .run import (Image, PhotonMap, Result, fire_photons, load_photon_map,
                   merge_photon_maps, render, simulate)
-from .scene import Scene, load_scene, scene_from_dict, scene_from_json
+from .scene import Scene, identify, load_scene, scene_from_dict, scene_from_json
 from .sequence import BatchProgress, BatchResult, Frame, Sequence, batch, load_sequence
 
 __version__ = _lib.text(_lib.lib.thz_version())
@@ -32,6 +32,6 @@ library_path = _lib.path
 __all__ = ["ArgumentError", "BandSelection", "BatchProgress", "BatchResult", "CancelledError",
            "Classification", "Error", "Frame", "Image", "OutOfMemoryError",
            "PhotonMap", "Progress", "Result", "RunWarning", "Scene", "SceneError", "Sequence",
-           "bands", "batch", "classify", "fire_photons", "library_path", "load_photon_map",
-           "load_scene", "load_sequence", "merge_photon_maps", "render", "scene_from_dict",
-           "scene_from_json", "simulate"]
+           "bands", "batch", "classify", "fire_photons", "identify", "library_path",
+           "load_photon_map", "load_scene", "load_sequence", "merge_photon_maps", "render",
+           "scene_from_dict", "scene_from_json", "simulate"]

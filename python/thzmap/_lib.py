@@ -40,6 +40,9 @@ PLANE_VISUAL_RGB = 8
 PLANE_MEASURED_RADIANCE = 9
 PLANE_MEASURED_BRIGHTNESS_TEMPERATURE = 10
 
+# ---- file kinds (scene.h, enum thz_file_kind) ------------------------------------------
+FILE_KINDS = {0: "other", 1: "scene", 2: "sequence", 3: "photon-map"}
+
 
 # ---- structures ------------------------------------------------------------------------
 class ThzError(Structure):
@@ -158,6 +161,7 @@ _PROTOTYPES = {
     "thz_scene_load_within": (c_int, [c_char_p, c_char_p, _PP, _ERR]),
     "thz_scene_load_string_within": (c_int, [c_char_p, c_char_p, c_char_p, c_char_p, _PP, _ERR]),
     "thz_scene_destroy": (None, [_P]),
+    "thz_file_identify": (c_int, [c_char_p, POINTER(c_int), _ERR]),
     "thz_scene_get_info": (c_int, [_P, POINTER(ThzSceneInfo)]),
     "thz_scene_channel": (c_int, [_P, c_size_t, POINTER(ThzChannelInfo)]),
     "thz_scene_material": (c_int, [_P, c_size_t, POINTER(ThzMaterialInfo)]),

@@ -184,6 +184,21 @@ def load_scene(path, root=None):
         os.fsencode(path), r, out, err), path, path)
 
 
+def identify(path):
+    """What kind of thzmap file `path` is: "scene", "sequence" (for load_sequence),
+    "photon-map" (a .thzpm file, for load_photon_map) or "other", from its first bytes or
+    its JSON "format"; it does not check the file (the loaders do). Raises Error for a
+    path that is not a regular file."""
+    path = _path_arg("path", path)
+    kind = ctypes.c_int(0)
+    err = _lib.ThzError()
+    status = _lib.lib.thz_file_identify(os.fsencode(path), ctypes.byref(kind), ctypes.byref(err))
+    if status != _lib.OK:
+        from .errors import from_status
+        raise from_status(status, _lib.text(err.message))
+    return _lib.FILE_KINDS[kind.value]
+
+
 def _check_json_values(value, path, label):
     """Raises SceneError at the first value JSON cannot hold (NaN, infinity, other
     types), naming its JSON path as the library would."""

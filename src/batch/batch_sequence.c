@@ -480,13 +480,13 @@ static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_s
     /* the format first: a scene file given here would otherwise be told its first key is
      * unknown */
     const char *format = json_string_value(json_object_get(root, "format"));
-    if (format && !strncmp(format, "thzmap-scene/", 13))
+    if (format && (!strcmp(format, LOAD_FORMAT) || !strcmp(format, LOAD_FORMAT_1_1)))
         return seq_fail(b, "format",
-                        "expected \"thzmap-sequence/1\", got \"%s\" (a scene file, which "
-                        "`thzmap simulate` runs; a sequence names it in \"scene\")",
+                        "expected \"" LOAD_SEQUENCE_FORMAT "\", got \"%s\" (a scene file, "
+                        "which `thzmap simulate` runs; a sequence names it in \"scene\")",
                         format);
-    if (!format || strcmp(format, "thzmap-sequence/1"))
-        return seq_fail(b, "format", "%s", "expected \"thzmap-sequence/1\"");
+    if (!format || strcmp(format, LOAD_SEQUENCE_FORMAT))
+        return seq_fail(b, "format", "%s", "expected \"" LOAD_SEQUENCE_FORMAT "\"");
     json_object_foreach(root, key, v)
     {
         size_t i = 0;

@@ -319,12 +319,13 @@ int cmd_validate(int argc, char **argv)
         return cli_usage_error("validate", "expected a scene file (thzmap validate SCENE.json)");
     thz_scene *scene = NULL;
     thz_error err = {0};
-    if (thz_scene_load(path, &scene, &err) != THZ_OK) {
-        /* a sequence file (the scene loader names its format) */
-        if (err.status == THZ_ERR_INPUT && strstr(err.message, "got \"thzmap-sequence/1\""))
-            return validate_sequence(path);
+    thz_file_kind kind = THZ_FILE_OTHER;
+    if (thz_file_identify(path, &kind, &err) != THZ_OK)
         return cli_fail(&err);
-    }
+    if (kind == THZ_FILE_SEQUENCE)
+        return validate_sequence(path);
+    if (thz_scene_load(path, &scene, &err) != THZ_OK)
+        return cli_fail(&err);
     validate_print(scene);
     fflush(stdout);
     for (size_t i = 0; i < thz_scene_warning_count(scene); i++)

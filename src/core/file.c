@@ -1,7 +1,9 @@
-/* The regular-file check of input files. */
+/* The regular-file check of input files, and what a file is from its first bytes. */
 #include "core/file.h"
 
 #include <errno.h>
+#include <stdbool.h>
+#include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 
@@ -40,4 +42,45 @@ thz_status file_check_regular(const char *path, const char *label, uint64_t max_
     if (size_bytes)
         *size_bytes = size;
     return THZ_OK;
+}
+
+size_t file_read_head(const char *path, unsigned char *head)
+{
+    struct stat info;
+    if (stat(path, &info) != 0 || !S_ISREG(info.st_mode))
+        return 0; /* a FIFO would block the open */
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 0;
+    size_t n = fread(head, 1, FILE_HEAD_BYTES, f);
+    fclose(f);
+    return n;
+}
+
+static bool file_starts(const unsigned char *head, size_t n, const char *magic, size_t len)
+{
+    return n >= len && memcmp(head, magic, len) == 0;
+}
+
+const char *file_kind_hint(const unsigned char *head, size_t n)
+{
+    static const struct {
+        const char *magic;
+        size_t offset, len;
+        const char *what;
+    } kinds[] = {
+        {FILE_MAGIC_PHOTON_MAP, 0, 8,
+         "a photon-map file, which `thzmap render --photon-map` reads"},
+        {"ply\n", 0, 4, "a PLY mesh, which a scene names in an object's \"mesh\""},
+        {"ply\r\n", 0, 5, "a PLY mesh, which a scene names in an object's \"mesh\""},
+        {"glTF", 0, 4, "a glTF binary mesh, which a scene names in an object's \"mesh\""},
+        {"\x89PNG\r\n\x1a\n", 0, 8, "a PNG image"},
+        {"ENVI", 0, 4, "an ENVI header"},
+        {"ftyp", 4, 4, "an MP4 movie"},
+    };
+    for (size_t i = 0; i < sizeof kinds / sizeof kinds[0]; i++)
+        if (n >= kinds[i].offset &&
+            file_starts(head + kinds[i].offset, n - kinds[i].offset, kinds[i].magic, kinds[i].len))
+            return kinds[i].what;
+    return NULL;
 }

@@ -1,11 +1,13 @@
 /* Input files: the one check every reader makes before it opens a file, so that a FIFO
  * or a device given as an input (which would block the open or never end) and a file
  * larger than the reader's limit are refused with a message instead of a hang or an
- * exhausted memory.
+ * exhausted memory; and what a file is from its first bytes, for the message when a
+ * file of one kind is given where another was expected.
  */
 #ifndef THZ_CORE_FILE_H
 #define THZ_CORE_FILE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "core/error.h"
@@ -17,5 +19,20 @@
  * open the file (opening a FIFO blocks). */
 thz_status file_check_regular(const char *path, const char *label, uint64_t max_bytes,
                               uint64_t *size_bytes, thz_error *err);
+
+/* The first bytes of thzmap's photon-map file (io/photon_map_file.h gives its layout). */
+#define FILE_MAGIC_PHOTON_MAP "THZPMAP\x1a"
+/* The bytes file_read_head reads (every magic below fits). */
+#define FILE_HEAD_BYTES 16u
+
+/* Reads up to FILE_HEAD_BYTES bytes from the start of the regular file at path into
+ * head (its size at least FILE_HEAD_BYTES); returns how many, 0 when it cannot. */
+size_t file_read_head(const char *path, unsigned char *head);
+
+/* What a file is from its first n bytes, as a phrase for a message: "a photon-map file,
+ * which `thzmap render --photon-map` reads", "a PLY mesh, which a scene names in an
+ * object's \"mesh\"", a glTF binary mesh, a PNG image, an ENVI header, an MP4 movie; NULL
+ * for anything else (JSON among it). */
+const char *file_kind_hint(const unsigned char *head, size_t n);
 
 #endif

@@ -32,12 +32,14 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "core/file.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
 #include "scene/scene.h"
 
 #define PHOTON_MAP_FILE_VERSION 4u
-#define PHOTON_MAP_FILE_MAGIC "THZPMAP\x1a"
+/* core/file.h holds the magic: a file given where JSON was expected is named by it */
+#define PHOTON_MAP_FILE_MAGIC FILE_MAGIC_PHOTON_MAP
 
 /* What a file says beyond its maps. */
 typedef struct photon_map_file_info {

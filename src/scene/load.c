@@ -18,11 +18,6 @@
 #include "scene/mesh_import.h"
 #include "scene/scene_checks.h"
 
-#define LOAD_FORMAT "thzmap-scene/1"
-/* Format 1.1 adds optional keys only (scene-format.md): a file may say so. */
-#define LOAD_FORMAT_1_1 "thzmap-scene/1.1"
-/* A scene file larger than this is refused before it is read (as the CSV reader caps its
- * tables): scenes are kilobytes; inline tables may make them megabytes. */
 /* Explicit emissivity may differ from Kirchhoff's value by this much before validate
  * warns (physics.md "Surfaces"). */
 #define LOAD_KIRCHHOFF_TOLERANCE 0.01
@@ -281,7 +276,7 @@ static thz_status load_document(load_ctx *ctx, json_t *doc)
     thz_status st = load_string(ctx, &root, "format", true, NULL, &format);
     if (st == THZ_OK && strcmp(format, LOAD_FORMAT) != 0 && strcmp(format, LOAD_FORMAT_1_1) != 0) {
         load_cursor k = load_key(&root, "format");
-        bool sequence = strcmp(format, "thzmap-sequence/1") == 0;
+        bool sequence = strcmp(format, LOAD_SEQUENCE_FORMAT) == 0;
         return load_fail(ctx, &k, "expected \"%s\" or \"%s\", got \"%s\"%s", LOAD_FORMAT,
                          LOAD_FORMAT_1_1, format,
                          sequence ? " (a sequence file, which `thzmap batch` runs)" : "");
@@ -389,17 +384,23 @@ static thz_status load_finish(thz_scene **scene, json_t *doc, const char *root, 
     return st;
 }
 
-/* The error of a failed parse: out of memory, or the syntax error jansson found. */
+/* The error of a failed parse: out of memory, or the syntax error jansson found, and
+ * what the file is when its first bytes tell (real: the file's path, NULL for a text). */
 static thz_status load_syntax_error(const char *label, const char *what, const json_error_t *je,
-                                    bool out_of_memory, thz_error *err)
+                                    bool out_of_memory, const char *real, thz_error *err)
 {
     if (out_of_memory)
         return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while parsing the %s", label,
                              what);
+    unsigned char head[FILE_HEAD_BYTES];
+    const char *kind = real ? file_kind_hint(head, file_read_head(real, head)) : NULL;
+    char is[160] = "";
+    if (kind)
+        snprintf(is, sizeof is, " (the file is %s)", kind);
     if (je->line > 0)
-        return thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s", label, je->line,
-                             je->column, je->text);
-    return thz_error_set(err, THZ_ERR_INPUT, "%s: invalid JSON: %s", label, je->text);
+        return thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s%s", label, je->line,
+                             je->column, je->text, is);
+    return thz_error_set(err, THZ_ERR_INPUT, "%s: invalid JSON: %s%s", label, je->text, is);
 }
 
 thz_status load_json_file(const char *path, const char *real, const char *label, const char *what,
@@ -425,7 +426,7 @@ thz_status load_json_file(const char *path, const char *real, const char *label,
     bool oom = false;
     *out = load_json_parse(f, NULL, &je, &oom);
     fclose(f);
-    return *out ? THZ_OK : load_syntax_error(path, what, &je, oom, err);
+    return *out ? THZ_OK : load_syntax_error(path, what, &je, oom, real, err);
 }
 
 thz_status scene_load_within(const char *path, const char *root, thz_scene **out, thz_error *err)
@@ -481,7 +482,7 @@ thz_status scene_load_string_within(const char *json_text, const char *base_dir,
     json_t *doc = load_json_parse(NULL, json_text, &je, &oom);
     if (!doc) {
         free(root_real);
-        return load_syntax_error(label, "scene", &je, oom, err);
+        return load_syntax_error(label, "scene", &je, oom, NULL, err);
     }
     st = load_begin(label, base_dir ? base_dir : ".", out, err);
     st = load_finish(out, doc, root_real, st, err);

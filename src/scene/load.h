@@ -29,7 +29,16 @@
  * (load_json.c). */
 json_t *load_json_parse(FILE *f, const char *text, json_error_t *je, bool *out_of_memory);
 
-/* The most a scene file may hold (a sequence and the scenes it lists too). */
+/* The "format" of a scene file; format 1.1 adds optional keys only (scene-format.md): a
+ * file may say so. A sequence file's (batch/), named here for the scene loader's message
+ * when it is given one. */
+#define LOAD_FORMAT "thzmap-scene/1"
+#define LOAD_FORMAT_1_1 "thzmap-scene/1.1"
+#define LOAD_SEQUENCE_FORMAT "thzmap-sequence/1"
+
+/* The most a scene file may hold (a sequence and the scenes it lists too): it is refused
+ * before it is read (as the CSV reader caps its tables); scenes are kilobytes, inline
+ * tables may make them megabytes. */
 #define LOAD_MAX_SCENE_BYTES (256u * 1024u * 1024u)
 
 /* Reads the JSON document of the file at path as the scene loader does: a regular file

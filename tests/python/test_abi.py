@@ -24,7 +24,9 @@ ENUMS = {"THZ_OK": _lib.OK, "THZ_ERR_INPUT": _lib.ERR_INPUT, "THZ_ERR_IO": _lib.
          "THZ_PLANE_VISUAL_RGB": _lib.PLANE_VISUAL_RGB,
          "THZ_PLANE_MEASURED_RADIANCE": _lib.PLANE_MEASURED_RADIANCE,
          "THZ_PLANE_MEASURED_BRIGHTNESS_TEMPERATURE":
-             _lib.PLANE_MEASURED_BRIGHTNESS_TEMPERATURE}
+             _lib.PLANE_MEASURED_BRIGHTNESS_TEMPERATURE,
+         **{f"THZ_FILE_{name.upper().replace('-', '_')}": value
+            for value, name in _lib.FILE_KINDS.items()}}
 
 
 def expected():

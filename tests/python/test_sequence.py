@@ -1,7 +1,7 @@
 """thzmap.load_sequence and thzmap.batch: a sequence's frames as the library interpolates
 them, a batch in memory equal byte for byte to `thzmap batch` (timings aside), resuming,
 cancelling, progress, frame warnings named and folded as the program prints them, and
-errors with the file and JSON path."""
+errors with the file and JSON path. thzmap.identify tells a sequence from a scene."""
 import json
 import os
 import shutil
@@ -164,3 +164,16 @@ def test_errors(tmp_path):
     with pytest.raises(thzmap.Error) as e:
         thzmap.batch(SEQUENCE, tmp_path / "file", movies=False)
     assert e.value.status == "bad input" and "not a directory" in e.value.message
+
+
+def test_identify_tells_the_files_apart(tmp_path):
+    assert thzmap.identify(SEQUENCE) == "sequence"
+    assert thzmap.identify(os.path.join(BATCH, "scene.json")) == "scene"
+    scene = thzmap.load_scene(os.path.join(BATCH, "scene.json"))
+    thzmap.fire_photons(scene, integrator="photon-map", photons=100, seed=1).save(
+        tmp_path / "map.thzpm")
+    assert thzmap.identify(tmp_path / "map.thzpm") == "photon-map"
+    (tmp_path / "other.json").write_text('{"format": "thzmap-batch/1"}')
+    assert thzmap.identify(tmp_path / "other.json") == "other"
+    with pytest.raises(thzmap.Error, match="is a directory"):
+        thzmap.identify(tmp_path)
