@@ -61,6 +61,36 @@ static void plate_in_frame(const thz_sequence *seq, size_t i, double *x, double 
     thz_scene_destroy(scene);
 }
 
+/* A sweep of n values of one frame each: its first and last directories, which must sort
+ * in order (two digits to 100 values, three beyond). */
+static void sweep_dirs(const char *dir, size_t n, const char *first, const char *last)
+{
+    char path[4200], *text = malloc(64 * n + 200);
+    if (!text) {
+        CHECK(0, "out of memory");
+        return;
+    }
+    size_t k = (size_t)sprintf(text, "{\"format\": \"thzmap-sequence/1\", \"scene\": "
+                                     "\"scene.json\", \"frames\": 1, \"sweep\": "
+                                     "{\"objects.plate.temperature_k\": [");
+    for (size_t i = 0; i < n; i++)
+        k += (size_t)sprintf(text + k, "%s%zu", i ? ", " : "", 300 + i);
+    sprintf(text + k, "]}}\n");
+    snprintf(path, sizeof path, "%s/sweep-%zu.json", dir, n);
+    test_write_file(path, text);
+    free(text);
+    thz_error err = {0};
+    thz_sequence *seq = NULL;
+    thz_frame_info a = {0}, b = {0};
+    REQUIRE_OK(thz_sequence_load(path, &seq, &err), &err);
+    CHECK(thz_sequence_frame_count(seq) == n && thz_sequence_frame(seq, 0, &a) == THZ_OK &&
+              thz_sequence_frame(seq, n - 1, &b) == THZ_OK && !strcmp(a.dir, first) &&
+              !strcmp(b.dir, last),
+          "%zu sweep values: %zu frames in %s .. %s, expected %s .. %s", n,
+          thz_sequence_frame_count(seq), a.dir ? a.dir : "?", b.dir ? b.dir : "?", first, last);
+    thz_sequence_destroy(seq);
+}
+
 int main(int argc, char **argv)
 {
     (void)argc;
@@ -152,6 +182,11 @@ int main(int argc, char **argv)
     CHECK(thz_sequence_frame_scene(seq, 10, &bad, &err) == THZ_ERR_INPUT && bad == NULL,
           "frame 10's scene: not refused");
     thz_sequence_destroy(seq);
+
+    /* sweep directories sort in order: sweep-00 .. sweep-99, sweep-000 .. sweep-100 (the
+     * batch writes where these say: test_batch.sh) */
+    sweep_dirs(dir, 100, "sweep-00/frame-00000", "sweep-99/frame-00000");
+    sweep_dirs(dir, 101, "sweep-000/frame-00000", "sweep-100/frame-00000");
 
     return test_finish(argv[0], dir);
 }
