@@ -21,8 +21,11 @@ thz_status thz_file_identify(const char *path, thz_file_kind *out, thz_error *er
     if (st != THZ_OK)
         return st;
     unsigned char head[FILE_HEAD_BYTES];
+    errno = 0;
     size_t n = file_read_head(path, head);
-    if (n == 0 && size > 0)
+    if (n == 0 && size > 0 && errno == ENOMEM)
+        return thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory while opening the file", path);
+    if (n == 0 && size > 0 && errno != 0)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot read: %s", path, strerror(errno));
     if (n >= 8 && memcmp(head, FILE_MAGIC_PHOTON_MAP, 8) == 0) {
         *out = THZ_FILE_PHOTON_MAP;

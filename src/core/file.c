@@ -2,10 +2,11 @@
 #include "core/file.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdbool.h>
-#include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* What a non-regular file is, for the message. */
 static const char *file_kind(mode_t mode)
@@ -48,12 +49,22 @@ size_t file_read_head(const char *path, unsigned char *head)
 {
     struct stat info;
     if (stat(path, &info) != 0 || !S_ISREG(info.st_mode))
-        return 0; /* a FIFO would block the open */
-    FILE *f = fopen(path, "rb");
-    if (!f)
+        return 0;                              /* a FIFO would block the open */
+    int fd = open(path, O_RDONLY | O_CLOEXEC); /* not stdio's: it allocates a buffer */
+    if (fd < 0)
         return 0;
-    size_t n = fread(head, 1, FILE_HEAD_BYTES, f);
-    fclose(f);
+    size_t n = 0;
+    while (n < FILE_HEAD_BYTES) {
+        ssize_t got = read(fd, head + n, FILE_HEAD_BYTES - n);
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got <= 0)
+            break;
+        n += (size_t)got;
+    }
+    int saved = errno;
+    close(fd);
+    errno = saved;
     return n;
 }
 

@@ -26,7 +26,8 @@ thz_status file_check_regular(const char *path, const char *label, uint64_t max_
 #define FILE_HEAD_BYTES 16u
 
 /* Reads up to FILE_HEAD_BYTES bytes from the start of the regular file at path into
- * head (its size at least FILE_HEAD_BYTES); returns how many, 0 when it cannot. */
+ * head (its size at least FILE_HEAD_BYTES); returns how many, 0 when it cannot (errno
+ * then says why). It allocates nothing. */
 size_t file_read_head(const char *path, unsigned char *head);
 
 /* What a file is from its first n bytes, as a phrase for a message: "a photon-map file,
