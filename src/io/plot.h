@@ -22,7 +22,9 @@
 
 /* THZ_OK if PLplot has the pngcairo device; otherwise THZ_ERR_IO with a message
  * naming the missing package. (PLplot asked for a missing device exits the process,
- * so every figure checks this first.) */
+ * so every figure checks this first, in its child.) Checked in a child process once per
+ * process and PLPLOT_DRV_DIR: a success is remembered (a failure is not), so a batch's
+ * frames and a library caller's runs do not start a child each for it. */
 thz_status plot_check_device(thz_error *err);
 
 /* Text: titles and curve names are shown as given ('#', PLplot's escape character,
@@ -80,11 +82,17 @@ thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_
 /* A batch of figures drawn by a few child processes at once: plot_image's and
  * plot_lines' figures, added in order (the batch copies every text and a line plot's
  * arrays; an image's values must stay valid until plot_batch_run), then drawn by up to
- * `processes` children (0: one per online processor), each drawing a contiguous share
- * in order: one process start and one PLplot, cairo and fontconfig set-up per child
- * rather than per figure, and the shares side by side. Returns THZ_OK or the failure of
- * the first figure that failed, in the order they were added (a child stops at its
- * first); the figures before it are written. */
+ * `processes` children (0: one per online processor), and by no more than one per
+ * PLOT_FIGURES_PER_CHILD figures, each drawing a contiguous share in order: one process
+ * start and one PLplot, cairo and fontconfig set-up per child rather than per figure,
+ * and the shares side by side. Returns THZ_OK or the failure of the first figure that
+ * failed, in the order they were added (a child stops at its first); the figures before
+ * it are written. */
+/* A child's set-up (fork, PLplot's cairo driver and its libraries loaded, fontconfig)
+ * costs about two figures' drawing (a 4 x 3 sensor's three figures: 0.17 s of CPU in one
+ * child, 0.23 s in two, the same wall time; the paper's scene's seven: 0.27 s of wall
+ * time in one child, 0.18-0.20 s in two). */
+#define PLOT_FIGURES_PER_CHILD 3u
 typedef struct plot_batch plot_batch;
 
 plot_batch *plot_batch_create(void); /* NULL: out of memory */

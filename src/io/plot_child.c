@@ -2,6 +2,7 @@
  * (plot_image, plot_lines, plot_attenuation) or a batch of them by a few children at once
  * (plot_batch_*).
  */
+#include <pthread.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -42,10 +43,31 @@ static thz_status plot_check_device_child(void *arg, thz_error *err)
     return plot_check_device_here(arg, err);
 }
 
+/* The PLPLOT_DRV_DIR of the last check that found the device ("" when unset), and
+ * whether there was one; guarded by the mutex (runs may write outputs from several
+ * threads: the GUI server's jobs). */
+static pthread_mutex_t plot_device_lock = PTHREAD_MUTEX_INITIALIZER;
+static bool plot_device_found;
+static char plot_device_dir[PLOT_CHILD_TEXT];
+
 thz_status plot_check_device(thz_error *err)
 {
-    return child_run("checking PLplot's devices", plot_check_device_child, NULL, plot_timeout_s(0),
-                     err);
+    const char *env = getenv("PLPLOT_DRV_DIR");
+    const char *dir = env ? env : "";
+    pthread_mutex_lock(&plot_device_lock);
+    bool known = plot_device_found && strcmp(plot_device_dir, dir) == 0;
+    pthread_mutex_unlock(&plot_device_lock);
+    if (known)
+        return THZ_OK;
+    thz_status st = child_run("checking PLplot's devices", plot_check_device_child, NULL,
+                              plot_timeout_s(0), err);
+    if (st == THZ_OK && strlen(dir) < sizeof plot_device_dir) {
+        pthread_mutex_lock(&plot_device_lock);
+        strcpy(plot_device_dir, dir);
+        plot_device_found = true;
+        pthread_mutex_unlock(&plot_device_lock);
+    }
+    return st;
 }
 
 /* plot_attenuation's arguments, passed to its child (which sees the caller's memory). */
@@ -257,7 +279,9 @@ thz_status plot_batch_run(plot_batch *b, int processes, const cancel_check *canc
         long cpus = sysconf(_SC_NPROCESSORS_ONLN);
         k = cpus > 0 ? (size_t)cpus : 1;
     }
-    k = k < b->n ? k : b->n;
+    size_t most = b->n / PLOT_FIGURES_PER_CHILD; /* a child's set-up is worth it */
+    most = most > 0 ? most : 1;
+    k = k < most ? k : most;
     k = k < CHILD_GROUP_MAX ? k : CHILD_GROUP_MAX;
     plot_share shares[CHILD_GROUP_MAX];
     void *args[CHILD_GROUP_MAX];
