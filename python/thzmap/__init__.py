@@ -19,6 +19,8 @@ from .band_selection import BandSelection, bands
 from .classification import Classification, classify
 from .errors import (ArgumentError, CancelledError, Error, OutOfMemoryError,
                      SceneError)
+from .optics import (Atmosphere, MaterialLibrary, atmosphere, brightness_temperature,
+                     material_library, planck_radiance, surface_optics)
 from .progress import Progress
 from .run import (Image, PhotonMap, Result, fire_photons, load_photon_map,
                   merge_photon_maps, render, simulate)
@@ -29,9 +31,11 @@ __version__ = _lib.text(_lib.lib.thz_version())
 library_path = _lib.path
 """The libthzmap file this package uses."""
 
-__all__ = ["ArgumentError", "BandSelection", "BatchProgress", "BatchResult", "CancelledError",
-           "Classification", "Error", "Frame", "Image", "OutOfMemoryError",
-           "PhotonMap", "Progress", "Result", "RunWarning", "Scene", "SceneError", "Sequence",
-           "bands", "batch", "classify", "fire_photons", "identify", "library_path",
-           "load_photon_map", "load_scene", "load_sequence", "merge_photon_maps", "render",
-           "scene_from_dict", "scene_from_json", "simulate"]
+__all__ = ["ArgumentError", "Atmosphere", "BandSelection", "BatchProgress", "BatchResult",
+           "CancelledError", "Classification", "Error", "Frame", "Image", "MaterialLibrary",
+           "OutOfMemoryError", "PhotonMap", "Progress", "Result", "RunWarning", "Scene",
+           "SceneError", "Sequence", "atmosphere", "bands", "batch", "brightness_temperature",
+           "classify", "fire_photons", "identify", "library_path", "load_photon_map",
+           "load_scene", "load_sequence", "material_library", "merge_photon_maps",
+           "planck_radiance", "render", "scene_from_dict", "scene_from_json", "simulate",
+           "surface_optics"]

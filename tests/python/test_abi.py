@@ -9,7 +9,7 @@ import subprocess
 
 import pytest
 from conftest import REPO
-from thzmap import _lib, sequence
+from thzmap import _lib, optics, sequence
 
 ENUMS = {"THZ_OK": _lib.OK, "THZ_ERR_INPUT": _lib.ERR_INPUT, "THZ_ERR_IO": _lib.ERR_IO,
          "THZ_ERR_NOMEM": _lib.ERR_NOMEM, "THZ_ERR_LIMIT": _lib.ERR_LIMIT,
@@ -26,12 +26,14 @@ ENUMS = {"THZ_OK": _lib.OK, "THZ_ERR_INPUT": _lib.ERR_INPUT, "THZ_ERR_IO": _lib.
          "THZ_PLANE_MEASURED_BRIGHTNESS_TEMPERATURE":
              _lib.PLANE_MEASURED_BRIGHTNESS_TEMPERATURE,
          **{f"THZ_FILE_{name.upper().replace('-', '_')}": value
-            for value, name in _lib.FILE_KINDS.items()}}
+            for value, name in _lib.FILE_KINDS.items()},
+         **{f"THZ_HUMIDITY_{name.upper()}": value
+            for name, value in optics.HUMIDITY_KINDS.items()}}
 
 
 def expected():
     out = {}
-    for cname, struct in {**_lib.STRUCTS, **sequence.STRUCTS}.items():
+    for cname, struct in {**_lib.STRUCTS, **sequence.STRUCTS, **optics.STRUCTS}.items():
         out[f"sizeof {cname}"] = ctypes.sizeof(struct)
         for field, _ in struct._fields_:
             out[f"offsetof {cname}.{field}"] = getattr(struct, field).offset
