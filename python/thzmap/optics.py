@@ -387,25 +387,23 @@ def surface_optics(scene, material, frequency_thz, thickness_m=0.0):
     return SurfaceOptics(*values)
 
 
+def _per_frequency(fn, frequency_thz, other):
+    """fn(freq_hz, x) over frequency_thz and `other` broadcast against each other."""
+    f = np.asarray(frequency_thz, dtype=np.float64)
+    _frequencies(f)
+    fb, xb = np.broadcast_arrays(f, np.asarray(other, dtype=np.float64))
+    out = np.array([fn(float(a) * 1e12, float(b)) for a, b in zip(fb.ravel(), xb.ravel())])
+    out = out.reshape(fb.shape)
+    return float(out) if out.ndim == 0 else out
+
+
 def planck_radiance(frequency_thz, temperature_k):
     """Planck's B_nu(T) in W m^-2 sr^-1 Hz^-1, as the images use it; frequency_thz and
     temperature_k broadcast against each other."""
-    f = np.asarray(frequency_thz, dtype=np.float64)
-    t = np.asarray(temperature_k, dtype=np.float64)
-    _frequencies(f)
-    fb, tb = np.broadcast_arrays(f, t)
-    out = np.array([_lib.lib.thz_planck_radiance(float(x) * 1e12, float(y))
-                    for x, y in zip(fb.ravel(), tb.ravel())]).reshape(fb.shape)
-    return float(out) if out.ndim == 0 else out
+    return _per_frequency(_lib.lib.thz_planck_radiance, frequency_thz, temperature_k)
 
 
 def brightness_temperature(frequency_thz, radiance):
     """The brightness temperature in K of a radiance (W m^-2 sr^-1 Hz^-1) at
     frequency_thz, Planck's law inverted (0 for radiance <= 0); broadcasts."""
-    f = np.asarray(frequency_thz, dtype=np.float64)
-    r = np.asarray(radiance, dtype=np.float64)
-    _frequencies(f)
-    fb, rb = np.broadcast_arrays(f, r)
-    out = np.array([_lib.lib.thz_brightness_temperature(float(x) * 1e12, float(y))
-                    for x, y in zip(fb.ravel(), rb.ravel())]).reshape(fb.shape)
-    return float(out) if out.ndim == 0 else out
+    return _per_frequency(_lib.lib.thz_brightness_temperature, frequency_thz, radiance)
