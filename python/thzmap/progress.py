@@ -64,13 +64,13 @@ class _Callback:
         return bool(self._fn(p))
 
 
-def make_reporter(progress):
-    """None/False: no reports; True: a bar; a callable: called with a Progress, a true
-    return value cancels the run."""
+def make_reporter(progress, bar=None):
+    """None/False: no reports; True: a bar (`bar()`, default a run's _Bar); a callable:
+    called with each report, a true return value cancels the run."""
     if progress is None or progress is False:
         return None
     if progress is True:
-        return _Bar()
+        return bar() if bar is not None else _Bar()
     if callable(progress):
         return _Callback(progress)
     raise ArgumentError(f"progress: expected None, True or a callable, got {progress!r}")

@@ -21,6 +21,7 @@ from ctypes import (CFUNCTYPE, POINTER, Structure, c_char_p, c_double, c_int, c_
 from . import _lib
 from ._call import Call
 from .errors import ArgumentError
+from .progress import make_reporter
 from .scene import _load, _load_error, _path_arg, _root_arg
 
 
@@ -254,16 +255,6 @@ class _BatchBar:
         self._bar = None
 
 
-def _batch_reporter(progress):
-    if progress is None or progress is False:
-        return None
-    if progress is True:
-        return _BatchBar()
-    if callable(progress):
-        return lambda p: bool(progress(p))
-    raise ArgumentError(f"progress: expected None, True or a callable, got {progress!r}")
-
-
 def batch(sequence, outdir, threads=None, progress=None, movies=True):
     """`thzmap batch SEQUENCE -o OUTDIR` in this process: runs every frame of `sequence`
     (a Sequence, or the path of a sequence file) into outdir/[sweep-NN/]frame-NNNNN/ as
@@ -282,7 +273,7 @@ def batch(sequence, outdir, threads=None, progress=None, movies=True):
     outdir = _path_arg("outdir", outdir)
     if not isinstance(movies, bool):
         raise ArgumentError(f"movies: expected True or False, got {movies!r}")
-    report = _batch_reporter(progress)
+    report = make_reporter(progress, _BatchBar)
     try:
         with _BatchCall(threads, len(sequence)) as call:
 
