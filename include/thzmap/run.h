@@ -43,6 +43,9 @@ typedef struct thz_run_plan {
     double target_noise_k; /* the run's noise target, K; 0: none */
     /* "command line" (settings), "scene", "default" or NULL */
     const char *target_source;
+    /* non-zero: photon-map's photon passes (a noise target) will stop at the memory they
+     * may hold, half the machine's, above the target, after `passes` passes */
+    int memory_stop;
 } thz_run_plan;
 typedef void (*thz_plan_fn)(void *user, const thz_run_plan *plan);
 

@@ -118,7 +118,8 @@ static void api_plan(void *user, const run_plan *plan)
                       .memory_bytes = plan->memory_bytes,
                       .available_bytes = plan->available_bytes,
                       .target_noise_k = plan->target_noise_k,
-                      .target_source = plan->target_source};
+                      .target_source = plan->target_source,
+                      .memory_stop = plan->memory_stop};
     settings->plan(settings->plan_user, &p);
 }
 

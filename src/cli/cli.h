@@ -41,6 +41,10 @@ bool cli_is_help(const char *arg);
 int cli_option_value(const char *command, int argc, char **argv, int *i,
                      const char *const *with_value, char **value);
 
+/* True if an option's value looks like an option itself ("-o -q": a forgotten value):
+ * anything from "-" and a letter or "--" on; "-" alone and negative numbers are values. */
+bool cli_looks_like_option(const char *value);
+
 /* Parse whole numbers and reals from option values; false (after printing a usage
  * error naming `option`) when the text is not one, or is out of [min, max]. Whole
  * numbers may be written with a fraction or an exponent when their value is whole

@@ -31,11 +31,13 @@ static void batch_usage(FILE *f)
                "options:\n"
                "  -o, --output OUTDIR   where the results go (required)\n"
                "  --threads T           threads to use (default: all cores)\n"
+               "  --no-movies           the frames and batch.json only, no movies\n"
                "  -q, --quiet           no progress output (warnings are still printed)\n");
 }
 
 typedef struct batch_cli {
     bool quiet;
+    bool no_movies;     /* --no-movies */
     bool tty;           /* stderr is a terminal: the progress within frames is redrawn */
     bool line_open;     /* a redrawn line is on the terminal */
     double last_draw_s; /* when it was drawn, s */
@@ -167,8 +169,11 @@ static int batch_parse(int argc, char **argv, const char **seq_path, const char 
             return CLI_EXIT_OK;
         }
         if (!strcmp(arg, "-o") || !strcmp(arg, "--output") || !strcmp(arg, "--threads")) {
-            if (i + 1 >= argc || !strncmp(argv[i + 1], "--", 2))
+            if (i + 1 >= argc)
                 return cli_usage_error("batch", "%s needs a value", arg);
+            if (cli_looks_like_option(argv[i + 1]))
+                return cli_usage_error("batch", "%s needs a value, got the option '%s'", arg,
+                                       argv[i + 1]);
             const char *val = argv[++i];
             if (!strcmp(arg, "--threads")) {
                 if (!cli_parse_u64("batch", arg, val, 1, THZ_MAX_THREADS, threads))
@@ -178,6 +183,8 @@ static int batch_parse(int argc, char **argv, const char **seq_path, const char 
             }
         } else if (!strcmp(arg, "--quiet") || !strcmp(arg, "-q")) {
             b->quiet = true;
+        } else if (!strcmp(arg, "--no-movies")) {
+            b->no_movies = true;
         } else if (arg[0] == '-' && arg[1]) {
             return cli_usage_error("batch", "unknown option '%s'", arg);
         } else if (!*seq_path) {
@@ -244,8 +251,10 @@ int cmd_batch(int argc, char **argv)
                 thz_sequence_frame_count(seq), thz_sequence_frame_count(seq) == 1 ? "" : "s",
                 thz_sequence_sweep_count(seq), thz_sequence_sweep_count(seq) == 1 ? "" : "s",
                 thz_sequence_frames_per_sweep(seq), outdir);
-    thz_batch_options opt = {
-        .progress = batch_on_progress, .progress_user = &b, .open_output = cli_exit_guard()};
+    thz_batch_options opt = {.progress = batch_on_progress,
+                             .progress_user = &b,
+                             .open_output = cli_exit_guard(),
+                             .no_movies = b.no_movies};
     thz_batch_result res;
     thz_status st = thz_batch_run(ctx, seq, outdir, &opt, &res, &err);
     if (b.line_open)

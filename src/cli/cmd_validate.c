@@ -247,8 +247,8 @@ static void validate_print(const thz_scene *s)
            si.min_relative_power, si.gather_min_photons);
     printf("render: integrator %s, gather_rays %u, paths_per_sample %u\n", si.integrator,
            si.gather_rays, si.paths_per_sample);
-    printf("\nemitted spectral power of the surfaces (band mean; P_A without the air's own "
-           "emission, which a run adds and reports in summary.json):\n");
+    printf("\nemitted spectral power of the surfaces (band mean P_A; a run's photon phase "
+           "also fires the air's own emission, in summary.json's energy_balance):\n");
     for (size_t c = 0; c < si.n_channels; c++) {
         thz_channel_info ch;
         thz_scene_channel(s, c, &ch);

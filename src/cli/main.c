@@ -9,6 +9,7 @@
 
 #include "cli.h"
 #include "cli_mpi.h"
+#include "progress.h"
 
 typedef struct command {
     const char *name;
@@ -88,6 +89,8 @@ int cli_option_value(const char *cmd, int argc, char **argv, int *i, const char 
                                a[0] == '-' ? "unknown option '%s'" : "unexpected argument '%s'", a);
     if (*i + 1 >= argc)
         return cli_usage_error(cmd, "%s needs a value", a);
+    if (cli_looks_like_option(argv[*i + 1]))
+        return cli_usage_error(cmd, "%s needs a value, got the option '%s'", a, argv[*i + 1]);
     *value = argv[++*i];
     return -1;
 }
@@ -143,6 +146,37 @@ static int main_run(const command *c, int argc, char **argv)
     return c->run(argc, argv);
 }
 
+bool cli_looks_like_option(const char *value)
+{
+    /* "-" alone (a file name) and negative numbers ("-1", "-.5") are values */
+    return value[0] == '-' && value[1] && value[1] != '.' && !(value[1] >= '0' && value[1] <= '9');
+}
+
+/* argv with every "--name=value" written as "--name" "value", as GNU's getopt takes it:
+ * every command's parser then sees one form. NULL when out of memory. */
+static char **split_assignments(int argc, char **argv, int *out_argc)
+{
+    int n = argc;
+    for (int i = 1; i < argc; i++)
+        n += strncmp(argv[i], "--", 2) == 0 && strchr(argv[i], '=') != NULL;
+    char **out = calloc((size_t)n + 1, sizeof *out);
+    if (!out)
+        return NULL;
+    int k = 0;
+    for (int i = 0; i < argc; i++) {
+        char *eq = i > 0 && strncmp(argv[i], "--", 2) == 0 ? strchr(argv[i], '=') : NULL;
+        if (eq) {
+            *eq = '\0'; /* argv's strings are the program's to change (C17 5.1.2.2.1) */
+            out[k++] = argv[i];
+            out[k++] = eq + 1;
+        } else {
+            out[k++] = argv[i];
+        }
+    }
+    *out_argc = n;
+    return out;
+}
+
 int main(int argc, char **argv)
 {
     int rc = cli_environment_check();
@@ -152,12 +186,23 @@ int main(int argc, char **argv)
         print_usage(stderr);
         return CLI_EXIT_USAGE;
     }
-    if (cli_is_help(argv[1])) {
-        print_usage(stdout);
-        return cli_stdout_finish(CLI_EXIT_OK);
+    char **split = split_assignments(argc, argv, &argc);
+    if (!split) {
+        fprintf(stderr, "thzmap: out of memory\n");
+        return CLI_EXIT_FAILURE;
     }
-    if (strcmp(argv[1], "--version") == 0) {
-        printf("thzmap %s\n", thz_version());
+    static char **process_argv; /* the process's: reachable until it ends */
+    argv = process_argv = split;
+    if (cli_is_help(argv[1]) || strcmp(argv[1], "--version") == 0) {
+        if (argc > 2) {
+            fprintf(stderr, "thzmap: %s takes no arguments, got '%s'\n\n", argv[1], argv[2]);
+            print_usage(stderr);
+            return CLI_EXIT_USAGE;
+        }
+        if (cli_is_help(argv[1]))
+            print_usage(stdout);
+        else
+            printf("thzmap %s\n", thz_version());
         return cli_stdout_finish(CLI_EXIT_OK);
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {
@@ -166,7 +211,9 @@ int main(int argc, char **argv)
         rc = cli_mpi_init(&argc, &argv);
         if (rc >= 0)
             return rc;
-        return cli_mpi_finalize(cli_stdout_finish(main_run(&commands[i], argc - 1, argv + 1)));
+        bool shared = cli_mpi_size() > 1; /* mpirun reports a rank's exit status itself */
+        rc = cli_mpi_finalize(cli_stdout_finish(main_run(&commands[i], argc - 1, argv + 1)));
+        return shared ? rc : cli_end_by_signal(rc);
     }
     /* under mpirun, rank 0 alone says so (every rank printed the usage) */
     const char *unknown = argv[1];
@@ -174,7 +221,8 @@ int main(int argc, char **argv)
     if (rc >= 0)
         return rc;
     if (cli_mpi_rank() == 0) {
-        fprintf(stderr, "thzmap: unknown command '%s'\n\n", unknown);
+        fprintf(stderr, "thzmap: unknown %s '%s'\n\n", unknown[0] == '-' ? "option" : "command",
+                unknown);
         print_usage(stderr);
     }
     return cli_mpi_finalize(CLI_EXIT_USAGE);

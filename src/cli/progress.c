@@ -41,6 +41,19 @@ void cli_signals_install(void)
     signal(SIGPIPE, SIG_IGN);
 }
 
+int cli_end_by_signal(int rc)
+{
+    int sig = cli_interrupt_signal();
+    if (sig == 0 || rc != 128 + sig)
+        return rc;
+    /* as the signal's default action would have ended it, after cleaning up: the shell
+     * that started thzmap sees it ended by the signal (a script's loop stops on Ctrl-C) */
+    fflush(NULL);
+    signal(sig, SIG_DFL);
+    raise(sig);
+    return rc; /* the signal blocked: the status says it */
+}
+
 void cli_progress_init(cli_progress *p, const char *command, bool quiet)
 {
     memset(p, 0, sizeof *p);
@@ -233,12 +246,18 @@ void cli_progress_plan(void *user, const thz_run_plan *plan)
     p->run_start_s = cli_now_s();
     if (p->quiet)
         return;
-    char target[160] = "";
-    if (plan->target_noise_k > 0.0)
+    char target[256] = "";
+    const char *source = plan->target_source ? plan->target_source : "given";
+    if (plan->target_noise_k > 0.0 && plan->memory_stop)
+        snprintf(target, sizeof target,
+                 ", about %u photon passes per channel, where they stop at the memory they may "
+                 "hold (half the machine's), short of the noise target of %g K (%s; --photons N "
+                 "fires N photons once)",
+                 plan->passes, plan->target_noise_k, source);
+    else if (plan->target_noise_k > 0.0)
         snprintf(target, sizeof target,
                  ", up to about %u pass%s per channel to reach the noise target of %g K (%s)",
-                 plan->passes, plan->passes == 1 ? "" : "es", plan->target_noise_k,
-                 plan->target_source ? plan->target_source : "given");
+                 plan->passes, plan->passes == 1 ? "" : "es", plan->target_noise_k, source);
     char memory[32], available[40] = "";
     cli_format_bytes(memory, sizeof memory, plan->memory_bytes);
     if (plan->available_bytes > 0) { /* 0: unknown */

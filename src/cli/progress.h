@@ -72,5 +72,10 @@ void cli_signals_install(void);
 /* The signal that interrupted the run (SIGINT, SIGTERM), 0 if none: the exit status is
  * 128 + it, the shell's convention (130 for Ctrl-C, 143 for SIGTERM). */
 int cli_interrupt_signal(void);
+/* The end of a command that returned rc: when rc is 128 + the signal that interrupted it
+ * (SIGINT, SIGTERM, SIGHUP; its outputs cleaned up), the process ends by that signal
+ * (its default action), so that its parent sees it killed by the signal; otherwise, or
+ * if it returns, rc. */
+int cli_end_by_signal(int rc);
 
 #endif

@@ -102,7 +102,7 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
             if (i + 1 >= argc)
                 return cli_usage_error(cmd, "%s needs a value", arg);
             const char *val = argv[++i];
-            if (strncmp(val, "--", 2) == 0) /* -o --quiet: a forgotten value, not a name */
+            if (cli_looks_like_option(val)) /* -o --quiet: a forgotten value, not a name */
                 return cli_usage_error(cmd, "%s needs a value, got the option '%s'", arg, val);
             uint64_t u = 0;
             if (strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0) {

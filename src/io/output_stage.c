@@ -47,6 +47,14 @@ static thz_status stage_nomem(const char *outdir, thz_error *err)
                          outdir);
 }
 
+/* The status of a refusal by the file system of a place the user chose for the results:
+ * no permission or a read-only file system is bad usage (exit 2), not a failure. */
+static thz_status stage_errno_status(int e)
+{
+    return e == EACCES || e == EPERM || e == EROFS ? THZ_ERR_INPUT
+                                                   : thz_errno_status(e, THZ_ERR_IO);
+}
+
 /* mkdir -p: creates path and its missing parents; *created (may be NULL) gets the
  * topmost directory created (malloc'd), or NULL when all existed. */
 static thz_status stage_make_dirs(const char *path, char **created, thz_error *err)
@@ -66,8 +74,8 @@ static thz_status stage_make_dirs(const char *path, char **created, thz_error *e
                 goto cleanup;
             }
         } else if (errno != EEXIST) {
-            status = thz_error_set(err, THZ_ERR_IO, "%s: cannot create directory: %s", copy,
-                                   strerror(errno));
+            status = thz_error_set(err, stage_errno_status(errno),
+                                   "%s: cannot create directory: %s", copy, strerror(errno));
             goto cleanup;
         }
         if (end)
@@ -319,7 +327,7 @@ thz_status output_stage_create(const char *outdir, output_stage **out, thz_error
         goto cleanup;
     }
     if (lstat(stage->target, &st) == 0 && access(stage->target, W_OK) != 0) {
-        status = thz_error_set(err, THZ_ERR_IO,
+        status = thz_error_set(err, stage_errno_status(errno),
                                "%s: exists and is not writable (%s): make it writable, or choose "
                                "another output directory",
                                outdir, strerror(errno));
@@ -335,6 +343,16 @@ thz_status output_stage_create(const char *outdir, output_stage **out, thz_error
         goto cleanup;
     }
     stage->mode = stage_choose_mode(stage);
+    /* the lock and the staging directory go beside OUTDIR (or into it, STAGE_FILES) */
+    const char *holder = stage->mode == STAGE_FILES ? stage->target : stage->parent;
+    if (access(holder, W_OK | X_OK) != 0) {
+        status = thz_error_set(err, stage_errno_status(errno),
+                               "%s: cannot write in %s, where a run stages its results before "
+                               "they replace OUTDIR (%s): make it writable, or choose another "
+                               "output directory",
+                               outdir, holder, strerror(errno));
+        goto cleanup;
+    }
     char lock_path[THZ_PATH_MAX + 8];
     if (stage->mode == STAGE_FILES)
         status = thz_path_join(lock_path, THZ_PATH_MAX, stage->target, ".thzmap-lock", err);

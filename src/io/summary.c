@@ -76,7 +76,6 @@ static void sum_photon_stats(json_t *o, const photon_stats *s, bool *ok)
 {
     sum_set(o, "photons_fired", sum_u64(s->fired), ok);
     sum_set(o, "photons_stored", sum_u64(s->stored), ok);
-    sum_set(o, "emitted_power_w_per_hz", sum_real(s->emitted_power_w_per_hz), ok);
     sum_set(o, "photon_reference_temperature_k", sum_real(s->reference_temperature_k), ok);
     sum_set(o, "fraction_absorbed", sum_real(sum_ratio(s->absorbed, s->fired)), ok);
     sum_set(o, "fraction_escaped", sum_real(sum_ratio(s->escaped, s->fired)), ok);
@@ -127,8 +126,15 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
     sum_set(o, "response", json_string(table ? "table" : "gaussian"), ok);
     sum_set(o, "bandwidth_ghz", sum_real(channel_bandwidth_hz(ch) * 1e-9), ok);
     sum_set(o, "noise_bandwidth_ghz", sum_real(channel_noise_bandwidth_hz(ch) * 1e-9), ok);
-    if (summary->channel_stats)
+    /* P_A of the surfaces (physics.md; what validate prints), with or without a photon
+     * phase; the air's own emission is in energy_balance.emitted_w_per_hz */
+    sum_set(o, "emitted_power_w_per_hz", sum_real(scene_band_emitted_power_w_per_hz(scene, c)), ok);
+    if (summary->channel_stats) {
         sum_photon_stats(o, &summary->channel_stats[c], ok);
+    } else { /* path: no photon phase */
+        sum_set(o, "photons_fired", json_integer(0), ok);
+        sum_set(o, "photons_stored", json_integer(0), ok);
+    }
     if (summary->noise) {
         sum_set(o, "median_stderr_k", sum_real(summary->noise[c].median_k), ok);
         sum_set(o, "p95_stderr_k", sum_real(summary->noise[c].p95_k), ok);

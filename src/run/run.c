@@ -155,6 +155,21 @@ static thz_status run_state_init(run_state *rs, const thz_scene *scene, const ru
     if (rs->n_selected == 0)
         return thz_error_set(err, THZ_ERR_INPUT, "%s: the scene has no sensor named '%s'", command,
                              opt->sensor_name ? opt->sensor_name : "");
+    /* a limit on passes that no target asks for: said, not silently dropped */
+    if (rs->max_seconds > 0.0 && !(rs->target_noise_k > 0.0)) {
+        thz_status st = run_add_warning(
+            rs, err,
+            "max_seconds %g s is not used: it limits the passes towards a noise target, and "
+            "this run has none (%s)",
+            rs->max_seconds,
+            strcmp(command, "render") == 0 &&
+                    !render_integrator_has_passes(scene->render.integrator)
+                ? "photon-map renders from its map in one pass"
+                : "each channel runs one pass of the count given; set --target-noise-k or "
+                  "render.target_noise_k for passes");
+        if (st != THZ_OK)
+            return st;
+    }
     rs->images = thz_calloc(rs->n_selected, sizeof *rs->images);
     rs->back_face = thz_calloc(ns, sizeof *rs->back_face); /* summary.json: per scene sensor */
     rs->render_sum = thz_calloc(rs->n_selected, sizeof *rs->render_sum);
@@ -354,14 +369,21 @@ static thz_status run_tell_plan(run_state *rs, bool fires_photons, thz_error *er
                              .target_noise_k = rs->target_noise_k,
                              .threads = rs->opt->threads,
                              .reach = &rs->reach};
-    run_plan plan = {.memory_bytes = rs->memory_bytes,
+    run_estimate e;
+    thz_status st = run_estimate_time(&in, &e, err);
+    if (st != THZ_OK)
+        return st;
+    /* photon-map's passes hold every pass's map until the channel ends */
+    run_plan plan = {.seconds_photons = fires_photons ? e.seconds_photons : 0.0,
+                     .seconds_render = e.seconds_render,
+                     .passes = e.passes,
+                     .memory_bytes = e.passes_bytes > UINT64_MAX - rs->memory_bytes
+                                         ? UINT64_MAX
+                                         : rs->memory_bytes + e.passes_bytes,
                      .available_bytes = thz_memory_limit_bytes(),
+                     .memory_stop = e.memory_stop,
                      .target_noise_k = rs->target_noise_k,
                      .target_source = rs->target_source};
-    thz_status st =
-        run_estimate_time(&in, &plan.seconds_photons, &plan.seconds_render, &plan.passes, err);
-    if (!fires_photons)
-        plan.seconds_photons = 0.0;
     if (st == THZ_OK)
         rs->opt->plan(rs->opt->plan_user, &plan);
     return st;

@@ -50,8 +50,9 @@ typedef struct run_plan {
     uint32_t passes;                        /* estimated passes per channel */
     uint64_t memory_bytes;                  /* estimated peak, bytes */
     uint64_t available_bytes;               /* physical memory, 0 if unknown */
-    double target_noise_k;                  /* 0: none */
-    const char *target_source;              /* run_target_noise_k's *source */
+    bool memory_stop;          /* photon-map's passes stop at their memory before the target */
+    double target_noise_k;     /* 0: none */
+    const char *target_source; /* run_target_noise_k's *source */
 } run_plan;
 
 typedef struct run_options {
@@ -261,6 +262,12 @@ thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_
 /* The next check after one at pass n whose noise asks for `need` passes in all: at most
  * a quarter more than n, at least n + 1 (run_photon_passes). */
 uint32_t run_photon_next_check(uint32_t n, double need);
+
+/* The memory the photon passes of one channel may hold, bytes (half the machine's; 0 if
+ * unknown), and what they hold per pass: the passes' maps and a merge of them, twice the
+ * records, and their indexes: RUN_PASSES_MAP_FACTOR x one pass's map. */
+double run_passes_memory_limit_bytes(void);
+#define RUN_PASSES_MAP_FACTOR 2.2
 
 /* How many checks run_photon_passes renders before `passes` passes if every check asks
  * for more than a quarter more (the most; the time estimate's count of renders). */

@@ -99,12 +99,32 @@ static thz_status estimate_channel(const run_estimate_input *in, thz_scene *pilo
     return st;
 }
 
-thz_status run_estimate_time(const run_estimate_input *in, double *seconds_photons,
-                             double *seconds_render, uint32_t *passes, thz_error *err)
+/* photon-map's passes of channel c: their count capped at what the memory they may hold
+ * allows (run_photon_passes stops there), and the bytes they then hold. */
+static thz_status estimate_photon_passes(const run_estimate_input *in, size_t c, uint32_t *passes,
+                                         run_estimate *out, thz_error *err)
+{
+    uint64_t map_bytes = 0; /* one pass's map (T0 = 0: the paper's map) */
+    thz_status st =
+        photon_phase_estimate_bytes(in->scene, in->accel, c, 0.0, in->reach, &map_bytes, err);
+    if (st != THZ_OK)
+        return st;
+    double per_pass = RUN_PASSES_MAP_FACTOR * (double)map_bytes;
+    double limit = run_passes_memory_limit_bytes();
+    if (limit > 0.0 && per_pass * (double)*passes > limit) {
+        *passes = (uint32_t)fmax(floor(limit / per_pass), 1.0);
+        out->memory_stop = true;
+    }
+    double held = per_pass * (double)*passes;
+    if (held > (double)out->passes_bytes)
+        out->passes_bytes = (uint64_t)held;
+    return THZ_OK;
+}
+
+thz_status run_estimate_time(const run_estimate_input *in, run_estimate *out, thz_error *err)
 {
     const thz_scene *scene = in->scene;
-    *seconds_photons = *seconds_render = 0.0;
-    *passes = 1;
+    *out = (run_estimate){.passes = 1};
     /* the pilot scene: the same objects, K photons and one small sensor */
     thz_scene pilot = *scene;
     thz_sensor cam;
@@ -142,13 +162,18 @@ thz_status run_estimate_time(const run_estimate_input *in, double *seconds_photo
                                             (double)scene->photons.per_channel
                                       : need / per_pixel);
             passes_c = (uint32_t)fmin(fmax(p, 1.0), 100000.0);
+            if (paper_map) {
+                st = estimate_photon_passes(in, c, &passes_c, out, err);
+                if (st != THZ_OK)
+                    return st;
+            }
         }
         double channels = piloted == 1 ? (double)scene->n_channels : 1.0;
-        *passes = passes_c > *passes ? passes_c : *passes;
+        out->passes = passes_c > out->passes ? passes_c : out->passes;
         /* photon-map's passes render at checks only (run_photon_passes) */
         double renders = paper_map ? (double)run_photon_checks(passes_c) : (double)passes_c;
-        *seconds_render += per_sample * samples * renders * channels;
-        *seconds_photons += (paper_map ? photons_s * passes_c : photons_s) * channels;
+        out->seconds_render += per_sample * samples * renders * channels;
+        out->seconds_photons += (paper_map ? photons_s * passes_c : photons_s) * channels;
     }
     return THZ_OK;
 }

@@ -10,6 +10,7 @@
 #ifndef THZ_RUN_RUN_ESTIMATE_H
 #define THZ_RUN_RUN_ESTIMATE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -36,9 +37,17 @@ typedef struct run_estimate_input {
 void run_estimate_pilot(const thz_scene *scene, const thz_sensor *sensor, thz_sensor *cam,
                         uint64_t *photons);
 
-/* *seconds_photons and *seconds_render of the whole run, s; *passes: the most a channel
- * needs. */
-thz_status run_estimate_time(const run_estimate_input *in, double *seconds_photons,
-                             double *seconds_render, uint32_t *passes, thz_error *err);
+typedef struct run_estimate {
+    double seconds_photons, seconds_render; /* the whole run's, s */
+    uint32_t passes;                        /* the most a channel needs */
+    /* photon-map with a noise target: the most one channel's photon passes hold, bytes
+     * (0 without passes), and whether a channel's passes stop at the memory they may
+     * hold (run_passes_memory_limit_bytes) before its target, their count then that */
+    uint64_t passes_bytes;
+    bool memory_stop;
+} run_estimate;
+
+/* The estimate of the run of in. */
+thz_status run_estimate_time(const run_estimate_input *in, run_estimate *out, thz_error *err);
 
 #endif

@@ -178,6 +178,11 @@ uint32_t run_photon_next_check(uint32_t n, double need)
     return need > (double)n ? (uint32_t)need : n + 1;
 }
 
+double run_passes_memory_limit_bytes(void)
+{
+    return 0.5 * (double)thz_physical_memory_bytes();
+}
+
 uint32_t run_photon_checks(uint32_t passes)
 {
     uint32_t checks = 1;
@@ -205,7 +210,7 @@ thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_
     if (!maps)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the photon passes");
     uint64_t k = scene->photons.per_channel;
-    double limit = 0.5 * (double)thz_physical_memory_bytes();
+    double limit = run_passes_memory_limit_bytes();
     while (st == THZ_OK) {
         if (n == cap) {
             photon_map **m = thz_realloc_array(maps, 2 * cap, sizeof *m);
@@ -261,8 +266,7 @@ thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_
                                  n == 1 ? "" : "es", p95, target);
             break;
         }
-        /* The passes' maps and a merge of them: twice the records, and their indexes. */
-        double per_pass = 2.2 * (double)photon_map_bytes(map) / (double)n;
+        double per_pass = RUN_PASSES_MAP_FACTOR * (double)photon_map_bytes(map) / (double)n;
         double most = limit > 0.0 ? floor(limit / per_pass) : (double)RUN_MAX_PASSES;
         if (most <= (double)n) { /* limit 0: the machine's memory is unknown */
             st = run_add_warning(rs, err,

@@ -378,6 +378,14 @@ echo '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1e-4, "frame
 ffprobe -v error -show_entries stream=r_frame_rate -of default=nw=1 "$work/S/cam.band-01.mp4" |
     grep -qx 'r_frame_rate=1/100' || fail "a sequence at 1e-4 fps: the movie is not at 0.01 fps"
 grep -q '"fps": 0.01' "$work/S/batch.json" || fail "a sequence at 1e-4 fps: batch.json's movie rate"
+# --no-movies: the frames (reused here) and batch.json, no movie
+"$THZMAP" batch "$work/slow.json" -o "$work/S" --no-movies --quiet > /dev/null 2>&1 ||
+    fail "batch --no-movies: exit $?"
+"$PY" - "$work/S/batch.json" <<'PY' || fail "batch --no-movies: batch.json lists movies"
+import json, sys
+b = json.load(open(sys.argv[1]))
+assert b["movies"] == [] and b["frames_reused"] == len(b["frames"]), b
+PY
 sed -i 's/"temperature_k": 306/"temperature_k": 307/' "$work/sub/b.json"
 "$THZMAP" batch "$work/list.json" -o "$work/L" --quiet > /dev/null 2>&1 || fail "list, changed: exit $?"
 "$PY" - "$work/L/batch.json" <<'PY' || fail "a changed scene of the list must redo its frame only"

@@ -109,11 +109,17 @@ if [[ $(id -u) -eq 0 ]] && command -v runuser >/dev/null; then
     echo notes >"$work/ro/own/notes.txt"
     chmod 555 "$work/ro/own"
     runuser -u nobody -- "$T" simulate "$S" -o "$work/ro/own" "${R[@]}" --seed 9 2>"$work/err"
-    expect "a read-only OUTDIR" $? 1 "exists and is not writable"
+    expect "a read-only OUTDIR" $? 2 "exists and is not writable"
     [[ $(ls -A "$work/ro" | tr '\n' ' ') == "own " ]] ||
         fail "a read-only OUTDIR: beside it: $(ls -A "$work/ro" | tr '\n' ' ')"
     [[ -f $work/ro/own/notes.txt ]] || fail "a read-only OUTDIR lost the user's notes"
     chmod 755 "$work/ro/own"
+    # a new OUTDIR in a directory the user cannot write: named, not the lock file
+    chown root "$work/ro" && chmod 555 "$work/ro"
+    runuser -u nobody -- "$T" simulate "$S" -o "$work/ro/new" "${R[@]}" 2>"$work/err"
+    expect "OUTDIR in a read-only directory" $? 2 "ro/new: cannot write in .*/ro, where a run"
+    [[ ! -e $work/ro/new ]] || fail "OUTDIR in a read-only directory was created"
+    chmod 755 "$work/ro"
 fi
 
 # --- THZMAP_EMBREE_MAX_ISA: a set the processor has at most, or refused -------------------

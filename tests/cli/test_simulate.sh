@@ -294,6 +294,24 @@ grep -q "stopped by the time limit" "$work/ms/summary.json" ||
 "$THZMAP" simulate "$work/scene.json" -o "$work/u" --seed 9223372036854775808 2> "$work/u.err"
 [ $? -eq 2 ] || fail "--seed 2^63 should exit 2"
 grep -q "0 to 9223372036854775807" "$work/u.err" || fail "--seed 2^63 message: $(cat "$work/u.err")"
+# a forgotten value is not taken from the next option, short or long
+for opt in -q --quiet -x; do
+    (cd "$work" && "$THZMAP" simulate scene.json -o $opt 2> u.err)
+    [ $? -eq 2 ] || fail "simulate -o $opt: not refused"
+    grep -q -- "-o needs a value, got the option '$opt'" "$work/u.err" ||
+        fail "simulate -o $opt: $(head -n 1 "$work/u.err")"
+    [ ! -e "$work/$opt" ] || fail "simulate -o $opt made a directory named after the option"
+done
+# --name=value as GNU's getopt takes it; a time limit that no noise target uses is said
+"$THZMAP" simulate "$work/scene.json" --output="$work/eq" --photons=2000 --integrator=photon-map \
+    --max-seconds=5 --quiet 2> "$work/eq.err" || fail "simulate --photons=N exited $?"
+grep -q '"photons_per_channel": 2000,' "$work/eq/summary.json" ||
+    fail "--photons=2000 was not taken"
+grep -q "max_seconds 5 s is not used: it limits the passes towards a noise target" \
+    "$work/eq.err" || fail "--max-seconds with a count: no warning: $(cat "$work/eq.err")"
+"$THZMAP" --version extra 2>/dev/null
+[ $? -eq 2 ] || fail "thzmap --version with an argument should exit 2"
+"$THZMAP" --bogus 2>&1 | grep -q "unknown option '--bogus'" || fail "thzmap --bogus: not an option"
 "$THZMAP" simulate --help | grep -q -- "--save-photon-map" || fail "simulate --help"
 for opt in --integrator --target-noise-k --max-seconds; do
     "$THZMAP" simulate --help | grep -q -- "$opt" || fail "simulate --help lacks $opt"
@@ -376,7 +394,13 @@ for f in cam.radiance.img cam.radiance_stderr.img side.brightness_temperature.im
 done
 grep -q '"photons_per_channel": *0' "$work/path1/summary.json" \
     || fail "path's summary.json should say 0 photons: $(grep photons "$work/path1/summary.json")"
-grep -q '"photons_fired"' "$work/path1/summary.json" && fail "path fired photons"
+# ... and each channel 0 photons fired and stored, and the surfaces' P_A (the spec's keys)
+python3 - "$work/path1/summary.json" <<'PY' || fail "path's summary.json: photon keys"
+import json, sys
+for c in json.load(open(sys.argv[1]))["channels"]:
+    assert c["photons_fired"] == 0 and c["photons_stored"] == 0, c
+    assert c["emitted_power_w_per_hz"] > 0 and "energy_balance" not in c, c
+PY
 "$THZMAP" render "$work/scene.json" -o "$work/rpath" --integrator path --threads 2 --quiet \
     || fail "render --integrator path without a photon map exited $?"
 for f in cam.radiance.img side.radiance_stderr.img; do

@@ -524,7 +524,14 @@ static void test_summary_json(void **state)
     json_t *o1 = json_array_get(json_object_get(c1, "objects"), 0);
     assert_int_equal(json_integer_value(json_object_get(o1, "pixels")), 0);
     assert_true(json_is_null(json_object_get(o1, "p95_stderr_k"))); /* no pixels: no figure */
-    assert_true(json_is_null(json_object_get(c1, "emitted_power_w_per_hz")));
+    /* a figure that is not a number is written as null */
+    assert_true(
+        json_is_null(json_object_get(json_object_get(c1, "energy_balance"), "emitted_w_per_hz")));
+    /* P_A is the surfaces' (physics.md), from the scene, not the photon phase's total */
+    assert_true(json_is_number(json_object_get(c1, "emitted_power_w_per_hz")));
+    assert_true(fabs(json_number_value(json_object_get(c0, "emitted_power_w_per_hz")) -
+                     scene_band_emitted_power_w_per_hz(scene, 0)) <=
+                1e-12 * scene_band_emitted_power_w_per_hz(scene, 0));
     assert_true(json_is_null(
         json_object_get(json_object_get(c1, "energy_balance"), "relative_difference")));
 
@@ -541,13 +548,17 @@ static void test_summary_json(void **state)
     assert_string_equal(json_string_value(json_array_get(w, 1)), "run warning");
     json_decref(root);
 
-    /* render: no photon statistics, no stderr, no back-face counts */
-    run_summary render = {.command = "render", .integrator = "photon-map"};
+    /* path: no photon phase, so no photon statistics but the counts (0) and P_A the
+     * spec lists; no stderr, no back-face counts */
+    run_summary render = {.command = "render", .integrator = "path"};
     assert_int_equal(summary_write(tmp, scene, &render, &err), THZ_OK);
     root = json_load_file(path, 0, &jerr);
     assert_non_null(root);
     c0 = json_array_get(json_object_get(root, "channels"), 0);
-    assert_null(json_object_get(c0, "photons_fired"));
+    assert_int_equal(json_integer_value(json_object_get(c0, "photons_fired")), 0);
+    assert_int_equal(json_integer_value(json_object_get(c0, "photons_stored")), 0);
+    assert_true(json_is_number(json_object_get(c0, "emitted_power_w_per_hz")));
+    assert_null(json_object_get(c0, "energy_balance"));
     assert_null(json_object_get(c0, "median_stderr_k"));
     assert_string_equal(json_string_value(json_object_get(c0, "name")), "a");
     json_decref(root);

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "accel/accel.h"
+#include "run/run.h"
 #include "run/run_estimate.h"
 #include "scene/scene.h"
 
@@ -86,12 +87,44 @@ static void test_estimate_small_run(void **state)
                              .n_selected = 1,
                              .target_noise_k = 0.01,
                              .threads = 1};
-    double photons_s = -1.0, render_s = -1.0;
-    uint32_t passes = 0;
-    assert_int_equal(run_estimate_time(&in, &photons_s, &render_s, &passes, &err), THZ_OK);
-    assert_true(photons_s > 0.0 && render_s > 0.0);
-    /* 300 photons cannot reach 0.01 K in a 300 K room: several passes of 300 */
-    assert_true(passes > 1);
+    run_estimate e;
+    assert_int_equal(run_estimate_time(&in, &e, &err), THZ_OK);
+    assert_true(e.seconds_photons > 0.0 && e.seconds_render > 0.0);
+    /* 300 photons cannot reach 0.01 K in a 300 K room: several passes of 300, holding
+     * their maps, which fit */
+    assert_true(e.passes > 1);
+    assert_true(e.passes_bytes > 0 && !e.memory_stop);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
+/* Passes of 3 x 10^7 photons towards 0.0001 K: their maps, held until the channel ends, would
+ * pass the memory the passes may hold long before the target; the estimate says so and
+ * counts the passes that fit (the pilot still fires its RUN_PILOT_PHOTONS alone). */
+static void test_estimate_passes_stop_at_memory(void **state)
+{
+    (void)state;
+    thz_scene *s = load(3, 2, 1, 3e7);
+    accel *acc;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    size_t selected = 0;
+    run_estimate_input in = {.scene = s,
+                             .accel = acc,
+                             .selected = &selected,
+                             .n_selected = 1,
+                             .target_noise_k = 1e-4,
+                             .threads = 1};
+    run_estimate e;
+    assert_int_equal(run_estimate_time(&in, &e, &err), THZ_OK);
+    double limit = run_passes_memory_limit_bytes();
+    if (limit > 0.0) {
+        assert_true(e.memory_stop);
+        /* (a single pass is never refused here: the run's memory check is before) */
+        assert_true((double)e.passes_bytes <= limit || e.passes == 1);
+        /* one pass more would not have fitted */
+        assert_true((double)e.passes_bytes / e.passes * (e.passes + 1) > limit);
+    }
     accel_destroy(acc);
     scene_destroy(s);
 }
@@ -101,6 +134,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pilot_no_larger_than_the_run),
         cmocka_unit_test(test_estimate_small_run),
+        cmocka_unit_test(test_estimate_passes_stop_at_memory),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
