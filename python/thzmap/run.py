@@ -19,7 +19,7 @@ import numpy as np
 from . import _lib
 from ._call import Call
 from .errors import ArgumentError
-from .scene import Scene, _path_arg, load_scene
+from .scene import _path_arg, scene_arg
 
 # PLplot, which draws the spectra plots of written results, keeps global state: one
 # figure at a time in the whole process.
@@ -57,14 +57,6 @@ def _positive(name, value):
     if not (math.isfinite(value) and value > 0):
         raise ArgumentError(f"{name}: expected a finite number > 0, got {value}")
     return float(value)
-
-
-def _scene_arg(scene):
-    if isinstance(scene, Scene):
-        return scene
-    if isinstance(scene, (str, bytes, os.PathLike)):
-        return load_scene(scene)
-    raise ArgumentError(f"scene: expected a thzmap.Scene or a path, got {type(scene).__name__}")
 
 
 def _integrator_arg(integrator):
@@ -173,7 +165,7 @@ def fire_photons(scene, integrator=None, photons=None, seed=None, first_photon=0
                  threads=None, progress=None):
     """The photon phase alone: fires every channel's photons (photons 'first_photon' ..
     + photons - 1, so that maps of disjoint ranges merge)."""
-    scene = _scene_arg(scene)
+    scene = scene_arg(scene)
     s = _settings(scene, integrator, photons, seed, first_photon=first_photon)
     with Call(threads, progress) as call:
         return _photons_call(call, lambda out: _lib.lib.thz_photons_fire(
@@ -186,7 +178,7 @@ def load_photon_map(scene, path, channel=None, threads=None, progress=None):
     map alone is kept (the others' records are checked and dropped: has_channel is False
     for them, their statistics are read), for a look at one channel's photons of a large
     file."""
-    scene = _scene_arg(scene)
+    scene = scene_arg(scene)
     path = _path_arg("path", path)
     if channel is None:
         with Call(threads, progress) as call:
@@ -201,6 +193,9 @@ def load_photon_map(scene, path, channel=None, threads=None, progress=None):
 def merge_photon_maps(parts, threads=None):
     """One photon map of all the photons of `parts` (one scene, seed and integrator,
     fired with disjoint photon ranges)."""
+    if isinstance(parts, (str, bytes)) or not hasattr(parts, "__iter__"):
+        raise ArgumentError(f"parts: expected a non-empty sequence of PhotonMap, got "
+                            f"{type(parts).__name__}")
     parts = list(parts)
     if not parts or not all(isinstance(p, PhotonMap) for p in parts):
         raise ArgumentError("parts: expected a non-empty sequence of PhotonMap")
@@ -383,7 +378,7 @@ def simulate(scene, integrator=None, photons=None, seed=None, threads=None,
     True for a bar, or a callable given a Progress whose true return value cancels.
     The GIL is released while the engine runs. Raises CancelledError when cancelled,
     KeyboardInterrupt after Ctrl-C; nothing is kept either way."""
-    scene = _scene_arg(scene)
+    scene = scene_arg(scene)
     s = _settings(scene, integrator, photons, seed, target_noise_k, max_seconds, keep_photons)
     with Call(threads, progress) as call:
         return _run_call(call, lambda out: _lib.lib.thz_simulate(
@@ -396,7 +391,7 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
     rendered from `photon_map` (a PhotonMap of this scene, or the path of a .thzpm
     file, which is read one channel at a time as the render comes to it: one channel's
     map in memory). The path integrator needs no photon map (it then uses `seed`)."""
-    scene = _scene_arg(scene)
+    scene = scene_arg(scene)
     path = None
     if isinstance(photon_map, (str, bytes, os.PathLike)):
         path = _path_arg("photon_map", photon_map)

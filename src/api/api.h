@@ -34,6 +34,11 @@ struct thz_photons {
     photon_stats *stats; /* per channel */
     uint64_t seed;
     uint64_t photons_per_channel;
+    /* fired here: photons first_photon .. + photons_per_channel - 1 of each channel
+     * (thz_photons_merge refuses overlapping ranges); a map loaded, merged or kept by a
+     * run does not know its range */
+    bool range_known;
+    uint64_t first_photon;
     bool owned; /* maps and stats belong to this handle (not to a thz_run) */
 };
 

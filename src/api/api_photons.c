@@ -118,6 +118,8 @@ static thz_status api_fire(thz_context *ctx, const thz_scene *scene,
     }
     ph->seed = eff->photons.seed;
     ph->photons_per_channel = eff->photons.per_channel;
+    ph->range_known = true;
+    ph->first_photon = settings ? settings->first_photon : 0;
     *out = ph;
     return THZ_OK;
 }
@@ -221,6 +223,24 @@ static thz_status api_merge_check(const thz_photons *const *parts, size_t n, thz
                                  "thz_photons_merge: part %zu has another scene, seed or photon "
                                  "count than part 0",
                                  i);
+        /* the same photons of a channel twice would count as twice as many */
+        for (size_t j = 0; j < i; j++) {
+            const thz_photons *q = parts[j];
+            uint64_t lo = p->first_photon < q->first_photon ? p->first_photon : q->first_photon;
+            uint64_t hi = p->first_photon < q->first_photon ? q->first_photon : p->first_photon;
+            if (!p->range_known || !q->range_known || hi - lo >= p->photons_per_channel)
+                continue;
+            for (size_t c = 0; c < p->n_channels; c++)
+                if (p->maps[c] && q->maps[c])
+                    return thz_error_set(err, THZ_ERR_INPUT,
+                                         "thz_photons_merge: parts %zu and %zu hold the same "
+                                         "photons of channel %zu (fired from photon %llu and "
+                                         "%llu, %llu each): merge maps of disjoint ranges "
+                                         "(thz_run_settings.first_photon)",
+                                         j, i, c, (unsigned long long)q->first_photon,
+                                         (unsigned long long)p->first_photon,
+                                         (unsigned long long)p->photons_per_channel);
+        }
         for (size_t c = 0; c < p->n_channels; c++)
             if (p->maps[c] && a->maps[c] &&
                 photon_map_reference_temperature_k(p->maps[c]) !=

@@ -99,6 +99,19 @@ static void check_merge_per_channel(thz_context *ctx, thz_scene *scene)
     CHECK(thz_photons_per_channel(merged) == 6000, "mixed parts: %llu per channel",
           (unsigned long long)thz_photons_per_channel(merged));
     thz_photons_destroy(merged);
+    /* the same photons of a channel twice, or ranges that overlap, are refused */
+    const thz_photons *twice[2] = {part[2], part[2]};
+    merged = NULL;
+    expect_input_error(thz_photons_merge(ctx, twice, 2, &merged, &err), &err,
+                       "hold the same photons of channel 0", "a part merged with itself");
+    CHECK(merged == NULL, "a refused merge returned photons");
+    thz_photons *overlap = NULL;
+    settings.first_photon = 4000; /* 4000..6999 against 3000..5999 */
+    REQUIRE_OK(thz_photons_fire_channel(ctx, scene, &settings, 1, &overlap, &err), &err);
+    const thz_photons *over[2] = {part[2], overlap};
+    expect_input_error(thz_photons_merge(ctx, over, 2, &merged, &err), &err,
+                       "fired from photon 3000 and 4000", "overlapping ranges");
+    thz_photons_destroy(overlap);
     for (size_t i = 0; i < 3; i++)
         thz_photons_destroy(part[i]);
 }

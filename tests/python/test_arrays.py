@@ -119,6 +119,14 @@ def test_fire_and_merge(tiny_dir):
     b = thzmap.fire_photons(scene, photons=1500, seed=SEED, first_photon=1500)
     merged = thzmap.merge_photon_maps([a, b])
     assert [s.fired for s in merged.stats] == [3000, 3000]
+    # the same photons twice would count double: refused, as overlapping ranges are
+    with pytest.raises(thzmap.Error, match="hold the same photons of channel 0"):
+        thzmap.merge_photon_maps([a, a])
+    c = thzmap.fire_photons(scene, photons=1500, seed=SEED, first_photon=1000)
+    with pytest.raises(thzmap.Error, match="fired from photon 1000 and 1500"):
+        thzmap.merge_photon_maps([c, b])
+    with pytest.raises(thzmap.ArgumentError, match="sequence of PhotonMap"):
+        thzmap.merge_photon_maps(a)
     assert thzmap.render(scene, merged).image("cam").radiance.shape == (12, 20, 2)
 
 
