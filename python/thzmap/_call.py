@@ -38,6 +38,9 @@ MAX_THREADS = 4096
 class Call:
     """Use as `with Call(threads, progress) as call: status = call.run(fn, ...)`."""
 
+    # the RunWarnings point at the caller of the function whose `with` this is
+    _stacklevel = 3
+
     def __init__(self, threads=None, progress=None):
         if threads is not None:
             if (isinstance(threads, bool) or not isinstance(threads, numbers.Integral)
@@ -116,7 +119,7 @@ class Call:
         _lib.lib.thz_context_destroy(self.ctx)
         self.ctx = None
         for w in self._warnings:
-            warnings.warn(w, RunWarning, stacklevel=3)
+            warnings.warn(w, RunWarning, stacklevel=self._stacklevel)
         return False
 
     def check(self, status, scene_label=None):

@@ -194,6 +194,9 @@ def bands(scene, count, from_thz=None, to_thz=None, step_ghz=None, relative_widt
                             "or the widths searched)")
     keep = []  # buffers the options point into, alive until the call returns
     if widths is not None:
+        if isinstance(widths, (str, bytes)) or not hasattr(widths, "__iter__"):
+            raise ArgumentError(f"widths: expected a sequence of relative widths, got "
+                                f"{widths!r}")
         widths = [_number("widths", w, 0.0, 0.5, lo_open=True) for w in widths]
         if not 1 <= len(widths) <= MAX_WIDTHS:
             raise ArgumentError(f"widths: expected 1 to {MAX_WIDTHS} relative widths")
@@ -205,6 +208,8 @@ def bands(scene, count, from_thz=None, to_thz=None, step_ghz=None, relative_widt
     if targets is not None:
         if isinstance(targets, str):
             targets = [targets]
+        if not hasattr(targets, "__iter__"):
+            raise ArgumentError(f"targets: expected object names, got {targets!r}")
         names = [_text("targets", t) for t in targets]
         if not names:
             raise ArgumentError("targets: expected at least one object name")

@@ -127,13 +127,14 @@ def scene_error(message, label, doc=None):
 
 def from_status(status, message, scene_label=None):
     """The exception for a failed call: SceneError for bad input about a scene (when
-    `scene_label` names it), CancelledError, else Error."""
+    `scene_label` names it: a position or JSON path in it, or the message about the file
+    itself, which cannot be opened), CancelledError, else Error."""
     if status == _lib.ERR_CANCELLED:
         return CancelledError(message or "cancelled")
     if status == _lib.ERR_NOMEM:
         return OutOfMemoryError(message, "out of memory")
     if status == _lib.ERR_INPUT and scene_label is not None:
         err = scene_error(message, scene_label)
-        if err.path is not None or err.line is not None:
+        if err.path is not None or err.line is not None or err.file == scene_label:
             return err
     return Error(message, _lib.text(_lib.lib.thz_status_name(status)))

@@ -19,7 +19,7 @@ import numpy as np
 
 from . import _lib
 from .errors import ArgumentError, from_status
-from .scene import Scene, _path_arg
+from .scene import _path_arg, scene_arg
 
 
 class ThzAtmOptions(Structure):
@@ -204,11 +204,10 @@ def atmosphere(model="lines", temperature_k=None, pressure_hpa=None, relative_hu
     default 288.15), pressure_hpa (total, default 1013.25) and at most one humidity:
     relative_humidity (0..1), water_vapour_g_m3 (default 7.5) or h2o_vmr; for "lines" the
     catalogues h2o_lines and o2_lines (files; None: built in) and continuum=False for
-    no MT_CKD continuum. With `scene` (a Scene) and nothing else, the scene's own
+    no MT_CKD continuum. With `scene` (a Scene or a path) and nothing else, the scene's own
     atmosphere, whatever its model."""
     if scene is not None:
-        if not isinstance(scene, Scene):
-            raise ArgumentError(f"scene: expected a Scene, got {type(scene).__name__}")
+        scene = scene_arg(scene)
         others = (temperature_k, pressure_hpa, relative_humidity, water_vapour_g_m3, h2o_vmr,
                   h2o_lines, o2_lines)
         if model != "lines" or any(v is not None for v in others) or continuum is not True:
@@ -359,8 +358,7 @@ has a complex index; each shaped as the frequencies (has_index a plain int)."""
 def surface_optics(scene, material, frequency_thz, thickness_m=0.0):
     """The optics of `scene`'s material (its name or index) at frequency_thz, for a
     half-space (thickness_m 0: a solid) or a slab of thickness_m (a shell)."""
-    if not isinstance(scene, Scene):
-        raise ArgumentError(f"scene: expected a Scene, got {type(scene).__name__}")
+    scene = scene_arg(scene)
     names = [m.name for m in scene.materials]
     if isinstance(material, str) and material in names:
         i = names.index(material)
@@ -387,11 +385,21 @@ def surface_optics(scene, material, frequency_thz, thickness_m=0.0):
     return SurfaceOptics(*values)
 
 
-def _per_frequency(fn, frequency_thz, other):
-    """fn(freq_hz, x) over frequency_thz and `other` broadcast against each other."""
+def _per_frequency(fn, frequency_thz, other, name, lowest=None):
+    """fn(freq_hz, x) over frequency_thz and `other` (called `name`: finite numbers, at
+    least `lowest` unless None) broadcast against each other."""
+    _frequencies(frequency_thz)
     f = np.asarray(frequency_thz, dtype=np.float64)
-    _frequencies(f)
-    fb, xb = np.broadcast_arrays(f, np.asarray(other, dtype=np.float64))
+    try:
+        x = np.asarray(other, dtype=np.float64)
+        fb, xb = np.broadcast_arrays(f, x)
+    except (TypeError, ValueError) as e:
+        raise ArgumentError(f"{name}: expected a number or an array of numbers that "
+                            f"broadcasts against frequency_thz ({e})") from None
+    if isinstance(other, bool) or not np.all(np.isfinite(x)) or \
+            (lowest is not None and np.any(x < lowest)):
+        raise ArgumentError(f"{name}: expected finite numbers"
+                            + (f" of at least {lowest}" if lowest is not None else ""))
     out = np.array([fn(float(a) * 1e12, float(b)) for a, b in zip(fb.ravel(), xb.ravel())])
     out = out.reshape(fb.shape)
     return float(out) if out.ndim == 0 else out
@@ -400,10 +408,12 @@ def _per_frequency(fn, frequency_thz, other):
 def planck_radiance(frequency_thz, temperature_k):
     """Planck's B_nu(T) in W m^-2 sr^-1 Hz^-1, as the images use it; frequency_thz and
     temperature_k broadcast against each other."""
-    return _per_frequency(_lib.lib.thz_planck_radiance, frequency_thz, temperature_k)
+    return _per_frequency(_lib.lib.thz_planck_radiance, frequency_thz, temperature_k,
+                          "temperature_k", 0.0)
 
 
 def brightness_temperature(frequency_thz, radiance):
     """The brightness temperature in K of a radiance (W m^-2 sr^-1 Hz^-1) at
     frequency_thz, Planck's law inverted (0 for radiance <= 0); broadcasts."""
-    return _per_frequency(_lib.lib.thz_brightness_temperature, frequency_thz, radiance)
+    return _per_frequency(_lib.lib.thz_brightness_temperature, frequency_thz, radiance,
+                          "radiance")

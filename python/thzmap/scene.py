@@ -184,6 +184,16 @@ def load_scene(path, root=None):
         os.fsencode(path), r, out, err), path, path)
 
 
+def scene_arg(scene):
+    """A Scene, or the Scene load_scene makes of a path: what every function taking a
+    scene accepts."""
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, (str, bytes, os.PathLike)):
+        return load_scene(scene)
+    raise ArgumentError(f"scene: expected a thzmap.Scene or a path, got {type(scene).__name__}")
+
+
 def identify(path):
     """What kind of thzmap file `path` is: "scene", "sequence" (for load_sequence),
     "photon-map" (a .thzpm file, for load_photon_map) or "other", from its first bytes or

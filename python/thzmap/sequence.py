@@ -191,6 +191,8 @@ class _BatchCall(Call):
     it), and at the end how many later frames repeated it, as `thzmap batch` prints
     them."""
 
+    _stacklevel = 4  # past __exit__ below
+
     def __init__(self, threads, n_frames):
         super().__init__(threads, None)
         self.frame = 0

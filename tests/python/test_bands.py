@@ -85,7 +85,8 @@ def test_bands_errors(tmp_path):
                    dict(count=1, netd_k=-1), dict(count=1, netd_k=0), dict(count=True),
                    dict(count=1, from_thz=1.0, to_thz=0.5), dict(count=1, widths=[0.01, 0.01]),
                    dict(count=2, from_thz=0.5, to_thz=0.5), dict(count=1, targets=["A", "A"]),
-                   dict(count=1, relative_width=0.01, widths=[0.02])):
+                   dict(count=1, relative_width=0.01, widths=[0.02]),
+                   dict(count=1, widths=0.01), dict(count=1, targets=5)):
         with pytest.raises(thzmap.ArgumentError):
             thzmap.bands(FEATURES, **kwargs)
     with pytest.raises(thzmap.ArgumentError):
@@ -118,6 +119,11 @@ def test_bands_errors(tmp_path):
     with pytest.raises(thzmap.SceneError) as e:
         thzmap.bands(bad, 1, **GRID)
     assert e.value.line == 2
+    # a scene file that cannot be read is a SceneError too, as load_scene's
+    for path in (tmp_path / "missing.json", tmp_path):
+        with pytest.raises(thzmap.SceneError) as e:
+            thzmap.bands(path, 1, **GRID)
+        assert e.value.file == str(path)
 
 
 @pytest.fixture(scope="module")

@@ -124,6 +124,11 @@ def test_surface_optics_agree_with_the_library_and_kirchhoff():
     assert (thicker.transmission_mean < denim.transmission_mean).all()
     with pytest.raises(thzmap.ArgumentError, match="no material"):
         thzmap.surface_optics(scene, "wool", 0.5)
+    # a path wherever a Scene is taken
+    path = os.path.join(REPO, "examples", "outdoor-concealed", "scene.json")
+    by_path = thzmap.surface_optics(path, "denim", f, thickness_m=0.0005)
+    np.testing.assert_array_equal(by_path.transmission_mean, denim.transmission_mean)
+    assert thzmap.atmosphere(scene=path).info == thzmap.atmosphere(scene=scene).info
 
 
 def test_planck():
@@ -136,6 +141,12 @@ def test_planck():
     # broadcasting, and 0 K for no radiance
     assert thzmap.planck_radiance(1.0, [[200.0], [300.0]]).shape == (2, 1)
     assert thzmap.brightness_temperature(1.0, 0.0) == 0.0
+    # what is not a temperature or a radiance is an ArgumentError, not 0 or numpy's error
+    for bad in ("x", float("nan"), -5.0, None, [1.0, 2.0]):
+        with pytest.raises(thzmap.ArgumentError, match="temperature_k"):
+            thzmap.planck_radiance(np.linspace(0.2, 1.0, 5), bad)
+    with pytest.raises(thzmap.ArgumentError, match="radiance"):
+        thzmap.brightness_temperature(0.5, float("inf"))
 
 
 def test_errors():

@@ -140,6 +140,9 @@ def test_batch_warnings_name_their_frame_once(tmp_path):
     assert outside[1].startswith('the same in 3 later frames: sensor "cam" at')
     assert back_side[0].startswith("frame 2/6: sensor 'cam': ")
     assert back_side[1].startswith("the same in 3 later frames: sensor 'cam': ")
+    # each points at the caller of batch, as simulate's do, not into the package
+    assert {w.filename for w in caught if issubclass(w.category, thzmap.RunWarning)} == \
+        {__file__}
 
 
 def test_errors(tmp_path):
