@@ -384,6 +384,21 @@ static thz_status load_finish(thz_scene **scene, json_t *doc, const char *root, 
     return st;
 }
 
+/* The column where the token jansson names ("... near 'TOKEN'") begins: jansson gives
+ * the column of its last character, a user looks for its first (characters, as
+ * jansson counts them: UTF-8 continuation bytes are not counted). */
+static int load_token_column(const json_error_t *je)
+{
+    const char *near = strstr(je->text, " near '");
+    size_t len = strlen(je->text);
+    if (!near || len < 2 || je->text[len - 1] != '\'')
+        return je->column;
+    int chars = 0;
+    for (const char *c = near + 7; c < je->text + len - 1; c++)
+        chars += ((unsigned char)*c & 0xC0) != 0x80;
+    return chars > 1 && je->column >= chars ? je->column - (chars - 1) : je->column;
+}
+
 /* The error of a failed parse: out of memory, or the syntax error jansson found, and
  * what the file is when its first bytes tell (real: the file's path, NULL for a text). */
 static thz_status load_syntax_error(const char *label, const char *what, const json_error_t *je,
@@ -397,9 +412,15 @@ static thz_status load_syntax_error(const char *label, const char *what, const j
     char is[160] = "";
     if (kind)
         snprintf(is, sizeof is, " (the file is %s)", kind);
-    if (je->line > 0)
+    else if (json_error_code(je) == json_error_numeric_overflow)
+        snprintf(is, sizeof is, " (a number beyond what JSON's numbers hold here: whole numbers "
+                                "up to 9223372036854775807, reals up to about 1.8e308)");
+    else if (je->position == 0 && je->line <= 1)
+        snprintf(is, sizeof is, " (the %s is empty)", real ? "file" : "text");
+    int column = load_token_column(je);
+    if (je->line > 0) /* a column 0 (an empty file) is the line's first */
         return thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: invalid JSON: %s%s", label, je->line,
-                             je->column, je->text, is);
+                             column > 0 ? column : 1, je->text, is);
     return thz_error_set(err, THZ_ERR_INPUT, "%s: invalid JSON: %s%s", label, je->text, is);
 }
 

@@ -19,6 +19,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "scene/load.h"
 
@@ -121,7 +122,7 @@ static void load_json_install(void)
     }
 }
 
-json_t *load_json_parse(FILE *f, const char *text, json_error_t *je, bool *out_of_memory)
+static json_t *load_json_run(FILE *f, const char *text, json_error_t *je, bool *out_of_memory)
 {
     static pthread_once_t once = PTHREAD_ONCE_INIT;
     pthread_once(&once, load_json_install);
@@ -145,4 +146,17 @@ json_t *load_json_parse(FILE *f, const char *text, json_error_t *je, bool *out_o
     if (!doc && json_error_code(je) == json_error_out_of_memory)
         *out_of_memory = true;
     return doc;
+}
+
+json_t *load_json_parse(FILE *f, const char *text, json_error_t *je, bool *out_of_memory)
+{
+    /* a UTF-8 byte-order mark, which some editors write first: RFC 8259 lets a parser
+     * ignore it (it was refused as "'[' or '{' expected near" an invisible character) */
+    static const char bom[3] = {'\xEF', '\xBB', '\xBF'};
+    char head[3];
+    if (f && !(fread(head, 1, 3, f) == 3 && memcmp(head, bom, 3) == 0))
+        rewind(f);
+    if (!f && strncmp(text, bom, 3) == 0)
+        text += 3;
+    return load_json_run(f, text, je, out_of_memory);
 }

@@ -42,12 +42,20 @@ DELETE = object()
 # (file, edits [(path, value)], expected substring); raw text instead of edits for
 # syntax errors.
 CASES = [
-    ("syntax_missing_comma", '{\n  "format": "thzmap-scene/1"\n  "channels": []\n}\n', "syntax_missing_comma.json:3:12: invalid JSON"),
-    ("syntax_nan", '{"format": "thzmap-scene/1",\n "x": NaN}\n', "syntax_nan.json:2:"),
-    ("syntax_overflow", '{"format": "thzmap-scene/1",\n "x": 1e999}\n', "real number overflow"),
+    ("syntax_missing_comma", '{\n  "format": "thzmap-scene/1"\n  "channels": []\n}\n', "syntax_missing_comma.json:3:3: invalid JSON: '}' expected near '\"channels\"'"),
+    ("syntax_nan", '{"format": "thzmap-scene/1",\n "x": NaN}\n', "syntax_nan.json:2:7: invalid"),
+    ("syntax_overflow", '{"format": "thzmap-scene/1",\n "x": 1e999}\n',
+     "syntax_overflow.json:2:7: invalid JSON: real number overflow near '1e999' (a number beyond what JSON's numbers hold here"),
+    ("syntax_big_integer", '{"format": "thzmap-scene/1",\n "photons": {"per_channel": '
+     '18446744073709551616}}\n', "syntax_big_integer.json:2:29: invalid JSON: too big integer"
+     " near '18446744073709551616' (a number beyond what JSON's numbers hold here: whole "
+     "numbers up to 9223372036854775807"),
     ("syntax_duplicate_key", '{"format": "thzmap-scene/1",\n "format": "thzmap-scene/1"}\n',
      "duplicate object key"),
-    ("syntax_empty", "", "invalid JSON"),
+    ("syntax_empty", "", "syntax_empty.json:1:1: invalid JSON: '[' or '{' expected near end of "
+     "file (the file is empty)"),
+    # a UTF-8 byte-order mark is read past (RFC 8259): the document's own error follows
+    ("syntax_bom", '\ufeff{"format": "thzmap-scene/1"}\n', "channels: missing key"),
     ("not_an_object", "[1, 2, 3]\n", "expected a JSON object"),
     ("format_missing", [(["format"], DELETE)], "format: missing key"),
     ("format_wrong", [(["format"], "thzmap-scene/2")], "format: expected \"thzmap-scene/1\""),
