@@ -62,13 +62,13 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
         snprintf(key, sizeof key, "sensors[%zu].resolution", big);
     }
     return thz_error_set(err, THZ_ERR_LIMIT,
-                         "the run would need %.2f GiB of memory (photon maps %.2f GiB, images "
-                         "and tables %.2f GiB, the scene as loaded %.2f GiB) but this process "
-                         "may have %.2f GiB (the machine's memory, or less under ulimit -v or "
-                         "a cgroup limit); lower %s",
-                         (double)need->total_bytes / gib, (double)need->photon_bytes / gib,
-                         (double)need->image_bytes / gib, (double)need->held_bytes / gib,
-                         (double)need->available_bytes / gib, key);
+                         "%s: the run would need %.2f GiB of memory (photon maps %.2f GiB, "
+                         "images and tables %.2f GiB, the scene as loaded %.2f GiB) but this "
+                         "process may have %.2f GiB (the machine's memory, or less under ulimit "
+                         "-v or a cgroup limit); lower %s",
+                         scene->path ? scene->path : "the scene", (double)need->total_bytes / gib,
+                         (double)need->photon_bytes / gib, (double)need->image_bytes / gib,
+                         (double)need->held_bytes / gib, (double)need->available_bytes / gib, key);
 }
 
 thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err)

@@ -249,6 +249,8 @@ fi
 rc=$?
 [ $rc -eq 2 ] || fail "an oversized run exited $rc, expected 2 (THZ_ERR_LIMIT: the user's settings)"
 grep -q "photons.per_channel" "$work/big.err" || fail "oversized run message: $(cat "$work/big.err")"
+grep -q "^thzmap: $work/scene.json: the run would need" "$work/big.err" ||
+    fail "oversized run: the message does not name the scene: $(cat "$work/big.err")"
 [ -z "$(ls -A "$work/big" 2>/dev/null)" ] || fail "refused run left files in OUTDIR"
 
 # --- usage --------------------------------------------------------------------------------
