@@ -413,8 +413,9 @@ static thz_status load_syntax_error(const char *label, const char *what, const j
     if (kind)
         snprintf(is, sizeof is, " (the file is %s)", kind);
     else if (json_error_code(je) == json_error_numeric_overflow)
-        snprintf(is, sizeof is, " (a number beyond what JSON's numbers hold here: whole numbers "
-                                "up to 9223372036854775807, reals up to about 1.8e308)");
+        snprintf(is, sizeof is,
+                 " (a number beyond what JSON's numbers hold here: whole numbers "
+                 "up to 9223372036854775807, reals up to about 1.8e308)");
     else if (je->position == 0 && je->line <= 1)
         snprintf(is, sizeof is, " (the %s is empty)", real ? "file" : "text");
     int column = load_token_column(je);
