@@ -71,52 +71,47 @@ static void test_pilot_no_larger_than_the_run(void **state)
     check_pilot(4096, 4096, 1e9, 32, 32, RUN_PILOT_PHOTONS);
 }
 
+/* The estimate of the photon-map run of load(3, 2, 1, photons) towards target_k. */
+static run_estimate estimate(double photons, double target_k)
+{
+    thz_scene *s = load(3, 2, 1, photons);
+    accel *acc;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    size_t selected = 0;
+    run_estimate_input in = {.scene = s,
+                             .accel = acc,
+                             .selected = &selected,
+                             .n_selected = 1,
+                             .target_noise_k = target_k,
+                             .threads = 1};
+    run_estimate e;
+    assert_int_equal(run_estimate_time(&in, &e, &err), THZ_OK);
+    accel_destroy(acc);
+    scene_destroy(s);
+    return e;
+}
+
 /* The estimate of a small photon-map run with a noise target: its pilot fires the run's
  * 300 photons and renders its 3 x 2 pixels. */
 static void test_estimate_small_run(void **state)
 {
     (void)state;
-    thz_scene *s = load(3, 2, 1, 300);
-    accel *acc;
-    thz_error err;
-    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
-    size_t selected = 0;
-    run_estimate_input in = {.scene = s,
-                             .accel = acc,
-                             .selected = &selected,
-                             .n_selected = 1,
-                             .target_noise_k = 0.01,
-                             .threads = 1};
-    run_estimate e;
-    assert_int_equal(run_estimate_time(&in, &e, &err), THZ_OK);
+    run_estimate e = estimate(300, 0.01);
     assert_true(e.seconds_photons > 0.0 && e.seconds_render > 0.0);
     /* 300 photons cannot reach 0.01 K in a 300 K room: several passes of 300, holding
      * their maps, which fit */
     assert_true(e.passes > 1);
     assert_true(e.passes_bytes > 0 && !e.memory_stop);
-    accel_destroy(acc);
-    scene_destroy(s);
 }
 
-/* Passes of 3 x 10^7 photons towards 0.0001 K: their maps, held until the channel ends, would
- * pass the memory the passes may hold long before the target; the estimate says so and
- * counts the passes that fit (the pilot still fires its RUN_PILOT_PHOTONS alone). */
+/* Passes of 3 x 10^7 photons towards 0.0001 K: their maps, held until the channel ends,
+ * would pass the memory the passes may hold long before the target; the estimate says so
+ * and counts the passes that fit (the pilot still fires its RUN_PILOT_PHOTONS alone). */
 static void test_estimate_passes_stop_at_memory(void **state)
 {
     (void)state;
-    thz_scene *s = load(3, 2, 1, 3e7);
-    accel *acc;
-    thz_error err;
-    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
-    size_t selected = 0;
-    run_estimate_input in = {.scene = s,
-                             .accel = acc,
-                             .selected = &selected,
-                             .n_selected = 1,
-                             .target_noise_k = 1e-4,
-                             .threads = 1};
-    run_estimate e;
-    assert_int_equal(run_estimate_time(&in, &e, &err), THZ_OK);
+    run_estimate e = estimate(3e7, 1e-4);
     double limit = run_passes_memory_limit_bytes();
     if (limit > 0.0) {
         assert_true(e.memory_stop);
@@ -125,8 +120,6 @@ static void test_estimate_passes_stop_at_memory(void **state)
         /* one pass more would not have fitted */
         assert_true((double)e.passes_bytes / e.passes * (e.passes + 1) > limit);
     }
-    accel_destroy(acc);
-    scene_destroy(s);
 }
 
 int main(void)
