@@ -90,13 +90,13 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
         return thz_error_set(err, THZ_ERR_INPUT, "count %zu: only %.0f candidate centres", o->count,
                              n);
     if (!(o->relative_width >= 0.0 && o->relative_width <= 0.5))
-        return thz_error_set(err, THZ_ERR_INPUT, "relative width %g: expected 0 < w <= 0.5",
+        return thz_error_set(err, THZ_ERR_INPUT, "relative_width %g: expected 0 < w <= 0.5",
                              o->relative_width);
     if (o->n_widths && !o->relative_widths)
         return thz_error_set(err, THZ_ERR_INPUT, "widths: %zu given but no list", o->n_widths);
     if (o->n_widths && o->relative_width > 0.0)
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "relative width %g and widths: give one (the candidates' one "
+                             "relative_width %g and widths: give one (the candidates' one "
                              "width, or the widths searched)",
                              o->relative_width);
     for (size_t i = 0; i < o->n_widths; i++) {
@@ -253,9 +253,11 @@ static thz_status resolve_scene(thz_bands *b, const thz_bands_options *o, thz_er
         st = thz_atm_from_scene(scene, &atm, err);
         if (st != THZ_OK)
             goto done;
+        char what[1200]; /* the scene's air refuses the candidates: name both */
+        snprintf(what, sizeof what, "%s: the candidate frequencies (from_thz to to_thz)",
+                 info.path ? info.path : "the scene");
         st = thz_atm_check_range(atm, b->candidates_thz[0] * 1e12,
-                                 b->candidates_thz[b->setup.n_candidates - 1] * 1e12,
-                                 "the candidate frequencies", err);
+                                 b->candidates_thz[b->setup.n_candidates - 1] * 1e12, what, err);
         if (st != THZ_OK)
             goto done;
         b->air_db_per_km = thz_calloc(b->setup.n_candidates, sizeof *b->air_db_per_km);

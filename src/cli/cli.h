@@ -53,6 +53,9 @@ bool cli_parse_u64(const char *command, const char *option, const char *text, ui
                    uint64_t max, uint64_t *out);
 bool cli_parse_double(const char *command, const char *option, const char *text, double min,
                       double max, double *out);
+/* A number in (0, max]: what must be above 0 says so (not "from 0", then refused at 0). */
+bool cli_parse_positive(const char *command, const char *option, const char *text, double max,
+                        double *out);
 
 /* Mends or refuses the process's start (cli_env.c): closed standard streams reopened on
  * /dev/null, SIGXFSZ ignored, a stack limit or OMP_STACKSIZE below what the threads need

@@ -99,15 +99,15 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
         if (rc >= 0)
             return rc;
         if (strcmp(a, "--from-thz") == 0) {
-            if (!cli_parse_double(CMD, a, v, 0.0, 1000.0, &o->from_thz))
+            if (!cli_parse_positive(CMD, a, v, 1000.0, &o->from_thz))
                 return CLI_EXIT_USAGE;
             o->have_from = true;
         } else if (strcmp(a, "--to-thz") == 0) {
-            if (!cli_parse_double(CMD, a, v, 0.0, 1000.0, &o->to_thz))
+            if (!cli_parse_positive(CMD, a, v, 1000.0, &o->to_thz))
                 return CLI_EXIT_USAGE;
             o->have_to = true;
         } else if (strcmp(a, "--step-ghz") == 0) {
-            if (!cli_parse_double(CMD, a, v, 1e-9, 1e6, &o->step_ghz))
+            if (!cli_parse_positive(CMD, a, v, 1e6, &o->step_ghz))
                 return CLI_EXIT_USAGE;
             o->have_step = true;
         } else if (strcmp(a, "--model") == 0) {
@@ -120,7 +120,7 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
                 return CLI_EXIT_USAGE;
             o->air_given = true;
         } else if (strcmp(a, "--pressure-hpa") == 0) {
-            if (!cli_parse_double(CMD, a, v, 0.0, THZ_AIR_MAX_PRESSURE_HPA, &o->pressure_hpa))
+            if (!cli_parse_positive(CMD, a, v, THZ_AIR_MAX_PRESSURE_HPA, &o->pressure_hpa))
                 return CLI_EXIT_USAGE;
             o->air_given = true;
         } else if (strcmp(a, "--relative-humidity") == 0 || strcmp(a, "--water-vapour-g-m3") == 0 ||

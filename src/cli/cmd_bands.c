@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <unistd.h>
 
@@ -163,13 +164,13 @@ int cmd_bands(int argc, char **argv)
             ok = cli_parse_u64(CMD, a, v, 1, 32, &count);
             have_count = true;
         } else if (strcmp(a, "--from-thz") == 0) {
-            ok = cli_parse_double(CMD, a, v, 1e-6, 1000.0, &opt.from_thz);
+            ok = cli_parse_positive(CMD, a, v, 1000.0, &opt.from_thz);
         } else if (strcmp(a, "--to-thz") == 0) {
-            ok = cli_parse_double(CMD, a, v, 1e-6, 1000.0, &opt.to_thz);
+            ok = cli_parse_positive(CMD, a, v, 1000.0, &opt.to_thz);
         } else if (strcmp(a, "--step-ghz") == 0) {
-            ok = cli_parse_double(CMD, a, v, 1e-6, 1e6, &opt.step_ghz);
+            ok = cli_parse_positive(CMD, a, v, 1e6, &opt.step_ghz);
         } else if (strcmp(a, "--relative-width") == 0) {
-            ok = cli_parse_double(CMD, a, v, 1e-9, 0.5, &opt.relative_width);
+            ok = cli_parse_positive(CMD, a, v, 0.5, &opt.relative_width);
         } else if (strcmp(a, "--widths") == 0) {
             if (!split_widths(v, widths, &opt.n_widths))
                 return cli_usage_error(CMD,
@@ -191,7 +192,7 @@ int cmd_bands(int argc, char **argv)
         } else if (strcmp(a, "--sensor") == 0) {
             opt.sensor = v;
         } else if (strcmp(a, "--netd-k") == 0) {
-            ok = cli_parse_double(CMD, a, v, 0.0, 1e6, &opt.netd_k);
+            ok = cli_parse_positive(CMD, a, v, 1e6, &opt.netd_k);
             opt.has_netd = 1;
         } else if (strcmp(a, "--temperature-range-k") == 0) {
             ok = cli_parse_double(CMD, a, v, 0.0, 1000.0, &opt.target_temperature_range_k);
@@ -221,6 +222,26 @@ int cmd_bands(int argc, char **argv)
     if (!(opt.to_thz >= opt.from_thz))
         return cli_usage_error(CMD, "--to-thz (%g THz) must not be below --from-thz (%g THz)",
                                opt.to_thz, opt.from_thz);
+    /* what the library would refuse only after loading the scene, said by option */
+    double centres = floor((opt.to_thz - opt.from_thz) * 1e3 / opt.step_ghz + 1e-9) + 1.0;
+    if ((double)count > centres)
+        return cli_usage_error(CMD,
+                               "--count %llu: only %.0f candidate centres from %g to %g THz "
+                               "every %g GHz (--from-thz, --to-thz, --step-ghz)",
+                               (unsigned long long)count, centres, opt.from_thz, opt.to_thz,
+                               opt.step_ghz);
+    if (opt.n_widths && opt.relative_width > 0.0)
+        return cli_usage_error(CMD,
+                               "--relative-width %g and --widths: give one (the candidates' "
+                               "one width, or the widths searched)",
+                               opt.relative_width);
+    /* an OUTDIR that cannot be one is refused before the renders, not after them */
+    struct stat out_st;
+    if (stat(outdir, &out_st) == 0 && !S_ISDIR(out_st.st_mode))
+        return cli_usage_error(CMD,
+                               "-o %s: exists and is not a directory (expected a directory "
+                               "for the results, or a name to create one)",
+                               outdir);
     opt.count = (size_t)count;
 
     thz_context *ctx = thz_context_create();

@@ -118,6 +118,21 @@ bool cli_parse_u64(const char *cmd, const char *option, const char *text, uint64
     return true;
 }
 
+bool cli_parse_positive(const char *cmd, const char *option, const char *text, double max,
+                        double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (!text[0] || *end || errno || !isfinite(v) || !(v > 0.0) || v > max) {
+        cli_usage_error(cmd, "%s expects a number above 0 and at most %g, got '%s'", option, max,
+                        text);
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
 bool cli_parse_double(const char *cmd, const char *option, const char *text, double min, double max,
                       double *out)
 {

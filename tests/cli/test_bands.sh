@@ -239,7 +239,7 @@ expect2 "to below from" "$IN/features.json" -o "$TMP/x" --count 1 --from-thz 1 -
 expect2 "unknown target" "$IN/features.json" -o "$TMP/x" --count 1 --targets A,nope
 grep -q "nope" "$TMP/err" || fail "unknown target not named: $(cat "$TMP/err")"
 expect2 "no sensor noise" "$IN/features.json" -o "$TMP/x" --count 1 --netd-k 0
-grep -q "NETD 0 K: expected > 0 K" "$TMP/err" || fail "NETD 0 not named: $(cat "$TMP/err")"
+grep -q -- "--netd-k expects a number above 0" "$TMP/err" || fail "NETD 0 not named: $(cat "$TMP/err")"
 expect2 "missing scene" "$TMP/none.json" -o "$TMP/x" --count 1
 expect2 "count above candidates" "$IN/features.json" -o "$TMP/x" --count 3 --from-thz 0.5 \
     --to-thz 0.52 --step-ghz 20
@@ -254,8 +254,15 @@ expect2 "angle above 90" "$IN/features.json" -o "$TMP/x" --count 1 --angle-range
 grep -q -- "--angle-range-deg.*91" "$TMP/err" || fail "the bad angle not named: $(cat "$TMP/err")"
 expect2 "a width and widths" "$IN/features.json" -o "$TMP/x" --count 1 --relative-width 0.02 \
     --widths 0.01,0.05
-grep -q -- "relative width 0.02 and widths" "$TMP/err" ||
+grep -q -- "--relative-width 0.02 and --widths" "$TMP/err" ||
   fail "--relative-width with --widths not refused by name: $(cat "$TMP/err")"
+expect2 "count above the candidates" "$IN/features.json" -o "$TMP/x" --count 5 \
+    --from-thz 0.5 --to-thz 0.53
+grep -q -- "--count 5: only 4 candidate centres from 0.5 to 0.53 THz every 10 GHz" "$TMP/err" ||
+    fail "--count above the candidates not refused by name: $(cat "$TMP/err")"
+touch "$TMP/file"
+expect2 "OUTDIR a file" "$IN/features.json" -o "$TMP/file" --count 1
+grep -q -- "exists and is not a directory" "$TMP/err" || fail "-o FILE: $(cat "$TMP/err")"
 expect2 "thickness range 1" "$IN/features.json" -o "$TMP/x" --count 1 --thickness-range 1
 [ -e "$TMP/x" ] && fail "a failed run left $TMP/x"
 echo ok
