@@ -28,7 +28,7 @@ typedef enum thz_humidity_kind {
 } thz_humidity_kind;
 
 typedef struct thz_atm_options {
-    const char *model;    /* "lines", "itu-p676" or "none" */
+    const char *model;    /* "lines", "itu-p676" or "none"; NULL: "lines" */
     double temperature_k; /* default 288.15 */
     double pressure_hpa;  /* total (dry air + water vapour), default 1013.25 */
     thz_humidity_kind humidity_kind;

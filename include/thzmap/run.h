@@ -65,10 +65,12 @@ typedef struct thz_run_settings {
     int keep_photons;       /* thz_simulate: keep the photon maps in the run (needed to
                                write photon-map.thzpm) */
     uint64_t first_photon;  /* thz_photons_fire*: fire photons first_photon .. + K - 1, so that
-                               maps fired with disjoint ranges merge (thz_photons_merge) */
+                               maps fired with disjoint ranges merge (thz_photons_merge;
+                               a range past 2^64 - 1 is refused) */
     double seconds_load;    /* reported in summary.json (timings_s.load); 0: unknown */
-    thz_plan_fn plan;       /* thz_simulate: called once with the estimate before the work
-                               (its pilot costs a moment: only when set); may be NULL */
+    thz_plan_fn plan;       /* thz_simulate and thz_render_run: called once with the
+                               estimate before the work (its pilot costs a moment: only
+                               when set); may be NULL */
     void *plan_user;
 } thz_run_settings;
 
@@ -174,8 +176,8 @@ typedef enum thz_plane {
 
 /* Renders sensor `sensor` of the scene: from `photons` (their seed, every channel), or
  * with photons NULL for the path integrator (seed from settings or the scene). With a
- * noise target, passes stop on this sensor's median error. *out owns the image, which
- * borrows the scene (destroy or write it first). */
+ * noise target, passes stop on the 95th percentile of this sensor's error. *out owns the image,
+ * which borrows the scene (destroy or write it first). */
 THZ_API thz_status thz_render_sensor(thz_context *ctx, const thz_scene *scene,
                                      const thz_photons *photons, size_t sensor,
                                      const thz_run_settings *settings, thz_image **out,

@@ -13,7 +13,8 @@
  *     (may be NULL); on failure every out-handle is set to NULL. A NULL out-handle,
  *     info struct or handle is refused with THZ_ERR_INPUT (e.g. "thz_simulate: no place
  *     for the run"); functions returning a value give a neutral one (0, NULL, NaN) and
- *     void ones do nothing;
+ *     void ones do nothing. The context is the exception: a NULL thz_context is the
+ *     defaults (every core, no progress or warning callbacks, no MPI);
  *   - parameters are borrowed; strings and arrays returned by accessors belong to the
  *     handle they came from and live as long as it;
  *   - photons, runs and images (a run's or thz_render_sensor's) and a scene's thz_atm

@@ -37,8 +37,22 @@ static atm_humidity_kind api_humidity_kind(thz_humidity_kind kind)
     return ATM_HUMIDITY_NONE;
 }
 
+/* A humidity kind the enum does not have is refused (it gave dry air silently). */
+static thz_status api_humidity_check(const thz_atm_options *opt, const char *fn, thz_error *err)
+{
+    int kind = (int)opt->humidity_kind; /* an enum may be unsigned: compare ints */
+    if (kind < (int)THZ_HUMIDITY_DRY || kind > (int)THZ_HUMIDITY_VMR)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: humidity_kind %d: expected THZ_HUMIDITY_DRY, _RELATIVE, "
+                             "_DENSITY_G_M3 or _VMR",
+                             fn, kind);
+    return THZ_OK;
+}
+
 void thz_atm_options_init(thz_atm_options *opt)
 {
+    if (!opt)
+        return;
     *opt = (thz_atm_options){.model = "lines",
                              .temperature_k = 288.15,
                              .pressure_hpa = 1013.25,
@@ -50,6 +64,9 @@ thz_status thz_atm_check_air(const thz_atm_options *opt, thz_error *err)
 {
     if (!opt)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_atm_check_air: no options");
+    thz_status checked = api_humidity_check(opt, "thz_atm_check_air", err);
+    if (checked != THZ_OK)
+        return checked;
     atm_air_state air;
     return atm_air_state_init(&air, opt->temperature_k, opt->pressure_hpa,
                               api_humidity_kind(opt->humidity_kind), opt->humidity, err);
@@ -65,6 +82,9 @@ thz_status thz_atm_create(const thz_atm_options *opt, const thz_atm *air_from, t
         return thz_error_set(err, THZ_ERR_INPUT,
                              "thz_atm_create: no options (thz_atm_options_init gives the "
                              "defaults)");
+    thz_status checked = api_humidity_check(opt, "thz_atm_create", err);
+    if (checked != THZ_OK)
+        return checked;
     const char *name = opt->model ? opt->model : "lines";
     atm_model model;
     if (!atmosphere_model_from_name(name, &model) ||

@@ -36,6 +36,8 @@ struct thz_bands {
 
 void thz_bands_options_init(thz_bands_options *opt)
 {
+    if (!opt)
+        return;
     memset(opt, 0, sizeof *opt);
     opt->from_thz = 0.1;
     opt->to_thz = 1.5;

@@ -105,6 +105,8 @@ const char *thz_cube_object_name(const thz_cube *cube, size_t i)
 
 void thz_classify_options_init(thz_classify_options *opt)
 {
+    if (!opt)
+        return;
     memset(opt, 0, sizeof *opt);
     opt->method = "sam";
     opt->train_fraction = 0.5;

@@ -85,6 +85,13 @@ static thz_status api_fire(thz_context *ctx, const thz_scene *scene,
     const thz_scene *eff = ph ? &ph->effective : NULL;
     if (st == THZ_OK)
         st = render_integrator_check(eff->render.integrator, err);
+    uint64_t first = settings ? settings->first_photon : 0;
+    if (st == THZ_OK && first > UINT64_MAX - eff->photons.per_channel)
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "thz_photons_fire: photons %llu to %llu + %llu leave the photon "
+                           "numbers (at most 2^64 - 1): lower first_photon",
+                           (unsigned long long)first, (unsigned long long)first,
+                           (unsigned long long)eff->photons.per_channel);
     if (st == THZ_OK && !render_integrator_needs_photons(eff->render.integrator))
         st = thz_error_set(err, THZ_ERR_INPUT, "the %s integrator uses no photons",
                            render_integrator_name(eff->render.integrator));

@@ -59,6 +59,8 @@ size_t thz_sequence_frames_per_sweep(const thz_sequence *seq)
 
 thz_status thz_sequence_frame(const thz_sequence *seq, size_t i, thz_frame_info *out)
 {
+    if (!out)
+        return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
     if (!seq || i >= seq->n_frames)
         return THZ_ERR_INPUT;

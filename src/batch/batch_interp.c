@@ -30,7 +30,7 @@ void batch_segment(const double *t, size_t k, double time_s, size_t *j, double *
 void thz_interp_linear(const double *t, const double *v, size_t k, size_t n, double time_s,
                        double *out)
 {
-    if (k == 0)
+    if (k == 0 || !t || !v || !out) /* void functions do nothing on NULL (thzmap.h) */
         return;
     size_t j;
     double u;
@@ -89,7 +89,7 @@ static void quat_to_deg(const double q[4], double deg[3])
 void thz_interp_rotation(const double *t, const double *rotate_deg, size_t k, double time_s,
                          double out_deg[3])
 {
-    if (k == 0)
+    if (k == 0 || !t || !rotate_deg || !out_deg)
         return;
     size_t j;
     double u;

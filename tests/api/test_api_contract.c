@@ -419,6 +419,7 @@ static int null_row(size_t i, thz_context *ctx, thz_scene *scene, thz_photons *p
         ROW(31, thz_scene_object_mesh(scene, 0, NULL));
         ROW(32, thz_scene_material_optics(scene, 0, 3e11, 0, NULL));
         ROW(33, thz_photons_stats(ph, 0, NULL));
+        ROW(34, thz_sequence_frame(NULL, 0, NULL));
 #undef ROW
     }
     return -1;
@@ -436,7 +437,8 @@ static void check_null_arguments(thz_context *ctx, thz_scene *scene, thz_photons
     for (size_t i = 0; (st = null_row(i, ctx, scene, ph, atm, lib, &err, &what)) >= 0; i++) {
         CHECK(st == THZ_ERR_INPUT, "%s: %s (%s)", what, thz_status_name((thz_status)st),
               err.message);
-        CHECK(i >= 25 || strstr(err.message, "no "), "%s: message '%s'", what, err.message);
+        CHECK((i >= 25 && i <= 34) || strstr(err.message, "no "), "%s: message '%s'", what,
+              err.message);
         err = (thz_error){0};
     }
     /* the functions that return values give their neutral one */
@@ -455,6 +457,35 @@ static void check_null_arguments(thz_context *ctx, thz_scene *scene, thz_photons
     thz_library_optics optics;
     thz_library_optics_at(NULL, 0, 1e12, &optics);
     CHECK(optics.n == 0 && optics.k == 0, "optics of no library: %g", optics.n);
+    /* the void functions that fill what they are given do nothing with NULL */
+    thz_atm_options_init(NULL);
+    thz_bands_options_init(NULL);
+    thz_classify_options_init(NULL);
+    thz_run_settings_init(NULL);
+    const double t[2] = {0, 1}, v[6] = {0}, r[6] = {0};
+    double x[3] = {7, 7, 7};
+    thz_interp_linear(t, v, 2, 3, 0.5, NULL);
+    thz_interp_linear(NULL, v, 2, 3, 0.5, x);
+    thz_interp_linear(t, NULL, 2, 3, 0.5, x);
+    thz_interp_rotation(t, NULL, 2, 0.5, x);
+    thz_interp_rotation(t, r, 2, 0.5, NULL);
+    thz_interp_rotation(NULL, r, 2, 0.5, x);
+    CHECK(x[0] == 7 && x[1] == 7 && x[2] == 7, "interpolation of NULL arrays wrote %g", x[0]);
+    /* a humidity kind the enum does not have, and photon numbers past 2^64 - 1 */
+    thz_atm_options opt;
+    thz_atm_options_init(&opt);
+    opt.humidity_kind = (thz_humidity_kind)77;
+    thz_atm *bad = NULL;
+    expect_input_error(thz_atm_create(&opt, NULL, &bad, &err), &err, "humidity_kind 77",
+                       "humidity kind 77");
+    expect_input_error(thz_atm_check_air(&opt, &err), &err, "humidity_kind 77",
+                       "humidity kind 77 (check)");
+    thz_run_settings wrap = {
+        .photons_per_channel = 2000, .first_photon = UINT64_MAX - 999, .integrator = "photon-map"};
+    thz_photons *wrapped = NULL;
+    expect_input_error(thz_photons_fire(ctx, scene, &wrap, &wrapped, &err), &err,
+                       "lower first_photon", "photon numbers past 2^64 - 1");
+    CHECK(wrapped == NULL, "a refused fire returned photons");
     thz_library_destroy(lib);
     thz_atm_destroy(atm);
 }
