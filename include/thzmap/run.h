@@ -198,7 +198,9 @@ THZ_API const float *thz_image_plane(const thz_image *image, thz_plane plane, si
 THZ_API const char *thz_plane_name(thz_plane plane);
 
 /* Writes the image's files (S.radiance, ... ENVI; S.visual.png, S.band-NN.png,
- * S.spectra.png) into `dir` (created if missing), atomically like a run. */
+ * S.spectra.png) into `dir` (created if missing), atomically like a run: ctx's threads
+ * bound the figure processes and its progress callback hears the "output" stage (done 0
+ * then 1 of 1) and may cancel it (THZ_ERR_CANCELLED, `dir` as it was). */
 THZ_API thz_status thz_image_write(thz_context *ctx, const thz_image *image, const char *dir,
                                    thz_error *err);
 

@@ -8,6 +8,7 @@
 
 #include "api/api.h"
 #include "core/alloc.h"
+#include "core/cancel.h"
 #include "core/path.h"
 #include "io/output.h"
 
@@ -119,6 +120,30 @@ thz_status thz_run_write(thz_context *ctx, thz_run *run, const char *outdir,
     return api_done(ctx, st, err);
 }
 
+/* The "output" stage of an image's write, told to ctx's progress callback (done 0 or 1
+ * of 1); non-zero: cancel. Also cancel_check's question while the figures are drawn. */
+static int api_image_write_report(const thz_context *ctx, const thz_image *image, uint64_t done)
+{
+    if (!ctx || !ctx->progress)
+        return 0;
+    thz_progress p = {.stage = "output",
+                      .n_channels = image ? image->scene->n_channels : 0,
+                      .done = done,
+                      .total = 1};
+    return ctx->progress(ctx->progress_user, &p);
+}
+
+typedef struct api_image_asking {
+    const thz_context *ctx;
+    const thz_image *image;
+} api_image_asking;
+
+static int api_image_write_cancelled(void *user)
+{
+    const api_image_asking *a = user;
+    return api_image_write_report(a->ctx, a->image, 0);
+}
+
 thz_status thz_image_write(thz_context *ctx, const thz_image *image, const char *dir,
                            thz_error *err)
 {
@@ -126,8 +151,19 @@ thz_status thz_image_write(thz_context *ctx, const thz_image *image, const char 
     err = api_err(err, &local);
     thz_output *o = NULL;
     thz_status st = thz_output_open(dir, &o, err);
+    if (st == THZ_OK && !image)
+        st = thz_error_set(err, THZ_ERR_INPUT, "thz_image_write: no image");
+    /* as a run's write: the context's threads bound the figure processes, its progress
+     * callback hears the stage and may cancel it (nothing is then committed) */
+    api_image_asking asking = {ctx, image};
+    cancel_check cancel = {api_image_write_cancelled, &asking};
+    if (st == THZ_OK && api_image_write_report(ctx, image, 0))
+        st = thz_error_set(err, THZ_ERR_CANCELLED, "writing the image: cancelled");
     if (st == THZ_OK)
-        st = thz_output_add_image(o, image, err);
+        st = output_write_sensor(output_stage_dir(o->stage), image->scene, image->sensor,
+                                 image->img, ctx ? ctx->threads : 0, &cancel, err);
+    if (st == THZ_OK && api_image_write_report(ctx, image, 1))
+        st = thz_error_set(err, THZ_ERR_CANCELLED, "writing the image: cancelled");
     if (st == THZ_OK)
         st = thz_output_commit(o, err);
     thz_output_destroy(o);

@@ -127,6 +127,19 @@ int main(int argc, char **argv)
     thz_context_set_progress(ctx, NULL, NULL);
     REQUIRE_OK(thz_run_write(ctx, run, out, NULL, &err), &err);
     CHECK(!empty_or_missing(out), "%s empty after a write", out);
+    /* an image's write alike (it wrote whatever the callback said) */
+    const thz_image *image = thz_run_image(run, 0);
+    CHECK(image != NULL, "the run has no image");
+    cancel_at ci = {.stage = "output"};
+    thz_context_set_progress(ctx, cancel_progress, &ci);
+    snprintf(out, sizeof out, "%s/out-image", dir);
+    st = thz_image_write(ctx, image, out, &err);
+    CHECK(st == THZ_ERR_CANCELLED && ci.cancelled && strstr(err.message, "writing the image"),
+          "image write: %s (%s)", thz_status_name(st), err.message);
+    CHECK(stat(out, &info) != 0, "%s exists after a cancelled image write", out);
+    thz_context_set_progress(ctx, NULL, NULL);
+    REQUIRE_OK(thz_image_write(ctx, image, out, &err), &err);
+    CHECK(!empty_or_missing(out), "%s empty after an image write", out);
     thz_run_destroy(run);
 
     /* photon counts whose memory estimate overflows 64 bits are refused at once (they
