@@ -123,7 +123,7 @@ int cmd_serve(int argc, char **argv)
         nanosleep(&ts, NULL);
     }
     fprintf(stderr, "thzmap serve: stopping (a running job is cancelled; its output is not "
-                    "written)\n");
+                    "written, but for the frames a batch finished)\n");
     serve_stop(s);
     return 128 + cli_interrupt_signal();
 }

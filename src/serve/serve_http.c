@@ -278,12 +278,14 @@ void serve_text_fit(char *text)
     text[n] = '\0';
 }
 
-/* MHD's iterator over the query: counts the arguments that are not UTF-8. */
+/* MHD's iterator over the query: counts the arguments that are not UTF-8 text, or hold
+ * a NUL (%00), which would end the C string early: "a.json%00.txt" named a.json. */
 static enum MHD_Result serve_count_bad_arg(void *cls, enum MHD_ValueKind kind, const char *key,
-                                           const char *value)
+                                           size_t key_size, const char *value, size_t value_size)
 {
     (void)kind;
-    if (!serve_is_utf8(key) || (value && !serve_is_utf8(value)))
+    if (!serve_is_utf8(key) || strlen(key) != key_size ||
+        (value && (!serve_is_utf8(value) || strlen(value) != value_size)))
         ++*(int *)cls;
     return MHD_YES;
 }
@@ -330,10 +332,12 @@ static enum MHD_Result serve_access(void *cls, struct MHD_Connection *conn, cons
          * other bytes than UTF-8, and they became 500 "out of memory" (a PUT had written
          * its file by then) */
         int bad = 0;
-        MHD_get_connection_values(conn, MHD_GET_ARGUMENT_KIND, serve_count_bad_arg, &bad);
+        MHD_get_connection_values_n(conn, MHD_GET_ARGUMENT_KIND, serve_count_bad_arg, &bad);
         if (bad || !serve_is_utf8(url)) {
             r->answered = true;
-            return serve_reply_error(r, 400, "the URL or its query is not UTF-8 text");
+            return serve_reply_error(r, 400,
+                                     "the URL or its query is not UTF-8 text (or holds a NUL, "
+                                     "%%00)");
         }
         return MHD_YES;
     }
@@ -409,8 +413,11 @@ serve *serve_start(const serve_options *opt, char *why, size_t size, bool *usage
     }
     struct stat st;
     /* the bundle first: a relative path names it from the directory serve started in */
+    char index[PATH_MAX + 16];
     if (opt->web_dir && realpath(opt->web_dir, s->web_dir) && stat(s->web_dir, &st) == 0 &&
-        S_ISDIR(st.st_mode))
+        S_ISDIR(st.st_mode) &&
+        snprintf(index, sizeof index, "%s/index.html", s->web_dir) < (int)sizeof index &&
+        stat(index, &st) == 0 && S_ISREG(st.st_mode)) /* a directory without the page: none */
         s->has_web = true;
     bool found = realpath(opt->root, s->root) != NULL;
     if (!found || stat(s->root, &st) != 0 || !S_ISDIR(st.st_mode) || chdir(s->root) != 0) {

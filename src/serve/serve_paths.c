@@ -59,12 +59,15 @@ serve_path_status serve_path(const serve *s, const char *rel, bool must_exist, c
      * what leads to it lies inside the root (else it says nothing of what is outside) */
     char probe[PATH_MAX], real[PATH_MAX];
     snprintf(probe, sizeof probe, "%s", rel);
-    bool denied = false;
+    bool denied = false, whole = true; /* whole: probe is still the path itself */
     for (;;) {
         if (realpath(probe, real))
             break;
+        whole = false;
         if (errno == EACCES) {
             denied = true;
+        } else if (errno == ENAMETOOLONG) { /* a name longer than the file system's */
+            return SERVE_PATH_TOO_LONG;
         } else if (errno != ENOENT && errno != ENOTDIR) {
             return SERVE_PATH_FORBIDDEN;
         } else if (!denied) {
@@ -85,6 +88,12 @@ serve_path_status serve_path(const serve *s, const char *rel, bool must_exist, c
     }
     if (!serve_below(s->root, real))
         return SERVE_PATH_FORBIDDEN;
+    /* inside the root, but a file the server may not read or a directory it may not list:
+     * told as such (a listing said "not a directory", a pixel "no cube") */
+    struct stat st;
+    if (whole && !denied && stat(real, &st) == 0 &&
+        access(real, S_ISDIR(st.st_mode) ? R_OK | X_OK : R_OK) != 0 && errno == EACCES)
+        denied = true;
     return denied ? SERVE_PATH_DENIED : SERVE_PATH_OK;
 }
 
@@ -100,6 +109,11 @@ enum MHD_Result serve_reply_path(serve_request *r, serve_path_status st, const c
     case SERVE_PATH_MISSING:
         return serve_reply_error(r, 404, "%s%s%s: no such file or directory", label, sep, rel);
     case SERVE_PATH_TOO_LONG:
+        if (strlen(rel) < SERVE_MAX_REL_BYTES) /* one name too long for the file system */
+            return serve_reply_error(r, 400,
+                                     "%s: a name in the path is longer than the file "
+                                     "system allows",
+                                     label);
         return serve_reply_error(r, 400, "%s: a path of %zu bytes, longer than the %d allowed",
                                  label, strlen(rel), SERVE_MAX_REL_BYTES - 1);
     default:
@@ -196,6 +210,8 @@ enum MHD_Result serve_files_list(serve_request *r)
     else if (!serve_path_arg(r, "dir", true, dir, &ret))
         return ret;
     DIR *d = opendir(dir);
+    if (!d && errno == EACCES)
+        return serve_reply_error(r, 403, "%s: permission denied", dir);
     if (!d)
         return serve_reply_error(r, errno == ENOTDIR ? 400 : 404, "%s: %s", dir, strerror(errno));
     json_t *list = json_array();
@@ -335,6 +351,8 @@ enum MHD_Result serve_file_put(serve_request *r)
     if (lstat(path, &st) == 0 && !S_ISREG(st.st_mode))
         return serve_reply_error(r, 403, "%s: not a regular file", path);
     int e = serve_write_atomic(path, r->body ? r->body : "", r->body_size);
+    if (e == EACCES || e == EPERM || e == EROFS) /* the server may not write there */
+        return serve_reply_error(r, 403, "%s: permission denied (%s)", path, strerror(e));
     if (e)
         return serve_reply_error(r, e == ENOENT ? 404 : 500, "%s: %s", path, strerror(e));
     const char *rel = serve_arg(r, "path");

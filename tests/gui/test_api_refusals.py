@@ -97,6 +97,10 @@ def test_files(srv, root):
             {"command": "simulate", "scene": path, "out": "o"}))
         check(st == 403 and b"permission denied" in data, "POST a run of %s: %s %r"
               % (path, st, data[:200]))
+    # a directory it may not list, likewise (it said "not a directory" and 404)
+    for path in ("/api/files?dir=s/closed", "/api/outputs?dir=s/closed"):
+        st, err = get_within(srv, path, 10)
+        check(st == 403 and "permission denied" in err["error"], "GET %s: %s %r" % (path, st, err))
 
 
 def test_lengths(srv):
@@ -104,6 +108,10 @@ def test_lengths(srv):
     st, err = get_within(srv, "/api/file?path=" + long_path, 10)
     check(st == 400 and "longer than the 4093 allowed" in err["error"],
           "GET a path of %d bytes: %s %r" % (len(long_path), st, err))
+    # one name longer than the file system's: not "outside the root"
+    st, err = get_within(srv, "/api/files?dir=s/" + "n" * 300, 10)
+    check(st == 400 and "longer than the file system allows" in err["error"],
+          "GET a 300-byte name: %s %r" % (st, err))
     for key, value, words in (("scene", long_path, "at most 4093 bytes"),
                               ("options.sensor", "c" * 300, "at most 255 bytes"),
                               ("options.integrator", "i" * 100,
@@ -130,6 +138,14 @@ def test_text_and_limits(srv, root):
         check(st == 400 and b"not UTF-8 text" in data, "%s %s: %s %r" % (method, url, st, data))
     check(not [n for n in os.listdir(os.path.join(root, "s").encode()) if b"\xff" in n],
           "a refused PUT wrote its file")
+    st, _, data = srv.request("GET", "/api/info")
+    check(st == 200 and json.loads(data)["web"] is False, "/api/info without a bundle: %r" % data)
+    # a NUL (%00) ended the C string: "n.json%00.txt" wrote n.json
+    for method, url in (("PUT", "/api/file?path=s/nul.json%00.txt"),
+                        ("GET", "/api/files?dir=s%00x"), ("GET", "/api/file?path=s/pm.json%00z")):
+        st, _, data = srv.request(method, url, body="{}" if method == "PUT" else None)
+        check(st == 400 and b"NUL" in data, "%s %s: %s %r" % (method, url, st, data))
+    check(not os.path.exists(os.path.join(root, "s", "nul.json")), "a PUT with %00 wrote its file")
     procs = os.cpu_count() or 1
     err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/path.json",
                                                "out": "o", "options": {"threads": procs + 1}},
@@ -238,6 +254,8 @@ def main():
     try:
         make_root(root)
         open(os.path.join(tmp, "secret.json"), "w").write("{}")
+        # a web directory without the page's bundle: no page (it said "web": true)
+        os.makedirs(os.path.join(tmp, "web"))
         env = dict(os.environ, THZMAP_WEB_DIR=os.path.join(tmp, "web"))
         srv = Server(BINARY, root, env, prefix=NO_DAC)
         try:

@@ -163,7 +163,7 @@ export class Results {
     bar.getContext("2d").clearRect(0, 0, bar.width, bar.height);
     const seen = new Set(cube.band(0));
     const info = $("image-info");
-    info.replaceChildren("object seen (grey: nothing hit): ");
+    info.replaceChildren("object seen, truth (grey: nothing hit): ");
     names.forEach((n, i) => {
       if (!seen.has(i)) return;
       const sw = document.createElement("span");
