@@ -2,14 +2,15 @@
 """Time to a converged image, per integrator (issue 7; docs/integrators.md).
 
 For the paper's scene (examples/teraeye/scene.json: 64 x 64 pixels, 2 x 2 oversampling,
-six channels 0.2-1.2 THz) and each integrator, measures the time to reach a median
-per-pixel standard error of TARGET kelvin of brightness temperature, per channel and in
-total, on THREADS threads, and prints a table; writes the numbers as JSON.
+six channels 0.2-1.2 THz) and each integrator, measures the time to reach a 95th
+percentile over the pixels of the per-pixel standard error of TARGET kelvin of brightness
+temperature (what --target-noise-k aims at; the median is shown beside it), per channel
+and in total, on THREADS threads, and prints a table; writes the numbers as JSON.
 
   path          thzmap simulate --integrator path --target-noise-k TARGET
   final-gather  the same with --photons PHOTONS; the time includes the photon phase;
-                stops at --max-seconds per channel (then "not reached" and the median
-                reached is shown)
+                stops at --max-seconds per channel, or at the floor its photon map
+                leaves (then "not reached" and the figures reached are shown)
   photon-map    its photon passes (simulate --target-noise-k) would need ~1e10 photons
                 on this scene: one run with PHOTONS photons, and the photon count (and
                 time) the target would need if the standard error falls as
@@ -48,15 +49,16 @@ def channel_rows(summary, target):
     for c in summary["channels"]:
         photons = c.get("photon_phase_s") or 0.0
         render = c.get("render_s") or 0.0
-        se = c.get("median_stderr_k")
+        p95 = c.get("p95_stderr_k")
         rows.append({
             "channel": c["name"],
             "photon_phase_s": photons,
             "render_s": render,
             "seconds": photons + render,
             "passes": c.get("render_passes"),
-            "median_stderr_k": se,
-            "reached": se is not None and se <= target,
+            "median_stderr_k": c.get("median_stderr_k"),
+            "p95_stderr_k": p95,
+            "reached": p95 is not None and p95 <= target,
         })
     return rows
 
@@ -96,7 +98,7 @@ def main():
                 for r in rows:
                     # standard error ~ 1/sqrt(K): the photons (and, in proportion, the time)
                     # the target would need
-                    f = (r["median_stderr_k"] / a.target) ** 2 if r["median_stderr_k"] else 1.0
+                    f = (r["p95_stderr_k"] / a.target) ** 2 if r["p95_stderr_k"] else 1.0
                     r["photons_needed_extrapolated"] = int(a.photons * f)
                     r["seconds_extrapolated"] = r["seconds"] * f
             results["integrators"][integ] = {
@@ -105,11 +107,11 @@ def main():
                 "wall_s": wall,
                 "all_reached": all(r["reached"] for r in rows),
             }
-    print("Median per-pixel standard error target: %.3g K on %s, %d threads"
+    print("Target: 95th percentile of the per-pixel standard error %.3g K on %s, %d threads"
           % (a.target, os.path.relpath(a.scene, REPO), a.threads))
-    print("%-13s %-10s %10s %10s %10s %7s %12s" % ("integrator", "channel", "photons s",
-                                                  "render s", "total s", "passes",
-                                                  "median K"))
+    print("%-13s %-10s %10s %10s %10s %7s %10s %10s" % ("integrator", "channel", "photons s",
+                                                       "render s", "total s", "passes",
+                                                       "median K", "p95 K"))
     for integ, res in results["integrators"].items():
         for r in res["channels"]:
             total = "%.2f" % r["seconds"]
@@ -117,9 +119,9 @@ def main():
             if integ == "photon-map":
                 total = "~%.0f" % r["seconds_extrapolated"]
                 note = "  (~%.2g photons needed)" % r["photons_needed_extrapolated"]
-            print("%-13s %-10s %10.2f %10.2f %10s %7s %12.4f%s"
+            print("%-13s %-10s %10.2f %10.2f %10s %7s %10.4f %10.4f%s"
                   % (integ, r["channel"], r["photon_phase_s"], r["render_s"], total,
-                     r["passes"], r["median_stderr_k"], note))
+                     r["passes"], r["median_stderr_k"], r["p95_stderr_k"], note))
         if integ == "photon-map":
             tot = sum(r["seconds_extrapolated"] for r in res["channels"])
             print("%-13s %-10s %32s" % (integ, "total", "~%.0f s (extrapolated)" % tot))
