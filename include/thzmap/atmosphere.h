@@ -71,14 +71,14 @@ THZ_API thz_status thz_atm_check_range(const thz_atm *atm, double lo_hz, double 
 
 /* alpha at freq_hz in 1/m, per part (parts a model lacks are 0; itu-p676 puts all of
  * its water vapour into h2o_lines_per_m); total_per_m is their sum. Every part is NaN
- * at a non-finite freq_hz or for a NULL atm. */
+ * at a negative or non-finite freq_hz or for a NULL atm. */
 typedef struct thz_atm_attenuation {
     double total_per_m;
     double h2o_lines_per_m, h2o_continuum_per_m, o2_per_m, dry_continuum_per_m;
 } thz_atm_attenuation;
 THZ_API void thz_atm_attenuation_parts(const thz_atm *atm, double freq_hz,
                                        thz_atm_attenuation *out);
-/* alpha at freq_hz in 1/m, computed directly (no tabulation); NaN at a non-finite
+/* alpha at freq_hz in 1/m, computed directly (no tabulation); NaN at a negative or non-finite
  * freq_hz or for a NULL atm. */
 THZ_API double thz_atm_attenuation_per_m(const thz_atm *atm, double freq_hz);
 

@@ -209,7 +209,8 @@ typedef struct thz_surface_optics {
     double n, k;
 } thz_surface_optics;
 /* Fills *out for material i at freq_hz > 0; THZ_ERR_INPUT (and *out zeroed) when i is
- * out of range, freq_hz is not positive or thickness_m is negative. */
+ * out of range, freq_hz is not positive and finite or thickness_m is negative or
+ * infinite. */
 THZ_API thz_status thz_scene_material_optics(const thz_scene *scene, size_t i, double freq_hz,
                                              double thickness_m, thz_surface_optics *out);
 

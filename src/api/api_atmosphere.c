@@ -184,7 +184,7 @@ void thz_atm_attenuation_parts(const thz_atm *a, double freq_hz, thz_atm_attenua
 {
     if (!out)
         return;
-    if (!a || !isfinite(freq_hz)) {
+    if (!a || !isfinite(freq_hz) || !(freq_hz >= 0.0)) {
         *out = (thz_atm_attenuation){NAN, NAN, NAN, NAN, NAN};
         return;
     }
@@ -199,7 +199,7 @@ void thz_atm_attenuation_parts(const thz_atm *a, double freq_hz, thz_atm_attenua
 
 double thz_atm_attenuation_per_m(const thz_atm *a, double freq_hz)
 {
-    if (!a || !isfinite(freq_hz))
+    if (!a || !isfinite(freq_hz) || !(freq_hz >= 0.0))
         return NAN;
     return atmosphere_alpha_direct_per_m(a->atm, freq_hz);
 }

@@ -334,7 +334,8 @@ thz_status thz_scene_material_optics(const thz_scene *s, size_t i, double freq_h
     if (!out)
         return THZ_ERR_INPUT;
     memset(out, 0, sizeof *out);
-    if (!s || i >= s->n_materials || !(freq_hz > 0.0) || !(thickness_m >= 0.0))
+    if (!s || i >= s->n_materials || !(freq_hz > 0.0) || !isfinite(freq_hz) ||
+        !(thickness_m >= 0.0) || !isfinite(thickness_m))
         return THZ_ERR_INPUT;
     /* an object of this material, as the simulation would see it */
     thz_object obj = {

@@ -444,6 +444,10 @@ static void check_null_arguments(thz_context *ctx, thz_scene *scene, thz_photons
     /* the functions that return values give their neutral one */
     CHECK(thz_library_count(NULL) == 0, "count of no library");
     CHECK(isnan(thz_atm_attenuation_per_m(NULL, 3e11)), "alpha of no atmosphere");
+    CHECK(isnan(thz_atm_attenuation_per_m(atm, -3e11)), "alpha at a negative frequency");
+    thz_surface_optics so;
+    CHECK(thz_scene_material_optics(scene, 0, INFINITY, 0, &so) == THZ_ERR_INPUT,
+          "optics at an infinite frequency accepted");
     thz_atm_attenuation parts = {0};
     thz_atm_attenuation_parts(NULL, 3e11, &parts);
     CHECK(isnan(parts.total_per_m), "parts of no atmosphere: %g", parts.total_per_m);
