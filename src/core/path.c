@@ -11,8 +11,9 @@ thz_status thz_path_join(char *out, size_t size, const char *dir, const char *na
     if (size == 0 || d + s + n >= size) {
         if (size)
             out[0] = '\0';
-        /* The limit first: a path this long fills most of the message and is cut. */
-        return thz_error_set(err, THZ_ERR_IO,
+        /* The limit first: a path this long fills most of the message and is cut. A path
+         * too long is the caller's (a directory named too deep), so bad input: exit 2. */
+        return thz_error_set(err, THZ_ERR_INPUT,
                              "path of %zu bytes, longer than the limit of %zu bytes: %s%s%s",
                              d + s + n, size ? size - 1 : 0, dir, sep, name);
     }

@@ -19,8 +19,9 @@ static thz_status envi_path(char *buf, const char *dir, const char *stem, const 
     char name[THZ_PATH_MAX];
     int n = snprintf(name, sizeof name, "%s.%s", stem, ext);
     if (n < 0 || (size_t)n >= sizeof name)
-        return thz_error_set(err, THZ_ERR_IO, "file name longer than the limit of %zu bytes: %s.%s",
-                             sizeof name - 1, stem, ext);
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "file name longer than the limit of %zu bytes: %s.%s", sizeof name - 1,
+                             stem, ext);
     return thz_path_join(buf, THZ_PATH_MAX, dir, name, err);
 }
 

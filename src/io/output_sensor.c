@@ -38,7 +38,7 @@ static thz_status out_file_name(char *buf, size_t size, const char *sensor, cons
                                 const char *ext, thz_error *err)
 {
     if (!output_file_name(buf, size, sensor, quantity, ext))
-        return thz_error_set(err, THZ_ERR_IO,
+        return thz_error_set(err, THZ_ERR_INPUT,
                              "sensor %s: file name longer than the limit of %zu bytes: %s%s",
                              sensor, size - 1, quantity, ext);
     return THZ_OK;

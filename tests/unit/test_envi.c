@@ -331,13 +331,13 @@ static void test_path_too_long(void **state)
     outdir[0] = '/';
     outdir[4080] = '\0';
     thz_error err = {0};
-    assert_int_equal(output_write_sensor(outdir, scene, 0, &img, 0, NULL, &err), THZ_ERR_IO);
+    assert_int_equal(output_write_sensor(outdir, scene, 0, &img, 0, NULL, &err), THZ_ERR_INPUT);
     assert_non_null(strstr(err.message, "path of 4097 bytes, longer than the limit of 4095"));
     memset(outdir, 'd', 4090);
     outdir[0] = '/';
     outdir[4090] = '\0';
     run_summary rs = {.command = "simulate"};
-    assert_int_equal(summary_write(outdir, scene, &rs, &err), THZ_ERR_IO);
+    assert_int_equal(summary_write(outdir, scene, &rs, &err), THZ_ERR_INPUT);
     assert_non_null(strstr(err.message, "path of 4103 bytes, longer than the limit of 4095"));
     free(outdir);
     sensor_images_fini(&img);
