@@ -52,7 +52,8 @@ typedef struct thz_classification thz_classification;
 
 /* Classifies every pixel of `cube` whose `truth` (a one-band cube of object indices,
  * -1 where nothing is hit, as S.object_id) is >= 0; the classes are the objects the
- * truth shows. *out owns the result; the cubes stay the caller's. */
+ * truth shows. opt NULL: thz_classify_options_init's defaults. *out owns the result; the
+ * cubes stay the caller's. */
 THZ_API thz_status thz_classify_cube(const thz_cube *cube, const thz_cube *truth,
                                      const thz_classify_options *opt, thz_classification **out,
                                      thz_error *err);

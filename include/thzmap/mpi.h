@@ -4,7 +4,9 @@
  * MPI_Init_thread (MPI_THREAD_FUNNELED is enough: only the thread that calls these
  * functions and the runs uses MPI), destroys its contexts, then calls MPI_Finalize; when a
  * call fails on any rank, the program ends the job (MPI_Abort), since the other ranks may
- * be waiting for it. Every rank loads the same scene with the same run settings.
+ * be waiting for it. Every rank loads the same scene with the same run settings. In a
+ * build with MPI, the calls below made before MPI_Init_thread (or after MPI_Finalize)
+ * return THZ_ERR_INTERNAL ("MPI: not initialised").
  *
  * Rank 0 calls thz_context_set_mpi and then thz_simulate, thz_render_run or thz_batch_run
  * as one process would: each photon phase is split by batches of photons across the ranks

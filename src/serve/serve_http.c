@@ -148,8 +148,9 @@ json_t *serve_body_object(serve_request *r, enum MHD_Result *result)
     json_error_t jerr;
     json_t *o = json_loadb(r->body ? r->body : "", r->body_size, JSON_REJECT_DUPLICATES, &jerr);
     if (!o) {
+        /* an empty body: jansson's column 0 is the line's first character */
         *result = serve_reply_bad_json(r, "$", "invalid JSON at line %d, column %d: %s", jerr.line,
-                                       jerr.column, jerr.text);
+                                       jerr.column > 0 ? jerr.column : 1, jerr.text);
         return NULL;
     }
     if (!json_is_object(o)) {

@@ -140,6 +140,9 @@ def test_text_and_limits(srv, root):
           "a refused PUT wrote its file")
     st, _, data = srv.request("GET", "/api/info")
     check(st == 200 and json.loads(data)["web"] is False, "/api/info without a bundle: %r" % data)
+    # an empty body: its syntax error at column 1, the first (it said column 0)
+    err = srv.json("POST", "/api/runs", body="", status=400)
+    check(err and "line 1, column 1:" in err["error"], "an empty body: %r" % err)
     # a NUL (%00) ended the C string: "n.json%00.txt" wrote n.json
     for method, url in (("PUT", "/api/file?path=s/nul.json%00.txt"),
                         ("GET", "/api/files?dir=s%00x"), ("GET", "/api/file?path=s/pm.json%00z")):
