@@ -10,6 +10,7 @@
 #ifndef THZ_PHYSICS_CHANNEL_H
 #define THZ_PHYSICS_CHANNEL_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "core/error.h"
@@ -44,6 +45,14 @@ void channel_fini(thz_channel *ch);
 static inline int channel_has_response(const thz_channel *ch)
 {
     return ch->n_response > 0;
+}
+
+/* The piece i of a table, [f_i, f_i+1]: its width and end weights. */
+static inline void channel_piece(const thz_channel *ch, size_t i, double *h, double *a, double *b)
+{
+    *h = ch->response_hz[i + 1] - ch->response_hz[i];
+    *a = ch->response_weight[i];
+    *b = ch->response_weight[i + 1];
 }
 
 /* sigma_c in Hz. For a table, B_c / sqrt(2 pi) (the sigma of the peak-1 Gaussian of the
@@ -86,22 +95,66 @@ void channel_sample_many_hz(const thz_channel *ch, const double *u1, const doubl
  * composite Simpson on each piece where g_c > 0, the table's points among the nodes,
  * about n nodes in all, spread in proportion to the pieces' widths), weights
  * proportional to g_c times the rule's weights, normalised to sum to exactly 1 so
- * that the band mean of a constant is that constant. */
+ * that the band mean of a constant is that constant. `even`: the nodes are evenly
+ * spaced (the Gaussian's rule without knots), so a frequency's node is found by
+ * division. */
 typedef struct channel_quadrature {
     size_t n;
     double *freq_hz;
     double *weight;
+    bool even;
 } channel_quadrature;
+
+/* The span of the Gaussian's fixed rule: nu_c +- this many sigma_c. */
+#define CHANNEL_QUADRATURE_SIGMAS 6.0
 
 /* Default number of nodes of the fixed rule. The fixed rule resolves features of about
  * a tenth of sigma to ~3 %; channel_band_mean refines adaptively and reaches 1e-6 on
  * lines of sigma/10. Callers that integrate narrow lines with the fixed nodes must use
- * more of them. Nodes below 0 Hz (w > 0.39) are dropped. */
+ * more of them, or name the lines' kinks (channel_quadrature_init_knots). Nodes below
+ * 0 Hz (w > 0.39) are dropped. */
 #define CHANNEL_QUADRATURE_NODES 401
+
+/* The most knots channel_quadrature_init_knots places inside one band; more are
+ * thinned evenly (taking every k-th), so a rule has at most about n + 2 x this many
+ * nodes. */
+#define CHANNEL_QUADRATURE_MAX_KNOTS 2048
+
+/* At most this many splits of a panel refine one rule (channel_structure). */
+#define CHANNEL_QUADRATURE_MAX_SPLITS (4 * CHANNEL_QUADRATURE_NODES)
 
 thz_status channel_quadrature_init(channel_quadrature *q, const thz_channel *ch, size_t n,
                                    thz_error *err);
+
+/* Test functions of an integrand's structure between the knots, for a rule that refines
+ * where they vary faster than its panels resolve (an atmosphere's transmittance over
+ * long paths): eval writes m <= CHANNEL_STRUCTURE_MAX values at freq_hz, each of
+ * magnitude at most about 1. */
+#define CHANNEL_STRUCTURE_MAX 8
+typedef struct channel_structure {
+    size_t m;
+    void (*eval)(double freq_hz, void *ctx, double *values);
+    void *ctx;
+} channel_structure;
+
+/* channel_quadrature_init with the frequencies where the integrand may have a kink:
+ * `knots` (n_knots, ascending; NULL when 0), the points of a scene's spectral tables,
+ * which are linear in between. Each knot inside the band ends a piece of the rule, so
+ * that composite Simpson integrates the tables' kinks exactly instead of with the
+ * O(h^2) error of a kink between two nodes (0.1 % of a band mean for a line sigma/5 wide
+ * in the air). The pieces share about n nodes in proportion to their widths, at least
+ * one Simpson panel each. With `s` (may be NULL), a panel is split in two while its
+ * halves change the band mean of a test function by more than 1e-7 (each split halving
+ * the tolerance; at most CHANNEL_QUADRATURE_MAX_SPLITS splits). Without knots inside
+ * the band and without s the rule is channel_quadrature_init's, node for node. */
+thz_status channel_quadrature_init_knots(channel_quadrature *q, const thz_channel *ch, size_t n,
+                                         const double *knots, size_t n_knots,
+                                         const channel_structure *s, thz_error *err);
 void channel_quadrature_fini(channel_quadrature *q);
+
+/* An upper bound on the nodes of channel_quadrature_init_knots with at most n_knots
+ * knots inside the band, refined by a structure or not (the memory estimate's). */
+size_t channel_quadrature_max_nodes(const thz_channel *ch, size_t n, size_t n_knots, bool refined);
 
 /* Band mean of f over channel ch, adaptive (see CHANNEL_QUADRATURE_NODES): the
  * Gaussian's base grid is the default quadrature's, a table's about as many nodes over

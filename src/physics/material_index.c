@@ -162,6 +162,13 @@ void material_index_range_at(const material_index *idx, size_t r, double *lo_hz,
     }
 }
 
+size_t material_index_table_hz(const material_index *idx, const double **freq_hz)
+{
+    bool table = !idx->is_model && idx->freq_hz && idx->count > 1;
+    *freq_hz = table ? idx->freq_hz : NULL;
+    return table ? idx->count : 0;
+}
+
 const permittivity_model *material_index_model_of(const material_index *idx)
 {
     return idx->is_model ? &idx->model : NULL;

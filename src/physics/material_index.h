@@ -52,6 +52,10 @@ bool material_index_range(const material_index *idx, double *lo_hz, double *hi_h
 size_t material_index_n_ranges(const material_index *idx);
 void material_index_range_at(const material_index *idx, size_t r, double *lo_hz, double *hi_hz);
 
+/* A table's frequencies (its count; *freq_hz points into idx), where n and k have kinks;
+ * 0 (and NULL) for constants and models. */
+size_t material_index_table_hz(const material_index *idx, const double **freq_hz);
+
 /* The model behind idx, or NULL for constants and tables. */
 const permittivity_model *material_index_model_of(const material_index *idx);
 

@@ -259,3 +259,77 @@ double scene_reference_temperature_k(const thz_scene *scene, size_t channel)
     }
     return t0;
 }
+
+/* The points of one table in (lo_hz, hi_hz), appended at out[m] when out is not NULL;
+ * the new count. */
+static size_t scene_knots_add(const double *freq_hz, size_t count, double lo_hz, double hi_hz,
+                              double *out, size_t m)
+{
+    for (size_t i = 0; freq_hz && count > 1 && i < count; i++)
+        if (freq_hz[i] > lo_hz && freq_hz[i] < hi_hz) {
+            if (out)
+                out[m] = freq_hz[i];
+            m++;
+        }
+    return m;
+}
+
+static size_t scene_knots_collect(const thz_scene *s, double lo_hz, double hi_hz, double *out)
+{
+    size_t m = 0;
+    for (size_t i = 0; i < s->n_materials; i++) {
+        bool used = false;
+        for (size_t o = 0; o < s->n_objects && !used; o++)
+            used = s->objects[o].material == i;
+        if (!used)
+            continue;
+        const thz_material *mat = &s->materials[i];
+        const thz_spectrum *spectra[] = {&mat->reflectivity, &mat->attenuation_per_m,
+                                         &mat->emissivity};
+        for (size_t k = 0; k < sizeof spectra / sizeof spectra[0]; k++)
+            m = scene_knots_add(spectra[k]->freq_hz, spectra[k]->n, lo_hz, hi_hz, out, m);
+        if (mat->index) {
+            const double *f;
+            size_t count = material_index_table_hz(mat->index, &f);
+            m = scene_knots_add(f, count, lo_hz, hi_hz, out, m);
+        }
+    }
+    const thz_spectrum *air = &s->atmosphere.attenuation_per_m;
+    if (s->atmosphere.model == ATM_TABLE)
+        m = scene_knots_add(air->freq_hz, air->n, lo_hz, hi_hz, out, m);
+    return m;
+}
+
+size_t scene_spectral_knots_bound(const thz_scene *scene, double lo_hz, double hi_hz)
+{
+    return scene_knots_collect(scene, lo_hz, hi_hz, NULL);
+}
+
+static int scene_knot_compare(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+thz_status scene_spectral_knots(const thz_scene *scene, double lo_hz, double hi_hz, double **knots,
+                                size_t *n, thz_error *err)
+{
+    *knots = NULL;
+    *n = 0;
+    size_t count = scene_knots_collect(scene, lo_hz, hi_hz, NULL);
+    if (count == 0)
+        return THZ_OK;
+    double *k = thz_malloc_array(count, sizeof *k);
+    if (!k)
+        return thz_error_set(err, THZ_ERR_NOMEM, "scene: cannot allocate %zu spectral knots",
+                             count);
+    scene_knots_collect(scene, lo_hz, hi_hz, k);
+    qsort(k, count, sizeof *k, scene_knot_compare);
+    size_t m = 1;
+    for (size_t i = 1; i < count; i++)
+        if (k[i] != k[m - 1])
+            k[m++] = k[i];
+    *knots = k;
+    *n = m;
+    return THZ_OK;
+}

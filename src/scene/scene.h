@@ -229,6 +229,16 @@ double scene_band_emitted_power_w_per_hz(const thz_scene *scene, size_t channel)
  * the T0 of final-gather's deviation photon map (photon_map.h). */
 double scene_reference_temperature_k(const thz_scene *scene, size_t channel);
 
+/* The frequencies in (lo_hz, hi_hz) where a spectrum that the renderers tabulate per
+ * quadrature node may have a kink: the points of the spectral tables (R, alpha_M, eps,
+ * a tabled complex index) of the materials the objects use and of a tabled atmosphere,
+ * ascending and distinct, in *knots (malloc'd; NULL when there are none). */
+thz_status scene_spectral_knots(const thz_scene *scene, double lo_hz, double hi_hz, double **knots,
+                                size_t *n, thz_error *err);
+
+/* An upper bound on scene_spectral_knots' count, without allocating. */
+size_t scene_spectral_knots_bound(const thz_scene *scene, double lo_hz, double hi_hz);
+
 /* Computes the mesh-derived data from positions and indices: allocates (replacing any
  * earlier) normals and areas_m2, and sets total_area_m2 and the bounding box.
  * Degenerate triangles keep area 0 and a zero normal. False on allocation failure. */

@@ -65,6 +65,83 @@ static void render_pair_table(render_context *ctx)
     ctx->pair_mean = table;
 }
 
+/* The diagonal of the box around every object, sensor and the atmosphere's extent: the
+ * longest straight path through the air a sensor can see along (m). */
+static double render_scene_span_m(const thz_scene *scene)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t o = 0; o < scene->n_objects; o++)
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], scene->objects[o].mesh.bbox_min_m[a]);
+            hi[a] = fmax(hi[a], scene->objects[o].mesh.bbox_max_m[a]);
+        }
+    for (size_t s = 0; s < scene->n_sensors; s++)
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], scene->sensors[s].position_m[a]);
+            hi[a] = fmax(hi[a], scene->sensors[s].position_m[a]);
+        }
+    const thz_atmosphere *atm = &scene->atmosphere;
+    for (int a = 0; a < 3 && atm->has_extent; a++) {
+        lo[a] = fmin(lo[a], atm->extent_min_m[a]);
+        hi[a] = fmax(hi[a], atm->extent_max_m[a]);
+    }
+    double d2 = 0.0;
+    for (int a = 0; a < 3; a++)
+        d2 += hi[a] > lo[a] ? (hi[a] - lo[a]) * (hi[a] - lo[a]) : 0.0;
+    return sqrt(d2);
+}
+
+/* The air's transmittances exp(-alpha d) over the scene's span and a quarter, a
+ * sixteenth and a 64th of it: what a band mean through air whose attenuation has lines
+ * must resolve between the knots. */
+#define RENDER_AIR_PATHS 4
+typedef struct render_air_paths {
+    const thz_atmosphere *atm;
+    double d_m[RENDER_AIR_PATHS];
+} render_air_paths;
+
+static void render_air_transmittances(double freq_hz, void *ctx, double *values)
+{
+    const render_air_paths *air = ctx;
+    double alpha = atmosphere_alpha_per_m(air->atm, freq_hz);
+    for (int j = 0; j < RENDER_AIR_PATHS; j++)
+        values[j] = exp(-alpha * air->d_m[j]);
+}
+
+/* Whether the air's attenuation varies with frequency (a constant needs no refinement). */
+static bool render_air_spectral(const thz_scene *scene)
+{
+    atm_model m = scene->atmosphere.model;
+    return m == ATM_TABLE || m == ATM_ITU_P676 || m == ATM_LINES;
+}
+
+/* The channel's quadrature, its pieces ending at the scene's spectral knots inside the
+ * band (the tables' kinks are nodes) and refined where the air's transmittance varies
+ * faster than the nodes resolve, so that a narrow line, tabled or in the air, is
+ * integrated to ~1e-7 whatever the band (physics.md "Channels": an unbiased quadrature;
+ * the fixed rule missed a line sigma/5 wide in the air by 1e-3). */
+static thz_status render_context_quadrature(channel_quadrature *q, const thz_scene *scene,
+                                            size_t channel, thz_error *err)
+{
+    const thz_channel *ch = &scene->channels[channel];
+    double lo, hi, *knots;
+    size_t n_knots;
+    channel_support_hz(ch, CHANNEL_QUADRATURE_SIGMAS, &lo, &hi);
+    thz_status st = scene_spectral_knots(scene, lo, hi, &knots, &n_knots, err);
+    if (st != THZ_OK)
+        return st;
+    render_air_paths air = {.atm = &scene->atmosphere};
+    air.d_m[0] = render_scene_span_m(scene);
+    for (int j = 1; j < RENDER_AIR_PATHS; j++)
+        air.d_m[j] = 0.25 * air.d_m[j - 1];
+    channel_structure s = {RENDER_AIR_PATHS, render_air_transmittances, &air};
+    bool refine = render_air_spectral(scene) && air.d_m[0] > 0.0;
+    st = channel_quadrature_init_knots(q, ch, CHANNEL_QUADRATURE_NODES, knots, n_knots,
+                                       refine ? &s : NULL, err);
+    free(knots);
+    return st;
+}
+
 /* T0: the photon map's when map_t0 (photon-map, final-gather), else path_t0_k when it is
  * not NAN, else scene_reference_temperature_k (path). */
 static thz_status render_context_init(render_context *ctx, const thz_scene *scene, const accel *a,
@@ -80,8 +157,7 @@ static thz_status render_context_init(render_context *ctx, const thz_scene *scen
     ctx->seed = scene->photons.seed;
     ctx->k = scene->photons.gather_min_photons;
     ctx->k_secondary = ctx->k > RENDER_SECONDARY_K ? ctx->k : RENDER_SECONDARY_K;
-    thz_status st = channel_quadrature_init(&ctx->quad, &scene->channels[channel],
-                                            CHANNEL_QUADRATURE_NODES, err);
+    thz_status st = render_context_quadrature(&ctx->quad, scene, channel, err);
     if (st != THZ_OK)
         return st;
     size_t n = ctx->quad.n, n_obj = scene->n_objects;
@@ -240,7 +316,26 @@ uint64_t render_context_bytes(const thz_scene *scene)
 {
     /* as render_context_init allocates: planck, optics, tbar, rbar, lobes, ward_scale and
      * ward_comp per cell; the per-object arrays; the pair table */
-    uint64_t n_obj = scene->n_objects, cells = n_obj * CHANNEL_QUADRATURE_NODES;
+    uint64_t nodes = CHANNEL_QUADRATURE_NODES;
+    for (size_t c = 0; c < scene->n_channels; c++) {
+        /* the channel's own rule (a few thousand table lookups), else a bound */
+        channel_quadrature q;
+        thz_error err;
+        size_t n;
+        if (render_context_quadrature(&q, scene, c, &err) == THZ_OK) {
+            n = q.n;
+            channel_quadrature_fini(&q);
+        } else {
+            const thz_channel *ch = &scene->channels[c];
+            double lo, hi;
+            channel_support_hz(ch, CHANNEL_QUADRATURE_SIGMAS, &lo, &hi);
+            size_t k = scene_spectral_knots_bound(scene, lo, hi);
+            n = channel_quadrature_max_nodes(ch, CHANNEL_QUADRATURE_NODES, k,
+                                             render_air_spectral(scene));
+        }
+        nodes = n > nodes ? n : nodes;
+    }
+    uint64_t n_obj = scene->n_objects, cells = n_obj * nodes;
     uint64_t per_cell = 5u * sizeof(double) + sizeof(optics_point) + sizeof(brdf_lobe);
     uint64_t per_object = sizeof(optics_point) + 3u * sizeof(bool) + 3u * sizeof(double);
     uint64_t bytes = cells * per_cell + n_obj * per_object + sizeof(render_context);

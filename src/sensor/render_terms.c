@@ -28,11 +28,12 @@ double render_path_weight(const render_context *ctx, const render_path *path, do
 }
 
 /* Linear interpolation of table[object * n + node] at freq_hz between the quadrature
- * nodes inside the band; NAN outside. The tabled quantities are smooth in frequency, so
- * the interpolation is exact to ~1e-8 over a node spacing of 0.03 sigma; it spares a
- * quadrature per photon term. The Gaussian's nodes are evenly spaced (the node is found
- * by division); a measured response's are not (each piece has its own Simpson spacing,
- * pieces where g = 0 have none), so there the node is found by bisection. */
+ * nodes inside the band; NAN outside. The tabled quantities are smooth in frequency
+ * between the scene's spectral knots, which are nodes, so the interpolation is exact
+ * to ~1e-8 over a node spacing of 0.03 sigma; it spares a quadrature per photon term.
+ * The Gaussian's nodes without knots are evenly spaced (the node is found by division);
+ * otherwise each piece has its own Simpson spacing (a measured response's pieces where
+ * g = 0 have none), so the node is found by bisection. */
 static double render_interp(const render_context *ctx, const double *table, uint32_t object,
                             double freq_hz)
 {
@@ -42,7 +43,7 @@ static double render_interp(const render_context *ctx, const double *table, uint
     const double *f = ctx->quad.freq_hz;
     size_t i;
     double t;
-    if (!channel_has_response(ctx->channel)) {
+    if (ctx->quad.even) {
         double step = f[1] - f[0];
         double x = (freq_hz - f[0]) / step;
         if (!(x >= 0.0 && x < (double)(n - 1)))
