@@ -142,6 +142,12 @@ typedef struct thz_bands_options {
 
 THZ_API void thz_bands_options_init(thz_bands_options *opt);
 
+/* The candidate centres opt's from_thz, to_thz and step_ghz give: from_thz + i x step
+ * up to to_thz (a step landing within 1e-9 of a step of to_thz counts), so a client can
+ * check `count` before thz_bands_select loads the scene. 0 when opt is NULL or the
+ * range or step is not valid (0 < from <= to, step > 0, all finite). */
+THZ_API double thz_bands_candidate_centres(const thz_bands_options *opt);
+
 typedef struct thz_bands thz_bands;
 
 /* Chooses opt->count channel centres (with their widths when opt->n_widths > 0) among

@@ -45,6 +45,7 @@ _P = c_void_p
 _ERR = POINTER(_lib.ThzError)
 _PROTOTYPES = {
     "thz_bands_options_init": (None, [POINTER(ThzBandsOptions)]),
+    "thz_bands_candidate_centres": (c_double, [POINTER(ThzBandsOptions)]),
     "thz_bands_select": (c_int, [_P, c_char_p, POINTER(ThzBandsOptions), POINTER(c_void_p),
                                  _ERR]),
     "thz_bands_destroy": (None, [_P]),
@@ -185,7 +186,7 @@ def bands(scene, count, from_thz=None, to_thz=None, step_ghz=None, relative_widt
     lo, hi, step = o.from_thz, o.to_thz, o.step_ghz
     if lo > hi:
         raise ArgumentError(f"from_thz {lo} > to_thz {hi}: expected from_thz <= to_thz")
-    centres = math.floor((hi - lo) * 1e3 / step + 1e-9) + 1
+    centres = int(_lib.lib.thz_bands_candidate_centres(ctypes.byref(o)))
     if o.count > centres:
         raise ArgumentError(f"count {o.count}: only {centres} candidate centres from {lo} to "
                             f"{hi} THz every {step} GHz")

@@ -71,6 +71,14 @@ void thz_bands_destroy(thz_bands *b)
     free(b);
 }
 
+double thz_bands_candidate_centres(const thz_bands_options *o)
+{
+    if (!o || !(o->from_thz > 0.0) || !(o->to_thz >= o->from_thz) || !(o->step_ghz > 0.0) ||
+        !isfinite(o->to_thz) || !isfinite(o->step_ghz))
+        return 0.0;
+    return floor((o->to_thz - o->from_thz) * 1e3 / o->step_ghz + 1e-9) + 1.0;
+}
+
 static thz_status check_options(const thz_bands_options *o, size_t *n_candidates, thz_error *err)
 {
     if (o->count < 1 || o->count > BANDS_MAX_COUNT)
@@ -82,7 +90,7 @@ static thz_status check_options(const thz_bands_options *o, size_t *n_candidates
                              "candidates %g to %g THz by %g GHz: expected 0 < from <= to and a "
                              "step > 0",
                              o->from_thz, o->to_thz, o->step_ghz);
-    double n = floor((o->to_thz - o->from_thz) * 1e3 / o->step_ghz + 1e-9) + 1.0;
+    double n = thz_bands_candidate_centres(o);
     if (n > BANDS_MAX_CANDIDATES)
         return thz_error_set(err, THZ_ERR_INPUT,
                              "%.0f candidates from %g to %g THz by %g GHz: at most %d (raise "

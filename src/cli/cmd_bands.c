@@ -223,7 +223,7 @@ int cmd_bands(int argc, char **argv)
         return cli_usage_error(CMD, "--to-thz (%g THz) must not be below --from-thz (%g THz)",
                                opt.to_thz, opt.from_thz);
     /* what the library would refuse only after loading the scene, said by option */
-    double centres = floor((opt.to_thz - opt.from_thz) * 1e3 / opt.step_ghz + 1e-9) + 1.0;
+    double centres = thz_bands_candidate_centres(&opt);
     if ((double)count > centres)
         return cli_usage_error(CMD,
                                "--count %llu: only %.0f candidate centres from %g to %g THz "

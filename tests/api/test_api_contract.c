@@ -291,6 +291,21 @@ static void check_bands_targets(thz_context *ctx, const char *scene_path)
     o.n_targets = 2;
     expect_input_error(thz_bands_select(ctx, scene_path, &o, &bands, &err), &err,
                        "targets[1]: expected an object's name, got NULL", "target NULL");
+
+    /* the candidate centres: both ends included (0.1 to 1.5 THz by 10 GHz: 141), a step
+     * a rounding short of to_thz counted, bad ranges 0 */
+    thz_bands_options_init(&o);
+    CHECK(thz_bands_candidate_centres(&o) == 141.0, "default candidates");
+    o.from_thz = 0.3;
+    o.to_thz = 0.6;
+    o.step_ghz = 100.0; /* 0.3 + 3 x 0.1 lands a hair off 0.6 in binary */
+    CHECK(thz_bands_candidate_centres(&o) == 4.0, "0.3 to 0.6 by 100 GHz");
+    o.step_ghz = 0.0;
+    CHECK(thz_bands_candidate_centres(&o) == 0.0, "step 0");
+    o.step_ghz = 10.0;
+    o.to_thz = 0.2;
+    CHECK(thz_bands_candidate_centres(&o) == 0.0, "to below from");
+    CHECK(thz_bands_candidate_centres(NULL) == 0.0, "NULL options");
 }
 
 /* An output takes nothing after its commit, and says so (THZ_ERR_INPUT, not an I/O
