@@ -291,7 +291,7 @@ thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, 
             photon_stats_merge(&ph->stats[c], &parts[i]->stats[c], (uint32_t)m);
         }
         if (m > 0)
-            st = photon_map_merge(maps, m, ph->effective.n_objects, ctx ? ctx->threads : 0,
+            st = photon_map_merge(maps, m, ph->effective.n_objects, ctx ? ctx->threads : 0, NULL,
                                   &ph->maps[c], err);
         if (st == THZ_OK && ph->maps[c])
             ph->stats[c].stored = photon_map_count(ph->maps[c]);

@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/threads.h"
 #include "photon/photon_map_layout.h"
 
 /* k up to this uses a heap on the stack; larger k allocates one per query. */
@@ -109,6 +110,10 @@ void photon_map_pool_fini(photon_map_pool *pool)
 
 photon_record *photon_map_pool_take(photon_map_pool *pool, size_t *capacity)
 {
+    if (!pool) {
+        *capacity = 0;
+        return NULL;
+    }
     photon_record *r = pool->records;
     *capacity = r ? pool->records_capacity : 0;
     pool->records = NULL;
@@ -165,7 +170,7 @@ void *photon_map_pool_index(photon_map_pool *pool, size_t bytes)
 }
 
 thz_status photon_map_merge(const photon_map *const *maps, size_t n, size_t n_objects, int threads,
-                            photon_map **out, thz_error *err)
+                            photon_map_pool *pool, photon_map **out, thz_error *err)
 {
     *out = NULL;
     size_t total = 0;
@@ -179,20 +184,45 @@ thz_status photon_map_merge(const photon_map *const *maps, size_t n, size_t n_ob
             batches = 1;
         total += photon_map_count(maps[i]);
     }
-    photon_record *all = thz_malloc_array(total ? total : 1, sizeof *all);
-    if (!all)
-        return thz_error_set(err, THZ_ERR_NOMEM, "photon map merge: out of memory for %zu photons",
-                             total);
-    size_t at = 0;
+    /* the pool's array (an earlier merge's), grown in place where it can be: a merge into
+     * fresh memory spent most of its time faulting the pages in */
+    size_t capacity = 0;
+    photon_record *all = photon_map_pool_take(pool, &capacity);
+    if (capacity < total || !all) {
+        photon_record *grown = thz_realloc_array(all, total ? total : 1, sizeof *all);
+        if (!grown) {
+            free(all);
+            return thz_error_set(err, THZ_ERR_NOMEM,
+                                 "photon map merge: out of memory for %zu photons", total);
+        }
+        /* the new pages at once (the kernel's populate, not a fault per page) */
+        thz_populate(grown + capacity, ((total ? total : 1) - capacity) * sizeof *grown);
+        all = grown;
+        capacity = total ? total : 1;
+    }
+    size_t *at = thz_malloc_array(n ? n : 1, sizeof *at);
+    if (!at) {
+        free(all);
+        return thz_error_set(err, THZ_ERR_NOMEM, "photon map merge: out of memory");
+    }
+    for (size_t i = 0, sum = 0; i < n; i++) {
+        at[i] = sum;
+        sum += photon_map_count(maps[i]);
+    }
     double scale = 1.0 / (double)(n ? n : 1);
+    /* each map to its own place: the same records whatever the thread count */
+    int nt = thz_threads_or_all(threads);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
     for (size_t i = 0; i < n; i++) {
         size_t count = photon_map_count(maps[i]);
-        memcpy(all + at, photon_map_records(maps[i]), count * sizeof *all);
-        for (size_t j = at; j < at + count; j++)
-            all[j].power_w_per_hz = (float)((double)all[j].power_w_per_hz * scale);
-        at += count;
+        photon_record *to = all + at[i];
+        memcpy(to, photon_map_records(maps[i]), count * sizeof *all);
+        for (size_t j = 0; j < count; j++)
+            to[j].power_w_per_hz = (float)((double)to[j].power_w_per_hz * scale);
     }
-    thz_status st = photon_map_create(all, total, n_objects, threads, out, err);
+    free(at);
+    thz_status st =
+        photon_map_build(all, total, capacity, n_objects, threads, pool, NULL, out, err);
     if (st != THZ_OK)
         return st;
     photon_map_set_reference_temperature_k(*out,

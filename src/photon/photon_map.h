@@ -104,7 +104,8 @@ typedef struct photon_map_pool {
 
 void photon_map_pool_fini(photon_map_pool *pool);
 
-/* The pool's spare record array (NULL if none) and its capacity, now the caller's. */
+/* The pool's spare record array (NULL if none, or pool NULL) and its capacity, now the
+ * caller's. */
 photon_record *photon_map_pool_take(photon_map_pool *pool, size_t *capacity);
 
 /* Destroys map, keeping its record array in pool when larger than the pool's spare
@@ -130,9 +131,11 @@ thz_status photon_map_build(photon_record *photons, size_t count, size_t capacit
 /* One map of the photons of n maps of one channel fired with the same K and disjoint
  * photon ranges (photon_phase_options.first_photon): their records in order, each power
  * divided by n (each map's photons carry P/K; together they are n K photons). The maps
- * must share T0; the result has it, and batches when all have them. Deterministic. */
+ * must share T0; the result has it, and batches when all have them. Deterministic. With
+ * a pool (may be NULL), the record array is the pool's spare grown to size (recycle the
+ * last merge into it: photon_map_recycle) and the index build uses its scratch. */
 thz_status photon_map_merge(const photon_map *const *maps, size_t n, size_t n_objects, int threads,
-                            photon_map **out, thz_error *err);
+                            photon_map_pool *pool, photon_map **out, thz_error *err);
 
 size_t photon_map_count(const photon_map *map);
 

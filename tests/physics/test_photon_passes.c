@@ -56,9 +56,9 @@ static void merge_case(double t0_k)
     photon_map *passes[2] = {fire(s, acc, k, 0, t0_k), fire(s, acc, k, k, t0_k)};
     photon_map *whole = fire(s, acc, 2 * k, 0, t0_k);
     photon_map *merged = NULL;
-    assert_int_equal(
-        photon_map_merge((const photon_map *const *)passes, 2, s->n_objects, 2, &merged, &err),
-        THZ_OK);
+    assert_int_equal(photon_map_merge((const photon_map *const *)passes, 2, s->n_objects, 2, NULL,
+                                      &merged, &err),
+                     THZ_OK);
     size_t n = photon_map_count(whole);
     printf("# T0 = %.0f K: %zu + %zu records merged, %zu fired at once\n", t0_k,
            photon_map_count(passes[0]), photon_map_count(passes[1]), n);
@@ -93,6 +93,48 @@ static void test_merge_equals_one_phase(void **state)
     merge_case(295.0);
 }
 
+/* A merge through a pool (run_photon_passes' checks: the last merge recycled into it,
+ * its array grown in place) is the merge without one, record for record in the same
+ * order, for 1 and 2 threads; the pool's array is reused. */
+static void test_merge_through_pool(void **state)
+{
+    (void)state;
+    uint64_t k = PHASE_BATCH + 501;
+    thz_scene *s = ps_box_scene(k, 7, 0.1);
+    accel *acc;
+    thz_error err;
+    if (accel_create(s, &acc, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    photon_map *maps[3] = {fire(s, acc, k, 0, 0.0), fire(s, acc, k, k, 0.0),
+                           fire(s, acc, k, 2 * k, 0.0)};
+    const photon_map *const *m = (const photon_map *const *)maps;
+    photon_map *plain = NULL;
+    assert_int_equal(photon_map_merge(m, 3, s->n_objects, 2, NULL, &plain, &err), THZ_OK);
+    size_t n = photon_map_count(plain);
+    for (int threads = 1; threads <= 2; threads++) {
+        photon_map_pool pool = {0};
+        photon_map *first = NULL, *pooled = NULL;
+        assert_int_equal(photon_map_merge(m, 2, s->n_objects, threads, &pool, &first, &err),
+                         THZ_OK);
+        const photon_record *kept = photon_map_records(first);
+        photon_map_recycle(first, &pool); /* a smaller merge's array, to be grown */
+        assert_ptr_equal(pool.records, kept);
+        assert_int_equal(photon_map_merge(m, 3, s->n_objects, threads, &pool, &pooled, &err),
+                         THZ_OK);
+        assert_null(pool.records); /* taken */
+        assert_int_equal(photon_map_count(pooled), n);
+        assert_memory_equal(photon_map_records(pooled), photon_map_records(plain),
+                            n * sizeof(photon_record));
+        photon_map_destroy(pooled);
+        photon_map_pool_fini(&pool);
+    }
+    photon_map_destroy(plain);
+    for (int i = 0; i < 3; i++)
+        photon_map_destroy(maps[i]);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
 /* Maps of different reference temperatures do not merge. */
 static void test_merge_refuses_mixed_t0(void **state)
 {
@@ -105,7 +147,7 @@ static void test_merge_refuses_mixed_t0(void **state)
     photon_map *maps[2] = {fire(s, acc, 2000, 0, 0.0), fire(s, acc, 2000, 2000, 295.0)};
     photon_map *merged = NULL;
     assert_int_not_equal(
-        photon_map_merge((const photon_map *const *)maps, 2, s->n_objects, 1, &merged, &err),
+        photon_map_merge((const photon_map *const *)maps, 2, s->n_objects, 1, NULL, &merged, &err),
         THZ_OK);
     assert_null(merged);
     photon_map_destroy(maps[0]);
@@ -118,6 +160,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_merge_equals_one_phase),
+        cmocka_unit_test(test_merge_through_pool),
         cmocka_unit_test(test_merge_refuses_mixed_t0),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
