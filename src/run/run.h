@@ -273,4 +273,8 @@ double run_passes_memory_limit_bytes(void);
  * for more than a quarter more (the most; the time estimate's count of renders). */
 uint32_t run_photon_checks(uint32_t passes);
 
+/* The passes those checks merge, summed over the checks after the first (each merges
+ * every pass so far): the time estimate's count of merged photons, in passes. */
+double run_photon_merged_passes(uint32_t passes);
+
 #endif

@@ -14,6 +14,14 @@
 #include "sensor/render_accum.h"
 #include "sensor/truth.h"
 
+/* A merge's time per photon against the photon phase's index build per photon: the copy
+ * of the records and their index built again, over arrays far larger than a pass's.
+ * Measured on the walkthrough's room with photon-map and no count (2 channels, 1 M
+ * photons a pass, 202 and 204 passes to the memory stop, 2 threads): the run took 205 s,
+ * of which the passes' own photon phases 66 s; 1.0 estimated 142 s, 1.8 gives 202 s
+ * (without the merges the estimate said 68 s). */
+#define RUN_ESTIMATE_MERGE_PER_INDEX 1.8
+
 /* Samples one pass of sensor s renders: pixels x oversampling^2 (x paths for path). */
 static double estimate_samples(const thz_scene *scene, const thz_sensor *s)
 {
@@ -38,14 +46,15 @@ void run_estimate_pilot(const thz_scene *scene, const thz_sensor *sensor, thz_se
  * photons), its render time per sample, and the 95th percentile of its pixels' standard
  * error of Tb_c (K). */
 static thz_status estimate_channel(const run_estimate_input *in, thz_scene *pilot, thz_sensor *cam,
-                                   size_t c, double *seconds_photons, double *per_sample,
-                                   double *p95_k, thz_error *err)
+                                   size_t c, double *seconds_photons, double *merge_per_photon,
+                                   double *per_sample, double *p95_k, thz_error *err)
 {
     const thz_scene *scene = in->scene;
     bool photons = render_integrator_needs_photons(scene->render.integrator);
     photon_map *map = NULL;
     thz_status st = THZ_OK;
     *seconds_photons = 0.0;
+    *merge_per_photon = 0.0;
     if (photons) {
         const uint64_t pilot_photons = pilot->photons.per_channel;
         photon_phase_options po = {.threads = in->threads,
@@ -65,6 +74,8 @@ static thz_status estimate_channel(const run_estimate_input *in, thz_scene *pilo
         double per_photon = (ps.seconds_tracing + ps.seconds_index) / (double)pilot_photons;
         *seconds_photons =
             ps.seconds_emission_table + per_photon * (double)scene->photons.per_channel;
+        /* a merge of photon passes copies the records and builds their index again */
+        *merge_per_photon = RUN_ESTIMATE_MERGE_PER_INDEX * ps.seconds_index / (double)pilot_photons;
     }
     sensor_images img;
     render_accum acc;
@@ -149,8 +160,9 @@ thz_status run_estimate_time(const run_estimate_input *in, run_estimate *out, th
      * 3.3 s; now 4.6 s against 3.5 s). Without a target, channel 0's stands for all. */
     size_t piloted = in->target_noise_k > 0.0 ? scene->n_channels : 1;
     for (size_t c = 0; c < piloted; c++) {
-        double photons_s, per_sample, p95_k;
-        thz_status st = estimate_channel(in, &pilot, &cam, c, &photons_s, &per_sample, &p95_k, err);
+        double photons_s, merge_per_photon, per_sample, p95_k;
+        thz_status st = estimate_channel(in, &pilot, &cam, c, &photons_s, &merge_per_photon,
+                                         &per_sample, &p95_k, err);
         if (st != THZ_OK)
             return st;
         uint32_t passes_c = 1;
@@ -173,7 +185,11 @@ thz_status run_estimate_time(const run_estimate_input *in, run_estimate *out, th
         /* photon-map's passes render at checks only (run_photon_passes) */
         double renders = paper_map ? (double)run_photon_checks(passes_c) : (double)passes_c;
         out->seconds_render += per_sample * samples * renders * channels;
-        out->seconds_photons += (paper_map ? photons_s * passes_c : photons_s) * channels;
+        double merges = paper_map ? merge_per_photon * (double)scene->photons.per_channel *
+                                        run_photon_merged_passes(passes_c)
+                                  : 0.0;
+        out->seconds_photons +=
+            ((paper_map ? photons_s * passes_c : photons_s) + merges) * channels;
     }
     return THZ_OK;
 }
