@@ -193,10 +193,11 @@ class _BatchCall(Call):
 
     _stacklevel = 4  # past __exit__ below
 
-    def __init__(self, threads, n_frames):
+    def __init__(self, threads, sequence):
         super().__init__(threads, None)
         self.frame = 0
-        self._n_frames = n_frames
+        self._sequence = sequence
+        self._n_frames = len(sequence)
         self._repeats = {}
 
     def _on_warning(self, user, message):
@@ -206,7 +207,9 @@ class _BatchCall(Call):
                 self._repeats[text] += 1
             else:
                 self._repeats[text] = 0
-                self._warnings.append(f"frame {self.frame + 1}/{self._n_frames}: {text}")
+                where = self._sequence.frame(self.frame).dir if self._n_frames else "?"
+                self._warnings.append(f"frame {self.frame + 1}/{self._n_frames} ({where}): "
+                                      f"{text}")
         except BaseException as e:  # noqa: B902 - every exception must stop at this frame
             if self._exc is None:
                 self._exc = e
@@ -277,7 +280,7 @@ def batch(sequence, outdir, threads=None, progress=None, movies=True):
         raise ArgumentError(f"movies: expected True or False, got {movies!r}")
     report = make_reporter(progress, _BatchBar)
     try:
-        with _BatchCall(threads, len(sequence)) as call:
+        with _BatchCall(threads, sequence) as call:
 
             def on_progress(user, p):
                 c = p.contents

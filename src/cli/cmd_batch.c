@@ -45,6 +45,7 @@ typedef struct batch_cli {
     size_t frame;       /* the frame running (its warnings name it), when in_frame */
     size_t n_frames;
     bool in_frame;
+    const thz_sequence *seq;     /* the frames' directories, which the warnings name */
     cli_frame_warnings warnings; /* printed once, the later frames' same counted */
 } batch_cli;
 
@@ -132,7 +133,11 @@ static void batch_on_warning(void *user, const char *message)
         fputs("\r\033[K", stderr);
         b->line_open = false;
     }
-    if (b->in_frame)
+    thz_frame_info fi;
+    if (b->in_frame && b->seq && thz_sequence_frame(b->seq, b->frame, &fi) == THZ_OK)
+        fprintf(stderr, "thzmap batch: warning: frame %zu/%zu (%s): %s\n", b->frame + 1,
+                b->n_frames, fi.dir, message);
+    else if (b->in_frame)
         fprintf(stderr, "thzmap batch: warning: frame %zu/%zu: %s\n", b->frame + 1, b->n_frames,
                 message);
     else
@@ -225,6 +230,7 @@ int cmd_batch(int argc, char **argv)
                     failed, seq_path);
         return CLI_EXIT_FAILURE;
     }
+    b.seq = seq;
     bool shared = cli_mpi_size() > 1;
     if (shared && cli_mpi_rank() > 0) {
         rc = batch_member(seq, (int)threads);

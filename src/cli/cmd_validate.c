@@ -290,8 +290,10 @@ static int validate_sequence(const char *path)
         }
         for (size_t i = 0; i < thz_scene_warning_count(scene); i++) {
             const char *w = thz_scene_warning(scene, i);
+            thz_frame_info fi;
             if (cli_frame_warnings_first(&warnings, w))
-                fprintf(stderr, "thzmap validate: warning: frame %zu/%zu: %s\n", f + 1, n, w);
+                fprintf(stderr, "thzmap validate: warning: frame %zu/%zu (%s): %s\n", f + 1, n,
+                        thz_sequence_frame(seq, f, &fi) == THZ_OK ? fi.dir : "?", w);
         }
         thz_scene_destroy(scene);
     }

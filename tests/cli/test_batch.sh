@@ -431,7 +431,7 @@ echo '{"format": "thzmap-sequence/1", "scene": "few.json", "fps": 1, "frames": 3
 "$THZMAP" batch "$work/few-seq.json" -o "$work/F" --threads 2 --quiet > /dev/null 2> "$work/F.err" ||
     fail "few photons: exit $?"
 [ "$(grep -c 'fewer photons than a density estimate needs' "$work/F.err")" = 2 ] &&
-    grep -q '^thzmap batch: warning: frame 1/3: ' "$work/F.err" &&
+    grep -q '^thzmap batch: warning: frame 1/3 (frame-00000): ' "$work/F.err" &&
     grep -q '^thzmap batch: warning: the same in 2 later frames: ' "$work/F.err" ||
     fail "a warning of every frame: not once with its frame, then counted: $(cat "$work/F.err")"
 
@@ -446,7 +446,7 @@ PY
 echo '{"format": "thzmap-sequence/1", "scene": "bg.json", "fps": 1, "frames": 2}' > "$work/bg-seq.json"
 "$THZMAP" batch "$work/bg-seq.json" -o "$work/BG" --threads 2 --quiet > /dev/null 2> "$work/BG.err" ||
     fail "scene warnings: exit $?"
-grep -q '^thzmap batch: warning: frame 1/2: atmosphere.background_temperature_k is given' "$work/BG.err" &&
+grep -q '^thzmap batch: warning: frame 1/2 (frame-00000): atmosphere.background_temperature_k is given' "$work/BG.err" &&
     grep -q '^thzmap batch: warning: the same in 1 later frame: atmosphere.background' "$work/BG.err" ||
     fail "a frame's scene warning not printed once with its frame: $(cat "$work/BG.err")"
 

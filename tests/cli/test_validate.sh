@@ -191,9 +191,9 @@ expect_line "$tmp/seq.out" '^frames: 6 \(2 sweep values x 3 frames, t = 0 to 2 s
 [[ $(grep -c 'background_temperature_k is given' "$tmp/seq.err") -eq 2 ]] &&
     [[ $(grep -c 'is outside the enclosure' "$tmp/seq.err") -eq 2 ]] ||
     fail "the warnings: not each once and once repeated: $(cat "$tmp/seq.err")"
-expect_line "$tmp/seq.err" '^thzmap validate: warning: frame 1/6: atmosphere\.background_temperature_k is given'
+expect_line "$tmp/seq.err" '^thzmap validate: warning: frame 1/6 \(sweep-00/frame-00000\): atmosphere\.background_temperature_k is given'
 expect_line "$tmp/seq.err" '^thzmap validate: warning: the same in 1 later frame: atmosphere\.background_temperature_k'
-expect_line "$tmp/seq.err" '^thzmap validate: warning: frame 2/6: sensor "cam" at \[0, -3, 0\.4\] m is outside'
+expect_line "$tmp/seq.err" '^thzmap validate: warning: frame 2/6 \(sweep-00/frame-00001\): sensor "cam" at \[0, -3, 0\.4\] m is outside'
 expect_line "$tmp/seq.err" '^thzmap validate: warning: the same in 3 later frames: sensor "cam" .* is outside'
 # a frame whose scene is bad: exit 2, naming the frame (from 0, as batch does) and the
 # scene's JSON path

@@ -134,11 +134,13 @@ def test_batch_warnings_name_their_frame_once(tmp_path):
     outside = [t for t in texts if "is outside the enclosure" in t]
     back_side = [t for t in texts if "saw the back side" in t]
     assert len(texts) == 6 and len(background) == len(outside) == len(back_side) == 2, texts
-    assert background[0].startswith("frame 1/6: atmosphere.background_temperature_k")
+    assert background[0].startswith(
+        "frame 1/6 (sweep-00/frame-00000): atmosphere.background_temperature_k")
     assert background[1].startswith("the same in 1 later frame: atmosphere.background")
-    assert outside[0].startswith('frame 2/6: sensor "cam" at [0, -3, 0.4] m is outside')
+    assert outside[0].startswith(
+        'frame 2/6 (sweep-00/frame-00001): sensor "cam" at [0, -3, 0.4] m is outside')
     assert outside[1].startswith('the same in 3 later frames: sensor "cam" at')
-    assert back_side[0].startswith("frame 2/6: sensor 'cam': ")
+    assert back_side[0].startswith("frame 2/6 (sweep-00/frame-00001): sensor 'cam': ")
     assert back_side[1].startswith("the same in 3 later frames: sensor 'cam': ")
     # each points at the caller of batch, as simulate's do, not into the package
     assert {w.filename for w in caught if issubclass(w.category, thzmap.RunWarning)} == \
