@@ -265,9 +265,12 @@ uint32_t run_photon_next_check(uint32_t n, double need);
 
 /* The memory the photon passes of one channel may hold, bytes (half the machine's; 0 if
  * unknown), and what they hold per pass: the passes' maps and a merge of them, twice the
- * records, and their indexes: RUN_PASSES_MAP_FACTOR x one pass's map. */
+ * records, their indexes and the merge's index scratch (3/8 of its records):
+ * RUN_PASSES_MAP_FACTOR x one pass's map. 2.2 left the scratch out: the walkthrough's
+ * room, stopped at 202 passes of 28 MB maps, peaked at 13.4 GB against a limit of
+ * 12.6 GB (11.75 GiB). */
 double run_passes_memory_limit_bytes(void);
-#define RUN_PASSES_MAP_FACTOR 2.2
+#define RUN_PASSES_MAP_FACTOR 2.45
 
 /* How many checks run_photon_passes renders before `passes` passes if every check asks
  * for more than a quarter more (the most; the time estimate's count of renders). */
