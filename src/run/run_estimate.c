@@ -17,10 +17,11 @@
 /* A merge's time per photon against the photon phase's index build per photon: the copy
  * of the records and their index built again, over arrays far larger than a pass's.
  * Measured on the walkthrough's room with photon-map and no count (2 channels, 1 M
- * photons a pass, 202 and 204 passes to the memory stop, 2 threads): the run took 205 s,
- * of which the passes' own photon phases 66 s; 1.0 estimated 142 s, 1.8 gives 202 s
- * (without the merges the estimate said 68 s). */
-#define RUN_ESTIMATE_MERGE_PER_INDEX 1.8
+ * photons a pass, 2 threads, an idle machine): to the memory stop at 202 and 204 passes
+ * the run took 205 s, which a ratio of 1.8 estimated; at 182 and 183 passes 211 s, a
+ * ratio of 2.5 (the machine's speed moves by 10-15 % from hour to hour); without the
+ * merges the estimate said 68 s. */
+#define RUN_ESTIMATE_MERGE_PER_INDEX 2.2
 
 /* Samples one pass of sensor s renders: pixels x oversampling^2 (x paths for path). */
 static double estimate_samples(const thz_scene *scene, const thz_sensor *s)
