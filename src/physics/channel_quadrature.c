@@ -144,20 +144,31 @@ static void channel_rule_node(channel_rule *r, double nu, double wk, bool first)
 }
 
 /* Whether Simpson on [p0, p2] (midpoint p1) disagrees with its halves on a test
- * function by more than 15 tol (the halves' error is then above tol). */
+ * function by more than 15 tol (the halves' error is then above tol). Points at or
+ * below 0 Hz count 0, as the rule drops them (the test functions are not asked there:
+ * the air's attenuation is NaN below 0 Hz, and NaN splitting every panel of a wide
+ * channel's negative tail spent the whole budget there); a NaN elsewhere splits
+ * nothing. */
 static bool channel_rule_split(const channel_rule *r, const channel_point p[5], double tol)
 {
     enum { most = CHANNEL_STRUCTURE_MAX };
-    double v[5][most];
-    for (int i = 0; i < 5; i++)
-        r->s->eval(p[i].nu, r->s->ctx, v[i]);
+    double v[5][most], g[5];
+    for (int i = 0; i < 5; i++) {
+        g[i] = p[i].nu > 0.0 ? p[i].g : 0.0;
+        for (size_t j = 0; j < r->s->m; j++)
+            v[i][j] = 0.0;
+        if (p[i].nu > 0.0)
+            r->s->eval(p[i].nu, r->s->ctx, v[i]);
+    }
+    if (!(g[4] > 0.0 || g[0] > 0.0))
+        return false; /* wholly below 0 Hz */
     double h = p[4].nu - p[0].nu;
     for (size_t j = 0; j < r->s->m; j++) {
-        double one = h / 6.0 * (p[0].g * v[0][j] + 4.0 * p[2].g * v[2][j] + p[4].g * v[4][j]);
+        double one = h / 6.0 * (g[0] * v[0][j] + 4.0 * g[2] * v[2][j] + g[4] * v[4][j]);
         double two = h / 12.0 *
-                     (p[0].g * v[0][j] + 4.0 * p[1].g * v[1][j] + 2.0 * p[2].g * v[2][j] +
-                      4.0 * p[3].g * v[3][j] + p[4].g * v[4][j]);
-        if (!(fabs(two - one) <= 15.0 * tol))
+                     (g[0] * v[0][j] + 4.0 * g[1] * v[1][j] + 2.0 * g[2] * v[2][j] +
+                      4.0 * g[3] * v[3][j] + g[4] * v[4][j]);
+        if (fabs(two - one) > 15.0 * tol)
             return true;
     }
     return false;
@@ -235,6 +246,10 @@ static void channel_rule_piece(channel_rule *r, size_t piece, double s0, double 
     }
 }
 
+/* Knots closer than this (relative) to a piece's end are taken as at it: a piece a
+ * rounding wide had nodes that coincide. */
+#define CHANNEL_KNOT_GAP 1e-9
+
 /* The pieces of [lo_hz, hi_hz] between the knots inside it (from knot *next on), each
  * given to channel_rule_piece; t_lo, t_hi as there. */
 static void channel_rule_span(channel_rule *r, size_t piece, double lo_hz, double hi_hz,
@@ -245,6 +260,8 @@ static void channel_rule_span(channel_rule *r, size_t piece, double lo_hz, doubl
         (*next)++;
     for (; *next < k->used && channel_knot_hz(k, *next) < hi_hz; (*next)++) {
         double s1 = channel_knot_hz(k, *next);
+        if (s1 - s0 <= CHANNEL_KNOT_GAP * s1 || hi_hz - s1 <= CHANNEL_KNOT_GAP * s1)
+            continue; /* a kink within 1e-9 of a piece's end is at it: no piece of nothing */
         double t1 = t_lo + (t_hi - t_lo) * (s1 - lo_hz) / (hi_hz - lo_hz);
         channel_rule_piece(r, piece, s0, s1, t0, t1);
         s0 = s1;
@@ -458,7 +475,7 @@ static void channel_adapt_panel(channel_adapt *a, double x0, double x2, const do
     channel_adapt_panel(a, x1, x2, rf, rg, rn, 0.5 * tol, depth + 1);
 }
 
-/* A table's base panels (as channel_quadrature_table's for CHANNEL_QUADRATURE_NODES),
+/* A table's base panels (as the fixed rule's for CHANNEL_QUADRATURE_NODES, without knots),
  * each refined adaptively. Two passes: the first sums |g f| for the tolerance's scale
  * (no allocation; f is evaluated twice on the base nodes). */
 static double channel_band_mean_table(const thz_channel *ch, double (*f)(double freq_hz, void *ctx),
