@@ -207,9 +207,12 @@ class _BatchCall(Call):
                 self._repeats[text] += 1
             else:
                 self._repeats[text] = 0
-                where = self._sequence.frame(self.frame).dir if self._n_frames else "?"
-                self._warnings.append(f"frame {self.frame + 1}/{self._n_frames} ({where}): "
-                                      f"{text}")
+                if self.frame is None:
+                    self._warnings.append(text)
+                else:
+                    where = self._sequence.frame(self.frame).dir
+                    self._warnings.append(f"frame {self.frame + 1}/{self._n_frames} "
+                                          f"({where}): {text}")
         except BaseException as e:  # noqa: B902 - every exception must stop at this frame
             if self._exc is None:
                 self._exc = e
@@ -284,7 +287,11 @@ def batch(sequence, outdir, threads=None, progress=None, movies=True):
 
             def on_progress(user, p):
                 c = p.contents
-                call.frame = min(c.frame, c.n_frames - 1) if c.n_frames else 0
+                stage = _lib.text(c.stage)
+                # a frame's warnings name it; the movies' and the end's name none, as
+                # `thzmap batch` prints them
+                in_frame = stage in ("frame", "run") and c.frame < c.n_frames
+                call.frame = c.frame if in_frame else None
                 if report is None:
                     return call.guarded(lambda: False)
                 return call.guarded(report, BatchProgress(

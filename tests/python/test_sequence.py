@@ -147,6 +147,30 @@ def test_batch_warnings_name_their_frame_once(tmp_path):
         {__file__}
 
 
+def test_batch_movie_warning_names_no_frame(tmp_path):
+    # scenes with other sensors: no movies, and the warning saying why belongs to the
+    # batch, not to its last frame (as `thzmap batch` prints it)
+    shutil.copytree(PLATE, tmp_path / "plate")
+    with open(tmp_path / "plate" / "scene.json") as f:
+        scene = json.load(f)
+    scene["sensors"][0]["resolution"] = [8, 6]
+    scene["render"] = {"integrator": "path", "paths_per_sample": 1}
+    with open(tmp_path / "plate" / "a.json", "w") as f:
+        json.dump(scene, f)
+    scene["sensors"][0]["resolution"] = [4, 3]
+    with open(tmp_path / "plate" / "b.json", "w") as f:
+        json.dump(scene, f)
+    with open(tmp_path / "plate" / "mixed.json", "w") as f:
+        json.dump({"format": "thzmap-sequence/1", "scenes": ["a.json", "b.json"]}, f)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        thzmap.batch(tmp_path / "plate" / "mixed.json", tmp_path / "out")
+    texts = [str(w.message) for w in caught if issubclass(w.category, thzmap.RunWarning)]
+    movie = [t for t in texts if "no movies" in t]
+    assert movie and movie[0].startswith("no movies: frame frame-00001 has other sensors"), \
+        texts
+
+
 def test_errors(tmp_path):
     with pytest.raises(thzmap.SceneError) as e:
         thzmap.load_sequence(os.path.join(BATCH, "scene.json"))
