@@ -116,9 +116,10 @@ typedef struct channel_quadrature {
 #define CHANNEL_QUADRATURE_NODES 401
 
 /* The most knots channel_quadrature_init_knots places inside one band; more are
- * thinned evenly (taking every k-th), so a rule has at most about n + 2 x this many
- * nodes. */
-#define CHANNEL_QUADRATURE_MAX_KNOTS 2048
+ * thinned evenly (taking every k-th), so a rule has at most about n + 3 x this many
+ * nodes before refinement. A table denser than that is finer than the 401 nodes, and
+ * the renderers' per-sample band sums cost a node each. */
+#define CHANNEL_QUADRATURE_MAX_KNOTS 512
 
 /* At most this many splits of a panel refine one rule (channel_structure). */
 #define CHANNEL_QUADRATURE_MAX_SPLITS (4 * CHANNEL_QUADRATURE_NODES)
