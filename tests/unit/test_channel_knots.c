@@ -128,6 +128,21 @@ static void test_knots_table(void **state)
     channel_fini(&ch);
 }
 
+/* The line's rules through its knots alone (q[0]) and refined by s (q[1], checked), and
+ * their errors e[0], e[1]. */
+static void refine_pair(const thz_channel *ch, line *l, const channel_structure *s,
+                        channel_quadrature q[2], double e[2])
+{
+    thz_error err;
+    for (int i = 0; i < 2; i++) {
+        assert_int_equal(channel_quadrature_init_knots(&q[i], ch, CHANNEL_QUADRATURE_NODES,
+                                                       l->knots, 3, i ? s : NULL, &err),
+                         THZ_OK);
+        e[i] = rule_error(&q[i], ch, l);
+    }
+    check_rule(&q[1], l->knots, 3);
+}
+
 /* The line as the air's attenuation (0.05 /m, 1 /m at its peak) over 10 m: the knots
  * alone leave exp(-alpha d) under-resolved between them; the structure refines it. */
 static void test_structure(void **state)
@@ -138,15 +153,11 @@ static void test_structure(void **state)
     line l;
     line_init(&l, &ch, 0.05, 1.0, 10.0);
     channel_structure s = {1, line_structure, &l};
-    channel_quadrature knotted, refined;
-    assert_int_equal(channel_quadrature_init_knots(&knotted, &ch, CHANNEL_QUADRATURE_NODES, l.knots,
-                                                   3, NULL, &err),
-                     THZ_OK);
-    assert_int_equal(channel_quadrature_init_knots(&refined, &ch, CHANNEL_QUADRATURE_NODES, l.knots,
-                                                   3, &s, &err),
-                     THZ_OK);
-    check_rule(&refined, l.knots, 3);
-    double e_knots = rule_error(&knotted, &ch, &l), e_refined = rule_error(&refined, &ch, &l);
+    channel_quadrature q[2];
+    double e[2];
+    refine_pair(&ch, &l, &s, q, e);
+    channel_quadrature knotted = q[0], refined = q[1];
+    double e_knots = e[0], e_refined = e[1];
     print_message("line in the air over 10 m: knots alone %.2e (%zu nodes), refined %.2e (%zu "
                   "nodes)\n",
                   e_knots, knotted.n, e_refined, refined.n);
@@ -175,19 +186,14 @@ static void test_structure_wide(void **state)
 {
     (void)state;
     const thz_channel ch = {.name = "wide", .center_hz = 0.35e12, .relative_width = 0.5};
-    thz_error err;
     line l;
     line_init(&l, &ch, 0.05, 1.0, 20.0);
     channel_structure s = {1, line_structure_nan_below_0, &l};
-    channel_quadrature plain, refined;
-    assert_int_equal(channel_quadrature_init_knots(&plain, &ch, CHANNEL_QUADRATURE_NODES, l.knots,
-                                                   3, NULL, &err),
-                     THZ_OK);
-    assert_int_equal(channel_quadrature_init_knots(&refined, &ch, CHANNEL_QUADRATURE_NODES, l.knots,
-                                                   3, &s, &err),
-                     THZ_OK);
-    check_rule(&refined, l.knots, 3);
-    double e_plain = rule_error(&plain, &ch, &l), e_refined = rule_error(&refined, &ch, &l);
+    channel_quadrature q[2];
+    double e[2];
+    refine_pair(&ch, &l, &s, q, e);
+    channel_quadrature plain = q[0], refined = q[1];
+    double e_plain = e[0], e_refined = e[1];
     print_message("wide channel, line over 20 m: knots alone %.2e, refined %.2e (%zu nodes)\n",
                   e_plain, e_refined, refined.n);
     assert_true(e_plain > 1e-5);
