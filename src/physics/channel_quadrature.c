@@ -200,49 +200,50 @@ static void channel_rule_panel(channel_rule *r, size_t piece, channel_point p0, 
     channel_rule_node(r, p2.nu, h6 * p2.g, false);
 }
 
+/* Node k of k_n on [s0, s1] Hz (t0, t1: its ends as fractions of table piece `piece`):
+ * its frequency (the ends exactly) and its point with g there. */
+static channel_point channel_rule_at(const channel_rule *r, size_t piece, double s0, double s1,
+                                     double t0, double t1, size_t k, size_t k_n)
+{
+    const thz_channel *ch = r->ch;
+    bool table = channel_has_response(ch);
+    double u = (double)k / (double)(k_n - 1);
+    double t = table ? t0 + (t1 - t0) * u : 0.0;
+    double h = ch->n_response ? ch->response_hz[piece + 1] - ch->response_hz[piece] : 0.0;
+    double nu = k == 0         ? s0
+                : k + 1 == k_n ? s1
+                : table        ? ch->response_hz[piece] + t * h
+                               : s0 + u * (s1 - s0);
+    return channel_rule_point(r, piece, nu, t);
+}
+
 /* Composite Simpson on [s0, s1] Hz: a part of table piece `piece` (t0, t1 its ends as
  * fractions of the piece; g linear in between) or, for the Gaussian, of its support
- * (piece, t0 and t1 unused). The ends are nodes exactly. */
+ * (piece, t0 and t1 unused). The ends are nodes exactly. Refined (r->s): panel by
+ * panel, each split as channel_rule_panel says. */
 static void channel_rule_piece(channel_rule *r, size_t piece, double s0, double s1, double t0,
                                double t1)
 {
     /* (the 1e-9: a single piece's width in Hz may round a hair above the support's) */
     double p = ceil((double)r->panels * (s1 - s0) / r->width_hz - 1e-9);
     size_t k_n = 2 * (p < 1.0 ? 1 : (size_t)p) + 1;
-    const thz_channel *ch = r->ch;
-    bool table = channel_has_response(ch);
-    double h = s1 - s0, a = 0.0, b = 0.0;
-    if (table)
-        channel_piece(ch, piece, &h, &a, &b);
-    /* node k: its frequency and fraction of the table's piece */
-    double nu[3] = {0.0, 0.0, 0.0}, tk[3] = {0.0, 0.0, 0.0};
+    if (r->s) {
+        for (size_t k = 0; k + 1 < k_n; k += 2)
+            channel_rule_panel(r, piece, channel_rule_at(r, piece, s0, s1, t0, t1, k, k_n),
+                               channel_rule_at(r, piece, s0, s1, t0, t1, k + 1, k_n),
+                               channel_rule_at(r, piece, s0, s1, t0, t1, k + 2, k_n), r->tol, 0);
+        return;
+    }
+    if (!r->f) {
+        r->m += k_n;
+        return;
+    }
+    bool table = channel_has_response(r->ch);
+    double h = table ? r->ch->response_hz[piece + 1] - r->ch->response_hz[piece] : s1 - s0;
+    double d = (table ? (t1 - t0) * h : s1 - s0) / (double)(k_n - 1);
     for (size_t k = 0; k < k_n; k++) {
-        double u = (double)k / (double)(k_n - 1);
-        double tt = table ? t0 + (t1 - t0) * u : 0.0;
-        double f = k == 0         ? s0
-                   : k + 1 == k_n ? s1
-                   : table        ? ch->response_hz[piece] + tt * h
-                                  : s0 + u * (s1 - s0);
-        if (r->s) { /* refined: panel by panel */
-            nu[k % 2 ? 1 : k == 0 ? 0 : 2] = f;
-            tk[k % 2 ? 1 : k == 0 ? 0 : 2] = tt;
-            if (k > 0 && k % 2 == 0) {
-                channel_rule_panel(r, piece, channel_rule_point(r, piece, nu[0], tk[0]),
-                                   channel_rule_point(r, piece, nu[1], tk[1]),
-                                   channel_rule_point(r, piece, nu[2], tk[2]), r->tol, 0);
-                nu[0] = nu[2];
-                tk[0] = tk[2];
-            }
-            continue;
-        }
-        if (!r->f) {
-            r->m += k_n;
-            return;
-        }
-        double d = (table ? (t1 - t0) * h : s1 - s0) / (double)(k_n - 1);
-        double wk =
-            d / 3.0 * channel_simpson_weight(k, k_n) * channel_rule_point(r, piece, f, tt).g;
-        channel_rule_node(r, f, wk, k == 0);
+        channel_point q = channel_rule_at(r, piece, s0, s1, t0, t1, k, k_n);
+        channel_rule_node(r, q.nu, d / 3.0 * channel_simpson_weight(k, k_n) * q.g, k == 0);
     }
 }
 
