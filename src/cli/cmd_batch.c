@@ -134,11 +134,9 @@ static void batch_on_warning(void *user, const char *message)
         b->line_open = false;
     }
     thz_frame_info fi;
-    if (b->in_frame && b->seq && thz_sequence_frame(b->seq, b->frame, &fi) == THZ_OK)
+    if (b->in_frame)
         fprintf(stderr, "thzmap batch: warning: frame %zu/%zu (%s): %s\n", b->frame + 1,
-                b->n_frames, fi.dir, message);
-    else if (b->in_frame)
-        fprintf(stderr, "thzmap batch: warning: frame %zu/%zu: %s\n", b->frame + 1, b->n_frames,
+                b->n_frames, thz_sequence_frame(b->seq, b->frame, &fi) == THZ_OK ? fi.dir : "?",
                 message);
     else
         fprintf(stderr, "thzmap batch: warning: %s\n", message);
