@@ -161,8 +161,16 @@ static int main_run(const command *c, int argc, char **argv)
     return c->run(argc, argv);
 }
 
+/* The values split_assignments took from "--name=value": given with their option, so
+ * values even when they begin with "-" ("--sensor=-cam"). */
+static char **assigned_values;
+static int n_assigned_values;
+
 bool cli_looks_like_option(const char *value)
 {
+    for (int i = 0; i < n_assigned_values; i++)
+        if (value == assigned_values[i])
+            return false;
     /* "-" alone (a file name) and negative numbers ("-1", "-.5") are values */
     return value[0] == '-' && value[1] && value[1] != '.' && !(value[1] >= '0' && value[1] <= '9');
 }
@@ -175,15 +183,18 @@ static char **split_assignments(int argc, char **argv, int *out_argc)
     for (int i = 1; i < argc; i++)
         n += strncmp(argv[i], "--", 2) == 0 && strchr(argv[i], '=') != NULL;
     char **out = calloc((size_t)n + 1, sizeof *out);
-    if (!out)
+    assigned_values = calloc((size_t)(n - argc) + 1, sizeof *assigned_values);
+    if (!out || !assigned_values) {
+        free(out);
         return NULL;
+    }
     int k = 0;
     for (int i = 0; i < argc; i++) {
         char *eq = i > 0 && strncmp(argv[i], "--", 2) == 0 ? strchr(argv[i], '=') : NULL;
         if (eq) {
             *eq = '\0'; /* argv's strings are the program's to change (C17 5.1.2.2.1) */
             out[k++] = argv[i];
-            out[k++] = eq + 1;
+            out[k++] = assigned_values[n_assigned_values++] = eq + 1;
         } else {
             out[k++] = argv[i];
         }

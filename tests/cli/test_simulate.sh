@@ -311,6 +311,10 @@ grep -q '"photons_per_channel": 2000,' "$work/eq/summary.json" ||
     fail "--photons=2000 was not taken"
 grep -q "max_seconds 5 s is not used: it limits the passes towards a noise target" \
     "$work/eq.err" || fail "--max-seconds with a count: no warning: $(cat "$work/eq.err")"
+# a value given with its option by "=" is the value even when it begins with "-"
+(cd "$work" && "$THZMAP" simulate scene.json --output=-eqdash --photons=2000 \
+    --integrator=photon-map --quiet 2> eqd.err) || fail "--output=-eqdash: exit $?: $(cat "$work/eqd.err")"
+[ -f "$work/-eqdash/summary.json" ] || fail "--output=-eqdash wrote no -eqdash/summary.json"
 "$THZMAP" --version extra 2>/dev/null
 [ $? -eq 2 ] || fail "thzmap --version with an argument should exit 2"
 "$THZMAP" --bogus 2>&1 | grep -q "unknown option '--bogus'" || fail "thzmap --bogus: not an option"
