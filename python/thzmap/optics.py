@@ -388,8 +388,8 @@ def surface_optics(scene, material, frequency_thz, thickness_m=0.0):
 def _per_frequency(fn, frequency_thz, other, name, lowest=None):
     """fn(freq_hz, x) over frequency_thz and `other` (called `name`: finite numbers, at
     least `lowest` unless None) broadcast against each other."""
-    _frequencies(frequency_thz)
-    f = np.asarray(frequency_thz, dtype=np.float64)
+    hz, shape, _ = _frequencies(frequency_thz)  # checked, in Hz
+    f = hz.reshape(shape)
     try:
         x = np.asarray(other, dtype=np.float64)
         fb, xb = np.broadcast_arrays(f, x)
@@ -400,7 +400,7 @@ def _per_frequency(fn, frequency_thz, other, name, lowest=None):
             (lowest is not None and np.any(x < lowest)):
         raise ArgumentError(f"{name}: expected finite numbers"
                             + (f" of at least {lowest}" if lowest is not None else ""))
-    out = np.array([fn(float(a) * 1e12, float(b)) for a, b in zip(fb.ravel(), xb.ravel())])
+    out = np.array([fn(float(a), float(b)) for a, b in zip(fb.ravel(), xb.ravel())])
     out = out.reshape(fb.shape)
     return float(out) if out.ndim == 0 else out
 
