@@ -11,7 +11,7 @@ and in total, on THREADS threads, and prints a table; writes the numbers as JSON
   final-gather  the same with --photons PHOTONS; the time includes the photon phase;
                 stops at --max-seconds per channel, or at the floor its photon map
                 leaves (then "not reached" and the figures reached are shown)
-  photon-map    its photon passes (simulate --target-noise-k) would need ~1e10 photons
+  photon-map    its photon passes (simulate --target-noise-k) would need ~1e12 photons
                 on this scene: one run with PHOTONS photons, and the photon count (and
                 time) the target would need if the standard error falls as
                 1/sqrt(photons) (extrapolated, marked ~)
