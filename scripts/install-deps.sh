@@ -15,7 +15,7 @@ packages=(
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   python3 python3-numpy  # the Python package
   libmicrohttpd-dev  # optional: thzmap serve, the browser GUI (docs/gui.md)
-  libopenmpi-dev openmpi-bin  # optional: MPI runs (docs/mpi.md)
+  libopenmpi-dev openmpi-bin python3-mpi4py  # optional: MPI runs, also from Python (docs/mpi.md)
   nodejs  # the web page's bundle (three.js, esbuild from npm; docs/gui.md)
 )
 case "${1:-all}" in

@@ -13,7 +13,7 @@ A binding of libthzmap's C API (include/thzmap/) through ctypes; docs/python.md 
 the whole story (installation, threads, cancellation, memory ownership); installed,
 docs/ is PREFIX/share/doc/thzmap/.
 """
-from . import _lib
+from . import _lib, mpi
 from ._call import RunWarning
 from .band_selection import BandSelection, bands
 from .classification import Classification, classify
@@ -36,6 +36,6 @@ __all__ = ["ArgumentError", "Atmosphere", "BandSelection", "BatchProgress", "Bat
            "OutOfMemoryError", "PhotonMap", "Progress", "Result", "RunWarning", "Scene",
            "SceneError", "Sequence", "atmosphere", "bands", "batch", "brightness_temperature",
            "classify", "fire_photons", "identify", "library_path", "load_photon_map",
-           "load_scene", "load_sequence", "material_library", "merge_photon_maps",
+           "load_scene", "load_sequence", "material_library", "merge_photon_maps", "mpi",
            "planck_radiance", "render", "scene_from_dict", "scene_from_json", "simulate",
            "surface_optics"]

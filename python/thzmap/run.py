@@ -17,6 +17,7 @@ import threading
 import numpy as np
 
 from . import _lib
+from . import mpi as _mpi
 from ._call import Call
 from .errors import ArgumentError
 from .scene import _path_arg, scene_arg
@@ -304,6 +305,7 @@ class Result:
         self._summary = None
         kept = _lib.lib.thz_run_photons(ptr)
         self.photon_map = PhotonMap(owner, kept, scene) if kept else None
+        self.mpi_bytes = 0  # a run with mpi=True: bytes rank 0 sent and received
 
     @property
     def sensors(self):
@@ -372,26 +374,33 @@ def _run_call(call, fn, scene, photons=None):
 
 
 def simulate(scene, integrator=None, photons=None, seed=None, threads=None,
-             target_noise_k=None, max_seconds=None, progress=None, keep_photons=False):
+             target_noise_k=None, max_seconds=None, progress=None, keep_photons=False,
+             mpi=False):
     """`thzmap simulate` in memory: the photon phase (none for the path integrator) and
     every sensor rendered. Arguments left None keep the scene's settings. `progress`:
     True for a bar, or a callable given a Progress whose true return value cancels.
     The GIL is released while the engine runs. Raises CancelledError when cancelled,
-    KeyboardInterrupt after Ctrl-C; nothing is kept either way."""
+    KeyboardInterrupt after Ctrl-C; nothing is kept either way. mpi=True in a script
+    that mpirun started on several ranks (thzmap.mpi): the ranks share the run, rank 0
+    gets the Result, the others None."""
     scene = scene_arg(scene)
     s = _settings(scene, integrator, photons, seed, target_noise_k, max_seconds, keep_photons)
-    with Call(threads, progress) as call:
-        return _run_call(call, lambda out: _lib.lib.thz_simulate(
-            call.ctx, scene._handle, ctypes.byref(s), out, call.err), scene)
+    return _shared_run(threads, progress, _world(mpi), scene, s, lambda call: _run_call(
+        call, lambda out: _lib.lib.thz_simulate(call.ctx, scene._handle, ctypes.byref(s), out,
+                                                call.err), scene))
 
 
 def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, threads=None,
-           target_noise_k=None, max_seconds=None, progress=None):
+           target_noise_k=None, max_seconds=None, progress=None, mpi=False):
     """`thzmap render` in memory: every sensor (or only `sensor`, a name or index)
     rendered from `photon_map` (a PhotonMap of this scene, or the path of a .thzpm
     file, which is read one channel at a time as the render comes to it: one channel's
-    map in memory). The path integrator needs no photon map (it then uses `seed`)."""
+    map in memory). The path integrator needs no photon map (it then uses `seed`).
+    mpi=True: shared by the ranks as simulate's; rank 0 alone needs the photon map (it
+    sends it to the others), whose `photon_map` may then be None."""
     scene = scene_arg(scene)
+    comm = _world(mpi)
+    member = comm is not None and comm.Get_rank() > 0
     path = None
     if isinstance(photon_map, (str, bytes, os.PathLike)):
         path = _path_arg("photon_map", photon_map)
@@ -404,7 +413,7 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
                             "this one with load_photon_map(scene, path)")
     effective = integrator if integrator is not None else scene.info.integrator
     _integrator_arg(integrator)
-    if photon_map is None and path is None and \
+    if photon_map is None and path is None and not member and \
             _lib.lib.thz_integrator_needs_photons(effective.encode()):
         raise ArgumentError(f"photon_map: the {effective} integrator renders from a photon "
                             "map; give one (or integrator='path')")
@@ -414,12 +423,34 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
     index = -1 if sensor is None else scene.sensor_index(sensor)
     s = _settings(scene, integrator, None, seed, target_noise_k, max_seconds)
     if path is not None:
-        with Call(threads, progress) as call:
-            return _run_call(call, lambda out: _lib.lib.thz_render_file(
+        return _shared_run(threads, progress, comm, scene, s, lambda call: _run_call(
+            call, lambda out: _lib.lib.thz_render_file(
                 call.ctx, scene._handle, os.fsencode(path), index, ctypes.byref(s), out,
-                call.err), scene)
+                call.err), scene))
     ptr = photon_map._ptr if photon_map is not None else None
-    with Call(threads, progress) as call:
-        return _run_call(call, lambda out: _lib.lib.thz_render_run(
+    return _shared_run(threads, progress, comm, scene, s, lambda call: _run_call(
+        call, lambda out: _lib.lib.thz_render_run(
             call.ctx, scene._handle, ptr, index, ctypes.byref(s), out, call.err),
-            scene, photon_map)
+        scene, photon_map))
+
+
+def _world(mpi):
+    """The MPI job's communicator for mpi=True under an MPI launcher, else None."""
+    if not isinstance(mpi, bool):
+        raise ArgumentError(f"mpi: expected True or False, got {mpi!r}")
+    return _mpi.world() if mpi else None
+
+
+def _shared_run(threads, progress, comm, scene, settings, run):
+    """run(call), a Result, on a Call of its own; with comm (thzmap.mpi), shared with the
+    other ranks: rank 0 runs it, the others serve it and return None."""
+    if comm is not None and comm.Get_rank() > 0:
+        with Call(threads) as call:
+            _mpi.serve(comm, call, scene=scene, settings=settings)
+        return None
+    with Call(threads, progress) as call:
+        with _mpi.Lead(comm, call) as lead:
+            result = run(call)
+            if comm is not None:
+                result.mpi_bytes = lead.bytes()
+        return result

@@ -19,6 +19,7 @@ from ctypes import (CFUNCTYPE, POINTER, Structure, c_char_p, c_double, c_int, c_
                     c_uint64, c_void_p)
 
 from . import _lib
+from . import mpi as _mpi
 from ._call import Call
 from .errors import ArgumentError
 from .progress import make_reporter
@@ -263,7 +264,7 @@ class _BatchBar:
         self._bar = None
 
 
-def batch(sequence, outdir, threads=None, progress=None, movies=True):
+def batch(sequence, outdir, threads=None, progress=None, movies=True, mpi=False):
     """`thzmap batch SEQUENCE -o OUTDIR` in this process: runs every frame of `sequence`
     (a Sequence, or the path of a sequence file) into outdir/[sweep-NN/]frame-NNNNN/ as
     `thzmap simulate` would, writes outdir/batch.json and (with movies=True, when every
@@ -272,7 +273,10 @@ def batch(sequence, outdir, threads=None, progress=None, movies=True):
     that was cancelled or killed resumes. `progress`: True for a bar, or a callable given
     a BatchProgress whose true return value cancels (finished frames stay; raises
     CancelledError). Each frame's warnings become RunWarnings naming the frame, each
-    message once. Returns a BatchResult."""
+    message once. Returns a BatchResult. mpi=True in a script that mpirun started on
+    several ranks (thzmap.mpi): the ranks share the batch as `mpirun thzmap batch` does
+    (whole frames dealt to them when there are enough); rank 0 alone writes outdir and
+    gets the BatchResult, the others None."""
     if isinstance(sequence, (str, bytes, os.PathLike)):
         sequence = load_sequence(sequence)
     elif not isinstance(sequence, Sequence):
@@ -281,9 +285,16 @@ def batch(sequence, outdir, threads=None, progress=None, movies=True):
     outdir = _path_arg("outdir", outdir)
     if not isinstance(movies, bool):
         raise ArgumentError(f"movies: expected True or False, got {movies!r}")
+    if not isinstance(mpi, bool):
+        raise ArgumentError(f"mpi: expected True or False, got {mpi!r}")
+    comm = _mpi.world() if mpi else None
+    if comm is not None and comm.Get_rank() > 0:
+        with Call(threads) as call:
+            _mpi.serve(comm, call, sequence=sequence)
+        return None
     report = make_reporter(progress, _BatchBar)
     try:
-        with _BatchCall(threads, sequence) as call:
+        with _BatchCall(threads, sequence) as call, _mpi.Lead(comm, call):
 
             def on_progress(user, p):
                 c = p.contents
