@@ -41,7 +41,7 @@ class Call:
     # the RunWarnings point at the caller of the function whose `with` this is
     _stacklevel = 3
 
-    def __init__(self, threads=None, progress=None):
+    def __init__(self, threads=None, progress=None, report_warnings=True):
         if threads is not None:
             if (isinstance(threads, bool) or not isinstance(threads, numbers.Integral)
                     or not 1 <= threads <= MAX_THREADS):
@@ -53,6 +53,7 @@ class Call:
         self._interrupted = False
         self._cancelled = False
         self._warnings = []
+        self._keep_warnings = report_warnings  # False: an MPI rank other than 0 (rank 0 says them)
         self._old_handler = None
         self.error = _lib.ThzError()
         self.ctx = _lib.lib.thz_context_create()
@@ -90,7 +91,8 @@ class Call:
 
     def _on_warning(self, user, message):
         try:
-            self._warnings.append(_lib.text(message))
+            if self._keep_warnings:
+                self._warnings.append(_lib.text(message))
         except BaseException as e:  # noqa: B902
             if self._exc is None:
                 self._exc = e

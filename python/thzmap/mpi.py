@@ -1,6 +1,7 @@
 """MPI runs from Python (docs/python.md "MPI"): simulate, render and batch with mpi=True
 share their work among the ranks of an MPI job as `mpirun thzmap simulate|render|batch`
-does (docs/mpi.md), with the same results, byte for byte, as one process.
+does (docs/mpi.md), with the same results as one process (images, photon maps and every
+file but summary.json's and batch.json's times, threads and ranks, byte for byte).
 
     mpirun -np 4 python3 -m mpi4py script.py
 
@@ -14,27 +15,32 @@ launcher started the process (mpirun's OMPI_COMM_WORLD_SIZE, Slurm's PMI_SIZE or
 PMIX_RANK), or whenever the program has imported it already; it must be the MPI that
 libthzmap was built with. A process that no launcher started runs alone, without MPI.
 
-Once the ranks work together, a failure on any of them (an error, a cancellation, Ctrl-C)
-ends the whole job (MPI_Abort, exit status 1, 130 after Ctrl-C) after printing the error on
-stderr: the other ranks would wait for it forever. `python3 -m mpi4py` does the same for an
-exception anywhere else in the script.
+The arguments every rank checks alike raise as without MPI, on every rank. Past them, once
+the ranks work together, a failure on any rank (an error, a cancellation, Ctrl-C, also
+while it waits for another rank) ends the whole job (MPI_Abort, exit status 1, 130 after
+Ctrl-C) after printing the error on stderr: the other ranks would wait for it forever.
+`python3 -m mpi4py` does the same for an exception anywhere else in the script.
 """
 import ctypes
 import os
+import signal
 import sys
+import threading
 import traceback
 from ctypes import POINTER, c_int, c_uint64
 
 from . import _lib
 from .errors import Error, from_status
 
-_lib.bind({
+_PROTOTYPES = {
     "thz_mpi_supported": (c_int, []),
+    "thz_mpi_interrupt": (None, []),
     "thz_context_set_mpi": (c_int, [_lib._P, _lib._ERR]),
     "thz_mpi_serve": (c_int, [_lib._P, _lib._P, POINTER(_lib.ThzRunSettings), _lib._ERR]),
     "thz_mpi_serve_batch": (c_int, [_lib._P, _lib._P, _lib._ERR]),
     "thz_context_mpi_bytes": (c_uint64, [_lib._P]),
-})
+}
+_lib.bind(_PROTOTYPES)
 
 # The variables MPI launchers set, as the thzmap program reads them (src/cli/cli_mpi.c).
 _LAUNCHERS = ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK")
@@ -61,8 +67,12 @@ def world():
     if not supported():
         raise Error(f"this libthzmap ({_lib.path}) was built without MPI support; rebuild it "
                     "with an MPI library (libopenmpi-dev) or run one process", "bad input")
-    if MPI.Query_thread() < MPI.THREAD_FUNNELED:
+    level = MPI.Query_thread()
+    if level < MPI.THREAD_FUNNELED:
         raise Error("the MPI library does not allow threads (MPI_THREAD_FUNNELED)",
+                    "bad input")
+    if level < MPI.THREAD_MULTIPLE and not MPI.Is_thread_main():
+        raise Error("mpi=True: call from the thread that started MPI (it allows no other)",
                     "bad input")
     return comm
 
@@ -78,41 +88,101 @@ def end_job(comm, exc):
         comm.Abort(130 if isinstance(exc, KeyboardInterrupt) else 1)
 
 
-class Lead:
-    """`with Lead(comm, call):` on rank 0 around a run on call's context: the context
-    joins the other ranks (thz_context_set_mpi, collective with their serve), and a
-    failure inside ends the job. comm None: nothing is shared, failures raise."""
+class _Interrupts:
+    """While a shared run is in C on the main thread: a signal Python catches (Ctrl-C,
+    which the Call's handler takes) also stops this process's waits for other ranks
+    (thz_mpi_interrupt, as the thzmap program's handler does). Python runs its own
+    handlers only between bytecodes, never while a call waits in C; its wakeup fd is
+    written at once, and a thread reading it makes the call."""
 
-    def __init__(self, comm, call):
-        self._comm = comm
-        self._call = call
+    def __init__(self):
+        self._old = None
+        self._thread = None
 
     def __enter__(self):
-        if self._comm is not None:
+        if threading.current_thread() is not threading.main_thread():
+            return self
+        r, w = os.pipe()
+        os.set_blocking(w, False)
+        try:
+            self._old = signal.set_wakeup_fd(w, warn_on_full_buffer=False)
+        except ValueError:  # not the main interpreter
+            os.close(r)
+            os.close(w)
+            return self
+        self._pipe = (r, w)
+        self._thread = threading.Thread(target=self._watch, args=(r,), daemon=True,
+                                        name="thzmap-mpi-interrupt")
+        self._thread.start()
+        return self
+
+    @staticmethod
+    def _watch(r):
+        while True:
+            data = os.read(r, 64)
+            if not data:  # closed: the run is over
+                return
+            if signal.SIGINT in data:
+                _lib.lib.thz_mpi_interrupt()
+                return
+
+    def __exit__(self, exc_type, exc, tb):
+        if self._thread is not None:
+            signal.set_wakeup_fd(self._old)
+            r, w = self._pipe
+            os.close(w)  # the watcher reads the end of the pipe
+            self._thread.join()
+            os.close(r)
+            self._thread = None
+        return False
+
+
+class Shared:
+    """`with Shared(comm, call):` around a run on call's context, inside the Call (the
+    job must end before the context is destroyed). comm None: nothing shared, failures
+    raise. On rank 0 (lead=True) the context joins the other ranks (thz_context_set_mpi,
+    collective with their serve); on every rank Ctrl-C also stops waits for other ranks,
+    and a failure inside ends the job."""
+
+    def __init__(self, comm, call, lead=True):
+        self._comm = comm
+        self._call = call
+        self._lead = lead
+        self._interrupts = _Interrupts() if comm is not None else None
+
+    def __enter__(self):
+        if self._comm is None:
+            return self
+        if self._lead:
             status = _lib.lib.thz_context_set_mpi(self._call.ctx, self._call.err)
             if status != _lib.OK:
                 end_job(self._comm, from_status(status, _lib.text(self._call.error.message)))
+        self._interrupts.__enter__()
         return self
 
     def bytes(self):
-        """What rank 0 sent and received so far, in bytes."""
+        """What this rank sent and received so far, in bytes (0 when not shared)."""
+        if self._comm is None:
+            return 0
         return int(_lib.lib.thz_context_mpi_bytes(self._call.ctx))
 
     def __exit__(self, exc_type, exc, tb):
-        if exc is not None and self._comm is not None:
+        if self._comm is None:
+            return False
+        self._interrupts.__exit__(exc_type, exc, tb)
+        if exc is not None:
             end_job(self._comm, exc)
         return False
 
 
 def serve(comm, call, scene=None, settings=None, sequence=None):
-    """A rank other than 0: serves rank 0's run on call's context until it ends (a
-    scene's runs with `settings`, or a batch of `sequence`); a failure ends the job."""
-    try:
+    """A rank other than 0: serves rank 0's run on call's context (a Call that reports
+    no warnings: rank 0 reports them) until it ends: a scene's runs with `settings`, or
+    a batch of `sequence`. A failure ends the job."""
+    with Shared(comm, call, lead=False):
         if sequence is not None:
             status = _lib.lib.thz_mpi_serve_batch(call.ctx, sequence._handle, call.err)
         else:
             status = _lib.lib.thz_mpi_serve(call.ctx, scene._handle, ctypes.byref(settings),
                                             call.err)
         call.check(status)
-    except BaseException as e:  # noqa: B902 - rank 0 waits for this rank: end the job
-        end_job(comm, e)

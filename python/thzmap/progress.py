@@ -64,13 +64,18 @@ class _Callback:
         return bool(self._fn(p))
 
 
+def check(progress):
+    """ArgumentError unless progress is None, False, True or a callable."""
+    if not (progress is None or isinstance(progress, bool) or callable(progress)):
+        raise ArgumentError(f"progress: expected None, True or a callable, got {progress!r}")
+
+
 def make_reporter(progress, bar=None):
     """None/False: no reports; True: a bar (`bar()`, default a run's _Bar); a callable:
     called with each report, a true return value cancels the run."""
+    check(progress)
     if progress is None or progress is False:
         return None
     if progress is True:
         return bar() if bar is not None else _Bar()
-    if callable(progress):
-        return _Callback(progress)
-    raise ArgumentError(f"progress: expected None, True or a callable, got {progress!r}")
+    return _Callback(progress)

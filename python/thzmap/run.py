@@ -20,6 +20,7 @@ from . import _lib
 from . import mpi as _mpi
 from ._call import Call
 from .errors import ArgumentError
+from .progress import check as check_progress
 from .scene import _path_arg, scene_arg
 
 # PLplot, which draws the spectra plots of written results, keeps global state: one
@@ -400,7 +401,26 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
     sends it to the others), whose `photon_map` may then be None."""
     scene = scene_arg(scene)
     comm = _world(mpi)
-    member = comm is not None and comm.Get_rank() > 0
+    _integrator_arg(integrator)
+    index = -1 if sensor is None else scene.sensor_index(sensor)
+    s = _settings(scene, integrator, None, seed, target_noise_k, max_seconds)
+
+    def run(call):  # rank 0's (or the one process's): the map is its alone
+        path, pm = _render_map_arg(scene, photon_map, integrator, seed)
+        if path is not None:
+            return _run_call(call, lambda out: _lib.lib.thz_render_file(
+                call.ctx, scene._handle, os.fsencode(path), index, ctypes.byref(s), out,
+                call.err), scene)
+        ptr = pm._ptr if pm is not None else None
+        return _run_call(call, lambda out: _lib.lib.thz_render_run(
+            call.ctx, scene._handle, ptr, index, ctypes.byref(s), out, call.err), scene, pm)
+
+    return _shared_run(threads, progress, comm, scene, s, run)
+
+
+def _render_map_arg(scene, photon_map, integrator, seed):
+    """render's photon_map, checked: (the path of a .thzpm file or None, a PhotonMap of
+    this scene or None)."""
     path = None
     if isinstance(photon_map, (str, bytes, os.PathLike)):
         path = _path_arg("photon_map", photon_map)
@@ -412,26 +432,14 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
         raise ArgumentError("photon_map: it belongs to another Scene object; load it for "
                             "this one with load_photon_map(scene, path)")
     effective = integrator if integrator is not None else scene.info.integrator
-    _integrator_arg(integrator)
-    if photon_map is None and path is None and not member and \
+    if photon_map is None and path is None and \
             _lib.lib.thz_integrator_needs_photons(effective.encode()):
         raise ArgumentError(f"photon_map: the {effective} integrator renders from a photon "
                             "map; give one (or integrator='path')")
     if seed is not None and (photon_map is not None or path is not None):
         raise ArgumentError("seed: a render from a photon map uses the map's seed" +
                             (f" ({photon_map.seed})" if photon_map is not None else ""))
-    index = -1 if sensor is None else scene.sensor_index(sensor)
-    s = _settings(scene, integrator, None, seed, target_noise_k, max_seconds)
-    if path is not None:
-        return _shared_run(threads, progress, comm, scene, s, lambda call: _run_call(
-            call, lambda out: _lib.lib.thz_render_file(
-                call.ctx, scene._handle, os.fsencode(path), index, ctypes.byref(s), out,
-                call.err), scene))
-    ptr = photon_map._ptr if photon_map is not None else None
-    return _shared_run(threads, progress, comm, scene, s, lambda call: _run_call(
-        call, lambda out: _lib.lib.thz_render_run(
-            call.ctx, scene._handle, ptr, index, ctypes.byref(s), out, call.err),
-        scene, photon_map))
+    return path, photon_map
 
 
 def _world(mpi):
@@ -443,14 +451,14 @@ def _world(mpi):
 
 def _shared_run(threads, progress, comm, scene, settings, run):
     """run(call), a Result, on a Call of its own; with comm (thzmap.mpi), shared with the
-    other ranks: rank 0 runs it, the others serve it and return None."""
+    other ranks: rank 0 runs it, the others serve it and return None. The arguments
+    every rank checks alike are checked before, raising on every rank."""
+    check_progress(progress)
     if comm is not None and comm.Get_rank() > 0:
-        with Call(threads) as call:
+        with Call(threads, report_warnings=False) as call:
             _mpi.serve(comm, call, scene=scene, settings=settings)
         return None
-    with Call(threads, progress) as call:
-        with _mpi.Lead(comm, call) as lead:
-            result = run(call)
-            if comm is not None:
-                result.mpi_bytes = lead.bytes()
-        return result
+    with Call(threads, progress) as call, _mpi.Shared(comm, call) as shared:
+        result = run(call)
+        result.mpi_bytes = shared.bytes()
+    return result

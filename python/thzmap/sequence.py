@@ -22,7 +22,7 @@ from . import _lib
 from . import mpi as _mpi
 from ._call import Call
 from .errors import ArgumentError
-from .progress import make_reporter
+from .progress import check as check_progress, make_reporter
 from .scene import _load, _load_error, _path_arg, _root_arg
 
 
@@ -287,14 +287,15 @@ def batch(sequence, outdir, threads=None, progress=None, movies=True, mpi=False)
         raise ArgumentError(f"movies: expected True or False, got {movies!r}")
     if not isinstance(mpi, bool):
         raise ArgumentError(f"mpi: expected True or False, got {mpi!r}")
+    check_progress(progress)
     comm = _mpi.world() if mpi else None
     if comm is not None and comm.Get_rank() > 0:
-        with Call(threads) as call:
+        with Call(threads, report_warnings=False) as call:
             _mpi.serve(comm, call, sequence=sequence)
         return None
     report = make_reporter(progress, _BatchBar)
     try:
-        with _BatchCall(threads, sequence) as call, _mpi.Lead(comm, call):
+        with _BatchCall(threads, sequence) as call, _mpi.Shared(comm, call):
 
             def on_progress(user, p):
                 c = p.contents

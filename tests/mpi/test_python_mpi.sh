@@ -3,10 +3,11 @@
 # `mpirun -np N python3 -m mpi4py` whose simulate, render and batch calls pass mpi=True
 # gives, byte for byte, the files of the same script run as one process (summary.json
 # and batch.json aside: wall times, threads, mpi_ranks); rank 0 gets the result (with the
-# bytes it communicated), the other ranks None; only rank 0 writes; a failure on rank 1
-# ends the job with a message naming the rank and a non-zero exit, never a hang, and
-# leaves no OUTDIR; without a launcher mpi=True runs alone; examples/python/simulate_mpi.py
-# runs on 2 ranks.
+# bytes it communicated), the other ranks None; only rank 0 writes and warns; a failure
+# on rank 1, an argument only rank 0 refuses, and Ctrl-C on rank 0 while it waits for a
+# stopped rank each end the job with a message naming the rank and a non-zero exit, never
+# a hang, and leave no OUTDIR; an argument every rank refuses raises on every rank;
+# without a launcher mpi=True runs alone; examples/python/simulate_mpi.py runs on 2 ranks.
 # Usage: bash test_python_mpi.sh THZMAP_BINARY REPO_DIR (the library beside the binary)
 set -u
 THZMAP=$1
@@ -53,31 +54,57 @@ q = {"format": "thzmap-sequence/1", "scene": "batch-scene.json", "fps": 2, "fram
                     "sensors": {"cam": {"position_m": [-0.3, -1.4, 0.9]}}},
                    {"time_s": 1.5, "sensors": {"cam": {"position_m": [0.3, -1.4, 0.9]}}}]}
 json.dump(q, open(os.path.join(work, "seq.json"), "w"))
+b["photons"] = {"seed": 7, "per_channel": 300, "gather_min_photons": 64}  # warns
+json.dump(b, open(os.path.join(work, "warn-scene.json"), "w"))
+q["scene"] = "warn-scene.json"
+json.dump(q, open(os.path.join(work, "warn-seq.json"), "w"))
 PY
 
-# The script every rank runs: run.py WHAT OUT; each rank records what its call returned
-# in OUT.rank-R (rank 0: the bytes it communicated).
+# The script every rank runs: run.py WHAT OUT; each rank records in OUT.rank-R what its
+# call returned (rank 0: the bytes it communicated) and the RunWarnings it gave, and its
+# pid in OUT.pid-R.
 cat > "$work/run.py" <<'PY'
-import os, sys
+import os, sys, warnings
 import thzmap
 
 what, out = sys.argv[1], sys.argv[2]
+work = os.path.dirname(out)
 rank = int(os.environ.get("OMPI_COMM_WORLD_RANK", "0"))
-if what == "batch":
-    r = thzmap.batch(os.path.join(os.path.dirname(out), "seq.json"), out, threads=1, mpi=True)
-else:
-    name = "other.json" if what == "fail" and rank == 1 else "scene.json"
-    scene = thzmap.load_scene(os.path.join(os.path.dirname(out), name))
-    if what == "render":
-        r = thzmap.render(scene, out + ".thzpm", integrator="final-gather", threads=1,
-                          mpi=True)
+with open(f"{out}.pid-{rank}", "w") as f:
+    f.write(str(os.getpid()))
+with warnings.catch_warnings(record=True) as said:
+    warnings.simplefilter("always", thzmap.RunWarning)
+    if what in ("batch", "warn"):
+        r = thzmap.batch(os.path.join(work, "seq.json" if what == "batch" else "warn-seq.json"),
+                         out, threads=1, movies=what == "batch", mpi=True)
     else:
-        r = thzmap.simulate(scene, integrator="photon-map", threads=1, keep_photons=True,
-                            mpi=True)
-    if r is not None:
-        r.save(out, photon_map=what != "render")
+        name = "other.json" if what == "fail" and rank == 1 else "scene.json"
+        scene = thzmap.load_scene(os.path.join(work, name))
+        if what == "render":
+            r = thzmap.render(scene, out + ".thzpm", integrator="final-gather", threads=1,
+                              mpi=True)
+        elif what == "seed":  # a seed with a map is refused; ranks 1.. give no map
+            r = thzmap.render(scene, out + ".thzpm" if rank == 0 else None, seed=3,
+                              integrator="final-gather", threads=1, mpi=True)
+        elif what == "progress":  # refused alike on every rank
+            try:
+                thzmap.simulate(scene, progress=42, mpi=True)
+            except thzmap.ArgumentError:
+                print(f"rank {rank}: refused", flush=True)
+            sys.exit(0)
+        else:
+            def started(p):  # rank 0 in its photon phase: the ranks' team has formed
+                if not os.path.exists(out + ".started"):
+                    open(out + ".started", "w").close()
+            r = thzmap.simulate(scene, integrator="photon-map", threads=1, keep_photons=True,
+                                photons=4_000_000 if what == "long" else None,
+                                progress=started if what == "long" else None, mpi=True)
+        if r is not None:
+            r.save(out, photon_map=what != "render")
 with open(f"{out}.rank-{rank}", "w") as f:
     f.write("None" if r is None else str(getattr(r, "mpi_bytes", "batch")))
+with open(f"{out}.warnings-{rank}", "w") as f:
+    f.write(str(len(said)))
 PY
 
 # Every file below $1 equals $2's (summary.json and batch.json: times, threads, ranks
@@ -147,6 +174,14 @@ for r in 1 2; do
     [ "$(said "$work/three-batch.rank-$r")" = None ] || fail "3 ranks: rank $r's batch returned $(said "$work/three-batch.rank-$r")"
 done
 
+# warnings: rank 0's alone (the others computed frames too), as `mpirun thzmap batch`
+mpi 3 $PY -m mpi4py "$work/run.py" warn "$work/warn" > "$work/warn.out" 2>&1 ||
+    { fail "3 ranks: the warning batch exited $?"; cat "$work/warn.out"; }
+[ "$(said "$work/warn.warnings-0")" -gt 0 ] 2>/dev/null || fail "3 ranks: rank 0 gave no warnings"
+for r in 1 2; do
+    [ "$(said "$work/warn.warnings-$r")" = 0 ] || fail "3 ranks: rank $r gave $(said "$work/warn.warnings-$r") warnings"
+done
+
 # --- a rank that fails ends the job, says which, and leaves no OUTDIR ------------------
 start=$SECONDS
 mpi 2 $PY -m mpi4py "$work/run.py" fail "$work/fail" > "$work/fail.out" 2>&1
@@ -164,6 +199,37 @@ grep -q "thzmap (MPI rank 1): the run failed; ending the MPI job" "$work/fail.ou
 grep -q "^2 MPI rank(s), 1 thread(s) each: 6 channels, .* MB communicated" "$work/example.out" ||
     fail "the example's line: $(cat "$work/example.out")"
 [ -f "$work/example/cam.brightness_temperature.img" ] || fail "the example wrote no images"
+
+# an argument rank 0 alone refuses (ranks 1.. give no photon map) ends the job
+mpi 2 $PY -m mpi4py "$work/run.py" seed "$work/seed" > "$work/seed.out" 2>&1
+rc=$?
+[ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] || fail "a seed with rank 0's map: exit $rc (124: a hang)"
+grep -q "thzmap (MPI rank 0): the run failed" "$work/seed.out" &&
+    grep -q "seed: a render from a photon map uses the map's seed" "$work/seed.out" ||
+    fail "a seed with rank 0's map: $(cat "$work/seed.out")"
+# an argument every rank refuses raises on every rank, which may go on
+mpi 2 $PY -m mpi4py "$work/run.py" progress "$work/progress" > "$work/progress.out" 2>&1 ||
+    fail "progress=42 on 2 ranks: exit $?"
+[ "$(grep -c "refused" "$work/progress.out")" = 2 ] || fail "progress=42: $(cat "$work/progress.out")"
+
+# Ctrl-C reaches rank 0 while it waits for rank 1, stopped in the photon phase: the job
+# ends (the program's handler does the same through thz_mpi_interrupt). Not before the
+# phase: forming the ranks' team (MPI_Comm_dup) cannot be interrupted.
+mpi 2 $PY -m mpi4py "$work/run.py" long "$work/long" > "$work/long.out" 2>&1 &
+job=$!
+for _ in $(seq 200); do [ -e "$work/long.started" ] && break; sleep 0.05; done
+kill -STOP "$(said "$work/long.pid-1")" 2>/dev/null || fail "Ctrl-C: rank 1 did not start"
+sleep 2 # rank 0 fires its share (2 M photons, about 1 s) and waits for rank 1's
+start=$SECONDS
+kill -INT "$(said "$work/long.pid-0")" 2>/dev/null
+wait "$job"
+rc=$?
+kill -CONT "$(said "$work/long.pid-1")" 2>/dev/null
+[ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] || fail "Ctrl-C while rank 0 waits: exit $rc (124: a hang)"
+[ $((SECONDS - start)) -lt 20 ] || fail "Ctrl-C while rank 0 waits: the job took $((SECONDS - start)) s to end"
+grep -q "thzmap (MPI rank 0): the run failed" "$work/long.out" && grep -q KeyboardInterrupt "$work/long.out" ||
+    fail "Ctrl-C while rank 0 waits: $(cat "$work/long.out")"
+[ -e "$work/long" ] && fail "Ctrl-C while rank 0 waits: rank 0 wrote OUTDIR"
 
 # --- mpi takes True or False -----------------------------------------------------------
 $PY - "$work/scene.json" <<'PY' || fail "mpi='yes' was not refused"
