@@ -100,6 +100,12 @@ class Call:
     def _on_sigint(self, signum, frame):
         self._interrupted = True
 
+    @property
+    def takes_sigint(self):
+        """Whether this call, entered, has taken SIGINT (Python's default handler was in
+        place): Ctrl-C then cancels it."""
+        return self._old_handler is not None
+
     # -- the call ----------------------------------------------------------------------------
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():

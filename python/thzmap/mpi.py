@@ -18,7 +18,8 @@ libthzmap was built with. A process that no launcher started runs alone, without
 The arguments every rank checks alike raise as without MPI, on every rank. Past them, once
 the ranks work together, a failure on any rank (an error, a cancellation, Ctrl-C, also
 while it waits for another rank) ends the whole job (MPI_Abort, exit status 1, 130 after
-Ctrl-C) after printing the error on stderr: the other ranks would wait for it forever.
+Ctrl-C) after printing the error on stderr: the other ranks would wait for it forever. A
+script with a SIGINT handler of its own keeps Ctrl-C (as a Call does without MPI).
 `python3 -m mpi4py` does the same for an exception anywhere else in the script.
 """
 import ctypes
@@ -77,61 +78,80 @@ def world():
     return comm
 
 
-def end_job(comm, exc):
-    """Prints exc (with its traceback) naming this rank, and ends the MPI job."""
+def end_job(comm, exc, interrupted=False):
+    """Prints exc (with its traceback) naming this rank, and ends the MPI job: exit status
+    130 after Ctrl-C (interrupted, or a KeyboardInterrupt), else 1."""
     try:
         print(f"thzmap (MPI rank {comm.Get_rank()}): the run failed; ending the MPI job",
               file=sys.stderr)
         traceback.print_exception(type(exc), exc, exc.__traceback__, file=sys.stderr)
         sys.stderr.flush()
     finally:
-        comm.Abort(130 if isinstance(exc, KeyboardInterrupt) else 1)
+        comm.Abort(130 if interrupted or isinstance(exc, KeyboardInterrupt) else 1)
+
+
+# The byte that tells _Interrupts' thread to end (Python's wakeup fd carries signal
+# numbers, never 0).
+_STOP = b"\0"
 
 
 class _Interrupts:
-    """While a shared run is in C on the main thread: a signal Python catches (Ctrl-C,
-    which the Call's handler takes) also stops this process's waits for other ranks
-    (thz_mpi_interrupt, as the thzmap program's handler does). Python runs its own
-    handlers only between bytecodes, never while a call waits in C; its wakeup fd is
-    written at once, and a thread reading it makes the call."""
+    """While a shared run that took SIGINT (Call.takes_sigint) is in C: Ctrl-C also stops
+    this process's waits for other ranks (thz_mpi_interrupt, as the thzmap program's
+    handler does). Python runs its own handlers only between bytecodes, never while a
+    call waits in C; its wakeup fd is written at once, and a thread reading it makes the
+    call. The bytes are passed on to the wakeup fd in place before (asyncio's, say).
+    `fired` says whether it did: the library's flag stays set for the rest of the process,
+    so the job must end even when the run then returned."""
 
     def __init__(self):
-        self._old = None
         self._thread = None
+        self.fired = False
 
     def __enter__(self):
-        if threading.current_thread() is not threading.main_thread():
-            return self
         r, w = os.pipe()
         os.set_blocking(w, False)
         try:
-            self._old = signal.set_wakeup_fd(w, warn_on_full_buffer=False)
-        except ValueError:  # not the main interpreter
+            old = signal.set_wakeup_fd(w, warn_on_full_buffer=False)
+        except ValueError:  # not the main thread, or not the main interpreter
             os.close(r)
             os.close(w)
             return self
-        self._pipe = (r, w)
-        self._thread = threading.Thread(target=self._watch, args=(r,), daemon=True,
-                                        name="thzmap-mpi-interrupt")
-        self._thread.start()
+        thread = threading.Thread(target=self._watch, args=(r, old), daemon=True,
+                                  name="thzmap-mpi-interrupt")
+        try:
+            thread.start()
+        except BaseException:
+            signal.set_wakeup_fd(old)
+            os.close(r)
+            os.close(w)
+            raise
+        self._thread, self._old, self._pipe = thread, old, (r, w)
         return self
 
-    @staticmethod
-    def _watch(r):
+    def _watch(self, r, old):
         while True:
             data = os.read(r, 64)
-            if not data:  # closed: the run is over
-                return
-            if signal.SIGINT in data:
+            stop = not data or _STOP in data
+            data = data.replace(_STOP, b"")
+            if data and old != -1:
+                try:
+                    os.write(old, data)
+                except OSError:  # full or closed: that fd's owner would drop them too
+                    pass
+            if signal.SIGINT in data and not self.fired:
+                self.fired = True
                 _lib.lib.thz_mpi_interrupt()
+            if stop:
                 return
 
     def __exit__(self, exc_type, exc, tb):
         if self._thread is not None:
             signal.set_wakeup_fd(self._old)
             r, w = self._pipe
-            os.close(w)  # the watcher reads the end of the pipe
+            os.write(w, _STOP)  # the pipe is drained: there is room
             self._thread.join()
+            os.close(w)
             os.close(r)
             self._thread = None
         return False
@@ -141,23 +161,28 @@ class Shared:
     """`with Shared(comm, call):` around a run on call's context, inside the Call (the
     job must end before the context is destroyed). comm None: nothing shared, failures
     raise. On rank 0 (lead=True) the context joins the other ranks (thz_context_set_mpi,
-    collective with their serve); on every rank Ctrl-C also stops waits for other ranks,
-    and a failure inside ends the job."""
+    collective with their serve); on every rank whose Call took SIGINT, Ctrl-C also stops
+    waits for other ranks; and a failure inside (an interrupted wait too) ends the job."""
 
     def __init__(self, comm, call, lead=True):
         self._comm = comm
         self._call = call
         self._lead = lead
-        self._interrupts = _Interrupts() if comm is not None else None
+        self._interrupts = _Interrupts()
 
     def __enter__(self):
         if self._comm is None:
             return self
-        if self._lead:
-            status = _lib.lib.thz_context_set_mpi(self._call.ctx, self._call.err)
-            if status != _lib.OK:
-                end_job(self._comm, from_status(status, _lib.text(self._call.error.message)))
-        self._interrupts.__enter__()
+        try:
+            if self._call.takes_sigint:
+                self._interrupts.__enter__()
+            if self._lead:
+                status = _lib.lib.thz_context_set_mpi(self._call.ctx, self._call.err)
+                if status != _lib.OK:
+                    raise from_status(status, _lib.text(self._call.error.message))
+        except BaseException as e:  # noqa: B902 - the other ranks wait: end the job
+            self._interrupts.__exit__(None, None, None)
+            end_job(self._comm, e, self._interrupts.fired)
         return self
 
     def bytes(self):
@@ -170,8 +195,10 @@ class Shared:
         if self._comm is None:
             return False
         self._interrupts.__exit__(exc_type, exc, tb)
+        if exc is None and self._interrupts.fired:
+            exc = KeyboardInterrupt()
         if exc is not None:
-            end_job(self._comm, exc)
+            end_job(self._comm, exc, self._interrupts.fired)
         return False
 
 

@@ -5,8 +5,9 @@
 # and batch.json aside: wall times, threads, mpi_ranks); rank 0 gets the result (with the
 # bytes it communicated), the other ranks None; only rank 0 writes and warns; a failure
 # on rank 1, an argument only rank 0 refuses, and Ctrl-C on rank 0 while it waits for a
-# stopped rank each end the job with a message naming the rank and a non-zero exit, never
-# a hang, and leave no OUTDIR; an argument every rank refuses raises on every rank;
+# stopped rank, or once its run has returned, each end the job with a message naming the
+# rank and a non-zero exit, never a hang, and leave no OUTDIR; a script's own SIGINT
+# handler keeps Ctrl-C; an argument every rank refuses raises on every rank;
 # without a launcher mpi=True runs alone; examples/python/simulate_mpi.py runs on 2 ranks.
 # Usage: bash test_python_mpi.sh THZMAP_BINARY REPO_DIR (the library beside the binary)
 set -u
@@ -93,12 +94,26 @@ with warnings.catch_warnings(record=True) as said:
                 print(f"rank {rank}: refused", flush=True)
             sys.exit(0)
         else:
+            long = what in ("long", "own", "late")
+
             def started(p):  # rank 0 in its photon phase: the ranks' team has formed
                 if not os.path.exists(out + ".started"):
                     open(out + ".started", "w").close()
+            if what == "own":  # the script's own SIGINT handler: Ctrl-C is the script's
+                import signal
+                signal.signal(signal.SIGINT, lambda *a: open(out + ".caught", "w").close())
+            if what == "late":  # a window after the run's C call, before the call ends
+                import time
+                bytes_ = thzmap.mpi.Shared.bytes
+
+                def slow(self):
+                    open(out + ".returned", "w").close()
+                    time.sleep(3)
+                    return bytes_(self)
+                thzmap.mpi.Shared.bytes = slow
             r = thzmap.simulate(scene, integrator="photon-map", threads=1, keep_photons=True,
-                                photons=4_000_000 if what == "long" else None,
-                                progress=started if what == "long" else None, mpi=True)
+                                photons=4_000_000 if long else None,
+                                progress=started if long else None, mpi=True)
         if r is not None:
             r.save(out, photon_map=what != "render")
 with open(f"{out}.rank-{rank}", "w") as f:
@@ -230,6 +245,28 @@ kill -CONT "$(said "$work/long.pid-1")" 2>/dev/null
 grep -q "thzmap (MPI rank 0): the run failed" "$work/long.out" && grep -q KeyboardInterrupt "$work/long.out" ||
     fail "Ctrl-C while rank 0 waits: $(cat "$work/long.out")"
 [ -e "$work/long" ] && fail "Ctrl-C while rank 0 waits: rank 0 wrote OUTDIR"
+
+# Ctrl-C once rank 0's run has returned from C, before its call ends: the library's
+# interrupt stays in force for the rest of the process, so the job ends (130), not the
+# next shared call
+mpi 2 $PY -m mpi4py "$work/run.py" late "$work/late" > "$work/late.out" 2>&1 &
+job=$!
+for _ in $(seq 400); do [ -e "$work/late.returned" ] && break; sleep 0.05; done
+sleep 0.5
+kill -INT "$(said "$work/late.pid-0")" 2>/dev/null || fail "late Ctrl-C: no rank 0"
+wait "$job"
+rc=$?
+[ "$rc" = 130 ] || fail "Ctrl-C after the run returned: exit $rc, not 130: $(cat "$work/late.out")"
+[ -e "$work/late" ] && fail "Ctrl-C after the run returned: rank 0 wrote OUTDIR"
+
+# a script with its own SIGINT handler keeps Ctrl-C: the run goes on to its end
+mpi 2 $PY -m mpi4py "$work/run.py" own "$work/own" > "$work/own.out" 2>&1 &
+job=$!
+for _ in $(seq 400); do [ -e "$work/own.started" ] && break; sleep 0.05; done
+kill -INT "$(said "$work/own.pid-0")" 2>/dev/null || fail "own handler: no rank 0"
+wait "$job" || fail "Ctrl-C with the script's own handler: exit $?: $(cat "$work/own.out")"
+[ -e "$work/own.caught" ] && [ -f "$work/own/summary.json" ] ||
+    fail "Ctrl-C with the script's own handler: not caught, or no results: $(cat "$work/own.out")"
 
 # --- mpi takes True or False -----------------------------------------------------------
 $PY - "$work/scene.json" <<'PY' || fail "mpi='yes' was not refused"
