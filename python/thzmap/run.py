@@ -401,9 +401,8 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
     sends it to the others), whose `photon_map` may then be None."""
     scene = scene_arg(scene)
     comm = _world(mpi)
-    _integrator_arg(integrator)
+    s = _settings(scene, integrator, None, seed, target_noise_k, max_seconds)  # the integrator too
     index = -1 if sensor is None else scene.sensor_index(sensor)
-    s = _settings(scene, integrator, None, seed, target_noise_k, max_seconds)
 
     def run(call):  # rank 0's (or the one process's): the map is its alone
         path, pm = _render_map_arg(scene, photon_map, integrator, seed)
