@@ -121,7 +121,10 @@ THZ_API thz_status thz_photons_save(const thz_photons *photons, const char *path
  * ranges (or for different channels), into one of all their photons (*out; the parts
  * stay the caller's). Each channel of *out holds the parts' photons of that channel;
  * its photons_per_channel is per channel the sum over the parts that hold the channel,
- * and the largest of these sums when they differ between channels. */
+ * and the largest of these sums when they differ between channels. THZ_ERR_INPUT when a
+ * part is given twice, or when two parts hold the same photons of a channel: a map
+ * fired here knows its photons (first_photon .. + K - 1), a merged map the union of its
+ * parts'; a loaded map does not know its photons, so that check cannot see them. */
 THZ_API thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, size_t n,
                                      thz_photons **out, thz_error *err);
 THZ_API void thz_photons_destroy(thz_photons *photons);

@@ -25,6 +25,12 @@ struct thz_context {
     bool mpi_alone;        /* rank 0 while a batch deals frames: its runs share nothing */
 };
 
+/* Photons first .. first + count - 1 of a channel. */
+typedef struct api_photon_span {
+    size_t channel;
+    uint64_t first, count;
+} api_photon_span;
+
 /* Photon maps of every channel of a scene (a channel may have none). */
 struct thz_photons {
     const thz_scene *scene; /* borrowed: the scene the caller fired or loaded them for */
@@ -34,11 +40,12 @@ struct thz_photons {
     photon_stats *stats; /* per channel */
     uint64_t seed;
     uint64_t photons_per_channel;
-    /* fired here: photons first_photon .. + photons_per_channel - 1 of each channel
-     * (thz_photons_merge refuses overlapping ranges); a map loaded, merged or kept by a
-     * run does not know its range */
-    bool range_known;
-    uint64_t first_photon;
+    /* The photons each channel's map holds, as ranges (thz_photons_merge refuses parts
+     * whose ranges of a channel overlap): one a channel when fired here, the union of
+     * the parts' when merged from parts that all know theirs; none (n_spans 0) for a map
+     * loaded or kept by a run, which does not know its range. Owned. */
+    api_photon_span *spans;
+    size_t n_spans;
     bool owned; /* maps and stats belong to this handle (not to a thz_run) */
 };
 

@@ -44,6 +44,7 @@ void thz_photons_destroy(thz_photons *ph)
         photon_map_destroy(ph->maps[c]);
     free(ph->maps);
     free(ph->stats);
+    free(ph->spans);
     free(ph);
 }
 
@@ -125,8 +126,15 @@ static thz_status api_fire(thz_context *ctx, const thz_scene *scene,
     }
     ph->seed = eff->photons.seed;
     ph->photons_per_channel = eff->photons.per_channel;
-    ph->range_known = true;
-    ph->first_photon = settings ? settings->first_photon : 0;
+    ph->spans = thz_calloc(scene->n_channels ? scene->n_channels : 1, sizeof *ph->spans);
+    if (!ph->spans) {
+        thz_photons_destroy(ph);
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for the photon maps");
+    }
+    for (size_t c = 0; c < scene->n_channels; c++)
+        if (ph->maps[c])
+            ph->spans[ph->n_spans++] = (api_photon_span){
+                .channel = c, .first = first, .count = ph->photons_per_channel};
     *out = ph;
     return THZ_OK;
 }
@@ -230,24 +238,13 @@ static thz_status api_merge_check(const thz_photons *const *parts, size_t n, thz
                                  "thz_photons_merge: part %zu has another scene, seed or photon "
                                  "count than part 0",
                                  i);
-        /* the same photons of a channel twice would count as twice as many */
-        for (size_t j = 0; j < i; j++) {
-            const thz_photons *q = parts[j];
-            uint64_t lo = p->first_photon < q->first_photon ? p->first_photon : q->first_photon;
-            uint64_t hi = p->first_photon < q->first_photon ? q->first_photon : p->first_photon;
-            if (!p->range_known || !q->range_known || hi - lo >= p->photons_per_channel)
-                continue;
-            for (size_t c = 0; c < p->n_channels; c++)
-                if (p->maps[c] && q->maps[c])
-                    return thz_error_set(err, THZ_ERR_INPUT,
-                                         "thz_photons_merge: parts %zu and %zu hold the same "
-                                         "photons of channel %zu (fired from photon %llu and "
-                                         "%llu, %llu each): merge maps of disjoint ranges "
-                                         "(thz_run_settings.first_photon)",
-                                         j, i, c, (unsigned long long)q->first_photon,
-                                         (unsigned long long)p->first_photon,
-                                         (unsigned long long)p->photons_per_channel);
-        }
+        /* the same photons twice would count as twice as many */
+        for (size_t j = 0; j < i; j++)
+            if (parts[j] == p)
+                return thz_error_set(err, THZ_ERR_INPUT,
+                                     "thz_photons_merge: parts %zu and %zu are the same photon "
+                                     "maps: their photons would count twice",
+                                     j, i);
         for (size_t c = 0; c < p->n_channels; c++)
             if (p->maps[c] && a->maps[c] &&
                 photon_map_reference_temperature_k(p->maps[c]) !=
@@ -257,6 +254,59 @@ static thz_status api_merge_check(const thz_photons *const *parts, size_t n, thz
                                      "integrator (reference temperature of channel %zu)",
                                      i, c);
     }
+    return THZ_OK;
+}
+
+static int api_span_order(const void *a, const void *b)
+{
+    const api_photon_span *x = a, *y = b;
+    if (x->channel != y->channel)
+        return x->channel < y->channel ? -1 : 1;
+    return x->first < y->first ? -1 : x->first > y->first;
+}
+
+/* The merged map's ranges: the union of the parts', refused where two overlap in a
+ * channel (its photons would count twice); none when a part does not know its ranges. */
+static thz_status api_merge_spans(const thz_photons *const *parts, size_t n, thz_photons *ph,
+                                  thz_error *err)
+{
+    size_t total = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (parts[i]->n_spans == 0)
+            return THZ_OK;
+        total += parts[i]->n_spans;
+    }
+    api_photon_span *s = thz_calloc(total, sizeof *s);
+    if (!s)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for merging photon maps");
+    for (size_t i = 0, k = 0; i < n; i++)
+        for (size_t j = 0; j < parts[i]->n_spans; j++, k++)
+            s[k] = parts[i]->spans[j];
+    qsort(s, total, sizeof *s, api_span_order);
+    thz_status st = THZ_OK;
+    size_t m = 0;
+    for (size_t k = 0; k < total && st == THZ_OK; k++) {
+        api_photon_span *last = m > 0 && s[m - 1].channel == s[k].channel ? &s[m - 1] : NULL;
+        if (last && s[k].first - last->first < last->count)
+            st = thz_error_set(err, THZ_ERR_INPUT,
+                               "thz_photons_merge: two parts hold the same photons of channel "
+                               "%zu (photons %llu to %llu, and %llu photons from %llu): merge "
+                               "maps of disjoint ranges (thz_run_settings.first_photon)",
+                               s[k].channel, (unsigned long long)last->first,
+                               (unsigned long long)(last->first + last->count - 1),
+                               (unsigned long long)s[k].count,
+                               (unsigned long long)s[k].first);
+        else if (last && s[k].first - last->first == last->count)
+            last->count += s[k].count; /* contiguous: one range */
+        else
+            s[m++] = s[k];
+    }
+    if (st != THZ_OK) {
+        free(s);
+        return st;
+    }
+    ph->spans = s;
+    ph->n_spans = m;
     return THZ_OK;
 }
 
@@ -276,6 +326,8 @@ thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, 
         st = api_check_threads(ctx, "thz_photons_merge", err);
     if (st == THZ_OK)
         st = api_photons_create(parts[0]->scene, &ph, err);
+    if (st == THZ_OK)
+        st = api_merge_spans(parts, n, ph, err);
     const photon_map **maps = st == THZ_OK ? thz_calloc(n, sizeof *maps) : NULL;
     if (st == THZ_OK && !maps)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory for merging photon maps");

@@ -98,20 +98,49 @@ static void check_merge_per_channel(thz_context *ctx, thz_scene *scene)
           (unsigned long long)s1.fired);
     CHECK(thz_photons_per_channel(merged) == 6000, "mixed parts: %llu per channel",
           (unsigned long long)thz_photons_per_channel(merged));
-    thz_photons_destroy(merged);
     /* the same photons of a channel twice, or ranges that overlap, are refused */
     const thz_photons *twice[2] = {part[2], part[2]};
-    merged = NULL;
-    expect_input_error(thz_photons_merge(ctx, twice, 2, &merged, &err), &err,
-                       "hold the same photons of channel 0", "a part merged with itself");
-    CHECK(merged == NULL, "a refused merge returned photons");
+    thz_photons *refused = NULL;
+    expect_input_error(thz_photons_merge(ctx, twice, 2, &refused, &err), &err,
+                       "parts 0 and 1 are the same photon maps", "a part merged with itself");
+    CHECK(refused == NULL, "a refused merge returned photons");
+    const thz_photons *merged_twice[2] = {merged, merged};
+    expect_input_error(thz_photons_merge(ctx, merged_twice, 2, &refused, &err), &err,
+                       "parts 0 and 1 are the same photon maps", "a merged map with itself");
     thz_photons *overlap = NULL;
     settings.first_photon = 4000; /* 4000..6999 against 3000..5999 */
     REQUIRE_OK(thz_photons_fire_channel(ctx, scene, &settings, 1, &overlap, &err), &err);
     const thz_photons *over[2] = {part[2], overlap};
-    expect_input_error(thz_photons_merge(ctx, over, 2, &merged, &err), &err,
-                       "fired from photon 3000 and 4000", "overlapping ranges");
+    expect_input_error(thz_photons_merge(ctx, over, 2, &refused, &err), &err,
+                       "channel 1 (photons 3000 to 5999, and 3000 photons from 4000)",
+                       "overlapping ranges");
     thz_photons_destroy(overlap);
+    /* a merged map knows its photons: channel 1's 0..5999 again is refused, 6000..11999
+     * merge, and the result's ranges join (0..11999 refuses 11999..17998) */
+    settings.photons_per_channel = 6000;
+    settings.first_photon = 0;
+    REQUIRE_OK(thz_photons_fire_channel(ctx, scene, &settings, 1, &overlap, &err), &err);
+    const thz_photons *again[2] = {overlap, merged};
+    expect_input_error(thz_photons_merge(ctx, again, 2, &refused, &err), &err,
+                       "channel 1 (photons 0 to 5999, and 6000 photons from 0)",
+                       "a fired map with a merged one of the same photons");
+    thz_photons_destroy(overlap);
+    settings.first_photon = 6000;
+    REQUIRE_OK(thz_photons_fire_channel(ctx, scene, &settings, 1, &overlap, &err), &err);
+    const thz_photons *next[2] = {overlap, merged};
+    thz_photons *joined = NULL;
+    REQUIRE_OK(thz_photons_merge(ctx, next, 2, &joined, &err), &err);
+    thz_photons_destroy(overlap);
+    settings.photons_per_channel = 12000;
+    settings.first_photon = 11999;
+    REQUIRE_OK(thz_photons_fire_channel(ctx, scene, &settings, 1, &overlap, &err), &err);
+    const thz_photons *last[2] = {joined, overlap};
+    expect_input_error(thz_photons_merge(ctx, last, 2, &refused, &err), &err,
+                       "channel 1 (photons 0 to 11999, and 12000 photons from 11999)",
+                       "a map overlapping a merged map's joined ranges");
+    thz_photons_destroy(overlap);
+    thz_photons_destroy(joined);
+    thz_photons_destroy(merged);
     for (size_t i = 0; i < 3; i++)
         thz_photons_destroy(part[i]);
 }

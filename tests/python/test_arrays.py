@@ -120,11 +120,19 @@ def test_fire_and_merge(tiny_dir):
     merged = thzmap.merge_photon_maps([a, b])
     assert [s.fired for s in merged.stats] == [3000, 3000]
     # the same photons twice would count double: refused, as overlapping ranges are
-    with pytest.raises(thzmap.Error, match="hold the same photons of channel 0"):
+    with pytest.raises(thzmap.Error, match="parts 0 and 1 are the same photon maps"):
         thzmap.merge_photon_maps([a, a])
+    with pytest.raises(thzmap.Error, match="parts 0 and 1 are the same photon maps"):
+        thzmap.merge_photon_maps([merged, merged])
     c = thzmap.fire_photons(scene, photons=1500, seed=SEED, first_photon=1000)
-    with pytest.raises(thzmap.Error, match="fired from photon 1000 and 1500"):
+    with pytest.raises(thzmap.Error, match=r"channel 0 \(photons 1000 to 2499, and 1500 photons "
+                       r"from 1500\)"):
         thzmap.merge_photon_maps([c, b])
+    # a merged map knows its photons: 0..2999 again is refused
+    full = thzmap.fire_photons(scene, photons=3000, seed=SEED)
+    with pytest.raises(thzmap.Error, match=r"channel 0 \(photons 0 to 2999, and 3000 photons "
+                       r"from 0\)"):
+        thzmap.merge_photon_maps([full, merged])
     with pytest.raises(thzmap.ArgumentError, match="sequence of PhotonMap"):
         thzmap.merge_photon_maps(a)
     assert thzmap.render(scene, merged).image("cam").radiance.shape == (12, 20, 2)
