@@ -133,8 +133,8 @@ static thz_status api_fire(thz_context *ctx, const thz_scene *scene,
     }
     for (size_t c = 0; c < scene->n_channels; c++)
         if (ph->maps[c])
-            ph->spans[ph->n_spans++] = (api_photon_span){
-                .channel = c, .first = first, .count = ph->photons_per_channel};
+            ph->spans[ph->n_spans++] =
+                (api_photon_span){.channel = c, .first = first, .count = ph->photons_per_channel};
     *out = ph;
     return THZ_OK;
 }
@@ -294,8 +294,7 @@ static thz_status api_merge_spans(const thz_photons *const *parts, size_t n, thz
                                "maps of disjoint ranges (thz_run_settings.first_photon)",
                                s[k].channel, (unsigned long long)last->first,
                                (unsigned long long)(last->first + last->count - 1),
-                               (unsigned long long)s[k].count,
-                               (unsigned long long)s[k].first);
+                               (unsigned long long)s[k].count, (unsigned long long)s[k].first);
         else if (last && s[k].first - last->first == last->count)
             last->count += s[k].count; /* contiguous: one range */
         else

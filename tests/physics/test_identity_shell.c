@@ -40,8 +40,7 @@ static void shell_case_with(const char *mode, uint64_t seed, double refl, double
              " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.3, 0],"
              "   \"direction\": [0, 1, 0], \"fov_deg\": 100, \"resolution\": [12, 12]}],"
              " \"photons\": {\"per_channel\": 300000, \"seed\": %llu}}",
-             mode, refl, alpha, mode, SHELL_TB, SHELL_T_M, SHELL_TS,
-             (unsigned long long)seed);
+             mode, refl, alpha, mode, SHELL_TB, SHELL_T_M, SHELL_TS, (unsigned long long)seed);
     /* The diffuse shell at the kink is the noisiest photon-map case (its pixels' standard
      * errors up to 8.6 % at 300 000 photons, over the bound of 8 %). */
     double photons = alpha == SHELL_ALPHA ? 300000 : 450000;
@@ -76,8 +75,8 @@ static void shell_case_with(const char *mode, uint64_t seed, double refl, double
         assert_true(capped >= pixels / 4 && pixels - capped >= pixels / 4); /* both pieces */
     char label[64], what[128];
     ident_label(label, sizeof label, integrator, t0_k);
-    snprintf(what, sizeof what, "%s shell, R = %g, alpha t = %g, %s", mode, refl,
-             alpha * SHELL_T_M, label);
+    snprintf(what, sizeof what, "%s shell, R = %g, alpha t = %g, %s", mode, refl, alpha * SHELL_T_M,
+             label);
     ident_tally_assert(&t, what, 0.08 / sqrt(ident_scale()), 1e-5);
     ident_run_fini(&r);
 }
