@@ -165,8 +165,8 @@ typedef enum thz_plane {
     THZ_PLANE_POWER,                  /* P_c on the pixel, W */
     THZ_PLANE_BRIGHTNESS_TEMPERATURE, /* Tb_c, K */
     THZ_PLANE_NORMALIZED,             /* N_c = L_c / B(T_ref), 1 */
-    THZ_PLANE_TEMPERATURE,            /* 1 band: temperature of the surface seen, K (0: none) */
-    THZ_PLANE_DISTANCE,               /* 1 band: distance to the surface seen, m (0: none) */
+    THZ_PLANE_TEMPERATURE,            /* 1 band: temperature of the surface seen, K (-1: none) */
+    THZ_PLANE_DISTANCE,               /* 1 band: distance to the surface seen, m (-1: none) */
     THZ_PLANE_OBJECT_ID,              /* 1 band: object index as float, -1: nothing hit */
     THZ_PLANE_VISUAL_RGB,             /* 3 bands, pixel-interleaved: [(row * columns + col)
                                        * 3 + k], shaded colour 0..1 */

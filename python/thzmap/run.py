@@ -458,6 +458,7 @@ def _shared_run(threads, progress, comm, scene, settings, run):
             _mpi.serve(comm, call, scene=scene, settings=settings)
         return None
     with Call(threads, progress) as call, _mpi.Shared(comm, call) as shared:
+        call._stacklevel = 4  # the warnings point past this function and simulate's or render's
         result = run(call)
         result.mpi_bytes = shared.bytes()
     return result

@@ -177,9 +177,13 @@ def test_a_photon_map_of_another_scene_is_refused(tiny_dir):
 
 def test_run_warnings_arrive_as_warnings(tiny_dir):
     scene = thzmap.load_scene(tiny_dir / "scene.json")
-    with pytest.warns(thzmap.RunWarning):
+    with pytest.warns(thzmap.RunWarning) as caught:
         result = thzmap.simulate(scene, photons=200)
     assert result.summary["warnings"]
+    # each warning points at the line that called simulate or render, not at the package
+    with pytest.warns(thzmap.RunWarning) as caught_render:
+        thzmap.render(scene, thzmap.fire_photons(scene, photons=200))
+    assert {w.filename for w in list(caught) + list(caught_render)} == {__file__}
 
 
 def _bad_scenes():
