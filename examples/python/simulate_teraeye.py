@@ -5,7 +5,7 @@ brightness temperature against frequency (the paper's Fig. 6) to a PNG.
     PYTHONPATH=python python3 examples/python/simulate_teraeye.py [--out spectra.png]
         [--small] [--integrator path|final-gather|photon-map] [--photons N]
 
-It renders with the converged `path` integrator by default (about a second for the six
+It renders with the converged `path` integrator by default (a few seconds for the six
 channels at 64 x 64 pixels); --small (or THZMAP_EXAMPLE_SMALL=1) renders 16 x 16 pixels,
 for tests.
 """

@@ -123,7 +123,9 @@ def _number(name, value, lo=None, hi=None):
             not math.isfinite(value):
         raise ArgumentError(f"{name}: expected a finite number, got {value!r}")
     if (lo is not None and value < lo) or (hi is not None and value > hi):
-        raise ArgumentError(f"{name}: expected a number in [{lo}, {hi}], got {value!r}")
+        want = (f"in [{lo:g}, {hi:g}]" if lo is not None and hi is not None else
+                f"at least {lo:g}" if lo is not None else f"at most {hi:g}")
+        raise ArgumentError(f"{name}: expected a number {want}, got {value!r}")
     return float(value)
 
 

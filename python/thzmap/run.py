@@ -87,6 +87,8 @@ def _settings(scene, integrator=None, photons=None, seed=None, target_noise_k=No
         if target_noise_k is None:
             raise ArgumentError("max_seconds limits target_noise_k; give both")
         s.max_seconds = _positive("max_seconds", max_seconds)
+    if not isinstance(keep_photons, bool):
+        raise ArgumentError(f"keep_photons: expected True or False, got {keep_photons!r}")
     s.keep_photons = 1 if keep_photons else 0
     s.first_photon = _whole("first_photon", first_photon, 0)
     s.seconds_load = scene.seconds_load
@@ -169,6 +171,10 @@ def fire_photons(scene, integrator=None, photons=None, seed=None, first_photon=0
     + photons - 1, so that maps of disjoint ranges merge)."""
     scene = scene_arg(scene)
     s = _settings(scene, integrator, photons, seed, first_photon=first_photon)
+    effective = integrator if integrator is not None else scene.info.integrator
+    if not _lib.lib.thz_integrator_needs_photons(effective.encode()):
+        raise ArgumentError(f"integrator: the {effective} integrator uses no photons; give "
+                            "integrator='photon-map' or 'final-gather'")
     with Call(threads, progress) as call:
         return _photons_call(call, lambda out: _lib.lib.thz_photons_fire(
             call.ctx, scene._handle, ctypes.byref(s), out, call.err), scene)

@@ -98,7 +98,8 @@ def test_missing_file(tmp_path):
     {"photons": 0}, {"photons": -5}, {"photons": 2.5}, {"photons": 1 << 64}, {"photons": 10**12 + 1},
     {"seed": -1}, {"seed": "1"}, {"seed": 1 << 63}, {"threads": 0}, {"threads": True},
     {"integrator": "magic"}, {"integrator": "path\0"}, {"target_noise_k": math.nan},
-    {"target_noise_k": -1}, {"max_seconds": 3}, {"progress": 42},
+    {"target_noise_k": -1}, {"max_seconds": 3}, {"progress": 42}, {"keep_photons": "yes"},
+    {"keep_photons": 1},
 ])
 def test_bad_arguments_raise_before_the_library(tiny_dir, kwargs):
     scene = thzmap.load_scene(tiny_dir / "scene.json")
@@ -134,6 +135,17 @@ def test_scene_integers_beyond_64_bits_are_named(tiny_dir):
     with pytest.raises(thzmap.SceneError) as e:
         thzmap.scene_from_dict(d, base_dir=tiny_dir)
     assert e.value.path == "photons.seed"
+
+
+def test_fire_photons_for_path_is_an_argument_error(tiny_dir):
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    with pytest.raises(thzmap.ArgumentError, match="the path integrator uses no photons"):
+        thzmap.fire_photons(scene, integrator="path", photons=500)
+    import json
+    d = json.loads((tiny_dir / "scene.json").read_text())
+    d["render"] = {"integrator": "path"}  # the scene's own
+    with pytest.raises(thzmap.ArgumentError, match="the path integrator uses no photons"):
+        thzmap.fire_photons(thzmap.scene_from_dict(d, base_dir=tiny_dir), photons=500)
 
 
 def test_bad_render_arguments(tiny_dir):

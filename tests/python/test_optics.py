@@ -158,6 +158,9 @@ def test_errors():
         thzmap.atmosphere(temperature_k=20)
     with pytest.raises(thzmap.ArgumentError, match="above 0 THz"):
         thzmap.atmosphere().attenuation_per_m([0.5, -1.0])
+    with pytest.raises(thzmap.ArgumentError, match=r"distance_m: expected a number at least 0, "
+                       r"got -1"):
+        thzmap.atmosphere().transmittance(0.5, -1)
     with pytest.raises(thzmap.Error, match="frequency_thz"):
         thzmap.atmosphere("itu-p676").attenuation_per_m(2.0)  # 1-1000 GHz only
     with pytest.raises(thzmap.ArgumentError, match="only for the lines model"):
