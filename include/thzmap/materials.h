@@ -65,7 +65,7 @@ typedef struct thz_library_optics {
     double attenuation_per_m;  /* 4 pi k nu / c, the power attenuation in the medium */
     double normal_reflectance; /* |(n + ik - 1)/(n + ik + 1)|^2 from air */
 } thz_library_optics;
-/* All zero when i is out of range. */
+/* All zero when i is out of range or freq_hz is not a finite frequency above 0. */
 THZ_API void thz_library_optics_at(const thz_library *lib, size_t i, double freq_hz,
                                    thz_library_optics *out);
 

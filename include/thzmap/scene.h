@@ -215,7 +215,8 @@ THZ_API thz_status thz_scene_material_optics(const thz_scene *scene, size_t i, d
                                              double thickness_m, thz_surface_optics *out);
 
 /* Planck's law B_nu(T) in W m^-2 sr^-1 Hz^-1 and its inverse, the brightness temperature
- * in K of a radiance at freq_hz (0 for radiance <= 0), as the images use them. */
+ * in K of a radiance at freq_hz (0 for radiance <= 0), as the images use them; NaN when
+ * an argument is NaN (thz_brightness_temperature_stderr too). */
 THZ_API double thz_planck_radiance(double freq_hz, double temperature_k);
 THZ_API double thz_brightness_temperature(double freq_hz, double radiance);
 /* The standard error in K of a brightness temperature tb_k from its radiance's standard

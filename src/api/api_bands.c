@@ -314,7 +314,10 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
     *out = NULL;
     size_t n = 0;
     if (!scene_path || !o)
-        return api_done(ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_bands_select: no scene"), err);
+        return api_done(ctx,
+                        thz_error_set(err, THZ_ERR_INPUT, "thz_bands_select: no %s",
+                                      scene_path ? "options" : "scene"),
+                        err);
     thz_status st = check_options(o, &n, err);
     if (st == THZ_OK)
         st = api_check_threads(ctx, "thz_bands_select", err);

@@ -132,7 +132,7 @@ void thz_library_optics_at(const thz_library *lib, size_t i, double freq_hz,
     if (!out)
         return;
     const material_library_entry *e = api_entry(lib, i);
-    if (!e) {
+    if (!e || !(freq_hz > 0.0) || isinf(freq_hz)) {
         *out = (thz_library_optics){0};
         return;
     }

@@ -184,7 +184,12 @@ thz_status thz_output_add_file(thz_output *output, const char *name, const void 
     st = thz_path_join(path, sizeof path, output_stage_dir(output->stage), name, err);
     if (st != THZ_OK)
         return st;
-    FILE *f = fopen(path, "wb");
+    FILE *f = fopen(path, "wbx"); /* a name already in the output is not replaced */
+    if (!f && errno == EEXIST)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "thz_output_add_file: %s is in this output already (added before, "
+                             "or a file of its run)",
+                             name);
     if (!f)
         return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
     int why = 0; /* the first failure's errno: a full disk says so */

@@ -363,15 +363,21 @@ thz_status thz_scene_material_optics(const thz_scene *s, size_t i, double freq_h
 
 double thz_planck_radiance(double freq_hz, double temperature_k)
 {
+    if (isnan(freq_hz) || isnan(temperature_k))
+        return NAN;
     return planck_radiance(freq_hz, temperature_k);
 }
 
 double thz_brightness_temperature(double freq_hz, double radiance)
 {
+    if (isnan(freq_hz) || isnan(radiance))
+        return NAN;
     return planck_brightness_temperature(freq_hz, radiance);
 }
 
 double thz_brightness_temperature_stderr(double freq_hz, double tb_k, double stderr_l)
 {
+    if (isnan(freq_hz) || isnan(tb_k) || isnan(stderr_l))
+        return NAN;
     return render_stderr_k(freq_hz, tb_k, stderr_l);
 }

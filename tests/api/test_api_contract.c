@@ -312,6 +312,8 @@ static void check_bands_targets(thz_context *ctx, const char *scene_path)
     o.count = 1;
     o.n_targets = 1;
     thz_bands *bands = (thz_bands *)&err;
+    expect_input_error(thz_bands_select(ctx, scene_path, NULL, &bands, &err), &err,
+                       "thz_bands_select: no options", "options NULL");
     expect_input_error(thz_bands_select(ctx, scene_path, &o, &bands, &err), &err,
                        "targets: 1 given but no list", "targets NULL");
     CHECK(bands == NULL, "bands came back");
@@ -338,7 +340,8 @@ static void check_bands_targets(thz_context *ctx, const char *scene_path)
 }
 
 /* An output takes nothing after its commit, and says so (THZ_ERR_INPUT, not an I/O
- * error about its vanished staging directory); a file of 0 bytes may have no data. */
+ * error about its vanished staging directory); a file of 0 bytes may have no data; a
+ * file never replaces one the output holds. */
 static void check_output_order(thz_context *ctx, thz_run *run, const char *dir)
 {
     thz_error err = {0};
@@ -347,6 +350,12 @@ static void check_output_order(thz_context *ctx, thz_run *run, const char *dir)
     thz_output *out = NULL;
     REQUIRE_OK(thz_output_open(outdir, &out, &err), &err);
     REQUIRE_OK(thz_output_add_file(out, "empty.txt", NULL, 0, &err), &err);
+    /* a name the output holds already is refused, not replaced */
+    expect_input_error(thz_output_add_file(out, "empty.txt", "x", 1, &err), &err,
+                       "empty.txt is in this output already", "the same file twice");
+    REQUIRE_OK(thz_output_add_run(ctx, out, run, NULL, &err), &err);
+    expect_input_error(thz_output_add_file(out, "summary.json", "{}", 2, &err), &err,
+                       "summary.json is in this output already", "a file over the run's");
     REQUIRE_OK(thz_output_commit(out, &err), &err);
     struct stat info;
     snprintf(path, sizeof path, "%s/empty.txt", outdir);
@@ -505,6 +514,18 @@ static void check_null_arguments(thz_context *ctx, thz_scene *scene, thz_photons
     thz_library_optics optics;
     thz_library_optics_at(NULL, 0, 1e12, &optics);
     CHECK(optics.n == 0 && optics.k == 0, "optics of no library: %g", optics.n);
+    const double bad_hz[3] = {-1e12, 0.0, NAN};
+    for (size_t i = 0; i < 3; i++) {
+        thz_library_optics_at(lib, 0, bad_hz[i], &optics);
+        CHECK(optics.n == 0 && optics.normal_reflectance == 0, "optics at %g Hz: n = %g", bad_hz[i],
+              optics.n);
+    }
+    /* Planck's law and its inverse: NaN in, NaN out (not 0 K) */
+    CHECK(isnan(thz_planck_radiance(NAN, 300.0)) && isnan(thz_planck_radiance(1e12, NAN)),
+          "Planck of NaN");
+    CHECK(isnan(thz_brightness_temperature(1e12, NAN)) &&
+              isnan(thz_brightness_temperature_stderr(1e12, NAN, 1e-16)),
+          "brightness temperature of NaN");
     /* the void functions that fill what they are given do nothing with NULL */
     thz_atm_options_init(NULL);
     thz_bands_options_init(NULL);
