@@ -205,6 +205,46 @@ static bool load_is_mesh_file(const load_cursor *root, size_t i)
     return type && strcmp(type, "mesh") == 0;
 }
 
+/* Whether the box lo..hi leaves the air's extent by more than a rounding (a room's walls
+ * on the extent's faces stay inside). */
+static bool load_outside_extent(const thz_atmosphere *atm, const double lo[3], const double hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        double size = atm->extent_max_m[k] - atm->extent_min_m[k];
+        double slack = 1e-6 * size + 1e-9;
+        if (lo[k] < atm->extent_min_m[k] - slack || hi[k] > atm->extent_max_m[k] + slack)
+            return true;
+    }
+    return false;
+}
+
+/* An extent smaller than the scene: free paths outside it still attenuate and emit
+ * (docs/atmosphere.md, "Limits"), so say which objects and sensors leave it. */
+static bool load_warn_extent(thz_scene *s)
+{
+    const thz_atmosphere *atm = &s->atmosphere;
+    if (!atm->emitting || !atm->has_extent)
+        return true;
+    bool ok = true;
+    for (size_t i = 0; i < s->n_objects && ok; i++) {
+        const thz_mesh *m = &s->objects[i].mesh;
+        if (load_outside_extent(atm, m->bbox_min_m, m->bbox_max_m))
+            ok = scene_add_warning(s,
+                                   "object \"%s\" reaches outside the atmosphere's extent: the "
+                                   "air between surfaces there attenuates and emits as inside "
+                                   "it; enclose the scene in extent_min_m .. extent_max_m",
+                                   s->objects[i].name);
+    }
+    for (size_t j = 0; j < s->n_sensors && ok; j++)
+        if (load_outside_extent(atm, s->sensors[j].position_m, s->sensors[j].position_m))
+            ok = scene_add_warning(s,
+                                   "sensor \"%s\" is outside the atmosphere's extent: the air "
+                                   "between it and the surfaces it sees attenuates and emits as "
+                                   "inside it; enclose the scene in extent_min_m .. extent_max_m",
+                                   s->sensors[j].name);
+    return ok;
+}
+
 static thz_status load_warnings(load_ctx *ctx, const load_cursor *root)
 {
     thz_scene *s = ctx->scene;
@@ -219,6 +259,8 @@ static thz_status load_warnings(load_ctx *ctx, const load_cursor *root)
     }
     if (ok && s->atmosphere.model == ATM_TABLE)
         ok = load_warn_table(s, &s->atmosphere.attenuation_per_m, "atmosphere attenuation_per_m");
+    if (ok)
+        ok = load_warn_extent(s);
     for (size_t i = 0; i < s->n_objects && ok; i++) {
         const thz_object *obj = &s->objects[i];
         if (s->materials[obj->material].emissivity.n > 0) {

@@ -126,10 +126,10 @@ thz_status sensor_measure(const thz_scene *scene, size_t sensor, uint64_t run_se
             measure_tb(ch, l, tb, pixels);
         if (st == THZ_OK && !measure_finite(l, tb, pixels))
             st = thz_error_set(err, THZ_ERR_INPUT,
-                               "sensors[%zu].noise (sensor '%s'), channel %zu: the noise takes "
-                               "the measured image beyond the range of its 32-bit values (an "
-                               "absurd netd_k, receiver_temperature_k or integration_time_s?)",
-                               sensor, sn->name, c + 1);
+                               "%s: sensors[%zu].noise (sensor '%s'), channel %zu: the noise "
+                               "takes the measured image beyond the range of its 32-bit values "
+                               "(an absurd netd_k, receiver_temperature_k or integration_time_s?)",
+                               scene->path ? scene->path : "scene", sensor, sn->name, c + 1);
     }
     return st;
 }

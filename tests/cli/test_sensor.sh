@@ -175,8 +175,8 @@ sed 's/"netd_k": \[0.5, 0.2\]/"netd_k": [0.5, 1e300]/' "$work/furnace.json" > "$
 "$THZMAP" simulate "$work/huge.json" -o "$work/huge" --quiet > "$work/huge.log" 2>&1
 rc=$?
 [ $rc -eq 2 ] || fail "netd_k 1e300 K: exit $rc, expected 2"
-grep -q "sensors\[2\].noise (sensor 'netd'), channel 2: the noise takes the measured image beyond" "$work/huge.log" ||
-    { fail "netd_k 1e300 K: no message naming the sensor and channel"; cat "$work/huge.log"; }
+grep -q "$work/huge.json: sensors\[2\].noise (sensor 'netd'), channel 2: the noise takes the measured image beyond" "$work/huge.log" ||
+    { fail "netd_k 1e300 K: no message naming the file, sensor and channel"; cat "$work/huge.log"; }
 [ ! -e "$work/huge" ] || fail "netd_k 1e300 K: OUTDIR written"
 
 [ $fails -eq 0 ] && echo "PASS"

@@ -394,6 +394,38 @@ static void test_refusals(void **state)
              "atmosphere.emitting: expected true or false");
 }
 
+/* How many of the scene's warnings name `what` and the atmosphere's extent. */
+static size_t extent_warnings(const char *extent, const char *what)
+{
+    char json[1024];
+    snprintf(json, sizeof json,
+             HEAD CHANNELS MATERIALS OBJECT(BOX) SENSORS
+             ", \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.1, "
+             "\"temperature_k\": 290, %s}}",
+             extent);
+    thz_scene *s = load_ok(json);
+    size_t n = 0;
+    for (size_t i = 0; i < s->n_warnings; i++)
+        n += strstr(s->warnings[i], what) && strstr(s->warnings[i], "atmosphere's extent");
+    thz_scene_destroy(s);
+    return n;
+}
+
+/* An extent that leaves out part of the scene is warned about (free paths there still
+ * attenuate and emit); surfaces on its faces are inside. */
+static void test_atmosphere_extent_warnings(void **state)
+{
+    (void)state;
+    const char *faces = "\"extent_min_m\": [-0.5, -0.5, -0.5], \"extent_max_m\": [0.5, 0.5, 0.5]";
+    const char *inner = "\"extent_min_m\": [-0.4, -0.4, -0.4], \"extent_max_m\": [0.4, 0.4, 0.4]";
+    const char *all = "\"extent_min_m\": [-9, -9, -9], \"extent_max_m\": [9, 9, 9]";
+    assert_int_equal(extent_warnings(faces, "object \"o\""), 0);
+    assert_int_equal(extent_warnings(faces, "sensor \"c\""), 1); /* the camera at y = -5 */
+    assert_int_equal(extent_warnings(inner, "object \"o\""), 1);
+    assert_int_equal(extent_warnings(all, "object"), 0);
+    assert_int_equal(extent_warnings(all, "sensor"), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -407,6 +439,7 @@ int main(void)
         cmocka_unit_test(test_mesh_file_named_thrice),
         cmocka_unit_test(test_sensor_model),
         cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_atmosphere_extent_warnings),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
