@@ -3,10 +3,12 @@
  * the channels of a scene marked). */
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <stdbool.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
 #include "cli.h"
@@ -160,7 +162,43 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
         return cli_usage_error(CMD, "more than %.0f frequencies; raise --step-ghz", MAX_POINTS);
     if (o->compare_model && !o->plot)
         return cli_usage_error(CMD, "--compare-model needs --plot");
+    size_t len = o->plot ? strlen(o->plot) : 0;
+    if (o->plot && (len < 5 || strcasecmp(o->plot + len - 4, ".png") != 0))
+        return cli_usage_error(CMD, "--plot expects a file name ending in .png, got '%s'", o->plot);
     return CLI_EXIT_OK;
+}
+
+/* Draws the figure into a file beside plot->path and renames it over that: a failure
+ * leaves the file that was there (or none). Signals wait until the figure is whole or
+ * gone, so that none leaves the partial file behind. */
+static thz_status draw_plot_whole(const thz_atm_plot *plot, thz_error *err)
+{
+    char partial[4096];
+    int n = snprintf(partial, sizeof partial, "%s.%ld.partial.png", plot->path, (long)getpid());
+    if (n < 0 || (size_t)n >= sizeof partial) {
+        err->status = THZ_ERR_INPUT;
+        snprintf(err->message, sizeof err->message, "--plot %s: the name is too long", plot->path);
+        return err->status;
+    }
+    sigset_t stop, before;
+    sigemptyset(&stop);
+    sigaddset(&stop, SIGINT);
+    sigaddset(&stop, SIGTERM);
+    sigaddset(&stop, SIGHUP);
+    sigaddset(&stop, SIGPIPE);
+    sigprocmask(SIG_BLOCK, &stop, &before);
+    thz_atm_plot into = *plot;
+    into.path = partial;
+    thz_status st = thz_atm_draw_plot(&into, err);
+    if (st == THZ_OK && rename(partial, plot->path) != 0) {
+        err->status = st = THZ_ERR_IO;
+        snprintf(err->message, sizeof err->message, "--plot %s: cannot replace: %s", plot->path,
+                 strerror(errno));
+    }
+    if (st != THZ_OK)
+        unlink(partial);
+    sigprocmask(SIG_SETMASK, &before, NULL);
+    return st;
 }
 
 static const char *humidity_option(thz_humidity_kind kind)
@@ -344,9 +382,7 @@ int cmd_atmosphere(int argc, char **argv)
                     "thzmap atmosphere: the attenuation%s at %.9g THz is not a finite number "
                     "(%g /m); a line catalogue with values beyond the physical range?\n",
                     mine ? "" : " of --compare-model", f_thz, mine ? p.total_per_m : other);
-            if (o.plot)
-                remove(o.plot); /* the empty file that checked it could be created */
-            rc = CLI_EXIT_USAGE;
+            rc = CLI_EXIT_USAGE; /* nothing printed or drawn: a figure there stays */
             goto cleanup;
         }
         s.f_thz[i] = f_thz;
@@ -413,7 +449,7 @@ int cmd_atmosphere(int argc, char **argv)
                              .o2_db = s.o2_db,
                              .dry_db = s.dry_db,
                              .compare_db = s.compare_db};
-        if (thz_atm_draw_plot(&plot, &err) != THZ_OK)
+        if (draw_plot_whole(&plot, &err) != THZ_OK)
             rc = cli_fail(&err);
     }
 cleanup:

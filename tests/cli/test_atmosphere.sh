@@ -116,6 +116,14 @@ expect_usage "apply to a lines model" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 -
     --no-continuum
 expect_usage "the scene's atmosphere is used" --scene "$TMP/humid.json" --from-thz 0.3 \
     --to-thz 0.4 --step-ghz 1 --h2o-lines "$TMP/no-such.par"
+# --plot writes PNG files only: a slip that names the scene is refused, the scene kept
+cp "$TMP/humid.json" "$TMP/keep.json"
+"$THZ" atmosphere --from-thz 0.3 --to-thz 0.4 --step-ghz 10 --scene "$TMP/keep.json" \
+    --plot "$TMP/keep.json" > "$TMP/out" 2> "$TMP/err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "plot expects a file name ending in .png, got '$TMP/keep.json'" "$TMP/err" ||
+    fail "--plot of the scene's name: exit $rc: $(cat "$TMP/err")"
+cmp -s "$TMP/humid.json" "$TMP/keep.json" || fail "--plot of the scene's name changed the scene"
 # an unwritable --plot path: PLplot would prompt on stdin and exit; thzmap refuses it
 # first (exit 2, naming the path) and never reads stdin
 timeout 60 "$THZ" atmosphere --from-thz 0.1 --to-thz 0.2 --step-ghz 1 \
@@ -130,6 +138,7 @@ grep -q "no-such-dir/a.png: cannot create" "$TMP/err" || fail "unwritable --plot
 # scene's images were NaN, exit 0).
 awk -F, 'BEGIN { OFS = "," } NR == 3 { $6 = "1e300" } NR <= 3' \
     "$REPO/tests/inputs/atm_h2o_subset.csv" > "$TMP/huge.csv"
+echo precious > "$TMP/huge.png" # a figure there before stays (the failure deleted it)
 "$THZ" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --h2o-lines "$TMP/huge.csv" \
     --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" --plot "$TMP/huge.png" \
     > "$TMP/out" 2> "$TMP/err"
@@ -137,7 +146,9 @@ rc=$?
 [ $rc -eq 2 ] || fail "n_air 1e300: exit status $rc, expected 2"
 grep -q "the attenuation at 0.3 THz is not a finite number" "$TMP/err" ||
     fail "n_air 1e300: message: $(cat "$TMP/err")"
-[ ! -s "$TMP/out" ] && [ ! -e "$TMP/huge.png" ] || fail "n_air 1e300: output written"
+[ ! -s "$TMP/out" ] && [ "$(cat "$TMP/huge.png")" = precious ] ||
+    fail "n_air 1e300: output written, or the figure there before changed"
+[ -z "$(ls "$TMP" | grep partial)" ] || fail "n_air 1e300: a partial figure left: $(ls "$TMP")"
 "$THZ" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --model itu-p676 \
     --compare-model lines --h2o-lines "$TMP/huge.csv" \
     --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" --plot "$TMP/cmp.png" > "$TMP/out" 2> "$TMP/err"
