@@ -7,6 +7,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdint.h>
@@ -345,6 +346,25 @@ typedef struct mesh_job {
     int fd;
 } mesh_job;
 
+/* text into out with every `from` (the name assimp was given) replaced by `to` (the
+ * user's), cut to fit. */
+static void mesh_rename_in(const char *text, const char *from, const char *to, char *out,
+                           size_t size)
+{
+    size_t n = 0, from_len = strlen(from), to_len = strlen(to);
+    while (*text && n + 1 < size) {
+        if (strncmp(text, from, from_len) == 0) {
+            size_t k = to_len < size - 1 - n ? to_len : size - 1 - n;
+            memcpy(out + n, to, k);
+            n += k;
+            text += from_len;
+        } else {
+            out[n++] = *text++;
+        }
+    }
+    out[n] = '\0';
+}
+
 /* Imports job's bytes with assimp into mesh (triangulated, welded). In the child. */
 static thz_status mesh_import_assimp(const mesh_job *job, thz_mesh *mesh, thz_error *err)
 {
@@ -364,8 +384,9 @@ static thz_status mesh_import_assimp(const mesh_job *job, thz_mesh *mesh, thz_er
                              name);
     if (!sc) {
         const char *why = aiGetErrorString();
-        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot read as a mesh: %s", name,
-                             why && why[0] ? why : "unknown format");
+        char said[512];
+        mesh_rename_in(why && why[0] ? why : "unknown format", fake_name, name, said, sizeof said);
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot read as a mesh: %s", name, said);
     }
     size_t nv = 0, nt = 0;
     if (!sc->mRootNode || mesh_import_count(sc, sc->mRootNode, 0, &nv, &nt) != THZ_OK) {
@@ -435,6 +456,15 @@ static bool mesh_write_all(int fd, const void *p, size_t n)
 static thz_status mesh_import_child(void *arg, thz_error *err)
 {
     const mesh_job *job = arg;
+    /* what assimp prints (the assertion it fails before it aborts) is not the library's
+     * to say: the parent reports the failure (a sanitizer's report stays on stderr) */
+    int quiet = open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (quiet >= 0) {
+        dup2(quiet, STDOUT_FILENO);
+        if (!MESH_SANITIZED)
+            dup2(quiet, STDERR_FILENO);
+        close(quiet);
+    }
 #if !MESH_SANITIZED
     /* a format only assimp checks: a header that asks for more memory than the machine
      * has fails here, in the child, not in the machine's other processes. The limit is on
@@ -575,6 +605,16 @@ thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_
     snprintf(what, sizeof what, "importing the mesh %s", name);
     st = child_run(what, mesh_import_child, &job, 60.0 + 1e-6 * (double)size, err);
     free(data);
+    if (format == MESH_FORMAT_OTHER && (st == THZ_ERR_IO || st == THZ_ERR_INTERNAL)) {
+        /* assimp aborted or hung on a file thzmap does not check itself: the file's fault
+         * as far as the user can act on it */
+        char why[sizeof err->message];
+        snprintf(why, sizeof why, "%s", err->message);
+        st = thz_error_set(err, THZ_ERR_INPUT,
+                           "%s: assimp cannot import it (%s); check the file, or convert it to "
+                           "OBJ, PLY or STL, which thzmap checks before importing",
+                           name, why);
+    }
     if (st == THZ_OK)
         st = mesh_import_receive(fd, name, mesh, err);
     close(fd);

@@ -120,6 +120,14 @@ with open(sys.argv[1], "w") as f:
 PY
 check "60 000-index polygon" "$tmp/polygon60k.obj" 2 \
     "a polygon of 60000 vertices, more than the limit of 1024"
+# A format only assimp reads, on which it fails an assertion and aborts: bad input
+# (exit 2, the JSON path), not a failure of thzmap, and assimp's own line not printed.
+# (The sanitizer build keeps the importer's stderr for its reports, and that line too.)
+printf 'OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >"$tmp/faces_missing.off"
+if ((limit_ms == 1000)); then
+    check "an OFF file with fewer faces than it says" "$tmp/faces_missing.off" 2 \
+        "objects[1].shape.file: $tmp/faces_missing.off: assimp cannot import it"
+fi
 # An OBJ whose mtllib names a FIFO: the importer reads no file but the mesh itself.
 mkfifo "$tmp/materials.mtl"
 { echo "mtllib materials.mtl"; cat "$repo/tests/inputs/meshes/tetra.obj"; } >"$tmp/with_mtl.obj"
