@@ -11,9 +11,12 @@ Progress.__doc__ = """One progress report. `stage` is "prepare" (objects whose b
 sources are set up, once per run before the first channel's photons, where a deviation map
 needs them), "photons" (done/total photons of the channel), "render" (rows of a sensor) or
 "output" (0/1, then 1/1); `channel` is the 0-based index of the channel among
-`n_channels`."""
+`n_channels`. In `bands` the stage is "bands": `channel` is the render (the nominal one,
+then the nuisances'; `n_channels` the renders, 0 while the nominal one runs and their
+count is not known yet) and done/total its candidate channels."""
 
-_UNITS = {"prepare": "objects", "photons": "photons", "render": "rows", "output": "steps"}
+_UNITS = {"prepare": "objects", "photons": "photons", "render": "rows", "output": "steps",
+          "bands": "channels"}
 
 
 class _Bar:
@@ -33,7 +36,11 @@ class _Bar:
 
     def __call__(self, p):
         key = (p.stage, p.channel)
-        label = f"channel {p.channel + 1}/{p.n_channels} {p.stage}"
+        if p.stage == "bands":
+            of = f"/{p.n_channels}" if p.n_channels else " (nominal)"
+            label = f"bands: render {p.channel + 1}{of}"
+        else:
+            label = f"channel {p.channel + 1}/{p.n_channels} {p.stage}"
         if self._tqdm is not None:
             if key != self._key or p.done < self._bar.n or p.total != self._bar.total:
                 self.close()

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "analysis/bands_progress.h"
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/path.h"
@@ -449,6 +450,15 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     memset(v, 0, sizeof *v);
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
+    const double ranges[VAR_COUNT] = {0,
+                                      s->target_range_k,
+                                      s->ambient_range_k,
+                                      s->humidity_range,
+                                      s->thickness_range,
+                                      s->angle_range_deg};
+    bool any_range = false; /* else one render, the nominal one */
+    for (int what = VAR_TARGETS; what < VAR_COUNT; what++)
+        any_range = any_range || ranges[what] > 0.0;
     size_t n = s->n_candidates;
     v->n_candidates = n;
     v->coarse_paths = coarse_paths(s->paths_per_sample);
@@ -457,6 +467,8 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     if (!root)
         return thz_error_set(err, THZ_ERR_INPUT, "%s:%d:%d: %s", s->scene_path, jerr.line,
                              jerr.column, jerr.text);
+    bands_progress progress;
+    bands_progress_begin(&progress, ctx, any_range ? 0 : 1);
     char base_dir[THZ_PATH_MAX];
     snprintf(base_dir, sizeof base_dir, "%s", s->scene_path);
     char *slash = strrchr(base_dir, '/');
@@ -533,12 +545,18 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
      * the Monte Carlo noise out of d). These renders and the nominal one d is taken
      * against are coarse (coarse_paths). Each render's own truth gives its classes'
      * pixels: a turned sensor sees them elsewhere in the image. */
-    double ranges[VAR_COUNT] = {0,
-                                s->target_range_k,
-                                s->ambient_range_k,
-                                s->humidity_range,
-                                s->thickness_range,
-                                s->angle_range_deg};
+    size_t varied = 0; /* the renders, now that the classes say which ranges change any */
+    for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
+        if (!(ranges[what] > 0.0))
+            continue;
+        text = variant_text(root, s, is_class, what, true, &changed, NULL);
+        if (!text)
+            goto nomem;
+        free(text);
+        text = NULL;
+        varied += changed != 0;
+    }
+    bands_progress_renders(&progress, 1 + (varied ? varied + 1 : 0));
     for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
         if (!(ranges[what] > 0.0))
             continue;
@@ -593,6 +611,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
 nomem:
     st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
 done:
+    bands_progress_end(&progress);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     v->seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     free(text);

@@ -250,10 +250,11 @@ int cmd_bands(int argc, char **argv)
         return CLI_EXIT_FAILURE;
     }
     thz_context_set_threads(ctx, (int)threads);
-    /* Progress on a terminal only (a render line per candidate channel and nuisance
-     * would flood a log); the callback also carries Ctrl-C into the run. */
+    /* Progress by render (stage "bands": the nominal render, then the nuisances'), on a
+     * terminal redrawn, in a log a line as each ends; the callback also carries Ctrl-C
+     * into the run. */
     cli_progress progress;
-    cli_progress_init(&progress, CMD, quiet || !isatty(STDERR_FILENO));
+    cli_progress_init(&progress, CMD, quiet);
     thz_context_set_progress(ctx, cli_progress_report, &progress);
     thz_context_set_warning(ctx, cli_progress_warning, &progress);
     cli_signals_install();

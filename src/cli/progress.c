@@ -104,6 +104,8 @@ static const char *cli_stage_unit(const char *stage)
         return "rows";
     if (strcmp(stage, "prepare") == 0)
         return "objects";
+    if (strcmp(stage, "bands") == 0)
+        return "candidate channels";
     return "steps";
 }
 
@@ -114,6 +116,19 @@ static void cli_progress_draw_tty(cli_progress *p, const thz_progress *pr, doubl
     double rate = elapsed > 0.0 ? (double)pr->done / elapsed : 0.0;
     if (strcmp(pr->stage, "output") == 0) {
         fprintf(p->out, "\r\033[Kthzmap %s: writing the results", p->command);
+        fflush(p->out);
+        p->line_open = true;
+        return;
+    }
+    if (strcmp(pr->stage, "bands") == 0) { /* thz_bands_select: its renders, one by one */
+        char of[32] = " (nominal)";        /* the count of renders, once known */
+        if (pr->n_channels)
+            snprintf(of, sizeof of, "/%zu", pr->n_channels);
+        fprintf(p->out, "\r\033[Kthzmap %s: render %zu%s, %llu/%llu candidate channels (%.0f %%)",
+                p->command, pr->channel + 1, of, (unsigned long long)pr->done,
+                (unsigned long long)pr->total, 100.0 * frac);
+        if (rate > 0.0)
+            fprintf(p->out, ", %.3g channels/s", rate);
         fflush(p->out);
         p->line_open = true;
         return;
@@ -163,6 +178,15 @@ static void cli_progress_line(cli_progress *p, const thz_progress *pr, double no
     if (strcmp(pr->stage, "prepare") == 0) {
         fprintf(p->out, "thzmap %s: back-side sources: %llu objects in %.2f s\n", p->command,
                 (unsigned long long)pr->done, elapsed);
+        fflush(p->out);
+        return;
+    }
+    if (strcmp(pr->stage, "bands") == 0) {
+        char of[32] = " (nominal)";
+        if (pr->n_channels)
+            snprintf(of, sizeof of, "/%zu", pr->n_channels);
+        fprintf(p->out, "thzmap %s: render %zu%s: %llu candidate channels in %.2f s\n", p->command,
+                pr->channel + 1, of, (unsigned long long)pr->done, elapsed);
         fflush(p->out);
         return;
     }

@@ -110,11 +110,23 @@ static int serve_on_progress(void *user, const thz_progress *p)
         share = 1.0;
     if (strcmp(p->stage, "prepare") == 0) /* before the first channel */
         share = 0.0;
+    bool bands = strcmp(p->stage, "bands") == 0; /* channel: the render, nominal first */
+    if (bands) /* the nominal render about half the time, the nuisances' coarse ones the rest */
+        share = p->channel == 0 || p->n_channels < 2
+                    ? 0.5 * frac
+                    : 0.5 + 0.5 * ((double)(p->channel - 1) + frac) / (double)(p->n_channels - 1);
     /* with the unit of the stage's count (rows; the photons stage's is its name); the output
      * has no channel */
     char message[256];
     if (strcmp(p->stage, "output") == 0)
         snprintf(message, sizeof message, "writing the results");
+    else if (bands && p->n_channels == 0)
+        snprintf(message, sizeof message, "nominal render, %llu/%llu candidate channels",
+                 (unsigned long long)p->done, (unsigned long long)p->total);
+    else if (bands)
+        snprintf(message, sizeof message, "render %zu/%zu, %llu/%llu candidate channels",
+                 p->channel + 1, p->n_channels, (unsigned long long)p->done,
+                 (unsigned long long)p->total);
     else if (strcmp(p->stage, "prepare") == 0)
         snprintf(message, sizeof message, "preparing the back-side sources: %llu/%llu objects",
                  (unsigned long long)p->done, (unsigned long long)p->total);

@@ -21,6 +21,16 @@ for o in --count --from-thz --to-thz --step-ghz --targets --netd-k --humidity-ra
     grep -q -- "$o" "$TMP/help" || fail "--help does not describe $o"
 done
 
+# progress into a log (not a terminal): a line as each render ends, the nominal one
+# first, then the nuisances' renders counted (it printed nothing until the end)
+"$THZ" bands "$IN/features.json" -o "$TMP/log" --count 2 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 50 --paths 4 --threads 1 2> "$TMP/log.err" || fail "progress run exit status $?"
+grep -E '^thzmap bands: render ' "$TMP/log.err" | sed -E 's/ in [0-9.]+ s$//' > "$TMP/renders"
+printf '%s\n' "thzmap bands: render 1 (nominal): 17 candidate channels" \
+    "thzmap bands: render 2/3: 17 candidate channels" \
+    "thzmap bands: render 3/3: 17 candidate channels" | diff - "$TMP/renders" ||
+    fail "progress lines: $(cat "$TMP/log.err")"
+
 # features at 0.40 and 0.80 THz, candidates every 50 GHz from 0.2 to 1.0 THz
 "$THZ" bands "$IN/features.json" -o "$TMP/f" --count 2 --from-thz 0.2 --to-thz 1.0 \
     --step-ghz 50 --paths 4 -q --threads 1 || fail "features run exit status $?"

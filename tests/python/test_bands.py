@@ -72,6 +72,16 @@ def test_bands_equals_the_command(tmp_path, thzmap_binary):
         assert f"{f:.4g} THz (relative width {w:.3g})" in repr(sel), repr(sel)
 
 
+def test_bands_progress_counts_renders():
+    seen = []
+    thzmap.bands(FEATURES, 1, threads=1, progress=seen.append, **GRID)
+    assert {p.stage for p in seen} == {"bands"}
+    ends = [(p.channel, p.n_channels) for p in seen if p.done == p.total]
+    # the nominal render before the nuisances' count is known, then 2 of 3 and 3 of 3
+    assert ends == [(0, 0), (1, 3), (2, 3)], ends
+    assert all(p.total == 5 for p in seen)  # the candidates, 0.2 to 1.0 THz by 200 GHz
+
+
 def test_bands_takes_a_loaded_scene_and_targets():
     scene = thzmap.load_scene(FEATURES)
     sel = thzmap.bands(scene, 1, targets=["A", "B"], seed=3, **GRID)
