@@ -26,7 +26,9 @@
  * index << 1 | side, u32 the bounce count (low 16 bits) and the batch (bits 24-26). */
 #define PMF_RECORD_BYTES_V3 32u
 #define PMF_MAX_HEADER_BYTES (16u << 20)
-#define PMF_FRAME_HEADER_MAX 18u /* bytes: zstd's largest frame header */
+#define PMF_MAX_T0_K 1e6                    /* a scene's temperatures end there */
+#define PMF_MAX_PHOTONS ((uint64_t)1 << 53) /* photons.per_channel's bound */
+#define PMF_FRAME_HEADER_MAX 18u            /* bytes: zstd's largest frame header */
 
 /* The bytes of a record in a file of `version`. */
 static inline size_t pmf_record_bytes(uint32_t version)

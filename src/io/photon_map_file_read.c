@@ -337,9 +337,12 @@ static thz_status pmf_open_header(photon_map_file_stream *s, thz_error *err)
                                  : "");
     for (size_t c = 0; c < scene->n_channels; c++) {
         double t0_k = s->version == 1u ? 0.0 : get_f64(pmf_channel_words(s, c) + 160);
-        if (!(t0_k >= 0.0) || !isfinite(t0_k))
+        if (!(t0_k >= 0.0 && t0_k <= PMF_MAX_T0_K))
             return pmf_corrupt(r, "impossible reference temperature", err);
     }
+    uint64_t per_channel = get_u64(header + 48);
+    if (per_channel == 0 || per_channel > PMF_MAX_PHOTONS)
+        return pmf_corrupt(r, "impossible photon count", err);
     return THZ_OK;
 }
 
@@ -447,9 +450,18 @@ static thz_status pmf_next_records(photon_map_file_stream *s, bool keep, photon_
                                  r->path, n);
         st = s->version >= 4u ? pmf_read(r, *records, n * sizeof(photon_record), err)
                               : pmf_read_v3(r, *records, n, err);
-        for (size_t i = 0; st == THZ_OK && i < n; i++)
-            if (photon_object(&(*records)[i]) >= s->scene->n_objects)
+        for (size_t i = 0; st == THZ_OK && i < n; i++) {
+            const photon_record *q = &(*records)[i];
+            if (photon_object(q) >= s->scene->n_objects)
                 st = pmf_corrupt(r, "a photon names an object the scene does not have", err);
+            else if (!isfinite(q->position_m[0]) || !isfinite(q->position_m[1]) ||
+                     !isfinite(q->position_m[2]) || !isfinite(q->power_w_per_hz) ||
+                     !(q->freq_hz > 0.0f && isfinite(q->freq_hz)))
+                st = pmf_corrupt(r,
+                                 "a photon's position, power or frequency is impossible (not "
+                                 "finite, or a frequency <= 0)",
+                                 err);
+        }
         if (st != THZ_OK) {
             free(*records);
             *records = NULL;

@@ -548,6 +548,64 @@ static void test_forged_count(void **state)
     free(header);
 }
 
+/* Values no run writes, under valid checksums: a reference temperature of 1e300 K, a
+ * photon count of 0 or 2^64 - 1, a photon whose power or position is not a number.
+ * Each is refused (render wrote Inf and NaN images from them, with exit status 0). */
+static void test_forged_values(void **state)
+{
+    fixture *f = *state;
+    size_t hsize;
+    unsigned char *header = header_of(f, &hsize);
+    char bad[160];
+    snprintf(bad, sizeof bad, "%s/forged-values.thzpm", f->dir);
+    unsigned char saved[8];
+    unsigned char *t0 = header + 8 * 7 + 160; /* channel 0's T0 */
+    memcpy(saved, t0, 8);
+    const double hot = 1e300;
+    memcpy(t0, &hot, 8);
+    spit_with_header(f, bad, header, hsize, 0);
+    expect_refusal(bad, f->scene, THZ_ERR_INPUT, "impossible reference temperature");
+    memcpy(t0, saved, 8);
+    unsigned char *count = header + 48; /* photons per channel */
+    const uint64_t counts[2] = {0, UINT64_MAX};
+    for (size_t k = 0; k < 2; k++) {
+        for (int i = 0; i < 8; i++)
+            count[i] = (unsigned char)(counts[k] >> (8 * i));
+        spit_with_header(f, bad, header, hsize, 0);
+        expect_refusal(bad, f->scene, THZ_ERR_INPUT, "impossible photon count");
+    }
+    free(header);
+
+    size_t n;
+    unsigned char *buf = slurp(f->path, &n);
+    size_t h1 = ZSTD_findFrameCompressedSize(buf + 24, n - 24);
+    const unsigned char *frame = buf + 24 + h1;
+    size_t fsize = n - 24 - h1;
+    unsigned long long rsize = ZSTD_getFrameContentSize(frame, fsize);
+    photon_record *rec = malloc(rsize);
+    assert_int_equal(ZSTD_decompress(rec, rsize, frame, fsize), rsize);
+    size_t rcap = ZSTD_compressBound(rsize);
+    unsigned char *out = malloc(24 + h1 + rcap);
+    for (int what = 0; what < 3; what++) {
+        photon_record keep = rec[5];
+        if (what == 0)
+            rec[5].power_w_per_hz = NAN;
+        else if (what == 1)
+            rec[5].position_m[2] = INFINITY;
+        else
+            rec[5].freq_hz = -1.0f;
+        memcpy(out, buf, 24 + h1);
+        size_t total = 24 + h1 + compress_frame(out + 24 + h1, rcap, rec, rsize);
+        set_prefix(out, 0, total);
+        spit(bad, out, total);
+        expect_refusal(bad, f->scene, THZ_ERR_INPUT, "position, power or frequency");
+        rec[5] = keep;
+    }
+    free(out);
+    free(rec);
+    free(buf);
+}
+
 static void test_truncated(void **state)
 {
     fixture *f = *state;
@@ -609,6 +667,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_version_1, setup, teardown),
         cmocka_unit_test_setup_teardown(test_versions_2_and_3, setup, teardown),
         cmocka_unit_test_setup_teardown(test_corrupted, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_forged_values, setup, teardown),
         cmocka_unit_test_setup_teardown(test_truncated, setup, teardown),
         cmocka_unit_test_setup_teardown(test_forged_count, setup, teardown),
         cmocka_unit_test_setup_teardown(test_mismatched_scene, setup, teardown),
