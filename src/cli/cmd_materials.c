@@ -10,6 +10,7 @@
 
 #define CMD "materials"
 #define MAX_FREQUENCIES 64
+#define MAX_THZ 1000.0 /* far past any data; the models gave NaN at 1e200 THz and beyond */
 
 /* The frequencies of the description when --at-thz is not given, in THz. */
 static const double default_thz[] = {0.1, 0.3, 0.5, 1.0, 1.5, 2.0, 3.0};
@@ -29,7 +30,8 @@ static void print_help(void)
            "frequencies.\n"
            "\n"
            "options:\n"
-           "  --at-thz F1,F2,...   frequencies of the description in THz, each > 0\n"
+           "  --at-thz F1,F2,...   frequencies of the description in THz, each above 0 and\n"
+           "                       at most 1000\n"
            "                       (default 0.1,0.3,0.5,1,1.5,2,3)\n"
            "  -h, --help           this help\n");
 }
@@ -42,7 +44,7 @@ static bool parse_list(const char *text, double *out, size_t max, size_t *n)
     while (*p) {
         char *end = NULL;
         double v = strtod(p, &end);
-        if (end == p || !(v > 0.0) || !isfinite(v) || (*end && *end != ',') || *n == max)
+        if (end == p || !(v > 0.0 && v <= MAX_THZ) || (*end && *end != ',') || *n == max)
             return false;
         out[(*n)++] = v;
         p = *end ? end + 1 : end;
@@ -137,9 +139,9 @@ int cmd_materials(int argc, char **argv)
                 return cli_usage_error(CMD, "--at-thz needs a list of frequencies in THz");
             if (!parse_list(argv[++i], thz, MAX_FREQUENCIES, &n_thz))
                 return cli_usage_error(CMD,
-                                       "--at-thz: expected up to %d frequencies > 0 in THz, "
-                                       "separated by commas, got '%s'",
-                                       MAX_FREQUENCIES, argv[i]);
+                                       "--at-thz: expected up to %d frequencies above 0 and at "
+                                       "most %g THz, separated by commas, got '%s'",
+                                       MAX_FREQUENCIES, MAX_THZ, argv[i]);
         } else if (argv[i][0] == '-') {
             return cli_usage_error(CMD, "unknown option '%s'", argv[i]);
         } else if (name) {

@@ -88,6 +88,9 @@ expect_exit() { # expect_exit STATUS PATTERN ARGS...
 expect_exit 2 'no material "unobtainium"' unobtainium
 expect_exit 2 "unknown option '--bogus'" --bogus
 expect_exit 2 -- '--at-thz: expected' water --at-thz 1,-2
+# beyond 1000 THz refused (water printed a row of -nan at 1e308 THz, exit 0); 1000 is finite
+expect_exit 2 -- 'at most 1000 THz' water --at-thz 1e308
+"$thzmap" materials water --at-thz 1000 | grep -qi nan && fail "materials water at 1000 THz: NaN"
 expect_exit 2 'one material name at most' water ice
 "$thzmap" materials --help | grep -q '^usage: thzmap materials' || fail "materials --help"
 
