@@ -113,7 +113,7 @@ static thz_status stage_split(output_stage *stage, char **base, thz_error *err)
     if (!stage->parent || !*base)
         return stage_nomem(stage->outdir, err);
     if (!**base)
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot write results into the root directory",
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: cannot write results into the root directory",
                              stage->outdir);
     return THZ_OK;
 }

@@ -258,6 +258,10 @@ grep -q "^thzmap: $work/scene.json: the run would need" "$work/big.err" ||
 [ $? -eq 2 ] || fail "simulate without -o should exit 2"
 "$THZMAP" simulate "$work/scene.json" -o "$work/u" --integrator nonsense 2>/dev/null
 [ $? -eq 2 ] || fail "unknown integrator should exit 2"
+"$THZMAP" simulate "$work/scene.json" -o / --quiet 2> "$work/root.err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "cannot write results into the root directory" "$work/root.err" ||
+    fail "-o /: exit $rc, expected 2 (a usage error): $(cat "$work/root.err")"
 "$THZMAP" render "$work/scene.json" -o "$work/u" --photon-map "$work/t1/photon-map.thzpm" \
     --target-noise-k 0.1 --quiet 2> "$work/u.err"
 [ $? -eq 2 ] || fail "render: a noise target with photon-map should exit 2"
