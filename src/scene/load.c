@@ -458,7 +458,12 @@ static thz_status load_syntax_error(const char *label, const char *what, const j
         snprintf(is, sizeof is,
                  " (a number beyond what JSON's numbers hold here: whole numbers "
                  "up to 9223372036854775807, reals up to about 1.8e308)");
-    else if (je->position == 0 && je->line <= 1)
+    else if (json_error_code(je) == json_error_invalid_utf8)
+        snprintf(is, sizeof is,
+                 " (JSON is UTF-8 text: was the %s saved in another encoding, such as UTF-16?)",
+                 real ? "file" : "text");
+    else if (je->position == 0 && je->line <= 1 &&
+             json_error_code(je) == json_error_premature_end_of_input)
         snprintf(is, sizeof is, " (the %s is empty)", real ? "file" : "text");
     int column = load_token_column(je);
     if (je->line > 0) /* a column 0 (an empty file) is the line's first */

@@ -111,6 +111,15 @@ static thz_status load_normalize_floor(load_ctx *ctx, const load_cursor *c, doub
                      shown, LOAD_NORMALIZE_MAX_X, top * 1e-12, s->channels[at].name, LOAD_G(t_ref));
 }
 
+/* v divided by its largest component's magnitude (0 when v is 0), so that its length is
+ * finite however large or small the numbers given (a direction [0, 0, 1e308] is one). */
+static vec3 load_sensor_unscaled(const double v[3])
+{
+    double m = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
+    if (!(m > 0.0))
+        return v3(0.0, 0.0, 0.0);
+    return v3(v[0] / m, v[1] / m, v[2] / m);
+}
 static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t index, thz_sensor *sn)
 {
     static const char *const keys[] = {
@@ -152,8 +161,8 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
     }
     if (st != THZ_OK)
         return st;
-    vec3 dv = v3_from_array(d);
-    if (!(v3_length(dv) > 0.0) || !isfinite(v3_length(dv)))
+    vec3 dv = load_sensor_unscaled(d);
+    if (!(v3_length(dv) > 0.0))
         return load_fail(ctx, look.value ? &look : &dir,
                          look.value ? "the point to look at is the sensor's position (expected "
                                       "a different point)"
@@ -163,10 +172,10 @@ static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t ind
     st = load_vector(ctx, c, "up", 3, LOAD_ANY, false, up);
     if (st != THZ_OK)
         return st;
-    vec3 uv = v3_from_array(up);
+    vec3 uv = load_sensor_unscaled(up);
     load_cursor up_c = load_key(c, "up");
     double ul = v3_length(uv);
-    if (!(ul > 0.0) || !isfinite(ul))
+    if (!(ul > 0.0))
         return load_fail(ctx, &up_c, "expected a non-zero up vector");
     uv = v3_scale(uv, 1.0 / ul);
     if (v3_length(v3_cross(dv, uv)) < 1e-6)

@@ -394,6 +394,26 @@ static void test_refusals(void **state)
              "atmosphere.emitting: expected true or false");
 }
 
+/* A direction or up vector of huge (or tiny) components is that direction: it was
+ * refused as "non-zero" when its length overflowed. */
+static void test_sensor_vectors_of_any_scale(void **state)
+{
+    (void)state;
+    const char *scales[2] = {"1e308", "1e-300"};
+    for (int k = 0; k < 2; k++) {
+        char json[1024];
+        snprintf(json, sizeof json,
+                 HEAD CHANNELS MATERIALS OBJECT(
+                     BOX) "\"sensors\": [{\"name\": \"c\", \"position_m\": [0, -5, 0], "
+                          "\"direction\": [0, %s, 0], \"up\": [0, 0, %s], \"fov_deg\": 40, "
+                          "\"resolution\": [16, 8]}]}",
+                 scales[k], scales[k]);
+        thz_scene *s = load_ok(json);
+        assert_true(s->sensors[0].direction[1] == 1.0 && s->sensors[0].up[2] == 1.0);
+        thz_scene_destroy(s);
+    }
+}
+
 /* How many of the scene's warnings name `what` and the atmosphere's extent. */
 static size_t extent_warnings(const char *extent, const char *what)
 {
@@ -440,6 +460,7 @@ int main(void)
         cmocka_unit_test(test_sensor_model),
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_atmosphere_extent_warnings),
+        cmocka_unit_test(test_sensor_vectors_of_any_scale),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -56,6 +56,10 @@ CASES = [
      "file (the file is empty)"),
     # a UTF-8 byte-order mark is read past (RFC 8259): the document's own error follows
     ("syntax_bom", '\ufeff{"format": "thzmap-scene/1"}\n', "channels: missing key"),
+    # saved as UTF-16 (its byte-order mark first): not said to be empty, as it was
+    ("syntax_utf16", '{"format": "thzmap-scene/1"}\n'.encode("utf-16"),
+     "syntax_utf16.json:1:1: invalid JSON: unable to decode byte 0xff (JSON is UTF-8 text: was "
+     "the file saved in another encoding, such as UTF-16?)"),
     ("not_an_object", "[1, 2, 3]\n", "expected a JSON object"),
     ("format_missing", [(["format"], DELETE)], "format: missing key"),
     ("format_wrong", [(["format"], "thzmap-scene/2")], "format: expected \"thzmap-scene/1\""),
@@ -404,7 +408,7 @@ def main():
     rows = ["# file\texit status\tthe message must contain (written by make_bad_scenes.py)"]
     for name, edits, expect in CASES:
         path = os.path.join(HERE, name + ".json")
-        if isinstance(edits, str):
+        if isinstance(edits, (str, bytes)):
             text = edits
         else:
             doc = copy.deepcopy(BASE)
@@ -414,7 +418,7 @@ def main():
                     continue
                 setp(doc, p, v)
             text = json.dumps(doc, indent=2) + "\n"
-        with open(path, "w") as f:
+        with open(path, "wb" if isinstance(text, bytes) else "w") as f:
             f.write(text)
         rows.append("%s.json\t2\t%s" % (name, expect))
     with open(os.path.join(HERE, "..", "bad_scenes.tsv"), "w") as f:
