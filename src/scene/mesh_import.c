@@ -583,6 +583,13 @@ thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_
         st = file_check_regular(path, name, MESH_MAX_FILE_BYTES, &size, err);
     if (st == THZ_OK)
         st = mesh_import_read(path, name, (size_t)size, &data, err);
+    /* an OBJ saved with a UTF-8 byte-order mark: its first line is a 'v' line all the same
+     * (the check, and assimp, dropped it) */
+    if (st == THZ_OK && format == MESH_FORMAT_OBJ && size >= 3 &&
+        memcmp(data, "\xEF\xBB\xBF", 3) == 0) {
+        size -= 3;
+        memmove(data, data + 3, (size_t)size);
+    }
     if (st == THZ_OK)
         st = mesh_check(data, (size_t)size, format, name, NULL, err);
     if (st != THZ_OK) {

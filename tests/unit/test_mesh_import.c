@@ -82,6 +82,18 @@ static void test_formats(void **state)
     /* a format the mesh check does not cover, read by assimp alone (its node's
      * translation of 2 along z applied) */
     check_tetra(MESHES "tetra.gltf", 2.0);
+    /* an OBJ with a UTF-8 byte-order mark (its first 'v' line was dropped) */
+    char bom[] = "/tmp/thz-test-bom-XXXXXX.obj";
+    int fd = mkstemps(bom, 4);
+    assert_true(fd >= 0);
+    FILE *out = fdopen(fd, "wb");
+    assert_non_null(out);
+    fputs("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+          "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+          out);
+    fclose(out);
+    check_tetra(bom, 0);
+    unlink(bom);
 }
 
 static void test_quads(void **state)
