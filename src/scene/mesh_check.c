@@ -182,6 +182,28 @@ static thz_status obj_reference(mc_ctx *c, obj_counts *k, mc_span tok, uint64_t 
     return THZ_OK;
 }
 
+/* What may follow a vertex's x y z, as the importer reads it: nothing, a homogeneous
+ * w (it divides by it), or a colour r g b; a comment ends the line. */
+static thz_status obj_vertex_rest(mc_ctx *c, mc_where w, mc_span rest)
+{
+    double value[4] = {0, 0, 0, 0};
+    int n = 0;
+    mc_span tok;
+    while (mc_token(&rest, &tok, '\\') && tok.p[0] != '#') {
+        if (n == 4 || !mc_number(tok, &value[n]))
+            n = 5; /* not numbers, or too many */
+        else
+            n++;
+        if (n == 5)
+            break;
+    }
+    if (n == 2 || n >= 4)
+        return mc_fail(c, w, "expected 'v x y z', 'v x y z w' or 'v x y z r g b' (finite numbers)");
+    if (n == 1 && value[0] == 0.0)
+        return mc_fail(c, w, "a homogeneous w of 0 puts the vertex at infinity (expected w not 0)");
+    return THZ_OK;
+}
+
 static thz_status obj_check(mc_ctx *c, const char *data, size_t size)
 {
     thz_status st = mc_check_text(c, data, size, "a Wavefront OBJ file");
@@ -220,6 +242,8 @@ static thz_status obj_check(mc_ctx *c, const char *data, size_t size)
                     st = mc_fail(c, w, "expected %d finite numbers after '%s'", need,
                                  obj_kind[kind]);
             }
+            if (st == THZ_OK && kind == 0)
+                st = obj_vertex_rest(c, w, rest);
             k.defined[kind]++;
         } else if (mc_is(tok, "f") || mc_is(tok, "l") || mc_is(tok, "p")) {
             bool face = mc_is(tok, "f");

@@ -62,6 +62,11 @@ CASES = [
     ("obj_truncated_vertex.obj", OBJ[:9].encode(), ":2: expected 3 finite numbers after 'v'"),
     ("obj_truncated_faces.obj", (OBJ + "f 1 2 5\n").encode(),
      ":9: index 5, but the file has only 4 'v' lines"),
+    # what assimp refused with no line ("vertex index out of range", "Division by zero")
+    ("obj_vertex_five_numbers.obj", (OBJ + "v 0 0 0 1 2\n").encode(),
+     ":9: expected 'v x y z', 'v x y z w' or 'v x y z r g b'"),
+    ("obj_vertex_w_zero.obj", (OBJ + "v 0 1 0 0\n").encode(),
+     ":9: a homogeneous w of 0 puts the vertex at infinity"),
     ("obj_no_vertices.obj", b"# faces, no vertices\nf 1 2 3\n",
      ":2: index 3, but the file has only 0 'v' lines"),
     ("obj_huge_index.obj", (OBJ + "f 1 2 99999999999999999999\n").encode(),
