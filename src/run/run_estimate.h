@@ -2,7 +2,9 @@
  * rendered sensor (at most RUN_PILOT_SIDE^2 pixels, one sample each, pass 0 twice, the
  * second timed) and, for the integrators that need photons, a pilot photon phase of
  * RUN_PILOT_PHOTONS (or the run's photons, if fewer): on channel 0 alone without a noise
- * target, for every channel with one. Time per path sample (or gather sample) and per photon
+ * target, for every channel with one; photon-map's towards a target fires a pass's
+ * photons (at most RUN_PILOT_PHOTONS_PASSES), and its noise is scaled to the sensor's
+ * pixels from the pilot's larger ones. Time per path sample (or gather sample) and per photon
  * (the emission table once), times the run's counts, gives the time; with a noise target
  * the pilot's 95th percentile of the standard error, scaled as 1/sqrt(samples), gives the
  * channel's passes. An estimate, not a promise.
@@ -20,6 +22,8 @@
 
 #define RUN_PILOT_SIDE 32u
 #define RUN_PILOT_PHOTONS 20000u
+/* photon-map's pilot towards a noise target: a pass's photons, at most this many */
+#define RUN_PILOT_PHOTONS_PASSES 1000000u
 
 typedef struct run_estimate_input {
     const thz_scene *scene;
