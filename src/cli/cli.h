@@ -37,9 +37,14 @@ bool cli_is_help(const char *arg);
 /* The option argv[*i] when it takes a value: -1 after setting *value to argv[*i + 1]
  * and moving *i past it, when argv[*i] is one of with_value (NULL-terminated);
  * otherwise the usage exit status after saying why (an unknown option, an unexpected
- * argument, or an option without its value). */
+ * argument, an option without its value, or one given twice). */
 int cli_option_value(const char *command, int argc, char **argv, int *i,
                      const char *const *with_value, char **value);
+
+/* -1 when the option argv[i] (one that takes a value) is not among argv[1 .. i - 1],
+ * else the usage exit status after saying it was given twice (the last one won, silently:
+ * `-o a -o b` wrote to b). */
+int cli_refuse_repeat(const char *command, char **argv, int i);
 
 /* True if an option's value looks like an option itself ("-o -q": a forgotten value):
  * anything from "-" and a letter or "--" on; "-" alone and negative numbers are values. */

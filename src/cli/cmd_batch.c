@@ -172,6 +172,8 @@ static int batch_parse(int argc, char **argv, const char **seq_path, const char 
             return CLI_EXIT_OK;
         }
         if (!strcmp(arg, "-o") || !strcmp(arg, "--output") || !strcmp(arg, "--threads")) {
+            if (cli_refuse_repeat("batch", argv, i) != -1)
+                return CLI_EXIT_USAGE;
             if (i + 1 >= argc)
                 return cli_usage_error("batch", "%s needs a value", arg);
             if (cli_looks_like_option(argv[i + 1]))

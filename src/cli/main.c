@@ -77,6 +77,20 @@ bool cli_is_help(const char *arg)
     return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
 }
 
+/* "-o" and "--output" are one option. */
+static const char *cli_option_name(const char *a)
+{
+    return strcmp(a, "--output") == 0 ? "-o" : a;
+}
+
+int cli_refuse_repeat(const char *cmd, char **argv, int i)
+{
+    for (int j = 1; j < i; j++)
+        if (strcmp(cli_option_name(argv[j]), cli_option_name(argv[i])) == 0)
+            return cli_usage_error(cmd, "%s given twice (give each option once)", argv[i]);
+    return -1;
+}
+
 int cli_option_value(const char *cmd, int argc, char **argv, int *i, const char *const *with_value,
                      char **value)
 {
@@ -87,6 +101,8 @@ int cli_option_value(const char *cmd, int argc, char **argv, int *i, const char 
     if (!known)
         return cli_usage_error(cmd,
                                a[0] == '-' ? "unknown option '%s'" : "unexpected argument '%s'", a);
+    if (cli_refuse_repeat(cmd, argv, *i) != -1)
+        return CLI_EXIT_USAGE;
     if (*i + 1 >= argc)
         return cli_usage_error(cmd, "%s needs a value", a);
     if (cli_looks_like_option(argv[*i + 1]))

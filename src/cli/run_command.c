@@ -99,6 +99,8 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
                          strcmp(arg, "--ply-max-points") == 0)) ||
             (render && (strcmp(arg, "--photon-map") == 0 || strcmp(arg, "--sensor") == 0));
         if (takes_value) {
+            if (cli_refuse_repeat(cmd, argv, i) != -1)
+                return CLI_EXIT_USAGE;
             if (i + 1 >= argc)
                 return cli_usage_error(cmd, "%s needs a value", arg);
             const char *val = argv[++i];

@@ -182,24 +182,41 @@ static thz_status obj_reference(mc_ctx *c, obj_counts *k, mc_span tok, uint64_t 
     return THZ_OK;
 }
 
-/* What may follow a vertex's x y z, as the importer reads it: nothing, a homogeneous
- * w (it divides by it), or a colour r g b; a comment ends the line. */
-static thz_status obj_vertex_rest(mc_ctx *c, mc_where w, mc_span rest)
+/* Whether assimp counts tok among a line's numbers: it starts with a digit or a sign
+ * (".5" is not counted; "#" and words are not). */
+static bool obj_numeric_looking(mc_span tok)
 {
-    double value[4] = {0, 0, 0, 0};
-    int n = 0;
-    mc_span tok;
-    while (mc_token(&rest, &tok, '\\') && tok.p[0] != '#') {
-        if (n == 4 || !mc_number(tok, &value[n]))
-            n = 5; /* not numbers, or too many */
-        else
-            n++;
-        if (n == 5)
-            break;
+    char ch = tok.p[0];
+    return (ch >= '0' && ch <= '9') || ch == '-' || ch == '+';
+}
+
+/* A 'v' line as the importer reads it: it counts the tokens that look like numbers on
+ * the line, comments and words included, takes 3 (x y z), 4 (x y z w, divided by w) or 6
+ * (x y z r g b), and then reads that many tokens from the start, each a number. Anything
+ * else it refused with no line ("vertex index out of range", "Division by zero",
+ * "Cannot parse string"), or it silently took fewer. */
+static thz_status obj_vertex(mc_ctx *c, mc_where w, mc_span rest)
+{
+    mc_span all = rest, tok;
+    int counted = 0;
+    while (mc_token(&all, &tok, '\\'))
+        counted += obj_numeric_looking(tok);
+    if (counted != 3 && counted != 4 && counted != 6)
+        return mc_fail(c, w,
+                       "expected 'v x y z', 'v x y z w' or 'v x y z r g b' (numbers that start "
+                       "with a digit or a sign, 0.5 not .5; a comment on its own line), found "
+                       "%d such numbers",
+                       counted);
+    double value = 0.0;
+    for (int k = 0; k < counted; k++) {
+        mc_token(&rest, &tok, '\\');
+        if (!obj_numeric_looking(tok) || !mc_number(tok, &value))
+            return mc_fail(c, w,
+                           "expected %d finite numbers after 'v' (0.5 not .5; a comment on its "
+                           "own line)",
+                           counted);
     }
-    if (n == 2 || n >= 4)
-        return mc_fail(c, w, "expected 'v x y z', 'v x y z w' or 'v x y z r g b' (finite numbers)");
-    if (n == 1 && value[0] == 0.0)
+    if (counted == 4 && (float)value == 0.0f)
         return mc_fail(c, w, "a homogeneous w of 0 puts the vertex at infinity (expected w not 0)");
     return THZ_OK;
 }
@@ -235,15 +252,15 @@ static thz_status obj_check(mc_ctx *c, const char *data, size_t size)
         if (mc_is(tok, "v") || mc_is(tok, "vt") || mc_is(tok, "vn")) {
             int kind = mc_is(tok, "v") ? 0 : mc_is(tok, "vt") ? 1 : 2;
             int need = kind == 1 ? 1 : 3;
-            for (int i = 0; i < need && st == THZ_OK; i++) {
+            if (kind == 0)
+                st = obj_vertex(c, w, rest);
+            for (int i = 0; i < need && st == THZ_OK && kind != 0; i++) {
                 mc_span num;
                 double v;
                 if (!mc_token(&rest, &num, '\\') || !mc_number(num, &v))
                     st = mc_fail(c, w, "expected %d finite numbers after '%s'", need,
                                  obj_kind[kind]);
             }
-            if (st == THZ_OK && kind == 0)
-                st = obj_vertex_rest(c, w, rest);
             k.defined[kind]++;
         } else if (mc_is(tok, "f") || mc_is(tok, "l") || mc_is(tok, "p")) {
             bool face = mc_is(tok, "f");

@@ -59,7 +59,9 @@ OBJ = "".join(f"v {x} {y} {z}\n" for x, y, z in V) + \
 CASES = [
     # Wavefront OBJ
     ("obj_empty.obj", b"", "the file is empty"),
-    ("obj_truncated_vertex.obj", OBJ[:9].encode(), ":2: expected 3 finite numbers after 'v'"),
+    ("obj_truncated_vertex.obj", OBJ[:9].encode(),
+     ":2: expected 'v x y z', 'v x y z w' or 'v x y z r g b' (numbers that start with a digit "
+     "or a sign, 0.5 not .5; a comment on its own line), found 0 such numbers"),
     ("obj_truncated_faces.obj", (OBJ + "f 1 2 5\n").encode(),
      ":9: index 5, but the file has only 4 'v' lines"),
     # what assimp refused with no line ("vertex index out of range", "Division by zero")
@@ -83,7 +85,11 @@ CASES = [
      ":9: expected at most three indices in '1/2/3/4'"),
     ("obj_texture_index.obj", (OBJ + "vt 0 0\nf 1/1 2/2 3/1\n").encode(),
      ":10: index 2, but the file has only 1 'vt' lines"),
-    ("obj_nan_vertex.obj", b"v nan 0 0\n", ":1: expected 3 finite numbers after 'v'"),
+    ("obj_nan_vertex.obj", b"v nan 0 0\n", ":1: expected 'v x y z'"),
+    ("obj_inf_vertex.obj", b"v 0 0 1e999\n", ":1: expected 3 finite numbers after 'v'"),
+    # a comment after the numbers is read as numbers by the importer ('Cannot parse "#"')
+    ("obj_vertex_comment.obj", (OBJ + "v 0 0 0 # from Blender 2\n").encode(),
+     ":9: expected 4 finite numbers after 'v'"),
     ("obj_binary.obj", b"v 0 0 0\n\x00\x01\x02garbage", "byte 8: a NUL byte"),
     # PLY
     ("ply_empty.ply", b"", "the file is empty"),
