@@ -262,6 +262,13 @@ grep -q "^thzmap: $work/scene.json: the run would need" "$work/big.err" ||
 rc=$?
 [ $rc -eq 2 ] && grep -q "cannot write results into the root directory" "$work/root.err" ||
     fail "-o /: exit $rc, expected 2 (a usage error): $(cat "$work/root.err")"
+# an option given twice is refused (the last one won, silently), -o and --output alike
+"$THZMAP" simulate "$work/scene.json" -o "$work/twice1" --output "$work/twice2" --quiet \
+    2> "$work/twice.err"
+rc=$?
+[ $rc -eq 2 ] && grep -q -- "--output given twice" "$work/twice.err" &&
+    [ ! -e "$work/twice1" ] && [ ! -e "$work/twice2" ] ||
+    fail "-o twice: exit $rc, expected 2 and nothing written: $(cat "$work/twice.err")"
 "$THZMAP" render "$work/scene.json" -o "$work/u" --photon-map "$work/t1/photon-map.thzpm" \
     --target-noise-k 0.1 --quiet 2> "$work/u.err"
 [ $? -eq 2 ] || fail "render: a noise target with photon-map should exit 2"
