@@ -266,16 +266,20 @@ static int api_span_order(const void *a, const void *b)
 }
 
 /* The merged map's ranges: the union of the parts', refused where two overlap in a
- * channel (its photons would count twice); none when a part does not know its ranges. */
+ * channel (its photons would count twice). The parts that know their ranges are checked
+ * among themselves however many do not; the merged map knows its ranges only when every
+ * part knows its own. */
 static thz_status api_merge_spans(const thz_photons *const *parts, size_t n, thz_photons *ph,
                                   thz_error *err)
 {
     size_t total = 0;
+    bool all_known = true;
     for (size_t i = 0; i < n; i++) {
-        if (parts[i]->n_spans == 0)
-            return THZ_OK;
+        all_known = all_known && parts[i]->n_spans > 0;
         total += parts[i]->n_spans;
     }
+    if (total == 0)
+        return THZ_OK;
     api_photon_span *s = thz_calloc(total, sizeof *s);
     if (!s)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for merging photon maps");
@@ -300,7 +304,7 @@ static thz_status api_merge_spans(const thz_photons *const *parts, size_t n, thz
         else
             s[m++] = s[k];
     }
-    if (st != THZ_OK) {
+    if (st != THZ_OK || !all_known) {
         free(s);
         return st;
     }

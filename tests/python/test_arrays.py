@@ -113,7 +113,7 @@ def test_photon_map_save_load_render(tiny_dir, thzmap_binary):
     assert_bitwise_equal(by_path.image(0).power, rendered.image(0).power, "power")
 
 
-def test_fire_and_merge(tiny_dir):
+def test_fire_and_merge(tiny_dir, tmp_path):
     scene = thzmap.load_scene(tiny_dir / "scene.json")
     a = thzmap.fire_photons(scene, photons=1500, seed=SEED)
     b = thzmap.fire_photons(scene, photons=1500, seed=SEED, first_photon=1500)
@@ -133,6 +133,14 @@ def test_fire_and_merge(tiny_dir):
     with pytest.raises(thzmap.Error, match=r"channel 0 \(photons 0 to 2999, and 3000 photons "
                        r"from 0\)"):
         thzmap.merge_photon_maps([full, merged])
+    # a part that does not know its range (a loaded map) hides no overlap of the others
+    b.save(tmp_path / "b.thzpm")
+    loaded = thzmap.load_photon_map(scene, tmp_path / "b.thzpm")
+    again = thzmap.fire_photons(scene, photons=1500, seed=SEED)  # a's photons
+    with pytest.raises(thzmap.Error, match=r"channel 0 \(photons 0 to 1499, and 1500 photons "
+                       r"from 0\)"):
+        thzmap.merge_photon_maps([a, again, loaded])
+    assert [s.fired for s in thzmap.merge_photon_maps([a, loaded]).stats] == [3000, 3000]
     with pytest.raises(thzmap.ArgumentError, match="sequence of PhotonMap"):
         thzmap.merge_photon_maps(a)
     assert thzmap.render(scene, merged).image("cam").radiance.shape == (12, 20, 2)
