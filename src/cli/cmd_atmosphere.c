@@ -2,6 +2,7 @@
  * PLplot figure (attenuation in dB/km on a log axis against frequency in THz, with
  * the channels of a scene marked). */
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -168,14 +169,25 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
     return CLI_EXIT_OK;
 }
 
+/* The file beside `plot` the figure is drawn into; false when the name does not fit
+ * (then partial is ""). */
+static bool plot_partial_name(const char *plot, char *partial, size_t size)
+{
+    int n = snprintf(partial, size, "%s.%ld.partial.png", plot, (long)getpid());
+    if (n < 0 || (size_t)n >= size) {
+        partial[0] = '\0';
+        return false;
+    }
+    return true;
+}
+
 /* Draws the figure into a file beside plot->path and renames it over that: a failure
  * leaves the file that was there (or none). Signals wait until the figure is whole or
  * gone, so that none leaves the partial file behind. */
 static thz_status draw_plot_whole(const thz_atm_plot *plot, thz_error *err)
 {
     char partial[4096];
-    int n = snprintf(partial, sizeof partial, "%s.%ld.partial.png", plot->path, (long)getpid());
-    if (n < 0 || (size_t)n >= sizeof partial) {
+    if (!plot_partial_name(plot->path, partial, sizeof partial)) {
         err->status = THZ_ERR_INPUT;
         snprintf(err->message, sizeof err->message, "--plot %s: the name is too long", plot->path);
         return err->status;
@@ -190,6 +202,13 @@ static thz_status draw_plot_whole(const thz_atm_plot *plot, thz_error *err)
     thz_atm_plot into = *plot;
     into.path = partial;
     thz_status st = thz_atm_draw_plot(&into, err);
+    char *at = st != THZ_OK ? strstr(err->message, partial) : NULL;
+    if (at) { /* the message names the figure, not the file it was drawn into */
+        char said[sizeof err->message];
+        snprintf(said, sizeof said, "%.*s%s%s", (int)(at - err->message), err->message, plot->path,
+                 at + strlen(partial));
+        snprintf(err->message, sizeof err->message, "%s", said);
+    }
     if (st == THZ_OK && rename(partial, plot->path) != 0) {
         err->status = st = THZ_ERR_IO;
         snprintf(err->message, sizeof err->message, "--plot %s: cannot replace: %s", plot->path,
@@ -348,6 +367,22 @@ int cmd_atmosphere(int argc, char **argv)
         fclose(f);
         if (!existed)
             unlink(o.plot);
+        /* and the file the figure is drawn into beside it (draw_plot_whole) */
+        char partial[4096];
+        int fd = -1;
+        if (plot_partial_name(o.plot, partial, sizeof partial))
+            fd = open(partial, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+        if (fd < 0) {
+            err.status = THZ_ERR_INPUT;
+            snprintf(err.message, sizeof err.message,
+                     "--plot %s: cannot create a file beside it (the figure is drawn there, "
+                     "then renamed): %s",
+                     o.plot, partial[0] ? strerror(errno) : "the name is too long");
+            rc = cli_fail(&err);
+            goto cleanup;
+        }
+        close(fd);
+        unlink(partial);
     }
 
     double step_thz = o.step_ghz * 1e-3;
