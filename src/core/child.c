@@ -170,8 +170,9 @@ static void child_kill(child_proc *c)
 /* Waits for a started child (killed at its deadline, or when cancelled) and returns its
  * status. */
 static thz_status child_finish(const char *what, child_proc *c, double timeout_s, double *paused_s,
-                               const cancel_check *cancel, thz_error *err)
+                               const cancel_check *cancel, bool *crashed, thz_error *err)
 {
+    *crashed = false;
     thz_error report;
     memset(&report, 0, sizeof report);
     size_t got = 0;
@@ -188,6 +189,8 @@ static thz_status child_finish(const char *what, child_proc *c, double timeout_s
     while (waitpid(c->pid, &ws, 0) < 0 && errno == EINTR) {
     }
 
+    *crashed = timed_out || WIFSIGNALED(ws) || got != sizeof report || !WIFEXITED(ws) ||
+               WEXITSTATUS(ws) != 0;
     if (timed_out)
         return thz_error_set(err, THZ_ERR_IO, "failed while %s: no result after %.0f s (stopped)",
                              what, timeout_s);
@@ -207,14 +210,35 @@ static thz_status child_finish(const char *what, child_proc *c, double timeout_s
     return thz_error_set(err, report.status, "%s", report.message);
 }
 
+static thz_status child_run_group_crash(const char *const *whats, child_fn fn, void *const *args,
+                                        size_t n, double timeout_s, const cancel_check *cancel,
+                                        bool *crashed, thz_error *err);
+
 thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err)
 {
-    return child_run_group(&what, fn, &arg, 1, timeout_s, NULL, err);
+    bool crashed;
+    return child_run_group_crash(&what, fn, &arg, 1, timeout_s, NULL, &crashed, err);
+}
+
+thz_status child_run_crash(const char *what, child_fn fn, void *arg, double timeout_s,
+                           bool *crashed, thz_error *err)
+{
+    return child_run_group_crash(&what, fn, &arg, 1, timeout_s, NULL, crashed, err);
 }
 
 thz_status child_run_group(const char *const *whats, child_fn fn, void *const *args, size_t n,
                            double timeout_s, const cancel_check *cancel, thz_error *err)
 {
+    bool crashed;
+    return child_run_group_crash(whats, fn, args, n, timeout_s, cancel, &crashed, err);
+}
+
+/* child_run_group, and *crashed: whether its failure is a child's crash or time-out. */
+static thz_status child_run_group_crash(const char *const *whats, child_fn fn, void *const *args,
+                                        size_t n, double timeout_s, const cancel_check *cancel,
+                                        bool *crashed, thz_error *err)
+{
+    *crashed = false;
     if (n == 0)
         return THZ_OK;
     if (n > CHILD_GROUP_MAX)
@@ -241,7 +265,8 @@ thz_status child_run_group(const char *const *whats, child_fn fn, void *const *a
     for (size_t i = 0; i < started; i++) {
         thz_error e;
         memset(&e, 0, sizeof e);
-        thz_status s = child_finish(whats[i], &procs[i], timeout_s, &paused_s, cancel, &e);
+        bool died = false;
+        thz_status s = child_finish(whats[i], &procs[i], timeout_s, &paused_s, cancel, &died, &e);
         if (s == THZ_ERR_CANCELLED) { /* the others too, at once */
             for (size_t j = i + 1; j < started; j++)
                 child_kill(&procs[j]);
@@ -251,6 +276,7 @@ thz_status child_run_group(const char *const *whats, child_fn fn, void *const *a
         }
         if (s != THZ_OK && st == THZ_OK) {
             st = s;
+            *crashed = died;
             if (err)
                 *err = e;
         }

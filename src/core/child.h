@@ -10,6 +10,8 @@
 #ifndef THZ_CORE_CHILD_H
 #define THZ_CORE_CHILD_H
 
+#include <stdbool.h>
+
 #include "core/cancel.h"
 #include "core/error.h"
 
@@ -27,6 +29,12 @@ typedef thz_status (*child_fn)(void *arg, thz_error *err);
  * of OpenMP threads: libgomp's pool is the parent's, whose threads the child lacks, and a
  * team of two waits for them for ever (a team of one, an `if` clause's, runs). */
 thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err);
+
+/* child_run, and *crashed: true when it failed because the child died from a signal,
+ * ended without reporting, or ran past timeout_s (the work's own failure, not one of
+ * starting the child or of the system around it). */
+thz_status child_run_crash(const char *what, child_fn fn, void *arg, double timeout_s,
+                           bool *crashed, thz_error *err);
 
 /* At most this many children in a group. */
 #define CHILD_GROUP_MAX 64

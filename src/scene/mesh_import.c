@@ -610,11 +610,13 @@ thz_status mesh_import(const char *path, const char *label, thz_mesh *mesh, thz_
     job.fd = fd;
     char what[256];
     snprintf(what, sizeof what, "importing the mesh %s", name);
-    st = child_run(what, mesh_import_child, &job, 60.0 + 1e-6 * (double)size, err);
+    bool crashed = false;
+    st = child_run_crash(what, mesh_import_child, &job, 60.0 + 1e-6 * (double)size, &crashed, err);
     free(data);
-    if (format == MESH_FORMAT_OTHER && (st == THZ_ERR_IO || st == THZ_ERR_INTERNAL)) {
+    if (format == MESH_FORMAT_OTHER && crashed) {
         /* assimp aborted or hung on a file thzmap does not check itself: the file's fault
-         * as far as the user can act on it */
+         * as far as the user can act on it (a child that could not start, or a full disk,
+         * stays the system's failure) */
         char why[sizeof err->message];
         snprintf(why, sizeof why, "%s", err->message);
         st = thz_error_set(err, THZ_ERR_INPUT,
