@@ -289,7 +289,9 @@ THZ_API thz_status thz_output_add_image(thz_output *output, const thz_image *ima
 /* Adds a file of the caller's (`name`: a plain file name, no '/') holding `size` bytes
  * of `data` (may be NULL when size is 0), committed with the rest (e.g. a batch frame's
  * frame.json). THZ_ERR_INPUT when the output holds that name already (added before, or
- * one of an added run's files, such as summary.json): nothing is replaced. */
+ * one of an added run's files, such as summary.json): nothing is replaced. Add a run
+ * first: thz_output_add_run writes its files over any of the same names. A failed write
+ * removes the file, so that it may be added again. */
 THZ_API thz_status thz_output_add_file(thz_output *output, const char *name, const void *data,
                                        size_t size, thz_error *err);
 /* Once committed, the output takes nothing more: thz_output_commit again and the

@@ -81,7 +81,10 @@ THZ_API const char *thz_status_name(thz_status status);
  * then 1/1). A channel's
  * "photons" and "render" first report done = 0 when they start (a clock of the stage
  * starts there, as summary.json's photon_phase_s and render_s do); each further render
- * pass, and each further sensor, reports its rows from 0 again. */
+ * pass, and each further sensor, reports its rows from 0 again. thz_bands_select reports
+ * "bands" alone: `channel` is the render (the nominal one, then the nuisances'),
+ * `n_channels` the renders (0 until their count is known), done/total its candidate
+ * channels. */
 typedef struct thz_progress {
     const char *stage;
     size_t channel; /* index of the channel being processed */

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "api/api.h"
 #include "core/alloc.h"
@@ -198,6 +199,8 @@ thz_status thz_output_add_file(thz_output *output, const char *name, const void 
         why = errno ? errno : EIO;
     if (fclose(f) != 0 && !why)
         why = errno ? errno : EIO;
+    if (why)
+        unlink(path); /* a retry may add it again */
     return why ? thz_error_set(err, THZ_ERR_IO, "%s: cannot write: %s", path, strerror(why))
                : THZ_OK;
 }

@@ -112,7 +112,8 @@ static int serve_on_progress(void *user, const thz_progress *p)
         share = 0.0;
     bool bands = strcmp(p->stage, "bands") == 0; /* channel: the render, nominal first */
     if (bands) /* the nominal render about half the time, the nuisances' coarse ones the rest */
-        share = p->channel == 0 || p->n_channels < 2
+        share = p->n_channels == 1 ? frac /* no nuisances: the nominal render alone */
+                : p->channel == 0 || p->n_channels < 2
                     ? 0.5 * frac
                     : 0.5 + 0.5 * ((double)(p->channel - 1) + frac) / (double)(p->n_channels - 1);
     /* with the unit of the stage's count (rows; the photons stage's is its name); the output
