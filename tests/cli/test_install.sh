@@ -70,11 +70,30 @@ for h in "$repo"/include/thzmap/*.h; do
 done
 [[ -f $lib/pkgconfig/thzmap.pc ]] || fail "no lib/pkgconfig/thzmap.pc"
 # the docs the headers, the man page and the Python package name as docs/
-for d in "$repo"/docs/*.md README.md; do
-    [[ $d == README.md ]] && d=$repo/README.md
-    cmp -s "$d" "$P/share/doc/thzmap/$(basename "$d")" || fail "$(basename "$d") not installed under share/doc/thzmap"
+for d in "$repo"/docs/*.md; do
+    cmp -s "$d" "$P/share/doc/thzmap/docs/$(basename "$d")" || fail "$(basename "$d") not installed under share/doc/thzmap/docs"
 done
-[[ -e $P/share/doc/thzmap/thzmap.1 ]] && fail "the man page is also under share/doc/thzmap"
+cmp -s "$repo/README.md" "$P/share/doc/thzmap/README.md" || fail "README.md not installed under share/doc/thzmap"
+[[ -e $P/share/doc/thzmap/docs/thzmap.1 ]] && fail "the man page is also under share/doc/thzmap/docs"
+# every relative link of the installed documents leads to an installed file
+/usr/bin/python3 - "$P/share/doc/thzmap" <<'PY' || fail "installed documents link to files not installed"
+import os, re, sys
+root, bad = sys.argv[1], []
+for d, _, files in os.walk(root):
+    for f in files:
+        if not f.endswith(".md"):
+            continue
+        text = open(os.path.join(d, f), encoding="utf-8").read()
+        text = re.sub(r"```.*?```", "", text, flags=re.S)  # code blocks hold no links
+        for target in re.findall(r"\]\(([^)\s]+)\)", text):
+            if re.match(r"[a-z]+:", target) or target.startswith("#"):
+                continue
+            path = os.path.normpath(os.path.join(d, target.split("#")[0]))
+            if not os.path.exists(path):
+                bad.append(f"{os.path.relpath(os.path.join(d, f), root)}: {target}")
+print("\n".join(bad), file=sys.stderr)
+sys.exit(1 if bad else 0)
+PY
 (cd "$repo/data" && find . -type f) | sort >"$tmp/data.list"
 [[ -s $tmp/data.list ]] || fail "the repository has no data/ files"
 while read -r f; do
