@@ -1,4 +1,5 @@
-/* thzmap simulate SCENE.json -o OUTDIR: fire photons and render every sensor. */
+/* thzmap simulate SCENE.json -o OUTDIR: render every sensor (after the photon phase for the
+ * integrators that need one). */
 #include "cli.h"
 #include "run_command.h"
 

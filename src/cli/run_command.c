@@ -18,7 +18,8 @@ static void cli_run_usage(FILE *f, bool render)
 {
     if (!render)
         fprintf(f, "usage: thzmap simulate SCENE.json -o OUTDIR [options]\n\n"
-                   "Fires photons and renders every sensor of the scene; writes the images,\n"
+                   "Renders every sensor of the scene (photon-map and final-gather fire their\n"
+                   "photons first; path, the default, fires none); writes the images,\n"
                    "previews and summary.json into OUTDIR (created if missing).\n\n"
                    "options:\n"
                    "  -o, --output OUTDIR   where the results go (required)\n"
