@@ -21,7 +21,8 @@ typedef struct command {
 static const command commands[] = {
     {"validate", cmd_validate, "check a scene; print its geometry and emitted power per channel",
      false},
-    {"simulate", cmd_simulate, "render every sensor of a scene (firing photons first if needed)", true},
+    {"simulate", cmd_simulate, "render every sensor of a scene (firing photons first if needed)",
+     true},
     {"render", cmd_render, "re-render sensors of a scene from a saved photon map", true},
     {"atmosphere", cmd_atmosphere, "print the atmosphere's attenuation against frequency", false},
     {"batch", cmd_batch, "run a sequence of frames (keyframes, sweeps) and make movies", true},
