@@ -117,6 +117,8 @@ def audit_fixes(driver, wait, patient, by_id, click_list, field, root):
     Select(field("objects[1].type").find_element(By.TAG_NAME, "select")).select_by_value("shell")
     wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, '.field[data-path="objects[1].thickness_m"]'))
     log("a shell shows its thickness")
+    click_list("files", "path.json")  # opened again: that edit dropped (a run reads the file)
+    wait.until(lambda d: "unsaved" not in (by_id("scene-path").get_attribute("class") or ""))
     # Run: the scene open is path.json (the path integrator): no map to save, none to read
     by_id("tab-run").click()
     wait.until(lambda d: by_id("run-scene").get_attribute("value") == "teraeye/path.json")
@@ -204,6 +206,51 @@ def audit_fixes(driver, wait, patient, by_id, click_list, field, root):
               and "/api/runs - Failed to load resource" not in e["message"]
               and "(at $.options.count)" not in e["message"]]
     assert not errors, errors
+
+
+def unsaved_edits(driver, wait, by_id, click_list, field):
+    """A second audit (2026-12-06): a run started with edits not saved ran the file on
+    disk without a word; an edit of a field while the JSON text did not parse rewrote the
+    text from the last valid document, losing the edits made in the text; "Save as" left
+    the Run tab on the old file."""
+    status = lambda: by_id("status").text
+    by_id("tab-scene").click()
+    click_list("files", "path.json")
+    wait.until(lambda d: by_id("scene-path").get_attribute("value") == "teraeye/path.json")
+    wait.until(lambda d: "✓" in by_id("validation-state").text)
+    unsaved = lambda: "unsaved" in (by_id("scene-path").get_attribute("class") or "")
+    assert not unsaved()
+    click_list("objects", "cylinder-A")
+    box = field("objects[1].temperature_k").find_element(By.TAG_NAME, "input")
+    box.send_keys(Keys.CONTROL, "a")
+    box.send_keys("400")
+    box.send_keys(Keys.TAB)
+    wait.until(lambda d: unsaved())
+    by_id("tab-run").click()
+    wait.until(lambda d: by_id("run-scene").get_attribute("value") == "teraeye/path.json")
+    by_id("btn-run").click()
+    wait.until(lambda d: "not saved" in status())
+    log(f"a run with edits not saved: {status()[:80]!r}")
+    # the text broken: the fields are out of use, the text's edits kept
+    by_id("tab-scene").click()
+    text = by_id("scene-text").get_attribute("value")
+    broken = text.replace('"name"', '"name-edited-in-text"', 1).rstrip().rstrip("}") + ",}"
+    driver.execute_script("const t = document.getElementById('scene-text'); t.value = arguments[0];"
+                          "t.dispatchEvent(new Event('input'));", broken)
+    wait.until(lambda d: d.execute_script("return document.getElementById('props').inert"))
+    assert by_id("scene-text").get_attribute("value") == broken
+    # mended in the text: the fields come back; saved as another file, which Run then takes
+    driver.execute_script("const t = document.getElementById('scene-text'); t.value = arguments[0];"
+                          "t.dispatchEvent(new Event('input'));", text)
+    wait.until(lambda d: not d.execute_script("return document.getElementById('props').inert"))
+    by_id("scene-path").clear()
+    by_id("scene-path").send_keys("teraeye/saved-as.json")
+    by_id("btn-save").click()
+    wait.until(lambda d: "saved teraeye/saved-as.json" in status())
+    assert not unsaved()
+    by_id("tab-run").click()
+    wait.until(lambda d: by_id("run-scene").get_attribute("value") == "teraeye/saved-as.json")
+    log("fields out of use while the text is broken; Save as moves the Run tab to the new file")
 
 
 def main():
@@ -389,6 +436,7 @@ def main():
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         assert not errors, errors
         audit_fixes(driver, wait, patient, by_id, click_list, field, root)
+        unsaved_edits(driver, wait, by_id, click_list, field)
     except Exception:
         shot("failure")
         print("status line:", driver.find_element(By.ID, "status").text)

@@ -22,6 +22,11 @@ const results = new Results();
 window.thzmap = { editor, runs, results, showTab }; // for the console and the end-to-end test
 
 document.addEventListener("scene-opened", (e) => runs.sceneOpened(e.detail));
+runs.unsaved = (path) => editor.dirty && editor.path === path;
+// edits not saved are lost with the page: the browser asks first
+window.addEventListener("beforeunload", (e) => {
+  if (editor.dirty) e.preventDefault();
+});
 // a run writes its cubes anew: drop what was read of them before (the cache is by path)
 document.addEventListener("run-finished", (e) => {
   forget(`${e.detail.out.replace(/\/+$/, "")}/`);

@@ -2,7 +2,7 @@
 // cubes; a clicked pixel's spectrum with error bars and truth; A/B differences in units of
 // the combined standard error; batch frames played one after the other.
 import { getJSON, q, reportError, request, status } from "./api.js";
-import { loadCube, range } from "./envi.js";
+import { forget, loadCube, range } from "./envi.js";
 import { cssColour, diverging, drawColourBar, formatNumber, planckDerivative, viridis } from "./colour.js";
 import { linePlot } from "./plots.js";
 import { PhotonView } from "./photons.js";
@@ -61,6 +61,10 @@ export class Results {
   // photon map, a batch's frames (sweeps' included)
   async open(dir) {
     const seq = (this.openSeq = (this.openSeq || 0) + 1);
+    // its cubes are read again: a run from another tab or a shell may have rewritten them
+    // since (the cache is by path alone)
+    forget(`${dir.replace(/\/+$/, "")}/`);
+    if (this.playing) this.play(); // a batch's frames played: stopped (Play toggles)
     const [, outputs] = await Promise.all([this.browse(dir), getJSON(`/api/outputs?dir=${q(dir)}`)]);
     if (seq !== this.openSeq) return; // another directory was asked for meanwhile
     this.frames = outputs.frames.map((f) => join(dir, f));
@@ -131,7 +135,7 @@ export class Results {
     phCh.replaceChildren(...Array.from({ length: tb.bands }, (_, b) => new Option(`${formatNumber(tb.freqThz[b])} THz`, b)));
     const names = this.truthId?.header["object names"] || [];
     $("ph-object").replaceChildren(new Option("all", ""), ...names.map((n) => new Option(n, n)));
-    status(`${base}: ${tb.cols} × ${tb.rows} pixels, ${tb.bands} channels, loaded in ${Math.round(performance.now() - t0)} ms`);
+    status(`${base}: ${tb.cols} × ${tb.rows} pixels, ${tb.bands} channel${tb.bands === 1 ? "" : "s"}, loaded in ${Math.round(performance.now() - t0)} ms`);
     await this.show();
   }
 

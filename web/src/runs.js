@@ -89,6 +89,12 @@ export class Runs {
 
   async start() {
     const command = $("run-command").value;
+    // a run reads the file on the server: edits of it not saved would be ignored unseen
+    const scenePath = $("run-scene").value.trim();
+    if (this.unsaved?.(scenePath)) {
+      throw new Error(`${scenePath} has changes in the Scene tab that are not saved: save them ` +
+        "first (a run reads the saved file), or open the file again to drop them");
+    }
     if (command === "simulate" || command === "render") await this.checkScene().catch(() => {});
     const takes = (id) => !$(id).disabled; // what updateForm left enabled for the command
     const options = {};

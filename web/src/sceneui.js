@@ -64,9 +64,21 @@ export class SceneEditor {
     }
   }
 
+  // edits not yet saved: a run reads the file on the server, not this text
+  get dirty() {
+    return this.savedText !== undefined && $("scene-text").value !== this.savedText;
+  }
+
+  markDirty() {
+    const dirty = this.dirty;
+    $("scene-path").classList.toggle("unsaved", dirty);
+    $("scene-path").title = dirty ? "unsaved changes: a run reads the saved file" : "";
+  }
+
   async open(path) {
     const text = await getText(`/api/file?path=${q(path)}`);
     this.path = path;
+    this.savedText = text;
     $("scene-path").value = path;
     this.view.framed = false;
     this.setText(text);
@@ -76,6 +88,8 @@ export class SceneEditor {
 
   setText(text) {
     $("scene-text").value = text;
+    this.setBroken(false);
+    this.markDirty();
     try {
       this.doc = JSON.parse(text);
     } catch (_) {
@@ -93,28 +107,48 @@ export class SceneEditor {
   async save() {
     const path = $("scene-path").value.trim();
     if (!path) throw new Error("no path to save to");
-    await putText(`/api/file?path=${q(path)}`, $("scene-text").value);
+    const text = $("scene-text").value;
+    await putText(`/api/file?path=${q(path)}`, text);
+    const moved = path !== this.path;
     this.path = path;
+    this.savedText = text;
+    this.markDirty();
     status(`saved ${path}`);
     this.listFiles(this.dir || "").catch(() => {});
+    // saved as another file: that is the scene a run now takes
+    if (moved) document.dispatchEvent(new CustomEvent("scene-opened", { detail: path }));
+  }
+
+  // While the text does not parse, the fields (which edit the last document that did)
+  // are out of use: an edit there rewrote the text from that document, and the edits
+  // made in the text since were lost.
+  setBroken(broken) {
+    this.broken = broken;
+    $("props").inert = broken;
+    $("props").classList.toggle("stale", broken);
+    $("props").title = broken ? "the JSON text does not parse: fix it there first" : "";
   }
 
   textEdited() {
     const text = $("scene-text").value;
     try {
       this.doc = JSON.parse(text);
+      this.setBroken(false);
       this.renderLists();
       this.renderProps();
     } catch (_) {
-      /* keep the panels; the validator names the line and column */
+      this.setBroken(true); /* the validator names the line and column */
     }
+    this.markDirty();
     this.scheduleValidate(text);
   }
 
   // a field changed the document: rewrite the text, validate
   edited(path) {
+    if (this.broken) return; // the fields are inert then (setBroken)
     const text = `${JSON.stringify(this.doc, null, 2)}\n`;
     $("scene-text").value = text;
+    this.markDirty();
     const keys = parsePath(path);
     if (keys[0] === "objects" && (keys[2] === "name" || keys[2] === "shape")) this.renderLists();
     // the fields of an object depend on its type (a shell's thickness) and its shape's
