@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "progress.h"
 #include "thzmap/thzmap.h"
 
 #define CMD "atmosphere"
@@ -192,13 +193,8 @@ static thz_status draw_plot_whole(const thz_atm_plot *plot, thz_error *err)
         snprintf(err->message, sizeof err->message, "--plot %s: the name is too long", plot->path);
         return err->status;
     }
-    sigset_t stop, before;
-    sigemptyset(&stop);
-    sigaddset(&stop, SIGINT);
-    sigaddset(&stop, SIGTERM);
-    sigaddset(&stop, SIGHUP);
-    sigaddset(&stop, SIGPIPE);
-    sigprocmask(SIG_BLOCK, &stop, &before);
+    sigset_t before;
+    cli_signals_hold(&before);
     thz_atm_plot into = *plot;
     into.path = partial;
     thz_status st = thz_atm_draw_plot(&into, err);
@@ -216,7 +212,7 @@ static thz_status draw_plot_whole(const thz_atm_plot *plot, thz_error *err)
     }
     if (st != THZ_OK)
         unlink(partial);
-    sigprocmask(SIG_SETMASK, &before, NULL);
+    cli_signals_release(&before);
     return st;
 }
 

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "progress.h"
 #include "thzmap/thzmap.h"
 
 #define CMD "classify"
@@ -110,15 +111,10 @@ int cmd_classify(int argc, char **argv)
     /* the write commits OUTDIR through a lock and a staging directory: a signal inside it
      * left both beside OUTDIR. Held until the write is whole, it then ends the process as
      * before (the classification fits no progress callback to stop sooner). */
-    sigset_t stop, before;
-    sigemptyset(&stop);
-    sigaddset(&stop, SIGINT);
-    sigaddset(&stop, SIGTERM);
-    sigaddset(&stop, SIGHUP);
-    sigaddset(&stop, SIGPIPE);
-    sigprocmask(SIG_BLOCK, &stop, &before);
+    sigset_t before;
+    cli_signals_hold(&before);
     thz_status written = thz_classification_write(c, outdir, &err);
-    sigprocmask(SIG_SETMASK, &before, NULL);
+    cli_signals_release(&before);
     if (written != THZ_OK) {
         thz_classification_destroy(c);
         return cli_fail(&err);

@@ -41,6 +41,22 @@ void cli_signals_install(void)
     signal(SIGPIPE, SIG_IGN);
 }
 
+void cli_signals_hold(sigset_t *before)
+{
+    sigset_t stop;
+    sigemptyset(&stop);
+    sigaddset(&stop, SIGINT);
+    sigaddset(&stop, SIGTERM);
+    sigaddset(&stop, SIGHUP);
+    sigaddset(&stop, SIGPIPE);
+    sigprocmask(SIG_BLOCK, &stop, before);
+}
+
+void cli_signals_release(const sigset_t *before)
+{
+    sigprocmask(SIG_SETMASK, before, NULL);
+}
+
 int cli_end_by_signal(int rc)
 {
     int sig = cli_interrupt_signal();

@@ -9,6 +9,7 @@
 #ifndef THZ_CLI_PROGRESS_H
 #define THZ_CLI_PROGRESS_H
 
+#include <signal.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -68,6 +69,12 @@ void cli_format_bytes(char *buf, size_t size, uint64_t bytes);
 
 /* Installs the SIGINT/SIGTERM handler (one-shot: a second signal kills at once). */
 void cli_signals_install(void);
+
+/* Holds SIGINT, SIGTERM, SIGHUP and SIGPIPE (into *before, the mask to restore) over a
+ * piece of work that must end whole or not at all, such as a commit; they are delivered
+ * when cli_signals_release restores the mask. */
+void cli_signals_hold(sigset_t *before);
+void cli_signals_release(const sigset_t *before);
 
 /* The signal that interrupted the run (SIGINT, SIGTERM), 0 if none: the exit status is
  * 128 + it, the shell's convention (130 for Ctrl-C, 143 for SIGTERM). */
