@@ -437,6 +437,16 @@ def main():
         assert not errors, errors
         audit_fixes(driver, wait, patient, by_id, click_list, field, root)
         unsaved_edits(driver, wait, by_id, click_list, field)
+        # the server stopped: the page says so (it said "Failed to fetch", and its
+        # validation box stayed at "validating…")
+        proc.terminate()
+        proc.wait(timeout=10)
+        by_id("tab-scene").click()
+        driver.execute_script("const t = document.getElementById('scene-text');"
+                              "t.value = t.value + ' '; t.dispatchEvent(new Event('input'));")
+        wait.until(lambda d: "does not answer" in by_id("status").text)
+        wait.until(lambda d: by_id("validation").text.startswith("not validated"))
+        log(f"server stopped: {by_id('status').text[:70]!r}")
     except Exception:
         shot("failure")
         print("status line:", driver.find_element(By.ID, "status").text)

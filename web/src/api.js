@@ -2,7 +2,15 @@
 // token URL set. Every failure becomes an Error whose message is the server's.
 
 export async function request(path, options = {}) {
-  const response = await fetch(path, { credentials: "same-origin", ...options });
+  let response;
+  try {
+    response = await fetch(path, { credentials: "same-origin", ...options });
+  } catch (e) {
+    // no answer at all ("Failed to fetch"): the server stopped, or the network is down
+    if (e.name !== "TypeError") throw e; // a timeout or an abort says so itself
+    throw new Error(`${path.split("?")[0]}: the server does not answer (stopped?); start ` +
+      "thzmap serve again and reload the page");
+  }
   if (!response.ok) {
     let message = response.statusText;
     try {

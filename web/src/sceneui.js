@@ -173,15 +173,17 @@ export class SceneEditor {
     }
     this.inflight = true;
     $("validation").textContent = "validating…";
-    let result = null;
+    let result = null, failure = null;
     for (let attempt = 0; attempt < 3 && !result; attempt++) {
       try {
         result = await sendJSON("POST", "/api/validate", { path: this.path, text }, AbortSignal.timeout(10000));
       } catch (e) {
+        failure = e;
         if (e.name !== "TimeoutError" || attempt === 2) reportError(e);
         if (e.name !== "TimeoutError") break;
       }
     }
+    if (!result) $("validation").textContent = `not validated: ${failure?.message || failure}`;
     this.inflight = false;
     if (this.pendingText !== undefined) {
       const next = this.pendingText;
