@@ -71,6 +71,11 @@ def _integrator_arg(integrator):
     return integrator
 
 
+def _effective_integrator(scene, integrator):
+    """The integrator a call runs: the one given, else the scene's."""
+    return integrator if integrator is not None else scene.info.integrator
+
+
 def _settings(scene, integrator=None, photons=None, seed=None, target_noise_k=None,
               max_seconds=None, keep_photons=False, first_photon=0):
     s = _lib.ThzRunSettings()
@@ -171,7 +176,7 @@ def fire_photons(scene, integrator=None, photons=None, seed=None, first_photon=0
     + photons - 1, so that maps of disjoint ranges merge)."""
     scene = scene_arg(scene)
     s = _settings(scene, integrator, photons, seed, first_photon=first_photon)
-    effective = integrator if integrator is not None else scene.info.integrator
+    effective = _effective_integrator(scene, integrator)
     if not _lib.lib.thz_integrator_needs_photons(effective.encode()):
         raise ArgumentError(f"integrator: the {effective} integrator uses no photons; give "
                             "integrator='photon-map' or 'final-gather'")
@@ -436,7 +441,7 @@ def _render_map_arg(scene, photon_map, integrator, seed):
     if photon_map is not None and photon_map.scene is not scene:
         raise ArgumentError("photon_map: it belongs to another Scene object; load it for "
                             "this one with load_photon_map(scene, path)")
-    effective = integrator if integrator is not None else scene.info.integrator
+    effective = _effective_integrator(scene, integrator)
     if photon_map is None and path is None and \
             _lib.lib.thz_integrator_needs_photons(effective.encode()):
         raise ArgumentError(f"photon_map: the {effective} integrator renders from a photon "

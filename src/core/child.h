@@ -30,9 +30,9 @@ typedef thz_status (*child_fn)(void *arg, thz_error *err);
  * team of two waits for them for ever (a team of one, an `if` clause's, runs). */
 thz_status child_run(const char *what, child_fn fn, void *arg, double timeout_s, thz_error *err);
 
-/* child_run, and *crashed: true when it failed because the child died from a signal,
- * ended without reporting, or ran past timeout_s (the work's own failure, not one of
- * starting the child or of the system around it). */
+/* child_run, and *crashed: true when it failed because the child died from a signal or
+ * ran past timeout_s (the work's own failure; not one of starting the child, nor an exit
+ * without a report, which a library makes when memory runs out). */
 thz_status child_run_crash(const char *what, child_fn fn, void *arg, double timeout_s,
                            bool *crashed, thz_error *err);
 

@@ -120,6 +120,7 @@ static vec3 load_sensor_unscaled(const double v[3])
         return v3(0.0, 0.0, 0.0);
     return v3(v[0] / m, v[1] / m, v[2] / m);
 }
+
 static thz_status load_sensor(load_ctx *ctx, const load_cursor *list, size_t index, thz_sensor *sn)
 {
     static const char *const keys[] = {

@@ -88,11 +88,12 @@ export class SceneEditor {
 
   setText(text) {
     $("scene-text").value = text;
-    this.setBroken(false);
     this.markDirty();
     try {
       this.doc = JSON.parse(text);
+      this.setBroken(false);
     } catch (_) {
+      this.setBroken(true); // the fields would edit the file open before
       /* the validator reports where */
     }
     this.selection = { kind: "object", index: 0 };
