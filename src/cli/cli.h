@@ -50,6 +50,10 @@ int cli_refuse_repeat(const char *command, char **argv, int i);
  * anything from "-" and a letter or "--" on; "-" alone and negative numbers are values. */
 bool cli_looks_like_option(const char *value);
 
+/* True if text[0..len) is a decimal number as JSON writes one, a leading '+' allowed:
+ * no blanks, no hexadecimal, no "inf" or "nan" (what strtod would also take). */
+bool cli_decimal_text(const char *text, size_t len);
+
 /* Parse whole numbers and reals from option values; false (after printing a usage
  * error naming `option`) when the text is not one, or is out of [min, max]. Whole
  * numbers may be written with a fraction or an exponent when their value is whole

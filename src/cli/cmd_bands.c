@@ -102,7 +102,8 @@ static bool split_widths(char *list, double *w, size_t *n)
         char *end = NULL;
         errno = 0;
         w[i] = strtod(items[i], &end);
-        if (end == items[i] || *end || errno || !(w[i] > 0.0 && w[i] <= 0.5))
+        if (!cli_decimal_text(items[i], strlen(items[i])) || *end || errno ||
+            !(w[i] > 0.0 && w[i] <= 0.5))
             return false;
     }
     return true;

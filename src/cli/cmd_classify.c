@@ -86,7 +86,7 @@ int cmd_classify(int argc, char **argv)
             char *end = NULL;
             errno = 0;
             opt.train_fraction = strtod(v, &end);
-            if (end == v || *end || errno ||
+            if (!cli_decimal_text(v, strlen(v)) || *end || errno ||
                 !(opt.train_fraction > 0.0 && opt.train_fraction < 1.0))
                 return cli_usage_error(CMD, "%s expects a fraction 0 < F < 1, got '%s'", a, v);
         } else if (strcmp(a, "--seed") == 0) {

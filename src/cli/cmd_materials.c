@@ -44,7 +44,8 @@ static bool parse_list(const char *text, double *out, size_t max, size_t *n)
     while (*p) {
         char *end = NULL;
         double v = strtod(p, &end);
-        if (end == p || !(v > 0.0 && v <= MAX_THZ) || (*end && *end != ',') || *n == max)
+        if (end == p || !cli_decimal_text(p, (size_t)(end - p)) || !(v > 0.0 && v <= MAX_THZ) ||
+            (*end && *end != ',') || *n == max)
             return false;
         out[(*n)++] = v;
         p = *end ? end + 1 : end;

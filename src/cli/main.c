@@ -112,14 +112,40 @@ int cli_option_value(const char *cmd, int argc, char **argv, int *i, const char 
     return -1;
 }
 
+bool cli_decimal_text(const char *text, size_t len)
+{
+    size_t i = 0, digits = 0;
+    if (i < len && (text[i] == '+' || text[i] == '-'))
+        i++;
+    for (; i < len && text[i] >= '0' && text[i] <= '9'; i++)
+        digits++;
+    if (i < len && text[i] == '.')
+        for (i++; i < len && text[i] >= '0' && text[i] <= '9'; i++)
+            digits++;
+    if (digits == 0)
+        return false;
+    if (i < len && (text[i] == 'e' || text[i] == 'E')) {
+        i++;
+        if (i < len && (text[i] == '+' || text[i] == '-'))
+            i++;
+        size_t exponent = 0;
+        for (; i < len && text[i] >= '0' && text[i] <= '9'; i++)
+            exponent++;
+        if (exponent == 0)
+            return false;
+    }
+    return i == len;
+}
+
 bool cli_parse_u64(const char *cmd, const char *option, const char *text, uint64_t min,
                    uint64_t max, uint64_t *out)
 {
     char *end = NULL;
     errno = 0;
+    bool decimal = cli_decimal_text(text, strlen(text)) && text[0] != '-';
     unsigned long long v = strtoull(text, &end, 10);
-    bool ok = text[0] && !*end && !errno && text[0] != '-';
-    if (!ok && text[0] && text[0] != '-' && strpbrk(text, ".eE")) {
+    bool ok = decimal && !*end && !errno;
+    if (!ok && decimal && strpbrk(text, ".eE")) {
         /* 1e6 or 2.5e3: a real that is a whole number, exact in a double (as in JSON) */
         errno = 0;
         double x = strtod(text, &end);
@@ -141,7 +167,8 @@ bool cli_parse_positive(const char *cmd, const char *option, const char *text, d
     char *end = NULL;
     errno = 0;
     double v = strtod(text, &end);
-    if (!text[0] || *end || errno || !isfinite(v) || !(v > 0.0) || v > max) {
+    if (!cli_decimal_text(text, strlen(text)) || *end || errno || !isfinite(v) || !(v > 0.0) ||
+        v > max) {
         cli_usage_error(cmd, "%s expects a number above 0 and at most %g, got '%s'", option, max,
                         text);
         return false;
@@ -156,7 +183,8 @@ bool cli_parse_double(const char *cmd, const char *option, const char *text, dou
     char *end = NULL;
     errno = 0;
     double v = strtod(text, &end);
-    if (!text[0] || *end || errno || !isfinite(v) || v < min || v > max) {
+    if (!cli_decimal_text(text, strlen(text)) || *end || errno || !isfinite(v) || v < min ||
+        v > max) {
         cli_usage_error(cmd, "%s expects a number from %g to %g, got '%s'", option, min, max, text);
         return false;
     }

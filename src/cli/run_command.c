@@ -126,7 +126,8 @@ static int cli_run_parse(int argc, char **argv, bool render, cli_run_args *a)
                 char *end = NULL;
                 errno = 0;
                 double x = strtod(val, &end);
-                if (end == val || *end || errno || !isfinite(x) || !(x > 0.0))
+                if (!cli_decimal_text(val, strlen(val)) || *end || errno || !isfinite(x) ||
+                    !(x > 0.0))
                     return cli_usage_error(cmd, "%s expects a positive number (%s), got '%s'", arg,
                                            target ? "K" : "s", val);
                 *(target ? &a->settings.target_noise_k : &a->settings.max_seconds) = x;

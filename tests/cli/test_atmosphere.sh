@@ -108,6 +108,8 @@ expect_usage "no-such.par" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --h2o-lines 
 expect_usage "temperature" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --temperature-k 20
 expect_usage "--temperature-k expects a number from 100 to 400" --from-thz 0.1 --to-thz 0.2 \
     --step-ghz 1 --temperature-k 500
+expect_usage "--from-thz expects a number above 0" --from-thz 0x1p-3 --to-thz 0.2 --step-ghz 1
+expect_usage "--step-ghz expects a number above 0" --from-thz 0.1 --to-thz 0.2 --step-ghz ' 1'
 expect_usage "--pressure-hpa expects a number above 0 and at most 2000, got '0'" --from-thz 0.1 --to-thz 0.2 \
     --step-ghz 1 --pressure-hpa 0
 expect_usage "--pressure-hpa expects a number above 0 and at most 2000" --from-thz 0.1 --to-thz 0.2 \

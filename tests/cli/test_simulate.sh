@@ -279,6 +279,15 @@ grep -q "fires no photons" "$work/u.err" || fail "render photon-map noise target
 [ $? -eq 2 ] || fail "--max-seconds 0 should exit 2"
 "$THZMAP" simulate "$work/scene.json" -o "$work/u" --photons 0 2>/dev/null
 [ $? -eq 2 ] || fail "--photons 0 should exit 2"
+# a number is written as JSON writes one: no blanks, no hexadecimal (strtod takes both)
+for bad in ' 100' '0x100' '1e' 'inf'; do
+    "$THZMAP" simulate "$work/scene.json" -o "$work/u" --photons "$bad" 2> "$work/u.err"
+    [ $? -eq 2 ] && grep -q "expects a whole number" "$work/u.err" ||
+        fail "--photons '$bad' should be a usage error: $(cat "$work/u.err")"
+done
+"$THZMAP" simulate "$work/scene.json" -o "$work/u" --integrator path --target-noise-k ' 1' \
+    2>/dev/null
+[ $? -eq 2 ] || fail "--target-noise-k ' 1' should exit 2"
 "$THZMAP" render "$work/scene.json" -o "$work/u" 2>/dev/null
 [ $? -eq 2 ] || fail "render without --photon-map should exit 2"
 # options the integrator has no use for are said to be unused, not silently dropped
