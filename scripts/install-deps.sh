@@ -25,6 +25,7 @@ case "${1:-all}" in
       clang libomp-dev  # the clang build the tests compare (make test-compilers)
       clang-format  # the code's layout (.clang-format: make format, tests/cli/test_format.sh)
       groff-base ffmpeg strace zstd  # the man page's, movies' and I/O checks
+      locales  # a comma-decimal locale the library must ignore (tests/python/test_locale.py)
       valgrind  # memcheck over the build for any x86-64 (tests/builds/memcheck.sh)
       python3-spectral gdal-bin python3-gdal  # reading the ENVI cubes back
       python3-pytest python3-matplotlib python3-sklearn python3-tqdm

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "api/api.h"
+#include "core/c_locale.h"
 #include "physics/channel.h"
 #include "physics/planck.h"
 #include "sensor/measure.h"
@@ -124,7 +125,7 @@ static double api_float_decimal(double v)
     for (int digits = 1; digits <= 9; digits++) {
         snprintf(text, sizeof text, "%.*g", digits, (double)f);
         if (strtof(text, NULL) == f)
-            return strtod(text, NULL);
+            return thz_strtod(text, NULL);
     }
     return v;
 }

@@ -12,6 +12,7 @@
 
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
+#include "core/c_locale.h"
 
 static thz_status catalog_push(raw_catalog *cat, const raw_line *line, thz_error *err)
 {
@@ -121,7 +122,7 @@ static bool par_field(const char *rec, size_t start, size_t len, double *out)
         return false;
     char *end = NULL;
     errno = 0;
-    *out = strtod(p, &end);
+    *out = thz_strtod(p, &end);
     while (*end == ' ')
         end++;
     return !*end && errno != ERANGE && isfinite(*out);

@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "core/alloc.h"
+#include "core/c_locale.h"
 
 /* Files larger than this are not tables a scene needs; refusing them early keeps a
  * mistaken path (a binary, a device) from being read whole. */
@@ -83,7 +84,7 @@ static thz_status csv_parse_header(csv_table *t, char *line, size_t line_no, thz
                 return thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: header names column '%s' twice",
                                      t->label, line_no, name);
         char *end = NULL;
-        strtod(name, &end);
+        thz_strtod(name, &end);
         if (*end == '\0')
             return thz_error_set(err, THZ_ERR_INPUT,
                                  "%s:%zu: the first line that is not a comment must be a header "
@@ -114,7 +115,7 @@ static thz_status csv_parse_row(csv_table *t, char *line, size_t line_no, double
         char *text = csv_field(field);
         char *end = NULL;
         errno = 0;
-        double v = strtod(text, &end);
+        double v = thz_strtod(text, &end);
         if (!text[0] || *end || (errno == ERANGE && fabs(v) == HUGE_VAL) || !isfinite(v))
             return thz_error_set(err, THZ_ERR_INPUT,
                                  "%s:%zu: row %zu, column '%s': expected a finite number, got '%s'",

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/c_locale.h"
 #include "core/path.h"
 #include "thzmap/thzmap.h"
 
@@ -68,6 +69,7 @@ static thz_status envi_write_header(const char *dir, const char *stem, const env
     if (!f)
         return thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO), "%s: cannot create: %s",
                              path, strerror(errno));
+    locale_t previous = thz_locale_enter(); /* "352.5", never "352,5" */
     fputs("ENVI\ndescription = {", f);
     envi_put_text(f, info->description ? info->description : "");
     fputs("}\n", f);
@@ -91,6 +93,7 @@ static thz_status envi_write_header(const char *dir, const char *stem, const env
         envi_put_number_list(f, "fwhm", info->fwhm_ghz, info->bands);
     if (info->object_names)
         envi_put_name_list(f, "object names", info->object_names, info->n_object_names);
+    thz_locale_leave(previous);
     int failed = ferror(f);
     if (fclose(f) != 0 || failed)
         return thz_error_set(err, THZ_ERR_IO, "%s: write failed: %s", path, strerror(errno));

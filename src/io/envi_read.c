@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/c_locale.h"
 #include "core/file.h"
 #include "core/path.h"
 
@@ -163,7 +164,7 @@ static thz_status header_entry(const char *path, size_t line, char *key, char *v
                 st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
             for (size_t i = 0; i < n && st == THZ_OK; i++) {
                 char *end = NULL;
-                c->wavelength[i] = strtod(items[i], &end);
+                c->wavelength[i] = thz_strtod(items[i], &end);
                 if (!items[i][0] || *end)
                     st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: wavelength %zu: not a number",
                                        path, line, i + 1);

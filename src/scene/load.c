@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 
 #include "core/alloc.h"
+#include "core/c_locale.h"
 #include "core/file.h"
 #include "scene/load.h"
 #include "scene/mesh_import.h"
@@ -415,7 +416,9 @@ static thz_status load_finish(thz_scene **scene, json_t *doc, const char *root, 
                         .root = root,
                         .scene = *scene,
                         .err = err};
+        locale_t previous = thz_locale_enter(); /* numbers in messages as in the file */
         st = load_document(&ctx, doc);
+        thz_locale_leave(previous);
         json_decref(ctx.names);
     }
     json_decref(doc);

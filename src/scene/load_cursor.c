@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/c_locale.h"
 #include "scene/load.h"
 
 load_cursor load_root(json_t *value)
@@ -119,7 +120,7 @@ const char *load_number_text(double v, char *out)
 {
     for (int digits = 6; digits <= 17; digits++) {
         snprintf(out, LOAD_NUMBER_CHARS, "%.*g", digits, v);
-        if (!isfinite(v) || strtod(out, NULL) == v)
+        if (!isfinite(v) || thz_strtod(out, NULL) == v)
             break;
     }
     return out;

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/c_locale.h"
 #include "physics/planck.h"
 #include "scene/load.h"
 #include "core/vec3.h"
@@ -101,7 +102,7 @@ static thz_status load_normalize_floor(load_ctx *ctx, const load_cursor *c, doub
     char shown[LOAD_NUMBER_CHARS]; /* 4 digits, rounded up: a value as shown is accepted */
     for (double up = floor_k;; up *= 1.0 + 1e-5) {
         snprintf(shown, sizeof shown, "%.4g", up);
-        if (strtod(shown, NULL) >= floor_k)
+        if (thz_strtod(shown, NULL) >= floor_k)
             break;
     }
     return load_fail(ctx, &k,

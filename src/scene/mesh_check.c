@@ -11,6 +11,7 @@
 #include <strings.h>
 
 #include "scene/mesh_check_internal.h"
+#include "core/c_locale.h"
 
 const char *const mesh_supported_formats = "Wavefront OBJ (.obj), PLY (.ply) or STL (.stl)";
 
@@ -114,7 +115,7 @@ bool mc_number(mc_span tok, double *value)
     if (!mc_copy(tok, buf))
         return false;
     errno = 0;
-    *value = strtod(buf, &end);
+    *value = thz_strtod(buf, &end);
     return *end == '\0' && isfinite(*value);
 }
 

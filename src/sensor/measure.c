@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/c_locale.h"
 #include "physics/planck.h"
 #include "sensor/noise.h"
 #include "sensor/psf.h"
@@ -39,6 +40,7 @@ const char *sensor_noise_name(const thz_sensor_noise *noise)
 void sensor_model_describe(const thz_sensor *sn, size_t channel, size_t n_channels,
                            uint64_t noise_seed, char *buf, size_t size)
 {
+    locale_t previous = thz_locale_enter(); /* written into files: "0.05", never "0,05" */
     int n = 0;
     if (sn->psf == PSF_AIRY)
         n = snprintf(buf, size, "Airy D %g m", sn->aperture_diameter_m);
@@ -66,6 +68,7 @@ void sensor_model_describe(const thz_sensor *sn, size_t channel, size_t n_channe
                  (unsigned long long)noise_seed);
     else
         snprintf(buf + used, size - used, "; no noise");
+    thz_locale_leave(previous);
 }
 
 /* Tb of every pixel of a plane, as the truth cube's. */
