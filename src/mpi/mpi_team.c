@@ -13,6 +13,7 @@
 
 #include "core/alloc.h"
 #include "photon/emission_reach.h"
+#include "scene/scene_hash.h"
 #include "sensor/render_context.h"
 
 enum {
@@ -68,6 +69,14 @@ typedef struct team_message {
 typedef struct team_result_header {
     uint64_t item, status, size;
 } team_result_header;
+
+/* What a member sends before its tiles of a render pass: its counts and how many doubles
+ * its tiles are, which the lead checks before receiving them (a message longer than the
+ * buffer is written past its end by some transports, not refused). */
+typedef struct team_tiles_header {
+    render_stats counts;
+    uint64_t doubles;
+} team_tiles_header;
 
 /* What a member sends first: the sizes of its share. */
 typedef struct team_header {
@@ -274,14 +283,21 @@ static thz_status team_render_gather(void *impl, render_accum *acc, uint32_t col
         return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for %zu pixels' tiles", most);
     int rc = MPI_SUCCESS;
     for (size_t r = 1; rc == MPI_SUCCESS && r < members; r++) {
-        render_stats counts;
-        rc = team_move(t, &counts, sizeof counts, (int)r, TEAM_TAG_HEADER, false);
+        team_tiles_header head;
+        rc = team_move(t, &head, sizeof head, (int)r, TEAM_TAG_HEADER, false);
         size_t n = render_tiles_count(acc->pixels, columns, r, members);
+        if (rc == MPI_SUCCESS && head.doubles != n * per) {
+            free(tiles);
+            return thz_error_set(err, THZ_ERR_INPUT,
+                                 "MPI: process %zu renders %llu values for its tiles, the lead "
+                                 "expects %zu (every process must load the same scene)",
+                                 r, (unsigned long long)head.doubles, n * per);
+        }
         if (rc == MPI_SUCCESS)
             rc = team_move(t, tiles, n * per * sizeof *tiles, (int)r, TEAM_TAG_TILES, false);
         if (rc == MPI_SUCCESS) {
             render_tiles_unpack(acc, columns, r, members, tiles);
-            render_stats_add_counts(stats, &counts);
+            render_stats_add_counts(stats, &head.counts);
         }
     }
     free(tiles);
@@ -491,6 +507,12 @@ static thz_status team_serve_begin(mpi_team *t, const thz_scene *scene, const ac
                              "must run with the same options)",
                              render_integrator_name((thz_integrator)m->rr.integrator), t->rank,
                              render_integrator_name(scene->render.integrator));
+    if (m->rr.scene_print != scene_hash_run(scene, true))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: MPI: process %d's scene differs from the lead's (objects, "
+                             "materials, air, channels, sensors or settings; every process must "
+                             "load the same scene with the same options)",
+                             scene->path ? scene->path : "scene", t->rank);
     r->ro = (render_options){.threads = threads,
                              .use_seed = m->rr.use_seed != 0,
                              .seed = m->rr.seed,
@@ -549,7 +571,8 @@ static thz_status team_serve_pass(mpi_team *t, const thz_scene *scene, const tea
     if (!tiles)
         return thz_error_set(err, THZ_ERR_NOMEM, "MPI: out of memory for %zu pixels' tiles", n);
     render_tiles_pack(a, sn->columns, r->ro.member, r->ro.members, tiles);
-    int rc = team_move(t, &counts, sizeof counts, 0, TEAM_TAG_HEADER, true);
+    team_tiles_header head = {.counts = counts, .doubles = n};
+    int rc = team_move(t, &head, sizeof head, 0, TEAM_TAG_HEADER, true);
     if (rc == MPI_SUCCESS)
         rc = team_move(t, tiles, n * sizeof *tiles, 0, TEAM_TAG_TILES, true);
     free(tiles);

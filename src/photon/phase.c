@@ -10,6 +10,7 @@
 #include "core/alloc.h"
 #include "core/sampling.h"
 #include "core/threads.h"
+#include "scene/scene_hash.h"
 #include "photon/air_emission.h"
 #include "photon/emission.h"
 #include "photon/emission_reach.h"
@@ -419,6 +420,12 @@ thz_status photon_phase_fire_share(const thz_scene *scene, const accel *acc,
                              (unsigned long long)scene->photons.seed,
                              (unsigned long long)scene->photons.per_channel,
                              (unsigned long long)rq->seed, (unsigned long long)rq->photons);
+    if (rq->scene_print != scene_hash_run(scene, false))
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: photon phase: process %zu's scene differs from the lead's "
+                             "(objects, materials, air, channels, sensors or settings; every "
+                             "process must load the same scene with the same options)",
+                             scene->path ? scene->path : "scene", member);
     emission_table table;
     air_emission air;
     double surface_power;
@@ -483,6 +490,7 @@ thz_status photon_phase_run(const thz_scene *scene, const accel *acc, size_t cha
                                .reference_temperature_k = t0_k};
     uint64_t lo = 0, hi = rq.photons;
     if (team) { /* the others start on their shares while the lead builds its table */
+        rq.scene_print = scene_hash_run(scene, false);
         photon_phase_share_range(rq.photons, 0, team->members, &lo, &hi);
         st = team->start(team->impl, &rq, err);
         if (st != THZ_OK) {

@@ -79,6 +79,7 @@ typedef struct photon_phase_request {
     uint64_t first_photon;
     uint64_t seed; /* the scene's, checked by the members (same scene on every process) */
     double reference_temperature_k;
+    uint64_t scene_print; /* the lead's scene_hash_run: the members check it */
 } photon_phase_request;
 
 /* One member's share: its records in photon-index order and the counters of each of its

@@ -9,6 +9,7 @@
 #include "core/clock.h"
 #include "photon/phase.h"
 #include "photon/photon_map.h"
+#include "scene/scene_hash.h"
 #include "run/run.h"
 #include "run/run_noise.h"
 #include "sensor/render.h"
@@ -113,7 +114,8 @@ thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, th
         render_channel_request rq = {.channel = c,
                                      .use_seed = ro.use_seed,
                                      .seed = ro.seed,
-                                     .integrator = (uint64_t)rs->scene->render.integrator};
+                                     .integrator = (uint64_t)rs->scene->render.integrator,
+                                     .scene_print = scene_hash_run(rs->scene, true)};
         st = team->channel_begin(team->impl, &rq, map, err);
     }
     if (st == THZ_OK)

@@ -136,3 +136,40 @@ void scene_hash_compute(const thz_scene *scene, scene_hash *out)
     out->optics = hash_finish(o);
     out->channels = hash_finish(c);
 }
+
+uint64_t scene_hash_run(const thz_scene *scene, bool render)
+{
+    scene_hash parts;
+    scene_hash_compute(scene, &parts);
+    uint64_t h = hash_word(HASH_OFFSET, parts.geometry);
+    h = hash_word(h, parts.optics);
+    h = hash_word(h, parts.channels);
+    h = hash_word(h, scene->n_sensors);
+    for (size_t i = 0; i < scene->n_sensors; i++) {
+        const thz_sensor *s = &scene->sensors[i];
+        for (int k = 0; k < 3; k++) {
+            h = hash_double(h, s->position_m[k]);
+            h = hash_double(h, s->direction[k]);
+            h = hash_double(h, s->up[k]);
+        }
+        h = hash_double(h, s->fov_deg);
+        h = hash_word(h, s->columns);
+        h = hash_word(h, s->rows);
+        h = hash_double(h, s->aperture_m2);
+        h = hash_word(h, s->oversampling);
+        h = hash_double(h, s->normalize_to_k);
+        h = hash_double(h, s->aperture_diameter_m);
+        h = hash_word(h, (uint64_t)s->psf);
+        h = hash_double(h, s->psf_fwhm_deg);
+    }
+    /* not the photon count and seed: a map loaded for render sets them on the lead alone
+     * (the members receive its records), and the photon phase checks them itself */
+    h = hash_double(h, scene->photons.min_relative_power);
+    h = hash_word(h, scene->photons.gather_min_photons);
+    if (render) {
+        h = hash_word(h, (uint64_t)scene->render.integrator);
+        h = hash_word(h, scene->render.gather_rays);
+        h = hash_word(h, scene->render.paths_per_sample);
+    }
+    return hash_finish(h);
+}

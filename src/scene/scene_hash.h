@@ -18,6 +18,7 @@
 #ifndef THZ_SCENE_SCENE_HASH_H
 #define THZ_SCENE_SCENE_HASH_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "scene/scene.h"
@@ -29,5 +30,15 @@ typedef struct scene_hash {
 } scene_hash;
 
 void scene_hash_compute(const thz_scene *scene, scene_hash *out);
+
+/* One fingerprint of all that the processes of an MPI run must share to compute the same
+ * photons and pixels: the three hashes above, the sensors' geometry and optics (size,
+ * pose, field, oversampling, aperture, PSF) and the photon and render settings the
+ * members use (not the photon count and seed, which the photon phase checks); the render
+ * settings (integrator, gather rays, paths) only when `render`, so that a photon phase
+ * shared by processes that would render differently reaches the render's own check. The lead sends
+ * it with each request; a member whose scene differs refuses (else it would render other images, or
+ * tiles of another size). */
+uint64_t scene_hash_run(const thz_scene *scene, bool render);
 
 #endif

@@ -49,7 +49,8 @@ void render_tiles_unpack(render_accum *acc, uint32_t columns, size_t member, siz
 typedef struct render_channel_request {
     uint64_t channel;
     uint64_t use_seed, seed;
-    uint64_t integrator; /* the lead's thz_integrator: every member must render with it */
+    uint64_t integrator;  /* the lead's thz_integrator: every member must render with it */
+    uint64_t scene_print; /* the lead's scene_hash_run: the members check it */
 } render_channel_request;
 
 /* How the lead reaches the other members; implemented over MPI by src/mpi/. */

@@ -302,6 +302,30 @@ rc=$?
 grep -q "the lead renders with final-gather, process 1 with photon-map" "$work/mixi.out" ||
     { fail "rank 1's other integrator not said"; cat "$work/mixi.out"; }
 [ ! -e "$work/mixi" ] || fail "rank 1 with another integrator: OUTDIR created"
+step "rank 1's scene differs"
+# rank 1 loads a scene that differs where no earlier check looked: a warmer target (path:
+# it wrote rank 1's tiles into the images, exit 0) and a larger sensor (its tiles were
+# written past the lead's buffer: "double free or corruption"). Both are refused.
+$PY - "$scene" "$work/warm.json" "$work/wide.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+w = json.loads(json.dumps(s))
+w["objects"][1]["temperature_k"] += 90
+json.dump(w, open(sys.argv[2], "w"))
+w = json.loads(json.dumps(s))
+w["sensors"][0]["resolution"] = [36, 36]
+json.dump(w, open(sys.argv[3], "w"))
+PY
+for other in warm wide; do
+    timeout 120 mpirun --oversubscribe -np 1 "$THZMAP" simulate "$scene" -o "$work/mix$other" \
+        --quiet --integrator path : -np 1 "$THZMAP" simulate "$work/$other.json" \
+        -o "$work/mix$other" --quiet --integrator path > "$work/mix$other.out" 2>&1
+    rc=$?
+    [ $rc != 0 ] && [ $rc != 124 ] || fail "rank 1 with the $other scene: exit $rc"
+    grep -q "process 1's scene differs from the lead's" "$work/mix$other.out" ||
+        { fail "rank 1's $other scene not said"; cat "$work/mix$other.out"; }
+    [ ! -e "$work/mix$other" ] || fail "rank 1 with the $other scene: OUTDIR created"
+done
 step "rank 1 cannot"
 # rank 1 cannot load its scene (missing on its node): rank 0 says so, exit non-zero
 timeout 120 mpirun --oversubscribe -np 1 "$THZMAP" simulate "$scene" -o "$work/miss" --quiet \
