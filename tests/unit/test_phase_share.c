@@ -17,6 +17,7 @@
 #include "accel/accel.h"
 #include "core/alloc.h"
 #include "photon/phase.h"
+#include "scene/scene_hash.h"
 
 typedef struct fake_team {
     const thz_scene *scene;
@@ -156,12 +157,18 @@ static void test_member_refuses_other_seed(void **state)
     accel *acc;
     thz_error err;
     assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
-    photon_phase_request rq = {.channel = 0, .photons = 1000, .seed = 8};
+    photon_phase_request rq = {
+        .channel = 0, .photons = 1000, .seed = 8, .scene_print = scene_hash_run(s, false)};
     photon_phase_share part;
     assert_int_equal(photon_phase_fire_share(s, acc, &rq, 1, NULL, 1, 2, &part, &err),
                      THZ_ERR_INPUT);
     assert_non_null(strstr(err.message, "seed 7"));
     rq.seed = 7;
+    rq.scene_print ^= 1; /* the lead's scene differs in anything else */
+    assert_int_equal(photon_phase_fire_share(s, acc, &rq, 1, NULL, 1, 2, &part, &err),
+                     THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "scene differs from the lead's"));
+    rq.scene_print ^= 1;
     assert_int_equal(photon_phase_fire_share(s, acc, &rq, 1, NULL, 1, 2, &part, &err), THZ_OK);
     assert_int_equal(part.n_chunks, 0); /* one batch: member 0's */
     photon_phase_share_fini(&part);
