@@ -178,15 +178,45 @@ static thz_status stage_carry_files(const struct output_stage *stage, thz_error 
     return status;
 }
 
+/* Step 3 of STAGE_SWAP: `old` holds the previous OUTDIR. Its entries without a namesake
+ * in `into` are the user's that step 1 could not link across (a file system without
+ * hard links, a file another user owns under fs.protected_hardlinks), a link or a
+ * directory: moved into `into`. Those with one (replaced by this run's file, or linked
+ * across) are removed, then `old` if empty. Nothing is removed that has not been found a
+ * namesake: where the listing or a move fails, the entry stays in `old`. */
+static void stage_return_old(const char *old, const char *into)
+{
+    char **names = NULL;
+    size_t n = 0;
+    if (stage_list(old, false, &names, &n, NULL) != THZ_OK)
+        return;
+    for (size_t i = 0; i < n; i++) {
+        char from[THZ_PATH_MAX], to[THZ_PATH_MAX];
+        struct stat sf, st;
+        if (thz_path_join(from, sizeof from, old, names[i], NULL) != THZ_OK ||
+            thz_path_join(to, sizeof to, into, names[i], NULL) != THZ_OK || lstat(from, &sf) != 0)
+            continue;
+        if (lstat(to, &st) != 0) {
+            if (errno == ENOENT)
+                rename(from, to);
+        } else if (!S_ISDIR(sf.st_mode)) {
+            unlink(from);
+        }
+    }
+    stage_free_names(names, n);
+    rmdir(old);
+}
+
 thz_status stage_commit_swap(struct output_stage *stage, thz_error *err)
 {
     struct stat st;
     if (lstat(stage->target, &st) != 0) {
         if (errno == ENOENT && rename(stage->dir, stage->target) == 0)
             return THZ_OK;
-        if (errno != EEXIST && errno != ENOTEMPTY)
+        if ((errno != EEXIST && errno != ENOTEMPTY) || lstat(stage->target, &st) != 0)
             return thz_error_set(err, THZ_ERR_IO, "%s: cannot move the results into place: %s",
                                  stage->outdir, strerror(errno));
+        /* made by another process since: swapped with as any OUTDIR, with its mode */
     }
     thz_status status = stage_carry_files(stage, err);
     if (status != THZ_OK)
@@ -226,25 +256,10 @@ thz_status stage_commit_swap(struct output_stage *stage, thz_error *err)
                                  "committed, the previous results stay",
                                  stage->outdir, strerror(e));
         }
-        stage_move_others(parked, stage->target);
-        stage_remove_files(parked);
+        stage_return_old(parked, stage->target);
         return THZ_OK;
     }
-    /* The stage's name now holds the old run. */
-    stage_move_others(stage->dir, stage->target);
-    char **names = NULL;
-    size_t n = 0;
-    if (stage_list(stage->dir, true, &names, &n, NULL) == THZ_OK) {
-        for (size_t i = 0; i < n; i++) { /* regular files that could not be linked */
-            char from[THZ_PATH_MAX], to[THZ_PATH_MAX];
-            if (thz_path_join(from, sizeof from, stage->dir, names[i], NULL) == THZ_OK &&
-                thz_path_join(to, sizeof to, stage->target, names[i], NULL) == THZ_OK &&
-                lstat(to, &st) != 0 && errno == ENOENT)
-                rename(from, to);
-        }
-        stage_free_names(names, n);
-    }
-    stage_remove_files(stage->dir);
+    stage_return_old(stage->dir, stage->target); /* the stage's name now holds the old run */
     return THZ_OK;
 }
 
