@@ -161,6 +161,16 @@ def test_paths(srv, root):
           open(os.path.join(root, "s", "new.json"), "rb").read() == text, "PUT file: %r" % res)
     check(sorted(os.listdir(os.path.join(root, "s"))) == ["materials", "new.json", "scene.json"],
           "PUT left files behind: %r" % os.listdir(os.path.join(root, "s")))
+    # a new file gets 0666 less the umask (the server's is the test's); a private file
+    # saved again stays private (it came back 0644, readable by every user)
+    mask = os.umask(0)
+    os.umask(mask)
+    mode = os.stat(os.path.join(root, "s", "new.json")).st_mode & 0o7777
+    check(mode == 0o666 & ~mask, "PUT new file: mode %o, umask %o" % (mode, mask))
+    os.chmod(os.path.join(root, "s", "new.json"), 0o600)
+    srv.json("PUT", "/api/file?path=s/new.json", body=text)
+    mode = os.stat(os.path.join(root, "s", "new.json")).st_mode & 0o7777
+    check(mode == 0o600, "PUT over a private file: mode %o, not 600" % mode)
     srv.json("GET", "/api/file?path=s/none.json", status=404)
 
 
