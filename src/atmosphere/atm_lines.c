@@ -216,7 +216,8 @@ cleanup:
     return st;
 }
 
-/* Catmull-Rom spline through the table at wavenumber nu (as am interpolates it); NaN
+/* Catmull-Rom spline through the table at wavenumber nu (am interpolates the product
+ * with the radiation term instead: docs/atmosphere.md gives the difference); NaN
  * at a NaN nu (which no comparison below would stop before the index). */
 static double catmull_rom(const double *v, size_t n, double step, double nu)
 {

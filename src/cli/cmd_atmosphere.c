@@ -2,6 +2,7 @@
  * PLplot figure (attenuation in dB/km on a log axis against frequency in THz, with
  * the channels of a scene marked). */
 #include <errno.h>
+#include <float.h>
 #include <fcntl.h>
 #include <math.h>
 #include <signal.h>
@@ -129,7 +130,8 @@ static int parse_options(int argc, char **argv, options *o, bool *help)
             o->air_given = true;
         } else if (strcmp(a, "--relative-humidity") == 0 || strcmp(a, "--water-vapour-g-m3") == 0 ||
                    strcmp(a, "--h2o-vmr") == 0) {
-            if (!cli_parse_double(CMD, a, v, 0.0, 1e6, &o->humidity))
+            /* any number: the air model says the range of each kind */
+            if (!cli_parse_double(CMD, a, v, -DBL_MAX, DBL_MAX, &o->humidity))
                 return CLI_EXIT_USAGE;
             o->humidity_kind = a[2] == 'r'   ? THZ_HUMIDITY_RELATIVE
                                : a[2] == 'w' ? THZ_HUMIDITY_DENSITY_G_M3

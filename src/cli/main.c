@@ -1,5 +1,6 @@
 /* thzmap: the program. Dispatches to the subcommands from a table (as git does). */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -185,7 +186,11 @@ bool cli_parse_double(const char *cmd, const char *option, const char *text, dou
     double v = strtod(text, &end);
     if (!cli_decimal_text(text, strlen(text)) || *end || errno || !isfinite(v) || v < min ||
         v > max) {
-        cli_usage_error(cmd, "%s expects a number from %g to %g, got '%s'", option, min, max, text);
+        if (min == -DBL_MAX && max == DBL_MAX) /* the range is checked later, by the library */
+            cli_usage_error(cmd, "%s expects a number, got '%s'", option, text);
+        else
+            cli_usage_error(cmd, "%s expects a number from %g to %g, got '%s'", option, min, max,
+                            text);
         return false;
     }
     *out = v;

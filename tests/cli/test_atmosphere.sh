@@ -102,6 +102,12 @@ expect_usage "must not be below" --from-thz 0.3 --to-thz 0.2 --step-ghz 1
 expect_usage "unknown option '--bogus'" --bogus 1
 expect_usage "unknown model 'foo'" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --model foo
 expect_usage "not per cent" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --relative-humidity 50
+# below the range too: one message with the range (it said "from 0 to 1e+06" here, then
+# "must be 0 to 1" above it)
+expect_usage "relative humidity must be 0 to 1 (a fraction, not per cent), got -0.1" \
+    --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --relative-humidity -0.1
+expect_usage "--relative-humidity expects a number, got 'nan'" --from-thz 0.1 --to-thz 0.2 \
+    --step-ghz 1 --relative-humidity nan
 expect_usage "only one of" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --relative-humidity 0.5 --h2o-vmr 0.01
 expect_usage "range of atmosphere model 'itu-p676'" --from-thz 0.9 --to-thz 1.2 --step-ghz 1 --model itu-p676
 expect_usage "no-such.par" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --h2o-lines "$TMP/no-such.par"
