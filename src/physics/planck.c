@@ -25,3 +25,12 @@ double planck_brightness_temperature(double freq_hz, double radiance)
     double prefactor = 2.0 * h * freq_hz / c * (freq_hz / c) * freq_hz;
     return h * freq_hz / (k * log1p(prefactor / radiance));
 }
+
+double planck_dbdt(double freq_hz, double temp_k)
+{
+    if (!(temp_k > 0.0))
+        return 0.0;
+    double x = THZ_PLANCK_H * freq_hz / (THZ_BOLTZMANN_K * temp_k);
+    double em1 = expm1(x);
+    return planck_radiance(freq_hz, temp_k) * x * (em1 + 1.0) / (em1 * temp_k);
+}

@@ -15,4 +15,8 @@ double planck_radiance(double freq_hz, double temp_k);
  * Returns 0 for radiance <= 0. Round trip to 1e-9 K. */
 double planck_brightness_temperature(double freq_hz, double radiance);
 
+/* dB_nu/dT = B_nu(T) x e^x / ((e^x - 1) T), x = h nu / k T, in W m^-2 sr^-1 Hz^-1 K^-1;
+ * 0 for T <= 0 (what a radiance error in K and a NETD in radiance convert through). */
+double planck_dbdt(double freq_hz, double temp_k);
+
 #endif

@@ -35,22 +35,12 @@ double noise_netd_k(const thz_sensor_noise *n, const thz_channel *ch, size_t c, 
     return 0.0;
 }
 
-/* dB_nu/dT = B_nu(T) x e^x / ((e^x - 1) T), x = h nu / k T. */
-static double noise_dbdt(double freq_hz, double temp_k)
-{
-    if (!(temp_k > 0.0))
-        return 0.0;
-    double x = THZ_PLANCK_H * freq_hz / (THZ_BOLTZMANN_K * temp_k);
-    double em1 = expm1(x);
-    return planck_radiance(freq_hz, temp_k) * x * (em1 + 1.0) / (em1 * temp_k);
-}
-
 /* Band mean of dB_nu/dT at temp_k over the quadrature q, W m^-2 sr^-1 Hz^-1 K^-1. */
 static double noise_band_dbdt(const channel_quadrature *q, double temp_k)
 {
     double sum = 0.0;
     for (size_t k = 0; k < q->n; k++)
-        sum += q->weight[k] * noise_dbdt(q->freq_hz[k], temp_k);
+        sum += q->weight[k] * planck_dbdt(q->freq_hz[k], temp_k);
     return sum;
 }
 

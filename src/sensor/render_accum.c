@@ -167,8 +167,5 @@ double render_stderr_k(double freq_hz, double tb_k, double stderr_l)
 {
     if (!(tb_k > 0.0))
         return 0.0;
-    double x = THZ_PLANCK_H * freq_hz / (THZ_BOLTZMANN_K * tb_k);
-    double em1 = expm1(x);
-    double dbdt = planck_radiance(freq_hz, tb_k) * x * (em1 + 1.0) / (em1 * tb_k);
-    return stderr_l / dbdt;
+    return stderr_l / planck_dbdt(freq_hz, tb_k);
 }
