@@ -93,6 +93,28 @@ static bool serve_opt_path(serve_request *r, json_t *v, const char *path, bool m
     return false;
 }
 
+/* True when a simulate job queued or running will write the photon map at `map` (a path
+ * as serve_path resolves it): a render queued behind it reads the map when it starts, so
+ * the map need not exist yet (it was refused with 404). */
+static bool serve_map_coming(serve *s, const char *map)
+{
+    static const char name[] = "photon-map.thzpm";
+    size_t len = strlen(map), name_len = sizeof name - 1;
+    if (len <= name_len || strcmp(map + len - name_len, name) != 0 ||
+        map[len - name_len - 1] != '/')
+        return false;
+    bool coming = false;
+    pthread_mutex_lock(&s->lock);
+    for (size_t i = 0; i < s->n_jobs && !coming; i++) {
+        const serve_job *q = s->jobs[i];
+        coming = !serve_job_finished(q) && q->command == CMD_SIMULATE && q->save_photon_map &&
+                 strlen(q->out) == len - name_len - 1 &&
+                 strncmp(q->out, map, len - name_len - 1) == 0;
+    }
+    pthread_mutex_unlock(&s->lock);
+    return coming;
+}
+
 /* The integrator a simulate or render job runs: its option, else the scene's
  * render.integrator, else "path", the scene format's default (docs/scene-format.md), into
  * buf. NULL when the scene does not name one the loader would take: loading it then fails
@@ -162,8 +184,12 @@ static bool serve_parse_option(serve_request *r, serve_job *j, const char *key, 
         return serve_opt_whole(r, v, path, 1, UINT64_C(1000000000000), &j->photons, ret);
     if (j->command == CMD_SIMULATE && strcmp(key, "save_photon_map") == 0)
         return serve_opt_bool(r, v, path, &j->save_photon_map, ret);
-    if (j->command == CMD_RENDER && strcmp(key, "photon_map") == 0)
-        return serve_opt_path(r, v, path, true, j->photon_map, ret);
+    if (j->command == CMD_RENDER && strcmp(key, "photon_map") == 0) {
+        if (!serve_opt_path(r, v, path, false, j->photon_map, ret))
+            return false;
+        return serve_map_coming(r->s, j->photon_map) ||
+               serve_opt_path(r, v, path, true, j->photon_map, ret);
+    }
     if (j->command == CMD_RENDER && strcmp(key, "sensor") == 0)
         return serve_opt_string(r, v, path, j->sensor, sizeof j->sensor, ret);
     if (j->command == CMD_BATCH && strcmp(key, "no_movies") == 0)

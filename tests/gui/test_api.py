@@ -388,13 +388,26 @@ def test_runs(srv, root):
           "output progress in a channel's terms: %r" % [d["message"] for d in progress][-3:])
     run_b = srv.json("POST", "/api/runs", body={
         "command": "simulate", "scene": "s/scene.json", "out": "out/b",
-        "options": {"seed": 2, "integrator": "photon-map"}}, status=202)
+        "options": {"seed": 2, "integrator": "photon-map", "save_photon_map": True}},
+        status=202)
     render = srv.json("POST", "/api/runs", body={
         "command": "render", "scene": "s/scene.json", "out": "out/r",
         "options": {"photon_map": "out/a/photon-map.thzpm", "sensor": "cam"}}, status=202)
+    # a render queued behind the simulate that writes its map (not there yet: it was 404),
+    # and one from a map no queued run writes
+    check(not os.path.exists(os.path.join(root, "out", "b", "photon-map.thzpm")),
+          "test set-up: run b's map exists before its run")
+    render_b = srv.json("POST", "/api/runs", body={
+        "command": "render", "scene": "s/scene.json", "out": "out/rb",
+        "options": {"photon_map": "out/b/photon-map.thzpm"}}, status=202)
+    srv.json("POST", "/api/runs", body={
+        "command": "render", "scene": "s/scene.json", "out": "out/rc",
+        "options": {"photon_map": "out/c/photon-map.thzpm"}}, status=404)
     job = wait_state(srv, render["id"], ("done", "failed"))
     check(job and job["state"] == "done", "render: %r" % job)
     check(wait_state(srv, run_b["id"], ("done",)) is not None, "second run")
+    job = wait_state(srv, render_b["id"], ("done", "failed"))
+    check(job and job["state"] == "done", "render queued behind its map's run: %r" % job)
     # batch (two still frames, no movies) and bands (3 candidates, choose 1)
     with open(os.path.join(root, "s", "seq.json"), "w") as f:
         json.dump({"format": "thzmap-sequence/1", "scene": "scene.json", "frames": 2}, f)
@@ -422,8 +435,9 @@ def test_runs(srv, root):
     chosen = json.load(open(os.path.join(root, "out", "bands", "bands.json")))["selected_thz"]
     check(len(chosen) == 1 and chosen[0] in (0.3, 0.35, 0.4), "bands chose %r" % chosen)
     listing = srv.json("GET", "/api/runs")
-    check(listing and [j["id"] for j in listing][:5] == [run["id"], run_b["id"], render["id"],
-                                                          batch["id"], bands["id"]],
+    check(listing and [j["id"] for j in listing][:6] == [run["id"], run_b["id"], render["id"],
+                                                          render_b["id"], batch["id"],
+                                                          bands["id"]],
           "runs list")
     srv.json("GET", "/api/runs/999", status=404)
     srv.json("DELETE", "/api/runs/%d" % run["id"], status=409)
@@ -444,7 +458,7 @@ def test_runs(srv, root):
     check(not os.path.exists(os.path.join(root, "out", "long")) and
           not os.path.exists(os.path.join(root, "out", "q")), "a cancelled run left output")
     test_runs_confined(srv, root, json.load(open(os.path.join(root, "s", "scene.json"))))
-    check(sorted(os.listdir(os.path.join(root, "out"))) == ["a", "b", "bands", "batch", "r"],
+    check(sorted(os.listdir(os.path.join(root, "out"))) == ["a", "b", "bands", "batch", "r", "rb"],
           "out/ holds %r" % os.listdir(os.path.join(root, "out")))
 
 
