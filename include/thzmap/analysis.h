@@ -118,6 +118,7 @@ typedef struct thz_bands_options {
     double target_temperature_range_k;  /* each target's temperature varies within +- this
                                            (uniformly, independently), K; default 2 */
     double ambient_temperature_range_k; /* the other objects' and the air's temperature
+                                           (also when it follows the enclosure's)
                                            together, +- K; default 2 */
     double humidity_range;              /* the air's humidity within +- this fraction of the scene's
                                            value (0.2: +- 20 %); default 0.2 */

@@ -45,10 +45,11 @@ static double planck_dbdt(double nu, double t)
     return b * x * ex / (ex - 1.0) / t;
 }
 
-/* The scene's JSON with the nuisance `what` changed: 0 nominal, 1 the targets'
- * temperatures + range, 2 the other objects' and the air's temperature + range, 3 the
- * humidity x (1 - range), 4 every shell's thickness x (1 + range), 5 the sensor turned
- * by the angle range. Channels and render settings replaced in every variant. */
+/* The scene's JSON with the nuisance `what` changed: 0 nominal, 1 one target's
+ * temperature + range (one variant per target), 2 the other objects' and the air's
+ * temperature + range, 3 the humidity x (1 - range), 4 every shell's thickness
+ * x (1 + range), 5 the sensor turned by the angle range. Channels and render settings
+ * replaced in every variant. */
 enum {
     VAR_NOMINAL = 0,
     VAR_TARGETS,
@@ -139,10 +140,24 @@ static uint32_t coarse_paths(uint32_t paths)
     return paths >= 4 ? paths / 4 : 1;
 }
 
-/* *air_changed (may be NULL): whether the air's temperature is among the values the
- * variant changes (*changed counts them all) */
+/* The air's temperature in a variant: the nominal scene's air_t_k (NaN: its air has
+ * none) raised by the ambient range in VAR_AMBIENT, and held at air_t_k in every other
+ * variant, written out where the scene leaves it to the enclosure's temperature (an
+ * enclosure that is a target then changes alone). Returns 1 when it changed it. */
+static int set_air_temperature(json_t *atm, int what, double air_t_k, double range_k)
+{
+    if (!atm || !isfinite(air_t_k))
+        return 0;
+    double t = what == VAR_AMBIENT ? air_t_k + range_k : air_t_k;
+    json_object_set_new(atm, "temperature_k", json_real(t));
+    return what == VAR_AMBIENT;
+}
+
+/* The scene text of a variant (what, and for VAR_TARGETS the one object `target` whose
+ * temperature is raised); *changed counts the values it changes. air_t_k: the nominal
+ * air's temperature, K (NaN: none). */
 static char *variant_text(const json_t *root, const bands_setup *s, const bool *is_class, int what,
-                          bool coarse, int *changed, bool *air_changed)
+                          size_t target, double air_t_k, bool coarse, int *changed)
 {
     json_t *doc = json_deep_copy(root);
     if (!doc)
@@ -170,21 +185,19 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
     if (coarse && sensor)
         json_object_set_new(sensor, "oversampling", json_integer(1));
     *changed = 0;
-    if (air_changed)
-        *air_changed = false;
     json_t *objects = json_object_get(doc, "objects");
     json_t *atm = json_object_get(doc, "atmosphere");
-    if (what == VAR_TARGETS || what == VAR_AMBIENT) {
-        double dt = what == VAR_TARGETS ? s->target_range_k : s->ambient_range_k;
+    if (what != VAR_NOMINAL)
+        *changed += set_air_temperature(atm, what, air_t_k, s->ambient_range_k);
+    if (what == VAR_TARGETS) {
+        /* one target at a time: the targets' temperatures vary independently */
+        *changed +=
+            add_number(json_array_get(objects, target), "temperature_k", s->target_range_k, 1.0);
+    } else if (what == VAR_AMBIENT) {
         for (size_t i = 0; i < json_array_size(objects); i++)
-            if (is_class[i] == (what == VAR_TARGETS))
-                *changed += add_number(json_array_get(objects, i), "temperature_k", dt, 1.0);
-        if (what == VAR_AMBIENT && atm) {
-            int air = add_number(atm, "temperature_k", dt, 1.0);
-            *changed += air;
-            if (air_changed)
-                *air_changed = air != 0;
-        }
+            if (!is_class[i])
+                *changed += add_number(json_array_get(objects, i), "temperature_k",
+                                       s->ambient_range_k, 1.0);
     } else if (what == VAR_HUMIDITY && atm) {
         /* downwards, which every humidity key accepts */
         for (size_t i = 0; i < 3; i++)
@@ -204,13 +217,23 @@ static char *variant_text(const json_t *root, const bands_setup *s, const bool *
     return text;
 }
 
-/* One render of a variant: its Tb cube and radiance standard error (copied), and its
- * object_id truth (a turned sensor sees the classes at other pixels). */
+/* One render of a variant: its Tb cube and radiance standard error (copied), its
+ * object_id truth (a turned sensor sees the classes at other pixels), and the air's
+ * temperature it used (K, NaN: its air has none). */
 typedef struct render_out {
     float *tb, *stderr_l;
     int32_t *ids;
     size_t pixels;
+    double air_t_k;
 } render_out;
+
+/* The temperature of the scene's air, K, or NaN when it has none (no air, or air that
+ * neither emits nor has a state): what the nuisances hold or vary. */
+static double scene_air_temperature_k(const thz_scene *scene)
+{
+    const thz_atmosphere *atm = &scene->atmosphere;
+    return atm->has_air || atm->emitting ? atm->air.temperature_k : NAN;
+}
 
 static thz_status render_variant(thz_context *ctx, const char *text, const bands_setup *s,
                                  const char *base_dir, render_out *out, thz_error *err)
@@ -221,6 +244,7 @@ static thz_status render_variant(thz_context *ctx, const char *text, const bands
         thz_scene_load_string_within(text, base_dir, s->scene_path, s->root, &scene, err);
     if (st != THZ_OK)
         return st;
+    out->air_t_k = scene_air_temperature_k(scene);
     thz_run_settings rs;
     thz_run_settings_init(&rs);
     rs.integrator = "path";
@@ -417,7 +441,8 @@ static void pixel_covariance(const render_out *r, const int32_t *cls, const band
 static thz_status variant_means(thz_context *ctx, const char *text, const bands_setup *s,
                                 const char *base_dir, const int32_t *class_of, size_t n_obj,
                                 size_t pixels, int32_t *cls, uint64_t *count, const bands_values *v,
-                                const double *fallback, double *mean, thz_error *err)
+                                const double *fallback, double *mean, double *air_t_k,
+                                thz_error *err)
 {
     render_out r = {0};
     thz_status st = render_variant(ctx, text, s, base_dir, &r, err);
@@ -426,6 +451,7 @@ static thz_status variant_means(thz_context *ctx, const char *text, const bands_
     if (st == THZ_OK) {
         pixel_classes(&r, class_of, n_obj, v->n_classes, cls, count);
         class_means(&r, cls, count, v, fallback, mean);
+        *air_t_k = r.air_t_k;
     }
     render_out_fini(&r);
     return st;
@@ -490,7 +516,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     class_of = thz_calloc(n_obj ? n_obj : 1, sizeof *class_of);
     if (!is_class || !class_of)
         goto nomem;
-    text = variant_text(root, s, is_class, VAR_NOMINAL, false, &changed, NULL);
+    text = variant_text(root, s, is_class, VAR_NOMINAL, 0, NAN, false, &changed);
     if (!text)
         goto nomem;
     st = thz_scene_load_string_within(text, base_dir, s->scene_path, s->root, &scene, err);
@@ -545,63 +571,68 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
      * the Monte Carlo noise out of d). These renders and the nominal one d is taken
      * against are coarse (coarse_paths). Each render's own truth gives its classes'
      * pixels: a turned sensor sees them elsewhere in the image. */
+    double air_t_k = scene_air_temperature_k(scene);
     size_t varied = 0; /* the renders, now that the classes say which ranges change any */
-    for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
-        if (!(ranges[what] > 0.0))
-            continue;
-        text = variant_text(root, s, is_class, what, true, &changed, NULL);
-        if (!text)
-            goto nomem;
-        free(text);
-        text = NULL;
-        varied += changed != 0;
-    }
-    bands_progress_renders(&progress, 1 + (varied ? varied + 1 : 0));
-    for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
-        if (!(ranges[what] > 0.0))
-            continue;
-        bool air = false;
-        text = variant_text(root, s, is_class, what, true, &changed, &air);
-        if (!text)
-            goto nomem;
-        if (!changed) {
-            free(text);
-            text = NULL;
-            continue;
-        }
-        if (!coarse_mean) { /* the coarse nominal render the changes are taken against */
-            char *nominal_text = variant_text(root, s, is_class, VAR_NOMINAL, true, &changed, NULL);
-            coarse_mean = thz_calloc(nc * n, sizeof *coarse_mean);
-            if (!nominal_text || !coarse_mean) {
-                free(nominal_text);
-                goto nomem;
-            }
-            st = variant_means(ctx, nominal_text, s, base_dir, class_of, n_obj, nominal.pixels, cls,
-                               count, v, v->mean, coarse_mean, err);
-            free(nominal_text);
-            if (st != THZ_OK)
-                goto done;
-            v->renders++;
-        }
-        v->humidity_varied = v->humidity_varied || what == VAR_HUMIDITY;
-        v->air_temperature_varied = v->air_temperature_varied || (what == VAR_AMBIENT && air);
-        v->thickness_varied = v->thickness_varied || what == VAR_THICKNESS;
-        v->angle_varied = v->angle_varied || what == VAR_ANGLE;
-        st = variant_means(ctx, text, s, base_dir, class_of, n_obj, nominal.pixels, cls, count, v,
-                           coarse_mean, dmean, err);
-        free(text);
-        text = NULL;
-        if (st != THZ_OK)
-            goto done;
-        v->renders++;
-        for (size_t k = 0; k < nc; k++) {
-            double *d = dmean + k * n, *cov = v->cov + k * n * n;
-            for (size_t c = 0; c < n; c++)
-                d[c] = (d[c] - coarse_mean[k * n + c]) / sqrt(3.0);
-            for (size_t a = 0; a < n; a++) {
-                for (size_t b = 0; b < n; b++)
-                    cov[a * n + b] += d[a] * d[b];
-                v->nuisance_sd[k * n + a] += d[a] * d[a];
+    for (int pass = 0; pass < 2; pass++) { /* 0 counts the renders, 1 makes them */
+        if (pass == 1)
+            bands_progress_renders(&progress, 1 + (varied ? varied + 1 : 0));
+        for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
+            if (!(ranges[what] > 0.0))
+                continue;
+            /* each target's temperature is its own nuisance: one render per target */
+            for (size_t o = 0; o < (what == VAR_TARGETS ? n_obj : 1); o++) {
+                if (what == VAR_TARGETS && !is_class[o])
+                    continue;
+                text = variant_text(root, s, is_class, what, o, air_t_k, true, &changed);
+                if (!text)
+                    goto nomem;
+                if (!changed || pass == 0) {
+                    varied += changed != 0;
+                    free(text);
+                    text = NULL;
+                    continue;
+                }
+                if (!coarse_mean) { /* the coarse nominal render the changes are taken against */
+                    char *nominal_text =
+                        variant_text(root, s, is_class, VAR_NOMINAL, 0, air_t_k, true, &changed);
+                    coarse_mean = thz_calloc(nc * n, sizeof *coarse_mean);
+                    if (!nominal_text || !coarse_mean) {
+                        free(nominal_text);
+                        goto nomem;
+                    }
+                    double unused;
+                    st = variant_means(ctx, nominal_text, s, base_dir, class_of, n_obj,
+                                       nominal.pixels, cls, count, v, v->mean, coarse_mean, &unused,
+                                       err);
+                    free(nominal_text);
+                    if (st != THZ_OK)
+                        goto done;
+                    v->renders++;
+                }
+                double air_used = air_t_k;
+                st = variant_means(ctx, text, s, base_dir, class_of, n_obj, nominal.pixels, cls,
+                                   count, v, coarse_mean, dmean, &air_used, err);
+                free(text);
+                text = NULL;
+                if (st != THZ_OK)
+                    goto done;
+                v->renders++;
+                v->humidity_varied = v->humidity_varied || what == VAR_HUMIDITY;
+                /* whatever moved it: the air that follows an enclosure's temperature too */
+                v->air_temperature_varied =
+                    v->air_temperature_varied || (isfinite(air_used) && air_used != air_t_k);
+                v->thickness_varied = v->thickness_varied || what == VAR_THICKNESS;
+                v->angle_varied = v->angle_varied || what == VAR_ANGLE;
+                for (size_t k = 0; k < nc; k++) {
+                    double *d = dmean + k * n, *cov = v->cov + k * n * n;
+                    for (size_t c = 0; c < n; c++)
+                        d[c] = (d[c] - coarse_mean[k * n + c]) / sqrt(3.0);
+                    for (size_t a = 0; a < n; a++) {
+                        for (size_t b = 0; b < n; b++)
+                            cov[a * n + b] += d[a] * d[b];
+                        v->nuisance_sd[k * n + a] += d[a] * d[a];
+                    }
+                }
             }
         }
     }

@@ -1,7 +1,7 @@
 /* Band values from the scene itself (docs/analysis.md "thzmap bands"): the scene is
  * rendered with the candidate channels as its channels (path integrator, converged
  * radiance through covers and air), once as it is and once per nuisance changed
- * (targets' temperatures, the surroundings' and the air's temperature, the air's
+ * (each target's temperature alone, the surroundings' and the air's temperature, the air's
  * humidity, the shells' thickness, the viewing angle); each class's pixels come from
  * each render's object_id truth. The result is each
  * class's mean brightness temperature per candidate and its covariance over the

@@ -77,9 +77,80 @@ def test_bands_progress_counts_renders():
     thzmap.bands(FEATURES, 1, threads=1, progress=seen.append, **GRID)
     assert {p.stage for p in seen} == {"bands"}
     ends = [(p.channel, p.n_channels) for p in seen if p.done == p.total]
-    # the nominal render before the nuisances' count is known, then 2 of 3 and 3 of 3
-    assert ends == [(0, 0), (1, 3), (2, 3)], ends
+    # the nominal render before the nuisances' count is known, then the coarse nominal
+    # and one per target (room, A, B, C) of 6
+    assert ends == [(0, 0)] + [(i, 6) for i in range(1, 6)], ends
     assert all(p.total == 5 for p in seen)  # the candidates, 0.2 to 1.0 THz by 200 GHz
+
+
+FLAT_AND_DIP = os.path.join(SCENES, "flat-and-dip.json")
+H, K_B, C0 = 6.62607015e-34, 1.380649e-23, 299792458.0
+
+
+def _class_mean_stderr_k(path, name, thz, seed, paths):
+    """The Monte Carlo standard error (K) of object `name`'s mean Tb, per frequency, in
+    a render made as bands makes its nuisances' (1 sample per pixel, paths // 4 paths):
+    its pixels' spread over sqrt(pixels), the object being of one flat reflectivity
+    (a Lambertian plate of uniform Tb but for the render's noise)."""
+    d = json.loads(Path(path).read_text())
+    d["channels"] = [{"frequency_thz": f, "relative_width": 0.01} for f in thz]
+    d["render"] = {"integrator": "path", "paths_per_sample": max(1, paths // 4)}
+    d["sensors"][0]["oversampling"] = 1
+    scene = thzmap.scene_from_dict(d, base_dir=os.path.dirname(path))
+    image = thzmap.render(scene, integrator="path", seed=seed, threads=1).image("cam")
+    names = [o["name"] for o in d["objects"]]
+    mask = np.asarray(image.object_id).astype(int) == names.index(name)
+    tb = np.asarray(image.brightness_temperature, dtype=np.float64)[mask]
+    return tb.std(axis=0, ddof=1) / math.sqrt(mask.sum())
+
+
+def test_each_target_temperature_varies_alone():
+    # X (emissivity 0.4, reflectivity 0.6) in a closed room of 293 K: every object seen
+    # is a target, each raised by 2 K in its own render. X's Tb moves by 0.4 x 2 K when
+    # X is raised and by 0.6 x 2 K when the room is (X sees nothing else), so its spread
+    # is sqrt(0.8^2 + 1.2^2) / sqrt(3) = 0.833 K; raised together (one render) it was
+    # 2 / sqrt(3) = 1.155 K.
+    thz = [0.2, 0.6, 1.0]
+    sel = thzmap.bands(FLAT_AND_DIP, 1, from_thz=0.2, to_thz=1.0, step_ghz=400, paths=4,
+                       threads=1)
+    rep = sel.report
+    assert [c["name"] for c in rep["classes"]] == ["room", "X", "Y"]
+    assert rep["candidates"]["frequency_thz"] == thz
+    x = next(c for c in rep["classes"] if c["name"] == "X")
+    expect = math.hypot(0.4 * 2.0, 0.6 * 2.0) / math.sqrt(3.0)
+    # the change of a class mean is the difference of two renders of the same seed: its
+    # noise is at most sqrt(2) x the mean's standard error (the common seed only lowers
+    # it); 3 of those, and 0.01 K for what the closed form leaves out (the room's view
+    # of the plates, 1.5 % of its surface)
+    se = _class_mean_stderr_k(FLAT_AND_DIP, "X", thz, rep["seed"], rep["paths_per_sample"])
+    for f, got, s in zip(thz, x["nuisance_sd_k"], se):
+        tol = max(3.0 * math.sqrt(2.0) * s, 0.01)
+        assert abs(got - expect) <= tol, (f, got, expect, tol)
+    # the nominal render, the coarse nominal one and one per target (no air, so the
+    # ambient range changes nothing)
+    assert rep["renders"] == 5
+
+
+def test_air_temperature_varied_when_it_follows_the_room(tmp_path):
+    # an emitting atmosphere without temperature_k takes the enclosure's: the ambient
+    # nuisance that raises the room raises the air, and bands.json says so; without
+    # targets the room is a target and its render holds the air, which the ambient
+    # render raises alone
+    d = json.loads(Path(FEATURES).read_text())
+    d["atmosphere"] = {"model": "constant", "attenuation_per_m": 1.0}
+    path = tmp_path / "air.json"
+    path.write_text(json.dumps(d))
+    grid = dict(from_thz=0.4, to_thz=0.8, step_ghz=400, paths=2, threads=1)
+    sel = thzmap.bands(path, 1, targets=["A", "B"], **grid)
+    assert sel.report["nuisances"]["air_temperature_varied"] is True
+    sel = thzmap.bands(path, 1, **grid)
+    assert sel.report["nuisances"]["air_temperature_varied"] is True
+    # nominal, coarse nominal, room, A, B, C, the air
+    assert sel.report["renders"] == 7
+    d["atmosphere"]["emitting"] = False
+    path.write_text(json.dumps(d))
+    sel = thzmap.bands(path, 1, targets=["A", "B"], **grid)
+    assert sel.report["nuisances"]["air_temperature_varied"] is False
 
 
 def test_bands_takes_a_loaded_scene_and_targets():
