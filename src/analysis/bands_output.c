@@ -91,6 +91,11 @@ char *bands_json(const bands_report *rep, thz_error *err)
     put(root, "bhattacharyya", num(final->worst_b), &ok);
     put(root, "mean_jm", num(final->mean_jm), &ok);
     put(root, "worst_pair", pair_names(rep, final, &ok), &ok);
+    put(root, "monte_carlo_bhattacharyya", num(rep->noise_b), &ok);
+    json_t *warnings = json_array();
+    put(root, "warnings", warnings, &ok);
+    if (rep->warning)
+        push(warnings, json_string(rep->warning), &ok);
     put(root, "search", json_string(r->search), &ok);
     put(root, "sets_scored", json_integer((json_int_t)r->evaluations), &ok);
     json_t *per_k = json_array();

@@ -29,6 +29,36 @@ static void sub_cov(const bands_classes *cl, size_t k, const size_t *set, size_t
             out[i * m + j] = c[set[i] * n + set[j]];
 }
 
+double bands_noise_bhattacharyya(const bands_classes *cl, const size_t *set, size_t m, size_t i,
+                                 size_t j, const double *mean_var, double *work)
+{
+    size_t n = cl->n_candidates;
+    double *s = work, *inv = s + m * m, *e = inv + m * m;
+    const double *ci = cl->cov + i * n * n, *cj = cl->cov + j * n * n;
+    for (size_t a = 0; a < m; a++)
+        for (size_t b = 0; b < m; b++)
+            s[a * m + b] = 0.5 * (ci[set[a] * n + set[b]] + cj[set[a] * n + set[b]]);
+    if (!linalg_cholesky(s, m))
+        return NAN;
+    for (size_t b = 0; b < m; b++) { /* column b of S^-1 */
+        for (size_t a = 0; a < m; a++)
+            e[a] = a == b;
+        linalg_cholesky_solve(s, m, e, e);
+        for (size_t a = 0; a < m; a++)
+            inv[a * m + b] = e[a];
+    }
+    double mean = 0.0, var = 0.0;
+    for (size_t a = 0; a < m; a++) {
+        double da = mean_var[i * n + set[a]] + mean_var[j * n + set[a]];
+        mean += inv[a * m + a] * da;
+        for (size_t b = 0; b < m; b++) {
+            double db = mean_var[i * n + set[b]] + mean_var[j * n + set[b]];
+            var += 2.0 * inv[a * m + b] * inv[b * m + a] * da * db;
+        }
+    }
+    return (mean + 3.0 * sqrt(var)) / 8.0;
+}
+
 thz_status bands_score_set(const bands_classes *cl, const size_t *set, size_t m, double *work,
                            bands_score *out, thz_error *err)
 {

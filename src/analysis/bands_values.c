@@ -31,6 +31,7 @@ void bands_values_fini(bands_values *v)
     free(v->cov);
     free(v->pixel_sd);
     free(v->nuisance_sd);
+    free(v->mean_mc_var);
     free(v->netd_k);
     memset(v, 0, sizeof *v);
 }
@@ -225,6 +226,7 @@ typedef struct render_out {
     int32_t *ids;
     size_t pixels;
     double air_t_k;
+    bool has_stderr; /* false: one sample of one path per pixel estimates none */
 } render_out;
 
 /* The temperature of the scene's air, K, or NaN when it has none (no air, or air that
@@ -266,8 +268,11 @@ static thz_status render_variant(thz_context *ctx, const char *text, const bands
         goto done;
     }
     memcpy(out->tb, tb, pixels * nb * sizeof *tb);
-    if (se && ne == nb)
+    if (se && ne == nb) {
         memcpy(out->stderr_l, se, pixels * nb * sizeof *se);
+        for (size_t i = 0; i < pixels * nb && !out->has_stderr; i++)
+            out->has_stderr = se[i] > 0.0f;
+    }
     for (size_t p = 0; p < pixels; p++)
         out->ids[p] = (int32_t)ids[p];
 done:
@@ -423,6 +428,9 @@ static void pixel_covariance(const render_out *r, const int32_t *cls, const band
                 }
             mc /= (double)v->class_pixels[k];
             double var = cov[c * n + c];
+            /* the pixels' errors are independent: the mean's variance is their mean / pixels;
+             * a render without standard errors has the pixels' variance stand in (a bound) */
+            v->mean_mc_var[k * n + c] = (r->has_stderr ? mc : var) / (double)v->class_pixels[k];
             x[c] = var > mc ? sqrt(1.0 - mc / var) : 0.0;
         }
         for (size_t a = 0; a < n; a++)
@@ -554,12 +562,13 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     v->cov = thz_calloc(nc * n * n, sizeof *v->cov);
     v->pixel_sd = thz_calloc(nc * n, sizeof *v->pixel_sd);
     v->nuisance_sd = thz_calloc(nc * n, sizeof *v->nuisance_sd);
+    v->mean_mc_var = thz_calloc(nc * n, sizeof *v->mean_mc_var);
     v->netd_k = thz_calloc(nc * n, sizeof *v->netd_k);
     x = thz_calloc(n, sizeof *x);
     dmean = thz_calloc(nc * n, sizeof *dmean);
     count = thz_calloc(nc, sizeof *count);
-    if (!v->mean || !v->cov || !v->pixel_sd || !v->nuisance_sd || !v->netd_k || !x || !dmean ||
-        !count)
+    if (!v->mean || !v->cov || !v->pixel_sd || !v->nuisance_sd || !v->mean_mc_var || !v->netd_k ||
+        !x || !dmean || !count)
         goto nomem;
     class_means(&nominal, cls, v->class_pixels, v, v->mean, v->mean);
     class_netd(scene, s, v);

@@ -42,6 +42,7 @@ typedef struct bands_values {
     double *cov;            /* [class * n^2 + c * n + c']: K^2 */
     double *pixel_sd;       /* [class * n + c]: pixel spread (MC removed), K */
     double *nuisance_sd;    /* [class * n + c]: all nuisances together, K */
+    double *mean_mc_var;    /* [class * n + c]: variance of the mean's Monte Carlo error, K^2 */
     double *netd_k;         /* [class * n + c]: the sensor's NETD at the class's mean Tb, K */
     bool humidity_varied, air_temperature_varied, thickness_varied, angle_varied;
     size_t renders;

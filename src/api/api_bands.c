@@ -31,6 +31,8 @@ struct thz_bands {
     bands_values values;
     bands_search_result search;
     double *air_db_per_km; /* or NULL */
+    double noise_b;        /* the worst pair's B from its means' Monte Carlo noise alone */
+    char *warning;         /* NULL, or: the worst pair cannot be told apart */
     char *json;
 };
 
@@ -67,6 +69,7 @@ void thz_bands_destroy(thz_bands *b)
     bands_values_fini(&b->values);
     bands_search_result_fini(&b->search);
     free(b->air_db_per_km);
+    free(b->warning);
     free(b->json);
     free(b);
 }
@@ -285,6 +288,44 @@ done:
     return st;
 }
 
+/* Whether the chosen set's worst pair is told apart by more than the Monte Carlo noise
+ * of the class means (docs/analysis.md "Outputs"): two identical targets get a B from
+ * that noise alone, and a chosen set that means nothing; warned through ctx and kept
+ * for bands.json. */
+static thz_status check_worst_pair(thz_context *ctx, thz_bands *b, thz_error *err)
+{
+    const bands_search_result *r = &b->search;
+    const bands_score *s = &r->scores[r->count - 1];
+    size_t m = r->count, work_n = 2 * m * m + m;
+    double *work = thz_calloc(work_n, sizeof *work);
+    if (!work)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    bands_classes cl = {.n_candidates = b->setup.n_candidates,
+                        .n_classes = b->values.n_classes,
+                        .mean = b->values.mean,
+                        .cov = b->values.cov,
+                        .group = b->group};
+    b->noise_b = bands_noise_bhattacharyya(&cl, r->sets + (m - 1) * r->count, m, s->worst_pair[0],
+                                           s->worst_pair[1], b->values.mean_mc_var, work);
+    free(work);
+    if (!(s->worst_b <= b->noise_b))
+        return THZ_OK;
+    char msg[1024];
+    snprintf(msg, sizeof msg,
+             "'%s' and '%s' cannot be told apart: their Bhattacharyya distance on the chosen "
+             "channels, %.3g, is not above the %.3g that the Monte Carlo noise of their mean "
+             "brightness temperatures alone gives: the chosen set may answer that noise (more "
+             "--paths lowers it), or the two are alike",
+             b->values.class_names[s->worst_pair[0]], b->values.class_names[s->worst_pair[1]],
+             s->worst_b, b->noise_b);
+    b->warning = thz_strdup(msg);
+    if (!b->warning)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    if (ctx && ctx->warning)
+        ctx->warning(ctx->warning_user, msg);
+    return THZ_OK;
+}
+
 static bands_report make_report(const thz_bands *b)
 {
     return (bands_report){.scene_path = b->scene_path,
@@ -299,7 +340,9 @@ static bands_report make_report(const thz_bands *b)
                           .air_db_per_km = b->air_db_per_km,
                           .width_list = b->width_list,
                           .n_widths = b->n_widths,
-                          .netd_source = b->netd_source};
+                          .netd_source = b->netd_source,
+                          .noise_b = b->noise_b,
+                          .warning = b->warning};
 }
 
 thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_bands_options *o,
@@ -383,6 +426,8 @@ thz_status thz_bands_select(thz_context *ctx, const char *scene_path, const thz_
                         .group = b->group};
     st = bands_search(&cl, o->count, o->exhaustive_limit ? o->exhaustive_limit : 2000000,
                       &b->search, err);
+    if (st == THZ_OK)
+        st = check_worst_pair(ctx, b, err);
     if (st != THZ_OK)
         goto done;
     bands_report rep = make_report(b);

@@ -247,6 +247,33 @@ expect2 "no --count" "$IN/features.json" -o "$TMP/x"
 expect2 "--count 0" "$IN/features.json" -o "$TMP/x" --count 0
 expect2 "no -o" "$IN/features.json" --count 1
 expect2 "to below from" "$IN/features.json" -o "$TMP/x" --count 1 --from-thz 1 --to-thz 0.5
+# two targets of one material: their means differ by the renders' Monte Carlo noise
+# alone, which the worst pair's B does not exceed: a warning on standard error (also
+# with -q) and in bands.json; two different plates: none
+$PY - "$IN/flat-and-dip.json" "$TMP/identical.json" <<'PYEOF'
+import json, sys
+d = json.load(open(sys.argv[1]))
+for o in d["objects"]:
+    if o["name"] == "Y":
+        o["material"] = "x"
+json.dump(d, open(sys.argv[2], "w"))
+PYEOF
+for s in identical flat; do
+    scene="$TMP/identical.json"; [ $s = flat ] && scene="$IN/flat-and-dip.json"
+    "$THZ" bands "$scene" -o "$TMP/$s" --count 2 --from-thz 0.2 --to-thz 1.0 --step-ghz 50 \
+        --paths 4 --targets X,Y -q 2> "$TMP/$s.err" || fail "$s targets: exit status $?"
+done
+grep -q "^thzmap bands: warning: 'X' and 'Y' cannot be told apart: their Bhattacharyya distance" \
+    "$TMP/identical.err" || fail "identical targets, no warning: $(cat "$TMP/identical.err")"
+[ -s "$TMP/flat.err" ] && fail "different targets warned: $(cat "$TMP/flat.err")"
+$PY - "$TMP/identical/bands.json" "$TMP/flat/bands.json" <<'PYEOF' || fail "warnings in bands.json"
+import json, sys
+same, diff = (json.load(open(p)) for p in sys.argv[1:3])
+assert same["bhattacharyya"] <= same["monte_carlo_bhattacharyya"], same
+assert len(same["warnings"]) == 1 and "cannot be told apart" in same["warnings"][0], same
+assert diff["warnings"] == [] and diff["bhattacharyya"] > 10 * diff["monte_carlo_bhattacharyya"]
+PYEOF
+
 expect2 "unknown target" "$IN/features.json" -o "$TMP/x" --count 1 --targets A,nope
 grep -q "nope" "$TMP/err" || fail "unknown target not named: $(cat "$TMP/err")"
 expect2 "no sensor noise" "$IN/features.json" -o "$TMP/x" --count 1 --netd-k 0
