@@ -106,7 +106,8 @@ typedef struct thz_bands_options {
     double from_thz;            /* candidate centres from .. to, both included; default 0.1 */
     double to_thz;              /* default 1.5 */
     double step_ghz;            /* default 10 */
-    double relative_width;      /* of every candidate; 0: the scene's first channel's */
+    double relative_width;      /* of every candidate; 0: the scene's first channel's (of a
+                                   measured response: its FWHM / centre, at most 0.5) */
     const char *sensor;         /* NULL: the scene's first */
     const char *const *targets; /* n_targets object names (not NULL; else THZ_ERR_INPUT);
                                    n_targets 0: every object the sensor sees */

@@ -257,8 +257,13 @@ static thz_status resolve_scene(thz_bands *b, const thz_bands_options *o, thz_er
         goto done;
     thz_channel_info ci;
     thz_scene_channel(scene, 0, &ci);
+    /* the default width: the first channel's; a measured response has none, its FWHM /
+     * centre stands for it (at most 0.5, the widest a candidate may be) */
+    double first_width = ci.relative_width;
+    if (!(first_width > 0.0) && ci.fwhm_hz > 0.0 && ci.frequency_hz > 0.0)
+        first_width = fmin(ci.fwhm_hz / ci.frequency_hz, 0.5);
     if (!o->n_widths)
-        b->width_list[0] = o->relative_width > 0.0 ? o->relative_width : ci.relative_width;
+        b->width_list[0] = o->relative_width > 0.0 ? o->relative_width : first_width;
     for (size_t c = 0; c < b->setup.n_candidates; c++)
         b->widths[c] = b->width_list[c % b->n_widths];
     b->setup.seed = o->has_seed ? o->seed : info.seed;

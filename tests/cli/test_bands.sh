@@ -247,6 +247,20 @@ expect2 "no --count" "$IN/features.json" -o "$TMP/x"
 expect2 "--count 0" "$IN/features.json" -o "$TMP/x" --count 0
 expect2 "no -o" "$IN/features.json" --count 1
 expect2 "to below from" "$IN/features.json" -o "$TMP/x" --count 1 --from-thz 1 --to-thz 0.5
+# a first channel with a measured response (no relative_width): the candidates take its
+# FWHM / centre (0.05 THz / 0.5 THz), not the 0 that blamed the scene's channels[0].relative_width
+$PY - "$IN/features.json" "$TMP/response.json" <<'PYEOF'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["channels"] = [{"frequency_thz": 0.5, "response": [[0.45, 0], [0.5, 1], [0.55, 0]]}]
+json.dump(d, open(sys.argv[2], "w"))
+PYEOF
+"$THZ" bands "$TMP/response.json" -o "$TMP/resp" --count 1 --from-thz 0.4 --to-thz 0.8 \
+    --step-ghz 400 --paths 2 -q 2> "$TMP/resp.err" || fail "response channel: $(cat "$TMP/resp.err")"
+$PY -c 'import json, sys; c = json.load(open(sys.argv[1]))["candidates"]
+assert abs(c["relative_width"] - 0.1) < 1e-9, c' "$TMP/resp/bands.json" ||
+    fail "response channel: not its FWHM / centre"
+
 # two targets of one material: their means differ by the renders' Monte Carlo noise
 # alone, which the worst pair's B does not exceed: a warning on standard error (also
 # with -q) and in bands.json; two different plates: none
