@@ -220,6 +220,35 @@ static thz_status classify_build(const thz_cube *cube, const thz_cube *truth,
         }
         ids[p] = (int32_t)v;
     }
+    /* what classify_run would refuse in terms of pixels: here, in the files' terms */
+    int32_t first = -1;
+    bool two = false;
+    for (size_t p = 0; p < pixels && !two; p++) {
+        if (ids[p] >= 0 && first < 0)
+            first = ids[p];
+        two = ids[p] >= 0 && ids[p] != first;
+    }
+    if (!two) {
+        st = first < 0 ? thz_error_set(err, THZ_ERR_INPUT,
+                                       "%s%s%s: the truth map shows no object (all -1)",
+                                       run_dir ? run_dir : "", run_dir ? "/" : "", truth->stem)
+                       : thz_error_set(err, THZ_ERR_INPUT,
+                                       "%s%s%s: the truth map shows one object only (index %d): "
+                                       "nothing to tell it from; classify needs two classes",
+                                       run_dir ? run_dir : "", run_dir ? "/" : "", truth->stem,
+                                       (int)first);
+        goto done;
+    }
+    for (size_t i = 0; i < pixels * cc->bands; i++)
+        if (!isfinite(cc->data[i])) {
+            size_t p = i % pixels;
+            st = thz_error_set(err, THZ_ERR_INPUT,
+                               "%s%s%s: band %zu, row %zu, column %zu holds a value that is not "
+                               "finite",
+                               run_dir ? run_dir : "", run_dir ? "/" : "", cube->stem,
+                               i / pixels + 1, p / cc->samples + 1, p % cc->samples + 1);
+            goto done;
+        }
     memcpy(values, cc->data, pixels * cc->bands * sizeof *values);
     for (size_t b = 0; b < cc->bands; b++)
         sigma[b] = opt->netd_k;

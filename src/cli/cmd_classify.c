@@ -130,7 +130,7 @@ int cmd_classify(int argc, char **argv)
                 (unsigned long long)info.training_pixels);
         for (size_t k = 0; k < info.n_classes; k++) {
             double auc = thz_classification_auc(c, k);
-            char auc_text[32] = "none (no held-out pixels)";
+            char auc_text[64] = "none (no held-out pixel of it or of the rest)";
             if (isfinite(auc))
                 snprintf(auc_text, sizeof auc_text, "%.4f", auc);
             fprintf(stderr, "  %-24s accuracy %6.2f %%  AUC %s\n",

@@ -132,5 +132,27 @@ printf 'ENVI\nsamples = 24\nlines = 16\nbands = 5\ndata type = 4\n' > "$TMP/run2
 head -c 100 "$TMP/run/cam.brightness_temperature.img" > "$TMP/run2/cam.measured_brightness_temperature.img"
 expect2 "truncated cube" "$TMP/run2" --sensor cam -o "$TMP/x"
 grep -q "bytes" "$TMP/err" || fail "truncated cube: $(cat "$TMP/err")"
+# a truth of one object only: nothing to tell apart (it reported 100 %), said of the truth
+# file with its run directory; a cube value that is not finite, by band, row and column
+cp -r "$TMP/run" "$TMP/one"
+$PY - "$TMP/one" <<'PYEOF' || fail "test set-up: one-object truth"
+import sys
+import numpy as np
+d = sys.argv[1]
+t = np.fromfile(d + "/cam.object_id.img", dtype="<f4")
+t[t >= 0] = t[t >= 0].min()
+t.tofile(d + "/cam.object_id.img")
+c = np.fromfile(d + "/cam.brightness_temperature.img", dtype="<f4")
+c[1 * t.size + 2 * 24 + 5] = np.nan  # band 2, row 3, column 6 (24 columns)
+c.tofile(d + "/cam.brightness_temperature.nan")
+PYEOF
+expect2 "one object" "$TMP/one" --sensor cam -o "$TMP/x"
+grep -q "one/cam.object_id: the truth map shows one object only" "$TMP/err" ||
+    fail "one object: $(cat "$TMP/err")"
+cp "$TMP/run/cam.object_id.img" "$TMP/one/cam.object_id.img"
+mv "$TMP/one/cam.brightness_temperature.nan" "$TMP/one/cam.brightness_temperature.img"
+expect2 "a NaN in the cube" "$TMP/one" --sensor cam -o "$TMP/x"
+grep -q "one/cam.brightness_temperature: band 2, row 3, column 6 holds a value that is not finite" \
+    "$TMP/err" || fail "NaN pixel: $(cat "$TMP/err")"
 [ -e "$TMP/x" ] && fail "a failed run left $TMP/x"
 echo ok
