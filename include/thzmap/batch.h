@@ -108,8 +108,9 @@ typedef struct thz_batch_result {
  * cancels too; the batch replaces ctx's callback while it runs and restores it). Each
  * frame's scene warnings and run warnings go to ctx's warning callback, frame by frame.
  * When the frames do not all have the same sensors and channels there are no movies:
- * ctx's warning callback says why. One batch at a time per outdir (THZ_ERR_IO naming the
- * other process). opt and result may be NULL. */
+ * ctx's warning callback says why; a sensor too large for the encoder (a movie frame
+ * above 16384 pixels a side with libx264) has none, which it says before the frames. One batch at a
+ * time per outdir (THZ_ERR_IO naming the other process). opt and result may be NULL. */
 THZ_API thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *outdir,
                                  const thz_batch_options *opt, thz_batch_result *result,
                                  thz_error *err);

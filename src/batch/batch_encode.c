@@ -286,6 +286,33 @@ static const AVCodec *movie_find_codec(const movie_av *av)
     return c ? c : av->avcodec_find_encoder(AV_CODEC_ID_MPEG4);
 }
 
+/* Probed with this libavcodec (59) and libx264 (164): x264 refuses a width or height
+ * above 16384 ("invalid width x height"), MPEG-4 part 2 one of 8192 or more ("dimensions
+ * too large for MPEG-4"; its sizes are 13-bit), whose largest even size is 8190. */
+enum { MOVIE_MAX_SIDE_X264 = 16384, MOVIE_MAX_SIDE_MPEG4 = 8190 };
+
+int movie_fits(uint32_t columns, uint32_t rows, movie_limit *out)
+{
+    movie_layout l;
+    movie_layout_of(columns, rows, &l);
+    *out = (movie_limit){.width = l.width,
+                         .height = l.height,
+                         .max_side = MOVIE_MAX_SIDE_MPEG4,
+                         .codec = "MPEG-4 part 2"};
+    if (l.width <= MOVIE_MAX_SIDE_MPEG4 && l.height <= MOVIE_MAX_SIDE_MPEG4)
+        return 1; /* within every encoder's: no need to open FFmpeg to know which */
+    movie_av av;
+    thz_error ignored;
+    /* without FFmpeg there is no movie either way; movie_open says why */
+    if (movie_av_open(&av, &ignored) != THZ_OK ||
+        av.avcodec_find_encoder_by_name("libx264") != NULL) {
+        out->max_side = MOVIE_MAX_SIDE_X264;
+        out->codec = "libx264";
+    }
+    movie_av_close(&av);
+    return l.width <= out->max_side && l.height <= out->max_side;
+}
+
 thz_status movie_open(const movie_spec *spec, movie_writer **out, thz_error *err)
 {
     *out = NULL;

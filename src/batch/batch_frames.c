@@ -24,6 +24,7 @@ void thz_sequence_destroy(thz_sequence *seq)
     free(seq->frame_dir);
     free(seq->hash);
     free(seq->sweep_label);
+    free(seq->movies_unmade);
     free(seq->path);
     free(seq->root);
     for (size_t k = 0; k < seq->n_scenes; k++) {

@@ -21,22 +21,23 @@
 #include "thzmap/thzmap.h"
 
 struct thz_sequence {
-    char *path;         /* the sequence file as given */
-    char *root;         /* NULL, or the real path its files are confined to (load_within) */
-    size_t n_scenes;    /* scene files: 1 ("scene"), or the length of "scenes" */
-    int scene_list;     /* "scenes": frame i of each sweep value is scene i */
-    char **scene_paths; /* per scene file, resolved against the sequence's directory */
-    char **scene_dirs;  /* per scene file, its directory: relative paths in its frames */
-    double fps;         /* frames per second */
-    size_t frames;      /* per sweep value */
-    size_t n_sweeps;    /* sweep values (1 without a sweep) */
-    int has_sweep;      /* frame directories under sweep-NN/ */
-    int sweep_digits;   /* NN's digits: 2, more where there are more than 100 values */
-    size_t n_frames;    /* frames * n_sweeps */
-    char **frame_json;  /* per frame: the scene text (compact, keys in document order) */
-    char **frame_dir;   /* per frame: "frame-NNNNN" or "sweep-NN/frame-NNNNN" */
-    uint64_t *hash;     /* per frame: hash of its inputs */
-    char **sweep_label; /* per sweep value: "atmosphere.relative_humidity = 0.5, ..." */
+    char *path;          /* the sequence file as given */
+    char *root;          /* NULL, or the real path its files are confined to (load_within) */
+    size_t n_scenes;     /* scene files: 1 ("scene"), or the length of "scenes" */
+    int scene_list;      /* "scenes": frame i of each sweep value is scene i */
+    char **scene_paths;  /* per scene file, resolved against the sequence's directory */
+    char **scene_dirs;   /* per scene file, its directory: relative paths in its frames */
+    double fps;          /* frames per second */
+    size_t frames;       /* per sweep value */
+    size_t n_sweeps;     /* sweep values (1 without a sweep) */
+    int has_sweep;       /* frame directories under sweep-NN/ */
+    int sweep_digits;    /* NN's digits: 2, more where there are more than 100 values */
+    size_t n_frames;     /* frames * n_sweeps */
+    char **frame_json;   /* per frame: the scene text (compact, keys in document order) */
+    char **frame_dir;    /* per frame: "frame-NNNNN" or "sweep-NN/frame-NNNNN" */
+    uint64_t *hash;      /* per frame: hash of its inputs */
+    char **sweep_label;  /* per sweep value: "atmosphere.relative_humidity = 0.5, ..." */
+    char *movies_unmade; /* NULL, or why some sensors' movies cannot be made (too large) */
 };
 
 /* "sweep-NN" (sweep_digits digits) of sweep value s into buf. */
@@ -78,8 +79,13 @@ thz_status batch_read_band(const char *path, uint32_t columns, uint32_t rows, si
  * one colour scale per sensor and channel over all frames; appends their descriptions
  * to `movies` (a JSON array, batch.json's "movies"). Deterministic: the same frames give
  * the same bytes. When the frames do not all have the same sensors (names and sizes)
- * and channels (frequencies and widths), writes none and says why in skipped (else
+ * and channels (frequencies and widths), writes none and says why in skipped; a sensor
+ * too large for the encoder (batch_movie_sizes) gets none and skipped says so (else
  * skipped[0] = '\0'). */
+/* Whether every sensor of scene (frame 0's) makes a movie the encoder accepts (1);
+ * else 0 and why, naming each sensor that does not, in why. */
+int batch_movie_sizes(const thz_scene *scene, char *why, size_t size);
+
 thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_t *movies,
                               char *skipped, size_t skipped_size, thz_error *err);
 
@@ -189,6 +195,19 @@ typedef struct movie_spec {
 } movie_spec;
 
 typedef struct movie_writer movie_writer;
+
+/* A movie's frame size against its encoder's largest (libx264: 16384 pixels a side;
+ * MPEG-4 part 2, where libavcodec lacks libx264: 8190). */
+typedef struct movie_limit {
+    uint32_t width, height; /* the movie's frame (movie_layout_of), px */
+    uint32_t max_side;      /* the encoder's largest width and height, px */
+    const char *codec;      /* its name, for messages (static) */
+} movie_limit;
+
+/* Whether a sensor of columns x rows pixels makes a movie the encoder accepts; *out says
+ * the sizes either way. Opens FFmpeg (to see which encoder there is) only for a frame
+ * larger than 8190 pixels a side. */
+int movie_fits(uint32_t columns, uint32_t rows, movie_limit *out);
 
 void movie_layout_of(uint32_t columns, uint32_t rows, movie_layout *out);
 /* Opens the encoder on a temporary file beside spec->path. */

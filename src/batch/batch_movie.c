@@ -4,7 +4,8 @@
  * movies as an uninterrupted one). One colour scale per sensor and channel: the least
  * and greatest finite Tb over every frame of every sweep value. Movies are made only
  * when every frame has frame 0's sensors and channels (a list of scenes or a sweep may
- * change them): else none, and batch.json and a warning say why.
+ * change them): else none, and batch.json and a warning say why; the same for the
+ * movies of a sensor too large for the encoder (16384 pixels a side with libx264).
  */
 #include <math.h>
 #include <stdio.h>
@@ -162,6 +163,26 @@ static int batch_same_frame_shape(const thz_scene *a, const thz_scene *b, char *
     return 1;
 }
 
+int batch_movie_sizes(const thz_scene *scene, char *why, size_t size)
+{
+    why[0] = '\0';
+    size_t len = 0;
+    for (size_t k = 0; k < thz_scene_sensor_count(scene); k++) {
+        thz_sensor_info si;
+        movie_limit lim;
+        thz_scene_sensor(scene, k, &si);
+        if (movie_fits(si.columns, si.rows, &lim))
+            continue;
+        int n = snprintf(why + len, size - len,
+                         "%sno movies of sensor \"%s\": its %u x %u pixels make movie frames of "
+                         "%u x %u pixels, and %s takes at most %u x %u",
+                         len ? "; " : "", si.name, si.columns, si.rows, lim.width, lim.height,
+                         lim.codec, lim.max_side, lim.max_side);
+        len = n > 0 && (size_t)n < size - len ? len + (size_t)n : size - 1;
+    }
+    return why[0] == '\0';
+}
+
 /* Loads the first frame's scene of every sweep value into sw; checks that every frame
  * has frame 0's sensors and channels (else says why in skipped and returns THZ_OK). */
 static thz_status batch_movie_sensors(const thz_sequence *seq, sweep_sensors *sw, char *skipped,
@@ -219,8 +240,14 @@ thz_status batch_movies_write(const thz_sequence *seq, const char *outdir, json_
     if (!band)
         st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     size_t n_sensors = st == THZ_OK ? sw[0].n : 0, n_channels = st == THZ_OK ? sw[0].n_channels : 0;
+    /* a sensor too large for the encoder has no movies; the others have theirs */
+    if (st == THZ_OK)
+        batch_movie_sizes(sw[0].scene, skipped, skipped_size);
     for (size_t k = 0; st == THZ_OK && k < n_sensors; k++)
         for (size_t c = 0; st == THZ_OK && c < n_channels; c++) {
+            movie_limit lim;
+            if (!movie_fits(sw[0].info[k].columns, sw[0].info[k].rows, &lim))
+                break;
             /* the colour scale over every frame of every sweep value */
             double lo = INFINITY, hi = -INFINITY;
             for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++) {

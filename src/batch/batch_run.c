@@ -41,9 +41,9 @@ typedef struct batch_state {
     size_t *base;        /* per frame: the frame whose photons it renders from (batch_reuse.c) */
     size_t *rank;        /* per frame: the MPI rank that computes it (0: this process) */
     int *reused_photons; /* per frame computed by this call: BATCH_PHOTONS_* */
-    batch_photon_cache cache; /* the photons of the current base frame */
-    json_t *movies;           /* the movies' descriptions (batch.json "movies") */
-    char movies_skipped[700]; /* why there are none ("" when there are) */
+    batch_photon_cache cache;  /* the photons of the current base frame */
+    json_t *movies;            /* the movies' descriptions (batch.json "movies") */
+    char movies_skipped[1024]; /* why there are none or some are missing ("": none is) */
     const thz_batch_options *opt;
     thz_progress_fn run_progress; /* the caller's progress callback on ctx, restored after */
     void *run_progress_user;
@@ -518,6 +518,13 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
         }
     if (st == THZ_OK && b.reused > 0)
         batch_clean_finished(&b);
+    /* a sensor too large for the movie encoder: said before the frames run */
+    bool movies = !(opt && opt->no_movies);
+    if (st == THZ_OK && movies && seq->movies_unmade) {
+        snprintf(b.movies_skipped, sizeof b.movies_skipped, "%s", seq->movies_unmade);
+        if (ctx && ctx->warning)
+            ctx->warning(ctx->warning_user, b.movies_skipped);
+    }
     if (st == THZ_OK)
         st = batch_write_json(&b, err);
     if (st == THZ_OK)
@@ -562,7 +569,7 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
     }
     if (dealt)
         api_mpi_deal_end(ctx);
-    if (st == THZ_OK && !(opt && opt->no_movies)) {
+    if (st == THZ_OK && movies) {
         if (batch_report(opt, &b, seq->n_frames, "movie"))
             st = thz_error_set(err, THZ_ERR_CANCELLED, "cancelled");
         double t0 = batch_now_s();
@@ -575,7 +582,9 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
          * one) still stops the batch: it said "complete" and exited 0 */
         if (st == THZ_OK && batch_report(opt, &b, seq->n_frames, "movie"))
             st = thz_error_set(err, THZ_ERR_CANCELLED, "cancelled");
-        if (st == THZ_OK && b.movies_skipped[0] && ctx && ctx->warning)
+        /* (not again when the frames' start said so) */
+        if (st == THZ_OK && b.movies_skipped[0] && ctx && ctx->warning &&
+            !(seq->movies_unmade && !strcmp(seq->movies_unmade, b.movies_skipped)))
             ctx->warning(ctx->warning_user, b.movies_skipped);
         b.seconds_movies = batch_now_s() - t0;
         if (st != THZ_OK) {

@@ -449,6 +449,13 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
     /* loaded (and so confined to seq->root) before the hash reads the files it names */
     thz_scene *scene = NULL;
     thz_status st = thz_sequence_frame_scene(seq, f, &scene, b->err);
+    /* a sensor too large for the movie encoder is known now, not after every frame ran:
+     * its movies are skipped (frame 0's sensors; other frames with other sensors make no
+     * movies at all, batch_movies_write) */
+    char why[1024];
+    if (st == THZ_OK && f == 0 && !batch_movie_sizes(scene, why, sizeof why) &&
+        !(seq->movies_unmade = thz_strdup(why)))
+        st = thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
     thz_scene_destroy(scene);
     if (st != THZ_OK && b->err && seq->scene_list)
         thz_error_prefix(b->err, "%s: frame %zu (scenes[%zu]%s%s): ", b->label, i, k,

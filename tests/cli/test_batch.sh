@@ -23,6 +23,8 @@
 #    hash, with movies; scenes with other sensors: no movies, a warning; the batch's
 #    progress within a frame (the CLI's lines on a non-terminal);
 #  - libgomp calling exit() inside a frame leaves no staging directory or lock;
+#  - a sensor too large for the movie encoder (libx264: 16384 pixels a side): its movies
+#    skipped with a warning before the first frame, the others made, exit 0;
 #  - bad sequence files: exit 2, the JSON path in the message, nothing written.
 # argv: path to the thzmap binary, repository directory.
 set -u
@@ -449,6 +451,47 @@ echo '{"format": "thzmap-sequence/1", "scene": "bg.json", "fps": 1, "frames": 2}
 grep -q '^thzmap batch: warning: frame 1/2 (frame-00000): atmosphere.background_temperature_k is given' "$work/BG.err" &&
     grep -q '^thzmap batch: warning: the same in 1 later frame: atmosphere.background' "$work/BG.err" ||
     fail "a frame's scene warning not printed once with its frame: $(cat "$work/BG.err")"
+
+# --- a sensor too large for the movie encoder: its movies skipped, said up front -------
+# (libx264 takes at most 16384 pixels a side; a 1 x 1100 sensor is enlarged 16 times to
+# 17616 rows.) The batch encoded every frame and then failed with exit 1, again on rerun.
+mkdir -p "$work/big"
+"$PY" - "$work/big" <<'PY'
+import json, sys
+d = sys.argv[1]
+cam = {"position_m": [0, -1.4, 0], "look_at_m": [0, 0, 0], "fov_deg": 40}
+scene = {"format": "thzmap-scene/1",
+         "channels": [{"frequency_thz": 0.35, "relative_width": 0.01}],
+         "materials": {"wall": {"reflectivity": 0.1}},
+         "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+                      "shape": {"type": "box", "size_m": [3, 3, 3], "inward": True}}],
+         "sensors": [dict(cam, name="cam", resolution=[4, 4]),
+                     dict(cam, name="tall", resolution=[1, 1100])],
+         "render": {"integrator": "path", "paths_per_sample": 1}}
+json.dump(scene, open(f"{d}/tall.json", "w"))
+json.dump({"format": "thzmap-sequence/1", "scene": "tall.json", "frames": 2},
+          open(f"{d}/seq.json", "w"))
+PY
+for run in 1 2; do
+    timeout 120 "$THZMAP" batch "$work/big/seq.json" -o "$work/big/out" > "$work/big/out$run.log" 2>&1
+    rc=$?
+    [ $rc -eq 0 ] || fail "batch with a too tall sensor (run $run): exit $rc: $(tail -3 "$work/big/out$run.log")"
+done
+# the warning comes before the first frame, once
+first=$(grep -n 'warning: no movies of sensor "tall"' "$work/big/out1.log" | head -1 | cut -d: -f1)
+frame1=$(grep -n 'frame 1/2' "$work/big/out1.log" | head -1 | cut -d: -f1)
+{ [ -n "$first" ] && [ -n "$frame1" ] && [ "$first" -lt "$frame1" ] &&
+    [ "$(grep -c 'no movies of sensor' "$work/big/out1.log")" -eq 1 ]; } ||
+    fail "too tall sensor: one warning before the frames: $(cat "$work/big/out1.log")"
+"$PY" - "$work/big/out" <<'PY' || fail "batch.json of the too tall sensor's batch"
+import json, os, sys
+d = sys.argv[1]
+b = json.load(open(f"{d}/batch.json"))
+assert b["complete"] and b["frames_done"] == 2, b
+assert "sensor \"tall\"" in b["movies_skipped"] and "16384" in b["movies_skipped"], b["movies_skipped"]
+assert [m["file"] for m in b["movies"]] == ["cam.band-01.mp4"], b["movies"]
+assert os.path.exists(f"{d}/cam.band-01.mp4") and not os.path.exists(f"{d}/tall.band-01.mp4")
+PY
 
 # --- bad sequence files -------------------------------------------------------------
 bad() { # bad NAME EXPECTED-TEXT JSON
