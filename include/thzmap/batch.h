@@ -31,7 +31,8 @@ typedef struct thz_sequence thz_sequence;
 /* Loads a sequence file and its scene and checks both: the sequence's keys and values
  * (errors name the file and JSON path, e.g. `seq.json: keyframes[1].objects.person:
  * the scene has no object named "person"`), and that every frame's scene loads (errors
- * name the frame). THZ_ERR_INPUT for bad input. *out owns the sequence. */
+ * name the frame). THZ_ERR_INPUT for bad input, also for more than 100000 frames in
+ * all (frames per sweep value x sweep values). *out owns the sequence. */
 THZ_API thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *err);
 /* The same confined to the directory `root` (NULL: not confined), as
  * thz_scene_load_within (thzmap/scene.h): the sequence file, the scene files it names
@@ -39,6 +40,13 @@ THZ_API thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_e
  * those scenes name must lie under root; thz_sequence_frame_scene keeps to it too. */
 THZ_API thz_status thz_sequence_load_within(const char *path, const char *root, thz_sequence **out,
                                             thz_error *err);
+/* The same, reporting through ctx's progress callback (ctx may be NULL: none) as it
+ * builds and checks the frames, which loads each frame's scene (milliseconds each:
+ * minutes for the largest sequences): stage "frames", done of total frames checked,
+ * channel and n_channels 0; non-zero from the callback cancels (THZ_ERR_CANCELLED).
+ * root as in thz_sequence_load_within (NULL: not confined). */
+THZ_API thz_status thz_sequence_load_ctx(thz_context *ctx, const char *path, const char *root,
+                                         thz_sequence **out, thz_error *err);
 THZ_API void thz_sequence_destroy(thz_sequence *seq);
 
 /* Frames over all sweep values; sweep values (1 without a sweep); frames per sweep value. */

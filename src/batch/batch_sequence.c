@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api/api.h"
 #include "batch/batch_internal.h"
 #include "core/alloc.h"
 #include "core/error.h"
@@ -524,8 +525,8 @@ static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_s
     return THZ_OK;
 }
 
-thz_status thz_sequence_load_within(const char *path, const char *root_dir, thz_sequence **out,
-                                    thz_error *err)
+thz_status thz_sequence_load_ctx(thz_context *ctx, const char *path, const char *root_dir,
+                                 thz_sequence **out, thz_error *err)
 {
     if (!out)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_sequence_load: no place for the sequence");
@@ -573,6 +574,16 @@ thz_status thz_sequence_load_within(const char *path, const char *root_dir, thz_
         for (size_t v = 100; v < seq->n_sweeps; v *= 10)
             seq->sweep_digits++;
         seq->n_frames = seq->frames * seq->n_sweeps;
+        /* frames and sweep values are limited each; their product too, before a frame is
+         * built (each frame's scene is loaded here, which 10^9 frames would take days) */
+        if (seq->n_frames > SEQ_MAX_FRAMES)
+            st =
+                thz_error_set(err, THZ_ERR_INPUT,
+                              "%s: frames: %zu frames per sweep value x %zu sweep values = %zu "
+                              "frames, more than the %d a sequence may have",
+                              path, seq->frames, seq->n_sweeps, seq->n_frames, (int)SEQ_MAX_FRAMES);
+    }
+    if (st == THZ_OK) {
         seq->frame_json = thz_calloc(seq->n_frames, sizeof *seq->frame_json);
         seq->frame_dir = thz_calloc(seq->n_frames, sizeof *seq->frame_dir);
         seq->hash = thz_calloc(seq->n_frames, sizeof *seq->hash);
@@ -580,8 +591,15 @@ thz_status thz_sequence_load_within(const char *path, const char *root_dir, thz_
         if (!seq->frame_json || !seq->frame_dir || !seq->hash || !seq->sweep_label)
             st = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
     }
-    for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++)
-        st = seq_frame(&b, seq, f);
+    /* each frame's scene is loaded (a few ms each: minutes for 10^5 frames): reported */
+    thz_progress_fn progress = ctx ? ctx->progress : NULL;
+    for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++) {
+        thz_progress p = {.stage = "frames", .done = f, .total = seq->n_frames};
+        if (progress && progress(ctx->progress_user, &p))
+            st = thz_error_set(err, THZ_ERR_CANCELLED, "%s: cancelled", path);
+        else
+            st = seq_frame(&b, seq, f);
+    }
     for (size_t i = 0; i < b.n_tracks; i++) {
         free(b.tracks[i].t);
         free(b.tracks[i].v);
@@ -598,7 +616,13 @@ thz_status thz_sequence_load_within(const char *path, const char *root_dir, thz_
     return THZ_OK;
 }
 
+thz_status thz_sequence_load_within(const char *path, const char *root_dir, thz_sequence **out,
+                                    thz_error *err)
+{
+    return thz_sequence_load_ctx(NULL, path, root_dir, out, err);
+}
+
 thz_status thz_sequence_load(const char *path, thz_sequence **out, thz_error *err)
 {
-    return thz_sequence_load_within(path, NULL, out, err);
+    return thz_sequence_load_ctx(NULL, path, NULL, out, err);
 }

@@ -45,6 +45,7 @@ typedef struct batch_cli {
     size_t frame;       /* the frame running (its warnings name it), when in_frame */
     size_t n_frames;
     bool in_frame;
+    double load_start_s;         /* when the sequence's load began */
     const thz_sequence *seq;     /* the frames' directories, which the warnings name */
     cli_frame_warnings warnings; /* printed once, the later frames' same counted */
 } batch_cli;
@@ -113,6 +114,63 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
                 p->n_frames, p->seconds);
     }
     return 0;
+}
+
+/* While the sequence loads (thz_sequence_load_ctx checks every frame's scene, a few ms
+ * each): after the first second, the share of frames checked, on a redrawn line on a
+ * terminal, else a line per tenth. */
+static int batch_on_load_progress(void *user, const thz_progress *p)
+{
+    batch_cli *b = user;
+    double now = cli_now_s();
+    if (b->quiet || !p->total || now - b->load_start_s < 1.0)
+        return 0;
+    double frac = (double)p->done / (double)p->total;
+    if (b->tty) {
+        if (now - b->last_draw_s < 0.1)
+            return 0;
+        b->last_draw_s = now;
+        fprintf(stderr,
+                "\r\033[Kthzmap batch: checking the frames' scenes: %.0f %% (%llu of %llu "
+                "frames), %.1f s",
+                100.0 * frac, (unsigned long long)p->done, (unsigned long long)p->total,
+                now - b->load_start_s);
+        b->line_open = true;
+    } else {
+        int tenth = (int)(10.0 * frac);
+        if (tenth <= b->last_tenth)
+            return 0;
+        b->last_tenth = tenth;
+        fprintf(stderr,
+                "thzmap batch: checking the frames' scenes: %d %% (%llu of %llu frames), "
+                "%.1f s\n",
+                10 * tenth, (unsigned long long)p->done, (unsigned long long)p->total,
+                now - b->load_start_s);
+    }
+    fflush(stderr);
+    return 0;
+}
+
+/* Loads the sequence, showing the check of its frames when it takes long. */
+static thz_status batch_load(batch_cli *b, const char *path, thz_sequence **seq, thz_error *err)
+{
+    thz_context *ctx = thz_context_create();
+    if (!ctx) {
+        err->status = THZ_ERR_NOMEM;
+        snprintf(err->message, sizeof err->message, "out of memory");
+        return err->status;
+    }
+    b->load_start_s = cli_now_s();
+    thz_context_set_progress(ctx, batch_on_load_progress, b);
+    thz_status st = thz_sequence_load_ctx(ctx, path, NULL, seq, err);
+    thz_context_destroy(ctx);
+    if (b->line_open) {
+        fputs("\r\033[K", stderr);
+        b->line_open = false;
+    }
+    b->last_tenth = 0;
+    b->last_draw_s = 0.0;
+    return st;
 }
 
 /* A frame's run: no per-stage display (the batch shows frames), but Ctrl-C cancels. */
@@ -215,7 +273,7 @@ int cmd_batch(int argc, char **argv)
     cli_mpi_quiet_begin();
     int rc = batch_parse(argc, argv, &seq_path, &outdir, &threads, &b);
     thz_error err = {0};
-    if (rc < 0 && thz_sequence_load(seq_path, &seq, &err) != THZ_OK)
+    if (rc < 0 && batch_load(&b, seq_path, &seq, &err) != THZ_OK)
         rc = cli_fail(&err);
     cli_mpi_quiet_end();
     int lead_rc = rc, failed = cli_mpi_agree(rc < 0, rc, &lead_rc);

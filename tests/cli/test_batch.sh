@@ -25,7 +25,8 @@
 #  - libgomp calling exit() inside a frame leaves no staging directory or lock;
 #  - a sensor too large for the movie encoder (libx264: 16384 pixels a side): its movies
 #    skipped with a warning before the first frame, the others made, exit 0;
-#  - bad sequence files: exit 2, the JSON path in the message, nothing written.
+#  - bad sequence files: exit 2, the JSON path in the message, nothing written (also
+#    more than 100000 frames in all); a long check of the frames shows its progress.
 # argv: path to the thzmap binary, repository directory.
 set -u
 THZMAP=$1
@@ -526,6 +527,17 @@ bad fps 'fps: required with keyframes' \
     "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"keyframes\": [$K0]}"
 bad sweep 'sweep.objects.person.temperature_k: expected a non-empty array' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "sweep": {"objects.person.temperature_k": []}}'
+# --- too many frames in all; a long check of the frames is shown -----------------------
+# frames (<= 100000) and sweep values (<= 10000) were limited each, their product not:
+# such a sequence was accepted and then loaded frame after frame, silently, for hours.
+bad total_frames 'bad-total_frames.json: frames: 100000 frames per sweep value x 2 sweep values = 200000 frames, more than the 100000 a sequence may have' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "frames": 100000, "sweep": {"objects.person.temperature_k": [300, 310]}}'
+# 2500 frames take seconds to check (each frame's scene is loaded): the share checked is
+# shown after the first second; the last frame is bad, so nothing runs
+bad long_check 'frame 2499' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 2500, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 2498, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 2499, "objects": {"person": {"temperature_k": -10}}}]}'
+grep -qE "checking the frames' scenes: [0-9]+ % \([0-9]+ of 2500 frames\), [0-9.]+ s" "$work/bad.err" ||
+    fail "a long check of the frames shows no progress: $(head -c 600 "$work/bad.err")"
 mkfifo "$work/pipe.json" # a FIFO as the scene would block the open: refused at once
 bad fifo_scene 'pipe.json: is a FIFO' '{"format": "thzmap-sequence/1", "scene": "pipe.json"}'
 # and the other way round: simulate given a sequence file
