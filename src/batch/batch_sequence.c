@@ -16,9 +16,11 @@
 #include "batch/batch_internal.h"
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "scene/load.h"
 
 enum { SEQ_MAX_FRAMES = 100000, SEQ_MAX_SWEEPS = 10000, SEQ_MAX_DEPTH = 8 };
+#define SEQ_MIN_FPS 1e-9 /* frames per second */
 
 /* A value that keyframes name: its path (segments; objects and sensors by name), and
  * per keyframe that names it the time and n numbers. */
@@ -511,8 +513,20 @@ static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_s
     b->scene = b->scenes[0];
     *keyframes = json_object_get(root, "keyframes");
     json_t *fps = json_object_get(root, "fps"), *frames = json_object_get(root, "frames");
-    if (fps && (!json_is_number(fps) || !(json_number_value(fps) > 0.0)))
-        return seq_fail(b, "fps", "%s", "expected frames per second > 0");
+    /* a least rate: frame times i / fps stay finite (5e-324 made them infinite: no
+     * time_s in frame.json, null in batch.json), and any slow process fits (1e-9: a frame
+     * in 31.7 years) */
+    if (fps && (!json_is_number(fps) || !(json_number_value(fps) >= SEQ_MIN_FPS))) {
+        char got[40];
+        if (json_is_number(fps))
+            thz_number_text(json_number_value(fps), got, sizeof got);
+        else
+            snprintf(got, sizeof got, "%s", seq_type(fps));
+        return seq_fail(b, "fps",
+                        "expected frames per second of at least 1e-9 (a frame in 31.7 years), "
+                        "got %s",
+                        got);
+    }
     if (!fps && *keyframes)
         return seq_fail(b, "fps", "%s", "required with keyframes (frames per second > 0)");
     seq->fps = fps ? json_number_value(fps) : 1.0;

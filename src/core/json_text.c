@@ -1,6 +1,7 @@
 /* Text for a JSON document (json_text.h). */
 #include "core/json_text.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "core/error.h"
@@ -16,4 +17,15 @@ json_t *thz_json_text(const char *s)
     j = clean ? json_string(clean) : NULL;
     free(clean);
     return j;
+}
+
+void thz_number_text(double x, char *buf, size_t size)
+{
+    if (!size)
+        return;
+    for (int digits = 1; digits <= 17; digits++) {
+        snprintf(buf, size, "%.*g", digits, x);
+        if (strtod(buf, NULL) == x || x != x)
+            return;
+    }
 }

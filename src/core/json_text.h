@@ -12,4 +12,8 @@
  * show them (thz_text_clean). JSON null for NULL; NULL only when out of memory. */
 json_t *thz_json_text(const char *s);
 
+/* x in the fewest significant digits (at most 17) that read back as the same double,
+ * for messages: 0.1, not 0.10000000000000001 ("%.17g"); nan and inf as "nan", "inf". */
+void thz_number_text(double x, char *buf, size_t size);
+
 #endif

@@ -525,6 +525,9 @@ bad frames 'frames: expected a whole number of frames' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 0}'
 bad fps 'fps: required with keyframes' \
     "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"keyframes\": [$K0]}"
+# a rate so small that frame times are infinite (time_s was missing from frame.json)
+bad fps_tiny 'bad-fps_tiny.json: fps: expected frames per second of at least 1e-9 (a frame in 31.7 years), got 5e-324' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 5e-324, "frames": 2}'
 bad sweep 'sweep.objects.person.temperature_k: expected a non-empty array' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "sweep": {"objects.person.temperature_k": []}}'
 # --- too many frames in all; a long check of the frames is shown -----------------------
