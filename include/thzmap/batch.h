@@ -75,8 +75,9 @@ THZ_API size_t thz_sequence_frame_json(const thz_sequence *seq, size_t i, char *
 THZ_API thz_status thz_sequence_frame_scene(const thz_sequence *seq, size_t i, thz_scene **out,
                                             thz_error *err);
 
-/* Progress of a batch: before each frame (stage "frame"), while it runs (stage "run",
- * as often as the frame's run reports progress), before the movies ("movie") and once
+/* Progress of a batch: before checking each frame to run against the memory
+ * (stage "check", before anything is written), before each frame (stage "frame"), while it runs
+ * (stage "run", as often as the frame's run reports progress), before the movies ("movie") and once
  * at the end ("done"; frame == n_frames for these two). */
 typedef struct thz_batch_progress {
     size_t frame; /* index of the frame about to be run or running (n_frames: done) */

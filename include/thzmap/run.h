@@ -214,6 +214,13 @@ THZ_API thz_status thz_image_write(thz_context *ctx, const thz_image *image, con
  * summary; it borrows the scene, which must outlive it (thz_run_write reads it). */
 THZ_API thz_status thz_simulate(thz_context *ctx, const thz_scene *scene,
                                 const thz_run_settings *settings, thz_run **out, thz_error *err);
+/* What thz_simulate checks before its first photon, alone (a batch checks every frame
+ * before it runs one): THZ_ERR_LIMIT, with the message thz_simulate would give, when
+ * the run would not fit in the memory the process may have. Builds the scene's
+ * ray-casting structure and fires a pilot of photons per channel to estimate; keeps
+ * nothing. */
+THZ_API thz_status thz_simulate_check(thz_context *ctx, const thz_scene *scene,
+                                      const thz_run_settings *settings, thz_error *err);
 /* `thzmap render` in memory: every sensor (sensor -1) or only sensor `sensor` (0 ..
  * count - 1; any other index is refused with THZ_ERR_INPUT) rendered from `photons`
  * (NULL only for path). The run's seed and photon count are the photons'. `photons`

@@ -278,6 +278,25 @@ thz_status api_run_unpack(const thz_scene *scene, const void *data, size_t size,
     return THZ_OK;
 }
 
+thz_status thz_simulate_check(thz_context *ctx, const thz_scene *scene,
+                              const thz_run_settings *settings, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    if (!scene)
+        return api_done(ctx, thz_error_set(err, THZ_ERR_INPUT, "thz_simulate_check: no scene"),
+                        err);
+    thz_status st = api_check_threads(ctx, "thz_simulate_check", err);
+    thz_scene effective;
+    if (st == THZ_OK)
+        st = api_effective_scene(scene, settings, &effective, err);
+    run_options opt;
+    api_run_options(ctx, settings, &opt);
+    if (st == THZ_OK)
+        st = run_check_simulate(&effective, &opt, err);
+    return api_done(ctx, st, err);
+}
+
 thz_status thz_simulate(thz_context *ctx, const thz_scene *scene, const thz_run_settings *settings,
                         thz_run **out, thz_error *err)
 {

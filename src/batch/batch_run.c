@@ -458,6 +458,36 @@ static int batch_on_run_progress(void *user, const thz_progress *p)
     return stop | batch_report(b->opt, b, b->frame, "run");
 }
 
+/* Every frame to run is refused before the first starts, as its own run would refuse it,
+ * when it would not fit in memory (thz_simulate_check: 10^11 photons of a sweep's second
+ * value were refused only after the first value's frames had run). Frames that render
+ * from a base frame's photons need that base's maps: their base's first pending frame is
+ * checked for them. Stage "check" reports each frame checked (the checks build each
+ * scene's ray casting and fire a pilot of photons). */
+static thz_status batch_check_memory(thz_context *ctx, batch_state *b, thz_error *err)
+{
+    const thz_sequence *seq = b->seq;
+    size_t checked_base = SIZE_MAX;
+    for (size_t f = 0; f < seq->n_frames; f++) {
+        if (b->state[f] != FRAME_PENDING || b->base[f] == checked_base)
+            continue;
+        if (batch_report(b->opt, b, f, "check"))
+            return thz_error_set(err, THZ_ERR_CANCELLED, "cancelled");
+        checked_base = b->base[f];
+        thz_scene *scene = NULL;
+        thz_status st = thz_sequence_frame_scene(seq, f, &scene, err);
+        if (st == THZ_OK)
+            st = thz_simulate_check(ctx, scene, NULL, err);
+        thz_scene_destroy(scene);
+        if (st != THZ_OK) {
+            if (err)
+                thz_error_prefix(err, "%s: %s: ", seq->path, seq->frame_dir[f]);
+            return st;
+        }
+    }
+    return THZ_OK;
+}
+
 /* Takes OUTDIR's batch lock (held until fd is closed or the process ends). */
 static thz_status batch_lock(const char *outdir, int *fd, thz_error *err)
 {
@@ -507,15 +537,18 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
     thz_status st = b.state && b.seconds && b.base && b.reused_photons && b.rank
                         ? batch_photon_bases(seq, b.base, err)
                         : thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-    if (st == THZ_OK)
-        st = batch_mkdirs(outdir, err);
-    if (st == THZ_OK)
-        st = batch_lock(outdir, &lock_fd, err);
+    /* (read before OUTDIR is created or locked: the memory check writes nothing) */
     for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++)
         if (batch_frame_done(&b, f)) {
             b.state[f] = FRAME_REUSED;
             b.reused++;
         }
+    if (st == THZ_OK)
+        st = batch_check_memory(ctx, &b, err);
+    if (st == THZ_OK)
+        st = batch_mkdirs(outdir, err);
+    if (st == THZ_OK)
+        st = batch_lock(outdir, &lock_fd, err);
     if (st == THZ_OK && b.reused > 0)
         batch_clean_finished(&b);
     /* a sensor too large for the movie encoder: said before the frames run */

@@ -45,7 +45,8 @@ typedef struct batch_cli {
     size_t frame;       /* the frame running (its warnings name it), when in_frame */
     size_t n_frames;
     bool in_frame;
-    double load_start_s;         /* when the sequence's load began */
+    double load_start_s;         /* when the sequence's load (or the memory check) began */
+    bool checking;               /* the frames' memory check has begun */
     const thz_sequence *seq;     /* the frames' directories, which the warnings name */
     cli_frame_warnings warnings; /* printed once, the later frames' same counted */
 } batch_cli;
@@ -80,6 +81,8 @@ static void batch_show_run(batch_cli *b, const thz_batch_progress *p)
     fflush(stderr);
 }
 
+static int batch_on_load_progress(void *user, const thz_progress *p);
+
 static int batch_on_progress(void *user, const thz_batch_progress *p)
 {
     batch_cli *b = user;
@@ -92,6 +95,15 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
         return 0;
     if (!strcmp(p->stage, "run")) {
         batch_show_run(b, p);
+        return 0;
+    }
+    if (!strcmp(p->stage, "check")) { /* the frames' memory, before the first runs */
+        if (!b->checking) {
+            b->checking = true;
+            b->load_start_s = cli_now_s();
+        }
+        thz_progress lp = {.stage = "check", .done = p->frame, .total = p->n_frames};
+        batch_on_load_progress(b, &lp);
         return 0;
     }
     if (b->line_open) {
@@ -125,15 +137,16 @@ static int batch_on_load_progress(void *user, const thz_progress *p)
     double now = cli_now_s();
     if (b->quiet || !p->total || now - b->load_start_s < 1.0)
         return 0;
+    const char *what = !strcmp(p->stage, "check") ? "memory" : "scenes";
     double frac = (double)p->done / (double)p->total;
     if (b->tty) {
         if (now - b->last_draw_s < 0.1)
             return 0;
         b->last_draw_s = now;
         fprintf(stderr,
-                "\r\033[Kthzmap batch: checking the frames' scenes: %.0f %% (%llu of %llu "
+                "\r\033[Kthzmap batch: checking the frames' %s: %.0f %% (%llu of %llu "
                 "frames), %.1f s",
-                100.0 * frac, (unsigned long long)p->done, (unsigned long long)p->total,
+                what, 100.0 * frac, (unsigned long long)p->done, (unsigned long long)p->total,
                 now - b->load_start_s);
         b->line_open = true;
     } else {
@@ -142,9 +155,9 @@ static int batch_on_load_progress(void *user, const thz_progress *p)
             return 0;
         b->last_tenth = tenth;
         fprintf(stderr,
-                "thzmap batch: checking the frames' scenes: %d %% (%llu of %llu frames), "
+                "thzmap batch: checking the frames' %s: %d %% (%llu of %llu frames), "
                 "%.1f s\n",
-                10 * tenth, (unsigned long long)p->done, (unsigned long long)p->total,
+                what, 10 * tenth, (unsigned long long)p->done, (unsigned long long)p->total,
                 now - b->load_start_s);
     }
     fflush(stderr);

@@ -390,6 +390,20 @@ static thz_status run_tell_plan(run_state *rs, bool fires_photons, thz_error *er
     return st;
 }
 
+thz_status run_check_simulate(const thz_scene *scene, const run_options *opt, thz_error *err)
+{
+    run_state rs;
+    memset(&rs, 0, sizeof rs);
+    thz_status st = run_begin(&rs, scene, opt, "simulate", err);
+    bool photons = render_integrator_needs_photons(scene->render.integrator);
+    if (st == THZ_OK && photons)
+        st = run_prepare_photons(&rs, err);
+    if (st == THZ_OK)
+        st = run_check_run_memory(&rs, photons, 0, err);
+    run_state_fini(&rs);
+    return st;
+}
+
 thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_state *rs,
                         thz_error *err)
 {

@@ -209,6 +209,11 @@ thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t map_bytes,
 
 /* Fire and render (simulate) or render from `in` (render; NULL only for path) into rs,
  * nothing written. On failure rs is finalised. */
+/* What run_simulate checks before it fires a photon, alone: the ray-casting structure
+ * built, the photons' memory estimated (a pilot per channel) and the run refused as
+ * run_check_run_memory does; nothing kept. */
+thz_status run_check_simulate(const thz_scene *scene, const run_options *opt, thz_error *err);
+
 thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_state *rs,
                         thz_error *err);
 thz_status run_render(const thz_scene *scene, const run_options *opt, const run_photons *in,

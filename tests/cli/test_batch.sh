@@ -26,7 +26,8 @@
 #  - a sensor too large for the movie encoder (libx264: 16384 pixels a side): its movies
 #    skipped with a warning before the first frame, the others made, exit 0;
 #  - bad sequence files: exit 2, the JSON path in the message, nothing written (also
-#    more than 100000 frames in all); a long check of the frames shows its progress.
+#    more than 100000 frames in all, or a frame that would not fit in memory, found
+#    before the first frame runs); a long check of the frames shows its progress.
 # argv: path to the thzmap binary, repository directory.
 set -u
 THZMAP=$1
@@ -525,6 +526,18 @@ bad frames 'frames: expected a whole number of frames' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 0}'
 bad fps 'fps: required with keyframes' \
     "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"keyframes\": [$K0]}"
+# every frame checked against the memory before the first runs: 10^11 photons of the
+# second sweep value were refused only after the first value's frame had run
+"$PY" - "$work" <<'PY'
+import json, sys
+s = json.load(open(f"{sys.argv[1]}/scene.json"))
+s["render"] = {"integrator": "photon-map"}
+s["sensors"][0]["resolution"] = [4, 4]
+json.dump(s, open(f"{sys.argv[1]}/scene-pm.json", "w"))
+PY
+bad memory 'bad-memory.json: sweep-01/frame-00000: ' \
+    '{"format": "thzmap-sequence/1", "scene": "scene-pm.json", "sweep": {"photons.per_channel": [1000, 100000000000]}}'
+grep -qF 'lower photons.per_channel (now 100000000000' "$work/bad.err" || fail "bad memory: the photons named: $(cat "$work/bad.err")"
 # a rate so small that frame times are infinite (time_s was missing from frame.json)
 bad fps_tiny 'bad-fps_tiny.json: fps: expected frames per second of at least 1e-9 (a frame in 31.7 years), got 5e-324' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 5e-324, "frames": 2}'
