@@ -462,30 +462,43 @@ static int batch_on_run_progress(void *user, const thz_progress *p)
  * when it would not fit in memory (thz_simulate_check: 10^11 photons of a sweep's second
  * value were refused only after the first value's frames had run). Frames that render
  * from a base frame's photons need that base's maps: their base's first pending frame is
- * checked for them. Stage "check" reports each frame checked (the checks build each
+ * checked for them. Frames of an integrator that fires no photons need only their images,
+ * which loading them checked. Stage "check" reports each frame checked (the checks build each
  * scene's ray casting and fire a pilot of photons). */
-static thz_status batch_check_memory(thz_context *ctx, batch_state *b, thz_error *err)
+static thz_status batch_check_memory(batch_state *b, thz_error *err)
 {
     const thz_sequence *seq = b->seq;
     size_t checked_base = SIZE_MAX;
-    for (size_t f = 0; f < seq->n_frames; f++) {
+    /* on this thread alone: a pilot is small, and no thread starts before the first frame
+     * (where a library that cannot start one ends the process, an open frame is cleaned
+     * up: thz_batch_options.open_output) */
+    thz_context *one = thz_context_create();
+    if (!one)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    thz_context_set_threads(one, 1);
+    thz_status st = THZ_OK;
+    for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++) {
         if (b->state[f] != FRAME_PENDING || b->base[f] == checked_base)
             continue;
-        if (batch_report(b->opt, b, f, "check"))
-            return thz_error_set(err, THZ_ERR_CANCELLED, "cancelled");
+        if (batch_report(b->opt, b, f, "check")) {
+            st = thz_error_set(err, THZ_ERR_CANCELLED, "cancelled");
+            break;
+        }
         checked_base = b->base[f];
         thz_scene *scene = NULL;
-        thz_status st = thz_sequence_frame_scene(seq, f, &scene, err);
-        if (st == THZ_OK)
-            st = thz_simulate_check(ctx, scene, NULL, err);
+        st = thz_sequence_frame_scene(seq, f, &scene, err);
+        /* an integrator that fires no photons (path) needs its images, which loading the
+         * frame checked */
+        thz_scene_info info;
+        if (st == THZ_OK && thz_scene_get_info(scene, &info) == THZ_OK &&
+            thz_integrator_needs_photons(info.integrator))
+            st = thz_simulate_check(one, scene, NULL, err);
         thz_scene_destroy(scene);
-        if (st != THZ_OK) {
-            if (err)
-                thz_error_prefix(err, "%s: %s: ", seq->path, seq->frame_dir[f]);
-            return st;
-        }
+        if (st != THZ_OK && err)
+            thz_error_prefix(err, "%s: %s: ", seq->path, seq->frame_dir[f]);
     }
-    return THZ_OK;
+    thz_context_destroy(one);
+    return st;
 }
 
 /* Takes OUTDIR's batch lock (held until fd is closed or the process ends). */
@@ -544,7 +557,7 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
             b.reused++;
         }
     if (st == THZ_OK)
-        st = batch_check_memory(ctx, &b, err);
+        st = batch_check_memory(&b, err);
     if (st == THZ_OK)
         st = batch_mkdirs(outdir, err);
     if (st == THZ_OK)

@@ -470,7 +470,12 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
         uint64_t h = batch_hash_bytes(BATCH_HASH_INIT, "thzmap " THZ_VERSION_STRING,
                                       sizeof("thzmap " THZ_VERSION_STRING) - 1);
         h = batch_hash_bytes(h, seq->frame_json[f], strlen(seq->frame_json[f]));
-        h = batch_hash_bytes(h, seq->scene_dirs[k], strlen(seq->scene_dirs[k]));
+        /* the directory as the file system names it: `s/cam.json` from the parent and
+         * `cam.json` from s/ are the same inputs (the text made them differ) */
+        char *real = realpath(seq->scene_dirs[k], NULL);
+        const char *scene_dir = real ? real : seq->scene_dirs[k];
+        h = batch_hash_bytes(h, scene_dir, strlen(scene_dir));
+        free(real);
         seq->hash[f] = batch_hash_files(b->file_hashes, seq->scene_dirs[k], doc, h);
     }
     json_decref(doc);
