@@ -23,6 +23,8 @@
 #    hash, with movies; scenes with other sensors: no movies, a warning; the batch's
 #    progress within a frame (the CLI's lines on a non-terminal);
 #  - libgomp calling exit() inside a frame leaves no staging directory or lock;
+#  - resuming does not depend on how the sequence's path is spelled (s/cam.json from the
+#    parent, cam.json in s/);
 #  - a sensor too large for the movie encoder (libx264: 16384 pixels a side): its movies
 #    skipped with a warning before the first frame, the others made, exit 0;
 #  - bad sequence files: exit 2, the JSON path in the message, nothing written (also
@@ -493,6 +495,28 @@ assert b["complete"] and b["frames_done"] == 2, b
 assert "sensor \"tall\"" in b["movies_skipped"] and "16384" in b["movies_skipped"], b["movies_skipped"]
 assert [m["file"] for m in b["movies"]] == ["cam.band-01.mp4"], b["movies"]
 assert os.path.exists(f"{d}/cam.band-01.mp4") and not os.path.exists(f"{d}/tall.band-01.mp4")
+PY
+
+# --- resuming does not depend on how the sequence's path is spelled --------------------
+# the hash took the scene's directory as written: `cam.json` in s/ and `s/cam.json` from
+# the parent hashed differently, and the second batch recomputed every frame
+mkdir -p "$work/spell/s"
+cp "$work/big/tall.json" "$work/spell/s/scene.json"
+"$PY" - "$work/spell/s/scene.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["sensors"] = s["sensors"][:1]
+json.dump(s, open(sys.argv[1], "w"))
+PY
+echo '{"format": "thzmap-sequence/1", "scene": "scene.json", "frames": 2}' > "$work/spell/s/cam.json"
+(cd "$work/spell/s" && "$THZMAP" batch cam.json -o camout --quiet --no-movies) ||
+    fail "batch in s/: exit $?"
+(cd "$work/spell" && "$THZMAP" batch s/cam.json -o s/camout --quiet --no-movies) ||
+    fail "batch from the parent: exit $?"
+"$PY" - "$work/spell/s/camout/batch.json" <<'PY' || fail "the same frames spelled otherwise were recomputed"
+import json, sys
+b = json.load(open(sys.argv[1]))
+assert b["frames_reused"] == 2 and b["frames_computed"] == 0, b
 PY
 
 # --- bad sequence files -------------------------------------------------------------
