@@ -80,9 +80,10 @@ without a sweep), `index` its number within that sweep value, `time_s` index / f
 
 BatchProgress = collections.namedtuple(
     "BatchProgress", "stage frame n_frames computed reused fraction seconds")
-BatchProgress.__doc__ = """One progress report of a batch. `stage` is "frame" (before
-frame `frame`, 0-based, of `n_frames`), "run" (while it runs), "movie" (before the movies)
-or "done" (once at the end; `frame` is then n_frames); `computed` and `reused` count the
+BatchProgress.__doc__ = """One progress report of a batch. `stage` is "check" (before
+checking frame `frame`, 0-based, of `n_frames`, against the memory, before anything is
+written), "frame" (before running it), "run" (while it runs), "movie" (before the
+movies) or "done" (once at the end; `frame` is then n_frames); `computed` and `reused` count the
 frames this call ran and the ones it found finished; `fraction` (0..1, never falling) is
 the share of the whole batch done; `seconds` the wall time so far, s."""
 
@@ -253,7 +254,9 @@ class _BatchBar:
             if p.stage == "done" or frame != p.frame or now - last >= 1.0:
                 self._last = (p.frame, now)
                 where = "done" if p.stage == "done" else \
-                    ("movies" if p.stage == "movie" else f"frame {p.frame + 1}/{p.n_frames}")
+                    ("movies" if p.stage == "movie" else
+                     f"checking frame {p.frame + 1}/{p.n_frames}" if p.stage == "check" else
+                     f"frame {p.frame + 1}/{p.n_frames}")
                 print(f"thzmap: batch: {where}, {100 * p.fraction:.0f} % of the batch, "
                       f"{p.seconds:.1f} s", file=sys.stderr, flush=True)
         return False
