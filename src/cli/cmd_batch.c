@@ -47,6 +47,7 @@ typedef struct batch_cli {
     bool in_frame;
     double load_start_s;         /* when the sequence's load (or the memory check) began */
     bool checking;               /* the frames' memory check has begun */
+    bool movies_said;            /* "encoding the movies" printed (the stage comes twice) */
     const thz_sequence *seq;     /* the frames' directories, which the warnings name */
     cli_frame_warnings warnings; /* printed once, the later frames' same counted */
 } batch_cli;
@@ -121,7 +122,8 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
         }
         fprintf(stderr, "thzmap batch: frame %zu/%zu (%zu done, %zu reused), %.1f s%s\n",
                 p->frame + 1, p->n_frames, finished, p->reused, p->seconds, eta);
-    } else if (!strcmp(p->stage, "movie")) {
+    } else if (!strcmp(p->stage, "movie") && !b->movies_said) { /* reported again after */
+        b->movies_said = true;
         fprintf(stderr, "thzmap batch: %zu frames done (%.1f s); encoding the movies\n",
                 p->n_frames, p->seconds);
     }

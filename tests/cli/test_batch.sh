@@ -61,6 +61,14 @@ seq="$work/sequence.json"
 "$THZMAP" batch "$seq" -o "$work/A" --threads 2 --quiet > "$work/A.out" 2> "$work/A.err" ||
     { fail "batch A: exit $?"; cat "$work/A.err"; }
 [ -s "$work/A.err" ] && fail "batch --quiet printed on stderr: $(head -c 300 "$work/A.err")"
+# not quiet (all frames reused, the movies made again): the movies are announced once
+# (the stage is reported before and after them; the second said it again)
+cp -r "$work/A" "$work/A2"
+"$THZMAP" batch "$seq" -o "$work/A2" --threads 2 > /dev/null 2> "$work/A2.err" ||
+    fail "batch A again: exit $?"
+rm -rf "$work/A2"
+[ "$(grep -c 'encoding the movies' "$work/A2.err")" = 1 ] ||
+    fail "the movies announced $(grep -c 'encoding the movies' "$work/A2.err") times, not once"
 for i in 0 1 2 3 4; do
     [ -f "$work/A/frame-0000$i/cam.brightness_temperature.img" ] || fail "frame $i missing"
 done
