@@ -20,6 +20,9 @@ void thz_sequence_destroy(thz_sequence *seq)
     }
     for (size_t s = 0; seq->sweep_label && s < seq->n_sweeps; s++)
         free(seq->sweep_label[s]);
+    for (size_t s = 0; seq->sweep_json && s < seq->n_sweeps; s++)
+        json_decref(seq->sweep_json[s]);
+    free(seq->sweep_json);
     free(seq->frame_json);
     free(seq->frame_dir);
     free(seq->hash);

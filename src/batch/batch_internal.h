@@ -36,7 +36,10 @@ struct thz_sequence {
     char **frame_json;   /* per frame: the scene text (compact, keys in document order) */
     char **frame_dir;    /* per frame: "frame-NNNNN" or "sweep-NN/frame-NNNNN" */
     uint64_t *hash;      /* per frame: hash of its inputs */
-    char **sweep_label;  /* per sweep value: "atmosphere.relative_humidity = 0.5, ..." */
+    json_t **sweep_json; /* per sweep value: its values by key, the sequence file's own
+                            ({"atmosphere.relative_humidity": 0.5, ...}); NULL: no sweep */
+    char **sweep_label;  /* per sweep value: "atmosphere.relative_humidity = 0.5, ..."
+                            (numbers in their shortest form: 0.1, not 0.10000000000000001) */
     char *movies_unmade; /* NULL, or why some sensors' movies cannot be made (too large) */
 };
 

@@ -194,6 +194,19 @@ static const char *batch_state_name(frame_state s)
     return s == FRAME_PENDING ? "pending" : s == FRAME_FAILED ? "failed" : "done";
 }
 
+/* Sweep value s's values by key as JSON, the numbers as the sequence file wrote them
+ * (0.3, where json_dumps writes 0.29999999999999999 or rounds to its precision): a
+ * placeholder for thz_json_dumps_raw. JSON null without a sweep. */
+static json_t *batch_sweep_values(const thz_sequence *seq, size_t s)
+{
+    if (!seq->sweep_json || !seq->sweep_json[s])
+        return json_null();
+    char *text = thz_json_shortest(seq->sweep_json[s]);
+    json_t *raw = text ? thz_json_raw(text) : NULL;
+    free(text);
+    return raw;
+}
+
 static thz_status batch_write_json(batch_state *b, thz_error *err)
 {
     double t_start = batch_now_s();
@@ -235,7 +248,8 @@ static thz_status batch_write_json(batch_state *b, thz_error *err)
         batch_sweep_dir(seq, s, dir, sizeof dir);
         json_t *e = json_object();
         json_object_set_new(e, "dir", json_string(dir));
-        json_object_set_new(e, "values", json_string(seq->sweep_label[s]));
+        json_object_set_new(e, "values", batch_sweep_values(seq, s));
+        json_object_set_new(e, "label", thz_json_text(seq->sweep_label[s]));
         json_array_append_new(sweeps, e);
     }
     json_t *t = json_object();
@@ -274,7 +288,7 @@ static thz_status batch_write_json(batch_state *b, thz_error *err)
     json_object_set_new(root, "timings_s", t);
     /* 12 digits, as summary.json: its reals are times and statistics (17 printed float
      * noise such as 293.0049133300781 K) */
-    char *text = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(12));
+    char *text = thz_json_dumps_raw(root, JSON_INDENT(2) | JSON_REAL_PRECISION(12));
     json_decref(root);
     if (!text)
         return thz_error_set(err, THZ_ERR_NOMEM, "batch.json: out of memory");
@@ -310,7 +324,10 @@ static char *batch_frame_json(const thz_sequence *seq, size_t f, long reused_fro
     json_object_set_new(root, "sweep", json_integer((json_int_t)(f / seq->frames)));
     json_object_set_new(root, "index", json_integer((json_int_t)(f % seq->frames)));
     json_object_set_new(root, "time_s", json_real((double)(f % seq->frames) / seq->fps));
-    json_object_set_new(root, "sweep_values", json_string(seq->sweep_label[f / seq->frames]));
+    json_object_set_new(root, "sweep_values", batch_sweep_values(seq, f / seq->frames));
+    json_object_set_new(root, "sweep_label",
+                        seq->has_sweep ? thz_json_text(seq->sweep_label[f / seq->frames])
+                                       : json_null());
     json_object_set_new(root, "input_hash", json_string(hex));
     json_object_set_new(root, "photons_reused_from_frame",
                         reused_from >= 0 ? json_integer(reused_from) : json_null());
@@ -320,7 +337,7 @@ static char *batch_frame_json(const thz_sequence *seq, size_t f, long reused_fro
     json_object_set_new(root, "scene", json_loads(seq->frame_json[f], 0, NULL));
     /* 17 digits: the scene must read back to the same doubles, to rerun the frame to the
      * same bytes (0.3 prints as 0.29999999999999999, the same double) */
-    char *text = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
+    char *text = thz_json_dumps_raw(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
     json_decref(root);
     return text;
 }

@@ -357,12 +357,18 @@ static thz_status seq_check_sweep(seq_build *b, const thz_sequence *seq, size_t 
     return st;
 }
 
-/* Sets sweep combination s (the first key varies slowest) into doc; its label. */
-static int seq_apply_sweep(const seq_build *b, size_t s, json_t *doc, char *label, size_t size)
+/* Sets sweep combination s (the first key varies slowest) into doc; *values gets its
+ * values by key (the sequence file's own, copied; NULL without a sweep), label the same
+ * as text ("key = value, ...", numbers in their shortest form). */
+static int seq_apply_sweep(const seq_build *b, size_t s, json_t *doc, json_t **values, char *label,
+                           size_t size)
 {
     label[0] = '\0';
+    *values = NULL;
     if (!b->sweep)
         return 0;
+    if (!(*values = json_object()))
+        return -1;
     size_t stride = 1;
     const char *key;
     json_t *vals;
@@ -375,11 +381,14 @@ static int seq_apply_sweep(const seq_build *b, size_t s, json_t *doc, char *labe
         snprintf(buf, sizeof buf, "%s", key);
         const char *seg[SEQ_MAX_DEPTH];
         size_t depth = seq_split(buf, seg);
-        if (seq_set(doc, seg, depth, v) != 0)
+        if (seq_set(doc, seg, depth, v) != 0 ||
+            json_object_set_new(*values, key, json_deep_copy(v)) != 0)
             return -1;
-        char *text = json_dumps(v, JSON_ENCODE_ANY | JSON_COMPACT);
+        char *text = thz_json_shortest(v);
+        if (!text)
+            return -1;
         size_t len = strlen(label);
-        snprintf(label + len, size - len, "%s%s = %s", len ? ", " : "", key, text ? text : "?");
+        snprintf(label + len, size - len, "%s%s = %s", len ? ", " : "", key, text);
         free(text);
     }
     return 0;
@@ -430,13 +439,18 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
     size_t k = batch_frame_scene(seq, f);
     json_t *doc = json_deep_copy(b->scenes[k]);
     char label[1024];
+    json_t *values = NULL;
     if (!doc || seq_apply_tracks(b, time_s, doc) != 0 ||
-        seq_apply_sweep(b, s, doc, label, sizeof label) != 0) {
+        seq_apply_sweep(b, s, doc, &values, label, sizeof label) != 0) {
         json_decref(doc);
+        json_decref(values);
         return thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
     }
-    if (i == 0 && !seq->sweep_label[s])
+    if (i == 0 && !seq->sweep_label[s]) {
         seq->sweep_label[s] = thz_strdup(label);
+        seq->sweep_json[s] = json_incref(values);
+    }
+    json_decref(values);
     seq->frame_json[f] = json_dumps(doc, JSON_COMPACT);
     char dir[64], sweep[32];
     batch_sweep_dir(seq, s, sweep, sizeof sweep);
@@ -607,7 +621,9 @@ thz_status thz_sequence_load_ctx(thz_context *ctx, const char *path, const char 
         seq->frame_dir = thz_calloc(seq->n_frames, sizeof *seq->frame_dir);
         seq->hash = thz_calloc(seq->n_frames, sizeof *seq->hash);
         seq->sweep_label = thz_calloc(seq->n_sweeps, sizeof *seq->sweep_label);
-        if (!seq->frame_json || !seq->frame_dir || !seq->hash || !seq->sweep_label)
+        seq->sweep_json = thz_calloc(seq->n_sweeps, sizeof *seq->sweep_json);
+        if (!seq->frame_json || !seq->frame_dir || !seq->hash || !seq->sweep_label ||
+            !seq->sweep_json)
             st = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
     }
     /* each frame's scene is loaded (a few ms each: minutes for 10^5 frames): reported */

@@ -230,7 +230,8 @@ PY
 # --- a sweep without keyframes ------------------------------------------------------
 cat > "$work/sweep.json" <<'JSON'
 {"format": "thzmap-sequence/1", "scene": "scene.json",
- "sweep": {"objects.person.temperature_k": [300, 310]}}
+ "sweep": {"objects.person.temperature_k": [300, 310], "materials.skin.reflectivity": [0.1],
+           "materials.wall.reflectivity": [0.100000000000001], "render.integrator": ["path"]}}
 JSON
 "$THZMAP" batch "$work/sweep.json" -o "$work/W" --quiet > /dev/null 2>&1 || fail "sweep batch: exit $?"
 for s in 00 01; do
@@ -238,6 +239,33 @@ for s in 00 01; do
     [ -f "$work/W/sweep-$s/cam.band-01.mp4" ] || fail "sweep-$s/cam.band-01.mp4 missing"
 done
 grep -q '"temperature_k": 310' "$work/W/sweep-01/frame-00000/frame.json" || fail "sweep-01 is not at 310 K"
+# the sweep values as JSON values, written as the sequence file wrote them (they were one
+# string, "materials.skin.reflectivity = 0.10000000000000001, ..."; and batch.json's 12
+# digits would round 0.100000000000001), with a label in the shortest numbers too
+"$PY" - "$work/W" <<'PY' || fail "the sweep values in batch.json and frame.json"
+import json, sys
+d = sys.argv[1]
+b = json.load(open(f"{d}/batch.json"))
+values = {"objects.person.temperature_k": 310, "materials.skin.reflectivity": 0.1,
+          "materials.wall.reflectivity": 0.100000000000001, "render.integrator": "path"}
+label = ("objects.person.temperature_k = 310, materials.skin.reflectivity = 0.1, "
+         "materials.wall.reflectivity = 0.100000000000001, render.integrator = \"path\"")
+assert b["sweeps"][1] == {"dir": "sweep-01", "values": values, "label": label}, b["sweeps"]
+assert list(b["sweeps"][1]["values"]) == list(values), "not in the sequence file's order"
+f = json.load(open(f"{d}/sweep-01/frame-00000/frame.json"))
+assert f["sweep_values"] == values and f["sweep_label"] == label, f
+# (frame.json's scene keeps 17 digits: it must read back to the same doubles)
+for name in ("batch.json", "sweep-01/frame-00000/frame.json"):
+    text = "".join(l for l in open(f"{d}/{name}") if '"values"' in l or '"sweep_values"' in l)
+    assert "0.10000000000000001" not in text and '"materials.skin.reflectivity": 0.1,' in text, name
+    assert '"materials.wall.reflectivity": 0.100000000000001,' in text, name
+PY
+# without a sweep, frame.json has no sweep values
+"$PY" - "$work/A/frame-00000/frame.json" <<'PY' || fail "frame.json without a sweep"
+import json, sys
+f = json.load(open(sys.argv[1]))
+assert f["sweep_values"] is None and f["sweep_label"] is None, f
+PY
 
 # --- a sensor-only sequence: photons fired once, frames rendered from them ----------
 "$PY" - "$work/scene.json" "$work/pm-scene.json" "$work/pm-seq.json" <<'PY'
@@ -573,6 +601,10 @@ grep -qF 'lower photons.per_channel (now 100000000000' "$work/bad.err" || fail "
 # a rate so small that frame times are infinite (time_s was missing from frame.json)
 bad fps_tiny 'bad-fps_tiny.json: fps: expected frames per second of at least 1e-9 (a frame in 31.7 years), got 5e-324' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 5e-324, "frames": 2}'
+# a message that shows the sweep values shows them in their shortest numbers
+bad sweep_label 'materials.skin.reflectivity = 0.1, ' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "sweep": {"materials.skin.reflectivity": [0.1], "objects.room.shape.size_m": [[3, 3, -2]]}}'
+grep -qF '0.10000000000000001' "$work/bad.err" && fail "bad sweep_label: 17 digits: $(cat "$work/bad.err")"
 bad sweep 'sweep.objects.person.temperature_k: expected a non-empty array' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "sweep": {"objects.person.temperature_k": []}}'
 # --- too many frames in all; a long check of the frames is shown -----------------------

@@ -111,6 +111,23 @@ def test_batch_resumes_reports_and_cancels(tmp_path):
         thzmap.batch(seq, out, progress=boom)
 
 
+def test_batch_sweep_values_are_json_values(tmp_path):
+    # batch.json's sweeps[].values (and frame.json's sweep_values) were one display string
+    # with 17-digit numbers, "materials.skin.reflectivity = 0.10000000000000001"
+    shutil.copy(os.path.join(BATCH, "scene.json"), tmp_path / "scene.json")
+    (tmp_path / "sweep.json").write_text(json.dumps(
+        {"format": "thzmap-sequence/1", "scene": "scene.json",
+         "sweep": {"materials.skin.reflectivity": [0.1, 0.3], "render.integrator": ["path"]}}))
+    res = thzmap.batch(tmp_path / "sweep.json", tmp_path / "out", movies=False)
+    assert res.summary["sweeps"] == [
+        {"dir": f"sweep-0{i}", "values": {"materials.skin.reflectivity": r,
+                                          "render.integrator": "path"},
+         "label": f'materials.skin.reflectivity = {r}, render.integrator = "path"'}
+        for i, r in enumerate((0.1, 0.3))]
+    with open(tmp_path / "out" / "sweep-01" / "frame-00000" / "frame.json") as f:
+        assert json.load(f)["sweep_values"] == res.summary["sweeps"][1]["values"]
+
+
 def test_batch_warnings_name_their_frame_once(tmp_path):
     # As test_validate.sh's sequence: the plate in its box with a background given (a
     # warning while the camera is in the room: the first frame of each sweep value), the
