@@ -152,7 +152,7 @@ class Sequence:
         """Frame i's scene, loaded (within the sequence's root if it has one): a Scene
         to simulate or render as any other, whose `warnings` are that frame's."""
         i = self._index(i)
-        label = f"{self.path}: frame {i}"
+        label = f"{self.path}: {self.frame(i).dir}"
         return _load(lambda out, err: _lib.lib.thz_sequence_frame_scene(
             self._handle, i, out, err), label)
 
@@ -199,7 +199,6 @@ class _BatchCall(Call):
         super().__init__(threads, None)
         self.frame = 0
         self._sequence = sequence
-        self._n_frames = len(sequence)
         self._repeats = {}
 
     def _on_warning(self, user, message):
@@ -213,8 +212,7 @@ class _BatchCall(Call):
                     self._warnings.append(text)
                 else:
                     where = self._sequence.frame(self.frame).dir
-                    self._warnings.append(f"frame {self.frame + 1}/{self._n_frames} "
-                                          f"({where}): {text}")
+                    self._warnings.append(f"{where}: {text}")
         except BaseException as e:  # noqa: B902 - every exception must stop at this frame
             if self._exc is None:
                 self._exc = e

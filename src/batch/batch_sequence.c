@@ -33,6 +33,7 @@ typedef struct seq_track {
     int rotation;     /* rotate_deg: slerp */
     size_t k;         /* keyframes naming it */
     double *t, *v;    /* k times; k * n values */
+    size_t *kf;       /* k indexes into "keyframes": where each value is written */
 } seq_track;
 
 typedef struct seq_build {
@@ -44,6 +45,7 @@ typedef struct seq_build {
     size_t n_tracks;
     json_t *sweep;       /* the sweep object, or NULL */
     json_t *file_hashes; /* path -> hash of the files frames name (hex string) */
+    size_t keyframe;     /* the keyframe being read (its index in "keyframes") */
     thz_error *err;
 } seq_build;
 
@@ -198,11 +200,15 @@ static thz_status seq_add_value(seq_build *b, const char *where, const char *con
     double *t2 = thz_realloc_array(tr->t, tr->k + 1, sizeof *t2);
     if (t2)
         tr->t = t2;
-    double *v2 = t2 ? thz_realloc_array(tr->v, (tr->k + 1) * n, sizeof *v2) : NULL;
+    size_t *kf2 = t2 ? thz_realloc_array(tr->kf, tr->k + 1, sizeof *kf2) : NULL;
+    if (kf2)
+        tr->kf = kf2;
+    double *v2 = kf2 ? thz_realloc_array(tr->v, (tr->k + 1) * n, sizeof *v2) : NULL;
     if (!v2)
         return thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
     tr->v = v2;
     tr->t[tr->k] = t;
+    tr->kf[tr->k] = b->keyframe;
     for (size_t i = 0; i < n; i++) {
         const json_t *x = json_is_array(v) ? json_array_get(v, i) : v;
         tr->v[tr->k * n + i] = json_number_value(x);
@@ -270,6 +276,7 @@ static thz_status seq_keyframes(seq_build *b, json_t *keyframes)
                             "one before)");
         }
         last_t = t;
+        b->keyframe = i;
         const char *key;
         json_t *val;
         json_object_foreach(kf, key, val)
@@ -431,6 +438,143 @@ void batch_sweep_dir(const thz_sequence *seq, size_t s, char *buf, size_t size)
     snprintf(buf, size, "sweep-%0*zu", seq->sweep_digits, s);
 }
 
+/* The keys of a scene's JSON path as a sequence names them: "objects[1].transform.
+ * translate_m[2]" of doc gives seg {"objects", "person", "transform", "translate_m"} (an
+ * object or sensor by its name) and *suffix "[2]" (the rest, from the first other
+ * index); 0 when path is not such a path. The segments point into buf or doc. */
+static size_t seq_scene_path(json_t *doc, const char *path, char *buf, size_t size,
+                             const char **seg, const char **suffix)
+{
+    if (!path[0] || strlen(path) >= size)
+        return 0;
+    for (const char *c = path; *c; c++)
+        if (!strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.[]", *c))
+            return 0;
+    size_t depth = 0;
+    const char *p = path;
+    char *out = buf; /* the keys, each ended by '\0' (no longer than path) */
+    *suffix = "";
+    while (*p && depth < SEQ_MAX_DEPTH) {
+        if (*p == '[') {
+            /* objects[i] or sensors[i]: by name; any other index ends the keys */
+            char *end;
+            unsigned long i = strtoul(p + 1, &end, 10);
+            const char *name = NULL;
+            if (depth == 1 && (!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors")) &&
+                *end == ']')
+                name = json_string_value(
+                    json_object_get(json_array_get(json_object_get(doc, seg[0]), i), "name"));
+            if (!name) {
+                *suffix = p;
+                return depth;
+            }
+            seg[depth++] = name;
+            p = end + 1;
+        } else {
+            size_t n = strcspn(p, ".[");
+            memcpy(out, p, n);
+            out[n] = '\0';
+            seg[depth++] = out;
+            out += n + 1;
+            p += n;
+        }
+        if (*p == '.')
+            p++;
+    }
+    return *p ? 0 : depth;
+}
+
+/* Whether key (n segments) is a prefix of path (depth segments). */
+static int seq_prefix(const char *const *key, size_t n, const char *const *path, size_t depth)
+{
+    size_t i = 0;
+    while (i < n && i < depth && !strcmp(key[i], path[i]))
+        i++;
+    return i == n;
+}
+
+/* An error of frame f's scene at a value the sequence set (a sweep's value, which wins,
+ * or a keyframe's): the message names that place in the sequence file first, then the
+ * scene's path, the frame and its time: "seq.json: keyframes[0].sensors.cam.fov: unknown
+ * key (the scene s.json's sensors[0].fov, frame-00000, t = 0 s)". 1 when rewritten; 0 when
+ * the error lies elsewhere (the scene is bad itself), and err is left as it was. */
+static int seq_blame(const seq_build *b, const thz_sequence *seq, size_t f, json_t *doc,
+                     const char *label, double time_s)
+{
+    size_t k = batch_frame_scene(seq, f);
+    const char *msg = b->err->message, *scene = seq->scene_paths[k];
+    size_t n = strlen(scene);
+    if (b->err->status != THZ_ERR_INPUT || strncmp(msg, scene, n) || strncmp(msg + n, ": ", 2))
+        return 0;
+    const char *path = msg + n + 2, *colon = strstr(path, ": ");
+    if (!colon)
+        return 0;
+    char scene_path[512], buf[512], key_buf[512], where[1024], note[160] = "";
+    if ((size_t)(colon - path) >= sizeof scene_path)
+        return 0;
+    memcpy(scene_path, path, (size_t)(colon - path));
+    scene_path[colon - path] = '\0';
+    const char *seg[SEQ_MAX_DEPTH], *suffix;
+    size_t depth = seq_scene_path(doc, scene_path, buf, sizeof buf, seg, &suffix);
+    if (!depth)
+        return 0;
+    size_t blamed = 0; /* segments of the place found (0: none) */
+    /* the sweep's value first: set after the keyframes, it wins where both name a key */
+    size_t stride = 1, s = f / seq->frames;
+    const char *key;
+    json_t *vals;
+    if (b->sweep)
+        json_object_foreach(b->sweep, key, vals) stride *= json_array_size(vals);
+    if (b->sweep)
+        json_object_foreach(b->sweep, key, vals)
+        {
+            stride /= json_array_size(vals);
+            const char *kseg[SEQ_MAX_DEPTH];
+            snprintf(key_buf, sizeof key_buf, "%s", key);
+            size_t kd = seq_split(key_buf, kseg);
+            if (!blamed && seq_prefix(kseg, kd, seg, depth)) {
+                snprintf(where, sizeof where, "sweep.%s[%zu]", key,
+                         (s / stride) % json_array_size(vals));
+                blamed = kd;
+            }
+        }
+    for (size_t i = 0; !blamed && i < b->n_tracks; i++) {
+        const seq_track *tr = &b->tracks[i];
+        if (!seq_prefix(tr->seg, tr->depth, seg, depth))
+            continue;
+        size_t j;
+        double u;
+        batch_segment(tr->t, tr->k, time_s, &j, &u);
+        size_t at = u > 0.0 ? tr->kf[j + 1] : tr->kf[j];
+        if (u > 0.0 && u < 1.0)
+            snprintf(note, sizeof note, "interpolated between keyframes[%zu] and keyframes[%zu]; ",
+                     tr->kf[j], tr->kf[j + 1]);
+        snprintf(where, sizeof where, "keyframes[%zu]", at);
+        for (size_t m = 0; m < tr->depth; m++) {
+            size_t len = strlen(where);
+            snprintf(where + len, sizeof where - len, ".%s", tr->seg[m]);
+        }
+        blamed = tr->depth;
+    }
+    if (!blamed)
+        return 0;
+    for (size_t m = blamed; m < depth; m++) {
+        size_t len = strlen(where);
+        snprintf(where + len, sizeof where - len, ".%s", seg[m]);
+    }
+    size_t len = strlen(where);
+    snprintf(where + len, sizeof where - len, "%s", suffix);
+    const char *name = strrchr(scene, '/');
+    char t[40];
+    thz_number_text(time_s, t, sizeof t);
+    char reason[sizeof b->err->message]; /* (the message is rewritten from it) */
+    snprintf(reason, sizeof reason, "%s", colon + 2);
+    thz_error_set(b->err, THZ_ERR_INPUT, "%s: %s: %s (%sthe scene %s's %s, %s%s%s, t = %s s)",
+                  b->label, where, reason, note, name ? name + 1 : scene, scene_path,
+                  seq->frame_dir[f], label[0] ? ": " : "", label, t);
+    return 1;
+}
+
 /* Builds frame f's scene text, dir, hash and sweep label; checks that it loads. */
 static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
 {
@@ -474,11 +618,15 @@ static thz_status seq_frame(seq_build *b, thz_sequence *seq, size_t f)
         !(seq->movies_unmade = thz_strdup(why)))
         st = thz_error_set(b->err, THZ_ERR_NOMEM, "%s: out of memory", b->label);
     thz_scene_destroy(scene);
-    if (st != THZ_OK && b->err && seq->scene_list)
-        thz_error_prefix(b->err, "%s: frame %zu (scenes[%zu]%s%s): ", b->label, i, k,
+    /* a bad value the sequence set is named where the sequence sets it; else the scene's
+     * own error, after the frame (its directory, as the warnings and later errors say) */
+    if (st != THZ_OK && b->err && seq_blame(b, seq, f, doc, label, time_s))
+        ;
+    else if (st != THZ_OK && b->err && seq->scene_list)
+        thz_error_prefix(b->err, "%s: %s (scenes[%zu]%s%s): ", b->label, seq->frame_dir[f], k,
                          label[0] ? ", " : "", label);
     else if (st != THZ_OK && b->err)
-        thz_error_prefix(b->err, "%s: frame %zu (%s%st = %g s): ", b->label, i, label,
+        thz_error_prefix(b->err, "%s: %s (%s%st = %g s): ", b->label, seq->frame_dir[f], label,
                          label[0] ? ", " : "", time_s);
     if (st == THZ_OK) {
         uint64_t h = batch_hash_bytes(BATCH_HASH_INIT, "thzmap " THZ_VERSION_STRING,
@@ -638,6 +786,7 @@ thz_status thz_sequence_load_ctx(thz_context *ctx, const char *path, const char 
     for (size_t i = 0; i < b.n_tracks; i++) {
         free(b.tracks[i].t);
         free(b.tracks[i].v);
+        free(b.tracks[i].kf);
     }
     free(b.tracks);
     json_decref(b.file_hashes);

@@ -43,7 +43,6 @@ typedef struct batch_cli {
     double last_draw_s; /* when it was drawn, s */
     int last_tenth;     /* not a terminal: the last tenth of the batch printed */
     size_t frame;       /* the frame running (its warnings name it), when in_frame */
-    size_t n_frames;
     bool in_frame;
     double load_start_s;         /* when the sequence's load (or the memory check) began */
     bool checking;               /* the frames' memory check has begun */
@@ -91,7 +90,6 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
         return 1;
     b->in_frame = !strcmp(p->stage, "frame") || !strcmp(p->stage, "run");
     b->frame = p->frame;
-    b->n_frames = p->n_frames;
     if (b->quiet)
         return 0;
     if (!strcmp(p->stage, "run")) {
@@ -208,9 +206,8 @@ static void batch_on_warning(void *user, const char *message)
     }
     thz_frame_info fi;
     if (b->in_frame)
-        fprintf(stderr, "thzmap batch: warning: frame %zu/%zu (%s): %s\n", b->frame + 1,
-                b->n_frames, thz_sequence_frame(b->seq, b->frame, &fi) == THZ_OK ? fi.dir : "?",
-                message);
+        fprintf(stderr, "thzmap batch: warning: %s: %s\n",
+                thz_sequence_frame(b->seq, b->frame, &fi) == THZ_OK ? fi.dir : "?", message);
     else
         fprintf(stderr, "thzmap batch: warning: %s\n", message);
 }

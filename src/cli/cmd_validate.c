@@ -29,7 +29,8 @@ static void validate_usage(FILE *f)
                "Given a sequence file (\"thzmap-sequence/1\", which `thzmap batch` runs), it\n"
                "checks the sequence and every frame's scene, prints the number of frames and\n"
                "the first frame's scene as above, and each frame's warnings once, naming the\n"
-               "first frame that has it and then how many later frames repeat it.\n\n"
+               "first frame that has it by its directory (frame-00001: ...) and then how\n"
+               "many later frames repeat it.\n\n"
                "options:\n"
                "  -h, --help   show this help\n");
 }
@@ -292,7 +293,7 @@ static int validate_sequence(const char *path)
             const char *w = thz_scene_warning(scene, i);
             thz_frame_info fi;
             if (cli_frame_warnings_first(&warnings, w))
-                fprintf(stderr, "thzmap validate: warning: frame %zu/%zu (%s): %s\n", f + 1, n,
+                fprintf(stderr, "thzmap validate: warning: %s: %s\n",
                         thz_sequence_frame(seq, f, &fi) == THZ_OK ? fi.dir : "?", w);
         }
         thz_scene_destroy(scene);

@@ -473,7 +473,7 @@ echo '{"format": "thzmap-sequence/1", "scene": "few.json", "fps": 1, "frames": 3
 "$THZMAP" batch "$work/few-seq.json" -o "$work/F" --threads 2 --quiet > /dev/null 2> "$work/F.err" ||
     fail "few photons: exit $?"
 [ "$(grep -c 'fewer photons than a density estimate needs' "$work/F.err")" = 2 ] &&
-    grep -q '^thzmap batch: warning: frame 1/3 (frame-00000): ' "$work/F.err" &&
+    grep -q '^thzmap batch: warning: frame-00000: ' "$work/F.err" &&
     grep -q '^thzmap batch: warning: the same in 2 later frames: ' "$work/F.err" ||
     fail "a warning of every frame: not once with its frame, then counted: $(cat "$work/F.err")"
 
@@ -488,7 +488,7 @@ PY
 echo '{"format": "thzmap-sequence/1", "scene": "bg.json", "fps": 1, "frames": 2}' > "$work/bg-seq.json"
 "$THZMAP" batch "$work/bg-seq.json" -o "$work/BG" --threads 2 --quiet > /dev/null 2> "$work/BG.err" ||
     fail "scene warnings: exit $?"
-grep -q '^thzmap batch: warning: frame 1/2 (frame-00000): atmosphere.background_temperature_k is given' "$work/BG.err" &&
+grep -q '^thzmap batch: warning: frame-00000: atmosphere.background_temperature_k is given' "$work/BG.err" &&
     grep -q '^thzmap batch: warning: the same in 1 later frame: atmosphere.background' "$work/BG.err" ||
     fail "a frame's scene warning not printed once with its frame: $(cat "$work/BG.err")"
 
@@ -614,7 +614,7 @@ bad total_frames 'bad-total_frames.json: frames: 100000 frames per sweep value x
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "frames": 100000, "sweep": {"objects.person.temperature_k": [300, 310]}}'
 # 2500 frames take seconds to check (each frame's scene is loaded): the share checked is
 # shown after the first second; the last frame is bad, so nothing runs
-bad long_check 'frame 2499' \
+bad long_check 'keyframes[2].objects.person.temperature_k: expected a number in [0, 1e+06], got -10 (the scene scene.json'"'"'s objects[1].temperature_k, frame-02499, t = 2499 s)' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 2500, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 2498, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 2499, "objects": {"person": {"temperature_k": -10}}}]}'
 grep -qE "checking the frames' scenes: [0-9]+ % \([0-9]+ of 2500 frames\), [0-9.]+ s" "$work/bad.err" ||
     fail "a long check of the frames shows no progress: $(head -c 600 "$work/bad.err")"
@@ -627,9 +627,32 @@ rc=$?
     grep -qF 'list.json: format: expected "thzmap-scene/1" or "thzmap-scene/1.1", got "thzmap-sequence/1" (a sequence file, which `thzmap batch` runs)' "$work/bad.err"; } ||
   fail "simulate given a sequence file: exit $rc: $(cat "$work/bad.err")"
 bad syntax 'bad-syntax.json:1:' '{"format": "thzmap-sequence/1",, }'
-bad frame_scene 'frame 2 (t = 0.5 s): ' \
+# a bad value a keyframe or the sweep set: named where the sequence file sets it (the
+# message led to the scene's JSON path, which the scene file does not have: "frame 2 (t =
+# 0.5 s): scene.json: objects[1].temperature_k"), then the scene's path and the frame by
+# its directory, as the warnings name it (errors counted frames from 0, warnings from 1)
+bad frame_scene 'bad-frame_scene.json: keyframes[1].objects.person.temperature_k: expected a number in [0, 1e+06], got -10 (the scene scene.json'"'"'s objects[1].temperature_k, frame-00002, t = 0.5 s)' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 3, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 0.5, "objects": {"person": {"temperature_k": -10}}}]}'
-grep -qF 'objects[1].temperature_k' "$work/bad.err" || fail "bad frame_scene: the scene's JSON path: $(cat "$work/bad.err")"
+bad frame_key 'bad-frame_key.json: keyframes[0].sensors.cam.fov: unknown key (expected one of: ' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 2, "keyframes": [{"time_s": 0, "sensors": {"cam": {"fov": 30}}}]}'
+grep -qF "(the scene scene.json's sensors[0].fov, frame-00000, t = 0 s)" "$work/bad.err" || fail "bad frame_key: the scene's path: $(cat "$work/bad.err")"
+bad frame_between 'bad-frame_between.json: keyframes[1].sensors.cam.position_m[2]: ' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 4, "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [0, -1.4, 0.9]}}}, {"time_s": 1, "sensors": {"cam": {"position_m": [0, -1.4, 1e300]}}}]}'
+grep -qF "(interpolated between keyframes[0] and keyframes[1]; the scene scene.json's sensors[0].position_m[2], frame-00001, t = 0.25 s)" "$work/bad.err" || fail "bad frame_between: $(cat "$work/bad.err")"
+bad frame_sweep "bad-frame_sweep.json: sweep.objects.room.temperature_k[1]: expected a number in [0, 1e+06], got -1 (the scene scene.json's objects[0].temperature_k, sweep-01/frame-00000: objects.room.temperature_k = -1, t = 0 s)" \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 1, "keyframes": [{"time_s": 0, "objects": {"room": {"temperature_k": 300}}}], "sweep": {"objects.room.temperature_k": [1, -1]}}'
+# a value inside one the sweep set: its place within that value
+bad frame_sweep_deep "bad-frame_sweep_deep.json: sweep.objects.person.transform[0].bogus: unknown key" \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "sweep": {"objects.person.transform": [{"translate_m": [0, 0, 0.8], "bogus": 1}]}}'
+# an error the sequence did not make: the scene's own, after the frame's directory
+"$PY" - "$work" <<'PY'
+import json, sys
+s = json.load(open(f"{sys.argv[1]}/scene.json"))
+s["sensors"][0]["fov"] = 30
+json.dump(s, open(f"{sys.argv[1]}/scene-fov.json", "w"))
+PY
+bad frame_own "bad-frame_own.json: frame-00000 (t = 0 s): $work/scene-fov.json: sensors[0].fov: unknown key" \
+    '{"format": "thzmap-sequence/1", "scene": "scene-fov.json", "fps": 1, "frames": 2, "keyframes": [{"time_s": 1, "sensors": {"cam": {"fov_deg": 60}}}]}'
 bad both 'bad-both.json: scenes: give either "scene"' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "scenes": ["scene.json"]}'
 bad empty_list 'bad-empty_list.json: scenes: expected a non-empty list of scene files, got an empty one' \

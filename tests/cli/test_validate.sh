@@ -191,12 +191,13 @@ expect_line "$tmp/seq.out" '^frames: 6 \(2 sweep values x 3 frames, t = 0 to 2 s
 [[ $(grep -c 'background_temperature_k is given' "$tmp/seq.err") -eq 2 ]] &&
     [[ $(grep -c 'is outside the enclosure' "$tmp/seq.err") -eq 2 ]] ||
     fail "the warnings: not each once and once repeated: $(cat "$tmp/seq.err")"
-expect_line "$tmp/seq.err" '^thzmap validate: warning: frame 1/6 \(sweep-00/frame-00000\): atmosphere\.background_temperature_k is given'
+expect_line "$tmp/seq.err" '^thzmap validate: warning: sweep-00/frame-00000: atmosphere\.background_temperature_k is given'
 expect_line "$tmp/seq.err" '^thzmap validate: warning: the same in 1 later frame: atmosphere\.background_temperature_k'
-expect_line "$tmp/seq.err" '^thzmap validate: warning: frame 2/6 \(sweep-00/frame-00001\): sensor "cam" at \[0, -3, 0\.4\] m is outside'
+expect_line "$tmp/seq.err" '^thzmap validate: warning: sweep-00/frame-00001: sensor "cam" at \[0, -3, 0\.4\] m is outside'
 expect_line "$tmp/seq.err" '^thzmap validate: warning: the same in 3 later frames: sensor "cam" .* is outside'
-# a frame whose scene is bad: exit 2, naming the frame (from 0, as batch does) and the
-# scene's JSON path
+# a frame whose scene is bad by a keyframe's value: exit 2, naming the keyframe's value
+# in the sequence file, then the scene's JSON path and the frame's directory (as batch
+# does)
 cat > "$tmp/seq/bad.json" <<'JSON'
 {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 3,
  "keyframes": [{"time_s": 0, "objects": {"target": {"temperature_k": 300}}},
@@ -204,7 +205,7 @@ cat > "$tmp/seq/bad.json" <<'JSON'
 JSON
 "$thzmap" validate "$tmp/seq/bad.json" >/dev/null 2>"$tmp/err"
 [[ $? -eq 2 ]] || fail "a sequence with a bad frame must exit 2: $(cat "$tmp/err")"
-expect_line "$tmp/err" 'bad\.json: frame 2 \(t = 2 s\): .*scene\.json: objects\[1\]\.temperature_k'
+expect_line "$tmp/err" 'bad\.json: keyframes\[1\]\.objects\.target\.temperature_k: .* \(the scene scene\.json.s objects\[1\]\.temperature_k, frame-00002, t = 2 s\)'
 
 [[ $failures -eq 0 ]] && echo "validate: all checks passed"
 [[ $failures -eq 0 ]]

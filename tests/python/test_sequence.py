@@ -156,12 +156,12 @@ def test_batch_warnings_name_their_frame_once(tmp_path):
     back_side = [t for t in texts if "saw the back side" in t]
     assert len(texts) == 6 and len(background) == len(outside) == len(back_side) == 2, texts
     assert background[0].startswith(
-        "frame 1/6 (sweep-00/frame-00000): atmosphere.background_temperature_k")
+        "sweep-00/frame-00000: atmosphere.background_temperature_k")
     assert background[1].startswith("the same in 1 later frame: atmosphere.background")
     assert outside[0].startswith(
-        'frame 2/6 (sweep-00/frame-00001): sensor "cam" at [0, -3, 0.4] m is outside')
+        'sweep-00/frame-00001: sensor "cam" at [0, -3, 0.4] m is outside')
     assert outside[1].startswith('the same in 3 later frames: sensor "cam" at')
-    assert back_side[0].startswith("frame 2/6 (sweep-00/frame-00001): sensor 'cam': ")
+    assert back_side[0].startswith("sweep-00/frame-00001: sensor 'cam': ")
     assert back_side[1].startswith("the same in 3 later frames: sensor 'cam': ")
     # each points at the caller of batch, as simulate's do, not into the package
     assert {w.filename for w in caught if issubclass(w.category, thzmap.RunWarning)} == \
@@ -204,6 +204,16 @@ def test_errors(tmp_path):
         thzmap.load_sequence(tmp_path / "bad.json")
     assert e.value.file == str(tmp_path / "bad.json")
     assert e.value.path == "keyframes[0].objects.nobody", e.value
+    # a bad value a keyframe set: its path in the sequence file (it was the scene's,
+    # "sensors[0].fov", which the scene file does not have)
+    bad["keyframes"] = [{"time_s": 0, "sensors": {"cam": {"fov": 30}}}]
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.load_sequence(tmp_path / "bad.json")
+    assert e.value.file == str(tmp_path / "bad.json")
+    assert e.value.path == "keyframes[0].sensors.cam.fov", e.value
+    assert e.value.reason.startswith("unknown key") and \
+        "(the scene scene.json's sensors[0].fov, frame-00000, t = 0 s)" in e.value.reason
     with pytest.raises(thzmap.Error, match="cannot"):
         thzmap.load_sequence(tmp_path / "missing.json")
     with pytest.raises(thzmap.ArgumentError, match="sequence: expected"):

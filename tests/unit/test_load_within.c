@@ -280,7 +280,7 @@ static void test_sequences(void **state)
         fail_msg("seq-abs.json: %s", m ? m : "loaded");
     /* the second scene of the list names a table outside: its frame is refused */
     m = sequence_refusal("seq-list.json");
-    if (!m || !strstr(m, "frame 1 (scenes[1]") ||
+    if (!m || !strstr(m, "frame-00001 (scenes[1]") ||
         !strstr(m, "materials.m.file: \"../../outside.csv\" is outside the served root") ||
         strstr(m, MARKER))
         fail_msg("seq-list.json: %s", m ? m : "loaded");
