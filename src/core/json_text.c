@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/c_locale.h"
 #include "core/error.h"
 
 json_t *thz_json_text(const char *s)
@@ -24,11 +25,13 @@ void thz_number_text(double x, char *buf, size_t size)
 {
     if (!size)
         return;
+    locale_t previous = thz_locale_enter(); /* "0.1" in any host's locale */
     for (int digits = 1; digits <= 17; digits++) {
         snprintf(buf, size, "%.*g", digits, x);
         if (strtod(buf, NULL) == x || x != x)
-            return;
+            break;
     }
+    thz_locale_leave(previous);
 }
 
 /* A growing text. */

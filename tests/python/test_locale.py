@@ -7,6 +7,7 @@ localedef (Debian's `locales` package, which scripts/install-deps.sh installs) a
 the package in a child process under it: the scene must load and the headers must be
 the bytes written under the "C" locale.
 """
+import json
 import os
 import subprocess
 import sys
@@ -21,6 +22,12 @@ if sys.argv[3] != "C":
     assert locale.localeconv()["decimal_point"] == ",", locale.localeconv()
 scene = thzmap.load_scene(sys.argv[1])
 thzmap.simulate(scene, integrator="photon-map", photons=2000, seed=3, threads=1).save(sys.argv[2])
+# a sweep's label writes its numbers shortest ("0.1"), through printf
+seq = sys.argv[1].replace("scene.json", "sequence.json")
+with open(seq, "w") as f:
+    json.dump({"format": "thzmap-sequence/1", "scene": "scene.json",
+               "sweep": {"objects.target.temperature_k": [300.5, 310.25]}}, f)
+thzmap.batch(seq, sys.argv[2] + "-batch", threads=1, movies=False)
 """
 
 
@@ -58,3 +65,6 @@ def test_a_comma_decimal_locale_changes_no_file(tiny_dir, tmp_path):
         image = name[:-4] + ".img"
         assert (tmp_path / "de" / image).read_bytes() == \
             (tmp_path / "c" / image).read_bytes()
+    for name in ("c-batch", "de-batch"):
+        label = json.loads((tmp_path / name / "batch.json").read_text())["sweeps"][1]["label"]
+        assert label == "objects.target.temperature_k = 310.25", (name, label)
