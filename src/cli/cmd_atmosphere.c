@@ -321,6 +321,13 @@ int cmd_atmosphere(int argc, char **argv)
                                         : "");
         goto cleanup;
     }
+    if (o.air_given && !strcmp(model_name, "none") &&
+        !(o.compare_model && strcmp(o.compare_model, "none") != 0)) {
+        rc = cli_usage_error(CMD, "--temperature-k, --pressure-hpa and the humidity options "
+                                  "describe the air of a lines or itu-p676 model; --model none "
+                                  "has no air");
+        goto cleanup;
+    }
     if (from_scene ? thz_atm_from_scene(scene, &atm, &err) != THZ_OK
                    : build_model(&o, model_name, NULL, &atm, &err) != THZ_OK) {
         rc = cli_fail(&err);

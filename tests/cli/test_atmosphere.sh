@@ -106,6 +106,8 @@ expect_usage "not per cent" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --relative-
 # "must be 0 to 1" above it)
 expect_usage "relative humidity must be 0 to 1 (a fraction, not per cent), got -0.1" \
     --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --relative-humidity -0.1
+expect_usage "--model none has no air" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --model none \
+    --relative-humidity 0.5
 expect_usage "--relative-humidity expects a number, got 'nan'" --from-thz 0.1 --to-thz 0.2 \
     --step-ghz 1 --relative-humidity nan
 expect_usage "only one of" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --relative-humidity 0.5 --h2o-vmr 0.01
