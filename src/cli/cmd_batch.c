@@ -122,8 +122,8 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
                 p->frame + 1, p->n_frames, finished, p->reused, p->seconds, eta);
     } else if (!strcmp(p->stage, "movie") && !b->movies_said) { /* reported again after */
         b->movies_said = true;
-        fprintf(stderr, "thzmap batch: %zu frames done (%.1f s); encoding the movies\n",
-                p->n_frames, p->seconds);
+        fprintf(stderr, "thzmap batch: %zu frame%s done (%.1f s); encoding the movies\n",
+                p->n_frames, p->n_frames == 1 ? "" : "s", p->seconds);
     }
     return 0;
 }
@@ -323,10 +323,11 @@ int cmd_batch(int argc, char **argv)
     thz_context_set_progress(ctx, batch_on_run_progress, &b);
     thz_context_set_warning(ctx, batch_on_warning, &b);
     if (!b.quiet)
-        fprintf(stderr, "thzmap batch: %zu frame%s (%zu sweep value%s x %zu frames) into %s\n",
+        fprintf(stderr, "thzmap batch: %zu frame%s (%zu sweep value%s x %zu frame%s) into %s\n",
                 thz_sequence_frame_count(seq), thz_sequence_frame_count(seq) == 1 ? "" : "s",
                 thz_sequence_sweep_count(seq), thz_sequence_sweep_count(seq) == 1 ? "" : "s",
-                thz_sequence_frames_per_sweep(seq), outdir);
+                thz_sequence_frames_per_sweep(seq),
+                thz_sequence_frames_per_sweep(seq) == 1 ? "" : "s", outdir);
     thz_batch_options opt = {.progress = batch_on_progress,
                              .progress_user = &b,
                              .open_output = cli_exit_guard(),
@@ -346,8 +347,9 @@ int cmd_batch(int argc, char **argv)
     } else if (st != THZ_OK) {
         rc = cli_fail(&err);
     } else if (!b.quiet) {
-        printf("thzmap batch: %zu frames (%zu computed, %zu already done), %zu movies",
-               res.n_frames, res.computed, res.reused, res.movies);
+        printf("thzmap batch: %zu frame%s (%zu computed, %zu already done), %zu movie%s",
+               res.n_frames, res.n_frames == 1 ? "" : "s", res.computed, res.reused, res.movies,
+               res.movies == 1 ? "" : "s");
         if (shared)
             printf(", %d MPI ranks (%.3g MB communicated)", cli_mpi_size(),
                    1e-6 * (double)thz_context_mpi_bytes(ctx));
