@@ -12,13 +12,9 @@
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/path.h"
+#include "physics/planck.h"
 #include "scene/scene.h"
 #include "sensor/noise.h"
-
-/* Physical constants (SI, exact since 2019). */
-#define BV_H 6.62607015e-34
-#define BV_K 1.380649e-23
-#define BV_C 299792458.0
 
 void bands_values_fini(bands_values *v)
 {
@@ -34,16 +30,6 @@ void bands_values_fini(bands_values *v)
     free(v->mean_mc_var);
     free(v->netd_k);
     memset(v, 0, sizeof *v);
-}
-
-/* dB_nu/dT at nu (Hz) and T (K), W m^-2 sr^-1 Hz^-1 K^-1: turns a radiance's standard
- * error into kelvin (at the channel centre: the bands are narrow). */
-static double planck_dbdt(double nu, double t)
-{
-    double x = BV_H * nu / (BV_K * t);
-    double ex = exp(x);
-    double b = 2.0 * BV_H * nu * nu * nu / (BV_C * BV_C) / (ex - 1.0);
-    return b * x * ex / (ex - 1.0) / t;
 }
 
 /* The scene's JSON with the nuisance `what` changed: 0 nominal, 1 one target's
@@ -419,6 +405,8 @@ static void pixel_covariance(const render_out *r, const int32_t *cls, const band
     for (size_t k = 0; k < v->n_classes; k++) {
         double *cov = v->cov + k * n * n;
         for (size_t c = 0; c < n; c++) {
+            /* the radiance's standard error in K through dB/dT at the channel's centre
+             * (the bands are narrow) */
             double nu = s->candidates_thz[c] * 1e12, mc = 0.0;
             for (size_t p = 0; p < pixels; p++)
                 if (cls[p] == (int32_t)k) {

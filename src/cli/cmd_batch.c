@@ -44,8 +44,11 @@ typedef struct batch_cli {
     int last_tenth;     /* not a terminal: the last tenth of the batch printed */
     size_t frame;       /* the frame running (its warnings name it), when in_frame */
     bool in_frame;
-    double load_start_s;         /* when the sequence's load (or the memory check) began */
-    bool checking;               /* the frames' memory check has begun */
+    double load_start_s; /* when the sequence's load (or the memory check) began */
+    bool checking;       /* the frames' memory check has begun */
+    /* not a terminal: the last tenth of the load or the check printed (its own, so that
+     * the batch's tenths do not start where a long check ended) */
+    int check_tenth;
     bool movies_said;            /* "encoding the movies" printed (the stage comes twice) */
     const thz_sequence *seq;     /* the frames' directories, which the warnings name */
     cli_frame_warnings warnings; /* printed once, the later frames' same counted */
@@ -100,6 +103,7 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
         if (!b->checking) {
             b->checking = true;
             b->load_start_s = cli_now_s();
+            b->check_tenth = 0;
         }
         thz_progress lp = {.stage = "check", .done = p->frame, .total = p->n_frames};
         batch_on_load_progress(b, &lp);
@@ -137,29 +141,18 @@ static int batch_on_load_progress(void *user, const thz_progress *p)
     double now = cli_now_s();
     if (b->quiet || !p->total || now - b->load_start_s < 1.0)
         return 0;
-    const char *what = !strcmp(p->stage, "check") ? "memory" : "scenes";
     double frac = (double)p->done / (double)p->total;
-    if (b->tty) {
-        if (now - b->last_draw_s < 0.1)
-            return 0;
-        b->last_draw_s = now;
-        fprintf(stderr,
-                "\r\033[Kthzmap batch: checking the frames' %s: %.0f %% (%llu of %llu "
-                "frames), %.1f s",
-                what, 100.0 * frac, (unsigned long long)p->done, (unsigned long long)p->total,
-                now - b->load_start_s);
-        b->line_open = true;
-    } else {
-        int tenth = (int)(10.0 * frac);
-        if (tenth <= b->last_tenth)
-            return 0;
-        b->last_tenth = tenth;
-        fprintf(stderr,
-                "thzmap batch: checking the frames' %s: %d %% (%llu of %llu frames), "
-                "%.1f s\n",
-                what, 10 * tenth, (unsigned long long)p->done, (unsigned long long)p->total,
-                now - b->load_start_s);
-    }
+    int tenth = (int)(10.0 * frac);
+    if (b->tty ? now - b->last_draw_s < 0.1 : tenth <= b->check_tenth)
+        return 0;
+    b->last_draw_s = now;
+    b->check_tenth = tenth;
+    fprintf(stderr,
+            "%sthzmap batch: checking the frames' %s: %.0f %% (%llu of %llu frames), %.1f s%s",
+            b->tty ? "\r\033[K" : "", !strcmp(p->stage, "check") ? "memory" : "scenes",
+            100.0 * frac, (unsigned long long)p->done, (unsigned long long)p->total,
+            now - b->load_start_s, b->tty ? "" : "\n");
+    b->line_open = b->tty;
     fflush(stderr);
     return 0;
 }
@@ -181,8 +174,6 @@ static thz_status batch_load(batch_cli *b, const char *path, thz_sequence **seq,
         fputs("\r\033[K", stderr);
         b->line_open = false;
     }
-    b->last_tenth = 0;
-    b->last_draw_s = 0.0;
     return st;
 }
 
