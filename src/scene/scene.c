@@ -10,6 +10,7 @@
 
 #include "core/alloc.h"
 #include "physics/planck.h"
+#include "scene/scene_hash.h"
 
 const char *const scene_integrator_names[] = {
     [INTEGRATOR_PHOTON_MAP] = "photon-map",
@@ -23,6 +24,11 @@ thz_scene *scene_create(void)
     thz_scene *s = thz_calloc(1, sizeof *s);
     if (!s)
         return NULL;
+    s->hash_memo = scene_hash_memo_create();
+    if (!s->hash_memo) {
+        free(s);
+        return NULL;
+    }
     s->atmosphere.model = ATM_NONE;
     s->photons.per_channel = 1000000;
     s->photons.seed = 1;
@@ -77,6 +83,7 @@ void scene_destroy(thz_scene *s)
     free(s->path);
     free(s->dir);
     free(s->name);
+    scene_hash_memo_destroy(s->hash_memo);
     free(s);
 }
 

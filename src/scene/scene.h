@@ -166,6 +166,10 @@ struct thz_scene {
 
     size_t n_warnings;
     char **warnings; /* messages for validate and summary.json, one line each */
+
+    /* What scene_hash.c keeps of the meshes' hash (owned; shallow copies share it, as
+     * they share the meshes); NULL for a scene not made by scene_create: nothing kept. */
+    struct scene_hash_memo *hash_memo;
 };
 typedef struct thz_scene thz_scene;
 

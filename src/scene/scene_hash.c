@@ -1,7 +1,11 @@
 /* Fingerprints of the parts of a scene that determine its photon maps. */
 #include "scene/scene_hash.h"
 
+#include <stdatomic.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "core/alloc.h"
 
 #define HASH_PRIME 0x100000001b3ull
 #define HASH_OFFSET 0xcbf29ce484222325ull
@@ -62,11 +66,32 @@ static uint64_t hash_finish(uint64_t h)
     return h;
 }
 
-void scene_hash_compute(const thz_scene *scene, scene_hash *out)
+struct scene_hash_memo {
+    atomic_bool done;
+    _Atomic uint64_t geometry;
+};
+
+struct scene_hash_memo *scene_hash_memo_create(void)
 {
-    uint64_t g = HASH_OFFSET, o = HASH_OFFSET, c = HASH_OFFSET;
-    g = hash_word(g, scene->n_objects);
-    o = hash_word(o, scene->n_objects);
+    struct scene_hash_memo *m = thz_calloc(1, sizeof *m);
+    if (m) {
+        atomic_init(&m->done, false);
+        atomic_init(&m->geometry, 0);
+    }
+    return m;
+}
+
+void scene_hash_memo_destroy(struct scene_hash_memo *memo)
+{
+    free(memo);
+}
+
+static uint64_t hash_geometry(const thz_scene *scene)
+{
+    struct scene_hash_memo *m = scene->hash_memo;
+    if (m && atomic_load_explicit(&m->done, memory_order_acquire))
+        return atomic_load_explicit(&m->geometry, memory_order_relaxed);
+    uint64_t g = hash_word(HASH_OFFSET, scene->n_objects);
     for (size_t i = 0; i < scene->n_objects; i++) {
         const thz_object *obj = &scene->objects[i];
         g = hash_word(g, (uint64_t)obj->type);
@@ -74,6 +99,20 @@ void scene_hash_compute(const thz_scene *scene, scene_hash *out)
         g = hash_double(g, obj->thickness_m);
         g = hash_words32(g, obj->mesh.positions, 3 * obj->mesh.n_vertices);
         g = hash_words32(g, obj->mesh.indices, 3 * obj->mesh.n_triangles);
+    }
+    if (m) {
+        atomic_store_explicit(&m->geometry, g, memory_order_relaxed);
+        atomic_store_explicit(&m->done, true, memory_order_release);
+    }
+    return g;
+}
+
+void scene_hash_compute(const thz_scene *scene, scene_hash *out)
+{
+    uint64_t g = hash_geometry(scene), o = HASH_OFFSET, c = HASH_OFFSET;
+    o = hash_word(o, scene->n_objects);
+    for (size_t i = 0; i < scene->n_objects; i++) {
+        const thz_object *obj = &scene->objects[i];
         o = hash_word(o, obj->material);
         o = hash_double(o, obj->temperature_k);
     }

@@ -31,6 +31,14 @@ typedef struct scene_hash {
 
 void scene_hash_compute(const thz_scene *scene, scene_hash *out);
 
+/* The geometry's hash, the bulk of the work (every vertex and index, about 0.3 s for
+ * 16.7 M triangles), is computed once per scene and kept in its memo: a scene's meshes
+ * do not change after loading, and every photon phase, render channel and photon-map file
+ * of an MPI run asks again. Safe when threads ask at once (they compute the same value).
+ * NULL on allocation failure. */
+struct scene_hash_memo *scene_hash_memo_create(void);
+void scene_hash_memo_destroy(struct scene_hash_memo *memo);
+
 /* One fingerprint of all that the processes of an MPI run must share to compute the same
  * photons and pixels: the three hashes above, the sensors' geometry and optics (size,
  * pose, field, oversampling, aperture, PSF) and the photon and render settings the

@@ -176,12 +176,43 @@ static void test_member_refuses_other_seed(void **state)
     scene_destroy(s);
 }
 
+/* The geometry's hash is kept in the scene's memo after its first computation: the kept
+ * value, the value computed afresh (a shallow copy without the memo) and the values the
+ * code before the memo gave this scene (photon-map files store them) are all the same; a
+ * scene with other geometry gets its own. */
+static void test_scene_hash_memo(void **state)
+{
+    (void)state;
+    thz_scene *s = ps_box_scene(1000, 7, 0.0);
+    scene_hash first, kept, fresh;
+    scene_hash_compute(s, &first);
+    scene_hash_compute(s, &kept);
+    thz_scene copy = *s;
+    copy.hash_memo = NULL;
+    scene_hash_compute(&copy, &fresh);
+    assert_int_equal(first.geometry, 0x866dd1ce38cbf0dbull);
+    assert_int_equal(first.optics, 0xfedc6833368f995cull);
+    assert_int_equal(first.channels, 0x52918b00c5097224ull);
+    assert_int_equal(scene_hash_run(s, true), 0x4f72153e85a8e58aull);
+    assert_int_equal(kept.geometry, first.geometry);
+    assert_int_equal(fresh.geometry, first.geometry);
+    thz_scene *other = ps_box_scene(1000, 7, 0.0);
+    other->objects[0].mesh.positions[0] += 0.5f; /* before its first hash */
+    scene_hash moved;
+    scene_hash_compute(other, &moved);
+    assert_true(moved.geometry != first.geometry);
+    assert_int_equal(moved.optics, first.optics);
+    scene_destroy(other);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_shares_identical),
         cmocka_unit_test(test_share_ranges),
         cmocka_unit_test(test_member_refuses_other_seed),
+        cmocka_unit_test(test_scene_hash_memo),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
