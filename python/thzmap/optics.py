@@ -206,7 +206,7 @@ def atmosphere(model="lines", temperature_k=None, pressure_hpa=None, relative_hu
     default 288.15), pressure_hpa (total, default 1013.25) and at most one humidity:
     relative_humidity (0..1), water_vapour_g_m3 (default 7.5) or h2o_vmr; for "lines" the
     catalogues h2o_lines and o2_lines (files; None: built in) and continuum=False for
-    no MT_CKD continuum. With `scene` (a Scene or a path) and nothing else, the scene's own
+    no MT_CKD continuum; "none" has no air and takes none of them. With `scene` (a Scene or a path) and nothing else, the scene's own
     atmosphere, whatever its model."""
     if scene is not None:
         scene = scene_arg(scene)
@@ -223,6 +223,13 @@ def atmosphere(model="lines", temperature_k=None, pressure_hpa=None, relative_hu
     if model not in ("lines", "itu-p676", "none"):
         raise ArgumentError(f"model: expected \"lines\", \"itu-p676\" or \"none\", got "
                             f"{model!r}")
+    air = {"temperature_k": temperature_k, "pressure_hpa": pressure_hpa,
+           "relative_humidity": relative_humidity, "water_vapour_g_m3": water_vapour_g_m3,
+           "h2o_vmr": h2o_vmr}
+    given = [k for k, v in air.items() if v is not None]
+    if model == "none" and given:
+        raise ArgumentError(f"{', '.join(given)}: describe the air of a lines or itu-p676 "
+                            f"model; model \"none\" has no air")
     o = ThzAtmOptions()
     _lib.lib.thz_atm_options_init(ctypes.byref(o))
     o.model = model.encode()

@@ -68,6 +68,11 @@ def test_the_scene_atmosphere_and_dry_air():
     parts = dry.attenuation(f)
     assert not parts["h2o_lines_per_m"].any() and parts["o2_per_m"].all()
     assert thzmap.atmosphere("none").attenuation_per_m(0.5) == 0.0
+    # no air to describe: refused, as `thzmap atmosphere --model none --humidity ...` is
+    with pytest.raises(thzmap.ArgumentError, match="relative_humidity: .*no air"):
+        thzmap.atmosphere("none", relative_humidity=0.5)
+    with pytest.raises(thzmap.ArgumentError, match="temperature_k, pressure_hpa: "):
+        thzmap.atmosphere("none", temperature_k=290, pressure_hpa=1000)
 
 
 def test_material_library(thzmap_binary):
