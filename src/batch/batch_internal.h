@@ -1,6 +1,8 @@
 /* Sequences and batches (include/thzmap/batch.h): what a loaded sequence holds, and
  * what the files of src/batch/ share. batch_sequence.c loads and checks a sequence and
- * builds every frame's scene text, from the scene files batch_scenes.c loads;
+ * builds every frame's scene text, from the scene files batch_scenes.c loads, the
+ * keyframes batch_keyframes.c gathers and the sweep batch_sweep.c reads (batch_blame.c
+ * names a bad value where the sequence sets it; batch_sequence_build.h);
  * batch_frames.c gives the frames out; batch_interp.c interpolates; batch_hash.c hashes
  * a frame's inputs; batch_run.c runs the frames and writes batch.json; batch_deal.c
  * computes a frame and deals frames to MPI ranks; batch_movie.c
