@@ -4,7 +4,8 @@
  * keyframes batch_keyframes.c gathers and the sweep batch_sweep.c reads (batch_blame.c
  * names a bad value where the sequence sets it; batch_sequence_build.h);
  * batch_frames.c gives the frames out; batch_interp.c interpolates; batch_hash.c hashes
- * a frame's inputs; batch_run.c runs the frames and writes batch.json; batch_deal.c
+ * a frame's inputs; batch_run.c runs the frames, into OUTDIR (batch_outdir.c) with
+ * batch.json and each frame's frame.json (batch_json.c; batch_run_state.h); batch_deal.c
  * computes a frame and deals frames to MPI ranks; batch_movie.c
  * makes the movies from the frames' cubes, through batch_encode.c (the only file that
  * includes FFmpeg). Nothing here is public.

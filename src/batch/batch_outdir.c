@@ -1,0 +1,102 @@
+/* A batch's output directory: created (mkdir -p), locked against a second batch into it
+ * (a POSIX lock, not inherited by forked children), and cleaned of what a batch killed
+ * inside a frame's commit left beside finished frames. batch_run.c runs the frames,
+ * batch_json.c writes batch.json and the frames' frame.json (batch_run_state.h).
+ */
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "batch/batch_internal.h"
+#include "batch/batch_run_state.h"
+#include "core/error.h"
+#include "core/path.h"
+
+thz_status batch_mkdirs(const char *dir, thz_error *err)
+{
+    char path[THZ_PATH_MAX];
+    if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path)
+        return thz_error_set(err, THZ_ERR_IO, "%s: path too long", dir);
+    for (char *p = path + 1;; p++) {
+        char c = *p;
+        if (c != '/' && c != '\0')
+            continue;
+        *p = '\0';
+        if (mkdir(path, 0777) != 0 && errno != EEXIST)
+            return thz_error_set(err, THZ_ERR_IO, "%s: cannot create the directory: %s", path,
+                                 strerror(errno));
+        *p = c;
+        if (!c)
+            break;
+    }
+    struct stat st;
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) /* a file where OUTDIR is: bad usage */
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: not a directory (expected a directory for the results, or a "
+                             "name to create one)",
+                             dir);
+    return THZ_OK;
+}
+
+/* Whether dir holds what a killed output commit leaves beside the directory it commits
+ * (.thzmap-H-lock, .thzmap-H-stage-..., .thzmap-H-old-...; io/output_stage.c). */
+static int batch_has_leftovers(const char *dir)
+{
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    int found = 0;
+    while (d && !found && (e = readdir(d)) != NULL)
+        found = !strncmp(e->d_name, ".thzmap-", 8) && strcmp(e->d_name, ".thzmap-batch-lock");
+    if (d)
+        closedir(d);
+    return found;
+}
+
+void batch_clean_finished(const batch_state *b)
+{
+    const thz_sequence *seq = b->seq;
+    for (size_t s = 0; s < seq->n_sweeps; s++) {
+        char parent[THZ_PATH_MAX], dir[THZ_PATH_MAX], sweep[32];
+        batch_sweep_dir(seq, s, sweep, sizeof sweep);
+        if (seq->has_sweep)
+            snprintf(parent, sizeof parent, "%s/%s", b->outdir, sweep);
+        else
+            snprintf(parent, sizeof parent, "%s", b->outdir);
+        if (!batch_has_leftovers(parent))
+            continue;
+        for (size_t f = s * seq->frames; f < (s + 1) * seq->frames; f++) {
+            if (b->state[f] != FRAME_REUSED ||
+                snprintf(dir, sizeof dir, "%s/%s", b->outdir, seq->frame_dir[f]) >= (int)sizeof dir)
+                continue;
+            thz_output *output = NULL;
+            thz_error ignored;
+            if (thz_output_open(dir, &output, &ignored) == THZ_OK)
+                thz_output_destroy(output);
+        }
+    }
+}
+
+thz_status batch_lock(const char *outdir, int *fd, thz_error *err)
+{
+    char path[THZ_PATH_MAX];
+    thz_status st = thz_path_join(path, sizeof path, outdir, ".thzmap-batch-lock", err);
+    if (st != THZ_OK)
+        return st;
+    *fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (*fd < 0)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    /* A process-associated (POSIX) lock, not flock: children forked for plotting
+     * (core/child.c) would inherit a flock and hold it after a SIGKILL of the batch. */
+    struct flock lk = {.l_type = F_WRLCK, .l_whence = SEEK_SET};
+    if (fcntl(*fd, F_SETLK, &lk) != 0) {
+        close(*fd);
+        *fd = -1;
+        return thz_error_set(err, THZ_ERR_IO,
+                             "%s: another thzmap batch is running into this directory", outdir);
+    }
+    return THZ_OK;
+}
