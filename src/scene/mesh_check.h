@@ -42,7 +42,7 @@
 
 /* OBJ, PLY and STL are checked before assimp reads them; MESH_FORMAT_OTHER is any other
  * format assimp reads (by the extension), which only assimp checks, in its child process
- * with a time and a memory limit (mesh_import.c). */
+ * with a time and a memory limit (mesh_import.c, mesh_import_child.c). */
 typedef enum mesh_format {
     MESH_FORMAT_OBJ,
     MESH_FORMAT_PLY,

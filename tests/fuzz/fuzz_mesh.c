@@ -1,5 +1,5 @@
 /* Fuzzes the mesh reader: the checks of src/scene/mesh_check*.c and the import through
- * assimp behind them (src/scene/mesh_import.c). The input is written to a file whose
+ * assimp behind them (src/scene/mesh_import*.c). The input is written to a file whose
  * extension follows its content, as a user's file would be named: "ply" first → .ply,
  * "solid" first or 84 + 50 n bytes → .stl, anything else → .obj. A mesh that is accepted
  * is finalised and its winding checked, as the scene loader does.
