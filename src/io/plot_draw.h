@@ -1,4 +1,6 @@
-/* The figures of io/plot.h as drawn, in the process that calls these (plot.c). Only a
+/* The figures of io/plot.h as drawn, in the process that calls these (plot.c: the
+ * device check, a figure's start and end, the image preview; plot_lines.c: the line plots
+ * and their wrapped titles; plot_attenuation.c: the attenuation spectrum). Only a
  * child process may call them (plot_child.c starts it): PLplot, and the cairo,
  * fontconfig and GLib it draws with, end the process (exit() or abort()) or deadlock
  * when an allocation fails, and PLplot also exits on some errors, so PLplot never runs
@@ -40,5 +42,18 @@ thz_status plot_attenuation_draw(const char *path, size_t n_x, const double *x, 
                                  const plot_curve *curves, size_t n_bands, const plot_band *bands,
                                  const char *title, const char *x_label, const char *y_label,
                                  thz_error *err);
+
+/* ---- what the figures share (plot.c) ---- */
+
+/* The bytes of a PLplot text: a title, a label, a curve's name. */
+enum { PLOT_TEXT = 512 };
+/* PLplot treats '#' as its escape character: double it in user text. */
+void plot_escape(char *dst, size_t size, const char *src);
+/* Starts a figure of width x height pixels into path: checks the device and that the
+ * file can be created (PLplot prompts on stdin and exits when it cannot open it),
+ * sets a white background with black text. In the child. */
+thz_status plot_begin(const char *path, int width, int height, thz_error *err);
+/* Finishes the figure and checks the file was written. In the child. */
+thz_status plot_end(const char *path, thz_error *err);
 
 #endif
