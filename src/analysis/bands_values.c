@@ -116,6 +116,124 @@ static thz_status variant_means(thz_context *ctx, const char *text, const bands_
     return st;
 }
 
+/* The nuisances' renders of bands_values_compute: what each needs, the coarse nominal
+ * class means their changes are taken against, and how many change the scene. */
+typedef struct nuisance_run {
+    thz_context *ctx;
+    const bands_setup *s;
+    const json_t *root;      /* the scene file's document */
+    const char *base_dir;    /* its directory */
+    const double *ranges;    /* per VAR_*: the nuisance's range (0: not varied) */
+    const bool *is_class;    /* per object: a class of its own */
+    const int32_t *class_of; /* per object: its class (-1: none) */
+    size_t n_obj, pixels;    /* the scene's objects; the nominal render's pixels */
+    int32_t *cls;            /* scratch: each pixel's class */
+    uint64_t *count;         /* scratch: each class's pixels */
+    double air_t_k;          /* the nominal air's temperature, K (NaN: none) */
+    double *coarse_mean;     /* the coarse nominal's class means; NULL until rendered */
+    double *dmean;           /* scratch: a variant's class means, then their change */
+    size_t varied;           /* the variants that change the scene (counted first) */
+    bands_values *v;
+} nuisance_run;
+
+/* Renders the coarse nominal variant, the one the changes are taken against, into
+ * r->coarse_mean (a class it does not see keeps the nominal mean). */
+static thz_status nuisance_coarse_nominal(nuisance_run *r, thz_error *err)
+{
+    bands_values *v = r->v;
+    int changed = 0;
+    char *nominal_text =
+        bands_variant_text(r->root, r->s, r->is_class, VAR_NOMINAL, 0, r->air_t_k, true, &changed);
+    r->coarse_mean = thz_calloc(v->n_classes * v->n_candidates, sizeof *r->coarse_mean);
+    if (!nominal_text || !r->coarse_mean) {
+        free(nominal_text);
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    }
+    double unused;
+    thz_status st =
+        variant_means(r->ctx, nominal_text, r->s, r->base_dir, r->class_of, r->n_obj, r->pixels,
+                      r->cls, r->count, v, v->mean, r->coarse_mean, &unused, err);
+    free(nominal_text);
+    if (st == THZ_OK)
+        v->renders++;
+    return st;
+}
+
+/* Adds a variant's change d of each class's mean (dmean holds its means; d is left there)
+ * to the class's covariance, d d^T, and d^2 to its nuisances' variance: d is the change
+ * over sqrt(3), a uniform variation within +-range having variance range^2 / 3. */
+static void nuisance_add(bands_values *v, const double *coarse_mean, double *dmean)
+{
+    size_t n = v->n_candidates;
+    for (size_t k = 0; k < v->n_classes; k++) {
+        double *d = dmean + k * n, *cov = v->cov + k * n * n;
+        for (size_t c = 0; c < n; c++)
+            d[c] = (d[c] - coarse_mean[k * n + c]) / sqrt(3.0);
+        for (size_t a = 0; a < n; a++) {
+            for (size_t b = 0; b < n; b++)
+                cov[a * n + b] += d[a] * d[b];
+            v->nuisance_sd[k * n + a] += d[a] * d[a];
+        }
+    }
+}
+
+/* The variant of nuisance `what` (of object o for VAR_TARGETS): counting, only whether
+ * it changes the scene (r->varied); else, when it does, its render against the coarse
+ * nominal one (rendered first, once), added to the classes' covariance. */
+static thz_status nuisance_variant(nuisance_run *r, int what, size_t o, bool counting,
+                                   thz_error *err)
+{
+    bands_values *v = r->v;
+    int changed = 0;
+    char *text =
+        bands_variant_text(r->root, r->s, r->is_class, what, o, r->air_t_k, true, &changed);
+    if (!text)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    if (counting)
+        r->varied += changed != 0;
+    if (counting || !changed) {
+        free(text);
+        return THZ_OK;
+    }
+    thz_status st = r->coarse_mean ? THZ_OK : nuisance_coarse_nominal(r, err);
+    double air_used = r->air_t_k;
+    if (st == THZ_OK)
+        st = variant_means(r->ctx, text, r->s, r->base_dir, r->class_of, r->n_obj, r->pixels,
+                           r->cls, r->count, v, r->coarse_mean, r->dmean, &air_used, err);
+    free(text);
+    if (st != THZ_OK)
+        return st;
+    v->renders++;
+    v->humidity_varied = v->humidity_varied || what == VAR_HUMIDITY;
+    /* whatever moved it: the air that follows an enclosure's temperature too */
+    v->air_temperature_varied =
+        v->air_temperature_varied || (isfinite(air_used) && air_used != r->air_t_k);
+    v->thickness_varied = v->thickness_varied || what == VAR_THICKNESS;
+    v->angle_varied = v->angle_varied || what == VAR_ANGLE;
+    nuisance_add(v, r->coarse_mean, r->dmean);
+    return THZ_OK;
+}
+
+/* Every nuisance whose range is not 0, in VAR_* order, through nuisance_variant: counting
+ * the renders, or making them. */
+static thz_status nuisance_each(nuisance_run *r, bool counting, thz_error *err)
+{
+    for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
+        if (!(r->ranges[what] > 0.0))
+            continue;
+        /* each target's temperature is its own nuisance: one render per target */
+        size_t n_variants = what == VAR_TARGETS ? r->n_obj : 1;
+        for (size_t o = 0; o < n_variants; o++) {
+            if (what == VAR_TARGETS && !r->is_class[o])
+                continue;
+            thz_status st = nuisance_variant(r, what, o, counting, err);
+            if (st != THZ_OK)
+                return st;
+        }
+    }
+    return THZ_OK;
+}
+
 thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_values *v,
                                 thz_error *err)
 {
@@ -218,71 +336,29 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
      * the Monte Carlo noise out of d). These renders and the nominal one d is taken
      * against are coarse (coarse_paths). Each render's own truth gives its classes'
      * pixels: a turned sensor sees them elsewhere in the image. */
-    double air_t_k = scene_air_temperature_k(scene);
-    size_t varied = 0; /* the renders, now that the classes say which ranges change any */
-    for (int pass = 0; pass < 2; pass++) { /* 0 counts the renders, 1 makes them */
-        if (pass == 1)
-            bands_progress_renders(&progress, 1 + (varied ? varied + 1 : 0));
-        for (int what = VAR_TARGETS; what < VAR_COUNT; what++) {
-            if (!(ranges[what] > 0.0))
-                continue;
-            /* each target's temperature is its own nuisance: one render per target */
-            for (size_t o = 0; o < (what == VAR_TARGETS ? n_obj : 1); o++) {
-                if (what == VAR_TARGETS && !is_class[o])
-                    continue;
-                text = bands_variant_text(root, s, is_class, what, o, air_t_k, true, &changed);
-                if (!text)
-                    goto nomem;
-                if (!changed || pass == 0) {
-                    varied += changed != 0;
-                    free(text);
-                    text = NULL;
-                    continue;
-                }
-                if (!coarse_mean) { /* the coarse nominal render the changes are taken against */
-                    char *nominal_text = bands_variant_text(root, s, is_class, VAR_NOMINAL, 0,
-                                                            air_t_k, true, &changed);
-                    coarse_mean = thz_calloc(nc * n, sizeof *coarse_mean);
-                    if (!nominal_text || !coarse_mean) {
-                        free(nominal_text);
-                        goto nomem;
-                    }
-                    double unused;
-                    st = variant_means(ctx, nominal_text, s, base_dir, class_of, n_obj,
-                                       nominal.pixels, cls, count, v, v->mean, coarse_mean, &unused,
-                                       err);
-                    free(nominal_text);
-                    if (st != THZ_OK)
-                        goto done;
-                    v->renders++;
-                }
-                double air_used = air_t_k;
-                st = variant_means(ctx, text, s, base_dir, class_of, n_obj, nominal.pixels, cls,
-                                   count, v, coarse_mean, dmean, &air_used, err);
-                free(text);
-                text = NULL;
-                if (st != THZ_OK)
-                    goto done;
-                v->renders++;
-                v->humidity_varied = v->humidity_varied || what == VAR_HUMIDITY;
-                /* whatever moved it: the air that follows an enclosure's temperature too */
-                v->air_temperature_varied =
-                    v->air_temperature_varied || (isfinite(air_used) && air_used != air_t_k);
-                v->thickness_varied = v->thickness_varied || what == VAR_THICKNESS;
-                v->angle_varied = v->angle_varied || what == VAR_ANGLE;
-                for (size_t k = 0; k < nc; k++) {
-                    double *d = dmean + k * n, *cov = v->cov + k * n * n;
-                    for (size_t c = 0; c < n; c++)
-                        d[c] = (d[c] - coarse_mean[k * n + c]) / sqrt(3.0);
-                    for (size_t a = 0; a < n; a++) {
-                        for (size_t b = 0; b < n; b++)
-                            cov[a * n + b] += d[a] * d[b];
-                        v->nuisance_sd[k * n + a] += d[a] * d[a];
-                    }
-                }
-            }
-        }
+    nuisance_run nr = {.ctx = ctx,
+                       .s = s,
+                       .root = root,
+                       .base_dir = base_dir,
+                       .ranges = ranges,
+                       .is_class = is_class,
+                       .class_of = class_of,
+                       .n_obj = n_obj,
+                       .pixels = nominal.pixels,
+                       .cls = cls,
+                       .count = count,
+                       .air_t_k = scene_air_temperature_k(scene),
+                       .dmean = dmean,
+                       .v = v};
+    /* the renders counted first, now that the classes say which ranges change any */
+    st = nuisance_each(&nr, true, err);
+    if (st == THZ_OK) {
+        bands_progress_renders(&progress, 1 + (nr.varied ? nr.varied + 1 : 0));
+        st = nuisance_each(&nr, false, err);
     }
+    coarse_mean = nr.coarse_mean;
+    if (st != THZ_OK)
+        goto done;
     for (size_t i = 0; i < nc * n; i++)
         v->nuisance_sd[i] = sqrt(v->nuisance_sd[i]);
     goto done;
