@@ -134,7 +134,7 @@ thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t
     }
     /* While a map is built: kept maps (the one being built among them) and the build's
      * scratch (3/8 as large), else the map in the pool's spare array (up to a quarter
-     * larger: phase.c) and the scratch. */
+     * larger: phase_fire.c) and the scratch. */
     uint64_t scratch =
         photon_map_scratch_records(max / sizeof(photon_record)) * (uint64_t)sizeof(photon_record);
     *out = keep_all ? run_add_bytes(sum, scratch)
