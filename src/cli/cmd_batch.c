@@ -44,11 +44,10 @@ typedef struct batch_cli {
     int last_tenth;     /* not a terminal: the last tenth of the batch printed */
     size_t frame;       /* the frame running (its warnings name it), when in_frame */
     bool in_frame;
-    double load_start_s; /* when the sequence's load (or the memory check) began */
-    bool checking;       /* the frames' memory check has begun */
-    /* not a terminal: the last tenth of the load or the check printed (its own, so that
-     * the batch's tenths do not start where a long check ended) */
-    int check_tenth;
+    bool checking; /* the frames' memory check has begun */
+    /* the sequence's load, then the memory check (its own count, so that the batch's
+     * tenths do not start where a long check ended) */
+    cli_count_line check;
     bool movies_said;            /* "encoding the movies" printed (the stage comes twice) */
     const thz_sequence *seq;     /* the frames' directories, which the warnings name */
     cli_frame_warnings warnings; /* printed once, the later frames' same counted */
@@ -102,8 +101,7 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
     if (!strcmp(p->stage, "check")) { /* the frames' memory, before the first runs */
         if (!b->checking) {
             b->checking = true;
-            b->load_start_s = cli_now_s();
-            b->check_tenth = 0;
+            cli_count_line_start(&b->check, b->tty);
         }
         thz_progress lp = {.stage = "check", .done = p->frame, .total = p->n_frames};
         batch_on_load_progress(b, &lp);
@@ -133,27 +131,15 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
 }
 
 /* While the sequence loads (thz_sequence_load_ctx checks every frame's scene, a few ms
- * each): after the first second, the share of frames checked, on a redrawn line on a
- * terminal, else a line per tenth. */
+ * each) and while its frames' memory is checked: the share of frames checked. */
 static int batch_on_load_progress(void *user, const thz_progress *p)
 {
     batch_cli *b = user;
-    double now = cli_now_s();
-    if (b->quiet || !p->total || now - b->load_start_s < 1.0)
-        return 0;
-    double frac = (double)p->done / (double)p->total;
-    int tenth = (int)(10.0 * frac);
-    if (b->tty ? now - b->last_draw_s < 0.1 : tenth <= b->check_tenth)
-        return 0;
-    b->last_draw_s = now;
-    b->check_tenth = tenth;
-    fprintf(stderr,
-            "%sthzmap batch: checking the frames' %s: %.0f %% (%llu of %llu frames), %.1f s%s",
-            b->tty ? "\r\033[K" : "", !strcmp(p->stage, "check") ? "memory" : "scenes",
-            100.0 * frac, (unsigned long long)p->done, (unsigned long long)p->total,
-            now - b->load_start_s, b->tty ? "" : "\n");
-    b->line_open = b->tty;
-    fflush(stderr);
+    if (!b->quiet && cli_count_line_show(&b->check, "batch",
+                                         !strcmp(p->stage, "check") ? "the frames' memory"
+                                                                    : "the frames' scenes",
+                                         p->done, p->total))
+        b->line_open = b->tty;
     return 0;
 }
 
@@ -166,7 +152,7 @@ static thz_status batch_load(batch_cli *b, const char *path, thz_sequence **seq,
         snprintf(err->message, sizeof err->message, "out of memory");
         return err->status;
     }
-    b->load_start_s = cli_now_s();
+    cli_count_line_start(&b->check, b->tty);
     thz_context_set_progress(ctx, batch_on_load_progress, b);
     thz_status st = thz_sequence_load_ctx(ctx, path, NULL, seq, err);
     thz_context_destroy(ctx);

@@ -7,9 +7,11 @@
 #include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "frame_warnings.h"
+#include "progress.h"
 #include "thzmap/thzmap.h"
 
 static void validate_usage(FILE *f)
@@ -261,11 +263,50 @@ static void validate_print(const thz_scene *s)
  * frames, the first frame's scene as a scene's, and every frame's warnings, each printed
  * once with its first frame and then the number of later frames that repeat it, as
  * `thzmap batch` prints them. */
+typedef struct validate_count {
+    cli_count_line line;
+    const char *what;
+    bool line_open; /* on the terminal, without its newline */
+} validate_count;
+
+static void validate_count_show(validate_count *v, uint64_t done, uint64_t total)
+{
+    if (cli_count_line_show(&v->line, "validate", v->what, done, total))
+        v->line_open = v->line.tty;
+}
+
+static void validate_count_end(validate_count *v)
+{
+    if (v->line_open)
+        fputs("\r\033[K", stderr);
+    v->line_open = false;
+}
+
+static int validate_on_load_progress(void *user, const thz_progress *p)
+{
+    validate_count_show(user, p->done, p->total);
+    return 0;
+}
+
 static int validate_sequence(const char *path)
 {
     thz_sequence *seq = NULL;
     thz_error err = {0};
-    if (thz_sequence_load(path, &seq, &err) != THZ_OK)
+    /* a long sequence's two passes over its frames (the load checks each one's scene,
+     * then each is loaded again for its warnings) are counted as `thzmap batch` counts */
+    bool tty = isatty(STDERR_FILENO) != 0;
+    validate_count count = {.what = "the frames' scenes"};
+    cli_count_line_start(&count.line, tty);
+    thz_context *ctx = thz_context_create();
+    if (!ctx) {
+        fprintf(stderr, "thzmap validate: out of memory\n");
+        return CLI_EXIT_FAILURE;
+    }
+    thz_context_set_progress(ctx, validate_on_load_progress, &count);
+    thz_status st = thz_sequence_load_ctx(ctx, path, NULL, &seq, &err);
+    thz_context_destroy(ctx);
+    validate_count_end(&count);
+    if (st != THZ_OK)
         return cli_fail(&err);
     size_t n = thz_sequence_frame_count(seq), per = thz_sequence_frames_per_sweep(seq);
     thz_frame_info last;
@@ -274,15 +315,22 @@ static int validate_sequence(const char *path)
     printf("frames: %zu (%zu sweep value%s x %zu frame%s, t = 0 to %g s)\n", n,
            thz_sequence_sweep_count(seq), thz_sequence_sweep_count(seq) == 1 ? "" : "s", per,
            per == 1 ? "" : "s", last.time_s);
+    fflush(stdout);
     cli_frame_warnings warnings = {0};
     int rc = CLI_EXIT_OK;
+    count.what = "the frames' warnings";
+    cli_count_line_start(&count.line, tty);
     for (size_t f = 0; f < n && rc == CLI_EXIT_OK; f++) {
+        validate_count_show(&count, f, n);
         thz_scene *scene = NULL;
-        if (thz_sequence_frame_scene(seq, f, &scene, &err) != THZ_OK) {
+        st = thz_sequence_frame_scene(seq, f, &scene, &err);
+        if (st != THZ_OK) {
+            validate_count_end(&count); /* each line to come starts on its own */
             rc = cli_fail(&err);
             break;
         }
         if (f == 0) {
+            validate_count_end(&count);
             thz_frame_info fi;
             thz_sequence_frame(seq, 0, &fi);
             printf("\nthe first frame's scene (%s):\n\n", fi.dir);
@@ -292,12 +340,15 @@ static int validate_sequence(const char *path)
         for (size_t i = 0; i < thz_scene_warning_count(scene); i++) {
             const char *w = thz_scene_warning(scene, i);
             thz_frame_info fi;
-            if (cli_frame_warnings_first(&warnings, w))
-                fprintf(stderr, "thzmap validate: warning: %s: %s\n",
-                        thz_sequence_frame(seq, f, &fi) == THZ_OK ? fi.dir : "?", w);
+            if (!cli_frame_warnings_first(&warnings, w))
+                continue;
+            validate_count_end(&count);
+            fprintf(stderr, "thzmap validate: warning: %s: %s\n",
+                    thz_sequence_frame(seq, f, &fi) == THZ_OK ? fi.dir : "?", w);
         }
         thz_scene_destroy(scene);
     }
+    validate_count_end(&count);
     cli_frame_warnings_finish(&warnings, "validate", rc == CLI_EXIT_OK);
     thz_sequence_destroy(seq);
     return rc;

@@ -326,3 +326,28 @@ void cli_format_bytes(char *buf, size_t size, uint64_t bytes)
     else
         snprintf(buf, size, "%.3g MiB", (double)bytes / 1048576.0);
 }
+
+void cli_count_line_start(cli_count_line *c, bool tty)
+{
+    *c = (cli_count_line){.tty = tty, .start_s = cli_now_s()};
+}
+
+bool cli_count_line_show(cli_count_line *c, const char *command, const char *what, uint64_t done,
+                         uint64_t total)
+{
+    double now = cli_now_s();
+    if (!total || now - c->start_s < 1.0)
+        return false;
+    double frac = (double)done / (double)total;
+    int tenth = (int)(10.0 * frac);
+    if (c->tty ? now - c->last_draw_s < 0.1 : tenth <= c->tenth)
+        return false;
+    c->last_draw_s = now;
+    c->tenth = tenth;
+    /* the percentage rounded down, as the tenths are: 19.8 % is not a second "20 %" */
+    fprintf(stderr, "%sthzmap %s: checking %s: %d %% (%llu of %llu frames), %.1f s%s",
+            c->tty ? "\r\033[K" : "", command, what, (int)(100.0 * frac), (unsigned long long)done,
+            (unsigned long long)total, now - c->start_s, c->tty ? "" : "\n");
+    fflush(stderr);
+    return true;
+}

@@ -57,6 +57,23 @@ void cli_progress_warning(void *user, const char *message);
  * (not with --quiet) and keeps it for the whole-run ETA. */
 void cli_progress_plan(void *user, const thz_run_plan *plan);
 
+/* A count of items checked (a sequence's frames), shown once it has taken 1 s: on a
+ * line redrawn at most every 0.1 s on a terminal, else a line each time it passes
+ * another tenth. `thzmap batch` and `thzmap validate` show their checks of a sequence so. */
+typedef struct cli_count_line {
+    bool tty;           /* stderr is a terminal */
+    double start_s;     /* when the count began */
+    double last_draw_s; /* the last line's time */
+    int tenth;          /* not a terminal: the last tenth printed */
+} cli_count_line;
+
+void cli_count_line_start(cli_count_line *c, bool tty);
+
+/* Prints "thzmap COMMAND: checking WHAT: 40 % (400 of 1000 frames), 2.1 s" on stderr when
+ * due; true when it did (on a terminal the line is then left open, without its newline). */
+bool cli_count_line_show(cli_count_line *c, const char *command, const char *what, uint64_t done,
+                         uint64_t total);
+
 /* Ends the terminal line, if one is open. */
 void cli_progress_finish(cli_progress *p);
 

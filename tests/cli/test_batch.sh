@@ -618,6 +618,14 @@ bad long_check 'keyframes[2].objects.person.temperature_k: expected a number in 
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 2500, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 2498, "objects": {"person": {"temperature_k": 300}}}, {"time_s": 2499, "objects": {"person": {"temperature_k": -10}}}]}'
 grep -qE "checking the frames' scenes: [0-9]+ % \([0-9]+ of 2500 frames\), [0-9.]+ s" "$work/bad.err" ||
     fail "a long check of the frames shows no progress: $(head -c 600 "$work/bad.err")"
+# validate shows the same check (it showed nothing for as long), each tenth once, and the
+# same error
+timeout 60 "$THZMAP" validate "$work/bad-long_check.json" > /dev/null 2> "$work/val.err"
+rc=$?
+{ [ $rc -eq 2 ] && grep -qF 'got -10 (the scene scene.json' "$work/val.err" &&
+    grep -qE "^thzmap validate: checking the frames' scenes: [0-9]+ % \([0-9]+ of 2500 frames\), [0-9.]+ s$" "$work/val.err" &&
+    [ -z "$(grep -oE ': [0-9]+ % \(' "$work/val.err" | sort | uniq -d)" ]; } ||
+    fail "validate of a long sequence: exit $rc, its progress: $(head -c 600 "$work/val.err")"
 mkfifo "$work/pipe.json" # a FIFO as the scene would block the open: refused at once
 bad fifo_scene 'pipe.json: is a FIFO' '{"format": "thzmap-sequence/1", "scene": "pipe.json"}'
 # and the other way round: simulate given a sequence file
