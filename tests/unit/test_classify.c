@@ -1,6 +1,7 @@
 /* Classification (analysis/classify.c): on a synthetic cube of three distinct spectra
  * every method is exact without noise; with noise raised the accuracy falls
- * monotonically; the confusion matrix sums to the pixels that see an object; the
+ * monotonically; the confusion matrix sums to the pixels that see an object, its rows
+ * to each object's (the truth) and its columns to the pixels assigned each; the
  * training split depends on the seed alone. (The AUC is checked only where it is 1;
  * analysis/classify.c's roc_curve is static.) */
 #include <setjmp.h>
@@ -42,6 +43,28 @@ static uint64_t confusion_sum(const classify_result *r)
     for (size_t i = 0; i < r->n_classes * r->n_classes; i++)
         s += r->confusion[i];
     return s;
+}
+
+/* Rows are the truth and columns the class assigned (docs/analysis.md): row k sums to
+ * the pixels of class k's object, column j to the pixels assigned object j. Transposed,
+ * the sums still hold in total and the accuracy stays, but a class's accuracy (the
+ * diagonal over its row) becomes its precision. */
+static void assert_confusion_rows_are_truth(const classify_result *r, const int32_t *truth)
+{
+    size_t nc = r->n_classes;
+    for (size_t k = 0; k < nc; k++) {
+        uint64_t in_truth = 0, assigned = 0, row = 0, column = 0;
+        for (size_t p = 0; p < PIXELS; p++) {
+            in_truth += truth[p] == r->class_object[k];
+            assigned += truth[p] >= 0 && r->assigned[p] == r->class_object[k];
+        }
+        for (size_t j = 0; j < nc; j++) {
+            row += r->confusion[k * nc + j];
+            column += r->confusion[j * nc + k];
+        }
+        assert_int_equal(row, in_truth);
+        assert_int_equal(column, assigned);
+    }
 }
 
 static void test_noise_free_exact(void **state)
@@ -93,6 +116,7 @@ static void test_accuracy_falls_with_noise(void **state)
                 classify_run(cube, BANDS, PIXELS, truth, (classify_method)m, 0.5, 1, &r, &err),
                 THZ_OK);
             assert_int_equal(confusion_sum(&r), PIXELS - ROWS);
+            assert_confusion_rows_are_truth(&r, truth);
             if (!(r.held_out_accuracy <= last))
                 fail_msg("%s: held-out accuracy %g at %g K above %g at the level before",
                          classify_method_name((classify_method)m), r.held_out_accuracy, levels[i],
