@@ -59,6 +59,42 @@ static void test_closed_form(void **state)
     assert_true(fabs(s.worst_b - expect) < 1e-12);
 }
 
+/* The Monte Carlo noise's B (bands_noise_bhattacharyya): with r = S^-1 D, S the pair's
+ * mean covariance on the set and D the summed variances of the two class means,
+ * (tr r + 3 sqrt(2 tr r^2)) / 8. One channel: (d / s) (1 + 3 sqrt 2) / 8. Two of three
+ * candidates with a full S: its inverse by hand. (Only inequalities checked it before: a
+ * factor 2 on it passed every test, and moves the warning that a pair cannot be told
+ * from noise.) */
+static void test_noise_bhattacharyya(void **state)
+{
+    (void)state;
+    double m1[2] = {300.0, 302.0}, c1[2] = {0.5, 1.5}, v1[2] = {0.01, 0.03};
+    bands_classes one = {.n_candidates = 1, .n_classes = 2, .mean = m1, .cov = c1};
+    size_t set1[1] = {0};
+    double work[2 * 4 + 2];
+    double d = 0.04, sv = 1.0; /* D and S */
+    double expect = d / sv * (1.0 + 3.0 * sqrt(2.0)) / 8.0;
+    assert_true(fabs(bands_noise_bhattacharyya(&one, set1, 1, 0, 1, v1, work) - expect) <
+                1e-12 * expect);
+
+    /* three candidates, classes' covariances over them; the set {0, 2} */
+    double m3[6] = {0};
+    double c3[18] = {1.0, 0.2, 0.3, 0.2, 2.0, 0.1, 0.3, 0.1, 1.5,  /* class 0 */
+                     2.0, 0.0, 0.5, 0.0, 1.0, 0.0, 0.5, 0.0, 0.5}; /* class 1 */
+    double v3[6] = {0.01, 0.5, 0.02, 0.03, 0.5, 0.04};
+    bands_classes three = {.n_candidates = 3, .n_classes = 2, .mean = m3, .cov = c3};
+    size_t set2[2] = {0, 2};
+    double s11 = 1.5, s12 = 0.4, s22 = 1.0, det = s11 * s22 - s12 * s12;
+    double i11 = s22 / det, i12 = -s12 / det, i22 = s11 / det;
+    double d1 = 0.04, d2 = 0.06;
+    /* r = S^-1 D = [[i11 d1, i12 d2], [i12 d1, i22 d2]] */
+    double tr = i11 * d1 + i22 * d2;
+    double tr2 = i11 * d1 * i11 * d1 + 2.0 * i12 * d2 * i12 * d1 + i22 * d2 * i22 * d2;
+    expect = (tr + 3.0 * sqrt(2.0 * tr2)) / 8.0;
+    double got = bands_noise_bhattacharyya(&three, set2, 2, 0, 1, v3, work);
+    assert_true(fabs(got - expect) < 1e-12 * expect);
+}
+
 static void check_search(uint64_t limit, const char *expect_search)
 {
     make_classes();
@@ -181,6 +217,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_closed_form),
+        cmocka_unit_test(test_noise_bhattacharyya),
         cmocka_unit_test(test_exhaustive_finds_features),
         cmocka_unit_test(test_sffs_finds_features),
         cmocka_unit_test(test_sffs_drops_a_band),
