@@ -305,6 +305,49 @@ static void test_no_stderr(void **state)
     remove_dir(dir);
 }
 
+/* Cubes that thzmap does not write but reads (thz_cube_read, classify): big-endian
+ * (byte order = 1) and with bytes before the data (header offset). Both read as the same
+ * values; the reader once could ignore either and pass every test (a helper's mutants). */
+static void test_read_byte_order_and_offset(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    const float want[6] = {1.5f, -2.25f, 300.125f, 4e-20f, 5e20f, 6.0f};
+    for (int big = 0; big < 2; big++)
+        for (int offset = 0; offset <= 7; offset += 7) {
+            char path[1024];
+            snprintf(path, sizeof path, "%s/o.hdr", dir);
+            FILE *f = fopen(path, "w");
+            assert_non_null(f);
+            fprintf(f,
+                    "ENVI\ndescription = {other}\nsamples = 3\nlines = 2\nbands = 1\n"
+                    "header offset = %d\nfile type = ENVI Standard\ndata type = 4\n"
+                    "interleave = bsq\nbyte order = %d\n",
+                    offset, big);
+            fclose(f);
+            snprintf(path, sizeof path, "%s/o.img", dir);
+            f = fopen(path, "wb");
+            assert_non_null(f);
+            for (int i = 0; i < offset; i++)
+                fputc(0xA5, f); /* not a float of the cube */
+            for (int i = 0; i < 6; i++) {
+                uint32_t w;
+                memcpy(&w, &want[i], 4);
+                for (int k = 0; k < 4; k++)
+                    fputc((int)(w >> (8 * (big ? 3 - k : k))) & 0xff, f);
+            }
+            fclose(f);
+            envi_cube c;
+            thz_error err = {0};
+            assert_int_equal(envi_read_float32(dir, "o", &c, &err), THZ_OK);
+            assert_int_equal(c.samples, 3);
+            assert_int_equal(c.lines, 2);
+            assert_memory_equal(c.data, want, sizeof want);
+            envi_cube_fini(&c);
+        }
+    remove_dir(dir);
+}
+
 /* A directory that does not exist is an I/O error naming the file, not a crash. */
 static void test_unwritable(void **state)
 {
@@ -349,6 +392,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sensor_files),
         cmocka_unit_test(test_no_stderr),
+        cmocka_unit_test(test_read_byte_order_and_offset),
         cmocka_unit_test(test_unwritable),
         cmocka_unit_test(test_path_too_long),
     };
