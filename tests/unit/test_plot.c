@@ -21,6 +21,7 @@
 #include "core/alloc.h"
 #include "io/plot.h"
 #include "io/plot_draw.h"
+#include "io/png_image.h"
 
 static char *make_tmp_dir(void)
 {
@@ -111,6 +112,33 @@ static void test_image_colours(void **state)
     assert_memory_equal(px, "\xff\xff\xff", 3);
     assert_true(has_colour(px, n, 68, 1, 84, 6));
     assert_true(has_colour(px, n, 253, 231, 37, 6));
+    free(px);
+    unlink(path);
+    rmdir(dir);
+    free(dir);
+}
+
+/* S.visual.png's writer: row 0 at the top, column 0 at the left, sRGB values as given
+ * (a negative row stride, which libpng takes as bottom-up, passed every test before). */
+static void test_visual_png_orientation(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    char path[1024];
+    snprintf(path, sizeof path, "%s/visual.png", dir);
+    /* 3 x 2: the top row red, green, blue; the bottom row white, black, grey */
+    const float rgb[18] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 0.5f, 0.5f, 0.5f};
+    thz_error err = {0};
+    if (png_image_write_srgb8(path, rgb, 3, 2, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    unsigned char *px = NULL;
+    uint32_t w = 0, h = 0;
+    read_png(path, &px, &w, &h);
+    assert_int_equal(w, 3);
+    assert_int_equal(h, 2);
+    const unsigned char want[18] = {255, 0,   0,   0, 255, 0, 0,   0,   255,
+                                    255, 255, 255, 0, 0,   0, 128, 128, 128};
+    assert_memory_equal(px, want, sizeof want);
     free(px);
     unlink(path);
     rmdir(dir);
@@ -547,12 +575,19 @@ static void test_attenuation(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_device),        cmocka_unit_test(test_device_dir_without_cairo),
-        cmocka_unit_test(test_image_colours), cmocka_unit_test(test_odd_images),
-        cmocka_unit_test(test_lines),         cmocka_unit_test(test_threads),
-        cmocka_unit_test(test_attenuation),   cmocka_unit_test(test_batch),
-        cmocka_unit_test(test_long_title),    cmocka_unit_test(test_whole_ticks),
-        cmocka_unit_test(test_label_digits),  cmocka_unit_test(test_large_image),
+        cmocka_unit_test(test_device),
+        cmocka_unit_test(test_device_dir_without_cairo),
+        cmocka_unit_test(test_image_colours),
+        cmocka_unit_test(test_odd_images),
+        cmocka_unit_test(test_visual_png_orientation),
+        cmocka_unit_test(test_lines),
+        cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_attenuation),
+        cmocka_unit_test(test_batch),
+        cmocka_unit_test(test_long_title),
+        cmocka_unit_test(test_whole_ticks),
+        cmocka_unit_test(test_label_digits),
+        cmocka_unit_test(test_large_image),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
