@@ -106,6 +106,7 @@ static void test_defaults_and_range(void **state)
     assert_true(c->up[2] == 1.0);
     assert_true(s->photons.per_channel == 1000000 && s->photons.seed == 1);
     assert_true(s->photons.min_relative_power == 0.01);
+    assert_int_equal(s->photons.gather_min_photons, 16);     /* the spec's k (8 passed unseen) */
     assert_int_equal(s->render.integrator, INTEGRATOR_PATH); /* changed: docs/integrators.md */
     assert_false(s->photons.per_channel_given);
     assert_false(s->render.paths_per_sample_given);
