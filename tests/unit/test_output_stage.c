@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <stdbool.h>
 #include <unistd.h>
 
 #include "core/alloc.h"
@@ -124,11 +125,17 @@ static void test_commit_moves_files(void **state)
 
 /* A commit that fails half-way (the last file, in name order, meets a non-empty
  * directory of its name in OUTDIR, after three files were moved in, two of them
- * replacing old ones) is undone: OUTDIR holds exactly the old files again. */
-static void test_failed_commit_rolls_back(void **state)
+ * replacing old ones) is undone: OUTDIR holds exactly the old files again. Both ways of
+ * committing: the directories exchanged, and file by file where OUTDIR is the working
+ * directory (or a mount point), whose undoing no test reached before (a helper's mutant
+ * left the new c.json in OUTDIR and passed). */
+static void failed_commit_rolls_back(bool in_cwd)
 {
-    (void)state;
     char *outdir = make_tmp_dir();
+    char cwd[1024];
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    if (in_cwd)
+        assert_int_equal(chdir(outdir), 0);
     write_file(outdir, "a.hdr", "old a");
     write_file(outdir, "b.img", "old b");
     write_file(outdir, "keep.txt", "not ours");
@@ -150,6 +157,8 @@ static void test_failed_commit_rolls_back(void **state)
     assert_non_null(strstr(err.message, "z.png"));
     assert_non_null(strstr(err.message, "previous results stay"));
     output_stage_destroy(stage);
+    if (in_cwd)
+        assert_int_equal(chdir(cwd), 0);
 
     assert_int_equal(count_entries(outdir), 4); /* a.hdr b.img keep.txt z.png/, no stage */
     assert_file_text(outdir, "a.hdr", "old a");
@@ -168,6 +177,13 @@ static void test_failed_commit_rolls_back(void **state)
     rm(outdir, "keep.txt");
     assert_int_equal(rmdir(outdir), 0);
     free(outdir);
+}
+
+static void test_failed_commit_rolls_back(void **state)
+{
+    (void)state;
+    failed_commit_rolls_back(false);
+    failed_commit_rolls_back(true);
 }
 
 /* The commit leaves no hidden directory behind when it replaced files. */
