@@ -131,6 +131,35 @@ static void plot_set_viridis(void)
     plscmap1l(1, N, pos, r, g, b, NULL);
 }
 
+/* The colour bar spans the 1st to 99th percentile of the finite values, so that a few
+ * noisy pixels do not flatten the picture; values beyond are drawn in the end colours, and
+ * the bar then shows a triangular cap at that end. */
+plot_range plot_colour_range(const float *values, size_t n, double *finite)
+{
+    plot_range r = {.lo = 0.0, .hi = 1.0};
+    double lowest = INFINITY, highest = -INFINITY;
+    size_t n_finite = 0;
+    for (size_t i = 0; i < n; i++)
+        if (isfinite(values[i])) {
+            finite[n_finite++] = values[i];
+            lowest = fmin(lowest, values[i]);
+            highest = fmax(highest, values[i]);
+        }
+    if (n_finite > 0) {
+        r.lo = order_select(finite, n_finite, (size_t)floor(0.01 * (double)(n_finite - 1)));
+        r.hi = order_select(finite, n_finite, (size_t)ceil(0.99 * (double)(n_finite - 1)));
+        r.clipped_low = lowest < r.lo;
+        r.clipped_high = highest > r.hi;
+    }
+    double scale = fmax(fabs(r.lo), fabs(r.hi));
+    if (r.hi - r.lo <= 1e-9 * scale) { /* a flat image still needs a scale */
+        double pad = scale > 0.0 ? 1e-3 * scale : 0.5;
+        r.lo -= pad;
+        r.hi += pad;
+    }
+    return r;
+}
+
 thz_status plot_image_draw(const char *path, const float *values, uint32_t columns, uint32_t rows,
                            const char *title, const char *value_label, thz_error *err)
 {
@@ -155,30 +184,9 @@ thz_status plot_image_draw(const char *path, const float *values, uint32_t colum
         status = thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
         goto cleanup;
     }
-    /* The colour bar spans the 1st to 99th percentile of the finite values, so that a
-     * few noisy pixels do not flatten the picture; values beyond are drawn in the end
-     * colours, and the bar then shows a triangular cap at that end. */
-    double vmin = 0.0, vmax = 1.0, lowest = INFINITY, highest = -INFINITY;
-    bool clipped_low = false, clipped_high = false;
-    size_t n_finite = 0;
-    for (size_t i = 0; i < (size_t)columns * rows; i++)
-        if (isfinite(values[i])) {
-            finite[n_finite++] = values[i];
-            lowest = fmin(lowest, values[i]);
-            highest = fmax(highest, values[i]);
-        }
-    if (n_finite > 0) {
-        vmin = order_select(finite, n_finite, (size_t)floor(0.01 * (double)(n_finite - 1)));
-        vmax = order_select(finite, n_finite, (size_t)ceil(0.99 * (double)(n_finite - 1)));
-        clipped_low = lowest < vmin;
-        clipped_high = highest > vmax;
-    }
-    double scale = fmax(fabs(vmin), fabs(vmax));
-    if (vmax - vmin <= 1e-9 * scale) { /* a flat image still needs a scale */
-        double pad = scale > 0.0 ? 1e-3 * scale : 0.5;
-        vmin -= pad;
-        vmax += pad;
-    }
+    plot_range bar = plot_colour_range(values, (size_t)columns * rows, finite);
+    double vmin = bar.lo, vmax = bar.hi;
+    bool clipped_low = bar.clipped_low, clipped_high = bar.clipped_high;
     for (size_t i = 0; i < nx; i++) {
         cols[i] = grid + i * ny;
         size_t c0 = (i < bx ? i : bx - 1) * f, c1 = c0 + f < columns ? c0 + f : columns;

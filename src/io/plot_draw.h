@@ -23,6 +23,15 @@ void plot_set_timeout_base_s(double base_s);
 /* plot_check_device's check, here (a child_fn: arg unused). */
 thz_status plot_check_device_here(void *arg, thz_error *err);
 
+/* An image's colour bar: lo to hi, the 1st to the 99th percentile of its finite values
+ * (widened when flat), and whether values lie beyond either end (the bar's caps). */
+typedef struct plot_range {
+    double lo, hi;
+    bool clipped_low, clipped_high;
+} plot_range;
+/* Of n values; finite is scratch for n doubles. */
+plot_range plot_colour_range(const float *values, size_t n, double *finite);
+
 /* plot_image's, plot_lines' and plot_attenuation's figures, drawn here. */
 thz_status plot_image_draw(const char *path, const float *values, uint32_t columns, uint32_t rows,
                            const char *title, const char *value_label, thz_error *err);

@@ -1,5 +1,6 @@
 /* PLplot figures: the pngcairo device is found, previews show the colour map's ends
- * at the image's extremes on a white page, odd inputs (flat, NaN, one pixel, no
+ * at the image's extremes on a white page, row 0 on top and column 0 on the left, their
+ * colour bar from the 1st to the 99th percentile, odd inputs (flat, NaN, one pixel, no
  * curves, '#' in names) still give a figure, figures drawn from two threads at
  * once come out whole (the mutex), and a batch drawn by 1, 2 or 5 processes writes the
  * same bytes as the figures one at a time, and reports its first failing figure. */
@@ -116,6 +117,103 @@ static void test_image_colours(void **state)
     unlink(path);
     rmdir(dir);
     free(dir);
+}
+
+/* The mean (x, y) of the pixels within tol of (r, g, b) left of x_end (the image, not
+ * its colour bar); whether there is any. */
+static int colour_centre(const unsigned char *px, uint32_t w, uint32_t h, uint32_t x_end, int r,
+                         int g, int b, int tol, double *x, double *y)
+{
+    double sx = 0.0, sy = 0.0;
+    size_t n = 0;
+    for (uint32_t j = 0; j < h; j++)
+        for (uint32_t i = 0; i < x_end && i < w; i++) {
+            const unsigned char *p = px + 3 * ((size_t)j * w + i);
+            if (abs(p[0] - r) <= tol && abs(p[1] - g) <= tol && abs(p[2] - b) <= tol) {
+                sx += i;
+                sy += j;
+                n++;
+            }
+        }
+    if (n == 0)
+        return 0;
+    *x = sx / (double)n;
+    *y = sy / (double)n;
+    return 1;
+}
+
+/* A preview shows row 0 at the top and column 0 at the left, as the ENVI cube and
+ * S.visual.png do: the coldest quarter (top left) in the colour map's low end lies above
+ * and left of the hottest (bottom right) in its high end. Drawn upside down (the y axis
+ * from 0 at the bottom, a helper's mutant) it passed every test. */
+static void test_image_orientation(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    char path[1024];
+    snprintf(path, sizeof path, "%s/orient.png", dir);
+    enum { C = 16, R = 12 };
+    float v[C * R];
+    for (int r = 0; r < R; r++)
+        for (int c = 0; c < C; c++)
+            v[r * C + c] = r < R / 2 && c < C / 2     ? 280.0f
+                           : r >= R / 2 && c >= C / 2 ? 320.0f
+                                                      : 300.0f;
+    thz_error err = {0};
+    if (plot_image(path, v, C, R, "orientation", "T (K)", &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    unsigned char *px = NULL;
+    uint32_t w = 0, h = 0;
+    read_png(path, &px, &w, &h);
+    /* the image's viewport ends at 0.78 of the width; the colour bar is beyond */
+    uint32_t x_end = (uint32_t)(0.78 * w);
+    double cold_x = 0, cold_y = 0, hot_x = 0, hot_y = 0, mid_x = 0, mid_y = 0;
+    assert_true(colour_centre(px, w, h, x_end, 68, 1, 84, 6, &cold_x, &cold_y));
+    assert_true(colour_centre(px, w, h, x_end, 253, 231, 37, 6, &hot_x, &hot_y));
+    assert_true(colour_centre(px, w, h, x_end, 33, 145, 140, 12, &mid_x, &mid_y));
+    /* each quarter is 8 x 6 pixels of about 34 figure pixels each */
+    assert_true(hot_y - cold_y > 100.0);
+    assert_true(hot_x - cold_x > 100.0);
+    free(px);
+    unlink(path);
+    rmdir(dir);
+    free(dir);
+}
+
+/* The colour bar's range is the 1st to the 99th percentile of the finite values (as
+ * docs/gui.md says of the page's, whose range the CLI's previews share), with a cap at each
+ * end beyond which values lie, and a flat image widened to a range. */
+static void test_colour_range(void **state)
+{
+    (void)state;
+    enum { N = 203 };
+    float v[N];
+    double scratch[N];
+    /* 0, 1, ..., 200 K shuffled by a stride coprime to 201, and two NaN */
+    for (int i = 0; i < 201; i++)
+        v[i] = (float)((i * 73) % 201);
+    v[201] = NAN;
+    v[202] = INFINITY;
+    plot_range r = plot_colour_range(v, N, scratch);
+    /* of 201 finite values: index floor(0.01 x 200) = 2 and ceil(0.99 x 200) = 198 */
+    assert_true(r.lo == 2.0);
+    assert_true(r.hi == 198.0);
+    assert_true(r.clipped_low && r.clipped_high);
+
+    float inside[5] = {3.0f, 1.0f, 2.0f, NAN, 4.0f}; /* 4 values: indices 0 and 3 */
+    r = plot_colour_range(inside, 5, scratch);
+    assert_true(r.lo == 1.0 && r.hi == 4.0);
+    assert_false(r.clipped_low || r.clipped_high);
+
+    float flat[3] = {300.0f, 300.0f, 300.0f};
+    r = plot_colour_range(flat, 3, scratch);
+    assert_true(fabs(r.lo - 299.7) < 1e-9 && fabs(r.hi - 300.3) < 1e-9);
+    float zero[2] = {0.0f, 0.0f};
+    r = plot_colour_range(zero, 2, scratch);
+    assert_true(r.lo == -0.5 && r.hi == 0.5);
+    float none[2] = {NAN, NAN};
+    r = plot_colour_range(none, 2, scratch);
+    assert_true(r.lo == 0.0 && r.hi == 1.0);
 }
 
 /* S.visual.png's writer: row 0 at the top, column 0 at the left, sRGB values as given
@@ -580,6 +678,8 @@ int main(void)
         cmocka_unit_test(test_image_colours),
         cmocka_unit_test(test_odd_images),
         cmocka_unit_test(test_visual_png_orientation),
+        cmocka_unit_test(test_image_orientation),
+        cmocka_unit_test(test_colour_range),
         cmocka_unit_test(test_lines),
         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_attenuation),
