@@ -14,7 +14,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <linux/magic.h>
 #include <sys/stat.h>
+#include <sys/vfs.h>
 #include <stdbool.h>
 #include <unistd.h>
 
@@ -426,6 +428,23 @@ static void test_bad_outdir(void **state)
     free(tmp);
 }
 
+/* A directory that access() calls writable but that refuses a new file (root in /sys, a
+ * file system that is sysfs): bad input like any unwritable OUTDIR, not an I/O failure
+ * (exit 1 before). Only where the test runs as root and /sys is sysfs. */
+static void test_outdir_refusing_files(void **state)
+{
+    (void)state;
+    struct statfs fs;
+    if (geteuid() != 0 || statfs("/sys", &fs) != 0 || fs.f_type != SYSFS_MAGIC ||
+        access("/sys", W_OK | X_OK) != 0)
+        skip();
+    output_stage *stage = (output_stage *)&stage;
+    thz_error err = {0};
+    assert_int_equal(output_stage_create("/sys/thz-test-outdir", &stage, &err), THZ_ERR_INPUT);
+    assert_null(stage);
+    assert_non_null(strstr(err.message, "choose another output directory"));
+}
+
 /* summary.json: the run's numbers under their documented keys, fractions with their
  * documented denominators, non-finite values as null, scene and run warnings merged. */
 static void test_summary_json(void **state)
@@ -599,6 +618,7 @@ int main(void)
         cmocka_unit_test(test_commit_into_working_directory),
         cmocka_unit_test(test_commit_through_symlink),
         cmocka_unit_test(test_bad_outdir),
+        cmocka_unit_test(test_outdir_refusing_files),
         cmocka_unit_test(test_summary_json),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
