@@ -32,7 +32,8 @@ static void batch_usage(FILE *f)
                "  -o, --output OUTDIR   where the results go (required)\n"
                "  --threads T           threads to use (default: all cores)\n"
                "  --no-movies           the frames and batch.json only, no movies\n"
-               "  -q, --quiet           no progress output (warnings are still printed)\n");
+               "  -q, --quiet           no progress output (warnings are still printed)\n"
+               "  -h, --help            this help\n");
 }
 
 typedef struct batch_cli {

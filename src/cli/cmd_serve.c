@@ -37,7 +37,8 @@ static void print_help(void)
            "                ssh -L 8765:127.0.0.1:8765 HOST)\n"
            "  --port N      the TCP port (default 8765; 0: any free port)\n"
            "  --root DIR    the directory whose files the page may use (default: the\n"
-           "                current directory)\n");
+           "                current directory)\n"
+           "  -h, --help    this help\n");
 }
 
 /* Whether dir is an existing directory. */

@@ -49,7 +49,8 @@ static void cli_run_usage(FILE *f, bool render)
                    "  --ply-max-points N    at most N photons (evenly strided) in\n"
                    "                        photon-map.ply (default 2000000)\n"
                    "  -q, --quiet           no progress output and no up-front estimate\n"
-                   "                        (warnings are still printed)\n");
+                   "                        (warnings are still printed)\n"
+                   "  -h, --help            this help\n");
     else
         fprintf(f, "usage: thzmap render SCENE.json --photon-map FILE -o OUTDIR [options]\n\n"
                    "Renders the scene's sensors again from a photon map saved by\n"
@@ -68,7 +69,8 @@ static void cli_run_usage(FILE *f, bool render)
                    "  --max-seconds S       stop adding passes once a channel has rendered for\n"
                    "                        S s (time-dependent result)\n"
                    "  -q, --quiet           no progress output and no up-front estimate\n"
-                   "                        (warnings are still printed)\n");
+                   "                        (warnings are still printed)\n"
+                   "  -h, --help            this help\n");
 }
 
 typedef struct cli_run_args {

@@ -315,7 +315,9 @@ static thz_status load_document(load_ctx *ctx, json_t *doc)
         return load_fail(ctx, NULL, "expected a JSON object {\"format\": \"%s\", ...}",
                          LOAD_FORMAT);
     if (!json_object_get(doc, "format"))
-        return load_require(ctx, &root, "format", "\"" LOAD_FORMAT "\"");
+        return load_require(ctx, &root, "format",
+                            "\"" LOAD_FORMAT "\" or \"" LOAD_FORMAT_1_1 "\"; a sequence file, "
+                            "which `thzmap batch` runs, says \"" LOAD_SEQUENCE_FORMAT "\"");
     thz_status st = load_string(ctx, &root, "format", true, NULL, &format);
     if (st == THZ_OK && strcmp(format, LOAD_FORMAT) != 0 && strcmp(format, LOAD_FORMAT_1_1) != 0) {
         load_cursor k = load_key(&root, "format");

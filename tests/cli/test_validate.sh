@@ -156,6 +156,11 @@ mkfifo "$tmp/pipe.json"
 timeout 10 "$thzmap" validate "$tmp/pipe.json" 2>"$tmp/err"
 [[ $? -eq 2 ]] || fail "validate of a FIFO must exit 2 at once"
 expect_line "$tmp/err" 'pipe\.json: is a FIFO'
+# a file with no format could be either kind: the message names both
+echo '{"frames": 3}' >"$tmp/noformat.json"
+"$thzmap" validate "$tmp/noformat.json" >/dev/null 2>"$tmp/err"
+[[ $? -eq 2 ]] || fail "validate of a file without format must exit 2"
+expect_line "$tmp/err" 'noformat\.json: format: missing key \(expected "thzmap-scene/1" or "thzmap-scene/1\.1"; a sequence file, .*"thzmap-sequence/1"\)'
 
 # --- a sequence file: its frames, the first frame's scene, every frame's warnings ----
 "$thzmap" validate "$repo/examples/walker/sequence.json" >"$tmp/walker" 2>"$tmp/err"
