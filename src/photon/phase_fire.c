@@ -118,6 +118,7 @@ thz_status phase_fire(const phase_fire_args *a, photon_record **out_records, siz
         for (int t = 0; t < nthreads; t++)
             bufs[t].count = 0;
         int failed = 0;
+        size_t wanted = 0; /* the records the array failed to grow to */
 
 #pragma omp parallel num_threads(nthreads)
         {
@@ -187,6 +188,7 @@ thz_status phase_fire(const phase_fire_args *a, photon_record **out_records, siz
                         capacity = cap;
                     } else {
                         failed = 2;
+                        wanted = cap;
                     }
                 }
                 if (!failed)
@@ -213,7 +215,9 @@ thz_status phase_fire(const phase_fire_args *a, photon_record **out_records, siz
         if (failed) {
             st = failed == 2
                      ? thz_error_set(err, THZ_ERR_NOMEM,
-                                     "photon phase: out of memory for %zu photon records", count)
+                                     "photon phase: out of memory growing the photon map to %zu "
+                                     "records (%.3g GiB; %zu stored so far)",
+                                     wanted, (double)wanted * sizeof *records / 1073741824.0, count)
                      : thz_error_set(err, THZ_ERR_NOMEM,
                                      "photon phase: out of memory for photon records");
             goto cleanup;
