@@ -497,6 +497,8 @@ thz_status thz_bands_write(const thz_bands *b, const char *outdir, thz_error *er
         return st;
     bands_report rep = make_report(b);
     st = bands_write_files(output_stage_dir(stage), &rep, b->json, err);
+    if (st != THZ_OK)
+        output_stage_error_names_outdir(stage, err);
     if (st == THZ_OK)
         st = output_stage_commit(stage, err);
     output_stage_destroy(stage);

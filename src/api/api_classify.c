@@ -422,6 +422,8 @@ thz_status thz_classification_write(const thz_classification *c, const char *out
         return st;
     classify_report rep = report_of(c);
     st = classify_write_files(output_stage_dir(stage), &rep, c->json, err);
+    if (st != THZ_OK)
+        output_stage_error_names_outdir(stage, err);
     if (st == THZ_OK)
         st = output_stage_commit(stage, err);
     output_stage_destroy(stage);

@@ -92,7 +92,10 @@ thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run
                                       "the run kept no photon maps to write (keep_photons, and "
                                       "an integrator that fires photons)"),
                         err);
-    return api_done(ctx, run_write(&run->rs, output_stage_dir(output->stage), &wo, err), err);
+    st = run_write(&run->rs, output_stage_dir(output->stage), &wo, err);
+    if (st != THZ_OK)
+        output_stage_error_names_outdir(output->stage, err);
+    return api_done(ctx, st, err);
 }
 
 thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_error *err)
@@ -102,8 +105,11 @@ thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_
     thz_status st = api_output_check(output, "thz_output_add_image", err);
     if (st != THZ_OK)
         return st;
-    return output_write_sensor(output_stage_dir(output->stage), image->scene, image->sensor,
-                               image->img, 0, NULL, err);
+    st = output_write_sensor(output_stage_dir(output->stage), image->scene, image->sensor,
+                             image->img, 0, NULL, err);
+    if (st != THZ_OK)
+        output_stage_error_names_outdir(output->stage, err);
+    return st;
 }
 
 thz_status thz_run_write(thz_context *ctx, thz_run *run, const char *outdir,
@@ -163,6 +169,8 @@ thz_status thz_image_write(thz_context *ctx, const thz_image *image, const char 
     if (st == THZ_OK)
         st = output_write_sensor(output_stage_dir(o->stage), image->scene, image->sensor,
                                  image->img, ctx ? ctx->threads : 0, &cancel, err);
+    if (st != THZ_OK && o)
+        output_stage_error_names_outdir(o->stage, err);
     if (st == THZ_OK && api_image_write_report(ctx, image, 1))
         st = thz_error_set(err, THZ_ERR_CANCELLED, "writing the image: cancelled");
     if (st == THZ_OK)
@@ -191,16 +199,21 @@ thz_status thz_output_add_file(thz_output *output, const char *name, const void 
                              "thz_output_add_file: %s is in this output already (added before, "
                              "or a file of its run)",
                              name);
-    if (!f)
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+    if (!f) {
+        thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+        output_stage_error_names_outdir(output->stage, err);
+        return THZ_ERR_IO;
+    }
     int why = 0; /* the first failure's errno: a full disk says so */
     errno = 0;
     if (size > 0 && fwrite(data, 1, size, f) != size) /* data may be NULL for 0 bytes */
         why = errno ? errno : EIO;
     if (fclose(f) != 0 && !why)
         why = errno ? errno : EIO;
-    if (why)
-        unlink(path); /* a retry may add it again */
-    return why ? thz_error_set(err, THZ_ERR_IO, "%s: cannot write: %s", path, strerror(why))
-               : THZ_OK;
+    if (!why)
+        return THZ_OK;
+    unlink(path); /* a retry may add it again */
+    thz_error_set(err, THZ_ERR_IO, "%s: cannot write: %s", path, strerror(why));
+    output_stage_error_names_outdir(output->stage, err);
+    return THZ_ERR_IO;
 }

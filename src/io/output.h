@@ -31,6 +31,11 @@ thz_status output_stage_create(const char *outdir, output_stage **out, thz_error
 /* The directory writers write into (the staging directory). */
 const char *output_stage_dir(const output_stage *stage);
 
+/* A writer's error names the staging directory's file, a name the user never sees: the
+ * same message naming OUTDIR's file instead ("OUTDIR/S.radiance.img: write failed: ...").
+ * Any other message is left as it is. */
+void output_stage_error_names_outdir(const output_stage *stage, thz_error *err);
+
 /* Makes the staged files OUTDIR's results (replacing files of the same name, keeping
  * the others) and removes the staging directory. All or nothing: on failure (e.g.
  * OUTDIR holds a directory where the run writes a file) OUTDIR keeps exactly the

@@ -414,6 +414,20 @@ const char *output_stage_dir(const output_stage *stage)
     return stage->dir;
 }
 
+void output_stage_error_names_outdir(const output_stage *stage, thz_error *err)
+{
+    if (!stage || !err)
+        return;
+    size_t n = strlen(stage->dir);
+    char *at = strstr(err->message, stage->dir);
+    if (!at || at[n] != '/')
+        return;
+    char message[sizeof err->message];
+    snprintf(message, sizeof message, "%.*s%s%s%s", (int)(at - err->message), err->message,
+             stage->outdir, stage->outdir[strlen(stage->outdir) - 1] == '/' ? "" : "/", at + n + 1);
+    memcpy(err->message, message, sizeof message);
+}
+
 thz_status output_stage_commit(output_stage *stage, thz_error *err)
 {
     thz_status status =

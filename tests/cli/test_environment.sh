@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The process thzmap starts in (docs/reliability.md "The environment"): a standard output
 # that cannot be written fails the commands whose product it is (exit 1, a message); a
-# file-size limit fails a run cleanly (exit 1, nothing left) instead of SIGXFSZ killing it;
+# file-size limit fails a run cleanly (exit 1, nothing left, the message naming the file in
+# OUTDIR, not in the staging directory) instead of SIGXFSZ killing it;
 # a stack limit or OMP_STACKSIZE too small for its threads is refused up front (exit 2,
 # they ended in SIGSEGV); OMP_NUM_THREADS beyond 4096 runs with 4096, the same bytes (it
 # crashed libgomp); closed standard streams do not end up as the lock file's descriptor;
@@ -49,7 +50,7 @@ rc=$?
 "$T" simulate "$S" -o "$work/before" "${R[@]}" --seed 1 2>"$work/err" || fail "the first run failed"
 cp -r "$work/before" "$work/limited"
 (ulimit -f 10; exec "$T" simulate "$S" -o "$work/limited" "${R[@]}" --seed 7) 2>"$work/err"
-expect "ulimit -f 10" $? 1 "File too large"
+expect "ulimit -f 10" $? 1 "^thzmap: $work/limited/[^ ]*: write failed: File too large"
 diff -r "$work/before" "$work/limited" >/dev/null || fail "ulimit -f: OUTDIR changed"
 [[ -z $(leftovers) ]] || fail "ulimit -f left: $(leftovers)"
 

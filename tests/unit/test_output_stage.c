@@ -405,6 +405,41 @@ static void test_commit_through_symlink(void **state)
     free(tmp);
 }
 
+/* A writer's failure names OUTDIR's file, not the staging directory's (a name the user
+ * never sees: "/tmp/.thzmap-3d3c...-stage-549-0/cam.radiance.img: write failed: File too
+ * large" under ulimit -f); other messages stay as they were. */
+static void test_error_names_outdir(void **state)
+{
+    (void)state;
+    char *tmp = make_tmp_dir();
+    char outdir[1024];
+    snprintf(outdir, sizeof outdir, "%s/out", tmp);
+    output_stage *stage = NULL;
+    thz_error err = {0};
+    if (output_stage_create(outdir, &stage, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    const char *dir = output_stage_dir(stage);
+    thz_error_set(&err, THZ_ERR_IO, "writing: %s/cam.radiance.img: write failed: File too large",
+                  dir);
+    output_stage_error_names_outdir(stage, &err);
+    char want[2048];
+    snprintf(want, sizeof want, "writing: %s/cam.radiance.img: write failed: File too large",
+             outdir);
+    assert_string_equal(err.message, want);
+    assert_int_equal(err.status, THZ_ERR_IO);
+    /* the directory's name alone, or another file's: unchanged */
+    thz_error_set(&err, THZ_ERR_IO, "%s: cannot remove", dir);
+    snprintf(want, sizeof want, "%s: cannot remove", dir);
+    output_stage_error_names_outdir(stage, &err);
+    assert_string_equal(err.message, want);
+    thz_error_set(&err, THZ_ERR_IO, "/elsewhere/x.img: write failed");
+    output_stage_error_names_outdir(stage, &err);
+    assert_string_equal(err.message, "/elsewhere/x.img: write failed");
+    output_stage_destroy(stage);
+    assert_int_equal(rmdir(tmp), 0);
+    free(tmp);
+}
+
 /* OUTDIR under a regular file cannot be made: bad input (exit 2) naming the path. */
 static void test_bad_outdir(void **state)
 {
@@ -618,6 +653,7 @@ int main(void)
         cmocka_unit_test(test_commit_into_working_directory),
         cmocka_unit_test(test_commit_through_symlink),
         cmocka_unit_test(test_bad_outdir),
+        cmocka_unit_test(test_error_names_outdir),
         cmocka_unit_test(test_outdir_refusing_files),
         cmocka_unit_test(test_summary_json),
     };
