@@ -36,7 +36,8 @@ THZ_API const char *thz_cube_object_name(const thz_cube *cube, size_t i);
 /* ---- classification ----------------------------------------------------------------- */
 
 typedef struct thz_classify_options {
-    const char *method;    /* "sam" (default), "mahalanobis", "lda", "matched-filter", "ace" */
+    const char *method;    /* "sam" (default; refused on a cube of 1 band), "mahalanobis",
+                              "lda", "matched-filter", "ace" */
     double train_fraction; /* of each class's pixels that train, 0 < f < 1; default 0.5 */
     uint64_t seed;         /* chooses the training pixels and the added noise, 0 to INT64_MAX;
                               default 1 */

@@ -201,6 +201,14 @@ static thz_status classify_build(const thz_cube *cube, const thz_cube *truth,
                              "%u x %u like %s",
                              truth->stem, tc->samples, tc->lines, tc->bands, cc->samples, cc->lines,
                              cube->stem);
+    /* In one band every positive spectrum has the angle 0 to every class: SAM would give
+     * every pixel to the first class (37.5 % on plate-in-box, with no word of why). */
+    if (method == CLASSIFY_SAM && cc->bands < 2)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s has 1 channel: sam compares spectral shapes (the angle between "
+                             "spectra), which needs 2 channels or more; use another method: "
+                             "mahalanobis, lda, matched-filter or ace",
+                             cube->stem);
     size_t pixels = (size_t)cc->samples * cc->lines;
     thz_classification *c = thz_calloc(1, sizeof *c);
     int32_t *ids = thz_calloc(pixels, sizeof *ids);

@@ -128,6 +128,21 @@ expect2 "unknown method" "$TMP/run" --sensor cam -o "$TMP/x" --method svm
 expect2 "seed beyond 2^63 - 1 (classification.json could not record it)" "$TMP/run" \
     --sensor cam -o "$TMP/x" --seed 9223372036854775808
 expect2 "no run" "$TMP/none" --sensor cam -o "$TMP/x"
+# one channel: sam's angle is 0 to every class (every pixel went to the first class, 37.5 %
+# on plate-in-box, silently); refused, naming the methods that work; mahalanobis runs
+$PY - "$IN/distinct.json" "$TMP/one-channel.json" <<'PYEOF'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["channels"] = [{"frequency_thz": 0.6, "relative_width": 0.01}]
+json.dump(d, open(sys.argv[2], "w"))
+PYEOF
+"$THZ" simulate "$TMP/one-channel.json" -o "$TMP/run1" -q --seed 3 || fail "one channel: simulate exit status $?"
+expect2 "sam on one channel" "$TMP/run1" --sensor cam -o "$TMP/x"
+grep -q "cam.brightness_temperature has 1 channel: sam .* needs 2 channels or more; use another method: mahalanobis, lda, matched-filter or ace" \
+    "$TMP/err" || fail "sam on one channel: $(cat "$TMP/err")"
+[ -e "$TMP/x" ] && fail "sam on one channel left $TMP/x"
+"$THZ" classify "$TMP/run1" --sensor cam -o "$TMP/c-one-mahalanobis" --method mahalanobis -q ||
+    fail "mahalanobis on one channel: exit status $?"
 printf 'ENVI\nsamples = 24\nlines = 16\nbands = 5\ndata type = 4\n' > "$TMP/run2/cam.measured_brightness_temperature.hdr"
 head -c 100 "$TMP/run/cam.brightness_temperature.img" > "$TMP/run2/cam.measured_brightness_temperature.img"
 expect2 "truncated cube" "$TMP/run2" --sensor cam -o "$TMP/x"
