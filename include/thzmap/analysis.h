@@ -102,8 +102,11 @@ THZ_API thz_status thz_classification_write(const thz_classification *c, const c
 
 /* ---- band selection ----------------------------------------------------------------- */
 
+/* The most channels thz_bands_select chooses (opt->count). */
+#define THZ_BANDS_MAX_COUNT 32
+
 typedef struct thz_bands_options {
-    size_t count;               /* K, channels to choose, >= 1 (required) */
+    size_t count;               /* K, channels to choose, 1 to THZ_BANDS_MAX_COUNT (required) */
     double from_thz;            /* candidate centres from .. to, both included; default 0.1 */
     double to_thz;              /* default 1.5 */
     double step_ghz;            /* default 10 */

@@ -58,7 +58,7 @@ _PROTOTYPES = {
 }
 _lib.bind(_PROTOTYPES)
 
-# The CLI's bounds (cmd_bands.c); the library checks the count too, and caps the
+# THZ_BANDS_MAX_COUNT of thzmap/analysis.h; the library checks the count too, and caps the
 # candidates (centres x widths) at 4096.
 MAX_COUNT = 32
 MAX_WIDTHS = 16

@@ -11,9 +11,10 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "thzmap/analysis.h"
 
 /* Largest K the search accepts (sets are small: a camera has a few channels). */
-enum { BANDS_MAX_COUNT = 32 };
+enum { BANDS_MAX_COUNT = THZ_BANDS_MAX_COUNT };
 
 typedef struct bands_classes {
     size_t n_candidates, n_classes;

@@ -164,7 +164,7 @@ int cmd_bands(int argc, char **argv)
         if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
             outdir = v;
         } else if (strcmp(a, "--count") == 0) {
-            ok = cli_parse_u64(CMD, a, v, 1, 32, &count);
+            ok = cli_parse_u64(CMD, a, v, 1, THZ_BANDS_MAX_COUNT, &count);
             have_count = true;
         } else if (strcmp(a, "--from-thz") == 0) {
             ok = cli_parse_positive(CMD, a, v, 1000.0, &opt.from_thz);

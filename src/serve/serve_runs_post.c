@@ -196,7 +196,7 @@ static bool serve_parse_option(serve_request *r, serve_job *j, const char *key, 
         return serve_opt_bool(r, v, path, &j->no_movies, ret);
     if (j->command == CMD_BANDS) {
         if (strcmp(key, "count") == 0) {
-            if (!serve_opt_whole(r, v, path, 1, 64, &u, ret))
+            if (!serve_opt_whole(r, v, path, 1, THZ_BANDS_MAX_COUNT, &u, ret))
                 return false;
             j->count = (size_t)u;
             return true;

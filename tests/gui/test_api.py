@@ -212,6 +212,11 @@ def test_limits(srv):
     err = srv.json("POST", "/api/runs", body={"command": "bands", "scene": "s/scene.json",
                                                "out": "o"}, status=400)
     check(err and err.get("path") == "$.options.count", "bands without count: %r" % err)
+    # the library's limit, 32 (the server took up to 64, and the job failed after its 202)
+    err = srv.json("POST", "/api/runs", body={"command": "bands", "scene": "s/scene.json",
+                                               "out": "o", "options": {"count": 33}}, status=400)
+    check(err and err.get("path") == "$.options.count" and "1 to 32" in err.get("error", ""),
+          "bands count 33: %r" % err)
     srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "../secret.json",
                                          "out": "o"}, status=403)
     srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/scene.json",
