@@ -63,7 +63,8 @@ typedef struct thz_run_settings {
                                0.1 K where the scene gives no count) */
     double max_seconds;     /* > 0: stop adding passes after this (s) */
     int keep_photons;       /* thz_simulate: keep the photon maps in the run (needed to
-                               write photon-map.thzpm) */
+                               write photon-map.thzpm); THZ_ERR_INPUT with the path
+                               integrator, which fires none */
     uint64_t first_photon;  /* thz_photons_fire*: fire photons first_photon .. + K - 1, so that
                                maps fired with disjoint ranges merge (thz_photons_merge;
                                a range past 2^64 - 1 is refused) */

@@ -397,6 +397,11 @@ def simulate(scene, integrator=None, photons=None, seed=None, threads=None,
     gets the Result, the others None."""
     scene = scene_arg(scene)
     s = _settings(scene, integrator, photons, seed, target_noise_k, max_seconds, keep_photons)
+    effective = _effective_integrator(scene, integrator)
+    if keep_photons and not _lib.lib.thz_integrator_needs_photons(effective.encode()):
+        raise ArgumentError(f"keep_photons: the {effective} integrator fires no photons, so "
+                            "there is no photon map to keep; give integrator='photon-map' or "
+                            "'final-gather'")
     return _shared_run(threads, progress, _world(mpi), scene, s, lambda call: _run_call(
         call, lambda out: _lib.lib.thz_simulate(call.ctx, scene._handle, ctypes.byref(s), out,
                                                 call.err), scene))

@@ -390,11 +390,26 @@ static thz_status run_tell_plan(run_state *rs, bool fires_photons, thz_error *er
     return st;
 }
 
+/* Photon maps to keep from an integrator that fires none: refused, as the CLI's
+ * --save-photon-map and the server's save_photon_map are (Python's keep_photons=True
+ * gave a run without a map, and a later save said keep_photons had not been given). */
+static thz_status run_check_keep(const thz_scene *scene, const run_options *opt, thz_error *err)
+{
+    if (!opt->keep_photon_maps || render_integrator_needs_photons(scene->render.integrator))
+        return THZ_OK;
+    return thz_error_set(err, THZ_ERR_INPUT,
+                         "keep_photons: the %s integrator fires no photons, so there is no "
+                         "photon map to keep (choose final-gather or photon-map)",
+                         render_integrator_name(scene->render.integrator));
+}
+
 thz_status run_check_simulate(const thz_scene *scene, const run_options *opt, thz_error *err)
 {
     run_state rs;
     memset(&rs, 0, sizeof rs);
-    thz_status st = run_begin(&rs, scene, opt, "simulate", err);
+    thz_status st = run_check_keep(scene, opt, err);
+    if (st == THZ_OK)
+        st = run_begin(&rs, scene, opt, "simulate", err);
     bool photons = render_integrator_needs_photons(scene->render.integrator);
     if (st == THZ_OK && photons)
         st = run_prepare_photons(&rs, err);
@@ -408,7 +423,9 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
                         thz_error *err)
 {
     double t_start = thz_now_s();
-    thz_status st = run_begin(rs, scene, opt, "simulate", err);
+    thz_status st = run_check_keep(scene, opt, err);
+    if (st == THZ_OK)
+        st = run_begin(rs, scene, opt, "simulate", err);
     bool photons = render_integrator_needs_photons(scene->render.integrator);
     if (st == THZ_OK && photons)
         st = run_prepare_photons(rs, err);

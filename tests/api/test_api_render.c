@@ -167,6 +167,15 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < thz_run_image_count(run); i++)
         compare_with_files(thz_run_image(run, i), path);
     thz_run_destroy(run);
+    /* photon maps to keep from the path integrator, which fires none: refused (the run came
+     * back without a map, and a write of it then said keep_photons had not been given) */
+    settings.integrator = "path";
+    run = NULL;
+    CHECK(thz_simulate(ctx, scene, &settings, &run, &err) == THZ_ERR_INPUT && !run &&
+              strstr(err.message, "keep_photons: the path integrator fires no photons"),
+          "keep_photons with path: %s", err.message);
+    CHECK(thz_simulate_check(ctx, scene, &settings, &err) == THZ_ERR_INPUT,
+          "thz_simulate_check, keep_photons with path: %s", err.message);
 
     thz_photons_destroy(photons);
     thz_context_destroy(ctx);

@@ -100,6 +100,7 @@ def test_missing_file(tmp_path):
     {"integrator": "magic"}, {"integrator": "path\0"}, {"target_noise_k": math.nan},
     {"target_noise_k": -1}, {"max_seconds": 3}, {"progress": 42}, {"keep_photons": "yes"},
     {"keep_photons": 1},
+    {"integrator": "path", "keep_photons": True},  # no map to keep (it gave a run without one)
 ])
 def test_bad_arguments_raise_before_the_library(tiny_dir, kwargs):
     scene = thzmap.load_scene(tiny_dir / "scene.json")

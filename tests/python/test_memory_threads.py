@@ -43,13 +43,13 @@ MARGIN = 4 << 20  # bytes: allocator noise; a leak of the images alone is 5 time
 def test_simulate_in_a_loop_does_not_grow(tiny_dir):
     scene = sensitive_scene(tiny_dir)
     for _ in range(10):  # let the allocator and OpenMP reach their steady state
-        r = thzmap.simulate(scene, integrator="path", seed=1, threads=2, keep_photons=True)
+        r = thzmap.simulate(scene, integrator="path", seed=1, threads=2)
         r.image("cam").radiance.sum()
     del r
     gc.collect()
     before = rss_bytes()
     for i in range(100):
-        r = thzmap.simulate(scene, integrator="path", seed=i, threads=2, keep_photons=True)
+        r = thzmap.simulate(scene, integrator="path", seed=i, threads=2)
         assert r.image("cam").radiance.shape == (64, 64, 2)
         r.summary
     del r
