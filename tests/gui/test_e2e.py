@@ -66,6 +66,9 @@ def make_root(root):
                       ("bad-null.json", {"objects": [None, 5]})):
         with open(os.path.join(root, "teraeye", name), "w") as f:
             json.dump(doc, f)
+    # text that is no JSON at all: opened after a scene, it showed that scene's panels
+    with open(os.path.join(root, "teraeye", "not-json.json"), "w") as f:
+        f.write("not json\n")
     return scene
 
 
@@ -110,6 +113,16 @@ def audit_fixes(driver, wait, patient, by_id, click_list, field, root):
         assert "Error" not in status(), status()
         log(f"{name}: {state()}, status {status()!r}")
     # the object's type decides its fields: a shell has a thickness
+    click_list("files", "path.json")
+    wait.until(lambda d: "✓" in state())
+    # a file that does not parse, opened after it: none of path.json's objects, sensors or
+    # plots under its name (they all stayed, with the status saying "opened not-json.json")
+    click_list("files", "not-json.json")
+    wait.until(lambda d: "opened teraeye/not-json.json" in status() and "✗" in state())
+    assert not driver.find_elements(By.CSS_SELECTOR, "#objects li, #sensors li"), \
+        by_id("objects").text
+    assert "cylinder" not in by_id("material-plots").text, by_id("material-plots").text
+    log(f"not-json.json: {state()}, no objects or sensors shown")
     click_list("files", "path.json")
     wait.until(lambda d: "✓" in state())
     click_list("objects", "cylinder-A")
@@ -435,6 +448,27 @@ def main():
         shot("diff")
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         assert not errors, errors
+        # the page made to fail on purpose: its errors are logged (and checked below)
+        # a comparison that fails clears the one before (it stayed, looking like the answer)
+        by_id("diff-b").clear()
+        by_id("diff-b").send_keys("teraeye/no-such-run")
+        by_id("btn-diff").click()
+        wait.until(lambda d: by_id("diff-info").text.startswith("no comparison:"))
+        painted = driver.execute_script(
+            "const c = document.getElementById('diff-image');"
+            "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;"
+            "return d.some((v, i) => i % 4 === 3 && v !== 0);")
+        assert not painted, "the earlier difference image stayed after a failed comparison"
+        log(f"A/B failed: {by_id('diff-info').text[:80]!r}, image cleared")
+        # "At most" holding no number: said so (the request went out with max=0)
+        Select(by_id("res-view")).select_by_value("photons")
+        driver.execute_script("document.getElementById('ph-max').value = '';")
+        by_id("btn-photons").click()
+        wait.until(lambda d: "At most: expected a whole number of photons" in by_id("status").text)
+        log(f"photons without a number: {by_id('status').text[:80]!r}")
+        made = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+        assert made and all("no-such-run" in e["message"] or "At most" in e["message"]
+                            for e in made), made  # those two failures, nothing else
         audit_fixes(driver, wait, patient, by_id, click_list, field, root)
         unsaved_edits(driver, wait, by_id, click_list, field)
         # the server stopped: the page says so (it said "Failed to fetch", and its

@@ -249,8 +249,22 @@ export class Results {
     const a = $("diff-a").value.trim();
     const b = $("diff-b").value.trim();
     const band = Number($("res-channel").value) || 0;
-    const cube = await loadCube(join(a, `${sensor}.brightness_temperature`));
-    const response = await request(`/api/diff?a=${q(a)}&b=${q(b)}&sensor=${q(sensor)}&band=${band}`);
+    // a comparison that fails leaves no earlier one on screen as if it were its answer
+    this.diffZ = null;
+    for (const id of ["diff-image", "diff-bar"]) {
+      const canvas = $(id);
+      canvas.getContext("2d").clearRect(0, 0, canvas.width, canvas.height);
+    }
+    $("diff-info").textContent = `comparing ${a} with ${b}…`;
+    const cube = await loadCube(join(a, `${sensor}.brightness_temperature`)).catch((e) => {
+      $("diff-info").textContent = `no comparison: ${e.message}`;
+      throw e;
+    });
+    const response = await request(`/api/diff?a=${q(a)}&b=${q(b)}&sensor=${q(sensor)}&band=${band}`)
+      .catch((e) => {
+        $("diff-info").textContent = `no comparison: ${e.message}`;
+        throw e;
+      });
     const z = new Float32Array(await response.arrayBuffer());
     const sigma = response.headers.get("X-Thzmap-Diff-Units") !== "K";
     let beyond = 0;
@@ -283,8 +297,13 @@ export class Results {
   async loadPhotons() {
     if (!this.mapPath) throw new Error(`${this.runDir}: no photon-map.thzpm (run simulate with "save the photon map")`);
     const t0 = performance.now();
+    // a number field holding text reads as "" (the request then said max=0, a value never typed)
+    const max = $("ph-max").value.trim();
+    if (!/^[0-9]+$/.test(max) || Number(max) < 1) {
+      throw new Error(`At most: expected a whole number of photons, 1 or more; got "${max || "nothing (not a number)"}"`);
+    }
     this.photons ||= new PhotonView($("photon-view")); // its WebGL context only when wanted
-    const n = await this.photons.load(this.mapPath, $("ph-channel").value, $("ph-object").value, Number($("ph-max").value));
+    const n = await this.photons.load(this.mapPath, $("ph-channel").value, $("ph-object").value, Number(max));
     const of = this.photons.total ? ` of ${this.photons.total}` : "";
     const { fetch_ms: fetchMs, draw_ms: drawMs } = this.photons.timing;
     $("ph-info").textContent = `${n}${of} photons, ${Math.round(performance.now() - t0)} ms ` +

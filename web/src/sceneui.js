@@ -81,6 +81,12 @@ export class SceneEditor {
     this.savedText = text;
     $("scene-path").value = path;
     this.view.framed = false;
+    // nothing of the file open before may show under this one's name: a file that does not
+    // parse showed the previous scene's objects, sensors, 3D view and plots
+    this.doc = {};
+    this.info = null;
+    this.view.update(this.info, this.doc);
+    this.renderPlots();
     this.setText(text);
     status(`opened ${path}`);
     document.dispatchEvent(new CustomEvent("scene-opened", { detail: path }));
