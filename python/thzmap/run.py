@@ -113,17 +113,22 @@ class PhotonMap:
 
     @property
     def seed(self):
+        """The seed the photons were fired with."""
         return _lib.lib.thz_photons_seed(self._ptr)
 
     @property
     def photons_per_channel(self):
+        """Photons fired per channel (K)."""
         return _lib.lib.thz_photons_per_channel(self._ptr)
 
     @property
     def n_channels(self):
+        """The scene's channels (a map loaded for one channel holds only that one's)."""
         return _lib.lib.thz_photons_channel_count(self._ptr)
 
     def has_channel(self, c):
+        """Whether channel c's records are in the map (False for the others of a map
+        loaded with load_photon_map(..., channel=...))."""
         c = _whole("channel", c, 0, self.n_channels - 1)
         return bool(_lib.lib.thz_photons_has_channel(self._ptr, c))
 
@@ -279,22 +284,45 @@ class Image:
         a = self.plane(plane)
         return None if a is None else a.transpose(1, 2, 0)
 
-    radiance = property(lambda self: self._cube(_lib.PLANE_RADIANCE))
-    radiance_stderr = property(lambda self: self._cube(_lib.PLANE_RADIANCE_STDERR))
-    power = property(lambda self: self._cube(_lib.PLANE_POWER))
+    radiance = property(lambda self: self._cube(_lib.PLANE_RADIANCE),
+                        doc="Band-mean spectral radiance L_c, W m^-2 sr^-1 Hz^-1, float32 "
+                            "(rows, columns, channels).")
+    radiance_stderr = property(lambda self: self._cube(_lib.PLANE_RADIANCE_STDERR),
+                               doc="Standard error of radiance, W m^-2 sr^-1 Hz^-1, (rows, "
+                                   "columns, channels); None when the integrator gives none.")
+    power = property(lambda self: self._cube(_lib.PLANE_POWER),
+                     doc="Power received P_c = L_c Omega_S A_S B_c, W, (rows, columns, "
+                         "channels).")
     brightness_temperature = property(
-        lambda self: self._cube(_lib.PLANE_BRIGHTNESS_TEMPERATURE))
-    normalized = property(lambda self: self._cube(_lib.PLANE_NORMALIZED))
-    temperature = property(lambda self: self.plane(_lib.PLANE_TEMPERATURE))
-    distance = property(lambda self: self.plane(_lib.PLANE_DISTANCE))
-    object_id = property(lambda self: self.plane(_lib.PLANE_OBJECT_ID))
-    visual = property(lambda self: self.plane(_lib.PLANE_VISUAL_RGB))
-    measured_radiance = property(lambda self: self._cube(_lib.PLANE_MEASURED_RADIANCE))
+        lambda self: self._cube(_lib.PLANE_BRIGHTNESS_TEMPERATURE),
+        doc="Brightness temperature Tb_c, K, (rows, columns, channels).")
+    normalized = property(lambda self: self._cube(_lib.PLANE_NORMALIZED),
+                          doc="Normalised radiance N_c = L_c / B(T_ref), 1, (rows, columns, "
+                              "channels).")
+    temperature = property(lambda self: self.plane(_lib.PLANE_TEMPERATURE),
+                           doc="Truth: temperature of the surface seen, K, (rows, columns); "
+                               "-1 where nothing is hit.")
+    distance = property(lambda self: self.plane(_lib.PLANE_DISTANCE),
+                        doc="Truth: distance from the pinhole to the surface seen, m, (rows, "
+                            "columns); -1 where nothing is hit.")
+    object_id = property(lambda self: self.plane(_lib.PLANE_OBJECT_ID),
+                         doc="Truth: index into the scene's objects of the object seen, as "
+                             "float32 (rows, columns); -1 where nothing is hit.")
+    visual = property(lambda self: self.plane(_lib.PLANE_VISUAL_RGB),
+                      doc="A shaded picture in the materials' colors (S.visual.png), sRGB "
+                          "0..1, (rows, columns, 3).")
+    measured_radiance = property(
+        lambda self: self._cube(_lib.PLANE_MEASURED_RADIANCE),
+        doc="radiance through the sensor's PSF and noise, W m^-2 sr^-1 Hz^-1; None when "
+            "the sensor has neither.")
     measured_brightness_temperature = property(
-        lambda self: self._cube(_lib.PLANE_MEASURED_BRIGHTNESS_TEMPERATURE))
+        lambda self: self._cube(_lib.PLANE_MEASURED_BRIGHTNESS_TEMPERATURE),
+        doc="brightness_temperature through the sensor's PSF and noise, K; None when the "
+            "sensor has neither.")
 
     @property
     def frequencies_thz(self):
+        """The channels' centre frequencies, THz, in the cubes' channel order."""
         return np.array([c.frequency_thz for c in self.scene.channels])
 
     def __repr__(self):
@@ -351,6 +379,8 @@ class Result:
 
     @property
     def totals(self):
+        """The run's totals (photons fired and stored, sensors, channels, ...) as a
+        named tuple, the fields of thz_run_totals (thzmap/run.h)."""
         t = _lib.ThzRunTotals()
         _lib.lib.thz_run_get_totals(self._owner.ptr, ctypes.byref(t))
         return Totals(*(getattr(t, f) for f, _ in t._fields_))

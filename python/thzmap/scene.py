@@ -77,14 +77,17 @@ class Scene:
 
     @property
     def name(self):
+        """The scene's name (its "name", else the file's stem)."""
         return self.info.name
 
     @property
     def sensor_names(self):
+        """The sensors' names, in the scene's order (the index simulate's images use)."""
         return [s.name for s in self.sensors]
 
     @property
     def object_names(self):
+        """The objects' names, in the scene's order (object_id's indices)."""
         return [o.name for o in self.objects]
 
     def sensor_index(self, sensor):
