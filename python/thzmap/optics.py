@@ -100,14 +100,15 @@ _lib.bind(_PROTOTYPES)
 
 def _frequencies(frequency_thz, name="frequency_thz"):
     """(flat float64 array in Hz, the shape to return, whether a scalar was given)."""
-    if isinstance(frequency_thz, bool):
-        raise ArgumentError(f"{name}: expected a number or an array of numbers in THz, "
-                            f"got {frequency_thz!r}")
+    bad = ArgumentError(f"{name}: expected a number or an array of numbers in THz, "
+                        f"got {frequency_thz!r}")
     try:
-        f = np.asarray(frequency_thz, dtype=np.float64)
+        f = np.asarray(frequency_thz)
     except (TypeError, ValueError):
-        raise ArgumentError(f"{name}: expected a number or an array of numbers in THz, "
-                            f"got {frequency_thz!r}") from None
+        raise bad from None
+    if f.dtype.kind not in "iuf":  # not True, "0.5" (numpy would read the text), None
+        raise bad
+    f = f.astype(np.float64)
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ArgumentError(f"{name}: expected frequencies above 0 THz, finite")
     return (f * 1e12).ravel(), f.shape, f.ndim == 0
@@ -400,7 +401,10 @@ def _per_frequency(fn, frequency_thz, other, name, lowest=None):
     hz, shape, _ = _frequencies(frequency_thz)  # checked, in Hz
     f = hz.reshape(shape)
     try:
-        x = np.asarray(other, dtype=np.float64)
+        x = np.asarray(other)
+        if x.dtype.kind not in "iuf":  # "300" (numpy would read the text), True, None
+            raise TypeError(f"got {other!r}")
+        x = x.astype(np.float64)
         fb, xb = np.broadcast_arrays(f, x)
     except (TypeError, ValueError) as e:
         raise ArgumentError(f"{name}: expected a number or an array of numbers that "

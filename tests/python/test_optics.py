@@ -166,7 +166,16 @@ def test_errors():
     with pytest.raises(thzmap.ArgumentError, match=r"distance_m: expected a number at least 0, "
                        r"got -1"):
         thzmap.atmosphere().transmittance(0.5, -1)
-    with pytest.raises(thzmap.Error, match="frequency_thz"):
-        thzmap.atmosphere("itu-p676").attenuation_per_m(2.0)  # 1-1000 GHz only
+    with pytest.raises(thzmap.Error, match=r"frequency_thz: 2 THz lies outside the range of "
+                       r"atmosphere model 'itu-p676' \(0\.001 to 1 THz\)"):
+        thzmap.atmosphere("itu-p676").attenuation_per_m(2.0)  # 1-1000 GHz only (not "2 to 2 THz")
+    with pytest.raises(thzmap.Error, match="0.5 to 2 THz leaves the range"):
+        thzmap.atmosphere("itu-p676").attenuation_per_m([0.5, 2.0])
+    # text is not a frequency or a temperature (numpy read "0.5" as 0.5)
+    for bad in ("0.5", ["0.3", "0.4"], True):
+        with pytest.raises(thzmap.ArgumentError, match="frequency_thz: expected a number"):
+            thzmap.atmosphere().attenuation_per_m(bad)
+    with pytest.raises(thzmap.ArgumentError, match="temperature_k: expected a number"):
+        thzmap.planck_radiance(0.5, "300")
     with pytest.raises(thzmap.ArgumentError, match="only for the lines model"):
         thzmap.atmosphere("itu-p676", h2o_lines="x.par")
