@@ -307,7 +307,22 @@ enum MHD_Result serve_pixel(serve_request *r)
     double *centres = v + NQ * SERVE_MAX_BANDS;
     size_t n[NQ];
     json_t *names = NULL;
+    /* the image's size, from its brightness temperature: a pixel outside it is the
+     * request's mistake (400, saying the size), a missing cube a 404 (one message said
+     * either, for both) */
+    char hdr[PATH_MAX];
+    thz_error cube_err = {0};
+    long rows = -1, cols = -1;
     pthread_mutex_lock(&r->s->cache_lock);
+    if (snprintf(hdr, sizeof hdr, "%s/%s.brightness_temperature.hdr", dir, sensor) <
+            (int)sizeof hdr &&
+        serve_path_inside(r->s, hdr)) {
+        const thz_cube *c = serve_cube_get(r->s, hdr, &cube_err);
+        if (c) {
+            rows = (long)thz_cube_rows(c);
+            cols = (long)thz_cube_columns(c);
+        }
+    }
     for (size_t i = 0; i < NQ; i++)
         n[i] = serve_pixel_values(r->s, dir, sensor, q[i], row, col, v + i * SERVE_MAX_BANDS,
                                   SERVE_MAX_BANDS, i == 0 ? centres : NULL, i == 6 ? &names : NULL);
@@ -315,10 +330,13 @@ enum MHD_Result serve_pixel(serve_request *r)
     if (!n[0]) {
         free(v);
         json_decref(names);
-        return serve_reply_error(r, 404,
-                                 "%s: no brightness temperature cube of sensor '%s', or the "
-                                 "pixel (%ld, %ld) lies outside it",
-                                 dir, sensor, row, col);
+        if (rows > 0 && (row < 0 || col < 0 || row >= rows || col >= cols))
+            return serve_reply_error(r, 400,
+                                     "row %ld, col %ld: outside the image of %ld x %ld pixels "
+                                     "(row 0 to %ld, col 0 to %ld)",
+                                     row, col, cols, rows, rows - 1, cols - 1);
+        return serve_reply_error(r, 404, "%s: no brightness temperature cube of sensor '%s'%s%s",
+                                 dir, sensor, cube_err.message[0] ? ": " : "", cube_err.message);
     }
     double *tb = v, *l = v + SERVE_MAX_BANDS, *sl = v + 2 * SERVE_MAX_BANDS;
     double stderr_k[SERVE_MAX_BANDS];

@@ -518,7 +518,15 @@ def test_results(srv, root):
         check(t["object"] == names[int(oid[i])] and f32([t["temperature_K"]]) == [temp[i]] and
               f32([t["distance_m"]]) == [dist[i]], "pixel truth: %r" % t)
     print("3 pixel answers: %.1f ms each" % ((time.time() - t0) / 3 * 1e3))
-    srv.json("GET", "/api/pixel?dir=out/a&sensor=cam&row=12&col=0", status=404)
+    # outside the 16 x 12 image: the request's mistake, with the size (a 404 that also
+    # blamed a missing cube); a sensor without a cube is the 404
+    err = srv.json("GET", "/api/pixel?dir=out/a&sensor=cam&row=12&col=0", status=400)
+    check(err and "row 12, col 0: outside the image of 16 x 12 pixels (row 0 to 11, col 0 to 15)"
+          in err.get("error", ""), "pixel outside: %r" % err)
+    srv.json("GET", "/api/pixel?dir=out/a&sensor=cam&row=0&col=-1", status=400)
+    err = srv.json("GET", "/api/pixel?dir=out/a&sensor=nope&row=0&col=0", status=404)
+    check(err and "no brightness temperature cube of sensor 'nope'" in err.get("error", ""),
+          "pixel of no sensor: %r" % err)
     # A/B difference, in units of the combined standard error
     st, h, data = srv.request("GET", "/api/diff?a=out/a&b=out/b&sensor=cam&band=0")
     _, tb_b = read_img(os.path.join(root, "out", "b", "cam.brightness_temperature.img"))
