@@ -2,8 +2,8 @@
  * every method is exact without noise; with noise raised the accuracy falls
  * monotonically; the confusion matrix sums to the pixels that see an object, its rows
  * to each object's (the truth) and its columns to the pixels assigned each; the
- * training split depends on the seed alone. (The AUC is checked only where it is 1;
- * analysis/classify.c's roc_curve is static.) */
+ * training split depends on the seed alone; the AUC and the ROC's points are those of
+ * the held-out pixels, ties counted one half, against a count done here. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -131,6 +131,81 @@ static void test_accuracy_falls_with_noise(void **state)
     }
 }
 
+/* One band, two classes of 120 and 80 pixels (objects 0 and 1) on a grid of integer
+ * values that overlap, so that held-out pixels of both classes tie: class 0 holds 10 ..
+ * 29, class 1 0 .. 19, each value 6 resp. 4 times. LDA's margin of class 0 rises with
+ * the value (its mean is the larger), so its ROC is the value's: the test's own
+ * Mann-Whitney count over the held-out pixels (a tie counting one half) and the curve
+ * after the pixels down to the i-th largest value, point i of 100 at rank i n / 100. */
+enum { ROC_A = 120, ROC_B = 80, ROC_PIXELS = ROC_A + ROC_B };
+
+static void test_auc_and_roc_of_held_out_pixels(void **state)
+{
+    (void)state;
+    static float cube[ROC_PIXELS];
+    static int32_t truth[ROC_PIXELS];
+    for (size_t p = 0; p < ROC_PIXELS; p++) {
+        truth[p] = p < ROC_A ? 0 : 1;
+        cube[p] = p < ROC_A ? (float)(10 + p % 20) : (float)((p - ROC_A) % 20);
+    }
+    classify_result r;
+    thz_error err = {0};
+    assert_int_equal(classify_run(cube, 1, ROC_PIXELS, truth, CLASSIFY_LDA, 0.5, 3, &r, &err),
+                     THZ_OK);
+    /* held out: 60 of class 0, 40 of class 1, 100 in all (a ROC point per rank) */
+    assert_int_equal(r.n_held_out, 100);
+    double x[100];
+    int positive[100];
+    size_t n = 0, pos = 0, neg = 0;
+    for (size_t p = 0; p < ROC_PIXELS; p++)
+        if (!r.train[p]) {
+            x[n] = cube[p];
+            positive[n] = truth[p] == 0;
+            pos += (size_t)positive[n];
+            n++;
+        }
+    assert_int_equal(n, 100);
+    neg = n - pos;
+    assert_int_equal(pos, 60);
+    double wins = 0.0;
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < n; j++)
+            if (positive[i] && !positive[j])
+                wins += x[i] > x[j] ? 1.0 : x[i] == x[j] ? 0.5 : 0.0;
+    double auc = wins / ((double)pos * (double)neg);
+    assert_true(auc > 0.8 && auc < 0.99); /* the case has overlap and ties */
+    if (!(fabs(r.auc[0] - auc) < 1e-12))
+        fail_msg("AUC of class 0 %.15g, the held-out pixels' Mann-Whitney count %.15g", r.auc[0],
+                 auc);
+    /* class 1's margin is class 0's negated: the same area */
+    assert_true(fabs(r.auc[1] - auc) < 1e-12);
+    double sorted[100];
+    memcpy(sorted, x, sizeof sorted);
+    for (size_t i = 1; i < n; i++) /* descending */
+        for (size_t j = i; j > 0 && sorted[j] > sorted[j - 1]; j--) {
+            double t = sorted[j];
+            sorted[j] = sorted[j - 1];
+            sorted[j - 1] = t;
+        }
+    assert_true(r.roc_fpr[0] == 0.0 && r.roc_tpr[0] == 0.0);
+    for (size_t i = 1; i < CLASSIFY_ROC_POINTS; i++) {
+        double threshold = sorted[i - 1]; /* rank i = i n / 100 with n = 100 */
+        size_t tp = 0, fp = 0;
+        for (size_t j = 0; j < n; j++)
+            if (x[j] >= threshold) {
+                tp += (size_t)positive[j];
+                fp += (size_t)!positive[j];
+            }
+        double want_fpr = (double)fp / (double)neg, want_tpr = (double)tp / (double)pos;
+        if (!(fabs(r.roc_fpr[i] - want_fpr) < 1e-12 && fabs(r.roc_tpr[i] - want_tpr) < 1e-12))
+            fail_msg("ROC point %zu: (%g, %g), expected (%g, %g)", i, r.roc_fpr[i], r.roc_tpr[i],
+                     want_fpr, want_tpr);
+    }
+    assert_true(r.roc_fpr[CLASSIFY_ROC_POINTS - 1] == 1.0);
+    assert_true(r.roc_tpr[CLASSIFY_ROC_POINTS - 1] == 1.0);
+    classify_result_fini(&r);
+}
+
 static void test_split_depends_on_seed(void **state)
 {
     (void)state;
@@ -181,6 +256,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_noise_free_exact),
         cmocka_unit_test(test_accuracy_falls_with_noise),
+        cmocka_unit_test(test_auc_and_roc_of_held_out_pixels),
         cmocka_unit_test(test_split_depends_on_seed),
         cmocka_unit_test(test_bad_input),
     };
