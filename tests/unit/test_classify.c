@@ -206,6 +206,46 @@ static void test_auc_and_roc_of_held_out_pixels(void **state)
     classify_result_fini(&r);
 }
 
+/* Four classes of unequal sizes in two bands: A (200 pixels) on the segment between B
+ * (40) and D (60), C (100) off that line, 1.5-4 K apart, noise 0.05 K. The classifiers
+ * and ACE assign every pixel its class; every method ranks all held-out pixels of a
+ * corner of the classes' hull (B, C, D) above the rest (AUC 1). The matched filter, a
+ * linear detector, cannot single out A, between B and D, and is not exact (its
+ * assignments compare targets). Its background is the other classes' training pixels
+ * with their counts as weights: their means unweighted, C's AUC fell to 0.8. */
+static void test_unequal_classes(void **state)
+{
+    (void)state;
+    enum { N = 400 };
+    static const double tb[4][2] = {{300.0, 300.0}, {302.0, 300.0}, {300.0, 301.5}, {296.0, 300.0}};
+    static const size_t count[4] = {200, 40, 100, 60};
+    static float cube[2 * N];
+    static int32_t truth[N];
+    size_t p = 0;
+    for (size_t k = 0; k < 4; k++)
+        for (size_t i = 0; i < count[k]; i++, p++) {
+            truth[p] = (int32_t)k;
+            for (size_t b = 0; b < 2; b++)
+                cube[b * N + p] = (float)tb[k][b];
+        }
+    assert_int_equal(p, N);
+    const double sd[2] = {0.05, 0.05};
+    classify_add_noise(cube, 2, N, sd, 5);
+    for (int m = 0; m < CLASSIFY_METHOD_COUNT; m++) {
+        classify_result r;
+        thz_error err = {0};
+        assert_int_equal(classify_run(cube, 2, N, truth, (classify_method)m, 0.5, 1, &r, &err),
+                         THZ_OK);
+        const char *name = classify_method_name((classify_method)m);
+        if (m != CLASSIFY_MATCHED_FILTER && !(r.accuracy == 1.0))
+            fail_msg("%s: accuracy %g", name, r.accuracy);
+        for (size_t k = 1; k < 4; k++)
+            if (!(r.auc[k] == 1.0))
+                fail_msg("%s: AUC of class %zu %g", name, k, r.auc[k]);
+        classify_result_fini(&r);
+    }
+}
+
 static void test_split_depends_on_seed(void **state)
 {
     (void)state;
@@ -257,6 +297,7 @@ int main(void)
         cmocka_unit_test(test_noise_free_exact),
         cmocka_unit_test(test_accuracy_falls_with_noise),
         cmocka_unit_test(test_auc_and_roc_of_held_out_pixels),
+        cmocka_unit_test(test_unequal_classes),
         cmocka_unit_test(test_split_depends_on_seed),
         cmocka_unit_test(test_bad_input),
     };
