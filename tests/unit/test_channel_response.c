@@ -134,6 +134,14 @@ static void test_triangles_and_trapezoid(void **state)
     assert_true(close_rel(channel_fwhm_hz(&ch), p + r, 1e-12));
     channel_fini(&ch);
 
+    /* Flanks that do not start from 0: g rises 0.2 -> 1 over [1.00, 1.08] THz and falls
+     * 1 -> 0.4 over [1.10, 1.16]: half the peak is crossed at 1.00 + 0.08 x 0.3 / 0.8 and
+     * 1.10 + 0.06 x 0.5 / 0.6 THz. */
+    const double fz[] = {1.0, 1.08, 1.10, 1.16}, fw[] = {0.2, 1.0, 1.0, 0.4};
+    ch = table_channel(fz, fw, 4, 0.0);
+    assert_true(close_rel(channel_fwhm_hz(&ch), (1.15 - 1.03) * 1e12, 1e-12));
+    channel_fini(&ch);
+
     /* bad tables are refused (the loader's messages are tested with the loader) */
     thz_channel bad = {.name = "bad"};
     thz_error err;
