@@ -55,6 +55,17 @@ static void test_slab(void **state)
     double r0 = fresnel_reflectance(1.9, 0.02, 1.0);
     double t_expect = (1 - r0) * (1 - r0) * tau / (1 - r0 * r0 * tau * tau);
     assert_true(fabs(optics_transmission(&o, 1.0) - t_expect) <= 1e-12);
+    /* oblique, real index: Snell's law bends the ray inside, whose path through the slab
+     * is t / cos theta_t; each polarisation's slab sum with its own r */
+    const double n = 1.9, a = 200.0, t = 0.003, mu = 0.4;
+    double ct = sqrt(1.0 - (1.0 - mu * mu) / (n * n)), ti = exp(-a * t / ct);
+    double r_s = (mu - n * ct) / (mu + n * ct), r_p = (n * mu - ct) / (n * mu + ct);
+    r_s *= r_s;
+    r_p *= r_p;
+    double t_oblique = 0.5 * ((1 - r_s) * (1 - r_s) * ti / (1 - r_s * r_s * ti * ti) +
+                              (1 - r_p) * (1 - r_p) * ti / (1 - r_p * r_p * ti * ti));
+    fresnel_slab(n, 0.0, mu, a, t, &refl, &trans);
+    assert_true(fabs(trans - t_oblique) <= 1e-12);
 }
 
 /* Hemispherical means: Gauss-Legendre against composite Simpson with 20000 intervals. */
