@@ -11,6 +11,7 @@
 
 #include <cmocka.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -71,10 +72,10 @@ static void test_pilot_no_larger_than_the_run(void **state)
     check_pilot(4096, 4096, 1e9, 32, 32, RUN_PILOT_PHOTONS);
 }
 
-/* The estimate of the photon-map run of load(3, 2, 1, photons) towards target_k. */
-static run_estimate estimate(double photons, double target_k)
+/* The estimate of the photon-map run of load(columns, rows, 1, photons) towards target_k. */
+static run_estimate estimate_of(unsigned columns, unsigned rows, double photons, double target_k)
 {
-    thz_scene *s = load(3, 2, 1, photons);
+    thz_scene *s = load(columns, rows, 1, photons);
     accel *acc;
     thz_error err;
     assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
@@ -90,6 +91,11 @@ static run_estimate estimate(double photons, double target_k)
     accel_destroy(acc);
     scene_destroy(s);
     return e;
+}
+
+static run_estimate estimate(double photons, double target_k)
+{
+    return estimate_of(3, 2, photons, target_k);
 }
 
 /* The estimate of a small photon-map run with a noise target: its pilot fires the run's
@@ -122,12 +128,40 @@ static void test_estimate_passes_stop_at_memory(void **state)
     }
 }
 
+/* The noise falls as 1/sqrt(photons): half the target asks 4 x the passes (each count a
+ * ceiling, so 4 x less up to 3); a sensor of twice the pilot's pixel pitch (64 x 32
+ * against the pilot's 32 x 32, the same field) has each disk hold a quarter of the
+ * pilot's photons, so twice its noise: 4 x the passes of a 32 x 32 sensor. */
+static void test_estimate_passes_law(void **state)
+{
+    (void)state;
+    run_estimate a = estimate_of(32, 32, 300, 2.0), b = estimate_of(32, 32, 300, 1.0);
+    run_estimate c = estimate_of(64, 32, 300, 2.0);
+    assert_true(a.passes >= 10 && !b.memory_stop && !c.memory_stop);
+    assert_true(b.passes <= 4 * a.passes && b.passes + 3 >= 4 * a.passes);
+    assert_true(c.passes <= 4 * a.passes && c.passes + 3 >= 4 * a.passes);
+}
+
+/* A check at most a quarter more passes than so far and at least one more, at the passes
+ * the noise asks when fewer (run.h). */
+static void test_next_check(void **state)
+{
+    (void)state;
+    assert_int_equal(run_photon_next_check(100, INFINITY), 125);
+    assert_int_equal(run_photon_next_check(100, 110), 110);
+    assert_int_equal(run_photon_next_check(100, 50), 101);
+    assert_int_equal(run_photon_next_check(3, INFINITY), 4);
+    assert_int_equal(run_photon_next_check(1, INFINITY), 2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pilot_no_larger_than_the_run),
         cmocka_unit_test(test_estimate_small_run),
         cmocka_unit_test(test_estimate_passes_stop_at_memory),
+        cmocka_unit_test(test_estimate_passes_law),
+        cmocka_unit_test(test_next_check),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
