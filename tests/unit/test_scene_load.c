@@ -415,6 +415,37 @@ static void test_sensor_vectors_of_any_scale(void **state)
     }
 }
 
+/* Enclosures (closed boxes with inward normals): the air's temperature defaults to the
+ * innermost one around the sensors (scene-format.md), here the room at 290 K inside the
+ * hall at 310 K; an annex in the hall that holds no sensor is no reason to warn that the
+ * sensor is outside "the enclosure". */
+static void test_nested_enclosures(void **state)
+{
+    (void)state;
+#define ENCLOSURE(n, t, size, x)                                                                   \
+    "{\"name\": \"" n "\", \"type\": \"solid\", \"material\": \"m\", \"temperature_k\": " t ", "   \
+    "\"shape\": {\"type\": \"box\", \"size_m\": [" size ", " size ", " size                        \
+    "], \"inward\": true}, "                                                                       \
+    "\"transform\": {\"translate_m\": [" x ", 0, 0]}}"
+    thz_scene *s = load_ok(
+        HEAD CHANNELS MATERIALS
+        "\"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.01}, "
+        "\"objects\": [" ENCLOSURE("hall", "310", "10", "0") ", " ENCLOSURE(
+            "room", "290", "2", "0") ", " ENCLOSURE("annex", "300", "2",
+                                                    "4") "], "
+                                                         "\"sensors\": [{\"name\": \"c\", "
+                                                         "\"position_m\": [0, -0.5, 0], "
+                                                         "\"look_at_m\": [0, 0.5, 0], "
+                                                         "\"fov_deg\": 40, \"resolution\": [16, "
+                                                         "8]}]}");
+#undef ENCLOSURE
+    assert_true(s->atmosphere.air.temperature_k == 290.0);
+    assert_true(s->atmosphere.background_temperature_k == 290.0);
+    for (size_t i = 0; i < s->n_warnings; i++)
+        fail_msg("warning: %s", s->warnings[i]);
+    thz_scene_destroy(s);
+}
+
 /* How many of the scene's warnings name `what` and the atmosphere's extent. */
 static size_t extent_warnings(const char *extent, const char *what)
 {
@@ -455,6 +486,7 @@ int main(void)
         cmocka_unit_test(test_blocks),
         cmocka_unit_test(test_optics_constant),
         cmocka_unit_test(test_csv_material_and_warnings),
+        cmocka_unit_test(test_nested_enclosures),
         cmocka_unit_test(test_default_channel_names),
         cmocka_unit_test(test_unique_names),
         cmocka_unit_test(test_mesh_file_named_thrice),
