@@ -446,6 +446,32 @@ static void test_nested_enclosures(void **state)
     thz_scene_destroy(s);
 }
 
+/* An explicit emissivity more than 0.01 from Kirchhoff's absorptivity is warned of
+ * (scene-format.md), one closer is not: R = 0.1 on a solid, A = 0.9. */
+static size_t kirchhoff_warnings(const char *emissivity)
+{
+    char json[1024];
+    snprintf(json, sizeof json,
+             HEAD CHANNELS
+             "\"materials\": {\"m\": {\"reflectivity\": 0.1, \"emissivity\": %s}}, " OBJECT(BOX)
+                 SENSORS "}",
+             emissivity);
+    thz_scene *s = load_ok(json);
+    size_t n = 0;
+    for (size_t i = 0; i < s->n_warnings; i++)
+        n += strstr(s->warnings[i], "Kirchhoff") != NULL;
+    thz_scene_destroy(s);
+    return n;
+}
+
+static void test_kirchhoff_warning_threshold(void **state)
+{
+    (void)state;
+    assert_int_equal(kirchhoff_warnings("0.9"), 0);
+    assert_int_equal(kirchhoff_warnings("0.895"), 0);
+    assert_int_equal(kirchhoff_warnings("0.88"), 1);
+}
+
 /* How many of the scene's warnings name `what` and the atmosphere's extent. */
 static size_t extent_warnings(const char *extent, const char *what)
 {
@@ -487,6 +513,7 @@ int main(void)
         cmocka_unit_test(test_optics_constant),
         cmocka_unit_test(test_csv_material_and_warnings),
         cmocka_unit_test(test_nested_enclosures),
+        cmocka_unit_test(test_kirchhoff_warning_threshold),
         cmocka_unit_test(test_default_channel_names),
         cmocka_unit_test(test_unique_names),
         cmocka_unit_test(test_mesh_file_named_thrice),
