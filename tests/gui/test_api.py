@@ -48,6 +48,10 @@ def make_root(root):
     with open(os.path.join(root, "s", "scene.json"), "w") as f:
         json.dump(scene, f, indent=1)
     os.symlink("/etc", os.path.join(root, "etc-link"))
+    # a sibling of the root whose name begins with the root's: outside it all the same
+    os.makedirs(root + "-sibling")
+    open(os.path.join(root + "-sibling", "secret.json"), "w").write("{}")
+    os.symlink(root + "-sibling", os.path.join(root, "sibling-link"))
     web = os.path.join(root, "..", "web")
     os.makedirs(os.path.join(web, "assets"))
     open(os.path.join(web, "index.html"), "w").write("<!doctype html><title>t</title>")
@@ -91,6 +95,9 @@ def test_auth(srv):
     st, _, _ = srv.request("GET", "/api/info", auth=False,
                            headers={"Cookie": "thzmap_token=" + "1" * 32})
     check(st == 403, "wrong cookie: %d, expected 403" % st)
+    st, _, _ = srv.request("GET", "/api/info", auth=False,
+                           headers={"Authorization": "Bearer " + srv.token + "0"})
+    check(st == 403, "the token with a character more: %d, expected 403" % st)
     st, _, _ = srv.request("GET", "/?token=" + "2" * 32, auth=False)
     check(st == 403, "login with a wrong token: %d, expected 403" % st)
     st, h, _ = srv.request("GET", "/?token=" + srv.token, auth=False)
@@ -118,7 +125,8 @@ def test_paths(srv, root):
                  "/api/file?path=%2e%2e/secret.json", "/api/file?path=s/%2E%2E/%2e%2e/secret.json",
                  "/api/file?path=etc-link/passwd", "/api/files?dir=etc-link",
                  "/api/files?dir=..", "/api/files?dir=/", "/api/cube?path=../x.hdr",
-                 "/api/outputs?dir=etc-link", "/api/pixel?dir=..&sensor=cam&row=0&col=0"]:
+                 "/api/outputs?dir=etc-link", "/api/pixel?dir=..&sensor=cam&row=0&col=0",
+                 "/api/file?path=sibling-link/secret.json", "/api/files?dir=sibling-link"]:
         st, _, data = srv.request("GET", path)
         check(st == 403 and "error" in json.loads(data), "%s: %d, expected 403" % (path, st))
     for path in ["/assets/../../secret.json", "/assets/%2e%2e/%2e%2e/secret.json",
@@ -130,6 +138,11 @@ def test_paths(srv, root):
         st, _, _ = srv.request("PUT", path, body=b"{}")
         check(st == 403, "PUT %s: %d, expected 403" % (path, st))
     check(not os.path.exists(os.path.join(root, "..", "x.json")), "a PUT escaped the root")
+    # a .json name that is a directory is not written over
+    os.makedirs(os.path.join(root, "s", "dir.json"))
+    st, _, data = srv.request("PUT", "/api/file?path=s/dir.json", body=b"{}")
+    check(st == 403 and b"not a regular file" in data, "PUT onto a directory: %d %r" % (st, data))
+    os.rmdir(os.path.join(root, "s", "dir.json"))
     # the file endpoints inside the root
     listing = srv.json("GET", "/api/files?dir=s")
     names = {e["name"]: e for e in listing["entries"]} if listing else {}
