@@ -143,6 +143,18 @@ def test_paths(srv, root):
     st, _, data = srv.request("PUT", "/api/file?path=s/dir.json", body=b"{}")
     check(st == 403 and b"not a regular file" in data, "PUT onto a directory: %d %r" % (st, data))
     os.rmdir(os.path.join(root, "s", "dir.json"))
+    # a dangling symbolic link: where it points is unknown, so it is outside (a PUT through
+    # it would create a file wherever it points; without the refusal a GET was a 404)
+    target = os.path.join(root, "..", "nowhere", "x.json")
+    os.symlink(target, os.path.join(root, "s", "dangle.json"))
+    st, _, _ = srv.request("GET", "/api/file?path=s/dangle.json")
+    check(st == 403, "GET through a dangling link: %d, expected 403" % st)
+    os.makedirs(os.path.dirname(target))
+    st, _, _ = srv.request("PUT", "/api/file?path=s/dangle.json", body=b"{}")
+    check(st == 403 and not os.path.exists(target),
+          "PUT through a dangling link: %d, expected 403, nothing written" % st)
+    os.rmdir(os.path.dirname(target))
+    os.unlink(os.path.join(root, "s", "dangle.json"))
     # the file endpoints inside the root
     listing = srv.json("GET", "/api/files?dir=s")
     names = {e["name"]: e for e in listing["entries"]} if listing else {}
