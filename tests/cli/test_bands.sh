@@ -312,6 +312,31 @@ expect2 "count above the candidates" "$IN/features.json" -o "$TMP/x" --count 5 \
     --from-thz 0.5 --to-thz 0.53
 grep -q -- "--count 5: only 4 candidate centres from 0.5 to 0.53 THz every 10 GHz" "$TMP/err" ||
     fail "--count above the candidates not refused by name: $(cat "$TMP/err")"
+# One channel: the worst pair's B and the mean JM from bands.json's own class statistics,
+# each class's variance its pixels' spread, its nuisances' and the NETD squared (a NETD
+# of 0.5 K added unsquared, a helper's mutant, passed every test: the runs above have none)
+"$THZ" bands "$IN/features.json" -o "$TMP/one" --count 1 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 100 --netd-k 0.5 -q 2> /dev/null || fail "one channel: exit status $?"
+$PY - "$TMP/one/bands.json" <<'PYEOF' || fail "one channel's B from the class statistics"
+import itertools, json, math, sys
+d = json.load(open(sys.argv[1]))
+c = d["candidates"]["frequency_thz"].index(d["selected_thz"][0])
+def var(k):
+    return k["pixel_sd_k"][c] ** 2 + k["nuisance_sd_k"][c] ** 2 + k["netd_k"][c] ** 2
+def bhatt(a, b):
+    v1, v2 = var(a), var(b)
+    v = (v1 + v2) / 2
+    return (a["mean_tb_k"][c] - b["mean_tb_k"][c]) ** 2 / (8 * v) + 0.5 * math.log(v / math.sqrt(v1 * v2))
+assert all(k["netd_k"][c] == 0.5 for k in d["classes"]), d["classes"]
+pairs = sorted((bhatt(a, b), a["name"], b["name"]) for a, b in itertools.combinations(d["classes"], 2))
+jm = [2 * (1 - math.exp(-b)) for b, _, _ in pairs]
+ok = (math.isclose(pairs[0][0], d["bhattacharyya"], rel_tol=1e-6) and
+      sorted(d["worst_pair"]) == sorted(pairs[0][1:]) and
+      math.isclose(sum(jm) / len(jm), d["mean_jm"], rel_tol=1e-6) and
+      math.isclose(jm[0], d["score"], rel_tol=1e-6))
+print("B", pairs[0], d["bhattacharyya"], "mean JM", sum(jm) / len(jm), d["mean_jm"], file=sys.stderr)
+sys.exit(0 if ok else 1)
+PYEOF
 touch "$TMP/file"
 expect2 "OUTDIR a file" "$IN/features.json" -o "$TMP/file" --count 1
 grep -q -- "exists and is not a directory" "$TMP/err" || fail "-o FILE: $(cat "$TMP/err")"
