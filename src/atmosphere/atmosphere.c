@@ -95,19 +95,19 @@ thz_status atmosphere_check_range(const thz_atmosphere *atm, double lo_hz, doubl
                              what, lo_hz * 1e-12, hi_hz * 1e-12);
     double lo, hi;
     atmosphere_model_range_hz(atm->model, &lo, &hi);
-    if ((lo_hz < lo || hi_hz > hi) && lo_hz == hi_hz) /* one frequency: not "20 to 20 THz" */
+    if (lo_hz >= lo && hi_hz <= hi)
+        return THZ_OK;
+    if (lo_hz == hi_hz) /* one frequency: not "20 to 20 THz" */
         return thz_error_set(err, THZ_ERR_INPUT,
                              "%s: %.6g THz lies outside the range of atmosphere model '%s' "
                              "(%.6g to %.6g THz)",
                              what, lo_hz * 1e-12, atmosphere_model_name(atm->model), lo * 1e-12,
                              hi * 1e-12);
-    if (lo_hz < lo || hi_hz > hi)
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "%s: %.6g to %.6g THz leaves the range of atmosphere model '%s' "
-                             "(%.6g to %.6g THz)",
-                             what, lo_hz * 1e-12, hi_hz * 1e-12, atmosphere_model_name(atm->model),
-                             lo * 1e-12, hi * 1e-12);
-    return THZ_OK;
+    return thz_error_set(err, THZ_ERR_INPUT,
+                         "%s: %.6g to %.6g THz leaves the range of atmosphere model '%s' "
+                         "(%.6g to %.6g THz)",
+                         what, lo_hz * 1e-12, hi_hz * 1e-12, atmosphere_model_name(atm->model),
+                         lo * 1e-12, hi * 1e-12);
 }
 
 void atmosphere_alpha_parts(const thz_atmosphere *atm, double freq_hz, atm_alpha_parts *parts)

@@ -307,9 +307,8 @@ enum MHD_Result serve_pixel(serve_request *r)
     double *centres = v + NQ * SERVE_MAX_BANDS;
     size_t n[NQ];
     json_t *names = NULL;
-    /* the image's size, from its brightness temperature: a pixel outside it is the
-     * request's mistake (400, saying the size), a missing cube a 404 (one message said
-     * either, for both) */
+    /* The brightness temperature sets the image: none, a 404; a pixel outside it, the
+     * request's mistake (400, with the size). One 404 said either, for both. */
     char hdr[PATH_MAX];
     thz_error cube_err = {0};
     long rows = -1, cols = -1;
@@ -323,14 +322,15 @@ enum MHD_Result serve_pixel(serve_request *r)
             cols = (long)thz_cube_columns(c);
         }
     }
-    for (size_t i = 0; i < NQ; i++)
+    bool inside = row >= 0 && col >= 0 && row < rows && col < cols;
+    for (size_t i = 0; i < NQ && inside; i++)
         n[i] = serve_pixel_values(r->s, dir, sensor, q[i], row, col, v + i * SERVE_MAX_BANDS,
                                   SERVE_MAX_BANDS, i == 0 ? centres : NULL, i == 6 ? &names : NULL);
     pthread_mutex_unlock(&r->s->cache_lock);
-    if (!n[0]) {
+    if (!inside || !n[0]) { /* n[0]: the cube read, but no band of it (not one of ours) */
         free(v);
         json_decref(names);
-        if (rows > 0 && (row < 0 || col < 0 || row >= rows || col >= cols))
+        if (rows >= 0 && !inside)
             return serve_reply_error(r, 400,
                                      "row %ld, col %ld: outside the image of %ld x %ld pixels "
                                      "(row 0 to %ld, col 0 to %ld)",

@@ -427,18 +427,19 @@ static void test_nested_enclosures(void **state)
     "\"shape\": {\"type\": \"box\", \"size_m\": [" size ", " size ", " size                        \
     "], \"inward\": true}, "                                                                       \
     "\"transform\": {\"translate_m\": [" x ", 0, 0]}}"
-    thz_scene *s = load_ok(
-        HEAD CHANNELS MATERIALS
+#define HALL ENCLOSURE("hall", "310", "10", "0")
+#define ROOM ENCLOSURE("room", "290", "2", "0")
+#define ANNEX ENCLOSURE("annex", "300", "2", "4")
+    static const char json[] = HEAD CHANNELS MATERIALS
         "\"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.01}, "
-        "\"objects\": [" ENCLOSURE("hall", "310", "10", "0") ", " ENCLOSURE(
-            "room", "290", "2", "0") ", " ENCLOSURE("annex", "300", "2",
-                                                    "4") "], "
-                                                         "\"sensors\": [{\"name\": \"c\", "
-                                                         "\"position_m\": [0, -0.5, 0], "
-                                                         "\"look_at_m\": [0, 0.5, 0], "
-                                                         "\"fov_deg\": 40, \"resolution\": [16, "
-                                                         "8]}]}");
+        "\"objects\": [" HALL ", " ROOM ", " ANNEX "], "
+        "\"sensors\": [{\"name\": \"c\", \"position_m\": [0, -0.5, 0], "
+        "\"look_at_m\": [0, 0.5, 0], \"fov_deg\": 40, \"resolution\": [16, 8]}]}";
+#undef HALL
+#undef ROOM
+#undef ANNEX
 #undef ENCLOSURE
+    thz_scene *s = load_ok(json);
     assert_true(s->atmosphere.air.temperature_k == 290.0);
     assert_true(s->atmosphere.background_temperature_k == 290.0);
     for (size_t i = 0; i < s->n_warnings; i++)

@@ -256,15 +256,14 @@ export class Results {
       canvas.getContext("2d").clearRect(0, 0, canvas.width, canvas.height);
     }
     $("diff-info").textContent = `comparing ${a} with ${b}…`;
-    const cube = await loadCube(join(a, `${sensor}.brightness_temperature`)).catch((e) => {
+    let cube, response;
+    try {
+      cube = await loadCube(join(a, `${sensor}.brightness_temperature`));
+      response = await request(`/api/diff?a=${q(a)}&b=${q(b)}&sensor=${q(sensor)}&band=${band}`);
+    } catch (e) {
       $("diff-info").textContent = `no comparison: ${e.message}`;
       throw e;
-    });
-    const response = await request(`/api/diff?a=${q(a)}&b=${q(b)}&sensor=${q(sensor)}&band=${band}`)
-      .catch((e) => {
-        $("diff-info").textContent = `no comparison: ${e.message}`;
-        throw e;
-      });
+    }
     const z = new Float32Array(await response.arrayBuffer());
     const sigma = response.headers.get("X-Thzmap-Diff-Units") !== "K";
     let beyond = 0;
