@@ -146,10 +146,18 @@ def audit_fixes(driver, wait, patient, by_id, click_list, field, root):
                 box.send_keys(value)
         by_id("run-out").clear()
         by_id("run-out").send_keys(out)
-        before = status()
+        # every text the status line shows from the click on: a short run's "queued" may
+        # be replaced by its results' "loaded" before a poll reads it (a busy machine)
+        driver.execute_script(
+            "window.statusSeen = []; window.statusWatch?.disconnect();"
+            "const s = document.getElementById('status');"
+            "window.statusWatch = new MutationObserver(() => window.statusSeen.push(s.textContent));"
+            "window.statusWatch.observe(s, {childList: true, characterData: true, subtree: true});")
         by_id("btn-run").click()
-        patient(10).until(lambda d: status() != before and ("queued" in status() or "/api/" in status()))
-        return status()
+        said = lambda d: next((t for t in d.execute_script("return window.statusSeen")
+                               if "queued" in t or "/api/" in t), None)
+        patient(10).until(said)
+        return said(driver)
 
     def final_state(out):
         row = lambda d: d.execute_script(
