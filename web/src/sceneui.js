@@ -316,7 +316,8 @@ export class SceneEditor {
       for (const k of keys) {
         const kindOfKey = typeof o.shape?.[k] === "boolean" || ["inward", "caps"].includes(k) ? "boolean"
           : k === "file" ? "text" : "vector";
-        add({ label: `  ${k}`, path: `${p}.shape.${k}`, kind: kindOfKey, unit: UNIT(k) });
+        // "radius (m)", not "radius_m (m)": the unit once, as the other fields give it
+        add({ label: `  ${UNIT(k) ? k.replace(/_(m|deg|k)$/, "") : k}`, path: `${p}.shape.${k}`, kind: kindOfKey, unit: UNIT(k) });
       }
       add({ label: "translate", path: `${p}.transform.translate_m`, kind: "vector", unit: "m", placeholder: "0, 0, 0" });
       add({ label: "rotate", path: `${p}.transform.rotate_deg`, kind: "vector", unit: "°", placeholder: "0, 0, 0" });
