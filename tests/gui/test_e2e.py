@@ -69,6 +69,11 @@ def make_root(root):
     # text that is no JSON at all: opened after a scene, it showed that scene's panels
     with open(os.path.join(root, "teraeye", "not-json.json"), "w") as f:
         f.write("not json\n")
+    # a bands run's directory (no images): plates whose emissivity peaks at 0.4 and 0.8 THz
+    subprocess.run([THZMAP, "bands", os.path.join(REPO, "tests", "inputs", "analysis", "features.json"),
+                    "-o", os.path.join(root, "teraeye", "out-bands-cli"), "--count", "2",
+                    "--from-thz", "0.3", "--to-thz", "0.9", "--step-ghz", "100", "--paths", "4", "-q"],
+                   check=True)
     return scene
 
 
@@ -230,6 +235,44 @@ def audit_fixes(driver, wait, patient, by_id, click_list, field, root):
               and "/api/runs - Failed to load resource" not in e["message"]
               and "(at $.options.count)" not in e["message"]]
     assert not errors, errors
+
+
+def bands_results(driver, wait, by_id, click_list, root, shot):
+    """A bands run's directory opens in Results as its chosen channels, the best set of
+    each size with its score, and its figures (it said "no images here"); an image run
+    opened after it hides them again."""
+    by_id("tab-results").click()
+    driver.execute_script("window.thzmap.results.browse('teraeye')")
+    click_list("outputs", "out-bands-cli/")
+    wait.until(lambda d: by_id("bands-pane").is_displayed())
+    doc = json.load(open(os.path.join(root, "teraeye", "out-bands-cli", "bands.json")))
+    assert doc["selected_thz"] == [0.4, 0.8], doc["selected_thz"]
+    summary = by_id("bands-summary").text
+    assert "chosen 0.4, 0.8 THz (relative width 1 %, 1 %)" in summary, summary
+    assert f"({' vs '.join(doc['worst_pair'])})" in summary, summary
+    rows = driver.execute_script(
+        "return [...document.querySelectorAll('#bands-table tbody tr')].map((r) =>"
+        " [...r.cells].map((c) => c.textContent));")
+    assert [r[0] for r in rows] == ["1", "2"], rows
+    for row, k in zip(rows, doc["per_k"]):
+        assert row[1] == ", ".join("%g" % v for v in k["selected_thz"]), (row, k)
+        assert abs(float(row[3]) - k["score"]) <= 5e-4 * max(1.0, k["score"]), (row, k)
+        assert row[4] == " vs ".join(k["worst_pair"]), (row, k)
+    figures = lambda d: d.execute_script(
+        "return [...document.querySelectorAll('#bands-figures img')].map((i) =>"
+        " [i.alt, i.complete && i.naturalWidth > 0]);")
+    wait.until(lambda d: all(ok for _, ok in figures(d)))
+    assert [name for name, _ in figures(driver)] == ["bands-score.png", "bands-spectra.png"], figures(driver)
+    # the image's controls and the pixel column of the run opened before: hidden
+    assert not by_id("image-pane").is_displayed() and not by_id("res-sensor").is_displayed()
+    assert not by_id("pixel-info").is_displayed()
+    shot("bands")
+    log(f"bands run: {summary[:70]!r}, {len(rows)} sets, figures shown")
+    click_list("outputs", "..")
+    click_list("outputs", "out-seed1/")
+    wait.until(lambda d: "loaded" in by_id("status").text and "out-seed1" in by_id("status").text)
+    assert not by_id("bands-pane").is_displayed() and by_id("image-pane").is_displayed()
+    assert by_id("res-sensor").is_displayed() and by_id("pixel-info").is_displayed()
 
 
 def unsaved_edits(driver, wait, by_id, click_list, field):
@@ -481,6 +524,7 @@ def main():
         assert made and all("no-such-run" in e["message"] or "At most" in e["message"]
                             for e in made), made  # those two failures, nothing else
         audit_fixes(driver, wait, patient, by_id, click_list, field, root)
+        bands_results(driver, wait, by_id, click_list, root, shot)
         unsaved_edits(driver, wait, by_id, click_list, field)
         # the server stopped: the page says so (it said "Failed to fetch", and its
         # validation box stayed at "validating…")

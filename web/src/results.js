@@ -6,6 +6,7 @@ import { forget, loadCube, range } from "./envi.js";
 import { cssColour, diverging, drawColourBar, formatNumber, planckDerivative, viridis } from "./colour.js";
 import { linePlot } from "./plots.js";
 import { PhotonView } from "./photons.js";
+import { showBands } from "./bands.js";
 
 const $ = (id) => document.getElementById(id);
 const QUANTITIES = ["brightness_temperature", "measured_brightness_temperature", "temperature",
@@ -31,6 +32,8 @@ export class Results {
   }
 
   setView(view) {
+    $("bands-pane").hidden = true; // shown by open() alone, for a bands run's directory
+    $("view-results").classList.remove("bands");
     $("image-pane").hidden = view !== "image";
     $("photon-pane").hidden = view !== "photons";
     $("diff-pane").hidden = view !== "diff";
@@ -65,8 +68,9 @@ export class Results {
     // since (the cache is by path alone)
     forget(`${dir.replace(/\/+$/, "")}/`);
     if (this.playing) this.play(); // a batch's frames played: stopped (Play toggles)
-    const [, outputs] = await Promise.all([this.browse(dir), getJSON(`/api/outputs?dir=${q(dir)}`)]);
+    const [entries, outputs] = await Promise.all([this.browse(dir), getJSON(`/api/outputs?dir=${q(dir)}`)]);
     if (seq !== this.openSeq) return; // another directory was asked for meanwhile
+    this.setView($("res-view").value); // a bands run's pane, shown before, hidden
     this.frames = outputs.frames.map((f) => join(dir, f));
     $("frames").hidden = this.frames.length === 0;
     if (this.frames.length) {
@@ -75,7 +79,16 @@ export class Results {
       return this.openFrame(0);
     }
     if (imageSensors(outputs).length) return this.openRun(dir, outputs);
-    status(`${dir}: no images here`);
+    const names = entries.filter((e) => e.type === "file").map((e) => e.name);
+    if (names.includes("bands.json")) {
+      const doc = await getJSON(`/api/file?path=${q(join(dir, "bands.json"))}`);
+      if (seq !== this.openSeq) return;
+      for (const pane of ["image-pane", "photon-pane", "diff-pane"]) $(pane).hidden = true;
+      showBands(dir, doc, names);
+      status(`${dir}: a bands run, ${doc.count} channel${doc.count === 1 ? "" : "s"} chosen`);
+      return;
+    }
+    status(`${dir}: no images or bands.json here`);
   }
 
   cubesOf(sensor) {
