@@ -286,7 +286,10 @@ THZ_API thz_status thz_run_write(thz_context *ctx, thz_run *run, const char *out
 /* An atomic result directory (docs/reliability.md): files go into a staging directory
  * beside `outdir`, which holds outdir's lock (a second output into it fails with
  * THZ_ERR_IO), and become outdir's results on thz_output_commit, all or nothing;
- * destroying an uncommitted output removes them. Open it before a long run to fail
+ * destroying an uncommitted output removes them. Outdir's other files stay, but for an
+ * earlier run's files of the sensors added (thz_output_add_run, _add_image) and, when a
+ * simulation is added, its photon map: those this output does not write are removed, so
+ * that what outdir holds of a sensor is one run's. Open it before a long run to fail
  * early on a bad or busy outdir. */
 THZ_API thz_status thz_output_open(const char *outdir, thz_output **out, thz_error *err);
 THZ_API thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run,

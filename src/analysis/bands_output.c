@@ -184,6 +184,13 @@ static thz_status join(char *path, const char *dir, const char *name, thz_error 
     return thz_path_join(path, THZ_PATH_MAX, dir, name, err);
 }
 
+enum { BANDS_JSON, BANDS_SCORE_PNG, BANDS_SPECTRA_PNG, BANDS_AIR_PNG };
+const char *const bands_output_files[BANDS_OUTPUT_FILES] = {[BANDS_JSON] = "bands.json",
+                                                            [BANDS_SCORE_PNG] = "bands-score.png",
+                                                            [BANDS_SPECTRA_PNG] =
+                                                                "bands-spectra.png",
+                                                            [BANDS_AIR_PNG] = "bands-air.png"};
+
 thz_status bands_write_files(const char *dir, const bands_report *rep, const char *json_text,
                              thz_error *err)
 {
@@ -194,7 +201,7 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
     char path[THZ_PATH_MAX], title[1024];
     thz_status st = plot_check_device(err);
     if (st == THZ_OK)
-        st = join(path, dir, "bands.json", err);
+        st = join(path, dir, bands_output_files[BANDS_JSON], err);
     if (st != THZ_OK)
         return st;
     FILE *f = fopen(path, "w");
@@ -226,7 +233,7 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
     }
     const char *score_name[] = {"worst pair"};
     snprintf(title, sizeof title, "%s: best set of K channels (%s)", rep->scene_name, r->search);
-    st = join(path, dir, "bands-score.png", err);
+    st = join(path, dir, bands_output_files[BANDS_SCORE_PNG], err);
     if (st == THZ_OK)
         st = plot_lines_whole_x(path, K, x, 1, score_name, y, title, "channels K",
                                 "Jeffries-Matusita distance (0..2)", err);
@@ -255,7 +262,7 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
             bands_title_add(title, sizeof title, &used, " THz");
     }
     if (st == THZ_OK)
-        st = join(path, dir, "bands-spectra.png", err);
+        st = join(path, dir, bands_output_files[BANDS_SPECTRA_PNG], err);
     if (st == THZ_OK)
         st = plot_lines(path, nx, fx, v->n_classes, (const char *const *)v->class_names, my, title,
                         nw > 1 ? "frequency (THz), at the narrowest width" : "frequency (THz)",
@@ -270,7 +277,7 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
         plot_curve curve = {.name = "air", .y = air, .rgb = {31, 119, 180}, .width = 2.0};
         snprintf(title, sizeof title, "%s: the air's attenuation and the chosen channels",
                  rep->scene_name);
-        st = join(path, dir, "bands-air.png", err);
+        st = join(path, dir, bands_output_files[BANDS_AIR_PNG], err);
         if (st == THZ_OK)
             st = plot_attenuation(path, nx, fx, 1, &curve, K, bands, title, "frequency (THz)",
                                   "attenuation (dB/km)", err);

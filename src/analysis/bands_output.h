@@ -27,6 +27,11 @@ typedef struct bands_report {
 /* bands.json's text (malloc'd), NULL with err set when out of memory. */
 char *bands_json(const bands_report *rep, thz_error *err);
 
+/* Every file bands_write_files may write (some only for some scenes): an output
+ * directory's claims (io/output.h output_stage_claim). */
+#define BANDS_OUTPUT_FILES 4
+extern const char *const bands_output_files[BANDS_OUTPUT_FILES];
+
 /* Writes bands.json (json_text) and the figures into dir. */
 thz_status bands_write_files(const char *dir, const bands_report *rep, const char *json_text,
                              thz_error *err);

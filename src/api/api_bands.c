@@ -495,8 +495,12 @@ thz_status thz_bands_write(const thz_bands *b, const char *outdir, thz_error *er
     thz_status st = output_stage_create(outdir, &stage, err);
     if (st != THZ_OK)
         return st;
+    /* an earlier run's bands-air.png does not stay beside a scene whose air is clear */
+    for (size_t i = 0; i < BANDS_OUTPUT_FILES && st == THZ_OK; i++)
+        st = output_stage_claim(stage, bands_output_files[i], err);
     bands_report rep = make_report(b);
-    st = bands_write_files(output_stage_dir(stage), &rep, b->json, err);
+    if (st == THZ_OK)
+        st = bands_write_files(output_stage_dir(stage), &rep, b->json, err);
     if (st != THZ_OK)
         output_stage_error_names_outdir(stage, err);
     if (st == THZ_OK)

@@ -92,7 +92,18 @@ thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run
                                       "the run kept no photon maps to write (keep_photons, and "
                                       "an integrator that fires photons)"),
                         err);
-    st = run_write(&run->rs, output_stage_dir(output->stage), &wo, err);
+    /* What OUTDIR holds of the run's sensors is this run's (an earlier run's measured
+     * cubes do not stay beside a sensor without noise), and a simulation's photon map:
+     * an earlier one does not stay beside it (a render's stays: it may be its input). */
+    for (size_t i = 0; i < run->rs.n_selected && st == THZ_OK; i++)
+        st = output_stage_claim_sensor(output->stage,
+                                       run->rs.scene->sensors[run->rs.selected[i]].name, err);
+    if (st == THZ_OK && !strcmp(run->rs.command, "simulate"))
+        st = output_stage_claim(output->stage, RUN_PHOTON_MAP_FILE, err);
+    if (st == THZ_OK && !strcmp(run->rs.command, "simulate"))
+        st = output_stage_claim(output->stage, RUN_PHOTON_PLY_FILE, err);
+    if (st == THZ_OK)
+        st = run_write(&run->rs, output_stage_dir(output->stage), &wo, err);
     if (st != THZ_OK)
         output_stage_error_names_outdir(output->stage, err);
     return api_done(ctx, st, err);
@@ -105,8 +116,10 @@ thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_
     thz_status st = api_output_check(output, "thz_output_add_image", err);
     if (st != THZ_OK)
         return st;
-    st = output_write_sensor(output_stage_dir(output->stage), image->scene, image->sensor,
-                             image->img, 0, NULL, err);
+    st = output_stage_claim_sensor(output->stage, image->scene->sensors[image->sensor].name, err);
+    if (st == THZ_OK)
+        st = output_write_sensor(output_stage_dir(output->stage), image->scene, image->sensor,
+                                 image->img, 0, NULL, err);
     if (st != THZ_OK)
         output_stage_error_names_outdir(output->stage, err);
     return st;

@@ -36,8 +36,19 @@ const char *output_stage_dir(const output_stage *stage);
  * Any other message is left as it is. */
 void output_stage_error_names_outdir(const output_stage *stage, thz_error *err);
 
-/* Makes the staged files OUTDIR's results (replacing files of the same name, keeping
- * the others) and removes the staging directory. All or nothing: on failure (e.g.
+/* Claims for this run the names of OUTDIR's files that it may write: the commit keeps
+ * no earlier run's file of a claimed name that this run did not write (a sensor's
+ * measured cubes once its noise is gone, the figures of channels it no longer has,
+ * bands-air.png of a scene whose air attenuated), so that what OUTDIR holds under a
+ * claimed name is this run's alone. output_stage_claim: one file name;
+ * output_stage_claim_sensor: every name the files of sensor `sensor` may have
+ * (output_sensor_file). OUTDIR's other files stay. THZ_ERR_NOMEM only. */
+thz_status output_stage_claim(output_stage *stage, const char *name, thz_error *err);
+thz_status output_stage_claim_sensor(output_stage *stage, const char *sensor, thz_error *err);
+
+/* Makes the staged files OUTDIR's results (replacing files of the same name, removing
+ * the claimed ones the run did not write, keeping the others) and removes the staging
+ * directory. All or nothing: on failure (e.g.
  * OUTDIR holds a directory where the run writes a file) OUTDIR keeps exactly the
  * previous results, and the error says so. */
 thz_status output_stage_commit(output_stage *stage, thz_error *err);
@@ -52,6 +63,10 @@ void output_stage_destroy(output_stage *stage);
  * fit in size bytes. */
 bool output_file_name(char *buf, size_t size, const char *sensor, const char *quantity,
                       const char *ext);
+
+/* Whether `name` is a name output_write_sensor may give a file of the sensor whose file
+ * names begin with `stem` ("S.": output_file_name of quantity "" and no extension). */
+bool output_sensor_file(const char *stem, const char *name);
 
 /* Writes every file of sensor `sensor` into dir: the ENVI images S.radiance,
  * S.power, S.brightness_temperature, S.normalized (and S.radiance_stderr when

@@ -4,20 +4,23 @@
  * STAGE_SWAP, the usual case: OUTDIR may hold files this run does not write (other
  * sensors of an earlier run, a user's notes) and directories (another run's OUTDIR).
  *   1. Each regular file of OUTDIR that the stage lacks is hard-linked into the stage,
- *      so the new OUTDIR carries it from the first instant.
+ *      so the new OUTDIR carries it from the first instant; but not a file of a name the
+ *      run claims (output_stage_claim): an earlier run's, which this one replaces.
  *   2. renameat2(RENAME_EXCHANGE) swaps the stage and OUTDIR in one step: OUTDIR is now
  *      the new run, whole, and the stage's name holds the old one. (Where the file system
  *      cannot exchange, OUTDIR is renamed aside and the stage renamed in: for an instant
  *      OUTDIR is missing, and a run killed then is put back by the next run.)
  *   3. What OUTDIR held that is not a regular file (directories, links), or that could
- *      not be linked, is renamed back into the new OUTDIR; the old run is removed.
+ *      not be linked (and is not claimed), is renamed back into the new OUTDIR; the old
+ *      run is removed.
  * A kill at any instant leaves OUTDIR the old run or the new one, each whole; what
  * step 3 had not moved back yet is moved back by the next run into that OUTDIR.
  *
  * STAGE_FILES: moves the files it will replace aside (STAGE/.thzmap-replaced/), renames
  * the new ones in, and on any failure renames the old ones back: all or nothing on
  * failure, a mix after a crash in the middle (the next run puts the old ones back where
- * the new ones are missing).
+ * the new ones are missing). Once all are in, the claimed files it did not write are
+ * removed.
  */
 #define _GNU_SOURCE /* renameat2, RENAME_EXCHANGE */
 #include "io/output_stage_internal.h"
@@ -170,7 +173,7 @@ static thz_status stage_carry_files(const struct output_stage *stage, thz_error 
                                        "%s: is a directory, where this run writes a file of its "
                                        "name; nothing committed, the previous results stay",
                                        old);
-        } else if (S_ISREG(so.st_mode)) {
+        } else if (S_ISREG(so.st_mode) && !stage_claimed(stage, names[i])) {
             link(old, staged); /* on failure: moved after the swap */
         }
     }
@@ -181,10 +184,11 @@ static thz_status stage_carry_files(const struct output_stage *stage, thz_error 
 /* Step 3 of STAGE_SWAP: `old` holds the previous OUTDIR. Its entries without a namesake
  * in `into` are the user's that step 1 could not link across (a file system without
  * hard links, a file another user owns under fs.protected_hardlinks), a link or a
- * directory: moved into `into`. Those with one (replaced by this run's file, or linked
- * across) are removed, then `old` if empty. Nothing is removed that has not been found a
+ * directory: moved into `into`; or regular files the run claims, which it did not
+ * write: removed. Those with one (replaced by this run's file, or linked across) are
+ * removed, then `old` if empty. Nothing else is removed that has not been found a
  * namesake: where the listing or a move fails, the entry stays in `old`. */
-static void stage_return_old(const char *old, const char *into)
+static void stage_return_old(const struct output_stage *stage, const char *old, const char *into)
 {
     char **names = NULL;
     size_t n = 0;
@@ -197,7 +201,11 @@ static void stage_return_old(const char *old, const char *into)
             thz_path_join(to, sizeof to, into, names[i], NULL) != THZ_OK || lstat(from, &sf) != 0)
             continue;
         if (lstat(to, &st) != 0) {
-            if (errno == ENOENT)
+            if (errno != ENOENT)
+                continue;
+            if (S_ISREG(sf.st_mode) && stage_claimed(stage, names[i]))
+                unlink(from);
+            else
                 rename(from, to);
         } else if (!S_ISDIR(sf.st_mode)) {
             unlink(from);
@@ -256,10 +264,10 @@ thz_status stage_commit_swap(struct output_stage *stage, thz_error *err)
                                  "committed, the previous results stay",
                                  stage->outdir, strerror(e));
         }
-        stage_return_old(parked, stage->target);
+        stage_return_old(stage, parked, stage->target);
         return THZ_OK;
     }
-    stage_return_old(stage->dir, stage->target); /* the stage's name now holds the old run */
+    stage_return_old(stage, stage->dir, stage->target); /* the stage's name now holds the old run */
     return THZ_OK;
 }
 
@@ -296,6 +304,25 @@ static bool stage_roll_back(const struct output_stage *stage, const char *aside,
             unlink(target);
     }
     return ok;
+}
+
+/* The last step of STAGE_FILES: removes OUTDIR's regular files that the run claims and
+ * did not write (not among the n sorted names it placed). A listing that fails leaves
+ * them: the results are in place already. */
+static void stage_drop_claimed(const struct output_stage *stage, char **placed, size_t n)
+{
+    char **names = NULL;
+    size_t n_names = 0;
+    if (!stage->n_claims || stage_list(stage->target, true, &names, &n_names, NULL) != THZ_OK)
+        return;
+    for (size_t i = 0; i < n_names; i++) {
+        char path[THZ_PATH_MAX];
+        if (stage_claimed(stage, names[i]) &&
+            !(n && bsearch(&names[i], placed, n, sizeof *placed, stage_name_cmp)) &&
+            thz_path_join(path, sizeof path, stage->target, names[i], NULL) == THZ_OK)
+            unlink(path);
+    }
+    stage_free_names(names, n_names);
 }
 
 thz_status stage_commit_files(struct output_stage *stage, thz_error *err)
@@ -360,6 +387,7 @@ thz_status stage_commit_files(struct output_stage *stage, thz_error *err)
         if (had_old[i] &&
             stage_paths(stage, aside, names[i], staged, target, moved, NULL) == THZ_OK)
             unlink(moved);
+    stage_drop_claimed(stage, names, n);
     rmdir(aside);
     made_aside = false;
     if (rmdir(stage->dir) != 0)

@@ -34,6 +34,49 @@ bool output_file_name(char *buf, size_t size, const char *sensor, const char *qu
     return true;
 }
 
+/* The quantities of a sensor's ENVI files (each .hdr and .img), as output_write_sensor
+ * names them. */
+static const char *const out_cube_names[] = {"radiance",
+                                             "radiance_stderr",
+                                             "power",
+                                             "brightness_temperature",
+                                             "normalized",
+                                             "temperature",
+                                             "distance",
+                                             "object_id",
+                                             "measured_radiance",
+                                             "measured_brightness_temperature"};
+
+/* "<prefix><digits>.png" */
+static bool out_numbered_png(const char *s, const char *prefix)
+{
+    size_t n = strlen(prefix);
+    if (strncmp(s, prefix, n) != 0)
+        return false;
+    s += n;
+    size_t digits = strspn(s, "0123456789");
+    return digits > 0 && !strcmp(s + digits, ".png");
+}
+
+bool output_sensor_file(const char *stem, const char *name)
+{
+    size_t n = strlen(stem);
+    if (strncmp(name, stem, n) != 0)
+        return false;
+    const char *q = name + n;
+    if (!strcmp(q, "visual.png") || !strcmp(q, "spectra.png") || out_numbered_png(q, "band-") ||
+        out_numbered_png(q, "measured-band-"))
+        return true;
+    const char *dot = strrchr(q, '.');
+    if (!dot || (strcmp(dot, ".hdr") != 0 && strcmp(dot, ".img") != 0))
+        return false;
+    for (size_t i = 0; i < sizeof out_cube_names / sizeof *out_cube_names; i++)
+        if (strlen(out_cube_names[i]) == (size_t)(dot - q) &&
+            !strncmp(q, out_cube_names[i], (size_t)(dot - q)))
+            return true;
+    return false;
+}
+
 static thz_status out_file_name(char *buf, size_t size, const char *sensor, const char *quantity,
                                 const char *ext, thz_error *err)
 {

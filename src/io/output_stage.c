@@ -428,6 +428,42 @@ void output_stage_error_names_outdir(const output_stage *stage, thz_error *err)
     memcpy(err->message, message, sizeof message);
 }
 
+static thz_status stage_add_claim(output_stage *stage, const char *name, bool sensor,
+                                  thz_error *err)
+{
+    stage_claim *grown = thz_realloc_array(stage->claims, stage->n_claims + 1, sizeof *grown);
+    if (!grown)
+        return stage_nomem(stage->outdir, err);
+    stage->claims = grown;
+    if (!(grown[stage->n_claims].name = thz_strdup(name)))
+        return stage_nomem(stage->outdir, err);
+    grown[stage->n_claims++].sensor = sensor;
+    return THZ_OK;
+}
+
+thz_status output_stage_claim(output_stage *stage, const char *name, thz_error *err)
+{
+    return stage_add_claim(stage, name, false, err);
+}
+
+thz_status output_stage_claim_sensor(output_stage *stage, const char *sensor, thz_error *err)
+{
+    char stem[THZ_PATH_MAX];
+    if (!output_file_name(stem, sizeof stem, sensor, "", ""))
+        return thz_error_set(err, THZ_ERR_INPUT, "sensor %.64s...: file name too long", sensor);
+    return stage_add_claim(stage, stem, true, err);
+}
+
+bool stage_claimed(const struct output_stage *stage, const char *name)
+{
+    for (size_t i = 0; i < stage->n_claims; i++) {
+        const stage_claim *c = &stage->claims[i];
+        if (c->sensor ? output_sensor_file(c->name, name) : !strcmp(c->name, name))
+            return true;
+    }
+    return false;
+}
+
 thz_status output_stage_commit(output_stage *stage, thz_error *err)
 {
     thz_status status =
@@ -474,5 +510,8 @@ void output_stage_destroy(output_stage *stage)
     free(stage->dir);
     free(stage->lock_path);
     free(stage->created_root);
+    for (size_t i = 0; i < stage->n_claims; i++)
+        free(stage->claims[i].name);
+    free(stage->claims);
     free(stage);
 }

@@ -18,6 +18,12 @@
  *                file, all or nothing on failure but not across a crash. */
 typedef enum stage_mode { STAGE_SWAP = 0, STAGE_FILES } stage_mode;
 
+/* A name the run claims (output_stage_claim): one file's, or every file's of a sensor. */
+typedef struct stage_claim {
+    char *name; /* the file name, or the sensor's stem "S." */
+    bool sensor;
+} stage_claim;
+
 struct output_stage {
     char *outdir;       /* as given, for messages */
     char *target;       /* OUTDIR without trailing '/', or its real path for "." and ".." */
@@ -29,7 +35,12 @@ struct output_stage {
     char *created_root; /* the topmost directory the stage created, or NULL */
     stage_mode mode;
     bool committed;
+    stage_claim *claims;
+    size_t n_claims;
 };
+
+/* Whether OUTDIR's file `name` is claimed by this run: not kept unless the run wrote it. */
+bool stage_claimed(const struct output_stage *stage, const char *name);
 
 /* The commit of either mode (output_commit.c). */
 thz_status stage_commit_swap(struct output_stage *stage, thz_error *err);

@@ -219,6 +219,10 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
 thz_status run_render(const thz_scene *scene, const run_options *opt, const run_photons *in,
                       run_state *rs, thz_error *err);
 
+/* The photon map's files in an output directory (run_write_options.photon_map). */
+#define RUN_PHOTON_MAP_FILE "photon-map.thzpm"
+#define RUN_PHOTON_PLY_FILE "photon-map.ply"
+
 /* What run_write adds to the files of every sensor and summary.json. */
 typedef struct run_write_options {
     bool photon_map;          /* photon-map.thzpm and photon-map.ply (needs kept maps) */

@@ -56,12 +56,12 @@ static thz_status run_save_photon_map(const run_state *rs, const char *dir, uint
                                       thz_error *err)
 {
     char path[THZ_PATH_MAX];
-    thz_status st = thz_path_join(path, sizeof path, dir, "photon-map.thzpm", err);
+    thz_status st = thz_path_join(path, sizeof path, dir, RUN_PHOTON_MAP_FILE, err);
     const photon_map *const *maps = (const photon_map *const *)rs->maps;
     if (st == THZ_OK)
         st = photon_map_file_write(path, rs->scene, maps, rs->stats, rs->opt->threads, err);
     if (st == THZ_OK)
-        st = thz_path_join(path, sizeof path, dir, "photon-map.ply", err);
+        st = thz_path_join(path, sizeof path, dir, RUN_PHOTON_PLY_FILE, err);
     if (st != THZ_OK)
         return st;
     uint64_t cap = ply_max_points ? ply_max_points : PLY_DEFAULT_MAX_POINTS;
