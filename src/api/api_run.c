@@ -6,6 +6,7 @@
 
 #include "api/api.h"
 #include "core/alloc.h"
+#include "io/output.h"
 #include "io/photon_map_file.h"
 #include "run/run_pack.h"
 
@@ -130,18 +131,7 @@ const float *thz_image_plane(const thz_image *image, thz_plane plane, size_t *n_
 
 const char *thz_plane_name(thz_plane plane)
 {
-    static const char *const names[THZ_PLANE_COUNT] = {"radiance",
-                                                       "radiance_stderr",
-                                                       "power",
-                                                       "brightness_temperature",
-                                                       "normalized",
-                                                       "temperature",
-                                                       "distance",
-                                                       "object_id",
-                                                       "visual",
-                                                       "measured_radiance",
-                                                       "measured_brightness_temperature"};
-    return (unsigned)plane < THZ_PLANE_COUNT ? names[plane] : NULL;
+    return output_plane_name(plane);
 }
 
 /* ---- runs ----------------------------------------------------------------------------- */

@@ -19,6 +19,7 @@
 #include "run/run_noise.h"
 #include "scene/scene.h"
 #include "sensor/images.h"
+#include "thzmap/run.h"
 
 typedef struct output_stage output_stage;
 
@@ -63,6 +64,10 @@ void output_stage_destroy(output_stage *stage);
  * fit in size bytes. */
 bool output_file_name(char *buf, size_t size, const char *sensor, const char *quantity,
                       const char *ext);
+
+/* The quantity of a plane in its files' names ("S.<quantity>.hdr"; the visual plane's
+ * file is S.visual.png): thz_plane_name's answer. NULL for no plane. */
+const char *output_plane_name(thz_plane plane);
 
 /* Whether `name` is a name output_write_sensor may give a file of the sensor whose file
  * names begin with `stem` ("S.": output_file_name of quantity "" and no extension). */

@@ -34,18 +34,22 @@ bool output_file_name(char *buf, size_t size, const char *sensor, const char *qu
     return true;
 }
 
-/* The quantities of a sensor's ENVI files (each .hdr and .img), as output_write_sensor
- * names them. */
-static const char *const out_cube_names[] = {"radiance",
-                                             "radiance_stderr",
-                                             "power",
-                                             "brightness_temperature",
-                                             "normalized",
-                                             "temperature",
-                                             "distance",
-                                             "object_id",
-                                             "measured_radiance",
-                                             "measured_brightness_temperature"};
+const char *output_plane_name(thz_plane plane)
+{
+    static const char *const names[THZ_PLANE_COUNT] = {
+        [THZ_PLANE_RADIANCE] = "radiance",
+        [THZ_PLANE_RADIANCE_STDERR] = "radiance_stderr",
+        [THZ_PLANE_POWER] = "power",
+        [THZ_PLANE_BRIGHTNESS_TEMPERATURE] = "brightness_temperature",
+        [THZ_PLANE_NORMALIZED] = "normalized",
+        [THZ_PLANE_TEMPERATURE] = "temperature",
+        [THZ_PLANE_DISTANCE] = "distance",
+        [THZ_PLANE_OBJECT_ID] = "object_id",
+        [THZ_PLANE_VISUAL_RGB] = "visual",
+        [THZ_PLANE_MEASURED_RADIANCE] = "measured_radiance",
+        [THZ_PLANE_MEASURED_BRIGHTNESS_TEMPERATURE] = "measured_brightness_temperature"};
+    return (unsigned)plane < THZ_PLANE_COUNT ? names[plane] : NULL;
+}
 
 /* "<prefix><digits>.png" */
 static bool out_numbered_png(const char *s, const char *prefix)
@@ -70,10 +74,12 @@ bool output_sensor_file(const char *stem, const char *name)
     const char *dot = strrchr(q, '.');
     if (!dot || (strcmp(dot, ".hdr") != 0 && strcmp(dot, ".img") != 0))
         return false;
-    for (size_t i = 0; i < sizeof out_cube_names / sizeof *out_cube_names; i++)
-        if (strlen(out_cube_names[i]) == (size_t)(dot - q) &&
-            !strncmp(q, out_cube_names[i], (size_t)(dot - q)))
+    for (int p = 0; p < THZ_PLANE_COUNT; p++) { /* S.visual is a PNG, not a cube */
+        const char *cube = output_plane_name((thz_plane)p);
+        if (p != THZ_PLANE_VISUAL_RGB && strlen(cube) == (size_t)(dot - q) &&
+            !strncmp(q, cube, (size_t)(dot - q)))
             return true;
+    }
     return false;
 }
 
