@@ -128,6 +128,22 @@ enum MHD_Result serve_outputs(serve_request *r)
         }
     }
     serve_names_free(names, n);
+    /* a batch's frames are those its batch.json lists: a shorter sequence run into the
+     * directory leaves the longer one's last frames standing (scene-format.md) */
+    snprintf(path, sizeof path, "%s/batch.json", dir);
+    json_t *batch = serve_read_json(path), *listed = json_object_get(batch, "frames");
+    if (json_is_array(listed)) {
+        json_array_clear(frames);
+        size_t i;
+        json_t *f;
+        json_array_foreach(listed, i, f)
+        {
+            const char *d = json_string_value(json_object_get(f, "dir"));
+            if (d && serve_is_dir(dir, d))
+                json_array_append_new(frames, json_string(d));
+        }
+    }
+    json_decref(batch);
     const char *rel = serve_arg(r, "dir");
     json_t *pm = json_null();
     if (photon_map)

@@ -460,6 +460,18 @@ def test_runs(srv, root):
     check(job and job["state"] == "done" and job["progress"] == 1.0, "batch: %r" % job)
     res = srv.json("GET", "/api/outputs?dir=out/batch")
     check(res and res["frames"] == ["frame-00000", "frame-00001"], "batch frames: %r" % res)
+    # the sequence made one frame shorter, run into the same directory: frame-00001 stays
+    # on disk (scene-format.md), but the batch's frames are the one its batch.json lists
+    with open(os.path.join(root, "s", "seq1.json"), "w") as f:
+        json.dump({"format": "thzmap-sequence/1", "scene": "scene.json", "frames": 1}, f)
+    shorter = srv.json("POST", "/api/runs", body={
+        "command": "batch", "scene": "s/seq1.json", "out": "out/batch",
+        "options": {"no_movies": True}}, status=202)
+    job = wait_state(srv, shorter["id"], ("done", "failed"))
+    check(job and job["state"] == "done", "shorter batch: %r" % job)
+    res = srv.json("GET", "/api/outputs?dir=out/batch")
+    check(os.path.isdir(os.path.join(root, "out", "batch", "frame-00001")) and res
+          and res["frames"] == ["frame-00000"], "a shorter batch's frames: %r" % res)
     job = wait_state(srv, bands["id"], ("done", "failed"))
     check(job and job["state"] == "done", "bands: %r" % job)
     chosen = json.load(open(os.path.join(root, "out", "bands", "bands.json")))["selected_thz"]
