@@ -11,6 +11,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <plplot/plplot.h>
@@ -102,18 +104,45 @@ thz_status plot_begin(const char *path, int width, int height, thz_error *err)
     return THZ_OK;
 }
 
+/* Why a figure's file stopped short, as far as can be told after the fact: PLplot's
+ * cairo driver ignores a failed write, so its errno is gone. */
+static const char *plot_short_reason(const char *path, long size)
+{
+    struct rlimit lim;
+    if (getrlimit(RLIMIT_FSIZE, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY && size >= 0 &&
+        (rlim_t)size >= lim.rlim_cur)
+        return strerror(EFBIG);
+    struct statvfs fs;
+    if (statvfs(path, &fs) == 0 && fs.f_bavail == 0)
+        return strerror(ENOSPC);
+    return "a write failed";
+}
+
 thz_status plot_end(const char *path, thz_error *err)
 {
     plend();
+    /* A PNG ends with its IEND chunk. A write that fails part-way (a full disk, a
+     * file-size limit) leaves a file cut short, which PLplot does not report: without
+     * this check a truncated figure was kept as a result (exit status 0). */
+    static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82};
+    unsigned char tail[sizeof iend];
     FILE *f = fopen(path, "rb");
     long size = -1;
+    int whole = 0;
     if (f) {
         if (fseek(f, 0, SEEK_END) == 0)
             size = ftell(f);
+        whole = size >= (long)sizeof iend && fseek(f, -(long)sizeof iend, SEEK_END) == 0 &&
+                fread(tail, 1, sizeof tail, f) == sizeof tail &&
+                memcmp(tail, iend, sizeof iend) == 0;
         fclose(f);
     }
     if (size <= 0)
-        return thz_error_set(err, THZ_ERR_IO, "%s: PLplot wrote no figure", path);
+        return thz_error_set(err, THZ_ERR_IO, "%s: PLplot wrote no figure: %s", path,
+                             plot_short_reason(path, size));
+    if (!whole)
+        return thz_error_set(err, THZ_ERR_IO, "%s: PLplot wrote an incomplete figure: %s", path,
+                             plot_short_reason(path, size));
     return THZ_OK;
 }
 

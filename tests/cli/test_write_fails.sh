@@ -51,6 +51,16 @@ check "simulate over a run" $? "$work/err2" "$work"
 [ "$(ls "$work/old" | wc -l)" -eq "$(wc -l < "$work/old.sums")" ] ||
     fail "simulate: files added to the earlier run's OUTDIR"
 
+# a figure cut short: with files limited to 24 KB every image (16 KB a plane) and header
+# is written whole, and only a preview (about 37 KB) passes the limit. PLplot ignores the
+# failed write; the run kept the truncated PNG (no IEND chunk) and ended with status 0.
+(trap '' XFSZ; ulimit -f 24; exec "$THZMAP" simulate "$work/scene.json" -o "$work/fig" -q $PM) \
+    2>"$work/err5"
+check "simulate, a figure cut short" $? "$work/err5" "$work"
+grep -q "\.png: PLplot wrote an incomplete figure: File too large" "$work/err5" ||
+    fail "simulate, a figure cut short: the message does not name the figure: $(cat "$work/err5")"
+[ ! -e "$work/fig" ] || fail "simulate: a run with a truncated figure kept its OUTDIR"
+
 # render from the saved map
 limited "$THZMAP" render "$work/scene.json" --photon-map "$work/old/photon-map.thzpm" \
     -o "$work/rendered" -q $PM 2>"$work/err3"
