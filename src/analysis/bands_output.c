@@ -1,6 +1,7 @@
 /* The files of a band selection (bands_output.h). */
 #include "analysis/bands_output.h"
 
+#include <errno.h>
 #include <jansson.h>
 #include <math.h>
 #include <stdarg.h>
@@ -206,10 +207,15 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
         return st;
     FILE *f = fopen(path, "w");
     if (!f)
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create", path);
-    int failed = fputs(json_text, f) < 0 || fputc('\n', f) == EOF;
-    if (fclose(f) != 0 || failed)
-        return thz_error_set(err, THZ_ERR_IO, "%s: write failed", path);
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+    int why = 0; /* the first failure's errno: a full disk says so */
+    errno = 0;
+    if (fputs(json_text, f) < 0 || fputc('\n', f) == EOF)
+        why = errno ? errno : EIO;
+    if (fclose(f) != 0 && !why)
+        why = errno ? errno : EIO;
+    if (why)
+        return thz_error_set(err, THZ_ERR_IO, "%s: write failed: %s", path, strerror(why));
 
     /* the spectra and the air over the centres, at the narrowest width searched */
     double *x = thz_calloc(K > n ? K : n, sizeof *x), *y = thz_calloc(K, sizeof *y);

@@ -2,6 +2,7 @@
  * map as ENVI and as a PNG in a qualitative palette. */
 #include "analysis/classify_output.h"
 
+#include <errno.h>
 #include <jansson.h>
 #include <math.h>
 #include <stdbool.h>
@@ -125,10 +126,15 @@ static thz_status write_text(const char *dir, const char *name, const char *text
         return st;
     FILE *f = fopen(path, "w");
     if (!f)
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create", path);
-    int failed = fputs(text, f) < 0 || fputc('\n', f) == EOF;
-    if (fclose(f) != 0 || failed)
-        return thz_error_set(err, THZ_ERR_IO, "%s: write failed", path);
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+    int why = 0; /* the first failure's errno: a full disk says so */
+    errno = 0;
+    if (fputs(text, f) < 0 || fputc('\n', f) == EOF)
+        why = errno ? errno : EIO;
+    if (fclose(f) != 0 && !why)
+        why = errno ? errno : EIO;
+    if (why)
+        return thz_error_set(err, THZ_ERR_IO, "%s: write failed: %s", path, strerror(why));
     return THZ_OK;
 }
 

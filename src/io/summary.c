@@ -297,8 +297,11 @@ thz_status summary_write(const char *dir, const thz_scene *scene, const run_summ
     else {
         errno = 0; /* ENOMEM after a failure: out of memory, not a write error */
         if (json_dump_file(root, path, SUMMARY_FLAGS) != 0)
-            status = thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO), "%s: cannot write%s",
-                                   path, errno == ENOMEM ? ": out of memory" : "");
+            status = thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO), "%s: cannot write: %s",
+                                   path,
+                                   errno == ENOMEM ? "out of memory"
+                                   : errno         ? strerror(errno)
+                                                   : "write failed");
     }
     json_decref(root);
     return status;

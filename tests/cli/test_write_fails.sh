@@ -61,6 +61,15 @@ grep -q "\.png: PLplot wrote an incomplete figure: File too large" "$work/err5" 
     fail "simulate, a figure cut short: the message does not name the figure: $(cat "$work/err5")"
 [ ! -e "$work/fig" ] || fail "simulate: a run with a truncated figure kept its OUTDIR"
 
+# classify: classification.json (13 KB) passes the limit. Its message, as bands.json's and
+# summary.json's, gave no reason ("write failed") before.
+limited "$THZMAP" classify "$work/old" --sensor cam -o "$work/classified" --method lda -q \
+    2>"$work/err6"
+check "classify" $? "$work/err6" "$work"
+grep -q "classification.json: write failed: File too large" "$work/err6" ||
+    fail "classify: the message does not name the file: $(cat "$work/err6")"
+[ ! -e "$work/classified" ] || fail "classify: a failed run created its OUTDIR"
+
 # render from the saved map
 limited "$THZMAP" render "$work/scene.json" --photon-map "$work/old/photon-map.thzpm" \
     -o "$work/rendered" -q $PM 2>"$work/err3"
