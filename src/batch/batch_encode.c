@@ -8,6 +8,7 @@
  * run time, for each movie (see movie_av).
  */
 #include <dlfcn.h>
+#include <errno.h>
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
 #include <libavutil/macros.h>
@@ -276,7 +277,7 @@ static thz_status movie_encode(movie_writer *m, AVFrame *frame, thz_error *err)
         m->packet->stream_index = m->stream->index;
         rc = m->av.av_interleaved_write_frame(m->fmt, m->packet);
         if (rc < 0)
-            return movie_av_error(m, err, m->tmp, "cannot write", rc);
+            return movie_av_error(m, err, m->spec.path, "cannot write", rc);
     }
 }
 
@@ -394,11 +395,11 @@ thz_status movie_open(const movie_spec *spec, movie_writer **out, thz_error *err
         return thz_error_set(err, THZ_ERR_IO, "%s: no RGB to YUV conversion", spec->path);
     rc = m->av.avio_open(&m->fmt->pb, m->tmp, AVIO_FLAG_WRITE);
     if (rc < 0)
-        return movie_av_error(m, err, m->tmp, "cannot create", rc);
+        return movie_av_error(m, err, m->spec.path, "cannot create", rc);
     m->file_open = 1;
     rc = m->av.avformat_write_header(m->fmt, NULL);
     if (rc < 0)
-        return movie_av_error(m, err, m->tmp, "cannot write", rc);
+        return movie_av_error(m, err, m->spec.path, "cannot write", rc);
     return THZ_OK;
 }
 
@@ -421,13 +422,14 @@ thz_status movie_finish(movie_writer *m, thz_error *err)
     thz_status st = movie_encode(m, NULL, err);
     int rc = st == THZ_OK ? m->av.av_write_trailer(m->fmt) : 0;
     if (st == THZ_OK && rc < 0)
-        st = movie_av_error(m, err, m->tmp, "cannot write", rc);
+        st = movie_av_error(m, err, m->spec.path, "cannot write", rc);
     rc = m->av.avio_closep(&m->fmt->pb);
     m->file_open = 0;
     if (st == THZ_OK && rc < 0)
-        st = movie_av_error(m, err, m->tmp, "cannot write", rc);
+        st = movie_av_error(m, err, m->spec.path, "cannot write", rc);
     if (st == THZ_OK && rename(m->tmp, m->spec.path) != 0)
-        st = thz_error_set(err, THZ_ERR_IO, "%s: cannot rename into place", m->spec.path);
+        st = thz_error_set(err, THZ_ERR_IO, "%s: cannot rename into place: %s", m->spec.path,
+                           strerror(errno));
     m->finished = st == THZ_OK;
     return st;
 }
