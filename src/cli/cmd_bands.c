@@ -266,6 +266,11 @@ int cmd_bands(int argc, char **argv)
     double t0 = cli_now_s();
     int rc = CLI_EXIT_OK;
     thz_status st = thz_bands_select(ctx, scene, &opt, &b, &err);
+    /* The progress callback carries a stop only while the renders run: one that came
+     * during the search, which reports no progress, stops here, before anything is
+     * written (it was ignored: the results written, exit status 0). */
+    if (st == THZ_OK && cli_interrupt_signal())
+        st = THZ_ERR_CANCELLED;
     if (st == THZ_OK)
         st = thz_bands_write(b, outdir, &err);
     cli_progress_finish(&progress);
@@ -275,6 +280,11 @@ int cmd_bands(int argc, char **argv)
         rc = 128 + cli_interrupt_signal();
     } else if (st != THZ_OK) {
         rc = cli_fail(&err);
+    } else if (cli_interrupt_signal()) {
+        /* the stop came while the results were written, which nothing interrupts: they
+         * are whole, and the process still ends by the signal, as classify's does */
+        fprintf(stderr, "thzmap bands: interrupted; the results in %s are complete\n", outdir);
+        rc = 128 + cli_interrupt_signal();
     } else if (!quiet) {
         thz_bands_info info;
         thz_bands_get_info(b, &info);

@@ -77,6 +77,29 @@ ms=$((($(date +%s%N) - t0) / 1000000))
 sleep 0.2
 [ -z "$(pgrep -P $pid)" ] || fail "SIGINT while drawing: figure children left running"
 
+# SIGTERM to bands after its last render, while it searches and writes: its progress
+# callback, which alone carried a stop, is called no more. The stop was ignored: bands
+# wrote its results and ended with status 0.
+"$THZMAP" bands "$REPO/tests/inputs/batch/scene.json" -o "$work/bands" --count 5 \
+    --from-thz 0.1 --to-thz 1.5 --step-ghz 20 --paths 1 2> "$work/bands.err" &
+pid=$!
+for _ in $(seq 1200); do
+    grep -q "render 4/4" "$work/bands.err" 2>/dev/null && break
+    sleep 0.02
+done
+kill -TERM $pid
+wait $pid
+rc=$?
+[ "$rc" = 143 ] || fail "SIGTERM to bands after its renders: exit $rc, expected 143"
+grep -q "^thzmap bands: interrupted" "$work/bands.err" ||
+    fail "SIGTERM to bands after its renders: no message: $(tail -n 1 "$work/bands.err")"
+[ -z "$(leftovers)" ] || fail "SIGTERM to bands left: $(leftovers)"
+if [ -e "$work/bands" ]; then # only when the stop came while it wrote: then whole
+    grep -q "results in .* are complete" "$work/bands.err" ||
+        fail "SIGTERM to bands: OUTDIR written, yet the message says $(tail -n 1 "$work/bands.err")"
+    [ -s "$work/bands/bands.json" ] || fail "SIGTERM to bands: OUTDIR without bands.json"
+fi
+
 # atmosphere --plot into a closed pipe: the figure there stays as it was
 if "$THZMAP" atmosphere --from-thz 0.1 --to-thz 1 --step-ghz 10 --plot "$work/atm.png" \
     > /dev/null 2>&1; then
