@@ -246,6 +246,13 @@ int cmd_bands(int argc, char **argv)
                                "for the results, or a name to create one)",
                                outdir);
     opt.count = (size_t)count;
+    /* nor one the results cannot be staged beside (a read-only parent, another run
+     * writing there): refused after every render before, the work lost */
+    thz_output *probe = NULL;
+    thz_error probe_err = {0};
+    if (thz_output_open(outdir, &probe, &probe_err) != THZ_OK)
+        return cli_fail(&probe_err);
+    thz_output_destroy(probe);
 
     thz_context *ctx = thz_context_create();
     if (!ctx) {

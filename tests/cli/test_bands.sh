@@ -342,4 +342,22 @@ expect2 "OUTDIR a file" "$IN/features.json" -o "$TMP/file" --count 1
 grep -q -- "exists and is not a directory" "$TMP/err" || fail "-o FILE: $(cat "$TMP/err")"
 expect2 "thickness range 1" "$IN/features.json" -o "$TMP/x" --count 1 --thickness-range 1
 [ -e "$TMP/x" ] && fail "a failed run left $TMP/x"
+
+# an OUTDIR another run is writing into is refused before the renders, not after every
+# one of them (the work lost); here a long simulate holds OUTDIR's lock
+"$THZ" simulate "$REPO/examples/plate-in-box/scene.json" -o "$TMP/busy" --photons 50000000 \
+    --integrator photon-map 2> "$TMP/busy.err" &
+busy=$!
+for _ in $(seq 600); do # the estimate's line: OUTDIR (and its lock) opened
+    grep -q "estimate:" "$TMP/busy.err" 2>/dev/null && break
+    sleep 0.1
+done
+"$THZ" bands "$IN/features.json" -o "$TMP/busy" --count 1 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 50 --paths 4 2> "$TMP/err"
+st=$?
+kill -TERM $busy
+wait $busy 2>/dev/null
+[ "$st" = 1 ] || fail "a busy OUTDIR: exit status $st, expected 1: $(cat "$TMP/err")"
+grep -q "another thzmap run" "$TMP/err" || fail "a busy OUTDIR: $(cat "$TMP/err")"
+grep -q "render 1" "$TMP/err" && fail "a busy OUTDIR refused only after the renders"
 echo ok
