@@ -415,6 +415,12 @@ int cli_run_command(int argc, char **argv, bool render)
             }
         }
     }
+    /* a stop that came while the results were committed, after the library's last check:
+     * they are whole, and the process still ends by the signal (it ended with status 0) */
+    if (rc == CLI_EXIT_OK && cli_interrupt_signal()) {
+        fprintf(stderr, "thzmap %s: interrupted; the results in %s are complete\n", cmd, a.outdir);
+        rc = 128 + cli_interrupt_signal();
+    }
     if (shared && rc != CLI_EXIT_OK) /* the other ranks may be waiting for rank 0 */
         cli_mpi_abort(rc);
     thz_run_destroy(run);

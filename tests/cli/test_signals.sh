@@ -100,6 +100,33 @@ if [ -e "$work/bands" ]; then # only when the stop came while it wrote: then who
     [ -s "$work/bands/bands.json" ] || fail "SIGTERM to bands: OUTDIR without bands.json"
 fi
 
+# SIGTERM while simulate commits (its last check for a stop already made): the commit,
+# slowed by strace (200 ms per link, rename and unlink), goes on and the results are whole;
+# the process still ends by the signal. It ended with status 0, saying nothing.
+if command -v strace > /dev/null; then
+    "$THZMAP" simulate "$scene" -o "$work/commit" --photons 20000 --integrator photon-map \
+        -q 2> /dev/null || fail "simulate into commit/: exit status $?"
+    strace -f -qq -o /dev/null -e trace=renameat2,linkat,link,unlinkat,unlink \
+        -e inject=renameat2,linkat,link,unlinkat,unlink:delay_enter=200000 \
+        "$THZMAP" simulate "$scene" -o "$work/commit" --photons 20000 --seed 2 \
+        --integrator photon-map -q 2> "$work/commit.err" &
+    tracer=$!
+    for _ in $(seq 1200); do # summary.json staged: the last check is made right after it
+        compgen -G "$work/.thzmap-*-stage-*/summary.json" > /dev/null && break
+        sleep 0.02
+    done
+    sleep 0.1
+    kill -TERM "$(pgrep -P $tracer)"
+    wait $tracer
+    rc=$?
+    [ "$rc" = 143 ] || fail "SIGTERM while committing: exit $rc, expected 143"
+    grep -q "interrupted; the results in .* are complete" "$work/commit.err" ||
+        fail "SIGTERM while committing: $(tail -n 1 "$work/commit.err")"
+    grep -q '"seed": 2' "$work/commit/summary.json" ||
+        fail "SIGTERM while committing: OUTDIR does not hold the committed run"
+    [ -z "$(leftovers)" ] || fail "SIGTERM while committing left: $(leftovers)"
+fi
+
 # atmosphere --plot into a closed pipe: the figure there stays as it was
 if "$THZMAP" atmosphere --from-thz 0.1 --to-thz 1 --step-ghz 10 --plot "$work/atm.png" \
     > /dev/null 2>&1; then
