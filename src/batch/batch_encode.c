@@ -95,6 +95,11 @@ static thz_status movie_av_open(movie_av *av, thz_error *err)
         if (!av->lib[i]) {
             const char *why = dlerror();
             movie_av_close(av);
+            /* installing helps only where the library is missing, not where it could not
+             * be mapped (out of address space: ulimit -v) */
+            if (why && !strstr(why, "No such file"))
+                return thz_error_set(err, THZ_ERR_IO, "movies: cannot load FFmpeg's %s: %s",
+                                     movie_sonames[i], why);
             return thz_error_set(err, THZ_ERR_IO,
                                  "movies need FFmpeg's %s (Debian: libavcodec-dev, "
                                  "libavformat-dev, libswscale-dev): %s",
