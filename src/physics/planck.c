@@ -14,6 +14,10 @@ double planck_radiance(double freq_hz, double temp_k)
     double denom = expm1(x);
     if (isinf(denom))
         return 0.0;
+    /* h nu / k T underflowed to 0 (nu below about 1e-290 Hz): the Rayleigh-Jeans limit
+     * 2 nu^2 k T / c^2, which underflows too, instead of 0/0. */
+    if (!(denom > 0.0))
+        return 2.0 * (freq_hz / c) * (freq_hz / c) * k * temp_k;
     return prefactor / denom;
 }
 
@@ -32,5 +36,12 @@ double planck_dbdt(double freq_hz, double temp_k)
         return 0.0;
     double x = THZ_PLANCK_H * freq_hz / (THZ_BOLTZMANN_K * temp_k);
     double em1 = expm1(x);
+    /* Beyond the Wien tail's overflow B and its derivative are 0; where x underflowed
+     * the Rayleigh-Jeans limit 2 nu^2 k / c^2 (both instead of 0/0 or 0 inf). */
+    if (isinf(em1))
+        return 0.0;
+    if (!(em1 > 0.0))
+        return 2.0 * (freq_hz / THZ_SPEED_OF_LIGHT) * (freq_hz / THZ_SPEED_OF_LIGHT) *
+               THZ_BOLTZMANN_K;
     return planck_radiance(freq_hz, temp_k) * x * (em1 + 1.0) / (em1 * temp_k);
 }

@@ -102,6 +102,31 @@ static void test_zero_and_negative(void **state)
     assert_true(b == 0.0 || (b > 0.0 && isfinite(b)));
 }
 
+/* Frequencies so low that h nu / k T underflows (a channel may be anywhere above 0 THz):
+ * the Rayleigh-Jeans limit, which underflows to 0 too, not 0/0 = NaN (a NaN there made
+ * the band mean's adaptive quadrature split every panel 40 levels deep: a scene with a
+ * channel at 1e-301 THz hung in validate). Likewise dB/dT, and dB/dT beyond the Wien
+ * tail's overflow (x > 709.8), where it was 0 * inf. */
+static void test_extreme_arguments(void **state)
+{
+    (void)state;
+    static const double nus[] = {1e-290, 1e-300, 5e-324};
+    static const double ts[] = {1e-3, 300.0, 1e6};
+    for (size_t i = 0; i < 3; i++)
+        for (size_t j = 0; j < 3; j++) {
+            double b = planck_radiance(nus[i], ts[j]), d = planck_dbdt(nus[i], ts[j]);
+            assert_true(isfinite(b) && b >= 0.0);
+            assert_true(isfinite(d) && d >= 0.0);
+        }
+    /* 10 THz at 0.65 K: x = 738, e^x overflows */
+    double d = planck_dbdt(10e12, 0.65);
+    assert_true(isfinite(d) && d >= 0.0);
+    /* and where nothing underflows, dB/dT is still the closed form's */
+    double t = 300.0, nu = 1e12, dt = 1e-3;
+    double fd = (planck_radiance(nu, t + dt) - planck_radiance(nu, t - dt)) / (2.0 * dt);
+    assert_true(fabs(planck_dbdt(nu, t) - fd) <= 1e-6 * fd);
+}
+
 static void test_round_trip(void **state)
 {
     (void)state;
@@ -125,6 +150,7 @@ int main(void)
         cmocka_unit_test(test_matches_long_double),  cmocka_unit_test(test_exact_values),
         cmocka_unit_test(test_rayleigh_jeans_limit), cmocka_unit_test(test_wien_limit),
         cmocka_unit_test(test_zero_and_negative),    cmocka_unit_test(test_round_trip),
+        cmocka_unit_test(test_extreme_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
