@@ -71,7 +71,7 @@ static thz_status load_check_energy(load_ctx *ctx, const load_cursor *c, const t
 }
 
 /* The `reflection` key: "diffuse" (default), "specular", or {"model": "ward", "alpha_x",
- * "alpha_y"} (0 < alpha <= 1), whose albedo table is built here (brdf.h). */
+ * "alpha_y"} (1e-6 <= alpha <= 1), whose albedo table is built here (brdf.h). */
 static thz_status load_material_reflection(load_ctx *ctx, const load_cursor *c, thz_material *m)
 {
     static const char *const names[] = {"diffuse", "specular", NULL};
@@ -94,7 +94,9 @@ static thz_status load_material_reflection(load_ctx *ctx, const load_cursor *c, 
         return load_fail(ctx, &r, "%s %s", forms, load_type_name(r.value));
     thz_status st = load_expect_object(ctx, &r, ward_keys);
     size_t model = 0;
-    const load_range slope = {0.0, 1.0, true, false};
+    /* Below 1e-6 (a mirror: "specular"), alpha_x alpha_y (h.n)^4 underflows in the lobe's
+     * normalisation, near 1e-155 for both, and photon-map's estimates were NaN. */
+    const load_range slope = {1e-6, 1.0, false, false};
     if (st == THZ_OK)
         st = load_choice(ctx, &r, "model", models, true, 0, &model);
     if (st == THZ_OK)

@@ -393,6 +393,12 @@ static void test_refusals(void **state)
              ", \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.1, "
              "\"temperature_k\": 290, \"emitting\": 1}}",
              "atmosphere.emitting: expected true or false");
+    /* a Ward slope so small that the lobe's normalisation underflowed (photon-map's
+     * images were NaN below about 1e-155) */
+    load_bad(HEAD CHANNELS
+             "\"materials\": {\"m\": {\"reflectivity\": 0.5, \"reflection\": {\"model\": "
+             "\"ward\", \"alpha_x\": 0.2, \"alpha_y\": 1e-200}}}, " OBJECT(BOX) SENSORS "}",
+             "materials.m.reflection.alpha_y: expected a number in [1e-06, 1], got 1e-200");
 }
 
 /* A direction or up vector of huge (or tiny) components is that direction: it was
