@@ -157,11 +157,12 @@ static thz_status load_check_index_energy(load_ctx *ctx, const load_cursor *root
                 eps + r_bar > 1.0 + LOAD_ENERGY_SLACK) {
                 load_cursor mc = load_key(root, "materials"), c = load_key(&mc, m->name);
                 load_cursor e = load_key(&c, "emissivity");
-                return load_fail(ctx, e.value ? &e : &c,
-                                 "emissivity + the hemispherical mean reflectance of the "
-                                 "material's complex index must not exceed 1, got %g + %g = %g "
-                                 "at %.4g THz (object \"%s\")",
-                                 eps, r_bar, eps + r_bar, f * 1e-12, obj->name);
+                return load_fail(
+                    ctx, e.value ? &e : &c,
+                    "emissivity + the hemispherical mean reflectance of the "
+                    "material's complex index must not exceed 1, got %.10g + %.10g = %.10g "
+                    "at %.4g THz (object \"%s\")",
+                    eps, r_bar, eps + r_bar, f * 1e-12, obj->name);
             }
         }
     }

@@ -61,9 +61,10 @@ static thz_status load_check_energy(load_ctx *ctx, const load_cursor *c, const t
                 char at[64] = ""; /* two constants: no frequency to name */
                 if (sp[which]->freq_hz)
                     snprintf(at, sizeof at, " at %.4g THz", f * 1e-12);
-                return load_fail(ctx, &k,
-                                 "emissivity + reflectivity must not exceed 1, got %g + %g = %g%s",
-                                 e, r, e + r, at);
+                return load_fail(
+                    ctx, &k,
+                    "emissivity + reflectivity must not exceed 1, got %.10g + %.10g = %.10g%s", e,
+                    r, e + r, at);
             }
         }
     }

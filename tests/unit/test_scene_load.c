@@ -399,6 +399,13 @@ static void test_refusals(void **state)
              "\"materials\": {\"m\": {\"reflectivity\": 0.5, \"reflection\": {\"model\": "
              "\"ward\", \"alpha_x\": 0.2, \"alpha_y\": 1e-200}}}, " OBJECT(BOX) SENSORS "}",
              "materials.m.reflection.alpha_y: expected a number in [1e-06, 1], got 1e-200");
+    /* a sum just above 1 is shown with the digits that make it exceed 1 (it read
+     * "must not exceed 1, got 0.6 + 0.4 = 1") */
+    load_bad(HEAD CHANNELS
+             "\"materials\": {\"m\": {\"reflectivity\": 0.4, \"emissivity\": 0.6000001}}, " OBJECT(
+                 BOX) SENSORS "}",
+             "materials.m.emissivity: emissivity + reflectivity must not exceed 1, got 0.6000001 + "
+             "0.4 = 1.0000001");
 }
 
 /* A direction or up vector of huge (or tiny) components is that direction: it was
