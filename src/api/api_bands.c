@@ -450,6 +450,8 @@ done:
 
 void thz_bands_get_info(const thz_bands *b, thz_bands_info *out)
 {
+    if (!out)
+        return;
     memset(out, 0, sizeof *out);
     if (!b)
         return;

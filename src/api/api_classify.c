@@ -368,6 +368,8 @@ thz_status thz_classify_run(const char *run_dir, const char *sensor,
 
 void thz_classification_get_info(const thz_classification *c, thz_classification_info *out)
 {
+    if (!out)
+        return;
     memset(out, 0, sizeof *out);
     if (!c)
         return;

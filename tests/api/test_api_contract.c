@@ -509,6 +509,9 @@ static void check_null_arguments(thz_context *ctx, thz_scene *scene, thz_photons
     thz_run_get_totals(run, NULL);
     CHECK(thz_photons_points(ph, 0, 0, 10, NULL) == 0, "points into NULL");
     thz_library_get_info(lib, 0, NULL);
+    /* the analysis results' info of no handle into no struct (they wrote through NULL) */
+    thz_classification_get_info(NULL, NULL);
+    thz_bands_get_info(NULL, NULL);
     thz_library_get_range(lib, 0, 0, NULL, NULL);
     thz_library_optics_at(lib, 0, 1e12, NULL);
     thz_library_optics optics;
