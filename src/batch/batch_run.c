@@ -218,11 +218,13 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
     if (result)
         memset(result, 0, sizeof *result);
     if (!seq || !outdir || !outdir[0])
-        return thz_error_set(err, THZ_ERR_INPUT, "thz_batch_run: no %s",
-                             seq ? "output directory" : "sequence");
+        return api_done(ctx,
+                        thz_error_set(err, THZ_ERR_INPUT, "thz_batch_run: no %s",
+                                      seq ? "output directory" : "sequence"),
+                        err);
     thz_status checked = api_check_threads(ctx, "thz_batch_run", err);
     if (checked != THZ_OK)
-        return checked;
+        return api_done(ctx, checked, err);
     batch_state b = {
         .seq = seq, .outdir = outdir, .opt = opt, .t0 = batch_now_s(), .cache = {.base = SIZE_MAX}};
     b.state = thz_calloc(seq->n_frames, sizeof *b.state);
@@ -342,5 +344,5 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
     free(b.rank);
     if (lock_fd >= 0)
         close(lock_fd);
-    return st;
+    return api_done(ctx, st, err);
 }

@@ -261,8 +261,8 @@ static thz_status seq_top(seq_build *b, json_t *root, const char *seq_dir, thz_s
     return THZ_OK;
 }
 
-thz_status thz_sequence_load_ctx(thz_context *ctx, const char *path, const char *root_dir,
-                                 thz_sequence **out, thz_error *err)
+static thz_status sequence_load(thz_context *ctx, const char *path, const char *root_dir,
+                                thz_sequence **out, thz_error *err)
 {
     if (!out)
         return thz_error_set(err, THZ_ERR_INPUT, "thz_sequence_load: no place for the sequence");
@@ -353,6 +353,14 @@ thz_status thz_sequence_load_ctx(thz_context *ctx, const char *path, const char 
     }
     *out = seq;
     return THZ_OK;
+}
+
+thz_status thz_sequence_load_ctx(thz_context *ctx, const char *path, const char *root_dir,
+                                 thz_sequence **out, thz_error *err)
+{
+    thz_error local;
+    err = api_err(err, &local);
+    return api_done(ctx, sequence_load(ctx, path, root_dir, out, err), err);
 }
 
 thz_status thz_sequence_load_within(const char *path, const char *root_dir, thz_sequence **out,

@@ -181,6 +181,21 @@ int main(int argc, char **argv)
     thz_scene *bad = NULL;
     CHECK(thz_sequence_frame_scene(seq, 10, &bad, &err) == THZ_ERR_INPUT && bad == NULL,
           "frame 10's scene: not refused");
+
+    /* a batch's and a sequence load's failures stay in the context, as every call that
+     * takes one keeps its last failure (docs/api.md; they were not recorded) */
+    thz_context *ctx = thz_context_create();
+    CHECK(thz_batch_run(ctx, seq, path, NULL, NULL, NULL) == THZ_ERR_INPUT &&
+              thz_context_last_status(ctx) == THZ_ERR_INPUT &&
+              strstr(thz_context_last_message(ctx), "not a directory"),
+          "a batch into a file: context says %d '%s'", (int)thz_context_last_status(ctx),
+          thz_context_last_message(ctx));
+    thz_sequence *missing = NULL;
+    CHECK(thz_sequence_load_ctx(ctx, "/nonexistent/sequence.json", NULL, &missing, NULL) ==
+                  THZ_ERR_INPUT &&
+              strstr(thz_context_last_message(ctx), "/nonexistent/sequence.json"),
+          "a missing sequence: context says '%s'", thz_context_last_message(ctx));
+    thz_context_destroy(ctx);
     thz_sequence_destroy(seq);
 
     /* sweep directories sort in order: sweep-00 .. sweep-99, sweep-000 .. sweep-100 (the
