@@ -304,13 +304,15 @@ static thz_status api_sensor_name(const thz_scene *scene, long sensor, const cha
                                   thz_error *err)
 {
     *name = NULL;
+    if (!scene)
+        return thz_error_set(err, THZ_ERR_INPUT, "render: no scene");
     if (sensor == -1)
         return THZ_OK;
     if (sensor < -1)
         return thz_error_set(err, THZ_ERR_INPUT,
                              "render: sensor %ld: expected -1 (every sensor) or a sensor's index",
                              sensor);
-    if (!scene || (size_t)sensor >= scene->n_sensors)
+    if ((size_t)sensor >= scene->n_sensors)
         return thz_error_set(err, THZ_ERR_INPUT, "render: the scene has no sensor %ld", sensor);
     *name = scene->sensors[sensor].name;
     return THZ_OK;

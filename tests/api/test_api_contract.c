@@ -664,6 +664,16 @@ int main(int argc, char **argv)
                        "saving half-fired photons");
     expect_input_error(thz_render_sensor(ctx, a, merged, 7, NULL, &image, &err), &err, "sensor 7",
                        "sensor out of range");
+    /* no scene is "no scene" (it was "the scene has no sensor 0"), for each sensor index */
+    expect_input_error(thz_render_sensor(ctx, NULL, merged, 0, NULL, &image, &err), &err,
+                       "render: no scene", "render_sensor without a scene");
+    thz_run *unrun = NULL;
+    expect_input_error(thz_render_run(ctx, NULL, merged, 0, NULL, &unrun, &err), &err,
+                       "render: no scene", "render_run without a scene");
+    expect_input_error(thz_render_file(ctx, NULL, "x.thzpm", 1, NULL, &unrun, &err), &err,
+                       "render: no scene", "render_file without a scene");
+    expect_input_error(thz_render_run(ctx, NULL, merged, -1, NULL, &unrun, &err), &err, "no scene",
+                       "render_run of every sensor without a scene");
     thz_photons *none = (thz_photons *)&err;
     expect_input_error(thz_photons_fire_channel(ctx, a, &settings, 2, &none, &err), &err,
                        "channel 2", "channel out of range");
