@@ -4,7 +4,7 @@
  * (documented and tested on 0.1 mm shells): a ray leaving a surface passes the
  * (object, triangle) it leaves from in `ignore` and is filtered against it, and its
  * origin is offset along the geometric normal to the side it leaves on by a distance
- * relative to the scene size; see accel.c for the exact numbers.
+ * relative to the size of the hit point's coordinates; see accel.c for the exact numbers.
  */
 #ifndef THZ_ACCEL_ACCEL_H
 #define THZ_ACCEL_ACCEL_H

@@ -196,6 +196,63 @@ static void test_threads(void **state)
     }
 }
 
+/* The offset is the hit's own, not the scene's: two rectangles `gap` apart near the
+ * origin, with a room 2 km across (its offset was 1e-6 of the diagonal, 3.5 mm) or a
+ * small box 1e7 m away (16 float epsilons of that coordinate, 19 m) in the scene: a ray
+ * leaving the lower one upwards hits the upper one at the gap. */
+static void check_gap_in(double gap, bool far_box)
+{
+    thz_scene *s = ps_scene(0.35, 0.01, 1000, 1);
+    size_t m = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t lower = ps_object(s, OBJECT_SOLID, m, 300, 0, true);
+    ps_face(s, lower, v3(0.3, -0.2, 0.5), v3(0.1, 0, 0), v3(0, 0.1, 0));
+    size_t upper = ps_object(s, OBJECT_SOLID, m, 300, 0, true);
+    ps_face(s, upper, v3(0.3, -0.2, 0.5 + gap), v3(0, 0.1, 0), v3(0.1, 0, 0));
+    size_t room = ps_object(s, OBJECT_SOLID, m, 300, 0, false);
+    if (far_box) {
+        ps_box(s, room, v3(-5, -5, -5), v3(5, 5, 5), true);
+        size_t box = ps_object(s, OBJECT_SOLID, m, 300, 0, false);
+        ps_box(s, box, v3(1e7, 0, 0), v3(1e7 + 1, 1, 1), false);
+    } else {
+        ps_box(s, room, v3(-1000, -1000, -1000), v3(1000, 1000, 1000), true);
+    }
+    ps_finalize(s);
+    accel *acc;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    /* from both triangles of the lower rectangle, straight up and at 37 and 82 degrees */
+    const vec3 points[] = {v3(0.27, -0.22, 0.5), v3(0.33, -0.18, 0.5)};
+    const vec3 dirs[] = {v3(0, 0, 1), v3(0.6, 0, 0.8), v3(0, -0.99, sqrt(1 - 0.99 * 0.99))};
+    uint32_t first = 0;
+    for (size_t k = 0; k < 2; k++) {
+        accel_hit from, h;
+        assert_true(accel_intersect(acc, v3(points[k].x, points[k].y, 0.4), v3(0, 0, 1), INFINITY,
+                                    ACCEL_NO_OBJECT, 0, &from));
+        assert_int_equal(from.object, lower);
+        if (k == 1) /* one point on each */
+            assert_int_not_equal(from.triangle, first);
+        first = from.triangle;
+        from.position_m = points[k];
+        for (size_t i = 0; i < sizeof dirs / sizeof *dirs; i++) {
+            vec3 o = accel_offset_origin(acc, &from, dirs[i]);
+            assert_true(o.z > points[k].z && o.z - points[k].z < 0.25 * gap);
+            assert_true(
+                accel_intersect(acc, o, dirs[i], INFINITY, (uint32_t)lower, from.triangle, &h));
+            assert_int_equal(h.object, upper);
+            assert_float_equal(h.distance_m * dirs[i].z, gap, 0.3 * gap);
+        }
+    }
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
+static void test_offset_is_the_hits(void **state)
+{
+    (void)state;
+    check_gap_in(2e-3, false);
+    check_gap_in(1e-4, true);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -204,6 +261,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_thin_shell_normal_and_grazing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_shared_edge, setup, teardown),
         cmocka_unit_test_setup_teardown(test_threads, setup, teardown),
+        cmocka_unit_test(test_offset_is_the_hits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
