@@ -1,6 +1,7 @@
 /* Plausibility checks of a loaded scene (scene_checks.h). */
 #include "scene/scene_checks.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -243,6 +244,32 @@ static bool check_scales(thz_scene *s, const check_object *info, size_t enclosur
     return ok;
 }
 
+/* Objects so far from the origin, for their size, that single precision (which meshes
+ * and Embree's rays use) blurs them: a ray leaves a surface 16 float epsilons of its
+ * coordinates off it (accel.c), above SCENE_CHECK_PRECISION of the object's size. */
+static bool check_precision(thz_scene *s, const check_object *info)
+{
+    bool ok = true;
+    for (size_t i = 0; i < s->n_objects && ok; i++) {
+        const thz_mesh *m = &s->objects[i].mesh;
+        double far = 0.0;
+        for (int k = 0; k < 3 && m->n_triangles; k++)
+            far = fmax(far, fmax(fabs(m->bbox_min_m[k]), fabs(m->bbox_max_m[k])));
+        double offset = 16.0 * FLT_EPSILON * far;
+        if (!(offset > SCENE_CHECK_PRECISION * info[i].diagonal_m))
+            continue;
+        ok = scene_add_warning(
+            s,
+            "object \"%s\" (%.3g m across) lies up to %.3g m from the origin, where single "
+            "precision, in which meshes and rays are held, resolves %.2g m and a ray leaves a "
+            "surface %.2g m off it: surfaces closer than that are not told apart; move the "
+            "scene so that the origin lies among the objects (\"transform\": "
+            "{\"translate_m\": ...})",
+            s->objects[i].name, info[i].diagonal_m, far, FLT_EPSILON * far, offset);
+    }
+    return ok;
+}
+
 static bool check_frequencies(thz_scene *s)
 {
     size_t outside = 0, first = 0;
@@ -326,6 +353,6 @@ bool scene_checks_run(thz_scene *scene, const check_object *info, size_t enclosu
                       const scene_check_inputs *in)
 {
     return check_celsius(scene) && check_scales(scene, info, enclosure) &&
-           check_frequencies(scene) && check_sensors(scene, info) &&
+           check_precision(scene, info) && check_frequencies(scene) && check_sensors(scene, info) &&
            check_atmosphere(scene, in, enclosure);
 }

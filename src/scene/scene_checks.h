@@ -23,6 +23,9 @@
 /* An object whose bounding box diagonal exceeds this times the enclosure's (or, without
  * one, the median object's) is taken for a unit mistake. */
 #define SCENE_CHECK_SCALE_RATIO 100.0
+/* An object farther from the origin than about 500 times its size: the offset by which
+ * rays leave its surfaces (accel.c) exceeds this fraction of its bounding box diagonal. */
+#define SCENE_CHECK_PRECISION 1e-3
 
 /* What the loader knew of the atmosphere block, beyond the scene. */
 typedef struct scene_check_inputs {

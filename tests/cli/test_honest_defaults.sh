@@ -43,6 +43,11 @@ make_scene outside "s['sensors'][0]['position_m'] = [0, -3, 0]"
 make_scene inside "s['sensors'][0]['position_m'] = [0, 0.5, 0]"
 make_scene nonemitting "s['atmosphere']['emitting'] = False"
 make_scene background "s['atmosphere']['background_temperature_k'] = 3"
+# the whole scene 1000 km from the origin: single precision blurs it to 0.12 m
+make_scene far "
+for o in s['objects']:
+    t = o.setdefault('transform', {}); x = t.get('translate_m', [0, 0, 0]); t['translate_m'] = [x[0] + 1e6, x[1], x[2]]
+s['sensors'][0]['position_m'][0] += 1e6"
 
 check_warning() { # $1: scene, $2: text the warning must contain
     "$THZMAP" validate "$work/$1.json" > /dev/null 2> "$work/$1.err" ||
@@ -56,6 +61,7 @@ check_warning outside 'sensor "cam" .* is outside the enclosure "room"'
 check_warning inside 'sensor "cam" .* is inside object "target"'
 check_warning nonemitting "breaks equilibrium"
 check_warning background "no ray leaves the scene"
+check_warning far 'object "target" .* lies up to 1e+06 m from the origin, where single precision'
 "$THZMAP" validate "$work/plain.json" > /dev/null 2> "$work/plain.err"
 [ -s "$work/plain.err" ] && fail "the plain scene warns: $(cat "$work/plain.err")"
 for ex in "$REPO"/examples/*/scene.json; do
