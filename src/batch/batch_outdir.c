@@ -26,9 +26,16 @@ thz_status batch_mkdirs(const char *dir, thz_error *err)
         if (c != '/' && c != '\0')
             continue;
         *p = '\0';
-        if (mkdir(path, 0777) != 0 && errno != EEXIST)
-            return thz_error_set(err, THZ_ERR_IO, "%s: cannot create the directory: %s", path,
-                                 strerror(errno));
+        if (mkdir(path, 0777) != 0 && errno != EEXIST) {
+            /* a place the user may not write, or a file on the way, is bad usage (exit
+             * 2), as for simulate's OUTDIR */
+            int e = errno;
+            return thz_error_set(err,
+                                 e == EACCES || e == EPERM || e == EROFS || e == ENOTDIR
+                                     ? THZ_ERR_INPUT
+                                     : THZ_ERR_IO,
+                                 "%s: cannot create the directory: %s", path, strerror(e));
+        }
         *p = c;
         if (!c)
             break;

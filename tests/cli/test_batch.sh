@@ -720,6 +720,12 @@ bad list_sweep 'sweep.objects.nobody.temperature_k: scenes[0] (scene.json) has n
     '{"format": "thzmap-sequence/1", "scenes": ["scene.json"], "sweep": {"objects.nobody.temperature_k": [300]}}'
 "$THZMAP" batch "$seq" > /dev/null 2>&1
 [ $? -eq 2 ] || fail "batch without -o: expected exit 2"
+# an OUTDIR under a file is bad usage, as for simulate (it exited 1)
+touch "$work/a-file"
+"$THZMAP" batch "$seq" -o "$work/a-file/out" -q 2> "$work/under-file.err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "a-file/out: cannot create the directory: Not a directory" "$work/under-file.err" ||
+    fail "batch into a path under a file: exit $rc, $(cat "$work/under-file.err")"
 
 # A FIFO or device that a frame's scene names but the loader does not read (the continuum
 # table of a lines model without the continuum) and a FIFO frame.json in OUTDIR: the
