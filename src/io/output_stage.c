@@ -172,6 +172,11 @@ static thz_status stage_lock(output_stage *stage, const char *lock_path, thz_err
                                      strerror(e));
             pid[n > 0 ? n : 0] = '\0';
             pid[strcspn(pid, "\n")] = '\0';
+            if (pid[0] && strtol(pid, NULL, 10) == (long)getpid()) /* a library caller's */
+                return thz_error_set(err, THZ_ERR_IO,
+                                     "%s: this process has an output open there already "
+                                     "(commit or destroy it first)",
+                                     stage->outdir);
             return thz_error_set(err, THZ_ERR_IO,
                                  "%s: another thzmap run (process %s) is writing its results "
                                  "there; wait for it to end or choose another output directory",
