@@ -84,7 +84,7 @@ THZ_API const char *thz_status_name(thz_status status);
  * pass, and each further sensor, reports its rows from 0 again. thz_bands_select reports
  * "bands" alone: `channel` is the render (the nominal one, then the nuisances'),
  * `n_channels` the renders (0 until their count is known), done/total its candidate
- * channels. */
+ * channels. thz_sequence_load_ctx reports "frames": done/total frames checked. */
 typedef struct thz_progress {
     const char *stage;
     size_t channel; /* index of the channel being processed */
