@@ -30,12 +30,17 @@ void cli_signals_install(void)
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = cli_on_signal;
     sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESETHAND; /* a second Ctrl-C ends the process at once */
-    sigaction(SIGINT, &sa, NULL);
+    sa.sa_flags = SA_RESETHAND;   /* a second Ctrl-C ends the process at once */
+    sigaction(SIGINT, &sa, NULL); /* also where a script's shell ignored it for a
+                                     background job: `kill -INT` still stops the run */
     sigaction(SIGTERM, &sa, NULL);
     /* a closed terminal or ssh session stops the run as Ctrl-C does (it was killed
-     * mid-commit, leaving its lock and staging directory beside OUTDIR) */
-    sigaction(SIGHUP, &sa, NULL);
+     * mid-commit, leaving its lock and staging directory beside OUTDIR); but a SIGHUP
+     * ignored when thzmap starts stays ignored: `nohup` asks for that (closing the
+     * terminal ended a nohup run) */
+    struct sigaction hup;
+    if (sigaction(SIGHUP, NULL, &hup) != 0 || hup.sa_handler != SIG_IGN)
+        sigaction(SIGHUP, &sa, NULL);
     /* progress piped to a reader that left (`2>&1 | head -1`): the writes fail, the run
      * goes on (SIGPIPE killed it mid-commit too) */
     signal(SIGPIPE, SIG_IGN);

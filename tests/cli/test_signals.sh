@@ -2,7 +2,7 @@
 # Signals other than Ctrl-C (test_render_cancel.sh and the commit-kill tests cover SIGINT
 # and SIGKILL): a reader of the progress that leaves (SIGPIPE) does not stop the run
 # mid-commit; a closed terminal (SIGHUP) stops it as Ctrl-C does, exit 128 + 1, nothing
-# written and nothing left beside OUTDIR; SIGINT to the program alone while it draws its
+# written and nothing left beside OUTDIR, but not when SIGHUP was ignored at start (nohup); SIGINT to the program alone while it draws its
 # figures stops the drawing at once. `atmosphere --plot` stopped early keeps an
 # existing figure (it was emptied before the work).
 # argv: path to the thzmap binary, repository directory.
@@ -41,6 +41,22 @@ grep -q "interrupted; no results written" "$work/hup.err" ||
     fail "SIGHUP: no message: $(tail -n 1 "$work/hup.err")"
 [ ! -e "$work/hup" ] || fail "SIGHUP: OUTDIR written"
 [ -z "$(leftovers)" ] || fail "SIGHUP left: $(leftovers)"
+
+# SIGHUP ignored when thzmap starts (`nohup`) stays ignored: the run goes on to its end
+# (closing the terminal of a nohup run stopped it)
+(trap '' HUP; exec "$THZMAP" simulate "$scene" -o "$work/nohup" --photons 3000000 \
+    --integrator photon-map 2> "$work/nohup.err") &
+pid=$!
+for _ in $(seq 600); do
+    grep -q "estimate:" "$work/nohup.err" 2>/dev/null && break
+    sleep 0.1
+done
+sleep 0.3
+kill -HUP $pid 2>/dev/null || fail "nohup: the run ended before the test sent SIGHUP (too short)"
+wait $pid
+rc=$?
+[ "$rc" = 0 ] || fail "SIGHUP ignored at start: exit $rc, expected 0: $(tail -n 1 "$work/nohup.err")"
+[ -s "$work/nohup/summary.json" ] || fail "SIGHUP ignored at start: no results"
 
 # SIGINT to the program alone (`kill -INT`, as a batch system may send it; a terminal's
 # Ctrl-C also ends the figure children) while hundreds of figures are drawn: it stops
