@@ -178,7 +178,10 @@ static thz_status run_state_init(run_state *rs, const thz_scene *scene, const ru
          i++) {
         const thz_material *m = &scene->materials[i];
         double alpha = fmin(m->ward_alpha[0], m->ward_alpha[1]);
-        if (m->reflection != REFLECTION_WARD || !(alpha < RUN_WARD_ALPHA_PHOTON_MAP))
+        bool used = false; /* a material no object uses shapes no image */
+        for (size_t j = 0; j < scene->n_objects && !used; j++)
+            used = scene->objects[j].material == i;
+        if (!used || m->reflection != REFLECTION_WARD || !(alpha < RUN_WARD_ALPHA_PHOTON_MAP))
             continue;
         thz_status st = run_add_warning(
             rs, err,

@@ -128,6 +128,8 @@ grep -q "sensors\[0\].resolution" "$work/h.err" || fail "too large: $(cat "$work
 for a in 0.03 0.3; do
     make_scene "ward-$a" "s['materials']['metal']['reflection'] = {'model': 'ward', 'alpha_x': $a, 'alpha_y': 0.5}"
 done
+# a narrow lobe in a material that no object uses: no warning (it shapes no image)
+make_scene ward-unused "s['materials']['spare'] = {'reflectivity': 0.9, 'reflection': {'model': 'ward', 'alpha_x': 0.03, 'alpha_y': 0.5}}"
 glossy() { # $1: scene, $2: integrator; prints the warnings in summary.json matching "glossy lobe"
     "$THZMAP" simulate "$work/$1.json" -o "$work/out-$1-$2" --integrator "$2" --photons 2000 \
         --quiet 2> "$work/g.err" || fail "$1 $2: $(cat "$work/g.err")"
@@ -139,6 +141,7 @@ grep -q 'material "metal": photon-map cannot resolve its glossy lobe (alpha 0.03
     fail "photon-map, Ward alpha 0.03: no warning on stderr: $(cat "$work/g.err")"
 [ "$(glossy ward-0.3 photon-map)" = 0 ] || fail "photon-map, Ward alpha 0.3: warned"
 [ "$(glossy ward-0.03 final-gather)" = 0 ] || fail "final-gather, Ward alpha 0.03: warned"
+[ "$(glossy ward-unused photon-map)" = 0 ] || fail "photon-map, Ward alpha 0.03 in a material no object uses: warned"
 
 [ $fails -eq 0 ] && echo "honest defaults: all checks passed"
 exit $((fails > 0))
