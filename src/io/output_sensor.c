@@ -51,7 +51,8 @@ const char *output_plane_name(thz_plane plane)
     return (unsigned)plane < THZ_PLANE_COUNT ? names[plane] : NULL;
 }
 
-/* "<prefix><digits>.png" */
+/* "<prefix>NN.png" as output_write_sensor numbers a channel's figure (band-%02zu): two
+ * digits, or more without a leading 0; "band-1.png" or "band-007.png" is a user's */
 static bool out_numbered_png(const char *s, const char *prefix)
 {
     size_t n = strlen(prefix);
@@ -59,7 +60,7 @@ static bool out_numbered_png(const char *s, const char *prefix)
         return false;
     s += n;
     size_t digits = strspn(s, "0123456789");
-    return digits > 0 && !strcmp(s + digits, ".png");
+    return (digits == 2 || (digits > 2 && s[0] != '0')) && !strcmp(s + digits, ".png");
 }
 
 bool output_sensor_file(const char *stem, const char *name)

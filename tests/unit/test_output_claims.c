@@ -67,11 +67,12 @@ static void test_sensor_file_names(void **state)
             fail_msg("%s is a file of sensor cam", ours[i]);
     /* a user's files beside them, another sensor's (also one whose name begins with
      * "cam."), classify's, and near misses */
-    const char *not_ours[] = {"cam.notes.txt",       "cam.radiance.txt",      "cam.radiance",
-                              "cam.band-.png",       "cam.band-01.jpg",       "cam.band-1a.png",
-                              "camera.radiance.hdr", "cam.wide.radiance.hdr", "cam.class.hdr",
-                              "cam.visual.png.bak",  "summary.json",          "cam.",
-                              "other.radiance.hdr",  "cam.radiance.hdr.img"};
+    const char *not_ours[] = {"cam.notes.txt", "cam.radiance.txt", "cam.radiance", "cam.band-.png",
+                              "cam.band-01.jpg", "cam.band-1a.png", "camera.radiance.hdr",
+                              "cam.wide.radiance.hdr", "cam.class.hdr", "cam.visual.png.bak",
+                              "summary.json", "cam.", "other.radiance.hdr", "cam.radiance.hdr.img",
+                              /* numbers thzmap never writes (band-%02zu): a user's */
+                              "cam.band-1.png", "cam.band-007.png", "cam.measured-band-3.png"};
     for (size_t i = 0; i < sizeof not_ours / sizeof *not_ours; i++)
         if (output_sensor_file("cam.", not_ours[i]))
             fail_msg("%s is not a file of sensor cam", not_ours[i]);
