@@ -244,30 +244,36 @@ static bool check_scales(thz_scene *s, const check_object *info, size_t enclosur
     return ok;
 }
 
-/* Objects so far from the origin, for their size, that single precision (which meshes
- * and Embree's rays use) blurs them: a ray leaves a surface 16 float epsilons of its
- * coordinates off it (accel.c), above SCENE_CHECK_PRECISION of the object's size. */
-static bool check_precision(thz_scene *s, const check_object *info)
+/* A scene far from the origin for its size: its coordinates' single-precision step (in
+ * which meshes and Embree's rays are held) above SCENE_CHECK_PRECISION of its bounding
+ * box's diagonal. */
+static bool check_precision(thz_scene *s)
 {
-    bool ok = true;
-    for (size_t i = 0; i < s->n_objects && ok; i++) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double far = 0.0;
+    for (size_t i = 0; i < s->n_objects; i++) {
         const thz_mesh *m = &s->objects[i].mesh;
-        double far = 0.0;
-        for (int k = 0; k < 3 && m->n_triangles; k++)
+        for (int k = 0; k < 3 && m->n_triangles; k++) {
+            lo[k] = fmin(lo[k], m->bbox_min_m[k]);
+            hi[k] = fmax(hi[k], m->bbox_max_m[k]);
             far = fmax(far, fmax(fabs(m->bbox_min_m[k]), fabs(m->bbox_max_m[k])));
-        double offset = 16.0 * FLT_EPSILON * far;
-        if (!(offset > SCENE_CHECK_PRECISION * info[i].diagonal_m))
-            continue;
-        ok = scene_add_warning(
-            s,
-            "object \"%s\" (%.3g m across) lies up to %.3g m from the origin, where single "
-            "precision, in which meshes and rays are held, resolves %.2g m and a ray leaves a "
-            "surface %.2g m off it: surfaces closer than that are not told apart; move the "
-            "scene so that the origin lies among the objects (\"transform\": "
-            "{\"translate_m\": ...})",
-            s->objects[i].name, info[i].diagonal_m, far, FLT_EPSILON * far, offset);
+        }
     }
-    return ok;
+    if (!(lo[0] <= hi[0]))
+        return true;
+    double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    double step = FLT_EPSILON * far;
+    if (!(step > SCENE_CHECK_PRECISION * diag))
+        return true;
+    return scene_add_warning(
+        s,
+        "the objects lie up to %.3g m from the origin, %.0f times the scene's size (%.3g m "
+        "across): single precision, in which meshes and rays are held, resolves %.2g m "
+        "there, and a ray leaving a surface near a corner may start behind the next one "
+        "(a closed room 10 m across, 3 km from the origin, read some pixels up to 3.7 K "
+        "low); place the scene around the origin",
+        far, far / diag, diag, step);
 }
 
 static bool check_frequencies(thz_scene *s)
@@ -352,7 +358,7 @@ static bool check_atmosphere(thz_scene *s, const scene_check_inputs *in, size_t 
 bool scene_checks_run(thz_scene *scene, const check_object *info, size_t enclosure,
                       const scene_check_inputs *in)
 {
-    return check_celsius(scene) && check_scales(scene, info, enclosure) &&
-           check_precision(scene, info) && check_frequencies(scene) && check_sensors(scene, info) &&
+    return check_celsius(scene) && check_scales(scene, info, enclosure) && check_precision(scene) &&
+           check_frequencies(scene) && check_sensors(scene, info) &&
            check_atmosphere(scene, in, enclosure);
 }

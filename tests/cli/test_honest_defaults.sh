@@ -61,7 +61,11 @@ check_warning outside 'sensor "cam" .* is outside the enclosure "room"'
 check_warning inside 'sensor "cam" .* is inside object "target"'
 check_warning nonemitting "breaks equilibrium"
 check_warning background "no ray leaves the scene"
-check_warning far 'object "target" .* lies up to 1e+06 m from the origin, where single precision'
+check_warning far 'the objects lie up to 1e+06 m from the origin, .* times the scene.s size .*single precision'
+# but not a 2 mm pellet in the room: small, yet among the objects around the origin
+make_scene pellet "s['objects'].append({'name': 'pellet', 'type': 'solid', 'material': 'metal', 'temperature_k': 300, 'shape': {'type': 'sphere', 'radius_m': 0.001}, 'transform': {'translate_m': [0.5, 0.5, 0.5]}})"
+"$THZMAP" validate "$work/pellet.json" > /dev/null 2> "$work/pellet.err" || fail "pellet: $(cat "$work/pellet.err")"
+[ -s "$work/pellet.err" ] && fail "a 2 mm pellet in the room warns: $(cat "$work/pellet.err")"
 "$THZMAP" validate "$work/plain.json" > /dev/null 2> "$work/plain.err"
 [ -s "$work/plain.err" ] && fail "the plain scene warns: $(cat "$work/plain.err")"
 for ex in "$REPO"/examples/*/scene.json; do
