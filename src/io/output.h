@@ -43,7 +43,8 @@ void output_stage_error_names_outdir(const output_stage *stage, thz_error *err);
  * bands-air.png of a scene whose air attenuated), so that what OUTDIR holds under a
  * claimed name is this run's alone. output_stage_claim: one file name;
  * output_stage_claim_sensor: every name the files of sensor `sensor` may have
- * (output_sensor_file). OUTDIR's other files stay. THZ_ERR_NOMEM only. */
+ * (output_sensor_file). OUTDIR's other files stay. THZ_ERR_NOMEM, or THZ_ERR_INPUT for a
+ * sensor name too long for a file name (the loader's limit keeps them shorter). */
 thz_status output_stage_claim(output_stage *stage, const char *name, thz_error *err);
 thz_status output_stage_claim_sensor(output_stage *stage, const char *sensor, thz_error *err);
 
