@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/file.h"
 #include "core/json_text.h"
 #include "core/path.h"
 #include "io/plot.h"
@@ -205,17 +206,9 @@ thz_status bands_write_files(const char *dir, const bands_report *rep, const cha
         st = join(path, dir, bands_output_files[BANDS_JSON], err);
     if (st != THZ_OK)
         return st;
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
-    int why = 0; /* the first failure's errno: a full disk says so */
-    errno = 0;
-    if (fputs(json_text, f) < 0 || fputc('\n', f) == EOF)
-        why = errno ? errno : EIO;
-    if (fclose(f) != 0 && !why)
-        why = errno ? errno : EIO;
-    if (why)
-        return thz_error_set(err, THZ_ERR_IO, "%s: write failed: %s", path, strerror(why));
+    st = file_write_text(path, json_text, err);
+    if (st != THZ_OK)
+        return st;
 
     /* the spectra and the air over the centres, at the narrowest width searched */
     double *x = thz_calloc(K > n ? K : n, sizeof *x), *y = thz_calloc(K, sizeof *y);

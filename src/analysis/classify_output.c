@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/file.h"
 #include "core/json_text.h"
 #include "core/path.h"
 #include "io/envi.h"
@@ -124,18 +125,7 @@ static thz_status write_text(const char *dir, const char *name, const char *text
     thz_status st = thz_path_join(path, sizeof path, dir, name, err);
     if (st != THZ_OK)
         return st;
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
-    int why = 0; /* the first failure's errno: a full disk says so */
-    errno = 0;
-    if (fputs(text, f) < 0 || fputc('\n', f) == EOF)
-        why = errno ? errno : EIO;
-    if (fclose(f) != 0 && !why)
-        why = errno ? errno : EIO;
-    if (why)
-        return thz_error_set(err, THZ_ERR_IO, "%s: write failed: %s", path, strerror(why));
-    return THZ_OK;
+    return file_write_text(path, text, err);
 }
 
 thz_status classify_write_files(const char *dir, const classify_report *rep, const char *json_text,

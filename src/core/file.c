@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <stdbool.h>
+#include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -94,4 +95,20 @@ const char *file_kind_hint(const unsigned char *head, size_t n)
             file_starts(head + kinds[i].offset, n - kinds[i].offset, kinds[i].magic, kinds[i].len))
             return kinds[i].what;
     return NULL;
+}
+
+thz_status file_write_text(const char *path, const char *text, thz_error *err)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+    int why = 0; /* the first failure's errno: a full disk says so */
+    errno = 0;
+    if (fputs(text, f) < 0 || fputc('\n', f) == EOF)
+        why = errno ? errno : EIO;
+    if (fclose(f) != 0 && !why)
+        why = errno ? errno : EIO;
+    if (why)
+        return thz_error_set(err, THZ_ERR_IO, "%s: write failed: %s", path, strerror(why));
+    return THZ_OK;
 }

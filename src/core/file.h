@@ -36,4 +36,8 @@ size_t file_read_head(const char *path, unsigned char *head);
  * for anything else (JSON among it). */
 const char *file_kind_hint(const unsigned char *head, size_t n);
 
+/* Writes text and a newline to path (created or replaced): THZ_ERR_IO naming path and
+ * the first failure's reason ("No space left on device") when it cannot. */
+thz_status file_write_text(const char *path, const char *text, thz_error *err);
+
 #endif
