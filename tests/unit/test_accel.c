@@ -246,6 +246,30 @@ static void check_gap_in(double gap, bool far_box)
     scene_destroy(s);
 }
 
+/* A ray whose origin, rounded to single precision, lies on a wall of a closed room 3 km
+ * from the origin (as one leaving near a concave corner does) and heads into the room:
+ * it met that wall's back at t = 0 (radiance 0: a furnace's pixels read up to 3.7 K
+ * low); it goes on to the far wall's front. */
+static void test_back_of_the_wall_it_starts_on(void **state)
+{
+    (void)state;
+    thz_scene *s = ps_scene(0.35, 0.01, 1000, 1);
+    size_t m = ps_material(s, 0.1, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t room = ps_object(s, OBJECT_SOLID, m, 300, 0, false);
+    ps_box(s, room, v3(2995, -5, -5), v3(3005, 5, 5), true);
+    ps_finalize(s);
+    accel *acc;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    accel_hit h;
+    vec3 dir = v3_normalize(v3(-0.6, 0.1, 0.8));
+    assert_true(accel_intersect(acc, v3(3005.0, 0.3, 0.2), dir, INFINITY, ACCEL_NO_OBJECT, 0, &h));
+    assert_int_equal(h.side, 0);
+    assert_true(h.distance_m > 1.0);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
 static void test_offset_is_the_hits(void **state)
 {
     (void)state;
@@ -262,6 +286,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_shared_edge, setup, teardown),
         cmocka_unit_test_setup_teardown(test_threads, setup, teardown),
         cmocka_unit_test(test_offset_is_the_hits),
+        cmocka_unit_test(test_back_of_the_wall_it_starts_on),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
