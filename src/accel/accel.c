@@ -241,6 +241,18 @@ void accel_destroy(accel *a)
     free(a);
 }
 
+/* Casts rh's ray again over [tnear, tfar] (with ctx's filter, if set), forgetting its hit. */
+static void accel_recast(const accel *a, accel_context *ctx, struct RTCRayHit *rh, float tnear,
+                         float tfar)
+{
+    rh->ray.tnear = tnear;
+    rh->ray.tfar = tfar;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(a->rtc, &ctx->base, rh);
+}
+
 bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distance_m,
                      uint32_t ignore_object, uint32_t ignore_triangle, accel_hit *hit)
 {
@@ -275,11 +287,7 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
     if (ignore_object != ACCEL_NO_OBJECT && rh.hit.geomID == ignore_object &&
         rh.hit.primID == ignore_triangle) {
         ctx.base.filter = accel_filter;
-        rh.ray.tfar = tfar;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(a->rtc, &ctx.base, &rh);
+        accel_recast(a, &ctx, &rh, 0.0f, tfar);
     }
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return false;
@@ -291,10 +299,9 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
     double c = v3_dot(dir, n);
     /* A face met from its back, of a solid whose back no ray can see (solids are opaque),
      * its plane closer to the origin than the origin's rounding to single precision may
-     * move it: the origin of a
-     * ray leaving near a concave corner, offset off its own wall, rounded behind the next
-     * one (a closed room 10 m across, 3 km from the origin, read some pixels up to 3.7 K
-     * low). Cast again from beyond that distance. */
+     * move it: the origin of a ray leaving near a concave corner, offset off its own wall,
+     * rounded onto or behind the next one (a closed room 10 m across, 3 km from the
+     * origin, read some pixels up to 3.7 K low). Cast again from just beyond that face. */
     float near = 32.0f * FLT_EPSILON *
                  fmaxf(fabsf(rh.ray.org_x), fmaxf(fabsf(rh.ray.org_y), fabsf(rh.ray.org_z)));
     if (c > 0.0 && rh.ray.tfar * c < near &&
@@ -302,12 +309,7 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
         if (ignore_object != ACCEL_NO_OBJECT)
             ctx.base.filter = accel_filter;
         /* just beyond that plane: not a centimetre on, where a corner's third wall may be */
-        rh.ray.tnear = fmaxf(1.001f * rh.ray.tfar, 0.125f * near);
-        rh.ray.tfar = tfar;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(a->rtc, &ctx.base, &rh);
+        accel_recast(a, &ctx, &rh, fmaxf(1.001f * rh.ray.tfar, 0.125f * near), tfar);
         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
             return false;
         m = &a->scene->objects[rh.hit.geomID].mesh;
