@@ -302,8 +302,10 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
      * move it: the origin of a ray leaving near a concave corner, offset off its own wall,
      * rounded onto or behind the next one (a closed room 10 m across, 3 km from the
      * origin, read some pixels up to 3.7 K low). Cast again from just beyond that face. */
-    float near = 32.0f * FLT_EPSILON *
-                 fmaxf(fabsf(rh.ray.org_x), fmaxf(fabsf(rh.ray.org_y), fabsf(rh.ray.org_z)));
+    float near =
+        c > 0.0 ? 32.0f * FLT_EPSILON *
+                      fmaxf(fabsf(rh.ray.org_x), fmaxf(fabsf(rh.ray.org_y), fabsf(rh.ray.org_z)))
+                : 0.0f; /* only for a back-side hit: not on every ray's path */
     if (c > 0.0 && rh.ray.tfar * c < near &&
         !scene_object_side_is_front(&a->scene->objects[rh.hit.geomID], 1)) {
         if (ignore_object != ACCEL_NO_OBJECT)
