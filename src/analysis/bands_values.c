@@ -13,6 +13,7 @@
 
 #include "analysis/bands_progress.h"
 #include "analysis/bands_values_internal.h"
+#include "api/api.h"
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/path.h"
@@ -284,6 +285,13 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     if (!text)
         goto nomem;
     st = thz_scene_load_string_within(text, base_dir, s->scene_path, s->root, &scene, err);
+    /* The scene's warnings, as simulate and render give them: those of the scene with the
+     * candidates as its channels (a candidate's band beyond a material table, a sensor
+     * outside its enclosure, ...), which the run warnings refer to; the nuisances'
+     * variants repeat them and are not said again. */
+    if (st == THZ_OK && ctx && ctx->warning)
+        for (size_t i = 0; i < thz_scene_warning_count(scene); i++)
+            ctx->warning(ctx->warning_user, thz_scene_warning(scene, i));
     if (st == THZ_OK)
         st = render_variant(ctx, text, s, base_dir, &nominal, err);
     free(text);

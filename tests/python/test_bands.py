@@ -160,6 +160,20 @@ def test_bands_takes_a_loaded_scene_and_targets():
     assert sel.report["seed"] == 3 and 0.0 <= sel.score <= 2.0
 
 
+def test_bands_says_the_scene_warnings():
+    """The scene's warnings reach the caller, as simulate's and render's do: those of the
+    scene with the candidates as its channels, here candidates at 1.2 and 1.3 THz whose
+    bands leave the tables of features.json, which end at 1.2 THz (the end values are
+    used there). bands
+    used to drop them, and the run warnings that refer to them ("see the scene
+    warning") came alone."""
+    with pytest.warns(thzmap.RunWarning) as caught:
+        thzmap.bands(FEATURES, 1, from_thz=1.1, to_thz=1.3, step_ghz=100, paths=2)
+    said = [str(w.message) for w in caught]
+    assert any('material "a", reflectivity: the table covers 0.1 to 1.2 THz' in m
+               and 'channel "1.200 THz"' in m for m in said), said
+
+
 def test_bands_errors(tmp_path):
     for kwargs in (dict(count=0), dict(count=1, widths=[0.6]), dict(count=1, widths=[]),
                    dict(count=1, angle_range_deg=91), dict(count=1, targets=[""]),
