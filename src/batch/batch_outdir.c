@@ -1,8 +1,10 @@
 /* A batch's output directory: created (mkdir -p), locked against a second batch into it
- * (a POSIX lock, not inherited by forked children), and cleaned of what a batch killed
- * inside a frame's commit left beside finished frames. batch_run.c runs the frames,
- * batch_json.c writes batch.json and the frames' frame.json (batch_run_state.h).
+ * (an open file description's lock, which a second batch of the same process meets too),
+ * and cleaned of what a batch killed inside a frame's commit left beside finished frames.
+ * batch_run.c runs the frames, batch_json.c writes batch.json and the frames' frame.json
+ * (batch_run_state.h).
  */
+#define _GNU_SOURCE /* F_OFD_SETLK */
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -96,10 +98,14 @@ thz_status batch_lock(const char *outdir, int *fd, thz_error *err)
     *fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
     if (*fd < 0)
         return thz_error_set(err, THZ_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    /* A process-associated (POSIX) lock, not flock: children forked for plotting
-     * (core/child.c) would inherit a flock and hold it after a SIGKILL of the batch. */
+    /* An open file description's lock, as the outputs' flock (io/output_stage.c): a
+     * process-associated (POSIX) lock never conflicts with one of the same process, so
+     * two batches into OUTDIR from two threads (Python, a C program) both ran and mixed
+     * their frames, and closing any descriptor of the file let the lock go. The children
+     * forked for plotting share the description, and die with the batch (core/child.c:
+     * PR_SET_PDEATHSIG), so a SIGKILLed batch leaves no holder behind. */
     struct flock lk = {.l_type = F_WRLCK, .l_whence = SEEK_SET};
-    if (fcntl(*fd, F_SETLK, &lk) != 0) {
+    if (fcntl(*fd, F_OFD_SETLK, &lk) != 0) {
         close(*fd);
         *fd = -1;
         return thz_error_set(err, THZ_ERR_IO,
