@@ -3,7 +3,8 @@
  *
  * Names beside OUTDIR (PARENT is the directory holding it, H a hash of its name, so that
  * every name fits NAME_MAX however long OUTDIR's name is):
- *   PARENT/.thzmap-H-lock            held with flock(2) for the stage's lifetime
+ *   PARENT/.thzmap-H-lock            held with flock(2) for the stage's lifetime (for a
+ *                                    mount point, OUTDIR/.thzmap-lock)
  *   PARENT/.thzmap-H-stage-PID-N     the new run (STAGE_SWAP), or the old run after the swap
  *   PARENT/.thzmap-H-old-PID-N       the old run, only while a swap falls back to two renames
  * A run that holds the lock owns every such name: anything found there is left by a run
@@ -272,13 +273,21 @@ static void stage_clean_leftovers(const output_stage *stage, const char *base_pr
     }
 }
 
+/* Whether OUTDIR exists and is a mount point (its parent is another file system). */
+static bool stage_mount_point(const output_stage *stage)
+{
+    struct stat out, parent;
+    return stat(stage->target, &out) == 0 && S_ISDIR(out.st_mode) &&
+           stat(stage->parent, &parent) == 0 && parent.st_dev != out.st_dev;
+}
+
 /* STAGE_FILES when OUTDIR exists and is a mount point or the working directory. */
 static stage_mode stage_choose_mode(const output_stage *stage)
 {
-    struct stat out, parent, cwd;
+    struct stat out, cwd;
     if (stat(stage->target, &out) != 0 || !S_ISDIR(out.st_mode))
         return STAGE_SWAP;
-    if (stat(stage->parent, &parent) == 0 && parent.st_dev != out.st_dev)
+    if (stage_mount_point(stage))
         return STAGE_FILES;
     if (stat(".", &cwd) == 0 && cwd.st_dev == out.st_dev && cwd.st_ino == out.st_ino)
         return STAGE_FILES;
@@ -362,8 +371,15 @@ thz_status output_stage_create(const char *outdir, output_stage **out, thz_error
                                outdir, holder, strerror(errno));
         goto cleanup;
     }
+    /* The lock goes beside OUTDIR wherever the caller stands: a run from inside OUTDIR
+     * (-o .) stages and commits file by file, but must meet a run from elsewhere (-o out,
+     * swapped) at the same lock, or both ran and each removed the other's stage as a
+     * dead run's. Inside OUTDIR only where no swapping run can be: a mount point, or a
+     * parent this user cannot write. */
+    bool lock_inside = stage->mode == STAGE_FILES &&
+                       (stage_mount_point(stage) || access(stage->parent, W_OK | X_OK) != 0);
     char lock_path[THZ_PATH_MAX + 8];
-    if (stage->mode == STAGE_FILES)
+    if (lock_inside)
         status = thz_path_join(lock_path, THZ_PATH_MAX, stage->target, ".thzmap-lock", err);
     else
         snprintf(lock_path, sizeof lock_path, "%s-lock", stage->prefix);

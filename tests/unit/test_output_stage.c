@@ -336,6 +336,39 @@ static void test_commit_into_working_directory(void **state)
     free(tmp);
 }
 
+/* A run from inside OUTDIR (-o ., committed file by file) and a run from its parent (-o
+ * out, swapped) take the same lock: the one that came second is refused. They took a
+ * lock each (inside OUTDIR, and beside it), both ran, and each removed the other's stage
+ * as a dead run's ("cannot create: No such file or directory"). */
+static void test_working_directory_shares_the_lock(void **state)
+{
+    (void)state;
+    char *tmp = make_tmp_dir();
+    char cwd[4096], outdir[1024];
+    snprintf(outdir, sizeof outdir, "%s/out", tmp);
+    assert_int_equal(mkdir(outdir, 0777), 0);
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    for (int first_inside = 0; first_inside < 2; first_inside++) {
+        output_stage *a = NULL, *b = NULL;
+        thz_error err = {0};
+        assert_int_equal(chdir(first_inside ? outdir : tmp), 0);
+        assert_int_equal(output_stage_create(first_inside ? "." : "out", &a, NULL), THZ_OK);
+        assert_int_equal(chdir(first_inside ? tmp : outdir), 0);
+        assert_int_equal(output_stage_create(first_inside ? "out" : ".", &b, &err), THZ_ERR_IO);
+        assert_null(b);
+        assert_non_null(strstr(err.message, "has an output open there already"));
+        assert_int_equal(chdir(first_inside ? outdir : tmp), 0); /* a's paths are relative */
+        assert_int_equal(access(output_stage_dir(a), F_OK), 0);  /* its stage is still there */
+        output_stage_destroy(a);
+        assert_int_equal(chdir(cwd), 0);
+        assert_int_equal(count_entries(tmp), 1);
+        assert_int_equal(count_entries(outdir), 0);
+    }
+    assert_int_equal(rmdir(outdir), 0);
+    assert_int_equal(rmdir(tmp), 0);
+    free(tmp);
+}
+
 /* OUTDIR's subdirectories (another run's OUTDIR), foreign files and permissions survive a
  * commit. */
 static void test_commit_keeps_subdirectories(void **state)
@@ -652,6 +685,7 @@ int main(void)
         cmocka_unit_test(test_leftovers_cleaned),
         cmocka_unit_test(test_commit_keeps_subdirectories),
         cmocka_unit_test(test_commit_into_working_directory),
+        cmocka_unit_test(test_working_directory_shares_the_lock),
         cmocka_unit_test(test_commit_through_symlink),
         cmocka_unit_test(test_bad_outdir),
         cmocka_unit_test(test_error_names_outdir),
