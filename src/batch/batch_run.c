@@ -164,6 +164,23 @@ static int batch_on_run_progress(void *user, const thz_progress *p)
     return stop | batch_report(b->opt, b, b->frame, "run");
 }
 
+/* Reads again, under OUTDIR's lock, whether the frames found finished still are: the
+ * first reading comes before the lock (and the memory check, which builds every frame to
+ * run), and a batch of other values that ran into OUTDIR and ended meanwhile left its own
+ * frames there, which this batch then counted as its own (batch.json of one sequence
+ * over the images of another). Such frames are run again. Whether any was. */
+static bool batch_recheck_done(batch_state *b)
+{
+    bool changed = false;
+    for (size_t f = 0; f < b->seq->n_frames; f++)
+        if (b->state[f] == FRAME_REUSED && !batch_frame_done(b, f)) {
+            b->state[f] = FRAME_PENDING;
+            b->reused--;
+            changed = true;
+        }
+    return changed;
+}
+
 /* Every frame to run is refused before the first starts, as its own run would refuse it,
  * when it would not fit in memory (thz_simulate_check: 10^11 photons of a sweep's second
  * value were refused only after the first value's frames had run). Frames that render
@@ -248,6 +265,8 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
         st = batch_mkdirs(outdir, err);
     if (st == THZ_OK)
         st = batch_lock(outdir, &lock_fd, err);
+    if (st == THZ_OK && b.reused > 0 && batch_recheck_done(&b))
+        st = batch_check_memory(&b, err);
     if (st == THZ_OK && b.reused > 0)
         batch_clean_finished(&b);
     /* a sensor too large for the movie encoder: said before the frames run */

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# A batch that resumes into OUTDIR reads which frames are finished before it locks OUTDIR
+# (and before its memory check, which builds every frame to run). A batch of other values
+# that runs into OUTDIR and ends in that window replaces those frames with its own; the
+# resumed batch must see that once it holds the lock and run them again, not count them
+# as finished (it wrote a batch.json of sequence B over the images of sequence A).
+# strace delays the resumed batch's open of the lock file by 5 s to make the window sure.
+# argv: path to the thzmap binary, repository directory.
+set -u
+THZMAP=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+command -v strace >/dev/null || { echo "FAIL: strace is missing (scripts/install-deps.sh installs it)"; exit 1; }
+
+cat > "$work/scene.json" <<'JSON'
+{
+  "format": "thzmap-scene/1",
+  "name": "batch-reuse-race",
+  "channels": [{"frequency_thz": 0.35, "relative_width": 0.05}],
+  "materials": {"wall": {"reflectivity": 0.2}, "paint": {"reflectivity": 0.5}},
+  "objects": [
+    {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}},
+    {"name": "plate", "type": "solid", "material": "paint", "temperature_k": 310,
+     "shape": {"type": "box", "size_m": [0.5, 0.05, 0.5]}}
+  ],
+  "sensors": [
+    {"name": "a", "position_m": [0, -0.9, 0], "look_at_m": [0, 0, 0], "fov_deg": 60,
+     "resolution": [8, 6]}
+  ],
+  "render": {"integrator": "path", "paths_per_sample": 2},
+  "photons": {"seed": 1}
+}
+JSON
+for t in A:320:300 B:340:305; do
+  IFS=: read -r name t0 t1 <<<"$t"
+  cat > "$work/seq$name.json" <<JSON
+{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 2,
+ "keyframes": [{"time_s": 0, "objects": {"plate": {"temperature_k": $t0}}},
+               {"time_s": 1, "objects": {"plate": {"temperature_k": $t1}}}]}
+JSON
+done
+cd "$work" || exit 1
+"$THZMAP" batch seqA.json -o pureA -q --no-movies --threads 1 || fail "batch A"
+"$THZMAP" batch seqB.json -o out -q --no-movies --threads 1 || fail "batch B"
+# resume B (every frame finished), its lock delayed; A runs and ends meanwhile
+# (LeakSanitizer cannot run under ptrace: the sanitizer build checks the rest)
+ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 strace -f -qq -o /dev/null -e trace=openat -e inject=openat:delay_enter=5000000 \
+  -P out/.thzmap-batch-lock "$THZMAP" batch seqB.json -o out -q --no-movies --threads 1 2>/dev/null &
+resumed=$!
+sleep 1
+"$THZMAP" batch seqA.json -o out -q --no-movies --threads 1 || fail "batch A into out"
+wait $resumed || fail "resumed batch B: exit $?"
+grep -q '"sequence": ".*seqB.json"' out/batch.json || fail "batch.json is not B's"
+for f in frame-00000 frame-00001; do
+  cmp -s out/$f/a.brightness_temperature.img pureA/$f/a.brightness_temperature.img &&
+    fail "$f holds A's images under B's batch.json"
+done
+grep -q '"frames_computed": 2' out/batch.json || fail "B did not run its frames again: $(grep frames_ out/batch.json | tr -d '\n ')"
+[ $fails -eq 0 ] && echo ok
+exit $((fails > 0))
