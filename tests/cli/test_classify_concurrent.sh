@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# classify reads RUN_DIR's cube and then its truth map. A simulate that commits into
+# RUN_DIR between the two reads (made sure here by delaying, with strace, classify's open
+# of the truth header by 2 s while the simulate runs) must not give a classification of
+# one run's cube against the other's truth: classify reads RUN_DIR again and classifies
+# the new run, as if it had started after it (it paired them, exit 0, accuracy 0.27
+# where each run alone gives 0.99).
+# argv: path to the thzmap binary, repository directory.
+set -u
+THZMAP=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+command -v strace >/dev/null || { echo "FAIL: strace is missing (scripts/install-deps.sh installs it)"; exit 1; }
+
+for x in 1:0:310 2:0.15:320; do
+  IFS=: read -r n dx t <<<"$x"
+  cat > "$work/scene$n.json" <<JSON
+{
+  "format": "thzmap-scene/1",
+  "name": "classify-concurrent",
+  "channels": [{"frequency_thz": 0.35, "relative_width": 0.01},
+               {"frequency_thz": 0.8, "relative_width": 0.01}],
+  "materials": {"wall": {"reflectivity": 0.0},
+                "paint": {"reflectivity": [[0.2, 0.05], [1.2, 0.12]]}},
+  "objects": [
+    {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+     "shape": {"type": "box", "size_m": [1, 1, 2], "inward": true},
+     "transform": {"translate_m": [0, 0, 1]}},
+    {"name": "target", "type": "solid", "material": "paint", "temperature_k": $t,
+     "shape": {"type": "cylinder", "radius_m": 0.1, "height_m": 0.75, "caps": true},
+     "transform": {"translate_m": [$dx, 0, 0.001]}}
+  ],
+  "sensors": [
+    {"name": "cam", "position_m": [0, -0.45, 0.4], "look_at_m": [0, 0, 0.4],
+     "up": [0, 0, 1], "fov_deg": 40, "resolution": [24, 24]}
+  ],
+  "render": {"integrator": "path", "paths_per_sample": 2},
+  "photons": {"seed": 1}
+}
+JSON
+done
+cd "$work" || exit 1
+"$THZMAP" simulate scene2.json -o run2 -q && "$THZMAP" classify run2 --sensor cam -o pure2 -q ||
+  fail "run 2 alone"
+"$THZMAP" simulate scene1.json -o run -q || fail "run 1"
+# (LeakSanitizer cannot run under ptrace: the sanitizer build checks the rest)
+ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 strace -f -qq -o /dev/null -e trace=openat -e inject=openat:delay_enter=2000000:when=1 \
+  -P run/cam.object_id.hdr "$THZMAP" classify run --sensor cam -o mixed -q 2>"$work/classify.err" &
+classify=$!
+sleep 0.5
+"$THZMAP" simulate scene2.json -o run -q || fail "run 2 into run"
+wait $classify || fail "classify: exit $?: $(cat "$work/classify.err")"
+cmp -s mixed/cam.class.img pure2/cam.class.img ||
+  fail "the classification is not run 2's: $(grep -m1 '"accuracy"' mixed/classification.json)"
+[ $fails -eq 0 ] && echo ok
+exit $((fails > 0))
