@@ -116,7 +116,8 @@ THZ_API thz_status thz_photons_load_channel(thz_context *ctx, const thz_scene *s
                                             const char *path, size_t channel, thz_photons **out,
                                             thz_error *err);
 /* Writes every channel's map to `path` (.thzpm, what `render` reads); THZ_ERR_INPUT
- * when a channel has no map. Writes the file directly (not staged). */
+ * when a channel has no map. Written beside `path` and renamed over it once whole: a
+ * reader of the previous file keeps it whole, and a failed save leaves it as it was. */
 THZ_API thz_status thz_photons_save(const thz_photons *photons, const char *path, thz_error *err);
 /* Merges n photon sets of one scene, seed and integrator, fired with disjoint photon
  * ranges (or for different channels), into one of all their photons (*out; the parts

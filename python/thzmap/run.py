@@ -143,7 +143,8 @@ class PhotonMap:
         return out
 
     def save(self, path):
-        """Writes the maps to `path` (.thzpm, what render and load_photon_map read)."""
+        """Writes the maps to `path` (.thzpm, what render and load_photon_map read),
+        replacing a file there only once the new one is whole."""
         path = _path_arg("path", path)
         err = _lib.ThzError()
         status = _lib.lib.thz_photons_save(self._ptr, os.fsencode(path), ctypes.byref(err))

@@ -113,6 +113,40 @@ def test_photon_map_save_load_render(tiny_dir, thzmap_binary):
     assert_bitwise_equal(by_path.image(0).power, rendered.image(0).power, "power")
 
 
+def test_photon_map_save_replaces_whole(tiny_dir):
+    """PhotonMap.save writes beside the file and renames it into place: a save that fails
+    (a file-size limit; Python ignores SIGXFSZ, so the write fails with EFBIG) leaves the
+    map that was there, whole (it was truncated in place, and then failed to load as
+    corrupted); nothing else is left in the directory; a symbolic link is written
+    through and the file keeps its mode."""
+    import resource
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    pm = thzmap.fire_photons(scene, photons=3000, seed=SEED)
+    maps = tiny_dir / "maps"
+    maps.mkdir()
+    path = maps / "map.thzpm"
+    pm.save(path)
+    os.chmod(path, 0o640)
+    before = path.read_bytes()
+    other = thzmap.fire_photons(scene, photons=3000, seed=SEED + 1)
+    soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (len(before) // 2, hard))
+    try:
+        with pytest.raises(thzmap.Error, match="cannot write photon map .*maps/map.thzpm: File too large"):
+            other.save(path)
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
+    assert path.read_bytes() == before
+    assert os.listdir(maps) == ["map.thzpm"]
+    os.symlink("map.thzpm", maps / "link.thzpm")
+    other.save(maps / "link.thzpm")
+    assert os.path.islink(maps / "link.thzpm")
+    assert path.read_bytes() != before
+    assert os.stat(path).st_mode & 0o777 == 0o640
+    assert sorted(os.listdir(maps)) == ["link.thzpm", "map.thzpm"]
+    assert thzmap.load_photon_map(scene, path).seed == SEED + 1
+
+
 def test_fire_and_merge(tiny_dir, tmp_path):
     scene = thzmap.load_scene(tiny_dir / "scene.json")
     a = thzmap.fire_photons(scene, photons=1500, seed=SEED)
