@@ -312,20 +312,42 @@ enum MHD_Result serve_pixel(serve_request *r)
     char hdr[PATH_MAX];
     thz_error cube_err = {0};
     long rows = -1, cols = -1;
+    bool inside = false;
     pthread_mutex_lock(&r->s->cache_lock);
-    if (snprintf(hdr, sizeof hdr, "%s/%s.brightness_temperature.hdr", dir, sensor) <
-            (int)sizeof hdr &&
-        serve_path_inside(r->s, hdr)) {
-        const thz_cube *c = serve_cube_get(r->s, hdr, &cube_err);
-        if (c) {
-            rows = (long)thz_cube_rows(c);
-            cols = (long)thz_cube_columns(c);
+    /* The cubes are read one after the other: a run that committed into dir meanwhile
+     * gave one answer of both runs (the first's Tb beside the second's truth object and
+     * the first's temperature). dir, the same before and after (a commit gives it a new
+     * inode, or renames files into it: a new modification time), says none did; else
+     * the pixel is read again (the cache re-reads the files that changed). */
+    for (int attempt = 0; attempt < 10; attempt++) {
+        struct stat before, after;
+        bool known = stat(dir, &before) == 0;
+        json_decref(names);
+        names = NULL;
+        cube_err = (thz_error){0};
+        rows = cols = -1;
+        if (snprintf(hdr, sizeof hdr, "%s/%s.brightness_temperature.hdr", dir, sensor) <
+                (int)sizeof hdr &&
+            serve_path_inside(r->s, hdr)) {
+            const thz_cube *c = serve_cube_get(r->s, hdr, &cube_err);
+            if (c) {
+                rows = (long)thz_cube_rows(c);
+                cols = (long)thz_cube_columns(c);
+            }
         }
+        inside = row >= 0 && col >= 0 && row < rows && col < cols;
+        for (size_t i = 0; i < NQ && inside; i++)
+            n[i] = serve_pixel_values(r->s, dir, sensor, q[i], row, col, v + i * SERVE_MAX_BANDS,
+                                      SERVE_MAX_BANDS, i == 0 ? centres : NULL,
+                                      i == 6 ? &names : NULL);
+        if (!known ||
+            (stat(dir, &after) == 0 && before.st_dev == after.st_dev &&
+             before.st_ino == after.st_ino && before.st_mtim.tv_sec == after.st_mtim.tv_sec &&
+             before.st_mtim.tv_nsec == after.st_mtim.tv_nsec &&
+             before.st_ctim.tv_sec == after.st_ctim.tv_sec &&
+             before.st_ctim.tv_nsec == after.st_ctim.tv_nsec))
+            break;
     }
-    bool inside = row >= 0 && col >= 0 && row < rows && col < cols;
-    for (size_t i = 0; i < NQ && inside; i++)
-        n[i] = serve_pixel_values(r->s, dir, sensor, q[i], row, col, v + i * SERVE_MAX_BANDS,
-                                  SERVE_MAX_BANDS, i == 0 ? centres : NULL, i == 6 ? &names : NULL);
     pthread_mutex_unlock(&r->s->cache_lock);
     if (!inside || !n[0]) { /* n[0]: the cube read, but no band of it (not one of ours) */
         free(v);
