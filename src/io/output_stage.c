@@ -176,7 +176,8 @@ static thz_status stage_lock(output_stage *stage, const char *lock_path, thz_err
             if (pid[0] && strtol(pid, NULL, 10) == (long)getpid()) /* a library caller's */
                 return thz_error_set(err, THZ_ERR_IO,
                                      "%s: this process has an output open there already "
-                                     "(commit or destroy it first)",
+                                     "(another thread writing its results there, or an "
+                                     "output not yet committed or destroyed)",
                                      stage->outdir);
             return thz_error_set(err, THZ_ERR_IO,
                                  "%s: another thzmap run (process %s) is writing its results "
