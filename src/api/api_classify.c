@@ -372,12 +372,7 @@ thz_status thz_classify_run(const char *run_dir, const char *sensor,
         st = thz_cube_read(run_dir, cube_stem, &cube, err);
         if (st == THZ_OK)
             st = thz_cube_read(run_dir, truth_stem, &truth, err);
-        bool stable = !known || (stat(run_dir, &after) == 0 && before.st_dev == after.st_dev &&
-                                 before.st_ino == after.st_ino &&
-                                 before.st_mtim.tv_sec == after.st_mtim.tv_sec &&
-                                 before.st_mtim.tv_nsec == after.st_mtim.tv_nsec &&
-                                 before.st_ctim.tv_sec == after.st_ctim.tv_sec &&
-                                 before.st_ctim.tv_nsec == after.st_ctim.tv_nsec);
+        bool stable = !known || (stat(run_dir, &after) == 0 && file_dir_unchanged(&before, &after));
         if (stable)
             break;
         thz_cube_destroy(cube);

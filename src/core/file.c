@@ -1,4 +1,5 @@
-/* The regular-file check of input files, and what a file is from its first bytes. */
+/* The regular-file check of input files, what a file is from its first bytes, and whether
+ * a directory changed while it was read. */
 #include "core/file.h"
 
 #include <errno.h>
@@ -111,4 +112,11 @@ thz_status file_write_text(const char *path, const char *text, thz_error *err)
     if (why)
         return thz_error_set(err, THZ_ERR_IO, "%s: write failed: %s", path, strerror(why));
     return THZ_OK;
+}
+
+bool file_dir_unchanged(const struct stat *a, const struct stat *b)
+{
+    return a->st_dev == b->st_dev && a->st_ino == b->st_ino &&
+           a->st_mtim.tv_sec == b->st_mtim.tv_sec && a->st_mtim.tv_nsec == b->st_mtim.tv_nsec &&
+           a->st_ctim.tv_sec == b->st_ctim.tv_sec && a->st_ctim.tv_nsec == b->st_ctim.tv_nsec;
 }

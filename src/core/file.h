@@ -7,8 +7,10 @@
 #ifndef THZ_CORE_FILE_H
 #define THZ_CORE_FILE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <sys/stat.h>
 
 #include "core/error.h"
 
@@ -39,5 +41,11 @@ const char *file_kind_hint(const unsigned char *head, size_t n);
 /* Writes text and a newline to path (created or replaced): THZ_ERR_IO naming path and
  * the first failure's reason ("No space left on device") when it cannot. */
 thz_status file_write_text(const char *path, const char *text, thz_error *err);
+
+/* Whether a directory stat'ed before and after reading files in it (a = before, b =
+ * after) is the same and unchanged: a run's commit into it gives it a new inode (the
+ * exchange) or renames files into it (a new modification or change time), so readers of
+ * several files of one run (classify) read again when this is false. */
+bool file_dir_unchanged(const struct stat *a, const struct stat *b);
 
 #endif
