@@ -80,9 +80,10 @@ thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err)
         if ((double)need > 0.9 * (double)have) /* as run_check_memory */
             return thz_error_set(err, THZ_ERR_LIMIT,
                                  "%s: sensors[%zu].resolution: the images of %u x %u pixels in "
-                                 "%zu channels need %.1f GiB, more than this machine's memory "
-                                 "(%.1f GiB) allows; lower 'resolution' (or the number of "
-                                 "channels)",
+                                 "%zu channels need %.1f GiB, more than the %.1f GiB this "
+                                 "process may have (the machine's memory, or less under ulimit "
+                                 "-v or a cgroup limit) allows; lower 'resolution' (or the "
+                                 "number of channels)",
                                  scene->path, s, sn->columns, sn->rows, scene->n_channels,
                                  (double)need / 1073741824.0, (double)have / 1073741824.0);
     }
