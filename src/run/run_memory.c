@@ -59,7 +59,9 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
             if ((uint64_t)scene->sensors[s].columns * scene->sensors[s].rows >
                 (uint64_t)scene->sensors[big].columns * scene->sensors[big].rows)
                 big = s;
-        snprintf(key, sizeof key, "sensors[%zu].resolution", big);
+        /* the images of every sensor together: the largest alone may not be the cause */
+        snprintf(key, sizeof key, "sensors[%zu].resolution%s", big,
+                 scene->n_sensors > 1 ? " (or the number of sensors)" : "");
     }
     return thz_error_set(err, THZ_ERR_LIMIT,
                          "%s: the run would need %.2f GiB of memory (photon maps %.2f GiB, "

@@ -1,7 +1,10 @@
 /* The refusal of a scene whose images would not fit (run_check_scene_memory) names the
  * limit for what it is: under `ulimit -v` (RLIMIT_AS) it is the process's address space,
  * not the machine's memory. With `prlimit --as=4G` on a machine of 23.5 GiB the message
- * said "more than this machine's memory (4.0 GiB) allows". */
+ * said "more than this machine's memory (4.0 GiB) allows". And a run refused for the
+ * images of all its sensors together (run_check_memory) names the number of sensors
+ * among what to lower: 120 sensors of 1024 x 1024 pixels (9.4 GiB) were told "lower
+ * sensors[0].resolution", which alone would not have made them fit. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -9,6 +12,7 @@
 
 #include <cmocka.h>
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/resource.h>
@@ -16,10 +20,14 @@
 #include "run/run.h"
 #include "scene/scene.h"
 
-/* 1024 x 1024 pixels in 100 channels: about 2 GiB of images */
-static thz_scene *load_large(void)
+/* 1024 x 1024 pixels in 100 channels: about 2 GiB of images; a second sensor if two */
+static thz_scene *load_large(bool two)
 {
     char json[2048];
+    const char *second = two ? ", {\"name\": \"cam2\", \"position_m\": [0, 0, 0],"
+                               " \"look_at_m\": [1, 0, 0], \"fov_deg\": 50,"
+                               " \"resolution\": [64, 64]}"
+                             : "";
     int n =
         snprintf(json, sizeof json,
                  "{\"format\": \"thzmap-scene/1\","
@@ -30,7 +38,8 @@ static thz_scene *load_large(void)
                  "\"wall\", \"temperature_k\": 300,"
                  "   \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2], \"inward\": true}}],"
                  " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, 0, 0],"
-                 "   \"look_at_m\": [0, 1, 0], \"fov_deg\": 50, \"resolution\": [1024, 1024]}]}");
+                 "   \"look_at_m\": [0, 1, 0], \"fov_deg\": 50, \"resolution\": [1024, 1024]}%s]}",
+                 second);
     assert_true(n > 0 && (size_t)n < sizeof json);
     thz_scene *s = NULL;
     thz_error err;
@@ -42,7 +51,7 @@ static thz_scene *load_large(void)
 static void test_refusal_under_address_space_limit(void **state)
 {
     (void)state;
-    thz_scene *s = load_large();
+    thz_scene *s = load_large(false);
     struct rlimit before;
     assert_int_equal(getrlimit(RLIMIT_AS, &before), 0);
     struct rlimit one_gib = {.rlim_cur = (rlim_t)1 << 30, .rlim_max = before.rlim_max};
@@ -60,10 +69,36 @@ static void test_refusal_under_address_space_limit(void **state)
     scene_destroy(s);
 }
 
+/* What to lower, with one sensor and with two, when the images are what does not fit. */
+static const char *refusal(bool two, char *buf, size_t size)
+{
+    thz_scene *s = load_large(two);
+    run_memory need = {.image_bytes = (uint64_t)3 << 30, .held_bytes = (uint64_t)20 << 20};
+    need.total_bytes = need.image_bytes + need.held_bytes;
+    need.available_bytes = (uint64_t)1 << 30;
+    thz_error err;
+    thz_error_clear(&err);
+    assert_int_not_equal(run_check_memory(s, &need, &err), THZ_OK);
+    snprintf(buf, size, "%s", err.message);
+    scene_destroy(s);
+    return buf;
+}
+
+static void test_images_of_several_sensors(void **state)
+{
+    (void)state;
+    char one[1024], two[1024];
+    assert_non_null(strstr(refusal(false, one, sizeof one), "lower sensors[0].resolution"));
+    assert_null(strstr(one, "number of sensors"));
+    assert_non_null(strstr(refusal(true, two, sizeof two), "lower sensors[0].resolution"));
+    assert_non_null(strstr(two, "number of sensors"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_refusal_under_address_space_limit),
+        cmocka_unit_test(test_images_of_several_sensors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
