@@ -182,7 +182,10 @@ uint32_t run_photon_next_check(uint32_t n, double need)
 
 double run_passes_memory_limit_bytes(void)
 {
-    return 0.5 * (double)thz_physical_memory_bytes();
+    /* the process's limit (ulimit -v, a cgroup), not only the machine's: under a limit of
+     * 1 GiB the passes were let hold 11.7 GiB and ended out of memory (under a cgroup's
+     * limit, the kernel's OOM killer ends them) */
+    return 0.5 * (double)thz_memory_limit_bytes();
 }
 
 uint32_t run_photon_checks(uint32_t passes)
