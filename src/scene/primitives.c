@@ -56,23 +56,26 @@ thz_status primitive_box(thz_mesh *mesh, const double size_m[3], bool inward, th
     for (size_t v = 0; v < 8; v++)
         primitive_set_vertex(mesh, v, (v & 1 ? 0.5 : -0.5) * size_m[0],
                              (v & 2 ? 0.5 : -0.5) * size_m[1], (v & 4 ? 0.5 : -0.5) * size_m[2]);
-    /* each face as a quad a b c d, counter-clockwise seen from outside */
+    /* each face as a quad a b c d, counter-clockwise seen from outside, with a -> b along
+     * x (the faces normal to x: along y), the direction of Ward's tangent there */
     static const size_t faces[6][4] = {
-        {0, 2, 3, 1}, /* -z */
+        {1, 0, 2, 3}, /* -z */
         {4, 5, 7, 6}, /* +z */
         {0, 1, 5, 4}, /* -y */
-        {2, 6, 7, 3}, /* +y */
-        {0, 4, 6, 2}, /* -x */
+        {3, 2, 6, 7}, /* +y */
+        {2, 0, 4, 6}, /* -x */
         {1, 3, 7, 5}, /* +x */
     };
+    /* Both triangles of a face start on a side parallel to a -> b (the tangent is a
+     * triangle's first edge; on the diagonal, half of each face was brushed across it) */
     for (size_t f = 0; f < 6; f++) {
         const size_t *q = faces[f];
         if (inward) {
-            primitive_set_triangle(mesh, 2 * f, q[0], q[2], q[1]);
-            primitive_set_triangle(mesh, 2 * f + 1, q[0], q[3], q[2]);
+            primitive_set_triangle(mesh, 2 * f, q[1], q[0], q[2]);
+            primitive_set_triangle(mesh, 2 * f + 1, q[3], q[2], q[0]);
         } else {
             primitive_set_triangle(mesh, 2 * f, q[0], q[1], q[2]);
-            primitive_set_triangle(mesh, 2 * f + 1, q[0], q[2], q[3]);
+            primitive_set_triangle(mesh, 2 * f + 1, q[2], q[3], q[0]);
         }
     }
     return THZ_OK;
@@ -97,8 +100,9 @@ thz_status primitive_cylinder(thz_mesh *mesh, double radius_m, double height_m, 
     size_t t = 0;
     for (size_t i = 0; i < n; i++) {
         size_t j = (i + 1) % n;
+        /* both start along the circumference (Ward's tangent) */
         primitive_set_triangle(mesh, t++, i, j, n + j);
-        primitive_set_triangle(mesh, t++, i, n + j, n + i);
+        primitive_set_triangle(mesh, t++, n + j, n + i, i);
     }
     if (caps) {
         size_t cb = 2 * n, ct = 2 * n + 1;
@@ -123,8 +127,8 @@ thz_status primitive_rectangle(thz_mesh *mesh, const double size_m[2], thz_error
     primitive_set_vertex(mesh, 1, hx, -hy, 0.0);
     primitive_set_vertex(mesh, 2, hx, hy, 0.0);
     primitive_set_vertex(mesh, 3, -hx, hy, 0.0);
-    primitive_set_triangle(mesh, 0, 0, 1, 2);
-    primitive_set_triangle(mesh, 1, 0, 2, 3);
+    primitive_set_triangle(mesh, 0, 0, 1, 2); /* both start along x (Ward's tangent) */
+    primitive_set_triangle(mesh, 1, 2, 3, 0);
     return THZ_OK;
 }
 

@@ -223,7 +223,9 @@ static void test_stderr_is_honest_path(void **state)
 /* final-gather over photon seeds, so that the map's own noise is in the spread: with its
  * deviation map (simulate's), and from the paper's map of L, whose noise is a large part
  * of the error; there, without the map term (batches withheld) the reported error falls
- * short by 1.4 x or more: the check that the term is needed and that the test can fail. */
+ * short by more than the 1.2 x the checks allow (1.27 and 1.31 x on two triangulations
+ * of the room, whose maps' noise is shared by neighbouring pixels): the check that the
+ * term is needed and that the test can fail. */
 static void test_stderr_is_honest_final_gather(void **state)
 {
     (void)state;
@@ -239,7 +241,7 @@ static void test_stderr_is_honest_final_gather(void **state)
     r = honesty_ratio(
         INTEGRATOR_FINAL_GATHER,
         (honesty_case){.photons = 100000, .estimates = 16, .no_batches = true, .planck_map = true});
-    assert_true(r > 1.3);
+    assert_true(r > 1.2);
 }
 
 /* With one photon map the spread holds the gather rays' noise only: the reported error

@@ -1,7 +1,8 @@
 /* Primitives: triangle counts, areas against the exact polygon formulas (a tessellated
  * cylinder, sphere or disk has the area of its polygons, not of the smooth shape),
  * outward normals (each points away from the shape's centroid; for closed shapes the
- * area-weighted normals sum to zero), consistent winding, and Embree's padding. */
+ * area-weighted normals sum to zero), consistent winding, Embree's padding, and Ward's
+ * tangent (each triangle's first edge) along one line over a whole face. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -55,6 +56,27 @@ static void check_closed(const thz_mesh *m)
     assert_int_equal(winding_conflicts(m), 0);
 }
 
+/* Triangle t's first edge v0 -> v1, Ward's tangent, is parallel (either way) to `axis`
+ * (a unit vector): a quad's second triangle once started on its diagonal, and half of an
+ * anisotropic lobe's face was brushed across it. */
+static void check_tangent(const thz_mesh *m, size_t t, const double axis[3])
+{
+    const float *a = &m->positions[3 * m->indices[3 * t]];
+    const float *b = &m->positions[3 * m->indices[3 * t + 1]];
+    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double len = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    double dot = (e[0] * axis[0] + e[1] * axis[1] + e[2] * axis[2]) / len;
+    assert_true(fabs(fabs(dot) - 1.0) < 1e-6);
+}
+
+/* A box's faces: the tangent along x, on the faces normal to x along y. */
+static void check_box_tangents(const thz_mesh *m)
+{
+    const double x[3] = {1, 0, 0}, y[3] = {0, 1, 0};
+    for (size_t t = 0; t < m->n_triangles; t++)
+        check_tangent(m, t, fabs(m->normals[3 * t]) > 0.5 ? y : x);
+}
+
 static void check_padding(const thz_mesh *m)
 {
     for (int k = 0; k < 4; k++)
@@ -76,6 +98,7 @@ static void test_box(void **state)
     check_closed(&m);
     check_padding(&m);
     assert_true(m.bbox_min_m[2] == -1.0 && m.bbox_max_m[2] == 1.0);
+    check_box_tangents(&m);
     mesh_fini(&m);
 }
 
@@ -97,6 +120,7 @@ static void test_box_inward(void **state)
         assert_true(dot < 0); /* towards the inside */
     }
     check_closed(&m);
+    check_box_tangents(&m);
     mesh_fini(&m);
 }
 
@@ -127,6 +151,11 @@ static void test_cylinder(void **state)
         assert_true(fabs(m.total_area_m2 - side) < 1e-6 * side);
         check_normals(&m, centre, NULL);
         assert_int_equal(winding_conflicts(&m), 0);
+        for (size_t t = 0; t < m.n_triangles; t++) { /* along the circumference */
+            double a = 2.0 * M_PI * ((double)(t / 2) + 0.5) / (double)n;
+            const double along[3] = {-sin(a), cos(a), 0.0};
+            check_tangent(&m, t, along);
+        }
         mesh_fini(&m);
     }
 }
@@ -183,6 +212,9 @@ static void test_rectangle(void **state)
     check_normals(&m, NULL, up);
     assert_true(m.bbox_min_m[0] == -0.25 && m.bbox_max_m[1] == 1.5);
     assert_int_equal(winding_conflicts(&m), 0);
+    const double x[3] = {1, 0, 0};
+    check_tangent(&m, 0, x);
+    check_tangent(&m, 1, x);
     mesh_fini(&m);
 }
 
