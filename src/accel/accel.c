@@ -61,14 +61,21 @@ struct accel {
 };
 
 /* The context passed to rtcIntersect1: Embree's context first, then what to ignore. */
+/* Back faces met on their edge that a ray may pass over (accel_intersect): a box's
+ * corner joins three faces, each of two triangles. */
+#define ACCEL_EDGE_RECASTS 4
+
 typedef struct accel_context {
     struct RTCIntersectContext base;
     uint32_t ignore_object;
     uint32_t ignore_triangle;
+    uint32_t n_edges; /* back faces met on their edge, passed over too */
+    uint32_t edge_object[ACCEL_EDGE_RECASTS], edge_triangle[ACCEL_EDGE_RECASTS];
 } accel_context;
 
-/* Context filter: rejects the hit on the triangle the ray leaves from. The hit layout
- * is Embree's RTCHitN (SOA): primID at word 5N + i, geomID at 6N + i. */
+/* Context filter: rejects the hit on the triangle the ray leaves from, and on the back
+ * faces met on their edge. The hit layout is Embree's RTCHitN (SOA): primID at word
+ * 5N + i, geomID at 6N + i. */
 static void accel_filter(const struct RTCFilterFunctionNArguments *args)
 {
     const accel_context *ctx = (const accel_context *)args->context;
@@ -77,9 +84,20 @@ static void accel_filter(const struct RTCFilterFunctionNArguments *args)
     for (unsigned i = 0; i < n; i++) {
         if (args->valid[i] == 0)
             continue;
-        if (words[6 * n + i] == ctx->ignore_object && words[5 * n + i] == ctx->ignore_triangle)
+        unsigned geom = words[6 * n + i], prim = words[5 * n + i];
+        if (geom == ctx->ignore_object && prim == ctx->ignore_triangle)
             args->valid[i] = 0;
+        for (uint32_t k = 0; k < ctx->n_edges; k++)
+            if (geom == ctx->edge_object[k] && prim == ctx->edge_triangle[k])
+                args->valid[i] = 0;
     }
+}
+
+/* Whether Embree's hit lies on its triangle's edge, to single precision. */
+static bool accel_on_edge(const struct RTCRayHit *rh)
+{
+    const float e = 64.0f * FLT_EPSILON;
+    return rh->hit.u <= e || rh->hit.v <= e || 1.0f - rh->hit.u - rh->hit.v <= e;
 }
 
 static const char *accel_error_name(enum RTCError e)
@@ -253,6 +271,13 @@ static void accel_recast(const accel *a, accel_context *ctx, struct RTCRayHit *r
     rtcIntersect1(a->rtc, &ctx->base, rh);
 }
 
+/* The cosine between dir and the normal of the triangle rh hit (> 0: met from its back). */
+static double accel_hit_cos(const accel *a, const struct RTCRayHit *rh, vec3 dir)
+{
+    const float *nf = &a->scene->objects[rh->hit.geomID].mesh.normals[3 * (size_t)rh->hit.primID];
+    return v3_dot(dir, v3(nf[0], nf[1], nf[2]));
+}
+
 bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distance_m,
                      uint32_t ignore_object, uint32_t ignore_triangle, accel_hit *hit)
 {
@@ -260,6 +285,7 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
     rtcInitIntersectContext(&ctx.base);
     ctx.ignore_object = ignore_object;
     ctx.ignore_triangle = ignore_triangle;
+    ctx.n_edges = 0;
 
     struct RTCRayHit rh;
     rh.ray.org_x = (float)origin_m.x;
@@ -292,11 +318,7 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return false;
 
-    const thz_mesh *m = &a->scene->objects[rh.hit.geomID].mesh;
-    uint32_t tri = rh.hit.primID;
-    const float *nf = &m->normals[3 * (size_t)tri];
-    vec3 n = v3(nf[0], nf[1], nf[2]);
-    double c = v3_dot(dir, n);
+    double c = accel_hit_cos(a, &rh, dir);
     /* A face met from its back, of a solid whose back no ray can see (solids are opaque),
      * its plane closer to the origin than the origin's rounding to single precision may
      * move it: the origin of a ray leaving near a concave corner, offset off its own wall,
@@ -306,20 +328,49 @@ bool accel_intersect(const accel *a, vec3 origin_m, vec3 dir, double max_distanc
         c > 0.0 ? 32.0f * FLT_EPSILON *
                       fmaxf(fabsf(rh.ray.org_x), fmaxf(fabsf(rh.ray.org_y), fabsf(rh.ray.org_z)))
                 : 0.0f; /* only for a back-side hit: not on every ray's path */
+    float tnear = 0.0f;
     if (c > 0.0 && rh.ray.tfar * c < near &&
         !scene_object_side_is_front(&a->scene->objects[rh.hit.geomID], 1)) {
         if (ignore_object != ACCEL_NO_OBJECT)
             ctx.base.filter = accel_filter;
         /* just beyond that plane: not a centimetre on, where a corner's third wall may be */
-        accel_recast(a, &ctx, &rh, fmaxf(1.001f * rh.ray.tfar, 0.125f * near), tfar);
+        tnear = fmaxf(1.001f * rh.ray.tfar, 0.125f * near);
+        accel_recast(a, &ctx, &rh, tnear, tfar);
         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
             return false;
-        m = &a->scene->objects[rh.hit.geomID].mesh;
-        tri = rh.hit.primID;
-        nf = &m->normals[3 * (size_t)tri];
-        n = v3(nf[0], nf[1], nf[2]);
-        c = v3_dot(dir, n);
+        c = accel_hit_cos(a, &rh, dir);
     }
+    /* A face met from its back on its edge, of such a solid, where a face met from its
+     * front shares the point: a ray through the edge between two faces of a box (its
+     * silhouette, met exactly by a camera ray at round coordinates) may be given the face
+     * behind the edge rather than the one before it (such pixels read 0 K beside a 310 K
+     * box). Cast again without the back faces met there (a corner joins several): a face
+     * met from its front at that distance is the hit; else (the inner edge of a plate
+     * met from behind, or a ray that only grazes) the back face stays. */
+    if (c > 0.0 && accel_on_edge(&rh) &&
+        !scene_object_side_is_front(&a->scene->objects[rh.hit.geomID], 1)) {
+        const struct RTCRayHit back = rh;
+        const float t_edge = (1.0f + 64.0f * FLT_EPSILON) * rh.ray.tfar;
+        ctx.base.filter = accel_filter;
+        bool again = true;
+        while (again) {
+            ctx.edge_object[ctx.n_edges] = rh.hit.geomID;
+            ctx.edge_triangle[ctx.n_edges++] = rh.hit.primID;
+            accel_recast(a, &ctx, &rh, tnear, fminf(t_edge, tfar));
+            c = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? accel_hit_cos(a, &rh, dir) : 0.0;
+            again = c > 0.0 && ctx.n_edges < ACCEL_EDGE_RECASTS && accel_on_edge(&rh) &&
+                    !scene_object_side_is_front(&a->scene->objects[rh.hit.geomID], 1);
+        }
+        if (!(c < 0.0)) {
+            rh = back;
+            c = accel_hit_cos(a, &rh, dir);
+        }
+    }
+
+    const thz_mesh *m = &a->scene->objects[rh.hit.geomID].mesh;
+    uint32_t tri = rh.hit.primID;
+    const float *nf = &m->normals[3 * (size_t)tri];
+    vec3 n = v3(nf[0], nf[1], nf[2]);
 
     /* Where the ray meets the triangle's plane, in double from the ray as the caller gave
      * it: on that plane to double precision however long the ray, and the same on every

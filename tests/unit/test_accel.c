@@ -270,6 +270,41 @@ static void test_back_of_the_wall_it_starts_on(void **state)
     scene_destroy(s);
 }
 
+/* Rays through a closed box's silhouette edges, from a point level with the box's middle
+ * (x and z of the edges in a ratio that single precision keeps): each meets the face
+ * before the edge or passes; none is given the back of the face behind it (such pixels
+ * read 0 K and blamed the mesh's normals). */
+static void test_silhouette_edge(void **state)
+{
+    (void)state;
+    thz_scene *s = ps_scene(0.35, 0.01, 1000, 1);
+    size_t m = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t room = ps_object(s, OBJECT_SOLID, m, 290, 0, false);
+    ps_box(s, room, v3(-4, -4, -4), v3(4, 4, 4), true);
+    size_t box = ps_object(s, OBJECT_SOLID, m, 310, 0, false);
+    ps_box(s, box, v3(-1.25, -0.05, -0.25), v3(-0.75, 0.45, 0.25), false);
+    ps_finalize(s);
+    accel *acc;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    const vec3 origin = v3(0, -2, 0);
+    int backs = 0, fronts = 0;
+    for (int i = 0; i <= 400; i++) {
+        double y = -0.05 + 0.5 * i / 400.0;
+        for (int top = 0; top < 2; top++) { /* the +x face's top and bottom edges */
+            vec3 dir = v3_normalize(v3_sub(v3(-0.75, y, top ? 0.25 : -0.25), origin));
+            accel_hit h;
+            assert_true(accel_intersect(acc, origin, dir, INFINITY, ACCEL_NO_OBJECT, 0, &h));
+            backs += h.side == 1;
+            fronts += h.object == box && h.side == 0;
+        }
+    }
+    assert_int_equal(backs, 0);
+    assert_true(fronts > 0); /* the edges are met, not all passed by */
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
 static void test_offset_is_the_hits(void **state)
 {
     (void)state;
@@ -287,6 +322,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_threads, setup, teardown),
         cmocka_unit_test(test_offset_is_the_hits),
         cmocka_unit_test(test_back_of_the_wall_it_starts_on),
+        cmocka_unit_test(test_silhouette_edge),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
