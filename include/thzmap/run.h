@@ -117,7 +117,8 @@ THZ_API thz_status thz_photons_load_channel(thz_context *ctx, const thz_scene *s
                                             thz_error *err);
 /* Writes every channel's map to `path` (.thzpm, what `render` reads); THZ_ERR_INPUT
  * when a channel has no map. Written beside `path` and renamed over it once whole: a
- * reader of the previous file keeps it whole, and a failed save leaves it as it was. */
+ * reader of the previous file keeps it whole, and a failed save leaves it as it was
+ * (what is not a regular file, such as /dev/null, is written through in place). */
 THZ_API thz_status thz_photons_save(const thz_photons *photons, const char *path, thz_error *err);
 /* Merges n photon sets of one scene, seed and integrator, fired with disjoint photon
  * ranges (or for different channels), into one of all their photons (*out; the parts

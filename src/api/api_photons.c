@@ -231,18 +231,21 @@ thz_status thz_photons_save(const thz_photons *ph, const char *path, thz_error *
      * limit) left a truncated file where a good map had been, and a render reading that
      * map meanwhile, a channel at a time, failed calling it corrupted. A symbolic link
      * is written through, and the file keeps the mode of the one it replaces. Where no
-     * such name can be made (a directory that takes no new file), in place as before. */
+     * such name can be made (a directory that takes no new file), in place as before; so
+     * too over what is not a regular file (/dev/null, which a rename would replace) and
+     * through a symbolic link to a file not there yet (a rename would replace the link). */
     static unsigned serial;
     struct stat old, lst;
-    bool replaces = stat(path, &old) == 0 && S_ISREG(old.st_mode);
+    bool exists = stat(path, &old) == 0, replaces = exists && S_ISREG(old.st_mode);
+    bool link = lstat(path, &lst) == 0 && S_ISLNK(lst.st_mode);
     char target[THZ_PATH_MAX], tmp[THZ_PATH_MAX + 64];
-    char *real =
-        replaces && lstat(path, &lst) == 0 && S_ISLNK(lst.st_mode) ? realpath(path, NULL) : NULL;
+    char *real = replaces && link ? realpath(path, NULL) : NULL;
+    bool in_place = (exists && !replaces) || (link && !real);
     int n = snprintf(target, sizeof target, "%s", real ? real : path);
     free(real);
     const char *slash = strrchr(target, '/');
     int fd = -1;
-    for (int tries = 0; n < (int)sizeof target && fd < 0 && tries < 100; tries++) {
+    for (int tries = 0; !in_place && n < (int)sizeof target && fd < 0 && tries < 100; tries++) {
         snprintf(tmp, sizeof tmp, "%.*s.thzmap-pm-%ld-%u.part",
                  slash ? (int)(slash - target + 1) : 0, target, (long)getpid(),
                  __atomic_fetch_add(&serial, 1, __ATOMIC_RELAXED));

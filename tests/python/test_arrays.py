@@ -4,6 +4,7 @@ files; photon maps save, load and re-render."""
 import filecmp
 import json
 import os
+import stat
 
 import numpy as np
 import pytest
@@ -145,6 +146,32 @@ def test_photon_map_save_replaces_whole(tiny_dir):
     assert os.stat(path).st_mode & 0o777 == 0o640
     assert sorted(os.listdir(maps)) == ["link.thzpm", "map.thzpm"]
     assert thzmap.load_photon_map(scene, path).seed == SEED + 1
+
+
+def test_photon_map_save_through_links_and_devices(tiny_dir):
+    """PhotonMap.save onto what is not a regular file, or a symbolic link to a file not
+    there yet, writes through it in place, as before the save renamed a temporary file
+    into place: renamed over them, a link to /dev/null and a dangling link became regular
+    files, and a device node (as root, /dev/null itself) was replaced by the map."""
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    pm = thzmap.fire_photons(scene, photons=3000, seed=SEED)
+    null = tiny_dir / "null.thzpm"
+    os.symlink("/dev/null", null)
+    pm.save(null)
+    assert os.path.islink(null) and os.readlink(null) == "/dev/null"
+    dangling = tiny_dir / "dangling.thzpm"
+    os.symlink("made.thzpm", dangling)
+    pm.save(dangling)
+    assert os.path.islink(dangling)
+    assert thzmap.load_photon_map(scene, tiny_dir / "made.thzpm").seed == SEED
+    device = tiny_dir / "device"
+    try:
+        os.mknod(device, 0o666 | stat.S_IFCHR, os.makedev(1, 3))  # /dev/null's numbers
+    except PermissionError:
+        return  # not root: no device node to write to
+    pm.save(device)
+    assert stat.S_ISCHR(os.lstat(device).st_mode)
+    assert not [n for n in os.listdir(tiny_dir) if n.endswith(".part")]
 
 
 def test_fire_and_merge(tiny_dir, tmp_path):
