@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # classify reads RUN_DIR's cube and then its truth map. A simulate that commits into
-# RUN_DIR between the two reads (made sure here by delaying, with strace, classify's open
-# of the truth header by 2 s while the simulate runs) must not give a classification of
-# one run's cube against the other's truth: classify reads RUN_DIR again and classifies
-# the new run, as if it had started after it (it paired them, exit 0, accuracy 0.27
-# where each run alone gives 0.99).
+# RUN_DIR between the two reads (made sure here by stopping classify, with strace's
+# SIGSTOP at its open of the truth header, until the simulate has ended) must not give a
+# classification of one run's cube against the other's truth: classify reads RUN_DIR
+# again and classifies the new run, as if it had started after it (it paired them, exit
+# 0, accuracy 0.27 where each run alone gives 0.99). A delay of 2 s at that open, in
+# place of the stop, made the test depend on the simulate ending within it: under the
+# sanitizer build on a loaded 2-core machine it did not, and classify read run 1 whole.
 # argv: path to the thzmap binary, repository directory.
 set -u
 THZMAP=$1
@@ -46,11 +48,18 @@ cd "$work" || exit 1
   fail "run 2 alone"
 "$THZMAP" simulate scene1.json -o run -q || fail "run 1"
 # (LeakSanitizer cannot run under ptrace: the sanitizer build checks the rest)
-ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 strace -f -qq -o /dev/null -e trace=openat -e inject=openat:delay_enter=2000000:when=1 \
+ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 strace -f -qq -o "$work/strace.log" -e trace=openat -e inject=openat:signal=SIGSTOP:when=1 \
   -P run/cam.object_id.hdr "$THZMAP" classify run --sensor cam -o mixed -q 2>"$work/classify.err" &
 classify=$!
-sleep 0.5
+for _ in $(seq 1 1200); do # at most 120 s
+  grep -q "stopped by SIGSTOP" "$work/strace.log" 2>/dev/null && break
+  kill -0 $classify 2>/dev/null || break
+  sleep 0.1
+done
+grep -q "stopped by SIGSTOP" "$work/strace.log" 2>/dev/null || fail "classify never opened the truth header"
 "$THZMAP" simulate scene2.json -o run -q || fail "run 2 into run"
+# SIGCONT to classify itself, strace's child
+for pid in $(cat /proc/$classify/task/$classify/children 2>/dev/null); do kill -CONT "$pid"; done
 wait $classify || fail "classify: exit $?: $(cat "$work/classify.err")"
 cmp -s mixed/cam.class.img pure2/cam.class.img ||
   fail "the classification is not run 2's: $(grep -m1 '"accuracy"' mixed/classification.json)"
