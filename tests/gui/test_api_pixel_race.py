@@ -2,8 +2,11 @@
 """GET /api/pixel reads a run directory's cubes one after the other. A run that commits
 into the directory between two of those reads must not give an answer mixing both runs
 (it gave run 1's Tb beside run 2's truth object and run 1's temperature): the server
-reads the pixel again. strace delays the server's first open of the truth header by 2 s
-while `thzmap simulate` commits run 2 into the directory.
+reads the pixel again. strace stops the server (SIGSTOP) at its first open of the truth
+header, `thzmap simulate` commits run 2 into the directory, and the server goes on
+(SIGCONT). A delay of 2 s there, in place of the stop, made the test depend on the
+simulate ending within it: under the sanitizer build on a loaded 2-core machine it did
+not, and the server read run 1 whole.
 
 usage: test_api_pixel_race.py THZMAP_BINARY REPO_DIR [--requests-only]
 
@@ -50,10 +53,19 @@ try:
     # LeakSanitizer cannot run under ptrace (the sanitizer build checks the rest)
     env = dict(os.environ, ASAN_OPTIONS=":".join(
         filter(None, [os.environ.get("ASAN_OPTIONS"), "detect_leaks=0"])))
+    log = os.path.join(root, "strace.log")
     srv = Server(BINARY, root, env=env, prefix=[
-        "strace", "-f", "-qq", "-o", "/dev/null", "-e", "trace=openat", "-e",
-        "inject=openat:delay_enter=2000000:when=1", "-P",
+        "strace", "-f", "-qq", "-o", log, "-e", "trace=openat", "-e",
+        "inject=openat:signal=SIGSTOP:when=1", "-P",
         os.path.join(root, "run", "cam.object_id.hdr")])
+
+    def server_pids():  # the server itself, strace's child
+        with open("/proc/%d/task/%d/children" % (srv.proc.pid, srv.proc.pid)) as f:
+            return [int(pid) for pid in f.read().split()]
+
+    def stopped():
+        with open(log) as f:
+            return "stopped by SIGSTOP" in f.read()
     try:
         # a pixel where run one sees the target and run two the room
         q = "/api/pixel?dir=%s&sensor=cam&row=12&col=10"
@@ -62,8 +74,16 @@ try:
         got = {}
         t = threading.Thread(target=lambda: got.update(a=srv.json("GET", q % "run")))
         t.start()
-        time.sleep(0.5)
-        simulate("two.json", "run")
+        for _ in range(1200):  # at most 120 s
+            if stopped() or not t.is_alive():
+                break
+            time.sleep(0.1)
+        check(stopped(), "the server never opened the truth header")
+        try:
+            simulate("two.json", "run")
+        finally:
+            for pid in server_pids():
+                os.kill(pid, signal.SIGCONT)
         t.join()
         a = got.get("a") or {}
         check(a.get("tb_K") == two["tb_K"] and a.get("truth") == two["truth"],
@@ -71,9 +91,8 @@ try:
               % (a, one, two))
     finally:
         # SIGINT to the server itself (strace, told, would detach and leave it running)
-        with open("/proc/%d/task/%d/children" % (srv.proc.pid, srv.proc.pid)) as f:
-            for pid in f.read().split():
-                os.kill(int(pid), signal.SIGINT)
+        for pid in server_pids():
+            os.kill(pid, signal.SIGINT)
         srv.proc.wait(timeout=30)
 finally:
     shutil.rmtree(root, ignore_errors=True)
