@@ -4,7 +4,10 @@
 # that runs into OUTDIR and ends in that window replaces those frames with its own; the
 # resumed batch must see that once it holds the lock and run them again, not count them
 # as finished (it wrote a batch.json of sequence B over the images of sequence A).
-# strace delays the resumed batch's open of the lock file by 5 s to make the window sure.
+# strace stops the resumed batch (SIGSTOP) at its open of the lock file until the other
+# batch has ended, which makes the window sure. A delay of 5 s there, in place of the
+# stop, made the test depend on the other batch ending within it: under the sanitizer
+# build on a loaded 2-core machine it did not, and the resumed batch met its lock.
 # argv: path to the thzmap binary, repository directory.
 set -u
 THZMAP=$1
@@ -45,13 +48,20 @@ done
 cd "$work" || exit 1
 "$THZMAP" batch seqA.json -o pureA -q --no-movies --threads 1 || fail "batch A"
 "$THZMAP" batch seqB.json -o out -q --no-movies --threads 1 || fail "batch B"
-# resume B (every frame finished), its lock delayed; A runs and ends meanwhile
+# resume B (every frame finished), stopped at its lock; A runs and ends meanwhile
 # (LeakSanitizer cannot run under ptrace: the sanitizer build checks the rest)
-ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 strace -f -qq -o /dev/null -e trace=openat -e inject=openat:delay_enter=5000000 \
+ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 strace -f -qq -o "$work/strace.log" -e trace=openat -e inject=openat:signal=SIGSTOP:when=1 \
   -P out/.thzmap-batch-lock "$THZMAP" batch seqB.json -o out -q --no-movies --threads 1 2>/dev/null &
 resumed=$!
-sleep 1
+for _ in $(seq 1 1200); do # at most 120 s
+  grep -q "stopped by SIGSTOP" "$work/strace.log" 2>/dev/null && break
+  kill -0 $resumed 2>/dev/null || break
+  sleep 0.1
+done
+grep -q "stopped by SIGSTOP" "$work/strace.log" 2>/dev/null || fail "the resumed batch never opened its lock"
 "$THZMAP" batch seqA.json -o out -q --no-movies --threads 1 || fail "batch A into out"
+# SIGCONT to the batch itself, strace's child
+for pid in $(cat /proc/$resumed/task/$resumed/children 2>/dev/null); do kill -CONT "$pid"; done
 wait $resumed || fail "resumed batch B: exit $?"
 grep -q '"sequence": ".*seqB.json"' out/batch.json || fail "batch.json is not B's"
 for f in frame-00000 frame-00001; do
