@@ -44,7 +44,7 @@ typedef struct thz_run_plan {
     /* "command line" (settings), "scene", "default" or NULL */
     const char *target_source;
     /* non-zero: photon-map's photon passes (a noise target) will stop at the memory they
-     * may hold, half of what the process may have, above the target, after `passes` passes */
+     * may hold, half of available_bytes, above the target, after `passes` passes */
     int memory_stop;
 } thz_run_plan;
 typedef void (*thz_plan_fn)(void *user, const thz_run_plan *plan);
