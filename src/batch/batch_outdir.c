@@ -106,8 +106,14 @@ thz_status batch_lock(const char *outdir, int *fd, thz_error *err)
      * PR_SET_PDEATHSIG), so a SIGKILLed batch leaves no holder behind. */
     struct flock lk = {.l_type = F_WRLCK, .l_whence = SEEK_SET};
     if (fcntl(*fd, F_OFD_SETLK, &lk) != 0) {
+        int e = errno;
         close(*fd);
         *fd = -1;
+        /* held: EAGAIN or EACCES; else no lock could be had (ENOLCK on a network file
+         * system without a lock service, EINVAL where open file description locks are
+         * unknown), which no other batch is to blame for */
+        if (e != EAGAIN && e != EACCES)
+            return thz_error_set(err, THZ_ERR_IO, "%s: cannot lock: %s", path, strerror(e));
         return thz_error_set(err, THZ_ERR_IO,
                              "%s: another thzmap batch is running into this directory", outdir);
     }

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# A batch that cannot lock OUTDIR for another reason than another batch's lock (ENOLCK:
+# a network file system without a lock service; EINVAL: a kernel or file system without
+# open file description locks) says why, not "another thzmap batch is running into this
+# directory", which sent the user looking for a batch that did not exist. strace makes
+# the batch's fcntl on its lock file fail with ENOLCK.
+# argv: path to the thzmap binary, repository directory.
+set -u
+THZMAP=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+command -v strace >/dev/null || { echo "FAIL: strace is missing (scripts/install-deps.sh installs it)"; exit 1; }
+cat > "$work/scene.json" <<'JSON'
+{
+  "format": "thzmap-scene/1",
+  "channels": [{"frequency_thz": 0.35, "relative_width": 0.05}],
+  "materials": {"wall": {"reflectivity": 0.2}},
+  "objects": [
+    {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}}
+  ],
+  "sensors": [
+    {"name": "a", "position_m": [0, 0, 0], "look_at_m": [0, 1, 0], "fov_deg": 60,
+     "resolution": [4, 3]}
+  ],
+  "render": {"integrator": "path", "paths_per_sample": 1}
+}
+JSON
+cat > "$work/seq.json" <<'JSON'
+{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 1,
+ "keyframes": [{"time_s": 0, "objects": {"room": {"temperature_k": 300}}}]}
+JSON
+cd "$work" || exit 1
+mkdir out && : > out/.thzmap-batch-lock
+# (LeakSanitizer cannot run under ptrace)
+ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 strace -f -qq -o /dev/null -e trace=fcntl -e inject=fcntl:error=ENOLCK \
+  -P out/.thzmap-batch-lock "$THZMAP" batch seq.json -o out -q --no-movies --threads 1 2>"$work/err"
+status=$?
+[ $status -eq 1 ] || fail "exit $status, expected 1: $(cat "$work/err")"
+grep -q "out/.thzmap-batch-lock: cannot lock: No locks available" "$work/err" ||
+  fail "the message does not say why: $(cat "$work/err")"
+grep -q "another thzmap batch" "$work/err" && fail "blames another batch: $(cat "$work/err")"
+[ $fails -eq 0 ] && echo ok
+exit $((fails > 0))
