@@ -1,4 +1,5 @@
 /* The photon phase as a handle: fire, load, save, merge, statistics. */
+#define _GNU_SOURCE /* gettid */
 #include <errno.h>
 #include <fcntl.h>
 #include <stdint.h>
@@ -234,7 +235,6 @@ thz_status thz_photons_save(const thz_photons *ph, const char *path, thz_error *
      * such name can be made (a directory that takes no new file), in place as before; so
      * too over what is not a regular file (/dev/null, which a rename would replace) and
      * through a symbolic link to a file not there yet (a rename would replace the link). */
-    static unsigned serial;
     struct stat old, lst;
     bool exists = stat(path, &old) == 0, replaces = exists && S_ISREG(old.st_mode);
     bool link = lstat(path, &lst) == 0 && S_ISLNK(lst.st_mode);
@@ -246,9 +246,10 @@ thz_status thz_photons_save(const thz_photons *ph, const char *path, thz_error *
     const char *slash = strrchr(target, '/');
     int fd = -1;
     for (int tries = 0; !in_place && n < (int)sizeof target && fd < 0 && tries < 100; tries++) {
-        snprintf(tmp, sizeof tmp, "%.*s.thzmap-pm-%ld-%u.part",
-                 slash ? (int)(slash - target + 1) : 0, target, (long)getpid(),
-                 __atomic_fetch_add(&serial, 1, __ATOMIC_RELAXED));
+        /* the thread's id: names of two threads' saves never meet */
+        snprintf(tmp, sizeof tmp, "%.*s.thzmap-pm-%ld-%ld-%d.part",
+                 slash ? (int)(slash - target + 1) : 0, target, (long)getpid(), (long)gettid(),
+                 tries);
         fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
         if (fd < 0 && errno != EEXIST)
             break;
@@ -256,12 +257,13 @@ thz_status thz_photons_save(const thz_photons *ph, const char *path, thz_error *
     if (fd < 0)
         return photon_map_file_write(path, &ph->effective, (const photon_map *const *)ph->maps,
                                      ph->stats, 0, err);
+    /* the replaced file's mode before a byte is written: a private map stays private */
+    if (replaces && fchmod(fd, old.st_mode & 07777) != 0) {
+        /* not allowed: kept as created */
+    }
     close(fd);
     thz_status st = photon_map_file_write(tmp, &ph->effective, (const photon_map *const *)ph->maps,
                                           ph->stats, 0, err);
-    if (st == THZ_OK && replaces && chmod(tmp, old.st_mode & 07777) != 0) {
-        /* not allowed: kept as created */
-    }
     if (st == THZ_OK && rename(tmp, target) != 0)
         st = thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO),
                            "cannot write photon map %s: %s", path, strerror(errno));
