@@ -84,7 +84,7 @@ thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err)
                                  "%s: sensors[%zu].resolution: the images of %u x %u pixels in "
                                  "%zu channels need %.1f GiB, more than the %.1f GiB this "
                                  "process may have (the machine's memory, or less under ulimit "
-                                 "-v or a cgroup limit) allows; lower 'resolution' (or the "
+                                 "-v or a cgroup limit); lower 'resolution' (or the "
                                  "number of channels)",
                                  scene->path, s, sn->columns, sn->rows, scene->n_channels,
                                  (double)need / 1073741824.0, (double)have / 1073741824.0);
