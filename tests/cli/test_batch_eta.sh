@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # batch's ETA counts from the first frame, not from the batch's start: the sequence's load
-# and the frames' memory check (seconds for thousands of frames) are behind it when the
-# frames run. Counted from the start, a 5000-frame batch of a tiny scene said "ETA 43779 s"
-# after its first frame (8.6 s of checks over one frame, times 4999) for about 1 100 s of
-# frames. 1000 frames of a 2 x 1 sensor (2000 took 104 s under the sanitizers): after the
-# first frame, the ETA must be below the time so far times the frames left (what the old
-# ETA was) by a wide margin, and so must it after four frames: below half the time so far
-# over the frames done, times the frames left. (An absolute bound, 2 s a frame, and a
-# wait of at most 120 s for frame 5 made the test depend on the machine's speed: the
+# and the frames' memory check (each frame's scene loaded) are behind it when the frames
+# run. Counted from the start, a 5000-frame batch of a tiny scene said "ETA 43779 s" after
+# its first frame (8.6 s of checks over one frame, times 4999) for about 1 100 s of frames.
+# 1000 frames of a 2 x 1 sensor in a room with 100 crates (so that the checks, 2-3 ms a
+# frame, 10-15 ms under the sanitizers, take several times a frame's figures and files):
+# after the first frame, the ETA must be below the time so far times the frames left (what
+# the old ETA was) by a wide margin, and so must it after four frames: below half the time
+# so far over the frames done, times the frames left. (An absolute bound, 2 s a frame, and
+# a wait of at most 120 s for frame 5 made the test depend on the machine's speed: the
 # sanitizer build on a loaded 2-core machine took 38 s to the first frame and 0.64 s a
 # frame.) The batch is stopped (SIGINT) once frame 4 has begun.
 # usage: test_batch_eta.sh THZMAP_BINARY REPO_DIR
@@ -20,20 +21,23 @@ fail() {
     echo "FAIL: $*"
     failures=$((failures + 1))
 }
-cat >"$tmp/scene.json" <<'JSON'
-{"format": "thzmap-scene/1",
- "channels": [{"frequency_thz": 0.35, "relative_width": 0.01}],
- "materials": {"wall": {"reflectivity": 0.0}, "m": {"reflectivity": 0.2}},
- "objects": [
-  {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
-   "shape": {"type": "box", "size_m": [10, 10, 4], "inward": true},
-   "transform": {"translate_m": [0, 0, 2]}},
-  {"name": "ball", "type": "solid", "material": "m", "temperature_k": 310,
-   "shape": {"type": "sphere", "radius_m": 0.5, "subdivisions": 1}}],
- "sensors": [{"name": "cam", "position_m": [0, -4, 1], "look_at_m": [0, 0, 1],
-              "fov_deg": 40, "resolution": [2, 1]}],
- "render": {"integrator": "path", "paths_per_sample": 1}}
-JSON
+/usr/bin/python3 - "$tmp/scene.json" <<'PY'
+import json, sys
+crates = [{"name": f"crate{i}", "type": "solid", "material": "m", "temperature_k": 295,
+           "shape": {"type": "box", "size_m": [0.05, 0.05, 0.05]},
+           "transform": {"translate_m": [-4 + 0.08 * i, 4, 0.1]}} for i in range(100)]
+json.dump({"format": "thzmap-scene/1",
+           "channels": [{"frequency_thz": 0.35, "relative_width": 0.01}],
+           "materials": {"wall": {"reflectivity": 0.0}, "m": {"reflectivity": 0.2}},
+           "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+                        "shape": {"type": "box", "size_m": [10, 10, 4], "inward": True},
+                        "transform": {"translate_m": [0, 0, 2]}},
+                       {"name": "ball", "type": "solid", "material": "m", "temperature_k": 310,
+                        "shape": {"type": "sphere", "radius_m": 0.5, "subdivisions": 1}}] + crates,
+           "sensors": [{"name": "cam", "position_m": [0, -4, 1], "look_at_m": [0, 0, 1],
+                        "fov_deg": 40, "resolution": [2, 1]}],
+           "render": {"integrator": "path", "paths_per_sample": 1}}, open(sys.argv[1], "w"))
+PY
 cat >"$tmp/seq.json" <<'JSON'
 {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 10, "frames": 1000,
  "keyframes": [{"time_s": 0, "objects": {"ball": {"transform": {"translate_m": [-1, 0, 1]}}}},
