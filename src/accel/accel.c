@@ -60,11 +60,11 @@ struct accel {
     RTCScene rtc;
 };
 
-/* The context passed to rtcIntersect1: Embree's context first, then what to ignore. */
 /* Back faces met on their edge that a ray may pass over (accel_intersect): a box's
  * corner joins three faces, each of two triangles. */
 #define ACCEL_EDGE_RECASTS 4
 
+/* The context passed to rtcIntersect1: Embree's context first, then what to ignore. */
 typedef struct accel_context {
     struct RTCIntersectContext base;
     uint32_t ignore_object;

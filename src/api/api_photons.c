@@ -1,19 +1,13 @@
 /* The photon phase as a handle: fire, load, save, merge, statistics. */
-#define _GNU_SOURCE /* gettid */
-#include <errno.h>
-#include <fcntl.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "accel/accel.h"
 #include "api/api.h"
 #include "core/alloc.h"
 #include "core/error.h"
-#include "core/path.h"
 #include "io/photon_map_file.h"
 #include "photon/emission_reach.h"
 #include "photon/phase.h"
@@ -227,58 +221,8 @@ thz_status thz_photons_save(const thz_photons *ph, const char *path, thz_error *
             return thz_error_set(err, THZ_ERR_INPUT,
                                  "%s: channel %zu has no photon map (fired one channel only?)",
                                  path, c);
-    /* Written beside its place under a name of its own, and renamed into it whole:
-     * written in place (truncated first), a save that failed (a full disk, a file-size
-     * limit) left a truncated file where a good map had been, and a render reading that
-     * map meanwhile, a channel at a time, failed calling it corrupted. A symbolic link
-     * is written through, and the file keeps the mode of the one it replaces. Where no
-     * such name can be made (a directory that takes no new file), in place as before; so
-     * too over what is not a regular file (/dev/null, which a rename would replace) and
-     * through a symbolic link to a file not there yet (a rename would replace the link). */
-    struct stat old, lst;
-    bool exists = stat(path, &old) == 0, replaces = exists && S_ISREG(old.st_mode);
-    bool link = lstat(path, &lst) == 0 && S_ISLNK(lst.st_mode);
-    char target[THZ_PATH_MAX], tmp[THZ_PATH_MAX + 64];
-    char *real = replaces && link ? realpath(path, NULL) : NULL;
-    bool in_place = (exists && !replaces) || (link && !real);
-    int n = snprintf(target, sizeof target, "%s", real ? real : path);
-    free(real);
-    const char *slash = strrchr(target, '/');
-    int fd = -1;
-    for (int tries = 0; !in_place && n < (int)sizeof target && fd < 0 && tries < 100; tries++) {
-        /* the thread's id: names of two threads' saves never meet */
-        snprintf(tmp, sizeof tmp, "%.*s.thzmap-pm-%ld-%ld-%d.part",
-                 slash ? (int)(slash - target + 1) : 0, target, (long)getpid(), (long)gettid(),
-                 tries);
-        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0 && errno != EEXIST)
-            break;
-    }
-    if (fd < 0)
-        return photon_map_file_write(path, &ph->effective, (const photon_map *const *)ph->maps,
-                                     ph->stats, 0, err);
-    /* the replaced file's mode before a byte is written: a private map stays private */
-    if (replaces && fchmod(fd, old.st_mode & 07777) != 0) {
-        /* not allowed: kept as created */
-    }
-    close(fd);
-    thz_status st = photon_map_file_write(tmp, &ph->effective, (const photon_map *const *)ph->maps,
-                                          ph->stats, 0, err);
-    if (st == THZ_OK && rename(tmp, target) != 0)
-        st = thz_error_set(err, thz_errno_status(errno, THZ_ERR_IO),
-                           "cannot write photon map %s: %s", path, strerror(errno));
-    if (st != THZ_OK) {
-        unlink(tmp);
-        /* the message names the file as the caller did, not the temporary one */
-        char *at = err ? strstr(err->message, tmp) : NULL;
-        if (at) {
-            char message[sizeof err->message];
-            snprintf(message, sizeof message, "%.*s%s%s", (int)(at - err->message), err->message,
-                     path, at + strlen(tmp));
-            memcpy(err->message, message, sizeof message);
-        }
-    }
-    return st;
+    return photon_map_file_save(path, &ph->effective, (const photon_map *const *)ph->maps,
+                                ph->stats, 0, err);
 }
 
 /* Whether the parts can merge: one scene, seed, photon count and T0 per channel. */

@@ -58,6 +58,19 @@ thz_status photon_map_file_write(const char *path, const thz_scene *scene,
                                  const photon_map *const *maps, const photon_stats *stats,
                                  int threads, thz_error *err);
 
+/* photon_map_file_write to a file beside path under a name of its own (ending in
+ * ".part"), renamed into path whole: written in place (truncated first), a save that
+ * failed (a full disk, a file-size limit) left a truncated file where a good map had
+ * been, and a render reading that map meanwhile, a channel at a time, failed calling it
+ * corrupted. A symbolic link is written through, and the file keeps the mode of the one
+ * it replaces. Where no such name can be made (a directory that takes no new file), in
+ * place; so too over what is not a regular file (/dev/null, which a rename would
+ * replace) and through a symbolic link to a file not there yet (a rename would replace
+ * the link). Errors name path, not the temporary file. */
+thz_status photon_map_file_save(const char *path, const thz_scene *scene,
+                                const photon_map *const *maps, const photon_stats *stats,
+                                int threads, thz_error *err);
+
 /* Reads a photon-map file made from `scene`: fills maps[0..n_channels-1] (the caller
  * destroys them; all NULL on failure; each with its reference temperature set), stats
  * (n_channels entries, may be NULL; seconds is 0; reference_temperature_k the map's)
