@@ -3,7 +3,7 @@
 #   make demo   installs what is missing, builds, and runs the paper's test scene
 #   make check  installs what is missing, builds, and runs all tests (also under ASan+UBSan,
 #               and a clang build's outputs against the gcc build's),
-#               then fuzzes each reader for 30 s (fuzz-ci)
+#               then fuzzes each reader for 20 s (fuzz-ci)
 #   make fuzz   fuzzes each reader for FUZZ_SECONDS (default 60) s (tests/fuzz/README.md)
 JOBS ?= $(shell nproc)
 BUILD ?= build
@@ -13,7 +13,7 @@ PREFIX ?= /usr/local
 FUZZ_BUILD ?= build-fuzz
 CLANG_BUILD ?= build-clang
 FUZZ_SECONDS ?= 60
-FUZZ_CI_SECONDS ?= 30
+FUZZ_CI_SECONDS ?= 20
 
 .PHONY: all deps deps-build build install uninstall demo check test test-asan test-compilers fuzz-build fuzz fuzz-ci bench format clean
 

@@ -8,16 +8,17 @@
 # exit status other than 0 and a missing output. Where valgrind cannot decode an
 # instruction a library runs (RDTSCP on a processor whose CPUID hides it), that run is
 # said to be skipped and runs without valgrind instead (memcheck() below).
-# Not a CTest test (the release build is -march=native): make test-compilers runs it on
-# the clang build.
+# Two runs at a time (valgrind runs a program's threads one at a time, on one core):
+# final-gather beside path then photon-map, then the render beside the batch. Not a CTest test (the release build is
+# -march=native): make test-compilers runs it on the clang build.
 # argv: thzmap (built with -DTHZ_NATIVE=OFF), repository directory.
 set -u
 THZ=$1
 REPO=$2
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+# failures counted in a file: the runs are background jobs
+fail() { echo "FAIL: $*"; echo >>"$work/failures"; }
 command -v valgrind >/dev/null || { echo "FAIL: no valgrind (scripts/install-deps.sh installs it)"; exit 1; }
 
 cp -r "$REPO/examples/teraeye" "$work/room"
@@ -84,18 +85,21 @@ memcheck() { # memcheck NAME ARGS...: runs thzmap ARGS under memcheck
     fi
 }
 
-for integrator in path photon-map final-gather; do
-    extra=()
-    [[ $integrator == final-gather ]] && extra=(--save-photon-map)
-    memcheck "simulate-$integrator" simulate "$work/room/scene.json" -o "$work/$integrator" \
-        --integrator "$integrator" --threads 2 "${extra[@]}"
-done
+simulate() { # simulate INTEGRATOR [ARGS...]
+    memcheck "simulate-$1" simulate "$work/room/scene.json" -o "$work/$1" --integrator "$@" \
+        --threads 2
+}
+simulate final-gather --save-photon-map &
+{ simulate path; simulate photon-map; } &
+wait
 memcheck render render "$work/room/scene.json" --photon-map "$work/final-gather/photon-map.thzpm" \
-    -o "$work/render" --integrator final-gather --threads 2
-memcheck batch batch "$work/walker/sequence.json" -o "$work/batch" --threads 2
+    -o "$work/render" --integrator final-gather --threads 2 &
+memcheck batch batch "$work/walker/sequence.json" -o "$work/batch" --threads 2 &
+wait
 [[ -f $work/render/summary.json ]] || fail "render wrote no summary.json"
 ls "$work/batch"/*.mp4 >/dev/null 2>&1 || fail "batch wrote no movie"
 
+fails=$(cat "$work/failures" 2>/dev/null | wc -l)
 if [[ $fails -gt 0 ]]; then
     echo "memcheck: $fails failure(s)"
     exit 1
