@@ -2,7 +2,7 @@
 # The README's two set-up commands:
 #   bash scripts/setup.sh demo    install what is missing, build, run the paper's test scene
 #   bash scripts/setup.sh check   install what is missing, build, run every test (also ASan+UBSan),
-#                                 then fuzz each file reader for 30 s
+#                                 then fuzz each file reader for 20 s
 # On a fresh Debian 12 machine as root this is all it takes; it installs the Debian
 # packages listed in scripts/install-deps.sh (make and the compilers among them).
 set -euo pipefail
