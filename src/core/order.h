@@ -15,7 +15,7 @@ double order_select(double *x, size_t n, size_t k);
 
 /* Sorts x[0..n) in increasing order: a radix sort (16 bits a pass, the passes whose digit
  * every key shares skipped), where qsort's comparisons took most of the 21 s a scene of
- * three 5 M-triangle meshes spent loading (the edges' checks). Fewer than 2^16 keys, and
+ * three 5 M-triangle meshes spent loading (the edges' checks). Fewer than 2^11 keys, and
  * keys whose scratch (8 bytes a key) cannot be had, are sorted by qsort. */
 void order_sort_u64(uint64_t *x, size_t n);
 /* The same with at most `threads` threads. With 1 it starts no OpenMP team (a team of

@@ -1,5 +1,5 @@
 /* core/order.c's radix sort of 64-bit keys against qsort: random keys, keys that share
- * digits (passes skipped), duplicates, one and no key, counts either side of 2^16 (below
+ * digits (passes skipped), duplicates, one and no key, counts either side of 2^11 (below
  * it the library's sort is used), and key counts that the threads sort together (run with
  * OMP_NUM_THREADS unset: all cores, 2 in CI). */
 #include <setjmp.h>
@@ -60,8 +60,8 @@ static void test_sort_u64(void **state_)
     check(100000, 0x7, 0xabcdef0123456780ull);    /* many duplicates */
     check(100000, 0xffffffffull << 32 | 0xff, 0); /* edges' keys: two indices */
     check(3, 0, 42);                              /* all equal */
-    check(65535, ~0ull, 0);                       /* the last count the library sorts */
-    check(65536, 0xffffffffull << 32 | 0xff, 0);  /* the first the passes sort */
+    check(2047, ~0ull, 0);                        /* the last count the library sorts */
+    check(2048, 0xffffffffull << 32 | 0xff, 0);   /* the first the passes sort */
     /* from 2^20 keys on, every thread sorts a part of each pass (the parts of one digit
      * in order): an odd count, so that the parts differ in size */
     check(3000001, ~0ull, 0);
