@@ -9,14 +9,27 @@
 # instruction a library runs (RDTSCP on a processor whose CPUID hides it), that run is
 # said to be skipped and runs without valgrind instead (memcheck() below).
 # Two runs at a time (valgrind runs a program's threads one at a time, on one core):
-# final-gather beside path then photon-map, then the render beside the batch. Not a CTest test (the release build is
-# -march=native): make test-compilers runs it on the clang build.
+# final-gather beside path then photon-map, then the render beside the batch. Not a CTest
+# test (the release build is -march=native): make test-compilers runs it on the clang
+# build.
 # argv: thzmap (built with -DTHZ_NATIVE=OFF), repository directory.
 set -u
 THZ=$1
 REPO=$2
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+# stopped while runs go on (they are background jobs): the runs, valgrind and thzmap's
+# children ended first, then the files removed
+kill_tree() {
+    local p c
+    for p; do
+        for c in $(pgrep -P "$p"); do kill_tree "$c"; done
+        kill "$p" 2>/dev/null
+    done
+}
+runs=() # the background jobs' pids
+trap 'kill_tree "${runs[@]}"; wait; rm -rf "$work"' EXIT
+trap 'exit 143' TERM
+trap 'exit 130' INT
 # failures counted in a file: the runs are background jobs
 fail() { echo "FAIL: $*"; echo >>"$work/failures"; }
 command -v valgrind >/dev/null || { echo "FAIL: no valgrind (scripts/install-deps.sh installs it)"; exit 1; }
@@ -90,11 +103,15 @@ simulate() { # simulate INTEGRATOR [ARGS...]
         --threads 2
 }
 simulate final-gather --save-photon-map &
+runs+=($!)
 { simulate path; simulate photon-map; } &
+runs+=($!)
 wait
 memcheck render render "$work/room/scene.json" --photon-map "$work/final-gather/photon-map.thzpm" \
     -o "$work/render" --integrator final-gather --threads 2 &
+runs+=($!)
 memcheck batch batch "$work/walker/sequence.json" -o "$work/batch" --threads 2 &
+runs+=($!)
 wait
 [[ -f $work/render/summary.json ]] || fail "render wrote no summary.json"
 ls "$work/batch"/*.mp4 >/dev/null 2>&1 || fail "batch wrote no movie"
