@@ -296,9 +296,8 @@ void cli_progress_plan(void *user, const thz_run_plan *plan)
     if (plan->target_noise_k > 0.0 && plan->memory_stop)
         snprintf(target, sizeof target,
                  ", about %u photon passes per channel, where they stop at the memory they may "
-                 "hold (half of what the process may have), short of the noise target of %g K (%s; "
-                 "--photons N "
-                 "fires N photons once)",
+                 "hold (half of what the process may have), short of the noise target of %g K "
+                 "(%s; --photons N fires N photons once)",
                  plan->passes, plan->target_noise_k, source);
     else if (plan->target_noise_k > 0.0)
         snprintf(target, sizeof target,

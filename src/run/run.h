@@ -282,8 +282,9 @@ uint32_t run_photon_next_check(uint32_t n, double need);
 
 /* The memory the photon passes of one channel may hold, bytes (half of what the process
  * may have, thz_memory_limit_bytes: the machine's, or less under ulimit -v or a cgroup
- * limit; 0 if unknown), and what they hold per pass: the passes' maps and a merge of them, twice
- * the records, their indexes and the merge's index scratch (3/8 of its records):
+ * limit; 0 if unknown), and what they hold per pass: the passes' maps and a merge of
+ * them, twice the records, their indexes and the merge's index scratch (3/8 of its
+ * records):
  * RUN_PASSES_MAP_FACTOR x one pass's map. 2.2 left the scratch out: the walkthrough's
  * room, stopped at 202 passes of 28 MB maps, peaked at 13.4 GB against a limit of
  * 12.6 GB (11.75 GiB). */
