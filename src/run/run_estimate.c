@@ -23,29 +23,46 @@
  * merges the estimate said 68 s. */
 #define RUN_ESTIMATE_MERGE_PER_INDEX 2.2
 
-/* Samples one pass of sensor s renders: pixels x oversampling^2 (x paths for path). */
-static double estimate_samples(const thz_scene *scene, const thz_sensor *s)
+/* Samples one pass of sensor s renders: pixels x oversampling^2. */
+static double estimate_samples(const thz_sensor *s)
 {
-    double n = (double)s->columns * s->rows * s->oversampling * s->oversampling;
-    return scene->render.integrator == INTEGRATOR_PATH ? n * scene->render.paths_per_sample : n;
+    return (double)s->columns * s->rows * s->oversampling * s->oversampling;
 }
 
-void run_estimate_pilot(const thz_scene *scene, const thz_sensor *sensor, thz_sensor *cam,
-                        uint64_t *photons)
+/* Estimates one pass of sensor s gives, the noise's unit: samples x paths (path) or x
+ * gather rays (final-gather). */
+static double estimate_estimates(const thz_scene *scene, const thz_sensor *s)
+{
+    return estimate_samples(s) * render_estimates_per_pass(scene);
+}
+
+static uint64_t estimate_min(uint64_t a, uint64_t b)
+{
+    return a < b ? a : b;
+}
+
+void run_estimate_pilot(const thz_scene *scene, const thz_sensor *sensor, thz_scene *pilot,
+                        thz_sensor *cam)
 {
     *cam = *sensor;
     /* no larger than the run: a 2 x 2 camera's pilot at 32 x 32 took 1.4 s before a
      * render of 5 ms (a cavity of mirrors, paths of 10 000 hits) */
-    cam->columns = cam->columns < RUN_PILOT_SIDE ? cam->columns : RUN_PILOT_SIDE;
-    cam->rows = cam->rows < RUN_PILOT_SIDE ? cam->rows : RUN_PILOT_SIDE;
+    cam->columns = (uint32_t)estimate_min(cam->columns, RUN_PILOT_SIDE);
+    cam->rows = (uint32_t)estimate_min(cam->rows, RUN_PILOT_SIDE);
     cam->oversampling = 1;
-    uint64_t k = scene->photons.per_channel;
-    *photons = k < RUN_PILOT_PHOTONS ? k : RUN_PILOT_PHOTONS;
+    *pilot = *scene;
+    pilot->sensors = cam;
+    pilot->n_sensors = 1;
+    pilot->n_warnings = 0;
+    pilot->photons.per_channel = estimate_min(scene->photons.per_channel, RUN_PILOT_PHOTONS);
+    thz_render_settings *r = &pilot->render;
+    r->paths_per_sample = (uint32_t)estimate_min(r->paths_per_sample, RUN_PILOT_ESTIMATES);
+    r->gather_rays = (uint32_t)estimate_min(r->gather_rays, RUN_PILOT_ESTIMATES);
 }
 
 /* The pilot of channel c: its photon phase's time for the run's photons (0 without
- * photons), its render time per sample, and the 95th percentile of its pixels' standard
- * error of Tb_c (K). */
+ * photons), its render time per sample (at the run's paths or gather rays), and the 95th
+ * percentile of its pixels' standard error of Tb_c (K). */
 static thz_status estimate_channel(const run_estimate_input *in, thz_scene *pilot, thz_sensor *cam,
                                    size_t c, double *seconds_photons, double *merge_per_photon,
                                    double *per_sample, double *p95_k, thz_error *err)
@@ -88,17 +105,23 @@ static thz_status estimate_channel(const run_estimate_input *in, thz_scene *pilo
     render_stats rst;
     if (st == THZ_OK)
         st = render_sensor_truth(pilot, in->accel, 0, &img, &ro, err);
-    /* pass 0 warms up (threads, caches, the channel's tables); pass 1 is timed */
+    /* pass 0 warms up (threads, caches, the channel's tables); it is then timed afresh
+     * (photon-map has one pass only), and its noise taken */
     if (st == THZ_OK)
         st = render_sensor_channel_pass(pilot, in->accel, map, c, 0, 0, &acc, &ro, &rst, err);
-    if (st == THZ_OK) { /* photon-map has one pass only: time pass 0 again, afresh */
+    if (st == THZ_OK) {
         render_accum_fini(&acc);
         st = render_accum_init(&acc, (size_t)cam->columns * cam->rows, err);
     }
     double t0 = thz_now_s();
     if (st == THZ_OK)
         st = render_sensor_channel_pass(pilot, in->accel, map, c, 0, 0, &acc, &ro, &rst, err);
-    *per_sample = (thz_now_s() - t0) / estimate_samples(pilot, cam);
+    /* per path or gather ray where the pilot casts fewer than the run (RUN_PILOT_ESTIMATES):
+     * it also counts the camera ray and first hit that a sample's paths share, so a run
+     * of many more is estimated high by that share (a 32 x 24 sensor in a box: about 14
+     * paths' worth against the pilot's 64; 1.3 x measured for 1 000 and 30 000 paths) */
+    *per_sample = (thz_now_s() - t0) / estimate_samples(cam) * render_estimates_per_pass(scene) /
+                  render_estimates_per_pass(pilot);
     if (st == THZ_OK)
         st = render_accum_write(pilot, c, 0, &acc, &img, err);
     run_noise noise = {0};
@@ -138,12 +161,9 @@ thz_status run_estimate_time(const run_estimate_input *in, run_estimate *out, th
     const thz_scene *scene = in->scene;
     *out = (run_estimate){.passes = 1};
     /* the pilot scene: the same objects, K photons and one small sensor */
-    thz_scene pilot = *scene;
+    thz_scene pilot;
     thz_sensor cam;
-    run_estimate_pilot(scene, &scene->sensors[in->selected[0]], &cam, &pilot.photons.per_channel);
-    pilot.sensors = &cam;
-    pilot.n_sensors = 1;
-    pilot.n_warnings = 0;
+    run_estimate_pilot(scene, &scene->sensors[in->selected[0]], &pilot, &cam);
     bool paper_map = scene->render.integrator == INTEGRATOR_PHOTON_MAP;
     /* photon-map towards a target: with RUN_PILOT_PHOTONS the disks were widened to the
      * k-th nearest photon, where the noise hardly falls with more photons, and 1/sqrt
@@ -159,16 +179,17 @@ thz_status run_estimate_time(const run_estimate_input *in, run_estimate *out, th
         pilot.photons.per_channel = k < RUN_PILOT_PHOTONS_PASSES ? k : RUN_PILOT_PHOTONS_PASSES;
         pitch_ratio = (double)scene->sensors[in->selected[0]].columns / (double)cam.columns;
     }
-    double samples = 0.0, pixels = 0.0;
+    double samples = 0.0, estimates = 0.0, pixels = 0.0;
     for (size_t i = 0; i < in->n_selected; i++) {
         const thz_sensor *s = &scene->sensors[in->selected[i]];
-        samples += estimate_samples(scene, s);
+        samples += estimate_samples(s);
+        estimates += estimate_estimates(scene, s);
         pixels += (double)s->columns * s->rows;
     }
-    const double per_pixel = samples / pixels; /* samples per pixel in one pass */
-    /* the pilot has estimate_samples(cam) / side^2 samples per pixel */
+    const double per_pixel = estimates / pixels; /* estimates per pixel in one pass */
+    /* the pilot's, with its paths or gather rays (RUN_PILOT_ESTIMATES at most) */
     const double pilot_per_pixel =
-        estimate_samples(&pilot, &cam) / (double)(cam.columns * cam.rows);
+        estimate_estimates(&pilot, &cam) / (double)(cam.columns * cam.rows);
     /* With a noise target every channel gets its own pilot: their noise differs (the
      * paper's scene, final-gather's pilot: p95 0.24 K at 0.2 THz, 0.14-0.16 K at 1.0-1.2
      * THz), and channel 0's for all made `path`'s estimate twice its run (6.9 s against
@@ -183,8 +204,10 @@ thz_status run_estimate_time(const run_estimate_input *in, run_estimate *out, th
         uint32_t passes_c = 1;
         p95_k *= pitch_ratio;
         if (in->target_noise_k > 0.0 && p95_k > in->target_noise_k) {
-            /* the standard error falls as 1/sqrt(samples) (photon-map: of photons, the
-             * same law) */
+            /* the standard error falls as 1/sqrt(estimates) (photon-map: of photons, the
+             * same law; final-gather's map noise does not fall with its gather rays, so a
+             * run of more than the pilot's is estimated at too few passes where it
+             * dominates) */
             double need = pilot_per_pixel * pow(p95_k / in->target_noise_k, 2.0);
             double p = ceil(paper_map ? need / pilot_per_pixel * (double)pilot.photons.per_channel /
                                             (double)scene->photons.per_channel
