@@ -18,15 +18,9 @@
 # Then render with each of zstd's own allocations failing in turn (THZ_FAIL_ALLOC_IN),
 # which the sample may miss: exit 1, "out of memory".
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
+. "$(dirname "$0")/lib.sh"
 SHIM=$(dirname "$THZMAP")/libthz_failalloc.so
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 [ -f "$SHIM" ] || { echo "FAIL: $SHIM is missing (built with the thzmap target's CMake)"; exit 1; }
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
 SCALE=${THZ_ALLOC_FAIL_SCALE:-${THZ_TEST_SCALE:-1}}
 
 mkdir -p "$work/scene/materials"
@@ -310,5 +304,4 @@ while :; do
 done
 [ "$k" -ge 3 ] || fail "render: zstd made $((k - 1)) allocations; its context and window make 2"
 echo "alloc fail: zstd's $((k - 1)) allocations in render failed in turn"
-[ "$fails" = 0 ] && echo "alloc fail: all checks passed"
-exit $((fails > 0))
+finish "alloc fail: all checks passed"

@@ -33,14 +33,8 @@
 #    more than 100000 frames in all, or a frame that would not fit in memory, found
 #    before the first frame runs); a long check of the frames shows its progress.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
+. "$(dirname "$0")/lib.sh"
 PY=/usr/bin/python3 # Debian's, with numpy
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 # Every file of the run in $1 (summary.json aside: timings) equals, byte for byte, the
 # file of the same name in $2; at least 10 of them ($3 names the comparison).
 same_files() {
@@ -53,8 +47,8 @@ same_files() {
     done
     [ "$n" -ge 10 ] || fail "$3: only $n files compared"
 }
-command -v ffprobe >/dev/null || { echo "FAIL: ffprobe is missing (scripts/install-deps.sh installs ffmpeg)"; exit 1; }
-command -v ffmpeg >/dev/null || { echo "FAIL: ffmpeg is missing (scripts/install-deps.sh installs it)"; exit 1; }
+need ffprobe ffmpeg
+need ffmpeg
 
 cp "$REPO/tests/inputs/batch/scene.json" "$REPO/tests/inputs/batch/sequence.json" "$work/"
 seq="$work/sequence.json"
@@ -779,8 +773,4 @@ timeout 60 "$THZMAP" batch "$work/fifo/seq-fifo.json" -o "$work/fifo/o-fifo" --q
 rc=$?
 [ $rc -ne 124 ] || fail "batch resuming with a FIFO frame.json hung"
 
-if [ "$fails" -ne 0 ]; then
-    echo "$fails failure(s)"
-    exit 1
-fi
-echo "test_batch: all passed"
+finish_counted "test_batch: all passed"

@@ -15,27 +15,16 @@
 #  - run again unslowed, the batch ends with every file equal to an uninterrupted NEW
 #    batch's (summary.json and batch.json aside: timings) and nothing left beside them.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-command -v strace >/dev/null || { echo "FAIL: strace is missing (scripts/install-deps.sh installs it)"; exit 1; }
+. "$(dirname "$0")/lib.sh"
+need strace
 
-cat > "$work/scene.json" <<'JSON'
+cat > "$work/scene.json" <<JSON
 {
   "format": "thzmap-scene/1",
   "name": "batch-commit-kill",
   "channels": [{"frequency_thz": 0.35, "relative_width": 0.05},
                {"frequency_thz": 0.6, "relative_width": 0.05}],
-  "materials": {"wall": {"reflectivity": 0.2}, "paint": {"reflectivity": 0.5}},
-  "objects": [
-    {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
-     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}},
-    {"name": "plate", "type": "solid", "material": "paint", "temperature_k": 310,
-     "shape": {"type": "box", "size_m": [0.5, 0.05, 0.5]}}
-  ],
+$(plate_in_room)
   "sensors": [
     {"name": "a", "position_m": [0, -0.9, 0], "look_at_m": [0, 0, 0], "fov_deg": 60,
      "resolution": [8, 8]}
@@ -128,5 +117,4 @@ done
 echo "kills at the moment aimed at: $n_hit of 3"
 [ $n_hit -ge 2 ] || fail "only $n_hit of 3 kills came at the moment aimed at"
 
-[ "$fails" = 0 ] && echo "batch commit kill: all checks passed"
-exit $((fails > 0))
+finish "batch commit kill: all checks passed"

@@ -5,13 +5,8 @@
 # directory", which sent the user looking for a batch that did not exist. strace makes
 # the batch's fcntl on its lock file fail with ENOLCK.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-command -v strace >/dev/null || { echo "FAIL: strace is missing (scripts/install-deps.sh installs it)"; exit 1; }
+. "$(dirname "$0")/lib.sh"
+need strace
 cat > "$work/scene.json" <<'JSON'
 {
   "format": "thzmap-scene/1",
@@ -42,5 +37,4 @@ status=$?
 grep -q "out/.thzmap-batch-lock: cannot lock: No locks available" "$work/err" ||
   fail "the message does not say why: $(cat "$work/err")"
 grep -q "another thzmap batch" "$work/err" && fail "blames another batch: $(cat "$work/err")"
-[ $fails -eq 0 ] && echo ok
-exit $((fails > 0))
+finish ok

@@ -9,26 +9,15 @@
 # stop, made the test depend on the other batch ending within it: under the sanitizer
 # build on a loaded 2-core machine it did not, and the resumed batch met its lock.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-command -v strace >/dev/null || { echo "FAIL: strace is missing (scripts/install-deps.sh installs it)"; exit 1; }
+. "$(dirname "$0")/lib.sh"
+need strace
 
-cat > "$work/scene.json" <<'JSON'
+cat > "$work/scene.json" <<JSON
 {
   "format": "thzmap-scene/1",
   "name": "batch-reuse-race",
   "channels": [{"frequency_thz": 0.35, "relative_width": 0.05}],
-  "materials": {"wall": {"reflectivity": 0.2}, "paint": {"reflectivity": 0.5}},
-  "objects": [
-    {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
-     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}},
-    {"name": "plate", "type": "solid", "material": "paint", "temperature_k": 310,
-     "shape": {"type": "box", "size_m": [0.5, 0.05, 0.5]}}
-  ],
+$(plate_in_room)
   "sensors": [
     {"name": "a", "position_m": [0, -0.9, 0], "look_at_m": [0, 0, 0], "fov_deg": 60,
      "resolution": [8, 6]}
@@ -69,5 +58,4 @@ for f in frame-00000 frame-00001; do
     fail "$f holds A's images under B's batch.json"
 done
 grep -q '"frames_computed": 2' out/batch.json || fail "B did not run its frames again: $(grep frames_ out/batch.json | tr -d '\n ')"
-[ $fails -eq 0 ] && echo ok
-exit $((fails > 0))
+finish ok

@@ -8,13 +8,8 @@
 # place of the stop, made the test depend on the simulate ending within it: under the
 # sanitizer build on a loaded 2-core machine it did not, and classify read run 1 whole.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-command -v strace >/dev/null || { echo "FAIL: strace is missing (scripts/install-deps.sh installs it)"; exit 1; }
+. "$(dirname "$0")/lib.sh"
+need strace
 
 for x in 1:0:310 2:0.15:320; do
   IFS=: read -r n dx t <<<"$x"
@@ -63,5 +58,4 @@ for pid in $(cat /proc/$classify/task/$classify/children 2>/dev/null); do kill -
 wait $classify || fail "classify: exit $?: $(cat "$work/classify.err")"
 cmp -s mixed/cam.class.img pure2/cam.class.img ||
   fail "the classification is not run 2's: $(grep -m1 '"accuracy"' mixed/classification.json)"
-[ $fails -eq 0 ] && echo ok
-exit $((fails > 0))
+finish ok

@@ -9,27 +9,16 @@
 #  - the next run into that OUTDIR cleans up what the killed one left beside it;
 #  - a second run into an OUTDIR in use is refused with a message, exit 1.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-command -v strace >/dev/null || { echo "FAIL: strace is missing (scripts/install-deps.sh installs it)"; exit 1; }
+. "$(dirname "$0")/lib.sh"
+need strace
 
-cat > "$work/scene.json" <<'JSON'
+cat > "$work/scene.json" <<JSON
 {
   "format": "thzmap-scene/1",
   "name": "commit-kill",
   "channels": [{"frequency_thz": 0.35, "relative_width": 0.05},
                {"frequency_thz": 0.6, "relative_width": 0.05}],
-  "materials": {"wall": {"reflectivity": 0.2}, "paint": {"reflectivity": 0.5}},
-  "objects": [
-    {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
-     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}},
-    {"name": "plate", "type": "solid", "material": "paint", "temperature_k": 310,
-     "shape": {"type": "box", "size_m": [0.5, 0.05, 0.5]}}
-  ],
+$(plate_in_room)
   "sensors": [
     {"name": "a", "position_m": [0, -0.9, 0], "look_at_m": [0, 0, 0], "fov_deg": 60,
      "resolution": [8, 8]},
@@ -107,5 +96,4 @@ rc=$?
 grep -q 'another thzmap run' "$work/err" || fail "no clear message: $(cat "$work/err")"
 wait "$tracer" || fail "the first run into busy/ failed"
 
-[ "$fails" = 0 ] && echo "commit kill: all checks passed"
-exit $((fails > 0))
+finish "commit kill: all checks passed"

@@ -8,13 +8,7 @@
 # systems: link fails with EPERM, and renameat2 with EINVAL. The earlier run's files of a
 # sensor the new run writes go, though: its measured cubes, its sensor's noise removed.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "$0")/lib.sh"
 
 cp -r "$REPO/examples/plate-in-box/." "$work/"
 sed -i 's/"resolution": \[[0-9, ]*\]/"resolution": [16, 12]/' "$work/scene.json"
@@ -40,5 +34,4 @@ for mode in exchange parked; do
     left=$(ls -A "$work" | grep -v -x -e out -e scene.json -e noisy.json -e materials -e err -e README.md)
     [ -z "$left" ] || fail "$mode: left beside OUTDIR: $left"
 done
-[ $fails -eq 0 ] && echo "ok: commit keeps a user's file where hard links fail"
-exit $((fails > 0))
+finish "ok: commit keeps a user's file where hard links fail"

@@ -13,13 +13,7 @@
 #    picture within 0.02 K; a missing B0 or a sign error is off by ~300 K or by the
 #    target's contrast.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "$0")/lib.sh"
 
 cp -r "$REPO/examples/plate-in-box" "$work/scene"
 S=$work/scene/scene.json
@@ -95,8 +89,4 @@ for b in bad:
 sys.exit(1 if bad else 0)
 PY
 
-if [ "$fails" -ne 0 ]; then
-    echo "$fails failure(s)"
-    exit 1
-fi
-echo "deviation maps: ok"
+finish_counted "deviation maps: ok"

@@ -12,15 +12,8 @@
 # give the same images (a hit's point and distance are thzmap's own arithmetic), and
 # refuses anything else.
 # usage: test_environment.sh THZMAP_BINARY REPO_DIR
-set -u
-T=$1
-repo=$2
-S=$repo/examples/plate-in-box/scene.json
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-leftovers() { find "$work" -maxdepth 1 -name '.thzmap-*' | head -n 3; }
+. "$(dirname "$0")/lib.sh"
+S=$REPO/examples/plate-in-box/scene.json
 R=(--photons 20000 --integrator photon-map --threads 2 -q)
 
 # expect WHAT STATUS PATTERN: the last command's status and stderr ($work/err)
@@ -30,50 +23,50 @@ expect() {
 }
 
 # --- a standard output that cannot be written --------------------------------------------
-"$T" --version >/dev/full 2>"$work/err"
+"$THZMAP" --version >/dev/full 2>"$work/err"
 expect "--version >/dev/full" $? 1 "cannot write the standard output"
-"$T" validate "$S" >/dev/full 2>"$work/err"
+"$THZMAP" validate "$S" >/dev/full 2>"$work/err"
 expect "validate >/dev/full" $? 1 "cannot write the standard output"
-"$T" materials >/dev/full 2>"$work/err"
+"$THZMAP" materials >/dev/full 2>"$work/err"
 expect "materials >/dev/full" $? 1 "cannot write the standard output"
-"$T" validate "$S" 2>"$work/err" | head -c 10 >/dev/null
+"$THZMAP" validate "$S" 2>"$work/err" | head -c 10 >/dev/null
 expect "validate | head" "${PIPESTATUS[0]}" 0 ""
 
 # --- stderr closed: the lock file does not take its descriptor ----------------------------
-"$T" simulate "$S" -o "$work/closed" --photons 20000 --integrator photon-map 2>&- >"$work/out"
+"$THZMAP" simulate "$S" -o "$work/closed" --photons 20000 --integrator photon-map 2>&- >"$work/out"
 rc=$?
 [[ $rc -eq 0 ]] || fail "simulate with stderr closed: exit $rc"
 [[ -s $work/closed/summary.json ]] || fail "simulate with stderr closed: no results"
 [[ -z $(leftovers) ]] || fail "simulate with stderr closed left: $(leftovers)"
 
 # --- a file-size limit --------------------------------------------------------------------
-"$T" simulate "$S" -o "$work/before" "${R[@]}" --seed 1 2>"$work/err" || fail "the first run failed"
+"$THZMAP" simulate "$S" -o "$work/before" "${R[@]}" --seed 1 2>"$work/err" || fail "the first run failed"
 cp -r "$work/before" "$work/limited"
-(ulimit -f 10; exec "$T" simulate "$S" -o "$work/limited" "${R[@]}" --seed 7) 2>"$work/err"
+(ulimit -f 10; exec "$THZMAP" simulate "$S" -o "$work/limited" "${R[@]}" --seed 7) 2>"$work/err"
 expect "ulimit -f 10" $? 1 "^thzmap: $work/limited/[^ ]*: write failed: File too large"
 diff -r "$work/before" "$work/limited" >/dev/null || fail "ulimit -f: OUTDIR changed"
 [[ -z $(leftovers) ]] || fail "ulimit -f left: $(leftovers)"
 
 # --- few open files: a soft limit raised, a hard one refused ------------------------------
-(ulimit -Sn 8; exec "$T" simulate "$S" -o "$work/soft8" "${R[@]}") 2>"$work/err"
+(ulimit -Sn 8; exec "$THZMAP" simulate "$S" -o "$work/soft8" "${R[@]}") 2>"$work/err"
 expect "ulimit -Sn 8" $? 0 ""
-(ulimit -n 8; exec "$T" simulate "$S" -o "$work/hard8" "${R[@]}") 2>"$work/err"
+(ulimit -n 8; exec "$THZMAP" simulate "$S" -o "$work/hard8" "${R[@]}") 2>"$work/err"
 expect "ulimit -n 8" $? 2 "limit on open files (ulimit -n) is 8"
 
 # --- a dangling symbolic link as OUTDIR ------------------------------------------------------
 ln -s "$work/nowhere/x" "$work/dangling"
-"$T" simulate "$S" -o "$work/dangling" "${R[@]}" 2>"$work/err"
+"$THZMAP" simulate "$S" -o "$work/dangling" "${R[@]}" 2>"$work/err"
 expect "a dangling symlink OUTDIR" $? 2 "symbolic link to a missing path"
 
 # --- stacks too small, threads too many ---------------------------------------------------
-(ulimit -s 64; exec "$T" simulate "$S" -o "$work/s64" "${R[@]}") 2>"$work/err"
+(ulimit -s 64; exec "$THZMAP" simulate "$S" -o "$work/s64" "${R[@]}") 2>"$work/err"
 expect "ulimit -s 64" $? 2 "stack size limit (ulimit -s) is 64 KiB"
-OMP_STACKSIZE=64K "$T" simulate "$S" -o "$work/o64" "${R[@]}" 2>"$work/err"
+OMP_STACKSIZE=64K "$THZMAP" simulate "$S" -o "$work/o64" "${R[@]}" 2>"$work/err"
 expect "OMP_STACKSIZE=64K" $? 2 "OMP_STACKSIZE=64K"
 [[ ! -e $work/s64 && ! -e $work/o64 ]] || fail "a refused stack wrote OUTDIR"
-OMP_STACKSIZE=2M "$T" validate "$S" >/dev/null 2>"$work/err"
+OMP_STACKSIZE=2M "$THZMAP" validate "$S" >/dev/null 2>"$work/err"
 expect "OMP_STACKSIZE=2M" $? 0 ""
-OMP_NUM_THREADS=100000 "$T" simulate "$S" -o "$work/many" --photons 20000 \
+OMP_NUM_THREADS=100000 "$THZMAP" simulate "$S" -o "$work/many" --photons 20000 \
     --integrator photon-map -q --seed 1 2>"$work/err"
 expect "OMP_NUM_THREADS=100000" $? 0 ""
 cmp -s "$work/many/cam.radiance.img" "$work/before/cam.radiance.img" ||
@@ -82,8 +75,8 @@ cmp -s "$work/many/cam.radiance.img" "$work/before/cam.radiance.img" ||
 # --- a scene in a directory whose name is not UTF-8 (Latin-1 bytes): summary.json says
 #     where, the bytes written as \xNN (it failed as "out of memory" after the run) ----
 odd=$work/$'sc\xff\xfe'
-mkdir "$odd" && cp -r "$repo/examples/plate-in-box/." "$odd/"
-"$T" simulate "$odd/scene.json" -o "$work/odd" "${R[@]}" 2>"$work/err"
+mkdir "$odd" && cp -r "$REPO/examples/plate-in-box/." "$odd/"
+"$THZMAP" simulate "$odd/scene.json" -o "$work/odd" "${R[@]}" 2>"$work/err"
 expect "a scene path that is not UTF-8" $? 0 ""
 /usr/bin/python3 -c 'import json, sys; p = json.load(open(sys.argv[1]))["scene"]["path"]; assert p.endswith("sc\\xff\\xfe/scene.json"), p' \
     "$work/odd/summary.json" || fail "summary.json's scene path: $(grep '"path"' "$work/odd/summary.json")"
@@ -93,23 +86,23 @@ expect "a scene path that is not UTF-8" $? 0 ""
 deep=$work
 for _ in $(seq 11); do deep=$deep/$(printf 'd%.0s' $(seq 100)); done
 mkdir -p "$deep"
-(cd "$deep" && exec "$T" simulate "$S" -o out "${R[@]}") 2>"$work/err"
+(cd "$deep" && exec "$THZMAP" simulate "$S" -o out "${R[@]}") 2>"$work/err"
 expect "a working directory of ${#deep} bytes" $? 0 ""
 [[ -s $deep/out/cam.band-01.png ]] || fail "a deep working directory: no figure"
 
 # --- OUTDIR refused before the run: a name too long, a directory not writable ------------
 long=$work/$(printf 'b%.0s' $(seq 256))
-"$T" simulate "$S" -o "$long" --photons 20000000 --integrator photon-map -q 2>"$work/err"
+"$THZMAP" simulate "$S" -o "$long" --photons 20000000 --integrator photon-map -q 2>"$work/err"
 expect "a 256-byte OUTDIR name" $? 2 "its name is 256 bytes long"
 [[ -z $(leftovers) ]] || fail "a 256-byte OUTDIR name left: $(leftovers)"
 if [[ $(id -u) -eq 0 ]] && command -v runuser >/dev/null; then
     # as another user (root may write anywhere): OUTDIR theirs but read-only, parent writable
     mkdir "$work/ro" && chmod 755 "$work" && chown nobody "$work/ro"
-    runuser -u nobody -- "$T" simulate "$S" -o "$work/ro/own" "${R[@]}" 2>"$work/err" ||
+    runuser -u nobody -- "$THZMAP" simulate "$S" -o "$work/ro/own" "${R[@]}" 2>"$work/err" ||
         fail "nobody's first run: $(cat "$work/err")"
     echo notes >"$work/ro/own/notes.txt"
     chmod 555 "$work/ro/own"
-    runuser -u nobody -- "$T" simulate "$S" -o "$work/ro/own" "${R[@]}" --seed 9 2>"$work/err"
+    runuser -u nobody -- "$THZMAP" simulate "$S" -o "$work/ro/own" "${R[@]}" --seed 9 2>"$work/err"
     expect "a read-only OUTDIR" $? 2 "exists and is not writable"
     [[ $(ls -A "$work/ro" | tr '\n' ' ') == "own " ]] ||
         fail "a read-only OUTDIR: beside it: $(ls -A "$work/ro" | tr '\n' ' ')"
@@ -117,31 +110,30 @@ if [[ $(id -u) -eq 0 ]] && command -v runuser >/dev/null; then
     chmod 755 "$work/ro/own"
     # a new OUTDIR in a directory the user cannot write: named, not the lock file
     chown root "$work/ro" && chmod 555 "$work/ro"
-    runuser -u nobody -- "$T" simulate "$S" -o "$work/ro/new" "${R[@]}" 2>"$work/err"
+    runuser -u nobody -- "$THZMAP" simulate "$S" -o "$work/ro/new" "${R[@]}" 2>"$work/err"
     expect "OUTDIR in a read-only directory" $? 2 "ro/new: cannot write in .*/ro, where a run"
     [[ ! -e $work/ro/new ]] || fail "OUTDIR in a read-only directory was created"
     chmod 755 "$work/ro"
 fi
 
 # --- THZMAP_EMBREE_MAX_ISA: a set the processor has at most, or refused -------------------
-"$T" simulate "$S" -o "$work/isa-default" "${R[@]}" 2>"$work/err"
+"$THZMAP" simulate "$S" -o "$work/isa-default" "${R[@]}" 2>"$work/err"
 expect "simulate" $? 0 ""
-THZMAP_EMBREE_MAX_ISA=avx2 "$T" simulate "$S" -o "$work/isa-avx2" "${R[@]}" 2>"$work/err"
+THZMAP_EMBREE_MAX_ISA=avx2 "$THZMAP" simulate "$S" -o "$work/isa-avx2" "${R[@]}" 2>"$work/err"
 expect "THZMAP_EMBREE_MAX_ISA=avx2" $? 0 ""
 for f in "$work/isa-default"/*.img; do # the default cap
     cmp -s "$f" "$work/isa-avx2/${f##*/}" || fail "THZMAP_EMBREE_MAX_ISA=avx2 changed ${f##*/}"
 done
-THZMAP_EMBREE_MAX_ISA=avx512 "$T" simulate "$S" -o "$work/isa-avx512" "${R[@]}" 2>"$work/err"
+THZMAP_EMBREE_MAX_ISA=avx512 "$THZMAP" simulate "$S" -o "$work/isa-avx512" "${R[@]}" 2>"$work/err"
 expect "THZMAP_EMBREE_MAX_ISA=avx512" $? 0 ""
-THZMAP_EMBREE_MAX_ISA=sse4.2 "$T" simulate "$S" -o "$work/isa-sse" "${R[@]}" 2>"$work/err"
+THZMAP_EMBREE_MAX_ISA=sse4.2 "$THZMAP" simulate "$S" -o "$work/isa-sse" "${R[@]}" 2>"$work/err"
 expect "THZMAP_EMBREE_MAX_ISA=sse4.2" $? 0 ""
 for f in "$work/isa-default"/*.img; do # the kernels' own last bits stay out of the paths
     cmp -s "$f" "$work/isa-avx512/${f##*/}" || fail "THZMAP_EMBREE_MAX_ISA=avx512 changed ${f##*/}"
     cmp -s "$f" "$work/isa-sse/${f##*/}" || fail "THZMAP_EMBREE_MAX_ISA=sse4.2 changed ${f##*/}"
 done
-THZMAP_EMBREE_MAX_ISA=avx3 "$T" simulate "$S" -o "$work/isa-bad" "${R[@]}" 2>"$work/err"
+THZMAP_EMBREE_MAX_ISA=avx3 "$THZMAP" simulate "$S" -o "$work/isa-bad" "${R[@]}" 2>"$work/err"
 expect "THZMAP_EMBREE_MAX_ISA=avx3" $? 2 'THZMAP_EMBREE_MAX_ISA: expected one of sse2, sse4.2'
 [[ ! -e $work/isa-bad && -z $(leftovers) ]] || fail "THZMAP_EMBREE_MAX_ISA=avx3 left files"
 
-[[ $fails -eq 0 ]] && echo "environment: all passed"
-exit $((fails > 0))
+finish "environment: all passed"

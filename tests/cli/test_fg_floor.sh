@@ -12,13 +12,7 @@
 # The floor's estimate itself (the spread between the map's photon batches) is checked
 # against the spread over photon seeds in tests/physics/test_integrators.c.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "$0")/lib.sh"
 
 cp -r "$REPO/examples/teraeye" "$work/scene"
 S=$work/scene/scene.json
@@ -96,5 +90,4 @@ if any("photon map alone" in w for w in s["warnings"]):
     sys.exit(f"path stopped at a map floor: {s['warnings']}")
 PY
 
-[ "$fails" -eq 0 ] && echo "all final-gather floor checks passed"
-exit $((fails > 0))
+finish "all final-gather floor checks passed"

@@ -6,13 +6,7 @@
 # the last line with its unit) and the command-line items (--photons 1e6, an option
 # given as a value, a run too large for the machine exits 2).
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "$0")/lib.sh"
 
 # variants of one small scene: NAME and a Python statement changing the dict `s`
 make_scene() {
@@ -148,5 +142,4 @@ grep -q 'material "metal": photon-map cannot resolve its glossy lobe (alpha 0.03
 [ "$(glossy ward-0.03 final-gather)" = 0 ] || fail "final-gather, Ward alpha 0.03: warned"
 [ "$(glossy ward-unused photon-map)" = 0 ] || fail "photon-map, Ward alpha 0.03 in a material no object uses: warned"
 
-[ $fails -eq 0 ] && echo "honest defaults: all checks passed"
-exit $((fails > 0))
+finish "honest defaults: all checks passed"

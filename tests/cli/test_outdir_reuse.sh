@@ -8,13 +8,7 @@
 # bands-air.png beside a band selection in clear air. The user's own files, another
 # sensor's, and a photon map a render reads stay.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "$0")/lib.sh"
 
 cp -r "$REPO/examples/plate-in-box/." "$work/"
 # cam with noise, two channels, and a second sensor; then cam without noise, one channel
@@ -75,5 +69,4 @@ done
 [ ! -e "$work/bands/bands-air.png" ] || fail "the humid run's bands-air.png stayed"
 [ -f "$work/bands/bands.json" ] || fail "no bands.json"
 
-[ $fails -eq 0 ] && echo "ok: an OUTDIR used again holds the new run's files alone"
-exit $((fails > 0))
+finish "ok: an OUTDIR used again holds the new run's files alone"

@@ -5,27 +5,16 @@
 # pass and the pixel loop, whichever runs then). It must exit 143 (128 + SIGTERM) and
 # leave nothing: no OUTDIR, nothing beside it.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
+. "$(dirname "$0")/lib.sh"
 # the stop limit: 1 s; the sanitizer build sets THZ_CANCEL_LIMIT_MS=2000 (CMakeLists.txt)
 limit_ms=${THZ_CANCEL_LIMIT_MS:-1000}
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 
-cat > "$work/scene.json" <<'JSON'
+cat > "$work/scene.json" <<JSON
 {
   "format": "thzmap-scene/1",
   "name": "render-cancel",
   "channels": [{"frequency_thz": 0.35, "relative_width": 0.05}],
-  "materials": {"wall": {"reflectivity": 0.2}, "paint": {"reflectivity": 0.5}},
-  "objects": [
-    {"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
-     "shape": {"type": "box", "size_m": [2, 2, 2], "inward": true}},
-    {"name": "plate", "type": "solid", "material": "paint", "temperature_k": 310,
-     "shape": {"type": "box", "size_m": [0.5, 0.05, 0.5]}}
-  ],
+$(plate_in_room)
   "sensors": [{"name": "big", "position_m": [0, -0.9, 0], "look_at_m": [0, 0, 0],
                "fov_deg": 60, "resolution": [4000, 4000], "oversampling": 8}],
   "render": {"integrator": "path", "paths_per_sample": 1}
@@ -51,5 +40,4 @@ for at in 1.0 2.0 3.0; do
   left=$(ls -A "$work/run")
   [ -z "$left" ] || fail "SIGTERM at $at s: left $left"
 done
-[ "$fails" = 0 ] && echo "render cancel: all checks passed"
-exit $((fails > 0))
+finish "render cancel: all checks passed"

@@ -13,11 +13,7 @@
 # The peak is the child's maxrss (getrusage), and the sanitizers reserve more address
 # space than ulimit -v allows, so this runs without sanitizers.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. "$(dirname "$0")/lib.sh"
 
 cp -r "$REPO/examples/teraeye" "$work/scene"
 python3 - "$work/scene/scene.json" <<'PY' || exit 1

@@ -17,13 +17,7 @@
 #  - summary.json names the model, validate prints NETD and spot size with units, and a
 #    bad noise block is refused with its JSON path (exit 2).
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "$0")/lib.sh"
 run() { # $1: what, rest: thzmap arguments
     local what=$1
     shift
@@ -179,5 +173,4 @@ grep -q "$work/huge.json: sensors\[2\].noise (sensor 'netd'), channel 2: the noi
     { fail "netd_k 1e300 K: no message naming the file, sensor and channel"; cat "$work/huge.log"; }
 [ ! -e "$work/huge" ] || fail "netd_k 1e300 K: OUTDIR written"
 
-[ $fails -eq 0 ] && echo "PASS"
-exit $((fails > 0))
+finish "PASS"

@@ -6,15 +6,8 @@
 # figures stops the drawing at once. `atmosphere --plot` stopped early keeps an
 # existing figure (it was emptied before the work).
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "$0")/lib.sh"
 scene=$REPO/examples/plate-in-box/scene.json
-leftovers() { find "$work" -maxdepth 1 -name '.thzmap-*' | head -n 3; }
 
 # SIGPIPE: the progress goes to `head -1`, which exits after the first line
 "$THZMAP" simulate "$scene" -o "$work/pipe" --photons 300000 --integrator photon-map 2>&1 |
@@ -153,5 +146,4 @@ if "$THZMAP" atmosphere --from-thz 0.1 --to-thz 1 --step-ghz 10 --plot "$work/at
         fail "atmosphere --plot stopped early changed the figure ($size bytes before)"
 fi
 
-[ "$fails" -eq 0 ] && echo "signals: all passed"
-exit $((fails > 0))
+finish "signals: all passed"

@@ -9,13 +9,7 @@
 #  - a mirror of R = 0 starts no mirror chain, one of R > 0 is cut after 32 reflections;
 #  - usage errors exit 2.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "$0")/lib.sh"
 
 scene() { # $1: file, $2: width of the plate in m
 cat > "$1" <<JSON

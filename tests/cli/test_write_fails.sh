@@ -6,13 +6,7 @@
 # byte for byte. For simulate, render and batch (whose frames and state file are
 # written through other paths). The limit does not apply to the pipes stderr goes to.
 # argv: path to the thzmap binary, repository directory.
-set -u
-THZMAP=$1
-REPO=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "$0")/lib.sh"
 
 # the example's scene (64 x 64 pixels: 16 KB a plane, past the limit), fewer photons
 cp -r "$REPO/examples/plate-in-box/." "$work/"
@@ -91,5 +85,4 @@ check "batch" $? "$work/err4" "$work/batch"
 grep -q '"status": "failed"' "$work/batch/batch.json" 2>/dev/null ||
     fail "batch: batch.json does not record the failed frame"
 
-[ "$fails" -eq 0 ] && echo "write failures: all runs failed cleanly"
-exit $((fails > 0))
+finish "write failures: all runs failed cleanly"
