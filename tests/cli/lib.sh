@@ -28,6 +28,11 @@ need() {
         { echo "FAIL: $1 is missing (scripts/install-deps.sh installs ${2:-it})"; exit 1; }
 }
 
+# expect_line FILE PATTERN: some line of FILE matches the extended regex PATTERN.
+expect_line() {
+    grep -Eq -- "$2" "$1" || fail "no line matching '$2' in $(basename "$1"):" "$(cat "$1")"
+}
+
 # leftovers: up to three of thzmap's staging or lock files (.thzmap-*) left in $work.
 leftovers() { find "$work" -maxdepth 1 -name '.thzmap-*' | head -n 3; }
 

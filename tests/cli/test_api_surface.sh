@@ -5,41 +5,31 @@
 # function list (every function, nothing else). And every public header compiles on
 # its own, as C17 and as C++17, with the warnings as errors.
 # usage: test_api_surface.sh THZMAP_BINARY REPO_DIR
-set -u
-thzmap=$1
-repo=$2
-build=$(cd "$(dirname "$thzmap")" && pwd)
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-    echo "FAIL: $*"
-    failures=$((failures + 1))
-}
+. "$(dirname "$0")/lib.sh"
+build=$(cd "$(dirname "$THZMAP")" && pwd)
 
 lib=$build/libthzmap.so
 [[ -f $lib ]] || fail "no $lib"
 
 # --- declared, exported, documented ----------------------------------------------------------
-/usr/bin/python3 - "$repo" >"$tmp/declared" <<'PY' || fail "could not read the headers"
+/usr/bin/python3 - "$REPO" >"$work/declared" <<'PY' || fail "could not read the headers"
 import glob, re, sys
 text = "".join(open(h).read() for h in sorted(glob.glob(sys.argv[1] + "/include/thzmap/*.h")))
 text = re.sub(r"/\*.*?\*/", " ", text, flags=re.S)
 for name in sorted(set(re.findall(r"\bTHZ_API\b[^;{]*?\b(thz_\w+)\s*\(", text))):
     print(name)
 PY
-[[ $(wc -l <"$tmp/declared") -gt 100 ]] || fail "only $(wc -l <"$tmp/declared") THZ_API functions found in include/thzmap/"
+[[ $(wc -l <"$work/declared") -gt 100 ]] || fail "only $(wc -l <"$work/declared") THZ_API functions found in include/thzmap/"
 
-nm -D --defined-only "$lib" | awk '{print $3}' | sort -u >"$tmp/exported"
-comm -13 "$tmp/declared" "$tmp/exported" >"$tmp/extra"
-comm -23 "$tmp/declared" "$tmp/exported" >"$tmp/missing"
-[[ -s $tmp/extra ]] && fail "libthzmap.so exports symbols no header declares: $(tr '\n' ' ' <"$tmp/extra")"
-[[ -s $tmp/missing ]] && fail "declared but not exported: $(tr '\n' ' ' <"$tmp/missing")"
+nm -D --defined-only "$lib" | awk '{print $3}' | sort -u >"$work/exported"
+comm -13 "$work/declared" "$work/exported" >"$work/extra"
+comm -23 "$work/declared" "$work/exported" >"$work/missing"
+[[ -s $work/extra ]] && fail "libthzmap.so exports symbols no header declares: $(tr '\n' ' ' <"$work/extra")"
+[[ -s $work/missing ]] && fail "declared but not exported: $(tr '\n' ' ' <"$work/missing")"
 
 # docs/api.md's table: "thz_photons_fire, _fire_channel": a name starting with "_" continues
 # a prefix of the last full name (thz_photons + _fire_channel)
-/usr/bin/python3 - "$repo/docs/api.md" "$tmp/declared" >"$tmp/docs.check" <<'PY'
+/usr/bin/python3 - "$REPO/docs/api.md" "$work/declared" >"$work/docs.check" <<'PY'
 import re, sys
 doc = open(sys.argv[1]).read()
 declared = set(open(sys.argv[2]).read().split())
@@ -69,21 +59,17 @@ for name in sorted(declared - listed):
 for name in bad:
     print("docs/api.md's function list names no declared function:", name)
 PY
-[[ -s $tmp/docs.check ]] && fail "$(cat "$tmp/docs.check")"
+[[ -s $work/docs.check ]] && fail "$(cat "$work/docs.check")"
 
 # --- each header alone ---------------------------------------------------------------------
-for h in "$repo"/include/thzmap/*.h; do
+for h in "$REPO"/include/thzmap/*.h; do
     name=$(basename "$h")
-    printf '#include <thzmap/%s>\nint thz_surface_test_unused;\n' "$name" >"$tmp/alone.c"
-    cc -std=c17 -Wall -Wextra -Wpedantic -Werror -fsyntax-only -I"$repo/include" "$tmp/alone.c" \
-        >"$tmp/cc.out" 2>&1 || fail "<thzmap/$name> alone does not compile as C17: $(head -c 600 "$tmp/cc.out")"
-    c++ -std=c++17 -Wall -Wextra -Wpedantic -Werror -fsyntax-only -I"$repo/include" -x c++ \
-        "$tmp/alone.c" >"$tmp/cxx.out" 2>&1 ||
-        fail "<thzmap/$name> alone does not compile as C++17: $(head -c 600 "$tmp/cxx.out")"
+    printf '#include <thzmap/%s>\nint thz_surface_test_unused;\n' "$name" >"$work/alone.c"
+    cc -std=c17 -Wall -Wextra -Wpedantic -Werror -fsyntax-only -I"$REPO/include" "$work/alone.c" \
+        >"$work/cc.out" 2>&1 || fail "<thzmap/$name> alone does not compile as C17: $(head -c 600 "$work/cc.out")"
+    c++ -std=c++17 -Wall -Wextra -Wpedantic -Werror -fsyntax-only -I"$REPO/include" -x c++ \
+        "$work/alone.c" >"$work/cxx.out" 2>&1 ||
+        fail "<thzmap/$name> alone does not compile as C++17: $(head -c 600 "$work/cxx.out")"
 done
 
-if [[ $failures -ne 0 ]]; then
-    echo "$failures failure(s)"
-    exit 1
-fi
-echo "ok: $(wc -l <"$tmp/declared") functions declared, exported and listed; every header compiles alone"
+finish_counted "ok: $(wc -l <"$work/declared") functions declared, exported and listed; every header compiles alone"

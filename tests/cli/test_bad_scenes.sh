@@ -4,29 +4,24 @@
 # must exit with that status, print nothing to stdout, print exactly one line to
 # stderr naming the file, and that line must contain the text. Lists every mismatch.
 # usage: test_bad_scenes.sh THZMAP_BINARY REPO_DIR
-set -u
-thzmap=$1
-repo=$2
-table=$repo/tests/inputs/bad_scenes.tsv
-dir=$repo/tests/inputs/bad
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/lib.sh"
+table=$REPO/tests/inputs/bad_scenes.tsv
+dir=$REPO/tests/inputs/bad
 
-failures=0
 rows=0
 while IFS=$'\t' read -r file status expect; do
     [[ -z $file || $file == \#* ]] && continue
     rows=$((rows + 1))
-    "$thzmap" validate "$dir/$file" >"$tmp/out" 2>"$tmp/err"
+    "$THZMAP" validate "$dir/$file" >"$work/out" 2>"$work/err"
     got=$?
-    msg=$(cat "$tmp/err")
+    msg=$(cat "$work/err")
     problem=""
     if [[ $got -ne $status ]]; then
         problem="exit status $got, expected $status"
-    elif [[ -s $tmp/out ]]; then
+    elif [[ -s $work/out ]]; then
         problem="printed to stdout"
-    elif [[ $(wc -l <"$tmp/err") -ne 1 ]]; then
-        problem="expected one line on stderr, got $(wc -l <"$tmp/err")"
+    elif [[ $(wc -l <"$work/err") -ne 1 ]]; then
+        problem="expected one line on stderr, got $(wc -l <"$work/err")"
     elif [[ $msg != *"$file"* && $msg != *"$dir"* ]]; then
         problem="message does not name the file"
     elif [[ $msg != *"$expect"* ]]; then
@@ -35,7 +30,7 @@ while IFS=$'\t' read -r file status expect; do
     if [[ -n $problem ]]; then
         echo "FAIL $file: $problem"
         echo "     message: $msg"
-        failures=$((failures + 1))
+        fails=$((fails + 1))
     fi
 done <"$table"
 
@@ -48,8 +43,8 @@ for f in "$dir"/*.json; do
     name=$(basename "$f")
     if ! cut -f1 "$table" | grep -qxF "$name"; then
         echo "FAIL $name: not listed in bad_scenes.tsv"
-        failures=$((failures + 1))
+        fails=$((fails + 1))
     fi
 done
-echo "$rows bad scenes, $failures failure(s)"
-[[ $failures -eq 0 ]]
+echo "$rows bad scenes, $fails failure(s)"
+[[ $fails -eq 0 ]]

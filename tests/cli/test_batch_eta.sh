@@ -12,16 +12,8 @@
 # sanitizer build on a loaded 2-core machine took 38 s to the first frame and 0.64 s a
 # frame.) The batch is stopped (SIGINT) once frame 4 has begun.
 # usage: test_batch_eta.sh THZMAP_BINARY REPO_DIR
-set -u
-thzmap=$1
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() {
-    echo "FAIL: $*"
-    failures=$((failures + 1))
-}
-/usr/bin/python3 - "$tmp/scene.json" <<'PY'
+. "$(dirname "$0")/lib.sh"
+/usr/bin/python3 - "$work/scene.json" <<'PY'
 import json, sys
 crates = [{"name": f"crate{i}", "type": "solid", "material": "m", "temperature_k": 295,
            "shape": {"type": "box", "size_m": [0.05, 0.05, 0.05]},
@@ -38,25 +30,25 @@ json.dump({"format": "thzmap-scene/1",
                         "fov_deg": 40, "resolution": [2, 1]}],
            "render": {"integrator": "path", "paths_per_sample": 1}}, open(sys.argv[1], "w"))
 PY
-cat >"$tmp/seq.json" <<'JSON'
+cat >"$work/seq.json" <<'JSON'
 {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 10, "frames": 1000,
  "keyframes": [{"time_s": 0, "objects": {"ball": {"transform": {"translate_m": [-1, 0, 1]}}}},
                {"time_s": 99.9, "objects": {"ball": {"transform": {"translate_m": [1, 0, 1]}}}}]}
 JSON
-"$thzmap" batch "$tmp/seq.json" -o "$tmp/out" --no-movies --threads 1 >"$tmp/log" 2>&1 &
+"$THZMAP" batch "$work/seq.json" -o "$work/out" --no-movies --threads 1 >"$work/log" 2>&1 &
 pid=$!
 for _ in $(seq 1 4500); do # at most 450 s (ctest gives the test 600 s)
-    grep -q "frame 5/1000" "$tmp/log" && break
+    grep -q "frame 5/1000" "$work/log" && break
     kill -0 $pid 2>/dev/null || break
     sleep 0.1
 done
 kill -INT $pid 2>/dev/null
 wait $pid
-line2=$(grep -m1 "frame 2/1000" "$tmp/log")
-line5=$(grep -m1 "frame 5/1000" "$tmp/log")
-[[ -n $line2 && -n $line5 ]] || fail "no frame lines: $(tail -3 "$tmp/log")"
+line2=$(grep -m1 "frame 2/1000" "$work/log")
+line5=$(grep -m1 "frame 5/1000" "$work/log")
+[[ -n $line2 && -n $line5 ]] || fail "no frame lines: $(tail -3 "$work/log")"
 if [[ -n $line2 && -n $line5 ]]; then
-    /usr/bin/python3 - "$line2" "$line5" <<'PY' || failures=$((failures + 1))
+    /usr/bin/python3 - "$line2" "$line5" <<'PY' || fails=$((fails + 1))
 import re, sys
 def parse(line):
     m = re.search(r"\), ([0-9.]+) s, ETA ([0-9.]+) (s|min|h)", line)
@@ -77,5 +69,4 @@ if not eta5 < 0.5 * old5:
 print("ETA after frame 1: %g s (%g s so far); after frame 4: %g s" % (eta2, t2, eta5))
 PY
 fi
-[[ $failures -eq 0 ]] && echo "ok: batch ETA counts from the first frame"
-exit $((failures > 0))
+finish "ok: batch ETA counts from the first frame"

@@ -5,18 +5,9 @@
 # once at the start, once a second, after the last frame and at the end (strace counts
 # the renames), and the final file is complete and lists every frame.
 # usage: test_batch_json_rate.sh THZMAP_BINARY REPO_DIR
-set -u
-thzmap=$1
-repo=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() {
-    echo "FAIL: $*"
-    failures=$((failures + 1))
-}
+. "$(dirname "$0")/lib.sh"
 command -v strace >/dev/null || { echo "FAIL: strace is not installed (scripts/install-deps.sh)"; exit 1; }
-/usr/bin/python3 - "$repo/examples/walker/scene.json" "$tmp" <<'PY'
+/usr/bin/python3 - "$REPO/examples/walker/scene.json" "$work" <<'PY'
 import json, sys
 sc = json.load(open(sys.argv[1]))
 for m in sc["materials"].values():  # absolute paths: the scene moves to tmp
@@ -33,23 +24,19 @@ json.dump({"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 25, "fra
 PY
 t0=$(date +%s.%N)
 # LeakSanitizer (the sanitizer build) cannot run under ptrace: no leak check here
-ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 strace -f -qq -e trace=rename,renameat,renameat2 -o "$tmp/trace" \
-    "$thzmap" batch "$tmp/seq.json" -o "$tmp/out" --quiet >"$tmp/log" 2>&1
+ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 strace -f -qq -e trace=rename,renameat,renameat2 -o "$work/trace" \
+    "$THZMAP" batch "$work/seq.json" -o "$work/out" --quiet >"$work/log" 2>&1
 status=$?
 t1=$(date +%s.%N)
-[[ $status -eq 0 ]] || fail "batch: exit $status: $(tail -5 "$tmp/log")"
-writes=$(grep -c 'batch\.json"' "$tmp/trace")
+[[ $status -eq 0 ]] || fail "batch: exit $status: $(tail -5 "$work/log")"
+writes=$(grep -c 'batch\.json"' "$work/trace")
 allowed=$(/usr/bin/python3 -c "import math; print(3 + math.ceil($t1 - $t0))")
 [[ $writes -ge 2 && $writes -le $allowed ]] ||
     fail "batch.json written $writes times for 40 frames in $(/usr/bin/python3 -c "print(round($t1 - $t0, 2))") s (expected 2 to $allowed)"
-/usr/bin/python3 - "$tmp/out/batch.json" <<'PY' || fail "the final batch.json"
+/usr/bin/python3 - "$work/out/batch.json" <<'PY' || fail "the final batch.json"
 import json, sys
 b = json.load(open(sys.argv[1]))
 assert b["complete"] and b["frames_done"] == 40 and len(b["frames"]) == 40, b["frames_done"]
 assert all(f["status"] == "done" for f in b["frames"])
 PY
-if [[ $failures -ne 0 ]]; then
-    echo "$failures failure(s)"
-    exit 1
-fi
-echo "ok: batch.json written $writes times for 40 frames in $(/usr/bin/python3 -c "print(round($t1 - $t0, 2))") s"
+finish_counted "ok: batch.json written $writes times for 40 frames in $(/usr/bin/python3 -c "print(round($t1 - $t0, 2))") s"

@@ -5,34 +5,30 @@
 # a verdict for every target of issue 19. Asserts nothing about speed. The thzbench
 # binary sits next to thzmap in the build directory.
 # usage: test_bench_small.sh THZMAP_BINARY REPO_DIR
-set -u
-thzmap=$1
-repo=$2
-bench="$(dirname "$thzmap")/thzbench"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/lib.sh"
+bench="$(dirname "$THZMAP")/thzbench"
 
 [[ -x $bench ]] || { echo "FAIL: no $bench"; exit 1; }
-TMPDIR=$tmp "$bench" --small --json "$tmp/bench.json" \
-    --scene "$repo/examples/teraeye/scene.json" >"$tmp/out" 2>"$tmp/err"
+TMPDIR=$work "$bench" --small --json "$work/bench.json" \
+    --scene "$REPO/examples/teraeye/scene.json" >"$work/out" 2>"$work/err"
 status=$?
-cat "$tmp/out"
-[[ $status -eq 0 ]] || { echo "FAIL: thzbench --small exited $status: $(cat "$tmp/err")"; exit 1; }
-grep -q '^Targets' "$tmp/out" || { echo "FAIL: no table of targets"; exit 1; }
+cat "$work/out"
+[[ $status -eq 0 ]] || { echo "FAIL: thzbench --small exited $status: $(cat "$work/err")"; exit 1; }
+grep -q '^Targets' "$work/out" || { echo "FAIL: no table of targets"; exit 1; }
 # every ratio printed with its x, every time per photon said so, no negative floor in K
 printed_fails=0
 printed() { # printed EXTENDED-REGEX WHAT
-    grep -Eq -- "$1" "$tmp/out" || { echo "FAIL: the table lacks $2"; printed_fails=1; }
+    grep -Eq -- "$1" "$work/out" || { echo "FAIL: the table lacks $2"; printed_fails=1; }
 }
 printed 'photon phase / raw trace = [0-9.]+ x \(tracing alone: [0-9.]+ x\)' "the tracing ratios' x"
 printed 'trace ns/photon +index ns/photon +CPU ns/photon +fastest CPU ns/photon' \
     "section 3's per-photon headers"
 printed '^  path +[0-9]+( +[0-9.]+){7} +[0-9.]+ x +[0-9.]+-[0-9.]+ x +[0-9.]+ x ' \
     "section 5's speed-up, pair range and fastest with their x"
-grep -q 'with a floor -' "$tmp/out" && { echo "FAIL: a negative floor in K"; printed_fails=1; }
+grep -q 'with a floor -' "$work/out" && { echo "FAIL: a negative floor in K"; printed_fails=1; }
 [[ $printed_fails -eq 0 ]] || exit 1
 
-python3 - "$tmp/bench.json" <<'PY'
+python3 - "$work/bench.json" <<'PY'
 import json, math, sys
 with open(sys.argv[1]) as f:
     r = json.load(f)

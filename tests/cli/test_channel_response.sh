@@ -6,20 +6,7 @@
 # saved photon map once a response changes and takes it while it does not; a bad
 # response exits 2 naming the JSON path.
 # usage: test_channel_response.sh THZMAP_BINARY REPO_DIR
-set -u
-thzmap=$1
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-    echo "FAIL: $*"
-    failures=$((failures + 1))
-}
-
-expect_line() {
-    grep -Eq -- "$2" "$1" || fail "no line matching '$2' in $(basename "$1"):" "$(cat "$1")"
-}
+. "$(dirname "$0")/lib.sh"
 
 # scene HAT_HI_THZ ATMOSPHERE: a black box with a grey plate; channels: a top-hat
 # 0.34..HAT_HI THz, a triangle 0.58/0.60/0.62 THz (peak 2 in the file), a 1 % Gaussian.
@@ -42,48 +29,47 @@ scene() {
  "photons": {"per_channel": 3000, "seed": 2}}
 JSON
 }
-printf '# triangle\nfrequency_thz,weight\n0.58,0\n0.60,2\n0.62,0\n' >"$tmp/tri.csv"
-scene 0.36 '{"model": "none"}' >"$tmp/scene.json"
+printf '# triangle\nfrequency_thz,weight\n0.58,0\n0.60,2\n0.62,0\n' >"$work/tri.csv"
+scene 0.36 '{"model": "none"}' >"$work/scene.json"
 
-"$thzmap" validate "$tmp/scene.json" >"$tmp/out" 2>"$tmp/err" || fail "validate: $(cat "$tmp/err")"
+"$THZMAP" validate "$work/scene.json" >"$work/out" 2>"$work/err" || fail "validate: $(cat "$work/err")"
 # top-hat: B_c = B_n = FWHM = 20 GHz, centre its middle; triangle of base 40 GHz and
 # peak 2: B_c = 40, B_n = 30, FWHM 20 GHz, centre its centroid 0.6 THz; 1 % Gaussian at 0.35 THz:
 # FWHM 3.5, B_c = 1.0645 FWHM = 3.726, B_n = 1.5054 FWHM = 5.269 GHz
-expect_line "$tmp/out" 'hat +centre 0\.3500 THz +FWHM 20\.000 GHz +bandwidth B_c 20\.000 GHz +noise bandwidth B_n 20\.000 GHz +measured response \(2 points\)'
-expect_line "$tmp/out" 'tri +centre 0\.6000 THz +FWHM 20\.000 GHz +bandwidth B_c 40\.000 GHz +noise bandwidth B_n 30\.000 GHz +measured response \(3 points\)'
-expect_line "$tmp/out" 'gauss +centre 0\.3500 THz +FWHM 3\.500 GHz +bandwidth B_c 3\.726 GHz +noise bandwidth B_n 5\.269 GHz +Gaussian'
+expect_line "$work/out" 'hat +centre 0\.3500 THz +FWHM 20\.000 GHz +bandwidth B_c 20\.000 GHz +noise bandwidth B_n 20\.000 GHz +measured response \(2 points\)'
+expect_line "$work/out" 'tri +centre 0\.6000 THz +FWHM 20\.000 GHz +bandwidth B_c 40\.000 GHz +noise bandwidth B_n 30\.000 GHz +measured response \(3 points\)'
+expect_line "$work/out" 'gauss +centre 0\.3500 THz +FWHM 3\.500 GHz +bandwidth B_c 3\.726 GHz +noise bandwidth B_n 5\.269 GHz +Gaussian'
 
 # an atmosphere model tabulated over the measured bands
-scene 0.36 '{"model": "itu-p676", "temperature_k": 293, "pressure_hpa": 1013, "relative_humidity": 0.5}' >"$tmp/air.json"
-"$thzmap" validate "$tmp/air.json" >"$tmp/out" 2>"$tmp/err" || fail "validate itu-p676: $(cat "$tmp/err")"
+scene 0.36 '{"model": "itu-p676", "temperature_k": 293, "pressure_hpa": 1013, "relative_humidity": 0.5}' >"$work/air.json"
+"$THZMAP" validate "$work/air.json" >"$work/out" 2>"$work/err" || fail "validate itu-p676: $(cat "$work/err")"
 
-"$thzmap" simulate "$tmp/scene.json" -o "$tmp/sim" --integrator final-gather --save-photon-map \
-    --quiet --threads 2 >/dev/null 2>"$tmp/err" || fail "simulate: $(cat "$tmp/err")"
-python3 - "$tmp/sim/summary.json" <<'PY' || fail "summary.json's channel keys"
+"$THZMAP" simulate "$work/scene.json" -o "$work/sim" --integrator final-gather --save-photon-map \
+    --quiet --threads 2 >/dev/null 2>"$work/err" || fail "simulate: $(cat "$work/err")"
+python3 - "$work/sim/summary.json" <<'PY' || fail "summary.json's channel keys"
 import json, sys
 ch = json.load(open(sys.argv[1]))["channels"]
 assert [c["response"] for c in ch] == ["table", "table", "gaussian"], ch
 assert ch[0]["relative_width"] is None and ch[2]["relative_width"] == 0.01
 assert abs(ch[1]["bandwidth_ghz"] - 40) < 1e-9 and abs(ch[1]["noise_bandwidth_ghz"] - 30) < 1e-9
 PY
-expect_line "$tmp/sim/cam.radiance.hdr" '^fwhm = \{20, 20, 3\.5\}'
+expect_line "$work/sim/cam.radiance.hdr" '^fwhm = \{20, 20, 3\.5\}'
 
-"$thzmap" render "$tmp/scene.json" --photon-map "$tmp/sim/photon-map.thzpm" -o "$tmp/r1" \
-    --integrator final-gather --quiet --threads 2 >/dev/null 2>"$tmp/err" || fail "render, same responses: $(cat "$tmp/err")"
-scene 0.361 '{"model": "none"}' >"$tmp/other.json"
-"$thzmap" render "$tmp/other.json" --photon-map "$tmp/sim/photon-map.thzpm" -o "$tmp/r2" \
-    --integrator final-gather --quiet >/dev/null 2>"$tmp/err"
+"$THZMAP" render "$work/scene.json" --photon-map "$work/sim/photon-map.thzpm" -o "$work/r1" \
+    --integrator final-gather --quiet --threads 2 >/dev/null 2>"$work/err" || fail "render, same responses: $(cat "$work/err")"
+scene 0.361 '{"model": "none"}' >"$work/other.json"
+"$THZMAP" render "$work/other.json" --photon-map "$work/sim/photon-map.thzpm" -o "$work/r2" \
+    --integrator final-gather --quiet >/dev/null 2>"$work/err"
 status=$?
 [[ $status -eq 2 ]] || fail "render with another response: exit $status, expected 2"
-expect_line "$tmp/err" 'another channel set \(frequencies, widths or responses differ'
-[[ -e $tmp/r2 ]] && fail "render with another response left $tmp/r2 behind"
+expect_line "$work/err" 'another channel set \(frequencies, widths or responses differ'
+[[ -e $work/r2 ]] && fail "render with another response left $work/r2 behind"
 
 # a bad response: exit 2, the JSON path
-sed 's/\[0.34, 1\]/[0.34, -1]/' "$tmp/scene.json" >"$tmp/bad.json"
-"$thzmap" validate "$tmp/bad.json" >/dev/null 2>"$tmp/err"
+sed 's/\[0.34, 1\]/[0.34, -1]/' "$work/scene.json" >"$work/bad.json"
+"$THZMAP" validate "$work/bad.json" >/dev/null 2>"$work/err"
 status=$?
 [[ $status -eq 2 ]] || fail "negative weight: exit $status, expected 2"
-expect_line "$tmp/err" 'bad\.json: channels\[0\]\.response\[0\]\[1\]: expected a number >= 0, got -1'
+expect_line "$work/err" 'bad\.json: channels\[0\]\.response\[0\]\[1\]: expected a number >= 0, got -1'
 
-[[ $failures -eq 0 ]] && echo "all channel response checks passed"
-exit $((failures > 0))
+finish "all channel response checks passed"

@@ -10,48 +10,29 @@
 # overrides; and that scripts/uninstall.sh (make uninstall) removes it all again. Writes
 # nothing into the build tree but what `cmake --install` writes.
 # usage: test_install.sh THZMAP_BINARY REPO_DIR
-set -u
-thzmap=$1
-repo=$2
-build=$(cd "$(dirname "$thzmap")" && pwd)
-tmp=$(mktemp -d)
-tmp=$(realpath "$tmp")
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-    echo "FAIL: $*"
-    failures=$((failures + 1))
-}
+. "$(dirname "$0")/lib.sh"
+build=$(cd "$(dirname "$THZMAP")" && pwd)
+work=$(realpath "$work")
 
 # brief FILE: the start of FILE, for a failure message.
 brief() {
     head -c 400 "$1"
 }
 
-finish() {
-    if [[ $failures -ne 0 ]]; then
-        echo "$failures failure(s)"
-        exit 1
-    fi
-    echo "ok"
-    exit 0
-}
-
 [[ -f $build/cmake_install.cmake ]] || {
-    fail "$build (the directory of $thzmap) is not a CMake build tree"
-    finish
+    fail "$build (the directory of $THZMAP) is not a CMake build tree"
+    finish_counted ok
 }
 unset THZMAP_DATA_DIR
-version=$("$thzmap" --version | awk '{print $2}')
+version=$("$THZMAP" --version | awk '{print $2}')
 [[ $version =~ ^[0-9]+\.[0-9]+\.[0-9]+$ ]] || fail "thzmap --version gave '$version'"
 major=${version%%.*}
 
 # --- install ----------------------------------------------------------------------------
-P=$tmp/prefix
-if ! cmake --install "$build" --prefix "$P" >"$tmp/install.log" 2>&1; then
-    fail "cmake --install failed: $(cat "$tmp/install.log")"
-    finish
+P=$work/prefix
+if ! cmake --install "$build" --prefix "$P" >"$work/install.log" 2>&1; then
+    fail "cmake --install failed: $(cat "$work/install.log")"
+    finish_counted ok
 fi
 
 # --- the file list ------------------------------------------------------------------------
@@ -65,15 +46,15 @@ lib=$P/lib
 soname=$(readelf -d "$lib/libthzmap.so.$version" 2>/dev/null | sed -n 's/.*Library soname: \[\(.*\)\]/\1/p')
 [[ $soname == "libthzmap.so.$major" ]] || fail "soname is '$soname', expected libthzmap.so.$major"
 [[ -x $P/bin/thzmap ]] || fail "no executable bin/thzmap"
-for h in "$repo"/include/thzmap/*.h; do
+for h in "$REPO"/include/thzmap/*.h; do
     cmp -s "$h" "$P/include/thzmap/$(basename "$h")" || fail "header $(basename "$h") not installed as is"
 done
 [[ -f $lib/pkgconfig/thzmap.pc ]] || fail "no lib/pkgconfig/thzmap.pc"
 # the docs the headers, the man page and the Python package name as docs/
-for d in "$repo"/docs/*.md; do
+for d in "$REPO"/docs/*.md; do
     cmp -s "$d" "$P/share/doc/thzmap/docs/$(basename "$d")" || fail "$(basename "$d") not installed under share/doc/thzmap/docs"
 done
-cmp -s "$repo/README.md" "$P/share/doc/thzmap/README.md" || fail "README.md not installed under share/doc/thzmap"
+cmp -s "$REPO/README.md" "$P/share/doc/thzmap/README.md" || fail "README.md not installed under share/doc/thzmap"
 [[ -e $P/share/doc/thzmap/docs/thzmap.1 ]] && fail "the man page is also under share/doc/thzmap/docs"
 # every relative link of the installed documents leads to an installed file
 /usr/bin/python3 - "$P/share/doc/thzmap" <<'PY' || fail "installed documents link to files not installed"
@@ -94,18 +75,18 @@ for d, _, files in os.walk(root):
 print("\n".join(bad), file=sys.stderr)
 sys.exit(1 if bad else 0)
 PY
-(cd "$repo/data" && find . -type f) | sort >"$tmp/data.list"
-[[ -s $tmp/data.list ]] || fail "the repository has no data/ files"
+(cd "$REPO/data" && find . -type f) | sort >"$work/data.list"
+[[ -s $work/data.list ]] || fail "the repository has no data/ files"
 while read -r f; do
-    cmp -s "$repo/data/$f" "$P/share/thzmap/$f" || fail "data file $f not installed as is under share/thzmap"
-done <"$tmp/data.list"
+    cmp -s "$REPO/data/$f" "$P/share/thzmap/$f" || fail "data file $f not installed as is under share/thzmap"
+done <"$work/data.list"
 grep -q 'AER' "$P/share/thzmap/atmosphere/README.md" 2>/dev/null ||
     fail "the data's README with its licence notices is not installed"
 
 # --- the CLI runs from the prefix, without the environment's help -----------------------
 [[ $("$P/bin/thzmap" --version 2>&1) == "thzmap $version" ]] || fail "installed thzmap --version: $("$P/bin/thzmap" --version 2>&1)"
-"$P/bin/thzmap" materials water >"$tmp/materials.out" 2>&1 && grep -q '^source: ' "$tmp/materials.out" ||
-    fail "installed thzmap materials water: $(cat "$tmp/materials.out")"
+"$P/bin/thzmap" materials water >"$work/materials.out" 2>&1 && grep -q '^source: ' "$work/materials.out" ||
+    fail "installed thzmap materials water: $(cat "$work/materials.out")"
 
 # --- the man page: renders without warnings, names every command and option ---------------
 man1=$P/share/man/man1/thzmap.1
@@ -114,29 +95,29 @@ if [[ ! -f $man1 ]]; then
 elif ! command -v groff >/dev/null; then
     fail "groff is not installed (package groff-base, in scripts/install-deps.sh): cannot check the man page"
 else
-    LC_ALL=C groff -man -Tutf8 -ww -z "$man1" 2>"$tmp/groff.err" || fail "groff failed on thzmap.1"
-    [[ -s $tmp/groff.err ]] && fail "groff warnings on thzmap.1: $(cat "$tmp/groff.err")"
-    LC_ALL=C groff -man -Tutf8 -P-cbou "$man1" 2>/dev/null >"$tmp/man.txt"
+    LC_ALL=C groff -man -Tutf8 -ww -z "$man1" 2>"$work/groff.err" || fail "groff failed on thzmap.1"
+    [[ -s $work/groff.err ]] && fail "groff warnings on thzmap.1: $(cat "$work/groff.err")"
+    LC_ALL=C groff -man -Tutf8 -P-cbou "$man1" 2>/dev/null >"$work/man.txt"
     for section in NAME SYNOPSIS DESCRIPTION COMMANDS FILES ENVIRONMENT 'EXIT STATUS'; do
-        grep -q "^$section" "$tmp/man.txt" || fail "thzmap.1 has no $section section"
+        grep -q "^$section" "$work/man.txt" || fail "thzmap.1 has no $section section"
     done
     # every environment variable the program reads
-    awk '/^ENVIRONMENT/ {f = 1; next} /^[A-Z]/ {f = 0} f' "$tmp/man.txt" >"$tmp/man.environment"
-    variables=$(grep -rhoE 'getenv\("[A-Z_]+"\)' "$repo/src" | sed -E 's/getenv\("([A-Z_]+)"\)/\1/' | sort -u)
+    awk '/^ENVIRONMENT/ {f = 1; next} /^[A-Z]/ {f = 0} f' "$work/man.txt" >"$work/man.environment"
+    variables=$(grep -rhoE 'getenv\("[A-Z_]+"\)' "$REPO/src" | sed -E 's/getenv\("([A-Z_]+)"\)/\1/' | sort -u)
     [[ $variables == *THZMAP_DATA_DIR* ]] || fail "no getenv(\"THZMAP_DATA_DIR\") found in src/"
     for v in $variables; do
-        grep -Eq "^ +$v( |\$)" "$tmp/man.environment" || fail "thzmap.1 ENVIRONMENT does not describe $v (src/ reads it)"
+        grep -Eq "^ +$v( |\$)" "$work/man.environment" || fail "thzmap.1 ENVIRONMENT does not describe $v (src/ reads it)"
     done
-    commands=$("$thzmap" --help | awk '/^commands:/ {f = 1; next} f && /^  [a-z]/ {print $1}')
+    commands=$("$THZMAP" --help | awk '/^commands:/ {f = 1; next} f && /^  [a-z]/ {print $1}')
     [[ -n $commands ]] || fail "no commands in thzmap --help"
-    awk '/^COMMANDS/ {f = 1; next} /^[A-Z]/ {f = 0} f' "$tmp/man.txt" >"$tmp/man.commands"
+    awk '/^COMMANDS/ {f = 1; next} /^[A-Z]/ {f = 0} f' "$work/man.txt" >"$work/man.commands"
     for c in $commands; do
-        grep -Eq "^ +$c( |\$)" "$tmp/man.commands" || fail "thzmap.1 COMMANDS does not describe '$c'"
-        options=$("$thzmap" "$c" --help | grep -oE -- '(^| )--?[a-z0-9][a-z0-9-]*' | tr -d ' ' | sort -u)
+        grep -Eq "^ +$c( |\$)" "$work/man.commands" || fail "thzmap.1 COMMANDS does not describe '$c'"
+        options=$("$THZMAP" "$c" --help | grep -oE -- '(^| )--?[a-z0-9][a-z0-9-]*' | tr -d ' ' | sort -u)
         [[ -n $options ]] || fail "no options in 'thzmap $c --help'"
         for o in $options; do
             [[ $o == -h || $o == --help ]] && continue
-            grep -Eq -- "(^|[^a-z0-9-])$o([^a-z0-9-]|\$)" "$tmp/man.txt" ||
+            grep -Eq -- "(^|[^a-z0-9-])$o([^a-z0-9-]|\$)" "$work/man.txt" ||
                 fail "thzmap.1 does not mention option $o of '$c'"
         done
     done
@@ -149,7 +130,7 @@ export PKG_CONFIG_PATH=$lib/pkgconfig
 flags=$(pkg-config --cflags --libs thzmap) || fail "pkg-config --cflags --libs thzmap failed"
 [[ $flags == *"-I$P/include"* && $flags == *"-L$lib"* && $flags == *"-lthzmap"* ]] ||
     fail "pkg-config --cflags --libs thzmap gave: $flags"
-[[ $flags == *"$repo"* || $flags == *"$build"* ]] && fail "pkg-config flags point into the source or build tree: $flags"
+[[ $flags == *"$REPO"* || $flags == *"$build"* ]] && fail "pkg-config flags point into the source or build tree: $flags"
 pkg-config --static --libs thzmap | grep -q -- -lembree3 || fail "pkg-config --static --libs lacks -lembree3"
 
 # --- every examples/api/*.c, built against P alone --------------------------------------------
@@ -160,33 +141,33 @@ if grep -q '^THZ_SANITIZE:BOOL=ON' "$build/CMakeCache.txt"; then
     cc=$(sed -n 's/^CMAKE_C_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")
     extra=(-fsanitize=address,undefined)
 fi
-scene=$repo/examples/plate-in-box/scene.json
-examples=("$repo"/examples/api/*.c)
+scene=$REPO/examples/plate-in-box/scene.json
+examples=("$REPO"/examples/api/*.c)
 [[ -f ${examples[0]} ]] || fail "no examples/api/*.c"
 for src in "${examples[@]}"; do
     name=$(basename "$src" .c)
     # shellcheck disable=SC2046 # the flags are words
-    if ! "$cc" -std=c17 -Wall -Wextra -Wpedantic -Werror "${extra[@]}" "$src" -o "$tmp/$name" \
-        $(pkg-config --cflags --libs thzmap) >"$tmp/$name.cc" 2>&1; then
-        fail "examples/api/$name.c does not build against the installed tree: $(cat "$tmp/$name.cc")"
+    if ! "$cc" -std=c17 -Wall -Wextra -Wpedantic -Werror "${extra[@]}" "$src" -o "$work/$name" \
+        $(pkg-config --cflags --libs thzmap) >"$work/$name.cc" 2>&1; then
+        fail "examples/api/$name.c does not build against the installed tree: $(cat "$work/$name.cc")"
         continue
     fi
-    resolved=$(LD_LIBRARY_PATH=$lib ldd "$tmp/$name" | awk '/libthzmap/ {print $3}')
+    resolved=$(LD_LIBRARY_PATH=$lib ldd "$work/$name" | awk '/libthzmap/ {print $3}')
     [[ $resolved == "$lib/libthzmap.so.$major" ]] || fail "$name loads libthzmap from '$resolved', not $lib"
-    mkdir -p "$tmp/run-$name"
-    if ! (cd "$tmp/run-$name" && LD_LIBRARY_PATH=$lib "$tmp/$name" "$scene") >"$tmp/$name.out" 2>&1; then
-        fail "examples/api/$name on plate-in-box: $(cat "$tmp/$name.out")"
+    mkdir -p "$work/run-$name"
+    if ! (cd "$work/run-$name" && LD_LIBRARY_PATH=$lib "$work/$name" "$scene") >"$work/$name.out" 2>&1; then
+        fail "examples/api/$name on plate-in-box: $(cat "$work/$name.out")"
     fi
 done
 
 # --- the installed data directory is the one used ----------------------------------------------
 # A scene with the line-by-line atmosphere reads the catalogues while it loads.
-mkdir -p "$tmp/lines"
-cp -r "$repo/examples/plate-in-box/." "$tmp/lines/"
+mkdir -p "$work/lines"
+cp -r "$REPO/examples/plate-in-box/." "$work/lines/"
 sed 's/"model": "constant", "attenuation_per_m": 0.05/"model": "lines", "temperature_k": 293, "pressure_hpa": 1000, "relative_humidity": 0.5/' \
-    "$scene" >"$tmp/lines/scene.json"
-grep -q '"model": "lines"' "$tmp/lines/scene.json" || fail "could not make the lines scene"
-load=$tmp/load_scene
+    "$scene" >"$work/lines/scene.json"
+grep -q '"model": "lines"' "$work/lines/scene.json" || fail "could not make the lines scene"
+load=$work/load_scene
 catalogue=atmosphere/am14_h2o_lines.csv
 
 # expect_load WHAT STATUS PATTERN [ENV...]: load_scene on the lines scene exits STATUS and
@@ -194,73 +175,73 @@ catalogue=atmosphere/am14_h2o_lines.csv
 expect_load() {
     local what=$1 want=$2 pattern=$3
     shift 3
-    env "$@" LD_LIBRARY_PATH="$lib" "$load" "$tmp/lines/scene.json" >"$tmp/load.out" 2>&1
+    env "$@" LD_LIBRARY_PATH="$lib" "$load" "$work/lines/scene.json" >"$work/load.out" 2>&1
     local status=$?
-    [[ $status -eq $want ]] || fail "$what: load_scene exit $status, expected $want: $(brief "$tmp/load.out")"
-    [[ -z $pattern ]] || grep -qF -- "$pattern" "$tmp/load.out" ||
-        fail "$what: expected '$pattern' in: $(brief "$tmp/load.out")"
+    [[ $status -eq $want ]] || fail "$what: load_scene exit $status, expected $want: $(brief "$work/load.out")"
+    [[ -z $pattern ]] || grep -qF -- "$pattern" "$work/load.out" ||
+        fail "$what: expected '$pattern' in: $(brief "$work/load.out")"
 }
 
 # expect_cli WHAT STATUS PATTERN: the installed CLI validates the lines scene likewise.
 expect_cli() {
-    "$P/bin/thzmap" validate "$tmp/lines/scene.json" >"$tmp/cli.out" 2>&1
+    "$P/bin/thzmap" validate "$work/lines/scene.json" >"$work/cli.out" 2>&1
     local status=$?
-    [[ $status -eq $2 ]] || fail "$1: installed thzmap validate exit $status, expected $2: $(brief "$tmp/cli.out")"
-    [[ -z $3 ]] || grep -qF -- "$3" "$tmp/cli.out" || fail "$1: expected '$3' in: $(brief "$tmp/cli.out")"
+    [[ $status -eq $2 ]] || fail "$1: installed thzmap validate exit $status, expected $2: $(brief "$work/cli.out")"
+    [[ -z $3 ]] || grep -qF -- "$3" "$work/cli.out" || fail "$1: expected '$3' in: $(brief "$work/cli.out")"
 }
 
 if [[ -x $load ]]; then
     expect_load "installed, complete" 0 ""
     expect_cli "installed, complete" 0 ""
     # The build's data/ stays complete: only the installed copy loses a catalogue.
-    mv "$P/share/thzmap/$catalogue" "$tmp/catalogue.csv"
-    "$thzmap" validate "$tmp/lines/scene.json" >/dev/null 2>&1 ||
+    mv "$P/share/thzmap/$catalogue" "$work/catalogue.csv"
+    "$THZMAP" validate "$work/lines/scene.json" >/dev/null 2>&1 ||
         fail "the build tree's thzmap no longer loads the lines scene (its data/ must be untouched)"
     expect_load "installed, catalogue missing" 1 "$P/share/thzmap/$catalogue: cannot read thzmap's own data file"
     expect_cli "installed, catalogue missing" 1 "(installed with the library) lacks it: reinstall thzmap, or set THZMAP_DATA_DIR"
     # Moved as a whole, the tree still finds its own data (nothing of P compiled in).
-    mv "$P" "$tmp/moved"
-    P=$tmp/moved lib=$tmp/moved/lib
+    mv "$P" "$work/moved"
+    P=$work/moved lib=$work/moved/lib
     expect_load "moved prefix, catalogue missing" 1 "$P/share/thzmap/$catalogue"
     expect_cli "moved prefix, catalogue missing" 1 "$P/share/thzmap/$catalogue"
-    mv "$tmp/catalogue.csv" "$P/share/thzmap/$catalogue"
+    mv "$work/catalogue.csv" "$P/share/thzmap/$catalogue"
     expect_load "moved prefix, complete" 0 ""
     # THZMAP_DATA_DIR overrides the installed directory, also to fail.
-    mkdir -p "$tmp/alt"
-    cp -r "$repo/data/." "$tmp/alt/"
-    rm "$tmp/alt/$catalogue"
-    expect_load "THZMAP_DATA_DIR without the catalogue" 1 "$tmp/alt (from THZMAP_DATA_DIR) lacks it" THZMAP_DATA_DIR="$tmp/alt"
-    cp "$repo/data/$catalogue" "$tmp/alt/$catalogue"
-    mv "$P/share/thzmap/$catalogue" "$tmp/catalogue.csv"
-    expect_load "THZMAP_DATA_DIR complete, installed incomplete" 0 "" THZMAP_DATA_DIR="$tmp/alt"
-    mv "$tmp/catalogue.csv" "$P/share/thzmap/$catalogue"
+    mkdir -p "$work/alt"
+    cp -r "$REPO/data/." "$work/alt/"
+    rm "$work/alt/$catalogue"
+    expect_load "THZMAP_DATA_DIR without the catalogue" 1 "$work/alt (from THZMAP_DATA_DIR) lacks it" THZMAP_DATA_DIR="$work/alt"
+    cp "$REPO/data/$catalogue" "$work/alt/$catalogue"
+    mv "$P/share/thzmap/$catalogue" "$work/catalogue.csv"
+    expect_load "THZMAP_DATA_DIR complete, installed incomplete" 0 "" THZMAP_DATA_DIR="$work/alt"
+    mv "$work/catalogue.csv" "$P/share/thzmap/$catalogue"
     # Without an installed data directory the build's data/ is the fallback.
-    mv "$P/share/thzmap" "$tmp/share-aside"
+    mv "$P/share/thzmap" "$work/share-aside"
     expect_load "no installed data directory" 0 ""
 else
     fail "examples/api/load_scene.c did not build: cannot check the data directory"
 fi
 
 # --- make uninstall (scripts/uninstall.sh) removes what the install put there, no more --------
-U=$tmp/uninstall
-if cmake --install "$build" --prefix "$U" >"$tmp/install2.log" 2>&1; then
+U=$work/uninstall
+if cmake --install "$build" --prefix "$U" >"$work/install2.log" 2>&1; then
     python_dir=$(find "$U" -type d -path '*-packages/thzmap' | head -1)
     [[ -n $python_dir ]] && mkdir -p "$python_dir/__pycache__" && touch "$python_dir/__pycache__/x.pyc"
     touch "$U/lib/someone-else.so"
     mkdir -p "$U/share/man/man1"
-    if bash "$repo/scripts/uninstall.sh" "$build" "$U" >"$tmp/uninstall.log" 2>&1; then
-        (cd "$U" && find . -type f) >"$tmp/left"
-        [[ $(cat "$tmp/left") == "./lib/someone-else.so" ]] ||
-            fail "uninstall left (or removed) files: $(tr '\n' ' ' <"$tmp/left")"
+    if bash "$REPO/scripts/uninstall.sh" "$build" "$U" >"$work/uninstall.log" 2>&1; then
+        (cd "$U" && find . -type f) >"$work/left"
+        [[ $(cat "$work/left") == "./lib/someone-else.so" ]] ||
+            fail "uninstall left (or removed) files: $(tr '\n' ' ' <"$work/left")"
         for d in include/thzmap share/thzmap share/doc/thzmap "${python_dir#"$U"/}"; do
             [[ -e $U/$d ]] && fail "uninstall left the directory $d"
         done
         [[ -d $U/share/man/man1 && -d $U/lib ]] || fail "uninstall removed a shared directory"
     else
-        fail "uninstall.sh failed: $(cat "$tmp/uninstall.log")"
+        fail "uninstall.sh failed: $(cat "$work/uninstall.log")"
     fi
 else
-    fail "the second cmake --install failed: $(cat "$tmp/install2.log")"
+    fail "the second cmake --install failed: $(cat "$work/install2.log")"
 fi
 
-finish
+finish_counted ok

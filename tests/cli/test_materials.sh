@@ -4,21 +4,11 @@
 # computed here independently; P.2040 rows; units); usage errors; and scenes using the
 # library: P.2040 outside its range refused with exit 2, the JSON path and the range.
 # usage: test_materials.sh THZMAP_BINARY REPO_DIR
-set -u
-thzmap=$1
-repo=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-    echo "FAIL: $*"
-    failures=$((failures + 1))
-}
+. "$(dirname "$0")/lib.sh"
 
 # --- the list: every entry, each followed by its source -----------------------------
-"$thzmap" materials >"$tmp/list" 2>"$tmp/err" || fail "materials: exit $?: $(cat "$tmp/err")"
-python3 - "$repo/data/materials/library.json" "$tmp/list" <<'PY' || fail "the list does not match library.json"
+"$THZMAP" materials >"$work/list" 2>"$work/err" || fail "materials: exit $?: $(cat "$work/err")"
+python3 - "$REPO/data/materials/library.json" "$work/list" <<'PY' || fail "the list does not match library.json"
 import json, sys
 lib = json.load(open(sys.argv[1]))["materials"]
 lines = open(sys.argv[2]).read().splitlines()
@@ -36,8 +26,8 @@ sys.exit(0 if ok else 1)
 PY
 
 # --- one entry: water (Liebe 1991 double Debye at 25 C), computed independently -------
-"$thzmap" materials water --at-thz 0.5,1 >"$tmp/water" 2>"$tmp/err" || fail "materials water: exit $?"
-python3 - "$tmp/water" <<'PY' || fail "water's n, k differ from Liebe's model: $(cat "$tmp/water")"
+"$THZMAP" materials water --at-thz 0.5,1 >"$work/water" 2>"$work/err" || fail "materials water: exit $?"
+python3 - "$work/water" <<'PY' || fail "water's n, k differ from Liebe's model: $(cat "$work/water")"
 import cmath, sys
 T = 298.15; th = 1 - 300 / T
 e0 = 77.66 - 103.3 * th; e1 = 0.0671 * e0; e2 = 3.52 + 7.52 * th
@@ -59,40 +49,40 @@ for f, r in rows.items():
             print(f, got, want); ok = False
 sys.exit(0 if ok else 1)
 PY
-grep -q '^source: H. J. Liebe' "$tmp/water" || fail "water: no source line"
-grep -q 'alpha (1/m)' "$tmp/water" || fail "water: the attenuation column has no unit"
-grep -q '^stated validity: 0.001 to 1 THz' "$tmp/water" || fail "water: no stated range"
-grep -q '^reflection: not part of the entry' "$tmp/water" || fail "water: no reflection line"
+grep -q '^source: H. J. Liebe' "$work/water" || fail "water: no source line"
+grep -q 'alpha (1/m)' "$work/water" || fail "water: the attenuation column has no unit"
+grep -q '^stated validity: 0.001 to 1 THz' "$work/water" || fail "water: no stated range"
+grep -q '^reflection: not part of the entry' "$work/water" || fail "water: no reflection line"
 
-"$thzmap" materials concrete >"$tmp/concrete" || fail "materials concrete: exit $?"
-grep -q '^data: 0.001 to 0.1 THz, 0.11 to 0.33 THz' "$tmp/concrete" ||
-    fail "concrete: P.2040 rows not listed: $(cat "$tmp/concrete")"
-grep -Eq '^ +1 .* \*$' "$tmp/concrete" || fail "concrete: 1 THz not marked outside the range"
+"$THZMAP" materials concrete >"$work/concrete" || fail "materials concrete: exit $?"
+grep -q '^data: 0.001 to 0.1 THz, 0.11 to 0.33 THz' "$work/concrete" ||
+    fail "concrete: P.2040 rows not listed: $(cat "$work/concrete")"
+grep -Eq '^ +1 .* \*$' "$work/concrete" || fail "concrete: 1 THz not marked outside the range"
 # the footnote says what the stars mark: concrete states no validity, its rows' ranges do
-grep -qx '\* outside the ranges the data cover' "$tmp/concrete" ||
-    fail "concrete: the footnote does not name the data's ranges: $(tail -1 "$tmp/concrete")"
-"$thzmap" materials rdx >"$tmp/rdx" || fail "materials rdx: exit $?"
-grep -qx '\* outside the stated validity' "$tmp/rdx" ||
-    fail "rdx: the footnote does not name the stated validity: $(tail -1 "$tmp/rdx")"
+grep -qx '\* outside the ranges the data cover' "$work/concrete" ||
+    fail "concrete: the footnote does not name the data's ranges: $(tail -1 "$work/concrete")"
+"$THZMAP" materials rdx >"$work/rdx" || fail "materials rdx: exit $?"
+grep -qx '\* outside the stated validity' "$work/rdx" ||
+    fail "rdx: the footnote does not name the stated validity: $(tail -1 "$work/rdx")"
 
 # --- usage errors ------------------------------------------------------------------
 expect_exit() { # expect_exit STATUS PATTERN ARGS...
     local want=$1 pattern=$2
     shift 2
-    "$thzmap" materials "$@" >"$tmp/out" 2>"$tmp/err"
+    "$THZMAP" materials "$@" >"$work/out" 2>"$work/err"
     local got=$?
     [[ $got -eq $want ]] || fail "materials $*: exit $got, want $want"
-    grep -q -- "$pattern" "$tmp/err" || fail "materials $*: stderr lacks '$pattern': $(cat "$tmp/err")"
-    [[ -s $tmp/out ]] && fail "materials $*: printed to stdout on error"
+    grep -q -- "$pattern" "$work/err" || fail "materials $*: stderr lacks '$pattern': $(cat "$work/err")"
+    [[ -s $work/out ]] && fail "materials $*: printed to stdout on error"
 }
 expect_exit 2 'no material "unobtainium"' unobtainium
 expect_exit 2 "unknown option '--bogus'" --bogus
 expect_exit 2 -- '--at-thz: expected' water --at-thz 1,-2
 # beyond 1000 THz refused (water printed a row of -nan at 1e308 THz, exit 0); 1000 is finite
 expect_exit 2 -- 'at most 1000 THz' water --at-thz 1e308
-"$thzmap" materials water --at-thz 1000 | grep -qi nan && fail "materials water at 1000 THz: NaN"
+"$THZMAP" materials water --at-thz 1000 | grep -qi nan && fail "materials water at 1000 THz: NaN"
 expect_exit 2 'one material name at most' water ice
-"$thzmap" materials --help | grep -q '^usage: thzmap materials' || fail "materials --help"
+"$THZMAP" materials --help | grep -q '^usage: thzmap materials' || fail "materials --help"
 
 # --- scenes with library materials ------------------------------------------------------
 scene() { # scene FILE FREQUENCY_THZ MATERIAL_JSON
@@ -105,33 +95,29 @@ scene() { # scene FILE FREQUENCY_THZ MATERIAL_JSON
               "fov_deg": 40, "resolution": [16, 8]}]}
 JSON
 }
-scene "$tmp/ok.json" 0.3 '{"library": "skin"}'
-"$thzmap" validate "$tmp/ok.json" >/dev/null 2>"$tmp/err" || fail "skin scene: exit $?: $(cat "$tmp/err")"
-scene "$tmp/far.json" 0.5 '{"library": "wood"}'
-"$thzmap" validate "$tmp/far.json" >/dev/null 2>"$tmp/err"
+scene "$work/ok.json" 0.3 '{"library": "skin"}'
+"$THZMAP" validate "$work/ok.json" >/dev/null 2>"$work/err" || fail "skin scene: exit $?: $(cat "$work/err")"
+scene "$work/far.json" 0.5 '{"library": "wood"}'
+"$THZMAP" validate "$work/far.json" >/dev/null 2>"$work/err"
 status=$?
 [[ $status -eq 2 ]] || fail "wood at 0.5 THz: exit $status, want 2"
-grep -q 'far.json: materials.m.library: ITU-R P.2040 gives "wood" only for 0.001 to 100 GHz, 110 to 330 GHz, 100 to 400 GHz, but channel "0.500 THz" (band 490 to 510 GHz' "$tmp/err" ||
-    fail "wood at 0.5 THz: message: $(cat "$tmp/err")"
+grep -q 'far.json: materials.m.library: ITU-R P.2040 gives "wood" only for 0.001 to 100 GHz, 110 to 330 GHz, 100 to 400 GHz, but channel "0.500 THz" (band 490 to 510 GHz' "$work/err" ||
+    fail "wood at 0.5 THz: message: $(cat "$work/err")"
 
 # --- a data directory whose JSON files are a FIFO or a directory: refused, no hang; a
 #     damaged installation is an I/O error (exit 1), not bad input -------------------------
-cp -r "$repo/data" "$tmp/dd"
-rm "$tmp/dd/materials/library.json"
-mkfifo "$tmp/dd/materials/library.json"
-THZMAP_DATA_DIR="$tmp/dd" timeout 30 "$thzmap" materials >"$tmp/out" 2>"$tmp/err"
+cp -r "$REPO/data" "$work/dd"
+rm "$work/dd/materials/library.json"
+mkfifo "$work/dd/materials/library.json"
+THZMAP_DATA_DIR="$work/dd" timeout 30 "$THZMAP" materials >"$work/out" 2>"$work/err"
 rc=$?
 [[ $rc -eq 1 ]] || fail "library.json a FIFO: exit $rc (124: it hung), expected 1"
-grep -q 'library.json.*FIFO' "$tmp/err" || fail "library.json a FIFO: message: $(cat "$tmp/err")"
-rm "$tmp/dd/materials/library.json"
-mkdir "$tmp/dd/materials/library.json"
-THZMAP_DATA_DIR="$tmp/dd" timeout 30 "$thzmap" materials >"$tmp/out" 2>"$tmp/err"
+grep -q 'library.json.*FIFO' "$work/err" || fail "library.json a FIFO: message: $(cat "$work/err")"
+rm "$work/dd/materials/library.json"
+mkdir "$work/dd/materials/library.json"
+THZMAP_DATA_DIR="$work/dd" timeout 30 "$THZMAP" materials >"$work/out" 2>"$work/err"
 rc=$?
-[[ $rc -eq 1 ]] && grep -q 'library.json.*directory' "$tmp/err" ||
-    fail "library.json a directory: exit $rc: $(cat "$tmp/err")"
+[[ $rc -eq 1 ]] && grep -q 'library.json.*directory' "$work/err" ||
+    fail "library.json a directory: exit $rc: $(cat "$work/err")"
 
-if [[ $failures -ne 0 ]]; then
-    echo "$failures failure(s)"
-    exit 1
-fi
-echo "materials: all checks passed"
+finish_counted "materials: all checks passed"

@@ -5,17 +5,13 @@
 # against the memory the process may have, an address-space limit (ulimit -v) included
 # (a run estimated at 14.9 GiB under `ulimit -v 6G` was accepted and failed after 26 s).
 # usage: test_memory_estimate.sh THZMAP_BINARY REPO_DIR
-set -u
-T=$1
-repo=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. "$(dirname "$0")/lib.sh"
 # the sanitizer build's shadow memory is in its resident set and its address space
-if grep -q '^THZ_SANITIZE:BOOL=ON' "$(dirname "$T")/CMakeCache.txt" 2>/dev/null; then
+if grep -q '^THZ_SANITIZE:BOOL=ON' "$(dirname "$THZMAP")/CMakeCache.txt" 2>/dev/null; then
     echo "skipped: a sanitizer build (its shadow memory is neither estimated nor limitable)"
     exit 0
 fi
-/usr/bin/python3 - "$T" "$repo" "$work" <<'PY'
+/usr/bin/python3 - "$THZMAP" "$REPO" "$work" <<'PY'
 import json, os, re, resource, subprocess, sys
 T, repo, work = sys.argv[1:4]
 base = os.path.join(repo, "examples", "plate-in-box")

@@ -3,44 +3,29 @@
 # triangle counts, areas, temperatures, the emitted power P_A against an independent
 # computation), the mesh example, warnings on stderr, --help and usage errors.
 # usage: test_validate.sh THZMAP_BINARY REPO_DIR
-set -u
-thzmap=$1
-repo=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-    echo "FAIL: $*"
-    failures=$((failures + 1))
-}
-
-# expect_line FILE PATTERN: some line of FILE matches the extended regex PATTERN
-expect_line() {
-    grep -Eq -- "$2" "$1" || fail "no line matching '$2' in $(basename "$1"):" "$(cat "$1")"
-}
+. "$(dirname "$0")/lib.sh"
 
 # --- the spec's example -------------------------------------------------------------
-"$thzmap" validate "$repo/examples/plate-in-box/scene.json" >"$tmp/out" 2>"$tmp/err"
+"$THZMAP" validate "$REPO/examples/plate-in-box/scene.json" >"$work/out" 2>"$work/err"
 status=$?
-[[ $status -eq 0 ]] || fail "plate-in-box: exit $status: $(cat "$tmp/err")"
-[[ -s $tmp/err ]] && fail "plate-in-box: unexpected warnings: $(cat "$tmp/err")"
-expect_line "$tmp/out" '^scene "plate-in-box"'
-expect_line "$tmp/out" '0\.35 THz +centre 0\.3500 THz +FWHM 3\.500 GHz'
-expect_line "$tmp/out" '^  \[0\] room: solid, material wall, 12 triangles, area 10 m², temperature 295\.00 K'
-expect_line "$tmp/out" '^  \[1\] target: solid, material paint, 256 triangles, area 0\.533781 m², temperature 310\.00 K'
-expect_line "$tmp/out" '^  \[2\] cover: shell 0\.5 mm, material cloth, 128 triangles, area 0\.0634347 m², temperature 300\.00 K'
-expect_line "$tmp/out" 'cam: 64 x 64 pixels, fov 40 deg, oversampling 2 x 2, aperture 0\.01 m²'
+[[ $status -eq 0 ]] || fail "plate-in-box: exit $status: $(cat "$work/err")"
+[[ -s $work/err ]] && fail "plate-in-box: unexpected warnings: $(cat "$work/err")"
+expect_line "$work/out" '^scene "plate-in-box"'
+expect_line "$work/out" '0\.35 THz +centre 0\.3500 THz +FWHM 3\.500 GHz'
+expect_line "$work/out" '^  \[0\] room: solid, material wall, 12 triangles, area 10 m², temperature 295\.00 K'
+expect_line "$work/out" '^  \[1\] target: solid, material paint, 256 triangles, area 0\.533781 m², temperature 310\.00 K'
+expect_line "$work/out" '^  \[2\] cover: shell 0\.5 mm, material cloth, 128 triangles, area 0\.0634347 m², temperature 300\.00 K'
+expect_line "$work/out" 'cam: 64 x 64 pixels, fov 40 deg, oversampling 2 x 2, aperture 0\.01 m²'
 # the air emits at the enclosure's temperature unless told otherwise
-expect_line "$tmp/out" '^atmosphere: constant; emitting at 295\.00 K, background 295\.00 K$'
-expect_line "$tmp/out" '^  table: reflectivity table \(5 points'
+expect_line "$work/out" '^atmosphere: constant; emitting at 295\.00 K, background 295\.00 K$'
+expect_line "$work/out" '^  table: reflectivity table \(5 points'
 
 # the air's state: 50 % relative humidity at 288 K is about 8.5 hPa of water vapour
 # (half of 17.0 hPa), 216.7 e / T = 6.4 g/m³; the given background
-"$thzmap" validate "$repo/examples/outdoor-concealed/scene.json" >"$tmp/outdoor" 2>"$tmp/err" ||
-    fail "outdoor-concealed: exit $?: $(cat "$tmp/err")"
-expect_line "$tmp/outdoor" '^atmosphere: itu-p676; air at 288\.00 K and 1013\.00 hPa, water vapour 8\.[45][0-9]* hPa \(6\.[34][0-9]* g/m³\); emitting at 288\.00 K, background 40\.00 K$'
-cat > "$tmp/cold-air.json" <<'JSON'
+"$THZMAP" validate "$REPO/examples/outdoor-concealed/scene.json" >"$work/outdoor" 2>"$work/err" ||
+    fail "outdoor-concealed: exit $?: $(cat "$work/err")"
+expect_line "$work/outdoor" '^atmosphere: itu-p676; air at 288\.00 K and 1013\.00 hPa, water vapour 8\.[45][0-9]* hPa \(6\.[34][0-9]* g/m³\); emitting at 288\.00 K, background 40\.00 K$'
+cat > "$work/cold-air.json" <<'JSON'
 {"format": "thzmap-scene/1", "name": "cold-air",
  "channels": [{"frequency_thz": 0.35, "relative_width": 0.05}],
  "materials": {"wall": {"reflectivity": 0.1}},
@@ -50,17 +35,17 @@ cat > "$tmp/cold-air.json" <<'JSON'
  "sensors": [{"name": "cam", "position_m": [0, 0, 0], "direction": [0, 1, 0], "fov_deg": 40,
               "resolution": [4, 4]}]}
 JSON
-"$thzmap" validate "$tmp/cold-air.json" >"$tmp/cold" 2>/dev/null || fail "cold-air: exit $?"
-expect_line "$tmp/cold" '^atmosphere: constant; not emitting$'
+"$THZMAP" validate "$work/cold-air.json" >"$work/cold" 2>/dev/null || fail "cold-air: exit $?"
+expect_line "$work/cold" '^atmosphere: constant; not emitting$'
 # a rotated rectangle's bottom edge lies at z = 2.4e-08 m in float vertices: shown as 0
-"$thzmap" validate "$repo/examples/walker/scene.json" >"$tmp/walker" 2>"$tmp/err" ||
-    fail "walker: exit $?: $(cat "$tmp/err")"
-expect_line "$tmp/walker" 'screen: .* bounds \[-0\.6, 0, 0\] to \[0\.6, 0, 1\.8\] m$'
+"$THZMAP" validate "$REPO/examples/walker/scene.json" >"$work/walker" 2>"$work/err" ||
+    fail "walker: exit $?: $(cat "$work/err")"
+expect_line "$work/walker" 'screen: .* bounds \[-0\.6, 0, 0\] to \[0\.6, 0, 1\.8\] m$'
 
 # P_A = sum pi eps-bar A B(T) over emitting sides, here at the channel centre (the
 # band mean over a 1 % band differs by ~1e-5), computed independently in Python.
-pa=$(awk '/^emitted spectral power/ {getline; print $(NF-1)}' "$tmp/out")
-unit=$(awk '/^emitted spectral power/ {getline; print $NF}' "$tmp/out")
+pa=$(awk '/^emitted spectral power/ {getline; print $(NF-1)}' "$work/out")
+unit=$(awk '/^emitted spectral power/ {getline; print $NF}' "$work/out")
 [[ $unit == "W/Hz" ]] || fail "P_A unit is '$unit', expected W/Hz"
 python3 - "$pa" <<'PY' || fail "P_A of plate-in-box is wrong"
 import math, sys
@@ -86,35 +71,35 @@ sys.exit(0 if abs(got / pa - 1) < 1e-3 else 1)
 PY
 
 # --- the mesh example -----------------------------------------------------------------
-"$thzmap" validate "$repo/examples/meshes/scene.json" >"$tmp/out" 2>"$tmp/err"
+"$THZMAP" validate "$REPO/examples/meshes/scene.json" >"$work/out" 2>"$work/err"
 status=$?
-[[ $status -eq 0 ]] || fail "meshes example: exit $status: $(cat "$tmp/err")"
-[[ -s $tmp/err ]] && fail "meshes example: unexpected warnings: $(cat "$tmp/err")"
-expect_line "$tmp/out" 'pyramid: solid, material metal, 6 triangles, area 1\.009 m²'
-expect_line "$tmp/out" '^  0\.900 THz +[0-9.]+e-[0-9]+ W/Hz'
+[[ $status -eq 0 ]] || fail "meshes example: exit $status: $(cat "$work/err")"
+[[ -s $work/err ]] && fail "meshes example: unexpected warnings: $(cat "$work/err")"
+expect_line "$work/out" 'pyramid: solid, material metal, 6 triangles, area 1\.009 m²'
+expect_line "$work/out" '^  0\.900 THz +[0-9.]+e-[0-9]+ W/Hz'
 
 # --- reflection lobes: each material's `reflection`, Ward's slopes as given ------------------
-"$thzmap" validate "$repo/examples/outdoor-concealed/scene.json" >"$tmp/out" 2>"$tmp/err" ||
-    fail "outdoor-concealed: exit $?: $(cat "$tmp/err")"
-expect_line "$tmp/out" '^  object: .*; reflection ward \(alpha_x 0\.1, alpha_y 0\.3\)$'
-expect_line "$tmp/out" '^  skin: .*; reflection diffuse$'
-"$thzmap" validate "$repo/examples/mirror-plate/scene.json" >"$tmp/out" 2>"$tmp/err" ||
-    fail "mirror-plate: exit $?: $(cat "$tmp/err")"
-expect_line "$tmp/out" '^  metal: .*; reflection specular$'
+"$THZMAP" validate "$REPO/examples/outdoor-concealed/scene.json" >"$work/out" 2>"$work/err" ||
+    fail "outdoor-concealed: exit $?: $(cat "$work/err")"
+expect_line "$work/out" '^  object: .*; reflection ward \(alpha_x 0\.1, alpha_y 0\.3\)$'
+expect_line "$work/out" '^  skin: .*; reflection diffuse$'
+"$THZMAP" validate "$REPO/examples/mirror-plate/scene.json" >"$work/out" 2>"$work/err" ||
+    fail "mirror-plate: exit $?: $(cat "$work/err")"
+expect_line "$work/out" '^  metal: .*; reflection specular$'
 
 # --- warnings ---------------------------------------------------------------------------
-"$thzmap" validate "$repo/tests/inputs/scenes/warnings.json" >"$tmp/out" 2>"$tmp/err"
+"$THZMAP" validate "$REPO/tests/inputs/scenes/warnings.json" >"$work/out" 2>"$work/err"
 status=$?
 [[ $status -eq 0 ]] || fail "warnings scene: exit $status"
-[[ $(grep -c '^thzmap validate: warning: ' "$tmp/err") -eq 4 ]] || fail "expected 4 warnings, got: $(cat "$tmp/err")"
-expect_line "$tmp/err" '^thzmap validate: warning: object "part": inconsistent winding'
-expect_line "$tmp/err" '^thzmap validate: warning: object "plate": the explicit emissivity .* Kirchhoff'
-expect_line "$tmp/err" '^thzmap validate: warning: material "lossy", reflectivity: the table covers'
+[[ $(grep -c '^thzmap validate: warning: ' "$work/err") -eq 4 ]] || fail "expected 4 warnings, got: $(cat "$work/err")"
+expect_line "$work/err" '^thzmap validate: warning: object "part": inconsistent winding'
+expect_line "$work/err" '^thzmap validate: warning: object "plate": the explicit emissivity .* Kirchhoff'
+expect_line "$work/err" '^thzmap validate: warning: material "lossy", reflectivity: the table covers'
 
 # a mesh file with a triangle repeated (the other way round) and one of no area: each
 # named, as the import counts them
-mkdir -p "$tmp/defects"
-cat > "$tmp/defects/tile.obj" <<'OBJ'
+mkdir -p "$work/defects"
+cat > "$work/defects/tile.obj" <<'OBJ'
 v 0 0 0
 v 1 0 0
 v 0 1 0
@@ -125,7 +110,7 @@ f 2 4 3
 f 3 2 1
 f 1 4 5
 OBJ
-cat > "$tmp/defects/scene.json" <<'JSON'
+cat > "$work/defects/scene.json" <<'JSON'
 {"format": "thzmap-scene/1", "name": "defects",
  "channels": [{"frequency_thz": 0.35, "relative_width": 0.05}],
  "materials": {"wall": {"reflectivity": 0.1}},
@@ -134,83 +119,82 @@ cat > "$tmp/defects/scene.json" <<'JSON'
  "sensors": [{"name": "cam", "position_m": [0.5, 0.5, 2], "look_at_m": [0.5, 0.5, 0], "up": [0, 1, 0],
               "fov_deg": 40, "resolution": [4, 4]}]}
 JSON
-"$thzmap" validate "$tmp/defects/scene.json" >"$tmp/out" 2>"$tmp/err" ||
-    fail "defects: exit $?: $(cat "$tmp/err")"
-expect_line "$tmp/err" '^thzmap validate: warning: object "tile": 1 triangle\(s\) repeat another.s three corners'
-expect_line "$tmp/err" '^thzmap validate: warning: object "tile": 1 triangle\(s\) of no area'
+"$THZMAP" validate "$work/defects/scene.json" >"$work/out" 2>"$work/err" ||
+    fail "defects: exit $?: $(cat "$work/err")"
+expect_line "$work/err" '^thzmap validate: warning: object "tile": 1 triangle\(s\) repeat another.s three corners'
+expect_line "$work/err" '^thzmap validate: warning: object "tile": 1 triangle\(s\) of no area'
 
 # --- help and usage -----------------------------------------------------------------------
-"$thzmap" validate --help >"$tmp/out" 2>&1 || fail "validate --help failed"
-expect_line "$tmp/out" '^usage: thzmap validate SCENE\.json'
-"$thzmap" validate >/dev/null 2>"$tmp/err"
+"$THZMAP" validate --help >"$work/out" 2>&1 || fail "validate --help failed"
+expect_line "$work/out" '^usage: thzmap validate SCENE\.json'
+"$THZMAP" validate >/dev/null 2>"$work/err"
 [[ $? -eq 2 ]] || fail "validate without a scene must exit 2"
-"$thzmap" validate a.json b.json >/dev/null 2>&1
+"$THZMAP" validate a.json b.json >/dev/null 2>&1
 [[ $? -eq 2 ]] || fail "validate with two scenes must exit 2"
-"$thzmap" validate --bogus "$repo/examples/plate-in-box/scene.json" >/dev/null 2>&1
+"$THZMAP" validate --bogus "$REPO/examples/plate-in-box/scene.json" >/dev/null 2>&1
 [[ $? -eq 2 ]] || fail "validate with an unknown option must exit 2"
-"$thzmap" validate "$tmp/does-not-exist.json" >/dev/null 2>"$tmp/err"
+"$THZMAP" validate "$work/does-not-exist.json" >/dev/null 2>"$work/err"
 [[ $? -eq 2 ]] || fail "validate of a missing file must exit 2"
-expect_line "$tmp/err" 'does-not-exist\.json: cannot open'
+expect_line "$work/err" 'does-not-exist\.json: cannot open'
 # a FIFO as the scene would block the open: refused at once (timeout: a hang fails)
-mkfifo "$tmp/pipe.json"
-timeout 10 "$thzmap" validate "$tmp/pipe.json" 2>"$tmp/err"
+mkfifo "$work/pipe.json"
+timeout 10 "$THZMAP" validate "$work/pipe.json" 2>"$work/err"
 [[ $? -eq 2 ]] || fail "validate of a FIFO must exit 2 at once"
-expect_line "$tmp/err" 'pipe\.json: is a FIFO'
+expect_line "$work/err" 'pipe\.json: is a FIFO'
 # a file with no format could be either kind: the message names both
-echo '{"frames": 3}' >"$tmp/noformat.json"
-"$thzmap" validate "$tmp/noformat.json" >/dev/null 2>"$tmp/err"
+echo '{"frames": 3}' >"$work/noformat.json"
+"$THZMAP" validate "$work/noformat.json" >/dev/null 2>"$work/err"
 [[ $? -eq 2 ]] || fail "validate of a file without format must exit 2"
-expect_line "$tmp/err" 'noformat\.json: format: missing key \(expected "thzmap-scene/1" or "thzmap-scene/1\.1"; a sequence file, .*"thzmap-sequence/1"\)'
+expect_line "$work/err" 'noformat\.json: format: missing key \(expected "thzmap-scene/1" or "thzmap-scene/1\.1"; a sequence file, .*"thzmap-sequence/1"\)'
 
 # --- a sequence file: its frames, the first frame's scene, every frame's warnings ----
-"$thzmap" validate "$repo/examples/walker/sequence.json" >"$tmp/walker" 2>"$tmp/err"
+"$THZMAP" validate "$REPO/examples/walker/sequence.json" >"$work/walker" 2>"$work/err"
 status=$?
-[[ $status -eq 0 ]] || fail "walker sequence: exit $status: $(cat "$tmp/err")"
-[[ -s $tmp/err ]] && fail "walker sequence: unexpected warnings: $(cat "$tmp/err")"
-expect_line "$tmp/walker" '^sequence \(.*/walker/sequence\.json\): valid$'
-expect_line "$tmp/walker" '^frames: 25 \(1 sweep value x 25 frames, t = 0 to 3 s\)$'
-expect_line "$tmp/walker" "^the first frame's scene \(frame-00000\):$"
-expect_line "$tmp/walker" '^scene "walker"'
+[[ $status -eq 0 ]] || fail "walker sequence: exit $status: $(cat "$work/err")"
+[[ -s $work/err ]] && fail "walker sequence: unexpected warnings: $(cat "$work/err")"
+expect_line "$work/walker" '^sequence \(.*/walker/sequence\.json\): valid$'
+expect_line "$work/walker" '^frames: 25 \(1 sweep value x 25 frames, t = 0 to 3 s\)$'
+expect_line "$work/walker" "^the first frame's scene \(frame-00000\):$"
+expect_line "$work/walker" '^scene "walker"'
 # the plate in its box with a background given (a warning while the camera is in the
 # room: frame 0 of each sweep value, counting from 0), the camera leaving the room at
 # t = 1 s (a warning in frames 1 and 2 of each), swept over two temperatures of the
 # target; the warnings count the frames from 1 of 6
-cp -r "$repo/examples/plate-in-box" "$tmp/seq"
-/usr/bin/python3 - "$tmp/seq/scene.json" <<'PY'
+cp -r "$REPO/examples/plate-in-box" "$work/seq"
+/usr/bin/python3 - "$work/seq/scene.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
 s["atmosphere"]["background_temperature_k"] = 3
 json.dump(s, open(sys.argv[1], "w"))
 PY
-cat > "$tmp/seq/sequence.json" <<'JSON'
+cat > "$work/seq/sequence.json" <<'JSON'
 {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 3,
  "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [0, -0.45, 0.4]}}},
                {"time_s": 1, "sensors": {"cam": {"position_m": [0, -3, 0.4]}}}],
  "sweep": {"objects.target.temperature_k": [300, 320]}}
 JSON
-"$thzmap" validate "$tmp/seq/sequence.json" >"$tmp/seq.out" 2>"$tmp/seq.err"
+"$THZMAP" validate "$work/seq/sequence.json" >"$work/seq.out" 2>"$work/seq.err"
 status=$?
-[[ $status -eq 0 ]] || fail "a sequence with warnings: exit $status: $(cat "$tmp/seq.err")"
-expect_line "$tmp/seq.out" '^frames: 6 \(2 sweep values x 3 frames, t = 0 to 2 s\)$'
+[[ $status -eq 0 ]] || fail "a sequence with warnings: exit $status: $(cat "$work/seq.err")"
+expect_line "$work/seq.out" '^frames: 6 \(2 sweep values x 3 frames, t = 0 to 2 s\)$'
 # each warning once, with the first frame that has it, then its repeats
-[[ $(grep -c 'background_temperature_k is given' "$tmp/seq.err") -eq 2 ]] &&
-    [[ $(grep -c 'is outside the enclosure' "$tmp/seq.err") -eq 2 ]] ||
-    fail "the warnings: not each once and once repeated: $(cat "$tmp/seq.err")"
-expect_line "$tmp/seq.err" '^thzmap validate: warning: sweep-00/frame-00000: atmosphere\.background_temperature_k is given'
-expect_line "$tmp/seq.err" '^thzmap validate: warning: the same in 1 later frame: atmosphere\.background_temperature_k'
-expect_line "$tmp/seq.err" '^thzmap validate: warning: sweep-00/frame-00001: sensor "cam" at \[0, -3, 0\.4\] m is outside'
-expect_line "$tmp/seq.err" '^thzmap validate: warning: the same in 3 later frames: sensor "cam" .* is outside'
+[[ $(grep -c 'background_temperature_k is given' "$work/seq.err") -eq 2 ]] &&
+    [[ $(grep -c 'is outside the enclosure' "$work/seq.err") -eq 2 ]] ||
+    fail "the warnings: not each once and once repeated: $(cat "$work/seq.err")"
+expect_line "$work/seq.err" '^thzmap validate: warning: sweep-00/frame-00000: atmosphere\.background_temperature_k is given'
+expect_line "$work/seq.err" '^thzmap validate: warning: the same in 1 later frame: atmosphere\.background_temperature_k'
+expect_line "$work/seq.err" '^thzmap validate: warning: sweep-00/frame-00001: sensor "cam" at \[0, -3, 0\.4\] m is outside'
+expect_line "$work/seq.err" '^thzmap validate: warning: the same in 3 later frames: sensor "cam" .* is outside'
 # a frame whose scene is bad by a keyframe's value: exit 2, naming the keyframe's value
 # in the sequence file, then the scene's JSON path and the frame's directory (as batch
 # does)
-cat > "$tmp/seq/bad.json" <<'JSON'
+cat > "$work/seq/bad.json" <<'JSON'
 {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 3,
  "keyframes": [{"time_s": 0, "objects": {"target": {"temperature_k": 300}}},
                {"time_s": 2, "objects": {"target": {"temperature_k": -300}}}]}
 JSON
-"$thzmap" validate "$tmp/seq/bad.json" >/dev/null 2>"$tmp/err"
-[[ $? -eq 2 ]] || fail "a sequence with a bad frame must exit 2: $(cat "$tmp/err")"
-expect_line "$tmp/err" 'bad\.json: keyframes\[1\]\.objects\.target\.temperature_k: .* \(the scene scene\.json.s objects\[1\]\.temperature_k, frame-00002, t = 2 s\)'
+"$THZMAP" validate "$work/seq/bad.json" >/dev/null 2>"$work/err"
+[[ $? -eq 2 ]] || fail "a sequence with a bad frame must exit 2: $(cat "$work/err")"
+expect_line "$work/err" 'bad\.json: keyframes\[1\]\.objects\.target\.temperature_k: .* \(the scene scene\.json.s objects\[1\]\.temperature_k, frame-00002, t = 2 s\)'
 
-[[ $failures -eq 0 ]] && echo "validate: all checks passed"
-[[ $failures -eq 0 ]]
+finish "validate: all checks passed"
