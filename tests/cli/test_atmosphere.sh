@@ -3,27 +3,24 @@
 # itu-p676 with an ITU-R validation value, the plot, scene channels, and exit
 # status 2 with a message for bad options.
 # argv: thzmap binary, repository directory.
-set -u
-THZ="$1"
-REPO="$2"
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
+. "$(dirname "$0")/lib.sh"
+# unlike lib.sh's fail: on stderr, and the test stops at the first failure
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-"$THZ" atmosphere --help > "$TMP/help" || fail "--help exit status $?"
-grep -q -- "--from-thz" "$TMP/help" || fail "--help does not describe --from-thz"
+"$THZMAP" atmosphere --help > "$work/help" || fail "--help exit status $?"
+grep -q -- "--from-thz" "$work/help" || fail "--help does not describe --from-thz"
 
 # 0.1 to 0.2 THz in 10 GHz steps, both ends included: 11 rows
-"$THZ" atmosphere --from-thz 0.1 --to-thz 0.2 --step-ghz 10 --distance-m 100 > "$TMP/a.csv" \
+"$THZMAP" atmosphere --from-thz 0.1 --to-thz 0.2 --step-ghz 10 --distance-m 100 > "$work/a.csv" \
     || fail "lines run exit status $?"
-grep -v '^#' "$TMP/a.csv" > "$TMP/a.data"
+grep -v '^#' "$work/a.csv" > "$work/a.data"
 # the comment line records the path the transmittance column is of
-grep -q '^# thzmap atmosphere: model lines; air .*; transmittance over a path of 100 m$' "$TMP/a.csv" ||
-    fail "the comment line lacks --distance-m: $(head -1 "$TMP/a.csv")"
-head -1 "$TMP/a.data" | grep -qx "frequency_thz,attenuation_per_m,attenuation_db_per_km,h2o_lines_db_per_km,h2o_continuum_db_per_km,o2_db_per_km,dry_continuum_db_per_km,transmittance" \
-    || fail "unexpected header: $(head -1 "$TMP/a.data")"
-[ "$(tail -n +2 "$TMP/a.data" | wc -l)" -eq 11 ] || fail "expected 11 rows"
-tail -n +2 "$TMP/a.data" | awk -F, '
+grep -q '^# thzmap atmosphere: model lines; air .*; transmittance over a path of 100 m$' "$work/a.csv" ||
+    fail "the comment line lacks --distance-m: $(head -1 "$work/a.csv")"
+head -1 "$work/a.data" | grep -qx "frequency_thz,attenuation_per_m,attenuation_db_per_km,h2o_lines_db_per_km,h2o_continuum_db_per_km,o2_db_per_km,dry_continuum_db_per_km,transmittance" \
+    || fail "unexpected header: $(head -1 "$work/a.data")"
+[ "$(tail -n +2 "$work/a.data" | wc -l)" -eq 11 ] || fail "expected 11 rows"
+tail -n +2 "$work/a.data" | awk -F, '
     NR == 1 && $1 != 0.1 { print "first frequency " $1; bad = 1 }
     NR == 11 && $1 != 0.2 { print "last frequency " $1; bad = 1 }
     { if ($2 <= 0 || $8 <= 0 || $8 >= 1) { print "bad row " $0; bad = 1 }
@@ -37,22 +34,22 @@ tail -n +2 "$TMP/a.data" | awk -F, '
 # 288.15 K, 7.5 g/m^3): total pressure 1013.25 + 7.5 * 288.15 / 216.7 hPa
 P=$(awk 'BEGIN { printf "%.10f", 1013.25 + 7.5 * 288.15 / 216.7 }')
 REF=$(awk -F, '!/^#/ && $1 == 100 { print $7 }' "$REPO/data/atmosphere/itu_r_p676_13_specific_attenuation_validation.csv")
-GOT=$("$THZ" atmosphere --model itu-p676 --from-thz 0.1 --to-thz 0.1 --step-ghz 1 \
+GOT=$("$THZMAP" atmosphere --model itu-p676 --from-thz 0.1 --to-thz 0.1 --step-ghz 1 \
       --temperature-k 288.15 --pressure-hpa "$P" --water-vapour-g-m3 7.5 | grep -v '^#' | tail -1 | cut -d, -f3)
 awk -v a="$GOT" -v b="$REF" 'BEGIN { exit !((a / b - 1)^2 < 1e-6) }' \
     || fail "itu-p676 at 100 GHz: $GOT dB/km, ITU-R validation $REF dB/km"
 
 # the plot (scripts/install-deps.sh installs PLplot's pngcairo device: a missing device
 # is a failure here, not a reason to skip)
-if "$THZ" atmosphere --from-thz 0.2 --to-thz 0.5 --step-ghz 1 --plot "$TMP/a.png" \
-       --compare-model itu-p676 > /dev/null 2> "$TMP/err"; then
-    head -c 8 "$TMP/a.png" | od -An -c | grep -q "P   N   G" || fail "--plot did not write a PNG"
+if "$THZMAP" atmosphere --from-thz 0.2 --to-thz 0.5 --step-ghz 1 --plot "$work/a.png" \
+       --compare-model itu-p676 > /dev/null 2> "$work/err"; then
+    head -c 8 "$work/a.png" | od -An -c | grep -q "P   N   G" || fail "--plot did not write a PNG"
 else
-    fail "--plot failed: $(cat "$TMP/err")"
+    fail "--plot failed: $(cat "$work/err")"
 fi
 
 # a scene's channels on the plot; without --model the scene's atmosphere is used
-cat > "$TMP/scene.json" <<'JSON'
+cat > "$work/scene.json" <<'JSON'
 {
   "format": "thzmap-scene/1",
   "channels": [{"name": "0.35 THz", "frequency_thz": 0.35, "relative_width": 0.05},
@@ -65,36 +62,36 @@ cat > "$TMP/scene.json" <<'JSON'
                "fov_deg": 40, "resolution": [4, 4]}]
 }
 JSON
-"$THZ" atmosphere --scene "$TMP/scene.json" --from-thz 0.3 --to-thz 0.4 --step-ghz 50 > "$TMP/s.csv" \
+"$THZMAP" atmosphere --scene "$work/scene.json" --from-thz 0.3 --to-thz 0.4 --step-ghz 50 > "$work/s.csv" \
     || fail "--scene run exit status $?"
-grep -v '^#' "$TMP/s.csv" | head -1 | grep -qx "frequency_thz,attenuation_per_m,attenuation_db_per_km" \
-    || fail "scene atmosphere header: $(cat "$TMP/s.csv")"
-grep -v '^#' "$TMP/s.csv" | tail -1 | grep -q "^0.4,5.000000e-02," || fail "scene constant alpha"
-if "$THZ" atmosphere --scene "$TMP/scene.json" --model lines --from-thz 0.3 --to-thz 0.4 \
-       --step-ghz 1 --plot "$TMP/s.png" > /dev/null 2> "$TMP/err"; then
-    [ -s "$TMP/s.png" ] || fail "--scene --plot wrote no PNG"
+grep -v '^#' "$work/s.csv" | head -1 | grep -qx "frequency_thz,attenuation_per_m,attenuation_db_per_km" \
+    || fail "scene atmosphere header: $(cat "$work/s.csv")"
+grep -v '^#' "$work/s.csv" | tail -1 | grep -q "^0.4,5.000000e-02," || fail "scene constant alpha"
+if "$THZMAP" atmosphere --scene "$work/scene.json" --model lines --from-thz 0.3 --to-thz 0.4 \
+       --step-ghz 1 --plot "$work/s.png" > /dev/null 2> "$work/err"; then
+    [ -s "$work/s.png" ] || fail "--scene --plot wrote no PNG"
 else
-    fail "--scene --plot failed: $(cat "$TMP/err")"
+    fail "--scene --plot failed: $(cat "$work/err")"
 fi
 
 # a scene's humid air compared with itu-p676 (the comparison takes the scene's air)
 sed 's/"model": "constant", "attenuation_per_m": 0.05/"model": "lines", "temperature_k": 250, "pressure_hpa": 900, "relative_humidity": 0.5/' \
-    "$TMP/scene.json" > "$TMP/humid.json"
-if "$THZ" atmosphere --scene "$TMP/humid.json" --from-thz 0.3 --to-thz 0.4 --step-ghz 1 \
-       --plot "$TMP/h.png" --compare-model itu-p676 > "$TMP/h.csv" 2> "$TMP/err"; then
-    [ -s "$TMP/h.png" ] || fail "--scene --compare-model wrote no PNG"
-    grep -q "^# .*250.00 K, 900.00 hPa" "$TMP/h.csv" || fail "scene air not used: $(head -1 "$TMP/h.csv")"
+    "$work/scene.json" > "$work/humid.json"
+if "$THZMAP" atmosphere --scene "$work/humid.json" --from-thz 0.3 --to-thz 0.4 --step-ghz 1 \
+       --plot "$work/h.png" --compare-model itu-p676 > "$work/h.csv" 2> "$work/err"; then
+    [ -s "$work/h.png" ] || fail "--scene --compare-model wrote no PNG"
+    grep -q "^# .*250.00 K, 900.00 hPa" "$work/h.csv" || fail "scene air not used: $(head -1 "$work/h.csv")"
 else
-    fail "--scene --compare-model failed: $(cat "$TMP/err")"
+    fail "--scene --compare-model failed: $(cat "$work/err")"
 fi
 
 # bad usage: exit 2 and a message naming the problem
 expect_usage() {
     local pattern="$1"; shift
-    "$THZ" atmosphere "$@" > /dev/null 2> "$TMP/err"
+    "$THZMAP" atmosphere "$@" > /dev/null 2> "$work/err"
     local rc=$?
     [ $rc -eq 2 ] || fail "'$*' exit status $rc, expected 2"
-    grep -q -- "$pattern" "$TMP/err" || fail "'$*' message lacks '$pattern': $(cat "$TMP/err")"
+    grep -q -- "$pattern" "$work/err" || fail "'$*' message lacks '$pattern': $(cat "$work/err")"
 }
 expect_usage "required" --from-thz 0.1
 expect_usage "step-ghz" --from-thz 0.1 --to-thz 0.2 --step-ghz 0
@@ -112,7 +109,7 @@ expect_usage "--relative-humidity expects a number, got 'nan'" --from-thz 0.1 --
     --step-ghz 1 --relative-humidity nan
 expect_usage "only one of" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --relative-humidity 0.5 --h2o-vmr 0.01
 expect_usage "range of atmosphere model 'itu-p676'" --from-thz 0.9 --to-thz 1.2 --step-ghz 1 --model itu-p676
-expect_usage "no-such.par" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --h2o-lines "$TMP/no-such.par"
+expect_usage "no-such.par" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --h2o-lines "$work/no-such.par"
 expect_usage "temperature" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --temperature-k 20
 expect_usage "--temperature-k expects a number from 100 to 400" --from-thz 0.1 --to-thz 0.2 \
     --step-ghz 1 --temperature-k 500
@@ -124,58 +121,58 @@ expect_usage "--pressure-hpa expects a number above 0 and at most 2000" --from-t
     --step-ghz 1 --pressure-hpa 5000
 expect_usage "apply to a lines model" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --model itu-p676 \
     --no-continuum
-expect_usage "the scene's atmosphere is used" --scene "$TMP/humid.json" --from-thz 0.3 \
-    --to-thz 0.4 --step-ghz 1 --h2o-lines "$TMP/no-such.par"
+expect_usage "the scene's atmosphere is used" --scene "$work/humid.json" --from-thz 0.3 \
+    --to-thz 0.4 --step-ghz 1 --h2o-lines "$work/no-such.par"
 # --plot writes PNG files only: a slip that names the scene is refused, the scene kept
-cp "$TMP/humid.json" "$TMP/keep.json"
-"$THZ" atmosphere --from-thz 0.3 --to-thz 0.4 --step-ghz 10 --scene "$TMP/keep.json" \
-    --plot "$TMP/keep.json" > "$TMP/out" 2> "$TMP/err"
+cp "$work/humid.json" "$work/keep.json"
+"$THZMAP" atmosphere --from-thz 0.3 --to-thz 0.4 --step-ghz 10 --scene "$work/keep.json" \
+    --plot "$work/keep.json" > "$work/out" 2> "$work/err"
 rc=$?
-[ $rc -eq 2 ] && grep -q "plot expects a file name ending in .png, got '$TMP/keep.json'" "$TMP/err" ||
-    fail "--plot of the scene's name: exit $rc: $(cat "$TMP/err")"
-cmp -s "$TMP/humid.json" "$TMP/keep.json" || fail "--plot of the scene's name changed the scene"
+[ $rc -eq 2 ] && grep -q "plot expects a file name ending in .png, got '$work/keep.json'" "$work/err" ||
+    fail "--plot of the scene's name: exit $rc: $(cat "$work/err")"
+cmp -s "$work/humid.json" "$work/keep.json" || fail "--plot of the scene's name changed the scene"
 # an unwritable --plot path: PLplot would prompt on stdin and exit; thzmap refuses it
 # first (exit 2, naming the path) and never reads stdin
-timeout 60 "$THZ" atmosphere --from-thz 0.1 --to-thz 0.2 --step-ghz 1 \
-    --plot "$TMP/no-such-dir/a.png" < /dev/null > "$TMP/out" 2> "$TMP/err"
+timeout 60 "$THZMAP" atmosphere --from-thz 0.1 --to-thz 0.2 --step-ghz 1 \
+    --plot "$work/no-such-dir/a.png" < /dev/null > "$work/out" 2> "$work/err"
 rc=$?
-[ $rc -eq 2 ] || fail "unwritable --plot: exit status $rc, expected 2 ($(cat "$TMP/err"))"
-grep -q "no-such-dir/a.png: cannot create" "$TMP/err" || fail "unwritable --plot message: $(cat "$TMP/err")"
-[ ! -s "$TMP/out" ] || fail "unwritable --plot: CSV printed before the failure"
+[ $rc -eq 2 ] || fail "unwritable --plot: exit status $rc, expected 2 ($(cat "$work/err"))"
+grep -q "no-such-dir/a.png: cannot create" "$work/err" || fail "unwritable --plot message: $(cat "$work/err")"
+[ ! -s "$work/out" ] || fail "unwritable --plot: CSV printed before the failure"
 
 # A line catalogue with an absurd (finite) value: the attenuation is NaN; refused with
 # exit 2 and nothing printed or plotted, here and in a scene (it printed -nan rows and a
 # scene's images were NaN, exit 0).
 awk -F, 'BEGIN { OFS = "," } NR == 3 { $6 = "1e300" } NR <= 3' \
-    "$REPO/tests/inputs/atm_h2o_subset.csv" > "$TMP/huge.csv"
-echo precious > "$TMP/huge.png" # a figure there before stays (the failure deleted it)
-"$THZ" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --h2o-lines "$TMP/huge.csv" \
-    --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" --plot "$TMP/huge.png" \
-    > "$TMP/out" 2> "$TMP/err"
+    "$REPO/tests/inputs/atm_h2o_subset.csv" > "$work/huge.csv"
+echo precious > "$work/huge.png" # a figure there before stays (the failure deleted it)
+"$THZMAP" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --h2o-lines "$work/huge.csv" \
+    --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" --plot "$work/huge.png" \
+    > "$work/out" 2> "$work/err"
 rc=$?
 [ $rc -eq 2 ] || fail "n_air 1e300: exit status $rc, expected 2"
-grep -q "the attenuation at 0.3 THz is not a finite number" "$TMP/err" ||
-    fail "n_air 1e300: message: $(cat "$TMP/err")"
-[ ! -s "$TMP/out" ] && [ "$(cat "$TMP/huge.png")" = precious ] ||
+grep -q "the attenuation at 0.3 THz is not a finite number" "$work/err" ||
+    fail "n_air 1e300: message: $(cat "$work/err")"
+[ ! -s "$work/out" ] && [ "$(cat "$work/huge.png")" = precious ] ||
     fail "n_air 1e300: output written, or the figure there before changed"
-[ -z "$(ls "$TMP" | grep partial)" ] || fail "n_air 1e300: a partial figure left: $(ls "$TMP")"
-"$THZ" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --model itu-p676 \
-    --compare-model lines --h2o-lines "$TMP/huge.csv" \
-    --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" --plot "$TMP/cmp.png" > "$TMP/out" 2> "$TMP/err"
+[ -z "$(ls "$work" | grep partial)" ] || fail "n_air 1e300: a partial figure left: $(ls "$work")"
+"$THZMAP" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --model itu-p676 \
+    --compare-model lines --h2o-lines "$work/huge.csv" \
+    --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" --plot "$work/cmp.png" > "$work/out" 2> "$work/err"
 rc=$?
-[ $rc -eq 2 ] && grep -q "attenuation of --compare-model at 0.3 THz is not a finite number" "$TMP/err" ||
-    fail "n_air 1e300 in --compare-model: exit $rc: $(cat "$TMP/err")"
-[ ! -s "$TMP/out" ] && [ ! -e "$TMP/cmp.png" ] || fail "n_air 1e300 in --compare-model: output written"
+[ $rc -eq 2 ] && grep -q "attenuation of --compare-model at 0.3 THz is not a finite number" "$work/err" ||
+    fail "n_air 1e300 in --compare-model: exit $rc: $(cat "$work/err")"
+[ ! -s "$work/out" ] && [ ! -e "$work/cmp.png" ] || fail "n_air 1e300 in --compare-model: output written"
 # an isotopologue the partition sums lack: the message names the catalogue and the table
 awk -F, 'BEGIN { OFS = "," } NR == 3 { $8 = "99" } { print }' \
-    "$REPO/tests/inputs/atm_h2o_subset.csv" > "$TMP/iso99.csv"
-"$THZ" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --h2o-lines "$TMP/iso99.csv" \
-    --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" > "$TMP/out" 2> "$TMP/err"
+    "$REPO/tests/inputs/atm_h2o_subset.csv" > "$work/iso99.csv"
+"$THZMAP" atmosphere --from-thz 0.3 --to-thz 0.31 --step-ghz 5 --h2o-lines "$work/iso99.csv" \
+    --o2-lines "$REPO/tests/inputs/atm_o2_subset.csv" > "$work/out" 2> "$work/err"
 rc=$?
-[ $rc -eq 2 ] && grep -q "iso99.csv: H2O lines: no partition sum for isotopologue 99 at .* K in .*partition_sums" "$TMP/err" ||
-    fail "isotopologue 99: exit $rc: $(cat "$TMP/err")"
-cp "$REPO/tests/inputs/atm_o2_subset.csv" "$TMP/"
-cat > "$TMP/huge.json" <<'JSON'
+[ $rc -eq 2 ] && grep -q "iso99.csv: H2O lines: no partition sum for isotopologue 99 at .* K in .*partition_sums" "$work/err" ||
+    fail "isotopologue 99: exit $rc: $(cat "$work/err")"
+cp "$REPO/tests/inputs/atm_o2_subset.csv" "$work/"
+cat > "$work/huge.json" <<'JSON'
 {"format": "thzmap-scene/1.1", "channels": [{"frequency_thz": 0.35, "relative_width": 0.01}],
  "materials": {"wall": {"reflectivity": 0.1}},
  "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
@@ -186,16 +183,16 @@ cat > "$TMP/huge.json" <<'JSON'
                 "relative_humidity": 0.5, "h2o_lines_file": "huge.csv",
                 "o2_lines_file": "atm_o2_subset.csv"}}
 JSON
-"$THZ" validate "$TMP/huge.json" > "$TMP/out" 2> "$TMP/err"
+"$THZMAP" validate "$work/huge.json" > "$work/out" 2> "$work/err"
 rc=$?
-[ $rc -eq 2 ] && grep -q "attenuation at .* THz is not a finite number" "$TMP/err" ||
-    fail "a scene with n_air 1e300: exit status $rc: $(cat "$TMP/err")"
+[ $rc -eq 2 ] && grep -q "attenuation at .* THz is not a finite number" "$work/err" ||
+    fail "a scene with n_air 1e300: exit status $rc: $(cat "$work/err")"
 # a catalogue's own error names the scene key that gave the file (it said "atmosphere:")
 awk -F, 'BEGIN { OFS = "," } NR == 3 { $2 = "-1" } NR <= 3' \
-    "$REPO/tests/inputs/atm_h2o_subset.csv" > "$TMP/neg.csv"
-sed 's/"h2o_lines_file": "huge.csv"/"h2o_lines_file": "neg.csv"/' "$TMP/huge.json" > "$TMP/neg.json"
-"$THZ" validate "$TMP/neg.json" > "$TMP/out" 2> "$TMP/err"
+    "$REPO/tests/inputs/atm_h2o_subset.csv" > "$work/neg.csv"
+sed 's/"h2o_lines_file": "huge.csv"/"h2o_lines_file": "neg.csv"/' "$work/huge.json" > "$work/neg.json"
+"$THZMAP" validate "$work/neg.json" > "$work/out" 2> "$work/err"
 rc=$?
-[ $rc -eq 2 ] && grep -q "neg.json: atmosphere.h2o_lines_file: .*neg.csv:3: the line's intensity must be >= 0" "$TMP/err" ||
-    fail "a scene's bad catalogue: exit status $rc: $(cat "$TMP/err")"
+[ $rc -eq 2 ] && grep -q "neg.json: atmosphere.h2o_lines_file: .*neg.csv:3: the line's intensity must be >= 0" "$work/err" ||
+    fail "a scene's bad catalogue: exit status $rc: $(cat "$work/err")"
 echo "ok"

@@ -6,40 +6,37 @@
 # score, the best set of every k <= K), the figures, determinism for a seed and any
 # thread count, and exit status 2 for bad input.
 # argv: thzmap binary, repository directory.
-set -u
-THZ="$1"
-REPO="$2"
+. "$(dirname "$0")/lib.sh"
 IN="$REPO/tests/inputs/analysis"
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
+# unlike lib.sh's fail: on stderr, and the test stops at the first failure
 fail() { echo "FAIL: $*" >&2; exit 1; }
 PY=/usr/bin/python3
 
-"$THZ" bands --help > "$TMP/help" || fail "--help exit status $?"
+"$THZMAP" bands --help > "$work/help" || fail "--help exit status $?"
 for o in --count --from-thz --to-thz --step-ghz --targets --netd-k --humidity-range --widths \
     --thickness-range --angle-range-deg; do
-    grep -q -- "$o" "$TMP/help" || fail "--help does not describe $o"
+    grep -q -- "$o" "$work/help" || fail "--help does not describe $o"
 done
 
 # progress into a log (not a terminal): a line as each render ends, the nominal one
 # first, then the nuisances' renders counted (it printed nothing until the end)
-"$THZ" bands "$IN/features.json" -o "$TMP/log" --count 2 --from-thz 0.2 --to-thz 1.0 \
-    --step-ghz 50 --paths 4 --threads 1 2> "$TMP/log.err" || fail "progress run exit status $?"
-grep -E '^thzmap bands: render ' "$TMP/log.err" | sed -E 's/ in [0-9.]+ s$//' > "$TMP/renders"
+"$THZMAP" bands "$IN/features.json" -o "$work/log" --count 2 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 50 --paths 4 --threads 1 2> "$work/log.err" || fail "progress run exit status $?"
+grep -E '^thzmap bands: render ' "$work/log.err" | sed -E 's/ in [0-9.]+ s$//' > "$work/renders"
 # (the coarse nominal and one per target: room, A, B, C)
 { echo "thzmap bands: render 1 (nominal): 17 candidate channels"
   for i in 2 3 4 5 6; do echo "thzmap bands: render $i/6: 17 candidate channels"; done; } |
-    diff - "$TMP/renders" ||
-    fail "progress lines: $(cat "$TMP/log.err")"
+    diff - "$work/renders" ||
+    fail "progress lines: $(cat "$work/log.err")"
 
 # features at 0.40 and 0.80 THz, candidates every 50 GHz from 0.2 to 1.0 THz
-"$THZ" bands "$IN/features.json" -o "$TMP/f" --count 2 --from-thz 0.2 --to-thz 1.0 \
+"$THZMAP" bands "$IN/features.json" -o "$work/f" --count 2 --from-thz 0.2 --to-thz 1.0 \
     --step-ghz 50 --paths 4 -q --threads 1 || fail "features run exit status $?"
 for f in bands.json bands-score.png bands-spectra.png; do
-    [ -s "$TMP/f/$f" ] || fail "no $f"
+    [ -s "$work/f/$f" ] || fail "no $f"
 done
-[ -e "$TMP/f/bands-air.png" ] && fail "bands-air.png written without attenuating air"
-$PY - "$TMP/f/bands.json" <<'PYEOF' || fail "features: $(cat "$TMP/f/bands.json" | head -c 600)"
+[ -e "$work/f/bands-air.png" ] && fail "bands-air.png written without attenuating air"
+$PY - "$work/f/bands.json" <<'PYEOF' || fail "features: $(cat "$work/f/bands.json" | head -c 600)"
 import json, sys
 d = json.load(open(sys.argv[1]))
 sel = d["selected_thz"]
@@ -60,9 +57,9 @@ assert d["noise"]["netd_k"] == [0.5] * 17 and "no noise" in d["noise"]["source"]
 PYEOF
 
 # the same with two threads: the same file but for its timing
-"$THZ" bands "$IN/features.json" -o "$TMP/f2" --count 2 --from-thz 0.2 --to-thz 1.0 \
+"$THZMAP" bands "$IN/features.json" -o "$work/f2" --count 2 --from-thz 0.2 --to-thz 1.0 \
     --step-ghz 50 --paths 4 -q --threads 2 || fail "second run exit status $?"
-$PY - "$TMP/f/bands.json" "$TMP/f2/bands.json" <<'PYEOF' || fail "not reproducible over threads"
+$PY - "$work/f/bands.json" "$work/f2/bands.json" <<'PYEOF' || fail "not reproducible over threads"
 import json, sys
 a, b = (json.load(open(p)) for p in sys.argv[1:3])
 a.pop("seconds"); b.pop("seconds")
@@ -70,24 +67,24 @@ assert a == b
 PYEOF
 
 # --targets: the plates and the rest as one background class
-"$THZ" bands "$IN/features.json" -o "$TMP/t" --count 2 --from-thz 0.2 --to-thz 1.0 \
+"$THZMAP" bands "$IN/features.json" -o "$work/t" --count 2 --from-thz 0.2 --to-thz 1.0 \
     --step-ghz 50 --paths 4 -q --targets A,B || fail "--targets run exit status $?"
-$PY -c "import json,sys; d=json.load(open('$TMP/t/bands.json')); \
+$PY -c "import json,sys; d=json.load(open('$work/t/bands.json')); \
 names=[c['name'] for c in d['classes']]; assert names==['A','B','background'], names" \
     || fail "--targets classes"
 # the scene has no air: its temperature is not among the nuisances (two background
 # objects varied together once made it look so)
-$PY -c "import json; n=json.load(open('$TMP/t/bands.json'))['nuisances']; \
+$PY -c "import json; n=json.load(open('$work/t/bands.json'))['nuisances']; \
 assert not n['air_temperature_varied'], n" || fail "air temperature 'varied' in a scene without air"
 
 # a feature across the 556.9 GHz water line: dry air lets the choice sit on the line,
 # humid air moves it off (within the feature, 0.52-0.60 THz)
 for air in dry humid; do
-    "$THZ" bands "$IN/water-line-$air.json" -o "$TMP/w-$air" --count 2 --from-thz 0.5 \
+    "$THZMAP" bands "$IN/water-line-$air.json" -o "$work/w-$air" --count 2 --from-thz 0.5 \
         --to-thz 0.72 --step-ghz 20 --paths 4 -q || fail "water line ($air) exit status $?"
 done
-[ -s "$TMP/w-humid/bands-air.png" ] || fail "no bands-air.png with humid air"
-$PY - "$TMP/w-dry/bands.json" "$TMP/w-humid/bands.json" <<'PYEOF' || fail "water line"
+[ -s "$work/w-humid/bands-air.png" ] || fail "no bands-air.png with humid air"
+$PY - "$work/w-dry/bands.json" "$work/w-humid/bands.json" <<'PYEOF' || fail "water line"
 import json, sys
 dry, humid = (json.load(open(p))["selected_thz"] for p in sys.argv[1:3])
 line = 0.55693
@@ -114,7 +111,7 @@ PYEOF
 # the sensor's noise: a given netd_k per channel, interpolated to the candidates; a
 # radiometer, whose NETD falls as 1/sqrt(bandwidth), i.e. 1/sqrt(frequency) at a fixed
 # relative width; --netd-k overrides both
-$PY - "$IN/features.json" "$TMP" <<'PYEOF' || fail "noisy scenes"
+$PY - "$IN/features.json" "$work" <<'PYEOF' || fail "noisy scenes"
 import json, sys
 d = json.load(open(sys.argv[1]))
 d["channels"] = [{"frequency_thz": 0.2, "relative_width": 0.01},
@@ -126,12 +123,12 @@ d["sensors"][0]["noise"] = {"receiver_temperature_k": 2000, "integration_time_s"
 json.dump(d, open(sys.argv[2] + "/radiometer.json", "w"))
 PYEOF
 for s in netd radiometer; do
-    "$THZ" bands "$TMP/$s.json" -o "$TMP/n-$s" --count 1 --from-thz 0.2 --to-thz 1.0 \
+    "$THZMAP" bands "$work/$s.json" -o "$work/n-$s" --count 1 --from-thz 0.2 --to-thz 1.0 \
         --step-ghz 200 --paths 2 -q || fail "$s scene exit status $?"
 done
-"$THZ" bands "$TMP/netd.json" -o "$TMP/n-given" --count 1 --from-thz 0.2 --to-thz 1.0 \
+"$THZMAP" bands "$work/netd.json" -o "$work/n-given" --count 1 --from-thz 0.2 --to-thz 1.0 \
     --step-ghz 200 --paths 2 -q --netd-k 0.7 || fail "--netd-k on a noisy scene: exit status $?"
-$PY - "$TMP" <<'PYEOF' || fail "the sensor's NETD"
+$PY - "$work" <<'PYEOF' || fail "the sensor's NETD"
 import json, math, sys
 n = {k: json.load(open(f"{sys.argv[1]}/n-{k}/bands.json"))["noise"]
      for k in ("netd", "radiometer", "given")}
@@ -157,9 +154,9 @@ PYEOF
 # widths searched: every centre with a narrow (1 %) and a broad (30 %) width at one
 # NETD; the 80 GHz-wide features are diluted in a 120-240 GHz-wide channel, so the
 # narrow width is chosen at each feature and no centre is chosen twice
-"$THZ" bands "$IN/features.json" -o "$TMP/wd" --count 2 --from-thz 0.2 --to-thz 1.0 \
+"$THZMAP" bands "$IN/features.json" -o "$work/wd" --count 2 --from-thz 0.2 --to-thz 1.0 \
     --step-ghz 50 --paths 4 -q --widths 0.3,0.01 || fail "--widths run exit status $?"
-$PY - "$TMP/wd/bands.json" <<'PYEOF' || fail "widths: $(head -c 600 "$TMP/wd/bands.json")"
+$PY - "$work/wd/bands.json" <<'PYEOF' || fail "widths: $(head -c 600 "$work/wd/bands.json")"
 import json, sys
 d = json.load(open(sys.argv[1]))
 sel, wid = d["selected_thz"], d["selected_relative_width"]
@@ -183,7 +180,7 @@ PYEOF
 # 0.5 mm shell at 280 K (alpha t = 1), whose pixels the truth names "cover"; varying the thickness by
 # +-50 % spreads that class and hardly B's (which nothing covers); turning the sensor by
 # 10 degrees spreads the classes too
-$PY - "$IN/features.json" "$TMP" <<'PYEOF' || fail "covered scene"
+$PY - "$IN/features.json" "$work" <<'PYEOF' || fail "covered scene"
 import json, sys
 d = json.load(open(sys.argv[1]))
 d["materials"]["cloth"] = {"reflectivity": 0.05, "attenuation_per_m": 2000}
@@ -196,15 +193,15 @@ PYEOF
 NUIS="--count 1 --from-thz 0.2 --to-thz 1.0 --step-ghz 200 --paths 2 -q --targets cover,B,C
       --temperature-range-k 0 --ambient-range-k 0 --humidity-range 0"
 # shellcheck disable=SC2086
-"$THZ" bands "$TMP/covered.json" -o "$TMP/c0" $NUIS || fail "covered scene exit status $?"
+"$THZMAP" bands "$work/covered.json" -o "$work/c0" $NUIS || fail "covered scene exit status $?"
 # shellcheck disable=SC2086
-"$THZ" bands "$TMP/covered.json" -o "$TMP/ct" $NUIS --thickness-range 0.5 \
+"$THZMAP" bands "$work/covered.json" -o "$work/ct" $NUIS --thickness-range 0.5 \
     || fail "--thickness-range exit status $?"
 # shellcheck disable=SC2086
-"$THZ" bands "$TMP/covered.json" -o "$TMP/ca" $NUIS --angle-range-deg 10 \
+"$THZMAP" bands "$work/covered.json" -o "$work/ca" $NUIS --angle-range-deg 10 \
     || fail "--angle-range-deg exit status $?"
 # the same camera given by a direction instead of look_at_m: turned about its position
-$PY - "$TMP/covered.json" "$TMP/covered-dir.json" <<'PYEOF'
+$PY - "$work/covered.json" "$work/covered-dir.json" <<'PYEOF'
 import json, math, sys
 d = json.load(open(sys.argv[1]))
 for sn in d["sensors"]:
@@ -215,9 +212,9 @@ for sn in d["sensors"]:
 json.dump(d, open(sys.argv[2], "w"))
 PYEOF
 # shellcheck disable=SC2086
-"$THZ" bands "$TMP/covered-dir.json" -o "$TMP/cd" $NUIS --angle-range-deg 10 \
+"$THZMAP" bands "$work/covered-dir.json" -o "$work/cd" $NUIS --angle-range-deg 10 \
     || fail "--angle-range-deg with a sensor direction: exit status $?"
-$PY - "$TMP" <<'PYEOF' || fail "thickness and angle nuisances"
+$PY - "$work" <<'PYEOF' || fail "thickness and angle nuisances"
 import json, sys
 r = {k: json.load(open(f"{sys.argv[1]}/{k}/bands.json")) for k in ("c0", "ct", "ca", "cd")}
 sd = {k: {c["name"]: c["nuisance_sd_k"] for c in d["classes"]} for k, d in r.items()}
@@ -238,33 +235,33 @@ PYEOF
 # bad input: exit status 2 and a message naming the problem
 expect2() {
     local what=$1; shift
-    "$THZ" bands "$@" > /dev/null 2> "$TMP/err"
+    "$THZMAP" bands "$@" > /dev/null 2> "$work/err"
     local rc=$?
     [ $rc -eq 2 ] || fail "$what: exit status $rc, expected 2"
-    [ -s "$TMP/err" ] || fail "$what: no message"
+    [ -s "$work/err" ] || fail "$what: no message"
 }
-expect2 "no --count" "$IN/features.json" -o "$TMP/x"
-expect2 "--count 0" "$IN/features.json" -o "$TMP/x" --count 0
+expect2 "no --count" "$IN/features.json" -o "$work/x"
+expect2 "--count 0" "$IN/features.json" -o "$work/x" --count 0
 expect2 "no -o" "$IN/features.json" --count 1
-expect2 "to below from" "$IN/features.json" -o "$TMP/x" --count 1 --from-thz 1 --to-thz 0.5
+expect2 "to below from" "$IN/features.json" -o "$work/x" --count 1 --from-thz 1 --to-thz 0.5
 # a first channel with a measured response (no relative_width): the candidates take its
 # FWHM / centre (0.05 THz / 0.5 THz), not the 0 that blamed the scene's channels[0].relative_width
-$PY - "$IN/features.json" "$TMP/response.json" <<'PYEOF'
+$PY - "$IN/features.json" "$work/response.json" <<'PYEOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
 d["channels"] = [{"frequency_thz": 0.5, "response": [[0.45, 0], [0.5, 1], [0.55, 0]]}]
 json.dump(d, open(sys.argv[2], "w"))
 PYEOF
-"$THZ" bands "$TMP/response.json" -o "$TMP/resp" --count 1 --from-thz 0.4 --to-thz 0.8 \
-    --step-ghz 400 --paths 2 -q 2> "$TMP/resp.err" || fail "response channel: $(cat "$TMP/resp.err")"
+"$THZMAP" bands "$work/response.json" -o "$work/resp" --count 1 --from-thz 0.4 --to-thz 0.8 \
+    --step-ghz 400 --paths 2 -q 2> "$work/resp.err" || fail "response channel: $(cat "$work/resp.err")"
 $PY -c 'import json, sys; c = json.load(open(sys.argv[1]))["candidates"]
-assert abs(c["relative_width"] - 0.1) < 1e-9, c' "$TMP/resp/bands.json" ||
+assert abs(c["relative_width"] - 0.1) < 1e-9, c' "$work/resp/bands.json" ||
     fail "response channel: not its FWHM / centre"
 
 # two targets of one material: their means differ by the renders' Monte Carlo noise
 # alone, which the worst pair's B does not exceed: a warning on standard error (also
 # with -q) and in bands.json; two different plates: none
-$PY - "$IN/flat-and-dip.json" "$TMP/identical.json" <<'PYEOF'
+$PY - "$IN/flat-and-dip.json" "$work/identical.json" <<'PYEOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
 for o in d["objects"]:
@@ -273,14 +270,14 @@ for o in d["objects"]:
 json.dump(d, open(sys.argv[2], "w"))
 PYEOF
 for s in identical flat; do
-    scene="$TMP/identical.json"; [ $s = flat ] && scene="$IN/flat-and-dip.json"
-    "$THZ" bands "$scene" -o "$TMP/$s" --count 2 --from-thz 0.2 --to-thz 1.0 --step-ghz 50 \
-        --paths 4 --targets X,Y -q 2> "$TMP/$s.err" || fail "$s targets: exit status $?"
+    scene="$work/identical.json"; [ $s = flat ] && scene="$IN/flat-and-dip.json"
+    "$THZMAP" bands "$scene" -o "$work/$s" --count 2 --from-thz 0.2 --to-thz 1.0 --step-ghz 50 \
+        --paths 4 --targets X,Y -q 2> "$work/$s.err" || fail "$s targets: exit status $?"
 done
 grep -q "^thzmap bands: warning: 'X' and 'Y' cannot be told apart: their Bhattacharyya distance" \
-    "$TMP/identical.err" || fail "identical targets, no warning: $(cat "$TMP/identical.err")"
-[ -s "$TMP/flat.err" ] && fail "different targets warned: $(cat "$TMP/flat.err")"
-$PY - "$TMP/identical/bands.json" "$TMP/flat/bands.json" <<'PYEOF' || fail "warnings in bands.json"
+    "$work/identical.err" || fail "identical targets, no warning: $(cat "$work/identical.err")"
+[ -s "$work/flat.err" ] && fail "different targets warned: $(cat "$work/flat.err")"
+$PY - "$work/identical/bands.json" "$work/flat/bands.json" <<'PYEOF' || fail "warnings in bands.json"
 import json, sys
 same, diff = (json.load(open(p)) for p in sys.argv[1:3])
 assert same["bhattacharyya"] <= same["monte_carlo_bhattacharyya"], same
@@ -288,36 +285,36 @@ assert len(same["warnings"]) == 1 and "cannot be told apart" in same["warnings"]
 assert diff["warnings"] == [] and diff["bhattacharyya"] > 10 * diff["monte_carlo_bhattacharyya"]
 PYEOF
 
-expect2 "unknown target" "$IN/features.json" -o "$TMP/x" --count 1 --targets A,nope
-grep -q "nope" "$TMP/err" || fail "unknown target not named: $(cat "$TMP/err")"
-expect2 "no sensor noise" "$IN/features.json" -o "$TMP/x" --count 1 --netd-k 0
-grep -q -- "--netd-k expects a number above 0" "$TMP/err" || fail "NETD 0 not named: $(cat "$TMP/err")"
-expect2 "missing scene" "$TMP/none.json" -o "$TMP/x" --count 1
-expect2 "count above candidates" "$IN/features.json" -o "$TMP/x" --count 3 --from-thz 0.5 \
+expect2 "unknown target" "$IN/features.json" -o "$work/x" --count 1 --targets A,nope
+grep -q "nope" "$work/err" || fail "unknown target not named: $(cat "$work/err")"
+expect2 "no sensor noise" "$IN/features.json" -o "$work/x" --count 1 --netd-k 0
+grep -q -- "--netd-k expects a number above 0" "$work/err" || fail "NETD 0 not named: $(cat "$work/err")"
+expect2 "missing scene" "$work/none.json" -o "$work/x" --count 1
+expect2 "count above candidates" "$IN/features.json" -o "$work/x" --count 3 --from-thz 0.5 \
     --to-thz 0.52 --step-ghz 20
-expect2 "width above 0.5" "$IN/features.json" -o "$TMP/x" --count 1 --widths 0.01,0.6
-expect2 "an empty width" "$IN/features.json" -o "$TMP/x" --count 1 --widths 0.01,,0.2
-expect2 "an empty target" "$IN/features.json" -o "$TMP/x" --count 1 --targets A,,B
-expect2 "width above 0.5, said once" "$IN/features.json" -o "$TMP/x" --count 1 --widths 0.01,0.6
-[ "$(grep -c expects "$TMP/err")" = 1 ] || fail "a bad width said other than once: $(cat "$TMP/err")"
-expect2 "width twice" "$IN/features.json" -o "$TMP/x" --count 1 --widths 0.01,0.01
-grep -q "twice" "$TMP/err" || fail "a repeated width not named: $(cat "$TMP/err")"
-expect2 "angle above 90" "$IN/features.json" -o "$TMP/x" --count 1 --angle-range-deg 91
-grep -q -- "--angle-range-deg.*91" "$TMP/err" || fail "the bad angle not named: $(cat "$TMP/err")"
-expect2 "a width and widths" "$IN/features.json" -o "$TMP/x" --count 1 --relative-width 0.02 \
+expect2 "width above 0.5" "$IN/features.json" -o "$work/x" --count 1 --widths 0.01,0.6
+expect2 "an empty width" "$IN/features.json" -o "$work/x" --count 1 --widths 0.01,,0.2
+expect2 "an empty target" "$IN/features.json" -o "$work/x" --count 1 --targets A,,B
+expect2 "width above 0.5, said once" "$IN/features.json" -o "$work/x" --count 1 --widths 0.01,0.6
+[ "$(grep -c expects "$work/err")" = 1 ] || fail "a bad width said other than once: $(cat "$work/err")"
+expect2 "width twice" "$IN/features.json" -o "$work/x" --count 1 --widths 0.01,0.01
+grep -q "twice" "$work/err" || fail "a repeated width not named: $(cat "$work/err")"
+expect2 "angle above 90" "$IN/features.json" -o "$work/x" --count 1 --angle-range-deg 91
+grep -q -- "--angle-range-deg.*91" "$work/err" || fail "the bad angle not named: $(cat "$work/err")"
+expect2 "a width and widths" "$IN/features.json" -o "$work/x" --count 1 --relative-width 0.02 \
     --widths 0.01,0.05
-grep -q -- "--relative-width 0.02 and --widths" "$TMP/err" ||
-  fail "--relative-width with --widths not refused by name: $(cat "$TMP/err")"
-expect2 "count above the candidates" "$IN/features.json" -o "$TMP/x" --count 5 \
+grep -q -- "--relative-width 0.02 and --widths" "$work/err" ||
+  fail "--relative-width with --widths not refused by name: $(cat "$work/err")"
+expect2 "count above the candidates" "$IN/features.json" -o "$work/x" --count 5 \
     --from-thz 0.5 --to-thz 0.53
-grep -q -- "--count 5: only 4 candidate centres from 0.5 to 0.53 THz every 10 GHz" "$TMP/err" ||
-    fail "--count above the candidates not refused by name: $(cat "$TMP/err")"
+grep -q -- "--count 5: only 4 candidate centres from 0.5 to 0.53 THz every 10 GHz" "$work/err" ||
+    fail "--count above the candidates not refused by name: $(cat "$work/err")"
 # One channel: the worst pair's B and the mean JM from bands.json's own class statistics,
 # each class's variance its pixels' spread, its nuisances' and the NETD squared (a NETD
 # of 0.5 K added unsquared, a helper's mutant, passed every test: the runs above have none)
-"$THZ" bands "$IN/features.json" -o "$TMP/one" --count 1 --from-thz 0.2 --to-thz 1.0 \
+"$THZMAP" bands "$IN/features.json" -o "$work/one" --count 1 --from-thz 0.2 --to-thz 1.0 \
     --step-ghz 100 --netd-k 0.5 -q 2> /dev/null || fail "one channel: exit status $?"
-$PY - "$TMP/one/bands.json" <<'PYEOF' || fail "one channel's B from the class statistics"
+$PY - "$work/one/bands.json" <<'PYEOF' || fail "one channel's B from the class statistics"
 import itertools, json, math, sys
 d = json.load(open(sys.argv[1]))
 c = d["candidates"]["frequency_thz"].index(d["selected_thz"][0])
@@ -337,27 +334,27 @@ ok = (math.isclose(pairs[0][0], d["bhattacharyya"], rel_tol=1e-6) and
 print("B", pairs[0], d["bhattacharyya"], "mean JM", sum(jm) / len(jm), d["mean_jm"], file=sys.stderr)
 sys.exit(0 if ok else 1)
 PYEOF
-touch "$TMP/file"
-expect2 "OUTDIR a file" "$IN/features.json" -o "$TMP/file" --count 1
-grep -q -- "exists and is not a directory" "$TMP/err" || fail "-o FILE: $(cat "$TMP/err")"
-expect2 "thickness range 1" "$IN/features.json" -o "$TMP/x" --count 1 --thickness-range 1
-[ -e "$TMP/x" ] && fail "a failed run left $TMP/x"
+touch "$work/file"
+expect2 "OUTDIR a file" "$IN/features.json" -o "$work/file" --count 1
+grep -q -- "exists and is not a directory" "$work/err" || fail "-o FILE: $(cat "$work/err")"
+expect2 "thickness range 1" "$IN/features.json" -o "$work/x" --count 1 --thickness-range 1
+[ -e "$work/x" ] && fail "a failed run left $work/x"
 
 # an OUTDIR another run is writing into is refused before the renders, not after every
 # one of them (the work lost); here a long simulate holds OUTDIR's lock
-"$THZ" simulate "$REPO/examples/plate-in-box/scene.json" -o "$TMP/busy" --photons 50000000 \
-    --integrator photon-map 2> "$TMP/busy.err" &
+"$THZMAP" simulate "$REPO/examples/plate-in-box/scene.json" -o "$work/busy" --photons 50000000 \
+    --integrator photon-map 2> "$work/busy.err" &
 busy=$!
 for _ in $(seq 600); do # the estimate's line: OUTDIR (and its lock) opened
-    grep -q "estimate:" "$TMP/busy.err" 2>/dev/null && break
+    grep -q "estimate:" "$work/busy.err" 2>/dev/null && break
     sleep 0.1
 done
-"$THZ" bands "$IN/features.json" -o "$TMP/busy" --count 1 --from-thz 0.2 --to-thz 1.0 \
-    --step-ghz 50 --paths 4 2> "$TMP/err"
+"$THZMAP" bands "$IN/features.json" -o "$work/busy" --count 1 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 50 --paths 4 2> "$work/err"
 st=$?
 kill -TERM $busy
 wait $busy 2>/dev/null
-[ "$st" = 1 ] || fail "a busy OUTDIR: exit status $st, expected 1: $(cat "$TMP/err")"
-grep -q "another thzmap run" "$TMP/err" || fail "a busy OUTDIR: $(cat "$TMP/err")"
-grep -q "render 1" "$TMP/err" && fail "a busy OUTDIR refused only after the renders"
+[ "$st" = 1 ] || fail "a busy OUTDIR: exit status $st, expected 1: $(cat "$work/err")"
+grep -q "another thzmap run" "$work/err" || fail "a busy OUTDIR: $(cat "$work/err")"
+grep -q "render 1" "$work/err" && fail "a busy OUTDIR refused only after the renders"
 echo ok

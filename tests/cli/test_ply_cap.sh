@@ -2,25 +2,22 @@
 # simulate --save-photon-map --ply-max-points N writes a PLY with exactly N points when
 # more photons were stored, and refuses a cap of 0; uncapped, photon-map.ply read back
 # by a generic PLY reader holds the photon map's photons (tests/cli/photon_ply.py).
-set -u
-thzmap=$1
-repo=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/lib.sh"
+# unlike lib.sh's fail: the test stops at the first failure
 fail() { echo "FAIL: $*"; exit 1; }
 
-"$thzmap" simulate "$repo/examples/plate-in-box/scene.json" -o "$tmp/out" --integrator photon-map --photons 2000 \
+"$THZMAP" simulate "$REPO/examples/plate-in-box/scene.json" -o "$work/out" --integrator photon-map --photons 2000 \
     --save-photon-map --ply-max-points 100 --quiet || fail "simulate exited $?"
-header=$(head -c 2000 "$tmp/out/photon-map.ply" | tr -d '\0' | sed -n '1,/end_header/p')
+header=$(head -c 2000 "$work/out/photon-map.ply" | tr -d '\0' | sed -n '1,/end_header/p')
 grep -q '^format binary_little_endian 1.0' <<<"$header" || fail "not a binary LE PLY: $header"
 grep -q '^element vertex 100$' <<<"$header" || fail "expected 100 points: $header"
-stored=$(/usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['channels'][0]['photons_stored'])" "$tmp/out/summary.json")
+stored=$(/usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['channels'][0]['photons_stored'])" "$work/out/summary.json")
 [ "$stored" -gt 100 ] || fail "only $stored photons stored: the cap was not exercised"
 
 # Uncapped: every photon, compared with photon-map.thzpm; two channels, and final-gather's
 # deviation maps (from B(T0)): the sphere, colder than T0 (the room's), sends photons of
 # negative power
-cat >"$tmp/two.json" <<'JSON'
+cat >"$work/two.json" <<'JSON'
 {"format": "thzmap-scene/1", "name": "two",
  "channels": [{"frequency_thz": 0.35, "relative_width": 0.01},
               {"frequency_thz": 0.7, "relative_width": 0.01}],
@@ -35,15 +32,15 @@ cat >"$tmp/two.json" <<'JSON'
  "render": {"integrator": "final-gather"},
  "photons": {"per_channel": 2000, "seed": 5}}
 JSON
-"$thzmap" simulate "$tmp/two.json" -o "$tmp/all" --save-photon-map --quiet ||
+"$THZMAP" simulate "$work/two.json" -o "$work/all" --save-photon-map --quiet ||
     fail "simulate exited $?"
-/usr/bin/python3 "$repo/tests/cli/photon_ply.py" "$tmp/all" 2 2 --negative ||
+/usr/bin/python3 "$REPO/tests/cli/photon_ply.py" "$work/all" 2 2 --negative ||
     fail "photon-map.ply"
 
-"$thzmap" simulate "$repo/examples/plate-in-box/scene.json" -o "$tmp/out2" \
-    --save-photon-map --ply-max-points 0 --quiet 2>"$tmp/err"
+"$THZMAP" simulate "$REPO/examples/plate-in-box/scene.json" -o "$work/out2" \
+    --save-photon-map --ply-max-points 0 --quiet 2>"$work/err"
 status=$?
 [ $status -eq 2 ] || fail "--ply-max-points 0: exit $status, expected 2"
-grep -q -- "--ply-max-points" "$tmp/err" || fail "message does not name the option: $(cat "$tmp/err")"
-[ ! -e "$tmp/out2" ] || [ -z "$(ls -A "$tmp/out2")" ] || fail "a refused run wrote files"
+grep -q -- "--ply-max-points" "$work/err" || fail "message does not name the option: $(cat "$work/err")"
+[ ! -e "$work/out2" ] || [ -z "$(ls -A "$work/out2")" ] || fail "a refused run wrote files"
 echo "1 passed, 0 failed"
