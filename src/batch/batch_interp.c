@@ -1,9 +1,12 @@
 /* Keyframe interpolation in time (scene-format.md "Sequences, sweeps and movies"):
  * linear for numbers and vectors, quaternion slerp for rotations, the end values held
  * beyond the first and last keyframe. The segment weights are exact at the keyframes
- * ((1 - u) a + u b), so a frame at a keyframe's time gets the keyframe's value bit for bit.
+ * ((1 - u) a + u b), so a frame at a keyframe's time gets the keyframe's value bit for bit;
+ * a value both ends of a segment give alike is that value throughout (the weights' sum
+ * would move it in its last bit, and a still object would then differ from frame to frame).
  */
 #include <math.h>
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "batch/batch_internal.h"
@@ -38,7 +41,7 @@ void thz_interp_linear(const double *t, const double *v, size_t k, size_t n, dou
     for (size_t m = 0; m < n; m++) {
         double a = v[j * n + m];
         double b = k > 1 ? v[(j + 1) * n + m] : a;
-        out[m] = u == 0.0 ? a : u == 1.0 ? b : (1.0 - u) * a + u * b;
+        out[m] = u == 0.0 || a == b ? a : u == 1.0 ? b : (1.0 - u) * a + u * b;
     }
 }
 
@@ -94,8 +97,10 @@ void thz_interp_rotation(const double *t, const double *rotate_deg, size_t k, do
     size_t j;
     double u;
     batch_segment(t, k, time_s, &j, &u);
-    if (k == 1 || u == 0.0 || u == 1.0) { /* a keyframe's own angles, as written */
-        const double *src = &rotate_deg[(k == 1 || u == 0.0 ? j : j + 1) * 3];
+    const double *ra = &rotate_deg[j * 3], *rb = k > 1 ? &rotate_deg[(j + 1) * 3] : ra;
+    bool same = ra[0] == rb[0] && ra[1] == rb[1] && ra[2] == rb[2];
+    if (k == 1 || u == 0.0 || u == 1.0 || same) { /* a keyframe's own angles, as written */
+        const double *src = u == 1.0 ? rb : ra;
         for (int m = 0; m < 3; m++)
             out_deg[m] = src[m];
         return;

@@ -108,11 +108,34 @@ static void test_slerp(void **state)
     assert_true(angle_between(out, g_mid) < 1e-6);
 }
 
+/* A value two keyframes give alike stays that value bit for bit between them: (1 - u) a
+ * + u a is not always a (0.06 at u = 1/8 gives 0.060000000000000005), and a still
+ * object's position moving in its last bit made the frames differ in more than their
+ * sensors, so a camera moving past it fired every frame's photons anew. */
+static void test_equal_keyframes_stay_exact(void **state)
+{
+    (void)state;
+    const double t[2] = {0.0, 3.0};
+    const double v[6] = {0.0, 0.06, 0.001, 0.0, 0.06, 0.001};
+    for (int i = 0; i <= 24; i++) {
+        double out[3];
+        thz_interp_linear(t, v, 2, 3, i / 8.0, out);
+        assert_true(out[0] == 0.0 && out[1] == 0.06 && out[2] == 0.001);
+    }
+    const double r[6] = {10.0, 20.0, 37.5, 10.0, 20.0, 37.5};
+    for (int i = 0; i <= 24; i++) {
+        double out[3];
+        thz_interp_rotation(t, r, 2, i / 8.0, out);
+        assert_true(out[0] == 10.0 && out[1] == 20.0 && out[2] == 37.5);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_linear),
         cmocka_unit_test(test_slerp),
+        cmocka_unit_test(test_equal_keyframes_stay_exact),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
