@@ -84,9 +84,15 @@ const char *file_kind_hint(const unsigned char *head, size_t n)
     } kinds[] = {
         {FILE_MAGIC_PHOTON_MAP, 0, 8,
          "a photon-map file, which `thzmap render --photon-map` reads"},
-        {"ply\n", 0, 4, "a PLY mesh, which a scene names in an object's \"mesh\""},
-        {"ply\r\n", 0, 5, "a PLY mesh, which a scene names in an object's \"mesh\""},
-        {"glTF", 0, 4, "a glTF binary mesh, which a scene names in an object's \"mesh\""},
+        {"ply\n", 0, 4,
+         "a PLY mesh, which a scene names in a shape's \"file\", {\"type\": \"mesh\", \"file\": "
+         "...}"},
+        {"ply\r\n", 0, 5,
+         "a PLY mesh, which a scene names in a shape's \"file\", {\"type\": \"mesh\", \"file\": "
+         "...}"},
+        {"glTF", 0, 4,
+         "a glTF binary mesh, which a scene names in a shape's \"file\", {\"type\": \"mesh\", "
+         "\"file\": ...}"},
         {"\x89PNG\r\n\x1a\n", 0, 8, "a PNG image"},
         {"ENVI", 0, 4, "an ENVI header"},
         {"ftyp", 4, 4, "an MP4 movie"},

@@ -77,8 +77,8 @@ int main(int argc, char **argv)
           "the scene loader given a photon map: %s", err.message);
     snprintf(path, sizeof path, "%s/mesh.ply", dir);
     CHECK(thz_scene_load(path, &wrong, &err) == THZ_ERR_INPUT &&
-              strstr(err.message, "(the file is a PLY mesh, which a scene names in an "
-                                  "object's \"mesh\")"),
+              strstr(err.message, "(the file is a PLY mesh, which a scene names in a "
+                                  "shape's \"file\", {\"type\": \"mesh\", \"file\": ...})"),
           "the scene loader given a PLY mesh: %s", err.message);
     snprintf(path, sizeof path, "%s/broken.json", dir);
     CHECK(thz_scene_load(path, &wrong, &err) == THZ_ERR_INPUT &&
