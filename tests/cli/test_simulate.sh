@@ -337,6 +337,13 @@ for opt in --integrator --target-noise-k --max-seconds; do
     "$THZMAP" simulate --help | grep -q -- "$opt" || fail "simulate --help lacks $opt"
     "$THZMAP" render --help | grep -q -- "$opt" || fail "render --help lacks $opt"
 done
+# render's default integrator is the scene's, as simulate's is: its help must say so
+for cmd in simulate render; do
+    "$THZMAP" $cmd --help | grep -q "overrides render.integrator" ||
+        fail "$cmd --help does not say --integrator overrides render.integrator"
+    "$THZMAP" $cmd --help | grep -q "overrides render.max_seconds" ||
+        fail "$cmd --help does not say --max-seconds overrides render.max_seconds"
+done
 
 # --- integrators --------------------------------------------------------------------------
 # path fires no photons; both sampled integrators are thread-count independent, with and
