@@ -217,6 +217,15 @@ CASES = [
     ("sensor_normalize_too_cold", [(["sensors", 0, "normalize_to_k"], 0.1)],
      "sensors[0].normalize_to_k: expected a temperature >= 0.3427 K (h nu / k T_ref at most 50 "
      "at 0.357 THz"),
+    # a GHz value given in THz (350 for 0.35) with normalize_to_k given: the refusal says
+    # what the warning about channels beyond 10 THz would have said, which it hides
+    ("sensor_normalize_ghz_as_thz", [(["channels", 0, "frequency_thz"], 350),
+                                     (["sensors", 0, "normalize_to_k"], 295)],
+     "sensors[0].normalize_to_k: expected a temperature >= 342.7 K (h nu / k T_ref at most "
+     "50 at 357 THz, the top of channel \"350.000 THz\"'s band; colder, B(T_ref) is too "
+     "small for the normalised cube), got 295 K; channel \"350.000 THz\" is at 350 THz, "
+     "beyond the 0.05 to 10 THz thzmap's models are meant for: frequency_thz is in THz "
+     "(350 GHz = 0.35 THz)"),
     ("sensor_normalize_huge", [(["sensors", 0, "normalize_to_k"], 1e300)],
      "sensors[0].normalize_to_k: expected a number in (0, 1e+06], got 1e+300"),
     ("sensor_noise_receiver_temperature_huge",
