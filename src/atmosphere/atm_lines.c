@@ -31,6 +31,7 @@
 #include <string.h>
 
 #include "atmosphere/atm_catalog.h"
+#include "atmosphere/atm_inputs.h"
 #include "atmosphere/atm_internal.h"
 #include "atmosphere/atm_lines_data.h"
 #include "core/alloc.h"
@@ -41,7 +42,6 @@
 #define LINE_MIN_RELATIVE 1e-10
 #define O2_DRY_AIR_VMR 0.20946          /* O2 fraction of dry air */
 #define VOIGT_DOPPLER_RATIO 1e-3        /* Voigt when gamma_D > this times gamma_L */
-#define COUPLED_MATCH_GHZ 0.005         /* .par O2 lines this close to a coupled line are it */
 #define H_OVER_K_K_PER_GHZ 0.0479924307 /* h / k in K/GHz (CODATA 2018) */
 #define BOLTZMANN_HPA_CM3 1.380649e-19  /* k in hPa cm^3 / K: n[cm^-3] = p[hPa] / (k T) */
 #define AMU_KG 1.66053906660e-27
@@ -150,71 +150,7 @@ static thz_status species_build(lbl_species *sp, const raw_catalog *cat, const p
     return THZ_OK;
 }
 
-/* Drops from cat the lines of isotopologue 1 within COUPLED_MATCH_GHZ of a coupled
- * line: a HITRAN O2 list holds the 60 GHz band and 118.75 GHz line, which the
- * coupled table already has (with line mixing). */
-static void drop_coupled_duplicates(raw_catalog *cat, const raw_catalog *coupled)
-{
-    size_t n = 0;
-    for (size_t i = 0; i < cat->n; i++) {
-        bool dup = false;
-        for (size_t j = 0; !dup && cat->lines[i].iso == 1 && j < coupled->n; j++)
-            dup = fabs(cat->lines[i].nu0_ghz - coupled->lines[j].nu0_ghz) < COUPLED_MATCH_GHZ;
-        if (!dup)
-            cat->lines[n++] = cat->lines[i];
-    }
-    cat->n = n;
-}
-
 /* ---- MT_CKD -------------------------------------------------------------------- */
-
-static thz_status read_continuum(atm_lines_data *d, const char *path, thz_error *err)
-{
-    csv_table csv;
-    thz_status st = csv_read(path, NULL, &csv, err);
-    if (st != THZ_OK)
-        return st;
-    size_t c_nu, c_f, c_s, c_x;
-    st = csv_column_index(&csv, "nu_cm-1", &c_nu, err);
-    if (st == THZ_OK)
-        st = csv_column_index(&csv, "C_foreign_ref_cm2_per_molec_per_cm-1", &c_f, err);
-    if (st == THZ_OK)
-        st = csv_column_index(&csv, "C_self_ref_cm2_per_molec_per_cm-1", &c_s, err);
-    if (st == THZ_OK)
-        st = csv_column_index(&csv, "self_texp", &c_x, err);
-    if (st != THZ_OK)
-        goto cleanup;
-    d->n_cont = csv.n_rows;
-    d->cont_step_cm1 = csv.n_rows > 1 ? csv_value(&csv, 1, c_nu) : 0.0;
-    if (csv.n_rows < 4 || csv_value(&csv, 0, c_nu) != 0.0 || !(d->cont_step_cm1 > 0.0)) {
-        st = thz_error_set(err, THZ_ERR_INPUT,
-                           "%s: the continuum table must start at 0 cm^-1, be evenly spaced and "
-                           "have at least 4 rows",
-                           path);
-        goto cleanup;
-    }
-    d->c_foreign = thz_malloc_array(d->n_cont, sizeof *d->c_foreign);
-    d->c_self = thz_malloc_array(d->n_cont, sizeof *d->c_self);
-    d->self_texp = thz_malloc_array(d->n_cont, sizeof *d->self_texp);
-    if (!d->c_foreign || !d->c_self || !d->self_texp) {
-        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory reading %s", path);
-        goto cleanup;
-    }
-    for (size_t r = 0; r < csv.n_rows; r++) {
-        double nu = csv_value(&csv, r, c_nu);
-        if (fabs(nu - (double)r * d->cont_step_cm1) > 1e-6 * d->cont_step_cm1) {
-            st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: wavenumbers must be evenly spaced",
-                               path, csv.row_lines[r]);
-            goto cleanup;
-        }
-        d->c_foreign[r] = csv_value(&csv, r, c_f);
-        d->c_self[r] = csv_value(&csv, r, c_s);
-        d->self_texp[r] = csv_value(&csv, r, c_x);
-    }
-cleanup:
-    csv_fini(&csv);
-    return st;
-}
 
 /* Catmull-Rom spline through the table at wavenumber nu (am interpolates the product
  * with the radiation term instead: docs/atmosphere.md gives the difference); NaN
@@ -357,8 +293,7 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
 {
     enum { PATH = 4096 };
     char p_h2o[PATH], p_o2[PATH], p_o2c[PATH], p_qh2o[PATH], p_qo2[PATH], p_cont[PATH] = "";
-    raw_catalog h2o = {0}, o2 = {0}, o2c = {0};
-    partition_sums q_h2o = {0}, q_o2 = {0};
+    const atm_inputs *in = NULL;
     atm_lines_data *d = thz_calloc(1, sizeof *d);
     if (!d)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
@@ -384,26 +319,28 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
                      "atmosphere/mt_ckd_4.2_h2o_continuum_0-520cm-1.csv", err);
     /* Regular files of bounded size only: the readers grow their buffers line by line, and
      * /dev/zero or a FIFO would grow them, or block, without end. */
-    const char *const inputs[] = {p_h2o, p_o2, p_o2c, p_qh2o, p_qo2, p_cont};
-    for (size_t i = 0; st == THZ_OK && i < sizeof inputs / sizeof inputs[0]; i++)
-        if (i < 5 || d->continuum)
+    const char *const inputs[ATM_IN_FILES] = {p_h2o, p_o2, p_o2c, p_qh2o, p_qo2, p_cont};
+    for (size_t i = 0; st == THZ_OK && i < ATM_IN_FILES; i++)
+        if (inputs[i][0] != '\0')
             st = file_check_regular(inputs[i], NULL, ATM_CATALOG_MAX_FILE_BYTES, NULL, err);
     if (st == THZ_OK)
-        st = atm_catalog_read(p_h2o, 1, &h2o, err);
-    if (st == THZ_OK)
-        st = atm_catalog_read(p_o2, 7, &o2, err);
-    if (st == THZ_OK)
-        st = atm_catalog_read_csv(p_o2c, true, &o2c, err);
-    if (st == THZ_OK)
-        st = atm_partition_sums_read(p_qh2o, &q_h2o, err);
-    if (st == THZ_OK)
-        st = atm_partition_sums_read(p_qo2, &q_o2, err);
-    if (st == THZ_OK && d->continuum)
-        st = read_continuum(d, p_cont, err);
+        st = atm_inputs_acquire(inputs, &in, err);
+    if (st == THZ_OK && d->continuum) { /* d keeps its own copy of the small table */
+        d->n_cont = in->n_cont;
+        d->cont_step_cm1 = in->cont_step_cm1;
+        d->c_foreign = thz_malloc_array(d->n_cont, sizeof *d->c_foreign);
+        d->c_self = thz_malloc_array(d->n_cont, sizeof *d->c_self);
+        d->self_texp = thz_malloc_array(d->n_cont, sizeof *d->self_texp);
+        if (!d->c_foreign || !d->c_self || !d->self_texp)
+            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory reading %s", p_cont);
+        else {
+            memcpy(d->c_foreign, in->c_foreign, d->n_cont * sizeof *d->c_foreign);
+            memcpy(d->c_self, in->c_self, d->n_cont * sizeof *d->c_self);
+            memcpy(d->self_texp, in->self_texp, d->n_cont * sizeof *d->self_texp);
+        }
+    }
     if (st != THZ_OK)
         goto cleanup;
-    if (atm_catalog_is_par(p_o2))
-        drop_coupled_duplicates(&o2, &o2c);
 
     double t = air->temperature_k, p = air->pressure_hpa, e = air->h2o_pressure_hpa;
     d->dry_hpa = p - e;
@@ -413,20 +350,17 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
     d->n_ref = MT_CKD_P_REF_HPA / (BOLTZMANN_HPA_CM3 * MT_CKD_T_REF_K);
     double po2_hpa = O2_DRY_AIR_VMR * (p - e);
     double n_o2 = po2_hpa / (BOLTZMANN_HPA_CM3 * t);
-    st = species_build(&d->h2o, &h2o, &q_h2o, 1, d->continuum ? SHAPE_VVH_CUTOFF : SHAPE_VVH, air,
-                       e, d->n_h2o, "H2O", p_h2o, p_qh2o, err);
+    st =
+        species_build(&d->h2o, &in->h2o, &in->q_h2o, 1, d->continuum ? SHAPE_VVH_CUTOFF : SHAPE_VVH,
+                      air, e, d->n_h2o, "H2O", p_h2o, p_qh2o, err);
     if (st == THZ_OK)
-        st = species_build(&d->o2, &o2, &q_o2, 7, SHAPE_GROSS, air, po2_hpa, n_o2, "O2", p_o2,
-                           p_qo2, err);
+        st = species_build(&d->o2, &in->o2, &in->q_o2, 7, SHAPE_GROSS, air, po2_hpa, n_o2, "O2",
+                           p_o2, p_qo2, err);
     if (st == THZ_OK)
-        st = species_build(&d->o2_coupled, &o2c, &q_o2, 7, SHAPE_COUPLED, air, po2_hpa, n_o2,
-                           "O2 coupled", p_o2c, p_qo2, err);
+        st = species_build(&d->o2_coupled, &in->o2_coupled, &in->q_o2, 7, SHAPE_COUPLED, air,
+                           po2_hpa, n_o2, "O2 coupled", p_o2c, p_qo2, err);
 cleanup:
-    free(h2o.lines);
-    free(o2.lines);
-    free(o2c.lines);
-    free(q_h2o.q);
-    free(q_o2.q);
+    atm_inputs_release(in);
     if (st != THZ_OK) {
         atm_lines_destroy(d);
         return st;
