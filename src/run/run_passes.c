@@ -42,6 +42,13 @@ typedef struct run_channel_label {
     char text[160];
 } run_channel_label;
 
+/* The scene key that sets the estimates a pass gives each pixel. */
+static const char *run_estimates_key(const thz_scene *scene)
+{
+    return scene->render.integrator == INTEGRATOR_FINAL_GATHER ? "render.gather_rays"
+                                                               : "render.paths_per_sample";
+}
+
 static run_channel_label run_channel_name(const run_state *rs, size_t c)
 {
     run_channel_label l;
@@ -140,7 +147,10 @@ thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, th
         rs->passes[c] = pass + 1;
         if (!(target > 0.0))
             break;
-        if (run_channel_p95_stderr_k(rs, c) <= target)
+        /* one estimate a pixel (paths_per_sample or gather_rays 1, one pass) has no
+         * spread yet: its standard error of 0 K is not a target met (a run of one path a
+         * sample stopped there, at "0 K", after one pass) */
+        if (acc[0].n >= 2 && run_channel_p95_stderr_k(rs, c) <= target)
             break;
         if (pass + 1 >= RUN_FLOOR_PASSES && run_at_map_floor(rs, c, acc, target, &st, err))
             break;
@@ -161,6 +171,12 @@ thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, th
             break;
         }
     }
+    if (st == THZ_OK && c == 0 && rs->n_selected > 0 && !acc[0].poisson && acc[0].n < 2)
+        st = run_add_warning(rs, err,
+                             "one estimate per pixel (%s 1, one pass): the standard errors "
+                             "cannot be estimated and are reported as 0 K; give %s of 2 or "
+                             "more, or a noise target",
+                             run_estimates_key(rs->scene), run_estimates_key(rs->scene));
     if (st == THZ_OK && team)
         st = team->channel_end(team->impl, err);
     render_context_destroy(ctx);
