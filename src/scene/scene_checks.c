@@ -280,8 +280,9 @@ static bool check_frequencies(thz_scene *s)
 {
     size_t outside = 0, first = 0;
     for (size_t c = 0; c < s->n_channels; c++) {
-        double thz = s->channels[c].center_hz * 1e-12;
-        if (thz < SCENE_CHECK_MIN_THZ || thz > SCENE_CHECK_MAX_THZ) {
+        /* in Hz, as the loader made it: hz * 1e-12 puts 0.05 THz just below 0.05 */
+        double hz = s->channels[c].center_hz;
+        if (hz < SCENE_CHECK_MIN_THZ * 1e12 || hz > SCENE_CHECK_MAX_THZ * 1e12) {
             if (outside++ == 0)
                 first = c;
         }

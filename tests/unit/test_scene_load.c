@@ -518,6 +518,35 @@ static void test_atmosphere_extent_warnings(void **state)
     assert_int_equal(extent_warnings(all, "sensor"), 0);
 }
 
+/* How many of the scene's warnings say that a channel lies outside the frequencies the
+ * models are meant for, with one channel at `thz`. */
+static size_t frequency_warnings(const char *thz)
+{
+    char json[1024];
+    snprintf(json, sizeof json,
+             HEAD
+             "\"channels\": [{\"frequency_thz\": %s, \"relative_width\": 0.01}], " MATERIALS OBJECT(
+                 BOX) SENSORS "}",
+             thz);
+    thz_scene *s = load_ok(json);
+    size_t n = 0;
+    for (size_t i = 0; i < s->n_warnings; i++)
+        n += strstr(s->warnings[i], "the range thzmap's models are meant for") != NULL;
+    thz_scene_destroy(s);
+    return n;
+}
+
+/* The range's ends, 0.05 and 10 THz, are inside it (0.05 THz was warned about as outside
+ * 0.05 to 10 THz: its centre in Hz times 1e-12 rounds to 0.049999...). */
+static void test_frequency_range_ends(void **state)
+{
+    (void)state;
+    assert_int_equal(frequency_warnings("0.05"), 0);
+    assert_int_equal(frequency_warnings("10"), 0);
+    assert_int_equal(frequency_warnings("0.0499"), 1);
+    assert_int_equal(frequency_warnings("10.01"), 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -535,6 +564,7 @@ int main(void)
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_atmosphere_extent_warnings),
         cmocka_unit_test(test_sensor_vectors_of_any_scale),
+        cmocka_unit_test(test_frequency_range_ends),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
