@@ -5,6 +5,7 @@
 #include <fftw3.h>
 #include <math.h>
 #include <omp.h>
+#include <stdbool.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -86,6 +87,35 @@ static thz_status psf_profile_init(psf_profile *p, const thz_sensor *sn, const t
     return THZ_OK;
 }
 
+/* Offset d folded into [-n, n] modulo 2n (the mirror border's period), as up to two
+ * offsets and their shares of the weight: -n and n read the same pixels, and each takes
+ * half, so that the kernel stays symmetric. */
+static int psf_fold(long long d, uint32_t n, long long out[2])
+{
+    long long p = 2 * (long long)n, m = ((d + n) % p + p) % p - n; /* in [-n, n - 1] */
+    out[0] = m;
+    if (m != -(long long)n)
+        return 1;
+    out[1] = n;
+    return 2;
+}
+
+/* Adds w at kernel offset (dx, dy), folded onto the image's period where fold is set. */
+static void psf_kernel_add(psf_kernel *k, bool fold, uint32_t columns, uint32_t rows, long long dx,
+                           long long dy, double w)
+{
+    long long h = k->half, side = 2 * h + 1;
+    if (!fold) {
+        k->weight[(dy + h) * side + dx + h] += w;
+        return;
+    }
+    long long xs[2], ys[2];
+    int nx = psf_fold(dx, columns, xs), ny = psf_fold(dy, rows, ys);
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++)
+            k->weight[(ys[j] + h) * side + xs[i] + h] += w / (nx * ny);
+}
+
 thz_status psf_kernel_init(psf_kernel *k, const thz_sensor *sn, const thz_channel *ch,
                            thz_error *err)
 {
@@ -115,37 +145,56 @@ thz_status psf_kernel_init(psf_kernel *k, const thz_sensor *sn, const thz_channe
         k->weight[0] = 1.0;
         return THZ_OK;
     }
-    /* no wider than the image: beyond, the mirror border repeats the image anyway */
-    double max_half = (double)(sn->columns > sn->rows ? sn->columns : sn->rows);
-    k->half = (uint32_t)fmin(ceil(radius_rad / k->pitch_rad), max_half);
-    k->subsamples =
-        (uint32_t)fmin(fmax(ceil(8.0 * k->pitch_rad / fwhm_rad), 1.0), (double)PSF_MAX_SUBSAMPLES);
-    /* the table reaches the far corner of the outermost kernel pixel */
-    double reach = fmin(radius_rad, ((double)k->half + 1.0) * k->pitch_rad * M_SQRT2);
+    /* A kernel wider than the image is folded: the mirror border repeats the image with a
+     * period of 2 columns x 2 rows, so a tap dx reads what dx +- 2 columns reads, and the
+     * weights of the whole support are summed onto offsets within the image's size. (It
+     * was cut there and renormalised: a 30 deg PSF on a 20 deg field put an edge pixel of
+     * a 300/400 K step 5.3 K off.) */
+    double full = ceil(radius_rad / k->pitch_rad);
+    uint32_t max_half = sn->columns > sn->rows ? sn->columns : sn->rows;
+    bool fold = full > (double)max_half;
+    /* with oversampling, the image is already the mean over each pixel: the PSF is then
+     * taken at the kernel pixels' centres, not averaged over their cells again (that
+     * counted the pixel twice: a step through a pixel's middle, a PSF of one pixel's FWHM,
+     * oversampling 8, lit its neighbours with 0.059 of the step against 0.025) */
+    uint32_t n =
+        sn->oversampling > 1
+            ? 1
+            : (uint32_t)fmin(fmax(ceil(8.0 * k->pitch_rad / fwhm_rad), 1.0), PSF_MAX_SUBSAMPLES);
+    if (fold && (2.0 * full + 1.0) * (2.0 * full + 1.0) * n * n > PSF_FOLD_MAX_SAMPLES)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "sensor '%s': its PSF reaches %.0f pixels from the centre, against "
+                             "an image of %u x %u pixels: too much wider than the field of view "
+                             "to be computed; widen the field of view or narrow the PSF",
+                             sn->name, full, sn->columns, sn->rows);
+    k->half = fold ? max_half : (uint32_t)full;
+    k->subsamples = n;
+    long long reach_half = fold ? (long long)full : (long long)k->half;
+    /* the table reaches the far corner of the outermost pixel summed */
+    double reach = fmin(radius_rad, ((double)reach_half + 1.0) * k->pitch_rad * M_SQRT2);
     psf_profile prof;
     st = psf_profile_init(&prof, sn, ch, reach, err);
     if (st != THZ_OK)
         return st;
     size_t side = 2 * (size_t)k->half + 1;
-    k->weight = thz_malloc_array(side * side, sizeof *k->weight);
+    k->weight = thz_calloc(side * side, sizeof *k->weight);
     if (!k->weight) {
         free(prof.value);
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for a PSF kernel of %zu x %zu",
                              side, side);
     }
-    uint32_t n = k->subsamples;
     double total = 0.0;
-    for (size_t y = 0; y < side; y++) {
-        for (size_t x = 0; x < side; x++) {
-            double dx = (double)x - (double)k->half, dy = (double)y - (double)k->half, sum = 0.0;
+    for (long long dy = -reach_half; dy <= reach_half; dy++) {
+        for (long long dx = -reach_half; dx <= reach_half; dx++) {
+            double sum = 0.0;
             for (uint32_t j = 0; j < n; j++) {
-                double oy = (dy + ((double)j + 0.5) / n - 0.5) * k->pitch_rad;
+                double oy = ((double)dy + ((double)j + 0.5) / n - 0.5) * k->pitch_rad;
                 for (uint32_t i = 0; i < n; i++) {
-                    double ox = (dx + ((double)i + 0.5) / n - 0.5) * k->pitch_rad;
+                    double ox = ((double)dx + ((double)i + 0.5) / n - 0.5) * k->pitch_rad;
                     sum += psf_profile_at(&prof, sqrt(ox * ox + oy * oy));
                 }
             }
-            k->weight[y * side + x] = sum;
+            psf_kernel_add(k, fold, sn->columns, sn->rows, dx, dy, sum);
             total += sum;
         }
     }

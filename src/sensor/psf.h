@@ -20,7 +20,11 @@
  * mean of P_c over its cell, sampled at n x n points (n chosen so that the sub-sample
  * spacing is at most an eighth of the PSF's FWHM, 1 <= n <= PSF_MAX_SUBSAMPLES): the
  * sharp image is taken as pixel-centre samples and each detector pixel integrates the
- * PSF over its cell. The kernel is normalised to sum exactly to 1. A PSF whose support
+ * PSF over its cell. With oversampling > 1 the sharp image is already each pixel's mean,
+ * and n = 1: P_c at the kernel pixels' centres (the cell counted once). The kernel is
+ * normalised to sum exactly to 1. A PSF wider than the image is folded onto offsets
+ * within the image's size (the mirror border's period, below); one whose fold would
+ * take more than PSF_FOLD_MAX_SAMPLES samples is refused. A PSF whose support
  * lies within the central pixel (radius <= half the pitch: a large aperture or a tiny
  * FWHM) is the one-pixel kernel 1 exactly: no blur.
  *
@@ -49,6 +53,9 @@
 #define PSF_AIRY_SUPPORT 25.0
 /* Most sub-samples per pixel side. */
 #define PSF_MAX_SUBSAMPLES 16u
+/* Most PSF samples a kernel folded onto the image (wider than it) may take: a PSF
+ * reaching 4 096 pixels from the centre. */
+#define PSF_FOLD_MAX_SAMPLES ((double)(1u << 26))
 /* Kernels with more taps than this are applied by FFT. */
 #define PSF_DIRECT_MAX_TAPS 441u
 

@@ -259,6 +259,93 @@ static void test_gaussian_direct(void **state)
     free(in);
 }
 
+/* A sensor of columns x rows with an angular pixel pitch of pitch_rad and a Gaussian PSF
+ * of fwhm_px pixels. */
+static thz_sensor gauss_sensor(uint32_t columns, uint32_t rows, double pitch_rad, double fwhm_px)
+{
+    thz_sensor s = test_sensor(pitch_rad, 0.0);
+    s.columns = columns;
+    s.rows = rows;
+    s.fov_deg = 2.0 * atan(tan(pitch_rad / 2.0) * columns) * 180.0 / M_PI;
+    s.psf = PSF_GAUSSIAN;
+    s.psf_fwhm_deg = fwhm_px * pitch_rad * 180.0 / M_PI;
+    return s;
+}
+
+static size_t mirror(long long i, long long n)
+{
+    long long m = ((i % (2 * n)) + 2 * n) % (2 * n);
+    return (size_t)(m < n ? m : 2 * n - 1 - m);
+}
+
+/* A PSF far wider than the image (FWHM twice its width: support 96 pixels, image 12 x 9)
+ * is the whole PSF on the mirror-extended image, against a convolution summed over the
+ * whole support (the Gaussian at the pixels' centres, as the kernel samples it at this
+ * width): it was cut at the image's size and renormalised, 1e-2 off at the edges. */
+static void test_wider_than_the_image(void **state)
+{
+    (void)state;
+    const thz_channel ch = {.name = "a", .center_hz = 0.35e12, .relative_width = 0.01};
+    enum { W = 12, H = 9 };
+    const double pitch = 2e-3, fwhm_px = 2.0 * W;
+    thz_sensor s = gauss_sensor(W, H, pitch, fwhm_px);
+    float in[W * H], out[W * H];
+    for (int i = 0; i < W * H; i++) /* a step and a slope: no symmetry to hide behind */
+        in[i] = (float)((i % W >= 7 ? 1.0 : 0.0) + 0.01 * (i / W));
+    psf_kernel k;
+    thz_error err;
+    assert_int_equal(psf_kernel_init(&k, &s, &ch, &err), THZ_OK);
+    assert_int_equal(k.subsamples, 1);
+    assert_int_equal(psf_apply(&k, in, out, W, H, 1, &err), THZ_OK);
+    psf_kernel_fini(&k);
+    const double sigma = fwhm_px / 2.3548200450309493, radius = 4.0 * fwhm_px;
+    const long long f = (long long)ceil(radius);
+    double worst = 0.0;
+    for (long long r = 0; r < H; r++) {
+        for (long long c = 0; c < W; c++) {
+            double num = 0.0, den = 0.0;
+            for (long long dy = -f; dy <= f; dy++) {
+                for (long long dx = -f; dx <= f; dx++) {
+                    double d = sqrt((double)(dx * dx + dy * dy));
+                    double w = d <= radius ? exp(-0.5 * d * d / (sigma * sigma)) : 0.0;
+                    num += w * in[mirror(r - dy, H) * W + mirror(c - dx, W)];
+                    den += w;
+                }
+            }
+            worst = fmax(worst, fabs(out[r * W + c] - num / den));
+        }
+    }
+    if (worst > 1e-5)
+        fail_msg("wider than the image: %.3g off the whole PSF on the mirrored image", worst);
+}
+
+/* With oversampling the image is already each pixel's mean: a step through the middle of
+ * the central column (0, 0.5, 1) under a PSF of one pixel's FWHM lights its left
+ * neighbour with 0.0249 of the step (a pixel integrating the blurred scene:
+ * int_{-1.5}^{-0.5} Phi(x / sigma) dx); the PSF taken at the kernel pixels' centres gives
+ * 0.0278, and averaged over their cells again, as before, 0.0593. */
+static void test_oversampled_pixel_counted_once(void **state)
+{
+    (void)state;
+    const thz_channel ch = {.name = "a", .center_hz = 0.35e12, .relative_width = 0.01};
+    enum { W = 15, H = 7 };
+    thz_sensor s = gauss_sensor(W, H, 1e-3, 1.0);
+    s.oversampling = 8;
+    float in[W * H], out[W * H];
+    for (int i = 0; i < W * H; i++)
+        in[i] = i % W < W / 2 ? 0.0f : i % W == W / 2 ? 0.5f : 1.0f;
+    psf_kernel k;
+    thz_error err;
+    assert_int_equal(psf_kernel_init(&k, &s, &ch, &err), THZ_OK);
+    assert_int_equal(psf_apply(&k, in, out, W, H, 1, &err), THZ_OK);
+    psf_kernel_fini(&k);
+    double left = out[3 * W + W / 2 - 1], right = out[3 * W + W / 2 + 1];
+    if (fabs(left - 0.0249) > 0.005 || fabs(right - (1.0 - 0.0249)) > 0.005)
+        fail_msg("neighbours of the step's pixel: %.4f and %.4f, a pixel integrating the "
+                 "blurred scene 0.0249 and 0.9751",
+                 left, right);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -266,6 +353,8 @@ int main(void)
         cmocka_unit_test(test_airy_narrow),
         cmocka_unit_test(test_gaussian_direct),
         cmocka_unit_test(test_narrower_than_a_pixel),
+        cmocka_unit_test(test_wider_than_the_image),
+        cmocka_unit_test(test_oversampled_pixel_counted_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
