@@ -94,7 +94,8 @@ static thz_status seq_walk(seq_build *b, char *where, size_t where_size, const c
     if (depth == SEQ_MAX_DEPTH)
         return seq_fail(b, where, "%s", "nested too deeply");
     /* the block's name even when it names nothing ("cameras": {} is a typo, not a no-op) */
-    if (depth == 1 || (depth == 2 && (!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors")))) {
+    if (depth == 1 || (depth == 2 && (!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors") ||
+                                      !strcmp(seg[0], "materials")))) {
         thz_status st = seq_check_path(b, where, seg, depth, 0);
         if (st != THZ_OK)
             return st;

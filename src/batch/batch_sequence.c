@@ -111,6 +111,14 @@ thz_status seq_check_path(const seq_build *b, const char *where, const char *con
                  !strcmp(seg[0], "objects") ? "object" : "sensor", seg[1]);
         return seq_fail(b, where, "%s", what);
     }
+    /* materials by name as the scene has them: a misspelt name made a new material that
+     * no object uses, and the keyframe or sweep value changed nothing, silently */
+    if (!strcmp(seg[0], "materials") && depth >= 2 &&
+        !json_object_get(json_object_get(b->scene, "materials"), seg[1])) {
+        char what[300];
+        snprintf(what, sizeof what, "%s has no material named \"%s\"", b->scene_name, seg[1]);
+        return seq_fail(b, where, "%s", what);
+    }
     if (leaf && depth < (!strcmp(seg[0], "objects") || !strcmp(seg[0], "sensors") ? 3u : 2u))
         return seq_fail(b, where, "%s",
                         "expected a path to a value, e.g. objects.NAME.temperature_k");

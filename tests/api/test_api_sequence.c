@@ -198,6 +198,26 @@ int main(int argc, char **argv)
     thz_context_destroy(ctx);
     thz_sequence_destroy(seq);
 
+    /* a material the scene lacks, misspelt in a keyframe or a sweep: refused with its
+     * path (it made a new material that no object uses: the value changed nothing) */
+    static const char *const misspelt[][2] = {
+        {"{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"fps\": 2,\n"
+         " \"keyframes\": [{\"time_s\": 0, \"materials\": {\"wal\": {\"reflectivity\": 0.5}}}]}\n",
+         "keyframes[0].materials.wal: the scene has no material named \"wal\""},
+        {"{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\",\n"
+         " \"sweep\": {\"materials.wal.reflectivity\": [0.1, 0.5]}}\n",
+         "sweep.materials.wal.reflectivity: the scene has no material named \"wal\""}};
+    for (size_t i = 0; i < sizeof misspelt / sizeof misspelt[0]; i++) {
+        snprintf(path, sizeof path, "%s/misspelt-%zu.json", dir, i);
+        test_write_file(path, misspelt[i][0]);
+        thz_sequence *m = NULL;
+        thz_error merr = {0};
+        CHECK(thz_sequence_load(path, &m, &merr) == THZ_ERR_INPUT && m == NULL &&
+                  strstr(merr.message, misspelt[i][1]),
+              "misspelt material %zu: status %d '%s'", i, (int)merr.status, merr.message);
+        thz_sequence_destroy(m);
+    }
+
     /* sweep directories sort in order: sweep-00 .. sweep-99, sweep-000 .. sweep-100 (the
      * batch writes where these say: test_batch.sh) */
     sweep_dirs(dir, 100, "sweep-00/frame-00000", "sweep-99/frame-00000");
