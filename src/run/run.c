@@ -523,6 +523,11 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, const run_
     if (st == THZ_OK && in) {
         if (in->stats)
             memcpy(rs->stats, in->stats, scene->n_channels * sizeof *rs->stats);
+        /* a render fires no photons: summary.json's photon_phase_s is 0, as for a map
+         * read from a file (maps kept in memory carried the time of the run that fired
+         * them: a batch frame rendered from its base frame's photons showed the base's) */
+        for (size_t c = 0; c < scene->n_channels; c++)
+            rs->stats[c].seconds = 0.0;
         rs->seed = in->seed;
         rs->photons_per_channel = in->photons_per_channel;
     }
