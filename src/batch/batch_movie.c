@@ -7,6 +7,7 @@
  * change them): else none, and batch.json and a warning say why; the same for the
  * movies of a sensor too large for the encoder (16384 pixels a side with libx264).
  */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,15 +24,20 @@ thz_status batch_read_band(const char *path, uint32_t columns, uint32_t rows, si
                            size_t channel, float *out, thz_error *err)
 {
     size_t n = (size_t)columns * rows;
+    /* a finished frame's file gone or cut short (the frame counts as finished by its
+     * frame.json alone): the reason, and how to have the frame computed again */
+    static const char again[] = "remove the frame's directory and run the batch again to "
+                                "compute the frame anew";
     FILE *f = fopen(path, "rb");
     if (!f)
-        return thz_error_set(err, THZ_ERR_IO, "%s: cannot open (a frame's cube)", path);
+        return thz_error_set(err, THZ_ERR_IO, "%s: cannot open (a frame's cube): %s; %s", path,
+                             strerror(errno), again);
     int ok = channel < channels && fseek(f, (long)(channel * n * sizeof(float)), SEEK_SET) == 0 &&
              fread(out, sizeof(float), n, f) == n;
     fclose(f);
     if (!ok)
-        return thz_error_set(err, THZ_ERR_IO, "%s: shorter than %u x %u x %zu floats", path,
-                             columns, rows, channels);
+        return thz_error_set(err, THZ_ERR_IO, "%s: shorter than %u x %u x %zu floats; %s", path,
+                             columns, rows, channels, again);
     /* ENVI byte order 0 (little-endian): swap on a big-endian host */
     const uint16_t probe = 1;
     if (*(const unsigned char *)&probe == 0)
