@@ -6,6 +6,7 @@
  * (batch_sequence_build.h).
  */
 #include <jansson.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -175,6 +176,17 @@ int seq_apply_tracks(const seq_build *b, double time_s, json_t *doc)
             thz_interp_rotation(tr->t, tr->v, tr->k, time_s, x);
         else
             thz_interp_linear(tr->t, tr->v, tr->k, tr->n, time_s, x);
+        /* keyframes of whole numbers (a seed, a count): an interpolated value within the
+         * interpolation's rounding of a whole number is that number (1 to 7 over seven
+         * frames gave 4.999999999999999, refused as no whole number) */
+        if (tr->all_integers && !tr->rotation) {
+            double vmax = 1.0;
+            for (size_t j = 0; j < tr->k * tr->n; j++)
+                vmax = fmax(vmax, fabs(tr->v[j]));
+            for (size_t m = 0; m < tr->n; m++)
+                if (fabs(x[m] - nearbyint(x[m])) <= 4.0 * DBL_EPSILON * vmax)
+                    x[m] = nearbyint(x[m]);
+        }
         json_t *v = tr->is_array ? json_array() : NULL;
         for (size_t m = 0; m < tr->n; m++) {
             json_t *num = tr->all_integers && fabs(x[m]) < 9.0e15 && x[m] == floor(x[m])
