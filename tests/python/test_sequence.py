@@ -37,6 +37,20 @@ def test_frames_are_the_keyframes_interpolated():
         seq.frame(5)
 
 
+def test_whole_number_keyframes_stay_whole(tmp_path):
+    """A seed keyed from 1 to 7 over seven frames is 1, 2, ..., 7: 1 + (7 - 1) 4/6 came out
+    4.999999999999999 and the frame was refused as no whole number (scene-format.md
+    gives this as the way to draw a sensor's noise afresh in each frame)."""
+    shutil.copy(os.path.join(BATCH, "scene.json"), tmp_path / "scene.json")
+    seq = {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 7,
+           "keyframes": [{"time_s": 0, "sensors": {"cam": {"noise_seed": 1}}},
+                         {"time_s": 6, "sensors": {"cam": {"noise_seed": 7}}}]}
+    (tmp_path / "seq.json").write_text(json.dumps(seq))
+    s = thzmap.load_sequence(str(tmp_path / "seq.json"))
+    seeds = [s.frame_dict(i)["sensors"][0]["noise_seed"] for i in range(7)]
+    assert seeds == [1, 2, 3, 4, 5, 6, 7] and all(type(x) is int for x in seeds), seeds
+
+
 def _tree(outdir):
     """Every file under outdir (the lock aside) with its bytes; batch.json and the
     frames' summary.json without their timings."""
@@ -154,7 +168,10 @@ def test_batch_warnings_name_their_frame_once(tmp_path):
     background = [t for t in texts if "background_temperature_k is given" in t]
     outside = [t for t in texts if "is outside the enclosure" in t]
     back_side = [t for t in texts if "saw the back side" in t]
-    assert len(texts) == 6 and len(background) == len(outside) == len(back_side) == 2, texts
+    # and one path a sample: its standard errors not estimated (once per sweep value)
+    one_path = [t for t in texts if "one estimate per pixel" in t]
+    assert len(texts) == 8 and len(background) == len(outside) == len(back_side) == 2, texts
+    assert len(one_path) == 2, texts
     assert background[0].startswith(
         "sweep-00/frame-00000: atmosphere.background_temperature_k")
     assert background[1].startswith("the same in 1 later frame: atmosphere.background")
