@@ -27,27 +27,87 @@ static void batch_hex(uint64_t h, char hex[17])
 /* A frame.json is a few kilobytes; anything far larger is not one. */
 #define BATCH_FRAME_JSON_MAX ((uint64_t)64 << 20)
 
+/* The frame whose photons a finished frame's files were rendered from, numbered as this
+ * sequence numbers frames: doc's photons_reused_from_frame, which the run that made it
+ * numbered by its own frames per sweep value (doc's frame, sweep and index tell them),
+ * moved to the number the same frame directory has now. -1 for null (it fired its own
+ * photons, or fired none); -2 when that directory is no frame of this sequence or doc
+ * does not say. */
+static long batch_kept_base(const thz_sequence *seq, const json_t *doc)
+{
+    const json_t *from = json_object_get(doc, "photons_reused_from_frame");
+    if (json_is_null(from))
+        return -1;
+    json_int_t b = json_integer_value(from), f = json_integer_value(json_object_get(doc, "frame")),
+               s = json_integer_value(json_object_get(doc, "sweep")),
+               i = json_integer_value(json_object_get(doc, "index"));
+    /* (a sequence has at most 100 000 frames: larger numbers are no frame's) */
+    if (!json_is_integer(from) || b < 0 || b > f || f > 1000000 || i < 0 || s < 0 || f - i < 0)
+        return -2;
+    /* the frames per sweep value it was run with; without a sweep value before this one's,
+     * the base (at most this frame) is in the first and keeps its number */
+    json_int_t per = s > 0 ? (f - i) / s : f + 1;
+    if (per <= 0 || (s > 0 && (f - i) % s != 0))
+        return -2;
+    json_int_t bs = b / per, bi = b % per;
+    if ((size_t)bs >= seq->n_sweeps || (size_t)bi >= seq->frames)
+        return -2;
+    return (long)((size_t)bs * seq->frames + (size_t)bi);
+}
+
+/* Frame f's frame.json as read from its directory into path (NULL when there is none or it
+ * is no regular file of reasonable size); *text its bytes (malloc'd) when text is not
+ * NULL. */
+static json_t *batch_frame_json_read(const batch_state *b, size_t f, char path[THZ_PATH_MAX],
+                                     char **text)
+{
+    if (text)
+        *text = NULL;
+    if (snprintf(path, THZ_PATH_MAX, "%s/%s/frame.json", b->outdir, b->seq->frame_dir[f]) >=
+        THZ_PATH_MAX)
+        return NULL;
+    /* a FIFO or device there would block or never end (core/file.h) */
+    thz_error ignored;
+    uint64_t size = 0;
+    if (file_check_regular(path, path, BATCH_FRAME_JSON_MAX, &size, &ignored) != THZ_OK)
+        return NULL;
+    if (!text)
+        return json_load_file(path, 0, NULL);
+    FILE *in = fopen(path, "rb");
+    char *buf = in ? malloc((size_t)size + 1) : NULL;
+    size_t n = buf ? fread(buf, 1, (size_t)size + 1, in) : 0;
+    if (in)
+        fclose(in);
+    json_t *doc = NULL;
+    if (buf && n <= (size_t)size) {
+        buf[n] = '\0';
+        doc = json_loadb(buf, n, 0, NULL);
+    }
+    if (doc)
+        *text = buf;
+    else
+        free(buf);
+    return doc;
+}
+
 int batch_frame_done(const batch_state *b, size_t f)
 {
     char path[THZ_PATH_MAX], hex[17];
-    if (snprintf(path, sizeof path, "%s/%s/frame.json", b->outdir, b->seq->frame_dir[f]) >=
-        (int)sizeof path)
-        return 0;
-    /* a FIFO or device there would block or never end (core/file.h) */
-    thz_error ignored;
-    if (file_check_regular(path, path, BATCH_FRAME_JSON_MAX, NULL, &ignored) != THZ_OK)
-        return 0;
-    json_t *doc = json_load_file(path, 0, NULL);
+    json_t *doc = batch_frame_json_read(b, f, path, NULL);
     batch_hex(b->seq->hash[f], hex);
     const char *h = json_string_value(json_object_get(doc, "input_hash"));
-    int done = h && !strcmp(h, hex);
+    /* rendered from another frame's photons: that frame must still be its base (the first
+     * of the frames before it that differ from it only in their sensors), else it is run
+     * again: its photons_reused_from_frame would name a frame that no longer fires them */
+    long kept = h && !strcmp(h, hex) ? batch_kept_base(b->seq, doc) : -2;
     json_decref(doc);
-    return done;
+    return kept == -1 || (kept >= 0 && (size_t)kept == b->base[f]);
 }
 
-/* Writes text to outdir/name through a temporary file and a rename. */
+/* Writes text (and a newline when newline) to outdir/name through a temporary file,
+ * outdir/.name.part, and a rename: a kill at any instant leaves the old file or the new. */
 static thz_status batch_write_atomic(const char *outdir, const char *name, const char *text,
-                                     thz_error *err)
+                                     bool newline, thz_error *err)
 {
     char path[THZ_PATH_MAX], tmp[THZ_PATH_MAX];
     if (snprintf(path, sizeof path, "%s/%s", outdir, name) >= (int)sizeof path ||
@@ -59,7 +119,7 @@ static thz_status batch_write_atomic(const char *outdir, const char *name, const
     size_t n = strlen(text);
     int why = 0; /* the first failure's errno: a full disk says so */
     errno = 0;
-    if (fwrite(text, 1, n, f) != n || fputc('\n', f) == EOF || fflush(f) != 0 ||
+    if (fwrite(text, 1, n, f) != n || (newline && fputc('\n', f) == EOF) || fflush(f) != 0 ||
         fsync(fileno(f)) != 0)
         why = errno ? errno : EIO;
     if (fclose(f) != 0 && !why)
@@ -176,7 +236,7 @@ thz_status batch_write_json(batch_state *b, thz_error *err)
     json_decref(root);
     if (!text)
         return thz_error_set(err, THZ_ERR_NOMEM, "batch.json: out of memory");
-    thz_status st = batch_write_atomic(b->outdir, "batch.json", text, err);
+    thz_status st = batch_write_atomic(b->outdir, "batch.json", text, true, err);
     free(text);
     b->json_at_s = batch_now_s();
     b->json_cost_s = b->json_at_s - t_start;
@@ -217,4 +277,28 @@ char *batch_frame_json(const thz_sequence *seq, size_t f, long reused_from)
     char *text = thz_json_dumps_raw(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
     json_decref(root);
     return text;
+}
+
+thz_status batch_frame_refresh(const batch_state *b, size_t f, thz_error *err)
+{
+    char path[THZ_PATH_MAX], dir[THZ_PATH_MAX], part[THZ_PATH_MAX];
+    if (snprintf(dir, sizeof dir, "%s/%s", b->outdir, b->seq->frame_dir[f]) >= (int)sizeof dir ||
+        snprintf(part, sizeof part, "%s/.frame.json.part", dir) >= (int)sizeof part)
+        return thz_error_set(err, THZ_ERR_IO, "%s: path too long", b->outdir);
+    unlink(part); /* a refresh killed before its rename left it */
+    char *old = NULL;
+    json_t *doc = batch_frame_json_read(b, f, path, &old);
+    long kept = batch_kept_base(b->seq, doc);
+    json_decref(doc);
+    if (!old || kept == -2) { /* (gone or changed since: the next batch runs it again) */
+        free(old);
+        return THZ_OK;
+    }
+    char *text = batch_frame_json(b->seq, f, kept);
+    thz_status st = text ? THZ_OK : thz_error_set(err, THZ_ERR_NOMEM, "%s: out of memory", path);
+    if (st == THZ_OK && strcmp(old, text) != 0)
+        st = batch_write_atomic(dir, "frame.json", text, false, err);
+    free(text);
+    free(old);
+    return st;
 }

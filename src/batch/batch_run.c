@@ -269,6 +269,11 @@ thz_status thz_batch_run(thz_context *ctx, const thz_sequence *seq, const char *
         st = batch_check_memory(&b, err);
     if (st == THZ_OK && b.reused > 0)
         batch_clean_finished(&b);
+    /* a kept frame's frame.json says what this sequence's would (its time at a changed
+     * fps, its number at a changed frames per sweep value), as batch.json does */
+    for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++)
+        if (b.state[f] == FRAME_REUSED)
+            st = batch_frame_refresh(&b, f, err);
     /* a sensor too large for the movie encoder: said before the frames run */
     bool movies = !(opt && opt->no_movies);
     if (st == THZ_OK && movies && seq->movies_unmade) {

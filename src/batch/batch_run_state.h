@@ -48,7 +48,8 @@ double batch_now_s(void);
 
 /* ---- batch_json.c: batch.json and frame.json ---- */
 
-/* Whether frame f's directory holds a finished frame with the same inputs. */
+/* Whether frame f's directory holds a finished frame with the same inputs, and, when it
+ * was rendered from another frame's photons, that frame is still its base (b->base). */
 int batch_frame_done(const batch_state *b, size_t f);
 /* Writes OUTDIR/batch.json (a temporary file, then a rename) from b. */
 thz_status batch_write_json(batch_state *b, thz_error *err);
@@ -58,6 +59,13 @@ thz_status batch_write_json(batch_state *b, thz_error *err);
  * last frame and after one that failed or was cancelled. The frame directories, not
  * batch.json, tell a later batch what is done. */
 bool batch_json_due(const batch_state *b, size_t f, thz_status st);
+/* Rewrites a finished frame's frame.json (a temporary file, then a rename) where it says
+ * other than this sequence's frame.json for it would: its number, time and sweep value
+ * as this sequence has them (a changed fps or frames per sweep value keeps the frames
+ * whose scenes did not change); photons_reused_from_frame stays how its files were made,
+ * numbered as this sequence numbers frames (batch_frame_done kept it only when that is
+ * its base). */
+thz_status batch_frame_refresh(const batch_state *b, size_t f, thz_error *err);
 /* frame.json: which frame this directory is and the hash of its inputs (and the scene
  * it was run with, to rerun it by hand). No timings: it is the same in every run. */
 char *batch_frame_json(const thz_sequence *seq, size_t f, long reused_from);

@@ -11,7 +11,9 @@
 #    with SIGKILL after more, and run again, redoes no finished frame (frame.json's
 #    inode and time unchanged; batch.json's counts) and ends with every file identical
 #    to an uninterrupted run's (summary.json and batch.json aside: timings);
-#  - a changed keyframe redoes exactly the frames it changes;
+#  - a changed keyframe redoes exactly the frames it changes; a changed fps, frames per
+#    sweep value or base frame leaves OUTDIR as a fresh run of the new sequence leaves it
+#    (a kept frame's frame.json: its time, its number, its photons' frame);
 #  - a sensor-only sequence (the camera moving, photon-map integrator, 3 frames) fires
 #    photons once (batch.json, frame.json) and its frames equal, bit for bit, `thzmap
 #    render` of each frame's scene from the map `simulate --save-photon-map` fires for
@@ -345,6 +347,77 @@ import json, sys
 b = json.load(open(sys.argv[1]))
 assert b["complete"] and b["photon_phases_fired"] <= 1, b
 PY
+
+# --- a kept frame says what a fresh run of the changed sequence says ----------------
+# A changed sequence keeps the frames whose scenes did not change, and their frame.json
+# must then be what a fresh run writes (it kept its time at the old fps and its number
+# at the old frames per sweep value): OUTDIR after the change equals a fresh run's of
+# the new sequence, every file (summary.json's timings and batch.json's record of which
+# run computed which frame aside), with no temporary file left. Three changes: the fps
+# (2 to 1.9: frames 0, 2, 3, 4 hold keyframe values and are kept); the frames per sweep
+# value (2 to 3: sweep-01/frame-00001, rendered from sweep-01/frame-00000's photons, is
+# renumbered 3 to 4 and its base 2 to 3); a changed base frame (frame 0 warmer, 1 and 2
+# as before: they were rendered from frame 0's photons, a fresh run fires them for
+# frame 1, so both are run again).
+# same_outdir KEPT FRESH LABEL NREUSED
+same_outdir() {
+    "$PY" - "$1" "$2" "$4" <<'PY' || fail "$3: the changed sequence's OUTDIR is not a fresh run's"
+import json, os, sys
+kept, fresh, nreused = sys.argv[1], sys.argv[2], int(sys.argv[3])
+def untimed(v):  # summary.json without its timings (keys ending in _s)
+    if isinstance(v, dict):
+        return {k: untimed(x) for k, x in v.items() if not k.endswith("_s")}
+    return [untimed(x) for x in v] if isinstance(v, list) else v
+left = [n for _, _, ns in os.walk(kept) for n in ns if n.endswith(".part")]
+assert not left, left
+def files(d):
+    return sorted(os.path.relpath(os.path.join(r, n), d) for r, _, ns in os.walk(d)
+                  for n in ns if not n.startswith("."))
+assert files(kept) == files(fresh), (files(kept), files(fresh))
+bad = []
+for name in files(fresh):
+    a, b = (open(os.path.join(d, name), "rb").read() for d in (kept, fresh))
+    if name.endswith("summary.json"):
+        a, b = untimed(json.loads(a)), untimed(json.loads(b))
+    elif name == "batch.json":
+        a, b = json.loads(a), json.loads(b)
+        assert a["frames_reused"] == nreused, (a["frames_reused"], nreused)
+        assert all(f["computed"] == "this run" for f in b["frames"])
+        for x in (a, b):
+            for k in ("frames_computed", "frames_reused", "photon_phases_fired",
+                      "frames_rerendered", "timings_s"):
+                del x[k]
+            for f in x["frames"]:
+                for k in ("computed", "photons", "seconds"):
+                    f.pop(k, None)
+    if a != b:
+        bad.append(name)
+assert not bad, bad
+PY
+}
+sed 's/"fps": 4, "frames": 5/"fps": 2, "frames": 5/' "$seq" > "$work/fps2.json"
+sed 's/"fps": 4, "frames": 5/"fps": 1.9, "frames": 5/' "$seq" > "$work/fps19.json"
+"$PY" - "$work/pm-seq.json" "$work/pm-sweep2.json" "$work/pm-sweep3.json" "$work/pm-warm0.json" <<'PY'
+import json, sys
+q = json.load(open(sys.argv[1]))
+q["sweep"] = {"objects.person.temperature_k": [300, 310]}
+for n, name in ((2, sys.argv[2]), (3, sys.argv[3])):
+    q["frames"] = n
+    json.dump(q, open(name, "w"))
+q = json.load(open(sys.argv[1]))
+q["keyframes"][0]["objects"] = {"person": {"temperature_k": 301}}
+q["keyframes"].insert(1, {"time_s": 0.5, "objects": {"person": {"temperature_k": 300}}})
+json.dump(q, open(sys.argv[4], "w"))
+PY
+for change in "fps2 fps19 4" "pm-sweep2 pm-sweep3 4" "pm-seq pm-warm0 0"; do
+    set -- $change
+    rm -rf "$work/K" "$work/F"
+    "$THZMAP" batch "$work/$1.json" -o "$work/K" --threads 2 --quiet --no-movies > /dev/null 2>&1 &&
+        "$THZMAP" batch "$work/$2.json" -o "$work/K" --threads 2 --quiet --no-movies > /dev/null 2>&1 &&
+        "$THZMAP" batch "$work/$2.json" -o "$work/F" --threads 2 --quiet --no-movies > /dev/null 2>&1 ||
+        fail "$1 then $2: exit $?"
+    same_outdir "$work/K" "$work/F" "$1 then $2" "$3"
+done
 
 # --- a sensor moving into another enclosure: that frame fires its own photons --------
 # The air's temperature defaults to the enclosure around the sensors (scene-format.md),
