@@ -151,6 +151,19 @@ static json_t *batch_sweep_values(const thz_sequence *seq, size_t s)
     return raw;
 }
 
+/* A frame's time for batch.json, in the text frame.json gives it: jansson's at 17 digits
+ * (batch.json's 12 wrote 1.57894736842 where frame.json has 1.5789473684210527, and the
+ * two did not compare equal). NULL when out of memory. */
+static json_t *batch_time_json(double time_s)
+{
+    json_t *t = json_real(time_s);
+    char *text = t ? json_dumps(t, JSON_ENCODE_ANY | JSON_REAL_PRECISION(17)) : NULL;
+    json_t *raw = text ? thz_json_raw(text) : NULL;
+    free(text);
+    json_decref(t);
+    return raw;
+}
+
 thz_status batch_write_json(batch_state *b, thz_error *err)
 {
     double t_start = batch_now_s();
@@ -164,7 +177,7 @@ thz_status batch_write_json(batch_state *b, thz_error *err)
         json_object_set_new(e, "frame", json_integer((json_int_t)f));
         json_object_set_new(e, "sweep", json_integer((json_int_t)(f / seq->frames)));
         json_object_set_new(e, "index", json_integer((json_int_t)(f % seq->frames)));
-        json_object_set_new(e, "time_s", json_real((double)(f % seq->frames) / seq->fps));
+        json_object_set_new(e, "time_s", batch_time_json((double)(f % seq->frames) / seq->fps));
         json_object_set_new(e, "dir", thz_json_text(seq->frame_dir[f]));
         if (seq->scene_list)
             json_object_set_new(e, "scene",
@@ -231,7 +244,7 @@ thz_status batch_write_json(batch_state *b, thz_error *err)
                         b->movies_skipped[0] ? thz_json_text(b->movies_skipped) : json_null());
     json_object_set_new(root, "timings_s", t);
     /* 12 digits, as summary.json: its reals are times and statistics (17 printed float
-     * noise such as 293.0049133300781 K) */
+     * noise such as 293.0049133300781 K); the frames' time_s as frame.json writes it */
     char *text = thz_json_dumps_raw(root, JSON_INDENT(2) | JSON_REAL_PRECISION(12));
     json_decref(root);
     if (!text)

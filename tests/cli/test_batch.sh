@@ -353,12 +353,13 @@ PY
 # must then be what a fresh run writes (it kept its time at the old fps and its number
 # at the old frames per sweep value): OUTDIR after the change equals a fresh run's of
 # the new sequence, every file (summary.json's timings and batch.json's record of which
-# run computed which frame aside), with no temporary file left. Three changes: the fps
-# (2 to 1.9: frames 0, 2, 3, 4 hold keyframe values and are kept); the frames per sweep
-# value (2 to 3: sweep-01/frame-00001, rendered from sweep-01/frame-00000's photons, is
-# renumbered 3 to 4 and its base 2 to 3); a changed base frame (frame 0 warmer, 1 and 2
-# as before: they were rendered from frame 0's photons, a fresh run fires them for
-# frame 1, so both are run again).
+# run computed which frame aside; batch.json's time_s as frame.json's, 17 digits), with
+# no temporary file left. Three changes: the fps (2 to 1.9: frames 0, 2, 3, 4 hold
+# keyframe values and are kept); the frames per sweep value (2 to 3:
+# sweep-01/frame-00001, rendered from sweep-01/frame-00000's photons, is renumbered 3 to
+# 4 and its base 2 to 3); a changed base frame (frame 0 warmer, 1 and 2 as before: they
+# were rendered from frame 0's photons, a fresh run fires them for frame 1, so both are
+# run again).
 # same_outdir KEPT FRESH LABEL NREUSED
 same_outdir() {
     "$PY" - "$1" "$2" "$4" <<'PY' || fail "$3: the changed sequence's OUTDIR is not a fresh run's"
@@ -390,6 +391,10 @@ for name in files(fresh):
             for f in x["frames"]:
                 for k in ("computed", "photons", "seconds"):
                     f.pop(k, None)
+        # one time, one text: batch.json's time_s as frame.json's (17 digits, not 12)
+        times = [json.load(open(os.path.join(kept, f["dir"], "frame.json")))["time_s"]
+                 for f in a["frames"]]
+        assert [f["time_s"] for f in a["frames"]] == times, ([f["time_s"] for f in a["frames"]], times)
     if a != b:
         bad.append(name)
 assert not bad, bad
