@@ -42,13 +42,6 @@ typedef struct run_channel_label {
     char text[160];
 } run_channel_label;
 
-/* The scene key that sets the estimates a pass gives each pixel. */
-static const char *run_estimates_key(const thz_scene *scene)
-{
-    return scene->render.integrator == INTEGRATOR_FINAL_GATHER ? "render.gather_rays"
-                                                               : "render.paths_per_sample";
-}
-
 static run_channel_label run_channel_name(const run_state *rs, size_t c)
 {
     run_channel_label l;
@@ -171,12 +164,6 @@ thz_status run_render_channel(run_state *rs, size_t c, const photon_map *map, th
             break;
         }
     }
-    if (st == THZ_OK && c == 0 && rs->n_selected > 0 && !acc[0].poisson && acc[0].n < 2)
-        st = run_add_warning(rs, err,
-                             "one estimate per pixel (%s 1, one pass): the standard errors "
-                             "cannot be estimated and are reported as 0 K; give %s of 2 or "
-                             "more, or a noise target",
-                             run_estimates_key(rs->scene), run_estimates_key(rs->scene));
     if (st == THZ_OK && team)
         st = team->channel_end(team->impl, err);
     render_context_destroy(ctx);

@@ -168,10 +168,7 @@ def test_batch_warnings_name_their_frame_once(tmp_path):
     background = [t for t in texts if "background_temperature_k is given" in t]
     outside = [t for t in texts if "is outside the enclosure" in t]
     back_side = [t for t in texts if "saw the back side" in t]
-    # and one path a sample: its standard errors not estimated (once per sweep value)
-    one_path = [t for t in texts if "one estimate per pixel" in t]
-    assert len(texts) == 8 and len(background) == len(outside) == len(back_side) == 2, texts
-    assert len(one_path) == 2, texts
+    assert len(texts) == 6 and len(background) == len(outside) == len(back_side) == 2, texts
     assert background[0].startswith(
         "sweep-00/frame-00000: atmosphere.background_temperature_k")
     assert background[1].startswith("the same in 1 later frame: atmosphere.background")
