@@ -21,6 +21,7 @@
 #include "run/run_noise.h"
 #include "sensor/images.h"
 #include "sensor/measure.h"
+#include "sensor/psf.h"
 #include "sensor/render.h"
 #include "sensor/render_tiles.h"
 #include "sensor/truth.h"
@@ -343,7 +344,24 @@ static thz_status run_finish(run_state *rs, double t_start, thz_error *err)
     return THZ_OK;
 }
 
-/* The common start: integrator check, sensors, accel. */
+/* The rendered sensors' PSF kernels can be built (psf_kernel_check), before the work
+ * rather than at its outputs. */
+static thz_status run_check_psfs(const run_state *rs, thz_error *err)
+{
+    const thz_scene *sc = rs->scene;
+    for (size_t i = 0; i < rs->n_selected; i++) {
+        const thz_sensor *sn = &sc->sensors[rs->selected[i]];
+        for (size_t c = 0; sn->psf != PSF_NONE && c < sc->n_channels; c++) {
+            thz_error why = {0};
+            if (psf_kernel_check(sn, &sc->channels[c], &why) != THZ_OK)
+                return thz_error_set(err, why.status, "%s: sensors[%zu].psf: %s",
+                                     sc->path ? sc->path : "scene", rs->selected[i], why.message);
+        }
+    }
+    return THZ_OK;
+}
+
+/* The common start: integrator check, sensors, PSFs, accel. */
 static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_options *opt,
                             const char *command, thz_error *err)
 {
@@ -352,6 +370,8 @@ static thz_status run_begin(run_state *rs, const thz_scene *scene, const run_opt
         st = render_integrator_check(scene->render.integrator, err);
     if (st == THZ_OK)
         st = run_check_options(opt, err);
+    if (st == THZ_OK)
+        st = run_check_psfs(rs, err);
     if (st != THZ_OK)
         return st;
     double t0 = thz_now_s();

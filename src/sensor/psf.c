@@ -116,27 +116,79 @@ static void psf_kernel_add(psf_kernel *k, bool fold, uint32_t columns, uint32_t 
             k->weight[(ys[j] + h) * side + xs[i] + h] += w / (nx * ny);
 }
 
-thz_status psf_kernel_init(psf_kernel *k, const thz_sensor *sn, const thz_channel *ch,
-                           thz_error *err)
+/* A kernel's extent: the angular pitch, the PSF's FWHM and support, the support in
+ * pixels (full), the samples per kernel pixel side (n) and whether it is folded. */
+typedef struct psf_extent {
+    double pitch_rad, fwhm_rad, radius_rad, full;
+    uint32_t n, max_half;
+    bool within_pixel, fold;
+} psf_extent;
+
+static thz_status psf_extent_of(const thz_sensor *sn, const thz_channel *ch, psf_extent *e,
+                                thz_error *err)
 {
-    memset(k, 0, sizeof *k);
+    memset(e, 0, sizeof *e);
     camera cam;
     thz_status st = camera_init(&cam, sn, err);
     if (st != THZ_OK)
         return st;
-    k->pitch_rad = 2.0 * atan(0.5 * cam.pixel_pitch);
-    double fwhm_rad, radius_rad;
+    e->pitch_rad = 2.0 * atan(0.5 * cam.pixel_pitch);
     if (sn->psf == PSF_AIRY) {
         double lambda_over_d = THZ_SPEED_OF_LIGHT / ch->center_hz / sn->aperture_diameter_m;
-        fwhm_rad = PSF_AIRY_FWHM_X / M_PI * lambda_over_d;
-        radius_rad = PSF_AIRY_SUPPORT * lambda_over_d;
+        e->fwhm_rad = PSF_AIRY_FWHM_X / M_PI * lambda_over_d;
+        e->radius_rad = PSF_AIRY_SUPPORT * lambda_over_d;
     } else if (sn->psf == PSF_GAUSSIAN) {
-        fwhm_rad = sn->psf_fwhm_deg * M_PI / 180.0;
-        radius_rad = PSF_GAUSS_SUPPORT * fwhm_rad;
+        e->fwhm_rad = sn->psf_fwhm_deg * M_PI / 180.0;
+        e->radius_rad = PSF_GAUSS_SUPPORT * e->fwhm_rad;
     } else {
         return thz_error_set(err, THZ_ERR_INTERNAL, "psf: sensor '%s' has no PSF", sn->name);
     }
-    if (radius_rad <= 0.5 * k->pitch_rad) { /* the support lies in the pixel: no blur */
+    /* the support lies in the pixel: no blur */
+    e->within_pixel = e->radius_rad <= 0.5 * e->pitch_rad;
+    if (e->within_pixel)
+        return THZ_OK;
+    /* A kernel wider than the image is folded: the mirror border repeats the image with a
+     * period of 2 columns x 2 rows, so a tap dx reads what dx +- 2 columns reads, and the
+     * weights of the whole support are summed onto offsets within the image's size. (It
+     * was cut there and renormalised: a 30 deg PSF on a 20 deg field put an edge pixel of
+     * a 300/400 K step 5.3 K off.) */
+    e->full = ceil(e->radius_rad / e->pitch_rad);
+    e->max_half = sn->columns > sn->rows ? sn->columns : sn->rows;
+    e->fold = e->full > (double)e->max_half;
+    /* with oversampling, the image is already the mean over each pixel: the PSF is then
+     * taken at the kernel pixels' centres, not averaged over their cells again (that
+     * counted the pixel twice: a step through a pixel's middle, a PSF of one pixel's FWHM,
+     * oversampling 8, lit its neighbours with 0.059 of the step against 0.025) */
+    e->n = sn->oversampling > 1 ? 1
+                                : (uint32_t)fmin(fmax(ceil(8.0 * e->pitch_rad / e->fwhm_rad), 1.0),
+                                                 PSF_MAX_SUBSAMPLES);
+    double side = 2.0 * e->full + 1.0;
+    if (e->fold && side * side * e->n * e->n > PSF_FOLD_MAX_SAMPLES)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "sensor '%s': its PSF reaches %.0f pixels from the centre at %.4g "
+                             "THz, against an image of %u x %u pixels: too much wider than the "
+                             "field of view to be computed; widen the field of view or narrow "
+                             "the PSF",
+                             sn->name, e->full, ch->center_hz * 1e-12, sn->columns, sn->rows);
+    return THZ_OK;
+}
+
+thz_status psf_kernel_check(const thz_sensor *sn, const thz_channel *ch, thz_error *err)
+{
+    psf_extent e;
+    return psf_extent_of(sn, ch, &e, err);
+}
+
+thz_status psf_kernel_init(psf_kernel *k, const thz_sensor *sn, const thz_channel *ch,
+                           thz_error *err)
+{
+    memset(k, 0, sizeof *k);
+    psf_extent e;
+    thz_status st = psf_extent_of(sn, ch, &e, err);
+    if (st != THZ_OK)
+        return st;
+    k->pitch_rad = e.pitch_rad;
+    if (e.within_pixel) {
         k->weight = thz_malloc_array(1, sizeof *k->weight);
         if (!k->weight)
             return thz_error_set(err, THZ_ERR_NOMEM, "out of memory for a PSF kernel");
@@ -145,31 +197,12 @@ thz_status psf_kernel_init(psf_kernel *k, const thz_sensor *sn, const thz_channe
         k->weight[0] = 1.0;
         return THZ_OK;
     }
-    /* A kernel wider than the image is folded: the mirror border repeats the image with a
-     * period of 2 columns x 2 rows, so a tap dx reads what dx +- 2 columns reads, and the
-     * weights of the whole support are summed onto offsets within the image's size. (It
-     * was cut there and renormalised: a 30 deg PSF on a 20 deg field put an edge pixel of
-     * a 300/400 K step 5.3 K off.) */
-    double full = ceil(radius_rad / k->pitch_rad);
-    uint32_t max_half = sn->columns > sn->rows ? sn->columns : sn->rows;
-    bool fold = full > (double)max_half;
-    /* with oversampling, the image is already the mean over each pixel: the PSF is then
-     * taken at the kernel pixels' centres, not averaged over their cells again (that
-     * counted the pixel twice: a step through a pixel's middle, a PSF of one pixel's FWHM,
-     * oversampling 8, lit its neighbours with 0.059 of the step against 0.025) */
-    uint32_t n =
-        sn->oversampling > 1
-            ? 1
-            : (uint32_t)fmin(fmax(ceil(8.0 * k->pitch_rad / fwhm_rad), 1.0), PSF_MAX_SUBSAMPLES);
-    if (fold && (2.0 * full + 1.0) * (2.0 * full + 1.0) * n * n > PSF_FOLD_MAX_SAMPLES)
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "sensor '%s': its PSF reaches %.0f pixels from the centre, against "
-                             "an image of %u x %u pixels: too much wider than the field of view "
-                             "to be computed; widen the field of view or narrow the PSF",
-                             sn->name, full, sn->columns, sn->rows);
-    k->half = fold ? max_half : (uint32_t)full;
+    bool fold = e.fold;
+    uint32_t n = e.n;
+    double radius_rad = e.radius_rad;
+    k->half = fold ? e.max_half : (uint32_t)e.full;
     k->subsamples = n;
-    long long reach_half = fold ? (long long)full : (long long)k->half;
+    long long reach_half = fold ? (long long)e.full : (long long)k->half;
     /* the table reaches the far corner of the outermost pixel summed */
     double reach = fmin(radius_rad, ((double)reach_half + 1.0) * k->pitch_rad * M_SQRT2);
     psf_profile prof;

@@ -74,6 +74,9 @@ double psf_airy(double theta_rad, double freq_hz, double diameter_m);
 thz_status psf_kernel_init(psf_kernel *k, const thz_sensor *sn, const thz_channel *ch,
                            thz_error *err);
 void psf_kernel_fini(psf_kernel *k);
+/* THZ_OK if psf_kernel_init can build sn's kernel in channel ch, else its refusal (a PSF
+ * too much wider than the image): the run asks before its work. */
+thz_status psf_kernel_check(const thz_sensor *sn, const thz_channel *ch, thz_error *err);
 
 /* out = k convolved with in (one plane of columns x rows, row-major), with the mirror
  * border above; in and out must not overlap. */

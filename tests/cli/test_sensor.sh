@@ -15,7 +15,8 @@
 #    matches the band-averaged Airy pattern, FWHM within 3 % of it, summed power within
 #    0.5 % of the sharp image's;
 #  - summary.json names the model, validate prints NETD and spot size with units, and a
-#    bad noise block is refused with its JSON path (exit 2).
+#    bad noise block is refused with its JSON path (exit 2), as is, before the work, a PSF
+#    too much wider than the image to fold onto it.
 # argv: path to the thzmap binary, repository directory.
 . "$(dirname "$0")/lib.sh"
 run() { # $1: what, rest: thzmap arguments
@@ -172,5 +173,20 @@ rc=$?
 grep -q "$work/huge.json: sensors\[2\].noise (sensor 'netd'), channel 2: the noise takes the measured image beyond" "$work/huge.log" ||
     { fail "netd_k 1e300 K: no message naming the file, sensor and channel"; cat "$work/huge.log"; }
 [ ! -e "$work/huge" ] || fail "netd_k 1e300 K: OUTDIR written"
+# a PSF too much wider than the image to fold onto it: refused before the work (no
+# estimate, no render), exit 2, the sensor's JSON path, nothing written
+python3 - "$work/furnace.json" "$work/wide.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["sensors"][0].update({"psf": "gaussian", "psf_fwhm_deg": 120, "fov_deg": 0.01})
+json.dump(s, open(sys.argv[2], "w"))
+PY
+"$THZMAP" simulate "$work/wide.json" -o "$work/wide" > "$work/wide.log" 2>&1
+rc=$?
+[ $rc -eq 2 ] || fail "a 120 deg PSF on a 0.01 deg field: exit $rc, expected 2"
+grep -q "$work/wide.json: sensors\[0\].psf: sensor '[^']*': its PSF reaches [0-9]* pixels from the centre" "$work/wide.log" ||
+    { fail "a 120 deg PSF on a 0.01 deg field: no message naming sensors[0].psf"; cat "$work/wide.log"; }
+grep -q "estimate:" "$work/wide.log" && fail "a 120 deg PSF on a 0.01 deg field: refused only after the estimate"
+[ ! -e "$work/wide" ] || fail "a 120 deg PSF on a 0.01 deg field: OUTDIR written"
 
 finish "PASS"

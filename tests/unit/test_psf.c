@@ -346,6 +346,26 @@ static void test_oversampled_pixel_counted_once(void **state)
                  left, right);
 }
 
+/* A PSF whose fold would take more than PSF_FOLD_MAX_SAMPLES samples (a 120 deg FWHM on
+ * a field of 0.01 deg) is refused, by the check the run makes before its work and by the
+ * kernel; the 12 x 9 image under a PSF twice its width is not. */
+static void test_fold_too_large_refused(void **state)
+{
+    (void)state;
+    const thz_channel ch = {.name = "a", .center_hz = 0.35e12, .relative_width = 0.01};
+    thz_sensor s = gauss_sensor(64, 48, 0.01 / 64 * M_PI / 180.0, 0.0);
+    s.psf_fwhm_deg = 120.0;
+    thz_error err = {0};
+    assert_int_equal(psf_kernel_check(&s, &ch, &err), THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "sensor 'cam': its PSF reaches"));
+    assert_non_null(strstr(err.message, "against an image of 64 x 48 pixels"));
+    psf_kernel k;
+    assert_int_equal(psf_kernel_init(&k, &s, &ch, &err), THZ_ERR_INPUT);
+    assert_null(k.weight);
+    thz_sensor ok = gauss_sensor(12, 9, 2e-3, 24.0);
+    assert_int_equal(psf_kernel_check(&ok, &ch, &err), THZ_OK);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -355,6 +375,7 @@ int main(void)
         cmocka_unit_test(test_narrower_than_a_pixel),
         cmocka_unit_test(test_wider_than_the_image),
         cmocka_unit_test(test_oversampled_pixel_counted_once),
+        cmocka_unit_test(test_fold_too_large_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
