@@ -60,7 +60,8 @@ THZ_API thz_status thz_classify_cube(const thz_cube *cube, const thz_cube *truth
                                      thz_error *err);
 /* The same on a run directory (what `thzmap simulate` wrote): sensor S's
  * S.measured_brightness_temperature when there is one, else S.brightness_temperature,
- * against S.object_id. */
+ * against S.object_id. A sensor the run lacks (neither cube there): THZ_ERR_INPUT,
+ * naming the sensors the run has (by its *.brightness_temperature.hdr files). */
 THZ_API thz_status thz_classify_run(const char *run_dir, const char *sensor,
                                     const thz_classify_options *opt, thz_classification **out,
                                     thz_error *err);

@@ -1,5 +1,7 @@
 /* The public API of cubes read from disk and of classification (thzmap/analysis.h):
  * handles over io/envi_read.c and analysis/classify.c. */
+#include <dirent.h>
+#include <errno.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -333,6 +335,93 @@ static thz_status run_stem(char *buf, size_t size, const char *sensor, const cha
     return THZ_OK;
 }
 
+static int compare_names(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+/* A sensor the run in RUN_DIR does not have (neither S.measured_brightness_temperature.hdr
+ * nor S.brightness_temperature.hdr there) was said as the cube file that cannot be opened,
+ * leaving the user to guess the sensors' names: refused naming the sensors the run has, by
+ * its *.brightness_temperature.hdr files. THZ_OK when the cube is there or RUN_DIR cannot
+ * be listed (its reads then say what is wrong). `cube` is S.brightness_temperature
+ * without ".hdr", `measured` S.measured_brightness_temperature.hdr. */
+static thz_status check_run_sensor(const char *run_dir, const char *sensor, const char *cube,
+                                   const char *measured, thz_error *err)
+{
+    char path[THZ_PATH_MAX], cube_hdr[THZ_PATH_MAX];
+    struct stat st;
+    if (snprintf(cube_hdr, sizeof cube_hdr, "%s.hdr", cube) >= (int)sizeof cube_hdr)
+        return THZ_OK;
+    const char *names[2] = {cube_hdr, measured};
+    for (int i = 0; i < 2; i++)
+        if (thz_path_join(path, sizeof path, run_dir, names[i], NULL) != THZ_OK ||
+            stat(path, &st) == 0 || errno != ENOENT)
+            return THZ_OK;
+    DIR *dir = opendir(run_dir);
+    if (!dir)
+        return THZ_OK;
+    static const char suffix[] = ".brightness_temperature.hdr";
+    const size_t ns = sizeof suffix - 1;
+    char **found = NULL;
+    size_t n = 0, cap = 0;
+    thz_status status = THZ_OK;
+    for (struct dirent *e; (e = readdir(dir));) {
+        size_t len = strlen(e->d_name);
+        if (len <= ns || strcmp(e->d_name + len - ns, suffix) != 0)
+            continue;
+        char **grown = n < cap ? found : thz_grow_array(found, &cap, 8, sizeof *found);
+        if (!grown) {
+            status = THZ_ERR_NOMEM;
+            break;
+        }
+        found = grown;
+        found[n] = malloc(len - ns + 1);
+        if (!found[n]) {
+            status = THZ_ERR_NOMEM;
+            break;
+        }
+        memcpy(found[n], e->d_name, len - ns);
+        found[n++][len - ns] = '\0';
+    }
+    closedir(dir);
+    if (status == THZ_OK) {
+        if (n > 1) /* found is NULL for none */
+            qsort(found, n, sizeof *found, compare_names);
+        /* whole names, as many as leave the message room for its paths (err holds 1024
+         * bytes), then how many more */
+        char list[400] = "", more[48] = "";
+        size_t used = 0, listed = 0;
+        for (; listed < n; listed++) {
+            int w = snprintf(list + used, sizeof list - used, "%s\"%s\"", listed ? ", " : "",
+                             found[listed]);
+            if (w < 0 || (size_t)w >= sizeof list - used) {
+                list[used] = '\0';
+                break;
+            }
+            used += (size_t)w;
+        }
+        if (listed < n)
+            snprintf(more, sizeof more, "%s%zu more", listed ? " and " : "", n - listed);
+        if (n == 0)
+            status = thz_error_set(err, THZ_ERR_INPUT,
+                                   "%s: the run there has no sensor \"%s\", nor any other (no "
+                                   "*.brightness_temperature.hdr: not a directory thzmap "
+                                   "simulate wrote?)",
+                                   run_dir, sensor);
+        else
+            status = thz_error_set(err, THZ_ERR_INPUT,
+                                   "%s: the run there has no sensor \"%s\"; its sensor%s: %s%s",
+                                   run_dir, sensor, n == 1 ? "" : "s", list, more);
+    } else {
+        status = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    }
+    for (size_t i = 0; i < n; i++)
+        free(found[i]);
+    free(found);
+    return status;
+}
+
 thz_status thz_classify_run(const char *run_dir, const char *sensor,
                             const thz_classify_options *opt, thz_classification **out,
                             thz_error *err)
@@ -351,6 +440,8 @@ thz_status thz_classify_run(const char *run_dir, const char *sensor,
         st = run_stem(truth_stem, sizeof truth_stem, sensor, "object_id", err);
     if (st == THZ_OK)
         st = run_stem(name, sizeof name, sensor, "brightness_temperature", err);
+    if (st == THZ_OK)
+        st = check_run_sensor(run_dir, sensor, name, stem, err);
     if (st != THZ_OK)
         return st;
     /* RUN_DIR is read a file at a time: a run that committed its results there meanwhile

@@ -120,7 +120,19 @@ expect2() {
 }
 expect2 "no sensor" "$work/run" -o "$work/x"
 expect2 "unknown sensor" "$work/run" --sensor nope -o "$work/x"
-grep -q "nope.brightness_temperature" "$work/err" || fail "missing cube not named: $(cat "$work/err")"
+# said as a sensor the run lacks, naming the ones it has (was: nope.brightness_temperature.hdr
+# cannot be opened); a directory without any sensor's cube says so
+grep -q "^thzmap: $work/run: the run there has no sensor \"nope\"; its sensor: \"cam\"$" "$work/err" ||
+    fail "unknown sensor: $(cat "$work/err")"
+mkdir "$work/no-sensors"
+expect2 "a directory of no run" "$work/no-sensors" --sensor cam -o "$work/x"
+grep -q "no-sensors: the run there has no sensor \"cam\", nor any other" "$work/err" ||
+    fail "a directory of no run: $(cat "$work/err")"
+# sensors too many for one message: whole names, then how many more
+for k in $(seq 100 159); do : > "$work/no-sensors/sensor_with_a_long_name_$k.brightness_temperature.hdr"; done
+expect2 "sixty sensors" "$work/no-sensors" --sensor cam -o "$work/x"
+grep -q 'its sensors: "sensor_with_a_long_name_100", .*"sensor_with_a_long_name_1[0-9][0-9]" and [1-9][0-9]* more$' \
+    "$work/err" || fail "sixty sensors: $(cat "$work/err")"
 expect2 "unknown method" "$work/run" --sensor cam -o "$work/x" --method svm
 expect2 "seed beyond 2^63 - 1 (classification.json could not record it)" "$work/run" \
     --sensor cam -o "$work/x" --seed 9223372036854775808

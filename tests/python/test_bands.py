@@ -280,7 +280,9 @@ def test_classify_errors(distinct_run, tmp_path):
             thzmap.classify(run_dir, "cam", **kwargs)
     with pytest.raises(thzmap.ArgumentError):
         thzmap.classify(run_dir, "")
-    with pytest.raises(thzmap.Error):
+    # a sensor the run lacks: said so, with the sensors it has (was: the cube file that
+    # could not be opened, nope.brightness_temperature.hdr)
+    with pytest.raises(thzmap.Error, match='the run there has no sensor "nope"; its sensor: "cam"'):
         thzmap.classify(run_dir, "nope")
     with pytest.raises(thzmap.Error):
         thzmap.classify(tmp_path / "missing", "cam")
