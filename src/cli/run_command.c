@@ -226,6 +226,11 @@ static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_ru
     else if (st == THZ_OK)
         st = render ? thz_render_run(ctx, scene, NULL, sensor, &a->settings, run, err)
                     : thz_simulate(ctx, scene, &a->settings, run, err);
+    /* the library's memory refusal names the scene key; simulate also has --photons */
+    if (st == THZ_ERR_LIMIT && !render && strstr(err->message, "; lower photons.per_channel (")) {
+        size_t len = strlen(err->message);
+        snprintf(err->message + len, sizeof err->message - len, " (or --photons)");
+    }
     if (st == THZ_OK)
         st = thz_output_add_run(ctx, output, *run, &a->write, err);
     if (st == THZ_OK)

@@ -51,7 +51,8 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
         char most[64] = "";
         if (fit > 0)
             snprintf(most, sizeof most, "; at most about %llu fit", (unsigned long long)fit);
-        snprintf(key, sizeof key, "photons.per_channel (now %llu%s; or --photons)",
+        /* the scene key only: batch and Python have no --photons (simulate adds it) */
+        snprintf(key, sizeof key, "photons.per_channel (now %llu%s)",
                  (unsigned long long)scene->photons.per_channel, most);
     } else {
         size_t big = 0;

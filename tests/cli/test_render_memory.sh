@@ -64,11 +64,14 @@ fits() { # PHOTONS: prints the count the refusal names, or nothing if the run wa
     done
     wait $pid
     echo "exit $?" >> "$work/big.err"
-    sed -n 's/.*; at most about \([0-9]*\) fit;.*/\1/p' "$work/big.err"
+    sed -n 's/.*; at most about \([0-9]*\) fit[;)].*/\1/p' "$work/big.err"
 }
 n=$(fits 1e9)
 grep -q 'would need' "$work/big.err" || { echo "FAIL: 1e9 photons not refused: $(cat "$work/big.err")"; exit 1; }
 grep -q 'exit 2$' "$work/big.err" || { echo "FAIL: the refusal's exit status: $(cat "$work/big.err")"; exit 1; }
+# the library names the scene key; simulate, which has the option, adds it
+grep -q '; lower photons.per_channel (now 1000000000; at most about [0-9]* fit) (or --photons)$' \
+    "$work/big.err" || { echo "FAIL: the refusal's remedy: $(cat "$work/big.err")"; exit 1; }
 if [[ ! $n =~ ^[1-9][0-9]*$ ]] || (( n >= 1000000000 )); then
     echo "FAIL: the refusal names no count that fits: $(cat "$work/big.err")"
     exit 1

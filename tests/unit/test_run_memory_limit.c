@@ -112,6 +112,29 @@ static void test_images_of_several_sensors(void **state)
     assert_non_null(strstr(two, "number of sensors"));
 }
 
+/* The photon maps not fitting: the scene key to lower, with the count that fits, and no
+ * CLI option (it said "or --photons", which neither batch nor Python has; simulate adds
+ * it to the message itself). */
+static void test_photons_refusal_names_the_scene_key(void **state)
+{
+    (void)state;
+    thz_scene *s = load_large(false);
+    s->photons.per_channel = 1000000000;
+    run_memory need = {.photon_bytes = (uint64_t)64 << 30,
+                       .image_bytes = (uint64_t)1 << 20,
+                       .held_bytes = (uint64_t)20 << 20};
+    need.total_bytes = need.photon_bytes + need.image_bytes + need.held_bytes;
+    need.available_bytes = (uint64_t)4 << 30;
+    thz_error err;
+    thz_error_clear(&err);
+    assert_int_equal(run_check_memory(s, &need, &err), THZ_ERR_LIMIT);
+    assert_non_null(strstr(err.message, "; lower photons.per_channel (now 1000000000; at most "
+                                        "about "));
+    assert_true(err.message[strlen(err.message) - 1] == ')');
+    assert_null(strstr(err.message, "--photons"));
+    scene_destroy(s);
+}
+
 static void test_passes_limit_under_address_space_limit(void **state)
 {
     (void)state;
@@ -133,6 +156,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_refusal_under_address_space_limit),
         cmocka_unit_test(test_images_of_several_sensors),
+        cmocka_unit_test(test_photons_refusal_names_the_scene_key),
         cmocka_unit_test(test_passes_limit_under_address_space_limit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
