@@ -99,8 +99,20 @@ thz_status load_sensor_model(load_ctx *ctx, const load_cursor *c, size_t n_chann
         load_number(ctx, c, "aperture_diameter_m", diameter, false, 0.0, &sn->aperture_diameter_m);
     if (st != THZ_OK)
         return st;
+    double circle_m2 = M_PI * sn->aperture_diameter_m * sn->aperture_diameter_m / 4.0;
     if (sn->aperture_diameter_m > 0.0 && !json_object_get(c->value, "aperture_m2"))
-        sn->aperture_m2 = M_PI * sn->aperture_diameter_m * sn->aperture_diameter_m / 4.0;
+        sn->aperture_m2 = circle_m2;
+    /* an area no circular aperture of that diameter has: the power then collects through
+     * one aperture and the diffraction PSF spreads it as another (a relative 1e-9 over
+     * for a circle's area given in decimals) */
+    if (sn->aperture_diameter_m > 0.0 && sn->aperture_m2 > circle_m2 * (1.0 + 1e-9) &&
+        !scene_add_warning(ctx->scene,
+                           "%s.aperture_m2: %.6g m^2 is more than a circular aperture of "
+                           "aperture_diameter_m %.6g m can have (pi D^2 / 4 = %.6g m^2): the "
+                           "power is collected over the one and the diffraction PSF is that "
+                           "of the other; give one of them, or both of one aperture",
+                           c->path, sn->aperture_m2, sn->aperture_diameter_m, circle_m2))
+        return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
     size_t psf = sn->aperture_diameter_m > 0.0 ? PSF_AIRY : PSF_NONE;
     st = load_choice(ctx, c, "psf", psfs, false, psf, &psf);
     if (st != THZ_OK)

@@ -37,6 +37,11 @@ make_scene outside "s['sensors'][0]['position_m'] = [0, -3, 0]"
 make_scene inside "s['sensors'][0]['position_m'] = [0, 0.5, 0]"
 make_scene nonemitting "s['atmosphere']['emitting'] = False"
 make_scene background "s['atmosphere']['background_temperature_k'] = 3"
+# an aperture area no circle of the given diameter has (0.05 m^2 > pi 0.1^2 / 4)
+make_scene aperture "s['sensors'][0].update(aperture_m2=0.05, aperture_diameter_m=0.1)"
+# but not the circle's own area in decimals, nor less (an obstructed aperture)
+make_scene circle "s['sensors'][0].update(aperture_m2=0.007853981633974483, aperture_diameter_m=0.1)"
+make_scene obstructed "s['sensors'][0].update(aperture_m2=0.006, aperture_diameter_m=0.1)"
 # the whole scene 1000 km from the origin: single precision blurs it to 0.12 m
 make_scene far "
 for o in s['objects']:
@@ -55,6 +60,11 @@ check_warning outside 'sensor "cam" .* is outside the enclosure "room"'
 check_warning inside 'sensor "cam" .* is inside object "target"'
 check_warning nonemitting "breaks equilibrium"
 check_warning background "no ray leaves the scene"
+check_warning aperture 'sensors\[0\]\.aperture_m2: 0\.05 m^2 is more than a circular aperture of aperture_diameter_m 0\.1 m can have (pi D^2 / 4 = 0\.00785398 m^2)'
+for v in circle obstructed; do
+    "$THZMAP" validate "$work/$v.json" > /dev/null 2> "$work/$v.err" || fail "$v: $(cat "$work/$v.err")"
+    [ -s "$work/$v.err" ] && fail "$v aperture warns: $(cat "$work/$v.err")"
+done
 check_warning far 'the objects lie up to 1e+06 m from the origin, .* times the scene.s size .*single precision'
 # but not a 2 mm pellet in the room: small, yet among the objects around the origin
 make_scene pellet "s['objects'].append({'name': 'pellet', 'type': 'solid', 'material': 'metal', 'temperature_k': 300, 'shape': {'type': 'sphere', 'radius_m': 0.001}, 'transform': {'translate_m': [0.5, 0.5, 0.5]}})"
