@@ -197,4 +197,28 @@ JSON
 [[ $? -eq 2 ]] || fail "a sequence with a bad frame must exit 2: $(cat "$work/err")"
 expect_line "$work/err" 'bad\.json: keyframes\[1\]\.objects\.target\.temperature_k: .* \(the scene scene\.json.s objects\[1\]\.temperature_k, frame-00002, t = 2 s\)'
 
+# a Gaussian PSF's width at the objects' distance is 2 d tan(FWHM / 2) (60 deg at 1 m: 1.15 m;
+# distance x angle said 1.05 m), and none from 90 deg on (170 deg said 6.37 m at 2.147 m)
+psf_scene() { # $1: psf_fwhm_deg
+    cat > "$work/psf$1.json" <<JSON
+{"format": "thzmap-scene/1", "channels": [{"frequency_thz": 0.35, "relative_width": 0.02}],
+ "materials": {"wall": {"reflectivity": 0.1}},
+ "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+              "shape": {"type": "box", "size_m": [4, 4, 4], "inward": true}},
+             {"name": "target", "type": "solid", "material": "wall", "temperature_k": 300,
+              "shape": {"type": "box", "size_m": [0.2, 0.2, 0.2]},
+              "transform": {"translate_m": [0, 1, 0]}}],
+ "sensors": [{"name": "cam", "position_m": [0, 0, 0], "direction": [0, 1, 0], "fov_deg": 40,
+              "resolution": [4, 4], "psf": "gaussian", "psf_fwhm_deg": $1}]}
+JSON
+    "$THZMAP" validate "$work/psf$1.json" >"$work/psf$1.out" 2>"$work/err" ||
+        fail "psf_fwhm_deg $1: exit $?: $(cat "$work/err")"
+}
+psf_scene 60
+expect_line "$work/psf60.out" 'PSF FWHM 1047 mrad = 1\.15 m at 1 m, 1\.15 m at 1 m \(nearest and farthest object centre\)$'
+for deg in 90 170; do
+    psf_scene $deg
+    expect_line "$work/psf$deg.out" 'PSF FWHM [0-9]+ mrad$'
+done
+
 finish "validate: all checks passed"
