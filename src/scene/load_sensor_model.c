@@ -103,9 +103,9 @@ thz_status load_sensor_model(load_ctx *ctx, const load_cursor *c, size_t n_chann
     if (sn->aperture_diameter_m > 0.0 && !json_object_get(c->value, "aperture_m2"))
         sn->aperture_m2 = circle_m2;
     /* an area no circular aperture of that diameter has: the power then collects through
-     * one aperture and the diffraction PSF spreads it as another (a relative 1e-9 over
-     * for a circle's area given in decimals) */
-    if (sn->aperture_diameter_m > 0.0 && sn->aperture_m2 > circle_m2 * (1.0 + 1e-9) &&
+     * one aperture and the diffraction PSF spreads it as another (up to a thousandth over:
+     * the circle's area rounded up to four digits, 0.007854 for D = 0.1 m) */
+    if (sn->aperture_diameter_m > 0.0 && sn->aperture_m2 > circle_m2 * (1.0 + 1e-3) &&
         !scene_add_warning(ctx->scene,
                            "%s.aperture_m2: %.6g m^2 is more than a circular aperture of "
                            "aperture_diameter_m %.6g m can have (pi D^2 / 4 = %.6g m^2): the "

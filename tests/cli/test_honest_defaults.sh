@@ -39,8 +39,8 @@ make_scene nonemitting "s['atmosphere']['emitting'] = False"
 make_scene background "s['atmosphere']['background_temperature_k'] = 3"
 # an aperture area no circle of the given diameter has (0.05 m^2 > pi 0.1^2 / 4)
 make_scene aperture "s['sensors'][0].update(aperture_m2=0.05, aperture_diameter_m=0.1)"
-# but not the circle's own area in decimals, nor less (an obstructed aperture)
-make_scene circle "s['sensors'][0].update(aperture_m2=0.007853981633974483, aperture_diameter_m=0.1)"
+# but not the circle's own area rounded up to four digits, nor less (an obstructed aperture)
+make_scene circle "s['sensors'][0].update(aperture_m2=0.007854, aperture_diameter_m=0.1)"
 make_scene obstructed "s['sensors'][0].update(aperture_m2=0.006, aperture_diameter_m=0.1)"
 # the whole scene 1000 km from the origin: single precision blurs it to 0.12 m
 make_scene far "
