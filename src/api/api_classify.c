@@ -343,9 +343,9 @@ static int compare_names(const void *a, const void *b)
 /* A sensor the run in RUN_DIR does not have (neither S.measured_brightness_temperature.hdr
  * nor S.brightness_temperature.hdr there) was said as the cube file that cannot be opened,
  * leaving the user to guess the sensors' names: refused naming the sensors the run has, by
- * its *.brightness_temperature.hdr files. THZ_OK when the cube is there or RUN_DIR cannot
- * be listed (its reads then say what is wrong). `cube` is S.brightness_temperature
- * without ".hdr", `measured` S.measured_brightness_temperature.hdr. */
+ * its *.brightness_temperature.hdr files; a RUN_DIR that is not there, so. THZ_OK when the
+ * cube is there or RUN_DIR cannot be listed otherwise (its reads then say what is wrong). `cube` is
+ * S.brightness_temperature without ".hdr", `measured` S.measured_brightness_temperature.hdr. */
 static thz_status check_run_sensor(const char *run_dir, const char *sensor, const char *cube,
                                    const char *measured, thz_error *err)
 {
@@ -359,6 +359,9 @@ static thz_status check_run_sensor(const char *run_dir, const char *sensor, cons
             stat(path, &st) == 0 || errno != ENOENT)
             return THZ_OK;
     DIR *dir = opendir(run_dir);
+    if (!dir && (errno == ENOENT || errno == ENOTDIR)) /* it said the cube's file */
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: no run directory there (%s)", run_dir,
+                             strerror(errno));
     if (!dir)
         return THZ_OK;
     static const char suffix[] = ".brightness_temperature.hdr";

@@ -128,6 +128,10 @@ mkdir "$work/no-sensors"
 expect2 "a directory of no run" "$work/no-sensors" --sensor cam -o "$work/x"
 grep -q "no-sensors: the run there has no sensor \"cam\", nor any other" "$work/err" ||
     fail "a directory of no run: $(cat "$work/err")"
+# a run directory that is not there: said so (was: its cube file cannot be opened)
+expect2 "no directory" "$work/not-there" --sensor cam -o "$work/x"
+grep -q "^thzmap: $work/not-there: no run directory there (No such file or directory)$" "$work/err" ||
+    fail "no directory: $(cat "$work/err")"
 # sensors too many for one message: whole names, then how many more
 for k in $(seq 100 159); do : > "$work/no-sensors/sensor_with_a_long_name_$k.brightness_temperature.hdr"; done
 expect2 "sixty sensors" "$work/no-sensors" --sensor cam -o "$work/x"
