@@ -180,9 +180,10 @@ static double continuum_per_cm(const atm_lines_data *d, double f_ghz)
     double nu = f_ghz / ATM_GHZ_PER_CM1;
     double t = d->air.temperature_k;
     double rad = nu * tanh(ATM_HC_OVER_K_CM_K * nu / (2.0 * t));
-    double cs = catmull_rom(d->c_self, d->n_cont, d->cont_step_cm1, nu);
-    double cf = catmull_rom(d->c_foreign, d->n_cont, d->cont_step_cm1, nu);
-    double tx = catmull_rom(d->self_texp, d->n_cont, d->cont_step_cm1, nu);
+    const atm_inputs *in = d->inputs;
+    double cs = catmull_rom(in->c_self, in->n_cont, in->cont_step_cm1, nu);
+    double cf = catmull_rom(in->c_foreign, in->n_cont, in->cont_step_cm1, nu);
+    double tx = catmull_rom(in->self_texp, in->n_cont, in->cont_step_cm1, nu);
     return d->n_h2o * rad *
            (d->n_h2o / d->n_ref * pow(MT_CKD_T_REF_K / t, tx) * cs + d->n_foreign / d->n_ref * cf);
 }
@@ -293,7 +294,6 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
 {
     enum { PATH = 4096 };
     char p_h2o[PATH], p_o2[PATH], p_o2c[PATH], p_qh2o[PATH], p_qo2[PATH], p_cont[PATH] = "";
-    const atm_inputs *in = NULL;
     atm_lines_data *d = thz_calloc(1, sizeof *d);
     if (!d)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
@@ -324,21 +324,7 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
         if (inputs[i][0] != '\0')
             st = file_check_regular(inputs[i], NULL, ATM_CATALOG_MAX_FILE_BYTES, NULL, err);
     if (st == THZ_OK)
-        st = atm_inputs_acquire(inputs, &in, err);
-    if (st == THZ_OK && d->continuum) { /* d keeps its own copy of the small table */
-        d->n_cont = in->n_cont;
-        d->cont_step_cm1 = in->cont_step_cm1;
-        d->c_foreign = thz_malloc_array(d->n_cont, sizeof *d->c_foreign);
-        d->c_self = thz_malloc_array(d->n_cont, sizeof *d->c_self);
-        d->self_texp = thz_malloc_array(d->n_cont, sizeof *d->self_texp);
-        if (!d->c_foreign || !d->c_self || !d->self_texp)
-            st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory reading %s", p_cont);
-        else {
-            memcpy(d->c_foreign, in->c_foreign, d->n_cont * sizeof *d->c_foreign);
-            memcpy(d->c_self, in->c_self, d->n_cont * sizeof *d->c_self);
-            memcpy(d->self_texp, in->self_texp, d->n_cont * sizeof *d->self_texp);
-        }
-    }
+        st = atm_inputs_acquire(inputs, &d->inputs, err);
     if (st != THZ_OK)
         goto cleanup;
 
@@ -350,6 +336,7 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
     d->n_ref = MT_CKD_P_REF_HPA / (BOLTZMANN_HPA_CM3 * MT_CKD_T_REF_K);
     double po2_hpa = O2_DRY_AIR_VMR * (p - e);
     double n_o2 = po2_hpa / (BOLTZMANN_HPA_CM3 * t);
+    const atm_inputs *in = d->inputs;
     st =
         species_build(&d->h2o, &in->h2o, &in->q_h2o, 1, d->continuum ? SHAPE_VVH_CUTOFF : SHAPE_VVH,
                       air, e, d->n_h2o, "H2O", p_h2o, p_qh2o, err);
@@ -360,7 +347,6 @@ thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
         st = species_build(&d->o2_coupled, &in->o2_coupled, &in->q_o2, 7, SHAPE_COUPLED, air,
                            po2_hpa, n_o2, "O2 coupled", p_o2c, p_qo2, err);
 cleanup:
-    atm_inputs_release(in);
     if (st != THZ_OK) {
         atm_lines_destroy(d);
         return st;
@@ -376,8 +362,6 @@ void atm_lines_destroy(atm_lines_data *d)
     free(d->h2o.lines);
     free(d->o2.lines);
     free(d->o2_coupled.lines);
-    free(d->c_foreign);
-    free(d->c_self);
-    free(d->self_texp);
+    atm_inputs_release(d->inputs);
     free(d);
 }

@@ -40,11 +40,9 @@ struct atm_lines_data {
     double half_h_over_kt; /* h / (2 k T) in 1/GHz */
     lbl_species h2o, o2, o2_coupled;
     bool continuum;
-    /* MT_CKD on a uniform grid from 0 in steps of cont_step_cm1 */
-    size_t n_cont;
-    double cont_step_cm1;
-    double *c_foreign, *c_self, *self_texp;
-    double n_h2o, n_foreign, n_ref; /* cm^-3 */
+    const struct atm_inputs *inputs; /* the files read (atm_inputs.h), held while d lives:
+                                        their MT_CKD table */
+    double n_h2o, n_foreign, n_ref;  /* cm^-3 */
     double dry_hpa;
 };
 
