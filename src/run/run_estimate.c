@@ -55,9 +55,14 @@ void run_estimate_pilot(const thz_scene *scene, const thz_sensor *sensor, thz_sc
     pilot->n_sensors = 1;
     pilot->n_warnings = 0;
     pilot->photons.per_channel = estimate_min(scene->photons.per_channel, RUN_PILOT_PHOTONS);
+    /* at least 2: one a sample gives each pixel one estimate, whose spread (the noise a
+     * target's passes are counted from) is unknown; the run then renders at least two
+     * passes (run_passes.c) */
     thz_render_settings *r = &pilot->render;
     r->paths_per_sample = (uint32_t)estimate_min(r->paths_per_sample, RUN_PILOT_ESTIMATES);
     r->gather_rays = (uint32_t)estimate_min(r->gather_rays, RUN_PILOT_ESTIMATES);
+    r->paths_per_sample = r->paths_per_sample < 2 ? 2 : r->paths_per_sample;
+    r->gather_rays = r->gather_rays < 2 ? 2 : r->gather_rays;
 }
 
 /* The pilot of channel c: its photon phase's time for the run's photons (0 without

@@ -42,8 +42,9 @@ typedef struct run_estimate_input {
 /* The pilot's copy of sensor (*cam: at most RUN_PILOT_SIDE pixels a side, never more
  * than the sensor's; oversampling 1) and of the scene (*pilot: cam its one sensor, no
  * warnings; photons per channel, paths and gather rays per sample at most
- * RUN_PILOT_PHOTONS and RUN_PILOT_ESTIMATES, never more than the scene's): a pilot never
- * does more work than the run. *pilot borrows the scene's objects and cam. */
+ * RUN_PILOT_PHOTONS and RUN_PILOT_ESTIMATES, never more than the scene's, but paths and
+ * gather rays at least 2, whose spread tells the noise): a pilot does no more work than
+ * the run but for that. *pilot borrows the scene's objects and cam. */
 void run_estimate_pilot(const thz_scene *scene, const thz_sensor *sensor, thz_scene *pilot,
                         thz_sensor *cam);
 

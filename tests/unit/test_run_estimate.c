@@ -1,12 +1,12 @@
-/* The up-front estimate's pilot (run_estimate.c) never does more work than the run it
+/* The up-front estimate's pilot (run_estimate.c) does no more work than the run it
  * estimates: its copy of the sensor has at most RUN_PILOT_SIDE pixels a side and no more
  * than the sensor's, one sample a pixel, and it fires at most RUN_PILOT_PHOTONS photons,
  * casts at most RUN_PILOT_ESTIMATES paths or gather rays a sample, and no more than the
- * run's. A 2 x 2 camera's pilot once rendered 32 x 32 pixels: 1.4 s before a render of 5
- * ms; a 32 x 24 camera's pilot at the run's 30 000 paths a sample took 12 s before a
- * render of 21 s. The copy is otherwise the sensor (its position and field). Then the
- * estimate itself, on a small scene with a noise target, with a pilot of the run's size,
- * and a path run's passes from a pilot of fewer paths than the run's. */
+ * run's (but at least 2, whose spread tells the noise). A 2 x 2 camera's pilot once rendered 32 x
+ * 32 pixels: 1.4 s before a render of 5 ms; a 32 x 24 camera's pilot at the run's 30 000 paths a
+ * sample took 12 s before a render of 21 s. The copy is otherwise the sensor (its position and
+ * field). Then the estimate itself, on a small scene with a noise target, with a pilot of the run's
+ * size, and a path run's passes from a pilot of fewer paths than the run's. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -82,7 +82,8 @@ static void check_pilot(unsigned columns, unsigned rows, double photons, unsigne
     scene_destroy(s);
 }
 
-/* Paths and gather rays a pilot's sample casts: the run's, at most RUN_PILOT_ESTIMATES. */
+/* Paths and gather rays a pilot's sample casts: the run's, at most RUN_PILOT_ESTIMATES
+ * and at least 2. */
 static void check_pilot_estimates(const char *integrator, unsigned j, unsigned want)
 {
     thz_scene *s = load_with(8, 8, 1, 1000, integrator, j);
@@ -105,6 +106,8 @@ static void test_pilot_no_larger_than_the_run(void **state)
     check_pilot(4096, 4096, 1e9, 32, 32, RUN_PILOT_PHOTONS);
     check_pilot_estimates("path", 30000, RUN_PILOT_ESTIMATES);
     check_pilot_estimates("path", 3, 3);
+    check_pilot_estimates("path", 1, 2); /* one estimate a pixel tells no noise */
+    check_pilot_estimates("final-gather", 1, 2);
     check_pilot_estimates("final-gather", 1000000, RUN_PILOT_ESTIMATES);
     check_pilot_estimates("final-gather", RUN_PILOT_ESTIMATES, RUN_PILOT_ESTIMATES);
 }
@@ -200,6 +203,13 @@ static void test_estimate_path_pilot_paths(void **state)
     assert_true(a.passes >= 64 && a.passes < 100000);
     assert_true(b.passes * 16 >= a.passes && b.passes * 16 <= a.passes + 15);
     assert_true(a.seconds_photons == 0.0 && b.seconds_photons == 0.0);
+    /* one path a sample: the pilot casts 2 (one tells no noise: it said 1 pass, at the
+     * pilot's "0 K"), and the run needs twice the passes of one of 2 paths */
+    run_estimate one = estimate_run(8, 8, 1000, "path", 1, target_k);
+    run_estimate two = estimate_run(8, 8, 1000, "path", 2, target_k);
+    print_message("1 path: %u passes, 2 paths: %u\n", one.passes, two.passes);
+    assert_true(two.passes >= 64);
+    assert_true(one.passes >= 2 * two.passes - 1 && one.passes <= 2 * two.passes);
 }
 
 /* A check at most a quarter more passes than so far and at least one more, at the passes
