@@ -14,7 +14,7 @@ scene=$repo/examples/teraeye/scene.json
 
 "$thzmap" validate "$scene" >/dev/null
 echo "simulating $scene with the paper's method (photon-map: 6 channels x 10 million"
-echo "photons; about 25 s on 2 cores)"
+echo "photons; 12-15 s on 2 idle cores)"
 # No --save-photon-map: at 10 M photons per channel the map file is about 1.6 GB.
 "$thzmap" simulate "$scene" --integrator photon-map -o "$outdir"
 
