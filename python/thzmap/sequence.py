@@ -13,6 +13,7 @@ import ctypes
 import json
 import numbers
 import os
+import re
 import sys
 import time
 from ctypes import (CFUNCTYPE, POINTER, Structure, c_char_p, c_double, c_int, c_size_t,
@@ -188,10 +189,34 @@ def _load_handle(loader, path):
     return out.value
 
 
+# A number in a warning, as the CLI's frame warnings find them (src/cli/frame_warnings.c):
+# digits with points between them, and an exponent.
+_NUMBER = re.compile(r"\d(?:\d|\.(?=\d))*(?:[eE][-+]?\d+)?")
+
+
+class _SeenWarning:
+    """A warning as a batch first met it: its frame, the frames that repeated it."""
+
+    def __init__(self, frame, shape):
+        self.first = self.last = frame
+        self.shape = shape
+        self.repeats = self.alike = 0
+
+    def count(self, frame, same):
+        """Counts frame once, as repeating it to the letter or but for its numbers."""
+        if frame is not None and self.last == frame:
+            return
+        self.last = frame
+        if same:
+            self.repeats += 1
+        else:
+            self.alike += 1
+
+
 class _BatchCall(Call):
     """A Call whose warnings name their frame, each message once (the first frame with
-    it), and at the end how many later frames repeated it, as `thzmap batch` prints
-    them."""
+    it), and at the end how many later frames repeated it, to the letter or but for its
+    numbers, as `thzmap batch` prints them."""
 
     _stacklevel = 4  # past __exit__ below
 
@@ -199,15 +224,27 @@ class _BatchCall(Call):
         super().__init__(threads, None)
         self.frame = 0
         self._sequence = sequence
-        self._repeats = {}
+        self._seen = {}
+
+    def _first(self, text):
+        """Whether text is new; else counts it with the warning it repeats."""
+        seen = self._seen.get(text)
+        if seen is not None:
+            seen.count(self.frame, True)
+            return False
+        shape = _NUMBER.sub("#", text)
+        if self.frame is not None:
+            for seen in self._seen.values():
+                if seen.first is not None and seen.first < self.frame and seen.shape == shape:
+                    seen.count(self.frame, False)
+                    return False
+        self._seen[text] = _SeenWarning(self.frame, shape)
+        return True
 
     def _on_warning(self, user, message):
         try:
             text = _lib.text(message)
-            if text in self._repeats:
-                self._repeats[text] += 1
-            else:
-                self._repeats[text] = 0
+            if self._first(text):
                 if self.frame is None:
                     self._warnings.append(text)
                 else:
@@ -218,10 +255,13 @@ class _BatchCall(Call):
                 self._exc = e
 
     def __exit__(self, exc_type, exc, tb):
-        for text, k in self._repeats.items():
-            if k:
-                self._warnings.append(f"the same in {k} later frame{'' if k == 1 else 's'}: "
-                                      f"{text}")
+        for text, seen in self._seen.items():
+            for k, how in ((seen.repeats, "the same"),
+                           (seen.alike, "the same but for its numbers")):
+                if k:
+                    kept = " (each frame's summary.json has its own)" if how != "the same" else ""
+                    self._warnings.append(f"{how} in {k} later frame{'' if k == 1 else 's'}"
+                                          f"{kept}: {text}")
         return super().__exit__(exc_type, exc, tb)
 
 

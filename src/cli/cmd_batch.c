@@ -186,7 +186,7 @@ static int batch_on_run_progress(void *user, const thz_progress *p)
 static void batch_on_warning(void *user, const char *message)
 {
     batch_cli *b = user;
-    if (!cli_frame_warnings_first(&b->warnings, message))
+    if (!cli_frame_warnings_first(&b->warnings, b->in_frame ? b->frame : CLI_NO_FRAME, message))
         return;
     if (b->line_open) {
         fputs("\r\033[K", stderr);
@@ -343,7 +343,7 @@ int cmd_batch(int argc, char **argv)
                    1e-6 * (double)thz_context_mpi_bytes(ctx));
         printf(", %.2f s; results in %s\n", res.seconds, outdir);
     }
-    cli_frame_warnings_finish(&b.warnings, "batch", true);
+    cli_frame_warnings_finish(&b.warnings, "batch", "each frame's summary.json has its own", true);
     if (shared && rc != CLI_EXIT_OK) /* the other ranks may be waiting for rank 0 */
         cli_mpi_abort(rc);
     thz_context_destroy(ctx); /* ends the other ranks' thz_mpi_serve_batch */

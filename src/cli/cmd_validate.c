@@ -343,7 +343,7 @@ static int validate_sequence(const char *path)
         for (size_t i = 0; i < thz_scene_warning_count(scene); i++) {
             const char *w = thz_scene_warning(scene, i);
             thz_frame_info fi;
-            if (!cli_frame_warnings_first(&warnings, w))
+            if (!cli_frame_warnings_first(&warnings, f, w))
                 continue;
             validate_count_end(&count);
             fprintf(stderr, "thzmap validate: warning: %s: %s\n",
@@ -352,7 +352,7 @@ static int validate_sequence(const char *path)
         thz_scene_destroy(scene);
     }
     validate_count_end(&count);
-    cli_frame_warnings_finish(&warnings, "validate", rc == CLI_EXIT_OK);
+    cli_frame_warnings_finish(&warnings, "validate", NULL, rc == CLI_EXIT_OK);
     thz_sequence_destroy(seq);
     return rc;
 }

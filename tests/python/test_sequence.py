@@ -182,6 +182,33 @@ def test_batch_warnings_name_their_frame_once(tmp_path):
         {__file__}
 
 
+def test_batch_warnings_alike_but_for_numbers(tmp_path):
+    """A camera moving outside the room warns in every frame with its own position: the
+    first frame's warning in full, the later ones counted, as thzmap batch does."""
+    shutil.copytree(PLATE, tmp_path / "plate")
+    with open(tmp_path / "plate" / "scene.json") as f:
+        scene = json.load(f)
+    scene["sensors"][0]["resolution"] = [8, 6]
+    scene["render"] = {"integrator": "path", "paths_per_sample": 1}
+    with open(tmp_path / "plate" / "scene.json", "w") as f:
+        json.dump(scene, f)
+    cam = [{"time_s": t, "sensors": {"cam": {"position_m": [0, y, 0.4]}}}
+           for t, y in ((0, -3), (2, -5))]
+    with open(tmp_path / "plate" / "sequence.json", "w") as f:
+        json.dump({"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1,
+                   "frames": 3, "keyframes": cam}, f)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        thzmap.batch(tmp_path / "plate" / "sequence.json", tmp_path / "out", movies=False)
+    texts = [str(w.message) for w in caught if issubclass(w.category, thzmap.RunWarning)]
+    outside = [t for t in texts if "is outside the enclosure" in t]
+    assert len(outside) == 2, texts
+    assert outside[0].startswith('frame-00000: sensor "cam" at [0, -3, 0.4] m is outside')
+    assert outside[1].startswith(
+        "the same but for its numbers in 2 later frames (each frame's summary.json has its "
+        'own): sensor "cam" at [0, -3, 0.4] m is outside')
+
+
 def test_batch_movie_warning_names_no_frame(tmp_path):
     # scenes with other sensors: no movies, and the warning saying why belongs to the
     # batch, not to its last frame (as `thzmap batch` prints it)
