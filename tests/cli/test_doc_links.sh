@@ -9,7 +9,9 @@
 . "$(dirname "$0")/lib.sh"
 
 cd "$REPO" || fail "no repository at $REPO"
-git ls-files '*.md' | grep -v -e '^web/node_modules/' > "$work/pages"
+# the tracked pages; outside a git checkout (an unpacked archive), every page but npm's
+{ git ls-files '*.md' 2>/dev/null || find . -name '*.md' -not -path '*/node_modules/*' |
+    sed 's|^\./||'; } | grep -v -e '^web/node_modules/' > "$work/pages"
 [ "$(wc -l < "$work/pages")" -ge 10 ] || fail "fewer than 10 Markdown pages found: $(cat "$work/pages")"
 
 /usr/bin/python3 - "$work/pages" > "$work/bad" <<'PY'
