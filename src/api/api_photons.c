@@ -247,14 +247,21 @@ static thz_status api_merge_check(const thz_photons *const *parts, size_t n, thz
                                      "thz_photons_merge: parts %zu and %zu are the same photon "
                                      "maps: their photons would count twice",
                                      j, i);
-        for (size_t c = 0; c < p->n_channels; c++)
-            if (p->maps[c] && a->maps[c] &&
-                photon_map_reference_temperature_k(p->maps[c]) !=
-                    photon_map_reference_temperature_k(a->maps[c]))
+    }
+    /* per channel against the first part that holds it: part 0 may hold none of it */
+    for (size_t c = 0; c < parts[0]->n_channels; c++) {
+        const photon_map *first = NULL;
+        for (size_t i = 0; i < n; i++) {
+            const photon_map *m = parts[i]->maps[c];
+            if (m && !first)
+                first = m;
+            else if (m && photon_map_reference_temperature_k(m) !=
+                              photon_map_reference_temperature_k(first))
                 return thz_error_set(err, THZ_ERR_INPUT,
                                      "thz_photons_merge: part %zu was fired for another "
                                      "integrator (reference temperature of channel %zu)",
                                      i, c);
+        }
     }
     return THZ_OK;
 }
