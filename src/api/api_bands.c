@@ -225,8 +225,8 @@ static thz_status resolve_scene(thz_bands *b, const thz_bands_options *o, thz_er
     thz_scene_get_info(scene, &info);
     long sensor = o->sensor ? thz_scene_sensor_index(scene, o->sensor) : 0;
     if (sensor < 0) {
-        st =
-            thz_error_set(err, THZ_ERR_INPUT, "%s: no sensor named '%s'", b->scene_path, o->sensor);
+        st = thz_error_set(err, THZ_ERR_INPUT, "sensor: %s has no sensor named '%s'", b->scene_path,
+                           o->sensor);
         goto done;
     }
     thz_sensor_info si;

@@ -207,8 +207,12 @@ def test_bands_errors(tmp_path):
     copy.write_text(copy.read_text() + "\n")
     with pytest.raises(thzmap.ArgumentError, match="has changed since"):
         thzmap.bands(loaded, 1, **GRID)
-    with pytest.raises(thzmap.Error, match="nope"):
-        thzmap.bands(FEATURES, 1, targets=["A", "nope"], **GRID)
+    # an unknown target or sensor is an argument the scene lacks, not a bad scene file:
+    # thzmap.Error (the sensor's was a SceneError, as if the file were broken)
+    for kwargs in (dict(targets=["A", "nope"]), dict(sensor="nope")):
+        with pytest.raises(thzmap.Error, match="nope") as e:
+            thzmap.bands(FEATURES, 1, **kwargs, **GRID)
+        assert not isinstance(e.value, thzmap.SceneError), (kwargs, e.value)
     bad = tmp_path / "bad.json"
     bad.write_text('{"format": "thzmap-scene/1",\n "name": }\n')
     with pytest.raises(thzmap.SceneError) as e:
