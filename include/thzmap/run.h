@@ -126,8 +126,9 @@ THZ_API thz_status thz_photons_save(const thz_photons *photons, const char *path
  * its photons_per_channel is per channel the sum over the parts that hold the channel,
  * and the largest of these sums when they differ between channels. THZ_ERR_INPUT when a
  * part is given twice, or when two parts hold the same photons of a channel: a map
- * fired here knows its photons (first_photon .. + K - 1), a merged map the union of its
- * parts'; a loaded map does not know its photons, so that check cannot see them. */
+ * fired here knows its photons (first_photon .. + K - 1), a simulation's kept map
+ * (thz_run_photons) its 0 .. fired - 1, a merged map the union of its parts'; a loaded map
+ * does not know its photons, so that check cannot see them. */
 THZ_API thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, size_t n,
                                      thz_photons **out, thz_error *err);
 THZ_API void thz_photons_destroy(thz_photons *photons);

@@ -41,9 +41,10 @@ struct thz_photons {
     uint64_t seed;
     uint64_t photons_per_channel;
     /* The photons each channel's map holds, as ranges (thz_photons_merge refuses parts
-     * whose ranges of a channel overlap): one a channel when fired here, the union of
-     * the parts' when merged from parts that all know theirs; none (n_spans 0) for a map
-     * loaded or kept by a run, which does not know its range. Owned. */
+     * whose ranges of a channel overlap): one a channel when fired here or kept by a
+     * simulation (photons 0 .. fired - 1), the union of the parts' when merged from parts
+     * that all know theirs; none (n_spans 0) for a loaded map, which does not know its
+     * range. Owned (a run's by the run). */
     api_photon_span *spans;
     size_t n_spans;
     bool owned; /* maps and stats belong to this handle (not to a thz_run) */

@@ -143,6 +143,7 @@ void thz_run_destroy(thz_run *run)
     for (size_t i = 0; run->images && i < run->rs.n_selected; i++)
         api_image_fini(&run->images[i]);
     free(run->images);
+    free(run->photons.spans);
     free(run->summary);
     run_state_fini(&run->rs);
     free(run);
@@ -174,6 +175,17 @@ static thz_status api_run_wrap(thz_run *run, thz_error *err)
                                      .photons_per_channel = rs->photons_per_channel,
                                      .owned = false};
         run->has_photons = true;
+        /* a simulation fired photons 0 .. fired - 1 of each channel (over its photon
+         * passes too): known, so that a merge refuses them twice (thz_photons_merge) */
+        size_t nc = run->effective.n_channels;
+        if (!strcmp(rs->command, "simulate")) {
+            run->photons.spans = thz_calloc(nc ? nc : 1, sizeof *run->photons.spans);
+            if (!run->photons.spans)
+                return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+            for (size_t c = 0; c < nc; c++)
+                run->photons.spans[run->photons.n_spans++] =
+                    (api_photon_span){.channel = c, .first = 0, .count = rs->stats[c].fired};
+        }
     }
     run->summary = run_summary_text(rs, err);
     return run->summary ? THZ_OK : THZ_ERR_NOMEM;

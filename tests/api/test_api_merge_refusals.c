@@ -1,8 +1,45 @@
-/* thz_photons_merge refuses parts fired for different integrators in a channel as bad
- * input naming the part, whichever part holds the channel first: part 0 may hold none of
- * that channel's photons (fired for another channel alone). argv: the thzmap binary
- * (unused), the repo (unused). */
+/* thz_photons_merge refuses what would count photons wrongly, as bad input naming the
+ * parts: parts fired for different integrators in a channel, whichever part holds the
+ * channel first (part 0 may hold none of it: fired for another channel alone); and a
+ * simulation's kept photons merged with a set fired over the same photon numbers (the
+ * kept set knows them as a fired one does). argv: the thzmap binary (unused), the repo
+ * (unused). */
 #include "api_test.h"
+
+/* The kept photons of a simulation hold photons 0 .. K - 1 of each channel: a set fired
+ * from 0 again is refused (it merged, every photon counted twice), one fired from K
+ * merges. */
+static void check_kept_photons(thz_context *ctx, const thz_scene *scene)
+{
+    thz_error err = {0};
+    thz_run_settings settings = {.photons_per_channel = 2000, .keep_photons = 1};
+    thz_run *run = NULL;
+    REQUIRE_OK(thz_simulate(ctx, scene, &settings, &run, &err), &err);
+    const thz_photons *kept = thz_run_photons(run);
+    CHECK(kept != NULL, "the run kept no photons");
+    settings.keep_photons = 0;
+    thz_photons *again = NULL, *next = NULL, *merged = (thz_photons *)&err;
+    REQUIRE_OK(thz_photons_fire(ctx, scene, &settings, &again, &err), &err);
+    const thz_photons *same[2] = {kept, again};
+    thz_status st = thz_photons_merge(ctx, same, 2, &merged, &err);
+    CHECK(st == THZ_ERR_INPUT && strstr(err.message, "hold the same photons of channel 0") &&
+              strstr(err.message, "photons 0 to 1999"),
+          "kept and fired photons 0..1999: %s: %s", thz_status_name(st), err.message);
+    CHECK(merged == NULL, "a refused merge returned photons");
+    if (st == THZ_OK)
+        thz_photons_destroy(merged);
+    settings.first_photon = 2000;
+    REQUIRE_OK(thz_photons_fire(ctx, scene, &settings, &next, &err), &err);
+    const thz_photons *disjoint[2] = {kept, next};
+    merged = NULL;
+    REQUIRE_OK(thz_photons_merge(ctx, disjoint, 2, &merged, &err), &err);
+    CHECK(thz_photons_per_channel(merged) == 4000, "merged: %llu per channel",
+          (unsigned long long)thz_photons_per_channel(merged));
+    thz_photons_destroy(merged);
+    thz_photons_destroy(next);
+    thz_photons_destroy(again);
+    thz_run_destroy(run);
+}
 
 int main(int argc, char **argv)
 {
@@ -13,6 +50,7 @@ int main(int argc, char **argv)
     REQUIRE_OK(thz_scene_load_string(test_scene_json, NULL, "merge.json", &scene, &err), &err);
     thz_context *ctx = thz_context_create();
     thz_context_set_threads(ctx, 1);
+    check_kept_photons(ctx, scene);
     thz_run_settings settings = {.photons_per_channel = 2000};
     thz_photons *part[3] = {NULL, NULL, NULL};
     /* channel 0 alone; channel 1 as a map of L (photon-map, T0 0) and, with other photon
@@ -47,6 +85,6 @@ int main(int argc, char **argv)
         thz_photons_destroy(part[i]);
     thz_context_destroy(ctx);
     thz_scene_destroy(scene);
-    printf("test_api_merge_integrators: %d failures\n", test_failures);
+    printf("test_api_merge_refusals: %d failures\n", test_failures);
     return test_failures ? 1 : 0;
 }
