@@ -211,15 +211,8 @@ static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_ru
     thz_output *output = NULL;
     thz_status st = thz_output_open(a->outdir, &output, err);
     *cli_exit_guard() = output;
-    long sensor = -1;
-    if (st == THZ_OK && render && a->sensor_name) {
-        sensor = thz_scene_sensor_index(scene, a->sensor_name);
-        if (sensor < 0) {
-            snprintf(err->message, sizeof err->message,
-                     "render: the scene has no sensor named '%s'", a->sensor_name);
-            err->status = st = THZ_ERR_INPUT;
-        }
-    }
+    /* (a sensor the scene lacks was refused on loading, on every rank) */
+    long sensor = render && a->sensor_name ? thz_scene_sensor_index(scene, a->sensor_name) : -1;
     /* render reads the photon-map file a channel at a time: one channel's map in memory */
     if (st == THZ_OK && render && a->photon_map_path)
         st = thz_render_file(ctx, scene, a->photon_map_path, sensor, &a->settings, run, err);
@@ -271,6 +264,9 @@ static int cli_run_load(const char *cmd, cli_run_args *a, bool render, thz_scene
     if (render && !a->photon_map_path && thz_integrator_needs_photons(integrator))
         return cli_usage_error(cmd, "no photon map given (--photon-map FILE); only the path "
                                     "integrator renders without one");
+    /* here, before the ranks of an MPI run work together: every rank refuses it alike */
+    if (render && a->sensor_name && thz_scene_sensor_index(*scene, a->sensor_name) < 0)
+        return cli_usage_error(cmd, "--sensor: the scene has no sensor named '%s'", a->sensor_name);
     /* options the integrator has no use for: said, not silently dropped */
     if (!render && a->settings.photons_per_channel && !thz_integrator_needs_photons(integrator))
         fprintf(stderr,

@@ -285,6 +285,14 @@ rc=$?
 [ $rc = 2 ] || fail "bad scene under mpirun: exit $rc, not 2"
 [ "$(grep -c 'bad.json' "$work/bad.out")" = 1 ] || { fail "bad scene: not one message"; cat "$work/bad.out"; }
 [ ! -e "$work/bad" ] || fail "bad scene: OUTDIR created"
+# an option wrong for the scene (render --sensor of no sensor) likewise: every rank checks
+# it before they work together (rank 0 alone found it, after: MPI_ABORT and its banner)
+mpi 2 "$THZMAP" render "$scene" --integrator path --sensor nope -o "$work/nos" > "$work/nos.out" 2>&1
+rc=$?
+[ $rc = 2 ] || fail "render --sensor nope under mpirun: exit $rc, not 2"
+[ "$(grep -c "no sensor named 'nope'" "$work/nos.out")" = 1 ] || { fail "--sensor nope: not one message"; cat "$work/nos.out"; }
+! grep -q MPI_ABORT "$work/nos.out" || { fail "--sensor nope: the job was aborted"; cat "$work/nos.out"; }
+[ ! -e "$work/nos" ] || fail "--sensor nope: OUTDIR created"
 step "rank 1 loads"
 # rank 1 loads another scene (a different seed): it refuses rank 0's request, the job ends
 sed 's/"seed": 1/"seed": 2/' "$scene" > "$work/other.json"
