@@ -267,6 +267,13 @@ static int cli_run_load(const char *cmd, cli_run_args *a, bool render, thz_scene
     /* here, before the ranks of an MPI run work together: every rank refuses it alike */
     if (render && a->sensor_name && thz_scene_sensor_index(*scene, a->sensor_name) < 0)
         return cli_usage_error(cmd, "--sensor: the scene has no sensor named '%s'", a->sensor_name);
+    if (render && a->settings.target_noise_k > 0.0 && !thz_integrator_has_passes(integrator))
+        return cli_usage_error(cmd,
+                               "--target-noise-k: the %s integrator renders its photon map in one "
+                               "deterministic pass, and render fires no photons (simulate fires "
+                               "them until the target is met; or give --integrator final-gather "
+                               "or path)",
+                               integrator);
     /* options the integrator has no use for: said, not silently dropped */
     if (!render && a->settings.photons_per_channel && !thz_integrator_needs_photons(integrator))
         fprintf(stderr,

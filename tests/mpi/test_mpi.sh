@@ -293,6 +293,14 @@ rc=$?
 [ "$(grep -c "no sensor named 'nope'" "$work/nos.out")" = 1 ] || { fail "--sensor nope: not one message"; cat "$work/nos.out"; }
 ! grep -q MPI_ABORT "$work/nos.out" || { fail "--sensor nope: the job was aborted"; cat "$work/nos.out"; }
 [ ! -e "$work/nos" ] || fail "--sensor nope: OUTDIR created"
+# and a noise target for an integrator whose render has no passes (photon-map)
+mpi 2 "$THZMAP" render "$scene" --integrator photon-map --photon-map "$work/fg1/photon-map.thzpm" \
+    --target-noise-k 0.1 -o "$work/not" > "$work/not.out" 2>&1
+rc=$?
+[ $rc = 2 ] || fail "render photon-map --target-noise-k under mpirun: exit $rc, not 2"
+[ "$(grep -c "target-noise-k" "$work/not.out")" = 1 ] || { fail "--target-noise-k: not one message"; cat "$work/not.out"; }
+! grep -q MPI_ABORT "$work/not.out" || { fail "--target-noise-k: the job was aborted"; cat "$work/not.out"; }
+[ ! -e "$work/not" ] || fail "--target-noise-k: OUTDIR created"
 step "rank 1 loads"
 # rank 1 loads another scene (a different seed): it refuses rank 0's request, the job ends
 sed 's/"seed": 1/"seed": 2/' "$scene" > "$work/other.json"
