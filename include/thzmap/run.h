@@ -309,7 +309,11 @@ THZ_API thz_status thz_output_add_image(thz_output *output, const thz_image *ima
 THZ_API thz_status thz_output_add_file(thz_output *output, const char *name, const void *data,
                                        size_t size, thz_error *err);
 /* Once committed, the output takes nothing more: thz_output_commit again and the
- * thz_output_add_* functions return THZ_ERR_INPUT ("already committed"). */
+ * thz_output_add_* functions return THZ_ERR_INPUT ("already committed"). A run or image
+ * whose writing failed part way (a full disk: THZ_ERR_IO) leaves the output failed: its
+ * commit and further adds return THZ_ERR_INPUT and nothing of it reaches outdir; destroy
+ * it (which removes the staged files) and open another. (thz_output_add_file's failure
+ * removes its file and leaves the output as it was.) */
 THZ_API thz_status thz_output_commit(thz_output *output, thz_error *err);
 THZ_API void thz_output_destroy(thz_output *output);
 

@@ -16,9 +16,13 @@
 struct thz_output {
     output_stage *stage;
     bool committed; /* the staging directory is gone: nothing more can be added */
+    /* a run's or image's files failed part way (a full disk): those written stay in the
+     * staging directory, so the output neither takes more nor commits */
+    const char *failed;
 };
 
-/* THZ_ERR_INPUT when output is NULL or already committed; `what` names the call. */
+/* THZ_ERR_INPUT when output is NULL, already committed or failed; `what` names the
+ * call. */
 static thz_status api_output_check(const thz_output *output, const char *what, thz_error *err)
 {
     if (!output)
@@ -27,6 +31,11 @@ static thz_status api_output_check(const thz_output *output, const char *what, t
         return thz_error_set(err, THZ_ERR_INPUT,
                              "%s: the output is already committed (open another to write more)",
                              what);
+    if (output->failed)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: an earlier %s failed and left its files partial: this output "
+                             "commits nothing (destroy it, which removes them, and open another)",
+                             what, output->failed);
     return THZ_OK;
 }
 
@@ -102,8 +111,11 @@ thz_status thz_output_add_run(thz_context *ctx, thz_output *output, thz_run *run
         st = output_stage_claim(output->stage, RUN_PHOTON_MAP_FILE, err);
     if (st == THZ_OK && !strcmp(run->rs.command, "simulate"))
         st = output_stage_claim(output->stage, RUN_PHOTON_PLY_FILE, err);
-    if (st == THZ_OK)
+    if (st == THZ_OK) {
         st = run_write(&run->rs, output_stage_dir(output->stage), &wo, err);
+        if (st != THZ_OK)
+            output->failed = "thz_output_add_run";
+    }
     if (st != THZ_OK)
         output_stage_error_names_outdir(output->stage, err);
     return api_done(ctx, st, err);
@@ -117,9 +129,12 @@ thz_status thz_output_add_image(thz_output *output, const thz_image *image, thz_
     if (st != THZ_OK)
         return st;
     st = output_stage_claim_sensor(output->stage, image->scene->sensors[image->sensor].name, err);
-    if (st == THZ_OK)
+    if (st == THZ_OK) {
         st = output_write_sensor(output_stage_dir(output->stage), image->scene, image->sensor,
                                  image->img, 0, NULL, err);
+        if (st != THZ_OK)
+            output->failed = "thz_output_add_image";
+    }
     if (st != THZ_OK)
         output_stage_error_names_outdir(output->stage, err);
     return st;
