@@ -52,9 +52,9 @@ THZ_API void thz_library_get_info(const thz_library *lib, size_t i, thz_library_
  * 0 to 0 when i or r is out of range. */
 THZ_API void thz_library_get_range(const thz_library *lib, size_t i, size_t r, double *from_thz,
                                    double *to_thz);
-/* True when freq_hz lies in one of entry i's itu-p2040 rows or in its stated validity
- * (valid_from/to_thz); always true for entries that state neither; false when i is out
- * of range. */
+/* True when freq_hz lies within entry i's stated validity (valid_from/to_thz), where it
+ * states one, and, for an itu-p2040 entry, within one of its rows: both where it has
+ * both; always true for entries that state neither; false when i is out of range. */
 THZ_API int thz_library_in_range(const thz_library *lib, size_t i, double freq_hz);
 
 /* The complex index n + ik (k >= 0) and relative permittivity eps' + i eps'' of entry

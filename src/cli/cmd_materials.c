@@ -118,8 +118,7 @@ static int describe(const thz_library *lib, const char *name, const double *thz,
     if (outside) {
         bool rows = strcmp(info.model, "itu-p2040") == 0;
         printf("\n* outside %s%s%s\n", info.has_valid_range ? "the stated validity" : "",
-               info.has_valid_range && rows ? " and " : "",
-               rows ? "the ranges the data cover" : "");
+               info.has_valid_range && rows ? " or " : "", rows ? "the ranges the data cover" : "");
     }
     return CLI_EXIT_OK;
 }
