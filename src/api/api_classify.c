@@ -458,12 +458,21 @@ thz_status thz_classify_run(const char *run_dir, const char *sensor,
         struct stat before, after;
         bool known = stat(run_dir, &before) == 0; /* else its reads say what is wrong */
         char cube_stem[THZ_PATH_MAX];
-        if (file_check_regular(path, NULL, ENVI_MAX_HEADER_BYTES, NULL, NULL) == THZ_OK)
+        /* the measured cube where the sensor has noise; the noise-free one where it has
+         * none (no measured header). A measured header that is there but cannot be read
+         * is an error: the noise-free cube instead would be classified without the
+         * noise the user's sensor has, silently. */
+        struct stat hs;
+        st = THZ_OK;
+        if (lstat(path, &hs) == 0) {
+            st = file_check_regular(path, NULL, ENVI_MAX_HEADER_BYTES, NULL, err);
             snprintf(cube_stem, sizeof cube_stem, "%.*s", (int)(strlen(stem) - 4),
                      stem); /* the measured cube: without ".hdr" */
-        else
+        } else {
             memcpy(cube_stem, name, sizeof cube_stem);
-        st = thz_cube_read(run_dir, cube_stem, &cube, err);
+        }
+        if (st == THZ_OK)
+            st = thz_cube_read(run_dir, cube_stem, &cube, err);
         if (st == THZ_OK)
             st = thz_cube_read(run_dir, truth_stem, &truth, err);
         bool stable = !known || (stat(run_dir, &after) == 0 && file_dir_unchanged(&before, &after));

@@ -97,6 +97,19 @@ import json; d = json.load(open('$work/m/classification.json'))
 assert d['source'] == 'cam.measured_brightness_temperature', d['source']
 assert d['accuracy'] < 0.9, d['accuracy']" || fail "the measured cube was not used"
 
+# a measured header that is there but is no file to read (a directory, too large) is an
+# error, not a quiet fallback to the noise-free cube (the classification would be of
+# the sensor without its noise)
+cp -r "$work/run2" "$work/run2d"
+rm "$work/run2d/cam.measured_brightness_temperature.hdr"
+mkdir "$work/run2d/cam.measured_brightness_temperature.hdr"
+"$THZMAP" classify "$work/run2d" --sensor cam -o "$work/md" --method lda -q 2> "$work/err"
+rc=$?
+[ $rc -eq 2 ] || fail "a measured header that is a directory: exit status $rc, expected 2"
+grep -q 'cam\.measured_brightness_temperature\.hdr: .*directory' "$work/err" ||
+    fail "a measured header that is a directory: $(cat "$work/err")"
+[ ! -e "$work/md" ] || fail "a measured header that is a directory: OUTDIR written"
+
 # a run whose sensor has noise writes the measured cube; classify takes it
 $PY -c "
 import json; d = json.load(open('$IN/distinct.json'))
