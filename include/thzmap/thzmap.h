@@ -78,7 +78,8 @@ THZ_API const char *thz_status_name(thz_status status);
  * whose back-side sources a deviation map needs, once per run before the first channel's
  * photons, channel 0; only where there are such objects: one-sided solids), "photons"
  * (done/total in photons of the channel), "render" (rows of a sensor), "output" (0/1,
- * then 1/1). A channel's
+ * then 1/1), "read" (thz_photons_load and _load_channel: a channel's stored photons in
+ * the file, 0 of them before its records are read and all once its map is built). A channel's
  * "photons" and "render" first report done = 0 when they start (a clock of the stage
  * starts there, as summary.json's photon_phase_s and render_s do); each further render
  * pass, and each further sensor, reports its rows from 0 again. thz_bands_select reports

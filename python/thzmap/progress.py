@@ -10,13 +10,14 @@ Progress = collections.namedtuple("Progress", "stage channel n_channels done tot
 Progress.__doc__ = """One progress report. `stage` is "prepare" (objects whose back-side
 sources are set up, once per run before the first channel's photons, where a deviation map
 needs them), "photons" (done/total photons of the channel), "render" (rows of a sensor) or
-"output" (0/1, then 1/1); `channel` is the 0-based index of the channel among
-`n_channels`. In `bands` the stage is "bands": `channel` is the render (the nominal one,
+"output" (0/1, then 1/1) or "read" (load_photon_map: a channel's stored photons in the
+file, 0 before its records are read and all once its map is built); `channel` is the
+0-based index of the channel among `n_channels`. In `bands` the stage is "bands": `channel` is the render (the nominal one,
 then the nuisances'; `n_channels` the renders, 0 while the nominal one runs and their
 count is not known yet) and done/total its candidate channels."""
 
 _UNITS = {"prepare": "objects", "photons": "photons", "render": "rows", "output": "steps",
-          "bands": "channels"}
+          "bands": "channels", "read": "photons"}
 
 
 class _Bar:

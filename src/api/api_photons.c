@@ -160,6 +160,23 @@ thz_status thz_photons_fire_channel(thz_context *ctx, const thz_scene *scene,
     return api_done(ctx, api_fire(ctx, scene, settings, channel, out, err), err);
 }
 
+/* The file's reading, told to the context's progress callback as the "read" stage. */
+typedef struct api_read_report {
+    const thz_context *ctx;
+    size_t n_channels;
+} api_read_report;
+
+static int api_read_progress(void *user, size_t channel, uint64_t done, uint64_t total)
+{
+    const api_read_report *r = user;
+    thz_progress p = {.stage = "read",
+                      .channel = channel,
+                      .n_channels = r->n_channels,
+                      .done = done,
+                      .total = total};
+    return r->ctx->progress(r->ctx->progress_user, &p);
+}
+
 /* thz_photons_load of every channel (channel = SIZE_MAX) or of one. */
 static thz_status api_photons_load(thz_context *ctx, const thz_scene *scene, const char *path,
                                    size_t channel, thz_photons **out, thz_error *err)
@@ -182,11 +199,12 @@ static thz_status api_photons_load(thz_context *ctx, const thz_scene *scene, con
         st = api_photons_create(scene, &ph, err);
     photon_map_file_info info;
     int threads = ctx ? ctx->threads : 0;
+    api_read_report report = {.ctx = ctx, .n_channels = scene->n_channels};
+    photon_map_file_progress progress = {.fn = api_read_progress, .user = &report};
     if (st == THZ_OK)
-        st = channel == SIZE_MAX
-                 ? photon_map_file_read(path, scene, threads, ph->maps, ph->stats, &info, err)
-                 : photon_map_file_read_channel(path, scene, threads, channel, ph->maps, ph->stats,
-                                                &info, err);
+        st = photon_map_file_read_progress(path, scene, threads, channel,
+                                           ctx && ctx->progress ? &progress : NULL, ph->maps,
+                                           ph->stats, &info, err);
     if (st != THZ_OK) {
         thz_photons_destroy(ph);
         return api_done(ctx, st, err);

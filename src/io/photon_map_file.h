@@ -89,6 +89,21 @@ thz_status photon_map_file_read_channel(const char *path, const thz_scene *scene
                                         size_t channel, photon_map **maps, photon_stats *stats,
                                         photon_map_file_info *info, thz_error *err);
 
+/* Progress of a read, on the calling thread: channel c's record count before its records
+ * are read (done 0) and after its map is built (done = total; a channel dropped by
+ * _read_channel reports no build); non-zero stops the read with THZ_ERR_CANCELLED. */
+typedef struct photon_map_file_progress {
+    int (*fn)(void *user, size_t channel, uint64_t done, uint64_t total);
+    void *user;
+} photon_map_file_progress;
+
+/* photon_map_file_read (want SIZE_MAX) or _read_channel (want the channel) with progress
+ * (NULL: none). */
+thz_status photon_map_file_read_progress(const char *path, const thz_scene *scene, int threads,
+                                         size_t want, const photon_map_file_progress *progress,
+                                         photon_map **maps, photon_stats *stats,
+                                         photon_map_file_info *info, thz_error *err);
+
 /* A file read one channel at a time, in channel order: for a render that holds one
  * channel's map at once instead of all (run.h: run_photons.next_map). Opening checks
  * what photon_map_file_read checks before the records (prefix, header and its checksum,

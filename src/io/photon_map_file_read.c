@@ -511,9 +511,19 @@ thz_status photon_map_file_next(photon_map_file_stream *s, int threads, photon_m
 
 /* photon_map_file_read of every channel (want = SIZE_MAX) or of channel want alone: all
  * the records read and the checksum verified before any map is built. */
+/* Reports channel c's done of total to progress (may be NULL); THZ_ERR_CANCELLED when
+ * it says stop. */
+static thz_status pmf_report(const photon_map_file_progress *progress, const char *path, size_t c,
+                             uint64_t done, uint64_t total, thz_error *err)
+{
+    if (progress && progress->fn && progress->fn(progress->user, c, done, total) != 0)
+        return thz_error_set(err, THZ_ERR_CANCELLED, "reading photon map %s: cancelled", path);
+    return THZ_OK;
+}
+
 static thz_status pmf_read_file(const char *path, const thz_scene *scene, int threads, size_t want,
-                                photon_map **maps, photon_stats *stats, photon_map_file_info *info,
-                                thz_error *err)
+                                const photon_map_file_progress *progress, photon_map **maps,
+                                photon_stats *stats, photon_map_file_info *info, thz_error *err)
 {
     size_t nc = scene->n_channels;
     for (size_t c = 0; c < nc; c++)
@@ -526,13 +536,20 @@ static thz_status pmf_read_file(const char *path, const thz_scene *scene, int th
         st = thz_error_set(err, THZ_ERR_NOMEM, "cannot read photon map %s: out of memory", path);
     if (st == THZ_OK)
         st = photon_map_file_open(path, scene, stats, info, &s, err);
-    for (size_t c = 0; st == THZ_OK && c < nc; c++)
-        st = pmf_next_records(s, want == SIZE_MAX || c == want, &records[c], &counts[c], err);
+    for (size_t c = 0; st == THZ_OK && c < nc; c++) {
+        uint64_t n = get_u64(pmf_channel_words(s, c) + 16);
+        st = pmf_report(progress, path, c, 0, n, err);
+        if (st == THZ_OK)
+            st = pmf_next_records(s, want == SIZE_MAX || c == want, &records[c], &counts[c], err);
+    }
     for (size_t c = 0; st == THZ_OK && c < nc; c++) {
         if (records[c]) {
             photon_record *rec = records[c];
+            size_t n = counts[c];
             records[c] = NULL; /* pmf_build owns it from here, also on failure */
-            st = pmf_build(s, c, rec, counts[c], threads, &maps[c], err);
+            st = pmf_build(s, c, rec, n, threads, &maps[c], err);
+            if (st == THZ_OK)
+                st = pmf_report(progress, path, c, n, n, err);
         }
     }
     if (st != THZ_OK)
@@ -552,16 +569,26 @@ thz_status photon_map_file_read(const char *path, const thz_scene *scene, int th
                                 photon_map **maps, photon_stats *stats, photon_map_file_info *info,
                                 thz_error *err)
 {
-    return pmf_read_file(path, scene, threads, SIZE_MAX, maps, stats, info, err);
+    return photon_map_file_read_progress(path, scene, threads, SIZE_MAX, NULL, maps, stats, info,
+                                         err);
 }
 
 thz_status photon_map_file_read_channel(const char *path, const thz_scene *scene, int threads,
                                         size_t channel, photon_map **maps, photon_stats *stats,
                                         photon_map_file_info *info, thz_error *err)
 {
-    if (channel >= scene->n_channels)
+    return photon_map_file_read_progress(path, scene, threads, channel, NULL, maps, stats, info,
+                                         err);
+}
+
+thz_status photon_map_file_read_progress(const char *path, const thz_scene *scene, int threads,
+                                         size_t want, const photon_map_file_progress *progress,
+                                         photon_map **maps, photon_stats *stats,
+                                         photon_map_file_info *info, thz_error *err)
+{
+    if (want != SIZE_MAX && want >= scene->n_channels)
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "photon map %s: no channel %zu (the scene has %zu)", path, channel,
+                             "photon map %s: no channel %zu (the scene has %zu)", path, want,
                              scene->n_channels);
-    return pmf_read_file(path, scene, threads, channel, maps, stats, info, err);
+    return pmf_read_file(path, scene, threads, want, progress, maps, stats, info, err);
 }

@@ -64,3 +64,20 @@ def test_one_channel_of_a_photon_map_file(tiny_dir):
     for bad in (2, -1, "1"):
         with pytest.raises(thzmap.ArgumentError):
             thzmap.load_photon_map(scene, path, channel=bad)
+
+
+def test_load_photon_map_progress_and_cancel(tiny_dir):
+    """load_photon_map reports "read" per channel and a true return cancels it (it
+    reported nothing: progress was accepted and never called, Ctrl-C waited)."""
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    path = tiny_dir / "progress.thzpm"
+    full = thzmap.fire_photons(scene, photons=2000, seed=SEED)
+    full.save(path)
+    seen = []
+    thzmap.load_photon_map(scene, path, progress=seen.append)
+    stored = [s.stored for s in full.stats]
+    assert [(p.stage, p.channel, p.done, p.total) for p in seen] == \
+        [("read", 0, 0, stored[0]), ("read", 1, 0, stored[1]),
+         ("read", 0, stored[0], stored[0]), ("read", 1, stored[1], stored[1])], seen
+    with pytest.raises(thzmap.CancelledError):
+        thzmap.load_photon_map(scene, path, progress=lambda p: True)
