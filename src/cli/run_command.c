@@ -203,14 +203,12 @@ thz_output **cli_exit_guard(void)
     return &cli_open_output;
 }
 
-/* The run: photons read (render) or fired, images rendered, results written through an
- * output directory opened first, so that a bad OUTDIR fails before any work. */
+/* The run: photons read (render) or fired, images rendered, results written through
+ * `output` (opened before, so that a bad OUTDIR fails before any work; destroyed here). */
 static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_run_args *a,
-                          bool render, thz_run **run, thz_error *err)
+                          bool render, thz_output *output, thz_run **run, thz_error *err)
 {
-    thz_output *output = NULL;
-    thz_status st = thz_output_open(a->outdir, &output, err);
-    *cli_exit_guard() = output;
+    thz_status st = THZ_OK;
     /* (a sensor the scene lacks was refused on loading, on every rank) */
     long sensor = render && a->sensor_name ? thz_scene_sensor_index(scene, a->sensor_name) : -1;
     /* render reads the photon-map file a channel at a time: one channel's map in memory */
@@ -329,9 +327,21 @@ int cli_run_command(int argc, char **argv, bool render)
     int rc = cli_run_parse(argc, argv, render, &a);
     if (rc < 0)
         rc = cli_run_load(cmd, &a, render, &scene);
+    /* OUTDIR (its lock, its staging directory) before the ranks work together: rank 0
+     * alone writes, and a bad OUTDIR (a file, a busy one) found after would abort the
+     * job; now every rank exits as rank 0 does */
+    thz_output *output = NULL;
+    if (rc < 0 && cli_mpi_rank() == 0) {
+        thz_error oerr = {0};
+        if (thz_output_open(a.outdir, &output, &oerr) != THZ_OK)
+            rc = cli_fail(&oerr);
+        *cli_exit_guard() = output;
+    }
     cli_mpi_quiet_end();
     int lead_rc = rc, failed = cli_mpi_agree(rc < 0, rc, &lead_rc);
     if (failed >= 0) {
+        *cli_exit_guard() = NULL;
+        thz_output_destroy(output);
         thz_scene_destroy(scene);
         if (lead_rc >= 0)
             return lead_rc;
@@ -354,6 +364,8 @@ int cli_run_command(int argc, char **argv, bool render)
     thz_status st = THZ_OK;
     thz_context *ctx = thz_context_create();
     if (!ctx) {
+        *cli_exit_guard() = NULL;
+        thz_output_destroy(output);
         thz_scene_destroy(scene);
         fprintf(stderr, "thzmap %s: out of memory\n", cmd);
         if (shared) /* the other ranks wait for this one: end them too */
@@ -366,8 +378,11 @@ int cli_run_command(int argc, char **argv, bool render)
                          render && a.sensor_name ? thz_scene_sensor_index(scene, a.sensor_name)
                                                  : -1);
     thz_context_set_threads(ctx, a.threads);
-    if (shared && thz_context_set_mpi(ctx, &err) != THZ_OK)
+    if (shared && thz_context_set_mpi(ctx, &err) != THZ_OK) {
+        *cli_exit_guard() = NULL;
+        thz_output_destroy(output); /* nothing staged yet: removed, OUTDIR as it was */
         cli_mpi_abort(cli_fail(&err));
+    }
     thz_context_set_progress(ctx, cli_progress_report, &progress);
     thz_context_set_warning(ctx, cli_progress_warning, &progress);
     if (!a.quiet) { /* the estimate is printed only; its pilot costs a moment */
@@ -377,7 +392,7 @@ int cli_run_command(int argc, char **argv, bool render)
     a.settings.seconds_load = cli_now_s() - t0;
     double t_run = cli_now_s();
     thz_run *run = NULL;
-    st = cli_run(ctx, scene, &a, render, &run, &err);
+    st = cli_run(ctx, scene, &a, render, output, &run, &err);
     cli_progress_finish(&progress);
 
     /* a failure under an interrupt is the interrupt's: a Ctrl-C at the terminal also ends
