@@ -42,9 +42,10 @@ THZ_API thz_status thz_sequence_load_within(const char *path, const char *root, 
                                             thz_error *err);
 /* The same, reporting through ctx's progress callback (ctx may be NULL: none) as it
  * builds and checks the frames, which loads each frame's scene (milliseconds each:
- * minutes for the largest sequences): stage "frames", done of total frames checked,
- * channel and n_channels 0; non-zero from the callback cancels (THZ_ERR_CANCELLED).
- * root as in thz_sequence_load_within (NULL: not confined). */
+ * minutes for the largest sequences): stage "frames", done of total frames checked (0
+ * before the first, total once all are), channel and n_channels 0; non-zero from the
+ * callback cancels (THZ_ERR_CANCELLED). root as in thz_sequence_load_within (NULL: not
+ * confined). */
 THZ_API thz_status thz_sequence_load_ctx(thz_context *ctx, const char *path, const char *root,
                                          thz_sequence **out, thz_error *err);
 THZ_API void thz_sequence_destroy(thz_sequence *seq);

@@ -14,10 +14,11 @@ needs them), "photons" (done/total photons of the channel), "render" (rows of a 
 file, 0 before its records are read and all once its map is built); `channel` is the
 0-based index of the channel among `n_channels`. In `bands` the stage is "bands": `channel` is the render (the nominal one,
 then the nuisances'; `n_channels` the renders, 0 while the nominal one runs and their
-count is not known yet) and done/total its candidate channels."""
+count is not known yet) and done/total its candidate channels. In `load_sequence` it is
+"frames": done/total frames checked (channel and n_channels 0)."""
 
 _UNITS = {"prepare": "objects", "photons": "photons", "render": "rows", "output": "steps",
-          "bands": "channels", "read": "photons"}
+          "bands": "channels", "read": "photons", "frames": "frames"}
 
 
 class _Bar:

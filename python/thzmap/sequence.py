@@ -61,6 +61,7 @@ _ERR = POINTER(_lib.ThzError)
 _PROTOTYPES = {
     "thz_sequence_load": (c_int, [c_char_p, POINTER(c_void_p), _ERR]),
     "thz_sequence_load_within": (c_int, [c_char_p, c_char_p, POINTER(c_void_p), _ERR]),
+    "thz_sequence_load_ctx": (c_int, [_P, c_char_p, c_char_p, POINTER(c_void_p), _ERR]),
     "thz_sequence_destroy": (None, [_P]),
     "thz_sequence_frame_count": (c_size_t, [_P]),
     "thz_sequence_sweep_count": (c_size_t, [_P]),
@@ -163,30 +164,34 @@ class Sequence:
                 f"value{'' if k == 1 else 's'} x {self.frames_per_sweep})>")
 
 
-def load_sequence(path, root=None):
+def load_sequence(path, root=None, progress=None):
     """Loads and checks the sequence file at `path`, its scene and every frame's scene
     (as `thzmap batch` does before its first frame). Raises SceneError for a bad one:
     its `file` and JSON `path` name the sequence's key (e.g.
     "keyframes[1].objects.person"), or its `reason` names the frame and the scene's
     own error. With `root`, the sequence file and every file it names must lie under
-    root (as for load_scene)."""
+    root (as for load_scene). `progress` as for simulate: the stage "frames", done/total
+    frames checked (minutes for the largest sequences); a true return value, or Ctrl-C,
+    cancels it."""
     path = _path_arg("path", path)
-    if root is None:
-        return Sequence(_load_handle(lambda out, err: _lib.lib.thz_sequence_load(
-            os.fsencode(path), out, err), path), path)
     r = _root_arg(root)
-    return Sequence(_load_handle(lambda out, err: _lib.lib.thz_sequence_load_within(
-        os.fsencode(path), r, out, err), path), path)
-
-
-def _load_handle(loader, path):
-    """The handle a sequence loader returns; raises as load_scene does."""
+    check_progress(progress)
     out = ctypes.c_void_p()
-    err = _lib.ThzError()
-    status = loader(ctypes.byref(out), ctypes.byref(err))
-    if status != _lib.OK:
-        raise _load_error(status, _lib.text(err.message), path, path)
-    return out.value
+    with Call(None, progress) as call:
+        status = _lib.lib.thz_sequence_load_ctx(call.ctx, os.fsencode(path), r,
+                                                ctypes.byref(out), call.err)
+        if status == _lib.OK:
+            try:
+                call.check(status)  # a callback's exception, or Ctrl-C, that came too late
+            except BaseException:
+                _lib.lib.thz_sequence_destroy(out.value)
+                raise
+        elif status == _lib.ERR_CANCELLED:
+            call.check(status)  # the callback's exception, Ctrl-C or CancelledError
+        else:
+            call.check(_lib.OK)
+            raise _load_error(status, _lib.text(call.error.message), path, path)
+    return Sequence(out.value, path)
 
 
 # A number in a warning, as the CLI's frame warnings find them (src/cli/frame_warnings.c):

@@ -339,11 +339,11 @@ static thz_status sequence_load(thz_context *ctx, const char *path, const char *
     }
     /* each frame's scene is loaded (a few ms each: minutes for 10^5 frames): reported */
     thz_progress_fn progress = ctx ? ctx->progress : NULL;
-    for (size_t f = 0; st == THZ_OK && f < seq->n_frames; f++) {
+    for (size_t f = 0; st == THZ_OK && f <= seq->n_frames; f++) {
         thz_progress p = {.stage = "frames", .done = f, .total = seq->n_frames};
-        if (progress && progress(ctx->progress_user, &p))
+        if (progress && progress(ctx->progress_user, &p)) /* the last: all checked */
             st = thz_error_set(err, THZ_ERR_CANCELLED, "%s: cancelled", path);
-        else
+        else if (f < seq->n_frames)
             st = seq_frame(&b, seq, f);
     }
     for (size_t i = 0; i < b.n_tracks; i++) {

@@ -10,6 +10,8 @@ import warnings
 import pytest
 from conftest import PLATE, REPO, run_cli
 
+WALKER = os.path.join(REPO, "examples", "walker", "sequence.json")
+
 import thzmap
 
 BATCH = os.path.join(REPO, "tests", "inputs", "batch")
@@ -278,3 +280,17 @@ def test_identify_tells_the_files_apart(tmp_path):
     assert thzmap.identify(tmp_path / "other.json") == "other"
     with pytest.raises(thzmap.Error, match="is a directory"):
         thzmap.identify(tmp_path)
+
+
+def test_load_sequence_progress_and_cancel():
+    """load_sequence reports its frames' check and a true return cancels it (it took no
+    context: no progress, and Ctrl-C waited for the whole load)."""
+    seen = []
+    seq = thzmap.load_sequence(WALKER, progress=seen.append)
+    assert len(seq) == 25
+    assert seen and {p.stage for p in seen} == {"frames"}, seen
+    assert seen[-1].done == seen[-1].total == 25, seen[-1]
+    with pytest.raises(thzmap.CancelledError):
+        thzmap.load_sequence(WALKER, progress=lambda p: True)
+    with pytest.raises(thzmap.ArgumentError):
+        thzmap.load_sequence(WALKER, progress=3)
