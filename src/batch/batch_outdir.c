@@ -45,8 +45,8 @@ thz_status batch_mkdirs(const char *dir, thz_error *err)
     struct stat st;
     if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) /* a file where OUTDIR is: bad usage */
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "%s: not a directory (expected a directory for the results, or a "
-                             "name to create one)",
+                             "%s: exists and is not a directory (expected a directory for "
+                             "the results, or a name to create one)",
                              dir);
     return THZ_OK;
 }

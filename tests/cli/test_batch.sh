@@ -811,6 +811,11 @@ touch "$work/a-file"
 rc=$?
 [ $rc -eq 2 ] && grep -q "a-file/out: cannot create the directory: Not a directory" "$work/under-file.err" ||
     fail "batch into a path under a file: exit $rc, $(cat "$work/under-file.err")"
+# and an OUTDIR that is a file is said as simulate says it
+"$THZMAP" batch "$seq" -o "$work/a-file" -q 2> "$work/is-file.err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "a-file: exists and is not a directory (expected a directory" "$work/is-file.err" ||
+    fail "batch into a file: exit $rc, $(cat "$work/is-file.err")"
 
 # A FIFO or device that a frame's scene names but the loader does not read (the continuum
 # table of a lines model without the continuum) and a FIFO frame.json in OUTDIR: the
