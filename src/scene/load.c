@@ -192,10 +192,10 @@ static bool load_warn_table(thz_scene *s, const thz_spectrum *sp, const char *wh
     return scene_add_warning(
         s,
         "%s: the table covers %.4g to %.4g THz but channel \"%s\" (band %.4g to %.4g THz, "
-        "%s)%s reaches beyond it; the end values are used there",
+        "%s)%s beyond it; the end values are used there",
         what, sp->freq_hz[0] * 1e-12, sp->freq_hz[sp->n - 1] * 1e-12, ch->name, lo * 1e-12,
         hi * 1e-12, channel_has_response(ch) ? "where its response is > 0" : "centre +- 2 FWHM",
-        count > 1 ? " and others" : "");
+        count > 1 ? " and others reach" : " reaches");
 }
 
 /* Whether object i of the document (validated) is a mesh file: built-in shapes are

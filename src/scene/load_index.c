@@ -317,10 +317,10 @@ static thz_status warn_outside(load_ctx *ctx, const load_cursor *c, const char *
     load_channel_band(ch, &lo, &hi);
     if (!scene_add_warning(ctx->scene,
                            "%s: %s covers %.4g to %.4g THz but channel \"%s\" (band %.4g to "
-                           "%.4g THz, %s)%s reaches beyond it; %s",
+                           "%.4g THz, %s)%s beyond it; %s",
                            c->path, what, lo_hz * 1e-12, hi_hz * 1e-12, ch->name, lo * 1e-12,
-                           hi * 1e-12, index_band_how(ch), count > 1 ? " and others" : "",
-                           consequence))
+                           hi * 1e-12, index_band_how(ch),
+                           count > 1 ? " and others reach" : " reaches", consequence))
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");
     return THZ_OK;
 }
