@@ -118,6 +118,29 @@ static void test_defaults_and_range(void **state)
     thz_scene_destroy(s);
 }
 
+/* The shapes' defaults of scene-format.md "shapes", counted in triangles: a cylinder
+ * has caps (2 n side + 2 n cap triangles) and a disk 64 segments; a sphere 4
+ * subdivisions, 20 * 4^4 triangles. (Caps off by default left every cylinder open,
+ * subdivisions 3 gave 1280 triangles; neither was caught.) */
+static void test_shape_defaults(void **state)
+{
+    (void)state;
+    thz_scene *s = load_ok(
+        HEAD CHANNELS MATERIALS
+        "\"objects\": [{\"name\": \"can\", \"type\": \"solid\", \"material\": \"m\", "
+        "\"temperature_k\": 300, \"shape\": {\"type\": \"cylinder\", \"radius_m\": 0.5, "
+        "\"height_m\": 1}}, {\"name\": \"ball\", \"type\": \"solid\", \"material\": \"m\", "
+        "\"temperature_k\": 300, \"shape\": {\"type\": \"sphere\", \"radius_m\": 0.5}}, "
+        "{\"name\": \"disk\", \"type\": \"solid\", \"material\": \"m\", \"temperature_k\": 300, "
+        "\"shape\": {\"type\": \"disk\", \"radius_m\": 0.5}}], " SENSORS "}");
+    assert_int_equal(s->objects[0].mesh.n_triangles, 2 * 64 + 2 * 64);
+    /* the caps close it at z = 0 and z = height_m: a base at the origin */
+    assert_true(s->objects[0].mesh.bbox_min_m[2] == 0.0 && s->objects[0].mesh.bbox_max_m[2] == 1.0);
+    assert_int_equal(s->objects[1].mesh.n_triangles, 20 * 4 * 4 * 4 * 4);
+    assert_int_equal(s->objects[2].mesh.n_triangles, 64);
+    thz_scene_destroy(s);
+}
+
 static void test_blocks(void **state)
 {
     (void)state;
@@ -553,6 +576,7 @@ int main(void)
         cmocka_unit_test(test_example),
         cmocka_unit_test(test_defaults_and_range),
         cmocka_unit_test(test_blocks),
+        cmocka_unit_test(test_shape_defaults),
         cmocka_unit_test(test_optics_constant),
         cmocka_unit_test(test_csv_material_and_warnings),
         cmocka_unit_test(test_nested_enclosures),
