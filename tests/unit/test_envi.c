@@ -305,6 +305,61 @@ static void test_no_stderr(void **state)
     remove_dir(dir);
 }
 
+/* A sensor with a PSF writes the measured cubes (scene-format.md "Outputs"): their
+ * values, and the header keys of a per-channel cube with their own units, W m-2 sr-1 Hz-1
+ * and K. (`data units = 1` for the measured brightness temperature passed every test.) */
+static void test_measured_files(void **state)
+{
+    (void)state;
+    char *dir = make_tmp_dir();
+    thz_scene *scene = make_scene();
+    scene->sensors[0].psf = PSF_GAUSSIAN;
+    scene->sensors[0].psf_fwhm_deg = 0.5;
+    sensor_images img;
+    fill_images(&img, 0);
+    const size_t cube = (size_t)COLS * ROWS * NCH;
+    img.measured_radiance = thz_malloc_array(cube, sizeof *img.measured_radiance);
+    img.measured_brightness_temperature =
+        thz_malloc_array(cube, sizeof *img.measured_brightness_temperature);
+    assert_true(img.measured_radiance && img.measured_brightness_temperature);
+    for (size_t i = 0; i < cube; i++) {
+        img.measured_radiance[i] = (float)(2e-15 * (1.0 + (double)i));
+        img.measured_brightness_temperature[i] = (float)(250.0 + 0.5 * (double)i);
+    }
+    thz_error err = {0};
+    if (output_write_sensor(dir, scene, 0, &img, 0, NULL, &err) != THZ_OK)
+        fail_msg("output_write_sensor: %s", err.message);
+    struct {
+        const char *stem, *units;
+        const float *data;
+    } cubes[] = {
+        {"cam.measured_radiance", "W m-2 sr-1 Hz-1", img.measured_radiance},
+        {"cam.measured_brightness_temperature", "K", img.measured_brightness_temperature},
+    };
+    for (size_t k = 0; k < 2; k++) {
+        assert_img_floats(dir, cubes[k].stem, cubes[k].data, cube);
+        char *hdr = read_header(dir, cubes[k].stem);
+        assert_header(hdr, "bands", "2");
+        assert_header(hdr, "data units", cubes[k].units);
+        assert_header(hdr, "band names", "{0.200 THz, band  b ; 2}");
+        assert_header(hdr, "wavelength units", "GHz");
+        assert_header(hdr, "wavelength", "{200, 1200}");
+        char v[1024];
+        assert_non_null(header_value(hdr, "description", v, sizeof v));
+        if (!strstr(v, cubes[k].units) || !strstr(v, "Gaussian FWHM 0.5 deg"))
+            fail_msg("%s: description '%s' lacks its unit or the model", cubes[k].stem, v);
+        free(hdr);
+    }
+    for (size_t c = 1; c <= NCH; c++) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/cam.measured-band-%02zu.png", dir, c);
+        assert_int_equal(access(path, F_OK), 0);
+    }
+    sensor_images_fini(&img);
+    scene_destroy(scene);
+    remove_dir(dir);
+}
+
 /* Cubes that thzmap does not write but reads (thz_cube_read, classify): big-endian
  * (byte order = 1) and with bytes before the data (header offset). Both read as the same
  * values; the reader once could ignore either and pass every test (a helper's mutants). */
@@ -390,11 +445,9 @@ static void test_path_too_long(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_sensor_files),
-        cmocka_unit_test(test_no_stderr),
-        cmocka_unit_test(test_read_byte_order_and_offset),
-        cmocka_unit_test(test_unwritable),
-        cmocka_unit_test(test_path_too_long),
+        cmocka_unit_test(test_sensor_files),   cmocka_unit_test(test_no_stderr),
+        cmocka_unit_test(test_measured_files), cmocka_unit_test(test_read_byte_order_and_offset),
+        cmocka_unit_test(test_unwritable),     cmocka_unit_test(test_path_too_long),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
