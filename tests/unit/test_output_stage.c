@@ -539,6 +539,10 @@ static void test_summary_json(void **state)
     scene->sensors[0].name = thz_strdup("cam");
     scene->sensors[0].columns = 7;
     scene->sensors[0].rows = 5;
+    scene->sensors[0].fov_deg = 40.0;
+    scene->sensors[0].oversampling = 3;
+    scene->sensors[0].aperture_m2 = 0.02;
+    scene->sensors[0].normalize_to_k = 300.0;
     scene->n_objects = 1;
     scene->objects = thz_calloc(1, sizeof *scene->objects);
     scene->objects[0].name = thz_strdup("wall");
@@ -604,6 +608,14 @@ static void test_summary_json(void **state)
     json_t *c0 = json_array_get(chs, 0);
     assert_string_equal(json_string_value(json_object_get(c0, "name")), "a");
     assert_true(fabs(json_number_value(json_object_get(c0, "frequency_thz")) - 0.35) < 1e-12);
+    /* physics.md: a Gaussian's B_c = sqrt(pi / (4 ln 2)) FWHM = 1.0645 FWHM and B_n =
+     * sqrt(pi / (2 ln 2)) FWHM = 1.5054 FWHM, FWHM = 0.01 * 350 GHz (the two swapped
+     * passed every unit test) */
+    const double fwhm_ghz = 3.5;
+    assert_true(fabs(json_number_value(json_object_get(c0, "bandwidth_ghz")) -
+                     sqrt(M_PI / (4.0 * log(2.0))) * fwhm_ghz) < 1e-9);
+    assert_true(fabs(json_number_value(json_object_get(c0, "noise_bandwidth_ghz")) -
+                     sqrt(M_PI / (2.0 * log(2.0))) * fwhm_ghz) < 1e-9);
     assert_int_equal(json_integer_value(json_object_get(c0, "photons_fired")), 1000);
     assert_int_equal(json_integer_value(json_object_get(c0, "photons_stored")), 1500);
     /* per photon fired: 0.9 + 0.06 + 0.04 = 1; per hit: 0.2 and 0.1333 */
@@ -646,6 +658,11 @@ static void test_summary_json(void **state)
     assert_int_equal(json_integer_value(json_object_get(s0, "columns")), 7);
     assert_int_equal(json_integer_value(json_object_get(s0, "rows")), 5);
     assert_int_equal(json_integer_value(json_object_get(s0, "back_face_samples")), 3);
+    /* the sensor's keys in the scene's units (an aperture in cm^2, 200, passed unseen) */
+    assert_true(json_number_value(json_object_get(s0, "fov_deg")) == 40.0);
+    assert_int_equal(json_integer_value(json_object_get(s0, "oversampling")), 3);
+    assert_true(json_number_value(json_object_get(s0, "aperture_m2")) == 0.02);
+    assert_true(json_number_value(json_object_get(s0, "normalize_to_k")) == 300.0);
     json_t *t = json_object_get(root, "timings_s");
     assert_true(fabs(json_number_value(json_object_get(t, "photons")) - 1.25) < 1e-12);
     json_t *w = json_object_get(root, "warnings");
