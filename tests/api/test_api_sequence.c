@@ -218,6 +218,47 @@ int main(int argc, char **argv)
         thz_sequence_destroy(m);
     }
 
+    /* keyframe times strictly increasing: two at the same time are refused, naming the
+     * later one (accepted, the segment between them had length 0) */
+    snprintf(path, sizeof path, "%s/same-time.json", dir);
+    test_write_file(path,
+                    "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\", \"fps\": 2,\n"
+                    " \"keyframes\": [{\"time_s\": 1, \"objects\": {\"plate\": {\"temperature_k\": "
+                    "300}}},\n  {\"time_s\": 1, \"objects\": {\"plate\": {\"temperature_k\": "
+                    "310}}}]}\n");
+    thz_sequence *same = NULL;
+    thz_error serr = {0};
+    CHECK(thz_sequence_load(path, &same, &serr) == THZ_ERR_INPUT && same == NULL &&
+              strstr(serr.message,
+                     "keyframes[1].time_s: expected keyframe times in increasing order"),
+          "keyframes at the same time: status %d '%s'", (int)serr.status, serr.message);
+    thz_sequence_destroy(same);
+
+    /* a sweep of two keys runs every combination, the first key varying slowest: sweep s
+     * has the plate at 300 + 10 (s / 3) K (the sweep's values of the other key, 3, vary
+     * fastest; every key indexed by s alone passed the other tests) */
+    snprintf(path, sizeof path, "%s/two-keys.json", dir);
+    test_write_file(path, "{\"format\": \"thzmap-sequence/1\", \"scene\": \"scene.json\",\n"
+                          " \"sweep\": {\"objects.plate.temperature_k\": [300, 310],\n"
+                          "  \"atmosphere.attenuation_per_m\": [0.01, 0.1, 0.2]}}\n");
+    thz_sequence *two = NULL;
+    REQUIRE_OK(thz_sequence_load(path, &two, &err), &err);
+    CHECK(thz_sequence_frame_count(two) == 6, "two keys of 2 and 3 values: %zu frames",
+          thz_sequence_frame_count(two));
+    for (size_t i = 0; i < 6 && i < thz_sequence_frame_count(two); i++) {
+        double x, width, t_k;
+        plate_in_frame(two, i, &x, &width, &t_k);
+        char json[4096];
+        thz_sequence_frame_json(two, i, json, sizeof json);
+        static const double att[3] = {0.01, 0.1, 0.2};
+        const char *a = strstr(json, "\"attenuation_per_m\":");
+        double got = a ? strtod(a + strlen("\"attenuation_per_m\":"), NULL) : NAN;
+        CHECK(t_k == 300.0 + 10.0 * (double)(i / 3) && got == att[i % 3],
+              "sweep %zu: the plate at %g K, attenuation %g per m; expected %g K, %g per m", i, t_k,
+              got, 300.0 + 10.0 * (double)(i / 3), att[i % 3]);
+    }
+    thz_sequence_destroy(two);
+
     /* sweep directories sort in order: sweep-00 .. sweep-99, sweep-000 .. sweep-100 (the
      * batch writes where these say: test_batch.sh) */
     sweep_dirs(dir, 100, "sweep-00/frame-00000", "sweep-99/frame-00000");
