@@ -259,6 +259,43 @@ int main(int argc, char **argv)
     }
     thz_sequence_destroy(two);
 
+    /* a frame's input hash covers the files its scene names under any "*_file" key: a
+     * channel's response_file changed under the same name changes the hash, so that a
+     * resumed batch redoes the frame (only "file" was hashed in a helper's mutant, and
+     * every test passed: a resumed batch kept frames of the old response) */
+    snprintf(path, sizeof path, "%s/resp.csv", dir);
+    test_write_file(path, "frequency_thz,weight\n0.58,0\n0.60,1\n0.62,0\n");
+    snprintf(path, sizeof path, "%s/resp-scene.json", dir);
+    test_write_file(
+        path, "{\"format\": \"thzmap-scene/1\", \"name\": \"resp\",\n"
+              " \"channels\": [{\"frequency_thz\": 0.6, \"response_file\": \"resp.csv\"}],\n"
+              " \"materials\": {\"wall\": {\"reflectivity\": 0.2}},\n"
+              " \"objects\": [{\"name\": \"room\", \"type\": \"solid\", \"material\": \"wall\",\n"
+              "   \"temperature_k\": 295, \"shape\": {\"type\": \"box\", \"size_m\": [4, 4, 4],\n"
+              "   \"inward\": true}}],\n"
+              " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -1.5, 0], \"look_at_m\": [0, "
+              "0, 0],\n   \"fov_deg\": 60, \"resolution\": [8, 6]}]}\n");
+    snprintf(path, sizeof path, "%s/resp-seq.json", dir);
+    test_write_file(path, "{\"format\": \"thzmap-sequence/1\", \"scene\": \"resp-scene.json\"}\n");
+    uint64_t resp_hash[3] = {0, 0, 0};
+    for (int k = 0; k < 3; k++) {
+        if (k == 2) { /* the same name, another response */
+            char csv[4200];
+            snprintf(csv, sizeof csv, "%s/resp.csv", dir);
+            test_write_file(csv, "frequency_thz,weight\n0.59,0\n0.61,1\n0.63,0\n");
+        }
+        thz_sequence *r = NULL;
+        thz_frame_info ri = {0};
+        REQUIRE_OK(thz_sequence_load(path, &r, &err), &err);
+        REQUIRE_OK(thz_sequence_frame(r, 0, &ri), &err);
+        resp_hash[k] = ri.hash;
+        thz_sequence_destroy(r);
+    }
+    CHECK(resp_hash[0] == resp_hash[1] && resp_hash[1] != resp_hash[2],
+          "input hashes %016llx, %016llx (the same file), %016llx (its content changed)",
+          (unsigned long long)resp_hash[0], (unsigned long long)resp_hash[1],
+          (unsigned long long)resp_hash[2]);
+
     /* sweep directories sort in order: sweep-00 .. sweep-99, sweep-000 .. sweep-100 (the
      * batch writes where these say: test_batch.sh) */
     sweep_dirs(dir, 100, "sweep-00/frame-00000", "sweep-99/frame-00000");
