@@ -141,6 +141,22 @@ static void test_shape_defaults(void **state)
     thz_scene_destroy(s);
 }
 
+/* scene-format.md: objects lie within 1e9 m of the origin; one just inside that limit
+ * (its top at 999 999 000.5 m, in float 999 999 040 m) loads. (A limit of 5e8 m passed
+ * every test: only objects beyond it, at 2e9 m, were tried.) */
+static void test_far_object_within_limit(void **state)
+{
+    (void)state;
+    thz_scene *s = load_ok(
+        HEAD CHANNELS MATERIALS
+        "\"objects\": [{\"name\": \"far\", \"type\": \"solid\", \"material\": \"m\", "
+        "\"temperature_k\": 300, \"shape\": " BOX ", \"transform\": {\"translate_m\": [0, 0, "
+        "999999000]}}], " SENSORS "}");
+    assert_true(s->objects[0].mesh.bbox_max_m[2] > 9.9e8 &&
+                s->objects[0].mesh.bbox_max_m[2] <= 1e9);
+    thz_scene_destroy(s);
+}
+
 static void test_blocks(void **state)
 {
     (void)state;
@@ -577,6 +593,7 @@ int main(void)
         cmocka_unit_test(test_defaults_and_range),
         cmocka_unit_test(test_blocks),
         cmocka_unit_test(test_shape_defaults),
+        cmocka_unit_test(test_far_object_within_limit),
         cmocka_unit_test(test_optics_constant),
         cmocka_unit_test(test_csv_material_and_warnings),
         cmocka_unit_test(test_nested_enclosures),
