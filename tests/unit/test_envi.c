@@ -232,6 +232,14 @@ static void test_sensor_files(void **state)
         char v[1024];
         assert_non_null(header_value(hdr, "description", v, sizeof v));
         assert_non_null(strstr(v, cubes[k].units));
+        /* {thzmap VERSION: QUANTITY [UNIT]; sensor S; scene NAME} (the two names swapped
+         * passed every test) */
+        char want[256];
+        snprintf(want, sizeof want, "[%s]; sensor cam; scene synthetic}", cubes[k].units);
+        if (strncmp(v, "{thzmap " THZ_VERSION_STRING ": ", 10 + strlen(THZ_VERSION_STRING)) != 0 ||
+            strlen(v) < strlen(want) || strcmp(v + strlen(v) - strlen(want), want) != 0)
+            fail_msg("%s: description '%s', expected '{thzmap %s: ... %s'", cubes[k].stem, v,
+                     THZ_VERSION_STRING, want);
         if (cubes[k].n == cube) {
             /* List characters in a channel name must not break the list. */
             assert_header(hdr, "band names", "{0.200 THz, band  b ; 2}");
