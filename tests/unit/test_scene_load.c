@@ -13,6 +13,7 @@
 
 #include <cmocka.h>
 
+#include "atmosphere/atmosphere.h"
 #include "scene/scene.h"
 
 #define SRC THZ_SOURCE_DIR
@@ -155,6 +156,43 @@ static void test_far_object_within_limit(void **state)
     assert_true(s->objects[0].mesh.bbox_max_m[2] > 9.9e8 &&
                 s->objects[0].mesh.bbox_max_m[2] <= 1e9);
     thz_scene_destroy(s);
+}
+
+/* The atmosphere's defaults (scene-format.md "atmosphere"): the background is the air's
+ * temperature where the air's is given (0 K, a cold sky, passed every test), the air's
+ * is 293.15 K without an enclosure around the sensors; the lines
+ * model includes the continuum (continuum off by default passed too): the same
+ * attenuation as "continuum": true, more than without it. */
+static void test_atmosphere_defaults(void **state)
+{
+    (void)state;
+    thz_scene *s = load_ok(HEAD CHANNELS MATERIALS OBJECT(BOX) SENSORS
+                           ", \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": "
+                           "0.01, \"temperature_k\": 280}}");
+    assert_true(s->atmosphere.emitting && s->atmosphere.background_temperature_k == 280.0);
+    thz_scene_destroy(s);
+    /* no temperature and no enclosure around the sensor (a box seen from outside): the
+     * air and its background at 293.15 K (295 K passed every test) */
+    s = load_ok(HEAD CHANNELS MATERIALS OBJECT(BOX) SENSORS
+                ", \"atmosphere\": {\"model\": \"constant\", \"attenuation_per_m\": 0.01}}");
+    assert_true(s->atmosphere.air.temperature_k == 293.15 &&
+                s->atmosphere.background_temperature_k == 293.15);
+    thz_scene_destroy(s);
+    double alpha[3];
+    static const char *const continuum[3] = {"", ", \"continuum\": true", ", \"continuum\": false"};
+    for (int k = 0; k < 3; k++) {
+        char json[2048];
+        snprintf(json, sizeof json,
+                 "%s%s%s%s%s, \"atmosphere\": {\"model\": \"lines\", \"temperature_k\": 296, "
+                 "\"pressure_hpa\": 1013.25, \"relative_humidity\": 0.5%s}}",
+                 HEAD, CHANNELS, MATERIALS, OBJECT(BOX), SENSORS, continuum[k]);
+        s = load_ok(json);
+        alpha[k] = atmosphere_alpha_direct_per_m(&s->atmosphere, 0.35e12);
+        thz_scene_destroy(s);
+    }
+    if (!(alpha[0] == alpha[1] && alpha[2] < alpha[1]))
+        fail_msg("alpha at 0.35 THz: %g per m by default, %g with the continuum, %g without",
+                 alpha[0], alpha[1], alpha[2]);
 }
 
 static void test_blocks(void **state)
@@ -594,6 +632,7 @@ int main(void)
         cmocka_unit_test(test_blocks),
         cmocka_unit_test(test_shape_defaults),
         cmocka_unit_test(test_far_object_within_limit),
+        cmocka_unit_test(test_atmosphere_defaults),
         cmocka_unit_test(test_optics_constant),
         cmocka_unit_test(test_csv_material_and_warnings),
         cmocka_unit_test(test_nested_enclosures),
