@@ -107,6 +107,9 @@ def test_batch_resumes_reports_and_cancels(tmp_path):
     reports = []
     result = thzmap.batch(seq, out, progress=reports.append, movies=False)
     assert (result.computed, result.reused, result.movies) == (3, 2, 0)
+    # every frame done, but no movie made: not complete (scene-format.md; it said
+    # complete once a helper's mutant ignored the movies, and every test passed)
+    assert result.summary["frames_done"] == 5 and result.summary["complete"] is False
     # the frames to run checked against the memory first (2, 3, 4: one photon group each
     # or one for all, as they share), then run
     stages = [p.stage for p in reports]
