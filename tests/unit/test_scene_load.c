@@ -116,6 +116,10 @@ static void test_defaults_and_range(void **state)
     assert_int_equal(s->render.paths_per_sample, 16);
     assert_false(s->objects[0].two_sided);
     assert_true(s->materials[0].attenuation_per_m.n == 1);
+    /* a material's defaults: no attenuation inside, diffuse transmission (1 per m and
+     * "straight" passed every loader test) */
+    assert_true(spectrum_eval(&s->materials[0].attenuation_per_m, 0.35e12) == 0.0);
+    assert_int_equal(s->materials[0].transmission, TRANSMISSION_DIFFUSE);
     thz_scene_destroy(s);
 }
 
