@@ -177,6 +177,17 @@ static void test_kirchhoff_violation(void **state)
     (void)state;
     optics_point o = shell(0.2, 100.0, 0.002);
     assert_true(optics_kirchhoff_violation(&o) == 0.0);
+    /* a shell that absorbs nothing (alpha_M = 0) transmits 1 - R at every angle, so
+     * A(mu) = 0 and an explicit eps violates Kirchhoff by eps itself: taking
+     * A(0+) = 1 - R there, as for an absorbing shell, reported 0.7 for eps = 0.1, R = 0.2
+     * (a helper's mutant, which no test noticed) */
+    optics_point clear = {.reflectivity = 0.2,
+                          .attenuation_per_m = 0.0,
+                          .thickness_m = 0.002,
+                          .emissivity = 0.1,
+                          .explicit_emissivity = true};
+    assert_true(optics_absorption(&clear, 0.01) == 0.0 && optics_absorption(&clear, 1.0) == 0.0);
+    assert_true(fabs(optics_kirchhoff_violation(&clear) - 0.1) < 1e-15);
     optics_point solid = {.reflectivity = 0.3,
                           .attenuation_per_m = 0.0,
                           .thickness_m = 0.0,
