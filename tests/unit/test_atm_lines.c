@@ -1,5 +1,6 @@
 /* The `lines` model: agreement with itu-p676 below 1 THz, line positions, humidity
- * scaling, HITRAN .par reading, the per-band tabulation and the Voigt profile. */
+ * scaling, HITRAN .par reading, the per-band tabulation, the Voigt profile, and both
+ * models' line widths at low pressure. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -439,6 +440,63 @@ static void test_band_split(void **state)
     assert_true(most_near <= 50.0);
 }
 
+/* Half width at half maximum (GHz) of the line peaking at f0_ghz: bisection on each
+ * side for alpha = alpha(f0) / 2 within 10 guess_ghz. */
+static double half_width_ghz(const thz_atmosphere *atm, double f0_ghz, double guess_ghz)
+{
+    double peak = atmosphere_alpha_direct_per_m(atm, f0_ghz * 1e9), sum = 0.0;
+    for (int side = -1; side <= 1; side += 2) {
+        double lo = 0.0, hi = 10.0 * guess_ghz;
+        for (int i = 0; i < 80; i++) {
+            double mid = 0.5 * (lo + hi);
+            double a = atmosphere_alpha_direct_per_m(atm, (f0_ghz + side * mid) * 1e9);
+            *(a > 0.5 * peak ? &lo : &hi) = mid;
+        }
+        sum += 0.5 * (lo + hi);
+    }
+    return 0.5 * sum;
+}
+
+/* At 1e-5 hPa the pressure widths vanish (~1e-8 GHz) and what remains is checked
+ * against physics, not the code: the H2O 22.235 GHz line's Doppler half width
+ * nu0/c sqrt(2 ln 2 k T / m), m = 18.0106 u (lines: the Voigt profile's Gaussian limit;
+ * itu-p676: P.676-13 eq. 6b's 2.1316e-12 f0^2 / theta GHz^2, this to 0.1 %), and
+ * itu-p676's O2 Zeeman floor of 1.5 MHz (eq. 6b: sqrt(df^2 + 2.25e-6)) at 118.75 GHz.
+ * The 1 atm tests see none of them: a Doppler width off by sqrt 2 or with the H2-18O
+ * mass, a Zeeman floor or P.676's Doppler term 10 x too wide, all survived them (a
+ * helper's mutants). 1 %. */
+static void test_low_pressure_widths(void **state)
+{
+    (void)state;
+    const double k = 1.380649e-23, amu = 1.66053906660e-27, c = 299792458.0, t = 300.0;
+    const double doppler_per_ghz = sqrt(2.0 * M_LN2 * k * t / (18.010565 * amu)) / c;
+    thz_error err = {0};
+    atm_air_state air;
+    assert_int_equal(atm_air_state_init(&air, t, 1e-5, ATM_HUMIDITY_VMR, 0.01, &err), THZ_OK);
+    thz_atmosphere itu = {0}, lbl;
+    assert_int_equal(atmosphere_init_itu_p676(&itu, &air, NULL, &err), THZ_OK);
+    init_lines(&lbl, &air, NULL);
+    const struct {
+        const thz_atmosphere *atm;
+        double f0_ghz, want_ghz;
+        const char *what;
+    } cases[] = {
+        {&lbl, 22.235067, 22.235067 * doppler_per_ghz, "lines: H2O 22.235 GHz (Doppler)"},
+        {&itu, 22.235080, 22.235080 * doppler_per_ghz, "itu-p676: H2O 22.235 GHz (Doppler)"},
+        {&itu, 118.750334, 1.5e-3, "itu-p676: O2 118.75 GHz (Zeeman)"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        double w = half_width_ghz(cases[i].atm, cases[i].f0_ghz, cases[i].want_ghz);
+        print_message("%s: half width %.4g kHz, want %.4g kHz\n", cases[i].what, w * 1e6,
+                      cases[i].want_ghz * 1e6);
+        if (!(fabs(w / cases[i].want_ghz - 1.0) < 0.01))
+            fail_msg("%s at 1e-5 hPa: half width %g kHz, want %g kHz", cases[i].what, w * 1e6,
+                     cases[i].want_ghz * 1e6);
+    }
+    atmosphere_fini(&itu);
+    atmosphere_fini(&lbl);
+}
+
 /* The Voigt profile against a direct quadrature of its defining convolution,
  * V(x) = int G(t) L(x - t) dt, to 1e-7 (the quadrature's own error is ~1e-9). */
 static void test_voigt_quadrature(void **state)
@@ -496,6 +554,7 @@ int main(void)
         cmocka_unit_test(test_band_split),
         cmocka_unit_test(test_voigt_quadrature),
         cmocka_unit_test(test_voigt),
+        cmocka_unit_test(test_low_pressure_widths),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
