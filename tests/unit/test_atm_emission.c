@@ -88,6 +88,13 @@ static void test_extent(void **state)
     assert_true(fabs(atmosphere_extent_exit_m(&atm, o, dz) - 3.0) < 1e-12);
     assert_true(fabs(atmosphere_extent_exit_m(&atm, o, d45) - M_SQRT2) < 1e-12);
     assert_true(atmosphere_extent_exit_m(&atm, out, dx) == 0.0);
+    /* from off the box's centre, along each negative axis: the distance to the min face
+     * (a centred origin cannot tell it from the max face's; a helper's mutant measuring
+     * to the wrong face survived) */
+    double off[3] = {0.5, -1.5, 2.0}, mx[3] = {-1, 0, 0}, my[3] = {0, -1, 0}, mz[3] = {0, 0, -1};
+    assert_true(fabs(atmosphere_extent_exit_m(&atm, off, mx) - 1.5) < 1e-12);
+    assert_true(fabs(atmosphere_extent_exit_m(&atm, off, my) - 0.5) < 1e-12);
+    assert_true(fabs(atmosphere_extent_exit_m(&atm, off, mz) - 5.0) < 1e-12);
     double f = 1e12, d = 1.0, t = exp(-0.1 * d);
     double want = planck_radiance(f, 3.0) * t + planck_radiance(f, 280.0) * (1 - t);
     assert_true(fabs(atmosphere_escape_radiance(&atm, f, d) / want - 1) < 1e-12);
