@@ -75,8 +75,14 @@ static inline double lbl_line_alpha(lbl_shape shape, const lbl_line *l, double f
     double term;
     switch (shape) {
     case SHAPE_COUPLED:
-        term =
-            (g * l->g + d1 * l->y) / (d1 * d1 + g * g) + (g * l->g - d2 * l->y) / (d2 * d2 + g * g);
+        /* where Doppler matters, the resonant absorption G L(d1) becomes G times the
+         * Voigt core; the dispersive d1 Y / (d1^2 + g^2) stays (Y grows with pressure:
+         * it is negligible there) */
+        if (l->voigt)
+            term = l->g * core(l, d1) + d1 * l->y / (d1 * d1 + g * g);
+        else
+            term = (g * l->g + d1 * l->y) / (d1 * d1 + g * g);
+        term += (g * l->g - d2 * l->y) / (d2 * d2 + g * g);
         break;
     case SHAPE_VVH_CUTOFF:
         term = 0.0;

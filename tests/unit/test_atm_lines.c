@@ -457,14 +457,13 @@ static double half_width_ghz(const thz_atmosphere *atm, double f0_ghz, double gu
     return 0.5 * sum;
 }
 
-/* At 1e-5 hPa the pressure widths vanish (~1e-8 GHz) and what remains is checked
- * against physics, not the code: the H2O 22.235 GHz line's Doppler half width
- * nu0/c sqrt(2 ln 2 k T / m), m = 18.0106 u (lines: the Voigt profile's Gaussian limit;
- * itu-p676: P.676-13 eq. 6b's 2.1316e-12 f0^2 / theta GHz^2, this to 0.1 %), and
- * itu-p676's O2 Zeeman floor of 1.5 MHz (eq. 6b: sqrt(df^2 + 2.25e-6)) at 118.75 GHz.
- * The 1 atm tests see none of them: a Doppler width off by sqrt 2 or with the H2-18O
- * mass, a Zeeman floor or P.676's Doppler term 10 x too wide, all survived them (a
- * helper's mutants). 1 %. */
+/* At 1e-5 hPa the pressure widths vanish (~1e-8 GHz); what remains is checked against
+ * physics: the Doppler half width nu0/c sqrt(2 ln 2 k T / m) of H2O at 22.235 GHz (lines:
+ * the Voigt limit; itu-p676: P.676-13 eq. 6b's 2.1316e-12 f0^2 / theta GHz^2, this to
+ * 0.1 %) and of the lines' line-mixed O2 118.75 GHz line (a Lorentzian 8000 x too narrow
+ * before), and itu-p676's 1.5 MHz O2 Zeeman floor (eq. 6b). The 1 atm tests saw none:
+ * a Doppler width off by sqrt 2 or with the H2-18O mass, or P.676's Zeeman or Doppler
+ * term 10 x too wide, survived them (a helper's mutants). 1 %. */
 static void test_low_pressure_widths(void **state)
 {
     (void)state;
@@ -484,6 +483,8 @@ static void test_low_pressure_widths(void **state)
         {&lbl, 22.235067, 22.235067 * doppler_per_ghz, "lines: H2O 22.235 GHz (Doppler)"},
         {&itu, 22.235080, 22.235080 * doppler_per_ghz, "itu-p676: H2O 22.235 GHz (Doppler)"},
         {&itu, 118.750334, 1.5e-3, "itu-p676: O2 118.75 GHz (Zeeman)"},
+        {&lbl, 118.750341, 118.750341 * doppler_per_ghz * sqrt(18.010565 / 31.98983),
+         "lines: O2 118.75 GHz, mixed (Doppler)"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         double w = half_width_ghz(cases[i].atm, cases[i].f0_ghz, cases[i].want_ghz);
