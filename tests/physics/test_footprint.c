@@ -11,7 +11,13 @@
  * effective photon count (its count itself where the powers are equal). Its mean over
  * the pixels is checked against rho (E p)^2 / E p^2 A_g computed here from the camera's
  * geometry: the far wall fills the view, d = sqrt(1 + x^2 + y^2) and cos theta = 1 / d
- * for the pixel centre (x, y) on the unit image plane, so A_g = Omega_S d^3. */
+ * for the pixel centre (x, y) on the unit image plane, so A_g = Omega_S d^3.
+ *
+ * With oversampling n each of the n^2 samples gathers over A_g / n^2 and the pixel is
+ * their mean, whose variance is the sum of theirs over n^4: the pixel's effective count
+ * is again rho A_g (the disks are disjoint). A footprint of Omega_S / n (not n^2) gave
+ * n times the count, a variance over n^2 (not n^4) n^2 times too small a count: both
+ * change the standard error the user reads by a factor n and passed every test. */
 #include "identity.h"
 
 #define FOOT_HALF_M 1.0 /* the box: 2 m a side, the camera at its centre */
@@ -28,10 +34,11 @@ static double foot_rectangle_sr(double x0, double x1, double y0, double y1)
     return f11 - f01 - f10 + f00;
 }
 
-static void test_gather_area(void **state)
+static void check_gather_area(uint32_t oversampling)
 {
-    (void)state;
-    const char *json =
+    char json[1400];
+    snprintf(
+        json, sizeof json,
         "{\"format\": \"thzmap-scene/1\", \"name\": \"footprint\","
         " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.02}],"
         " \"materials\": {\"grey\": {\"reflectivity\": 0.5}},"
@@ -39,8 +46,10 @@ static void test_gather_area(void **state)
         "   \"temperature_k\": 300,"
         "   \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2], \"inward\": true}}],"
         " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, 0, 0], \"direction\": [0, 1, 0],"
-        "   \"up\": [0, 0, 1], \"fov_deg\": 60, \"resolution\": [24, 18]}],"
-        " \"photons\": {\"per_channel\": 600000, \"seed\": 11}}";
+        "   \"up\": [0, 0, 1], \"fov_deg\": 60, \"resolution\": [24, 18],"
+        "   \"oversampling\": %u}],"
+        " \"photons\": {\"per_channel\": 600000, \"seed\": 11, \"gather_min_photons\": 2}}",
+        oversampling);
     thz_scene *scene = NULL;
     thz_error err;
     thz_error_clear(&err);
@@ -94,14 +103,18 @@ static void test_gather_area(void **state)
                 corner = n_eff / (rho * a_g);
         }
     double ratio = measured / expected;
-    print_message("footprint: %zu photons stored, %.4g per disk expected on average, "
-                  "%.4g found: ratio %.4f (centre pixel %.3f, corner %.3f)\n",
-                  stored, expected / (double)pixels, measured / (double)pixels, ratio, centre,
-                  corner);
-    /* The mean count is ~100 per disk over 432 disks: its relative error is ~0.5 %. A
+    print_message(
+        "footprint, oversampling %u: %zu photons stored, %.4g per pixel expected on average, "
+        "%.4g found: ratio %.4f (centre pixel %.3f, corner %.3f)\n",
+        oversampling, stored, expected / (double)pixels, measured / (double)pixels, ratio, centre,
+        corner);
+    /* The mean count is ~100 per pixel over 432 pixels: its relative error is ~0.5 %. A
      * footprint pi times too large or small is off by a factor pi; one of d^2 instead of
-     * d^3 (a cosine missing) by 8 % on this view. */
-    assert_true(expected / (double)pixels > 60.0); /* far above gather_min_photons */
+     * d^3 (a cosine missing) by 8 % on this view; with n = 2, Omega_S / n by 2 x, the
+     * variance over n^2 by 4 x. No disk is widened (~100 / n^2 photons against k = 2):
+     * widened pixels take the correlated bound instead. */
+    assert_true(expected / (double)pixels > 60.0);
+    assert_int_equal(rs.widened_gathers, 0);
     assert_true(fabs(ratio - 1.0) < 0.04);
 
     photon_map_destroy(map);
@@ -110,10 +123,23 @@ static void test_gather_area(void **state)
     scene_destroy(scene);
 }
 
+static void test_gather_area(void **state)
+{
+    (void)state;
+    check_gather_area(1);
+}
+
+static void test_gather_area_oversampled(void **state)
+{
+    (void)state;
+    check_gather_area(2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gather_area),
+        cmocka_unit_test(test_gather_area_oversampled),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
