@@ -212,6 +212,43 @@ static void test_thread_count_does_not_matter(void **state)
     sensor_images_fini(&b);
 }
 
+/* The truth maps and the radiance face the same way, the way the camera model says: at
+ * fov 30 deg, 33 x 17 pixels (pitch p = 2 tan 15 deg / 33 on the unit image plane), the
+ * grey box's front face (x, z in [0.2, 0.4] m at y = -0.1, 2.8 m ahead) covers pixel
+ * (col 23, row 2), whose centre is (7 p, 6 p) = (0.114, 0.097); the pixel mirrored about
+ * the vertical axis, (9, 2), sees the corridor's side wall x = -0.5 m, 0.5 / 7 p ahead. A
+ * truth map mirrored against the render passed every test (the corridor is symmetric). */
+static void test_truth_faces_the_render(void **state)
+{
+    fixture *f = *state;
+    thz_sensor *s = &f->scene->sensors[0];
+    thz_sensor saved = *s;
+    s->fov_deg = 30.0;
+    s->columns = 33;
+    s->rows = 17;
+    s->oversampling = 1;
+    sensor_images img;
+    render_stats st;
+    render(f, 0, 1, &img, &st);
+    *s = saved;
+    double p = 2.0 * tan(15.0 * M_PI / 180.0) / 33.0, x = 7.0 * p, z = 6.0 * p;
+    assert_true(x > 0.2 / 2.8 && x < 0.4 / 2.8 && z > 0.2 / 2.8 && z < 0.4 / 2.8);
+    size_t box = 2 * 33 + 23, wall = 2 * 33 + 9;
+    double r = sqrt(1.0 + x * x + z * z), d_box = 2.8 * r, d_wall = 0.5 / x * r;
+    assert_int_equal(img.object_id[box], 1);
+    assert_int_equal(img.object_id[wall], 0);
+    assert_true(fabs(img.distance_m[box] - d_box) < 1e-5);
+    assert_true(fabs(img.distance_m[wall] - d_wall) < 1e-5);
+    assert_true(img.temperature_k[box] == 320.0f && img.temperature_k[wall] == 300.0f);
+    /* the black wall: B(300 K) exp(-alpha d); the box's own emission alone,
+     * (1 - R) B(320 K) exp(-alpha d), is a lower bound of its radiance */
+    const thz_channel *ch = &f->scene->channels[0];
+    double wall_l = ident_band_planck(ch, 300.0) * exp(-0.2 * d_wall);
+    assert_true(fabs(img.radiance[wall] - wall_l) <= 1e-5 * wall_l);
+    assert_true(img.radiance[box] > 0.5 * ident_band_planck(ch, 320.0) * exp(-0.2 * d_box));
+    sensor_images_fini(&img);
+}
+
 static int cancel_at_second_call(void *user, const thz_progress *p)
 {
     int *calls = user;
@@ -370,6 +407,7 @@ int main(void)
         cmocka_unit_test(test_oversampled_attenuation_and_truth),
         cmocka_unit_test(test_back_faces_are_black_and_counted),
         cmocka_unit_test(test_thread_count_does_not_matter),
+        cmocka_unit_test(test_truth_faces_the_render),
         cmocka_unit_test(test_cancel),
         cmocka_unit_test(test_back_faces_every_integrator),
         cmocka_unit_test(test_integrator_table),
