@@ -18,6 +18,8 @@
 #include "scene/scene.h"
 #include "sensor/noise.h"
 
+#include "../physics/identity.h"
+
 enum { COLUMNS = 64, ROWS = 4, PIXELS = COLUMNS * ROWS };
 
 static thz_scene *load(const char *noise)
@@ -73,8 +75,59 @@ static void test_table_against_its_nodes(void **state)
                 "\"radiometer\": \"total-power\"}");
 }
 
+/* Band mean of dB_nu/dT at temp_k over ch by a central difference of the independent
+ * trapezoid band mean (identity.h), W m^-2 sr^-1 Hz^-1 K^-1. */
+static double band_dbdt(const thz_channel *ch, double temp_k)
+{
+    const double h = 0.01;
+    return (ident_band_planck(ch, temp_k + h) - ident_band_planck(ch, temp_k - h)) / (2.0 * h);
+}
+
+/* The noise is NETD in K turned into radiance by the band mean of dB/dT at each pixel's
+ * own Tb: at 1 THz, a plane at 30 K (h nu / k T = 1.6) takes 0.81 x the dB/dT of one at
+ * 300 K. Each pixel draws on its own stream, so its noise in the 30 K plane over that in
+ * the 300 K plane is that ratio exactly; and the 300 K plane's noise over NETD dB/dT is a
+ * unit normal: spread 1 within 3 / sqrt(2 (N - 1)), mean 0 within 3 / sqrt(N). sigma_L
+ * taken at a fixed 300 K (its noise in K then wrong where Tb is far from it) passed every
+ * test: at 0.35 THz, where test_sensor.sh's hot ball is, dB/dT is flat in T. */
+static void test_sigma_follows_tb(void **state)
+{
+    (void)state;
+    thz_scene *s = load("{\"netd_k\": 0.5}");
+    const thz_sensor *sn = &s->sensors[0];
+    const thz_channel *ch = &s->channels[0];
+    static float cold[PIXELS], warm[PIXELS], l_cold[PIXELS], l_warm[PIXELS];
+    for (size_t p = 0; p < PIXELS; p++) {
+        cold[p] = 30.0f;
+        warm[p] = 300.0f;
+    }
+    memset(l_cold, 0, sizeof l_cold);
+    memset(l_warm, 0, sizeof l_warm);
+    thz_error err;
+    assert_int_equal(noise_apply(sn, 0, ch, 0, 5, cold, l_cold, 1, &err), THZ_OK);
+    assert_int_equal(noise_apply(sn, 0, ch, 0, 5, warm, l_warm, 1, &err), THZ_OK);
+    double d_cold = band_dbdt(ch, 30.0), d_warm = band_dbdt(ch, 300.0);
+    assert_true(d_cold / d_warm < 0.85); /* the case tells the two apart */
+    double sum = 0.0, sum2 = 0.0;
+    for (size_t p = 0; p < PIXELS; p++) {
+        double ratio = (double)l_cold[p] / (double)l_warm[p];
+        if (!(fabs(ratio / (d_cold / d_warm) - 1.0) < 1e-5))
+            fail_msg("pixel %zu: noise at 30 K over that at 300 K %.6f, dB/dT ratio %.6f", p, ratio,
+                     d_cold / d_warm);
+        double z = (double)l_warm[p] / (0.5 * d_warm);
+        sum += z;
+        sum2 += z * z;
+    }
+    double n = PIXELS, mean = sum / n, sd = sqrt((sum2 - n * mean * mean) / (n - 1.0));
+    if (!(fabs(sd - 1.0) < 3.0 / sqrt(2.0 * (n - 1.0)) && fabs(mean) < 3.0 / sqrt(n)))
+        fail_msg("noise over NETD dB/dT: spread %.4f, mean %+.4f over %zu pixels", sd, mean,
+                 (size_t)PIXELS);
+    thz_scene_destroy(s);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_table_against_its_nodes)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_table_against_its_nodes),
+                                       cmocka_unit_test(test_sigma_follows_tb)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
