@@ -201,6 +201,29 @@ static void test_sffs_drops_a_band(void **state)
     bands_search_result_fini(&r);
 }
 
+/* Sets whose worst-pair JM differ by less than 0.001 are tied; the mean JM, then the
+ * worst-pair B decide (analysis.md): two classes, unit variances, candidate 0 separating
+ * them by 8 (B = 64 / 8 = 8, JM = 2 (1 - e^-8)) and candidate 1 by 10 (B = 12.5), JM
+ * 6.6e-4 apart: both searches pick candidate 1. The B rule reversed (the set less well
+ * separated chosen) passed every test. */
+static void test_saturated_jm_tie_goes_to_larger_b(void **state)
+{
+    (void)state;
+    double m[2 * 2] = {0.0, 0.0, 8.0, 10.0};
+    double c[2 * 4] = {1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0};
+    bands_classes cl = {.n_candidates = 2, .n_classes = 2, .mean = m, .cov = c};
+    assert_true(2.0 * (exp(-8.0) - exp(-12.5)) < 1e-3); /* the two JM are tied */
+    const uint64_t limits[2] = {100, 0};                /* exhaustive, SFFS */
+    for (size_t i = 0; i < 2; i++) {
+        bands_search_result r;
+        thz_error err = {0};
+        assert_int_equal(bands_search(&cl, 1, limits[i], &r, &err), THZ_OK);
+        assert_int_equal(r.sets[0], 1);
+        assert_true(fabs(r.scores[0].worst_b - 12.5) < 1e-9);
+        bands_search_result_fini(&r);
+    }
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -222,6 +245,7 @@ int main(void)
         cmocka_unit_test(test_sffs_finds_features),
         cmocka_unit_test(test_sffs_drops_a_band),
         cmocka_unit_test(test_one_width_per_centre),
+        cmocka_unit_test(test_saturated_jm_tie_goes_to_larger_b),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
