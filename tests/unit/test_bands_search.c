@@ -103,6 +103,10 @@ static void check_search(uint64_t limit, const char *expect_search)
     thz_error err = {0};
     assert_int_equal(bands_search(&cl, 3, limit, &r, &err), THZ_OK);
     assert_string_equal(r.search, expect_search);
+    /* exhaustive: every set of 1, 2 and 3 of the 24 candidates once (an enumeration that
+     * stopped a candidate short never scored the last one) */
+    if (strcmp(expect_search, "exhaustive") == 0)
+        assert_int_equal(r.evaluations, 24 + 24 * 23 / 2 + 24 * 23 * 22 / 6);
     const size_t *two = r.sets + 1 * 3;
     assert_int_equal(two[0], 5);
     assert_int_equal(two[1], 17);
