@@ -269,6 +269,32 @@ static void test_split_depends_on_seed(void **state)
     classify_result_fini(&c);
 }
 
+/* A tie goes to the class of the lower object index (analysis.md): two objects whose
+ * spectra have the same shape, (300, 301) K and twice that, are the same to `sam` (angle 0
+ * to both means, exactly: the means are whole numbers and the second is twice the
+ * first), so every pixel goes to object 3, none to object 7; the last class taking the
+ * ties passed every test. */
+static void test_tie_goes_to_lower_object(void **state)
+{
+    (void)state;
+    enum { N = 40 };
+    float cube[2 * N];
+    int32_t truth[N];
+    for (size_t p = 0; p < N; p++) {
+        double scale = p < N / 2 ? 1.0 : 2.0;
+        truth[p] = p < N / 2 ? 3 : 7;
+        cube[p] = (float)(300.0 * scale);
+        cube[N + p] = (float)(301.0 * scale);
+    }
+    classify_result r;
+    thz_error err = {0};
+    assert_int_equal(classify_run(cube, 2, N, truth, CLASSIFY_SAM, 0.5, 1, &r, &err), THZ_OK);
+    for (size_t p = 0; p < N; p++)
+        assert_int_equal(r.assigned[p], 3);
+    assert_true(r.accuracy == 0.5);
+    classify_result_fini(&r);
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -299,6 +325,7 @@ int main(void)
         cmocka_unit_test(test_auc_and_roc_of_held_out_pixels),
         cmocka_unit_test(test_unequal_classes),
         cmocka_unit_test(test_split_depends_on_seed),
+        cmocka_unit_test(test_tie_goes_to_lower_object),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
