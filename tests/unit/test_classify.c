@@ -295,6 +295,31 @@ static void test_tie_goes_to_lower_object(void **state)
     classify_result_fini(&r);
 }
 
+/* LDA's prior: one band, object 0 of 180 pixels at -1 and +1 K (mean 0, variance 1),
+ * object 1 of 20 at +1 and +3 K (mean 2, variance 1). At x = 1 K, midway, the
+ * discriminants differ by ln(180 / 20) = 2.2 in favour of object 0, against what the
+ * training half's means move them by (0.1 and 0.3 K standard errors: about +-0.35): every
+ * pixel at 1 K goes to object 0. With the prior's sign reversed they went to object 1;
+ * the test of unequal classes did not see it. */
+static void test_lda_prior(void **state)
+{
+    (void)state;
+    enum { N = 200, N0 = 180 };
+    float cube[N];
+    int32_t truth[N];
+    for (size_t p = 0; p < N; p++) {
+        truth[p] = p < N0 ? 0 : 1;
+        cube[p] = p < N0 ? (p % 2 ? 1.0f : -1.0f) : (p % 2 ? 1.0f : 3.0f);
+    }
+    classify_result r;
+    thz_error err = {0};
+    assert_int_equal(classify_run(cube, 1, N, truth, CLASSIFY_LDA, 0.5, 1, &r, &err), THZ_OK);
+    for (size_t p = 0; p < N; p++)
+        if (cube[p] <= 1.0f)
+            assert_int_equal(r.assigned[p], 0);
+    classify_result_fini(&r);
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -326,6 +351,7 @@ int main(void)
         cmocka_unit_test(test_unequal_classes),
         cmocka_unit_test(test_split_depends_on_seed),
         cmocka_unit_test(test_tie_goes_to_lower_object),
+        cmocka_unit_test(test_lda_prior),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
