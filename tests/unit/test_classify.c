@@ -320,6 +320,32 @@ static void test_lda_prior(void **state)
     classify_result_fini(&r);
 }
 
+/* The matched filter's statistic is normalised, 1 at the target's mean and 0 at the
+ * background's, so that the classes' scores compare: one band, object 0 at -1 and +1 K
+ * (mean 0, variance 1), object 1 at 4 and 16 K (mean 10, variance 36). A pixel at 1 K
+ * scores (1 - 10) / (0 - 10) = 0.9 as object 0 and 1 / 10 = 0.1 as object 1; unnormalised,
+ * s~ Sigma_b^-1 (x - mu_b) gives 10 x 9 / 36 = 2.5 against 10 x 1 / 1 = 10, and every pixel
+ * of object 0 at +1 K went to object 1 (the noise-free test's classes have equal spreads,
+ * where the two agree). */
+static void test_matched_filter_normalised(void **state)
+{
+    (void)state;
+    enum { N = 200 };
+    float cube[N];
+    int32_t truth[N];
+    for (size_t p = 0; p < N; p++) {
+        truth[p] = p < N / 2 ? 0 : 1;
+        cube[p] = p < N / 2 ? (p % 2 ? 1.0f : -1.0f) : (p % 2 ? 4.0f : 16.0f);
+    }
+    classify_result r;
+    thz_error err = {0};
+    assert_int_equal(classify_run(cube, 1, N, truth, CLASSIFY_MATCHED_FILTER, 0.5, 1, &r, &err),
+                     THZ_OK);
+    for (size_t p = 0; p < N / 2; p++)
+        assert_int_equal(r.assigned[p], 0);
+    classify_result_fini(&r);
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -352,6 +378,7 @@ int main(void)
         cmocka_unit_test(test_split_depends_on_seed),
         cmocka_unit_test(test_tie_goes_to_lower_object),
         cmocka_unit_test(test_lda_prior),
+        cmocka_unit_test(test_matched_filter_normalised),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
