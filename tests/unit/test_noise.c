@@ -16,6 +16,8 @@
 #include <string.h>
 
 #include "scene/scene.h"
+#include "sensor/images.h"
+#include "sensor/measure.h"
 #include "sensor/noise.h"
 
 #include "../physics/identity.h"
@@ -125,9 +127,61 @@ static void test_sigma_follows_tb(void **state)
     thz_scene_destroy(s);
 }
 
+/* The radiometer sees the image through its PSF: its NETD (T_rec + Tb) follows the Tb
+ * after the PSF, not the sharp scene's (measure.h). Columns alternating 1000 K and 100 K
+ * under a Gaussian PSF of 4.8 pixels' FWHM are a uniform ~550 K after it, away from the
+ * mirrored left and right edges, so there the noise (measured less the PSF alone) has the
+ * same spread on the hot columns as on the cold: a ratio 1 within 3 x its precision,
+ * sqrt(2 / (N - 1)) with N = 88 each. Taken at the sharp Tb it was (1000 + 500) /
+ * (100 + 500) x their dB/dT ratio = 2.5 x, and passed every test (the PSF test has no
+ * noise, the noise tests had no PSF). */
+static void test_noise_after_the_psf(void **state)
+{
+    (void)state;
+    thz_scene *s = load("{\"receiver_temperature_k\": 500, \"integration_time_s\": 0.01, "
+                        "\"radiometer\": \"total-power\"}, \"psf\": \"gaussian\", "
+                        "\"psf_fwhm_deg\": 3");
+    thz_sensor *sn = &s->sensors[0];
+    sensor_images img;
+    thz_error err;
+    assert_int_equal(sensor_images_init(&img, COLUMNS, ROWS, 1, 0, &err), THZ_OK);
+    double hot = ident_band_planck(&s->channels[0], 1000.0);
+    double cold = ident_band_planck(&s->channels[0], 100.0);
+    for (size_t p = 0; p < PIXELS; p++)
+        img.radiance[p] = (float)(p % 2 ? hot : cold);
+    static float blurred[PIXELS];
+    thz_sensor_noise noise = sn->noise;
+    sn->noise.kind = NOISE_NONE;
+    assert_int_equal(sensor_measure(s, 0, 9, &img, 1, &err), THZ_OK);
+    memcpy(blurred, img.measured_radiance, sizeof blurred);
+    sn->noise = noise;
+    assert_int_equal(sensor_measure(s, 0, 9, &img, 1, &err), THZ_OK);
+    double sum[2] = {0.0, 0.0}, sum2[2] = {0.0, 0.0}, n = 0.0;
+    for (size_t p = 0; p < PIXELS; p++) {
+        size_t col = p % COLUMNS;
+        if (col < 10 || col >= COLUMNS - 10)
+            continue;
+        /* the PSF evened the image out */
+        assert_true(fabs(blurred[p] / (0.5 * (hot + cold)) - 1.0) < 0.01);
+        double d = (double)img.measured_radiance[p] - (double)blurred[p];
+        sum[col % 2] += d;
+        sum2[col % 2] += d * d;
+        n += 0.5;
+    }
+    assert_true(n == 88.0);
+    double sd[2];
+    for (int h = 0; h < 2; h++)
+        sd[h] = sqrt((sum2[h] - sum[h] * sum[h] / n) / (n - 1.0));
+    if (!(fabs(sd[1] / sd[0] - 1.0) < 3.0 * sqrt(2.0 / (n - 1.0))))
+        fail_msg("noise on the hot columns over that on the cold: %.4f, expected 1", sd[1] / sd[0]);
+    sensor_images_fini(&img);
+    thz_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_table_against_its_nodes),
-                                       cmocka_unit_test(test_sigma_follows_tb)};
+                                       cmocka_unit_test(test_sigma_follows_tb),
+                                       cmocka_unit_test(test_noise_after_the_psf)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
