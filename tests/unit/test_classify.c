@@ -346,6 +346,29 @@ static void test_matched_filter_normalised(void **state)
     classify_result_fini(&r);
 }
 
+/* --netd-k X adds Gaussian noise of X K (classify_add_noise): 4000 values of 0 K with
+ * sigma 0.5 K in band 0 have a spread of 0.5 K within 3 / sqrt(2 (N - 1)) of it and a mean
+ * of 0 within 3 sigma / sqrt(N); band 1, sigma 0, is untouched. A noise of sigma^2
+ * (0.25 K here) passed every test. */
+static void test_added_noise_spread(void **state)
+{
+    (void)state;
+    enum { N = 4000 };
+    static float cube[2 * N];
+    memset(cube, 0, sizeof cube);
+    const double sigma[2] = {0.5, 0.0};
+    classify_add_noise(cube, 2, N, sigma, 7);
+    double sum = 0.0, sum2 = 0.0;
+    for (size_t p = 0; p < N; p++) {
+        sum += cube[p];
+        sum2 += (double)cube[p] * cube[p];
+        assert_true(cube[N + p] == 0.0f);
+    }
+    double mean = sum / N, sd = sqrt((sum2 - N * mean * mean) / (N - 1));
+    if (!(fabs(sd / 0.5 - 1.0) < 3.0 / sqrt(2.0 * (N - 1)) && fabs(mean) < 3.0 * 0.5 / sqrt(N)))
+        fail_msg("noise of 0.5 K: spread %.4f K, mean %+.4f K", sd, mean);
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -379,6 +402,7 @@ int main(void)
         cmocka_unit_test(test_tie_goes_to_lower_object),
         cmocka_unit_test(test_lda_prior),
         cmocka_unit_test(test_matched_filter_normalised),
+        cmocka_unit_test(test_added_noise_spread),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
