@@ -232,6 +232,36 @@ assert r["cd"]["nuisances"]["angle_varied"], r["cd"]["nuisances"]
 assert max(max(v) for v in sd["cd"].values()) > 0.05, sd["cd"]
 PYEOF
 
+# nuisances by hand: black objects seen directly (no air, no reflection: path's estimate
+# is the band mean of B(T) exactly, no Monte Carlo noise), so raising the target A by
+# --temperature-range-k 3 raises its Tb by 3 K and the ambient (the room) by 2 K the
+# background's by 2 K; a uniform variation within +-range has the spread range / sqrt(3):
+# nuisance_sd_k 1.7321 K for A, 1.1547 K for the background, in every candidate (range /
+# 3 instead passed every test)
+cat > "$work/plate.json" <<'EOF'
+{"format": "thzmap-scene/1", "name": "plate",
+ "channels": [{"frequency_thz": 0.5, "relative_width": 0.01}],
+ "materials": {"black": {"reflectivity": 0}},
+ "objects": [{"name": "room", "type": "solid", "material": "black", "temperature_k": 290,
+              "shape": {"type": "box", "size_m": [4, 4, 4], "inward": true}},
+             {"name": "A", "type": "solid", "material": "black", "temperature_k": 300,
+              "shape": {"type": "box", "size_m": [0.6, 0.1, 0.6]},
+              "transform": {"translate_m": [0, 1, 0]}}],
+ "sensors": [{"name": "cam", "position_m": [0, 0, 0], "direction": [0, 1, 0], "up": [0, 0, 1],
+              "fov_deg": 40, "resolution": [16, 16]}],
+ "render": {"integrator": "path", "paths_per_sample": 1}}
+EOF
+"$THZMAP" bands "$work/plate.json" -o "$work/plate" --count 1 --from-thz 0.3 --to-thz 0.7 \
+    --step-ghz 200 --paths 1 -q --targets A --temperature-range-k 3 --ambient-range-k 2 \
+    --humidity-range 0 --netd-k 0.1 --threads 1 || fail "plate run exit status $?"
+$PY - "$work/plate/bands.json" <<'PYEOF' || fail "nuisance spreads: $(head -c 600 "$work/plate/bands.json")"
+import json, math, sys
+sd = {c["name"]: c["nuisance_sd_k"] for c in json.load(open(sys.argv[1]))["classes"]}
+for name, rng in (("A", 3.0), ("background", 2.0)):
+    assert len(sd[name]) == 3 and all(abs(x / (rng / math.sqrt(3.0)) - 1.0) < 1e-3
+                                      for x in sd[name]), (name, sd[name])
+PYEOF
+
 # bad input: exit status 2 and a message naming the problem
 expect2() {
     local what=$1; shift
