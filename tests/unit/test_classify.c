@@ -6,6 +6,7 @@
  * the held-out pixels, ties counted one half, against a count done here. */
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -369,6 +370,61 @@ static void test_added_noise_spread(void **state)
         fail_msg("noise of 0.5 K: spread %.4f K, mean %+.4f K", sd, mean);
 }
 
+/* Mahalanobis with each class's own covariance, the unbiased scatter / (n - 1): one band,
+ * object 0 of 5 pixels (0 .. 4 K: 3 train) against object 1 of 120 (3 .. 14.9 K), whose
+ * distances are recomputed here from the training pixels the result reports. Every pixel
+ * whose two distances differ by more than 1e-3 (the ridge is 1e-6) must go to the nearer
+ * class; with scatter / n the small class's variance is 2/3 of that and some pixels
+ * between the classes change sides (checked below, so that the test can fail), which
+ * passed every test. */
+static double class_distance(const float *x, const int32_t *truth, const uint8_t *train, size_t n,
+                             int32_t object, double v, bool unbiased)
+{
+    double sum = 0.0, sum2 = 0.0, k = 0.0;
+    for (size_t p = 0; p < n; p++)
+        if (truth[p] == object && train[p]) {
+            sum += x[p];
+            k += 1.0;
+        }
+    double mean = sum / k;
+    for (size_t p = 0; p < n; p++)
+        if (truth[p] == object && train[p])
+            sum2 += (x[p] - mean) * (x[p] - mean);
+    double var = sum2 / (unbiased ? k - 1.0 : k);
+    return (v - mean) * (v - mean) / var;
+}
+
+static void test_mahalanobis_unbiased_covariance(void **state)
+{
+    (void)state;
+    enum { N0 = 5, N = 125 };
+    float cube[N];
+    int32_t truth[N];
+    for (size_t p = 0; p < N; p++) {
+        truth[p] = p < N0 ? 0 : 1;
+        cube[p] = p < N0 ? (float)p : (float)(3.0 + 0.1 * (double)(p - N0));
+    }
+    classify_result r;
+    thz_error err = {0};
+    assert_int_equal(classify_run(cube, 1, N, truth, CLASSIFY_MAHALANOBIS, 0.5, 1, &r, &err),
+                     THZ_OK);
+    size_t checked = 0, flips = 0;
+    for (size_t p = 0; p < N; p++) {
+        double d0 = class_distance(cube, truth, r.train, N, 0, cube[p], true);
+        double d1 = class_distance(cube, truth, r.train, N, 1, cube[p], true);
+        double b0 = class_distance(cube, truth, r.train, N, 0, cube[p], false);
+        double b1 = class_distance(cube, truth, r.train, N, 1, cube[p], false);
+        if (fabs(d0 - d1) <= 1e-3 * (d0 + d1))
+            continue;
+        assert_int_equal(r.assigned[p], d0 < d1 ? 0 : 1);
+        checked++;
+        flips += (d0 < d1) != (b0 < b1);
+    }
+    assert_true(checked > N - 3);
+    assert_true(flips > 0);
+    classify_result_fini(&r);
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -403,6 +459,7 @@ int main(void)
         cmocka_unit_test(test_lda_prior),
         cmocka_unit_test(test_matched_filter_normalised),
         cmocka_unit_test(test_added_noise_spread),
+        cmocka_unit_test(test_mahalanobis_unbiased_covariance),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
