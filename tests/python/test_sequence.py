@@ -147,29 +147,39 @@ def test_batch_sweep_values_are_json_values(tmp_path):
         assert json.load(f)["sweep_values"] == res.summary["sweeps"][1]["values"]
 
 
+def _moving_camera_batch(tmp_path, positions, background_k=None, sweep=None):
+    """The plate in its box (8 x 6 pixels, 1 path), its camera at y = positions' (t, y),
+    3 frames at 1 fps, run by thzmap.batch without movies: (the warnings caught, the
+    RunWarnings' texts)."""
+    shutil.copytree(PLATE, tmp_path / "plate")
+    with open(tmp_path / "plate" / "scene.json") as f:
+        scene = json.load(f)
+    if background_k is not None:
+        scene["atmosphere"]["background_temperature_k"] = background_k
+    scene["sensors"][0]["resolution"] = [8, 6]
+    scene["render"] = {"integrator": "path", "paths_per_sample": 1}
+    with open(tmp_path / "plate" / "scene.json", "w") as f:
+        json.dump(scene, f)
+    seq = {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 3,
+           "keyframes": [{"time_s": t, "sensors": {"cam": {"position_m": [0, y, 0.4]}}}
+                         for t, y in positions]}
+    if sweep:
+        seq["sweep"] = sweep
+    with open(tmp_path / "plate" / "sequence.json", "w") as f:
+        json.dump(seq, f)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        thzmap.batch(tmp_path / "plate" / "sequence.json", tmp_path / "out", movies=False)
+    return caught, [str(w.message) for w in caught if issubclass(w.category, thzmap.RunWarning)]
+
+
 def test_batch_warnings_name_their_frame_once(tmp_path):
     # As test_validate.sh's sequence: the plate in its box with a background given (a
     # warning while the camera is in the room: the first frame of each sweep value), the
     # camera leaving the room at t = 1 s (frames 2 and 3 of each: a scene warning and a
     # run warning), swept over two temperatures of the target: 6 frames
-    shutil.copytree(PLATE, tmp_path / "plate")
-    with open(tmp_path / "plate" / "scene.json") as f:
-        scene = json.load(f)
-    scene["atmosphere"]["background_temperature_k"] = 3
-    scene["sensors"][0]["resolution"] = [8, 6]
-    scene["render"] = {"integrator": "path", "paths_per_sample": 1}
-    with open(tmp_path / "plate" / "scene.json", "w") as f:
-        json.dump(scene, f)
-    cam = [{"time_s": t, "sensors": {"cam": {"position_m": [0, y, 0.4]}}}
-           for t, y in ((0, -0.45), (1, -3))]
-    with open(tmp_path / "plate" / "sequence.json", "w") as f:
-        json.dump({"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1,
-                   "frames": 3, "keyframes": cam,
-                   "sweep": {"objects.target.temperature_k": [300, 320]}}, f)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        thzmap.batch(tmp_path / "plate" / "sequence.json", tmp_path / "out", movies=False)
-    texts = [str(w.message) for w in caught if issubclass(w.category, thzmap.RunWarning)]
+    caught, texts = _moving_camera_batch(tmp_path, ((0, -0.45), (1, -3)), background_k=3,
+                                         sweep={"objects.target.temperature_k": [300, 320]})
     background = [t for t in texts if "background_temperature_k is given" in t]
     outside = [t for t in texts if "is outside the enclosure" in t]
     back_side = [t for t in texts if "saw the back side" in t]
@@ -190,22 +200,7 @@ def test_batch_warnings_name_their_frame_once(tmp_path):
 def test_batch_warnings_alike_but_for_numbers(tmp_path):
     """A camera moving outside the room warns in every frame with its own position: the
     first frame's warning in full, the later ones counted, as thzmap batch does."""
-    shutil.copytree(PLATE, tmp_path / "plate")
-    with open(tmp_path / "plate" / "scene.json") as f:
-        scene = json.load(f)
-    scene["sensors"][0]["resolution"] = [8, 6]
-    scene["render"] = {"integrator": "path", "paths_per_sample": 1}
-    with open(tmp_path / "plate" / "scene.json", "w") as f:
-        json.dump(scene, f)
-    cam = [{"time_s": t, "sensors": {"cam": {"position_m": [0, y, 0.4]}}}
-           for t, y in ((0, -3), (2, -5))]
-    with open(tmp_path / "plate" / "sequence.json", "w") as f:
-        json.dump({"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1,
-                   "frames": 3, "keyframes": cam}, f)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        thzmap.batch(tmp_path / "plate" / "sequence.json", tmp_path / "out", movies=False)
-    texts = [str(w.message) for w in caught if issubclass(w.category, thzmap.RunWarning)]
+    _, texts = _moving_camera_batch(tmp_path, ((0, -3), (2, -5)))
     outside = [t for t in texts if "is outside the enclosure" in t]
     assert len(outside) == 2, texts
     assert outside[0].startswith('frame-00000: sensor "cam" at [0, -3, 0.4] m is outside')
