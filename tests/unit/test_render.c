@@ -184,21 +184,28 @@ static void test_back_faces_every_integrator(void **state)
     f->scene->render.integrator = INTEGRATOR_PHOTON_MAP;
 }
 
-static void test_thread_count_does_not_matter(void **state)
+/* Renders sensor 0 as a 30 deg, 33 x 17 view that sees the grey box (photon terms,
+ * widened gathers), with the given oversampling and threads; the sensor as it was after. */
+static void render_wide(fixture *f, uint32_t oversampling, int threads, sensor_images *img,
+                        render_stats *st)
 {
-    fixture *f = *state;
-    /* a sensor that sees the grey box: photon terms, widened gathers */
     thz_sensor *s = &f->scene->sensors[0];
     thz_sensor saved = *s;
     s->fov_deg = 30.0;
     s->columns = 33;
     s->rows = 17;
-    s->oversampling = 2;
+    s->oversampling = oversampling;
+    render(f, 0, threads, img, st);
+    *s = saved;
+}
+
+static void test_thread_count_does_not_matter(void **state)
+{
+    fixture *f = *state;
     sensor_images a, b;
     render_stats sa, sb;
-    render(f, 0, 1, &a, &sa);
-    render(f, 0, 2, &b, &sb);
-    *s = saved;
+    render_wide(f, 2, 1, &a, &sa);
+    render_wide(f, 2, 2, &b, &sb);
     size_t n = 33 * 17;
     assert_memory_equal(a.radiance, b.radiance, n * sizeof(float));
     assert_memory_equal(a.radiance_stderr, b.radiance_stderr, n * sizeof(float));
@@ -221,16 +228,9 @@ static void test_thread_count_does_not_matter(void **state)
 static void test_truth_faces_the_render(void **state)
 {
     fixture *f = *state;
-    thz_sensor *s = &f->scene->sensors[0];
-    thz_sensor saved = *s;
-    s->fov_deg = 30.0;
-    s->columns = 33;
-    s->rows = 17;
-    s->oversampling = 1;
     sensor_images img;
     render_stats st;
-    render(f, 0, 1, &img, &st);
-    *s = saved;
+    render_wide(f, 1, 1, &img, &st);
     double p = 2.0 * tan(15.0 * M_PI / 180.0) / 33.0, x = 7.0 * p, z = 6.0 * p;
     assert_true(x > 0.2 / 2.8 && x < 0.4 / 2.8 && z > 0.2 / 2.8 && z < 0.4 / 2.8);
     size_t box = 2 * 33 + 23, wall = 2 * 33 + 9;
