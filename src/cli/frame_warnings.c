@@ -6,8 +6,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The message with each number (a run of digits and points holding a digit, with an
- * exponent) written '#': "at 0.123 K after 3 passes" -> "at # K after # passes". */
+/* True for a character of an identifier-like word (cam1, ch2, x86_64, h2o). */
+static bool frame_warning_word_char(char c)
+{
+    return isalnum((unsigned char)c) || c == '_';
+}
+
+/* The message with each free-standing number (a run of digits and points holding a digit,
+ * with an exponent, not following a letter, digit or '_') written '#': "at 0.123 K after 3
+ * passes" -> "at # K after # passes", while the digits of a name stay: "cam1" and "cam2"
+ * differ. python/thzmap/sequence.py's _NUMBER is the same rule. */
 static char *frame_warning_shape(const char *message)
 {
     char *out = malloc(strlen(message) + 1), *o = out;
@@ -17,7 +25,8 @@ static char *frame_warning_shape(const char *message)
         const char *q = p;
         while (isdigit((unsigned char)*q) || (*q == '.' && isdigit((unsigned char)q[1])))
             q++;
-        if (q > p && isdigit((unsigned char)*p)) {
+        if (q > p && isdigit((unsigned char)*p) &&
+            (p == message || !frame_warning_word_char(p[-1]))) {
             if ((*q == 'e' || *q == 'E') &&
                 (isdigit((unsigned char)q[1]) ||
                  ((q[1] == '-' || q[1] == '+') && isdigit((unsigned char)q[2])))) {

@@ -187,27 +187,26 @@ expect_line "$work/seq.err" '^thzmap validate: warning: sweep-00/frame-00001: se
 expect_line "$work/seq.err" '^thzmap validate: warning: the same in 3 later frames: sensor "cam" .* is outside'
 # a warning whose numbers change from frame to frame (the camera moving outside the room)
 # is printed in full once, the later frames' alike ones counted; within a frame, two
-# sensors' warnings are both printed (their names, cam and cam2, differ by more than
-# numbers: each is counted apart)
+# sensors' warnings are both printed, and their names, cam1 and cam2, differ by more than
+# numbers (a name's digits are no number): each is counted apart
 /usr/bin/python3 - "$work/seq/scene.json" "$work/seq/two.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
-cam2 = dict(s["sensors"][0], name="cam2")
-s["sensors"].append(cam2)
+s["sensors"] = [dict(s["sensors"][0], name=name) for name in ("cam1", "cam2")]
 json.dump(s, open(sys.argv[2], "w"))
 PY
 cat > "$work/seq/moving.json" <<'JSON'
 {"format": "thzmap-sequence/1", "scene": "two.json", "fps": 1, "frames": 4,
- "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [0, -3, 0.4]},
+ "keyframes": [{"time_s": 0, "sensors": {"cam1": {"position_m": [0, -3, 0.4]},
                                          "cam2": {"position_m": [0, -7, 0.4]}}},
-               {"time_s": 3, "sensors": {"cam": {"position_m": [0, -6, 0.4]},
+               {"time_s": 3, "sensors": {"cam1": {"position_m": [0, -6, 0.4]},
                                          "cam2": {"position_m": [0, -10, 0.4]}}}]}
 JSON
 "$THZMAP" validate "$work/seq/moving.json" >/dev/null 2>"$work/seq.err" ||
     fail "a moving camera's sequence: exit $?: $(cat "$work/seq.err")"
-expect_line "$work/seq.err" '^thzmap validate: warning: frame-00000: sensor "cam" at \[0, -3, 0\.4\] m is outside'
+expect_line "$work/seq.err" '^thzmap validate: warning: frame-00000: sensor "cam1" at \[0, -3, 0\.4\] m is outside'
 expect_line "$work/seq.err" '^thzmap validate: warning: frame-00000: sensor "cam2" at \[0, -7, 0\.4\] m is outside'
-expect_line "$work/seq.err" '^thzmap validate: warning: the same but for its numbers in 3 later frames: sensor "cam" at \[0, -3, 0\.4\] m is outside'
+expect_line "$work/seq.err" '^thzmap validate: warning: the same but for its numbers in 3 later frames: sensor "cam1" at \[0, -3, 0\.4\] m is outside'
 expect_line "$work/seq.err" '^thzmap validate: warning: the same but for its numbers in 3 later frames: sensor "cam2" at \[0, -7, 0\.4\] m is outside'
 [[ $(grep -c 'is outside' "$work/seq.err") -eq 4 ]] ||
     fail "a moving camera's warnings: not two, then two counts: $(cat "$work/seq.err")"

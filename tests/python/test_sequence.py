@@ -147,21 +147,25 @@ def test_batch_sweep_values_are_json_values(tmp_path):
         assert json.load(f)["sweep_values"] == res.summary["sweeps"][1]["values"]
 
 
-def _moving_camera_batch(tmp_path, positions, background_k=None, sweep=None):
-    """The plate in its box (8 x 6 pixels, 1 path), its camera at y = positions' (t, y),
-    3 frames at 1 fps, run by thzmap.batch without movies: (the warnings caught, the
-    RunWarnings' texts)."""
+def _moving_camera_batch(tmp_path, positions, background_k=None, sweep=None,
+                         cameras=("cam",)):
+    """The plate in its box (8 x 6 pixels, 1 path), its camera at y = positions' (t, y)
+    (cameras: copies of it by those names, the k-th at y - 4 k m), 3 frames at 1 fps, run
+    by thzmap.batch without movies: (the warnings caught, the RunWarnings' texts)."""
     shutil.copytree(PLATE, tmp_path / "plate")
     with open(tmp_path / "plate" / "scene.json") as f:
         scene = json.load(f)
     if background_k is not None:
         scene["atmosphere"]["background_temperature_k"] = background_k
     scene["sensors"][0]["resolution"] = [8, 6]
+    scene["sensors"] = [dict(scene["sensors"][0], name=name) for name in cameras]
     scene["render"] = {"integrator": "path", "paths_per_sample": 1}
     with open(tmp_path / "plate" / "scene.json", "w") as f:
         json.dump(scene, f)
     seq = {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1, "frames": 3,
-           "keyframes": [{"time_s": t, "sensors": {"cam": {"position_m": [0, y, 0.4]}}}
+           "keyframes": [{"time_s": t,
+                          "sensors": {name: {"position_m": [0, y - 4 * k, 0.4]}
+                                      for k, name in enumerate(cameras)}}
                          for t, y in positions]}
     if sweep:
         seq["sweep"] = sweep
@@ -207,6 +211,27 @@ def test_batch_warnings_alike_but_for_numbers(tmp_path):
     assert outside[1].startswith(
         "the same but for its numbers in 2 later frames (each frame's summary.json has its "
         'own): sensor "cam" at [0, -3, 0.4] m is outside')
+
+
+def test_batch_warnings_alike_but_for_names_apart(tmp_path):
+    """Two cameras, cam1 and cam2, moving outside the room: their warnings differ in the
+    digit of their names, which is no number (as thzmap validate's sequence in
+    test_validate.sh), so each is printed and counted on its own."""
+    _, texts = _moving_camera_batch(tmp_path, ((0, -3), (2, -5)), cameras=("cam1", "cam2"))
+    outside = [t for t in texts if "is outside the enclosure" in t]
+    assert len(outside) == 4, texts
+    assert outside[0].startswith('frame-00000: sensor "cam1" at [0, -3, 0.4] m is outside')
+    assert outside[1].startswith('frame-00000: sensor "cam2" at [0, -7, 0.4] m is outside')
+    kept = "the same but for its numbers in 2 later frames (each frame's summary.json has its own)"
+    assert outside[2].startswith(f'{kept}: sensor "cam1" at [0, -3, 0.4] m')
+    assert outside[3].startswith(f'{kept}: sensor "cam2" at [0, -7, 0.4] m')
+
+
+def test_warning_numbers_are_free_standing():
+    # the rule src/cli/frame_warnings.c's frame_warning_shape follows: a name's digits stay
+    shape = thzmap.sequence._NUMBER.sub(
+        "#", 'sensor "ch2" (x86_64, h2o): 0.4 m, 1e-3 K, -2.5E+2 s, 3 passes, [0, -7]')
+    assert shape == 'sensor "ch2" (x86_64, h2o): # m, # K, -# s, # passes, [#, -#]'
 
 
 def test_batch_movie_warning_names_no_frame(tmp_path):
