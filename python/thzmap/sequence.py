@@ -290,7 +290,7 @@ class _BatchBar:
                 self._bar = self._tqdm(total=p.n_frames, desc="batch", unit="frames",
                                        leave=False)
             self._bar.n = round(p.fraction * p.n_frames, 3)
-            self._bar.set_postfix_str(f"{p.computed} done, {p.reused} reused", refresh=False)
+            self._bar.set_postfix_str(f"{p.computed} computed, {p.reused} already done", refresh=False)
             self._bar.refresh()
         else:
             now = time.monotonic()

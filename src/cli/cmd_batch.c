@@ -131,8 +131,12 @@ static int batch_on_progress(void *user, const thz_batch_progress *p)
                                     per_frame * (double)(p->n_frames - finished));
             snprintf(eta, sizeof eta, ", ETA %s", left);
         }
-        fprintf(stderr, "thzmap batch: frame %zu/%zu (%zu done, %zu reused), %.1f s%s\n",
-                p->frame + 1, p->n_frames, finished, p->reused, p->seconds, eta);
+        /* finished counts the frames found done in OUTDIR ahead of this one too */
+        fprintf(stderr,
+                "thzmap batch: frame %zu/%zu (%zu of %zu frames finished so far: %zu computed, "
+                "%zu already done), %.1f s%s\n",
+                p->frame + 1, p->n_frames, finished, p->n_frames, p->computed, p->reused,
+                p->seconds, eta);
     } else if (!strcmp(p->stage, "movie") && !b->movies_said) { /* reported again after */
         b->movies_said = true;
         fprintf(stderr, "thzmap batch: %zu frame%s done (%.1f s); encoding the movies\n",

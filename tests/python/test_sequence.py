@@ -5,6 +5,8 @@ errors with the file and JSON path. thzmap.identify tells a sequence from a scen
 import json
 import os
 import shutil
+import sys
+import types
 import warnings
 
 import pytest
@@ -317,3 +319,28 @@ def test_load_sequence_progress_and_cancel():
         thzmap.load_sequence(WALKER, progress=lambda p: True)
     with pytest.raises(thzmap.ArgumentError):
         thzmap.load_sequence(WALKER, progress=3)
+
+
+def test_batch_bar_says_what_it_counts(monkeypatch):
+    """progress=True with tqdm: the bar's counts say computed and already done, as thzmap
+    batch's lines do (it said "1 done, 3 reused": done meant computed only there)."""
+    from thzmap.sequence import BatchProgress, _BatchBar
+    postfix = []
+
+    class FakeBar:
+        def __init__(self, total, **kw):
+            self.n = 0
+
+        def set_postfix_str(self, text, refresh=True):
+            postfix.append(text)
+
+        def refresh(self):
+            pass
+
+        def close(self):
+            pass
+    monkeypatch.setitem(sys.modules, "tqdm", types.SimpleNamespace(tqdm=FakeBar))
+    bar = _BatchBar()
+    bar(BatchProgress("frame", 4, 5, 1, 3, 0.8, 0.1))
+    bar.close()
+    assert postfix == ["1 computed, 3 already done"]
