@@ -165,6 +165,15 @@ for i in range(5):
     got = video[i][3:13, 2:2 + want.shape[1]] > 127
     wrong = (got != want).sum()
     assert wrong <= 0.05 * want.sum(), (i, "caption", wrong, want.sum())
+# the colour bar's labels, right of the image at its top and the frame's bottom: the
+# colour_scale of batch.json rounded to 0.1 K (a README's figure quotes them), to the dot
+# (a label 0.1 K off differs by 4 or more of the 2 x 2 dots' pixels)
+for end, y in (("max_k", L["image_y_px"] + 6), ("min_k", h - 18)):
+    want = caption("%.1f K" % m["colour_scale"][end])
+    strip = video[0][y:y + 10, cols * k:] > 127
+    wrong = min((strip[:, x:x + want.shape[1]] != want).sum()
+                for x in range(strip.shape[1] - want.shape[1] + 1))
+    assert wrong <= 2, (end, m["colour_scale"][end], wrong, want.sum())
 PY
 
 # --- interrupted, killed, resumed ---------------------------------------------------
