@@ -344,7 +344,8 @@ static thz_status run_finish(run_state *rs, double t_start, thz_error *err)
 }
 
 /* The rendered sensors' PSF kernels can be built (psf_kernel_check), before the work
- * rather than at its outputs. */
+ * rather than at its outputs. A refusal names the key that sets the PSF's width: the
+ * Gaussian's FWHM, or the aperture whose diffraction spreads the Airy pattern. */
 static thz_status run_check_psfs(const run_state *rs, thz_error *err)
 {
     const thz_scene *sc = rs->scene;
@@ -353,8 +354,10 @@ static thz_status run_check_psfs(const run_state *rs, thz_error *err)
         for (size_t c = 0; sn->psf != PSF_NONE && c < sc->n_channels; c++) {
             thz_error why = {0};
             if (psf_kernel_check(sn, &sc->channels[c], &why) != THZ_OK)
-                return thz_error_set(err, why.status, "%s: sensors[%zu].psf: %s",
-                                     sc->path ? sc->path : "scene", rs->selected[i], why.message);
+                return thz_error_set(
+                    err, why.status, "%s: sensors[%zu].%s: %s", sc->path ? sc->path : "scene",
+                    rs->selected[i],
+                    sn->psf == PSF_GAUSSIAN ? "psf_fwhm_deg" : "aperture_diameter_m", why.message);
         }
     }
     return THZ_OK;

@@ -163,13 +163,16 @@ static thz_status psf_extent_of(const thz_sensor *sn, const thz_channel *ch, psf
                                 : (uint32_t)fmin(fmax(ceil(8.0 * e->pitch_rad / e->fwhm_rad), 1.0),
                                                  PSF_MAX_SUBSAMPLES);
     double side = 2.0 * e->full + 1.0;
-    if (e->fold && side * side * e->n * e->n > PSF_FOLD_MAX_SAMPLES)
+    if (e->fold && side * side * e->n * e->n > PSF_FOLD_MAX_SAMPLES) {
+        /* the reach whose fold takes PSF_FOLD_MAX_SAMPLES samples */
+        double most = floor((sqrt(PSF_FOLD_MAX_SAMPLES) / e->n - 1.0) / 2.0);
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "sensor '%s': its PSF reaches %.0f pixels from the centre at %.4g "
-                             "THz, against an image of %u x %u pixels: too much wider than the "
-                             "field of view to be computed; widen the field of view or narrow "
-                             "the PSF",
-                             sn->name, e->full, ch->center_hz * 1e-12, sn->columns, sn->rows);
+                             "the PSF reaches %.0f pixels from the centre at %.4g THz, against "
+                             "an image of %u x %u pixels: expected at most %.0f pixels, the "
+                             "widest fold that can be computed; widen the field of view or "
+                             "narrow the PSF",
+                             e->full, ch->center_hz * 1e-12, sn->columns, sn->rows, most);
+    }
     return THZ_OK;
 }
 

@@ -174,7 +174,9 @@ grep -q "$work/huge.json: sensors\[2\].noise (sensor 'netd'), channel 2: the noi
     { fail "netd_k 1e300 K: no message naming the file, sensor and channel"; cat "$work/huge.log"; }
 [ ! -e "$work/huge" ] || fail "netd_k 1e300 K: OUTDIR written"
 # a PSF too much wider than the image to fold onto it: refused before the work (no
-# estimate, no render), exit 2, the sensor's JSON path, nothing written
+# estimate, no render), exit 2, the JSON path of the key that sets the PSF's width (it
+# said "sensors[0].psf: sensor 'cam': ..."), the most it may reach, nothing written; the
+# Airy pattern of a 10 um aperture: its aperture_diameter_m
 python3 - "$work/furnace.json" "$work/wide.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
@@ -184,9 +186,21 @@ PY
 "$THZMAP" simulate "$work/wide.json" -o "$work/wide" > "$work/wide.log" 2>&1
 rc=$?
 [ $rc -eq 2 ] || fail "a 120 deg PSF on a 0.01 deg field: exit $rc, expected 2"
-grep -q "$work/wide.json: sensors\[0\].psf: sensor '[^']*': its PSF reaches [0-9]* pixels from the centre" "$work/wide.log" ||
-    { fail "a 120 deg PSF on a 0.01 deg field: no message naming sensors[0].psf"; cat "$work/wide.log"; }
+grep -q "^thzmap: $work/wide.json: sensors\[0\].psf_fwhm_deg: the PSF reaches [0-9]* pixels from the centre at 0.35 THz, against an image of 128 x 128 pixels: expected at most 4095 pixels" "$work/wide.log" ||
+    { fail "a 120 deg PSF on a 0.01 deg field: no message naming sensors[0].psf_fwhm_deg"; cat "$work/wide.log"; }
 grep -q "estimate:" "$work/wide.log" && fail "a 120 deg PSF on a 0.01 deg field: refused only after the estimate"
 [ ! -e "$work/wide" ] || fail "a 120 deg PSF on a 0.01 deg field: OUTDIR written"
+python3 - "$work/wide.json" "$work/airy.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+del s["sensors"][0]["psf_fwhm_deg"]
+s["sensors"][0].update({"psf": "airy", "aperture_diameter_m": 1e-5, "aperture_m2": 7e-11})
+json.dump(s, open(sys.argv[2], "w"))
+PY
+"$THZMAP" simulate "$work/airy.json" -o "$work/airy" > "$work/airy.log" 2>&1
+rc=$?
+[ $rc -eq 2 ] && grep -q "^thzmap: $work/airy.json: sensors\[0\].aperture_diameter_m: the PSF reaches" "$work/airy.log" ||
+    { fail "the Airy PSF of a 10 um aperture: exit $rc, no message naming aperture_diameter_m"; cat "$work/airy.log"; }
+[ ! -e "$work/airy" ] || fail "the Airy PSF of a 10 um aperture: OUTDIR written"
 
 finish "PASS"

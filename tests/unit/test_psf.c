@@ -347,8 +347,9 @@ static void test_oversampled_pixel_counted_once(void **state)
 }
 
 /* A PSF whose fold would take more than PSF_FOLD_MAX_SAMPLES samples (a 120 deg FWHM on
- * a field of 0.01 deg) is refused, by the check the run makes before its work and by the
- * kernel; the 12 x 9 image under a PSF twice its width is not. */
+ * a field of 0.01 deg: 4 x 120 / (0.01 / 64) = 3072000 pixels of reach, against at most
+ * (sqrt(2^26) - 1) / 2 = 4095) is refused, by the check the run makes before its work and
+ * by the kernel; the 12 x 9 image under a PSF twice its width is not. */
 static void test_fold_too_large_refused(void **state)
 {
     (void)state;
@@ -357,8 +358,9 @@ static void test_fold_too_large_refused(void **state)
     s.psf_fwhm_deg = 120.0;
     thz_error err = {0};
     assert_int_equal(psf_kernel_check(&s, &ch, &err), THZ_ERR_INPUT);
-    assert_non_null(strstr(err.message, "sensor 'cam': its PSF reaches"));
-    assert_non_null(strstr(err.message, "against an image of 64 x 48 pixels"));
+    assert_non_null(strstr(err.message, "the PSF reaches 3072000 pixels from the centre"));
+    assert_non_null(strstr(err.message, "against an image of 64 x 48 pixels: expected at most "
+                                        "4095 pixels"));
     psf_kernel k;
     assert_int_equal(psf_kernel_init(&k, &s, &ch, &err), THZ_ERR_INPUT);
     assert_null(k.weight);
