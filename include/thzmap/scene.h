@@ -18,7 +18,10 @@ extern "C" {
 typedef struct thz_scene thz_scene;
 
 /* Loads and checks a scene file. On success *out owns the scene (thz_scene_destroy);
- * errors name the file and line:column or JSON path (THZ_ERR_INPUT). */
+ * errors name the file and line:column or JSON path (THZ_ERR_INPUT). Checked also is what
+ * a run would refuse of the scene before its work: sensors whose images would not fit in
+ * memory (sensors[i].resolution), and PSFs too much wider than the image to fold onto it
+ * (sensors[i].psf_fwhm_deg or .aperture_diameter_m). */
 THZ_API thz_status thz_scene_load(const char *path, thz_scene **out, thz_error *err);
 /* The same from JSON text. `base_dir` resolves the relative file paths in it (NULL:
  * the current directory); `label` names the text in messages as a file name would

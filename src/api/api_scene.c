@@ -1,6 +1,7 @@
-/* Scenes through the public API: loading (the loader, then the check that the sensors'
- * images fit in memory, which the loader cannot make: it knows no images), read access
- * by value. (Destroying is scene/scene.c's thz_scene_destroy.) */
+/* Scenes through the public API: loading (the loader, then the checks that the sensors'
+ * images fit in memory and that their PSFs can be built, which the loader cannot make:
+ * it knows no images nor kernels), read access by value. (Destroying is scene/scene.c's
+ * thz_scene_destroy.) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,14 +13,22 @@
 #include "physics/planck.h"
 #include "sensor/measure.h"
 #include "sensor/noise.h"
+#include "sensor/psf.h"
 #include "sensor/render.h"
 #include "sensor/render_accum.h"
 
 /* A loaded scene whose images would not fit in memory is refused (THZ_ERR_INPUT, naming
- * sensors[i].resolution). */
+ * sensors[i].resolution), and one whose PSF no run could build (psf_sensor_check, naming
+ * sensors[i].psf_fwhm_deg or .aperture_diameter_m): validate, Python and serve load
+ * through here, so they say what simulate would refuse. */
 static thz_status api_scene_checked(thz_status st, thz_scene **out, thz_error *err)
 {
-    if (st == THZ_OK && run_check_scene_memory(*out, err) != THZ_OK) {
+    if (st != THZ_OK)
+        return st;
+    bool refused = run_check_scene_memory(*out, err) != THZ_OK;
+    for (size_t i = 0; !refused && i < (*out)->n_sensors; i++)
+        refused = psf_sensor_check(*out, i, err) != THZ_OK;
+    if (refused) {
         scene_destroy(*out);
         *out = NULL;
         st = THZ_ERR_INPUT; /* the scene asks too much: bad input, as before */

@@ -182,6 +182,19 @@ thz_status psf_kernel_check(const thz_sensor *sn, const thz_channel *ch, thz_err
     return psf_extent_of(sn, ch, &e, err);
 }
 
+thz_status psf_sensor_check(const thz_scene *sc, size_t i, thz_error *err)
+{
+    const thz_sensor *sn = &sc->sensors[i];
+    for (size_t c = 0; sn->psf != PSF_NONE && c < sc->n_channels; c++) {
+        thz_error why = {0};
+        if (psf_kernel_check(sn, &sc->channels[c], &why) != THZ_OK)
+            return thz_error_set(
+                err, why.status, "%s: sensors[%zu].%s: %s", sc->path ? sc->path : "scene", i,
+                sn->psf == PSF_GAUSSIAN ? "psf_fwhm_deg" : "aperture_diameter_m", why.message);
+    }
+    return THZ_OK;
+}
+
 thz_status psf_kernel_init(psf_kernel *k, const thz_sensor *sn, const thz_channel *ch,
                            thz_error *err)
 {

@@ -77,6 +77,12 @@ void psf_kernel_fini(psf_kernel *k);
 /* THZ_OK if psf_kernel_init can build sn's kernel in channel ch, else its refusal (a PSF
  * too much wider than the image): the run asks before its work. */
 thz_status psf_kernel_check(const thz_sensor *sn, const thz_channel *ch, thz_error *err);
+/* THZ_OK if sensor i of scene sc has no PSF or psf_kernel_check accepts it in every
+ * channel, else that refusal named "FILE: sensors[i].KEY: ...", KEY the one that sets the
+ * PSF's width: the Gaussian's psf_fwhm_deg, or the aperture_diameter_m whose diffraction
+ * spreads the Airy pattern. Loading through the API asks it of every sensor (so validate
+ * says it), a run of the sensors it renders. */
+thz_status psf_sensor_check(const thz_scene *sc, size_t i, thz_error *err);
 
 /* out = k convolved with in (one plane of columns x rows, row-major), with the mirror
  * border above; in and out must not overlap. */

@@ -79,6 +79,20 @@ static const char test_scene_json[] =
     "  \"render\": {\"integrator\": \"photon-map\"}\n"
     "}\n";
 
+/* test_scene_json with `from` replaced by `to` (malloc'd); exits when `from` is not in it. */
+static inline char *test_scene_with(const char *from, const char *to)
+{
+    const char *at = strstr(test_scene_json, from);
+    if (!at)
+        exit(1);
+    size_t n = strlen(test_scene_json) - strlen(from) + strlen(to) + 1;
+    char *s = malloc(n);
+    if (!s)
+        exit(1);
+    snprintf(s, n, "%.*s%s%s", (int)(at - test_scene_json), test_scene_json, to, at + strlen(from));
+    return s;
+}
+
 /* A fresh directory under $TMPDIR (or /tmp); exits on failure. */
 static inline void test_temp_dir(char *out, size_t n)
 {

@@ -21,20 +21,6 @@ static void expect_input_error(thz_status st, const thz_error *err, const char *
     CHECK(strstr(err->message, needle) != NULL, "%s: '%s' not in '%s'", what, needle, err->message);
 }
 
-/* The test scene with `from` replaced by `to` (malloc'd). */
-static char *scene_with(const char *from, const char *to)
-{
-    const char *at = strstr(test_scene_json, from);
-    if (!at)
-        exit(1);
-    size_t n = strlen(test_scene_json) - strlen(from) + strlen(to) + 1;
-    char *s = malloc(n);
-    if (!s)
-        exit(1);
-    snprintf(s, n, "%.*s%s%s", (int)(at - test_scene_json), test_scene_json, to, at + strlen(from));
-    return s;
-}
-
 /* A context with more threads than THZ_MAX_THREADS runs nothing (OpenMP would exit the
  * process or crash on such counts): every call that runs with it refuses, naming the
  * limit. The count itself is kept as given. */
@@ -583,7 +569,7 @@ int main(int argc, char **argv)
 
     thz_error err = {0};
     thz_scene *scene = (thz_scene *)&err; /* must be reset to NULL */
-    char *bad = scene_with("\"frequency_thz\": 0.9", "\"frequency_thz\": -0.9");
+    char *bad = test_scene_with("\"frequency_thz\": 0.9", "\"frequency_thz\": -0.9");
     expect_input_error(thz_scene_load_string(bad, NULL, "bad.json", &scene, &err), &err,
                        "channels[1].frequency_thz", "negative frequency");
     CHECK(strstr(err.message, "bad.json") != NULL, "label missing: %s", err.message);
@@ -688,7 +674,8 @@ int main(int argc, char **argv)
     test_temp_dir(dir, sizeof dir);
     snprintf(path, sizeof path, "%s/a.thzpm", dir);
     REQUIRE_OK(thz_photons_save(merged, path, &err), &err);
-    char *other_text = scene_with("\"size_m\": [0.6, 0.05, 0.5]", "\"size_m\": [0.7, 0.05, 0.5]");
+    char *other_text =
+        test_scene_with("\"size_m\": [0.6, 0.05, 0.5]", "\"size_m\": [0.7, 0.05, 0.5]");
     thz_scene *other = NULL;
     REQUIRE_OK(thz_scene_load_string(other_text, NULL, "other.json", &other, &err), &err);
     thz_photons *foreign = (thz_photons *)&err;

@@ -190,6 +190,12 @@ grep -q "^thzmap: $work/wide.json: sensors\[0\].psf_fwhm_deg: the PSF reaches [0
     { fail "a 120 deg PSF on a 0.01 deg field: no message naming sensors[0].psf_fwhm_deg"; cat "$work/wide.log"; }
 grep -q "estimate:" "$work/wide.log" && fail "a 120 deg PSF on a 0.01 deg field: refused only after the estimate"
 [ ! -e "$work/wide" ] || fail "a 120 deg PSF on a 0.01 deg field: OUTDIR written"
+# validate says the same (it said "valid", exit 0, of the scene simulate refuses)
+"$THZMAP" validate "$work/wide.json" > "$work/wide-v.log" 2>&1
+rc=$?
+[ $rc -eq 2 ] && grep -q "^thzmap: $work/wide.json: sensors\[0\].psf_fwhm_deg: the PSF reaches [0-9]* pixels from the centre at 0.35 THz, against an image of 128 x 128 pixels: expected at most 4095 pixels" "$work/wide-v.log" ||
+    { fail "validate of a 120 deg PSF on a 0.01 deg field: exit $rc, not simulate's refusal"; cat "$work/wide-v.log"; }
+grep -q "valid" "$work/wide-v.log" && fail "validate of a 120 deg PSF on a 0.01 deg field: says valid"
 python3 - "$work/wide.json" "$work/airy.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
@@ -202,5 +208,9 @@ rc=$?
 [ $rc -eq 2 ] && grep -q "^thzmap: $work/airy.json: sensors\[0\].aperture_diameter_m: the PSF reaches" "$work/airy.log" ||
     { fail "the Airy PSF of a 10 um aperture: exit $rc, no message naming aperture_diameter_m"; cat "$work/airy.log"; }
 [ ! -e "$work/airy" ] || fail "the Airy PSF of a 10 um aperture: OUTDIR written"
+"$THZMAP" validate "$work/airy.json" > "$work/airy-v.log" 2>&1
+rc=$?
+[ $rc -eq 2 ] && grep -q "^thzmap: $work/airy.json: sensors\[0\].aperture_diameter_m: the PSF reaches" "$work/airy-v.log" ||
+    { fail "validate of the Airy PSF of a 10 um aperture: exit $rc, not simulate's refusal"; cat "$work/airy-v.log"; }
 
 finish "PASS"

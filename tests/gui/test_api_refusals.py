@@ -3,8 +3,8 @@
 regular files (a FIFO once held the request, and then the server's stop, for ever), files
 and directories the server may not read, paths with "." components, over-long strings,
 runs whose integrator (the option, or else the scene's render.integrator, or else path)
-contradicts save_photon_map or a missing photon_map; and the event stream's headers and
-numbers, as every other /api/ answer's.
+contradicts save_photon_map or a missing photon_map, a scene whose PSF no run could build;
+and the event stream's headers and numbers, as every other /api/ answer's.
 
 usage: test_api_refusals.py THZMAP_BINARY REPO_DIR [--requests-only]
 
@@ -178,6 +178,17 @@ def test_integrators(srv):
               "renders from a photon map" in err["error"], "render %s %r: %r" % (scene, options, err))
 
 
+def test_psf(srv, root):
+    """/api/validate refuses a PSF too much wider than the image to fold onto it, as a run
+    would (it answered ok, and the run then failed), at the key that sets its width."""
+    scene = json.load(open(os.path.join(root, "s", "pm.json")))
+    scene["sensors"][0].update(psf="gaussian", psf_fwhm_deg=120, fov_deg=0.01)
+    res = srv.json("POST", "/api/validate", body={"path": "s/wide.json", "text": json.dumps(scene)})
+    e = res and res["errors"] and res["errors"][0]
+    check(res and not res["ok"] and e and e["json_path"] == "sensors[0].psf_fwhm_deg" and
+          "the PSF reaches" in e["message"], "validate a 120 deg PSF on 0.01 deg: %r" % res)
+
+
 def test_events(srv, root):
     """A render of the path scene without a photon map runs; its event stream carries the
     headers of every /api/ answer and reals of 9 significant digits."""
@@ -264,6 +275,7 @@ def main():
         try:
             tests = [("files", lambda: test_files(srv, root)), ("lengths", lambda: test_lengths(srv)),
                      ("integrators", lambda: test_integrators(srv)),
+                     ("psf", lambda: test_psf(srv, root)),
                      ("text", lambda: test_text_and_limits(srv, root))]
             if not REQUESTS_ONLY:
                 tests.append(("events", lambda: test_events(srv, root)))

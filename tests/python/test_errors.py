@@ -45,6 +45,23 @@ def test_bad_values_name_their_path(tiny_dir, edit, path):
     assert str(e.value).startswith("mine: " + path + ": ")
 
 
+@pytest.mark.parametrize("psf, key", [
+    ({"psf": "gaussian", "psf_fwhm_deg": 120}, "psf_fwhm_deg"),
+    ({"psf": "airy", "aperture_diameter_m": 1e-5, "aperture_m2": 7e-11}, "aperture_diameter_m"),
+])
+def test_a_psf_no_run_could_build_is_refused_at_load(tiny_dir, psf, key):
+    """simulate refuses a PSF too much wider than the image to fold onto it; loading the
+    scene says so (it loaded, and simulate raised only later)."""
+    d = tiny_scene_dict()
+    d["sensors"][0].update(psf, fov_deg=0.01)
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.scene_from_dict(d, base_dir=tiny_dir, label="wide")
+    assert e.value.file == "wide"
+    assert e.value.path == "sensors[0]." + key
+    assert e.value.reason.startswith("the PSF reaches ")
+    assert "expected at most 4095 pixels" in e.value.reason
+
+
 @pytest.mark.parametrize("name", ["foam:v2", "a: b", "a.b"])
 def test_a_material_name_with_colons_or_dots_is_one_key_of_the_path(tiny_dir, name):
     d = tiny_scene_dict()
