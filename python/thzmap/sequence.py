@@ -196,8 +196,10 @@ def load_sequence(path, root=None, progress=None):
 
 # A number in a warning, as the CLI's frame warnings find them (src/cli/frame_warnings.c):
 # digits with points between them, and an exponent, free-standing: the digits of a name
-# (cam1, ch2, x86_64, h2o) follow a letter, digit or '_' and are not a number.
-_NUMBER = re.compile(r"(?<![A-Za-z0-9_])[0-9](?:[0-9]|\.(?=[0-9]))*(?:[eE][-+]?[0-9]+)?")
+# (cam1, ch2, x86_64, h2o) follow a letter, digit or '_' and are not a number, nor is an
+# index, digits alone between '[' and ']' (sensors[1] names another sensor than sensors[0]).
+_NUMBER = re.compile(r"(?<![A-Za-z0-9_])(?!(?<=\[)[0-9]+\])"
+                     r"[0-9](?:[0-9]|\.(?=[0-9]))*(?:[eE][-+]?[0-9]+)?")
 
 
 class _SeenWarning:

@@ -12,16 +12,32 @@ static bool frame_warning_word_char(char c)
     return isalnum((unsigned char)c) || c == '_';
 }
 
+/* True when p starts an index, digits alone between '[' and ']' (sensors[1], objects[12]). */
+static bool frame_warning_index(const char *message, const char *p)
+{
+    const char *q = p;
+    while (isdigit((unsigned char)*q))
+        q++;
+    return q > p && *q == ']' && p > message && p[-1] == '[';
+}
+
 /* The message with each free-standing number (a run of digits and points holding a digit,
  * with an exponent, not following a letter, digit or '_') written '#': "at 0.123 K after 3
  * passes" -> "at # K after # passes", while the digits of a name stay: "cam1" and "cam2"
- * differ. python/thzmap/sequence.py's _NUMBER is the same rule. */
+ * differ; so do a JSON path's indices, "sensors[0]" and "sensors[1]" (they name different
+ * things: one's warning counted with the other's was never printed). python/thzmap/
+ * sequence.py's _NUMBER is the same rule. */
 static char *frame_warning_shape(const char *message)
 {
     char *out = malloc(strlen(message) + 1), *o = out;
     if (!out)
         return NULL;
     for (const char *p = message; *p;) {
+        if (frame_warning_index(message, p)) {
+            while (*p != ']')
+                *o++ = *p++;
+            continue;
+        }
         const char *q = p;
         while (isdigit((unsigned char)*q) || (*q == '.' && isdigit((unsigned char)q[1])))
             q++;

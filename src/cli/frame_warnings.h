@@ -3,7 +3,8 @@
  * prints it, naming the frame, and the later frames' same message is only counted, said
  * at the end ("the same in K later frames: ..."). A message that differs from an earlier
  * frame's only in its free-standing numbers (a time limit's noise reached, a camera's
- * distance as it moves; not the digit of a name such as cam1) is counted with it too
+ * distance as it moves; not the digit of a name such as cam1, nor an index such as
+ * sensors[1]) is counted with it too
  * ("... the same but for its numbers: ..."; a batch's frames' summary.json keep their
  * own). Within one frame every message that is not the same to the letter is printed
  * (its channels' alike warnings among them). */

@@ -210,6 +210,28 @@ expect_line "$work/seq.err" '^thzmap validate: warning: the same but for its num
 expect_line "$work/seq.err" '^thzmap validate: warning: the same but for its numbers in 3 later frames: sensor "cam2" at \[0, -7, 0\.4\] m is outside'
 [[ $(grep -c 'is outside' "$work/seq.err") -eq 4 ]] ||
     fail "a moving camera's warnings: not two, then two counts: $(cat "$work/seq.err")"
+# an index in a JSON path is no number either: sensors[1]'s warning, alike sensors[0]'s of
+# an earlier frame but for the index, is its own (it was counted with sensors[0]'s, "the
+# same but for its numbers in 1 later frame", and never printed). Both apertures of
+# 0.05 m² with their 0.1 m diameter warn; cam2's is swept from 0.005 m² (no warning) to it
+/usr/bin/python3 - "$work/seq/two.json" "$work/seq/index.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+for sn in s["sensors"]:
+    sn.update(aperture_diameter_m=0.1, aperture_m2=0.05)
+json.dump(s, open(sys.argv[2], "w"))
+PY
+cat > "$work/seq/index-seq.json" <<'JSON'
+{"format": "thzmap-sequence/1", "scene": "index.json",
+ "sweep": {"sensors.cam2.aperture_m2": [0.005, 0.05]}}
+JSON
+"$THZMAP" validate "$work/seq/index-seq.json" >/dev/null 2>"$work/seq.err" ||
+    fail "a sweep of cam2's aperture: exit $?: $(cat "$work/seq.err")"
+expect_line "$work/seq.err" '^thzmap validate: warning: sweep-00/frame-00000: .*sensors\[0\]\.aperture_m2: 0\.05 m\^2 is more than'
+expect_line "$work/seq.err" '^thzmap validate: warning: sweep-01/frame-00000: .*sensors\[1\]\.aperture_m2: 0\.05 m\^2 is more than'
+expect_line "$work/seq.err" '^thzmap validate: warning: the same in 1 later frame: .*sensors\[0\]\.aperture_m2'
+[[ $(grep -c 'aperture_m2' "$work/seq.err") -eq 3 ]] ||
+    fail "a sweep of cam2's aperture: not cam1's, cam2's and cam1's repeat: $(cat "$work/seq.err")"
 
 # a frame whose scene is bad by a keyframe's value: exit 2, naming the keyframe's value
 # in the sequence file, then the scene's JSON path and the frame's directory (as batch

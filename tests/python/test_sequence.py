@@ -230,10 +230,15 @@ def test_batch_warnings_alike_but_for_names_apart(tmp_path):
 
 
 def test_warning_numbers_are_free_standing():
-    # the rule src/cli/frame_warnings.c's frame_warning_shape follows: a name's digits stay
+    # the rule src/cli/frame_warnings.c's frame_warning_shape follows: a name's digits stay,
+    # and so does an index (objects[3] and objects[4] name two objects: the warning of one
+    # was counted with the other's and never printed); a list's numbers are numbers
     shape = thzmap.sequence._NUMBER.sub(
         "#", 'sensor "ch2" (x86_64, h2o): 0.4 m, 1e-3 K, -2.5E+2 s, 3 passes, [0, -7]')
     assert shape == 'sensor "ch2" (x86_64, h2o): # m, # K, -# s, # passes, [#, -#]'
+    shape = thzmap.sequence._NUMBER.sub(
+        "#", "s.json: objects[3].shape, sensors[12].aperture_m2: 0.05 m^2, [2], [0.5], [7, 1]")
+    assert shape == "s.json: objects[3].shape, sensors[12].aperture_m2: # m^#, [2], [#], [#, #]"
 
 
 def test_batch_movie_warning_names_no_frame(tmp_path):
