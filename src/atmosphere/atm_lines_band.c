@@ -20,7 +20,7 @@
  * away, and a Voigt line's window is near, so that beyond it the line is a Lorentzian (a
  * Gaussian core within the window would need many more terms). The series then
  * converges like rho^-n with rho >= 2 + sqrt(3) = 3.7 (FAR = 1): 32 nodes leave the
- * sums' rounding (unit/test_atm_lines: within 1e-10 of alpha, or of 1e-9 of the band's
+ * sums' rounding (unit/test_atm_lines_tables: within 1e-10 of alpha, or of 1e-9 of the band's
  * peak where alpha is smaller, from 1 atm to 1e-10 hPa and bands of 0.02 % to 50 %).
  * The tables change in their last bits, not more.
  */
