@@ -1,6 +1,7 @@
-/* What the API tests share: a failure counter with messages, a temporary directory, the
- * two-sensor, two-channel scene of tests/cli/test_simulate.sh as JSON text, and file
- * reading. Header-only so that each test stays one program on the public API alone. */
+/* What the API tests share: a failure counter with messages, a check that a call was
+ * refused as bad input, a temporary directory, the two-sensor, two-channel scene of
+ * tests/cli/test_simulate.sh as JSON text, and file reading. Header-only so that each test
+ * stays one program on the public API alone. */
 #ifndef THZ_TESTS_API_TEST_H
 #define THZ_TESTS_API_TEST_H
 
@@ -33,6 +34,15 @@ static int test_failures = 0;
             exit(1);                                                                               \
         }                                                                                          \
     } while (0)
+
+/* A call refused as bad input (THZ_ERR_INPUT) whose message holds needle; what names the
+ * case in the failure. */
+static inline void expect_input_error(thz_status st, const thz_error *err, const char *needle,
+                                      const char *what)
+{
+    CHECK(st == THZ_ERR_INPUT, "%s: %s (%s)", what, thz_status_name(st), err->message);
+    CHECK(strstr(err->message, needle) != NULL, "%s: '%s' not in '%s'", what, needle, err->message);
+}
 
 /* The scene (20000 photons per channel, photon-map: the integrator that fires photons and
  * has no passes; settings may change both). Both sensors have optics and noise (an Airy
