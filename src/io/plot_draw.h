@@ -17,7 +17,7 @@
  * large image. */
 double plot_timeout_s(size_t cells);
 /* Sets that limit's base (60 s) for the figures drawn from now on; for tests only (a
- * sanitizer build's known hang, test_plot.c), before any thread draws. */
+ * sanitizer build's known hang, test_plot_batch.c), before any thread draws. */
 void plot_set_timeout_base_s(double base_s);
 
 /* plot_check_device's check, here (a child_fn: arg unused). */
