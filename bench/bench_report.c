@@ -48,6 +48,98 @@ void bench_report_point_runs(json_t *o, const bench_point *p)
         json_object_set_new(o, "cpu_vs_reference", bench_real(p->cpu_vs_reference));
 }
 
+json_t *bench_report_paper(const bench_paper *paper, const bench_usage *use, double load,
+                           double *bytes_per_photon)
+{
+    const uint64_t peak = use->peak_bytes;
+    /* a stored photon's memory: its record, its share of the index's offsets and cubes,
+     * and of the directory the renderers build over the map */
+    double bpp =
+        bench_ratio((double)(paper->largest_map_bytes + paper->largest_map_directory_bytes),
+                    (double)paper->largest_map_stored);
+    *bytes_per_photon = bpp;
+    printf("\n1. Paper's case: %llu photons x %llu channels, %llux%llu pixels, oversampling %llu "
+           "(load average %.2f)\n",
+           (unsigned long long)paper->photons_per_channel, (unsigned long long)paper->channels,
+           (unsigned long long)paper->columns, (unsigned long long)paper->rows,
+           (unsigned long long)paper->oversampling, load);
+    printf("  %-22s %9s %7s\n", "phase", "seconds", "share");
+    const char *names[] = {"load",        "ray-casting build", "emission table", "tracing",
+                           "index build", "rendering",         "output",         "total"};
+    double secs[] = {paper->s_load,  paper->s_accel,  paper->s_emission_table, paper->s_tracing,
+                     paper->s_index, paper->s_render, paper->s_output,         paper->s_total};
+    for (int i = 0; i < 8; i++)
+        printf("  %-22s %9.3f %6.1f %%\n", names[i], secs[i],
+               100.0 * bench_ratio(secs[i], paper->s_total));
+    double pps = bench_ratio((double)paper->fired, paper->s_photons);
+    printf("  photon phase %.3f s: %.3g photons/s, %llu stored (%.3f per photon), %llu rays\n",
+           paper->s_photons, pps, (unsigned long long)paper->stored,
+           bench_ratio((double)paper->stored, (double)paper->fired),
+           (unsigned long long)paper->rays);
+    printf("  %.1f CPU s over %.1f s wall: %.2f cores on average\n", use->cpu_s, paper->s_total,
+           bench_ratio(use->cpu_s, paper->s_total));
+    printf("  largest photon map %.1f MB and its renderers' directory %.1f MB: %.3f bytes per "
+           "stored photon; peak memory %.1f MB (%.2f x the map without its directory)\n",
+           (double)paper->largest_map_bytes / 1e6, (double)paper->largest_map_directory_bytes / 1e6,
+           bpp, (double)peak / 1e6, bench_ratio((double)peak, (double)paper->largest_map_bytes));
+    json_t *jpaper = json_object();
+    json_object_set_new(jpaper, "photons_per_channel",
+                        json_integer((json_int_t)paper->photons_per_channel));
+    json_object_set_new(jpaper, "channels", json_integer((json_int_t)paper->channels));
+    json_object_set_new(jpaper, "resolution",
+                        json_pack("[I, I]", (json_int_t)paper->columns, (json_int_t)paper->rows));
+    json_object_set_new(jpaper, "oversampling", json_integer((json_int_t)paper->oversampling));
+    json_t *jsec = json_object();
+    const char *keys[] = {"load",  "accel",  "emission_table", "tracing",
+                          "index", "render", "output",         "total"};
+    for (int i = 0; i < 8; i++)
+        json_object_set_new(jsec, keys[i], bench_real(secs[i]));
+    json_object_set_new(jsec, "photon_phase", bench_real(paper->s_photons));
+    json_object_set_new(jpaper, "seconds", jsec);
+    json_object_set_new(jpaper, "photons_fired", json_integer((json_int_t)paper->fired));
+    json_object_set_new(jpaper, "photons_stored", json_integer((json_int_t)paper->stored));
+    json_object_set_new(jpaper, "rays", json_integer((json_int_t)paper->rays));
+    json_object_set_new(jpaper, "photons_per_s", bench_real(pps));
+    json_object_set_new(jpaper, "largest_map_bytes",
+                        json_integer((json_int_t)paper->largest_map_bytes));
+    json_object_set_new(jpaper, "largest_map_stored",
+                        json_integer((json_int_t)paper->largest_map_stored));
+    json_object_set_new(jpaper, "largest_map_directory_bytes",
+                        json_integer((json_int_t)paper->largest_map_directory_bytes));
+    json_object_set_new(jpaper, "bytes_per_stored_photon", bench_real(bpp));
+    json_object_set_new(jpaper, "peak_memory_bytes", json_integer((json_int_t)peak));
+    json_object_set_new(jpaper, "peak_memory_over_map",
+                        bench_real(bench_ratio((double)peak, (double)paper->largest_map_bytes)));
+    json_object_set_new(jpaper, "load_average", bench_real(load));
+    json_object_set_new(jpaper, "cpu_seconds", bench_real(use->cpu_s));
+    return jpaper;
+}
+
+json_t *bench_report_probe(const bench_probe_out *probe, const bench_paper *paper, double load,
+                           double *phase_over_raw)
+{
+    double ratio_phase = bench_ratio(paper->s_photons, probe->seconds);
+    double ratio_trace = bench_ratio(paper->s_tracing, probe->seconds);
+    printf("\n2. Tracing limit: raw Embree, %llu rays (%.4f hit) in %.3f s = %.3g rays/s "
+           "(load average %.2f)\n",
+           (unsigned long long)probe->rays, bench_ratio((double)probe->hits, (double)probe->rays),
+           probe->seconds, bench_ratio((double)probe->rays, probe->seconds), load);
+    printf("  photon phase / raw trace = %.2f x (tracing alone: %.2f x)\n", ratio_phase,
+           ratio_trace);
+    json_t *jt = json_object();
+    json_object_set_new(jt, "rays", json_integer((json_int_t)probe->rays));
+    json_object_set_new(jt, "hit_fraction",
+                        bench_real(bench_ratio((double)probe->hits, (double)probe->rays)));
+    json_object_set_new(jt, "seconds", bench_real(probe->seconds));
+    json_object_set_new(jt, "rays_per_s",
+                        bench_real(bench_ratio((double)probe->rays, probe->seconds)));
+    json_object_set_new(jt, "photon_phase_over_raw", bench_real(ratio_phase));
+    json_object_set_new(jt, "tracing_over_raw", bench_real(ratio_trace));
+    json_object_set_new(jt, "load_average", bench_real(load));
+    *phase_over_raw = ratio_phase;
+    return jt;
+}
+
 json_t *bench_report_photons(const bench_series *sp, size_t channel, double load)
 {
     printf("\n3. Scaling in photons (channel %zu of the paper's case; load average %.2f): each "
@@ -77,6 +169,63 @@ json_t *bench_report_photons(const bench_series *sp, size_t channel, double load
         json_array_append_new(jsp, o);
     }
     return jsp;
+}
+
+void bench_report_triangles_head(uint64_t photons, double load)
+{
+    printf(
+        "\n   Scaling in triangles (enclosure + 4 icospheres, %llu photons; load average %.2f)\n",
+        (unsigned long long)photons, load);
+    printf("  %12s %5s %10s %10s %12s %12s %12s\n", "triangles", "runs", "phase s", "ns/photon",
+           "raw ns/ray", "phase/raw", "CPU ns/ph.");
+}
+
+json_t *bench_report_triangles_row(const bench_point *p)
+{
+    double ns = 1e9 * bench_ratio(p->s_photons, (double)p->photons);
+    printf("  %12llu %5d %10.3f %10.1f %12.1f %10.2f x %12.1f\n", (unsigned long long)p->triangles,
+           p->runs, p->s_photons, ns, 1e9 * bench_ratio(p->s_probe, (double)p->rays),
+           bench_ratio(p->s_photons, p->s_probe),
+           1e9 * bench_ratio(p->cpu_photons, (double)p->photons));
+    json_t *o = json_object();
+    json_object_set_new(o, "triangles", json_integer((json_int_t)p->triangles));
+    json_object_set_new(o, "photons", json_integer((json_int_t)p->photons));
+    json_object_set_new(o, "seconds", bench_real(p->s_photons));
+    json_object_set_new(o, "ns_per_photon", bench_real(ns));
+    json_object_set_new(o, "raw_seconds", bench_real(p->s_probe));
+    bench_report_point_runs(o, p);
+    json_object_set_new(o, "raw_ns_per_ray",
+                        bench_real(1e9 * bench_ratio(p->s_probe, (double)p->rays)));
+    return o;
+}
+
+json_t *bench_report_threads(const bench_threads *th, const bench_pairs *ceiling, size_t channel,
+                             int threads, int pairs, double load, double across[3])
+{
+    printf("\n   Threads (%llu photons, channel %zu; %d pairs of runs on 1 and %d threads, "
+           "alternating; load average %.2f): speed-up the median of the pairs' ratios\n",
+           (unsigned long long)th->photons, channel + 1, pairs, threads, load);
+    json_t *jth = json_object();
+    json_object_set_new(jth, "photons", json_integer((json_int_t)th->photons));
+    json_object_set_new(jth, "rays", json_integer((json_int_t)th->rays));
+    json_object_set_new(jth, "threads", json_integer(threads));
+    json_object_set_new(jth, "speedup", bench_real(bench_pairs_speedup(&th->phase)));
+    json_object_set_new(jth, "raw_speedup", bench_real(bench_pairs_speedup(&th->probe)));
+    json_object_set_new(jth, "photon_phase", bench_report_pairs("photon phase", &th->phase));
+    json_object_set_new(jth, "raw_probe", bench_report_pairs("raw Embree probe", &th->probe));
+    json_object_set_new(jth, "ceiling",
+                        bench_report_pairs("pure arithmetic (the machine)", ceiling));
+    across[0] = bench_pairs_across(&th->phase, &th->probe, &across[1], &across[2]);
+    printf("     photon phase / raw Embree probe, %d threads, round by round: %.2f x (rounds "
+           "%.2f-%.2f x)\n",
+           threads, across[0], across[1], across[2]);
+    json_t *jacross = json_object();
+    json_object_set_new(jacross, "median", bench_real(across[0]));
+    json_object_set_new(jacross, "round_min", bench_real(across[1]));
+    json_object_set_new(jacross, "round_max", bench_real(across[2]));
+    json_object_set_new(jth, "photon_phase_over_raw", jacross);
+    json_object_set_new(jth, "load_average", bench_real(load));
+    return jth;
 }
 
 json_t *bench_report_rendering(const bench_series *sp, size_t channel)

@@ -1,7 +1,7 @@
 /* The benchmark's printed table and its JSON (bench/thzbench.c): the targets list, and
- * sections that are tables of their own (photon scaling, rendering, end to end, the
- * integrators' 2-thread speed-ups, time to a converged image), each printed to stdout and
- * returned as JSON.
+ * each section's table (the paper's case, the tracing limit, photon, triangle and thread
+ * scaling, rendering, end to end, the integrators' 2-thread speed-ups, time to a
+ * converged image), printed to stdout and returned as JSON.
  */
 #ifndef THZ_BENCH_REPORT_H
 #define THZ_BENCH_REPORT_H
@@ -38,9 +38,31 @@ void bench_target(bench_targets *t, const char *name, double value, const char *
  * the fastest run's seconds and CPU ns per photon, and its ratio to the reference runs. */
 void bench_report_point_runs(json_t *o, const bench_point *p);
 
+/* Section 1, the paper's case stage by stage (use: its child's CPU time and peak memory;
+ * load: the load average at its start); *bytes_per_photon the memory of a stored photon
+ * (its record and its shares of the index and of the renderers' directory). The JSON
+ * takes the end-to-end runs after it. */
+json_t *bench_report_paper(const bench_paper *paper, const bench_usage *use, double load,
+                           double *bytes_per_photon);
+/* Section 2, the tracing limit: the raw probe against the paper's case's photon phase,
+ * which *phase_over_raw gets. */
+json_t *bench_report_probe(const bench_probe_out *probe, const bench_paper *paper, double load,
+                           double *phase_over_raw);
+
 /* Section 3's photon scaling and section 4's rendering, from the same series. */
 json_t *bench_report_photons(const bench_series *sp, size_t channel, double load);
 json_t *bench_report_rendering(const bench_series *sp, size_t channel);
+
+/* Section 3's triangle scaling, a row at a time as its points are measured: the table's
+ * head, then each point's row and its JSON. */
+void bench_report_triangles_head(uint64_t photons, double load);
+json_t *bench_report_triangles_row(const bench_point *p);
+
+/* Section 3's threads: the photon phase, the raw probe and the machine's ceiling, 1
+ * thread against all (pairs pairs on threads threads); across gets the phase over the
+ * probe on all threads, round by round: the median, the lowest and the highest. */
+json_t *bench_report_threads(const bench_threads *th, const bench_pairs *ceiling, size_t channel,
+                             int threads, int pairs, double load, double across[3]);
 
 /* One end-to-end run: a line under the label, and its JSON. */
 json_t *bench_report_e2e(const char *label, const bench_e2e *e, const bench_usage *use,
