@@ -3,8 +3,9 @@
  * Pass p of K photons fires photons p K .. (p + 1) K - 1 with power P/K; merged, each
  * power is halved (a power of two: exact), so the merge of passes [0, K) and [K, 2K)
  * holds the same records, bit for bit, as one phase of 2 K photons; and the batches
- * follow the global photon index. Checked on the box scene (every kind of surface, an
- * attenuating atmosphere) with the paper's map and a deviation map. */
+ * follow the global photon index; the passes' statistics merged (photon_stats_merge, as
+ * summary.json reports a run of passes) are the one phase's. Checked on the box scene (every kind
+ * of surface, an attenuating atmosphere) with the paper's map and a deviation map. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -33,16 +34,57 @@ static photon_record *sorted_records(const photon_map *map)
     return r;
 }
 
-static photon_map *fire(thz_scene *s, const accel *acc, uint64_t k, uint64_t first, double t0_k)
+static photon_map *fire_stats(thz_scene *s, const accel *acc, uint64_t k, uint64_t first,
+                              double t0_k, photon_stats *st)
 {
     thz_error err;
     s->photons.per_channel = k;
     photon_phase_options po = {
         .threads = 2, .reference_temperature_k = t0_k, .first_photon = first};
     photon_map *map = NULL;
-    if (photon_phase_run(s, acc, 0, &po, &map, NULL, &err) != THZ_OK)
+    if (photon_phase_run(s, acc, 0, &po, &map, st, &err) != THZ_OK)
         fail_msg("%s", err.message);
     return map;
+}
+
+static photon_map *fire(thz_scene *s, const accel *acc, uint64_t k, uint64_t first, double t0_k)
+{
+    return fire_stats(s, acc, k, first, t0_k, NULL);
+}
+
+/* The merged statistics of two passes against those of one phase of all their photons:
+ * counts equal, power sums equal to rounding (the passes' photons carry twice the power,
+ * their merge the mean of the two). Powers summed rather than averaged (a mutant) passed
+ * every test: summary.json's power balance of a run of n passes would read n times the
+ * power fired. */
+static void check_merged_stats(const photon_stats pass[2], const photon_stats *whole)
+{
+    photon_stats sum;
+    photon_stats_merge(&sum, &pass[0], 1);
+    photon_stats_merge(&sum, &pass[1], 2);
+    assert_int_equal(sum.fired, whole->fired);
+    assert_int_equal(sum.hits, whole->hits);
+    assert_int_equal(sum.reflected, whole->reflected);
+    assert_int_equal(sum.transmitted, whole->transmitted);
+    assert_int_equal(sum.absorbed, whole->absorbed);
+    assert_int_equal(sum.escaped, whole->escaped);
+    assert_int_equal(sum.terminated, whole->terminated);
+    assert_int_equal(sum.rays, whole->rays);
+    assert_float_equal(sum.mean_bounces, whole->mean_bounces, 1e-12);
+    const double scale = fabs(whole->absorbed_power_w_per_hz) +
+                         fabs(whole->escaped_power_w_per_hz) +
+                         fabs(whole->atmosphere_power_w_per_hz);
+    assert_true(scale > 0.0);
+    const double got[] = {sum.fired_power_w_per_hz, sum.absorbed_power_w_per_hz,
+                          sum.escaped_power_w_per_hz, sum.atmosphere_power_w_per_hz,
+                          sum.terminated_power_w_per_hz};
+    const double want[] = {whole->fired_power_w_per_hz, whole->absorbed_power_w_per_hz,
+                           whole->escaped_power_w_per_hz, whole->atmosphere_power_w_per_hz,
+                           whole->terminated_power_w_per_hz};
+    for (size_t i = 0; i < sizeof got / sizeof got[0]; i++) {
+        printf("# power %zu: merged %.9e, one phase %.9e\n", i, got[i], want[i]);
+        assert_true(fabs(got[i] - want[i]) <= 1e-9 * scale);
+    }
 }
 
 static void merge_case(double t0_k)
@@ -53,8 +95,11 @@ static void merge_case(double t0_k)
     thz_error err;
     if (accel_create(s, &acc, &err) != THZ_OK)
         fail_msg("%s", err.message);
-    photon_map *passes[2] = {fire(s, acc, k, 0, t0_k), fire(s, acc, k, k, t0_k)};
-    photon_map *whole = fire(s, acc, 2 * k, 0, t0_k);
+    photon_stats pass_stats[2], whole_stats;
+    photon_map *passes[2] = {fire_stats(s, acc, k, 0, t0_k, &pass_stats[0]),
+                             fire_stats(s, acc, k, k, t0_k, &pass_stats[1])};
+    photon_map *whole = fire_stats(s, acc, 2 * k, 0, t0_k, &whole_stats);
+    check_merged_stats(pass_stats, &whole_stats);
     photon_map *merged = NULL;
     assert_int_equal(photon_map_merge((const photon_map *const *)passes, 2, s->n_objects, 2, NULL,
                                       &merged, &err),
