@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include <cmocka.h>
 
@@ -312,6 +313,56 @@ static void test_offset_is_the_hits(void **state)
     check_gap_in(1e-4, true);
 }
 
+/* A ray at a grazing angle (|cos| < 0.01) to a tilted plate 6 m across meets it where it
+ * meets the plane of the triangle's corners, to double precision: for such rays accel.c
+ * takes that plane from the corners, not from the normal rounded to float, which tilts it
+ * by ~1e-7 rad and slides the point along the ray by ~1e-7 of the plate's size over |cos|
+ * (0.1 mm here at cos 0.003). Without that branch (a mutant) every test passed. */
+static void test_grazing_point_on_the_corners_plane(void **state)
+{
+    (void)state;
+    thz_scene *s = ps_scene(0.35, 0.01, 1000, 1);
+    size_t m = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t plate = ps_object(s, OBJECT_SOLID, m, 300, 0, true);
+    ps_face(s, plate, v3(1.0, 2.0, 3.0), v3(3.0, 0.3, 0.7), v3(-0.2, 2.9, 1.3));
+    ps_finalize(s);
+    accel *acc;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    const thz_mesh *mesh = &s->objects[plate].mesh;
+    double worst = 0.0;
+    for (uint32_t tri = 0; tri < 2; tri++) {
+        const uint32_t *idx = &mesh->indices[3 * tri];
+        vec3 p0 = v3_from_floats(&mesh->positions[3 * (size_t)idx[0]]);
+        vec3 p1 = v3_from_floats(&mesh->positions[3 * (size_t)idx[1]]);
+        vec3 p2 = v3_from_floats(&mesh->positions[3 * (size_t)idx[2]]);
+        vec3 n = v3_normalize(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
+        /* far corners of the triangle, where a tilted plane through p0 is furthest off */
+        vec3 target = v3_add(v3_scale(p0, 0.1), v3_add(v3_scale(p1, 0.45), v3_scale(p2, 0.45)));
+        vec3 e1 = v3_normalize(v3_sub(p1, p0)), e2 = v3_normalize(v3_cross(n, e1));
+        const double mus[] = {0.009, 0.003, 0.001};
+        for (size_t i = 0; i < sizeof mus / sizeof mus[0]; i++)
+            for (int a = 0; a < 8; a++) {
+                double phi = a * M_PI / 4.0 + 0.3, mu = mus[i], st = sqrt(1.0 - mu * mu);
+                vec3 along = v3_add(v3_scale(e1, cos(phi)), v3_scale(e2, sin(phi)));
+                /* from the front side (n), down onto the target, 0.2 m away */
+                vec3 dir = v3_sub(v3_scale(along, st), v3_scale(n, mu));
+                vec3 o = v3_madd(target, -0.2, dir);
+                accel_hit h;
+                assert_true(accel_intersect(acc, o, dir, INFINITY, ACCEL_NO_OBJECT, 0, &h));
+                assert_int_equal(h.object, plate);
+                double off = v3_length(v3_sub(h.position_m, target));
+                worst = off > worst ? off : worst;
+                assert_true(off <= 1e-10);
+                assert_float_equal(h.distance_m, 0.2, 1e-10);
+            }
+    }
+    printf("# grazing hits: the farthest %.2e m from where the ray meets the corners' plane\n",
+           worst);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -323,6 +374,7 @@ int main(void)
         cmocka_unit_test(test_offset_is_the_hits),
         cmocka_unit_test(test_back_of_the_wall_it_starts_on),
         cmocka_unit_test(test_silhouette_edge),
+        cmocka_unit_test(test_grazing_point_on_the_corners_plane),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
