@@ -521,6 +521,66 @@ static void test_crowded_key(void **state)
     free(src);
 }
 
+/* A dense cluster: 1500 of 3000 records of one group within 0.8 mm of a 1 m cube, all
+ * inside one cell of the octree's 10th level (1/1024 of the cube), so that queries there
+ * descend below it, where the records are told apart by the digits after the build's
+ * first 32 bits of code (photon_sort_range sorts those ties from the next level on). Radius
+ * and k-nearest queries in the cluster against brute force. Those ties sorted from one
+ * level deeper (a mutant: the 11th level's z bit left unsorted) passed every test, and
+ * radius queries there missed photons. */
+static void test_dense_cluster(void **state)
+{
+    (void)state;
+    const size_t n = 3000;
+    photon_record *src = malloc(n * sizeof *src);
+    assert_non_null(src);
+    rng_stream rng;
+    rng_init(&rng, 15, 0, RNG_PURPOSE_TEST, 0);
+    for (size_t i = 0; i < n; i++) {
+        float pos[3];
+        for (int a = 0; a < 3; a++) {
+            double u = rng_uniform(&rng);
+            pos[a] = (float)(i % 2 ? 0.5001 + 0.0008 * u : u);
+        }
+        src[i] = (photon_record){.position_m = {pos[0], pos[1], pos[2]},
+                                 .power_w_per_hz = (float)i,
+                                 .freq_hz = 1e12f,
+                                 .dir_oct = 0,
+                                 .tag = photon_tag(0, 0, 0, 0)};
+    }
+    for (int a = 0; a < 3; a++) { /* the cube from 0 to 1 m: the cluster in cell 512 */
+        src[0].position_m[a] = 0.0f;
+        src[2].position_m[a] = 1.0f;
+    }
+    photon_map *map = build(src, n, 1, 1, 0);
+    const photon_record *r = photon_map_records(map);
+    double *d2s = malloc(n * sizeof *d2s);
+    assert_non_null(d2s);
+    for (int trial = 0; trial < 20; trial++) {
+        vec3 q = v3(0.5001 + 0.0008 * rng_uniform(&rng), 0.5001 + 0.0008 * rng_uniform(&rng),
+                    0.5001 + 0.0008 * rng_uniform(&rng));
+        for (size_t i = 0; i < n; i++) {
+            double dx = (double)r[i].position_m[0] - q.x, dy = (double)r[i].position_m[1] - q.y,
+                   dz = (double)r[i].position_m[2] - q.z;
+            d2s[i] = dx * dx + dy * dy + dz * dz;
+        }
+        qsort(d2s, n, sizeof *d2s, cmp_double);
+        static const size_t ks[] = {1, 20, 300};
+        for (size_t ki = 0; ki < sizeof ks / sizeof ks[0]; ki++) {
+            assert_true(photon_map_kth_distance2(map, 0, 1u, q, ks[ki]) == d2s[ks[ki] - 1]);
+            int visits = 0;
+            photon_map_radius(map, 0, 0, q, d2s[ks[ki] - 1], noop_visit, &visits);
+            size_t expect = ks[ki];
+            while (expect < n && d2s[expect] <= d2s[ks[ki] - 1])
+                expect++;
+            assert_int_equal((size_t)visits, expect);
+        }
+    }
+    free(d2s);
+    photon_map_destroy(map);
+    free(src);
+}
+
 static void test_empty_and_errors(void **state)
 {
     (void)state;
@@ -560,15 +620,11 @@ static void test_empty_and_errors(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_directions),
-        cmocka_unit_test(test_queries_vs_brute_force),
-        cmocka_unit_test(test_same_records_grouped),
-        cmocka_unit_test(test_deterministic),
-        cmocka_unit_test(test_deterministic_crowded),
-        cmocka_unit_test(test_cancel),
-        cmocka_unit_test(test_in_order),
-        cmocka_unit_test(test_crowded_key),
-        cmocka_unit_test(test_empty_and_errors),
+        cmocka_unit_test(test_directions),    cmocka_unit_test(test_queries_vs_brute_force),
+        cmocka_unit_test(test_dense_cluster), cmocka_unit_test(test_same_records_grouped),
+        cmocka_unit_test(test_deterministic), cmocka_unit_test(test_deterministic_crowded),
+        cmocka_unit_test(test_cancel),        cmocka_unit_test(test_in_order),
+        cmocka_unit_test(test_crowded_key),   cmocka_unit_test(test_empty_and_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
