@@ -5,7 +5,8 @@
  * Scenes: the closed box scene with every kind of surface and an atmosphere, an open one
  * (a plate and a shell in free space) where photons escape, and a room with a Ward plate,
  * whose reflections weigh the power (the weights' difference from 1 is booked as
- * terminated power, so the balance still closes). */
+ * terminated power, so the balance still closes). Then the rules that end or send on a
+ * path: the bounce cap, a one-sided solid's back face, a diffuse transmission. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -241,12 +242,60 @@ static void test_back_face_absorbs(void **state)
     scene_destroy(s);
 }
 
+/* A diffusely transmitting shell (R = 0, alpha t = 0.5, 0 K) 10 m across between a small
+ * hot black plate below it and a small cold black one above: a photon transmitted through
+ * it leaves on the far side (trace_diffuse_transmission_dir about -n_in), so the plate
+ * above, which sees the hot one only through the shell, receives photons, and nothing
+ * ever comes back down onto the hot plate. Transmitted photons sent back to the side they
+ * came from (a mutant) was caught only by test_deviation_photons' T0 = 0 checksums, which
+ * pin the bytes rather than the rule: the plate above got nothing and the hot one what the
+ * shell let through. */
+static void test_diffuse_transmission_goes_through(void **state)
+{
+    (void)state;
+    const uint64_t k = ps_scaled(20000);
+    thz_scene *s = ps_scene(0.35, 0.05, k, 26);
+    size_t black = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t veil = ps_material(s, 0.0, 100.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t hot = ps_object(s, OBJECT_SOLID, black, 300, 0, false);
+    ps_face(s, hot, v3(0, 0, 0), v3(0.25, 0, 0), v3(0, 0.25, 0)); /* normal +z */
+    size_t shell = ps_object(s, OBJECT_SHELL, veil, 0, 5e-3, true);
+    ps_face(s, shell, v3(0, 0, 0.5), v3(5, 0, 0), v3(0, 5, 0));
+    size_t cold = ps_object(s, OBJECT_SOLID, black, 0, 0, false);
+    ps_face(s, cold, v3(0, 0, 1.0), v3(0, 0.25, 0), v3(0.25, 0, 0)); /* normal -z */
+    ps_finalize(s);
+    accel *acc;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    photon_map *map;
+    photon_stats st;
+    photon_phase_options opt = {.threads = 2};
+    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+    const photon_record *r = photon_map_records(map);
+    size_t on[3] = {0, 0, 0};
+    for (size_t i = 0; i < photon_map_count(map); i++)
+        on[photon_object(&r[i])]++;
+    printf("# shell between plates: %llu transmitted; %zu hits on the hot plate, %zu on the "
+           "shell, %zu on the cold plate\n",
+           (unsigned long long)st.transmitted, on[hot], on[shell], on[cold]);
+    assert_true(on[shell] > k * 9 / 10); /* the rest pass its edge, grazing */
+    assert_true(st.transmitted > k / 10);
+    assert_int_equal(on[hot], 0);
+    assert_true(on[cold] > 0);
+    photon_map_destroy(map);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_closed_box),        cmocka_unit_test(test_open_scene),
-        cmocka_unit_test(test_ward_room),         cmocka_unit_test(test_bounce_cap),
+        cmocka_unit_test(test_closed_box),
+        cmocka_unit_test(test_open_scene),
+        cmocka_unit_test(test_ward_room),
+        cmocka_unit_test(test_bounce_cap),
         cmocka_unit_test(test_back_face_absorbs),
+        cmocka_unit_test(test_diffuse_transmission_goes_through),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
