@@ -250,13 +250,15 @@ static void test_back_face_absorbs(void **state)
  * came from (a mutant) was caught only by test_deviation_photons' T0 = 0 checksums, which
  * pin the bytes rather than the rule: the plate above got nothing and the hot one what the
  * shell let through. */
-static void test_diffuse_transmission_goes_through(void **state)
+/* A small hot black plate (z = 0, facing up), a shell 10 m across (reflectivity r,
+ * attenuation alpha over 5 mm, 0 K, diffuse transmission) at z = 0.5 m and a small cold black
+ * plate (z = 1 m, facing down), which sees the hot one only through the shell: k photons
+ * fired; their hits on each (hot, shell, cold) into on[], the statistics into *st. */
+static void fire_sandwich(uint64_t k, double r, double alpha_per_m, size_t on[3], photon_stats *st)
 {
-    (void)state;
-    const uint64_t k = ps_scaled(20000);
     thz_scene *s = ps_scene(0.35, 0.05, k, 26);
     size_t black = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
-    size_t veil = ps_material(s, 0.0, 100.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t veil = ps_material(s, r, alpha_per_m, -1.0, TRANSMISSION_DIFFUSE);
     size_t hot = ps_object(s, OBJECT_SOLID, black, 300, 0, false);
     ps_face(s, hot, v3(0, 0, 0), v3(0.25, 0, 0), v3(0, 0.25, 0)); /* normal +z */
     size_t shell = ps_object(s, OBJECT_SHELL, veil, 0, 5e-3, true);
@@ -268,23 +270,61 @@ static void test_diffuse_transmission_goes_through(void **state)
     thz_error err;
     assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
     photon_map *map;
-    photon_stats st;
     photon_phase_options opt = {.threads = 2};
-    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
-    const photon_record *r = photon_map_records(map);
-    size_t on[3] = {0, 0, 0};
+    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, st, &err), THZ_OK);
+    const photon_record *rec = photon_map_records(map);
+    on[0] = on[1] = on[2] = 0;
     for (size_t i = 0; i < photon_map_count(map); i++)
-        on[photon_object(&r[i])]++;
-    printf("# shell between plates: %llu transmitted; %zu hits on the hot plate, %zu on the "
-           "shell, %zu on the cold plate\n",
-           (unsigned long long)st.transmitted, on[hot], on[shell], on[cold]);
+        on[photon_object(&rec[i])]++;
+    printf("# shell (R %.1f, alpha t %.2f) between plates: %llu reflected, %llu transmitted, "
+           "%llu absorbed; %zu hits on the hot plate, %zu on the shell, %zu on the cold plate\n",
+           r, alpha_per_m * 5e-3, (unsigned long long)st->reflected,
+           (unsigned long long)st->transmitted, (unsigned long long)st->absorbed, on[hot],
+           on[shell], on[cold]);
     assert_true(on[shell] > k * 9 / 10); /* the rest pass its edge, grazing */
-    assert_true(st.transmitted > k / 10);
-    assert_int_equal(on[hot], 0);
-    assert_true(on[cold] > 0);
     photon_map_destroy(map);
     accel_destroy(acc);
     scene_destroy(s);
+}
+
+/* A shell without reflection (alpha t = 0.5): a photon transmitted through it leaves on
+ * its far side (trace_diffuse_transmission_dir about -n_in), so the cold plate receives
+ * photons and nothing ever comes back down onto the hot one. Transmitted photons sent back
+ * to the side they came from (a mutant) was caught only by test_deviation_photons' T0 = 0
+ * checksums, which pin the bytes rather than the rule: the plate behind got nothing and the
+ * hot one what the shell let through. */
+static void test_diffuse_transmission_goes_through(void **state)
+{
+    (void)state;
+    const uint64_t k = ps_scaled(20000);
+    size_t on[3];
+    photon_stats st;
+    fire_sandwich(k, 0.0, 100.0, on, &st);
+    assert_true(st.transmitted > k / 10);
+    assert_int_equal(on[0], 0);
+    assert_true(on[2] > 0);
+}
+
+/* A lossless shell (R = 0.3, alpha = 0: T = 1 - R = 0.7 at every angle, A = 0): at each
+ * hit on it the roulette reflects with probability 0.3 and transmits with 0.7 (trace_roulette:
+ * u < R, else u < R + T), and absorbs nothing; only the black plates absorb. Counts within
+ * 5 standard errors of the shell's hits. A transmission drawn as u < T instead of u < R + T
+ * (a mutant: T - R = 0.4 transmitted, 0.3 absorbed) was caught only by test_deviation_photons'
+ * T0 = 0 checksums. */
+static void test_shell_roulette(void **state)
+{
+    (void)state;
+    const uint64_t k = ps_scaled(20000);
+    size_t on[3];
+    photon_stats st;
+    fire_sandwich(k, 0.3, 0.0, on, &st);
+    double n = (double)on[1], se = sqrt(0.3 * 0.7 / n);
+    double fr = (double)st.reflected / n, ft = (double)st.transmitted / n;
+    printf("# lossless shell: reflected %.4f (0.3), transmitted %.4f (0.7), se %.4f\n", fr, ft, se);
+    assert_true(fabs(fr - 0.3) < 5.0 * se);
+    assert_true(fabs(ft - 0.7) < 5.0 * se);
+    assert_int_equal(st.reflected + st.transmitted, on[1]);
+    assert_int_equal(st.absorbed, on[0] + on[2]);
 }
 
 int main(void)
@@ -296,6 +336,7 @@ int main(void)
         cmocka_unit_test(test_bounce_cap),
         cmocka_unit_test(test_back_face_absorbs),
         cmocka_unit_test(test_diffuse_transmission_goes_through),
+        cmocka_unit_test(test_shell_roulette),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
