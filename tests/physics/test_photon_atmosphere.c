@@ -2,7 +2,8 @@
  * exp(-alpha d) times the power sent, exactly along a fixed ray and on average where the
  * low-power roulette is at work; a cosine emitter facing a black plane at distance d
  * delivers on average 2 E3(alpha d) of its power (E3 the exponential integral); and the
- * power lost on the way is booked as atmosphere power. Tolerances: 5 standard errors. */
+ * power lost on the way is booked as atmosphere power; emitting air sends its photons
+ * in every direction alike. Tolerances: 5 standard errors. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -156,12 +157,57 @@ static void test_cosine_emitter(void **state)
     scene_destroy(s);
 }
 
+/* Emitting air (alpha 0.2 /m at 300 K) filling a closed black room at 0 K (its extent the
+ * room): every photon is an air photon, emitted isotropically (air_emission.h), so by
+ * symmetry the floor and the ceiling receive as many, each within 5 standard errors of
+ * their sum. Air photons sent upwards only (a mutant: the direction's z drawn from
+ * (0, 1] instead of (-1, 1]) was caught only by test_deviation_photons' T0 = 0 checksums,
+ * which pin the bytes rather than the rule: the floor received nothing. */
+static void test_air_isotropic(void **state)
+{
+    (void)state;
+    const uint64_t k = ps_scaled(20000);
+    thz_scene *s = ps_scene(0.35, 0.05, k, 9);
+    size_t black = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t room = ps_object(s, OBJECT_SOLID, black, 0, 0, false);
+    ps_box(s, room, v3(-1, -1, 0), v3(1, 1, 2), true);
+    ps_finalize(s);
+    thz_error err;
+    double lo[3] = {-1, -1, 0}, hi[3] = {1, 1, 2};
+    s->atmosphere.model = ATM_CONSTANT;
+    ps_check(spectrum_set_constant(&s->atmosphere.attenuation_per_m, 0.2));
+    ps_check(atmosphere_set_emitting(&s->atmosphere, 300.0, 0.0, &err) == THZ_OK);
+    ps_check(atmosphere_set_extent(&s->atmosphere, lo, hi, &err) == THZ_OK);
+    accel *acc;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    photon_map *map;
+    photon_stats st;
+    photon_phase_options opt = {.threads = 2};
+    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+    const photon_record *r = photon_map_records(map);
+    size_t floor_hits = 0, ceiling_hits = 0;
+    for (size_t i = 0; i < photon_map_count(map); i++) {
+        floor_hits += fabsf(r[i].position_m[2]) < 1e-4f;
+        ceiling_hits += fabsf(r[i].position_m[2] - 2.0f) < 1e-4f;
+    }
+    double sum = (double)(floor_hits + ceiling_hits);
+    printf("# emitting air in a black room: %zu records, %zu on the floor, %zu on the ceiling\n",
+           photon_map_count(map), floor_hits, ceiling_hits);
+    assert_true(photon_map_count(map) > k / 2);             /* alpha 0.2 /m: most reach a wall */
+    assert_true(sum > 0.2 * (double)photon_map_count(map)); /* 2 of 6 equal faces: 1/3 */
+    assert_true(fabs((double)floor_hits - (double)ceiling_hits) < 5.0 * sqrt(sum));
+    photon_map_destroy(map);
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_fixed_path),
         cmocka_unit_test(test_low_power_roulette),
         cmocka_unit_test(test_cosine_emitter),
+        cmocka_unit_test(test_air_isotropic),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
