@@ -11,7 +11,7 @@ typedef struct photon_stats {
     uint64_t fired;                   /* K */
     uint64_t stored;                  /* records in the photon map */
     uint64_t hits;                    /* surface hits (each stored) */
-    uint64_t reflected;               /* roulette: reflection */
+    uint64_t reflected;               /* roulette: reflection (a lobe sample lost is absorbed) */
     uint64_t transmitted;             /* roulette: transmission through a shell */
     uint64_t absorbed;                /* roulette: absorption (front or back side) */
     uint64_t escaped;                 /* left the scene without a hit */

@@ -213,14 +213,14 @@ bool trace_photon(const thz_scene *scene, const accel *acc, const trace_optics *
 
         switch (trace_roulette(&o, hit.cos_theta, rng_uniform32(rng))) {
         case TRACE_REFLECT:
-            c->reflected++;
             if (o.lobe == OPTICS_LOBE_DIFFUSE && !optics_reflectance_varies(&o)) {
                 dir = sampling_cosine32(n_in, rng);
             } else if (!trace_reflect_lobe(scene, obj, &hit, &o, rng, &dir, &power, c)) {
-                c->absorbed++; /* a glossy sample below the surface: lost */
+                c->absorbed++; /* a glossy sample below the surface: lost, not reflected */
                 c->absorbed_power += power;
                 return true;
             }
+            c->reflected++;
             break;
         case TRACE_TRANSMIT:
             c->transmitted++;
