@@ -93,9 +93,12 @@ thz_status atm_catalog_read_csv(const char *path, bool coupled, raw_catalog *cat
         double iso = csv_value(&csv, r, col[7]);
         l.iso = iso >= 1.0 && iso <= 99.0 ? (int)iso : 0;
         if (coupled) {
-            double *m = &l.y0;
+            /* each field by its own address: indexing past &l.y0 into the next members is
+             * undefined behaviour, whatever the struct's layout */
+            double *const m[N_MIX] = {&l.y0, &l.y1, &l.yx, &l.g0, &l.g1,
+                                      &l.gx, &l.d0, &l.d1, &l.dx, &l.tref_k};
             for (size_t i = 0; i < N_MIX; i++)
-                m[i] = csv_value(&csv, r, col[N_BASE + i]);
+                *m[i] = csv_value(&csv, r, col[N_BASE + i]);
             if (!(l.tref_k > 0.0))
                 st = thz_error_set(err, THZ_ERR_INPUT, "%s:%zu: Tref_K must be > 0", path,
                                    csv.row_lines[r]);
