@@ -43,6 +43,7 @@ const thz_cube *serve_cube_get(serve *s, const char *hdr, thz_error *err)
     if (stat(img, &si) != 0)
         si = (struct stat){0};
     if (!s->cubes && !(s->cubes = calloc(SERVE_CUBE_CACHE, sizeof *s->cubes))) {
+        snprintf(err->message, sizeof err->message, "out of memory for the cube cache");
         err->status = THZ_ERR_NOMEM;
         return NULL;
     }
