@@ -6,7 +6,8 @@
  * uniform. At normal incidence this is the spec's T_0 form; each pixel is compared at
  * its own angle (one sample per pixel, through the pixel centre). For every integrator.
  * A third case gives the diffuse shell R = 0.05, a reflected part light enough to be
- * traced by roulette (path's first-hit branches, final-gather's split gather rays).
+ * traced by roulette (path's first-hit branches, final-gather's split gather rays), and
+ * a fourth a dense cold shell whose transmitted part is (T(theta) <= 0.05).
  * Two more put the cap's kink mu* = alpha t / -ln(1 - R) = 0.7 inside the view: pixels
  * nearer the normal see T = 1 - R, where the shell absorbs and emits nothing, and the
  * shell's mean emissivity and its diffuse transmission's directions come from both
@@ -14,12 +15,13 @@
 #include "identity.h"
 
 #define SHELL_ALPHA 200.0
-#define SHELL_ALPHA_KINK 78.1 /* alpha t = 0.156, mu* = 0.7 at R = 0.2 */
+#define SHELL_ALPHA_KINK 78.1    /* alpha t = 0.156, mu* = 0.7 at R = 0.2 */
+#define SHELL_ALPHA_DENSE 1500.0 /* alpha t = 3: T(theta) <= 0.05 */
 #define SHELL_T_M 0.002
 #define SHELL_TS 400.0
 #define SHELL_TB 250.0
 
-static void shell_case_with(const char *mode, uint64_t seed, double refl, double alpha,
+static void shell_case_with(const char *mode, uint64_t seed, double refl, double alpha, double ts,
                             thz_integrator integrator, double t0_k)
 {
     char json[2048];
@@ -40,14 +42,14 @@ static void shell_case_with(const char *mode, uint64_t seed, double refl, double
              " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.3, 0],"
              "   \"direction\": [0, 1, 0], \"fov_deg\": 100, \"resolution\": [12, 12]}],"
              " \"photons\": {\"per_channel\": 300000, \"seed\": %llu}}",
-             mode, refl, alpha, mode, SHELL_TB, SHELL_T_M, SHELL_TS, (unsigned long long)seed);
+             mode, refl, alpha, mode, SHELL_TB, SHELL_T_M, ts, (unsigned long long)seed);
     /* The diffuse shell at the kink is the noisiest photon-map case (its pixels' standard
      * errors up to 8.6 % at 300 000 photons, over the bound of 8 %). */
     double photons = alpha == SHELL_ALPHA ? 300000 : 450000;
     ident_run r;
     ident_run_scene_t0(&r, json, ident_photons(photons), integrator, ident_estimates(32), t0_k);
     const thz_channel *ch = &r.scene->channels[0];
-    double bs = ident_band_planck(ch, SHELL_TS), bb = ident_band_planck(ch, SHELL_TB);
+    double bs = ident_band_planck(ch, ts), bb = ident_band_planck(ch, SHELL_TB);
     double t_min = 1.0, t_max = 0.0, expects[144];
     size_t capped = 0;
     assert_true((size_t)r.img.rows * r.img.columns <= 144);
@@ -71,6 +73,8 @@ static void shell_case_with(const char *mode, uint64_t seed, double refl, double
     size_t pixels = (size_t)r.img.rows * r.img.columns;
     if (alpha == SHELL_ALPHA)
         assert_true(t_max - t_min > 0.1); /* the view spans a real range of T(theta) */
+    else if (alpha == SHELL_ALPHA_DENSE)
+        assert_true(t_max < 0.15 && t_max > 0.04); /* every T(theta) light, the largest not 0 */
     else
         assert_true(capped >= pixels / 4 && pixels - capped >= pixels / 4); /* both pieces */
     char label[64], what[128];
@@ -81,12 +85,17 @@ static void shell_case_with(const char *mode, uint64_t seed, double refl, double
     ident_run_fini(&r);
 }
 
-static void shell_case(const char *mode, uint64_t seed, double refl, double alpha)
+static void shell_case_ts(const char *mode, uint64_t seed, double refl, double alpha, double ts)
 {
     for (size_t k = 0; k < IDENT_N_INTEGRATORS; k++)
         for (size_t v = 0; v < IDENT_N_T0; v++)
             if (ident_t0_applies(ident_integrators[k], v))
-                shell_case_with(mode, seed, refl, alpha, ident_integrators[k], ident_t0s[v]);
+                shell_case_with(mode, seed, refl, alpha, ts, ident_integrators[k], ident_t0s[v]);
+}
+
+static void shell_case(const char *mode, uint64_t seed, double refl, double alpha)
+{
+    shell_case_ts(mode, seed, refl, alpha, SHELL_TS);
 }
 
 static void test_shell_straight(void **state)
@@ -119,6 +128,16 @@ static void test_shell_diffuse_cap(void **state)
     shell_case("diffuse", 11, 0.2, SHELL_ALPHA_KINK);
 }
 
+/* A dense shell, T(theta) <= 0.05 over the view: final-gather's transmitted part of a split
+ * gather ray is traced by roulette everywhere (q = T / 0.15). The shell is cold (50 K), so
+ * that what it transmits from the 250 K room is a large part of what the pixels see (at
+ * normal incidence 14 %); from a map of L (T0 = 0 K) that part is not zero. */
+static void test_shell_diffuse_light_transmission(void **state)
+{
+    (void)state;
+    shell_case_ts("diffuse", 12, 0.2, SHELL_ALPHA_DENSE, 50.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -127,6 +146,7 @@ int main(void)
         cmocka_unit_test(test_shell_diffuse_light_reflection),
         cmocka_unit_test(test_shell_straight_cap),
         cmocka_unit_test(test_shell_diffuse_cap),
+        cmocka_unit_test(test_shell_diffuse_light_transmission),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
