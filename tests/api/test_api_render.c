@@ -2,8 +2,12 @@
  * back, two sensors rendered in memory (and by thz_render_file from the saved file);
  * every plane must equal, bit for bit, the ENVI
  * image `thzmap simulate` writes for the same scene and seed (and the saved map the
- * CLI's photon-map.thzpm), whatever the thread counts (1 here, 2 for the CLI).
+ * CLI's photon-map.thzpm), whatever the thread counts (1 here, 2 for the CLI). And
+ * photon-map's photon passes towards a noise target render the photons of one phase of
+ * as many (check_photon_passes).
  * argv: the thzmap binary, the repository. */
+#include <math.h>
+
 #include "api_test.h"
 
 /* Compares every ENVI plane of `image` with the files of dir/<sensor>.<quantity>.img. */
@@ -35,6 +39,96 @@ static void compare_with_files(const thz_image *image, const char *dir)
         }
         free(file);
     }
+}
+
+/* photon-map towards a noise target fires photon passes (pass p: photons p K .. (p + 1) K - 1)
+ * and renders their merge: two passes of K must give the image of one phase of 2 K photons
+ * (the same photons; run.h), not of K photons twice over, whose standard error would fall
+ * as 1 / sqrt(passes) while the image kept the noise of K. */
+static const char passes_scene_json[] =
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"passes\","
+    " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.05}],"
+    " \"materials\": {\"wall\": {\"reflectivity\": 0.3}, \"grey\": {\"reflectivity\": 0.5}},"
+    " \"objects\": ["
+    "   {\"name\": \"room\", \"type\": \"solid\", \"material\": \"wall\","
+    "    \"temperature_k\": 295,"
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2], \"inward\": true}},"
+    "   {\"name\": \"box\", \"type\": \"solid\", \"material\": \"grey\","
+    "    \"temperature_k\": 330,"
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [0.5, 0.5, 0.5]}}],"
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.9, 0],"
+    "   \"direction\": [0, 1, 0], \"fov_deg\": 60, \"resolution\": [8, 6]}],"
+    " \"photons\": {\"per_channel\": 100000, \"seed\": 5},"
+    " \"render\": {\"integrator\": \"photon-map\"}}";
+
+/* A photon-map run of `photons` a channel towards `target_k` (0: one pass). */
+static thz_run *passes_run(thz_context *ctx, const thz_scene *scene, uint64_t photons,
+                           double target_k)
+{
+    thz_run_settings settings;
+    thz_run_settings_init(&settings);
+    settings.photons_per_channel = photons;
+    settings.target_noise_k = target_k;
+    thz_run *run = NULL;
+    thz_error err = {0};
+    if (thz_simulate(ctx, scene, &settings, &run, &err) != THZ_OK) {
+        CHECK(0, "photon passes: %s", err.message);
+        return NULL;
+    }
+    return run;
+}
+
+static void check_photon_passes(thz_context *ctx)
+{
+    thz_error err = {0};
+    thz_scene *scene = NULL;
+    REQUIRE_OK(thz_scene_load_string(passes_scene_json, NULL, "passes.json", &scene, &err), &err);
+    const uint64_t k = 100000;
+    thz_run *one = passes_run(ctx, scene, k, 0.0), *whole = passes_run(ctx, scene, 2 * k, 0.0);
+    if (!one || !whole) {
+        thz_run_destroy(one);
+        thz_run_destroy(whole);
+        thz_scene_destroy(scene);
+        return;
+    }
+    thz_run_totals t1, tw;
+    thz_run_get_totals(one, &t1);
+    thz_run_get_totals(whole, &tw);
+    /* a target between the noise of K photons and of 2 K (1 / sqrt 2 of it): the check
+     * after pass 1 goes on, the one after pass 2 stops */
+    double target = 0.85 * t1.worst_p95_stderr_k;
+    CHECK(t1.max_passes == 1 && tw.worst_p95_stderr_k < 0.8 * t1.worst_p95_stderr_k,
+          "K photons: %u passes, %.4g K; 2 K: %.4g K", t1.max_passes, t1.worst_p95_stderr_k,
+          tw.worst_p95_stderr_k);
+    thz_run *passes = passes_run(ctx, scene, k, target);
+    if (passes) {
+        thz_run_totals tp;
+        thz_run_get_totals(passes, &tp);
+        CHECK(tp.max_passes == 2 && tp.photons_fired == 2 * k,
+              "towards %.4g K: %u passes, %llu photons", target, tp.max_passes,
+              (unsigned long long)tp.photons_fired);
+        size_t na = 0, nb = 0;
+        const float *a = thz_image_plane(thz_run_image(passes, 0), THZ_PLANE_RADIANCE, &na);
+        const float *b = thz_image_plane(thz_run_image(whole, 0), THZ_PLANE_RADIANCE, &nb);
+        size_t pixels = 8 * 6, off = 0;
+        double worst = 0.0;
+        for (size_t i = 0; a && b && na == 1 && nb == 1 && i < pixels; i++) {
+            double rel = fabs((double)a[i] - (double)b[i]) / fabs((double)b[i]);
+            off += !(rel <= 1e-5); /* the merge's order of equal keys: rounding only */
+            worst = rel > worst ? rel : worst;
+        }
+        CHECK(a && b && off == 0,
+              "2 passes of %llu photons against one of %llu: %zu of %zu "
+              "pixels differ (worst by %.3g)",
+              (unsigned long long)k, (unsigned long long)(2 * k), off, pixels, worst);
+        CHECK(fabs(tp.worst_p95_stderr_k - tw.worst_p95_stderr_k) <= 1e-4 * tw.worst_p95_stderr_k,
+              "standard error after 2 passes %.5g K, of one phase of 2 K photons %.5g K",
+              tp.worst_p95_stderr_k, tw.worst_p95_stderr_k);
+    }
+    thz_run_destroy(passes);
+    thz_run_destroy(one);
+    thz_run_destroy(whole);
+    thz_scene_destroy(scene);
 }
 
 int main(int argc, char **argv)
@@ -176,6 +270,8 @@ int main(int argc, char **argv)
           "keep_photons with path: %s", err.message);
     CHECK(thz_simulate_check(ctx, scene, &settings, &err) == THZ_ERR_INPUT,
           "thz_simulate_check, keep_photons with path: %s", err.message);
+
+    check_photon_passes(ctx);
 
     thz_photons_destroy(photons);
     thz_context_destroy(ctx);
