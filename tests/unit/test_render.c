@@ -348,6 +348,55 @@ static void test_passes_are_deterministic(void **state)
     *s = saved;
 }
 
+/* Every sensor and pass has random numbers of its own (render.c's stream index, unique
+ * over passes x sensors): sensor 1, placed as sensor 0, renders its pass 0 from other
+ * numbers than sensor 0's pass 1. With streams shared between them, two cameras of a
+ * scene shared their noise (an average of the two was no less noisy than either, and
+ * the difference of a camera with its twin showed no noise at all). */
+static void test_streams_of_sensors_and_passes(void **state)
+{
+    fixture *f = *state;
+    thz_sensor *s0 = &f->scene->sensors[0], *s1 = &f->scene->sensors[1];
+    thz_sensor saved0 = *s0, saved1 = *s1;
+    s0->fov_deg = 30.0;
+    *s1 = *s0; /* the same camera */
+    size_t px = (size_t)s0->columns * s0->rows;
+    const thz_integrator kinds[] = {INTEGRATOR_PATH, INTEGRATOR_FINAL_GATHER};
+    for (size_t k = 0; k < 2; k++) {
+        f->scene->render.integrator = kinds[k];
+        f->scene->render.paths_per_sample = 3;
+        f->scene->render.gather_rays = 3;
+        render_accum a, b;
+        thz_error err;
+        render_options ro = {.threads = 2};
+        assert_int_equal(render_accum_init(&a, px, &err), THZ_OK);
+        assert_int_equal(render_accum_init(&b, px, &err), THZ_OK);
+        a.passes = 1; /* sensor 0's pass 1 alone */
+        assert_int_equal(
+            render_sensor_channel_pass(f->scene, f->acc, f->map, 0, 0, 1, &a, &ro, NULL, &err),
+            THZ_OK);
+        assert_int_equal(
+            render_sensor_channel_pass(f->scene, f->acc, f->map, 0, 1, 0, &b, &ro, NULL, &err),
+            THZ_OK);
+        size_t varied = 0, same = 0;
+        for (size_t p = 0; p < px; p++) {
+            if (!(render_accum_stderr(&a, p) > 0.0))
+                continue; /* no randomness in this pixel's estimates */
+            varied++;
+            same += a.mean[p] == b.mean[p];
+        }
+        print_message("%s: %zu of %zu pixels vary, %zu of them equal between the twins\n",
+                      render_integrator_name(kinds[k]), varied, px, same);
+        assert_true(varied > 0); /* the grey box's pixels */
+        assert_int_equal(same, 0);
+        render_accum_fini(&a);
+        render_accum_fini(&b);
+    }
+    f->scene->render.integrator = INTEGRATOR_PHOTON_MAP;
+    *s0 = saved0;
+    *s1 = saved1;
+}
+
 /* render_stderr_k: a radiance error converted to K with dTb/dL at the pixel's Tb. */
 static void test_stderr_in_kelvin(void **state)
 {
@@ -412,6 +461,7 @@ int main(void)
         cmocka_unit_test(test_back_faces_every_integrator),
         cmocka_unit_test(test_integrator_table),
         cmocka_unit_test(test_passes_are_deterministic),
+        cmocka_unit_test(test_streams_of_sensors_and_passes),
         cmocka_unit_test(test_stderr_in_kelvin),
         cmocka_unit_test(test_map_share_of_stderr),
     };
