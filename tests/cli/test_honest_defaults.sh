@@ -33,7 +33,8 @@ make_scene plain "pass"
 make_scene celsius "s['objects'][0]['temperature_k'] = 22; s['objects'][1]['temperature_k'] = 37"
 make_scene millimetres "s['objects'][1]['transform']['scale'] = 1000"
 make_scene ghz "s['channels'][0]['frequency_thz'] = 350"
-make_scene outside "s['sensors'][0]['position_m'] = [0, -3, 0]"
+# (two channels: the run warning counts the samples of both, 2 x 12 x 10)
+make_scene outside "s['sensors'][0]['position_m'] = [0, -3, 0]; s['channels'].append({'frequency_thz': 0.5, 'relative_width': 0.02})"
 make_scene inside "s['sensors'][0]['position_m'] = [0, 0.5, 0]"
 make_scene nonemitting "s['atmosphere']['emitting'] = False"
 make_scene background "s['atmosphere']['background_temperature_k'] = 3"
@@ -83,8 +84,8 @@ done
     > "$work/o.out" 2> "$work/o.err" || fail "simulate outside: $(cat "$work/o.err")"
 grep -q "warning: sensor \"cam\" .* is outside the enclosure" "$work/o.err" ||
     fail "--quiet hid the scene warning: $(cat "$work/o.err")"
-grep -q "warning: sensor 'cam': .* back side" "$work/o.err" ||
-    fail "the run warning is not printed in full: $(cat "$work/o.err")"
+grep -q "warning: sensor 'cam': [1-9][0-9]* of 240 samples saw the back side" "$work/o.err" ||
+    fail "the run warning is not printed in full, or not of both channels' 240 samples: $(cat "$work/o.err")"
 grep -q "mesh normals" "$work/o.err" && fail "a misplaced sensor's warning blames the normals"
 grep -q "see .*summary.json" "$work/o.err" && fail "warnings point to summary.json instead"
 grep -q "channel 1/1" "$work/o.err" && fail "--quiet printed progress"
