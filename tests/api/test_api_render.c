@@ -226,6 +226,14 @@ int main(int argc, char **argv)
         const char *sj = thz_run_summary_json(from_file);
         CHECK(sj && strstr(sj, "\"seed\": 4") && strstr(sj, "\"photons_fired\": 20000"),
               "render_file summary: %.300s", sj ? sj : "(null)");
+        /* the summary describes the map read; the totals count what this run fired: none
+         * (thzmap render's last line said "40000 photons fired" when they took the map's) */
+        thz_run_totals rt;
+        thz_run_get_totals(from_file, &rt);
+        CHECK(rt.photons_fired == 0 && rt.photons_stored == 0 && rt.n_sensors == 2,
+              "a render run's totals: %llu photons fired, %llu stored, %zu sensors",
+              (unsigned long long)rt.photons_fired, (unsigned long long)rt.photons_stored,
+              rt.n_sensors);
         thz_run_destroy(from_file);
         snprintf(map_path, sizeof map_path, "%s/missing.thzpm", dir);
         thz_run *none = NULL;
