@@ -96,9 +96,16 @@ grep -q "channel 1/1" "$work/o.err" && fail "--quiet printed progress"
 grep -q "estimate: .* s .*memory .* GiB" "$work/p.err" || fail "no estimate: $(cat "$work/p.err")"
 tail -1 "$work/p.out" | grep -q "noisiest object: '.*', 95th percentile standard error [0-9.e-]* K" ||
     fail "last line: $(tail -1 "$work/p.out")"
-python3 - "$work/out-plain/summary.json" <<'PY' || fail "summary.json noise figures"
-import json, sys
+python3 - "$work/out-plain/summary.json" "$work/p.out" <<'PY' || fail "summary.json noise figures"
+import json, re, sys
 d = json.load(open(sys.argv[1]))
+# the last line names the object of the largest 95th percentile over channels, its value
+last = open(sys.argv[2]).read().splitlines()[-1]
+m = re.search(r"noisiest object: '(.*)', 95th percentile standard error ([0-9.e+-]*) K", last)
+worst = max((o["p95_stderr_k"], o["name"]) for c in d["channels"] for o in c["objects"]
+            if o["pixels"] > 0)
+assert m and m.group(1) == worst[1] and abs(float(m.group(2)) - worst[0]) <= 5e-3 * worst[0], \
+    (last, worst)
 assert d["integrator"] == "path", d["integrator"]
 assert d["target_noise_k"] == 0.1 and d["target_noise_source"] == "default", d["target_noise_k"]
 for c in d["channels"]:
