@@ -8,7 +8,8 @@
 #  - a target of 1.2 F, which more gather rays do reach, runs past 2 passes to it, without
 #    that warning;
 #  - render from the saved map stops the same way and names the map's photons;
-#  - path, which has no map, never stops there (it runs to --max-seconds).
+#  - path, which has no map, never stops there (it runs to --max-seconds, which overrides
+#    the scene's render.max_seconds).
 # The floor's estimate itself (the spread between the map's photon batches) is checked
 # against the spread over photon seeds in tests/physics/test_integrators.c.
 # argv: path to the thzmap binary, repository directory.
@@ -81,13 +82,22 @@ if not any("photon map alone" in w and "the map read has 20000 per channel" in w
     sys.exit(f"passes {s['channels'][0]['render_passes']}, warnings {s['warnings']}")
 PY
 
-run path simulate "$S" -o "$work/path" --integrator path --target-noise-k 0.001 \
-    --max-seconds 0.3
+# (the scene's own render.max_seconds, 5 s, yields to the command line's 0.3 s)
+python3 - "$S" "$work/scene/limited.json" <<'PY' || fail "could not write the limited scene"
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["render"]["max_seconds"] = 5
+json.dump(d, open(sys.argv[2], "w"))
+PY
+run path simulate "$work/scene/limited.json" -o "$work/path" --integrator path \
+    --target-noise-k 0.001 --max-seconds 0.3
 python3 - "$work/path/summary.json" <<'PY' || fail "path at a low target"
 import json, sys
 s = json.load(open(sys.argv[1]))
 if any("photon map alone" in w for w in s["warnings"]):
     sys.exit(f"path stopped at a map floor: {s['warnings']}")
+if not any("stopped by the time limit of 0.3 s" in w for w in s["warnings"]):
+    sys.exit(f"not stopped by --max-seconds 0.3: {s['warnings']}")
 PY
 
 finish "all final-gather floor checks passed"
