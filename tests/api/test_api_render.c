@@ -131,6 +131,65 @@ static void check_photon_passes(thz_context *ctx)
     thz_scene_destroy(scene);
 }
 
+/* A room, two channels and two cameras: "cam" inside, "out" outside it, whose every
+ * sample sees the back of the room's inward faces. summary.json's back-face counts are
+ * each sensor's over both channels (0 and 2 x 20), of the whole run and of "out" rendered
+ * alone (not given to the first sensor of the scene). */
+static const char outside_scene_json[] =
+    "{\"format\": \"thzmap-scene/1\", \"name\": \"outside\","
+    " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.05},"
+    "   {\"frequency_thz\": 0.8, \"relative_width\": 0.05}],"
+    " \"materials\": {\"wall\": {\"reflectivity\": 0.3}},"
+    " \"objects\": [{\"name\": \"room\", \"type\": \"solid\", \"material\": \"wall\","
+    "   \"temperature_k\": 295,"
+    "   \"shape\": {\"type\": \"box\", \"size_m\": [2, 2, 2], \"inward\": true}}],"
+    " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -0.9, 0],"
+    "   \"direction\": [0, 1, 0], \"fov_deg\": 60, \"resolution\": [4, 3]},"
+    "  {\"name\": \"out\", \"position_m\": [0, -3, 0], \"direction\": [0, 1, 0],"
+    "   \"fov_deg\": 20, \"resolution\": [5, 4]}],"
+    " \"photons\": {\"per_channel\": 5000, \"seed\": 3},"
+    " \"render\": {\"integrator\": \"photon-map\"}}";
+
+/* The value of the n-th (from 0) "back_face_samples" of a summary's text, or -1. */
+static long long nth_back_face_count(const char *json, int n)
+{
+    const char *key = "\"back_face_samples\":";
+    const char *at = json;
+    for (int k = 0; at && k <= n; k++) {
+        at = strstr(at, key);
+        if (at && k < n)
+            at += strlen(key);
+    }
+    long long v = -1;
+    if (!at || sscanf(at + strlen(key), " %lld", &v) != 1)
+        return -1;
+    return v;
+}
+
+static void check_one_sensor_back_faces(thz_context *ctx)
+{
+    thz_error err = {0};
+    thz_scene *scene = NULL;
+    REQUIRE_OK(thz_scene_load_string(outside_scene_json, NULL, "outside.json", &scene, &err), &err);
+    thz_run_settings settings;
+    thz_run_settings_init(&settings);
+    settings.keep_photons = 1;
+    thz_run *sim = NULL, *one = NULL;
+    REQUIRE_OK(thz_simulate(ctx, scene, &settings, &sim, &err), &err);
+    REQUIRE_OK(thz_render_run(ctx, scene, thz_run_photons(sim), 1, NULL, &one, &err), &err);
+    for (int r = 0; r < 2; r++) {
+        const char *sj = thz_run_summary_json(r ? one : sim);
+        long long cam = sj ? nth_back_face_count(sj, 0) : -1;
+        long long out = sj ? nth_back_face_count(sj, 1) : -1;
+        CHECK(cam == 0 && out == 40,
+              "%s: back_face_samples %lld (cam), %lld (out; its 20 samples in 2 channels)",
+              r ? "'out' rendered alone" : "both simulated", cam, out);
+    }
+    thz_run_destroy(one);
+    thz_run_destroy(sim);
+    thz_scene_destroy(scene);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -280,6 +339,7 @@ int main(int argc, char **argv)
           "thz_simulate_check, keep_photons with path: %s", err.message);
 
     check_photon_passes(ctx);
+    check_one_sensor_back_faces(ctx);
 
     thz_photons_destroy(photons);
     thz_context_destroy(ctx);
