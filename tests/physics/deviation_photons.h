@@ -20,15 +20,8 @@
 static inline void fire(const thz_scene *s, double t0_k, int threads, photon_map **map,
                         photon_stats *st)
 {
-    accel *acc;
-    thz_error err;
-    if (accel_create(s, &acc, &err) != THZ_OK)
-        fail_msg("%s", err.message);
-    photon_phase_options opt = {.threads = threads, .reference_temperature_k = t0_k};
-    thz_status status = photon_phase_run(s, acc, 0, &opt, map, st, &err);
-    accel_destroy(acc);
-    if (status != THZ_OK)
-        fail_msg("%s", err.message);
+    ps_fire(s, &(photon_phase_options){.threads = threads, .reference_temperature_k = t0_k}, map,
+            st);
 }
 
 #endif

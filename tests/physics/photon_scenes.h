@@ -4,11 +4,14 @@
 #define THZ_TESTS_PHOTON_SCENES_H
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "accel/accel.h"
 #include "core/alloc.h"
 #include "core/vec3.h"
+#include "photon/phase.h"
 #include "scene/scene.h"
 
 /* THZ_TEST_SCALE (e.g. 0.25 under sanitizers) shrinks photon counts; tolerances are
@@ -147,6 +150,25 @@ static inline void ps_finalize(thz_scene *s)
 {
     for (size_t i = 0; i < s->n_objects; i++)
         ps_check(mesh_finalize(&s->objects[i].mesh));
+}
+
+/* Channel 0's photon phase of s with options opt (NULL: the defaults), its accel built and
+ * freed here: the map into *map, the statistics into *st. A failure aborts the test
+ * program, its message on stderr. */
+static inline void ps_fire(const thz_scene *s, const photon_phase_options *opt, photon_map **map,
+                           photon_stats *st)
+{
+    accel *acc;
+    thz_error err;
+    thz_status status = accel_create(s, &acc, &err);
+    if (status == THZ_OK) {
+        status = photon_phase_run(s, acc, 0, opt, map, st, &err);
+        accel_destroy(acc);
+    }
+    if (status != THZ_OK) {
+        fprintf(stderr, "photon phase: %s\n", err.message);
+        abort();
+    }
 }
 
 /* A "box scene" with every kind of surface: a 2 x 2 x 2.5 m room (inward, R = 0.3,

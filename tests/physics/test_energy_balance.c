@@ -38,13 +38,9 @@ static double moment_at(double freq_hz, void *ctx)
  * three, so summary.json's fractions per hit sum to 1 in such scenes too.) */
 static void check_balance(thz_scene *s, const char *name, bool weighted)
 {
-    accel *acc;
-    thz_error err;
-    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
     photon_map *map;
     photon_stats st;
-    photon_phase_options opt = {.threads = 2};
-    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+    ps_fire(s, &(photon_phase_options){.threads = 2}, &map, &st);
     uint64_t k = s->photons.per_channel;
 
     /* Counts. */
@@ -89,7 +85,6 @@ static void check_balance(thz_scene *s, const char *name, bool weighted)
         assert_true(fabs(st.terminated_power_w_per_hz) <=
                     5 * w_min * sqrt((double)(st.terminated + st.hits)));
     photon_map_destroy(map);
-    accel_destroy(acc);
 }
 
 static void test_closed_box(void **state)
@@ -170,13 +165,9 @@ static void test_bounce_cap(void **state)
     size_t room = ps_object(s, OBJECT_SOLID, mirror, 300, 0, false);
     ps_box(s, room, v3(-1, -1, 0), v3(1, 1, 2), true);
     ps_finalize(s);
-    accel *acc;
-    thz_error err;
-    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
     photon_map *map;
     photon_stats st;
-    photon_phase_options opt = {.threads = 2};
-    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+    ps_fire(s, &(photon_phase_options){.threads = 2}, &map, &st);
     printf("# mirror room: %llu fired, %llu capped, %llu terminated, %llu absorbed, %llu hits\n",
            (unsigned long long)st.fired, (unsigned long long)st.bounce_capped,
            (unsigned long long)st.terminated, (unsigned long long)st.absorbed,
@@ -190,7 +181,6 @@ static void test_bounce_cap(void **state)
     assert_float_equal(st.terminated_power_w_per_hz, st.fired_power_w_per_hz,
                        1e-12 * st.fired_power_w_per_hz);
     photon_map_destroy(map);
-    accel_destroy(acc);
     scene_destroy(s);
 }
 
@@ -212,13 +202,9 @@ static void test_back_face_absorbs(void **state)
     size_t plate = ps_object(s, OBJECT_SOLID, mirror, 0, 0, false);
     ps_face(s, plate, v3(0, 0, 0.5), v3(0.5, 0, 0), v3(0, 0.5, 0)); /* +z: its back below */
     ps_finalize(s);
-    accel *acc;
-    thz_error err;
-    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
     photon_map *map;
     photon_stats st;
-    photon_phase_options opt = {.threads = 2};
-    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+    ps_fire(s, &(photon_phase_options){.threads = 2}, &map, &st);
     const photon_record *r = photon_map_records(map);
     size_t on_back = 0, later = 0;
     for (size_t i = 0; i < photon_map_count(map); i++) {
@@ -236,18 +222,9 @@ static void test_back_face_absorbs(void **state)
     assert_float_equal(st.absorbed_power_w_per_hz + st.escaped_power_w_per_hz,
                        st.fired_power_w_per_hz, 1e-9 * st.fired_power_w_per_hz);
     photon_map_destroy(map);
-    accel_destroy(acc);
     scene_destroy(s);
 }
 
-/* A diffusely transmitting shell (R = 0, alpha t = 0.5, 0 K) 10 m across between a small
- * hot black plate below it and a small cold black one above: a photon transmitted through
- * it leaves on the far side (trace_diffuse_transmission_dir about -n_in), so the plate
- * above, which sees the hot one only through the shell, receives photons, and nothing
- * ever comes back down onto the hot plate. Transmitted photons sent back to the side they
- * came from (a mutant) was caught only by test_deviation_photons' T0 = 0 checksums, which
- * pin the bytes rather than the rule: the plate above got nothing and the hot one what the
- * shell let through. */
 /* A small hot black plate (z = 0, facing up), a shell 10 m across (reflectivity r,
  * attenuation alpha over 5 mm, 0 K, diffuse transmission) at z = 0.5 m and a small cold black
  * plate (z = 1 m, facing down), which sees the hot one only through the shell: k photons
@@ -264,12 +241,8 @@ static void fire_sandwich(uint64_t k, double r, double alpha_per_m, size_t on[3]
     size_t cold = ps_object(s, OBJECT_SOLID, black, 0, 0, false);
     ps_face(s, cold, v3(0, 0, 1.0), v3(0, 0.25, 0), v3(0.25, 0, 0)); /* normal -z */
     ps_finalize(s);
-    accel *acc;
-    thz_error err;
-    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
     photon_map *map;
-    photon_phase_options opt = {.threads = 2};
-    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, st, &err), THZ_OK);
+    ps_fire(s, &(photon_phase_options){.threads = 2}, &map, st);
     const photon_record *rec = photon_map_records(map);
     on[0] = on[1] = on[2] = 0;
     for (size_t i = 0; i < photon_map_count(map); i++)
@@ -281,7 +254,6 @@ static void fire_sandwich(uint64_t k, double r, double alpha_per_m, size_t on[3]
            on[shell], on[cold]);
     assert_true(on[shell] > k * 9 / 10); /* the rest pass its edge, grazing */
     photon_map_destroy(map);
-    accel_destroy(acc);
     scene_destroy(s);
 }
 

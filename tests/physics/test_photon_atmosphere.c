@@ -130,12 +130,9 @@ static void test_cosine_emitter(void **state)
     size_t src = ps_object(s, OBJECT_SOLID, black, 300, 0, false);
     ps_face(s, src, v3(0, 0, d), v3(0, 0.005, 0), v3(0.005, 0, 0)); /* 1 cm, facing down */
     ps_finalize(s);
-    accel *acc;
-    thz_error err;
-    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
     photon_map *map;
     photon_stats st;
-    assert_int_equal(photon_phase_run(s, acc, 0, NULL, &map, &st, &err), THZ_OK);
+    ps_fire(s, NULL, &map, &st);
     const photon_record *r = photon_map_records(map);
     double phi = st.fired_power_w_per_hz / (double)k, sum = 0.0, sum2 = 0.0;
     for (size_t i = 0; i < photon_map_count(map); i++) {
@@ -153,7 +150,6 @@ static void test_cosine_emitter(void **state)
                            st.terminated_power_w_per_hz + st.escaped_power_w_per_hz,
                        st.fired_power_w_per_hz, 1e-9 * st.fired_power_w_per_hz);
     photon_map_destroy(map);
-    accel_destroy(acc);
     scene_destroy(s);
 }
 
@@ -178,12 +174,9 @@ static void test_air_isotropic(void **state)
     ps_check(spectrum_set_constant(&s->atmosphere.attenuation_per_m, 0.2));
     ps_check(atmosphere_set_emitting(&s->atmosphere, 300.0, 0.0, &err) == THZ_OK);
     ps_check(atmosphere_set_extent(&s->atmosphere, lo, hi, &err) == THZ_OK);
-    accel *acc;
-    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
     photon_map *map;
     photon_stats st;
-    photon_phase_options opt = {.threads = 2};
-    assert_int_equal(photon_phase_run(s, acc, 0, &opt, &map, &st, &err), THZ_OK);
+    ps_fire(s, &(photon_phase_options){.threads = 2}, &map, &st);
     const photon_record *r = photon_map_records(map);
     size_t floor_hits = 0, ceiling_hits = 0;
     for (size_t i = 0; i < photon_map_count(map); i++) {
@@ -197,7 +190,6 @@ static void test_air_isotropic(void **state)
     assert_true(sum > 0.2 * (double)photon_map_count(map)); /* 2 of 6 equal faces: 1/3 */
     assert_true(fabs((double)floor_hits - (double)ceiling_hits) < 5.0 * sqrt(sum));
     photon_map_destroy(map);
-    accel_destroy(acc);
     scene_destroy(s);
 }
 
