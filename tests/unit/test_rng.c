@@ -177,6 +177,17 @@ static void test_open0(void **state)
         assert_true(u > 0.0 && u <= 1.0);
         assert_true(isfinite(log(u)));
     }
+    /* its ends, from words set by hand (2^-53 apart from rng_uniform's, too rare to meet by
+     * drawing): two zero words give 1, not 0 and a log of -inf (the radiometer noise's
+     * Box-Muller); two all-ones words give 2^-53, not 1 - 2^-53 */
+    static const uint32_t ends[2] = {0u, UINT32_MAX};
+    static const double want[2] = {1.0, 0x1p-53};
+    for (int e = 0; e < 2; e++) {
+        s.buf[0] = s.buf[1] = ends[e];
+        s.used = 0;
+        s.avail = 2;
+        assert_true(rng_uniform_open0(&s) == want[e]);
+    }
 }
 
 int main(void)
