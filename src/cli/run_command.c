@@ -208,13 +208,13 @@ thz_output **cli_exit_guard(void)
 static thz_status cli_run(thz_context *ctx, const thz_scene *scene, const cli_run_args *a,
                           bool render, thz_output *output, thz_run **run, thz_error *err)
 {
-    thz_status st = THZ_OK;
     /* (a sensor the scene lacks was refused on loading, on every rank) */
     long sensor = render && a->sensor_name ? thz_scene_sensor_index(scene, a->sensor_name) : -1;
+    thz_status st;
     /* render reads the photon-map file a channel at a time: one channel's map in memory */
-    if (st == THZ_OK && render && a->photon_map_path)
+    if (render && a->photon_map_path)
         st = thz_render_file(ctx, scene, a->photon_map_path, sensor, &a->settings, run, err);
-    else if (st == THZ_OK)
+    else
         st = render ? thz_render_run(ctx, scene, NULL, sensor, &a->settings, run, err)
                     : thz_simulate(ctx, scene, &a->settings, run, err);
     /* the library's memory refusal names the scene key; simulate also has --photons */

@@ -509,8 +509,6 @@ thz_status photon_map_file_next(photon_map_file_stream *s, int threads, photon_m
     return st;
 }
 
-/* photon_map_file_read of every channel (want = SIZE_MAX) or of channel want alone: all
- * the records read and the checksum verified before any map is built. */
 /* Reports channel c's done of total to progress (may be NULL); THZ_ERR_CANCELLED when
  * it says stop. */
 static thz_status pmf_report(const photon_map_file_progress *progress, const char *path, size_t c,
@@ -521,6 +519,8 @@ static thz_status pmf_report(const photon_map_file_progress *progress, const cha
     return THZ_OK;
 }
 
+/* photon_map_file_read of every channel (want = SIZE_MAX) or of channel want alone: all
+ * the records read and the checksum verified before any map is built. */
 static thz_status pmf_read_file(const char *path, const thz_scene *scene, int threads, size_t want,
                                 const photon_map_file_progress *progress, photon_map **maps,
                                 photon_stats *stats, photon_map_file_info *info, thz_error *err)
