@@ -1,7 +1,7 @@
 /* Sampling helpers: sampling_direction's azimuth (its libm-free cos and sin of 2 pi u)
  * against libm, its polar angle, and unit length; sampling_direction_many's directions
  * against sampling_direction's; sampling_cosine32's order of draws; the strata of
- * sampling_stratum_of. */
+ * sampling_stratum_of; v3_normalize's zero vector. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdbool.h>
@@ -54,6 +54,21 @@ static void test_polar_angle_and_length(void **state)
         assert_true(fabs(v3_length(d) - 1.0) < 1e-15);
         assert_true(fabs(v3_dot(d, n) - mu) < 1e-14);
     }
+}
+
+/* v3_normalize: unit length along the vector, and a zero vector stays zero rather than
+ * NaN (0 / 0), as vec3.h promises: a degenerate normal or direction must not turn every
+ * later dot product into NaN. */
+static void test_normalize(void **state)
+{
+    (void)state;
+    vec3 z = v3_normalize(v3(0.0, 0.0, 0.0));
+    assert_true(z.x == 0.0 && z.y == 0.0 && z.z == 0.0);
+    vec3 d = v3_normalize(v3(3.0, -4.0, 12.0)); /* length 13 */
+    assert_true(fabs(d.x - 3.0 / 13.0) < 1e-16 && fabs(d.y + 4.0 / 13.0) < 1e-16 &&
+                fabs(d.z - 12.0 / 13.0) < 1e-16);
+    vec3 tiny = v3_normalize(v3(1e-100, 0.0, 0.0));
+    assert_true(tiny.x == 1.0 && tiny.y == 0.0 && tiny.z == 0.0);
 }
 
 /* sampling_direction_many gives sampling_direction's directions bit for bit: normals
@@ -171,6 +186,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_azimuth_against_libm),
         cmocka_unit_test(test_polar_angle_and_length),
+        cmocka_unit_test(test_normalize),
         cmocka_unit_test(test_many),
         cmocka_unit_test(test_cosine32_order),
         cmocka_unit_test(test_strata),
