@@ -1,6 +1,6 @@
-/* What the scene loader's unit tests share (test_scene_load.c, test_scene_load_air.c):
- * loading a scene from a JSON string that must load or must be refused with a message,
- * counting a scene's warnings, and the pieces of a small valid scene. Header-only (static
+/* What the scene loader's unit tests share (test_scene_load.c, test_scene_load_air.c,
+ * test_channel_load.c): loading a scene from a JSON string that must load or must be refused with a
+ * message, counting a scene's warnings, and the pieces of a small valid scene. Header-only (static
  * inline), as tests/physics/photon_scenes.h. */
 #ifndef THZ_TESTS_SCENE_LOAD_HELPERS_H
 #define THZ_TESTS_SCENE_LOAD_HELPERS_H

@@ -13,48 +13,21 @@
 #include <cmocka.h>
 
 #include "scene/scene.h"
+#include "scene_load_helpers.h"
 
-#define SRC THZ_SOURCE_DIR
-
-static thz_scene *load_ok(const char *json)
-{
-    thz_scene *s = NULL;
-    thz_error err = {0};
-    thz_status st = scene_load_string(json, SRC "/tests/inputs/scenes", "test.json", &s, &err);
-    if (st != THZ_OK)
-        fail_msg("refused: %s", err.message);
-    return s;
-}
-
-static void load_bad(const char *json, const char *expect)
-{
-    thz_scene *s = (thz_scene *)1;
-    thz_error err = {0};
-    assert_int_equal(scene_load_string(json, SRC "/tests/inputs/scenes", "test.json", &s, &err),
-                     THZ_ERR_INPUT);
-    assert_null(s);
-    if (!strstr(err.message, expect))
-        fail_msg("message '%s' lacks '%s'", err.message, expect);
-    if (strncmp(err.message, "test.json", 9) != 0)
-        fail_msg("message '%s' does not start with the file name", err.message);
-}
-
-#define HEAD "{\"format\": \"thzmap-scene/1\", \"channels\": ["
-#define TAIL                                                                                       \
-    "], \"materials\": {\"m\": {\"reflectivity\": 0.1}}, "                                         \
-    "\"objects\": [{\"name\": \"o\", \"type\": \"solid\", \"material\": \"m\", "                   \
-    "\"temperature_k\": 300, \"shape\": {\"type\": \"box\", \"size_m\": [1, 1, 1]}}], "            \
-    "\"sensors\": [{\"name\": \"c\", \"position_m\": [0, -5, 0], \"look_at_m\": [0, 0, 0], "       \
-    "\"fov_deg\": 40, \"resolution\": [16, 8]}]}"
+/* A scene whose channels are those between the two. */
+#define CHANNELS_OPEN HEAD "\"channels\": ["
+#define CHANNELS_CLOSE "], " MATERIALS OBJECT(BOX) SENSORS "}"
 
 static void test_tables(void **state)
 {
     (void)state;
-    thz_scene *s = load_ok(HEAD "{\"name\": \"hat\", \"response\": [[0.34, 4], [0.36, 4]]},"
-                                "{\"frequency_thz\": 0.605, \"response_file\": "
-                                "\"responses/triangle.csv\"},"
-                                "{\"response\": [[0.5, 0], [0.6, 1], [0.9, 0]]},"
-                                "{\"frequency_thz\": 0.35, \"relative_width\": 0.01}" TAIL);
+    thz_scene *s =
+        load_ok(CHANNELS_OPEN "{\"name\": \"hat\", \"response\": [[0.34, 4], [0.36, 4]]},"
+                              "{\"frequency_thz\": 0.605, \"response_file\": "
+                              "\"responses/triangle.csv\"},"
+                              "{\"response\": [[0.5, 0], [0.6, 1], [0.9, 0]]},"
+                              "{\"frequency_thz\": 0.35, \"relative_width\": 0.01}" CHANNELS_CLOSE);
     assert_int_equal(s->n_channels, 4);
     const thz_channel *hat = &s->channels[0], *tri = &s->channels[1], *skew = &s->channels[2];
     assert_int_equal(hat->n_response, 2);
@@ -74,41 +47,46 @@ static void test_tables(void **state)
 static void test_refusals(void **state)
 {
     (void)state;
-    load_bad(HEAD "{\"response\": [[0.34, 1], [0.35, -0.5], [0.36, 1]]}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response\": [[0.34, 1], [0.35, -0.5], [0.36, 1]]}" CHANNELS_CLOSE,
              "channels[0].response[1][1]: expected a number >= 0, got -0.5");
-    load_bad(HEAD "{\"response\": [[0.34, 0], [0.36, 0]]}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response\": [[0.34, 0], [0.36, 0]]}" CHANNELS_CLOSE,
              "channels[0].response: every weight is 0 (expected at least one > 0)");
-    load_bad(HEAD "{\"response\": [[0.36, 1], [0.34, 1]]}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response\": [[0.36, 1], [0.34, 1]]}" CHANNELS_CLOSE,
              "channels[0].response[1][0]: frequencies must increase strictly, got 0.34 THz after "
              "0.36 THz");
-    load_bad(HEAD "{\"response\": [[0.34, 1], [0.34, 1]]}" TAIL, "must increase strictly");
-    load_bad(HEAD "{\"response\": [[0.34, 1]]}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response\": [[0.34, 1], [0.34, 1]]}" CHANNELS_CLOSE,
+             "must increase strictly");
+    load_bad(CHANNELS_OPEN "{\"response\": [[0.34, 1]]}" CHANNELS_CLOSE,
              "channels[0].response: expected at least 2 points [frequency_thz, weight], got 1");
-    load_bad(HEAD "{\"response\": 1}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response\": 1}" CHANNELS_CLOSE,
              "channels[0].response: expected a table [[frequency_thz, weight], ...], got a number");
-    load_bad(HEAD "{\"response\": [[0.34, 1], [0.36]]}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response\": [[0.34, 1], [0.36]]}" CHANNELS_CLOSE,
              "channels[0].response[1]: expected a pair [frequency_thz, value]");
-    load_bad(HEAD "{\"response_file\": \"responses/none.csv\"}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response_file\": \"responses/none.csv\"}" CHANNELS_CLOSE,
              "channels[0].response_file: ");
-    load_bad(HEAD "{\"response_file\": \"responses/none.csv\"}" TAIL, "none.csv");
-    load_bad(HEAD "{\"response_file\": \"responses/negative.csv\"}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response_file\": \"responses/none.csv\"}" CHANNELS_CLOSE,
+             "none.csv");
+    load_bad(CHANNELS_OPEN "{\"response_file\": \"responses/negative.csv\"}" CHANNELS_CLOSE,
              "negative.csv:3: row 2, column 'weight': expected a number >= 0, got -0.5");
-    load_bad(HEAD "{\"response_file\": \"responses/descending.csv\"}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response_file\": \"responses/descending.csv\"}" CHANNELS_CLOSE,
              "descending.csv:4: row 3: frequencies must increase strictly");
-    load_bad(HEAD "{\"response_file\": \"responses/zero.csv\"}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response_file\": \"responses/zero.csv\"}" CHANNELS_CLOSE,
              "zero.csv: every weight is 0");
-    load_bad(HEAD "{\"response_file\": \"responses/wrong_column.csv\"}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"response_file\": \"responses/wrong_column.csv\"}" CHANNELS_CLOSE,
              "wrong_column.csv: the header names no column 'weight'");
-    load_bad(HEAD "{\"frequency_thz\": 0.3, \"response\": [[0.34, 1], [0.36, 1]]}" TAIL,
+    load_bad(CHANNELS_OPEN
+             "{\"frequency_thz\": 0.3, \"response\": [[0.34, 1], [0.36, 1]]}" CHANNELS_CLOSE,
              "channels[0].frequency_thz: expected a frequency where the response is > 0 (0.34 to "
              "0.36 THz), got 0.3");
-    load_bad(HEAD "{\"frequency_thz\": 0.35, \"relative_width\": 0.01, \"response\": [[0.34, 1], "
-                  "[0.36, 1]]}" TAIL,
+    load_bad(CHANNELS_OPEN
+             "{\"frequency_thz\": 0.35, \"relative_width\": 0.01, \"response\": [[0.34, 1], "
+             "[0.36, 1]]}" CHANNELS_CLOSE,
              "channels[0]: conflicting responses (expected exactly one of relative_width, "
              "response, response_file)");
-    load_bad(HEAD "{\"frequency_thz\": 0.35}" TAIL,
+    load_bad(CHANNELS_OPEN "{\"frequency_thz\": 0.35}" CHANNELS_CLOSE,
              "channels[0]: missing spectral response (expected exactly one of relative_width");
-    load_bad(HEAD "{\"relative_width\": 0.01}" TAIL, "channels[0].frequency_thz: missing key");
+    load_bad(CHANNELS_OPEN "{\"relative_width\": 0.01}" CHANNELS_CLOSE,
+             "channels[0].frequency_thz: missing key");
 }
 
 int main(void)
