@@ -53,6 +53,25 @@ def test_whole_number_keyframes_stay_whole(tmp_path):
     s = thzmap.load_sequence(str(tmp_path / "seq.json"))
     seeds = [s.frame_dict(i)["sensors"][0]["noise_seed"] for i in range(7)]
     assert seeds == [1, 2, 3, 4, 5, 6, 7] and all(type(x) is int for x in seeds), seeds
+    # whole numbers at the keyframes, a fraction between them: the fraction, not the whole
+    # number below it (300 -> 301 K over four frames' time is 300.25 K a frame later)
+    seq["frames"], seq["keyframes"] = 5, [
+        {"time_s": 0, "objects": {"person": {"temperature_k": 300}}},
+        {"time_s": 4, "objects": {"person": {"temperature_k": 301}}}]
+    (tmp_path / "seq.json").write_text(json.dumps(seq))
+    s = thzmap.load_sequence(str(tmp_path / "seq.json"))
+    temps = [s.frame_dict(i)["objects"][1]["temperature_k"] for i in range(5)]
+    assert temps == [300, 300.25, 300.5, 300.75, 301], temps
+    # and a seed that falls on a fraction is refused, named where the later keyframe sets
+    # it (scene-format.md: keyed from 1 to N over N frames, not 1 to 2 over 3)
+    seq["frames"], seq["keyframes"] = 3, [
+        {"time_s": 0, "sensors": {"cam": {"noise_seed": 1}}},
+        {"time_s": 2, "sensors": {"cam": {"noise_seed": 2}}}]
+    (tmp_path / "seq.json").write_text(json.dumps(seq))
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.load_sequence(str(tmp_path / "seq.json"))
+    assert e.value.path == "keyframes[1].sensors.cam.noise_seed", e.value
+    assert "frame-00001" in e.value.reason, e.value
 
 
 def _tree(outdir):
