@@ -308,6 +308,31 @@ def test_errors(tmp_path):
         "(the scene scene.json's sensors[0].fov, frame-00000, t = 0 s)" in e.value.reason
     with pytest.raises(thzmap.Error, match="cannot"):
         thzmap.load_sequence(tmp_path / "missing.json")
+    # a sweep key checked against every listed scene, not the first alone: the second
+    # lacks the object (it was "out of memory", from setting a value where none could go)
+    empty = json.loads((tmp_path / "scene.json").read_text())
+    empty["objects"] = empty["objects"][:1]
+    (tmp_path / "empty.json").write_text(json.dumps(empty))
+    bad = {"format": "thzmap-sequence/1", "scenes": ["scene.json", "empty.json"],
+           "sweep": {"objects.person.temperature_k": [300, 310]}}
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.load_sequence(tmp_path / "bad.json")
+    assert e.value.path == "sweep.objects.person.temperature_k", e.value
+    assert 'scenes[1] (empty.json) has no object named "person"' in e.value.reason, e.value
+    # at most 10 000 combinations of sweep values: 10 000 itself is accepted, and 11 frames
+    # of each are then refused as more than the 100 000 frames a sequence may have
+    bad = {"format": "thzmap-sequence/1", "scene": "scene.json", "frames": 11,
+           "sweep": {"objects.person.temperature_k": list(range(300, 400)),
+                     "photons.seed": list(range(100))}}
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    with pytest.raises(thzmap.SceneError, match="11 frames per sweep value x 10000 sweep "
+                                                "values = 110000 frames, more than the 100000"):
+        thzmap.load_sequence(tmp_path / "bad.json")
+    bad["sweep"]["photons.seed"].append(100)
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    with pytest.raises(thzmap.SceneError, match="more than 10000 combinations"):
+        thzmap.load_sequence(tmp_path / "bad.json")
     with pytest.raises(thzmap.ArgumentError, match="sequence: expected"):
         thzmap.batch(42, tmp_path / "out")
     with pytest.raises(thzmap.ArgumentError, match="movies"):
