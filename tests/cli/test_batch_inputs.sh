@@ -246,6 +246,10 @@ bad string 'keyframes[0].objects.person.temperature_k: expected a number or an a
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "keyframes": [{"time_s": 0, "objects": {"person": {"temperature_k": "hot"}}}]}'
 bad shape 'keyframes[1].sensors.cam.position_m: expected the same kind of value' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "keyframes": [{"time_s": 0, "sensors": {"cam": {"position_m": [0, -1, 1]}}}, {"time_s": 1, "sensors": {"cam": {"position_m": [0, 1]}}}]}'
+# a sweep key that names an object, not a value of it (it set a key "person" inside the
+# object, which the scene then refused as unknown, not saying what the sweep lacked)
+bad whole_object 'bad-whole_object.json: sweep.objects.person: expected a path to a value, e.g. objects.NAME.temperature_k' \
+    '{"format": "thzmap-sequence/1", "scene": "scene.json", "sweep": {"objects.person": [300]}}'
 bad frames 'frames: expected a whole number of frames' \
     '{"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 4, "frames": 0}'
 bad fps 'fps: required with keyframes' \
