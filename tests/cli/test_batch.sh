@@ -326,6 +326,10 @@ for how in removed killed; do
     # reused)", as if 3 frames were finished)
     [ $how = removed ] && expect_line "$work/Q.err" \
         '^thzmap batch: frame 3/3 \(2 of 3 frames finished so far: 1 computed, 1 already done\), '
+    # frame 0's photons fired again are counted as this run's photon phase
+    [ $how = removed ] && { "$PY" -c 'import json, sys; b = json.load(open(sys.argv[1]))
+assert b["photon_phases_fired"] == 1 and b["frames_rerendered"] == 2, b' "$work/Q/batch.json" ||
+        fail "sensor-only batch resumed: frame 0's photons fired again are not counted"; }
     (cd "$work/P" && find . -type f ! -name summary.json ! -name batch.json ! -name '.*' | sort) > "$work/P.files"
     while read -r f; do
         cmp -s "$work/P/$f" "$work/Q/$f" || fail "sensor-only batch resumed ($how): $f differs"
