@@ -282,6 +282,19 @@ def test_batch_movie_warning_names_no_frame(tmp_path):
     movie = [t for t in texts if "no movies" in t]
     assert movie and movie[0].startswith("no movies: frame frame-00001 has other sensors"), \
         texts
+    # the same sensors, another channel centre: no movies either (a band's movie would
+    # show two bands' frames on one colour scale), and batch.json says which channel
+    scene["sensors"][0]["resolution"] = [8, 6]
+    scene["channels"][0]["frequency_thz"] = 0.4
+    with open(tmp_path / "plate" / "b.json", "w") as f:
+        json.dump(scene, f)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        thzmap.batch(tmp_path / "plate" / "mixed.json", tmp_path / "out2")
+    with open(tmp_path / "out2" / "batch.json") as f:
+        b = json.load(f)
+    assert b["movies"] == [] and b["complete"], b
+    assert "its channel 1 is at 0.4 THz, frame 0's at 0.35 THz" in b["movies_skipped"], b
 
 
 def test_errors(tmp_path):
