@@ -151,6 +151,19 @@ def test_batch_resumes_reports_and_cancels(tmp_path):
         thzmap.batch(seq, out, progress=boom)
 
 
+def test_batch_failed_frame(tmp_path):
+    """A frame that fails stops the batch: batch.json marks it failed, the frames before it
+    done and those after it pending, and counts only the done ones (scene-format.md)."""
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "frame-00001").write_text("")  # no directory can go there
+    with pytest.raises(thzmap.Error, match="frame-00001: .*not a directory"):
+        thzmap.batch(SEQUENCE, tmp_path / "out", movies=False)
+    with open(tmp_path / "out" / "batch.json") as f:
+        b = json.load(f)
+    assert [f["status"] for f in b["frames"]] == ["done", "failed"] + ["pending"] * 3, b
+    assert b["frames_done"] == 1 and b["frames_computed"] == 1 and not b["complete"], b
+
+
 def test_batch_sweep_values_are_json_values(tmp_path):
     # batch.json's sweeps[].values (and frame.json's sweep_values) were one display string
     # with 17-digit numbers, "materials.skin.reflectivity = 0.10000000000000001"
