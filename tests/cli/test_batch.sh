@@ -262,6 +262,21 @@ for s in ("00", "01"):
 assert abs(scales[0]["min_k"] - min(values)) < 1e-6 and abs(scales[0]["max_k"] - max(values)) < 1e-6, \
     (scales[0], min(values), max(values))
 PY
+# each sweep value's movie starts at t = 0 (frame i of a value at i / fps): sweep-01's
+# caption is sweep-00's, "t = 0 s" (not 1 s, the frame's number in the whole batch)
+for s in 00 01; do
+    ffmpeg -v error -i "$work/W/sweep-$s/cam.band-01.mp4" -frames:v 1 -f rawvideo -pix_fmt gray \
+        "$work/W$s.gray" || fail "decoding sweep-$s's movie"
+done
+"$PY" - "$work/W" <<'PY' || fail "sweep-01's movie: its first caption is not sweep-00's (t = 0 s)"
+import json, sys
+import numpy as np
+d = sys.argv[1]
+L = json.load(open(f"{d}/batch.json"))["movies"][0]["layout"]
+a, b = (np.fromfile(f"{d}{s}.gray", np.uint8).reshape(L["height_px"], L["width_px"])[3:13] > 127
+        for s in ("00", "01"))
+assert a.sum() > 50 and (a != b).sum() <= 4, (a.sum(), (a != b).sum())
+PY
 # without a sweep, frame.json has no sweep values
 "$PY" - "$work/A/frame-00000/frame.json" <<'PY' || fail "frame.json without a sweep"
 import json, sys
