@@ -41,6 +41,22 @@ def test_frames_are_the_keyframes_interpolated():
         seq.frame(5)
 
 
+def test_hash_covers_the_scene_directory(tmp_path):
+    """The same sequence and scene text in two directories: other inputs (the hash covers
+    the scene's directory, scene-format.md "Resuming"), the same directory however its
+    path is spelled: the same."""
+    for d in ("a", "b"):
+        (tmp_path / d).mkdir()
+        shutil.copy(SEQUENCE, tmp_path / d / "sequence.json")
+        shutil.copy(os.path.join(BATCH, "scene.json"), tmp_path / d / "scene.json")
+    a, b, a2 = (thzmap.load_sequence(str(p)) for p in (
+        tmp_path / "a" / "sequence.json", tmp_path / "b" / "sequence.json",
+        tmp_path / "b" / ".." / "a" / "sequence.json"))
+    assert a.frame_json(0) == b.frame_json(0)
+    assert all(x.hash != y.hash for x, y in zip(a.frames, b.frames))
+    assert [x.hash for x in a.frames] == [x.hash for x in a2.frames]
+
+
 def test_whole_number_keyframes_stay_whole(tmp_path):
     """A seed keyed from 1 to 7 over seven frames is 1, 2, ..., 7: 1 + (7 - 1) 4/6 came out
     4.999999999999999 and the frame was refused as no whole number (scene-format.md
