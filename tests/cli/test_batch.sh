@@ -150,6 +150,10 @@ for end, y in (("max_k", L["image_y_px"] + 6), ("min_k", h - 18)):
     wrong = min((strip[:, x:x + want.shape[1]] != want).sum()
                 for x in range(strip.shape[1] - want.shape[1] + 1))
     assert wrong <= 2, (end, m["colour_scale"][end], wrong, want.sum())
+# the colour bar between them (16 pixels wide, 8 right of the image): lightest at the top,
+# beside max_k, darkening all the way down to min_k (viridis' lightness rises with Tb)
+bar = video[0][L["image_y_px"] + 8:h - 10, cols * k + 16].astype(float)
+assert bar[0] > bar[-1] + 100 and (np.diff(bar[::8]) <= 4).all(), bar[::8]
 PY
 
 # --- interrupted, killed, resumed ---------------------------------------------------
