@@ -57,6 +57,35 @@ def test_hash_covers_the_scene_directory(tmp_path):
     assert [x.hash for x in a.frames] == [x.hash for x in a2.frames]
 
 
+def test_hash_covers_every_named_file(tmp_path):
+    """A finished frame is done only while every file its scene names is as it was: a
+    mesh ("file" of an object in the list "objects") and a channel's response_file (a
+    "*_file" key); each file changed, every frame's hash changes (scene-format.md
+    "Resuming": else the batch keeps frames made from the old file)."""
+    with open(os.path.join(BATCH, "scene.json")) as f:
+        scene = json.load(f)
+    scene["channels"][0] = {"name": "r", "response_file": "r.csv"}
+    scene["objects"].append({"name": "tetra", "type": "solid", "material": "wall",
+                             "temperature_k": 290, "shape": {"type": "mesh",
+                                                             "file": "tetra.obj"}})
+    (tmp_path / "scene.json").write_text(json.dumps(scene))
+    shutil.copy(SEQUENCE, tmp_path / "sequence.json")
+    shutil.copy(os.path.join(REPO, "tests", "inputs", "meshes", "tetra.obj"), tmp_path)
+    (tmp_path / "r.csv").write_text("frequency_thz,weight\n0.29,1\n0.31,1\n")
+
+    def hashes():
+        return [f.hash for f in thzmap.load_sequence(str(tmp_path / "sequence.json")).frames]
+
+    before = hashes()
+    assert hashes() == before
+    (tmp_path / "r.csv").write_text("frequency_thz,weight\n0.29,1\n0.31,0.5\n")
+    after_response = hashes()
+    assert all(a != b for a, b in zip(before, after_response))
+    obj = (tmp_path / "tetra.obj").read_text()
+    (tmp_path / "tetra.obj").write_text(obj.replace("v 0 0 1\n", "v 0 0 1.5\n"))  # taller
+    assert all(a != b for a, b in zip(after_response, hashes()))
+
+
 def test_whole_number_keyframes_stay_whole(tmp_path):
     """A seed keyed from 1 to 7 over seven frames is 1, 2, ..., 7: 1 + (7 - 1) 4/6 came out
     4.999999999999999 and the frame was refused as no whole number (scene-format.md
