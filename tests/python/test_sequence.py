@@ -391,6 +391,15 @@ def test_errors(tmp_path):
         thzmap.load_sequence(tmp_path / "bad.json")
     assert e.value.path == "sweep.objects.person.temperature_k", e.value
     assert 'scenes[1] (empty.json) has no object named "person"' in e.value.reason, e.value
+    # a bad sweep value named by its own index, with a key varying faster after it
+    # (sweep-02 is its second value with the seed's first)
+    bad = {"format": "thzmap-sequence/1", "scene": "scene.json",
+           "sweep": {"objects.person.temperature_k": [300, -1], "photons.seed": [1, 2]}}
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    with pytest.raises(thzmap.SceneError) as e:
+        thzmap.load_sequence(tmp_path / "bad.json")
+    assert e.value.path == "sweep.objects.person.temperature_k[1]", e.value
+    assert "sweep-02/frame-00000" in e.value.reason, e.value
     # at most 10 000 combinations of sweep values: 10 000 itself is accepted, and 11 frames
     # of each are then refused as more than the 100 000 frames a sequence may have
     bad = {"format": "thzmap-sequence/1", "scene": "scene.json", "frames": 11,
