@@ -413,6 +413,11 @@ def test_errors(tmp_path):
     (tmp_path / "bad.json").write_text(json.dumps(bad))
     with pytest.raises(thzmap.SceneError, match="more than 10000 combinations"):
         thzmap.load_sequence(tmp_path / "bad.json")
+    # the least rate, 1e-9 frames per second, is accepted (a frame in 31.7 years)
+    slow = {"format": "thzmap-sequence/1", "scene": "scene.json", "fps": 1e-9, "frames": 2}
+    (tmp_path / "slow.json").write_text(json.dumps(slow))
+    times = [f.time_s for f in thzmap.load_sequence(tmp_path / "slow.json").frames]
+    assert times == pytest.approx([0, 1e9], rel=1e-12), times
     with pytest.raises(thzmap.ArgumentError, match="sequence: expected"):
         thzmap.batch(42, tmp_path / "out")
     with pytest.raises(thzmap.ArgumentError, match="movies"):
