@@ -119,11 +119,34 @@ static void test_humidity_conversions(void **state)
         atm_air_state_init(&c, 293.15, 1013.25, ATM_HUMIDITY_VMR, atm_air_h2o_vmr(&a), &err),
         THZ_OK);
     assert_true(fabs(c.h2o_pressure_hpa - a.h2o_pressure_hpa) < 1e-9);
+    /* the ends of the documented ranges are taken: saturated air (relative humidity 1,
+     * e = e_s; refused by a mutant that read the range as 0 to below 1), 100 and 400 K,
+     * 2000 hPa */
+    assert_int_equal(atm_air_state_init(&a, 293.15, 1013.25, ATM_HUMIDITY_RELATIVE, 1.0, &err),
+                     THZ_OK);
+    assert_true(fabs(a.h2o_pressure_hpa - es) < 1e-12);
+    assert_int_equal(atm_air_state_init(&c, 100.0, 2000.0, ATM_HUMIDITY_NONE, 0.0, &err), THZ_OK);
+    assert_int_equal(atm_air_state_init(&c, 400.0, 2000.0, ATM_HUMIDITY_NONE, 0.0, &err), THZ_OK);
+    /* and beyond them refused, naming the bound (the 2000 hPa bound dropped, a mutant, passed
+     * every test: the scene loader and thzmap atmosphere check it themselves, the C API's
+     * atmosphere functions (api_atmosphere.c) rely on this one) */
+    assert_int_equal(atm_air_state_init(&c, 400.5, 1000.0, ATM_HUMIDITY_NONE, 0.0, &err),
+                     THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "100 to 400 K"));
+    assert_int_equal(atm_air_state_init(&c, 300.0, 2000.5, ATM_HUMIDITY_NONE, 0.0, &err),
+                     THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "at most 2000 hPa"));
     assert_int_equal(atm_air_state_init(&a, 293.15, 1013.25, ATM_HUMIDITY_RELATIVE, 50, &err),
                      THZ_ERR_INPUT);
     assert_non_null(strstr(err.message, "not per cent"));
     assert_int_equal(atm_air_state_init(&a, 293.15, 10, ATM_HUMIDITY_DENSITY_G_M3, 100, &err),
                      THZ_ERR_INPUT);
+    /* a vapour pressure equal to the total is refused too ("at or above", docs/atmosphere.md):
+     * 1000 g/m^3 at 216.7 K is e = 1000 hPa exactly (accepted by a mutant that refused only
+     * e > P: air of water vapour alone) */
+    assert_int_equal(atm_air_state_init(&a, 216.7, 1000.0, ATM_HUMIDITY_DENSITY_G_M3, 1000.0, &err),
+                     THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "is not below the total pressure"));
 }
 
 int main(void)
