@@ -86,6 +86,19 @@ static void test_range_refused(void **state)
     assert_int_equal(atmosphere_prepare(&atm, &ch, 1, &err), THZ_ERR_INPUT);
     assert_non_null(strstr(err.message, "itu-p676"));
     assert_non_null(strstr(err.message, "1.5 THz"));
+    /* A wide band whose low tail (centre - 6 sigma = -0.82 GHz) reaches below the model's
+     * 1 GHz is taken, tabulated from 1 GHz (atmosphere.h: the centre and the upper edge must
+     * be in range): refused when the range check took its own lower end as outside, or
+     * without the tail's clamp (two mutants). The table then agrees with direct evaluation
+     * in the band. */
+    thz_channel wide = {.name = "3 GHz", .center_hz = 3e9, .relative_width = 0.5};
+    if (atmosphere_prepare(&atm, &wide, 1, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    assert_int_equal(atm.n_tables, 1);
+    assert_true(fabs(atm.tables[0].lo_hz + atm.tables[0].step_hz - 1e9) < 1e-3);
+    for (double f = 1.5e9; f < 6.5e9; f += 0.37e9)
+        assert_true(fabs(atmosphere_alpha_per_m(&atm, f) / atmosphere_alpha_direct_per_m(&atm, f) -
+                         1.0) < 1e-4);
     atmosphere_fini(&atm);
 }
 
