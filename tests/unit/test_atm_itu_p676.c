@@ -86,6 +86,17 @@ static void test_range_refused(void **state)
     assert_int_equal(atmosphere_prepare(&atm, &ch, 1, &err), THZ_ERR_INPUT);
     assert_non_null(strstr(err.message, "itu-p676"));
     assert_non_null(strstr(err.message, "1.5 THz"));
+    /* A channel whose centre (0.97 THz) lies in the range but whose band, centre + 6 sigma =
+     * 1.019 THz, leaves it is refused too, naming the band (checked over centre +- 3 sigma,
+     * a mutant, it passed every test); and the range ends at 1000 GHz, not beyond (1001 GHz,
+     * a mutant, passed too) */
+    thz_channel edge = {.name = "0.97 THz", .center_hz = 0.97e12, .relative_width = 0.02};
+    assert_int_equal(atmosphere_prepare(&atm, &edge, 1, &err), THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "centre +- 6 sigma"));
+    assert_int_equal(atmosphere_check_range(&atm, 0.5e12, 1000e9, "band", &err), THZ_OK);
+    assert_int_equal(atmosphere_check_range(&atm, 0.5e12, 1000.5e9, "band", &err), THZ_ERR_INPUT);
+    assert_int_equal(atmosphere_check_range(&atm, 1e9, 2e9, "band", &err), THZ_OK);
+    assert_int_equal(atmosphere_check_range(&atm, 0.9995e9, 2e9, "band", &err), THZ_ERR_INPUT);
     /* A wide band whose low tail (centre - 6 sigma = -0.82 GHz) reaches below the model's
      * 1 GHz is taken, tabulated from 1 GHz (atmosphere.h: the centre and the upper edge must
      * be in range): refused when the range check took its own lower end as outside, or
