@@ -1,12 +1,13 @@
-/* The `lines` model's H2O line, one line at a time, against docs/atmosphere.md's formulas
- * evaluated here from the catalogue's numbers: the strength S(T) (TIPS partition sums
- * interpolated linearly in the repository's table, lower-state energy, stimulated
- * emission), the width (296/T)^n_air (gamma_air (P - e) + gamma_self e), the shift
- * delta_air (P - e), and the Van Vleck-Huber shape with MT_CKD's 750 GHz cut-off and
- * pedestal (continuum on) or full wings (continuum off), its mirror term included. The
- * comparisons with itu-p676 (6 % at line centres, 20-25 % in windows) cannot see a slip
- * of a few per cent in any of these (the mutants this caught are in the commit
- * messages). 1e-9 relative. */
+/* The `lines` model's lines, one at a time, against docs/atmosphere.md's formulas evaluated
+ * here from the catalogue's numbers: an H2O line (the strength S(T) with the TIPS partition
+ * sums interpolated linearly in the repository's table, the lower-state energy and
+ * stimulated emission; the width (296/T)^n_air (gamma_air (P - e) + gamma_self e); the shift
+ * delta_air (P - e); the Van Vleck-Huber shape with MT_CKD's 750 GHz cut-off and pedestal,
+ * or full wings, its mirror term included), a line-mixed and an uncoupled O2 line, and the
+ * Doppler widths of three H2O isotopologues. The comparisons with itu-p676 (6 % at line
+ * centres, 20-25 % in windows) cannot see a slip of a few per cent in any of these (the
+ * mutants this caught are in the commit messages). 1e-9 relative. And a line that breaks a
+ * catalogue rule is refused, naming it. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -325,13 +326,57 @@ static void test_isotopologue_doppler(void **state)
     rmdir(dir);
 }
 
+/* A catalogue line that breaks one of docs/atmosphere.md's rules (frequency > 0, intensity
+ * and widths >= 0, isotopologue >= 1) is refused with its file, line and the rule: a
+ * negative air-broadened width accepted (the rule dropped, a mutant) passed every test,
+ * and such a line then absorbed with a negative Lorentzian. */
+static void test_bad_line_refused(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *line, *rule;
+    } bad[] = {
+        {"0,1e-22,100,2.7e-3,1.1e-2,0.65,0,1", "frequency must be > 0"},
+        {"22.2,-1e-22,100,2.7e-3,1.1e-2,0.65,0,1", "intensity must be >= 0"},
+        {"22.2,1e-22,100,-2.7e-3,1.1e-2,0.65,0,1", "air-broadened width must be >= 0"},
+        {"22.2,1e-22,100,2.7e-3,-1.1e-2,0.65,0,1", "self-broadened width must be >= 0"},
+        {"22.2,1e-22,100,2.7e-3,1.1e-2,0.65,0,0", "isotopologue must be >= 1"},
+    };
+    char dir[] = "/tmp/thz-atm-line-XXXXXX", path[64];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/h2o.csv", dir);
+    atm_air_state air = reference_air(7.5);
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        FILE *f = fopen(path, "w");
+        assert_non_null(f);
+        fprintf(f,
+                "freq_GHz,S296_cm2_GHz,Elower_K,gamma_air_GHz_per_mbar,gamma_self_GHz_per_mbar,"
+                "n_air,delta_air_GHz_per_mbar,hitran_iso\n22.0,1e-22,100,2.7e-3,1.1e-2,0.65,0,1\n"
+                "%s\n",
+                bad[i].line);
+        assert_int_equal(fclose(f), 0);
+        atm_lines_options o;
+        atmosphere_lines_options_default(&o);
+        o.h2o_lines_file = path;
+        thz_atmosphere lbl = {0};
+        thz_error err = {0};
+        char want[128];
+        snprintf(want, sizeof want, "%s:3: the line's %s", path, bad[i].rule);
+        thz_status st = atmosphere_init_lines(&lbl, &air, &o, &err);
+        if (st != THZ_ERR_INPUT || !strstr(err.message, want))
+            fail_msg("'%s': status %d, message '%s', expected '%s'", bad[i].line, st, err.message,
+                     want);
+    }
+    unlink(path);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_one_h2o_line),
-        cmocka_unit_test(test_one_coupled_o2_line),
-        cmocka_unit_test(test_one_gross_o2_line),
-        cmocka_unit_test(test_isotopologue_doppler),
+        cmocka_unit_test(test_one_h2o_line),      cmocka_unit_test(test_one_coupled_o2_line),
+        cmocka_unit_test(test_one_gross_o2_line), cmocka_unit_test(test_isotopologue_doppler),
+        cmocka_unit_test(test_bad_line_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
