@@ -3,7 +3,8 @@
  * low-power roulette is at work; a cosine emitter facing a black plane at distance d
  * delivers on average 2 E3(alpha d) of its power (E3 the exponential integral); and the
  * power lost on the way is booked as atmosphere power; emitting air sends its photons
- * in every direction alike. Tolerances: 5 standard errors. */
+ * in every direction alike; non-emitting humid air is air at 0 K for a deviation map.
+ * Tolerances: 5 standard errors (the last, deterministic in its power: 1e-3). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -15,6 +16,9 @@
 #include "accel/accel.h"
 #include "photon/phase.h"
 #include "photon/trace.h"
+#include "deviation_photons.h"
+#include "physics/channel.h"
+#include "physics/planck.h"
 #include "photon_scenes.h"
 
 /* A black plane at z = 0 (normal +z, half-size `half` m), a constant atmosphere. */
@@ -193,6 +197,45 @@ static void test_air_isotropic(void **state)
     scene_destroy(s);
 }
 
+static double alpha_b_at(double freq_hz, void *s)
+{
+    const thz_atmosphere *atm = &((const thz_scene *)s)->atmosphere;
+    return atmosphere_alpha_per_m(atm, freq_hz) * planck_radiance(freq_hz, 300.0);
+}
+
+/* Non-emitting air with an air state (itu-p676 humid air at 290 K, "emitting": false) is,
+ * as the constant model's, air at 0 K for the photons: with T0 = 300 K it fires
+ * -4 pi V <alpha B(T0)>, its band mean by channel_band_mean. Its air's 290 K taken as an
+ * emitter's (a mutant) passed every test, whose non-emitting air had no temperature: the
+ * deviation map of such a scene then held the air's 4 pi alpha B(290 K) as well. */
+static void test_non_emitting_humid_air(void **state)
+{
+    (void)state;
+    const double t0 = 300.0;
+    thz_error err = {0};
+    thz_scene *s = ps_scene(0.35, 0.1, ps_scaled(200000), 23);
+    size_t wall = ps_material(s, 0.3, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t room = ps_object(s, OBJECT_SOLID, wall, t0, 0, false);
+    ps_box(s, room, v3(-1, -1, 0), v3(1, 1, 2.5), true);
+    ps_finalize(s);
+    atm_air_state air;
+    ps_check(atm_air_state_init(&air, 290.0, 1013.25, ATM_HUMIDITY_RELATIVE, 0.6, &err) == THZ_OK);
+    ps_check(atmosphere_init_itu_p676(&s->atmosphere, &air, NULL, &err) == THZ_OK);
+    ps_check(atmosphere_prepare(&s->atmosphere, s->channels, s->n_channels, &err) == THZ_OK);
+    double lo[3] = {-0.99, -0.99, 0.01}, hi[3] = {0.99, 0.99, 2.49};
+    ps_check(atmosphere_set_extent(&s->atmosphere, lo, hi, &err) == THZ_OK);
+    double v = 1.98 * 1.98 * 2.48;
+    double expected = -4.0 * M_PI * v * channel_band_mean(&s->channels[0], alpha_b_at, s);
+    photon_map *map;
+    photon_stats st;
+    fire(s, t0, 2, &map, &st);
+    printf("# non-emitting humid air: fired %.6e W/Hz, expected %.6e\n", st.fired_power_w_per_hz,
+           expected);
+    assert_true(fabs(st.fired_power_w_per_hz - expected) <= 1e-3 * fabs(expected));
+    photon_map_destroy(map);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -200,6 +243,7 @@ int main(void)
         cmocka_unit_test(test_low_power_roulette),
         cmocka_unit_test(test_cosine_emitter),
         cmocka_unit_test(test_air_isotropic),
+        cmocka_unit_test(test_non_emitting_humid_air),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
