@@ -2,7 +2,8 @@
  * optical depth (Kirchhoff's law for a non-scattering gas in local thermodynamic
  * equilibrium), inside an optional box-shaped extent beyond which a black
  * background at T_bg is seen. These are the atmosphere-side pieces; the photon phase
- * and the renderer call them. */
+ * (src/photon/air_emission.c) and the renderer (render_air in src/sensor/render_terms.c,
+ * band means over the channel's quadrature) call them. */
 #include <math.h>
 
 #include "atmosphere/atmosphere.h"
@@ -48,32 +49,12 @@ thz_status atmosphere_set_extent(thz_atmosphere *atm, const double min_m[3], con
     return THZ_OK;
 }
 
-double atmosphere_path_radiance(const thz_atmosphere *atm, double freq_hz, double distance_m)
-{
-    if (!atm->emitting)
-        return 0.0;
-    double alpha = atmosphere_alpha_per_m(atm, freq_hz);
-    if (alpha <= 0.0)
-        return 0.0; /* also avoids 0 * infinity */
-    double tau = alpha * distance_m;
-    return planck_radiance(freq_hz, atm->air.temperature_k) * -expm1(-tau);
-}
-
 double atmosphere_volume_emission_w_per_m3_hz(const thz_atmosphere *atm, double freq_hz)
 {
     if (!atm->emitting)
         return 0.0;
     return 4.0 * M_PI * atmosphere_alpha_per_m(atm, freq_hz) *
            planck_radiance(freq_hz, atm->air.temperature_k);
-}
-
-double atmosphere_extent_volume_m3(const thz_atmosphere *atm)
-{
-    if (!atm->has_extent)
-        return 0.0;
-    return (atm->extent_max_m[0] - atm->extent_min_m[0]) *
-           (atm->extent_max_m[1] - atm->extent_min_m[1]) *
-           (atm->extent_max_m[2] - atm->extent_min_m[2]);
 }
 
 double atmosphere_extent_exit_m(const thz_atmosphere *atm, const double origin_m[3],
@@ -93,14 +74,4 @@ double atmosphere_extent_exit_m(const thz_atmosphere *atm, const double origin_m
             t_exit = fmin(t_exit, (atm->extent_min_m[i] - o) / d);
     }
     return t_exit;
-}
-
-double atmosphere_escape_radiance(const thz_atmosphere *atm, double freq_hz, double distance_m)
-{
-    if (!atm->emitting)
-        return 0.0;
-    double alpha = atmosphere_alpha_per_m(atm, freq_hz);
-    double t = alpha <= 0.0 ? 1.0 : exp(-alpha * distance_m);
-    return planck_radiance(freq_hz, atm->background_temperature_k) * t +
-           planck_radiance(freq_hz, atm->air.temperature_k) * (1.0 - t);
 }

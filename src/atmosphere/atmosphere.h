@@ -204,28 +204,15 @@ thz_status atmosphere_set_emitting(thz_atmosphere *atm, double temperature_k,
 thz_status atmosphere_set_extent(thz_atmosphere *atm, const double min_m[3], const double max_m[3],
                                  thz_error *err);
 
-/* Radiance the air adds along a free path of length distance_m towards the viewer:
- * B_nu(T_air) (1 - exp(-alpha d)). 0 when not emitting. A sample ray that hits a
- * surface at distance d records L_surface exp(-alpha d) + this. */
-double atmosphere_path_radiance(const thz_atmosphere *atm, double freq_hz, double distance_m);
-
 /* Spectral power emitted per unit volume, 4 pi alpha B_nu(T_air), W m^-3 Hz^-1
- * (isotropic; 0 when not emitting). The photon phase may fire air photons from the
- * extent with this density (total: times atmosphere_extent_volume_m3). */
+ * (isotropic; 0 when not emitting): the density with which the photon phase fires air
+ * photons. */
 double atmosphere_volume_emission_w_per_m3_hz(const thz_atmosphere *atm, double freq_hz);
-
-/* Volume of the extent in m^3 (0 without one). */
-double atmosphere_extent_volume_m3(const thz_atmosphere *atm);
 
 /* Distance from origin_m along the unit direction to where the ray leaves the
  * extent; INFINITY without an extent, 0 if the origin is outside it. */
 double atmosphere_extent_exit_m(const thz_atmosphere *atm, const double origin_m[3],
                                 const double direction[3]);
-
-/* Radiance seen by a ray that hits nothing and leaves the extent after distance_m:
- * B_nu(T_bg) exp(-alpha d) + B_nu(T_air) (1 - exp(-alpha d)). Without an extent
- * (d infinite) that is B_nu(T_air) where alpha > 0. 0 when not emitting. */
-double atmosphere_escape_radiance(const thz_atmosphere *atm, double freq_hz, double distance_m);
 
 void atmosphere_fini(thz_atmosphere *atm);
 
