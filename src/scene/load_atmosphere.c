@@ -33,11 +33,13 @@ static thz_status load_air(load_ctx *ctx, const load_cursor *c, atm_air_state *a
     static const load_range ranges[] = {
         {0.0, 1.0, false, false}, {0.0, INFINITY, false, false}, {0.0, 1.0, false, true}};
     double t = 0.0, p = 0.0, h = 0.0;
-    thz_status st = load_number(ctx, c, "temperature_k", (load_range){100.0, 400.0, false, false},
-                                true, 0.0, &t);
+    thz_status st = load_number(
+        ctx, c, "temperature_k",
+        (load_range){ATM_AIR_MIN_TEMPERATURE_K, ATM_AIR_MAX_TEMPERATURE_K, false, false}, true, 0.0,
+        &t);
     if (st == THZ_OK)
-        st = load_number(ctx, c, "pressure_hpa", (load_range){0.0, 2000.0, true, false}, true, 0.0,
-                         &p);
+        st = load_number(ctx, c, "pressure_hpa",
+                         (load_range){0.0, ATM_AIR_MAX_PRESSURE_HPA, true, false}, true, 0.0, &p);
     if (st != THZ_OK)
         return st;
     int found = -1;
