@@ -119,6 +119,15 @@ expect_usage "--pressure-hpa expects a number above 0 and at most 2000, got '0'"
     --step-ghz 1 --pressure-hpa 0
 expect_usage "--pressure-hpa expects a number above 0 and at most 2000" --from-thz 0.1 --to-thz 0.2 \
     --step-ghz 1 --pressure-hpa 5000
+# ... and the ends of the documented ranges are taken (scene-format.md: above 0 and at
+# most 2000 hPa; 100-400 K; frequencies up to 1000 THz)
+for air in "--pressure-hpa 2000" "--temperature-k 100" "--temperature-k 400"; do
+    # shellcheck disable=SC2086 # (the option and its value)
+    "$THZMAP" atmosphere --model itu-p676 --from-thz 0.1 --to-thz 0.1 --step-ghz 1 $air \
+        > /dev/null 2> "$work/err" || fail "$air, the end of its range: exit $?: $(cat "$work/err")"
+done
+"$THZMAP" atmosphere --model none --from-thz 999 --to-thz 1000 --step-ghz 1e6 > "$work/ends.csv" \
+    2> "$work/err" || fail "--to-thz 1000 --step-ghz 1e6, the ends of their ranges: exit $?: $(cat "$work/err")"
 expect_usage "apply to a lines model" --from-thz 0.1 --to-thz 0.2 --step-ghz 1 --model itu-p676 \
     --no-continuum
 expect_usage "the scene's atmosphere is used" --scene "$work/humid.json" --from-thz 0.3 \
