@@ -273,6 +273,15 @@ grep -q "fires no photons" "$work/u.err" || fail "render photon-map noise target
 [ $? -eq 2 ] || fail "--max-seconds 0 should exit 2"
 "$THZMAP" simulate "$work/scene.json" -o "$work/u" --photons 0 2>/dev/null
 [ $? -eq 2 ] || fail "--photons 0 should exit 2"
+# one past either end of the documented ranges (--photons 1 to 10^12, --threads 1 to 4096)
+# is refused as the option's own usage error, before the scene or the memory is looked at
+for bad in "--photons 1000000000001" "--threads 0" "--threads 4097"; do
+    # shellcheck disable=SC2086 # (the option and its value)
+    "$THZMAP" simulate "$work/scene.json" -o "$work/u" $bad --quiet 2> "$work/u.err"
+    rc=$?
+    [ $rc -eq 2 ] && grep -q -- "^thzmap simulate: ${bad% *} expects a whole number from 1 to" "$work/u.err" ||
+        fail "simulate $bad: exit $rc, expected 2 and the option's range: $(head -n 1 "$work/u.err")"
+done
 # a number is written as JSON writes one: no blanks, no hexadecimal (strtod takes both)
 for bad in ' 100' '0x100' '1e' 'inf'; do
     "$THZMAP" simulate "$work/scene.json" -o "$work/u" --photons "$bad" 2> "$work/u.err"
@@ -331,6 +340,15 @@ grep -q "max_seconds 5 s is not used: it limits the passes towards a noise targe
 [ -f "$work/-eqdash/summary.json" ] || fail "--output=-eqdash wrote no -eqdash/summary.json"
 "$THZMAP" --version extra 2>/dev/null
 [ $? -eq 2 ] || fail "thzmap --version with an argument should exit 2"
+# no command at all: the usage, on standard error, and exit 2 (scene-format.md "Command
+# line"), as for an unknown command
+"$THZMAP" > "$work/none.out" 2> "$work/none.err"
+rc=$?
+[ $rc -eq 2 ] && [ ! -s "$work/none.out" ] && grep -q '^usage: thzmap <command>' "$work/none.err" ||
+    fail "thzmap without arguments: exit $rc, stdout '$(cat "$work/none.out")', $(head -n 1 "$work/none.err")"
+"$THZMAP" simulat > /dev/null 2>&1
+rc=$?
+[ $rc -eq 2 ] || fail "thzmap simulat (an unknown command): exit $rc, expected 2"
 "$THZMAP" --bogus 2>&1 | grep -q "unknown option '--bogus'" || fail "thzmap --bogus: not an option"
 "$THZMAP" simulate --help | grep -q -- "--save-photon-map" || fail "simulate --help"
 for opt in --integrator --target-noise-k --max-seconds; do
