@@ -269,4 +269,31 @@ for deg in 90 170; do
     expect_line "$work/psf$deg.out" 'PSF FWHM [0-9]+ mrad$'
 done
 
+# an Airy spot and a radiometer's NETD, by hand: at 0.35 THz (lambda 0.8565 mm) with D 0.5 m,
+# 1.22 lambda / D = 2.090 mrad, 2 d tan(spot / 2) = 2.09 mm at the near box (1 m) and
+# 1.254 cm at the far one (6 m; the room around the sensor is left out); B_n of a Gaussian
+# of FWHM 7 GHz is sqrt(pi / (2 ln 2)) FWHM = 10.54 GHz, and the total-power NETD at the
+# largest emitter's 295 K is (295 + 700) K / sqrt(B_n 0.01 s) = 0.09693 K. The total area
+# is the room's 2400 m^2, 0.24 and 0.96 m^2.
+cat > "$work/airy.json" <<'JSON'
+{"format": "thzmap-scene/1", "channels": [{"frequency_thz": 0.35, "relative_width": 0.02}],
+ "materials": {"wall": {"reflectivity": 0.1}},
+ "objects": [{"name": "room", "type": "solid", "material": "wall", "temperature_k": 295,
+              "shape": {"type": "box", "size_m": [20, 20, 20], "inward": true}},
+             {"name": "near", "type": "solid", "material": "wall", "temperature_k": 300,
+              "shape": {"type": "box", "size_m": [0.2, 0.2, 0.2]},
+              "transform": {"translate_m": [0, 1, 0]}},
+             {"name": "far", "type": "solid", "material": "wall", "temperature_k": 300,
+              "shape": {"type": "box", "size_m": [0.4, 0.4, 0.4]},
+              "transform": {"translate_m": [0, 6, 0]}}],
+ "sensors": [{"name": "cam", "position_m": [0, 0, 0], "direction": [0, 1, 0], "fov_deg": 40,
+              "resolution": [4, 4], "aperture_diameter_m": 0.5,
+              "noise": {"receiver_temperature_k": 700, "integration_time_s": 0.01,
+                        "radiometer": "total-power"}}]}
+JSON
+"$THZMAP" validate "$work/airy.json" >"$work/airy.out" 2>"$work/err" ||
+    fail "an Airy PSF and a radiometer: exit $?: $(cat "$work/err")"
+expect_line "$work/airy.out" ' NETD 0\.09693 K at Tb 295 K \(B_n 10\.54 GHz\); spot 1\.22 lambda/D 2\.09 mrad = 2\.09 mm at 1 m, 1\.25 cm at 6 m \(nearest and farthest object centre\)$'
+expect_line "$work/airy.out" '^  total: 36 triangles, area 2401\.2 m²$'
+
 finish "validate: all checks passed"
