@@ -34,6 +34,9 @@ static void check_thread_limit(thz_scene *scene, const thz_photons *photons)
           thz_context_last_status(ctx));
     thz_context_set_threads(ctx, THZ_MAX_THREADS);
     CHECK(thz_context_threads(ctx) == THZ_MAX_THREADS, "threads %d", thz_context_threads(ctx));
+    /* a negative count means 0, all cores (thzmap.h), as read back */
+    thz_context_set_threads(ctx, -3);
+    CHECK(thz_context_threads(ctx) == 0, "threads after -3: %d", thz_context_threads(ctx));
     thz_context_destroy(ctx);
 }
 
