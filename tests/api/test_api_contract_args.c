@@ -251,6 +251,10 @@ int main(int argc, char **argv)
     REQUIRE_OK(thz_photons_save(photons, path, &err), &err);
     thz_run *run = NULL;
     REQUIRE_OK(thz_render_run(ctx, scene, photons, 1, NULL, &run, &err), &err);
+    /* its one image (sensor 1's) is image 0; image 1 is out of range: NULL (run.h) */
+    CHECK(thz_run_image_count(run) == 1 && thz_run_image(run, 0) != NULL &&
+              thz_image_sensor(thz_run_image(run, 0)) == 1 && thz_run_image(run, 1) == NULL,
+          "a run of sensor 1: %zu images", thz_run_image_count(run));
 
     check_thread_limit(scene, photons);
     check_sensor_index(ctx, scene, photons, path);
