@@ -17,6 +17,10 @@ grep -v '^#' "$work/a.csv" > "$work/a.data"
 # the comment line records the path the transmittance column is of
 grep -q '^# thzmap atmosphere: model lines; air .*; transmittance over a path of 100 m$' "$work/a.csv" ||
     fail "the comment line lacks --distance-m: $(head -1 "$work/a.csv")"
+# ... and the air of the documented defaults: 288.15 K, 1013.25 hPa, 7.5 g/m^3 of water
+# vapour, whose pressure is 7.5 x 288.15 / 216.7 = 9.973 hPa (mixing ratio 0.009842)
+grep -q '^# thzmap atmosphere: model lines; air 288.15 K, 1013.25 hPa total, water vapour 9.973 hPa (7.5 g/m^3, volume mixing ratio 0.009842);' \
+    "$work/a.csv" || fail "the default air is not 288.15 K, 1013.25 hPa, 7.5 g/m^3: $(head -1 "$work/a.csv")"
 head -1 "$work/a.data" | grep -qx "frequency_thz,attenuation_per_m,attenuation_db_per_km,h2o_lines_db_per_km,h2o_continuum_db_per_km,o2_db_per_km,dry_continuum_db_per_km,transmittance" \
     || fail "unexpected header: $(head -1 "$work/a.data")"
 [ "$(tail -n +2 "$work/a.data" | wc -l)" -eq 11 ] || fail "expected 11 rows"
