@@ -53,6 +53,16 @@ grep -q '^source: H. J. Liebe' "$work/water" || fail "water: no source line"
 grep -q 'alpha (1/m)' "$work/water" || fail "water: the attenuation column has no unit"
 grep -q '^stated validity: 0.001 to 1 THz' "$work/water" || fail "water: no stated range"
 grep -q '^reflection: not part of the entry' "$work/water" || fail "water: no reflection line"
+# the stated validity's end is inside it (1 THz unmarked), past it is marked; the list
+# gives n and k at 1 THz, as the row of 1 THz (checked against Liebe's model above) does
+grep -Eq '^ +1 [^*]*[0-9]$' "$work/water" || fail "water: 1 THz, its validity's end, marked outside"
+"$THZMAP" materials water --at-thz 1.5,1000 >"$work/water2" 2>"$work/err" ||
+    fail "materials water --at-thz 1.5,1000 (1000 THz: the end of the option's range): exit $?: $(cat "$work/err")"
+grep -Eq '^ +1\.5 .* \*$' "$work/water2" || fail "water: 1.5 THz not marked outside its validity"
+awk '$1 == "water" { n = $4; k = $5 } END { print n, k }' "$work/list" >"$work/listed"
+awk '$1 == "1" { printf "%.4g %.4g\n", $2, $3 }' "$work/water" >"$work/row"
+cmp -s "$work/listed" "$work/row" ||
+    fail "the list's water (n k: $(cat "$work/listed")) is not its 1 THz row ($(cat "$work/row"))"
 
 "$THZMAP" materials concrete >"$work/concrete" || fail "materials concrete: exit $?"
 grep -q '^data: 0.001 to 0.1 THz, 0.11 to 0.33 THz' "$work/concrete" ||
