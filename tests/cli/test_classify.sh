@@ -53,6 +53,10 @@ for k, c in enumerate(d["classes"]):
     assert conf[k].sum() == (ids == c["object"]).sum() == c["pixels"]
 assert d["accuracy"] == 1.0, d["accuracy"]
 assert d["training_pixels"] + d["held_out_pixels"] == seen
+# the documented defaults (no --seed, no --train-fraction given): seed 1, half of each
+# object's pixels training (rounded per object)
+assert d["seed"] == 1 and d["train_fraction"] == 0.5, (d["seed"], d["train_fraction"])
+assert abs(d["training_pixels"] - seen / 2) <= len(d["classes"]), (d["training_pixels"], seen)
 cls = np.fromfile(f"{out}/cam.class.img", "<f4").astype(int)
 assert (cls == ids).all()
 hdr = open(f"{out}/cam.class.hdr").read()
