@@ -71,6 +71,17 @@ JSON
 grep -v '^#' "$work/s.csv" | head -1 | grep -qx "frequency_thz,attenuation_per_m,attenuation_db_per_km" \
     || fail "scene atmosphere header: $(cat "$work/s.csv")"
 grep -v '^#' "$work/s.csv" | tail -1 | grep -q "^0.4,5.000000e-02," || fail "scene constant alpha"
+# an air option describes the air: the model is then built from the options (lines by
+# default), not taken from the scene (scene-format.md: "without --model and air options")
+"$THZMAP" atmosphere --scene "$work/scene.json" --from-thz 0.3 --to-thz 0.3 --step-ghz 1 \
+    --temperature-k 250 > "$work/sa.csv" || fail "--scene --temperature-k: exit status $?"
+grep -q '^# thzmap atmosphere: model lines; air 250.00 K, ' "$work/sa.csv" ||
+    fail "--scene --temperature-k 250 used the scene's atmosphere: $(head -1 "$work/sa.csv")"
+# both ends included when the step does not divide the range: 0.1 to 0.2 by 30 GHz ends at 0.2
+"$THZMAP" atmosphere --model none --from-thz 0.1 --to-thz 0.2 --step-ghz 30 > "$work/odd.csv" ||
+    fail "a step that does not divide the range: exit status $?"
+[ "$(grep -v '^#' "$work/odd.csv" | tail -n +2 | cut -d, -f1 | tr '\n' ' ')" = "0.1 0.13 0.16 0.19 0.2 " ] ||
+    fail "0.1 to 0.2 THz by 30 GHz: rows $(grep -v '^#' "$work/odd.csv" | tail -n +2 | cut -d, -f1 | tr '\n' ' ')"
 if "$THZMAP" atmosphere --scene "$work/scene.json" --model lines --from-thz 0.3 --to-thz 0.4 \
        --step-ghz 1 --plot "$work/s.png" > /dev/null 2> "$work/err"; then
     [ -s "$work/s.png" ] || fail "--scene --plot wrote no PNG"
