@@ -275,7 +275,8 @@ static void check_bands_targets(thz_context *ctx, const char *scene_path)
 }
 
 /* An output takes nothing after its commit, and says so (THZ_ERR_INPUT, not an I/O
- * error about its vanished staging directory); a file of 0 bytes may have no data; a
+ * error about its vanished staging directory); a file of 0 bytes may have no data, one
+ * of more bytes must; a run kept without photons writes no photon map; a
  * file never replaces one the output holds. */
 static void check_output_order(thz_context *ctx, thz_run *run, const char *dir)
 {
@@ -288,6 +289,13 @@ static void check_output_order(thz_context *ctx, thz_run *run, const char *dir)
     /* a name the output holds already is refused, not replaced */
     expect_input_error(thz_output_add_file(out, "empty.txt", "x", 1, &err), &err,
                        "empty.txt is in this output already", "the same file twice");
+    /* bytes without data, and a photon map of a run that kept none (no keep_photons):
+     * refused as input, before anything is written */
+    expect_input_error(thz_output_add_file(out, "nodata.bin", NULL, 5, &err), &err,
+                       "expected a plain file name and data", "5 bytes of NULL data");
+    thz_write_options with_map = {.photon_map = 1};
+    expect_input_error(thz_output_add_run(ctx, out, run, &with_map, &err), &err,
+                       "kept no photon maps", "a photon map the run did not keep");
     REQUIRE_OK(thz_output_add_run(ctx, out, run, NULL, &err), &err);
     expect_input_error(thz_output_add_file(out, "summary.json", "{}", 2, &err), &err,
                        "summary.json is in this output already", "a file over the run's");
