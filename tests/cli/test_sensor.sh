@@ -78,6 +78,19 @@ assert s["tp"]["noise"]["model"] == "total-power" and s["tp"]["psf"] == "none", 
 assert s["dicke"]["noise"]["model"] == "dicke", s["dicke"]
 assert s["netd"]["noise"]["netd_k"] == [0.5, 0.2] and s["netd"]["noise_seed"] == 7, s["netd"]
 assert s["tp"]["noise_seed"] == 1, s["tp"]
+# the radiometer's NETD per channel at the reference temperature it names (the box's
+# 300 K): (T + T_rec) / sqrt(B_n tau), B_n = sqrt(pi / (2 ln 2)) FWHM; a given NETD is at
+# no temperature and has no receiver
+import math
+tp = s["tp"]["noise"]
+assert tp["netd_at_temperature_k"] == [300, 300] and tp["receiver_temperature_k"] == 500, tp
+for k, f in zip(tp["netd_k"], (0.35e12, 0.65e12)):
+    b_n = math.sqrt(math.pi / (2 * math.log(2))) * 0.01 * f
+    assert abs(k / ((300 + 500) / math.sqrt(b_n * 0.01)) - 1) < 1e-6, (k, f)
+nd = s["netd"]["noise"]
+assert "netd_at_temperature_k" not in nd and "receiver_temperature_k" not in nd, nd
+# no aperture_diameter_m given: null, not a diameter of 0 m
+assert s["tp"]["aperture_diameter_m"] is None, s["tp"]
 EOF
 # the measured cube's header gives every channel's NETD, not the first one's
 grep -q "NETD per channel 0.5 / 0.2 K" "$work/n2/netd.measured_brightness_temperature.hdr" ||
