@@ -66,6 +66,12 @@ expect "OMP_STACKSIZE=64K" $? 2 "OMP_STACKSIZE=64K"
 [[ ! -e $work/s64 && ! -e $work/o64 ]] || fail "a refused stack wrote OUTDIR"
 OMP_STACKSIZE=2M "$THZMAP" validate "$S" >/dev/null 2>"$work/err"
 expect "OMP_STACKSIZE=2M" $? 0 ""
+# a size without a unit is in kilobytes (OpenMP's rule): 512 is 512 KiB, taken; 100 is
+# 100 KiB, refused
+OMP_STACKSIZE=512 "$THZMAP" validate "$S" >/dev/null 2>"$work/err"
+expect "OMP_STACKSIZE=512" $? 0 ""
+OMP_STACKSIZE=100 "$THZMAP" validate "$S" >/dev/null 2>"$work/err"
+expect "OMP_STACKSIZE=100" $? 2 "gives each thread 100 KiB of stack"
 OMP_NUM_THREADS=100000 "$THZMAP" simulate "$S" -o "$work/many" --photons 20000 \
     --integrator photon-map -q --seed 1 2>"$work/err"
 expect "OMP_NUM_THREADS=100000" $? 0 ""
