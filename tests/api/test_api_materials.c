@@ -88,6 +88,11 @@ int main(int argc, char **argv)
     double lo = 0, hi = 0;
     thz_library_get_range(lib, c, 1, &lo, &hi);
     CHECK(fabs(lo - 0.11) < 1e-12 && fabs(hi - 0.33) < 1e-12, "%g to %g THz", lo, hi);
+    /* the data's whole range: from the first row's start to the last row's end (concrete's
+     * rows: 0.001 to 0.1 and 0.11 to 0.33 THz, as thzmap materials lists them) */
+    CHECK(info.has_data_range && fabs(info.data_from_thz - 0.001) < 1e-12 &&
+              fabs(info.data_to_thz - 0.33) < 1e-12,
+          "data range %d: %g to %g THz", info.has_data_range, info.data_from_thz, info.data_to_thz);
     CHECK(thz_library_in_range(lib, c, 0.2e12) && !thz_library_in_range(lib, c, 0.105e12) &&
               !thz_library_in_range(lib, c, 1e12),
           "P.2040 coverage");
