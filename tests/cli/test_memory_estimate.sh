@@ -50,5 +50,16 @@ p = subprocess.run([T, "simulate", os.path.join(base, "scene.json"), "-o", os.pa
 assert p.returncode == 2, (p.returncode, p.stderr)
 assert "but this process may have" in p.stderr and "ulimit -v" in p.stderr, p.stderr
 assert not os.path.exists(os.path.join(work, "big"))
+
+# the estimate's line says what the process may have in binary units: 4 GiB under
+# ulimit -v 4194304 (KiB), 879 MiB under 900000 (900000 / 1024 = 878.9)
+for kib, said in ((4194304, "of 4 GiB"), (900000, "of 879 MiB")):
+    def limit_to(kib=kib):
+        resource.setrlimit(resource.RLIMIT_AS, (kib << 10, resource.RLIM_INFINITY))
+    p = subprocess.run([T, "simulate", os.path.join(base, "scene.json"), "-o",
+                        os.path.join(work, "est"), "--threads", "2"],
+                       capture_output=True, text=True, preexec_fn=limit_to, timeout=120)
+    line = [l for l in p.stderr.splitlines() if "estimate:" in l]
+    assert p.returncode == 0 and line and line[0].endswith(said), (kib, p.returncode, p.stderr)
 print("ok")
 PY
