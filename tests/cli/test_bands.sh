@@ -76,6 +76,11 @@ names=[c['name'] for c in d['classes']]; assert names==['A','B','background'], n
 # objects varied together once made it look so)
 $PY -c "import json; n=json.load(open('$work/t/bands.json'))['nuisances']; \
 assert not n['air_temperature_varied'], n" || fail "air temperature 'varied' in a scene without air"
+# the nuisances not given take their documented defaults: +-2 K for the targets and for the
+# rest, the humidity +-0.2 of itself, the thickness and the angle not varied
+$PY -c "import json; n=json.load(open('$work/t/bands.json'))['nuisances']; \
+assert (n['target_temperature_range_k'], n['ambient_temperature_range_k'], n['humidity_range'], \
+n['thickness_range'], n['angle_range_deg']) == (2, 2, 0.2, 0, 0), n" || fail "default nuisances"
 
 # a feature across the 556.9 GHz water line: dry air lets the choice sit on the line,
 # humid air moves it off (within the feature, 0.52-0.60 THz)
