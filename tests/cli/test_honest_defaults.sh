@@ -106,6 +106,14 @@ worst = max((o["p95_stderr_k"], o["name"]) for c in d["channels"] for o in c["ob
             if o["pixels"] > 0)
 assert m and m.group(1) == worst[1] and abs(float(m.group(2)) - worst[0]) <= 5e-3 * worst[0], \
     (last, worst)
+# the line before it gives the worst median and the worst 95th percentile over the
+# channels, each in its place
+first = open(sys.argv[2]).read().splitlines()[-2]
+m = re.search(r"pixel standard error: median <= ([0-9.e+-]*) K, 95th percentile <= ([0-9.e+-]*) K",
+              first)
+want = (max(c["median_stderr_k"] for c in d["channels"]),
+        max(c["p95_stderr_k"] for c in d["channels"]))
+assert m and all(abs(float(g) - w) <= 5e-3 * w for g, w in zip(m.groups(), want)), (first, want)
 assert d["integrator"] == "path", d["integrator"]
 assert d["target_noise_k"] == 0.1 and d["target_noise_source"] == "default", d["target_noise_k"]
 for c in d["channels"]:
