@@ -96,6 +96,20 @@ CASES = [
     ("channel_range_reversed",
      [(["channels"], {"from_thz": 1.2, "to_thz": 0.2, "count": 3, "relative_width": 0.01})],
      "channels.to_thz: expected a number > from_thz"),
+    # an evenly spaced range needs distinct ends (to_thz == from_thz with count 2 gave two
+    # channels at one frequency), and count 1 a single one (to_thz != from_thz was taken)
+    ("channel_range_same_ends",
+     [(["channels"], {"from_thz": 0.35, "to_thz": 0.35, "count": 2, "relative_width": 0.01})],
+     "channels.to_thz: expected a number > from_thz (0.35), got 0.35"),
+    ("channel_range_one_two_ends",
+     [(["channels"], {"from_thz": 0.35, "to_thz": 0.5, "count": 1, "relative_width": 0.01})],
+     "channels.to_thz: with count 1, to_thz must equal from_thz (0.35)"),
+    # frequency_thz beside a measured response lies where the response is > 0: above its
+    # top as well as below its bottom
+    ("channel_frequency_above_response",
+     [(["channels", 0], {"frequency_thz": 0.4, "response": [[0.34, 1], [0.36, 1]]})],
+     "channels[0].frequency_thz: expected a frequency where the response is > 0 (0.34 to "
+     "0.36 THz), got 0.4"),
     ("materials_missing", [(["materials"], DELETE)], "materials: missing key"),
     ("materials_empty", [(["materials"], {})], "materials: expected at least one material"),
     ("reflectivity_above_one", [(["materials", "wall", "reflectivity"], 1.5)],
@@ -118,6 +132,12 @@ CASES = [
     ("emissivity_plus_reflectivity_table",
      [(["materials", "paint", "emissivity"], [[0.1, 0.5], [1.0, 0.9]])],
      "materials.paint.emissivity: emissivity + reflectivity must not exceed 1"),
+    # eps + R checked at the emissivity table's own points: its peak at 0.5 THz (0.95 + 0.1)
+    # lies between none of R's (a constant), and not at 1 THz either
+    ("emissivity_table_peak",
+     [(["materials", "wall", "emissivity"], [[0.2, 0.3], [0.5, 0.95], [1.0, 0.3]])],
+     "materials.wall.emissivity: emissivity + reflectivity must not exceed 1, got 0.95 + 0.1 "
+     "= 1.05 at 0.5 THz"),
     ("emissivity_plus_index_reflectance",
      [(["format"], "thzmap-scene/1.1"),
       (["materials", "wall"], {"refractive_index": [10, 0], "emissivity": 0.5})],
@@ -174,6 +194,14 @@ CASES = [
      "unknown_column.csv: unknown column 'reflectance'"),
     ("material_file_decreasing", [(["materials", "wall"], {"file": "materials/decreasing.csv"})],
      "decreasing.csv:3: row 2: frequencies must increase strictly"),
+    # a table's frequencies increase strictly (a repeated one is a step of no width) and are > 0
+    ("material_file_repeated_frequency",
+     [(["materials", "wall"], {"file": "materials/repeated_frequency.csv"})],
+     "repeated_frequency.csv:4: row 2: frequencies must increase strictly, got 0.4 THz after "
+     "0.4 THz"),
+    ("material_file_zero_frequency",
+     [(["materials", "wall"], {"file": "materials/zero_frequency.csv"})],
+     "zero_frequency.csv:2: row 1, column 'frequency_thz': expected a number > 0, got 0"),
     ("material_file_out_of_range",
      [(["materials", "wall"], {"file": "materials/out_of_range.csv"})],
      "out_of_range.csv:3: row 2, column 'reflectivity': expected a number in [0, 1], got 1.2"),
@@ -261,6 +289,19 @@ CASES = [
      "objects[1].shape.segments: expected a whole number from 3"),
     ("cylinder_fractional_segments", [(["objects", 1, "shape", "segments"], 8.5)],
      "objects[1].shape.segments: expected a whole number from 3"),
+    # a whole number written as a real is held to the range too
+    ("cylinder_segments_real_too_many", [(["objects", 1, "shape", "segments"], 2e6)],
+     "objects[1].shape.segments: expected a whole number from 3 to 1000000, got 2e+06"),
+    # every size of every shape > 0 (a negative one mirrors the shape, turning its normals)
+    ("cylinder_negative_height", [(["objects", 1, "shape", "height_m"], -0.75)],
+     "objects[1].shape.height_m: expected a number > 0, got -0.75"),
+    ("rectangle_negative_size",
+     [(["objects", 1, "shape"], {"type": "rectangle", "size_m": [-1, 1]})],
+     "objects[1].shape.size_m[0]: expected a number > 0, got -1"),
+    # a mesh whose every triangle has its corners on one line has no surface
+    ("mesh_no_area",
+     [(["objects", 1, "shape"], {"type": "mesh", "file": "../meshes/no_area.obj"})],
+     "objects[1].shape: the shape has no triangles of non-zero area"),
     ("sphere_too_many_subdivisions",
      [(["objects", 1, "shape"], {"type": "sphere", "radius_m": 1, "subdivisions": 12})],
      "objects[1].shape.subdivisions: expected a whole number from 0 to 8"),
@@ -330,6 +371,15 @@ CASES = [
      "photons.per_channel: expected a whole number from 1"),
     ("photons_fractional", [(["photons"], {"per_channel": 1.5})],
      "photons.per_channel: expected a whole number from 1"),
+    ("photons_beyond_2_53", [(["photons"], {"per_channel": 9007199254740993})],
+     "photons.per_channel: expected a whole number from 1 to 9007199254740992, got "
+     "9007199254740993"),
+    ("photons_seed_real_beyond_int64", [(["photons"], {"seed": 1e19})],
+     "photons.seed: expected a whole number from 0 to 9223372036854775807, got 1e+19"),
+    ("render_max_seconds_zero", [(["render"], {"target_noise_k": 0.1, "max_seconds": 0})],
+     "render.max_seconds: expected a number > 0, got 0"),
+    ("render_target_zero", [(["render"], {"target_noise_k": 0})],
+     "render.target_noise_k: expected a number > 0, got 0"),
     ("photons_gather_min_one", [(["photons"], {"gather_min_photons": 1})],
      "photons.gather_min_photons: expected a whole number from 2"),
     ("photons_min_power_one", [(["photons"], {"min_relative_power": 1})],
@@ -387,6 +437,9 @@ CASES = [
      [(["format"], "thzmap-scene/1.1"), (["sensors", 0, "aperture_diameter_m"], 1e200)],
      "sensors[0].aperture_diameter_m: expected a number in [1e-06, 1000], got 1e+200"),
     ("object_too_far", [(["objects", 1, "transform"], {"translate_m": [0, 2e9, 0]})],
+     "objects[1].transform: the object reaches 2e+09 m from the origin; scenes must lie "
+     "within 1e+09 m of it"),
+    ("object_too_far_negative", [(["objects", 1, "transform"], {"translate_m": [0, 0, -2e9]})],
      "objects[1].transform: the object reaches 2e+09 m from the origin; scenes must lie "
      "within 1e+09 m of it"),
     ("sensor_too_far", [(["sensors", 0, "position_m"], [0, -0.45, 1e30])],
