@@ -46,6 +46,36 @@ static void test_order(void **state)
     assert_point(w, 0, 1, 0, 1e-15); /* x -> y about z */
 }
 
+/* scene-format.md: multiples of 90 degrees are exact. Each angle (any whole turn added,
+ * either sign) against its hand-written matrix, bit for bit: cos 90 deg in double is
+ * 6e-17, not 0 (taking that branch out passed the 1e-15 tolerances above), and 180 and
+ * 270 deg read as 0 and 90 (a quarter count taken mod 2) passed every test, whose
+ * angles were 90 deg. */
+static void test_quarter_turns_exact(void **state)
+{
+    (void)state;
+    const double angles[] = {0, 90, 180, 270, -90, -180, 450, 720, -630};
+    const double one[3] = {1, 1, 1}, zero[3] = {0, 0, 0};
+    for (size_t i = 0; i < sizeof angles / sizeof angles[0]; i++) {
+        long k = ((long)(angles[i] / 90) % 4 + 4) % 4; /* quarter turns, 0 .. 3 */
+        const double c[4] = {1, 0, -1, 0}, s[4] = {0, 1, 0, -1};
+        for (int axis = 0; axis < 3; axis++) {
+            double r[3] = {0, 0, 0};
+            r[axis] = angles[i];
+            scene_transform tf = transform_make(one, r, zero);
+            /* the axis after this one goes to c of itself + s of the one after it */
+            int a = (axis + 1) % 3, b = (axis + 2) % 3;
+            double p[3] = {0, 0, 0}, want[3] = {0, 0, 0};
+            p[a] = 1.0;
+            want[a] = c[k];
+            want[b] = s[k];
+            transform_apply_point(&tf, p, p);
+            for (int j = 0; j < 3; j++)
+                assert_true(p[j] == want[j]);
+        }
+    }
+}
+
 static void test_general_angles(void **state)
 {
     (void)state;
@@ -105,9 +135,8 @@ static void test_identity(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_order),
-        cmocka_unit_test(test_general_angles),
-        cmocka_unit_test(test_mirror_flips_winding),
+        cmocka_unit_test(test_order),          cmocka_unit_test(test_quarter_turns_exact),
+        cmocka_unit_test(test_general_angles), cmocka_unit_test(test_mirror_flips_winding),
         cmocka_unit_test(test_identity),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
