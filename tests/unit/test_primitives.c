@@ -77,6 +77,33 @@ static void check_box_tangents(const thz_mesh *m)
         check_tangent(m, t, fabs(m->normals[3 * t]) > 0.5 ? y : x);
 }
 
+/* scene-format.md: Ward's tangent runs radially on a disk and a cylinder's caps:
+ * triangles t0 .. t0 + n - 1, every other one from t0 when `step` is 2, each at height
+ * z, have their first edge along the line from the axis through its centroid. (A disk,
+ * and caps, listed from the rim, the tangent along the circumference, passed every
+ * test.) */
+static void check_radial_tangents(const thz_mesh *m, size_t t0, size_t step, size_t n, double z)
+{
+    for (size_t i = 0; i < n; i++) {
+        size_t t = t0 + step * i;
+        double c[3] = {0, 0, 0};
+        for (int v = 0; v < 3; v++)
+            for (int k = 0; k < 3; k++)
+                c[k] += m->positions[3 * m->indices[3 * t + (size_t)v] + (size_t)k] / 3.0;
+        assert_true(fabs(c[2] - z) < 1e-6);
+        double len = hypot(c[0], c[1]);
+        const double radial[3] = {c[0] / len, c[1] / len, 0.0};
+        /* the first edge from the centre to the rim: at an angle of pi / n at most from
+         * the centroid's direction, where one along the rim is at pi / 2 */
+        const float *a = &m->positions[3 * m->indices[3 * t]];
+        const float *b = &m->positions[3 * m->indices[3 * t + 1]];
+        double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        double el = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+        double cosang = fabs(e[0] * radial[0] + e[1] * radial[1] + e[2] * radial[2]) / el;
+        assert_true(cosang >= cos(M_PI / (double)n) - 1e-6);
+    }
+}
+
 static void check_padding(const thz_mesh *m)
 {
     for (int k = 0; k < 4; k++)
@@ -143,6 +170,8 @@ static void test_cylinder(void **state)
         check_closed(&m);
         check_padding(&m);
         assert_true(fabs(m.bbox_min_m[2]) < 1e-7 && fabs(m.bbox_max_m[2] - h) < 1e-7);
+        check_radial_tangents(&m, 2 * n, 2, n, 0.0);   /* the bottom cap */
+        check_radial_tangents(&m, 2 * n + 1, 2, n, h); /* the top cap */
         mesh_fini(&m);
 
         assert_int_equal(primitive_cylinder(&m, r, h, false, n, NULL), THZ_OK);
@@ -235,6 +264,7 @@ static void test_disk(void **state)
         check_normals(&m, NULL, up);
         assert_int_equal(winding_conflicts(&m), 0);
         check_padding(&m);
+        check_radial_tangents(&m, 0, 1, n, 0.0);
         mesh_fini(&m);
     }
 }
