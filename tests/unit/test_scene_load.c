@@ -13,6 +13,7 @@
 
 #include <cmocka.h>
 
+#include "physics/brdf.h"
 #include "scene/scene.h"
 #include "scene_load_helpers.h"
 
@@ -409,6 +410,33 @@ static void test_sensor_vectors_of_any_scale(void **state)
     }
 }
 
+/* scene-format.md ("Reflection"): Ward's alpha_x is the spread along the tangent (a
+ * rectangle's: x), alpha_y across it. Seen at normal incidence, a lobe of alpha_x 0.5,
+ * alpha_y 0.05 reflects far more towards a direction tilted 20 degrees along x than
+ * along y (exp(-0.12) against exp(-12) in Ward's exponent). The loader handing the
+ * table alpha_y, alpha_x (a mutant) passed every test: every brushed surface would have
+ * been brushed across. */
+static void test_ward_alpha_x_along_tangent(void **state)
+{
+    (void)state;
+    thz_scene *s = load_ok(
+        HEAD CHANNELS "\"materials\": {\"m\": {\"reflectivity\": 0.5, \"reflection\": {\"model\": "
+                      "\"ward\", \"alpha_x\": 0.5, \"alpha_y\": 0.05}}}, " OBJECT(
+                          "{\"type\": \"rectangle\", \"size_m\": [1, 1]}") SENSORS "}");
+    const thz_object *o = &s->objects[0];
+    optics_point op = scene_object_optics(s, o, 0.35e12);
+    brdf_lobe lobe;
+    scene_object_lobe(s, o, &op, &lobe);
+    brdf_frame f = scene_triangle_frame(o, 0, 0);
+    assert_true(f.t.x == 1.0 && f.n.z == 1.0); /* the rectangle's tangent x, normal z */
+    double a = 20.0 * M_PI / 180.0;
+    vec3 wi = v3(0, 0, 1), along = v3(sin(a), 0, cos(a)), across = v3(0, sin(a), cos(a));
+    double fx = brdf_eval(&lobe, &f, wi, along), fy = brdf_eval(&lobe, &f, wi, across);
+    if (!(fx > 3.0 * fy))
+        fail_msg("f along the tangent %g, across it %g", fx, fy);
+    thz_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -424,6 +452,7 @@ int main(void)
         cmocka_unit_test(test_sensor_model),
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_sensor_vectors_of_any_scale),
+        cmocka_unit_test(test_ward_alpha_x_along_tangent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
