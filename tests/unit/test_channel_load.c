@@ -1,7 +1,8 @@
 /* The loader's measured channel responses: inline tables and CSV files (centre given or
  * the response-weighted mean, weights as given), and the refusals with their
  * JSON paths or file:line (negative weight, all zero, not ascending, too few points, a
- * missing file, a wrong column, two responses, none). */
+ * missing file, a wrong column, two responses, none), the limit of 4096 channels in a
+ * list, and a range's last channel at to_thz exactly. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -17,7 +18,8 @@
 
 /* A scene whose channels are those between the two. */
 #define CHANNELS_OPEN HEAD "\"channels\": ["
-#define CHANNELS_CLOSE "], " MATERIALS OBJECT(BOX) SENSORS "}"
+#define CHANNELS_REST ", " MATERIALS OBJECT(BOX) SENSORS "}"
+#define CHANNELS_CLOSE "]" CHANNELS_REST
 
 static void test_tables(void **state)
 {
@@ -89,11 +91,49 @@ static void test_refusals(void **state)
              "channels[0].frequency_thz: missing key");
 }
 
+/* scene-format.md: at most 4096 channels, in a list as in a range; a range's ends are
+ * the given numbers exactly (0.3 + (0.9 - 0.3) is 0.9000000000000001). A list's limit
+ * doubled, and the range's last channel left at from + (to - from) (mutants), passed
+ * every test. */
+static void test_channel_count_and_range_ends(void **state)
+{
+    (void)state;
+    size_t size = 4097 * 80 + sizeof CHANNELS_OPEN CHANNELS_CLOSE;
+    char *json = test_malloc(size);
+    for (unsigned n = 4096; n <= 4097; n++) {
+        size_t used = (size_t)snprintf(json, size, "%s", CHANNELS_OPEN);
+        for (unsigned i = 0; i < n; i++) {
+            used += (size_t)snprintf(json + used, size - used, i ? "," : "");
+            used += (size_t)snprintf(json + used, size - used,
+                                     "{\"frequency_thz\": 0.35, \"relative_width\": 0.01, "
+                                     "\"name\": \"c%04u\"}",
+                                     i);
+        }
+        snprintf(json + used, size - used, "%s", CHANNELS_CLOSE);
+        if (n == 4096) {
+            thz_scene *s = load_ok(json);
+            assert_int_equal(s->n_channels, 4096);
+            scene_destroy(s);
+        } else {
+            load_bad(json, "channels: expected at most 4096 channels, got 4097");
+        }
+    }
+    /* a range instead of a list: CHANNELS_REST, without the list's closing bracket */
+    snprintf(json, size, "%s",
+             HEAD "\"channels\": {\"from_thz\": 0.3, \"to_thz\": 0.9, \"count\": 2, "
+                  "\"relative_width\": 0.01}" CHANNELS_REST);
+    thz_scene *s = load_ok(json);
+    test_free(json);
+    assert_true(s->channels[0].center_hz == 0.3e12 && s->channels[1].center_hz == 0.9e12);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_tables),
         cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_channel_count_and_range_ends),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
