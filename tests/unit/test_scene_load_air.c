@@ -200,6 +200,27 @@ static void test_frequency_range_ends(void **state)
     assert_int_equal(frequency_warnings("10.01"), 1);
 }
 
+/* A sensor inside a closed solid is warned about, one outside it not, even where it lies
+ * within the solid's bounding box and the check's ray from it (oblique, towards +x +y +z)
+ * crosses the solid twice: here a sphere of radius 1 and a sensor at its bounding box's
+ * corner, 1.56 m from its centre. Counting any crossing as inside (a mutant of
+ * check_inside's parity) passed every test, and warned that such a sensor sees the
+ * sphere from inside. */
+#define SPHERE_SCENE(pos)                                                                          \
+    HEAD CHANNELS MATERIALS OBJECT(                                                                \
+        "{\"type\": \"sphere\", \"radius_m\": 1}") "\"sensors\": [{\"name\": \"c\", "              \
+                                                   "\"position_m\": " pos                          \
+                                                   ", \"direction\": [1, 1, 1], "                  \
+                                                   "\"fov_deg\": 40, \"resolution\": [16, 8]}]}"
+
+static void test_sensor_inside_by_parity(void **state)
+{
+    (void)state;
+    assert_int_equal(
+        load_count_warnings(SPHERE_SCENE("[-0.9, -0.9, -0.9]"), "is inside object", NULL), 0);
+    assert_int_equal(load_count_warnings(SPHERE_SCENE("[0, 0, 0.1]"), "is inside object", NULL), 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -209,6 +230,7 @@ int main(void)
         cmocka_unit_test(test_kirchhoff_warning_threshold),
         cmocka_unit_test(test_atmosphere_extent_warnings),
         cmocka_unit_test(test_frequency_range_ends),
+        cmocka_unit_test(test_sensor_inside_by_parity),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
