@@ -200,6 +200,34 @@ static void test_frequency_range_ends(void **state)
     assert_int_equal(frequency_warnings("10.01"), 1);
 }
 
+/* The humidity keys mean what scene-format.md says: h2o_vmr 0.01 at 296 K and 1013.25 hPa
+ * is 0.01 x 101325 Pa x 18.015 g/mol / (8.3145 J/(mol K) x 296 K) = 7.417 g/m^3 of water
+ * vapour (the ideal gas), and water_vapour_g_m3 7.5 is 7.5 g/m^3. The loader's kinds of
+ * the keys water_vapour_g_m3 and h2o_vmr swapped (a mutant) passed every test, none of
+ * whose scenes gave those keys: 0.01 of vapour was read as 0.01 g/m^3, dry air. */
+static void test_humidity_keys(void **state)
+{
+    (void)state;
+    static const char *const keys[2] = {"\"h2o_vmr\": 0.01", "\"water_vapour_g_m3\": 7.5"};
+    double rho[2];
+    for (int k = 0; k < 2; k++) {
+        char json[2048];
+        snprintf(json, sizeof json,
+                 "%s%s%s%s%s, \"atmosphere\": {\"model\": \"itu-p676\", \"temperature_k\": 296, "
+                 "\"pressure_hpa\": 1013.25, %s}}",
+                 HEAD, CHANNELS, MATERIALS, OBJECT(BOX), SENSORS, keys[k]);
+        thz_scene *s = load_ok(json);
+        rho[k] = atm_air_h2o_density_g_m3(&s->atmosphere.air);
+        if (k == 0)
+            assert_true(fabs(atm_air_h2o_vmr(&s->atmosphere.air) - 0.01) < 1e-12);
+        thz_scene_destroy(s);
+    }
+    double ideal = 0.01 * 101325.0 * 18.015 / (8.3145 * 296.0);
+    if (!(fabs(rho[0] - ideal) < 0.005 * ideal && fabs(rho[1] - 7.5) < 1e-9))
+        fail_msg("water vapour %g g/m^3 from h2o_vmr 0.01 (ideal gas %g), %g from 7.5 g/m^3",
+                 rho[0], ideal, rho[1]);
+}
+
 /* A sensor inside a closed solid is warned about, one outside it not, even where it lies
  * within the solid's bounding box and the check's ray from it (oblique, towards +x +y +z)
  * crosses the solid twice: here a sphere of radius 1 and a sensor at its bounding box's
@@ -231,6 +259,7 @@ int main(void)
         cmocka_unit_test(test_atmosphere_extent_warnings),
         cmocka_unit_test(test_frequency_range_ends),
         cmocka_unit_test(test_sensor_inside_by_parity),
+        cmocka_unit_test(test_humidity_keys),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
