@@ -178,6 +178,16 @@ static void test_p2040(void **state)
     expect_rel(im, 17.98 * sigma / 50.0, 1e-3, "the Recommendation's 17.98 sigma / f_GHz");
     permittivity_eval(&m, 200e9, &re, &im);
     expect_rel(re, 5.17, 1e-15, "second row");
+    /* outside every row, the row with the nearest end (permittivity.h): a Gaussian
+     * band's quadrature reaches 6 sigma, beyond the +-2 FWHM the scene's check covers */
+    permittivity_eval(&m, 400e9, &re, &im);
+    expect_rel(re, 5.17, 1e-15, "above the rows: the nearest, 110-330 GHz");
+    permittivity_eval(&m, 0.5e9, &re, &im);
+    expect_rel(re, 5.24, 1e-15, "below the rows: the nearest, 1-100 GHz");
+    permittivity_eval(&m, 104e9, &re, &im);
+    expect_rel(re, 5.24, 1e-15, "in the gap, nearer 100 GHz");
+    permittivity_eval(&m, 107e9, &re, &im);
+    expect_rel(re, 5.17, 1e-15, "in the gap, nearer 110 GHz");
     assert_true(permittivity_covers(&m, 2e9, 99e9));
     assert_true(permittivity_covers(&m, 120e9, 330e9));
     assert_false(permittivity_covers(&m, 95e9, 105e9)); /* the gap */
@@ -199,6 +209,10 @@ static void test_p2040(void **state)
     expect_rel(re, 2.1183, 1e-15, "overlap: first matching row");
     permittivity_eval(&w, 200e9, &re, &im);
     expect_rel(re, 1.82, 1e-15, "overlap: first matching row in file order");
+    /* a row holds its ends (scene-format.md: the first row that holds the frequency):
+     * 100 GHz is the 0.001-100 GHz row's, not the 100-400 GHz one's */
+    permittivity_eval(&w, 100e9, &re, &im);
+    expect_rel(re, 1.99, 1e-15, "a row's upper end is inside it");
 }
 
 static void test_table_and_copy(void **state)
