@@ -114,6 +114,25 @@ status=$?
 grep -q 'far.json: materials.m.library: ITU-R P.2040 gives "wood" only for 0.001 to 100 GHz, 110 to 330 GHz, 100 to 400 GHz, but channel "0.500 THz" (band 490 to 510 GHz' "$work/err" ||
     fail "wood at 0.5 THz: message: $(cat "$work/err")"
 
+# --- an entry of the library that tables n and k (a data directory's library.json): its
+#     data range is the table's, printed with what is done beyond it; n and k between the
+#     points interpolated linearly (physics.md "Complex indices") ----------------------------
+cp -r "$REPO/data" "$work/dt"
+python3 - "$work/dt/materials/library.json" <<'PY' || fail "cannot add a tabled entry"
+import json, sys
+lib = json.load(open(sys.argv[1]))
+lib["materials"]["tabled"] = {"description": "an index from a table", "basis": "measured",
+                              "source": "test_materials.sh",
+                              "refractive_index": [[0.2, 1.5, 0.01], [1, 1.6, 0.03], [2, 2, 0.05]]}
+json.dump(lib, open(sys.argv[1], "w"))
+PY
+THZMAP_DATA_DIR="$work/dt" "$THZMAP" materials tabled --at-thz 0.6 >"$work/tabled" 2>"$work/err" ||
+    fail "materials tabled: exit $?: $(cat "$work/err")"
+grep -qx 'data: 0.2 to 2 THz (end values held beyond the ends)' "$work/tabled" ||
+    fail "tabled: no data range: $(cat "$work/tabled")"
+awk '$1 == "0.6" && $2 == 1.55 && $3 == 0.02 { ok = 1 } END { exit !ok }' "$work/tabled" ||
+    fail "tabled: n, k at 0.6 THz are not 1.55, 0.02: $(cat "$work/tabled")"
+
 # --- a data directory whose JSON files are a FIFO or a directory: refused, no hang; a
 #     damaged installation is an I/O error (exit 1), not bad input -------------------------
 cp -r "$REPO/data" "$work/dd"
