@@ -213,6 +213,18 @@ static void test_kirchhoff_violation(void **state)
         assert_true(v >= worst - 1e-15);
         assert_true(v <= worst + 1e-3); /* the scan stops at mu = 1e-5 */
     }
+    /* an index solid (n = 1.5, k = 0) with an explicit eps: A(mu) = 1 - R(mu) runs from
+     * 0 at grazing incidence to 1 - ((n - 1)/(n + 1))^2 = 0.96 at normal incidence, so
+     * the worst |eps - A| is at an end: eps itself, or 0.96 - eps (the Gauss-Legendre
+     * nodes alone stop at mu = 6e-4 and 0.9994, where A is 3e-3 and 1e-6 short of them) */
+    optics_point idx = {.has_index = true,
+                        .n = 1.5,
+                        .freq_hz = 0.5e12,
+                        .emissivity = 0.5,
+                        .explicit_emissivity = true};
+    assert_true(fabs(optics_kirchhoff_violation(&idx) - 0.5) < 1e-7);
+    idx.emissivity = 0.0;
+    assert_true(fabs(optics_kirchhoff_violation(&idx) - 0.96) < 1e-12);
 }
 
 static double next_uniform(void *ctx)
