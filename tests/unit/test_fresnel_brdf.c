@@ -99,6 +99,13 @@ static void test_means(void **state)
         assert_true(fabs(optics_mean_reflectance(&cases[c]) - sr) <= 1e-10);
         assert_true(fabs(optics_mean_transmission(&cases[c]) - st) <= 1e-10);
         assert_true(fabs(optics_mean_emissivity(&cases[c]) - (1 - sr - st)) <= 1e-10);
+        /* the means optics_prepare caches (the renderers' tables, the API's optics) */
+        optics_point prepared = cases[c];
+        optics_prepare(&prepared);
+        assert_true(prepared.means_ready);
+        assert_true(fabs(optics_mean_reflectance(&prepared) - sr) <= 1e-10);
+        assert_true(fabs(optics_mean_transmission(&prepared) - st) <= 1e-10);
+        assert_true(fabs(optics_mean_emissivity(&prepared) - (1 - sr - st)) <= 1e-10);
     }
 }
 
