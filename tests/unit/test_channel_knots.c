@@ -233,6 +233,27 @@ static void test_knots_bounds(void **state)
     assert_true(q.n > CHANNEL_QUADRATURE_MAX_KNOTS);
     assert_true(q.n <= channel_quadrature_max_nodes(&ch, CHANNEL_QUADRATURE_NODES, many, false));
     channel_quadrature_fini(&q);
+    /* between one and two caps' worth inside the band (physics.md: at most 512 points a
+     * band, more thinned evenly): every second knot is a node, 500 of the 1000 (spaced
+     * unevenly, so that no skipped knot falls on a piece's midpoint) */
+    const size_t some = 1000;
+    for (size_t i = 0; i < some; i++) {
+        double x = (double)(i + 1) / (double)(some + 1);
+        k[i] = 0.8e12 + 0.4e12 * x * x;
+    }
+    assert_int_equal(
+        channel_quadrature_init_knots(&q, &ch, CHANNEL_QUADRATURE_NODES, k, some, NULL, &err),
+        THZ_OK);
+    check_rule(&q, NULL, 0);
+    size_t as_nodes = 0;
+    for (size_t i = 0, j = 0; i < some; i++) {
+        while (j < q.n && q.freq_hz[j] < k[i])
+            j++;
+        as_nodes += j < q.n && q.freq_hz[j] == k[i];
+    }
+    assert_true(as_nodes == some / 2);
+    assert_true(q.n <= channel_quadrature_max_nodes(&ch, CHANNEL_QUADRATURE_NODES, some, false));
+    channel_quadrature_fini(&q);
     free(k);
 
     const double close[2] = {0.98e12, nextafter(0.98e12, 1e13)};
