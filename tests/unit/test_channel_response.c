@@ -149,6 +149,8 @@ static void test_triangles_and_trapezoid(void **state)
     assert_int_equal(channel_set_response(&bad, 2, f2, zero, 0.0, &err), THZ_ERR_INPUT);
     assert_int_equal(channel_set_response(&bad, 2, f2, neg, 0.0, &err), THZ_ERR_INPUT);
     assert_int_equal(channel_set_response(&bad, 2, down, tw, 0.0, &err), THZ_ERR_INPUT);
+    const double same[] = {1e12, 1e12, 2e12}, w3[] = {1, 1, 1}; /* strictly increasing */
+    assert_int_equal(channel_set_response(&bad, 3, same, w3, 0.0, &err), THZ_ERR_INPUT);
     assert_int_equal(channel_set_response(&bad, 1, f2, tw + 1, 0.0, &err), THZ_ERR_INPUT);
     assert_false(channel_has_response(&bad));
 }
