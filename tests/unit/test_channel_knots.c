@@ -179,6 +179,31 @@ static void test_structure(void **state)
     channel_quadrature_fini(&refined);
 }
 
+/* A test function no panel resolves (a period of 6 MHz against base panels of 0.6 GHz):
+ * the refinement spends its whole budget, 1604 splits of two nodes each (physics.md),
+ * and stays within the memory estimate's bound. */
+static void wiggle_structure(double nu, void *ctx, double *values)
+{
+    (void)ctx;
+    values[0] = sin(nu * 1e-6);
+}
+
+static void test_structure_budget(void **state)
+{
+    (void)state;
+    const thz_channel ch = {.name = "air", .center_hz = 0.5e12, .relative_width = 0.05};
+    channel_structure s = {1, wiggle_structure, NULL};
+    channel_quadrature q;
+    thz_error err;
+    assert_int_equal(
+        channel_quadrature_init_knots(&q, &ch, CHANNEL_QUADRATURE_NODES, NULL, 0, &s, &err),
+        THZ_OK);
+    check_rule(&q, NULL, 0);
+    assert_int_equal(q.n, CHANNEL_QUADRATURE_NODES + 2 * CHANNEL_QUADRATURE_MAX_SPLITS);
+    assert_true(q.n <= channel_quadrature_max_nodes(&ch, CHANNEL_QUADRATURE_NODES, 0, true));
+    channel_quadrature_fini(&q);
+}
+
 /* A channel so wide (w = 0.5) that nu_c - 6 sigma is below 0 Hz, where the air's
  * transmittance is NaN: the refinement goes where the line is, not into the tail the
  * rule drops (the NaN there split every panel until the budget was spent). */
@@ -267,9 +292,9 @@ static void test_knots_bounds(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_knots_gaussian), cmocka_unit_test(test_knots_table),
-        cmocka_unit_test(test_structure),      cmocka_unit_test(test_structure_wide),
-        cmocka_unit_test(test_knots_bounds),
+        cmocka_unit_test(test_knots_gaussian),   cmocka_unit_test(test_knots_table),
+        cmocka_unit_test(test_structure),        cmocka_unit_test(test_structure_wide),
+        cmocka_unit_test(test_structure_budget), cmocka_unit_test(test_knots_bounds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
