@@ -276,6 +276,79 @@ static void test_ward(void **state)
     brdf_ward_table_destroy(table);
 }
 
+/* Sampling Ward's lobe: E[weight h(wo)] = int f h cos dwo / R(theta_i) (brdf_sample's
+ * weight is f cos / pdf over R), for h = 1 and h peaked at the mirror direction, against
+ * the midpoint rule of brdf_eval, and E[f cos / (brdf_pdf R)] the same as for h = 1; and the lobe
+ * is glossy: s >= min R (a_W <= 1), and at normal incidence f >= s f_W(n, n) = s / (4 pi alpha_x
+ * alpha_y) (physics.md). */
+static double mirror_peak(vec3 wi, vec3 wo)
+{
+    double c = v3_dot(v3(-wi.x, -wi.y, wi.z), wo);
+    return c > 0.0 ? pow(c, 8.0) : 0.0;
+}
+
+static void test_ward_sampling(void **state)
+{
+    (void)state;
+    const double ax = 0.2, ay = 0.45;
+    brdf_ward_table *table = brdf_ward_table_create(ax, ay);
+    assert_non_null(table);
+    brdf_frame f = {.n = v3(0, 0, 1), .t = v3(1, 0, 0), .b = v3(0, 1, 0)};
+    optics_point cases[] = {
+        {.has_index = true, .n = 3.0, .k = 0.5, .freq_hz = 1e12, .lobe = OPTICS_LOBE_WARD},
+        {.reflectivity = 0.7, .lobe = OPTICS_LOBE_WARD},
+    };
+    rng_stream rng;
+    rng_init(&rng, 23, 0, 0, 0);
+    for (size_t c = 0; c < 2; c++) {
+        brdf_lobe l;
+        brdf_lobe_init(&l, &cases[c], table);
+        double r_min = 1.0;
+        for (int i = 0; i <= 1000; i++)
+            r_min = fmin(r_min, optics_reflectance(&cases[c], fmax(i / 1000.0, 1e-3)));
+        assert_true(l.scale >= r_min - 1e-12);
+        vec3 n = v3(0, 0, 1);
+        assert_true(brdf_eval(&l, &f, n, n) >= l.scale / (4 * M_PI * ax * ay));
+        const double mus[] = {0.95, 0.6};
+        for (int t = 0; t < 2; t++) {
+            vec3 wi = dir_at(mus[t], 0.4);
+            double r = optics_reflectance(&cases[c], mus[t]);
+            const int nm = 600, np = 600, draws = 200000;
+            double q[2] = {0.0, 0.0};
+            for (int i = 0; i < nm; i++)
+                for (int j = 0; j < np; j++) {
+                    double mu = (i + 0.5) / nm;
+                    vec3 wo = dir_at(mu, 2 * M_PI * (j + 0.5) / np);
+                    double v = brdf_eval(&l, &f, wi, wo) * mu * (2 * M_PI) / (nm * np) / r;
+                    q[0] += v;
+                    q[1] += v * mirror_peak(wi, wo);
+                }
+            double s[3] = {0.0, 0.0, 0.0}, s2[3] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < draws; k++) {
+                vec3 wo;
+                double w = 0.0;
+                if (!brdf_sample(&l, &f, wi, sampling_uniform, &rng, &wo, &w))
+                    continue;
+                /* and f cos / (pdf R): brdf_pdf is the density drawn from (final-gather's) */
+                double p = brdf_pdf(&l, &f, wi, wo);
+                double x[3] = {w, w * mirror_peak(wi, wo),
+                               brdf_eval(&l, &f, wi, wo) * wo.z / (p * r)};
+                for (int m = 0; m < 3; m++) {
+                    s[m] += x[m];
+                    s2[m] += x[m] * x[m];
+                }
+            }
+            for (int m = 0; m < 3; m++) {
+                double mean = s[m] / draws, se = sqrt((s2[m] / draws - mean * mean) / draws);
+                print_message("ward %zu, mu %.2f, h %d: sampled %.5f +- %.5f, quadrature %.5f\n", c,
+                              mus[t], m, mean, se, q[m % 2]);
+                assert_true(fabs(mean - q[m % 2]) <= 5 * se + 0.005 * q[m % 2]);
+            }
+        }
+    }
+    brdf_ward_table_destroy(table);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -286,6 +359,7 @@ int main(void)
         cmocka_unit_test(test_sample_reflection),
         cmocka_unit_test(test_sample_negligible),
         cmocka_unit_test(test_ward),
+        cmocka_unit_test(test_ward_sampling),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
