@@ -264,6 +264,14 @@ CASES = [
     ("sensor_normalize_too_cold", [(["sensors", 0, "normalize_to_k"], 0.1)],
      "sensors[0].normalize_to_k: expected a temperature >= 0.3427 K (h nu / k T_ref at most 50 "
      "at 0.357 THz"),
+    # the floor is set by the channel whose band reaches highest (0.5 THz at 50 %: 1 THz,
+    # h 1 THz / 50 k = 0.95985 K), not the highest centre (0.8 THz at 1 %: 0.816 THz,
+    # 0.7832 K, which 0.95 K would pass)
+    ("sensor_normalize_wide_band", [(["channels"], [{"frequency_thz": 0.5, "relative_width": 0.5},
+                                                    {"frequency_thz": 0.8, "relative_width": 0.01}]),
+                                    (["sensors", 0, "normalize_to_k"], 0.95)],
+     "sensors[0].normalize_to_k: expected a temperature >= 0.9599 K (h nu / k T_ref at most 50 "
+     "at 1 THz, the top of channel \"0.500 THz\"'s band"),
     # a GHz value given in THz (350 for 0.35) with normalize_to_k given: the refusal says
     # what the warning about channels beyond 10 THz would have said, which it hides
     ("sensor_normalize_ghz_as_thz", [(["channels", 0, "frequency_thz"], 350),
