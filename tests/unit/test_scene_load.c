@@ -55,6 +55,23 @@ static void test_example(void **state)
     thz_scene_destroy(s);
 }
 
+/* How many of m's triangles face away from the point c (normal . (centroid - c) > 0). */
+static size_t faces_away_from(const thz_mesh *m, const double c[3])
+{
+    size_t n = 0;
+    for (size_t t = 0; t < m->n_triangles; t++) {
+        double d = 0.0;
+        for (int a = 0; a < 3; a++) {
+            double centroid = 0.0;
+            for (int v = 0; v < 3; v++)
+                centroid += m->positions[3 * m->indices[3 * t + v] + a] / 3.0;
+            d += m->normals[3 * t + a] * (centroid - c[a]);
+        }
+        n += d > 0.0;
+    }
+    return n;
+}
+
 static void test_defaults_and_range(void **state)
 {
     (void)state;
@@ -67,6 +84,10 @@ static void test_defaults_and_range(void **state)
     assert_true(fabs(s->channels[2].center_hz - 0.6e12) < 1e-3);
     assert_true(s->channels[5].center_hz == 1.2e12);
     assert_int_equal(s->atmosphere.model, ATM_NONE);
+    /* a box's inward defaults to false: all 12 triangles face out (scene-format.md) */
+    const double origin[3] = {0.0, 0.0, 0.0};
+    assert_int_equal(s->objects[0].mesh.n_triangles, 12);
+    assert_int_equal(faces_away_from(&s->objects[0].mesh, origin), 12);
     const thz_sensor *c = &s->sensors[0];
     assert_true(c->aperture_m2 == 1e-2 && c->oversampling == 1 && c->normalize_to_k == 295);
     assert_true(c->up[2] == 1.0);
