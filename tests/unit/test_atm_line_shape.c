@@ -67,6 +67,19 @@ static double lorentz(double d, double g)
     return g / (d * d + g * g);
 }
 
+/* k in hPa cm^3 / K and h / k in K / GHz. */
+#define K_HPA_CM3 1.380649e-19
+#define H_OVER_K 0.0479924307
+
+/* A line's strength at t from its S296, docs/atmosphere.md's scaling: the partition sums'
+ * ratio q296 / qt, the lower state's Boltzmann factor and the stimulated emission's. */
+static double line_strength(double s296, double q296, double qt, double elower_k, double nu0_ghz,
+                            double t)
+{
+    return s296 * q296 / qt * exp(elower_k * (t - 296.0) / (296.0 * t)) *
+           (1.0 - exp(-H_OVER_K * nu0_ghz / t)) / (1.0 - exp(-H_OVER_K * nu0_ghz / 296.0));
+}
+
 static void test_one_h2o_line(void **state)
 {
     (void)state;
@@ -81,7 +94,6 @@ static void test_one_h2o_line(void **state)
             NU0, S296, ELOWER, GAMMA_AIR, GAMMA_SELF, N_AIR, DELTA_AIR);
     assert_int_equal(fclose(f), 0);
 
-    const double k_hpa_cm3 = 1.380649e-19, h_over_k = 0.0479924307; /* K/GHz */
     const double temps_k[] = {296.0, 260.5};
     double worst = 0.0;
     for (int it = 0; it < 2; it++) {
@@ -91,11 +103,10 @@ static void test_one_h2o_line(void **state)
         /* e = 20 hPa: self broadening 8 % of the width */
         assert_int_equal(atm_air_state_init(&air, t, 1000.0, ATM_HUMIDITY_VMR, 0.02, &err), THZ_OK);
         double e = air.h2o_pressure_hpa, p = air.pressure_hpa;
-        double s = S296 * q_h2o(296.0) / q_h2o(t) * exp(ELOWER * (t - 296.0) / (296.0 * t)) *
-                   (1.0 - exp(-h_over_k * NU0 / t)) / (1.0 - exp(-h_over_k * NU0 / 296.0));
-        double amp = e / (k_hpa_cm3 * t) * s / M_PI; /* cm^-1 GHz */
+        double s = line_strength(S296, q_h2o(296.0), q_h2o(t), ELOWER, NU0, t);
+        double amp = e / (K_HPA_CM3 * t) * s / M_PI; /* cm^-1 GHz */
         double g = pow(296.0 / t, N_AIR) * (GAMMA_AIR * (p - e) + GAMMA_SELF * e);
-        double nu = NU0 + DELTA_AIR * (p - e), vvh0 = NU0 * tanh(h_over_k * NU0 / (2.0 * t));
+        double nu = NU0 + DELTA_AIR * (p - e), vvh0 = NU0 * tanh(H_OVER_K * NU0 / (2.0 * t));
         for (int continuum = 0; continuum < 2; continuum++) {
             atm_lines_options o;
             atmosphere_lines_options_default(&o);
@@ -116,7 +127,7 @@ static void test_one_h2o_line(void **state)
                 } else {
                     shape = lorentz(d1, g) + lorentz(d2, g);
                 }
-                double want = 100.0 * amp * shape * fq * tanh(h_over_k * fq / (2.0 * t)) / vvh0;
+                double want = 100.0 * amp * shape * fq * tanh(H_OVER_K * fq / (2.0 * t)) / vvh0;
                 atm_alpha_parts parts;
                 atmosphere_alpha_parts(&lbl, fq * 1e9, &parts);
                 double got = parts.h2o_lines_per_m;
@@ -174,7 +185,6 @@ static void test_one_coupled_o2_line(void **state)
                "1000.0,0,0,1e-3,1e-3,0.8,0,1\n");
     assert_int_equal(fclose(f), 0);
 
-    const double k_hpa_cm3 = 1.380649e-19, h_over_k = 0.0479924307;
     const double temps_k[] = {296.0, 260.5};
     double worst = 0.0;
     for (int it = 0; it < 2; it++) {
@@ -183,14 +193,13 @@ static void test_one_coupled_o2_line(void **state)
         atm_air_state air;
         assert_int_equal(atm_air_state_init(&air, t, 1000.0, ATM_HUMIDITY_VMR, 0.03, &err), THZ_OK);
         double pd = air.pressure_hpa - air.h2o_pressure_hpa, po2 = 0.20946 * pd, r = tref / t;
-        double s = s296 * q_o2(296.0) / q_o2(t) * exp(elower * (t - 296.0) / (296.0 * t)) *
-                   (1.0 - exp(-h_over_k * nu0 / t)) / (1.0 - exp(-h_over_k * nu0 / 296.0));
-        double amp = po2 / (k_hpa_cm3 * t) * s / M_PI;
+        double s = line_strength(s296, q_o2(296.0), q_o2(t), elower, nu0, t);
+        double amp = po2 / (K_HPA_CM3 * t) * s / M_PI;
         double g = pow(296.0 / t, nair) * (gair * (air.pressure_hpa - po2) + gself * po2);
         double y = pd * (y0 + y1 * (r - 1.0)) * pow(r, yx);
         double gg = 1.0 + pd * pd * (g0 + g1 * (r - 1.0)) * pow(r, gx);
         double nu = nu0 + pd * pd * (d0 + d1 * (r - 1.0)) * pow(r, dx);
-        double vvh0 = nu0 * tanh(h_over_k * nu0 / (2.0 * t));
+        double vvh0 = nu0 * tanh(H_OVER_K * nu0 / (2.0 * t));
         atm_lines_options o;
         atmosphere_lines_options_default(&o);
         o.o2_lines_file = none;
@@ -201,7 +210,7 @@ static void test_one_coupled_o2_line(void **state)
         for (size_t i = 0; i < sizeof freqs_ghz / sizeof freqs_ghz[0]; i++) {
             double fq = freqs_ghz[i], a = fq - nu, b = fq + nu;
             double shape = (g * gg + a * y) / (a * a + g * g) + (g * gg - b * y) / (b * b + g * g);
-            double want = 100.0 * amp * shape * fq * tanh(h_over_k * fq / (2.0 * t)) / vvh0;
+            double want = 100.0 * amp * shape * fq * tanh(H_OVER_K * fq / (2.0 * t)) / vvh0;
             atm_alpha_parts parts;
             atmosphere_alpha_parts(&lbl, fq * 1e9, &parts);
             double rel = fabs(parts.o2_per_m / want - 1.0);
@@ -247,14 +256,13 @@ static void test_one_gross_o2_line(void **state)
                "g1_per_mbar2,gx,d0_per_mbar2,d1_per_mbar2,dx,Tref_K\n"
                "118.750341,0,0,1.6835e-03,1.6717e-03,0.80,0,1,0,0,0.8,0,0,1.6,0,0,1.6,300\n");
     assert_int_equal(fclose(f), 0);
-    const double k_hpa_cm3 = 1.380649e-19, h_over_k = 0.0479924307, t = 260.5;
+    const double t = 260.5;
     thz_error err = {0};
     atm_air_state air;
     assert_int_equal(atm_air_state_init(&air, t, 1000.0, ATM_HUMIDITY_VMR, 0.03, &err), THZ_OK);
     double pd = air.pressure_hpa - air.h2o_pressure_hpa, po2 = 0.20946 * pd;
-    double s = s296 * q_o2(296.0) / q_o2(t) * exp(elower * (t - 296.0) / (296.0 * t)) *
-               (1.0 - exp(-h_over_k * nu0 / t)) / (1.0 - exp(-h_over_k * nu0 / 296.0));
-    double amp = po2 / (k_hpa_cm3 * t) * s / M_PI;
+    double s = line_strength(s296, q_o2(296.0), q_o2(t), elower, nu0, t);
+    double amp = po2 / (K_HPA_CM3 * t) * s / M_PI;
     double g = pow(296.0 / t, nair) * (gair * (air.pressure_hpa - po2) + gself * po2);
     atm_lines_options o;
     atmosphere_lines_options_default(&o);
