@@ -211,10 +211,12 @@ class _SeenWarning:
         self.repeats = self.alike = 0
 
     def count(self, frame, same):
-        """Counts frame once, as repeating it to the letter or but for its numbers."""
-        if frame is not None and self.last == frame:
-            return
-        self.last = frame
+        """Counts frame once, as repeating it to the letter or but for its numbers; a
+        warning of no frame (None) each time, leaving the last frame as it was."""
+        if frame is not None:
+            if self.last == frame:
+                return
+            self.last = frame
         if same:
             self.repeats += 1
         else:

@@ -60,12 +60,16 @@ static char *frame_warning_shape(const char *message)
     return out;
 }
 
-/* Counts frame in entry i's frames: once a frame, in its same or alike count. */
+/* Counts frame in entry i's frames: once a frame, in its same or alike count. A warning of
+ * no frame is counted each time and leaves the last frame as it was, so that a frame's
+ * message, the batch's own, and the frame's again count that frame once. */
 static void frame_warning_count(cli_frame_warnings *w, size_t i, size_t frame, bool same)
 {
-    if (frame != CLI_NO_FRAME && w->last[i] == frame)
-        return;
-    w->last[i] = frame;
+    if (frame != CLI_NO_FRAME) {
+        if (w->last[i] == frame)
+            return;
+        w->last[i] = frame;
+    }
     if (same)
         w->repeats[i]++;
     else

@@ -318,6 +318,18 @@ def test_warning_numbers_are_free_standing():
     assert shape == "s.json: objects[3].shape, sensors[12].aperture_m2: # m^#, [2], [#], [#, #]"
 
 
+def test_warning_counted_once_a_frame():
+    # as src/cli/frame_warnings.c counts (tests/unit/test_frame_warnings.c): frame 1, the
+    # batch's own (no frame), frame 1 again is one later frame and one repeat of no frame
+    seen = thzmap.sequence._SeenWarning(0, "disk nearly full")
+    for frame in (1, 1, None, 1, 2):
+        seen.count(frame, True)
+    assert (seen.repeats, seen.alike) == (3, 0)
+    seen.count(3, False)
+    seen.count(3, True)
+    assert (seen.repeats, seen.alike) == (3, 1)
+
+
 def test_batch_movie_warning_names_no_frame(tmp_path):
     # scenes with other sensors: no movies, and the warning saying why belongs to the
     # batch, not to its last frame (as `thzmap batch` prints it)
