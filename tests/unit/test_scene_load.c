@@ -431,6 +431,31 @@ static void test_sensor_vectors_of_any_scale(void **state)
     }
 }
 
+/* An up vector is refused when it is parallel to the viewing direction within 1e-6 rad
+ * (docs/scene-format.md), where the picture's right-hand side direction x up has no
+ * reliable direction; 1e-5 rad off is a camera like any other, its up the direction's
+ * perpendicular. A tolerance of 1e-12 (a mutant) passed every test. */
+static void test_sensor_up_nearly_parallel(void **state)
+{
+    (void)state;
+    const char *ups[2] = {"1e-7", "1e-5"};
+    for (int k = 0; k < 2; k++) {
+        char json[1024];
+        snprintf(json, sizeof json,
+                 HEAD CHANNELS MATERIALS OBJECT(
+                     BOX) "\"sensors\": [{\"name\": \"c\", \"position_m\": [0, -5, 0], "
+                          "\"direction\": [0, 1, 0], \"up\": [0, 1, %s], \"fov_deg\": 40, "
+                          "\"resolution\": [16, 8]}]}",
+                 ups[k]);
+        if (k == 0) {
+            load_bad(json, "sensors[0].up: the up vector is parallel to the viewing direction");
+            continue;
+        }
+        thz_scene *s = load_ok(json);
+        thz_scene_destroy(s);
+    }
+}
+
 /* scene-format.md ("Reflection"): Ward's alpha_x is the spread along the tangent (a
  * rectangle's: x), alpha_y across it. Seen at normal incidence, a lobe of alpha_x 0.5,
  * alpha_y 0.05 reflects far more towards a direction tilted 20 degrees along x than
@@ -473,6 +498,7 @@ int main(void)
         cmocka_unit_test(test_sensor_model),
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_sensor_vectors_of_any_scale),
+        cmocka_unit_test(test_sensor_up_nearly_parallel),
         cmocka_unit_test(test_ward_alpha_x_along_tangent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
