@@ -228,6 +228,24 @@ static void test_saturated_jm_tie_goes_to_larger_b(void **state)
     }
 }
 
+/* "When the sets of 1 ... K channels number at most" the limit, every set is scored
+ * (analysis.md): 24 candidates, K = 3 give 24 + 276 + 2024 = 2324 sets, exhaustive with a
+ * limit of 2324 (the comparison made strict passed every test), SFFS with 2323. */
+static void test_exhaustive_up_to_the_limit(void **state)
+{
+    (void)state;
+    make_classes();
+    bands_classes cl = {.n_candidates = N, .n_classes = NC, .mean = mean, .cov = cov};
+    const uint64_t sets = 24 + 24 * 23 / 2 + 24 * 23 * 22 / 6;
+    for (uint64_t limit = sets - 1; limit <= sets; limit++) {
+        bands_search_result r;
+        thz_error err = {0};
+        assert_int_equal(bands_search(&cl, 3, limit, &r, &err), THZ_OK);
+        assert_string_equal(r.search, limit == sets ? "exhaustive" : "sffs");
+        bands_search_result_fini(&r);
+    }
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -238,6 +256,26 @@ static void test_bad_input(void **state)
     assert_int_equal(bands_search(&cl, 2, 100, &r, &err), THZ_ERR_INPUT);
     cl.n_classes = NC;
     assert_int_equal(bands_search(&cl, N + 1, 100, &r, &err), THZ_ERR_INPUT);
+    /* K above the centres, refused as such: with the centres miscounted (every candidate
+     * its own) the grouped test's K = 13 of 12 centres still failed, as a covariance read
+     * past its end that was not positive definite */
+    size_t group[N];
+    for (size_t c = 0; c < N; c++)
+        group[c] = c / 2;
+    cl.group = group;
+    assert_int_equal(bands_search(&cl, N / 2 + 1, 100, &r, &err), THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "expected 1 to 12 (the candidate centres"));
+    /* a covariance that is singular on a set (its channels perfectly correlated, the
+     * second pivot exactly 0) is refused, not scored with log 0 (a Cholesky that took a
+     * zero pivot passed every test) */
+    double m[2 * 2] = {0.0, 0.0, 1.0, 2.0};
+    double c[2 * 4] = {1.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 1.0};
+    bands_classes sing = {.n_candidates = 2, .n_classes = 2, .mean = m, .cov = c};
+    size_t set[2] = {0, 1};
+    double work[4 * 4 + 2 * 2];
+    bands_score sc;
+    assert_int_equal(bands_score_set(&sing, set, 2, work, &sc, &err), THZ_ERR_INPUT);
+    assert_non_null(strstr(err.message, "not positive definite"));
 }
 
 int main(void)
@@ -250,6 +288,7 @@ int main(void)
         cmocka_unit_test(test_sffs_drops_a_band),
         cmocka_unit_test(test_one_width_per_centre),
         cmocka_unit_test(test_saturated_jm_tie_goes_to_larger_b),
+        cmocka_unit_test(test_exhaustive_up_to_the_limit),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
