@@ -35,6 +35,30 @@ static void test_corrupted(void **state)
     /* A device or a directory: refused before opening (a FIFO would block the open). */
     expect_refusal("/dev/zero", f->scene, THZ_ERR_INPUT, "is a character device");
     expect_refusal(f->dir, f->scene, THZ_ERR_INPUT, "is a directory");
+    /* Format versions this thzmap does not know: 0 (none was written) and the next one
+     * (a later thzmap's layout, which this one would misread as its own). */
+    const unsigned char versions[] = {0, PHOTON_MAP_FILE_VERSION + 1u};
+    for (size_t i = 0; i < 2; i++) {
+        char want[64];
+        snprintf(want, sizeof want, "has format version %u;", versions[i]);
+        unsigned char keep = buf[8];
+        buf[8] = versions[i];
+        spit(bad, buf, n);
+        expect_refusal(bad, f->scene, THZ_ERR_INPUT, want);
+        buf[8] = keep;
+    }
+    /* Bytes after the records frame: longer than the prefix says, or (the size in the
+     * prefix made to match) data after the end. */
+    unsigned char *longer = malloc(n + 16);
+    assert_non_null(longer);
+    memcpy(longer, buf, n);
+    memset(longer + n, 0, 16);
+    spit(bad, longer, n + 16);
+    expect_refusal(bad, f->scene, THZ_ERR_INPUT, "where its header says");
+    set_prefix(longer, 0, n + 16);
+    spit(bad, longer, n + 16);
+    expect_refusal(bad, f->scene, THZ_ERR_INPUT, "data after the end");
+    free(longer);
     /* A damaged magic number: not a photon map at all. */
     buf[2] ^= 0x01;
     spit(bad, buf, n);
@@ -103,19 +127,28 @@ static void test_forged_values(void **state)
     assert_int_equal(ZSTD_decompress(rec, rsize, frame, fsize), rsize);
     size_t rcap = ZSTD_compressBound(rsize);
     unsigned char *out = malloc(24 + h1 + rcap);
-    for (int what = 0; what < 3; what++) {
+    /* a frequency of 0 and an object index one past the scene's last (their bounds taken
+     * as <= 0 and > n_objects, mutants, passed every other test) */
+    for (int what = 0; what < 5; what++) {
         photon_record keep = rec[5];
         if (what == 0)
             rec[5].power_w_per_hz = NAN;
         else if (what == 1)
             rec[5].position_m[2] = INFINITY;
-        else
+        else if (what == 2)
             rec[5].freq_hz = -1.0f;
+        else if (what == 3)
+            rec[5].freq_hz = 0.0f;
+        else
+            rec[5].tag = photon_tag((uint32_t)f->scene->n_objects, photon_side(&rec[5]),
+                                    photon_first_hit(&rec[5]), photon_batch(&rec[5]));
         memcpy(out, buf, 24 + h1);
         size_t total = 24 + h1 + compress_frame(out + 24 + h1, rcap, rec, rsize);
         set_prefix(out, 0, total);
         spit(bad, out, total);
-        expect_refusal(bad, f->scene, THZ_ERR_INPUT, "position, power or frequency");
+        expect_refusal(bad, f->scene, THZ_ERR_INPUT,
+                       what < 4 ? "position, power or frequency"
+                                : "an object the scene does not have");
         rec[5] = keep;
     }
     free(out);
