@@ -34,6 +34,18 @@ static void test_round_trip(void **state)
     }
     assert_true(photon_map_reference_temperature_k(maps[1]) == 290.0);
     assert_true(photon_map_count(maps[0]) != photon_map_count(maps[1]));
+    /* The header's channel words that no reader of thzmap uses, for other programs
+     * (photon_map_file.h's layout): each channel's centre in Hz and relative width. */
+    size_t hsize;
+    unsigned char *header = header_of(f, &hsize);
+    for (size_t c = 0; c < 2; c++) {
+        double centre, width;
+        memcpy(&centre, header + 8 * (7 + 21 * c), 8); /* little-endian hosts only */
+        memcpy(&width, header + 8 * (7 + 21 * c) + 8, 8);
+        assert_true(centre == f->scene->channels[c].center_hz);
+        assert_true(width == f->scene->channels[c].relative_width);
+    }
+    free(header);
 
     char again[160];
     snprintf(again, sizeof again, "%s/again.thzpm", f->dir);
