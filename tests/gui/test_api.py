@@ -61,6 +61,26 @@ def test_auth(srv):
           "info: %r" % info)
     srv.json("GET", "/api/nothing", status=404)
     srv.json("DELETE", "/api/info", status=405)
+    # every character of the token counts, the last too
+    last = srv.token[:-1] + ("1" if srv.token[-1] == "0" else "0")
+    st, _, _ = srv.request("GET", "/api/info", auth=False,
+                           headers={"Authorization": "Bearer " + last})
+    check(st == 403, "the token with its last character changed: %d, expected 403" % st)
+    # the token logs in at / alone: on an API URL it is no credential (it was a 303)
+    st, _, _ = srv.request("GET", "/api/info?token=" + srv.token, auth=False)
+    check(st == 401, "GET /api/info?token=T without the cookie: %d, expected 401" % st)
+    # every /api/ answer, JSON ones and errors too, may not run as a page nor be cached
+    for path in ("/api/info", "/api/nothing"):
+        st, h, _ = srv.request("GET", path)
+        check(h.get("Content-Security-Policy") == "default-src 'none'; sandbox" and
+              h.get("X-Content-Type-Options") == "nosniff" and
+              h.get("Cache-Control") == "no-store", "headers of %s: %r" % (path, h))
+    # an endpoint's name with more after it is no endpoint (/api/materials + a material's
+    # name answered that material)
+    lib = srv.json("GET", "/api/materials")
+    if lib and lib["materials"]:
+        st, _, _ = srv.request("GET", "/api/materials" + lib["materials"][0]["name"])
+        check(st == 404, "/api/materials%s: %d, expected 404" % (lib["materials"][0]["name"], st))
 
 
 def test_paths(srv, root):
@@ -140,6 +160,46 @@ def test_paths(srv, root):
     mode = os.stat(os.path.join(root, "s", "new.json")).st_mode & 0o7777
     check(mode == 0o600, "PUT over a private file: mode %o, not 600" % mode)
     srv.json("GET", "/api/file?path=s/none.json", status=404)
+    # an absolute path is refused even where it names a file inside the root
+    st, _, _ = srv.request("GET", "/api/file?path=" + os.path.join(root, "s", "scene.json"))
+    check(st == 403, "GET the absolute path of a file in the root: %d, expected 403" % st)
+    # a listing: sorted by name, size in bytes, mtime in s since 1970 (the names are made
+    # in an order that is not theirs)
+    os.mkdir(os.path.join(root, "l"))
+    for name, size in (("m.json", 5), ("b.txt", 1000), ("z.csv", 0), ("a.json", 77)):
+        open(os.path.join(root, "l", name), "w").write("x" * size)
+    os.utime(os.path.join(root, "l", "b.txt"), (1600000000, 1600000000))
+    listing = srv.json("GET", "/api/files?dir=l")
+    entries = listing["entries"] if listing else []
+    check([e["name"] for e in entries] == ["a.json", "b.txt", "m.json", "z.csv"],
+          "listing not sorted by name: %r" % [e["name"] for e in entries])
+    for e in entries:
+        st_ = os.stat(os.path.join(root, "l", e["name"]))
+        check(e["size"] == st_.st_size and e["mtime"] == int(st_.st_mtime),
+              "listed %s: %r, the file %d bytes, mtime %d" % (e["name"], e, st_.st_size,
+                                                              int(st_.st_mtime)))
+    # a file is no directory to list: the request's mistake
+    err = srv.json("GET", "/api/files?dir=s/scene.json", status=400)
+    check(err and "Not a directory" in err.get("error", ""), "list a file: %r" % err)
+    # types by extension (docs/gui.md): JSON as JSON, tables as plain text
+    for rel, ctype in (("s/scene.json", "application/json"),
+                       ("s/materials/sample.csv", "text/plain; charset=utf-8"),
+                       ("l/b.txt", "text/plain; charset=utf-8")):
+        st, h, _ = srv.request("GET", "/api/file?path=" + rel)
+        check(st == 200 and h.get("Content-Type") == ctype, "GET %s: %d %r, expected %s"
+              % (rel, st, h.get("Content-Type"), ctype))
+    # a PUT writes text: a NUL in the body is refused, nothing written; a directory that
+    # does not exist is a 404 (it is not the server's fault)
+    st, _, data = srv.request("PUT", "/api/file?path=l/nul.json", body=b'{"a": "\x00"}')
+    check(st == 400 and b"not text" in data and not os.path.exists(os.path.join(root, "l", "nul.json")),
+          "PUT a body with a NUL: %d %r" % (st, data[:200]))
+    st, _, data = srv.request("PUT", "/api/file?path=l/none/x.json", body=b"{}")
+    check(st == 404, "PUT into a directory that does not exist: %d %r" % (st, data[:200]))
+    # the page's files are those of its bundle: a link in it to a file outside is not served
+    web = os.path.join(root, "..", "web")
+    os.symlink(os.path.join(root, "..", "secret.json"), os.path.join(web, "assets", "leak.js"))
+    st, _, data = srv.request("GET", "/assets/leak.js")
+    check(st == 404, "a link out of the bundle: %d %r" % (st, data[:100]))
 
 
 def test_limits(srv):
@@ -158,6 +218,30 @@ def test_limits(srv):
     st = conn.getresponse().status
     conn.close()
     check(st == 413, "chunked 5 MiB body: %d, expected 413" % st)
+    # 4 MiB exactly is within the limit ("above 4 MiB: 413"), declared or chunked; a
+    # declared byte more is not
+    pad = (4 << 20) - len('{"text": ""}')
+    body = ('{"text": "%s"}' % ("x" * pad)).encode()
+    st, _, _ = srv.request("POST", "/api/validate", body=body)
+    check(st == 200, "a body of 4 MiB: %d, expected 200" % st)
+    conn = http.client.HTTPConnection("127.0.0.1", srv.port, timeout=60)
+    conn.request("POST", "/api/validate", body=(body[i:i + (1 << 20)] for i in
+                                                range(0, len(body), 1 << 20)),
+                 headers={"Authorization": "Bearer " + srv.token}, encode_chunked=True)
+    st = conn.getresponse().status
+    conn.close()
+    check(st == 200, "a chunked body of 4 MiB: %d, expected 200" % st)
+    sock = socket.create_connection(("127.0.0.1", srv.port), timeout=30)
+    sock.sendall(("POST /api/validate HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer %s\r\n"
+                  "Content-Length: %d\r\n\r\n" % (srv.token, (4 << 20) + 1)).encode())
+    answer = sock.recv(4096).decode(errors="replace")
+    sock.close()
+    check(answer.startswith("HTTP/1.1 413"), "declared 4 MiB + 1 byte: %r" % answer[:40])
+    # a key twice is malformed JSON, as in a scene (which of the two would count?)
+    err = srv.json("POST", "/api/runs", body='{"command": "simulate", "command": "bands", '
+                   '"scene": "s/scene.json", "out": "o"}', status=400)
+    check(err and err.get("path") == "$" and "duplicate" in err.get("error", ""),
+          "a body with a key twice: %r" % err)
     err = srv.json("POST", "/api/validate", body="{bad", status=400)
     check(err and err.get("path") == "$" and "line 1" in err["error"], "malformed: %r" % err)
     err = srv.json("POST", "/api/validate", body={"text": 3}, status=400)
