@@ -53,6 +53,8 @@ def make_root(root):
     os.makedirs(os.path.join(root, "s", "closed"))
     open(os.path.join(root, "s", "closed", "x.json"), "w").write("{}")
     os.chmod(os.path.join(root, "s", "closed"), 0)
+    os.makedirs(os.path.join(root, "s", "ro"))
+    os.chmod(os.path.join(root, "s", "ro"), 0o555)
 
 
 def get_within(srv, path, seconds):
@@ -97,6 +99,11 @@ def test_files(srv, root):
             {"command": "simulate", "scene": path, "out": "o"}))
         check(st == 403 and b"permission denied" in data, "POST a run of %s: %s %r"
               % (path, st, data[:200]))
+    # a directory it may not write in: a PUT there is a 403 "permission denied", not the
+    # server's fault (500)
+    st, _, data = srv.request("PUT", "/api/file?path=s/ro/x.json", body="{}")
+    check(st == 403 and b"permission denied" in data, "PUT into a read-only directory: %s %r"
+          % (st, data[:200]))
     # a directory it may not list, likewise (it said "not a directory" and 404)
     for path in ("/api/files?dir=s/closed", "/api/outputs?dir=s/closed"):
         st, err = get_within(srv, path, 10)
@@ -178,6 +185,25 @@ def test_integrators(srv):
               "renders from a photon map" in err["error"], "render %s %r: %r" % (scene, options, err))
 
 
+def test_options(srv):
+    """Each command takes its own options (docs/gui.md), of their types and ranges: an
+    option of another command, a count that is no whole number or out of range, or an
+    unknown key of the body is a 400 at its JSON path (taken silently, a render's seed or
+    a batch's integrator did nothing)."""
+    for command, key, value in (("render", "seed", 3), ("batch", "seed", 3),
+                                ("batch", "integrator", "path"), ("simulate", "photons", 1.5),
+                                ("simulate", "photons", 0), ("simulate", "target_noise_k", 0),
+                                ("render", "max_seconds", 0)):
+        err = srv.json("POST", "/api/runs", body={"command": command, "scene": "s/path.json",
+                                                   "out": "o", "options": {key: value}},
+                       status=400)
+        check(err and err.get("path") == "$.options." + key,
+              "%s with %s %r: %r" % (command, key, value, err))
+    err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/path.json",
+                                               "out": "o", "output": "p"}, status=400)
+    check(err and err.get("path") == "$.output", "an unknown key of the body: %r" % err)
+
+
 def test_psf(srv, root):
     """/api/validate refuses a PSF too much wider than the image to fold onto it, as a run
     would (it answered ok, and the run then failed), at the key that sets its width."""
@@ -187,6 +213,17 @@ def test_psf(srv, root):
     e = res and res["errors"] and res["errors"][0]
     check(res and not res["ok"] and e and e["json_path"] == "sensors[0].psf_fwhm_deg" and
           "the PSF reaches" in e["message"], "validate a 120 deg PSF on 0.01 deg: %r" % res)
+
+
+def wait_state(srv, run_id):
+    """The job once it is done, failed or cancelled (None after 60 s)."""
+    for _ in range(600):
+        st, _, data = srv.request("GET", "/api/runs/%d" % run_id)
+        job = json.loads(data) if st == 200 else None
+        if job and job["state"] not in ("queued", "running"):
+            return job
+        time.sleep(0.1)
+    return None
 
 
 def test_events(srv, root):
@@ -217,6 +254,29 @@ def test_events(srv, root):
     check(reals and max(digits(x) for x in reals) <= 9,
           "reals of more than 9 digits: %r" % [x for x in reals if digits(x) > 9][:5])
     check(os.path.exists(os.path.join(root, "out", "path", "summary.json")), "no output written")
+    # the options reach the run: the integrator over the scene's, the noise target, the
+    # time limit (which, without a target, a run warning says it does not use), the sensor
+    runs = {name: srv.json("POST", "/api/runs", body={
+        "command": "render", "scene": scene, "out": "out/" + name, "options": options},
+        status=202) for name, scene, options in (
+            ("integrator", "s/pm.json", {"integrator": "path", "max_seconds": 5}),
+            ("unused", "s/path.json", {"max_seconds": 30}),
+            ("target", "s/path.json", {"target_noise_k": 50}),
+            ("sensor", "s/path.json", {"sensor": "nope"}))}
+    jobs = {name: run and wait_state(srv, run["id"]) for name, run in runs.items()}
+    summary = lambda name: json.load(open(os.path.join(root, "out", name, "summary.json")))
+    check(jobs["integrator"] and jobs["integrator"]["state"] == "done" and
+          summary("integrator")["integrator"] == "path",
+          "render of the photon-map scene with integrator path: %r" % jobs["integrator"])
+    check(jobs["unused"] and jobs["unused"]["state"] == "done" and
+          any("max_seconds 30 s is not used" in w for w in summary("unused")["warnings"]),
+          "render with max_seconds and no target: %r" % jobs["unused"])
+    check(jobs["target"] and jobs["target"]["state"] == "done" and
+          summary("target")["target_noise_k"] == 50, "render with target_noise_k 50: %r"
+          % jobs["target"])
+    check(jobs["sensor"] and jobs["sensor"]["state"] == "failed" and
+          "no sensor named 'nope'" in (jobs["sensor"]["error"] or ""),
+          "render of a sensor the scene does not have: %r" % jobs["sensor"])
     # an out path of two-byte characters whose "done; results in ..." message is cut inside
     # one: the job stays in the list, its answer 200 (it was 500 and gone from the list)
     out = "o/x" + "\u00e9" * 100 + "/" + "\u00e9" * 20
@@ -234,7 +294,8 @@ def test_events(srv, root):
     st, _, data = srv.request("GET", "/api/runs")
     check(st == 200 and run["id"] in [j["id"] for j in json.loads(data)],
           "the run is missing from the list: %s %r" % (st, data[:200]))
-    # finished jobs beyond the last 256 go (every job stayed, 14 KB each, until the stop)
+    # finished jobs beyond the last 256 go: 256 stay, and the new one (every job stayed,
+    # 14 KB each, until the stop)
     with open(os.path.join(root, "s", "broken.json"), "w") as f:
         f.write("{")
     ids = []
@@ -255,7 +316,7 @@ def test_events(srv, root):
         {"command": "simulate", "scene": "s/broken.json", "out": "o"}))  # prunes
     st, _, data = srv.request("GET", "/api/runs")
     listed = [j["id"] for j in json.loads(data)] if st == 200 else []
-    check(len(listed) <= 257 and ids[-1] in listed and run["id"] not in listed,
+    check(len(listed) == 257 and ids[-1] in listed and run["id"] not in listed,
           "after 270 more jobs: %d listed, the first kept: %s" % (len(listed), listed[:1]))
     st, _, _ = srv.request("GET", "/api/runs/%d" % run["id"])
     check(st == 404, "a job pruned from the list: %s, expected 404" % st)
@@ -275,6 +336,7 @@ def main():
         try:
             tests = [("files", lambda: test_files(srv, root)), ("lengths", lambda: test_lengths(srv)),
                      ("integrators", lambda: test_integrators(srv)),
+                     ("options", lambda: test_options(srv)),
                      ("psf", lambda: test_psf(srv, root)),
                      ("text", lambda: test_text_and_limits(srv, root))]
             if not REQUESTS_ONLY:
