@@ -73,6 +73,20 @@ def test_validate(srv, scene):
         # the air emits at the enclosure's temperature (the room's 295 K), as validate says
         check(atm["emission_temperature_k"] == 295.0 and atm["background_temperature_k"] == 295.0,
               "the air's emission: %r" % atm)
+        check_scene_answer(sc, scene)
+    # spectra span the channels +- 20 %, at least 0.1-1.5 THz, on 200 frequencies; air
+    # that does not emit has no emission or background temperature (null)
+    wide = json.loads(text)
+    wide["channels"] = [{"name": "lo", "frequency_thz": 0.1, "relative_width": 0.01},
+                        {"name": "hi", "frequency_thz": 2.0, "relative_width": 0.01}]
+    wide["atmosphere"] = {"model": "none"}
+    res = srv.json("POST", "/api/validate", body={"path": "s/scene.json", "text": json.dumps(wide)})
+    f = res and res["scene"] and res["scene"]["materials"][0]["spectra"]["freq_thz"]
+    check(f and len(f) == 200 and abs(f[0] - 0.08) < 1e-12 and abs(f[-1] - 2.4) < 1e-12,
+          "spectra of channels at 0.1 and 2 THz: %r" % ((f and (len(f), f[0], f[-1])),))
+    atm = res and res["scene"] and res["scene"]["atmosphere"]
+    check(atm and atm["emission_temperature_k"] is None and atm["background_temperature_k"] is None,
+          "air that does not emit: %r" % atm)
     # the meshes of an answer stop at 300 000 triangles (a cylinder of 1 000 000 segments, a
     # 1.7 KB body, made a 1 GB server and a 170 MB answer): later objects' are null
     big = json.loads(text)
@@ -99,6 +113,47 @@ def test_validate(srv, scene):
     check(res and not res["ok"] and "sample.csv" in json.dumps(res["errors"]), "base_dir")
 
 
+def check_scene_answer(sc, scene):
+    """The objects and the sensor of /api/validate's answer against the scene file and
+    their own meshes: bounding boxes, areas, temperatures, the sensor's axes, the
+    distance to what it looks at, the settings."""
+    for o, want in zip(sc["objects"], scene["objects"]):
+        pos, idx = o["mesh"]["positions"], o["mesh"]["indices"]
+        pts = [pos[3 * k:3 * k + 3] for k in range(len(pos) // 3)]
+        lo = [min(p[a] for p in pts) for a in range(3)]
+        hi = [max(p[a] for p in pts) for a in range(3)]
+        area = 0.0
+        for t in range(len(idx) // 3):
+            a, b, c = (pts[idx[3 * t + v]] for v in range(3))
+            u = [b[k] - a[k] for k in range(3)]
+            w = [c[k] - a[k] for k in range(3)]
+            n = [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]]
+            area += 0.5 * math.sqrt(sum(x * x for x in n))
+        check(all(abs(o["bbox_min_m"][a] - lo[a]) < 1e-6 and abs(o["bbox_max_m"][a] - hi[a]) < 1e-6
+                  for a in range(3)) and abs(o["area_m2"] - area) <= 1e-6 * area and
+              o["temperature_K"] == want["temperature_k"],
+              "object %s: %r against its mesh's box %r %r, area %r, %r K" %
+              (o["name"], {k: o[k] for k in ("bbox_min_m", "bbox_max_m", "area_m2", "temperature_K")},
+               lo, hi, area, want["temperature_k"]))
+    cam, want = sc["sensors"][0], scene["sensors"][0]
+    check(cam["position_m"] == want["position_m"] and cam["direction"] == [0, 1, 0] and
+          cam["up"] == want["up"] and cam["aperture_m2"] == want["aperture_m2"],
+          "sensor axes: %r" % cam)
+    # the distance: to the centre of the box around the objects but the room (which holds
+    # the sensor)
+    seen = [o for o in sc["objects"] if o["name"] != "room"]
+    centre = [0.5 * (min(o["bbox_min_m"][a] for o in seen) + max(o["bbox_max_m"][a] for o in seen))
+              for a in range(3)]
+    d = math.dist(centre, want["position_m"])
+    check(abs(sc["atmosphere"]["sensors"][0]["distance_m"] - d) < 1e-9,
+          "distance to what the sensor sees: %r, expected %r" %
+          (sc["atmosphere"]["sensors"][0]["distance_m"], d))
+    check(sc["channels"][0]["relative_width"] == scene["channels"][0]["relative_width"] and
+          sc["settings"]["seed"] == scene["photons"]["seed"] and
+          sc["settings"]["photons_per_channel"] == scene["photons"]["per_channel"],
+          "channel width and settings: %r %r" % (sc["channels"][0], sc["settings"]))
+
+
 def test_materials(srv):
     lib = srv.json("GET", "/api/materials")
     check(lib and len(lib["materials"]) > 0, "material library")
@@ -108,6 +163,12 @@ def test_materials(srv):
         sp = m and m["spectra"]
         ok = sp and len(sp["freq_thz"]) == len(sp["n"]) and any(v is not None for v in sp["n"])
         check(ok, "material spectra of %s" % name)
+    # one entry's spectra span its data's range, else its valid range, else 0.1-3 THz
+    for e in lib["materials"] if lib else []:
+        span = e["data_thz"] or e["valid_thz"] or [0.1, 3.0]
+        f = srv.json("GET", "/api/materials/" + e["name"])["spectra"]["freq_thz"]
+        check(len(f) == 200 and abs(f[0] - span[0]) < 1e-9 and abs(f[-1] - span[1]) < 1e-9,
+              "spectra of %s over %r: %r to %r" % (e["name"], span, f[0], f[-1]))
     srv.json("GET", "/api/materials/no-such-material", status=404)
 
 
