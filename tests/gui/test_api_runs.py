@@ -19,6 +19,7 @@ import re
 import shutil
 import signal
 import struct
+import subprocess
 import sys
 import tempfile
 import threading
@@ -227,6 +228,8 @@ def test_runs(srv, root):
     job = wait_state(srv, render["id"], ("done", "failed"))
     check(job and job["state"] == "done", "render: %r" % job)
     check(wait_state(srv, run_b["id"], ("done",)) is not None, "second run")
+    summary_b = json.load(open(os.path.join(root, "out", "b", "summary.json")))
+    check(summary_b["seed"] == 2, "run b's seed option: summary seed %r" % summary_b["seed"])
     job = wait_state(srv, render_b["id"], ("done", "failed"))
     check(job and job["state"] == "done", "render queued behind its map's run: %r" % job)
     # batch (two still frames, no movies) and bands (3 candidates, choose 1)
@@ -237,7 +240,7 @@ def test_runs(srv, root):
         "options": {"no_movies": True}}, status=202)
     bands = srv.json("POST", "/api/runs", body={
         "command": "bands", "scene": "s/scene.json", "out": "out/bands",
-        "options": {"count": 1, "from_thz": 0.3, "to_thz": 0.4, "step_ghz": 50,
+        "options": {"count": 1, "from_thz": 0.3, "to_thz": 0.4, "step_ghz": 50, "netd_k": 0.7,
                     "targets": ["target"], "seed": 3}}, status=202)
     # the batch's progress is the batch's (its frames and share), not its runs' channels
     # with a share frozen at 0 (the runs' reports once took every turn)
@@ -251,6 +254,9 @@ def test_runs(srv, root):
     check(job and job["state"] == "done" and job["progress"] == 1.0, "batch: %r" % job)
     res = srv.json("GET", "/api/outputs?dir=out/batch")
     check(res and res["frames"] == ["frame-00000", "frame-00001"], "batch frames: %r" % res)
+    movies = [n for _, _, names in os.walk(os.path.join(root, "out", "batch")) for n in names
+              if n.endswith(".mp4")]
+    check(not movies, "a batch with no_movies made %r" % movies)
     # the sequence made one frame shorter, run into the same directory: frame-00001 stays
     # on disk (scene-format.md), but the batch's frames are the one its batch.json lists
     with open(os.path.join(root, "s", "seq1.json"), "w") as f:
@@ -264,9 +270,21 @@ def test_runs(srv, root):
     check(os.path.isdir(os.path.join(root, "out", "batch", "frame-00001")) and res
           and res["frames"] == ["frame-00000"], "a shorter batch's frames: %r" % res)
     job = wait_state(srv, bands["id"], ("done", "failed"))
-    check(job and job["state"] == "done", "bands: %r" % job)
+    check(job and job["state"] == "done" and job["progress"] == 1.0, "bands: %r" % job)
     chosen = json.load(open(os.path.join(root, "out", "bands", "bands.json")))["selected_thz"]
     check(len(chosen) == 1 and chosen[0] in (0.3, 0.35, 0.4), "bands chose %r" % chosen)
+    # its NETD and its targets (the other objects seen: one class, background)
+    done = json.load(open(os.path.join(root, "out", "bands", "bands.json")))
+    check(done["noise"]["netd_k"] == [0.7] * 3 and
+          sorted(c["name"] for c in done["classes"]) == ["background", "target"],
+          "bands' noise and classes: %r %r" % (done["noise"], [c["name"] for c in done["classes"]]))
+    # and its seed: `thzmap bands` with the same options gives the same classes and score
+    subprocess.run([BINARY, "bands", "s/scene.json", "-o", "cli-bands", "-q", "--count", "1",
+                    "--from-thz", "0.3", "--to-thz", "0.4", "--step-ghz", "50", "--netd-k", "0.7",
+                    "--targets", "target", "--seed", "3"], cwd=root, check=True)
+    cli = json.load(open(os.path.join(root, "cli-bands", "bands.json")))
+    check(cli["classes"] == done["classes"] and cli["score"] == done["score"],
+          "bands of the server and of the CLI differ: score %r, %r" % (done["score"], cli["score"]))
     listing = srv.json("GET", "/api/runs")
     check(listing and [j["id"] for j in listing][:6] == [run["id"], run_b["id"], render["id"],
                                                           render_b["id"], batch["id"],
@@ -274,6 +292,12 @@ def test_runs(srv, root):
           "runs list")
     srv.json("GET", "/api/runs/999", status=404)
     srv.json("DELETE", "/api/runs/%d" % run["id"], status=409)
+    # a finished job: no error (null), and its time stays what the run took
+    first = srv.json("GET", "/api/runs/%d" % run["id"])
+    time.sleep(0.3)
+    again = srv.json("GET", "/api/runs/%d" % run["id"])
+    check(first and again and first["error"] is None and
+          0 < first["seconds"] == again["seconds"], "a done job: %r, then %r" % (first, again))
     # cancel: a long run while it runs, and one still queued behind it
     long_run = srv.json("POST", "/api/runs", body={
         "command": "simulate", "scene": "s/scene.json", "out": "out/long",
@@ -281,8 +305,37 @@ def test_runs(srv, root):
     queued = srv.json("POST", "/api/runs", body={
         "command": "simulate", "scene": "s/scene.json", "out": "out/q"}, status=202)
     wait_state(srv, long_run["id"], ("running",))
+    # nor from a map that a queued simulate saves nowhere, or saves into a directory whose
+    # name only begins with the map's: 404 (docs/gui.md: "unless a simulate ... with
+    # save_photon_map writes it")
+    no_map = srv.json("POST", "/api/runs", body={
+        "command": "simulate", "scene": "s/scene.json", "out": "out/nm"}, status=202)
+    longer = srv.json("POST", "/api/runs", body={
+        "command": "simulate", "scene": "s/scene.json", "out": "out/nmx",
+        "options": {"save_photon_map": True}}, status=202)
+    for d in ("nm", "n"):
+        st, _, data = srv.request("POST", "/api/runs", body=json.dumps({
+            "command": "render", "scene": "s/scene.json", "out": "out/rnm",
+            "options": {"photon_map": "out/%s/photon-map.thzpm" % d}}))
+        check(st == 404, "render of out/%s's map, which no queued run saves: %d %r"
+              % (d, st, data[:200]))
+    for queued_run in (no_map, longer):
+        srv.request("DELETE", "/api/runs/%d" % queued_run["id"])
+    # at most 64 jobs wait or run (long_run and queued, and 62 more): the next is a 409
+    extra = []
+    for _ in range(63):
+        st, _, data = srv.request("POST", "/api/runs", body=json.dumps(
+            {"command": "simulate", "scene": "s/scene.json", "out": "out/q64"}))
+        if st == 202:
+            extra.append(json.loads(data)["id"])
+    check(len(extra) == 62 and st == 409 and b"64 jobs" in data,
+          "64 jobs and one more: %d accepted, then %d %r" % (len(extra), st, data[:200]))
+    for i in extra:
+        srv.request("DELETE", "/api/runs/%d" % i)
     job = srv.json("DELETE", "/api/runs/%d" % queued["id"])
     check(job and job["state"] == "cancelled", "cancel queued: %r" % job)
+    # cancelled is finished: cancelling it again is a 409, as for a done job
+    srv.json("DELETE", "/api/runs/%d" % queued["id"], status=409)
     srv.json("DELETE", "/api/runs/%d" % long_run["id"])
     t0 = time.time()
     job = wait_state(srv, long_run["id"], ("cancelled", "done", "failed"))
@@ -413,11 +466,16 @@ def test_sigterm(root, env):
     run = srv.json("POST", "/api/runs", body={
         "command": "simulate", "scene": "s/scene.json", "out": "out/term",
         "options": {"photons": 300000000}}, status=202)
+    queued = srv.json("POST", "/api/runs", body={
+        "command": "simulate", "scene": "s/scene.json", "out": "out/term2"}, status=202)
     wait_state(srv, run["id"], ("running",))
-    # a page following the run: its stream ends with the run's final state, not just "end"
-    streamed = []
+    # a page following the run: its stream ends with the run's final state, not just "end";
+    # and one following the job queued behind it, which is dropped (docs/gui.md)
+    streamed, streamed_q = [], []
     follower = threading.Thread(target=lambda: streamed.extend(sse_events(srv, run["id"])))
     follower.start()
+    follower_q = threading.Thread(target=lambda: streamed_q.extend(sse_events(srv, queued["id"])))
+    follower_q.start()
     time.sleep(0.2)  # into the photon phase, its staging directory open
     t0 = time.time()
     rc = srv.stop(signal.SIGTERM)
@@ -428,6 +486,10 @@ def test_sigterm(root, env):
     states = [d.get("state") for n, d in streamed if n == "progress"]
     check(streamed and streamed[-1][0] == "end" and states and states[-1] == "cancelled",
           "the event stream at SIGTERM: %r" % streamed[-3:])
+    follower_q.join(timeout=30)
+    states = [d.get("state") for n, d in streamed_q if n == "progress"]
+    check(streamed_q and streamed_q[-1][0] == "end" and states and states[-1] == "cancelled",
+          "the queued job's event stream at SIGTERM: %r" % streamed_q[-3:])
     after = sorted(os.listdir(os.path.join(root, "out")))
     check(after == before and
           not os.path.exists(os.path.join(root, "out", "term")), "SIGTERM left output behind: %r -> %r" % (before, after))
