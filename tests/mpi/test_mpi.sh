@@ -5,9 +5,10 @@
 # photon-map and final-gather (with the saved photon map; also an empty deviation map), photon passes (several shared
 # phases in one run), path with render passes, render from a saved map, and a batch
 # (frames dealt whole by photon groups, fresh and resumed; one frame shared by the ranks;
-# a frame failing on rank 1 keeps the frames before it); only rank 0
-# writes; a failed or killed rank fails the run with a message and a non-zero exit, never
-# a hang, and leaves no OUTDIR.
+# a frame failing on rank 1 keeps the frames before it; a dealt frame's seconds and its
+# run warnings come with it); the render counts (back-face samples) are every rank's; only
+# rank 0 writes; a failed or killed rank fails the run with a message and a non-zero exit,
+# never a hang, and leaves no OUTDIR; so does a rank running another command (no hang).
 # Usage: bash test_mpi.sh THZMAP_BINARY REPO_DIR
 set -u
 THZMAP=$1
@@ -154,6 +155,24 @@ mpi 2 "$THZMAP" simulate "$work/in/iso.json" -o "$work/iso2" --integrator final-
     --threads 1 > "$work/iso2.out" 2>&1 || { fail "2 ranks, empty map: exit $?"; cat "$work/iso2.out"; }
 same_run "$work/iso2" "$work/iso1" "2 ranks, final-gather from an empty deviation map"
 
+step "counts of every rank"
+# The render counts behind summary.json's back_face_samples and its warning ("N of M
+# samples saw the back side of a one-sided solid") are every rank's: a target turned
+# inside out, across both ranks' tiles (rank 0 counted its own tiles alone)
+$PY - "$scene" "$work/in/inside.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+t = [o for o in s["objects"] if o["name"] == "target"][0]
+t["shape"] = {"type": "box", "size_m": [0.2, 0.2, 0.75], "inward": True}
+json.dump(s, open(sys.argv[2], "w"))
+PY
+"$THZMAP" simulate "$work/in/inside.json" -o "$work/bk1" --integrator path --threads 1 --quiet \
+    2> /dev/null || fail "one process, back faces: exit $?"
+grep -q '"back_face_samples"' "$work/bk1/summary.json" || fail "test set-up: no back-face samples"
+mpi 2 "$THZMAP" simulate "$work/in/inside.json" -o "$work/bk2" --integrator path --threads 1 \
+    --quiet 2> /dev/null || fail "2 ranks, back faces: exit $?"
+same_run "$work/bk2" "$work/bk1" "2 ranks, samples that saw back faces"
+
 step "batch"
 # --- batch: whole frames dealt to the ranks by photon groups (frames 0 and 1 fire, 2
 # fires and 3 renders from its photons: 3 groups), then resumed under mpirun after
@@ -231,6 +250,10 @@ same_batch "$work/bt3" "$work/bt1" "3 ranks, frames dealt" 0
 ls "$work/bt3"/*.mp4 > /dev/null 2>&1 || fail "3 ranks, batch: no movie"
 [ "$(frame_ranks "$work/bt3")" = "1 1 1 1" ] ||
     fail "3 ranks: frames not dealt whole (mpi_ranks per frame: $(frame_ranks "$work/bt3"))"
+# each frame's seconds (docs/mpi.md "Outputs"): for a frame dealt to another rank, its time
+# there, which comes with the frame (it was 0 for every frame rank 0 did not compute)
+$PY -c 'import json,sys; t = [f["seconds"] for f in json.load(open(sys.argv[1]))["frames"]]; sys.exit(not (len(t) == 4 and all(x > 0 for x in t)))' \
+    "$work/bt3/batch.json" || fail "3 ranks: a frame's seconds is not its time: $(grep seconds "$work/bt3/batch.json" | tr -d ' \n')"
 rm -rf "$work/bt3/frame-00001" "$work/bt3/frame-00003"
 mpi 2 "$THZMAP" batch "$work/bt/seq.json" -o "$work/bt3" --threads 1 > "$work/bt2.out" 2>&1 ||
     { fail "2 ranks, resumed batch: exit $?"; cat "$work/bt2.out"; }
@@ -272,7 +295,7 @@ grep -q '"status": "failed"' "$work/bf/out/batch.json" || fail "a frame failing 
 
 step "only rank 0"
 # --- only rank 0 writes: nothing else beside the outputs -----------------------------
-extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3|pp1|pp2|re1|re2|pa1|pa3|pa3.out|in|iso1|iso2|iso2.out|bt|bt1|bt3|bt3.out|bt2.out|bt1s.out|bf|bf.out')
+extra=$(ls "$work" | grep -vxE 'scene.json|pm1|pm2|pm2.out|pm22|fg1|fg3|pp1|pp2|re1|re2|pa1|pa3|pa3.out|in|iso1|iso2|iso2.out|bk1|bk2|bt|bt1|bt3|bt3.out|bt2.out|bt1s.out|bf|bf.out')
 [ -z "$extra" ] || fail "files beside the outputs: $extra"
 
 
@@ -408,8 +431,8 @@ else
     kill $job
 fi
 step "dealt warnings"
-# A dealt batch says every frame's scene warnings, also of the frames other ranks computed
-# (they were lost), and blames rank 0's own failure to write a frame on no other rank.
+# A dealt batch says every frame's scene and run warnings, also of the frames other ranks
+# computed (they were lost; the run's went to summary.json alone), and blames rank 0's own failure to write a frame on no other rank.
 mkdir -p "$work/dw"
 $PY - "$REPO/tests/inputs/batch/scene.json" "$work/dw" <<'PY'
 import json, sys
@@ -418,6 +441,7 @@ s["render"] = {"integrator": "photon-map"}
 s["photons"] = {"seed": 7, "per_channel": 20000}
 json.dump(s, open(sys.argv[2] + "/s0.json", "w"))
 s["atmosphere"] = {"model": "constant", "attenuation_per_m": 0.05, "emitting": False}
+s["materials"]["skin"]["reflection"] = {"model": "ward", "alpha_x": 0.1, "alpha_y": 0.1}
 json.dump(s, open(sys.argv[2] + "/s1.json", "w"))
 json.dump({"format": "thzmap-sequence/1", "scenes": ["s0.json", "s1.json"]},
           open(sys.argv[2] + "/seq.json", "w"))
@@ -426,11 +450,27 @@ mpi 2 "$THZMAP" batch "$work/dw/seq.json" -o "$work/dw/two" -q --threads 1 > "$w
     fail "dealt batch of two scenes: exit $?: $(tail -3 "$work/dw.out")"
 grep -q 'warning: frame-00001: atmosphere: "emitting": false' "$work/dw.out" ||
     { fail "dealt batch: frame 2's scene warning not said"; cat "$work/dw.out"; }
+grep -q 'warning: frame-00001: material "skin": photon-map cannot resolve its glossy lobe' "$work/dw.out" ||
+    { fail "dealt batch: frame 2's run warning not said"; cat "$work/dw.out"; }
 mkdir "$work/dw/o2" && touch "$work/dw/o2/frame-00001"
 mpi 2 "$THZMAP" batch "$work/dw/seq.json" -o "$work/dw/o2" -q --threads 1 > "$work/dw2.out" 2>&1
 grep -q "frame-00001: .*exists and is not a directory" "$work/dw2.out" &&
     ! grep -q "MPI rank 1" "$work/dw2.out" ||
     { fail "rank 0's own write failure: message"; cat "$work/dw2.out"; }
+step "rank 1 runs another command"
+# rank 0 runs a batch while rank 1 simulates one scene: refused with a message naming it,
+# non-zero exit, no hang; frames dealt (seq.json: 3 groups) or shared (the same scene
+# twice: one group, each frame's scene sent to rank 1, which returned as if stopped)
+echo '{"format": "thzmap-sequence/1", "scenes": ["scene.json", "scene.json"]}' > "$work/bt/two.json"
+for seqf in seq two; do
+    timeout 120 mpirun --oversubscribe -np 1 "$THZMAP" batch "$work/bt/$seqf.json" \
+        -o "$work/mixb-$seqf" --quiet --threads 1 : -np 1 "$THZMAP" simulate "$work/bt/scene.json" \
+        -o "$work/mixb-$seqf" --quiet --threads 1 > "$work/mixb.out" 2>&1
+    rc=$?
+    [ $rc != 0 ] && [ $rc != 124 ] || fail "rank 1 simulating while rank 0 runs a batch ($seqf): exit $rc"
+    grep -q "the lead runs several scenes (batch) while process 1 serves one" "$work/mixb.out" ||
+        { fail "rank 1's other command not said ($seqf)"; cat "$work/mixb.out"; }
+done
 step "other commands"
 # other commands refuse several ranks
 mpi 2 "$THZMAP" validate "$scene" > "$work/val.out" 2>&1
