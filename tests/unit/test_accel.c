@@ -7,6 +7,8 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include <cmocka.h>
 
@@ -109,6 +111,16 @@ static void test_ignored_closest(void **state)
     assert_float_equal(g.distance_m, 0.1 + GAP_M, 1e-5);
     /* and with a limit short of the next surface, nothing */
     assert_false(accel_intersect(f->acc, o, up, 0.1 + 0.5 * GAP_M, h.object, h.triangle, &g));
+    /* Only that triangle: the next surface may be another of its object's (a ray into the
+     * room from outside, its near wall ignored, meets the far wall 10 m on). */
+    vec3 out = v3(-6.0, 0.3, 2.1), east = v3(1, 0, 0);
+    assert_true(accel_intersect(f->acc, out, east, INFINITY, ACCEL_NO_OBJECT, 0, &h));
+    assert_int_equal(h.object, f->room);
+    assert_float_equal(h.distance_m, 1.0, 1e-6);
+    assert_true(accel_intersect(f->acc, out, east, INFINITY, h.object, h.triangle, &g));
+    assert_int_equal(g.object, f->room);
+    assert_int_equal(g.side, 0);
+    assert_float_equal(g.distance_m, 11.0, 1e-6);
 }
 
 /* Leaves the lower rectangle upwards from point p (on triangle tri) in direction dir and
@@ -250,7 +262,7 @@ static void check_gap_in(double gap, bool far_box)
 /* A ray whose origin, rounded to single precision, lies on a wall of a closed room 3 km
  * from the origin (as one leaving near a concave corner does) and heads into the room:
  * it met that wall's back at t = 0 (radiance 0: a furnace's pixels read up to 3.7 K
- * low); it goes on to the far wall's front. */
+ * low); it goes on to the far wall's front, also at a grazing angle. */
 static void test_back_of_the_wall_it_starts_on(void **state)
 {
     (void)state;
@@ -265,6 +277,15 @@ static void test_back_of_the_wall_it_starts_on(void **state)
     accel_hit h;
     vec3 dir = v3_normalize(v3(-0.6, 0.1, 0.8));
     assert_true(accel_intersect(acc, v3(3005.0, 0.3, 0.2), dir, INFINITY, ACCEL_NO_OBJECT, 0, &h));
+    assert_int_equal(h.side, 0);
+    assert_true(h.distance_m > 1.0);
+    /* The same at a grazing angle (cos 0.01), its origin one float step (2^-12 m) behind the
+     * wall: the wall's back lies 2.4 cm along the ray, beyond the 1.1 cm (32 float epsilons
+     * at 3 km) allowed for the origin's rounding, though its plane lies within them; a side
+     * wall's front is met all the same. */
+    vec3 graze = v3_normalize(v3(-0.01, 0.6, 0.8));
+    assert_true(accel_intersect(acc, v3(3005.0 + 1.0 / 4096.0, 0.3, 0.2), graze, INFINITY,
+                                ACCEL_NO_OBJECT, 0, &h));
     assert_int_equal(h.side, 0);
     assert_true(h.distance_m > 1.0);
     accel_destroy(acc);
@@ -304,6 +325,55 @@ static void test_silhouette_edge(void **state)
     assert_true(fronts > 0); /* the edges are met, not all passed by */
     accel_destroy(acc);
     scene_destroy(s);
+}
+
+/* A ray from behind a one-sided plate through the edge its two triangles share (the
+ * inside of the plate) meets the plate's back there: the recast that looks for a face
+ * met from its front at the edge (test_silhouette_edge) looks no farther than the edge,
+ * and keeps the back face when it finds none (not the room's ceiling 3 m on). */
+static void test_back_of_a_plate_on_its_inner_edge(void **state)
+{
+    (void)state;
+    thz_scene *s = ps_scene(0.35, 0.01, 1000, 1);
+    size_t m = ps_material(s, 0.0, 0.0, -1.0, TRANSMISSION_DIFFUSE);
+    size_t room = ps_object(s, OBJECT_SOLID, m, 290, 0, false);
+    ps_box(s, room, v3(-4, -4, -4), v3(4, 4, 4), true);
+    size_t plate = ps_object(s, OBJECT_SOLID, m, 310, 0, false);
+    ps_face(s, plate, v3(0, 0, 1), v3(1, 0, 0), v3(0, 1, 0)); /* normal +z */
+    ps_finalize(s);
+    accel *acc;
+    thz_error err;
+    assert_int_equal(accel_create(s, &acc, &err), THZ_OK);
+    const double on_diagonal[] = {-0.5, 0.25, 0.75};
+    for (size_t i = 0; i < sizeof on_diagonal / sizeof *on_diagonal; i++) {
+        double a = on_diagonal[i];
+        accel_hit h;
+        assert_true(
+            accel_intersect(acc, v3(a, a, 0), v3(0, 0, 1), INFINITY, ACCEL_NO_OBJECT, 0, &h));
+        assert_int_equal(h.object, plate);
+        assert_int_equal(h.side, 1);
+        assert_float_equal(h.distance_m, 1.0, 1e-9);
+    }
+    accel_destroy(acc);
+    scene_destroy(s);
+}
+
+/* The offset exceeds single precision's rounding of the hit's largest coordinate (Embree
+ * takes the origin in single precision) whichever axis holds it: hits 3 km out along x,
+ * y and z on a face normal to z are lifted by more than 4 float steps (2.4e-4 m each),
+ * and by less than a centimetre. */
+static void test_offset_beyond_rounding(void **state)
+{
+    fixture *f = *state;
+    const vec3 points[] = {v3(3000.3, 0.2, 0.5), v3(0.3, -3000.2, 0.5), v3(0.3, 0.2, 3000.5)};
+    for (size_t i = 0; i < sizeof points / sizeof *points; i++) {
+        accel_hit from = at((uint32_t)f->lower, 0, points[i]);
+        vec3 o = accel_offset_origin(f->acc, &from, v3(0, 0, 1));
+        double step = ldexp(1.0, -12); /* float spacing from 2048 to 4096 */
+        assert_true(o.z - points[i].z > 4.0 * step);
+        assert_true(o.z - points[i].z < 0.01);
+        assert_true(o.x == points[i].x && o.y == points[i].y);
+    }
 }
 
 static void test_offset_is_the_hits(void **state)
@@ -363,6 +433,33 @@ static void test_grazing_point_on_the_corners_plane(void **state)
     scene_destroy(s);
 }
 
+/* THZMAP_EMBREE_MAX_ISA (docs/scene-format.md "Reproducibility"): unset or empty, the cap
+ * is AVX2, so that every processor with AVX2 runs the same kernels; each of Embree's
+ * names is taken as it is; anything else is refused, naming the variable. */
+static void test_max_isa(void **state)
+{
+    (void)state;
+    const char *isa = NULL;
+    thz_error err;
+    assert_int_equal(unsetenv("THZMAP_EMBREE_MAX_ISA"), 0);
+    assert_int_equal(accel_max_isa(&isa, &err), THZ_OK);
+    assert_string_equal(isa, "avx2");
+    const char *names[] = {"sse2", "sse4.2", "avx", "avx2", "avx512", ""};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        assert_int_equal(setenv("THZMAP_EMBREE_MAX_ISA", names[i], 1), 0);
+        isa = NULL;
+        assert_int_equal(accel_max_isa(&isa, &err), THZ_OK);
+        assert_string_equal(isa, names[i][0] ? names[i] : "avx2");
+    }
+    const char *bad[] = {"avx5", "AVX2", "sse4", "avx2 "};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        assert_int_equal(setenv("THZMAP_EMBREE_MAX_ISA", bad[i], 1), 0);
+        assert_int_equal(accel_max_isa(&isa, &err), THZ_ERR_INPUT);
+        assert_non_null(strstr(err.message, "THZMAP_EMBREE_MAX_ISA"));
+    }
+    assert_int_equal(unsetenv("THZMAP_EMBREE_MAX_ISA"), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -372,9 +469,12 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_shared_edge, setup, teardown),
         cmocka_unit_test_setup_teardown(test_threads, setup, teardown),
         cmocka_unit_test(test_offset_is_the_hits),
+        cmocka_unit_test_setup_teardown(test_offset_beyond_rounding, setup, teardown),
+        cmocka_unit_test(test_back_of_a_plate_on_its_inner_edge),
         cmocka_unit_test(test_back_of_the_wall_it_starts_on),
         cmocka_unit_test(test_silhouette_edge),
         cmocka_unit_test(test_grazing_point_on_the_corners_plane),
+        cmocka_unit_test(test_max_isa),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
