@@ -271,3 +271,48 @@ def test_maps_hold_minus_one_where_nothing_is_hit(tmp_path):
         assert np.all(getattr(im, q)[~none] > 0), q
     doc = " ".join(thzmap.Image.__doc__.split())
     assert "temperature (K, -1 where nothing is hit), distance (m, -1: none)" in doc
+
+
+def test_sensors_by_name_or_index_and_their_shapes(tiny_dir):
+    """render(sensor=None) renders every sensor, sensor= one of them (a name or a 0-based
+    index; -1 is no sensor, not "every sensor" as the C API's -1 means); an image's visual
+    is (rows, columns, 3) and its frequencies_thz the channels' centres in THz."""
+    d = tiny_scene_dict()
+    side = dict(d["sensors"][0], name="side", resolution=[8, 6])
+    d["sensors"].append(side)
+    scene = thzmap.scene_from_dict(d, base_dir=tiny_dir)
+    both = thzmap.render(scene, integrator="path", seed=SEED)
+    assert both.sensors == ["cam", "side"]
+    for s in ("side", 1):
+        one = thzmap.render(scene, integrator="path", seed=SEED, sensor=s)
+        assert one.sensors == ["side"]
+    for bad in (-1, 2):
+        with pytest.raises(thzmap.ArgumentError, match="no sensor"):
+            thzmap.render(scene, integrator="path", seed=SEED, sensor=bad)
+        with pytest.raises(thzmap.ArgumentError, match="no sensor"):
+            both.image(bad)
+    im = both.image("side")
+    assert (im.rows, im.columns) == (6, 8)
+    assert im.visual.shape == (6, 8, 3)
+    assert im.temperature.shape == (6, 8)
+    assert list(im.frequencies_thz) == [0.35, 0.8]  # the scene's numbers, THz
+
+
+def test_photon_map_accessors(tiny_dir):
+    """A map's seed is the whole 64-bit seed fired with; has_channel takes the scene's
+    channels only; maps of two Scene objects (even of one file) do not merge; a run's
+    summary says the scene's load time."""
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    seed = (1 << 40) + 3  # above 32 bits
+    a = thzmap.fire_photons(scene, photons=500, seed=seed)
+    assert a.seed == seed
+    assert [a.has_channel(c) for c in (0, 1)] == [True, True]
+    with pytest.raises(thzmap.ArgumentError, match=r"channel: expected a whole number in \[0, 1\]"):
+        a.has_channel(2)
+    other = thzmap.load_scene(tiny_dir / "scene.json")
+    b = thzmap.fire_photons(other, photons=500, seed=seed, first_photon=500)
+    with pytest.raises(thzmap.ArgumentError, match="different Scene objects"):
+        thzmap.merge_photon_maps([a, b])
+    assert scene.seconds_load > 0
+    run = thzmap.render(scene, a)
+    assert run.summary["timings_s"]["load"] == pytest.approx(scene.seconds_load, rel=1e-6)
