@@ -291,6 +291,20 @@ def test_runs(srv, root):
                                                           bands["id"]],
           "runs list")
     srv.json("GET", "/api/runs/999", status=404)
+    # photons (reported every 65536), then a render of 600 rows: the progress never goes
+    # back (the photons' share was once the channel's whole share, the render's half after)
+    tall = json.load(open(os.path.join(root, "s", "scene.json")))
+    tall["channels"] = tall["channels"][:1]
+    tall["sensors"][0]["resolution"] = [64, 600]
+    with open(os.path.join(root, "s", "tall.json"), "w") as f:
+        json.dump(tall, f)
+    run_t = srv.json("POST", "/api/runs", body={
+        "command": "simulate", "scene": "s/tall.json", "out": "out/tall",
+        "options": {"photons": 300000}}, status=202)
+    progress = [d for n, d in sse_events(srv, run_t["id"]) if n == "progress"]
+    fractions = [d["progress"] for d in progress]
+    check(len(fractions) >= 3 and fractions == sorted(fractions) and
+          progress[-1]["state"] == "done", "progress of a run: %r" % fractions)
     srv.json("DELETE", "/api/runs/%d" % run["id"], status=409)
     # a finished job: no error (null), and its time stays what the run took
     first = srv.json("GET", "/api/runs/%d" % run["id"])
@@ -343,7 +357,8 @@ def test_runs(srv, root):
     print("cancel took %.2f s" % (time.time() - t0))
     check(not os.path.exists(os.path.join(root, "out", "long")) and
           not os.path.exists(os.path.join(root, "out", "q")), "a cancelled run left output")
-    check(sorted(os.listdir(os.path.join(root, "out"))) == ["a", "b", "bands", "batch", "r", "rb"],
+    check(sorted(os.listdir(os.path.join(root, "out"))) == ["a", "b", "bands", "batch", "r", "rb",
+                                                               "tall"],
           "out/ holds %r" % os.listdir(os.path.join(root, "out")))
 
 
