@@ -15,8 +15,10 @@ why it runs no jobs).
 import http.client
 import json
 import os
+import re
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -61,6 +63,7 @@ def test_auth(srv):
           "info: %r" % info)
     srv.json("GET", "/api/nothing", status=404)
     srv.json("DELETE", "/api/info", status=405)
+    srv.json("POST", "/", status=405)
     # every character of the token counts, the last too
     last = srv.token[:-1] + ("1" if srv.token[-1] == "0" else "0")
     st, _, _ = srv.request("GET", "/api/info", auth=False,
@@ -328,6 +331,15 @@ def test_runs_confined(srv, root, scene):
               "a refused run wrote %s" % job["command"])
 
 
+def ipv6_loopback():
+    try:
+        with socket.socket(socket.AF_INET6) as s:
+            s.bind(("::1", 0))
+        return True
+    except OSError:
+        return False
+
+
 def main():
     tmp = tempfile.mkdtemp(prefix="thzmap-serve-")
     root = os.path.join(tmp, "root")
@@ -348,6 +360,23 @@ def main():
                 t = time.time()
                 fn()
                 print("%-10s %.2f s" % (name, time.time() - t), flush=True)
+            # IPv6's loopback (docs/gui.md: --host ::1) serves as IPv4's does (where the
+            # machine has one)
+            p = ipv6_loopback() and subprocess.Popen([BINARY, "serve", "--host", "::1", "--port", "0", "--root", root],
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            m = p and re.search(r"http://\[::1\]:(\d+)/\?token=([0-9a-f]{32}) ",
+                                p.stdout.readline())
+            info = None
+            if m:
+                conn = http.client.HTTPConnection("::1", int(m.group(1)), timeout=30)
+                conn.request("GET", "/api/info", headers={"Authorization": "Bearer " + m.group(2)})
+                info = json.loads(conn.getresponse().read())
+                conn.close()
+            if p:
+                p.send_signal(signal.SIGINT)
+                p.wait(timeout=30)
+                check(info and info["root"] == os.path.realpath(root),
+                      "serve --host ::1: %r %r" % (m and m.group(0), info))
             # a second server on the same port, or on a root that is no directory: exit 2
             for args in (["--port", str(srv.port), "--root", root],
                          ["--port", "0", "--root", os.path.join(root, "s", "scene.json")],

@@ -63,6 +63,9 @@ def test_cubes(srv):
 
 def test_pixel(root, srv):
     err = srv.json("GET", "/api/pixel?dir=out/a&sensor=cam&row=0&col=%d" % COLS, status=400)
+    # numbers that are not whole numbers are no pixel nor band (they were read as 0 and 1)
+    srv.json("GET", "/api/pixel?dir=out/a&sensor=cam&row=x&col=0", status=400)
+    srv.json("GET", "/api/cube/data?path=out/a/cam.radiance.hdr&band=1x", status=400)
     check(err and "outside the image of 16 x 12 pixels" in err.get("error", ""),
           "pixel one column right of the image: %r" % err)
     # a run without radiance_stderr: no standard error (null), the rest as it is
@@ -135,6 +138,8 @@ def test_outputs(root, srv):
     check(cam and "cam.visual.png" in cam[0]["images"] and
           "camera.visual.png" not in cam[0]["images"],
           "images of sensor cam: %r" % (cam and cam[0]["images"]))
+    err = srv.json("GET", "/api/outputs?dir=s/scene.json", status=400)
+    check(err and "not a directory" in err.get("error", ""), "outputs of a file: %r" % err)
     # a sweep's frames, without a batch.json (docs/gui.md: sweep-NN/frame-NNNNN)
     for d in ("sweep-01/frame-00000", "sweep-01/frame-00001", "sweep-02/frame-00000"):
         os.makedirs(os.path.join(root, "out", "sw", d))
@@ -166,6 +171,8 @@ def test_photons(srv):
                    status=404)
     check(err and "nobody" in err.get("error", ""), "photons of no such object: %r" % err)
     srv.json("GET", "/api/photons?path=out/a/photon-map.thzpm&channel=0&max=20000001", status=400)
+    # channel 2 of two (0 and 1): no such channel
+    srv.json("GET", "/api/photons?path=out/a/photon-map.thzpm&channel=2", status=404)
 
 
 def main():
