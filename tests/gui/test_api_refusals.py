@@ -147,6 +147,10 @@ def test_text_and_limits(srv, root):
           "a refused PUT wrote its file")
     st, _, data = srv.request("GET", "/api/info")
     check(st == 200 and json.loads(data)["web"] is False, "/api/info without a bundle: %r" % data)
+    # and / says so (docs/gui.md), as a page
+    st, h, data = srv.request("GET", "/")
+    check(st == 200 and h.get("Content-Type", "").startswith("text/html") and
+          b"not built" in data, "/ without a bundle: %s %r" % (st, data[:200]))
     # an empty body: its syntax error at column 1, the first (it said column 0)
     err = srv.json("POST", "/api/runs", body="", status=400)
     check(err and "line 1, column 1:" in err["error"], "an empty body: %r" % err)
@@ -233,6 +237,8 @@ def test_events(srv, root):
                                                "out": "out/path"}, status=202)
     if not run:
         return
+    # the stream is GET's alone (docs/gui.md: 405 wrong method)
+    srv.json("POST", "/api/runs/%d/events" % run["id"], status=405)
     sock = socket.create_connection(("127.0.0.1", srv.port), timeout=60)
     sock.sendall(("GET /api/runs/%d/events HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer %s\r\n"
                   "\r\n" % (run["id"], srv.token)).encode())
