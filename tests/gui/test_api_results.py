@@ -138,6 +138,12 @@ def test_outputs(root, srv):
     check(cam and "cam.visual.png" in cam[0]["images"] and
           "camera.visual.png" not in cam[0]["images"],
           "images of sensor cam: %r" % (cam and cam[0]["images"]))
+    # a map at the root itself: its path relative to the root, not "/photon-map.thzpm"
+    shutil.copy(os.path.join(root, "out", "a", "photon-map.thzpm"), root)
+    res = srv.json("GET", "/api/outputs?dir=")
+    check(res and res["photon_map"] == "photon-map.thzpm", "a map at the root: %r"
+          % (res and res["photon_map"]))
+    os.remove(os.path.join(root, "photon-map.thzpm"))
     err = srv.json("GET", "/api/outputs?dir=s/scene.json", status=400)
     check(err and "not a directory" in err.get("error", ""), "outputs of a file: %r" % err)
     # a sweep's frames, without a batch.json (docs/gui.md: sweep-NN/frame-NNNNN)
@@ -171,6 +177,16 @@ def test_photons(srv):
                    status=404)
     check(err and "nobody" in err.get("error", ""), "photons of no such object: %r" % err)
     srv.json("GET", "/api/photons?path=out/a/photon-map.thzpm&channel=0&max=20000001", status=400)
+    # the room's photons (object 0) are the room's alone
+    st, h, data = srv.request("GET", "/api/photons?path=out/a/photon-map.thzpm&channel=0&object=room"
+                              "&max=20000000")
+    objs = {struct.unpack_from("<f", data, 32 * k + 28)[0] for k in range(len(data) // 32)}
+    check(st == 200 and objs == {0.0} and len(data) == 32 * int(h["X-Thzmap-Photons-Total"]),
+          "photons of the room: %d, objects %r" % (st, objs))
+    # a map without a summary.json beside it: its scene is the one given (else a 400)
+    srv.json("GET", "/api/photons/info?path=out/maponly/photon-map.thzpm", status=400)
+    info = srv.json("GET", "/api/photons/info?path=out/maponly/photon-map.thzpm&scene=s/scene.json")
+    check(info and info["objects"] == ["room", "target", "cover"], "a map with scene=: %r" % info)
     # channel 2 of two (0 and 1): no such channel
     srv.json("GET", "/api/photons?path=out/a/photon-map.thzpm&channel=2", status=404)
 
@@ -194,6 +210,9 @@ def main():
                      ["s/small.json", "-o", "out/small"]):
             subprocess.run([BINARY, "simulate", "-q"] + args, cwd=root, check=True)
         copy_run(root, "a", "nose", drop=("radiance_stderr",))
+        os.makedirs(os.path.join(root, "out", "maponly"))
+        shutil.copy(os.path.join(root, "out", "a", "photon-map.thzpm"),
+                    os.path.join(root, "out", "maponly"))
         shutil.copy(os.path.join(root, "out", "nose", "cam.visual.png"),
                     os.path.join(root, "out", "nose", "camera.visual.png"))
         # errors of 0 everywhere, and a second run like it but 1 K warmer at pixel 5

@@ -100,6 +100,12 @@ def test_validate(srv, scene):
           objs["target-2"]["triangles"] == objs["target"]["triangles"] > 300000 // 2,
           "a scene of two large meshes: %r" % (objs and {n: (o["triangles"], o["mesh"] is None)
                                                           for n, o in objs.items()}))
+    # a sensor outside the enclosure: valid, with the loader's warning
+    away = json.loads(text)
+    away["sensors"][0]["position_m"] = [0, -5, 0.4]
+    res = srv.json("POST", "/api/validate", body={"path": "s/scene.json", "text": json.dumps(away)})
+    check(res and res["ok"] and any("outside" in w for w in res["warnings"]),
+          "a sensor outside the room: %r" % (res and res["warnings"]))
     bad = json.loads(text)
     bad["objects"][1]["temperature_k"] = -5
     res = srv.json("POST", "/api/validate", body={"path": "s/scene.json", "text": json.dumps(bad)})
