@@ -202,10 +202,7 @@ void movie_layout_of(uint32_t columns, uint32_t rows, movie_layout *out)
                           .height = (h + 1) & ~1u};
 }
 
-/* The decimals of a frame time: the fewest (at most 2 beyond the interval's first
- * significant digit) that write every multiple of the frame interval dt exactly (0.25 s
- * at 4 fps, 0.125 s at 8), else those that tell frames apart (30 fps: 2). */
-static int movie_time_decimals(double dt)
+int movie_time_decimals(double dt)
 {
     if (!(dt > 0.0) || !isfinite(dt))
         return 2;

@@ -216,6 +216,10 @@ typedef struct movie_limit {
 int movie_fits(uint32_t columns, uint32_t rows, movie_limit *out);
 
 void movie_layout_of(uint32_t columns, uint32_t rows, movie_layout *out);
+/* The decimals of a movie caption's frame time: the fewest (at most 2 beyond the
+ * interval's first significant digit) that write every multiple of the frame interval dt
+ * exactly (0.25 s at 4 fps, 0.125 s at 8), else those that tell frames apart (30 fps: 2). */
+int movie_time_decimals(double dt);
 /* Opens the encoder on a temporary file beside spec->path. */
 thz_status movie_open(const movie_spec *spec, movie_writer **out, thz_error *err);
 /* Encodes the next frame: tb (columns * rows, K, row 0 at the top) at time_s. */

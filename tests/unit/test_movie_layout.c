@@ -31,10 +31,28 @@ static void test_enlargement(void **state)
         }
 }
 
+/* The caption's decimals: every frame time written exactly where a few decimals can
+ * (0.125 s at 8 fps needs 3, 0.0625 s at 16 fps 4), else enough to tell frames apart
+ * (30 fps: 0.03, 0.07, 0.10 s). */
+static void test_time_decimals(void **state)
+{
+    (void)state;
+    const struct {
+        double dt;
+        int decimals;
+    } cases[] = {{1.0, 0},   {3.0, 0},    {0.5, 1},   {0.2, 1},      {0.25, 2},
+                 {0.125, 3}, {0.0625, 4}, {0.001, 3}, {1.0 / 30, 2}, {1.0 / 3, 1}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+        if (movie_time_decimals(cases[i].dt) != cases[i].decimals)
+            fail_msg("a frame interval of %g s: %d decimals, expected %d", cases[i].dt,
+                     movie_time_decimals(cases[i].dt), cases[i].decimals);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_enlargement),
+        cmocka_unit_test(test_time_decimals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
