@@ -135,6 +135,23 @@ same_run "$work/pa3" "$work/pa1" "3 ranks, path with passes"
 $PY -c 'import json,sys; sys.exit(json.load(open(sys.argv[1]))["channels"][0]["render_passes"] < 2)' \
     "$work/pa3/summary.json" || fail "path: fewer than 2 passes (the test tests one pass)"
 grep -q "warning" "$work/pa3.out" && fail "path under mpirun warned: $(grep warning "$work/pa3.out")"
+# the bytes its closing line says (docs/mpi.md "What moves"): per channel a request to
+# begin, one per pass and one to end, 152 B to each other rank; per pass each other rank's
+# tiles, 72 B of counts and size + 16 B per pixel, its pixels those of the 16 x 16 tiles
+# (tx + ty) mod 3 gives it (24 x 24 pixels)
+$PY - "$work/pa3/summary.json" "$work/pa3.out" <<'PY' || fail "3 ranks, path: the bytes communicated differ from docs/mpi.md's"
+import json, re, sys
+passes = json.load(open(sys.argv[1]))["channels"][0]["render_passes"]
+N, W, H, T = 3, 24, 24, 16
+px = [0] * N
+for y in range(H):
+    for x in range(W):
+        px[(x // T + y // T) % N] += 1
+total = (2 + passes) * 152 * (N - 1) + passes * sum(72 + 16 * p for p in px[1:])
+said = re.search(r"3 MPI ranks \(([0-9.e+-]+) MB communicated\)", open(sys.argv[2]).read())
+if not said or said.group(1) != "%.3g" % (1e-6 * total):
+    sys.exit(f"said {said and said.group(1)} MB, expected {total} B in {passes} passes")
+PY
 
 # An isothermal room: final-gather's deviation map holds no photon at all, which the other
 # ranks must render from as one process does (an empty map, not "no map").
