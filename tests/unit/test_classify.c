@@ -65,6 +65,12 @@ static void assert_confusion_rows_are_truth(const classify_result *r, const int3
         }
         assert_int_equal(row, in_truth);
         assert_int_equal(column, assigned);
+        /* a class's accuracy is its recall: its pixels assigned to it over its pixels
+         * (analysis.md), not its precision (over the pixels assigned to it) */
+        uint64_t hits = 0;
+        for (size_t p = 0; p < PIXELS; p++)
+            hits += truth[p] == r->class_object[k] && r->assigned[p] == r->class_object[k];
+        assert_true(r->class_accuracy[k] == (double)hits / (double)in_truth);
     }
 }
 
@@ -270,6 +276,34 @@ static void test_split_depends_on_seed(void **state)
     classify_result_fini(&c);
 }
 
+/* The split is a shuffle of each class's pixels: in a class of two pixels, half training,
+ * each pixel trains for about half of the seeds (40 seeds: 20 +- 3.2 sigma). A shuffle
+ * that stopped before its last swap (a mutant) passed every test: it never moved the
+ * class's first pixel out of the first place, so that it trained for every seed. */
+static void test_split_is_a_shuffle(void **state)
+{
+    (void)state;
+    enum { N = 6, SEEDS = 40 };
+    const float cube[2 * N] = {300, 300, 302, 302, 304, 304, 300, 300, 300, 300, 301, 301};
+    const int32_t truth[N] = {0, 0, 1, 1, 2, 2};
+    size_t first_trains[3] = {0, 0, 0};
+    for (uint64_t seed = 1; seed <= SEEDS; seed++) {
+        classify_result r;
+        thz_error err = {0};
+        assert_int_equal(classify_run(cube, 2, N, truth, CLASSIFY_LDA, 0.5, seed, &r, &err),
+                         THZ_OK);
+        for (size_t k = 0; k < 3; k++) {
+            assert_int_equal(r.train[2 * k] + r.train[2 * k + 1], 1);
+            first_trains[k] += r.train[2 * k];
+        }
+        classify_result_fini(&r);
+    }
+    for (size_t k = 0; k < 3; k++)
+        if (first_trains[k] < 10 || first_trains[k] > 30)
+            fail_msg("class %zu: its first pixel trained for %zu of %d seeds", k, first_trains[k],
+                     SEEDS);
+}
+
 /* A tie goes to the class of the lower object index (analysis.md): two objects whose
  * spectra have the same shape, (300, 301) K and twice that, are the same to `sam` (angle 0
  * to both means, exactly: the means are whole numbers and the second is twice the
@@ -425,6 +459,37 @@ static void test_mahalanobis_unbiased_covariance(void **state)
     classify_result_fini(&r);
 }
 
+/* Of each class's pixels the fraction rounded, at least one, trains (analysis.md): one
+ * band, object 0 of 3 pixels at 0 K, object 1 of 97 at 10 K, --train-fraction 0.1: 1 and
+ * 10 training pixels (0.3 rounds to 0). With no training pixel object 0's mean was 0 / 0,
+ * every pixel went to it (accuracy 0.03), and that passed every test. */
+static void test_at_least_one_training_pixel(void **state)
+{
+    (void)state;
+    enum { N = 100, N0 = 3 };
+    float cube[N];
+    int32_t truth[N];
+    for (size_t p = 0; p < N; p++) {
+        truth[p] = p < N0 ? 0 : 1;
+        cube[p] = (p < N0 ? 0.0f : 10.0f) + 0.01f * (float)(p % 5);
+    }
+    /* (sam and ace say nothing in one band: every angle is 0, every coherence 1) */
+    for (int m = CLASSIFY_MAHALANOBIS; m <= CLASSIFY_MATCHED_FILTER; m++) {
+        classify_result r;
+        thz_error err = {0};
+        assert_int_equal(classify_run(cube, 1, N, truth, (classify_method)m, 0.1, 1, &r, &err),
+                         THZ_OK);
+        size_t train[2] = {0, 0};
+        for (size_t p = 0; p < N; p++)
+            train[truth[p]] += r.train[p];
+        assert_int_equal(train[0], 1);
+        assert_int_equal(train[1], 10);
+        if (!(r.accuracy == 1.0))
+            fail_msg("%s: accuracy %g", classify_method_name((classify_method)m), r.accuracy);
+        classify_result_fini(&r);
+    }
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -455,11 +520,13 @@ int main(void)
         cmocka_unit_test(test_auc_and_roc_of_held_out_pixels),
         cmocka_unit_test(test_unequal_classes),
         cmocka_unit_test(test_split_depends_on_seed),
+        cmocka_unit_test(test_split_is_a_shuffle),
         cmocka_unit_test(test_tie_goes_to_lower_object),
         cmocka_unit_test(test_lda_prior),
         cmocka_unit_test(test_matched_filter_normalised),
         cmocka_unit_test(test_added_noise_spread),
         cmocka_unit_test(test_mahalanobis_unbiased_covariance),
+        cmocka_unit_test(test_at_least_one_training_pixel),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
