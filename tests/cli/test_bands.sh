@@ -267,6 +267,37 @@ for name, rng in (("A", 3.0), ("background", 2.0)):
                                       for x in sd[name]), (name, sd[name])
 PYEOF
 
+# Two channels of the same plates: each class has one nuisance (A its own temperature,
+# the background the room's), which moves its Tb the same way in both channels, so its
+# covariance is its nuisance_sd_k's outer product (correlation 1) plus the NETD^2 (its
+# pixels do not spread): the worst pair's B from bands.json's class statistics with that
+# covariance. A nuisance added to the diagonal alone (a mutant) passed every test (the
+# one-channel checks cannot see a correlation): B 11.56 for 5.80, as if each channel
+# brought independent evidence when one temperature change moves both.
+"$THZMAP" bands "$work/plate.json" -o "$work/plate2" --count 2 --from-thz 0.3 --to-thz 0.7 \
+    --step-ghz 200 --paths 1 -q --targets A --temperature-range-k 3 --ambient-range-k 2 \
+    --humidity-range 0 --netd-k 0.1 --threads 1 || fail "plate run, two channels: exit status $?"
+$PY - "$work/plate2/bands.json" <<'PYEOF' || fail "nuisance correlation: $(head -c 600 "$work/plate2/bands.json")"
+import json, math, sys
+import numpy as np
+d = json.load(open(sys.argv[1]))
+f = d["candidates"]["frequency_thz"]
+idx = [f.index(x) for x in d["selected_thz"]]
+a, bg = d["classes"]
+assert (a["name"], bg["name"]) == ("A", "background") and len(idx) == 2, d["classes"]
+def cov(c):
+    g = lambda key: np.array([c[key][i] for i in idx])
+    assert all(g("pixel_sd_k") == 0.0), c
+    return np.outer(g("nuisance_sd_k"), g("nuisance_sd_k")) + np.diag(g("netd_k") ** 2)
+ca, cb = cov(a), cov(bg)
+s = (ca + cb) / 2
+dm = np.array([a["mean_tb_k"][i] - bg["mean_tb_k"][i] for i in idx])
+b = dm @ np.linalg.solve(s, dm) / 8 + 0.5 * math.log(
+    np.linalg.det(s) / math.sqrt(np.linalg.det(ca) * np.linalg.det(cb)))
+print("B", b, d["bhattacharyya"], file=sys.stderr)
+sys.exit(0 if math.isclose(b, d["bhattacharyya"], rel_tol=1e-6) else 1)
+PYEOF
+
 # bad input: exit status 2 and a message naming the problem
 expect2() {
     local what=$1; shift
