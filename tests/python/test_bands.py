@@ -158,6 +158,11 @@ def test_bands_takes_a_loaded_scene_and_targets():
     sel = thzmap.bands(scene, 1, targets=["A", "B"], seed=3, **GRID)
     assert [c["name"] for c in sel.report["classes"]] == ["A", "B", "background"]
     assert sel.report["seed"] == 3 and 0.0 <= sel.score <= 2.0
+    # every object seen a target: no "background" class (docs/analysis.md: every other
+    # object seen forms it); one without pixels (a mutant that always added it passed
+    # every test) would be a class of no pixels in every pair
+    sel = thzmap.bands(scene, 1, targets=["room", "A", "B", "C"], seed=3, **GRID)
+    assert [c["name"] for c in sel.report["classes"]] == ["room", "A", "B", "C"]
 
 
 def test_bands_says_the_scene_warnings():
