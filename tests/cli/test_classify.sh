@@ -36,6 +36,12 @@ done
     2> "$work/all.err" || fail "classify --train-fraction 0.999 exit status $?"
 grep -q "warning: no pixel was held out" "$work/all.err" || fail "no held-out warning: $(cat "$work/all.err")"
 grep -qi "nan" "$work/all.err" && fail "classify printed nan: $(cat "$work/all.err")"
+# ... and classification.json counts them so: every pixel seen training, none held out
+# (training_pixels written from the held-out count, a mutant, passed every test: at a
+# fraction of 1/2 the two counts are equal)
+$PY -c "import json, sys; d = json.load(open(sys.argv[1]))
+assert (d['training_pixels'], d['held_out_pixels']) == (d['pixels'], 0), d" \
+    "$work/c-all/classification.json" || fail "training pixels at --train-fraction 0.999"
 
 $PY - "$work/run" "$work/c-lda" <<'PYEOF' || fail "lda, noise-free"
 import json, sys
@@ -61,8 +67,43 @@ cls = np.fromfile(f"{out}/cam.class.img", "<f4").astype(int)
 assert (cls == ids).all()
 hdr = open(f"{out}/cam.class.hdr").read()
 assert "object names = {room, A, B, C}" in hdr, hdr
+# -1 is "nothing hit" and what an ENVI reader is to leave out (0 there, a mutant that
+# passed every test, hid the room's pixels, object 0, as no data)
+assert "data ignore value = -1\n" in hdr and "data units = 1\n" in hdr, hdr
 for c in d["classes"]:
     assert c["auc"] == 1.0 and len(c["roc"]["true_positive_rate"]) == 101
+PYEOF
+
+# S.class.png draws each pixel in its class's `color` (classification.json), nothing hit
+# in black: here the room's pixels made "nothing hit", so that the classes (A, B, C:
+# objects 1, 2, 3) are not numbered as their objects. The palette indexed by the object
+# instead of the class (a mutant) passed every test, whose objects were all seen: every
+# class drawn in the next class's colour, the PNG's legend in the JSON wrong.
+cp -r "$work/run" "$work/run-noroom"
+$PY - "$work/run-noroom/cam.object_id.img" <<'PYEOF'
+import sys
+import numpy as np
+t = np.fromfile(sys.argv[1], "<f4")
+t[t == 0] = -1
+t.tofile(sys.argv[1])
+PYEOF
+"$THZMAP" classify "$work/run-noroom" --sensor cam -o "$work/c-noroom" --method lda -q ||
+    fail "classify without the room: exit status $?"
+$PY - "$work/c-noroom" <<'PYEOF' || fail "class map colours"
+import json, sys
+import numpy as np
+from PIL import Image
+out = sys.argv[1]
+d = json.load(open(f"{out}/classification.json"))
+assert [c["object"] for c in d["classes"]] == [1, 2, 3], d["classes"]
+cls = np.fromfile(f"{out}/cam.class.img", "<f4").astype(int)
+png = np.asarray(Image.open(f"{out}/cam.class.png").convert("RGB")).reshape(-1, 3)
+assert len(png) == len(cls) and (cls == -1).any() and (cls >= 0).any()
+colour = {c["object"]: c["color"] for c in d["classes"]}
+colour[-1] = [0, 0, 0]
+want = np.array([colour[o] for o in cls])
+assert len({tuple(c) for c in colour.values()}) == 4
+assert (png == want).all(), [(tuple(p), tuple(w)) for p, w in zip(png, want) if tuple(p) != tuple(w)][:3]
 PYEOF
 
 # accuracy against the added NETD: exact up to 1 K (the plates differ by more), then
