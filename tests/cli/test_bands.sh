@@ -111,6 +111,9 @@ assert tb_dry[i_line] > max(tb_dry[i] for i in plateau) - 0.3, tb_dry
 assert tb_humid[i_line] < tb_humid[freqs.index(humid_f)] - 2.0, tb_humid
 # the air's temperature is given here: it is among the nuisances varied
 assert h["nuisances"]["air_temperature_varied"], h["nuisances"]
+# ... and so is its humidity (bands.json's humidity_varied never set, a mutant, passed
+# every test)
+assert h["nuisances"]["humidity_varied"], h["nuisances"]
 PYEOF
 
 # the sensor's noise: a given netd_k per channel, interpolated to the candidates; a
@@ -235,6 +238,21 @@ assert r["ca"]["renders"] == 3 and n["angle_varied"] and not n["thickness_varied
 assert max(max(v) for v in sd["ca"].values()) > 0.05, sd["ca"]
 assert r["cd"]["nuisances"]["angle_varied"], r["cd"]["nuisances"]
 assert max(max(v) for v in sd["cd"].values()) > 0.05, sd["cd"]
+# no air in this scene: the humidity is not among the nuisances varied
+assert not any(d["nuisances"]["humidity_varied"] for d in r.values()), r["ct"]["nuisances"]
+PYEOF
+# a pan of 90 degrees leaves the targets out of view: "a class the turned sensor no longer
+# sees gets no angle spread" (analysis.md); the room it then sees does. A lost class's mean
+# taken as 0 K instead of the nominal one (a mutant) passed every test: a spread of
+# 280 / sqrt(3) K, the class unseparable from anything.
+# shellcheck disable=SC2086
+"$THZMAP" bands "$work/covered-dir.json" -o "$work/c90" $NUIS --angle-range-deg 90 \
+    || fail "--angle-range-deg 90: exit status $?"
+$PY - "$work/c90/bands.json" <<'PYEOF' || fail "a class out of the turned view: $(head -c 600 "$work/c90/bands.json")"
+import json, sys
+sd = {c["name"]: c["nuisance_sd_k"] for c in json.load(open(sys.argv[1]))["classes"]}
+assert all(x == 0.0 for name in ("cover", "B", "C") for x in sd[name]), sd
+assert min(sd["background"]) > 0.5, sd
 PYEOF
 
 # nuisances by hand: black objects seen directly (no air, no reflection: path's estimate
