@@ -66,6 +66,37 @@ a.pop("seconds"); b.pop("seconds")
 assert a == b
 PYEOF
 
+# per_k[0] (one channel) from bands.json's own class statistics: each class's variance in
+# the channel its pixels' spread, its nuisances' and the NETD squared; B of every pair,
+# the worst (its JM the score, its pair the worst_pair) and the mean JM; the top level is
+# per_k's last entry. The top-level mean_jm taken from k = 1, or per_k's B and worst pair
+# from k = K (mutants), passed every test, whose checks of these had K = 1. (abs_tol: a B of
+# 1e-3 from means of 300 K written with bands.json's 10 digits.)
+$PY - "$work/f/bands.json" <<'PYEOF' || fail "per_k from the class statistics"
+import itertools, json, math, sys
+d = json.load(open(sys.argv[1]))
+e = d["per_k"][0]
+c = d["candidates"]["frequency_thz"].index(e["selected_thz"][0])
+var = lambda k: k["pixel_sd_k"][c] ** 2 + k["nuisance_sd_k"][c] ** 2 + k["netd_k"][c] ** 2
+def bhatt(a, b):
+    v1, v2 = var(a), var(b)
+    v = (v1 + v2) / 2
+    return (a["mean_tb_k"][c] - b["mean_tb_k"][c]) ** 2 / (8 * v) + 0.5 * math.log(v / math.sqrt(v1 * v2))
+pairs = sorted((bhatt(a, b), a["name"], b["name"]) for a, b in itertools.combinations(d["classes"], 2))
+jm = [2 * (1 - math.exp(-b)) for b, _, _ in pairs]
+print("k = 1:", pairs[0], e, file=sys.stderr)
+assert math.isclose(pairs[0][0], e["bhattacharyya"], rel_tol=1e-6, abs_tol=1e-7)
+assert math.isclose(jm[0], e["score"], rel_tol=1e-6, abs_tol=1e-7)
+assert sorted(e["worst_pair"]) == sorted(pairs[0][1:])
+assert math.isclose(sum(jm) / len(jm), e["mean_jm"], rel_tol=1e-6, abs_tol=1e-7)
+last = d["per_k"][-1]
+for key in ("selected_thz", "selected_relative_width", "score", "bhattacharyya", "mean_jm",
+            "worst_pair"):
+    assert d[key] == last[key], key
+# the k = 1 and k = 2 entries differ where the tests above could not tell them apart
+assert e["mean_jm"] != last["mean_jm"] and e["bhattacharyya"] != last["bhattacharyya"]
+PYEOF
+
 # --targets: the plates and the rest as one background class
 "$THZMAP" bands "$IN/features.json" -o "$work/t" --count 2 --from-thz 0.2 --to-thz 1.0 \
     --step-ghz 50 --paths 4 -q --targets A,B || fail "--targets run exit status $?"
