@@ -126,6 +126,16 @@ acc = [json.load(open(f"{sys.argv[1]}/n-{n}/classification.json"))["accuracy"]
 assert acc[:3] == [1.0, 1.0, 1.0], acc
 assert 1.0 > acc[3] > acc[4] > acc[5], acc
 assert acc[-1] < 0.7, acc
+# each class's auc is the area under its own ROC: the 101-point curve's trapezoids, within
+# the points' spacing (the held-out pixels / 100 each), at 8 K where the classes' AUCs differ
+# (every class given class 0's auc or ROC, mutants, passed every test: at 0 K all are 1)
+d = json.load(open(f"{sys.argv[1]}/n-8/classification.json"))
+auc = [c["auc"] for c in d["classes"]]
+assert max(auc) - min(auc) > 0.1, auc
+for c in d["classes"]:
+    f, t = c["roc"]["false_positive_rate"], c["roc"]["true_positive_rate"]
+    area = sum((f[i + 1] - f[i]) * (t[i + 1] + t[i]) / 2 for i in range(len(f) - 1))
+    assert abs(area - c["auc"]) < 0.01, (c["name"], area, c["auc"])
 PYEOF
 
 # a measured cube is preferred: a copy of the run with a noisy measured cube
