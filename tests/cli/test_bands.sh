@@ -400,6 +400,27 @@ assert len(same["warnings"]) == 1 and "cannot be told apart" in same["warnings"]
 assert diff["warnings"] == [] and diff["bhattacharyya"] > 10 * diff["monte_carlo_bhattacharyya"]
 PYEOF
 
+# one path of one sample per pixel estimates no standard error: the pixels' variance stands
+# in for the Monte Carlo one (analysis.md, a bound), so that on one channel
+# monte_carlo_bhattacharyya = r (1 + 3 sqrt 2) / 8, r = (sd_X^2 / n_X + sd_Y^2 / n_Y) / S
+# with S the pair's mean variance, from bands.json's class statistics. A render taken as
+# having standard errors whatever they were (a mutant) passed every test: the means' noise
+# then 0, and B_MC 0, for every --paths 1 run.
+"$THZMAP" bands "$work/identical.json" -o "$work/id1" --count 1 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 50 --paths 1 --targets X,Y -q || fail "one path: exit status $?"
+$PY - "$work/id1/bands.json" <<'PYEOF' || fail "B_MC with one path: $(head -c 600 "$work/id1/bands.json")"
+import json, math, sys
+d = json.load(open(sys.argv[1]))
+c = d["candidates"]["frequency_thz"].index(d["selected_thz"][0])
+cl = {k["name"]: k for k in d["classes"]}
+x, y = (cl[n] for n in d["worst_pair"])
+var = lambda k: k["pixel_sd_k"][c] ** 2 + k["nuisance_sd_k"][c] ** 2 + k["netd_k"][c] ** 2
+r = (x["pixel_sd_k"][c] ** 2 / x["pixels"] + y["pixel_sd_k"][c] ** 2 / y["pixels"]) / (
+    (var(x) + var(y)) / 2)
+want = r * (1 + 3 * math.sqrt(2)) / 8
+assert want > 1e-3 and math.isclose(d["monte_carlo_bhattacharyya"], want, rel_tol=1e-6), want
+PYEOF
+
 expect2 "unknown target" "$IN/features.json" -o "$work/x" --count 1 --targets A,nope
 grep -q "nope" "$work/err" || fail "unknown target not named: $(cat "$work/err")"
 expect2 "no sensor noise" "$IN/features.json" -o "$work/x" --count 1 --netd-k 0
