@@ -340,7 +340,7 @@ static double roc_curve(scored *v, size_t n, double *fpr, double *tpr)
     next_point = 1;
     for (size_t i = 0; i < n;) {
         size_t j = i, dtp = 0, dfp = 0;
-        while (j < n && v[j].score == v[i].score) {
+        while (j < n && (j == i || v[j].score == v[i].score)) { /* NaN: a group of one */
             dtp += (size_t)v[j].positive;
             dfp += (size_t)!v[j].positive;
             j++;
