@@ -142,7 +142,7 @@ def _classify_dir(run_dir, sensor, o):
 def classify(run, sensor, method=None, train_fraction=None, seed=None, netd_k=None):
     """`thzmap classify` in memory: classifies sensor `sensor`'s cube of `run` (a
     directory `thzmap simulate` wrote, or a Result, which is saved to a temporary
-    directory first) with `method` (default "sam", which needs 2 channels or more;
+    directory first) with `method` (default "sam"; "sam" and "ace" need 2 channels or more;
     methods() lists them), training on
     `train_fraction` of each class's pixels (default 0.5) chosen by `seed` (default 1);
     `netd_k` > 0 first adds Gaussian noise of that many K. Raises ArgumentError for bad

@@ -206,13 +206,17 @@ static thz_status classify_build(const thz_cube *cube, const thz_cube *truth,
                              truth->stem, tc->samples, tc->lines, tc->bands, cc->samples, cc->lines,
                              cube->stem);
     /* In one band every positive spectrum has the angle 0 to every class: SAM would give
-     * every pixel to the first class (37.5 % on plate-in-box, with no word of why). */
-    if (method == CLASSIFY_SAM && cc->bands < 2)
+     * every pixel to the first class (37.5 % on plate-in-box, with no word of why). ACE's
+     * squared cosine is 1 for every pixel there, its sign only the side of the background
+     * mean: every class scored +-1, ties to the first (0.42 on three separable classes). */
+    if ((method == CLASSIFY_SAM || method == CLASSIFY_ACE) && cc->bands < 2)
         return thz_error_set(err, THZ_ERR_INPUT,
-                             "%s has 1 channel: sam compares spectral shapes (the angle between "
-                             "spectra), which needs 2 channels or more; use another method: "
-                             "mahalanobis, lda, matched-filter or ace",
-                             cube->stem);
+                             "%s has 1 channel: %s compares spectral shapes (%s), which needs 2 "
+                             "channels or more; use another method: mahalanobis, lda or "
+                             "matched-filter",
+                             cube->stem, method == CLASSIFY_SAM ? "sam" : "ace",
+                             method == CLASSIFY_SAM ? "the angle between spectra"
+                                                    : "a pixel's whitened cosine to a target's");
     size_t pixels = (size_t)cc->samples * cc->lines;
     thz_classification *c = thz_calloc(1, sizeof *c);
     int32_t *ids = thz_calloc(pixels, sizeof *ids);

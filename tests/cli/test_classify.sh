@@ -219,9 +219,17 @@ json.dump(d, open(sys.argv[2], "w"))
 PYEOF
 "$THZMAP" simulate "$work/one-channel.json" -o "$work/run1" -q --seed 3 || fail "one channel: simulate exit status $?"
 expect2 "sam on one channel" "$work/run1" --sensor cam -o "$work/x"
-grep -q "cam.brightness_temperature has 1 channel: sam .* needs 2 channels or more; use another method: mahalanobis, lda, matched-filter or ace" \
+grep -q "cam.brightness_temperature has 1 channel: sam .* needs 2 channels or more; use another method: mahalanobis, lda or matched-filter" \
     "$work/err" || fail "sam on one channel: $(cat "$work/err")"
 [ -e "$work/x" ] && fail "sam on one channel left $work/x"
+# ace likewise: its squared cosine is 1 for every pixel in one channel (a separable scene
+# classified 42 % right, every class scored +-1)
+expect2 "ace on one channel" "$work/run1" --sensor cam -o "$work/x" --method ace
+grep -q "cam.brightness_temperature has 1 channel: ace compares spectral shapes .* needs 2 channels or more; use another method: mahalanobis, lda or matched-filter" \
+    "$work/err" || fail "ace on one channel: $(cat "$work/err")"
+[ -e "$work/x" ] && fail "ace on one channel left $work/x"
+"$THZMAP" classify "$work/run1" --sensor cam -o "$work/c-one-mf" --method matched-filter -q ||
+    fail "matched-filter on one channel: exit status $?"
 "$THZMAP" classify "$work/run1" --sensor cam -o "$work/c-one-mahalanobis" --method mahalanobis -q ||
     fail "mahalanobis on one channel: exit status $?"
 printf 'ENVI\nsamples = 24\nlines = 16\nbands = 5\ndata type = 4\n' > "$work/run2/cam.measured_brightness_temperature.hdr"
