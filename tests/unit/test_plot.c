@@ -348,14 +348,31 @@ static void test_long_title(void **state)
     free(dir);
 }
 
+/* '#' starts a PLplot escape ("#d" lowers the text, "#u" raises it): a '#' in a name
+ * that goes into a figure (an object "hidden#1" in S.spectra.png's legend, a sensor in a
+ * title) is doubled, which PLplot draws as one '#'. The doubling dropped (a mutant)
+ * passed every test. */
+static void test_escape(void **state)
+{
+    (void)state;
+    char out[64];
+    plot_escape(out, sizeof out, "hidden#1 #d#u");
+    assert_string_equal(out, "hidden##1 ##d##u");
+    plot_escape(out, sizeof out, "T (K)");
+    assert_string_equal(out, "T (K)");
+}
+
 /* A count's axis (bands-score.png's K) has its ticks at whole numbers. */
 static void test_whole_ticks(void **state)
 {
     (void)state;
-    const double spans[] = {0.2, 2.2, 3.1, 9.0, 17.0, 33.0, 250.0};
-    const double want[] = {1.0, 1.0, 1.0, 2.0, 5.0, 5.0, 50.0};
-    for (size_t i = 0; i < sizeof spans / sizeof spans[0]; i++)
+    const double spans[] = {0.2, 2.2, 3.1, 9.0, 17.0, 33.0, 60.0, 250.0, 700.0};
+    const double want[] = {1.0, 1.0, 1.0, 2.0, 5.0, 5.0, 10.0, 50.0, 100.0};
+    for (size_t i = 0; i < sizeof spans / sizeof spans[0]; i++) {
         assert_true(plot_whole_tick(spans[i]) == want[i]);
+        /* at most 10 ticks (60 in steps of 5 would be 12) */
+        assert_true(spans[i] / want[i] <= 10.0);
+    }
     char *dir = make_tmp_dir();
     char path[1024];
     snprintf(path, sizeof path, "%s/k.png", dir);
@@ -452,6 +469,7 @@ int main(void)
         cmocka_unit_test(test_image_colours),
         cmocka_unit_test(test_odd_images),
         cmocka_unit_test(test_visual_png_orientation),
+        cmocka_unit_test(test_escape),
         cmocka_unit_test(test_image_orientation),
         cmocka_unit_test(test_colour_range),
         cmocka_unit_test(test_lines),
