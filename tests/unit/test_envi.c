@@ -10,6 +10,7 @@
 
 #include <dirent.h>
 #include <math.h>
+#include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -127,6 +128,49 @@ static void assert_img_floats(const char *dir, const char *stem, const float *ex
     free(data);
 }
 
+/* The mean column of the pixels within 12 of (r, g, b) left of 0.78 of the width (the
+ * preview, not its colour bar: test_plot.c); -1 if none. */
+static double mean_x_of(const unsigned char *px, uint32_t w, uint32_t h, int r, int g, int b)
+{
+    double sx = 0.0;
+    size_t n = 0;
+    for (uint32_t j = 0; j < h; j++)
+        for (uint32_t i = 0; i < (uint32_t)(0.78 * w); i++) {
+            const unsigned char *p = px + 3 * ((size_t)j * w + i);
+            if (abs(p[0] - r) <= 12 && abs(p[1] - g) <= 12 && abs(p[2] - b) <= 12) {
+                sx += i;
+                n++;
+            }
+        }
+    return n ? sx / (double)n : -1.0;
+}
+
+/* DIR/cam.PREFIX-NN.png shows channel NN (scene-format.md), whose values fill_images
+ * makes warmest at the right in channel 1 and at the left in channel 2: the colour map's
+ * warm end (viridis 253 231 37) right of its cold end (68 1 84) in the first, left of it
+ * in the second. Every preview drawn from channel 1 (a mutant, of S.band-NN.png or of
+ * S.measured-band-NN.png) passed every test. */
+static void check_previews(const char *dir, const char *prefix)
+{
+    for (int c = 0; c < NCH; c++) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/cam.%s-%02d.png", dir, prefix, c + 1);
+        png_image im;
+        memset(&im, 0, sizeof im);
+        im.version = PNG_IMAGE_VERSION;
+        assert_true(png_image_begin_read_from_file(&im, path));
+        im.format = PNG_FORMAT_RGB;
+        unsigned char *px = malloc(PNG_IMAGE_SIZE(im));
+        assert_non_null(px);
+        assert_true(png_image_finish_read(&im, NULL, px, 0, NULL));
+        double warm = mean_x_of(px, im.width, im.height, 253, 231, 37);
+        double cold = mean_x_of(px, im.width, im.height, 68, 1, 84);
+        if (warm < 0.0 || cold < 0.0 || (c == 0 ? !(warm > cold) : !(warm < cold)))
+            fail_msg("%s: warmest at x = %.0f, coldest at %.0f", path, warm, cold);
+        free(px);
+    }
+}
+
 static char *read_header(const char *dir, const char *stem)
 {
     char path[1024];
@@ -178,8 +222,11 @@ static void fill_images(sensor_images *img, int with_stderr)
                 size_t i = (c * ROWS + r) * COLS + x;
                 img->radiance[i] = (float)(1e-15 * (1.0 + (double)i));
                 img->power[i] = (float)(1e-12 * (double)(i + 1));
+                /* channel 1 warmer to the right, channel 2 to the left: their previews
+                 * are told apart (check_previews) */
+                double x_warm = c == 0 ? (double)x : (double)(COLS - 1 - x);
                 img->brightness_temperature[i] =
-                    (float)(280.0 + 10.0 * (double)c + (double)x + 0.25 * (double)r);
+                    (float)(280.0 + 10.0 * (double)c + x_warm + 0.25 * (double)r);
                 img->normalized[i] = (float)(0.9 + 0.01 * (double)i);
                 if (with_stderr)
                     img->radiance_stderr[i] = (float)(1e-17 * (double)i);
@@ -288,6 +335,7 @@ static void test_sensor_files(void **state)
     }
     snprintf(path, sizeof path, "%s/cam.band-03.png", dir);
     assert_int_not_equal(access(path, F_OK), 0);
+    check_previews(dir, "band");
 
     sensor_images_fini(&img);
     scene_destroy(scene);
@@ -333,7 +381,7 @@ static void test_measured_files(void **state)
     assert_true(img.measured_radiance && img.measured_brightness_temperature);
     for (size_t i = 0; i < cube; i++) {
         img.measured_radiance[i] = (float)(2e-15 * (1.0 + (double)i));
-        img.measured_brightness_temperature[i] = (float)(250.0 + 0.5 * (double)i);
+        img.measured_brightness_temperature[i] = img.brightness_temperature[i] - 30.0f;
     }
     thz_error err = {0};
     if (output_write_sensor(dir, scene, 0, &img, 0, NULL, &err) != THZ_OK)
@@ -364,6 +412,7 @@ static void test_measured_files(void **state)
         snprintf(path, sizeof path, "%s/cam.measured-band-%02zu.png", dir, c);
         assert_int_equal(access(path, F_OK), 0);
     }
+    check_previews(dir, "measured-band");
     sensor_images_fini(&img);
     scene_destroy(scene);
     remove_dir(dir);
