@@ -72,7 +72,9 @@ static void test_sensor_file_names(void **state)
                               "cam.wide.radiance.hdr", "cam.class.hdr", "cam.visual.png.bak",
                               "summary.json", "cam.", "other.radiance.hdr", "cam.radiance.hdr.img",
                               /* numbers thzmap never writes (band-%02zu): a user's */
-                              "cam.band-1.png", "cam.band-007.png", "cam.measured-band-3.png"};
+                              "cam.band-1.png", "cam.band-007.png", "cam.measured-band-3.png",
+                              /* S.visual is a PNG: no cube of that name is thzmap's */
+                              "cam.visual.hdr", "cam.visual.img"};
     for (size_t i = 0; i < sizeof not_ours / sizeof *not_ours; i++)
         if (output_sensor_file("cam.", not_ours[i]))
             fail_msg("%s is not a file of sensor cam", not_ours[i]);
