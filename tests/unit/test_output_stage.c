@@ -13,6 +13,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <errno.h>
 #include <string.h>
 #include <linux/magic.h>
 #include <sys/stat.h>
@@ -314,6 +315,44 @@ static void test_leftovers_cleaned(void **state)
     free(tmp);
 }
 
+/* A run killed between the two renames of the fallback for file systems that cannot
+ * exchange (output_commit.c) left OUTDIR missing and the old run parked beside it as
+ * PREFIX-old-PID-0: the next run puts it back as OUTDIR, whole. Not putting it back
+ * (a mutant) passed every test: the user's results and files were gone from OUTDIR. */
+static void test_parked_run_restored(void **state)
+{
+    (void)state;
+    char *tmp = make_tmp_dir();
+    char outdir[1024], parked[1200];
+    snprintf(outdir, sizeof outdir, "%s/out", tmp);
+    output_stage *a = NULL;
+    assert_int_equal(output_stage_create(outdir, &a, NULL), THZ_OK);
+    const char *stage = output_stage_dir(a);
+    const char *at = NULL; /* the last "-stage-": the temporary directory's name has one */
+    for (const char *q = strstr(stage, "-stage-"); q; q = strstr(q + 1, "-stage-"))
+        at = q;
+    assert_non_null(at);
+    snprintf(parked, sizeof parked, "%.*s-old-99999-0", (int)(at - stage), stage);
+    output_stage_destroy(a);
+    if (mkdir(parked, 0777) != 0)
+        fail_msg("%s: %s", parked, strerror(errno));
+    write_file(parked, "cam.radiance.img", "previous run");
+    write_file(parked, "notes.txt", "user data");
+    assert_int_equal(access(outdir, F_OK), -1);
+
+    assert_int_equal(output_stage_create(outdir, &a, NULL), THZ_OK);
+    output_stage_destroy(a);
+    assert_int_equal(access(parked, F_OK), -1);
+    assert_file_text(outdir, "cam.radiance.img", "previous run");
+    assert_file_text(outdir, "notes.txt", "user data");
+    assert_int_equal(count_entries(tmp), 1);
+    rm(outdir, "cam.radiance.img");
+    rm(outdir, "notes.txt");
+    rmdir(outdir);
+    assert_int_equal(rmdir(tmp), 0);
+    free(tmp);
+}
+
 /* OUTDIR = the working directory is not swapped (a shell there would be left in a
  * deleted directory): the stage is inside it and the files move one by one. */
 static void test_commit_into_working_directory(void **state)
@@ -526,6 +565,7 @@ int main(void)
         cmocka_unit_test(test_destroy_removes_created_outdir),
         cmocka_unit_test(test_two_stages),
         cmocka_unit_test(test_leftovers_cleaned),
+        cmocka_unit_test(test_parked_run_restored),
         cmocka_unit_test(test_commit_keeps_subdirectories),
         cmocka_unit_test(test_commit_into_working_directory),
         cmocka_unit_test(test_working_directory_shares_the_lock),
