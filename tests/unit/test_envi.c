@@ -194,7 +194,9 @@ static thz_scene *make_scene(void)
     snprintf(s->channels[0].name, sizeof s->channels[0].name, "0.200 THz");
     s->channels[0].center_hz = 0.2e12;
     s->channels[0].relative_width = 0.01;
-    snprintf(s->channels[1].name, sizeof s->channels[1].name, "band {b}, 2");
+    /* ENVI list characters and a line break (a JSON "\n") in a name: written as spaces
+     * and ';', the header keeping one key a line */
+    snprintf(s->channels[1].name, sizeof s->channels[1].name, "band {b},\n2");
     /* 8 significant digits: the header keeps them (scene-format.md: the channel centres) */
     s->channels[1].center_hz = 1.2345678e12;
     s->channels[1].relative_width = 0.02;
