@@ -247,32 +247,23 @@ static thz_status out_spectra(const out_context *ctx, thz_error *err)
     const thz_scene *scene = ctx->scene;
     const sensor_images *img = ctx->images;
     size_t n_obj = scene->n_objects, n_ch = img->n_channels;
-    size_t pixels = (size_t)img->columns * img->rows;
     thz_status status = THZ_OK;
     uint64_t *count = thz_calloc(n_obj, sizeof *count);
-    double *sum = thz_calloc(n_obj * n_ch, sizeof *sum);
+    double *mean = thz_calloc(n_obj * n_ch, sizeof *mean);
     double *y = thz_calloc(n_obj * n_ch, sizeof *y);
     double *x = thz_calloc(n_ch, sizeof *x);
     const char **names = thz_calloc(n_obj, sizeof *names);
-    if (!count || !sum || !y || !x || !names) {
+    if (!count || !mean || !y || !x || !names) {
         status = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
         goto cleanup;
     }
-    for (size_t p = 0; p < pixels; p++) {
-        int32_t id = img->object_id[p];
-        if (id < 0 || (size_t)id >= n_obj)
-            continue;
-        count[id]++;
-        for (size_t c = 0; c < n_ch; c++)
-            sum[(size_t)id * n_ch + c] += img->normalized[c * pixels + p];
-    }
+    sensor_images_object_means(img, img->normalized, n_obj, count, mean);
     size_t n_lines = 0;
     for (size_t o = 0; o < n_obj; o++) {
         if (!count[o])
             continue;
         names[n_lines] = scene->objects[o].name;
-        for (size_t c = 0; c < n_ch; c++)
-            y[n_lines * n_ch + c] = sum[o * n_ch + c] / (double)count[o];
+        memcpy(&y[n_lines * n_ch], &mean[o * n_ch], n_ch * sizeof *y);
         n_lines++;
     }
     for (size_t c = 0; c < n_ch; c++)
@@ -288,7 +279,7 @@ static thz_status out_spectra(const out_context *ctx, thz_error *err)
                               "frequency (THz)", y_label, err);
 cleanup:
     free(count);
-    free(sum);
+    free(mean);
     free(y);
     free(x);
     free(names);

@@ -59,6 +59,25 @@ thz_status sensor_images_init(sensor_images *img, uint32_t columns, uint32_t row
     return THZ_OK;
 }
 
+void sensor_images_object_means(const sensor_images *img, const float *cube, size_t n_objects,
+                                uint64_t *count, double *mean)
+{
+    size_t n_ch = img->n_channels, pixels = (size_t)img->columns * img->rows;
+    memset(count, 0, n_objects * sizeof *count);
+    memset(mean, 0, n_objects * n_ch * sizeof *mean);
+    for (size_t p = 0; p < pixels; p++) {
+        int32_t id = img->object_id[p];
+        if (id < 0 || (size_t)id >= n_objects)
+            continue;
+        count[id]++;
+        for (size_t c = 0; c < n_ch; c++)
+            mean[(size_t)id * n_ch + c] += cube[c * pixels + p];
+    }
+    for (size_t o = 0; o < n_objects; o++)
+        for (size_t c = 0; count[o] && c < n_ch; c++)
+            mean[o * n_ch + c] /= (double)count[o];
+}
+
 void sensor_images_fini(sensor_images *img)
 {
     free(img->radiance);

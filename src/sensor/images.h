@@ -46,6 +46,12 @@ thz_status sensor_images_alloc(sensor_images *img, uint32_t columns, uint32_t ro
                                size_t n_channels, int with_stderr, thz_error *err);
 void sensor_images_fini(sensor_images *img);
 
+/* Each object's mean of cube (one of img's, n_channels bands) over the pixels that see it:
+ * count[o] its pixels and mean[o * n_channels + c] channel c's mean (0 where count[o] is
+ * 0), for objects 0 to n_objects - 1 (object_id outside them is nothing hit). */
+void sensor_images_object_means(const sensor_images *img, const float *cube, size_t n_objects,
+                                uint64_t *count, double *mean);
+
 /* Bytes the images of a sensor take (to refuse runs that would not fit). */
 uint64_t sensor_images_bytes(uint32_t columns, uint32_t rows, size_t n_channels);
 
