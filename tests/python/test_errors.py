@@ -97,12 +97,11 @@ def test_numpy_values_are_accepted(tiny_dir):
 
 def test_syntax_error_in_a_file_names_line_and_column(tmp_path):
     p = tmp_path / "broken.json"
-    p.write_text('{\n  "format": "thzmap-scene/1"\n  "name": "x"\n}\n')
+    p.write_text('{\n  "format": "thzmap-scene/1"\n      "name": "x"\n}\n')
     with pytest.raises(thzmap.SceneError) as e:
         thzmap.load_scene(p)
     assert e.value.file == str(p)
-    assert (e.value.line, e.value.path) == (3, None)
-    assert e.value.column is not None
+    assert (e.value.line, e.value.column, e.value.path) == (3, 7, None)  # at "name"
 
 
 def test_missing_file(tmp_path):
@@ -118,6 +117,8 @@ def test_missing_file(tmp_path):
     {"target_noise_k": -1}, {"max_seconds": 3}, {"progress": 42}, {"keep_photons": "yes"},
     {"keep_photons": 1},
     {"integrator": "path", "keep_photons": True},  # no map to keep (it gave a run without one)
+    {"target_noise_k": 0}, {"target_noise_k": 0.5, "max_seconds": 0}, {"mpi": 1},
+    {"mpi": "yes"},
 ])
 def test_bad_arguments_raise_before_the_library(tiny_dir, kwargs):
     scene = thzmap.load_scene(tiny_dir / "scene.json")
@@ -308,3 +309,42 @@ def test_a_damaged_data_file_is_no_scene_error(tmp_path, monkeypatch):
     assert not isinstance(e.value, thzmap.SceneError)
     assert e.value.status == "input/output error"
     assert "thzmap's own data is damaged" in e.value.message
+
+
+def test_photons_up_to_the_cli_bound_are_taken(tiny_dir):
+    """photons may be 10^12, the CLI's --photons bound itself (the run starts: the path
+    integrator's, cancelled at its first report); ply_max_points is 1 to 10^12 as
+    --ply-max-points."""
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    with pytest.raises(thzmap.CancelledError):
+        thzmap.simulate(scene, integrator="path", photons=10**12, progress=lambda p: True)
+    run = thzmap.simulate(scene, integrator="path", seed=1)
+    for bad in (0, 10**12 + 1):
+        with pytest.raises(thzmap.ArgumentError, match="ply_max_points"):
+            run.save(tiny_dir / "out", ply_max_points=bad)
+
+
+def test_exception_classes():
+    """As docs/python.md says: ArgumentError is also a ValueError, OutOfMemoryError a
+    MemoryError (a status of out of memory becomes one), every one a thzmap.Error."""
+    from thzmap import _lib
+    from thzmap.errors import from_status
+    assert issubclass(thzmap.ArgumentError, ValueError)
+    assert issubclass(thzmap.OutOfMemoryError, MemoryError)
+    e = from_status(_lib.ERR_NOMEM, "out of memory")
+    assert isinstance(e, thzmap.OutOfMemoryError) and isinstance(e, MemoryError)
+    assert e.status == "out of memory"
+    e = from_status(_lib.ERR_LIMIT, "the run would need 9 GiB")
+    assert type(e) is thzmap.Error and not isinstance(e, MemoryError)
+    assert isinstance(from_status(_lib.ERR_CANCELLED, ""), thzmap.CancelledError)
+
+
+def test_nul_in_a_path_or_label_is_refused(tiny_dir):
+    """A NUL would cut the path or label the C library sees (another file, or a shorter
+    name in its messages): refused instead."""
+    for bad in (str(tiny_dir / "scene.json") + "\0x", b"scene.json\0"):
+        with pytest.raises(thzmap.ArgumentError, match="NUL"):
+            thzmap.load_scene(bad)
+    with pytest.raises(thzmap.ArgumentError, match="NUL"):
+        thzmap.scene_from_json(json.dumps(tiny_scene_dict()), base_dir=tiny_dir,
+                               label="a\0b")
