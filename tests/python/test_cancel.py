@@ -133,3 +133,49 @@ def test_progress_bar_never_runs_backwards(monkeypatch):
     bar(Progress("render", 1, 1, 64, 64))
     bar.close()
     assert [b.updates for b in bars] == [[16, 48], [8, 56], [64]]
+
+
+def test_progress_true_prints_each_stage_to_its_end_and_false_prints_nothing(
+        tiny_dir, monkeypatch, capfd):
+    """Without tqdm, progress=True prints "thzmap: channel C/N STAGE: DONE/TOTAL UNIT"
+    lines on stderr, channels counted from 1, each stage's last line at its end (done =
+    total, however soon it comes); progress=False and None print nothing, as for the
+    CLI's --quiet."""
+    import re
+    monkeypatch.setitem(sys.modules, "tqdm", None)  # import tqdm fails
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    for quiet in (None, False):
+        thzmap.simulate(scene, seed=1, progress=quiet)
+        assert capfd.readouterr().err == ""
+    thzmap.simulate(scene, seed=1, progress=True)
+    lines = capfd.readouterr().err.splitlines()
+    last = {}
+    units = {"photons": "photons", "render": "rows"}
+    for line in lines:
+        m = re.fullmatch(r"thzmap: channel (\d+)/2 (\w+): (\d+)/(\d+) (\w+)", line)
+        assert m, line
+        c, stage, done, total, unit = m.groups()
+        assert c in ("1", "2") and unit == units[stage], line
+        last[(c, stage)] = (done, total)
+    assert set(last) == {(c, s) for c in ("1", "2") for s in ("photons", "render")}
+    assert all(done == total for done, total in last.values()), last
+
+
+def test_progress_bars_are_closed_when_the_run_ends(tiny_dir, monkeypatch):
+    """With tqdm, progress=True leaves no bar open once the call returns."""
+    import types
+    bars = []
+
+    class FakeBar:
+        def __init__(self, total, **kw):
+            self.total, self.n, self.closed = total, 0, False
+            bars.append(self)
+
+        def update(self, k):
+            self.n += k
+
+        def close(self):
+            self.closed = True
+    monkeypatch.setitem(sys.modules, "tqdm", types.SimpleNamespace(tqdm=FakeBar))
+    thzmap.simulate(thzmap.load_scene(tiny_dir / "scene.json"), seed=1, progress=True)
+    assert bars and all(b.closed for b in bars)
