@@ -55,6 +55,19 @@ def test_attenuation_equals_the_command(thzmap_binary, model, columns):
     assert air.attenuation_per_m(np.full((2, 3), 0.35)).shape == (2, 3)
 
 
+
+@pytest.mark.parametrize("args,kwargs", [
+    (["--water-vapour-g-m3", "12"], {"water_vapour_g_m3": 12}),
+    (["--h2o-vmr", "0.004"], {"h2o_vmr": 0.004}),
+    (["--no-continuum", "--pressure-hpa", "900"], {"continuum": False, "pressure_hpa": 900})])
+def test_each_humidity_and_the_continuum_as_the_command(thzmap_binary, args, kwargs):
+    """Each way to give the humidity, and continuum=False, mean what the command's
+    options mean: the same attenuation."""
+    rows = cli_atmosphere(thzmap_binary, *args)
+    f = np.array([float(r["frequency_thz"]) for r in rows])
+    np.testing.assert_allclose(thzmap.atmosphere(**kwargs).attenuation_per_m(f),
+                               [float(r["attenuation_per_m"]) for r in rows], rtol=1e-6)
+
 def test_the_scene_atmosphere_and_dry_air():
     scene = thzmap.load_scene(os.path.join(REPO, "examples", "outdoor-concealed", "scene.json"))
     a = thzmap.atmosphere(scene=scene)
@@ -195,6 +208,12 @@ def test_errors():
         thzmap.atmosphere(temperature_k=20)
     with pytest.raises(thzmap.ArgumentError, match="above 0 THz"):
         thzmap.atmosphere().attenuation_per_m([0.5, -1.0])
+    with pytest.raises(thzmap.ArgumentError, match="above 0 THz"):
+        thzmap.atmosphere().attenuation_per_m(0)  # 0 Hz is no frequency either
+    scene = os.path.join(REPO, "examples", "outdoor-concealed", "scene.json")
+    for other in ({"temperature_k": 300}, {"continuum": False}, {"model": "none"}):
+        with pytest.raises(thzmap.ArgumentError, match="takes no other arguments"):
+            thzmap.atmosphere(scene=scene, **other)  # not silently the scene's air
     with pytest.raises(thzmap.ArgumentError, match=r"distance_m: expected a number at least 0, "
                        r"got -1"):
         thzmap.atmosphere().transmittance(0.5, -1)
