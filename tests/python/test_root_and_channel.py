@@ -6,7 +6,7 @@ import os
 
 import pytest
 import thzmap
-from conftest import tiny_scene_dict
+from conftest import REPO, tiny_scene_dict
 
 SEED = 5
 
@@ -81,3 +81,11 @@ def test_load_photon_map_progress_and_cancel(tiny_dir):
          ("read", 0, stored[0], stored[0]), ("read", 1, stored[1], stored[1])], seen
     with pytest.raises(thzmap.CancelledError):
         thzmap.load_photon_map(scene, path, progress=lambda p: True)
+
+
+def test_a_sequence_outside_its_root_is_refused(tmp_path):
+    """load_sequence(root=...) confines the sequence file as load_scene's root does."""
+    seq = os.path.join(REPO, "tests", "inputs", "batch", "sequence.json")
+    assert len(thzmap.load_sequence(seq, root=os.path.dirname(seq))) == 5
+    with pytest.raises(thzmap.SceneError):
+        thzmap.load_sequence(seq, root=tmp_path)

@@ -25,7 +25,7 @@ def test_frames_are_the_keyframes_interpolated():
     assert (len(seq), seq.n_sweeps, seq.frames_per_sweep) == (5, 1, 5)
     assert [f.dir for f in seq.frames] == [f"frame-{i:05d}" for i in range(5)]
     assert [f.time_s for f in seq.frames] == [0.0, 0.25, 0.5, 0.75, 1.0]
-    assert seq.frame(-1) == seq.frame(4)
+    assert seq.frame(-1) == seq.frame(4) and seq.frame(-5) == seq.frame(0)
     # linear between t = 0 s (300 K, x = -0.5 m) and t = 1 s (308 K, x = 0.5 m)
     for i, (t_k, x_m) in enumerate([(300, -0.5), (302, -0.25), (304, 0), (306, 0.25),
                                     (308, 0.5)]):
@@ -182,6 +182,7 @@ def test_batch_resumes_reports_and_cancels(tmp_path):
     assert stages[0] == "check" and "frame" in stages and reports[-1].stage == "done"
     assert "check" not in stages[stages.index("frame"):]
     assert reports[-1].frame == 5 and reports[-1].fraction == 1.0
+    assert (reports[-1].computed, reports[-1].reused) == (3, 2)  # as the result's
     fractions = [p.fraction for p in reports]
     assert fractions == sorted(fractions) and fractions[0] < 1.0
     assert {p.frame for p in reports if p.stage == "run"} == {2, 3, 4}
@@ -216,7 +217,10 @@ def test_batch_sweep_values_are_json_values(tmp_path):
     (tmp_path / "sweep.json").write_text(json.dumps(
         {"format": "thzmap-sequence/1", "scene": "scene.json",
          "sweep": {"materials.skin.reflectivity": [0.1, 0.3], "render.integrator": ["path"]}}))
-    res = thzmap.batch(tmp_path / "sweep.json", tmp_path / "out", movies=False)
+    seq = thzmap.load_sequence(tmp_path / "sweep.json")
+    assert [(f.sweep, f.index, f.dir) for f in seq.frames] == [
+        (0, 0, "sweep-00/frame-00000"), (1, 0, "sweep-01/frame-00000")]
+    res = thzmap.batch(seq, tmp_path / "out", movies=False)
     assert res.summary["sweeps"] == [
         {"dir": f"sweep-0{i}", "values": {"materials.skin.reflectivity": r,
                                           "render.integrator": "path"},
@@ -490,3 +494,18 @@ def test_batch_bar_says_what_it_counts(monkeypatch):
     bar(BatchProgress("frame", 4, 5, 1, 3, 0.8, 0.1))
     bar.close()
     assert postfix == ["1 computed, 3 already done"]
+
+
+def test_batch_lines_without_tqdm(monkeypatch, capsys):
+    """progress=True without tqdm: a line per frame (counted from 1) and at the end, with
+    the share of the batch done in per cent."""
+    from thzmap.sequence import BatchProgress, _BatchBar
+    monkeypatch.setitem(sys.modules, "tqdm", None)
+    bar = _BatchBar()
+    bar(BatchProgress("frame", 0, 4, 0, 0, 0.0, 0.0))
+    bar(BatchProgress("frame", 1, 4, 1, 0, 0.25, 1.5))
+    bar(BatchProgress("done", 4, 4, 4, 0, 1.0, 6.0))
+    assert capsys.readouterr().err.splitlines() == [
+        "thzmap: batch: frame 1/4, 0 % of the batch, 0.0 s",
+        "thzmap: batch: frame 2/4, 25 % of the batch, 1.5 s",
+        "thzmap: batch: done, 100 % of the batch, 6.0 s"]
