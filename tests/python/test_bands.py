@@ -186,9 +186,14 @@ def test_bands_errors(tmp_path):
                    dict(count=1, from_thz=1.0, to_thz=0.5), dict(count=1, widths=[0.01, 0.01]),
                    dict(count=2, from_thz=0.5, to_thz=0.5), dict(count=1, targets=["A", "A"]),
                    dict(count=1, relative_width=0.01, widths=[0.02]),
-                   dict(count=1, widths=0.01), dict(count=1, targets=5)):
+                   dict(count=1, widths=0.01), dict(count=1, targets=5),
+                   # the CLI's bounds: --from-thz > 0, --humidity-range 0 to 0.99,
+                   # --count 1 to 32
+                   dict(count=1, humidity_range=1.0), dict(count=33)):
         with pytest.raises(thzmap.ArgumentError):
             thzmap.bands(FEATURES, **kwargs)
+    with pytest.raises(thzmap.ArgumentError, match=r"from_thz: expected a number in \(0"):
+        thzmap.bands(FEATURES, 1, from_thz=0)
     with pytest.raises(thzmap.ArgumentError):
         thzmap.bands(thzmap.scene_from_json(Path(FEATURES).read_text()), 1)
     # a Scene made from a dict labelled with the file's name is not the file: refused,
@@ -251,6 +256,7 @@ def test_classify_equals_the_command(distinct_run, tmp_path, thzmap_binary):
     assert c.confusion.tolist() == cli["confusion"]
     assert int(c.confusion.sum()) == c.pixels == cli["pixels"]
     assert c.classes == [k["name"] for k in cli["classes"]]
+    assert c.report["seed"] == cli["seed"] == 2
     image = result.image("cam")
     assert c.class_map.shape == (image.rows, image.columns)
     truth = image.object_id.astype(np.int32)
@@ -295,3 +301,22 @@ def test_classify_errors(distinct_run, tmp_path):
         thzmap.classify(run_dir, "nope")
     with pytest.raises(thzmap.Error):
         thzmap.classify(tmp_path / "missing", "cam")
+    # a Result's sensors are checked before it is saved
+    result, _ = distinct_run
+    with pytest.raises(thzmap.ArgumentError, match="the run has no sensor 'nope'"):
+        thzmap.classify(result, "nope")
+
+
+def test_classify_fields_and_netd_zero(distinct_run):
+    """held_out_accuracy is the held-out pixels' (not the whole accuracy: they differ
+    when a tenth trains), as classification.json says; netd_k=0 adds no noise."""
+    result, run_dir = distinct_run
+    c = thzmap.classify(run_dir, "cam", method="lda", netd_k=0.5, seed=2, train_fraction=0.1)
+    assert c.training_pixels + c.held_out_pixels == c.pixels
+    # the JSON's 10 significant digits
+    assert c.accuracy == pytest.approx(c.report["accuracy"], rel=1e-9)
+    assert c.held_out_accuracy == pytest.approx(c.report["held_out_accuracy"], rel=1e-9)
+    assert c.accuracy != c.held_out_accuracy
+    plain = thzmap.classify(run_dir, "cam", method="lda", seed=2)
+    zero = thzmap.classify(run_dir, "cam", method="lda", seed=2, netd_k=0)
+    assert zero.confusion.tolist() == plain.confusion.tolist()
