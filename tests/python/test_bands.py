@@ -177,6 +177,8 @@ def test_bands_says_the_scene_warnings():
     said = [str(w.message) for w in caught]
     assert any('material "a", reflectivity: the table covers 0.1 to 1.2 THz' in m
                and 'channel "1.200 THz"' in m for m in said), said
+    # each points at the line that called bands, not into the package
+    assert {w.filename for w in caught} == {__file__}
 
 
 def test_bands_errors(tmp_path):
