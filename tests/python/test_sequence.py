@@ -332,6 +332,16 @@ def test_warning_counted_once_a_frame():
     seen.count(3, False)
     seen.count(3, True)
     assert (seen.repeats, seen.alike) == (3, 1)
+    # within one frame, messages alike but for their numbers are each new; a later
+    # frame's is folded; with no frame, only the same to the letter is
+    call = thzmap.sequence._BatchCall(None, None)
+    call.frame = 0
+    assert call._first("noise 0.12 K") and call._first("noise 0.25 K")
+    call.frame = 1
+    assert not call._first("noise 0.3 K") and call._first("sensor cam2 at 3 m")
+    call.frame = None
+    assert call._first("movie 3 s") and call._first("movie 4 s")
+    assert not call._first("movie 4 s")
 
 
 def test_batch_movie_warning_names_no_frame(tmp_path):
