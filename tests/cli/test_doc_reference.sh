@@ -1,0 +1,128 @@
+#!/usr/bin/env bash
+# docs/scene-format.md, the reference outside programs read, against the program:
+# - each command's section lists every long option its --help describes, and every
+#   option of the section's table is one --help describes;
+# - "Outputs": a run of a sensor with a PSF and noise writes exactly the files the table
+#   names (S the sensor), and each ENVI header's `data units` is the table's unit;
+# - "summary.json": every key a run writes (path with two sensors, of an Airy and a
+#   Gaussian PSF and of radiometer and NETD noise; final-gather with a photon phase) is named in that section, and every snake_case key the section names
+#   is one a run writes.
+# (The photon-map PLY's properties were documented in another order than the file's:
+# tests/unit/test_ply.c checks the file's.)
+# argv: path to the thzmap binary, repository directory.
+. "$(dirname "$0")/lib.sh"
+doc=$REPO/docs/scene-format.md
+
+# section TITLE: the lines of $doc after the heading line that begins with TITLE, up to
+# the next heading of that level or above
+section() {
+    awk -v t="$1" 'BEGIN { n = index(t, " ") - 1 }
+        on && /^#+ / && index($0, " ") - 1 <= n { on = 0 }
+        index($0, t) == 1 { on = 1; next }
+        on' "$doc"
+}
+
+for cmd in simulate render batch atmosphere materials bands classify serve; do
+    "$THZMAP" $cmd --help >"$work/$cmd.help" || fail "$cmd --help: exit $?"
+    section "### thzmap $cmd" >"$work/$cmd.sec"
+    [ -s "$work/$cmd.sec" ] || { fail "scene-format.md has no section '### thzmap $cmd'"; continue; }
+    for o in $(grep -oE -- '--[a-z][a-z0-9-]*' "$work/$cmd.help" | sort -u); do
+        [ "$o" = --help ] && continue
+        grep -q -- "$o\b" "$work/$cmd.sec" || fail "scene-format.md's thzmap $cmd lacks $o"
+    done
+    for o in $(grep -E '^\| `' "$work/$cmd.sec" | cut -d'|' -f2 |
+        grep -oE -- '--[a-z][a-z0-9-]*' | sort -u); do
+        grep -q -- "$o\b" "$work/$cmd.help" ||
+            fail "scene-format.md's thzmap $cmd lists $o, which '$cmd --help' does not"
+    done
+done
+
+cat >"$work/scene.json" <<JSON
+{"format": "thzmap-scene/1.1", "name": "doc",
+ "channels": [{"frequency_thz": 0.35, "relative_width": 0.02}],
+$(plate_in_room)
+ "sensors": [{"name": "cam", "position_m": [0, -0.9, 0], "look_at_m": [0, 0, 0],
+   "fov_deg": 40, "resolution": [8, 6], "aperture_diameter_m": 0.1,
+   "noise": {"receiver_temperature_k": 1000, "integration_time_s": 0.01,
+             "radiometer": "dicke"}},
+  {"name": "cam2", "position_m": [0, -0.9, 0], "look_at_m": [0, 0, 0],
+   "fov_deg": 40, "resolution": [4, 3], "psf": "gaussian", "psf_fwhm_deg": 5,
+   "noise": {"netd_k": 0.5}}],
+ "render": {"paths_per_sample": 2},
+ "photons": {"per_channel": 20000}}
+JSON
+"$THZMAP" simulate "$work/scene.json" -o "$work/path" -q --threads 1 ||
+    fail "simulate (path): exit $?"
+"$THZMAP" simulate "$work/scene.json" -o "$work/fg" -q --threads 1 --integrator final-gather ||
+    fail "simulate (final-gather): exit $?"
+
+section "## Outputs" >"$work/outputs.sec"
+section "### summary.json" >"$work/summary.sec"
+/usr/bin/python3 - "$work" <<'PY' || fail "the outputs or summary.json differ from scene-format.md"
+import json, os, re, sys
+
+work = sys.argv[1]
+ok = True
+
+
+def bad(msg):
+    global ok
+    ok = False
+    print("FAIL:", msg)
+
+
+# The outputs table: | `S.x.hdr/.img` | bands | unit (`data units`) | content |
+rows = [l for l in open(os.path.join(work, "outputs.sec")) if re.match(r"\| `S[.]", l)]
+if len(rows) < 10:
+    bad(f"only {len(rows)} rows in the outputs table")
+ascii_unit = {"W·m⁻²·sr⁻¹·Hz⁻¹": "W m-2 sr-1 Hz-1", "W": "W", "K": "K", "1": "1", "m": "m"}
+documented = set()
+for row in rows:
+    cells = [c.strip() for c in row.strip().strip("|").split("|")]
+    name = re.match(r"`S(\.[^`]*)`", cells[0]).group(1).replace("NN", "01")
+    unit = re.sub(r"\s*\(.*\)$", "", cells[2])
+    if name.endswith(".hdr/.img"):
+        stem = "cam" + name[: -len(".hdr/.img")]
+        documented |= {stem + ".hdr", stem + ".img"}
+        hdr = os.path.join(work, "path", stem + ".hdr")
+        if os.path.exists(hdr):
+            m = re.search(r"^data units = (.*)$", open(hdr).read(), re.M)
+            want = ascii_unit.get(unit)
+            if not m or m.group(1) != want:
+                bad(f"{stem}.hdr: data units {m and m.group(1)!r}, the table says {unit!r}")
+    else:
+        documented.add("cam" + name)
+written = {f for f in os.listdir(os.path.join(work, "path")) if f.startswith("cam.")}
+for f in sorted(written - documented):
+    bad(f"the run wrote {f}, which the outputs table does not name")
+for f in sorted(documented - written):
+    bad(f"the outputs table names {f}, which a run of a sensor with a PSF and noise did not write")
+
+# summary.json: every key written is named in the section, and every snake_case key
+# named there is written by one of the runs.
+text = open(os.path.join(work, "summary.sec")).read()
+named = set(re.findall(r"[`{,]\s*([a-z][a-z0-9_]*)", text)) | set(
+    re.findall(r"\.([a-z][a-z0-9_]*)", text))
+keys = set()
+
+
+def walk(v):
+    if isinstance(v, dict):
+        for k, x in v.items():
+            keys.add(k)
+            walk(x)
+    elif isinstance(v, list):
+        for x in v:
+            walk(x)
+
+
+for run in ("path", "fg"):
+    walk(json.load(open(os.path.join(work, run, "summary.json"))))
+for k in sorted(keys - named):
+    bad(f"summary.json has the key {k}, which scene-format.md's summary.json section does not name")
+for k in sorted(k for k in named - keys if "_" in k and re.search(r"`" + k + r"`", text)):
+    bad(f"scene-format.md's summary.json section names `{k}`, which no run wrote")
+sys.exit(0 if ok else 1)
+PY
+
+finish "doc reference: all checks passed"
