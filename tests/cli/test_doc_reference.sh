@@ -6,7 +6,7 @@
 #   names (S the sensor), and each ENVI header's `data units` is the table's unit;
 # - "summary.json": every key a run writes (path with two sensors, of an Airy and a
 #   Gaussian PSF and of radiometer and NETD noise; final-gather with a photon phase) is named in that section, and every snake_case key the section names
-#   is one a run writes.
+#   is one a run writes; an object no sensor sees has pixels 0 and null figures.
 # (The photon-map PLY's properties were documented in another order than the file's:
 # tests/unit/test_ply.c checks the file's.)
 # argv: path to the thzmap binary, repository directory.
@@ -45,8 +45,9 @@ $(plate_in_room)
    "fov_deg": 40, "resolution": [8, 6], "aperture_diameter_m": 0.1,
    "noise": {"receiver_temperature_k": 1000, "integration_time_s": 0.01,
              "radiometer": "dicke"}},
-  {"name": "cam2", "position_m": [0, -0.9, 0], "look_at_m": [0, 0, 0],
+  {"name": "cam2", "position_m": [0, -0.9, 0],
    "fov_deg": 40, "resolution": [4, 3], "psf": "gaussian", "psf_fwhm_deg": 5,
+   "direction": [0, -1, 0],
    "noise": {"netd_k": 0.5}}],
  "render": {"paths_per_sample": 2},
  "photons": {"per_channel": 20000}}
@@ -55,6 +56,9 @@ JSON
     fail "simulate (path): exit $?"
 "$THZMAP" simulate "$work/scene.json" -o "$work/fg" -q --threads 1 --integrator final-gather ||
     fail "simulate (final-gather): exit $?"
+# cam2 looks away from the plate: rendered alone, the plate is an object not seen
+"$THZMAP" render "$work/scene.json" -o "$work/away" -q --threads 1 --sensor cam2 ||
+    fail "render --sensor cam2: exit $?"
 
 section "## Outputs" >"$work/outputs.sec"
 section "### summary.json" >"$work/summary.sec"
@@ -116,12 +120,19 @@ def walk(v):
             walk(x)
 
 
-for run in ("path", "fg"):
+for run in ("path", "fg", "away"):
     walk(json.load(open(os.path.join(work, run, "summary.json"))))
 for k in sorted(keys - named):
     bad(f"summary.json has the key {k}, which scene-format.md's summary.json section does not name")
 for k in sorted(k for k in named - keys if "_" in k and re.search(r"`" + k + r"`", text)):
     bad(f"scene-format.md's summary.json section names `{k}`, which no run wrote")
+# "pixels 0 and both figures null where the object is not seen"
+s = json.load(open(os.path.join(work, "away", "summary.json")))
+if s["command"] != "render":
+    bad(f"render's summary.json says command {s['command']!r}")
+plate = [o for o in s["channels"][0]["objects"] if o["name"] == "plate"]
+if plate != [{"name": "plate", "pixels": 0, "median_stderr_k": None, "p95_stderr_k": None}]:
+    bad(f"an object not seen: {plate}, expected pixels 0 and null figures")
 sys.exit(0 if ok else 1)
 PY
 
