@@ -9,6 +9,7 @@
 #   is one a run writes; an object no sensor sees has pixels 0 and null figures.
 # (The photon-map PLY's properties were documented in another order than the file's:
 # tests/unit/test_ply.c checks the file's.)
+# - "Sequences": every key of batch.json and frame.json is named in its Outputs.
 # argv: path to the thzmap binary, repository directory.
 . "$(dirname "$0")/lib.sh"
 doc=$REPO/docs/scene-format.md
@@ -60,7 +61,21 @@ JSON
 "$THZMAP" render "$work/scene.json" -o "$work/away" -q --threads 1 --sensor cam2 ||
     fail "render --sensor cam2: exit $?"
 
+# a batch of 2 sweep values x 2 frames of cam alone (path), for batch.json and frame.json
+/usr/bin/python3 - "$work" <<'PY'
+import json, sys
+w = sys.argv[1]
+s = json.load(open(f"{w}/scene.json"))
+s["sensors"] = s["sensors"][:1]
+json.dump(s, open(f"{w}/one.json", "w"))
+json.dump({"format": "thzmap-sequence/1", "scene": "one.json", "fps": 2, "frames": 2,
+           "sweep": {"objects.plate.temperature_k": [305, 315]}}, open(f"{w}/seq.json", "w"))
+PY
+"$THZMAP" batch "$work/seq.json" -o "$work/batch" -q --threads 1 || fail "batch: exit $?"
+
 section "## Outputs" >"$work/outputs.sec"
+awk '/^\*\*Outputs\*\* in OUTDIR/ { on = 1 } /^\*\*Resuming\.\*\*/ { on = 0 } on' "$doc" \
+    >"$work/batch.sec"
 section "### summary.json" >"$work/summary.sec"
 /usr/bin/python3 - "$work" <<'PY' || fail "the outputs or summary.json differ from scene-format.md"
 import json, os, re, sys
@@ -126,6 +141,26 @@ for k in sorted(keys - named):
     bad(f"summary.json has the key {k}, which scene-format.md's summary.json section does not name")
 for k in sorted(k for k in named - keys if "_" in k and re.search(r"`" + k + r"`", text)):
     bad(f"scene-format.md's summary.json section names `{k}`, which no run wrote")
+# batch.json and frame.json: every key is named in the sequences' Outputs paragraph (the
+# frame's scene and the sweep values' dotted keys aside)
+text = open(os.path.join(work, "batch.sec")).read()
+named = set(re.findall(r'`"?([a-z][a-z0-9_]*)(?:`|": )', text))
+for name in ("batch.json", "sweep-01/frame-00001/frame.json"):
+    path = os.path.join(work, "batch", name)
+    if not os.path.exists(path):
+        bad(f"the batch wrote no {name}")
+        continue
+    keys = set()
+    top = json.load(open(path))
+    if name.endswith("frame.json"):
+        top["scene"] = None  # the frame's scene, as a scene file holds it
+    for sw in top.get("sweeps", []):
+        sw.pop("values", None)
+    top.pop("sweep_values", None)
+    walk(top)
+    for k in sorted(keys - named):
+        bad(f"{name} has the key {k}, which scene-format.md's sequence Outputs do not name")
+
 # "pixels 0 and both figures null where the object is not seen"
 s = json.load(open(os.path.join(work, "away", "summary.json")))
 if s["command"] != "render":
