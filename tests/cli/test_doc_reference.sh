@@ -10,6 +10,7 @@
 # (The photon-map PLY's properties were documented in another order than the file's:
 # tests/unit/test_ply.c checks the file's.)
 # - "Sequences": every key of batch.json and frame.json is named in its Outputs.
+# - "An example" is examples/plate-in-box/scene.json.
 # argv: path to the thzmap binary, repository directory.
 . "$(dirname "$0")/lib.sh"
 doc=$REPO/docs/scene-format.md
@@ -77,7 +78,7 @@ section "## Outputs" >"$work/outputs.sec"
 awk '/^\*\*Outputs\*\* in OUTDIR/ { on = 1 } /^\*\*Resuming\.\*\*/ { on = 0 } on' "$doc" \
     >"$work/batch.sec"
 section "### summary.json" >"$work/summary.sec"
-/usr/bin/python3 - "$work" <<'PY' || fail "the outputs or summary.json differ from scene-format.md"
+REPO=$REPO /usr/bin/python3 - "$work" <<'PY' || fail "the program and scene-format.md differ (above)"
 import json, os, re, sys
 
 work = sys.argv[1]
@@ -160,6 +161,13 @@ for name in ("batch.json", "sweep-01/frame-00001/frame.json"):
     walk(top)
     for k in sorted(keys - named):
         bad(f"{name} has the key {k}, which scene-format.md's sequence Outputs do not name")
+
+# "An example" is examples/plate-in-box/scene.json, as JSON
+doc = open(os.path.join(os.environ["REPO"], "docs", "scene-format.md")).read()
+block = re.search(r"## An example\n.*?```json\n(.*?)```", doc, re.S)
+shipped = json.load(open(os.path.join(os.environ["REPO"], "examples/plate-in-box/scene.json")))
+if not block or json.loads(block.group(1)) != shipped:
+    bad("scene-format.md's example is not examples/plate-in-box/scene.json")
 
 # "pixels 0 and both figures null where the object is not seen"
 s = json.load(open(os.path.join(work, "away", "summary.json")))
