@@ -5,12 +5,13 @@
 # - "Outputs": a run of a sensor with a PSF and noise writes exactly the files the table
 #   names (S the sensor), and each ENVI header's `data units` is the table's unit;
 # - "summary.json": every key a run writes (path with two sensors, of an Airy and a
-#   Gaussian PSF and of radiometer and NETD noise; final-gather with a photon phase) is named in that section, and every snake_case key the section names
-#   is one a run writes; an object no sensor sees has pixels 0 and null figures.
+#   Gaussian PSF and of radiometer and NETD noise; final-gather with a photon phase) is
+#   named in that section, and every snake_case key the section names is one a run
+#   writes; an object no sensor sees has pixels 0 and null figures;
+# - "Sequences": every key of batch.json and frame.json is named in its Outputs;
+# - "An example" is examples/plate-in-box/scene.json.
 # (The photon-map PLY's properties were documented in another order than the file's:
 # tests/unit/test_ply.c checks the file's.)
-# - "Sequences": every key of batch.json and frame.json is named in its Outputs.
-# - "An example" is examples/plate-in-box/scene.json.
 # argv: path to the thzmap binary, repository directory.
 . "$(dirname "$0")/lib.sh"
 doc=$REPO/docs/scene-format.md
