@@ -186,7 +186,7 @@ n2=$(frames_done "$work/B")
 echo "interrupted after $n1 frame(s) (SIGTERM), killed after $n2 (SIGKILL)"
 [ "$n2" -lt 5 ] || echo "note: the SIGKILL came after the last frame"
 stat -c '%n %i %Y.%y' "$work"/B/frame-*/frame.json | sort > "$work/B.before"
-"$THZMAP" batch "$seq" -o "$work/B" --quiet > /dev/null 2>&1 || fail "batch B, resumed: exit $?"
+"$THZMAP" batch "$seq" -o "$work/B" --quiet > /dev/null 2> "$work/B.err" || fail "batch B, resumed: exit $?: $(cat "$work/B.err")"
 stat -c '%n %i %Y.%y' "$work"/B/frame-*/frame.json | sort | head -n "$n2" > "$work/B.after"
 cmp -s "$work/B.before" "$work/B.after" || fail "a finished frame was redone: $(diff "$work/B.before" "$work/B.after")"
 "$PY" - "$work/B/batch.json" "$n2" <<'PY' || fail "batch.json of the resumed run"
