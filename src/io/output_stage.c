@@ -21,8 +21,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "core/alloc.h"
@@ -30,6 +32,20 @@
 
 /* How many staging names are tried before giving up. */
 enum { STAGE_MAX_TRIES = 10000 };
+/* How long a lock is waited for whose run is gone (stage_holder_gone), in 10 ms steps. */
+enum { STAGE_GONE_HOLDER_WAITS = 500 };
+
+/* Whether the run whose pid the lock file holds has ended, though the lock is still held:
+ * then a child it forked holds it (flock follows the descriptor across fork), and that
+ * child is being killed with its parent (PR_SET_PDEATHSIG, core/child.c). A run started
+ * right after a kill (a batch killed and resumed, a user's second try) waits the few
+ * milliseconds that takes instead of being told that a dead process is writing. */
+static bool stage_holder_gone(const char *pid)
+{
+    char *end;
+    long holder = strtol(pid, &end, 10);
+    return end != pid && holder > 0 && kill((pid_t)holder, 0) != 0 && errno == ESRCH;
+}
 
 /* strndup through malloc (alloc.h has no counterpart). */
 static char *stage_strndup(const char *s, size_t n)
@@ -154,7 +170,7 @@ static thz_status stage_target(output_stage *stage, thz_error *err)
  * path (same inode) once the lock is had; otherwise it was removed meanwhile: retry. */
 static thz_status stage_lock(output_stage *stage, const char *lock_path, thz_error *err)
 {
-    for (int attempt = 0; attempt < 100; attempt++) {
+    for (int attempt = 0, waits = 0; attempt < 100; attempt++) {
         int fd = open(lock_path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
         /* A directory access() calls writable may still refuse (root on sysfs): bad
          * output directory, as access()'s refusal is. */
@@ -179,6 +195,11 @@ static thz_status stage_lock(output_stage *stage, const char *lock_path, thz_err
                                      "(another thread writing its results there, or an "
                                      "output not yet committed or destroyed)",
                                      stage->outdir);
+            if (stage_holder_gone(pid) && waits++ < STAGE_GONE_HOLDER_WAITS) {
+                nanosleep(&(struct timespec){.tv_nsec = 10000000}, NULL);
+                attempt--;
+                continue;
+            }
             return thz_error_set(err, THZ_ERR_IO,
                                  "%s: another thzmap run (process %s) is writing its results "
                                  "there; wait for it to end or choose another output directory",
