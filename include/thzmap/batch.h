@@ -86,7 +86,7 @@ typedef struct thz_batch_progress {
     size_t computed;   /* frames computed so far by this call */
     size_t reused;     /* frames found finished in OUTDIR and skipped */
     double seconds;    /* wall time of this call so far, s */
-    const char *stage; /* "frame", "run", "movie", "done" */
+    const char *stage; /* "check", "frame", "run", "movie", "done" */
     /* (added after the fields above, for callers built earlier) the share of the whole
      * batch done, 0..1, never falling: (frames done + the share of the running frame)
      * / n_frames; a frame's share counts its channels equally, photons (when it fires
