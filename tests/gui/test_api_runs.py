@@ -49,6 +49,11 @@ def planck_tb(freq_hz, radiance):
 
 def test_validate(srv, scene):
     text = json.dumps(scene)
+    other = json.loads(text)
+    other["sensors"][0]["normalize_to_k"] = 300  # not the room's 295 K, the default
+    res = srv.json("POST", "/api/validate", body={"path": "s/scene.json", "text": json.dumps(other)})
+    check(res and res["ok"] and res["scene"]["sensors"][0]["normalize_to_k"] == 300,
+          "the sensor's normalize_to_k (docs/gui.md): %r" % (res and res["scene"]["sensors"]))
     res = srv.json("POST", "/api/validate", body={"path": "s/scene.json", "text": text})
     sc = res and res["scene"]
     check(res and res["ok"] and not res["errors"], "validate ok: %r" % (res and res["errors"]))
@@ -67,6 +72,8 @@ def test_validate(srv, scene):
               abs(paint["emissivity"][i] - (1 - paint["R"][i])) < 1e-9, "paint spectrum")
         cam = sc["sensors"][0]
         check(cam["rows"] == 12 and cam["columns"] == 16 and cam["fov_deg"] == 40, "sensor")
+        check(cam["normalize_to_k"] == scene["sensors"][0]["normalize_to_k"],
+              "sensor T_ref: %r" % cam)
         atm = sc["atmosphere"]
         d = atm["sensors"][0]["distance_m"]
         check(abs(atm["sensors"][0]["transmittance"][0] - math.exp(-0.05 * d)) < 1e-9 and
