@@ -21,11 +21,11 @@
  * object's and the sensors (teraeye's "box"): the cylinders and the cover stripes.
  * Noise falling as 1/sqrt(render time) then gives the time to a target from the larger
  * run (bench_converge_seconds); the two runs' own exponent shows whether that holds.
- * A third run then checks the worst channel by running it: that channel alone, with the
- * J* estimates the larger run says it needs (J* = 4 J (RMS / target)^2, at most a given
- * cap), so that its seconds to the target are measured at the target, not extrapolated
- * across a cost per sample (the first ray, the first hit's band mean) that more
- * estimates do not repeat.
+ * Every channel is then run to check it: that channel alone, with the J* estimates the
+ * larger run says it needs (J* = 4 J (RMS / target)^2, at least 2, at most a given cap),
+ * so that its seconds to the target are measured at the target, not extrapolated across
+ * a cost per sample (the first ray, the first hit's band mean) that more estimates do not
+ * repeat; the worst of those runs is the figure.
  */
 #ifndef THZ_BENCH_RENDER_H
 #define THZ_BENCH_RENDER_H

@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 double bench_ratio(double a, double b)
 {
@@ -15,8 +16,9 @@ json_t *bench_real(double v)
 }
 
 void bench_target(bench_targets *t, const char *name, double value, const char *op, double limit,
-                  bool met, const char *unit, bool shown)
+                  const char *unit, bool shown)
 {
+    bool met = strcmp(op, ">=") == 0 ? value >= limit : value <= limit;
     bench_verdict v = !shown ? BENCH_NOT_SHOWN : met ? BENCH_MET : BENCH_NOT_MET;
     const char *word = v == BENCH_MET ? "met" : v == BENCH_NOT_MET ? "NOT met" : "not shown";
     printf("  %-66s %10.3f %s %-6g %-3s %s\n", name, value, op, limit, unit, word);
@@ -270,6 +272,7 @@ json_t *bench_report_e2e(const char *label, const bench_e2e *e, const bench_usag
     json_object_set_new(je, "integrator", json_string(e->integrator));
     json_object_set_new(je, "seconds", bench_real(e->s_total));
     json_object_set_new(je, "seconds_load", bench_real(e->s_load));
+    json_object_set_new(je, "seconds_run", bench_real(e->s_run));
     json_object_set_new(je, "photons_fired", json_integer((json_int_t)e->fired));
     json_object_set_new(je, "photons_stored", json_integer((json_int_t)e->stored));
     json_object_set_new(je, "max_passes", json_integer((json_int_t)e->max_passes));

@@ -29,10 +29,11 @@ typedef struct bench_targets {
 } bench_targets;
 
 /* Prints one line of the targets table and appends it to t->list: name, value (unit),
- * the comparison ("<=" or ">=") with limit, and the verdict: `met` unless `shown` is
- * false (then "not shown"). */
+ * the comparison op ("<=" or ">=") with limit, and the verdict: met when `value op limit`
+ * holds (judged here, on the value and limit printed), else NOT met; "not shown" over
+ * either when `shown` is false. */
 void bench_target(bench_targets *t, const char *name, double value, const char *op, double limit,
-                  bool met, const char *unit, bool shown);
+                  const char *unit, bool shown);
 
 /* A scaling point's runs into its JSON object o: how many, the median's CPU ns per photon,
  * the fastest run's seconds and CPU ns per photon, and its ratio to the reference runs. */

@@ -13,8 +13,8 @@
  *   4. rendering: gathers/s and time per pixel as the photons per pixel grow;
  *   5. each integrator's render stage on 1 thread against all (bench_render.h);
  *   6. the time to a converged image, path and final-gather: the RMS over the objects'
- *      pixels of the per-pixel noise, extrapolated to 0.05 K, the worst channel then run
- *      at the estimates that asks for (bench_render.h);
+ *      pixels of the per-pixel noise, extrapolated to 0.05 K, every channel then run at
+ *      the estimates that asks for, the worst of those runs the figure (bench_render.h);
  *
  * and ends with issue 19's targets and issue 6's, each with its value, limit and verdict.
  * This file holds the counts, the order and the targets; each section's table and JSON
@@ -464,9 +464,9 @@ int main(int argc, char **argv)
     bench_target(&t,
                  e2e ? "paper's case (photon-map) end to end, thz_simulate"
                      : "paper's case (photon-map) end to end, stage by stage",
-                 total, "<=", 10, total <= 10, "s", true);
+                 total, "<=", 10, "s", true);
     bench_target(&t, "photon phase / raw Embree, same rays (bounces incl.)", ratio_phase, "<=", 2,
-                 ratio_phase <= 2, "x", true);
+                 "x", true);
     printf("  (the same in %d rounds, channel %zu, %.3g M photons, each round's phase and probe "
            "one after the other: %.3f x, rounds %.2f-%.2f x)\n",
            th.phase.n, series_channel + 1, 1e-6 * (double)th.photons, across[0], across[1],
@@ -475,12 +475,12 @@ int main(int argc, char **argv)
      * but do not show the target. */
     char name[128];
     snprintf(name, sizeof name, "photon phase speed-up, %d threads against 1", threads);
-    bench_target(&t, name, speedup, ">=", 1.85, speedup >= 1.85, "x", threads == 2);
+    bench_target(&t, name, speedup, ">=", 1.85, "x", threads == 2);
     for (int i = 0; i < 3; i++) {
         double x = bench_pairs_speedup(&spd[i].runs);
         snprintf(name, sizeof name, "render speed-up, %d threads against 1: %s", threads,
                  integrators[i]);
-        bench_target(&t, name, x, ">=", 1.85, x >= 1.85, "x", threads == 2);
+        bench_target(&t, name, x, ">=", 1.85, "x", threads == 2);
     }
     printf("  (not a target: pure arithmetic, the machine's own ceiling, %.3f x; fastest over "
            "fastest %.3f x)\n",
@@ -488,11 +488,10 @@ int main(int argc, char **argv)
     for (int i = 0; i < 2; i++) {
         snprintf(name, sizeof name, "%s: s per channel to %g K objects' RMS (worst of all run)",
                  conv_names[i], converged_k);
-        bench_target(&t, name, conv_worst[i], "<=", conv_limit_s[i],
-                     conv_worst[i] <= conv_limit_s[i], "s", true);
+        bench_target(&t, name, conv_worst[i], "<=", conv_limit_s[i], "s", true);
     }
-    bench_target(&t, "bytes per stored photon (record, index, directory)", bpp, "<=", 32,
-                 bpp <= 32.0, "B", true);
+    bench_target(&t, "bytes per stored photon (record, index, directory)", bpp, "<=", 32, "B",
+                 true);
     /* Flatness and triangle growth from the CPU time per photon: the wall time of a point
      * also counts the time slices other processes took, which on a shared machine varies
      * from point to point; CPU time does not (both are in the table and the JSON). The
@@ -516,24 +515,23 @@ int main(int argc, char **argv)
              sp.n ? 1e-6 * (double)sp.p[0].photons : 0.0,
              sp.n ? 1e-6 * (double)sp.p[sp.n - 1].photons : 0.0);
     bool whole = sp.n > 0 && sp.p[0].photons <= 1000000 && sp.p[sp.n - 1].photons >= 100000000;
-    bench_target(&t, name, 100 * dev, "<=", 20, dev <= 0.2, "%", whole);
+    bench_target(&t, name, 100 * dev, "<=", 20, "%", whole);
     printf("  (each point against its own reference runs; the points' medians against each "
            "other, runs minutes apart: %.1f %%)\n",
            100 * dev_points);
     json_object_set_new(root, "flatness_between_points_percent", bench_real(100 * dev_points));
     double peak_ratio = bench_ratio((double)paper_peak, (double)paper.largest_map_bytes);
-    bench_target(&t, "peak memory / photon map (issue 6)", peak_ratio, "<=", 1.5, peak_ratio <= 1.5,
-                 "x", true);
+    bench_target(&t, "peak memory / photon map (issue 6)", peak_ratio, "<=", 1.5, "x", true);
     double tri_ratio =
         tri.n ? bench_ratio(
                     bench_ratio(tri.p[tri.n - 1].cpu_photons, (double)tri.p[tri.n - 1].photons),
                     bench_ratio(tri.p[0].cpu_photons, (double)tri.p[0].photons))
               : 0;
-    bench_target(&t, "CPU time per photon, 1 k..1 M triangles (issue 6)", tri_ratio, "<=", 3,
-                 tri_ratio <= 3, "x", true);
+    bench_target(&t, "CPU time per photon, 1 k..1 M triangles (issue 6)", tri_ratio, "<=", 3, "x",
+                 true);
     double render_share = bench_ratio(paper.s_render, paper.s_total);
     bench_target(&t, "rendering share of the paper's case (issue 6)", 100 * render_share, "<=", 20,
-                 render_share <= 0.2, "%", true);
+                 "%", true);
     json_object_set_new(root, "targets", t.list);
     json_object_set_new(root, "targets_met", json_integer(t.met));
     json_object_set_new(root, "load_average_end", bench_real(bench_load1()));
