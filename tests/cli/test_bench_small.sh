@@ -183,5 +183,103 @@ assert all(x > 0 for x in rel), rel
 want = 100 * max(abs(x - 1) for x in rel)
 assert abs(flat["value"] - want) <= 1e-6 * max(want, 1), (flat, rel)
 finite(r, ["flatness_between_points_percent"], "root")
+
+# Each figure as docs/benchmark.md "What it measures" computes it from its parts, each
+# target's value the figure its section reports, and each verdict what value and limit say.
+def near(a, b, what, rel=1e-9):
+    if not abs(a - b) <= rel * max(abs(a), abs(b), 1e-300):
+        sys.exit(f"FAIL: {what}: {a!r}, its parts give {b!r}")
+sec = p["seconds"]
+near(p["photons_per_s"], p["photons_fired"] / sec["photon_phase"], "photons per second")
+for run in [e, d]:  # end to end: the scene's load counted (run: thz_simulate and the writing)
+    near(run["seconds"], run["seconds_load"] + run["seconds_run"], "end-to-end seconds", rel=1e-6)
+near(p["peak_memory_over_map"], p["peak_memory_bytes"] / p["largest_map_bytes"],
+     "peak memory over the map")
+tl = r["tracing_limit"]
+near(tl["photon_phase_over_raw"], sec["photon_phase"] / tl["seconds"], "photon phase / raw")
+near(tl["tracing_over_raw"], sec["tracing"] / tl["seconds"], "tracing / raw")
+near(th["raw_speedup"], th["raw_probe"]["speedup"], "the probe's speed-up")
+for k in ["photon_phase", "raw_probe", "ceiling"]:
+    q = th[k]
+    ratios = [a / b for a, b in zip(q["seconds_1"], q["seconds_all"])]
+    near(q["pair_min"], min(ratios), f"{k}'s smallest pair")
+    near(q["pair_max"], max(ratios), f"{k}'s largest pair")
+for x in s["integrators"]:
+    q = x["runs"]
+    near(x["speedup"], q["speedup"], f"{x['integrator']}'s speed-up")
+    ratios = [a / b for a, b in zip(q["seconds_1"], q["seconds_all"])]
+    assert len(ratios) == 3, ratios
+    m = sorted(range(3), key=lambda i: ratios[i])[1]  # the median pair's seconds
+    near(x["seconds_1"], q["seconds_1"][m], "the median pair's 1-thread seconds")
+    near(x["seconds_all"], q["seconds_all"][m], "the median pair's all-thread seconds")
+for pt in r["scaling_photons"]:
+    near(pt["ns_per_photon"], 1e9 * pt["seconds"] / pt["photons"], "ns per photon")
+for pt in r["rendering"]:
+    near(pt["gathers_per_s"], pt["gathers"] / pt["seconds"], "gathers per second")
+# time to a converged image: the larger run's render time x (RMS / target)^2 plus its
+# photon phase; each channel run at J* = 4 J (RMS / target)^2 (at least 2, at most
+# --small's 8), its seconds scaled up only where it missed the target
+for name in ["path", "final-gather"]:
+    c = r["converged_image"][name]
+    tk, lim, big, small_run = c["target_k"], c["limit_seconds_per_channel"], c["runs"][1], c["runs"][0]
+    assert tk == 0.05, tk
+    # the photon phase: none for path, final-gather's own map in every run (its
+    # seconds counted, not the render's read twice)
+    for run in c["runs"] + c["runs_at_target"]:
+        ph = run["seconds_photons"] if isinstance(run["seconds_photons"], list) \
+            else [run["seconds_photons"]]
+        assert all((x == 0) if name == "path" else (x > 0) for x in ph), (name, run)
+    for w, ch in enumerate(c["channels"]):
+        q = (big["rms_stderr_k"][w] / tk) ** 2
+        near(ch["seconds_to_target"], big["seconds_photons"][w] + big["seconds_render"][w] * q,
+             f"{name} {ch['frequency_thz']} THz extrapolated seconds")
+        near(ch["ratio_to_limit"], ch["seconds_to_target"] / lim, f"{name} ratio to the limit")
+        r0, r1 = small_run["seconds_render"][w], big["seconds_render"][w]
+        k = (math.log(big["rms_stderr_k"][w] / small_run["rms_stderr_k"][w]) / math.log(r1 / r0)
+             if r1 > r0 else 0.0)
+        near(ch["exponent"], k, f"{name} exponent", rel=1e-6)
+        t = c["runs_at_target"][w]
+        sc = big["rms_stderr_k"][w] / tk  # in the order bench_converge_confirm multiplies
+        want = max(2, min(8, math.ceil(big["estimates_per_pass"] * sc * sc)))
+        first = t["first_estimates_per_pass"]
+        assert (first if first is not None else t["estimates_per_pass"]) == want, (name, w, t, want)
+        near(t["seconds_to_target"], t["seconds_photons"]
+             + t["seconds_render"] * max(1.0, (t["rms_stderr_k"] / tk) ** 2),
+             f"{name} {t['frequency_thz']} THz seconds at the target")
+    near(c["worst_ratio_to_limit"], c["worst_seconds_to_target"] / lim, f"{name} worst ratio")
+
+# the targets: each value the figure above, each verdict what the value and limit say
+def target(start):
+    found = [t for t in r["targets"] if t["target"].startswith(start)]
+    assert len(found) == 1, (start, found)
+    return found[0]
+sp = r["scaling_photons"]
+tri = r["scaling_triangles"]
+for start, value in [
+        ("paper's case (photon-map) end to end", e["seconds"]),
+        ("photon phase / raw Embree", tl["photon_phase_over_raw"]),
+        (f"photon phase speed-up, {r['threads']} threads", th["speedup"]),
+        ("path: s per channel", r["converged_image"]["path"]["worst_seconds_to_target"]),
+        ("final-gather: s per channel",
+         r["converged_image"]["final-gather"]["worst_seconds_to_target"]),
+        ("bytes per stored photon", p["bytes_per_stored_photon"]),
+        ("peak memory / photon map", p["peak_memory_over_map"]),
+        ("CPU time per photon, 1 k..1 M triangles",
+         tri[-1]["cpu_ns_per_photon"] / tri[0]["cpu_ns_per_photon"]),
+        ("rendering share", 100 * sec["render"] / sec["total"])] + [
+        (f"render speed-up, {r['threads']} threads against 1: {x['integrator']}", x["speedup"])
+        for x in s["integrators"]]:
+    near(target(start)["value"], value, f"target '{start}'")
+for t in r["targets"]:
+    shown = True
+    if "speed-up" in t["target"]:
+        shown = r["threads"] == 2
+    if t["target"].startswith("CPU time per photon, 0.01 M"):
+        shown = sp[0]["photons"] <= 1000000 and sp[-1]["photons"] >= 100000000
+    assert t["comparison"] == (">=" if "speed-up" in t["target"] else "<="), t
+    met = t["value"] >= t["limit"] if t["comparison"] == ">=" else t["value"] <= t["limit"]
+    want = "not shown" if not shown else "met" if met else "not met"
+    assert t["verdict"] == want and t["met"] == (want == "met"), (t, want)
+assert r["targets_met"] == sum(t["met"] for t in r["targets"]), r["targets_met"]
 print("bench JSON ok")
 PY
