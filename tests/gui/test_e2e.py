@@ -30,6 +30,8 @@ from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.ui import Select, WebDriverWait
 
+import e2e_readouts as readouts
+
 THZMAP, REPO, SHOTS = sys.argv[1], sys.argv[2], sys.argv[3]
 T0 = time.monotonic()
 
@@ -49,10 +51,12 @@ def make_root(root):
     scene["render"] = {"integrator": "photon-map"}
     with open(path, "w") as f:
         json.dump(scene, f, indent=2)
-    # one channel, the path integrator (fires no photons, needs no map), 8 x 8 pixels
+    # one channel, the path integrator (fires no photons, needs no map), 12 x 8 pixels
+    # (columns x rows: a click on an image not square reads the row and column apart)
     one = json.loads(json.dumps(scene))
     one["channels"] = [{"name": "0.35 THz", "frequency_thz": 0.35, "relative_width": 0.01}]
-    one["sensors"][0].update(resolution=[8, 8])
+    one["sensors"][0].update(resolution=[12, 8], noise={"netd_k": 2})  # and a measured cube
+    one["format"] = "thzmap-scene/1.1"
     one["render"] = {"integrator": "path", "paths_per_sample": 1}
     with open(os.path.join(root, "teraeye", "path.json"), "w") as f:
         json.dump(one, f, indent=2)
@@ -127,9 +131,16 @@ def audit_fixes(driver, wait, patient, by_id, click_list, field, root):
     assert not driver.find_elements(By.CSS_SELECTOR, "#objects li, #sensors li"), \
         by_id("objects").text
     assert "cylinder" not in by_id("material-plots").text, by_id("material-plots").text
+    # where the text stops parsing: its line and column
+    assert re.search(r"\(line 1:\d+\)", by_id("validation").text), by_id("validation").text
     log(f"not-json.json: {state()}, no objects or sensors shown")
     click_list("files", "path.json")
     wait.until(lambda d: "✓" in state())
+    with open(os.path.join(root, "teraeye", "path.json")) as f:  # its sensor is 12 x 8
+        readouts.sensor_frustum(driver, json.load(f)["sensors"][0])
+    click_list("sensors", "cam")
+    readouts.sensor_units(driver, {"sensors[0].position_m": "position (m)", "sensors[0].fov_deg": "horizontal fov (°)",
+                                   "sensors[0].aperture_m2": "aperture (m²)"})
     click_list("objects", "cylinder-A")
     assert not driver.find_elements(By.CSS_SELECTOR, '.field[data-path="objects[1].thickness_m"]')
     # a shape's key with its unit once: "radius (m)" (it read "radius_m (m)")
@@ -186,8 +197,15 @@ def audit_fixes(driver, wait, patient, by_id, click_list, field, root):
     Select(by_id("res-quantity")).select_by_value("brightness_temperature")
     caption = lambda: by_id("image-info").get_attribute("textContent")
     wait.until(lambda d: caption().startswith("brightness temperature, "))
-    assert caption().startswith("brightness temperature, channel 1 (0.35 THz)"), caption()
-    log(f"one-channel run: {caption()[:60]!r}")
+    shown = caption()
+    assert shown.startswith("brightness temperature, channel 1 (0.35 THz)"), shown
+    tb = np.fromfile(os.path.join(root, "teraeye", "out-path-sim", "cam.brightness_temperature.img"),
+                     "<f4").reshape(1, 8, 12)
+    readouts.pixel_not_square(driver, wait, by_id, tb, 5, 9)
+    measured = np.fromfile(os.path.join(root, "teraeye", "out-path-sim", "cam.measured_brightness_temperature.img"),
+                           "<f4").reshape(1, 8, 12)
+    readouts.measured_pixel(driver, wait, by_id, measured, 5, 9)
+    log(f"one-channel run: {shown[:60]!r}; pixel (5, 9) of 8 x 12 read back, measured too")
     by_id("tab-run").click()
     said = start("render", "teraeye/out-path-render", **{"photon-map": ""})
     assert "queued" in said, said
@@ -200,9 +218,17 @@ def audit_fixes(driver, wait, patient, by_id, click_list, field, root):
     assert "queued" in said, said
     assert final_state("teraeye/out-render") == "done"
     log("simulate and render of the path scene, render from a map: done")
+    # a run that fails: its error in its row and in the status line
+    said = start("render", "teraeye/out-bad-map", **{"photon-map": "teraeye/path.json"})
+    assert "queued" in said and final_state("teraeye/out-bad-map") == "failed", said
+    log(f"a run that failed: {readouts.failed_run(driver, wait, by_id, 'teraeye/out-bad-map', 'path.json')!r}")
     # an error names where in the request it is
+    driver.execute_script(readouts.RECORD_RUNS)
     said = start("bands", "teraeye/out-bands", count="0")
     assert "$.options.count" in said, said
+    # bands takes the seed (still 3) and the count, nothing else
+    sent = driver.execute_script("return window.sentRuns.at(-1)")
+    assert sent["options"] == {"seed": 3, "count": 0}, sent
     log(f"error: {said!r}")
     # eight runs queued: the page still answers (one stream, not one per run)
     by_id("run-count").clear()
@@ -258,6 +284,12 @@ def bands_results(driver, wait, by_id, click_list, root, shot):
         assert row[1] == ", ".join("%g" % v for v in k["selected_thz"]), (row, k)
         assert abs(float(row[3]) - k["score"]) <= 5e-4 * max(1.0, k["score"]), (row, k)
         assert row[4] == " vs ".join(k["worst_pair"]), (row, k)
+        assert abs(float(row[5]) - k["mean_jm"]) <= 5e-4 * max(1.0, k["mean_jm"]), (row, k)
+    # the chosen set's worst-pair JM (its score) and mean JM, each where the line names it
+    m = re.search(r"worst-pair JM (\S+) of 2 .*, mean JM (\S+);", summary)
+    near = lambda text, value: abs(float(text) - value) <= 5e-4 * max(1.0, value)
+    assert m and near(m.group(1), doc["score"]) and near(m.group(2), doc["mean_jm"]), \
+        (summary, doc["score"], doc["mean_jm"])
     figures = lambda d: d.execute_script(
         "return [...document.querySelectorAll('#bands-figures img')].map((i) =>"
         " [i.alt, i.complete && i.naturalWidth > 0]);")
@@ -363,6 +395,7 @@ def main():
         click_list("files", "scene.json")
         wait.until(lambda d: "valid" in by_id("validation-state").text and "✓" in by_id("validation-state").text)
         names = [o["name"] for o in scene["objects"]]
+        readouts.temperature_colours(driver, by_id, scene)
         # the box's wall does not attenuate: its α plot is flat at 0, on an axis from 0 up
         # (a flat curve's axis once ran -0.5 to 0.5 1/m)
         click_list("objects", "box")
@@ -370,13 +403,23 @@ def main():
             "const svg = [...document.querySelectorAll('#material-plots svg')].find((s) =>"
             " [...s.querySelectorAll('text')].some((t) => t.textContent === 'α (1/m)'));"
             "return svg ? [...svg.querySelectorAll('text[text-anchor=end]')]"
-            ".map((t) => t.textContent) : null;")
+            ".map((t) => [t.textContent, Number(t.getAttribute('y'))]) : null;")
         wait.until(lambda d: alpha_ticks(d))
-        ticks = [float(v) for v in alpha_ticks(driver)]
+        ticks = [float(v) for v, _ in alpha_ticks(driver)]
         assert min(ticks) == 0 and max(ticks) > 0, f"the α axis of a flat α = 0: {ticks}"
+        readouts.grey_wall_plot(driver, scene["materials"]["wall"]["reflectivity"])
+        # drawn upwards: a larger value higher up (a smaller y in the SVG)
+        heights = [y for _, y in sorted(alpha_ticks(driver), key=lambda t: float(t[0]))]
+        assert heights == sorted(heights, reverse=True), alpha_ticks(driver)
         c = names.index("cylinder-C")
         click_list("objects", "cylinder-C")
         path = f"objects[{c}].temperature_k"
+        # the plots are of the object selected
+        plots = lambda d: d.execute_script("return document.querySelector('#material-plots div')?.textContent")
+        material = scene["objects"][c]["material"]
+        wait.until(lambda d: plots(d) == f"material {material}")
+        label = field(path).find_element(By.TAG_NAME, "label").get_attribute("textContent").strip()
+        assert label == "temperature (K)", label
         assert field(path).find_element(By.TAG_NAME, "input").get_attribute("value") == "310"
         # the atmosphere's caption: the paper's scene has none (nothing emits, no background)
         atm_title = driver.execute_script(
@@ -396,7 +439,20 @@ def main():
         assert "✗" in by_id("validation-state").text
         shot("validation")
         log(f"error at the field: {message!r}")
+        type_into(path, "3x0")  # kept as typed: the message says what it is
+        wait.until(lambda d: "got a string" in error_text(d))
         type_into(path, "330")
+        wait.until(lambda d: "✓" in by_id("validation-state").text)
+        # an error at an element of a list (translate_m[1]) is shown at the list's field
+        moved = f"objects[{c}].transform.translate_m"
+        was = ", ".join(str(v) for v in scene["objects"][c]["transform"]["translate_m"])
+        type_into(moved, "0, x, 0")
+        wait.until(lambda d: "expected a number" in field(moved).text)
+        type_into(moved, was)
+        wait.until(lambda d: "✓" in by_id("validation-state").text)
+        # one number in a list's field is that number (a uniform scale), not a list of one
+        type_into(f"objects[{c}].transform.scale", "1")
+        wait.until(lambda d: '"scale": 1' in by_id("scene-text").get_attribute("value"))
         wait.until(lambda d: "✓" in by_id("validation-state").text)
         assert '"temperature_k": 330' in by_id("scene-text").get_attribute("value")
         by_id("btn-save").click()
@@ -412,6 +468,8 @@ def main():
         for seed in ("1", "2"):
             by_id("run-seed").clear()
             by_id("run-seed").send_keys(seed)
+            by_id("run-photons").clear()
+            by_id("run-photons").send_keys("12000")  # the scene's 10 000 overridden
             by_id("run-out").clear()
             by_id("run-out").send_keys(f"teraeye/out-seed{seed}")
             by_id("btn-run").click()
@@ -422,6 +480,7 @@ def main():
         shot("run")
         patient(90, 0.1).until(lambda d: all(s in final for s in ours(d)))
         assert all(s in ("done", "finished", "succeeded") for s in ours(driver)), ours(driver)
+        readouts.runs_as_typed(root, {f"teraeye/out-seed{k}": k for k in (1, 2)}, 12000)
         log("both runs done")
         # Post-processor: the image of the last run, a pixel on cylinder C
         # the first run's Results button (the last run to finish opened by itself)
@@ -453,10 +512,7 @@ def main():
         centre_hz = 1e9 * np.array([float(v) for v in
                                     re.search(r"wavelength\s*=\s*\{([^}]*)\}", hdr).group(1).split(",")])
         s_l = np.fromfile(os.path.join(out, "cam.radiance_stderr.img"), "<f4").reshape(bands, 32, 32)
-        t = tb[:, row, col].astype(float)
-        x = 6.62607015e-34 * centre_hz / (1.380649e-23 * t)
-        b_nu = 2 * 6.62607015e-34 * centre_hz ** 3 / 299792458.0 ** 2 / np.expm1(x)
-        sigma = s_l[:, row, col] / (b_nu * x * np.exp(x) / (np.expm1(x) * t))
+        sigma = readouts.tb_sigma(tb[:, row, col], s_l[:, row, col], centre_hz)
         shown = [float(td.get_attribute("data-value")) for td in driver.find_elements(By.CSS_SELECTOR, "#pixel-table td.sigma")]
         assert np.allclose(shown, sigma, rtol=1e-5, atol=0), f"page σ {shown} != {list(sigma)}"
         # as printed: σ to two significant digits, Tb to the same decimal place
@@ -469,21 +525,23 @@ def main():
             assert decimals(tb_text) == decimals(s_text) == places, (tb_text, s_text, s_b)
             assert abs(float(tb_text) - t_b) <= 0.5 * 10.0 ** -places * (1 + 1e-9), (tb_text, t_b)
             assert abs(float(s_text) - s_b) <= 0.5 * 10.0 ** -places * (1 + 1e-9), (s_text, s_b)
-        truth = by_id("pixel-truth").text
-        assert "cylinder-C" in truth and "330" in truth, truth
+        truth = readouts.pixel_column(driver, by_id, out, (32, 32), row, col, centre_hz, "cylinder-C, 330 K")
         log(f"pixel ({row}, {col}): {len(values)} channels equal the cube; truth {truth!r}; "
             f"answered in {page_ms:.1f} ms in the page, {1000 * (time.monotonic() - t_click):.0f} ms round trip")
         assert page_ms < 100, page_ms
         shot("results")
+        # another channel chosen: its colours, scale and colour bar
+        log(readouts.image_scale(driver, wait, by_id, tb, centre_hz / 1e12, 2))
         # the truth map, the photon map, the A/B difference
         Select(by_id("res-quantity")).select_by_value("object_id")
-        time.sleep(0.2)
+        readouts.object_colours(driver, wait, by_id, oid, names)
         shot("truth")
         Select(by_id("res-view")).select_by_value("photons")
         by_id("ph-max").clear()
         by_id("ph-max").send_keys("200000")
         by_id("btn-photons").click()
         wait.until(lambda d: "photons," in by_id("ph-info").text)
+        readouts.photons_drawn(by_id, json.load(open(os.path.join(out, "summary.json"))), 200000)
         log(f"photon map: {by_id('ph-info').text}")
         time.sleep(0.3)
         shot("photons")
@@ -492,8 +550,11 @@ def main():
         by_id("diff-a").send_keys("teraeye/out-seed1")
         by_id("diff-b").clear()
         by_id("diff-b").send_keys("teraeye/out-seed2")
-        by_id("btn-diff").click()
-        wait.until(lambda d: "beyond" in by_id("diff-info").text)
+        # of channel 3, as chosen above, worked out here from both runs' cubes
+        out2 = os.path.join(root, "teraeye", "out-seed2")
+        cubes = lambda d, q: np.fromfile(os.path.join(d, f"cam.{q}.img"), "<f4").reshape(bands, 32, 32)
+        readouts.difference(driver, wait, by_id, (tb, s_l, centre_hz),
+                            (cubes(out2, "brightness_temperature"), cubes(out2, "radiance_stderr")), 2)
         log(f"A/B: {by_id('diff-info').text}")
         # two seeds agree within their errors: about 0.27 % beyond 3 σ; errors 2x too small
         # would put some 13 % there
