@@ -172,10 +172,11 @@ static thz_status stage_lock(output_stage *stage, const char *lock_path, thz_err
 {
     for (int attempt = 0, waits = 0; attempt < 100; attempt++) {
         int fd = open(lock_path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-        /* A directory access() calls writable may still refuse (root on sysfs): bad
-         * output directory, as access()'s refusal is. */
+        /* A directory access() calls writable may still refuse (root on sysfs; procfs
+         * says ENOENT, the directory being there): bad output directory, as access()'s
+         * refusal is. */
         if (fd < 0)
-            return thz_error_set(err, stage_errno_status(errno),
+            return thz_error_set(err, errno == ENOENT ? THZ_ERR_INPUT : stage_errno_status(errno),
                                  "%s: cannot create the lock file (%s): make its directory "
                                  "writable, or choose another output directory",
                                  lock_path, strerror(errno));
