@@ -20,7 +20,7 @@ typedef struct bands_report {
     const double *width_list;    /* the n_widths relative widths searched, ascending; the
                                     candidates are centre-major (c = centre * n_widths + w) */
     size_t n_widths;
-    double noise_b;      /* the worst pair's B from its means' Monte Carlo noise alone */
+    double noise_b;      /* the worst pair's B from the render's Monte Carlo noise alone */
     const char *warning; /* NULL, or the worst pair cannot be told apart */
 } bands_report;
 

@@ -30,7 +30,8 @@ static void sub_cov(const bands_classes *cl, size_t k, const size_t *set, size_t
 }
 
 double bands_noise_bhattacharyya(const bands_classes *cl, const size_t *set, size_t m, size_t i,
-                                 size_t j, const double *mean_var, double *work)
+                                 size_t j, const double *mean_var, bool spread_is_noise,
+                                 double *work)
 {
     size_t n = cl->n_candidates;
     double *s = work, *inv = s + m * m, *e = inv + m * m;
@@ -40,6 +41,17 @@ double bands_noise_bhattacharyya(const bands_classes *cl, const size_t *set, siz
             s[a * m + b] = 0.5 * (ci[set[a] * n + set[b]] + cj[set[a] * n + set[b]]);
     if (!linalg_cholesky(s, m))
         return NAN;
+    double spread = 0.0; /* B's second term, all of it noise when spread_is_noise */
+    if (spread_is_noise) {
+        double logdet[2];
+        for (size_t q = 0; q < 2; q++) {
+            sub_cov(cl, q ? j : i, set, m, inv);
+            if (!linalg_cholesky(inv, m))
+                return NAN;
+            logdet[q] = linalg_cholesky_logdet(inv, m);
+        }
+        spread = fmax(0.0, 0.5 * (linalg_cholesky_logdet(s, m) - 0.5 * (logdet[0] + logdet[1])));
+    }
     for (size_t b = 0; b < m; b++) { /* column b of S^-1 */
         for (size_t a = 0; a < m; a++)
             e[a] = a == b;
@@ -56,7 +68,7 @@ double bands_noise_bhattacharyya(const bands_classes *cl, const size_t *set, siz
             var += 2.0 * inv[a * m + b] * inv[b * m + a] * da * db;
         }
     }
-    return (mean + 3.0 * sqrt(var)) / 8.0;
+    return (mean + 3.0 * sqrt(var)) / 8.0 + spread;
 }
 
 thz_status bands_score_set(const bands_classes *cl, const size_t *set, size_t m, double *work,

@@ -7,6 +7,7 @@
 #ifndef THZ_ANALYSIS_BANDS_SEARCH_H
 #define THZ_ANALYSIS_BANDS_SEARCH_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -46,15 +47,18 @@ typedef struct bands_search_result {
 thz_status bands_score_set(const bands_classes *cl, const size_t *set, size_t m, double *work,
                            bands_score *out, thz_error *err);
 
-/* The Bhattacharyya distance that the Monte Carlo noise of classes i and j's means alone
- * gives on `set` (m candidates): with mean_var[class * n + c] the variance of a class
- * mean's Monte Carlo error, the means' difference d ~ N(0, D), D diagonal, has
- * E[d^T S^-1 d] = tr(S^-1 D) and variance 2 tr((S^-1 D)^2), S the pair's mean
- * covariance; returns (mean + 3 standard deviations) / 8, the first term of B. A pair
- * whose B is not above it cannot be told from two identical classes. `work` holds
- * 2 m^2 + m doubles; NaN when S is not positive definite. */
+/* The Bhattacharyya distance that the Monte Carlo noise of classes i and j gives on `set`
+ * (m candidates): with mean_var[class * n + c] the variance of a class mean's Monte Carlo
+ * error, the means' difference d ~ N(0, D), D diagonal, has E[d^T S^-1 d] = tr(S^-1 D)
+ * and variance 2 tr((S^-1 D)^2), S the pair's mean covariance; (mean + 3 standard
+ * deviations) / 8 bounds the first term of B. spread_is_noise (the covariances hold the
+ * render's noise, which no standard error let us take out): B's second term, the
+ * covariances' difference, is added whole. A pair whose B is not above the result
+ * cannot be told from two identical classes. `work` holds 2 m^2 + m doubles; NaN when a
+ * covariance is not positive definite. */
 double bands_noise_bhattacharyya(const bands_classes *cl, const size_t *set, size_t m, size_t i,
-                                 size_t j, const double *mean_var, double *work);
+                                 size_t j, const double *mean_var, bool spread_is_noise,
+                                 double *work);
 
 /* Whether score a is better than b: worst-pair JM larger by more than 1e-3; when the
  * two are that close, the larger mean pairwise JM, and when that ties too (saturated

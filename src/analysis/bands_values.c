@@ -337,6 +337,7 @@ thz_status bands_values_compute(thz_context *ctx, const bands_setup *s, bands_va
     bands_class_means(&nominal, cls, v->class_pixels, v, v->mean, v->mean);
     bands_class_netd(scene, s, v);
     bands_pixel_covariance(&nominal, cls, s, v, x);
+    v->spread_is_noise = !nominal.has_stderr;
 
     /* Nuisances: a uniform variation within +-range has variance range^2 / 3; the
      * render at +range (humidity: x (1 - range)) gives the change d of each class's

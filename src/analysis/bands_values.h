@@ -44,6 +44,8 @@ typedef struct bands_values {
     double *nuisance_sd;    /* [class * n + c]: all nuisances together, K */
     double *mean_mc_var;    /* [class * n + c]: variance of the mean's Monte Carlo error, K^2 */
     double *netd_k;         /* [class * n + c]: the sensor's NETD at the class's mean Tb, K */
+    bool spread_is_noise;   /* the render estimated no standard error (one path of one
+                               sample per pixel): cov's pixel spread holds its noise */
     bool humidity_varied, air_temperature_varied, thickness_varied, angle_varied;
     size_t renders;
     uint32_t coarse_paths; /* paths per sample of the nuisances' renders (1 sample per pixel) */

@@ -31,7 +31,7 @@ struct thz_bands {
     bands_values values;
     bands_search_result search;
     double *air_db_per_km; /* or NULL */
-    double noise_b;        /* the worst pair's B from its means' Monte Carlo noise alone */
+    double noise_b;        /* the worst pair's B from the render's Monte Carlo noise alone */
     char *warning;         /* NULL, or: the worst pair cannot be told apart */
     char *json;
 };
@@ -311,7 +311,8 @@ static thz_status check_worst_pair(thz_context *ctx, thz_bands *b, thz_error *er
                         .cov = b->values.cov,
                         .group = b->group};
     b->noise_b = bands_noise_bhattacharyya(&cl, r->sets + (m - 1) * r->count, m, s->worst_pair[0],
-                                           s->worst_pair[1], b->values.mean_mc_var, work);
+                                           s->worst_pair[1], b->values.mean_mc_var,
+                                           b->values.spread_is_noise, work);
     free(work);
     if (!(s->worst_b <= b->noise_b))
         return THZ_OK;
@@ -319,10 +320,14 @@ static thz_status check_worst_pair(thz_context *ctx, thz_bands *b, thz_error *er
     snprintf(msg, sizeof msg,
              "'%s' and '%s' cannot be told apart: their Bhattacharyya distance on the chosen "
              "channels, %.3g, is not above the %.3g that the Monte Carlo noise of their mean "
-             "brightness temperatures alone gives: the chosen set may answer that noise (more "
+             "brightness temperatures %s gives: the chosen set may answer that noise (more "
              "--paths lowers it), or the two are alike",
              b->values.class_names[s->worst_pair[0]], b->values.class_names[s->worst_pair[1]],
-             s->worst_b, b->noise_b);
+             s->worst_b, b->noise_b,
+             b->values.spread_is_noise
+                 ? "and of their spreads (one path of one sample per pixel estimates no "
+                   "standard error to take out of the spreads)"
+                 : "alone");
     b->warning = thz_strdup(msg);
     if (!b->warning)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");

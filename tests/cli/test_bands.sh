@@ -401,11 +401,12 @@ assert diff["warnings"] == [] and diff["bhattacharyya"] > 10 * diff["monte_carlo
 PYEOF
 
 # one path of one sample per pixel estimates no standard error: the pixels' variance stands
-# in for the Monte Carlo one (analysis.md, a bound), so that on one channel
-# monte_carlo_bhattacharyya = r (1 + 3 sqrt 2) / 8, r = (sd_X^2 / n_X + sd_Y^2 / n_Y) / S
-# with S the pair's mean variance, from bands.json's class statistics. A render taken as
-# having standard errors whatever they were (a mutant) passed every test: the means' noise
-# then 0, and B_MC 0, for every --paths 1 run.
+# in for the Monte Carlo one (analysis.md, a bound), and the spreads hold the render's
+# noise, so that on one channel monte_carlo_bhattacharyya = r (1 + 3 sqrt 2) / 8
+# + 1/2 ln(S / sqrt(S_X S_Y)), r = (sd_X^2 / n_X + sd_Y^2 / n_Y) / S with S_X, S_Y the
+# classes' variances and S their mean, from bands.json's class statistics. A render taken
+# as having standard errors whatever they were (a mutant) passed every test: the means'
+# noise then 0, and B_MC 0, for every --paths 1 run.
 "$THZMAP" bands "$work/identical.json" -o "$work/id1" --count 1 --from-thz 0.2 --to-thz 1.0 \
     --step-ghz 50 --paths 1 --targets X,Y -q || fail "one path: exit status $?"
 $PY - "$work/id1/bands.json" <<'PYEOF' || fail "B_MC with one path: $(head -c 600 "$work/id1/bands.json")"
@@ -417,9 +418,18 @@ x, y = (cl[n] for n in d["worst_pair"])
 var = lambda k: k["pixel_sd_k"][c] ** 2 + k["nuisance_sd_k"][c] ** 2 + k["netd_k"][c] ** 2
 r = (x["pixel_sd_k"][c] ** 2 / x["pixels"] + y["pixel_sd_k"][c] ** 2 / y["pixels"]) / (
     (var(x) + var(y)) / 2)
-want = r * (1 + 3 * math.sqrt(2)) / 8
+want = r * (1 + 3 * math.sqrt(2)) / 8 + 0.5 * math.log(
+    (var(x) + var(y)) / 2 / math.sqrt(var(x) * var(y)))
 assert want > 1e-3 and math.isclose(d["monte_carlo_bhattacharyya"], want, rel_tol=1e-6), want
 PYEOF
+
+# ... and on two channels the search picks a pair where one class's spread holds a few
+# pixels that met something hot: B 0.856, all from the spreads, against 0.019 from the
+# means alone, and no warning before
+"$THZMAP" bands "$work/identical.json" -o "$work/id1k2" --count 2 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 50 --paths 1 --targets X,Y -q 2> "$work/id1k2.err" || fail "one path, two channels"
+grep -q "^thzmap bands: warning: 'X' and 'Y' cannot be told apart: .* and of their spreads" \
+    "$work/id1k2.err" || fail "one path, two channels: no warning: $(cat "$work/id1k2.err")"
 
 expect2 "unknown target" "$IN/features.json" -o "$work/x" --count 1 --targets A,nope
 grep -q "nope" "$work/err" || fail "unknown target not named: $(cat "$work/err")"

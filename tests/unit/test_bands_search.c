@@ -74,8 +74,13 @@ static void test_noise_bhattacharyya(void **state)
     double work[2 * 4 + 2];
     double d = 0.04, sv = 1.0; /* D and S */
     double expect = d / sv * (1.0 + 3.0 * sqrt(2.0)) / 8.0;
-    assert_true(fabs(bands_noise_bhattacharyya(&one, set1, 1, 0, 1, v1, work) - expect) <
+    assert_true(fabs(bands_noise_bhattacharyya(&one, set1, 1, 0, 1, v1, false, work) - expect) <
                 1e-12 * expect);
+    /* spreads that hold the render's noise: B's second term added whole,
+     * 1/2 ln(S / sqrt(c_0 c_1)) */
+    double spread = 0.5 * (log(1.0) - 0.5 * (log(0.5) + log(1.5)));
+    assert_true(fabs(bands_noise_bhattacharyya(&one, set1, 1, 0, 1, v1, true, work) -
+                     (expect + spread)) < 1e-12 * (expect + spread));
 
     /* three candidates, classes' covariances over them; the set {0, 2} */
     double m3[6] = {0};
@@ -91,8 +96,12 @@ static void test_noise_bhattacharyya(void **state)
     double tr = i11 * d1 + i22 * d2;
     double tr2 = i11 * d1 * i11 * d1 + 2.0 * i12 * d2 * i12 * d1 + i22 * d2 * i22 * d2;
     expect = (tr + 3.0 * sqrt(2.0 * tr2)) / 8.0;
-    double got = bands_noise_bhattacharyya(&three, set2, 2, 0, 1, v3, work);
+    double got = bands_noise_bhattacharyya(&three, set2, 2, 0, 1, v3, false, work);
     assert_true(fabs(got - expect) < 1e-12 * expect);
+    /* the determinants on {0, 2}: class 0 1.5 - 0.09, class 1 1 - 0.25, S 1.5 - 0.16 */
+    spread = 0.5 * (log(1.34) - 0.5 * (log(1.41) + log(0.75)));
+    got = bands_noise_bhattacharyya(&three, set2, 2, 0, 1, v3, true, work);
+    assert_true(fabs(got - (expect + spread)) < 1e-12 * (expect + spread));
 }
 
 static void check_search(uint64_t limit, const char *expect_search)
