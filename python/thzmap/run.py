@@ -506,6 +506,10 @@ def _shared_run(threads, progress, comm, scene, settings, run):
         return None
     with Call(threads, progress) as call, _mpi.Shared(comm, call) as shared:
         call._stacklevel = 4  # the warnings point past this function and simulate's or render's
+        # the scene's own warnings first, as `thzmap simulate|render` prints them: they are
+        # in summary["warnings"] too, and a run warning may refer to them ("see the scene
+        # warning"); the library says them through thz_scene_warning, not the callback
+        call._warnings.extend(scene.warnings)
         result = run(call)
         result.mpi_bytes = shared.bytes()
     return result

@@ -10,7 +10,7 @@ import threading
 import numpy as np
 import pytest
 import thzmap
-from conftest import tiny_scene_dict
+from conftest import PLATE, tiny_scene_dict
 
 
 def test_bad_dict_names_the_json_path(tiny_dir):
@@ -215,6 +215,27 @@ def test_run_warnings_arrive_as_warnings(tiny_dir):
     with pytest.warns(thzmap.RunWarning) as caught_render:
         thzmap.render(scene, thzmap.fire_photons(scene, photons=200))
     assert {w.filename for w in list(caught) + list(caught_render)} == {__file__}
+
+
+def test_scene_warnings_arrive_from_simulate_and_render(tiny_dict):
+    """The scene's warnings arrive as RunWarnings from simulate and render, first, as
+    `thzmap simulate|render` prints them, and the RunWarnings are summary["warnings"].
+    They used to stay in Scene.warnings alone: a sensor outside its room, or a library
+    material used beyond its source's range, went unsaid in Python though bands and batch
+    said them."""
+    tiny_dict["sensors"][0]["position_m"] = [0, -50, 0.4]
+    scene = thzmap.scene_from_dict(tiny_dict, base_dir=PLATE)
+    assert len(scene.warnings) == 1 and "outside the enclosure" in scene.warnings[0]
+    with pytest.warns(thzmap.RunWarning) as caught:
+        result = thzmap.simulate(scene, integrator="path", seed=1)
+    said = [str(w.message) for w in caught]
+    assert said[0] == scene.warnings[0]
+    assert said == result.summary["warnings"]
+    with pytest.warns(thzmap.RunWarning) as caught:
+        result = thzmap.render(scene, integrator="path")
+    assert [str(w.message) for w in caught] == result.summary["warnings"]
+    assert str(caught[0].message) == scene.warnings[0]
+    assert {w.filename for w in caught} == {__file__}
 
 
 def _bad_scenes():
