@@ -238,15 +238,17 @@ def atmosphere(model="lines", temperature_k=None, pressure_hpa=None, relative_hu
         o.temperature_k = _number("temperature_k", temperature_k)
     if pressure_hpa is not None:
         o.pressure_hpa = _number("pressure_hpa", pressure_hpa)
-    humidities = [(k, v) for k, v in (("relative", relative_humidity),
-                                      ("density_g_m3", water_vapour_g_m3), ("vmr", h2o_vmr))
-                  if v is not None]
+    # (the argument's name, the library's kind of humidity, the value)
+    humidities = [(n, k, v) for n, k, v in (
+        ("relative_humidity", "relative", relative_humidity),
+        ("water_vapour_g_m3", "density_g_m3", water_vapour_g_m3),
+        ("h2o_vmr", "vmr", h2o_vmr)) if v is not None]
     if len(humidities) > 1:
         raise ArgumentError("relative_humidity, water_vapour_g_m3, h2o_vmr: give at most one")
     if humidities:
-        kind, value = humidities[0]
+        name, kind, value = humidities[0]
         o.humidity_kind = HUMIDITY_KINDS[kind]
-        o.humidity = _number(kind, value)
+        o.humidity = _number(name, value)
     files = []
     for name, value in (("h2o_lines", h2o_lines), ("o2_lines", o2_lines)):
         if value is not None:

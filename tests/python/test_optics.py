@@ -230,3 +230,9 @@ def test_errors():
         thzmap.planck_radiance(0.5, "300")
     with pytest.raises(thzmap.ArgumentError, match="only for the lines model"):
         thzmap.atmosphere("itu-p676", h2o_lines="x.par")
+    # a humidity that is no number is named by its argument, not by the library's kind of
+    # humidity ("relative: expected a finite number" was what relative_humidity=nan said)
+    for name in ("relative_humidity", "water_vapour_g_m3", "h2o_vmr"):
+        for bad in (float("nan"), "0.5"):
+            with pytest.raises(thzmap.ArgumentError, match=f"^{name}: expected a finite number"):
+                thzmap.atmosphere(**{name: bad})
