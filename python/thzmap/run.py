@@ -89,8 +89,8 @@ def _settings(scene, integrator=None, photons=None, seed=None, target_noise_k=No
     if target_noise_k is not None:
         s.target_noise_k = _positive("target_noise_k", target_noise_k)
     if max_seconds is not None:
-        if target_noise_k is None:
-            raise ArgumentError("max_seconds limits target_noise_k; give both")
+        # as --max-seconds: it limits the target given here, the scene's, or the default
+        # one; where no target applies a run warning says it is not used
         s.max_seconds = _positive("max_seconds", max_seconds)
     if not isinstance(keep_photons, bool):
         raise ArgumentError(f"keep_photons: expected True or False, got {keep_photons!r}")

@@ -114,7 +114,7 @@ def test_missing_file(tmp_path):
     {"photons": 0}, {"photons": -5}, {"photons": 2.5}, {"photons": 1 << 64}, {"photons": 10**12 + 1},
     {"seed": -1}, {"seed": "1"}, {"seed": 1 << 63}, {"threads": 0}, {"threads": True},
     {"integrator": "magic"}, {"integrator": "path\0"}, {"target_noise_k": math.nan},
-    {"target_noise_k": -1}, {"max_seconds": 3}, {"progress": 42}, {"keep_photons": "yes"},
+    {"target_noise_k": -1}, {"max_seconds": -3}, {"progress": 42}, {"keep_photons": "yes"},
     {"keep_photons": 1},
     {"integrator": "path", "keep_photons": True},  # no map to keep (it gave a run without one)
     {"target_noise_k": 0}, {"target_noise_k": 0.5, "max_seconds": 0}, {"mpi": 1},
@@ -124,6 +124,24 @@ def test_bad_arguments_raise_before_the_library(tiny_dir, kwargs):
     scene = thzmap.load_scene(tiny_dir / "scene.json")
     with pytest.raises(thzmap.ArgumentError):
         thzmap.simulate(scene, **kwargs)
+
+
+def test_max_seconds_alone_is_taken_as_the_cli_takes_it(tiny_dict):
+    """max_seconds without target_noise_k limits the scene's target, as --max-seconds
+    does; where no target applies, a run warning says it is not used. Python refused it
+    ('max_seconds limits target_noise_k; give both') even when the scene gave the target,
+    where thzmap simulate --max-seconds and the server's max_seconds run."""
+    tiny_dict["render"] = {"integrator": "path", "target_noise_k": 5.0}
+    scene = thzmap.scene_from_dict(tiny_dict, base_dir=PLATE)
+    result = thzmap.simulate(scene, max_seconds=60, seed=1)
+    assert result.summary["target_noise_source"] == "scene"
+    assert result.summary["target_noise_k"] == 5.0
+    # the same scene with a count and no target: one pass, max_seconds unused, said so
+    tiny_dict["render"] = {"integrator": "path", "paths_per_sample": 2}
+    scene = thzmap.scene_from_dict(tiny_dict, base_dir=PLATE)
+    with pytest.warns(thzmap.RunWarning, match="max_seconds 60 s is not used"):
+        result = thzmap.simulate(scene, max_seconds=60, seed=1)
+    assert result.summary["target_noise_k"] is None
 
 
 @pytest.mark.parametrize("threads", [4097, 40000, 1 << 20, 1 << 40])
