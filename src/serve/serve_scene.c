@@ -312,8 +312,19 @@ enum MHD_Result serve_materials(serve_request *r)
     } else {
         size_t i = 0;
         if (thz_library_find(lib, name, &i, &err) != THZ_OK) {
+            /* the library's message begins with its file's absolute path, which a client
+             * of the server has no business knowing: name the known entries here */
+            char known[2048] = "";
+            size_t used = 0;
+            for (size_t k = 0; k < thz_library_count(lib) && used < sizeof known; k++) {
+                thz_library_material_info m;
+                thz_library_get_info(lib, k, &m);
+                int n = snprintf(known + used, sizeof known - used, "%s%s", k ? ", " : "", m.name);
+                used = n < 0 ? sizeof known : used + (size_t)n;
+            }
             thz_library_destroy(lib);
-            return serve_reply_error(r, 404, "%s", err.message);
+            return serve_reply_error(
+                r, 404, "no material \"%s\" in the material library (known: %s)", name, known);
         }
         out = serve_library_entry(lib, i, true);
     }

@@ -183,7 +183,14 @@ def test_materials(srv):
         f = srv.json("GET", "/api/materials/" + e["name"])["spectra"]["freq_thz"]
         check(len(f) == 200 and abs(f[0] - span[0]) < 1e-9 and abs(f[-1] - span[1]) < 1e-9,
               "spectra of %s over %r: %r to %r" % (e["name"], span, f[0], f[-1]))
-    srv.json("GET", "/api/materials/no-such-material", status=404)
+    # an unknown name: what is known, and not where the server's data lie (the message
+    # began with the library file's absolute path)
+    e = srv.json("GET", "/api/materials/no-such-material", status=404) or {}
+    msg = e.get("error", "")
+    check(msg.startswith('no material "no-such-material"') and "known: " in msg and
+          all(m["name"] in msg for m in (lib["materials"] if lib else [])) and
+          "/" not in msg and "library.json" not in msg,
+          "unknown material's message: %r" % msg)
 
 
 def sse_events(srv, run_id):
