@@ -143,7 +143,7 @@ const char *serve_arg(serve_request *r, const char *name)
     return MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, name);
 }
 
-json_t *serve_body_object(serve_request *r, enum MHD_Result *result)
+json_t *serve_body_object(serve_request *r, const char *const *keys, enum MHD_Result *result)
 {
     json_error_t jerr;
     json_t *o = json_loadb(r->body ? r->body : "", r->body_size, JSON_REJECT_DUPLICATES, &jerr);
@@ -156,6 +156,25 @@ json_t *serve_body_object(serve_request *r, enum MHD_Result *result)
     if (!json_is_object(o)) {
         json_decref(o);
         *result = serve_reply_bad_json(r, "$", "expected a JSON object");
+        return NULL;
+    }
+    const char *key;
+    json_t *v;
+    json_object_foreach(o, key, v)
+    {
+        size_t k = 0;
+        while (keys[k] && strcmp(key, keys[k]) != 0)
+            k++;
+        if (keys[k])
+            continue;
+        char path[300], expected[200] = "";
+        snprintf(path, sizeof path, "$.%s", key);
+        serve_text_fit(path);
+        for (k = 0; keys[k]; k++)
+            snprintf(expected + strlen(expected), sizeof expected - strlen(expected), "%s%s",
+                     k ? ", " : "", keys[k]);
+        *result = serve_reply_bad_json(r, path, "unknown key (expected %s)", expected);
+        json_decref(o);
         return NULL;
     }
     return o;

@@ -96,8 +96,10 @@ enum MHD_Result serve_reply_thz_error(serve_request *r, const thz_error *err);
 
 /* A query argument, or NULL. */
 const char *serve_arg(serve_request *r, const char *name);
-/* The body parsed as a JSON object; NULL after replying 400 (then return *result). */
-json_t *serve_body_object(serve_request *r, enum MHD_Result *result);
+/* The body parsed as a JSON object whose keys are among `keys` (NULL-ended); NULL after
+ * replying 400 (then return *result): malformed, not an object, or a key not in `keys`
+ * (at "$.KEY": a misspelt key would otherwise be passed over in silence). */
+json_t *serve_body_object(serve_request *r, const char *const *keys, enum MHD_Result *result);
 
 /* ---- paths under the root (serve_paths.c) ------------------------------------------- */
 

@@ -240,18 +240,6 @@ static serve_job *serve_parse_job(serve_request *r, json_t *body, enum MHD_Resul
     }
     const char *key;
     json_t *v;
-    json_object_foreach(body, key, v)
-    {
-        if (strcmp(key, "command") && strcmp(key, "scene") && strcmp(key, "out") &&
-            strcmp(key, "options")) {
-            char path[300];
-            snprintf(path, sizeof path, "$.%s", key);
-            *ret = serve_reply_bad_json(r, path,
-                                        "unknown key (expected command, scene, out, "
-                                        "options)");
-            goto fail;
-        }
-    }
     const char *cmd = json_string_value(json_object_get(body, "command"));
     size_t c = 0;
     while (c < 4 && (!cmd || strcmp(cmd, serve_command_names[c]) != 0))
@@ -311,7 +299,8 @@ enum MHD_Result serve_runs_post(serve_request *r)
 {
     serve *s = r->s;
     enum MHD_Result ret = MHD_NO;
-    json_t *body = serve_body_object(r, &ret);
+    static const char *const keys[] = {"command", "scene", "out", "options", NULL};
+    json_t *body = serve_body_object(r, keys, &ret);
     if (!body)
         return ret;
     serve_job *j = serve_parse_job(r, body, &ret);

@@ -202,7 +202,8 @@ static json_t *serve_scene_json(const thz_scene *scene)
 enum MHD_Result serve_validate(serve_request *r)
 {
     enum MHD_Result ret = MHD_NO;
-    json_t *body = serve_body_object(r, &ret);
+    static const char *const keys[] = {"path", "text", NULL};
+    json_t *body = serve_body_object(r, keys, &ret);
     if (!body)
         return ret;
     json_t *jpath = json_object_get(body, "path"), *jtext = json_object_get(body, "text");

@@ -249,6 +249,13 @@ def test_limits(srv):
     check(err and err.get("path") == "$" and "line 1" in err["error"], "malformed: %r" % err)
     err = srv.json("POST", "/api/validate", body={"text": 3}, status=400)
     check(err and err.get("path") == "$.text", "text not a string: %r" % err)
+    # a misspelt key (the scene's path as "file") is a 400 at it, not a scene whose
+    # relative file names were silently taken from the root
+    err = srv.json("POST", "/api/validate", body={"file": "s/scene.json", "text": "{}"},
+                   status=400)
+    check(err and err.get("path") == "$.file" and
+          err.get("error") == "unknown key (expected path, text)",
+          "an unknown key of a validate body: %r" % err)
     err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/scene.json",
                                                "out": "o", "options": {"integrator": "path",
                                                                        "save_photon_map": True}},
