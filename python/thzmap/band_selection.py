@@ -209,7 +209,7 @@ def bands(scene, count, from_thz=None, to_thz=None, step_ghz=None, relative_widt
     if targets is not None:
         if isinstance(targets, str):
             targets = [targets]
-        if not hasattr(targets, "__iter__"):
+        if isinstance(targets, (bytes, bytearray)) or not hasattr(targets, "__iter__"):
             raise ArgumentError(f"targets: expected object names, got {targets!r}")
         names = [_text("targets", t) for t in targets]
         if not names:

@@ -194,6 +194,10 @@ def test_bands_errors(tmp_path):
                    dict(count=1, humidity_range=1.0), dict(count=33)):
         with pytest.raises(thzmap.ArgumentError):
             thzmap.bands(FEATURES, **kwargs)
+    # bytes are not a list of names (they were taken apart: 'expected a non-empty name,
+    # got 65', the code of their first letter)
+    with pytest.raises(thzmap.ArgumentError, match=r"targets: expected object names, got b'A'"):
+        thzmap.bands(FEATURES, 1, targets=b"A")
     with pytest.raises(thzmap.ArgumentError, match=r"from_thz: expected a number in \(0"):
         thzmap.bands(FEATURES, 1, from_thz=0)
     with pytest.raises(thzmap.ArgumentError):
