@@ -169,6 +169,12 @@ void serve_cubes_free(serve *s);
  * read; valid while the caller holds s->cache_lock and gets no other cube. NULL with err
  * filled when it cannot be read. */
 const thz_cube *serve_cube_get(serve *s, const char *hdr, thz_error *err);
+/* DIR/SENSOR.QUANTITY.hdr, a cube a run may or may not have written, by serve_cube_get:
+ * NULL with why "" when there is no such file (the run wrote none), NULL with why saying
+ * what is wrong when it is there but cannot be read (damaged, cut short, outside the
+ * root): such a cube is reported, never taken for one the run did not write. */
+const thz_cube *serve_run_cube(serve *s, const char *dir, const char *sensor, const char *quantity,
+                               char *why, size_t size);
 /* The standard error of Tb (K) from that of the radiance L at the channel centre (where
  * the images' Tb is defined): sigma / (dB/dT at Tb), thz_brightness_temperature_stderr.
  * NaN without a positive centre, a sigma or a positive Tb (L <= 0). */

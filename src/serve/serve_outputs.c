@@ -70,8 +70,14 @@ const thz_cube *serve_cube_get(serve *s, const char *hdr, thz_error *err)
     char stem[PATH_MAX];
     snprintf(stem, sizeof stem, "%.*s", (int)(strlen(slash + 1) - 4), slash + 1);
     thz_cube *cube = NULL;
-    if (thz_cube_read(dir[0] ? dir : "/", stem, &cube, err) != THZ_OK)
+    if (thz_cube_read(dir[0] ? dir : "/", stem, &cube, err) != THZ_OK) {
+        /* the library names the file by its real path: name it relative to the root, as
+         * every other answer does */
+        size_t rn = strlen(s->root);
+        if (strncmp(err->message, s->root, rn) == 0 && err->message[rn] == '/')
+            memmove(err->message, err->message + rn + 1, strlen(err->message + rn + 1) + 1);
         return NULL;
+    }
     thz_cube_destroy(victim->cube);
     *victim = (serve_cube_entry){.cube = cube,
                                  .used = ++s->cube_clock,
@@ -80,6 +86,26 @@ const thz_cube *serve_cube_get(serve *s, const char *hdr, thz_error *err)
                                  .size_img = si.st_size};
     snprintf(victim->path, sizeof victim->path, "%s", real);
     return cube;
+}
+
+const thz_cube *serve_run_cube(serve *s, const char *dir, const char *sensor, const char *quantity,
+                               char *why, size_t size)
+{
+    char hdr[PATH_MAX];
+    struct stat st;
+    why[0] = '\0';
+    if (snprintf(hdr, sizeof hdr, "%s/%s.%s.hdr", dir, sensor, quantity) >= (int)sizeof hdr ||
+        (lstat(hdr, &st) != 0 && errno == ENOENT))
+        return NULL;
+    if (!serve_path_inside(s, hdr)) {
+        snprintf(why, size, "%s: outside the root", hdr);
+        return NULL;
+    }
+    thz_error err = {0};
+    const thz_cube *c = serve_cube_get(s, hdr, &err);
+    if (!c)
+        snprintf(why, size, "%s", err.message);
+    return c;
 }
 
 static json_t *serve_num(double x)
@@ -224,18 +250,14 @@ enum MHD_Result serve_cube_data(serve_request *r)
 }
 
 /* Reads DIR/SENSOR.QUANTITY.hdr's values at one pixel (all bands, up to max) into out;
- * the number of bands, 0 when the cube is absent or the pixel outside. Also its centres
- * (THz) and object names when asked. The caller holds the cache lock. */
+ * the number of bands, 0 when the cube is absent or the pixel outside, or when it cannot
+ * be read (why says so, else it is ""). Also its centres (THz) and object names when
+ * asked. The caller holds the cache lock. */
 static size_t serve_pixel_values(serve *s, const char *dir, const char *sensor, const char *q,
                                  long row, long col, double *out, size_t max, double *centres_thz,
-                                 json_t **object_names)
+                                 json_t **object_names, char *why, size_t size)
 {
-    char hdr[PATH_MAX];
-    if (snprintf(hdr, sizeof hdr, "%s/%s.%s.hdr", dir, sensor, q) >= (int)sizeof hdr ||
-        !serve_path_inside(s, hdr))
-        return 0;
-    thz_error err = {0};
-    const thz_cube *c = serve_cube_get(s, hdr, &err);
+    const thz_cube *c = serve_run_cube(s, dir, sensor, q, why, size);
     if (!c || row < 0 || col < 0 || row >= (long)thz_cube_rows(c) ||
         col >= (long)thz_cube_columns(c))
         return 0;
@@ -310,8 +332,8 @@ enum MHD_Result serve_pixel(serve_request *r)
     json_t *names = NULL;
     /* The brightness temperature sets the image: none, a 404; a pixel outside it, the
      * request's mistake (400, with the size). One 404 said either, for both. */
-    char hdr[PATH_MAX];
     thz_error cube_err = {0};
+    char hdr[PATH_MAX], why[sizeof cube_err.message + PATH_MAX] = "";
     long rows = -1, cols = -1;
     bool inside = false;
     pthread_mutex_lock(&r->s->cache_lock);
@@ -337,10 +359,11 @@ enum MHD_Result serve_pixel(serve_request *r)
             }
         }
         inside = row >= 0 && col >= 0 && row < rows && col < cols;
-        for (size_t i = 0; i < NQ && inside; i++)
+        why[0] = '\0';
+        for (size_t i = 0; i < NQ && inside && !why[0]; i++)
             n[i] = serve_pixel_values(r->s, dir, sensor, q[i], row, col, v + i * SERVE_MAX_BANDS,
                                       SERVE_MAX_BANDS, i == 0 ? centres : NULL,
-                                      i == 6 ? &names : NULL);
+                                      i == 6 ? &names : NULL, why, sizeof why);
         if (!known ||
             (stat(dir, &after) == 0 && before.st_dev == after.st_dev &&
              before.st_ino == after.st_ino && before.st_mtim.tv_sec == after.st_mtim.tv_sec &&
@@ -350,6 +373,11 @@ enum MHD_Result serve_pixel(serve_request *r)
             break;
     }
     pthread_mutex_unlock(&r->s->cache_lock);
+    if (why[0]) { /* a cube beside it damaged: said, not left out of the answer */
+        free(v);
+        json_decref(names);
+        return serve_reply_error(r, 400, "%s", why);
+    }
     if (!inside || !n[0]) { /* n[0]: the cube read, but no band of it (not one of ours) */
         free(v);
         json_decref(names);

@@ -189,21 +189,35 @@ static bool serve_diff_side(serve *s, const char *dir, const char *sensor, size_
     }
     memcpy(*tb, thz_cube_data(c) + band * plane, plane * sizeof **tb);
     float *l = malloc(plane * sizeof *l + 1);
-    snprintf(hdr, sizeof hdr, "%s/%s.radiance.hdr", dir, sensor);
-    c = l && serve_path_inside(s, hdr) ? serve_cube_get(s, hdr, &err) : NULL;
-    if (c && thz_cube_rows(c) == *rows && thz_cube_columns(c) == *cols && band < thz_cube_bands(c))
-        memcpy(l, thz_cube_data(c) + band * plane, plane * sizeof *l);
-    else
-        c = NULL;
-    snprintf(hdr, sizeof hdr, "%s/%s.radiance_stderr.hdr", dir, sensor);
-    const thz_cube *cs = c && serve_path_inside(s, hdr) ? serve_cube_get(s, hdr, &err) : NULL;
-    *has_se = cs && thz_cube_rows(cs) == *rows && thz_cube_columns(cs) == *cols &&
-              band < thz_cube_bands(cs);
+    if (!l) {
+        snprintf(why, size, "out of memory");
+        return false;
+    }
+    /* Tb's standard error needs the radiance and its standard error: a run without them
+     * gives Tb_a - Tb_b in K (docs/gui.md); one whose cubes are there but cannot be read,
+     * or are not of Tb's size, is said, not taken for a run without them */
+    static const char *const q[] = {"radiance", "radiance_stderr"};
+    const thz_cube *cs = NULL;
+    for (int k = 0; k < 2; k++) {
+        cs = serve_run_cube(s, dir, sensor, q[k], why, size);
+        if (cs && (thz_cube_rows(cs) != *rows || thz_cube_columns(cs) != *cols ||
+                   band >= thz_cube_bands(cs)))
+            snprintf(why, size,
+                     "%s/%s.%s.hdr: %u x %u pixels, %zu bands: not its "
+                     "brightness temperature's %u x %u with band %zu",
+                     dir, sensor, q[k], thz_cube_columns(cs), thz_cube_rows(cs), thz_cube_bands(cs),
+                     *cols, *rows, band);
+        if (why[0] || !cs)
+            break;
+        if (k == 0)
+            memcpy(l, thz_cube_data(cs) + band * plane, plane * sizeof *l);
+    }
+    *has_se = cs && !why[0];
     for (size_t i = 0; i < plane; i++)
         (*se)[i] =
             *has_se ? serve_tb_stderr(centre_hz, l[i], thz_cube_data(cs)[band * plane + i]) : NAN;
     free(l);
-    return true;
+    return !why[0];
 }
 
 enum MHD_Result serve_diff(serve_request *r)

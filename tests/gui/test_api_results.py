@@ -132,6 +132,34 @@ def test_diff(root, srv):
           "diff with errors of 0: %r" % (diff and diff[:8],))
 
 
+def test_damaged_cubes(root, srv):
+    """A standard-error or radiance cube that is there but cannot be read (here a header
+    without its sizes), or is not of Tb's size, is said: a 400 naming it, relative to the
+    root. /api/diff answered Tb_a - Tb_b in K and /api/pixel a null standard error, as for
+    a run that wrote no such cube, and /api/cube named the file by its absolute path."""
+    for q in ("radiance_stderr", "radiance"):
+        copy_run(root, "b", "bad-" + q)
+        with open(os.path.join(root, "out", "bad-" + q, "cam.%s.hdr" % q), "w") as f:
+            f.write("ENVI\ngarbage\n")
+        want = "out/bad-%s/cam.%s.hdr: " % (q, q)
+        err = srv.json("GET", "/api/diff?a=out/a&b=out/bad-%s&sensor=cam&band=0" % q,
+                       status=400)
+        check(err and err.get("error", "").startswith(want), "diff, damaged %s: %r" % (q, err))
+        err = srv.json("GET", "/api/pixel?dir=out/bad-%s&sensor=cam&row=3&col=4" % q, status=400)
+        check(err and err.get("error", "").startswith(want), "pixel, damaged %s: %r" % (q, err))
+        err = srv.json("GET", "/api/cube?path=out/bad-%s/cam.%s.hdr" % (q, q), status=400)
+        check(err and err.get("error", "").startswith(want) and root not in err["error"],
+              "cube, damaged %s: %r" % (q, err))
+    # a standard error of another run's size beside Tb (out/small's 8 x 12 cubes)
+    copy_run(root, "b", "mixed")
+    for ext in ("hdr", "img"):
+        shutil.copy(os.path.join(root, "out", "small", "cam.radiance_stderr." + ext),
+                    os.path.join(root, "out", "mixed", "cam.radiance_stderr." + ext))
+    err = srv.json("GET", "/api/diff?a=out/a&b=out/mixed&sensor=cam&band=0", status=400)
+    check(err and "out/mixed/cam.radiance_stderr.hdr: 8 x 12 pixels" in err.get("error", ""),
+          "diff, a standard error of another size: %r" % err)
+
+
 def test_outputs(root, srv):
     res = srv.json("GET", "/api/outputs?dir=out/nose")
     cam = res and [s for s in res["sensors"] if s["name"] == "cam"]
@@ -233,6 +261,7 @@ def main():
             test_cubes(srv)
             test_pixel(root, srv)
             test_diff(root, srv)
+            test_damaged_cubes(root, srv)
             test_outputs(root, srv)
             test_photons(srv)
         finally:
