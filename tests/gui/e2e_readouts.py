@@ -149,6 +149,12 @@ def difference(driver, wait, by_id, a, b, band):
     m = re.search(r"A − B = (\S+) σ$", by_id("pixel-info").text)
     assert m and abs(float(m.group(1)) - z[row, col]) <= 1e-3 * abs(z[row, col]) + 1e-4, \
         (by_id("pixel-info").text, z[row, col])
+    # no spectrum or table of another pixel under it: they stayed those of the pixel last
+    # clicked on the image, under this pixel's row and column
+    left = driver.execute_script(
+        "return document.querySelectorAll('#pixel-table td').length +"
+        " document.getElementById('pixel-plot').childElementCount;")
+    assert left == 0, f"{left} cells and plots of another pixel under {by_id('pixel-info').text!r}"
     return info
 
 

@@ -303,7 +303,13 @@ export class Results {
   clickDiff(e) {
     if (!this.diffZ) return;
     const [row, col] = this.pixelOf(e, $("diff-image"), this.diffZ.cube);
-    $("pixel-info").textContent = `row ${row}, column ${col}: A − B = ${formatNumber(this.diffZ.z[row * this.diffZ.cube.cols + col])} ${this.diffZ.unit}`;
+    const info = $("pixel-info");
+    info.dataset.row = row;
+    info.dataset.col = col;
+    info.textContent = `row ${row}, column ${col}: A − B = ${formatNumber(this.diffZ.z[row * this.diffZ.cube.cols + col])} ${this.diffZ.unit}`;
+    // the spectrum and table below were those of the pixel last clicked on the image
+    $("pixel-plot").replaceChildren();
+    $("pixel-table").replaceChildren();
   }
 
   async loadPhotons() {
