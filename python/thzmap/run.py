@@ -393,6 +393,9 @@ class Result:
         appear only when all were written; a failure or cancellation leaves outdir as it
         was."""
         outdir = _path_arg("outdir", outdir)
+        if photon_map is not None and not isinstance(photon_map, bool):
+            raise ArgumentError("photon_map: expected True or False (whether to write the "
+                                f"run's own photon map) or None, got {photon_map!r}")
         opt = _lib.ThzWriteOptions()
         opt.photon_map = int(self.photon_map is not None if photon_map is None
                              else bool(photon_map))

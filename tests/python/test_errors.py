@@ -209,6 +209,15 @@ def test_bad_render_arguments(tiny_dir):
         result.image("nope")
     with pytest.raises(thzmap.ArgumentError, match="keep"):
         result.save(tiny_dir / "o", photon_map=True)
+    # photon_map says whether to write the run's own map: a map or a path given there
+    # (to save "with this map") was read as True and answered 'the run did not keep its
+    # photons', or, for a run that kept them, wrote the run's own map in silence
+    kept = thzmap.simulate(scene, keep_photons=True)
+    for res in (result, kept):
+        for bad in (pm, str(tiny_dir / "map.thzpm"), 1):
+            with pytest.raises(thzmap.ArgumentError, match="photon_map: expected True or False"):
+                res.save(tiny_dir / "o", photon_map=bad)
+    assert not (tiny_dir / "o").exists()
 
 
 def test_a_photon_map_of_another_scene_is_refused(tiny_dir):
