@@ -275,6 +275,15 @@ class Handle:
         if ptr and self._destroy is not None:
             self._destroy(ptr)
 
+    def __reduce__(self):
+        # pickle and copy.deepcopy reach every object through this: a copy of the pointer
+        # would be freed twice, and ctypes' own refusal ('ctypes objects containing
+        # pointers cannot be pickled') came with a half-made Handle failing in __del__
+        raise TypeError("a thzmap Scene, Result, PhotonMap or other library object holds a "
+                        "library handle and cannot be pickled or deep-copied: give another "
+                        "process what made it (a scene's path or dict) and load it there, "
+                        "or copy the arrays (np.array(image.radiance))")
+
 
 def text(value):
     """A C string (bytes or None) as str."""

@@ -9,6 +9,7 @@ import time
 import weakref
 
 import numpy as np
+import pytest
 import thzmap
 from conftest import CUBES, MAPS, assert_bitwise_equal, tiny_scene_dict
 
@@ -143,3 +144,22 @@ def test_the_gil_is_released_during_a_run(tiny_dir):
     assert seconds > 0.3, f"the run was too short to tell ({photons} photons, {seconds:.2f} s)"
     assert ticks > 5 * len(reports) + 20, \
         f"{ticks} ticks of the main thread for {len(reports)} reports in {seconds:.2f} s"
+
+
+def test_library_objects_refuse_pickle_and_deepcopy(tiny_dir):
+    """A Scene, Result, PhotonMap or material library cannot be pickled (as
+    multiprocessing does to a sweep's arguments) or deep-copied: a TypeError that says
+    what to do instead. ctypes refused with 'ctypes objects containing pointers cannot be
+    pickled' and a half-made Handle then failed in __del__ ('Exception ignored'), which
+    pytest reports as an error here. A shallow copy shares the handle and works."""
+    import copy
+    import pickle
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    result = thzmap.simulate(scene, photons=500, keep_photons=True)
+    for obj in (scene, result, result.photon_map, thzmap.material_library()):
+        with pytest.raises(TypeError, match="cannot be pickled or deep-copied: give another"):
+            copy.deepcopy(obj)
+        with pytest.raises(TypeError, match="cannot be pickled or deep-copied"):
+            pickle.dumps(obj)
+    gc.collect()
+    assert copy.copy(scene).sensor_names == scene.sensor_names
