@@ -188,9 +188,25 @@ class Atmosphere:
         return self.attenuation_per_m(frequency_thz) * (1000.0 * 10.0 / math.log(10.0))
 
     def transmittance(self, frequency_thz, distance_m):
-        """exp(-alpha * distance_m) of a path through this air."""
-        d = _number("distance_m", distance_m, 0.0)
-        return np.exp(-self.attenuation_per_m(frequency_thz) * d)
+        """exp(-alpha * distance_m) of a path through this air; distance_m (m, at least 0)
+        a number or an array that broadcasts against frequency_thz."""
+        alpha = self.attenuation_per_m(frequency_thz)
+        if np.ndim(distance_m) == 0:
+            d = _number("distance_m", distance_m, 0.0)
+        else:
+            try:
+                d = np.asarray(distance_m)
+                if d.dtype.kind not in "iuf":  # text, booleans, None
+                    raise TypeError
+                d = d.astype(np.float64)
+                np.broadcast_shapes(np.shape(alpha), d.shape)
+            except (TypeError, ValueError):
+                raise ArgumentError("distance_m: expected a number or an array of numbers in m "
+                                    "that broadcasts against frequency_thz, got "
+                                    f"{distance_m!r}") from None
+            if not np.all(np.isfinite(d)) or np.any(d < 0):
+                raise ArgumentError("distance_m: expected finite numbers of at least 0 m")
+        return np.exp(-alpha * d)
 
     def __repr__(self):
         i = self.info

@@ -217,6 +217,19 @@ def test_errors():
     with pytest.raises(thzmap.ArgumentError, match=r"distance_m: expected a number at least 0, "
                        r"got -1"):
         thzmap.atmosphere().transmittance(0.5, -1)
+    # distances as an array broadcast against the frequencies, as planck_radiance's
+    # temperatures do (a sweep over path length was refused: 'expected a finite number')
+    air = thzmap.atmosphere()
+    f, d = np.array([0.3, 0.5, 0.65]), np.array([[1.0], [10.0]])
+    t = air.transmittance(f, d)
+    assert t.shape == (2, 3)
+    for i in range(2):
+        for j in range(3):
+            assert t[i, j] == air.transmittance(f[j], d[i, 0])
+    assert np.all(t[1] < t[0])
+    for bad in ([[1.0, -1.0]], [np.nan, 1.0], ["1", "2"], [1.0, 2.0]):  # the last: shape (2,) against (3,)
+        with pytest.raises(thzmap.ArgumentError, match="distance_m: expected"):
+            air.transmittance(f, bad)
     with pytest.raises(thzmap.Error, match=r"frequency_thz: 2 THz lies outside the range of "
                        r"atmosphere model 'itu-p676' \(0\.001 to 1 THz\)"):
         thzmap.atmosphere("itu-p676").attenuation_per_m(2.0)  # 1-1000 GHz only (not "2 to 2 THz")
