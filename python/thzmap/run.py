@@ -436,9 +436,13 @@ def simulate(scene, integrator=None, photons=None, seed=None, threads=None,
         raise ArgumentError(f"keep_photons: the {effective} integrator fires no photons, so "
                             "there is no photon map to keep; give integrator='photon-map' or "
                             "'final-gather'")
+    unused = []  # said, not silently dropped, as `thzmap simulate --photons` says it
+    if photons is not None and not _lib.lib.thz_integrator_needs_photons(effective.encode()):
+        unused.append(f"photons={photons} is not used: the {effective} integrator fires no "
+                      "photons (give integrator='photon-map' or 'final-gather' to fire them)")
     return _shared_run(threads, progress, _world(mpi), scene, s, lambda call: _run_call(
         call, lambda out: _lib.lib.thz_simulate(call.ctx, scene._handle, ctypes.byref(s), out,
-                                                call.err), scene))
+                                                call.err), scene), unused)
 
 
 def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, threads=None,
@@ -453,6 +457,12 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
     comm = _world(mpi)
     s = _settings(scene, integrator, None, seed, target_noise_k, max_seconds)  # the integrator too
     index = -1 if sensor is None else scene.sensor_index(sensor)
+    effective = _effective_integrator(scene, integrator)
+    unused = []  # as `thzmap render --photon-map` with the path integrator says it
+    if photon_map is not None and not _lib.lib.thz_integrator_needs_photons(effective.encode()):
+        unused.append(f"photon_map is not used: the {effective} integrator renders without "
+                      "photons (give integrator='photon-map' or 'final-gather' to render "
+                      "from it)")
 
     def run(call):  # rank 0's (or the one process's): the map is its alone
         path, pm = _render_map_arg(scene, photon_map, integrator, seed)
@@ -464,7 +474,7 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
         return _run_call(call, lambda out: _lib.lib.thz_render_run(
             call.ctx, scene._handle, ptr, index, ctypes.byref(s), out, call.err), scene, pm)
 
-    return _shared_run(threads, progress, comm, scene, s, run)
+    return _shared_run(threads, progress, comm, scene, s, run, unused)
 
 
 def _render_map_arg(scene, photon_map, integrator, seed):
@@ -498,10 +508,11 @@ def _world(mpi):
     return _mpi.world() if mpi else None
 
 
-def _shared_run(threads, progress, comm, scene, settings, run):
+def _shared_run(threads, progress, comm, scene, settings, run, unused=()):
     """run(call), a Result, on a Call of its own; with comm (thzmap.mpi), shared with the
     other ranks: rank 0 runs it, the others serve it and return None. The arguments
-    every rank checks alike are checked before, raising on every rank."""
+    every rank checks alike are checked before, raising on every rank. `unused`: the
+    warnings about arguments the integrator does not use, said first (rank 0)."""
     check_progress(progress)
     if comm is not None and comm.Get_rank() > 0:
         with Call(threads, report_warnings=False) as call:
@@ -512,7 +523,7 @@ def _shared_run(threads, progress, comm, scene, settings, run):
         # the scene's own warnings first, as `thzmap simulate|render` prints them: they are
         # in summary["warnings"] too, and a run warning may refer to them ("see the scene
         # warning"); the library says them through thz_scene_warning, not the callback
-        call._warnings.extend(scene.warnings)
+        call._warnings.extend([*unused, *scene.warnings])
         result = run(call)
         result.mpi_bytes = shared.bytes()
     return result

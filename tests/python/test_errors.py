@@ -6,6 +6,7 @@ import math
 import os
 import shutil
 import threading
+import warnings
 
 import numpy as np
 import pytest
@@ -263,6 +264,30 @@ def test_scene_warnings_arrive_from_simulate_and_render(tiny_dict):
     assert [str(w.message) for w in caught] == result.summary["warnings"]
     assert str(caught[0].message) == scene.warnings[0]
     assert {w.filename for w in caught} == {__file__}
+
+
+def test_arguments_the_integrator_does_not_use_are_said(tiny_dir):
+    """photons= with the path integrator, and a photon map given to a path render, are
+    said (RunWarning), first, as thzmap simulate --photons and render --photon-map say
+    them; simulate(scene, photons=1000) with a scene whose integrator is path fired
+    nothing and said nothing, which reads as a run of 1000 photons."""
+    scene = thzmap.load_scene(tiny_dir / "scene.json")
+    with pytest.warns(thzmap.RunWarning) as caught:
+        result = thzmap.simulate(scene, integrator="path", photons=1000, seed=1)
+    said = [str(w.message) for w in caught]
+    assert said[0].startswith("photons=1000 is not used: the path integrator fires no photons")
+    assert said[1:] == result.summary["warnings"] and result.totals.photons_fired == 0
+    pm = thzmap.fire_photons(scene, photons=300)
+    with pytest.warns(thzmap.RunWarning) as caught:
+        thzmap.render(scene, pm, integrator="path")
+    assert str(caught[0].message).startswith("photon_map is not used: the path integrator")
+    assert {w.filename for w in caught} == {__file__}
+    # used: nothing said about them
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        thzmap.simulate(scene, integrator="photon-map", photons=300, seed=1)
+        thzmap.render(scene, pm, integrator="photon-map")
+    assert not [w for w in caught if "is not used" in str(w.message)]
 
 
 def _bad_scenes():
