@@ -43,7 +43,14 @@ struct serve_job {
     bool cancel;
     unsigned version; /* bumped on every change (event streams wait for it) */
     bool photons_seen;
+    /* the warnings `thzmap simulate|render|batch|bands` would print: the scene's, an
+     * option not used, the run's (JSON strings; at most SERVE_JOB_WARNINGS kept, the
+     * others counted); NULL until the first */
+    json_t *warnings;
+    size_t warnings_dropped;
 };
+
+#define SERVE_JOB_WARNINGS 100
 
 bool serve_job_finished(const serve_job *j);
 void serve_job_free(serve_job *j);

@@ -3,6 +3,7 @@
  * streamed by GET /api/runs/ID/events) and cancellation (DELETE, or the server
  * stopping). Outputs are written atomically, as by the CLI: a cancelled run leaves its
  * output directory as it was. */
+#include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -43,8 +44,16 @@ static json_t *serve_job_json(const serve_job *j)
                           serve_command_names[j->command], "scene", j->scene, "out", j->out,
                           "state", serve_state_names[j->state], "progress", j->progress, "message",
                           message, "seconds", j->t_start > 0.0 ? end - j->t_start : 0.0);
-    if (o)
+    if (o) {
         json_object_set_new(o, "error", error[0] ? json_string(error) : json_null());
+        /* a copy: the worker appends to the job's while the answer is written unlocked */
+        json_t *w = j->warnings ? json_deep_copy(j->warnings) : json_array();
+        if (w && j->warnings_dropped)
+            json_array_append_new(w, json_sprintf("... and %zu more warnings (summary.json "
+                                                  "of the run has them)",
+                                                  j->warnings_dropped));
+        json_object_set_new(o, "warnings", w);
+    }
     return o;
 }
 
@@ -55,6 +64,7 @@ void serve_job_free(serve_job *j)
     for (size_t i = 0; i < j->n_targets; i++)
         free(j->targets[i]);
     free(j->targets);
+    json_decref(j->warnings);
     free(j);
 }
 
@@ -148,12 +158,24 @@ static int serve_on_batch_progress(void *user, const thz_batch_progress *p)
     return serve_job_report(c, p->fraction, message);
 }
 
+/* A warning of the job: kept in its "warnings" (it passed as the message alone, which
+ * the next progress report replaced) and shown as the message until then. */
 static void serve_on_warning(void *user, const char *message)
 {
     serve_job_ctx *c = user;
+    serve_job *j = c->job;
+    char text[1024];
+    snprintf(text, sizeof text, "%s", message);
+    serve_text_fit(text);
     pthread_mutex_lock(&c->s->lock);
-    snprintf(c->job->message, sizeof c->job->message, "warning: %s", message);
-    c->job->version++;
+    snprintf(j->message, sizeof j->message, "warning: %.240s", text);
+    if (!j->warnings)
+        j->warnings = json_array();
+    if (j->warnings && json_array_size(j->warnings) < SERVE_JOB_WARNINGS)
+        json_array_append_new(j->warnings, json_string(text));
+    else
+        j->warnings_dropped++;
+    j->version++;
     pthread_cond_broadcast(&c->s->changed);
     pthread_mutex_unlock(&c->s->lock);
 }
@@ -162,9 +184,10 @@ static void serve_on_warning(void *user, const char *message)
 
 /* The jobs load their scene or sequence within the root (thz_scene_load_within): a file
  * it names outside the root fails the job before anything is written. */
-static thz_status serve_run_scene(thz_context *ctx, const serve *s, const serve_job *j,
-                                  thz_error *err)
+static thz_status serve_run_scene(thz_context *ctx, serve_job_ctx *c, thz_error *err)
 {
+    const serve *s = c->s;
+    const serve_job *j = c->job;
     thz_scene *scene = NULL;
     thz_run *run = NULL;
     thz_output *output = NULL;
@@ -179,9 +202,34 @@ static thz_status serve_run_scene(thz_context *ctx, const serve *s, const serve_
     settings.keep_photons = j->save_photon_map;
     thz_write_options write = {.photon_map = j->save_photon_map};
     long sensor = -1;
+    const char *map = j->photon_map[0] ? j->photon_map : NULL;
     thz_status st = thz_scene_load_within(j->scene, s->root, &scene, err);
-    if (st == THZ_OK)
+    if (st == THZ_OK) { /* what `thzmap simulate|render` prints before it runs */
+        thz_scene_info info;
+        thz_scene_get_info(scene, &info);
+        const char *integrator = j->integrator[0] ? j->integrator : info.integrator;
+        char said[320];
+        if (j->command == CMD_SIMULATE && j->photons && !thz_integrator_needs_photons(integrator)) {
+            snprintf(said, sizeof said,
+                     "options.photons %" PRIu64 " is not used: the %s integrator fires no "
+                     "photons (give options.integrator photon-map or final-gather to fire them)",
+                     j->photons, integrator);
+            serve_on_warning(c, said);
+        }
+        if (j->command == CMD_RENDER && j->photon_map[0] &&
+            !thz_integrator_needs_photons(integrator)) {
+            snprintf(said, sizeof said,
+                     "options.photon_map is not used: the %s integrator renders without "
+                     "photons (give options.integrator photon-map or final-gather to render "
+                     "from it)",
+                     integrator);
+            serve_on_warning(c, said);
+            map = NULL;
+        }
+        for (size_t i = 0; i < thz_scene_warning_count(scene); i++)
+            serve_on_warning(c, thz_scene_warning(scene, i));
         st = thz_output_open(j->out, &output, err);
+    }
     *cli_exit_guard() = output;
     if (st == THZ_OK && j->sensor[0] && (sensor = thz_scene_sensor_index(scene, j->sensor)) < 0) {
         snprintf(err->message, sizeof err->message, "render: the scene has no sensor named '%s'",
@@ -189,8 +237,8 @@ static thz_status serve_run_scene(thz_context *ctx, const serve *s, const serve_
         err->status = st = THZ_ERR_INPUT;
     }
     /* a render reads the photon-map file a channel at a time, as `thzmap render` does */
-    if (st == THZ_OK && j->command == CMD_RENDER && j->photon_map[0])
-        st = thz_render_file(ctx, scene, j->photon_map, sensor, &settings, &run, err);
+    if (st == THZ_OK && j->command == CMD_RENDER && map)
+        st = thz_render_file(ctx, scene, map, sensor, &settings, &run, err);
     else if (st == THZ_OK)
         st = j->command == CMD_RENDER
                  ? thz_render_run(ctx, scene, NULL, sensor, &settings, &run, err)
@@ -261,7 +309,7 @@ static void serve_run_job(serve *s, serve_job *j)
         thz_context_set_warning(ctx, serve_on_warning, &c);
         st = j->command == CMD_BATCH   ? serve_run_batch(ctx, &c, &err)
              : j->command == CMD_BANDS ? serve_run_bands(ctx, s, j, &err)
-                                       : serve_run_scene(ctx, s, j, &err);
+                                       : serve_run_scene(ctx, &c, &err);
         thz_context_destroy(ctx);
     }
     pthread_mutex_lock(&s->lock);
@@ -269,7 +317,12 @@ static void serve_run_job(serve *s, serve_job *j)
     if (st == THZ_OK) {
         j->state = JOB_DONE;
         j->progress = 1.0;
-        snprintf(j->message, sizeof j->message, "done; results in %.200s", j->out);
+        size_t n_warn = json_array_size(j->warnings) + j->warnings_dropped;
+        if (n_warn)
+            snprintf(j->message, sizeof j->message, "done; results in %.200s (%zu warning%s)",
+                     j->out, n_warn, n_warn == 1 ? "" : "s");
+        else
+            snprintf(j->message, sizeof j->message, "done; results in %.200s", j->out);
     } else if (st == THZ_ERR_CANCELLED) {
         j->state = JOB_CANCELLED;
         if (j->command == CMD_BATCH) /* finished frames stay, for a later batch to reuse */

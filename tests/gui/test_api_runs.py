@@ -495,6 +495,39 @@ def test_photons(srv, scene):
              status=400)
 
 
+def test_run_warnings(srv, root):
+    """A job keeps the warnings `thzmap simulate|render` prints, in "warnings": an option
+    its integrator does not use, the scene's (a sensor outside its room), the run's. Each
+    passed as the message alone until the next report ("done; results in ..."), so a
+    client polling the job saw none, and the scene's and the unused option's not even
+    there."""
+    scene = json.load(open(os.path.join(root, "s", "scene.json")))
+    scene["sensors"][0]["position_m"] = [0, -50, 0.4]
+    with open(os.path.join(root, "s", "outside.json"), "w") as f:
+        json.dump(scene, f)
+    run = srv.json("POST", "/api/runs", body={
+        "command": "simulate", "scene": "s/outside.json", "out": "out/warned",
+        "options": {"integrator": "path", "photons": 1000, "threads": 1}}, status=202)
+    job = wait_state(srv, run["id"], ("done", "failed"))
+    summary = json.load(open(os.path.join(root, "out", "warned", "summary.json")))
+    w = job and job.get("warnings") or []
+    check(job and job["state"] == "done" and len(w) >= 2 and
+          w[0].startswith("options.photons 1000 is not used: the path integrator fires no") and
+          "is outside the enclosure" in w[1] and w[1:] == summary["warnings"] and
+          job["message"] == "done; results in out/warned (%d warnings)" % len(w),
+          "a run's warnings: %r, summary %r" % (job, summary["warnings"]))
+    run = srv.json("POST", "/api/runs", body={
+        "command": "render", "scene": "s/scene.json", "out": "out/warned-r",
+        "options": {"integrator": "path", "photon_map": "out/a/photon-map.thzpm"}}, status=202)
+    job = wait_state(srv, run["id"], ("done", "failed"))
+    check(job and job["state"] == "done" and job["warnings"] and
+          job["warnings"][0].startswith("options.photon_map is not used: the path integrator"),
+          "a path render given a photon map: %r" % job)
+    listed = [j for j in srv.json("GET", "/api/runs") or [] if j["id"] == 1]
+    check(listed and listed[0]["warnings"] == [] and listed[0]["message"] == "done; results in out/a",
+          "a run without warnings: %r" % listed)
+
+
 def test_sigterm(root, env):
     srv = Server(BINARY, root, env)
     before = sorted(os.listdir(os.path.join(root, "out")))
@@ -545,7 +578,8 @@ def main():
             if not REQUESTS_ONLY:
                 tests += [("runs", lambda: test_runs(srv, root)),
                           ("results", lambda: test_results(srv, root)),
-                          ("photons", lambda: test_photons(srv, scene))]
+                          ("photons", lambda: test_photons(srv, scene)),
+                          ("warnings", lambda: test_run_warnings(srv, root))]
             for name, fn in tests:
                 t = time.time()
                 fn()

@@ -128,11 +128,16 @@ export class Runs {
     const before = run.message;
     const wasOpen = known !== undefined && !FINAL.has(known.state); // else finished before this page
     Object.assign(run, data); // the job's JSON: state, progress 0..1, message, error
-    if (run.message && run.message !== before) this.log(`[${id}] ${run.message}`);
+    // (a warning shown as the message is logged from the warnings below, once)
+    if (run.message && run.message !== before && !run.message.startsWith("warning: ")) this.log(`[${id}] ${run.message}`);
     if (run.error && !run.errorLogged) {
       run.errorLogged = true;
       this.log(`[${id}] error: ${run.error}`);
     }
+    // every warning once (the message shows each only until the next progress report)
+    const warnings = run.warnings || [];
+    for (let i = run.warningsLogged || 0; i < warnings.length; i++) this.log(`[${id}] warning: ${warnings[i]}`);
+    run.warningsLogged = warnings.length;
     this.runs.set(id, run);
     if (FINAL.has(run.state) && wasOpen) this.finished(id, run);
   }
