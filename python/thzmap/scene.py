@@ -92,19 +92,26 @@ class Scene:
 
     def sensor_index(self, sensor):
         """The index of a sensor given by name or index; ArgumentError if there is none."""
-        if isinstance(sensor, numbers.Integral) and not isinstance(sensor, bool):
-            if 0 <= sensor < len(self.sensors):
-                return int(sensor)
-        elif isinstance(sensor, str):
-            for i, s in enumerate(self.sensors):
-                if s.name == sensor:
-                    return i
-        raise ArgumentError(f"sensor: the scene has no sensor {sensor!r} "
-                            f"(it has {', '.join(self.sensor_names)})")
+        return _index("sensor", sensor, self.sensor_names)
+
+    def object_index(self, obj):
+        """The index of an object given by name or index (the value of its pixels in an
+        image's object_id); ArgumentError if there is none."""
+        return _index("object", obj, self.object_names)
 
     def __repr__(self):
         return (f"<thzmap.Scene {self.name!r}: {len(self.channels)} channels, "
                 f"{len(self.objects)} objects, sensors {self.sensor_names}>")
+
+
+def _index(kind, key, names):
+    """The index of `key` (a name, or an index) among names; ArgumentError naming them."""
+    if isinstance(key, numbers.Integral) and not isinstance(key, bool):
+        if 0 <= key < len(names):
+            return int(key)
+    elif isinstance(key, str) and key in names:
+        return names.index(key)
+    raise ArgumentError(f"{kind}: the scene has no {kind} {key!r} (it has {', '.join(names)})")
 
 
 def _file_stamp(path):

@@ -216,6 +216,18 @@ def test_scene_accessors(tiny_dir):
     table = [m for m in scene.materials if m.name == "table"][0]
     assert table.reflectivity.kind == "table"
     assert scene.info.path == "tiny"
+    # an object by name, as its pixels hold it in object_id (there was sensor_index alone,
+    # and object_names.index("targt") said "'targt' is not in list")
+    assert scene.object_index("target") == 1 and scene.object_index(2) == 2
+    ids = thzmap.simulate(scene, photons=500).image(0).object_id
+    assert (ids == scene.object_index("target")).any()
+    for bad in ("targt", 3, -1, True, None):
+        with pytest.raises(thzmap.ArgumentError, match="object: the scene has no object .* "
+                           r"\(it has room, target, cover\)"):
+            scene.object_index(bad)
+    with pytest.raises(thzmap.ArgumentError, match=r"sensor: the scene has no sensor 'x' "
+                       r"\(it has cam\)"):
+        scene.sensor_index("x")
 
 
 def test_scene_values_as_written():
