@@ -98,6 +98,10 @@ _PROTOTYPES = {
 _lib.bind(_PROTOTYPES)
 
 
+# The highest centre frequency a channel may have (docs/scene-format.md, channels).
+MAX_FREQUENCY_THZ = 10000.0
+
+
 def _frequencies(frequency_thz, name="frequency_thz"):
     """(flat float64 array in Hz, the shape to return, whether a scalar was given)."""
     bad = ArgumentError(f"{name}: expected a number or an array of numbers in THz, "
@@ -111,6 +115,10 @@ def _frequencies(frequency_thz, name="frequency_thz"):
     f = f.astype(np.float64)
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ArgumentError(f"{name}: expected frequencies above 0 THz, finite")
+    if np.any(f > MAX_FREQUENCY_THZ):  # a channel's limit; beyond, most likely Hz or GHz
+        raise ArgumentError(f"{name}: {np.max(f):g} THz is above {MAX_FREQUENCY_THZ:g} THz, "
+                            "the highest a channel may have: frequencies are in THz "
+                            "(0.82 for 820 GHz)")
     return (f * 1e12).ravel(), f.shape, f.ndim == 0
 
 

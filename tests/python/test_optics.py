@@ -210,6 +210,15 @@ def test_errors():
         thzmap.atmosphere().attenuation_per_m([0.5, -1.0])
     with pytest.raises(thzmap.ArgumentError, match="above 0 THz"):
         thzmap.atmosphere().attenuation_per_m(0)  # 0 Hz is no frequency either
+    # a frequency in Hz (3e11 for 0.3 THz) gave B = 0 and a material's end values in silence
+    scene = os.path.join(REPO, "examples", "teraeye", "scene.json")
+    for call in (lambda f: thzmap.planck_radiance(f, 300.0),
+                 lambda f: thzmap.brightness_temperature(f, 1e-14),
+                 lambda f: thzmap.surface_optics(scene, 0, f),
+                 lambda f: thzmap.atmosphere().attenuation_per_m(f)):
+        with pytest.raises(thzmap.ArgumentError, match=r"3e\+11 THz is above 10000 THz"):
+            call([0.3, 3e11])
+        call(0.3)
     scene = os.path.join(REPO, "examples", "outdoor-concealed", "scene.json")
     for other in ({"temperature_k": 300}, {"continuum": False}, {"model": "none"}):
         with pytest.raises(thzmap.ArgumentError, match="takes no other arguments"):
