@@ -278,6 +278,11 @@ static int cli_run_load(const char *cmd, cli_run_args *a, bool render, thz_scene
                 "thzmap %s: warning: --photons %" PRIu64 " is not used: the %s integrator fires "
                 "no photons (give --integrator photon-map or final-gather to fire them)\n",
                 cmd, a->settings.photons_per_channel, integrator);
+    if (!render && a->write.ply_max_points && !a->write.photon_map)
+        fprintf(stderr,
+                "thzmap %s: warning: --ply-max-points %" PRIu64 " is not used: photon-map.ply is "
+                "written only with --save-photon-map\n",
+                cmd, a->write.ply_max_points);
     if (render && a->photon_map_path && !thz_integrator_needs_photons(integrator)) {
         fprintf(stderr,
                 "thzmap %s: warning: --photon-map %s is not used: the %s integrator renders "

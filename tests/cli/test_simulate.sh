@@ -295,9 +295,11 @@ done
 [ $? -eq 2 ] || fail "render without --photon-map should exit 2"
 # options the integrator has no use for are said to be unused, not silently dropped
 "$THZMAP" simulate "$work/scene.json" -o "$work/up" --integrator path --photons 1000 --quiet \
-    2> "$work/up.err" || fail "simulate --integrator path --photons exited $?"
+    --ply-max-points 10 2> "$work/up.err" || fail "simulate --integrator path --photons exited $?"
 grep -q -- "--photons 1000 is not used: the path integrator fires no photons" "$work/up.err" \
     || fail "path with --photons: no warning: $(cat "$work/up.err")"
+grep -q -- "--ply-max-points 10 is not used: photon-map.ply is written only with --save-photon-map" \
+    "$work/up.err" || fail "--ply-max-points without a map: no warning: $(cat "$work/up.err")"
 "$THZMAP" render "$work/scene.json" -o "$work/upr" --integrator path \
     --photon-map "$work/t1/photon-map.thzpm" --quiet 2> "$work/upr.err" \
     || fail "render --integrator path --photon-map exited $?"
