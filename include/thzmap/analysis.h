@@ -14,13 +14,31 @@ extern "C" {
 
 /* ---- cubes -------------------------------------------------------------------------- */
 
-/* An ENVI image read from disk (float32, band-sequential, either byte order). */
+/* An image of float32 values, band-sequential: read from an ENVI file (either byte
+ * order), or made of the caller's values. The classifiers take either kind. */
 typedef struct thz_cube thz_cube;
 
 /* Reads DIR/STEM.hdr and DIR/STEM.img (e.g. stem "cam.brightness_temperature").
  * THZ_ERR_INPUT naming the file (and the header's line) when one is missing, too large
  * (header 1 MiB, data 16 GiB), or not what its header says. */
 THZ_API thz_status thz_cube_read(const char *dir, const char *stem, thz_cube **out, thz_error *err);
+/* A cube of the caller's values: `bands` planes of rows x columns, laid out as
+ * thz_cube_data gives them (value(band, row, col) at [(band * rows + row) * columns +
+ * col]), copied (data stays the caller's). `name` (NULL: "cube") stands for the file stem
+ * in messages and in the classification's source, e.g. "spectra" or "truth". A truth for
+ * thz_classify_cube is such a cube of one band holding object indices (-1: none) as
+ * floats. Any float value is taken, as from a file: thz_classify_cube refuses one that is
+ * not finite. No wavelength (thz_cube_wavelength_ghz gives NULL), no object names.
+ * THZ_ERR_INPUT beginning with the name when data is NULL, a size is 0, bands is above
+ * 2^20, or the values' bytes overflow a size_t. */
+THZ_API thz_status thz_cube_create(const char *name, uint32_t columns, uint32_t rows, size_t bands,
+                                   const float *data, thz_cube **out, thz_error *err);
+/* Gives the cube the `object names` thz_classify_cube names a truth's classes by (name i:
+ * object index i), copies of names[0 .. n-1], replacing any it had (n 0: none).
+ * THZ_ERR_INPUT for a NULL cube, names NULL with n > 0, or a NULL or empty name; the cube
+ * keeps its names then. */
+THZ_API thz_status thz_cube_set_object_names(thz_cube *cube, const char *const *names, size_t n,
+                                             thz_error *err);
 THZ_API void thz_cube_destroy(thz_cube *cube);
 THZ_API uint32_t thz_cube_columns(const thz_cube *cube);
 THZ_API uint32_t thz_cube_rows(const thz_cube *cube);
@@ -53,8 +71,13 @@ typedef struct thz_classification thz_classification;
 
 /* Classifies every pixel of `cube` whose `truth` (a one-band cube of object indices,
  * -1 where nothing is hit, as S.object_id) is >= 0; the classes are the objects the
- * truth shows. opt NULL: thz_classify_options_init's defaults. *out owns the result; the
- * cubes stay the caller's. */
+ * truth shows, named by its object names (else "object N"). Either cube may be read
+ * (thz_cube_read) or made (thz_cube_create: spectra pooled over several runs, say).
+ * opt NULL: thz_classify_options_init's defaults. *out owns the result; the cubes stay
+ * the caller's. THZ_ERR_INPUT, naming the cube by its stem or name, when the two differ
+ * in size, the truth has more than one band, holds a value other than -1 or a whole
+ * number 0 to 2^24 - 1, or shows fewer than two objects, or a value of `cube` is not
+ * finite (named by band, row and column, from 1). */
 THZ_API thz_status thz_classify_cube(const thz_cube *cube, const thz_cube *truth,
                                      const thz_classify_options *opt, thz_classification **out,
                                      thz_error *err);
@@ -70,7 +93,8 @@ THZ_API void thz_classification_destroy(thz_classification *c);
 typedef struct thz_classification_info {
     const char *method;
     const char *sensor; /* NULL for thz_classify_cube */
-    const char *source; /* the cube's file stem, e.g. "cam.brightness_temperature" */
+    const char *source; /* the cube's file stem, e.g. "cam.brightness_temperature", or the
+                           name it was made with */
     size_t n_classes;
     uint32_t columns, rows;
     uint64_t pixels; /* classified: the truth is >= 0; the confusion matrix sums to this */

@@ -6,6 +6,7 @@
 #include <stdbool.h>
 
 #include "core/error.h"
+#include "io/envi.h"
 #include "photon/photon_map.h"
 #include "photon/photon_stats.h"
 #include "run/run.h"
@@ -67,6 +68,14 @@ struct thz_run {
     thz_photons photons; /* the kept maps (borrowed from rs), if any */
     bool has_photons;
     char *summary;
+};
+
+/* A cube read from disk (thz_cube_read) or made of the caller's values (thz_cube_create):
+ * api_cube.c fills it, api_classify.c reads it. */
+struct thz_cube {
+    envi_cube c;
+    char *stem; /* the file stem, or the name it was made with: what messages call it */
+    bool wavelength_ghz;
 };
 
 /* Applies the settings' overrides to a shallow copy of `scene` (the copy shares every

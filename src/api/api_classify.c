@@ -1,5 +1,5 @@
-/* The public API of cubes read from disk and of classification (thzmap/analysis.h):
- * handles over io/envi_read.c and analysis/classify.c. */
+/* The public API of classification (thzmap/analysis.h): a handle over
+ * analysis/classify.c, on cubes (api_cube.c) or a run directory's files. */
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
@@ -11,6 +11,7 @@
 
 #include "analysis/classify.h"
 #include "analysis/classify_output.h"
+#include "api/api.h"
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/file.h"
@@ -18,12 +19,6 @@
 #include "io/envi.h"
 #include "io/output.h"
 #include "thzmap/thzmap.h"
-
-struct thz_cube {
-    envi_cube c;
-    char *stem;
-    bool wavelength_ghz;
-};
 
 struct thz_classification {
     classify_result r;
@@ -37,73 +32,6 @@ struct thz_classification {
     double train_fraction, netd_k;
     char *json;
 };
-
-thz_status thz_cube_read(const char *dir, const char *stem, thz_cube **out, thz_error *err)
-{
-    if (!out)
-        return thz_error_set(err, THZ_ERR_INPUT, "thz_cube_read: no place for the cube");
-    *out = NULL;
-    if (!dir || !stem)
-        return thz_error_set(err, THZ_ERR_INPUT, "thz_cube_read: no directory or stem");
-    thz_cube *cube = thz_calloc(1, sizeof *cube);
-    if (!cube)
-        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-    thz_status st = envi_read_float32(dir, stem, &cube->c, err);
-    if (st == THZ_OK && !(cube->stem = thz_strdup(stem)))
-        st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
-    if (st != THZ_OK) {
-        thz_cube_destroy(cube);
-        return st;
-    }
-    cube->wavelength_ghz = cube->c.wavelength && cube->c.wavelength_units &&
-                           strcmp(cube->c.wavelength_units, "GHz") == 0;
-    *out = cube;
-    return THZ_OK;
-}
-
-void thz_cube_destroy(thz_cube *cube)
-{
-    if (!cube)
-        return;
-    envi_cube_fini(&cube->c);
-    free(cube->stem);
-    free(cube);
-}
-
-uint32_t thz_cube_columns(const thz_cube *cube)
-{
-    return cube ? cube->c.samples : 0;
-}
-
-uint32_t thz_cube_rows(const thz_cube *cube)
-{
-    return cube ? cube->c.lines : 0;
-}
-
-size_t thz_cube_bands(const thz_cube *cube)
-{
-    return cube ? cube->c.bands : 0;
-}
-
-const float *thz_cube_data(const thz_cube *cube)
-{
-    return cube ? cube->c.data : NULL;
-}
-
-const double *thz_cube_wavelength_ghz(const thz_cube *cube)
-{
-    return cube && cube->wavelength_ghz ? cube->c.wavelength : NULL;
-}
-
-size_t thz_cube_object_name_count(const thz_cube *cube)
-{
-    return cube ? cube->c.n_object_names : 0;
-}
-
-const char *thz_cube_object_name(const thz_cube *cube, size_t i)
-{
-    return cube && i < cube->c.n_object_names ? cube->c.object_names[i] : NULL;
-}
 
 /* ---- classification ------------------------------------------------------------------ */
 

@@ -47,14 +47,30 @@ typedef struct envi_cube {
     size_t n_object_names;
 } envi_cube;
 
-/* Largest header and data file envi_read_float32 reads (bytes). */
+/* Largest header and data file envi_read_float32 reads (bytes), and the most samples,
+ * lines or bands a header may give (a cube made in memory: the most bands). */
 #define ENVI_MAX_HEADER_BYTES (1u << 20)
 #define ENVI_MAX_DATA_BYTES (16ull << 30)
+#define ENVI_MAX_DIM (1u << 20)
 
 /* Reads DIR/STEM.hdr and DIR/STEM.img. THZ_ERR_INPUT (naming the file and, for the
  * header, the line) when a file is missing, not a regular file, above the limits, or
  * not a float32 BSQ image of the size its header says. */
 thz_status envi_read_float32(const char *dir, const char *stem, envi_cube *out, thz_error *err);
 void envi_cube_fini(envi_cube *cube);
+
+/* A cube of the caller's values (bands x lines x samples, BSQ), copied, without a
+ * wavelength or object names: what a file of them would read back as. Any float is
+ * taken, as the reader takes any (the classifier refuses what it cannot use).
+ * THZ_ERR_INPUT, its message beginning with `name`, when data is NULL, a size is 0,
+ * bands is above ENVI_MAX_DIM, or the values' bytes overflow a size_t. */
+thz_status envi_cube_init(envi_cube *out, const char *name, uint32_t samples, uint32_t lines,
+                          size_t bands, const float *data, thz_error *err);
+
+/* Replaces the cube's `object names` by copies of names[0 .. n-1] (n 0: none).
+ * THZ_ERR_INPUT, its message beginning with `name`, for a NULL or empty name; the cube
+ * keeps its names then. */
+thz_status envi_cube_set_object_names(envi_cube *cube, const char *name, const char *const *names,
+                                      size_t n, thz_error *err);
 
 #endif

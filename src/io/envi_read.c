@@ -1,7 +1,8 @@
 /* ENVI reader: the header's keys that locate and describe the values, then the raw
  * data (io/envi.h). Inputs are checked before they are opened (core/file.h) and the
  * data's size must match the header exactly, so a damaged or foreign file ends in an
- * error naming it instead of a wrong picture.
+ * error naming it instead of a wrong picture. A cube of the caller's values
+ * (envi_cube_init) is made here too, so that one file fills an envi_cube.
  */
 #include "io/envi.h"
 
@@ -25,6 +26,61 @@ void envi_cube_fini(envi_cube *c)
         free(c->object_names[i]);
     free(c->object_names);
     memset(c, 0, sizeof *c);
+}
+
+thz_status envi_cube_init(envi_cube *out, const char *name, uint32_t samples, uint32_t lines,
+                          size_t bands, const float *data, thz_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!data)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: no values (data is NULL)", name);
+    if (!samples || !lines || !bands)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: %u columns, %u rows, %zu bands: expected at least 1 of each",
+                             name, samples, lines, bands);
+    if (bands > ENVI_MAX_DIM)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: %zu bands: expected at most %u", name, bands,
+                             ENVI_MAX_DIM);
+    size_t pixels = (size_t)samples * lines; /* < 2^64: no overflow */
+    if (pixels > SIZE_MAX / sizeof(float) / bands)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s: %u x %u pixels of %zu bands: more values than memory holds", name,
+                             samples, lines, bands);
+    out->data = thz_malloc_array(pixels * bands, sizeof *out->data);
+    if (!out->data)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    memcpy(out->data, data, pixels * bands * sizeof *out->data);
+    out->samples = samples;
+    out->lines = lines;
+    out->bands = bands;
+    return THZ_OK;
+}
+
+thz_status envi_cube_set_object_names(envi_cube *cube, const char *name, const char *const *names,
+                                      size_t n, thz_error *err)
+{
+    if (n && !names)
+        return thz_error_set(err, THZ_ERR_INPUT, "%s: no object names (names is NULL)", name);
+    for (size_t i = 0; i < n; i++)
+        if (!names[i] || !names[i][0])
+            return thz_error_set(err, THZ_ERR_INPUT, "%s: object name %zu is %s", name, i,
+                                 names[i] ? "empty" : "NULL");
+    char **copy = n ? thz_calloc(n, sizeof *copy) : NULL;
+    if (n && !copy)
+        return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < n; i++)
+        if (!(copy[i] = thz_strdup(names[i]))) {
+            for (size_t j = 0; j < i; j++)
+                free(copy[j]);
+            free(copy);
+            return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
+        }
+    for (size_t i = 0; i < cube->n_object_names; i++)
+        free(cube->object_names[i]);
+    free(cube->object_names);
+    cube->object_names = copy;
+    cube->n_object_names = n;
+    return THZ_OK;
 }
 
 /* The whole file into a NUL-terminated buffer (at most max bytes). */
@@ -125,7 +181,7 @@ static thz_status header_entry(const char *path, size_t line, char *key, char *v
     for (char *p = key; *p; p++)
         *p = (char)tolower((unsigned char)*p);
     thz_status st = THZ_OK;
-    const uint64_t max_dim = 1u << 20;
+    const uint64_t max_dim = ENVI_MAX_DIM;
     if (strcmp(key, "samples") == 0) {
         st = parse_count(path, line, key, value, max_dim, &h->samples, err);
         h->have[0] = 1;
