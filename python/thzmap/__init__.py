@@ -16,7 +16,7 @@ docs/ is PREFIX/share/doc/thzmap/.
 from . import _lib, mpi
 from ._call import RunWarning
 from .band_selection import BandSelection, bands
-from .classification import Classification, classify
+from .classification import Classification, classify, classify_spectra
 from .errors import (ArgumentError, CancelledError, Error, OutOfMemoryError,
                      SceneError)
 from .optics import (Atmosphere, MaterialLibrary, atmosphere, brightness_temperature,
@@ -35,7 +35,7 @@ __all__ = ["ArgumentError", "Atmosphere", "BandSelection", "BatchProgress", "Bat
            "CancelledError", "Classification", "Error", "Frame", "Image", "MaterialLibrary",
            "OutOfMemoryError", "PhotonMap", "Progress", "Result", "RunWarning", "Scene",
            "SceneError", "Sequence", "atmosphere", "bands", "batch", "brightness_temperature",
-           "classify", "fire_photons", "identify", "library_path", "load_photon_map",
+           "classify", "classify_spectra", "fire_photons", "identify", "library_path", "load_photon_map",
            "load_scene", "load_sequence", "material_library", "merge_photon_maps", "mpi",
            "planck_radiance", "render", "scene_from_dict", "scene_from_json", "simulate",
            "surface_optics"]
