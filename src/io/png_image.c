@@ -22,6 +22,13 @@ thz_status png_image_write_srgb8(const char *path, const float *rgb, uint32_t co
 {
     if (columns == 0 || rows == 0)
         return thz_error_set(err, THZ_ERR_INTERNAL, "%s: empty image", path);
+    /* libpng's writer refuses a side above its user limits with "Invalid IHDR data";
+     * said here with the sizes (a classification of more than 10^6 pooled pixels, one
+     * row of them, reaches it) */
+    if (columns > PNG_USER_WIDTH_MAX || rows > PNG_USER_HEIGHT_MAX)
+        return thz_error_set(
+            err, THZ_ERR_LIMIT, "%s: %u x %u pixels: a PNG is written up to %lu x %lu pixels", path,
+            columns, rows, (unsigned long)PNG_USER_WIDTH_MAX, (unsigned long)PNG_USER_HEIGHT_MAX);
     size_t n = (size_t)columns * rows;
     unsigned char *bytes = thz_malloc_array(n, 3);
     if (!bytes)

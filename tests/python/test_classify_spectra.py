@@ -169,3 +169,18 @@ def test_save_writes_the_cube_files(distinct, tmp_path):
     saved = read_envi(tmp_path / "out", "cube", "class", image.rows, image.columns)
     assert np.array_equal(saved.reshape(image.rows, image.columns), c.class_map)
     assert "object names = {room, A, B, C}" in (tmp_path / "out" / "cube.class.hdr").read_text()
+
+
+def test_save_of_more_pixels_than_a_png_row_takes(tmp_path):
+    """(pixels, channels) is one row of pixels in cube.class.png, and libpng writes up to
+    10^6 a side: one more was 'cannot write PNG: Invalid IHDR data'; now the sizes are
+    said, and nothing is written."""
+    n = 1_000_001
+    labels = np.arange(n) % 2
+    spectra = np.stack([300.0 + 2 * labels, 290.0 - labels], axis=1)
+    c = thzmap.classify_spectra(spectra, labels, method="lda")
+    assert c.accuracy == 1.0 and c.class_map.shape == (n,)
+    with pytest.raises(thzmap.Error, match="cube.class.png: 1000001 x 1 pixels: a PNG is "
+                                           "written up to 1000000 x 1000000 pixels"):
+        c.save(tmp_path / "out")
+    assert not (tmp_path / "out").exists()
