@@ -302,39 +302,15 @@ static thz_status pmf_open_header(photon_map_file_stream *s, thz_error *err)
         return pmf_corrupt(r, "inconsistent header", err);
 
     /* Does it belong to this scene? */
-    const char *name = scene->path ? scene->path : "this scene";
-    scene_hash h;
-    scene_hash_compute(scene, &h);
-    if (get_u64(header + 0) != h.geometry || get_u64(header + 32) != scene->n_objects)
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "photon map %s was made from another scene geometry (objects or "
-                             "meshes differ from %s); run `thzmap simulate` on this scene",
-                             path, name);
-    if (file_nc != scene->n_channels)
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "photon map %s was made from another channel set (%llu channels; %s "
-                             "has %zu); run `thzmap simulate` on this scene",
-                             path, (unsigned long long)file_nc, name, scene->n_channels);
-    if (get_u64(header + 16) != h.channels)
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "photon map %s was made from another channel set (frequencies, "
-                             "widths or responses differ from %s); run `thzmap simulate` on "
-                             "this scene",
-                             path, name);
-    /* The sensors are not in the fingerprint, but an emitting air's default temperature
-     * and background are the enclosure's around them: a user who only moved the camera
-     * into another room is told why. */
-    bool air = scene->atmosphere.emitting && scene->atmosphere.model != ATM_NONE;
-    if (get_u64(header + 8) != h.optics)
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "photon map %s was made from another scene (materials, temperatures "
-                             "or atmosphere differ from %s%s); run `thzmap simulate` on this "
-                             "scene",
-                             path, name,
-                             air ? "; the air's temperature and background, unless given, are "
-                                   "the enclosure's around the sensors, which a sensor moved "
-                                   "into another enclosure changes"
-                                 : "");
+    scene_hash made = {.geometry = get_u64(header + 0),
+                       .optics = get_u64(header + 8),
+                       .channels = get_u64(header + 16)};
+    char maps[sizeof err->message];
+    snprintf(maps, sizeof maps, "photon map %s", path);
+    st = scene_hash_fit(&made, get_u64(header + 32), file_nc, scene, maps,
+                        "run `thzmap simulate` on this scene", err);
+    if (st != THZ_OK)
+        return st;
     for (size_t c = 0; c < scene->n_channels; c++) {
         double t0_k = s->version == 1u ? 0.0 : get_f64(pmf_channel_words(s, c) + 160);
         if (!(t0_k >= 0.0 && t0_k <= PMF_MAX_T0_K))

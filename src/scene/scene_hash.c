@@ -176,6 +176,44 @@ void scene_hash_compute(const thz_scene *scene, scene_hash *out)
     out->channels = hash_finish(c);
 }
 
+thz_status scene_hash_fit(const scene_hash *made, uint64_t n_objects, uint64_t n_channels,
+                          const thz_scene *scene, const char *maps, const char *remedy,
+                          thz_error *err)
+{
+    const char *name = scene->path ? scene->path : "this scene";
+    scene_hash h;
+    scene_hash_compute(scene, &h);
+    if (made->geometry != h.geometry || n_objects != scene->n_objects)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s was made from another scene geometry (objects or meshes differ "
+                             "from %s); %s",
+                             maps, name, remedy);
+    if (n_channels != scene->n_channels)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s was made from another channel set (%llu channels; %s has %zu); %s",
+                             maps, (unsigned long long)n_channels, name, scene->n_channels, remedy);
+    if (made->channels != h.channels)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s was made from another channel set (frequencies, widths or "
+                             "responses differ from %s); %s",
+                             maps, name, remedy);
+    /* The sensors are not in the fingerprint, but an emitting air's default temperature
+     * and background are the enclosure's around them: a user who only moved the camera
+     * into another room is told why. */
+    bool air = scene->atmosphere.emitting && scene->atmosphere.model != ATM_NONE;
+    if (made->optics != h.optics)
+        return thz_error_set(err, THZ_ERR_INPUT,
+                             "%s was made from another scene (materials, temperatures or "
+                             "atmosphere differ from %s%s); %s",
+                             maps, name,
+                             air ? "; the air's temperature and background, unless given, are "
+                                   "the enclosure's around the sensors, which a sensor moved "
+                                   "into another enclosure changes"
+                                 : "",
+                             remedy);
+    return THZ_OK;
+}
+
 uint64_t scene_hash_run(const thz_scene *scene, bool render)
 {
     scene_hash parts;

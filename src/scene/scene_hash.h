@@ -31,6 +31,17 @@ typedef struct scene_hash {
 
 void scene_hash_compute(const thz_scene *scene, scene_hash *out);
 
+/* Whether photon maps made from a scene of hashes `made`, n_objects objects and
+ * n_channels channels fit `scene`: THZ_OK, else THZ_ERR_INPUT saying what differs (the
+ * geometry, the channel count, the channels, or the materials, temperatures and
+ * atmosphere), the message starting with `maps` (what the maps are, e.g. "photon map
+ * PATH") and ending with `remedy`. The one test of "made from the same scene": a .thzpm
+ * file's header against the scene rendering it, and photons fired or loaded for another
+ * scene handle against the one thz_render_run is given. */
+thz_status scene_hash_fit(const scene_hash *made, uint64_t n_objects, uint64_t n_channels,
+                          const thz_scene *scene, const char *maps, const char *remedy,
+                          thz_error *err);
+
 /* The geometry's hash, the bulk of the work (every vertex and index, about 0.3 s for
  * 16.7 M triangles), is computed once per scene and kept in its memo: a scene's meshes
  * do not change after loading, and every photon phase, render channel and photon-map file
