@@ -181,7 +181,8 @@ typedef enum thz_plane {
     THZ_PLANE_COUNT
 } thz_plane;
 
-/* Renders sensor `sensor` of the scene: from `photons` (their seed, every channel), or
+/* Renders sensor `sensor` of the scene: from `photons` (their seed, every channel; made
+ * for this scene or one that fits it, as for thz_render_run), or
  * with photons NULL for the path integrator (seed from settings or the scene). With a
  * noise target, passes stop on the 95th percentile of this sensor's error. *out owns the image,
  * which borrows the scene (destroy or write it first). */
@@ -227,8 +228,12 @@ THZ_API thz_status thz_simulate_check(thz_context *ctx, const thz_scene *scene,
                                       const thz_run_settings *settings, thz_error *err);
 /* `thzmap render` in memory: every sensor (sensor -1) or only sensor `sensor` (0 ..
  * count - 1; any other index is refused with THZ_ERR_INPUT) rendered from `photons`
- * (NULL only for path). The run's seed and photon count are the photons'. `photons`
- * must have been made for `scene`; the run borrows the scene as thz_simulate's does. */
+ * (NULL only for path). The run's seed and photon count are the photons'. `photons` may
+ * have been made for another scene handle whose geometry, channels, materials,
+ * temperatures and atmosphere are `scene`'s (one that differs in its sensors: a new
+ * viewpoint), as `render --photon-map` takes a file; else THZ_ERR_INPUT says which
+ * differs. Their own scene must be alive (photons never outlive it); the run holds
+ * nothing of the photons once made, and borrows `scene` as thz_simulate's does. */
 THZ_API thz_status thz_render_run(thz_context *ctx, const thz_scene *scene,
                                   const thz_photons *photons, long sensor,
                                   const thz_run_settings *settings, thz_run **out, thz_error *err);

@@ -9,6 +9,7 @@
 #include "io/output.h"
 #include "io/photon_map_file.h"
 #include "run/run_pack.h"
+#include "scene/scene_hash.h"
 
 /* ---- images ------------------------------------------------------------------------- */
 
@@ -217,9 +218,19 @@ static thz_status api_run(thz_context *ctx, const thz_scene *scene, const thz_ph
     thz_status checked = api_check_threads(ctx, render ? "render" : "simulate", err);
     if (checked != THZ_OK)
         return checked;
-    if (photons && photons->scene != scene)
-        return thz_error_set(err, THZ_ERR_INPUT,
-                             "the photons were fired or loaded for another scene handle");
+    if (photons && photons->scene != scene) {
+        /* Another handle of a scene that may differ in its sensors alone (another
+         * viewpoint): what `thzmap render --photon-map` asks of a file's header. The
+         * render reads the photons' maps and statistics, none of their scene. */
+        scene_hash made;
+        scene_hash_compute(&photons->effective, &made);
+        thz_status fit =
+            scene_hash_fit(&made, photons->effective.n_objects, photons->n_channels, scene,
+                           "the photon map (fired or loaded for another scene handle)",
+                           "fire photons for this scene, or simulate it keeping them", err);
+        if (fit != THZ_OK)
+            return fit;
+    }
     thz_run *run = thz_calloc(1, sizeof *run);
     if (!run)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");

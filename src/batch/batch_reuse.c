@@ -76,10 +76,8 @@ static bool reuse_fits(const thz_scene *scene, batch_photon_cache *c)
         scene_hash_compute(c->scene, &c->hash);
         c->hashed = true;
     }
-    scene_hash a;
-    scene_hash_compute(scene, &a);
-    return a.geometry == c->hash.geometry && a.optics == c->hash.optics &&
-           a.channels == c->hash.channels;
+    return scene_hash_fit(&c->hash, c->scene->n_objects, c->scene->n_channels, scene, "", "",
+                          NULL) == THZ_OK;
 }
 
 thz_status batch_render_reused(thz_context *ctx, const thz_sequence *seq, batch_photon_cache *c,
@@ -110,10 +108,7 @@ thz_status batch_render_reused(thz_context *ctx, const thz_sequence *seq, batch_
     const thz_photons *kept = c->fired ? c->fired : thz_run_photons(c->run);
     if (!kept)
         return thz_error_set(err, THZ_ERR_INPUT, "frame %zu kept no photons", base);
-    /* The same maps seen from this frame's scene handle, which differs from the base's
-     * only in its sensors (the photon phase reads none). */
-    thz_photons view = *kept;
-    view.scene = scene;
-    view.owned = false;
-    return thz_render_run(ctx, scene, &view, -1, &settings, run, err);
+    /* the base's maps, for this frame's scene handle: thz_render_run takes them, as it
+     * checks what reuse_fits did */
+    return thz_render_run(ctx, scene, kept, -1, &settings, run, err);
 }

@@ -1,6 +1,7 @@
 /* What the API tests share: a failure counter with messages, a check that a call was
  * refused as bad input, a temporary directory, the two-sensor, two-channel scene of
- * tests/cli/test_simulate.sh as JSON text, and file reading. Header-only so that each test
+ * tests/cli/test_simulate.sh as JSON text, file reading, and an image's planes compared
+ * with the ENVI files of a run. Header-only so that each test
  * stays one program on the public API alone. */
 #ifndef THZ_TESTS_API_TEST_H
 #define THZ_TESTS_API_TEST_H
@@ -149,6 +150,38 @@ static inline void test_write_file(const char *path, const char *text)
     if (!f || fputs(text, f) < 0 || fclose(f) != 0) {
         perror(path);
         exit(1);
+    }
+}
+
+/* Compares every ENVI plane of `image` with the files of dir/<sensor>.<quantity>.img, bit
+ * for bit (the visual plane is a PNG of 8 bits: not compared). */
+static inline void test_compare_image_files(const thz_image *image, const char *dir)
+{
+    size_t pixels = (size_t)thz_image_columns(image) * thz_image_rows(image);
+    for (int p = 0; p < THZ_PLANE_COUNT; p++) {
+        if (p == THZ_PLANE_VISUAL_RGB)
+            continue; /* a PNG, 8 bits: not the float plane */
+        size_t bands = 0;
+        const float *plane = thz_image_plane(image, (thz_plane)p, &bands);
+        char path[8400];
+        snprintf(path, sizeof path, "%s/%s.%s.img", dir, thz_image_sensor_name(image),
+                 thz_plane_name((thz_plane)p));
+        size_t size = 0;
+        unsigned char *file = test_read_file(path, &size);
+        if (!plane) {
+            CHECK(!file, "%s exists but the image has no %s plane", path,
+                  thz_plane_name((thz_plane)p));
+            free(file);
+            continue;
+        }
+        CHECK(file != NULL, "%s missing", path);
+        if (file) {
+            CHECK(size == bands * pixels * sizeof(float), "%s: %zu bytes, plane %zu", path, size,
+                  bands * pixels * sizeof(float));
+            CHECK(size == bands * pixels * sizeof(float) && memcmp(file, plane, size) == 0,
+                  "%s differs from the in-memory plane", path);
+        }
+        free(file);
     }
 }
 

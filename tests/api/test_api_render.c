@@ -10,37 +10,6 @@
 
 #include "api_test.h"
 
-/* Compares every ENVI plane of `image` with the files of dir/<sensor>.<quantity>.img. */
-static void compare_with_files(const thz_image *image, const char *dir)
-{
-    size_t pixels = (size_t)thz_image_columns(image) * thz_image_rows(image);
-    for (int p = 0; p < THZ_PLANE_COUNT; p++) {
-        if (p == THZ_PLANE_VISUAL_RGB)
-            continue; /* a PNG, 8 bits: not the float plane */
-        size_t bands = 0;
-        const float *plane = thz_image_plane(image, (thz_plane)p, &bands);
-        char path[4200];
-        snprintf(path, sizeof path, "%s/%s.%s.img", dir, thz_image_sensor_name(image),
-                 thz_plane_name((thz_plane)p));
-        size_t size = 0;
-        unsigned char *file = test_read_file(path, &size);
-        if (!plane) {
-            CHECK(!file, "%s exists but the image has no %s plane", path,
-                  thz_plane_name((thz_plane)p));
-            free(file);
-            continue;
-        }
-        CHECK(file != NULL, "%s missing", path);
-        if (file) {
-            CHECK(size == bands * pixels * sizeof(float), "%s: %zu bytes, plane %zu", path, size,
-                  bands * pixels * sizeof(float));
-            CHECK(size == bands * pixels * sizeof(float) && memcmp(file, plane, size) == 0,
-                  "%s differs from the in-memory plane", path);
-        }
-        free(file);
-    }
-}
-
 /* photon-map towards a noise target fires photon passes (pass p: photons p K .. (p + 1) K - 1)
  * and renders their merge: two passes of K must give the image of one phase of 2 K photons
  * (the same photons; run.h), not of K photons twice over, whose standard error would fall
@@ -251,12 +220,12 @@ int main(int argc, char **argv)
         size_t bands = 0;
         CHECK(thz_image_plane(image, THZ_PLANE_RADIANCE, &bands) && bands == 2, "radiance bands");
         CHECK(thz_image_plane(image, THZ_PLANE_VISUAL_RGB, &bands) && bands == 3, "visual bands");
-        compare_with_files(image, path);
+        test_compare_image_files(image, path);
         if (s == 0) { /* written alone: the same files, its figures, nothing of a run */
             char one[4200], file[4300];
             snprintf(one, sizeof one, "%s/image-only", dir);
             REQUIRE_OK(thz_image_write(ctx, image, one, &err), &err);
-            compare_with_files(image, one);
+            test_compare_image_files(image, one);
             const char *want[] = {"cam.band-01.png", "cam.band-02.png", "cam.spectra.png",
                                   "cam.visual.png", "cam.radiance.hdr"};
             for (size_t k = 0; k < sizeof want / sizeof *want; k++) {
@@ -281,7 +250,7 @@ int main(int argc, char **argv)
         CHECK(thz_run_image_count(from_file) == 2, "%zu images from the file",
               thz_run_image_count(from_file));
         for (size_t i = 0; i < thz_run_image_count(from_file); i++)
-            compare_with_files(thz_run_image(from_file, i), path);
+            test_compare_image_files(thz_run_image(from_file, i), path);
         const char *sj = thz_run_summary_json(from_file);
         CHECK(sj && strstr(sj, "\"seed\": 4") && strstr(sj, "\"photons_fired\": 20000"),
               "render_file summary: %.300s", sj ? sj : "(null)");
@@ -312,7 +281,7 @@ int main(int argc, char **argv)
     REQUIRE_OK(thz_simulate(ctx, scene, &settings, &run, &err), &err);
     CHECK(thz_run_image_count(run) == 2, "%zu images", thz_run_image_count(run));
     for (size_t i = 0; i < thz_run_image_count(run); i++)
-        compare_with_files(thz_run_image(run, i), path);
+        test_compare_image_files(thz_run_image(run, i), path);
     const char *summary = thz_run_summary_json(run);
     CHECK(summary && strstr(summary, "\"photons_fired\": 20000"), "summary: %.200s",
           summary ? summary : "(null)");
@@ -326,7 +295,7 @@ int main(int argc, char **argv)
     thz_write_options wo = {.photon_map = 1};
     REQUIRE_OK(thz_run_write(ctx, run, path, &wo, &err), &err);
     for (size_t i = 0; i < thz_run_image_count(run); i++)
-        compare_with_files(thz_run_image(run, i), path);
+        test_compare_image_files(thz_run_image(run, i), path);
     thz_run_destroy(run);
     /* photon maps to keep from the path integrator, which fires none: refused (the run came
      * back without a map, and a write of it then said keep_photons had not been given) */
