@@ -448,9 +448,12 @@ def simulate(scene, integrator=None, photons=None, seed=None, threads=None,
 def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, threads=None,
            target_noise_k=None, max_seconds=None, progress=None, mpi=False):
     """`thzmap render` in memory: every sensor (or only `sensor`, a name or index)
-    rendered from `photon_map` (a PhotonMap of this scene, or the path of a .thzpm
-    file, which is read one channel at a time as the render comes to it: one channel's
-    map in memory). The path integrator needs no photon map (it then uses `seed`).
+    rendered from `photon_map` (a PhotonMap, or the path of a .thzpm file, which is read
+    one channel at a time as the render comes to it: one channel's map in memory). The
+    map may have been made for another Scene that differs in its sensors alone (another
+    viewpoint: rendered without firing again); one of another geometry, materials or
+    channels is refused (thzmap.Error saying which). The path integrator needs no photon
+    map (it then uses `seed`).
     mpi=True: shared by the ranks as simulate's; rank 0 alone needs the photon map (it
     sends it to the others), whose `photon_map` may then be None."""
     scene = scene_arg(scene)
@@ -478,8 +481,10 @@ def render(scene, photon_map=None, integrator=None, sensor=None, seed=None, thre
 
 
 def _render_map_arg(scene, photon_map, integrator, seed):
-    """render's photon_map, checked: (the path of a .thzpm file or None, a PhotonMap of
-    this scene or None)."""
+    """render's photon_map, checked: (the path of a .thzpm file or None, a PhotonMap or
+    None). A PhotonMap made for another Scene object is the library's to check, as a
+    file's header is: the same geometry, materials and channels render, others are
+    refused saying which differs."""
     path = None
     if isinstance(photon_map, (str, bytes, os.PathLike)):
         path = _path_arg("photon_map", photon_map)
@@ -487,9 +492,6 @@ def _render_map_arg(scene, photon_map, integrator, seed):
     elif photon_map is not None and not isinstance(photon_map, PhotonMap):
         raise ArgumentError(f"photon_map: expected a PhotonMap or a path, got "
                             f"{type(photon_map).__name__}")
-    if photon_map is not None and photon_map.scene is not scene:
-        raise ArgumentError("photon_map: it belongs to another Scene object; load it for "
-                            "this one with load_photon_map(scene, path)")
     effective = _effective_integrator(scene, integrator)
     if photon_map is None and path is None and \
             _lib.lib.thz_integrator_needs_photons(effective.encode()):

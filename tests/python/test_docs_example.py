@@ -30,7 +30,8 @@ def test_the_docs_example_runs(tmp_path):
     assert (tmp_path / "out" / "teraeye-py" / "cam.radiance.img").exists()
     assert (tmp_path / "map.thzpm").exists()
     assert "cylinder-A" in p.stdout
-    assert "['side'] 0\n" in p.stdout  # the second viewpoint, from the saved map
+    # the second viewpoint, from the kept map of the first Scene, as from its file
+    assert "['side'] 0\nTrue\n" in p.stdout
 
 
 def test_the_docs_optics_snippet_runs(tmp_path):
