@@ -365,8 +365,11 @@ static thz_status load_document(load_ctx *ctx, json_t *doc)
                                                              : s->objects[enclosure].temperature_k);
     if (st == THZ_OK) {
         st = atmosphere_prepare(&s->atmosphere, s->channels, s->n_channels, ctx->err);
-        if (st != THZ_OK)
+        if (st != THZ_OK && ctx->err) {
             thz_error_prefix(ctx->err, "%s: atmosphere: ", ctx->label);
+            size_t n = strnlen(ctx->err->message, sizeof ctx->err->message);
+            scene_checks_ghz_hint(s, ctx->err->message + n, sizeof ctx->err->message - n);
+        }
     }
     if (st == THZ_OK)
         st = load_check_index_energy(ctx, &root);

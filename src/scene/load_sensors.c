@@ -108,19 +108,14 @@ static thz_status load_normalize_floor(load_ctx *ctx, const load_cursor *c, doub
     }
     /* A channel beyond the range thzmap is meant for is most often a GHz value given in
      * THz; validate's warning says so, but this refusal comes first and would hide it. */
-    const thz_channel *ch = &s->channels[at];
-    char ghz[256] = "";
-    if (ch->center_hz * 1e-12 > SCENE_CHECK_MAX_THZ)
-        snprintf(ghz, sizeof ghz,
-                 "; channel \"%s\" is at %g THz, beyond the %g to %g THz thzmap's models are "
-                 "meant for: frequency_thz is in THz (%g GHz = %g THz)",
-                 ch->name, ch->center_hz * 1e-12, SCENE_CHECK_MIN_THZ, SCENE_CHECK_MAX_THZ,
-                 ch->center_hz * 1e-12, ch->center_hz * 1e-15);
+    char ghz[256];
+    scene_checks_ghz_hint(s, ghz, sizeof ghz);
     return load_fail(ctx, &k,
                      "expected a temperature >= %s K (h nu / k T_ref at most %g at %.4g THz, "
                      "the top of channel \"%s\"'s band; colder, B(T_ref) is too small for the "
                      "normalised cube), got %s K%s",
-                     shown, LOAD_NORMALIZE_MAX_X, top * 1e-12, ch->name, LOAD_G(t_ref), ghz);
+                     shown, LOAD_NORMALIZE_MAX_X, top * 1e-12, s->channels[at].name, LOAD_G(t_ref),
+                     ghz);
 }
 
 /* v divided by its largest component's magnitude (0 when v is 0), so that its length is

@@ -4,6 +4,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -297,6 +298,23 @@ static bool check_frequencies(thz_scene *s)
                              ch->name, ch->center_hz * 1e-12, outside > 1 ? " and others" : "",
                              SCENE_CHECK_MIN_THZ, SCENE_CHECK_MAX_THZ, ch->center_hz * 1e-12,
                              ch->center_hz * 1e-15);
+}
+
+void scene_checks_ghz_hint(const thz_scene *s, char *buf, size_t size)
+{
+    if (size)
+        buf[0] = '\0';
+    for (size_t c = 0; c < s->n_channels; c++) {
+        const thz_channel *ch = &s->channels[c];
+        if (ch->center_hz > SCENE_CHECK_MAX_THZ * 1e12) {
+            snprintf(buf, size,
+                     "; channel \"%s\" is at %g THz, beyond the %g to %g THz thzmap's models are "
+                     "meant for: frequency_thz is in THz (%g GHz = %g THz)",
+                     ch->name, ch->center_hz * 1e-12, SCENE_CHECK_MIN_THZ, SCENE_CHECK_MAX_THZ,
+                     ch->center_hz * 1e-12, ch->center_hz * 1e-15);
+            return;
+        }
+    }
 }
 
 /* A sensor inside a closed solid, or outside every enclosure while the scene has one. */

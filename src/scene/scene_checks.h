@@ -51,6 +51,13 @@ check_object *scene_checks_objects(const thz_scene *scene);
  * rays can leave the scene). */
 size_t scene_checks_enclosure(const thz_scene *scene, const check_object *info);
 
+/* Writes into buf (of size bytes) "; channel \"NAME\" is at F THz, beyond the 0.05 to 10
+ * THz thzmap's models are meant for: frequency_thz is in THz (F GHz = f THz)" for the first
+ * channel beyond SCENE_CHECK_MAX_THZ, else "": a refusal that comes before validate's
+ * warning about such channels (a GHz value given in THz) appends it, since it hides the
+ * warning. */
+void scene_checks_ghz_hint(const thz_scene *scene, char *buf, size_t size);
+
 /* Adds the warnings (and marks misplaced sensors); enclosure: scene_checks_enclosure's.
  * False only on allocation failure. */
 bool scene_checks_run(thz_scene *scene, const check_object *info, size_t enclosure,

@@ -225,6 +225,17 @@ CASES = [
      [(["atmosphere"], {"model": "itu-p676", "temperature_k": 290, "pressure_hpa": 0,
                         "relative_humidity": 0.5})],
      "atmosphere.pressure_hpa: expected a number in (0, 2000], got 0"),
+    # a GHz value given in THz (350 for 0.35) with humid air: the refusal of the band beyond
+    # the model's range says what validate's warning about channels beyond 10 THz would
+    # have said, which it hides (it named only the model's range)
+    ("atmosphere_ghz_as_thz",
+     [(["channels", 0, "frequency_thz"], 350),
+      (["atmosphere"], {"model": "itu-p676", "temperature_k": 295, "pressure_hpa": 1013.25,
+                        "relative_humidity": 0.5})],
+     "atmosphere: channel '350.000 THz' band (centre +- 6 sigma): 341.082 to 358.918 THz leaves "
+     "the range of atmosphere model 'itu-p676' (0.001 to 1 THz); channel \"350.000 THz\" is at "
+     "350 THz, beyond the 0.05 to 10 THz thzmap's models are meant for: frequency_thz is in THz "
+     "(350 GHz = 0.35 THz)"),
     ("atmosphere_vmr_one",
      [(["atmosphere"], {"model": "itu-p676", "temperature_k": 290, "pressure_hpa": 1013.25,
                         "h2o_vmr": 1})],
