@@ -211,7 +211,9 @@ static int check_double_cmp(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Objects 100 times larger than the enclosure, or than the median object. */
+/* Objects SCENE_CHECK_ENCLOSURE_RATIO times larger than the enclosure around the sensors
+ * (other enclosures, such as a hall around a booth, SCENE_CHECK_SCALE_RATIO times), or
+ * SCENE_CHECK_SCALE_RATIO times the median object. */
 static bool check_scales(thz_scene *s, const check_object *info, size_t enclosure)
 {
     double ref = 0.0;
@@ -231,7 +233,10 @@ static bool check_scales(thz_scene *s, const check_object *info, size_t enclosur
     }
     bool ok = true;
     for (size_t i = 0; i < s->n_objects && ok && ref > 0.0; i++) {
-        if (!(info[i].diagonal_m > SCENE_CHECK_SCALE_RATIO * ref))
+        double ratio = enclosure != SIZE_MAX && !check_is_enclosure(&info[i])
+                           ? SCENE_CHECK_ENCLOSURE_RATIO
+                           : SCENE_CHECK_SCALE_RATIO;
+        if (!(info[i].diagonal_m > ratio * ref))
             continue;
         const char *ref_name = enclosure != SIZE_MAX ? s->objects[enclosure].name : "";
         ok = scene_add_warning(
@@ -341,7 +346,9 @@ static bool check_sensors(thz_scene *s, const check_object *info)
                 ok = scene_add_warning(
                     s,
                     "sensor \"%s\" at [%g, %g, %g] m is inside object \"%s\" (a closed solid): "
-                    "it sees that object from inside; move the sensor out of it",
+                    "it sees that object from inside; move the sensor out of it, or, if it is "
+                    "meant as the room around the sensor, turn its normals inwards (\"inward\": "
+                    "true on a box; a mesh's faces listed clockwise seen from outside)",
                     sn->name, p[0], p[1], p[2], s->objects[i].name);
             }
         }
@@ -350,9 +357,80 @@ static bool check_sensors(thz_scene *s, const check_object *info)
             ok = scene_add_warning(s,
                                    "sensor \"%s\" at [%g, %g, %g] m is outside the enclosure "
                                    "\"%s\" (a closed object with inward normals): it sees the "
-                                   "enclosure from outside; move the sensor into it",
+                                   "enclosure from outside; move the sensor into it, or, if it "
+                                   "is a solid seen from outside, turn its normals outwards "
+                                   "(no \"inward\": true; a mesh's faces listed "
+                                   "counter-clockwise seen from outside)",
                                    sn->name, p[0], p[1], p[2], s->objects[any_enclosure].name);
         }
+    }
+    return ok;
+}
+
+/* Whether some sensor is inside closed mesh i. */
+static bool check_holds_sensor(const thz_scene *s, size_t i)
+{
+    for (size_t k = 0; k < s->n_sensors; k++)
+        if (check_inside(&s->objects[i].mesh, s->sensors[k].position_m))
+            return true;
+    return false;
+}
+
+/* Whether the bounding boxes of meshes a and b are apart (share no point). */
+static bool check_apart(const thz_mesh *a, const thz_mesh *b)
+{
+    bool apart = false;
+    for (int k = 0; k < 3; k++)
+        apart = apart || a->bbox_min_m[k] > b->bbox_max_m[k] || a->bbox_max_m[k] < b->bbox_min_m[k];
+    return apart;
+}
+
+/* A closed object with inward normals, in the enclosure around the sensors but holding
+ * none of them: a solid whose mesh is wound the wrong way round, seen from outside. (An
+ * annex beside that enclosure, which no sensor sees, is no mistake; without an enclosure
+ * around the sensors check_sensors says they are outside one.) */
+static bool check_inverted(thz_scene *s, const check_object *info, size_t enclosure)
+{
+    if (enclosure == SIZE_MAX)
+        return true;
+    const thz_mesh *e = &s->objects[enclosure].mesh;
+    bool ok = true;
+    for (size_t i = 0; i < s->n_objects && ok; i++)
+        if (i != enclosure && check_is_enclosure(&info[i]) &&
+            !check_apart(&s->objects[i].mesh, e) && !check_holds_sensor(s, i))
+            ok = scene_add_warning(
+                s,
+                "object \"%s\" is closed with its normals pointing inwards, as a room's, but no "
+                "sensor is inside it: seen from outside it shows only its back faces (radiance "
+                "0, counted in summary.json's back_face_samples); a solid's normals point "
+                "outwards (no \"inward\": true; a mesh's faces listed counter-clockwise seen "
+                "from outside)",
+                s->objects[i].name);
+    return ok;
+}
+
+/* An object wholly outside the enclosure around the sensors (their bounding boxes apart):
+ * no sensor sees it and none of its radiation reaches them; most often a coordinate in
+ * centimetres or millimetres. */
+static bool check_outside(thz_scene *s, const check_object *info, size_t enclosure)
+{
+    if (enclosure == SIZE_MAX)
+        return true;
+    const thz_mesh *e = &s->objects[enclosure].mesh;
+    bool ok = true;
+    for (size_t i = 0; i < s->n_objects && ok; i++) {
+        const thz_mesh *m = &s->objects[i].mesh;
+        if (i == enclosure || check_is_enclosure(&info[i]) || !m->n_triangles || !check_apart(m, e))
+            continue;
+        ok = scene_add_warning(
+            s,
+            "object \"%s\" (bounds [%g, %g, %g] to [%g, %g, %g] m) lies wholly outside \"%s\", "
+            "the enclosure around the sensors ([%g, %g, %g] to [%g, %g, %g] m): no sensor sees "
+            "it; are its coordinates in metres?",
+            s->objects[i].name, m->bbox_min_m[0], m->bbox_min_m[1], m->bbox_min_m[2],
+            m->bbox_max_m[0], m->bbox_max_m[1], m->bbox_max_m[2], s->objects[enclosure].name,
+            e->bbox_min_m[0], e->bbox_min_m[1], e->bbox_min_m[2], e->bbox_max_m[0],
+            e->bbox_max_m[1], e->bbox_max_m[2]);
     }
     return ok;
 }
@@ -379,5 +457,6 @@ bool scene_checks_run(thz_scene *scene, const check_object *info, size_t enclosu
 {
     return check_celsius(scene) && check_scales(scene, info, enclosure) && check_precision(scene) &&
            check_frequencies(scene) && check_sensors(scene, info) &&
+           check_inverted(scene, info, enclosure) && check_outside(scene, info, enclosure) &&
            check_atmosphere(scene, in, enclosure);
 }

@@ -1,7 +1,8 @@
 /* Plausibility checks of a loaded scene: the mistakes that load without an error and
  * give wrong answers that look right (temperatures in degrees Celsius, a mesh in
  * millimetres in a room in metres, GHz given as THz, a sensor outside the enclosure or
- * inside a solid, non-emitting absorbing air, a background no ray can see). Each adds
+ * inside a solid, a solid whose normals point inwards, an object outside the room,
+ * non-emitting absorbing air, a background no ray can see). Each adds
  * a scene warning (validate prints them; simulate prints and records them).
  *
  * Geometry is judged from the meshes alone: an object is closed when every edge (by
@@ -23,6 +24,10 @@
 /* An object whose bounding box diagonal exceeds this times the enclosure's (or, without
  * one, the median object's) is taken for a unit mistake. */
 #define SCENE_CHECK_SCALE_RATIO 100.0
+/* An object (not an enclosure) larger than this times the enclosure around the sensors
+ * cannot stand in it: a 0.2 m slab drawn in millimetres in a room 7.7 m across is 32
+ * times the room, which the ratio of 100 let pass. */
+#define SCENE_CHECK_ENCLOSURE_RATIO 10.0
 /* A scene farther from the origin than about 8 times its size: the single-precision step
  * of its coordinates exceeds this fraction of its bounding box's diagonal. A closed room
  * 10 m across at 300 K read 300 K in every pixel 100 m from the origin (16 seeds); 1 km

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A newcomer's run (issue 13): scene warnings for the usual unit and placement mistakes
+# A newcomer's run (issue 13): scene warnings for the usual unit, placement and winding mistakes
 # (each triggered by a scene made for it, none on the shipped examples), warnings printed
 # in full on stderr also with --quiet, the estimate before the run, the noise figures
 # (median and 95th percentile per channel and per object, the noisiest object named on
@@ -43,6 +43,18 @@ make_scene aperture "s['sensors'][0].update(aperture_m2=0.05, aperture_diameter_
 # but not the circle's own area rounded up to four digits, nor less (an obstructed aperture)
 make_scene circle "s['sensors'][0].update(aperture_m2=0.007854, aperture_diameter_m=0.1)"
 make_scene obstructed "s['sensors'][0].update(aperture_m2=0.006, aperture_diameter_m=0.1)"
+# a bolt 4 cm long drawn in millimetres: 42 m across, 12 times the room (the ratio of 100
+# to the median object or the enclosure let it pass; an object cannot be 10 times the room
+# it stands in)
+make_scene bolt "s['objects'].append({'name': 'bolt', 'type': 'solid', 'material': 'metal', 'temperature_k': 300, 'shape': {'type': 'cylinder', 'radius_m': 0.005, 'height_m': 0.04}, 'transform': {'scale': 1000}})"
+# a solid whose normals point inwards (a mesh wound clockwise, here a box given inward)
+# in the room: seen from outside, only back faces (radiance 0); validate said nothing
+make_scene inverted "s['objects'][1]['shape']['inward'] = True"
+# the room without inward: the sensor is inside a solid, and the warning must not only
+# say to move the sensor out of the room
+make_scene outward "del s['objects'][0]['shape']['inward']"
+# a position in centimetres: the target 50 m away, outside the room, seen by no sensor
+make_scene centimetres "s['objects'][1]['transform']['translate_m'] = [0, 50, 0]"
 # the whole scene 1000 km from the origin: single precision blurs it to 0.12 m
 make_scene far "
 for o in s['objects']:
@@ -56,6 +68,10 @@ check_warning() { # $1: scene, $2: text the warning must contain
 }
 check_warning celsius "look like degrees Celsius"
 check_warning millimetres "scales differ by orders of magnitude"
+check_warning bolt 'object "bolt" is 42.4 m across, 12 times the enclosure "room" .*millimetres'
+check_warning inverted 'object "target" is closed with its normals pointing inwards, as a room.s, but no sensor is inside it'
+check_warning outward 'sensor "cam" .* is inside object "room" .*"inward": true on a box'
+check_warning centimetres 'object "target" (bounds \[-0.2, 49.8, -0.2\] to \[0.2, 50.2, 0.2\] m) lies wholly outside "room"'
 check_warning ghz "outside 0.05 to 10 THz"
 check_warning outside 'sensor "cam" .* is outside the enclosure "room"'
 check_warning inside 'sensor "cam" .* is inside object "target"'
