@@ -36,7 +36,11 @@ thz_status bands_assign_classes(const bands_setup *s, const thz_scene *scene, co
             if (!seen[s->targets[t]]) {
                 thz_object_info oi;
                 thz_scene_object(scene, (size_t)s->targets[t], &oi);
-                st = thz_error_set(err, THZ_ERR_INPUT, "targets: the sensor sees no pixel of '%s'",
+                st = thz_error_set(err, THZ_ERR_INPUT,
+                                   "targets: the sensor sees no pixel of '%s' (the truth names "
+                                   "the first surface a ray meets: a target behind a cover is "
+                                   "the cover's pixels; name the cover, giving the part over "
+                                   "the target an object of its own)",
                                    oi.name);
                 goto done;
             }

@@ -229,6 +229,14 @@ d["objects"].append({"name": "cover", "type": "shell", "thickness_m": 0.0005,
                      "transform": {"rotate_deg": [90, 0, 0], "translate_m": [-0.35, 0.45, 0]}})
 json.dump(d, open(sys.argv[2] + "/covered.json", "w"))
 PYEOF
+# plate A hidden whole by the cover: a target the sensor sees no pixel of is refused,
+# and the message says what to name instead (it said only 'sees no pixel of')
+"$THZMAP" bands "$work/covered.json" -o "$work/hidden" --count 1 --from-thz 0.2 --to-thz 1.0 \
+    --step-ghz 400 --paths 1 -q --targets A,B 2> "$work/hidden.err"
+[ $? -eq 2 ] || fail "a hidden target: exit status not 2"
+grep -q "targets: the sensor sees no pixel of 'A' (.*a target behind a cover is the cover's pixels; name the cover" \
+    "$work/hidden.err" || fail "a hidden target: $(cat "$work/hidden.err")"
+[ -e "$work/hidden" ] && fail "a hidden target: OUTDIR written"
 NUIS="--count 1 --from-thz 0.2 --to-thz 1.0 --step-ghz 200 --paths 2 -q --targets cover,B,C
       --temperature-range-k 0 --ambient-range-k 0 --humidity-range 0"
 # shellcheck disable=SC2086
