@@ -189,11 +189,19 @@ static bool load_warn_table(thz_scene *s, const thz_spectrum *sp, const char *wh
     const thz_channel *ch = &s->channels[first];
     double lo, hi;
     load_channel_band(ch, &lo, &hi);
+    /* a table wholly beyond the range thzmap is meant for, the channel within it: a
+     * column of GHz headed frequency_thz (500 for 0.5) */
+    char ghz[160] = "";
+    if (sp->freq_hz[0] > SCENE_CHECK_MAX_THZ * 1e12 && ch->center_hz <= SCENE_CHECK_MAX_THZ * 1e12)
+        snprintf(ghz, sizeof ghz,
+                 " (a table beyond %g THz: are its frequencies in GHz? frequency_thz is in THz, "
+                 "%.4g GHz = %.4g THz)",
+                 SCENE_CHECK_MAX_THZ, sp->freq_hz[0] * 1e-12, sp->freq_hz[0] * 1e-15);
     return scene_add_warning(
         s,
-        "%s: the table covers %.4g to %.4g THz but channel \"%s\" (band %.4g to %.4g THz, "
+        "%s: the table covers %.4g to %.4g THz%s but channel \"%s\" (band %.4g to %.4g THz, "
         "%s)%s beyond it; the end values are used there",
-        what, sp->freq_hz[0] * 1e-12, sp->freq_hz[sp->n - 1] * 1e-12, ch->name, lo * 1e-12,
+        what, sp->freq_hz[0] * 1e-12, sp->freq_hz[sp->n - 1] * 1e-12, ghz, ch->name, lo * 1e-12,
         hi * 1e-12, channel_has_response(ch) ? "where its response is > 0" : "centre +- 2 FWHM",
         count > 1 ? " and others reach" : " reaches");
 }

@@ -53,6 +53,9 @@ make_scene inverted "s['objects'][1]['shape']['inward'] = True"
 # the room without inward: the sensor is inside a solid, and the warning must not only
 # say to move the sensor out of the room
 make_scene outward "del s['objects'][0]['shape']['inward']"
+# a material table in GHz under a frequency_thz heading: the warning that the channel
+# leaves the table says so (it gave only the ranges, 300 to 400 THz against 0.35 THz)
+make_scene ghztable "s['materials']['wall']['reflectivity'] = [[300, 0.1], [400, 0.12]]"
 # a position in centimetres: the target 50 m away, outside the room, seen by no sensor
 make_scene centimetres "s['objects'][1]['transform']['translate_m'] = [0, 50, 0]"
 # the whole scene 1000 km from the origin: single precision blurs it to 0.12 m
@@ -73,6 +76,7 @@ check_warning inverted 'object "target" is closed with its normals pointing inwa
 check_warning outward 'sensor "cam" .* is inside object "room" .*"inward": true on a box'
 check_warning centimetres 'object "target" (bounds \[-0.2, 49.8, -0.2\] to \[0.2, 50.2, 0.2\] m) lies wholly outside "room"'
 check_warning ghz "outside 0.05 to 10 THz"
+check_warning ghztable 'material "wall", reflectivity: the table covers 300 to 400 THz (a table beyond 10 THz: are its frequencies in GHz? frequency_thz is in THz, 300 GHz = 0.3 THz) but channel'
 check_warning outside 'sensor "cam" .* is outside the enclosure "room"'
 check_warning inside 'sensor "cam" .* is inside object "target"'
 check_warning nonemitting "breaks equilibrium"
