@@ -189,14 +189,8 @@ static bool load_warn_table(thz_scene *s, const thz_spectrum *sp, const char *wh
     const thz_channel *ch = &s->channels[first];
     double lo, hi;
     load_channel_band(ch, &lo, &hi);
-    /* a table wholly beyond the range thzmap is meant for, the channel within it: a
-     * column of GHz headed frequency_thz (500 for 0.5) */
-    char ghz[160] = "";
-    if (sp->freq_hz[0] > SCENE_CHECK_MAX_THZ * 1e12 && ch->center_hz <= SCENE_CHECK_MAX_THZ * 1e12)
-        snprintf(ghz, sizeof ghz,
-                 " (a table beyond %g THz: are its frequencies in GHz? frequency_thz is in THz, "
-                 "%.4g GHz = %.4g THz)",
-                 SCENE_CHECK_MAX_THZ, sp->freq_hz[0] * 1e-12, sp->freq_hz[0] * 1e-15);
+    char ghz[160];
+    scene_checks_ghz_table_hint(sp->freq_hz[0], ch->center_hz, ghz, sizeof ghz);
     return scene_add_warning(
         s,
         "%s: the table covers %.4g to %.4g THz%s but channel \"%s\" (band %.4g to %.4g THz, "

@@ -10,6 +10,7 @@
 #include "core/data_dir.h"
 #include "core/path.h"
 #include "scene/load.h"
+#include "scene/scene_checks.h"
 
 /* n and k, each at most 1e100: fresnel_interface squares n + ik, and [1e300, 1e300] (or
  * [1e-300, 1e300]) overflowed it into a photon map at 11.83 K where path read 295 K;
@@ -315,10 +316,12 @@ static thz_status warn_outside(load_ctx *ctx, const load_cursor *c, const char *
     const thz_channel *ch = &ctx->scene->channels[first];
     double lo, hi;
     load_channel_band(ch, &lo, &hi);
+    char ghz[160];
+    scene_checks_ghz_table_hint(lo_hz, ch->center_hz, ghz, sizeof ghz);
     if (!scene_add_warning(ctx->scene,
-                           "%s: %s covers %.4g to %.4g THz but channel \"%s\" (band %.4g to "
+                           "%s: %s covers %.4g to %.4g THz%s but channel \"%s\" (band %.4g to "
                            "%.4g THz, %s)%s beyond it; %s",
-                           c->path, what, lo_hz * 1e-12, hi_hz * 1e-12, ch->name, lo * 1e-12,
+                           c->path, what, lo_hz * 1e-12, hi_hz * 1e-12, ghz, ch->name, lo * 1e-12,
                            hi * 1e-12, index_band_how(ch),
                            count > 1 ? " and others reach" : " reaches", consequence))
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");

@@ -322,6 +322,17 @@ void scene_checks_ghz_hint(const thz_scene *s, char *buf, size_t size)
     }
 }
 
+void scene_checks_ghz_table_hint(double table_lo_hz, double centre_hz, char *buf, size_t size)
+{
+    if (size)
+        buf[0] = '\0';
+    if (table_lo_hz > SCENE_CHECK_MAX_THZ * 1e12 && centre_hz <= SCENE_CHECK_MAX_THZ * 1e12)
+        snprintf(buf, size,
+                 " (a table beyond %g THz: are its frequencies in GHz? frequency_thz is in THz, "
+                 "%.4g GHz = %.4g THz)",
+                 SCENE_CHECK_MAX_THZ, table_lo_hz * 1e-12, table_lo_hz * 1e-15);
+}
+
 /* A sensor inside a closed solid, or outside every enclosure while the scene has one. */
 static bool check_sensors(thz_scene *s, const check_object *info)
 {

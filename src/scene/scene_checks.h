@@ -63,6 +63,12 @@ size_t scene_checks_enclosure(const thz_scene *scene, const check_object *info);
  * warning. */
 void scene_checks_ghz_hint(const thz_scene *scene, char *buf, size_t size);
 
+/* Writes into buf " (a table beyond 10 THz: are its frequencies in GHz? ...)" when a table
+ * starting at table_lo_hz lies wholly beyond SCENE_CHECK_MAX_THZ while the channel at
+ * centre_hz that leaves it lies within (a GHz column headed frequency_thz), else "": for
+ * the warnings that a channel's band leaves a table. */
+void scene_checks_ghz_table_hint(double table_lo_hz, double centre_hz, char *buf, size_t size);
+
 /* Adds the warnings (and marks misplaced sensors); enclosure: scene_checks_enclosure's.
  * False only on allocation failure. */
 bool scene_checks_run(thz_scene *scene, const check_object *info, size_t enclosure,
