@@ -46,6 +46,11 @@ int cli_option_value(const char *command, int argc, char **argv, int *i,
  * `-o a -o b` wrote to b). */
 int cli_refuse_repeat(const char *command, char **argv, int i);
 
+/* -1 unless OUTDIR exists and is not a directory; then the usage exit status after
+ * saying so: for commands that would otherwise find out only after minutes of work
+ * (bands' renders, batch's check of every frame). */
+int cli_refuse_file_outdir(const char *command, const char *outdir);
+
 /* True if an option's value looks like an option itself ("-o -q": a forgotten value):
  * anything from "-" and a letter or "--" on; "-" alone and negative numbers are values. */
 bool cli_looks_like_option(const char *value);

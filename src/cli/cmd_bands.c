@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <unistd.h>
 
@@ -239,12 +238,9 @@ int cmd_bands(int argc, char **argv)
                                "one width, or the widths searched)",
                                opt.relative_width);
     /* an OUTDIR that cannot be one is refused before the renders, not after them */
-    struct stat out_st;
-    if (stat(outdir, &out_st) == 0 && !S_ISDIR(out_st.st_mode))
-        return cli_usage_error(CMD,
-                               "-o %s: exists and is not a directory (expected a directory "
-                               "for the results, or a name to create one)",
-                               outdir);
+    int refused = cli_refuse_file_outdir(CMD, outdir);
+    if (refused >= 0)
+        return refused;
     opt.count = (size_t)count;
     /* nor one the results cannot be staged beside (a read-only parent, another run
      * writing there): refused after every render before, the work lost */

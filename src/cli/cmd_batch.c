@@ -264,7 +264,9 @@ static int batch_parse(int argc, char **argv, const char **seq_path, const char 
         return cli_usage_error("batch", "no sequence file given");
     if (!*outdir)
         return cli_usage_error("batch", "no output directory given (-o OUTDIR)");
-    return -1;
+    /* before every frame's scene is built and checked (seconds for a few dozen frames in
+     * humid air), not after */
+    return cli_refuse_file_outdir("batch", *outdir);
 }
 
 int cmd_batch(int argc, char **argv)

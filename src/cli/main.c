@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include "cli.h"
@@ -77,6 +78,17 @@ double cli_now_s(void)
 bool cli_is_help(const char *arg)
 {
     return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
+}
+
+int cli_refuse_file_outdir(const char *cmd, const char *outdir)
+{
+    struct stat st;
+    if (stat(outdir, &st) == 0 && !S_ISDIR(st.st_mode))
+        return cli_usage_error(cmd,
+                               "-o %s: exists and is not a directory (expected a directory "
+                               "for the results, or a name to create one)",
+                               outdir);
+    return -1;
 }
 
 /* "-o" and "--output" are one option. */

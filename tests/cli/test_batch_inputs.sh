@@ -368,6 +368,13 @@ rc=$?
 rc=$?
 [ $rc -eq 2 ] && grep -q "a-file: exists and is not a directory (expected a directory" "$work/is-file.err" ||
     fail "batch into a file: exit $rc, $(cat "$work/is-file.err")"
+# before the sequence is loaded, whose check of every frame's scene takes seconds (1.4 s
+# for 12 frames in humid air): a sequence that cannot load gets the OUTDIR's refusal
+echo '{"format": "thzmap-sequence/1", "scene": "no-such-scene.json", "frames": 2}' > "$work/noscene.json"
+"$THZMAP" batch "$work/noscene.json" -o "$work/a-file" -q 2> "$work/is-file-first.err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "a-file: exists and is not a directory" "$work/is-file-first.err" ||
+    fail "batch into a file, refused after loading the sequence: exit $rc, $(cat "$work/is-file-first.err")"
 
 # A FIFO or device that a frame's scene names but the loader does not read (the continuum
 # table of a lines model without the continuum) and a FIFO frame.json in OUTDIR: the
