@@ -36,6 +36,39 @@ static double run_channel_p95_stderr_k(const run_state *rs, size_t c)
     return all.p95_k;
 }
 
+/* Samples of channel c's last render (all selected sensors) whose density estimate found
+ * fewer photons than it needs and took the reflected radiance as 0: their standard error
+ * says nothing of that error, so a noise target is not met while any remain. */
+static uint64_t run_channel_starved(const run_state *rs, size_t c)
+{
+    uint64_t n = 0;
+    for (size_t i = 0; i < rs->n_selected; i++)
+        n += rs->last[c * rs->n_selected + i].starved_gathers;
+    return n;
+}
+
+/* What a photon-pass warning says of where the channel stopped: above the target, or
+ * below it with samples still lacking photons. */
+typedef struct run_stop_text {
+    char text[256];
+} run_stop_text;
+
+static run_stop_text run_stop_where(double p95, double target, uint64_t starved)
+{
+    run_stop_text s;
+    if (p95 > target)
+        snprintf(s.text, sizeof s.text,
+                 "at %.3g K (95th percentile of the pixels' standard error) above the noise "
+                 "target of %g K",
+                 p95, target);
+    else
+        snprintf(s.text, sizeof s.text,
+                 "short of the noise target of %g K: %llu samples still hit objects holding "
+                 "fewer photons than a density estimate needs",
+                 target, (unsigned long long)starved);
+    return s;
+}
+
 /* How a warning names channel c: as the progress lines count it, and by its name (the
  * frequency unless the scene names it), "channel 1/6 (0.200 THz)". */
 typedef struct run_channel_label {
@@ -276,33 +309,32 @@ thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_
         st = run_render_channel(rs, c, map, err);
         rs->passes[c] = (uint32_t)n;
         double p95 = run_channel_p95_stderr_k(rs, c);
-        if (st != THZ_OK || p95 <= target)
+        /* a sample short of photons took its reflected radiance as 0 with a standard
+         * error of 0: 10 photons a pass "met" a target of 0.1 K after one pass */
+        uint64_t starved = run_channel_starved(rs, c);
+        if (st != THZ_OK || (p95 <= target && !starved))
             break;
+        run_stop_text where = run_stop_where(p95, target, starved);
         if (out_of_time) {
-            st = run_add_warning(rs, err,
-                                 "%s: stopped by the time limit of %g s after %zu "
-                                 "photon pass%s, at %.3g K (95th percentile of the pixels' "
-                                 "standard error) above the noise target of %g K",
-                                 run_channel_name(rs, c).text, rs->max_seconds, n,
-                                 n == 1 ? "" : "es", p95, target);
+            st = run_add_warning(
+                rs, err, "%s: stopped by the time limit of %g s after %zu photon pass%s, %s",
+                run_channel_name(rs, c).text, rs->max_seconds, n, n == 1 ? "" : "es", where.text);
             break;
         }
         double per_pass = RUN_PASSES_MAP_FACTOR * (double)photon_map_bytes(map) / (double)n;
         double most = limit > 0.0 ? floor(limit / per_pass) : (double)RUN_MAX_PASSES;
         if (most <= (double)n) { /* limit 0: the machine's memory is unknown */
             st = run_add_warning(rs, err,
-                                 "%s: stopped after %zu photon passes (%llu photons) "
-                                 "above the noise target of %g K: the next would need %.2f GiB "
-                                 "of memory",
+                                 "%s: stopped after %zu photon passes (%llu photons), %s: the "
+                                 "next would need %.2f GiB of memory",
                                  run_channel_name(rs, c).text, n, (unsigned long long)(n * k),
-                                 target, per_pass * (double)(n + 1) / 1073741824.0);
+                                 where.text, per_pass * (double)(n + 1) / 1073741824.0);
             break;
         }
         if (n >= RUN_MAX_PASSES) {
-            st = run_add_warning(rs, err,
-                                 "%s: stopped after %u passes above the noise target "
-                                 "of %g K",
-                                 run_channel_name(rs, c).text, (unsigned)RUN_MAX_PASSES, target);
+            st =
+                run_add_warning(rs, err, "%s: stopped after %u passes, %s",
+                                run_channel_name(rs, c).text, (unsigned)RUN_MAX_PASSES, where.text);
             break;
         }
         /* The next check where the noise, falling as 1/sqrt(photons), meets the target, at
@@ -311,7 +343,7 @@ thz_status run_photon_passes(run_state *rs, size_t c, photon_map **out_map, thz_
          * 5 x one of the last, not the last's times the passes): a check after every pass
          * made a run of 450 passes take 5 minutes. Between checks the passes are only
          * fired; a time limit checks at once. */
-        double need = ceil((double)n * (p95 / target) * (p95 / target));
+        double need = starved ? INFINITY : ceil((double)n * (p95 / target) * (p95 / target));
         check = run_photon_next_check((uint32_t)n, fmin(need, most));
     }
     if (st == THZ_OK && n > 0) {
