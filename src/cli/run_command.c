@@ -263,8 +263,16 @@ static int cli_run_load(const char *cmd, cli_run_args *a, bool render, thz_scene
         return cli_usage_error(cmd, "no photon map given (--photon-map FILE); only the path "
                                     "integrator renders without one");
     /* here, before the ranks of an MPI run work together: every rank refuses it alike */
-    if (render && a->sensor_name && thz_scene_sensor_index(*scene, a->sensor_name) < 0)
-        return cli_usage_error(cmd, "--sensor: the scene has no sensor named '%s'", a->sensor_name);
+    if (render && a->sensor_name && thz_scene_sensor_index(*scene, a->sensor_name) < 0) {
+        char names[512] = "";
+        for (size_t i = 0, n = 0; i < thz_scene_sensor_count(*scene); i++) {
+            thz_sensor_info s;
+            if (thz_scene_sensor(*scene, i, &s) == THZ_OK && n < sizeof names)
+                n += (size_t)snprintf(names + n, sizeof names - n, "%s'%s'", i ? ", " : "", s.name);
+        }
+        return cli_usage_error(cmd, "--sensor: the scene has no sensor named '%s'; its sensors: %s",
+                               a->sensor_name, names);
+    }
     if (render && a->settings.target_noise_k > 0.0 && !thz_integrator_has_passes(integrator))
         return cli_usage_error(cmd,
                                "--target-noise-k: the %s integrator renders its photon map in one "

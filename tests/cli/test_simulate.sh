@@ -170,8 +170,11 @@ ls "$work/rs" | grep -q '^cam\.' && fail "render --sensor side wrote cam images"
 cmp -s "$work/t1/side.radiance.img" "$work/rs/side.radiance.img" \
     || fail "render --sensor side differs from simulate"
 "$THZMAP" render "$work/scene.json" --photon-map "$work/t1/photon-map.thzpm" -o "$work/rx" \
-    --sensor nosuch --quiet 2>/dev/null
+    --sensor nosuch --quiet 2> "$work/rx.err"
 [ $? -eq 2 ] || fail "render --sensor nosuch should exit 2"
+# and names the sensors there are, as classify does (a typo had to be found in the scene)
+grep -q "no sensor named 'nosuch'; its sensors: 'cam', 'side'" "$work/rx.err" ||
+    fail "render --sensor nosuch: $(cat "$work/rx.err")"
 
 # --- a map from another scene is refused -----------------------------------------------
 "$THZMAP" render "$work/other.json" --photon-map "$work/t1/photon-map.thzpm" -o "$work/o" \
