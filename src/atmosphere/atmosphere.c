@@ -97,17 +97,25 @@ thz_status atmosphere_check_range(const thz_atmosphere *atm, double lo_hz, doubl
     atmosphere_model_range_hz(atm->model, &lo, &hi);
     if (lo_hz >= lo && hi_hz <= hi)
         return THZ_OK;
+    /* itu-p676 ends at 1 THz, where a THz camera's channels go on: name the model that
+     * covers them (a channel at 1.05 THz was refused with the range alone) */
+    double lines_lo, lines_hi;
+    atmosphere_model_range_hz(ATM_LINES, &lines_lo, &lines_hi);
+    char other[96] = "";
+    if (atm->model == ATM_ITU_P676 && lo_hz >= lines_lo && hi_hz <= lines_hi)
+        snprintf(other, sizeof other, "; model 'lines' covers %.6g to %.6g THz", lines_lo * 1e-12,
+                 lines_hi * 1e-12);
     if (lo_hz == hi_hz) /* one frequency: not "20 to 20 THz" */
         return thz_error_set(err, THZ_ERR_INPUT,
                              "%s: %.6g THz lies outside the range of atmosphere model '%s' "
-                             "(%.6g to %.6g THz)",
+                             "(%.6g to %.6g THz)%s",
                              what, lo_hz * 1e-12, atmosphere_model_name(atm->model), lo * 1e-12,
-                             hi * 1e-12);
+                             hi * 1e-12, other);
     return thz_error_set(err, THZ_ERR_INPUT,
                          "%s: %.6g to %.6g THz leaves the range of atmosphere model '%s' "
-                         "(%.6g to %.6g THz)",
+                         "(%.6g to %.6g THz)%s",
                          what, lo_hz * 1e-12, hi_hz * 1e-12, atmosphere_model_name(atm->model),
-                         lo * 1e-12, hi * 1e-12);
+                         lo * 1e-12, hi * 1e-12, other);
 }
 
 void atmosphere_alpha_parts(const thz_atmosphere *atm, double freq_hz, atm_alpha_parts *parts)

@@ -225,6 +225,13 @@ CASES = [
      [(["atmosphere"], {"model": "itu-p676", "temperature_k": 290, "pressure_hpa": 0,
                         "relative_humidity": 0.5})],
      "atmosphere.pressure_hpa: expected a number in (0, 2000], got 0"),
+    # a channel just above itu-p676's 1 THz: the refusal names the model that covers it
+    ("atmosphere_itu_above_1thz",
+     [(["channels", 0, "frequency_thz"], 1.05),
+      (["atmosphere"], {"model": "itu-p676", "temperature_k": 295, "pressure_hpa": 1013.25,
+                        "relative_humidity": 0.5})],
+     "leaves the range of atmosphere model 'itu-p676' (0.001 to 1 THz); model 'lines' covers "
+     "0.001 to 15 THz"),
     # a GHz value given in THz (350 for 0.35) with humid air: the refusal of the band beyond
     # the model's range says what validate's warning about channels beyond 10 THz would
     # have said, which it hides (it named only the model's range)
