@@ -242,8 +242,8 @@ static bool check_scales(thz_scene *s, const check_object *info, size_t enclosur
         ok = scene_add_warning(
             s,
             "object \"%s\" is %.3g m across, %.0f times %s%s%s%s (%.3g m): the scene's scales "
-            "differ by orders of magnitude; is a mesh in millimetres (coordinates are in metres; "
-            "\"transform\": {\"scale\": 0.001} converts)?",
+            "differ by orders of magnitude; is a mesh or a size in millimetres (coordinates "
+            "and sizes are in metres; for a mesh \"transform\": {\"scale\": 0.001} converts)?",
             s->objects[i].name, info[i].diagonal_m, info[i].diagonal_m / ref, ref_what,
             ref_name[0] ? " \"" : "", ref_name, ref_name[0] ? "\"" : "", ref);
     }

@@ -58,6 +58,8 @@ make_scene outward "del s['objects'][0]['shape']['inward']"
 make_scene ghztable "s['materials']['wall']['reflectivity'] = [[300, 0.1], [400, 0.12]]"
 # the same for a table of n and k (format 1.1)
 make_scene ghzindex "s['format'] = 'thzmap-scene/1.1'; s['materials']['metal'] = {'refractive_index': [[300, 3, 0.1], [400, 3, 0.2]]}"
+# a box's size in millimetres: the warning does not speak of a mesh alone
+make_scene sizemm "s['objects'][1]['shape']['size_m'] = [400, 400, 400]"
 # a position in centimetres: the target 50 m away, outside the room, seen by no sensor
 make_scene centimetres "s['objects'][1]['transform']['translate_m'] = [0, 50, 0]"
 # the whole scene 1000 km from the origin: single precision blurs it to 0.12 m
@@ -78,6 +80,7 @@ check_warning inverted 'object "target" is closed with its normals pointing inwa
 check_warning outward 'sensor "cam" .* is inside object "room" .*"inward": true on a box'
 check_warning centimetres 'object "target" (bounds \[-0.2, 49.8, -0.2\] to \[0.2, 50.2, 0.2\] m) lies wholly outside "room"'
 check_warning ghz "outside 0.05 to 10 THz"
+check_warning sizemm 'object "target" is 693 m across, 200 times the enclosure "room" .*is a mesh or a size in millimetres'
 check_warning ghzindex 'materials.metal: the table of n and k covers 300 to 400 THz (a table beyond 10 THz: are its frequencies in GHz?'
 check_warning ghztable 'material "wall", reflectivity: the table covers 300 to 400 THz (a table beyond 10 THz: are its frequencies in GHz? frequency_thz is in THz, 300 GHz = 0.3 THz) but channel'
 check_warning outside 'sensor "cam" .* is outside the enclosure "room"'
