@@ -15,11 +15,18 @@ build=${1:?usage: campaign.sh BUILD_DIR OUT_DIR CPU_SECONDS [HARNESS...]}
 out=${2:?usage: campaign.sh BUILD_DIR OUT_DIR CPU_SECONDS [HARNESS...]}
 budget=${3:?usage: campaign.sh BUILD_DIR OUT_DIR CPU_SECONDS [HARNESS...]}
 shift 3
+# absolute: the serve harness's server works in its root directory (chdir)
+mkdir -p "$out" && out=$(cd "$out" && pwd) && build=$(cd "$build" && pwd) || exit 2
 chunk=${CHUNK:-120}
 here=$(cd "$(dirname "$0")" && pwd)
 harnesses=("$@")
-[ ${#harnesses[@]} -gt 0 ] || harnesses=(scene csv lines photon_map mesh)
-declare -A max_len=([scene]=8192 [csv]=4096 [lines]=8192 [photon_map]=16384 [mesh]=16384)
+if [ ${#harnesses[@]} -eq 0 ]; then
+  harnesses=(scene csv lines photon_map mesh envi sequence)
+  # the server's only where libmicrohttpd was found (tests/fuzz/CMakeLists.txt)
+  [ -x "$build/tests/fuzz/fuzz_serve" ] && harnesses+=(serve)
+fi
+declare -A max_len=([scene]=8192 [csv]=4096 [lines]=8192 [photon_map]=16384 [mesh]=16384 [envi]=8192
+  [sequence]=8192 [serve]=8192)
 mkdir -p "$out/bin" "$out/state"
 for h in "${harnesses[@]}"; do
   [ -x "$out/bin/fuzz_$h" ] || cp "$build/tests/fuzz/fuzz_$h" "$build/tests/fuzz/fuzz_replay_$h" "$out/bin/"

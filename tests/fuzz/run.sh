@@ -18,10 +18,18 @@ set -uo pipefail
 build=${1:?usage: run.sh BUILD_DIR SECONDS [HARNESS...]}
 seconds=${2:?usage: run.sh BUILD_DIR SECONDS [HARNESS...]}
 shift 2
+# absolute: the serve harness's server works in its root directory (chdir), and libFuzzer
+# writes the corpus and findings it finds after that
+build=$(cd "$build" && pwd) || exit 2
 here=$(cd "$(dirname "$0")" && pwd)
 harnesses=("$@")
-[ ${#harnesses[@]} -gt 0 ] || harnesses=(scene csv lines photon_map mesh)
-declare -A max_len=([scene]=8192 [csv]=4096 [lines]=8192 [photon_map]=16384 [mesh]=16384)
+if [ ${#harnesses[@]} -eq 0 ]; then
+  harnesses=(scene csv lines photon_map mesh envi sequence)
+  # the server's only where libmicrohttpd was found (tests/fuzz/CMakeLists.txt)
+  [ -x "$build/tests/fuzz/fuzz_serve" ] && harnesses+=(serve)
+fi
+declare -A max_len=([scene]=8192 [csv]=4096 [lines]=8192 [photon_map]=16384 [mesh]=16384 [envi]=8192
+  [sequence]=8192 [serve]=8192)
 
 # One harness: its line on stdout; exit 0 if it found nothing.
 fuzz_one() {
