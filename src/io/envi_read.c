@@ -227,7 +227,11 @@ static thz_status header_entry(const char *path, size_t line, char *key, char *v
             }
             h->n_wavelength = n;
             h->wavelength_line = line;
-        } else {
+        } else { /* a second list replaces the first (it leaked) */
+            for (size_t i = 0; i < c->n_object_names; i++)
+                free(c->object_names[i]);
+            free(c->object_names);
+            c->n_object_names = 0;
             c->object_names = thz_calloc(n, sizeof *c->object_names);
             if (!c->object_names)
                 st = thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
