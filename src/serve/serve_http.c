@@ -348,16 +348,17 @@ static enum MHD_Result serve_access(void *cls, struct MHD_Connection *conn, cons
             return serve_reply_error(r, 413, "request body larger than %u bytes",
                                      SERVE_MAX_BODY_BYTES);
         }
-        /* the answers quote the URL and the query (paths, names), as JSON: jansson refuses
-         * other bytes than UTF-8, and they became 500 "out of memory" (a PUT had written
-         * its file by then) */
+        /* the answers quote the method, the URL and the query (paths, names), as JSON:
+         * jansson refuses other bytes than UTF-8, and they became 500 "out of memory" (a
+         * PUT had written its file by then; a method of other bytes on a known path, the
+         * 405 that names it: the fuzzer found it) */
         int bad = 0;
         MHD_get_connection_values_n(conn, MHD_GET_ARGUMENT_KIND, serve_count_bad_arg, &bad);
-        if (bad || !serve_is_utf8(url)) {
+        if (bad || !serve_is_utf8(url) || !serve_is_utf8(method)) {
             r->answered = true;
             return serve_reply_error(r, 400,
-                                     "the URL or its query is not UTF-8 text (or holds a NUL, "
-                                     "%%00)");
+                                     "the method, the URL or its query is not UTF-8 text (or "
+                                     "holds a NUL, %%00)");
         }
         return MHD_YES;
     }
