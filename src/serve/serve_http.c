@@ -90,6 +90,9 @@ serve_reply_errorv(serve_request *r, unsigned status, const char *json_path, con
 {
     char message[1200];
     vsnprintf(message, sizeof message, fmt, ap);
+    /* what it quotes may not be UTF-8 (jansson's syntax errors quote the bytes near the
+     * error, cut inside a character: the answer was 500 "out of memory") */
+    serve_text_utf8(message);
     json_t *o = json_pack("{s:s}", "error", message);
     if (o && json_path)
         json_object_set_new(o, "path", json_string(json_path));
@@ -286,6 +289,36 @@ static bool serve_is_utf8(const char *text)
     json_t *t = json_string(text);
     json_decref(t);
     return t != NULL;
+}
+
+void serve_text_utf8(char *text)
+{
+    if (serve_is_utf8(text))
+        return;
+    for (char *p = text; *p;) {
+        size_t len = 1; /* the character at p: the shortest prefix jansson takes */
+        json_t *c = NULL;
+        while (len <= 4 && p[len - 1] && !(c = json_stringn(p, len)))
+            len++;
+        json_decref(c);
+        if (c)
+            p += len;
+        else
+            *p++ = '?';
+    }
+}
+
+json_t *serve_json_text(const char *text)
+{
+    if (!text)
+        return json_null();
+    char *copy = strdup(text);
+    if (!copy)
+        return NULL;
+    serve_text_utf8(copy);
+    json_t *s = json_string(copy);
+    free(copy);
+    return s;
 }
 
 void serve_text_fit(char *text)

@@ -79,6 +79,12 @@ enum MHD_Result serve_reply_json(serve_request *r, unsigned status, json_t *json
 /* Cuts text at its end until it is valid UTF-8: a message cut to its buffer's size may end
  * inside a character, and jansson refuses such a string. */
 void serve_text_fit(char *text);
+/* Replaces each byte of text that starts no valid UTF-8 character with '?': a message that
+ * quotes bytes of a request (a syntax error near them) is still one jansson takes. */
+void serve_text_utf8(char *text);
+/* The JSON string of text as serve_text_utf8 makes it (a name or unit read from a file,
+ * which may be Latin-1), or JSON null for NULL. NULL only when out of memory. */
+json_t *serve_json_text(const char *text);
 enum MHD_Result serve_reply_error(serve_request *r, unsigned status, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 /* 400 with "path": the JSON path of the problem in the request body. */

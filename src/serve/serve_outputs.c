@@ -192,21 +192,23 @@ enum MHD_Result serve_cube(serve_request *r)
             size_t len = strlen(tok);
             while (len && (tok[len - 1] == ' ' || tok[len - 1] == '\n'))
                 tok[--len] = '\0';
-            json_array_append_new(band_names, json_string(tok));
+            json_array_append_new(band_names, serve_json_text(tok));
         }
         json_t *objects = json_null();
         if (thz_cube_object_name_count(c)) {
             objects = json_array();
             for (size_t i = 0; i < thz_cube_object_name_count(c); i++)
-                json_array_append_new(objects, json_string(thz_cube_object_name(c, i)));
+                json_array_append_new(objects, serve_json_text(thz_cube_object_name(c, i)));
         }
         const char *slash = strrchr(path, '/');
         const char *q = serve_quantity(slash ? slash + 1 : path);
-        o = json_pack("{s:s, s:I, s:I, s:I, s:o, s:s?, s:o, s:s?, s:o, s:o, s:o}", "path",
+        /* a header of another program may hold Latin-1 ("data units = \xb0C"): it made
+         * the answer 500, a band name or object name was left out */
+        o = json_pack("{s:s, s:I, s:I, s:I, s:o, s:o, s:o, s:s?, s:o, s:o, s:o}", "path",
                       serve_arg(r, "path"), "rows", (json_int_t)rows, "columns", (json_int_t)cols,
-                      "bands", (json_int_t)bands, "centres_thz", centres, "units", units,
-                      "band_names", band_names, "quantity", q, "min", mins, "max", maxs,
-                      "object_names", objects);
+                      "bands", (json_int_t)bands, "centres_thz", centres, "units",
+                      serve_json_text(units), "band_names", band_names, "quantity", q, "min", mins,
+                      "max", maxs, "object_names", objects);
     }
     pthread_mutex_unlock(&r->s->cache_lock);
     free(units);

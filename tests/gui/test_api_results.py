@@ -59,6 +59,15 @@ def test_cubes(srv):
     cube = srv.json("GET", "/api/cube?path=out/a/cam.object_id.hdr")
     check(cube and cube["object_names"] == ["room", "target", "cover"],
           "object_id cube's object names: %r" % (cube and cube["object_names"]))
+    # a header of another program in Latin-1 (main): the answer was 500 "out of memory"
+    # for its unit, its band names and object names were left out; each byte that is not
+    # UTF-8 is told as '?'
+    cube = srv.json("GET", "/api/cube?path=out/latin1/cam.brightness_temperature.hdr")
+    check(cube and cube["units"] == "?K" and len(cube["band_names"]) == cube["bands"] and
+          cube["band_names"][0].startswith("?"), "a Latin-1 header's cube: %r" % cube)
+    cube = srv.json("GET", "/api/cube?path=out/latin1/cam.object_id.hdr")
+    check(cube and cube["object_names"] == ["r?om", "target", "cover"],
+          "a Latin-1 header's object names: %r" % (cube and cube["object_names"]))
 
 
 def test_pixel(root, srv):
@@ -238,6 +247,16 @@ def main():
                      ["s/small.json", "-o", "out/small"]):
             subprocess.run([BINARY, "simulate", "-q"] + args, cwd=root, check=True)
         copy_run(root, "a", "nose", drop=("radiance_stderr",))
+        copy_run(root, "a", "latin1", drop=("photon-map",))
+        for stem, old, new in (("brightness_temperature", b"data units = K", b"data units = \xb0K"),
+                               ("brightness_temperature", b"band names = {", b"band names = {\xb5"),
+                               ("object_id", b"object names = {room", b"object names = {r\xf6om")):
+            path = os.path.join(root, "out", "latin1", "cam.%s.hdr" % stem)
+            with open(path, "rb") as f:
+                text = f.read()
+            check(old in text, "%s holds %r" % (path, old))
+            with open(path, "wb") as f:
+                f.write(text.replace(old, new))
         os.makedirs(os.path.join(root, "out", "maponly"))
         shutil.copy(os.path.join(root, "out", "a", "photon-map.thzpm"),
                     os.path.join(root, "out", "maponly"))
