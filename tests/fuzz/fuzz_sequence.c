@@ -122,8 +122,8 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     return 0;
 }
 
-/* Sequences whose load is slow by design: each frame's scene is built and loaded (about
- * 1 ms here), and a sequence may have 100 000 frames. */
+/* Sequences whose load is slow by design: each frame's scene is built and loaded (a few
+ * ms under the sanitizers), and a sequence may have 100 000 frames. */
 static bool asks_for_many_frames(const char *text)
 {
     json_t *doc = json_loads(text, 0, NULL);
