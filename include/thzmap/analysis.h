@@ -117,6 +117,10 @@ THZ_API const uint64_t *thz_classification_confusion(const thz_classification *c
 /* Per pixel (rows x columns, row 0 at the top) the object index of the assigned class,
  * -1 where the truth is -1. */
 THZ_API const int32_t *thz_classification_map(const thz_classification *c);
+/* Per pixel (as _map) 1 where the pixel trained the class statistics (a seeded
+ * train_fraction of each class, at least one pixel), 0 where it was held out or not
+ * classified: the split that held_out_accuracy and the AUCs are measured on. */
+THZ_API const uint8_t *thz_classification_training(const thz_classification *c);
 /* classification.json as text (owned by c). */
 THZ_API const char *thz_classification_json(const thz_classification *c);
 /* Writes classification.json, S.class.hdr/.img (ENVI float32: object index per pixel,

@@ -15,7 +15,7 @@ import numbers
 import os
 import tempfile
 from ctypes import (POINTER, Structure, c_char_p, c_double, c_float, c_int, c_int32,
-                    c_long, c_size_t, c_uint32, c_uint64, c_void_p)
+                    c_long, c_size_t, c_uint8, c_uint32, c_uint64, c_void_p)
 
 import numpy as np
 
@@ -63,6 +63,7 @@ _PROTOTYPES = {
     "thz_classification_auc": (c_double, [_P, c_size_t]),
     "thz_classification_confusion": (POINTER(c_uint64), [_P]),
     "thz_classification_map": (POINTER(c_int32), [_P]),
+    "thz_classification_training": (POINTER(c_uint8), [_P]),
     "thz_classification_json": (c_char_p, [_P]),
     "thz_classification_write": (c_int, [_P, c_char_p, _ERR]),
 }
@@ -89,7 +90,9 @@ class Classification:
     (classes, classes): rows the truth, columns the assigned class; it sums to
     `pixels`), class_map (numpy int32 (rows, columns), or truth's shape for
     classify_spectra: the object index of each pixel's class, -1 where nothing is hit),
-    report (the dict of classification.json).
+    training_mask (numpy bool, class_map's shape: the pixels that trained; the held-out
+    figures are measured on the classified pixels outside it, so another classifier can
+    be trained and scored on the same split), report (the dict of classification.json).
     save(outdir) writes what `thzmap classify -o outdir` writes."""
 
     def __init__(self, handle):
@@ -119,6 +122,9 @@ class Classification:
         cmap = _lib.lib.thz_classification_map(ptr)
         self.class_map = np.ctypeslib.as_array(
             cmap, shape=(info.rows * info.columns,)).reshape(info.rows, info.columns).copy()
+        train = _lib.lib.thz_classification_training(ptr)
+        self.training_mask = np.ctypeslib.as_array(
+            train, shape=(info.rows * info.columns,)).reshape(info.rows, info.columns) != 0
         self.report = json.loads(_lib.text(_lib.lib.thz_classification_json(ptr)))
 
     def save(self, outdir):
@@ -336,4 +342,5 @@ def classify_spectra(spectra, truth, method=None, train_fraction=None, seed=None
                                         ctypes.byref(out), ctypes.byref(err))
     c = _finish(status, out, err)
     c.class_map = c.class_map.reshape(labels.shape)
+    c.training_mask = c.training_mask.reshape(labels.shape)
     return c

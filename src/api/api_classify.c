@@ -478,6 +478,11 @@ const int32_t *thz_classification_map(const thz_classification *c)
     return c ? c->r.assigned : NULL;
 }
 
+const uint8_t *thz_classification_training(const thz_classification *c)
+{
+    return c ? c->r.train : NULL;
+}
+
 const char *thz_classification_json(const thz_classification *c)
 {
     return c ? c->json : NULL;

@@ -184,3 +184,34 @@ def test_save_of_more_pixels_than_a_png_row_takes(tmp_path):
                                            "written up to 1000000 x 1000000 pixels"):
         c.save(tmp_path / "out")
     assert not (tmp_path / "out").exists()
+
+
+def test_training_mask_is_the_split_the_figures_use(distinct):
+    """training_mask: the pixels that trained. Each class trains round(0.3 n) of its n
+    pixels (at least 1), no unclassified pixel trains, and the held-out accuracy and the
+    confusion matrix recomputed from class_map over the pixels outside the mask are the
+    library's: a user's own classifier can be scored on the same split."""
+    _, result, run_dir = distinct
+    ids = result.image("cam").object_id.astype(np.int32)
+    for method in ("sam", "lda"):
+        c = thzmap.classify(run_dir, "cam", method=method, train_fraction=0.3, netd_k=1.0,
+                            seed=5)
+        m = c.training_mask
+        assert m.dtype == bool and m.shape == c.class_map.shape == ids.shape
+        assert int(m.sum()) == c.training_pixels and not m[ids < 0].any()
+        for obj in c.class_objects:
+            n = int((ids == obj).sum())
+            assert int(m[ids == obj].sum()) == max(1, math.floor(0.3 * n + 0.5)), obj
+        held = (ids >= 0) & ~m
+        assert int(held.sum()) == c.held_out_pixels
+        right = int((c.class_map[held] == ids[held]).sum())
+        assert c.held_out_accuracy == pytest.approx(right / int(held.sum()), rel=1e-12)
+        # another seed, another split
+        other = thzmap.classify(run_dir, "cam", method=method, train_fraction=0.3,
+                                netd_k=1.0, seed=6)
+        assert not np.array_equal(other.training_mask, m)
+    tb = result.image("cam").brightness_temperature
+    flat = thzmap.classify_spectra(tb.reshape(-1, tb.shape[-1]), ids.reshape(-1), method="lda",
+                                   train_fraction=0.3, netd_k=1.0, seed=5)
+    assert flat.training_mask.shape == (ids.size,)
+    assert np.array_equal(flat.training_mask, c.training_mask.reshape(-1))
