@@ -31,6 +31,7 @@ from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.ui import Select, WebDriverWait
 
 import e2e_readouts as readouts
+import e2e_user as user
 
 THZMAP, REPO, SHOTS = sys.argv[1], sys.argv[2], sys.argv[3]
 T0 = time.monotonic()
@@ -587,6 +588,11 @@ def main():
         audit_fixes(driver, wait, patient, by_id, click_list, field, root)
         bands_results(driver, wait, by_id, click_list, root, shot)
         unsaved_edits(driver, wait, by_id, click_list, field)
+        t_user = time.monotonic()
+        lib, legend = user.library_material(driver, wait, by_id, click_list, field, 1, "cylinder-A")
+        width = user.narrow_window(driver, wait, by_id)
+        log(f"library material {lib} chosen, legend {legend} in its curves' colours; 3D view {width} px "
+            f"at 800 px ({time.monotonic() - t_user:.1f} s)")
         # the server stopped: the page says so (it said "Failed to fetch", and its
         # validation box stayed at "validating…")
         proc.terminate()

@@ -19,7 +19,9 @@ export class PhotonView {
     this.camera.position.set(2, -3, 2);
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.addEventListener("change", () => this.render());
-    new ResizeObserver(() => this.resize()).observe(container);
+    // resized in the next frame: resized at once, the canvas's new size is observed
+    // again in the same turn, an error event ("ResizeObserver loop completed …")
+    new ResizeObserver(() => requestAnimationFrame(() => this.resize())).observe(container);
   }
 
   resize() {

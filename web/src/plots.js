@@ -60,7 +60,9 @@ export function linePlot(container, series, axes) {
       const e = s.err?.[i];
       if (e) el("line", { x1: px(x), x2: px(x), y1: py(y - e), y2: py(y + e), stroke: colour }, svg);
     });
-    el("text", { x: m.l + 6 + 70 * k, y: m.t + 11, fill: colour }, svg).textContent = s.label;
+    // the label in its curve's colour (a style: app.css's grey for the axes' text would
+    // override a fill attribute, leaving R and ε alike)
+    el("text", { x: m.l + 6 + 70 * k, y: m.t + 11, style: `fill: ${colour}` }, svg).textContent = s.label;
   });
   container.appendChild(svg);
   return svg;

@@ -333,7 +333,10 @@ export class Results {
 function paint(canvas, cube, values, lo, hi, map, ignore) {
   canvas.width = cube.cols;
   canvas.height = cube.rows;
-  const zoom = Math.max(1, Math.floor(512 / Math.max(cube.cols, cube.rows)));
+  // up to 512 px a side, less in a narrow window (the colour bar beside it, 110 px)
+  const room = (canvas.closest("#image-pane, #diff-pane")?.clientWidth || 0) - 126;
+  const side = room > 0 ? Math.min(512, room) : 512;
+  const zoom = Math.max(1, Math.floor(side / Math.max(cube.cols, cube.rows)));
   canvas.style.width = `${cube.cols * zoom}px`;
   canvas.style.height = `${cube.rows * zoom}px`;
   const g = canvas.getContext("2d");

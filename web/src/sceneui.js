@@ -153,10 +153,17 @@ export class SceneEditor {
   // a field changed the document: rewrite the text, validate
   edited(path) {
     if (this.broken) return; // the fields are inert then (setBroken)
+    const keys = parsePath(path);
+    // a library material chosen that the scene does not define yet: define it as
+    // {"library": NAME}, else the scene names a material it does not have
+    const mat = keys[0] === "objects" && keys[2] === "material" ? this.doc.objects?.[keys[1]]?.material : undefined;
+    if (typeof mat === "string" && this.library.includes(mat) && !Object.hasOwn(this.doc.materials || {}, mat)) {
+      if (this.doc.materials == null || typeof this.doc.materials !== "object") this.doc.materials = {};
+      this.doc.materials[mat] = { library: mat };
+    }
     const text = `${JSON.stringify(this.doc, null, 2)}\n`;
     $("scene-text").value = text;
     this.markDirty();
-    const keys = parsePath(path);
     if (keys[0] === "objects" && (keys[2] === "name" || keys[2] === "shape")) this.renderLists();
     // the fields of an object depend on its type (a shell's thickness) and its shape's
     if (keys[0] === "objects" && (keys[2] === "type" || (keys[2] === "shape" && keys[3] === "type"))) {

@@ -46,7 +46,9 @@ export class SceneView {
     this.meshes = [];
     this.options = { colourBy: "material", normals: false, cut: true, preview: true };
     this.selectedSensor = 0;
-    new ResizeObserver(() => this.resize()).observe(container);
+    // resized in the next frame: resized at once, the canvas's new size is observed
+    // again in the same turn, an error event ("ResizeObserver loop completed …")
+    new ResizeObserver(() => requestAnimationFrame(() => this.resize())).observe(container);
     this.renderer.domElement.addEventListener("pointerdown", (e) => (this.down = [e.clientX, e.clientY]));
     this.renderer.domElement.addEventListener("pointerup", (e) => this.pick(e));
     this.framed = false;

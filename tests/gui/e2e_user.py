@@ -1,0 +1,82 @@
+"""A user's session of the page (for test_e2e.py, session 56): what a person saw go
+wrong. A plot's legend was grey for every curve (app.css's fill for the axes' text beat
+the labels' fill attribute), so R and ε could not be told apart; a material of the
+library chosen in an object's material list was refused ("unknown material", the scene
+did not define it); resizing the window raised "ResizeObserver loop completed with
+undelivered notifications" error events; at 800 px the side columns left the 3D view and
+the image some 190 px, where the image was drawn 512 px wide all the same, its colour
+bar and unit beyond the pane's edge."""
+import json
+
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support.ui import Select
+
+ERRORS = ("window.userErrors = []; window.addEventListener('error', (e) =>"
+          " window.userErrors.push(String(e.message)));")
+
+
+def legend_colours(driver):
+    """Each plot's legend labels are drawn in the colour of their curves, in order."""
+    plots = driver.execute_script(
+        "return [...document.querySelectorAll('#material-plots svg')].map((s) => ["
+        " [...s.querySelectorAll('polyline')].map((p) => getComputedStyle(p).stroke),"
+        " [...s.querySelectorAll('text')].filter((t) => t.hasAttribute('style'))"
+        "   .map((t) => [t.textContent, getComputedStyle(t).fill])]);")
+    assert plots, "no material plot"
+    for strokes, labels in plots:
+        assert [f for _, f in labels] == strokes, f"legend {labels} for curves {strokes}"
+    return [n for _, labels in plots for n, _ in labels]
+
+
+def library_material(driver, wait, by_id, click_list, field, index, name):
+    """The library's material chosen for object `index` (the scene open, saved, valid):
+    the scene defines it as {"library": NAME} and stays valid; its plots are drawn."""
+    by_id("tab-scene").click()
+    click_list("objects", name)
+    path = f"objects[{index}].material"
+    choice = Select(field(path).find_element(By.TAG_NAME, "select"))
+    defined = json.loads(by_id("scene-text").get_attribute("value")).get("materials", {})
+    lib = next(o.get_attribute("value") for o in choice.options if o.get_attribute("value") not in defined)
+    choice.select_by_value(lib)
+    wait.until(lambda d: json.loads(by_id("scene-text").get_attribute("value"))["objects"][index]["material"] == lib)
+    doc = json.loads(by_id("scene-text").get_attribute("value"))
+    assert doc["materials"].get(lib) == {"library": lib}, f"materials.{lib}: {doc['materials'].get(lib)}"
+    # its spectra are plotted once the scene validates with it
+    wait.until(lambda d: d.execute_script(
+        "return document.querySelector('#material-plots div')?.textContent || ''").startswith(f"material {lib}"))
+    assert "✓" in by_id("validation-state").text, by_id("validation").text
+    return lib, legend_colours(driver)
+
+
+def narrow_window(driver, wait, by_id):
+    """At 800 x 600 the 3D view keeps 300 px, a run's image and colour bar fit their pane;
+    resizing raises no error event."""
+    driver.execute_script(ERRORS)
+    size = driver.get_window_size()
+    try:
+        driver.set_window_size(800, 600)
+        wait.until(lambda d: d.execute_script("return document.getElementById('view3d').clientWidth") < 500)
+        width = driver.execute_script("return document.getElementById('view3d').clientWidth")
+        assert width >= 300, f"the 3D view at 800 px: {width} px wide"
+        # the image (of the run open in Results) drawn in the narrow window: it and its
+        # colour bar fit the pane (512 px always, the colour bar and its unit needed a scroll)
+        by_id("tab-results").click()
+        channel = Select(by_id("res-channel"))
+        channel.select_by_index(1 - [o.is_selected() for o in channel.options].index(True) % 2)
+        fits = lambda d: d.execute_script(
+            "const p = document.getElementById('image-pane').getBoundingClientRect();"
+            "const b = document.getElementById('colourbar').getBoundingClientRect();"
+            "const i = document.getElementById('image').getBoundingClientRect();"
+            "return [b.right, p.right, i.width];")
+        bar_right, pane_right, image_width = fits(driver)
+        assert bar_right <= pane_right and image_width >= 64, \
+            f"at 800 px: colour bar's right edge {bar_right} px, the pane's {pane_right} px; image {image_width} px"
+        by_id("tab-scene").click()
+        driver.set_window_size(1000, 700)
+        driver.execute_script("return new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))")
+    finally:
+        driver.set_window_size(size["width"], size["height"])
+    driver.execute_script("return new Promise((r) => setTimeout(r, 300))")
+    errors = driver.execute_script("return window.userErrors")
+    assert not errors, f"error events while resizing: {errors}"
+    return width
