@@ -7,6 +7,7 @@
 
 #include "core/alloc.h"
 #include "scene/load.h"
+#include "scene/material_library.h"
 #include "scene/mesh_import.h"
 #include "scene/primitives.h"
 #include "scene/transform.h"
@@ -238,6 +239,36 @@ static thz_status load_transform(load_ctx *ctx, const load_cursor *c, thz_mesh *
     return THZ_OK;
 }
 
+/* An object's material the scene does not define: the scene's names, and the library's
+ * entry of that name when there is one (a library material must be defined in "materials"). */
+static thz_status unknown_material(load_ctx *ctx, const load_cursor *c, const thz_scene *s,
+                                   const char *material)
+{
+    char names[400] = "";
+    size_t used = 0;
+    for (size_t m = 0; m < s->n_materials && used < sizeof names - 1; m++) {
+        int n = snprintf(names + used, sizeof names - used, "%s%s", m ? ", " : "",
+                         s->materials[m].name);
+        used = n < 0 ? used : used + (size_t)n;
+    }
+    if (used >= sizeof names - 1)
+        memcpy(names + sizeof names - 5, "...", 4);
+    material_library *lib = NULL;
+    thz_error ignored = {0};
+    bool in_library = material_library_load(&lib, &ignored) == THZ_OK &&
+                      material_library_find(lib, material) != NULL;
+    material_library_destroy(lib);
+    load_cursor k = load_key(c, "material");
+    if (in_library)
+        return load_fail(ctx, &k,
+                         "unknown material \"%s\" (the scene's materials: %s); the material "
+                         "library has one of that name: define it in \"materials\" as "
+                         "\"%s\": {\"library\": \"%s\"}",
+                         material, names, material, material);
+    return load_fail(ctx, &k, "unknown material \"%s\" (the scene's materials: %s)", material,
+                     names);
+}
+
 static thz_status load_object(load_ctx *ctx, const load_cursor *list, size_t index, thz_object *o)
 {
     static const char *const keys[] = {"name",          "type",        "material",
@@ -267,11 +298,8 @@ static thz_status load_object(load_ctx *ctx, const load_cursor *list, size_t ind
     for (size_t m = 0; m < s->n_materials; m++)
         if (strcmp(s->materials[m].name, material) == 0)
             o->material = m;
-    if (o->material == s->n_materials) {
-        load_cursor k = load_key(c, "material");
-        return load_fail(ctx, &k, "unknown material \"%s\" (expected a key of \"materials\")",
-                         material);
-    }
+    if (o->material == s->n_materials)
+        return unknown_material(ctx, c, s, material);
     st = load_number(ctx, c, "temperature_k", LOAD_TEMPERATURE, true, 0, &o->temperature_k);
     if (st != THZ_OK)
         return st;

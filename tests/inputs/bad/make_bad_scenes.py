@@ -307,8 +307,12 @@ CASES = [
      "sensors[0].noise.receiver_temperature_k: expected a number in [0, 1e+06], got 1e+300"),
     ("object_temperature_missing", [(["objects", 1, "temperature_k"], DELETE)],
      "objects[1].temperature_k: missing key"),
+    # the scene's materials listed; a library entry of that name: how to take it
     ("object_unknown_material", [(["objects", 1, "material"], "gold")],
-     "objects[1].material: unknown material \"gold\""),
+     'objects[1].material: unknown material "gold" (the scene\'s materials: wall, paint); the '
+     'material library has one of that name: define it in "materials" as "gold": {"library": "gold"}'),
+    ("object_unknown_material_typo", [(["objects", 1, "material"], "pain")],
+     'objects[1].material: unknown material "pain" (the scene\'s materials: wall, paint)'),
     ("object_duplicate_name", [(["objects", 1, "name"], "room")],
      "objects[1].name: object name \"room\" is already used"),
     ("object_unknown_key", [(["objects", 0, "temprature_k"], 300)],
