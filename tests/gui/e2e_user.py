@@ -5,7 +5,9 @@ library chosen in an object's material list was refused ("unknown material", the
 did not define it); resizing the window raised "ResizeObserver loop completed with
 undelivered notifications" error events; at 800 px the side columns left the 3D view and
 the image some 190 px, where the image was drawn 512 px wide all the same, its colour
-bar and unit beyond the pane's edge."""
+bar and unit beyond the pane's edge; a channel chosen in the A/B difference's view left
+the difference of the channel compared before, under a list naming the new one, and the
+image's quantity and scale stayed in view where they act on nothing."""
 import json
 
 from selenium.webdriver.common.by import By
@@ -80,3 +82,30 @@ def narrow_window(driver, wait, by_id):
     errors = driver.execute_script("return window.userErrors")
     assert not errors, f"error events while resizing: {errors}"
     return width
+
+
+def diff_follows_channel(driver, wait, by_id, a, b):
+    """In the A/B view the difference shown is of the channel chosen; quantity and scale
+    (the image's) are out of sight there, and sensor and channel in the photon view."""
+    by_id("tab-results").click()
+    Select(by_id("res-view")).select_by_value("diff")
+    shown = lambda i: by_id(i).is_displayed()
+    assert not shown("res-quantity") and not shown("res-scale") and shown("res-channel"), \
+        "the A/B view shows the image's quantity and scale"
+    for box, run in (("diff-a", a), ("diff-b", b)):
+        by_id(box).clear()
+        by_id(box).send_keys(run)
+    channel = Select(by_id("res-channel"))
+    channel.select_by_index(0)
+    by_id("btn-diff").click()
+    caption = lambda: by_id("diff-info").text
+    wait.until(lambda d: "channel 1 (" in caption())
+    channel.select_by_index(2)
+    wait.until(lambda d: "channel 3 (" in caption() and "%" in caption())
+    said = caption()
+    Select(by_id("res-view")).select_by_value("photons")
+    assert not shown("res-channel") and not shown("res-sensor") and not shown("res-quantity"), \
+        "the photon view shows the image's sensor, channel or quantity"
+    Select(by_id("res-view")).select_by_value("image")
+    assert shown("res-quantity") and shown("res-scale") and shown("res-channel")
+    return said

@@ -22,6 +22,13 @@ export class Results {
       $(id).onchange = () => this.show().catch(reportError);
     }
     $("res-sensor").onchange = () => this.loadSensor().catch(reportError);
+    // the A/B difference shown follows the sensor and channel chosen (it stayed at the
+    // channel of its Compare while the list said another)
+    for (const id of ["res-sensor", "res-channel"]) {
+      $(id).addEventListener("change", () => {
+        if ($("res-view").value === "diff" && this.diffZ) this.diff().catch(reportError);
+      });
+    }
     $("res-view").onchange = () => this.setView($("res-view").value);
     $("image").addEventListener("click", (e) => this.click(e, $("image")).catch(reportError));
     $("diff-image").addEventListener("click", (e) => this.clickDiff(e));
@@ -37,6 +44,12 @@ export class Results {
     $("image-pane").hidden = view !== "image";
     $("photon-pane").hidden = view !== "photons";
     $("diff-pane").hidden = view !== "diff";
+    // the image's controls where they act: quantity and scale for the image alone, sensor
+    // and channel for the difference too, none for the photons (they have their own)
+    for (const [id, shown] of [["res-quantity", view === "image"], ["res-scale", view === "image"],
+      ["res-sensor", view !== "photons"], ["res-channel", view !== "photons"]]) {
+      $(id).closest("label").hidden = !shown;
+    }
     if (view === "photons") this.photons?.resize();
   }
 
