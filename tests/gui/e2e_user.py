@@ -7,7 +7,8 @@ undelivered notifications" error events; at 800 px the side columns left the 3D 
 the image some 190 px, where the image was drawn 512 px wide all the same, its colour
 bar and unit beyond the pane's edge; a channel chosen in the A/B difference's view left
 the difference of the channel compared before, under a list naming the new one, and the
-image's quantity and scale stayed in view where they act on nothing."""
+image's quantity and scale stayed in view where they act on nothing; A was filled with
+the first run the page opened, whatever was open since, and B left empty."""
 import json
 
 from selenium.webdriver.common.by import By
@@ -109,3 +110,10 @@ def diff_follows_channel(driver, wait, by_id, a, b):
     Select(by_id("res-view")).select_by_value("image")
     assert shown("res-quantity") and shown("res-scale") and shown("res-channel")
     return said
+
+
+def diff_prefilled(by_id, a, b):
+    """A and B hold the run open and the one opened before it (A stayed the first run the
+    page opened, B empty)."""
+    shown = by_id("diff-a").get_attribute("value"), by_id("diff-b").get_attribute("value")
+    assert shown == (a, b), f"A/B prefilled with {shown}, not the run open {a} and the one before {b}"

@@ -547,6 +547,7 @@ def main():
         time.sleep(0.3)
         shot("photons")
         Select(by_id("res-view")).select_by_value("diff")
+        user.diff_prefilled(by_id, "teraeye/out-seed1", "teraeye/out-seed2")
         by_id("diff-a").clear()
         by_id("diff-a").send_keys("teraeye/out-seed1")
         by_id("diff-b").clear()

@@ -33,6 +33,7 @@ export class Results {
     $("image").addEventListener("click", (e) => this.click(e, $("image")).catch(reportError));
     $("diff-image").addEventListener("click", (e) => this.clickDiff(e));
     $("btn-diff").onclick = () => this.diff().catch(reportError);
+    for (const id of ["diff-a", "diff-b"]) $(id).addEventListener("input", () => (this.diffTyped = true));
     $("frame").oninput = () => this.openFrame(Number($("frame").value)).catch(reportError);
     $("btn-play").onclick = () => this.play();
     $("btn-photons").onclick = () => this.loadPhotons().catch(reportError);
@@ -137,7 +138,12 @@ export class Results {
     $("res-sensor").replaceChildren(...sensors.map((s) => new Option(s, s, false, s === keep)));
     this.summary = outputs.summary;
     this.mapPath = outputs.photon_map;
-    if (!$("diff-a").value) $("diff-a").value = dir;
+    // A: the run open, B: the one opened before it (A stayed the first run ever opened),
+    // until either is typed into
+    if (!this.diffTyped && $("diff-a").value !== dir) {
+      $("diff-b").value = $("diff-a").value;
+      $("diff-a").value = dir;
+    }
     await this.loadSensor();
   }
 
