@@ -8,8 +8,12 @@ the image some 190 px, where the image was drawn 512 px wide all the same, its c
 bar and unit beyond the pane's edge; a channel chosen in the A/B difference's view left
 the difference of the channel compared before, under a list naming the new one, and the
 image's quantity and scale stayed in view where they act on nothing; A was filled with
-the first run the page opened, whatever was open since, and B left empty."""
+the first run the page opened, whatever was open since, and B left empty; a pixel
+clicked on an image of power or radiance showed Tb alone, not the value of the image."""
 import json
+import os
+
+import numpy as np
 
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
@@ -117,3 +121,22 @@ def diff_prefilled(by_id, a, b):
     page opened, B empty)."""
     shown = by_id("diff-a").get_attribute("value"), by_id("diff-b").get_attribute("value")
     assert shown == (a, b), f"A/B prefilled with {shown}, not the run open {a} and the one before {b}"
+
+
+def pixel_of_quantity(driver, wait, by_id, out, bands, size, row, col):
+    """A pixel clicked on the power image of channel 2: the column gives the cube's value,
+    in its unit, beside the Tb spectrum."""
+    from e2e_readouts import click_pixel
+    Select(by_id("res-quantity")).select_by_value("power")
+    Select(by_id("res-channel")).select_by_index(1)
+    wait.until(lambda d: by_id("image-info").text.startswith("power, channel 2 ("))
+    click_pixel(driver, wait, by_id, "image", size[0], size[1], row, col)
+    wait.until(lambda d: d.execute_script(
+        "const e = document.getElementById('pixel-shown'); return e && e.textContent.startsWith('power, channel 2')"
+        " && document.getElementById('pixel-info').dataset.row === arguments[0];", str(row)))
+    power = np.fromfile(os.path.join(out, "cam.power.img"), "<f4").reshape(bands, *size)[1, row, col]
+    line = by_id("pixel-shown")
+    assert float(line.get_attribute("data-value")) == float(power), (line.get_attribute("data-value"), power)
+    assert line.text.endswith(" W") and f"{power:.3e}" in line.text, (line.text, power)
+    Select(by_id("res-quantity")).select_by_value("brightness_temperature")
+    return line.text

@@ -247,6 +247,19 @@ export class Results {
     truth.textContent = id >= 0
       ? `${objectName}, ${formatNumber(truthT)} K at ${formatNumber(truthD)} m` : objectName;
     info.appendChild(truth);
+    // the quantity of the image when the spectrum below is not of it (radiance, power, …)
+    const qn = $("res-quantity").value;
+    const cube = this.shown;
+    if (cube && !qn.includes("brightness") && !TRUTH.has(qn) && cube.rows === tb.rows && cube.cols === tb.cols) {
+      const band = Math.min(Number($("res-channel").value) || 0, cube.bands - 1);
+      const v = cube.at(band, row, col);
+      const line = document.createElement("div");
+      line.id = "pixel-shown";
+      line.dataset.value = String(v);
+      line.textContent = `${qn.replace(/_/g, " ")}, channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz): ` +
+        `${formatNumber(v)}${cube.unit === "1" ? "" : ` ${cube.unit}`}`;
+      info.appendChild(line);
+    }
     $("pixel-plot").replaceChildren();
     linePlot($("pixel-plot"), [{ label: measured ? "measured Tb" : "Tb ± 1σ", x: f, y, err }], { xLabel: "frequency (THz)", yLabel: "Tb (K)" });
     const table = $("pixel-table");
