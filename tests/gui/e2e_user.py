@@ -9,7 +9,9 @@ bar and unit beyond the pane's edge; a channel chosen in the A/B difference's vi
 the difference of the channel compared before, under a list naming the new one, and the
 image's quantity and scale stayed in view where they act on nothing; A was filled with
 the first run the page opened, whatever was open since, and B left empty; a pixel
-clicked on an image of power or radiance showed Tb alone, not the value of the image."""
+clicked on an image of power or radiance showed Tb alone, not the value of the image; the
+Run tab had no integrator to choose, so seeing a path scene's photons meant editing its
+render.integrator."""
 import json
 import os
 
@@ -140,3 +142,31 @@ def pixel_of_quantity(driver, wait, by_id, out, bands, size, row, col):
     assert line.text.endswith(" W") and f"{power:.3e}" in line.text, (line.text, power)
     Select(by_id("res-quantity")).select_by_value("brightness_temperature")
     return line.text
+
+
+def run_integrator(driver, wait, by_id, root, scene, out):
+    """A path scene simulated with the integrator chosen in the Run tab, photon-map: its
+    photon map can be saved, and the run is of that integrator with its map written."""
+    by_id("tab-scene").click()
+    by_id("btn-save").click()  # the edits of library_material
+    wait.until(lambda d: by_id("status").text == f"saved {scene}")
+    by_id("tab-run").click()
+    wait.until(lambda d: by_id("run-scene").get_attribute("value") == scene)
+    Select(by_id("run-command")).select_by_visible_text("simulate")
+    save = by_id("run-save-map")
+    wait.until(lambda d: not save.is_enabled())  # the scene's integrator is path
+    Select(by_id("run-integrator")).select_by_visible_text("photon-map")
+    assert save.is_enabled(), "save the photon map stays greyed out with photon-map chosen"
+    if not save.is_selected():
+        save.click()
+    by_id("run-out").clear()
+    by_id("run-out").send_keys(out)
+    by_id("btn-run").click()
+    summary = os.path.join(root, out, "summary.json")
+    wait.until(lambda d: os.path.exists(summary))
+    with open(summary) as f:
+        integrator = json.load(f)["integrator"]
+    assert integrator == "photon-map", integrator
+    assert os.path.exists(os.path.join(root, out, "photon-map.thzpm"))
+    Select(by_id("run-integrator")).select_by_value("")
+    return integrator

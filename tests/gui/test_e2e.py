@@ -594,8 +594,9 @@ def main():
         width = user.narrow_window(driver, wait, by_id)
         diff = user.diff_follows_channel(driver, wait, by_id, "teraeye/out-seed1", "teraeye/out-seed2")
         diff += "; " + user.pixel_of_quantity(driver, wait, by_id, out, bands, (32, 32), row, col)
+        ran = user.run_integrator(driver, wait, by_id, root, "teraeye/saved-as.json", "teraeye/out-integrator")
         log(f"library material {lib} chosen, legend {legend} in its curves' colours; 3D view {width} px "
-            f"at 800 px; {diff!r} ({time.monotonic() - t_user:.1f} s)")
+            f"at 800 px; {diff!r}; a path scene run as {ran} ({time.monotonic() - t_user:.1f} s)")
         # the server stopped: the page says so (it said "Failed to fetch", and its
         # validation box stayed at "validating…")
         proc.terminate()

@@ -9,8 +9,8 @@ const FINAL = new Set(["done", "finished", "succeeded", "failed", "cancelled", "
 const POLL_MS = 1000; // the states of the runs not streamed, while any is unfinished
 // the form's fields each command takes (others are disabled and not sent)
 const FIELDS = {
-  simulate: ["run-photons", "run-seed", "run-save-map"],
-  render: ["run-photon-map"],
+  simulate: ["run-photons", "run-seed", "run-integrator", "run-save-map"],
+  render: ["run-integrator", "run-photon-map"],
   batch: [],
   bands: ["run-seed", "run-count"],
 };
@@ -31,6 +31,7 @@ export class Runs {
       this.updateForm();
     };
     $("run-scene").onchange = () => this.checkScene().catch(() => {});
+    $("run-integrator").onchange = () => this.updateForm();
     this.updateForm();
   }
 
@@ -75,7 +76,9 @@ export class Runs {
     // the path integrator fires no photons: no map to save (the server refuses it); what
     // the box said comes back with a scene that makes one
     const box = $("run-save-map");
-    const noPhotons = this.integrator === "path";
+    // the integrator chosen here, else the scene's
+    const integrator = (!$("run-integrator").disabled && $("run-integrator").value) || this.integrator;
+    const noPhotons = integrator === "path";
     if (noPhotons && box.dataset.wanted === undefined) {
       box.dataset.wanted = String(box.checked);
       box.checked = false;
@@ -84,7 +87,7 @@ export class Runs {
       delete box.dataset.wanted;
     }
     box.disabled ||= noPhotons;
-    box.title = noPhotons ? "the scene's integrator, path, fires no photons: no map to save" : "";
+    box.title = noPhotons ? "the integrator, path, fires no photons: no map to save" : "";
   }
 
   async start() {
@@ -102,6 +105,7 @@ export class Runs {
     const seed = $("run-seed").value;
     if (takes("run-photons") && photons) options.photons = Number(photons);
     if (takes("run-seed") && seed) options.seed = Number(seed);
+    if (takes("run-integrator") && $("run-integrator").value) options.integrator = $("run-integrator").value;
     if (takes("run-save-map") && $("run-save-map").checked) options.save_photon_map = true;
     const map = $("run-photon-map").value.trim();
     if (takes("run-photon-map") && map) options.photon_map = map; // none: the path integrator
