@@ -5,7 +5,8 @@ library chosen in an object's material list was refused ("unknown material", the
 did not define it); resizing the window raised "ResizeObserver loop completed with
 undelivered notifications" error events; at 800 px the side columns left the 3D view and
 the image some 190 px, where the image was drawn 512 px wide all the same, its colour
-bar and unit beyond the pane's edge; a channel chosen in the A/B difference's view left
+bar and unit beyond the pane's edge, and the runs' Cancel and Results buttons beyond the
+Run tab's; a channel chosen in the A/B difference's view left
 the difference of the channel compared before, under a list naming the new one, and the
 image's quantity and scale stayed in view where they act on nothing; A was filled with
 the first run the page opened, whatever was open since, and B left empty; a pixel
@@ -58,7 +59,8 @@ def library_material(driver, wait, by_id, click_list, field, index, name):
 
 
 def narrow_window(driver, wait, by_id):
-    """At 800 x 600 the 3D view keeps 300 px, a run's image and colour bar fit their pane;
+    """At 800 x 600 the 3D view keeps 300 px, a run's image and colour bar fit their pane,
+    the runs' Cancel and Results buttons theirs;
     resizing raises no error event."""
     driver.execute_script(ERRORS)
     size = driver.get_window_size()
@@ -80,6 +82,13 @@ def narrow_window(driver, wait, by_id):
         bar_right, pane_right, image_width = fits(driver)
         assert bar_right <= pane_right and image_width >= 64, \
             f"at 800 px: colour bar's right edge {bar_right} px, the pane's {pane_right} px; image {image_width} px"
+        # the Run tab: the runs table's last column (Cancel, Results) within its panel
+        by_id("tab-run").click()
+        right = driver.execute_script(
+            "const t = document.querySelector('#runs thead tr').lastElementChild.getBoundingClientRect();"
+            "const p = document.querySelector('#runs').closest('.panel').getBoundingClientRect();"
+            "return [t.right, p.right];")
+        assert right[0] <= right[1], f"at 800 px the runs' buttons end at {right[0]} px, their panel at {right[1]} px"
         by_id("tab-scene").click()
         driver.set_window_size(1000, 700)
         driver.execute_script("return new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))")
