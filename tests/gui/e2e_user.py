@@ -12,7 +12,7 @@ image's quantity and scale stayed in view where they act on nothing; A was fille
 the first run the page opened, whatever was open since, and B left empty; a pixel
 clicked on an image of power or radiance showed Tb alone, not the value of the image; the
 Run tab had no integrator to choose, so seeing a path scene's photons meant editing its
-render.integrator."""
+render.integrator; a run cancelled was announced in the error's red."""
 import json
 import os
 
@@ -179,3 +179,9 @@ def run_integrator(driver, wait, by_id, root, scene, out):
     assert os.path.exists(os.path.join(root, out, "photon-map.thzpm"))
     Select(by_id("run-integrator")).select_by_value("")
     return integrator
+
+
+def cancelled_not_error(wait, by_id):
+    """A run cancelled is said so in the status line, not in the error's red."""
+    wait.until(lambda d: " cancelled" in by_id("status").text)
+    assert "error" not in (by_id("status").get_attribute("class") or ""), by_id("status").text

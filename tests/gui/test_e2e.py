@@ -257,6 +257,7 @@ def audit_fixes(driver, wait, patient, by_id, click_list, field, root):
         ".map((r) => fetch(`/api/runs/${r.id}`, {method: 'DELETE'})))).then(() => done(), () => done());")
     states = [final_state(f"teraeye/out-many-{k}") for k in range(8)]
     assert states == ["cancelled"] * 8, states
+    user.cancelled_not_error(wait, by_id)
     # the errors the browser logged are the bands run's, asked for above
     errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"
               and "/api/runs - Failed to load resource" not in e["message"]

@@ -204,7 +204,8 @@ export class Runs {
     if (run.announced) return;
     run.announced = true;
     const ok = ["done", "finished", "succeeded"].includes(run.state);
-    status(`run ${id} ${run.state}${run.error ? `: ${run.error}` : ""}`, !ok);
+    // a cancelled run is what was asked for, not an error (it was shown in the error's red)
+    status(`run ${id} ${run.state}${run.error ? `: ${run.error}` : ""}`, !ok && !run.state.startsWith("cancel"));
     if (ok) document.dispatchEvent(new CustomEvent("run-finished", { detail: run }));
   }
 
