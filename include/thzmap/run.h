@@ -122,13 +122,15 @@ THZ_API thz_status thz_photons_load_channel(thz_context *ctx, const thz_scene *s
 THZ_API thz_status thz_photons_save(const thz_photons *photons, const char *path, thz_error *err);
 /* Merges n photon sets of one scene, seed and integrator, fired with disjoint photon
  * ranges (or for different channels), into one of all their photons (*out; the parts
- * stay the caller's). Each channel of *out holds the parts' photons of that channel;
- * its photons_per_channel is per channel the sum over the parts that hold the channel,
- * and the largest of these sums when they differ between channels. THZ_ERR_INPUT when a
- * part is given twice, or when two parts hold the same photons of a channel: a map
- * fired here knows its photons (first_photon .. + K - 1), a simulation's kept map
- * (thz_run_photons) its 0 .. fired - 1, a merged map the union of its parts'; a loaded map
- * does not know its photons, so that check cannot see them. */
+ * stay the caller's). Parts of different scene handles merge when the scenes fit one
+ * another as thz_render_run's photons must; *out belongs to part 0's scene. Each channel
+ * of *out holds the parts' photons of that channel; its photons_per_channel is per
+ * channel the sum over the parts that hold the channel, and the largest of these sums
+ * when they differ between channels. THZ_ERR_INPUT when a part is given twice, or when
+ * two parts hold the same photons of a channel: a map fired here knows its photons
+ * (first_photon .. + K - 1), a simulation's kept map (thz_run_photons) its
+ * 0 .. fired - 1, a merged map the union of its parts'; a loaded map does not know its
+ * photons, so that check cannot see them. */
 THZ_API thz_status thz_photons_merge(thz_context *ctx, const thz_photons *const *parts, size_t n,
                                      thz_photons **out, thz_error *err);
 THZ_API void thz_photons_destroy(thz_photons *photons);

@@ -211,7 +211,10 @@ def load_photon_map(scene, path, channel=None, threads=None, progress=None):
 
 def merge_photon_maps(parts, threads=None):
     """One photon map of all the photons of `parts` (one scene, seed and integrator,
-    fired with disjoint photon ranges)."""
+    fired with disjoint photon ranges). Parts of different Scene objects merge when their
+    scenes fit one another as a render's photon map must (the same geometry, channels,
+    materials, temperatures and atmosphere; thzmap.Error says what differs); the merged
+    map belongs to the first part's Scene."""
     if isinstance(parts, (str, bytes)) or not hasattr(parts, "__iter__"):
         raise ArgumentError(f"parts: expected a non-empty sequence of PhotonMap, got "
                             f"{type(parts).__name__}")
@@ -219,8 +222,6 @@ def merge_photon_maps(parts, threads=None):
     if not parts or not all(isinstance(p, PhotonMap) for p in parts):
         raise ArgumentError("parts: expected a non-empty sequence of PhotonMap")
     scene = parts[0].scene
-    if any(p.scene is not scene for p in parts):
-        raise ArgumentError("parts: the photon maps belong to different Scene objects")
     arr = (ctypes.c_void_p * len(parts))(*(p._ptr for p in parts))
     with Call(threads) as call:
         pm = _photons_call(call, lambda out: _lib.lib.thz_photons_merge(

@@ -13,6 +13,7 @@
 #include "photon/phase.h"
 #include "photon/photon_map.h"
 #include "run/run.h"
+#include "scene/scene_hash.h"
 
 static thz_status api_photons_create(const thz_scene *scene, thz_photons **out, thz_error *err)
 {
@@ -243,7 +244,24 @@ thz_status thz_photons_save(const thz_photons *ph, const char *path, thz_error *
                                 ph->stats, 0, err);
 }
 
-/* Whether the parts can merge: one scene, seed, photon count and T0 per channel. */
+/* Whether part i, fired or loaded for another scene handle than part 0's, fits part 0's
+ * scene: the test a .thzpm file's header and thz_render_run apply (scene_hash_fit). */
+static thz_status api_merge_fits(const thz_photons *p, const thz_photons *a, size_t i,
+                                 thz_error *err)
+{
+    if (p->scene == a->scene)
+        return THZ_OK;
+    scene_hash made;
+    scene_hash_compute(&p->effective, &made);
+    char maps[96];
+    snprintf(maps, sizeof maps, "thz_photons_merge: part %zu (another scene handle than part 0's)",
+             i);
+    return scene_hash_fit(&made, p->effective.n_objects, p->n_channels, a->scene, maps,
+                          "fire every part for the same scene", err);
+}
+
+/* Whether the parts can merge: one scene (or handles of scenes that fit one another),
+ * seed, photon count and T0 per channel. */
 static thz_status api_merge_check(const thz_photons *const *parts, size_t n, thz_error *err)
 {
     if (!parts || n == 0)
@@ -252,12 +270,14 @@ static thz_status api_merge_check(const thz_photons *const *parts, size_t n, thz
         const thz_photons *p = parts[i], *a = parts[0];
         if (!p)
             return thz_error_set(err, THZ_ERR_INPUT, "thz_photons_merge: part %zu is NULL", i);
-        if (p->scene != a->scene || p->seed != a->seed ||
-            p->photons_per_channel != a->photons_per_channel)
+        if (p->seed != a->seed || p->photons_per_channel != a->photons_per_channel)
             return thz_error_set(err, THZ_ERR_INPUT,
-                                 "thz_photons_merge: part %zu has another scene, seed or photon "
-                                 "count than part 0",
+                                 "thz_photons_merge: part %zu has another seed or photon count "
+                                 "than part 0",
                                  i);
+        thz_status fits = api_merge_fits(p, a, i, err);
+        if (fits != THZ_OK)
+            return fits;
         /* the same photons twice would count as twice as many */
         for (size_t j = 0; j < i; j++)
             if (parts[j] == p)

@@ -41,6 +41,57 @@ static void check_kept_photons(thz_context *ctx, const thz_scene *scene)
     thz_run_destroy(run);
 }
 
+/* Parts fired for another handle of the same scene merge as parts of one handle do
+ * (they were refused: "another scene"), and the merged set renders the same bytes; a
+ * handle of a scene with a plate 1 K warmer is refused naming the part and what differs. */
+static void check_other_handles(thz_context *ctx, const thz_scene *scene)
+{
+    thz_error err = {0};
+    thz_scene *twin = NULL, *warmer = NULL;
+    char *warm = test_scene_with("\"temperature_k\": 310", "\"temperature_k\": 311");
+    REQUIRE_OK(thz_scene_load_string(test_scene_json, NULL, "twin.json", &twin, &err), &err);
+    REQUIRE_OK(thz_scene_load_string(warm, NULL, "warmer.json", &warmer, &err), &err);
+    thz_run_settings settings = {.photons_per_channel = 2000};
+    thz_photons *first = NULL, *own = NULL, *other = NULL, *warm_part = NULL;
+    REQUIRE_OK(thz_photons_fire(ctx, scene, &settings, &first, &err), &err);
+    settings.first_photon = 2000;
+    REQUIRE_OK(thz_photons_fire(ctx, scene, &settings, &own, &err), &err);
+    REQUIRE_OK(thz_photons_fire(ctx, twin, &settings, &other, &err), &err);
+    REQUIRE_OK(thz_photons_fire(ctx, warmer, &settings, &warm_part, &err), &err);
+    const thz_photons *one[2] = {first, own}, *two[2] = {first, other};
+    const thz_photons *bad[2] = {first, warm_part};
+    thz_photons *a = NULL, *b = NULL, *refused = (thz_photons *)&err;
+    REQUIRE_OK(thz_photons_merge(ctx, one, 2, &a, &err), &err);
+    REQUIRE_OK(thz_photons_merge(ctx, two, 2, &b, &err), &err);
+    thz_run *ra = NULL, *rb = NULL;
+    thz_run_settings render = {0};
+    REQUIRE_OK(thz_render_run(ctx, scene, a, -1, &render, &ra, &err), &err);
+    REQUIRE_OK(thz_render_run(ctx, scene, b, -1, &render, &rb, &err), &err);
+    const thz_image *ia = thz_run_image(ra, 0), *ib = thz_run_image(rb, 0);
+    size_t na = 0, nb = 0;
+    const float *pa = thz_image_plane(ia, THZ_PLANE_RADIANCE, &na);
+    const float *pb = thz_image_plane(ib, THZ_PLANE_RADIANCE, &nb);
+    size_t values = (size_t)thz_image_columns(ia) * thz_image_rows(ia) * na;
+    CHECK(pa && pb && na == nb && values > 0 && !memcmp(pa, pb, values * sizeof *pa),
+          "the merge of two handles' parts renders other bytes than one handle's");
+    thz_status st = thz_photons_merge(ctx, bad, 2, &refused, &err);
+    CHECK(st == THZ_ERR_INPUT && strstr(err.message, "part 1") &&
+              strstr(err.message, "made from another scene (materials, temperatures"),
+          "a warmer scene's part: %s: %s", thz_status_name(st), err.message);
+    CHECK(refused == NULL, "a refused merge returned photons");
+    thz_run_destroy(ra);
+    thz_run_destroy(rb);
+    thz_photons_destroy(a);
+    thz_photons_destroy(b);
+    thz_photons_destroy(first);
+    thz_photons_destroy(own);
+    thz_photons_destroy(other);
+    thz_photons_destroy(warm_part);
+    thz_scene_destroy(twin);
+    thz_scene_destroy(warmer);
+    free(warm);
+}
+
 int main(int argc, char **argv)
 {
     (void)argc;
@@ -51,6 +102,7 @@ int main(int argc, char **argv)
     thz_context *ctx = thz_context_create();
     thz_context_set_threads(ctx, 1);
     check_kept_photons(ctx, scene);
+    check_other_handles(ctx, scene);
     thz_run_settings settings = {.photons_per_channel = 2000};
     thz_photons *part[3] = {NULL, NULL, NULL};
     /* channel 0 alone; channel 1 as a map of L (photon-map, T0 0) and, with other photon

@@ -312,8 +312,9 @@ def test_sensors_by_name_or_index_and_their_shapes(tiny_dir):
 
 def test_photon_map_accessors(tiny_dir):
     """A map's seed is the whole 64-bit seed fired with; has_channel takes the scene's
-    channels only; maps of two Scene objects (even of one file) do not merge; a run's
-    summary says the scene's load time."""
+    channels only; maps of two Scene objects of one file merge as maps of one Scene do
+    (they were refused: 'different Scene objects'), and those of a scene that differs are
+    refused saying what differs; a run's summary says the scene's load time."""
     scene = thzmap.load_scene(tiny_dir / "scene.json")
     seed = (1 << 40) + 3  # above 32 bits
     a = thzmap.fire_photons(scene, photons=500, seed=seed)
@@ -323,8 +324,20 @@ def test_photon_map_accessors(tiny_dir):
         a.has_channel(2)
     other = thzmap.load_scene(tiny_dir / "scene.json")
     b = thzmap.fire_photons(other, photons=500, seed=seed, first_photon=500)
-    with pytest.raises(thzmap.ArgumentError, match="different Scene objects"):
-        thzmap.merge_photon_maps([a, b])
+    same = thzmap.fire_photons(scene, photons=500, seed=seed, first_photon=500)
+    merged = thzmap.merge_photon_maps([a, b])
+    assert merged.scene is scene and merged.photons_per_channel == 1000
+    want = thzmap.render(scene, thzmap.merge_photon_maps([a, same]))
+    got = thzmap.render(scene, merged)
+    assert np.array_equal(got.image("cam").radiance, want.image("cam").radiance)
+    with open(tiny_dir / "scene.json") as f:
+        warmer = json.load(f)
+    for o in warmer["objects"]:
+        o["temperature_k"] = o.get("temperature_k", 300) + 1
+    c = thzmap.fire_photons(thzmap.scene_from_dict(warmer, base_dir=tiny_dir), photons=500,
+                            seed=seed, first_photon=500)
+    with pytest.raises(thzmap.Error, match="part 1 .* made from another scene"):
+        thzmap.merge_photon_maps([a, c])
     assert scene.seconds_load > 0
     run = thzmap.render(scene, a)
     assert run.summary["timings_s"]["load"] == pytest.approx(scene.seconds_load, rel=1e-6)
