@@ -494,8 +494,9 @@ def _render_map_arg(scene, photon_map, integrator, seed):
         raise ArgumentError(f"photon_map: expected a PhotonMap or a path, got "
                             f"{type(photon_map).__name__}")
     effective = _effective_integrator(scene, integrator)
-    if photon_map is None and path is None and \
-            _lib.lib.thz_integrator_needs_photons(effective.encode()):
+    if not _lib.lib.thz_integrator_needs_photons(effective.encode()):
+        return None, None  # unused (render warns), as `thzmap render` drops it: seed counts
+    if photon_map is None and path is None:
         raise ArgumentError(f"photon_map: the {effective} integrator renders from a photon "
                             "map; give one (or integrator='path')")
     if seed is not None and (photon_map is not None or path is not None):
