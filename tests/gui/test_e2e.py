@@ -46,9 +46,21 @@ def main():
         wait.until(lambda d: "valid" in by_id("validation-state").text and "✓" in by_id("validation-state").text)
         names = [o["name"] for o in scene["objects"]]
         readouts.temperature_colours(driver, by_id, scene)
-        # the box's wall does not attenuate: its α plot is flat at 0, on an axis from 0 up
-        # (a flat curve's axis once ran -0.5 to 0.5 1/m)
+        # the box is a solid: opaque, no α through it (its plot said α = 0 1/m, as if
+        # the wall let everything through)
         click_list("objects", "box")
+        opaque = lambda d: d.execute_script(
+            "return document.querySelector('#material-plots .opaque')?.textContent || ''")
+        wait.until(lambda d: opaque(d).startswith("α: none through box, a solid: opaque"))
+        assert "α (1/m)" not in by_id("material-plots").text, by_id("material-plots").text
+        # made a shell, its wall does not attenuate: its α plot is flat at 0, on an axis
+        # from 0 up (a flat curve's axis once ran -0.5 to 0.5 1/m)
+        text = by_id("scene-text").get_attribute("value")
+        shell = json.loads(text)
+        shell["objects"][0].update(type="shell", thickness_m=0.001)
+        set_text = ("const t = document.getElementById('scene-text'); t.value = arguments[0];"
+                    "t.dispatchEvent(new Event('input'));")
+        driver.execute_script(set_text, json.dumps(shell, indent=2))
         alpha_ticks = lambda d: d.execute_script(
             "const svg = [...document.querySelectorAll('#material-plots svg')].find((s) =>"
             " [...s.querySelectorAll('text')].some((t) => t.textContent === 'α (1/m)'));"
@@ -61,6 +73,9 @@ def main():
         # drawn upwards: a larger value higher up (a smaller y in the SVG)
         heights = [y for _, y in sorted(alpha_ticks(driver), key=lambda t: float(t[0]))]
         assert heights == sorted(heights, reverse=True), alpha_ticks(driver)
+        assert not opaque(driver), opaque(driver)
+        driver.execute_script(set_text, text)  # a solid again
+        wait.until(lambda d: opaque(d))
         c = names.index("cylinder-C")
         click_list("objects", "cylinder-C")
         path = f"objects[{c}].temperature_k"

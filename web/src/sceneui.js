@@ -363,7 +363,18 @@ export class SceneEditor {
       if (sp.emissivity) series.push({ label: "ε", x: f, y: sp.emissivity });
       if (series.length) linePlot(box, series, { xLabel: "frequency (THz)", yLabel: "R, ε (1)", yMin: 0, yMax: 1 });
       const alpha = sp.alpha_per_m || sp.alpha;
-      if (alpha) linePlot(box, [{ label: "α", x: f, y: alpha }], { xLabel: "frequency (THz)", yLabel: "α (1/m)", yMin: 0 });
+      // α acts inside shells alone: a solid is opaque, and its α (0 when the material gives
+      // none) would read as "transparent" (physics.md "Surfaces")
+      const validated = this.info?.objects?.[this.selection.index]; // as the spectra: the last valid state
+      if (alpha && (validated?.type ?? o?.type) === "solid") {
+        const note = document.createElement("p");
+        note.className = "note opaque";
+        note.textContent = `α: none through ${o.name ?? "this object"}, a solid: opaque (nothing passes ` +
+          "through it; a material's α acts inside shells)";
+        box.appendChild(note);
+      } else if (alpha) {
+        linePlot(box, [{ label: "α", x: f, y: alpha }], { xLabel: "frequency (THz)", yLabel: "α (1/m)", yMin: 0 });
+      }
       const nk = [];
       if (sp.n) nk.push({ label: "n", x: f, y: sp.n });
       if (sp.k) nk.push({ label: "k", x: f, y: sp.k });
