@@ -140,11 +140,16 @@ bool serve_path_inside(const serve *s, const char *path);
  * opened (or only with O_NONBLOCK, and closed again). The descriptor, or -1 with errno
  * set; EINVAL: not a regular file. */
 int serve_open_regular(const char *path);
-/* Reads a whole regular file (at most max bytes) into a malloc'd NUL-terminated buffer. */
+/* Reads a whole regular file (at most max bytes) into a malloc'd NUL-terminated buffer;
+ * NULL with errno set (EINVAL not a regular file, EFBIG larger than max, EIO cut short). */
 char *serve_read_file(const char *path, size_t max, size_t *size);
 
 /* The JSON document of a regular file (serve_read_file: a FIFO does not block), or NULL. */
 json_t *serve_read_json(const char *path);
+/* The same, NULL with why "" when there is no such file, NULL with why naming the file
+ * and what is wrong when it is there but cannot be read or parsed (the JSON's line and
+ * column): a damaged file is told apart from one that is absent. */
+json_t *serve_read_json_why(const char *path, char *why, size_t size);
 
 /* ---- endpoints ----------------------------------------------------------------------- */
 typedef enum MHD_Result (*serve_handler)(serve_request *r);

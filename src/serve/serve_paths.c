@@ -161,10 +161,37 @@ int serve_open_regular(const char *path)
 
 json_t *serve_read_json(const char *path)
 {
+    char why[256];
+    return serve_read_json_why(path, why, sizeof why);
+}
+
+json_t *serve_read_json_why(const char *path, char *why, size_t size)
+{
     size_t n = 0;
+    why[0] = '\0';
+    errno = 0;
     char *text = serve_read_file(path, SERVE_MAX_FILE_BYTES, &n);
-    json_t *doc = text ? json_loadb(text, n, 0, NULL) : NULL;
+    if (!text) {
+        if (errno == EINVAL)
+            snprintf(why, size, "%s: not a regular file", path);
+        else if (errno == EFBIG)
+            snprintf(why, size, "%s: larger than the %u MiB read", path,
+                     SERVE_MAX_FILE_BYTES >> 20);
+        else if (errno == EACCES)
+            snprintf(why, size, "%s: permission denied", path);
+        else if (errno != ENOENT)
+            snprintf(why, size, "%s: %s", path, errno ? strerror(errno) : "cannot be read");
+        return NULL;
+    }
+    json_error_t error;
+    json_t *doc = json_loadb(text, n, 0, &error);
     free(text);
+    if (!doc) { /* the parser's words may quote bytes that are not UTF-8 */
+        snprintf(why, size, "%s: line %d, column %d: %s", path, error.line, error.column,
+                 error.text);
+        serve_text_fit(why);
+        serve_text_utf8(why);
+    }
     return doc;
 }
 
@@ -179,12 +206,14 @@ char *serve_read_file(const char *path, size_t max, size_t *size)
     }
     struct stat st;
     char *buf = NULL;
-    if (fstat(fileno(f), &st) == 0 && (uint64_t)st.st_size <= max &&
-        (buf = malloc((size_t)st.st_size + 1))) {
+    if (fstat(fileno(f), &st) == 0 && (uint64_t)st.st_size > max)
+        errno = EFBIG;
+    else if (fstat(fileno(f), &st) == 0 && (buf = malloc((size_t)st.st_size + 1))) {
         size_t n = fread(buf, 1, (size_t)st.st_size, f);
         if (n != (size_t)st.st_size) {
             free(buf);
             buf = NULL;
+            errno = EIO;
         } else {
             buf[n] = '\0';
             if (size)

@@ -82,8 +82,20 @@ enum MHD_Result serve_outputs(serve_request *r)
     char **names = serve_dir_names(dir, &n);
     if (!names && n == 0 && !serve_is_dir(dir, "."))
         return serve_reply_error(r, 400, "%s: not a directory", dir);
-    snprintf(path, sizeof path, "%s/summary.json", dir);
-    json_t *summary = serve_read_json(path);
+    /* a summary.json that is there but damaged is said so, not shown as none */
+    size_t dl = strlen(dir);
+    while (dl > 1 && dir[dl - 1] == '/')
+        dl--;
+    snprintf(path, sizeof path, "%.*s%ssummary.json", strcmp(dir, ".") ? (int)dl : 0, dir,
+             strcmp(dir, ".") ? "/" : "");
+    char why[PATH_MAX + 256];
+    json_t *summary = serve_read_json_why(path, why, sizeof why);
+    if (summary && !json_is_object(summary)) {
+        snprintf(why, sizeof why, "%s: expected a JSON object, got %s", path,
+                 json_is_array(summary) ? "an array" : "another value");
+        json_decref(summary);
+        summary = NULL;
+    }
     json_t *sensors = json_array(), *frames = json_array();
     bool photon_map = false;
     /* the sensors: from S.QUANTITY.hdr of a known quantity (sensor names may hold dots) */
@@ -150,9 +162,10 @@ enum MHD_Result serve_outputs(serve_request *r)
         pm = strcmp(dir, ".") == 0 ? json_string("photon-map.thzpm")
                                    : json_sprintf("%s/photon-map.thzpm", rel);
     return serve_reply_json(r, 200,
-                            json_pack("{s:s, s:o, s:o, s:o, s:o}", "dir", rel, "summary",
-                                      summary ? summary : json_null(), "sensors", sensors, "frames",
-                                      frames, "photon_map", pm));
+                            json_pack("{s:s, s:o, s:o, s:o, s:o, s:o}", "dir", rel, "summary",
+                                      summary ? summary : json_null(), "summary_error",
+                                      why[0] ? serve_json_text(why) : json_null(), "sensors",
+                                      sensors, "frames", frames, "photon_map", pm));
 }
 
 /* One run's band of sensor s: Tb and its standard error (NaN when the run has no

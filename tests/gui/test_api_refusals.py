@@ -74,8 +74,10 @@ def test_files(srv, root):
     os.makedirs(os.path.join(root, "f"), exist_ok=True)
     if not os.path.exists(os.path.join(root, "f", "summary.json")):
         os.mkfifo(os.path.join(root, "f", "summary.json"))
-    st, _ = get_within(srv, "/api/outputs?dir=f", 5)
+    st, res = get_within(srv, "/api/outputs?dir=f", 5)
     check(st is not None, "GET /api/outputs of a directory whose summary.json is a FIFO hung")
+    check(res["summary"] is None and res["summary_error"] == "f/summary.json: not a regular file",
+          "a FIFO as summary.json: %r" % res)
     err = srv.json("POST", "/api/runs", body={"command": "simulate", "scene": "s/fifo.json",
                                                "out": "o"}, status=400)
     check(err and err.get("path") == "$.scene" and "not a regular file" in err["error"],

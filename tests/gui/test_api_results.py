@@ -183,6 +183,27 @@ def test_outputs(root, srv):
     os.remove(os.path.join(root, "photon-map.thzpm"))
     err = srv.json("GET", "/api/outputs?dir=s/scene.json", status=400)
     check(err and "not a directory" in err.get("error", ""), "outputs of a file: %r" % err)
+    # a summary.json that is there but damaged: said so, naming the file and where the
+    # JSON breaks (it was "summary": null, as for a directory with none)
+    res = srv.json("GET", "/api/outputs?dir=out/a")
+    check(res and isinstance(res["summary"], dict) and res["summary_error"] is None,
+          "a run's summary: %r" % (res and res.get("summary_error")))
+    copy_run(root, "a", "cut", drop=("photon-map",))
+    path = os.path.join(root, "out", "cut", "summary.json")
+    text = open(path).read()
+    open(path, "w").write(text[:len(text) // 2])
+    res = srv.json("GET", "/api/outputs?dir=out/cut/")
+    why = res and res.get("summary_error") or ""
+    check(res and res["summary"] is None and why.startswith("out/cut/summary.json: line ")
+          and ", column " in why, "a summary cut in half: %r" % why)
+    open(path, "w").write("[1, 2]")
+    res = srv.json("GET", "/api/outputs?dir=out/cut")
+    check(res and res["summary"] is None and res["summary_error"] ==
+          "out/cut/summary.json: expected a JSON object, got an array", "an array: %r" % res)
+    os.remove(path)
+    res = srv.json("GET", "/api/outputs?dir=out/cut")
+    check(res and res["summary"] is None and res["summary_error"] is None,
+          "no summary.json: %r" % (res and res.get("summary_error")))
     # a sweep's frames, without a batch.json (docs/gui.md: sweep-NN/frame-NNNNN)
     for d in ("sweep-01/frame-00000", "sweep-01/frame-00001", "sweep-02/frame-00000"):
         os.makedirs(os.path.join(root, "out", "sw", d))

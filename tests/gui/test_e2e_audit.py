@@ -11,7 +11,7 @@ scene, a `bands` run and a batch: files that broke the scene panels, runs starte
 the Run tab (of the path integrator, failing, refused, eight queued), a bands run's
 directory in Results, edits not saved, a library material, a narrow window, the A/B
 difference of the channel chosen, the value of the image clicked, the integrator chosen in
-the Run tab. Screenshots go to
+the Run tab; a damaged summary.json (e2e_view.py). Screenshots go to
 SCREENSHOT_DIR/gui-*.png."""
 import json
 import os
@@ -28,6 +28,7 @@ from selenium.webdriver.support.ui import Select
 import e2e_readouts as readouts
 import e2e_session
 import e2e_user as user
+import e2e_view as view
 from e2e_session import log
 
 THZMAP, REPO, SHOTS = sys.argv[1], sys.argv[2], sys.argv[3]
@@ -344,6 +345,9 @@ def main():
         ran = user.run_integrator(driver, wait, by_id, root, "teraeye/saved-as.json", "teraeye/out-integrator")
         log(f"library material {lib} chosen, legend {legend} in its curves' colours; 3D view {width} px "
             f"at 800 px; {diff!r}; a path scene run as {ran} ({time.monotonic() - t_user:.1f} s)")
+        # the run the Run tab started last opens in Results when done: not over those below
+        wait.until(lambda d: d.execute_script("return window.thzmap.results.base") == "teraeye/out-integrator/cam")
+        log(view.damaged_summary(driver, wait, by_id, click_list, root))
     except Exception:
         s.failed()
         raise

@@ -85,6 +85,7 @@ export class Results {
     const [entries, outputs] = await Promise.all([this.browse(dir), getJSON(`/api/outputs?dir=${q(dir)}`)]);
     if (seq !== this.openSeq) return; // another directory was asked for meanwhile
     this.setView($("res-view").value); // a bands run's pane, shown before, hidden
+    summaryNote(outputs);
     this.frames = outputs.frames.map((f) => join(dir, f));
     $("frames").hidden = this.frames.length === 0;
     if (this.frames.length) {
@@ -112,7 +113,9 @@ export class Results {
   async openFrame(i) {
     const dir = this.frames[i];
     $("frame-name").textContent = `${dir.split("/").slice(-2).join("/")} (${i + 1}/${this.frames.length})`;
-    return this.openRun(dir, await getJSON(`/api/outputs?dir=${q(dir)}`));
+    const outputs = await getJSON(`/api/outputs?dir=${q(dir)}`);
+    summaryNote(outputs);
+    return this.openRun(dir, outputs);
   }
 
   play() {
@@ -389,6 +392,14 @@ function paint(canvas, cube, values, lo, hi, map, ignore) {
     img.data[o + 3] = 255;
   }
   g.putImageData(img, 0, 0);
+}
+
+// A summary.json that is there but damaged (/api/outputs' summary_error): said above the
+// image, which the cubes still give (the run's options, seed and warnings are not known)
+function summaryNote(outputs) {
+  const note = $("res-note");
+  note.hidden = !outputs.summary_error;
+  note.textContent = outputs.summary_error ? `damaged: ${outputs.summary_error} (the run's settings and warnings are not known)` : "";
 }
 
 // the sensors of an /api/outputs answer that have brightness temperature images
