@@ -36,6 +36,12 @@ export class Results {
     for (const id of ["diff-a", "diff-b"]) $(id).addEventListener("input", () => (this.diffTyped = true));
     $("frame").oninput = () => this.openFrame(Number($("frame").value)).catch(reportError);
     $("btn-play").onclick = () => this.play();
+    // the images drawn again at the window's new size (they kept the old one: cut off at
+    // the pane's edge, or small in a window made larger); the tabs send one when shown
+    window.addEventListener("resize", () => {
+      cancelAnimationFrame(this.refit);
+      this.refit = requestAnimationFrame(() => ["image", "diff-image"].forEach((id) => fit($(id))));
+    });
     $("btn-photons").onclick = () => this.loadPhotons().catch(reportError);
   }
 
@@ -52,6 +58,7 @@ export class Results {
       $(id).closest("label").hidden = !shown;
     }
     if (view === "photons") this.photons?.resize();
+    else fit($(view === "diff" ? "diff-image" : "image")); // the window may have changed meanwhile
   }
 
   async browse(dir) {
@@ -213,9 +220,9 @@ export class Results {
   }
 
   pixelOf(e, canvas, cube) {
-    const r = canvas.getBoundingClientRect();
-    const col = Math.floor(((e.clientX - r.left) / r.width) * cube.cols);
-    const row = Math.floor(((e.clientY - r.top) / r.height) * cube.rows);
+    const r = canvas.getBoundingClientRect(); // the border's width left out: the image's box
+    const col = Math.floor(((e.clientX - r.left - canvas.clientLeft) / canvas.clientWidth) * cube.cols);
+    const row = Math.floor(((e.clientY - r.top - canvas.clientTop) / canvas.clientHeight) * cube.rows);
     return [Math.min(Math.max(row, 0), cube.rows - 1), Math.min(Math.max(col, 0), cube.cols - 1)];
   }
 
@@ -368,12 +375,8 @@ export class Results {
 function paint(canvas, cube, values, lo, hi, map, ignore) {
   canvas.width = cube.cols;
   canvas.height = cube.rows;
-  // up to 512 px a side, less in a narrow window (the colour bar beside it, 110 px)
-  const room = (canvas.closest("#image-pane, #diff-pane")?.clientWidth || 0) - 126;
-  const side = room > 0 ? Math.min(512, room) : 512;
-  const zoom = Math.max(1, Math.floor(side / Math.max(cube.cols, cube.rows)));
-  canvas.style.width = `${cube.cols * zoom}px`;
-  canvas.style.height = `${cube.rows * zoom}px`;
+  canvas.dataset.painted = "1";
+  fit(canvas);
   const g = canvas.getContext("2d");
   const img = g.createImageData(cube.cols, cube.rows);
   const lut = Array.from({ length: 256 }, (_, i) => map(i / 255));
@@ -392,6 +395,21 @@ function paint(canvas, cube, values, lo, hi, map, ignore) {
     img.data[o + 3] = 255;
   }
   g.putImageData(img, 0, 0);
+}
+
+// The image's size on screen: a whole number of screen pixels per pixel, up to 512 px a
+// side, less in a narrow pane (the colour bar beside it, 110 px); again at every resize.
+// A pane out of sight (another tab) has no width: the size waits for the next resize.
+function fit(canvas) {
+  if (!canvas.dataset.painted) return;
+  const pane = canvas.closest("#image-pane, #diff-pane");
+  const width = pane?.clientWidth || 0;
+  if (!width && canvas.style.width) return;
+  const room = width - 128;
+  const side = room > 0 ? Math.min(512, room) : 512;
+  const zoom = Math.max(1, Math.floor(side / Math.max(canvas.width, canvas.height)));
+  canvas.style.width = `${canvas.width * zoom}px`;
+  canvas.style.height = `${canvas.height * zoom}px`;
 }
 
 // A summary.json that is there but damaged (/api/outputs' summary_error): said above the
