@@ -1,19 +1,76 @@
 """The Results view as a user looks at it (for test_e2e_audit.py, session 57), each a fault
-noticed and left by earlier sessions: the image kept its size when the window was
-resized (cut off at the pane's edge in a narrower one); a summary.json that was there
-but damaged was shown as no summary at all. Each check failed before its fix (web/src,
-src/serve/serve_results.c)."""
+noticed and left by earlier sessions: the pixel clicked had no mark on the image, so the
+Pixel column's spectrum was of a pixel the user had to remember; the image kept its size
+when the window was resized (cut off at the pane's edge in a narrower one); a
+summary.json that was there but damaged was shown as no summary at all. Each check
+failed before its fix (web/src, src/serve/serve_results.c)."""
 import os
 import shutil
 
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
+import e2e_readouts as readouts
+
+GEOMETRY = ("const c = document.getElementById(arguments[0]); const r = c.getBoundingClientRect();"
+            "const m = document.getElementById(arguments[0] + '-marker');"
+            "const box = m.hasAttribute('hidden') ? null : m.querySelector('path.over').getBoundingClientRect();"
+            "const over = m.querySelector('path.over'), under = m.querySelector('path.under');"
+            "return {left: r.left + c.clientLeft, top: r.top + c.clientTop, width: c.clientWidth,"
+            " height: c.clientHeight, box: box && [box.left, box.top, box.width, box.height],"
+            " shown: !m.hasAttribute('hidden') && getComputedStyle(m).display !== 'none',"
+            " strokes: over && [getComputedStyle(over).stroke, getComputedStyle(under).stroke],"
+            " at: [m.dataset.row, m.dataset.col]};")
+
+
+def marked_at(driver, canvas_id, size, row, col):
+    """The mark is shown, white over black, centred on pixel (row, col) of the image as
+    drawn now (to a screen pixel), a box at least as large as the pixel and 9 px."""
+    g = driver.execute_script(GEOMETRY, canvas_id)
+    assert g["shown"] and g["box"], f"no mark on the pixel clicked: {g}"
+    assert g["strokes"] == ["rgb(255, 255, 255)", "rgb(0, 0, 0)"], g["strokes"]
+    cell = g["width"] / size[1]
+    x, y = g["left"] + (col + 0.5) * cell, g["top"] + (row + 0.5) * cell
+    bx, by, bw, bh = g["box"]  # the ticks included: the box's centre is the path's
+    assert abs(bx + bw / 2 - x) <= 1 and abs(by + bh / 2 - y) <= 1, \
+        f"mark centred at ({bx + bw / 2}, {by + bh / 2}), pixel ({row}, {col}) at ({x}, {y}); {g}"
+    assert bw >= max(cell, 9) + 12, f"mark {bw} px for a pixel of {cell} px"
+    assert g["at"] == [str(row), str(col)], g["at"]
+    return cell
+
 
 def open_run(driver, wait, by_id, out):
     driver.execute_script("window.thzmap.showTab('results'); window.thzmap.results.open(arguments[0])", out)
     wait.until(lambda d: f"{out}/cam:" in by_id("status").text and "loaded" in by_id("status").text)
     Select(by_id("res-view")).select_by_value("image")
+
+
+def marker(driver, wait, by_id, shot, size, row, col):
+    """A pixel clicked is marked on the image (of the run open, size rows x columns); the
+    mark stays on it when the image is drawn again (another channel) and moves with it
+    when the window narrows."""
+    Select(by_id("res-quantity")).select_by_value("brightness_temperature")
+    readouts.click_pixel(driver, wait, by_id, "image", size[0], size[1], row, col)
+    wait.until(lambda d: by_id("pixel-info").get_attribute("data-row") == str(row)
+               and by_id("pixel-info").get_attribute("data-col") == str(col))
+    wide = marked_at(driver, "image", size, row, col)
+    shot("marker")
+    channel = Select(by_id("res-channel"))
+    channel.select_by_index(3)
+    wait.until(lambda d: by_id("image-info").text.startswith("brightness temperature, channel 4 ("))
+    marked_at(driver, "image", size, row, col)
+    window = driver.get_window_size()
+    try:
+        driver.set_window_size(800, 600)
+        wait.until(lambda d: driver.execute_script(GEOMETRY, "image")["width"] < size[1] * wide)
+        narrow = marked_at(driver, "image", size, row, col)
+        shot("marker-800")
+    finally:
+        driver.set_window_size(window["width"], window["height"])
+    wait.until(lambda d: driver.execute_script(GEOMETRY, "image")["width"] == size[1] * wide)
+    marked_at(driver, "image", size, row, col)
+    channel.select_by_index(0)
+    return f"pixel ({row}, {col}) marked: {wide:g} px a pixel at 1400 px, {narrow:g} px at 800 px"
 
 
 def fits_window(driver, wait, by_id, shot):

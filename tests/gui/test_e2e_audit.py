@@ -11,7 +11,7 @@ scene, a `bands` run and a batch: files that broke the scene panels, runs starte
 the Run tab (of the path integrator, failing, refused, eight queued), a bands run's
 directory in Results, edits not saved, a library material, a narrow window, the A/B
 difference of the channel chosen, the value of the image clicked, the integrator chosen in
-the Run tab; the image at the window's size, a damaged summary.json (e2e_view.py). Screenshots go to
+the Run tab; the clicked pixel's mark, the image at the window's size, a damaged summary.json (e2e_view.py). Screenshots go to
 SCREENSHOT_DIR/gui-*.png."""
 import json
 import os
@@ -348,6 +348,7 @@ def main():
         # the run the Run tab started last opens in Results when done: not over those below
         wait.until(lambda d: d.execute_script("return window.thzmap.results.base") == "teraeye/out-integrator/cam")
         log(view.fits_window(driver, wait, by_id, shot))
+        log(view.marker(driver, wait, by_id, shot, (32, 32), row, col))
         log(view.damaged_summary(driver, wait, by_id, click_list, root))
     except Exception:
         s.failed()

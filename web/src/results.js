@@ -219,11 +219,18 @@ export class Results {
     });
   }
 
+  // the pixel under a click, and marked so on the image (the other image's mark dropped:
+  // the Pixel column holds one pixel)
   pixelOf(e, canvas, cube) {
     const r = canvas.getBoundingClientRect(); // the border's width left out: the image's box
     const col = Math.floor(((e.clientX - r.left - canvas.clientLeft) / canvas.clientWidth) * cube.cols);
     const row = Math.floor(((e.clientY - r.top - canvas.clientTop) / canvas.clientHeight) * cube.rows);
-    return [Math.min(Math.max(row, 0), cube.rows - 1), Math.min(Math.max(col, 0), cube.cols - 1)];
+    const at = [Math.min(Math.max(row, 0), cube.rows - 1), Math.min(Math.max(col, 0), cube.cols - 1)];
+    for (const c of [$("image"), $("diff-image")]) {
+      c.dataset.mark = c === canvas ? at.join(",") : "";
+      drawMarker(c);
+    }
+    return at;
   }
 
   async click(e, canvas) {
@@ -410,6 +417,31 @@ function fit(canvas) {
   const zoom = Math.max(1, Math.floor(side / Math.max(canvas.width, canvas.height)));
   canvas.style.width = `${canvas.width * zoom}px`;
   canvas.style.height = `${canvas.height * zoom}px`;
+  drawMarker(canvas);
+}
+
+// The mark of the pixel clicked (canvas.dataset.mark "row,col"), over the image as drawn:
+// a box around the pixel, at least 9 px, with a tick out of each side.
+function drawMarker(canvas) {
+  const svg = $(`${canvas.id}-marker`);
+  const [row, col] = (canvas.dataset.mark || "").split(",").map(Number);
+  const cell = canvas.clientWidth / canvas.width;
+  if (!canvas.dataset.mark || !(row < canvas.height && col < canvas.width) || !cell) {
+    svg.toggleAttribute("hidden", true); // an SVG element has no .hidden of its own
+    return;
+  }
+  Object.assign(svg.style, { left: `${canvas.offsetLeft + canvas.clientLeft}px`,
+    top: `${canvas.offsetTop + canvas.clientTop}px`, width: `${canvas.clientWidth}px`, height: `${canvas.clientHeight}px` });
+  const x = (col + 0.5) * cell;
+  const y = (row + 0.5) * cell;
+  const h = Math.max(cell, 9) / 2 + 1;
+  const t = h + 6;
+  const d = `M${x - h},${y - h}h${2 * h}v${2 * h}h${-2 * h}z M${x},${y - h}V${y - t} M${x},${y + h}V${y + t}` +
+    ` M${x - h},${y}H${x - t} M${x + h},${y}H${x + t}`;
+  svg.innerHTML = `<path class="under" d="${d}"/><path class="over" d="${d}"/>`;
+  svg.dataset.row = row;
+  svg.dataset.col = col;
+  svg.toggleAttribute("hidden", false);
 }
 
 // A summary.json that is there but damaged (/api/outputs' summary_error): said above the
