@@ -1,12 +1,16 @@
 """The Results view as a user looks at it (for test_e2e_audit.py, session 57), each a fault
 noticed and left by earlier sessions: the pixel clicked had no mark on the image, so the
 Pixel column's spectrum was of a pixel the user had to remember; the image kept its size
-when the window was resized (cut off at the pane's edge in a narrower one); a
-summary.json that was there but damaged was shown as no summary at all. Each check
-failed before its fix (web/src, src/serve/serve_results.c)."""
+when the window was resized (cut off at the pane's edge in a narrower one); a batch's
+frames were each coloured on their own scale, so one colour meant another temperature in
+the next frame; a summary.json that was there but damaged was shown as no summary at
+all. Each check failed before its fix (web/src, src/serve/serve_results.c)."""
+import json
 import os
+import re
 import shutil
 
+import numpy as np
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
@@ -100,6 +104,47 @@ def fits_window(driver, wait, by_id, shot):
         driver.set_window_size(window["width"], window["height"])
     wait.until(lambda d: size()[0] == wide, f"the image {size()[0]} px wide again, not {wide} px")
     return f"the image {wide} px wide at {window['width']} px, {at_800} px at 800 px, {wide} px again"
+
+
+def frames_scale(driver, wait, by_id, click_list, root, shot):
+    """A batch's frames on one colour scale, the 1st to 99th percentile over all its
+    frames, said in the caption and the colour bar; unlocked, each frame's own."""
+    driver.execute_script(readouts.HOOK)
+    driver.execute_script("window.thzmap.results.browse('teraeye')")
+    click_list("outputs", "out-batch/")
+    wait.until(lambda d: by_id("frames").is_displayed() and "(1/3)" in by_id("frame-name").text)
+    out = os.path.join(root, "teraeye", "out-batch")
+    dirs = [f["dir"] for f in json.load(open(os.path.join(out, "batch.json")))["frames"]]
+    tb = [np.fromfile(os.path.join(out, d, "cam.brightness_temperature.img"), "<f4").reshape(8, 12) for d in dirs]
+    lo, hi = readouts.percentiles(np.concatenate([t.ravel() for t in tb]))
+    own = readouts.percentiles(tb[2].ravel())
+    assert own[0] > lo + 10, f"the frames' temperatures barely differ: {own} against {lo, hi}"
+
+    def coloured(frame, lo, hi):
+        rgb = readouts.canvas_rgb(driver, "image")
+        want = readouts.viridis(np.round((tb[frame] - lo) * (255 / (hi - lo))) / 255)
+        return rgb.shape == want.shape and np.abs(rgb - want).max() <= 3
+
+    caption = lambda: by_id("image-info").get_attribute("textContent")
+    scale = r"percentile of all 3 frames \(one scale\): (\S+) to (\S+) K$"
+    assert by_id("frames-lock").is_selected(), "the frames' scale is not locked by default"
+    for frame in (0, 2):
+        driver.execute_script("window.canvasText = [];")
+        driver.execute_script("const f = document.getElementById('frame'); f.value = arguments[0];"
+                              "f.dispatchEvent(new Event('input'));", frame)
+        wait.until(lambda d: f"({frame + 1}/3)" in by_id("frame-name").text and coloured(frame, lo, hi),
+                   f"frame {frame + 1} not coloured over {lo} to {hi} K, the frames' percentiles: {caption()!r}")
+        m = re.search(scale, caption())
+        assert m and readouts.close(float(m.group(1)), lo) and readouts.close(float(m.group(2)), hi), \
+            (caption(), lo, hi)
+        labels, _ = readouts.bar_texts(driver, "colourbar")
+        assert readouts.close(labels[0], hi) and readouts.close(labels[-1], lo), (labels, lo, hi)
+    shot("frames")
+    by_id("frames-lock").click()  # each frame its own scale, as before
+    wait.until(lambda d: coloured(2, *own) and "frames" not in caption())
+    by_id("frames-lock").click()
+    wait.until(lambda d: coloured(2, lo, hi))
+    return f"frames on one scale, {lo:.2f} to {hi:.2f} K (frame 3's own: {own[0]:.2f} to {own[1]:.2f} K)"
 
 
 def damaged_summary(driver, wait, by_id, click_list, root):

@@ -11,7 +11,8 @@ scene, a `bands` run and a batch: files that broke the scene panels, runs starte
 the Run tab (of the path integrator, failing, refused, eight queued), a bands run's
 directory in Results, edits not saved, a library material, a narrow window, the A/B
 difference of the channel chosen, the value of the image clicked, the integrator chosen in
-the Run tab; the clicked pixel's mark, the image at the window's size, a damaged summary.json (e2e_view.py). Screenshots go to
+the Run tab; the clicked pixel's mark, the image at the window's size, a batch's frames on
+one colour scale and a damaged summary.json (e2e_view.py). Screenshots go to
 SCREENSHOT_DIR/gui-*.png."""
 import json
 import os
@@ -69,6 +70,14 @@ def make_root(root):
                     "-o", os.path.join(root, "teraeye", "out-bands-cli"), "--count", "2",
                     "--from-thz", "0.3", "--to-thz", "0.9", "--step-ghz", "100", "--paths", "4", "-q"],
                    check=True)
+    # a batch of three frames of the path scene, its walls warming from 280 to 340 K: each
+    # frame's own colour scale would give 280 K in the first the colour of 340 K in the last
+    with open(os.path.join(teraeye, "sequence.json"), "w") as f:
+        json.dump({"format": "thzmap-sequence/1", "scene": "path.json", "fps": 1, "frames": 3,
+                   "keyframes": [{"time_s": 0, "objects": {"box": {"temperature_k": 280}}},
+                                 {"time_s": 2, "objects": {"box": {"temperature_k": 340}}}]}, f)
+    run("batch", os.path.join(teraeye, "sequence.json"), "-o", os.path.join(teraeye, "out-batch"),
+        "--no-movies", "--threads", "2")
     return scene
 
 
@@ -349,6 +358,7 @@ def main():
         wait.until(lambda d: d.execute_script("return window.thzmap.results.base") == "teraeye/out-integrator/cam")
         log(view.fits_window(driver, wait, by_id, shot))
         log(view.marker(driver, wait, by_id, shot, (32, 32), row, col))
+        log(view.frames_scale(driver, wait, by_id, click_list, root, shot))
         log(view.damaged_summary(driver, wait, by_id, click_list, root))
     except Exception:
         s.failed()

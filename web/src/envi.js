@@ -63,12 +63,16 @@ export function forget(prefix) {
 
 // [lo, hi]: the 1st and 99th percentiles of the finite values that are not the ignore value
 // (a few hot pixels of a noisy run would take the whole scale); at most 200 000 sampled.
+// values: an array of numbers, or a list of them (a batch's frames) taken together.
 export function range(values, ignore) {
-  const step = Math.max(1, Math.floor(values.length / 200000));
+  const parts = Array.isArray(values) && values.length && typeof values[0] !== "number" ? values : [values];
+  const step = Math.max(1, Math.floor(parts.reduce((n, p) => n + p.length, 0) / 200000));
   const kept = [];
-  for (let i = 0; i < values.length; i += step) {
-    const v = values[i];
-    if (Number.isFinite(v) && v !== ignore) kept.push(v);
+  for (const part of parts) {
+    for (let i = 0; i < part.length; i += step) {
+      const v = part[i];
+      if (Number.isFinite(v) && v !== ignore) kept.push(v);
+    }
   }
   if (!kept.length) return [0, 1];
   const sorted = Float64Array.from(kept).sort();

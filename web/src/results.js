@@ -1,7 +1,7 @@
 // The post-processor: per-channel images with a colour bar in kelvin, truth maps, measured
 // cubes; a clicked pixel's spectrum with error bars and truth; A/B differences in units of
-// the combined standard error; batch frames played one after the other.
-import { getJSON, q, reportError, request, status } from "./api.js";
+// the combined standard error; batch frames played one after the other, on one colour scale.
+import { getBytes, getJSON, q, reportError, request, status } from "./api.js";
 import { forget, loadCube, range } from "./envi.js";
 import { cssColour, diverging, drawColourBar, formatNumber, planckDerivative, viridis } from "./colour.js";
 import { linePlot } from "./plots.js";
@@ -36,6 +36,7 @@ export class Results {
     for (const id of ["diff-a", "diff-b"]) $(id).addEventListener("input", () => (this.diffTyped = true));
     $("frame").oninput = () => this.openFrame(Number($("frame").value)).catch(reportError);
     $("btn-play").onclick = () => this.play();
+    $("frames-lock").onchange = () => this.show().catch(reportError);
     // the images drawn again at the window's new size (they kept the old one: cut off at
     // the pane's edge, or small in a window made larger); the tabs send one when shown
     window.addEventListener("resize", () => {
@@ -94,6 +95,7 @@ export class Results {
     this.setView($("res-view").value); // a bands run's pane, shown before, hidden
     summaryNote(outputs);
     this.frames = outputs.frames.map((f) => join(dir, f));
+    this.frameRanges = new Map(); // the colour scales over all frames, worked out once each
     $("frames").hidden = this.frames.length === 0;
     if (this.frames.length) {
       $("frame").max = this.frames.length - 1;
@@ -190,15 +192,52 @@ export class Results {
     const ignore = cube.ignore ?? (qn.includes("brightness") ? 0 : null);
     const names = cube.header["object names"];
     if (qn === "object_id" && names) return this.showObjects(cube, names);
-    const [lo, hi] = $("res-scale").value === "common" ? range(cube.data, ignore) : range(values, ignore);
+    const common = $("res-scale").value === "common";
+    // a batch's frame: the scale over all its frames (each its own made a colour mean
+    // another temperature in the next frame)
+    const locked = this.frames.length > 1 && this.frames.includes(this.runDir) && $("frames-lock").checked;
+    const all = locked ? await this.framesRange(qn, common ? null : band, ignore) : null;
+    const over = all?.frames ? all : null; // no frame's values read: this frame's own scale
+    if (this.shown !== cube) return; // another image was asked for meanwhile
+    const [lo, hi] = over ? over.range : common ? range(cube.data, ignore) : range(values, ignore);
     paint($("image"), cube, values, lo, hi, viridis, ignore);
     const unit = cube.unit === "1" ? "(1)" : cube.unit;
     drawColourBar($("colourbar"), lo, hi, unit);
     // the truth maps hold one band whatever the run; a one-channel run's cubes one channel
     const which = TRUTH.has(qn) ? "truth" : `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)`;
     $("image-info").textContent = `${qn.replace(/_/g, " ")}, ${which}; colours span the 1st to 99th ` +
-      `percentile${$("res-scale").value === "common" ? " of all channels" : ""}: ` +
+      `percentile${common ? " of all channels" : ""}${over ? ` of all ${over.frames} frames (one scale)` : ""}: ` +
       `${formatNumber(lo)} to ${formatNumber(hi)}${cube.unit === "1" ? "" : ` ${cube.unit}`}`;
+  }
+
+  // The 1st and 99th percentile of quantity qn (band, or all bands when null) over every
+  // frame of the batch open that has it: {range, frames}. Each frame's values are read
+  // once through /api/cube/data and sampled (range's 200 000 values over all frames), so
+  // that a long batch does not stay in memory; four requests at a time.
+  async framesRange(qn, band, ignore) {
+    const sensor = $("res-sensor").value;
+    const key = `${sensor}|${qn}|${band ?? "all"}`;
+    if (!this.frameRanges.has(key)) {
+      const frames = this.frames;
+      const per = Math.max(1, Math.floor(200000 / frames.length));
+      const parts = [];
+      let next = 0;
+      const worker = async () => {
+        while (next < frames.length) {
+          const path = `${frames[next++]}/${sensor}.${qn}.hdr`;
+          const values = new Float32Array(await getBytes(
+            `/api/cube/data?path=${q(path)}${band === null ? "" : `&band=${band}`}`).catch(() => new ArrayBuffer(0)));
+          if (!values.length) continue; // a frame without it (not finished, or not written)
+          const step = Math.max(1, Math.floor(values.length / per));
+          parts.push(Float32Array.from({ length: Math.ceil(values.length / step) }, (_, i) => values[i * step]));
+        }
+      };
+      const pending = Promise.all(Array.from({ length: Math.min(4, frames.length) }, worker))
+        .then(() => ({ range: range(parts, ignore), frames: parts.length }));
+      this.frameRanges.set(key, pending);
+      pending.catch(() => this.frameRanges.delete(key));
+    }
+    return this.frameRanges.get(key);
   }
 
   // the truth map of objects: one colour per object, named beside the picture
