@@ -265,7 +265,10 @@ typedef struct thz_run_totals {
     uint64_t photons_stored;
     uint64_t back_face_samples;
     size_t n_warnings;            /* the run's own (summary.json adds the scene's) */
-    double worst_median_stderr_k; /* largest median per-pixel standard error of Tb_c, K */
+    double worst_median_stderr_k; /* largest median per-pixel standard error of Tb_c, K;
+                                     these three are INFINITY when the figure falls on
+                                     pixels whose error is unknown (photon-map samples
+                                     short of photons: summary.json starved_pixels) */
     uint32_t max_passes;          /* most render passes of any channel */
     double seconds;               /* wall time of the run */
     double worst_p95_stderr_k;    /* largest 95th percentile of the per-pixel standard

@@ -428,7 +428,15 @@ int cli_run_command(int argc, char **argv, bool render)
                 printf(", %llu photons fired, %llu stored",
                        (unsigned long long)result.photons_fired,
                        (unsigned long long)result.photons_stored);
-            if (result.worst_p95_stderr_k > 0.0)
+            /* infinite: the figure falls on pixels whose samples were short of photons,
+             * whose error is unknown (not 0: their reflected radiance is missing) */
+            if (isinf(result.worst_median_stderr_k))
+                printf(", pixel standard error unknown (samples short of photons)");
+            else if (isinf(result.worst_p95_stderr_k))
+                printf(", pixel standard error: median <= %.3g K, 95th percentile unknown "
+                       "(samples short of photons)",
+                       result.worst_median_stderr_k);
+            else if (result.worst_p95_stderr_k > 0.0)
                 printf(", pixel standard error: median <= %.3g K, 95th percentile <= %.3g K",
                        result.worst_median_stderr_k, result.worst_p95_stderr_k);
             if (result.max_passes > 1)
@@ -447,9 +455,14 @@ int cli_run_command(int argc, char **argv, bool render)
                 size_t n = strlen(ch.name);
                 if (n < 4 || strcmp(ch.name + n - 4, " THz") != 0)
                     snprintf(freq, sizeof freq, " (%.4g THz)", ch.frequency_thz);
+                char value[64];
+                if (isinf(result.worst_object_p95_stderr_k))
+                    snprintf(value, sizeof value, "unknown (samples short of photons)");
+                else
+                    snprintf(value, sizeof value, "%.3g K", result.worst_object_p95_stderr_k);
                 printf("thzmap %s: noisiest object: '%s', 95th percentile standard error "
-                       "%.3g K at %s%s\n",
-                       cmd, obj.name, result.worst_object_p95_stderr_k, ch.name, freq);
+                       "%s at %s%s\n",
+                       cmd, obj.name, value, ch.name, freq);
             }
         }
     }

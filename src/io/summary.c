@@ -138,9 +138,11 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
     if (summary->noise) {
         sum_set(o, "median_stderr_k", sum_real(summary->noise[c].median_k), ok);
         sum_set(o, "p95_stderr_k", sum_real(summary->noise[c].p95_k), ok);
+        sum_set(o, "starved_pixels", sum_u64(summary->noise[c].unknown), ok);
     }
     if (summary->object_noise) {
-        /* per object: the pixels whose truth object_id is it (null figures: none) */
+        /* per object: the pixels whose truth object_id is it (null figures: none, or
+         * the rank falls on a pixel whose standard error is unknown) */
         json_t *objects = json_array();
         for (size_t i = 0; i < scene->n_objects; i++) {
             const run_noise *n = &summary->object_noise[c * scene->n_objects + i];
@@ -149,6 +151,7 @@ static json_t *sum_channel(const thz_scene *scene, size_t c, const run_summary *
             sum_set(e, "pixels", sum_u64(n->pixels), ok);
             sum_set(e, "median_stderr_k", n->pixels ? sum_real(n->median_k) : json_null(), ok);
             sum_set(e, "p95_stderr_k", n->pixels ? sum_real(n->p95_k) : json_null(), ok);
+            sum_set(e, "starved_pixels", sum_u64(n->unknown), ok);
             sum_append(objects, e, ok);
         }
         sum_set(o, "objects", objects, ok);

@@ -279,8 +279,12 @@ static thz_status run_render_warnings(run_state *rs, thz_error *err)
                                  "sensor '%s': %llu samples hit objects holding fewer photons "
                                  "than a density estimate needs (gather_min_photons; "
                                  "final-gather's secondary hits at least %d) and took their "
-                                 "reflected radiance as 0; raise photons.per_channel",
-                                 name, (unsigned long long)r->starved_gathers, RENDER_SECONDARY_K);
+                                 "reflected radiance as 0%s; raise photons.per_channel",
+                                 name, (unsigned long long)r->starved_gathers, RENDER_SECONDARY_K,
+                                 rs->scene->render.integrator == INTEGRATOR_PHOTON_MAP
+                                     ? ": their pixels' standard error is unknown (NaN in "
+                                       "radiance_stderr, starved_pixels in summary.json)"
+                                     : "");
         if (st == THZ_OK && r->truncated_paths)
             st = run_add_warning(rs, err,
                                  "sensor '%s': %llu samples were cut short: after %d straight "

@@ -106,7 +106,8 @@ typedef struct run_result {
     uint64_t back_face_samples;   /* over all sensors and channels */
     size_t n_warnings;            /* run warnings written to summary.json */
     double worst_median_stderr_k; /* largest over channels of the median per-pixel standard
-                                     error of Tb_c, K (0 if not estimated) */
+                                     error of Tb_c, K (0 if not estimated, INFINITY
+                                     if unknown: run_noise) */
     double worst_p95_stderr_k;    /* the same for the 95th percentile, K */
     size_t worst_object;          /* object whose pixels' p95 is largest (over channels), or
                                      SIZE_MAX when no object was seen */

@@ -21,6 +21,8 @@ static run_noise noise_of(double *x, size_t n)
     run_noise r = {.pixels = n};
     if (n == 0)
         return r;
+    for (size_t k = 0; k < n; k++)
+        r.unknown += isinf(x[k]) != 0;
     double upper = order_select(x, n, n / 2);
     if (n % 2) {
         r.median_k = upper;

@@ -13,11 +13,15 @@
 #include "sensor/images.h"
 #include "sensor/render_accum.h"
 
-/* One set of pixels' figures; both 0 when there are no pixels. */
+/* One set of pixels' figures; both 0 when there are no pixels. A pixel whose standard
+ * error is unknown (NaN in radiance_stderr: a photon-map sample short of photons) ranks
+ * above every known one, as +infinity: the figures are then bounds the truth cannot
+ * exceed, and +infinity where the rank falls on such a pixel. */
 typedef struct run_noise {
     double median_k;
-    double p95_k;  /* nearest rank: the smallest value >= 95 % of the pixels' */
-    size_t pixels; /* pixels counted (Tb_c > 0: nothing or a back face seen are left out) */
+    double p95_k;   /* nearest rank: the smallest value >= 95 % of the pixels' */
+    size_t pixels;  /* pixels counted (Tb_c > 0: nothing or a back face seen are left out) */
+    size_t unknown; /* of them, those whose standard error is unknown */
 } run_noise;
 
 /* Figures of channel c (centre freq_hz) over n_images images: *all for every pixel, and

@@ -48,7 +48,8 @@ static uint64_t run_channel_starved(const run_state *rs, size_t c)
 }
 
 /* What a photon-pass warning says of where the channel stopped: above the target, or
- * below it with samples still lacking photons. */
+ * below it or unknown (infinite: the rank falls on a pixel short of photons) with samples
+ * still lacking photons. */
 typedef struct run_stop_text {
     char text[256];
 } run_stop_text;
@@ -56,7 +57,7 @@ typedef struct run_stop_text {
 static run_stop_text run_stop_where(double p95, double target, uint64_t starved)
 {
     run_stop_text s;
-    if (p95 > target)
+    if (p95 > target && isfinite(p95))
         snprintf(s.text, sizeof s.text,
                  "at %.3g K (95th percentile of the pixels' standard error) above the noise "
                  "target of %g K",

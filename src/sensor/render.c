@@ -176,7 +176,7 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
          * squared) instead: never less than the truth (tests/cli/
          * test_deviation_maps.sh measured the sum of variances 2x short in sd). */
         double var_sum = 0.0, sd_sum = 0.0;
-        bool pixel_widened = false;
+        bool pixel_widened = false, pixel_starved = false;
         for (uint32_t j = 0; j < n; j++)
             for (uint32_t i = 0; i < n; i++) {
                 render_sample s = {.variance = 0.0};
@@ -198,6 +198,7 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
                 var_sum += s.variance;
                 sd_sum += sqrt(s.variance);
                 pixel_widened = pixel_widened || s.widened;
+                pixel_starved = pixel_starved || s.starved;
                 n_samples++;
                 n_escaped += s.escaped;
                 n_back += s.back_face;
@@ -207,9 +208,12 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
                 n_paths += s.paths;
             }
         size_t p = (size_t)px;
+        /* a sample short of photons took its reflected radiance as 0 and added no
+         * variance: the pixel's error is unknown, not its samples' variance (NaN) */
         if (!integ->purpose)
-            render_accum_set_poisson_pixel(acc, p, est[0],
-                                           (pixel_widened ? sd_sum * sd_sum : var_sum) / (n2 * n2));
+            render_accum_set_poisson_pixel(
+                acc, p, est[0],
+                pixel_starved ? NAN : (pixel_widened ? sd_sum * sd_sum : var_sum) / (n2 * n2));
         else
             render_accum_add_pixel(acc, p, est, n_est, pixel_batch, pixel_disk_var);
         render_poll_pixel_done(&poll);

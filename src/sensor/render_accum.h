@@ -22,7 +22,8 @@ typedef struct render_accum {
     bool poisson; /* photon-map: var holds the Poisson variance of the mean */
     double *mean; /* per pixel: mean of the estimates, W m^-2 sr^-1 Hz^-1 */
     double *m2;   /* per pixel: sum of squared deviations from the mean (or, poisson,
-                     the variance of the mean) */
+                     the variance of the mean: NaN, unknown, where a sample was short
+                     of photons) */
     /* final-gather with a batched photon map (photon_map.h), else NULL: the map's own
      * noise, which the spread of the estimates given the map cannot show */
     double *batch;    /* [pixel * PHOTON_MAP_BATCHES + b]: sum over all estimates of the
@@ -34,7 +35,8 @@ typedef struct render_accum {
 thz_status render_accum_init(render_accum *acc, size_t pixels, thz_error *err);
 void render_accum_fini(render_accum *acc);
 
-/* Standard error of pixel p's mean, W m^-2 sr^-1 Hz^-1 (0 with fewer than 2 estimates).
+/* Standard error of pixel p's mean, W m^-2 sr^-1 Hz^-1 (0 with fewer than 2 estimates;
+ * NaN, unknown, for a photon-map pixel with a sample short of photons).
  * With a batched photon map (final-gather) the variance is s^2 / N from the estimates'
  * spread given the map, plus the map's own variance given the gather rays: the spread of
  * the pixel's photon part between the independent batches, s_B^2 / B, less what s^2 / N

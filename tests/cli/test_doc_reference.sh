@@ -175,7 +175,8 @@ s = json.load(open(os.path.join(work, "away", "summary.json")))
 if s["command"] != "render":
     bad(f"render's summary.json says command {s['command']!r}")
 plate = [o for o in s["channels"][0]["objects"] if o["name"] == "plate"]
-if plate != [{"name": "plate", "pixels": 0, "median_stderr_k": None, "p95_stderr_k": None}]:
+if plate != [{"name": "plate", "pixels": 0, "median_stderr_k": None, "p95_stderr_k": None,
+              "starved_pixels": 0}]:
     bad(f"an object not seen: {plate}, expected pixels 0 and null figures")
 sys.exit(0 if ok else 1)
 PY

@@ -439,6 +439,47 @@ import json, sys
 for c in json.load(open(sys.argv[1]))["channels"]:
     assert c["render_passes"] >= 2 and c["p95_stderr_k"] <= 40.0, c
 PY
+# without a target, photon-map samples short of photons leave their pixels' standard error
+# unknown, not 0: NaN in radiance_stderr, counted in starved_pixels, and no figure of 0 K
+# (10 photons a channel: every figure was 0 K and the closing line gave none, read as
+# noise-free)
+for n in 10 1000; do
+    "$THZMAP" simulate "$work/scene.json" -o "$work/pmu$n" --photons "$n" --threads 2 \
+        > "$work/pmu$n.out" 2> /dev/null || fail "simulate photon-map, $n photons: exit $?"
+done
+grep -q "pixel standard error unknown" "$work/pmu10.out" && ! grep -q "<= 0 K" "$work/pmu10.out" ||
+    fail "10 photons: the closing line does not say the error is unknown: $(cat "$work/pmu10.out")"
+python3 - "$work" <<'PY' || fail "pixels short of photons: their standard error not unknown"
+import json, math, struct, sys
+for n in (10, 1000):
+    d = f"{sys.argv[1]}/pmu{n}"
+    s = json.load(open(f"{d}/summary.json"))
+    nc = len(s["channels"])
+    def band(name, q, b, px):  # band b of a little-endian float32 ENVI cube
+        raw = open(f"{d}/{name}.{q}.img", "rb").read()[4 * b * px:4 * (b + 1) * px]
+        return struct.unpack(f"<{px}f", raw)
+    for c, ch in enumerate(s["channels"]):
+        unknown, per_object = 0, [0] * len(ch["objects"])
+        for sn in s["sensors"]:
+            px = sn["rows"] * sn["columns"]
+            tb = band(sn["name"], "brightness_temperature", c, px)
+            se = band(sn["name"], "radiance_stderr", c, px)
+            ids = band(sn["name"], "object_id", 0, px)
+            for t, e, i in zip(tb, se, ids):
+                assert not (t > 0 and e == 0), (n, sn["name"], "a standard error of 0")
+                if t > 0 and math.isnan(e):
+                    unknown += 1
+                    if 0 <= i < len(per_object):
+                        per_object[int(i)] += 1
+        assert unknown > 0 and ch["starved_pixels"] == unknown, (n, ch["starved_pixels"], unknown)
+        for o, e in zip(per_object, ch["objects"]):
+            assert e["starved_pixels"] == o, (n, e, o)
+            if o == e["pixels"]:  # every pixel unknown: no figure
+                assert e["median_stderr_k"] is None and e["p95_stderr_k"] is None, (n, e)
+        if n == 10:
+            assert ch["median_stderr_k"] is None and ch["p95_stderr_k"] is None, ch
+        assert ch["median_stderr_k"] != 0 and ch["p95_stderr_k"] != 0, ch
+PY
 # final-gather's deviation map sets up the one-sided solids' back-side sources once per
 # run, before its estimate (progress stage "prepare": the room and the plate here)
 "$THZMAP" simulate "$work/scene.json" -o "$work/fgp" --integrator final-gather --photons 20000 \

@@ -3,7 +3,9 @@
  * same values done here: random values with many ties, all equal, one and two pixels,
  * pixels of no object and of object ids out of range, and a pixel whose Tb is not
  * counted. The figures come from a selection (linear time), which must give a sort's
- * values exactly. */
+ * values exactly. A pixel whose standard error is unknown (NaN: photon-map samples short
+ * of photons) is counted and ranks above every known one: a figure that falls on one is
+ * infinite (summary.json's null), never 0 K (10 photons a channel gave every figure 0 K). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -50,10 +52,21 @@ static uint64_t next(void)
     return rng_next_u64(&rng);
 }
 
+/* The unknown values (infinite) among n. */
+static size_t count_unknown(const double *x, size_t n)
+{
+    size_t u = 0;
+    for (size_t k = 0; k < n; k++)
+        u += isinf(x[k]) != 0;
+    return u;
+}
+
 /* One image of `px` pixels in one channel: object ids in -1 .. n_objects + 1 (the last two
  * out of range), Tb 0 (not counted) now and then, radiance standard errors from `levels`
- * distinct values (ties) or all the same; checks run_noise_channel against by_sort. */
-static void check(size_t px, size_t n_objects, unsigned levels, int all_same)
+ * distinct values (ties) or all the same, one in `unknown_every` NaN (0: none); checks
+ * run_noise_channel against by_sort of the values with NaN taken as +infinity. */
+static void check_unknown(size_t px, size_t n_objects, unsigned levels, int all_same,
+                          unsigned unknown_every)
 {
     const double freq_hz = 0.5e12;
     float tb[4096], se[4096];
@@ -70,14 +83,17 @@ static void check(size_t px, size_t n_objects, unsigned levels, int all_same)
         ids[p] = (int32_t)(next() % (n_objects + 3)) - 1;
         tb[p] = next() % 17 == 0 ? 0.0f : (float)(250.0 + (double)(next() % 100));
         se[p] = all_same ? 2e-18f : (float)(1e-18 * (double)(1 + next() % levels));
+        if (unknown_every && next() % unknown_every == 0)
+            se[p] = NAN;
         if (tb[p] > 0.0f)
-            want_all[n_all++] = render_stderr_k(freq_hz, tb[p], se[p]);
+            want_all[n_all++] = isnan(se[p]) ? INFINITY : render_stderr_k(freq_hz, tb[p], se[p]);
     }
     run_noise all, objects[8];
     assert_true(n_objects <= 8);
     thz_error err = {0};
     assert_int_equal(run_noise_channel(&img, 1, 0, freq_hz, n_objects, &all, objects, &err),
                      THZ_OK);
+    assert_int_equal(all.unknown, count_unknown(want_all, n_all));
     run_noise ref = by_sort(want_all, n_all);
     assert_int_equal(all.pixels, ref.pixels);
     assert_true(all.median_k == ref.median_k);
@@ -86,7 +102,8 @@ static void check(size_t px, size_t n_objects, unsigned levels, int all_same)
         size_t n = 0;
         for (size_t p = 0; p < px; p++)
             if (ids[p] == (int32_t)o && tb[p] > 0.0f)
-                want_obj[n++] = render_stderr_k(freq_hz, tb[p], se[p]);
+                want_obj[n++] = isnan(se[p]) ? INFINITY : render_stderr_k(freq_hz, tb[p], se[p]);
+        assert_int_equal(objects[o].unknown, count_unknown(want_obj, n));
         ref = by_sort(want_obj, n);
         assert_int_equal(objects[o].pixels, ref.pixels);
         assert_true(objects[o].median_k == ref.median_k);
@@ -94,6 +111,11 @@ static void check(size_t px, size_t n_objects, unsigned levels, int all_same)
     }
     free(want_all);
     free(want_obj);
+}
+
+static void check(size_t px, size_t n_objects, unsigned levels, int all_same)
+{
+    check_unknown(px, n_objects, levels, all_same, 0);
 }
 
 static void test_against_a_sort(void **state)
@@ -111,8 +133,44 @@ static void test_against_a_sort(void **state)
     check(4096, 1, 1u << 30, 0); /* nearly all distinct */
 }
 
+/* Unknown standard errors: at random among known ones, and at the edges of the ranks. */
+static void test_unknown(void **state)
+{
+    (void)state;
+    for (int round = 0; round < 100; round++)
+        check_unknown(1 + next() % 4096, 1 + next() % 8, 1 + (unsigned)(next() % 50), 0,
+                      2 + (unsigned)(next() % 40));
+    check_unknown(300, 2, 5, 0, 1); /* every one unknown */
+    /* 100 pixels, Tb 300 K, standard errors 1..100 x 1e-19 in pixel order: the 95th
+     * percentile is the 95th, known with the 5 largest unknown and unknown with 6; the
+     * median unknown once 50 are */
+    const double freq_hz = 0.5e12;
+    float tb[100], se[100];
+    int32_t ids[100];
+    sensor_images img = {.columns = 100, .rows = 1, .n_channels = 1};
+    img.brightness_temperature = tb;
+    img.radiance_stderr = se;
+    img.object_id = ids;
+    for (size_t u = 0; u <= 50; u++) {
+        for (size_t p = 0; p < 100; p++) {
+            tb[p] = 300.0f;
+            ids[p] = 0;
+            se[p] = p >= 100 - u ? NAN : (float)(1e-19 * (double)(p + 1));
+        }
+        run_noise all;
+        thz_error err = {0};
+        assert_int_equal(run_noise_channel(&img, 1, 0, freq_hz, 0, &all, NULL, &err), THZ_OK);
+        assert_int_equal(all.pixels, 100);
+        assert_int_equal(all.unknown, u);
+        assert_true(u <= 5 ? all.p95_k == render_stderr_k(freq_hz, 300.0, se[94])
+                           : isinf(all.p95_k));
+        assert_true(u < 50 ? isfinite(all.median_k) && all.median_k > 0.0 : isinf(all.median_k));
+    }
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_against_a_sort)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_against_a_sort),
+                                       cmocka_unit_test(test_unknown)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
