@@ -249,13 +249,8 @@ static thz_status run_render_warnings(run_state *rs, thz_error *err)
     for (size_t i = 0; i < rs->n_selected; i++) {
         render_stats *sum = &rs->render_sum[i];
         memset(sum, 0, sizeof *sum);
-        for (size_t c = 0; c < rs->scene->n_channels; c++) {
-            const render_stats *l = &rs->last[c * rs->n_selected + i];
-            sum->samples += l->samples;
-            sum->back_face_samples += l->back_face_samples;
-            sum->starved_gathers += l->starved_gathers;
-            sum->truncated_paths += l->truncated_paths;
-        }
+        for (size_t c = 0; c < rs->scene->n_channels; c++)
+            render_stats_add_counts(sum, &rs->last[c * rs->n_selected + i]);
         rs->back_face[rs->selected[i]] = sum->back_face_samples;
     }
     thz_status st = THZ_OK;
@@ -265,15 +260,23 @@ static thz_status run_render_warnings(run_state *rs, thz_error *err)
         /* a sensor inside a solid or outside the enclosure has its own scene warning:
          * then the normals are not to blame */
         bool misplaced = rs->scene->sensors[rs->selected[i]].misplaced;
-        if (r->back_face_samples)
-            st = run_add_warning(rs, err,
-                                 "sensor '%s': %llu of %llu samples saw the back side of a "
-                                 "one-sided solid (radiance 0); %s",
-                                 name, (unsigned long long)r->back_face_samples,
-                                 (unsigned long long)r->samples,
-                                 misplaced ? "the sensor is inside a solid or outside the "
-                                             "enclosure (see the scene warning)"
-                                           : "check the mesh normals");
+        if (r->back_face_samples) {
+            /* the objects: one, or the first and last by index of several */
+            const thz_object *lo = &rs->scene->objects[r->back_face_object_lo];
+            const thz_object *hi = &rs->scene->objects[r->back_face_object_hi];
+            bool one = lo == hi;
+            st = run_add_warning(
+                rs, err,
+                "sensor '%s': %llu of %llu samples saw the back side of %s '%s'%s%s%s "
+                "(radiance 0); %s",
+                name, (unsigned long long)r->back_face_samples, (unsigned long long)r->samples,
+                one ? "one-sided solid" : "one-sided solids, among them", lo->name,
+                one ? "" : " and '", one ? "" : hi->name, one ? "" : "'",
+                misplaced ? "the sensor is inside a solid or outside the "
+                            "enclosure (see the scene warning)"
+                : one     ? "check its mesh normals"
+                          : "check their mesh normals");
+        }
         if (st == THZ_OK && r->starved_gathers)
             st = run_add_warning(rs, err,
                                  "sensor '%s': %llu samples hit objects holding fewer photons "

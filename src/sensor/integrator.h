@@ -20,6 +20,7 @@ typedef struct render_sample {
     double variance;                  /* photon-map: estimated variance of its radiance (Poisson) */
     double batch[PHOTON_MAP_BATCHES]; /* the photon terms of each batch (in the radiance) */
     unsigned escaped, back_face, widened, starved, truncated;
+    uint32_t back_object; /* with back_face: the object whose back it saw */
     uint64_t paths;
 } render_sample;
 

@@ -163,6 +163,7 @@ static void render_final_gather_trace(const render_context *ctx, vec3 origin_m, 
         const thz_object *obj = &ctx->scene->objects[hit.object];
         if (!scene_object_side_is_front(obj, hit.side)) {
             out->back_face = 1;
+            out->back_object = hit.object;
             if (ctx->deviation)
                 render_add_all(t, -render_b0_term(ctx, &path, NULL, distance_m));
             return;

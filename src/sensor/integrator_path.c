@@ -290,6 +290,7 @@ void render_path_sample(const render_context *ctx, vec3 origin_m, vec3 dir, doub
     }
     if (!scene_object_side_is_front(&ctx->scene->objects[first.object], first.side)) {
         out->back_face = 1;
+        out->back_object = first.object;
         if (ctx->emitting)
             render_add_all(t, render_air(ctx, &none, NULL, 0.0, first.distance_m, false));
         return;

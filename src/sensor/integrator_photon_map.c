@@ -57,6 +57,7 @@ double render_photon_map_trace(const render_context *ctx, vec3 origin_m, vec3 di
         const thz_object *obj = &ctx->scene->objects[hit.object];
         if (!scene_object_side_is_front(obj, hit.side)) {
             out->back_face = 1;
+            out->back_object = hit.object;
             if (ctx->deviation)
                 radiance -= render_b0_term(ctx, &path, scatter, distance_m);
             return radiance;

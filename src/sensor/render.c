@@ -136,6 +136,7 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
     size_t members = opt ? opt->members : 0, member = opt ? opt->member : 0;
     uint64_t n_samples = 0, n_escaped = 0, n_back = 0, n_widened = 0, n_starved = 0,
              n_truncated = 0, n_paths = 0;
+    uint64_t back_lo = UINT64_MAX, back_hi = 0; /* the objects seen from the back */
 
     if (render_report(opt, scene, channel, 0, rows)) {
         st = thz_error_set(err, THZ_ERR_CANCELLED, "render: cancelled");
@@ -153,7 +154,8 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
                         .next_s = thz_now_s() + RENDER_POLL_S};
     const int64_t n_px = (int64_t)rows * cols;
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads) \
-    reduction(+ : n_samples, n_escaped, n_back, n_widened, n_starved, n_truncated, n_paths)
+    reduction(+ : n_samples, n_escaped, n_back, n_widened, n_starved, n_truncated, n_paths) \
+    reduction(min : back_lo) reduction(max : back_hi)
     for (int64_t px = 0; px < n_px; px++) {
         uint32_t row = (uint32_t)(px / cols), col = (uint32_t)(px % cols);
         if (render_tile_owner(col, row, members) != member) {
@@ -202,6 +204,10 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
                 n_samples++;
                 n_escaped += s.escaped;
                 n_back += s.back_face;
+                if (s.back_face) {
+                    back_lo = s.back_object < back_lo ? s.back_object : back_lo;
+                    back_hi = s.back_object > back_hi ? s.back_object : back_hi;
+                }
                 n_widened += s.widened;
                 n_starved += s.starved;
                 n_truncated += s.truncated;
@@ -229,6 +235,8 @@ cleanup:
         stats->samples = n_samples;
         stats->escaped_samples = n_escaped;
         stats->back_face_samples = n_back;
+        stats->back_face_object_lo = n_back ? back_lo : 0;
+        stats->back_face_object_hi = n_back ? back_hi : 0;
         stats->widened_gathers = n_widened;
         stats->starved_gathers = n_starved;
         stats->truncated_paths = n_truncated;

@@ -133,12 +133,15 @@ typedef struct render_stats {
     uint64_t samples;           /* sample rays cast (per pass) */
     uint64_t escaped_samples;   /* rays that hit nothing (radiance 0) */
     uint64_t back_face_samples; /* rays that saw the back of a one-sided solid (radiance 0) */
-    uint64_t widened_gathers;   /* footprints with < k photons, widened to the k-th nearest */
-    uint64_t starved_gathers;   /* objects with < k photons where the gather looked: term 0 */
-    uint64_t truncated_paths;   /* rays cut after RENDER_MAX_CROSSINGS straight shells and
-                                   mirror reflections, or paths after RENDER_MAX_BOUNCES hits */
-    uint64_t paths;             /* path: paths traced; final-gather: gather rays cast */
-    double seconds;             /* wall time (not reproducible) */
+    /* the lowest and the highest index of the objects whose back those rays saw (the
+     * warning names them; 0 and 0 while back_face_samples is 0) */
+    uint64_t back_face_object_lo, back_face_object_hi;
+    uint64_t widened_gathers; /* footprints with < k photons, widened to the k-th nearest */
+    uint64_t starved_gathers; /* objects with < k photons where the gather looked: term 0 */
+    uint64_t truncated_paths; /* rays cut after RENDER_MAX_CROSSINGS straight shells and
+                                 mirror reflections, or paths after RENDER_MAX_BOUNCES hits */
+    uint64_t paths;           /* path: paths traced; final-gather: gather rays cast */
+    double seconds;           /* wall time (not reproducible) */
 } render_stats;
 
 /* The integrator's name as in the scene file ("photon-map", "final-gather", "path"). */

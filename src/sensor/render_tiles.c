@@ -1,6 +1,8 @@
 /* Pixel tiles of a render shared by processes: see render_tiles.h. */
 #include "sensor/render_tiles.h"
 
+#include <stdbool.h>
+
 size_t render_tiles_doubles_per_pixel(const render_accum *acc)
 {
     return 2 + (acc->batch ? PHOTON_MAP_BATCHES + 1 : 0);
@@ -48,6 +50,13 @@ void render_tiles_unpack(render_accum *acc, uint32_t columns, size_t member, siz
 
 void render_stats_add_counts(render_stats *a, const render_stats *b)
 {
+    if (b->back_face_samples) { /* the objects: of the side that saw any */
+        bool none = a->back_face_samples == 0;
+        if (none || b->back_face_object_lo < a->back_face_object_lo)
+            a->back_face_object_lo = b->back_face_object_lo;
+        if (none || b->back_face_object_hi > a->back_face_object_hi)
+            a->back_face_object_hi = b->back_face_object_hi;
+    }
     a->samples += b->samples;
     a->escaped_samples += b->escaped_samples;
     a->back_face_samples += b->back_face_samples;

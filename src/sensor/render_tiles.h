@@ -70,7 +70,7 @@ typedef struct render_team {
     void *impl;
 } render_team;
 
-/* Adds b's counts (not its seconds) to a's. */
+/* Adds b's counts (not its seconds) to a's; the objects seen from the back: of both. */
 void render_stats_add_counts(render_stats *a, const render_stats *b);
 
 #endif

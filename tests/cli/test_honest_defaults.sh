@@ -50,6 +50,8 @@ make_scene bolt "s['objects'].append({'name': 'bolt', 'type': 'solid', 'material
 # a solid whose normals point inwards (a mesh wound clockwise, here a box given inward)
 # in the room: seen from outside, only back faces (radiance 0); validate said nothing
 make_scene inverted "s['objects'][1]['shape']['inward'] = True"
+# and a second one beside it, a crate (the run's warning names both)
+make_scene inverted2 "s['objects'][1]['shape']['inward'] = True; s['objects'].append({'name': 'crate', 'type': 'solid', 'material': 'metal', 'temperature_k': 300, 'shape': {'type': 'box', 'size_m': [0.3, 0.3, 0.3], 'inward': True}, 'transform': {'translate_m': [-0.6, 0.5, 0]}})"
 # the room without inward: the sensor is inside a solid, and the warning must not only
 # say to move the sensor out of the room
 make_scene outward "del s['objects'][0]['shape']['inward']"
@@ -115,6 +117,16 @@ grep -q "warning: sensor 'cam': [1-9][0-9]* of 240 samples saw the back side" "$
 grep -q "mesh normals" "$work/o.err" && fail "a misplaced sensor's warning blames the normals"
 grep -q "see .*summary.json" "$work/o.err" && fail "warnings point to summary.json instead"
 grep -q "channel 1/1" "$work/o.err" && fail "--quiet printed progress"
+# the run's back-face warning names the solid seen from the back, as validate does (it
+# said "a one-sided solid"), and of several the first and the last in the scene
+for v in inverted inverted2; do
+    "$THZMAP" simulate "$work/$v.json" -o "$work/out-$v" --integrator path --quiet \
+        2> "$work/$v-run.err" || fail "simulate $v: $(cat "$work/$v-run.err")"
+done
+grep -q "warning: sensor 'cam': [1-9][0-9]* of 120 samples saw the back side of one-sided solid 'target' (radiance 0); check its mesh normals" \
+    "$work/inverted-run.err" || fail "an inverted target not named: $(cat "$work/inverted-run.err")"
+grep -q "warning: sensor 'cam': [1-9][0-9]* of 120 samples saw the back side of one-sided solids, among them 'target' and 'crate' (radiance 0); check their mesh normals" \
+    "$work/inverted2-run.err" || fail "two inverted solids not named: $(cat "$work/inverted2-run.err")"
 
 # --- estimate, noise figures, last line ---------------------------------------------------
 "$THZMAP" simulate "$work/plain.json" -o "$work/out-plain" > "$work/p.out" 2> "$work/p.err" ||

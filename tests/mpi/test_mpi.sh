@@ -137,7 +137,8 @@ $PY -c 'import json,sys; sys.exit(json.load(open(sys.argv[1]))["channels"][0]["r
 grep -q "warning" "$work/pa3.out" && fail "path under mpirun warned: $(grep warning "$work/pa3.out")"
 # the bytes its closing line says (docs/mpi.md "What moves"): per channel a request to
 # begin, one per pass and one to end, 152 B to each other rank; per pass each other rank's
-# tiles, 72 B of counts and size + 16 B per pixel, its pixels those of the 16 x 16 tiles
+# tiles, 88 B of counts, the objects seen from the back and size + 16 B per pixel, its
+# pixels those of the 16 x 16 tiles
 # (tx + ty) mod 3 gives it (24 x 24 pixels)
 $PY - "$work/pa3/summary.json" "$work/pa3.out" <<'PY' || fail "3 ranks, path: the bytes communicated differ from docs/mpi.md's"
 import json, re, sys
@@ -147,7 +148,7 @@ px = [0] * N
 for y in range(H):
     for x in range(W):
         px[(x // T + y // T) % N] += 1
-total = (2 + passes) * 152 * (N - 1) + passes * sum(72 + 16 * p for p in px[1:])
+total = (2 + passes) * 152 * (N - 1) + passes * sum(88 + 16 * p for p in px[1:])
 said = re.search(r"3 MPI ranks \(([0-9.e+-]+) MB communicated\)", open(sys.argv[2]).read())
 if not said or said.group(1) != "%.3g" % (1e-6 * total):
     sys.exit(f"said {said and said.group(1)} MB, expected {total} B in {passes} passes")
@@ -174,8 +175,9 @@ same_run "$work/iso2" "$work/iso1" "2 ranks, final-gather from an empty deviatio
 
 step "counts of every rank"
 # The render counts behind summary.json's back_face_samples and its warning ("N of M
-# samples saw the back side of a one-sided solid") are every rank's: a target turned
-# inside out, across both ranks' tiles (rank 0 counted its own tiles alone)
+# samples saw the back side of one-sided solid 'NAME'") are every rank's: a target turned
+# inside out, across both ranks' tiles (rank 0 counted its own tiles alone); the warning
+# names it whichever rank's tiles saw it
 $PY - "$scene" "$work/in/inside.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
@@ -189,6 +191,8 @@ grep -q '"back_face_samples"' "$work/bk1/summary.json" || fail "test set-up: no 
 mpi 2 "$THZMAP" simulate "$work/in/inside.json" -o "$work/bk2" --integrator path --threads 1 \
     --quiet 2> /dev/null || fail "2 ranks, back faces: exit $?"
 same_run "$work/bk2" "$work/bk1" "2 ranks, samples that saw back faces"
+grep -q "samples saw the back side of one-sided solid 'target' (radiance 0); check its mesh" \
+    "$work/bk2/summary.json" || fail "2 ranks: the back-face warning does not name the target"
 
 step "batch"
 # --- batch: whole frames dealt to the ranks by photon groups (frames 0 and 1 fire, 2

@@ -5,7 +5,9 @@
  * sums and disk variances) and summed counts must equal, byte for byte, one process's,
  * for photon-map, final-gather (batched deviation map) and path, 2 passes where the
  * integrator has passes, 2, 3 and 5 members and 1 and 2 threads; the tiles deal every
- * pixel to exactly one member, each member within one tile row of the others' shares. */
+ * pixel to exactly one member, each member within one tile row of the others' shares.
+ * Two crates inside out, left and right of the box, are seen from the back in different
+ * members' tiles: the counts name both, as one process's do. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -22,8 +24,8 @@
 #include "sensor/render.h"
 #include "sensor/render_tiles.h"
 
-/* A grey box at 320 K in a black enclosure at 300 K, seen by a camera of 37 x 21 pixels
- * (3 x 2 tiles, the last ones partial). */
+/* A grey box at 320 K in a black enclosure at 300 K between two crates inside out (objects
+ * 2 and 3), seen by a camera of 37 x 21 pixels (3 x 2 tiles, the last ones partial). */
 static const char *tiles_json =
     "{\"format\": \"thzmap-scene/1\", \"name\": \"tiles-unit\","
     " \"channels\": [{\"frequency_thz\": 0.5, \"relative_width\": 0.02}],"
@@ -33,7 +35,13 @@ static const char *tiles_json =
     "    \"temperature_k\": 300,"
     "    \"shape\": {\"type\": \"box\", \"size_m\": [2, 6, 2], \"inward\": true}},"
     "   {\"name\": \"box\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 320,"
-    "    \"shape\": {\"type\": \"box\", \"size_m\": [0.4, 0.4, 0.4]}}],"
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [0.4, 0.4, 0.4]}},"
+    "   {\"name\": \"left\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 310,"
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [0.15, 0.15, 0.15], \"inward\": true},"
+    "    \"transform\": {\"translate_m\": [-0.32, 0, 0]}},"
+    "   {\"name\": \"right\", \"type\": \"solid\", \"material\": \"grey\", \"temperature_k\": 310,"
+    "    \"shape\": {\"type\": \"box\", \"size_m\": [0.15, 0.15, 0.15], \"inward\": true},"
+    "    \"transform\": {\"translate_m\": [0.32, 0, 0]}}],"
     " \"sensors\": ["
     "   {\"name\": \"cam\", \"position_m\": [0, -2.5, 0], \"direction\": [0, 1, 0],"
     "    \"fov_deg\": 20, \"resolution\": [37, 21]}],"
@@ -148,6 +156,8 @@ static void check_integrator(thz_integrator integrator)
     assert_int_equal(render_accum_init(&alone, pixels, &err), THZ_OK);
     render_passes(s, acc, map, passes, 1, 0, 0, &alone, &alone_counts);
     assert_true(alone_counts.samples > 0);
+    assert_true(alone_counts.back_face_samples > 0 && alone_counts.back_face_object_lo == 2 &&
+                alone_counts.back_face_object_hi == 3);
     if (integrator == INTEGRATOR_FINAL_GATHER)
         assert_non_null(alone.batch); /* the batched map's statistics are shared too */
     size_t members[] = {2, 3, 5};
