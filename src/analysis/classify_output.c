@@ -1,5 +1,5 @@
 /* The files of a classification (classify_output.h): classification.json, the class
- * map as ENVI and as a PNG in a qualitative palette. */
+ * map as ENVI and as a figure in a qualitative palette with a legend. */
 #include "analysis/classify_output.h"
 
 #include <errno.h>
@@ -16,7 +16,7 @@
 #include "core/path.h"
 #include "io/envi.h"
 #include "io/output.h"
-#include "io/png_image.h"
+#include "io/plot.h"
 
 /* A qualitative palette (sRGB 0..255): class k is drawn in colour k mod 10, pixels
  * where nothing is hit in black. */
@@ -137,23 +137,25 @@ thz_status classify_write_files(const char *dir, const classify_report *rep, con
     if (st != THZ_OK)
         return st;
     float *map = thz_malloc_array(pixels, sizeof *map);
-    float *rgb = thz_malloc_array(pixels * 3, sizeof *rgb);
-    if (!map || !rgb) {
+    int32_t *slot = thz_malloc_array(pixels, sizeof *slot); /* the class, -1: nothing hit */
+    unsigned char(*rgb)[3] = thz_malloc_array(r->n_classes + 1, sizeof *rgb);
+    if (!map || !slot || !rgb) {
         free(map);
+        free(slot);
         free(rgb);
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     }
+    for (size_t k = 0; k < r->n_classes; k++)
+        memcpy(rgb[k], class_palette[k % 10], sizeof rgb[k]);
     for (size_t p = 0; p < pixels; p++) {
         map[p] = (float)r->assigned[p];
         size_t k = 0;
         while (k < r->n_classes && r->class_object[k] != r->assigned[p])
             k++;
-        for (int i = 0; i < 3; i++)
-            rgb[3 * p + (size_t)i] =
-                k < r->n_classes ? (float)class_palette[k % 10][i] / 255.0f : 0.0f;
+        slot[p] = k < r->n_classes ? (int32_t)k : -1;
     }
     const char *stem_sensor = rep->sensor ? rep->sensor : "cube";
-    char stem[THZ_PATH_MAX], description[1024], png[THZ_PATH_MAX], name[THZ_PATH_MAX];
+    char stem[THZ_PATH_MAX], description[1024], png[THZ_PATH_MAX], name[THZ_PATH_MAX], title[1024];
     st = output_file_name(stem, sizeof stem, stem_sensor, "class", "")
              ? THZ_OK
              : thz_error_set(err, THZ_ERR_IO, "sensor %.64s...: file name too long", stem_sensor);
@@ -180,9 +182,13 @@ thz_status classify_write_files(const char *dir, const classify_report *rep, con
                  ? thz_path_join(png, sizeof png, dir, name, err)
                  : thz_error_set(err, THZ_ERR_IO, "%s.png: file name too long", stem);
     }
+    snprintf(title, sizeof title, "%.400s: classes by %s", rep->source,
+             classify_method_name(rep->method));
     if (st == THZ_OK)
-        st = png_image_write_srgb8(png, rgb, rep->columns, rep->rows, err);
+        st = plot_classes(png, slot, rep->columns, rep->rows, r->n_classes, rep->class_names,
+                          (const unsigned char(*)[3])rgb, title, err);
     free(map);
+    free(slot);
     free(rgb);
     return st;
 }

@@ -1,7 +1,7 @@
 /* The files `thzmap classify` writes (scene-format.md "thzmap classify"):
  * classification.json, S.class.hdr/.img (ENVI float32, the object index of each pixel's
- * class, -1 where nothing is hit) and S.class.png (classes in the colours the JSON
- * lists, nothing hit in black).
+ * class, -1 where nothing is hit) and S.class.png (a figure of the map: classes in the
+ * colours the JSON lists, nothing hit in black, and a legend naming them).
  */
 #ifndef THZ_ANALYSIS_CLASSIFY_OUTPUT_H
 #define THZ_ANALYSIS_CLASSIFY_OUTPUT_H

@@ -57,6 +57,18 @@ void plot_escape(char *dst, size_t size, const char *src)
  * its figure gives the image (720 wide), so a larger image loses nothing to the eye. */
 #define PLOT_IMAGE_CELLS 1024
 
+plot_layout plot_image_layout(uint32_t columns, uint32_t rows)
+{
+    plot_layout l;
+    uint32_t longest = columns > rows ? columns : rows;
+    l.f = longest > PLOT_IMAGE_CELLS ? (longest + PLOT_IMAGE_CELLS - 1) / PLOT_IMAGE_CELLS : 1;
+    l.bx = (columns + (size_t)l.f - 1) / l.f;
+    l.by = (rows + (size_t)l.f - 1) / l.f;
+    l.aspect = (double)rows / columns;
+    l.height = (int)fmin(fmax(120.0 + 480.0 * l.aspect, 240.0), 1400.0);
+    return l;
+}
+
 thz_status plot_check_device_here(void *arg, thz_error *err)
 {
     (void)arg;
@@ -198,10 +210,9 @@ thz_status plot_image_draw(const char *path, const float *values, uint32_t colum
      * the mean of its finite pixels: plimage draws a rectangle per cell, and a 4096 x 4096
      * preview took 10 s for the figure's ~500 pixels across (scale audit). The colour bar
      * still comes from every pixel. */
-    uint32_t longest = columns > rows ? columns : rows;
-    uint32_t f =
-        longest > PLOT_IMAGE_CELLS ? (longest + PLOT_IMAGE_CELLS - 1) / PLOT_IMAGE_CELLS : 1;
-    size_t bx = (columns + (size_t)f - 1) / f, by = (rows + (size_t)f - 1) / f;
+    plot_layout lay = plot_image_layout(columns, rows);
+    uint32_t f = lay.f;
+    size_t bx = lay.bx, by = lay.by;
     /* plimage draws (nx-1) x (ny-1) cells coloured by their lower corner: pass one more
      * column and row (copies of the last) so that every block is one whole cell. */
     size_t nx = bx + 1, ny = by + 1;
@@ -237,12 +248,9 @@ thz_status plot_image_draw(const char *path, const float *values, uint32_t colum
     snprintf(t_label, sizeof t_label, "%s", value_label);
 
     /* Square pixels: the plot area follows the image's aspect ratio. */
-    double aspect = (double)rows / columns;
-    int width = 720;
-    int height = (int)fmin(fmax(120.0 + 480.0 * aspect, 240.0), 1400.0);
-    status = plot_begin(path, width, height, err);
+    status = plot_begin(path, 720, lay.height, err);
     if (status == THZ_OK) {
-        plvpas(0.10, 0.78, 0.12, 0.90, aspect);
+        plvpas(0.10, 0.78, 0.12, 0.90, lay.aspect);
         /* Row 0 at the top: the y axis runs from `rows` at the bottom to 0 on top. */
         plwind(0.0, columns, rows, 0.0);
         plot_set_viridis();

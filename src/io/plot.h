@@ -1,5 +1,6 @@
 /* Figures drawn with PLplot's pngcairo device: the per-channel preview S.band-NN.png
- * (an image with a perceptual colour map and a labelled colour bar), S.spectra.png
+ * (an image with a perceptual colour map and a labelled colour bar), classify's
+ * S.class.png (classes in their colours, with a legend), S.spectra.png
  * (one line per object against frequency, as the paper's Fig. 6), and the
  * attenuation spectrum of `thzmap atmosphere --plot` (log axis, shaded channels).
  *
@@ -36,6 +37,16 @@ thz_status plot_check_device(thz_error *err);
  * `value_label` (which carries the unit), axes in pixels, and `title` on top. */
 thz_status plot_image(const char *path, const float *values, uint32_t columns, uint32_t rows,
                       const char *title, const char *value_label, thz_error *err);
+
+/* A map of classes: classes[row * columns + column] is pixel (column, row)'s class, 0 to
+ * n_classes - 1, or -1 where nothing is hit (row 0 at the top). Class k is drawn in
+ * colour rgb[k] (sRGB), nothing hit in black, beside a legend naming every class (and
+ * "nothing hit" when a pixel is -1) with its colour; axes in pixels, `title` on top.
+ * 960 pixels wide, high as plot_image's figure of the same image; an image larger than
+ * the figure shows is drawn from the first (top-left) pixel of each block. */
+thz_status plot_classes(const char *path, const int32_t *classes, uint32_t columns, uint32_t rows,
+                        size_t n_classes, const char *const *names, const unsigned char (*rgb)[3],
+                        const char *title, thz_error *err);
 
 /* Line plot: n_lines curves over n_x abscissae x (in `x_label` units), curve i at
  * y[i * n_x + j]; non-finite points are left out. A legend names each curve. A title

@@ -1,6 +1,6 @@
 /* PLplot's figures, each drawn in a child process (plot_draw.h says why): one at a time
- * (plot_image, plot_lines, plot_attenuation) or a batch of them by a few children at once
- * (plot_batch_*).
+ * (plot_image, plot_classes, plot_lines, plot_attenuation) or a batch of them by a few children at
+ * once (plot_batch_*).
  */
 #include <pthread.h>
 #include <stdbool.h>
@@ -107,6 +107,42 @@ thz_status plot_attenuation(const char *path, size_t n_x, const double *x, size_
     char what[PLOT_CHILD_TEXT];
     snprintf(what, sizeof what, "plotting %s", path);
     return child_run(what, plot_attenuation_child, &a, plot_timeout_s(n_x * n_curves), err);
+}
+
+/* plot_classes' arguments, passed to its child. */
+typedef struct plot_classes_args {
+    const char *path, *title;
+    const int32_t *classes;
+    uint32_t columns, rows;
+    size_t n_classes;
+    const char *const *names;
+    const unsigned char (*rgb)[3];
+} plot_classes_args;
+
+static thz_status plot_classes_child(void *arg, thz_error *err)
+{
+    const plot_classes_args *a = arg;
+    char cwd[PLOT_CHILD_TEXT], path[2 * PLOT_CHILD_TEXT];
+    plot_child_short_cwd(cwd, sizeof cwd);
+    return plot_classes_draw(plot_child_path(cwd, a->path, path, sizeof path), a->classes,
+                             a->columns, a->rows, a->n_classes, a->names, a->rgb, a->title, err);
+}
+
+thz_status plot_classes(const char *path, const int32_t *classes, uint32_t columns, uint32_t rows,
+                        size_t n_classes, const char *const *names, const unsigned char (*rgb)[3],
+                        const char *title, thz_error *err)
+{
+    plot_classes_args a = {.path = path,
+                           .title = title,
+                           .classes = classes,
+                           .columns = columns,
+                           .rows = rows,
+                           .n_classes = n_classes,
+                           .names = names,
+                           .rgb = rgb};
+    char what[PLOT_CHILD_TEXT];
+    snprintf(what, sizeof what, "plotting %s", path);
+    return child_run(what, plot_classes_child, &a, plot_timeout_s((size_t)columns * rows), err);
 }
 
 /* ---- batches ------------------------------------------------------------------------ */

@@ -10,6 +10,9 @@
 #ifndef THZ_IO_PLOT_DRAW_H
 #define THZ_IO_PLOT_DRAW_H
 
+#include <stddef.h>
+#include <stdint.h>
+
 #include "io/plot.h"
 
 /* How long a figure may take before its child is killed (a deadlocked GLib): far
@@ -32,9 +35,24 @@ typedef struct plot_range {
 /* Of n values; finite is scratch for n doubles. */
 plot_range plot_colour_range(const float *values, size_t n, double *finite);
 
-/* plot_image's, plot_lines' and plot_attenuation's figures, drawn here. */
+/* How an image of columns x rows pixels is drawn (plot_image, plot_classes): cells of
+ * f x f pixels, bx x by of them (at most 1024 along the longer side: a larger image is
+ * drawn from blocks), in a plot area of the image's aspect (rows / columns: square
+ * pixels) on a figure `height` pixels high. */
+typedef struct plot_layout {
+    uint32_t f;
+    size_t bx, by;
+    double aspect;
+    int height;
+} plot_layout;
+plot_layout plot_image_layout(uint32_t columns, uint32_t rows);
+
+/* plot_image's, plot_classes', plot_lines' and plot_attenuation's figures, drawn here. */
 thz_status plot_image_draw(const char *path, const float *values, uint32_t columns, uint32_t rows,
                            const char *title, const char *value_label, thz_error *err);
+thz_status plot_classes_draw(const char *path, const int32_t *classes, uint32_t columns,
+                             uint32_t rows, size_t n_classes, const char *const *names,
+                             const unsigned char (*rgb)[3], const char *title, thz_error *err);
 thz_status plot_lines_draw(const char *path, size_t n_x, const double *x, size_t n_lines,
                            const char *const *names, const double *y, const char *title,
                            const char *x_label, const char *y_label, bool whole_x, thz_error *err);

@@ -74,11 +74,15 @@ for c in d["classes"]:
     assert c["auc"] == 1.0 and len(c["roc"]["true_positive_rate"]) == 101
 PYEOF
 
-# S.class.png draws each pixel in its class's `color` (classification.json), nothing hit
-# in black: here the room's pixels made "nothing hit", so that the classes (A, B, C:
-# objects 1, 2, 3) are not numbered as their objects. The palette indexed by the object
-# instead of the class (a mutant) passed every test, whose objects were all seen: every
-# class drawn in the next class's colour, the PNG's legend in the JSON wrong.
+# S.class.png is a figure: the class map in the classes' `color` (classification.json),
+# nothing hit in black, and a legend beside it, a box of each class's colour, in the
+# order of `classes`, then a black one for nothing hit (it had no legend: a user could
+# not tell the colours apart). Read back: the figure's size, the legend's boxes (one
+# column, right of the map), and per class its share of the map's coloured area against
+# its share of S.class.img's pixels. Here the room's pixels made "nothing hit", so that
+# the classes (A, B, C: objects 1, 2, 3) are not numbered as their objects: the palette
+# indexed by the object instead of the class (a mutant) drew every class in the next
+# class's colour.
 cp -r "$work/run" "$work/run-noroom"
 $PY - "$work/run-noroom/cam.object_id.img" <<'PYEOF'
 import sys
@@ -89,22 +93,51 @@ t.tofile(sys.argv[1])
 PYEOF
 "$THZMAP" classify "$work/run-noroom" --sensor cam -o "$work/c-noroom" --method lda -q ||
     fail "classify without the room: exit status $?"
-$PY - "$work/c-noroom" <<'PYEOF' || fail "class map colours"
+for out in c-lda c-noroom; do
+    $PY - "$work/$out" <<'PYEOF' || fail "$out: the class figure and its legend"
 import json, sys
 import numpy as np
 from PIL import Image
+from scipy import ndimage
 out = sys.argv[1]
 d = json.load(open(f"{out}/classification.json"))
-assert [c["object"] for c in d["classes"]] == [1, 2, 3], d["classes"]
 cls = np.fromfile(f"{out}/cam.class.img", "<f4").astype(int)
-png = np.asarray(Image.open(f"{out}/cam.class.png").convert("RGB")).reshape(-1, 3)
-assert len(png) == len(cls) and (cls == -1).any() and (cls >= 0).any()
-colour = {c["object"]: c["color"] for c in d["classes"]}
-colour[-1] = [0, 0, 0]
-want = np.array([colour[o] for o in cls])
-assert len({tuple(c) for c in colour.values()}) == 4
-assert (png == want).all(), [(tuple(p), tuple(w)) for p, w in zip(png, want) if tuple(p) != tuple(w)][:3]
+png = np.asarray(Image.open(f"{out}/cam.class.png").convert("RGB")).astype(int)
+h, w, _ = png.shape
+# a figure 960 pixels wide (scene-format.md), not the map's 24 x 16 pixels
+assert w == 960 and 240 <= h <= 1400, (w, h)
+colours = [tuple(c["color"]) for c in d["classes"]] + ([(0, 0, 0)] if (cls == -1).any() else [])
+assert len(set(colours)) == len(colours), colours
+# each colour's regions; a legend box is one of at least 8 x 8 pixels, the rightmost
+boxes, area = [], []
+for c in colours:
+    mask = (png == c).all(axis=2)
+    lab, n = ndimage.label(mask)
+    regions = [s for s in ndimage.find_objects(lab)
+               if s[0].stop - s[0].start >= 8 and s[1].stop - s[1].start >= 8]
+    assert regions, f"no region of colour {c}"
+    box = max(regions, key=lambda s: s[1].start)
+    boxes.append(box)
+    area.append(int(mask.sum()) - (box[0].stop - box[0].start) * (box[1].stop - box[1].start))
+# one column of boxes, in the order of the classes, right of everything else drawn in them
+lefts = {b[1].start for b in boxes}
+assert max(lefts) - min(lefts) <= 1, boxes
+tops = [b[0].start for b in boxes]
+assert tops == sorted(tops) and len(set(tops)) == len(tops), tops
+for c, b in zip(colours, boxes):
+    mask = (png == c).all(axis=2)
+    mask[b] = False
+    xs = np.nonzero(mask.any(axis=0))[0]
+    if c != (0, 0, 0):  # black is also the text's and the axes'
+        assert len(xs) and xs.max() < b[1].start, (c, b)
+# the map: each class's share of the coloured area as its share of the class map's pixels
+k = len(d["classes"])
+share = np.array(area[:k], float) / sum(area[:k])
+want = np.array([(cls == c["object"]).sum() for c in d["classes"]], float)
+want /= want.sum()
+assert np.abs(share - want).max() < 0.02, (share, want)
 PYEOF
+done
 
 # accuracy against the added NETD: exact up to 1 K (the plates differ by more), then
 # falling strictly with every doubling (the same seed: the same draws, scaled), and far

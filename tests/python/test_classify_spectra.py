@@ -172,18 +172,21 @@ def test_save_writes_the_cube_files(distinct, tmp_path):
 
 
 def test_save_of_more_pixels_than_a_png_row_takes(tmp_path):
-    """(pixels, channels) is one row of pixels in cube.class.png, and libpng writes up to
-    10^6 a side: one more was 'cannot write PNG: Invalid IHDR data'; now the sizes are
-    said, and nothing is written."""
+    """(pixels, channels) is one row of pixels in cube.class.png. When the PNG was the map
+    itself, libpng's limit of 10^6 a side refused one more pixel; the PNG is now a figure
+    of the map with its legend (scene-format.md: 960 pixels wide), whatever the map's
+    size, so the row saves and its map is the ENVI file's."""
     n = 1_000_001
     labels = np.arange(n) % 2
     spectra = np.stack([300.0 + 2 * labels, 290.0 - labels], axis=1)
     c = thzmap.classify_spectra(spectra, labels, method="lda")
     assert c.accuracy == 1.0 and c.class_map.shape == (n,)
-    with pytest.raises(thzmap.Error, match="cube.class.png: 1000001 x 1 pixels: a PNG is "
-                                           "written up to 1000000 x 1000000 pixels"):
-        c.save(tmp_path / "out")
-    assert not (tmp_path / "out").exists()
+    c.save(tmp_path / "out")
+    png = (tmp_path / "out" / "cube.class.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and png[12:16] == b"IHDR"
+    assert int.from_bytes(png[16:20], "big") == 960, int.from_bytes(png[16:20], "big")
+    saved = np.fromfile(tmp_path / "out" / "cube.class.img", "<f4")
+    assert np.array_equal(saved, c.class_map)
 
 
 def test_training_mask_is_the_split_the_figures_use(distinct):
