@@ -133,6 +133,23 @@ grep -qx 'data: 0.2 to 2 THz (end values held beyond the ends)' "$work/tabled" |
 awk '$1 == "0.6" && $2 == 1.55 && $3 == 0.02 { ok = 1 } END { exit !ok }' "$work/tabled" ||
     fail "tabled: n, k at 0.6 THz are not 1.55, 0.02: $(cat "$work/tabled")"
 
+# --- an entry whose valid_thz is empty (from = to) or runs backwards: the library is
+#     refused at load, naming the key (an empty range would have made every channel
+#     "leave" it, and thz_library_in_range hold at one frequency only) -------------------
+for range in "[0.5, 0.5]" "[0.6, 0.5]"; do
+    rm -rf "$work/dv" && cp -r "$REPO/data" "$work/dv"
+    python3 - "$work/dv/materials/library.json" "$range" <<'PY' || fail "cannot set valid_thz"
+import json, sys
+lib = json.load(open(sys.argv[1]))
+lib["materials"]["water"]["valid_thz"] = json.loads(sys.argv[2])
+json.dump(lib, open(sys.argv[1], "w"))
+PY
+    THZMAP_DATA_DIR="$work/dv" "$THZMAP" materials >"$work/out" 2>"$work/err"
+    rc=$?
+    [[ $rc -eq 1 ]] && grep -q 'library.json: materials.water.valid_thz: expected \[from_thz, to_thz\] with from < to' "$work/err" ||
+        fail "valid_thz $range: exit $rc: $(cat "$work/err")"
+done
+
 # --- a data directory whose JSON files are a FIFO or a directory: refused, no hang; a
 #     damaged installation is an I/O error (exit 1), not bad input -------------------------
 cp -r "$REPO/data" "$work/dd"
