@@ -19,7 +19,8 @@
 typedef struct deal_header {
     uint64_t reused; /* rendered from its base frame's photons */
     uint64_t fired;  /* fired photons (its own or, resuming, its base's again) */
-    double seconds;  /* wall time of the frame on the rank that computed it, s */
+    double seconds;  /* wall time of computing the frame (its scene and its run, not the
+                        packing) on the rank that computed it, s */
 } deal_header;
 
 static double deal_now_s(void)
@@ -134,8 +135,9 @@ thz_status batch_deal_serve(thz_context *ctx, const thz_sequence *seq, const uin
         thz_status fst = batch_frame_load(seq, base, f, &fr, &ferr);
         if (fst == THZ_OK)
             fst = batch_frame_compute(ctx, seq, base, &cache, f, &fr, &ferr);
+        double seconds = deal_now_s() - t0;
         if (fst == THZ_OK)
-            fst = deal_pack(&fr, deal_now_s() - t0, &data, &size, &ferr);
+            fst = deal_pack(&fr, seconds, &data, &size, &ferr);
         if (fst == THZ_OK)
             st = send_frame(send_user, f, THZ_OK, data, size, err);
         else /* rank 0 reports it and ends the job; this rank computes no more */

@@ -171,7 +171,8 @@ thz_status batch_deal_serve(thz_context *ctx, const thz_sequence *seq, const uin
                             void *send_user, thz_error *err);
 
 /* Rank 0: frame f from rank `rank` (its next one): fr's scene loaded here, its run from
- * the received bytes; *seconds the time it took there, s. A failure the rank sent comes
+ * the received bytes; *seconds the time computing it took there (its scene and its run),
+ * s. A failure the rank sent comes
  * back as its status and message, with *theirs set (else false: this rank's own). */
 thz_status batch_deal_receive(thz_context *ctx, const thz_sequence *seq, size_t f, size_t rank,
                               batch_frame *fr, double *seconds, bool *theirs, thz_error *err);
