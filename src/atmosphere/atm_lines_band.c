@@ -31,7 +31,6 @@
 #include "atmosphere/atm_internal.h"
 #include "atmosphere/atm_lines_data.h"
 #include "core/alloc.h"
-#include "core/threads.h"
 
 #define NODES 32
 #define FAR 1.0
@@ -181,7 +180,7 @@ static thz_status band_pieces(atm_lines_band *b, size_t points, thz_error *err)
     if (!b->piece_start || !b->piece_coef)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory tabulating the atmosphere");
     long np = (long)b->n_pieces;
-#pragma omp parallel for schedule(dynamic, 16) num_threads(thz_threads_all())
+#pragma omp parallel for schedule(dynamic, 16) num_threads(atm_table_threads(points))
     for (long p = 0; p < np; p++)
         b->piece_start[p + 1] = piece_near_lines(b, (size_t)p, NULL);
     for (size_t p = 0; p < b->n_pieces; p++)
@@ -190,7 +189,7 @@ static thz_status band_pieces(atm_lines_band *b, size_t points, thz_error *err)
                                      sizeof *b->piece_near);
     if (!b->piece_near)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory tabulating the atmosphere");
-#pragma omp parallel for schedule(dynamic, 16) num_threads(thz_threads_all())
+#pragma omp parallel for schedule(dynamic, 16) num_threads(atm_table_threads(points))
     for (long p = 0; p < np; p++) {
         piece_near_lines(b, (size_t)p, b->piece_near + b->piece_start[p]);
         piece_fit(b, (size_t)p);

@@ -9,7 +9,6 @@
 
 #include "atmosphere/atm_internal.h"
 #include "core/alloc.h"
-#include "core/threads.h"
 
 /* Tabulation: the grid step starts from the line widths in the band (see
  * model_first_step_hz) and is halved until the cubic interpolation agrees with
@@ -245,7 +244,7 @@ static void fill_table(const thz_atmosphere *atm, const atm_lines_band *band, at
                        const atm_band_table *prev, const double *prev_mid)
 {
     long n = (long)t->n;
-#pragma omp parallel for schedule(dynamic, 64) num_threads(thz_threads_all())
+#pragma omp parallel for schedule(dynamic, 64) num_threads(atm_table_threads(t->n))
     for (long j = 0; j < n; j++) {
         double f = table_freq_hz(t, (double)j);
         size_t i = (size_t)(j + 1) / 2;
@@ -271,7 +270,8 @@ static double table_midpoint_error(const thz_atmosphere *atm, const atm_lines_ba
         peak = fmax(peak, fabs(t->alpha_per_m[i]));
     const double floor_per_m = fmax(TABLE_FLOOR * peak, 1e-300);
     double worst = 0.0;
-#pragma omp parallel for schedule(dynamic, 64) reduction(max : worst) num_threads(thz_threads_all())
+    int threads = atm_table_threads(t->n);
+#pragma omp parallel for schedule(dynamic, 64) reduction(max : worst) num_threads(threads)
     for (long i = 1; i < n - 2; i++) {
         double f = table_freq_hz(t, (double)i + 0.5);
         double direct = band_alpha_per_m(atm, band, f);
