@@ -2,11 +2,12 @@
 # The newcomer walkthrough (docs/walkthrough.md) runs as written: its fenced blocks
 # marked `file=NAME` are saved under NAME and those marked `run` are run by bash, in
 # order, in an empty directory, with `thzmap` (the binary under test) and Debian's
-# `python3` first on PATH. Then the results are checked independently of the page's own
-# script: every room pixel reads the room's 295 K and every person pixel the grey-plate
-# value (1 - R) B(310 K) + R B(295 K), within 5 of the pixel's reported standard errors
-# plus 0.02 K (the band-mean term of a 1 % channel, a few mK, and float32 rounding);
-# and the page's script and its numpy-only reader must print the same numbers.
+# `python3` first on PATH; each block marked `text` (an output the page shows) must be
+# lines the steps printed, as they printed them. Then the results are checked
+# independently of the page's own script: every room pixel reads the room's 295 K and
+# every person pixel the grey-plate value (1 - R) B(310 K) + R B(295 K), within 5 of the
+# pixel's reported standard errors plus 0.02 K (the band-mean term of a 1 % channel, a
+# few mK, and float32 rounding); and the page's script and its numpy-only reader must print the same numbers.
 #   usage: test_walkthrough.sh THZMAP REPO
 set -euo pipefail
 thzmap=$(realpath "$1")
@@ -32,7 +33,7 @@ import sys
 doc, tmp = sys.argv[1], sys.argv[2]
 text = open(doc).read()
 blocks = re.findall(r"^```([^\n]*)\n(.*?)^```", text, re.M | re.S)
-n_files = n_runs = 0
+n_files = n_runs = n_texts = 0
 with open(f"{tmp}/steps.sh", "w") as steps:
     for info, body in blocks:
         words = info.split()
@@ -43,6 +44,9 @@ with open(f"{tmp}/steps.sh", "w") as steps:
         elif "run" in words[1:]:
             n_runs += 1
             steps.write(f"echo '>>> step {n_runs}'\n{body}")
+        elif words[:1] == ["text"]:  # what the page says a step prints
+            n_texts += 1
+            open(f"{tmp}/shown-{n_texts}.txt", "w").write(body)
 if n_files < 3 or n_runs < 4:
     sys.exit(f"FAIL: {doc}: expected at least 3 file blocks and 4 run blocks, "
              f"found {n_files} and {n_runs} (are the fences still marked?)")
@@ -61,6 +65,19 @@ fi
 cat "$tmp/stdout"
 
 fail() { echo "FAIL: $*"; exit 1; }
+# Each output the page shows (```text) is what a step printed, line for line: the run is
+# deterministic (seed, paths per sample), so a changed message or figure is a stale page.
+for shown in "$tmp"/shown-*.txt; do
+    [ -e "$shown" ] || fail "the page shows no output (\`\`\`text) to compare"
+    "$py" - "$shown" "$tmp/stdout" <<'PY' || exit 1
+import sys
+shown = open(sys.argv[1]).read().splitlines()
+out = open(sys.argv[2]).read().splitlines()
+if not any(out[i:i + len(shown)] == shown for i in range(len(out))):
+    sys.exit("FAIL: the page shows\n" + "\n".join(shown) + "\nbut no step printed it; they printed\n"
+             + "\n".join(out))
+PY
+done
 grep -q 'scene "first-room" (room.json): valid' "$tmp/stdout" || fail "validate did not say the scene is valid"
 grep -q 'typo.json: objects\[0\].temperature_c: unknown key' "$tmp/stderr" ||
     fail "the typo's message does not name objects[0].temperature_c"
