@@ -2,8 +2,9 @@
 # The library's public surface, three ways that must agree: the THZ_API declarations
 # in include/thzmap/*.h, the dynamic symbols libthzmap.so exports (exactly those: a
 # named OpenMP critical section once exported a lock of its own), and docs/api.md's
-# function list (every function, nothing else). And every public header compiles on
-# its own, as C17 and as C++17, with the warnings as errors.
+# function list (every function, nothing else). docs/api.md's complete example is
+# examples/api/simulate.c as it stands. And every public header compiles on its own, as
+# C17 and as C++17, with the warnings as errors.
 # usage: test_api_surface.sh THZMAP_BINARY REPO_DIR
 . "$(dirname "$0")/lib.sh"
 build=$(cd "$(dirname "$THZMAP")" && pwd)
@@ -60,6 +61,18 @@ for name in bad:
     print("docs/api.md's function list names no declared function:", name)
 PY
 [[ -s $work/docs.check ]] && fail "$(cat "$work/docs.check")"
+
+# --- docs/api.md's complete example is examples/api/simulate.c, which test_install.sh builds
+# and runs: a listing edited on the page alone would show a program no test compiles
+/usr/bin/python3 - "$REPO" <<'PY' || fail "docs/api.md's complete example is not examples/api/simulate.c"
+import re, sys
+doc = open(sys.argv[1] + "/docs/api.md").read()
+m = re.search(r"`examples/api/simulate.c`[^\n]*\n\n```c\n(.*?)^```", doc, re.M | re.S)
+if not m:
+    sys.exit("docs/api.md: no listing of examples/api/simulate.c under 'A complete example'")
+if m.group(1) != open(sys.argv[1] + "/examples/api/simulate.c").read():
+    sys.exit("docs/api.md's listing differs from examples/api/simulate.c")
+PY
 
 # --- each header alone ---------------------------------------------------------------------
 for h in "$REPO"/include/thzmap/*.h; do
