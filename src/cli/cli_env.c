@@ -1,7 +1,9 @@
 /* The process thzmap starts in: standard streams, signals and limits it cannot work
  * with, mended or refused before any work; and its standard output checked at the end. */
+#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT */
 #include <errno.h>
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -120,6 +122,27 @@ int cli_environment_check(void)
         return CLI_EXIT_USAGE;
     }
     return -1;
+}
+
+void cli_threads_check(const char *command, uint64_t threads)
+{
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (threads == 0 || sched_getaffinity(0, sizeof set, &set) != 0)
+        return;
+    int cpus = CPU_COUNT(&set);
+    if (cpus < 1 || threads <= (uint64_t)cpus)
+        return;
+    /* Open MPI 4 binds each rank to a core (2 ranks or fewer) or a socket, Slurm's srun to
+     * its --cpus-per-task (since 22.05 not taken from sbatch's): 8 threads on 1 core ran
+     * 8 times slower, and said nothing */
+    fprintf(stderr,
+            "thzmap %s: warning: --threads %llu, but this process may run on only %d CPU%s "
+            "(its affinity: mpirun binds each rank to one core or socket unless given "
+            "--bind-to none or --map-by slot:PE=%llu, srun to its --cpus-per-task); the threads "
+            "will share %s\n",
+            command, (unsigned long long)threads, cpus, cpus == 1 ? "" : "s",
+            (unsigned long long)threads, cpus == 1 ? "it" : "them");
 }
 
 int cli_stdout_finish(int rc)

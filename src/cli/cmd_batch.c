@@ -278,6 +278,8 @@ int cmd_batch(int argc, char **argv)
     /* Under mpirun every rank parses and loads alike; rank 0 alone says what is wrong. */
     cli_mpi_quiet_begin();
     int rc = batch_parse(argc, argv, &seq_path, &outdir, &threads, &b);
+    if (rc < 0)
+        cli_threads_check("batch", threads);
     thz_error err = {0};
     if (rc < 0 && batch_load(&b, seq_path, &seq, &err) != THZ_OK)
         rc = cli_fail(&err);

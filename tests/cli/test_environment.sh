@@ -10,7 +10,8 @@
 # scene path that is not UTF-8 is written into summary.json with its bytes escaped;
 # THZMAP_EMBREE_MAX_ISA takes Embree's instruction sets (avx2 by default), whose kernels
 # give the same images (a hit's point and distance are thzmap's own arithmetic), and
-# refuses anything else.
+# refuses anything else. More --threads than the CPUs the process may run on (its
+# affinity: mpirun binds each rank to a core) are run, with a warning, and give the same bytes.
 # usage: test_environment.sh THZMAP_BINARY REPO_DIR
 . "$(dirname "$0")/lib.sh"
 S=$REPO/examples/plate-in-box/scene.json
@@ -141,5 +142,21 @@ done
 THZMAP_EMBREE_MAX_ISA=avx3 "$THZMAP" simulate "$S" -o "$work/isa-bad" "${R[@]}" 2>"$work/err"
 expect "THZMAP_EMBREE_MAX_ISA=avx3" $? 2 'THZMAP_EMBREE_MAX_ISA: expected one of sse2, sse4.2'
 [[ ! -e $work/isa-bad && -z $(leftovers) ]] || fail "THZMAP_EMBREE_MAX_ISA=avx3 left files"
+
+# --- more threads than CPUs to run on (mpirun and srun bind ranks): said, same bytes ------
+need taskset util-linux
+taskset -c 0 "$THZMAP" simulate "$S" -o "$work/pinned" "${R[@]}" 2>"$work/err"
+expect "--threads 2 on 1 CPU" $? 0 "simulate: warning: --threads 2, but this process may run on only 1 CPU"
+for f in "$work/isa-default"/*.img; do
+    cmp -s "$f" "$work/pinned/${f##*/}" || fail "--threads 2 on 1 CPU changed ${f##*/}"
+done
+taskset -c 0 "$THZMAP" simulate "$S" -o "$work/pinned1" --photons 20000 --integrator photon-map \
+    --threads 1 -q 2>"$work/err"
+expect "--threads 1 on 1 CPU" $? 0 ""
+! grep -q "may run on only" "$work/err" || fail "--threads 1 on 1 CPU warned: $(cat "$work/err")"
+echo '{"format": "thzmap-sequence/1", "scene": "'"$S"'"}' >"$work/seq.json"
+taskset -c 0 "$THZMAP" batch "$work/seq.json" -o "$work/pinned-batch" --threads 3 -q --no-movies \
+    2>"$work/err"
+expect "batch --threads 3 on 1 CPU" $? 0 "batch: warning: --threads 3, but this process may run on only 1 CPU"
 
 finish "environment: all passed"
