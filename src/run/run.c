@@ -456,7 +456,7 @@ thz_status run_check_simulate(const thz_scene *scene, const run_options *opt, th
     if (st == THZ_OK && photons)
         st = run_prepare_photons(&rs, err);
     if (st == THZ_OK)
-        st = run_check_run_memory(&rs, photons, 0, err);
+        st = run_check_run_memory(&rs, photons, 0, 0, err);
     run_state_fini(&rs);
     return st;
 }
@@ -472,7 +472,7 @@ thz_status run_simulate(const thz_scene *scene, const run_options *opt, run_stat
     if (st == THZ_OK && photons)
         st = run_prepare_photons(rs, err);
     if (st == THZ_OK)
-        st = run_check_run_memory(rs, photons, 0, err);
+        st = run_check_run_memory(rs, photons, 0, 0, err);
     if (st == THZ_OK && opt->plan)
         st = run_tell_plan(rs, true, err);
     if (st == THZ_OK)
@@ -539,7 +539,8 @@ thz_status run_render(const thz_scene *scene, const run_options *opt, const run_
                                  c);
     thz_status st = run_begin(rs, scene, opt, "render", err);
     if (st == THZ_OK) /* maps in memory already: the images alone; or one read at a time */
-        st = run_check_run_memory(rs, false, stream ? in->next_map_bytes : 0, err);
+        st = run_check_run_memory(rs, false, stream ? in->next_map_bytes : 0,
+                                  stream ? in->photons_per_channel : 0, err);
     if (st == THZ_OK && in) {
         if (in->stats)
             memcpy(rs->stats, in->stats, scene->n_channels * sizeof *rs->stats);

@@ -192,11 +192,13 @@ typedef struct run_memory {
                                * ray-casting structure (thz_process_memory_bytes) */
     uint64_t total_bytes;     /* all three */
     uint64_t available_bytes; /* thz_memory_limit_bytes, 0 if unknown */
+    uint64_t map_photons;     /* photon_bytes are a map read (render), not fired: its
+                               * photons per channel; 0 when fired */
 } run_memory;
 
 /* THZ_OK, or THZ_ERR_LIMIT when `need` exceeds 90 % of the memory the process may have
- * (thz_memory_limit_bytes), with a message naming `photons.per_channel`,
- * `sensors[i].resolution` or the scene's size. */
+ * (thz_memory_limit_bytes), with a message naming `photons.per_channel` (a map read: a
+ * map of fewer photons), `sensors[i].resolution` or the scene's size. */
 thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err);
 
 /* The same for each sensor's images alone (what loading can tell without building
@@ -212,9 +214,11 @@ thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t
 
 /* Estimates the memory of the run in rs (what the process holds already, its selected
  * sensors' images and the renderer's tables, and, when `photons`, the photon maps it
- * fires, else the map_bytes of maps the run reads one at a time), stores it in
+ * fires, else the map_bytes of maps the run reads one at a time, of map_photons photons
+ * per channel), stores it in
  * rs->memory_bytes and refuses the run as run_check_memory does. */
-thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t map_bytes, thz_error *err);
+thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t map_bytes,
+                                uint64_t map_photons, thz_error *err);
 
 /* Fire and render (simulate) or render from `in` (render; NULL only for path) into rs,
  * nothing written. On failure rs is finalised. */

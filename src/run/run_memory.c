@@ -38,21 +38,32 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
     if ((double)need->total_bytes <= limit)
         return THZ_OK;
     double gib = 1024.0 * 1024.0 * 1024.0;
-    char key[128];
+    char remedy[192];
     if (need->held_bytes > need->photon_bytes && need->held_bytes > need->image_bytes) {
         size_t big = 0; /* the object of most triangles */
         for (size_t o = 1; o < scene->n_objects; o++)
             if (scene->objects[o].mesh.n_triangles > scene->objects[big].mesh.n_triangles)
                 big = o;
-        snprintf(key, sizeof key, "objects[%zu].shape (%zu triangles) or the number of objects",
-                 big, scene->n_objects ? scene->objects[big].mesh.n_triangles : (size_t)0);
+        snprintf(remedy, sizeof remedy,
+                 "lower objects[%zu].shape (%zu triangles) or the number of objects", big,
+                 scene->n_objects ? scene->objects[big].mesh.n_triangles : (size_t)0);
+    } else if (need->photon_bytes >= need->image_bytes && need->map_photons > 0) {
+        /* render: the scene's photons.per_channel does not make the map it reads */
+        uint64_t fit = run_photons_that_fit(need->map_photons, need, limit);
+        char most[64] = "";
+        if (fit > 0)
+            snprintf(most, sizeof most, "; at most about %llu fit", (unsigned long long)fit);
+        snprintf(remedy, sizeof remedy,
+                 "render from a map of fewer photons (this one has %llu per channel, read a "
+                 "channel at a time%s)",
+                 (unsigned long long)need->map_photons, most);
     } else if (need->photon_bytes >= need->image_bytes) {
         uint64_t fit = run_photons_that_fit(scene->photons.per_channel, need, limit);
         char most[64] = "";
         if (fit > 0)
             snprintf(most, sizeof most, "; at most about %llu fit", (unsigned long long)fit);
         /* the scene key only: batch and Python have no --photons (simulate adds it) */
-        snprintf(key, sizeof key, "photons.per_channel (now %llu%s)",
+        snprintf(remedy, sizeof remedy, "lower photons.per_channel (now %llu%s)",
                  (unsigned long long)scene->photons.per_channel, most);
     } else {
         size_t big = 0;
@@ -61,17 +72,18 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
                 (uint64_t)scene->sensors[big].columns * scene->sensors[big].rows)
                 big = s;
         /* the images of every sensor together: the largest alone may not be the cause */
-        snprintf(key, sizeof key, "sensors[%zu].resolution%s", big,
+        snprintf(remedy, sizeof remedy, "lower sensors[%zu].resolution%s", big,
                  scene->n_sensors > 1 ? " (or the number of sensors)" : "");
     }
     return thz_error_set(err, THZ_ERR_LIMIT,
                          "%s: the run would need %.2f GiB of memory (photon maps %.2f GiB, "
                          "images and tables %.2f GiB, the scene as loaded %.2f GiB) but this "
                          "process may have %.2f GiB (the machine's memory, or less under ulimit "
-                         "-v or a cgroup limit); lower %s",
+                         "-v or a cgroup limit); %s",
                          scene->path ? scene->path : "the scene", (double)need->total_bytes / gib,
                          (double)need->photon_bytes / gib, (double)need->image_bytes / gib,
-                         (double)need->held_bytes / gib, (double)need->available_bytes / gib, key);
+                         (double)need->held_bytes / gib, (double)need->available_bytes / gib,
+                         remedy);
 }
 
 thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err)
@@ -146,12 +158,14 @@ thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t
     return THZ_OK;
 }
 
-thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t map_bytes, thz_error *err)
+thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t map_bytes,
+                                uint64_t map_photons, thz_error *err)
 {
     run_memory need = {.image_bytes = run_image_bytes(rs),
                        .photon_bytes = map_bytes,
                        .held_bytes = thz_process_memory_bytes(),
-                       .available_bytes = thz_memory_limit_bytes()};
+                       .available_bytes = thz_memory_limit_bytes(),
+                       .map_photons = map_bytes > 0 ? map_photons : 0};
     if (photons) {
         thz_status st =
             run_photon_map_bytes(rs->scene, rs->accel, SIZE_MAX, rs->opt->keep_photon_maps,

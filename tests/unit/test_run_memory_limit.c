@@ -7,7 +7,8 @@
  * sensors[0].resolution", which alone would not have made them fit. The photon passes
  * of photon-map towards a noise target stop at half the memory the process may have, not
  * half the machine's: under `prlimit --as=1G` on 23.5 GiB they were allowed 11.7 GiB
- * ("memory 11.7 GiB of 1 GiB") and the run ended "out of memory" after 12 s of passes. */
+ * ("memory 11.7 GiB of 1 GiB") and the run ended "out of memory" after 12 s of passes.
+ * A render whose photon map file does not fit names that map's photons, not the scene's. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -136,6 +137,33 @@ static void test_photons_refusal_names_the_scene_key(void **state)
     scene_destroy(s);
 }
 
+/* A render's map read from a file not fitting: the scene's photons.per_channel did not
+ * make that map, the map's own count did. `thzmap render --photon-map` of a map of 2e7
+ * photons a channel, under ulimit -v 400000, was told "lower photons.per_channel (now
+ * 300000; at most about 150000 fit)": the scene's key, and a count scaled from it. */
+static void test_read_map_refusal_names_the_map(void **state)
+{
+    (void)state;
+    thz_scene *s = load_large(false);
+    s->photons.per_channel = 300000;
+    run_memory need = {.photon_bytes = (uint64_t)64 << 30,
+                       .image_bytes = (uint64_t)1 << 20,
+                       .held_bytes = (uint64_t)20 << 20,
+                       .map_photons = 1000000000};
+    need.total_bytes = need.photon_bytes + need.image_bytes + need.held_bytes;
+    need.available_bytes = (uint64_t)4 << 30;
+    thz_error err;
+    thz_error_clear(&err);
+    assert_int_equal(run_check_memory(s, &need, &err), THZ_ERR_LIMIT);
+    /* room 0.9 x 4096 - 21 MiB for 65536 MiB of 1e9 photons, less 3 %: 5.43e7, rounded
+     * down to two digits */
+    assert_non_null(strstr(err.message, "; render from a map of fewer photons (this one has "
+                                        "1000000000 per channel, read a channel at a time; "
+                                        "at most about 54000000 fit)"));
+    assert_null(strstr(err.message, "photons.per_channel"));
+    scene_destroy(s);
+}
+
 static void test_passes_limit_under_address_space_limit(void **state)
 {
     (void)state;
@@ -187,6 +215,7 @@ int main(void)
         cmocka_unit_test(test_refusal_under_address_space_limit),
         cmocka_unit_test(test_images_of_several_sensors),
         cmocka_unit_test(test_photons_refusal_names_the_scene_key),
+        cmocka_unit_test(test_read_map_refusal_names_the_map),
         cmocka_unit_test(test_passes_limit_under_address_space_limit),
         cmocka_unit_test(test_image_bytes_are_the_planes),
     };
