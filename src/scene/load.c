@@ -299,6 +299,13 @@ static thz_status load_warnings(load_ctx *ctx, const load_cursor *root)
                                    "object \"%s\": inconsistent winding: %zu edge(s) used twice "
                                    "in the same direction, so some normals point the wrong way",
                                    obj->name, d.winding_conflicts);
+        if (ok && d.open_edges > 0 && !scene_object_two_sided(obj))
+            ok = scene_add_warning(s,
+                                   "object \"%s\": the mesh is open: %zu edge(s) of one triangle "
+                                   "only (holes, an open surface's rim, or a file cut short); "
+                                   "seen through an opening, a solid shows its back side, which "
+                                   "neither emits nor reflects",
+                                   obj->name, d.open_edges);
     }
     if (!ok)
         return thz_error_set(ctx->err, THZ_ERR_NOMEM, "out of memory");

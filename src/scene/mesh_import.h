@@ -33,6 +33,9 @@ typedef struct mesh_defects {
      * consistently wound mesh (a shared edge runs opposite ways in its two triangles; the
      * same way twice means one is wound the other way and its normal points wrong) */
     size_t winding_conflicts;
+    /* edges of one triangle only (no other triangle runs them either way): holes, an open
+     * surface's rim, or a file cut short; 0 for a closed mesh */
+    size_t open_edges;
 } mesh_defects;
 
 /* Counts the defects of an imported mesh into *out; false when out of memory. */

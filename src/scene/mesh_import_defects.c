@@ -1,6 +1,6 @@
 /* The defects of an imported mesh (mesh_import.h; load.c warns of each): repeated
- * triangles, triangles of no area, and edges that two triangles run the same way (the
- * winding check). mesh_import.c imports the mesh. */
+ * triangles, triangles of no area, edges that two triangles run the same way (the
+ * winding check) and edges of one triangle only (holes). mesh_import.c imports the mesh. */
 #include "scene/mesh_import.h"
 
 #include <math.h>
@@ -93,6 +93,21 @@ bool mesh_import_defects(const thz_mesh *mesh, mesh_defects *out)
     for (size_t i = 1; i < m; i++)
         if (edges[i] == edges[i - 1] && (i < 2 || edges[i - 1] != edges[i - 2]))
             out->winding_conflicts++;
+    for (size_t i = 0; i < m; i++) {
+        if ((i > 0 && edges[i - 1] == edges[i]) || (i + 1 < m && edges[i + 1] == edges[i]))
+            continue; /* run twice: not open, whatever its winding */
+        uint64_t rev = (edges[i] << 32) | (edges[i] >> 32);
+        size_t lo = 0, hi = m; /* the first edge >= rev */
+        while (lo < hi) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (edges[mid] < rev)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        if (lo == m || edges[lo] != rev)
+            out->open_edges++;
+    }
     free(tri);
     free(repeat);
     free(edges);

@@ -1,7 +1,8 @@
 /* Mesh import: the same tetrahedron from OBJ, PLY (ASCII, binary little- and big-endian)
  * and STL (ASCII and binary) gives 4 welded vertices, 4 triangles, the exact area and
  * outward normals; quads are triangulated; vertices of points and lines are dropped
- * and -0.0 welds with 0; the winding check finds a flipped face; a format only assimp
+ * and -0.0 welds with 0; the winding check finds a flipped face, the open-edge count a
+ * hole; a format only assimp
  * reads (glTF) gives the same tetrahedron; missing, empty and garbage files and formats
  * assimp does not read either are refused with the file named; a large STL's weld puts
  * its positions in (x, y, z) order, each corner where it was, also after the process used
@@ -182,9 +183,54 @@ static void test_repeats_and_no_area(void **state)
     assert_int_equal(d.repeated, 2);
     assert_int_equal(d.degenerate, 1);
     assert_int_equal(d.winding_conflicts, 0);
+    assert_int_equal(d.open_edges, 0); /* the repeats and the flat face leave it closed */
     mesh_fini(&m);
     unlink(path);
     rmdir(dir);
+}
+
+/* The open edges of `obj_text` (an OBJ file's text) as mesh_import_defects counts them. */
+static size_t open_edges(const char *obj_text)
+{
+    char dir[] = "/tmp/thz-test-mesh-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[64];
+    snprintf(path, sizeof path, "%s/m.obj", dir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(obj_text, f);
+    fclose(f);
+    thz_mesh m;
+    thz_error err = {0};
+    if (mesh_import(path, NULL, &m, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    mesh_defects d;
+    assert_true(mesh_import_defects(&m, &d));
+    mesh_fini(&m);
+    unlink(path);
+    rmdir(dir);
+    return d.open_edges;
+}
+
+/* Edges of one triangle only: a closed tetrahedron has none, one without its fourth face
+ * the three of its rim, a lone triangle three, a square of two triangles four (the
+ * diagonal is shared); a face wound the wrong way shares its edges all the same (a
+ * winding conflict, not a hole). A 1.3 M-triangle OBJ cut at 30 MB of 49 was imported
+ * with 454 061 triangles and no warning before these were counted. */
+static void test_open_edges(void **state)
+{
+    (void)state;
+    const char *v = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+    char text[256];
+    snprintf(text, sizeof text, "%sf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n", v);
+    assert_int_equal(open_edges(text), 0);
+    snprintf(text, sizeof text, "%sf 1 3 2\nf 1 2 4\nf 2 3 4\n", v);
+    assert_int_equal(open_edges(text), 3);
+    snprintf(text, sizeof text, "%sf 1 2 3\n", v);
+    assert_int_equal(open_edges(text), 3);
+    assert_int_equal(open_edges("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n"), 4);
+    snprintf(text, sizeof text, "%sf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 3 4\n", v);
+    assert_int_equal(open_edges(text), 0);
 }
 
 /* Lexicographic order of two positions, as the weld defines it (floats compared). */
@@ -337,6 +383,7 @@ int main(void)
         cmocka_unit_test(test_examples_unchanged),
         cmocka_unit_test(test_bad_winding),
         cmocka_unit_test(test_repeats_and_no_area),
+        cmocka_unit_test(test_open_edges),
         cmocka_unit_test(test_points_lines_negative_zero),
         cmocka_unit_test(test_weld_order),
         cmocka_unit_test(test_weld_negative_zero),
