@@ -397,6 +397,21 @@ static thz_status stl_check(mc_ctx *c, const char *data, size_t size)
                            (unsigned long long)count, MESH_MAX_TRIANGLES);
         c->triangles = count;
         c->work = 9 * count;
+        /* the corners' coordinates finite, as an ASCII file's numbers must be (NaN
+         * reached the import, which named a vertex of its own numbering): a float32's
+         * exponent bits all ones; the normal before them is not used */
+        const unsigned char *b = (const unsigned char *)data;
+        for (uint64_t t = 0; t < count; t++)
+            for (uint64_t k = 0; k < 9; k++) {
+                uint64_t at = 84 + 50 * t + 12 + 4 * k;
+                uint32_t bits = (uint32_t)b[at] | (uint32_t)b[at + 1] << 8 |
+                                (uint32_t)b[at + 2] << 16 | (uint32_t)b[at + 3] << 24;
+                if (((bits >> 23) & 0xffu) == 0xffu)
+                    return mc_fail(c, (mc_where){true, at},
+                                   "triangle %llu: vertex %llu has a coordinate that is not a "
+                                   "finite number (NaN or infinity)",
+                                   (unsigned long long)t + 1, (unsigned long long)k / 3 + 1);
+            }
         return THZ_OK;
     }
     mc_span all = {data, data + size}, tok;

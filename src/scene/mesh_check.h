@@ -14,10 +14,10 @@
  *   MESH_MAX_PLY_HEADER_BYTES; the declared records must fit in the file (binary: their
  *   exact sizes, list by list; ASCII: one record per line, the declared number of values,
  *   at least 2 bytes per value); list counts bounded; `vertex` has x, y and z; face
- *   indices name existing vertices.
- * - STL: binary exactly when 84 + 50 × (its triangle count) is the file's size; else
- *   ASCII with `solid`, `facet normal`, `outer loop`, three `vertex`, `endloop`,
- *   `endfacet`, `endsolid`, every coordinate a finite number.
+ *   indices name existing vertices; every float or double value finite (binary too).
+ * - STL: binary exactly when 84 + 50 × (its triangle count) is the file's size, every
+ *   corner's coordinate finite; else ASCII with `solid`, `facet normal`, `outer loop`,
+ *   three `vertex`, `endloop`, `endfacet`, `endsolid`, every coordinate a finite number.
  * - All: at most MESH_MAX_TRIANGLES triangles after triangulation, and a total
  *   triangulation work (the sum of the squares of the polygons' vertex counts) of at
  *   most MESH_MAX_POLYGON_WORK.

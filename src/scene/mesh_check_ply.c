@@ -264,6 +264,17 @@ static long long ply_get_int(const unsigned char *p, int t, bool big)
     return (long long)v;
 }
 
+/* Whether the float or double at p (PLY type t, its bytes in the file's order) is finite:
+ * its exponent bits are not all ones (NaN, infinity). */
+static bool ply_finite(const unsigned char *p, int t, bool big)
+{
+    unsigned n = ply_types[t].size;
+    uint64_t v = 0;
+    for (unsigned i = 0; i < n; i++)
+        v |= (uint64_t)p[big ? i : n - 1 - i] << (8 * (n - 1 - i));
+    return n == 4 ? ((v >> 23) & 0xffu) != 0xffu : ((v >> 52) & 0x7ffu) != 0x7ffu;
+}
+
 /* A list count, checked against its bound. */
 static thz_status ply_list_count(mc_ctx *c, const ply_element *e, const ply_property *p,
                                  long long n, mc_where w)
@@ -287,10 +298,11 @@ static thz_status ply_index(mc_ctx *c, const ply_header *h, long long v, mc_wher
     return THZ_OK;
 }
 
-/* One binary record of e from *at: list counts bounded, face indices checked. Returns
- * THZ_ERR_LIMIT, without a message, when the file ends inside it. */
+/* Record r of e, binary, from *at: list counts bounded, face indices checked, floats
+ * finite (as an ASCII file's numbers must be). Returns THZ_ERR_LIMIT, without a message,
+ * when the file ends inside it. */
 static thz_status ply_binary_record(mc_ctx *c, const ply_header *h, const ply_element *e,
-                                    const unsigned char *b, size_t size, uint64_t *at)
+                                    uint64_t r, const unsigned char *b, size_t size, uint64_t *at)
 {
     bool big = h->encoding == PLY_BIG;
     for (size_t k = 0; k < e->n_props; k++) {
@@ -309,6 +321,14 @@ static thz_status ply_binary_record(mc_ctx *c, const ply_header *h, const ply_el
         }
         if (*at + (uint64_t)n * isize > size)
             return THZ_ERR_LIMIT;
+        for (long long j = 0; !ply_types[p->type].integer && j < n; j++) {
+            uint64_t where = *at + (uint64_t)j * isize;
+            if (!ply_finite(b + where, p->type, big))
+                return mc_fail(c, (mc_where){true, where},
+                               "expected a finite number for '%s' of record %llu of element "
+                               "'%s', found NaN or infinity",
+                               p->name, (unsigned long long)r + 1, e->name);
+        }
         for (long long j = 0; p->is_index && j < n; j++) {
             uint64_t where = *at + (uint64_t)j * isize;
             thz_status st =
@@ -332,18 +352,19 @@ static thz_status ply_walk_binary(mc_ctx *c, const ply_header *h, const char *da
     uint64_t at = h->body;
     for (size_t i = 0; i < h->n_elements; i++) {
         const ply_element *e = &h->elements[i];
-        bool fixed = true;
+        bool fixed = true, floats = false;
         uint64_t record = 0;
         for (size_t k = 0; k < e->n_props; k++) {
             fixed &= e->props[k].count_type < 0;
+            floats |= !ply_types[e->props[k].type].integer;
             record += ply_types[e->props[k].type].size;
         }
-        if (fixed) { /* ply_check_sizes made sure they fit */
+        if (fixed && !floats) { /* ply_check_sizes made sure they fit */
             at += e->count * record;
             continue;
         }
         for (uint64_t r = 0; r < e->count; r++) {
-            thz_status st = ply_binary_record(c, h, e, b, size, &at);
+            thz_status st = ply_binary_record(c, h, e, r, b, size, &at);
             if (st == THZ_ERR_LIMIT)
                 return mc_fail(c, (mc_where){true, size},
                                "the file ends inside record %llu of the %llu of element '%s'",

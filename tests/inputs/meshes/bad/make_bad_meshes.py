@@ -26,9 +26,9 @@ def ply_header(fmt, n_vertices=4, n_faces=4, face=FACE, extra=""):
             f"element face {n_faces}\n{face}end_header\n").encode()
 
 
-def ply_binary(endian):
+def ply_binary(endian, verts=V):
     fmt = "binary_little_endian" if endian == "<" else "binary_big_endian"
-    body = b"".join(struct.pack(endian + "3f", *v) for v in V)
+    body = b"".join(struct.pack(endian + "3f", *v) for v in verts)
     body += b"".join(struct.pack(endian + "B3i", 3, *f) for f in F)
     return ply_header(fmt, extra="comment unit right tetrahedron, outward winding\n") + body
 
@@ -157,6 +157,13 @@ CASES = [
     ("ply_binary_empty_faces.ply",  # found by fuzzing: assimp aborts the process on it
      ply_header("binary_little_endian") + b"".join(struct.pack("<3f", *v) for v in V)
      + b"\0" * 4, "byte 217: a face of no vertices in element 'face'"),
+    # a binary float that is NaN or infinite, at its byte (the import named a vertex of
+    # its own numbering, without the byte)
+    ("ply_binary_nan_vertex.ply", ply_binary("<", [V[0], (1, float("nan"), 0)] + V[2:]),
+     f"byte {len(ply_binary('<')) - 4 * 13 - 4 * 12 + 12 + 4}: expected a finite number for "
+     "'y' of record 2 of element 'vertex', found NaN or infinity"),
+    ("ply_binary_be_inf_vertex.ply", ply_binary(">", V[:3] + [(0, 0, float("inf"))]),
+     "expected a finite number for 'z' of record 4 of element 'vertex', found NaN or infinity"),
     ("ply_ascii_bad_number.ply", PLY_ASCII.replace("1 0 0\n", "1 zero 0\n").encode(),
      ":11: expected a finite number for 'y' of element 'vertex'"),
     ("ply_ascii_extra_values.ply", PLY_ASCII.replace("0 1 0\n", "0 1 0 5\n").encode(),
@@ -172,6 +179,9 @@ CASES = [
     ("stl_binary_truncated.stl", STL_BINARY[:-10], "header counts 4 triangles"),
     ("stl_binary_solid_header_truncated.stl", b"solid" + STL_BINARY[5:-10],
      "header counts 4 triangles"),
+    ("stl_binary_nan_vertex.stl", STL_BINARY[:84 + 50 + 12 + 32] + struct.pack("<f", float("nan"))
+     + STL_BINARY[84 + 50 + 12 + 36:],
+     f"byte {84 + 50 + 12 + 32}: triangle 2: vertex 3 has a coordinate that is not a finite"),
     ("stl_ascii_truncated.stl", STL_ASCII[:150].encode(), "the file ends"),
     ("stl_ascii_no_endsolid.stl", STL_ASCII.replace("endsolid tetra\n", "").encode(),
      "the file ends inside a solid: expected 'endsolid'"),
