@@ -130,6 +130,25 @@ static const char *cli_stage_unit(const char *stage)
     return "steps";
 }
 
+/* Prints ", run ETA 12 s" for the whole run: from the share of the channels done so far
+ * (photons the first half of a channel when it fires any), else the estimate less the
+ * time spent; nothing without a plan or time left. frac: the stage's share done. */
+static void cli_progress_eta(const cli_progress *p, const thz_progress *pr, double frac, double now)
+{
+    double run_elapsed = now - p->run_start_s;
+    double render = cli_render_share(p, frac);
+    double share = (double)pr->channel + (strcmp(pr->stage, "photons") == 0 ? 0.5 * frac
+                                          : p->photons_seen                 ? 0.5 + 0.5 * render
+                                                                            : render);
+    share /= (double)(pr->n_channels ? pr->n_channels : 1);
+    double eta = share > 0.02 ? run_elapsed * (1.0 - share) / share : p->estimate_s - run_elapsed;
+    if (eta > 0.0 && p->run_start_s > 0.0) {
+        char left[32];
+        cli_format_seconds_left(left, sizeof left, eta);
+        fprintf(p->out, ", run ETA %s", left);
+    }
+}
+
 static void cli_progress_draw_tty(cli_progress *p, const thz_progress *pr, double now)
 {
     double elapsed = now - p->stage_start_s;
@@ -174,20 +193,7 @@ static void cli_progress_draw_tty(cli_progress *p, const thz_progress *pr, doubl
             sensor);
     if (rate > 0.0)
         fprintf(p->out, ", %.3g %s/s", rate, unit);
-    /* the whole run: the share of the channels done so far (photons the first half of a
-     * channel when it fires any), else the estimate less the time spent */
-    double run_elapsed = now - p->run_start_s;
-    double render = cli_render_share(p, frac);
-    double share = (double)pr->channel + (strcmp(pr->stage, "photons") == 0 ? 0.5 * frac
-                                          : p->photons_seen                 ? 0.5 + 0.5 * render
-                                                                            : render);
-    share /= (double)(pr->n_channels ? pr->n_channels : 1);
-    double eta = share > 0.02 ? run_elapsed * (1.0 - share) / share : p->estimate_s - run_elapsed;
-    if (eta > 0.0 && p->run_start_s > 0.0) {
-        char left[32];
-        cli_format_seconds_left(left, sizeof left, eta);
-        fprintf(p->out, ", run ETA %s", left);
-    }
+    cli_progress_eta(p, pr, frac, now);
     fflush(p->out);
     p->line_open = true;
 }
@@ -223,6 +229,33 @@ static void cli_progress_line(cli_progress *p, const thz_progress *pr, double no
     fflush(p->out);
 }
 
+/* Not a terminal (a log file, a batch system's output): a line within a long stage,
+ * "thzmap simulate: channel 1/6, photons: 40 % (400000000 of 1000000000 photons), 612 s,
+ * run ETA 7650 s", each time it passes another tenth at least CLI_LINE_EVERY_S after the
+ * stage's start or its last such line; before, a stage of an hour said nothing until
+ * it ended. */
+#define CLI_LINE_EVERY_S 10.0
+
+static void cli_progress_partial_line(cli_progress *p, const thz_progress *pr, double now)
+{
+    double frac = (double)pr->done / (double)pr->total;
+    int tenth = (int)(10.0 * frac);
+    if (tenth <= p->line_tenth || now - p->last_line_s < CLI_LINE_EVERY_S ||
+        (strcmp(pr->stage, "photons") != 0 && strcmp(pr->stage, "render") != 0))
+        return;
+    p->line_tenth = tenth;
+    p->last_line_s = now;
+    char sensor[160];
+    cli_progress_sensor_text(p, pr, sensor, sizeof sensor);
+    fprintf(p->out, "thzmap %s: channel %zu/%zu, %s: %.0f %% (%llu of %llu %s), %.0f s%s",
+            p->command, pr->channel + 1, pr->n_channels, pr->stage, 100.0 * frac,
+            (unsigned long long)pr->done, (unsigned long long)pr->total, cli_stage_unit(pr->stage),
+            now - p->stage_start_s, sensor);
+    cli_progress_eta(p, pr, frac, now);
+    fputc('\n', p->out);
+    fflush(p->out);
+}
+
 int cli_progress_report(void *user, const thz_progress *pr)
 {
     cli_progress *p = user;
@@ -248,6 +281,8 @@ int cli_progress_report(void *user, const thz_progress *pr)
          * previous pass (the time between belongs to the channel's rendering). */
         p->stage_start_s = other_stage && pr->done == 0 ? now : previous;
         p->last_draw_s = 0.0;
+        p->last_line_s = p->stage_start_s;
+        p->line_tenth = 0;
     }
     p->last_done = pr->done;
     if (strcmp(pr->stage, "photons") == 0)
@@ -260,6 +295,8 @@ int cli_progress_report(void *user, const thz_progress *pr)
         }
     } else if (done && !p->completed && strcmp(pr->stage, "output") != 0) {
         cli_progress_line(p, pr, now);
+    } else if (!done && pr->total > 0) {
+        cli_progress_partial_line(p, pr, now);
     }
     if (done)
         p->completed = true;

@@ -1,7 +1,8 @@
 /* Progress display on stderr for long runs, and Ctrl-C handling.
  *
  * When stderr is a terminal: one line, updated in place (channel i/n, stage, units done,
- * rate, ETA in s). Otherwise: one line per channel and stage when it completes. No
+ * rate, ETA in s). Otherwise: one line per channel and stage when it completes, and
+ * within a stage that runs long a line per tenth, at least 10 s apart. No
  * progress with --quiet; warnings always. The progress callback also carries cancellation: once
  * SIGINT or SIGTERM arrived it returns non-zero, so the run stops and removes its staging
  * directory.
@@ -30,6 +31,8 @@ typedef struct cli_progress {
                              starts); a pass that starts over: the report before */
     double last_report_s;
     double last_draw_s;
+    double last_line_s; /* not a terminal: the stage's start or its last partial line */
+    int line_tenth;     /* not a terminal: the tenth of the stage that line showed */
     double run_start_s; /* when the plan was told (0: no plan) */
     double estimate_s;  /* the plan's estimate of the whole run, s */
     bool photons_seen;  /* the run fires photons (half of each channel's share) */
@@ -61,10 +64,13 @@ void cli_progress_plan(void *user, const thz_run_plan *plan);
  * line redrawn at most every 0.1 s on a terminal, else a line each time it passes
  * another tenth. `thzmap batch` and `thzmap validate` show their checks of a sequence so. */
 typedef struct cli_count_line {
-    bool tty;           /* stderr is a terminal */
-    double start_s;     /* when the count began */
-    double last_draw_s; /* the last line's time */
-    int tenth;          /* not a terminal: the last tenth printed */
+    bool tty;       /* stderr is a terminal */
+    double start_s; /* when the count began */
+    double last_draw_s;
+    double last_line_s; /* not a terminal: the stage's start or its last partial line */
+    int line_tenth;
+    /* not a terminal: the tenth of the stage that line showed */ /* the last line's time */
+    int tenth; /* not a terminal: the last tenth printed */
 } cli_count_line;
 
 void cli_count_line_start(cli_count_line *c, bool tty);

@@ -121,6 +121,30 @@ for out in sys.argv[1:3]:
                 (out, "channel %d" % c, stage, times, key, ch[key])
 PY
 
+# --- a long stage on a non-terminal (a batch system's log): a line per tenth, 10 s apart ---
+# The render of 512 paths a sample takes seconds; stopped for 11 s within it (SIGSTOP:
+# no CPU), the stage has run 10 s when it goes on, and its next tenth is said. Before,
+# a stage said nothing until it ended, however long it ran.
+python3 - "$REPO/examples/plate-in-box/scene.json" "$work/long.json" <<'PY'
+import json, os, sys
+s = json.load(open(sys.argv[1]))
+s["materials"]["table"]["file"] = os.path.join(os.path.dirname(sys.argv[1]), "materials/sample.csv")
+s["render"] = {"integrator": "path", "paths_per_sample": 512}
+json.dump(s, open(sys.argv[2], "w"))
+PY
+"$THZMAP" simulate "$work/long.json" -o "$work/long" --threads 1 > /dev/null 2> "$work/long.err" &
+pid=$!
+for _ in $(seq 100); do grep -q 'estimate:' "$work/long.err" && break; sleep 0.1; done
+sleep 0.5
+kill -STOP $pid
+sleep 11
+kill -CONT $pid
+wait $pid || fail "the stopped and continued simulate exited $?"
+grep -Eq '^thzmap simulate: channel 1/1, render: [0-9]+ % \([0-9]+ of 64 rows\), (1[0-9]|[2-9][0-9]) s' \
+    "$work/long.err" || fail "no line within the long render: $(cat "$work/long.err")"
+[ "$(grep -c ' % (' "$work/long.err")" -eq 1 ] ||
+    fail "not one line within the long render: $(cat "$work/long.err")"
+
 # --- on a terminal: one line redrawn, rows named, no "ETA 0 s", memory in MiB below 1 GiB ---
 if command -v script > /dev/null; then
     TERM=xterm script -qec "'$THZMAP' simulate '$REPO/examples/teraeye/scene.json' -o '$work/tty' \
