@@ -8,7 +8,8 @@
 # a frame failing on rank 1 keeps the frames before it; a dealt frame's seconds and its
 # run warnings come with it); the render counts (back-face samples) are every rank's; only
 # rank 0 writes; a failed or killed rank fails the run with a message and a non-zero exit,
-# never a hang, and leaves no OUTDIR; so does a rank running another command (no hang).
+# never a hang, and leaves no OUTDIR; so does a rank running another command (no hang);
+# ranks bound to a core (Open MPI's default for 2) with 2 threads each are warned, once.
 # Usage: bash test_mpi.sh THZMAP_BINARY REPO_DIR
 set -u
 THZMAP=$1
@@ -516,6 +517,20 @@ rc=$?
 [ "$(grep -c "unknown command 'bogus'" "$work/bogus.out")" = 1 ] &&
     [ "$(grep -c "^usage: thzmap" "$work/bogus.out")" = 1 ] ||
     { fail "unknown command under mpirun: not printed once"; cat "$work/bogus.out"; }
+
+step "threads bound"
+# Open MPI binds each of 2 ranks to a core: --threads 2 then runs both threads on it.
+# Rank 0 says so, once (it said nothing: docs/mpi.md's hybrid example ran so); with
+# --bind-to none, nothing.
+timeout 120 mpirun --bind-to core:overload-allowed -np 2 "$THZMAP" simulate "$scene" \
+    -o "$work/bound" --threads 2 --quiet > "$work/bound.out" 2>&1 || fail "bound ranks: exit $?"
+[ "$(grep -c "warning: --threads 2, but this process may run on only 1 CPU" "$work/bound.out")" = 1 ] ||
+    { fail "2 ranks bound to a core, 2 threads: not warned once"; cat "$work/bound.out"; }
+timeout 120 mpirun --bind-to none -np 2 "$THZMAP" simulate "$scene" -o "$work/unbound" \
+    --threads 2 --quiet > "$work/unbound.out" 2>&1 || fail "unbound ranks: exit $?"
+if [ "$(nproc)" -ge 2 ] && grep -q "may run on only" "$work/unbound.out"; then
+    fail "--bind-to none: warned: $(cat "$work/unbound.out")"
+fi
 
 [ $fails = 0 ] && echo "test_mpi: all passed"
 exit $((fails > 0))
