@@ -17,7 +17,9 @@ thread only).
 """
 import ctypes
 import numbers
+import os
 import signal
+import sys
 import threading
 import warnings
 
@@ -35,6 +37,38 @@ class RunWarning(UserWarning):
 MAX_THREADS = 4096
 
 
+def _warn_threads_beyond_cpus(threads):
+    """A RuntimeWarning when `threads` exceed the CPUs this process may run on (its
+    affinity: mpirun binds each rank to a core or socket by default, srun to its
+    --cpus-per-task), as the thzmap program warns: the threads would share them
+    unseen (they ran so, and nothing said it)."""
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return
+    if 0 < cpus < threads:
+        warnings.warn(
+            f"threads={threads}, but this process may run on only {cpus} CPU"
+            f"{'' if cpus == 1 else 's'} (its affinity: mpirun binds each rank to one core "
+            f"or socket unless given --bind-to none or --map-by slot:PE={threads}, srun to "
+            f"its --cpus-per-task); the threads will share {'it' if cpus == 1 else 'them'}",
+            RuntimeWarning, stacklevel=_outside_stacklevel())
+
+
+def _outside_stacklevel():
+    """The stacklevel, for warnings.warn in the function that calls this one, of the
+    first caller outside the package (the calls in between differ from one entry point
+    to another)."""
+    def inside(frame):
+        return os.path.dirname(os.path.abspath(frame.f_code.co_filename)) == package
+
+    package = os.path.dirname(os.path.abspath(__file__))
+    frame, level = sys._getframe(1), 1
+    while frame is not None and inside(frame):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
 class Call:
     """Use as `with Call(threads, progress) as call: status = call.run(fn, ...)`."""
 
@@ -48,6 +82,8 @@ class Call:
                 raise ArgumentError(
                     f"threads: expected a whole number from 1 to {MAX_THREADS}, got {threads!r}")
             threads = int(threads)
+            if report_warnings:
+                _warn_threads_beyond_cpus(threads)
         self._report = make_reporter(progress)
         self._exc = None
         self._interrupted = False

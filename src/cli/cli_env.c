@@ -134,8 +134,8 @@ void cli_threads_check(const char *command, uint64_t threads)
     if (cpus < 1 || threads <= (uint64_t)cpus)
         return;
     /* Open MPI 4 binds each rank to a core (2 ranks or fewer) or a socket, Slurm's srun to
-     * its --cpus-per-task (since 22.05 not taken from sbatch's): 8 threads on 1 core ran
-     * 8 times slower, and said nothing */
+     * its --cpus-per-task (since 22.05 not taken from sbatch's): docs/mpi.md's hybrid
+     * example ran its 8 threads a rank on one core, and nothing said so */
     fprintf(stderr,
             "thzmap %s: warning: --threads %llu, but this process may run on only %d CPU%s "
             "(its affinity: mpirun binds each rank to one core or socket unless given "

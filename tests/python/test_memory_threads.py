@@ -6,6 +6,7 @@ import gc
 import os
 import threading
 import time
+import warnings
 import weakref
 
 import numpy as np
@@ -163,3 +164,23 @@ def test_library_objects_refuse_pickle_and_deepcopy(tiny_dir):
             pickle.dumps(obj)
     gc.collect()
     assert copy.copy(scene).sensor_names == scene.sensor_names
+
+
+def test_threads_beyond_the_cpus_to_run_on_are_warned(tiny_dir):
+    """threads=2 in a process that may run on one CPU (its affinity, as mpirun binds a
+    rank to a core) warns, pointing at the caller, as the thzmap program does; the run
+    goes on and gives the bytes of 1 thread. threads=1 does not warn."""
+    scene = thzmap.scene_from_dict(tiny_scene_dict(), base_dir=tiny_dir)
+    before = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, {min(before)})
+    try:
+        with pytest.warns(RuntimeWarning,
+                          match=r"threads=2, but this process may run on only 1 CPU \(") as w:
+            two = thzmap.simulate(scene, integrator="photon-map", seed=3, threads=2)
+        assert w[0].filename == __file__
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            one = thzmap.simulate(scene, integrator="photon-map", seed=3, threads=1)
+    finally:
+        os.sched_setaffinity(0, before)
+    assert_bitwise_equal(two.image(0).radiance, one.image(0).radiance, "radiance")
