@@ -2,6 +2,7 @@
 #include "cli_mpi.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h>
@@ -83,6 +84,14 @@ int cli_mpi_rank(void)
 int cli_mpi_size(void)
 {
     return cli_size;
+}
+
+const char *cli_mpi_signal_note(int sig)
+{
+    if (cli_size < 2 || sig != SIGTERM)
+        return "";
+    return " by SIGTERM, which mpirun sends every rank when one has ended (failed or killed: "
+           "mpirun names it) or when mpirun itself was signalled";
 }
 
 void cli_mpi_abort(int rc)

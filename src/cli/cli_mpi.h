@@ -20,6 +20,11 @@ int cli_mpi_finalize(int rc);
 int cli_mpi_rank(void);
 int cli_mpi_size(void);
 
+/* What to add to "interrupted" when signal sig stopped this rank of a job of several:
+ * for SIGTERM, that mpirun sends it when another rank ended (a rank killed with SIGKILL
+ * left rank 0 saying "interrupted", as if the user had stopped the job); else "". */
+const char *cli_mpi_signal_note(int sig);
+
 /* Ends every rank of the job with exit status rc (after this rank printed why). */
 _Noreturn void cli_mpi_abort(int rc);
 

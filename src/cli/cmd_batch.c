@@ -336,9 +336,10 @@ int cmd_batch(int argc, char **argv)
     /* a failure under an interrupt is the interrupt's (a child ended by the same Ctrl-C) */
     if (st == THZ_ERR_CANCELLED || (st != THZ_OK && cli_interrupt_signal())) {
         fprintf(stderr,
-                "thzmap batch: interrupted after %zu new frame%s; finished frames stay in %s "
+                "thzmap batch: interrupted%s after %zu new frame%s; finished frames stay in %s "
                 "(run the same command again to resume)\n",
-                res.computed, res.computed == 1 ? "" : "s", outdir);
+                cli_mpi_signal_note(cli_interrupt_signal()), res.computed,
+                res.computed == 1 ? "" : "s", outdir);
         rc = cli_interrupt_signal() ? 128 + cli_interrupt_signal() : CLI_EXIT_INTERRUPTED;
     } else if (st != THZ_OK) {
         rc = cli_fail(&err);

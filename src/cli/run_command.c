@@ -412,7 +412,8 @@ int cli_run_command(int argc, char **argv, bool render)
     /* a failure under an interrupt is the interrupt's: a Ctrl-C at the terminal also ends
      * the figure or mesh-import child, whose death the library reports as a failure */
     if (st == THZ_ERR_CANCELLED || (st != THZ_OK && cli_interrupt_signal())) {
-        fprintf(stderr, "thzmap %s: interrupted; no results written to %s\n", cmd, a.outdir);
+        fprintf(stderr, "thzmap %s: interrupted%s; no results written to %s\n", cmd,
+                cli_mpi_signal_note(cli_interrupt_signal()), a.outdir);
         rc = cli_interrupt_signal() ? 128 + cli_interrupt_signal() : CLI_EXIT_INTERRUPTED;
     } else if (st != THZ_OK) {
         rc = cli_fail(&err);
