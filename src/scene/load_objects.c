@@ -59,8 +59,8 @@ static thz_status load_mesh_file(load_ctx *ctx, const load_cursor *k, const char
     free(label);
     if (st == THZ_ERR_INPUT)
         return load_fail(ctx, k, "%s", inner.message);
-    if (st != THZ_OK)
-        return thz_error_set(ctx->err, st, "%s", inner.message);
+    if (st != THZ_OK) /* out of memory, a failed child: the scene and the key too */
+        return thz_error_set(ctx->err, st, "%s: %s: %s", ctx->label, k->path, inner.message);
     json_t *uses = json_object_get(ctx->mesh_uses, file);
     if (json_integer_value(uses) < 2)
         return THZ_OK;
