@@ -134,7 +134,7 @@ void cli_threads_check(const char *command, uint64_t threads)
     if (cpus < 1 || threads <= (uint64_t)cpus)
         return;
     /* Open MPI 4 binds each rank to a core (2 ranks or fewer) or a socket, Slurm's srun to
-     * its --cpus-per-task (since 22.05 not taken from sbatch's): docs/mpi.md's hybrid
+     * its --cpus-per-task (Slurm 22.05 to 23.02 do not take sbatch's): docs/mpi.md's hybrid
      * example ran its 8 threads a rank on one core, and nothing said so */
     fprintf(stderr,
             "thzmap %s: warning: --threads %llu, but this process may run on only %d CPU%s "
