@@ -64,13 +64,10 @@ void cli_progress_plan(void *user, const thz_run_plan *plan);
  * line redrawn at most every 0.1 s on a terminal, else a line each time it passes
  * another tenth. `thzmap batch` and `thzmap validate` show their checks of a sequence so. */
 typedef struct cli_count_line {
-    bool tty;       /* stderr is a terminal */
-    double start_s; /* when the count began */
-    double last_draw_s;
-    double last_line_s; /* not a terminal: the stage's start or its last partial line */
-    int line_tenth;
-    /* not a terminal: the tenth of the stage that line showed */ /* the last line's time */
-    int tenth; /* not a terminal: the last tenth printed */
+    bool tty;           /* stderr is a terminal */
+    double start_s;     /* when the count began */
+    double last_draw_s; /* the last line's time */
+    int tenth;          /* not a terminal: the last tenth printed */
 } cli_count_line;
 
 void cli_count_line_start(cli_count_line *c, bool tty);
