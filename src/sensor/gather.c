@@ -175,6 +175,9 @@ void render_gather(const render_context *ctx, const accel_hit *hit, vec3 ray_dir
     double area = M_PI * g.radius2_m2 / inv_q; /* the weight 1/q folded in */
     *radiance += g.sum / area;
     out->variance += g.sum2 / (area * area);
+    double sd = sqrt(g.sum2) / area;
+    out->covariance_bound += 2.0 * out->sd_sum * sd;
+    out->sd_sum += sd;
     for (unsigned b = 0; b < PHOTON_MAP_BATCHES; b++)
         out->batch[b] += g.batch[b] / area;
 }

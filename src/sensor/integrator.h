@@ -17,7 +17,11 @@
 
 /* Counters and the photon-map variance of one sample. */
 typedef struct render_sample {
-    double variance;                  /* photon-map: estimated variance of its radiance (Poisson) */
+    double variance; /* photon-map: estimated variance of its radiance (Poisson) */
+    /* photon-map: the bound of perfect correlation on the covariances of its density
+     * estimates (2 sum_{i<j} sd_i sd_j; 0 for one), and the sum of their standard errors:
+     * one photon is recorded on a straight shell and again behind it */
+    double covariance_bound, sd_sum;
     double batch[PHOTON_MAP_BATCHES]; /* the photon terms of each batch (in the radiance) */
     unsigned escaped, back_face, widened, starved, truncated;
     uint32_t back_object; /* with back_face: the object whose back it saw */

@@ -176,7 +176,10 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
          * photon overlaps its neighbours' and shares their photons, so for a pixel
          * with one, the bound of perfect correlation (the sum of standard errors,
          * squared) instead: never less than the truth (tests/cli/
-         * test_deviation_maps.sh measured the sum of variances 2x short in sd). */
+         * test_deviation_maps.sh measured the sum of variances 2x short in sd). Within
+         * a sample, the estimates on a straight shell and behind it share the photons
+         * that crossed it: their covariance takes the same bound (test_integrators.c,
+         * the tight cover: 1.32x short with the variances summed). */
         double var_sum = 0.0, sd_sum = 0.0;
         bool pixel_widened = false, pixel_starved = false;
         for (uint32_t j = 0; j < n; j++)
@@ -197,8 +200,9 @@ thz_status render_context_pass(const render_context *ctx, size_t sensor, uint32_
                     .strata = &strata[(size_t)omp_get_thread_num() * n_est],
                 };
                 integ->sample(ctx, cam.position_m, dir, sample_sr, &t, &s);
-                var_sum += s.variance;
-                sd_sum += sqrt(s.variance);
+                double var = s.variance + s.covariance_bound;
+                var_sum += var;
+                sd_sum += sqrt(var);
                 pixel_widened = pixel_widened || s.widened;
                 pixel_starved = pixel_starved || s.starved;
                 n_samples++;
