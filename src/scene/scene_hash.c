@@ -55,6 +55,35 @@ static uint64_t hash_spectrum(uint64_t h, const thz_spectrum *s)
     return h;
 }
 
+/* A complex index (material_index.h), which the material's spectra do not hold: n and k
+ * at the table's frequencies and at 17 points across each channel's band (its support
+ * at 4 sigma, inside the 2 FWHM where the loader checks the index), which a change of
+ * any table value or model parameter that the bands can see moves. */
+static uint64_t hash_index(uint64_t h, const thz_scene *scene, const material_index *idx)
+{
+    const double *table_hz = NULL;
+    size_t n_table = material_index_table_hz(idx, &table_hz);
+    h = hash_word(h, n_table);
+    double n, k;
+    for (size_t i = 0; i < n_table; i++)
+        if (material_index_at(idx, table_hz[i], &n, &k)) {
+            h = hash_double(h, n);
+            h = hash_double(h, k);
+        }
+    for (size_t c = 0; c < scene->n_channels; c++) {
+        double lo, hi;
+        channel_support_hz(&scene->channels[c], 4.0, &lo, &hi);
+        if (!(lo > 0.0))
+            lo = hi / 1024.0;
+        for (int j = 0; j <= 16; j++)
+            if (material_index_at(idx, lo + (hi - lo) * j / 16.0, &n, &k)) {
+                h = hash_double(h, n);
+                h = hash_double(h, k);
+            }
+    }
+    return h;
+}
+
 /* splitmix64's finaliser: spreads the last bytes over the whole word. */
 static uint64_t hash_finish(uint64_t h)
 {
@@ -128,6 +157,8 @@ void scene_hash_compute(const thz_scene *scene, scene_hash *out)
             o = hash_double(o, m->ward_alpha[0]);
             o = hash_double(o, m->ward_alpha[1]);
         }
+        if (m->index) /* only then, as the lobe */
+            o = hash_index(o, scene, m->index);
     }
     const thz_atmosphere *atm = &scene->atmosphere;
     o = hash_word(o, (uint64_t)atm->model);

@@ -5,8 +5,9 @@
  *  - geometry: every object's type, sidedness, thickness and mesh (vertex positions
  *    and triangle indices, bit for bit);
  *  - optics: every object's material index and temperature, every material's spectra
- *    (R, alpha_M, eps) and transmission mode, the atmosphere (model, spectrum, air
- *    state, the prepared alpha tables of the line-by-line models, emission, extent);
+ *    (R, alpha_M, eps), transmission mode, lobe and complex index, the atmosphere
+ *    (model, spectrum, air state, the prepared alpha tables of the line-by-line models,
+ *    emission, extent);
  *  - channels: the channels' centres and widths, and measured responses' tables (nothing
  *    for a Gaussian, so that its hash is what it was before tables existed).
  * Names, colours, sensors, render settings and the photon count, seed and

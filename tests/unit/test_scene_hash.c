@@ -6,7 +6,9 @@
  * gets another scene's images without a word; the sensors must move none, else no frame
  * of a moving camera reuses photons. Here the values no other test changes: a Ward lobe's
  * alpha_y, a spectral table's frequencies, an emitting air's background temperature and
- * extent, a measured response's weights, a line model's switch (its air state alike). */
+ * extent, a measured response's weights, a line model's switch (its air state alike), a
+ * complex index (its R, T and eps follow from it, and none of the material's spectra holds
+ * it: a map fired for n = 2 was taken to render n = 3). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -134,12 +136,57 @@ static void test_sensors_move_none(void **state)
     assert_true(a.channels == b.channels);
 }
 
+/* The optics' fingerprint of a box of material `material` (a JSON object). */
+static uint64_t optics_of(const char *material)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"format\": \"thzmap-scene/1\","
+             " \"channels\": [{\"frequency_thz\": 0.35, \"relative_width\": 0.02}],"
+             " \"materials\": {\"m\": %s},"
+             " \"objects\": [{\"name\": \"box\", \"type\": \"solid\", \"material\": \"m\","
+             "   \"temperature_k\": 300, \"shape\": {\"type\": \"box\", \"size_m\": [1, 1, 1]}}],"
+             " \"sensors\": [{\"name\": \"cam\", \"position_m\": [0, -2, 0],"
+             "   \"look_at_m\": [0, 0, 0], \"fov_deg\": 40, \"resolution\": [4, 4]}]}",
+             material);
+    thz_scene *s = NULL;
+    thz_error err = {0};
+    if (scene_load_string(text, THZ_SOURCE_DIR, "t.json", &s, &err) != THZ_OK)
+        fail_msg("%s", err.message);
+    scene_hash h;
+    scene_hash_compute(s, &h);
+    scene_destroy(s);
+    return h.optics;
+}
+
+/* A complex index, constant, tabled or a permittivity model, changed in one value. */
+static void test_complex_index_moves_it(void **state)
+{
+    (void)state;
+    static const char *const pairs[][2] = {
+        {"{\"refractive_index\": [2, 0.01]}", "{\"refractive_index\": [3, 0.01]}"},
+        {"{\"refractive_index\": [2, 0.01]}", "{\"refractive_index\": [2, 0.02]}"},
+        {"{\"refractive_index\": [[0.3, 2, 0.01], [0.4, 2.1, 0.01]]}",
+         "{\"refractive_index\": [[0.3, 2, 0.01], [0.4, 2.2, 0.01]]}"},
+        {"{\"permittivity_model\": {\"model\": \"debye\", \"eps_inf\": 2, \"eps_s\": 4,"
+         " \"tau_ps\": 1}}",
+         "{\"permittivity_model\": {\"model\": \"debye\", \"eps_inf\": 2, \"eps_s\": 4,"
+         " \"tau_ps\": 1.1}}"},
+    };
+    for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; i++)
+        if (optics_of(pairs[i][0]) == optics_of(pairs[i][1]))
+            fail_msg("%s -> %s: the optics' fingerprint stayed", pairs[i][0], pairs[i][1]);
+    /* and the same index gives the same fingerprint */
+    assert_true(optics_of(pairs[0][0]) == optics_of(pairs[1][0]));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_photon_inputs_move_it),
         cmocka_unit_test(test_line_switch_moves_it),
         cmocka_unit_test(test_sensors_move_none),
+        cmocka_unit_test(test_complex_index_moves_it),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
