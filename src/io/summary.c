@@ -20,6 +20,7 @@
 #include "core/json_text.h"
 #include "core/path.h"
 #include "physics/channel.h"
+#include "scene/scene_hash.h"
 #include "sensor/measure.h"
 #include "sensor/noise.h"
 #include "thzmap/thzmap.h"
@@ -220,6 +221,29 @@ static json_t *sum_sensor(const thz_scene *scene, size_t i, const run_summary *s
     return o;
 }
 
+static json_t *sum_hex(uint64_t v)
+{
+    char hex[17];
+    snprintf(hex, sizeof hex, "%016llx", (unsigned long long)v);
+    return json_string(hex);
+}
+
+/* What identifies the scene as run, for telling whether two outputs came from the same
+ * one (scene_hash.h): its geometry, its optics (materials and their tables, temperatures,
+ * atmosphere), its channels, and all that with the sensors and the photon and render
+ * settings but for the photon count and seed, which summary.json gives beside it. */
+static json_t *sum_fingerprint(const thz_scene *scene, bool *ok)
+{
+    scene_hash h;
+    scene_hash_compute(scene, &h);
+    json_t *o = json_object();
+    sum_set(o, "geometry", sum_hex(h.geometry), ok);
+    sum_set(o, "optics", sum_hex(h.optics), ok);
+    sum_set(o, "channels", sum_hex(h.channels), ok);
+    sum_set(o, "run", sum_hex(scene_hash_run(scene, true)), ok);
+    return o;
+}
+
 /* The document, or NULL when out of memory. */
 static json_t *summary_build(const thz_scene *scene, const run_summary *summary)
 {
@@ -230,6 +254,7 @@ static json_t *summary_build(const thz_scene *scene, const run_summary *summary)
     json_t *sc = json_object();
     sum_set(sc, "name", sum_string(scene->name), &ok);
     sum_set(sc, "path", sum_string(scene->path), &ok);
+    sum_set(sc, "fingerprint", sum_fingerprint(scene, &ok), &ok);
     sum_set(root, "scene", sc, &ok);
     sum_set(root, "seed", sum_u64(summary->seed), &ok);
     sum_set(root, "photons_per_channel", sum_u64(summary->photons_per_channel), &ok);
@@ -238,6 +263,14 @@ static json_t *summary_build(const thz_scene *scene, const run_summary *summary)
     sum_set(root, "target_noise_k",
             summary->target_noise_k > 0.0 ? sum_real(summary->target_noise_k) : json_null(), &ok);
     sum_set(root, "target_noise_source", sum_string(summary->target_source), &ok);
+    /* the settings that, with the scene and seed, make the images */
+    sum_set(root, "max_seconds",
+            scene->render.max_seconds > 0.0 ? sum_real(scene->render.max_seconds) : json_null(),
+            &ok);
+    sum_set(root, "paths_per_sample", json_integer(scene->render.paths_per_sample), &ok);
+    sum_set(root, "gather_rays", json_integer(scene->render.gather_rays), &ok);
+    sum_set(root, "gather_min_photons", json_integer(scene->photons.gather_min_photons), &ok);
+    sum_set(root, "min_relative_power", sum_real(scene->photons.min_relative_power), &ok);
     sum_set(root, "threads", json_integer(summary->threads), &ok);
     sum_set(root, "mpi_ranks", json_integer(summary->mpi_ranks > 1 ? summary->mpi_ranks : 1), &ok);
     sum_set(root, "atmosphere_model", json_string(atmosphere_model_name(scene->atmosphere.model)),
