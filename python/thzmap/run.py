@@ -241,8 +241,8 @@ _MAPS = (_lib.PLANE_TEMPERATURE, _lib.PLANE_DISTANCE, _lib.PLANE_OBJECT_ID)
 
 class Image:
     """One sensor's rendered image. Cubes are numpy float32 arrays shaped (rows, columns,
-    channels): radiance (W m^-2 sr^-1 Hz^-1), radiance_stderr (None when not estimated),
-    power (W), brightness_temperature (K), normalized (1). Maps shaped (rows, columns):
+    channels): radiance (W m^-2 sr^-1 Hz^-1), radiance_stderr (the same unit; all 0 where
+    not estimated: one estimate per sample in one pass), power (W), brightness_temperature (K), normalized (1). Maps shaped (rows, columns):
     temperature (K, -1 where nothing is hit), distance (m, -1: none), object_id (index
     of the object seen as float, -1: none), as in the ENVI files; visual (rows, columns,
     3) rgb 0..1; measured_radiance and measured_brightness_temperature (the sensor's PSF

@@ -341,3 +341,15 @@ def test_photon_map_accessors(tiny_dir):
     assert scene.seconds_load > 0
     run = thzmap.render(scene, a)
     assert run.summary["timings_s"]["load"] == pytest.approx(scene.seconds_load, rel=1e-6)
+
+
+def test_stderr_not_estimated_is_zero(tiny_dir):
+    """One path per sample in one pass gives each pixel no spread to estimate its error
+    from: radiance_stderr holds zeros there (python.md), and a number with 2 paths."""
+    for paths, estimated in ((1, False), (2, True)):
+        d = tiny_scene_dict()
+        d.setdefault("render", {})["paths_per_sample"] = paths
+        scene = thzmap.scene_from_dict(d, base_dir=tiny_dir)
+        im = thzmap.simulate(scene, integrator="path", seed=SEED, threads=2).image("cam")
+        assert im.radiance_stderr is not None
+        assert bool((im.radiance_stderr > 0).any()) == estimated, paths
