@@ -180,6 +180,15 @@ THZ_API size_t thz_scene_sensor_count(const thz_scene *scene);
 THZ_API long thz_scene_sensor_index(const thz_scene *scene, const char *name);
 THZ_API long thz_scene_object_index(const thz_scene *scene, const char *name);
 
+/* What identifies the scene as loaded (summary.json's scene.fingerprint): 64-bit hashes
+ * of its geometry (meshes bit for bit), its optics (materials as evaluated, temperatures,
+ * atmosphere), its channels, and `run`: those with the sensors and the photon and render
+ * settings but for the photon count and seed. Names and colours do not count. */
+typedef struct thz_scene_fingerprint {
+    uint64_t geometry, optics, channels, run;
+} thz_scene_fingerprint;
+THZ_API thz_status thz_scene_get_fingerprint(const thz_scene *scene, thz_scene_fingerprint *out);
+
 /* The scene's validation warnings (emissivity breaking Kirchhoff's law, bands leaving
  * a table, mesh winding): count, and warning i (NULL when out of range). */
 THZ_API size_t thz_scene_warning_count(const thz_scene *scene);

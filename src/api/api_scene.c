@@ -11,6 +11,7 @@
 #include "core/c_locale.h"
 #include "physics/channel.h"
 #include "physics/planck.h"
+#include "scene/scene_hash.h"
 #include "sensor/measure.h"
 #include "sensor/noise.h"
 #include "sensor/psf.h"
@@ -100,6 +101,22 @@ thz_status thz_scene_get_info(const thz_scene *s, thz_scene_info *out)
         .gather_rays = s->render.gather_rays,
         .paths_per_sample = s->render.paths_per_sample,
     };
+    return THZ_OK;
+}
+
+thz_status thz_scene_get_fingerprint(const thz_scene *s, thz_scene_fingerprint *out)
+{
+    if (!out)
+        return THZ_ERR_INPUT;
+    memset(out, 0, sizeof *out);
+    if (!s)
+        return THZ_ERR_INPUT;
+    scene_hash h;
+    scene_hash_compute(s, &h);
+    *out = (thz_scene_fingerprint){.geometry = h.geometry,
+                                   .optics = h.optics,
+                                   .channels = h.channels,
+                                   .run = scene_hash_run(s, true)};
     return THZ_OK;
 }
 

@@ -253,6 +253,12 @@ static void validate_print(const thz_scene *s)
            si.min_relative_power, si.gather_min_photons);
     printf("render: integrator %s, gather_rays %u, paths_per_sample %u\n", si.integrator,
            si.gather_rays, si.paths_per_sample);
+    thz_scene_fingerprint fp;
+    if (thz_scene_get_fingerprint(s, &fp) == THZ_OK)
+        printf("fingerprint: geometry %016llx, optics %016llx, channels %016llx, run %016llx "
+               "(summary.json's scene.fingerprint; run as the scene's own settings give it)\n",
+               (unsigned long long)fp.geometry, (unsigned long long)fp.optics,
+               (unsigned long long)fp.channels, (unsigned long long)fp.run);
     printf("\nemitted spectral power of the surfaces (band mean P_A; a run's photon phase "
            "also fires the air's own emission, in summary.json's energy_balance):\n");
     for (size_t c = 0; c < si.n_channels; c++) {

@@ -20,7 +20,6 @@
 #include "core/json_text.h"
 #include "core/path.h"
 #include "physics/channel.h"
-#include "scene/scene_hash.h"
 #include "sensor/measure.h"
 #include "sensor/noise.h"
 #include "thzmap/thzmap.h"
@@ -228,19 +227,18 @@ static json_t *sum_hex(uint64_t v)
     return json_string(hex);
 }
 
-/* What identifies the scene as run, for telling whether two outputs came from the same
- * one (scene_hash.h): its geometry, its optics (materials and their tables, temperatures,
- * atmosphere), its channels, and all that with the sensors and the photon and render
- * settings but for the photon count and seed, which summary.json gives beside it. */
+/* What identifies the scene as run (thz_scene_get_fingerprint): its geometry, optics and
+ * channels, and with the sensors and settings but for the photon count and seed, which
+ * summary.json gives beside it. */
 static json_t *sum_fingerprint(const thz_scene *scene, bool *ok)
 {
-    scene_hash h;
-    scene_hash_compute(scene, &h);
+    thz_scene_fingerprint f;
+    thz_scene_get_fingerprint(scene, &f);
     json_t *o = json_object();
-    sum_set(o, "geometry", sum_hex(h.geometry), ok);
-    sum_set(o, "optics", sum_hex(h.optics), ok);
-    sum_set(o, "channels", sum_hex(h.channels), ok);
-    sum_set(o, "run", sum_hex(scene_hash_run(scene, true)), ok);
+    sum_set(o, "geometry", sum_hex(f.geometry), ok);
+    sum_set(o, "optics", sum_hex(f.optics), ok);
+    sum_set(o, "channels", sum_hex(f.channels), ok);
+    sum_set(o, "run", sum_hex(f.run), ok);
     return o;
 }
 

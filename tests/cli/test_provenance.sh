@@ -6,8 +6,9 @@
 # min_relative_power, target_noise_k, max_seconds); a rerun from what it records alone,
 # on another thread count, writes the same files with the same fingerprint. A scene
 # whose physics differs has another fingerprint; one renamed and recoloured the same.
-# (Before, summary.json named the scene's file and name only, and none of the render
-# settings: an output could not be told from one of an edited scene.)
+# `thzmap validate` prints a scene file's fingerprint. (Before, summary.json named the
+# scene's file and name only, and none of the render settings: an output could not be
+# told from one of an edited scene.)
 # argv: path to the thzmap binary, repository directory.
 . "$(dirname "$0")/lib.sh"
 
@@ -91,4 +92,12 @@ read -r g2 o2 c2 r2 <<<"$(fingerprint "$work/moved")"
 if ! { [ "$g2" != "$g" ] && [ "$o2 $c2" = "$o $c" ]; }; then
     fail "a plate moved 1 cm: fingerprint $g2 $o2 $c2 $r2 against $base"
 fi
+# validate prints the fingerprint a scene file has, to match with an output's: the run
+# hash is of the scene's own integrator (path here; the runs above were given another)
+"$THZMAP" validate "$work/base.json" >"$work/validate.out" || fail "validate: exit $?"
+"$THZMAP" simulate "$work/base.json" -o "$work/own" -q --threads 2 || fail "simulate own: exit $?"
+read -r g2 o2 c2 r2 <<<"$(fingerprint "$work/own")"
+expect_line "$work/validate.out" \
+    "^fingerprint: geometry $g, optics $o, channels $c, run $r2 \\(summary.json's"
+[ "$g2 $o2 $c2" = "$g $o $c" ] || fail "the path run's fingerprint differs in its physics"
 finish "summary.json records the scene's fingerprint and settings; a rerun from it writes the same files"
