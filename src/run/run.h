@@ -150,6 +150,7 @@ typedef struct run_state {
     uint64_t photons_per_channel;
     size_t n_warnings;
     char **warnings;
+    bool told_unestimated; /* run_write's warning that the standard errors read 0 */
     double seconds_accel, seconds_photons, seconds_render, seconds_output;
     run_result result; /* the totals, filled when the run succeeded */
 } run_state;

@@ -109,6 +109,23 @@ thz_status run_write(run_state *rs, const char *dir, const run_write_options *wo
     if (st != THZ_OK)
         return st;
     rs->seconds_output = thz_now_s() - t0;
+    /* One estimate per sample in one pass has no spread: the stderr cubes and the noise
+     * figures read 0 K, which must not pass for exact pixels. Said where the files are
+     * written (thzmap bands renders its variants so, and estimates their noise itself). */
+    if (!rs->told_unestimated && render_integrator_has_passes(rs->scene->render.integrator) &&
+        render_estimates_per_pass(rs->scene) < 2 && !(rs->target_noise_k > 0.0)) {
+        bool path = rs->scene->render.integrator == INTEGRATOR_PATH;
+        const char *key = path ? "paths_per_sample" : "gather_rays";
+        st = run_add_warning(rs, err,
+                             "the standard errors are not estimated: %s 1 in one pass gives "
+                             "one estimate per sample, whose spread is unknown, so the "
+                             "radiance_stderr cubes and the noise figures read 0 K (give %s 2 "
+                             "or more, or a noise target)",
+                             key, key);
+        if (st != THZ_OK)
+            return st;
+        rs->told_unestimated = true;
+    }
     run_summary sum = run_summary_of(rs);
     st = summary_write(dir, rs->scene, &sum, err);
     if (st != THZ_OK)

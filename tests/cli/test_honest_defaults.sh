@@ -219,5 +219,18 @@ import json, sys
 c = json.load(open(sys.argv[1]))["channels"][0]
 assert c["render_passes"] >= 2 and 0 <= c["p95_stderr_k"] <= 0.5, c
 PY
+# without the target: one pass, its standard errors read 0 K, and the run says they are
+# not estimated (it did not: a cube of zeros passed for exact pixels); 2 paths do not
+make_scene onepass "s['render'] = {'integrator': 'path', 'paths_per_sample': 1}"
+make_scene twopaths "s['render'] = {'integrator': 'path', 'paths_per_sample': 2}"
+for v in onepass twopaths; do
+    "$THZMAP" simulate "$work/$v.json" -o "$work/out-$v" --quiet 2>"$work/$v.err" ||
+        fail "$v: $(cat "$work/$v.err")"
+done
+expect_line "$work/onepass.err" "^thzmap simulate: warning: the standard errors are not estimated: paths_per_sample 1 in one pass"
+grep -q 'not estimated' "$work/out-onepass/summary.json" ||
+    fail "one path a sample, one pass: summary.json's warnings do not say the errors are not estimated"
+grep -q 'not estimated' "$work/twopaths.err" "$work/out-twopaths/summary.json" &&
+    fail "two paths a sample: warned that the errors are not estimated"
 
 finish "honest defaults: all checks passed"
