@@ -27,6 +27,18 @@ static void plot_child_short_cwd(char *cwd, size_t size)
         cwd[0] = '\0';
 }
 
+/* In a figure's child, before PLplot loads its cairo driver (and with it GLib): GLib's
+ * slice allocator, when an allocation in its own set-up fails, logs the failure through
+ * code that allocates a slice again and waits on its own lock for ever (seen under
+ * tests/cli/test_alloc_fail.sh's failing allocator: render hung past the test's 90 s,
+ * the figures' time limit being 60 s each). With plain malloc GLib aborts instead, and
+ * the run fails at once "while plotting". Set in the child alone, which one thread runs. */
+static void plot_child_begin(char *cwd, size_t size)
+{
+    setenv("G_SLICE", "always-malloc", 0);
+    plot_child_short_cwd(cwd, size);
+}
+
 /* path as the child must name it: as given, or after cwd when the child moved. */
 static const char *plot_child_path(const char *cwd, const char *path, char *buf, size_t size)
 {
@@ -39,7 +51,7 @@ static const char *plot_child_path(const char *cwd, const char *path, char *buf,
 static thz_status plot_check_device_child(void *arg, thz_error *err)
 {
     char cwd[PLOT_CHILD_TEXT];
-    plot_child_short_cwd(cwd, sizeof cwd);
+    plot_child_begin(cwd, sizeof cwd);
     return plot_check_device_here(arg, err);
 }
 
@@ -83,7 +95,7 @@ static thz_status plot_attenuation_child(void *arg, thz_error *err)
 {
     const plot_attenuation_args *a = arg;
     char cwd[PLOT_CHILD_TEXT], path[2 * PLOT_CHILD_TEXT];
-    plot_child_short_cwd(cwd, sizeof cwd);
+    plot_child_begin(cwd, sizeof cwd);
     return plot_attenuation_draw(plot_child_path(cwd, a->path, path, sizeof path), a->n_x, a->x,
                                  a->n_curves, a->curves, a->n_bands, a->bands, a->title, a->x_label,
                                  a->y_label, err);
@@ -285,7 +297,7 @@ static thz_status plot_share_child(void *arg, thz_error *err)
 {
     const plot_share *sh = arg;
     char cwd[PLOT_CHILD_TEXT], buf[2 * PLOT_CHILD_TEXT];
-    plot_child_short_cwd(cwd, sizeof cwd);
+    plot_child_begin(cwd, sizeof cwd);
     for (size_t i = sh->lo; i < sh->hi; i++) {
         const plot_item *it = &sh->b->items[i];
         const char *path = plot_child_path(cwd, it->path, buf, sizeof buf);
