@@ -143,8 +143,10 @@ static void mirror_case(thz_integrator integrator)
             vec3 q = v3(p.x + u * d.x, 1.0, -u * d.z);
             double rho = sqrt(q.x * q.x + (q.z - 1.0) * (q.z - 1.0));
             double l = r.img.radiance[ident_at(&r, 0, col, row)];
-            /* exact but for path's frequency sampling beyond the first hit */
-            double tol = 1e-6 * b + IDENT_Z * r.img.radiance_stderr[ident_at(&r, 0, col, row)];
+            /* exact but for path's frequency sampling beyond the first hit; photon-map's
+             * error is unknown (NaN) on the unlit disk, whose reflection 0 is exact */
+            double se = r.img.radiance_stderr[ident_at(&r, 0, col, row)];
+            double tol = 1e-6 * b + (isnan(se) ? 0.0 : IDENT_Z * se);
             if (rho < 0.17) {
                 inside++;
                 if (!(fabs(l - 0.9 * b) <= tol))
