@@ -18,12 +18,70 @@
 #include "io/output.h"
 #include "io/plot.h"
 
-/* A qualitative palette (sRGB 0..255): class k is drawn in colour k mod 10, pixels
- * where nothing is hit in black. */
-static const unsigned char class_palette[10][3] = {
-    {31, 119, 180}, {255, 127, 14},  {44, 160, 44},   {214, 39, 40},  {148, 103, 189},
-    {140, 86, 75},  {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207},
+/* The first classes' colours (sRGB 0..255): a qualitative palette of 20, its first ten
+ * the common "tab10" and then their lighter companions ("tab20"). */
+static const unsigned char class_palette[20][3] = {
+    {31, 119, 180},  {255, 127, 14},  {44, 160, 44},   {214, 39, 40},   {148, 103, 189},
+    {140, 86, 75},   {227, 119, 194}, {127, 127, 127}, {188, 189, 34},  {23, 190, 207},
+    {174, 199, 232}, {255, 187, 120}, {152, 223, 138}, {255, 152, 150}, {197, 176, 213},
+    {196, 156, 148}, {247, 182, 210}, {199, 199, 199}, {219, 219, 141}, {158, 218, 229},
 };
+
+/* Squared sRGB distance. */
+static int colour_distance2(const unsigned char *a, const unsigned char *b)
+{
+    int d = 0;
+    for (int i = 0; i < 3; i++)
+        d += ((int)a[i] - b[i]) * ((int)a[i] - b[i]);
+    return d;
+}
+
+/* Candidate j beyond the palette: hue by the golden ratio, saturation 0.45-0.95 and
+ * value 0.55-0.95 (never near the black of "nothing hit") by a plastic-number sequence,
+ * so that successive candidates lie far apart. */
+static void colour_candidate(size_t j, unsigned char *rgb)
+{
+    double h = fmod(0.5 + (double)j * 0.6180339887498949, 1.0) * 6.0;
+    double s = 0.45 + 0.5 * fmod((double)j * 0.7548776662466927, 1.0);
+    double v = 0.55 + 0.4 * fmod((double)j * 0.5698402909980532, 1.0);
+    double f = h - floor(h), p = v * (1.0 - s), q = v * (1.0 - s * f),
+           t = v * (1.0 - s * (1.0 - f));
+    double c[6][3] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
+    int sector = (int)h % 6;
+    for (int i = 0; i < 3; i++)
+        rgb[i] = (unsigned char)lround(255.0 * c[sector][i]);
+}
+
+void classify_class_colours(size_t n_classes, unsigned char (*rgb)[3])
+{
+    static const unsigned char black[3] = {0, 0, 0}, white[3] = {255, 255, 255};
+    /* the distance (squared) a new colour keeps from every earlier one, black (nothing
+     * hit) and white (the page): halved after 64 candidates in a row fail, down to 1
+     * (merely different), so that it ends for any count */
+    int min_d2 = 40 * 40, failed = 0;
+    size_t j = 0;
+    for (size_t k = 0; k < n_classes; k++) {
+        if (k < 20) {
+            memcpy(rgb[k], class_palette[k], sizeof rgb[k]);
+            continue;
+        }
+        for (;; j++) {
+            colour_candidate(j, rgb[k]);
+            bool ok = colour_distance2(rgb[k], black) >= min_d2 &&
+                      colour_distance2(rgb[k], white) >= min_d2;
+            for (size_t i = 0; i < k && ok; i++)
+                ok = colour_distance2(rgb[k], rgb[i]) >= min_d2;
+            if (ok)
+                break;
+            if (++failed == 64) {
+                failed = 0;
+                min_d2 = min_d2 > 1 ? min_d2 / 2 : 1;
+            }
+        }
+        j++;
+        failed = 0;
+    }
+}
 
 static void put(json_t *obj, const char *key, json_t *v, bool *ok)
 {
@@ -47,9 +105,11 @@ char *classify_json(const classify_report *rep, thz_error *err)
     const classify_result *r = rep->result;
     size_t nc = r->n_classes;
     bool ok = true;
-    json_t *root = json_object();
+    unsigned char(*rgb)[3] = thz_malloc_array(nc + 1, sizeof *rgb);
+    json_t *root = rgb ? json_object() : NULL;
     if (!root)
         goto nomem;
+    classify_class_colours(nc, rgb);
     put(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
     put(root, "run_dir", thz_json_text(rep->run_dir), &ok);
     put(root, "sensor", rep->sensor ? json_string(rep->sensor) : json_null(), &ok);
@@ -95,7 +155,7 @@ char *classify_json(const classify_report *rep, thz_error *err)
         put(c, "accuracy", real_or_null(r->class_accuracy[k]), &ok);
         put(c, "auc", real_or_null(r->auc[k]), &ok);
         for (int i = 0; i < 3; i++)
-            push(color, json_integer(class_palette[k % 10][i]), &ok);
+            push(color, json_integer(rgb[k][i]), &ok);
         put(c, "color", color, &ok);
         put(c, "roc", roc, &ok);
         put(roc, "false_positive_rate", fpr, &ok);
@@ -109,11 +169,13 @@ char *classify_json(const classify_report *rep, thz_error *err)
         goto nomem;
     char *text = json_dumps(root, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10));
     json_decref(root);
+    free(rgb);
     if (!text)
         goto nomem_text;
     return text;
 nomem:
     json_decref(root);
+    free(rgb);
 nomem_text:
     thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     return NULL;
@@ -145,8 +207,7 @@ thz_status classify_write_files(const char *dir, const classify_report *rep, con
         free(rgb);
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory");
     }
-    for (size_t k = 0; k < r->n_classes; k++)
-        memcpy(rgb[k], class_palette[k % 10], sizeof rgb[k]);
+    classify_class_colours(r->n_classes, rgb);
     for (size_t p = 0; p < pixels; p++) {
         map[p] = (float)r->assigned[p];
         size_t k = 0;

@@ -23,6 +23,12 @@ typedef struct classify_report {
     size_t n_object_names;
 } classify_report;
 
+/* Class k's colour (sRGB) in rgb[k] for k < n_classes: a fixed qualitative palette for
+ * the first 20, then hues generated far from every earlier colour, black and white;
+ * every colour distinct, the same for the same count (classification.json's `color`
+ * and S.class.png's). */
+void classify_class_colours(size_t n_classes, unsigned char (*rgb)[3]);
+
 /* classification.json's text (malloc'd), NULL with err set when out of memory. */
 char *classify_json(const classify_report *rep, thz_error *err);
 
