@@ -4,7 +4,8 @@ Pixel column's spectrum was of a pixel the user had to remember; the image kept 
 when the window was resized (cut off at the pane's edge in a narrower one); a batch's
 frames were each coloured on their own scale, so one colour meant another temperature in
 the next frame; a summary.json that was there but damaged was shown as no summary at
-all. Each check failed before its fix (web/src, src/serve/serve_results.c)."""
+all; the Pixel column kept a pixel's values when another run or frame was opened. Each
+check failed before its fix (web/src, src/serve/serve_results.c)."""
 import json
 import os
 import re
@@ -75,6 +76,56 @@ def marker(driver, wait, by_id, shot, size, row, col):
     marked_at(driver, "image", size, row, col)
     channel.select_by_index(0)
     return f"pixel ({row}, {col}) marked: {wide:g} px a pixel at 1400 px, {narrow:g} px at 800 px"
+
+
+def pixel_values(driver):
+    """The Pixel column's row, column and Tb values (None, None, [] when it holds none),
+    read at once (the table is rebuilt while a frame opens)."""
+    row, col, values = driver.execute_script(
+        "const i = document.getElementById('pixel-info');"
+        "return [i.dataset.row ?? null, i.dataset.col ?? null,"
+        " [...document.querySelectorAll('#pixel-table td.tb')].map((td) => td.dataset.value)];")
+    return row, col, [float(v) for v in values]
+
+
+def pixel_follows_run(driver, wait, by_id, click_list, root, row, col):
+    """The pixel clicked (row, col of out-seed1, marked) follows the run open: another run
+    of the same size shows its values there; a batch's frame of 8 x 12 pixels, which has
+    no such pixel, empties the Pixel column and takes the mark off; a pixel clicked on
+    frame 1 shows frame 3's values once frame 3 is chosen. (The column kept the last
+    pixel's values under every run and frame opened after it.)"""
+    cube = lambda out, rows, cols: np.fromfile(
+        os.path.join(root, "teraeye", out, "cam.brightness_temperature.img"), "<f4").reshape(-1, rows, cols)
+    seed1, seed2 = cube("out-seed1", 32, 32), cube("out-seed2", 32, 32)
+    assert (seed1[:, row, col] != seed2[:, row, col]).any(), "the two seeds agree at the pixel"
+    assert pixel_values(driver) == (str(row), str(col), [float(v) for v in seed1[:, row, col]]), \
+        pixel_values(driver)
+    open_run(driver, wait, by_id, "teraeye/out-seed2")
+    want = (str(row), str(col), [float(v) for v in seed2[:, row, col]])
+    wait.until(lambda d: pixel_values(d) == want,
+               f"out-seed2 open, the Pixel column does not show its {want}")
+    marked_at(driver, "image", (32, 32), row, col)
+
+    out = os.path.join(root, "teraeye", "out-batch")
+    dirs = [f["dir"] for f in json.load(open(os.path.join(out, "batch.json")))["frames"]]
+    frames = [cube(os.path.join("out-batch", d), 8, 12) for d in dirs]
+    assert row >= 8 or col >= 12, (row, col)
+    driver.execute_script("window.thzmap.results.browse('teraeye')")
+    click_list("outputs", "out-batch/")
+    wait.until(lambda d: "(1/3)" in by_id("frame-name").text and pixel_values(d) == (None, None, []),
+               "frame 1 (8 x 12 pixels) open, the Pixel column still holds a pixel")
+    assert by_id("pixel-info").text == "Click a pixel of the image.", by_id("pixel-info").text
+    assert not driver.execute_script(GEOMETRY, "image")["shown"], "a mark on a pixel the frame has not"
+    readouts.click_pixel(driver, wait, by_id, "image", 8, 12, 5, 7)
+    wait.until(lambda d: pixel_values(d) == ("5", "7", [float(v) for v in frames[0][:, 5, 7]]))
+    assert (frames[0][:, 5, 7] != frames[2][:, 5, 7]).any(), "frames 1 and 3 agree at the pixel"
+    driver.execute_script("const f = document.getElementById('frame'); f.value = 2;"
+                          "f.dispatchEvent(new Event('input'));")
+    want = ("5", "7", [float(v) for v in frames[2][:, 5, 7]])
+    wait.until(lambda d: "(3/3)" in by_id("frame-name").text and pixel_values(d) == want,
+               f"frame 3 chosen, the Pixel column does not show its {want}")
+    marked_at(driver, "image", (8, 12), 5, 7)
+    return f"pixel ({row}, {col}) followed out-seed2, dropped for an 8 x 12 frame; (5, 7) followed frame 3"
 
 
 def fits_window(driver, wait, by_id, shot):

@@ -358,6 +358,7 @@ def main():
         wait.until(lambda d: d.execute_script("return window.thzmap.results.base") == "teraeye/out-integrator/cam")
         log(view.fits_window(driver, wait, by_id, shot))
         log(view.marker(driver, wait, by_id, shot, (32, 32), row, col))
+        log(view.pixel_follows_run(driver, wait, by_id, click_list, root, row, col))
         log(view.frames_scale(driver, wait, by_id, click_list, root, shot))
         log(view.damaged_summary(driver, wait, by_id, click_list, root))
     except Exception:

@@ -181,6 +181,26 @@ export class Results {
     $("ph-object").replaceChildren(new Option("all", ""), ...names.map((n) => new Option(n, n)));
     status(`${base}: ${tb.cols} × ${tb.rows} pixels, ${tb.bands} channel${tb.bands === 1 ? "" : "s"}, loaded in ${Math.round(performance.now() - t0)} ms`);
     await this.show();
+    if (base === this.base) await this.refreshPixel();
+  }
+
+  // Another run, frame or sensor open: the pixel clicked on the image shown again from
+  // its cubes, or, where the new image has no such pixel, the Pixel column emptied and
+  // the mark taken off (the column kept the last run's values under the new image). A
+  // pixel of the A/B difference stays: that image did not change.
+  async refreshPixel() {
+    const canvas = $("image");
+    if (!canvas.dataset.mark) return;
+    const [row, col] = canvas.dataset.mark.split(",").map(Number);
+    if (row < this.tb.rows && col < this.tb.cols) return this.showPixel(row, col);
+    this.pixelSeq = (this.pixelSeq || 0) + 1; // a spectrum still being read: not shown
+    canvas.dataset.mark = "";
+    drawMarker(canvas);
+    const info = $("pixel-info");
+    for (const key of ["row", "col", "ms"]) delete info.dataset[key];
+    info.textContent = "Click a pixel of the image.";
+    $("pixel-plot").replaceChildren();
+    $("pixel-table").replaceChildren();
   }
 
   async show() {
@@ -272,12 +292,20 @@ export class Results {
     return at;
   }
 
-  async click(e, canvas) {
-    const t0 = performance.now();
+  click(e, canvas) {
     const [row, col] = this.pixelOf(e, canvas, this.tb);
+    return this.showPixel(row, col);
+  }
+
+  // The Pixel column for pixel (row, col) of the run open: its truth, the value shown,
+  // its spectrum and table (only the last pixel asked for is shown)
+  async showPixel(row, col) {
+    const t0 = performance.now();
+    const seq = (this.pixelSeq = (this.pixelSeq || 0) + 1);
     const measured = $("res-quantity").value.startsWith("measured") &&
       this.cubesOf($("res-sensor").value).includes("measured_brightness_temperature");
     const tb = measured ? await loadCube(`${this.base}.measured_brightness_temperature`) : this.tb;
+    if (seq !== this.pixelSeq) return; // another pixel or run asked for meanwhile
     const f = tb.freqThz;
     const y = [];
     const err = [];
@@ -391,6 +419,7 @@ export class Results {
   clickDiff(e) {
     if (!this.diffZ) return;
     const [row, col] = this.pixelOf(e, $("diff-image"), this.diffZ.cube);
+    this.pixelSeq = (this.pixelSeq || 0) + 1; // an image's pixel still being read: not shown
     const info = $("pixel-info");
     info.dataset.row = row;
     info.dataset.col = col;
