@@ -141,12 +141,10 @@ class BandSelection:
     def save(self, outdir):
         """Writes bands.json, bands-score.png, bands-spectra.png and, when the air
         attenuates, bands-air.png into `outdir` (created if missing), all or nothing."""
-        from .run import _WRITE_LOCK  # PLplot draws the figures: one at a time
         outdir = _path_arg("outdir", outdir)
         err = _lib.ThzError()
-        with _WRITE_LOCK:
-            status = _lib.lib.thz_bands_write(self._handle.ptr, os.fsencode(outdir),
-                                              ctypes.byref(err))
+        status = _lib.lib.thz_bands_write(self._handle.ptr, os.fsencode(outdir),
+                                          ctypes.byref(err))
         if status != _lib.OK:
             raise from_status(status, _lib.text(err.message))
 

@@ -23,10 +23,6 @@ from .errors import ArgumentError
 from .progress import check as check_progress
 from .scene import _path_arg, scene_arg
 
-# PLplot, which draws the spectra plots of written results, keeps global state: one
-# figure at a time in the whole process.
-_WRITE_LOCK = threading.Lock()
-
 # The CLI's bound of --photons; the library itself does not bound photons_per_channel.
 MAX_PHOTONS = 10**12
 
@@ -345,6 +341,10 @@ class Result:
         self._images = [Image(owner, _lib.lib.thz_run_image(ptr, i), scene)
                         for i in range(_lib.lib.thz_run_image_count(ptr))]
         self._summary = None
+        # thz_run_write records its time in the run (thzmap/run.h): a handle used by one
+        # thread at a time, so saves of this result take turns; other results' saves go
+        # on at once (their figures are drawn in the library's child processes)
+        self._lock = threading.RLock()
         kept = _lib.lib.thz_run_photons(ptr)
         self.photon_map = PhotonMap(owner, kept, scene) if kept else None
         self.mpi_bytes = 0  # a run with mpi=True: bytes rank 0 sent and received
@@ -376,7 +376,9 @@ class Result:
     def summary(self):
         """The dict of summary.json (as written by save, but for timings_s.output)."""
         if self._summary is None:
-            self._summary = json.loads(_lib.text(_lib.lib.thz_run_summary_json(self._owner.ptr)))
+            with self._lock:  # not while a save rewrites it
+                self._summary = json.loads(
+                    _lib.text(_lib.lib.thz_run_summary_json(self._owner.ptr)))
         return self._summary
 
     @property
@@ -405,7 +407,7 @@ class Result:
                                 "(simulate(..., keep_photons=True))")
         if ply_max_points is not None:
             opt.ply_max_points = _whole("ply_max_points", ply_max_points, 1, MAX_PHOTONS)
-        with _WRITE_LOCK, Call(None, progress) as call:
+        with self._lock, Call(None, progress) as call:
             status = _lib.lib.thz_run_write(call.ctx, self._owner.ptr, os.fsencode(outdir),
                                             ctypes.byref(opt), call.err)
             self._summary = None
