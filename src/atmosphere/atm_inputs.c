@@ -136,6 +136,7 @@ typedef struct inputs_entry {
 static pthread_mutex_t cache_lock = PTHREAD_MUTEX_INITIALIZER;
 static inputs_entry *slots[ATM_INPUTS_CACHED];
 static uint64_t use_clock;
+static uint64_t reads; /* the last read_id handed out */
 
 static void entry_free(inputs_entry *e)
 {
@@ -221,6 +222,9 @@ thz_status atm_inputs_acquire(const char *const paths[ATM_IN_FILES], const atm_i
         return st;
     }
     e->refs = 1;
+    pthread_mutex_lock(&cache_lock);
+    e->in.read_id = ++reads;
+    pthread_mutex_unlock(&cache_lock);
     /* kept only when every file is as it was before the read (else one changed while it
      * was read: this process uses what it read, the next reads it again) */
     file_id after[ATM_IN_FILES];

@@ -10,6 +10,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "atmosphere/atm_catalog.h"
 #include "core/error.h"
@@ -35,6 +36,8 @@ typedef struct atm_inputs {
     size_t n_cont;
     double cont_step_cm1;
     double *c_foreign, *c_self, *self_texp;
+    uint64_t read_id; /* the read's number in this process, 1 up: another for every read
+                         (what the tables cached from these inputs are keyed by) */
 } atm_inputs;
 
 /* The inputs read from paths (each a regular file the caller has checked), valid until

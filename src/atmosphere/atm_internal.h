@@ -6,6 +6,7 @@
 
 #include <stddef.h>
 
+#include "atmosphere/atm_table_cache.h"
 #include "atmosphere/atmosphere.h"
 #include "core/csv.h"
 #include "core/threads.h"
@@ -33,12 +34,17 @@ thz_status atm_itu_create(atm_itu_data **out, const char *data_dir, thz_error *e
 void atm_itu_destroy(atm_itu_data *itu);
 void atm_itu_parts(const atm_itu_data *itu, const atm_air_state *air, double freq_hz,
                    atm_alpha_parts *parts);
+/* Appends to key the tables' inputs the P.676 line tables are (all their values). */
+void atm_itu_table_key(const atm_itu_data *itu, atm_table_key *key);
 
 /* lines (atm_lines.c). */
 thz_status atm_lines_create(atm_lines_data **out, const atm_air_state *air,
                             const atm_lines_options *opt, thz_error *err);
 void atm_lines_destroy(atm_lines_data *lines);
 void atm_lines_parts(const atm_lines_data *lines, double freq_hz, atm_alpha_parts *parts);
+/* Appends to key what the model's lines and continua are made from: the files' read (its
+ * read_id, atm_inputs.h), the continuum switch and the air. */
+void atm_lines_table_key(const atm_lines_data *lines, atm_table_key *key);
 /* Grid step in Hz for tabulating alpha over [lo_hz, hi_hz] to ~6e-6 relative with
  * cubic interpolation, from the widths of the lines near the band and their share
  * of alpha; INFINITY if no line shapes the band. */

@@ -108,6 +108,14 @@ void atm_itu_destroy(atm_itu_data *itu)
     free(itu);
 }
 
+void atm_itu_table_key(const atm_itu_data *itu, atm_table_key *key)
+{
+    atm_table_key_add(key, &itu->n_o2, sizeof itu->n_o2);
+    atm_table_key_add(key, &itu->n_h2o, sizeof itu->n_h2o);
+    atm_table_key_add(key, itu->o2, itu->n_o2 * sizeof *itu->o2); /* doubles: no padding */
+    atm_table_key_add(key, itu->h2o, itu->n_h2o * sizeof *itu->h2o);
+}
+
 /* Line shape factor F_i (eq. 5) with width df and interference correction delta. */
 static double shape(double f, double fi, double df, double delta)
 {

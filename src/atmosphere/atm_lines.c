@@ -244,6 +244,17 @@ void atm_lines_parts(const atm_lines_data *d, double freq_hz, atm_alpha_parts *p
     parts->dry_continuum_per_m = 100.0 * dry_continuum_per_cm(d, f);
 }
 
+void atm_lines_table_key(const atm_lines_data *d, atm_table_key *key)
+{
+    /* what atm_lines_create builds d from; the rest of d follows from these */
+    unsigned char continuum = d->continuum;
+    atm_table_key_add(key, &d->inputs->read_id, sizeof d->inputs->read_id);
+    atm_table_key_add(key, &continuum, 1);
+    atm_table_key_add(key, &d->air.temperature_k, sizeof(double));
+    atm_table_key_add(key, &d->air.pressure_hpa, sizeof(double));
+    atm_table_key_add(key, &d->air.h2o_pressure_hpa, sizeof(double));
+}
+
 double atm_lines_grid_step_hz(const atm_lines_data *d, double lo_hz, double hi_hz)
 {
     const lbl_species *all[] = {&d->h2o, &d->o2, &d->o2_coupled};

@@ -367,6 +367,36 @@ static thz_status build_table(const thz_atmosphere *atm, const thz_channel *ch, 
     return st;
 }
 
+/* Appends to key what every table of atm is computed from but the band: the model, its data
+ * and its air (build_table's constants are the same in the whole process). */
+static void table_key_model(const thz_atmosphere *atm, atm_table_key *key)
+{
+    int model = (int)atm->model;
+    atm_table_key_add(key, &model, sizeof model);
+    atm_table_key_add(key, &atm->air.temperature_k, sizeof(double));
+    atm_table_key_add(key, &atm->air.pressure_hpa, sizeof(double));
+    atm_table_key_add(key, &atm->air.h2o_pressure_hpa, sizeof(double));
+    if (atm->model == ATM_LINES)
+        atm_lines_table_key(atm->lines, key);
+    else
+        atm_itu_table_key(atm->itu, key);
+}
+
+/* The table over [lo_hz, hi_hz]: a copy of the one an atmosphere with the same key had
+ * (key: table_key_model's, to which the band is appended), else tabulated and kept. */
+static thz_status band_table(const thz_atmosphere *atm, const thz_channel *ch, double lo_hz,
+                             double hi_hz, atm_table_key *key, atm_band_table *t, thz_error *err)
+{
+    atm_table_key_add(key, &lo_hz, sizeof lo_hz);
+    atm_table_key_add(key, &hi_hz, sizeof hi_hz);
+    if (atm_table_cache_get(key, t))
+        return THZ_OK;
+    thz_status st = build_table(atm, ch, lo_hz, hi_hz, t, err);
+    if (st == THZ_OK)
+        atm_table_cache_put(key, t);
+    return st;
+}
+
 static void free_tables(thz_atmosphere *atm)
 {
     for (size_t i = 0; i < atm->n_tables; i++)
@@ -387,6 +417,9 @@ thz_status atmosphere_prepare(thz_atmosphere *atm, const thz_channel *channels, 
     if (!tables)
         return thz_error_set(err, THZ_ERR_NOMEM, "out of memory tabulating the atmosphere");
     size_t done = 0;
+    atm_table_key key = {0};
+    table_key_model(atm, &key);
+    const size_t model_key_n = key.n;
     for (size_t c = 0; c < n_channels; c++) {
         const thz_channel *ch = &channels[c];
         double lo, hi;
@@ -404,15 +437,18 @@ thz_status atmosphere_prepare(thz_atmosphere *atm, const thz_channel *channels, 
         st = atmosphere_check_range(atm, lo, hi, what, err);
         if (st != THZ_OK)
             goto cleanup;
-        st = build_table(atm, ch, lo, hi, &tables[c], err);
+        key.n = model_key_n;
+        st = band_table(atm, ch, lo, hi, &key, &tables[c], err);
         done = c + 1;
         if (st != THZ_OK)
             goto cleanup;
     }
+    atm_table_key_fini(&key);
     atm->tables = tables;
     atm->n_tables = n_channels;
     return THZ_OK;
 cleanup:
+    atm_table_key_fini(&key);
     for (size_t i = 0; i < done; i++)
         free(tables[i].alpha_per_m);
     free(tables);

@@ -170,7 +170,9 @@ thz_status atmosphere_check_range(const thz_atmosphere *atm, double lo_hz, doubl
 /* Prepares the model for a run over these channels: checks that every band
  * (centre +- 6 sigma) lies in the model's range and tabulates line-by-line alpha
  * over each band. The scene loader calls it once after loading; thread-safe use
- * of atmosphere_alpha_per_m needs it done. Calling it again replaces the tables. */
+ * of atmosphere_alpha_per_m needs it done. Calling it again replaces the tables. A
+ * table an atmosphere of the same inputs (model data, air, band) computed earlier in the
+ * process is copied, the same bits (atm_table_cache.h). */
 thz_status atmosphere_prepare(thz_atmosphere *atm, const thz_channel *channels, size_t n_channels,
                               thz_error *err);
 
