@@ -123,6 +123,18 @@ THZ_API int thz_context_threads(const thz_context *ctx);
 THZ_API void thz_context_set_progress(thz_context *ctx, thz_progress_fn fn, void *user);
 /* The warning callback (NULL: none; the library never prints). */
 THZ_API void thz_context_set_warning(thz_context *ctx, thz_warning_fn fn, void *user);
+/* Under an address-space limit (RLIMIT_AS, `ulimit -v`), libgomp ends the process when
+ * it cannot map a new thread's stack ("Thread creation failed"). Call this first, from
+ * the thread that will call the library: it starts `threads` OpenMP threads now (0:
+ * OpenMP's default), or as many as fit in half the room the limit leaves (each maps its
+ * stack, OMP_STACKSIZE or the C library's default, and a 64 MiB malloc arena), at least
+ * 1, so that later work of no more threads finds them started and a shortage of memory
+ * is an ordinary THZ_ERR_NOMEM. Returns `threads` when they all fit, else the count
+ * started, which it also makes what 0 (all cores) stands for. Without a limit it starts
+ * nothing and returns `threads`. */
+THZ_API int thz_threads_prepare(int threads);
+/* OMP_STACKSIZE as libgomp reads it, in bytes; 0 when unset or not a size. */
+THZ_API uint64_t thz_omp_stack_bytes(void);
 /* The status and message of the last failed call that took ctx (THZ_OK and "" if
  * none); the message is valid until the next call with ctx. */
 THZ_API thz_status thz_context_last_status(const thz_context *ctx);

@@ -53,6 +53,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/threads.h"
 
 struct accel {
     const thz_scene *scene;
@@ -172,14 +173,18 @@ thz_status accel_create(const thz_scene *scene, accel **out, thz_error *err)
     if (st != THZ_OK)
         goto cleanup;
     int build_threads = omp_get_num_procs();
+    /* under ulimit -v, no more than thz_threads_prepare found room for: a thread libgomp
+     * cannot start ends the process */
+    if (thz_address_space_limit_bytes() > 0 && build_threads > thz_threads_fitting(0))
+        build_threads = thz_threads_fitting(0);
     char config[96];
     snprintf(config, sizeof config, "threads=%d,user_threads=%d,max_isa=%s", build_threads,
              build_threads, isa);
     a->device = rtcNewDevice(config);
     if (!a->device) {
-        st =
-            thz_error_set(err, THZ_ERR_INTERNAL, "ray casting: cannot create the Embree device: %s",
-                          accel_error_name(rtcGetDeviceError(NULL)));
+        enum RTCError e = rtcGetDeviceError(NULL); /* its 128 MiB pool under ulimit -v */
+        st = thz_error_set(err, e == RTC_ERROR_OUT_OF_MEMORY ? THZ_ERR_NOMEM : THZ_ERR_INTERNAL,
+                           "ray casting: cannot create the Embree device: %s", accel_error_name(e));
         goto cleanup;
     }
     a->rtc = rtcNewScene(a->device);

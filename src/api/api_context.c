@@ -6,6 +6,7 @@
 
 #include "api/api.h"
 #include "core/alloc.h"
+#include "core/threads.h"
 #include "sensor/render.h"
 
 thz_context *thz_context_create(void)
@@ -34,6 +35,20 @@ thz_status api_check_threads(const thz_context *ctx, const char *what, thz_error
                              "(thz_context_set_threads)",
                              what, ctx->threads, THZ_MAX_THREADS);
     return THZ_OK;
+}
+
+int thz_threads_prepare(int threads)
+{
+    int t = threads < 0 ? 0 : threads > THZ_MAX_THREADS ? THZ_MAX_THREADS : threads;
+    if (thz_address_space_limit_bytes() == 0)
+        return threads;
+    int want = thz_threads_or_all(t), n = thz_threads_start(t);
+    return n < want ? n : threads;
+}
+
+uint64_t thz_omp_stack_bytes(void)
+{
+    return thz_thread_omp_stack_bytes();
 }
 
 int thz_context_threads(const thz_context *ctx)

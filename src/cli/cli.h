@@ -75,10 +75,16 @@ bool cli_parse_positive(const char *command, const char *option, const char *tex
  * /dev/null, SIGXFSZ ignored, a stack limit or OMP_STACKSIZE below what the threads need
  * refused with a message. The exit status to end with, or -1 to go on. */
 int cli_environment_check(void);
-/* Warns on stderr when `threads` (--threads; 0, the default, takes what OpenMP finds)
- * exceeds the CPUs the process may run on (its affinity mask: mpirun's and srun's
- * binding), where the threads would share a core unseen. */
-void cli_threads_check(const char *command, uint64_t threads);
+/* Starts the threads before any work under an address-space limit (ulimit -v), so that
+ * libgomp never meets a thread it cannot start later (it ends the process); fewer when
+ * not all fit, with a warning. Returns the count to run with: `threads` (0: OpenMP's
+ * default), or the lowered count. Without a limit it does nothing. */
+uint64_t cli_threads_prepare(const char *command, uint64_t threads);
+/* cli_threads_prepare, then warns on stderr when `threads` (--threads; 0, the default,
+ * takes what OpenMP finds) exceeds the CPUs the process may run on (its affinity mask:
+ * mpirun's and srun's binding), where the threads would share a core unseen. Returns the
+ * count to run with. */
+uint64_t cli_threads_check(const char *command, uint64_t threads);
 /* rc, or CLI_EXIT_FAILURE (with a message) when the standard output could not be written
  * (a full disk, a closed descriptor): a command whose product is what it prints must not
  * end with 0 then. A reader that left a pipe is no failure. */

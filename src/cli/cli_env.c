@@ -23,51 +23,6 @@
 #define CLI_MIN_FILES 32u
 #define CLI_WANT_FILES 1024u
 
-/* OMP_STACKSIZE as libgomp reads it (a size, K by default; B, K, M, G suffixes), in
- * bytes; 0 when unset or not a size (libgomp then warns and keeps its default). */
-static unsigned long long cli_omp_stack_bytes(void)
-{
-    const char *s = getenv("OMP_STACKSIZE");
-    if (!s || !*s)
-        return 0;
-    char *end = NULL;
-    errno = 0;
-    unsigned long long v = strtoull(s, &end, 10);
-    if (errno || end == s)
-        return 0;
-    while (*end == ' ' || *end == '\t')
-        end++;
-    unsigned long long unit = 1024;
-    if (*end) {
-        switch (*end) {
-        case 'b':
-        case 'B':
-            unit = 1;
-            break;
-        case 'k':
-        case 'K':
-            unit = 1024;
-            break;
-        case 'm':
-        case 'M':
-            unit = 1024ull * 1024;
-            break;
-        case 'g':
-        case 'G':
-            unit = 1024ull * 1024 * 1024;
-            break;
-        default:
-            return 0;
-        }
-        end++;
-        while (*end == ' ' || *end == '\t')
-            end++;
-        if (*end)
-            return 0;
-    }
-    return v > ~0ull / unit ? ~0ull : v * unit;
-}
-
 int cli_environment_check(void)
 {
     /* Standard streams closed at start: the first files opened would take their numbers
@@ -113,7 +68,7 @@ int cli_environment_check(void)
                 (unsigned long long)rl.rlim_cur / 1024, CLI_MIN_STACK_BYTES / 1024);
         return CLI_EXIT_USAGE;
     }
-    unsigned long long omp = cli_omp_stack_bytes();
+    unsigned long long omp = thz_omp_stack_bytes();
     if (omp > 0 && omp < CLI_MIN_STACK_BYTES) {
         fprintf(stderr,
                 "thzmap: OMP_STACKSIZE=%s gives each thread %llu KiB of stack; thzmap's threads "
@@ -124,15 +79,37 @@ int cli_environment_check(void)
     return -1;
 }
 
-void cli_threads_check(const char *command, uint64_t threads)
+uint64_t cli_threads_prepare(const char *command, uint64_t threads)
 {
+    static bool warned; /* once a process: main's default team, then the command's */
+    int n = thz_threads_prepare((int)threads);
+    if ((uint64_t)n == threads || warned)
+        return (uint64_t)n;
+    warned = true;
+    struct rlimit rl;
+    unsigned long long kib =
+        getrlimit(RLIMIT_AS, &rl) == 0 ? (unsigned long long)rl.rlim_cur / 1024 : 0;
+    char asked[48] = "all cores";
+    if (threads > 0)
+        snprintf(asked, sizeof asked, "%llu", (unsigned long long)threads);
+    fprintf(stderr,
+            "thzmap %s: warning: the address space is limited (ulimit -v %llu KiB), and "
+            "each thread maps its stack and a 64 MiB malloc arena: there is room for %d "
+            "thread%s, not %s (raise ulimit -v, or lower OMP_STACKSIZE)\n",
+            command, kib, n, n == 1 ? "" : "s", asked);
+    return (uint64_t)n;
+}
+
+uint64_t cli_threads_check(const char *command, uint64_t threads)
+{
+    threads = cli_threads_prepare(command, threads);
     cpu_set_t set;
     CPU_ZERO(&set);
     if (threads == 0 || sched_getaffinity(0, sizeof set, &set) != 0)
-        return;
+        return threads;
     int cpus = CPU_COUNT(&set);
     if (cpus < 1 || threads <= (uint64_t)cpus)
-        return;
+        return threads;
     /* Open MPI 4 binds each rank to a core (2 ranks or fewer) or a socket, Slurm's srun to
      * its --cpus-per-task (Slurm 22.05 to 23.02 do not take sbatch's): docs/mpi.md's hybrid
      * example ran its 8 threads a rank on one core, and nothing said so */
@@ -143,6 +120,7 @@ void cli_threads_check(const char *command, uint64_t threads)
             "will share %s\n",
             command, (unsigned long long)threads, cpus, cpus == 1 ? "" : "s",
             (unsigned long long)threads, cpus == 1 ? "it" : "them");
+    return threads;
 }
 
 int cli_stdout_finish(int rc)

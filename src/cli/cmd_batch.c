@@ -279,7 +279,7 @@ int cmd_batch(int argc, char **argv)
     cli_mpi_quiet_begin();
     int rc = batch_parse(argc, argv, &seq_path, &outdir, &threads, &b);
     if (rc < 0)
-        cli_threads_check("batch", threads);
+        threads = cli_threads_check("batch", threads);
     thz_error err = {0};
     if (rc < 0 && batch_load(&b, seq_path, &seq, &err) != THZ_OK)
         rc = cli_fail(&err);

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 
@@ -51,7 +52,14 @@ int cli_fail(const thz_error *err)
     const char *message = err->message[0] ? err->message : thz_status_name(err->status);
     /* a C library call that failed with ENOMEM says "Cannot allocate memory" */
     bool say_oom = err->status == THZ_ERR_NOMEM && !strstr(message, "out of memory");
-    fprintf(stderr, "thzmap: %s%s\n", say_oom ? "out of memory: " : "", message);
+    /* under ulimit -v, "out of memory" is the address space's limit, not the machine's */
+    char limited[96] = "";
+    struct rlimit rl;
+    if (err->status == THZ_ERR_NOMEM && getrlimit(RLIMIT_AS, &rl) == 0 &&
+        rl.rlim_cur != RLIM_INFINITY)
+        snprintf(limited, sizeof limited, " (the address space is limited: ulimit -v %llu KiB)",
+                 (unsigned long long)rl.rlim_cur / 1024);
+    fprintf(stderr, "thzmap: %s%s%s\n", say_oom ? "out of memory: " : "", message, limited);
     /* THZ_ERR_LIMIT: the scene or the options ask for more than fits (memory, sizes) */
     return err->status == THZ_ERR_INPUT || err->status == THZ_ERR_LIMIT ? CLI_EXIT_USAGE
                                                                         : CLI_EXIT_FAILURE;
@@ -220,6 +228,9 @@ static int main_run(const command *c, int argc, char **argv)
                     c->name);
         return CLI_EXIT_USAGE;
     }
+    /* OpenMP's default team started before any work, under ulimit -v (a command's
+     * --threads starts more, or fewer, once parsed) */
+    cli_threads_prepare(c->name, 0);
     return c->run(argc, argv);
 }
 

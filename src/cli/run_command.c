@@ -299,7 +299,7 @@ static int cli_run_load(const char *cmd, cli_run_args *a, bool render, thz_scene
                 cmd, a->photon_map_path, integrator);
         a->photon_map_path = NULL;
     }
-    cli_threads_check(cmd, (uint64_t)a->threads);
+    a->threads = (int)cli_threads_check(cmd, (uint64_t)a->threads);
     for (size_t i = 0; i < thz_scene_warning_count(*scene); i++) /* --quiet hides progress only */
         fprintf(stderr, "thzmap %s: warning: %s\n", cmd, thz_scene_warning(*scene, i));
     return -1;

@@ -104,6 +104,25 @@ static uint64_t alloc_cgroup_limit(void)
     return limit;
 }
 
+uint64_t thz_address_space_limit_bytes(void)
+{
+    uint64_t as = alloc_address_space_limit();
+    return as == UINT64_MAX ? 0 : as;
+}
+
+uint64_t thz_address_space_bytes(void)
+{
+    unsigned long long pages = 0;
+    long page = sysconf(_SC_PAGESIZE);
+    FILE *f = fopen("/proc/self/statm", "r"); /* its first number: the pages mapped */
+    if (f) {
+        if (fscanf(f, "%llu", &pages) != 1)
+            pages = 0;
+        fclose(f);
+    }
+    return page > 0 ? (uint64_t)pages * (uint64_t)page : 0;
+}
+
 uint64_t thz_memory_limit_bytes(void)
 {
     uint64_t have = thz_physical_memory_bytes(), as = alloc_address_space_limit(),

@@ -69,5 +69,11 @@ uint64_t thz_memory_limit_bytes(void);
 /* The memory this process holds now (its resident set; 0 if unknown): the scene's
  * meshes and the ray-casting structure, which a run's estimate counts. */
 uint64_t thz_process_memory_bytes(void);
+/* The address space this process has mapped now (0 if unknown): beside what it holds,
+ * its libraries, thread stacks, malloc arenas and Embree's reserved pool, which count
+ * against an address-space limit though little of them is resident. */
+uint64_t thz_address_space_bytes(void);
+/* RLIMIT_AS (ulimit -v) in bytes, 0 when unlimited. */
+uint64_t thz_address_space_limit_bytes(void);
 
 #endif

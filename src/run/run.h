@@ -188,18 +188,23 @@ void run_apply_overrides(thz_scene *scene, const run_overrides *ov);
  * scene key of the larger part. */
 typedef struct run_memory {
     uint64_t photon_bytes;
-    uint64_t image_bytes;     /* the images, their statistics, the renderer's tables */
-    uint64_t held_bytes;      /* what the process holds already: the scene, its meshes'
-                               * ray-casting structure (thz_process_memory_bytes) */
-    uint64_t total_bytes;     /* all three */
-    uint64_t available_bytes; /* thz_memory_limit_bytes, 0 if unknown */
-    uint64_t map_photons;     /* photon_bytes are a map read (render), not fired: its
-                               * photons per channel; 0 when fired */
+    uint64_t image_bytes;         /* the images, their statistics, the renderer's tables */
+    uint64_t held_bytes;          /* what the process holds already: the scene, its meshes'
+                                   * ray-casting structure (thz_process_memory_bytes) */
+    uint64_t total_bytes;         /* all three */
+    uint64_t available_bytes;     /* thz_memory_limit_bytes, 0 if unknown */
+    uint64_t map_photons;         /* photon_bytes are a map read (render), not fired: its
+                                   * photons per channel; 0 when fired */
+    uint64_t mapped_bytes;        /* the address space mapped already (thz_address_space_bytes),
+                                   * and the stacks and arenas of the threads still to start */
+    uint64_t address_limit_bytes; /* thz_address_space_limit_bytes, 0 if unlimited */
 } run_memory;
 
 /* THZ_OK, or THZ_ERR_LIMIT when `need` exceeds 90 % of the memory the process may have
- * (thz_memory_limit_bytes), with a message naming `photons.per_channel` (a map read: a
- * map of fewer photons), `sensors[i].resolution` or the scene's size. */
+ * (thz_memory_limit_bytes), or, under ulimit -v, its photon maps and images beside what
+ * is mapped already exceed 90 % of the address-space limit, with a message naming
+ * `photons.per_channel` (a map read: a map of fewer photons), `sensors[i].resolution` or
+ * the scene's size; under ulimit -v also the limit, and the limit that would do. */
 thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err);
 
 /* The same for each sensor's images alone (what loading can tell without building

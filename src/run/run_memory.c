@@ -4,6 +4,7 @@
 #include <stdio.h>
 
 #include "core/alloc.h"
+#include "core/threads.h"
 #include "photon/phase.h"
 #include "photon/photon_map.h"
 #include "run/run.h"
@@ -11,14 +12,16 @@
 #include "sensor/measure.h"
 #include "sensor/render.h"
 
-/* The photons per channel whose maps would fit in limit beside the rest of the run: the
- * maps' bytes grow in proportion to the photons (records per photon, the build's scratch
- * a fixed share of them), so per_channel scaled by the room over the maps' bytes, less 3 %
- * (the process's own memory, in the room, moves a little from run to run), rounded down to
- * two significant digits; 0 if none fit. */
-static uint64_t run_photons_that_fit(uint64_t per_channel, const run_memory *need, double limit)
+/* The photons per channel whose maps would fit in limit beside the rest of the run (held:
+ * what the process holds, or has mapped, already): the maps' bytes grow in proportion to
+ * the photons (records per photon, the build's scratch a fixed share of them), so
+ * per_channel scaled by the room over the maps' bytes, less 3 % (the process's own
+ * memory, in the room, moves a little from run to run), rounded down to two significant
+ * digits; 0 if none fit. */
+static uint64_t run_photons_that_fit(uint64_t per_channel, const run_memory *need, uint64_t held,
+                                     double limit)
 {
-    double room = limit - (double)need->image_bytes - (double)need->held_bytes;
+    double room = limit - (double)need->image_bytes - (double)held;
     if (!(room > 0.0) || need->photon_bytes == 0)
         return 0;
     double fit = 0.97 * (double)per_channel * room / (double)need->photon_bytes;
@@ -30,40 +33,35 @@ static uint64_t run_photons_that_fit(uint64_t per_channel, const run_memory *nee
     return (uint64_t)(floor(fit / unit) * unit);
 }
 
-thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err)
+/* What to lower, into remedy: the larger part of the run (what the process holds decides
+ * for the scene's objects), with the photons that would fit beside `held` in `limit`. */
+static void run_memory_remedy(const thz_scene *scene, const run_memory *need, uint64_t held,
+                              double limit, char *remedy, size_t size)
 {
-    if (need->available_bytes == 0)
-        return THZ_OK; /* unknown: let the allocations decide */
-    double limit = 0.9 * (double)need->available_bytes;
-    if ((double)need->total_bytes <= limit)
-        return THZ_OK;
-    double gib = 1024.0 * 1024.0 * 1024.0;
-    char remedy[192];
     if (need->held_bytes > need->photon_bytes && need->held_bytes > need->image_bytes) {
         size_t big = 0; /* the object of most triangles */
         for (size_t o = 1; o < scene->n_objects; o++)
             if (scene->objects[o].mesh.n_triangles > scene->objects[big].mesh.n_triangles)
                 big = o;
-        snprintf(remedy, sizeof remedy,
-                 "lower objects[%zu].shape (%zu triangles) or the number of objects", big,
-                 scene->n_objects ? scene->objects[big].mesh.n_triangles : (size_t)0);
+        snprintf(remedy, size, "lower objects[%zu].shape (%zu triangles) or the number of objects",
+                 big, scene->n_objects ? scene->objects[big].mesh.n_triangles : (size_t)0);
     } else if (need->photon_bytes >= need->image_bytes && need->map_photons > 0) {
         /* render: the scene's photons.per_channel does not make the map it reads */
-        uint64_t fit = run_photons_that_fit(need->map_photons, need, limit);
+        uint64_t fit = run_photons_that_fit(need->map_photons, need, held, limit);
         char most[64] = "";
         if (fit > 0)
             snprintf(most, sizeof most, "; at most about %llu fit", (unsigned long long)fit);
-        snprintf(remedy, sizeof remedy,
+        snprintf(remedy, size,
                  "render from a map of fewer photons (this one has %llu per channel, read a "
                  "channel at a time%s)",
                  (unsigned long long)need->map_photons, most);
     } else if (need->photon_bytes >= need->image_bytes) {
-        uint64_t fit = run_photons_that_fit(scene->photons.per_channel, need, limit);
+        uint64_t fit = run_photons_that_fit(scene->photons.per_channel, need, held, limit);
         char most[64] = "";
         if (fit > 0)
             snprintf(most, sizeof most, "; at most about %llu fit", (unsigned long long)fit);
         /* the scene key only: batch and Python have no --photons (simulate adds it) */
-        snprintf(remedy, sizeof remedy, "lower photons.per_channel (now %llu%s)",
+        snprintf(remedy, size, "lower photons.per_channel (now %llu%s)",
                  (unsigned long long)scene->photons.per_channel, most);
     } else {
         size_t big = 0;
@@ -72,18 +70,51 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
                 (uint64_t)scene->sensors[big].columns * scene->sensors[big].rows)
                 big = s;
         /* the images of every sensor together: the largest alone may not be the cause */
-        snprintf(remedy, sizeof remedy, "lower sensors[%zu].resolution%s", big,
+        snprintf(remedy, size, "lower sensors[%zu].resolution%s", big,
                  scene->n_sensors > 1 ? " (or the number of sensors)" : "");
     }
+}
+
+thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err)
+{
+    const char *path = scene->path ? scene->path : "the scene";
+    char remedy[192];
+    /* Under ulimit -v the address space counts, not what is resident: at the check a render
+     * had 18 MB resident and 291 MB mapped (Embree's pool, thread stacks and arenas), and
+     * a map that passed the resident check then failed to load. */
+    double as_limit = 0.9 * (double)need->address_limit_bytes;
+    double as_need =
+        (double)need->mapped_bytes + (double)need->photon_bytes + (double)need->image_bytes;
+    if (need->address_limit_bytes > 0 && as_need > as_limit) {
+        const double mib = 1024.0 * 1024.0;
+        run_memory_remedy(scene, need, need->mapped_bytes, as_limit, remedy, sizeof remedy);
+        return thz_error_set(
+            err, THZ_ERR_LIMIT,
+            "%s: the run would need %.0f MiB of address space (photon maps %.0f MiB, images "
+            "and tables %.0f MiB, mapped already %.0f MiB: the program and its libraries, the "
+            "scene, the ray-casting structure, the threads' stacks and malloc arenas) but "
+            "ulimit -v limits this process to %llu KiB (%.0f MiB), of which a run may take 90 "
+            "%% (ulimit -v %.0f or more would do); %s",
+            path, as_need / mib, (double)need->photon_bytes / mib, (double)need->image_bytes / mib,
+            (double)need->mapped_bytes / mib,
+            (unsigned long long)(need->address_limit_bytes / 1024),
+            (double)need->address_limit_bytes / mib, ceil(as_need / 0.9 / 1024.0), remedy);
+    }
+    if (need->available_bytes == 0)
+        return THZ_OK; /* unknown: let the allocations decide */
+    double limit = 0.9 * (double)need->available_bytes;
+    if ((double)need->total_bytes <= limit)
+        return THZ_OK;
+    double gib = 1024.0 * 1024.0 * 1024.0;
+    run_memory_remedy(scene, need, need->held_bytes, limit, remedy, sizeof remedy);
     return thz_error_set(err, THZ_ERR_LIMIT,
                          "%s: the run would need %.2f GiB of memory (photon maps %.2f GiB, "
                          "images and tables %.2f GiB, the scene as loaded %.2f GiB) but this "
                          "process may have %.2f GiB (the machine's memory, or less under ulimit "
                          "-v or a cgroup limit); %s",
-                         scene->path ? scene->path : "the scene", (double)need->total_bytes / gib,
-                         (double)need->photon_bytes / gib, (double)need->image_bytes / gib,
-                         (double)need->held_bytes / gib, (double)need->available_bytes / gib,
-                         remedy);
+                         path, (double)need->total_bytes / gib, (double)need->photon_bytes / gib,
+                         (double)need->image_bytes / gib, (double)need->held_bytes / gib,
+                         (double)need->available_bytes / gib, remedy);
 }
 
 thz_status run_check_scene_memory(const thz_scene *scene, thz_error *err)
@@ -158,6 +189,17 @@ thz_status run_photon_map_bytes(const thz_scene *scene, const accel *acc, size_t
     return THZ_OK;
 }
 
+/* The address space mapped now, and what the threads of rs's runs still to start will
+ * map (thz_thread_address_bytes each). */
+static uint64_t run_mapped_bytes(const run_state *rs)
+{
+    uint64_t mapped = thz_address_space_bytes();
+    int team = thz_threads_or_all(rs->opt->threads), running = thz_threads_running();
+    uint64_t more = team > running ? (uint64_t)(team - running) : 0;
+    uint64_t per = thz_thread_address_bytes();
+    return more > 0 && per > (UINT64_MAX - mapped) / more ? UINT64_MAX : mapped + more * per;
+}
+
 thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t map_bytes,
                                 uint64_t map_photons, thz_error *err)
 {
@@ -165,7 +207,9 @@ thz_status run_check_run_memory(run_state *rs, bool photons, uint64_t map_bytes,
                        .photon_bytes = map_bytes,
                        .held_bytes = thz_process_memory_bytes(),
                        .available_bytes = thz_memory_limit_bytes(),
-                       .map_photons = map_bytes > 0 ? map_photons : 0};
+                       .map_photons = map_bytes > 0 ? map_photons : 0,
+                       .mapped_bytes = run_mapped_bytes(rs),
+                       .address_limit_bytes = thz_address_space_limit_bytes()};
     if (photons) {
         thz_status st =
             run_photon_map_bytes(rs->scene, rs->accel, SIZE_MAX, rs->opt->keep_photon_maps,

@@ -48,7 +48,7 @@ p = subprocess.run([T, "simulate", os.path.join(base, "scene.json"), "-o", os.pa
                     "--photons", "200000000", "--integrator", "photon-map", "--threads", "2"],
                    capture_output=True, text=True, preexec_fn=limited, timeout=60)
 assert p.returncode == 2, (p.returncode, p.stderr)
-assert "but this process may have" in p.stderr and "ulimit -v" in p.stderr, p.stderr
+assert "but ulimit -v limits this process to 3145728 KiB" in p.stderr, p.stderr
 assert not os.path.exists(os.path.join(work, "big"))
 
 # the estimate's line says what the process may have in binary units: 4 GiB under
