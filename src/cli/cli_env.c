@@ -81,22 +81,19 @@ int cli_environment_check(void)
 
 uint64_t cli_threads_prepare(const char *command, uint64_t threads)
 {
-    static bool warned; /* once a process: main's default team, then the command's */
+    static int said; /* the count last warned of: main's default team, then the command's */
     int n = thz_threads_prepare((int)threads);
-    if ((uint64_t)n == threads || warned)
+    if ((uint64_t)n == threads || n == said)
         return (uint64_t)n;
-    warned = true;
+    said = n;
     struct rlimit rl;
     unsigned long long kib =
         getrlimit(RLIMIT_AS, &rl) == 0 ? (unsigned long long)rl.rlim_cur / 1024 : 0;
-    char asked[48] = "all cores";
-    if (threads > 0)
-        snprintf(asked, sizeof asked, "%llu", (unsigned long long)threads);
     fprintf(stderr,
             "thzmap %s: warning: the address space is limited (ulimit -v %llu KiB), and "
-            "each thread maps its stack and a 64 MiB malloc arena: there is room for %d "
-            "thread%s, not %s (raise ulimit -v, or lower OMP_STACKSIZE)\n",
-            command, kib, n, n == 1 ? "" : "s", asked);
+            "each thread maps its stack and a 64 MiB malloc arena: running with %d thread%s, "
+            "as many as fit (raise ulimit -v, or lower OMP_STACKSIZE)\n",
+            command, kib, n, n == 1 ? "" : "s");
     return (uint64_t)n;
 }
 
