@@ -25,7 +25,7 @@ static void cli_run_usage(FILE *f, bool render)
                    "  -o, --output OUTDIR   where the results go (required)\n"
                    "  --photons N           photons per channel (overrides photons.per_channel;\n"
                    "                        1e6 is accepted)\n"
-                   "  --seed S              random seed (overrides photons.seed)\n"
+                   "  --seed S              random seed, 0 to 2^63 - 1 (overrides photons.seed)\n"
                    "  --threads T           threads to use (default: all cores)\n"
                    "  --integrator NAME     path (default) | final-gather | photon-map\n"
                    "                        (overrides render.integrator; path fires no\n"

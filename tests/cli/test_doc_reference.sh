@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # docs/scene-format.md, the reference outside programs read, against the program:
 # - each command's section lists every long option its --help describes, and every
-#   option of the section's table is one --help describes;
+#   option of the section's table is one --help describes; --seed's states its range;
 # - "Outputs": a run of a sensor with a PSF and noise writes exactly the files the table
 #   names (S the sensor), and each ENVI header's `data units` is the table's unit;
 # - "summary.json": every key a run writes (path with two sensors, of an Airy and a
@@ -38,6 +38,13 @@ for cmd in simulate render batch atmosphere materials bands classify serve; do
         grep -q -- "$o\b" "$work/$cmd.help" ||
             fail "scene-format.md's thzmap $cmd lists $o, which '$cmd --help' does not"
     done
+done
+# --seed's range, which the docs' tables and the error for a seed out of it state, is in
+# --help too (it was not: "random seed (overrides photons.seed)")
+for cmd in simulate bands classify; do
+    awk '/^  --seed / { on = 1; print; next } on && /^  -/ { exit } on' "$work/$cmd.help" |
+        tr -s ' \n' ' ' | grep -qF "0 to 2^63 - 1" ||
+        fail "$cmd --help: --seed does not state its range, 0 to 2^63 - 1"
 done
 
 cat >"$work/scene.json" <<JSON
