@@ -69,6 +69,11 @@ typedef struct thz_error {
 
 /* "0.1.0"; static. */
 THZ_API const char *thz_version(void);
+/* The source revision built: the git commit, 40 lowercase hex digits, with "-dirty"
+ * appended when tracked files differed from it; "unknown" when built from outside a git
+ * checkout (an archive) or without git; or what the build was given (-DTHZ_REVISION).
+ * Read from git at every build (cmake/revision.cmake); static, never NULL. */
+THZ_API const char *thz_revision(void);
 /* "bad input", "cancelled", ...; static, never NULL. */
 THZ_API const char *thz_status_name(thz_status status);
 

@@ -79,6 +79,7 @@ char *bands_json(const bands_report *rep, thz_error *err)
     bool ok = true;
     json_t *root = json_object();
     put(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
+    put(root, "thzmap_revision", json_string(thz_revision()), &ok);
     put(root, "scene", thz_json_text(rep->scene_path), &ok);
     put(root, "scene_name", json_string(rep->scene_name), &ok);
     put(root, "sensor", json_string(rep->sensor), &ok);

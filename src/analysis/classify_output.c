@@ -111,6 +111,7 @@ char *classify_json(const classify_report *rep, thz_error *err)
         goto nomem;
     classify_class_colours(nc, rgb);
     put(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
+    put(root, "thzmap_revision", json_string(thz_revision()), &ok);
     put(root, "run_dir", thz_json_text(rep->run_dir), &ok);
     put(root, "sensor", rep->sensor ? json_string(rep->sensor) : json_null(), &ok);
     put(root, "source", json_string(rep->source), &ok);

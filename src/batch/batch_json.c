@@ -215,6 +215,7 @@ thz_status batch_write_json(batch_state *b, thz_error *err)
     json_object_set_new(t, "total", json_real(batch_now_s() - b->t0));
     json_object_set_new(root, "format", json_string("thzmap-batch/1"));
     json_object_set_new(root, "thzmap_version", json_string(THZ_VERSION_STRING));
+    json_object_set_new(root, "thzmap_revision", json_string(thz_revision()));
     json_object_set_new(root, "sequence", thz_json_text(seq->path));
     if (seq->scene_list) {
         json_t *scenes = json_array();

@@ -301,7 +301,7 @@ int main(int argc, char **argv)
         if (cli_is_help(argv[1]))
             print_usage(stdout);
         else
-            printf("thzmap %s\n", thz_version());
+            printf("thzmap %s (revision %s)\n", thz_version(), thz_revision());
         return cli_stdout_finish(CLI_EXIT_OK);
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {

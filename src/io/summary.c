@@ -248,6 +248,7 @@ static json_t *summary_build(const thz_scene *scene, const run_summary *summary)
     bool ok = true;
     json_t *root = json_object();
     sum_set(root, "thzmap_version", json_string(THZ_VERSION_STRING), &ok);
+    sum_set(root, "thzmap_revision", json_string(thz_revision()), &ok);
     sum_set(root, "command", sum_string(summary->command), &ok);
     json_t *sc = json_object();
     sum_set(sc, "name", sum_string(scene->name), &ok);

@@ -341,10 +341,31 @@ static void check_output_write_fails(const char *dir)
     CHECK(stat(outdir, &info) != 0, "%s exists after a failed, uncommitted output", outdir);
 }
 
+/* thz_revision(): a git commit (40 lowercase hex digits, "-dirty" appended when the tree
+ * differed from it), "unknown", or the revision the build was given (-DTHZ_REVISION), the
+ * same at every call. tests/cli/test_revision.sh holds it against the checkout's commit. */
+static void check_revision(void)
+{
+    const char *rev = thz_revision();
+    CHECK(rev != NULL, "thz_revision() is NULL");
+    if (!rev)
+        return;
+    size_t hex = strspn(rev, "0123456789abcdef");
+    if (THZ_TEST_REVISION_GIVEN[0])
+        CHECK(strcmp(rev, THZ_TEST_REVISION_GIVEN) == 0, "revision '%s', built with '%s'", rev,
+              THZ_TEST_REVISION_GIVEN);
+    else
+        CHECK(strcmp(rev, "unknown") == 0 ||
+                  (hex == 40 && (rev[40] == '\0' || strcmp(rev + 40, "-dirty") == 0)),
+              "revision '%s': expected 40 hex digits, then nothing or -dirty, or unknown", rev);
+    CHECK(thz_revision() == rev, "thz_revision() is not one static string");
+}
+
 int main(int argc, char **argv)
 {
     (void)argc;
     CHECK(strcmp(thz_version(), THZ_VERSION_STRING) == 0, "version %s", thz_version());
+    check_revision();
 
     thz_error err = {0};
     thz_scene *scene = (thz_scene *)&err; /* must be reset to NULL */

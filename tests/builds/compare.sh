@@ -3,7 +3,11 @@
 # whichever processor: two builds (`make test-compilers`: gcc with -march=native, clang
 # for any x86-64, -DTHZ_NATIVE=OFF) run the same small scenes with each integrator, and
 # every output must be byte for byte the same, the same files on both sides, and
-# summary.json the same but for its timings (keys ending in _s) and its scene path.
+# summary.json the same but for its timings (keys ending in _s), its scene path and
+# thzmap_revision: what the two builds compute is compared, not the source they were
+# built from (in make test-compilers the same checkout's, but a file edited between the
+# two builds makes one "-dirty"; two commits' builds may be compared too). The two
+# revisions are printed.
 # Where C leaves an order unspecified, an argument list that draws two random numbers
 # (f(u(rng), u(rng))), gcc and clang choose differently: the paths, the photon maps and
 # the gather rays of the two builds then differed in every image.
@@ -68,7 +72,8 @@ compare() { # $1: name, rest: simulate arguments
 import json, sys
 def strip(x):
     if isinstance(x, dict):
-        return {k: strip(v) for k, v in x.items() if not k.endswith("_s") and k != "path"}
+        return {k: strip(v) for k, v in x.items()
+                if not k.endswith("_s") and k not in ("path", "thzmap_revision")}
     if isinstance(x, list):
         return [strip(v) for v in x]
     return x
@@ -86,6 +91,7 @@ PY
     if [ "$fails" = "$fails_before" ]; then echo "ok: $name, $files files the same"; fi
 }
 
+echo "revisions: $("$A" --version) and $("$B" --version)"
 compare room-path "$work/room/scene.json"
 compare room-photon-map "$work/room/scene.json" --integrator photon-map
 compare room-final-gather "$work/room/scene.json" --integrator final-gather --photons 30000

@@ -24,7 +24,8 @@ brief() {
     finish_counted ok
 }
 unset THZMAP_DATA_DIR
-version=$("$THZMAP" --version | awk '{print $2}')
+version_line=$("$THZMAP" --version)
+version=$(awk '{print $2}' <<<"$version_line")
 [[ $version =~ ^[0-9]+\.[0-9]+\.[0-9]+$ ]] || fail "thzmap --version gave '$version'"
 major=${version%%.*}
 
@@ -84,7 +85,8 @@ grep -q 'AER' "$P/share/thzmap/atmosphere/README.md" 2>/dev/null ||
     fail "the data's README with its licence notices is not installed"
 
 # --- the CLI runs from the prefix, without the environment's help -----------------------
-[[ $("$P/bin/thzmap" --version 2>&1) == "thzmap $version" ]] || fail "installed thzmap --version: $("$P/bin/thzmap" --version 2>&1)"
+# (the same line as the build tree's: "thzmap X.Y.Z (revision R)")
+[[ $("$P/bin/thzmap" --version 2>&1) == "$version_line" ]] || fail "installed thzmap --version: $("$P/bin/thzmap" --version 2>&1)"
 "$P/bin/thzmap" materials water >"$work/materials.out" 2>&1 && grep -q '^source: ' "$work/materials.out" ||
     fail "installed thzmap materials water: $(cat "$work/materials.out")"
 

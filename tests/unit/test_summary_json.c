@@ -111,6 +111,8 @@ static void test_summary_json(void **state)
         fail_msg("summary.json does not parse: %s", jerr.text);
     assert_string_equal(json_string_value(json_object_get(root, "thzmap_version")),
                         THZ_VERSION_STRING);
+    assert_string_equal(json_string_value(json_object_get(root, "thzmap_revision")),
+                        thz_revision());
     assert_string_equal(json_string_value(json_object_get(root, "command")), "simulate");
     assert_int_equal(json_integer_value(json_object_get(root, "seed")), 42);
     assert_int_equal(json_integer_value(json_object_get(root, "threads")), 2);
