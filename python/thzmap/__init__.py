@@ -28,6 +28,10 @@ from .scene import Scene, identify, load_scene, scene_from_dict, scene_from_json
 from .sequence import BatchProgress, BatchResult, Frame, Sequence, batch, load_sequence
 
 __version__ = _lib.text(_lib.lib.thz_version())
+revision = _lib.text(_lib.lib.thz_revision())
+"""The source revision of the library this package uses, as summary.json's
+thzmap_revision: the git commit (40 hex digits, "-dirty" when the tree differed from
+it), or "unknown" (built outside a git checkout)."""
 library_path = _lib.path
 """The libthzmap file this package uses."""
 
@@ -37,5 +41,5 @@ __all__ = ["ArgumentError", "Atmosphere", "BandSelection", "BatchProgress", "Bat
            "SceneError", "Sequence", "atmosphere", "bands", "batch", "brightness_temperature",
            "classify", "classify_spectra", "fire_photons", "identify", "library_path", "load_photon_map",
            "load_scene", "load_sequence", "material_library", "merge_photon_maps", "mpi",
-           "planck_radiance", "render", "scene_from_dict", "scene_from_json", "simulate",
-           "surface_optics"]
+           "planck_radiance", "render", "revision", "scene_from_dict", "scene_from_json",
+           "simulate", "surface_optics"]

@@ -150,6 +150,7 @@ _PP = POINTER(c_void_p)
 # name: (return type, argument types)
 _PROTOTYPES = {
     "thz_version": (c_char_p, []),
+    "thz_revision": (c_char_p, []),
     "thz_status_name": (c_char_p, [c_int]),
     "thz_context_create": (_P, []),
     "thz_context_destroy": (None, [_P]),

@@ -227,9 +227,10 @@ static enum MHD_Result serve_login(serve_request *r, const char *token)
 
 static enum MHD_Result serve_info(serve_request *r)
 {
-    json_t *o = json_pack("{s:s, s:s, s:[s,s,s], s:[s,s,s,s]}", "version", thz_version(), "root",
-                          r->s->root, "integrators", "path", "final-gather", "photon-map",
-                          "commands", "simulate", "render", "batch", "bands");
+    json_t *o =
+        json_pack("{s:s, s:s, s:s, s:[s,s,s], s:[s,s,s,s]}", "version", thz_version(), "revision",
+                  thz_revision(), "root", r->s->root, "integrators", "path", "final-gather",
+                  "photon-map", "commands", "simulate", "render", "batch", "bands");
     if (o)
         json_object_set_new(o, "web", json_boolean(r->s->has_web));
     return serve_reply_json(r, 200, o);

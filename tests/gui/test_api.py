@@ -61,6 +61,10 @@ def test_auth(srv):
     info = srv.json("GET", "/api/info")
     check(info and "photon-map" in info["integrators"] and "simulate" in info["commands"],
           "info: %r" % info)
+    # the program's version and source revision, as `thzmap --version` prints them
+    line = subprocess.run([BINARY, "--version"], capture_output=True, text=True).stdout.strip()
+    check(info and line == "thzmap %s (revision %s)" % (info.get("version"), info.get("revision")),
+          "info's version and revision %r against --version's %r" % (info, line))
     srv.json("GET", "/api/nothing", status=404)
     srv.json("DELETE", "/api/info", status=405)
     srv.json("POST", "/", status=405)
