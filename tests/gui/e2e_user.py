@@ -148,9 +148,10 @@ def pixel_of_quantity(driver, wait, by_id, out, bands, size, row, col):
     power = np.fromfile(os.path.join(out, "cam.power.img"), "<f4").reshape(bands, *size)[1, row, col]
     line = by_id("pixel-shown")
     assert float(line.get_attribute("data-value")) == float(power), (line.get_attribute("data-value"), power)
-    assert line.text.endswith(" W") and f"{power:.3e}" in line.text, (line.text, power)
+    text = line.text  # (the line goes with the power image)
+    assert text.endswith(" W") and f"{power:.3e}" in text, (text, power)
     Select(by_id("res-quantity")).select_by_value("brightness_temperature")
-    return line.text
+    return text
 
 
 def run_integrator(driver, wait, by_id, root, scene, out):

@@ -12,7 +12,8 @@ the Run tab (of the path integrator, failing, refused, eight queued), a bands ru
 directory in Results, edits not saved, a library material, a narrow window, the A/B
 difference of the channel chosen, the value of the image clicked, the integrator chosen in
 the Run tab; the clicked pixel's mark, the image at the window's size, a batch's frames on
-one colour scale and a damaged summary.json (e2e_view.py). Screenshots go to
+one colour scale and a damaged summary.json (e2e_view.py); the Pixel column of an A/B
+difference compared again and of another quantity chosen (e2e_refresh.py). Screenshots go to
 SCREENSHOT_DIR/gui-*.png."""
 import json
 import os
@@ -27,6 +28,7 @@ from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.ui import Select
 
 import e2e_readouts as readouts
+import e2e_refresh as refresh
 import e2e_session
 import e2e_user as user
 import e2e_view as view
@@ -78,6 +80,7 @@ def make_root(root):
                                  {"time_s": 2, "objects": {"box": {"temperature_k": 340}}}]}, f)
     run("batch", os.path.join(teraeye, "sequence.json"), "-o", os.path.join(teraeye, "out-batch"),
         "--no-movies", "--threads", "2")
+    refresh.make_runs(run, teraeye)  # two seeds of two sensors and two channels
     return scene
 
 
@@ -361,6 +364,8 @@ def main():
         log(view.pixel_follows_run(driver, wait, by_id, click_list, root, row, col))
         log(view.frames_scale(driver, wait, by_id, click_list, root, shot))
         log(view.damaged_summary(driver, wait, by_id, click_list, root))
+        log(refresh.diff_compared_again(driver, wait, by_id, root))
+        log(refresh.value_follows_quantity(driver, wait, by_id, root, bands, (32, 32), row, col))
     except Exception:
         s.failed()
         raise

@@ -18,8 +18,8 @@ export class Results {
   constructor() {
     this.dir = "";
     this.frames = [];
-    for (const id of ["res-sensor", "res-quantity", "res-channel", "res-scale"]) {
-      $(id).onchange = () => this.show().catch(reportError);
+    for (const id of ["res-quantity", "res-channel", "res-scale"]) {
+      $(id).onchange = () => this.redraw().catch(reportError);
     }
     $("res-sensor").onchange = () => this.loadSensor().catch(reportError);
     // the A/B difference shown follows the sensor and channel chosen (it stayed at the
@@ -36,7 +36,7 @@ export class Results {
     for (const id of ["diff-a", "diff-b"]) $(id).addEventListener("input", () => (this.diffTyped = true));
     $("frame").oninput = () => this.openFrame(Number($("frame").value)).catch(reportError);
     $("btn-play").onclick = () => this.play();
-    $("frames-lock").onchange = () => this.show().catch(reportError);
+    $("frames-lock").onchange = () => this.redraw().catch(reportError);
     // the images drawn again at the window's new size (they kept the old one: cut off at
     // the pane's edge, or small in a window made larger); the tabs send one when shown
     window.addEventListener("resize", () => {
@@ -180,22 +180,35 @@ export class Results {
     const names = this.truthId?.header["object names"] || [];
     $("ph-object").replaceChildren(new Option("all", ""), ...names.map((n) => new Option(n, n)));
     status(`${base}: ${tb.cols} × ${tb.rows} pixels, ${tb.bands} channel${tb.bands === 1 ? "" : "s"}, loaded in ${Math.round(performance.now() - t0)} ms`);
-    await this.show();
-    if (base === this.base) await this.refreshPixel();
+    await this.redraw();
   }
 
-  // Another run, frame or sensor open: the pixel clicked on the image shown again from
-  // its cubes, or, where the new image has no such pixel, the Pixel column emptied and
-  // the mark taken off (the column kept the last run's values under the new image). A
-  // pixel of the A/B difference stays: that image did not change.
+  // The image drawn, then the pixel marked on it shown again: its spectrum (measured or
+  // not, with the quantity) and the value of the image shown (the line kept the quantity
+  // and channel of the click when another was chosen)
+  async redraw() {
+    if (await this.show()) await this.refreshPixel();
+  }
+
+  // The image drawn again (another run, frame, sensor, quantity or channel): the pixel
+  // clicked on it shown again from its cubes, or, where the new image has no such pixel,
+  // the Pixel column emptied and the mark taken off (the column kept the last run's values
+  // under the new image). A pixel of the A/B difference stays: diff() refreshes it.
   async refreshPixel() {
-    const canvas = $("image");
-    if (!canvas.dataset.mark) return;
-    const [row, col] = canvas.dataset.mark.split(",").map(Number);
+    const mark = $("image").dataset.mark;
+    if (!mark) return;
+    const [row, col] = mark.split(",").map(Number);
     if (row < this.tb.rows && col < this.tb.cols) return this.showPixel(row, col);
+    this.clearPixel();
+  }
+
+  // the Pixel column emptied, the marks taken off both images
+  clearPixel() {
     this.pixelSeq = (this.pixelSeq || 0) + 1; // a spectrum still being read: not shown
-    canvas.dataset.mark = "";
-    drawMarker(canvas);
+    for (const canvas of [$("image"), $("diff-image")]) {
+      canvas.dataset.mark = "";
+      drawMarker(canvas);
+    }
     const info = $("pixel-info");
     for (const key of ["row", "col", "ms"]) delete info.dataset[key];
     info.textContent = "Click a pixel of the image.";
@@ -203,22 +216,29 @@ export class Results {
     $("pixel-table").replaceChildren();
   }
 
+  // The image of the quantity and channel chosen; false when another was asked for meanwhile
+  // (a cube read late was drawn over the one chosen after it)
   async show() {
+    const seq = (this.showSeq = (this.showSeq || 0) + 1);
     const qn = $("res-quantity").value || "brightness_temperature";
     const cube = await loadCube(`${this.base}.${qn}`);
+    if (seq !== this.showSeq) return false;
     this.shown = cube;
     const band = Math.min(Number($("res-channel").value) || 0, cube.bands - 1);
     const values = cube.band(band);
     const ignore = cube.ignore ?? (qn.includes("brightness") ? 0 : null);
     const names = cube.header["object names"];
-    if (qn === "object_id" && names) return this.showObjects(cube, names);
+    if (qn === "object_id" && names) {
+      this.showObjects(cube, names);
+      return true;
+    }
     const common = $("res-scale").value === "common";
     // a batch's frame: the scale over all its frames (each its own made a colour mean
     // another temperature in the next frame)
     const locked = this.frames.length > 1 && this.frames.includes(this.runDir) && $("frames-lock").checked;
     const all = locked ? await this.framesRange(qn, common ? null : band, ignore) : null;
     const over = all?.frames ? all : null; // no frame's values read: this frame's own scale
-    if (this.shown !== cube) return; // another image was asked for meanwhile
+    if (seq !== this.showSeq) return false; // another image was asked for meanwhile
     const [lo, hi] = over ? over.range : common ? range(cube.data, ignore) : range(values, ignore);
     paint($("image"), cube, values, lo, hi, viridis, ignore);
     const unit = cube.unit === "1" ? "(1)" : cube.unit;
@@ -228,6 +248,7 @@ export class Results {
     $("image-info").textContent = `${qn.replace(/_/g, " ")}, ${which}; colours span the 1st to 99th ` +
       `percentile${common ? " of all channels" : ""}${over ? ` of all ${over.frames} frames (one scale)` : ""}: ` +
       `${formatNumber(lo)} to ${formatNumber(hi)}${cube.unit === "1" ? "" : ` ${cube.unit}`}`;
+    return true;
   }
 
   // The 1st and 99th percentile of quantity qn (band, or all bands when null) over every
@@ -374,6 +395,7 @@ export class Results {
   // the server's /api/diff: (Tb_A − Tb_B) / √(σ_A² + σ_B²), or Tb_A − Tb_B in K when a run
   // has no standard errors (its X-Thzmap-Diff-Units header says which)
   async diff() {
+    const seq = (this.diffSeq = (this.diffSeq || 0) + 1);
     const sensor = $("res-sensor").value;
     const a = $("diff-a").value.trim();
     const b = $("diff-b").value.trim();
@@ -385,15 +407,18 @@ export class Results {
       canvas.getContext("2d").clearRect(0, 0, canvas.width, canvas.height);
     }
     $("diff-info").textContent = `comparing ${a} with ${b}…`;
-    let cube, response;
+    let cube, z, response;
     try {
       cube = await loadCube(join(a, `${sensor}.brightness_temperature`));
       response = await request(`/api/diff?a=${q(a)}&b=${q(b)}&sensor=${q(sensor)}&band=${band}`);
+      z = new Float32Array(await response.arrayBuffer());
     } catch (e) {
+      if (seq !== this.diffSeq) return;
       $("diff-info").textContent = `no comparison: ${e.message}`;
+      if ($("diff-image").dataset.mark) this.clearPixel(); // its A − B is of no image now
       throw e;
     }
-    const z = new Float32Array(await response.arrayBuffer());
+    if (seq !== this.diffSeq) return; // another comparison was asked for meanwhile
     const sigma = response.headers.get("X-Thzmap-Diff-Units") !== "K";
     let beyond = 0;
     let count = 0;
@@ -414,11 +439,22 @@ export class Results {
       ? `(A − B) / √(σA² + σB²), ${channel}: ${((100 * beyond) / Math.max(count, 1)).toFixed(2)} % of ` +
         `${count} pixels beyond ±3 σ (0.27 % expected if A and B agree within their errors)`
       : `A − B in K, ${channel} (a run without standard errors: no σ to compare with)`;
+    // the pixel marked on the difference: its A − B of this comparison (it kept the value
+    // of the sensor and channel compared before), or none where this one has no such pixel
+    const mark = $("diff-image").dataset.mark;
+    if (!mark) return;
+    const [row, col] = mark.split(",").map(Number);
+    if (row < cube.rows && col < cube.cols) this.showDiffPixel(row, col);
+    else this.clearPixel();
   }
 
   clickDiff(e) {
     if (!this.diffZ) return;
-    const [row, col] = this.pixelOf(e, $("diff-image"), this.diffZ.cube);
+    this.showDiffPixel(...this.pixelOf(e, $("diff-image"), this.diffZ.cube));
+  }
+
+  // the Pixel column for pixel (row, col) of the A/B difference: its A − B alone
+  showDiffPixel(row, col) {
     this.pixelSeq = (this.pixelSeq || 0) + 1; // an image's pixel still being read: not shown
     const info = $("pixel-info");
     info.dataset.row = row;

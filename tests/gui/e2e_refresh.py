@@ -1,0 +1,125 @@
+"""What the Results view drew again and what it left as it was (for test_e2e_audit.py,
+session 57, second pass), each a fault left after the Pixel column learned to follow the
+run and frame opened: the A/B difference compared again (another sensor or channel) kept
+the clicked pixel's A − B of the comparison before; the Pixel column's line of the value
+shown kept the quantity and channel of the click when another was chosen. Each check
+failed before its fix (web/src/results.js)."""
+import json
+import os
+import re
+
+import numpy as np
+from selenium.webdriver.support.ui import Select
+
+import e2e_readouts as readouts
+import e2e_view as view
+
+
+def make_runs(thzmap_run, teraeye):
+    """Two seeds of the path scene with two channels and two sensors, cam (12 x 8) and
+    small (6 x 4), eight paths a sample (standard errors to compare in σ)."""
+    with open(os.path.join(teraeye, "path.json")) as f:
+        scene = json.load(f)
+    scene["channels"] = [{"name": "0.35 THz", "frequency_thz": 0.35, "relative_width": 0.01},
+                         {"name": "0.5 THz", "frequency_thz": 0.5, "relative_width": 0.01}]
+    cam = scene["sensors"][0]
+    cam.pop("noise")
+    scene["sensors"].append(dict(cam, name="small", resolution=[6, 4]))
+    scene["render"]["paths_per_sample"] = 8
+    with open(os.path.join(teraeye, "two.json"), "w") as f:
+        json.dump(scene, f, indent=2)
+    for seed in (1, 2):
+        thzmap_run("simulate", os.path.join(teraeye, "two.json"), "-o", os.path.join(teraeye, f"out-two{seed}"),
+                   "--seed", str(seed), "--threads", "2")
+
+
+def diff_z(root, sensor, shape, band):
+    """(Tb_A − Tb_B) / √(σ_A² + σ_B²) of out-two1 and out-two2, channel band + 1."""
+    def cubes(out):
+        read = lambda qn: np.fromfile(os.path.join(root, "teraeye", out, f"{sensor}.{qn}.img"),
+                                      "<f4").reshape(2, *shape)[band]
+        return read("brightness_temperature"), read("radiance_stderr")
+    (ta, sa), (tb, sb) = cubes("out-two1"), cubes("out-two2")
+    hz = [0.35e12, 0.5e12][band]
+    with np.errstate(invalid="ignore", divide="ignore"):  # σ 0 (one value over the paths): NaN
+        return (ta.astype(float) - tb) / np.hypot(readouts.tb_sigma(ta, sa, hz), readouts.tb_sigma(tb, sb, hz))
+
+
+def pixel_diff(driver):
+    """The row, column and A − B (σ) the Pixel column shows, None for each it does not."""
+    row, col, text = driver.execute_script(
+        "const i = document.getElementById('pixel-info'); return [i.dataset.row ?? null, i.dataset.col ?? null,"
+        " i.textContent];")
+    m = re.search(r"A − B = (\S+) σ$", text)
+    return row, col, float(m.group(1)) if m else None
+
+
+def diff_compared_again(driver, wait, by_id, root):
+    """A pixel clicked on the difference of channel 1 shows the A − B of channel 2 once
+    channel 2 is chosen (each worked out here from the cubes), and is emptied, its mark
+    taken off, when the sensor chosen (small, 6 x 4) has no such pixel."""
+    view.open_run(driver, wait, by_id, "teraeye/out-two1")
+    Select(by_id("res-view")).select_by_value("diff")
+    for box, run in (("diff-a", "teraeye/out-two1"), ("diff-b", "teraeye/out-two2")):
+        by_id(box).clear()
+        by_id(box).send_keys(run)
+    Select(by_id("res-sensor")).select_by_value("cam")
+    Select(by_id("res-channel")).select_by_index(0)
+    by_id("btn-diff").click()
+    wait.until(lambda d: "channel 1 (" in by_id("diff-info").text and "%" in by_id("diff-info").text)
+    z1, z2 = diff_z(root, "cam", (8, 12), 0), diff_z(root, "cam", (8, 12), 1)
+    # a pixel that sensor small has not, whose A − B differs between the channels
+    row, col = max(((r, c) for r in range(4, 8) for c in range(6, 12)), key=lambda rc: np.nan_to_num(
+        abs(z1[rc] - z2[rc])) * (rc[0] != rc[1]))
+    assert abs(z1[row, col] - z2[row, col]) > 0.1, (z1[row, col], z2[row, col])
+    near = lambda shown, z: shown is not None and abs(shown - z) <= 1e-3 * abs(z) + 1e-4
+    readouts.click_pixel(driver, wait, by_id, "diff-image", 8, 12, row, col)
+    wait.until(lambda d: near(pixel_diff(d)[2], z1[row, col]), f"{pixel_diff(driver)} for {z1[row, col]}")
+    Select(by_id("res-channel")).select_by_index(1)
+    wait.until(lambda d: "channel 2 (" in by_id("diff-info").text and "%" in by_id("diff-info").text)
+    wait.until(lambda d: pixel_diff(d)[:2] == (str(row), str(col)) and near(pixel_diff(d)[2], z2[row, col]),
+               f"channel 2 compared: the Pixel column shows {pixel_diff(driver)}, channel 2's A − B is "
+               f"{z2[row, col]:.4g} σ (channel 1's {z1[row, col]:.4g} σ)")
+    view.marked_at(driver, "diff-image", (8, 12), row, col)
+    said = f"({row}, {col}) A − B {pixel_diff(driver)[2]} σ at channel 2"
+    Select(by_id("res-sensor")).select_by_value("small")
+    wait.until(lambda d: pixel_diff(d) == (None, None, None) and not d.execute_script(view.GEOMETRY, "diff-image")["shown"],
+               f"sensor small (6 x 4) compared: the Pixel column still shows {pixel_diff(driver)}")
+    assert by_id("pixel-info").text == "Click a pixel of the image.", by_id("pixel-info").text
+    Select(by_id("res-sensor")).select_by_value("cam")
+    Select(by_id("res-view")).select_by_value("image")
+    return said + "; emptied for sensor small (6 x 4)"
+
+
+def shown_line(driver):
+    """The Pixel column's line of the value of the image shown: [text, value], or None."""
+    return driver.execute_script(
+        "const e = document.getElementById('pixel-shown'); return e && [e.textContent, Number(e.dataset.value)];")
+
+
+def value_follows_quantity(driver, wait, by_id, root, bands, size, row, col):
+    """A pixel clicked on out-seed1's power image of channel 2: radiance chosen, the line
+    gives the radiance cube's value there in its unit; channel 3 chosen, channel 3's;
+    brightness temperature chosen, no line (the spectrum is of it)."""
+    view.open_run(driver, wait, by_id, "teraeye/out-seed1")
+    cube = lambda qn: np.fromfile(os.path.join(root, "teraeye", "out-seed1", f"cam.{qn}.img"),
+                                  "<f4").reshape(bands, *size)[:, row, col]
+    Select(by_id("res-quantity")).select_by_value("power")
+    Select(by_id("res-channel")).select_by_index(1)
+    readouts.click_pixel(driver, wait, by_id, "image", *size, row, col)
+    wait.until(lambda d: (shown_line(d) or [""])[0].startswith("power, channel 2 ("))
+    radiance = cube("radiance")
+    for band, choose in ((1, lambda: Select(by_id("res-quantity")).select_by_value("radiance")),
+                         (2, lambda: Select(by_id("res-channel")).select_by_index(2))):
+        choose()
+        want = float(radiance[band])
+        wait.until(lambda d: shown_line(d) and shown_line(d)[1] == want
+                   and shown_line(d)[0].startswith(f"radiance, channel {band + 1} ("),
+                   f"radiance of channel {band + 1} chosen: the Pixel column says {shown_line(driver)}, "
+                   f"the cube {want:.4g} W m-2 sr-1 Hz-1")
+    line = shown_line(driver)[0]
+    assert line.endswith(" W m-2 sr-1 Hz-1"), line
+    Select(by_id("res-quantity")).select_by_value("brightness_temperature")
+    wait.until(lambda d: shown_line(d) is None, f"brightness temperature chosen, the column still says {shown_line(driver)}")
+    Select(by_id("res-channel")).select_by_index(0)
+    return f"value line followed: {line!r}"
