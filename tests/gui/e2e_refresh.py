@@ -2,8 +2,10 @@
 session 57, second pass), each a fault left after the Pixel column learned to follow the
 run and frame opened: the A/B difference compared again (another sensor or channel) kept
 the clicked pixel's A − B of the comparison before; the Pixel column's line of the value
-shown kept the quantity and channel of the click when another was chosen. Each check
-failed before its fix (web/src/results.js)."""
+shown kept the quantity and channel of the click when another was chosen; a `bands`
+run's directory, which has no pixels, left the column holding the pixel of the run
+before, shown again under the next run opened. Each check failed before its fix
+(web/src/results.js)."""
 import json
 import os
 import re
@@ -123,3 +125,21 @@ def value_follows_quantity(driver, wait, by_id, root, bands, size, row, col):
     wait.until(lambda d: shown_line(d) is None, f"brightness temperature chosen, the column still says {shown_line(driver)}")
     Select(by_id("res-channel")).select_by_index(0)
     return f"value line followed: {line!r}"
+
+
+def bands_empties_pixel(driver, wait, by_id, click_list, size, row, col):
+    """A pixel clicked on out-seed1, then the bands run's directory opened: the Pixel
+    column empty and the mark off, and still so when out-seed1 is opened again."""
+    view.open_run(driver, wait, by_id, "teraeye/out-seed1")
+    readouts.click_pixel(driver, wait, by_id, "image", *size, row, col)
+    wait.until(lambda d: view.pixel_values(d)[:2] == (str(row), str(col)))
+    driver.execute_script("window.thzmap.results.browse('teraeye')")
+    click_list("outputs", "out-bands-cli/")
+    wait.until(lambda d: by_id("bands-pane").is_displayed())
+    assert view.pixel_values(driver) == (None, None, []), \
+        f"a bands run's directory open, the Pixel column holds {view.pixel_values(driver)}"
+    view.open_run(driver, wait, by_id, "teraeye/out-seed1")
+    assert view.pixel_values(driver) == (None, None, []) and not driver.execute_script(view.GEOMETRY, "image")["shown"], \
+        f"out-seed1 opened after the bands run: the Pixel column shows {view.pixel_values(driver)} of before"
+    assert by_id("pixel-info").text == "Click a pixel of the image.", by_id("pixel-info").text
+    return "a bands run's directory empties the Pixel column"

@@ -13,8 +13,8 @@ directory in Results, edits not saved, a library material, a narrow window, the 
 difference of the channel chosen, the value of the image clicked, the integrator chosen in
 the Run tab; the clicked pixel's mark, the image at the window's size, a batch's frames on
 one colour scale and a damaged summary.json (e2e_view.py); the Pixel column of an A/B
-difference compared again and of another quantity chosen (e2e_refresh.py). Screenshots go to
-SCREENSHOT_DIR/gui-*.png."""
+difference compared again, of another quantity chosen and of a bands run's directory
+(e2e_refresh.py). Screenshots go to SCREENSHOT_DIR/gui-*.png."""
 import json
 import os
 import re
@@ -366,6 +366,7 @@ def main():
         log(view.damaged_summary(driver, wait, by_id, click_list, root))
         log(refresh.diff_compared_again(driver, wait, by_id, root))
         log(refresh.value_follows_quantity(driver, wait, by_id, root, bands, (32, 32), row, col))
+        log(refresh.bands_empties_pixel(driver, wait, by_id, click_list, (32, 32), row, col))
     except Exception:
         s.failed()
         raise

@@ -108,6 +108,9 @@ export class Results {
       const doc = await getJSON(`/api/file?path=${q(join(dir, "bands.json"))}`);
       if (seq !== this.openSeq) return;
       for (const pane of ["image-pane", "photon-pane", "diff-pane"]) $(pane).hidden = true;
+      // no pixel here: the run opened next starts with an empty column (it showed the
+      // pixel clicked before this directory, of a run that may be long gone from mind)
+      this.clearPixel();
       showBands(dir, doc, names);
       status(`${dir}: a bands run, ${doc.count} channel${doc.count === 1 ? "" : "s"} chosen`);
       return;
