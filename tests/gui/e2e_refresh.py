@@ -4,8 +4,9 @@ run and frame opened: the A/B difference compared again (another sensor or chann
 the clicked pixel's A − B of the comparison before; the Pixel column's line of the value
 shown kept the quantity and channel of the click when another was chosen; a `bands`
 run's directory, which has no pixels, left the column holding the pixel of the run
-before, shown again under the next run opened. Each check failed before its fix
-(web/src/results.js)."""
+before, shown again under the next run opened; the colour bar stayed 300 px tall beside
+an image drawn 192 px tall at 800 x 600, so the pane scrolled. Each check failed before
+its fix (web/src/results.js)."""
 import json
 import os
 import re
@@ -143,3 +144,39 @@ def bands_empties_pixel(driver, wait, by_id, click_list, size, row, col):
         f"out-seed1 opened after the bands run: the Pixel column shows {view.pixel_values(driver)} of before"
     assert by_id("pixel-info").text == "Click a pixel of the image.", by_id("pixel-info").text
     return "a bands run's directory empties the Pixel column"
+
+
+def bar_geometry(driver, image, bar, pane):
+    return driver.execute_script(
+        "const [i, b, p] = [...arguments].map((x) => document.getElementById(x));"
+        "return {image: i.offsetHeight, bar: b.offsetHeight, barPixels: b.height,"
+        " scroll: p.scrollHeight, client: p.clientHeight};", image, bar, pane)
+
+
+def bar_follows_image(driver, wait, by_id, shot):
+    """At 800 x 600 the colour bar is as tall as the image drawn (with its border) and
+    the image pane does not scroll; the bar still runs from the top colour to the bottom
+    one with five labels; at the window's first size it is the image's 514 px again."""
+    view.open_run(driver, wait, by_id, "teraeye/out-seed1")
+    Select(by_id("res-quantity")).select_by_value("brightness_temperature")
+    g = bar_geometry(driver, "image", "colourbar", "image-pane")
+    assert g["bar"] == g["image"] == 514, g
+    window = driver.get_window_size()
+    try:
+        driver.set_window_size(800, 600)
+        wait.until(lambda d: bar_geometry(d, "image", "colourbar", "image-pane")["image"] < 514)
+        wait.until(lambda d: bar_geometry(d, "image", "colourbar", "image-pane")["bar"]
+                   == bar_geometry(d, "image", "colourbar", "image-pane")["image"],
+                   f"at 800 x 600: {bar_geometry(driver, 'image', 'colourbar', 'image-pane')}")
+        g = bar_geometry(driver, "image", "colourbar", "image-pane")
+        assert g["barPixels"] == g["bar"] and g["scroll"] <= g["client"], \
+            f"at 800 x 600 the image pane scrolls: {g}"
+        rgb = readouts.canvas_rgb(driver, "colourbar")
+        top, bottom = rgb[10, 5], rgb[rgb.shape[0] - 24, 5]
+        assert np.abs(top - readouts.VIRIDIS[-1]).max() <= 2 and np.abs(bottom - readouts.VIRIDIS[0]).max() <= 2, \
+            (top, bottom)
+        shot("bar-800")
+    finally:
+        driver.set_window_size(window["width"], window["height"])
+    wait.until(lambda d: bar_geometry(d, "image", "colourbar", "image-pane")["bar"] == 514)
+    return f"colour bar {g['bar']} px beside an image {g['image']} px tall at 800 x 600, 514 px at 1400"

@@ -243,14 +243,14 @@ export class Results {
     const over = all?.frames ? all : null; // no frame's values read: this frame's own scale
     if (seq !== this.showSeq) return false; // another image was asked for meanwhile
     const [lo, hi] = over ? over.range : common ? range(cube.data, ignore) : range(values, ignore);
-    paint($("image"), cube, values, lo, hi, viridis, ignore);
-    const unit = cube.unit === "1" ? "(1)" : cube.unit;
-    drawColourBar($("colourbar"), lo, hi, unit);
     // the truth maps hold one band whatever the run; a one-channel run's cubes one channel
+    // (the caption before the image, which is fitted to the room the caption leaves)
     const which = TRUTH.has(qn) ? "truth" : `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)`;
     $("image-info").textContent = `${qn.replace(/_/g, " ")}, ${which}; colours span the 1st to 99th ` +
       `percentile${common ? " of all channels" : ""}${over ? ` of all ${over.frames} frames (one scale)` : ""}: ` +
       `${formatNumber(lo)} to ${formatNumber(hi)}${cube.unit === "1" ? "" : ` ${cube.unit}`}`;
+    $("colourbar").args = [lo, hi, cube.unit === "1" ? "(1)" : cube.unit];
+    paint($("image"), cube, values, lo, hi, viridis, ignore);
     return true;
   }
 
@@ -287,9 +287,6 @@ export class Results {
   // the truth map of objects: one colour per object, named beside the picture
   showObjects(cube, names) {
     const palette = names.map((_, i) => viridis(names.length > 1 ? i / (names.length - 1) : 0.5));
-    paint($("image"), cube, cube.band(0), 0, Math.max(names.length - 1, 1), viridis, -1);
-    const bar = $("colourbar");
-    bar.getContext("2d").clearRect(0, 0, bar.width, bar.height);
     const seen = new Set(cube.band(0));
     const info = $("image-info");
     info.replaceChildren("object seen, truth (grey: nothing hit): ");
@@ -300,6 +297,8 @@ export class Results {
       sw.style.background = cssColour(palette[i]);
       info.append(sw, `${n}  `);
     });
+    $("colourbar").args = null; // the names' swatches instead
+    paint($("image"), cube, cube.band(0), 0, Math.max(names.length - 1, 1), viridis, -1);
   }
 
   // the pixel under a click, and marked so on the image (the other image's mark dropped:
@@ -405,6 +404,7 @@ export class Results {
     const band = Number($("res-channel").value) || 0;
     // a comparison that fails leaves no earlier one on screen as if it were its answer
     this.diffZ = null;
+    $("diff-bar").args = null;
     for (const id of ["diff-image", "diff-bar"]) {
       const canvas = $(id);
       canvas.getContext("2d").clearRect(0, 0, canvas.width, canvas.height);
@@ -435,13 +435,13 @@ export class Results {
     const [lo, hi] = sigma ? [-4, 4] : range(z, null);
     const span = sigma ? 4 : Math.max(Math.abs(lo), Math.abs(hi)) || 1;
     this.diffZ = { z, cube, unit: sigma ? "σ" : "K" };
-    paint($("diff-image"), cube, z, -span, span, diverging, null);
-    drawColourBar($("diff-bar"), -span, span, this.diffZ.unit, diverging);
     const channel = `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)`;
     $("diff-info").textContent = sigma
       ? `(A − B) / √(σA² + σB²), ${channel}: ${((100 * beyond) / Math.max(count, 1)).toFixed(2)} % of ` +
         `${count} pixels beyond ±3 σ (0.27 % expected if A and B agree within their errors)`
       : `A − B in K, ${channel} (a run without standard errors: no σ to compare with)`;
+    $("diff-bar").args = [-span, span, this.diffZ.unit, diverging];
+    paint($("diff-image"), cube, z, -span, span, diverging, null);
     // the pixel marked on the difference: its A − B of this comparison (it kept the value
     // of the sensor and channel compared before), or none where this one has no such pixel
     const mark = $("diff-image").dataset.mark;
@@ -512,19 +512,42 @@ function paint(canvas, cube, values, lo, hi, map, ignore) {
 }
 
 // The image's size on screen: a whole number of screen pixels per pixel, up to 512 px a
-// side, less in a narrow pane (the colour bar beside it, 110 px); again at every resize.
-// A pane out of sight (another tab) has no width: the size waits for the next resize.
+// side, less in a narrow pane (the colour bar beside it, 110 px) or a low one (the pane's
+// toolbar and caption above and under it: at 800 × 600 the caption needed a scroll);
+// again at every resize. A pane out of sight (another tab) has no width: the size waits
+// for the next resize. Its colour bar is drawn then too, at its height.
 function fit(canvas) {
   if (!canvas.dataset.painted) return;
   const pane = canvas.closest("#image-pane, #diff-pane");
   const width = pane?.clientWidth || 0;
-  if (!width && canvas.style.width) return;
-  const room = width - 128;
-  const side = room > 0 ? Math.min(512, room) : 512;
-  const zoom = Math.max(1, Math.floor(side / Math.max(canvas.width, canvas.height)));
-  canvas.style.width = `${canvas.width * zoom}px`;
-  canvas.style.height = `${canvas.height * zoom}px`;
-  drawMarker(canvas);
+  if (width || !canvas.style.width) {
+    const room = width - 128;
+    const side = room > 0 ? Math.min(512, room) : 512;
+    let zoom = Math.floor(side / Math.max(canvas.width, canvas.height));
+    if (width) {
+      const style = getComputedStyle(pane);
+      const others = [...pane.children].filter((c) => !c.contains(canvas)).reduce((h, c) => h + c.offsetHeight, 0);
+      const tall = pane.clientHeight - parseFloat(style.paddingTop) - parseFloat(style.paddingBottom) - others - 2;
+      zoom = Math.min(zoom, Math.floor(tall / canvas.height));
+    }
+    zoom = Math.max(1, zoom);
+    canvas.style.width = `${canvas.width * zoom}px`;
+    canvas.style.height = `${canvas.height * zoom}px`;
+    drawMarker(canvas);
+  }
+  drawBar(canvas);
+}
+
+// The colour bar beside an image, from what was last asked of it (bar.args: drawColourBar's
+// arguments after the canvas, or null for none), as tall as the image is drawn with its
+// border: a fixed 300 px bar made the pane scroll under an image drawn 192 px tall at 800 ×
+// 600. At least 120 px, which its five labels and unit need.
+function drawBar(image) {
+  const bar = $(image.id === "image" ? "colourbar" : "diff-bar");
+  const height = Math.max(120, Math.round(parseFloat(image.style.height) || 0) + 2);
+  if (bar.height !== height) bar.height = height; // (which clears it)
+  if (bar.args) drawColourBar(bar, ...bar.args);
+  else bar.getContext("2d").clearRect(0, 0, bar.width, bar.height);
 }
 
 // The mark of the pixel clicked (canvas.dataset.mark "row,col"), over the image as drawn:
