@@ -5,8 +5,9 @@ the clicked pixel's A − B of the comparison before; the Pixel column's line of
 shown kept the quantity and channel of the click when another was chosen; a `bands`
 run's directory, which has no pixels, left the column holding the pixel of the run
 before, shown again under the next run opened; the colour bar stayed 300 px tall beside
-an image drawn 192 px tall at 800 x 600, so the pane scrolled. Each check failed before
-its fix (web/src/results.js)."""
+an image drawn 192 px tall at 800 x 600, so the pane scrolled; a run's warnings (its
+summary.json's) were nowhere on the page, so a σ of 0.000 K not estimated read as exact.
+Each check failed before its fix (web/src/results.js)."""
 import json
 import os
 import re
@@ -180,3 +181,20 @@ def bar_follows_image(driver, wait, by_id, shot):
         driver.set_window_size(window["width"], window["height"])
     wait.until(lambda d: bar_geometry(d, "image", "colourbar", "image-pane")["bar"] == 514)
     return f"colour bar {g['bar']} px beside an image {g['image']} px tall at 800 x 600, 514 px at 1400"
+
+
+def run_warnings(driver, wait, by_id, root):
+    """A batch frame of one path a sample: its summary.json's warning (no standard error
+    estimated) said above the image, where the Pixel column's σ reads 0.000 K; a run
+    without warnings says nothing there."""
+    out = "teraeye/out-batch/frame-00001"
+    with open(os.path.join(root, out, "summary.json")) as f:
+        warnings = json.load(f)["warnings"]
+    assert any("standard errors are not estimated" in w for w in warnings), warnings
+    view.open_run(driver, wait, by_id, out)
+    note = lambda: by_id("res-note").text if by_id("res-note").is_displayed() else None
+    assert note() == "\n".join(f"warning: {w}" for w in warnings), \
+        f"{out} open, its warnings {warnings} not said: note {note()!r}"
+    view.open_run(driver, wait, by_id, "teraeye/out-seed1")
+    assert note() is None, note()
+    return f"a run's warning said: {warnings[0][:60]!r}"

@@ -574,12 +574,17 @@ function drawMarker(canvas) {
   svg.toggleAttribute("hidden", false);
 }
 
-// A summary.json that is there but damaged (/api/outputs' summary_error): said above the
-// image, which the cubes still give (the run's options, seed and warnings are not known)
+// Above the image: a summary.json that is there but damaged (/api/outputs' summary_error),
+// the cubes still giving the image (the run's options, seed and warnings are not known);
+// else the run's warnings, which say what its images cannot (a σ column of 0.000 K read
+// as exact where paths_per_sample 1 estimated no standard error)
 function summaryNote(outputs) {
   const note = $("res-note");
-  note.hidden = !outputs.summary_error;
-  note.textContent = outputs.summary_error ? `damaged: ${outputs.summary_error} (the run's settings and warnings are not known)` : "";
+  const warnings = outputs.summary?.warnings || [];
+  note.textContent = outputs.summary_error
+    ? `damaged: ${outputs.summary_error} (the run's settings and warnings are not known)`
+    : warnings.map((w) => `warning: ${w}`).join("\n");
+  note.hidden = !note.textContent;
 }
 
 // the sensors of an /api/outputs answer that have brightness temperature images
