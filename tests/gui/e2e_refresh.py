@@ -6,8 +6,9 @@ shown kept the quantity and channel of the click when another was chosen; a `ban
 run's directory, which has no pixels, left the column holding the pixel of the run
 before, shown again under the next run opened; the colour bar stayed 300 px tall beside
 an image drawn 192 px tall at 800 x 600, so the pane scrolled; a run's warnings (its
-summary.json's) were nowhere on the page, so a σ of 0.000 K not estimated read as exact.
-Each check failed before its fix (web/src/results.js)."""
+summary.json's) were nowhere on the page, so a σ of 0.000 K not estimated read as exact;
+the A/B difference's caption did not name the runs compared, under A and B boxes that
+each run opened fills anew. Each check failed before its fix (web/src/results.js)."""
 import json
 import os
 import re
@@ -198,3 +199,26 @@ def run_warnings(driver, wait, by_id, root):
     view.open_run(driver, wait, by_id, "teraeye/out-seed1")
     assert note() is None, note()
     return f"a run's warning said: {warnings[0][:60]!r}"
+
+
+def diff_names_runs(driver, wait, by_id):
+    """The A/B difference's caption names the runs compared: A and B above it may say
+    others (filled anew with each run opened until typed into, or typed into without
+    Compare), while the image is still that of the last Compare."""
+    Select(by_id("res-view")).select_by_value("diff")
+    for box, run in (("diff-a", "teraeye/out-seed1"), ("diff-b", "teraeye/out-seed2")):
+        by_id(box).clear()
+        by_id(box).send_keys(run)
+    by_id("btn-diff").click()
+    caption = lambda: by_id("diff-info").text
+    wait.until(lambda d: "%" in caption())
+    view.open_run(driver, wait, by_id, "teraeye/out-two1")
+    Select(by_id("res-view")).select_by_value("diff")
+    by_id("diff-a").clear()
+    by_id("diff-a").send_keys("teraeye/out-two1")
+    assert caption().startswith("A teraeye/out-seed1, B teraeye/out-seed2: (A − B) / √(σA² + σB²), channel "), \
+        f"A {by_id('diff-a').get_attribute('value')!r}, B {by_id('diff-b').get_attribute('value')!r} " \
+        f"above a difference of out-seed1 and out-seed2 captioned {caption()!r}"
+    said = caption()
+    Select(by_id("res-view")).select_by_value("image")
+    return f"the difference names its runs: {said[:70]!r}"

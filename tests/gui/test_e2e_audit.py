@@ -14,8 +14,8 @@ difference of the channel chosen, the value of the image clicked, the integrator
 the Run tab; the clicked pixel's mark, the image at the window's size, a batch's frames on
 one colour scale and a damaged summary.json (e2e_view.py); the Pixel column of an A/B
 difference compared again, of another quantity chosen and of a bands run's directory,
-the colour bar at the image's height, a run's warnings (e2e_refresh.py). Screenshots go to
-SCREENSHOT_DIR/gui-*.png."""
+the colour bar at the image's height, a run's warnings, the runs an A/B difference
+compared (e2e_refresh.py). Screenshots go to SCREENSHOT_DIR/gui-*.png."""
 import json
 import os
 import re
@@ -370,6 +370,7 @@ def main():
         log(refresh.bands_empties_pixel(driver, wait, by_id, click_list, (32, 32), row, col))
         log(refresh.bar_follows_image(driver, wait, by_id, shot))
         log(refresh.run_warnings(driver, wait, by_id, root))
+        log(refresh.diff_names_runs(driver, wait, by_id))
     except Exception:
         s.failed()
         raise

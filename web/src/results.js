@@ -436,10 +436,13 @@ export class Results {
     const span = sigma ? 4 : Math.max(Math.abs(lo), Math.abs(hi)) || 1;
     this.diffZ = { z, cube, unit: sigma ? "σ" : "K" };
     const channel = `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)`;
+    // the runs compared named: A and B above are filled anew with each run opened, while
+    // this image stays that of the last Compare
+    const runs = `A ${a}, B ${b}: `;
     $("diff-info").textContent = sigma
-      ? `(A − B) / √(σA² + σB²), ${channel}: ${((100 * beyond) / Math.max(count, 1)).toFixed(2)} % of ` +
+      ? `${runs}(A − B) / √(σA² + σB²), ${channel}: ${((100 * beyond) / Math.max(count, 1)).toFixed(2)} % of ` +
         `${count} pixels beyond ±3 σ (0.27 % expected if A and B agree within their errors)`
-      : `A − B in K, ${channel} (a run without standard errors: no σ to compare with)`;
+      : `${runs}A − B in K, ${channel} (a run without standard errors: no σ to compare with)`;
     $("diff-bar").args = [-span, span, this.diffZ.unit, diverging];
     paint($("diff-image"), cube, z, -span, span, diverging, null);
     // the pixel marked on the difference: its A − B of this comparison (it kept the value
