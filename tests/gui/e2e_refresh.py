@@ -8,7 +8,9 @@ before, shown again under the next run opened; the colour bar stayed 300 px tall
 an image drawn 192 px tall at 800 x 600, so the pane scrolled; a run's warnings (its
 summary.json's) were nowhere on the page, so a σ of 0.000 K not estimated read as exact;
 the A/B difference's caption did not name the runs compared, under A and B boxes that
-each run opened fills anew. Each check failed before its fix (web/src/results.js)."""
+each run opened fills anew; a one-channel spectrum's frequency axis ran from −0.15 THz,
+its first tick's label over the lowest y tick's. Each check failed before its fix
+(web/src/results.js, plots.js)."""
 import json
 import os
 import re
@@ -222,3 +224,27 @@ def diff_names_runs(driver, wait, by_id):
     said = caption()
     Select(by_id("res-view")).select_by_value("image")
     return f"the difference names its runs: {said[:70]!r}"
+
+
+def one_channel_plot(driver, wait, by_id):
+    """A pixel of a one-channel frame: its spectrum's frequency axis about the channel
+    (0.35 THz), no tick below 0 THz, each tick's label and the axes' names inside the
+    plot and apart from each other."""
+    view.open_run(driver, wait, by_id, "teraeye/out-batch/frame-00000")
+    readouts.click_pixel(driver, wait, by_id, "image", 8, 12, 5, 7)
+    wait.until(lambda d: d.find_elements("css selector", "#pixel-plot svg"))
+    ticks, boxes, frame = driver.execute_script(
+        "const svg = document.querySelector('#pixel-plot svg'); const f = svg.getBoundingClientRect();"
+        "const texts = [...svg.querySelectorAll('text')].filter((t) => !t.hasAttribute('style'));"
+        "return [texts.filter((t) => t.getAttribute('text-anchor') !== 'end' && !t.hasAttribute('transform'))"
+        " .map((t) => t.textContent), texts.map((t) => { const b = t.getBoundingClientRect();"
+        " return [t.textContent, b.left, b.top, b.right, b.bottom]; }), [f.left, f.top, f.right, f.bottom]];")
+    freqs = [float(t) for t in ticks if t != "frequency (THz)"]
+    assert len(freqs) == 5 and min(freqs) > 0 and freqs[0] < 0.35 < freqs[-1] and freqs[-1] - freqs[0] < 0.2, freqs
+    for name, left, top, right, bottom in boxes:
+        assert left >= frame[0] - 0.5 and right <= frame[2] + 0.5, f"{name!r} [{left}, {right}] beyond the plot {frame}"
+    for a in boxes:
+        for b in boxes:
+            overlap = min(a[3], b[3]) - max(a[1], b[1]) > 0.5 and min(a[4], b[4]) - max(a[2], b[2]) > 0.5
+            assert a is b or not overlap, f"{a[0]!r} over {b[0]!r}"
+    return f"one channel's spectrum on {freqs[0]:g} to {freqs[-1]:g} THz"

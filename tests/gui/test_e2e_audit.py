@@ -371,6 +371,7 @@ def main():
         log(refresh.bar_follows_image(driver, wait, by_id, shot))
         log(refresh.run_warnings(driver, wait, by_id, root))
         log(refresh.diff_names_runs(driver, wait, by_id))
+        log(refresh.one_channel_plot(driver, wait, by_id))
     except Exception:
         s.failed()
         raise

@@ -16,7 +16,9 @@ function el(name, attrs, parent) {
 export function linePlot(container, series, axes) {
   const W = 320;
   const Hh = 150;
-  const m = { l: 48, r: 8, t: 8, b: 30 };
+  // room for the y ticks' five digits beside the axis's name, and for half of the last
+  // x tick's label (it was cut off at the right edge)
+  const m = { l: 54, r: 14, t: 8, b: 30 };
   const svg = el("svg", { viewBox: `0 0 ${W} ${Hh}`, class: "plot" });
   const xs = series.flatMap((s) => s.x);
   const ys = series.flatMap((s) => s.y.map((y, i) => [y - (s.err?.[i] || 0), y + (s.err?.[i] || 0)]).flat());
@@ -26,7 +28,9 @@ export function linePlot(container, series, axes) {
   let y1 = axes.yMax ?? Math.max(...finite(ys));
   if (!Number.isFinite(x0)) [x0, x1] = [0, 1];
   if (!Number.isFinite(y0) || !Number.isFinite(y1)) [y0, y1] = [0, 1];
-  if (x1 === x0) [x0, x1] = [x0 - 0.5, x1 + 0.5];
+  // one x (a one-channel run's spectrum): ±10 % about it (±0.5 made 0.35 THz's axis run
+  // from −0.15 THz, a frequency no channel has)
+  if (x1 === x0) [x0, x1] = [x0 - (0.1 * Math.abs(x0) || 0.5), x1 + (0.1 * Math.abs(x0) || 0.5)];
   // a flat curve: a unit range about it, but never past a bound the caller set (α ≡ 0
   // with yMin 0: 0…1, not −0.5…0.5)
   if (y1 === y0) {
@@ -40,7 +44,8 @@ export function linePlot(container, series, axes) {
   for (let i = 0; i <= 4; i++) {
     const xv = x0 + (i / 4) * (x1 - x0);
     const yv = y0 + (i / 4) * (y1 - y0);
-    el("text", { x: px(xv), y: Hh - m.b + 11, "text-anchor": "middle" }, svg).textContent = formatNumber(xv);
+    // the first x tick's label from its tick on: centred, it ran into the lowest y tick's
+    el("text", { x: px(xv), y: Hh - m.b + 11, "text-anchor": i ? "middle" : "start" }, svg).textContent = formatNumber(xv);
     el("text", { x: m.l - 3, y: py(yv) + 3, "text-anchor": "end" }, svg).textContent = formatNumber(yv);
   }
   el("text", { x: (W + m.l) / 2, y: Hh - 3, "text-anchor": "middle" }, svg).textContent = axes.xLabel;
