@@ -145,7 +145,7 @@ def difference(driver, wait, by_id, a, b, band):
     row, col = max(((r, c) for r in range(rows) for c in range(cols) if r != c and finite[r, c]),
                    key=lambda rc: abs(z[rc] - z[rc[::-1]]))
     click_pixel(driver, wait, by_id, "diff-image", rows, cols, row, col)
-    wait.until(lambda d: by_id("pixel-info").text.startswith(f"row {row}, column {col}: A − B = "))
+    wait.until(lambda d: by_id("pixel-info").text.startswith(f"row {row}, column {col} of the A/B difference: A − B = "))
     m = re.search(r"A − B = (\S+) σ$", by_id("pixel-info").text)
     assert m and abs(float(m.group(1)) - z[row, col]) <= 1e-3 * abs(z[row, col]) + 1e-4, \
         (by_id("pixel-info").text, z[row, col])

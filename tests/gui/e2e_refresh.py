@@ -9,7 +9,8 @@ an image drawn 192 px tall at 800 x 600, so the pane scrolled; a run's warnings 
 summary.json's) were nowhere on the page, so a σ of 0.000 K not estimated read as exact;
 the A/B difference's caption did not name the runs compared, under A and B boxes that
 each run opened fills anew; a one-channel spectrum's frequency axis ran from −0.15 THz,
-its first tick's label over the lowest y tick's. Each check failed before its fix
+its first tick's label over the lowest y tick's; a pixel of the difference read, in the
+image view, as of the image shown. Each check failed before its fix
 (web/src/results.js, plots.js)."""
 import json
 import os
@@ -89,6 +90,11 @@ def diff_compared_again(driver, wait, by_id, root):
                f"{z2[row, col]:.4g} σ (channel 1's {z1[row, col]:.4g} σ)")
     view.marked_at(driver, "diff-image", (8, 12), row, col)
     said = f"({row}, {col}) A − B {pixel_diff(driver)[2]} σ at channel 2"
+    # in the image view (no mark there) the column says which image its pixel is of
+    Select(by_id("res-view")).select_by_value("image")
+    assert by_id("pixel-info").text.startswith(f"row {row}, column {col} of the A/B difference: A − B = "), \
+        f"the image view shows {by_id('pixel-info').text!r}, a pixel of the A/B difference"
+    Select(by_id("res-view")).select_by_value("diff")
     Select(by_id("res-sensor")).select_by_value("small")
     wait.until(lambda d: pixel_diff(d) == (None, None, None) and not d.execute_script(view.GEOMETRY, "diff-image")["shown"],
                f"sensor small (6 x 4) compared: the Pixel column still shows {pixel_diff(driver)}")

@@ -466,7 +466,10 @@ export class Results {
     const info = $("pixel-info");
     info.dataset.row = row;
     info.dataset.col = col;
-    info.textContent = `row ${row}, column ${col}: A − B = ${formatNumber(this.diffZ.z[row * this.diffZ.cube.cols + col])} ${this.diffZ.unit}`;
+    // the image it is of named: in the image view, whose pixel is not marked, the line read
+    // as of the image shown
+    info.textContent = `row ${row}, column ${col} of the A/B difference: ` +
+      `A − B = ${formatNumber(this.diffZ.z[row * this.diffZ.cube.cols + col])} ${this.diffZ.unit}`;
     // the spectrum and table below were those of the pixel last clicked on the image
     $("pixel-plot").replaceChildren();
     $("pixel-table").replaceChildren();
