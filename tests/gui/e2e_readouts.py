@@ -66,9 +66,11 @@ def close(shown, value, digits=4):
 
 
 def image_scale(driver, wait, by_id, tb, freq_thz, band):
-    """Channel band+1 chosen by its label: the caption names it, the colours span the 1st
-    to 99th percentile of that channel in K, each pixel's colour is viridis there, and the
-    colour bar runs from the hottest (top) to the coldest with its labels and unit K."""
+    """Channel band+1 chosen by its label: the caption names it as the Channel list and
+    the photon view's list do (the scene loader's name of an unnamed channel, "0.600 THz";
+    the caption said "0.6 THz"), the colours span the 1st to 99th percentile of that
+    channel in K, each pixel's colour is viridis there, and the colour bar runs from the
+    hottest (top) to the coldest with its labels and unit K."""
     driver.execute_script(HOOK)
     Select(by_id("res-quantity")).select_by_value("brightness_temperature")
     choice = Select(by_id("res-channel"))
@@ -76,7 +78,11 @@ def image_scale(driver, wait, by_id, tb, freq_thz, band):
     choice.select_by_visible_text(label)
     caption = lambda: by_id("image-info").get_attribute("textContent")
     wait.until(lambda d: caption().startswith(f"brightness temperature, channel {band + 1} ("))
-    assert f"channel {band + 1} ({freq_thz[band]:g} THz)" in caption(), caption()
+    name = label.split(": ", 1)[1]
+    assert name == f"{freq_thz[band]:.3f} THz", label
+    assert f"channel {band + 1} ({name})" in caption(), caption()
+    photon_list = [o.get_attribute("textContent") for o in Select(by_id("ph-channel")).options]
+    assert photon_list == [o.text.split(": ", 1)[1] for o in choice.options], photon_list
     lo, hi = percentiles(tb[band])
     m = re.search(r"percentile: (\S+) to (\S+) K$", caption())
     assert m and close(float(m.group(1)), lo) and close(float(m.group(2)), hi), (caption(), lo, hi)
@@ -129,7 +135,7 @@ def difference(driver, wait, by_id, a, b, band):
     wait.until(lambda d: "beyond" in by_id("diff-info").text)
     info = by_id("diff-info").text
     freq = a[2][band] / 1e12
-    assert f"channel {band + 1} ({freq:g} THz)" in info, info
+    assert f"channel {band + 1} ({freq:.3f} THz)" in info, info  # as the Channel list names it
     za = tb_sigma(a[0][band], a[1][band], a[2][band])
     zb = tb_sigma(b[0][band], b[1][band], a[2][band])
     z = (a[0][band].astype(float) - b[0][band]) / np.sqrt(za ** 2 + zb ** 2)

@@ -1,6 +1,7 @@
 // ENVI cubes as thzmap writes them (float32, little-endian, band-sequential, no header
 // bytes): read once whole through /api/file, then every pixel is an array lookup.
 import { getBytes, getText, q } from "./api.js";
+import { formatNumber } from "./colour.js";
 
 export function parseHeader(text) {
   const h = {};
@@ -48,6 +49,12 @@ export function loadCube(path) {
         },
         band(b) {
           return data.subarray(b * rows * cols, (b + 1) * rows * cols);
+        },
+        // channel b as the Channel list, the captions and the Pixel column name it: its
+        // name in the header (the scene's, or its centre as the scene loader writes it,
+        // "0.200 THz"), else its centre
+        channelName(b) {
+          return this.bandNames[b] || `${formatNumber(this.freqThz[b])} THz`;
         },
       };
     })();

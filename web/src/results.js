@@ -178,9 +178,9 @@ export class Results {
     const tb = this.tb;
     const keepCh = $("res-channel").value;
     $("res-channel").replaceChildren(...Array.from({ length: tb.bands }, (_, b) =>
-      new Option(`${b + 1}: ${tb.bandNames[b] || `${formatNumber(tb.freqThz[b])} THz`}`, b, false, String(b) === keepCh)));
+      new Option(`${b + 1}: ${tb.channelName(b)}`, b, false, String(b) === keepCh)));
     const phCh = $("ph-channel");
-    phCh.replaceChildren(...Array.from({ length: tb.bands }, (_, b) => new Option(`${formatNumber(tb.freqThz[b])} THz`, b)));
+    phCh.replaceChildren(...Array.from({ length: tb.bands }, (_, b) => new Option(tb.channelName(b), b)));
     const names = this.truthId?.header["object names"] || [];
     $("ph-object").replaceChildren(new Option("all", ""), ...names.map((n) => new Option(n, n)));
     status(`${base}: ${tb.cols} × ${tb.rows} pixels, ${tb.bands} channel${tb.bands === 1 ? "" : "s"}, loaded in ${Math.round(performance.now() - t0)} ms`);
@@ -246,7 +246,7 @@ export class Results {
     const [lo, hi] = over ? over.range : common ? range(cube.data, ignore) : range(values, ignore);
     // the truth maps hold one band whatever the run; a one-channel run's cubes one channel
     // (the caption before the image, which is fitted to the room the caption leaves)
-    const which = TRUTH.has(qn) ? "truth" : `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)`;
+    const which = TRUTH.has(qn) ? "truth" : `channel ${band + 1} (${cube.channelName(band)})`;
     $("image-info").textContent = `${qn.replace(/_/g, " ")}, ${which}; colours span the 1st to 99th ` +
       `percentile${common ? " of all channels" : ""}${over ? ` of all ${over.frames} frames (one scale)` : ""}: ` +
       `${formatNumber(lo)} to ${formatNumber(hi)}${cube.unit === "1" ? "" : ` ${cube.unit}`}`;
@@ -364,7 +364,7 @@ export class Results {
       const line = document.createElement("div");
       line.id = "pixel-shown";
       line.dataset.value = String(v);
-      line.textContent = `${qn.replace(/_/g, " ")}, channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz): ` +
+      line.textContent = `${qn.replace(/_/g, " ")}, channel ${band + 1} (${cube.channelName(band)}): ` +
         `${formatNumber(v)}${cube.unit === "1" ? "" : ` ${cube.unit}`}`;
       info.appendChild(line);
     }
@@ -436,7 +436,7 @@ export class Results {
     const [lo, hi] = sigma ? [-4, 4] : range(z, null);
     const span = sigma ? 4 : Math.max(Math.abs(lo), Math.abs(hi)) || 1;
     this.diffZ = { z, cube, unit: sigma ? "σ" : "K" };
-    const channel = `channel ${band + 1} (${formatNumber(cube.freqThz[band])} THz)`;
+    const channel = `channel ${band + 1} (${cube.channelName(band)})`;
     // the runs compared named: A and B above are filled anew with each run opened, while
     // this image stays that of the last Compare
     const runs = `A ${a}, B ${b}: `;
