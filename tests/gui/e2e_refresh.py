@@ -10,7 +10,8 @@ summary.json's) were nowhere on the page, so a σ of 0.000 K not estimated read 
 the A/B difference's caption did not name the runs compared, under A and B boxes that
 each run opened fills anew; a one-channel spectrum's frequency axis ran from −0.15 THz,
 its first tick's label over the lowest y tick's; a pixel of the difference read, in the
-image view, as of the image shown. Each check failed before its fix
+image view, as of the image shown; a directory holding neither images nor bands.json
+left the run before's image on screen. Each check failed before its fix
 (web/src/results.js, plots.js)."""
 import json
 import os
@@ -154,6 +155,29 @@ def bands_empties_pixel(driver, wait, by_id, click_list, size, row, col):
         f"out-seed1 opened after the bands run: the Pixel column shows {view.pixel_values(driver)} of before"
     assert by_id("pixel-info").text == "Click a pixel of the image.", by_id("pixel-info").text
     return "a bands run's directory empties the Pixel column"
+
+
+def empty_dir_clears(driver, wait, by_id, click_list, root, size, row, col):
+    """A directory holding neither images nor bands.json opened after out-seed1, a pixel
+    clicked: the status line says so, and the run before's image, its caption, its
+    controls and the Pixel column are gone (the image stayed, under a line saying there
+    was none); out-seed1 opened again shows its image."""
+    os.makedirs(os.path.join(root, "teraeye", "notes"), exist_ok=True)
+    with open(os.path.join(root, "teraeye", "notes", "readme.txt"), "w") as f:
+        f.write("no run here\n")
+    view.open_run(driver, wait, by_id, "teraeye/out-seed1")
+    readouts.click_pixel(driver, wait, by_id, "image", *size, row, col)
+    wait.until(lambda d: view.pixel_values(d)[:2] == (str(row), str(col)))
+    driver.execute_script("window.thzmap.results.browse('teraeye')")
+    click_list("outputs", "notes/")
+    wait.until(lambda d: by_id("status").text == "teraeye/notes: no images or bands.json here")
+    shown = [i for i in ("image", "image-info", "colourbar", "diff-image", "res-sensor", "pixel-info")
+             if by_id(i).is_displayed()]
+    assert not shown, f"a directory without images open, still shown of out-seed1: {shown}"
+    assert view.pixel_values(driver) == (None, None, []), view.pixel_values(driver)
+    view.open_run(driver, wait, by_id, "teraeye/out-seed1")
+    assert by_id("image").is_displayed() and by_id("res-sensor").is_displayed()
+    return "a directory without images clears the image of the run before"
 
 
 def bar_geometry(driver, image, bar, pane):

@@ -15,7 +15,7 @@ the Run tab; the clicked pixel's mark, the image at the window's size, a batch's
 one colour scale and a damaged summary.json (e2e_view.py); the Pixel column of an A/B
 difference compared again, of another quantity chosen and of a bands run's directory,
 the colour bar at the image's height, a run's warnings, the runs an A/B difference
-compared (e2e_refresh.py). Screenshots go to SCREENSHOT_DIR/gui-*.png."""
+compared, a directory without images (e2e_refresh.py). Screenshots go to SCREENSHOT_DIR/gui-*.png."""
 import json
 import os
 import re
@@ -368,6 +368,7 @@ def main():
         log(refresh.diff_compared_again(driver, wait, by_id, root))
         log(refresh.value_follows_quantity(driver, wait, by_id, root, bands, (32, 32), row, col))
         log(refresh.bands_empties_pixel(driver, wait, by_id, click_list, (32, 32), row, col))
+        log(refresh.empty_dir_clears(driver, wait, by_id, click_list, root, (32, 32), row, col))
         log(refresh.bar_follows_image(driver, wait, by_id, shot))
         log(refresh.run_warnings(driver, wait, by_id, root))
         log(refresh.diff_names_runs(driver, wait, by_id))

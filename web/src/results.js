@@ -49,7 +49,7 @@ export class Results {
 
   setView(view) {
     $("bands-pane").hidden = true; // shown by open() alone, for a bands run's directory
-    $("view-results").classList.remove("bands");
+    $("view-results").classList.remove("bands", "empty"); // (open() sets either)
     $("image-pane").hidden = view !== "image";
     $("photon-pane").hidden = view !== "photons";
     $("diff-pane").hidden = view !== "diff";
@@ -108,15 +108,24 @@ export class Results {
     if (names.includes("bands.json")) {
       const doc = await getJSON(`/api/file?path=${q(join(dir, "bands.json"))}`);
       if (seq !== this.openSeq) return;
-      for (const pane of ["image-pane", "photon-pane", "diff-pane"]) $(pane).hidden = true;
-      // no pixel here: the run opened next starts with an empty column (it showed the
-      // pixel clicked before this directory, of a run that may be long gone from mind)
-      this.clearPixel();
+      this.hideImages();
       showBands(dir, doc, names);
       status(`${dir}: a bands run, ${doc.count} channel${doc.count === 1 ? "" : "s"} chosen`);
       return;
     }
+    // nothing of this directory to show: nor the run opened before (its image stayed,
+    // under a status line that said there was none), nor its controls
+    this.hideImages();
+    $("view-results").classList.add("empty");
     status(`${dir}: no images or bands.json here`);
+  }
+
+  // A directory without images opened: the image, photon and difference panes hidden, and
+  // no pixel: the run opened next starts with an empty column (it showed the pixel clicked
+  // before this directory, of a run that may be long gone from mind)
+  hideImages() {
+    for (const pane of ["image-pane", "photon-pane", "diff-pane"]) $(pane).hidden = true;
+    this.clearPixel();
   }
 
   cubesOf(sensor) {
