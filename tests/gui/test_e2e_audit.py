@@ -15,7 +15,8 @@ the Run tab; the clicked pixel's mark, the image at the window's size, a batch's
 one colour scale and a damaged summary.json (e2e_view.py); the Pixel column of an A/B
 difference compared again, of another quantity chosen and of a bands run's directory,
 the colour bar at the image's height, a run's warnings, the runs an A/B difference
-compared, a directory without images (e2e_refresh.py). Screenshots go to SCREENSHOT_DIR/gui-*.png."""
+compared, a directory without images (e2e_refresh.py); the build's revision in the
+status line. Screenshots go to SCREENSHOT_DIR/gui-*.png."""
 import json
 import os
 import re
@@ -339,6 +340,12 @@ def main():
         s.start()
         driver, wait, patient, by_id = s.driver, s.wait, s.patient, s.by_id
         shot, click_list, field = s.shot, s.click_list, s.field
+        # the status line names the build as `thzmap --version` does, its revision too
+        # (/api/info's "revision"; the line said "thzmap 0.1.0" alone)
+        version = subprocess.run([THZMAP, "--version"], capture_output=True, text=True, check=True).stdout.strip()
+        assert "(revision " in version, version
+        wait.until(lambda d: by_id("status").text.startswith("thzmap "))
+        assert by_id("status").text.startswith(f"{version} · root "), (by_id("status").text, version)
         click_list("files", "teraeye/")
         click_list("files", "scene.json")
         wait.until(lambda d: "✓" in by_id("validation-state").text)

@@ -40,7 +40,10 @@ document.addEventListener("show-results", (e) => {
 (async () => {
   try {
     const info = await getJSON("/api/info");
-    status(`thzmap ${info.version || ""} · root ${info.root || ""}`);
+    // the revision names the build between releases (docs/gui.md); a server without it
+    // says the version alone
+    const revision = info.revision ? ` (revision ${info.revision})` : "";
+    status(`thzmap ${info.version || ""}${revision} · root ${info.root || ""}`);
     await editor.listFiles("");
     await results.browse("");
     await runs.refresh();
