@@ -26,17 +26,13 @@ void atm_table_key_add(atm_table_key *key, const void *data, size_t n)
 {
     if (key->failed)
         return;
-    if (n > key->cap - key->n) {
-        size_t cap = key->cap ? key->cap : 256;
-        while (cap - key->n < n && cap <= SIZE_MAX / 2)
-            cap *= 2;
-        unsigned char *bytes = cap - key->n >= n ? realloc(key->bytes, cap) : NULL;
+    while (n > key->cap - key->n) {
+        unsigned char *bytes = thz_grow_array(key->bytes, &key->cap, 256, 1);
         if (!bytes) {
             key->failed = true;
             return;
         }
         key->bytes = bytes;
-        key->cap = cap;
     }
     memcpy(key->bytes + key->n, data, n);
     key->n += n;
