@@ -8,10 +8,12 @@
 #include <pthread.h>
 #include <stdbool.h>
 #include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -193,16 +195,23 @@ static thz_status child_finish(const char *what, child_proc *c, double timeout_s
     if (timed_out)
         return thz_error_set(err, THZ_ERR_IO, "failed while %s: no result after %.0f s (stopped)",
                              what, timeout_s);
+    /* the child shares the parent's ulimit -v, and starts with its address space: GLib
+     * ends it (SIGTRAP) when it cannot map a thread's stack there */
+    char limited[96] = "";
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY)
+        snprintf(limited, sizeof limited, " (the address space is limited: ulimit -v %llu KiB)",
+                 (unsigned long long)rl.rlim_cur / 1024);
     if (WIFSIGNALED(ws))
         return thz_error_set(err, THZ_ERR_IO,
-                             "failed while %s: the process doing it ended by signal %d (%s)", what,
-                             WTERMSIG(ws), strsignal(WTERMSIG(ws)));
+                             "failed while %s: the process doing it ended by signal %d (%s)%s",
+                             what, WTERMSIG(ws), strsignal(WTERMSIG(ws)), limited);
     if (got != sizeof report || !WIFEXITED(ws) || WEXITSTATUS(ws) != 0)
         return thz_error_set(err, THZ_ERR_IO,
                              "failed while %s: the process doing it stopped with exit status %d "
                              "before it finished (a library it uses ends the process when it "
-                             "runs out of memory)",
-                             what, WIFEXITED(ws) ? WEXITSTATUS(ws) : -1);
+                             "runs out of memory)%s",
+                             what, WIFEXITED(ws) ? WEXITSTATUS(ws) : -1, limited);
     report.message[sizeof report.message - 1] = '\0';
     if (report.status == THZ_OK)
         return THZ_OK;

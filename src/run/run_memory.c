@@ -75,6 +75,19 @@ static void run_memory_remedy(const thz_scene *scene, const run_memory *need, ui
     }
 }
 
+/* The ulimit -v (KiB) to suggest for a run needing `need` bytes of address space: its 90 %
+ * rule, 16 MiB to spare, in 4 MiB steps. The address space mapped before the check moves
+ * from run to run by a few KiB (the environment, the libraries' placement): a limit of
+ * exactly the need refused a later run by 84 KiB (tests/cli/test_address_space_limit.sh
+ * under ctest -j2, 2026-12-08). Not more: a limit with room for another thread's stack
+ * and 64 MiB arena lets thz_threads_prepare start it, and the run then needs that too
+ * (a render refused at 250000 KiB on 1 thread, told 360448, was refused there on 2). */
+static double run_memory_limit_kib(double need)
+{
+    const double step = 4096.0; /* KiB */
+    return ceil((need / 0.9 / 1024.0 + 16384.0) / step) * step;
+}
+
 thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_error *err)
 {
     const char *path = scene->path ? scene->path : "the scene";
@@ -98,7 +111,7 @@ thz_status run_check_memory(const thz_scene *scene, const run_memory *need, thz_
             path, as_need / mib, (double)need->photon_bytes / mib, (double)need->image_bytes / mib,
             (double)need->mapped_bytes / mib,
             (unsigned long long)(need->address_limit_bytes / 1024),
-            (double)need->address_limit_bytes / mib, ceil(as_need / 0.9 / 1024.0), remedy);
+            (double)need->address_limit_bytes / mib, run_memory_limit_kib(as_need), remedy);
     }
     if (need->available_bytes == 0)
         return THZ_OK; /* unknown: let the allocations decide */
