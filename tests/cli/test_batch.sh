@@ -182,6 +182,10 @@ pid=$!
 wait_frames "$work/B" $((n1 + 2)) $pid
 kill -KILL -- -$pid 2>/dev/null
 wait $pid 2>/dev/null
+# and until the group's other members (a figure's process) are gone: they share OUTDIR's
+# lock, which the kernel lets go as the last of them exits (a resume a few ms earlier was
+# refused, "another thzmap batch is running", in a fresh-clone check on 2 busy cores)
+for _ in $(seq 1 250); do pgrep -g $pid > /dev/null || break; sleep 0.02; done
 n2=$(frames_done "$work/B")
 echo "interrupted after $n1 frame(s) (SIGTERM), killed after $n2 (SIGKILL)"
 [ "$n2" -lt 5 ] || echo "note: the SIGKILL came after the last frame"
